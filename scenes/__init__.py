@@ -1,0 +1,22 @@
+"""The scenes, one registry, and the switcher that shows one scene at a time on a viser server.
+
+Add a scene by writing ``scenes/<name>.py`` with a :class:`~scenes._base.Scene` subclass and one line in
+:data:`SCENES` (and its key in :data:`SceneName`, which the CLI offers).
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+from scenes._base import Scene
+from scenes.peloton import PelotonScene
+
+SceneName = Literal["peloton"]
+"""Keys of :data:`SCENES`, for the command line."""
+
+SCENES: dict[str, type[Scene]] = {
+    PelotonScene.key: PelotonScene,
+}
+"""Every scene that exists, in switcher order."""
+
+__all__ = ["SCENES", "Scene", "SceneName"]

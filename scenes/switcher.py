@@ -1,0 +1,56 @@
+"""The scene switcher: a dropdown that tears the shown scene down completely and builds the chosen one."""
+
+from __future__ import annotations
+
+import logging
+import threading
+
+import viser
+
+from scenes import SCENES, Scene
+
+logger = logging.getLogger(__name__)
+
+
+class SceneSwitcher:
+    """Owns the one live scene on ``server`` and the dropdown that picks it."""
+
+    def __init__(self, server: viser.ViserServer, initial: str) -> None:
+        if initial not in SCENES:
+            raise ValueError(f"scene must be one of {sorted(SCENES)}, got {initial!r}")
+        self.server = server
+        self._lock = threading.RLock()
+        titles = {cls.title: key for key, cls in SCENES.items()}
+        self._key_from_title = titles
+        self.dropdown = server.gui.add_dropdown(
+            "Scene", options=tuple(titles), initial_value=SCENES[initial].title, order=-100.0
+        )
+        self.scene: Scene = SCENES[initial](server)
+        self.dropdown.on_update(self._on_pick)
+
+    def show(self, key: str) -> Scene:
+        """Replace the current scene with ``key``'s (a no-op when it is already shown)."""
+        if key not in SCENES:
+            raise ValueError(f"scene must be one of {sorted(SCENES)}, got {key!r}")
+        with self._lock:
+            if self.scene.key != key:
+                self.scene.close()
+                self.scene = SCENES[key](self.server)
+            if self.dropdown.value != SCENES[key].title:
+                self.dropdown.value = SCENES[key].title
+            return self.scene
+
+    def _on_pick(self, _event: object) -> None:
+        key = self._key_from_title.get(str(self.dropdown.value))
+        if key is None:  # not one of ours: a crafted message; show what is really on screen
+            self.dropdown.value = self.scene.title
+            return
+        try:
+            self.show(key)
+        except Exception:
+            logger.exception("switching to %s failed", key)
+
+    def close(self) -> None:
+        with self._lock:
+            self.scene.close()
+            self.dropdown.remove()
