@@ -123,7 +123,11 @@ class LineState:
 
     @property
     def saving(self) -> np.ndarray:
-        return 1.0 - self.power.total / float(self.solo.total)
+        """(n,) fraction of the solo rider's power each rider saves; zero when riding alone costs nothing."""
+        solo = float(self.solo.total)
+        if solo <= 0.0:
+            return np.zeros_like(self.power.total)
+        return 1.0 - self.power.total / solo
 
 
 def compute_line(p: PelotonParams) -> LineState:

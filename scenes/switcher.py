@@ -25,15 +25,17 @@ class SceneSwitcher:
         self.dropdown = server.gui.add_dropdown(
             "Scene", options=tuple(titles), initial_value=SCENES[initial].title, order=-100.0
         )
+        self.reset_button = server.gui.add_button("Reset scene to defaults", order=-99.0)
         self.scene: Scene = SCENES[initial](server)
         self.dropdown.on_update(self._on_pick)
+        self.reset_button.on_click(self._on_reset)
 
-    def show(self, key: str) -> Scene:
-        """Replace the current scene with ``key``'s (a no-op when it is already shown)."""
+    def show(self, key: str, *, rebuild: bool = False) -> Scene:
+        """Replace the current scene with ``key``'s; when it is already shown, only ``rebuild`` rebuilds it."""
         if key not in SCENES:
             raise ValueError(f"scene must be one of {sorted(SCENES)}, got {key!r}")
         with self._lock:
-            if self.scene.key != key:
+            if self.scene.key != key or rebuild:
                 self.scene.close()
                 self.scene = SCENES[key](self.server)
             if self.dropdown.value != SCENES[key].title:
@@ -50,7 +52,14 @@ class SceneSwitcher:
         except Exception:
             logger.exception("switching to %s failed", key)
 
+    def _on_reset(self, _event: object) -> None:
+        try:
+            self.show(self.scene.key, rebuild=True)
+        except Exception:
+            logger.exception("resetting %s failed", self.scene.key)
+
     def close(self) -> None:
         with self._lock:
             self.scene.close()
             self.dropdown.remove()
+            self.reset_button.remove()

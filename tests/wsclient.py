@@ -208,7 +208,10 @@ class BrowserClient:
 
     def set_value(self, label: str, value: Any) -> None:
         """What a browser sends when a person moves the slider (or edits the input) labelled ``label``."""
-        self.send("GuiUpdateMessage", uuid=self.uuid_of(label), updates={"value": value})
+        uuid = self.uuid_of(label)
+        with self._lock:  # the browser shows its own edit at once, as the real one does
+            self.gui[uuid]["value"] = value
+        self.send("GuiUpdateMessage", uuid=uuid, updates={"value": value})
 
     def click(self, label: str) -> None:
         """What a browser sends when a person clicks the button labelled ``label``."""

@@ -1,0 +1,121 @@
+"""The app: loopback by default, a warning for other addresses, and a switcher that leaves nothing behind."""
+
+from __future__ import annotations
+
+import inspect
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+import viser
+from viser_private import gui_uuid, gui_uuids, node_names
+from wsclient import BrowserClient
+
+import app
+from scenes import SCENES
+from scenes.switcher import SceneSwitcher
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_defaults_bind_loopback_port_8080_and_open_peloton() -> None:
+    defaults = {name: p.default for name, p in inspect.signature(app.main).parameters.items()}
+    assert defaults == {"scene": "peloton", "host": "127.0.0.1", "port": 8080}
+
+
+@pytest.mark.parametrize("host", ["127.0.0.1", "localhost", "::1", "127.0.0.2"])
+def test_loopback_hosts_print_no_warning(host: str) -> None:
+    assert app.exposure_warning(host, 8080) is None
+
+
+@pytest.mark.parametrize("host", ["0.0.0.0", "::", "192.168.1.20", "my-laptop.local"])
+def test_other_hosts_warn_what_they_expose(host: str) -> None:
+    warning = app.exposure_warning(host, 9000)
+    assert warning is not None
+    assert f"{host}:9000" in warning and "Anyone who can reach" in warning
+
+
+def test_cli_help_lists_scene_host_and_port() -> None:
+    result = subprocess.run(
+        [sys.executable, str(ROOT / "app.py"), "--help"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=True,
+    )
+    for flag in ("--scene", "--host", "--port"):
+        assert flag in result.stdout
+    for key in SCENES:
+        assert key in result.stdout
+
+
+def test_cli_rejects_an_unknown_scene() -> None:
+    result = subprocess.run(
+        [sys.executable, str(ROOT / "app.py"), "--scene", "pinball"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert result.returncode != 0
+    assert "pinball" in result.stdout + result.stderr
+
+
+def test_every_scene_has_an_about_panel_with_equations_and_sources() -> None:
+    for cls in SCENES.values():
+        about = cls.about.lower()
+        assert len(about) > 300, cls.key
+        assert "assumption" in about, cls.key
+        assert "=" in about, cls.key  # at least one equation
+
+
+def test_switcher_lists_every_scene(switcher: SceneSwitcher) -> None:
+    assert tuple(switcher.dropdown.options) == tuple(cls.title for cls in SCENES.values())
+
+
+def test_switching_removes_every_node_and_gui_element_of_the_old_scene(
+    server: viser.ViserServer,
+) -> None:
+    bare_nodes = node_names(server)
+    keys = list(SCENES)
+    switcher = SceneSwitcher(server, keys[0])
+    switcher_gui = {gui_uuid(switcher.dropdown), gui_uuid(switcher.reset_button)}
+    for key in keys[1:] + keys[:1]:
+        old_nodes = node_names(server) - bare_nodes
+        old_gui = gui_uuids(server)
+        switcher.show(key, rebuild=True)
+        new_nodes = node_names(server) - bare_nodes
+        assert all(name == f"/{key}" or name.startswith(f"/{key}/") for name in new_nodes), key
+        if old_nodes != new_nodes:
+            assert not (old_nodes & new_nodes)
+        assert old_gui & gui_uuids(server) == switcher_gui
+    # Closing the last scene leaves only what the bare server had, plus the switcher's own controls.
+    switcher.scene.close()
+    assert node_names(server) == bare_nodes
+    assert gui_uuids(server) == switcher_gui
+
+
+def test_switching_from_a_browser(server: viser.ViserServer) -> None:
+    switcher = SceneSwitcher(server, "peloton")
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_node("/peloton")
+        for key, cls in SCENES.items():
+            client.set_value("Scene", cls.title)
+            client.wait_for(lambda key=key: switcher.scene.key == key, what=f"switch to {key}")
+            client.wait_for(lambda key=key: f"/{key}" in client.nodes, what=f"/{key} on the client")
+        stale = switcher.scene
+        client.click("Reset scene to defaults")
+        client.wait_for(lambda: switcher.scene is not stale, what="reset to rebuild the scene")
+        client.set_value("Scene", "Not a scene")
+        client.set_value("Scene", SCENES["peloton"].title)
+        client.wait_for(lambda: switcher.scene.key == "peloton", what="back to peloton")
+        client.wait_for(
+            lambda: (
+                not any(
+                    name.startswith("/") and name.split("/")[1] in set(SCENES) - {"peloton"}
+                    for name in client.nodes
+                )
+            ),
+            what="other scenes' nodes gone from the client",
+        )
+    switcher.close()
