@@ -1,0 +1,1023 @@
+"""Inverse kinematics of a chain of rigid links: FABRIK, and the solvers it is compared with.
+
+A chain is ``n + 1`` joint positions ``p_0 … p_n`` in 2D or 3D (``d`` = 2 or 3, metres); ``p_0`` is the fixed root,
+``p_n`` the end effector. Link lengths ``L_i = |p_{i+1} − p_i|`` come from the joints given and never change.
+Batches lead: a batch of chains is ``(B, n + 1, d)`` and its targets ``(B, d)``. Internally the joints are stored
+``(n + 1, d, B)`` so that one joint of every chain is a contiguous block and the passes vectorise over ``B``.
+
+Model and method:
+
+* FABRIK (Aristidou & Lasenby 2011, "FABRIK: a fast, iterative solver for the Inverse Kinematics problem",
+  Graphical Models 73(5)): a forward pass sets ``p_n`` on the target and re-places every joint on the line to the
+  joint before it at the link's length; a backward pass sets ``p_0`` back on the root and does the same outwards.
+  It stops when ``|p_n − target| < tolerance`` or after ``max_iterations``.
+* Reach: a target at distance ``r`` from the root is reachable only if ``max(0, 2·max L − ΣL) ≤ r ≤ ΣL``. Outside
+  that annulus the closest pose is returned at once (stretched straight toward the target, or folded back onto the
+  inner boundary), as the paper does for unreachable targets, unless joint limits or obstacles forbid that pose.
+* Joint limits: each segment stays within a cone of half-angle ``φ`` around the previous segment's direction (the
+  first segment around ``root_direction``). The forward pass clamps each segment against the one placed just before
+  it, the backward pass against its predecessor, so the pose every iteration ends on satisfies every limit
+  (Aristidou & Lasenby 2011, section 4, with a symmetric cone; in 2D the cone is the angle range ``[−φ, φ]``).
+* Obstacles: circles (2D) or spheres (3D). Whenever a pass would place a segment through one, the segment is turned
+  about its anchor, by the least angle, until it only touches it (tangent, or its far end on the surface). The solver
+  keeps the best collision-free pose it has seen and returns that one; "blocked" says that the chain rests against an
+  obstacle without reaching the target. Obstacles that contain the root cannot be avoided and are ignored.
+* Degenerate input never makes NaN: a zero-length link or coincident joints keep the last defined direction, a
+  straight chain whose target lies on its own axis is first bent into a gentle arc (a straight chain otherwise never
+  bends, a known FABRIK complaint), and a target on the root picks the root direction.
+* ``two_bone`` is the analytic law-of-cosines solution for two links; ``ccd`` (cyclic coordinate descent, Wang &
+  Chen 1991) and ``jacobian_dls`` (damped least squares, Wampler 1986; Buss 2004) are the methods the FABRIK paper
+  compared with (its Table 1: 10 joints, FABRIK 15.5 iterations, CCD 26.3, DLS 999). They take the same arguments,
+  honour the same limits and obstacles by projecting every iterate with the constrained backward pass, and return
+  the same result.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable, Sequence
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+Status = Literal["reached", "unreachable", "max_iterations", "blocked"]
+"""Why a solve stopped: target within tolerance; target outside the chain's reach (or outside what the joint limits
+allow: the solver reached a fixed point); iteration cap; resting against an obstacle short of the target."""
+STATUSES: tuple[Status, ...] = ("reached", "unreachable", "max_iterations", "blocked")
+_REACHED, _UNREACHABLE, _MAX_ITERATIONS, _BLOCKED = range(4)
+
+Solver = Literal["fabrik", "ccd", "jacobian_dls"]
+"""The iterative methods; they share arguments, constraints and result."""
+
+Obstacle = tuple[ArrayLike, float]
+"""``(centre (d,) m, radius m)``: a circle in 2D, a sphere in 3D."""
+
+_TINY = 1e-12
+"""Relative length below which a vector has no direction (times the chain's scale)."""
+_CLEARANCE = 1e-6
+"""Segments are turned to clear an obstacle by this fraction of its radius, so rounding never leaves them inside."""
+_STALL = 1e-3
+"""A chain whose joints all moved less than this fraction of the tolerance in an iteration is at a fixed point."""
+_DLS_DAMPING = 0.1
+"""Damping of the DLS step, times the mean link length (Buss 2004 suggests λ of the order of the link size)."""
+
+
+@dataclasses.dataclass(frozen=True)
+class Solution:
+    """One chain's solve."""
+
+    joints: NDArray[np.float64]
+    """(n + 1, d) joint positions of the returned pose (m); ``joints[0]`` is the root."""
+    iterations: int
+    """Iterations run (0 when the starting pose already met the tolerance and every constraint)."""
+    error: float
+    """Final distance from the end effector to the target (m)."""
+    status: Status
+    """Why it stopped; see :data:`Status`."""
+    error_history: NDArray[np.float64]
+    """(iterations + 1,) end-effector distance before the first iteration and after each one (m)."""
+
+
+@dataclasses.dataclass(frozen=True)
+class BatchSolution:
+    """A batch of solves, one entry per chain."""
+
+    joints: NDArray[np.float64]
+    """(B, n + 1, d) joint positions (m)."""
+    iterations: NDArray[np.int64]
+    """(B,) iterations each chain ran."""
+    error: NDArray[np.float64]
+    """(B,) final end-effector distance to the target (m)."""
+    status: NDArray[np.str_]
+    """(B,) status strings, each one of :data:`STATUSES`."""
+    error_history: NDArray[np.float64]
+    """(B, max_iterations + 1) error before the first and after each iteration; NaN after a chain stopped."""
+
+    def __getitem__(self, index: int) -> Solution:
+        """The ``index``-th chain as a :class:`Solution`."""
+        count = int(self.iterations[index])
+        return Solution(
+            joints=self.joints[index],
+            iterations=count,
+            error=float(self.error[index]),
+            status=_status_literal(str(self.status[index])),
+            error_history=self.error_history[index, : count + 1],
+        )
+
+
+# ================================================================================================ public API
+def solve(
+    joints: ArrayLike,
+    target: ArrayLike,
+    *,
+    tolerance: float = 1e-3,
+    max_iterations: int = 50,
+    cone_half_angle_rad: float | None = None,
+    obstacles: Sequence[Obstacle] = (),
+    root_direction: ArrayLike | None = None,
+) -> Solution:
+    """Solve one chain with FABRIK.
+
+    Args:
+        joints: (n + 1, d) starting joint positions (m), d = 2 or 3, n ≥ 1; ``joints[0]`` is the fixed root.
+        target: (d,) target of the end effector (m).
+        tolerance: stop when the end effector is closer than this to the target (m), ≥ 0.
+        max_iterations: iteration cap, ≥ 1.
+        cone_half_angle_rad: joint limit, in [0, π]: the angle between consecutive segments (and between the
+            first segment and ``root_direction``) never exceeds it. None: no limits.
+        obstacles: circles (2D) or spheres (3D) as ``(centre (d,), radius)`` no segment may pass through.
+        root_direction: (d,) rest direction of the root, the axis of the first segment's cone. Default: +y in 2D
+            (the plane's up), +z in 3D.
+
+    Returns:
+        The :class:`Solution`.
+
+    Raises:
+        ValueError: naming the argument, for non-finite values, wrong shapes, n < 1, a negative tolerance, a
+            half-angle outside [0, π], a non-positive radius or max_iterations < 1.
+    """
+    chain = _check_joints("joints", joints, batched=False)
+    point = _check_vector("target", target, chain.shape[1])
+    return solve_batch(
+        chain[None],
+        point[None],
+        tolerance=tolerance,
+        max_iterations=max_iterations,
+        cone_half_angle_rad=cone_half_angle_rad,
+        obstacles=obstacles,
+        root_direction=root_direction,
+    )[0]
+
+
+def solve_batch(
+    joints: ArrayLike,
+    targets: ArrayLike,
+    *,
+    tolerance: float = 1e-3,
+    max_iterations: int = 50,
+    cone_half_angle_rad: float | None = None,
+    obstacles: Sequence[Obstacle] = (),
+    root_direction: ArrayLike | None = None,
+    solver: Solver = "fabrik",
+) -> BatchSolution:
+    """Solve B chains at once, vectorised over the batch; each chain stops on its own.
+
+    Args:
+        joints: (B, n + 1, d) starting joint positions (m), every chain with the same n and d.
+        targets: (B, d) targets (m).
+        tolerance: as in :func:`solve`.
+        max_iterations: as in :func:`solve`.
+        cone_half_angle_rad: as in :func:`solve`, the same for every chain.
+        obstacles: as in :func:`solve`, shared by every chain.
+        root_direction: as in :func:`solve`, shared by every chain.
+        solver: "fabrik", "ccd" or "jacobian_dls".
+
+    Returns:
+        The :class:`BatchSolution`; ``result[i]`` is chain i's :class:`Solution`.
+
+    Raises:
+        ValueError: as :func:`solve`, and for a batch size mismatch or an unknown solver.
+    """
+    chains = _check_joints("joints", joints, batched=True)
+    batch, _, dim = chains.shape
+    points = np.asarray(_finite_array("targets", targets), dtype=np.float64)
+    if points.shape != (batch, dim):
+        raise ValueError(
+            f"targets must have shape ({batch}, {dim}) to match joints, got {points.shape}"
+        )
+    setup = _Setup.build(
+        dim=dim,
+        tolerance=tolerance,
+        max_iterations=max_iterations,
+        cone_half_angle_rad=cone_half_angle_rad,
+        obstacles=obstacles,
+        root_direction=root_direction,
+    )
+    match solver:
+        case "fabrik":
+            step, shortcut = _fabrik_step, True
+        case "ccd":
+            step, shortcut = _ccd_step, False
+        case "jacobian_dls":
+            step, shortcut = _dls_step, False
+        case _:
+            raise ValueError(
+                f"solver must be one of 'fabrik', 'ccd', 'jacobian_dls', got {solver!r}"
+            )
+    return _run(chains, points, setup, step, shortcut=shortcut)
+
+
+def ccd(
+    joints: ArrayLike,
+    target: ArrayLike,
+    *,
+    tolerance: float = 1e-3,
+    max_iterations: int = 50,
+    cone_half_angle_rad: float | None = None,
+    obstacles: Sequence[Obstacle] = (),
+    root_direction: ArrayLike | None = None,
+) -> Solution:
+    """Cyclic coordinate descent: one iteration turns each joint, end to root, to point the end at the target.
+
+    Arguments, result and errors are those of :func:`solve`.
+    """
+    chain = _check_joints("joints", joints, batched=False)
+    point = _check_vector("target", target, chain.shape[1])
+    return solve_batch(
+        chain[None],
+        point[None],
+        tolerance=tolerance,
+        max_iterations=max_iterations,
+        cone_half_angle_rad=cone_half_angle_rad,
+        obstacles=obstacles,
+        root_direction=root_direction,
+        solver="ccd",
+    )[0]
+
+
+def jacobian_dls(
+    joints: ArrayLike,
+    target: ArrayLike,
+    *,
+    tolerance: float = 1e-3,
+    max_iterations: int = 50,
+    cone_half_angle_rad: float | None = None,
+    obstacles: Sequence[Obstacle] = (),
+    root_direction: ArrayLike | None = None,
+) -> Solution:
+    """Damped-least-squares Jacobian IK: ``Δθ = Jᵀ(JJᵀ + λ²I)⁻¹e`` with ball joints (3D) or hinges (2D).
+
+    Arguments, result and errors are those of :func:`solve`.
+    """
+    chain = _check_joints("joints", joints, batched=False)
+    point = _check_vector("target", target, chain.shape[1])
+    return solve_batch(
+        chain[None],
+        point[None],
+        tolerance=tolerance,
+        max_iterations=max_iterations,
+        cone_half_angle_rad=cone_half_angle_rad,
+        obstacles=obstacles,
+        root_direction=root_direction,
+        solver="jacobian_dls",
+    )[0]
+
+
+def two_bone(
+    root: ArrayLike,
+    upper_length: float,
+    lower_length: float,
+    target: ArrayLike,
+    bend_direction: ArrayLike,
+) -> NDArray[np.float64]:
+    """The analytic two-link solution by the law of cosines.
+
+    The elbow sits at angle ``α = acos((L1² + r² − L2²) / (2·L1·r))`` from the root–target line, on the side of
+    ``bend_direction``. A target out of reach (``r > L1 + L2`` or ``r < |L1 − L2|``) gives the closest pose: the
+    chain straight, or folded, along the root–target line.
+
+    Args:
+        root: (d,) root position (m), d = 2 or 3.
+        upper_length: root-to-elbow length (m), ≥ 0.
+        lower_length: elbow-to-end length (m), ≥ 0.
+        target: (d,) target (m).
+        bend_direction: (d,) the side the elbow bends toward (only its part perpendicular to the root–target line
+            counts; if it has none, a fixed perpendicular is used).
+
+    Returns:
+        (3, d) root, elbow and end positions (m).
+
+    Raises:
+        ValueError: naming the argument, for non-finite values, wrong shapes or negative lengths.
+    """
+    p_root = _finite_array("root", root)
+    if p_root.ndim != 1 or p_root.shape[0] not in (2, 3):
+        raise ValueError(f"root must have shape (2,) or (3,), got {p_root.shape}")
+    dim = p_root.shape[0]
+    p_target = _check_vector("target", target, dim)
+    bend = _check_vector("bend_direction", bend_direction, dim)
+    upper = _check_length("upper_length", upper_length)
+    lower = _check_length("lower_length", lower_length)
+
+    offset = p_target - p_root
+    distance = float(np.linalg.norm(offset))
+    scale = max(upper + lower, distance, 1.0)
+    axis = offset / distance if distance > _TINY * scale else _fallback_axis(bend, dim)
+    side = bend - float(bend @ axis) * axis
+    side_norm = float(np.linalg.norm(side))
+    side = side / side_norm if side_norm > _TINY else _perpendicular(axis[:, None])[:, 0]
+
+    reach = min(max(distance, abs(upper - lower)), upper + lower)
+    if upper <= _TINY * scale or reach <= _TINY * scale:
+        cos_alpha = 1.0 if reach >= upper else -1.0
+    else:
+        cos_alpha = (upper**2 + reach**2 - lower**2) / (2.0 * upper * reach)
+    cos_alpha = min(1.0, max(-1.0, cos_alpha))
+    sin_alpha = math.sqrt(max(0.0, 1.0 - cos_alpha**2))
+    elbow = p_root + upper * (cos_alpha * axis + sin_alpha * side)
+    end_offset = p_root + reach * axis - elbow
+    end_norm = float(np.linalg.norm(end_offset))
+    direction = end_offset / end_norm if end_norm > _TINY * scale else axis
+    return np.stack([p_root, elbow, elbow + lower * direction])
+
+
+def link_lengths(joints: ArrayLike) -> NDArray[np.float64]:
+    """Link lengths (m): (n,) for (n + 1, d) joints, (B, n) for (B, n + 1, d)."""
+    chain = np.asarray(joints, dtype=np.float64)
+    return np.linalg.norm(np.diff(chain, axis=-2), axis=-1)
+
+
+def joint_angles(joints: ArrayLike, root_direction: ArrayLike | None = None) -> NDArray[np.float64]:
+    """Angle of each segment to the one before it (the first to ``root_direction``), radians in [0, π].
+
+    Zero-length segments have no direction: they get angle 0 and the next segment is measured against the last
+    segment that has one.
+
+    Args:
+        joints: (n + 1, d) joint positions (m).
+        root_direction: (d,) as in :func:`solve`.
+
+    Returns:
+        (n,) angles (rad).
+    """
+    chain = _check_joints("joints", joints, batched=False)
+    dim = chain.shape[1]
+    previous = _root_direction(root_direction, dim)
+    segments = np.diff(chain, axis=0)
+    scale = max(float(np.sum(np.linalg.norm(segments, axis=1))), 1.0)
+    angles = np.zeros(segments.shape[0])
+    for i, segment in enumerate(segments):
+        length = float(np.linalg.norm(segment))
+        if length <= _TINY * scale:
+            continue
+        direction = segment / length
+        angles[i] = math.acos(min(1.0, max(-1.0, float(direction @ previous))))
+        previous = direction
+    return angles
+
+
+def reach_limits(lengths: ArrayLike) -> tuple[float, float]:
+    """``(inner, outer)`` radii (m) of the annulus the end effector can reach: ``max(0, 2·max L − ΣL)`` and ``ΣL``."""
+    links = np.asarray(lengths, dtype=np.float64)
+    total = float(links.sum())
+    return max(0.0, 2.0 * float(links.max()) - total), total
+
+
+# ================================================================================================ checks
+def _finite_array(name: str, value: ArrayLike) -> NDArray[np.float64]:
+    try:
+        array = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError) as error:
+        raise ValueError(f"{name} must be an array of numbers, got {value!r}") from error
+    if not np.all(np.isfinite(array)):
+        raise ValueError(f"{name} must be finite, got {value!r}")
+    return array
+
+
+def _check_joints(name: str, value: ArrayLike, *, batched: bool) -> NDArray[np.float64]:
+    array = _finite_array(name, value)
+    want = 3 if batched else 2
+    shape = "(B, n + 1, d)" if batched else "(n + 1, d)"
+    if array.ndim != want or array.shape[-1] not in (2, 3):
+        raise ValueError(f"{name} must have shape {shape} with d = 2 or 3, got {array.shape}")
+    if array.shape[-2] < 2:
+        raise ValueError(f"{name} must hold at least two joints (n ≥ 1 link), got {array.shape}")
+    return array
+
+
+def _check_vector(name: str, value: ArrayLike, dim: int) -> NDArray[np.float64]:
+    array = _finite_array(name, value)
+    if array.shape != (dim,):
+        raise ValueError(f"{name} must have shape ({dim},), got {array.shape}")
+    return array
+
+
+def _check_length(name: str, value: float) -> float:
+    number = _finite_array(name, value)
+    if number.shape != () or float(number) < 0.0:
+        raise ValueError(f"{name} must be a finite number ≥ 0, got {value!r}")
+    return float(number)
+
+
+def _root_direction(value: ArrayLike | None, dim: int) -> NDArray[np.float64]:
+    if value is None:
+        axis = np.zeros(dim)
+        axis[-1] = 1.0
+        return axis
+    axis = _check_vector("root_direction", value, dim)
+    norm = float(np.linalg.norm(axis))
+    if norm <= _TINY:
+        raise ValueError(f"root_direction must be non-zero, got {value!r}")
+    return axis / norm
+
+
+def _status_literal(text: str) -> Status:
+    for status in STATUSES:
+        if status == text:
+            return status
+    raise ValueError(f"unknown status {text!r}")
+
+
+# ================================================================================================ set-up
+@dataclasses.dataclass(frozen=True)
+class _Setup:
+    """Checked options shared by every chain of a batch."""
+
+    dim: int
+    tolerance: float
+    max_iterations: int
+    limits: tuple[float, float] | None
+    """(cos φ, sin φ) of the cone half-angle, or None."""
+    root_direction: NDArray[np.float64]
+    """(d, 1) unit rest direction of the root."""
+    centres: NDArray[np.float64]
+    """(K, d, 1) obstacle centres (m)."""
+    radii: NDArray[np.float64]
+    """(K, 1) obstacle radii (m)."""
+
+    @staticmethod
+    def build(
+        *,
+        dim: int,
+        tolerance: float,
+        max_iterations: int,
+        cone_half_angle_rad: float | None,
+        obstacles: Sequence[Obstacle],
+        root_direction: ArrayLike | None,
+    ) -> _Setup:
+        tol = _finite_array("tolerance", tolerance)
+        if tol.shape != () or float(tol) < 0.0:
+            raise ValueError(f"tolerance must be a finite number ≥ 0, got {tolerance!r}")
+        if isinstance(max_iterations, bool) or not isinstance(max_iterations, (int, np.integer)):
+            raise ValueError(f"max_iterations must be an integer, got {max_iterations!r}")
+        if max_iterations < 1:
+            raise ValueError(f"max_iterations must be ≥ 1, got {max_iterations}")
+        limits = None
+        if cone_half_angle_rad is not None:
+            phi = _finite_array("cone_half_angle_rad", cone_half_angle_rad)
+            if phi.shape != () or not 0.0 <= float(phi) <= math.pi:
+                raise ValueError(
+                    f"cone_half_angle_rad must be in [0, π], got {cone_half_angle_rad!r}"
+                )
+            if float(phi) < math.pi:
+                limits = (math.cos(float(phi)), math.sin(float(phi)))
+        centres, radii = [], []
+        for k, obstacle in enumerate(obstacles):
+            try:
+                centre, radius = obstacle
+            except (TypeError, ValueError) as error:
+                raise ValueError(
+                    f"obstacles[{k}] must be (centre, radius), got {obstacle!r}"
+                ) from error
+            centres.append(_check_vector(f"obstacles[{k}] centre", centre, dim))
+            r = _finite_array(f"obstacles[{k}] radius", radius)
+            if r.shape != () or float(r) <= 0.0:
+                raise ValueError(
+                    f"obstacles[{k}] radius must be a finite number > 0, got {radius!r}"
+                )
+            radii.append(float(r))
+        return _Setup(
+            dim=dim,
+            tolerance=float(tol),
+            max_iterations=int(max_iterations),
+            limits=limits,
+            root_direction=_root_direction(root_direction, dim)[:, None],
+            centres=np.array(centres, dtype=np.float64).reshape(len(centres), dim, 1),
+            radii=np.array(radii, dtype=np.float64).reshape(len(radii), 1),
+        )
+
+
+@dataclasses.dataclass
+class _Chains:
+    """The active chains of a batch, laid out joint-major: one joint of every chain is a contiguous (d, B) block."""
+
+    p: NDArray[np.float64]
+    """(n + 1, d, B) joints (m)."""
+    target: NDArray[np.float64]
+    """(d, B) targets (m)."""
+    lengths: NDArray[np.float64]
+    """(n, B) link lengths (m)."""
+    tiny: NDArray[np.float64]
+    """(B,) length below which a vector has no direction (m)."""
+    obstacle_live: NDArray[np.bool_]
+    """(K, B) obstacles this chain avoids (those that do not contain its root)."""
+    has_zero_link: bool
+
+    def take(self, keep: NDArray[np.bool_]) -> _Chains:
+        return _Chains(
+            p=self.p[:, :, keep],
+            target=self.target[:, keep],
+            lengths=self.lengths[:, keep],
+            tiny=self.tiny[keep],
+            obstacle_live=self.obstacle_live[:, keep],
+            has_zero_link=self.has_zero_link,
+        )
+
+
+# ================================================================================================ vector helpers
+def _norm(v: NDArray[np.float64]) -> NDArray[np.float64]:
+    """(…, d, B) → (…, B) Euclidean norm over the d axis."""
+    return np.sqrt(np.sum(v * v, axis=-2))
+
+
+def _unit(
+    v: NDArray[np.float64], fallback: NDArray[np.float64], tiny: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """(d, B) unit vectors of ``v``, ``fallback`` where ``|v| ≤ tiny``; and the norms (B,)."""
+    norm = _norm(v)
+    defined = norm > tiny
+    if defined.all():
+        return v / norm, norm
+    return np.where(defined, v / np.where(defined, norm, 1.0), fallback), norm
+
+
+def _perpendicular(axis: NDArray[np.float64]) -> NDArray[np.float64]:
+    """(d, B) a fixed unit vector perpendicular to each unit ``axis`` (d, B)."""
+    if axis.shape[0] == 2:
+        return np.stack([-axis[1], axis[0]])
+    # cross with the coordinate axis least aligned with ``axis``
+    use_y = np.abs(axis[0]) > 0.9
+    ex = np.where(use_y, 0.0, 1.0)
+    ey = np.where(use_y, 1.0, 0.0)
+    cross = np.stack([-axis[2] * ey, axis[2] * ex, axis[0] * ey - axis[1] * ex])
+    return cross / _norm(cross)
+
+
+def _fallback_axis(bend: NDArray[np.float64], dim: int) -> NDArray[np.float64]:
+    """Any unit axis perpendicular to ``bend`` (or +last axis), for a target on the root."""
+    norm = float(np.linalg.norm(bend))
+    if norm <= _TINY:
+        axis = np.zeros(dim)
+        axis[-1] = 1.0
+        return axis
+    return _perpendicular((bend / norm)[:, None])[:, 0]
+
+
+def _clamp_cone(
+    v: NDArray[np.float64], axis: NDArray[np.float64], limits: tuple[float, float]
+) -> NDArray[np.float64]:
+    """Unit directions ``v`` (d, B) turned, by the least angle, into the cone of half-angle φ around ``axis``."""
+    cos_phi, sin_phi = limits
+    cos_v = np.sum(v * axis, axis=0)
+    outside = cos_v < cos_phi
+    if not outside.any():
+        return v
+    side = v - cos_v * axis
+    side_norm = _norm(side)
+    has_side = side_norm > 1e-9
+    side = np.where(has_side, side / np.where(has_side, side_norm, 1.0), _perpendicular(axis))
+    clamped = cos_phi * axis + sin_phi * side
+    # A nearly (anti)parallel v leaves ``side`` only roughly perpendicular: renormalise so lengths stay exact.
+    return np.where(outside, clamped / _norm(clamped), v)
+
+
+def _deflect(
+    anchor: NDArray[np.float64],
+    v: NDArray[np.float64],
+    length: NDArray[np.float64],
+    setup: _Setup,
+    live: NDArray[np.bool_],
+    tiny: NDArray[np.float64],
+) -> tuple[NDArray[np.float64], bool]:
+    """Turn the segments ``anchor + t·v, t ∈ [0, length]`` by the least angle until no live obstacle cuts them.
+
+    Returns the new unit directions (d, B) and whether any was turned.
+    """
+    turned = False
+    for _ in range(3):  # turning around one obstacle can push into another: a few rounds settle it
+        rel = setup.centres - anchor  # (K, d, B)
+        along = np.sum(rel * v, axis=1)  # (K, B)
+        t = np.clip(along, 0.0, length)
+        dist2 = np.sum(rel * rel, axis=1) - 2.0 * t * along + t * t
+        hit = (dist2 < setup.radii * setup.radii) & live
+        if not hit.any():
+            return v, turned
+        turned = True
+        for k in np.flatnonzero(hit.any(axis=1)):
+            v = np.where(
+                hit[k], _turn_clear(anchor, v, length, setup.centres[k], setup.radii[k], tiny), v
+            )
+    return v, turned
+
+
+def _turn_clear(
+    anchor: NDArray[np.float64],
+    v: NDArray[np.float64],
+    length: NDArray[np.float64],
+    centre: NDArray[np.float64],
+    radius: NDArray[np.float64],
+    tiny: NDArray[np.float64],
+) -> NDArray[np.float64]:
+    """Directions (d, B) nearest ``v`` whose segment of ``length`` from ``anchor`` just clears one obstacle."""
+    clear = radius * (1.0 + _CLEARANCE)
+    to_centre, distance = _unit(centre - anchor, -v, tiny)
+    # Far enough to reach the tangent point: stop at the tangent; otherwise the far end rests on the surface.
+    safe_distance = np.maximum(distance, tiny)
+    safe_length = np.maximum(length, tiny)
+    sin_tangent = np.clip(clear / safe_distance, 0.0, 1.0)
+    cos_end = np.clip(
+        (length * length + distance * distance - clear * clear)
+        / (2.0 * safe_length * safe_distance),
+        -1.0,
+        1.0,
+    )
+    tangent = length * length >= distance * distance - clear * clear
+    cos_t = np.where(tangent, np.sqrt(1.0 - sin_tangent * sin_tangent), cos_end)
+    sin_t = np.where(tangent, sin_tangent, np.sqrt(1.0 - cos_end * cos_end))
+    side = v - np.sum(v * to_centre, axis=0) * to_centre
+    side, _ = _unit(side, _perpendicular(to_centre), np.full_like(tiny, 1e-9))
+    turned = cos_t * to_centre + sin_t * side
+    turned = turned / _norm(turned)
+    inside = distance <= radius  # an anchor inside: leave straight away from the centre
+    return np.where(inside, -to_centre, turned)
+
+
+# ================================================================================================ passes
+def _forward_pass(chains: _Chains, setup: _Setup) -> None:
+    """End on the target, each joint back toward its old place at its link's length (the root is left)."""
+    p, lengths, tiny = chains.p, chains.lengths, chains.tiny
+    n = lengths.shape[0]
+    p[n] = chains.target
+    previous, _ = _unit(p[0] - p[n], -setup.root_direction * np.ones_like(tiny), tiny)
+    has_obstacles = setup.radii.shape[0] > 0
+    for i in range(n - 1, 0, -1):
+        direction, _ = _unit(p[i] - p[i + 1], previous, tiny)
+        if has_obstacles:
+            direction, _ = _deflect(
+                p[i + 1], direction, lengths[i], setup, chains.obstacle_live, tiny
+            )
+        if setup.limits is not None and i < n - 1:
+            direction = _clamp_cone(direction, previous, setup.limits)
+        p[i] = p[i + 1] + lengths[i] * direction
+        previous = (
+            np.where(lengths[i] > tiny, direction, previous) if chains.has_zero_link else direction
+        )
+
+
+def _backward_pass(chains: _Chains, setup: _Setup) -> None:
+    """Root back on its place, each joint outward toward its current place; limits and obstacles enforced."""
+    p, lengths, tiny = chains.p, chains.lengths, chains.tiny
+    n = lengths.shape[0]
+    previous = setup.root_direction * np.ones_like(tiny)
+    has_obstacles = setup.radii.shape[0] > 0
+    for i in range(1, n + 1):
+        direction, _ = _unit(p[i] - p[i - 1], previous, tiny)
+        if setup.limits is not None:
+            direction = _clamp_cone(direction, previous, setup.limits)
+        if has_obstacles:
+            direction, turned = _deflect(
+                p[i - 1], direction, lengths[i - 1], setup, chains.obstacle_live, tiny
+            )
+            if turned and setup.limits is not None:
+                direction = _clamp_cone(direction, previous, setup.limits)
+        p[i] = p[i - 1] + lengths[i - 1] * direction
+        previous = (
+            np.where(lengths[i - 1] > tiny, direction, previous)
+            if chains.has_zero_link
+            else direction
+        )
+
+
+def _fabrik_step(chains: _Chains, setup: _Setup) -> None:
+    _forward_pass(chains, setup)
+    _backward_pass(chains, setup)
+
+
+def _rotate_2d(
+    v: NDArray[np.float64], cos_a: NDArray[np.float64], sin_a: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """Rotate (…, 2, B) vectors by angles given as cos/sin (B,)."""
+    x, y = v[..., 0, :], v[..., 1, :]
+    return np.stack([cos_a * x - sin_a * y, sin_a * x + cos_a * y], axis=-2)
+
+
+def _cross(a: NDArray[np.float64], b: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Cross product over the d = 3 axis (-2) of (…, 3, B) arrays."""
+    ax, ay, az = a[..., 0, :], a[..., 1, :], a[..., 2, :]
+    bx, by, bz = b[..., 0, :], b[..., 1, :], b[..., 2, :]
+    return np.stack([ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx], axis=-2)
+
+
+def _ccd_step(chains: _Chains, setup: _Setup) -> None:
+    """One CCD sweep, end to root, then the constrained backward pass as a projection."""
+    p, tiny = chains.p, chains.tiny
+    n = chains.lengths.shape[0]
+    for i in range(n - 1, -1, -1):
+        pivot = p[i]
+        to_end, end_norm = _unit(p[n] - pivot, setup.root_direction * np.ones_like(tiny), tiny)
+        to_target, target_norm = _unit(chains.target - pivot, to_end, tiny)
+        cos_a = np.clip(np.sum(to_end * to_target, axis=0), -1.0, 1.0)
+        move = (end_norm > tiny) & (target_norm > tiny)
+        downstream = p[i + 1 :] - pivot
+        if setup.dim == 2:
+            sin_a = to_end[0] * to_target[1] - to_end[1] * to_target[0]
+            rotated = _rotate_2d(downstream, cos_a, sin_a)
+        else:
+            axis = _cross(to_end, to_target)
+            sin_a = _norm(axis)
+            axis, _ = _unit(axis, _perpendicular(to_end), np.full_like(tiny, 1e-12))
+            # Rodrigues: v cos a + (k × v) sin a + k (k·v)(1 − cos a)
+            k_dot_v = np.sum(axis * downstream, axis=-2, keepdims=True)
+            rotated = (
+                downstream * cos_a + _cross(axis * np.ones_like(downstream), downstream) * sin_a
+            )
+            rotated = rotated + axis * k_dot_v * (1.0 - cos_a)
+        p[i + 1 :] = np.where(move, pivot + rotated, p[i + 1 :])
+    _backward_pass(chains, setup)
+
+
+def _dls_step(chains: _Chains, setup: _Setup) -> None:
+    """One damped-least-squares step on joint angles, then the constrained backward pass as a projection."""
+    p, lengths = chains.p, chains.lengths
+    n = lengths.shape[0]
+    batch = p.shape[2]
+    end = p[n]
+    lever = end - p[:n]  # (n, d, B): end effector relative to each joint
+    error = chains.target - end  # (d, B)
+    # Clamp the step as Buss 2004 advises, so the linearisation holds.
+    step_cap = np.maximum(lengths.mean(axis=0), chains.tiny)
+    error_norm = _norm(error)
+    error = error * np.minimum(1.0, step_cap / np.maximum(error_norm, chains.tiny))
+    damping = _DLS_DAMPING * step_cap
+    if setup.dim == 2:
+        jac = np.stack(
+            [-lever[:, 1], lever[:, 0]], axis=1
+        )  # (n, 2, B): ∂end/∂θ_i = perp(end − p_i)
+        jac = np.transpose(jac, (2, 1, 0))  # (B, 2, n)
+    else:
+        basis = np.eye(3)[:, :, None, None] * np.ones((1, 1, n, batch))  # (3 axes, 3, n, B)
+        cols = _cross(np.moveaxis(basis, 1, -2), lever[None])  # (3 axes, n, 3, B)
+        jac = np.transpose(cols, (3, 2, 1, 0)).reshape(
+            batch, 3, 3 * n
+        )  # columns ordered joint-major
+    jjt = jac @ np.swapaxes(jac, 1, 2)
+    jjt = jjt + (damping**2)[:, None, None] * np.eye(setup.dim)
+    solved = np.linalg.solve(jjt, error.T[:, :, None])  # (B, d, 1)
+    dtheta = (np.swapaxes(jac, 1, 2) @ solved)[:, :, 0]  # (B, m)
+    segments = np.diff(p, axis=0)  # (n, d, B)
+    if setup.dim == 2:
+        total = np.cumsum(dtheta.T, axis=0)  # (n, B): segment j turns by the sum of joints 0..j
+        segments = _rotate_2d(segments, np.cos(total), np.sin(total))
+    else:
+        rotvec = dtheta.reshape(batch, n, 3)  # (B, n, 3)
+        rot = _rotation_matrices(rotvec)  # (B, n, 3, 3)
+        cumulative = rot[:, 0]
+        seg = np.transpose(segments, (2, 0, 1))  # (B, n, 3)
+        out = np.empty_like(seg)
+        for j in range(n):
+            if j > 0:
+                cumulative = cumulative @ rot[:, j]
+            out[:, j] = (cumulative @ seg[:, j, :, None])[:, :, 0]
+        segments = np.transpose(out, (1, 2, 0))
+    p[1:] = p[0] + np.cumsum(segments, axis=0)
+    _backward_pass(chains, setup)
+
+
+def _rotation_matrices(rotvec: NDArray[np.float64]) -> NDArray[np.float64]:
+    """(…, 3) rotation vectors → (…, 3, 3) matrices (Rodrigues)."""
+    angle = np.linalg.norm(rotvec, axis=-1)
+    safe = np.where(angle > 1e-15, angle, 1.0)
+    k = rotvec / safe[..., None]
+    kx, ky, kz = k[..., 0], k[..., 1], k[..., 2]
+    zero = np.zeros_like(kx)
+    skew = np.stack(
+        [
+            np.stack([zero, -kz, ky], -1),
+            np.stack([kz, zero, -kx], -1),
+            np.stack([-ky, kx, zero], -1),
+        ],
+        -2,
+    )
+    sin_a, cos_a = np.sin(angle)[..., None, None], np.cos(angle)[..., None, None]
+    return np.eye(3) + sin_a * skew + (1.0 - cos_a) * (skew @ skew)
+
+
+# ================================================================================================ checks on poses
+def _cone_ok(chains: _Chains, setup: _Setup) -> NDArray[np.bool_]:
+    """(B,) whether every segment of each chain lies within its cone."""
+    if setup.limits is None:
+        return np.ones(chains.p.shape[2], dtype=bool)
+    cos_phi = setup.limits[0]
+    previous = setup.root_direction * np.ones_like(chains.tiny)
+    ok = np.ones(chains.p.shape[2], dtype=bool)
+    for i in range(chains.lengths.shape[0]):
+        direction, norm = _unit(chains.p[i + 1] - chains.p[i], previous, chains.tiny)
+        ok &= (np.sum(direction * previous, axis=0) >= cos_phi - 1e-12) | (norm <= chains.tiny)
+        previous = np.where(norm > chains.tiny, direction, previous)
+    return ok
+
+
+def _colliding(p: NDArray[np.float64], setup: _Setup, live: NDArray[np.bool_]) -> NDArray[np.bool_]:
+    """(B,) whether any segment of the (n + 1, d, B) chains passes through a live obstacle."""
+    batch = p.shape[2]
+    if setup.radii.shape[0] == 0:
+        return np.zeros(batch, dtype=bool)
+    start = p[:-1, None]  # (n, 1, d, B)
+    seg = (p[1:] - p[:-1])[:, None]
+    rel = setup.centres[None] - start  # (n, K, d, B)
+    seg2 = np.sum(seg * seg, axis=2)
+    t = np.clip(np.sum(rel * seg, axis=2) / np.where(seg2 > 0.0, seg2, 1.0), 0.0, 1.0)
+    gap = rel - t[:, :, None] * seg
+    dist2 = np.sum(gap * gap, axis=2)  # (n, K, B)
+    return np.any((dist2 < setup.radii * setup.radii) & live, axis=(0, 1))
+
+
+def _touching(p: NDArray[np.float64], setup: _Setup, live: NDArray[np.bool_]) -> NDArray[np.bool_]:
+    """(B,) whether a segment rests against (or cuts) a live obstacle, within 0.1 % of its radius."""
+    grown = dataclasses.replace(setup, radii=setup.radii * (1.0 + 1e-3))
+    return _colliding(p, grown, live)
+
+
+# ================================================================================================ driver
+def _run(
+    joints: NDArray[np.float64],
+    targets: NDArray[np.float64],
+    setup: _Setup,
+    step: Callable[[_Chains, _Setup], None],
+    *,
+    shortcut: bool,
+) -> BatchSolution:
+    batch, count, _ = joints.shape
+    n = count - 1
+    p = np.ascontiguousarray(np.transpose(joints, (1, 2, 0)))  # (n + 1, d, B)
+    target = np.ascontiguousarray(targets.T)  # (d, B)
+    lengths = _norm(np.diff(p, axis=0))  # (n, B)
+    total = lengths.sum(axis=0)
+    scale = np.maximum(np.maximum(total, _norm(target - p[0])), 1.0)
+    tiny = _TINY * scale
+    root_to_obstacle = _norm(setup.centres - p[0][None])  # (K, B)
+    live = root_to_obstacle > setup.radii
+    chains = _Chains(p, target, lengths, tiny, live, bool((lengths <= tiny).any()))
+    has_obstacles = setup.radii.shape[0] > 0
+
+    out_p = p.copy()
+    iterations = np.zeros(batch, dtype=np.int64)
+    status = np.full(batch, _MAX_ITERATIONS, dtype=np.int64)
+    history = np.full((batch, setup.max_iterations + 1), np.nan)
+
+    offset = target - p[0]
+    distance = _norm(offset)
+    inner = np.maximum(0.0, 2.0 * lengths.max(axis=0) - total)
+    out_of_reach = (distance > total) | (distance < inner)
+    error0 = _norm(p[n] - target)
+    history[:, 0] = error0
+
+    # The starting pose is kept if it already meets the tolerance and every constraint.
+    valid0 = _cone_ok(chains, setup) & ~_colliding(p, setup, live)
+    best_p = p.copy()
+    best_error = np.where(valid0, error0, np.inf)
+    done = valid0 & (error0 < setup.tolerance)
+    status[done] = _REACHED
+
+    if shortcut:
+        placed = _unreachable_shortcut(
+            chains, setup, offset, distance, total, inner, out_of_reach & ~done, out_p
+        )
+        history[placed, 1] = _norm(out_p[n] - target)[placed]
+        iterations[placed] = 1
+        status[placed] = _UNREACHABLE
+        done = done | placed
+
+    _unbend_axis_chains(chains, setup, offset, distance, ~done)
+
+    index = np.flatnonzero(~done)
+    active = chains.take(~done)
+    best_p_active = best_p[:, :, index]
+    best_error_active = best_error[index]
+    stall = _STALL * setup.tolerance + tiny[index]
+    for iteration in range(1, setup.max_iterations + 1):
+        if index.size == 0:
+            break
+        before = active.p.copy()
+        step(active, setup)
+        error = _norm(active.p[n] - active.target)
+        history[index, iteration] = error
+        if has_obstacles:
+            clear = ~_colliding(active.p, setup, active.obstacle_live)
+            better = clear & (error < best_error_active)
+            if better.any():
+                best_p_active[:, :, better] = active.p[:, :, better]
+                best_error_active = np.where(better, error, best_error_active)
+            reached = clear & (error < setup.tolerance)
+        else:
+            reached = error < setup.tolerance
+        moved = np.max(np.abs(active.p - before), axis=(0, 1))
+        stalled = moved < stall
+        finished = reached | stalled | (iteration == setup.max_iterations)
+        if not finished.any():
+            continue
+        rows = index[finished]
+        iterations[rows] = iteration
+        status[rows] = np.where(
+            reached[finished], _REACHED, np.where(stalled[finished], _UNREACHABLE, _MAX_ITERATIONS)
+        )
+        if has_obstacles:
+            # Return the best collision-free pose seen; only if there was none, the last one (still "blocked").
+            use_best = ~reached[finished] & np.isfinite(best_error_active[finished])
+            final = np.where(use_best, best_p_active[:, :, finished], active.p[:, :, finished])
+            out_p[:, :, rows] = final
+            live_rows = active.obstacle_live[:, finished]
+            blocked = ~reached[finished] & (
+                _touching(final, setup, live_rows)
+                | _target_inside(active.target[:, finished], setup, live_rows)
+            )
+            status[rows] = np.where(blocked, _BLOCKED, status[rows])
+        else:
+            out_p[:, :, rows] = active.p[:, :, finished]
+        keep = ~finished
+        index = index[keep]
+        active = active.take(keep)
+        best_p_active = best_p_active[:, :, keep]
+        best_error_active = best_error_active[keep]
+        stall = stall[keep]
+
+    final_error = _norm(out_p[n] - target)
+    # A target outside the annulus is unreachable whatever the iterations did (unless an obstacle explains it).
+    status = np.where(
+        out_of_reach & (status != _BLOCKED) & (status != _REACHED), _UNREACHABLE, status
+    )
+    return BatchSolution(
+        joints=np.ascontiguousarray(np.transpose(out_p, (2, 0, 1))),
+        iterations=iterations,
+        error=final_error,
+        status=np.array(STATUSES)[status],
+        error_history=history,
+    )
+
+
+def _target_inside(
+    target: NDArray[np.float64], setup: _Setup, live: NDArray[np.bool_]
+) -> NDArray[np.bool_]:
+    dist = _norm(setup.centres - target[None])  # (K, B)
+    return np.any((dist < setup.radii) & live, axis=0)
+
+
+def _unreachable_shortcut(
+    chains: _Chains,
+    setup: _Setup,
+    offset: NDArray[np.float64],
+    distance: NDArray[np.float64],
+    total: NDArray[np.float64],
+    inner: NDArray[np.float64],
+    candidates: NDArray[np.bool_],
+    out_p: NDArray[np.float64],
+) -> NDArray[np.bool_]:
+    """Place out-of-reach chains in their closest pose at once, where limits and obstacles allow it.
+
+    Beyond the reach: every link along the root–target direction. Inside the inner hole: the longest link toward the
+    target and the others folded back, so the end rests on the inner boundary. Returns (B,) which chains it placed.
+    """
+    if not candidates.any():
+        return candidates
+    p, lengths = chains.p, chains.lengths
+    n = lengths.shape[0]
+    direction, _ = _unit(offset, setup.root_direction * np.ones_like(chains.tiny), chains.tiny)
+    beyond = distance > total
+    longest = np.argmax(lengths, axis=0)
+    sign = np.where(beyond | (np.arange(n)[:, None] == longest[None]), 1.0, -1.0)  # (n, B)
+    reach = np.cumsum(sign * lengths, axis=0)  # (n, B)
+    pose = p.copy()
+    pose[1:] = p[0] + reach[:, None, :] * direction
+    ok = candidates.copy()
+    if setup.limits is not None:
+        # A folded chain turns by π; a straight one only at the root.
+        root_cos = np.sum(direction * setup.root_direction, axis=0)
+        ok &= beyond & (root_cos >= setup.limits[0])
+    if setup.radii.shape[0] > 0:
+        ok &= ~_colliding(pose, setup, chains.obstacle_live)
+    out_p[:, :, ok] = pose[:, :, ok]
+    return ok
+
+
+def _unbend_axis_chains(
+    chains: _Chains,
+    setup: _Setup,
+    offset: NDArray[np.float64],
+    distance: NDArray[np.float64],
+    todo: NDArray[np.bool_],
+) -> None:
+    """Bend straight chains whose target lies on their own line into a gentle arc, so the passes can bend them."""
+    p, tiny = chains.p, chains.tiny
+    segments = np.diff(p, axis=0)  # (n, d, B)
+    norms = _norm(segments)
+    first = np.argmax(norms > tiny, axis=0)  # first segment with a direction
+    axis_raw = np.take_along_axis(segments, first[None, None, :], axis=0)[0]
+    axis, _ = _unit(axis_raw, setup.root_direction * np.ones_like(tiny), tiny)
+    along = np.sum(segments * axis, axis=1)  # (n, B)
+    off_axis = _norm(segments - along[:, None, :] * axis)  # (n, B)
+    straight = np.all(off_axis <= 1e-9 * np.maximum(norms, tiny), axis=0)
+    target_off = _norm(offset - np.sum(offset * axis, axis=0) * axis)
+    on_axis = target_off <= 1e-9 * np.maximum(distance, 1.0)
+    bend = todo & straight & on_axis
+    if not bend.any():
+        return
+    step = 0.1 if setup.limits is None else min(0.1, 0.5 * math.acos(setup.limits[0]))
+    if step <= 0.0:
+        return
+    side = _perpendicular(axis)
+    angle = step * np.arange(segments.shape[0])[:, None]  # (n, 1)
+    directions = np.cos(angle)[:, None, :] * axis + np.sin(angle)[:, None, :] * side  # (n, d, B)
+    arc = p[0] + np.cumsum(norms[:, None, :] * directions, axis=0)
+    p[1:] = np.where(bend, arc, p[1:])

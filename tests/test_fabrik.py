@@ -1,0 +1,384 @@
+"""FABRIK, CCD, DLS and the two-bone solver against geometry: properties over random chains, and exact cases."""
+
+from __future__ import annotations
+
+import itertools
+import math
+from typing import Any
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from numpy.typing import NDArray
+
+from kernels import fabrik
+
+PROPERTY = settings(max_examples=60, deadline=None)
+BAD_SOLVER: Any = "newton"
+"""A solver name a caller could send that is not a :data:`fabrik.Solver`."""
+
+
+# ------------------------------------------------------------------------------------------------ helpers
+def random_chain(
+    rng: np.random.Generator, n: int, d: int, *, bend: float = 0.6
+) -> NDArray[np.float64]:
+    """A chain of n links, lengths 0.2–1.5 m, each turning by up to ``bend`` rad from the last, rooted at a random place."""
+    lengths = rng.uniform(0.2, 1.5, n)
+    direction = np.zeros(d)
+    direction[-1] = 1.0
+    joints = [rng.uniform(-1.0, 1.0, d)]
+    for length in lengths:
+        turn = rng.normal(size=d) * bend
+        direction = direction + turn - (turn @ direction) * direction
+        direction /= np.linalg.norm(direction)
+        joints.append(joints[-1] + length * direction)
+    return np.array(joints)
+
+
+def random_direction(rng: np.random.Generator, d: int) -> NDArray[np.float64]:
+    v = rng.normal(size=d)
+    return v / np.linalg.norm(v)
+
+
+def segment_clearance(joints: NDArray[np.float64], centre: NDArray[np.float64]) -> float:
+    """Smallest distance from ``centre`` to any segment of the chain."""
+    best = math.inf
+    for a, b in itertools.pairwise(joints):
+        seg = b - a
+        t = 0.0 if seg @ seg == 0.0 else min(1.0, max(0.0, float((centre - a) @ seg / (seg @ seg))))
+        best = min(best, float(np.linalg.norm(a + t * seg - centre)))
+    return best
+
+
+chains = st.tuples(st.integers(1, 12), st.sampled_from([2, 3]), st.integers(0, 2**32 - 1))
+
+
+# ------------------------------------------------------------------------------------------------ properties
+@PROPERTY
+@given(chains, st.floats(0.0, 1.0), st.booleans(), st.booleans())
+def test_lengths_preserved_and_finite(
+    chain: tuple[int, int, int], where: float, limits: bool, obstacle: bool
+) -> None:
+    n, d, seed = chain
+    rng = np.random.default_rng(seed)
+    joints = random_chain(rng, n, d)
+    total = fabrik.link_lengths(joints).sum()
+    target = joints[0] + random_direction(rng, d) * where * 1.3 * total
+    obstacles = (
+        [(joints[0] + random_direction(rng, d) * 0.5 * total, 0.1 * total)] if obstacle else []
+    )
+    obstacles = [o for o in obstacles if np.linalg.norm(o[0] - joints[0]) > o[1]]
+    result = fabrik.solve(
+        joints,
+        target,
+        cone_half_angle_rad=0.7 if limits else None,
+        obstacles=obstacles,
+        max_iterations=200,
+    )
+    assert np.all(np.isfinite(result.joints))
+    assert np.all(np.isfinite(result.error_history))
+    np.testing.assert_allclose(
+        fabrik.link_lengths(result.joints), fabrik.link_lengths(joints), rtol=1e-9
+    )
+    np.testing.assert_array_equal(result.joints[0], joints[0])
+    assert result.error == pytest.approx(np.linalg.norm(result.joints[-1] - target), abs=1e-12)
+
+
+@PROPERTY
+@given(chains, st.floats(0.0, 1.0), st.sampled_from(["fabrik", "ccd", "jacobian_dls"]))
+def test_reachable_targets_are_reached(
+    chain: tuple[int, int, int], where: float, solver: fabrik.Solver
+) -> None:
+    n, d, seed = chain
+    n = max(n, 2)  # one link reaches only its own circle
+    rng = np.random.default_rng(seed)
+    joints = random_chain(rng, n, d)
+    inner, outer = fabrik.reach_limits(fabrik.link_lengths(joints))
+    # Stay clear of the annulus edges, where every iterative solver slows down (see the physics notes).
+    radius = inner + (0.05 + 0.9 * where) * (outer - inner)
+    target = joints[0] + random_direction(rng, d) * radius
+    tolerance = 1e-3 * outer
+    result = fabrik.solve_batch(
+        joints[None], target[None], tolerance=tolerance, max_iterations=3000, solver=solver
+    )[0]
+    assert result.status == "reached"
+    assert result.error < tolerance
+    assert np.linalg.norm(result.joints[-1] - target) < tolerance
+
+
+@PROPERTY
+@given(chains, st.floats(1.001, 5.0))
+def test_targets_beyond_reach_give_a_straight_chain_at_once(
+    chain: tuple[int, int, int], factor: float
+) -> None:
+    n, d, seed = chain
+    rng = np.random.default_rng(seed)
+    joints = random_chain(rng, n, d)
+    lengths = fabrik.link_lengths(joints)
+    direction = random_direction(rng, d)
+    target = joints[0] + direction * factor * lengths.sum()
+    result = fabrik.solve(joints, target)
+    assert result.status == "unreachable"
+    assert result.iterations <= 1
+    expected = joints[0] + np.concatenate([[0.0], np.cumsum(lengths)])[:, None] * direction
+    np.testing.assert_allclose(result.joints, expected, atol=1e-9 * lengths.sum())
+    assert result.error == pytest.approx((factor - 1.0) * lengths.sum(), rel=1e-9)
+
+
+def test_target_in_the_inner_hole_gives_the_folded_closest_pose() -> None:
+    # Links 3, 1, 0.5: the end can come no closer to the root than 3 − 1.5 = 1.5 m.
+    joints = np.array([[0.0, 0.0], [0.0, 3.0], [1.0, 3.0], [1.0, 3.5]])
+    target = np.array([0.5, 0.0])
+    result = fabrik.solve(joints, target)
+    assert result.status == "unreachable"
+    assert result.iterations == 1
+    np.testing.assert_allclose(result.joints[-1], [1.5, 0.0], atol=1e-12)
+    assert result.error == pytest.approx(1.0)
+    np.testing.assert_allclose(fabrik.link_lengths(result.joints), [3.0, 1.0, 0.5])
+
+
+@PROPERTY
+@given(chains, st.floats(0.0, 1.5), st.floats(0.05, math.pi))
+def test_cone_limits_never_violated(chain: tuple[int, int, int], where: float, phi: float) -> None:
+    n, d, seed = chain
+    rng = np.random.default_rng(seed)
+    joints = random_chain(rng, n, d, bend=2.0)  # starting poses are often outside the limits
+    total = fabrik.link_lengths(joints).sum()
+    target = joints[0] + random_direction(rng, d) * where * total
+    root_direction = random_direction(rng, d)
+    for solver in ("fabrik", "ccd", "jacobian_dls"):
+        result = fabrik.solve_batch(
+            joints[None],
+            target[None],
+            cone_half_angle_rad=phi,
+            root_direction=root_direction,
+            max_iterations=60,
+            solver=solver,
+        )[0]
+        angles = fabrik.joint_angles(result.joints, root_direction)
+        assert np.all(angles <= phi + 1e-6), (solver, angles.max(), phi)
+        np.testing.assert_allclose(
+            fabrik.link_lengths(result.joints), fabrik.link_lengths(joints), rtol=1e-9
+        )
+
+
+@PROPERTY
+@given(chains, st.floats(0.0, 1.3), st.integers(1, 4), st.booleans())
+def test_no_segment_passes_through_an_obstacle(
+    chain: tuple[int, int, int], where: float, count: int, limits: bool
+) -> None:
+    n, d, seed = chain
+    rng = np.random.default_rng(seed)
+    joints = random_chain(rng, n, d, bend=0.3)
+    total = fabrik.link_lengths(joints).sum()
+    target = joints[0] + random_direction(rng, d) * where * total
+    obstacles = []
+    for _ in range(20 * count):
+        centre = joints[0] + random_direction(rng, d) * rng.uniform(0.1, 1.0) * total
+        radius = rng.uniform(0.03, 0.25) * total
+        if segment_clearance(joints, centre) > radius and len(obstacles) < count:
+            obstacles.append((centre, radius))
+    phi = 0.8 if limits else None
+    result = fabrik.solve(
+        joints, target, obstacles=obstacles, cone_half_angle_rad=phi, max_iterations=100
+    )
+    for centre, radius in obstacles:
+        assert segment_clearance(result.joints, centre) >= radius * (1.0 - 1e-9), result.status
+    if limits:
+        assert np.all(fabrik.joint_angles(result.joints) <= 0.8 + 1e-6)
+
+
+@PROPERTY
+@given(st.integers(1, 12), st.sampled_from([2, 3]), st.integers(0, 2**32 - 1), st.booleans())
+def test_batch_equals_single_solves(n: int, d: int, seed: int, limits: bool) -> None:
+    rng = np.random.default_rng(seed)
+    joints = np.stack([random_chain(rng, n, d) for _ in range(6)])
+    joints -= joints[:, :1]  # one root, so the shared obstacle means the same to every chain
+    total = fabrik.link_lengths(joints).sum(axis=1)
+    targets = np.stack([random_direction(rng, d) * rng.uniform(0.0, 1.3) * t for t in total])
+    obstacles = [(random_direction(rng, d) * 0.6 * total.min(), 0.1 * total.min())]
+    kwargs = {
+        "cone_half_angle_rad": 0.9 if limits else None,
+        "obstacles": obstacles,
+        "max_iterations": 40,
+    }
+    batch = fabrik.solve_batch(joints, targets, **kwargs)
+    for i in range(len(joints)):
+        single = fabrik.solve(joints[i], targets[i], **kwargs)
+        np.testing.assert_allclose(batch.joints[i], single.joints, rtol=0, atol=1e-12)
+        assert batch.iterations[i] == single.iterations
+        assert batch.status[i] == single.status
+        assert batch.error[i] == pytest.approx(single.error, abs=1e-12)
+        np.testing.assert_allclose(batch[i].error_history, single.error_history, atol=1e-12)
+
+
+# ------------------------------------------------------------------------------------------------ degenerate input
+@pytest.mark.parametrize("d", [2, 3])
+def test_straight_chain_bends_toward_a_closer_target_on_its_axis(d: int) -> None:
+    joints = np.zeros((6, d))
+    joints[:, -1] = np.arange(6.0)  # straight up, reach 5
+    # On the chain's own axis, closer than its reach (with 34° limits, no closer than they allow).
+    for phi, distance in ((None, 3.0), (0.6, 4.0)):
+        target = np.zeros(d)
+        target[-1] = distance
+        result = fabrik.solve(joints, target, cone_half_angle_rad=phi, max_iterations=200)
+        assert result.status == "reached"
+        assert result.error < 1e-3
+        off_axis = np.linalg.norm(result.joints[:, :-1], axis=1)
+        assert off_axis.max() > 0.1  # it really bent
+
+
+@pytest.mark.parametrize("d", [2, 3])
+def test_degenerate_inputs_never_give_nan(d: int) -> None:
+    zero = np.zeros((4, d))
+    coincident = np.zeros((4, d))
+    coincident[2:, 0] = 1.0  # links of length 0, 1, 0
+    folded = np.zeros((3, d))
+    folded[1, -1] = 1.0  # up and straight back down onto the root
+    cases = [
+        (zero, np.ones(d)),  # every link of zero length
+        (zero, np.zeros(d)),
+        (coincident, np.full(d, 0.5)),
+        (coincident, np.zeros(d)),  # target on the root
+        (folded, np.zeros(d)),
+        (folded, np.full(d, 0.3)),
+    ]
+    for joints, target in cases:
+        for phi in (None, 0.5):
+            for solver in ("fabrik", "ccd", "jacobian_dls"):
+                result = fabrik.solve_batch(
+                    joints[None], target[None], cone_half_angle_rad=phi, solver=solver
+                )[0]
+                assert np.all(np.isfinite(result.joints)), (joints, target, phi, solver)
+                assert np.isfinite(result.error)
+                np.testing.assert_allclose(
+                    fabrik.link_lengths(result.joints), fabrik.link_lengths(joints), atol=1e-12
+                )
+    # A target on the root of an equal two-link chain is reachable: the chain folds onto itself.
+    result = fabrik.solve(np.array([[0.0, 0.0], [0.0, 1.0], [1.0, 1.0]]), np.zeros(2))
+    assert result.status == "reached"
+    # The zero-reach chain cannot move: everything stays on the root.
+    result = fabrik.solve(zero, np.ones(d))
+    np.testing.assert_array_equal(result.joints, zero)
+    assert result.status == "unreachable"
+
+
+def test_obstacle_on_the_target_is_blocked_and_clear() -> None:
+    joints = np.array([[0.0, 0.0], [0.0, 1.0], [0.0, 2.0], [0.0, 3.0]])
+    centre = np.array([1.5, 1.5])
+    result = fabrik.solve(joints, centre, obstacles=[(centre, 0.4)], max_iterations=100)
+    assert result.status == "blocked"
+    assert segment_clearance(result.joints, centre) >= 0.4
+    # The best clear pose rests against the obstacle, as close to the target as it can get.
+    assert result.error == pytest.approx(0.4, abs=0.05)
+
+
+def test_obstacle_on_the_free_path_is_avoided_and_the_target_still_reached() -> None:
+    joints = np.array([[0.0, 0.0], [0.0, 1.0], [0.0, 2.0], [0.0, 3.0], [0.0, 4.0]])
+    target = np.array([2.5, 0.5])
+    free = fabrik.solve(joints, target, max_iterations=200)
+    centre = free.joints[2]  # right where the unobstructed solution puts its middle joint
+    result = fabrik.solve(joints, target, obstacles=[(centre, 0.3)], max_iterations=200)
+    assert result.status == "reached"
+    assert result.error < 1e-3
+    assert segment_clearance(result.joints, centre) >= 0.3
+
+
+def test_starting_pose_that_already_reaches_stops_at_zero_iterations() -> None:
+    joints = np.array([[0.0, 0.0], [0.0, 1.0], [1.0, 1.0]])
+    result = fabrik.solve(joints, np.array([1.0, 1.0 + 1e-5]))
+    assert result.iterations == 0
+    assert result.status == "reached"
+    # The same pose outside a 30° limit is first brought inside it.
+    limited = fabrik.solve(joints, np.array([1.0, 1.0]), cone_half_angle_rad=math.radians(30))
+    assert limited.iterations >= 1
+    assert np.all(fabrik.joint_angles(limited.joints) <= math.radians(30) + 1e-9)
+
+
+def test_max_iterations_is_respected_and_error_history_decreases() -> None:
+    rng = np.random.default_rng(3)
+    joints = random_chain(rng, 10, 3)
+    target = joints[0] + np.array([0.5, 0.5, 0.5])
+    result = fabrik.solve(joints, target, tolerance=0.0, max_iterations=7)
+    assert result.iterations == 7
+    assert result.status in ("max_iterations", "unreachable")
+    assert result.error_history.shape == (8,)
+    assert result.error_history[-1] < result.error_history[0]
+
+
+# ------------------------------------------------------------------------------------------------ two-bone
+def test_two_bone_matches_the_law_of_cosines() -> None:
+    joints = fabrik.two_bone([0.0, 0.0], 1.0, 1.0, [math.sqrt(2.0), 0.0], [0.0, 1.0])
+    np.testing.assert_allclose(
+        joints, [[0, 0], [math.sqrt(0.5), math.sqrt(0.5)], [math.sqrt(2.0), 0]], atol=1e-12
+    )
+    # 3-4-5 triangle: the elbow angle at the root is acos(3/5) off the root–target line.
+    joints = fabrik.two_bone([0.0, 0.0, 0.0], 3.0, 4.0, [5.0, 0.0, 0.0], [0.0, 0.0, -1.0])
+    np.testing.assert_allclose(joints[1], [3.0 * 0.6, 0.0, -3.0 * 0.8], atol=1e-12)
+    # Out of reach: straight toward the target; inside the hole: folded.
+    np.testing.assert_allclose(
+        fabrik.two_bone([0, 0], 1.0, 2.0, [10.0, 0.0], [0, 1])[2], [3.0, 0.0], atol=1e-12
+    )
+    np.testing.assert_allclose(
+        fabrik.two_bone([0, 0], 1.0, 2.0, [0.5, 0.0], [0, 1])[2], [1.0, 0.0], atol=1e-12
+    )
+
+
+@PROPERTY
+@given(st.sampled_from([2, 3]), st.integers(0, 2**32 - 1), st.floats(0.2, 0.9))
+def test_two_bone_equals_fabrik_at_two_links(d: int, seed: int, where: float) -> None:
+    rng = np.random.default_rng(seed)
+    joints = random_chain(rng, 2, d, bend=1.0)
+    upper, lower = fabrik.link_lengths(joints)
+    inner, outer = fabrik.reach_limits([upper, lower])
+    target = joints[0] + random_direction(rng, d) * (inner + where * (outer - inner))
+    result = fabrik.solve(joints, target, tolerance=1e-9 * outer, max_iterations=20000)
+    assert result.status == "reached"
+    # FABRIK keeps the elbow on its starting side; the analytic solver is told that side.
+    bend = result.joints[1] - joints[0]
+    analytic = fabrik.two_bone(joints[0], upper, lower, target, bend)
+    np.testing.assert_allclose(result.joints, analytic, atol=1e-5 * outer)
+    np.testing.assert_allclose(np.linalg.norm(analytic[1] - analytic[0]), upper, rtol=1e-12)
+    np.testing.assert_allclose(np.linalg.norm(analytic[2] - analytic[1]), lower, rtol=1e-12)
+    np.testing.assert_allclose(analytic[2], target, atol=1e-9 * outer)
+
+
+# ------------------------------------------------------------------------------------------------ invalid input
+@pytest.mark.parametrize(
+    ("call", "name"),
+    [
+        (lambda: fabrik.solve([[0, 0], [np.nan, 1]], [0, 1]), "joints"),
+        (lambda: fabrik.solve([[0, 0]], [0, 1]), "joints"),
+        (lambda: fabrik.solve([[0, 0, 0, 0], [1, 1, 1, 1]], [0, 1, 0, 0]), "joints"),
+        (lambda: fabrik.solve([[0, 0], [0, 1]], [0, 1, 2]), "target"),
+        (lambda: fabrik.solve([[0, 0], [0, 1]], [np.inf, 1]), "target"),
+        (lambda: fabrik.solve([[0, 0], [0, 1]], [0, 1], tolerance=-1.0), "tolerance"),
+        (lambda: fabrik.solve([[0, 0], [0, 1]], [0, 1], max_iterations=0), "max_iterations"),
+        (
+            lambda: fabrik.solve([[0, 0], [0, 1]], [0, 1], cone_half_angle_rad=4.0),
+            "cone_half_angle_rad",
+        ),
+        (
+            lambda: fabrik.solve([[0, 0], [0, 1]], [0, 1], obstacles=[([1, 1], -0.5)]),
+            "obstacles[0] radius",
+        ),
+        (
+            lambda: fabrik.solve([[0, 0], [0, 1]], [0, 1], obstacles=[([1, 1, 1], 0.5)]),
+            "obstacles[0] centre",
+        ),
+        (lambda: fabrik.solve([[0, 0], [0, 1]], [0, 1], root_direction=[0, 0]), "root_direction"),
+        (lambda: fabrik.solve_batch(np.zeros((2, 3, 2)), np.zeros((3, 2))), "targets"),
+        (
+            lambda: fabrik.solve_batch(np.zeros((1, 3, 2)), np.zeros((1, 2)), solver=BAD_SOLVER),
+            "solver",
+        ),
+        (lambda: fabrik.ccd([[0, 0], [0, 1]], [0, 1], tolerance=np.nan), "tolerance"),
+        (lambda: fabrik.jacobian_dls([[0, 0], [0, 1]], [[0, 1]]), "target"),
+        (lambda: fabrik.two_bone([0, 0], -1.0, 1.0, [1, 0], [0, 1]), "upper_length"),
+        (lambda: fabrik.two_bone([0, 0], 1.0, 1.0, [1, 0, 0], [0, 1]), "target"),
+    ],
+)
+def test_invalid_input_names_the_argument(call: object, name: str) -> None:
+    with pytest.raises(ValueError, match=name.replace("[", r"\[").replace("]", r"\]")):
+        call()  # type: ignore[operator]
