@@ -248,24 +248,14 @@ def speed_for_power(
 
     # Region s = +1 (v ≥ −w, air from ahead): a·v³ + 2aw·v² + (aw² + c)·v − p = 0.
     # Region s = −1 (v < −w, tailwind faster than the rider): −a·v³ − 2aw·v² + (−aw² + c)·v − p = 0.
+    # Region +1 lies to the right of region −1, so a root there is the largest; only then look left.
     speed = np.full(a.shape, np.nan)
     for sign in (1.0, -1.0):
         lead = sign * a
-        coefficients = (
-            np.stack([2 * sign * a * w, sign * a * w * w + c, -p], axis=-1) / lead[:, None]
-        )
-        companion = np.zeros((a.size, 3, 3))
-        companion[:, 0, :] = -coefficients
-        companion[:, 1, 0] = 1.0
-        companion[:, 2, 1] = 1.0
-        roots = np.linalg.eigvals(companion)
-        real = roots.real
-        in_region = (np.abs(roots.imag) <= 1e-7 * (1.0 + np.abs(real))) & (real >= -1e-9)
-        boundary = -w
-        in_region &= (
-            real >= boundary[:, None] - 1e-9 if sign > 0 else real <= boundary[:, None] + 1e-9
-        )
-        candidate = np.where(in_region, real, -np.inf).max(axis=1)
+        roots = _cubic_real_roots(2 * sign * a * w / lead, (sign * a * w * w + c) / lead, -p / lead)
+        valid = roots >= -1e-9
+        valid &= roots >= -w[:, None] - 1e-9 if sign > 0 else roots <= -w[:, None] + 1e-9
+        candidate = np.where(valid, roots, -np.inf).max(axis=1)
         take = np.isnan(speed) & np.isfinite(candidate)
         speed[take] = candidate[take]
     speed = np.maximum(np.nan_to_num(speed, nan=0.0), 0.0)
@@ -277,6 +267,31 @@ def speed_for_power(
         step = np.where(np.abs(df) > 1e-12, f / np.where(df == 0, 1.0, df), 0.0)
         speed = np.maximum(speed - step, 0.0)
     return speed.reshape(shape)
+
+
+def _cubic_real_roots(
+    b: NDArray[np.float64], c: NDArray[np.float64], d: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """Real roots of x³ + b·x² + c·x + d = 0, batched: (N, 3), NaN where a root is complex.
+
+    Cardano for one real root, the trigonometric form for three (no complex arithmetic, no loops).
+    """
+    shift = b / 3.0
+    p = c - b * b / 3.0
+    q = 2.0 * b**3 / 27.0 - b * c / 3.0 + d
+    disc = (q / 2.0) ** 2 + (p / 3.0) ** 3
+    roots = np.full(b.shape + (3,), np.nan)
+    one = disc >= 0.0
+    sq = np.sqrt(np.where(one, disc, 0.0))
+    roots[:, 0] = np.where(one, np.cbrt(-q / 2.0 + sq) + np.cbrt(-q / 2.0 - sq) - shift, np.nan)
+    three = ~one
+    m = 2.0 * np.sqrt(np.where(three, -p / 3.0, 0.0))
+    safe_p = np.where(three & (p != 0.0), p, -1.0)
+    arg = np.clip(3.0 * q / (2.0 * safe_p) * np.sqrt(-3.0 / safe_p), -1.0, 1.0)
+    phi = np.arccos(arg) / 3.0
+    for k in range(3):
+        roots[:, k] = np.where(three, m * np.cos(phi - 2.0 * np.pi * k / 3.0) - shift, roots[:, k])
+    return roots
 
 
 def paceline(
