@@ -1,0 +1,144 @@
+"""Benchmark the cycling kernel and the peloton scene's slider-to-screen latency.
+
+    python bench/bench_peloton.py
+
+Prints a table: kernel times for ``power`` on 10⁶ speeds and ``speed_for_power`` (against a plain Python loop
+run in the same process), and, through the websocket test client, the time from a slider message to the
+redrawn scene arriving back (p50, p95), with the server-side handling time on its own.
+"""
+
+from __future__ import annotations
+
+import os
+import statistics
+import sys
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "tests"))
+
+import viser  # noqa: E402
+from wsclient import BrowserClient  # noqa: E402
+
+from kernels import cycling  # noqa: E402
+from scenes.peloton import PelotonScene  # noqa: E402
+from scenes.switcher import SceneSwitcher  # noqa: E402
+
+
+def timings(func: Callable[[], object], repeat: int) -> list[float]:
+    out = []
+    for _ in range(repeat):
+        start = time.perf_counter()
+        func()
+        out.append(time.perf_counter() - start)
+    return out
+
+
+def p95(values: list[float]) -> float:
+    return float(np.percentile(values, 95))
+
+
+def python_loop_power(speeds: list[float]) -> list[float]:
+    """The baseline: the same formula one speed at a time."""
+    rho = 1.225
+    out = []
+    for v in speeds:
+        out.append((0.5 * rho * 0.3 * v * abs(v) * v + 0.004 * 80 * 9.81 * v) / 0.976)
+    return out
+
+
+def row(name: str, values: list[float], unit: float, unit_name: str, note: str = "") -> None:
+    print(
+        f"| {name:<44} | {statistics.median(values) / unit:>10.3f} | {p95(values) / unit:>10.3f} | {unit_name:<4} | {note}"
+    )
+
+
+def main() -> None:
+    print("| measurement                                  |     median |        p95 | unit | note")
+    print("|----------------------------------------------|-----------:|-----------:|------|-----")
+    rng = np.random.default_rng(0)
+    speeds = rng.uniform(0.0, 20.0, 1_000_000)
+    kernel = timings(
+        lambda: cycling.power(speeds, 0.3, 80.0, 0.004, drivetrain_efficiency=0.976), 15
+    )
+    sample = speeds[:100_000].tolist()
+    loop = timings(lambda: python_loop_power(sample), 5)
+    loop_per_million = [t * 10 for t in loop]
+    row(
+        "power, 10^6 speeds",
+        kernel,
+        1e-3,
+        "ms",
+        f"{statistics.median(loop_per_million) / statistics.median(kernel):.0f}x a Python loop",
+    )
+    row("power, Python loop (10^5, scaled to 10^6)", loop_per_million, 1e-3, "ms", "baseline")
+
+    powers = rng.uniform(0.0, 800.0, 100_000)
+    grades = rng.uniform(-0.1, 0.15, 100_000)
+    winds = rng.uniform(-10.0, 10.0, 100_000)
+    inverse = timings(
+        lambda: cycling.speed_for_power(powers, 0.3, 80.0, 0.004, grade=grades, headwind_ms=winds),
+        7,
+    )
+    row(
+        "speed_for_power, 10^5 (grade, wind mixed)",
+        inverse,
+        1e-3,
+        "ms",
+        f"{statistics.median(inverse) / 1e5 * 1e9:.0f} ns each",
+    )
+    single = timings(lambda: cycling.speed_for_power(250.0, 0.3, 80.0, 0.004), 200)
+    row("speed_for_power, one value", single, 1e-6, "us")
+
+    server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
+    switcher = SceneSwitcher(server, "peloton")
+    scene = switcher.scene
+    assert isinstance(scene, PelotonScene)
+    handling: list[float] = []
+    inner = scene._on_input
+
+    def timed_on_input() -> None:
+        start = time.perf_counter()
+        inner()
+        handling.append(time.perf_counter() - start)
+
+    scene.speed.remove_update_callback()
+    scene.speed.on_update(scene.callback(timed_on_input))
+
+    round_trips: list[float] = []
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Speed (km/h)")
+        time.sleep(0.5)
+        for i in range(120):
+            speed = 20.0 + (i % 50)
+            expected = f"**{float(cycling.paceline(4, 0.5, speed / 3.6, 0.32, 80.0, 0.004, drivetrain_efficiency=0.976, model='measured').total[0]):.0f}**"
+            start = time.perf_counter()
+            client.set_value("Speed (km/h)", speed)
+            client.wait_for(
+                lambda expected=expected: any(
+                    expected in str(e["props"].get("_markdown", "")) for e in client.gui.values()
+                ),
+                what="redrawn table",
+            )
+            round_trips.append(time.perf_counter() - start)
+            time.sleep(0.02)
+    switcher.close()
+    server.stop()
+    row("slider -> callback -> redraw (server side)", handling, 1e-3, "ms", "goal p95 <= 5 ms")
+    row("slider message -> redraw back at client", round_trips, 1e-3, "ms", "goal p95 <= 20 ms")
+    print(
+        f"\nmachine: {sys.platform}, {_cpus()} CPUs, Python {sys.version.split()[0]}, numpy {np.__version__}"
+    )
+
+
+def _cpus() -> int:
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 0
+
+
+if __name__ == "__main__":
+    main()
