@@ -566,8 +566,11 @@ time-averaged power is the mean over positions, far below the leader's.
         k = int(self._rotation_time_s // float(self.turn.value))
         return (np.arange(n) - k) % n
 
-    def redraw(self) -> None:
-        """Push the current state to every node and readout, in one atomic update."""
+    def redraw(self, *, readouts: bool = True) -> None:
+        """Push the current state to the riders, bars and labels and, with ``readouts``, to the GUI outputs.
+
+        One atomic update; the animation redraws without readouts, which do not change as riders move.
+        """
         p, state = self.params, self.state
         n = p.n_riders
         slots = self.current_slots()
@@ -606,20 +609,20 @@ time-averaged power is the mean over positions, far below the leader's.
                 label.visible = i < n
                 if i < n:
                     watts = float(total[slots[i]])
+                    solo = float(state.solo.total)
                     share = (
-                        100.0 * watts / float(state.solo.total)
-                        if float(state.solo.total) > 0
-                        else float("nan")
+                        f"{100.0 * watts / solo:.0f} % of solo" if solo > 0 else "solo needs 0 W"
                     )
-                    label.text = f"{watts:.0f} W · {share:.0f} % of solo"
+                    label.text = f"{watts:.0f} W · {share}"
                     label.position = (x[i], y[i], 1.95 + base[i])
 
-            self._draw_wind()
-            self.density.content = self._density_markdown()
-            self.table.content = self._table_markdown()
             self.rotation.content = self._rotation_markdown()
-            self.chart.data = self._chart_data()
-            self.speed_out.content = self._speed_markdown()
+            if readouts:
+                self._draw_wind()
+                self.density.content = self._density_markdown()
+                self.table.content = self._table_markdown()
+                self.chart.data = self._chart_data()
+                self.speed_out.content = self._speed_markdown()
         self.server.flush()
 
     def _draw_wind(self) -> None:
@@ -697,7 +700,7 @@ time-averaged power is the mean over positions, far below the leader's.
         self._energy_j[: self.params.n_riders] += np.asarray(self.state.power.total)[slots] * dt
         self._ridden_s += dt
         self._rotation_time_s += dt
-        self.redraw()
+        self.redraw(readouts=False)
 
     def rider_average_power(self) -> np.ndarray:
         """(n_riders,) time-averaged power of each rider since the rotation started (W); zeros before."""

@@ -107,6 +107,20 @@ def test_rotating_the_lead_equalises_time_averaged_power(scene: PelotonScene) ->
             scene._animate(0.1)
         averages = scene.rider_average_power()
         slots_after = scene.current_slots()
+        for _ in range(
+            27
+        ):  # part-way into the turn after next: each rider's label and bar show its current slot's power
+            scene._animate(0.1)
+        totals = (
+            sum(bar_heights(scene, c) for c in ("aero", "rolling", "climbing"))
+            / BAR_METRES_PER_WATT
+        )
+        slots_now = scene.current_slots()
+        assert slots_now.tolist() != list(range(4))
+        for rider in range(4):
+            watts = float(scene.state.power.total[slots_now[rider]])
+            assert scene.labels[rider].text.startswith(f"{watts:.0f} W")
+            assert totals[rider] == pytest.approx(watts * 0.976, rel=1e-3)  # bars show wheel power
     mean = float(np.mean(scene.state.power.total))
     np.testing.assert_allclose(averages, mean, rtol=0.02)
     assert mean < float(scene.state.power.total[0])
@@ -192,7 +206,9 @@ def _shown_matches(shown: object, expected: object) -> bool:
     if isinstance(expected, str):
         return isinstance(shown, str) and shown != "telepathy" and shown != "upside down"
     assert isinstance(expected, (int, float))
-    return isinstance(shown, (int, float)) and math.isfinite(shown) and float(shown) == float(expected)
+    return (
+        isinstance(shown, (int, float)) and math.isfinite(shown) and float(shown) == float(expected)
+    )
 
 
 def test_wrong_types_and_unknown_messages_leave_the_server_serving(
