@@ -22,6 +22,7 @@ import time
 from collections.abc import Callable, Sequence
 from typing import Any, ClassVar, TypeVar
 
+import numpy as np
 import viser
 
 logger = logging.getLogger(__name__)
@@ -161,6 +162,30 @@ class Scene(abc.ABC):
             return raw
         self._write_back(handle, last_good)
         return last_good
+
+    def read_position(
+        self,
+        handle: Any,
+        last_good: tuple[float, float, float],
+        lo: tuple[float, float, float],
+        hi: tuple[float, float, float],
+    ) -> tuple[float, float, float]:
+        """A gizmo's ``.position`` clamped to the box [lo, hi]; ``last_good`` if any coordinate is not finite.
+
+        Setting a transform control's position from the server does not run its ``on_update``, so the cleaned
+        value is written straight back.
+        """
+        try:
+            raw = np.asarray(handle.position, dtype=np.float64).reshape(3)
+        except (TypeError, ValueError):
+            raw = np.full(3, np.nan)
+        if np.all(np.isfinite(raw)):
+            cleaned = np.clip(raw, np.asarray(lo, np.float64), np.asarray(hi, np.float64))
+        else:
+            cleaned = np.asarray(last_good, dtype=np.float64)
+        if not np.array_equal(cleaned, raw):
+            handle.position = tuple(cleaned)
+        return (float(cleaned[0]), float(cleaned[1]), float(cleaned[2]))
 
     def _write_back(self, handle: Any, value: Any) -> None:
         was = self._in_callback
