@@ -474,6 +474,34 @@ def scene_bounds(scene: Scene) -> FloatArray:
 
 
 # ------------------------------------------------------------------------------------------ sphere tracing
+def scene_bounding_sphere(scene: Scene) -> tuple[FloatArray, float]:
+    """A sphere that holds the scene with room for the blend: centre (3,) in metres and radius (m).
+
+    Rays that miss it miss the scene, and marching starts where a ray enters it and stops where it leaves.
+    """
+    box = scene_bounds(scene)
+    center = 0.5 * (box[0] + box[1])
+    radius = max(
+        float(np.linalg.norm(np.asarray(p.center) - center)) + p.bounding_radius
+        for p in scene.primitives
+    )
+    return center, radius + scene.k
+
+
+def ray_sphere_interval(
+    origins: FloatArray, directions: FloatArray, center: FloatArray, radius: float
+) -> tuple[FloatArray, FloatArray]:
+    """Where unit rays enter and leave a sphere: (N,) t_enter ≥ 0 and t_exit, with t_exit < t_enter for a miss."""
+    oc = origins - center
+    b = np.einsum("ij,ij->i", oc, directions)
+    c = np.einsum("ij,ij->i", oc, oc) - radius * radius
+    disc = b * b - c
+    root = np.sqrt(np.maximum(disc, 0.0))
+    t_enter = np.maximum(-b - root, 0.0)
+    t_exit = np.where(disc >= 0.0, -b + root, -1.0)
+    return t_enter, t_exit
+
+
 def sphere_trace(
     scene: Scene,
     origins: ArrayLike,
@@ -485,7 +513,8 @@ def sphere_trace(
 ) -> FloatArray:
     """March rays by the distance bound until it drops below ``hit_epsilon``·max(1, t) (Hart 1996).
 
-    ``shaders/raymarch.frag`` runs the same loop, so the two can be compared ray by ray.
+    Marching runs over the part of each ray inside :func:`scene_bounding_sphere`. ``shaders/raymarch.frag`` runs
+    the same loop, so the two can be compared ray by ray.
 
     Args:
         scene: the scene.
@@ -506,9 +535,11 @@ def sphere_trace(
         raise ValueError(f"max_steps must be in 1..10000, got {max_steps}")
     eps = _positive(hit_epsilon, "hit_epsilon")
     far = _positive(max_distance, "max_distance")
-    t = np.zeros(len(o))
+    center, radius = scene_bounding_sphere(scene)
+    t, t_exit = ray_sphere_interval(o, d, center, radius)
+    t_exit = np.minimum(t_exit, far)
     hit = np.zeros(len(o), dtype=bool)
-    active = np.ones(len(o), dtype=bool)
+    active = t_exit >= t
     for _ in range(int(max_steps)):
         idx = np.flatnonzero(active)
         if idx.size == 0:
@@ -517,7 +548,7 @@ def sphere_trace(
         done = dist < eps * np.maximum(1.0, t[idx])
         hit[idx[done]] = True
         t[idx[~done]] += dist[~done]
-        escaped = t[idx] > far
+        escaped = t[idx] > t_exit[idx]
         active[idx[done | escaped]] = False
     return np.where(hit, t, np.inf)
 

@@ -1,0 +1,124 @@
+#version 330
+// Sphere-traces the scene in sdf.glsl (Hart 1996) from a pinhole camera, one ray per pixel centre, the same loop
+// as kernels/sdf.py sphere_trace. Normals by central differences; Phong shading; soft shadows with Quilez's improved
+// technique (2018: track the previous step to find the closest approach between samples, no banding); ambient
+// occlusion from five samples along the normal.
+
+// SHADOWS and OCCLUSION (0 or 1) are defined by the renderer, which compiles the four variants once each: a
+// switched-off term then costs nothing (a uniform flag would still be paid for under llvmpipe's masking).
+
+#include "sdf.glsl"
+#include "shading.glsl"
+
+uniform vec2 u_resolution;       // pixels
+uniform vec3 u_eye;              // camera position (m)
+uniform vec3 u_forward;          // unit view axis
+uniform vec3 u_right;            // unit, image x
+uniform vec3 u_up;               // unit, image y
+uniform float u_tan_half_fov;    // tan(vertical fov / 2)
+uniform int u_max_steps;
+uniform float u_hit_epsilon;     // m at t <= 1, relative beyond
+uniform float u_max_distance;    // m
+uniform float u_normal_epsilon;  // central-difference step (m)
+uniform float u_shadow_sharpness;  // k of the soft shadow: larger is harder
+uniform float u_occlusion_strength;
+uniform float u_occlusion_step;  // m between AO samples
+uniform vec3 u_bound_center;     // kernels/sdf.py scene_bounding_sphere: march only inside it
+uniform float u_bound_radius;
+
+layout(location = 0) out vec4 out_color;
+layout(location = 1) out float out_depth;  // along u_forward (m); -1 for a miss
+
+vec3 scene_normal(vec3 p) {
+    vec2 e = vec2(u_normal_epsilon, 0.0);
+    return normalize(vec3(
+        scene_distance(p + e.xyy) - scene_distance(p - e.xyy),
+        scene_distance(p + e.yxy) - scene_distance(p - e.yxy),
+        scene_distance(p + e.yyx) - scene_distance(p - e.yyx)));
+}
+
+// Where a unit ray enters and leaves the bounding sphere: (t_enter >= 0, t_exit), t_exit < t_enter for a miss.
+vec2 bound_interval(vec3 origin, vec3 dir) {
+    vec3 oc = origin - u_bound_center;
+    float b = dot(oc, dir);
+    float disc = b * b - (dot(oc, oc) - u_bound_radius * u_bound_radius);
+    if (disc < 0.0) {
+        return vec2(0.0, -1.0);
+    }
+    float root = sqrt(disc);
+    return vec2(max(-b - root, 0.0), -b + root);
+}
+
+float soft_shadow(vec3 origin, vec3 dir, float t_min, float t_max, float k) {
+    float result = 1.0;
+    float t = t_min;
+    float previous = 1e20;
+    for (int i = 0; i < 40 && t < t_max; ++i) {
+        float h = scene_distance(origin + dir * t);
+        if (h < 1e-4) {
+            return 0.0;
+        }
+        // The two distance spheres' overlap locates the closest approach between samples; only while the ray
+        // closes in (h < previous): moving away (h = 2·previous straight off a plane) would give d = 0, a false
+        // shadow, and the previous sample already holds the closest approach.
+        float y = h < previous ? h * h / (2.0 * previous) : 0.0;
+        float d = sqrt(max(h * h - y * y, 0.0));
+        result = min(result, k * d / max(1e-6, t - y));
+        previous = h;
+        t += clamp(h, 0.005, 0.25);  // bounded steps, as Quilez does: no tiny crawls, no skipped thin parts
+    }
+    return clamp(result, 0.0, 1.0);
+}
+
+float ambient_occlusion(vec3 p, vec3 n) {
+    float occlusion = 0.0;
+    float weight = 1.0;
+    for (int i = 1; i <= 5; ++i) {
+        float h = u_occlusion_step * float(i);
+        occlusion += (h - scene_distance(p + n * h)) * weight;
+        weight *= 0.75;
+    }
+    return clamp(1.0 - u_occlusion_strength * occlusion, 0.0, 1.0);
+}
+
+void main() {
+    vec2 ndc = gl_FragCoord.xy / u_resolution * 2.0 - 1.0;
+    float aspect = u_resolution.x / u_resolution.y;
+    vec3 dir = normalize(u_forward + ndc.x * u_tan_half_fov * aspect * u_right + ndc.y * u_tan_half_fov * u_up);
+
+    vec2 span = bound_interval(u_eye, dir);
+    float t = span.x;
+    float t_exit = min(span.y, u_max_distance);
+    bool hit = false;
+    for (int i = 0; i < u_max_steps && t_exit >= t; ++i) {
+        float d = scene_distance(u_eye + dir * t);
+        if (d < u_hit_epsilon * max(1.0, t)) {
+            hit = true;
+            break;
+        }
+        t += d;
+        if (t > t_exit) {
+            break;
+        }
+    }
+    if (!hit) {
+        // Misses keep the cleared target (depth -1). On llvmpipe a discard is also what lets a block of pixels
+        // that all missed skip the shading below: it runs both sides of an if, masked, but exits dead blocks.
+        discard;
+    }
+    vec3 p = u_eye + dir * t;
+    vec3 n = scene_normal(p);
+    float shadow = 1.0;
+#if SHADOWS
+    vec3 start = p + n * (4.0 * u_hit_epsilon * max(1.0, t));
+    float t_max = bound_interval(start, u_light_direction).y;
+    shadow = soft_shadow(start, u_light_direction, 0.01, t_max, u_shadow_sharpness);
+#endif
+    float occlusion = 1.0;
+#if OCCLUSION
+    occlusion = ambient_occlusion(p, n);
+#endif
+    vec3 color = phong(scene_color(p), n, -dir, shadow, occlusion);
+    out_color = vec4(clamp(color, 0.0, 1.0), 1.0);
+    out_depth = t * dot(dir, u_forward);
+}

@@ -1,0 +1,555 @@
+"""A small offscreen renderer: ray-marches an SDF scene in GLSL and rasterises its mesh from the same camera.
+
+It uses moderngl's standalone context on EGL: Mesa llvmpipe on a machine without a GPU, the GPU where there is one.
+Programs are compiled once per :class:`Renderer`; the scene reaches ``sdf.glsl`` as uniforms, so moving or changing
+a primitive never recompiles anything.
+
+Camera model: a pinhole at ``position`` looking at ``look_at`` with ``up`` and a vertical field of view. Pixel
+``(row, col)`` (row 0 at the top) looks along ``forward + x·tan(fov/2)·aspect·right + y·tan(fov/2)·up`` with
+``x = 2(col + ½)/W − 1`` and ``y = 1 − 2(row + ½)/H``; :func:`camera_rays` gives the same rays in numpy. Depth is
+the distance along the view axis (m), ``inf`` where nothing is hit; the rasterised mesh uses the same convention,
+so the two images compare pixel for pixel.
+
+An EGL context lives on the thread that made it: use a :class:`Renderer` on the thread that created it (the
+module-level :func:`render` keeps one per thread).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import threading
+from pathlib import Path
+
+import numpy as np
+import trimesh
+from numpy.typing import ArrayLike, NDArray
+
+from kernels import sdf
+
+KIND_CODE: dict[str, int] = {"sphere": 0, "box": 1, "torus": 2, "capsule": 3}
+OP_CODE: dict[str, int] = {"union": 0, "subtract": 1, "intersect": 2}
+BLEND_CODE: dict[str, int] = {"poly": 0, "exp": 1}
+_MISS = -1.0
+"""Depth the shaders write where no surface is hit; read back as inf."""
+_PROBE_WIDTH = 256
+
+
+class GLUnavailableError(RuntimeError):
+    """No OpenGL 3.3 context could be created; the mesh side of the app keeps working without one."""
+
+
+@dataclasses.dataclass(frozen=True)
+class Camera:
+    """A pinhole camera in the world frame (Z up)."""
+
+    position: tuple[float, float, float]
+    """Eye position (m)."""
+    look_at: tuple[float, float, float]
+    """Point the view axis passes through (m)."""
+    up: tuple[float, float, float] = (0.0, 0.0, 1.0)
+    """Approximate up direction; made orthogonal to the view axis."""
+    fov_y_rad: float = math.radians(50.0)
+    """Vertical field of view (rad), in (0, π)."""
+
+    def __post_init__(self) -> None:
+        eye, target, up = (
+            np.asarray(v, dtype=np.float64) for v in (self.position, self.look_at, self.up)
+        )
+        for name, v in (("position", eye), ("look_at", target), ("up", up)):
+            if v.shape != (3,) or not np.all(np.isfinite(v)):
+                raise ValueError(f"{name} must be 3 finite numbers, got {v.tolist()}")
+        forward = target - eye
+        if np.linalg.norm(forward) < 1e-9:
+            raise ValueError("look_at must differ from position")
+        if np.linalg.norm(np.cross(forward, up)) < 1e-9 * np.linalg.norm(forward) * max(
+            np.linalg.norm(up), 1e-30
+        ):
+            raise ValueError("up must not be parallel to the view axis")
+        if not (math.isfinite(self.fov_y_rad) and 0.0 < self.fov_y_rad < math.pi):
+            raise ValueError(f"fov_y_rad must be in (0, π), got {self.fov_y_rad}")
+
+    def basis(self) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+        """Unit (forward, right, up) vectors of the image."""
+        forward = np.subtract(self.look_at, self.position).astype(np.float64)
+        forward /= np.linalg.norm(forward)
+        right = np.cross(forward, self.up)
+        right /= np.linalg.norm(right)
+        return forward, right, np.cross(right, forward)
+
+    def view_projection(self, aspect: float, near: float, far: float) -> NDArray[np.float64]:
+        """(4, 4) OpenGL clip-from-world matrix for this camera."""
+        forward, right, up = self.basis()
+        eye = np.asarray(self.position, dtype=np.float64)
+        view = np.eye(4)
+        view[0, :3], view[1, :3], view[2, :3] = right, up, -forward
+        view[:3, 3] = -view[:3, :3] @ eye
+        f = 1.0 / math.tan(self.fov_y_rad / 2)
+        proj = np.zeros((4, 4))
+        proj[0, 0], proj[1, 1] = f / aspect, f
+        proj[2, 2], proj[2, 3] = (far + near) / (near - far), 2 * far * near / (near - far)
+        proj[3, 2] = -1.0
+        return proj @ view
+
+
+@dataclasses.dataclass(frozen=True)
+class Shading:
+    """Lighting and marching parameters of the reference image; defaults are the gallery's opening values."""
+
+    ambient: float = 0.2
+    """k_a, ambient reflection."""
+    diffuse: float = 0.75
+    """k_d, diffuse reflection."""
+    specular: float = 0.3
+    """k_s, specular reflection."""
+    shininess: float = 32.0
+    """α, Phong exponent."""
+    light_direction: tuple[float, float, float] = (0.45, -0.35, 0.82)
+    """Direction toward the light (world), normalised on use."""
+    shadows: bool = True
+    """Soft shadows (Quilez's improved technique)."""
+    shadow_sharpness: float = 8.0
+    """k of the soft shadow: penumbra width ∝ 1/k."""
+    occlusion: bool = True
+    """Ambient occlusion along the normal."""
+    occlusion_strength: float = 3.0
+    """How strongly occluded samples darken the ambient term."""
+    occlusion_step: float = 0.04
+    """Distance between the five AO samples (m)."""
+    background: tuple[float, float, float] = (0.93, 0.94, 0.96)
+    """Linear RGB where no surface is hit."""
+    max_steps: int = 256
+    """Sphere-tracing steps before a ray counts as a miss."""
+    hit_epsilon: float = 1e-4
+    """Hit threshold (m at t ≤ 1, relative beyond)."""
+    max_distance: float = 100.0
+    """Rays longer than this miss (m)."""
+    normal_epsilon: float = 1e-3
+    """Central-difference step for normals (m)."""
+
+    def __post_init__(self) -> None:
+        for name in ("ambient", "diffuse", "specular", "occlusion_strength"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and 0.0 <= value <= 10.0):
+                raise ValueError(f"{name} must be in [0, 10], got {value}")
+        for name in (
+            "shininess",
+            "shadow_sharpness",
+            "occlusion_step",
+            "hit_epsilon",
+            "max_distance",
+        ):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value > 0.0):
+                raise ValueError(f"{name} must be finite and positive, got {value}")
+        if not (math.isfinite(self.normal_epsilon) and self.normal_epsilon > 0.0):
+            raise ValueError(
+                f"normal_epsilon must be finite and positive, got {self.normal_epsilon}"
+            )
+        light = np.asarray(self.light_direction, dtype=np.float64)
+        if light.shape != (3,) or not np.all(np.isfinite(light)) or np.linalg.norm(light) < 1e-9:
+            raise ValueError(
+                f"light_direction must be a finite non-zero 3-vector, got {light.tolist()}"
+            )
+        if not 1 <= self.max_steps <= 4096:
+            raise ValueError(f"max_steps must be in 1..4096, got {self.max_steps}")
+
+
+def camera_rays(
+    camera: Camera, width: int, height: int
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The renderer's rays in numpy: origins and unit directions, (H·W, 3) each, row-major from the top row."""
+    _check_size(width, height)
+    forward, right, up = camera.basis()
+    tan_half = math.tan(camera.fov_y_rad / 2)
+    x = (2 * (np.arange(width) + 0.5) / width - 1) * tan_half * width / height
+    y = (1 - 2 * (np.arange(height) + 0.5) / height) * tan_half
+    dirs = forward + x[None, :, None] * right + y[:, None, None] * up
+    dirs = dirs.reshape(-1, 3)
+    dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
+    origins = np.broadcast_to(np.asarray(camera.position, dtype=np.float64), dirs.shape).copy()
+    return origins, dirs
+
+
+def _sphere_scissor(
+    camera: Camera, scene: sdf.Scene, width: int, height: int
+) -> tuple[int, int, int, int]:
+    """(x, y, w, h) pixel rectangle (GL origin bottom left) holding the screen image of the bounding sphere.
+
+    Conservative: the rectangle bounds the projected corners of the sphere's bounding box, widened by a pixel;
+    if any corner lies near or behind the eye it is the whole image.
+    """
+    center, radius = sdf.scene_bounding_sphere(scene)
+    corners = center + radius * np.array(
+        [[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]
+    )
+    forward, right, up = camera.basis()
+    rel = corners - np.asarray(camera.position)
+    z = rel @ forward
+    if np.any(z < 1e-3):
+        return (0, 0, width, height)
+    tan_half = math.tan(camera.fov_y_rad / 2)
+    x_ndc = (rel @ right) / (z * tan_half * width / height)
+    y_ndc = (rel @ up) / (z * tan_half)
+    x0 = int(np.clip(math.floor((x_ndc.min() + 1) / 2 * width) - 1, 0, width))
+    x1 = int(np.clip(math.ceil((x_ndc.max() + 1) / 2 * width) + 1, 0, width))
+    y0 = int(np.clip(math.floor((y_ndc.min() + 1) / 2 * height) - 1, 0, height))
+    y1 = int(np.clip(math.ceil((y_ndc.max() + 1) / 2 * height) + 1, 0, height))
+    return (x0, y0, max(x1 - x0, 0), max(y1 - y0, 0))
+
+
+def _check_size(width: int, height: int) -> None:
+    for name, value in (("width", width), ("height", height)):
+        if (
+            isinstance(value, bool)
+            or not isinstance(value, (int, np.integer))
+            or not 1 <= value <= 8192
+        ):
+            raise ValueError(f"{name} must be an integer in 1..8192, got {value!r}")
+
+
+SHADER_DIR = Path(__file__).resolve().parent
+"""Where the GLSL files live (installed as package data next to this module)."""
+
+
+def _source(name: str) -> str:
+    return (SHADER_DIR / name).read_text(encoding="utf-8")
+
+
+def _with_defines(source: str, **defines: int) -> str:
+    """``source`` with ``#define NAME value`` lines after its ``#version`` line."""
+    version, rest = source.split("\n", 1)
+    assert version.startswith("#version")
+    return "\n".join([version, *(f"#define {k} {v}" for k, v in defines.items()), rest])
+
+
+def create_context() -> object:
+    """A standalone OpenGL 3.3+ context on EGL, or :class:`GLUnavailableError` saying why not."""
+    try:
+        import moderngl
+    except ImportError as exc:  # pragma: no cover - moderngl is a dependency
+        raise GLUnavailableError(
+            f"moderngl is not installed ({exc}); the reference image needs it"
+        ) from exc
+    try:
+        # moderngl's stub types `backend` wrongly (as a dict); the runtime takes the backend's name.
+        return moderngl.create_standalone_context(backend="egl", require=330)  # pyright: ignore[reportArgumentType]
+    except Exception as exc:
+        raise GLUnavailableError(
+            "No OpenGL 3.3 context on EGL, so the GLSL reference image cannot be rendered "
+            f"({type(exc).__name__}: {exc}). Install Mesa's EGL (Debian: libegl1 libgl1-mesa-dri) or run on a "
+            "machine with a GPU driver; the mesh view works without it."
+        ) from exc
+
+
+class Renderer:
+    """Compiled programs on one EGL context; use it on the thread that created it."""
+
+    def __init__(self) -> None:
+        import moderngl
+
+        ctx = create_context()
+        assert isinstance(ctx, moderngl.Context)
+        self.ctx = ctx
+        self.ctx.includes["sdf.glsl"] = _source("sdf.glsl")
+        self.ctx.includes["shading.glsl"] = _source("shading.glsl")
+        fullscreen = _source("fullscreen.vert")
+        raymarch = _source("raymarch.frag")
+        self._raymarch = {
+            (shadows, occlusion): self.ctx.program(
+                vertex_shader=fullscreen,
+                fragment_shader=_with_defines(
+                    raymarch, SHADOWS=int(shadows), OCCLUSION=int(occlusion)
+                ),
+            )
+            for shadows in (False, True)
+            for occlusion in (False, True)
+        }
+        self._raymarch_vao = {
+            key: self.ctx.vertex_array(prog, []) for key, prog in self._raymarch.items()
+        }
+        self._probe = self.ctx.program(
+            vertex_shader=fullscreen, fragment_shader=_source("probe.frag")
+        )
+        self._mesh = self.ctx.program(
+            vertex_shader=_source("mesh.vert"), fragment_shader=_source("mesh.frag")
+        )
+        self._probe_vao = self.ctx.vertex_array(self._probe, [])
+        self.renderer_name = str(self.ctx.info.get("GL_RENDERER", "unknown"))
+        self._target_size: tuple[int, int] | None = None
+        self._target_objects: list = []
+
+    def release(self) -> None:
+        self.ctx.release()
+
+    # ------------------------------------------------------------------------------------- uniforms
+    def _set(self, program: object, name: str, value: object) -> None:
+        import moderngl
+
+        assert isinstance(program, moderngl.Program)
+        if name in program:  # the GLSL compiler drops uniforms a program does not use
+            uniform = program[name]
+            assert isinstance(uniform, moderngl.Uniform)
+            uniform.value = value
+
+    def _write(self, program: object, name: str, data: NDArray[np.generic]) -> None:
+        import moderngl
+
+        assert isinstance(program, moderngl.Program)
+        if name in program:
+            uniform = program[name]
+            assert isinstance(uniform, moderngl.Uniform)
+            uniform.write(np.ascontiguousarray(data).tobytes())
+
+    def _set_scene(self, program: object, scene: sdf.Scene) -> None:
+        n = sdf.MAX_PRIMITIVES
+        kind, op = np.zeros(n, np.int32), np.zeros(n, np.int32)
+        center, size, color = (
+            np.zeros((n, 3), np.float32),
+            np.zeros((n, 3), np.float32),
+            np.zeros((n, 3), np.float32),
+        )
+        rotation = np.tile(np.eye(3, dtype=np.float32), (n, 1, 1))
+        for i, prim in enumerate(scene.primitives):
+            kind[i], op[i] = KIND_CODE[prim.kind], OP_CODE[prim.op]
+            center[i], color[i] = prim.center, prim.color
+            size[i, : len(prim.size)] = prim.size
+            # GLSL mat3 is column-major: writing R row by row gives the matrix Rᵀ (world to local).
+            rotation[i] = sdf.rotation_matrix(prim.rotation)
+        self._set(program, "u_count", len(scene.primitives))
+        self._write(program, "u_kind", kind)
+        self._write(program, "u_op", op)
+        self._write(program, "u_center", center)
+        self._write(program, "u_size", size)
+        self._write(program, "u_world_to_local", rotation)
+        self._write(program, "u_color", color)
+        self._set(program, "u_k", float(scene.k))
+        self._set(program, "u_blend", BLEND_CODE[scene.blend])
+        center, radius = sdf.scene_bounding_sphere(scene)
+        self._set(program, "u_bound_center", tuple(float(v) for v in center))
+        self._set(program, "u_bound_radius", float(radius))
+
+    def _set_shading(self, program: object, shading: Shading) -> None:
+        light = np.asarray(shading.light_direction, dtype=np.float64)
+        self._set(program, "u_ambient", shading.ambient)
+        self._set(program, "u_diffuse", shading.diffuse)
+        self._set(program, "u_specular", shading.specular)
+        self._set(program, "u_shininess", shading.shininess)
+        self._set(program, "u_light_direction", tuple(light / np.linalg.norm(light)))
+
+    def _targets(self, width: int, height: int) -> tuple[object, object, object]:
+        """Colour (RGBA8), depth (R32F) and z-buffer of this size, kept between calls (new ones cost a draw)."""
+        if self._target_size != (width, height):
+            for obj in self._target_objects:
+                obj.release()
+            color = self.ctx.texture((width, height), 4, dtype="f1")
+            depth = self.ctx.texture((width, height), 1, dtype="f4")
+            zbuffer = self.ctx.depth_renderbuffer((width, height))
+            fbo = self.ctx.framebuffer(color_attachments=[color, depth], depth_attachment=zbuffer)
+            self._target_objects = [fbo, color, depth, zbuffer]
+            self._target_size = (width, height)
+        fbo, color, depth, _ = self._target_objects
+        return fbo, color, depth
+
+    def _read(
+        self, color: object, depth: object, width: int, height: int, shading: Shading
+    ) -> tuple[NDArray[np.uint8], NDArray[np.float32]]:
+        import moderngl
+
+        assert isinstance(color, moderngl.Texture) and isinstance(depth, moderngl.Texture)
+        rgb = np.frombuffer(color.read(), np.uint8).reshape(height, width, 4)[::-1, :, :3].copy()
+        z = np.frombuffer(depth.read(), np.float32).reshape(height, width)[::-1].copy()
+        miss = z == _MISS
+        z[miss] = np.inf
+        background = np.clip(np.round(np.asarray(shading.background) * 255), 0, 255).astype(
+            np.uint8
+        )
+        rgb[miss] = background
+        return rgb, z
+
+    # ------------------------------------------------------------------------------------- passes
+    def render(
+        self,
+        scene: sdf.Scene,
+        camera: Camera,
+        width: int,
+        height: int,
+        shading: Shading | None = None,
+    ) -> tuple[NDArray[np.uint8], NDArray[np.float32]]:
+        """Ray-march the scene.
+
+        Args:
+            scene: the SDF scene.
+            camera: where it is seen from.
+            width: image width (px).
+            height: image height (px).
+            shading: lighting and marching parameters (defaults if None).
+
+        Returns:
+            RGB (H, W, 3) uint8 (row 0 at the top) and depth along the view axis (H, W) float32 in metres, inf
+            where a ray misses.
+        """
+        import moderngl
+
+        _check_size(width, height)
+        shading = shading or Shading()
+        variant = (shading.shadows, shading.occlusion)
+        prog = self._raymarch[variant]
+        self._set_scene(prog, scene)
+        self._set_shading(prog, shading)
+        forward, right, up = camera.basis()
+        self._set(prog, "u_resolution", (float(width), float(height)))
+        self._set(prog, "u_eye", tuple(float(v) for v in camera.position))
+        self._set(prog, "u_forward", tuple(forward))
+        self._set(prog, "u_right", tuple(right))
+        self._set(prog, "u_up", tuple(up))
+        self._set(prog, "u_tan_half_fov", math.tan(camera.fov_y_rad / 2))
+        self._set(prog, "u_max_steps", int(shading.max_steps))
+        self._set(prog, "u_hit_epsilon", shading.hit_epsilon)
+        self._set(prog, "u_max_distance", shading.max_distance)
+        self._set(prog, "u_normal_epsilon", shading.normal_epsilon)
+        self._set(prog, "u_shadow_sharpness", shading.shadow_sharpness)
+        self._set(prog, "u_occlusion_strength", shading.occlusion_strength)
+        self._set(prog, "u_occlusion_step", shading.occlusion_step)
+        fbo, color, depth = self._targets(width, height)
+        assert isinstance(fbo, moderngl.Framebuffer)
+        fbo.use()
+        fbo.scissor = (0, 0, width, height)
+        fbo.clear(_MISS, _MISS, _MISS, 0.0)
+        # Only pixels whose rays can meet the bounding sphere run the shader (llvmpipe pays for every pixel).
+        fbo.scissor = _sphere_scissor(camera, scene, width, height)
+        self.ctx.disable(moderngl.DEPTH_TEST)
+        self._raymarch_vao[variant].render(moderngl.TRIANGLES, vertices=3)
+        fbo.scissor = (0, 0, width, height)
+        return self._read(color, depth, width, height, shading)
+
+    def render_mesh(
+        self,
+        vertices: ArrayLike,
+        faces: ArrayLike,
+        colors: ArrayLike,
+        camera: Camera,
+        width: int,
+        height: int,
+        shading: Shading | None = None,
+    ) -> tuple[NDArray[np.uint8], NDArray[np.float32]]:
+        """Rasterise a triangle mesh (e.g. :func:`kernels.sdf.mesh`'s) with the same camera and Phong terms.
+
+        Args:
+            vertices: (V, 3) world positions (m).
+            faces: (F, 3) vertex indices.
+            colors: (V, 3) linear RGB in [0, 1].
+            camera: where it is seen from.
+            width: image width (px).
+            height: image height (px).
+            shading: lighting (its shadows and AO are not used here).
+
+        Returns:
+            RGB (H, W, 3) uint8 and depth along the view axis (H, W) float32 (m), inf where no triangle covers
+            the pixel centre.
+        """
+        import moderngl
+
+        _check_size(width, height)
+        shading = shading or Shading()
+        v = np.asarray(vertices, dtype=np.float64)
+        f = np.asarray(faces, dtype=np.int64)
+        c = np.asarray(colors, dtype=np.float64)
+        if v.ndim != 2 or v.shape[1] != 3 or not np.all(np.isfinite(v)):
+            raise ValueError(f"vertices must be finite (V, 3), got {v.shape}")
+        if f.ndim != 2 or f.shape[1] != 3 or (f.size and (f.min() < 0 or f.max() >= len(v))):
+            raise ValueError(f"faces must be (F, 3) indices into vertices, got {f.shape}")
+        if c.shape != v.shape:
+            raise ValueError(f"colors must match vertices' shape {v.shape}, got {c.shape}")
+        normals = (
+            trimesh.Trimesh(v, f, process=False).vertex_normals if len(f) else np.zeros_like(v)
+        ).astype(np.float32)
+        eye = np.asarray(camera.position, dtype=np.float64)
+        forward, _, _ = camera.basis()
+        reach = np.linalg.norm(v - eye, axis=1).max() if len(v) else 1.0
+        near, far = max(1e-3, 1e-3 * reach), 2.0 * reach + 1.0
+        prog = self._mesh
+        self._set_shading(prog, shading)
+        self._write(
+            prog,
+            "u_view_projection",
+            camera.view_projection(width / height, near, far).T.astype("f4"),
+        )
+        self._set(prog, "u_eye", tuple(float(x) for x in eye))
+        self._set(prog, "u_forward", tuple(forward))
+        fbo, color, depth = self._targets(width, height)
+        assert isinstance(fbo, moderngl.Framebuffer)
+        fbo.use()
+        fbo.clear(_MISS, _MISS, _MISS, 0.0, depth=1.0)
+        if len(f):
+            interleaved = np.concatenate(
+                [v.astype(np.float32), normals, c.astype(np.float32)], axis=1
+            )
+            vbo = self.ctx.buffer(np.ascontiguousarray(interleaved).tobytes())
+            ibo = self.ctx.buffer(np.ascontiguousarray(f, dtype=np.int32).tobytes())
+            vao = self.ctx.vertex_array(
+                prog, [(vbo, "3f 3f 3f", "in_position", "in_normal", "in_color")], index_buffer=ibo
+            )
+            self.ctx.enable(moderngl.DEPTH_TEST)
+            vao.render(moderngl.TRIANGLES)
+            self.ctx.disable(moderngl.DEPTH_TEST)
+            for obj in (vao, vbo, ibo):
+                obj.release()
+        return self._read(color, depth, width, height, shading)
+
+    def probe(
+        self, scene: sdf.Scene, points: ArrayLike
+    ) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
+        """Evaluate ``scene_distance`` and ``scene_color`` of ``sdf.glsl`` at points (via a float texture).
+
+        Args:
+            scene: the scene.
+            points: (N, 3) world points (m).
+
+        Returns:
+            (N,) distances (m) and (N, 3) colours, float32, computed by the GLSL.
+        """
+        import moderngl
+
+        pts = np.asarray(points, dtype=np.float32)
+        if pts.ndim != 2 or pts.shape[1] != 3 or not np.all(np.isfinite(pts)) or len(pts) == 0:
+            raise ValueError(f"points must be finite (N, 3) with N ≥ 1, got {pts.shape}")
+        n = len(pts)
+        width = min(n, _PROBE_WIDTH)
+        height = -(-n // width)
+        padded = np.zeros((width * height, 3), np.float32)
+        padded[:n] = pts
+        source = self.ctx.texture((width, height), 3, padded.tobytes(), dtype="f4")
+        source.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        distance = self.ctx.texture((width, height), 1, dtype="f4")
+        color = self.ctx.texture((width, height), 4, dtype="f4")
+        fbo = self.ctx.framebuffer(color_attachments=[distance, color])
+        self._set_scene(self._probe, scene)
+        source.use(location=0)
+        self._set(self._probe, "u_points", 0)
+        fbo.use()
+        self._probe_vao.render(moderngl.TRIANGLES, vertices=3)
+        d = np.frombuffer(distance.read(), np.float32)[:n].copy()
+        rgb = np.frombuffer(color.read(), np.float32).reshape(-1, 4)[:n, :3].copy()
+        for obj in (fbo, source, distance, color):
+            obj.release()
+        return d, rgb
+
+
+_local = threading.local()
+
+
+def renderer() -> Renderer:
+    """This thread's renderer, created on first use (raises :class:`GLUnavailableError` without GL)."""
+    existing = getattr(_local, "renderer", None)
+    if existing is None:
+        existing = Renderer()
+        _local.renderer = existing
+    return existing
+
+
+def render(
+    scene: sdf.Scene, camera: Camera, width: int, height: int, shading: Shading | None = None
+) -> tuple[NDArray[np.uint8], NDArray[np.float32]]:
+    """Ray-march ``scene`` with this thread's :class:`Renderer`: RGB (H, W, 3) uint8 and depth (H, W) float32."""
+    return renderer().render(scene, camera, width, height, shading)

@@ -1,0 +1,157 @@
+// Signed distance functions: mirrors kernels/sdf.py name for name (float32 here, float64 there).
+// Included with moderngl's ctx.includes by raymarch.frag, probe.frag and mesh.frag; it has no #version of its own.
+// The scene arrives as uniforms, so changing it never recompiles a program.
+
+#define MAX_PRIMITIVES 4
+#define KIND_SPHERE 0
+#define KIND_BOX 1
+#define KIND_TORUS 2
+#define KIND_CAPSULE 3
+#define OP_UNION 0
+#define OP_SUBTRACT 1
+#define OP_INTERSECT 2
+#define BLEND_POLY 0
+#define BLEND_EXP 1
+// kernels/sdf.py EXP_SHARPNESS_PER_WIDTH = 4 ln 2: both blends dip by k/4 where two surfaces meet.
+#define EXP_SHARPNESS_PER_WIDTH 2.772588722239781
+
+uniform int u_count;                              // primitives in use, 1..4
+uniform int u_kind[MAX_PRIMITIVES];               // KIND_*
+uniform int u_op[MAX_PRIMITIVES];                 // OP_*; the first primitive's op is not used
+uniform vec3 u_center[MAX_PRIMITIVES];            // world position of each local origin (m)
+uniform vec3 u_size[MAX_PRIMITIVES];              // the kind's parameters (m), unused slots zero
+uniform mat3 u_world_to_local[MAX_PRIMITIVES];    // R transposed
+uniform vec3 u_color[MAX_PRIMITIVES];             // linear RGB
+uniform float u_k;                                // blend width (m); 0 is hard
+uniform int u_blend;                              // BLEND_*
+
+// ------------------------------------------------------------------------------ primitives
+float sd_sphere(vec3 p, float radius) {
+    return length(p) - radius;
+}
+
+float sd_box(vec3 p, vec3 half_size) {
+    vec3 q = abs(p) - half_size;
+    return length(max(q, 0.0)) + min(max(q.x, max(q.y, q.z)), 0.0);
+}
+
+// The ring lies in the local xz plane.
+float sd_torus(vec3 p, float major_radius, float minor_radius) {
+    vec2 q = vec2(length(p.xz) - major_radius, p.y);
+    return length(q) - minor_radius;
+}
+
+float sd_capsule(vec3 p, vec3 a, vec3 b, float radius) {
+    vec3 pa = p - a;
+    vec3 ba = b - a;
+    float length_sq = dot(ba, ba);
+    float h = length_sq == 0.0 ? 0.0 : clamp(dot(pa, ba) / length_sq, 0.0, 1.0);
+    return length(pa - ba * h) - radius;
+}
+
+// ------------------------------------------------------------------------------ blends
+// Each *_weighted form returns (distance, weight of b), the weight that blends colours.
+vec2 smin_poly_weighted(float a, float b, float k) {
+    if (k == 0.0) {
+        return vec2(min(a, b), b < a ? 1.0 : 0.0);
+    }
+    float h = clamp(0.5 + 0.5 * (b - a) / k, 0.0, 1.0);
+    return vec2(h * a + (1.0 - h) * b - k * h * (1.0 - h), 1.0 - h);
+}
+
+// k is the sharpness (1/m); min(a, b) - log(1 + exp(-k|a - b|))/k cannot overflow.
+vec2 smin_exp_weighted(float a, float b, float k) {
+    float d = min(a, b) - log(1.0 + exp(-k * abs(a - b))) / k;
+    return vec2(d, 0.5 + 0.5 * tanh(clamp(0.5 * k * (a - b), -15.0, 15.0)));
+}
+
+float smin_poly(float a, float b, float k) {
+    return smin_poly_weighted(a, b, k).x;
+}
+
+float smin_exp(float a, float b, float k) {
+    return smin_exp_weighted(a, b, k).x;
+}
+
+float op_union(float a, float b) {
+    return min(a, b);
+}
+
+float op_subtract(float a, float b) {
+    return max(a, -b);
+}
+
+float op_intersect(float a, float b) {
+    return max(a, b);
+}
+
+vec2 smin_blend(float a, float b, float k, int blend) {
+    if (k == 0.0) {
+        return smin_poly_weighted(a, b, 0.0);
+    }
+    if (blend == BLEND_EXP) {
+        return smin_exp_weighted(a, b, EXP_SHARPNESS_PER_WIDTH / k);
+    }
+    return smin_poly_weighted(a, b, k);
+}
+
+// Distance of (a op b) and the weight of b; k is the blend width (m).
+vec2 combine(float a, float b, int op, float k, int blend) {
+    if (op == OP_SUBTRACT) {
+        vec2 r = smin_blend(-a, b, k, blend);
+        return vec2(-r.x, r.y);
+    }
+    if (op == OP_INTERSECT) {
+        vec2 r = smin_blend(-a, -b, k, blend);
+        return vec2(-r.x, r.y);
+    }
+    return smin_blend(a, b, k, blend);
+}
+
+float smooth_union(float a, float b, float k, int blend) {
+    return combine(a, b, OP_UNION, k, blend).x;
+}
+
+float smooth_subtract(float a, float b, float k, int blend) {
+    return combine(a, b, OP_SUBTRACT, k, blend).x;
+}
+
+float smooth_intersect(float a, float b, float k, int blend) {
+    return combine(a, b, OP_INTERSECT, k, blend).x;
+}
+
+// ------------------------------------------------------------------------------ scene
+float primitive_distance(int i, vec3 p_world) {
+    vec3 p = u_world_to_local[i] * (p_world - u_center[i]);
+    vec3 s = u_size[i];
+    int kind = u_kind[i];
+    if (kind == KIND_SPHERE) {
+        return sd_sphere(p, s.x);
+    }
+    if (kind == KIND_BOX) {
+        return sd_box(p, s);
+    }
+    if (kind == KIND_TORUS) {
+        return sd_torus(p, s.x, s.y);
+    }
+    return sd_capsule(p, vec3(0.0, -s.x, 0.0), vec3(0.0, s.x, 0.0), s.y);
+}
+
+float scene_distance(vec3 p) {
+    float d = primitive_distance(0, p);
+    if (u_count > 1) d = combine(d, primitive_distance(1, p), u_op[1], u_k, u_blend).x;
+    if (u_count > 2) d = combine(d, primitive_distance(2, p), u_op[2], u_k, u_blend).x;
+    if (u_count > 3) d = combine(d, primitive_distance(3, p), u_op[3], u_k, u_blend).x;
+    return d;
+}
+
+vec3 scene_color(vec3 p) {
+    float d = primitive_distance(0, p);
+    vec3 color = u_color[0];
+    for (int i = 1; i < u_count; ++i) {
+        vec2 r = combine(d, primitive_distance(i, p), u_op[i], u_k, u_blend);
+        d = r.x;
+        color = mix(color, u_color[i], r.y);
+    }
+    return color;
+}
