@@ -111,10 +111,8 @@ def test_rotating_the_lead_equalises_time_averaged_power(scene: PelotonScene) ->
             27
         ):  # part-way into the turn after next: each rider's label and bar show its current slot's power
             scene._animate(0.1)
-        totals = (
-            sum(bar_heights(scene, c) for c in ("aero", "rolling", "climbing"))
-            / BAR_METRES_PER_WATT
-        )
+        heights = np.stack([bar_heights(scene, c) for c in ("aero", "rolling", "climbing")])
+        totals = heights.sum(axis=0) / BAR_METRES_PER_WATT
         slots_now = scene.current_slots()
         assert slots_now.tolist() != list(range(4))
         for rider in range(4):
