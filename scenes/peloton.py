@@ -689,7 +689,12 @@ time-averaged power is the mean over positions, far below the leader's.
                 p.drivetrain_pct / 100.0,
             )
         )  # fmt: skip
-        return f"Riding alone, {p.target_power_w:.0f} W holds **{3.6 * v:.1f} km/h** here."
+        text = f"Riding alone, {p.target_power_w:.0f} W ({p.target_power_w / p.mass_kg:.2f} W/kg of system mass) holds **{3.6 * v:.1f} km/h** here"
+        if v > 0.1:
+            minutes, seconds = divmod(round(40_000.0 / v), 60)
+            hours, minutes = divmod(minutes, 60)
+            text += f": a 40 km time trial in {hours:d}:{minutes:02d}:{seconds:02d}"
+        return text + "."
 
     # ----------------------------------------------------------------------------------------- animation
     def _animate(self, dt: float) -> None:
