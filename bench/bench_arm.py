@@ -37,7 +37,9 @@ def arc_chain(n: int, link: float, d: int = 3, turn: float = 0.15) -> NDArray[np
     return np.vstack([np.zeros(d), np.cumsum(link * directions, axis=0)])
 
 
-def random_targets(rng: np.random.Generator, count: int, radius: float, d: int = 3) -> NDArray[np.float64]:
+def random_targets(
+    rng: np.random.Generator, count: int, radius: float, d: int = 3
+) -> NDArray[np.float64]:
     """Uniform in a ball of ``radius`` (m)."""
     v = rng.normal(size=(count, d))
     v /= np.linalg.norm(v, axis=1, keepdims=True)
@@ -70,8 +72,12 @@ def paper_setup(runs: int, seed: int) -> None:
             reached += result.status == "reached"
         rows[name] = (np.mean(iterations), np.mean(times) * 1e3, np.median(times) * 1e3, reached)
     base = rows["fabrik"][1]
-    print(f"\n## Paper setup: 10 links of 1 m, 3D, {runs} reachable random targets, tolerance {tolerance} m")
-    print("| solver | mean iterations | mean ms/solve | median ms | reached | time / FABRIK | paper iterations | paper ms |")
+    print(
+        f"\n## Paper setup: 10 links of 1 m, 3D, {runs} reachable random targets, tolerance {tolerance} m"
+    )
+    print(
+        "| solver | mean iterations | mean ms/solve | median ms | reached | time / FABRIK | paper iterations | paper ms |"
+    )
     print("|---|---|---|---|---|---|---|---|")
     for name, (its, mean_ms, median_ms, reached) in rows.items():
         paper_its, paper_ms = PAPER[name]
@@ -94,7 +100,9 @@ def single_latency(frames: int, seed: int) -> None:
         (np.array([0.3, 0.3, 0.25]), 0.09),
     ]
     kwargs = {"cone_half_angle_rad": phi, "obstacles": obstacles}
-    print(f"\n## One 12-link solve, 30° limits, 4 obstacles, tolerance 1 mm, max 50 iterations ({frames} solves)")
+    print(
+        f"\n## One 12-link solve, 30° limits, 4 obstacles, tolerance 1 mm, max 50 iterations ({frames} solves)"
+    )
     print("| case | median ms | p95 ms | max ms | mean iterations | p95 iterations | statuses |")
     print("|---|---|---|---|---|---|---|")
     # Drag: the target moves 60 Hz-style along a figure-eight, each solve warm-started from the last pose.
@@ -103,7 +111,9 @@ def single_latency(frames: int, seed: int) -> None:
     for k in range(frames):
         s = 2.0 * math.pi * k / frames
         target = np.array([0.45 * math.sin(s), 0.25 * math.sin(2 * s), 0.75 + 0.2 * math.cos(s)])
-        elapsed, result = timed(lambda target=target, pose=pose: fabrik.solve(pose, target, **kwargs))
+        elapsed, result = timed(
+            lambda target=target, pose=pose: fabrik.solve(pose, target, **kwargs)
+        )
         pose = result.joints
         times.append(elapsed)
         iterations.append(result.iterations)
@@ -172,11 +182,13 @@ def batch_throughput(batch: int, loop_sample: int, seed: int) -> None:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description="Benchmark the arm scene's IK solvers.")
     parser.add_argument("--runs", type=int, default=100, help="targets in the paper setup (≥ 20)")
     parser.add_argument("--frames", type=int, default=500, help="solves in the latency cases")
     parser.add_argument("--batch", type=int, default=10_000)
-    parser.add_argument("--loop-sample", type=int, default=300, help="chains timed in the per-chain loop")
+    parser.add_argument(
+        "--loop-sample", type=int, default=300, help="chains timed in the per-chain loop"
+    )
     parser.add_argument("--seed", type=int, default=0)
     args = parser.parse_args()
     paper_setup(args.runs, args.seed)

@@ -346,7 +346,7 @@ def joint_angles(joints: ArrayLike, root_direction: ArrayLike | None = None) -> 
     dim = chain.shape[1]
     previous = _root_direction(root_direction, dim)
     segments = np.diff(chain, axis=0)
-    scale = max(float(np.sum(np.linalg.norm(segments, axis=1))), 1.0)
+    scale = max(float(np.add.reduce(np.linalg.norm(segments, axis=1))), 1.0)
     angles = np.zeros(segments.shape[0])
     for i, segment in enumerate(segments):
         length = float(np.linalg.norm(segment))
@@ -519,7 +519,7 @@ class _Chains:
 # ================================================================================================ vector helpers
 def _norm(v: NDArray[np.float64]) -> NDArray[np.float64]:
     """(…, d, B) → (…, B) Euclidean norm over the d axis."""
-    return np.sqrt(np.sum(v * v, axis=-2))
+    return np.sqrt(np.add.reduce(v * v, axis=-2))
 
 
 def _unit(
@@ -560,7 +560,7 @@ def _clamp_cone(
 ) -> NDArray[np.float64]:
     """Unit directions ``v`` (d, B) turned, by the least angle, into the cone of half-angle φ around ``axis``."""
     cos_phi, sin_phi = limits
-    cos_v = np.sum(v * axis, axis=0)
+    cos_v = np.add.reduce(v * axis, axis=0)
     outside = cos_v < cos_phi
     if not outside.any():
         return v
@@ -588,9 +588,9 @@ def _deflect(
     turned = False
     for _ in range(3):  # turning around one obstacle can push into another: a few rounds settle it
         rel = setup.centres - anchor  # (K, d, B)
-        along = np.sum(rel * v, axis=1)  # (K, B)
-        t = np.clip(along, 0.0, length)
-        dist2 = np.sum(rel * rel, axis=1) - 2.0 * t * along + t * t
+        along = np.add.reduce(rel * v, axis=1)  # (K, B)
+        t = np.minimum(np.maximum(along, 0.0), length)
+        dist2 = np.add.reduce(rel * rel, axis=1) - 2.0 * t * along + t * t
         hit = (dist2 < setup.radii * setup.radii) & live
         if not hit.any():
             return v, turned
@@ -626,7 +626,7 @@ def _turn_clear(
     tangent = length * length >= distance * distance - clear * clear
     cos_t = np.where(tangent, np.sqrt(1.0 - sin_tangent * sin_tangent), cos_end)
     sin_t = np.where(tangent, sin_tangent, np.sqrt(1.0 - cos_end * cos_end))
-    side = v - np.sum(v * to_centre, axis=0) * to_centre
+    side = v - np.add.reduce(v * to_centre, axis=0) * to_centre
     side, _ = _unit(side, _perpendicular(to_centre), np.full_like(tiny, 1e-9))
     turned = cos_t * to_centre + sin_t * side
     turned = turned / _norm(turned)
@@ -708,7 +708,7 @@ def _ccd_step(chains: _Chains, setup: _Setup) -> None:
         pivot = p[i]
         to_end, end_norm = _unit(p[n] - pivot, setup.root_direction * np.ones_like(tiny), tiny)
         to_target, target_norm = _unit(chains.target - pivot, to_end, tiny)
-        cos_a = np.clip(np.sum(to_end * to_target, axis=0), -1.0, 1.0)
+        cos_a = np.clip(np.add.reduce(to_end * to_target, axis=0), -1.0, 1.0)
         move = (end_norm > tiny) & (target_norm > tiny)
         downstream = p[i + 1 :] - pivot
         if setup.dim == 2:
@@ -719,7 +719,7 @@ def _ccd_step(chains: _Chains, setup: _Setup) -> None:
             sin_a = _norm(axis)
             axis, _ = _unit(axis, _perpendicular(to_end), np.full_like(tiny, 1e-12))
             # Rodrigues: v cos a + (k × v) sin a + k (k·v)(1 − cos a)
-            k_dot_v = np.sum(axis * downstream, axis=-2, keepdims=True)
+            k_dot_v = np.add.reduce(axis * downstream, axis=-2, keepdims=True)
             rotated = (
                 downstream * cos_a + _cross(axis * np.ones_like(downstream), downstream) * sin_a
             )
@@ -804,7 +804,9 @@ def _cone_ok(chains: _Chains, setup: _Setup) -> NDArray[np.bool_]:
     ok = np.ones(chains.p.shape[2], dtype=bool)
     for i in range(chains.lengths.shape[0]):
         direction, norm = _unit(chains.p[i + 1] - chains.p[i], previous, chains.tiny)
-        ok &= (np.sum(direction * previous, axis=0) >= cos_phi - 1e-12) | (norm <= chains.tiny)
+        ok &= (np.add.reduce(direction * previous, axis=0) >= cos_phi - 1e-12) | (
+            norm <= chains.tiny
+        )
         previous = np.where(norm > chains.tiny, direction, previous)
     return ok
 
@@ -817,10 +819,10 @@ def _colliding(p: NDArray[np.float64], setup: _Setup, live: NDArray[np.bool_]) -
     start = p[:-1, None]  # (n, 1, d, B)
     seg = (p[1:] - p[:-1])[:, None]
     rel = setup.centres[None] - start  # (n, K, d, B)
-    seg2 = np.sum(seg * seg, axis=2)
-    t = np.clip(np.sum(rel * seg, axis=2) / np.where(seg2 > 0.0, seg2, 1.0), 0.0, 1.0)
+    seg2 = np.add.reduce(seg * seg, axis=2)
+    t = np.clip(np.add.reduce(rel * seg, axis=2) / np.where(seg2 > 0.0, seg2, 1.0), 0.0, 1.0)
     gap = rel - t[:, :, None] * seg
-    dist2 = np.sum(gap * gap, axis=2)  # (n, K, B)
+    dist2 = np.add.reduce(gap * gap, axis=2)  # (n, K, B)
     return np.any((dist2 < setup.radii * setup.radii) & live, axis=(0, 1))
 
 
@@ -841,8 +843,8 @@ def _run(
 ) -> BatchSolution:
     batch, count, _ = joints.shape
     n = count - 1
-    p = np.ascontiguousarray(np.transpose(joints, (1, 2, 0)))  # (n + 1, d, B)
-    target = np.ascontiguousarray(targets.T)  # (d, B)
+    p = np.transpose(joints, (1, 2, 0)).copy()  # (n + 1, d, B); a copy: the passes work in place
+    target = targets.T.copy()  # (d, B)
     lengths = _norm(np.diff(p, axis=0))  # (n, B)
     total = lengths.sum(axis=0)
     scale = np.maximum(np.maximum(total, _norm(target - p[0])), 1.0)
@@ -983,7 +985,7 @@ def _unreachable_shortcut(
     ok = candidates.copy()
     if setup.limits is not None:
         # A folded chain turns by π; a straight one only at the root.
-        root_cos = np.sum(direction * setup.root_direction, axis=0)
+        root_cos = np.add.reduce(direction * setup.root_direction, axis=0)
         ok &= beyond & (root_cos >= setup.limits[0])
     if setup.radii.shape[0] > 0:
         ok &= ~_colliding(pose, setup, chains.obstacle_live)
@@ -1005,10 +1007,10 @@ def _unbend_axis_chains(
     first = np.argmax(norms > tiny, axis=0)  # first segment with a direction
     axis_raw = np.take_along_axis(segments, first[None, None, :], axis=0)[0]
     axis, _ = _unit(axis_raw, setup.root_direction * np.ones_like(tiny), tiny)
-    along = np.sum(segments * axis, axis=1)  # (n, B)
+    along = np.add.reduce(segments * axis, axis=1)  # (n, B)
     off_axis = _norm(segments - along[:, None, :] * axis)  # (n, B)
     straight = np.all(off_axis <= 1e-9 * np.maximum(norms, tiny), axis=0)
-    target_off = _norm(offset - np.sum(offset * axis, axis=0) * axis)
+    target_off = _norm(offset - np.add.reduce(offset * axis, axis=0) * axis)
     on_axis = target_off <= 1e-9 * np.maximum(distance, 1.0)
     bend = todo & straight & on_axis
     if not bend.any():
@@ -1017,7 +1019,9 @@ def _unbend_axis_chains(
     if step <= 0.0:
         return
     side = _perpendicular(axis)
-    angle = step * np.arange(segments.shape[0])[:, None]  # (n, 1)
+    # A symmetric arc: every interior joint leaves the line (an arc starting along it leaves p_1 on it).
+    count = segments.shape[0]
+    angle = step * (np.arange(count) - 0.5 * (count - 1))[:, None]  # (n, 1)
     directions = np.cos(angle)[:, None, :] * axis + np.sin(angle)[:, None, :] * side  # (n, d, B)
     arc = p[0] + np.cumsum(norms[:, None, :] * directions, axis=0)
     p[1:] = np.where(bend, arc, p[1:])

@@ -9,13 +9,15 @@ from __future__ import annotations
 from typing import Literal
 
 from scenes._base import Scene
+from scenes.arm import ArmScene
 from scenes.peloton import PelotonScene
 
-SceneName = Literal["peloton"]
+SceneName = Literal["peloton", "arm"]
 """Keys of :data:`SCENES`, for the command line."""
 
 SCENES: dict[str, type[Scene]] = {
     PelotonScene.key: PelotonScene,
+    ArmScene.key: ArmScene,
 }
 """Every scene that exists, in switcher order."""
 

@@ -229,6 +229,26 @@ def test_straight_chain_bends_toward_a_closer_target_on_its_axis(d: int) -> None
         assert off_axis.max() > 0.1  # it really bent
 
 
+def test_two_straight_links_bend_toward_a_target_on_their_axis() -> None:
+    axis = np.array([0.9, 0.6]) / np.linalg.norm([0.9, 0.6])
+    joints = np.array([[0.0, 0.0], 0.25 * axis, 0.5 * axis])
+    result = fabrik.solve(joints, 0.36 * axis, tolerance=1e-6, max_iterations=100)
+    assert result.status == "reached"
+    assert result.error < 1e-6
+
+
+@pytest.mark.parametrize("solver", ["fabrik", "ccd", "jacobian_dls"])
+def test_inputs_are_not_modified(solver: fabrik.Solver) -> None:
+    # Straight, with the target on its axis: the solver bends it, on its own copy.
+    joints = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, 2.0]])
+    target = np.array([0.0, 0.0, 1.5])
+    joints_before, target_before = joints.copy(), target.copy()
+    fabrik.solve_batch(joints[None], target[None], solver=solver, cone_half_angle_rad=0.5)
+    fabrik.solve(joints, target)
+    np.testing.assert_array_equal(joints, joints_before)
+    np.testing.assert_array_equal(target, target_before)
+
+
 @pytest.mark.parametrize("d", [2, 3])
 def test_degenerate_inputs_never_give_nan(d: int) -> None:
     zero = np.zeros((4, d))

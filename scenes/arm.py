@@ -1,0 +1,647 @@
+"""Arm: drag a target and watch a 2–12 link chain follow it by FABRIK, with joint limits and obstacles.
+
+Inverse kinematics comes from :mod:`kernels.fabrik`; this module owns the viser handles. The chain is two batched
+meshes (links as unit cylinders, joints as spheres) with one instance per link or joint; unused instances are
+scaled to zero, so changing the link count never re-adds a node. A translucent ghost shows the analytic two-bone
+solution for comparison.
+
+Planar by default: the chain moves in the world's x–z plane (kernel coordinates (x, z), d = 2), the target gizmo
+slides only in that plane and obstacles are circles, drawn as discs. The 3D toggle frees the target (d = 3) and
+makes the obstacles spheres.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import math
+import time
+from typing import Any, Literal
+
+import numpy as np
+import trimesh
+import viser
+import viser.uplot
+from numpy.typing import NDArray
+
+from kernels import fabrik
+from scenes._base import Scene
+
+MAX_LINKS = 12
+MAX_OBSTACLES = 4
+WORLD_LIMIT_M = 4.0
+"""Targets and obstacles stay inside this box (±m on each axis); anything a browser sends beyond it is refused."""
+LINK_RADIUS_M = 0.018
+JOINT_RADIUS_M = 0.03
+
+SolverLabel = Literal["FABRIK", "CCD", "Jacobian DLS"]
+SOLVER_FROM_LABEL: dict[SolverLabel, fabrik.Solver] = {
+    "FABRIK": "fabrik",
+    "CCD": "ccd",
+    "Jacobian DLS": "jacobian_dls",
+}
+
+REST_COLOUR = (205, 210, 220)
+GHOST_COLOUR = (120, 190, 255)
+OBSTACLE_COLOUR = (235, 120, 60)
+TARGET_COLOUR = (230, 40, 60)
+LIMIT_RAMP = np.array([(60, 200, 90), (250, 200, 40), (230, 50, 50)], dtype=np.float64)
+"""Joint colour at 0 %, 50 % and 100 % of its limit."""
+
+
+@dataclasses.dataclass(frozen=True)
+class ArmParams:
+    """Everything the scene shows is a function of these, the target and the obstacles; defaults open the scene."""
+
+    n_links: int = 6
+    """Links in the chain (2–12)."""
+    link_length_m: float = 0.25
+    """Length of every link (m)."""
+    three_d: bool = False
+    """False: the chain moves in the vertical x–z plane; True: in 3D."""
+    limits: bool = False
+    """Whether joint limits (cones) apply."""
+    half_angle_deg: float = 45.0
+    """Cone half-angle of every joint (degrees)."""
+    avoid: bool = True
+    """Whether the solver avoids the obstacles (when off they are drawn but ignored)."""
+    n_obstacles: int = 1
+    """Obstacles shown (0–4)."""
+    radii_m: tuple[float, ...] = (0.18, 0.15, 0.12, 0.2)
+    """Radius of each obstacle (m)."""
+    solver: SolverLabel = "FABRIK"
+    """Iterative method."""
+    tolerance_mm: float = 1.0
+    """Stop when the end effector is this close to the target (mm)."""
+    max_iterations: int = 50
+    """Iteration cap per solve."""
+
+
+OBSTACLE_STARTS = np.array(
+    [[0.45, 0.0, 0.45], [-0.6, 0.0, 0.9], [0.3, 0.0, 1.45], [-0.4, 0.0, 0.3]]
+)
+"""Where the obstacles open (world, m)."""
+TARGET_START = np.array([0.9, 0.0, 0.6])
+
+
+@dataclasses.dataclass(frozen=True)
+class SolveReport:
+    """The last solve, as the readouts show it."""
+
+    result: fabrik.Solution
+    micros: float
+    """Wall time of the kernel call (µs)."""
+    ghost: NDArray[np.float64]
+    """(3, 3) world root, elbow and end of the analytic two-bone ghost (m)."""
+    ghost_error_m: float
+    """Distance of the ghost's end from the target (m)."""
+    ghost_gap_m: float
+    """Distance from the ghost's elbow to the chain's middle joint (m); for two links, FABRIK's elbow."""
+
+
+def rest_pose(n_links: int, link_length_m: float) -> NDArray[np.float64]:
+    """(n + 1, 3) world joints of a gentle arc up from the root, bending toward +x in the x–z plane."""
+    angles = 0.12 * np.arange(n_links)
+    directions = np.stack([np.sin(angles), np.zeros(n_links), np.cos(angles)], axis=1)
+    return np.vstack([np.zeros(3), np.cumsum(link_length_m * directions, axis=0)])
+
+
+def to_kernel(points: NDArray[np.float64], three_d: bool) -> NDArray[np.float64]:
+    """World (…, 3) → kernel coordinates: (…, 3) in 3D, (…, 2) = (x, z) in the plane."""
+    return points if three_d else points[..., [0, 2]]
+
+
+def to_world(points: NDArray[np.float64], three_d: bool) -> NDArray[np.float64]:
+    """Kernel coordinates → world (…, 3)."""
+    if three_d:
+        return points
+    return np.stack([points[..., 0], np.zeros(points.shape[:-1]), points[..., 1]], axis=-1)
+
+
+def segment_pose(
+    start: NDArray[np.float64], end: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], ...]:
+    """wxyz (N, 4) turning +z onto each segment, and lengths (N,), for (N, 3) starts and ends."""
+    offset = end - start
+    length = np.linalg.norm(offset, axis=1)
+    direction = offset / np.where(length > 1e-12, length, 1.0)[:, None]
+    direction[length <= 1e-12] = (0.0, 0.0, 1.0)
+    # Half-way quaternion from +z to d: (1 + d_z, z × d) normalised; antiparallel: 180° about x.
+    wxyz = np.stack(
+        [1.0 + direction[:, 2], -direction[:, 1], direction[:, 0], np.zeros(len(length))], axis=1
+    )
+    flipped = direction[:, 2] < -1.0 + 1e-9
+    wxyz[flipped] = (0.0, 1.0, 0.0, 0.0)
+    return wxyz / np.linalg.norm(wxyz, axis=1, keepdims=True), length
+
+
+def limit_colours(joints: NDArray[np.float64], params: ArmParams) -> NDArray[np.uint8]:
+    """(n + 1, 3) joint colours: green far from the limit, yellow at half, red at it; grey without limits."""
+    count = joints.shape[0]
+    if not params.limits:
+        return np.tile(np.array(REST_COLOUR, np.uint8), (count, 1))
+    phi = math.radians(params.half_angle_deg)
+    angles = fabrik.joint_angles(to_kernel(joints, params.three_d), _root_direction(params.three_d))
+    share = np.ones(count - 1) if phi <= 0.0 else np.clip(angles / phi, 0.0, 1.0)
+    ramp = np.stack([np.interp(share, (0.0, 0.5, 1.0), LIMIT_RAMP[:, c]) for c in range(3)], axis=1)
+    end = np.array([REST_COLOUR], dtype=np.float64)
+    return np.vstack([ramp, end]).round().astype(np.uint8)
+
+
+def _root_direction(three_d: bool) -> NDArray[np.float64]:
+    return np.array([0.0, 0.0, 1.0]) if three_d else np.array([0.0, 1.0])
+
+
+def solve_arm(
+    params: ArmParams,
+    joints: NDArray[np.float64],
+    target: NDArray[np.float64],
+    obstacle_centres: NDArray[np.float64],
+) -> SolveReport:
+    """Solve one frame: the chosen solver from ``joints`` toward ``target``, and the two-bone ghost (no viser)."""
+    three_d = params.three_d
+    obstacles = (
+        [
+            (to_kernel(obstacle_centres[k], three_d), params.radii_m[k])
+            for k in range(params.n_obstacles)
+        ]
+        if params.avoid
+        else []
+    )
+    kwargs: dict[str, Any] = {
+        "tolerance": params.tolerance_mm / 1000.0,
+        "max_iterations": params.max_iterations,
+        "cone_half_angle_rad": math.radians(params.half_angle_deg) if params.limits else None,
+        "obstacles": obstacles,
+        "root_direction": _root_direction(three_d),
+    }
+    start = to_kernel(joints, three_d)
+    goal = to_kernel(target, three_d)
+    method = SOLVER_FROM_LABEL[params.solver]
+    began = time.perf_counter()
+    match method:
+        case "fabrik":
+            result = fabrik.solve(start, goal, **kwargs)
+        case "ccd":
+            result = fabrik.ccd(start, goal, **kwargs)
+        case "jacobian_dls":
+            result = fabrik.jacobian_dls(start, goal, **kwargs)
+    micros = (time.perf_counter() - began) * 1e6
+
+    lengths = fabrik.link_lengths(start)
+    upper, lower = (
+        (lengths[0], lengths[1]) if len(lengths) == 2 else (lengths.sum() / 2, lengths.sum() / 2)
+    )
+    middle = result.joints[len(lengths) // 2]
+    bend = middle - result.joints[0]
+    ghost = fabrik.two_bone(start[0], float(upper), float(lower), goal, bend)
+    return SolveReport(
+        result=dataclasses.replace(result, joints=to_world(result.joints, three_d)),
+        micros=micros,
+        ghost=to_world(ghost, three_d),
+        ghost_error_m=float(np.linalg.norm(ghost[2] - goal)),
+        ghost_gap_m=float(np.linalg.norm(ghost[1] - middle)),
+    )
+
+
+def clean_point(raw: object, three_d: bool) -> NDArray[np.float64] | None:
+    """A browser-sent position as a world point, or None when it is not three finite numbers inside the world box.
+
+    In the plane, y is put back to 0 (a crafted client may send any y).
+    """
+    try:
+        point = np.asarray(raw, dtype=np.float64)
+    except (TypeError, ValueError):
+        return None
+    if (
+        point.shape != (3,)
+        or not np.all(np.isfinite(point))
+        or np.any(np.abs(point) > WORLD_LIMIT_M)
+    ):
+        return None
+    if not three_d:
+        point = point.copy()
+        point[1] = 0.0
+    return point
+
+
+# --------------------------------------------------------------------------------------------- geometry
+def _unit_cylinder() -> trimesh.Trimesh:
+    """Radius 1 and length 1 along +z from the origin: scaled per instance to a link."""
+    mesh = trimesh.creation.cylinder(radius=1.0, height=1.0, sections=14)
+    mesh.apply_translation((0.0, 0.0, 0.5))
+    return mesh
+
+
+def _disc() -> trimesh.Trimesh:
+    """Radius 1, thin, facing ±y: a circle obstacle in the x–z plane."""
+    mesh = trimesh.creation.cylinder(radius=1.0, height=0.04, sections=48)
+    mesh.apply_transform(trimesh.transformations.rotation_matrix(math.pi / 2, (1.0, 0.0, 0.0)))
+    return mesh
+
+
+# --------------------------------------------------------------------------------------------- scene
+class ArmScene(Scene):
+    key = "arm"
+    title = "Arm: FABRIK inverse kinematics"
+    camera_position = (0.3, -2.9, 1.0)
+    camera_look_at = (0.3, 0.0, 0.75)
+    about = """
+**What it shows.** A chain of 2–12 rigid links whose root is fixed. Drag the red target's gizmo (or click in the
+plane) and the chain's end follows it. The readout gives the iterations this frame took, the final error, the
+status and the time per solve; the plot shows the error after each iteration (log scale). Joints turn from green
+to red as they approach their limit. The translucent blue ghost is the analytic two-bone solution (with two links
+the same problem; with more, two bones of the same total reach).
+
+**FABRIK** (Aristidou & Lasenby 2011): the forward pass puts the end on the target and pulls each joint toward
+the next, λ = dᵢ/|pᵢ − pᵢ₊₁|, pᵢ ← (1 − λ)·pᵢ₊₁ + λ·pᵢ; the backward pass re-anchors the root and does the same
+outwards. Repeat until |pₙ − target| < tolerance. No angles, no matrices.
+
+**Limits.** Each segment stays within a cone of the chosen half-angle around the previous one (the first around
+the vertical), clamped inside each pass. **Obstacles** (circles in the plane, spheres in 3D): a segment that would
+cut one is turned about its anchor by the least angle until it just clears it; "blocked" means the chain rests
+against one short of the target. **Reach**: only targets with max(0, 2·max L − ΣL) ≤ |target − root| ≤ ΣL can be
+reached; beyond, the chain stretches straight toward the target at once.
+
+**Compared with.** CCD (turn each joint, end to root, to aim the end at the target) and damped-least-squares
+Jacobian IK, Δθ = Jᵀ(JJᵀ + λ²I)⁻¹e. The paper's Table 1 (10 joints): FABRIK 15.5 iterations, CCD 26.3, DLS 999.
+
+**Assumptions.** Rigid links, ball joints (hinges in the plane), symmetric cone limits, no dynamics: each frame
+is a static pose.
+"""
+
+    def __init__(self, server: viser.ViserServer) -> None:
+        super().__init__(server)
+        self.params = ArmParams()
+        self.target = TARGET_START.copy()
+        self.obstacle_centres = OBSTACLE_STARTS.copy()
+        self.pose = rest_pose(self.params.n_links, self.params.link_length_m)
+        self.report: SolveReport | None = None
+        self.solves = 0
+        """Solves run so far (tests wait on it)."""
+        self._build_gui()
+        self._build_world()
+        self._click = server.scene.on_click()(self._on_scene_click)
+        self.solve_and_draw()
+
+    def close(self) -> None:
+        self.server.scene.remove_click_callback(self._click)
+        super().close()
+
+    # ----------------------------------------------------------------------------------------- GUI
+    def _build_gui(self) -> None:
+        gui, p = self.server.gui, self.params
+        with self.gui_root:
+            with gui.add_folder("Chain"):
+                self.links = gui.add_slider(
+                    "Links", min=2, max=MAX_LINKS, step=1, initial_value=p.n_links
+                )
+                self.length = gui.add_slider(
+                    "Link length (m)", min=0.05, max=0.5, step=0.01, initial_value=p.link_length_m
+                )
+                self.three_d = gui.add_checkbox(
+                    "3D (free target, sphere obstacles)", initial_value=p.three_d
+                )
+                self.reset_pose = gui.add_button("Straighten the chain")
+            with gui.add_folder("Joint limits"):
+                self.limits = gui.add_checkbox("Joint limits", initial_value=p.limits)
+                self.half_angle = gui.add_slider(
+                    "Cone half-angle (°)",
+                    min=0.0,
+                    max=180.0,
+                    step=1.0,
+                    initial_value=p.half_angle_deg,
+                )
+            with gui.add_folder("Obstacles"):
+                self.avoid = gui.add_checkbox("Avoid obstacles", initial_value=p.avoid)
+                self.obstacle_count = gui.add_slider(
+                    "Obstacles", min=0, max=MAX_OBSTACLES, step=1, initial_value=p.n_obstacles
+                )
+                self.radii = [
+                    gui.add_slider(
+                        f"Obstacle {k + 1} radius (m)",
+                        min=0.03,
+                        max=0.6,
+                        step=0.01,
+                        initial_value=p.radii_m[k],
+                    )
+                    for k in range(MAX_OBSTACLES)
+                ]
+            with gui.add_folder("Solver"):
+                self.solver = gui.add_dropdown(
+                    "Solver", options=list(SOLVER_FROM_LABEL), initial_value=p.solver
+                )
+                self.tolerance = gui.add_slider(
+                    "Tolerance (mm)", min=0.01, max=50.0, step=0.01, initial_value=p.tolerance_mm
+                )
+                self.max_iterations = gui.add_slider(
+                    "Max iterations", min=1, max=500, step=1, initial_value=p.max_iterations
+                )
+            with gui.add_folder("This frame"):
+                self.readout = gui.add_markdown("")
+                self.ghost_readout = gui.add_markdown("")
+                self.plot = gui.add_uplot(
+                    data=(np.zeros(1), np.ones(1)),
+                    series=(
+                        viser.uplot.Series(label="Iteration"),
+                        viser.uplot.Series(label="Error (mm)", stroke="rgb(230,50,50)", width=2),
+                    ),
+                    scales={
+                        "x": viser.uplot.Scale(time=False, auto=True),
+                        "y": viser.uplot.Scale(distr=3, auto=True),
+                    },
+                    legend=viser.uplot.Legend(show=True),
+                    title="Error after each iteration (log scale)",
+                    aspect=1.6,
+                )
+        for handle in (
+            self.links, self.length, self.three_d, self.limits, self.half_angle, self.avoid,
+            self.obstacle_count, *self.radii, self.solver, self.tolerance, self.max_iterations,
+        ):  # fmt: skip
+            handle.on_update(self.callback(self._on_input))
+        self.reset_pose.on_click(self.callback(self._on_reset_pose))
+
+    # ----------------------------------------------------------------------------------------- world
+    def _build_world(self) -> None:
+        scene, root = self.server.scene, self.root.name
+        base = trimesh.creation.box(extents=(0.16, 0.16, 0.06))
+        base.apply_translation((0.0, 0.0, -0.03))
+        scene.add_mesh_simple(f"{root}/base", base.vertices, base.faces, color=(90, 95, 105))
+        self.grid = scene.add_grid(
+            f"{root}/plane",
+            width=4.0,
+            height=4.0,
+            plane="xz",
+            cell_size=0.25,
+            section_size=1.0,
+            plane_color=(235, 240, 250),
+            plane_opacity=0.25,
+        )
+        cylinder, sphere = _unit_cylinder(), trimesh.creation.icosphere(subdivisions=2, radius=1.0)
+        identity = np.tile([1.0, 0.0, 0.0, 0.0], (MAX_LINKS, 1))
+        self.link_nodes = scene.add_batched_meshes_simple(
+            f"{root}/links",
+            vertices=cylinder.vertices.astype(np.float32),
+            faces=cylinder.faces.astype(np.uint32),
+            batched_wxyzs=identity,
+            batched_positions=np.zeros((MAX_LINKS, 3)),
+            batched_scales=np.zeros((MAX_LINKS, 3)),
+            batched_colors=(70, 110, 200),
+            lod="off",
+        )
+        self.joint_nodes = scene.add_batched_meshes_simple(
+            f"{root}/joints",
+            vertices=sphere.vertices.astype(np.float32),
+            faces=sphere.faces.astype(np.uint32),
+            batched_wxyzs=np.tile([1.0, 0.0, 0.0, 0.0], (MAX_LINKS + 1, 1)),
+            batched_positions=np.zeros((MAX_LINKS + 1, 3)),
+            batched_scales=np.zeros((MAX_LINKS + 1, 3)),
+            batched_colors=np.tile(np.array(REST_COLOUR, np.uint8), (MAX_LINKS + 1, 1)),
+            lod="off",
+        )
+        self.ghost_links = scene.add_batched_meshes_simple(
+            f"{root}/ghost_links",
+            vertices=cylinder.vertices.astype(np.float32),
+            faces=cylinder.faces.astype(np.uint32),
+            batched_wxyzs=identity[:2],
+            batched_positions=np.zeros((2, 3)),
+            batched_scales=np.zeros((2, 3)),
+            batched_colors=GHOST_COLOUR,
+            opacity=0.35,
+            lod="off",
+            cast_shadow=False,
+        )
+        self.ghost_elbow = scene.add_icosphere(
+            f"{root}/ghost_elbow", radius=JOINT_RADIUS_M * 0.9, color=GHOST_COLOUR, opacity=0.45
+        )
+        box = (-WORLD_LIMIT_M, WORLD_LIMIT_M)
+        limits = (box, box, box)
+        self.target_gizmo = scene.add_transform_controls(
+            f"{root}/target",
+            scale=0.3,
+            active_axes=(True, False, True),
+            disable_rotations=True,
+            translation_limits=limits,
+            position=self.target,
+        )
+        scene.add_icosphere(f"{root}/target/marker", radius=0.035, color=TARGET_COLOUR)
+        self.target_gizmo.on_update(self._on_target_drag)
+        self.obstacle_gizmos = []
+        self.obstacle_discs = []
+        self.obstacle_spheres = []
+        disc = _disc()
+        for k in range(MAX_OBSTACLES):
+            gizmo = scene.add_transform_controls(
+                f"{root}/obstacle_{k}",
+                scale=0.2,
+                active_axes=(True, False, True),
+                disable_rotations=True,
+                translation_limits=limits,
+                position=self.obstacle_centres[k],
+            )
+            self.obstacle_discs.append(
+                scene.add_mesh_simple(
+                    f"{root}/obstacle_{k}/disc",
+                    disc.vertices,
+                    disc.faces,
+                    color=OBSTACLE_COLOUR,
+                    opacity=0.8,
+                    scale=self.params.radii_m[k],
+                )
+            )
+            self.obstacle_spheres.append(
+                scene.add_icosphere(
+                    f"{root}/obstacle_{k}/sphere",
+                    radius=1.0,
+                    color=OBSTACLE_COLOUR,
+                    opacity=0.8,
+                    scale=self.params.radii_m[k],
+                    visible=False,
+                )
+            )
+            gizmo.on_update(functools.partial(self._on_obstacle_drag, k))
+            self.obstacle_gizmos.append(gizmo)
+
+    # ----------------------------------------------------------------------------------------- callbacks
+    def _on_target_drag(self, _event: object) -> None:
+        self.callback(self._apply_target)(None)
+
+    def _apply_target(self) -> None:
+        point = clean_point(self.target_gizmo.position, self.params.three_d)
+        if point is None:  # NaN, huge, wrong shape: keep the last good target and pose
+            self.target_gizmo.position = self.target
+            self.target_gizmo.wxyz = (1.0, 0.0, 0.0, 0.0)
+            return
+        if np.array_equal(point, self.target) and self.report is not None:
+            return  # a burst of updates: an earlier one already solved for this position
+        self.target = point
+        self.solve_and_draw()
+
+    def _on_obstacle_drag(self, k: int, _event: object) -> None:
+        self.callback(functools.partial(self._apply_obstacle, k))(None)
+
+    def _apply_obstacle(self, k: int) -> None:
+        gizmo = self.obstacle_gizmos[k]
+        point = clean_point(gizmo.position, self.params.three_d)
+        if point is None:
+            gizmo.position = self.obstacle_centres[k]
+            return
+        if np.array_equal(point, self.obstacle_centres[k]):
+            return
+        self.obstacle_centres[k] = point
+        self.solve_and_draw()
+
+    def _on_scene_click(self, event: viser.SceneClickEvent) -> None:
+        self.callback(functools.partial(self._apply_click, event.ray_origin, event.ray_direction))(
+            None
+        )
+
+    def _apply_click(self, origin: object, direction: object) -> None:
+        """Place the target where the click's ray meets the chain's plane (y = 0, or the target's y in 3D)."""
+        try:
+            o = np.asarray(origin, dtype=np.float64)
+            d = np.asarray(direction, dtype=np.float64)
+        except (TypeError, ValueError):
+            return
+        if (
+            o.shape != (3,)
+            or d.shape != (3,)
+            or not (np.all(np.isfinite(o)) and np.all(np.isfinite(d)))
+        ):
+            return
+        if abs(d[1]) < 1e-9:
+            return  # a ray parallel to the plane never meets it
+        plane_y = self.target[1] if self.params.three_d else 0.0
+        t = (plane_y - o[1]) / d[1]
+        if t <= 0.0:
+            return
+        point = clean_point(o + t * d, self.params.three_d)
+        if point is None:
+            return
+        self.target = point
+        self.target_gizmo.position = point
+        self.solve_and_draw()
+
+    def _on_reset_pose(self) -> None:
+        self.pose = rest_pose(self.params.n_links, self.params.link_length_m)
+        self.solve_and_draw()
+
+    def _on_input(self) -> None:
+        last = self.params
+        self.params = self.read_params()
+        p = self.params
+        if (p.n_links, p.link_length_m) != (last.n_links, last.link_length_m):
+            self.pose = rest_pose(p.n_links, p.link_length_m)
+        if p.three_d != last.three_d:
+            self._set_mode(p.three_d)
+        self.solve_and_draw()
+
+    def _set_mode(self, three_d: bool) -> None:
+        """Planar ↔ 3D: gizmo axes, obstacle shapes, the plane grid; leaving 3D flattens everything onto y = 0."""
+        axes = (True, True, True) if three_d else (True, False, True)
+        with self.server.atomic():
+            self.grid.visible = not three_d
+            self.target_gizmo.active_axes = axes
+            for k in range(MAX_OBSTACLES):
+                self.obstacle_gizmos[k].active_axes = axes
+            if not three_d:
+                self.target[1] = 0.0
+                self.obstacle_centres[:, 1] = 0.0
+                self.pose = rest_pose(self.params.n_links, self.params.link_length_m)
+                self.target_gizmo.position = self.target
+                for k in range(MAX_OBSTACLES):
+                    self.obstacle_gizmos[k].position = self.obstacle_centres[k]
+
+    def read_params(self) -> ArmParams:
+        """The current GUI values, cleaned: anything non-finite, out of range or unknown keeps the last good value."""
+        last = self.params
+        return ArmParams(
+            n_links=int(self.read_number(self.links, last.n_links, integer=True)),
+            link_length_m=self.read_number(self.length, last.link_length_m),
+            three_d=self.read_bool(self.three_d, last.three_d),
+            limits=self.read_bool(self.limits, last.limits),
+            half_angle_deg=self.read_number(self.half_angle, last.half_angle_deg),
+            avoid=self.read_bool(self.avoid, last.avoid),
+            n_obstacles=int(self.read_number(self.obstacle_count, last.n_obstacles, integer=True)),
+            radii_m=tuple(
+                self.read_number(handle, last.radii_m[k]) for k, handle in enumerate(self.radii)
+            ),
+            solver=self.read_choice(self.solver, list(SOLVER_FROM_LABEL), last.solver),
+            tolerance_mm=self.read_number(self.tolerance, last.tolerance_mm),
+            max_iterations=int(
+                self.read_number(self.max_iterations, last.max_iterations, integer=True)
+            ),
+        )
+
+    # ----------------------------------------------------------------------------------------- solve + draw
+    def solve_and_draw(self) -> None:
+        """Solve from the last pose toward the target and push the frame to every browser in one update."""
+        report = solve_arm(self.params, self.pose, self.target, self.obstacle_centres)
+        self.pose = report.result.joints
+        self.report = report
+        self.solves += 1
+        self._draw(report)
+
+    def _draw(self, report: SolveReport) -> None:
+        p, joints = self.params, report.result.joints
+        n = p.n_links
+        wxyz, lengths = segment_pose(joints[:-1], joints[1:])
+        link_wxyz = np.tile([1.0, 0.0, 0.0, 0.0], (MAX_LINKS, 1))
+        link_wxyz[:n] = wxyz
+        link_pos = np.zeros((MAX_LINKS, 3))
+        link_pos[:n] = joints[:-1]
+        link_scale = np.zeros((MAX_LINKS, 3))
+        link_scale[:n] = np.stack(
+            [np.full(n, LINK_RADIUS_M), np.full(n, LINK_RADIUS_M), lengths], axis=1
+        )
+        joint_pos = np.zeros((MAX_LINKS + 1, 3))
+        joint_pos[: n + 1] = joints
+        joint_scale = np.zeros((MAX_LINKS + 1, 3))
+        joint_scale[: n + 1] = JOINT_RADIUS_M
+        joint_colour = np.tile(np.array(REST_COLOUR, np.uint8), (MAX_LINKS + 1, 1))
+        joint_colour[: n + 1] = limit_colours(joints, p)
+        ghost_wxyz, ghost_lengths = segment_pose(report.ghost[:-1], report.ghost[1:])
+        ghost_scale = np.stack([np.full(2, LINK_RADIUS_M * 1.4)] * 2 + [ghost_lengths], axis=1)
+
+        with self.server.atomic():
+            self.link_nodes.batched_wxyzs = link_wxyz.astype(np.float32)
+            self.link_nodes.batched_positions = link_pos.astype(np.float32)
+            self.link_nodes.batched_scales = link_scale.astype(np.float32)
+            self.joint_nodes.batched_positions = joint_pos.astype(np.float32)
+            self.joint_nodes.batched_scales = joint_scale.astype(np.float32)
+            self.joint_nodes.batched_colors = joint_colour
+            self.ghost_links.batched_wxyzs = ghost_wxyz.astype(np.float32)
+            self.ghost_links.batched_positions = report.ghost[:-1].astype(np.float32)
+            self.ghost_links.batched_scales = ghost_scale.astype(np.float32)
+            self.ghost_elbow.position = report.ghost[1]
+            for k in range(MAX_OBSTACLES):
+                shown = k < p.n_obstacles
+                self.obstacle_gizmos[k].visible = shown
+                self.obstacle_discs[k].visible = shown and not p.three_d
+                self.obstacle_spheres[k].visible = shown and p.three_d
+                self.obstacle_discs[k].scale = p.radii_m[k]
+                self.obstacle_spheres[k].scale = p.radii_m[k]
+            self.readout.content = self._readout_markdown(report)
+            self.ghost_readout.content = self._ghost_markdown(report)
+            history = report.result.error_history
+            self.plot.data = (
+                np.arange(len(history), dtype=np.float64),
+                np.maximum(history * 1000.0, 1e-6),
+            )
+        self.server.flush()
+
+    def _readout_markdown(self, report: SolveReport) -> str:
+        r = report.result
+        return (
+            f"**{self.params.solver}**: {r.iterations} iteration{'s' if r.iterations != 1 else ''}, "
+            f"error **{r.error * 1000.0:.3f} mm**, status **{r.status}**  \n"
+            f"Solve time **{report.micros:,.0f} µs**"
+        )
+
+    def _ghost_markdown(self, report: SolveReport) -> str:
+        r = report.result
+        which = "FABRIK's elbow" if self.params.n_links == 2 else "the chain's middle joint"
+        return (
+            f"Two-bone ghost (analytic, one step): end error **{report.ghost_error_m * 1000.0:.3f} mm** "
+            f"vs {r.error * 1000.0:.3f} mm; its elbow is **{report.ghost_gap_m * 1000.0:.1f} mm** from {which}."
+        )

@@ -1,0 +1,284 @@
+"""The arm scene through a real ViserServer: handles read back, a browser-like websocket client, bad input."""
+
+from __future__ import annotations
+
+import itertools
+import math
+import time
+
+import numpy as np
+import pytest
+import viser
+from wsclient import BrowserClient
+
+from kernels import fabrik
+from scenes.arm import (
+    MAX_LINKS,
+    TARGET_START,
+    ArmParams,
+    ArmScene,
+    rest_pose,
+    solve_arm,
+)
+from scenes.switcher import SceneSwitcher
+
+
+@pytest.fixture
+def scene(switcher: SceneSwitcher) -> ArmScene:
+    shown = switcher.show("arm")
+    assert isinstance(shown, ArmScene)
+    return shown
+
+
+def drawn_joints(scene: ArmScene) -> np.ndarray:
+    """World joint positions as the batched joint mesh shows them (visible instances only)."""
+    positions = np.asarray(scene.joint_nodes.batched_positions)
+    scales = np.asarray(scene.joint_nodes.batched_scales)
+    return positions[scales[:, 0] > 0]
+
+
+def clearance(joints: np.ndarray, centre: np.ndarray) -> float:
+    best = math.inf
+    for a, b in itertools.pairwise(joints):
+        seg = b - a
+        t = min(1.0, max(0.0, float((centre - a) @ seg / (seg @ seg))))
+        best = min(best, float(np.linalg.norm(a + t * seg - centre)))
+    return best
+
+
+# ------------------------------------------------------------------------------------------------ server side
+def test_opening_state_reaches_the_target_around_the_obstacle(scene: ArmScene) -> None:
+    p = ArmParams()
+    report = scene.report
+    assert report is not None
+    assert report.result.status == "reached"
+    assert np.linalg.norm(scene.pose[-1] - TARGET_START) < p.tolerance_mm / 1000.0
+    np.testing.assert_allclose(fabrik.link_lengths(scene.pose), p.link_length_m, rtol=1e-9)
+    assert np.all(scene.pose[:, 1] == 0.0)  # planar: the chain stays in the x–z plane
+    # The obstacle sits on the straight line to the target: the chain goes round it.
+    assert clearance(scene.pose, scene.obstacle_centres[0]) >= p.radii_m[0]
+    # What is drawn is what was solved: 7 joints shown, the other instances scaled to zero.
+    np.testing.assert_allclose(drawn_joints(scene), scene.pose, atol=1e-6)
+    link_scales = np.asarray(scene.link_nodes.batched_scales)
+    np.testing.assert_allclose(link_scales[: p.n_links, 2], p.link_length_m, rtol=1e-5)
+    assert np.all(link_scales[p.n_links :] == 0.0)
+    # The ghost is the exact two-bone answer: its end is on the target.
+    assert report.ghost_error_m < 1e-9
+    assert "status **reached**" in scene.readout.content
+    assert f"{report.result.iterations} iteration" in scene.readout.content
+    history = np.asarray(scene.plot.data[1])
+    assert len(history) == report.result.iterations + 1
+    assert history[-1] < 1.0  # mm, below the tolerance
+
+
+def test_two_links_ghost_is_the_fabrik_solution(scene: ArmScene) -> None:
+    scene.obstacle_count.value = 0
+    scene.tolerance.value = 0.01
+    scene.max_iterations.value = 500
+    scene.links.value = 2
+    scene.target_gizmo.position = (0.3, 0.0, 0.2)  # inside the 0.5 m reach
+    scene._apply_target()
+    report = scene.report
+    assert report is not None and report.result.status == "reached"
+    assert report.ghost_gap_m < 1e-3  # the analytic elbow is FABRIK's elbow, to within a millimetre
+    assert "FABRIK's elbow" in scene.ghost_readout.content
+
+
+def test_more_links_and_joint_limits(scene: ArmScene) -> None:
+    scene.links.value = MAX_LINKS
+    scene.half_angle.value = 30.0
+    scene.limits.value = True
+    assert len(drawn_joints(scene)) == MAX_LINKS + 1
+    angles = fabrik.joint_angles(scene.pose[:, [0, 2]], [0.0, 1.0])
+    assert np.all(angles <= math.radians(30.0) + 1e-6)
+    report = scene.report
+    assert report is not None and report.result.status == "reached"
+    # 3 m of chain curled onto a target 1.08 m away: several joints sit at their limit, drawn red; the free end grey.
+    colours = np.asarray(scene.joint_nodes.batched_colors)[: MAX_LINKS + 1]
+    at_limit = angles > math.radians(29.9)
+    assert at_limit.sum() >= 3
+    assert np.all(colours[:-1][at_limit][:, 0] >= 220) and np.all(
+        colours[:-1][at_limit][:, 1] <= 60
+    )
+    relaxed = angles < math.radians(5.0)
+    assert np.all(colours[:-1][relaxed][:, 1] >= 190)  # green
+    np.testing.assert_array_equal(colours[-1], (205, 210, 220))
+
+
+def test_obstacles_are_avoided_and_ignored_when_avoidance_is_off(scene: ArmScene) -> None:
+    scene.avoid.value = False
+    free_pose = scene.pose.copy()
+    # Put the obstacle on the middle joint of the unobstructed solution, then let the chain avoid it.
+    scene.obstacle_gizmos[0].position = tuple(free_pose[3])
+    scene._apply_obstacle(0)
+    # Avoidance off: the chain goes straight through the obstacle's centre.
+    assert clearance(scene.pose, free_pose[3]) == 0.0
+    scene.avoid.value = True
+    report = scene.report
+    assert report is not None and report.result.status == "reached"
+    assert clearance(scene.pose, free_pose[3]) >= scene.params.radii_m[0]
+    scene.obstacle_count.value = 4
+    for k in range(4):
+        assert clearance(scene.pose, scene.obstacle_centres[k]) >= scene.params.radii_m[k]
+        assert scene.obstacle_discs[k].visible and not scene.obstacle_spheres[k].visible
+
+
+def test_solvers_all_reach_the_target(scene: ArmScene) -> None:
+    for label in ("CCD", "Jacobian DLS", "FABRIK"):
+        scene.pose = rest_pose(6, 0.25)
+        scene.solver.value = label
+        report = scene.report
+        assert report is not None
+        assert report.result.status == "reached", label
+        assert f"**{label}**" in scene.readout.content
+
+
+def test_three_d_mode_frees_the_target(scene: ArmScene) -> None:
+    scene.three_d.value = True
+    assert scene.target_gizmo.active_axes == (True, True, True)
+    assert scene.obstacle_spheres[0].visible and not scene.obstacle_discs[0].visible
+    assert not scene.grid.visible
+    scene.target_gizmo.position = (0.4, 0.5, 0.9)
+    scene._apply_target()
+    assert np.linalg.norm(scene.pose[-1] - [0.4, 0.5, 0.9]) < 1e-3
+    # Back to the plane: everything is flattened onto y = 0 and solved there.
+    scene.three_d.value = False
+    assert scene.target[1] == 0.0 and np.all(scene.pose[:, 1] == 0.0)
+    assert scene.target_gizmo.active_axes == (True, False, True)
+
+
+def test_solve_arm_is_pure() -> None:
+    report = solve_arm(ArmParams(n_obstacles=0), rest_pose(6, 0.25), TARGET_START, np.zeros((4, 3)))
+    assert report.result.status == "reached"
+    assert report.result.joints.shape == (7, 3)
+
+
+def test_scene_close_leaves_only_the_switcher(server: viser.ViserServer) -> None:
+    from viser_private import gui_uuids, node_names
+
+    bare_nodes, bare_gui = node_names(server), gui_uuids(server)
+    scene = ArmScene(server)
+    assert len(node_names(server)) > len(bare_nodes) + 10
+    scene.close()
+    assert node_names(server) == bare_nodes
+    assert gui_uuids(server) == bare_gui
+
+
+# ------------------------------------------------------------------------------------------------ over the websocket
+def client_joints(client: BrowserClient) -> np.ndarray | None:
+    """Joint positions of the visible instances as the fake browser last received them."""
+    node = client.nodes.get("/arm/joints")
+    if node is None:
+        return None
+    props = node.get("props", {})
+    positions, scales = props.get("batched_positions"), props.get("batched_scales")
+    if positions is None or scales is None:
+        return None
+    positions = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
+    scales = np.asarray(scales, dtype=np.float64).reshape(-1, 3)
+    return positions[scales[:, 0] > 0]
+
+
+def test_dragging_the_target_gizmo_moves_the_chain_end_onto_it(
+    server: viser.ViserServer, scene: ArmScene
+) -> None:
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_node("/arm/target")
+        path = [(0.9 - 0.05 * i, 0.0, 0.6 + 0.04 * i) for i in range(1, 13)]
+        client.drag_transform("/arm/target", path, period_s=0.01)
+        goal = np.array(path[-1])
+        client.wait_for(
+            lambda: bool(np.linalg.norm(scene.pose[-1] - goal) < 1e-3),
+            what="the chain end on the target",
+        )
+        assert scene.report is not None and scene.report.result.status == "reached"
+
+        def browser_shows_end_on_target() -> bool:
+            joints = client_joints(client)
+            return joints is not None and float(np.linalg.norm(joints[-1] - goal)) < 2e-3
+
+        client.wait_for(browser_shows_end_on_target, what="the browser to receive the new pose")
+
+
+@pytest.mark.parametrize(
+    "bad",
+    [
+        (float("nan"), 0.0, 0.5),
+        (float("inf"), 0.0, 0.5),
+        (1e12, 0.0, 0.5),
+        (0.3, -1e300, 0.5),
+    ],
+)
+def test_crafted_gizmo_messages_keep_the_last_good_pose(
+    server: viser.ViserServer, scene: ArmScene, bad: tuple[float, float, float]
+) -> None:
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_node("/arm/target")
+        good = (0.7, 0.0, 0.9)
+        client.drag_transform("/arm/target", [good])
+        client.wait_for(
+            lambda: bool(np.linalg.norm(scene.pose[-1] - good) < 1e-3), what="the good target"
+        )
+        time.sleep(0.2)  # the drag's trailing updates (start, move, end) all finish
+        pose_before = scene.pose.copy()
+        solves = scene.solves
+        client.drag_transform("/arm/target", [bad])
+        time.sleep(0.3)  # thread-pool callbacks run; a rejected message changes nothing to wait for
+        with scene._lock:
+            np.testing.assert_array_equal(scene.pose, pose_before)
+            np.testing.assert_array_equal(scene.target, good)
+            assert scene.solves == solves
+            # What every browser is told is the last good target.
+            np.testing.assert_array_equal(np.asarray(scene.target_gizmo.position), good)
+
+
+def test_crafted_obstacle_message_and_slider_values_keep_a_good_state(
+    server: viser.ViserServer, scene: ArmScene
+) -> None:
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_node("/arm/obstacle_0")
+        centre = scene.obstacle_centres[0].copy()
+        client.drag_transform("/arm/obstacle_0", [(float("nan"), 0.0, 0.0)])
+        client.wait_for_gui("Links")
+        for label, value in (
+            ("Links", float("nan")),
+            ("Links", 1000),
+            ("Tolerance (mm)", -5.0),
+            ("Solver", "Newton"),
+            ("Cone half-angle (°)", float("inf")),
+            ("Joint limits", "yes"),
+        ):
+            # No answer to wait for: viser itself drops a NaN for an int slider.
+            client.set_value(label, value)
+        time.sleep(0.4)
+        with scene._lock:
+            p = scene.params
+            np.testing.assert_array_equal(scene.obstacle_centres[0], centre)
+            # 1000 is clamped to the slider's max; NaN kept the last value.
+            assert p.n_links == MAX_LINKS
+            assert p.tolerance_mm == pytest.approx(0.01)  # clamped to the slider's min
+            assert p.solver == "FABRIK"
+            assert p.half_angle_deg == 45.0
+            assert p.limits is False
+            assert np.all(np.isfinite(scene.pose)) and scene.pose.shape == (MAX_LINKS + 1, 3)
+            report = scene.report
+            assert report is not None and report.result.status == "reached"
+
+
+def test_clicking_in_the_plane_places_the_target(
+    server: viser.ViserServer, scene: ArmScene
+) -> None:
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_node("/arm/target")
+        # A ray from the camera side (−y) through (−0.5, 0, 1.0).
+        origin = (-0.5, -4.0, 1.0)
+        client.click_scene(origin, (0.0, 1.0, 0.0))
+        client.wait_for(
+            lambda: bool(np.allclose(scene.target, (-0.5, 0.0, 1.0))),
+            what="the target placed by the click",
+        )
+        client.wait_for(
+            lambda: bool(np.linalg.norm(scene.pose[-1] - (-0.5, 0.0, 1.0)) < 1e-3),
+            what="the chain to follow",
+        )
+        np.testing.assert_allclose(np.asarray(scene.target_gizmo.position), (-0.5, 0.0, 1.0))
