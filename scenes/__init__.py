@@ -11,13 +11,15 @@ from typing import Literal
 from scenes._base import Scene
 from scenes.arm import ArmScene
 from scenes.peloton import PelotonScene
+from scenes.sdf_gallery import SdfGalleryScene
 
-SceneName = Literal["peloton", "arm"]
+SceneName = Literal["peloton", "arm", "sdf"]
 """Keys of :data:`SCENES`, for the command line."""
 
 SCENES: dict[str, type[Scene]] = {
     PelotonScene.key: PelotonScene,
     ArmScene.key: ArmScene,
+    SdfGalleryScene.key: SdfGalleryScene,
 }
 """Every scene that exists, in switcher order."""
 

@@ -1,0 +1,694 @@
+"""SDF gallery: up to four primitives blended with smooth-min, meshed for the 3D view and ray-marched in GLSL.
+
+The distance field comes from :mod:`kernels.sdf`; the mesh is its marching-cubes surface, shown with blended vertex
+colours; the "Reference" panel is the same scene sphere-traced by ``shaders/raymarch.frag`` from the viewer's
+camera, and the readouts say how well the two agree (silhouette IoU, mean depth difference).
+
+Threads: GUI and gizmo callbacks only record the new state and wake one worker thread. The worker meshes the latest
+scene (a burst of drags coalesces: only the newest request is meshed), then renders the reference when the camera
+has stopped moving (or at once, in live mode). The GL context lives on the worker thread, where it was created.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import io
+import logging
+import math
+import threading
+import time
+from typing import Any, Literal
+
+import numpy as np
+import viser
+from PIL import Image
+
+from kernels import sdf
+from scenes._base import Scene
+from shaders.renderer import Camera, GLUnavailableError, Renderer, Shading
+
+logger = logging.getLogger(__name__)
+
+BOX_M = 1.5
+"""Gizmos stay inside the cube [−BOX_M, BOX_M]³ (m)."""
+BOX_LO: tuple[float, float, float] = (-BOX_M, -BOX_M, -BOX_M)
+BOX_HI: tuple[float, float, float] = (BOX_M, BOX_M, BOX_M)
+SIZE_RANGE_M = (0.05, 1.0)
+KIND_LABELS: dict[str, sdf.PrimitiveKind] = {
+    "Sphere": "sphere",
+    "Box": "box",
+    "Torus": "torus",
+    "Capsule": "capsule",
+}
+OP_LABELS: dict[str, sdf.BooleanOp] = {
+    "Union": "union",
+    "Subtract": "subtract",
+    "Intersect": "intersect",
+}
+BLEND_LABELS: dict[str, sdf.BlendForm] = {"Polynomial": "poly", "Exponential": "exp"}
+ReferenceMode = Literal["stopped", "live"]
+MODE_LABELS: dict[str, ReferenceMode] = {"When the camera stops": "stopped", "Live": "live"}
+SIZE_MEANING = (
+    "**Sizes (m).** Sphere: a = radius. Box: a, b, c = half sizes along local x, y, z. "
+    "Torus: a = major radius, b = tube radius (ring in the local xz plane). "
+    "Capsule: a = half length along local y, b = radius."
+)
+CAMERA_REST_S = 0.25
+"""The camera counts as stopped after this long without an update (s)."""
+
+
+@dataclasses.dataclass(frozen=True)
+class PrimitiveParams:
+    """One primitive slot of the gallery."""
+
+    enabled: bool
+    """Whether it is part of the scene (the first always is)."""
+    kind: sdf.PrimitiveKind
+    """Sphere, box, torus or capsule."""
+    size: tuple[float, float, float]
+    """Sizes a, b, c (m); which ones count depends on the kind (see SIZE_MEANING)."""
+    color: tuple[int, int, int]
+    """8-bit RGB."""
+    op: sdf.BooleanOp
+    """How it combines with the primitives before it."""
+    position: tuple[float, float, float]
+    """Centre (m), where its gizmo is."""
+    wxyz: tuple[float, float, float, float]
+    """Orientation, the gizmo's."""
+
+    def primitive(self) -> sdf.Primitive:
+        a, b, c = self.size
+        size = {"sphere": (a,), "box": (a, b, c), "torus": (a, b), "capsule": (a, b)}[self.kind]
+        return sdf.Primitive(
+            self.kind,
+            self.position,
+            size,
+            rotation=self.wxyz,
+            color=(self.color[0] / 255, self.color[1] / 255, self.color[2] / 255),
+            op=self.op,
+        )
+
+
+def _default_primitives() -> tuple[PrimitiveParams, ...]:
+    out = []
+    for prim in sdf.default_scene().primitives:
+        size = (*prim.size, *([0.3] * (3 - len(prim.size))))
+        out.append(
+            PrimitiveParams(
+                enabled=True,
+                kind=prim.kind,
+                size=(size[0], size[1], size[2]),
+                color=(
+                    round(prim.color[0] * 255),
+                    round(prim.color[1] * 255),
+                    round(prim.color[2] * 255),
+                ),
+                op=prim.op,
+                position=prim.center,
+                wxyz=prim.rotation,
+            )
+        )
+    return tuple(out)
+
+
+@dataclasses.dataclass(frozen=True)
+class SdfGalleryParams:
+    """Everything the gallery shows is a function of these; defaults are the opening state."""
+
+    primitives: tuple[PrimitiveParams, ...] = dataclasses.field(default_factory=_default_primitives)
+    """The four primitive slots."""
+    k: float = 0.25
+    """Blend width (m); 0 is a hard boolean."""
+    blend: sdf.BlendForm = "poly"
+    """Polynomial or exponential smooth-min."""
+    resolution: int = 64
+    """Marching-cubes samples along the longest side of the bounds (32–256)."""
+    shading: Shading = dataclasses.field(default_factory=Shading)
+    """Phong terms, soft shadows and ambient occlusion of the reference image."""
+    reference_mode: ReferenceMode = "stopped"
+    """Render the reference when the camera stops, or live while it moves."""
+    reference_width: int = 320
+    """Width of the reference image (px); its height follows the viewer's aspect."""
+
+    def scene(self) -> sdf.Scene:
+        return sdf.Scene(
+            tuple(p.primitive() for p in self.primitives if p.enabled), k=self.k, blend=self.blend
+        )
+
+
+@dataclasses.dataclass(frozen=True)
+class Agreement:
+    """How the latest reference image and mesh compare, and what they cost."""
+
+    triangles: int
+    """Faces in the mesh."""
+    mesh_ms: float
+    """Time to mesh (ms)."""
+    render_ms: float | None
+    """Time to ray-march the reference (ms); None before the first."""
+    iou: float | None
+    """Silhouette intersection over union of mesh raster and ray-march."""
+    depth_diff_voxels: float | None
+    """Mean |depth difference| away from silhouette edges, in voxels of the mesh grid."""
+
+
+def camera_from_viser(camera: Any) -> Camera | None:
+    """The renderer's camera from a viser client camera; None if the browser sent something unusable."""
+    try:
+        position = tuple(float(v) for v in camera.position)
+        look_at = tuple(float(v) for v in camera.look_at)
+        up = tuple(float(v) for v in camera.up_direction)
+        return Camera(position, look_at, up, float(camera.fov))  # type: ignore[arg-type]
+    except (ValueError, TypeError, AttributeError):
+        return None
+
+
+class SdfGalleryScene(Scene):
+    key = "sdf"
+    title = "SDF gallery (ray marching)"
+    camera_position = (2.3, -2.5, 1.7)
+    camera_look_at = (0.05, 0.0, 0.3)
+    about = """
+**What it shows.** A scene of up to four signed-distance primitives (sphere, box, torus, capsule) combined by
+union, subtraction or intersection with a smooth minimum. The 3D view shows its marching-cubes mesh; the
+**Reference** panel shows the same scene sphere-traced in a GLSL fragment shader from your camera, and the readouts
+measure how well they agree. Drag a gizmo: the mesh follows.
+
+**Equations.** Sphere |p| − r; box |max(q,0)| + min(max(q.x,q.y,q.z),0), q = |p| − b; torus |(|p.xz| − R, p.y)| − r;
+capsule |pa − ba·h| − r. Smooth union, polynomial: h = clamp(½ + ½(b − a)/k, 0, 1),
+smin = mix(b, a, h) − k·h·(1 − h); exponential: −ln(e^(−sa) + e^(−sb))/s with sharpness s = 4 ln 2 / k, so both
+dip by k/4 where surfaces meet. Subtraction −smin(−a, b), intersection −smin(−a, −b). Colours blend by the same
+weights. Shading: I = k_a·AO·albedo + (k_d·albedo·max(n·L, 0) + k_s·max(r·v, 0)^α)·shadow; normals by central
+differences; soft shadows by Quilez's improved technique; AO from five samples along the normal.
+
+**Assumptions.** Smooth blends are distance bounds, not exact distances (1-Lipschitz), which is all sphere tracing
+and the mesher's coarse-to-fine pass need. Marching cubes bevels sharp box edges by up to about half a voxel, so
+IoU is lowest when a box edge is on the silhouette.
+
+**Sources.** I. Quilez, *distance functions*, *smooth minimum*, *soft shadows* (iquilezles.org); J. C. Hart,
+*Sphere tracing* (1996); T. Lewiner et al., marching cubes (2003), via scikit-image.
+"""
+
+    def __init__(self, server: viser.ViserServer) -> None:
+        super().__init__(server)
+        self.params = SdfGalleryParams()
+        self.mesh_vertices = np.zeros((0, 3))
+        self.mesh_faces = np.zeros((0, 3), dtype=np.int64)
+        self.mesh_colors = np.zeros((0, 3))
+        self.mesh_scene: sdf.Scene | None = None
+        """The scene the shown mesh was made from."""
+        self.mesh_serial = 0
+        """How many meshes have been shown."""
+        self.reference_serial = 0
+        """How many reference images have been shown."""
+        self.reference_rgb: np.ndarray | None = None
+        self.agreement = Agreement(0, 0.0, None, None, None)
+        self.gl_error: str | None = None
+        self._mesh_voxel = 1.0
+        self._work = threading.Condition()
+        self._wanted_scene: sdf.Scene | None = None
+        self._wanted_resolution = self.params.resolution
+        self._camera: Camera | None = None
+        self._aspect = 4 / 3
+        self._camera_time = 0.0
+        self._reference_due = True
+        self._build_gui()
+        self._build_world()
+        self._sync_enabled_inputs()
+        self._mesh_and_show(self.params.scene(), self.params.resolution)
+        self._watch_cameras()
+        worker = threading.Thread(target=self._work_forever, name="sdf-worker", daemon=True)
+        self._threads.append(worker)
+        worker.start()
+
+    # ----------------------------------------------------------------------------------------- GUI
+    def _build_gui(self) -> None:
+        gui = self.server.gui
+        p = self.params
+        self.slots: list[dict[str, Any]] = []
+        with self.gui_root:
+            with gui.add_folder("Blend and mesh"):
+                self.blend = gui.add_dropdown(
+                    "Blend",
+                    options=list(BLEND_LABELS),
+                    initial_value=_label(BLEND_LABELS, p.blend),
+                )
+                self.k = gui.add_slider("Blend width k (m)", 0.0, 1.0, 0.01, p.k)
+                self.resolution = gui.add_slider("Mesh resolution", 32, 256, 16, p.resolution)
+                self.progress = gui.add_progress_bar(0.0, visible=False)
+                self.readout = gui.add_markdown("")
+            with gui.add_folder("Reference (GLSL ray-march)"):
+                self.reference = gui.add_image(
+                    np.full((120, 160, 3), 235, np.uint8), label="Reference", format="png"
+                )
+                self.reference_note = gui.add_markdown("")
+                self.mode = gui.add_dropdown(
+                    "Re-render",
+                    options=list(MODE_LABELS),
+                    initial_value=_label(MODE_LABELS, p.reference_mode),
+                )
+                self.reference_width = gui.add_slider(
+                    "Reference width (px)", 128, 640, 32, p.reference_width
+                )
+                s = p.shading
+                self.ambient = gui.add_slider("Ambient k_a", 0.0, 1.0, 0.01, s.ambient)
+                self.diffuse = gui.add_slider("Diffuse k_d", 0.0, 1.0, 0.01, s.diffuse)
+                self.specular = gui.add_slider("Specular k_s", 0.0, 1.0, 0.01, s.specular)
+                self.shininess = gui.add_slider("Shininess α", 1.0, 128.0, 1.0, s.shininess)
+                self.shadows = gui.add_checkbox("Soft shadows", s.shadows)
+                self.shadow_k = gui.add_slider(
+                    "Shadow sharpness k", 1.0, 64.0, 1.0, s.shadow_sharpness
+                )
+                self.occlusion = gui.add_checkbox("Ambient occlusion", s.occlusion)
+                self.occlusion_strength = gui.add_slider(
+                    "AO strength", 0.0, 6.0, 0.1, s.occlusion_strength
+                )
+                elevation, azimuth = _light_angles_deg(s.light_direction)
+                self.light_elevation = gui.add_slider(
+                    "Light elevation (°)", 5.0, 90.0, 1.0, elevation
+                )
+                self.light_azimuth = gui.add_slider(
+                    "Light azimuth (°)", -180.0, 180.0, 1.0, azimuth
+                )
+            for i, slot in enumerate(p.primitives):
+                n = i + 1
+                with gui.add_folder(f"Primitive {n}", expand_by_default=False):
+                    handles: dict[str, Any] = {}
+                    if i > 0:
+                        handles["enabled"] = gui.add_checkbox(f"P{n} on", slot.enabled)
+                    handles["kind"] = gui.add_dropdown(
+                        f"P{n} kind",
+                        options=list(KIND_LABELS),
+                        initial_value=_label(KIND_LABELS, slot.kind),
+                    )
+                    handles["op"] = gui.add_dropdown(
+                        f"P{n} combine",
+                        options=list(OP_LABELS),
+                        initial_value=_label(OP_LABELS, slot.op),
+                        disabled=i == 0,
+                    )
+                    for axis, value in zip("abc", slot.size, strict=True):
+                        handles[f"size_{axis}"] = gui.add_slider(
+                            f"P{n} size {axis} (m)", *SIZE_RANGE_M, 0.01, value
+                        )
+                    handles["color"] = gui.add_rgb(f"P{n} colour", slot.color)
+                    self.slots.append(handles)
+            gui.add_markdown(SIZE_MEANING)
+            with gui.add_folder("Downloads", expand_by_default=False):
+                self.downloads = {
+                    "glb": gui.add_button("Download mesh (GLB)"),
+                    "stl": gui.add_button("Download mesh (STL)"),
+                    "obj": gui.add_button("Download mesh (OBJ)"),
+                    "png": gui.add_button("Download reference (PNG)"),
+                }
+        scene_inputs = [self.blend, self.k, self.resolution]
+        for handles in self.slots:
+            scene_inputs.extend(handles.values())
+        for handle in scene_inputs:
+            handle.on_update(self.callback(self._on_scene_input))
+        shading_inputs = [
+            self.mode,
+            self.reference_width,
+            self.ambient,
+            self.diffuse,
+            self.specular,
+            self.shininess,
+            self.shadows,
+            self.shadow_k,
+            self.occlusion,
+            self.occlusion_strength,
+            self.light_elevation,
+            self.light_azimuth,
+        ]
+        for handle in shading_inputs:
+            handle.on_update(self.callback(self._on_shading_input))
+        for fmt, button in self.downloads.items():
+            button.on_click(self._download_handler(fmt))
+
+    def _build_world(self) -> None:
+        scene = self.server.scene
+        vertices, faces, colors = sdf.mesh(self.params.scene(), self.params.resolution)
+        self.mesh_node = scene.add_mesh_trimesh(
+            f"{self.root.name}/mesh", sdf.mesh_trimesh(vertices, faces, colors)
+        )
+        self.mesh_node.glb_data = _viewer_glb(vertices, faces, colors)
+        self.gizmos = []
+        for i, slot in enumerate(self.params.primitives):
+            gizmo = scene.add_transform_controls(
+                f"{self.root.name}/gizmo_{i + 1}",
+                scale=0.35,
+                line_width=2.0,
+                position=slot.position,
+                wxyz=slot.wxyz,
+                visible=slot.enabled,
+            )
+            gizmo.on_update(self.callback(self._on_scene_input))
+            self.gizmos.append(gizmo)
+
+    def _watch_cameras(self) -> None:
+        def attach(client: viser.ClientHandle) -> None:
+            client.camera.on_update(lambda camera: self._on_camera(camera))
+            self._on_camera(client.camera)
+
+        for client in self.server.get_clients().values():
+            attach(client)
+        self.server.on_client_connect(attach)
+
+    # ----------------------------------------------------------------------------------------- inputs
+    def read_params(self) -> SdfGalleryParams:
+        """The current GUI and gizmo values, cleaned: anything unusable keeps the last good value."""
+        last = self.params
+        slots = []
+        for i, (handles, gizmo, old) in enumerate(
+            zip(self.slots, self.gizmos, last.primitives, strict=True)
+        ):
+            enabled = True if i == 0 else self.read_bool(handles["enabled"], old.enabled)
+            kind = KIND_LABELS[
+                self.read_choice(handles["kind"], list(KIND_LABELS), _label(KIND_LABELS, old.kind))
+            ]
+            op = OP_LABELS[
+                self.read_choice(handles["op"], list(OP_LABELS), _label(OP_LABELS, old.op))
+            ]
+            size = tuple(
+                self.read_number(handles[f"size_{axis}"], value)
+                for axis, value in zip("abc", old.size, strict=True)
+            )
+            position = self.read_position(gizmo, old.position, BOX_LO, BOX_HI)
+            slots.append(
+                PrimitiveParams(
+                    enabled=enabled,
+                    kind=kind,
+                    size=(size[0], size[1], size[2]),
+                    color=self._read_rgb(handles["color"], old.color),
+                    op=op,
+                    position=position,
+                    wxyz=self._read_wxyz(gizmo, old.wxyz),
+                )
+            )
+        return dataclasses.replace(
+            last,
+            primitives=tuple(slots),
+            k=self.read_number(self.k, last.k),
+            blend=BLEND_LABELS[
+                self.read_choice(self.blend, list(BLEND_LABELS), _label(BLEND_LABELS, last.blend))
+            ],
+            resolution=int(self.read_number(self.resolution, last.resolution, integer=True)),
+        )
+
+    def read_shading(self) -> tuple[Shading, ReferenceMode, int]:
+        last = self.params
+        s = last.shading
+        elevation_deg, azimuth_deg = _light_angles_deg(s.light_direction)
+        elevation = math.radians(self.read_number(self.light_elevation, elevation_deg))
+        azimuth = math.radians(self.read_number(self.light_azimuth, azimuth_deg))
+        shading = dataclasses.replace(
+            s,
+            ambient=self.read_number(self.ambient, s.ambient),
+            diffuse=self.read_number(self.diffuse, s.diffuse),
+            specular=self.read_number(self.specular, s.specular),
+            shininess=self.read_number(self.shininess, s.shininess),
+            shadows=self.read_bool(self.shadows, s.shadows),
+            shadow_sharpness=self.read_number(self.shadow_k, s.shadow_sharpness),
+            occlusion=self.read_bool(self.occlusion, s.occlusion),
+            occlusion_strength=self.read_number(self.occlusion_strength, s.occlusion_strength),
+            light_direction=(
+                math.cos(elevation) * math.cos(azimuth),
+                math.cos(elevation) * math.sin(azimuth),
+                math.sin(elevation),
+            ),
+        )
+        mode = MODE_LABELS[
+            self.read_choice(self.mode, list(MODE_LABELS), _label(MODE_LABELS, last.reference_mode))
+        ]
+        width = int(self.read_number(self.reference_width, last.reference_width, integer=True))
+        return shading, mode, width
+
+    def _read_rgb(self, handle: Any, last_good: tuple[int, int, int]) -> tuple[int, int, int]:
+        raw = handle.value
+        try:
+            values = [float(v) for v in raw]
+        except (TypeError, ValueError):
+            values = []
+        if len(values) == 3 and all(math.isfinite(v) and 0 <= v <= 255 for v in values):
+            return (round(values[0]), round(values[1]), round(values[2]))
+        self._write_back(handle, last_good)
+        return last_good
+
+    def _read_wxyz(
+        self, gizmo: Any, last_good: tuple[float, float, float, float]
+    ) -> tuple[float, float, float, float]:
+        try:
+            q = np.asarray(gizmo.wxyz, dtype=np.float64).reshape(4)
+        except (TypeError, ValueError):
+            q = np.full(4, np.nan)
+        norm = float(np.linalg.norm(q)) if np.all(np.isfinite(q)) else 0.0
+        if norm < 1e-6:
+            gizmo.wxyz = last_good
+            return last_good
+        q = q / norm
+        return (float(q[0]), float(q[1]), float(q[2]), float(q[3]))
+
+    def _on_scene_input(self) -> None:
+        params = self.read_params()
+        try:
+            params.scene()
+        except ValueError:
+            logger.warning("sdf: rejected scene input; keeping the last good scene", exc_info=True)
+            return
+        self.params = params
+        self._sync_enabled_inputs()
+        self._request_mesh()
+
+    def _on_shading_input(self) -> None:
+        shading, mode, width = self.read_shading()
+        self.params = dataclasses.replace(
+            self.params, shading=shading, reference_mode=mode, reference_width=width
+        )
+        with self._work:
+            self._reference_due = True
+            self._work.notify_all()
+
+    def _on_camera(self, camera: Any) -> None:
+        if self.closed:
+            return
+        cam = camera_from_viser(camera)
+        if cam is None:
+            return
+        try:
+            aspect = float(camera.aspect)
+        except (TypeError, ValueError, AttributeError):
+            aspect = 4 / 3
+        with self._work:
+            self._camera = cam
+            self._aspect = min(max(aspect, 0.5), 2.5) if math.isfinite(aspect) else 4 / 3
+            self._camera_time = time.monotonic()
+            self._reference_due = True
+            self._work.notify_all()
+
+    def _sync_enabled_inputs(self) -> None:
+        """Show gizmos of enabled primitives; grey out sizes the kind does not use."""
+        used = {"sphere": 1, "box": 3, "torus": 2, "capsule": 2}
+        for handles, gizmo, slot in zip(
+            self.slots, self.gizmos, self.params.primitives, strict=True
+        ):
+            gizmo.visible = slot.enabled
+            for j, axis in enumerate("abc"):
+                handles[f"size_{axis}"].disabled = j >= used[slot.kind] or not slot.enabled
+
+    def _request_mesh(self) -> None:
+        with self._work:
+            self._wanted_scene = self.params.scene()
+            self._wanted_resolution = self.params.resolution
+            self._work.notify_all()
+
+    # ----------------------------------------------------------------------------------------- worker
+    def _work_forever(self) -> None:
+        renderer: Renderer | None = None
+        try:
+            while not self._stop.is_set():
+                with self._work:
+                    self._work.wait(timeout=0.05)
+                    scene, resolution = self._wanted_scene, self._wanted_resolution
+                    self._wanted_scene = None
+                if self._stop.is_set():
+                    return
+                if scene is not None:
+                    self._mesh_and_show(scene, resolution)
+                    with self._work:
+                        self._reference_due = True
+                if self._reference_ready():
+                    if renderer is None and self.gl_error is None:
+                        renderer = self._open_renderer()
+                    if renderer is not None:
+                        self._render_reference(renderer)
+        except Exception:
+            logger.exception("sdf: worker stopped")
+        finally:
+            if renderer is not None:
+                renderer.release()
+
+    def _reference_ready(self) -> bool:
+        with self._work:
+            if not self._reference_due or self.mesh_scene is None or self._wanted_scene is not None:
+                return False
+            if self.params.reference_mode == "live" or self._camera is None:
+                return True
+            return time.monotonic() - self._camera_time >= CAMERA_REST_S
+
+    def _open_renderer(self) -> Renderer | None:
+        try:
+            return Renderer()
+        except GLUnavailableError as exc:
+            self.gl_error = str(exc)
+            logger.warning("sdf: %s", exc)
+            with self._lock:
+                if not self.closed:
+                    self.reference_note.content = f"**No reference image.** {exc}"
+            return None
+
+    def _mesh_and_show(self, scene: sdf.Scene, resolution: int) -> None:
+        big = resolution >= 128
+
+        def progress(fraction: float) -> None:
+            if big and not self.closed:
+                self.progress.value = 100.0 * fraction
+
+        if big:
+            self.progress.value = 0.0
+            self.progress.visible = True
+        start = time.perf_counter()
+        vertices, faces, colors = sdf.mesh(scene, resolution, progress=progress)
+        glb = _viewer_glb(vertices, faces, colors)
+        mesh_ms = 1e3 * (time.perf_counter() - start)
+        with self._lock:
+            if self.closed:
+                return
+            with self.server.atomic():
+                self.mesh_node.glb_data = glb
+                self.progress.visible = False
+                self.mesh_vertices, self.mesh_faces, self.mesh_colors = vertices, faces, colors
+                self.mesh_scene = scene
+                self._mesh_voxel = sdf.make_grid(scene, resolution).spacing
+                self.mesh_serial += 1
+                self.agreement = dataclasses.replace(
+                    self.agreement, triangles=len(faces), mesh_ms=mesh_ms
+                )
+                self.readout.content = self._readout_markdown()
+            self.server.flush()
+
+    def _render_reference(self, renderer: Renderer) -> None:
+        with self._work:
+            self._reference_due = False
+            camera = self._camera or Camera(self.camera_position, self.camera_look_at)
+            aspect = self._aspect
+        params = self.params
+        scene, vertices, faces, colors = (
+            self.mesh_scene,
+            self.mesh_vertices,
+            self.mesh_faces,
+            self.mesh_colors,
+        )
+        assert scene is not None
+        width = params.reference_width
+        height = max(16, round(width / aspect))
+        start = time.perf_counter()
+        rgb, depth = renderer.render(scene, camera, width, height, params.shading)
+        render_ms = 1e3 * (time.perf_counter() - start)
+        _, mesh_depth = renderer.render_mesh(
+            vertices, faces, colors, camera, width, height, params.shading
+        )
+        iou, depth_diff = _compare(depth, mesh_depth)
+        with self._lock:
+            if self.closed:
+                return
+            with self.server.atomic():
+                self.reference.image = rgb
+                self.reference_rgb = rgb
+                self.reference_serial += 1
+                self.agreement = dataclasses.replace(
+                    self.agreement,
+                    render_ms=render_ms,
+                    iou=iou,
+                    depth_diff_voxels=None if depth_diff is None else depth_diff / self._mesh_voxel,
+                )
+                self.readout.content = self._readout_markdown()
+                self.reference_note.content = f"{width}×{height} px on {renderer.renderer_name}."
+            self.server.flush()
+
+    def _readout_markdown(self) -> str:
+        a = self.agreement
+        render = "–" if a.render_ms is None else f"{a.render_ms:.0f} ms"
+        iou = "–" if a.iou is None else f"{a.iou:.4f}"
+        depth = "–" if a.depth_diff_voxels is None else f"{a.depth_diff_voxels:.3f} voxel"
+        return (
+            f"| | |\n|---|---|\n| Triangles | {a.triangles:,} |\n| Time to mesh | {a.mesh_ms:.0f} ms |\n"
+            f"| Time to render | {render} |\n| Silhouette IoU (mesh vs ray-march) | {iou} |\n"
+            f"| Mean depth difference | {depth} |"
+        )
+
+    # ----------------------------------------------------------------------------------------- downloads
+    def _download_handler(self, fmt: str) -> Any:
+        def handler(event: Any) -> None:
+            client = getattr(event, "client", None)
+            if client is None or self.closed:
+                return
+            try:
+                name, content = self.export(fmt)
+            except Exception:
+                logger.exception("sdf: export %s failed", fmt)
+                return
+            if content is None:
+                client.add_notification(
+                    "Nothing to download yet", "The reference image has not been rendered."
+                )
+                return
+            client.send_file_download(name, content)
+
+        return handler
+
+    def export(self, fmt: str) -> tuple[str, bytes | None]:
+        """File name and bytes of the current mesh (glb, stl, obj) or reference image (png)."""
+        if fmt == "png":
+            if self.reference_rgb is None:
+                return "sdf_reference.png", None
+            buffer = io.BytesIO()
+            Image.fromarray(self.reference_rgb).save(buffer, format="PNG")
+            return "sdf_reference.png", buffer.getvalue()
+        tri = sdf.mesh_trimesh(self.mesh_vertices, self.mesh_faces, self.mesh_colors)
+        data = tri.export(file_type=fmt)
+        return f"sdf_mesh.{fmt}", data.encode() if isinstance(data, str) else bytes(data)
+
+
+def _compare(marched: np.ndarray, rasterised: np.ndarray) -> tuple[float | None, float | None]:
+    """Silhouette IoU and mean depth difference (m) away from silhouette edges (both masks eroded a pixel)."""
+    a, b = np.isfinite(marched), np.isfinite(rasterised)
+    union = int((a | b).sum())
+    if union == 0:
+        return None, None
+    iou = float((a & b).sum()) / union
+    both = a & b
+    inner = np.zeros_like(both)
+    inner[1:-1, 1:-1] = (
+        both[1:-1, 1:-1] & both[:-2, 1:-1] & both[2:, 1:-1] & both[1:-1, :-2] & both[1:-1, 2:]
+    )
+    if not inner.any():
+        return iou, None
+    return iou, float(np.mean(np.abs(marched[inner].astype(np.float64) - rasterised[inner])))
+
+
+def _viewer_glb(vertices: np.ndarray, faces: np.ndarray, colors: np.ndarray) -> bytes:
+    """GLB for the 3D view: smooth vertex normals, and colours made linear (three.js shows vertex colours as
+    linear light, so sRGB-ish values would look washed out)."""
+    tri = sdf.mesh_trimesh(vertices, faces, np.clip(colors, 0.0, 1.0) ** 2.2)
+    glb = tri.export(file_type="glb", include_normals=True)
+    assert isinstance(glb, bytes)
+    return glb
+
+
+def _label(mapping: dict[str, Any], value: Any) -> str:
+    return next(label for label, v in mapping.items() if v == value)
+
+
+def _light_angles_deg(direction: tuple[float, float, float]) -> tuple[float, float]:
+    x, y, z = np.asarray(direction, dtype=np.float64) / np.linalg.norm(direction)
+    return round(math.degrees(math.asin(z))), round(math.degrees(math.atan2(y, x)))

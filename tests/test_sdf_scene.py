@@ -1,0 +1,317 @@
+"""The SDF gallery through a real ViserServer: the mesh it shows, gizmo drags over the websocket, bad input, the
+reference image and its readouts, downloads, and a clean teardown."""
+
+from __future__ import annotations
+
+import io
+import math
+import time
+from collections.abc import Callable
+
+import numpy as np
+import pytest
+import trimesh
+import viser
+from conftest import skip_or_fail
+from viser_private import gui_uuid, gui_uuids, node_names
+from wsclient import BrowserClient
+
+from kernels import sdf
+from scenes.sdf_gallery import SdfGalleryParams, SdfGalleryScene
+from scenes.switcher import SceneSwitcher
+from shaders.renderer import GLUnavailableError, Renderer
+
+MESH = "/sdf/mesh"
+
+
+@pytest.fixture
+def scene(switcher: SceneSwitcher) -> SdfGalleryScene:
+    shown = switcher.show("sdf")
+    assert isinstance(shown, SdfGalleryScene)
+    return shown
+
+
+def wait_until(
+    predicate: Callable[[], bool], timeout: float = 20.0, what: str = "condition"
+) -> None:
+    """Poll shared state (the worker thread publishes it); AssertionError on timeout."""
+    deadline = time.monotonic() + timeout
+    while not predicate():
+        if time.monotonic() > deadline:
+            raise AssertionError(f"timed out after {timeout} s waiting for {what}")
+        time.sleep(0.02)
+
+
+def shown_mesh(scene: SdfGalleryScene) -> trimesh.Trimesh:
+    """The mesh the browser receives: the GLB bytes of the mesh node, loaded back."""
+    loaded = trimesh.load(io.BytesIO(scene.mesh_node.glb_data), file_type="glb", force="mesh")
+    assert isinstance(loaded, trimesh.Trimesh)
+    return loaded
+
+
+def need_gl() -> None:
+    try:
+        Renderer().release()
+    except GLUnavailableError as exc:
+        skip_or_fail(str(exc))
+
+
+# ------------------------------------------------------------------------------------------ server side
+def test_opening_mesh_is_the_kernels(scene: SdfGalleryScene) -> None:
+    params = SdfGalleryParams()
+    vertices, faces, colors = sdf.mesh(params.scene(), params.resolution)
+    np.testing.assert_array_equal(scene.mesh_vertices, vertices)
+    np.testing.assert_array_equal(scene.mesh_faces, faces)
+    np.testing.assert_array_equal(scene.mesh_colors, colors)
+    glb = shown_mesh(scene)
+    assert len(glb.faces) == len(faces)
+    # The viewer's GLB is in the world frame, so its box matches the mesh's (GLB stores float32).
+    np.testing.assert_allclose(glb.bounds, [vertices.min(axis=0), vertices.max(axis=0)], atol=1e-5)
+    assert scene.agreement.triangles == len(faces)
+    assert f"{len(faces):,}" in scene.readout.content
+
+
+def test_gizmo_drag_remeshes(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
+    top_before = scene.mesh_vertices[:, 2].max()
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_node(MESH)
+        glb_before = scene.mesh_node.glb_data
+        path = [(0.0, 0.0, 0.5 + 0.05 * i) for i in range(1, 9)]
+        client.drag_transform("/sdf/gizmo_1", path, period_s=0.02)
+        wait_until(
+            lambda: (
+                scene.mesh_scene is not None and scene.mesh_scene.primitives[0].center == path[-1]
+            )
+        )
+        # The sphere (radius 0.45) rose 0.4 m: the mesh's top rose with it.
+        assert scene.mesh_vertices[:, 2].max() == pytest.approx(top_before + 0.4, abs=0.02)
+        assert scene.mesh_node.glb_data != glb_before
+        client.wait_for(
+            lambda: client.nodes[MESH].get("props", {}).get("glb_data") == scene.mesh_node.glb_data,
+            what="the new mesh at the client",
+        )
+
+
+def test_a_burst_of_drags_coalesces_to_the_latest(
+    server: viser.ViserServer, scene: SdfGalleryScene
+) -> None:
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_node(MESH)
+        before = scene.mesh_serial
+        path = [
+            (0.3 * math.cos(a), 0.3 * math.sin(a), 0.5) for a in np.linspace(0, 2 * math.pi, 41)[1:]
+        ]
+        client.drag_transform("/sdf/gizmo_2", path)  # no pauses: faster than any mesher
+        target = tuple(float(v) for v in path[-1])
+        wait_until(
+            lambda: (
+                scene.mesh_scene is not None
+                and np.allclose(scene.mesh_scene.primitives[1].center, target)
+            ),
+            what="the last drag position meshed",
+        )
+        expected = sdf.mesh(scene.params.scene(), scene.params.resolution)
+        np.testing.assert_array_equal(scene.mesh_vertices, expected[0])
+        assert scene.mesh_serial - before < 20  # 40 updates, far fewer meshes
+
+
+def test_gui_changes_remesh(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
+    volume_union = shown_mesh(scene).volume
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("P2 combine")
+        serial = scene.mesh_serial
+        client.set_value("P2 combine", "Subtract")
+        wait_until(lambda: scene.mesh_serial > serial, what="re-mesh after subtract")
+        assert scene.mesh_scene is not None and scene.mesh_scene.primitives[1].op == "subtract"
+        assert trimesh.Trimesh(scene.mesh_vertices, scene.mesh_faces).volume < 0.8 * volume_union
+        serial = scene.mesh_serial
+        client.set_value("P4 on", False)
+        wait_until(lambda: scene.mesh_serial > serial, what="re-mesh without P4")
+        assert scene.mesh_scene is not None and len(scene.mesh_scene.primitives) == 3
+        gizmo_4 = server.scene.get_handle_by_name("/sdf/gizmo_4")
+        assert gizmo_4 is not None and gizmo_4.visible is False
+        serial = scene.mesh_serial
+        client.set_value("Blend", "Exponential")
+        client.set_value("P1 kind", "Box")
+        client.set_value("P1 colour", (10, 200, 30))
+        wait_until(
+            lambda: (
+                scene.mesh_scene is not None
+                and scene.mesh_scene.blend == "exp"
+                and scene.mesh_scene.primitives[0].kind == "box"
+                and scene.mesh_scene.primitives[0].color[1] == pytest.approx(200 / 255)
+            ),
+            what="blend, kind and colour in the mesh",
+        )
+        expected = sdf.mesh(scene.params.scene(), scene.params.resolution)
+        for got, want in zip(
+            (scene.mesh_vertices, scene.mesh_faces, scene.mesh_colors), expected, strict=True
+        ):
+            np.testing.assert_array_equal(got, want)
+        assert (
+            client.element("P1 size b (m)")["props"]["disabled"] is False
+        )  # a box uses all three sizes
+
+
+def test_crafted_bad_values_keep_the_last_good_scene(
+    server: viser.ViserServer, scene: SdfGalleryScene
+) -> None:
+    good = scene.params
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Blend width k (m)")
+        client.wait_for_node("/sdf/gizmo_1")
+        client.set_value("Blend width k (m)", float("nan"))
+        client.wait_for(
+            lambda: client.value_of("Blend width k (m)") == good.k, what="k written back"
+        )
+        client.set_value("P2 kind", "Cone")
+        client.wait_for(lambda: client.value_of("P2 kind") == "Box", what="kind written back")
+        client.set_value(
+            "P3 size a (m)", "big"
+        )  # viser itself refuses this one; the final check covers it
+        client.set_value("P1 colour", (300, -4, 20))
+        client.wait_for(
+            lambda: tuple(client.value_of("P1 colour")) == good.primitives[0].color,
+            what="colour back",
+        )
+        client.drag_transform("/sdf/gizmo_1", [(float("nan"), 0.0, 0.0)])
+        client.drag_transform("/sdf/gizmo_2", [(0.6, 0.0, 0.3)], wxyz=(0.0, 0.0, 0.0, 0.0))
+        client.set_value("Mesh resolution", -5)  # out of range: clamped to the slider's minimum
+        client.wait_for(lambda: client.value_of("Mesh resolution") == 32, what="resolution clamped")
+        wait_until(lambda: scene.mesh_scene is not None and scene.params.resolution == 32)
+        wait_until(
+            lambda: len(scene.mesh_vertices) == len(sdf.mesh(good.scene(), 32)[0]), what="32³ mesh"
+        )
+    assert scene.params == SdfGalleryParams(resolution=32)
+    assert scene.mesh_scene == good.scene()
+    np.testing.assert_array_equal(scene.mesh_vertices, sdf.mesh(good.scene(), 32)[0])
+
+
+def test_gizmo_is_kept_inside_the_box(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
+    with BrowserClient(server.get_port()) as client:
+        client.drag_transform("/sdf/gizmo_3", [(9.0, -9.0, 0.1)])
+        wait_until(
+            lambda: scene.params.primitives[2].position == (1.5, -1.5, 0.1), what="clamped gizmo"
+        )
+    gizmo_3 = server.scene.get_handle_by_name("/sdf/gizmo_3")
+    assert gizmo_3 is not None and tuple(gizmo_3.position) == (1.5, -1.5, 0.1)
+
+
+def test_high_resolution_shows_progress_then_a_fine_mesh(
+    server: viser.ViserServer, scene: SdfGalleryScene
+) -> None:
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Mesh resolution")
+        client.set_value("Mesh resolution", 256)
+        progress_uuid = gui_uuid(scene.progress)
+        client.wait_for(
+            lambda: any(
+                m.get("type") == "GuiUpdateMessage"
+                and m.get("uuid") == progress_uuid
+                and m["updates"].get("visible") is True
+                for _, m in client.received
+            ),
+            what="progress bar shown",
+        )
+        wait_until(
+            lambda: scene.mesh_serial > 0 and len(scene.mesh_faces) > 100_000,
+            timeout=60,
+            what="256³ mesh",
+        )
+        wait_until(lambda: scene.progress.visible is False, what="progress bar hidden")
+
+
+# ------------------------------------------------------------------------------------------ reference image
+def test_reference_image_readouts_and_rerender(
+    server: viser.ViserServer, scene: SdfGalleryScene
+) -> None:
+    need_gl()
+    with BrowserClient(server.get_port()) as client:
+        client.send_camera(position=(2.3, -2.5, 1.7), look_at=(0.05, 0.0, 0.3), size=(600, 800))
+        wait_until(
+            lambda: scene.reference_serial >= 1 and scene.agreement.iou is not None, 60, "reference"
+        )
+        first = scene.reference_rgb
+        assert first is not None and first.shape == (240, 320, 3)
+        a = scene.agreement
+        assert (
+            a.iou is not None and a.iou > 0.97
+        )  # box edges on the silhouette are bevelled by marching cubes
+        assert a.depth_diff_voxels is not None and a.depth_diff_voxels < 0.1
+        assert a.render_ms is not None and "Silhouette IoU" in scene.readout.content
+        # Moving the camera re-renders from the new view once it rests.
+        count = scene.reference_serial
+        client.send_camera(position=(0.0, -3.5, 0.4), look_at=(0.0, 0.0, 0.3), size=(600, 800))
+        wait_until(lambda: scene.reference_serial > count, 30, "re-render after the camera moved")
+        assert scene.reference_rgb is not None and not np.array_equal(scene.reference_rgb, first)
+        # A brighter ambient term brightens the object.
+        dark = scene.reference_rgb.astype(float).mean()
+        count = scene.reference_serial
+        client.set_value("Ambient k_a", 0.9)
+        wait_until(lambda: scene.reference_serial > count, 30, "re-render after k_a")
+        assert scene.params.shading.ambient == 0.9
+        assert scene.reference_rgb.astype(float).mean() > dark + 5
+
+
+def test_downloads(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Download mesh (STL)")
+        for label, name in [
+            ("Download mesh (STL)", "sdf_mesh.stl"),
+            ("Download mesh (OBJ)", "sdf_mesh.obj"),
+        ]:
+            client.click(label)
+            client.wait_for(
+                lambda name=name: any(m.get("filename") == name for _, m in client.received),
+                what=name,
+            )
+            start = next(m for _, m in client.received if m.get("filename") == name)
+            client.wait_for(
+                lambda start=start: (
+                    sum(
+                        1
+                        for _, m in client.received
+                        if m.get("transfer_uuid") == start["transfer_uuid"]
+                    )
+                    > start["part_count"]
+                ),
+                what=f"{name} parts",
+            )
+            parts = sorted(
+                (m["part_index"], m["content"])
+                for _, m in client.received
+                if m.get("type") == "FileTransferPart"
+                and m["transfer_uuid"] == start["transfer_uuid"]
+            )
+            data = b"".join(content for _, content in parts)
+            assert len(data) == start["size_bytes"]
+            loaded = trimesh.load(
+                io.BytesIO(data), file_type=name.rsplit(".", 1)[1], force="mesh", process=False
+            )
+            assert isinstance(loaded, trimesh.Trimesh)
+            assert len(loaded.faces) == len(scene.mesh_faces)
+    name, glb = scene.export("glb")
+    assert name == "sdf_mesh.glb" and glb is not None and glb[:4] == b"glTF"
+
+
+def test_png_download_is_the_reference_image(scene: SdfGalleryScene) -> None:
+    need_gl()
+    wait_until(lambda: scene.reference_rgb is not None, 60, "reference")
+    from PIL import Image
+
+    name, png = scene.export("png")
+    assert name == "sdf_reference.png" and png is not None
+    assert scene.reference_rgb is not None
+    np.testing.assert_array_equal(np.asarray(Image.open(io.BytesIO(png))), scene.reference_rgb)
+
+
+# ------------------------------------------------------------------------------------------ teardown
+def test_close_removes_everything_and_stops_the_worker(server: viser.ViserServer) -> None:
+    nodes_before, gui_before = node_names(server), gui_uuids(server)
+    scene = SdfGalleryScene(server)
+    assert MESH in node_names(server)
+    worker = scene._threads[0]
+    scene.close()
+    assert not worker.is_alive()
+    assert node_names(server) == nodes_before
+    assert gui_uuids(server) == gui_before
