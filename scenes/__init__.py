@@ -10,16 +10,18 @@ from typing import Literal
 
 from scenes._base import Scene
 from scenes.arm import ArmScene
+from scenes.freekick import FreeKickScene
 from scenes.peloton import PelotonScene
 from scenes.sdf_gallery import SdfGalleryScene
 
-SceneName = Literal["peloton", "arm", "sdf"]
+SceneName = Literal["peloton", "arm", "sdf", "freekick"]
 """Keys of :data:`SCENES`, for the command line."""
 
 SCENES: dict[str, type[Scene]] = {
     PelotonScene.key: PelotonScene,
     ArmScene.key: ArmScene,
     SdfGalleryScene.key: SdfGalleryScene,
+    FreeKickScene.key: FreeKickScene,
 }
 """Every scene that exists, in switcher order."""
 

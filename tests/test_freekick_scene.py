@@ -1,0 +1,325 @@
+"""The free-kick scene through a real ViserServer: handles read back, presets, the kick animation, aiming, the
+outcome map, a browser-like websocket client, and crafted bad input."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+import viser
+from wsclient import BrowserClient
+
+from kernels import ball
+from scenes.freekick import (
+    ARROW_POINTS,
+    JUMP_M,
+    MAP_SPEEDS_MS,
+    MAP_SPINS_REV_S,
+    PATH_POINTS,
+    PRESETS,
+    RESULT_COLOURS,
+    FreeKickParams,
+    FreeKickScene,
+    compute_kick,
+    resample,
+)
+from scenes.switcher import SceneSwitcher
+
+
+@pytest.fixture
+def scene(switcher: SceneSwitcher) -> FreeKickScene:
+    shown = switcher.show("freekick")
+    assert isinstance(shown, FreeKickScene)
+    assert shown.wait_idle()
+    return shown
+
+
+def drawn_path(scene: FreeKickScene) -> np.ndarray:
+    segments = np.asarray(scene.path.points)
+    return np.concatenate([segments[:, 0], segments[-1:, 1]])
+
+
+# ------------------------------------------------------------------------------------------------ server side
+def test_opening_state_is_the_kernels_curler(scene: FreeKickScene) -> None:
+    expected = compute_kick(FreeKickParams())
+    assert scene.state.outcome.result == expected.outcome.result == "goal"
+    np.testing.assert_allclose(drawn_path(scene), resample(expected.flight), atol=1e-5)
+    ghost = np.asarray(scene.ghost.points)
+    np.testing.assert_allclose(ghost[-1, 1], expected.ghost.position[-1], atol=1e-5)
+    assert ghost.shape == (PATH_POINTS - 1, 2, 3)
+    # The ghost flies straight (no spin): every point on the vertical plane of its launch.
+    heading = math.atan2(expected.ghost.velocity[0, 1], expected.ghost.velocity[0, 0])
+    across = np.array([-math.sin(heading), math.cos(heading), 0.0])
+    np.testing.assert_allclose((ghost[:, 0] - expected.ghost.position[0]) @ across, 0.0, atol=1e-4)
+    assert "**GOAL**" in scene.result.content
+    assert f"{expected.outcome.wall_point[2]:.2f} m" in scene.result.content  # type: ignore[index]
+    assert "+3.38 m" in scene.result.content  # sideways against the no-spin kick, curled left
+    # Force chart: |drag|, |Magnus|, |gravity| against time, straight from the kernel.
+    t, drag, magnus, gravity, _ = scene.chart.data
+    np.testing.assert_allclose(t, expected.flight.t)
+    np.testing.assert_allclose(drag, np.linalg.norm(expected.flight.drag, axis=1))
+    np.testing.assert_allclose(magnus, np.linalg.norm(expected.flight.magnus, axis=1))
+    np.testing.assert_allclose(gravity, 0.43 * 9.81)
+    # Gravity arrows point down, 0.3 m per newton.
+    arrows = np.asarray(scene.arrows["gravity"].points)[:ARROW_POINTS]
+    np.testing.assert_allclose(
+        arrows[:, 1] - arrows[:, 0], [[0, 0, -0.3 * 0.43 * 9.81]] * ARROW_POINTS, atol=1e-5
+    )
+
+
+def test_spin_changes_path_band_and_outcome_with_the_measured_model(scene: FreeKickScene) -> None:
+    band = np.asarray(scene.band.vertices)
+    assert np.allclose(
+        band[0::2], band[1::2], atol=1e-5
+    )  # constant model: ±10 % spin flies the same path
+    scene.model.value = "Measured C_D(Re, S), C_L(S)"
+    scene.azimuth.value = -12.0
+    assert scene.params.model == "measured" and scene.state.outcome.result == "goal"
+    band = np.asarray(scene.band.vertices)
+    width_at_goal = np.linalg.norm(band[-2] - band[-1])
+    assert width_at_goal > 0.4  # a tenth more or less spin moves the ball tens of centimetres
+    before = drawn_path(scene)
+    scene.spin.value = 2.0
+    assert scene.state.outcome.result == "wide" and "Wide of the post" in scene.result.content
+    assert np.abs(drawn_path(scene) - before).max() > 1.0
+
+
+def test_presets_score_and_set_every_control(scene: FreeKickScene) -> None:
+    for preset, button in zip(PRESETS, scene.preset_buttons, strict=True):
+        button.value = True  # what a click does, server side
+        scene.wait_idle()
+        assert scene.params == preset.params, preset.label
+        assert scene.state.outcome.result == "goal", preset.label
+        assert scene.spin.value == preset.params.spin_rev_s
+        if preset.params.knuckle:  # the knuckle force acts, not just the label
+            assert preset.params.spin_rev_s == 0.0
+            assert np.abs(scene.state.flight.knuckle).max() > 0.1
+            assert np.all(scene.state.ghost.knuckle == 0.0)
+    assert any(preset.params.knuckle for preset in PRESETS)
+
+
+def test_a_jumping_wall_blocks_the_curler(scene: FreeKickScene) -> None:
+    scene.jump.value = True
+    assert scene.state.wall.height_m == pytest.approx(1.8 + JUMP_M)
+    positions = np.asarray(scene.wall_nodes.batched_positions)
+    np.testing.assert_allclose(positions[:, 2], JUMP_M)
+    np.testing.assert_allclose(positions[:, 0], -22.0 + 9.15, atol=1e-5)
+    assert scene.state.outcome.result == "wall" and "Blocked by the wall" in scene.result.content
+
+
+def test_kick_flies_the_ball_spinning_along_its_path(scene: FreeKickScene) -> None:
+    spot = np.array(scene.ball_frame.position)
+    scene.kick_button.value = True
+    with scene._lock:  # step the animation deterministically, with the scene's own loop held off
+        assert scene._kick_time_s is not None
+        scene._kick_time_s = 0.0
+        for _ in range(5):
+            scene._animate(0.1)
+        mid = np.array(scene.ball_frame.position)
+        wxyz = np.array(scene.ball_frame.wxyz)
+        flight = scene.state.flight
+        expected = [np.interp(0.5, flight.t, flight.position[:, k]) for k in range(3)]
+        np.testing.assert_allclose(mid, expected, atol=1e-9)
+        assert np.linalg.norm(mid - spot) > 10.0
+        # Rotated about the spin axis (+z, sidespin) by 2π·8 rev/s·0.5 s.
+        angle = 2 * math.pi * 8.0 * 0.5
+        np.testing.assert_allclose(
+            wxyz, [math.cos(angle / 2), 0, 0, math.sin(angle / 2)], atol=1e-9
+        )
+        for _ in range(40):
+            scene._animate(0.1)
+        assert scene._kick_time_s is None  # landed, rested, and went back to the spot
+        np.testing.assert_allclose(scene.ball_frame.position, spot)
+
+
+def test_aiming_at_a_point_of_the_goal_mouth_finds_a_kick_over_the_wall(
+    scene: FreeKickScene,
+) -> None:
+    scene.aim_at_point(-2.6, 1.9)
+    assert scene.wait_idle()
+    point = scene.state.outcome.goal_point
+    assert scene.state.outcome.result == "goal" and point is not None
+    assert np.linalg.norm(point[1:] - [-2.6, 1.9]) < 0.05
+    assert scene.speed.value == 25.0  # the speed is kept
+    assert scene.elevation.value == pytest.approx(scene.params.elevation_deg)
+    assert "Found" in scene.aim_status.content
+    np.testing.assert_allclose(scene.target_marker.position, (0.0, -2.6, 1.9))
+
+
+def test_a_click_ray_through_the_goal_mouth_aims_there(scene: FreeKickScene) -> None:
+    scene.aim_from_ray((-20.0, -1.0, 1.0), (20.0, -1.0, 1.0))  # hits x = 0 at y = −2, z = 2
+    assert scene.wait_idle()
+    assert scene.last_target == pytest.approx((-2.0, 2.0))
+    before = scene.params
+    scene.aim_from_ray((-20.0, 0.0, 1.0), (20.0, 10.0, 0.0))  # misses the mouth: nothing happens
+    scene.aim_from_ray((math.nan, 0.0, 1.0), (1.0, 0.0, 0.0))
+    scene.aim_from_ray("not a ray", None)
+    assert scene.wait_idle()
+    assert scene.params == before and scene.last_target == pytest.approx((-2.0, 2.0))
+
+
+def test_outcome_map_matches_single_runs(scene: FreeKickScene) -> None:
+    results = scene.map_results
+    assert results is not None and results.shape == (len(MAP_SPINS_REV_S), len(MAP_SPEEDS_MS))
+    assert {"goal", "wall", "over"} <= set(results.ravel().tolist())
+    wall, goal = scene.state.wall, scene.state.goal
+    for row, col in ((0, 0), (16, 20), (30, 40), (10, 25)):
+        params = dataclasses.replace(
+            scene.params, speed_ms=float(MAP_SPEEDS_MS[col]), spin_rev_s=float(MAP_SPINS_REV_S[row])
+        )
+        expected = ball.outcome(compute_kick(params).flight, wall, goal).result
+        assert results[row, col] == expected, (row, col)
+    image = np.asarray(scene.map_image.image)
+    rows = results.shape[0]
+    cell = image.shape[0] // rows
+    colour = image[(rows - 1 - 10) * cell + 1, 25 * cell + 1]
+    assert tuple(colour) == RESULT_COLOURS[str(results[10, 25])]
+    scene.jump.value = True  # the map follows the settings
+    assert scene.wait_idle()
+    assert np.sum(scene.map_results == "wall") > np.sum(results == "wall")  # type: ignore[operator]
+
+
+def test_scene_close_leaves_only_the_switcher(server: viser.ViserServer) -> None:
+    from viser_private import gui_uuids, node_names
+
+    bare_nodes, bare_gui = node_names(server), gui_uuids(server)
+    scene = FreeKickScene(server)
+    assert scene.wait_idle()
+    assert len(node_names(server)) > len(bare_nodes) + 10
+    scene.close()
+    assert node_names(server) == bare_nodes
+    assert gui_uuids(server) == bare_gui
+    assert not any(thread.is_alive() for thread in scene._threads)
+
+
+# ------------------------------------------------------------------------------------------------ over the websocket
+def _markdown_shown(client: BrowserClient, text: str) -> bool:
+    return any(
+        text in str(element["props"].get("_markdown", "")) for element in client.gui.values()
+    )
+
+
+def test_spin_slider_from_a_browser_changes_the_path_and_the_outcome(
+    server: viser.ViserServer, scene: FreeKickScene
+) -> None:
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Spin rate (rev/s)")
+        client.set_value("Model", "Measured C_D(Re, S), C_L(S)")
+        client.set_value("Azimuth (°, + = left)", -12.0)
+        client.wait_for(
+            lambda: scene.params.azimuth_deg == -12.0 and scene.params.model == "measured",
+            what="setup",
+        )
+        client.wait_for(lambda: _markdown_shown(client, "**GOAL**"), what="a goal shown")
+        path_node = client.wait_for_node("/freekick/path")
+        before = np.array(path_node["props"]["points"]).copy()
+        client.set_value("Spin rate (rev/s)", 2.0)
+        client.wait_for(
+            lambda: _markdown_shown(client, "**Wide of the post**"), what="the new outcome shown"
+        )
+        client.wait_for(
+            lambda: (
+                not np.allclose(np.array(client.nodes["/freekick/path"]["props"]["points"]), before)
+            ),
+            what="the new path sent",
+        )
+        sent = np.array(client.nodes["/freekick/path"]["props"]["points"]).reshape(-1, 2, 3)
+        np.testing.assert_allclose(sent, np.asarray(scene.path.points), atol=1e-6)
+
+
+CRAFTED = [
+    ("Spin rate (rev/s)", float("nan"), "spin_rev_s", 8.0),
+    ("Spin rate (rev/s)", float("-inf"), "spin_rev_s", 8.0),
+    ("Spin rate (rev/s)", 1e12, "spin_rev_s", 15.0),  # clamped to the slider's max
+    ("Launch speed (m/s)", -3.0, "speed_ms", 5.0),  # clamped to min
+    ("Elevation (°)", float("nan"), "elevation_deg", 17.0),
+    ("Distance to goal (m)", float("inf"), "distance_m", 22.0),
+    ("Spin axis", "sideways-ish", "spin_axis", "left"),
+    ("Model", "magic", "model", "constant"),
+    ("Integrator", "leapfrog", "integrator", "rk4"),
+    ("Knuckle seed", -7, "knuckle_seed", 0),
+]
+
+
+@pytest.mark.parametrize(("label", "value", "field", "expected"), CRAFTED)
+def test_crafted_values_keep_the_last_good_state(
+    server: viser.ViserServer,
+    scene: FreeKickScene,
+    label: str,
+    value: object,
+    field: str,
+    expected: object,
+) -> None:
+    good = scene.state
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui(label)
+        client.set_value(label, value)
+        # The cleaned value is echoed to every browser; the scene holds it.
+        client.wait_for(
+            lambda: _echoed(client.value_of(label), expected), what="the cleaned value echoed"
+        )
+        client.wait_for(
+            lambda: getattr(scene.params, field) == expected, what="the scene to hold the value"
+        )
+        with scene._lock:
+            assert np.all(np.isfinite(scene.state.flight.position))
+            assert np.all(np.isfinite(np.asarray(scene.path.points)))
+            if (
+                getattr(FreeKickParams(), field) == expected
+            ):  # refused outright: the flight is the one before
+                np.testing.assert_array_equal(scene.state.flight.position, good.flight.position)
+
+
+def _echoed(shown: object, expected: object) -> bool:
+    if isinstance(expected, str):
+        return isinstance(shown, str) and shown not in ("sideways-ish", "magic", "leapfrog")
+    assert isinstance(expected, (int, float))
+    return (
+        isinstance(shown, (int, float)) and math.isfinite(shown) and float(shown) == float(expected)
+    )
+
+
+def test_wrong_types_and_crafted_clicks_leave_the_scene_serving(
+    server: viser.ViserServer, scene: FreeKickScene
+) -> None:
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Spin rate (rev/s)")
+        client.set_value("Spin rate (rev/s)", "fast")
+        client.set_value("Knuckleball", "yes please")
+        client.set_value(
+            "Knuckle seed", float("nan")
+        )  # viser's own int cast refuses it before the scene
+        client.send(
+            "SceneNodeClickMessage",
+            name="/freekick/goal_mouth",
+            instance_index=None,
+            ray_origin=(math.nan, 0.0, 1.0),
+            ray_direction=(1.0, 0.0, 0.0),
+            screen_pos=(0.5, 0.5),
+            modifier=None,
+        )
+        # A real click through the mouth: the scene aims a kick at (y, z) = (1.5, 1.2).
+        client.send(
+            "SceneNodeClickMessage",
+            name="/freekick/goal_mouth",
+            instance_index=None,
+            ray_origin=(-20.0, 1.5, 1.2),
+            ray_direction=(1.0, 0.0, 0.0),
+            screen_pos=(0.5, 0.5),
+            modifier=None,
+        )
+        client.wait_for(
+            lambda: scene.last_target == (1.5, 1.2), what="the click to reach the scene"
+        )
+        assert scene.wait_idle()
+        client.wait_for(lambda: _markdown_shown(client, "Found:"), what="the aim result shown")
+        point = scene.state.outcome.goal_point
+        assert scene.state.outcome.result == "goal" and point is not None
+        assert np.linalg.norm(point[1:] - [1.5, 1.2]) < 0.05
+        assert scene.params.knuckle is False and scene.params.knuckle_seed == 1
+        client.set_value("Launch speed (m/s)", 27.0)
+        client.wait_for(
+            lambda: scene.params.speed_ms == 27.0, what="a good value after the bad ones"
+        )
