@@ -1,0 +1,82 @@
+"""A real browser: Chromium opens the SDF gallery, shows the mesh, and shows the GLSL reference image the server made."""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+import numpy as np
+import pytest
+import viser
+from browser import open_viser
+from conftest import skip_or_fail
+
+from scenes.sdf_gallery import SdfGalleryScene
+from scenes.switcher import SceneSwitcher
+from shaders.renderer import GLUnavailableError, Renderer
+
+pytestmark = pytest.mark.browser
+
+READ_IMAGE = """
+([w, h]) => {
+    const img = [...document.querySelectorAll('img')].find(
+        i => i.complete && i.naturalWidth === w && i.naturalHeight === h);
+    if (!img) return null;
+    const canvas = document.createElement('canvas');
+    canvas.width = w; canvas.height = h;
+    const ctx = canvas.getContext('2d');
+    ctx.drawImage(img, 0, 0);
+    return Array.from(ctx.getImageData(0, 0, w, h).data);
+}
+"""
+
+
+def test_browser_shows_the_mesh_and_the_reference_image(
+    server: viser.ViserServer, browser_page: Any
+) -> None:
+    try:
+        Renderer().release()
+    except GLUnavailableError as exc:
+        skip_or_fail(str(exc))
+    switcher = SceneSwitcher(server, "sdf")
+    scene = switcher.scene
+    assert isinstance(scene, SdfGalleryScene)
+    page = browser_page
+    try:
+        open_viser(page, server.get_port(), "/sdf/mesh")
+
+        # The 3D view shows the mesh: the sphere's red and the box's blue are on the canvas.
+        clients = list(server.get_clients().values())
+        assert len(clients) == 1
+        render = clients[0].get_render(height=360, width=480)
+        rgb = np.asarray(render)[..., :3].astype(int)
+        reddish = (rgb[..., 0] > rgb[..., 2] + 60) & (rgb[..., 0] > 120)
+        bluish = (rgb[..., 2] > rgb[..., 0] + 60) & (rgb[..., 2] > 120)
+        assert reddish.sum() > 200 and bluish.sum() > 200
+
+        # The reference panel shows the ray-marched image, pixel for pixel as the server rendered it.
+        deadline = time.monotonic() + 60
+        while scene.reference_rgb is None and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert scene.reference_rgb is not None
+        # The browser may move its camera once more (a re-render); wait until the page and the server agree.
+        shown = None
+        while time.monotonic() < deadline:
+            expected = scene.reference_rgb
+            height, width = expected.shape[:2]
+            handle = page.wait_for_function(
+                f"({READ_IMAGE})([{width}, {height}])", timeout=30_000, polling=200
+            )
+            shown = np.asarray(handle.json_value(), dtype=np.uint8).reshape(height, width, 4)[
+                ..., :3
+            ]
+            if np.array_equal(shown, scene.reference_rgb):
+                break
+            time.sleep(0.2)
+        assert shown is not None and scene.reference_rgb is not None
+        np.testing.assert_array_equal(shown, scene.reference_rgb)
+        height, width = shown.shape[:2]
+        object_pixels = (np.abs(shown.astype(int) - shown[0, 0].astype(int)).sum(axis=2) > 30).sum()
+        assert object_pixels > 0.02 * width * height  # the object, not just background
+    finally:
+        switcher.close()
