@@ -681,8 +681,172 @@ def _backward_pass(chains: _Chains, setup: _Setup) -> None:
 
 
 def _fabrik_step(chains: _Chains, setup: _Setup) -> None:
+    if chains.p.shape[2] == 1:
+        _fabrik_step_one(chains, setup)
+        return
     _forward_pass(chains, setup)
     _backward_pass(chains, setup)
+
+
+# ------------------------------------------------------------------------------------------------ one chain
+# With B = 1 every numpy call costs about a microsecond whatever its size, so one chain's passes run on Python
+# floats instead. They repeat the vectorised passes operation for operation, in the same order, so both paths give
+# the same bits (the batch-equals-single tests hold them to it).
+Vec = list[float]
+
+
+def _dot(a: Vec, b: Vec) -> float:
+    total = a[0] * b[0] + a[1] * b[1]
+    return total + a[2] * b[2] if len(a) == 3 else total
+
+
+def _length(v: Vec) -> float:
+    return math.sqrt(_dot(v, v))
+
+
+def _unit_one(v: Vec, fallback: Vec, tiny: float) -> tuple[Vec, float]:
+    norm = _length(v)
+    if norm > tiny:
+        return [x / norm for x in v], norm
+    return fallback, norm
+
+
+def _perpendicular_one(a: Vec) -> Vec:
+    if len(a) == 2:
+        return [-a[1], a[0]]
+    use_y = abs(a[0]) > 0.9
+    ex, ey = (0.0, 1.0) if use_y else (1.0, 0.0)
+    cross = [-a[2] * ey, a[2] * ex, a[0] * ey - a[1] * ex]
+    norm = _length(cross)
+    return [x / norm for x in cross]
+
+
+def _clamp_cone_one(v: Vec, axis: Vec, limits: tuple[float, float]) -> Vec:
+    cos_phi, sin_phi = limits
+    cos_v = _dot(v, axis)
+    if not cos_v < cos_phi:
+        return v
+    side = [x - cos_v * a for x, a in zip(v, axis, strict=True)]
+    side_norm = _length(side)
+    side = [x / side_norm for x in side] if side_norm > 1e-9 else _perpendicular_one(axis)
+    clamped = [cos_phi * a + sin_phi * x for a, x in zip(axis, side, strict=True)]
+    norm = _length(clamped)
+    return [x / norm for x in clamped]
+
+
+def _deflect_one(
+    anchor: Vec,
+    v: Vec,
+    length: float,
+    obstacles: list[tuple[Vec, float]],
+    tiny: float,
+) -> tuple[Vec, bool]:
+    """:func:`_deflect` for one chain; ``obstacles`` are its live ones as (centre, radius)."""
+    turned = False
+    three = len(anchor) == 3
+    for _ in range(3):
+        hits = []
+        for k, (centre, radius) in enumerate(obstacles):
+            # Written out, in the order numpy sums over the d axis, so the bits match the batch path.
+            rx, ry = centre[0] - anchor[0], centre[1] - anchor[1]
+            along = rx * v[0] + ry * v[1]
+            rel2 = rx * rx + ry * ry
+            if three:
+                rz = centre[2] - anchor[2]
+                along = along + rz * v[2]
+                rel2 = rel2 + rz * rz
+            t = min(max(along, 0.0), length)
+            if rel2 - 2.0 * t * along + t * t < radius * radius:
+                hits.append(k)
+        if not hits:
+            return v, turned
+        turned = True
+        for k in hits:
+            v = _turn_clear_one(anchor, v, length, obstacles[k][0], obstacles[k][1], tiny)
+    return v, turned
+
+
+def _turn_clear_one(
+    anchor: Vec, v: Vec, length: float, centre: Vec, radius: float, tiny: float
+) -> Vec:
+    clear = radius * (1.0 + _CLEARANCE)
+    to_centre, distance = _unit_one(
+        [c - a for c, a in zip(centre, anchor, strict=True)], [-x for x in v], tiny
+    )
+    if distance <= radius:
+        return [-x for x in to_centre]
+    safe_distance = max(distance, tiny)
+    safe_length = max(length, tiny)
+    if length * length >= distance * distance - clear * clear:
+        sin_t = min(max(clear / safe_distance, 0.0), 1.0)
+        cos_t = math.sqrt(1.0 - sin_t * sin_t)
+    else:
+        cos_t = min(
+            max(
+                (length * length + distance * distance - clear * clear)
+                / (2.0 * safe_length * safe_distance),
+                -1.0,
+            ),
+            1.0,
+        )
+        sin_t = math.sqrt(1.0 - cos_t * cos_t)
+    along = _dot(v, to_centre)
+    side, _ = _unit_one(
+        [x - along * c for x, c in zip(v, to_centre, strict=True)],
+        _perpendicular_one(to_centre),
+        1e-9,
+    )
+    turned = [cos_t * c + sin_t * x for c, x in zip(to_centre, side, strict=True)]
+    norm = _length(turned)
+    return [x / norm for x in turned]
+
+
+def _fabrik_step_one(chains: _Chains, setup: _Setup) -> None:
+    """:func:`_forward_pass` then :func:`_backward_pass` for a batch of one chain, on Python floats."""
+    p: list[Vec] = chains.p[:, :, 0].tolist()
+    lengths: Vec = chains.lengths[:, 0].tolist()
+    tiny = float(chains.tiny[0])
+    live: list[bool] = chains.obstacle_live[:, 0].tolist()
+    obstacles = [
+        (centre, radius)
+        for centre, radius, alive in zip(
+            setup.centres[:, :, 0].tolist(), setup.radii[:, 0].tolist(), live, strict=True
+        )
+        if alive
+    ]
+    root_direction: Vec = setup.root_direction[:, 0].tolist()
+    limits, has_obstacles, zero_links = setup.limits, bool(obstacles), chains.has_zero_link
+    n = len(lengths)
+
+    p[n] = chains.target[:, 0].tolist()
+    previous, _ = _unit_one(
+        [a - b for a, b in zip(p[0], p[n], strict=True)], [-x for x in root_direction], tiny
+    )
+    for i in range(n - 1, 0, -1):
+        anchor = p[i + 1]
+        direction, _ = _unit_one([a - b for a, b in zip(p[i], anchor, strict=True)], previous, tiny)
+        if has_obstacles:
+            direction, _ = _deflect_one(anchor, direction, lengths[i], obstacles, tiny)
+        if limits is not None and i < n - 1:
+            direction = _clamp_cone_one(direction, previous, limits)
+        p[i] = [a + lengths[i] * x for a, x in zip(anchor, direction, strict=True)]
+        if not zero_links or lengths[i] > tiny:
+            previous = direction
+
+    previous = root_direction
+    for i in range(1, n + 1):
+        anchor = p[i - 1]
+        direction, _ = _unit_one([a - b for a, b in zip(p[i], anchor, strict=True)], previous, tiny)
+        if limits is not None:
+            direction = _clamp_cone_one(direction, previous, limits)
+        if has_obstacles:
+            direction, turned = _deflect_one(anchor, direction, lengths[i - 1], obstacles, tiny)
+            if turned and limits is not None:
+                direction = _clamp_cone_one(direction, previous, limits)
+        p[i] = [a + lengths[i - 1] * x for a, x in zip(anchor, direction, strict=True)]
+        if not zero_links or lengths[i - 1] > tiny:
+            previous = direction
+    chains.p[:, :, 0] = p
 
 
 def _rotate_2d(
