@@ -59,7 +59,8 @@ _TINY = 1e-12
 _CLEARANCE = 1e-6
 """Segments are turned to clear an obstacle by this fraction of its radius, so rounding never leaves them inside."""
 _STALL = 1e-3
-"""A chain whose joints all moved less than this fraction of the tolerance in an iteration is at a fixed point."""
+"""A chain whose end-effector error changed by less than this fraction of the tolerance in an iteration is at a
+fixed point (caliko's "minimum change" rule)."""
 _DLS_DAMPING = 0.1
 """Damping of the DLS step, times the mean link length (Buss 2004 suggests λ of the order of the link size)."""
 
@@ -1056,7 +1057,7 @@ def _run(
     for iteration in range(1, setup.max_iterations + 1):
         if index.size == 0:
             break
-        before = active.p.copy()
+        last_error = history[index, iteration - 1]
         step(active, setup)
         error = _norm(active.p[n] - active.target)
         history[index, iteration] = error
@@ -1069,8 +1070,7 @@ def _run(
             reached = clear & (error < setup.tolerance)
         else:
             reached = error < setup.tolerance
-        moved = np.max(np.abs(active.p - before), axis=(0, 1))
-        stalled = moved < stall
+        stalled = np.abs(last_error - error) < stall
         finished = reached | stalled | (iteration == setup.max_iterations)
         if not finished.any():
             continue
