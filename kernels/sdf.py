@@ -205,9 +205,9 @@ def _smin_poly_weighted(a: FloatArray, b: FloatArray, k: float) -> tuple[FloatAr
 
 def _smin_exp_weighted(a: FloatArray, b: FloatArray, k: float) -> tuple[FloatArray, FloatArray]:
     """Exponential smooth min (``k`` = sharpness) and the weight of ``b``: exp(−kb)/(exp(−ka) + exp(−kb))."""
-    m = np.minimum(a, b)
-    d = m - np.log1p(np.exp(-k * np.abs(a - b))) / k
-    w_b = 0.5 + 0.5 * np.tanh(0.5 * k * (a - b))  # the logistic, written so it cannot overflow
+    e = np.exp(-k * np.abs(a - b))  # in (0, 1]: neither this nor what follows can overflow
+    d = np.minimum(a, b) - np.log1p(e) / k
+    w_b = np.where(a > b, 1.0, e) / (1.0 + e)
     return d, w_b
 
 

@@ -59,10 +59,12 @@ vec2 smin_poly_weighted(float a, float b, float k) {
     return vec2(h * a + (1.0 - h) * b - k * h * (1.0 - h), 1.0 - h);
 }
 
-// k is the sharpness (1/m); min(a, b) - log(1 + exp(-k|a - b|))/k cannot overflow.
+// k is the sharpness (1/m); min(a, b) - log(1 + exp(-k|a - b|))/k cannot overflow, and the weight of b,
+// exp(-kb)/(exp(-ka) + exp(-kb)), reuses the same exponential.
 vec2 smin_exp_weighted(float a, float b, float k) {
-    float d = min(a, b) - log(1.0 + exp(-k * abs(a - b))) / k;
-    return vec2(d, 0.5 + 0.5 * tanh(clamp(0.5 * k * (a - b), -15.0, 15.0)));
+    float e = exp(-k * abs(a - b));
+    float d = min(a, b) - log(1.0 + e) / k;
+    return vec2(d, a > b ? 1.0 / (1.0 + e) : e / (1.0 + e));
 }
 
 float smin_poly(float a, float b, float k) {
@@ -85,27 +87,22 @@ float op_intersect(float a, float b) {
     return max(a, b);
 }
 
+// llvmpipe (Mesa's CPU driver) runs every side of a branch under a lane mask, even when the condition is a
+// uniform, so the choices below are written as selects between values computed once.
 vec2 smin_blend(float a, float b, float k, int blend) {
-    if (k == 0.0) {
-        return smin_poly_weighted(a, b, 0.0);
-    }
-    if (blend == BLEND_EXP) {
-        return smin_exp_weighted(a, b, EXP_SHARPNESS_PER_WIDTH / k);
-    }
-    return smin_poly_weighted(a, b, k);
+    float width = max(k, 1e-20);  // k = 0 is the hard minimum; keep the division finite
+    vec2 poly = smin_poly_weighted(a, b, width);
+    vec2 expo = smin_exp_weighted(a, b, EXP_SHARPNESS_PER_WIDTH / width);
+    return (blend == BLEND_EXP && k > 0.0) ? expo : poly;
 }
 
-// Distance of (a op b) and the weight of b; k is the blend width (m).
+// Distance of (a op b) and the weight of b; k is the blend width (m). Union smin(a, b), subtraction
+// -smin(-a, b), intersection -smin(-a, -b): one blend with signs, not three.
 vec2 combine(float a, float b, int op, float k, int blend) {
-    if (op == OP_SUBTRACT) {
-        vec2 r = smin_blend(-a, b, k, blend);
-        return vec2(-r.x, r.y);
-    }
-    if (op == OP_INTERSECT) {
-        vec2 r = smin_blend(-a, -b, k, blend);
-        return vec2(-r.x, r.y);
-    }
-    return smin_blend(a, b, k, blend);
+    float sign_a = op == OP_UNION ? 1.0 : -1.0;
+    float sign_b = op == OP_INTERSECT ? -1.0 : 1.0;
+    vec2 r = smin_blend(sign_a * a, sign_b * b, k, blend);
+    return vec2(sign_a * r.x, r.y);
 }
 
 float smooth_union(float a, float b, float k, int blend) {
@@ -121,20 +118,19 @@ float smooth_intersect(float a, float b, float k, int blend) {
 }
 
 // ------------------------------------------------------------------------------ scene
+// Sphere, box and capsule are one rounded box |max(q, 0)| + min(max(q.x, q.y, q.z), 0) - r, q = |p| - e
+// (sphere: e = 0; box: e = half sizes, r = 0; capsule: e = (0, half length, 0)); the torus is the other formula.
+// Both are evaluated and one is selected (see smin_blend on why); the values equal sd_sphere, sd_box, sd_capsule and
+// sd_torus.
 float primitive_distance(int i, vec3 p_world) {
     vec3 p = u_world_to_local[i] * (p_world - u_center[i]);
     vec3 s = u_size[i];
     int kind = u_kind[i];
-    if (kind == KIND_SPHERE) {
-        return sd_sphere(p, s.x);
-    }
-    if (kind == KIND_BOX) {
-        return sd_box(p, s);
-    }
-    if (kind == KIND_TORUS) {
-        return sd_torus(p, s.x, s.y);
-    }
-    return sd_capsule(p, vec3(0.0, -s.x, 0.0), vec3(0.0, s.x, 0.0), s.y);
+    vec3 e = kind == KIND_BOX ? s : (kind == KIND_CAPSULE ? vec3(0.0, s.x, 0.0) : vec3(0.0));
+    float r = kind == KIND_BOX ? 0.0 : (kind == KIND_CAPSULE ? s.y : s.x);
+    float rounded = sd_box(p, e) - r;
+    float torus = sd_torus(p, s.x, s.y);
+    return kind == KIND_TORUS ? torus : rounded;
 }
 
 float scene_distance(vec3 p) {
