@@ -965,6 +965,12 @@ def _cone_ok(chains: _Chains, setup: _Setup) -> NDArray[np.bool_]:
     if setup.limits is None:
         return np.ones(chains.p.shape[2], dtype=bool)
     cos_phi = setup.limits[0]
+    if not chains.has_zero_link:  # every segment has a direction: compare them all at once
+        directions = np.diff(chains.p, axis=0) / chains.lengths[:, None, :]  # (n, d, B)
+        previous_all = np.concatenate(
+            [setup.root_direction[None] * np.ones_like(directions[:1]), directions[:-1]]
+        )
+        return np.all(np.add.reduce(directions * previous_all, axis=1) >= cos_phi - 1e-12, axis=0)
     previous = setup.root_direction * np.ones_like(chains.tiny)
     ok = np.ones(chains.p.shape[2], dtype=bool)
     for i in range(chains.lengths.shape[0]):
