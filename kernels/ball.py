@@ -557,8 +557,10 @@ def _kick_constants(
     """(K,)-array kick constants."""
     rates = np.linalg.norm(spins, axis=1)
     axes = spins / np.where(rates > 0.0, rates, 1.0)[:, None]
+    off = _knuckle_draw(None, velocities[0], spins[0], s)
     draws = [
-        _knuckle_draw(seed, v, w, s) for seed, v, w in zip(seeds, velocities, spins, strict=True)
+        off if seed is None else _knuckle_draw(seed, v, w, s)
+        for seed, v, w in zip(seeds, velocities, spins, strict=True)
     ]
     gain = np.array([d[0] for d in draws])
     rate = np.array([d[1] for d in draws])
@@ -863,28 +865,42 @@ def simulate_batch(
         ground_m=ground_m,
     )
     kick = _kick_constants(v0, w0, seeds, s)
-    _, acceleration = _force_law(_ARRAY_OPS, kick, s)
-    step = _stepper(s.method, acceleration, s.dt)
 
-    state = np.concatenate((p0, v0), axis=1).T.copy()  # (6, K)
-    frames = [state.copy()]
-    times = [np.zeros(k)]
-    active = np.ones(k, dtype=bool)
+    def stepper_for(lanes: NDArray[np.intp]):
+        """The step function for the kicks ``lanes`` only."""
+        sub = _Kick(
+            *(
+                tuple(part[lanes] for part in value) if isinstance(value, tuple) else value[lanes]
+                for value in (getattr(kick, field.name) for field in dataclasses.fields(kick))
+            )
+        )
+        return _stepper(s.method, _force_law(_ARRAY_OPS, sub, s)[1], s.dt)
+
+    state = np.concatenate(
+        (p0, v0), axis=1
+    ).T.copy()  # (6, K); finished kicks keep their final state
+    t_last = np.zeros(k)
+    frames = [state.T.copy()]  # (K, 6) per sample
+    times = [t_last.copy()]
+    lanes = np.arange(k)  # the kicks being stepped; compacted as they land
+    flying = np.ones(k, dtype=bool)  # which of ``lanes`` are still in the air
+    step = stepper_for(lanes)
     n_samples = np.ones(k, dtype=np.int64)
     ended = np.full(k, "t_max", dtype="<U6")
     x_stop_at = np.inf if s.x_stop is None else s.x_stop
     n_steps = math.ceil(s.t_max / s.dt - 1e-9)
     for n in range(n_steps):
-        if not active.any():
+        if not flying.any():
             break
-        x, y, z, vx, vy, vz = state
+        old = state[:, lanes]
+        x, y, z, vx, vy, vz = old
         new = np.array(step(x, y, z, vx, vy, vz, n * s.dt))
-        t_new = np.full(k, (n + 1) * s.dt)
-        done = active & ((new[2] <= s.ground_m) | ((state[0] < x_stop_at) & (new[0] >= x_stop_at)))
+        t_new = np.full(lanes.size, (n + 1) * s.dt)
+        done = flying & ((new[2] <= s.ground_m) | ((old[0] < x_stop_at) & (new[0] >= x_stop_at)))
         if done.any():
             end_p, end_v, end_t, hit_ground, _ = _finish(
-                state[:3, done].T,
-                state[3:, done].T,
+                old[:3, done].T,
+                old[3:, done].T,
                 new[:3, done].T,
                 new[3:, done].T,
                 n * s.dt,
@@ -894,21 +910,29 @@ def simulate_batch(
             new[:3, done] = end_p.T
             new[3:, done] = end_v.T
             t_new[done] = end_t
-            ended[done] = np.where(hit_ground, "ground", "x_stop")
-        # Finished kicks keep their final state: they are padding from here on.
-        new[:, ~active] = state[:, ~active]
-        t_new[~active] = times[-1][~active]
-        n_samples += active
-        active &= ~done
-        state = new
-        frames.append(new)
-        times.append(t_new)
+            ended[lanes[done]] = np.where(hit_ground, "ground", "x_stop")
+        moving = lanes[
+            flying
+        ]  # landed kicks in ``lanes`` are stepped but never written: they are padding
+        state[:, moving] = new[:, flying]
+        t_last[moving] = t_new[flying]
+        n_samples[moving] += 1
+        frames.append(state.T.copy())
+        times.append(t_last.copy())
+        flying &= ~done
+        if (
+            flying.sum() < 0.75 * lanes.size
+        ):  # rebuilding the force law for fewer lanes pays from here
+            lanes = lanes[flying]
+            flying = np.ones(lanes.size, dtype=bool)
+            step = stepper_for(lanes)
 
-    stacked = np.stack(frames, axis=1)  # (6, T, K)
+    # (T, K, 6) stacks fast; the fields are (K, T, ·) views of it, no transposing copy.
+    stacked = np.stack(frames).transpose(1, 0, 2)
     return BatchTrajectory(
-        t=np.stack(times, axis=1),
-        position=np.ascontiguousarray(stacked[:3].transpose(2, 1, 0)),
-        velocity=np.ascontiguousarray(stacked[3:].transpose(2, 1, 0)),
+        t=np.stack(times).T,
+        position=stacked[:, :, :3],
+        velocity=stacked[:, :, 3:],
         n_samples=n_samples,
         ended=ended,
     )

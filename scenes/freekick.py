@@ -8,7 +8,8 @@ the same nodes' arrays (line-segment points, one band mesh's vertices) and never
 
 Two searches run on a worker thread, never on a callback: the outcome map (a speed × spin grid through
 :func:`kernels.ball.simulate_batch`) and "aim at a clicked point of the goal mouth". The worker only ever runs the
-latest request; a newer one makes an older one's result be dropped.
+latest request (one worker each); a newer request makes an older one's result be dropped, and the map waits for the
+settings to be still for a moment so dragging a slider redraws at full speed.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ import itertools
 import logging
 import math
 import threading
+import time
 from collections.abc import Callable
 from typing import Literal
 
@@ -80,6 +82,8 @@ MAP_SPEEDS_MS = np.linspace(15.0, 35.0, 41)
 MAP_SPINS_REV_S = np.linspace(0.0, 15.0, 31)
 """Outcome-map rows: spin rate (rev/s), bottom to top."""
 MAP_CELL_PX = 6
+MAP_QUIET_S = 0.25
+"""The outcome map is recomputed once the settings have been still this long (s), not on every slider step."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -548,33 +552,38 @@ def _quaternion(axis: NDArray[np.float64], angle_rad: float) -> tuple[float, flo
 
 # --------------------------------------------------------------------------------------------- worker
 class _LatestWorker:
-    """Runs submitted jobs on one thread, newest only: a job still waiting is replaced by a newer one."""
+    """Runs submitted jobs on one thread, newest only: a job still waiting is replaced by a newer one.
+
+    A job may ask to wait for a quiet spell (``quiet_s``): it starts only once that long has passed with no newer
+    submission, so a slider being dragged redraws at full speed and the expensive job runs once, after.
+    """
 
     def __init__(self, stop: threading.Event, name: str) -> None:
         self._stop = stop
         self._condition = threading.Condition()
         self._job: Callable[[], None] | None = None
+        self._not_before = 0.0
         self.busy = False
         self.thread = threading.Thread(target=self._run, name=name, daemon=True)
 
-    def submit(self, job: Callable[[], None]) -> None:
+    def submit(self, job: Callable[[], None], quiet_s: float = 0.0) -> None:
         with self._condition:
             self._job = job
-            self._condition.notify()
+            self._not_before = time.monotonic() + quiet_s
+            self._condition.notify_all()
 
     def idle(self) -> bool:
         with self._condition:
             return self._job is None and not self.busy
 
-    def wake(self) -> None:
-        with self._condition:
-            self._condition.notify_all()
-
     def _run(self) -> None:
         while not self._stop.is_set():
             with self._condition:
-                while self._job is None and not self._stop.is_set():
-                    self._condition.wait(0.2)
+                while not self._stop.is_set():
+                    wait = self._not_before - time.monotonic()
+                    if self._job is not None and wait <= 0:
+                        break
+                    self._condition.wait(min(wait, 0.2) if self._job is not None else 0.2)
                 job, self._job = self._job, None
                 self.busy = job is not None
             if job is None:
@@ -628,14 +637,20 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
         self._map_version = 0
         self._aim_version = 0
         self.map_results: NDArray[np.str_] | None = None
+        self.map_runs = 0
+        """How many outcome maps have been computed (a burst of changes computes one)."""
+        self.map_params: FreeKickParams | None = None
+        """The settings the shown outcome map was computed for."""
         self.last_target: tuple[float, float] | None = None
         self.aim_message = ""
-        self._worker = _LatestWorker(self._stop, "freekick-worker")
-        self._threads.append(self._worker.thread)
+        self._map_worker = _LatestWorker(self._stop, "freekick-map")
+        self._aim_worker = _LatestWorker(self._stop, "freekick-aim")
+        self._threads += [self._map_worker.thread, self._aim_worker.thread]
         self._build_gui()
         self._build_world()
         self.redraw()
-        self._worker.thread.start()
+        self._map_worker.thread.start()
+        self._aim_worker.thread.start()
         self._request_map()
         self.start_loop(self._animate, 1.0 / 30.0)
 
@@ -975,7 +990,7 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
                 )
                 self.aim_status.content = self.aim_message
 
-        self._worker.submit(job)
+        self._aim_worker.submit(job)
 
     # ----------------------------------------------------------------------------------------- outcome map
     def _request_map(self) -> None:
@@ -983,18 +998,19 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
         version, params = self._map_version, self.params
 
         def job() -> None:
+            self.map_runs += 1
             results = outcome_map(params)
             with self._lock:
                 if self.closed or version != self._map_version:
                     return
-                self.map_results = results
+                self.map_results, self.map_params = results, params
                 counts = {name: int(np.sum(results == name)) for name in RESULT_COLOURS}
                 self.map_image.image = outcome_map_image(results, params)
                 self.map_status.content = ", ".join(
                     f"{name} {n}" for name, n in counts.items() if n
                 )
 
-        self._worker.submit(job)
+        self._map_worker.submit(job, quiet_s=MAP_QUIET_S)
 
     def wait_idle(self, timeout_s: float = 30.0) -> bool:
         """Block until no background job is queued or running (for tests and benchmarks)."""
@@ -1003,7 +1019,7 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
         timer.start()
         try:
             while not deadline.is_set():
-                if self._worker.idle():
+                if self._map_worker.idle() and self._aim_worker.idle():
                     return True
                 deadline.wait(0.02)
             return False

@@ -181,6 +181,18 @@ def test_outcome_map_matches_single_runs(scene: FreeKickScene) -> None:
     assert np.sum(scene.map_results == "wall") > np.sum(results == "wall")  # type: ignore[operator]
 
 
+def test_a_burst_of_slider_changes_computes_one_outcome_map_for_the_last(
+    scene: FreeKickScene,
+) -> None:
+    runs = scene.map_runs
+    for spin in np.linspace(5.0, 9.0, 12):
+        scene.spin.value = float(spin)  # each redraws at once; the map waits for the burst to end
+    assert scene.wait_idle()
+    # Twelve changes, one map (a few at most if this machine stalls for a quarter second mid-burst).
+    assert runs < scene.map_runs <= runs + 3
+    assert scene.map_params == scene.params and scene.params.spin_rev_s == 9.0
+
+
 def test_scene_close_leaves_only_the_switcher(server: viser.ViserServer) -> None:
     from viser_private import gui_uuids, node_names
 
