@@ -292,6 +292,23 @@ is a static pose.
     def _build_gui(self) -> None:
         gui, p = self.server.gui, self.params
         with self.gui_root:
+            with gui.add_folder("This frame"):
+                self.readout = gui.add_markdown("")
+                self.ghost_readout = gui.add_markdown("")
+                self.plot = gui.add_uplot(
+                    data=(np.zeros(1), np.ones(1)),
+                    series=(
+                        viser.uplot.Series(label="Iteration"),
+                        viser.uplot.Series(label="Error (mm)", stroke="rgb(230,50,50)", width=2),
+                    ),
+                    scales={
+                        "x": viser.uplot.Scale(time=False, auto=True),
+                        "y": viser.uplot.Scale(distr=3, auto=True),
+                    },
+                    legend=viser.uplot.Legend(show=True),
+                    title="Error after each iteration (log scale)",
+                    aspect=1.6,
+                )
             with gui.add_folder("Chain"):
                 self.links = gui.add_slider(
                     "Links", min=2, max=MAX_LINKS, step=1, initial_value=p.n_links
@@ -336,23 +353,6 @@ is a static pose.
                 )
                 self.max_iterations = gui.add_slider(
                     "Max iterations", min=1, max=500, step=1, initial_value=p.max_iterations
-                )
-            with gui.add_folder("This frame"):
-                self.readout = gui.add_markdown("")
-                self.ghost_readout = gui.add_markdown("")
-                self.plot = gui.add_uplot(
-                    data=(np.zeros(1), np.ones(1)),
-                    series=(
-                        viser.uplot.Series(label="Iteration"),
-                        viser.uplot.Series(label="Error (mm)", stroke="rgb(230,50,50)", width=2),
-                    ),
-                    scales={
-                        "x": viser.uplot.Scale(time=False, auto=True),
-                        "y": viser.uplot.Scale(distr=3, auto=True),
-                    },
-                    legend=viser.uplot.Legend(show=True),
-                    title="Error after each iteration (log scale)",
-                    aspect=1.6,
                 )
         for handle in (
             self.links, self.length, self.three_d, self.limits, self.half_angle, self.avoid,
