@@ -1056,7 +1056,7 @@ def _run(
     _unbend_axis_chains(chains, setup, offset, distance, ~done)
 
     index = np.flatnonzero(~done)
-    active = chains.take(~done)
+    active = chains.take(~done) if done.any() else chains
     best_p_active = best_p[:, :, index]
     best_error_active = best_error[index]
     stall = _STALL * setup.tolerance + tiny[index]
@@ -1172,6 +1172,14 @@ def _unbend_axis_chains(
 ) -> None:
     """Bend straight chains whose target lies on their own line into a gentle arc, so the passes can bend them."""
     p, tiny = chains.p, chains.tiny
+    # Cheap test first: a straight chain's end lies on the root–target line (or on the root).
+    end = p[-1] - p[0]
+    end2 = np.add.reduce(end * end, axis=0)
+    offset2 = distance * distance
+    along = np.add.reduce(end * offset, axis=0)
+    scale2 = np.maximum(end2 * offset2, tiny * tiny)
+    if not np.any(todo & ((end2 * offset2 - along * along) <= 1e-12 * scale2)):
+        return
     segments = np.diff(p, axis=0)  # (n, d, B)
     norms = _norm(segments)
     first = np.argmax(norms > tiny, axis=0)  # first segment with a direction
