@@ -72,6 +72,8 @@ EXP_SHARPNESS_PER_WIDTH = 4.0 * math.log(2.0)
 _SIZE_COUNT: dict[str, int] = {"sphere": 1, "box": 3, "torus": 2, "capsule": 2}
 
 FloatArray = NDArray[np.float64]
+AnyFloatArray = NDArray[np.floating]
+"""Internal fast paths keep their input's float dtype (float32 for the mesher's grid)."""
 
 
 # ------------------------------------------------------------------------------------------ input checks
@@ -193,7 +195,9 @@ def sd_capsule(p: ArrayLike, a: ArrayLike, b: ArrayLike, radius: float) -> Float
 
 
 # ------------------------------------------------------------------------------------------ blends
-def _smin_poly_weighted(a: FloatArray, b: FloatArray, k: float) -> tuple[FloatArray, FloatArray]:
+def _smin_poly_weighted(
+    a: AnyFloatArray, b: AnyFloatArray, k: float
+) -> tuple[AnyFloatArray, AnyFloatArray]:
     """Polynomial smooth min and the weight of ``b`` in it (``1 − h``)."""
     if k == 0.0:
         return np.minimum(a, b), (b < a).astype(np.float64)
@@ -203,7 +207,9 @@ def _smin_poly_weighted(a: FloatArray, b: FloatArray, k: float) -> tuple[FloatAr
     return h * a + (1.0 - h) * b - k * h * (1.0 - h), 1.0 - h  # exact at h = 0 and h = 1
 
 
-def _smin_exp_weighted(a: FloatArray, b: FloatArray, k: float) -> tuple[FloatArray, FloatArray]:
+def _smin_exp_weighted(
+    a: AnyFloatArray, b: AnyFloatArray, k: float
+) -> tuple[AnyFloatArray, AnyFloatArray]:
     """Exponential smooth min (``k`` = sharpness) and the weight of ``b``: exp(−kb)/(exp(−ka) + exp(−kb))."""
     e = np.exp(-k * np.abs(a - b))  # in (0, 1]: neither this nor what follows can overflow
     d = np.minimum(a, b) - np.log1p(e) / k
@@ -223,7 +229,7 @@ def smin_poly(a: ArrayLike, b: ArrayLike, k: float) -> FloatArray:
         Blended distances (m), the broadcast shape.
     """
     a_arr, b_arr = _distances(a, b)
-    return _smin_poly_weighted(a_arr, b_arr, _non_negative(k, "k"))[0]
+    return np.asarray(_smin_poly_weighted(a_arr, b_arr, _non_negative(k, "k"))[0], dtype=np.float64)
 
 
 def smin_exp(a: ArrayLike, b: ArrayLike, k: float) -> FloatArray:
@@ -238,7 +244,7 @@ def smin_exp(a: ArrayLike, b: ArrayLike, k: float) -> FloatArray:
         Blended distances (m), ≤ min(a, b) − 0 and ≥ min(a, b) − ln 2 / k.
     """
     a_arr, b_arr = _distances(a, b)
-    return _smin_exp_weighted(a_arr, b_arr, _positive(k, "k"))[0]
+    return np.asarray(_smin_exp_weighted(a_arr, b_arr, _positive(k, "k"))[0], dtype=np.float64)
 
 
 def op_union(a: ArrayLike, b: ArrayLike) -> FloatArray:
@@ -260,11 +266,11 @@ def op_intersect(a: ArrayLike, b: ArrayLike) -> FloatArray:
 
 
 def _combine(
-    a: FloatArray, b: FloatArray, op: BooleanOp, k: float, blend: BlendForm
-) -> tuple[FloatArray, FloatArray]:
+    a: AnyFloatArray, b: AnyFloatArray, op: BooleanOp, k: float, blend: BlendForm
+) -> tuple[AnyFloatArray, AnyFloatArray]:
     """Distance of ``a op b`` and the weight of ``b`` in it; ``k`` is the blend width (m), 0 for hard."""
 
-    def smin(x: FloatArray, y: FloatArray) -> tuple[FloatArray, FloatArray]:
+    def smin(x: AnyFloatArray, y: AnyFloatArray) -> tuple[AnyFloatArray, AnyFloatArray]:
         if k == 0.0:
             return _smin_poly_weighted(x, y, 0.0)
         match blend:
@@ -287,19 +293,25 @@ def _combine(
 def smooth_union(a: ArrayLike, b: ArrayLike, k: float, blend: BlendForm = "poly") -> FloatArray:
     """Smooth union ``smin(a, b)``; ``k`` is the blend width (m), 0 for the hard union."""
     a_arr, b_arr = _distances(a, b)
-    return _combine(a_arr, b_arr, "union", _non_negative(k, "k"), blend)[0]
+    return np.asarray(
+        _combine(a_arr, b_arr, "union", _non_negative(k, "k"), blend)[0], dtype=np.float64
+    )
 
 
 def smooth_subtract(a: ArrayLike, b: ArrayLike, k: float, blend: BlendForm = "poly") -> FloatArray:
     """Smooth subtraction, ``a`` minus ``b``: −smin(−a, b); ``k`` is the blend width (m)."""
     a_arr, b_arr = _distances(a, b)
-    return _combine(a_arr, b_arr, "subtract", _non_negative(k, "k"), blend)[0]
+    return np.asarray(
+        _combine(a_arr, b_arr, "subtract", _non_negative(k, "k"), blend)[0], dtype=np.float64
+    )
 
 
 def smooth_intersect(a: ArrayLike, b: ArrayLike, k: float, blend: BlendForm = "poly") -> FloatArray:
     """Smooth intersection −smin(−a, −b); ``k`` is the blend width (m)."""
     a_arr, b_arr = _distances(a, b)
-    return _combine(a_arr, b_arr, "intersect", _non_negative(k, "k"), blend)[0]
+    return np.asarray(
+        _combine(a_arr, b_arr, "intersect", _non_negative(k, "k"), blend)[0], dtype=np.float64
+    )
 
 
 # ------------------------------------------------------------------------------------------ scene
@@ -392,9 +404,41 @@ class Primitive:
 
     def distance(self, points: FloatArray) -> FloatArray:
         """(N,) distance of (N, 3) world points."""
-        rotation = rotation_matrix(self.rotation)
-        p_local = (points - np.asarray(self.center)) @ rotation  # row form of Rᵀ·(p − c)
-        return self.local_distance(p_local)
+        return self._distance_xyz(points[:, 0], points[:, 1], points[:, 2]).astype(
+            np.float64, copy=False
+        )
+
+    def _distance_xyz(
+        self, x: NDArray[np.floating], y: NDArray[np.floating], z: NDArray[np.floating]
+    ) -> NDArray[np.floating]:
+        """Distance of world points given as coordinate arrays (any float dtype, kept): the scene's fast path.
+
+        The same formulas as the ``sd_*`` functions, written per coordinate (no (N, 3) temporaries, no
+        re-validation); the tests hold the two equal.
+        """
+        r = rotation_matrix(self.rotation)
+        dx, dy, dz = x - self.center[0], y - self.center[1], z - self.center[2]
+        if np.array_equal(r, np.eye(3)):
+            lx, ly, lz = dx, dy, dz
+        else:  # p_local = Rᵀ·(p − c)
+            lx = dx * r[0, 0] + dy * r[1, 0] + dz * r[2, 0]
+            ly = dx * r[0, 1] + dy * r[1, 1] + dz * r[2, 1]
+            lz = dx * r[0, 2] + dy * r[1, 2] + dz * r[2, 2]
+        s = self.size
+        match self.kind:
+            case "sphere":
+                return np.sqrt(lx * lx + ly * ly + lz * lz) - s[0]
+            case "box":
+                qx, qy, qz = np.abs(lx) - s[0], np.abs(ly) - s[1], np.abs(lz) - s[2]
+                ox, oy, oz = np.maximum(qx, 0.0), np.maximum(qy, 0.0), np.maximum(qz, 0.0)
+                inside = np.minimum(np.maximum(np.maximum(qx, qy), qz), 0.0)
+                return np.sqrt(ox * ox + oy * oy + oz * oz) + inside
+            case "torus":
+                qx = np.sqrt(lx * lx + lz * lz) - s[0]
+                return np.sqrt(qx * qx + ly * ly) - s[1]
+            case "capsule":  # the segment runs from (0, −h, 0) to (0, h, 0)
+                off = ly - np.clip(ly, -s[0], s[0])
+                return np.sqrt(lx * lx + off * off + lz * lz) - s[1]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -423,13 +467,26 @@ class Scene:
 def _fold(
     scene: Scene, points: FloatArray, with_color: bool
 ) -> tuple[FloatArray, FloatArray | None]:
+    d, color = _fold_xyz(scene, points[:, 0], points[:, 1], points[:, 2], with_color)
+    return d.astype(np.float64, copy=False), None if color is None else color.astype(
+        np.float64, copy=False
+    )
+
+
+def _fold_xyz(
+    scene: Scene,
+    x: NDArray[np.floating],
+    y: NDArray[np.floating],
+    z: NDArray[np.floating],
+    with_color: bool,
+) -> tuple[NDArray[np.floating], NDArray[np.floating] | None]:
     first = scene.primitives[0]
-    d = first.distance(points)
-    color = np.tile(np.asarray(first.color), (len(points), 1)) if with_color else None
+    d = first._distance_xyz(x, y, z)
+    color = np.tile(np.asarray(first.color, dtype=d.dtype), (len(d), 1)) if with_color else None
     for prim in scene.primitives[1:]:
-        d, w = _combine(d, prim.distance(points), prim.op, scene.k, scene.blend)
+        d, w = _combine(d, prim._distance_xyz(x, y, z), prim.op, scene.k, scene.blend)
         if color is not None:
-            color += w[:, None] * (np.asarray(prim.color) - color)
+            color += w[:, None] * (np.asarray(prim.color, dtype=d.dtype) - color)
     return d, color
 
 
@@ -602,8 +659,19 @@ def sample_full(scene: Scene, grid: Grid) -> NDArray[np.float32]:
     """The field at every grid sample, (nx, ny, nz) float32: the plain baseline the coarse-to-fine pass matches."""
     axes = [grid.origin[i] + grid.spacing * np.arange(grid.shape[i]) for i in range(3)]
     xs, ys, zs = np.meshgrid(*axes, indexing="ij")
-    points = np.stack([xs.ravel(), ys.ravel(), zs.ravel()], axis=1)
-    return scene_distance(scene, points).astype(np.float32).reshape(grid.shape)
+    return _field_at(scene, np.stack([xs.ravel(), ys.ravel(), zs.ravel()], axis=1)).reshape(
+        grid.shape
+    )
+
+
+def _field_at(scene: Scene, points: NDArray[np.floating]) -> NDArray[np.float32]:
+    """The field at (N, 3) sample points, evaluated in float32 (what marching cubes reads) on coordinate arrays.
+
+    Both samplers call this with coordinates computed the same way, so equal points give bit-equal values.
+    """
+    p32 = points.astype(np.float32)
+    d, _ = _fold_xyz(scene, p32[:, 0].copy(), p32[:, 1].copy(), p32[:, 2].copy(), with_color=False)
+    return d.astype(np.float32, copy=False)
 
 
 _LEVELS = (16, 4)
@@ -626,7 +694,7 @@ def sample_near_surface(
     """
     h = grid.spacing
     # A corner of a crossed cell lies within one voxel diagonal of the surface.
-    margin = math.sqrt(3.0) * h
+    margin = math.sqrt(3.0) * h * (1.0 + 1e-3) + 1e-6  # slack for float32 rounding
     top = _LEVELS[0]
     padded = tuple(-(-n // top) * top for n in grid.shape)
     field = np.empty(padded, dtype=np.float32)
@@ -644,7 +712,7 @@ def sample_near_surface(
     n0 = [m // top for m in padded]
     idx = np.stack(np.meshgrid(*[np.arange(c) for c in n0], indexing="ij"), axis=-1).reshape(-1, 3)
     corners = idx * top
-    d = scene_distance(scene, block_centers(corners, top))
+    d = _field_at(scene, block_centers(corners, top))
     evaluated += len(d)
     view(top)[...] = d.astype(np.float32).reshape(n0[0], 1, n0[1], 1, n0[2], 1)
     keep = np.abs(d) <= math.sqrt(3.0) * 0.5 * (top - 1) * h + margin
@@ -659,7 +727,7 @@ def sample_near_surface(
             * child
         )
         corners = (corners[:, None, :] + offsets[None, :, :]).reshape(-1, 3)
-        d = scene_distance(scene, block_centers(corners, child))
+        d = _field_at(scene, block_centers(corners, child))
         evaluated += len(d)
         blocks = corners // child
         fill = d.astype(np.float32)[:, None, None, None]
@@ -714,13 +782,19 @@ def _polygonise(
     verts, faces, _normals, _values = marching_cubes(field, level=0.0, spacing=(grid.spacing,) * 3)
     verts = verts.astype(np.float64) + np.asarray(grid.origin)
     # scikit-image's default winding faces a field that is negative inside outward (tests check the volume's sign).
-    tri = trimesh.Trimesh(vertices=verts, faces=faces, process=False)
-    tri.merge_vertices()
-    tri.update_faces(tri.nondegenerate_faces())
-    tri.remove_unreferenced_vertices()
-    vertices = np.asarray(tri.vertices, dtype=np.float64)
-    colors = scene_color(scene, vertices)
-    return vertices, np.asarray(tri.faces, dtype=np.int64), colors
+    faces = faces.astype(np.int64)
+    if np.any(field == 0.0):
+        # A sample exactly on the surface puts vertices of several edges on one point: merge them and drop the
+        # faces that collapse. Otherwise every vertex lies inside its own edge and they are already distinct.
+        tri = trimesh.Trimesh(vertices=verts, faces=faces, process=False)
+        tri.merge_vertices()
+        tri.update_faces(tri.nondegenerate_faces())
+        tri.remove_unreferenced_vertices()
+        verts, faces = (
+            np.asarray(tri.vertices, dtype=np.float64),
+            np.asarray(tri.faces, dtype=np.int64),
+        )
+    return verts, faces, scene_color(scene, verts)
 
 
 def mesh_trimesh(

@@ -333,6 +333,28 @@ def test_default_scene_mesh_is_watertight_with_blended_colors() -> None:
     np.testing.assert_allclose(colors, sdf.scene_color(scene, vertices))
 
 
+def test_samples_exactly_on_the_surface_are_merged() -> None:
+    """Box faces on grid planes put marching-cubes vertices on top of each other: merged, still watertight."""
+    scene = sdf.Scene(
+        (
+            sdf.Primitive("box", (0, 0, 0), (0.5, 0.5, 0.5)),
+            sdf.Primitive("sphere", (0.5, 0.5, 0.5), (0.25,)),
+        ),
+        k=0.0,
+    )
+    bounds = [[-1, -1, -1], [1, 1, 1]]
+    grid = sdf.make_grid(scene, 17, bounds)
+    assert grid.spacing == 0.125  # so the faces at ±0.5 fall exactly on samples
+    field, _ = sdf.sample_near_surface(scene, grid)
+    assert np.count_nonzero(field == 0.0) > 100
+    vertices, faces, _ = sdf.mesh(scene, 17, bounds)
+    tri = trimesh.Trimesh(vertices, faces, process=False)
+    assert len(np.unique(vertices, axis=0)) == len(vertices)
+    assert np.all(faces[:, 0] != faces[:, 1]) and np.all(faces[:, 1] != faces[:, 2])
+    assert np.all(faces[:, 0] != faces[:, 2])
+    assert tri.is_watertight and tri.volume > 0
+
+
 @settings(max_examples=12, deadline=None)
 @given(scene=random_scenes())
 def test_near_surface_sampling_gives_the_full_grid_mesh(scene: sdf.Scene) -> None:
