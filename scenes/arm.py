@@ -631,12 +631,20 @@ is a static pose.
         self.server.flush()
 
     def _readout_markdown(self, report: SolveReport) -> str:
-        r = report.result
-        return (
-            f"**{self.params.solver}**: {r.iterations} iteration{'s' if r.iterations != 1 else ''}, "
+        r, p = report.result, self.params
+        text = (
+            f"**{p.solver}**: {r.iterations} iteration{'s' if r.iterations != 1 else ''}, "
             f"error **{r.error * 1000.0:.3f} mm**, status **{r.status}**  \n"
             f"Solve time **{report.micros:,.0f} µs**"
         )
+        covering = [
+            k + 1
+            for k in range(p.n_obstacles)
+            if np.linalg.norm(self.obstacle_centres[k] - self.pose[0]) <= p.radii_m[k]
+        ]
+        if p.avoid and covering:
+            text += f"  \nObstacle {', '.join(map(str, covering))} covers the root and cannot be avoided: ignored."
+        return text
 
     def _ghost_markdown(self, report: SolveReport) -> str:
         r = report.result

@@ -123,6 +123,14 @@ def test_obstacles_are_avoided_and_ignored_when_avoidance_is_off(scene: ArmScene
         assert scene.obstacle_discs[k].visible and not scene.obstacle_spheres[k].visible
 
 
+def test_an_obstacle_over_the_root_is_ignored_and_said_so(scene: ArmScene) -> None:
+    scene.obstacle_gizmos[0].position = (0.05, 0.0, 0.05)
+    scene._apply_obstacle(0)
+    report = scene.report
+    assert report is not None and report.result.status == "reached"
+    assert "Obstacle 1 covers the root" in scene.readout.content
+
+
 def test_solvers_all_reach_the_target(scene: ArmScene) -> None:
     for label in ("CCD", "Jacobian DLS", "FABRIK"):
         scene.pose = rest_pose(6, 0.25)
