@@ -1006,9 +1006,13 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
                 self.map_results, self.map_params = results, params
                 counts = {name: int(np.sum(results == name)) for name in RESULT_COLOURS}
                 self.map_image.image = outcome_map_image(results, params)
-                self.map_status.content = ", ".join(
-                    f"{name} {n}" for name, n in counts.items() if n
-                )
+                summary = ", ".join(f"{name} {n}" for name, n in counts.items() if n)
+                if params.model == "constant":
+                    summary += (
+                        "  \nConstant C_L: any spin above zero curls the same, so the rows repeat. Pick the "
+                        "measured model to see the spin rate matter."
+                    )
+                self.map_status.content = summary
 
         self._map_worker.submit(job, quiet_s=MAP_QUIET_S)
 

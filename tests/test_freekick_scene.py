@@ -164,6 +164,9 @@ def test_outcome_map_matches_single_runs(scene: FreeKickScene) -> None:
     results = scene.map_results
     assert results is not None and results.shape == (len(MAP_SPINS_REV_S), len(MAP_SPEEDS_MS))
     assert {"goal", "wall", "over"} <= set(results.ravel().tolist())
+    # Constant coefficients: every spinning row is the same; the readout says why.
+    assert all(np.array_equal(results[1], results[row]) for row in range(2, len(MAP_SPINS_REV_S)))
+    assert "rows repeat" in scene.map_status.content
     wall, goal = scene.state.wall, scene.state.goal
     for row, col in ((0, 0), (16, 20), (30, 40), (10, 25)):
         params = dataclasses.replace(
