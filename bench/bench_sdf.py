@@ -89,7 +89,7 @@ def bench_mesh(repeats: int) -> list[str]:
             strict=True,
         )
     )
-    _, evaluated = sdf.sample_near_surface(scene, grid)
+    evaluated = sdf.sample_near_surface(scene, grid).evaluated
     ratio = statistics.median(full) / statistics.median(near)
     rows.append(
         row(

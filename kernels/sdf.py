@@ -34,7 +34,8 @@ means hard booleans.
 field, which keeps sub-voxel accuracy. It evaluates the field only near the surface: a block of samples whose centre
 is farther from the surface than the block's radius plus one voxel diagonal cannot hold a corner of a cell the
 surface crosses (the field is 1-Lipschitz), so the block gets the sign of its centre and is not refined. Marching
-cubes reads values only at corners of crossed cells, so the output equals the full-grid output exactly.
+cubes reads values only at corners of crossed cells, so the output equals the full-grid output exactly; it is also
+told to skip cells outside the evaluated region (its ``mask``).
 
 Sources: I. Quilez, "distance functions" and "smooth minimum" (iquilezles.org, 2008–2024); J. C. Hart, "Sphere
 tracing", The Visual Computer 12 (1996); T. Lewiner et al., J. Graphics Tools 8(2) (2003).
@@ -678,19 +679,28 @@ _LEVELS = (16, 4)
 """Block sizes (samples per side) of the coarse passes; the last level's surviving blocks are sampled in full."""
 
 
+@dataclasses.dataclass(frozen=True)
+class NearSurfaceField:
+    """The grid field from the coarse-to-fine pass."""
+
+    field: NDArray[np.float32]
+    """(nx, ny, nz) values (m): exact at every corner of a cell the surface crosses, sign-correct elsewhere."""
+    mask: NDArray[np.bool_]
+    """(nx, ny, nz) True where the value was evaluated exactly; it holds every corner of every crossed cell, so
+    marching cubes may skip cells whose far corner is False."""
+    evaluated: int
+    """Points evaluated, block centres included."""
+
+
 def sample_near_surface(
     scene: Scene, grid: Grid, progress: Callable[[float], None] | None = None
-) -> tuple[NDArray[np.float32], int]:
+) -> NearSurfaceField:
     """The field, evaluated exactly where marching cubes reads it and sign-filled elsewhere.
 
     Args:
         scene: the scene.
         grid: the grid.
         progress: optional callback receiving the fraction done, 0..1.
-
-    Returns:
-        (nx, ny, nz) float32 field whose samples at corners of surface-crossing cells are exact, and how many
-        points were evaluated.
     """
     h = grid.spacing
     # A corner of a crossed cell lies within one voxel diagonal of the surface.
@@ -733,12 +743,14 @@ def sample_near_surface(
         fill = d.astype(np.float32)[:, None, None, None]
         view(child)[blocks[:, 0], :, blocks[:, 1], :, blocks[:, 2], :] = fill
         if child == 1:
+            mask = np.zeros(padded, dtype=bool)
+            mask[corners[:, 0], corners[:, 1], corners[:, 2]] = True
             break
         keep = np.abs(d) <= math.sqrt(3.0) * 0.5 * (child - 1) * h + margin
         corners = corners[keep]
         size = child
     nx, ny, nz = grid.shape
-    return field[:nx, :ny, :nz], evaluated
+    return NearSurfaceField(field[:nx, :ny, :nz], mask[:nx, :ny, :nz], evaluated)
 
 
 def mesh(
@@ -765,21 +777,28 @@ def mesh(
         gives a watertight mesh. An empty field (no surface inside the bounds) gives empty arrays.
     """
     grid = make_grid(scene, resolution, bounds)
+    mask = None
     if near_surface:
-        field, _ = sample_near_surface(scene, grid, progress)
+        sampled = sample_near_surface(scene, grid, progress)
+        field, mask = sampled.field, sampled.mask
     else:
         field = sample_full(scene, grid)
     if progress is not None:
         progress(0.8)
-    return _polygonise(scene, grid, field)
+    return _polygonise(scene, grid, field, mask)
 
 
 def _polygonise(
-    scene: Scene, grid: Grid, field: NDArray[np.float32]
+    scene: Scene, grid: Grid, field: NDArray[np.float32], mask: NDArray[np.bool_] | None
 ) -> tuple[FloatArray, NDArray[np.int64], FloatArray]:
     if not (field.min() < 0.0 < field.max()):
         return np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64), np.zeros((0, 3))
-    verts, faces, _normals, _values = marching_cubes(field, level=0.0, spacing=(grid.spacing,) * 3)
+    verts, faces, _normals, _values = marching_cubes(
+        np.ascontiguousarray(field),
+        level=0.0,
+        spacing=(grid.spacing,) * 3,
+        mask=None if mask is None else np.ascontiguousarray(mask),
+    )
     verts = verts.astype(np.float64) + np.asarray(grid.origin)
     # scikit-image's default winding faces a field that is negative inside outward (tests check the volume's sign).
     faces = faces.astype(np.int64)

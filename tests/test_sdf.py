@@ -345,7 +345,7 @@ def test_samples_exactly_on_the_surface_are_merged() -> None:
     bounds = [[-1, -1, -1], [1, 1, 1]]
     grid = sdf.make_grid(scene, 17, bounds)
     assert grid.spacing == 0.125  # so the faces at ±0.5 fall exactly on samples
-    field, _ = sdf.sample_near_surface(scene, grid)
+    field = sdf.sample_near_surface(scene, grid).field
     assert np.count_nonzero(field == 0.0) > 100
     vertices, faces, _ = sdf.mesh(scene, 17, bounds)
     tri = trimesh.Trimesh(vertices, faces, process=False)
@@ -364,15 +364,18 @@ def test_near_surface_sampling_gives_the_full_grid_mesh(scene: sdf.Scene) -> Non
     for a, b in zip(near, full, strict=True):
         np.testing.assert_array_equal(a, b)
     grid = sdf.make_grid(scene, 40)
-    field, evaluated = sdf.sample_near_surface(scene, grid)
-    np.testing.assert_array_equal(np.sign(field), np.sign(sdf.sample_full(scene, grid)))
-    assert evaluated > 0
+    near_field = sdf.sample_near_surface(scene, grid)
+    full_field = sdf.sample_full(scene, grid)
+    np.testing.assert_array_equal(np.sign(near_field.field), np.sign(full_field))
+    np.testing.assert_array_equal(near_field.field[near_field.mask], full_field[near_field.mask])
+    assert near_field.evaluated > 0
 
 
 def test_near_surface_evaluates_a_small_fraction_at_128() -> None:
     grid = sdf.make_grid(sdf.default_scene(), 128)
-    _, evaluated = sdf.sample_near_surface(sdf.default_scene(), grid)
-    assert evaluated < 0.2 * math.prod(grid.shape)
+    sampled = sdf.sample_near_surface(sdf.default_scene(), grid)
+    assert sampled.evaluated < 0.2 * math.prod(grid.shape)
+    assert sampled.mask.sum() < 0.2 * math.prod(grid.shape)
 
 
 def test_mesh_bounds_and_progress() -> None:
