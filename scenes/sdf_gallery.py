@@ -54,7 +54,7 @@ SIZE_MEANING = (
     "Capsule: a = half length along local y, b = radius."
 )
 CAMERA_REST_S = 0.25
-"""The camera counts as stopped after this long without an update (s)."""
+"""The camera (and the scene) count as stopped after this long without an update (s)."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -211,6 +211,7 @@ IoU is lowest when a box edge is on the silhouette.
         self._camera: Camera | None = None
         self._aspect = 4 / 3
         self._camera_time = 0.0
+        self._scene_time = 0.0
         self._reference_due = True
         self._build_gui()
         self._build_world()
@@ -497,6 +498,7 @@ IoU is lowest when a box edge is on the silhouette.
 
     def _request_mesh(self) -> None:
         with self._work:
+            self._scene_time = time.monotonic()
             self._wanted_scene = self.params.scene()
             self._wanted_resolution = self.params.resolution
             self._work.notify_all()
@@ -531,9 +533,11 @@ IoU is lowest when a box edge is on the silhouette.
         with self._work:
             if not self._reference_due or self.mesh_scene is None or self._wanted_scene is not None:
                 return False
-            if self.params.reference_mode == "live" or self._camera is None:
+            if self.params.reference_mode == "live":
                 return True
-            return time.monotonic() - self._camera_time >= CAMERA_REST_S
+            # Wait until the camera and the primitives have both been still for a moment: a render started in
+            # the middle of a drag would hold up the next mesh.
+            return time.monotonic() - max(self._camera_time, self._scene_time) >= CAMERA_REST_S
 
     def _open_renderer(self) -> Renderer | None:
         try:
