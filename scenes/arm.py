@@ -279,6 +279,8 @@ is a static pose.
         self.report: SolveReport | None = None
         self.solves = 0
         """Solves run so far (tests wait on it)."""
+        self.gizmo_events = 0
+        """Gizmo updates handled so far, accepted or refused (tests wait on it)."""
         self._build_gui()
         self._build_world()
         self._click = server.scene.on_click()(self._on_scene_click)
@@ -467,6 +469,7 @@ is a static pose.
         self.callback(self._apply_target)(None)
 
     def _apply_target(self) -> None:
+        self.gizmo_events += 1
         point = clean_point(self.target_gizmo.position, self.params.three_d)
         if point is None:  # NaN, huge, wrong shape: keep the last good target and pose
             self.target_gizmo.position = self.target
@@ -481,6 +484,7 @@ is a static pose.
         self.callback(functools.partial(self._apply_obstacle, k))(None)
 
     def _apply_obstacle(self, k: int) -> None:
+        self.gizmo_events += 1
         gizmo = self.obstacle_gizmos[k]
         point = clean_point(gizmo.position, self.params.three_d)
         if point is None:

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import itertools
 import math
-import time
 
 import numpy as np
 import pytest
@@ -224,14 +223,13 @@ def test_crafted_gizmo_messages_keep_the_last_good_pose(
         client.wait_for_node("/arm/target")
         good = (0.7, 0.0, 0.9)
         client.drag_transform("/arm/target", [good])
-        client.wait_for(
-            lambda: bool(np.linalg.norm(scene.pose[-1] - good) < 1e-3), what="the good target"
-        )
-        time.sleep(0.2)  # the drag's trailing updates (start, move, end) all finish
+        # A drag is three messages (start, move, end), each running the gizmo's callback once.
+        client.wait_for(lambda: scene.gizmo_events >= 3, what="the good drag handled")
+        assert np.linalg.norm(scene.pose[-1] - good) < 1e-3
         pose_before = scene.pose.copy()
         solves = scene.solves
         client.drag_transform("/arm/target", [bad])
-        time.sleep(0.3)  # thread-pool callbacks run; a rejected message changes nothing to wait for
+        client.wait_for(lambda: scene.gizmo_events >= 6, what="the crafted drag handled")
         with scene._lock:
             np.testing.assert_array_equal(scene.pose, pose_before)
             np.testing.assert_array_equal(scene.target, good)
@@ -247,18 +245,20 @@ def test_crafted_obstacle_message_and_slider_values_keep_a_good_state(
         client.wait_for_node("/arm/obstacle_0")
         centre = scene.obstacle_centres[0].copy()
         client.drag_transform("/arm/obstacle_0", [(float("nan"), 0.0, 0.0)])
+        client.wait_for(lambda: scene.gizmo_events >= 3, what="the crafted obstacle drag handled")
         client.wait_for_gui("Links")
         for label, value in (
-            ("Links", float("nan")),
+            ("Links", float("nan")),  # viser itself drops a NaN for an int slider
             ("Links", 1000),
             ("Tolerance (mm)", -5.0),
             ("Solver", "Newton"),
             ("Cone half-angle (°)", float("inf")),
             ("Joint limits", "yes"),
         ):
-            # No answer to wait for: viser itself drops a NaN for an int slider.
             client.set_value(label, value)
-        time.sleep(0.4)
+        # Every callback re-reads every control, so once this last, honest edit shows, the crafted ones are cleaned.
+        client.set_value("Max iterations", 77)
+        client.wait_for(lambda: scene.params.max_iterations == 77, what="the sentinel edit applied")
         with scene._lock:
             p = scene.params
             np.testing.assert_array_equal(scene.obstacle_centres[0], centre)
