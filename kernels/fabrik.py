@@ -518,9 +518,21 @@ class _Chains:
 
 
 # ================================================================================================ vector helpers
+def _dot_d(a: NDArray[np.float64], b: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Dot product over the d axis (−2) of broadcastable (…, d, B) arrays: (…, B).
+
+    Written out rather than reduced: numpy's reduction over a middle axis is slow, and this is the order (x + y) + z
+    that both the reduction and the one-chain path use, so every path gives the same bits.
+    """
+    total = a[..., 0, :] * b[..., 0, :] + a[..., 1, :] * b[..., 1, :]
+    if a.shape[-2] == 3:
+        total = total + a[..., 2, :] * b[..., 2, :]
+    return total
+
+
 def _norm(v: NDArray[np.float64]) -> NDArray[np.float64]:
     """(…, d, B) → (…, B) Euclidean norm over the d axis."""
-    return np.sqrt(np.add.reduce(v * v, axis=-2))
+    return np.sqrt(_dot_d(v, v))
 
 
 def _unit(
@@ -561,17 +573,21 @@ def _clamp_cone(
 ) -> NDArray[np.float64]:
     """Unit directions ``v`` (d, B) turned, by the least angle, into the cone of half-angle φ around ``axis``."""
     cos_phi, sin_phi = limits
-    cos_v = np.add.reduce(v * axis, axis=0)
+    cos_v = _dot_d(v, axis)
     outside = cos_v < cos_phi
     if not outside.any():
         return v
-    side = v - cos_v * axis
+    cols = np.flatnonzero(outside)  # work on the chains outside only: in a large batch they are few
+    axis = np.broadcast_to(axis, v.shape)[:, cols]
+    side = v[:, cols] - cos_v[cols] * axis
     side_norm = _norm(side)
     has_side = side_norm > 1e-9
     side = np.where(has_side, side / np.where(has_side, side_norm, 1.0), _perpendicular(axis))
     clamped = cos_phi * axis + sin_phi * side
+    out = v.copy()
     # A nearly (anti)parallel v leaves ``side`` only roughly perpendicular: renormalise so lengths stay exact.
-    return np.where(outside, clamped / _norm(clamped), v)
+    out[:, cols] = clamped / _norm(clamped)
+    return out
 
 
 def _deflect(
@@ -589,16 +605,23 @@ def _deflect(
     turned = False
     for _ in range(3):  # turning around one obstacle can push into another: a few rounds settle it
         rel = setup.centres - anchor  # (K, d, B)
-        along = np.add.reduce(rel * v, axis=1)  # (K, B)
+        along = _dot_d(rel, v)  # (K, B)
         t = np.minimum(np.maximum(along, 0.0), length)
-        dist2 = np.add.reduce(rel * rel, axis=1) - 2.0 * t * along + t * t
+        dist2 = _dot_d(rel, rel) - 2.0 * t * along + t * t
         hit = (dist2 < setup.radii * setup.radii) & live
         if not hit.any():
             return v, turned
         turned = True
+        v = v.copy()
         for k in np.flatnonzero(hit.any(axis=1)):
-            v = np.where(
-                hit[k], _turn_clear(anchor, v, length, setup.centres[k], setup.radii[k], tiny), v
+            cols = np.flatnonzero(hit[k])  # only the chains this obstacle cuts
+            v[:, cols] = _turn_clear(
+                anchor[:, cols],
+                v[:, cols],
+                length[cols],
+                setup.centres[k],
+                setup.radii[k],
+                tiny[cols],
             )
     return v, turned
 
@@ -627,7 +650,7 @@ def _turn_clear(
     tangent = length * length >= distance * distance - clear * clear
     cos_t = np.where(tangent, np.sqrt(1.0 - sin_tangent * sin_tangent), cos_end)
     sin_t = np.where(tangent, sin_tangent, np.sqrt(1.0 - cos_end * cos_end))
-    side = v - np.add.reduce(v * to_centre, axis=0) * to_centre
+    side = v - _dot_d(v, to_centre) * to_centre
     side, _ = _unit(side, _perpendicular(to_centre), np.full_like(tiny, 1e-9))
     turned = cos_t * to_centre + sin_t * side
     turned = turned / _norm(turned)
@@ -873,7 +896,7 @@ def _ccd_step(chains: _Chains, setup: _Setup) -> None:
         pivot = p[i]
         to_end, end_norm = _unit(p[n] - pivot, setup.root_direction * np.ones_like(tiny), tiny)
         to_target, target_norm = _unit(chains.target - pivot, to_end, tiny)
-        cos_a = np.clip(np.add.reduce(to_end * to_target, axis=0), -1.0, 1.0)
+        cos_a = np.clip(_dot_d(to_end, to_target), -1.0, 1.0)
         move = (end_norm > tiny) & (target_norm > tiny)
         downstream = p[i + 1 :] - pivot
         if setup.dim == 2:
@@ -970,14 +993,12 @@ def _cone_ok(chains: _Chains, setup: _Setup) -> NDArray[np.bool_]:
         previous_all = np.concatenate(
             [setup.root_direction[None] * np.ones_like(directions[:1]), directions[:-1]]
         )
-        return np.all(np.add.reduce(directions * previous_all, axis=1) >= cos_phi - 1e-12, axis=0)
+        return np.all(_dot_d(directions, previous_all) >= cos_phi - 1e-12, axis=0)
     previous = setup.root_direction * np.ones_like(chains.tiny)
     ok = np.ones(chains.p.shape[2], dtype=bool)
     for i in range(chains.lengths.shape[0]):
         direction, norm = _unit(chains.p[i + 1] - chains.p[i], previous, chains.tiny)
-        ok &= (np.add.reduce(direction * previous, axis=0) >= cos_phi - 1e-12) | (
-            norm <= chains.tiny
-        )
+        ok &= (_dot_d(direction, previous) >= cos_phi - 1e-12) | (norm <= chains.tiny)
         previous = np.where(norm > chains.tiny, direction, previous)
     return ok
 
@@ -990,10 +1011,10 @@ def _colliding(p: NDArray[np.float64], setup: _Setup, live: NDArray[np.bool_]) -
     start = p[:-1, None]  # (n, 1, d, B)
     seg = (p[1:] - p[:-1])[:, None]
     rel = setup.centres[None] - start  # (n, K, d, B)
-    seg2 = np.add.reduce(seg * seg, axis=2)
-    t = np.clip(np.add.reduce(rel * seg, axis=2) / np.where(seg2 > 0.0, seg2, 1.0), 0.0, 1.0)
+    seg2 = _dot_d(seg, seg)
+    t = np.clip(_dot_d(rel, seg) / np.where(seg2 > 0.0, seg2, 1.0), 0.0, 1.0)
     gap = rel - t[:, :, None] * seg
-    dist2 = np.add.reduce(gap * gap, axis=2)  # (n, K, B)
+    dist2 = _dot_d(gap, gap)  # (n, K, B)
     return np.any((dist2 < setup.radii * setup.radii) & live, axis=(0, 1))
 
 
@@ -1155,7 +1176,7 @@ def _unreachable_shortcut(
     ok = candidates.copy()
     if setup.limits is not None:
         # A folded chain turns by π; a straight one only at the root.
-        root_cos = np.add.reduce(direction * setup.root_direction, axis=0)
+        root_cos = _dot_d(direction, setup.root_direction)
         ok &= beyond & (root_cos >= setup.limits[0])
     if setup.radii.shape[0] > 0:
         ok &= ~_colliding(pose, setup, chains.obstacle_live)
@@ -1174,9 +1195,9 @@ def _unbend_axis_chains(
     p, tiny = chains.p, chains.tiny
     # Cheap test first: a straight chain's end lies on the root–target line (or on the root).
     end = p[-1] - p[0]
-    end2 = np.add.reduce(end * end, axis=0)
+    end2 = _dot_d(end, end)
     offset2 = distance * distance
-    along = np.add.reduce(end * offset, axis=0)
+    along = _dot_d(end, offset)
     scale2 = np.maximum(end2 * offset2, tiny * tiny)
     if not np.any(todo & ((end2 * offset2 - along * along) <= 1e-12 * scale2)):
         return
@@ -1185,10 +1206,10 @@ def _unbend_axis_chains(
     first = np.argmax(norms > tiny, axis=0)  # first segment with a direction
     axis_raw = np.take_along_axis(segments, first[None, None, :], axis=0)[0]
     axis, _ = _unit(axis_raw, setup.root_direction * np.ones_like(tiny), tiny)
-    along = np.add.reduce(segments * axis, axis=1)  # (n, B)
+    along = _dot_d(segments, axis)  # (n, B)
     off_axis = _norm(segments - along[:, None, :] * axis)  # (n, B)
     straight = np.all(off_axis <= 1e-9 * np.maximum(norms, tiny), axis=0)
-    target_off = _norm(offset - np.add.reduce(offset * axis, axis=0) * axis)
+    target_off = _norm(offset - _dot_d(offset, axis) * axis)
     on_axis = target_off <= 1e-9 * np.maximum(distance, 1.0)
     bend = todo & straight & on_axis
     if not bend.any():
