@@ -13,6 +13,7 @@ import pytest
 import trimesh
 import viser
 from conftest import skip_or_fail
+from trimesh.visual.color import ColorVisuals
 from viser_private import gui_uuid, gui_uuids, node_names
 from wsclient import BrowserClient
 
@@ -44,7 +45,9 @@ def wait_until(
 
 def shown_mesh(scene: SdfGalleryScene) -> trimesh.Trimesh:
     """The mesh the browser receives: the GLB bytes of the mesh node, loaded back."""
-    loaded = trimesh.load(io.BytesIO(scene.mesh_node.glb_data), file_type="glb", force="mesh")
+    loaded = trimesh.load(
+        io.BytesIO(scene.mesh_node.glb_data), file_type="glb", force="mesh", process=False
+    )
     assert isinstance(loaded, trimesh.Trimesh)
     return loaded
 
@@ -67,6 +70,12 @@ def test_opening_mesh_is_the_kernels(scene: SdfGalleryScene) -> None:
     assert len(glb.faces) == len(faces)
     # The viewer's GLB is in the world frame, so its box matches the mesh's (GLB stores float32).
     np.testing.assert_allclose(glb.bounds, [vertices.min(axis=0), vertices.max(axis=0)], atol=1e-5)
+    # Smooth normals point outward (the field's gradient); colours are the kernel's, made linear for three.js.
+    reference_normals = trimesh.Trimesh(vertices, faces, process=False).vertex_normals
+    assert np.median(np.einsum("ij,ij->i", glb.vertex_normals, reference_normals)) > 0.99
+    visual = glb.visual
+    assert isinstance(visual, ColorVisuals)
+    np.testing.assert_allclose(visual.vertex_colors[:, :3], 255 * colors**2.2, atol=0.51)
     assert scene.agreement.triangles == len(faces)
     assert f"{len(faces):,}" in scene.readout.content
 
@@ -148,9 +157,10 @@ def test_gui_changes_remesh(server: viser.ViserServer, scene: SdfGalleryScene) -
             (scene.mesh_vertices, scene.mesh_faces, scene.mesh_colors), expected, strict=True
         ):
             np.testing.assert_array_equal(got, want)
-        assert (
-            client.element("P1 size b (m)")["props"]["disabled"] is False
-        )  # a box uses all three sizes
+        client.wait_for(  # a box uses all three sizes
+            lambda: client.element("P1 size b (m)")["props"]["disabled"] is False,
+            what="size b enabled",
+        )
 
 
 def test_crafted_bad_values_keep_the_last_good_scene(
@@ -228,11 +238,18 @@ def test_reference_image_readouts_and_rerender(
     need_gl()
     with BrowserClient(server.get_port()) as client:
         client.send_camera(position=(2.3, -2.5, 1.7), look_at=(0.05, 0.0, 0.3), size=(600, 800))
+        # 320 px wide at this camera's 4:3 aspect (the client's first camera, 16:9, may get a render first).
         wait_until(
-            lambda: scene.reference_serial >= 1 and scene.agreement.iou is not None, 60, "reference"
+            lambda: (
+                scene.reference_rgb is not None
+                and scene.reference_rgb.shape == (240, 320, 3)
+                and scene.agreement.iou is not None
+            ),
+            60,
+            "reference from this camera",
         )
         first = scene.reference_rgb
-        assert first is not None and first.shape == (240, 320, 3)
+        assert first is not None
         a = scene.agreement
         assert (
             a.iou is not None and a.iou > 0.97
