@@ -13,10 +13,16 @@ from pathlib import Path
 
 import pytest
 import viser
+from hypothesis import settings
 
 from scenes.switcher import SceneSwitcher
 
 IN_CI = os.environ.get("CI", "").lower() in ("1", "true", "yes")
+
+# CI must not be flaky: under CI=true hypothesis draws the same examples on every run (locally it explores anew).
+settings.register_profile("ci", derandomize=True, deadline=None, print_blob=True)
+if IN_CI:
+    settings.load_profile("ci")
 CHROMIUM = os.environ.get("CHROMIUM", "/usr/bin/chromium")
 CHROMIUM_ARGS = [
     "--no-sandbox",
