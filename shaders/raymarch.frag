@@ -53,7 +53,7 @@ float soft_shadow(vec3 origin, vec3 dir, float t_min, float t_max, float k) {
     float result = 1.0;
     float t = t_min;
     float previous = 1e20;
-    for (int i = 0; i < 40 && t < t_max; ++i) {
+    for (int i = 0; i < 32 && t < t_max; ++i) {
         float h = scene_distance(origin + dir * t);
         if (h < 1e-4) {
             return 0.0;
@@ -65,7 +65,7 @@ float soft_shadow(vec3 origin, vec3 dir, float t_min, float t_max, float k) {
         float d = sqrt(max(h * h - y * y, 0.0));
         result = min(result, k * d / max(1e-6, t - y));
         previous = h;
-        t += clamp(h, 0.005, 0.25);  // bounded steps, as Quilez does: no tiny crawls, no skipped thin parts
+        t += clamp(h, 0.01, 0.3);  // bounded steps, as Quilez does: no tiny crawls, no skipped thin parts
     }
     return clamp(result, 0.0, 1.0);
 }

@@ -15,7 +15,7 @@ from scenes.sdf_gallery import SdfGalleryScene
 from scenes.switcher import SceneSwitcher
 from shaders.renderer import GLUnavailableError, Renderer
 
-pytestmark = pytest.mark.browser
+pytestmark = [pytest.mark.browser, pytest.mark.gl]
 
 READ_IMAGE = """
 ([w, h]) => {

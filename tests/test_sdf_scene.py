@@ -232,6 +232,7 @@ def test_high_resolution_shows_progress_then_a_fine_mesh(
 
 
 # ------------------------------------------------------------------------------------------ reference image
+@pytest.mark.gl
 def test_reference_image_readouts_and_rerender(
     server: viser.ViserServer, scene: SdfGalleryScene
 ) -> None:
@@ -268,6 +269,27 @@ def test_reference_image_readouts_and_rerender(
         wait_until(lambda: scene.reference_serial > count, 30, "re-render after k_a")
         assert scene.params.shading.ambient == 0.9
         assert scene.reference_rgb.astype(float).mean() > dark + 5
+
+
+@pytest.mark.gl
+def test_live_mode_renders_while_the_camera_moves(
+    server: viser.ViserServer, scene: SdfGalleryScene
+) -> None:
+    """ "When the camera stops" waits for a still camera; "Live" renders while camera messages keep coming."""
+    need_gl()
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Re-render")
+        client.set_value("Re-render", "Live")
+        wait_until(lambda: scene.params.reference_mode == "live", what="live mode")
+        count = scene.reference_serial
+        for step in range(60):  # an orbit, one camera message every 50 ms: never still for 0.25 s
+            angle = 0.05 * step
+            client.send_camera(
+                position=(3 * math.cos(angle), 3 * math.sin(angle), 1.5), look_at=(0, 0, 0.3)
+            )
+            time.sleep(0.05)
+        # A render already in flight accounts for one at most; live mode keeps rendering during the motion.
+        assert scene.reference_serial - count >= 3
 
 
 def test_downloads(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
@@ -311,6 +333,7 @@ def test_downloads(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
     assert name == "sdf_mesh.glb" and glb is not None and glb[:4] == b"glTF"
 
 
+@pytest.mark.gl
 def test_png_download_is_the_reference_image(scene: SdfGalleryScene) -> None:
     need_gl()
     wait_until(lambda: scene.reference_rgb is not None, 60, "reference")
