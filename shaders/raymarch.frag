@@ -87,6 +87,9 @@ void main() {
     vec3 dir = normalize(u_forward + ndc.x * u_tan_half_fov * aspect * u_right + ndc.y * u_tan_half_fov * u_up);
 
     vec2 span = bound_interval(u_eye, dir);
+    if (span.y < span.x) {
+        discard;  // misses the bounding sphere: a block of such pixels exits here (see the discard below)
+    }
     float t = span.x;
     float t_exit = min(span.y, u_max_distance);
     bool hit = false;

@@ -186,6 +186,8 @@ def _sphere_scissor(
     forward, right, up = camera.basis()
     rel = corners - np.asarray(camera.position)
     z = rel @ forward
+    if np.all(z <= 0.0):
+        return (0, 0, 0, 0)  # wholly behind the eye: nothing to draw
     if np.any(z < 1e-3):
         return (0, 0, width, height)
     tan_half = math.tan(camera.fov_y_rad / 2)

@@ -170,6 +170,28 @@ def test_image_rows_start_at_the_top_and_x_points_right(gl: Renderer) -> None:
     assert depth[rows, cols].min() == pytest.approx(5.0 - 0.3, abs=2e-3)
 
 
+@pytest.mark.gl
+@pytest.mark.parametrize(
+    "camera",
+    [
+        Camera((0, -3, 0.3), (0, -10, 0.3)),  # the scene wholly behind the eye
+        Camera((0, -1.0, 0.3), (0, -10, 0.3)),  # eye inside the bounding sphere, looking out
+        Camera((0, -200, 0.3), (0, 0, 0.3), fov_y_rad=math.radians(2)),  # far away: a few pixels
+    ],
+    ids=["behind", "looking-out", "far"],
+)
+def test_off_screen_and_distant_scenes(gl: Renderer, camera: Camera) -> None:
+    scene = sdf.default_scene()
+    rgb, depth = gl.render(scene, camera, 48, 32, NO_SHADOWS)
+    origins, directions = gl_renderer.camera_rays(camera, 48, 32)
+    expected = view_depth(camera, sdf.sphere_trace(scene, origins, directions), directions).reshape(
+        32, 48
+    )
+    np.testing.assert_array_equal(np.isfinite(depth), np.isfinite(expected))
+    background = np.round(np.array(NO_SHADOWS.background) * 255)
+    assert np.all(rgb[~np.isfinite(depth)] == background)
+
+
 # ------------------------------------------------------------------------------------------ mesh vs ray-march
 @pytest.mark.gl
 @pytest.mark.parametrize("camera", CAMERAS, ids=["front", "side", "top"])
