@@ -345,6 +345,37 @@ def test_png_download_is_the_reference_image(scene: SdfGalleryScene) -> None:
     np.testing.assert_array_equal(np.asarray(Image.open(io.BytesIO(png))), scene.reference_rgb)
 
 
+def test_without_gl_the_panel_says_why_and_meshing_goes_on(
+    server: viser.ViserServer, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import scenes.sdf_gallery as gallery
+
+    def no_gl() -> Renderer:
+        raise GLUnavailableError(
+            "No OpenGL 3.3 context on EGL (test): the mesh view works without it."
+        )
+
+    monkeypatch.setattr(gallery, "Renderer", no_gl)
+    scene = SdfGalleryScene(server)
+    try:
+        wait_until(lambda: scene.gl_error is not None, what="the renderer to be tried")
+        wait_until(
+            lambda: "No reference image" in scene.reference_note.content, what="the reason shown"
+        )
+        assert "EGL" in scene.reference_note.content and scene.reference_rgb is None
+        with BrowserClient(server.get_port()) as client:
+            client.drag_transform("/sdf/gizmo_1", [(0.1, 0.0, 0.6)])
+            wait_until(
+                lambda: (
+                    scene.mesh_scene is not None
+                    and scene.mesh_scene.primitives[0].center == (0.1, 0.0, 0.6)
+                ),
+                what="a mesh without GL",
+            )
+    finally:
+        scene.close()
+
+
 # ------------------------------------------------------------------------------------------ teardown
 def test_close_removes_everything_and_stops_the_worker(server: viser.ViserServer) -> None:
     nodes_before, gui_before = node_names(server), gui_uuids(server)
