@@ -596,13 +596,16 @@ IoU is lowest when a box edge is on the silhouette.
             self._reference_due = False
             camera = self._camera or Camera(self.camera_position, self.camera_look_at)
             aspect = self._aspect
-        params = self.params
-        scene, vertices, faces, colors = (
-            self.mesh_scene,
-            self.mesh_vertices,
-            self.mesh_faces,
-            self.mesh_colors,
-        )
+        with (
+            self._lock
+        ):  # one consistent mesh: the worker replaces all four together under this lock
+            params = self.params
+            scene, vertices, faces, colors = (
+                self.mesh_scene,
+                self.mesh_vertices,
+                self.mesh_faces,
+                self.mesh_colors,
+            )
         assert scene is not None
         width = params.reference_width
         height = max(16, round(width / aspect))
@@ -663,13 +666,22 @@ IoU is lowest when a box edge is on the silhouette.
 
     def export(self, fmt: str) -> tuple[str, bytes | None]:
         """File name and bytes of the current mesh (glb, stl, obj) or reference image (png)."""
+        with (
+            self._lock
+        ):  # a consistent snapshot: the worker replaces these together under this lock
+            reference, vertices, faces, colors = (
+                self.reference_rgb,
+                self.mesh_vertices,
+                self.mesh_faces,
+                self.mesh_colors,
+            )
         if fmt == "png":
-            if self.reference_rgb is None:
+            if reference is None:
                 return "sdf_reference.png", None
             buffer = io.BytesIO()
-            Image.fromarray(self.reference_rgb).save(buffer, format="PNG")
+            Image.fromarray(reference).save(buffer, format="PNG")
             return "sdf_reference.png", buffer.getvalue()
-        tri = sdf.mesh_trimesh(self.mesh_vertices, self.mesh_faces, self.mesh_colors)
+        tri = sdf.mesh_trimesh(vertices, faces, colors)
         data = tri.export(file_type=fmt)
         return f"sdf_mesh.{fmt}", data.encode() if isinstance(data, str) else bytes(data)
 
