@@ -535,31 +535,41 @@ def scene_bounds(scene: Scene) -> FloatArray:
 
 
 # ------------------------------------------------------------------------------------------ sphere tracing
-def scene_bounding_sphere(scene: Scene) -> tuple[FloatArray, float]:
-    """A sphere that holds the scene with room for the blend: centre (3,) in metres and radius (m).
+def scene_bounding_spheres(scene: Scene) -> tuple[FloatArray, FloatArray]:
+    """Spheres whose union holds the scene: (P, 3) centres and (P,) radii in metres.
 
-    Rays that miss it miss the scene, and marching starts where a ray enters it and stops where it leaves.
+    Each primitive's bounding sphere grown by the blend width k: a smooth union reaches at most 3k/4 beyond the
+    primitives (k/4 per blend), and subtraction and intersection only remove. Rays that miss every sphere miss the
+    scene; marching runs from the first entry to the last exit. 1 mm of slack covers float32 in the shader.
     """
-    box = scene_bounds(scene)
-    center = 0.5 * (box[0] + box[1])
-    radius = max(
-        float(np.linalg.norm(np.asarray(p.center) - center)) + p.bounding_radius
-        for p in scene.primitives
-    )
-    return center, radius + scene.k
+    centers = np.array([p.center for p in scene.primitives], dtype=np.float64)
+    radii = np.array([p.bounding_radius for p in scene.primitives]) + scene.k + 1e-3
+    return centers, radii
 
 
-def ray_sphere_interval(
-    origins: FloatArray, directions: FloatArray, center: FloatArray, radius: float
+def ray_spheres_interval(
+    origins: FloatArray, directions: FloatArray, centers: FloatArray, radii: FloatArray
 ) -> tuple[FloatArray, FloatArray]:
-    """Where unit rays enter and leave a sphere: (N,) t_enter ≥ 0 and t_exit, with t_exit < t_enter for a miss."""
-    oc = origins - center
-    b = np.einsum("ij,ij->i", oc, directions)
-    c = np.einsum("ij,ij->i", oc, oc) - radius * radius
+    """Where unit rays first enter and last leave a union of spheres.
+
+    Args:
+        origins: (N, 3) ray origins (m).
+        directions: (N, 3) unit directions.
+        centers: (P, 3) sphere centres (m).
+        radii: (P,) radii (m).
+
+    Returns:
+        (N,) t_enter ≥ 0 and (N,) t_exit (m); t_exit < t_enter where a ray meets no sphere ahead of it.
+    """
+    oc = origins[:, None, :] - centers[None, :, :]
+    b = np.einsum("npk,nk->np", oc, directions)
+    c = np.einsum("npk,npk->np", oc, oc) - radii[None, :] ** 2
     disc = b * b - c
     root = np.sqrt(np.maximum(disc, 0.0))
-    t_enter = np.maximum(-b - root, 0.0)
-    t_exit = np.where(disc >= 0.0, -b + root, -1.0)
+    exit_ = -b + root
+    ahead = (disc >= 0.0) & (exit_ >= 0.0)
+    t_enter = np.where(ahead, np.maximum(-b - root, 0.0), np.inf).min(axis=1)
+    t_exit = np.where(ahead, exit_, -1.0).max(axis=1)
     return t_enter, t_exit
 
 
@@ -574,7 +584,7 @@ def sphere_trace(
 ) -> FloatArray:
     """March rays by the distance bound until it drops below ``hit_epsilon``·max(1, t) (Hart 1996).
 
-    Marching runs over the part of each ray inside :func:`scene_bounding_sphere`. ``shaders/raymarch.frag`` runs
+    Marching runs over the part of each ray inside :func:`scene_bounding_spheres`. ``shaders/raymarch.frag`` runs
     the same loop, so the two can be compared ray by ray.
 
     Args:
@@ -596,8 +606,8 @@ def sphere_trace(
         raise ValueError(f"max_steps must be in 1..10000, got {max_steps}")
     eps = _positive(hit_epsilon, "hit_epsilon")
     far = _positive(max_distance, "max_distance")
-    center, radius = scene_bounding_sphere(scene)
-    t, t_exit = ray_sphere_interval(o, d, center, radius)
+    centers, radii = scene_bounding_spheres(scene)
+    t, t_exit = ray_spheres_interval(o, d, centers, radii)
     t_exit = np.minimum(t_exit, far)
     hit = np.zeros(len(o), dtype=bool)
     active = t_exit >= t

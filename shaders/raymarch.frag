@@ -23,8 +23,7 @@ uniform float u_normal_epsilon;  // central-difference step (m)
 uniform float u_shadow_sharpness;  // k of the soft shadow: larger is harder
 uniform float u_occlusion_strength;
 uniform float u_occlusion_step;  // m between AO samples
-uniform vec3 u_bound_center;     // kernels/sdf.py scene_bounding_sphere: march only inside it
-uniform float u_bound_radius;
+uniform vec4 u_bounds[MAX_PRIMITIVES];  // kernels/sdf.py scene_bounding_spheres: centre, radius; march inside
 
 layout(location = 0) out vec4 out_color;
 layout(location = 1) out float out_depth;  // along u_forward (m); -1 for a miss
@@ -37,16 +36,21 @@ vec3 scene_normal(vec3 p) {
         scene_distance(p + e.yyx) - scene_distance(p - e.yyx)));
 }
 
-// Where a unit ray enters and leaves the bounding sphere: (t_enter >= 0, t_exit), t_exit < t_enter for a miss.
+// Where a unit ray first enters and last leaves the bounding spheres (kernels/sdf.py ray_spheres_interval):
+// (t_enter >= 0, t_exit), t_exit < t_enter where it meets none ahead.
 vec2 bound_interval(vec3 origin, vec3 dir) {
-    vec3 oc = origin - u_bound_center;
-    float b = dot(oc, dir);
-    float disc = b * b - (dot(oc, oc) - u_bound_radius * u_bound_radius);
-    if (disc < 0.0) {
-        return vec2(0.0, -1.0);
+    float t_enter = 1e30;
+    float t_exit = -1.0;
+    for (int i = 0; i < MAX_PRIMITIVES; ++i) {
+        vec3 oc = origin - u_bounds[i].xyz;
+        float b = dot(oc, dir);
+        float disc = b * b - (dot(oc, oc) - u_bounds[i].w * u_bounds[i].w);
+        float root = sqrt(max(disc, 0.0));
+        bool ahead = i < u_count && disc >= 0.0 && -b + root >= 0.0;
+        t_enter = ahead ? min(t_enter, max(-b - root, 0.0)) : t_enter;
+        t_exit = ahead ? max(t_exit, -b + root) : t_exit;
     }
-    float root = sqrt(disc);
-    return vec2(max(-b - root, 0.0), -b + root);
+    return vec2(t_enter, t_exit);
 }
 
 float soft_shadow(vec3 origin, vec3 dir, float t_min, float t_max, float k) {

@@ -174,15 +174,16 @@ def camera_rays(
 def _sphere_scissor(
     camera: Camera, scene: sdf.Scene, width: int, height: int
 ) -> tuple[int, int, int, int]:
-    """(x, y, w, h) pixel rectangle (GL origin bottom left) holding the screen image of the bounding sphere.
+    """(x, y, w, h) pixel rectangle (GL origin bottom left) holding the screen image of the bounding spheres.
 
-    Conservative: the rectangle bounds the projected corners of the sphere's bounding box, widened by a pixel;
+    Conservative: the rectangle bounds the projected corners of the spheres' bounding boxes, widened by a pixel;
     if any corner lies near or behind the eye it is the whole image.
     """
-    center, radius = sdf.scene_bounding_sphere(scene)
-    corners = center + radius * np.array(
-        [[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]
+    centers, radii = sdf.scene_bounding_spheres(scene)
+    unit = np.array(
+        [[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=np.float64
     )
+    corners = (centers[:, None, :] + radii[:, None, None] * unit[None, :, :]).reshape(-1, 3)
     forward, right, up = camera.basis()
     rel = corners - np.asarray(camera.position)
     z = rel @ forward
@@ -327,9 +328,10 @@ class Renderer:
         self._write(program, "u_color", color)
         self._set(program, "u_k", float(scene.k))
         self._set(program, "u_blend", BLEND_CODE[scene.blend])
-        center, radius = sdf.scene_bounding_sphere(scene)
-        self._set(program, "u_bound_center", tuple(float(v) for v in center))
-        self._set(program, "u_bound_radius", float(radius))
+        centers, radii = sdf.scene_bounding_spheres(scene)
+        bounds = np.zeros((n, 4), np.float32)
+        bounds[: len(radii), :3], bounds[: len(radii), 3] = centers, radii
+        self._write(program, "u_bounds", bounds)
 
     def _set_shading(self, program: object, shading: Shading) -> None:
         light = np.asarray(shading.light_direction, dtype=np.float64)
