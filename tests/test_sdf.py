@@ -394,6 +394,30 @@ def test_grid_has_cubic_voxels_and_resolution_on_the_longest_side() -> None:
     assert grid.spacing == pytest.approx(2.0 / 99)
 
 
+@SETTINGS
+@given(scene=random_scenes(), seed=st.integers(0, 2**16))
+def test_bounding_spheres_hold_the_shape(scene: sdf.Scene, seed: int) -> None:
+    """Every point inside the blended shape lies in one of the grown spheres the ray-marcher is limited to."""
+    points = np.random.default_rng(seed).uniform(-1.6, 1.6, (20000, 3))
+    inside = points[sdf.scene_distance(scene, points) < 0]
+    centers, radii = sdf.scene_bounding_spheres(scene)
+    gap = np.linalg.norm(inside[:, None, :] - centers[None], axis=2) - radii[None]
+    assert np.all(gap.min(axis=1) <= 0)
+
+
+def test_ray_spheres_interval() -> None:
+    centers = np.array([[0.0, 0, 5], [0.0, 0, 10]])
+    radii = np.array([1.0, 2.0])
+    origins = np.array([[0.0, 0, 0], [5.0, 0, 0], [0.0, 0, 5], [0.0, 0, 20]])
+    directions = np.array([[0.0, 0, 1], [0.0, 0, 1], [0.0, 0, 1], [0.0, 0, 1]])
+    t_enter, t_exit = sdf.ray_spheres_interval(origins, directions, centers, radii)
+    np.testing.assert_allclose(
+        t_enter[[0, 2]], [4.0, 0.0]
+    )  # first entry; a ray born inside starts at 0
+    np.testing.assert_allclose(t_exit[[0, 2]], [12.0, 7.0])  # last exit
+    assert t_exit[1] < t_enter[1] and t_exit[3] < t_enter[3]  # beside them; past them
+
+
 # ------------------------------------------------------------------------------------------ sphere tracing
 def test_sphere_trace_hits_and_misses() -> None:
     scene = sdf.Scene((sdf.Primitive("sphere", (0, 0, 0), (1.0,)),))
