@@ -92,7 +92,7 @@ void main() {
 
     vec2 span = bound_interval(u_eye, dir);
     if (span.y < span.x) {
-        discard;  // misses the bounding sphere: a block of such pixels exits here (see the discard below)
+        discard;  // meets no bounding sphere: a block of such pixels exits here (see the discard below)
     }
     float t = span.x;
     float t_exit = min(span.y, u_max_distance);

@@ -420,7 +420,7 @@ class Renderer:
         fbo.use()
         fbo.scissor = (0, 0, width, height)
         fbo.clear(_MISS, _MISS, _MISS, 0.0)
-        # Only pixels whose rays can meet the bounding sphere run the shader (llvmpipe pays for every pixel).
+        # Only pixels whose rays can meet a bounding sphere run the shader (llvmpipe pays for every pixel).
         fbo.scissor = _sphere_scissor(camera, scene, width, height)
         self.ctx.disable(moderngl.DEPTH_TEST)
         self._raymarch_vao[variant].render(moderngl.TRIANGLES, vertices=3)
