@@ -160,6 +160,40 @@ def _road(grade: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.f
     return np.cos(theta), np.sin(theta)
 
 
+@dataclasses.dataclass(frozen=True)
+class _Resistance:
+    """The validated rider and course, reduced to the coefficients both directions of the model need."""
+
+    drag: NDArray[np.float64]
+    """½ρ·CdA (kg/m): aero force is drag·(v+w)|v+w|."""
+    rolling_force: NDArray[np.float64]
+    """Crr·m·g·cos θ (N)."""
+    climbing_force: NDArray[np.float64]
+    """m·g·sin θ (N)."""
+    wind: NDArray[np.float64]
+    efficiency: NDArray[np.float64]
+
+
+def _resistance(
+    cda_m2: ArrayLike,
+    mass_kg: ArrayLike,
+    crr: ArrayLike,
+    grade: ArrayLike,
+    altitude_m: ArrayLike,
+    headwind_ms: ArrayLike,
+    drivetrain_efficiency: ArrayLike,
+) -> _Resistance:
+    mass = _positive("mass_kg", mass_kg)
+    cos_theta, sin_theta = _road(_finite("grade", grade))
+    return _Resistance(
+        drag=0.5 * air_density(altitude_m) * _positive("cda_m2", cda_m2),
+        rolling_force=_non_negative("crr", crr) * mass * G * cos_theta,
+        climbing_force=mass * G * sin_theta,
+        wind=_finite("headwind_ms", headwind_ms),
+        efficiency=_efficiency(drivetrain_efficiency),
+    )
+
+
 def power(
     speed_ms: ArrayLike,
     cda_m2: ArrayLike,
@@ -186,19 +220,13 @@ def power(
         :class:`Power` with the broadcast shape of the inputs.
     """
     v = _non_negative("speed_ms", speed_ms)
-    cda = _positive("cda_m2", cda_m2)
-    mass = _positive("mass_kg", mass_kg)
-    c_rr = _non_negative("crr", crr)
-    cos_theta, sin_theta = _road(_finite("grade", grade))
-    rho = air_density(altitude_m)
-    wind = _finite("headwind_ms", headwind_ms)
-    efficiency = _efficiency(drivetrain_efficiency)
+    r = _resistance(cda_m2, mass_kg, crr, grade, altitude_m, headwind_ms, drivetrain_efficiency)
 
-    air_speed = v + wind
-    aero = 0.5 * rho * cda * air_speed * np.abs(air_speed) * v
-    rolling = c_rr * mass * G * cos_theta * v
-    climbing = mass * G * sin_theta * v
-    aero, rolling, climbing, efficiency = np.broadcast_arrays(aero, rolling, climbing, efficiency)
+    air_speed = v + r.wind
+    aero = r.drag * air_speed * np.abs(air_speed) * v
+    rolling = r.rolling_force * v
+    climbing = r.climbing_force * v
+    aero, rolling, climbing, efficiency = np.broadcast_arrays(aero, rolling, climbing, r.efficiency)
     total = (aero + rolling + climbing) / efficiency
     return Power(aero=aero.copy(), rolling=rolling.copy(), climbing=climbing.copy(), total=total)
 
@@ -217,8 +245,8 @@ def speed_for_power(
 
     P(v) is a cubic on each side of v = −w (where the air speed changes sign). With a tailwind or on a descent it
     need not be monotone, so the equation can have several roots; the rider settles at the largest, the only
-    stable one (beyond it more speed costs more power). The roots come from the cubics' companion matrices,
-    batched, then two Newton steps polish them.
+    stable one (beyond it more speed costs more power). The roots come in closed form (Cardano, or the
+    trigonometric form when all three are real), batched, then two Newton steps polish them.
 
     Args:
         power_w: power at the pedals (W, ≥ 0).
@@ -228,23 +256,12 @@ def speed_for_power(
         Speed (m/s, ≥ 0) with the broadcast shape of the inputs.
     """
     target = _non_negative("power_w", power_w)
-    cda = _positive("cda_m2", cda_m2)
-    mass = _positive("mass_kg", mass_kg)
-    c_rr = _non_negative("crr", crr)
-    cos_theta, sin_theta = _road(_finite("grade", grade))
-    rho = air_density(altitude_m)
-    wind = _finite("headwind_ms", headwind_ms)
-    efficiency = _efficiency(drivetrain_efficiency)
-
-    a = 0.5 * rho * cda
-    c = mass * G * (c_rr * cos_theta + sin_theta)
-    wheel_power = target * efficiency
-    a, c, w, p = (
-        x.astype(np.float64).ravel() for x in np.broadcast_arrays(a, c, wind, wheel_power)
+    r = _resistance(cda_m2, mass_kg, crr, grade, altitude_m, headwind_ms, drivetrain_efficiency)
+    broadcast = np.broadcast_arrays(
+        r.drag, r.rolling_force + r.climbing_force, r.wind, target * r.efficiency
     )
-    shape = np.broadcast_shapes(
-        *(np.shape(x) for x in (target, cda, mass, c_rr, cos_theta, rho, wind, efficiency))
-    )
+    shape = broadcast[0].shape
+    a, c, w, p = (x.astype(np.float64).ravel() for x in broadcast)
 
     # Region s = +1 (v ≥ −w, air from ahead): a·v³ + 2aw·v² + (aw² + c)·v − p = 0.
     # Region s = −1 (v < −w, tailwind faster than the rider): −a·v³ − 2aw·v² + (−aw² + c)·v − p = 0.
