@@ -56,6 +56,11 @@ def main(
                 page = context.new_page()
                 open_viser(page, server.get_port(), f"/{key}")
                 time.sleep(settle_s)
+                # The software-WebGL notice covers the top left corner; a person would close it.
+                close_buttons = page.locator(".mantine-Notification-closeButton")
+                for i in range(close_buttons.count()):
+                    close_buttons.nth(i).click()
+                time.sleep(0.5)
                 path = out_dir / f"{key}.png"
                 page.screenshot(path=str(path))
                 print(f"saved {path}")
