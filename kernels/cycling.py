@@ -8,7 +8,7 @@ Model (the seed's, with wind made sign-correct):
     P_aero  = ½·ρ·CdA·(v + w)·|v + w|·v        w = headwind (negative for a tailwind)
     P_roll  = Crr·m·g·cos θ·v
     P_climb = m·g·sin θ·v
-    P_total = (P_aero + P_roll + P_climb) / η   η = drivetrain efficiency
+    P_total = (P_aero + P_roll + P_climb) / η   η = drivetrain efficiency (when the sum is positive)
     ρ(h)    = 1.225·exp(−h / 8500)
 
 The absolute value matters: a tailwind faster than the rider pushes instead of dragging. Assumptions: steady speed
@@ -67,7 +67,7 @@ class Power:
     climbing: NDArray[np.float64]
     """Power against gravity along the road (W); negative downhill."""
     total: NDArray[np.float64]
-    """Power at the pedals: (aero + rolling + climbing) / drivetrain efficiency (W)."""
+    """Power at the pedals: (aero + rolling + climbing) / drivetrain efficiency (W); the plain sum when negative."""
 
 
 def _finite(name: str, value: ArrayLike) -> NDArray[np.float64]:
@@ -227,7 +227,10 @@ def power(
     rolling = r.rolling_force * v
     climbing = r.climbing_force * v
     aero, rolling, climbing, efficiency = np.broadcast_arrays(aero, rolling, climbing, r.efficiency)
-    total = (aero + rolling + climbing) / efficiency
+    wheel = aero + rolling + climbing
+    # The drivetrain loses a share of what the rider puts in; when the wheel needs no power (a descent),
+    # nothing passes through it, so a negative surplus is not scaled.
+    total = np.where(wheel > 0.0, wheel / efficiency, wheel)
     return Power(aero=aero.copy(), rolling=rolling.copy(), climbing=climbing.copy(), total=total)
 
 

@@ -271,6 +271,10 @@ time-averaged power is the mean over positions, far below the leader's.
         self.state = compute_line(self.params)
         self._drawn_position: Position | None = None
         self._rotation_time_s = 0.0
+        self._rotating = False
+        """Whether the lead rotates (the cleaned checkbox: the animation never reads raw browser values)."""
+        self._turn_s = 6.0
+        """Seconds each rider leads (the cleaned slider)."""
         self._energy_j = np.zeros(MAX_RIDERS)
         self._ridden_s = 0.0
         self._build_gui()
@@ -476,25 +480,31 @@ time-averaged power is the mean over positions, far below the leader's.
         self._on_input()
 
     def _on_crr_preset(self) -> None:
-        label = self.read_choice(self.crr_preset, list(CRR_PRESETS), str(self.crr_preset.value))
-        if label in CRR_PRESETS:
-            self._write_back(self.crr, CRR_PRESETS[label])
+        closest = min(CRR_PRESETS, key=lambda label: abs(CRR_PRESETS[label] - self.params.crr))
+        label = self.read_choice(self.crr_preset, list(CRR_PRESETS), closest)
+        self._write_back(self.crr, CRR_PRESETS[label])
         self._on_input()
 
     def _on_rotate(self) -> None:
-        self.read_bool(self.rotate, False)
-        self.read_number(self.turn, 6.0)
+        self._rotating = self.read_bool(self.rotate, self._rotating)
+        self._turn_s = self.read_number(self.turn, self._turn_s)
         self._rotation_time_s = 0.0
         self._energy_j[:] = 0.0
         self._ridden_s = 0.0
         self.redraw()
 
     def _on_input(self) -> None:
+        last_good = (self.params, self.state)
         self.params = self.read_params()
         self.state = compute_line(self.params)
         self._energy_j[:] = 0.0
         self._ridden_s = 0.0
-        self.redraw()
+        try:
+            self.redraw()
+        except Exception:
+            self.params, self.state = last_good  # never show one state while holding another
+            self.redraw()
+            raise
 
     def read_params(self) -> PelotonParams:
         """The current GUI values, cleaned: anything non-finite, out of range or unknown keeps the last good value."""
@@ -541,9 +551,9 @@ time-averaged power is the mean over positions, far below the leader's.
         n, p = self.params.n_riders, self.params
         slots = slot_offsets(n, p.gap_m)
         x, y = slots.copy(), np.zeros(MAX_RIDERS)
-        if not (self.rotate.value is True and n > 1):
+        if not (self._rotating and n > 1):
             return x, y
-        turn = float(self.turn.value)
+        turn = self._turn_s
         k, phase = divmod(self._rotation_time_s / turn, 1.0)
         order = (np.arange(n) - int(k)) % n  # slot each rider holds this turn
         swap = 0.25  # last quarter of a turn: leader swings off and drifts back, others move up
@@ -561,9 +571,9 @@ time-averaged power is the mean over positions, far below the leader's.
     def current_slots(self) -> np.ndarray:
         """(n_riders,) slot index each rider holds (0 = leader); the identity unless the lead rotates."""
         n = self.params.n_riders
-        if not (self.rotate.value is True and n > 1):
+        if not (self._rotating and n > 1):
             return np.arange(n)
-        k = int(self._rotation_time_s // float(self.turn.value))
+        k = int(self._rotation_time_s // self._turn_s)
         return (np.arange(n) - k) % n
 
     def redraw(self, *, readouts: bool = True) -> None:
@@ -670,11 +680,14 @@ time-averaged power is the mean over positions, far below the leader's.
             return ""
         mean = float(np.mean(self.state.power.total))
         lead = float(self.state.power.total[0])
-        text = (
-            f"Rotating evenly, each rider averages **{mean:.0f} W** against the leader's {lead:.0f} W "
-            f"({100 * (1 - mean / lead):.0f} % less): the reason teams rotate."
-        )
-        if self.rotate.value is True and self._ridden_s > 0:
+        if lead > 0:
+            text = (
+                f"Rotating evenly, each rider averages **{mean:.0f} W** against the leader's {lead:.0f} W "
+                f"({100 * (1 - mean / lead):.0f} % less): the reason teams rotate."
+            )
+        else:
+            text = f"Here the leader needs {lead:.0f} W: gravity does the work and nobody needs shelter."
+        if self._rotating and self._ridden_s > 0:
             averages = self._energy_j[:n] / self._ridden_s
             text += "  \nTime-averaged so far: " + ", ".join(
                 f"R{i + 1} {a:.0f} W" for i, a in enumerate(averages)
@@ -698,7 +711,7 @@ time-averaged power is the mean over positions, far below the leader's.
 
     # ----------------------------------------------------------------------------------------- animation
     def _animate(self, dt: float) -> None:
-        if not (self.rotate.value is True and self.params.n_riders > 1):
+        if not (self._rotating and self.params.n_riders > 1):
             return
         dt = min(dt, 0.2)
         slots = self.current_slots()

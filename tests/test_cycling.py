@@ -105,6 +105,13 @@ def test_drivetrain_loss_divides_the_wheel_power() -> None:
     assert float(pedals.aero) == pytest.approx(float(wheel.aero))
 
 
+def test_a_descent_surplus_is_not_scaled_by_the_drivetrain() -> None:
+    p = cycling.power(10.0, 0.3, 80.0, 0.004, grade=-0.1, drivetrain_efficiency=0.9)
+    wheel = float(p.aero + p.rolling + p.climbing)
+    assert wheel < 0.0
+    assert float(p.total) == pytest.approx(wheel)
+
+
 def test_power_broadcasts_over_arrays() -> None:
     speeds = np.linspace(1.0, 20.0, 5)[:, None]
     grades = np.array([0.0, 0.05, -0.05])[None, :]
