@@ -46,15 +46,26 @@ def test_drag_speed_slider_with_the_mouse(server: viser.ViserServer, browser_pag
         page.mouse.move(x + 4 * step, y)
     page.mouse.up()
 
-    end = time.monotonic() + 10.0
-    while time.monotonic() < end and scene.params.speed_kmh == before_speed:
+    # Wait until the drag's messages have all been handled: the speed has moved and then held still.
+    end = time.monotonic() + 15.0
+    last, still_since = before_speed, time.monotonic()
+    while time.monotonic() < end:
+        with scene._lock:
+            speed = scene.params.speed_kmh
+        if speed != last:
+            last, still_since = speed, time.monotonic()
+        elif speed != before_speed and time.monotonic() - still_since > 0.5:
+            break
         time.sleep(0.05)
-    assert scene.params.speed_kmh > before_speed
-    assert float(scene.state.power.total[0]) > before_power
+    with scene._lock:
+        final_speed = scene.params.speed_kmh
+        final_power = float(scene.state.power.total[0])
+    assert final_speed > before_speed
+    assert final_power > before_power
     # The page shows the server's new value in the slider's number box.
     page.wait_for_function(
         "v => [...document.querySelectorAll('[role=slider]')].some(e => Number(e.getAttribute('aria-valuenow')) === v)",
-        arg=scene.params.speed_kmh,
+        arg=final_speed,
         timeout=10_000,
         polling=100,
     )

@@ -24,6 +24,7 @@ class Probe(Scene):
         self.point = (0.0, 0.0, 0.0)
         self.calls = 0
         self.ticks = 0
+        self.gizmo_events = 0
         with self.gui_root:
             self.slider = server.gui.add_slider(
                 "Value", min=0.0, max=10.0, step=0.1, initial_value=1.0
@@ -45,6 +46,7 @@ class Probe(Scene):
 
     def _on_gizmo(self) -> None:
         self.point = self.read_position(self.gizmo, self.point, (-5.0, -5.0, 0.0), (5.0, 5.0, 5.0))
+        self.gizmo_events += 1
 
     def _tick(self, _dt: float) -> None:
         self.ticks += 1
@@ -86,10 +88,15 @@ def test_gizmo_positions_from_a_browser_are_cleaned(server: viser.ViserServer) -
         client.wait_for_node("/probe/gizmo")
         client.drag_transform("/probe/gizmo", [(1.0, 2.0, 3.0)])
         client.wait_for(lambda: probe.point == (1.0, 2.0, 3.0), what="a good drag")
+        seen = probe.gizmo_events
         client.drag_transform("/probe/gizmo", [(float("nan"), 0.0, 0.0)])
-        time.sleep(0.3)
-        assert probe.point == (1.0, 2.0, 3.0)
-        assert tuple(probe.gizmo.position) == (1.0, 2.0, 3.0)
+        # start, update and end each run the callback: wait until all three were handled
+        client.wait_for(
+            lambda: probe.gizmo_events >= seen + 3, what="the crafted drag to be handled"
+        )
+        with probe._lock:
+            assert probe.point == (1.0, 2.0, 3.0)
+            assert tuple(probe.gizmo.position) == (1.0, 2.0, 3.0)
         client.drag_transform("/probe/gizmo", [(1e9, -1e9, 2.0)])
         client.wait_for(lambda: probe.point == (5.0, -5.0, 2.0), what="a clamped drag")
     probe.close()
