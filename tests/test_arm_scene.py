@@ -207,6 +207,21 @@ def test_dragging_the_target_gizmo_moves_the_chain_end_onto_it(
         client.wait_for(browser_shows_end_on_target, what="the browser to receive the new pose")
 
 
+def test_an_off_plane_drag_is_put_back_in_the_plane(
+    server: viser.ViserServer, scene: ArmScene
+) -> None:
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_node("/arm/target")
+        client.drag_transform(
+            "/arm/target", [(0.7, 0.4, 0.9)]
+        )  # y = 0.4: a crafted client, out of the plane
+        client.wait_for(lambda: scene.gizmo_events >= 3, what="the drag handled")
+        with scene._lock:
+            np.testing.assert_array_equal(scene.target, (0.7, 0.0, 0.9))
+            # The gizmo is drawn where the chain solves, not where the message put it.
+            np.testing.assert_array_equal(np.asarray(scene.target_gizmo.position), (0.7, 0.0, 0.9))
+
+
 @pytest.mark.parametrize(
     "bad",
     [
