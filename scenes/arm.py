@@ -476,9 +476,8 @@ is a static pose.
             self.target_gizmo.wxyz = (1.0, 0.0, 0.0, 0.0)
             return
         if not np.array_equal(point, np.asarray(self.target_gizmo.position, dtype=np.float64)):
-            self.target_gizmo.position = (
-                point  # a crafted y off the plane: draw the gizmo where we solve
-            )
+            # A crafted y off the plane: draw the gizmo where the chain solves.
+            self.target_gizmo.position = point
         if np.array_equal(point, self.target) and self.report is not None:
             return  # a burst of updates: an earlier one already solved for this position
         self.target = point
