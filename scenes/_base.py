@@ -19,6 +19,7 @@ import logging
 import math
 import threading
 import time
+import weakref
 from collections.abc import Callable, Sequence
 from typing import Any, ClassVar, TypeVar
 
@@ -28,6 +29,57 @@ import viser
 logger = logging.getLogger(__name__)
 
 T = TypeVar("T")
+
+
+class _CameraHub:
+    """One set of viser camera callbacks per server, forwarding to whichever scenes listen now.
+
+    viser 1.1.1 cannot remove an ``on_client_connect`` or camera callback, so a scene that registered its own would
+    stay reachable (and keep being called) after it closed; scenes subscribe here instead.
+    """
+
+    def __init__(self, server: viser.ViserServer) -> None:
+        self._listeners: list[Callable[[viser.CameraHandle], None]] = []
+        self._lock = threading.Lock()
+        for client in server.get_clients().values():
+            self._attach(client)
+        server.on_client_connect(self._attach)
+
+    def _attach(self, client: viser.ClientHandle) -> None:
+        client.camera.on_update(self._dispatch)
+        self._dispatch(client.camera)
+
+    def _dispatch(self, camera: viser.CameraHandle) -> None:
+        with self._lock:
+            listeners = list(self._listeners)
+        for listener in listeners:
+            listener(camera)
+
+    def add(self, listener: Callable[[viser.CameraHandle], None]) -> None:
+        with self._lock:
+            self._listeners.append(listener)
+
+    def remove(self, listener: Callable[[viser.CameraHandle], None]) -> None:
+        with self._lock:
+            self._listeners = [other for other in self._listeners if other is not listener]
+
+    @property
+    def listener_count(self) -> int:
+        with self._lock:
+            return len(self._listeners)
+
+
+_camera_hubs: weakref.WeakKeyDictionary[viser.ViserServer, _CameraHub] = weakref.WeakKeyDictionary()
+_camera_hubs_lock = threading.Lock()
+
+
+def camera_hub(server: viser.ViserServer) -> _CameraHub:
+    """The server's one camera hub, made on first use."""
+    with _camera_hubs_lock:
+        hub = _camera_hubs.get(server)
+        if hub is None:
+            hub = _camera_hubs[server] = _CameraHub(server)
+        return hub
 
 
 class Scene(abc.ABC):
@@ -52,6 +104,7 @@ class Scene(abc.ABC):
         self._in_callback = False
         self._stop = threading.Event()
         self._threads: list[threading.Thread] = []
+        self._camera_listeners: list[Callable[[viser.CameraHandle], None]] = []
         with self.gui_root, server.gui.add_folder("About", expand_by_default=False):
             server.gui.add_markdown(self.about)
         self._frame_camera()
@@ -69,6 +122,9 @@ class Scene(abc.ABC):
     def close(self) -> None:
         """Stop the scene's threads and remove every node and GUI element it created."""
         self._stop.set()
+        hub = camera_hub(self.server)
+        for listener in self._camera_listeners:
+            hub.remove(listener)
         for thread in self._threads:
             thread.join(timeout=2.0)
         with self._lock:
@@ -78,6 +134,13 @@ class Scene(abc.ABC):
     @property
     def closed(self) -> bool:
         return self._stop.is_set()
+
+    def watch_cameras(self, listener: Callable[[viser.CameraHandle], None]) -> None:
+        """Call ``listener`` with every client's camera now and whenever one moves, until :meth:`close`."""
+        camera_hub(self.server).add(listener)
+        self._camera_listeners.append(listener)
+        for client in self.server.get_clients().values():
+            listener(client.camera)
 
     def start_loop(self, step: Callable[[float], None], period_s: float) -> None:
         """Run ``step(dt)`` every ``period_s`` on a daemon thread until :meth:`close`; it sleeps, never spins."""

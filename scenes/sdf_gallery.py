@@ -358,13 +358,7 @@ IoU is lowest when a box edge is on the silhouette.
             self.gizmos.append(gizmo)
 
     def _watch_cameras(self) -> None:
-        def attach(client: viser.ClientHandle) -> None:
-            client.camera.on_update(lambda camera: self._on_camera(camera))
-            self._on_camera(client.camera)
-
-        for client in self.server.get_clients().values():
-            attach(client)
-        self.server.on_client_connect(attach)
+        self.watch_cameras(self._on_camera)
 
     # ----------------------------------------------------------------------------------------- inputs
     def read_params(self) -> SdfGalleryParams:
@@ -525,17 +519,23 @@ IoU is lowest when a box edge is on the silhouette.
                     self._wanted_scene = None
                 if self._stop.is_set():
                     return
-                if scene is not None:
-                    self._mesh_and_show(scene, resolution)
+                try:
+                    if scene is not None:
+                        self._mesh_and_show(scene, resolution)
+                        with self._work:
+                            self._reference_due = True
+                    if self._reference_ready():
+                        if renderer is None and self.gl_error is None:
+                            renderer = self._open_renderer()
+                        if renderer is not None:
+                            self._render_reference(renderer)
+                except Exception:
+                    # One failed mesh or render must not stop every later one: log it and wait for new input.
+                    logger.exception(
+                        "sdf: meshing or rendering failed; keeping the last good picture"
+                    )
                     with self._work:
-                        self._reference_due = True
-                if self._reference_ready():
-                    if renderer is None and self.gl_error is None:
-                        renderer = self._open_renderer()
-                    if renderer is not None:
-                        self._render_reference(renderer)
-        except Exception:
-            logger.exception("sdf: worker stopped")
+                        self._reference_due = False
         finally:
             if renderer is not None:
                 renderer.release()
