@@ -58,8 +58,16 @@ def test_drag_the_target_gizmo_with_the_mouse(server: viser.ViserServer, browser
         time.sleep(0.02)
     page.mouse.up()
 
+    # Wait until the drag's messages have all been handled: the target has moved and then held still.
     deadline = time.monotonic() + 15.0
-    while time.monotonic() < deadline and scene.target[0] > target_before[0] - 0.05:
+    last, still_since = target_before.copy(), time.monotonic()
+    while time.monotonic() < deadline:
+        with scene._lock:
+            now = scene.target.copy()
+        if not np.array_equal(now, last):
+            last, still_since = now, time.monotonic()
+        elif now[0] < target_before[0] - 0.05 and time.monotonic() - still_since > 0.5:
+            break
         time.sleep(0.05)
     with scene._lock:
         target = scene.target.copy()
