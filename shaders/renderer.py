@@ -201,6 +201,12 @@ def _sphere_scissor(
     return (x0, y0, max(x1 - x0, 0), max(y1 - y0, 0))
 
 
+def _background_levels(shading: Shading) -> tuple[int, int, int]:
+    """The background colour in 8-bit levels, as the images hold it."""
+    red, green, blue = (int(np.clip(round(c * 255), 0, 255)) for c in shading.background)
+    return red, green, blue
+
+
 def _check_size(width: int, height: int) -> None:
     for name, value in (("width", width), ("height", height)):
         if (
@@ -258,15 +264,22 @@ class Renderer:
         self.ctx.includes["shading.glsl"] = _source("shading.glsl")
         fullscreen = _source("fullscreen.vert")
         raymarch = _source("raymarch.frag")
+        # One program per (shadows, occlusion, polynomial blend only), compiled here once: under llvmpipe a term
+        # switched off by a uniform would still be paid for, and the exponential blend's exp and log cost as much as
+        # the rest of the scene, so poly and hard scenes use a program without them.
         self._raymarch = {
-            (shadows, occlusion): self.ctx.program(
+            (shadows, occlusion, poly_only): self.ctx.program(
                 vertex_shader=fullscreen,
                 fragment_shader=_with_defines(
-                    raymarch, SHADOWS=int(shadows), OCCLUSION=int(occlusion)
+                    raymarch,
+                    SHADOWS=int(shadows),
+                    OCCLUSION=int(occlusion),
+                    POLY_BLEND_ONLY=int(poly_only),
                 ),
             )
             for shadows in (False, True)
             for occlusion in (False, True)
+            for poly_only in (False, True)
         }
         self._raymarch_vao = {
             key: self.ctx.vertex_array(prog, []) for key, prog in self._raymarch.items()
@@ -341,34 +354,48 @@ class Renderer:
         self._set(program, "u_shininess", shading.shininess)
         self._set(program, "u_light_direction", tuple(light / np.linalg.norm(light)))
 
-    def _targets(self, width: int, height: int) -> tuple[object, object, object]:
-        """Colour (RGBA8), depth (R32F) and z-buffer of this size, kept between calls (new ones cost a draw)."""
+    def _targets(self, width: int, height: int, shading: Shading) -> tuple[object, object, object]:
+        """Colour (RGB8), depth (R32F) and z-buffer of this size, kept between calls (new ones cost a draw), cleared.
+
+        The colour is cleared to the background and the depth to the miss value, each through a framebuffer of its
+        own, so reading back needs no masking (that masking cost more than the readback itself). Returns the
+        framebuffer of all three, bound, with the colour and depth textures.
+        """
+        import moderngl
+
         if self._target_size != (width, height):
             for obj in self._target_objects:
                 obj.release()
-            color = self.ctx.texture((width, height), 4, dtype="f1")
+            color = self.ctx.texture((width, height), 3, dtype="f1")
             depth = self.ctx.texture((width, height), 1, dtype="f4")
             zbuffer = self.ctx.depth_renderbuffer((width, height))
             fbo = self.ctx.framebuffer(color_attachments=[color, depth], depth_attachment=zbuffer)
-            self._target_objects = [fbo, color, depth, zbuffer]
+            color_only = self.ctx.framebuffer(color_attachments=[color])
+            depth_only = self.ctx.framebuffer(color_attachments=[depth], depth_attachment=zbuffer)
+            self._target_objects = [fbo, color_only, depth_only, color, depth, zbuffer]
             self._target_size = (width, height)
-        fbo, color, depth, _ = self._target_objects
+        fbo, color_only, depth_only, color, depth, _ = self._target_objects
+        assert isinstance(fbo, moderngl.Framebuffer)
+        assert isinstance(color_only, moderngl.Framebuffer)
+        assert isinstance(depth_only, moderngl.Framebuffer)
+        # Whole 8-bit levels: GL turns c/255 back into c exactly.
+        red, green, blue = (float(c) / 255.0 for c in _background_levels(shading))
+        color_only.use()
+        color_only.clear(red, green, blue, 1.0)
+        depth_only.use()
+        depth_only.clear(_MISS, _MISS, _MISS, 0.0, depth=1.0)
+        fbo.use()
         return fbo, color, depth
 
     def _read(
-        self, color: object, depth: object, width: int, height: int, shading: Shading
+        self, color: object, depth: object, width: int, height: int
     ) -> tuple[NDArray[np.uint8], NDArray[np.float32]]:
         import moderngl
 
         assert isinstance(color, moderngl.Texture) and isinstance(depth, moderngl.Texture)
-        rgb = np.frombuffer(color.read(), np.uint8).reshape(height, width, 4)[::-1, :, :3].copy()
+        rgb = np.frombuffer(color.read(), np.uint8).reshape(height, width, 3)[::-1].copy()
         z = np.frombuffer(depth.read(), np.float32).reshape(height, width)[::-1].copy()
-        miss = z == _MISS
-        z[miss] = np.inf
-        background = np.clip(np.round(np.asarray(shading.background) * 255), 0, 255).astype(
-            np.uint8
-        )
-        rgb[miss] = background
+        z[z == _MISS] = np.inf
         return rgb, z
 
     # ------------------------------------------------------------------------------------- passes
@@ -397,7 +424,8 @@ class Renderer:
 
         _check_size(width, height)
         shading = shading or Shading()
-        variant = (shading.shadows, shading.occlusion)
+        # sdf.glsl's smin_blend uses the polynomial form for hard scenes (k = 0) whatever the blend.
+        variant = (shading.shadows, shading.occlusion, scene.blend == "poly" or scene.k == 0.0)
         prog = self._raymarch[variant]
         self._set_scene(prog, scene)
         self._set_shading(prog, shading)
@@ -415,17 +443,14 @@ class Renderer:
         self._set(prog, "u_shadow_sharpness", shading.shadow_sharpness)
         self._set(prog, "u_occlusion_strength", shading.occlusion_strength)
         self._set(prog, "u_occlusion_step", shading.occlusion_step)
-        fbo, color, depth = self._targets(width, height)
+        fbo, color, depth = self._targets(width, height, shading)
         assert isinstance(fbo, moderngl.Framebuffer)
-        fbo.use()
-        fbo.scissor = (0, 0, width, height)
-        fbo.clear(_MISS, _MISS, _MISS, 0.0)
         # Only pixels whose rays can meet a bounding sphere run the shader (llvmpipe pays for every pixel).
         fbo.scissor = _sphere_scissor(camera, scene, width, height)
         self.ctx.disable(moderngl.DEPTH_TEST)
         self._raymarch_vao[variant].render(moderngl.TRIANGLES, vertices=3)
         fbo.scissor = (0, 0, width, height)
-        return self._read(color, depth, width, height, shading)
+        return self._read(color, depth, width, height)
 
     def render_mesh(
         self,
@@ -481,10 +506,7 @@ class Renderer:
         )
         self._set(prog, "u_eye", tuple(float(x) for x in eye))
         self._set(prog, "u_forward", tuple(forward))
-        fbo, color, depth = self._targets(width, height)
-        assert isinstance(fbo, moderngl.Framebuffer)
-        fbo.use()
-        fbo.clear(_MISS, _MISS, _MISS, 0.0, depth=1.0)
+        _, color, depth = self._targets(width, height, shading)
         if len(f):
             interleaved = np.concatenate(
                 [v.astype(np.float32), normals, c.astype(np.float32)], axis=1
@@ -499,7 +521,7 @@ class Renderer:
             self.ctx.disable(moderngl.DEPTH_TEST)
             for obj in (vao, vbo, ibo):
                 obj.release()
-        return self._read(color, depth, width, height, shading)
+        return self._read(color, depth, width, height)
 
     def probe(
         self, scene: sdf.Scene, points: ArrayLike

@@ -88,12 +88,21 @@ float op_intersect(float a, float b) {
 }
 
 // llvmpipe (Mesa's CPU driver) runs every side of a branch under a lane mask, even when the condition is a
-// uniform, so the choices below are written as selects between values computed once.
+// uniform, so the choices below are written as selects between values computed once. A program that defines
+// POLY_BLEND_ONLY 1 (the renderer's ray-march variant for polynomial and hard blends) leaves the exponential blend
+// out: its exp and log would otherwise cost as much as the rest of the scene.
+#ifndef POLY_BLEND_ONLY
+#define POLY_BLEND_ONLY 0
+#endif
 vec2 smin_blend(float a, float b, float k, int blend) {
     float width = max(k, 1e-20);  // k = 0 is the hard minimum; keep the division finite
     vec2 poly = smin_poly_weighted(a, b, width);
+#if POLY_BLEND_ONLY
+    return poly;
+#else
     vec2 expo = smin_exp_weighted(a, b, EXP_SHARPNESS_PER_WIDTH / width);
     return (blend == BLEND_EXP && k > 0.0) ? expo : poly;
+#endif
 }
 
 // Distance of (a op b) and the weight of b; k is the blend width (m). Union smin(a, b), subtraction
@@ -118,19 +127,20 @@ float smooth_intersect(float a, float b, float k, int blend) {
 }
 
 // ------------------------------------------------------------------------------ scene
-// Sphere, box and capsule are one rounded box |max(q, 0)| + min(max(q.x, q.y, q.z), 0) - r, q = |p| - e
-// (sphere: e = 0; box: e = half sizes, r = 0; capsule: e = (0, half length, 0)); the torus is the other formula.
-// Both are evaluated and one is selected (see smin_blend on why); the values equal sd_sphere, sd_box, sd_capsule and
-// sd_torus.
+// Every kind is one rounded box |max(q, 0)| + min(max(q.x, q.y, q.z), 0) - r, q = |p'| - e (sphere: p' = p, e = 0;
+// box: p' = p, e = half sizes, r = 0; capsule: p' = p, e = (0, half length, 0)). The torus is the same formula with
+// p' = (|p.xz| - major radius, p.y, 0) and e = 0: then q = |p'| has no negative part and the formula is
+// |p'| - minor radius, sd_torus. One formula with selected inputs, not two formulas and a select (see smin_blend on
+// why); the values equal sd_sphere, sd_box, sd_capsule and sd_torus.
 float primitive_distance(int i, vec3 p_world) {
     vec3 p = u_world_to_local[i] * (p_world - u_center[i]);
     vec3 s = u_size[i];
     int kind = u_kind[i];
+    bool torus = kind == KIND_TORUS;
+    vec3 shape_point = torus ? vec3(length(p.xz) - s.x, p.y, 0.0) : p;
     vec3 e = kind == KIND_BOX ? s : (kind == KIND_CAPSULE ? vec3(0.0, s.x, 0.0) : vec3(0.0));
-    float r = kind == KIND_BOX ? 0.0 : (kind == KIND_CAPSULE ? s.y : s.x);
-    float rounded = sd_box(p, e) - r;
-    float torus = sd_torus(p, s.x, s.y);
-    return kind == KIND_TORUS ? torus : rounded;
+    float r = kind == KIND_BOX ? 0.0 : (kind == KIND_CAPSULE || torus ? s.y : s.x);
+    return sd_box(shape_point, e) - r;
 }
 
 float scene_distance(vec3 p) {
