@@ -24,6 +24,7 @@ uniform float u_shadow_sharpness;  // k of the soft shadow: larger is harder
 uniform float u_occlusion_strength;
 uniform float u_occlusion_step;  // m between AO samples
 uniform vec4 u_bounds[MAX_PRIMITIVES];  // kernels/sdf.py scene_bounding_spheres: centre, radius; march inside
+uniform vec3 u_box_half[MAX_PRIMITIVES];  // renderer.py _bounding_boxes: half extents in the primitive's frame (m)
 
 layout(location = 0) out vec4 out_color;
 layout(location = 1) out float out_depth;  // along u_forward (m); -1 for a miss
@@ -36,8 +37,11 @@ vec3 scene_normal(vec3 p) {
         scene_distance(p + e.yyx) - scene_distance(p - e.yyx)));
 }
 
-// Where a unit ray first enters and last leaves the bounding spheres (kernels/sdf.py ray_spheres_interval):
-// (t_enter >= 0, t_exit), t_exit < t_enter where it meets none ahead.
+// Where a unit ray first enters and last leaves the bounds: per primitive, its bounding sphere
+// (kernels/sdf.py ray_spheres_interval) cut by its bounding box (renderer.py _bounding_boxes, a slab test in the
+// primitive's frame); over the primitives, the union. (t_enter >= 0, t_exit), t_exit < t_enter where it meets none
+// ahead. A sphere tracer started at any point before the first surface finds the same surface, so the image
+// equals kernels/sdf.py sphere_trace's from the spheres alone, while fewer steps are spent beside the shape.
 vec2 bound_interval(vec3 origin, vec3 dir) {
     float t_enter = 1e30;
     float t_exit = -1.0;
@@ -46,9 +50,19 @@ vec2 bound_interval(vec3 origin, vec3 dir) {
         float b = dot(oc, dir);
         float disc = b * b - (dot(oc, oc) - u_bounds[i].w * u_bounds[i].w);
         float root = sqrt(max(disc, 0.0));
-        bool ahead = i < u_count && disc >= 0.0 && -b + root >= 0.0;
-        t_enter = ahead ? min(t_enter, max(-b - root, 0.0)) : t_enter;
-        t_exit = ahead ? max(t_exit, -b + root) : t_exit;
+        vec3 o_local = u_world_to_local[i] * (origin - u_center[i]);
+        vec3 d_local = u_world_to_local[i] * dir;
+        // 1/d with the sign kept and no infinities (a zero component gives a huge, finite slab parameter).
+        vec3 inverse = 1.0 / mix(d_local, vec3(1e-20), lessThan(abs(d_local), vec3(1e-20)));
+        vec3 t_low = (-u_box_half[i] - o_local) * inverse;
+        vec3 t_high = (u_box_half[i] - o_local) * inverse;
+        vec3 t_near = min(t_low, t_high);
+        vec3 t_far = max(t_low, t_high);
+        float enter = max(-b - root, max(t_near.x, max(t_near.y, t_near.z)));
+        float exit = min(-b + root, min(t_far.x, min(t_far.y, t_far.z)));
+        bool ahead = i < u_count && disc >= 0.0 && exit >= max(enter, 0.0);
+        t_enter = ahead ? min(t_enter, max(enter, 0.0)) : t_enter;
+        t_exit = ahead ? max(t_exit, exit) : t_exit;
     }
     return vec2(t_enter, t_exit);
 }

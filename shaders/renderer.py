@@ -171,19 +171,49 @@ def camera_rays(
     return origins, dirs
 
 
-def _sphere_scissor(
+def _bounding_boxes(
+    scene: sdf.Scene,
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Oriented boxes whose union holds the scene: (P, 3) centres, (P, 3, 3) local-to-world rotations, (P, 3) half
+    extents (m).
+
+    Each primitive's box in its own frame (the torus's ring lies in the local xz plane, the capsule's axis is local
+    y), grown by k + 1 mm as :func:`kernels.sdf.scene_bounding_spheres` grows the spheres: a blend reaches at most k/4
+    beyond the primitives per blend (both forms), subtraction and intersection only remove. A flat torus's box is
+    far thinner than its sphere, so fewer rays march near the shape and miss.
+    """
+    half = np.zeros((len(scene.primitives), 3))
+    for i, prim in enumerate(scene.primitives):
+        s = prim.size
+        match prim.kind:
+            case "sphere":
+                half[i] = (s[0], s[0], s[0])
+            case "box":
+                half[i] = s[:3]
+            case "torus":
+                half[i] = (s[0] + s[1], s[1], s[0] + s[1])
+            case "capsule":
+                half[i] = (s[1], s[0] + s[1], s[1])
+    centers = np.array([p.center for p in scene.primitives], dtype=np.float64)
+    rotations = np.array([sdf.rotation_matrix(p.rotation) for p in scene.primitives])
+    return centers, rotations, half + scene.k + 1e-3
+
+
+def _bounds_scissor(
     camera: Camera, scene: sdf.Scene, width: int, height: int
 ) -> tuple[int, int, int, int]:
-    """(x, y, w, h) pixel rectangle (GL origin bottom left) holding the screen image of the bounding spheres.
+    """(x, y, w, h) pixel rectangle (GL origin bottom left) holding the screen image of the bounding boxes.
 
-    Conservative: the rectangle bounds the projected corners of the spheres' bounding boxes, widened by a pixel;
-    if any corner lies near or behind the eye it is the whole image.
+    Conservative: the rectangle bounds the boxes' projected corners, widened by a pixel; if any corner lies near or
+    behind the eye it is the whole image.
     """
-    centers, radii = sdf.scene_bounding_spheres(scene)
+    centers, rotations, half = _bounding_boxes(scene)
     unit = np.array(
         [[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=np.float64
     )
-    corners = (centers[:, None, :] + radii[:, None, None] * unit[None, :, :]).reshape(-1, 3)
+    corners = (
+        centers[:, None, :] + np.einsum("pij,pcj->pci", rotations, half[:, None, :] * unit[None])
+    ).reshape(-1, 3)
     forward, right, up = camera.basis()
     rel = corners - np.asarray(camera.position)
     z = rel @ forward
@@ -345,6 +375,9 @@ class Renderer:
         bounds = np.zeros((n, 4), np.float32)
         bounds[: len(radii), :3], bounds[: len(radii), 3] = centers, radii
         self._write(program, "u_bounds", bounds)
+        boxes = np.zeros((n, 3), np.float32)
+        boxes[: len(radii)] = _bounding_boxes(scene)[2]
+        self._write(program, "u_box_half", boxes)
 
     def _set_shading(self, program: object, shading: Shading) -> None:
         light = np.asarray(shading.light_direction, dtype=np.float64)
@@ -445,8 +478,8 @@ class Renderer:
         self._set(prog, "u_occlusion_step", shading.occlusion_step)
         fbo, color, depth = self._targets(width, height, shading)
         assert isinstance(fbo, moderngl.Framebuffer)
-        # Only pixels whose rays can meet a bounding sphere run the shader (llvmpipe pays for every pixel).
-        fbo.scissor = _sphere_scissor(camera, scene, width, height)
+        # Only pixels whose rays can meet a bounding box run the shader (llvmpipe pays for every pixel).
+        fbo.scissor = _bounds_scissor(camera, scene, width, height)
         self.ctx.disable(moderngl.DEPTH_TEST)
         self._raymarch_vao[variant].render(moderngl.TRIANGLES, vertices=3)
         fbo.scissor = (0, 0, width, height)
