@@ -397,7 +397,9 @@ def _force_law(ops: _Ops, kick: _Kick, s: _Settings):
     """Acceleration terms (m/s²) as a function of velocity components and time.
 
     Returns ``terms(vx, vy, vz, t) -> (drag xyz, magnus xyz, knuckle xyz)`` (9 values) and
-    ``acceleration(vx, vy, vz, t) -> (ax, ay, az)`` including gravity. Works unchanged on floats and on arrays.
+    ``acceleration(vx, vy, vz, t) -> (ax, ay, az)`` including gravity. Works unchanged on floats and on arrays;
+    :func:`simulate_batch` steps with it on (K,) arrays, while a single flight steps with
+    :func:`_scalar_acceleration`, the same law written for floats.
     """
     q = 0.5 * s.air_density * math.pi * s.radius_m**2 / s.mass_kg  # ½ρA/m (1/m)
     g = s.gravity
@@ -445,8 +447,8 @@ def _force_law(ops: _Ops, kick: _Kick, s: _Settings):
             s1 * az1 + s2 * az2,
         )
 
-    # The integrators call this hundreds of times per flight: it repeats ``terms``' sums inline (no 9-tuple) and
-    # skips the knuckle force when it is off everywhere, which keeps a single RK4 flight under a millisecond.
+    # The batch integrator calls this every stage of every step: it repeats ``terms``' sums inline (no 9-tuple) and
+    # skips the knuckle force when it is off everywhere.
     has_knuckle = bool(np.any(kg != 0.0))
 
     drag_factor, lift_factor = -q * c_d, q * c_l
@@ -471,7 +473,10 @@ def _force_law(ops: _Ops, kick: _Kick, s: _Settings):
 
 
 def _stepper(method: Method, acceleration, dt: float):
-    """One fixed step ``(x, y, z, vx, vy, vz, t) -> (x, y, z, vx, vy, vz)``; floats or arrays alike."""
+    """One fixed step ``(x, y, z, vx, vy, vz, t) -> (x, y, z, vx, vy, vz)`` on (K,) arrays (floats work too).
+
+    :func:`_integrate_one` writes the same steps out, operation for operation, for one kick on floats.
+    """
     match method:
         case "euler":
 
@@ -503,6 +508,65 @@ def _stepper(method: Method, acceleration, dt: float):
                 )
 
             return rk4
+
+
+def _scalar_acceleration(kick: _Kick, s: _Settings) -> Callable[..., tuple[float, float, float]]:
+    """``acceleration(vx, vy, vz, t) -> (ax, ay, az)`` (m/s²) for one kick on Python floats.
+
+    The same law as :func:`_force_law`, operation for operation (so a single flight and its batch lane agree to the
+    last bits), written for the single flight's inner loop: a thousand calls per Euler flight, so the measured
+    coefficients are inlined with comparisons instead of ``min``/``max`` calls, and the knuckle force is skipped when
+    it is off.
+    """
+    q = 0.5 * s.air_density * math.pi * s.radius_m**2 / s.mass_kg  # ½ρA/m (1/m)
+    g = s.gravity
+    wx, wy, wz = kick.spin_axis
+    spin_rate = kick.spin_rate
+    kg, kr = kick.knuckle_gain, kick.knuckle_rate
+    p1, p2 = kick.knuckle_phase
+    ax1, ay1, az1 = kick.knuckle_n1
+    ax2, ay2, az2 = kick.knuckle_n2
+    has_knuckle = kg != 0.0
+    sqrt, exp, sin = math.sqrt, math.exp, math.sin
+    r = s.radius_m
+    re_per_speed = s.air_density * 2.0 * r / AIR_VISCOSITY
+    drag_factor, lift_factor = -q * s.drag_coefficient, q * s.lift_coefficient
+
+    def knuckle(ax: float, ay: float, az: float, speed: float, t: float):
+        kk = kg * speed * speed
+        s1, s2 = kk * sin(kr * t + p1), kk * sin(kr * t + p2)
+        return ax + s1 * ax1 + s2 * ax2, ay + s1 * ay1 + s2 * ay2, az + s1 * az1 + s2 * az2
+
+    match s.model:
+        case "constant":
+
+            def constant(vx: float, vy: float, vz: float, t: float):
+                speed = sqrt(vx * vx + vy * vy + vz * vz)
+                kd, kl = drag_factor * speed, lift_factor * speed
+                ax = kd * vx + kl * (wy * vz - wz * vy)
+                ay = kd * vy + kl * (wz * vx - wx * vz)
+                az = kd * vz + kl * (wx * vy - wy * vx) - g
+                return knuckle(ax, ay, az, speed, t) if has_knuckle else (ax, ay, az)
+
+            return constant
+        case "measured":
+
+            def measured(vx: float, vy: float, vz: float, t: float):
+                speed = sqrt(vx * vx + vy * vy + vz * vz)
+                spin_parameter = r * spin_rate / (speed if speed > 1e-9 else 1e-9)
+                lift = 0.9 * (spin_parameter if spin_parameter < 0.3 else 0.3)
+                arg = (re_per_speed * speed - _RE_CRISIS) / _RE_WIDTH
+                still = 0.155 + 0.346 / (1.0 + exp(arg if arg < 50.0 else 50.0))
+                spinning = 0.4127 * (spin_parameter if spin_parameter > 0.05 else 0.05) ** 0.3056
+                blend = spin_parameter / 0.05
+                drag = still + (blend if blend < 1.0 else 1.0) * (spinning - still)
+                kd, kl = -q * drag * speed, q * lift * speed
+                ax = kd * vx + kl * (wy * vz - wz * vy)
+                ay = kd * vy + kl * (wz * vx - wx * vz)
+                az = kd * vz + kl * (wx * vy - wy * vx) - g
+                return knuckle(ax, ay, az, speed, t) if has_knuckle else (ax, ay, az)
+
+            return measured
 
 
 # --------------------------------------------------------------------------------------------- interpolation
@@ -648,6 +712,98 @@ def _finish(
     return position, velocity, t_old + frac[:, 0] * dt, first_ground, first_stop
 
 
+def _integrate_one(
+    p0: NDArray[np.float64],
+    v0: NDArray[np.float64],
+    acceleration: Callable[..., tuple[float, float, float]],
+    s: _Settings,
+) -> tuple[NDArray[np.float64], float, Ending]:
+    """Step one kick on Python floats until it lands, passes ``x_stop`` or runs out of time.
+
+    Each method's step is written out in its own loop (the same arithmetic as :func:`_stepper`), and the samples
+    go to one flat list: no per-step call or tuple beyond the acceleration's, which a 1 ms Euler flight of a
+    thousand steps feels.
+
+    Returns:
+        (samples (N, 6): position (m) then velocity (m/s), end time (s), why it ended).
+    """
+    dt = s.dt
+    n_steps = math.ceil(s.t_max / dt - 1e-9)
+    ground, x_stop_at = s.ground_m, math.inf if s.x_stop is None else s.x_stop
+    x, y, z = (float(c) for c in p0)
+    vx, vy, vz = (float(c) for c in v0)
+    x1, y1, z1, vx1, vy1, vz1 = x, y, z, vx, vy, vz
+    samples = [x, y, z, vx, vy, vz]
+    extend = samples.extend
+    n = 0
+    match s.method:
+        case "euler":
+            for n in range(n_steps):
+                ax, ay, az = acceleration(vx, vy, vz, n * dt)
+                vx1, vy1, vz1 = vx + ax * dt, vy + ay * dt, vz + az * dt
+                x1, y1, z1 = x + vx1 * dt, y + vy1 * dt, z + vz1 * dt
+                if z1 <= ground or x < x_stop_at <= x1:
+                    break
+                extend((x1, y1, z1, vx1, vy1, vz1))
+                x, y, z, vx, vy, vz = x1, y1, z1, vx1, vy1, vz1
+            else:
+                return _rows_of_six(samples), n_steps * dt, "t_max"
+        case "rk4":
+            half, sixth = 0.5 * dt, dt / 6.0
+            for n in range(n_steps):
+                t = n * dt
+                # The acceleration does not depend on position, so each stage's position slope is its velocity.
+                a1x, a1y, a1z = acceleration(vx, vy, vz, t)
+                v2x, v2y, v2z = vx + half * a1x, vy + half * a1y, vz + half * a1z
+                a2x, a2y, a2z = acceleration(v2x, v2y, v2z, t + half)
+                v3x, v3y, v3z = vx + half * a2x, vy + half * a2y, vz + half * a2z
+                a3x, a3y, a3z = acceleration(v3x, v3y, v3z, t + half)
+                v4x, v4y, v4z = vx + dt * a3x, vy + dt * a3y, vz + dt * a3z
+                a4x, a4y, a4z = acceleration(v4x, v4y, v4z, t + dt)
+                x1 = x + sixth * (vx + 2.0 * (v2x + v3x) + v4x)
+                y1 = y + sixth * (vy + 2.0 * (v2y + v3y) + v4y)
+                z1 = z + sixth * (vz + 2.0 * (v2z + v3z) + v4z)
+                vx1 = vx + sixth * (a1x + 2.0 * (a2x + a3x) + a4x)
+                vy1 = vy + sixth * (a1y + 2.0 * (a2y + a3y) + a4y)
+                vz1 = vz + sixth * (a1z + 2.0 * (a2z + a3z) + a4z)
+                if z1 <= ground or x < x_stop_at <= x1:
+                    break
+                extend((x1, y1, z1, vx1, vy1, vz1))
+                x, y, z, vx, vy, vz = x1, y1, z1, vx1, vy1, vz1
+            else:
+                return _rows_of_six(samples), n_steps * dt, "t_max"
+
+    # The last step crossed the ground or the stop plane: end on whichever the cubic through it reaches first.
+    hit_ground, hit_stop = z1 <= ground, x < x_stop_at <= x1
+    fraction_ground = (
+        _crossing_fraction(_FLOAT_OPS, z - ground, vz, z1 - ground, vz1, dt)
+        if hit_ground
+        else math.inf
+    )
+    fraction_stop = (
+        _crossing_fraction(_FLOAT_OPS, x - x_stop_at, vx, x1 - x_stop_at, vx1, dt)
+        if hit_stop
+        else math.inf
+    )
+    ended: Ending = "ground" if fraction_ground <= fraction_stop else "x_stop"
+    f = min(fraction_ground, fraction_stop)
+    (x1, vx1), (y1, vy1), (z1, vz1) = (
+        _hermite(a, va, b, vb, dt, f)
+        for a, va, b, vb in ((x, vx, x1, vx1), (y, vy, y1, vy1), (z, vz, z1, vz1))
+    )
+    if ended == "ground":
+        z1 = ground
+    else:
+        x1 = x_stop_at
+    extend((x1, y1, z1, vx1, vy1, vz1))
+    return _rows_of_six(samples), (n + f) * dt, ended
+
+
+def _rows_of_six(samples: list[float]) -> NDArray[np.float64]:
+    """(N, 6) array of a flat list of floats (``fromiter`` reads a list of floats faster than ``array``)."""
+    return np.fromiter(samples, np.float64, len(samples)).reshape(-1, 6)
+
+
 def simulate(
     position: ArrayLike,
     velocity: ArrayLike,
@@ -712,57 +868,12 @@ def simulate(
     )
     seed = _seed("knuckle_seed", knuckle_seed)
     kick_array = _kick_constants(v0[None], w0[None], [seed], s)
-    _, acceleration = _force_law(_FLOAT_OPS, _scalar_kick(kick_array), s)
-    step = _stepper(s.method, acceleration, s.dt)
-
-    x, y, z = (float(c) for c in p0)
-    vx, vy, vz = (float(c) for c in v0)
-    xs, ys, zs, vxs, vys, vzs = [x], [y], [z], [vx], [vy], [vz]
-    n_steps = math.ceil(s.t_max / s.dt - 1e-9)
-    ground, x_stop_at = s.ground_m, math.inf if s.x_stop is None else s.x_stop
-    ended: Ending = "t_max"
-    t_end = n_steps * s.dt
-    for n in range(n_steps):
-        x1, y1, z1, vx1, vy1, vz1 = step(x, y, z, vx, vy, vz, n * s.dt)
-        hit_ground, hit_stop = z1 <= ground, x < x_stop_at <= x1
-        if hit_ground or hit_stop:
-            # End on the ground or the stop plane, whichever the cubic through the last step reaches first.
-            fraction_ground = (
-                _crossing_fraction(_FLOAT_OPS, z - ground, vz, z1 - ground, vz1, s.dt)
-                if hit_ground
-                else math.inf
-            )
-            fraction_stop = (
-                _crossing_fraction(_FLOAT_OPS, x - x_stop_at, vx, x1 - x_stop_at, vx1, s.dt)
-                if hit_stop
-                else math.inf
-            )
-            ended = "ground" if fraction_ground <= fraction_stop else "x_stop"
-            f = min(fraction_ground, fraction_stop)
-            (x1, vx1), (y1, vy1), (z1, vz1) = (
-                _hermite(a, va, b, vb, s.dt, f)
-                for a, va, b, vb in ((x, vx, x1, vx1), (y, vy, y1, vy1), (z, vz, z1, vz1))
-            )
-            if ended == "ground":
-                z1 = ground
-            else:
-                x1 = x_stop_at
-            t_end = (n + f) * s.dt
-        xs.append(x1)
-        ys.append(y1)
-        zs.append(z1)
-        vxs.append(vx1)
-        vys.append(vy1)
-        vzs.append(vz1)
-        if ended != "t_max":
-            break
-        x, y, z, vx, vy, vz = x1, y1, z1, vx1, vy1, vz1
-
-    t = np.arange(len(xs), dtype=np.float64) * s.dt
+    samples, t_end, ended = _integrate_one(
+        p0, v0, _scalar_acceleration(_scalar_kick(kick_array), s), s
+    )
+    t = np.arange(len(samples), dtype=np.float64) * s.dt
     t[-1] = t_end
-    positions = np.column_stack((xs, ys, zs))
-    velocities = np.column_stack((vxs, vys, vzs))
-    return _with_forces(t, positions, velocities, kick_array, s, ended)
+    return _with_forces(t, samples[:, :3], samples[:, 3:], kick_array, s, ended)
 
 
 def _with_forces(
