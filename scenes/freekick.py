@@ -15,6 +15,7 @@ settings to be still for a moment so dragging a slider redraws at full speed.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import itertools
 import logging
 import math
@@ -280,20 +281,46 @@ def _fly(
 
 
 def compute_kick(p: FreeKickParams) -> KickState:
-    """Run the kernels for one parameter set (no viser: testable on its own)."""
+    """Run the kernels for one parameter set (no viser: testable on its own).
+
+    The no-spin ghost is flown once per launch and wall (:func:`_ghost_kick`): while only the spin or the knuckleball
+    settings change, as when the spin slider is dragged, it is reused rather than flown again.
+    """
     wall, goal = panels(p)
     flight = _fly(p, 1.0, knuckle=True)
-    ghost = _fly(p, 0.0, knuckle=False)
+    ghost, ghost_outcome = _ghost_kick(_without_spin(p))
     return KickState(
         flight=flight,
         ghost=ghost,
         less_spin=_fly(p, 0.9, knuckle=True, band=True),
         more_spin=_fly(p, 1.1, knuckle=True, band=True),
         outcome=ball.outcome(flight, wall, goal),
-        ghost_outcome=ball.outcome(ghost, wall, goal),
+        ghost_outcome=ghost_outcome,
         wall=wall,
         goal=goal,
     )
+
+
+def _without_spin(p: FreeKickParams) -> FreeKickParams:
+    """``p`` with its spin and knuckleball settings at their defaults: all its no-spin ghost depends on."""
+    plain = FreeKickParams()
+    return dataclasses.replace(
+        p,
+        spin_rev_s=0.0,
+        spin_axis=plain.spin_axis,
+        axis_tilt_deg=plain.axis_tilt_deg,
+        axis_turn_deg=plain.axis_turn_deg,
+        knuckle=False,
+        knuckle_seed=plain.knuckle_seed,
+    )
+
+
+@functools.lru_cache(maxsize=8)
+def _ghost_kick(p: FreeKickParams) -> tuple[ball.Trajectory, ball.Outcome]:
+    """The kick ``p`` with no spin and its outcome, kept for the last few launches (read it, never write to it)."""
+    wall, goal = panels(p)
+    ghost = _fly(p, 0.0, knuckle=False)
+    return ghost, ball.outcome(ghost, wall, goal)
 
 
 def resample(flight: ball.Trajectory, n: int = PATH_POINTS) -> NDArray[np.float64]:

@@ -86,6 +86,57 @@ def test_spin_changes_path_band_and_outcome_with_the_measured_model(scene: FreeK
     assert np.abs(drawn_path(scene) - before).max() > 1.0
 
 
+def _kernel_flight(
+    speed_ms: float, spin_rev_s: float, method: ball.Method, dt: float, model: ball.Model
+) -> ball.Trajectory:
+    """The default spot's kick (22 m out, 17° up, 9° right, sidespin about +z) straight from the kernel."""
+    return ball.simulate(
+        (-22.0, 0.0, ball.BALL_RADIUS_M),
+        ball.launch_velocity(speed_ms, math.radians(17.0), math.radians(-9.0)),
+        ball.spin_vector(spin_rev_s, (0.0, 0.0, 1.0)),
+        dt=dt,
+        method=method,
+        model=model,
+        t_max=4.0,
+        x_stop=2.0,
+        ground_m=ball.BALL_RADIUS_M,
+    )
+
+
+@pytest.mark.parametrize(
+    ("integrator", "method", "dt"),
+    [("RK4, 10 ms", "rk4", 1e-2), ("Euler, 1 ms (seed)", "euler", 1e-3)],
+)
+@pytest.mark.parametrize(
+    "model_label", ["Constant C_D = C_L = 0.25 (seed)", "Measured C_D(Re, S), C_L(S)"]
+)
+def test_drawn_path_ghost_and_band_are_the_kernels_flights(
+    scene: FreeKickScene, integrator: str, method: ball.Method, dt: float, model_label: str
+) -> None:
+    model: ball.Model = "measured" if model_label.startswith("Measured") else "constant"
+    scene.integrator.value = integrator
+    scene.model.value = model_label
+    # A spin change keeps the no-spin ghost; a speed change flies it again. Both must draw the kernel's flights.
+    for speed, spin in ((25.0, 6.5), (25.0, 9.5), (27.0, 9.5)):
+        scene.speed.value = speed
+        scene.spin.value = spin
+        assert (scene.params.speed_ms, scene.params.spin_rev_s) == (speed, spin)
+        flight = _kernel_flight(speed, spin, method, dt, model)
+        np.testing.assert_array_equal(scene.state.flight.position, flight.position)
+        np.testing.assert_array_equal(drawn_path(scene), resample(flight).astype(np.float32))
+        ghost = _kernel_flight(speed, 0.0, method, dt, model)
+        np.testing.assert_array_equal(scene.state.ghost.position, ghost.position)
+        drawn_ghost = np.asarray(scene.ghost.points)
+        np.testing.assert_array_equal(
+            np.concatenate([drawn_ghost[:, 0], drawn_ghost[-1:, 1]]),
+            resample(ghost).astype(np.float32),
+        )
+        band = np.asarray(scene.band.vertices)  # the ±10 % edges fly RK4 at 20 ms
+        for edge, scale in ((band[0::2], 0.9), (band[1::2], 1.1)):
+            expected = _kernel_flight(speed, scale * spin, "rk4", 2e-2, model)
+            np.testing.assert_array_equal(edge, resample(expected).astype(np.float32))
+
+
 def test_presets_score_and_set_every_control(scene: FreeKickScene) -> None:
     for preset, button in zip(PRESETS, scene.preset_buttons, strict=True):
         button.value = True  # what a click does, server side
