@@ -178,9 +178,11 @@ def _bounding_boxes(
     extents (m).
 
     Each primitive's box in its own frame (the torus's ring lies in the local xz plane, the capsule's axis is local
-    y), grown by k + 1 mm as :func:`kernels.sdf.scene_bounding_spheres` grows the spheres: a blend reaches at most k/4
-    beyond the primitives per blend (both forms), subtraction and intersection only remove. A flat torus's box is
-    far thinner than its sphere, so fewer rays march near the shape and miss.
+    y), grown by k/4 per smooth union and 1 mm: each union's blend lies at most k/4 below the smaller distance (poly:
+    k·h(1 - h) ≤ k/4; exp: ln 2 / sharpness = k/4), and subtraction and intersection only raise the distance, so
+    every point inside the scene lies within that reach of some primitive. (The spheres of
+    :func:`kernels.sdf.scene_bounding_spheres` grow by k, the same bound with slack.) A flat torus's box is far
+    thinner than its sphere, so fewer rays march beside the shape and miss.
     """
     half = np.zeros((len(scene.primitives), 3))
     for i, prim in enumerate(scene.primitives):
@@ -196,7 +198,8 @@ def _bounding_boxes(
                 half[i] = (s[1], s[0] + s[1], s[1])
     centers = np.array([p.center for p in scene.primitives], dtype=np.float64)
     rotations = np.array([sdf.rotation_matrix(p.rotation) for p in scene.primitives])
-    return centers, rotations, half + scene.k + 1e-3
+    unions = sum(prim.op == "union" for prim in scene.primitives[1:])
+    return centers, rotations, half + unions * scene.k / 4 + 1e-3
 
 
 def _bounds_scissor(
