@@ -531,6 +531,8 @@ def _scalar_acceleration(kick: _Kick, s: _Settings) -> Callable[..., tuple[float
     r = s.radius_m
     re_per_speed = s.air_density * 2.0 * r / AIR_VISCOSITY
     drag_factor, lift_factor = -q * s.drag_coefficient, q * s.lift_coefficient
+    # The law's leading products, precomputed as it evaluates them (left to right): the same bits.
+    r_spin_rate, minus_q = r * spin_rate, -q
 
     def knuckle(ax: float, ay: float, az: float, speed: float, t: float):
         kk = kg * speed * speed
@@ -553,14 +555,14 @@ def _scalar_acceleration(kick: _Kick, s: _Settings) -> Callable[..., tuple[float
 
             def measured(vx: float, vy: float, vz: float, t: float):
                 speed = sqrt(vx * vx + vy * vy + vz * vz)
-                spin_parameter = r * spin_rate / (speed if speed > 1e-9 else 1e-9)
+                spin_parameter = r_spin_rate / (speed if speed > 1e-9 else 1e-9)
                 lift = 0.9 * (spin_parameter if spin_parameter < 0.3 else 0.3)
                 arg = (re_per_speed * speed - _RE_CRISIS) / _RE_WIDTH
                 still = 0.155 + 0.346 / (1.0 + exp(arg if arg < 50.0 else 50.0))
                 spinning = 0.4127 * (spin_parameter if spin_parameter > 0.05 else 0.05) ** 0.3056
                 blend = spin_parameter / 0.05
                 drag = still + (blend if blend < 1.0 else 1.0) * (spinning - still)
-                kd, kl = -q * drag * speed, q * lift * speed
+                kd, kl = minus_q * drag * speed, q * lift * speed
                 ax = kd * vx + kl * (wy * vz - wz * vy)
                 ay = kd * vy + kl * (wz * vx - wx * vz)
                 az = kd * vz + kl * (wx * vy - wy * vx) - g
@@ -1074,9 +1076,12 @@ def _plane_crossing(
     rows = np.arange(len(d))
     h = t[rows, k + 1] - t[rows, k]
     h = np.where(h > 0.0, h, 1.0)
-    frac = _crossing_fraction(
-        _ARRAY_OPS, d[rows, k], dd[rows, k], d[rows, k + 1], dd[rows, k + 1], h
-    )
+    ends = (d[rows, k], dd[rows, k], d[rows, k + 1], dd[rows, k + 1], h)
+    # One flight (``outcome``): the Newton steps cost far less on floats than on (1,) arrays; same arithmetic.
+    if len(d) == 1:
+        frac = np.array([_crossing_fraction(_FLOAT_OPS, *(float(end[0]) for end in ends))])
+    else:
+        frac = _crossing_fraction(_ARRAY_OPS, *ends)
     point, _ = _hermite(
         position[rows, k],
         velocity[rows, k],
