@@ -391,7 +391,7 @@ def _finite_array(name: str, value: ArrayLike) -> NDArray[np.float64]:
         array = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError) as error:
         raise ValueError(f"{name} must be an array of numbers, got {value!r}") from error
-    if not np.all(np.isfinite(array)):
+    if not np.isfinite(array).all():
         raise ValueError(f"{name} must be finite, got {value!r}")
     return array
 
@@ -790,18 +790,26 @@ def _deflect_one(
     """:func:`_deflect` for one chain; ``obstacles`` are its live ones as (centre, radius)."""
     turned = False
     three = len(anchor) == 3
+    ax, ay = anchor[0], anchor[1]
+    az = anchor[2] if three else 0.0
     for _ in range(3):
+        # Written out, in the order numpy sums over the d axis, so the bits match the batch path; this test runs
+        # for every segment and obstacle of every pass, so it is kept to plain float arithmetic.
         hits = []
+        vx, vy = v[0], v[1]
+        vz = v[2] if three else 0.0
         for k, (centre, radius) in enumerate(obstacles):
-            # Written out, in the order numpy sums over the d axis, so the bits match the batch path.
-            rx, ry = centre[0] - anchor[0], centre[1] - anchor[1]
-            along = rx * v[0] + ry * v[1]
-            rel2 = rx * rx + ry * ry
+            rx, ry = centre[0] - ax, centre[1] - ay
             if three:
-                rz = centre[2] - anchor[2]
-                along = along + rz * v[2]
-                rel2 = rel2 + rz * rz
-            t = min(max(along, 0.0), length)
+                rz = centre[2] - az
+                along = rx * vx + ry * vy + rz * vz
+                rel2 = rx * rx + ry * ry + rz * rz
+            else:
+                along = rx * vx + ry * vy
+                rel2 = rx * rx + ry * ry
+            t = along if along > 0.0 else 0.0
+            if t > length:
+                t = length
             if rel2 - 2.0 * t * along + t * t < radius * radius:
                 hits.append(k)
         if not hits:
@@ -1025,25 +1033,33 @@ def _cone_ok(chains: _Chains, setup: _Setup) -> NDArray[np.bool_]:
     return ok
 
 
-def _colliding(p: NDArray[np.float64], setup: _Setup, live: NDArray[np.bool_]) -> NDArray[np.bool_]:
-    """(B,) whether any segment of the (n + 1, d, B) chains passes through a live obstacle."""
+def _colliding(
+    p: NDArray[np.float64],
+    setup: _Setup,
+    live: NDArray[np.bool_],
+    radii: NDArray[np.float64] | None = None,
+) -> NDArray[np.bool_]:
+    """(B,) whether any segment of the (n + 1, d, B) chains passes through a live obstacle.
+
+    ``radii`` (K, 1) replace the obstacles' own radii when given.
+    """
     batch = p.shape[2]
+    radii = setup.radii if radii is None else radii
     if setup.radii.shape[0] == 0:
         return np.zeros(batch, dtype=bool)
     start = p[:-1, None]  # (n, 1, d, B)
     seg = (p[1:] - p[:-1])[:, None]
     rel = setup.centres[None] - start  # (n, K, d, B)
     seg2 = _dot_d(seg, seg)
-    t = np.clip(_dot_d(rel, seg) / np.where(seg2 > 0.0, seg2, 1.0), 0.0, 1.0)
+    t = np.minimum(np.maximum(_dot_d(rel, seg) / np.where(seg2 > 0.0, seg2, 1.0), 0.0), 1.0)
     gap = rel - t[:, :, None] * seg
     dist2 = _dot_d(gap, gap)  # (n, K, B)
-    return np.any((dist2 < setup.radii * setup.radii) & live, axis=(0, 1))
+    return np.any((dist2 < radii * radii) & live, axis=(0, 1))
 
 
 def _touching(p: NDArray[np.float64], setup: _Setup, live: NDArray[np.bool_]) -> NDArray[np.bool_]:
     """(B,) whether a segment rests against (or cuts) a live obstacle, within 0.1 % of its radius."""
-    grown = dataclasses.replace(setup, radii=setup.radii * (1.0 + 1e-3))
-    return _colliding(p, grown, live)
+    return _colliding(p, setup, live, setup.radii * (1.0 + 1e-3))
 
 
 # ================================================================================================ driver
@@ -1266,7 +1282,7 @@ def _unbend_axis_chains(
     offset2 = distance * distance
     along = _dot_d(end, offset)
     scale2 = np.maximum(end2 * offset2, tiny * tiny)
-    if not np.any(todo & ((end2 * offset2 - along * along) <= 1e-12 * scale2)):
+    if not (todo & ((end2 * offset2 - along * along) <= 1e-12 * scale2)).any():
         return
     segments = np.diff(p, axis=0)  # (n, d, B)
     norms = _norm(segments)
