@@ -86,7 +86,9 @@ float soft_shadow(vec3 origin, vec3 dir, float t_min, float t_max, float k) {
         float d = sqrt(max(h * h - y * y, 0.0));
         result = min(result, k * d / max(1e-6, t - y));
         previous = h;
-        t += clamp(h, 0.01, 0.3);  // bounded steps, as Quilez does: no tiny crawls, no skipped thin parts
+        // Bounded steps, as Quilez does: no tiny crawls, no skipped thin parts. At least 2 cm: with 1 cm, rays in
+        // creases crawled to the 32-step cap; 2 cm takes an eighth fewer steps, the image the same to a few levels.
+        t += clamp(h, 0.02, 0.3);
     }
     return clamp(result, 0.0, 1.0);
 }
