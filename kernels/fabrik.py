@@ -784,10 +784,14 @@ def _deflect_one(
     anchor: Vec,
     v: Vec,
     length: float,
-    obstacles: list[tuple[Vec, float]],
+    obstacles: list[tuple[Vec, float, float]],
     tiny: float,
 ) -> tuple[Vec, bool]:
-    """:func:`_deflect` for one chain; ``obstacles`` are its live ones as (centre, radius)."""
+    """:func:`_deflect` for one chain; ``obstacles`` are its live ones as (centre, radius, far²).
+
+    ``far²`` is a squared distance from the anchor beyond which no segment of the chain can reach the obstacle
+    (with a 1 % margin, so rounding never skips a hit the batch path would see): most pairs stop there.
+    """
     turned = False
     three = len(anchor) == 3
     ax, ay = anchor[0], anchor[1]
@@ -798,15 +802,19 @@ def _deflect_one(
         hits = []
         vx, vy = v[0], v[1]
         vz = v[2] if three else 0.0
-        for k, (centre, radius) in enumerate(obstacles):
+        for k, (centre, radius, far2) in enumerate(obstacles):
             rx, ry = centre[0] - ax, centre[1] - ay
             if three:
                 rz = centre[2] - az
-                along = rx * vx + ry * vy + rz * vz
                 rel2 = rx * rx + ry * ry + rz * rz
+                if rel2 > far2:
+                    continue
+                along = rx * vx + ry * vy + rz * vz
             else:
-                along = rx * vx + ry * vy
                 rel2 = rx * rx + ry * ry
+                if rel2 > far2:
+                    continue
+                along = rx * vx + ry * vy
             t = along if along > 0.0 else 0.0
             if t > length:
                 t = length
@@ -861,8 +869,9 @@ def _fabrik_step_one(chains: _Chains, setup: _Setup) -> None:
     lengths: Vec = chains.lengths[:, 0].tolist()
     tiny = float(chains.tiny[0])
     live: list[bool] = chains.obstacle_live[:, 0].tolist()
+    longest = max(lengths)
     obstacles = [
-        (centre, radius)
+        (centre, radius, 1.01 * (longest + radius) * (longest + radius))
         for centre, radius, alive in zip(
             setup.centres[:, :, 0].tolist(), setup.radii[:, 0].tolist(), live, strict=True
         )
