@@ -317,9 +317,14 @@ def _without_spin(p: FreeKickParams) -> FreeKickParams:
 
 @functools.lru_cache(maxsize=8)
 def _ghost_kick(p: FreeKickParams) -> tuple[ball.Trajectory, ball.Outcome]:
-    """The kick ``p`` with no spin and its outcome, kept for the last few launches (read it, never write to it)."""
+    """The kick ``p`` with no spin and its outcome, kept for the last few launches (its arrays are read-only)."""
     wall, goal = panels(p)
     ghost = _fly(p, 0.0, knuckle=False)
+    # Shared by every state of this launch: a write would corrupt them all, so refuse it.
+    for field in dataclasses.fields(ghost):
+        value = getattr(ghost, field.name)
+        if isinstance(value, np.ndarray):
+            value.flags.writeable = False
     return ghost, ball.outcome(ghost, wall, goal)
 
 
