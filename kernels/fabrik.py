@@ -1151,7 +1151,12 @@ def _run(
         if extrapolate:
             trusted &= ~(moved & (error > last_error))
         if has_obstacles:
-            clear = ~_colliding(active.p, setup, active.obstacle_live)
+            # Whether the pose is clear matters only where it would be the best yet or reach the target.
+            improved = (error < best_error_active) | (error < setup.tolerance)
+            if improved.any():
+                clear = ~_colliding(active.p, setup, active.obstacle_live)
+            else:
+                clear = improved
             better = clear & (error < best_error_active)
             if better.any():
                 best_p_active[:, :, better] = active.p[:, :, better]
@@ -1173,12 +1178,14 @@ def _run(
             use_best = ~reached[finished] & np.isfinite(best_error_active[finished])
             final = np.where(use_best, best_p_active[:, :, finished], active.p[:, :, finished])
             out_p[:, :, rows] = final
-            live_rows = active.obstacle_live[:, finished]
-            blocked = ~reached[finished] & (
-                _touching(final, setup, live_rows)
-                | _target_inside(active.target[:, finished], setup, live_rows)
-            )
-            status[rows] = np.where(blocked, _BLOCKED, status[rows])
+            short = ~reached[finished]
+            if short.any():
+                live_rows = active.obstacle_live[:, finished]
+                blocked = short & (
+                    _touching(final, setup, live_rows)
+                    | _target_inside(active.target[:, finished], setup, live_rows)
+                )
+                status[rows] = np.where(blocked, _BLOCKED, status[rows])
         else:
             out_p[:, :, rows] = active.p[:, :, finished]
         keep = ~finished
