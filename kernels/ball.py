@@ -893,9 +893,11 @@ def _with_forces(
     n = len(t)
 
     def stack(a: Any, b: Any, c: Any) -> NDArray[np.float64]:
-        return m * np.column_stack(
-            [np.broadcast_to(np.asarray(part, dtype=np.float64), (n,)) for part in (a, b, c)]
-        )
+        """(n, 3) force from three acceleration components, each (n,) or a scalar (broadcast)."""
+        force = np.empty((n, 3))
+        force[:, 0], force[:, 1], force[:, 2] = a, b, c
+        force *= m
+        return force
 
     gravity = np.zeros((n, 3))
     gravity[:, 2] = -m * s.gravity
