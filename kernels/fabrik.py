@@ -138,6 +138,7 @@ def solve(
     cone_half_angle_rad: float | None = None,
     obstacles: Sequence[Obstacle] = (),
     root_direction: ArrayLike | None = None,
+    extrapolate: bool = True,
 ) -> Solution:
     """Solve one chain with FABRIK.
 
@@ -151,6 +152,8 @@ def solve(
         obstacles: circles (2D) or spheres (3D) as ``(centre (d,), radius)`` no segment may pass through.
         root_direction: (d,) rest direction of the root, the axis of the first segment's cone. Default: +y in 2D
             (the plane's up), +z in 3D.
+        extrapolate: move slowly converging iterates on along their last step (see :func:`_extrapolate`); False
+            gives plain FABRIK as the paper writes it.
 
     Returns:
         The :class:`Solution`.
@@ -169,6 +172,7 @@ def solve(
         cone_half_angle_rad=cone_half_angle_rad,
         obstacles=obstacles,
         root_direction=root_direction,
+        extrapolate=extrapolate,
     )[0]
 
 
@@ -182,6 +186,7 @@ def solve_batch(
     obstacles: Sequence[Obstacle] = (),
     root_direction: ArrayLike | None = None,
     solver: Solver = "fabrik",
+    extrapolate: bool = True,
 ) -> BatchSolution:
     """Solve B chains at once, vectorised over the batch; each chain stops on its own.
 
@@ -194,6 +199,7 @@ def solve_batch(
         obstacles: as in :func:`solve`, shared by every chain.
         root_direction: as in :func:`solve`, shared by every chain.
         solver: "fabrik", "ccd" or "jacobian_dls".
+        extrapolate: as in :func:`solve` (FABRIK only).
 
     Returns:
         The :class:`BatchSolution`; ``result[i]`` is chain i's :class:`Solution`.
@@ -227,7 +233,9 @@ def solve_batch(
             raise ValueError(
                 f"solver must be one of 'fabrik', 'ccd', 'jacobian_dls', got {solver!r}"
             )
-    return _run(chains, points, setup, step, shortcut=shortcut, extrapolate=shortcut)
+    return _run(
+        chains, points, setup, step, shortcut=shortcut, extrapolate=shortcut and extrapolate
+    )
 
 
 def ccd(

@@ -350,6 +350,29 @@ def test_dragged_target_near_the_cone_limits_is_followed_in_few_iterations() -> 
     assert worst <= 10
 
 
+def test_plain_fabrik_is_still_available_and_slower_near_the_limits() -> None:
+    """``extrapolate=False`` is FABRIK as the paper writes it: same guarantees, more iterations where limits bind."""
+    n, link, phi = 12, 0.1, math.radians(30.0)
+    angles = 0.15 * np.arange(n)
+    steps = link * np.stack([np.sin(angles), np.zeros(n), np.cos(angles)], axis=1)
+    start = np.vstack([np.zeros(3), np.cumsum(steps, axis=0)])
+    totals = {}
+    for extrapolate in (True, False):
+        pose, total = start, 0
+        for k in range(0, 260, 4):
+            s = 2.0 * math.pi * k / 500
+            target = np.array(
+                [0.45 * math.sin(s), 0.25 * math.sin(2 * s), 0.75 + 0.2 * math.cos(s)]
+            )
+            result = fabrik.solve(pose, target, cone_half_angle_rad=phi, extrapolate=extrapolate)
+            assert np.all(fabrik.joint_angles(result.joints) <= phi + 1e-6)
+            np.testing.assert_allclose(fabrik.link_lengths(result.joints), link, rtol=1e-9)
+            total += result.iterations
+            pose = result.joints
+        totals[extrapolate] = total
+    assert totals[True] < totals[False]
+
+
 @pytest.mark.parametrize("d", [2, 3])
 def test_targets_the_limits_put_out_of_reach_settle_unreachable_before_the_cap(d: int) -> None:
     joints = np.zeros((7, d))
