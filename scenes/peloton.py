@@ -9,6 +9,7 @@ never re-adds a node.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from typing import Literal
 
@@ -147,6 +148,39 @@ def compute_line(p: PelotonParams) -> LineState:
     power = cycling.power(np.full(n, speed), cda, **common)
     solo = cycling.power(speed, p.cda_m2, **common)
     return LineState(reduction=reduction, cda_m2=cda, power=power, solo=solo)
+
+
+# The solo rider's curve and speed-at-power depend on neither the speed nor the line: moving the speed slider (the
+# control people move most) reuses them.
+_SoloKey = tuple[float, float, float, float, float, float, float]
+
+
+def _solo_key(p: PelotonParams) -> _SoloKey:
+    return (p.cda_m2, p.mass_kg, p.crr, p.grade_pct, p.altitude_m, p.headwind_ms, p.drivetrain_pct)
+
+
+@functools.lru_cache(maxsize=64)
+def _solo_curves(key: _SoloKey) -> tuple[np.ndarray, ...]:
+    """(speeds in km/h, aero, rolling, climbing, total) of one rider from 0 to 80 km/h, for the chart."""
+    cda, mass, crr, grade_pct, altitude, wind, drivetrain_pct = key
+    speeds_kmh = np.linspace(0.0, 80.0, 161)
+    solo = cycling.power(
+        speeds_kmh / 3.6, cda, mass, crr, grade_pct / 100.0, altitude, wind, drivetrain_pct / 100.0
+    )
+    curves = (speeds_kmh, solo.aero, solo.rolling, solo.climbing, solo.total)
+    for curve in curves:
+        curve.setflags(write=False)  # shared between calls
+    return curves
+
+
+@functools.lru_cache(maxsize=64)
+def _solo_speed(key: _SoloKey, power_w: float) -> float:
+    cda, mass, crr, grade_pct, altitude, wind, drivetrain_pct = key
+    return float(
+        cycling.speed_for_power(
+            power_w, cda, mass, crr, grade_pct / 100.0, altitude, wind, drivetrain_pct / 100.0
+        )
+    )
 
 
 # --------------------------------------------------------------------------------------------- geometry
@@ -537,14 +571,10 @@ time-averaged power is the mean over positions, far below the leader's.
     # ----------------------------------------------------------------------------------------- drawing
     def _chart_data(self) -> tuple[np.ndarray, ...]:
         p = self.params
-        speeds_kmh = np.linspace(0.0, 80.0, 161)
-        solo = cycling.power(
-            speeds_kmh / 3.6, p.cda_m2, p.mass_kg, p.crr, p.grade_pct / 100.0, p.altitude_m, p.headwind_ms,
-            p.drivetrain_pct / 100.0,
-        )  # fmt: skip
+        speeds_kmh, aero, rolling, climbing, total = _solo_curves(_solo_key(p))
         now = np.full_like(speeds_kmh, np.nan)
         now[int(np.argmin(np.abs(speeds_kmh - p.speed_kmh)))] = float(self.state.solo.total)
-        return speeds_kmh, solo.aero, solo.rolling, solo.climbing, solo.total, now
+        return speeds_kmh, aero, rolling, climbing, total, now
 
     def _slot_of_rider(self) -> tuple[np.ndarray, np.ndarray]:
         """(x, y) of each rider now: the plain line, or mid-rotation when the lead rotates."""
@@ -616,17 +646,23 @@ time-averaged power is the mean over positions, far below the leader's.
                 ).astype(np.float32)
                 base = base + height
             for i, label in enumerate(self.labels):
-                label.visible = i < n
+                # Only write what changed: every property write is a message to every browser.
+                if label.visible != (i < n):
+                    label.visible = i < n
                 if i < n:
                     watts = float(total[slots[i]])
                     solo = float(state.solo.total)
                     share = (
                         f"{100.0 * watts / solo:.0f} % of solo" if solo > 0 else "solo needs 0 W"
                     )
-                    label.text = f"{watts:.0f} W · {share}"
+                    text = f"{watts:.0f} W · {share}"
+                    if label.text != text:
+                        label.text = text
                     label.position = (x[i], y[i], 1.95 + base[i])
 
-            self.rotation.content = self._rotation_markdown()
+            rotation = self._rotation_markdown()
+            if self.rotation.content != rotation:
+                self.rotation.content = rotation
             if readouts:
                 self._draw_wind()
                 self.density.content = self._density_markdown()
@@ -696,12 +732,7 @@ time-averaged power is the mean over positions, far below the leader's.
 
     def _speed_markdown(self) -> str:
         p = self.params
-        v = float(
-            cycling.speed_for_power(
-                p.target_power_w, p.cda_m2, p.mass_kg, p.crr, p.grade_pct / 100.0, p.altitude_m, p.headwind_ms,
-                p.drivetrain_pct / 100.0,
-            )
-        )  # fmt: skip
+        v = _solo_speed(_solo_key(p), p.target_power_w)
         text = f"Riding alone, {p.target_power_w:.0f} W ({p.target_power_w / p.mass_kg:.2f} W/kg of system mass) holds **{3.6 * v:.1f} km/h** here"
         if v > 0.1:
             minutes, seconds = divmod(round(40_000.0 / v), 60)
