@@ -45,7 +45,9 @@ Model and method:
   the same result.
 * Speed: a batch runs each pass as a handful of numpy operations on (d, B) blocks. A single chain (B = 1) runs its
   FABRIK passes on Python floats instead, in the same operation order, so it gives the same bits several times
-  faster than numpy calls on arrays of one.
+  faster than numpy calls on arrays of one; :func:`solve` also runs its set-up, collision and cone checks and
+  bookkeeping that way (its own driver, same bits, iterations and status as a batch of one), handing only the rare
+  cases (a target outside the annulus, a zero-length link, a straight chain aimed along itself) to the batch driver.
 """
 
 from __future__ import annotations
@@ -164,16 +166,15 @@ def solve(
     """
     chain = _check_joints("joints", joints, batched=False)
     point = _check_vector("target", target, chain.shape[1])
-    return solve_batch(
-        chain[None],
-        point[None],
+    setup = _Setup.build(
+        dim=chain.shape[1],
         tolerance=tolerance,
         max_iterations=max_iterations,
         cone_half_angle_rad=cone_half_angle_rad,
         obstacles=obstacles,
         root_direction=root_direction,
-        extrapolate=extrapolate,
-    )[0]
+    )
+    return _run_one(chain, point, setup, extrapolate=extrapolate)
 
 
 def solve_batch(
@@ -872,25 +873,54 @@ def _turn_clear_one(
     return [x / norm for x in turned]
 
 
-def _fabrik_step_one(chains: _Chains, setup: _Setup) -> None:
-    """:func:`_forward_pass` then :func:`_backward_pass` for a batch of one chain, on Python floats."""
-    p: list[Vec] = chains.p[:, :, 0].tolist()
-    lengths: Vec = chains.lengths[:, 0].tolist()
-    tiny = float(chains.tiny[0])
-    live: list[bool] = chains.obstacle_live[:, 0].tolist()
+def _live_obstacles_one(
+    setup: _Setup, live: list[bool], lengths: Vec
+) -> list[tuple[Vec, float, float]]:
+    """The live obstacles of one chain as :func:`_deflect_one` takes them: (centre, radius, far²)."""
     longest = max(lengths)
-    obstacles = [
+    return [
         (centre, radius, 1.01 * (longest + radius) * (longest + radius))
         for centre, radius, alive in zip(
             setup.centres[:, :, 0].tolist(), setup.radii[:, 0].tolist(), live, strict=True
         )
         if alive
     ]
-    root_direction: Vec = setup.root_direction[:, 0].tolist()
-    limits, has_obstacles, zero_links = setup.limits, bool(obstacles), chains.has_zero_link
+
+
+def _fabrik_step_one(chains: _Chains, setup: _Setup) -> None:
+    """:func:`_forward_pass` then :func:`_backward_pass` for a batch of one chain, on Python floats."""
+    p: list[Vec] = chains.p[:, :, 0].tolist()
+    lengths: Vec = chains.lengths[:, 0].tolist()
+    live: list[bool] = chains.obstacle_live[:, 0].tolist()
+    _fabrik_passes_one(
+        p,
+        chains.target[:, 0].tolist(),
+        lengths,
+        float(chains.tiny[0]),
+        _live_obstacles_one(setup, live, lengths),
+        setup.root_direction[:, 0].tolist(),
+        setup.limits,
+        zero_links=chains.has_zero_link,
+    )
+    chains.p[:, :, 0] = p
+
+
+def _fabrik_passes_one(
+    p: list[Vec],
+    target: Vec,
+    lengths: Vec,
+    tiny: float,
+    obstacles: list[tuple[Vec, float, float]],
+    root_direction: Vec,
+    limits: tuple[float, float] | None,
+    *,
+    zero_links: bool,
+) -> None:
+    """The forward then the backward pass of one chain ``p`` (n + 1 joints as lists), in place."""
+    has_obstacles = bool(obstacles)
     n = len(lengths)
 
-    p[n] = chains.target[:, 0].tolist()
+    p[n] = list(target)
     previous, _ = _unit_one(
         [a - b for a, b in zip(p[0], p[n], strict=True)], [-x for x in root_direction], tiny
     )
@@ -918,7 +948,6 @@ def _fabrik_step_one(chains: _Chains, setup: _Setup) -> None:
         p[i] = [a + lengths[i - 1] * x for a, x in zip(anchor, direction, strict=True)]
         if not zero_links or lengths[i - 1] > tiny:
             previous = direction
-    chains.p[:, :, 0] = p
 
 
 def _rotate_2d(
@@ -1218,6 +1247,175 @@ def _run(
         status=np.array(STATUSES)[status],
         error_history=history,
     )
+
+
+def _run_one(
+    joints: NDArray[np.float64], target: NDArray[np.float64], setup: _Setup, *, extrapolate: bool
+) -> Solution:
+    """:func:`_run` with FABRIK for one chain, on Python floats: the same operations in the same order, so the
+    same bits, iterations and status, without numpy's per-call cost on arrays of one.
+
+    The rare cases (a target outside the annulus, a zero-length link, a straight chain pointing at its target) go
+    to :func:`_run` itself.
+    """
+    p: list[Vec] = joints.tolist()
+    goal: Vec = target.tolist()
+    n = len(p) - 1
+    lengths = [
+        _length([a - b for a, b in zip(q, r, strict=True)]) for q, r in zip(p[1:], p, strict=False)
+    ]
+    # Summed by numpy, as _run sums it (pairwise, not left to right), so the reach tests agree to the bit.
+    total = float(np.add.reduce(np.array(lengths)[:, None], axis=0)[0])
+    offset = [a - b for a, b in zip(goal, p[0], strict=True)]
+    distance = _length(offset)
+    tiny = _TINY * max(max(total, distance), 1.0)
+    inner = max(0.0, 2.0 * max(lengths) - total)
+    end = [a - b for a, b in zip(p[n], p[0], strict=True)]
+    end2 = _dot(end, end)
+    offset2 = distance * distance
+    along = _dot(end, offset)
+    on_line = (end2 * offset2 - along * along) <= 1e-12 * max(end2 * offset2, tiny * tiny)
+    if distance > total or distance < inner or min(lengths) <= tiny or on_line:
+        return _run(
+            joints[None], target[None], setup, _fabrik_step, shortcut=True, extrapolate=extrapolate
+        )[0]
+
+    centres: list[Vec] = setup.centres[:, :, 0].tolist()
+    radii: list[float] = setup.radii[:, 0].tolist()
+    root = p[0]
+    live = [
+        _length([c - r for c, r in zip(centre, root, strict=True)]) > radius
+        for centre, radius in zip(centres, radii, strict=True)
+    ]
+    obstacles = _live_obstacles_one(setup, live, lengths)
+    has_obstacles = bool(radii)
+    root_direction: Vec = setup.root_direction[:, 0].tolist()
+    limits, tolerance = setup.limits, setup.tolerance
+
+    error0 = _length([a - b for a, b in zip(p[n], goal, strict=True)])
+    history = [error0]
+    valid0 = _cone_ok_one(p, lengths, root_direction, limits) and not _colliding_one(
+        p, obstacles, 1.0
+    )
+    if valid0 and error0 < tolerance:
+        return _solution_one(p, goal, 0, _REACHED, history)
+
+    best_p, best_error = [list(q) for q in p], error0 if valid0 else math.inf
+    stall = _STALL * tolerance + tiny
+    previous_p = p
+    trusted, moved = True, False
+    for iteration in range(1, setup.max_iterations + 1):
+        last_error = history[iteration - 1]
+        if extrapolate and iteration >= 2:
+            before = [list(q) for q in p]
+            if iteration >= 3:
+                moved = _extrapolate_one(p, previous_p, last_error, history[iteration - 2], trusted)
+            previous_p = before
+        _fabrik_passes_one(
+            p, goal, lengths, tiny, obstacles, root_direction, limits, zero_links=False
+        )
+        error = _length([a - b for a, b in zip(p[n], goal, strict=True)])
+        history.append(error)
+        if extrapolate:
+            trusted = trusted and not (moved and error > last_error)
+        if has_obstacles:
+            improved = error < best_error or error < tolerance
+            clear = improved and not _colliding_one(p, obstacles, 1.0)
+            if clear and error < best_error:
+                best_p, best_error = [list(q) for q in p], error
+            reached = clear and error < tolerance
+        else:
+            reached = error < tolerance
+        stalled = abs(last_error - error) < stall
+        if not (reached or stalled or iteration == setup.max_iterations):
+            continue
+        status = _REACHED if reached else _UNREACHABLE if stalled else _MAX_ITERATIONS
+        final = p
+        if has_obstacles and not reached:
+            if math.isfinite(best_error):
+                final = best_p
+            inside = any(
+                _length([c - t for c, t in zip(centre, goal, strict=True)]) < radius
+                for centre, radius, _ in obstacles
+            )
+            if inside or _colliding_one(final, obstacles, 1.0 + 1e-3):
+                status = _BLOCKED
+        return _solution_one(final, goal, iteration, status, history)
+    raise AssertionError("unreachable: the last iteration always finishes")  # pragma: no cover
+
+
+def _solution_one(p: list[Vec], goal: Vec, iterations: int, status: int, history: Vec) -> Solution:
+    return Solution(
+        joints=np.array(p),
+        iterations=iterations,
+        error=_length([a - b for a, b in zip(p[-1], goal, strict=True)]),
+        status=STATUSES[status],
+        error_history=np.array(history),
+    )
+
+
+def _cone_ok_one(
+    p: list[Vec], lengths: Vec, root_direction: Vec, limits: tuple[float, float] | None
+) -> bool:
+    """:func:`_cone_ok` for one chain with no zero-length link."""
+    if limits is None:
+        return True
+    bound = limits[0] - 1e-12
+    previous = root_direction
+    for i, length in enumerate(lengths):
+        direction = [(a - b) / length for a, b in zip(p[i + 1], p[i], strict=True)]
+        if not _dot(direction, previous) >= bound:
+            return False
+        previous = direction
+    return True
+
+
+def _colliding_one(p: list[Vec], obstacles: list[tuple[Vec, float, float]], inflate: float) -> bool:
+    """:func:`_colliding` (``inflate`` = 1) or :func:`_touching` (1 + 1e-3) for one chain.
+
+    ``obstacles`` are the chain's live ones as :func:`_deflect_one` takes them; a pair farther apart than ``far²``
+    (which has room for the 0.1 % inflation) cannot touch and is skipped. The rest is computed as the batch path
+    does, in the same order, so the answer is the same.
+    """
+    three = len(p[0]) == 3
+    for i in range(len(p) - 1):
+        x0, y0 = p[i][0], p[i][1]
+        sx, sy = p[i + 1][0] - x0, p[i + 1][1] - y0
+        z0 = p[i][2] if three else 0.0
+        sz = p[i + 1][2] - z0 if three else 0.0
+        seg2 = sx * sx + sy * sy + sz * sz if three else sx * sx + sy * sy
+        divisor = seg2 if seg2 > 0.0 else 1.0
+        for centre, radius, far2 in obstacles:
+            rx, ry = centre[0] - x0, centre[1] - y0
+            if three:
+                rz = centre[2] - z0
+                if rx * rx + ry * ry + rz * rz > far2:
+                    continue
+                t = min(max((rx * sx + ry * sy + rz * sz) / divisor, 0.0), 1.0)
+                gx, gy, gz = rx - t * sx, ry - t * sy, rz - t * sz
+                dist2 = gx * gx + gy * gy + gz * gz
+            else:
+                if rx * rx + ry * ry > far2:
+                    continue
+                t = min(max((rx * sx + ry * sy) / divisor, 0.0), 1.0)
+                gx, gy = rx - t * sx, ry - t * sy
+                dist2 = gx * gx + gy * gy
+            grown = radius * inflate
+            if dist2 < grown * grown:
+                return True
+    return False
+
+
+def _extrapolate_one(
+    p: list[Vec], previous_p: list[Vec], error: float, previous_error: float, trusted: bool
+) -> bool:
+    """:func:`_extrapolate` for one chain, in place."""
+    ratio = error / max(previous_error, _TINY)
+    slow = _EXTRAPOLATION_MIN_RATIO <= ratio < 1.0 and trusted
+    weight = ratio / max(1.0 - ratio, ratio / _EXTRAPOLATION_CAP) if slow else 0.0
+    for joint, before in zip(p, previous_p, strict=True):
+        joint[:] = [a + weight * (a - b) for a, b in zip(joint, before, strict=True)]
+    return slow
 
 
 def _extrapolate(

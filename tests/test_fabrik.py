@@ -213,6 +213,40 @@ def test_batch_equals_single_solves(n: int, d: int, seed: int, limits: bool) -> 
         np.testing.assert_allclose(batch[i].error_history, single.error_history, atol=1e-12)
 
 
+def test_single_solve_gives_the_batch_paths_bits_while_dragging_past_obstacles() -> None:
+    """``solve`` runs its own one-chain driver; every field must equal a batch of one, bit for bit, on every status."""
+    rng = np.random.default_rng(7)
+    angles = 0.15 * np.arange(12)
+    joints = np.vstack(
+        [np.zeros(3), np.cumsum(0.1 * np.stack([np.sin(angles), 0 * angles, np.cos(angles)], 1), 0)]
+    )
+    obstacles = [
+        (np.array([0.35, 0.0, 0.55]), 0.08),
+        (np.array([-0.3, 0.1, 0.6]), 0.1),
+        (np.array([0.0, 0.35, 0.8]), 0.07),
+        (np.array([0.3, 0.3, 0.25]), 0.09),
+        (joints[6] + 0.01, 0.05),  # cuts the starting pose
+    ]
+    kwargs: dict[str, Any] = {"cone_half_angle_rad": math.radians(30.0), "obstacles": obstacles}
+    pose, statuses = joints, set()
+    for k in range(120):
+        s = 2.0 * math.pi * k / 120
+        target = np.array([0.45 * math.sin(s), 0.25 * math.sin(2 * s), 0.75 + 0.2 * math.cos(s)])
+        if k % 10 == 0:
+            target = random_direction(rng, 3) * rng.uniform(0.0, 1.5)
+        elif k % 10 == 5:
+            target = obstacles[k % 4][0]  # inside an obstacle: "blocked"
+        single = fabrik.solve(pose, target, **kwargs)
+        batch = fabrik.solve_batch(pose[None], target[None], **kwargs)[0]
+        assert single.joints.tobytes() == batch.joints.tobytes()
+        assert single.error_history.tobytes() == batch.error_history.tobytes()
+        assert (single.iterations, single.status) == (batch.iterations, batch.status)
+        assert np.float64(single.error).tobytes() == np.float64(batch.error).tobytes()
+        statuses.add(single.status)
+        pose = single.joints
+    assert {"reached", "blocked", "unreachable"} <= statuses
+
+
 # ------------------------------------------------------------------------------------------------ degenerate input
 @pytest.mark.parametrize("d", [2, 3])
 def test_straight_chain_bends_toward_a_closer_target_on_its_axis(d: int) -> None:
