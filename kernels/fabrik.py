@@ -239,6 +239,31 @@ def solve_batch(
     )
 
 
+def _solve_one_by_batch(
+    solver: Solver,
+    joints: ArrayLike,
+    target: ArrayLike,
+    tolerance: float,
+    max_iterations: int,
+    cone_half_angle_rad: float | None,
+    obstacles: Sequence[Obstacle],
+    root_direction: ArrayLike | None,
+) -> Solution:
+    """One chain through :func:`solve_batch` (the comparison solvers have no single-chain fast path)."""
+    chain = _check_joints("joints", joints, batched=False)
+    point = _check_vector("target", target, chain.shape[1])
+    return solve_batch(
+        chain[None],
+        point[None],
+        tolerance=tolerance,
+        max_iterations=max_iterations,
+        cone_half_angle_rad=cone_half_angle_rad,
+        obstacles=obstacles,
+        root_direction=root_direction,
+        solver=solver,
+    )[0]
+
+
 def ccd(
     joints: ArrayLike,
     target: ArrayLike,
@@ -253,18 +278,16 @@ def ccd(
 
     Arguments, result and errors are those of :func:`solve`.
     """
-    chain = _check_joints("joints", joints, batched=False)
-    point = _check_vector("target", target, chain.shape[1])
-    return solve_batch(
-        chain[None],
-        point[None],
-        tolerance=tolerance,
-        max_iterations=max_iterations,
-        cone_half_angle_rad=cone_half_angle_rad,
-        obstacles=obstacles,
-        root_direction=root_direction,
-        solver="ccd",
-    )[0]
+    return _solve_one_by_batch(
+        "ccd",
+        joints,
+        target,
+        tolerance,
+        max_iterations,
+        cone_half_angle_rad,
+        obstacles,
+        root_direction,
+    )
 
 
 def jacobian_dls(
@@ -281,18 +304,16 @@ def jacobian_dls(
 
     Arguments, result and errors are those of :func:`solve`.
     """
-    chain = _check_joints("joints", joints, batched=False)
-    point = _check_vector("target", target, chain.shape[1])
-    return solve_batch(
-        chain[None],
-        point[None],
-        tolerance=tolerance,
-        max_iterations=max_iterations,
-        cone_half_angle_rad=cone_half_angle_rad,
-        obstacles=obstacles,
-        root_direction=root_direction,
-        solver="jacobian_dls",
-    )[0]
+    return _solve_one_by_batch(
+        "jacobian_dls",
+        joints,
+        target,
+        tolerance,
+        max_iterations,
+        cone_half_angle_rad,
+        obstacles,
+        root_direction,
+    )
 
 
 def two_bone(
