@@ -246,10 +246,17 @@ def speed_for_power(
 ) -> NDArray[np.float64]:
     """Steady ground speed that ``power_w`` at the pedals sustains: the inverse of :func:`power`.
 
-    P(v) is a cubic on each side of v = −w (where the air speed changes sign). With a tailwind or on a descent it
-    need not be monotone, so the equation can have several roots; the rider settles at the largest, the only
-    stable one (beyond it more speed costs more power). The roots come in closed form (Cardano, or the
-    trigonometric form when all three are real), batched, then two Newton steps polish them.
+    Write the wheel power as P(v) = v·g(v) with g(v) = a·(v + w)|v + w| + c, a = ½ρ·CdA and
+    c = m·g·cos θ·(Crr + grade) (rolling plus climbing, tan θ = grade). g rises with v, so it has one zero, the
+    coasting speed v_c = −w + sign(−c)·√(|c|/a), where the wind and the road's pull hold the rider without
+    pedalling. For P = 0 the roots are 0 and v_c, and the rider settles at the larger, max(0, v_c) (beyond it more
+    speed costs more power): computed in closed form, so where rolling cancels the grade (c = 0 exactly when
+    Crr = −grade) the rider is carried at the wind's speed, a double root of the cubic on that branch that rounding
+    would otherwise drop. For P > 0, v·g(v) rises strictly from 0 at v₀ = max(0, v_c) and is ≤ 0 below it, so
+    there is one root, inside [v₀, v₀ + 2·√(|c|/a) + ∛(P/a)]. The closed-form cubic of its branch (Cardano, or the
+    trigonometric form for three real roots) gives the first guess; a safeguarded Newton iteration (the
+    bracket's secant or midpoint whenever a step would leave the shrinking bracket, after ``rtsafe`` in Press et al.,
+    Numerical Recipes, 2007) then polishes it to rounding level, so ``power(v) == P`` and v moves continuously as P → 0⁺.
 
     Args:
         power_w: power at the pedals (W, ≥ 0).
@@ -260,33 +267,104 @@ def speed_for_power(
     """
     target = _non_negative("power_w", power_w)
     r = _resistance(cda_m2, mass_kg, crr, grade, altitude_m, headwind_ms, drivetrain_efficiency)
+    # Validated by _resistance above. Rolling plus climbing as m·g·cos θ·(Crr + grade), which is exactly 0 where
+    # Crr = −grade (the sum of the two forces would leave rounding there, and its square root would move v_c).
+    slope = np.asarray(grade, dtype=np.float64)
+    road = np.asarray(mass_kg, dtype=np.float64) * G * (np.asarray(crr, dtype=np.float64) + slope)
     broadcast = np.broadcast_arrays(
-        r.drag, r.rolling_force + r.climbing_force, r.wind, target * r.efficiency
+        r.drag, road / np.hypot(1.0, slope), r.wind, target * r.efficiency
     )
     shape = broadcast[0].shape
-    a, c, w, p = (x.astype(np.float64).ravel() for x in broadcast)
+    a, c, w, p = (np.array(x, dtype=np.float64).ravel() for x in broadcast)
+    return _largest_root(a, c, w, p).reshape(shape)
 
-    # Region s = +1 (v ≥ −w, air from ahead): a·v³ + 2aw·v² + (aw² + c)·v − p = 0.
-    # Region s = −1 (v < −w, tailwind faster than the rider): −a·v³ − 2aw·v² + (−aw² + c)·v − p = 0.
-    # Region +1 lies to the right of region −1, so a root there is the largest; only then look left.
-    speed = np.full(a.shape, np.nan)
-    for sign in (1.0, -1.0):
-        lead = sign * a
-        roots = _cubic_real_roots(2 * sign * a * w / lead, (sign * a * w * w + c) / lead, -p / lead)
-        valid = roots >= -1e-9
-        valid &= roots >= -w[:, None] - 1e-9 if sign > 0 else roots <= -w[:, None] + 1e-9
-        candidate = np.where(valid, roots, -np.inf).max(axis=1)
-        take = np.isnan(speed) & np.isfinite(candidate)
-        speed[take] = candidate[take]
-    speed = np.maximum(np.nan_to_num(speed, nan=0.0), 0.0)
 
-    for _ in range(2):  # Newton polish on the piecewise cubic.
-        air = speed + w
-        f = a * air * np.abs(air) * speed + c * speed - p
-        df = a * (np.abs(air) * air + 2.0 * np.abs(air) * speed) + c
-        step = np.where(np.abs(df) > 1e-12, f / np.where(df == 0, 1.0, df), 0.0)
-        speed = np.maximum(speed - step, 0.0)
-    return speed.reshape(shape)
+def _largest_root(
+    a: NDArray[np.float64], c: NDArray[np.float64], w: NDArray[np.float64], p: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """Largest v ≥ 0 with a·v·(v + w)|v + w| + c·v = p, all (N,), a > 0, p ≥ 0 (see :func:`speed_for_power`).
+
+    Each step takes Newton's point when it stays in the bracket, else the bracket's secant point (Newton
+    overshoots on the concave part of a tailwind branch, and the root may sit at the bracket's low end), else its
+    midpoint; the bracket shrinks on every evaluation.
+    """
+    balance_air = np.sign(-c) * np.sqrt(np.abs(c) / a)  # air speed at which drag balances c: g = 0
+    v0 = np.maximum(balance_air - w, 0.0)
+    lo, f_lo = v0.copy(), -p  # P(v0) = 0
+    hi = v0 + 2.0 * np.abs(balance_air) + np.cbrt(p / a)  # P(hi) ≥ p: see the docstring's bracket
+    f_hi = np.maximum(_residual(hi, a, c, w, p)[0], 0.0)
+    v = np.clip(_cubic_guess(a, c, w, p, v0), lo, hi)
+    v = np.where(np.isfinite(v), v, 0.5 * (lo + hi))
+    active = p > 0.0  # P = 0: v0 is the answer
+    v = np.where(active, v, v0)
+    eps = np.finfo(np.float64).eps
+    idx = np.flatnonzero(active)
+    for _ in range(_MAX_POLISH_STEPS):
+        if idx.size == 0:
+            break
+        # Work on the unconverged points only: most converge in three or four steps.
+        vi, ai, ci, wi, pi = v[idx], a[idx], c[idx], w[idx], p[idx]
+        f, g, g_slope, noise = _residual(vi, ai, ci, wi, pi)
+        below, above = f < 0.0, f > 0.0
+        lo_i = np.where(below, vi, lo[idx])
+        f_lo_i = np.where(below, f, f_lo[idx])
+        hi_i = np.where(above, vi, hi[idx])
+        f_hi_i = np.where(above, f, f_hi[idx])
+        lo[idx], f_lo[idx], hi[idx], f_hi[idx] = lo_i, f_lo_i, hi_i, f_hi_i
+        df = g + vi * g_slope
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            # v − f/df rearranged: on the bracket g ≥ 0, so no term cancels and a root near 0 keeps its digits.
+            newton = (pi + vi * vi * g_slope) / df
+            secant = lo_i - f_lo_i * (hi_i - lo_i) / (f_hi_i - f_lo_i)
+        step = np.where(
+            (newton >= lo_i) & (newton <= hi_i),
+            newton,
+            np.where((secant > lo_i) & (secant < hi_i), secant, 0.5 * (lo_i + hi_i)),
+        )
+        # Converged: f at the rounding level of its terms and of v itself, or no move left.
+        moving = (np.abs(f) > noise + 8.0 * eps * vi * np.abs(df)) & (step != vi)
+        v[idx[moving]] = step[moving]
+        idx = idx[moving]
+    return v
+
+
+def _residual(
+    v: NDArray[np.float64],
+    a: NDArray[np.float64],
+    c: NDArray[np.float64],
+    w: NDArray[np.float64],
+    p: NDArray[np.float64],
+) -> tuple[NDArray[np.float64], ...]:
+    """f = v·g(v) − p, g, dg/dv, and the rounding level of f's terms."""
+    u = v + w
+    drag = a * u * np.abs(u)
+    g = drag + c
+    noise = 8.0 * np.finfo(np.float64).eps * (np.abs(drag * v) + np.abs(c * v) + p)
+    return v * g - p, g, 2.0 * a * np.abs(u), noise
+
+
+_MAX_POLISH_STEPS = 200
+"""Bound on the safeguarded Newton steps; bisection alone halves a bracket to one ulp in about 60."""
+
+
+def _cubic_guess(
+    a: NDArray[np.float64],
+    c: NDArray[np.float64],
+    w: NDArray[np.float64],
+    p: NDArray[np.float64],
+    v0: NDArray[np.float64],
+) -> NDArray[np.float64]:
+    """Closed-form root of the cubic on the branch that holds the root: the first guess for the polish.
+
+    Branch s = +1 (v ≥ −w, air from ahead): a·v³ + 2aw·v² + (aw² + c)·v − p = 0; branch s = −1 (v < −w, a
+    tailwind faster than the rider) has every coefficient but c negated. The root lies on branch −1 when v₀ < −w
+    and P(−w) = −c·w ≥ p.
+    """
+    sign = np.where((v0 < -w) & (-c * w >= p), -1.0, 1.0)
+    lead = sign * a
+    roots = _cubic_real_roots(2.0 * w, (lead * w * w + c) / lead, -p / lead)
+    # The largest real root on the branch at or beyond v0 (rounding may move it a little; the polish repairs that).
+    return np.where(np.isfinite(roots), roots, -np.inf).max(axis=1)
 
 
 def _cubic_real_roots(
