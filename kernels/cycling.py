@@ -363,8 +363,14 @@ def _cubic_guess(
     sign = np.where((v0 < -w) & (-c * w >= p), -1.0, 1.0)
     lead = sign * a
     roots = _cubic_real_roots(2.0 * w, (lead * w * w + c) / lead, -p / lead)
-    # The largest real root on the branch at or beyond v0 (rounding may move it a little; the polish repairs that).
-    return np.where(np.isfinite(roots), roots, -np.inf).max(axis=1)
+    # The largest real root inside the branch and at or beyond v0, with slack for rounding (the polish repairs it);
+    # NaN where rounding leaves none there.
+    slack = 1e-9 * (1.0 + np.abs(w) + v0)[:, None]
+    edge = -w[:, None]
+    inside = np.where(sign[:, None] > 0.0, roots >= edge - slack, roots <= edge + slack)
+    inside &= roots >= v0[:, None] - slack
+    best = np.where(inside, roots, -np.inf).max(axis=1)
+    return np.where(np.isfinite(best), best, np.nan)
 
 
 def _cubic_real_roots(
