@@ -786,8 +786,10 @@ def mesh(
 
     Returns:
         vertices (V, 3) in metres, faces (F, 3) vertex indices wound outward, vertex colours (V, 3) RGB in [0, 1].
-        Coincident vertices are merged and the degenerate faces that merging makes are dropped, so a closed shape
-        gives a watertight mesh. An empty field (no surface inside the bounds) gives empty arrays.
+        Samples on (or within 1e-3 voxel of) the zero level are moved 1e-3 voxel off it first, a sample exactly
+        on it to the outside (see ``_polygonise``), so every vertex is distinct and a closed shape gives a
+        watertight mesh even where faces lie on grid planes. An empty field (no surface inside the bounds) gives
+        empty arrays.
     """
     grid = make_grid(scene, resolution, bounds)
     mask = None
@@ -801,32 +803,37 @@ def mesh(
     return _polygonise(scene, grid, field, mask)
 
 
+ISO_NUDGE_VOXELS = 1e-3
+"""Samples within this fraction of a voxel of the zero level move to that distance from it before marching cubes."""
+
+
 def _polygonise(
     scene: Scene, grid: Grid, field: NDArray[np.float32], mask: NDArray[np.bool_] | None
 ) -> tuple[FloatArray, NDArray[np.int64], FloatArray]:
+    # A sample exactly on the level is a tie that marching cubes breaks differently in neighbouring cells (its
+    # classification and its face test disagree), which leaves holes (scikit-image issue 8116). Such a sample counts
+    # as outside, as in Lewiner's reference code (values below FLT_EPSILON become a small positive one): it moves to
+    # +δ, δ = 1e-3 voxel. Samples closer than δ to the level (rounding residue of a face on a grid plane) move out to
+    # ±δ on their own side, so no sign changes. Neighbouring samples differ by at most a voxel (the field is
+    # 1-Lipschitz), so each vertex lies at least ~δ/voxel inside its own edge: vertices stay distinct in float32 and
+    # the mesh is a plain marching-cubes mesh (no merging), the surface moving by at most δ. Both samplers' fields
+    # pass through here, so the coarse-to-fine output still equals the full grid's (its sign fill comes from blocks
+    # far from the surface, never within δ of it).
+    delta = np.float32(ISO_NUDGE_VOXELS * grid.spacing)
+    near_level = np.abs(field) < delta
+    if near_level.any():
+        field = np.where(near_level, np.where(field < 0.0, -delta, delta), field)
     if not (field.min() < 0.0 < field.max()):
         return np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64), np.zeros((0, 3))
     verts, faces, _normals, _values = marching_cubes(
-        np.ascontiguousarray(field),
+        np.ascontiguousarray(field, dtype=np.float32),
         level=0.0,
         spacing=(grid.spacing,) * 3,
         mask=None if mask is None else np.ascontiguousarray(mask),
     )
     verts = verts.astype(np.float64) + np.asarray(grid.origin)
     # scikit-image's default winding faces a field that is negative inside outward (tests check the volume's sign).
-    faces = faces.astype(np.int64)
-    if np.any(field == 0.0):
-        # A sample exactly on the surface puts vertices of several edges on one point: merge them and drop the
-        # faces that collapse. Otherwise every vertex lies inside its own edge and they are already distinct.
-        tri = trimesh.Trimesh(vertices=verts, faces=faces, process=False)
-        tri.merge_vertices()
-        tri.update_faces(tri.nondegenerate_faces())
-        tri.remove_unreferenced_vertices()
-        verts, faces = (
-            np.asarray(tri.vertices, dtype=np.float64),
-            np.asarray(tri.faces, dtype=np.int64),
-        )
-    return verts, faces, scene_color(scene, verts)
+    return verts, faces.astype(np.int64), scene_color(scene, verts)
 
 
 def mesh_trimesh(

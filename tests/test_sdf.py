@@ -334,7 +334,7 @@ def test_default_scene_mesh_is_watertight_with_blended_colors() -> None:
 
 
 def test_samples_exactly_on_the_surface_are_merged() -> None:
-    """Box faces on grid planes put marching-cubes vertices on top of each other: merged, still watertight."""
+    """Box faces on grid planes put samples exactly on the level: nudged off it, vertices distinct, watertight."""
     scene = sdf.Scene(
         (
             sdf.Primitive("box", (0, 0, 0), (0.5, 0.5, 0.5)),
