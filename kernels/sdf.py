@@ -199,21 +199,37 @@ def sd_capsule(p: ArrayLike, a: ArrayLike, b: ArrayLike, radius: float) -> Float
 def _smin_poly_weighted(
     a: AnyFloatArray, b: AnyFloatArray, k: float
 ) -> tuple[AnyFloatArray, AnyFloatArray]:
-    """Polynomial smooth min and the weight of ``b`` in it (``1 − h``)."""
-    if k == 0.0:
+    """Polynomial smooth min and the weight of ``b`` in it (``1 − h``), in the inputs' float dtype.
+
+    Finite for every finite k ≥ 0: a width that is 0 in that dtype (0 itself, or below float32's smallest subnormal
+    on the mesher's grid) is the hard minimum; any other, subnormals included, overflows (b − a)/k to ±inf at worst,
+    which the clamp maps to 0 or 1, and 0/k = 0 where a = b. The result lies within k/4 of min(a, b).
+    """
+    dtype = np.result_type(a, b)
+    width = dtype.type(k)
+    if width == 0.0:
         return np.minimum(a, b), (b < a).astype(np.float64)
-    # A tiny k overflows the ratio to ±inf, which the clamp handles.
     with np.errstate(over="ignore"):
-        h = np.clip(0.5 + 0.5 * (b - a) / k, 0.0, 1.0)
-    return h * a + (1.0 - h) * b - k * h * (1.0 - h), 1.0 - h  # exact at h = 0 and h = 1
+        h = np.clip(0.5 + 0.5 * (b - a) / width, 0.0, 1.0)
+    return h * a + (1.0 - h) * b - width * h * (1.0 - h), 1.0 - h  # exact at h = 0 and h = 1
 
 
 def _smin_exp_weighted(
     a: AnyFloatArray, b: AnyFloatArray, k: float
 ) -> tuple[AnyFloatArray, AnyFloatArray]:
-    """Exponential smooth min (``k`` = sharpness) and the weight of ``b``: exp(−kb)/(exp(−ka) + exp(−kb))."""
-    e = np.exp(-k * np.abs(a - b))  # in (0, 1]: neither this nor what follows can overflow
-    d = np.minimum(a, b) - np.log1p(e) / k
+    """Exponential smooth min (``k`` = sharpness) and the weight of ``b``: exp(−kb)/(exp(−ka) + exp(−kb)).
+
+    Finite for every sharpness in (0, ∞], in the inputs' float dtype: a sharpness that overflows it (4·ln 2 / k
+    for a tiny width k) is the hard minimum, with exp(−k·|a − b|) taken as 1 where a = b instead of exp(−∞·0).
+    """
+    dtype = np.result_type(a, b)
+    with np.errstate(over="ignore"):
+        sharpness = dtype.type(k)  # inf when it overflows the dtype
+    gap = np.abs(a - b)
+    with np.errstate(over="ignore", invalid="ignore"):
+        e = np.exp(-sharpness * gap)  # in [0, 1]; −∞·0 (NaN) only at gap 0, set below
+    e = np.where(gap == 0.0, dtype.type(1.0), e)
+    d = np.minimum(a, b) - np.log1p(e) / sharpness  # log1p(e) ≤ ln 2: → 0 as the sharpness grows
     w_b = np.where(a > b, 1.0, e) / (1.0 + e)
     return d, w_b
 

@@ -50,19 +50,27 @@ float sd_capsule(vec3 p, vec3 a, vec3 b, float radius) {
 }
 
 // ------------------------------------------------------------------------------ blends
-// Each *_weighted form returns (distance, weight of b), the weight that blends colours.
+// Each *_weighted form returns (distance, weight of b), the weight that blends colours. Both are finite for every
+// finite width k >= 0 and tend to the hard minimum as k -> 0 (kernels/sdf.py holds the same property).
+// The smallest normal float: a width below it (0, or a subnormal that a GPU may flush to 0) is the hard minimum, its
+// dip k/4 being below any distance's rounding; above it 0.5 / k stays finite.
+#define SMALLEST_NORMAL 1.17549435e-38
+
 vec2 smin_poly_weighted(float a, float b, float k) {
-    if (k == 0.0) {
-        return vec2(min(a, b), b < a ? 1.0 : 0.0);
-    }
-    float h = clamp(0.5 + (b - a) * (0.5 / k), 0.0, 1.0);  // 0.5 / k: one division per blend, not per sample
-    return vec2(h * a + (1.0 - h) * b - k * h * (1.0 - h), 1.0 - h);
+    bool hard = !(k >= SMALLEST_NORMAL);
+    float width = hard ? 1.0 : k;
+    // (b - a) * (0.5 / width) may overflow to +-inf, which the clamp maps to 0 or 1; it is 0 where a = b.
+    float h = clamp(0.5 + (b - a) * (0.5 / width), 0.0, 1.0);
+    vec2 smooth_min = vec2(h * a + (1.0 - h) * b - width * h * (1.0 - h), 1.0 - h);
+    return hard ? vec2(min(a, b), b < a ? 1.0 : 0.0) : smooth_min;
 }
 
 // k is the sharpness (1/m); min(a, b) - log(1 + exp(-k|a - b|))/k cannot overflow, and the weight of b,
-// exp(-kb)/(exp(-ka) + exp(-kb)), reuses the same exponential.
+// exp(-kb)/(exp(-ka) + exp(-kb)), reuses the same exponential. Where a = b the exponential is 1 outright, so an
+// infinite sharpness (the hard minimum) never meets inf * 0.
 vec2 smin_exp_weighted(float a, float b, float k) {
-    float e = exp(-k * abs(a - b));
+    float gap = abs(a - b);
+    float e = gap == 0.0 ? 1.0 : exp(-k * gap);
     float d = min(a, b) - log(1.0 + e) / k;
     return vec2(d, a > b ? 1.0 / (1.0 + e) : e / (1.0 + e));
 }
@@ -95,13 +103,13 @@ float op_intersect(float a, float b) {
 #define POLY_BLEND_ONLY 0
 #endif
 vec2 smin_blend(float a, float b, float k, int blend) {
-    float width = max(k, 1e-20);  // k = 0 is the hard minimum; keep the division finite
-    vec2 poly = smin_poly_weighted(a, b, width);
+    vec2 poly = smin_poly_weighted(a, b, k);  // the hard minimum for k below SMALLEST_NORMAL
 #if POLY_BLEND_ONLY
     return poly;
 #else
-    vec2 expo = smin_exp_weighted(a, b, EXP_SHARPNESS_PER_WIDTH / width);
-    return (blend == BLEND_EXP && k > 0.0) ? expo : poly;
+    // The width is at least SMALLEST_NORMAL here, so the sharpness stays below 2.4e38: finite in float32.
+    vec2 expo = smin_exp_weighted(a, b, EXP_SHARPNESS_PER_WIDTH / max(k, SMALLEST_NORMAL));
+    return (blend == BLEND_EXP && k >= SMALLEST_NORMAL) ? expo : poly;
 #endif
 }
 
