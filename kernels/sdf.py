@@ -28,7 +28,8 @@ are ``smin(a, b)``, ``−smin(−a, b)`` and ``−smin(−a, −b)``.
 A :class:`Scene` folds its primitives in order: the first starts the shape (its ``op`` is not used) and each later
 one combines with the shape so far by its ``op``. One blend width ``k`` (m) serves both forms; the exponential form
 uses the sharpness ``4·ln 2 / k``, which makes both forms dip by the same ``k/4`` where two surfaces meet. ``k = 0``
-means hard booleans.
+means hard booleans, and so does any k below ``MIN_BLEND_WIDTH`` (float32's smallest normal): every form is then
+finite for every finite k ≥ 0 and tends to the hard boolean as k → 0, in float32 and float64 alike.
 
 :func:`mesh` samples the field on a grid and runs scikit-image's marching cubes (Lewiner et al. 2003) on the float
 field, which keeps sub-voxel accuracy. It evaluates the field only near the surface: a block of samples whose centre
@@ -69,6 +70,10 @@ MAX_RESOLUTION = 512
 
 EXP_SHARPNESS_PER_WIDTH = 4.0 * math.log(2.0)
 """A scene's exp blend uses sharpness ``EXP_SHARPNESS_PER_WIDTH / k``: both forms then dip by k/4 where a = b."""
+MIN_BLEND_WIDTH = float(np.finfo(np.float32).tiny)
+"""Blend widths below this (float32's smallest normal, 1.2e-38 m) are the hard booleans, here and in the GLSL: their
+dip k/4 is below any distance's rounding, a float32 uniform cannot hold them reliably (subnormal or 0), and
+above it 0.5/k and the exp sharpness 4·ln 2/k stay finite in float32."""
 
 _SIZE_COUNT: dict[str, int] = {"sphere": 1, "box": 3, "torus": 2, "capsule": 2}
 
@@ -201,14 +206,13 @@ def _smin_poly_weighted(
 ) -> tuple[AnyFloatArray, AnyFloatArray]:
     """Polynomial smooth min and the weight of ``b`` in it (``1 − h``), in the inputs' float dtype.
 
-    Finite for every finite k ≥ 0: a width that is 0 in that dtype (0 itself, or below float32's smallest subnormal
-    on the mesher's grid) is the hard minimum; any other, subnormals included, overflows (b − a)/k to ±inf at worst,
-    which the clamp maps to 0 or 1, and 0/k = 0 where a = b. The result lies within k/4 of min(a, b).
+    Finite for every finite k ≥ 0: a width below :data:`MIN_BLEND_WIDTH` is the hard minimum; above it
+    (b − a)/k overflows to ±inf at worst, which the clamp maps to 0 or 1, and is 0 where a = b. The result lies within
+    k/4 of min(a, b).
     """
-    dtype = np.result_type(a, b)
-    width = dtype.type(k)
-    if width == 0.0:
+    if not k >= MIN_BLEND_WIDTH:
         return np.minimum(a, b), (b < a).astype(np.float64)
+    width = np.result_type(a, b).type(k)
     with np.errstate(over="ignore"):
         h = np.clip(0.5 + 0.5 * (b - a) / width, 0.0, 1.0)
     return h * a + (1.0 - h) * b - width * h * (1.0 - h), 1.0 - h  # exact at h = 0 and h = 1
@@ -240,7 +244,7 @@ def smin_poly(a: ArrayLike, b: ArrayLike, k: float) -> FloatArray:
     Args:
         a: distances (m), any shape broadcastable with ``b``.
         b: distances (m).
-        k: blend width (m), ≥ 0; 0 is the hard minimum.
+        k: blend width (m), ≥ 0; 0 (or anything below ``MIN_BLEND_WIDTH``) is the hard minimum.
 
     Returns:
         Blended distances (m), the broadcast shape.
@@ -288,7 +292,7 @@ def _combine(
     """Distance of ``a op b`` and the weight of ``b`` in it; ``k`` is the blend width (m), 0 for hard."""
 
     def smin(x: AnyFloatArray, y: AnyFloatArray) -> tuple[AnyFloatArray, AnyFloatArray]:
-        if k == 0.0:
+        if k < MIN_BLEND_WIDTH:  # 0 and tiny widths: the hard boolean, as in the GLSL
             return _smin_poly_weighted(x, y, 0.0)
         match blend:
             case "poly":

@@ -52,12 +52,12 @@ float sd_capsule(vec3 p, vec3 a, vec3 b, float radius) {
 // ------------------------------------------------------------------------------ blends
 // Each *_weighted form returns (distance, weight of b), the weight that blends colours. Both are finite for every
 // finite width k >= 0 and tend to the hard minimum as k -> 0 (kernels/sdf.py holds the same property).
-// The smallest normal float: a width below it (0, or a subnormal that a GPU may flush to 0) is the hard minimum, its
-// dip k/4 being below any distance's rounding; above it 0.5 / k stays finite.
-#define SMALLEST_NORMAL 1.17549435e-38
+// kernels/sdf.py MIN_BLEND_WIDTH, float32's smallest normal: a width below it (0, or a subnormal that a GPU may flush
+// to 0) is the hard minimum, its dip k/4 being below any distance's rounding; above it 0.5 / k stays finite.
+#define MIN_BLEND_WIDTH 1.17549435e-38
 
 vec2 smin_poly_weighted(float a, float b, float k) {
-    bool hard = !(k >= SMALLEST_NORMAL);
+    bool hard = !(k >= MIN_BLEND_WIDTH);
     float width = hard ? 1.0 : k;
     // (b - a) * (0.5 / width) may overflow to +-inf, which the clamp maps to 0 or 1; it is 0 where a = b.
     float h = clamp(0.5 + (b - a) * (0.5 / width), 0.0, 1.0);
@@ -103,13 +103,13 @@ float op_intersect(float a, float b) {
 #define POLY_BLEND_ONLY 0
 #endif
 vec2 smin_blend(float a, float b, float k, int blend) {
-    vec2 poly = smin_poly_weighted(a, b, k);  // the hard minimum for k below SMALLEST_NORMAL
+    vec2 poly = smin_poly_weighted(a, b, k);  // the hard minimum for k below MIN_BLEND_WIDTH
 #if POLY_BLEND_ONLY
     return poly;
 #else
-    // The width is at least SMALLEST_NORMAL here, so the sharpness stays below 2.4e38: finite in float32.
-    vec2 expo = smin_exp_weighted(a, b, EXP_SHARPNESS_PER_WIDTH / max(k, SMALLEST_NORMAL));
-    return (blend == BLEND_EXP && k >= SMALLEST_NORMAL) ? expo : poly;
+    // The width is at least MIN_BLEND_WIDTH here, so the sharpness stays below 2.4e38: finite in float32.
+    vec2 expo = smin_exp_weighted(a, b, EXP_SHARPNESS_PER_WIDTH / max(k, MIN_BLEND_WIDTH));
+    return (blend == BLEND_EXP && k >= MIN_BLEND_WIDTH) ? expo : poly;
 #endif
 }
 

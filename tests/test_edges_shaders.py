@@ -166,3 +166,23 @@ def test_glsl_blend_functions_are_finite_and_near_the_hard_ones(
     slack = k / 4 * (1 + 1e-6) + 4e-7 * np.maximum(np.abs(x), np.abs(y))[:, None] + 1e-30
     assert np.all(np.abs(poly - hard) <= slack)
     assert np.all(np.abs(expo - hard) <= slack)
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("k", [0.0, 1e-310, 1e-40, 1.1e-38, 1.2e-38, 1e-30, 0.25])
+@pytest.mark.parametrize("blend", sdf.BLEND_FORMS)
+def test_glsl_and_numpy_colour_a_tie_alike_at_every_width(
+    gl: Renderer, k: float, blend: sdf.BlendForm
+) -> None:
+    """Two coincident spheres tie everywhere: the mesh (numpy) and the reference (GLSL) must colour them alike.
+
+    Below MIN_BLEND_WIDTH both take the first primitive's colour, as k = 0 does; above it both mix half and half.
+    """
+    red = sdf.Primitive("sphere", (0.0, 0.0, 0.5), (0.45,), color=(1.0, 0.0, 0.0))
+    blue = sdf.Primitive("sphere", (0.0, 0.0, 0.5), (0.45,), color=(0.0, 0.0, 1.0))
+    scene = sdf.Scene((red, blue), k=k, blend=blend)
+    points = np.random.default_rng(2).uniform(-1.0, 1.0, (500, 3))
+    _, color = gl.probe(scene, points)
+    np.testing.assert_allclose(color, sdf.scene_color(scene, points), atol=1e-5)
+    expected_blue = 0.0 if k < sdf.MIN_BLEND_WIDTH else 0.5
+    np.testing.assert_allclose(color[:, 2], expected_blue, atol=1e-5)
