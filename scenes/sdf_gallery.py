@@ -6,7 +6,8 @@ camera, and the readouts say how well the two agree (silhouette IoU, mean depth 
 
 Threads: GUI and gizmo callbacks only record the new state and wake one worker thread. The worker meshes the latest
 scene (a burst of drags coalesces: only the newest request is meshed), then renders the reference when the camera
-has stopped moving (or at once, in live mode). The GL context lives on the worker thread, where it was created.
+has stopped moving (or at once, in live mode). The GL work goes to :mod:`shaders.gl_service`: one context and one
+thread per process, shared by every gallery (a context per build leaked ~50 MiB each).
 """
 
 from __future__ import annotations
@@ -27,6 +28,7 @@ from PIL import Image
 
 from kernels import sdf
 from scenes._base import Scene
+from shaders import gl_service
 from shaders.renderer import Camera, GLUnavailableError, Renderer, Shading
 
 logger = logging.getLogger(__name__)
@@ -47,7 +49,13 @@ OP_LABELS: dict[str, sdf.BooleanOp] = {
     "Subtract": "subtract",
     "Intersect": "intersect",
 }
-BLEND_LABELS: dict[str, sdf.BlendForm] = {"Polynomial": "poly", "Exponential": "exp"}
+BlendChoice = Literal["hard", "poly", "exp"]
+"""Hard booleans, or a smooth minimum in one of its two forms."""
+BLEND_LABELS: dict[str, BlendChoice] = {
+    "Hard": "hard",
+    "Smooth (polynomial)": "poly",
+    "Smooth (exponential)": "exp",
+}
 ReferenceMode = Literal["stopped", "live"]
 MODE_LABELS: dict[str, ReferenceMode] = {"When the camera stops": "stopped", "Live": "live"}
 SIZE_MEANING = (
@@ -55,6 +63,11 @@ SIZE_MEANING = (
     "Torus: a = major radius, b = tube radius (ring in the local xz plane). "
     "Capsule: a = half length along local y, b = radius."
 )
+RESOLUTION_LABEL = "Mesh resolution (samples per side)"
+"""Marching-cubes samples along the longest side of the scene's bounds."""
+GIZMO_SCALE = 0.8
+"""Gizmo arrow length (m): longer than every default primitive's reach from its centre (the torus ring, 0.72 m),
+so the arrow tips poke out of the mesh."""
 CAMERA_REST_S = 0.25
 """The camera (and the scene) count as stopped after this long without an update (s)."""
 
@@ -121,8 +134,8 @@ class SdfGalleryParams:
     """The four primitive slots."""
     k: float = 0.25
     """Blend width (m); 0 is a hard boolean."""
-    blend: sdf.BlendForm = "poly"
-    """Polynomial or exponential smooth-min."""
+    blend: BlendChoice = "poly"
+    """Hard booleans (k is not used), or the polynomial or exponential smooth minimum of width k."""
     resolution: int = 64
     """Marching-cubes samples along the longest side of the bounds (32–256)."""
     shading: Shading = dataclasses.field(default_factory=Shading)
@@ -134,7 +147,9 @@ class SdfGalleryParams:
 
     def scene(self) -> sdf.Scene:
         return sdf.Scene(
-            tuple(p.primitive() for p in self.primitives if p.enabled), k=self.k, blend=self.blend
+            tuple(p.primitive() for p in self.primitives if p.enabled),
+            k=0.0 if self.blend == "hard" else self.k,
+            blend="poly" if self.blend == "hard" else self.blend,
         )
 
 
@@ -246,7 +261,7 @@ IoU is lowest when a box edge is on the silhouette.
                     initial_value=_label(BLEND_LABELS, p.blend),
                 )
                 self.k = gui.add_slider("Blend width k (m)", 0.0, 1.0, 0.01, p.k)
-                self.resolution = gui.add_slider("Mesh resolution", 32, 256, 16, p.resolution)
+                self.resolution = gui.add_slider(RESOLUTION_LABEL, 32, 256, 16, p.resolution)
                 self.progress = gui.add_progress_bar(0.0, visible=False)
                 self.readout = gui.add_markdown("")
             with gui.add_folder("Reference (GLSL ray-march)"):
@@ -348,14 +363,17 @@ IoU is lowest when a box edge is on the silhouette.
         for i, slot in enumerate(self.params.primitives):
             gizmo = scene.add_transform_controls(
                 f"{self.root.name}/gizmo_{i + 1}",
-                scale=0.35,
-                line_width=2.0,
+                scale=GIZMO_SCALE,
+                line_width=3.0,
+                # Drawn over the mesh: a gizmo sits at its primitive's centre, inside the surface.
+                depth_test=False,
                 position=slot.position,
                 wxyz=slot.wxyz,
                 visible=slot.enabled,
             )
             gizmo.on_update(self.callback(self._on_scene_input))
             self.gizmos.append(gizmo)
+            scene.add_label(f"{gizmo.name}/label", f"P{i + 1}", position=(0.0, 0.0, GIZMO_SCALE))
 
     def _watch_cameras(self) -> None:
         self.watch_cameras(self._on_camera)
@@ -482,8 +500,12 @@ IoU is lowest when a box edge is on the silhouette.
             return
         try:
             aspect = float(camera.aspect)
-        except (TypeError, ValueError, AttributeError):
+        except (TypeError, ValueError, AttributeError, ZeroDivisionError):
             aspect = 4 / 3
+        self._on_camera_values(cam, aspect)
+
+    def _on_camera_values(self, cam: Camera, aspect: float) -> None:
+        """Take a cleaned camera and its image aspect (width / height) and schedule a new reference."""
         with self._work:
             self._camera = cam
             self._aspect = min(max(aspect, 0.5), 2.5) if math.isfinite(aspect) else 4 / 3
@@ -494,6 +516,7 @@ IoU is lowest when a box edge is on the silhouette.
     def _sync_enabled_inputs(self) -> None:
         """Show gizmos of enabled primitives; grey out sizes the kind does not use."""
         used = {"sphere": 1, "box": 3, "torus": 2, "capsule": 2}
+        self.k.disabled = self.params.blend == "hard"
         for handles, gizmo, slot in zip(
             self.slots, self.gizmos, self.params.primitives, strict=True
         ):
@@ -510,35 +533,27 @@ IoU is lowest when a box edge is on the silhouette.
 
     # ----------------------------------------------------------------------------------------- worker
     def _work_forever(self) -> None:
-        renderer: Renderer | None = None
-        try:
-            while not self._stop.is_set():
-                with self._work:
-                    self._work.wait(timeout=0.05)
-                    scene, resolution = self._wanted_scene, self._wanted_resolution
-                    self._wanted_scene = None
-                if self._stop.is_set():
-                    return
-                try:
-                    if scene is not None:
-                        self._mesh_and_show(scene, resolution)
-                        with self._work:
-                            self._reference_due = True
-                    if self._reference_ready():
-                        if renderer is None and self.gl_error is None:
-                            renderer = self._open_renderer()
-                        if renderer is not None:
-                            self._render_reference(renderer)
-                except Exception:
-                    # One failed mesh or render must not stop every later one: log it and wait for new input.
-                    logger.exception(
-                        "sdf: meshing or rendering failed; keeping the last good picture"
-                    )
+        while not self._stop.is_set():
+            with self._work:
+                self._work.wait(timeout=0.05)
+                scene, resolution = self._wanted_scene, self._wanted_resolution
+                self._wanted_scene = None
+            if self._stop.is_set():
+                return
+            try:
+                if scene is not None:
+                    self._mesh_and_show(scene, resolution)
                     with self._work:
-                        self._reference_due = False
-        finally:
-            if renderer is not None:
-                renderer.release()
+                        self._reference_due = True
+                if self.gl_error is None and self._reference_ready():
+                    self._render_reference()
+            except GLUnavailableError as exc:
+                self._no_gl(exc)
+            except Exception:
+                # One failed mesh or render must not stop every later one: log it and wait for new input.
+                logger.exception("sdf: meshing or rendering failed; keeping the last good picture")
+                with self._work:
+                    self._reference_due = False
 
     def _reference_ready(self) -> bool:
         with self._work:
@@ -550,16 +565,12 @@ IoU is lowest when a box edge is on the silhouette.
             # the middle of a drag would hold up the next mesh.
             return time.monotonic() - max(self._camera_time, self._scene_time) >= CAMERA_REST_S
 
-    def _open_renderer(self) -> Renderer | None:
-        try:
-            return Renderer()
-        except GLUnavailableError as exc:
-            self.gl_error = str(exc)
-            logger.warning("sdf: %s", exc)
-            with self._lock:
-                if not self.closed:
-                    self.reference_note.content = f"**No reference image.** {exc}"
-            return None
+    def _no_gl(self, exc: GLUnavailableError) -> None:
+        self.gl_error = str(exc)
+        logger.warning("sdf: %s", exc)
+        with self._lock:
+            if not self.closed:
+                self.reference_note.content = f"**No reference image.** {exc}"
 
     def _mesh_and_show(self, scene: sdf.Scene, resolution: int) -> None:
         big = resolution >= 128
@@ -591,7 +602,7 @@ IoU is lowest when a box edge is on the silhouette.
                 self.readout.content = self._readout_markdown()
             self.server.flush()
 
-    def _render_reference(self, renderer: Renderer) -> None:
+    def _render_reference(self) -> None:
         with self._work:
             self._reference_due = False
             camera = self._camera or Camera(self.camera_position, self.camera_look_at)
@@ -609,12 +620,17 @@ IoU is lowest when a box edge is on the silhouette.
         assert scene is not None
         width = params.reference_width
         height = max(16, round(width / aspect))
-        start = time.perf_counter()
-        rgb, depth = renderer.render(scene, camera, width, height, params.shading)
-        render_ms = 1e3 * (time.perf_counter() - start)
-        _, mesh_depth = renderer.render_mesh(
-            vertices, faces, colors, camera, width, height, params.shading
-        )
+
+        def job(renderer: Renderer) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, str]:
+            start = time.perf_counter()
+            rgb, depth = renderer.render(scene, camera, width, height, params.shading)
+            render_ms = 1e3 * (time.perf_counter() - start)
+            _, mesh_depth = renderer.render_mesh(
+                vertices, faces, colors, camera, width, height, params.shading
+            )
+            return rgb, depth, mesh_depth, render_ms, renderer.renderer_name
+
+        rgb, depth, mesh_depth, render_ms, renderer_name = gl_service.run(job)
         iou, depth_diff = _compare(depth, mesh_depth)
         with self._lock:
             if self.closed:
@@ -630,7 +646,7 @@ IoU is lowest when a box edge is on the silhouette.
                     depth_diff_voxels=None if depth_diff is None else depth_diff / self._mesh_voxel,
                 )
                 self.readout.content = self._readout_markdown()
-                self.reference_note.content = f"{width}×{height} px on {renderer.renderer_name}."
+                self.reference_note.content = f"{width}×{height} px on {renderer_name}."
             self.server.flush()
 
     def _readout_markdown(self) -> str:

@@ -13,7 +13,8 @@ from conftest import skip_or_fail
 
 from scenes.sdf_gallery import SdfGalleryScene
 from scenes.switcher import SceneSwitcher
-from shaders.renderer import GLUnavailableError, Renderer
+from shaders import gl_service
+from shaders.renderer import GLUnavailableError
 
 pytestmark = [pytest.mark.browser, pytest.mark.gl]
 
@@ -35,7 +36,7 @@ def test_browser_shows_the_mesh_and_the_reference_image(
     server: viser.ViserServer, browser_page: Any
 ) -> None:
     try:
-        Renderer().release()
+        gl_service.run(lambda _renderer: None)
     except GLUnavailableError as exc:
         skip_or_fail(str(exc))
     switcher = SceneSwitcher(server, "sdf")

@@ -18,9 +18,10 @@ from viser_private import gui_uuid, gui_uuids, node_names
 from wsclient import BrowserClient
 
 from kernels import sdf
-from scenes.sdf_gallery import SdfGalleryParams, SdfGalleryScene
+from scenes.sdf_gallery import RESOLUTION_LABEL, SdfGalleryParams, SdfGalleryScene
 from scenes.switcher import SceneSwitcher
-from shaders.renderer import GLUnavailableError, Renderer
+from shaders import gl_service
+from shaders.renderer import Camera, GLUnavailableError
 
 MESH = "/sdf/mesh"
 
@@ -54,7 +55,7 @@ def shown_mesh(scene: SdfGalleryScene) -> trimesh.Trimesh:
 
 def need_gl() -> None:
     try:
-        Renderer().release()
+        gl_service.run(lambda _renderer: None)
     except GLUnavailableError as exc:
         skip_or_fail(str(exc))
 
@@ -140,7 +141,7 @@ def test_gui_changes_remesh(server: viser.ViserServer, scene: SdfGalleryScene) -
         gizmo_4 = server.scene.get_handle_by_name("/sdf/gizmo_4")
         assert gizmo_4 is not None and gizmo_4.visible is False
         serial = scene.mesh_serial
-        client.set_value("Blend", "Exponential")
+        client.set_value("Blend", "Smooth (exponential)")
         client.set_value("P1 kind", "Box")
         client.set_value("P1 colour", (10, 200, 30))
         wait_until(
@@ -186,8 +187,8 @@ def test_crafted_bad_values_keep_the_last_good_scene(
         )
         client.drag_transform("/sdf/gizmo_1", [(float("nan"), 0.0, 0.0)])
         client.drag_transform("/sdf/gizmo_2", [(0.6, 0.0, 0.3)], wxyz=(0.0, 0.0, 0.0, 0.0))
-        client.set_value("Mesh resolution", -5)  # out of range: clamped to the slider's minimum
-        client.wait_for(lambda: client.value_of("Mesh resolution") == 32, what="resolution clamped")
+        client.set_value(RESOLUTION_LABEL, -5)  # out of range: clamped to the slider's minimum
+        client.wait_for(lambda: client.value_of(RESOLUTION_LABEL) == 32, what="resolution clamped")
         wait_until(lambda: scene.mesh_scene is not None and scene.params.resolution == 32)
         wait_until(
             lambda: len(scene.mesh_vertices) == len(sdf.mesh(good.scene(), 32)[0]), what="32³ mesh"
@@ -211,8 +212,8 @@ def test_high_resolution_shows_progress_then_a_fine_mesh(
     server: viser.ViserServer, scene: SdfGalleryScene
 ) -> None:
     with BrowserClient(server.get_port()) as client:
-        client.wait_for_gui("Mesh resolution")
-        client.set_value("Mesh resolution", 256)
+        client.wait_for_gui(RESOLUTION_LABEL)
+        client.set_value(RESOLUTION_LABEL, 256)
         progress_uuid = gui_uuid(scene.progress)
         client.wait_for(
             lambda: any(
@@ -348,14 +349,14 @@ def test_png_download_is_the_reference_image(scene: SdfGalleryScene) -> None:
 def test_without_gl_the_panel_says_why_and_meshing_goes_on(
     server: viser.ViserServer, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    import scenes.sdf_gallery as gallery
+    from shaders import gl_service
 
-    def no_gl() -> Renderer:
+    def no_gl(job: object, timeout_s: float | None = None) -> None:
         raise GLUnavailableError(
             "No OpenGL 3.3 context on EGL (test): the mesh view works without it."
         )
 
-    monkeypatch.setattr(gallery, "Renderer", no_gl)
+    monkeypatch.setattr(gl_service, "run", no_gl)
     scene = SdfGalleryScene(server)
     try:
         wait_until(lambda: scene.gl_error is not None, what="the renderer to be tried")
@@ -376,6 +377,12 @@ def test_without_gl_the_panel_says_why_and_meshing_goes_on(
         scene.close()
 
 
+def scene_gizmo_scale() -> float:
+    from scenes.sdf_gallery import GIZMO_SCALE
+
+    return GIZMO_SCALE
+
+
 # ------------------------------------------------------------------------------------------ teardown
 def test_close_removes_everything_and_stops_the_worker(server: viser.ViserServer) -> None:
     nodes_before, gui_before = node_names(server), gui_uuids(server)
@@ -386,3 +393,73 @@ def test_close_removes_everything_and_stops_the_worker(server: viser.ViserServer
     assert not worker.is_alive()
     assert node_names(server) == nodes_before
     assert gui_uuids(server) == gui_before
+
+
+def rss_mib() -> float:
+    with open("/proc/self/statm") as f:
+        return int(f.read().split()[1]) * 4096 / 2**20
+
+
+@pytest.mark.gl
+def test_fifty_builds_share_one_gl_context_and_do_not_grow_memory(
+    server: viser.ViserServer,
+) -> None:
+    """Issue 10: each build made a new EGL context on a new thread (~50 MiB each, never reclaimed)."""
+    import gc
+    import threading
+
+    from shaders import gl_service
+
+    need_gl()
+
+    def build_render_close() -> None:
+        scene = SdfGalleryScene(server)
+        try:
+            scene._on_camera_values(Camera((1.9, -2.1, 1.4), (0.0, 0.0, 0.3)), 4 / 3)
+            wait_until(lambda: scene.reference_serial > 0, what="a reference image")
+        finally:
+            scene.close()
+
+    for _ in range(3):  # warm: the shared context, its programs, numba and skimage caches
+        build_render_close()
+    gc.collect()
+    threads_before = threading.active_count()
+    before = rss_mib()
+    for _ in range(50):
+        build_render_close()
+    gc.collect()
+    grown = rss_mib() - before
+    assert grown <= 20.0, f"RSS grew {grown:.1f} MiB over 50 builds"
+    assert threading.active_count() == threads_before
+    gl_threads = [t for t in threading.enumerate() if t.name == "gl-service"]
+    assert gl_threads == [gl_service.thread()]
+
+
+def test_blend_dropdown_says_hard_and_smooth_and_hard_ignores_k(
+    server: viser.ViserServer, scene: SdfGalleryScene
+) -> None:
+    assert scene.blend.options == ("Hard", "Smooth (polynomial)", "Smooth (exponential)")
+    assert "samples per side" in scene.resolution.label
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Blend")
+        client.set_value("Blend", "Hard")
+        wait_until(
+            lambda: scene.mesh_scene is not None and scene.mesh_scene.k == 0.0,
+            what="a hard mesh",
+        )
+        assert scene.k.disabled
+        meshed = scene.mesh_scene
+        assert meshed is not None
+        # The hard scene's distance is the plain minimum of the four primitives' distances.
+        p = np.array([[0.3, 0.0, 0.3], [0.2, 0.1, 0.6]])
+        expected = np.min([prim.distance(p) for prim in meshed.primitives], axis=0)
+        np.testing.assert_allclose(sdf.scene_distance(meshed, p), expected, atol=1e-12)
+
+
+def test_gizmos_draw_over_the_mesh_and_reach_out_of_it(scene: SdfGalleryScene) -> None:
+    for gizmo, slot in zip(scene.gizmos, scene.params.primitives, strict=True):
+        assert gizmo.depth_test is False
+        prim = slot.primitive()
+        # The arrow tips lie outside the primitive (positive distance): something to grab from outside.
+        tips = np.asarray(slot.position) + scene_gizmo_scale() * sdf.rotation_matrix(slot.wxyz).T
+        assert np.all(prim.distance(tips) > 0.0), slot.kind
