@@ -126,6 +126,102 @@ float smooth_intersect(float a, float b, float k, int blend) {
     return combine(a, b, OP_INTERSECT, k, blend).x;
 }
 
+// ------------------------------------------------------------------------------ more primitives
+// After I. Quilez, "distance functions" (iquilezles.org/articles/distfunctions); kernels/sdf.py has the same names,
+// arguments and frames, and says which are exact and which only bounds.
+float sd_cylinder(vec3 p, float half_height, float radius) {  // exact; capped, along y
+    vec2 d = vec2(length(p.xz) - radius, abs(p.y) - half_height);
+    return min(max(d.x, d.y), 0.0) + length(max(d, 0.0));
+}
+
+float sd_round_box(vec3 p, vec3 half_size, float radius) {  // exact; outer half extents, edges rounded
+    vec3 q = abs(p) - half_size + radius;
+    return length(max(q, 0.0)) + min(max(q.x, max(q.y, q.z)), 0.0) - radius;
+}
+
+float sd_octahedron(vec3 p, float size) {  // exact; |x| + |y| + |z| = size
+    p = abs(p);
+    float m = p.x + p.y + p.z - size;
+    vec3 q;
+    if (3.0 * p.x < m) {
+        q = p.xyz;
+    } else if (3.0 * p.y < m) {
+        q = p.yzx;
+    } else if (3.0 * p.z < m) {
+        q = p.zxy;
+    } else {
+        return m * 0.57735026918962576;
+    }
+    float k = clamp(0.5 * (q.z - q.y + size), 0.0, size);
+    return length(vec3(q.x, q.y - size + k, q.z - k));
+}
+
+float sd_cone(vec3 p, float radius, float height) {  // exact; along y, base at y = -height/2, apex at +height/2
+    vec2 q = vec2(radius, -height);
+    vec2 w = vec2(length(p.xz), p.y - 0.5 * height);
+    vec2 a = w - q * clamp(dot(w, q) / dot(q, q), 0.0, 1.0);
+    vec2 b = w - q * vec2(clamp(w.x / q.x, 0.0, 1.0), 1.0);
+    float d = min(dot(a, a), dot(b, b));
+    float s = max(-(w.x * q.y - w.y * q.x), -(w.y - q.y));
+    return sqrt(d) * sign(s);
+}
+
+float sd_hex_prism(vec3 p, float apothem, float half_height) {  // exact; along z
+    const vec3 k = vec3(-0.86602540378443865, 0.5, 0.57735026918962576);
+    p = abs(p);
+    p.xy -= 2.0 * min(dot(k.xy, p.xy), 0.0) * k.xy;
+    vec2 d = vec2(length(p.xy - vec2(clamp(p.x, -k.z * apothem, k.z * apothem), apothem)) * sign(p.y - apothem),
+                  p.z - half_height);
+    return min(max(d.x, d.y), 0.0) + length(max(d, 0.0));
+}
+
+float sd_ellipsoid(vec3 p, vec3 radii) {  // a bound, not exact; -min(radii) at the centre
+    float k0 = length(p / radii);
+    float k1 = length(p / (radii * radii));
+    return k1 > 0.0 ? k0 * (k0 - 1.0) / k1 : -min(radii.x, min(radii.y, radii.z));
+}
+
+float sd_plane(vec3 p, vec3 normal, float offset) {  // exact; n·p + offset, n normalised here
+    return dot(p, normalize(normal)) + offset;
+}
+
+// ------------------------------------------------------------------------------ operators
+// Rounding and onion act on a distance; the rest map the query point (GLSL has no function arguments), as in
+// kernels/sdf.py.
+float op_round(float d, float radius) {
+    return d - radius;
+}
+
+float op_onion(float d, float thickness) {
+    return abs(d) - thickness;
+}
+
+// xyz: the point to evaluate the shape at; w: the term to add to its distance.
+vec4 op_elongate(vec3 p, vec3 half_length) {
+    vec3 q = abs(p) - half_length;
+    return vec4(p - clamp(p, -half_length, half_length), min(max(q.x, max(q.y, q.z)), 0.0));
+}
+
+vec3 op_twist(vec3 p, float rate) {  // rotate (x, z) by rate·y
+    float c = cos(rate * p.y);
+    float s = sin(rate * p.y);
+    return vec3(c * p.x - s * p.z, p.y, s * p.x + c * p.z);
+}
+
+vec3 op_bend(vec3 p, float rate) {  // rotate (x, y) by rate·x
+    float c = cos(rate * p.x);
+    float s = sin(rate * p.x);
+    return vec3(c * p.x - s * p.y, s * p.x + c * p.y, p.z);
+}
+
+vec3 op_repeat_finite(vec3 p, vec3 spacing, vec3 limit) {  // floor(x + 0.5): round() leaves halves to the driver
+    return p - spacing * clamp(floor(p / spacing + 0.5), -limit, limit);
+}
+
+vec3 op_symmetry(vec3 p, vec3 axes) {  // axes: 1 mirrors that coordinate, 0 leaves it
+    return mix(p, abs(p), axes);
+}
+
 // ------------------------------------------------------------------------------ scene
 // Every kind is one rounded box |max(q, 0)| + min(max(q.x, q.y, q.z), 0) - r, q = |p'| - e (sphere: p' = p, e = 0;
 // box: p' = p, e = half sizes, r = 0; capsule: p' = p, e = (0, half length, 0)). The torus is the same formula with
