@@ -316,7 +316,8 @@ def dataclass_replace(shading: Shading, **changes: object) -> Shading:
 # ------------------------------------------------------------------------------------------ renderer edges
 @pytest.mark.gl
 def test_scene_changes_reuse_the_compiled_programs(gl: Renderer) -> None:
-    gl.render(sdf.default_scene(), CAMERAS[0], 8, 8, NO_SHADOWS)  # each variant compiles on first use
+    # Each variant compiles on first use.
+    gl.render(sdf.default_scene(), CAMERAS[0], 8, 8, NO_SHADOWS)
     gl.render(every_op_scene(), CAMERAS[0], 8, 8, NO_SHADOWS)
     programs = dict(gl._raymarch)
     first, _ = gl.render(sdf.default_scene(), CAMERAS[0], 32, 32, NO_SHADOWS)
