@@ -53,14 +53,38 @@ import trimesh
 from numpy.typing import ArrayLike, NDArray
 from skimage.measure import marching_cubes
 
-PrimitiveKind = Literal["sphere", "box", "torus", "capsule"]
-"""Kinds of primitive; ``size`` holds (radius,), (hx, hy, hz), (major, minor) or (half length, radius)."""
+PrimitiveKind = Literal[
+    "sphere",
+    "box",
+    "torus",
+    "capsule",
+    "cylinder",
+    "round_box",
+    "octahedron",
+    "cone",
+    "hex_prism",
+    "ellipsoid",
+]
+"""Kinds of primitive; see :attr:`Primitive.size` for what each one's sizes mean."""
 BooleanOp = Literal["union", "subtract", "intersect"]
 """How a primitive combines with the shape before it."""
 BlendForm = Literal["poly", "exp"]
 """Which smooth minimum blends the booleans."""
 
-PRIMITIVE_KINDS: tuple[PrimitiveKind, ...] = ("sphere", "box", "torus", "capsule")
+PRIMITIVE_KINDS: tuple[PrimitiveKind, ...] = (
+    "sphere",
+    "box",
+    "torus",
+    "capsule",
+    "cylinder",
+    "round_box",
+    "octahedron",
+    "cone",
+    "hex_prism",
+    "ellipsoid",
+)
+ROUND_BOX_ROUNDING = 0.25
+"""A scene's round box is rounded by this fraction of its smallest half size."""
 BOOLEAN_OPS: tuple[BooleanOp, ...] = ("union", "subtract", "intersect")
 BLEND_FORMS: tuple[BlendForm, ...] = ("poly", "exp")
 MAX_PRIMITIVES = 4
@@ -70,7 +94,18 @@ MAX_RESOLUTION = 512
 EXP_SHARPNESS_PER_WIDTH = 4.0 * math.log(2.0)
 """A scene's exp blend uses sharpness ``EXP_SHARPNESS_PER_WIDTH / k``: both forms then dip by k/4 where a = b."""
 
-_SIZE_COUNT: dict[str, int] = {"sphere": 1, "box": 3, "torus": 2, "capsule": 2}
+_SIZE_COUNT: dict[str, int] = {
+    "sphere": 1,
+    "box": 3,
+    "torus": 2,
+    "capsule": 2,
+    "cylinder": 2,
+    "round_box": 3,
+    "octahedron": 1,
+    "cone": 2,
+    "hex_prism": 2,
+    "ellipsoid": 3,
+}
 
 FloatArray = NDArray[np.float64]
 AnyFloatArray = NDArray[np.floating]
@@ -344,7 +379,10 @@ class Primitive:
     """Position of the local origin in the world (m)."""
     size: tuple[float, ...]
     """The kind's parameters (m): sphere (radius,); box (hx, hy, hz); torus (major, minor); capsule (half length,
-    radius), the segment running along local y."""
+    radius), the segment running along local y; cylinder (half height, radius) along y; round_box (hx, hy, hz),
+    rounded by ROUND_BOX_ROUNDING of the smallest; octahedron (size,); cone (base radius, height) along y;
+    hex_prism (apothem, half height) along z; ellipsoid (rx, ry, rz), by :func:`sd_ellipsoid_lipschitz` (a bound
+    that keeps the scene 1-Lipschitz, which Quilez's estimate does not for an elongated ellipsoid)."""
     rotation: tuple[float, float, float, float] = (1.0, 0.0, 0.0, 0.0)
     """Orientation as a unit quaternion (w, x, y, z), local to world; normalised on construction."""
     color: tuple[float, float, float] = (0.8, 0.8, 0.8)
@@ -389,6 +427,18 @@ class Primitive:
                 return s[0] + s[1]
             case "capsule":
                 return s[0] + s[1]
+            case "cylinder":
+                return math.hypot(s[0], s[1])
+            case "round_box":
+                return math.sqrt(s[0] ** 2 + s[1] ** 2 + s[2] ** 2)
+            case "octahedron":
+                return s[0]
+            case "cone":
+                return math.hypot(s[0], s[1] / 2)
+            case "hex_prism":
+                return math.hypot(2 * s[0] / math.sqrt(3.0), s[1])
+            case "ellipsoid":
+                return max(s)
 
     def local_distance(self, p_local: FloatArray) -> FloatArray:
         """(N,) distance of (N, 3) points given in this primitive's local frame."""
@@ -402,6 +452,18 @@ class Primitive:
                 return sd_torus(p_local, s[0], s[1])
             case "capsule":
                 return sd_capsule(p_local, (0.0, -s[0], 0.0), (0.0, s[0], 0.0), s[1])
+            case "cylinder":
+                return sd_cylinder(p_local, s[0], s[1])
+            case "round_box":
+                return sd_round_box(p_local, s, ROUND_BOX_ROUNDING * min(s))
+            case "octahedron":
+                return sd_octahedron(p_local, s[0])
+            case "cone":
+                return sd_cone(p_local, s[0], s[1])
+            case "hex_prism":
+                return sd_hex_prism(p_local, s[0], s[1])
+            case "ellipsoid":
+                return sd_ellipsoid_lipschitz(p_local, s)
 
     def distance(self, points: FloatArray) -> FloatArray:
         """(N,) distance of (N, 3) world points."""
@@ -440,6 +502,9 @@ class Primitive:
             case "capsule":  # the segment runs from (0, −h, 0) to (0, h, 0)
                 off = ly - np.clip(ly, -s[0], s[0])
                 return np.sqrt(lx * lx + off * off + lz * lz) - s[1]
+            case _:  # the catalogue's kinds: their sd_* function on stacked local points
+                local = np.stack([lx, ly, lz], axis=1).astype(np.float64)
+                return self.local_distance(local).astype(x.dtype, copy=False)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -986,8 +1051,9 @@ def sd_ellipsoid(p: ArrayLike, radii: ArrayLike) -> FloatArray:
     """A distance bound (not exact) for an axis-aligned ellipsoid (Quilez, "Ellipsoid - bound (not exact)", 2008).
 
     ``k0·(k0 − 1)/k1`` with ``k0 = |p/r|``, ``k1 = |p/r²|``: zero exactly on the surface and of the right sign,
-    but only an approximation of the distance away from it (exact for a sphere). At the centre, where the formula
-    is 0/0, it is −min(radii), the exact value there.
+    but only an approximation of the distance away from it (exact for a sphere), and not 1-Lipschitz for an
+    elongated ellipsoid (scenes use :func:`sd_ellipsoid_lipschitz`). At the centre, where the formula is 0/0, it is
+    −min(radii), the exact value there.
 
     Args:
         p: (N, 3) points in the local frame (m).
@@ -1005,6 +1071,29 @@ def sd_ellipsoid(p: ArrayLike, radii: ArrayLike) -> FloatArray:
     with np.errstate(invalid="ignore", divide="ignore"):
         d = k0 * (k0 - 1.0) / k1
     return np.where(k1 > 0.0, d, -r.min())
+
+
+def sd_ellipsoid_lipschitz(p: ArrayLike, radii: ArrayLike) -> FloatArray:
+    """A 1-Lipschitz distance bound for an axis-aligned ellipsoid: (|p/r| − 1)·min(r) (Quilez, "Ellipsoid SDF",
+    iquilezles.org/articles/ellipsoids, 2008: the first, simplest bound).
+
+    |∇|p/r|| ≤ 1/min(r), so the value is 1-Lipschitz; it is zero on the surface, hence never more than the true
+    distance: what sphere tracing and the coarse-to-fine mesher need. :func:`sd_ellipsoid` (Quilez's estimate)
+    is closer to the distance but can grow faster than 1 per metre (by up to max(r)/min(r)). Equal radii give
+    the sphere's distance.
+
+    Args:
+        p: (N, 3) points in the local frame (m).
+        radii: (3,) semi-axes along x, y, z (m), each > 0.
+
+    Returns:
+        (N,) signed distance bounds (m).
+    """
+    pts = _points(p)
+    r = _vector3(radii, "radii")
+    if np.any(r <= 0.0):
+        raise ValueError(f"radii must be positive, got {r.tolist()}")
+    return (np.linalg.norm(pts / r, axis=1) - 1.0) * r.min()
 
 
 def sd_plane(p: ArrayLike, normal: ArrayLike, offset: float) -> FloatArray:

@@ -43,7 +43,26 @@ KIND_LABELS: dict[str, sdf.PrimitiveKind] = {
     "Box": "box",
     "Torus": "torus",
     "Capsule": "capsule",
+    "Cylinder": "cylinder",
+    "Round box": "round_box",
+    "Octahedron": "octahedron",
+    "Cone": "cone",
+    "Hexagonal prism": "hex_prism",
+    "Ellipsoid (bound)": "ellipsoid",
 }
+SIZES_USED: dict[sdf.PrimitiveKind, int] = {
+    "sphere": 1,
+    "box": 3,
+    "torus": 2,
+    "capsule": 2,
+    "cylinder": 2,
+    "round_box": 3,
+    "octahedron": 1,
+    "cone": 2,
+    "hex_prism": 2,
+    "ellipsoid": 3,
+}
+"""How many of the sliders a, b, c each kind reads."""
 OP_LABELS: dict[str, sdf.BooleanOp] = {
     "Union": "union",
     "Subtract": "subtract",
@@ -61,7 +80,10 @@ MODE_LABELS: dict[str, ReferenceMode] = {"When the camera stops": "stopped", "Li
 SIZE_MEANING = (
     "**Sizes (m).** Sphere: a = radius. Box: a, b, c = half sizes along local x, y, z. "
     "Torus: a = major radius, b = tube radius (ring in the local xz plane). "
-    "Capsule: a = half length along local y, b = radius."
+    "Capsule: a = half length along local y, b = radius. Cylinder: a = half height along local y, b = radius. "
+    "Round box: a, b, c = half sizes, edges rounded by a quarter of the smallest. Octahedron: a = centre to vertex. "
+    "Cone: a = base radius, b = height, along local y. Hexagonal prism: a = centre to flat side, b = half "
+    "height along local z. Ellipsoid: a, b, c = semi-axes (a distance bound, not exact)."
 )
 RESOLUTION_LABEL = "Mesh resolution (samples per side)"
 """Marching-cubes samples along the longest side of the scene's bounds."""
@@ -79,7 +101,7 @@ class PrimitiveParams:
     enabled: bool
     """Whether it is part of the scene (the first always is)."""
     kind: sdf.PrimitiveKind
-    """Sphere, box, torus or capsule."""
+    """One of the kernel's kinds (sphere, box, torus, capsule and the catalogue's six)."""
     size: tuple[float, float, float]
     """Sizes a, b, c (m); which ones count depends on the kind (see SIZE_MEANING)."""
     color: tuple[int, int, int]
@@ -92,8 +114,7 @@ class PrimitiveParams:
     """Orientation, the gizmo's."""
 
     def primitive(self) -> sdf.Primitive:
-        a, b, c = self.size
-        size = {"sphere": (a,), "box": (a, b, c), "torus": (a, b), "capsule": (a, b)}[self.kind]
+        size = self.size[: SIZES_USED[self.kind]]
         return sdf.Primitive(
             self.kind,
             self.position,
@@ -186,7 +207,8 @@ class SdfGalleryScene(Scene):
     camera_position = (1.9, -2.1, 1.4)
     camera_look_at = (0.05, 0.0, 0.3)
     about = """
-**What it shows.** A scene of up to four signed-distance primitives (sphere, box, torus, capsule) combined by
+**What it shows.** A scene of up to four signed-distance primitives (sphere, box, torus, capsule, cylinder, round box, octahedron, cone, hexagonal
+prism, ellipsoid) combined by
 union, subtraction or intersection with a smooth minimum. The 3D view shows its marching-cubes mesh; the
 **Reference** panel shows the same scene sphere-traced in a GLSL fragment shader from your camera, and the readouts
 measure how well they agree. Drag a gizmo: the mesh follows.
@@ -515,7 +537,7 @@ IoU is lowest when a box edge is on the silhouette.
 
     def _sync_enabled_inputs(self) -> None:
         """Show gizmos of enabled primitives; grey out sizes the kind does not use."""
-        used = {"sphere": 1, "box": 3, "torus": 2, "capsule": 2}
+        used = SIZES_USED
         self.k.disabled = self.params.blend == "hard"
         for handles, gizmo, slot in zip(
             self.slots, self.gizmos, self.params.primitives, strict=True

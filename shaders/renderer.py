@@ -29,7 +29,20 @@ from numpy.typing import ArrayLike, NDArray
 
 from kernels import sdf
 
-KIND_CODE: dict[str, int] = {"sphere": 0, "box": 1, "torus": 2, "capsule": 3}
+KIND_CODE: dict[str, int] = {
+    "sphere": 0,
+    "box": 1,
+    "torus": 2,
+    "capsule": 3,
+    "cylinder": 4,
+    "round_box": 5,
+    "octahedron": 6,
+    "cone": 7,
+    "hex_prism": 8,
+    "ellipsoid": 9,
+}
+BASIC_KINDS = frozenset({"sphere", "box", "torus", "capsule"})
+"""Kinds the fast single-formula path of sdf.glsl's primitive_distance handles; others need EXTRA_KINDS."""
 OP_CODE: dict[str, int] = {"union": 0, "subtract": 1, "intersect": 2}
 BLEND_CODE: dict[str, int] = {"poly": 0, "exp": 1}
 _MISS = -1.0
@@ -198,6 +211,15 @@ def _bounding_boxes(
                 half[i] = (s[0] + s[1], s[1], s[0] + s[1])
             case "capsule":
                 half[i] = (s[1], s[0] + s[1], s[1])
+            case "cylinder" | "cone":
+                radius, half_height = (s[1], s[0]) if prim.kind == "cylinder" else (s[0], s[1] / 2)
+                half[i] = (radius, half_height, radius)
+            case "round_box" | "ellipsoid":
+                half[i] = s[:3]
+            case "octahedron":
+                half[i] = (s[0], s[0], s[0])
+            case "hex_prism":
+                half[i] = (2 * s[0] / math.sqrt(3.0), s[0], s[1])
     centers = np.array([p.center for p in scene.primitives], dtype=np.float64)
     rotations = np.array([sdf.rotation_matrix(p.rotation) for p in scene.primitives])
     unions = sum(prim.op == "union" for prim in scene.primitives[1:])
@@ -424,16 +446,17 @@ class Renderer:
         # cost as much as the rest of the scene, so poly and hard scenes use a program without them.
         self._raymarch_source = _source("raymarch.frag")
         self._fullscreen = _source("fullscreen.vert")
-        self._raymarch: dict[tuple[bool, bool, bool], object] = {}
-        self._raymarch_vao: dict[tuple[bool, bool, bool], object] = {}
+        self._raymarch: dict[tuple[bool, bool, bool, bool], object] = {}
+        self._raymarch_vao: dict[tuple[bool, bool, bool, bool], object] = {}
         self._fields: collections.OrderedDict[tuple[str, str], tuple[object, object]] = (
             collections.OrderedDict()
         )
         """Compiled editor programs by (source, variant), least recently used first."""
         for shadows, occlusion in ((True, True), (False, False)):  # the gallery's opening variants
-            self._raymarch_program((shadows, occlusion, True))
+            self._raymarch_program((shadows, occlusion, True, False))
         self._probe = self.ctx.program(
-            vertex_shader=fullscreen, fragment_shader=_source("probe.frag")
+            vertex_shader=fullscreen,
+            fragment_shader=_with_defines(_source("probe.frag"), EXTRA_KINDS=1),
         )
         self._mesh = self.ctx.program(
             vertex_shader=_source("mesh.vert"), fragment_shader=_source("mesh.frag")
@@ -446,9 +469,10 @@ class Renderer:
     def release(self) -> None:
         self.ctx.release()
 
-    def _raymarch_program(self, variant: tuple[bool, bool, bool]) -> tuple[object, object]:
+    def _raymarch_program(self, variant: tuple[bool, bool, bool, bool]) -> tuple[object, object]:
+        """The ray-march program for (shadows, occlusion, polynomial blend only, catalogue kinds), compiled once."""
         if variant not in self._raymarch:
-            shadows, occlusion, poly_only = variant
+            shadows, occlusion, poly_only, extra = variant
             prog = self.ctx.program(
                 vertex_shader=self._fullscreen,
                 fragment_shader=_with_defines(
@@ -456,6 +480,7 @@ class Renderer:
                     SHADOWS=int(shadows),
                     OCCLUSION=int(occlusion),
                     POLY_BLEND_ONLY=int(poly_only),
+                    EXTRA_KINDS=int(extra),
                 ),
             )
             self._raymarch[variant] = prog
@@ -592,7 +617,12 @@ class Renderer:
         _check_size(width, height)
         shading = shading or Shading()
         # sdf.glsl's smin_blend uses the polynomial form for hard scenes (k = 0) whatever the blend.
-        variant = (shading.shadows, shading.occlusion, scene.blend == "poly" or scene.k == 0.0)
+        variant = (
+            shading.shadows,
+            shading.occlusion,
+            scene.blend == "poly" or scene.k == 0.0,
+            any(p.kind not in BASIC_KINDS for p in scene.primitives),
+        )
         prog, vao = self._raymarch_program(variant)
         self._set_scene(prog, scene)
         self._set_camera(prog, camera, width, height, shading)

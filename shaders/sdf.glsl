@@ -7,6 +7,14 @@
 #define KIND_BOX 1
 #define KIND_TORUS 2
 #define KIND_CAPSULE 3
+#define KIND_CYLINDER 4
+#define KIND_ROUND_BOX 5
+#define KIND_OCTAHEDRON 6
+#define KIND_CONE 7
+#define KIND_HEX_PRISM 8
+#define KIND_ELLIPSOID 9
+// kernels/sdf.py ROUND_BOX_ROUNDING: a scene's round box is rounded by this fraction of its smallest half size.
+#define ROUND_BOX_ROUNDING 0.25
 #define OP_UNION 0
 #define OP_SUBTRACT 1
 #define OP_INTERSECT 2
@@ -181,6 +189,10 @@ float sd_ellipsoid(vec3 p, vec3 radii) {  // a bound, not exact; -min(radii) at 
     return k1 > 0.0 ? k0 * (k0 - 1.0) / k1 : -min(radii.x, min(radii.y, radii.z));
 }
 
+float sd_ellipsoid_lipschitz(vec3 p, vec3 radii) {  // a 1-Lipschitz bound: (|p/r| - 1)·min(r)
+    return (length(p / radii) - 1.0) * min(radii.x, min(radii.y, radii.z));
+}
+
 float sd_plane(vec3 p, vec3 normal, float offset) {  // exact; n·p + offset, n normalised here
     return dot(p, normalize(normal)) + offset;
 }
@@ -228,6 +240,22 @@ vec3 op_symmetry(vec3 p, vec3 axes) {  // axes: 1 mirrors that coordinate, 0 lea
 // p' = (|p.xz| - major radius, p.y, 0) and e = 0: then q = |p'| has no negative part and the formula is
 // |p'| - minor radius, sd_torus. One formula with selected inputs, not two formulas and a select (see smin_blend on
 // why); the values equal sd_sphere, sd_box, sd_capsule and sd_torus.
+// The catalogue's kinds cost every one of their formulas under llvmpipe's masking, so only programs that define
+// EXTRA_KINDS 1 (the renderer compiles those for scenes that use them) include them.
+#ifndef EXTRA_KINDS
+#define EXTRA_KINDS 0
+#endif
+#if EXTRA_KINDS
+float catalogue_distance(int kind, vec3 p, vec3 s) {
+    if (kind == KIND_CYLINDER) return sd_cylinder(p, s.x, s.y);
+    if (kind == KIND_ROUND_BOX) return sd_round_box(p, s, ROUND_BOX_ROUNDING * min(s.x, min(s.y, s.z)));
+    if (kind == KIND_OCTAHEDRON) return sd_octahedron(p, s.x);
+    if (kind == KIND_CONE) return sd_cone(p, s.x, s.y);
+    if (kind == KIND_HEX_PRISM) return sd_hex_prism(p, s.x, s.y);
+    return sd_ellipsoid_lipschitz(p, s);
+}
+#endif
+
 float primitive_distance(int i, vec3 p_world) {
     vec3 p = u_world_to_local[i] * (p_world - u_center[i]);
     vec3 s = u_size[i];
@@ -236,6 +264,11 @@ float primitive_distance(int i, vec3 p_world) {
     vec3 shape_point = torus ? vec3(length(p.xz) - s.x, p.y, 0.0) : p;
     vec3 e = kind == KIND_BOX ? s : (kind == KIND_CAPSULE ? vec3(0.0, s.x, 0.0) : vec3(0.0));
     float r = kind == KIND_BOX ? 0.0 : (kind == KIND_CAPSULE || torus ? s.y : s.x);
+#if EXTRA_KINDS
+    if (kind >= KIND_CYLINDER) {
+        return catalogue_distance(kind, p, s);
+    }
+#endif
     return sd_box(shape_point, e) - r;
 }
 

@@ -463,3 +463,29 @@ def test_gizmos_draw_over_the_mesh_and_reach_out_of_it(scene: SdfGalleryScene) -
         # The arrow tips lie outside the primitive (positive distance): something to grab from outside.
         tips = np.asarray(slot.position) + scene_gizmo_scale() * sdf.rotation_matrix(slot.wxyz).T
         assert np.all(prim.distance(tips) > 0.0), slot.kind
+
+
+@pytest.mark.parametrize(
+    ("label", "kind"),
+    [("Cylinder", "cylinder"), ("Octahedron", "octahedron"), ("Ellipsoid (bound)", "ellipsoid")],
+)
+def test_catalogue_primitives_from_the_dropdown_are_meshed(
+    server: viser.ViserServer, scene: SdfGalleryScene, label: str, kind: str
+) -> None:
+    from scenes.sdf_gallery import KIND_LABELS
+
+    assert {"Cylinder", "Round box", "Octahedron", "Cone", "Hexagonal prism"} <= set(KIND_LABELS)
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("P2 kind")
+        client.set_value("P2 kind", label)
+        wait_until(
+            lambda: scene.mesh_scene is not None and scene.mesh_scene.primitives[1].kind == kind,
+            what=f"a mesh with a {kind}",
+        )
+        meshed = scene.mesh_scene
+        assert meshed is not None
+        expected = sdf.mesh(meshed, scene.params.resolution)
+        np.testing.assert_array_equal(scene.mesh_vertices, expected[0])
+        # The mesh's vertices lie on the surface of the scene with the new kind.
+        d = sdf.scene_distance(meshed, scene.mesh_vertices)
+        assert np.abs(d).max() < 0.5 * sdf.make_grid(meshed, scene.params.resolution).spacing
