@@ -968,3 +968,13 @@ def _near_surface_mask(field: NDArray[np.float32], spacing: float) -> NDArray[np
     """Cells whose corners may straddle the surface (|d| within a cell diagonal at a corner): marching cubes skips
     the rest, which it would find empty anyway for a distance bound."""
     return np.abs(field) <= np.float32(math.sqrt(3.0) * spacing)
+
+
+def examples() -> dict[str, str]:
+    """The editor's example sources (``shaders/example_*.glsl``) by title (each file's first comment line)."""
+    out: dict[str, str] = {}
+    for path in sorted(SHADER_DIR.glob("example_*.glsl")):
+        source = path.read_text(encoding="utf-8")
+        title = source.split("\n", 1)[0].removeprefix("//").strip()
+        out[title] = source
+    return out

@@ -175,7 +175,7 @@ def test_crafted_bad_values_keep_the_last_good_scene(
         client.wait_for(
             lambda: client.value_of("Blend width k (m)") == good.k, what="k written back"
         )
-        client.set_value("P2 kind", "Cone")
+        client.set_value("P2 kind", "Pyramid")  # not an option
         client.wait_for(lambda: client.value_of("P2 kind") == "Box", what="kind written back")
         client.set_value(
             "P3 size a (m)", "big"
@@ -489,3 +489,146 @@ def test_catalogue_primitives_from_the_dropdown_are_meshed(
         # The mesh's vertices lie on the surface of the scene with the new kind.
         d = sdf.scene_distance(meshed, scene.mesh_vertices)
         assert np.abs(d).max() < 0.5 * sdf.make_grid(meshed, scene.params.resolution).spacing
+
+
+# ------------------------------------------------------------------------------------------ editor and view
+SPHERE_SOURCE = "float sdf(vec3 p) {\n    return sd_sphere(p - vec3(0.2, 0.0, 0.1), 0.6);\n}\n"
+
+
+def background_images(client: BrowserClient) -> list[dict]:
+    return [m for _, m in client.received if m.get("type") == "BackgroundImageMessage"]
+
+
+@pytest.mark.gl
+def test_typed_source_is_meshed_and_a_bad_one_keeps_the_last_good(
+    server: viser.ViserServer, scene: SdfGalleryScene
+) -> None:
+    need_gl()
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("sdf(p) in GLSL")
+        client.set_value("sdf(p) in GLSL", SPHERE_SOURCE)
+        client.click("Apply")
+        wait_until(lambda: scene.editor_serial == 1, what="the source applied")
+        assert scene.params.shape_source == "editor" and scene.mesh_scene is None
+        client.wait_for(lambda: client.value_of("Shape") == "GLSL editor", what="Shape shown")
+        # The mesh is the typed sphere: every vertex 0.6 m from (0.2, 0, 0.1), within a fraction of a voxel.
+        radii = np.linalg.norm(scene.mesh_vertices - [0.2, 0.0, 0.1], axis=1)
+        assert len(radii) > 1000
+        assert np.abs(radii - 0.6).max() < 0.01
+        assert not any(g.visible for g in scene.gizmos)
+        # A compile error: the message names the line; the sphere stays.
+        shown = scene.mesh_vertices.copy()
+        client.set_value("sdf(p) in GLSL", "float sdf(vec3 p) {\n    return sd_sphere(p, 0.5)\n}\n")
+        client.click("Apply")
+        wait_until(lambda: scene.editor_error is not None, what="the error")
+        assert scene.editor_error is not None and scene.editor_error.startswith("line 3:")
+        assert "line 3" in scene.editor_status.content
+        # A loop and an over-long source are refused before the compiler sees them.
+        for text, words in [
+            (
+                "float sdf(vec3 p) {\n    float d = 1.0;\n    for (;;) { d = 0.5; }\n    return d;\n}",
+                "line 3",
+            ),
+            ("float sdf(vec3 p) { return 1.0; }\n" + "//" * 5000, "limit"),
+            ("#extension GL_ARB_foo : enable\nfloat sdf(vec3 p) { return 1.0; }", "line 1"),
+        ]:
+            scene.editor_error = None
+            client.set_value("sdf(p) in GLSL", text)
+            client.click("Apply")
+            wait_until(lambda: scene.editor_error is not None, what="a refusal")
+            assert words in str(scene.editor_error)
+        assert scene.editor_serial == 1
+        np.testing.assert_array_equal(scene.mesh_vertices, shown)
+
+
+@pytest.mark.gl
+def test_every_example_applies_and_meshes(
+    server: viser.ViserServer, scene: SdfGalleryScene
+) -> None:
+    from scenes.sdf_gallery import EXAMPLES
+
+    need_gl()
+    assert len(EXAMPLES) >= 6
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Example")
+        for n, title in enumerate(list(EXAMPLES)[1:] + list(EXAMPLES)[:1], start=1):
+            client.set_value("Example", title)
+            wait_until(lambda n=n: scene.editor_serial == n, what=f"example {title!r}")
+            assert scene.params.editor.source == EXAMPLES[title]
+            assert len(scene.mesh_faces) > 500, title
+            client.wait_for(
+                lambda t=title: client.value_of("sdf(p) in GLSL") == EXAMPLES[t], what="text"
+            )
+
+
+@pytest.mark.gl
+def test_raymarched_view_goes_to_the_background_with_depth(
+    server: viser.ViserServer, scene: SdfGalleryScene
+) -> None:
+    need_gl()
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("View")
+        client.send_camera(position=(2.0, -2.4, 1.6), look_at=(0.0, 0.0, 0.3), size=(400, 640))
+        client.set_value("View", "Ray-marched")
+        wait_until(lambda: scene.view_serial > 0, what="a main-view frame")
+        assert scene.mesh_node.visible is False and scene.wireframe_node.visible is False
+        client.wait_for(lambda: len(background_images(client)) > 0, what="a background image")
+        message = background_images(client)[-1]
+        assert message["rgb_data"] and message["depth_data"]
+        # At rest the frame is the full width, with the viewer's aspect.
+        wait_until(
+            lambda: scene.view_rgb is not None and scene.view_rgb.shape[1] == 640,
+            what="the full frame",
+        )
+        assert scene.view_rgb is not None and scene.view_rgb.shape[:2] == (400, 640)
+        # Moving: a reduced frame first.
+        client.send_camera(position=(2.2, -2.2, 1.6), look_at=(0.0, 0.0, 0.3), size=(400, 640))
+        wait_until(
+            lambda: scene.view_rgb is not None and scene.view_rgb.shape[1] == 320,
+            what="a reduced frame",
+        )
+        client.set_value("View", "Both")
+        client.wait_for(lambda: True)
+        wait_until(lambda: scene.wireframe_node.visible, what="the wireframe")
+        assert len(scene.wireframe_node.faces) == len(scene.mesh_faces)
+        client.set_value("View", "Mesh")
+        wait_until(lambda: scene.mesh_node.visible, what="the mesh back")
+        client.wait_for(
+            lambda: background_images(client)[-1]["rgb_data"] is None, what="background cleared"
+        )
+
+
+def test_camera_with_zero_height_or_nan_is_ignored(
+    server: viser.ViserServer, scene: SdfGalleryScene
+) -> None:
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("View")
+        client.send_camera(size=(0, 640))
+        client.send_camera(position=(float("nan"), 0.0, 1.0))
+        client.send_camera(size=(400, 640))
+        serial = scene.mesh_serial
+        client.drag_transform("/sdf/gizmo_1", [(0.1, 0.0, 0.5)])
+        wait_until(lambda: scene.mesh_serial > serial, what="the scene still answering")
+
+
+@pytest.mark.gl
+def test_with_editing_off_apply_uses_only_the_servers_examples(
+    server: viser.ViserServer, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import scenes.sdf_gallery as gallery
+
+    need_gl()
+    monkeypatch.setattr(gallery, "_editing", {"allowed": False})
+    scene = SdfGalleryScene(server)
+    try:
+        assert scene.editor.disabled and "Editing is off" in scene.editor_status.content
+        with BrowserClient(server.get_port()) as client:
+            client.wait_for_gui("Apply")
+            client.set_value(
+                "sdf(p) in GLSL", SPHERE_SOURCE
+            )  # a crafted client can still send text
+            client.click("Apply")
+            wait_until(lambda: scene.editor_serial == 1, what="an apply")
+            assert scene.params.editor.source == next(iter(gallery.EXAMPLES.values()))
+    finally:
+        scene.close()
