@@ -239,7 +239,8 @@ def bench_view(repeats: int) -> list[str]:
 def bench_edit(edits: int) -> list[str]:
     server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
     scene = SdfGalleryScene(server)
-    latencies = []
+    latencies: list[float] = []
+    failures: list[str] = []
     try:
         with BrowserClient(server.get_port()) as client:
             client.send_camera(
@@ -278,7 +279,11 @@ def bench_edit(edits: int) -> list[str]:
                             frame = frame or t
                     return mesh, frame
 
-                client.wait_for(lambda: None not in arrivals(), timeout=20.0, what="mesh and frame")
+                try:
+                    client.wait_for(lambda: None not in arrivals(), timeout=20.0)
+                except AssertionError:
+                    failures.append(str(scene.editor_error))
+                    continue
                 mesh_t, frame_t = arrivals()
                 assert mesh_t is not None and frame_t is not None and scene.editor_serial > serial
                 latencies.append(1e3 * (max(mesh_t, frame_t) - start))
@@ -292,9 +297,10 @@ def bench_edit(edits: int) -> list[str]:
         row(
             f"Edit → new ray-march and 64³ mesh at the websocket client ({edits} new sources)",
             f"p50 {statistics.median(latencies):.0f} ms, p95 {p95(latencies):.0f} ms, "
-            f"max {max(latencies):.0f} ms",
+            f"max {max(latencies):.0f} ms"
+            + (f"; {len(failures)} refused: {failures[0]}" if failures else ""),
             "≤ 1 s",
-            "met" if max(latencies) <= 1000 else "missed",
+            "met" if max(latencies) <= 1000 and not failures else "missed",
         )
     ]
 

@@ -110,9 +110,9 @@ VIEW_WIDTH_PX = 640
 """Width of the ray-marched main view once the camera rests (px); its height follows the viewer's aspect."""
 MOVING_WIDTH_PX = 320
 """Width while the camera or a gizmo moves: a quarter of the pixels, so the view keeps up."""
-COMPILE_LIMIT_S = 2.0
+COMPILE_LIMIT_S = 10.0
 """An editor source whose programs take longer to compile is refused (s)."""
-FRAME_LIMIT_S = 0.25
+FRAME_LIMIT_S = 1.0
 """An editor source whose test frame (MOVING_WIDTH_PX wide) takes longer is refused (s)."""
 EDITOR_HALF_SIZE_M = 1.5
 """The editor's field is meshed and ray-marched inside the cube [−h, h]³ (m) by default."""
@@ -812,7 +812,7 @@ IoU is lowest when a box edge is on the silhouette.
         start = time.perf_counter()
         try:
             check_source(text)
-            gl_service.run(lambda gl: gl.compile_field(text))
+            gl_service.run(lambda gl: gl.compile_field(text, self.params.shading))
             compile_s = time.perf_counter() - start
             if compile_s > COMPILE_LIMIT_S:
                 raise ShaderCompileError(

@@ -766,8 +766,12 @@ class Renderer:
 
     # ------------------------------------------------------------------------------------- the editor's fields
     def _field_program(self, source: str, variant: str) -> tuple[object, object]:
-        """The compiled program of an editor source for one variant ("grid", "points", or "march:S:O" with the
-        shadow and occlusion flags), cached; :class:`ShaderCompileError` for a source the compiler rejects."""
+        """The compiled program of an editor source for one variant ("sample", or "march:S:O" with the shadow and
+        occlusion flags), cached; :class:`ShaderCompileError` for a source the compiler rejects.
+
+        A new program is drawn once into one pixel: llvmpipe compiles (JITs) a program at its first draw, which
+        costs more than most frames; drawing here keeps that cost in the compile time, not the first frame.
+        """
         import moderngl
 
         key = (source, variant)
@@ -775,10 +779,8 @@ class Renderer:
         if cached is not None:
             self._fields.move_to_end(key)
             return cached
-        if variant in ("grid", "points"):
-            template = _with_defines(
-                _source("field_sample.frag"), SAMPLE_POINTS=int(variant == "points")
-            )
+        if variant == "sample":
+            template = _source("field_sample.frag")
         else:
             _, shadows, occlusion = variant.split(":")
             template = _with_defines(
@@ -795,6 +797,13 @@ class Renderer:
         except moderngl.Error as exc:
             raise ShaderCompileError.from_compiler(str(exc), source) from None
         vao = self.ctx.vertex_array(prog, [])
+        warm_target = self.ctx.texture((1, 1), 4, dtype="f4")
+        warm = self.ctx.framebuffer(color_attachments=[warm_target])
+        warm.use()
+        vao.render(moderngl.TRIANGLES, vertices=3)
+        warm_target.read()  # wait for it
+        warm.release()
+        warm_target.release()
         self._fields[key] = (prog, vao)
         while len(self._fields) > _FIELD_CACHE:
             _, (old_prog, old_vao) = self._fields.popitem(last=False)
@@ -802,11 +811,13 @@ class Renderer:
             old_prog.release()  # pyright: ignore[reportAttributeAccessIssue]
         return prog, vao
 
-    def compile_field(self, source: str) -> None:
-        """Check and compile an editor source (its sampling programs), or raise ValueError saying why and where."""
+    def compile_field(self, source: str, shading: Shading | None = None) -> None:
+        """Check and compile an editor source (its sampling programs and the ray-march for ``shading``'s shadow and
+        occlusion switches), or raise ValueError saying why and where."""
         check_source(source)
-        self._field_program(source, "grid")
-        self._field_program(source, "points")
+        shading = shading or Shading()
+        self._field_program(source, "sample")
+        self._field_program(source, f"march:{int(shading.shadows)}:{int(shading.occlusion)}")
 
     def probe_field(
         self, source: str, points: ArrayLike
@@ -818,7 +829,8 @@ class Renderer:
         pts = np.asarray(points, dtype=np.float32)
         if pts.ndim != 2 or pts.shape[1] != 3 or not np.all(np.isfinite(pts)) or len(pts) == 0:
             raise ValueError(f"points must be finite (N, 3) with N ≥ 1, got {pts.shape}")
-        prog, vao = self._field_program(source, "points")
+        prog, vao = self._field_program(source, "sample")
+        self._set(prog, "u_sample_points", 1)
         n = len(pts)
         width = min(n, _PROBE_WIDTH)
         height = -(-n // width)
@@ -847,7 +859,8 @@ class Renderer:
         import moderngl
 
         check_source(source)
-        prog, vao = self._field_program(source, "grid")
+        prog, vao = self._field_program(source, "sample")
+        self._set(prog, "u_sample_points", 0)
         nx, ny, nz = grid.shape
         slices = max(1, min(nz, _MAX_ROWS // ny))
         distance = self.ctx.texture((nx, ny * slices), 1, dtype="f4")

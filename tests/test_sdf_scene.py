@@ -632,3 +632,27 @@ def test_with_editing_off_apply_uses_only_the_servers_examples(
             assert scene.params.editor.source == next(iter(gallery.EXAMPLES.values()))
     finally:
         scene.close()
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize(
+    ("limit", "words"), [("COMPILE_LIMIT_S", "compiling took"), ("FRAME_LIMIT_S", "frame took")]
+)
+def test_compile_and_frame_time_limits_refuse_a_slow_source(
+    server: viser.ViserServer,
+    scene: SdfGalleryScene,
+    monkeypatch: pytest.MonkeyPatch,
+    limit: str,
+    words: str,
+) -> None:
+    import scenes.sdf_gallery as gallery
+
+    need_gl()
+    monkeypatch.setattr(gallery, limit, 1e-9)  # every source is too slow now
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("sdf(p) in GLSL")
+        client.set_value("sdf(p) in GLSL", SPHERE_SOURCE.replace("0.6", "0.61"))
+        client.click("Apply")
+        wait_until(lambda: scene.editor_error is not None, what="a refusal")
+        assert words in str(scene.editor_error) and "limit" in str(scene.editor_error)
+        assert scene.editor_serial == 0 and scene.params.shape_source == "primitives"
