@@ -109,11 +109,12 @@ SOURCE_LABELS: dict[str, ShapeSource] = {
 VIEW_WIDTH_PX = 640
 """Width of the ray-marched main view once the camera rests (px); its height follows the viewer's aspect."""
 MOVING_WIDTH_PX = 320
-"""Width while the camera or a gizmo moves: a quarter of the pixels, so the view keeps up."""
+"""Width while the camera or a gizmo moves: a quarter of the pixels, and no shadows or AO, so the view keeps up."""
 COMPILE_LIMIT_S = 10.0
 """An editor source whose programs take longer to compile is refused (s)."""
 FRAME_LIMIT_S = 1.0
-"""An editor source whose test frame (MOVING_WIDTH_PX wide) takes longer is refused (s)."""
+"""An editor source whose test frame (MOVING_WIDTH_PX wide, moving shading) takes longer is refused (s); the fully
+shaded program at rest costs a few times more (its soft shadows and AO call sdf about twenty times a pixel more)."""
 EDITOR_HALF_SIZE_M = 1.5
 """The editor's field is meshed and ray-marched inside the cube [−h, h]³ (m) by default."""
 EXAMPLES = gl_renderer.examples()
@@ -812,7 +813,10 @@ IoU is lowest when a box edge is on the silhouette.
         start = time.perf_counter()
         try:
             check_source(text)
-            gl_service.run(lambda gl: gl.compile_field(text, self.params.shading))
+            # The moving frames' program (no shadows, no AO) first: the new shape appears with it, and the fully
+            # shaded program compiles when the view next rests.
+            moving_shading = _moving_shading(self.params.shading)
+            gl_service.run(lambda gl: gl.compile_field(text, moving_shading))
             compile_s = time.perf_counter() - start
             if compile_s > COMPILE_LIMIT_S:
                 raise ShaderCompileError(
@@ -827,7 +831,7 @@ IoU is lowest when a box edge is on the silhouette.
                     camera,
                     MOVING_WIDTH_PX,
                     MOVING_WIDTH_PX * 5 // 8,
-                    self.params.shading,
+                    moving_shading,
                 )
             )
             frame_s = time.perf_counter() - frame_start
@@ -984,10 +988,9 @@ IoU is lowest when a box edge is on the silhouette.
             return
         width = MOVING_WIDTH_PX if moving else VIEW_WIDTH_PX
         height = max(16, round(width / aspect))
+        shading = _moving_shading(params.shading) if moving else params.shading
         start = time.perf_counter()
-        rgb, depth = gl_service.run(
-            lambda gl: _march(gl, shape, camera, width, height, params.shading)
-        )
+        rgb, depth = gl_service.run(lambda gl: _march(gl, shape, camera, width, height, shading))
         view_ms = 1e3 * (time.perf_counter() - start)
         # viser encodes depth in fixed point up to 167 m: a miss goes to the far end.
         depth = np.where(np.isfinite(depth), depth, 1e3).astype(np.float32)
@@ -1068,6 +1071,12 @@ def _compare(marched: np.ndarray, rasterised: np.ndarray) -> tuple[float | None,
     if not inner.any():
         return iou, None
     return iou, float(np.mean(np.abs(marched[inner].astype(np.float64) - rasterised[inner])))
+
+
+def _moving_shading(shading: Shading) -> Shading:
+    """The shading of frames drawn while something moves: no soft shadows or ambient occlusion (a smaller program,
+    several times cheaper a frame under llvmpipe); the full shading returns when the view rests."""
+    return dataclasses.replace(shading, shadows=False, occlusion=False)
 
 
 def _march(
