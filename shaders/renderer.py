@@ -797,13 +797,28 @@ class Renderer:
         except moderngl.Error as exc:
             raise ShaderCompileError.from_compiler(str(exc), source) from None
         vao = self.ctx.vertex_array(prog, [])
-        warm_target = self.ctx.texture((1, 1), 4, dtype="f4")
-        warm = self.ctx.framebuffer(color_attachments=[warm_target])
+        # llvmpipe compiles a variant per framebuffer layout: warm with the layout the real draws use.
+        if variant == "sample":
+            warm_targets = [
+                self.ctx.texture((1, 1), 1, dtype="f4"),
+                self.ctx.texture((1, 1), 4, dtype="f4"),
+            ]
+            warm = self.ctx.framebuffer(color_attachments=warm_targets)
+        else:
+            warm_targets = [
+                self.ctx.texture((1, 1), 3, dtype="f1"),
+                self.ctx.texture((1, 1), 1, dtype="f4"),
+            ]
+            zbuffer = self.ctx.depth_renderbuffer((1, 1))
+            warm = self.ctx.framebuffer(color_attachments=warm_targets, depth_attachment=zbuffer)
+            warm_targets.append(zbuffer)  # type: ignore[arg-type]
         warm.use()
+        self.ctx.disable(moderngl.DEPTH_TEST)
         vao.render(moderngl.TRIANGLES, vertices=3)
-        warm_target.read()  # wait for it
+        warm.read(components=1, dtype="f4")  # wait for it
         warm.release()
-        warm_target.release()
+        for target in warm_targets:
+            target.release()
         self._fields[key] = (prog, vao)
         while len(self._fields) > _FIELD_CACHE:
             _, (old_prog, old_vao) = self._fields.popitem(last=False)
@@ -864,7 +879,9 @@ class Renderer:
         nx, ny, nz = grid.shape
         slices = max(1, min(nz, _MAX_ROWS // ny))
         distance = self.ctx.texture((nx, ny * slices), 1, dtype="f4")
-        color = self.ctx.texture((nx, ny * slices), 4, dtype="f1")
+        color = self.ctx.texture(
+            (nx, ny * slices), 4, dtype="f4"
+        )  # the points pass's layout: one variant
         fbo = self.ctx.framebuffer(color_attachments=[distance, color])
         fbo.use()
         self._set(prog, "u_origin", tuple(float(v) for v in grid.origin))
