@@ -797,28 +797,24 @@ class Renderer:
         except moderngl.Error as exc:
             raise ShaderCompileError.from_compiler(str(exc), source) from None
         vao = self.ctx.vertex_array(prog, [])
-        # llvmpipe compiles a variant per framebuffer layout: warm with the layout the real draws use.
-        if variant == "sample":
-            warm_targets = [
-                self.ctx.texture((1, 1), 1, dtype="f4"),
-                self.ctx.texture((1, 1), 4, dtype="f4"),
-            ]
-            warm = self.ctx.framebuffer(color_attachments=warm_targets)
-        else:
-            warm_targets = [
-                self.ctx.texture((1, 1), 3, dtype="f1"),
-                self.ctx.texture((1, 1), 1, dtype="f4"),
-            ]
-            zbuffer = self.ctx.depth_renderbuffer((1, 1))
-            warm = self.ctx.framebuffer(color_attachments=warm_targets, depth_attachment=zbuffer)
-            warm_targets.append(zbuffer)  # type: ignore[arg-type]
-        warm.use()
+        # llvmpipe compiles a variant per framebuffer layout: warm with each layout the real draws use (the grid
+        # pass's and the points pass's, or the ray-march's).
+        layouts = [("f1", 4), ("f4", 4)] if variant == "sample" else [("f4", 1)]
         self.ctx.disable(moderngl.DEPTH_TEST)
-        vao.render(moderngl.TRIANGLES, vertices=3)
-        warm.read(components=1, dtype="f4")  # wait for it
-        warm.release()
-        for target in warm_targets:
-            target.release()
+        for second_dtype, second_components in layouts:
+            first = (
+                self.ctx.texture((1, 1), 1, dtype="f4")
+                if variant == "sample"
+                else self.ctx.texture((1, 1), 3, dtype="f1")
+            )
+            second = self.ctx.texture((1, 1), second_components, dtype=second_dtype)
+            zbuffer = None if variant == "sample" else self.ctx.depth_renderbuffer((1, 1))
+            warm = self.ctx.framebuffer(color_attachments=[first, second], depth_attachment=zbuffer)
+            warm.use()
+            vao.render(moderngl.TRIANGLES, vertices=3)
+            warm.read(components=1, dtype="f4")  # wait for it
+            for obj in (warm, first, second, *([] if zbuffer is None else [zbuffer])):
+                obj.release()
         self._fields[key] = (prog, vao)
         while len(self._fields) > _FIELD_CACHE:
             _, (old_prog, old_vao) = self._fields.popitem(last=False)
@@ -880,8 +876,8 @@ class Renderer:
         slices = max(1, min(nz, _MAX_ROWS // ny))
         distance = self.ctx.texture((nx, ny * slices), 1, dtype="f4")
         color = self.ctx.texture(
-            (nx, ny * slices), 4, dtype="f4"
-        )  # the points pass's layout: one variant
+            (nx, ny * slices), 4, dtype="f1"
+        )  # a quarter of the points pass's bytes
         fbo = self.ctx.framebuffer(color_attachments=[distance, color])
         fbo.use()
         self._set(prog, "u_origin", tuple(float(v) for v in grid.origin))
