@@ -280,11 +280,13 @@ class SdfGalleryScene(Scene):
     camera_position = (1.9, -2.1, 1.4)
     camera_look_at = (0.05, 0.0, 0.3)
     about = """
-**What it shows.** A scene of up to four signed-distance primitives (sphere, box, torus, capsule, cylinder, round box, octahedron, cone, hexagonal
-prism, ellipsoid) combined by
-union, subtraction or intersection with a smooth minimum. The 3D view shows its marching-cubes mesh; the
-**Reference** panel shows the same scene sphere-traced in a GLSL fragment shader from your camera, and the readouts
-measure how well they agree. Drag a gizmo: the mesh follows.
+**What it shows.** A scene of up to four signed-distance primitives (sphere, box, torus, capsule and Quilez's
+cylinder, round box, octahedron, cone, hexagonal prism, ellipsoid) combined by union, subtraction or intersection,
+hard or with a smooth minimum; or any shape you write in GLSL in the **GLSL editor** (`float sdf(vec3 p)`, with the
+same primitives and operators). The 3D view shows its marching-cubes mesh, the GLSL ray-march rendered from your
+camera (**View: Ray-marched**, composited by depth with the gizmos), or both (the mesh as a wireframe over the
+ray-march). The **Reference** panel shows the ray-march as an image and the readouts measure how well mesh and
+ray-march agree. Drag a gizmo: the mesh follows.
 
 **Equations.** Sphere |p| − r; box |max(q,0)| + min(max(q.x,q.y,q.z),0), q = |p| − b; torus |(|p.xz| − R, p.y)| − r;
 capsule |pa − ba·h| − r. Smooth union, polynomial: h = clamp(½ + ½(b − a)/k, 0, 1),
