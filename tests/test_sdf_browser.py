@@ -126,7 +126,9 @@ def test_typed_shape_is_meshed_and_ray_marched_in_the_main_view(
     try:
         page.set_viewport_size({"width": 1600, "height": 1000})
         open_viser(page, server.get_port(), "/sdf/mesh")
-        page.get_by_text("GLSL editor", exact=True).first.click()
+        page.locator(
+            'text="GLSL editor" >> visible=true'
+        ).first.click()  # the folder, not the About text
         editor = page.locator("textarea").filter(has_text="sdf(vec3 p)").first
         editor.fill(OCTAHEDRON)
         page.get_by_role("button", name="Apply").click()
