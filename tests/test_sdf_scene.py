@@ -516,6 +516,12 @@ def test_typed_source_is_meshed_and_a_bad_one_keeps_the_last_good(
         assert len(radii) > 1000
         assert np.abs(radii - 0.6).max() < 0.01
         assert not any(g.visible for g in scene.gizmos)
+        # The downloads are the typed shape's mesh.
+        name, data = scene.export("stl")
+        assert name == "sdf_mesh.stl" and data is not None
+        exported = trimesh.load(io.BytesIO(data), file_type="stl", force="mesh")
+        assert isinstance(exported, trimesh.Trimesh)
+        assert exported.volume == pytest.approx(4 / 3 * math.pi * 0.6**3, rel=0.02)
         # A compile error: the message names the line; the sphere stays.
         shown = scene.mesh_vertices.copy()
         client.set_value("sdf(p) in GLSL", "float sdf(vec3 p) {\n    return sd_sphere(p, 0.5)\n}\n")
