@@ -14,6 +14,7 @@ import tyro
 import viser
 
 from scenes import SceneName
+from scenes.sdf_gallery import set_editing_allowed
 from scenes.switcher import SceneSwitcher
 
 logger = logging.getLogger("app")
@@ -29,27 +30,40 @@ def is_loopback(host: str) -> bool:
         return False
 
 
-def exposure_warning(host: str, port: int) -> str | None:
+def exposure_warning(host: str, port: int, *, allow_remote_glsl: bool = False) -> str | None:
     """The warning to print when ``host`` is reachable from other machines, else None."""
     if is_loopback(host):
         return None
+    glsl = (
+        "GLSL editing in the SDF gallery is ON (--allow-remote-glsl): anyone can make this machine compile and "
+        "run their shader code (length-, loop- and time-limited)."
+        if allow_remote_glsl
+        else "GLSL editing in the SDF gallery is OFF (its examples still work); --allow-remote-glsl turns it on."
+    )
     return (
         f"WARNING: binding {host}:{port} exposes this server beyond this machine. Anyone who can reach that "
         "address can open the page, move every slider and drag every gizmo, with no password; the server runs "
-        "their inputs on this machine. Use --host 127.0.0.1 (the default) unless that is what you want."
+        f"their inputs on this machine. Use --host 127.0.0.1 (the default) unless that is what you want. {glsl}"
     )
 
 
-def main(scene: SceneName = "peloton", host: str = "127.0.0.1", port: int = 8080) -> None:
+def main(
+    scene: SceneName = "peloton",
+    host: str = "127.0.0.1",
+    port: int = 8080,
+    allow_remote_glsl: bool = False,
+) -> None:
     """Serve the physics scenes in the browser.
 
     Args:
         scene: which scene opens first.
         host: address to bind; the default accepts connections from this machine only.
         port: TCP port to bind.
+        allow_remote_glsl: with a non-loopback host, still let browsers type GLSL into the SDF gallery's editor.
     """
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s %(levelname)s %(message)s")
-    warning = exposure_warning(host, port)
+    set_editing_allowed(is_loopback(host) or allow_remote_glsl)
+    warning = exposure_warning(host, port, allow_remote_glsl=allow_remote_glsl)
     if warning is not None:
         print(warning, flush=True)
     server = viser.ViserServer(host=host, port=port, label="Physics scenes")

@@ -54,14 +54,38 @@ import trimesh
 from numpy.typing import ArrayLike, NDArray
 from skimage.measure import marching_cubes
 
-PrimitiveKind = Literal["sphere", "box", "torus", "capsule"]
-"""Kinds of primitive; ``size`` holds (radius,), (hx, hy, hz), (major, minor) or (half length, radius)."""
+PrimitiveKind = Literal[
+    "sphere",
+    "box",
+    "torus",
+    "capsule",
+    "cylinder",
+    "round_box",
+    "octahedron",
+    "cone",
+    "hex_prism",
+    "ellipsoid",
+]
+"""Kinds of primitive; see :attr:`Primitive.size` for what each one's sizes mean."""
 BooleanOp = Literal["union", "subtract", "intersect"]
 """How a primitive combines with the shape before it."""
 BlendForm = Literal["poly", "exp"]
 """Which smooth minimum blends the booleans."""
 
-PRIMITIVE_KINDS: tuple[PrimitiveKind, ...] = ("sphere", "box", "torus", "capsule")
+PRIMITIVE_KINDS: tuple[PrimitiveKind, ...] = (
+    "sphere",
+    "box",
+    "torus",
+    "capsule",
+    "cylinder",
+    "round_box",
+    "octahedron",
+    "cone",
+    "hex_prism",
+    "ellipsoid",
+)
+ROUND_BOX_ROUNDING = 0.25
+"""A scene's round box is rounded by this fraction of its smallest half size."""
 BOOLEAN_OPS: tuple[BooleanOp, ...] = ("union", "subtract", "intersect")
 BLEND_FORMS: tuple[BlendForm, ...] = ("poly", "exp")
 MAX_PRIMITIVES = 4
@@ -75,7 +99,18 @@ MIN_BLEND_WIDTH = float(np.finfo(np.float32).tiny)
 dip k/4 is below any distance's rounding, a float32 uniform cannot hold them reliably (subnormal or 0), and
 above it 0.5/k and the exp sharpness 4·ln 2/k stay finite in float32."""
 
-_SIZE_COUNT: dict[str, int] = {"sphere": 1, "box": 3, "torus": 2, "capsule": 2}
+_SIZE_COUNT: dict[str, int] = {
+    "sphere": 1,
+    "box": 3,
+    "torus": 2,
+    "capsule": 2,
+    "cylinder": 2,
+    "round_box": 3,
+    "octahedron": 1,
+    "cone": 2,
+    "hex_prism": 2,
+    "ellipsoid": 3,
+}
 
 FloatArray = NDArray[np.float64]
 AnyFloatArray = NDArray[np.floating]
@@ -364,7 +399,10 @@ class Primitive:
     """Position of the local origin in the world (m)."""
     size: tuple[float, ...]
     """The kind's parameters (m): sphere (radius,); box (hx, hy, hz); torus (major, minor); capsule (half length,
-    radius), the segment running along local y."""
+    radius), the segment running along local y; cylinder (half height, radius) along y; round_box (hx, hy, hz),
+    rounded by ROUND_BOX_ROUNDING of the smallest; octahedron (size,); cone (base radius, height) along y;
+    hex_prism (apothem, half height) along z; ellipsoid (rx, ry, rz), by :func:`sd_ellipsoid_lipschitz` (a bound
+    that keeps the scene 1-Lipschitz, which Quilez's estimate does not for an elongated ellipsoid)."""
     rotation: tuple[float, float, float, float] = (1.0, 0.0, 0.0, 0.0)
     """Orientation as a unit quaternion (w, x, y, z), local to world; normalised on construction."""
     color: tuple[float, float, float] = (0.8, 0.8, 0.8)
@@ -409,6 +447,18 @@ class Primitive:
                 return s[0] + s[1]
             case "capsule":
                 return s[0] + s[1]
+            case "cylinder":
+                return math.hypot(s[0], s[1])
+            case "round_box":
+                return math.sqrt(s[0] ** 2 + s[1] ** 2 + s[2] ** 2)
+            case "octahedron":
+                return s[0]
+            case "cone":
+                return math.hypot(s[0], s[1] / 2)
+            case "hex_prism":
+                return math.hypot(2 * s[0] / math.sqrt(3.0), s[1])
+            case "ellipsoid":
+                return max(s)
 
     def local_distance(self, p_local: FloatArray) -> FloatArray:
         """(N,) distance of (N, 3) points given in this primitive's local frame."""
@@ -422,6 +472,18 @@ class Primitive:
                 return sd_torus(p_local, s[0], s[1])
             case "capsule":
                 return sd_capsule(p_local, (0.0, -s[0], 0.0), (0.0, s[0], 0.0), s[1])
+            case "cylinder":
+                return sd_cylinder(p_local, s[0], s[1])
+            case "round_box":
+                return sd_round_box(p_local, s, ROUND_BOX_ROUNDING * min(s))
+            case "octahedron":
+                return sd_octahedron(p_local, s[0])
+            case "cone":
+                return sd_cone(p_local, s[0], s[1])
+            case "hex_prism":
+                return sd_hex_prism(p_local, s[0], s[1])
+            case "ellipsoid":
+                return sd_ellipsoid_lipschitz(p_local, s)
 
     def distance(self, points: FloatArray) -> FloatArray:
         """(N,) distance of (N, 3) world points."""
@@ -460,6 +522,9 @@ class Primitive:
             case "capsule":  # the segment runs from (0, −h, 0) to (0, h, 0)
                 off = ly - np.clip(ly, -s[0], s[0])
                 return np.sqrt(lx * lx + off * off + lz * lz) - s[1]
+            case _:  # the catalogue's kinds: their sd_* function on stacked local points
+                local = np.stack([lx, ly, lz], axis=1).astype(np.float64)
+                return self.local_distance(local).astype(x.dtype, copy=False)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -885,3 +950,354 @@ def default_scene() -> Scene:
         k=0.25,
         blend="poly",
     )
+
+
+# ------------------------------------------------------------------------------------------ more primitives
+# After I. Quilez, "distance functions" (iquilezles.org/articles/distfunctions, 2008–2024), mirrored name for name
+# in shaders/sdf.glsl. Each says whether it is an exact distance or only a bound (≤ the true distance outside and
+# 1-Lipschitz, so sphere tracing stays safe).
+def sd_cylinder(p: ArrayLike, half_height: float, radius: float) -> FloatArray:
+    """Exact distance to a capped cylinder along local y, centred at the origin (Quilez, "Capped Cylinder").
+
+    Args:
+        p: (N, 3) points in the local frame (m).
+        half_height: half its length along y (m), > 0.
+        radius: radius (m), > 0.
+
+    Returns:
+        (N,) signed distances (m).
+    """
+    pts = _points(p)
+    h, r = _positive(half_height, "half_height"), _positive(radius, "radius")
+    dx = np.hypot(pts[:, 0], pts[:, 2]) - r
+    dy = np.abs(pts[:, 1]) - h
+    return np.minimum(np.maximum(dx, dy), 0.0) + np.hypot(np.maximum(dx, 0.0), np.maximum(dy, 0.0))
+
+
+def sd_round_box(p: ArrayLike, half_size: ArrayLike, radius: float) -> FloatArray:
+    """Exact distance to a box with rounded edges (Quilez, "Rounded Box").
+
+    The box's outer half extents are ``half_size``; its edges and corners are rounded with ``radius``.
+
+    Args:
+        p: (N, 3) points in the local frame (m).
+        half_size: (3,) outer half extents (m), each > 0.
+        radius: rounding radius (m), in [0, min(half_size)].
+
+    Returns:
+        (N,) signed distances (m).
+    """
+    pts = _points(p)
+    b = _vector3(half_size, "half_size")
+    if np.any(b <= 0.0):
+        raise ValueError(f"half_size must be positive, got {b.tolist()}")
+    r = _non_negative(radius, "radius")
+    if r > b.min():
+        raise ValueError(f"radius must be at most min(half_size) = {b.min()}, got {radius!r}")
+    q = np.abs(pts) - b + r
+    return np.linalg.norm(np.maximum(q, 0.0), axis=1) + np.minimum(q.max(axis=1), 0.0) - r
+
+
+def sd_octahedron(p: ArrayLike, size: float) -> FloatArray:
+    """Exact distance to the regular octahedron |x| + |y| + |z| = size (Quilez, "Octahedron - exact").
+
+    Args:
+        p: (N, 3) points in the local frame (m).
+        size: distance from the centre to each vertex (m), > 0.
+
+    Returns:
+        (N,) signed distances (m).
+    """
+    pts = np.abs(_points(p))
+    s = _positive(size, "size")
+    m = pts.sum(axis=1) - s
+    x, y, z = pts[:, 0], pts[:, 1], pts[:, 2]
+    # Pick the face region: q is p with its axes cycled so the nearest edge is the one the formula handles.
+    use_x, use_y, use_z = 3.0 * x < m, 3.0 * y < m, 3.0 * z < m
+    q = np.where(
+        use_x[:, None],
+        pts,
+        np.where(use_y[:, None], pts[:, [1, 2, 0]], pts[:, [2, 0, 1]]),
+    )
+    k = np.clip(0.5 * (q[:, 2] - q[:, 1] + s), 0.0, s)
+    edge = np.sqrt(q[:, 0] ** 2 + (q[:, 1] - s + k) ** 2 + (q[:, 2] - k) ** 2)
+    return np.where(use_x | use_y | use_z, edge, m * (1.0 / math.sqrt(3.0)))
+
+
+def sd_cone(p: ArrayLike, radius: float, height: float) -> FloatArray:
+    """Exact distance to a solid cone along local y (Quilez, "Cone - exact").
+
+    Its base, a disc of ``radius``, lies in the plane y = −height/2 and its apex at y = +height/2, so the origin is
+    the middle of its axis.
+
+    Args:
+        p: (N, 3) points in the local frame (m).
+        radius: base radius (m), > 0.
+        height: apex to base (m), > 0.
+
+    Returns:
+        (N,) signed distances (m).
+    """
+    pts = _points(p)
+    r, h = _positive(radius, "radius"), _positive(height, "height")
+    # Quilez's frame: apex at the origin, base at y = −h; q is the base rim in the (radial, y) half-plane.
+    qx, qy = r, -h
+    wx = np.hypot(pts[:, 0], pts[:, 2])
+    wy = pts[:, 1] - 0.5 * h
+    t = np.clip((wx * qx + wy * qy) / (qx * qx + qy * qy), 0.0, 1.0)
+    ax, ay = wx - qx * t, wy - qy * t
+    bx, by = wx - qx * np.clip(wx / qx, 0.0, 1.0), wy - qy
+    d = np.minimum(ax * ax + ay * ay, bx * bx + by * by)
+    # k = sign(q.y) = −1
+    s = np.maximum(-(wx * qy - wy * qx), -(wy - qy))
+    return np.sqrt(d) * np.sign(s)
+
+
+def sd_hex_prism(p: ArrayLike, apothem: float, half_height: float) -> FloatArray:
+    """Exact distance to a regular hexagonal prism along local z (Quilez, "Hexagonal Prism - exact").
+
+    Args:
+        p: (N, 3) points in the local frame (m).
+        apothem: distance from the axis to each flat side (m), > 0; two sides are parallel to the x axis.
+        half_height: half its length along z (m), > 0.
+
+    Returns:
+        (N,) signed distances (m).
+    """
+    pts = np.abs(_points(p))
+    a, h = _positive(apothem, "apothem"), _positive(half_height, "half_height")
+    kx, ky, kz = -math.sqrt(3.0) / 2.0, 0.5, 1.0 / math.sqrt(3.0)
+    fold = 2.0 * np.minimum(kx * pts[:, 0] + ky * pts[:, 1], 0.0)
+    x, y = pts[:, 0] - fold * kx, pts[:, 1] - fold * ky
+    dx = np.hypot(x - np.clip(x, -kz * a, kz * a), y - a) * np.sign(y - a)
+    dy = pts[:, 2] - h
+    return np.minimum(np.maximum(dx, dy), 0.0) + np.hypot(np.maximum(dx, 0.0), np.maximum(dy, 0.0))
+
+
+def sd_ellipsoid(p: ArrayLike, radii: ArrayLike) -> FloatArray:
+    """A distance bound (not exact) for an axis-aligned ellipsoid (Quilez, "Ellipsoid - bound (not exact)", 2008).
+
+    ``k0·(k0 − 1)/k1`` with ``k0 = |p/r|``, ``k1 = |p/r²|``: zero exactly on the surface and of the right sign,
+    but only an approximation of the distance away from it (exact for a sphere), and not 1-Lipschitz for an
+    elongated ellipsoid (scenes use :func:`sd_ellipsoid_lipschitz`). At the centre, where the formula is 0/0, it is
+    −min(radii), the exact value there.
+
+    Args:
+        p: (N, 3) points in the local frame (m).
+        radii: (3,) semi-axes along x, y, z (m), each > 0.
+
+    Returns:
+        (N,) signed distance estimates (m).
+    """
+    pts = _points(p)
+    r = _vector3(radii, "radii")
+    if np.any(r <= 0.0):
+        raise ValueError(f"radii must be positive, got {r.tolist()}")
+    k0 = np.linalg.norm(pts / r, axis=1)
+    k1 = np.linalg.norm(pts / (r * r), axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        d = k0 * (k0 - 1.0) / k1
+    return np.where(k1 > 0.0, d, -r.min())
+
+
+def sd_ellipsoid_lipschitz(p: ArrayLike, radii: ArrayLike) -> FloatArray:
+    """A 1-Lipschitz distance bound for an axis-aligned ellipsoid: (|p/r| − 1)·min(r) (Quilez, "Ellipsoid SDF",
+    iquilezles.org/articles/ellipsoids, 2008: the first, simplest bound).
+
+    |∇|p/r|| ≤ 1/min(r), so the value is 1-Lipschitz; it is zero on the surface, hence never more than the true
+    distance: what sphere tracing and the coarse-to-fine mesher need. :func:`sd_ellipsoid` (Quilez's estimate)
+    is closer to the distance but can grow faster than 1 per metre (by up to max(r)/min(r)). Equal radii give
+    the sphere's distance.
+
+    Args:
+        p: (N, 3) points in the local frame (m).
+        radii: (3,) semi-axes along x, y, z (m), each > 0.
+
+    Returns:
+        (N,) signed distance bounds (m).
+    """
+    pts = _points(p)
+    r = _vector3(radii, "radii")
+    if np.any(r <= 0.0):
+        raise ValueError(f"radii must be positive, got {r.tolist()}")
+    return (np.linalg.norm(pts / r, axis=1) - 1.0) * r.min()
+
+
+def sd_plane(p: ArrayLike, normal: ArrayLike, offset: float) -> FloatArray:
+    """Exact distance to the plane n·p + offset = 0, negative on the side −n points to (Quilez, "Plane").
+
+    Args:
+        p: (N, 3) points (m).
+        normal: (3,) normal; normalised here (must be non-zero).
+        offset: the plane's signed distance from the origin along −n (m).
+
+    Returns:
+        (N,) signed distances (m).
+    """
+    pts = _points(p)
+    n = _vector3(normal, "normal")
+    length = float(np.linalg.norm(n))
+    if length < 1e-12:
+        raise ValueError("normal must be non-zero")
+    off = float(offset)
+    if not math.isfinite(off):
+        raise ValueError(f"offset must be finite, got {offset!r}")
+    return pts @ (n / length) + off
+
+
+# ------------------------------------------------------------------------------------------ operators
+# Quilez, "distance functions": rounding, onion, and the point transforms (elongation, twist, bend, finite
+# repetition, mirror symmetry). A point transform maps the query point; the shape is then any primitive evaluated
+# at the mapped point. GLSL has no function arguments, so both sides are written this way, name for name.
+def op_round(d: ArrayLike, radius: float) -> FloatArray:
+    """d − radius: a shape grown by ``radius`` with rounded edges (Quilez, "Rounding"). Exact if d is, outside.
+
+    Args:
+        d: (N,) distances (m).
+        radius: rounding radius (m), ≥ 0.
+    """
+    return np.asarray(d, dtype=np.float64) - _non_negative(radius, "radius")
+
+
+def op_onion(d: ArrayLike, thickness: float) -> FloatArray:
+    """|d| − thickness: a shell of the surface (Quilez, "Onion"). Exact if d is.
+
+    Args:
+        d: (N,) distances (m).
+        thickness: half the shell's wall thickness (m), ≥ 0.
+    """
+    return np.abs(np.asarray(d, dtype=np.float64)) - _non_negative(thickness, "thickness")
+
+
+def op_elongate(p: ArrayLike, half_length: ArrayLike) -> tuple[FloatArray, FloatArray]:
+    """Stretch a shape by 2·half_length, splitting it at its centre planes (Quilez, "Elongation", exact form).
+
+    ``q = |p| − h``; the shape is ``sd(p − clamp(p, −h, h)) + min(max(q.x, q.y, q.z), 0)``. The first part keeps
+    the sign of p (Quilez writes ``max(q, 0)``, which needs a shape symmetric in every axis). Exact if sd is.
+
+    Args:
+        p: (N, 3) points (m).
+        half_length: (3,) elongation along x, y, z (m), each ≥ 0.
+
+    Returns:
+        (N, 3) points to evaluate the shape at, and (N,) the term to add to its distance.
+    """
+    pts = _points(p)
+    h = _vector3(half_length, "half_length")
+    if np.any(h < 0.0):
+        raise ValueError(f"half_length must be non-negative, got {h.tolist()}")
+    q = np.abs(pts) - h
+    return pts - np.clip(pts, -h, h), np.minimum(q.max(axis=1), 0.0)
+
+
+def op_twist(p: ArrayLike, rate: float) -> FloatArray:
+    """Twist about local y: rotate (x, z) by the angle rate·y (Quilez, "Twist").
+
+    Not a distance-preserving map: a shape of radius ρ from the axis needs its distance divided by
+    sqrt(1 + (rate·ρ)²) to stay a bound.
+
+    Args:
+        p: (N, 3) points (m).
+        rate: twist (rad/m), finite.
+
+    Returns:
+        (N, 3) points: (c·x − s·z, y, s·x + c·z) with c, s = cos, sin(rate·y).
+    """
+    pts = _points(p)
+    k = float(rate)
+    if not math.isfinite(k):
+        raise ValueError(f"rate must be finite, got {rate!r}")
+    c, s = np.cos(k * pts[:, 1]), np.sin(k * pts[:, 1])
+    return np.stack(
+        [c * pts[:, 0] - s * pts[:, 2], pts[:, 1], s * pts[:, 0] + c * pts[:, 2]], axis=1
+    )
+
+
+def op_bend(p: ArrayLike, rate: float) -> FloatArray:
+    """Bend in the xy plane: rotate (x, y) by the angle rate·x (Quilez, "Bend").
+
+    Not distance-preserving either (the same bound correction as :func:`op_twist`).
+
+    Args:
+        p: (N, 3) points (m).
+        rate: bend (rad/m), finite.
+
+    Returns:
+        (N, 3) points: (c·x − s·y, s·x + c·y, z) with c, s = cos, sin(rate·x).
+    """
+    pts = _points(p)
+    k = float(rate)
+    if not math.isfinite(k):
+        raise ValueError(f"rate must be finite, got {rate!r}")
+    c, s = np.cos(k * pts[:, 0]), np.sin(k * pts[:, 0])
+    return np.stack(
+        [c * pts[:, 0] - s * pts[:, 1], s * pts[:, 0] + c * pts[:, 1], pts[:, 2]], axis=1
+    )
+
+
+def op_repeat_finite(p: ArrayLike, spacing: ArrayLike, limit: ArrayLike) -> FloatArray:
+    """Finite repetition: copies every ``spacing`` along each axis, cell indices in [−limit, limit]
+    (Quilez, "Finite Repetition").
+
+    ``p − spacing·clamp(round(p/spacing), −limit, limit)``, rounding half up (floor(x + ½), the same in GLSL,
+    whose round() leaves halves to the driver). Exact for a shape that fits in its cell and is symmetric.
+
+    Args:
+        p: (N, 3) points (m).
+        spacing: (3,) cell size along x, y, z (m), each > 0.
+        limit: (3,) copies on each side of the middle one, each ≥ 0 (whole numbers).
+
+    Returns:
+        (N, 3) points in the nearest copy's frame.
+    """
+    pts = _points(p)
+    c = _vector3(spacing, "spacing")
+    if np.any(c <= 0.0):
+        raise ValueError(f"spacing must be positive, got {c.tolist()}")
+    lim = _vector3(limit, "limit")
+    if np.any(lim < 0.0) or np.any(lim != np.round(lim)):
+        raise ValueError(f"limit must be whole numbers ≥ 0, got {lim.tolist()}")
+    return pts - c * np.clip(np.floor(pts / c + 0.5), -lim, lim)
+
+
+def op_symmetry(p: ArrayLike, axes: ArrayLike) -> FloatArray:
+    """Mirror symmetry: the chosen coordinates replaced by their absolute values (Quilez, "Symmetry").
+
+    Args:
+        p: (N, 3) points (m).
+        axes: (3,) 1 (mirror across that coordinate's plane) or 0 (leave it), for x, y, z.
+
+    Returns:
+        (N, 3) points.
+    """
+    pts = _points(p)
+    mask = _vector3(axes, "axes")
+    if not np.all((mask == 0.0) | (mask == 1.0)):
+        raise ValueError(f"axes must be 0 or 1 each, got {mask.tolist()}")
+    return np.where(mask > 0.0, np.abs(pts), pts)
+
+
+# ------------------------------------------------------------------------------------------ sampled fields
+def mesh_samples(
+    grid: Grid, field: NDArray[np.float32], mask: NDArray[np.bool_] | None = None
+) -> tuple[FloatArray, NDArray[np.int64]]:
+    """Marching cubes of a field sampled elsewhere (the GLSL editor's, sampled on the GPU), by :func:`mesh`'s pass.
+
+    Args:
+        grid: where the samples are (:func:`make_grid`).
+        field: (nx, ny, nz) float32 distances (m), negative inside, shaped like ``grid.shape``.
+        mask: optional (nx, ny, nz) cells marching cubes may visit.
+
+    Returns:
+        vertices (V, 3) in metres and faces (F, 3) wound outward; empty when no surface crosses the grid.
+    """
+    if field.shape != grid.shape:
+        raise ValueError(f"field must have the grid's shape {grid.shape}, got {field.shape}")
+    if not np.all(np.isfinite(field)):
+        raise ValueError("field must be finite")
+    # _polygonise colours its vertices from a scene; one small sphere keeps that cost to a few ms.
+    verts, faces, _ = _polygonise(_COLOURLESS, grid, field.astype(np.float32, copy=False), mask)
+    return verts, faces
+
+
+_COLOURLESS = Scene((Primitive("sphere", (0.0, 0.0, 0.0), (1.0,)),))

@@ -6,7 +6,8 @@ camera, and the readouts say how well the two agree (silhouette IoU, mean depth 
 
 Threads: GUI and gizmo callbacks only record the new state and wake one worker thread. The worker meshes the latest
 scene (a burst of drags coalesces: only the newest request is meshed), then renders the reference when the camera
-has stopped moving (or at once, in live mode). The GL context lives on the worker thread, where it was created.
+has stopped moving (or at once, in live mode). The GL work goes to :mod:`shaders.gl_service`: one context and one
+thread per process, shared by every gallery (a context per build leaked ~50 MiB each).
 """
 
 from __future__ import annotations
@@ -27,7 +28,17 @@ from PIL import Image
 
 from kernels import sdf
 from scenes._base import Scene
-from shaders.renderer import Camera, GLUnavailableError, Renderer, Shading
+from shaders import gl_service
+from shaders import renderer as gl_renderer
+from shaders.renderer import (
+    MAX_SOURCE_CHARS,
+    Camera,
+    GLUnavailableError,
+    Renderer,
+    ShaderCompileError,
+    Shading,
+    check_source,
+)
 
 logger = logging.getLogger(__name__)
 
@@ -41,20 +52,106 @@ KIND_LABELS: dict[str, sdf.PrimitiveKind] = {
     "Box": "box",
     "Torus": "torus",
     "Capsule": "capsule",
+    "Cylinder": "cylinder",
+    "Round box": "round_box",
+    "Octahedron": "octahedron",
+    "Cone": "cone",
+    "Hexagonal prism": "hex_prism",
+    "Ellipsoid (bound)": "ellipsoid",
 }
+SIZES_USED: dict[sdf.PrimitiveKind, int] = {
+    "sphere": 1,
+    "box": 3,
+    "torus": 2,
+    "capsule": 2,
+    "cylinder": 2,
+    "round_box": 3,
+    "octahedron": 1,
+    "cone": 2,
+    "hex_prism": 2,
+    "ellipsoid": 3,
+}
+"""How many of the sliders a, b, c each kind reads."""
 OP_LABELS: dict[str, sdf.BooleanOp] = {
     "Union": "union",
     "Subtract": "subtract",
     "Intersect": "intersect",
 }
-BLEND_LABELS: dict[str, sdf.BlendForm] = {"Polynomial": "poly", "Exponential": "exp"}
+BlendChoice = Literal["hard", "poly", "exp"]
+"""Hard booleans, or a smooth minimum in one of its two forms."""
+BLEND_LABELS: dict[str, BlendChoice] = {
+    "Hard": "hard",
+    "Smooth (polynomial)": "poly",
+    "Smooth (exponential)": "exp",
+}
 ReferenceMode = Literal["stopped", "live"]
 MODE_LABELS: dict[str, ReferenceMode] = {"When the camera stops": "stopped", "Live": "live"}
 SIZE_MEANING = (
     "**Sizes (m).** Sphere: a = radius. Box: a, b, c = half sizes along local x, y, z. "
     "Torus: a = major radius, b = tube radius (ring in the local xz plane). "
-    "Capsule: a = half length along local y, b = radius."
+    "Capsule: a = half length along local y, b = radius. Cylinder: a = half height along local y, b = radius. "
+    "Round box: a, b, c = half sizes, edges rounded by a quarter of the smallest. Octahedron: a = centre to vertex. "
+    "Cone: a = base radius, b = height, along local y. Hexagonal prism: a = centre to flat side, b = half "
+    "height along local z. Ellipsoid: a, b, c = semi-axes (a distance bound, not exact)."
 )
+RESOLUTION_LABEL = "Mesh resolution (samples per side)"
+"""Marching-cubes samples along the longest side of the scene's bounds."""
+GIZMO_SCALE = 0.8
+"""Gizmo arrow length (m): longer than every default primitive's reach from its centre (the torus ring, 0.72 m),
+so the arrow tips poke out of the mesh."""
+ViewMode = Literal["mesh", "raymarch", "both"]
+VIEW_LABELS: dict[str, ViewMode] = {"Mesh": "mesh", "Ray-marched": "raymarch", "Both": "both"}
+ShapeSource = Literal["primitives", "editor"]
+SOURCE_LABELS: dict[str, ShapeSource] = {
+    "Primitives (panels below)": "primitives",
+    "GLSL editor": "editor",
+}
+VIEW_WIDTH_PX = 640
+"""Width of the ray-marched main view once the camera rests (px); its height follows the viewer's aspect."""
+MOVING_WIDTH_PX = 320
+"""Width while the camera or a gizmo moves: a quarter of the pixels, and no shadows or AO, so the view keeps up."""
+COMPILE_LIMIT_S = 10.0
+"""An editor source whose programs take longer to compile is refused (s)."""
+FRAME_LIMIT_S = 1.0
+"""An editor source whose test frame (MOVING_WIDTH_PX wide, moving shading) takes longer is refused (s); the fully
+shaded program at rest costs a few times more (its soft shadows and AO call sdf about twenty times a pixel more)."""
+EDITOR_HALF_SIZE_M = 1.5
+"""The editor's field is meshed and ray-marched inside the cube [−h, h]³ (m) by default."""
+EXAMPLES = gl_renderer.examples()
+"""The editor's examples, by title."""
+EDITOR_HELP = (
+    "Write `float sdf(vec3 p)` (metres, Z up) and optionally `vec3 color(vec3 p)`, using the library's "
+    "`sd_*` primitives and `op_*`, `smooth_*` operators, then **Apply**: the shape is meshed and ray-marched "
+    f"from the same source. At most {MAX_SOURCE_CHARS} characters; no loops, no `#` lines."
+)
+_editing = {"allowed": True}
+
+
+def set_editing_allowed(allowed: bool) -> None:
+    """Whether browsers may send GLSL to compile (app.py turns it off for a non-loopback host unless asked)."""
+    _editing["allowed"] = bool(allowed)
+
+
+def editing_allowed() -> bool:
+    return _editing["allowed"]
+
+
+@dataclasses.dataclass(frozen=True)
+class EditorField:
+    """The editor's shape: a GLSL source that compiled, and the box it is meshed and ray-marched in."""
+
+    source: str
+    """Defines float sdf(vec3 p) (m) and optionally vec3 color(vec3 p)."""
+    half_size: float
+    """The bounds are the cube [−half_size, half_size]³ (m)."""
+
+    @property
+    def bounds(self) -> np.ndarray:
+        return np.array([[-self.half_size] * 3, [self.half_size] * 3])
+
+
+Shape = sdf.Scene | EditorField
+"""What the gallery shows: the primitives' scene or the editor's field."""
 CAMERA_REST_S = 0.25
 """The camera (and the scene) count as stopped after this long without an update (s)."""
 
@@ -66,7 +163,7 @@ class PrimitiveParams:
     enabled: bool
     """Whether it is part of the scene (the first always is)."""
     kind: sdf.PrimitiveKind
-    """Sphere, box, torus or capsule."""
+    """One of the kernel's kinds (sphere, box, torus, capsule and the catalogue's six)."""
     size: tuple[float, float, float]
     """Sizes a, b, c (m); which ones count depends on the kind (see SIZE_MEANING)."""
     color: tuple[int, int, int]
@@ -79,8 +176,7 @@ class PrimitiveParams:
     """Orientation, the gizmo's."""
 
     def primitive(self) -> sdf.Primitive:
-        a, b, c = self.size
-        size = {"sphere": (a,), "box": (a, b, c), "torus": (a, b), "capsule": (a, b)}[self.kind]
+        size = self.size[: SIZES_USED[self.kind]]
         return sdf.Primitive(
             self.kind,
             self.position,
@@ -121,8 +217,8 @@ class SdfGalleryParams:
     """The four primitive slots."""
     k: float = 0.25
     """Blend width (m); 0 is a hard boolean."""
-    blend: sdf.BlendForm = "poly"
-    """Polynomial or exponential smooth-min."""
+    blend: BlendChoice = "poly"
+    """Hard booleans (k is not used), or the polynomial or exponential smooth minimum of width k."""
     resolution: int = 64
     """Marching-cubes samples along the longest side of the bounds (32–256)."""
     shading: Shading = dataclasses.field(default_factory=Shading)
@@ -131,10 +227,23 @@ class SdfGalleryParams:
     """Render the reference when the camera stops, or live while it moves."""
     reference_width: int = 320
     """Width of the reference image (px); its height follows the viewer's aspect."""
+    view_mode: ViewMode = "mesh"
+    """The main 3D view: the mesh, the GLSL ray-march (background image with depth), or both (mesh as wireframe)."""
+    shape_source: ShapeSource = "primitives"
+    """Show the primitives' scene or the editor's field."""
+    editor: EditorField = dataclasses.field(
+        default_factory=lambda: EditorField(next(iter(EXAMPLES.values())), EDITOR_HALF_SIZE_M)
+    )
+    """The last editor source that compiled, checked and meshed (the first example at first)."""
+
+    def shape(self) -> Shape:
+        return self.scene() if self.shape_source == "primitives" else self.editor
 
     def scene(self) -> sdf.Scene:
         return sdf.Scene(
-            tuple(p.primitive() for p in self.primitives if p.enabled), k=self.k, blend=self.blend
+            tuple(p.primitive() for p in self.primitives if p.enabled),
+            k=0.0 if self.blend == "hard" else self.k,
+            blend="poly" if self.blend == "hard" else self.blend,
         )
 
 
@@ -171,10 +280,13 @@ class SdfGalleryScene(Scene):
     camera_position = (1.9, -2.1, 1.4)
     camera_look_at = (0.05, 0.0, 0.3)
     about = """
-**What it shows.** A scene of up to four signed-distance primitives (sphere, box, torus, capsule) combined by
-union, subtraction or intersection with a smooth minimum. The 3D view shows its marching-cubes mesh; the
-**Reference** panel shows the same scene sphere-traced in a GLSL fragment shader from your camera, and the readouts
-measure how well they agree. Drag a gizmo: the mesh follows.
+**What it shows.** A scene of up to four signed-distance primitives (sphere, box, torus, capsule and Quilez's
+cylinder, round box, octahedron, cone, hexagonal prism, ellipsoid) combined by union, subtraction or intersection,
+hard or with a smooth minimum; or any shape you write in GLSL in the **GLSL editor** (`float sdf(vec3 p)`, with the
+same primitives and operators). The 3D view shows its marching-cubes mesh, the GLSL ray-march rendered from your
+camera (**View: Ray-marched**, composited by depth with the gizmos), or both (the mesh as a wireframe over the
+ray-march). The **Reference** panel shows the ray-march as an image and the readouts measure how well mesh and
+ray-march agree. Drag a gizmo: the mesh follows.
 
 **Equations.** Sphere |p| − r; box |max(q,0)| + min(max(q.x,q.y,q.z),0), q = |p| − b; torus |(|p.xz| − R, p.y)| − r;
 capsule |pa − ba·h| − r. Smooth union, polynomial: h = clamp(½ + ½(b − a)/k, 0, 1),
@@ -198,7 +310,19 @@ IoU is lowest when a box edge is on the silhouette.
         self.mesh_faces = np.zeros((0, 3), dtype=np.int64)
         self.mesh_colors = np.zeros((0, 3))
         self.mesh_scene: sdf.Scene | None = None
-        """The scene the shown mesh was made from."""
+        """The scene the shown mesh was made from (None when it came from the editor)."""
+        self.mesh_shape: Shape | None = None
+        """The scene or editor field the shown mesh was made from."""
+        self.view_serial = 0
+        """How many ray-marched main-view frames have been sent."""
+        self.view_rgb: np.ndarray | None = None
+        """The latest main-view frame."""
+        self.view_ms: float | None = None
+        """Time to ray-march it (ms)."""
+        self.editor_error: str | None = None
+        """Why the latest editor source was refused (None once one is applied)."""
+        self.editor_serial = 0
+        """How many editor sources have been applied."""
         self.mesh_serial = 0
         """How many meshes have been shown."""
         self.reference_serial = 0
@@ -208,7 +332,9 @@ IoU is lowest when a box edge is on the silhouette.
         self.gl_error: str | None = None
         self._mesh_voxel = 1.0
         self._work = threading.Condition()
-        self._wanted_scene: sdf.Scene | None = None
+        self._wanted_scene: Shape | None = None
+        self._wanted_source: str | None = None
+        self._view_key: tuple[Any, ...] | None = None
         self._wanted_resolution = self.params.resolution
         self._camera: Camera | None = None
         self._aspect = 4 / 3
@@ -231,6 +357,8 @@ IoU is lowest when a box edge is on the silhouette.
             self._work.notify_all()
         for thread in self._threads:
             thread.join(timeout=60.0)
+        with self._lock:
+            self.server.scene.set_background_image(None)
         super().close()
 
     # ----------------------------------------------------------------------------------------- GUI
@@ -239,6 +367,36 @@ IoU is lowest when a box edge is on the silhouette.
         p = self.params
         self.slots: list[dict[str, Any]] = []
         with self.gui_root:
+            with gui.add_folder("Shape and view"):
+                self.view_mode = gui.add_dropdown(
+                    "View",
+                    options=list(VIEW_LABELS),
+                    initial_value=_label(VIEW_LABELS, p.view_mode),
+                )
+                self.shape_source = gui.add_dropdown(
+                    "Shape",
+                    options=list(SOURCE_LABELS),
+                    initial_value=_label(SOURCE_LABELS, p.shape_source),
+                )
+                self.view_note = gui.add_markdown("")
+            with gui.add_folder("GLSL editor", expand_by_default=False):
+                allowed = editing_allowed()
+                self.example = gui.add_dropdown(
+                    "Example", options=list(EXAMPLES), initial_value=next(iter(EXAMPLES))
+                )
+                self.editor = gui.add_text(
+                    "sdf(p) in GLSL", p.editor.source, multiline=True, disabled=not allowed
+                )
+                self.editor_half_size = gui.add_slider(
+                    "Editor bounds half size (m)", 0.5, 3.0, 0.1, p.editor.half_size
+                )
+                self.apply = gui.add_button("Apply")
+                self.editor_status = gui.add_markdown(
+                    EDITOR_HELP
+                    if allowed
+                    else "**Editing is off**: this server is reachable from other machines. The examples "
+                    "still work; start the app with `--allow-remote-glsl` to allow typing GLSL."
+                )
             with gui.add_folder("Blend and mesh"):
                 self.blend = gui.add_dropdown(
                     "Blend",
@@ -246,7 +404,7 @@ IoU is lowest when a box edge is on the silhouette.
                     initial_value=_label(BLEND_LABELS, p.blend),
                 )
                 self.k = gui.add_slider("Blend width k (m)", 0.0, 1.0, 0.01, p.k)
-                self.resolution = gui.add_slider("Mesh resolution", 32, 256, 16, p.resolution)
+                self.resolution = gui.add_slider(RESOLUTION_LABEL, 32, 256, 16, p.resolution)
                 self.progress = gui.add_progress_bar(0.0, visible=False)
                 self.readout = gui.add_markdown("")
             with gui.add_folder("Reference (GLSL ray-march)"):
@@ -336,6 +494,10 @@ IoU is lowest when a box edge is on the silhouette.
             handle.on_update(self.callback(self._on_shading_input))
         for fmt, button in self.downloads.items():
             button.on_click(self._download_handler(fmt))
+        for handle in (self.view_mode, self.shape_source):
+            handle.on_update(self.callback(self._on_view_input))
+        self.example.on_update(self.callback(self._on_example))
+        self.apply.on_click(self.callback(self._on_apply))
 
     def _build_world(self) -> None:
         scene = self.server.scene
@@ -343,19 +505,32 @@ IoU is lowest when a box edge is on the silhouette.
         self.mesh_node = scene.add_mesh_trimesh(
             f"{self.root.name}/mesh", sdf.mesh_trimesh(vertices, faces, colors)
         )
-        self.mesh_node.glb_data = _viewer_glb(self.params.scene(), vertices, faces, colors)
+        self.mesh_node.glb_data = _viewer_glb(
+            vertices, faces, colors, _scene_normals(self.params.scene(), vertices)
+        )
+        self.wireframe_node = scene.add_mesh_simple(
+            f"{self.root.name}/wireframe",
+            vertices.astype(np.float32),
+            faces.astype(np.uint32),
+            color=(40, 40, 40),
+            wireframe=True,
+            visible=False,
+        )
         self.gizmos = []
         for i, slot in enumerate(self.params.primitives):
             gizmo = scene.add_transform_controls(
                 f"{self.root.name}/gizmo_{i + 1}",
-                scale=0.35,
-                line_width=2.0,
+                scale=GIZMO_SCALE,
+                line_width=3.0,
+                # Drawn over the mesh: a gizmo sits at its primitive's centre, inside the surface.
+                depth_test=False,
                 position=slot.position,
                 wxyz=slot.wxyz,
                 visible=slot.enabled,
             )
             gizmo.on_update(self.callback(self._on_scene_input))
             self.gizmos.append(gizmo)
+            scene.add_label(f"{gizmo.name}/label", f"P{i + 1}", position=(0.0, 0.0, GIZMO_SCALE))
 
     def _watch_cameras(self) -> None:
         self.watch_cameras(self._on_camera)
@@ -465,6 +640,73 @@ IoU is lowest when a box edge is on the silhouette.
         self._sync_enabled_inputs()
         self._request_mesh()
 
+    def _on_view_input(self) -> None:
+        p = self.params
+        view = VIEW_LABELS[
+            self.read_choice(self.view_mode, list(VIEW_LABELS), _label(VIEW_LABELS, p.view_mode))
+        ]
+        source = SOURCE_LABELS[
+            self.read_choice(
+                self.shape_source, list(SOURCE_LABELS), _label(SOURCE_LABELS, p.shape_source)
+            )
+        ]
+        self.params = dataclasses.replace(p, view_mode=view, shape_source=source)
+        self._show_view_mode()
+        if source != p.shape_source:
+            self._sync_enabled_inputs()
+            self._request_mesh()
+        with self._work:
+            self._view_key = None
+            self._work.notify_all()
+
+    def _on_example(self) -> None:
+        title = self.read_choice(self.example, list(EXAMPLES), next(iter(EXAMPLES)))
+        self._write_back(self.editor, EXAMPLES[title])
+        self._request_source(EXAMPLES[title])
+
+    def _on_apply(self) -> None:
+        if not editing_allowed():
+            # Only the server's own examples compile: the browser's text is not read.
+            title = self.read_choice(self.example, list(EXAMPLES), next(iter(EXAMPLES)))
+            self._write_back(self.editor, EXAMPLES[title])
+            self._request_source(EXAMPLES[title])
+            return
+        text = self.editor.value
+        if not isinstance(text, str) or len(text) > MAX_SOURCE_CHARS:
+            self._show_editor_error(
+                f"The source must be text; the limit is {MAX_SOURCE_CHARS} characters."
+            )
+            return
+        self._request_source(text)
+
+    def _request_source(self, text: str) -> None:
+        with self._work:
+            self._wanted_source = text
+            self._work.notify_all()
+
+    def _show_editor_error(self, message: str) -> None:
+        self.editor_error = message
+        with self._lock:
+            if not self.closed:
+                self.editor_status.content = (
+                    f"**Not applied.** {message}\n\nThe last good shape stays on screen."
+                )
+
+    def _show_view_mode(self) -> None:
+        mode = self.params.view_mode
+        with self.server.atomic():
+            self.mesh_node.visible = mode == "mesh"
+            self.wireframe_node.visible = mode == "both"
+            if mode == "mesh":
+                self.server.scene.set_background_image(None)
+            self.view_note.content = {
+                "mesh": "The 3D view shows the marching-cubes mesh.",
+                "raymarch": "The 3D view shows the GLSL ray-march, rendered from your camera "
+                "(coarser while it moves).",
+                "both": "The GLSL ray-march with the mesh as a wireframe over it: where they agree, the "
+                "wireframe hugs the surface.",
+            }[mode]
+
     def _on_shading_input(self) -> None:
         shading, mode, width = self.read_shading()
         self.params = dataclasses.replace(
@@ -482,8 +724,12 @@ IoU is lowest when a box edge is on the silhouette.
             return
         try:
             aspect = float(camera.aspect)
-        except (TypeError, ValueError, AttributeError):
+        except (TypeError, ValueError, AttributeError, ZeroDivisionError):
             aspect = 4 / 3
+        self._on_camera_values(cam, aspect)
+
+    def _on_camera_values(self, cam: Camera, aspect: float) -> None:
+        """Take a cleaned camera and its image aspect (width / height) and schedule a new reference."""
         with self._work:
             self._camera = cam
             self._aspect = min(max(aspect, 0.5), 2.5) if math.isfinite(aspect) else 4 / 3
@@ -493,56 +739,61 @@ IoU is lowest when a box edge is on the silhouette.
 
     def _sync_enabled_inputs(self) -> None:
         """Show gizmos of enabled primitives; grey out sizes the kind does not use."""
-        used = {"sphere": 1, "box": 3, "torus": 2, "capsule": 2}
+        used = SIZES_USED
+        self.k.disabled = self.params.blend == "hard"
         for handles, gizmo, slot in zip(
             self.slots, self.gizmos, self.params.primitives, strict=True
         ):
-            gizmo.visible = slot.enabled
+            gizmo.visible = slot.enabled and self.params.shape_source == "primitives"
             for j, axis in enumerate("abc"):
                 handles[f"size_{axis}"].disabled = j >= used[slot.kind] or not slot.enabled
 
     def _request_mesh(self) -> None:
+        params = self.params
+        half_size = self.read_number(self.editor_half_size, params.editor.half_size)
+        if half_size != params.editor.half_size:
+            params = dataclasses.replace(
+                params, editor=dataclasses.replace(params.editor, half_size=half_size)
+            )
+            self.params = params
         with self._work:
             self._scene_time = time.monotonic()
-            self._wanted_scene = self.params.scene()
-            self._wanted_resolution = self.params.resolution
+            self._wanted_scene = params.shape()
+            self._wanted_resolution = params.resolution
             self._work.notify_all()
 
     # ----------------------------------------------------------------------------------------- worker
     def _work_forever(self) -> None:
-        renderer: Renderer | None = None
-        try:
-            while not self._stop.is_set():
-                with self._work:
-                    self._work.wait(timeout=0.05)
-                    scene, resolution = self._wanted_scene, self._wanted_resolution
-                    self._wanted_scene = None
-                if self._stop.is_set():
-                    return
-                try:
-                    if scene is not None:
-                        self._mesh_and_show(scene, resolution)
-                        with self._work:
-                            self._reference_due = True
-                    if self._reference_ready():
-                        if renderer is None and self.gl_error is None:
-                            renderer = self._open_renderer()
-                        if renderer is not None:
-                            self._render_reference(renderer)
-                except Exception:
-                    # One failed mesh or render must not stop every later one: log it and wait for new input.
-                    logger.exception(
-                        "sdf: meshing or rendering failed; keeping the last good picture"
-                    )
+        while not self._stop.is_set():
+            with self._work:
+                self._work.wait(timeout=0.05)
+                scene, resolution = self._wanted_scene, self._wanted_resolution
+                source = self._wanted_source
+                self._wanted_scene = self._wanted_source = None
+            if self._stop.is_set():
+                return
+            try:
+                if source is not None:
+                    self._apply_source(source, resolution)
+                elif scene is not None:
+                    self._mesh_and_show(scene, resolution)
                     with self._work:
-                        self._reference_due = False
-        finally:
-            if renderer is not None:
-                renderer.release()
+                        self._reference_due = True
+                if self.gl_error is None:
+                    self._render_view()
+                if self.gl_error is None and self._reference_ready():
+                    self._render_reference()
+            except GLUnavailableError as exc:
+                self._no_gl(exc)
+            except Exception:
+                # One failed mesh or render must not stop every later one: log it and wait for new input.
+                logger.exception("sdf: meshing or rendering failed; keeping the last good picture")
+                with self._work:
+                    self._reference_due = False
 
     def _reference_ready(self) -> bool:
         with self._work:
-            if not self._reference_due or self.mesh_scene is None or self._wanted_scene is not None:
+            if not self._reference_due or self.mesh_shape is None or self._wanted_scene is not None:
                 return False
             if self.params.reference_mode == "live":
                 return True
@@ -550,18 +801,71 @@ IoU is lowest when a box edge is on the silhouette.
             # the middle of a drag would hold up the next mesh.
             return time.monotonic() - max(self._camera_time, self._scene_time) >= CAMERA_REST_S
 
-    def _open_renderer(self) -> Renderer | None:
-        try:
-            return Renderer()
-        except GLUnavailableError as exc:
-            self.gl_error = str(exc)
-            logger.warning("sdf: %s", exc)
-            with self._lock:
-                if not self.closed:
-                    self.reference_note.content = f"**No reference image.** {exc}"
-            return None
+    def _no_gl(self, exc: GLUnavailableError) -> None:
+        self.gl_error = str(exc)
+        logger.warning("sdf: %s", exc)
+        with self._lock:
+            if not self.closed:
+                self.reference_note.content = f"**No reference image.** {exc}"
 
-    def _mesh_and_show(self, scene: sdf.Scene, resolution: int) -> None:
+    def _apply_source(self, text: str, resolution: int) -> None:
+        """Check, compile, time and mesh an editor source; show it, or say why not and keep the last good one."""
+        half_size = self.params.editor.half_size
+        field = EditorField(text, half_size)
+        start = time.perf_counter()
+        try:
+            check_source(text)
+            # The moving frames' program (no shadows, no AO) first: the new shape appears with it, and the fully
+            # shaded program compiles when the view next rests.
+            moving_shading = _moving_shading(self.params.shading)
+            gl_service.run(lambda gl: gl.compile_field(text, moving_shading))
+            compile_s = time.perf_counter() - start
+            if compile_s > COMPILE_LIMIT_S:
+                raise ShaderCompileError(
+                    f"compiling took {compile_s:.1f} s; the limit is {COMPILE_LIMIT_S:.0f} s", None
+                )
+            camera = self._camera or Camera(self.camera_position, self.camera_look_at)
+            frame_start = time.perf_counter()
+            gl_service.run(
+                lambda gl: gl.render_field(
+                    text,
+                    field.bounds,
+                    camera,
+                    MOVING_WIDTH_PX,
+                    MOVING_WIDTH_PX * 5 // 8,
+                    moving_shading,
+                )
+            )
+            frame_s = time.perf_counter() - frame_start
+            if frame_s > FRAME_LIMIT_S:
+                raise ShaderCompileError(
+                    f"one {MOVING_WIDTH_PX}-pixel-wide frame took {1e3 * frame_s:.0f} ms; the limit is "
+                    f"{1e3 * FRAME_LIMIT_S:.0f} ms",
+                    None,
+                )
+            self._mesh_and_show(field, resolution)
+        except ShaderCompileError as exc:
+            self._show_editor_error(str(exc))
+            return
+        total_ms = 1e3 * (time.perf_counter() - start)
+        with self._lock:
+            if self.closed:
+                return
+            self.params = dataclasses.replace(self.params, editor=field, shape_source="editor")
+            self.editor_error = None
+            self.editor_serial += 1
+            self._write_back(self.shape_source, _label(SOURCE_LABELS, "editor"))
+            self._sync_enabled_inputs()
+            self.editor_status.content = f"**Applied** in {total_ms:.0f} ms (compile, a test frame and a {resolution}³ mesh)."
+        with self._work:
+            self._reference_due = True
+            self._view_key = None
+            self._scene_time = time.monotonic()
+
+    def _mesh_and_show(self, scene: Shape, resolution: int) -> None:
+        if isinstance(scene, EditorField):
+            self._mesh_field_and_show(scene, resolution)
+            return
         big = resolution >= 128
 
         def progress(fraction: float) -> None:
@@ -573,17 +877,46 @@ IoU is lowest when a box edge is on the silhouette.
             self.progress.visible = True
         start = time.perf_counter()
         vertices, faces, colors = sdf.mesh(scene, resolution, progress=progress)
-        glb = _viewer_glb(scene, vertices, faces, colors)
+        glb = _viewer_glb(vertices, faces, colors, _scene_normals(scene, vertices))
         mesh_ms = 1e3 * (time.perf_counter() - start)
+        self._show_mesh(scene, vertices, faces, colors, glb, mesh_ms, resolution)
+
+    def _mesh_field_and_show(self, field: EditorField, resolution: int) -> None:
+        start = time.perf_counter()
+        tri = gl_renderer.mesh_glsl(field.source, resolution, field.bounds)
+        vertices = np.asarray(tri.vertices, dtype=np.float64)
+        faces = np.asarray(tri.faces, dtype=np.int64)
+        rgba = getattr(tri.visual, "vertex_colors", np.zeros((len(vertices), 4)))
+        colors = np.asarray(rgba, dtype=np.float64)[:, :3] / 255.0
+        normals = np.asarray(tri.vertex_normals) if len(faces) else np.zeros_like(vertices)
+        glb = _viewer_glb(vertices, faces, colors, normals)
+        mesh_ms = 1e3 * (time.perf_counter() - start)
+        self._show_mesh(field, vertices, faces, colors, glb, mesh_ms, resolution)
+
+    def _show_mesh(
+        self,
+        shape: Shape,
+        vertices: np.ndarray,
+        faces: np.ndarray,
+        colors: np.ndarray,
+        glb: bytes,
+        mesh_ms: float,
+        resolution: int,
+    ) -> None:
         with self._lock:
             if self.closed:
                 return
             with self.server.atomic():
                 self.mesh_node.glb_data = glb
+                self.wireframe_node.vertices = vertices.astype(np.float32)
+                self.wireframe_node.faces = faces.astype(np.uint32)
                 self.progress.visible = False
                 self.mesh_vertices, self.mesh_faces, self.mesh_colors = vertices, faces, colors
-                self.mesh_scene = scene
-                self._mesh_voxel = sdf.make_grid(scene, resolution).spacing
+                self.mesh_shape = shape
+                self.mesh_scene = shape if isinstance(shape, sdf.Scene) else None
+                grid_scene = shape if isinstance(shape, sdf.Scene) else sdf.default_scene()
+                bounds = None if isinstance(shape, sdf.Scene) else shape.bounds
+                self._mesh_voxel = sdf.make_grid(grid_scene, resolution, bounds).spacing
                 self.mesh_serial += 1
                 self.agreement = dataclasses.replace(
                     self.agreement, triangles=len(faces), mesh_ms=mesh_ms
@@ -591,7 +924,7 @@ IoU is lowest when a box edge is on the silhouette.
                 self.readout.content = self._readout_markdown()
             self.server.flush()
 
-    def _render_reference(self, renderer: Renderer) -> None:
+    def _render_reference(self) -> None:
         with self._work:
             self._reference_due = False
             camera = self._camera or Camera(self.camera_position, self.camera_look_at)
@@ -601,7 +934,7 @@ IoU is lowest when a box edge is on the silhouette.
         ):  # one consistent mesh: the worker replaces all four together under this lock
             params = self.params
             scene, vertices, faces, colors = (
-                self.mesh_scene,
+                self.mesh_shape,
                 self.mesh_vertices,
                 self.mesh_faces,
                 self.mesh_colors,
@@ -609,12 +942,17 @@ IoU is lowest when a box edge is on the silhouette.
         assert scene is not None
         width = params.reference_width
         height = max(16, round(width / aspect))
-        start = time.perf_counter()
-        rgb, depth = renderer.render(scene, camera, width, height, params.shading)
-        render_ms = 1e3 * (time.perf_counter() - start)
-        _, mesh_depth = renderer.render_mesh(
-            vertices, faces, colors, camera, width, height, params.shading
-        )
+
+        def job(renderer: Renderer) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, str]:
+            start = time.perf_counter()
+            rgb, depth = _march(renderer, scene, camera, width, height, params.shading)
+            render_ms = 1e3 * (time.perf_counter() - start)
+            _, mesh_depth = renderer.render_mesh(
+                vertices, faces, colors, camera, width, height, params.shading
+            )
+            return rgb, depth, mesh_depth, render_ms, renderer.renderer_name
+
+        rgb, depth, mesh_depth, render_ms, renderer_name = gl_service.run(job)
         iou, depth_diff = _compare(depth, mesh_depth)
         with self._lock:
             if self.closed:
@@ -630,7 +968,41 @@ IoU is lowest when a box edge is on the silhouette.
                     depth_diff_voxels=None if depth_diff is None else depth_diff / self._mesh_voxel,
                 )
                 self.readout.content = self._readout_markdown()
-                self.reference_note.content = f"{width}×{height} px on {renderer.renderer_name}."
+                self.reference_note.content = f"{width}×{height} px on {renderer_name}."
+            self.server.flush()
+
+    def _render_view(self) -> None:
+        """The ray-marched main view: a coarse frame while the camera or the shape moves, a full one at rest."""
+        with self._work:
+            params = self.params
+            if params.view_mode == "mesh" or self._camera is None:
+                return
+            moving = time.monotonic() - max(self._camera_time, self._scene_time) < CAMERA_REST_S
+            camera, aspect = self._camera, self._aspect
+        shape = params.shape()
+        if isinstance(shape, sdf.Scene) and self.mesh_shape is not None:
+            try:
+                shape = self.params.scene()
+            except ValueError:
+                return
+        key = (shape, camera, aspect, moving, params.shading, params.view_mode)
+        if key == self._view_key:
+            return
+        width = MOVING_WIDTH_PX if moving else VIEW_WIDTH_PX
+        height = max(16, round(width / aspect))
+        shading = _moving_shading(params.shading) if moving else params.shading
+        start = time.perf_counter()
+        rgb, depth = gl_service.run(lambda gl: _march(gl, shape, camera, width, height, shading))
+        view_ms = 1e3 * (time.perf_counter() - start)
+        # viser encodes depth in fixed point up to 167 m: a miss goes to the far end.
+        depth = np.where(np.isfinite(depth), depth, 1e3).astype(np.float32)
+        with self._lock:
+            if self.closed or self.params.view_mode == "mesh":
+                return
+            self.server.scene.set_background_image(rgb, format="jpeg", jpeg_quality=90, depth=depth)
+            self.view_rgb, self.view_ms = rgb, view_ms
+            self.view_serial += 1
+            self._view_key = key
             self.server.flush()
 
     def _readout_markdown(self) -> str:
@@ -703,8 +1075,34 @@ def _compare(marched: np.ndarray, rasterised: np.ndarray) -> tuple[float | None,
     return iou, float(np.mean(np.abs(marched[inner].astype(np.float64) - rasterised[inner])))
 
 
+def _moving_shading(shading: Shading) -> Shading:
+    """The shading of frames drawn while something moves: no soft shadows or ambient occlusion (a smaller program,
+    several times cheaper a frame under llvmpipe); the full shading returns when the view rests."""
+    return dataclasses.replace(shading, shadows=False, occlusion=False)
+
+
+def _march(
+    gl: Renderer, shape: Shape, camera: Camera, width: int, height: int, shading: Shading
+) -> tuple[np.ndarray, np.ndarray]:
+    """Ray-march the primitives' scene or the editor's field: RGB (H, W, 3) uint8 and depth (H, W) (m)."""
+    if isinstance(shape, EditorField):
+        return gl.render_field(shape.source, shape.bounds, camera, width, height, shading)
+    return gl.render(shape, camera, width, height, shading)
+
+
+def _scene_normals(scene: sdf.Scene, vertices: np.ndarray) -> np.ndarray:
+    """(V, 3) unit normals: the field's gradient by four probes on a tetrahedron's corners (Quilez's trick)."""
+    if not len(vertices):
+        return np.zeros((0, 3))
+    corners = np.array([[1.0, -1.0, -1.0], [-1.0, -1.0, 1.0], [-1.0, 1.0, -1.0], [1.0, 1.0, 1.0]])
+    probes = (vertices[None, :, :] + 1e-4 * corners[:, None, :]).reshape(-1, 3)
+    d = sdf.scene_distance(scene, probes).reshape(4, -1)
+    gradient = d.T @ corners
+    return gradient / np.maximum(np.linalg.norm(gradient, axis=1, keepdims=True), 1e-12)
+
+
 def _viewer_glb(
-    scene: sdf.Scene, vertices: np.ndarray, faces: np.ndarray, colors: np.ndarray
+    vertices: np.ndarray, faces: np.ndarray, colors: np.ndarray, normals: np.ndarray
 ) -> bytes:
     """A minimal GLB for the 3D view: positions, smooth normals and 8-bit vertex colours, written directly.
 
@@ -713,20 +1111,7 @@ def _viewer_glb(
     this runs on every drag.)
     """
     v = np.asarray(vertices, dtype=np.float32)
-    if len(v):
-        # Four probes on a tetrahedron's corners (Quilez's normal trick): the gradient at a third less cost
-        # than six central differences; the reference shader keeps the six.
-        corners = np.array(
-            [[1.0, -1.0, -1.0], [-1.0, -1.0, 1.0], [-1.0, 1.0, -1.0], [1.0, 1.0, 1.0]]
-        )
-        probes = (vertices[None, :, :] + 1e-4 * corners[:, None, :]).reshape(-1, 3)
-        d = sdf.scene_distance(scene, probes).reshape(4, -1)
-        gradient = d.T @ corners
-        normals = (
-            gradient / np.maximum(np.linalg.norm(gradient, axis=1, keepdims=True), 1e-12)
-        ).astype(np.float32)
-    else:
-        normals = np.zeros((0, 3), np.float32)
+    normals = np.asarray(normals, dtype=np.float32).reshape(-1, 3)
     rgba = np.empty((len(v), 4), np.uint8)
     rgba[:, :3] = np.round(255 * np.clip(colors, 0.0, 1.0) ** 2.2)
     rgba[:, 3] = 255

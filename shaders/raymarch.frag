@@ -7,8 +7,26 @@
 // SHADOWS and OCCLUSION (0 or 1) are defined by the renderer, which compiles the four variants once each: a
 // switched-off term then costs nothing (a uniform flag would still be paid for under llvmpipe's masking).
 
+// USER_FIELD 1 (the editor's programs): march a person's `float sdf(vec3 p)` and `vec3 color(vec3 p)`, which the
+// renderer appends after this file, inside the box [u_field_lo, u_field_hi], instead of the uniforms' scene.
+
 #include "sdf.glsl"
 #include "shading.glsl"
+
+#ifndef USER_FIELD
+#define USER_FIELD 0
+#endif
+#if USER_FIELD
+float sdf(vec3 p);
+vec3 color(vec3 p);
+uniform vec3 u_field_lo;  // the editor's bounds (m)
+uniform vec3 u_field_hi;
+#define FIELD_DISTANCE(p) sdf(p)
+#define FIELD_COLOR(p) color(p)
+#else
+#define FIELD_DISTANCE(p) scene_distance(p)
+#define FIELD_COLOR(p) scene_color(p)
+#endif
 
 uniform vec2 u_resolution;       // pixels
 uniform vec3 u_eye;              // camera position (m)
@@ -32,9 +50,9 @@ layout(location = 1) out float out_depth;  // along u_forward (m); -1 for a miss
 vec3 scene_normal(vec3 p) {
     vec2 e = vec2(u_normal_epsilon, 0.0);
     return normalize(vec3(
-        scene_distance(p + e.xyy) - scene_distance(p - e.xyy),
-        scene_distance(p + e.yxy) - scene_distance(p - e.yxy),
-        scene_distance(p + e.yyx) - scene_distance(p - e.yyx)));
+        FIELD_DISTANCE(p + e.xyy) - FIELD_DISTANCE(p - e.xyy),
+        FIELD_DISTANCE(p + e.yxy) - FIELD_DISTANCE(p - e.yxy),
+        FIELD_DISTANCE(p + e.yyx) - FIELD_DISTANCE(p - e.yyx)));
 }
 
 // Where a unit ray first enters and last leaves the bounds: per primitive, its bounding sphere
@@ -42,6 +60,19 @@ vec3 scene_normal(vec3 p) {
 // primitive's frame); over the primitives, the union. (t_enter >= 0, t_exit), t_exit < t_enter where it meets none
 // ahead. A sphere tracer started at any point before the first surface finds the same surface, so the image
 // equals kernels/sdf.py sphere_trace's from the spheres alone, while fewer steps are spent beside the shape.
+#if USER_FIELD
+// The editor's field: the slab test against its bounds box.
+vec2 bound_interval(vec3 origin, vec3 dir) {
+    vec3 inverse = 1.0 / mix(dir, vec3(1e-20), lessThan(abs(dir), vec3(1e-20)));
+    vec3 t_low = (u_field_lo - origin) * inverse;
+    vec3 t_high = (u_field_hi - origin) * inverse;
+    vec3 t_near = min(t_low, t_high);
+    vec3 t_far = max(t_low, t_high);
+    float enter = max(max(t_near.x, max(t_near.y, t_near.z)), 0.0);
+    float exit = min(t_far.x, min(t_far.y, t_far.z));
+    return exit >= enter ? vec2(enter, exit) : vec2(1e30, -1.0);
+}
+#else
 vec2 bound_interval(vec3 origin, vec3 dir) {
     float t_enter = 1e30;
     float t_exit = -1.0;
@@ -66,6 +97,7 @@ vec2 bound_interval(vec3 origin, vec3 dir) {
     }
     return vec2(t_enter, t_exit);
 }
+#endif
 
 // A shadow factor this small is black to 8 bits (under half a level at the default k_d + k_s): stop marching there.
 #define SHADOW_BLACK 0.002
@@ -75,7 +107,7 @@ float soft_shadow(vec3 origin, vec3 dir, float t_min, float t_max, float k) {
     float t = t_min;
     float previous = 1e20;
     for (int i = 0; i < 32 && t < t_max && result > SHADOW_BLACK; ++i) {
-        float h = scene_distance(origin + dir * t);
+        float h = FIELD_DISTANCE(origin + dir * t);
         if (h < 1e-4) {
             return 0.0;
         }
@@ -98,7 +130,7 @@ float ambient_occlusion(vec3 p, vec3 n) {
     float weight = 1.0;
     for (int i = 1; i <= 5; ++i) {
         float h = u_occlusion_step * float(i);
-        occlusion += (h - scene_distance(p + n * h)) * weight;
+        occlusion += (h - FIELD_DISTANCE(p + n * h)) * weight;
         weight *= 0.75;
     }
     return clamp(1.0 - u_occlusion_strength * occlusion, 0.0, 1.0);
@@ -117,7 +149,7 @@ void main() {
     float t_exit = min(span.y, u_max_distance);
     bool hit = false;
     for (int i = 0; i < u_max_steps && t_exit >= t; ++i) {
-        float d = scene_distance(u_eye + dir * t);
+        float d = FIELD_DISTANCE(u_eye + dir * t);
         if (d < u_hit_epsilon * max(1.0, t)) {
             hit = true;
             break;
@@ -146,7 +178,7 @@ void main() {
 #if OCCLUSION
     occlusion = ambient_occlusion(p, n);
 #endif
-    vec3 color = phong(scene_color(p), n, -dir, shadow, occlusion);
-    out_color = vec4(clamp(color, 0.0, 1.0), 1.0);
+    vec3 shaded = phong(FIELD_COLOR(p), n, -dir, shadow, occlusion);
+    out_color = vec4(clamp(shaded, 0.0, 1.0), 1.0);
     out_depth = t * dot(dir, u_forward);
 }

@@ -16,8 +16,10 @@ module-level :func:`render` keeps one per thread).
 
 from __future__ import annotations
 
+import collections
 import dataclasses
 import math
+import re
 import threading
 from pathlib import Path
 
@@ -27,7 +29,20 @@ from numpy.typing import ArrayLike, NDArray
 
 from kernels import sdf
 
-KIND_CODE: dict[str, int] = {"sphere": 0, "box": 1, "torus": 2, "capsule": 3}
+KIND_CODE: dict[str, int] = {
+    "sphere": 0,
+    "box": 1,
+    "torus": 2,
+    "capsule": 3,
+    "cylinder": 4,
+    "round_box": 5,
+    "octahedron": 6,
+    "cone": 7,
+    "hex_prism": 8,
+    "ellipsoid": 9,
+}
+BASIC_KINDS = frozenset({"sphere", "box", "torus", "capsule"})
+"""Kinds the fast single-formula path of sdf.glsl's primitive_distance handles; others need EXTRA_KINDS."""
 OP_CODE: dict[str, int] = {"union": 0, "subtract": 1, "intersect": 2}
 BLEND_CODE: dict[str, int] = {"poly": 0, "exp": 1}
 _MISS = -1.0
@@ -196,6 +211,15 @@ def _bounding_boxes(
                 half[i] = (s[0] + s[1], s[1], s[0] + s[1])
             case "capsule":
                 half[i] = (s[1], s[0] + s[1], s[1])
+            case "cylinder" | "cone":
+                radius, half_height = (s[1], s[0]) if prim.kind == "cylinder" else (s[0], s[1] / 2)
+                half[i] = (radius, half_height, radius)
+            case "round_box" | "ellipsoid":
+                half[i] = s[:3]
+            case "octahedron":
+                half[i] = (s[0], s[0], s[0])
+            case "hex_prism":
+                half[i] = (2 * s[0] / math.sqrt(3.0), s[0], s[1])
     centers = np.array([p.center for p in scene.primitives], dtype=np.float64)
     rotations = np.array([sdf.rotation_matrix(p.rotation) for p in scene.primitives])
     unions = sum(prim.op == "union" for prim in scene.primitives[1:])
@@ -265,6 +289,127 @@ def _with_defines(source: str, **defines: int) -> str:
     return "\n".join([version, *(f"#define {k} {v}" for k, v in defines.items()), rest])
 
 
+# ------------------------------------------------------------------------------------------ the editor's source
+MAX_SOURCE_CHARS = 8000
+"""Longest editor source accepted (characters)."""
+_FIELD_CACHE = 12
+"""Editor programs kept compiled (a few sources × their variants)."""
+_MAX_ROWS = 8192
+"""Rows of one grid-sampling draw (GL_MAX_TEXTURE_SIZE is at least this on every driver we meet)."""
+DEFAULT_COLOR_GLSL = "vec3 color(vec3 p) {\n    return vec3(0.85, 0.55, 0.35);\n}\n"
+"""The colour an editor source gets when it defines no ``color``."""
+_FORBIDDEN = {
+    "for": "loops are not allowed (a loop could run forever and stall every viewer); use op_repeat_finite",
+    "while": "loops are not allowed (a loop could run forever and stall every viewer)",
+    "do": "loops are not allowed (a loop could run forever and stall every viewer)",
+    "discard": "discard is not allowed in sdf() or color()",
+    "uniform": "declaring uniforms is not allowed",
+    "main": "main() is the app's; write float sdf(vec3 p) and optionally vec3 color(vec3 p)",
+}
+
+
+class ShaderCompileError(ValueError):
+    """An editor source the checks or the GLSL compiler reject; ``line`` is 1-based in that source (or None)."""
+
+    def __init__(self, message: str, line: int | None) -> None:
+        super().__init__(message if line is None else f"line {line}: {message}")
+        self.line = line
+        self.reason = message
+
+    @classmethod
+    def from_compiler(cls, log: str, source: str) -> ShaderCompileError:
+        """The first error of a compiler log (Mesa "0:LINE(COL): error: …"; NVIDIA "0(LINE) : error …")."""
+        lines = source.count("\n") + 1
+        for match in re.finditer(
+            r"^\s*\d+[:(](\d+)\)?(?:\(\d+\))?\s*:\s*error\s*:?\s*(.+)$", log, re.M
+        ):
+            line, message = int(match.group(1)), match.group(2).strip()
+            return cls(message, line if 1 <= line <= lines else None)
+        text = (
+            " ".join(log.replace("GLSL Compiler failed", "").split())
+            or "the shader did not compile"
+        )
+        return cls(text, None)
+
+
+def check_source(source: object) -> str:
+    """The editor source if the app will compile it, else :class:`ShaderCompileError` saying why and where.
+
+    Untrusted text: at most :data:`MAX_SOURCE_CHARS` printable ASCII characters (tabs and newlines too); no
+    preprocessor lines (no ``#include``, ``#extension``, macros); no loops (``for``, ``while``, ``do``): without
+    them, and without recursion (which GLSL forbids), every call of ``sdf`` ends, and its cost grows with the
+    source's length; no ``uniform`` declarations, ``discard`` or ``main``. It must define
+    ``float sdf(vec3 p)``; ``vec3 color(vec3 p)`` is optional.
+    """
+    if not isinstance(source, str):
+        raise ShaderCompileError("the source must be text", None)
+    if len(source) > MAX_SOURCE_CHARS:
+        raise ShaderCompileError(
+            f"the source is {len(source)} characters; the limit is {MAX_SOURCE_CHARS}", None
+        )
+    for number, line in enumerate(source.split("\n"), start=1):
+        bad = next((c for c in line if not (" " <= c <= "~" or c in "\t\r")), None)
+        if bad is not None:
+            raise ShaderCompileError(
+                f"character {bad!r} is not allowed (printable ASCII only)", number
+            )
+        if line.lstrip().startswith("#"):
+            raise ShaderCompileError("preprocessor lines (#…) are not allowed", number)
+        code = line.split("//", 1)[0]
+        for word in re.findall(r"[A-Za-z_]\w*", code):
+            if word in _FORBIDDEN:
+                raise ShaderCompileError(_FORBIDDEN[word], number)
+            if word.startswith("gl_"):
+                raise ShaderCompileError(f"{word} is not available here", number)
+    if "/*" in source:
+        raise ShaderCompileError("block comments (/* */) are not allowed; use //", None)
+    if not re.search(r"\bfloat\s+sdf\s*\(\s*vec3\s+\w+\s*\)", source):
+        raise ShaderCompileError("define float sdf(vec3 p), the signed distance (m)", None)
+    return source
+
+
+def user_glsl(source: str) -> str:
+    """What a template gets appended: ``#line 1`` so compiler lines count from the source's first line, the
+    source, and the default ``color`` if it defines none."""
+    has_color = re.search(r"\bvec3\s+color\s*\(\s*vec3\s+\w+\s*\)", source) is not None
+    return "\n#line 1\n" + source + "\n" + ("" if has_color else DEFAULT_COLOR_GLSL)
+
+
+def _check_bounds(bounds: ArrayLike) -> NDArray[np.float64]:
+    box = np.asarray(bounds, dtype=np.float64)
+    if box.shape != (2, 3) or not np.all(np.isfinite(box)) or np.any(box[1] <= box[0]):
+        raise ValueError(
+            f"bounds must be finite (2, 3) min and max corners with max > min, got {box.tolist()}"
+        )
+    if np.any(np.abs(box) > 1e3):
+        raise ValueError("bounds must lie within ±1000 m")
+    return box
+
+
+def _box_scissor(
+    camera: Camera, box: NDArray[np.float64], width: int, height: int
+) -> tuple[int, int, int, int]:
+    """:func:`_bounds_scissor` for one axis-aligned box (the editor's bounds)."""
+    corners = np.array(
+        [[box[i, 0], box[j, 1], box[k, 2]] for i in (0, 1) for j in (0, 1) for k in (0, 1)]
+    )
+    forward, right, up = camera.basis()
+    rel = corners - np.asarray(camera.position)
+    z = rel @ forward
+    if np.all(z <= 0.0):
+        return (0, 0, 0, 0)
+    if np.any(z < 1e-3):
+        return (0, 0, width, height)
+    tan_half = math.tan(camera.fov_y_rad / 2)
+    x_ndc = (rel @ right) / (z * tan_half * width / height)
+    y_ndc = (rel @ up) / (z * tan_half)
+    x0 = int(np.clip(math.floor((x_ndc.min() + 1) / 2 * width) - 1, 0, width))
+    x1 = int(np.clip(math.ceil((x_ndc.max() + 1) / 2 * width) + 1, 0, width))
+    y0 = int(np.clip(math.floor((y_ndc.min() + 1) / 2 * height) - 1, 0, height))
+    y1 = int(np.clip(math.ceil((y_ndc.max() + 1) / 2 * height) + 1, 0, height))
+    return (x0, y0, max(x1 - x0, 0), max(y1 - y0, 0))
+
+
 def create_context() -> object:
     """A standalone OpenGL 3.3+ context on EGL, or :class:`GLUnavailableError` saying why not."""
     try:
@@ -296,29 +441,22 @@ class Renderer:
         self.ctx.includes["sdf.glsl"] = _source("sdf.glsl")
         self.ctx.includes["shading.glsl"] = _source("shading.glsl")
         fullscreen = _source("fullscreen.vert")
-        raymarch = _source("raymarch.frag")
-        # One program per (shadows, occlusion, polynomial blend only), compiled here once: under llvmpipe a term
-        # switched off by a uniform would still be paid for, and the exponential blend's exp and log cost as much as
-        # the rest of the scene, so poly and hard scenes use a program without them.
-        self._raymarch = {
-            (shadows, occlusion, poly_only): self.ctx.program(
-                vertex_shader=fullscreen,
-                fragment_shader=_with_defines(
-                    raymarch,
-                    SHADOWS=int(shadows),
-                    OCCLUSION=int(occlusion),
-                    POLY_BLEND_ONLY=int(poly_only),
-                ),
-            )
-            for shadows in (False, True)
-            for occlusion in (False, True)
-            for poly_only in (False, True)
-        }
-        self._raymarch_vao = {
-            key: self.ctx.vertex_array(prog, []) for key, prog in self._raymarch.items()
-        }
+        # One program per (shadows, occlusion, polynomial blend only), compiled on first use and kept: under
+        # llvmpipe a term switched off by a uniform would still be paid for, and the exponential blend's exp and log
+        # cost as much as the rest of the scene, so poly and hard scenes use a program without them.
+        self._raymarch_source = _source("raymarch.frag")
+        self._fullscreen = _source("fullscreen.vert")
+        self._raymarch: dict[tuple[bool, bool, bool, bool], object] = {}
+        self._raymarch_vao: dict[tuple[bool, bool, bool, bool], object] = {}
+        self._fields: collections.OrderedDict[tuple[str, str], tuple[object, object]] = (
+            collections.OrderedDict()
+        )
+        """Compiled editor programs by (source, variant), least recently used first."""
+        for shadows, occlusion in ((True, True), (False, False)):  # the gallery's opening variants
+            self._raymarch_program((shadows, occlusion, True, False))
         self._probe = self.ctx.program(
-            vertex_shader=fullscreen, fragment_shader=_source("probe.frag")
+            vertex_shader=fullscreen,
+            fragment_shader=_with_defines(_source("probe.frag"), EXTRA_KINDS=1),
         )
         self._mesh = self.ctx.program(
             vertex_shader=_source("mesh.vert"), fragment_shader=_source("mesh.frag")
@@ -330,6 +468,24 @@ class Renderer:
 
     def release(self) -> None:
         self.ctx.release()
+
+    def _raymarch_program(self, variant: tuple[bool, bool, bool, bool]) -> tuple[object, object]:
+        """The ray-march program for (shadows, occlusion, polynomial blend only, catalogue kinds), compiled once."""
+        if variant not in self._raymarch:
+            shadows, occlusion, poly_only, extra = variant
+            prog = self.ctx.program(
+                vertex_shader=self._fullscreen,
+                fragment_shader=_with_defines(
+                    self._raymarch_source,
+                    SHADOWS=int(shadows),
+                    OCCLUSION=int(occlusion),
+                    POLY_BLEND_ONLY=int(poly_only),
+                    EXTRA_KINDS=int(extra),
+                ),
+            )
+            self._raymarch[variant] = prog
+            self._raymarch_vao[variant] = self.ctx.vertex_array(prog, [])
+        return self._raymarch[variant], self._raymarch_vao[variant]
 
     # ------------------------------------------------------------------------------------- uniforms
     def _set(self, program: object, name: str, value: object) -> None:
@@ -461,9 +617,28 @@ class Renderer:
         _check_size(width, height)
         shading = shading or Shading()
         # sdf.glsl's smin_blend uses the polynomial form for hard scenes (k = 0) whatever the blend.
-        variant = (shading.shadows, shading.occlusion, scene.blend == "poly" or scene.k == 0.0)
-        prog = self._raymarch[variant]
+        variant = (
+            shading.shadows,
+            shading.occlusion,
+            scene.blend == "poly" or scene.k == 0.0,
+            any(p.kind not in BASIC_KINDS for p in scene.primitives),
+        )
+        prog, vao = self._raymarch_program(variant)
         self._set_scene(prog, scene)
+        self._set_camera(prog, camera, width, height, shading)
+        fbo, color, depth = self._targets(width, height, shading)
+        assert isinstance(fbo, moderngl.Framebuffer)
+        # Only pixels whose rays can meet a bounding box run the shader (llvmpipe pays for every pixel).
+        fbo.scissor = _bounds_scissor(camera, scene, width, height)
+        self.ctx.disable(moderngl.DEPTH_TEST)
+        vao.render(moderngl.TRIANGLES, vertices=3)  # pyright: ignore[reportAttributeAccessIssue]
+        fbo.scissor = (0, 0, width, height)
+        return self._read(color, depth, width, height)
+
+    def _set_camera(
+        self, prog: object, camera: Camera, width: int, height: int, shading: Shading
+    ) -> None:
+        """The camera, marching and shading uniforms of a ray-march program."""
         self._set_shading(prog, shading)
         forward, right, up = camera.basis()
         self._set(prog, "u_resolution", (float(width), float(height)))
@@ -479,14 +654,6 @@ class Renderer:
         self._set(prog, "u_shadow_sharpness", shading.shadow_sharpness)
         self._set(prog, "u_occlusion_strength", shading.occlusion_strength)
         self._set(prog, "u_occlusion_step", shading.occlusion_step)
-        fbo, color, depth = self._targets(width, height, shading)
-        assert isinstance(fbo, moderngl.Framebuffer)
-        # Only pixels whose rays can meet a bounding box run the shader (llvmpipe pays for every pixel).
-        fbo.scissor = _bounds_scissor(camera, scene, width, height)
-        self.ctx.disable(moderngl.DEPTH_TEST)
-        self._raymarch_vao[variant].render(moderngl.TRIANGLES, vertices=3)
-        fbo.scissor = (0, 0, width, height)
-        return self._read(color, depth, width, height)
 
     def render_mesh(
         self,
@@ -597,6 +764,173 @@ class Renderer:
             obj.release()
         return d, rgb
 
+    # ------------------------------------------------------------------------------------- the editor's fields
+    def _field_program(self, source: str, variant: str) -> tuple[object, object]:
+        """The compiled program of an editor source for one variant ("sample", or "march:S:O" with the shadow and
+        occlusion flags), cached; :class:`ShaderCompileError` for a source the compiler rejects.
+
+        A new program is drawn once into one pixel: llvmpipe compiles (JITs) a program at its first draw, which
+        costs more than most frames; drawing here keeps that cost in the compile time, not the first frame.
+        """
+        import moderngl
+
+        key = (source, variant)
+        cached = self._fields.get(key)
+        if cached is not None:
+            self._fields.move_to_end(key)
+            return cached
+        if variant == "sample":
+            template = _source("field_sample.frag")
+        else:
+            _, shadows, occlusion = variant.split(":")
+            template = _with_defines(
+                self._raymarch_source,
+                USER_FIELD=1,
+                SHADOWS=int(shadows),
+                OCCLUSION=int(occlusion),
+                POLY_BLEND_ONLY=1,
+            )
+        try:
+            prog = self.ctx.program(
+                vertex_shader=self._fullscreen, fragment_shader=template + user_glsl(source)
+            )
+        except moderngl.Error as exc:
+            raise ShaderCompileError.from_compiler(str(exc), source) from None
+        vao = self.ctx.vertex_array(prog, [])
+        # llvmpipe compiles a variant per framebuffer layout: warm with each layout the real draws use (the grid
+        # pass's and the points pass's, or the ray-march's).
+        layouts = [("f1", 4), ("f4", 4)] if variant == "sample" else [("f4", 1)]
+        self.ctx.disable(moderngl.DEPTH_TEST)
+        for second_dtype, second_components in layouts:
+            first = (
+                self.ctx.texture((1, 1), 1, dtype="f4")
+                if variant == "sample"
+                else self.ctx.texture((1, 1), 3, dtype="f1")
+            )
+            second = self.ctx.texture((1, 1), second_components, dtype=second_dtype)
+            zbuffer = None if variant == "sample" else self.ctx.depth_renderbuffer((1, 1))
+            warm = self.ctx.framebuffer(color_attachments=[first, second], depth_attachment=zbuffer)
+            warm.use()
+            vao.render(moderngl.TRIANGLES, vertices=3)
+            warm.read(components=1, dtype="f4")  # wait for it
+            for obj in (warm, first, second, *([] if zbuffer is None else [zbuffer])):
+                obj.release()
+        self._fields[key] = (prog, vao)
+        while len(self._fields) > _FIELD_CACHE:
+            _, (old_prog, old_vao) = self._fields.popitem(last=False)
+            old_vao.release()  # pyright: ignore[reportAttributeAccessIssue]
+            old_prog.release()  # pyright: ignore[reportAttributeAccessIssue]
+        return prog, vao
+
+    def compile_field(self, source: str, shading: Shading | None = None) -> None:
+        """Check and compile an editor source (its sampling programs and the ray-march for ``shading``'s shadow and
+        occlusion switches), or raise ValueError saying why and where."""
+        check_source(source)
+        shading = shading or Shading()
+        self._field_program(source, "sample")
+        self._field_program(source, f"march:{int(shading.shadows)}:{int(shading.occlusion)}")
+
+    def probe_field(
+        self, source: str, points: ArrayLike
+    ) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
+        """The editor's ``sdf`` and ``color`` at (N, 3) points: (N,) distances and (N, 3) colours, float32."""
+        import moderngl
+
+        check_source(source)
+        pts = np.asarray(points, dtype=np.float32)
+        if pts.ndim != 2 or pts.shape[1] != 3 or not np.all(np.isfinite(pts)) or len(pts) == 0:
+            raise ValueError(f"points must be finite (N, 3) with N ≥ 1, got {pts.shape}")
+        prog, vao = self._field_program(source, "sample")
+        self._set(prog, "u_sample_points", 1)
+        n = len(pts)
+        width = min(n, _PROBE_WIDTH)
+        height = -(-n // width)
+        padded = np.zeros((width * height, 3), np.float32)
+        padded[:n] = pts
+        texture = self.ctx.texture((width, height), 3, padded.tobytes(), dtype="f4")
+        texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        distance = self.ctx.texture((width, height), 1, dtype="f4")
+        color = self.ctx.texture((width, height), 4, dtype="f4")
+        fbo = self.ctx.framebuffer(color_attachments=[distance, color])
+        texture.use(location=0)
+        self._set(prog, "u_points", 0)
+        fbo.use()
+        vao.render(moderngl.TRIANGLES, vertices=3)  # pyright: ignore[reportAttributeAccessIssue]
+        d = np.frombuffer(distance.read(), np.float32)[:n].copy()
+        rgb = np.frombuffer(color.read(), np.float32).reshape(-1, 4)[:n, :3].copy()
+        for obj in (fbo, texture, distance, color):
+            obj.release()
+        return d, rgb
+
+    def sample_field(self, source: str, grid: sdf.Grid) -> NDArray[np.float32]:
+        """The editor's ``sdf`` at every sample of ``grid``: (nx, ny, nz) float32 (m), sampled in GLSL.
+
+        The samples are drawn as images of nx × (ny·slices) pixels, as many z slices a draw as fit in 8192 rows.
+        """
+        import moderngl
+
+        check_source(source)
+        prog, vao = self._field_program(source, "sample")
+        self._set(prog, "u_sample_points", 0)
+        nx, ny, nz = grid.shape
+        slices = max(1, min(nz, _MAX_ROWS // ny))
+        distance = self.ctx.texture((nx, ny * slices), 1, dtype="f4")
+        color = self.ctx.texture(
+            (nx, ny * slices), 4, dtype="f1"
+        )  # a quarter of the points pass's bytes
+        fbo = self.ctx.framebuffer(color_attachments=[distance, color])
+        fbo.use()
+        self._set(prog, "u_origin", tuple(float(v) for v in grid.origin))
+        self._set(prog, "u_spacing", float(grid.spacing))
+        self._set(prog, "u_ny", ny)
+        out = np.empty((nz, ny, nx), np.float32)
+        try:
+            for z0 in range(0, nz, slices):
+                count = min(slices, nz - z0)
+                self._set(prog, "u_z0", z0)
+                fbo.scissor = (0, 0, nx, ny * count)
+                vao.render(moderngl.TRIANGLES, vertices=3)  # pyright: ignore[reportAttributeAccessIssue]
+                block = np.frombuffer(distance.read(), np.float32).reshape(ny * slices, nx)
+                out[z0 : z0 + count] = block[: ny * count].reshape(count, ny, nx)
+        finally:
+            for obj in (fbo, distance, color):
+                obj.release()
+        return np.ascontiguousarray(out.transpose(2, 1, 0))
+
+    def render_field(
+        self,
+        source: str,
+        bounds: ArrayLike,
+        camera: Camera,
+        width: int,
+        height: int,
+        shading: Shading | None = None,
+    ) -> tuple[NDArray[np.uint8], NDArray[np.float32]]:
+        """Ray-march the editor's field inside ``bounds`` ((2, 3) min and max corners, m), as :meth:`render` does.
+
+        Returns:
+            RGB (H, W, 3) uint8 and depth along the view axis (H, W) float32 (m), inf where a ray misses.
+        """
+        import moderngl
+
+        _check_size(width, height)
+        check_source(source)
+        box = _check_bounds(bounds)
+        shading = shading or Shading()
+        prog, vao = self._field_program(
+            source, f"march:{int(shading.shadows)}:{int(shading.occlusion)}"
+        )
+        self._set(prog, "u_field_lo", tuple(float(v) for v in box[0]))
+        self._set(prog, "u_field_hi", tuple(float(v) for v in box[1]))
+        self._set_camera(prog, camera, width, height, shading)
+        fbo, color, depth = self._targets(width, height, shading)
+        assert isinstance(fbo, moderngl.Framebuffer)
+        fbo.scissor = _box_scissor(camera, box, width, height)
+        self.ctx.disable(moderngl.DEPTH_TEST)
+        vao.render(moderngl.TRIANGLES, vertices=3)  # pyright: ignore[reportAttributeAccessIssue]
+        fbo.scissor = (0, 0, width, height)
+        return self._read(color, depth, width, height)
+
 
 _local = threading.local()
 
@@ -615,3 +949,58 @@ def render(
 ) -> tuple[NDArray[np.uint8], NDArray[np.float32]]:
     """Ray-march ``scene`` with this thread's :class:`Renderer`: RGB (H, W, 3) uint8 and depth (H, W) float32."""
     return renderer().render(scene, camera, width, height, shading)
+
+
+def mesh_glsl(source: str, resolution: int, bounds: ArrayLike) -> trimesh.Trimesh:
+    """Mesh an editor source: its ``sdf`` sampled in GLSL on the marching-cubes grid, then marching cubes.
+
+    The same text the ray-march runs, so what a person types appears meshed and ray-marched from one source.
+    Runs on the process's one GL thread (:mod:`shaders.gl_service`).
+
+    Args:
+        source: GLSL defining ``float sdf(vec3 p)`` (m) and optionally ``vec3 color(vec3 p)`` (linear RGB), using
+            ``sdf.glsl``'s primitives and operators; see :func:`check_source` for what is allowed.
+        resolution: samples along the longest side of ``bounds``, 16..512.
+        bounds: (2, 3) min and max corners (m).
+
+    Returns:
+        The zero level set with vertex colours from ``color`` (empty if no surface crosses the bounds).
+
+    Raises:
+        ValueError: a bad resolution or bounds, or (:class:`ShaderCompileError`) a source the checks or the
+            compiler reject, with the compiler's message and the source line.
+        GLUnavailableError: no OpenGL context on this machine.
+    """
+    from shaders import gl_service
+
+    check_source(source)
+    box = _check_bounds(bounds)
+    grid = sdf.make_grid(
+        sdf.default_scene(), resolution, box
+    )  # the scene is unused when bounds are given
+
+    def job(gl: Renderer) -> trimesh.Trimesh:
+        field = gl.sample_field(source, grid)
+        if not np.all(np.isfinite(field)):
+            raise ShaderCompileError("sdf() returned NaN or infinity inside the bounds", None)
+        vertices, faces = sdf.mesh_samples(grid, field, _near_surface_mask(field, grid.spacing))
+        colors = gl.probe_field(source, vertices)[1] if len(vertices) else np.zeros((0, 3))
+        return sdf.mesh_trimesh(vertices, faces, np.clip(colors.astype(np.float64), 0.0, 1.0))
+
+    return gl_service.run(job)
+
+
+def _near_surface_mask(field: NDArray[np.float32], spacing: float) -> NDArray[np.bool_]:
+    """Cells whose corners may straddle the surface (|d| within a cell diagonal at a corner): marching cubes skips
+    the rest, which it would find empty anyway for a distance bound."""
+    return np.abs(field) <= np.float32(math.sqrt(3.0) * spacing)
+
+
+def examples() -> dict[str, str]:
+    """The editor's example sources (``shaders/example_*.glsl``) by title (each file's first comment line)."""
+    out: dict[str, str] = {}
+    for path in sorted(SHADER_DIR.glob("example_*.glsl")):
+        source = path.read_text(encoding="utf-8")
+        title = source.split("\n", 1)[0].removeprefix("//").strip()
+        out[title] = source
+    return out

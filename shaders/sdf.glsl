@@ -7,6 +7,14 @@
 #define KIND_BOX 1
 #define KIND_TORUS 2
 #define KIND_CAPSULE 3
+#define KIND_CYLINDER 4
+#define KIND_ROUND_BOX 5
+#define KIND_OCTAHEDRON 6
+#define KIND_CONE 7
+#define KIND_HEX_PRISM 8
+#define KIND_ELLIPSOID 9
+// kernels/sdf.py ROUND_BOX_ROUNDING: a scene's round box is rounded by this fraction of its smallest half size.
+#define ROUND_BOX_ROUNDING 0.25
 #define OP_UNION 0
 #define OP_SUBTRACT 1
 #define OP_INTERSECT 2
@@ -134,12 +142,128 @@ float smooth_intersect(float a, float b, float k, int blend) {
     return combine(a, b, OP_INTERSECT, k, blend).x;
 }
 
+// ------------------------------------------------------------------------------ more primitives
+// After I. Quilez, "distance functions" (iquilezles.org/articles/distfunctions); kernels/sdf.py has the same names,
+// arguments and frames, and says which are exact and which only bounds.
+float sd_cylinder(vec3 p, float half_height, float radius) {  // exact; capped, along y
+    vec2 d = vec2(length(p.xz) - radius, abs(p.y) - half_height);
+    return min(max(d.x, d.y), 0.0) + length(max(d, 0.0));
+}
+
+float sd_round_box(vec3 p, vec3 half_size, float radius) {  // exact; outer half extents, edges rounded
+    vec3 q = abs(p) - half_size + radius;
+    return length(max(q, 0.0)) + min(max(q.x, max(q.y, q.z)), 0.0) - radius;
+}
+
+float sd_octahedron(vec3 p, float size) {  // exact; |x| + |y| + |z| = size
+    p = abs(p);
+    float m = p.x + p.y + p.z - size;
+    vec3 q;
+    if (3.0 * p.x < m) {
+        q = p.xyz;
+    } else if (3.0 * p.y < m) {
+        q = p.yzx;
+    } else if (3.0 * p.z < m) {
+        q = p.zxy;
+    } else {
+        return m * 0.57735026918962576;
+    }
+    float k = clamp(0.5 * (q.z - q.y + size), 0.0, size);
+    return length(vec3(q.x, q.y - size + k, q.z - k));
+}
+
+float sd_cone(vec3 p, float radius, float height) {  // exact; along y, base at y = -height/2, apex at +height/2
+    vec2 q = vec2(radius, -height);
+    vec2 w = vec2(length(p.xz), p.y - 0.5 * height);
+    vec2 a = w - q * clamp(dot(w, q) / dot(q, q), 0.0, 1.0);
+    vec2 b = w - q * vec2(clamp(w.x / q.x, 0.0, 1.0), 1.0);
+    float d = min(dot(a, a), dot(b, b));
+    float s = max(-(w.x * q.y - w.y * q.x), -(w.y - q.y));
+    return sqrt(d) * sign(s);
+}
+
+float sd_hex_prism(vec3 p, float apothem, float half_height) {  // exact; along z
+    const vec3 k = vec3(-0.86602540378443865, 0.5, 0.57735026918962576);
+    p = abs(p);
+    p.xy -= 2.0 * min(dot(k.xy, p.xy), 0.0) * k.xy;
+    vec2 d = vec2(length(p.xy - vec2(clamp(p.x, -k.z * apothem, k.z * apothem), apothem)) * sign(p.y - apothem),
+                  p.z - half_height);
+    return min(max(d.x, d.y), 0.0) + length(max(d, 0.0));
+}
+
+float sd_ellipsoid(vec3 p, vec3 radii) {  // a bound, not exact; -min(radii) at the centre
+    float k0 = length(p / radii);
+    float k1 = length(p / (radii * radii));
+    return k1 > 0.0 ? k0 * (k0 - 1.0) / k1 : -min(radii.x, min(radii.y, radii.z));
+}
+
+float sd_ellipsoid_lipschitz(vec3 p, vec3 radii) {  // a 1-Lipschitz bound: (|p/r| - 1)·min(r)
+    return (length(p / radii) - 1.0) * min(radii.x, min(radii.y, radii.z));
+}
+
+float sd_plane(vec3 p, vec3 normal, float offset) {  // exact; n·p + offset, n normalised here
+    return dot(p, normalize(normal)) + offset;
+}
+
+// ------------------------------------------------------------------------------ operators
+// Rounding and onion act on a distance; the rest map the query point (GLSL has no function arguments), as in
+// kernels/sdf.py.
+float op_round(float d, float radius) {
+    return d - radius;
+}
+
+float op_onion(float d, float thickness) {
+    return abs(d) - thickness;
+}
+
+// xyz: the point to evaluate the shape at; w: the term to add to its distance.
+vec4 op_elongate(vec3 p, vec3 half_length) {
+    vec3 q = abs(p) - half_length;
+    return vec4(p - clamp(p, -half_length, half_length), min(max(q.x, max(q.y, q.z)), 0.0));
+}
+
+vec3 op_twist(vec3 p, float rate) {  // rotate (x, z) by rate·y
+    float c = cos(rate * p.y);
+    float s = sin(rate * p.y);
+    return vec3(c * p.x - s * p.z, p.y, s * p.x + c * p.z);
+}
+
+vec3 op_bend(vec3 p, float rate) {  // rotate (x, y) by rate·x
+    float c = cos(rate * p.x);
+    float s = sin(rate * p.x);
+    return vec3(c * p.x - s * p.y, s * p.x + c * p.y, p.z);
+}
+
+vec3 op_repeat_finite(vec3 p, vec3 spacing, vec3 limit) {  // floor(x + 0.5): round() leaves halves to the driver
+    return p - spacing * clamp(floor(p / spacing + 0.5), -limit, limit);
+}
+
+vec3 op_symmetry(vec3 p, vec3 axes) {  // axes: 1 mirrors that coordinate, 0 leaves it
+    return mix(p, abs(p), axes);
+}
+
 // ------------------------------------------------------------------------------ scene
 // Every kind is one rounded box |max(q, 0)| + min(max(q.x, q.y, q.z), 0) - r, q = |p'| - e (sphere: p' = p, e = 0;
 // box: p' = p, e = half sizes, r = 0; capsule: p' = p, e = (0, half length, 0)). The torus is the same formula with
 // p' = (|p.xz| - major radius, p.y, 0) and e = 0: then q = |p'| has no negative part and the formula is
 // |p'| - minor radius, sd_torus. One formula with selected inputs, not two formulas and a select (see smin_blend on
 // why); the values equal sd_sphere, sd_box, sd_capsule and sd_torus.
+// The catalogue's kinds cost every one of their formulas under llvmpipe's masking, so only programs that define
+// EXTRA_KINDS 1 (the renderer compiles those for scenes that use them) include them.
+#ifndef EXTRA_KINDS
+#define EXTRA_KINDS 0
+#endif
+#if EXTRA_KINDS
+float catalogue_distance(int kind, vec3 p, vec3 s) {
+    if (kind == KIND_CYLINDER) return sd_cylinder(p, s.x, s.y);
+    if (kind == KIND_ROUND_BOX) return sd_round_box(p, s, ROUND_BOX_ROUNDING * min(s.x, min(s.y, s.z)));
+    if (kind == KIND_OCTAHEDRON) return sd_octahedron(p, s.x);
+    if (kind == KIND_CONE) return sd_cone(p, s.x, s.y);
+    if (kind == KIND_HEX_PRISM) return sd_hex_prism(p, s.x, s.y);
+    return sd_ellipsoid_lipschitz(p, s);
+}
+#endif
+
 float primitive_distance(int i, vec3 p_world) {
     vec3 p = u_world_to_local[i] * (p_world - u_center[i]);
     vec3 s = u_size[i];
@@ -148,6 +272,11 @@ float primitive_distance(int i, vec3 p_world) {
     vec3 shape_point = torus ? vec3(length(p.xz) - s.x, p.y, 0.0) : p;
     vec3 e = kind == KIND_BOX ? s : (kind == KIND_CAPSULE ? vec3(0.0, s.x, 0.0) : vec3(0.0));
     float r = kind == KIND_BOX ? 0.0 : (kind == KIND_CAPSULE || torus ? s.y : s.x);
+#if EXTRA_KINDS
+    if (kind >= KIND_CYLINDER) {
+        return catalogue_distance(kind, p, s);
+    }
+#endif
     return sd_box(shape_point, e) - r;
 }
 

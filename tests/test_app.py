@@ -21,7 +21,20 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def test_defaults_bind_loopback_port_8080_and_open_peloton() -> None:
     defaults = {name: p.default for name, p in inspect.signature(app.main).parameters.items()}
-    assert defaults == {"scene": "peloton", "host": "127.0.0.1", "port": 8080}
+    assert defaults == {
+        "scene": "peloton",
+        "host": "127.0.0.1",
+        "port": 8080,
+        "allow_remote_glsl": False,
+    }
+
+
+def test_remote_host_warning_says_whether_glsl_editing_is_on() -> None:
+    off = app.exposure_warning("0.0.0.0", 9000)
+    on = app.exposure_warning("0.0.0.0", 9000, allow_remote_glsl=True)
+    assert off is not None and "GLSL editing in the SDF gallery is OFF" in off
+    assert "--allow-remote-glsl" in off
+    assert on is not None and "GLSL editing in the SDF gallery is ON" in on
 
 
 @pytest.mark.parametrize("host", ["127.0.0.1", "localhost", "::1", "127.0.0.2"])

@@ -250,6 +250,12 @@ def random_scenes(draw: st.DrawFn) -> sdf.Scene:
             "box": tuple(draw(st.floats(0.1, 0.5)) for _ in range(3)),
             "torus": (draw(st.floats(0.3, 0.6)), draw(st.floats(0.05, 0.25))),
             "capsule": (draw(st.floats(0.05, 0.5)), draw(st.floats(0.05, 0.3))),
+            "cylinder": (draw(st.floats(0.05, 0.5)), draw(st.floats(0.05, 0.4))),
+            "round_box": tuple(draw(st.floats(0.1, 0.5)) for _ in range(3)),
+            "octahedron": (draw(st.floats(0.1, 0.6)),),
+            "cone": (draw(st.floats(0.1, 0.5)), draw(st.floats(0.1, 0.8))),
+            "hex_prism": (draw(st.floats(0.1, 0.4)), draw(st.floats(0.05, 0.5))),
+            "ellipsoid": tuple(draw(st.floats(0.1, 0.6)) for _ in range(3)),
         }[kind]
         center = tuple(draw(st.floats(-0.5, 0.5)) for _ in range(3))
         rotation = (draw(st.floats(0.1, 1)), *(draw(st.floats(-1, 1)) for _ in range(3)))
@@ -286,7 +292,7 @@ def test_scene_field_is_one_lipschitz(scene: sdf.Scene, seed: int) -> None:
         (lambda: sdf.smin_poly(float("nan"), 2.0, 0.1), "a"),
         (lambda: sdf.Primitive("sphere", (0, 0, 0), (-0.5,)), "size"),
         (lambda: sdf.Primitive("box", (0, 0, 0), (0.5,)), "size"),
-        (lambda: sdf.Primitive("cone", (0, 0, 0), (0.5,)), "kind"),  # type: ignore[arg-type]
+        (lambda: sdf.Primitive("pyramid", (0, 0, 0), (0.5,)), "kind"),  # type: ignore[arg-type]
         (lambda: sdf.Primitive("sphere", (0, float("nan"), 0), (0.5,)), "center"),
         (lambda: sdf.Primitive("sphere", (0, 0, 0), (0.5,), rotation=(0, 0, 0, 0)), "rotation"),
         (lambda: sdf.Primitive("sphere", (0, 0, 0), (0.5,), color=(2, 0, 0)), "color"),

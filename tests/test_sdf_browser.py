@@ -13,7 +13,8 @@ from conftest import skip_or_fail
 
 from scenes.sdf_gallery import SdfGalleryScene
 from scenes.switcher import SceneSwitcher
-from shaders.renderer import GLUnavailableError, Renderer
+from shaders import gl_service
+from shaders.renderer import GLUnavailableError
 
 pytestmark = [pytest.mark.browser, pytest.mark.gl]
 
@@ -35,7 +36,7 @@ def test_browser_shows_the_mesh_and_the_reference_image(
     server: viser.ViserServer, browser_page: Any
 ) -> None:
     try:
-        Renderer().release()
+        gl_service.run(lambda _renderer: None)
     except GLUnavailableError as exc:
         skip_or_fail(str(exc))
     switcher = SceneSwitcher(server, "sdf")
@@ -78,5 +79,88 @@ def test_browser_shows_the_mesh_and_the_reference_image(
         height, width = shown.shape[:2]
         object_pixels = (np.abs(shown.astype(int) - shown[0, 0].astype(int)).sum(axis=2) > 30).sum()
         assert object_pixels > 0.02 * width * height  # the object, not just background
+    finally:
+        switcher.close()
+
+
+OCTAHEDRON = (
+    "float sdf(vec3 p) {\n    return sd_octahedron(p - vec3(0.0, 0.0, 0.4), 0.7);\n}\n"
+    "vec3 color(vec3 p) {\n    return vec3(0.1, 0.85, 0.2);\n}\n"
+)
+
+
+def green_mask(png: bytes) -> np.ndarray:
+    import io
+
+    from PIL import Image
+
+    rgb = np.asarray(Image.open(io.BytesIO(png)).convert("RGB")).astype(int)
+    # Green over red and blue by a ratio, so the shaded underside (dark green) counts too.
+    green = rgb[..., 1]
+    return (green > 20) & (green - np.maximum(rgb[..., 0], rgb[..., 2]) > 0.3 * green)
+
+
+def wait_for_green(page: Any, pixels: int = 5000, timeout_s: float = 30.0) -> np.ndarray:
+    """Screenshots until the green shape shows (the picture a person sees), its mask."""
+    deadline = time.monotonic() + timeout_s
+    mask = green_mask(page.screenshot())
+    while mask.sum() < pixels and time.monotonic() < deadline:
+        time.sleep(0.2)
+        mask = green_mask(page.screenshot())
+    return mask
+
+
+def test_typed_shape_is_meshed_and_ray_marched_in_the_main_view(
+    server: viser.ViserServer, browser_page: Any
+) -> None:
+    from kernels import sdf
+
+    try:
+        gl_service.run(lambda _renderer: None)
+    except GLUnavailableError as exc:
+        skip_or_fail(str(exc))
+    switcher = SceneSwitcher(server, "sdf")
+    scene = switcher.scene
+    assert isinstance(scene, SdfGalleryScene)
+    page = browser_page
+    try:
+        page.set_viewport_size({"width": 1600, "height": 1000})
+        open_viser(page, server.get_port(), "/sdf/mesh")
+        page.locator(
+            'text="GLSL editor" >> visible=true'
+        ).first.click()  # the folder, not the About text
+        editor = page.locator("textarea").filter(has_text="sdf(vec3 p)").first
+        editor.fill(OCTAHEDRON)
+        page.get_by_role("button", name="Apply").click()
+        deadline = time.monotonic() + 60
+        while scene.editor_serial == 0 and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert (
+            scene.editor_serial == 1 and scene.params.editor.source == OCTAHEDRON.strip("\n") + "\n"
+        )
+        # Meshed: every vertex on the octahedron the person typed.
+        d = sdf.sd_octahedron(scene.mesh_vertices - [0.0, 0.0, 0.4], 0.7)
+        assert len(d) > 500 and np.abs(d).max() < 0.02
+        assert not any(g.visible for g in scene.gizmos)
+        mesh_green = wait_for_green(page)
+        assert mesh_green.sum() > 5000  # the green octahedron fills a good part of the view
+
+        # Ray-marched: the same green shape, now from the shader, with the mesh hidden.
+        page.locator("input[value='Mesh']").first.click()
+        page.get_by_role("option", name="Ray-marched").click()
+        page.wait_for_function(
+            "() => !window.__viserMutable.nodeRefFromName['/sdf/mesh'].visible", timeout=30_000
+        )
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline and not (
+            scene.view_rgb is not None and scene.view_rgb.shape[1] == 640
+        ):
+            time.sleep(0.05)
+        assert scene.view_rgb is not None and scene.view_rgb.shape[1] == 640
+        marched_green = wait_for_green(page)
+        assert marched_green.sum() > 5000
+        overlap = (mesh_green & marched_green).sum() / (mesh_green | marched_green).sum()
+        assert overlap > 0.8, f"mesh and ray-march silhouettes overlap {overlap:.2f}"
+        page.screenshot(path="/tmp/sdf_browser_raymarched.png")
     finally:
         switcher.close()

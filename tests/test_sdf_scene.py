@@ -18,9 +18,10 @@ from viser_private import gui_uuid, gui_uuids, node_names
 from wsclient import BrowserClient
 
 from kernels import sdf
-from scenes.sdf_gallery import SdfGalleryParams, SdfGalleryScene
+from scenes.sdf_gallery import RESOLUTION_LABEL, SdfGalleryParams, SdfGalleryScene
 from scenes.switcher import SceneSwitcher
-from shaders.renderer import GLUnavailableError, Renderer
+from shaders import gl_service
+from shaders.renderer import Camera, GLUnavailableError
 
 MESH = "/sdf/mesh"
 
@@ -54,7 +55,7 @@ def shown_mesh(scene: SdfGalleryScene) -> trimesh.Trimesh:
 
 def need_gl() -> None:
     try:
-        Renderer().release()
+        gl_service.run(lambda _renderer: None)
     except GLUnavailableError as exc:
         skip_or_fail(str(exc))
 
@@ -140,7 +141,7 @@ def test_gui_changes_remesh(server: viser.ViserServer, scene: SdfGalleryScene) -
         gizmo_4 = server.scene.get_handle_by_name("/sdf/gizmo_4")
         assert gizmo_4 is not None and gizmo_4.visible is False
         serial = scene.mesh_serial
-        client.set_value("Blend", "Exponential")
+        client.set_value("Blend", "Smooth (exponential)")
         client.set_value("P1 kind", "Box")
         client.set_value("P1 colour", (10, 200, 30))
         wait_until(
@@ -174,7 +175,7 @@ def test_crafted_bad_values_keep_the_last_good_scene(
         client.wait_for(
             lambda: client.value_of("Blend width k (m)") == good.k, what="k written back"
         )
-        client.set_value("P2 kind", "Cone")
+        client.set_value("P2 kind", "Pyramid")  # not an option
         client.wait_for(lambda: client.value_of("P2 kind") == "Box", what="kind written back")
         client.set_value(
             "P3 size a (m)", "big"
@@ -186,8 +187,8 @@ def test_crafted_bad_values_keep_the_last_good_scene(
         )
         client.drag_transform("/sdf/gizmo_1", [(float("nan"), 0.0, 0.0)])
         client.drag_transform("/sdf/gizmo_2", [(0.6, 0.0, 0.3)], wxyz=(0.0, 0.0, 0.0, 0.0))
-        client.set_value("Mesh resolution", -5)  # out of range: clamped to the slider's minimum
-        client.wait_for(lambda: client.value_of("Mesh resolution") == 32, what="resolution clamped")
+        client.set_value(RESOLUTION_LABEL, -5)  # out of range: clamped to the slider's minimum
+        client.wait_for(lambda: client.value_of(RESOLUTION_LABEL) == 32, what="resolution clamped")
         wait_until(lambda: scene.mesh_scene is not None and scene.params.resolution == 32)
         wait_until(
             lambda: len(scene.mesh_vertices) == len(sdf.mesh(good.scene(), 32)[0]), what="32³ mesh"
@@ -211,8 +212,8 @@ def test_high_resolution_shows_progress_then_a_fine_mesh(
     server: viser.ViserServer, scene: SdfGalleryScene
 ) -> None:
     with BrowserClient(server.get_port()) as client:
-        client.wait_for_gui("Mesh resolution")
-        client.set_value("Mesh resolution", 256)
+        client.wait_for_gui(RESOLUTION_LABEL)
+        client.set_value(RESOLUTION_LABEL, 256)
         progress_uuid = gui_uuid(scene.progress)
         client.wait_for(
             lambda: any(
@@ -348,14 +349,14 @@ def test_png_download_is_the_reference_image(scene: SdfGalleryScene) -> None:
 def test_without_gl_the_panel_says_why_and_meshing_goes_on(
     server: viser.ViserServer, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    import scenes.sdf_gallery as gallery
+    from shaders import gl_service
 
-    def no_gl() -> Renderer:
+    def no_gl(job: object, timeout_s: float | None = None) -> None:
         raise GLUnavailableError(
             "No OpenGL 3.3 context on EGL (test): the mesh view works without it."
         )
 
-    monkeypatch.setattr(gallery, "Renderer", no_gl)
+    monkeypatch.setattr(gl_service, "run", no_gl)
     scene = SdfGalleryScene(server)
     try:
         wait_until(lambda: scene.gl_error is not None, what="the renderer to be tried")
@@ -376,6 +377,12 @@ def test_without_gl_the_panel_says_why_and_meshing_goes_on(
         scene.close()
 
 
+def scene_gizmo_scale() -> float:
+    from scenes.sdf_gallery import GIZMO_SCALE
+
+    return GIZMO_SCALE
+
+
 # ------------------------------------------------------------------------------------------ teardown
 def test_close_removes_everything_and_stops_the_worker(server: viser.ViserServer) -> None:
     nodes_before, gui_before = node_names(server), gui_uuids(server)
@@ -386,3 +393,272 @@ def test_close_removes_everything_and_stops_the_worker(server: viser.ViserServer
     assert not worker.is_alive()
     assert node_names(server) == nodes_before
     assert gui_uuids(server) == gui_before
+
+
+def rss_mib() -> float:
+    with open("/proc/self/statm") as f:
+        return int(f.read().split()[1]) * 4096 / 2**20
+
+
+@pytest.mark.gl
+def test_fifty_builds_share_one_gl_context_and_do_not_grow_memory(
+    server: viser.ViserServer,
+) -> None:
+    """Issue 10: each build made a new EGL context on a new thread (~50 MiB each, never reclaimed)."""
+    import gc
+    import threading
+
+    from shaders import gl_service
+
+    need_gl()
+
+    def build_render_close() -> None:
+        scene = SdfGalleryScene(server)
+        try:
+            scene._on_camera_values(Camera((1.9, -2.1, 1.4), (0.0, 0.0, 0.3)), 4 / 3)
+            wait_until(lambda: scene.reference_serial > 0, what="a reference image")
+        finally:
+            scene.close()
+
+    for _ in range(3):  # warm: the shared context, its programs, numba and skimage caches
+        build_render_close()
+    gc.collect()
+    threads_before = threading.active_count()
+    before = rss_mib()
+    for _ in range(50):
+        build_render_close()
+    gc.collect()
+    grown = rss_mib() - before
+    assert grown <= 20.0, f"RSS grew {grown:.1f} MiB over 50 builds"
+    assert threading.active_count() == threads_before
+    gl_threads = [t for t in threading.enumerate() if t.name == "gl-service"]
+    assert gl_threads == [gl_service.thread()]
+
+
+def test_blend_dropdown_says_hard_and_smooth_and_hard_ignores_k(
+    server: viser.ViserServer, scene: SdfGalleryScene
+) -> None:
+    assert scene.blend.options == ("Hard", "Smooth (polynomial)", "Smooth (exponential)")
+    assert "samples per side" in scene.resolution.label
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Blend")
+        client.set_value("Blend", "Hard")
+        wait_until(
+            lambda: scene.mesh_scene is not None and scene.mesh_scene.k == 0.0,
+            what="a hard mesh",
+        )
+        assert scene.k.disabled
+        meshed = scene.mesh_scene
+        assert meshed is not None
+        # The hard scene's distance is the plain minimum of the four primitives' distances.
+        p = np.array([[0.3, 0.0, 0.3], [0.2, 0.1, 0.6]])
+        expected = np.min([prim.distance(p) for prim in meshed.primitives], axis=0)
+        np.testing.assert_allclose(sdf.scene_distance(meshed, p), expected, atol=1e-12)
+
+
+def test_gizmos_draw_over_the_mesh_and_reach_out_of_it(scene: SdfGalleryScene) -> None:
+    for gizmo, slot in zip(scene.gizmos, scene.params.primitives, strict=True):
+        assert gizmo.depth_test is False
+        prim = slot.primitive()
+        # The arrow tips lie outside the primitive (positive distance): something to grab from outside.
+        tips = np.asarray(slot.position) + scene_gizmo_scale() * sdf.rotation_matrix(slot.wxyz).T
+        assert np.all(prim.distance(tips) > 0.0), slot.kind
+
+
+@pytest.mark.parametrize(
+    ("label", "kind"),
+    [("Cylinder", "cylinder"), ("Octahedron", "octahedron"), ("Ellipsoid (bound)", "ellipsoid")],
+)
+def test_catalogue_primitives_from_the_dropdown_are_meshed(
+    server: viser.ViserServer, scene: SdfGalleryScene, label: str, kind: str
+) -> None:
+    from scenes.sdf_gallery import KIND_LABELS
+
+    assert {"Cylinder", "Round box", "Octahedron", "Cone", "Hexagonal prism"} <= set(KIND_LABELS)
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("P2 kind")
+        client.set_value("P2 kind", label)
+        wait_until(
+            lambda: scene.mesh_scene is not None and scene.mesh_scene.primitives[1].kind == kind,
+            what=f"a mesh with a {kind}",
+        )
+        meshed = scene.mesh_scene
+        assert meshed is not None
+        expected = sdf.mesh(meshed, scene.params.resolution)
+        np.testing.assert_array_equal(scene.mesh_vertices, expected[0])
+        # The mesh's vertices lie on the surface of the scene with the new kind.
+        d = sdf.scene_distance(meshed, scene.mesh_vertices)
+        assert np.abs(d).max() < 0.5 * sdf.make_grid(meshed, scene.params.resolution).spacing
+
+
+# ------------------------------------------------------------------------------------------ editor and view
+SPHERE_SOURCE = "float sdf(vec3 p) {\n    return sd_sphere(p - vec3(0.2, 0.0, 0.1), 0.6);\n}\n"
+
+
+def background_images(client: BrowserClient) -> list[dict]:
+    return [m for _, m in client.received if m.get("type") == "BackgroundImageMessage"]
+
+
+@pytest.mark.gl
+def test_typed_source_is_meshed_and_a_bad_one_keeps_the_last_good(
+    server: viser.ViserServer, scene: SdfGalleryScene
+) -> None:
+    need_gl()
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("sdf(p) in GLSL")
+        client.set_value("sdf(p) in GLSL", SPHERE_SOURCE)
+        client.click("Apply")
+        wait_until(lambda: scene.editor_serial == 1, what="the source applied")
+        assert scene.params.shape_source == "editor" and scene.mesh_scene is None
+        client.wait_for(lambda: client.value_of("Shape") == "GLSL editor", what="Shape shown")
+        # The mesh is the typed sphere: every vertex 0.6 m from (0.2, 0, 0.1), within a fraction of a voxel.
+        radii = np.linalg.norm(scene.mesh_vertices - [0.2, 0.0, 0.1], axis=1)
+        assert len(radii) > 1000
+        assert np.abs(radii - 0.6).max() < 0.01
+        assert not any(g.visible for g in scene.gizmos)
+        # The downloads are the typed shape's mesh.
+        name, data = scene.export("stl")
+        assert name == "sdf_mesh.stl" and data is not None
+        exported = trimesh.load(io.BytesIO(data), file_type="stl", force="mesh")
+        assert isinstance(exported, trimesh.Trimesh)
+        assert exported.volume == pytest.approx(4 / 3 * math.pi * 0.6**3, rel=0.02)
+        # A compile error: the message names the line; the sphere stays.
+        shown = scene.mesh_vertices.copy()
+        client.set_value("sdf(p) in GLSL", "float sdf(vec3 p) {\n    return sd_sphere(p, 0.5)\n}\n")
+        client.click("Apply")
+        wait_until(lambda: scene.editor_error is not None, what="the error")
+        assert scene.editor_error is not None and scene.editor_error.startswith("line 3:")
+        assert "line 3" in scene.editor_status.content
+        # A loop and an over-long source are refused before the compiler sees them.
+        for text, words in [
+            (
+                "float sdf(vec3 p) {\n    float d = 1.0;\n    for (;;) { d = 0.5; }\n    return d;\n}",
+                "line 3",
+            ),
+            ("float sdf(vec3 p) { return 1.0; }\n" + "//" * 5000, "limit"),
+            ("#extension GL_ARB_foo : enable\nfloat sdf(vec3 p) { return 1.0; }", "line 1"),
+        ]:
+            scene.editor_error = None
+            client.set_value("sdf(p) in GLSL", text)
+            client.click("Apply")
+            wait_until(lambda: scene.editor_error is not None, what="a refusal")
+            assert words in str(scene.editor_error)
+        assert scene.editor_serial == 1
+        np.testing.assert_array_equal(scene.mesh_vertices, shown)
+
+
+@pytest.mark.gl
+def test_every_example_applies_and_meshes(
+    server: viser.ViserServer, scene: SdfGalleryScene
+) -> None:
+    from scenes.sdf_gallery import EXAMPLES
+
+    need_gl()
+    assert len(EXAMPLES) >= 6
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Example")
+        for n, title in enumerate(list(EXAMPLES)[1:] + list(EXAMPLES)[:1], start=1):
+            client.set_value("Example", title)
+            wait_until(lambda n=n: scene.editor_serial == n, what=f"example {title!r}")
+            assert scene.params.editor.source == EXAMPLES[title]
+            assert len(scene.mesh_faces) > 500, title
+            client.wait_for(
+                lambda t=title: client.value_of("sdf(p) in GLSL") == EXAMPLES[t], what="text"
+            )
+
+
+@pytest.mark.gl
+def test_raymarched_view_goes_to_the_background_with_depth(
+    server: viser.ViserServer, scene: SdfGalleryScene
+) -> None:
+    need_gl()
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("View")
+        client.send_camera(position=(2.0, -2.4, 1.6), look_at=(0.0, 0.0, 0.3), size=(400, 640))
+        client.set_value("View", "Ray-marched")
+        wait_until(lambda: scene.view_serial > 0, what="a main-view frame")
+        assert scene.mesh_node.visible is False and scene.wireframe_node.visible is False
+        client.wait_for(lambda: len(background_images(client)) > 0, what="a background image")
+        message = background_images(client)[-1]
+        assert message["rgb_data"] and message["depth_data"]
+        # At rest the frame is the full width, with the viewer's aspect.
+        wait_until(
+            lambda: scene.view_rgb is not None and scene.view_rgb.shape[1] == 640,
+            what="the full frame",
+        )
+        assert scene.view_rgb is not None and scene.view_rgb.shape[:2] == (400, 640)
+        # Moving: a reduced frame first.
+        client.send_camera(position=(2.2, -2.2, 1.6), look_at=(0.0, 0.0, 0.3), size=(400, 640))
+        wait_until(
+            lambda: scene.view_rgb is not None and scene.view_rgb.shape[1] == 320,
+            what="a reduced frame",
+        )
+        client.set_value("View", "Both")
+        client.wait_for(lambda: True)
+        wait_until(lambda: scene.wireframe_node.visible, what="the wireframe")
+        assert len(scene.wireframe_node.faces) == len(scene.mesh_faces)
+        client.set_value("View", "Mesh")
+        wait_until(lambda: scene.mesh_node.visible, what="the mesh back")
+        client.wait_for(
+            lambda: background_images(client)[-1]["rgb_data"] is None, what="background cleared"
+        )
+
+
+def test_camera_with_zero_height_or_nan_is_ignored(
+    server: viser.ViserServer, scene: SdfGalleryScene
+) -> None:
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("View")
+        client.send_camera(size=(0, 640))
+        client.send_camera(position=(float("nan"), 0.0, 1.0))
+        client.send_camera(size=(400, 640))
+        serial = scene.mesh_serial
+        client.drag_transform("/sdf/gizmo_1", [(0.1, 0.0, 0.5)])
+        wait_until(lambda: scene.mesh_serial > serial, what="the scene still answering")
+
+
+@pytest.mark.gl
+def test_with_editing_off_apply_uses_only_the_servers_examples(
+    server: viser.ViserServer, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import scenes.sdf_gallery as gallery
+
+    need_gl()
+    monkeypatch.setattr(gallery, "_editing", {"allowed": False})
+    scene = SdfGalleryScene(server)
+    try:
+        assert scene.editor.disabled and "Editing is off" in scene.editor_status.content
+        with BrowserClient(server.get_port()) as client:
+            client.wait_for_gui("Apply")
+            client.set_value(
+                "sdf(p) in GLSL", SPHERE_SOURCE
+            )  # a crafted client can still send text
+            client.click("Apply")
+            wait_until(lambda: scene.editor_serial == 1, what="an apply")
+            assert scene.params.editor.source == next(iter(gallery.EXAMPLES.values()))
+    finally:
+        scene.close()
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize(
+    ("limit", "words"), [("COMPILE_LIMIT_S", "compiling took"), ("FRAME_LIMIT_S", "frame took")]
+)
+def test_compile_and_frame_time_limits_refuse_a_slow_source(
+    server: viser.ViserServer,
+    scene: SdfGalleryScene,
+    monkeypatch: pytest.MonkeyPatch,
+    limit: str,
+    words: str,
+) -> None:
+    import scenes.sdf_gallery as gallery
+
+    need_gl()
+    monkeypatch.setattr(gallery, limit, 1e-9)  # every source is too slow now
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("sdf(p) in GLSL")
+        client.set_value("sdf(p) in GLSL", SPHERE_SOURCE.replace("0.6", "0.61"))
+        client.click("Apply")
+        wait_until(lambda: scene.editor_error is not None, what="a refusal")
+        assert words in str(scene.editor_error) and "limit" in str(scene.editor_error)
+        assert scene.editor_serial == 0 and scene.params.shape_source == "primitives"

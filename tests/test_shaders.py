@@ -84,7 +84,9 @@ def view_depth(camera: Camera, t: np.ndarray, directions: np.ndarray) -> np.ndar
 # ------------------------------------------------------------------------------------------ GLSL == numpy
 def test_glsl_mirrors_the_kernel_name_for_name() -> None:
     source = (gl_renderer.SHADER_DIR / "sdf.glsl").read_text()
-    glsl_functions = set(re.findall(r"^(?:float|vec2|vec3) (\w+)\(", source, flags=re.MULTILINE))
+    glsl_functions = set(
+        re.findall(r"^(?:float|vec2|vec3|vec4) (\w+)\(", source, flags=re.MULTILINE)
+    )
     public = {
         "sd_sphere",
         "sd_box",
@@ -122,23 +124,67 @@ def test_glsl_mirrors_the_kernel_name_for_name() -> None:
                 ("box", (0.3, 0.5, 0.7)),
                 ("torus", (0.6, 0.2)),
                 ("capsule", (0.5, 0.3)),
+                ("cylinder", (0.5, 0.3)),
+                ("round_box", (0.3, 0.5, 0.7)),
+                ("octahedron", (0.7,)),
+                ("cone", (0.5, 0.9)),
+                ("hex_prism", (0.4, 0.6)),
+                ("ellipsoid", (0.3, 0.5, 0.7)),
             ]
         ),
+        "catalogue",
     ],
-    ids=["default", "smooth-exp", "every-op", "hard", "sphere", "box", "torus", "capsule"],
+    ids=[
+        "default",
+        "smooth-exp",
+        "every-op",
+        "hard",
+        "sphere",
+        "box",
+        "torus",
+        "capsule",
+        "cylinder",
+        "round_box",
+        "octahedron",
+        "cone",
+        "hex_prism",
+        "ellipsoid",
+        "catalogue",
+    ],
 )
-def test_glsl_scene_distance_and_color_match_numpy(gl: Renderer, scene: sdf.Scene) -> None:
+def test_glsl_scene_distance_and_color_match_numpy(gl: Renderer, scene: sdf.Scene | str) -> None:
+    if scene == "catalogue":
+        scene = catalogue_scene()
+    assert isinstance(scene, sdf.Scene)
     points = np.random.default_rng(7).uniform(-1.6, 1.6, (5000, 3))
     distance, color = gl.probe(scene, points)
     np.testing.assert_allclose(distance, sdf.scene_distance(scene, points), atol=1e-5, rtol=0)
     np.testing.assert_allclose(color, sdf.scene_color(scene, points), atol=1e-5, rtol=0)
 
 
+def catalogue_scene() -> sdf.Scene:
+    """Four of the catalogue's kinds, smoothly combined (each op once)."""
+    return sdf.Scene(
+        (
+            sdf.Primitive("round_box", (0, 0, 0.3), (0.5, 0.4, 0.3), color=(0.9, 0.3, 0.3)),
+            sdf.Primitive("cylinder", (0.5, 0, 0.5), (0.4, 0.2), rotation=FLAT, op="subtract"),
+            sdf.Primitive("octahedron", (-0.5, 0.1, 0.4), (0.45,), color=(0.2, 0.8, 0.3)),
+            sdf.Primitive("cone", (0, -0.4, 0.7), (0.3, 0.6), rotation=FLAT, color=(0.2, 0.3, 0.9)),
+        ),
+        k=0.15,
+    )
+
+
 @pytest.mark.gl
 @pytest.mark.parametrize(
-    "scene", [sdf.default_scene(), every_op_scene()], ids=["default", "every-op"]
+    "scene",
+    [sdf.default_scene(), every_op_scene(), "catalogue"],
+    ids=["default", "every-op", "catalogue"],
 )
-def test_raymarched_depth_matches_numpy_sphere_tracer(gl: Renderer, scene: sdf.Scene) -> None:
+def test_raymarched_depth_matches_numpy_sphere_tracer(gl: Renderer, scene: sdf.Scene | str) -> None:
+    if scene == "catalogue":
+        scene = catalogue_scene()
+    assert isinstance(scene, sdf.Scene)
     camera = CAMERAS[0]
     _, depth = gl.render(scene, camera, 64, 64, NO_SHADOWS)
     origins, directions = gl_renderer.camera_rays(camera, 64, 64)
@@ -316,6 +362,9 @@ def dataclass_replace(shading: Shading, **changes: object) -> Shading:
 # ------------------------------------------------------------------------------------------ renderer edges
 @pytest.mark.gl
 def test_scene_changes_reuse_the_compiled_programs(gl: Renderer) -> None:
+    # Each variant compiles on first use.
+    gl.render(sdf.default_scene(), CAMERAS[0], 8, 8, NO_SHADOWS)
+    gl.render(every_op_scene(), CAMERAS[0], 8, 8, NO_SHADOWS)
     programs = dict(gl._raymarch)
     first, _ = gl.render(sdf.default_scene(), CAMERAS[0], 32, 32, NO_SHADOWS)
     second, _ = gl.render(every_op_scene(), CAMERAS[0], 32, 32, NO_SHADOWS)
