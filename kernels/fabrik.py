@@ -67,7 +67,8 @@ Status = Literal["reached", "unreachable", "max_iterations", "blocked", "limited
 """Why a solve stopped:
 
 * ``"reached"``: the end effector is within the tolerance of the target;
-* ``"unreachable"``: the target lies outside the reach annulus (the closest admissible pose seen is returned);
+* ``"unreachable"``: the target lies outside the reach annulus, farther than the tolerance from the closest pose
+  (the closest admissible pose seen is returned);
 * ``"blocked"``: a reachable target not reached, with the returned pose resting against an obstacle (within 0.1 %
   of its radius) or the target inside one;
 * ``"limited"``: a reachable target not reached, at a fixed point where the joint limits (or obstacles, not
@@ -1114,13 +1115,12 @@ def _solve_chain(
         ux, uy, uz, _ = _unit(ox, oy, oz, rest[0], rest[1], rest[2], tiny)
         _place_on_line(before, p[0], lengths, ux, uy, uz, fold)
         candidate = _end_error(before, target)
-        # ΣL − r ≤ tolerance, to rounding: the straight pose reaches (also for tolerance 0 at exactly ΣL)
-        if (out_of_reach or candidate <= tolerance + tiny) and _admissible(
-            before, tiny, rest, has_limits, cos_phi, centres, radii, live
-        ):
-            _copy(before, out_p)
-            history[1] = candidate
-            return 1, _UNREACHABLE if out_of_reach else _REACHED, candidate
+        # Within tolerance (ΣL − r ≤ tolerance, to rounding; also for tolerance 0 at exactly ΣL) it reaches.
+        if _admissible(before, tiny, rest, has_limits, cos_phi, centres, radii, live):
+            if candidate <= tolerance + tiny or out_of_reach:
+                _copy(before, out_p)
+                history[1] = candidate
+                return 1, _REACHED if candidate <= tolerance + tiny else _UNREACHABLE, candidate
 
     _unbend(p, target, lengths, tiny, rest, has_limits, cos_phi, dim)
     stall = _STALL * tolerance + tiny
