@@ -54,6 +54,7 @@ Model and method:
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import threading
 from collections.abc import Sequence
@@ -422,9 +423,20 @@ def _finite_array(name: str, value: ArrayLike) -> NDArray[np.float64]:
         array = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError) as error:
         raise ValueError(f"{name} must be an array of numbers, got {value!r}") from error
-    if not np.isfinite(array).all():
+    flat = array.reshape(-1)
+    # A compiled scan costs a fraction of numpy's isfinite + all on the few numbers of one chain.
+    finite = _all_finite(flat) if flat.flags.writeable else bool(np.isfinite(flat).all())
+    if not finite:
         raise ValueError(f"{name} must be finite, got {value!r}")
     return array
+
+
+@numba.njit(cache=True)
+def _all_finite(values: NDArray[np.float64]) -> bool:
+    for value in values:
+        if not math.isfinite(value):
+            return False
+    return True
 
 
 def _finite_number(name: str, value: object) -> float:
@@ -525,22 +537,18 @@ class _Setup:
         solver: int,
         extrapolate: bool,
     ) -> _Setup:
-        tol = _finite_number("tolerance", tolerance)
-        if tol < 0.0:
-            raise ValueError(f"tolerance must be a finite number ≥ 0, got {tolerance!r}")
-        if isinstance(max_iterations, bool) or not isinstance(max_iterations, (int, np.integer)):
-            raise ValueError(f"max_iterations must be an integer, got {max_iterations!r}")
-        if max_iterations < 1:
-            raise ValueError(f"max_iterations must be ≥ 1, got {max_iterations}")
-        cos_phi, sin_phi, has_limits = -1.0, 0.0, 0
-        if cone_half_angle_rad is not None:
-            phi = _finite_number("cone_half_angle_rad", cone_half_angle_rad)
-            if not 0.0 <= phi <= math.pi:
-                raise ValueError(
-                    f"cone_half_angle_rad must be in [0, π], got {cone_half_angle_rad!r}"
-                )
-            if phi < math.pi:
-                cos_phi, sin_phi, has_limits = math.cos(phi), math.sin(phi), 1
+        try:
+            options = _options(
+                dim, tolerance, max_iterations, cone_half_angle_rad, solver, extrapolate
+            )
+        except (
+            TypeError
+        ):  # an unhashable argument: check it without the cache (and raise ValueError)
+            options = _options.__wrapped__(
+                dim, tolerance, max_iterations, cone_half_angle_rad, solver, extrapolate
+            )
+        if root_direction is None and not obstacles:
+            return options
         count = len(obstacles)
         centres, radii = np.zeros((count, 3)), np.empty(count)
         for k, obstacle in enumerate(obstacles):
@@ -556,19 +564,50 @@ class _Setup:
                 raise ValueError(
                     f"obstacles[{k}] radius must be a finite number > 0, got {radius!r}"
                 )
-        rest = np.zeros(3)
-        rest[:dim] = _root_direction(root_direction, dim)
-        return _Setup(
-            max_iterations=int(max_iterations),
-            params=np.array([tol, cos_phi, sin_phi]),
-            flags=np.array(
-                [int(max_iterations), dim, solver, int(bool(extrapolate)), has_limits],
-                dtype=np.int64,
-            ),
-            root_direction=rest,
-            centres=centres,
-            radii=radii,
-        )
+        rest = options.root_direction
+        if root_direction is not None:
+            rest = np.zeros(3)
+            rest[:dim] = _root_direction(root_direction, dim)
+        return dataclasses.replace(options, root_direction=rest, centres=centres, radii=radii)
+
+
+@functools.lru_cache(maxsize=64, typed=True)
+def _options(
+    dim: int,
+    tolerance: float,
+    max_iterations: int,
+    cone_half_angle_rad: float | None,
+    solver: int,
+    extrapolate: bool,
+) -> _Setup:
+    """The checked scalar options, without obstacles, on the default root direction; cached, since a dragged
+    chain asks for the same ones every frame (the compiled core never writes to them)."""
+    tol = _finite_number("tolerance", tolerance)
+    if tol < 0.0:
+        raise ValueError(f"tolerance must be a finite number ≥ 0, got {tolerance!r}")
+    if isinstance(max_iterations, bool) or not isinstance(max_iterations, (int, np.integer)):
+        raise ValueError(f"max_iterations must be an integer, got {max_iterations!r}")
+    if max_iterations < 1:
+        raise ValueError(f"max_iterations must be ≥ 1, got {max_iterations}")
+    cos_phi, sin_phi, has_limits = -1.0, 0.0, 0
+    if cone_half_angle_rad is not None:
+        phi = _finite_number("cone_half_angle_rad", cone_half_angle_rad)
+        if not 0.0 <= phi <= math.pi:
+            raise ValueError(f"cone_half_angle_rad must be in [0, π], got {cone_half_angle_rad!r}")
+        if phi < math.pi:
+            cos_phi, sin_phi, has_limits = math.cos(phi), math.sin(phi), 1
+    rest = np.zeros(3)
+    rest[:dim] = _root_direction(None, dim)
+    return _Setup(
+        max_iterations=int(max_iterations),
+        params=np.array([tol, cos_phi, sin_phi]),
+        flags=np.array(
+            [int(max_iterations), dim, solver, int(bool(extrapolate)), has_limits], dtype=np.int64
+        ),
+        root_direction=rest,
+        centres=np.zeros((0, 3)),
+        radii=np.zeros(0),
+    )
 
 
 def _solve_single(
@@ -1110,7 +1149,7 @@ def _solve_chain(
             _copy(p, out_p)
             return 0, _REACHED, error
 
-    if solver == _FABRIK and (out_of_reach or distance >= total - tolerance):
+    if solver == _FABRIK and (out_of_reach or distance >= total - tolerance - tiny):
         # The closest pose to a target out of reach; the straight pose toward one within tolerance of full reach.
         ux, uy, uz, _ = _unit(ox, oy, oz, rest[0], rest[1], rest[2], tiny)
         _place_on_line(before, p[0], lengths, ux, uy, uz, fold)

@@ -46,8 +46,7 @@ def fabrik(
     t = np.asarray(target, dtype=np.float64)
     n = len(p) - 1
     d = [float(np.linalg.norm(p[i + 1] - p[i])) for i in range(n)]
-    if root_direction is None:
-        root_direction = np.eye(p.shape[1])[-1]
+    rest = np.eye(p.shape[1])[-1] if root_direction is None else root_direction
     if np.linalg.norm(t - p[0]) > sum(d):  # unreachable: stretch toward the target
         for i in range(n):
             lam = d[i] / float(np.linalg.norm(t - p[i]))
@@ -67,7 +66,7 @@ def fabrik(
             p[i] = p[i + 1] + d[i] * direction
             previous = direction
         p[0] = root  # backward reaching
-        previous = root_direction
+        previous = rest
         for i in range(n):
             lam = d[i] / float(np.linalg.norm(p[i + 1] - p[i]))
             point = (1 - lam) * p[i] + lam * p[i + 1]
