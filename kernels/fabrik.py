@@ -242,7 +242,7 @@ def solve_batch(
     goal = np.zeros((batch, 3))
     goal[:, :dim] = points
     out_p = np.empty_like(p)
-    history = np.full((batch, setup.max_iterations + 1), np.nan)
+    history = np.empty((batch, setup.max_iterations + 1))  # the core fills it, NaN past the end
     iterations = np.empty(batch, dtype=np.int64)
     status = np.empty(batch, dtype=np.int64)
     error = np.empty(batch)
@@ -431,7 +431,7 @@ def _finite_array(name: str, value: ArrayLike) -> NDArray[np.float64]:
     return array
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy")
 def _all_finite(values: NDArray[np.float64]) -> bool:
     for value in values:
         if not math.isfinite(value):
@@ -657,7 +657,7 @@ _CHUNKS = 256
 _PARALLEL_LOCK = threading.Lock()
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy")
 def _unit(
     x: float, y: float, z: float, fx: float, fy: float, fz: float, tiny: float
 ) -> tuple[float, float, float, float]:
@@ -669,7 +669,7 @@ def _unit(
     return fx, fy, fz, norm
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy")
 def _perpendicular(x: float, y: float, z: float, dim: int) -> tuple[float, float, float]:
     """A fixed unit vector perpendicular to the unit vector (x, y, z): in the plane for d = 2."""
     if dim == 2:
@@ -681,7 +681,7 @@ def _perpendicular(x: float, y: float, z: float, dim: int) -> tuple[float, float
     return cx / norm, cy / norm, cz / norm
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy")
 def _clamp_cone(
     vx: float, vy: float, vz: float, ax: float, ay: float, az: float, cos_phi: float,
     sin_phi: float, dim: int,
@@ -702,7 +702,7 @@ def _clamp_cone(
     return cx / norm, cy / norm, cz / norm
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy")
 def _turn_clear(
     ax: float, ay: float, az: float, vx: float, vy: float, vz: float, length: float,
     centre: NDArray[np.float64], radius: float, tiny: float, dim: int,
@@ -732,7 +732,7 @@ def _turn_clear(
     return tx / norm, ty / norm, tz / norm
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy")
 def _deflect(
     ax: float, ay: float, az: float, vx: float, vy: float, vz: float, length: float,
     centres: NDArray[np.float64], radii: NDArray[np.float64], live: NDArray[np.bool_], tiny: float,
@@ -759,7 +759,7 @@ def _deflect(
     return vx, vy, vz, turned
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy")
 def _forward_pass(
     p: NDArray[np.float64], target: NDArray[np.float64], lengths: NDArray[np.float64],
     tiny: float, rest: NDArray[np.float64], limits: tuple[bool, float, float],
@@ -772,8 +772,8 @@ def _forward_pass(
     p[n, 0], p[n, 1], p[n, 2] = target[0], target[1], target[2]
     qx, qy, qz, _ = _unit(p[0, 0] - p[n, 0], p[0, 1] - p[n, 1], p[0, 2] - p[n, 2],
                           -rest[0], -rest[1], -rest[2], tiny)  # fmt: skip
+    x, y, z = p[n, 0], p[n, 1], p[n, 2]  # the anchor, carried in registers from joint to joint
     for i in range(n - 1, 0, -1):
-        x, y, z = p[i + 1, 0], p[i + 1, 1], p[i + 1, 2]
         dx, dy, dz, _ = _unit(p[i, 0] - x, p[i, 1] - y, p[i, 2] - z, qx, qy, qz, tiny)
         if radii.shape[0] > 0:
             dx, dy, dz, _ = _deflect(
@@ -782,12 +782,13 @@ def _forward_pass(
         if has_limits and i < n - 1:
             dx, dy, dz = _clamp_cone(dx, dy, dz, qx, qy, qz, cos_phi, sin_phi, dim)
         length = lengths[i]
-        p[i, 0], p[i, 1], p[i, 2] = x + length * dx, y + length * dy, z + length * dz
+        x, y, z = x + length * dx, y + length * dy, z + length * dz
+        p[i, 0], p[i, 1], p[i, 2] = x, y, z
         if not has_zero or length > tiny:
             qx, qy, qz = dx, dy, dz
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy")
 def _backward_pass(
     p: NDArray[np.float64], lengths: NDArray[np.float64], tiny: float,
     rest: NDArray[np.float64], limits: tuple[bool, float, float], centres: NDArray[np.float64],
@@ -796,8 +797,8 @@ def _backward_pass(
     """Root back on its place, each joint outward toward its current place; limits and obstacles enforced."""
     has_limits, cos_phi, sin_phi = limits
     qx, qy, qz = rest[0], rest[1], rest[2]
+    x, y, z = p[0, 0], p[0, 1], p[0, 2]  # the anchor, carried in registers from joint to joint
     for i in range(1, lengths.shape[0] + 1):
-        x, y, z = p[i - 1, 0], p[i - 1, 1], p[i - 1, 2]
         dx, dy, dz, _ = _unit(p[i, 0] - x, p[i, 1] - y, p[i, 2] - z, qx, qy, qz, tiny)
         if has_limits:
             dx, dy, dz = _clamp_cone(dx, dy, dz, qx, qy, qz, cos_phi, sin_phi, dim)
@@ -807,12 +808,13 @@ def _backward_pass(
             if turned and has_limits:
                 dx, dy, dz = _clamp_cone(dx, dy, dz, qx, qy, qz, cos_phi, sin_phi, dim)
         length = lengths[i - 1]
-        p[i, 0], p[i, 1], p[i, 2] = x + length * dx, y + length * dy, z + length * dz
+        x, y, z = x + length * dx, y + length * dy, z + length * dz
+        p[i, 0], p[i, 1], p[i, 2] = x, y, z
         if not has_zero or length > tiny:
             qx, qy, qz = dx, dy, dz
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy")
 def _ccd_sweep(
     p: NDArray[np.float64], target: NDArray[np.float64], tiny: float, rest: NDArray[np.float64],
     dim: int,
@@ -848,7 +850,7 @@ def _ccd_sweep(
             p[j, 2] = oz + vz * cos_a + (kx * vy - ky * vx) * sin_a + kz * dot
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy")
 def _dls_step(
     p: NDArray[np.float64], target: NDArray[np.float64], lengths: NDArray[np.float64],
     tiny: float, dim: int, turns: NDArray[np.float64],
@@ -947,7 +949,7 @@ def _dls_step(
         p[i + 1, 0], p[i + 1, 1], p[i + 1, 2] = p[i, 0] + nx, p[i, 1] + ny, p[i, 2] + nz
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy")
 def _cone_ok(
     p: NDArray[np.float64], tiny: float, rest: NDArray[np.float64], cos_phi: float
 ) -> bool:
@@ -964,7 +966,7 @@ def _cone_ok(
     return True
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy")
 def _colliding(
     p: NDArray[np.float64], centres: NDArray[np.float64], radii: NDArray[np.float64],
     live: NDArray[np.bool_], inflate: float,
@@ -986,7 +988,7 @@ def _colliding(
     return False
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy")
 def _admissible(
     p: NDArray[np.float64], tiny: float, rest: NDArray[np.float64], has_limits: bool,
     cos_phi: float, centres: NDArray[np.float64], radii: NDArray[np.float64],
@@ -998,7 +1000,7 @@ def _admissible(
     return not _colliding(p, centres, radii, live, 1.0)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy")
 def _copy(source: NDArray[np.float64], destination: NDArray[np.float64]) -> None:
     for i in range(source.shape[0]):
         destination[i, 0], destination[i, 1], destination[i, 2] = (
@@ -1008,14 +1010,14 @@ def _copy(source: NDArray[np.float64], destination: NDArray[np.float64]) -> None
         )
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy")
 def _end_error(p: NDArray[np.float64], target: NDArray[np.float64]) -> float:
     n = p.shape[0] - 1
     x, y, z = p[n, 0] - target[0], p[n, 1] - target[1], p[n, 2] - target[2]
     return math.sqrt(x * x + y * y + z * z)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy")
 def _place_on_line(
     pose: NDArray[np.float64], root: NDArray[np.float64], lengths: NDArray[np.float64],
     ux: float, uy: float, uz: float, fold: bool,
@@ -1034,7 +1036,7 @@ def _place_on_line(
         )
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy")
 def _unbend(
     p: NDArray[np.float64], target: NDArray[np.float64], lengths: NDArray[np.float64],
     tiny: float, rest: NDArray[np.float64], has_limits: bool, cos_phi: float, dim: int,
@@ -1073,29 +1075,32 @@ def _unbend(
         p[i + 1, 2] = p[i, 2] + c * az + s * sz
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy")
 def _extrapolate(
-    p: NDArray[np.float64], previous: NDArray[np.float64], error: float, previous_error: float
-) -> bool:
-    """Move the joints on along their last step, in place, by the rest of a geometric series.
+    p: NDArray[np.float64], previous: NDArray[np.float64], error: float, previous_error: float,
+    allowed: bool,
+) -> bool:  # fmt: skip
+    """Move the joints on along their last step, in place, by the rest of a geometric series; ``previous`` (the
+    pose before the last step) becomes the pose before this move.
 
     Where the end-effector error shrank by a ratio ``r`` in [0.5, 1) in the last iteration, FABRIK converges
     linearly at about that ratio, and the steps still to come sum to ``r / (1 − r)`` times the last one (Aitken's
     Δ² extrapolation of a linearly converging sequence), capped at 8 steps. Only the next passes' starting guess
-    moves: they still place every joint at its link's length, inside its cone and clear of obstacles. Returns
-    whether it moved the joints.
+    moves: they still place every joint at its link's length, inside its cone and clear of obstacles. Nothing moves
+    unless ``allowed``. Returns whether it moved the joints.
     """
     ratio = error / max(previous_error, _TINY)
-    if not _EXTRAPOLATION_MIN_RATIO <= ratio < 1.0:
-        return False
-    weight = ratio / max(1.0 - ratio, ratio / _EXTRAPOLATION_CAP)
+    slow = allowed and _EXTRAPOLATION_MIN_RATIO <= ratio < 1.0
+    weight = ratio / max(1.0 - ratio, ratio / _EXTRAPOLATION_CAP) if slow else 0.0
     for i in range(p.shape[0]):
         for c in range(3):
-            p[i, c] += weight * (p[i, c] - previous[i, c])
-    return True
+            now = p[i, c]
+            p[i, c] = now + weight * (now - previous[i, c])
+            previous[i, c] = now
+    return slow
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy")
 def _solve_chain(
     p: NDArray[np.float64], target: NDArray[np.float64], params: NDArray[np.float64],
     flags: NDArray[np.int64], rest: NDArray[np.float64], centres: NDArray[np.float64],
@@ -1170,12 +1175,9 @@ def _solve_chain(
     for iteration in range(1, max_iterations + 1):
         count = iteration
         last_error = history[iteration - 1]
-        if extrapolate and iteration >= 2:
-            _copy(p, before)
-            moved = iteration >= 3 and trusted
-            if moved:
-                moved = _extrapolate(p, previous, last_error, history[iteration - 2])
-            _copy(before, previous)
+        if extrapolate and iteration >= 2:  # from the third iteration on, and while trusted
+            allowed = iteration >= 3 and trusted
+            moved = _extrapolate(p, previous, last_error, history[iteration - 2], allowed)
         if solver == _FABRIK:
             _forward_pass(
                 p, target, lengths, tiny, rest, limits, centres, radii, live, has_zero, dim
@@ -1229,7 +1231,7 @@ def _solve_chain(
     return count, _LIMITED if stalled else _MAX_ITERATIONS, final_error
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy")
 def _solve_rows(
     lo: int, hi: int, p: NDArray[np.float64], target: NDArray[np.float64],
     params: NDArray[np.float64], flags: NDArray[np.int64], rest: NDArray[np.float64],
@@ -1249,7 +1251,7 @@ def _solve_rows(
         )  # fmt: skip
 
 
-@numba.njit(cache=True, parallel=True)
+@numba.njit(cache=True, error_model="numpy", parallel=True)
 def _solve_parallel(
     chunks: int, p: NDArray[np.float64], target: NDArray[np.float64],
     params: NDArray[np.float64], flags: NDArray[np.int64], rest: NDArray[np.float64],

@@ -839,7 +839,8 @@ def test_warm_up_compiles_every_core_with_a_cache() -> None:
         cores
     )
     for name, core in cores.items():
-        assert type(core._cache).__name__ == "FunctionCache", name  # cache=True on every core
+        cache = core._cache  # pyright: ignore[reportAttributeAccessIssue]
+        assert type(cache).__name__ == "FunctionCache", name  # cache=True on every core
     # The two entry points are compiled (or loaded); the cores they call are linked into them.
     assert fabrik._solve_rows.signatures and fabrik._solve_parallel.signatures
 
