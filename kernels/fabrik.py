@@ -747,9 +747,13 @@ def _deflect(
             if not live[k]:
                 continue
             rx, ry, rz = centres[k, 0] - ax, centres[k, 1] - ay, centres[k, 2] - az
+            rel2 = rx * rx + ry * ry + rz * rz
+            reach = length + radii[k]
+            if rel2 >= reach * reach:  # too far for the segment to touch: most pairs stop here
+                continue
             along = rx * vx + ry * vy + rz * vz
             t = min(max(along, 0.0), length)
-            if rx * rx + ry * ry + rz * rz - 2.0 * t * along + t * t < radii[k] * radii[k]:
+            if rel2 - 2.0 * t * along + t * t < radii[k] * radii[k]:
                 hit = True
                 vx, vy, vz = _turn_clear(ax, ay, az, vx, vy, vz, length, centres[k], radii[k],
                                          tiny, dim)  # fmt: skip
@@ -980,9 +984,12 @@ def _colliding(
             if not live[k]:
                 continue
             rx, ry, rz = centres[k, 0] - x, centres[k, 1] - y, centres[k, 2] - z
+            grown = radii[k] * inflate
+            # |c − a| ≥ |s| + r, so no point of the segment is within r: (|s| + r)² ≤ 2(|s|² + r²)
+            if rx * rx + ry * ry + rz * rz >= 2.0 * (seg2 + grown * grown):
+                continue
             t = min(max((rx * sx + ry * sy + rz * sz) / (seg2 if seg2 > 0.0 else 1.0), 0.0), 1.0)
             gx, gy, gz = rx - t * sx, ry - t * sy, rz - t * sz
-            grown = radii[k] * inflate
             if gx * gx + gy * gy + gz * gz < grown * grown:
                 return True
     return False
