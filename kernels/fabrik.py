@@ -1098,13 +1098,16 @@ def _extrapolate(
     """
     ratio = error / max(previous_error, _TINY)
     slow = allowed and _EXTRAPOLATION_MIN_RATIO <= ratio < 1.0
-    weight = ratio / max(1.0 - ratio, ratio / _EXTRAPOLATION_CAP) if slow else 0.0
+    if not slow:  # (``previous`` is not yet set on the first call: only copy into it)
+        _copy(p, previous)
+        return False
+    weight = ratio / max(1.0 - ratio, ratio / _EXTRAPOLATION_CAP)
     for i in range(p.shape[0]):
         for c in range(3):
             now = p[i, c]
             p[i, c] = now + weight * (now - previous[i, c])
             previous[i, c] = now
-    return slow
+    return True
 
 
 @numba.njit(cache=True, error_model="numpy")
