@@ -1202,8 +1202,10 @@ def _solve_chain(
         # A chain whose extrapolation made its error grow (a target the limits keep away, r → 1) is left to plain
         # FABRIK from then on, which settles at its fixed point.
         trusted = trusted and not (moved and error > last_error)
+        # Every iterate ends on the backward pass, whose last word on each segment is the cone clamp: it keeps the
+        # limits by construction, and only an obstacle can still be cut.
         if (error < best_error or error < tolerance) and (
-            not constrained or _admissible(p, tiny, rest, has_limits, cos_phi, centres, radii, live)
+            not any_live or not _colliding(p, centres, radii, live, 1.0)
         ):
             if error < best_error:
                 _copy(p, best)
