@@ -690,8 +690,9 @@ def _clamp_cone(
     cos_v = vx * ax + vy * ay + vz * az
     if not cos_v < cos_phi:
         return vx, vy, vz
-    px, py, pz = _perpendicular(ax, ay, az, dim)
-    sx, sy, sz, _ = _unit(vx - cos_v * ax, vy - cos_v * ay, vz - cos_v * az, px, py, pz, 1e-9)
+    sx, sy, sz, side = _unit(vx - cos_v * ax, vy - cos_v * ay, vz - cos_v * az, 0.0, 0.0, 0.0, 1e-9)
+    if side <= 1e-9:  # v (anti)parallel to the axis: any side will do
+        sx, sy, sz = _perpendicular(ax, ay, az, dim)
     # A nearly (anti)parallel v leaves the side only roughly perpendicular: renormalise so lengths stay exact.
     cx, cy, cz = (
         cos_phi * ax + sin_phi * sx,
@@ -725,8 +726,9 @@ def _turn_clear(
         cos_t = min(max(cos_t, -1.0), 1.0)
         sin_t = math.sqrt(1.0 - cos_t * cos_t)
     along = vx * cx + vy * cy + vz * cz
-    px, py, pz = _perpendicular(cx, cy, cz, dim)
-    sx, sy, sz, _ = _unit(vx - along * cx, vy - along * cy, vz - along * cz, px, py, pz, 1e-9)
+    sx, sy, sz, side = _unit(vx - along * cx, vy - along * cy, vz - along * cz, 0.0, 0.0, 0.0, 1e-9)
+    if side <= 1e-9:  # v through the centre: turn to any side
+        sx, sy, sz = _perpendicular(cx, cy, cz, dim)
     tx, ty, tz = cos_t * cx + sin_t * sx, cos_t * cy + sin_t * sy, cos_t * cz + sin_t * sz
     norm = math.sqrt(tx * tx + ty * ty + tz * tz)
     return tx / norm, ty / norm, tz / norm
@@ -843,8 +845,9 @@ def _ccd_sweep(
             continue
         kx, ky, kz = ey * tz - ez * ty, ez * tx - ex * tz, ex * ty - ey * tx
         sin_a = math.sqrt(kx * kx + ky * ky + kz * kz)
-        px, py, pz = _perpendicular(ex, ey, ez, 3)
-        kx, ky, kz, _ = _unit(kx, ky, kz, px, py, pz, 1e-12)
+        kx, ky, kz, _ = _unit(kx, ky, kz, 0.0, 0.0, 0.0, 1e-12)
+        if sin_a <= 1e-12:  # end and target (anti)parallel: turn about any perpendicular
+            kx, ky, kz = _perpendicular(ex, ey, ez, 3)
         for j in range(i + 1, n + 1):
             # Rodrigues: v cos a + (k × v) sin a + k (k·v)(1 − cos a)
             vx, vy, vz = p[j, 0] - ox, p[j, 1] - oy, p[j, 2] - oz
