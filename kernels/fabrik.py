@@ -825,8 +825,8 @@ def _ccd_sweep(
     p: NDArray[np.float64], target: NDArray[np.float64], tiny: float, rest: NDArray[np.float64],
     dim: int,
 ) -> None:  # fmt: skip
-    """One CCD sweep (Wang & Chen 1991): each joint, end to root, turns what lies beyond it so that the end points
-    at the target (in 2D about the plane's normal, in 3D about ``to_end × to_target``, by Rodrigues' formula)."""
+    """One CCD sweep (Wang & Chen 1991): each joint, end to root, turns what lies beyond it about
+    ``to_end × to_target`` (Rodrigues' formula) so that the end points at the target."""
     n = p.shape[0] - 1
     for i in range(n - 1, -1, -1):
         ox, oy, oz = p[i, 0], p[i, 1], p[i, 2]
@@ -837,16 +837,11 @@ def _ccd_sweep(
         if not (end_norm > tiny and target_norm > tiny):
             continue
         cos_a = min(max(ex * tx + ey * ty + ez * tz, -1.0), 1.0)
-        if dim == 2:
-            sin_a = ex * ty - ey * tx
-            for j in range(i + 1, n + 1):
-                vx, vy = p[j, 0] - ox, p[j, 1] - oy
-                p[j, 0], p[j, 1] = ox + cos_a * vx - sin_a * vy, oy + sin_a * vx + cos_a * vy
-            continue
         kx, ky, kz = ey * tz - ez * ty, ez * tx - ex * tz, ex * ty - ey * tx
         sin_a = math.sqrt(kx * kx + ky * ky + kz * kz)
-        kx, ky, kz, _ = _unit(kx, ky, kz, 0.0, 0.0, 0.0, 1e-12)
-        if sin_a <= 1e-12:  # end and target (anti)parallel: turn about any perpendicular
+        # (In the plane the axis is ±z; end and target antiparallel turn about z, or in 3D any perpendicular.)
+        kx, ky, kz, _ = _unit(kx, ky, kz, 0.0, 0.0, 1.0, 1e-12)
+        if sin_a <= 1e-12 and dim == 3:
             kx, ky, kz = _perpendicular(ex, ey, ez, 3)
         for j in range(i + 1, n + 1):
             # Rodrigues: v cos a + (k × v) sin a + k (k·v)(1 − cos a)
@@ -858,102 +853,60 @@ def _ccd_sweep(
 
 
 @numba.njit(cache=True, error_model="numpy")
+def _product(a: NDArray[np.float64], b: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``a @ b`` for a 3 × 3 ``a`` and a (3,) or (3, m) ``b``, without BLAS (numba's ``@`` needs SciPy's)."""
+    out = np.zeros(b.shape)
+    for r in range(3):
+        for k in range(3):
+            out[r] += a[r, k] * b[k]
+    return out
+
+
+@numba.njit(cache=True, error_model="numpy")
 def _dls_step(
     p: NDArray[np.float64], target: NDArray[np.float64], lengths: NDArray[np.float64],
-    tiny: float, dim: int, turns: NDArray[np.float64],
+    tiny: float, turns: NDArray[np.float64],
 ) -> None:  # fmt: skip
     """One damped-least-squares step on joint angles (Wampler 1986; Buss 2004): ``Δθ = Jᵀ(JJᵀ + λ²I)⁻¹e``.
 
-    Hinges about the plane's normal in 2D (``J_i = perp(p_n − p_i)``), ball joints in 3D (``J_i = −[p_n − p_i]×``,
-    so ``J_i J_iᵀ = |l|²I − l lᵀ`` and ``Δθ_i = l × y``). The error is clamped to the mean link length and
-    ``λ = 0.1 × mean link length`` (Buss 2004). Segment j turns by joints 0…j: in 2D by their summed angle, in 3D by
-    the product ``R(Δθ_0) … R(Δθ_j)`` of the rotations of their rotation vectors. ``turns`` is (n + 1, 3) scratch.
+    Ball joints: ``J_i = −[l_i]×`` with ``l_i = p_n − p_i``, so ``JJᵀ = Σ |l_i|²I − l_i l_iᵀ`` and
+    ``Δθ_i = l_i × y`` for ``y = (JJᵀ + λ²I)⁻¹e``. In the plane (z = 0) every ``Δθ_i`` is along z and the step is the
+    planar one of hinges, ``J_i = perp(l_i)``. The error is clamped to the mean link length and
+    ``λ = 0.1 × mean link length`` (Buss 2004). Segment j turns by ``R(Δθ_0) … R(Δθ_j)``, the rotations of the
+    joints' rotation vectors (in the plane: by their summed angle). ``turns`` is (n + 1, 3) scratch.
     """
     n = lengths.shape[0]
-    endx, endy, endz = p[n, 0], p[n, 1], p[n, 2]
     cap = max(np.sum(lengths) / n, tiny)
-    ex, ey, ez = target[0] - endx, target[1] - endy, target[2] - endz
-    shrink = min(1.0, cap / max(math.sqrt(ex * ex + ey * ey + ez * ez), tiny))
-    ex, ey, ez = ex * shrink, ey * shrink, ez * shrink
-    damping2 = (_DLS_DAMPING * cap) ** 2
-    # (JJᵀ + λ²I): symmetric, a00 a01 a02 / a11 a12 / a22
-    a00 = a11 = a22 = damping2
-    a01 = a02 = a12 = 0.0
+    e = target - p[n]
+    e *= min(1.0, cap / max(math.sqrt(e[0] ** 2 + e[1] ** 2 + e[2] ** 2), tiny))
+    a = np.eye(3) * (_DLS_DAMPING * cap) ** 2  # JJᵀ + λ²I
     for i in range(n):
-        lx, ly, lz = endx - p[i, 0], endy - p[i, 1], endz - p[i, 2]
-        if dim == 2:
-            a00 += ly * ly
-            a01 -= lx * ly
-            a11 += lx * lx
-        else:
-            l2 = lx * lx + ly * ly + lz * lz
-            a00 += l2 - lx * lx
-            a11 += l2 - ly * ly
-            a22 += l2 - lz * lz
-            a01 -= lx * ly
-            a02 -= lx * lz
-            a12 -= ly * lz
-    if dim == 2:
-        det = a00 * a11 - a01 * a01
-        yx, yy, yz = (a11 * ex - a01 * ey) / det, (a00 * ey - a01 * ex) / det, 0.0
-    else:  # Cramer's rule on the 3 × 3 symmetric positive-definite matrix
-        c00, c01, c02 = a11 * a22 - a12 * a12, a02 * a12 - a01 * a22, a01 * a12 - a02 * a11
-        c11, c12, c22 = a00 * a22 - a02 * a02, a01 * a02 - a00 * a12, a00 * a11 - a01 * a01
-        det = a00 * c00 + a01 * c01 + a02 * c02
-        yx = (c00 * ex + c01 * ey + c02 * ez) / det
-        yy = (c01 * ex + c11 * ey + c12 * ez) / det
-        yz = (c02 * ex + c12 * ey + c22 * ez) / det
-    for i in range(n):  # Δθ_i = Jᵢᵀ y = l_i × y (its z component in 2D)
-        lx, ly, lz = endx - p[i, 0], endy - p[i, 1], endz - p[i, 2]
-        turns[i, 0], turns[i, 1], turns[i, 2] = (
-            ly * yz - lz * yy,
-            lz * yx - lx * yz,
-            lx * yy - ly * yx,
-        )
-    # Turn every segment by the joints before it and re-chain from the root.
-    angle = 0.0
-    r00, r01, r02, r10, r11, r12, r20, r21, r22 = 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0
-    ox, oy, oz = p[0, 0], p[0, 1], p[0, 2]
+        lever = p[n] - p[i]
+        a += np.sum(lever * lever) * np.eye(3) - np.outer(lever, lever)
+    # Cramer's rule on the symmetric positive-definite 3 × 3 matrix
+    c = np.empty((3, 3))
+    for r in range(3):
+        for s in range(3):
+            r1, r2, s1, s2 = (r + 1) % 3, (r + 2) % 3, (s + 1) % 3, (s + 2) % 3
+            c[s, r] = a[r1, s1] * a[r2, s2] - a[r1, s2] * a[r2, s1]  # the adjugate
+    y = _product(c, e) / np.sum(a[0] * c[:, 0])
     for i in range(n):
-        sx, sy, sz = p[i + 1, 0] - ox, p[i + 1, 1] - oy, p[i + 1, 2] - oz
-        ox, oy, oz = p[i + 1, 0], p[i + 1, 1], p[i + 1, 2]
-        if dim == 2:
-            angle += turns[i, 2]
-            c, s = math.cos(angle), math.sin(angle)
-            nx, ny, nz = c * sx - s * sy, s * sx + c * sy, 0.0
-        else:
-            wx, wy, wz = turns[i, 0], turns[i, 1], turns[i, 2]
-            theta = math.sqrt(wx * wx + wy * wy + wz * wz)
-            if theta > 1e-15:
-                kx, ky, kz = wx / theta, wy / theta, wz / theta
-                s, c1 = math.sin(theta), 1.0 - math.cos(theta)
-                # R = I + sin θ K + (1 − cos θ) K², K the cross-product matrix of the unit axis
-                m00, m01, m02 = (
-                    1.0 - c1 * (ky * ky + kz * kz),
-                    -s * kz + c1 * kx * ky,
-                    s * ky + c1 * kx * kz,
-                )
-                m10, m11, m12 = (
-                    s * kz + c1 * kx * ky,
-                    1.0 - c1 * (kx * kx + kz * kz),
-                    -s * kx + c1 * ky * kz,
-                )
-                m20, m21, m22 = (
-                    -s * ky + c1 * kx * kz,
-                    s * kx + c1 * ky * kz,
-                    1.0 - c1 * (kx * kx + ky * ky),
-                )
-                r00, r01, r02, r10, r11, r12, r20, r21, r22 = (
-                    r00 * m00 + r01 * m10 + r02 * m20, r00 * m01 + r01 * m11 + r02 * m21,
-                    r00 * m02 + r01 * m12 + r02 * m22, r10 * m00 + r11 * m10 + r12 * m20,
-                    r10 * m01 + r11 * m11 + r12 * m21, r10 * m02 + r11 * m12 + r12 * m22,
-                    r20 * m00 + r21 * m10 + r22 * m20, r20 * m01 + r21 * m11 + r22 * m21,
-                    r20 * m02 + r21 * m12 + r22 * m22,
-                )  # fmt: skip
-            nx = r00 * sx + r01 * sy + r02 * sz
-            ny = r10 * sx + r11 * sy + r12 * sz
-            nz = r20 * sx + r21 * sy + r22 * sz
-        p[i + 1, 0], p[i + 1, 1], p[i + 1, 2] = p[i, 0] + nx, p[i, 1] + ny, p[i, 2] + nz
+        lever = p[n] - p[i]
+        turns[i] = np.cross(lever, y)
+    # Turn every segment by the joints up to it and re-chain from the root.
+    turn, anchor = np.eye(3), p[0].copy()
+    for i in range(n):
+        segment = p[i + 1] - anchor
+        anchor = p[i + 1].copy()
+        theta = math.sqrt(np.sum(turns[i] * turns[i]))
+        if theta > 1e-15:
+            k = turns[i] / theta
+            skew = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+            # Rodrigues: R = I + sin θ K + (1 − cos θ) K²
+            turn = turn @ (
+                np.eye(3) + math.sin(theta) * skew + (1.0 - math.cos(theta)) * (skew @ skew)
+            )
+        p[i + 1] = p[i] + _product(turn, segment)
 
 
 @numba.njit(cache=True, error_model="numpy")
@@ -1198,7 +1151,7 @@ def _solve_chain(
         elif solver == _CCD:
             _ccd_sweep(p, target, tiny, rest, dim)
         else:
-            _dls_step(p, target, lengths, tiny, dim, before)
+            _dls_step(p, target, lengths, tiny, before)
         _backward_pass(p, lengths, tiny, rest, limits, centres, radii, live, has_zero, dim)
         error = _end_error(p, target)
         history[iteration] = error
