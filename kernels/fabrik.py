@@ -853,16 +853,6 @@ def _ccd_sweep(
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _product(a: NDArray[np.float64], b: NDArray[np.float64]) -> NDArray[np.float64]:
-    """``a @ b`` for a 3 × 3 ``a`` and a (3,) or (3, m) ``b``, without BLAS (numba's ``@`` needs SciPy's)."""
-    out = np.zeros(b.shape)
-    for r in range(3):
-        for k in range(3):
-            out[r] += a[r, k] * b[k]
-    return out
-
-
-@numba.njit(cache=True, error_model="numpy")
 def _dls_step(
     p: NDArray[np.float64], target: NDArray[np.float64], lengths: NDArray[np.float64],
     tiny: float, turns: NDArray[np.float64],
@@ -876,37 +866,67 @@ def _dls_step(
     joints' rotation vectors (in the plane: by their summed angle). ``turns`` is (n + 1, 3) scratch.
     """
     n = lengths.shape[0]
+    endx, endy, endz = p[n, 0], p[n, 1], p[n, 2]
     cap = max(np.sum(lengths) / n, tiny)
-    e = target - p[n]
-    e *= min(1.0, cap / max(math.sqrt(e[0] ** 2 + e[1] ** 2 + e[2] ** 2), tiny))
-    a = np.eye(3) * (_DLS_DAMPING * cap) ** 2  # JJᵀ + λ²I
+    ex, ey, ez = target[0] - endx, target[1] - endy, target[2] - endz
+    shrink = min(1.0, cap / max(math.sqrt(ex * ex + ey * ey + ez * ez), tiny))
+    ex, ey, ez = ex * shrink, ey * shrink, ez * shrink
+    # JJᵀ + λ²I, symmetric: a00 a01 a02 / a11 a12 / a22
+    a00 = a11 = a22 = (_DLS_DAMPING * cap) ** 2
+    a01 = a02 = a12 = 0.0
     for i in range(n):
-        lever = p[n] - p[i]
-        a += np.sum(lever * lever) * np.eye(3) - np.outer(lever, lever)
+        lx, ly, lz = endx - p[i, 0], endy - p[i, 1], endz - p[i, 2]
+        l2 = lx * lx + ly * ly + lz * lz
+        a00, a11, a22 = a00 + l2 - lx * lx, a11 + l2 - ly * ly, a22 + l2 - lz * lz
+        a01, a02, a12 = a01 - lx * ly, a02 - lx * lz, a12 - ly * lz
     # Cramer's rule on the symmetric positive-definite 3 × 3 matrix
-    c = np.empty((3, 3))
-    for r in range(3):
-        for s in range(3):
-            r1, r2, s1, s2 = (r + 1) % 3, (r + 2) % 3, (s + 1) % 3, (s + 2) % 3
-            c[s, r] = a[r1, s1] * a[r2, s2] - a[r1, s2] * a[r2, s1]  # the adjugate
-    y = _product(c, e) / np.sum(a[0] * c[:, 0])
-    for i in range(n):
-        lever = p[n] - p[i]
-        turns[i] = np.cross(lever, y)
+    c00, c01, c02 = a11 * a22 - a12 * a12, a02 * a12 - a01 * a22, a01 * a12 - a02 * a11
+    c11, c12, c22 = a00 * a22 - a02 * a02, a01 * a02 - a00 * a12, a00 * a11 - a01 * a01
+    det = a00 * c00 + a01 * c01 + a02 * c02
+    yx = (c00 * ex + c01 * ey + c02 * ez) / det
+    yy = (c01 * ex + c11 * ey + c12 * ez) / det
+    yz = (c02 * ex + c12 * ey + c22 * ez) / det
+    for i in range(n):  # Δθ_i = J_iᵀ y = l_i × y
+        lx, ly, lz = endx - p[i, 0], endy - p[i, 1], endz - p[i, 2]
+        turns[i, 0], turns[i, 1], turns[i, 2] = (
+            ly * yz - lz * yy,
+            lz * yx - lx * yz,
+            lx * yy - ly * yx,
+        )
     # Turn every segment by the joints up to it and re-chain from the root.
-    turn, anchor = np.eye(3), p[0].copy()
+    turn, step, product = np.eye(3), np.empty((3, 3)), np.empty((3, 3))
+    ox, oy, oz = p[0, 0], p[0, 1], p[0, 2]
     for i in range(n):
-        segment = p[i + 1] - anchor
-        anchor = p[i + 1].copy()
-        theta = math.sqrt(np.sum(turns[i] * turns[i]))
+        sx, sy, sz = p[i + 1, 0] - ox, p[i + 1, 1] - oy, p[i + 1, 2] - oz
+        ox, oy, oz = p[i + 1, 0], p[i + 1, 1], p[i + 1, 2]
+        theta = math.sqrt(turns[i, 0] ** 2 + turns[i, 1] ** 2 + turns[i, 2] ** 2)
         if theta > 1e-15:
-            k = turns[i] / theta
-            skew = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
-            # Rodrigues: R = I + sin θ K + (1 − cos θ) K²
-            turn = turn @ (
-                np.eye(3) + math.sin(theta) * skew + (1.0 - math.cos(theta)) * (skew @ skew)
+            kx, ky, kz = turns[i, 0] / theta, turns[i, 1] / theta, turns[i, 2] / theta
+            s, c = math.sin(theta), math.cos(theta)
+            # Rodrigues: R = cos θ I + sin θ [k]× + (1 − cos θ) k kᵀ
+            for r in range(3):
+                for q in range(3):
+                    step[r, q] = (1.0 - c) * turns[i, r] * turns[i, q] / (theta * theta)
+                step[r, r] += c
+            step[0, 1], step[0, 2], step[1, 2] = (
+                step[0, 1] - s * kz,
+                step[0, 2] + s * ky,
+                step[1, 2] - s * kx,
             )
-        p[i + 1] = p[i] + _product(turn, segment)
+            step[1, 0], step[2, 0], step[2, 1] = (
+                step[1, 0] + s * kz,
+                step[2, 0] - s * ky,
+                step[2, 1] + s * kx,
+            )
+            for r in range(3):
+                for q in range(3):
+                    product[r, q] = (
+                        turn[r, 0] * step[0, q] + turn[r, 1] * step[1, q] + turn[r, 2] * step[2, q]
+                    )
+            turn[:, :] = product
+        p[i + 1, 0] = p[i, 0] + turn[0, 0] * sx + turn[0, 1] * sy + turn[0, 2] * sz
+        p[i + 1, 1] = p[i, 1] + turn[1, 0] * sx + turn[1, 1] * sy + turn[1, 2] * sz
+        p[i + 1, 2] = p[i, 2] + turn[2, 0] * sx + turn[2, 1] * sy + turn[2, 2] * sz
 
 
 @numba.njit(cache=True, error_model="numpy")
