@@ -261,8 +261,8 @@ outwards. Repeat until |pₙ − target| < tolerance. No angles, no matrices.
 the vertical), clamped inside each pass. **Obstacles** (circles in the plane, spheres in 3D): a segment that would
 cut one is turned about its anchor by the least angle until it just clears it. The solver returns the best pose
 it saw that keeps every limit and clears every obstacle. **Status**: "reached" (within the tolerance);
-"unreachable" (the target is outside the reach, max(0, 2·max L − ΣL) ≤ |target − root| ≤ ΣL: the chain stretches
-straight toward it at once); "blocked" (within reach, but the chain rests against an obstacle short of it, or the
+"unreachable" (the target lies outside the reach annulus max(0, 2·max L − ΣL) ≤ |target − root| ≤ ΣL; the chain
+stretches straight toward it at once); "blocked" (within reach, but the chain rests against an obstacle short of it, or the
 target is inside one); "limited" (within reach, but the joint limits hold the chain at a fixed point short of
 it); "max_iterations" (still converging at the cap).
 
