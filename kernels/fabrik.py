@@ -2,39 +2,40 @@
 
 A chain is ``n + 1`` joint positions ``p_0 … p_n`` in 2D or 3D (``d`` = 2 or 3, metres); ``p_0`` is the fixed root,
 ``p_n`` the end effector. Link lengths ``L_i = |p_{i+1} − p_i|`` come from the joints given and never change.
-Batches lead: a batch of chains is ``(B, n + 1, d)`` and its targets ``(B, d)``. Internally the joints are stored
-``(n + 1, d, B)`` so that one joint of every chain is a contiguous block and the passes vectorise over ``B``.
+Batches lead: a batch of chains is ``(B, n + 1, d)`` and its targets ``(B, d)``.
 
 Model and method:
 
 * FABRIK (Aristidou & Lasenby 2011, "FABRIK: a fast, iterative solver for the Inverse Kinematics problem",
   Graphical Models 73(5)): a forward pass sets ``p_n`` on the target and re-places every joint on the line to the
   joint before it at the link's length; a backward pass sets ``p_0`` back on the root and does the same outwards.
-  It stops when ``|p_n − target| < tolerance`` or after ``max_iterations``.
-* Reach: a target at distance ``r`` from the root is reachable only if ``max(0, 2·max L − ΣL) ≤ r ≤ ΣL``. Outside
-  that annulus the closest pose is returned at once (stretched straight toward the target, or folded back onto the
-  inner boundary), as the paper does for unreachable targets, unless joint limits or obstacles forbid that pose.
+* Reach: a target at distance ``r`` from the root is reachable only if ``max(0, 2·max L − ΣL) ≤ r ≤ ΣL`` (the
+  reach annulus, to within 1e-12 of the chain's scale). Outside it FABRIK returns the closest pose at once
+  (stretched straight toward the target, or folded back onto the inner boundary), as the paper does for
+  unreachable targets, unless joint limits or obstacles forbid that pose.
+* Full reach: a target within ``tolerance`` of full reach (``r ≥ ΣL − tolerance``) is first tried with the
+  straight pose toward it (error ``ΣL − r``); near that singular pose FABRIK itself converges only linearly.
 * Joint limits: each segment stays within a cone of half-angle ``φ`` around the previous segment's direction (the
   first segment around ``root_direction``). The forward pass clamps each segment against the one placed just before
-  it, the backward pass against its predecessor, so the pose every iteration ends on satisfies every limit
-  (as Aristidou & Lasenby 2011 apply constraints inside the passes, here with a symmetric cone; in 2D the cone is
-  the angle range ``[−φ, φ]``).
+  it, the backward pass against its predecessor, so every iterate satisfies every limit (as Aristidou & Lasenby 2011
+  apply constraints inside the passes, here with a symmetric cone; in 2D the cone is the angle range ``[−φ, φ]``).
 * Obstacles: circles (2D) or spheres (3D). Whenever a pass would place a segment through one, the segment is turned
-  about its anchor, by the least angle, until it only touches it (tangent, or its far end on the surface). The solver
-  keeps the best collision-free pose it has seen and returns that one; "blocked" says that the chain rests against an
-  obstacle without reaching the target. Obstacles that contain the root cannot be avoided and are ignored. If no
-  collision-free pose was ever seen (the starting pose already cut an obstacle and no iterate cleared it), the last
-  pose is returned, still "blocked".
+  about its anchor, by the least angle, until it only touches it (tangent, or its far end on the surface).
+  Obstacles that contain the root cannot be avoided and are ignored.
+* Best pose: a pose is admissible when it keeps every limit and cuts no obstacle. The solvers return the best
+  admissible pose seen (the start, the closest-pose or straight candidates, or an iterate), so the returned error is
+  never larger than an admissible start's nor than any admissible iterate's (caliko keeps the best pose too). Only
+  if no admissible pose was ever seen is the last iterate returned.
 * Extrapolation (our addition, not in the paper): near cone limits FABRIK converges linearly and slowly (the
-  error shrinks by 0.8–0.95 per iteration, tens of iterations). Where the error ratio ``r`` of the last iteration
-  is in [0.5, 1), the joints are moved on along their last step by ``r / (1 − r)`` steps (the rest of the
-  geometric series, Aitken-style, at most 8) before the next passes, which then re-impose lengths, limits and
-  obstacles; a chain whose error grew after an extrapolation is not extrapolated again. A warm-started drag near
-  the limits takes 3 iterations at p95 instead of 31. Only FABRIK is extrapolated: ``ccd`` and ``jacobian_dls``
-  run as published, so iteration counts compared with the paper's Table 1 are this FABRIK's, not the paper's.
-* Stopping: at the tolerance, at ``max_iterations``, or at a fixed point, when the error changes by less than 0.1 %
-  of the tolerance in an iteration (caliko's "minimum change" rule); a fixed point short of the target is
-  "unreachable" (with joint limits: outside the reach the limits allow) or "blocked".
+  error shrinks by 0.8–0.95 per iteration). Where the error ratio ``r`` of the last iteration is in [0.5, 1), the
+  joints are moved on along their last step by ``r / (1 − r)`` steps (the rest of the geometric series,
+  Aitken-style, at most 8) before the next passes, which then re-impose lengths, limits and obstacles; a chain whose
+  error grew after an extrapolation is not extrapolated again. Only FABRIK is extrapolated, and only FABRIK tries
+  the closest-pose and straight candidates: ``ccd`` and ``jacobian_dls`` run as published.
+* Stopping: at the tolerance (``error < tolerance``), at ``max_iterations``, or, where limits or obstacles apply or
+  the target is out of reach, at a fixed point: when the error changes by less than 0.1 % of the tolerance in an
+  iteration (caliko's "minimum change" rule), or the best admissible error has improved by less than 10 % of the
+  tolerance in 10 iterations (the iterates creep toward, or circle, a fixed point). Without constraints the iterations converge and run to the cap.
 * Degenerate input never makes NaN: a zero-length link or coincident joints keep the last defined direction, a
   straight chain whose target lies on its own axis is first bent into a gentle arc (a straight chain otherwise never
   bends, a known FABRIK complaint), and a target on the root picks the root direction.
@@ -43,48 +44,73 @@ Model and method:
   compared with (its Table 1: 10 joints, FABRIK 15.5 iterations, CCD 26.3, DLS 999). They take the same arguments,
   honour the same limits and obstacles by projecting every iterate with the constrained backward pass, and return
   the same result.
-* Speed: a batch runs each pass as a handful of numpy operations on (d, B) blocks. A single chain (B = 1) runs its
-  FABRIK passes on Python floats instead, in the same operation order, so it gives the same bits several times
-  faster than numpy calls on arrays of one; :func:`solve` also runs its set-up, collision and cone checks and
-  bookkeeping that way (its own driver, same bits, iterations and status as a batch of one), handing only the rare
-  cases (a target outside the annulus, a zero-length link, a straight chain aimed along itself) to the batch driver.
+* Speed: each solver is one implementation compiled by numba (``@njit(cache=True)``) on the scalars of one chain;
+  :func:`solve` calls it for one chain, :func:`solve_batch` for every chain, in parallel over the batch
+  (``prange``; ``numba.set_num_threads`` sets the threads). 2D chains run as 3D ones in the plane ``z = 0``. The
+  first call compiles (seconds) or loads the machine code from numba's cache (``__pycache__`` beside this file, or
+  numba's user-wide cache directory where that is read-only); :func:`warm_up` does it ahead of time.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
-from collections.abc import Callable, Sequence
+import threading
+from collections.abc import Sequence
 from typing import Literal
 
+import numba
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-Status = Literal["reached", "unreachable", "max_iterations", "blocked"]
-"""Why a solve stopped: target within tolerance; target outside the chain's reach (or outside what the joint limits
-allow: the solver reached a fixed point); iteration cap; resting against an obstacle short of the target."""
-STATUSES: tuple[Status, ...] = ("reached", "unreachable", "max_iterations", "blocked")
-_REACHED, _UNREACHABLE, _MAX_ITERATIONS, _BLOCKED = range(4)
+Status = Literal["reached", "unreachable", "max_iterations", "blocked", "limited"]
+"""Why a solve stopped:
+
+* ``"reached"``: the end effector is within the tolerance of the target;
+* ``"unreachable"``: the target lies outside the reach annulus, farther than the tolerance from the closest pose
+  (the closest admissible pose seen is returned);
+* ``"blocked"``: a reachable target not reached, with the returned pose resting against an obstacle (within 0.1 %
+  of its radius) or the target inside one;
+* ``"limited"``: a reachable target not reached, at a fixed point where the joint limits (or obstacles, not
+  touched) keep the chain from it;
+* ``"max_iterations"``: the iteration cap came first (a reachable target, still converging).
+"""
+STATUSES: tuple[Status, ...] = ("reached", "unreachable", "max_iterations", "blocked", "limited")
+_REACHED, _UNREACHABLE, _MAX_ITERATIONS, _BLOCKED, _LIMITED = range(5)
 
 Solver = Literal["fabrik", "ccd", "jacobian_dls"]
 """The iterative methods; they share arguments, constraints and result."""
+_FABRIK, _CCD, _DLS = range(3)
+_SOLVER_IDS: dict[str, int] = {"fabrik": _FABRIK, "ccd": _CCD, "jacobian_dls": _DLS}
 
 Obstacle = tuple[ArrayLike, float]
 """``(centre (d,) m, radius m)``: a circle in 2D, a sphere in 3D."""
 
 _TINY = 1e-12
-"""Relative length below which a vector has no direction (times the chain's scale)."""
+"""Relative length below which a vector has no direction, and the rounding slack of reach and tolerance tests
+(times the chain's scale, ``max(ΣL, |target − root|, 1 m)``)."""
 _CLEARANCE = 1e-6
 """Segments are turned to clear an obstacle by this fraction of its radius, so rounding never leaves them inside."""
+_TOUCH = 1e-3
+"""A pose within this fraction of an obstacle's radius of it rests against it ("blocked")."""
 _STALL = 1e-3
 """A chain whose end-effector error changed by less than this fraction of the tolerance in an iteration is at a
 fixed point (caliko's "minimum change" rule)."""
+_PATIENCE = 10
+"""A constrained chain whose best admissible error has improved by less than :data:`_PROGRESS` of the tolerance in
+this many iterations has stopped making progress (it creeps toward, or circles, a fixed point the limits or
+obstacles impose)."""
+_PROGRESS = 0.1
+"""See :data:`_PATIENCE`: 1 % of the tolerance per iteration, a pace at which the cap would come first anyway."""
 _EXTRAPOLATION_CAP = 8.0
-"""Most last-steps a FABRIK iterate is moved on by (see :func:`_extrapolate`): enough for an error ratio of 0.89."""
+"""Most last-steps a FABRIK iterate is moved on by: enough for an error ratio of 0.89."""
 _EXTRAPOLATION_MIN_RATIO = 0.5
-"""Error ratio per iteration below which FABRIK iterates are left as they are (see :func:`_extrapolate`)."""
+"""Error ratio per iteration below which FABRIK iterates are left as they are."""
 _DLS_DAMPING = 0.1
 """Damping of the DLS step, times the mean link length (Buss 2004 suggests λ of the order of the link size)."""
+_CONE_SLACK = 1e-12
+"""Rounding allowed when checking ``cos(angle) ≥ cos φ``."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -100,7 +126,8 @@ class Solution:
     status: Status
     """Why it stopped; see :data:`Status`."""
     error_history: NDArray[np.float64]
-    """(iterations + 1,) end-effector distance before the first iteration and after each one (m)."""
+    """(iterations + 1,) end-effector distance before the first iteration and after each one (m): the iterates',
+    which may differ from the returned (best admissible) pose's ``error``."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -147,34 +174,25 @@ def solve(
     Args:
         joints: (n + 1, d) starting joint positions (m), d = 2 or 3, n ≥ 1; ``joints[0]`` is the fixed root.
         target: (d,) target of the end effector (m).
-        tolerance: stop when the end effector is closer than this to the target (m), ≥ 0.
+        tolerance: stop when the end effector is this close to the target (m), ≥ 0.
         max_iterations: iteration cap, ≥ 1.
         cone_half_angle_rad: joint limit, in [0, π]: the angle between consecutive segments (and between the
             first segment and ``root_direction``) never exceeds it. None: no limits.
         obstacles: circles (2D) or spheres (3D) as ``(centre (d,), radius)`` no segment may pass through.
         root_direction: (d,) rest direction of the root, the axis of the first segment's cone. Default: +y in 2D
             (the plane's up), +z in 3D.
-        extrapolate: move slowly converging iterates on along their last step (see :func:`_extrapolate`); False
+        extrapolate: move slowly converging iterates on along their last step (see the module docstring); False
             gives plain FABRIK as the paper writes it.
 
     Returns:
-        The :class:`Solution`.
+        The :class:`Solution`: the best admissible pose seen.
 
     Raises:
         ValueError: naming the argument, for non-finite values, wrong shapes, n < 1, a negative tolerance, a
             half-angle outside [0, π], a non-positive radius or max_iterations < 1.
     """
-    chain = _check_joints("joints", joints, batched=False)
-    point = _check_vector("target", target, chain.shape[1])
-    setup = _Setup.build(
-        dim=chain.shape[1],
-        tolerance=tolerance,
-        max_iterations=max_iterations,
-        cone_half_angle_rad=cone_half_angle_rad,
-        obstacles=obstacles,
-        root_direction=root_direction,
-    )
-    return _run_one(chain, point, setup, extrapolate=extrapolate)
+    return _solve_single("fabrik", joints, target, tolerance, max_iterations,
+                         cone_half_angle_rad, obstacles, root_direction, extrapolate)  # fmt: skip
 
 
 def solve_batch(
@@ -189,7 +207,7 @@ def solve_batch(
     solver: Solver = "fabrik",
     extrapolate: bool = True,
 ) -> BatchSolution:
-    """Solve B chains at once, vectorised over the batch; each chain stops on its own.
+    """Solve B chains at once, in parallel over the batch; each chain stops on its own.
 
     Args:
         joints: (B, n + 1, d) starting joint positions (m), every chain with the same n and d.
@@ -203,65 +221,46 @@ def solve_batch(
         extrapolate: as in :func:`solve` (FABRIK only).
 
     Returns:
-        The :class:`BatchSolution`; ``result[i]`` is chain i's :class:`Solution`.
+        The :class:`BatchSolution`; ``result[i]`` is chain i's :class:`Solution`, the same as solving it alone.
 
     Raises:
         ValueError: as :func:`solve`, and for a batch size mismatch or an unknown solver.
     """
     chains = _check_joints("joints", joints, batched=True)
-    batch, _, dim = chains.shape
-    points = np.asarray(_finite_array("targets", targets), dtype=np.float64)
+    batch, count, dim = chains.shape
+    points = _finite_array("targets", targets)
     if points.shape != (batch, dim):
         raise ValueError(
             f"targets must have shape ({batch}, {dim}) to match joints, got {points.shape}"
         )
-    setup = _Setup.build(
-        dim=dim,
-        tolerance=tolerance,
-        max_iterations=max_iterations,
-        cone_half_angle_rad=cone_half_angle_rad,
-        obstacles=obstacles,
-        root_direction=root_direction,
+    if not isinstance(solver, str) or solver not in _SOLVER_IDS:
+        raise ValueError(f"solver must be one of 'fabrik', 'ccd', 'jacobian_dls', got {solver!r}")
+    setup = _Setup.build(dim, tolerance, max_iterations, cone_half_angle_rad, obstacles,
+                         root_direction, _SOLVER_IDS[solver], extrapolate)  # fmt: skip
+    p = np.zeros((batch, count, 3))
+    p[:, :, :dim] = chains
+    goal = np.zeros((batch, 3))
+    goal[:, :dim] = points
+    out_p = np.empty_like(p)
+    history = np.empty((batch, setup.max_iterations + 1))  # the core fills it, NaN past the end
+    iterations = np.empty(batch, dtype=np.int64)
+    status = np.empty(batch, dtype=np.int64)
+    error = np.empty(batch)
+    args = (p, goal, setup.params, setup.flags, setup.root_direction, setup.centres, setup.radii,
+            out_p, history, iterations, status, error)  # fmt: skip
+    if batch == 1:
+        _solve_rows(0, 1, *args)
+    else:
+        # numba's workqueue threading layer (where OpenMP and TBB are missing) is not thread-safe
+        with _PARALLEL_LOCK:
+            _solve_parallel(min(batch, _CHUNKS), *args)
+    return BatchSolution(
+        joints=out_p[:, :, :dim].copy() if dim == 2 else out_p,
+        iterations=iterations,
+        error=error,
+        status=np.array(STATUSES)[status],
+        error_history=history,
     )
-    match solver:
-        case "fabrik":
-            step, shortcut = _fabrik_step, True
-        case "ccd":
-            step, shortcut = _ccd_step, False
-        case "jacobian_dls":
-            step, shortcut = _dls_step, False
-        case _:
-            raise ValueError(
-                f"solver must be one of 'fabrik', 'ccd', 'jacobian_dls', got {solver!r}"
-            )
-    return _run(
-        chains, points, setup, step, shortcut=shortcut, extrapolate=shortcut and extrapolate
-    )
-
-
-def _solve_one_by_batch(
-    solver: Solver,
-    joints: ArrayLike,
-    target: ArrayLike,
-    tolerance: float,
-    max_iterations: int,
-    cone_half_angle_rad: float | None,
-    obstacles: Sequence[Obstacle],
-    root_direction: ArrayLike | None,
-) -> Solution:
-    """One chain through :func:`solve_batch` (the comparison solvers have no single-chain fast path)."""
-    chain = _check_joints("joints", joints, batched=False)
-    point = _check_vector("target", target, chain.shape[1])
-    return solve_batch(
-        chain[None],
-        point[None],
-        tolerance=tolerance,
-        max_iterations=max_iterations,
-        cone_half_angle_rad=cone_half_angle_rad,
-        obstacles=obstacles,
-        root_direction=root_direction,
-        solver=solver,
-    )[0]
 
 
 def ccd(
@@ -278,16 +277,8 @@ def ccd(
 
     Arguments, result and errors are those of :func:`solve`.
     """
-    return _solve_one_by_batch(
-        "ccd",
-        joints,
-        target,
-        tolerance,
-        max_iterations,
-        cone_half_angle_rad,
-        obstacles,
-        root_direction,
-    )
+    return _solve_single("ccd", joints, target, tolerance, max_iterations,
+                         cone_half_angle_rad, obstacles, root_direction, False)  # fmt: skip
 
 
 def jacobian_dls(
@@ -304,16 +295,26 @@ def jacobian_dls(
 
     Arguments, result and errors are those of :func:`solve`.
     """
-    return _solve_one_by_batch(
-        "jacobian_dls",
-        joints,
-        target,
-        tolerance,
-        max_iterations,
-        cone_half_angle_rad,
-        obstacles,
-        root_direction,
-    )
+    return _solve_single("jacobian_dls", joints, target, tolerance, max_iterations,
+                         cone_half_angle_rad, obstacles, root_direction, False)  # fmt: skip
+
+
+def warm_up() -> None:
+    """Compile every solver core (or load it from numba's cache) on tiny inputs, so the first real solve waits for
+    nothing. Safe to call from a background thread; numba's compiler lock makes a concurrent first solve wait for
+    it instead of compiling twice."""
+    chain = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.3, 0.0, 1.9]])
+    obstacles = [(np.array([1.0, 0.0, 1.0]), 0.2)]
+    for solver in ("fabrik", "ccd", "jacobian_dls"):
+        for batch in (1, 2):  # the serial driver (one chain) and the parallel one
+            solve_batch(
+                np.repeat(chain[None], batch, axis=0),
+                np.repeat([[0.8, 0.0, 1.2]], batch, axis=0),
+                cone_half_angle_rad=1.0,
+                obstacles=obstacles,
+                max_iterations=3,
+                solver=solver,
+            )
 
 
 def two_bone(
@@ -358,7 +359,7 @@ def two_bone(
     axis = offset / distance if distance > _TINY * scale else _fallback_axis(bend, dim)
     side = bend - float(bend @ axis) * axis
     side_norm = float(np.linalg.norm(side))
-    side = side / side_norm if side_norm > _TINY else _perpendicular(axis[:, None])[:, 0]
+    side = side / side_norm if side_norm > _TINY else _perpendicular_numpy(axis)
 
     reach = min(max(distance, abs(upper - lower)), upper + lower)
     if upper <= _TINY * scale or reach <= _TINY * scale:
@@ -422,9 +423,29 @@ def _finite_array(name: str, value: ArrayLike) -> NDArray[np.float64]:
         array = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError) as error:
         raise ValueError(f"{name} must be an array of numbers, got {value!r}") from error
-    if not np.isfinite(array).all():
+    flat = array.reshape(-1)
+    # A compiled scan costs a fraction of numpy's isfinite + all on the few numbers of one chain.
+    finite = _all_finite(flat) if flat.flags.writeable else bool(np.isfinite(flat).all())
+    if not finite:
         raise ValueError(f"{name} must be finite, got {value!r}")
     return array
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _all_finite(values: NDArray[np.float64]) -> bool:
+    for value in values:
+        if not math.isfinite(value):
+            return False
+    return True
+
+
+def _finite_number(name: str, value: object) -> float:
+    """A finite real number (Python or numpy scalar; not bool) as a float, else ValueError naming it."""
+    if isinstance(value, (float, int, np.floating, np.integer)) and not isinstance(value, bool):
+        number = float(value)
+        if math.isfinite(number):
+            return number
+    raise ValueError(f"{name} must be a finite number, got {value!r}")
 
 
 def _check_joints(name: str, value: ArrayLike, *, batched: bool) -> NDArray[np.float64]:
@@ -471,141 +492,12 @@ def _status_literal(text: str) -> Status:
     raise ValueError(f"unknown status {text!r}")
 
 
-# ================================================================================================ set-up
-@dataclasses.dataclass(frozen=True)
-class _Setup:
-    """Checked options shared by every chain of a batch."""
-
-    dim: int
-    tolerance: float
-    max_iterations: int
-    limits: tuple[float, float] | None
-    """(cos φ, sin φ) of the cone half-angle, or None."""
-    root_direction: NDArray[np.float64]
-    """(d, 1) unit rest direction of the root."""
-    centres: NDArray[np.float64]
-    """(K, d, 1) obstacle centres (m)."""
-    radii: NDArray[np.float64]
-    """(K, 1) obstacle radii (m)."""
-
-    @staticmethod
-    def build(
-        *,
-        dim: int,
-        tolerance: float,
-        max_iterations: int,
-        cone_half_angle_rad: float | None,
-        obstacles: Sequence[Obstacle],
-        root_direction: ArrayLike | None,
-    ) -> _Setup:
-        tol = _finite_array("tolerance", tolerance)
-        if tol.shape != () or float(tol) < 0.0:
-            raise ValueError(f"tolerance must be a finite number ≥ 0, got {tolerance!r}")
-        if isinstance(max_iterations, bool) or not isinstance(max_iterations, (int, np.integer)):
-            raise ValueError(f"max_iterations must be an integer, got {max_iterations!r}")
-        if max_iterations < 1:
-            raise ValueError(f"max_iterations must be ≥ 1, got {max_iterations}")
-        limits = None
-        if cone_half_angle_rad is not None:
-            phi = _finite_array("cone_half_angle_rad", cone_half_angle_rad)
-            if phi.shape != () or not 0.0 <= float(phi) <= math.pi:
-                raise ValueError(
-                    f"cone_half_angle_rad must be in [0, π], got {cone_half_angle_rad!r}"
-                )
-            if float(phi) < math.pi:
-                limits = (math.cos(float(phi)), math.sin(float(phi)))
-        centres, radii = [], []
-        for k, obstacle in enumerate(obstacles):
-            try:
-                centre, radius = obstacle
-            except (TypeError, ValueError) as error:
-                raise ValueError(
-                    f"obstacles[{k}] must be (centre, radius), got {obstacle!r}"
-                ) from error
-            centres.append(_check_vector(f"obstacles[{k}] centre", centre, dim))
-            r = _finite_array(f"obstacles[{k}] radius", radius)
-            if r.shape != () or float(r) <= 0.0:
-                raise ValueError(
-                    f"obstacles[{k}] radius must be a finite number > 0, got {radius!r}"
-                )
-            radii.append(float(r))
-        return _Setup(
-            dim=dim,
-            tolerance=float(tol),
-            max_iterations=int(max_iterations),
-            limits=limits,
-            root_direction=_root_direction(root_direction, dim)[:, None],
-            centres=np.array(centres, dtype=np.float64).reshape(len(centres), dim, 1),
-            radii=np.array(radii, dtype=np.float64).reshape(len(radii), 1),
-        )
-
-
-@dataclasses.dataclass
-class _Chains:
-    """The active chains of a batch, laid out joint-major: one joint of every chain is a contiguous (d, B) block."""
-
-    p: NDArray[np.float64]
-    """(n + 1, d, B) joints (m)."""
-    target: NDArray[np.float64]
-    """(d, B) targets (m)."""
-    lengths: NDArray[np.float64]
-    """(n, B) link lengths (m)."""
-    tiny: NDArray[np.float64]
-    """(B,) length below which a vector has no direction (m)."""
-    obstacle_live: NDArray[np.bool_]
-    """(K, B) obstacles this chain avoids (those that do not contain its root)."""
-    has_zero_link: bool
-
-    def take(self, keep: NDArray[np.bool_]) -> _Chains:
-        return _Chains(
-            p=self.p[:, :, keep],
-            target=self.target[:, keep],
-            lengths=self.lengths[:, keep],
-            tiny=self.tiny[keep],
-            obstacle_live=self.obstacle_live[:, keep],
-            has_zero_link=self.has_zero_link,
-        )
-
-
-# ================================================================================================ vector helpers
-def _dot_d(a: NDArray[np.float64], b: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Dot product over the d axis (−2) of broadcastable (…, d, B) arrays: (…, B).
-
-    Written out rather than reduced: numpy's reduction over a middle axis is slow, and this is the order (x + y) + z
-    that both the reduction and the one-chain path use, so every path gives the same bits.
-    """
-    total = a[..., 0, :] * b[..., 0, :] + a[..., 1, :] * b[..., 1, :]
-    if a.shape[-2] == 3:
-        total = total + a[..., 2, :] * b[..., 2, :]
-    return total
-
-
-def _norm(v: NDArray[np.float64]) -> NDArray[np.float64]:
-    """(…, d, B) → (…, B) Euclidean norm over the d axis."""
-    return np.sqrt(_dot_d(v, v))
-
-
-def _unit(
-    v: NDArray[np.float64], fallback: NDArray[np.float64], tiny: NDArray[np.float64]
-) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """(d, B) unit vectors of ``v``, ``fallback`` where ``|v| ≤ tiny``; and the norms (B,)."""
-    norm = _norm(v)
-    defined = norm > tiny
-    if defined.all():
-        return v / norm, norm
-    return np.where(defined, v / np.where(defined, norm, 1.0), fallback), norm
-
-
-def _perpendicular(axis: NDArray[np.float64]) -> NDArray[np.float64]:
-    """(d, B) a fixed unit vector perpendicular to each unit ``axis`` (d, B)."""
+def _perpendicular_numpy(axis: NDArray[np.float64]) -> NDArray[np.float64]:
+    """A fixed unit vector perpendicular to the unit ``axis`` (d,)."""
     if axis.shape[0] == 2:
-        return np.stack([-axis[1], axis[0]])
-    # cross with the coordinate axis least aligned with ``axis``
-    use_y = np.abs(axis[0]) > 0.9
-    ex = np.where(use_y, 0.0, 1.0)
-    ey = np.where(use_y, 1.0, 0.0)
-    cross = np.stack([-axis[2] * ey, axis[2] * ex, axis[0] * ey - axis[1] * ex])
-    return cross / _norm(cross)
+        return np.array([-axis[1], axis[0]])
+    x, y, z = _perpendicular(float(axis[0]), float(axis[1]), float(axis[2]), 3)
+    return np.array([x, y, z])
 
 
 def _fallback_axis(bend: NDArray[np.float64], dim: int) -> NDArray[np.float64]:
@@ -615,939 +507,748 @@ def _fallback_axis(bend: NDArray[np.float64], dim: int) -> NDArray[np.float64]:
         axis = np.zeros(dim)
         axis[-1] = 1.0
         return axis
-    return _perpendicular((bend / norm)[:, None])[:, 0]
+    return _perpendicular_numpy(bend / norm)
 
 
-def _clamp_cone(
-    v: NDArray[np.float64], axis: NDArray[np.float64], limits: tuple[float, float]
-) -> NDArray[np.float64]:
-    """Unit directions ``v`` (d, B) turned, by the least angle, into the cone of half-angle φ around ``axis``."""
-    cos_phi, sin_phi = limits
-    cos_v = _dot_d(v, axis)
-    outside = cos_v < cos_phi
-    if not outside.any():
-        return v
-    cols = np.flatnonzero(outside)  # work on the chains outside only: in a large batch they are few
-    axis = np.broadcast_to(axis, v.shape)[:, cols]
-    side = v[:, cols] - cos_v[cols] * axis
-    side_norm = _norm(side)
-    has_side = side_norm > 1e-9
-    side = np.where(has_side, side / np.where(has_side, side_norm, 1.0), _perpendicular(axis))
-    clamped = cos_phi * axis + sin_phi * side
-    out = v.copy()
-    # A nearly (anti)parallel v leaves ``side`` only roughly perpendicular: renormalise so lengths stay exact.
-    out[:, cols] = clamped / _norm(clamped)
-    return out
+@dataclasses.dataclass(frozen=True)
+class _Setup:
+    """Checked options shared by every chain, packed as the compiled core takes them."""
 
+    max_iterations: int
+    params: NDArray[np.float64]
+    """(3,) tolerance (m), cos φ, sin φ."""
+    flags: NDArray[np.int64]
+    """(5,) max_iterations, d, solver id, extrapolate, has limits."""
+    root_direction: NDArray[np.float64]
+    """(3,) unit rest direction of the root (z = 0 in 2D)."""
+    centres: NDArray[np.float64]
+    """(K, 3) obstacle centres (m)."""
+    radii: NDArray[np.float64]
+    """(K,) obstacle radii (m)."""
 
-def _deflect(
-    anchor: NDArray[np.float64],
-    v: NDArray[np.float64],
-    length: NDArray[np.float64],
-    setup: _Setup,
-    live: NDArray[np.bool_],
-    tiny: NDArray[np.float64],
-) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
-    """Turn the segments ``anchor + t·v, t ∈ [0, length]`` by the least angle until no live obstacle cuts them.
-
-    Returns the new unit directions (d, B) and (B,) which were turned.
-    """
-    turned = np.zeros(v.shape[1], dtype=bool)
-    for _ in range(3):  # turning around one obstacle can push into another: a few rounds settle it
-        rel = setup.centres - anchor  # (K, d, B)
-        along = _dot_d(rel, v)  # (K, B)
-        t = np.minimum(np.maximum(along, 0.0), length)
-        dist2 = _dot_d(rel, rel) - 2.0 * t * along + t * t
-        hit = (dist2 < setup.radii * setup.radii) & live
-        if not hit.any():
-            return v, turned
-        turned = turned | hit.any(axis=0)
-        v = v.copy()
-        for k in np.flatnonzero(hit.any(axis=1)):
-            cols = np.flatnonzero(hit[k])  # only the chains this obstacle cuts
-            v[:, cols] = _turn_clear(
-                anchor[:, cols],
-                v[:, cols],
-                length[cols],
-                setup.centres[k],
-                setup.radii[k],
-                tiny[cols],
+    @staticmethod
+    def build(
+        dim: int,
+        tolerance: float,
+        max_iterations: int,
+        cone_half_angle_rad: float | None,
+        obstacles: Sequence[Obstacle],
+        root_direction: ArrayLike | None,
+        solver: int,
+        extrapolate: bool,
+    ) -> _Setup:
+        try:
+            options = _options(
+                dim, tolerance, max_iterations, cone_half_angle_rad, solver, extrapolate
             )
-    return v, turned
+        except (
+            TypeError
+        ):  # an unhashable argument: check it without the cache (and raise ValueError)
+            options = _options.__wrapped__(
+                dim, tolerance, max_iterations, cone_half_angle_rad, solver, extrapolate
+            )
+        if root_direction is None and not obstacles:
+            return options
+        count = len(obstacles)
+        centres, radii = np.zeros((count, 3)), np.empty(count)
+        for k, obstacle in enumerate(obstacles):
+            try:
+                centre, radius = obstacle
+            except (TypeError, ValueError) as error:
+                raise ValueError(
+                    f"obstacles[{k}] must be (centre, radius), got {obstacle!r}"
+                ) from error
+            centres[k, :dim] = _check_vector(f"obstacles[{k}] centre", centre, dim)
+            radii[k] = _finite_number(f"obstacles[{k}] radius", radius)
+            if not radii[k] > 0.0:
+                raise ValueError(
+                    f"obstacles[{k}] radius must be a finite number > 0, got {radius!r}"
+                )
+        rest = options.root_direction
+        if root_direction is not None:
+            rest = np.zeros(3)
+            rest[:dim] = _root_direction(root_direction, dim)
+        return dataclasses.replace(options, root_direction=rest, centres=centres, radii=radii)
 
 
-def _turn_clear(
-    anchor: NDArray[np.float64],
-    v: NDArray[np.float64],
-    length: NDArray[np.float64],
-    centre: NDArray[np.float64],
-    radius: NDArray[np.float64],
-    tiny: NDArray[np.float64],
-) -> NDArray[np.float64]:
-    """Directions (d, B) nearest ``v`` whose segment of ``length`` from ``anchor`` just clears one obstacle."""
-    clear = radius * (1.0 + _CLEARANCE)
-    to_centre, distance = _unit(centre - anchor, -v, tiny)
-    # Far enough to reach the tangent point: stop at the tangent; otherwise the far end rests on the surface.
-    safe_distance = np.maximum(distance, tiny)
-    safe_length = np.maximum(length, tiny)
-    sin_tangent = np.clip(clear / safe_distance, 0.0, 1.0)
-    cos_end = np.clip(
-        (length * length + distance * distance - clear * clear)
-        / (2.0 * safe_length * safe_distance),
-        -1.0,
-        1.0,
+@functools.lru_cache(maxsize=64, typed=True)
+def _options(
+    dim: int,
+    tolerance: float,
+    max_iterations: int,
+    cone_half_angle_rad: float | None,
+    solver: int,
+    extrapolate: bool,
+) -> _Setup:
+    """The checked scalar options, without obstacles, on the default root direction; cached, since a dragged
+    chain asks for the same ones every frame (the compiled core never writes to them)."""
+    tol = _finite_number("tolerance", tolerance)
+    if tol < 0.0:
+        raise ValueError(f"tolerance must be a finite number ≥ 0, got {tolerance!r}")
+    if isinstance(max_iterations, bool) or not isinstance(max_iterations, (int, np.integer)):
+        raise ValueError(f"max_iterations must be an integer, got {max_iterations!r}")
+    if max_iterations < 1:
+        raise ValueError(f"max_iterations must be ≥ 1, got {max_iterations}")
+    cos_phi, sin_phi, has_limits = -1.0, 0.0, 0
+    if cone_half_angle_rad is not None:
+        phi = _finite_number("cone_half_angle_rad", cone_half_angle_rad)
+        if not 0.0 <= phi <= math.pi:
+            raise ValueError(f"cone_half_angle_rad must be in [0, π], got {cone_half_angle_rad!r}")
+        if phi < math.pi:
+            cos_phi, sin_phi, has_limits = math.cos(phi), math.sin(phi), 1
+    rest = np.zeros(3)
+    rest[:dim] = _root_direction(None, dim)
+    return _Setup(
+        max_iterations=int(max_iterations),
+        params=np.array([tol, cos_phi, sin_phi]),
+        flags=np.array(
+            [int(max_iterations), dim, solver, int(bool(extrapolate)), has_limits], dtype=np.int64
+        ),
+        root_direction=rest,
+        centres=np.zeros((0, 3)),
+        radii=np.zeros(0),
     )
-    tangent = length * length >= distance * distance - clear * clear
-    cos_t = np.where(tangent, np.sqrt(1.0 - sin_tangent * sin_tangent), cos_end)
-    sin_t = np.where(tangent, sin_tangent, np.sqrt(1.0 - cos_end * cos_end))
-    side = v - _dot_d(v, to_centre) * to_centre
-    side, _ = _unit(side, _perpendicular(to_centre), np.full_like(tiny, 1e-9))
-    turned = cos_t * to_centre + sin_t * side
-    turned = turned / _norm(turned)
-    inside = distance <= radius  # an anchor inside: leave straight away from the centre
-    return np.where(inside, -to_centre, turned)
 
 
-# ================================================================================================ passes
-def _forward_pass(chains: _Chains, setup: _Setup) -> None:
-    """End on the target, each joint back toward its old place at its link's length (the root is left)."""
-    p, lengths, tiny = chains.p, chains.lengths, chains.tiny
-    n = lengths.shape[0]
-    p[n] = chains.target
-    previous, _ = _unit(p[0] - p[n], -setup.root_direction * np.ones_like(tiny), tiny)
-    has_obstacles = setup.radii.shape[0] > 0
-    for i in range(n - 1, 0, -1):
-        direction, _ = _unit(p[i] - p[i + 1], previous, tiny)
-        if has_obstacles:
-            direction, _ = _deflect(
-                p[i + 1], direction, lengths[i], setup, chains.obstacle_live, tiny
-            )
-        if setup.limits is not None and i < n - 1:
-            direction = _clamp_cone(direction, previous, setup.limits)
-        p[i] = p[i + 1] + lengths[i] * direction
-        previous = (
-            np.where(lengths[i] > tiny, direction, previous) if chains.has_zero_link else direction
-        )
+def _solve_single(
+    solver: Solver,
+    joints: ArrayLike,
+    target: ArrayLike,
+    tolerance: float,
+    max_iterations: int,
+    cone_half_angle_rad: float | None,
+    obstacles: Sequence[Obstacle],
+    root_direction: ArrayLike | None,
+    extrapolate: bool,
+) -> Solution:
+    """One chain: checked here, solved by the same compiled core as every chain of a batch."""
+    chain = _check_joints("joints", joints, batched=False)
+    count, dim = chain.shape
+    point = _check_vector("target", target, dim)
+    setup = _Setup.build(dim, tolerance, max_iterations, cone_half_angle_rad, obstacles,
+                         root_direction, _SOLVER_IDS[solver], extrapolate)  # fmt: skip
+    p = np.zeros((1, count, 3))
+    p[0, :, :dim] = chain
+    goal = np.zeros((1, 3))
+    goal[0, :dim] = point
+    out_p = np.empty_like(p)
+    history = np.empty((1, setup.max_iterations + 1))
+    iterations = np.empty(1, dtype=np.int64)
+    status = np.empty(1, dtype=np.int64)
+    error = np.empty(1)
+    _solve_rows(0, 1, p, goal, setup.params, setup.flags, setup.root_direction, setup.centres,
+                setup.radii, out_p, history, iterations, status, error)  # fmt: skip
+    used = int(iterations[0])
+    return Solution(
+        joints=out_p[0, :, :dim].copy() if dim == 2 else out_p[0],
+        iterations=used,
+        error=float(error[0]),
+        status=STATUSES[int(status[0])],
+        error_history=history[0, : used + 1],
+    )
 
 
-def _backward_pass(chains: _Chains, setup: _Setup) -> None:
-    """Root back on its place, each joint outward toward its current place; limits and obstacles enforced."""
-    p, lengths, tiny = chains.p, chains.lengths, chains.tiny
-    n = lengths.shape[0]
-    previous = setup.root_direction * np.ones_like(tiny)
-    has_obstacles = setup.radii.shape[0] > 0
-    for i in range(1, n + 1):
-        direction, _ = _unit(p[i] - p[i - 1], previous, tiny)
-        if setup.limits is not None:
-            direction = _clamp_cone(direction, previous, setup.limits)
-        if has_obstacles:
-            direction, turned = _deflect(
-                p[i - 1], direction, lengths[i - 1], setup, chains.obstacle_live, tiny
-            )
-            if setup.limits is not None and turned.any():
-                # Only the turned ones: clamping an already clamped direction again can move it by a rounding
-                # error, and the one-chain path (which the batch must equal) does not.
-                clamped = _clamp_cone(direction, previous, setup.limits)
-                direction = np.where(turned, clamped, direction)
-        p[i] = p[i - 1] + lengths[i - 1] * direction
-        previous = (
-            np.where(lengths[i - 1] > tiny, direction, previous)
-            if chains.has_zero_link
-            else direction
-        )
+# ================================================================================================ compiled core
+# Every solver lives once, below, on the scalars of one chain (3D; a 2D chain has z = 0 and d = 2 where the
+# perpendicular and the rotations differ). ``_solve_rows`` runs it over some rows of a batch; ``solve`` calls it for
+# one row, ``_solve_parallel`` splits a batch into chunks across threads.
+_CHUNKS = 256
+"""Most chunks a parallel batch is cut into: enough to balance chains that need 1 and 50 iterations."""
+_PARALLEL_LOCK = threading.Lock()
 
 
-def _fabrik_step(chains: _Chains, setup: _Setup) -> None:
-    if chains.p.shape[2] == 1:
-        _fabrik_step_one(chains, setup)
-        return
-    _forward_pass(chains, setup)
-    _backward_pass(chains, setup)
-
-
-# ------------------------------------------------------------------------------------------------ one chain
-# With B = 1 every numpy call costs about a microsecond whatever its size, so one chain's passes run on Python
-# floats instead. They repeat the vectorised passes operation for operation, in the same order, so both paths give
-# the same bits (the batch-equals-single tests hold them to it).
-Vec = list[float]
-
-
-def _dot(a: Vec, b: Vec) -> float:
-    total = a[0] * b[0] + a[1] * b[1]
-    return total + a[2] * b[2] if len(a) == 3 else total
-
-
-def _length(v: Vec) -> float:
-    return math.sqrt(_dot(v, v))
-
-
-def _unit_one(v: Vec, fallback: Vec, tiny: float) -> tuple[Vec, float]:
-    norm = _length(v)
+@numba.njit(cache=True, error_model="numpy")
+def _unit(
+    x: float, y: float, z: float, fx: float, fy: float, fz: float, tiny: float
+) -> tuple[float, float, float, float]:
+    """``(x, y, z) / |(x, y, z)|`` and the norm; the fallback direction where the norm is ≤ ``tiny``."""
+    norm = math.sqrt(x * x + y * y + z * z)
     if norm > tiny:
-        return [x / norm for x in v], norm
-    return fallback, norm
+        inverse = 1.0 / norm
+        return x * inverse, y * inverse, z * inverse, norm
+    return fx, fy, fz, norm
 
 
-def _perpendicular_one(a: Vec) -> Vec:
-    if len(a) == 2:
-        return [-a[1], a[0]]
-    use_y = abs(a[0]) > 0.9
-    ex, ey = (0.0, 1.0) if use_y else (1.0, 0.0)
-    cross = [-a[2] * ey, a[2] * ex, a[0] * ey - a[1] * ex]
-    norm = _length(cross)
-    return [x / norm for x in cross]
+@numba.njit(cache=True, error_model="numpy")
+def _perpendicular(x: float, y: float, z: float, dim: int) -> tuple[float, float, float]:
+    """A fixed unit vector perpendicular to the unit vector (x, y, z): in the plane for d = 2."""
+    if dim == 2:
+        return -y, x, 0.0
+    # the cross product with the coordinate axis least aligned with the vector
+    ex, ey = (0.0, 1.0) if abs(x) > 0.9 else (1.0, 0.0)
+    cx, cy, cz = -z * ey, z * ex, x * ey - y * ex
+    norm = math.sqrt(cx * cx + cy * cy + cz * cz)
+    return cx / norm, cy / norm, cz / norm
 
 
-def _clamp_cone_one(v: Vec, axis: Vec, limits: tuple[float, float]) -> Vec:
-    cos_phi, sin_phi = limits
-    cos_v = _dot(v, axis)
+@numba.njit(cache=True, error_model="numpy")
+def _clamp_cone(
+    vx: float, vy: float, vz: float, ax: float, ay: float, az: float, cos_phi: float,
+    sin_phi: float, dim: int,
+) -> tuple[float, float, float]:  # fmt: skip
+    """The unit direction v turned, by the least angle, into the cone of half-angle φ around the unit ``a``."""
+    cos_v = vx * ax + vy * ay + vz * az
     if not cos_v < cos_phi:
-        return v
-    side = [x - cos_v * a for x, a in zip(v, axis, strict=True)]
-    side_norm = _length(side)
-    side = [x / side_norm for x in side] if side_norm > 1e-9 else _perpendicular_one(axis)
-    clamped = [cos_phi * a + sin_phi * x for a, x in zip(axis, side, strict=True)]
-    norm = _length(clamped)
-    return [x / norm for x in clamped]
-
-
-def _deflect_one(
-    anchor: Vec,
-    v: Vec,
-    length: float,
-    obstacles: list[tuple[Vec, float, float]],
-    tiny: float,
-) -> tuple[Vec, bool]:
-    """:func:`_deflect` for one chain; ``obstacles`` are its live ones as (centre, radius, far²).
-
-    ``far²`` is a squared distance from the anchor beyond which no segment of the chain can reach the obstacle
-    (with a 1 % margin, so rounding never skips a hit the batch path would see): most pairs stop there.
-    """
-    turned = False
-    three = len(anchor) == 3
-    ax, ay = anchor[0], anchor[1]
-    az = anchor[2] if three else 0.0
-    for _ in range(3):
-        # Written out, in the order numpy sums over the d axis, so the bits match the batch path; this test runs
-        # for every segment and obstacle of every pass, so it is kept to plain float arithmetic.
-        hits = []
-        vx, vy = v[0], v[1]
-        vz = v[2] if three else 0.0
-        for k, (centre, radius, far2) in enumerate(obstacles):
-            rx, ry = centre[0] - ax, centre[1] - ay
-            if three:
-                rz = centre[2] - az
-                rel2 = rx * rx + ry * ry + rz * rz
-                if rel2 > far2:
-                    continue
-                along = rx * vx + ry * vy + rz * vz
-            else:
-                rel2 = rx * rx + ry * ry
-                if rel2 > far2:
-                    continue
-                along = rx * vx + ry * vy
-            t = along if along > 0.0 else 0.0
-            if t > length:
-                t = length
-            if rel2 - 2.0 * t * along + t * t < radius * radius:
-                hits.append(k)
-        if not hits:
-            return v, turned
-        turned = True
-        for k in hits:
-            v = _turn_clear_one(anchor, v, length, obstacles[k][0], obstacles[k][1], tiny)
-    return v, turned
-
-
-def _turn_clear_one(
-    anchor: Vec, v: Vec, length: float, centre: Vec, radius: float, tiny: float
-) -> Vec:
-    clear = radius * (1.0 + _CLEARANCE)
-    to_centre, distance = _unit_one(
-        [c - a for c, a in zip(centre, anchor, strict=True)], [-x for x in v], tiny
+        return vx, vy, vz
+    sx, sy, sz, side = _unit(vx - cos_v * ax, vy - cos_v * ay, vz - cos_v * az, 0.0, 0.0, 0.0, 1e-9)
+    if side <= 1e-9:  # v (anti)parallel to the axis: any side will do
+        sx, sy, sz = _perpendicular(ax, ay, az, dim)
+    # A nearly (anti)parallel v leaves the side only roughly perpendicular: renormalise so lengths stay exact.
+    cx, cy, cz = (
+        cos_phi * ax + sin_phi * sx,
+        cos_phi * ay + sin_phi * sy,
+        cos_phi * az + sin_phi * sz,
     )
-    if distance <= radius:
-        return [-x for x in to_centre]
-    safe_distance = max(distance, tiny)
-    safe_length = max(length, tiny)
+    norm = math.sqrt(cx * cx + cy * cy + cz * cz)
+    return cx / norm, cy / norm, cz / norm
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _turn_clear(
+    ax: float, ay: float, az: float, vx: float, vy: float, vz: float, length: float,
+    centre: NDArray[np.float64], radius: float, tiny: float, dim: int,
+) -> tuple[float, float, float]:  # fmt: skip
+    """The direction nearest v whose segment of ``length`` from anchor ``a`` just clears one obstacle: tangent to
+    it if the segment is long enough to reach the tangent point, else with its far end on the surface."""
+    clear = radius * (1.0 + _CLEARANCE)
+    cx, cy, cz, distance = _unit(
+        centre[0] - ax, centre[1] - ay, centre[2] - az, -vx, -vy, -vz, tiny
+    )
+    if distance <= radius:  # an anchor inside: leave straight away from the centre
+        return -cx, -cy, -cz
     if length * length >= distance * distance - clear * clear:
-        sin_t = min(max(clear / safe_distance, 0.0), 1.0)
+        sin_t = min(max(clear / max(distance, tiny), 0.0), 1.0)
         cos_t = math.sqrt(1.0 - sin_t * sin_t)
     else:
-        cos_t = min(
-            max(
-                (length * length + distance * distance - clear * clear)
-                / (2.0 * safe_length * safe_distance),
-                -1.0,
-            ),
-            1.0,
+        cos_t = (length * length + distance * distance - clear * clear) / (
+            2.0 * max(length, tiny) * max(distance, tiny)
         )
+        cos_t = min(max(cos_t, -1.0), 1.0)
         sin_t = math.sqrt(1.0 - cos_t * cos_t)
-    along = _dot(v, to_centre)
-    side, _ = _unit_one(
-        [x - along * c for x, c in zip(v, to_centre, strict=True)],
-        _perpendicular_one(to_centre),
-        1e-9,
-    )
-    turned = [cos_t * c + sin_t * x for c, x in zip(to_centre, side, strict=True)]
-    norm = _length(turned)
-    return [x / norm for x in turned]
+    along = vx * cx + vy * cy + vz * cz
+    sx, sy, sz, side = _unit(vx - along * cx, vy - along * cy, vz - along * cz, 0.0, 0.0, 0.0, 1e-9)
+    if side <= 1e-9:  # v through the centre: turn to any side
+        sx, sy, sz = _perpendicular(cx, cy, cz, dim)
+    tx, ty, tz = cos_t * cx + sin_t * sx, cos_t * cy + sin_t * sy, cos_t * cz + sin_t * sz
+    norm = math.sqrt(tx * tx + ty * ty + tz * tz)
+    return tx / norm, ty / norm, tz / norm
 
 
-def _live_obstacles_one(
-    setup: _Setup, live: list[bool], lengths: Vec
-) -> list[tuple[Vec, float, float]]:
-    """The live obstacles of one chain as :func:`_deflect_one` takes them: (centre, radius, far²)."""
-    longest = max(lengths)
-    return [
-        (centre, radius, 1.01 * (longest + radius) * (longest + radius))
-        for centre, radius, alive in zip(
-            setup.centres[:, :, 0].tolist(), setup.radii[:, 0].tolist(), live, strict=True
-        )
-        if alive
-    ]
+@numba.njit(cache=True, error_model="numpy")
+def _deflect(
+    ax: float, ay: float, az: float, vx: float, vy: float, vz: float, length: float,
+    centres: NDArray[np.float64], radii: NDArray[np.float64], live: NDArray[np.bool_], tiny: float,
+    dim: int,
+) -> tuple[float, float, float, bool]:  # fmt: skip
+    """Turn the segment ``a + t·v, t ∈ [0, length]`` by the least angle until no live obstacle cuts it; returns
+    the new unit direction and whether it was turned."""
+    turned = False
+    for _ in range(3):  # turning around one obstacle can push into another: a few rounds settle it
+        hit = False
+        for k in range(radii.shape[0]):
+            if not live[k]:
+                continue
+            rx, ry, rz = centres[k, 0] - ax, centres[k, 1] - ay, centres[k, 2] - az
+            rel2 = rx * rx + ry * ry + rz * rz
+            reach = length + radii[k]
+            if rel2 >= reach * reach:  # too far for the segment to touch: most pairs stop here
+                continue
+            along = rx * vx + ry * vy + rz * vz
+            t = min(max(along, 0.0), length)
+            if rel2 - 2.0 * t * along + t * t < radii[k] * radii[k]:
+                hit = True
+                vx, vy, vz = _turn_clear(ax, ay, az, vx, vy, vz, length, centres[k], radii[k],
+                                         tiny, dim)  # fmt: skip
+        if not hit:
+            return vx, vy, vz, turned
+        turned = True
+    return vx, vy, vz, turned
 
 
-def _fabrik_step_one(chains: _Chains, setup: _Setup) -> None:
-    """:func:`_forward_pass` then :func:`_backward_pass` for a batch of one chain, on Python floats."""
-    p: list[Vec] = chains.p[:, :, 0].tolist()
-    lengths: Vec = chains.lengths[:, 0].tolist()
-    live: list[bool] = chains.obstacle_live[:, 0].tolist()
-    _fabrik_passes_one(
-        p,
-        chains.target[:, 0].tolist(),
-        lengths,
-        float(chains.tiny[0]),
-        _live_obstacles_one(setup, live, lengths),
-        setup.root_direction[:, 0].tolist(),
-        setup.limits,
-        zero_links=chains.has_zero_link,
-    )
-    chains.p[:, :, 0] = p
-
-
-def _fabrik_passes_one(
-    p: list[Vec],
-    target: Vec,
-    lengths: Vec,
-    tiny: float,
-    obstacles: list[tuple[Vec, float, float]],
-    root_direction: Vec,
-    limits: tuple[float, float] | None,
-    *,
-    zero_links: bool,
-) -> None:
-    """The forward then the backward pass of one chain ``p`` (n + 1 joints as lists), in place."""
-    has_obstacles = bool(obstacles)
-    n = len(lengths)
-
-    p[n] = list(target)
-    previous, _ = _unit_one(
-        [a - b for a, b in zip(p[0], p[n], strict=True)], [-x for x in root_direction], tiny
-    )
-    for i in range(n - 1, 0, -1):
-        anchor = p[i + 1]
-        direction, _ = _unit_one([a - b for a, b in zip(p[i], anchor, strict=True)], previous, tiny)
-        if has_obstacles:
-            direction, _ = _deflect_one(anchor, direction, lengths[i], obstacles, tiny)
-        if limits is not None and i < n - 1:
-            direction = _clamp_cone_one(direction, previous, limits)
-        p[i] = [a + lengths[i] * x for a, x in zip(anchor, direction, strict=True)]
-        if not zero_links or lengths[i] > tiny:
-            previous = direction
-
-    previous = root_direction
-    for i in range(1, n + 1):
-        anchor = p[i - 1]
-        direction, _ = _unit_one([a - b for a, b in zip(p[i], anchor, strict=True)], previous, tiny)
-        if limits is not None:
-            direction = _clamp_cone_one(direction, previous, limits)
-        if has_obstacles:
-            direction, turned = _deflect_one(anchor, direction, lengths[i - 1], obstacles, tiny)
-            if turned and limits is not None:
-                direction = _clamp_cone_one(direction, previous, limits)
-        p[i] = [a + lengths[i - 1] * x for a, x in zip(anchor, direction, strict=True)]
-        if not zero_links or lengths[i - 1] > tiny:
-            previous = direction
-
-
-def _rotate_2d(
-    v: NDArray[np.float64], cos_a: NDArray[np.float64], sin_a: NDArray[np.float64]
-) -> NDArray[np.float64]:
-    """Rotate (…, 2, B) vectors by angles given as cos/sin (B,)."""
-    x, y = v[..., 0, :], v[..., 1, :]
-    return np.stack([cos_a * x - sin_a * y, sin_a * x + cos_a * y], axis=-2)
-
-
-def _cross(a: NDArray[np.float64], b: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Cross product over the d = 3 axis (-2) of (…, 3, B) arrays."""
-    ax, ay, az = a[..., 0, :], a[..., 1, :], a[..., 2, :]
-    bx, by, bz = b[..., 0, :], b[..., 1, :], b[..., 2, :]
-    return np.stack([ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx], axis=-2)
-
-
-def _ccd_step(chains: _Chains, setup: _Setup) -> None:
-    """One CCD sweep, end to root, then the constrained backward pass as a projection."""
-    p, tiny = chains.p, chains.tiny
-    n = chains.lengths.shape[0]
-    for i in range(n - 1, -1, -1):
-        pivot = p[i]
-        to_end, end_norm = _unit(p[n] - pivot, setup.root_direction * np.ones_like(tiny), tiny)
-        to_target, target_norm = _unit(chains.target - pivot, to_end, tiny)
-        cos_a = np.clip(_dot_d(to_end, to_target), -1.0, 1.0)
-        move = (end_norm > tiny) & (target_norm > tiny)
-        downstream = p[i + 1 :] - pivot
-        if setup.dim == 2:
-            sin_a = to_end[0] * to_target[1] - to_end[1] * to_target[0]
-            rotated = _rotate_2d(downstream, cos_a, sin_a)
-        else:
-            axis = _cross(to_end, to_target)
-            sin_a = _norm(axis)
-            axis, _ = _unit(axis, _perpendicular(to_end), np.full_like(tiny, 1e-12))
-            # Rodrigues: v cos a + (k × v) sin a + k (k·v)(1 − cos a)
-            k_dot_v = np.add.reduce(axis * downstream, axis=-2, keepdims=True)
-            rotated = (
-                downstream * cos_a + _cross(axis * np.ones_like(downstream), downstream) * sin_a
-            )
-            rotated = rotated + axis * k_dot_v * (1.0 - cos_a)
-        p[i + 1 :] = np.where(move, pivot + rotated, p[i + 1 :])
-    _backward_pass(chains, setup)
-
-
-def _dls_step(chains: _Chains, setup: _Setup) -> None:
-    """One damped-least-squares step on joint angles, then the constrained backward pass as a projection."""
-    p, lengths = chains.p, chains.lengths
+@numba.njit(cache=True, error_model="numpy")
+def _forward_pass(
+    p: NDArray[np.float64], target: NDArray[np.float64], lengths: NDArray[np.float64],
+    tiny: float, rest: NDArray[np.float64], limits: tuple[bool, float, float],
+    centres: NDArray[np.float64], radii: NDArray[np.float64], live: NDArray[np.bool_],
+    has_zero: bool, dim: int,
+) -> None:  # fmt: skip
+    """End on the target, each joint back toward its old place at its link's length (the root is left)."""
+    has_limits, cos_phi, sin_phi = limits
     n = lengths.shape[0]
-    batch = p.shape[2]
-    end = p[n]
-    lever = end - p[:n]  # (n, d, B): end effector relative to each joint
-    error = chains.target - end  # (d, B)
-    # Clamp the step as Buss 2004 advises, so the linearisation holds.
-    step_cap = np.maximum(lengths.mean(axis=0), chains.tiny)
-    error_norm = _norm(error)
-    error = error * np.minimum(1.0, step_cap / np.maximum(error_norm, chains.tiny))
-    damping = _DLS_DAMPING * step_cap
-    if setup.dim == 2:
-        jac = np.stack(
-            [-lever[:, 1], lever[:, 0]], axis=1
-        )  # (n, 2, B): ∂end/∂θ_i = perp(end − p_i)
-        jac = np.transpose(jac, (2, 1, 0))  # (B, 2, n)
-    else:
-        basis = np.eye(3)[:, :, None, None] * np.ones((1, 1, n, batch))  # (3 axes, 3, n, B)
-        cols = _cross(np.moveaxis(basis, 1, -2), lever[None])  # (3 axes, n, 3, B)
-        jac = np.transpose(cols, (3, 2, 1, 0)).reshape(
-            batch, 3, 3 * n
-        )  # columns ordered joint-major
-    jjt = jac @ np.swapaxes(jac, 1, 2)
-    jjt = jjt + (damping**2)[:, None, None] * np.eye(setup.dim)
-    solved = np.linalg.solve(jjt, error.T[:, :, None])  # (B, d, 1)
-    dtheta = (np.swapaxes(jac, 1, 2) @ solved)[:, :, 0]  # (B, m)
-    segments = np.diff(p, axis=0)  # (n, d, B)
-    if setup.dim == 2:
-        total = np.cumsum(dtheta.T, axis=0)  # (n, B): segment j turns by the sum of joints 0..j
-        segments = _rotate_2d(segments, np.cos(total), np.sin(total))
-    else:
-        rotvec = dtheta.reshape(batch, n, 3)  # (B, n, 3)
-        rot = _rotation_matrices(rotvec)  # (B, n, 3, 3)
-        cumulative = rot[:, 0]
-        seg = np.transpose(segments, (2, 0, 1))  # (B, n, 3)
-        out = np.empty_like(seg)
-        for j in range(n):
-            if j > 0:
-                cumulative = cumulative @ rot[:, j]
-            out[:, j] = (cumulative @ seg[:, j, :, None])[:, :, 0]
-        segments = np.transpose(out, (1, 2, 0))
-    p[1:] = p[0] + np.cumsum(segments, axis=0)
-    _backward_pass(chains, setup)
-
-
-def _rotation_matrices(rotvec: NDArray[np.float64]) -> NDArray[np.float64]:
-    """(…, 3) rotation vectors → (…, 3, 3) matrices (Rodrigues)."""
-    angle = np.linalg.norm(rotvec, axis=-1)
-    safe = np.where(angle > 1e-15, angle, 1.0)
-    k = rotvec / safe[..., None]
-    kx, ky, kz = k[..., 0], k[..., 1], k[..., 2]
-    zero = np.zeros_like(kx)
-    skew = np.stack(
-        [
-            np.stack([zero, -kz, ky], -1),
-            np.stack([kz, zero, -kx], -1),
-            np.stack([-ky, kx, zero], -1),
-        ],
-        -2,
-    )
-    sin_a, cos_a = np.sin(angle)[..., None, None], np.cos(angle)[..., None, None]
-    return np.eye(3) + sin_a * skew + (1.0 - cos_a) * (skew @ skew)
-
-
-# ================================================================================================ checks on poses
-def _cone_ok(chains: _Chains, setup: _Setup) -> NDArray[np.bool_]:
-    """(B,) whether every segment of each chain lies within its cone."""
-    if setup.limits is None:
-        return np.ones(chains.p.shape[2], dtype=bool)
-    cos_phi = setup.limits[0]
-    if not chains.has_zero_link:  # every segment has a direction: compare them all at once
-        directions = np.diff(chains.p, axis=0) / chains.lengths[:, None, :]  # (n, d, B)
-        previous_all = np.concatenate(
-            [setup.root_direction[None] * np.ones_like(directions[:1]), directions[:-1]]
-        )
-        return np.all(_dot_d(directions, previous_all) >= cos_phi - 1e-12, axis=0)
-    previous = setup.root_direction * np.ones_like(chains.tiny)
-    ok = np.ones(chains.p.shape[2], dtype=bool)
-    for i in range(chains.lengths.shape[0]):
-        direction, norm = _unit(chains.p[i + 1] - chains.p[i], previous, chains.tiny)
-        ok &= (_dot_d(direction, previous) >= cos_phi - 1e-12) | (norm <= chains.tiny)
-        previous = np.where(norm > chains.tiny, direction, previous)
-    return ok
-
-
-def _colliding(
-    p: NDArray[np.float64],
-    setup: _Setup,
-    live: NDArray[np.bool_],
-    radii: NDArray[np.float64] | None = None,
-) -> NDArray[np.bool_]:
-    """(B,) whether any segment of the (n + 1, d, B) chains passes through a live obstacle.
-
-    ``radii`` (K, 1) replace the obstacles' own radii when given.
-    """
-    batch = p.shape[2]
-    radii = setup.radii if radii is None else radii
-    if setup.radii.shape[0] == 0:
-        return np.zeros(batch, dtype=bool)
-    start = p[:-1, None]  # (n, 1, d, B)
-    seg = (p[1:] - p[:-1])[:, None]
-    rel = setup.centres[None] - start  # (n, K, d, B)
-    seg2 = _dot_d(seg, seg)
-    t = np.minimum(np.maximum(_dot_d(rel, seg) / np.where(seg2 > 0.0, seg2, 1.0), 0.0), 1.0)
-    gap = rel - t[:, :, None] * seg
-    dist2 = _dot_d(gap, gap)  # (n, K, B)
-    return np.any((dist2 < radii * radii) & live, axis=(0, 1))
-
-
-def _touching(p: NDArray[np.float64], setup: _Setup, live: NDArray[np.bool_]) -> NDArray[np.bool_]:
-    """(B,) whether a segment rests against (or cuts) a live obstacle, within 0.1 % of its radius."""
-    return _colliding(p, setup, live, setup.radii * (1.0 + 1e-3))
-
-
-# ================================================================================================ driver
-def _run(
-    joints: NDArray[np.float64],
-    targets: NDArray[np.float64],
-    setup: _Setup,
-    step: Callable[[_Chains, _Setup], None],
-    *,
-    shortcut: bool,
-    extrapolate: bool,
-) -> BatchSolution:
-    batch, count, _ = joints.shape
-    n = count - 1
-    p = np.transpose(joints, (1, 2, 0)).copy()  # (n + 1, d, B); a copy: the passes work in place
-    target = targets.T.copy()  # (d, B)
-    lengths = _norm(np.diff(p, axis=0))  # (n, B)
-    total = lengths.sum(axis=0)
-    scale = np.maximum(np.maximum(total, _norm(target - p[0])), 1.0)
-    tiny = _TINY * scale
-    root_to_obstacle = _norm(setup.centres - p[0][None])  # (K, B)
-    live = root_to_obstacle > setup.radii
-    chains = _Chains(p, target, lengths, tiny, live, bool((lengths <= tiny).any()))
-    has_obstacles = setup.radii.shape[0] > 0
-
-    out_p = p.copy()
-    iterations = np.zeros(batch, dtype=np.int64)
-    status = np.full(batch, _MAX_ITERATIONS, dtype=np.int64)
-    history = np.full((batch, setup.max_iterations + 1), np.nan)
-
-    offset = target - p[0]
-    distance = _norm(offset)
-    inner = np.maximum(0.0, 2.0 * lengths.max(axis=0) - total)
-    out_of_reach = (distance > total) | (distance < inner)
-    error0 = _norm(p[n] - target)
-    history[:, 0] = error0
-
-    # The starting pose is kept if it already meets the tolerance and every constraint.
-    valid0 = _cone_ok(chains, setup) & ~_colliding(p, setup, live)
-    best_p = p.copy()
-    best_error = np.where(valid0, error0, np.inf)
-    done = valid0 & (error0 < setup.tolerance)
-    status[done] = _REACHED
-
-    if shortcut:
-        placed = _unreachable_shortcut(
-            chains, setup, offset, distance, total, inner, out_of_reach & ~done, out_p
-        )
-        history[placed, 1] = _norm(out_p[n] - target)[placed]
-        iterations[placed] = 1
-        status[placed] = _UNREACHABLE
-        done = done | placed
-
-    _unbend_axis_chains(chains, setup, offset, distance, ~done)
-
-    index = np.flatnonzero(~done)
-    active = chains.take(~done) if done.any() else chains
-    best_p_active = best_p[:, :, index]
-    best_error_active = best_error[index]
-    stall = _STALL * setup.tolerance + tiny[index]
-    # Extrapolation (FABRIK only, see _extrapolate): the pose before the last step, which chains may still be
-    # extrapolated (none whose extrapolation once made its error grow), and which were before this step.
-    previous_p = active.p
-    trusted = np.ones(index.size, dtype=bool)
-    moved = np.zeros(index.size, dtype=bool)
-    for iteration in range(1, setup.max_iterations + 1):
-        if index.size == 0:
-            break
-        last_error = history[index, iteration - 1]
-        if extrapolate and iteration >= 2:
-            before = active.p.copy()
-            if iteration >= 3:
-                moved = _extrapolate(
-                    active.p, previous_p, last_error, history[index, iteration - 2], trusted
-                )
-            previous_p = before
-        step(active, setup)
-        error = _norm(active.p[n] - active.target)
-        history[index, iteration] = error
-        if extrapolate:
-            trusted &= ~(moved & (error > last_error))
-        if has_obstacles:
-            # Whether the pose is clear matters only where it would be the best yet or reach the target.
-            improved = (error < best_error_active) | (error < setup.tolerance)
-            if improved.any():
-                clear = ~_colliding(active.p, setup, active.obstacle_live)
-            else:
-                clear = improved
-            better = clear & (error < best_error_active)
-            if better.any():
-                best_p_active[:, :, better] = active.p[:, :, better]
-                best_error_active = np.where(better, error, best_error_active)
-            reached = clear & (error < setup.tolerance)
-        else:
-            reached = error < setup.tolerance
-        stalled = np.abs(last_error - error) < stall
-        finished = reached | stalled | (iteration == setup.max_iterations)
-        if not finished.any():
-            continue
-        rows = index[finished]
-        iterations[rows] = iteration
-        status[rows] = np.where(
-            reached[finished], _REACHED, np.where(stalled[finished], _UNREACHABLE, _MAX_ITERATIONS)
-        )
-        if has_obstacles:
-            # Return the best collision-free pose seen; only if there was none, the last one (still "blocked").
-            use_best = ~reached[finished] & np.isfinite(best_error_active[finished])
-            final = np.where(use_best, best_p_active[:, :, finished], active.p[:, :, finished])
-            out_p[:, :, rows] = final
-            short = ~reached[finished]
-            if short.any():
-                live_rows = active.obstacle_live[:, finished]
-                blocked = short & (
-                    _touching(final, setup, live_rows)
-                    | _target_inside(active.target[:, finished], setup, live_rows)
-                )
-                status[rows] = np.where(blocked, _BLOCKED, status[rows])
-        else:
-            out_p[:, :, rows] = active.p[:, :, finished]
-        keep = ~finished
-        index = index[keep]
-        active = active.take(keep)
-        best_p_active = best_p_active[:, :, keep]
-        best_error_active = best_error_active[keep]
-        stall = stall[keep]
-        previous_p = previous_p[:, :, keep]
-        trusted, moved = trusted[keep], moved[keep]
-
-    final_error = _norm(out_p[n] - target)
-    # A target outside the annulus is unreachable whatever the iterations did (unless an obstacle explains it).
-    status = np.where(
-        out_of_reach & (status != _BLOCKED) & (status != _REACHED), _UNREACHABLE, status
-    )
-    return BatchSolution(
-        joints=np.ascontiguousarray(np.transpose(out_p, (2, 0, 1))),
-        iterations=iterations,
-        error=final_error,
-        status=np.array(STATUSES)[status],
-        error_history=history,
-    )
-
-
-def _run_one(
-    joints: NDArray[np.float64], target: NDArray[np.float64], setup: _Setup, *, extrapolate: bool
-) -> Solution:
-    """:func:`_run` with FABRIK for one chain, on Python floats: the same operations in the same order, so the
-    same bits, iterations and status, without numpy's per-call cost on arrays of one.
-
-    The rare cases (a target outside the annulus, a zero-length link, a straight chain pointing at its target) go
-    to :func:`_run` itself.
-    """
-    p: list[Vec] = joints.tolist()
-    goal: Vec = target.tolist()
-    n = len(p) - 1
-    lengths = [
-        _length([a - b for a, b in zip(q, r, strict=True)]) for q, r in zip(p[1:], p, strict=False)
-    ]
-    # Summed by numpy, as _run sums it (pairwise, not left to right), so the reach tests agree to the bit.
-    total = float(np.add.reduce(np.array(lengths)[:, None], axis=0)[0])
-    offset = [a - b for a, b in zip(goal, p[0], strict=True)]
-    distance = _length(offset)
-    tiny = _TINY * max(max(total, distance), 1.0)
-    inner = max(0.0, 2.0 * max(lengths) - total)
-    end = [a - b for a, b in zip(p[n], p[0], strict=True)]
-    end2 = _dot(end, end)
-    offset2 = distance * distance
-    along = _dot(end, offset)
-    on_line = (end2 * offset2 - along * along) <= 1e-12 * max(end2 * offset2, tiny * tiny)
-    if distance > total or distance < inner or min(lengths) <= tiny or on_line:
-        return _run(
-            joints[None], target[None], setup, _fabrik_step, shortcut=True, extrapolate=extrapolate
-        )[0]
-
-    centres: list[Vec] = setup.centres[:, :, 0].tolist()
-    radii: list[float] = setup.radii[:, 0].tolist()
-    root = p[0]
-    live = [
-        _length([c - r for c, r in zip(centre, root, strict=True)]) > radius
-        for centre, radius in zip(centres, radii, strict=True)
-    ]
-    obstacles = _live_obstacles_one(setup, live, lengths)
-    has_obstacles = bool(radii)
-    root_direction: Vec = setup.root_direction[:, 0].tolist()
-    limits, tolerance = setup.limits, setup.tolerance
-
-    error0 = _length([a - b for a, b in zip(p[n], goal, strict=True)])
-    history = [error0]
-    valid0 = _cone_ok_one(p, lengths, root_direction, limits) and not _colliding_one(
-        p, obstacles, 1.0
-    )
-    if valid0 and error0 < tolerance:
-        return _solution_one(p, goal, 0, _REACHED, history)
-
-    best_p, best_error = [list(q) for q in p], error0 if valid0 else math.inf
-    stall = _STALL * tolerance + tiny
-    previous_p = p
-    trusted, moved = True, False
-    for iteration in range(1, setup.max_iterations + 1):
-        last_error = history[iteration - 1]
-        if extrapolate and iteration >= 2:
-            before = [list(q) for q in p]
-            if iteration >= 3:
-                moved = _extrapolate_one(p, previous_p, last_error, history[iteration - 2], trusted)
-            previous_p = before
-        _fabrik_passes_one(
-            p, goal, lengths, tiny, obstacles, root_direction, limits, zero_links=False
-        )
-        error = _length([a - b for a, b in zip(p[n], goal, strict=True)])
-        history.append(error)
-        if extrapolate:
-            trusted = trusted and not (moved and error > last_error)
-        if has_obstacles:
-            improved = error < best_error or error < tolerance
-            clear = improved and not _colliding_one(p, obstacles, 1.0)
-            if clear and error < best_error:
-                best_p, best_error = [list(q) for q in p], error
-            reached = clear and error < tolerance
-        else:
-            reached = error < tolerance
-        stalled = abs(last_error - error) < stall
-        if not (reached or stalled or iteration == setup.max_iterations):
-            continue
-        status = _REACHED if reached else _UNREACHABLE if stalled else _MAX_ITERATIONS
-        final = p
-        if has_obstacles and not reached:
-            if math.isfinite(best_error):
-                final = best_p
-            inside = any(
-                _length([c - t for c, t in zip(centre, goal, strict=True)]) < radius
-                for centre, radius, _ in obstacles
+    p[n, 0], p[n, 1], p[n, 2] = target[0], target[1], target[2]
+    qx, qy, qz, _ = _unit(p[0, 0] - p[n, 0], p[0, 1] - p[n, 1], p[0, 2] - p[n, 2],
+                          -rest[0], -rest[1], -rest[2], tiny)  # fmt: skip
+    x, y, z = p[n, 0], p[n, 1], p[n, 2]  # the anchor, carried in registers from joint to joint
+    for i in range(n - 1, 0, -1):
+        dx, dy, dz, _ = _unit(p[i, 0] - x, p[i, 1] - y, p[i, 2] - z, qx, qy, qz, tiny)
+        if radii.shape[0] > 0:
+            dx, dy, dz, _ = _deflect(
+                x, y, z, dx, dy, dz, lengths[i], centres, radii, live, tiny, dim
             )
-            if inside or _colliding_one(final, obstacles, 1.0 + 1e-3):
-                status = _BLOCKED
-        return _solution_one(final, goal, iteration, status, history)
-    raise AssertionError("unreachable: the last iteration always finishes")  # pragma: no cover
+        if has_limits and i < n - 1:
+            dx, dy, dz = _clamp_cone(dx, dy, dz, qx, qy, qz, cos_phi, sin_phi, dim)
+        length = lengths[i]
+        x, y, z = x + length * dx, y + length * dy, z + length * dz
+        p[i, 0], p[i, 1], p[i, 2] = x, y, z
+        if not has_zero or length > tiny:
+            qx, qy, qz = dx, dy, dz
 
 
-def _solution_one(p: list[Vec], goal: Vec, iterations: int, status: int, history: Vec) -> Solution:
-    return Solution(
-        joints=np.array(p),
-        iterations=iterations,
-        error=_length([a - b for a, b in zip(p[-1], goal, strict=True)]),
-        status=STATUSES[status],
-        error_history=np.array(history),
-    )
+@numba.njit(cache=True, error_model="numpy")
+def _backward_pass(
+    p: NDArray[np.float64], lengths: NDArray[np.float64], tiny: float,
+    rest: NDArray[np.float64], limits: tuple[bool, float, float], centres: NDArray[np.float64],
+    radii: NDArray[np.float64], live: NDArray[np.bool_], has_zero: bool, dim: int,
+) -> None:  # fmt: skip
+    """Root back on its place, each joint outward toward its current place; limits and obstacles enforced."""
+    has_limits, cos_phi, sin_phi = limits
+    qx, qy, qz = rest[0], rest[1], rest[2]
+    x, y, z = p[0, 0], p[0, 1], p[0, 2]  # the anchor, carried in registers from joint to joint
+    for i in range(1, lengths.shape[0] + 1):
+        dx, dy, dz, _ = _unit(p[i, 0] - x, p[i, 1] - y, p[i, 2] - z, qx, qy, qz, tiny)
+        if has_limits:
+            dx, dy, dz = _clamp_cone(dx, dy, dz, qx, qy, qz, cos_phi, sin_phi, dim)
+        if radii.shape[0] > 0:
+            dx, dy, dz, turned = _deflect(x, y, z, dx, dy, dz, lengths[i - 1], centres, radii, live,
+                                          tiny, dim)  # fmt: skip
+            if turned and has_limits:
+                dx, dy, dz = _clamp_cone(dx, dy, dz, qx, qy, qz, cos_phi, sin_phi, dim)
+        length = lengths[i - 1]
+        x, y, z = x + length * dx, y + length * dy, z + length * dz
+        p[i, 0], p[i, 1], p[i, 2] = x, y, z
+        if not has_zero or length > tiny:
+            qx, qy, qz = dx, dy, dz
 
 
-def _cone_ok_one(
-    p: list[Vec], lengths: Vec, root_direction: Vec, limits: tuple[float, float] | None
+@numba.njit(cache=True, error_model="numpy")
+def _ccd_sweep(
+    p: NDArray[np.float64], target: NDArray[np.float64], tiny: float, rest: NDArray[np.float64],
+    dim: int,
+) -> None:  # fmt: skip
+    """One CCD sweep (Wang & Chen 1991): each joint, end to root, turns what lies beyond it about
+    ``to_end × to_target`` (Rodrigues' formula) so that the end points at the target."""
+    n = p.shape[0] - 1
+    for i in range(n - 1, -1, -1):
+        ox, oy, oz = p[i, 0], p[i, 1], p[i, 2]
+        ex, ey, ez, end_norm = _unit(p[n, 0] - ox, p[n, 1] - oy, p[n, 2] - oz,
+                                     rest[0], rest[1], rest[2], tiny)  # fmt: skip
+        tx, ty, tz, target_norm = _unit(target[0] - ox, target[1] - oy, target[2] - oz,
+                                        ex, ey, ez, tiny)  # fmt: skip
+        if not (end_norm > tiny and target_norm > tiny):
+            continue
+        cos_a = min(max(ex * tx + ey * ty + ez * tz, -1.0), 1.0)
+        kx, ky, kz = ey * tz - ez * ty, ez * tx - ex * tz, ex * ty - ey * tx
+        sin_a = math.sqrt(kx * kx + ky * ky + kz * kz)
+        # (In the plane the axis is ±z; end and target antiparallel turn about z, or in 3D any perpendicular.)
+        kx, ky, kz, _ = _unit(kx, ky, kz, 0.0, 0.0, 1.0, 1e-12)
+        if sin_a <= 1e-12 and dim == 3:
+            kx, ky, kz = _perpendicular(ex, ey, ez, 3)
+        for j in range(i + 1, n + 1):
+            # Rodrigues: v cos a + (k × v) sin a + k (k·v)(1 − cos a)
+            vx, vy, vz = p[j, 0] - ox, p[j, 1] - oy, p[j, 2] - oz
+            dot = (kx * vx + ky * vy + kz * vz) * (1.0 - cos_a)
+            p[j, 0] = ox + vx * cos_a + (ky * vz - kz * vy) * sin_a + kx * dot
+            p[j, 1] = oy + vy * cos_a + (kz * vx - kx * vz) * sin_a + ky * dot
+            p[j, 2] = oz + vz * cos_a + (kx * vy - ky * vx) * sin_a + kz * dot
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _dls_step(
+    p: NDArray[np.float64], target: NDArray[np.float64], lengths: NDArray[np.float64],
+    tiny: float, turns: NDArray[np.float64],
+) -> None:  # fmt: skip
+    """One damped-least-squares step on joint angles (Wampler 1986; Buss 2004): ``Δθ = Jᵀ(JJᵀ + λ²I)⁻¹e``.
+
+    Ball joints: ``J_i = −[l_i]×`` with ``l_i = p_n − p_i``, so ``JJᵀ = Σ |l_i|²I − l_i l_iᵀ`` and
+    ``Δθ_i = l_i × y`` for ``y = (JJᵀ + λ²I)⁻¹e``. In the plane (z = 0) every ``Δθ_i`` is along z and the step is the
+    planar one of hinges, ``J_i = perp(l_i)``. The error is clamped to the mean link length and
+    ``λ = 0.1 × mean link length`` (Buss 2004). Segment j turns by ``R(Δθ_0) … R(Δθ_j)``, the rotations of the
+    joints' rotation vectors (in the plane: by their summed angle). ``turns`` is (n + 1, 3) scratch.
+    """
+    n = lengths.shape[0]
+    endx, endy, endz = p[n, 0], p[n, 1], p[n, 2]
+    cap = max(np.sum(lengths) / n, tiny)
+    ex, ey, ez = target[0] - endx, target[1] - endy, target[2] - endz
+    shrink = min(1.0, cap / max(math.sqrt(ex * ex + ey * ey + ez * ez), tiny))
+    ex, ey, ez = ex * shrink, ey * shrink, ez * shrink
+    # JJᵀ + λ²I, symmetric: a00 a01 a02 / a11 a12 / a22
+    a00 = a11 = a22 = (_DLS_DAMPING * cap) ** 2
+    a01 = a02 = a12 = 0.0
+    for i in range(n):
+        lx, ly, lz = endx - p[i, 0], endy - p[i, 1], endz - p[i, 2]
+        l2 = lx * lx + ly * ly + lz * lz
+        a00, a11, a22 = a00 + l2 - lx * lx, a11 + l2 - ly * ly, a22 + l2 - lz * lz
+        a01, a02, a12 = a01 - lx * ly, a02 - lx * lz, a12 - ly * lz
+    # Cramer's rule on the symmetric positive-definite 3 × 3 matrix
+    c00, c01, c02 = a11 * a22 - a12 * a12, a02 * a12 - a01 * a22, a01 * a12 - a02 * a11
+    c11, c12, c22 = a00 * a22 - a02 * a02, a01 * a02 - a00 * a12, a00 * a11 - a01 * a01
+    det = a00 * c00 + a01 * c01 + a02 * c02
+    yx = (c00 * ex + c01 * ey + c02 * ez) / det
+    yy = (c01 * ex + c11 * ey + c12 * ez) / det
+    yz = (c02 * ex + c12 * ey + c22 * ez) / det
+    for i in range(n):  # Δθ_i = J_iᵀ y = l_i × y
+        lx, ly, lz = endx - p[i, 0], endy - p[i, 1], endz - p[i, 2]
+        turns[i, 0], turns[i, 1], turns[i, 2] = (
+            ly * yz - lz * yy,
+            lz * yx - lx * yz,
+            lx * yy - ly * yx,
+        )
+    # Turn every segment by the joints up to it and re-chain from the root.
+    turn, step, product = np.eye(3), np.empty((3, 3)), np.empty((3, 3))
+    ox, oy, oz = p[0, 0], p[0, 1], p[0, 2]
+    for i in range(n):
+        sx, sy, sz = p[i + 1, 0] - ox, p[i + 1, 1] - oy, p[i + 1, 2] - oz
+        ox, oy, oz = p[i + 1, 0], p[i + 1, 1], p[i + 1, 2]
+        theta = math.sqrt(turns[i, 0] ** 2 + turns[i, 1] ** 2 + turns[i, 2] ** 2)
+        if theta > 1e-15:
+            kx, ky, kz = turns[i, 0] / theta, turns[i, 1] / theta, turns[i, 2] / theta
+            s, c = math.sin(theta), math.cos(theta)
+            # Rodrigues: R = cos θ I + sin θ [k]× + (1 − cos θ) k kᵀ
+            for r in range(3):
+                for q in range(3):
+                    step[r, q] = (1.0 - c) * turns[i, r] * turns[i, q] / (theta * theta)
+                step[r, r] += c
+            step[0, 1], step[0, 2], step[1, 2] = (
+                step[0, 1] - s * kz,
+                step[0, 2] + s * ky,
+                step[1, 2] - s * kx,
+            )
+            step[1, 0], step[2, 0], step[2, 1] = (
+                step[1, 0] + s * kz,
+                step[2, 0] - s * ky,
+                step[2, 1] + s * kx,
+            )
+            for r in range(3):
+                for q in range(3):
+                    product[r, q] = (
+                        turn[r, 0] * step[0, q] + turn[r, 1] * step[1, q] + turn[r, 2] * step[2, q]
+                    )
+            turn[:, :] = product
+        p[i + 1, 0] = p[i, 0] + turn[0, 0] * sx + turn[0, 1] * sy + turn[0, 2] * sz
+        p[i + 1, 1] = p[i, 1] + turn[1, 0] * sx + turn[1, 1] * sy + turn[1, 2] * sz
+        p[i + 1, 2] = p[i, 2] + turn[2, 0] * sx + turn[2, 1] * sy + turn[2, 2] * sz
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _cone_ok(
+    p: NDArray[np.float64], tiny: float, rest: NDArray[np.float64], cos_phi: float
 ) -> bool:
-    """:func:`_cone_ok` for one chain with no zero-length link."""
-    if limits is None:
-        return True
-    bound = limits[0] - 1e-12
-    previous = root_direction
-    for i, length in enumerate(lengths):
-        direction = [(a - b) / length for a, b in zip(p[i + 1], p[i], strict=True)]
-        if not _dot(direction, previous) >= bound:
+    """Whether every segment lies within its cone (zero-length segments have none and are skipped)."""
+    qx, qy, qz = rest[0], rest[1], rest[2]
+    for i in range(p.shape[0] - 1):
+        dx, dy, dz, norm = _unit(p[i + 1, 0] - p[i, 0], p[i + 1, 1] - p[i, 1],
+                                 p[i + 1, 2] - p[i, 2], qx, qy, qz, tiny)  # fmt: skip
+        if norm <= tiny:
+            continue
+        if not dx * qx + dy * qy + dz * qz >= cos_phi - _CONE_SLACK:
             return False
-        previous = direction
+        qx, qy, qz = dx, dy, dz
     return True
 
 
-def _colliding_one(p: list[Vec], obstacles: list[tuple[Vec, float, float]], inflate: float) -> bool:
-    """:func:`_colliding` (``inflate`` = 1) or :func:`_touching` (1 + 1e-3) for one chain.
-
-    ``obstacles`` are the chain's live ones as :func:`_deflect_one` takes them; a pair farther apart than ``far²``
-    (which has room for the 0.1 % inflation) cannot touch and is skipped. The rest is computed as the batch path
-    does, in the same order, so the answer is the same.
-    """
-    three = len(p[0]) == 3
-    for i in range(len(p) - 1):
-        x0, y0 = p[i][0], p[i][1]
-        sx, sy = p[i + 1][0] - x0, p[i + 1][1] - y0
-        z0 = p[i][2] if three else 0.0
-        sz = p[i + 1][2] - z0 if three else 0.0
-        seg2 = sx * sx + sy * sy + sz * sz if three else sx * sx + sy * sy
-        divisor = seg2 if seg2 > 0.0 else 1.0
-        for centre, radius, far2 in obstacles:
-            rx, ry = centre[0] - x0, centre[1] - y0
-            if three:
-                rz = centre[2] - z0
-                if rx * rx + ry * ry + rz * rz > far2:
-                    continue
-                t = min(max((rx * sx + ry * sy + rz * sz) / divisor, 0.0), 1.0)
-                gx, gy, gz = rx - t * sx, ry - t * sy, rz - t * sz
-                dist2 = gx * gx + gy * gy + gz * gz
-            else:
-                if rx * rx + ry * ry > far2:
-                    continue
-                t = min(max((rx * sx + ry * sy) / divisor, 0.0), 1.0)
-                gx, gy = rx - t * sx, ry - t * sy
-                dist2 = gx * gx + gy * gy
-            grown = radius * inflate
-            if dist2 < grown * grown:
+@numba.njit(cache=True, error_model="numpy")
+def _colliding(
+    p: NDArray[np.float64], centres: NDArray[np.float64], radii: NDArray[np.float64],
+    live: NDArray[np.bool_], inflate: float,
+) -> bool:  # fmt: skip
+    """Whether any segment passes within ``inflate`` × radius of a live obstacle's centre."""
+    for i in range(p.shape[0] - 1):
+        x, y, z = p[i, 0], p[i, 1], p[i, 2]
+        sx, sy, sz = p[i + 1, 0] - x, p[i + 1, 1] - y, p[i + 1, 2] - z
+        seg2 = sx * sx + sy * sy + sz * sz
+        for k in range(radii.shape[0]):
+            if not live[k]:
+                continue
+            rx, ry, rz = centres[k, 0] - x, centres[k, 1] - y, centres[k, 2] - z
+            grown = radii[k] * inflate
+            # |c − a| ≥ |s| + r, so no point of the segment is within r: (|s| + r)² ≤ 2(|s|² + r²)
+            if rx * rx + ry * ry + rz * rz >= 2.0 * (seg2 + grown * grown):
+                continue
+            t = min(max((rx * sx + ry * sy + rz * sz) / (seg2 if seg2 > 0.0 else 1.0), 0.0), 1.0)
+            gx, gy, gz = rx - t * sx, ry - t * sy, rz - t * sz
+            if gx * gx + gy * gy + gz * gz < grown * grown:
                 return True
     return False
 
 
-def _extrapolate_one(
-    p: list[Vec], previous_p: list[Vec], error: float, previous_error: float, trusted: bool
-) -> bool:
-    """:func:`_extrapolate` for one chain, in place."""
-    ratio = error / max(previous_error, _TINY)
-    slow = _EXTRAPOLATION_MIN_RATIO <= ratio < 1.0 and trusted
-    weight = ratio / max(1.0 - ratio, ratio / _EXTRAPOLATION_CAP) if slow else 0.0
-    for joint, before in zip(p, previous_p, strict=True):
-        joint[:] = [a + weight * (a - b) for a, b in zip(joint, before, strict=True)]
-    return slow
+@numba.njit(cache=True, error_model="numpy")
+def _admissible(
+    p: NDArray[np.float64], tiny: float, rest: NDArray[np.float64], has_limits: bool,
+    cos_phi: float, centres: NDArray[np.float64], radii: NDArray[np.float64],
+    live: NDArray[np.bool_],
+) -> bool:  # fmt: skip
+    """Whether the pose keeps every joint limit and cuts no live obstacle."""
+    if has_limits and not _cone_ok(p, tiny, rest, cos_phi):
+        return False
+    return not _colliding(p, centres, radii, live, 1.0)
 
 
-def _extrapolate(
-    p: NDArray[np.float64],
-    previous_p: NDArray[np.float64],
-    error: NDArray[np.float64],
-    previous_error: NDArray[np.float64],
-    trusted: NDArray[np.bool_],
-) -> NDArray[np.bool_]:
-    """Move the (n + 1, d, B) joints ``p`` on along their last step, in place, by the rest of a geometric series.
-
-    Where the end-effector error shrank by a ratio ``r < 1`` in the last iteration, FABRIK converges linearly at
-    about that ratio (near cone limits ``r`` is 0.8–0.95, so tens of iterations), and the steps still to come sum to
-    ``r / (1 − r)`` times the last one. The joints are moved on by that much (at most :data:`_EXTRAPOLATION_CAP`
-    steps) before the next iteration, as Aitken's Δ² extrapolation does for a linearly converging sequence. Only
-    the starting guess of the next passes moves: the passes still place every joint at its link's length, inside
-    its cone and clear of obstacles. Where the error grew, or shrank fast already (``r`` below
-    :data:`_EXTRAPOLATION_MIN_RATIO`, plain FABRIK needs only a few more iterations), nothing is moved; nor in
-    chains not ``trusted`` (B,): the caller stops extrapolating a chain once an extrapolation made its error grow
-    (a target the limits put out of reach, where the error tends to a positive value and ``r`` to 1), so plain
-    FABRIK settles it at its fixed point. Returns (B,) which chains were moved.
-    """
-    ratio = error / np.maximum(previous_error, _TINY)
-    cap = _EXTRAPOLATION_CAP
-    slow = (ratio >= _EXTRAPOLATION_MIN_RATIO) & (ratio < 1.0) & trusted
-    weight = np.where(slow, ratio / np.maximum(1.0 - ratio, ratio / cap), 0.0)
-    p += weight * (p - previous_p)
-    return slow
+@numba.njit(cache=True, error_model="numpy")
+def _copy(source: NDArray[np.float64], destination: NDArray[np.float64]) -> None:
+    for i in range(source.shape[0]):
+        destination[i, 0], destination[i, 1], destination[i, 2] = (
+            source[i, 0],
+            source[i, 1],
+            source[i, 2],
+        )
 
 
-def _target_inside(
-    target: NDArray[np.float64], setup: _Setup, live: NDArray[np.bool_]
-) -> NDArray[np.bool_]:
-    dist = _norm(setup.centres - target[None])  # (K, B)
-    return np.any((dist < setup.radii) & live, axis=0)
+@numba.njit(cache=True, error_model="numpy")
+def _end_error(p: NDArray[np.float64], target: NDArray[np.float64]) -> float:
+    n = p.shape[0] - 1
+    x, y, z = p[n, 0] - target[0], p[n, 1] - target[1], p[n, 2] - target[2]
+    return math.sqrt(x * x + y * y + z * z)
 
 
-def _unreachable_shortcut(
-    chains: _Chains,
-    setup: _Setup,
-    offset: NDArray[np.float64],
-    distance: NDArray[np.float64],
-    total: NDArray[np.float64],
-    inner: NDArray[np.float64],
-    candidates: NDArray[np.bool_],
-    out_p: NDArray[np.float64],
-) -> NDArray[np.bool_]:
-    """Place out-of-reach chains in their closest pose at once, where limits and obstacles allow it.
-
-    Beyond the reach: every link along the root–target direction. Inside the inner hole: the longest link toward the
-    target and the others folded back, so the end rests on the inner boundary. Returns (B,) which chains it placed.
-    """
-    if not candidates.any():
-        return candidates
-    p, lengths = chains.p, chains.lengths
-    n = lengths.shape[0]
-    direction, _ = _unit(offset, setup.root_direction * np.ones_like(chains.tiny), chains.tiny)
-    beyond = distance > total
-    longest = np.argmax(lengths, axis=0)
-    sign = np.where(beyond | (np.arange(n)[:, None] == longest[None]), 1.0, -1.0)  # (n, B)
-    reach = np.cumsum(sign * lengths, axis=0)  # (n, B)
-    pose = p.copy()
-    pose[1:] = p[0] + reach[:, None, :] * direction
-    ok = candidates.copy()
-    if setup.limits is not None:
-        # A folded chain turns by π; a straight one only at the root.
-        root_cos = _dot_d(direction, setup.root_direction)
-        ok &= beyond & (root_cos >= setup.limits[0])
-    if setup.radii.shape[0] > 0:
-        ok &= ~_colliding(pose, setup, chains.obstacle_live)
-    out_p[:, :, ok] = pose[:, :, ok]
-    return ok
+@numba.njit(cache=True, error_model="numpy")
+def _place_on_line(
+    pose: NDArray[np.float64], root: NDArray[np.float64], lengths: NDArray[np.float64],
+    ux: float, uy: float, uz: float, fold: bool,
+) -> None:  # fmt: skip
+    """The chain along the unit direction u from the root: straight, or (``fold``) with its longest link toward u
+    and the others folded back, so the end rests on the inner boundary of the reach."""
+    longest = np.argmax(lengths)
+    reach = 0.0
+    pose[0, 0], pose[0, 1], pose[0, 2] = root[0], root[1], root[2]
+    for i in range(lengths.shape[0]):
+        reach += lengths[i] if not fold or i == longest else -lengths[i]
+        pose[i + 1, 0], pose[i + 1, 1], pose[i + 1, 2] = (
+            root[0] + reach * ux,
+            root[1] + reach * uy,
+            root[2] + reach * uz,
+        )
 
 
-def _unbend_axis_chains(
-    chains: _Chains,
-    setup: _Setup,
-    offset: NDArray[np.float64],
-    distance: NDArray[np.float64],
-    todo: NDArray[np.bool_],
-) -> None:
-    """Bend straight chains whose target lies on their own line into a gentle arc, so the passes can bend them."""
-    p, tiny = chains.p, chains.tiny
-    # Cheap test first: a straight chain's end lies on the root–target line (or on the root).
-    end = p[-1] - p[0]
-    end2 = _dot_d(end, end)
-    offset2 = distance * distance
-    along = _dot_d(end, offset)
-    scale2 = np.maximum(end2 * offset2, tiny * tiny)
-    if not (todo & ((end2 * offset2 - along * along) <= 1e-12 * scale2)).any():
-        return
-    segments = np.diff(p, axis=0)  # (n, d, B)
-    norms = _norm(segments)
-    first = np.argmax(norms > tiny, axis=0)  # first segment with a direction
-    axis_raw = np.take_along_axis(segments, first[None, None, :], axis=0)[0]
-    axis, _ = _unit(axis_raw, setup.root_direction * np.ones_like(tiny), tiny)
-    along = _dot_d(segments, axis)  # (n, B)
-    off_axis = _norm(segments - along[:, None, :] * axis)  # (n, B)
-    straight = np.all(off_axis <= 1e-9 * np.maximum(norms, tiny), axis=0)
-    target_off = _norm(offset - _dot_d(offset, axis) * axis)
-    on_axis = target_off <= 1e-9 * np.maximum(distance, 1.0)
-    bend = todo & straight & on_axis
-    if not bend.any():
-        return
-    step = 0.1 if setup.limits is None else min(0.1, 0.5 * math.acos(setup.limits[0]))
+@numba.njit(cache=True, error_model="numpy")
+def _unbend(
+    p: NDArray[np.float64], target: NDArray[np.float64], lengths: NDArray[np.float64],
+    tiny: float, rest: NDArray[np.float64], has_limits: bool, cos_phi: float, dim: int,
+) -> None:  # fmt: skip
+    """Bend a straight chain whose target lies on its own line into a gentle symmetric arc, so the passes can bend
+    it (every interior joint leaves the line; an arc starting along it would leave p_1 on it)."""
+    n = p.shape[0] - 1
+    ax, ay, az = rest[0], rest[1], rest[2]
+    for i in range(n):  # the axis: the first segment with a direction
+        dx, dy, dz = p[i + 1, 0] - p[i, 0], p[i + 1, 1] - p[i, 1], p[i + 1, 2] - p[i, 2]
+        ux, uy, uz, norm = _unit(dx, dy, dz, ax, ay, az, tiny)
+        if norm > tiny:
+            ax, ay, az = ux, uy, uz
+            break
+    for i in range(n):
+        dx, dy, dz = p[i + 1, 0] - p[i, 0], p[i + 1, 1] - p[i, 1], p[i + 1, 2] - p[i, 2]
+        along = dx * ax + dy * ay + dz * az
+        ox, oy, oz = dx - along * ax, dy - along * ay, dz - along * az
+        if math.sqrt(ox * ox + oy * oy + oz * oz) > 1e-9 * max(lengths[i], tiny):
+            return  # not straight
+    tx, ty, tz = target[0] - p[0, 0], target[1] - p[0, 1], target[2] - p[0, 2]
+    along = tx * ax + ty * ay + tz * az
+    ox, oy, oz = tx - along * ax, ty - along * ay, tz - along * az
+    distance = math.sqrt(tx * tx + ty * ty + tz * tz)
+    if math.sqrt(ox * ox + oy * oy + oz * oz) > 1e-9 * max(distance, 1.0):
+        return  # the target is off the chain's line: the passes bend it
+    step = 0.1 if not has_limits else min(0.1, 0.5 * math.acos(cos_phi))
     if step <= 0.0:
         return
-    side = _perpendicular(axis)
-    # A symmetric arc: every interior joint leaves the line (an arc starting along it leaves p_1 on it).
-    count = segments.shape[0]
-    angle = step * (np.arange(count) - 0.5 * (count - 1))[:, None]  # (n, 1)
-    directions = np.cos(angle)[:, None, :] * axis + np.sin(angle)[:, None, :] * side  # (n, d, B)
-    arc = p[0] + np.cumsum(norms[:, None, :] * directions, axis=0)
-    p[1:] = np.where(bend, arc, p[1:])
+    sx, sy, sz = _perpendicular(ax, ay, az, dim)
+    for i in range(n):
+        angle = step * (i - 0.5 * (n - 1))
+        c, s = math.cos(angle) * lengths[i], math.sin(angle) * lengths[i]
+        p[i + 1, 0] = p[i, 0] + c * ax + s * sx
+        p[i + 1, 1] = p[i, 1] + c * ay + s * sy
+        p[i + 1, 2] = p[i, 2] + c * az + s * sz
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _extrapolate(
+    p: NDArray[np.float64], previous: NDArray[np.float64], error: float, previous_error: float,
+    allowed: bool,
+) -> bool:  # fmt: skip
+    """Move the joints on along their last step, in place, by the rest of a geometric series; ``previous`` (the
+    pose before the last step) becomes the pose before this move.
+
+    Where the end-effector error shrank by a ratio ``r`` in [0.5, 1) in the last iteration, FABRIK converges
+    linearly at about that ratio, and the steps still to come sum to ``r / (1 − r)`` times the last one (Aitken's
+    Δ² extrapolation of a linearly converging sequence), capped at 8 steps. Only the next passes' starting guess
+    moves: they still place every joint at its link's length, inside its cone and clear of obstacles. Nothing moves
+    unless ``allowed``. Returns whether it moved the joints.
+    """
+    ratio = error / max(previous_error, _TINY)
+    slow = allowed and _EXTRAPOLATION_MIN_RATIO <= ratio < 1.0
+    if not slow:  # (``previous`` is not yet set on the first call: only copy into it)
+        _copy(p, previous)
+        return False
+    weight = ratio / max(1.0 - ratio, ratio / _EXTRAPOLATION_CAP)
+    for i in range(p.shape[0]):
+        for c in range(3):
+            now = p[i, c]
+            p[i, c] = now + weight * (now - previous[i, c])
+            previous[i, c] = now
+    return True
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _solve_chain(
+    p: NDArray[np.float64], target: NDArray[np.float64], params: NDArray[np.float64],
+    flags: NDArray[np.int64], rest: NDArray[np.float64], centres: NDArray[np.float64],
+    radii: NDArray[np.float64], lengths: NDArray[np.float64], live: NDArray[np.bool_],
+    best: NDArray[np.float64], previous: NDArray[np.float64], before: NDArray[np.float64],
+    out_p: NDArray[np.float64], history: NDArray[np.float64],
+) -> tuple[int, int, float]:  # fmt: skip
+    """Solve one chain, starting from ``p`` (n + 1, 3), which it works on in place.
+
+    Writes the returned pose to ``out_p`` and the iterates' errors to ``history`` (max_iterations + 1,), which it
+    leaves NaN past the last iteration; ``lengths`` (n,), ``live`` (K,), ``best``, ``previous`` and ``before``
+    (n + 1, 3) are scratch. Returns (iterations, status, error of the returned pose).
+    """
+    tolerance, cos_phi, sin_phi = params[0], params[1], params[2]
+    max_iterations, dim, solver = flags[0], flags[1], flags[2]
+    extrapolate = flags[3] != 0 and solver == _FABRIK
+    has_limits = flags[4] != 0
+    limits = (has_limits, cos_phi, sin_phi)
+    n = p.shape[0] - 1
+    history[:] = np.nan
+
+    total, has_zero = 0.0, False
+    for i in range(n):
+        dx, dy, dz = p[i + 1, 0] - p[i, 0], p[i + 1, 1] - p[i, 1], p[i + 1, 2] - p[i, 2]
+        lengths[i] = math.sqrt(dx * dx + dy * dy + dz * dz)
+        total += lengths[i]
+    ox, oy, oz = target[0] - p[0, 0], target[1] - p[0, 1], target[2] - p[0, 2]
+    distance = math.sqrt(ox * ox + oy * oy + oz * oz)
+    tiny = _TINY * max(total, distance, 1.0)
+    for i in range(n):
+        has_zero = has_zero or lengths[i] <= tiny
+    inner = max(0.0, 2.0 * np.max(lengths) - total)
+    beyond = distance > total + tiny
+    fold = distance < inner - tiny
+    out_of_reach = beyond or fold
+    any_live = False
+    for k in range(radii.shape[0]):
+        live[k] = (centres[k, 0] - p[0, 0]) ** 2 + (centres[k, 1] - p[0, 1]) ** 2 + (
+            centres[k, 2] - p[0, 2]
+        ) ** 2 > radii[k] * radii[k]
+        any_live = any_live or live[k]
+    constrained = has_limits or any_live
+
+    error = _end_error(p, target)
+    history[0] = error
+    _copy(p, best)
+    best_error = np.inf
+    if _admissible(p, tiny, rest, has_limits, cos_phi, centres, radii, live):
+        best_error = error
+        if error < tolerance:
+            _copy(p, out_p)
+            return 0, _REACHED, error
+
+    if solver == _FABRIK and (out_of_reach or distance >= total - tolerance - tiny):
+        # The closest pose to a target out of reach; the straight pose toward one within tolerance of full reach.
+        ux, uy, uz, _ = _unit(ox, oy, oz, rest[0], rest[1], rest[2], tiny)
+        _place_on_line(before, p[0], lengths, ux, uy, uz, fold)
+        candidate = _end_error(before, target)
+        # Within tolerance (ΣL − r ≤ tolerance, to rounding; also for tolerance 0 at exactly ΣL) it reaches.
+        if _admissible(before, tiny, rest, has_limits, cos_phi, centres, radii, live):
+            if candidate <= tolerance + tiny or out_of_reach:
+                _copy(before, out_p)
+                history[1] = candidate
+                return 1, _REACHED if candidate <= tolerance + tiny else _UNREACHABLE, candidate
+
+    _unbend(p, target, lengths, tiny, rest, has_limits, cos_phi, dim)
+    stall = _STALL * tolerance + tiny
+    progress = _PROGRESS * tolerance + tiny
+    stall_applies = constrained or out_of_reach
+    trusted, moved, reached, stalled = True, False, False, False
+    count, mark_iteration, mark_error = 0, 0, best_error
+    for iteration in range(1, max_iterations + 1):
+        count = iteration
+        last_error = history[iteration - 1]
+        if extrapolate and iteration >= 2:  # from the third iteration on, and while trusted
+            allowed = iteration >= 3 and trusted
+            moved = _extrapolate(p, previous, last_error, history[iteration - 2], allowed)
+        if solver == _FABRIK:
+            _forward_pass(
+                p, target, lengths, tiny, rest, limits, centres, radii, live, has_zero, dim
+            )
+        elif solver == _CCD:
+            _ccd_sweep(p, target, tiny, rest, dim)
+        else:
+            _dls_step(p, target, lengths, tiny, before)
+        _backward_pass(p, lengths, tiny, rest, limits, centres, radii, live, has_zero, dim)
+        error = _end_error(p, target)
+        history[iteration] = error
+        # A chain whose extrapolation made its error grow (a target the limits keep away, r → 1) is left to plain
+        # FABRIK from then on, which settles at its fixed point.
+        trusted = trusted and not (moved and error > last_error)
+        # Every iterate ends on the backward pass, whose last word on each segment is the cone clamp: it keeps the
+        # limits by construction, and only an obstacle can still be cut.
+        if (error < best_error or error < tolerance) and (
+            not any_live or not _colliding(p, centres, radii, live, 1.0)
+        ):
+            if error < best_error:
+                _copy(p, best)
+                best_error = error
+            reached = error < tolerance
+        if best_error < mark_error - progress:
+            mark_iteration, mark_error = iteration, best_error
+        stalled = stall_applies and (
+            abs(last_error - error) < stall or iteration - mark_iteration >= _PATIENCE
+        )
+        if reached or stalled:
+            break
+
+    if (
+        reached or best_error == np.inf
+    ):  # reached: this iterate is the best; none admissible: the last
+        _copy(p, out_p)
+    else:
+        _copy(best, out_p)
+    final_error = _end_error(out_p, target)
+    if reached:
+        return count, _REACHED, final_error
+    if out_of_reach:
+        return count, _UNREACHABLE, final_error
+    if any_live:
+        for k in range(radii.shape[0]):
+            inside = (
+                (centres[k, 0] - target[0]) ** 2 + (centres[k, 1] - target[1]) ** 2
+                + (centres[k, 2] - target[2]) ** 2 < radii[k] * radii[k]
+            )  # fmt: skip
+            if live[k] and inside:
+                return count, _BLOCKED, final_error
+        if _colliding(out_p, centres, radii, live, 1.0 + _TOUCH):
+            return count, _BLOCKED, final_error
+    return count, _LIMITED if stalled else _MAX_ITERATIONS, final_error
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _solve_rows(
+    lo: int, hi: int, p: NDArray[np.float64], target: NDArray[np.float64],
+    params: NDArray[np.float64], flags: NDArray[np.int64], rest: NDArray[np.float64],
+    centres: NDArray[np.float64], radii: NDArray[np.float64], out_p: NDArray[np.float64],
+    history: NDArray[np.float64], iterations: NDArray[np.int64], status: NDArray[np.int64],
+    error: NDArray[np.float64],
+) -> None:  # fmt: skip
+    """Solve rows ``lo`` to ``hi`` of a batch (p (B, n + 1, 3), target (B, 3)) with one set of scratch arrays."""
+    count = p.shape[1]
+    lengths = np.empty(count - 1)
+    live = np.empty(radii.shape[0], dtype=np.bool_)
+    best, previous, before = np.empty((count, 3)), np.empty((count, 3)), np.empty((count, 3))
+    for b in range(lo, hi):
+        iterations[b], status[b], error[b] = _solve_chain(
+            p[b], target[b], params, flags, rest, centres, radii, lengths, live, best, previous,
+            before, out_p[b], history[b],
+        )  # fmt: skip
+
+
+@numba.njit(cache=True, error_model="numpy", parallel=True)
+def _solve_parallel(
+    chunks: int, p: NDArray[np.float64], target: NDArray[np.float64],
+    params: NDArray[np.float64], flags: NDArray[np.int64], rest: NDArray[np.float64],
+    centres: NDArray[np.float64], radii: NDArray[np.float64], out_p: NDArray[np.float64],
+    history: NDArray[np.float64], iterations: NDArray[np.int64], status: NDArray[np.int64],
+    error: NDArray[np.float64],
+) -> None:  # fmt: skip
+    """:func:`_solve_rows` over a whole batch, in ``chunks`` contiguous chunks spread over numba's threads."""
+    batch = p.shape[0]
+    for c in numba.prange(chunks):
+        _solve_rows(c * batch // chunks, (c + 1) * batch // chunks, p, target, params, flags, rest,
+                    centres, radii, out_p, history, iterations, status, error)  # fmt: skip

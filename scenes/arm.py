@@ -259,9 +259,12 @@ outwards. Repeat until |pₙ − target| < tolerance. No angles, no matrices.
 
 **Limits.** Each segment stays within a cone of the chosen half-angle around the previous one (the first around
 the vertical), clamped inside each pass. **Obstacles** (circles in the plane, spheres in 3D): a segment that would
-cut one is turned about its anchor by the least angle until it just clears it; "blocked" means the chain rests
-against one short of the target. **Reach**: only targets with max(0, 2·max L − ΣL) ≤ |target − root| ≤ ΣL can be
-reached; beyond, the chain stretches straight toward the target at once.
+cut one is turned about its anchor by the least angle until it just clears it. The solver returns the best pose
+it saw that keeps every limit and clears every obstacle. **Status**: "reached" (within the tolerance);
+"unreachable" (the target lies outside the reach annulus max(0, 2·max L − ΣL) ≤ |target − root| ≤ ΣL; the chain
+stretches straight toward it at once); "blocked" (within reach, but the chain rests against an obstacle short of it, or the
+target is inside one); "limited" (within reach, but the joint limits hold the chain at a fixed point short of
+it); "max_iterations" (still converging at the cap).
 
 **Compared with.** CCD (turn each joint, end to root, to aim the end at the target) and damped-least-squares
 Jacobian IK, Δθ = Jᵀ(JJᵀ + λ²I)⁻¹e. The paper's Table 1 (10 joints): FABRIK 15.5 iterations, CCD 26.3, DLS 999.

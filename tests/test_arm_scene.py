@@ -305,3 +305,19 @@ def test_clicking_in_the_plane_places_the_target(
             what="the chain to follow",
         )
         np.testing.assert_allclose(np.asarray(scene.target_gizmo.position), (-0.5, 0.0, 1.0))
+
+
+def test_a_target_the_limits_keep_away_reads_limited_not_unreachable(scene: ArmScene) -> None:
+    """Issue 8: a target inside the reach that 5° cones cannot bend to is "limited", with the best pose seen."""
+    scene.obstacle_count.value = 0
+    scene.limits.value = True
+    scene.half_angle.value = 5.0
+    report = scene.report
+    assert report is not None
+    assert np.linalg.norm(TARGET_START) < 6 * 0.25  # inside the reach
+    assert report.result.status == "limited"
+    assert "status **limited**" in scene.readout.content
+    # The starting pose (the last frame's) breaks the new limits; of the iterates, the best comes back.
+    assert report.result.error <= report.result.error_history[1:].min()
+    angles = fabrik.joint_angles(scene.pose[:, [0, 2]], [0.0, 1.0])
+    assert np.all(angles <= math.radians(5.0) + 1e-6)

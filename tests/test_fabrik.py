@@ -4,8 +4,13 @@ from __future__ import annotations
 
 import itertools
 import math
+import os
+import subprocess
+import sys
+from pathlib import Path
 from typing import Any
 
+import ik_reference
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -119,7 +124,8 @@ def test_targets_beyond_reach_give_a_straight_chain_at_once(
     direction = random_direction(rng, d)
     target = joints[0] + direction * factor * lengths.sum()
     result = fabrik.solve(joints, target)
-    assert result.status == "unreachable"
+    # Issue 8: a straight pose within the tolerance of the target reaches it, even from beyond the reach.
+    assert result.status == ("reached" if result.error <= 1e-3 else "unreachable")
     assert result.iterations <= 1
     expected = joints[0] + np.concatenate([[0.0], np.cumsum(lengths)])[:, None] * direction
     np.testing.assert_allclose(result.joints, expected, atol=1e-9 * lengths.sum())
@@ -408,14 +414,16 @@ def test_plain_fabrik_is_still_available_and_slower_near_the_limits() -> None:
 
 
 @pytest.mark.parametrize("d", [2, 3])
-def test_targets_the_limits_put_out_of_reach_settle_unreachable_before_the_cap(d: int) -> None:
+def test_targets_the_limits_put_out_of_reach_settle_limited_before_the_cap(d: int) -> None:
+    """Within the reach annulus but too far round for the limits: "limited" (issue 8: "unreachable" is only for
+    targets outside the annulus), at a fixed point well before the cap, with the best pose seen."""
     joints = np.zeros((7, d))
     joints[:, -1] = 0.5 * np.arange(7.0)  # straight up, reach 3
     for sideways in (1.0, 2.0, -1.5):  # within reach, but too far round for six joints of 0.25 rad
         target = np.zeros(d)
         target[0], target[-1] = sideways, 0.2
         result = fabrik.solve(joints, target, cone_half_angle_rad=0.25, max_iterations=200)
-        assert result.status == "unreachable"
+        assert result.status == "limited"
         assert result.iterations < 50
         assert np.all(fabrik.joint_angles(result.joints) <= 0.25 + 1e-6)
         assert result.error == pytest.approx(result.error_history.min(), rel=0.05)
@@ -496,3 +504,377 @@ def test_two_bone_equals_fabrik_at_two_links(d: int, seed: int, where: float) ->
 def test_invalid_input_names_the_argument(call: object, name: str) -> None:
     with pytest.raises(ValueError, match=name.replace("[", r"\[").replace("]", r"\]")):
         call()  # type: ignore[operator]
+
+
+# ------------------------------------------------------------------------------------------------ plain references
+SOLVERS: tuple[fabrik.Solver, ...] = ("fabrik", "ccd", "jacobian_dls")
+
+
+def reachable_target(
+    rng: np.random.Generator, joints: NDArray[np.float64], where: float
+) -> NDArray[np.float64]:
+    """A target inside the reach annulus, ``where`` ∈ [0, 1] of the way out, clear of both edges."""
+    inner, outer = fabrik.reach_limits(fabrik.link_lengths(joints))
+    radius = inner + (0.05 + 0.9 * where) * (outer - inner)
+    return joints[0] + random_direction(rng, joints.shape[1]) * radius
+
+
+@PROPERTY
+@given(chains, st.floats(0.0, 1.0), st.sampled_from([None, 0.4, 1.2]), st.integers(1, 20))
+def test_fabrik_iterates_are_the_papers_algorithm(
+    chain: tuple[int, int, int], where: float, phi: float | None, cap: int
+) -> None:
+    """Plain FABRIK (extrapolate=False) takes the steps of Aristidou & Lasenby's Algorithm 1 (with the documented
+    cone), and returns the best pose among the start and those steps."""
+    n, d, seed = chain
+    n = max(n, 2)
+    rng = np.random.default_rng(seed)
+    joints = random_chain(rng, n, d, bend=1.0)
+    target = reachable_target(rng, joints, where)
+    result = fabrik.solve(
+        joints,
+        target,
+        tolerance=0.0,
+        max_iterations=cap,
+        cone_half_angle_rad=phi,
+        extrapolate=False,
+    )
+    poses = ik_reference.fabrik(joints, target, result.iterations, phi)
+    scale = fabrik.link_lengths(joints).sum()
+    errors = [float(np.linalg.norm(pose[-1] - target)) for pose in poses]
+    np.testing.assert_allclose(result.error_history[1:], errors, rtol=0, atol=1e-9 * scale)
+    if phi is None:  # every iterate is admissible: the best of them, or the start, comes back
+        candidates = [joints, *poses]
+        best = candidates[int(np.argmin(result.error_history))]
+        np.testing.assert_allclose(result.joints, best, rtol=0, atol=1e-9 * scale)
+
+
+@PROPERTY
+@given(chains, st.floats(0.0, 1.0), st.sampled_from(["ccd", "jacobian_dls"]), st.integers(1, 15))
+def test_ccd_and_dls_iterates_are_the_published_methods(
+    chain: tuple[int, int, int], where: float, solver: fabrik.Solver, cap: int
+) -> None:
+    n, d, seed = chain
+    n = max(n, 2)
+    rng = np.random.default_rng(seed)
+    joints = random_chain(rng, n, d, bend=1.0)
+    target = reachable_target(rng, joints, where)
+    result = fabrik.solve_batch(
+        joints[None], target[None], tolerance=0.0, max_iterations=cap, solver=solver
+    )[0]
+    reference = ik_reference.ccd if solver == "ccd" else ik_reference.dls
+    poses = reference(joints, target, result.iterations)
+    scale = fabrik.link_lengths(joints).sum()
+    errors = [float(np.linalg.norm(pose[-1] - target)) for pose in poses]
+    np.testing.assert_allclose(result.error_history[1:], errors, rtol=0, atol=1e-8 * scale)
+    best = [joints, *poses][int(np.argmin(result.error_history))]
+    # Joints can drift along the redundant directions by rounding that CCD amplifies; the end does not.
+    np.testing.assert_allclose(result.joints, best, rtol=0, atol=1e-6 * scale)
+
+
+def test_paper_setup_reaches_in_fewer_iterations_than_table_1() -> None:
+    """Aristidou & Lasenby 2011, Table 1: 10 joints, reachable targets, FABRIK 15.5 mean iterations, CCD 26.3."""
+    rng = np.random.default_rng(0)
+    joints = np.zeros((11, 3))
+    joints[:, 2] = np.arange(11.0)
+    joints[:, 0] = 0.05 * np.arange(11.0) ** 2  # a gentle arc, as the benchmark's
+    targets = np.stack([random_direction(rng, 3) * rng.uniform(1.0, 9.0) for _ in range(40)])
+    counts = []
+    for plain in (False, True):
+        batch = fabrik.solve_batch(
+            np.repeat(joints[None], 40, axis=0), targets, tolerance=0.01, max_iterations=1000,
+            extrapolate=not plain,
+        )  # fmt: skip
+        assert np.all(batch.status == "reached")
+        counts.append(batch.iterations.mean())
+    assert counts[1] <= 15.5
+    assert counts[0] <= counts[1]
+
+
+@PROPERTY
+@given(st.integers(1, 12), st.sampled_from([2, 3]), st.integers(0, 2**32 - 1), st.booleans())
+def test_every_solver_gives_a_batch_the_bits_of_single_solves(
+    n: int, d: int, seed: int, limits: bool
+) -> None:
+    rng = np.random.default_rng(seed)
+    joints = np.stack([random_chain(rng, n, d) for _ in range(5)])
+    joints -= joints[:, :1]
+    total = fabrik.link_lengths(joints).sum(axis=1)
+    targets = np.stack([random_direction(rng, d) * rng.uniform(0.0, 1.3) * t for t in total])
+    kwargs: dict[str, Any] = {
+        "cone_half_angle_rad": 0.9 if limits else None,
+        "obstacles": [(random_direction(rng, d) * 0.6 * total.min(), 0.1 * total.min())],
+        "max_iterations": 30,
+    }
+    singles = {"fabrik": fabrik.solve, "ccd": fabrik.ccd, "jacobian_dls": fabrik.jacobian_dls}
+    for solver in SOLVERS:
+        batch = fabrik.solve_batch(joints, targets, solver=solver, **kwargs)
+        for i in range(len(joints)):
+            single = singles[solver](joints[i], targets[i], **kwargs)
+            assert single.joints.tobytes() == batch.joints[i].tobytes()
+            assert single.error_history.tobytes() == batch[i].error_history.tobytes()
+            assert (single.iterations, single.status) == (batch[i].iterations, batch[i].status)
+
+
+# ------------------------------------------------------------------------------------------------ issue 8, item 2
+def admissible(
+    joints: NDArray[np.float64],
+    phi: float | None,
+    root_direction: NDArray[np.float64],
+    obstacles: list[tuple[NDArray[np.float64], float]],
+) -> bool:
+    """The test's own check: every joint within its cone (cos θ ≥ cos φ − 1e-12, as documented) and no segment
+    through an obstacle."""
+    if phi is not None:
+        segments = np.diff(joints, axis=0)
+        directions = segments / np.linalg.norm(segments, axis=1, keepdims=True)
+        axes = np.vstack([root_direction, directions[:-1]])
+        if np.any(np.sum(directions * axes, axis=1) < math.cos(phi) - 1e-12):
+            return False
+    return all(segment_clearance(joints, c) >= r * (1.0 - 1e-9) for c, r in obstacles)
+
+
+def random_obstacles(
+    rng: np.random.Generator, joints: NDArray[np.float64], count: int
+) -> list[tuple[NDArray[np.float64], float]]:
+    """Up to ``count`` circles or spheres near the chain, none containing its root."""
+    total = fabrik.link_lengths(joints).sum()
+    found = []
+    for _ in range(count):
+        centre = joints[0] + random_direction(rng, joints.shape[1]) * rng.uniform(0.2, 1.0) * total
+        radius = rng.uniform(0.03, 0.2) * total
+        if np.linalg.norm(centre - joints[0]) > radius * 1.01:
+            found.append((centre, radius))
+    return found
+
+
+CAPS = (1, 2, 3, 5, 8, 13, 21, 34)
+
+
+@PROPERTY
+@given(
+    chains,
+    st.floats(0.0, 1.3),
+    st.one_of(st.none(), st.floats(0.05, 3.1)),
+    st.integers(0, 4),
+    st.sampled_from(SOLVERS),
+    st.booleans(),
+    st.floats(0.1, 2.0),
+)
+def test_the_returned_pose_is_the_best_admissible_pose_seen(
+    chain: tuple[int, int, int],
+    where: float,
+    phi: float | None,
+    count: int,
+    solver: fabrik.Solver,
+    extrapolate: bool,
+    bend: float,
+) -> None:
+    """Issue 8 item 2, over the whole family: never worse than an admissible start, never worse than an admissible
+    iterate, admissible whenever an admissible pose was seen, and status words that say what happened."""
+    n, d, seed = chain
+    rng = np.random.default_rng(seed)
+    joints = random_chain(rng, n, d, bend=bend)
+    lengths = fabrik.link_lengths(joints)
+    inner, outer = fabrik.reach_limits(lengths)
+    target = joints[0] + random_direction(rng, d) * where * outer
+    root_direction = random_direction(rng, d)
+    obstacles = random_obstacles(rng, joints, count)
+    start_ok = admissible(joints, phi, root_direction, obstacles)
+    start_error = float(np.linalg.norm(joints[-1] - target))
+    distance = float(np.linalg.norm(target - joints[0]))
+    previous = math.inf
+    for cap in CAPS:
+        result = fabrik.solve_batch(
+            joints[None], target[None], tolerance=1e-3 * outer, max_iterations=cap,
+            cone_half_angle_rad=phi, obstacles=obstacles, root_direction=root_direction,
+            solver=solver, extrapolate=extrapolate,
+        )[0]  # fmt: skip
+        # More iterations never give a worse admissible pose: each run repeats the shorter one's iterates first.
+        # (Only where no admissible pose was ever seen is the last iterate returned, whatever its error.)
+        if admissible(result.joints, phi, root_direction, obstacles):
+            assert result.error <= previous + 1e-12 * outer
+            previous = result.error
+        else:
+            assert previous == math.inf, "an admissible pose was seen with fewer iterations"
+        if start_ok:
+            assert result.error <= start_error + 1e-12 * outer
+            assert admissible(result.joints, phi, root_direction, obstacles), result.status
+        if not obstacles and result.iterations > 0:  # limits alone: every iterate is admissible
+            assert result.error <= result.error_history[1:].min() + 1e-12 * outer
+        if result.status == "reached":
+            assert result.error <= 1e-3 * outer * (1 + 1e-9)
+        if distance > outer * (1 + 1e-9) or distance < inner * (1 - 1e-9):
+            assert result.status in ("unreachable", "reached")
+        elif inner * (1 + 1e-9) < distance < outer * (1 - 1e-9):
+            assert result.status != "unreachable"
+        if result.status in ("limited", "blocked"):
+            assert phi is not None or obstacles
+        if result.status == "blocked":
+            assert obstacles
+
+
+def test_issue_8_limited_chain_returns_its_best_pose_not_its_last() -> None:
+    """Issue 8 item 2's input: it ended "unreachable" at 0.724 m from a 0.600 m start; its best iterate was
+    0.412 m. The target is within reach, so the status is "limited", with the best pose (0.412 m)."""
+    joints = np.array([[0.0, 0.0], [0.0, 1.0], [0.0, 2.0], [0.0, 3.0]])
+    result = fabrik.solve(joints, [0.0, 2.4], cone_half_angle_rad=math.radians(30.0))
+    assert result.status == "limited"
+    assert result.error <= 0.6
+    assert result.error <= result.error_history.min()
+    assert result.error == pytest.approx(0.412, abs=1e-3)
+    assert np.all(fabrik.joint_angles(result.joints, [0.0, 1.0]) <= math.radians(30.0) + 1e-9)
+    batch = fabrik.solve_batch(joints[None], [[0.0, 2.4]], cone_half_angle_rad=math.radians(30.0))
+    assert batch[0].error == result.error and batch[0].status == "limited"
+
+
+@pytest.mark.parametrize("solver", SOLVERS)
+def test_issue_8_ccd_with_limits_and_obstacles_is_not_unreachable(solver: fabrik.Solver) -> None:
+    """Issue 8: CCD on the arm scene's 12 links, 28° limits, its 4 obstacles, a target 1 m from the root read
+    "unreachable, 540 mm". 1 m is well inside the 3 m reach."""
+    from scenes.arm import OBSTACLE_STARTS, ArmParams, rest_pose
+
+    joints = rest_pose(12, 0.25)[:, [0, 2]]
+    radii = ArmParams().radii_m
+    obstacles = [(OBSTACLE_STARTS[k][[0, 2]], radii[k]) for k in range(4)]
+    for target in ([0.8, 0.6], [0.0, 1.0], [1.0, 0.0]):
+        result = fabrik.solve_batch(
+            joints[None], np.array([target]), cone_half_angle_rad=math.radians(28.0),
+            obstacles=obstacles, root_direction=[0.0, 1.0], solver=solver,
+        )[0]  # fmt: skip
+        assert result.status in ("reached", "limited", "blocked", "max_iterations"), target
+        assert result.error <= np.linalg.norm(joints[-1] - target)
+
+
+# ------------------------------------------------------------------------------------------------ issue 8, item 3
+@PROPERTY
+@given(
+    chains,
+    st.one_of(st.just(0.0), st.just(1.0), st.floats(0.0, 1.0)),
+    st.floats(1e-7, 1e-2),
+    st.one_of(st.none(), st.floats(0.0, 3.1)),
+    st.integers(0, 3),
+    st.integers(1, 50),
+    st.booleans(),
+)
+def test_targets_within_tolerance_of_full_reach_are_reached(
+    chain: tuple[int, int, int],
+    fraction: float,
+    relative_tolerance: float,
+    phi: float | None,
+    count: int,
+    cap: int,
+    batched: bool,
+) -> None:
+    """Issue 8 item 3, over the whole family: a target at ΣL − δ, 0 ≤ δ ≤ tolerance, in any direction, is
+    "reached" within max_iterations whenever the straight pose toward it is admissible."""
+    n, d, seed = chain
+    rng = np.random.default_rng(seed)
+    joints = random_chain(rng, n, d, bend=1.0)
+    lengths = fabrik.link_lengths(joints)
+    total = lengths.sum()
+    tolerance = relative_tolerance * total
+    direction = random_direction(rng, d)
+    target = joints[0] + direction * (total - fraction * tolerance)
+    straight = joints[0] + np.concatenate([[0.0], np.cumsum(lengths)])[:, None] * direction
+    # A rest direction the straight pose's first link keeps within its cone.
+    side = random_direction(rng, d)
+    side -= (side @ direction) * direction
+    tilt = 0.0 if phi is None else 0.99 * phi * rng.uniform()
+    root_direction = math.cos(tilt) * direction + math.sin(tilt) * side / np.linalg.norm(side)
+    obstacles = [
+        (c, r)
+        for c, r in random_obstacles(rng, joints, count)
+        if segment_clearance(straight, c) > r
+    ]
+    assert admissible(straight, phi, root_direction, obstacles)
+    kwargs: dict[str, Any] = {
+        "tolerance": tolerance, "max_iterations": cap, "cone_half_angle_rad": phi,
+        "obstacles": obstacles, "root_direction": root_direction,
+    }  # fmt: skip
+    if batched:
+        result = fabrik.solve_batch(joints[None], target[None], **kwargs)[0]
+    else:
+        result = fabrik.solve(joints, target, **kwargs)
+    assert result.status == "reached"
+    assert 0 <= result.iterations <= cap
+    assert result.error <= tolerance + 1e-12 * max(total, 1.0)
+    assert admissible(result.joints, phi, root_direction, obstacles)
+
+
+@pytest.mark.parametrize("d", [2, 3])
+@pytest.mark.parametrize(
+    ("degrees", "short_of_reach"), [(90.0, 0.5e-3), (135.0, 0.9e-3), (90.0, 0.0), (180.0, 0.0)]
+)
+def test_issue_8_full_reach_targets_of_the_default_arm_are_reached(
+    d: int, degrees: float, short_of_reach: float
+) -> None:
+    """Issue 8 item 3's inputs: 6 links of 0.25 m straight up, tolerance 1 mm, the target at ΣL − 0.5 mm at 90° to
+    the chain, ΣL − 0.9 mm at 135°, or exactly ΣL: "max_iterations" at 1.57, 5.07 and 7.94 mm before. The straight
+    pose toward the target is within tolerance: reached, its error exactly the shortfall."""
+    joints = np.zeros((7, d))
+    joints[:, -1] = 0.25 * np.arange(7.0)
+    direction = np.zeros(d)
+    direction[0], direction[-1] = math.sin(math.radians(degrees)), math.cos(math.radians(degrees))
+    target = direction * (1.5 - short_of_reach)
+    for result in (
+        fabrik.solve(joints, target, tolerance=1e-3),
+        fabrik.solve_batch(joints[None], target[None], tolerance=1e-3)[0],
+    ):
+        assert result.status == "reached"
+        assert result.iterations <= 50
+        assert result.error == pytest.approx(short_of_reach, abs=1e-12)
+        np.testing.assert_allclose(fabrik.link_lengths(result.joints), 0.25, rtol=1e-12)
+
+
+# ------------------------------------------------------------------------------------------------ compiled cores
+def test_warm_up_compiles_every_core_with_a_cache() -> None:
+    from numba.core.registry import CPUDispatcher
+
+    fabrik.warm_up()
+    cores = {
+        name: value for name, value in vars(fabrik).items() if isinstance(value, CPUDispatcher)
+    }
+    assert {"_solve_rows", "_solve_parallel", "_forward_pass", "_ccd_sweep", "_dls_step"} <= set(
+        cores
+    )
+    for name, core in cores.items():
+        cache = core._cache  # pyright: ignore[reportAttributeAccessIssue]
+        assert type(cache).__name__ == "FunctionCache", name  # cache=True on every core
+    # The two entry points are compiled (or loaded); the cores they call are linked into them.
+    assert fabrik._solve_rows.signatures and fabrik._solve_parallel.signatures
+
+
+def test_compile_cache_falls_back_to_a_user_directory_when_the_package_is_read_only(
+    tmp_path: Path,
+) -> None:
+    """numba's cache=True writes beside the module; where that cannot be written (a read-only site-packages),
+    it uses the user-wide cache directory. A ``__pycache__`` that is a file stands in for the read-only directory
+    (chmod would not stop root); the second process must load the machine code from the user cache."""
+    package = tmp_path / "site"
+    package.mkdir()
+    (package / "__pycache__").write_text("not a directory")
+    (package / "cached_core.py").write_text(
+        "import numba\n\n@numba.njit(cache=True)\ndef twice(x):\n    return 2.0 * x\n"
+    )
+    script = (
+        "import cached_core\n"
+        "assert cached_core.twice(2.0) == 4.0\n"
+        "print(sum(cached_core.twice.stats.cache_hits.values()), cached_core.twice._cache._cache_path)\n"
+    )
+    environment = {
+        **os.environ,
+        "PYTHONPATH": str(package),
+        "XDG_CACHE_HOME": str(tmp_path / "user-cache"),
+    }
+    environment.pop("NUMBA_CACHE_DIR", None)
+    runs = [
+        subprocess.run(
+            [sys.executable, "-c", script], env=environment, capture_output=True, text=True,
+            timeout=120, check=True,
+        ).stdout.split()
+        for _ in range(2)
+    ]  # fmt: skip
+    assert runs[0][1].startswith(str(tmp_path / "user-cache" / "numba"))
+    assert any(path.suffix == ".nbc" for path in (tmp_path / "user-cache").rglob("*"))
+    assert (runs[0][0], runs[1][0]) == ("0", "1")  # compiled once, then loaded from the user cache
