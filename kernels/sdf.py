@@ -253,12 +253,14 @@ def _smin_exp_weighted(
     tiny = np.finfo(dtype).tiny
     with np.errstate(over="ignore", under="ignore"):
         sharpness = max(dtype.type(k), tiny)  # inf when it overflows the dtype
-    with np.errstate(invalid="ignore"):
-        gap = np.where(a == b, dtype.type(0.0), np.abs(a - b))
+    # Overflow here is a true value beyond the dtype (a gap or a dip past its largest float), kept as ±inf.
     with np.errstate(over="ignore", invalid="ignore"):
+        gap = np.where(a == b, dtype.type(0.0), np.abs(a - b))
         e = np.exp(-sharpness * gap)  # in [0, 1]; −∞·0 (NaN) only at gap 0, set below
-    e = np.where(gap == 0.0, dtype.type(1.0), e)
-    d = np.minimum(a, b) - np.log1p(e) / sharpness  # log1p(e) ≤ ln 2: → 0 as the sharpness grows
+        e = np.where(gap == 0.0, dtype.type(1.0), e)
+        d = (
+            np.minimum(a, b) - np.log1p(e) / sharpness
+        )  # log1p(e) ≤ ln 2: → 0 as the sharpness grows
     w_b = np.where(a > b, 1.0, e) / (1.0 + e)
     return d, w_b
 
