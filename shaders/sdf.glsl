@@ -63,8 +63,9 @@ vec2 smin_poly_weighted(float a, float b, float k) {
     bool hard = !(k >= MIN_BLEND_WIDTH);
     float width = hard ? 1.0 : min(k, FLOAT32_MAX);
     float gap = a == b ? 0.0 : b - a;
-    // gap * (0.5 / width) may overflow to +-inf, which the clamp maps to 0 or 1.
-    float h = clamp(0.5 + gap * (0.5 / width), 0.0, 1.0);
+    // (0.5 * gap) / width may overflow to +-inf, which the clamp maps to 0 or 1. Not gap * (0.5 / width): past
+    // width 4e37 that factor is subnormal, a GPU flushes it to 0, and inf * 0 is NaN.
+    float h = clamp(0.5 + (0.5 * gap) / width, 0.0, 1.0);
     float blended = h * a + (1.0 - h) * b - width * h * (1.0 - h);
     vec2 smooth_min = vec2(h == 0.0 ? b : (h == 1.0 ? a : blended), 1.0 - h);
     return hard ? vec2(min(a, b), b < a ? 1.0 : 0.0) : smooth_min;
