@@ -894,7 +894,12 @@ def _polygonise(
     if near_level.any():
         # Only samples with a level neighbour (a face or a feature's edge along grid lines) take that test; a lone
         # one (a blend grazing a sample) stays outside, so a sub-voxel blend keeps the topology it always had.
+        # On the grid's outer layer a sample stays outside as well: the solid may go on beyond the bounds, and
+        # marching cubes only closes a surface that crosses inside them (a box that fills its bounds).
         lined = near_level & (field >= 0.0) & _beside(near_level)
+        lined[[0, -1], :, :] = False
+        lined[:, [0, -1], :] = False
+        lined[:, :, [0, -1]] = False
         inward = (field < 0.0) | _touches_solid(scene, grid, lined)
         nudged = np.where(inward, -delta, delta)
         # A level sample left outside next to one moved inside: the edge between them runs along a face that only

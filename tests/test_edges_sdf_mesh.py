@@ -294,3 +294,13 @@ def test_a_slab_one_voxel_thick_is_meshed() -> None:
         np.testing.assert_allclose(
             tri.bounds, [[-0.5, -0.5, 0.0], [0.5, 0.5, 0.125]], atol=1e-3 * 0.125 * 2
         )
+
+
+@pytest.mark.parametrize("resolution", [16, 17, 33])
+def test_a_box_that_fills_its_bounds_is_closed(resolution: int) -> None:
+    # Its faces lie on the grid's outer samples: they stay outside, so marching cubes closes the surface there.
+    scene = sdf.Scene((sdf.Primitive("box", (0.0, 0.0, 0.0), (0.5, 0.5, 0.5)),), k=0.0)
+    vertices, faces, _ = sdf.mesh(scene, resolution, [[-0.5] * 3, [0.5] * 3])
+    tri = trimesh.Trimesh(vertices, faces, process=False)
+    assert tri.is_watertight and tri.euler_number == 2
+    assert 0.95 <= tri.volume <= 1.0
