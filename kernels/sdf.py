@@ -852,10 +852,15 @@ def mesh(
 
     Returns:
         vertices (V, 3) in metres, faces (F, 3) vertex indices wound outward, vertex colours (V, 3) RGB in [0, 1].
-        Samples on (or within 1e-3 voxel of) the zero level are moved 1e-3 voxel off it first, a sample exactly
-        on it to the outside (see ``_polygonise``), so every vertex is distinct and a closed shape gives a
-        watertight mesh even where faces lie on grid planes. An empty field (no surface inside the bounds) gives
-        empty arrays.
+        Samples on (or within 1e-3 voxel of) the zero level are moved 1e-3 voxel off it first: inside where they
+        lie on a face along grid lines next to a grid cell whose centre is inside, else outside (see
+        ``_polygonise``), so every vertex is distinct, a closed shape gives a watertight mesh even where faces lie on
+        grid planes, and a feature one voxel thick between two grid planes keeps its volume. An empty field (no
+        surface inside the bounds) gives empty arrays.
+
+    Raises:
+        ValueError: a bad resolution, or bounds (given or the scene's) not finite or beyond
+            ±:data:`MAX_FIELD_COORDINATE`.
     """
     grid = make_grid(scene, resolution, bounds)
     mask = None
