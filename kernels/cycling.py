@@ -258,25 +258,58 @@ def speed_for_power(
     bracket's secant or midpoint whenever a step would leave the shrinking bracket, after ``rtsafe`` in Press et al.,
     Numerical Recipes, 2007) then polishes it to rounding level, so ``power(v) == P`` and v moves continuously as P → 0⁺.
 
+    Domain: the inverse is defined on :data:`SPEED_FOR_POWER_DOMAIN` (power up to 1 MW, CdA 1 mm² to 10⁴ m²,
+    mass up to 10⁶ kg, Crr up to 1, altitude −500 to 30 000 m, |wind| up to 1 000 m/s; any finite grade). Far
+    beyond any rider, and where the model still means something (the exponential atmosphere is no air above
+    ~30 km; drag ∝ v² fails past the speed of sound), it also keeps every intermediate (P/a, |c|/a, a·w²·v, the
+    cubic's coefficients) inside float64, so no answer is inf or silently wrong. Outside it: ValueError naming
+    the argument.
+
     Args:
         power_w: power at the pedals (W, ≥ 0).
         Other arguments as for :func:`power`.
 
     Returns:
         Speed (m/s, ≥ 0) with the broadcast shape of the inputs.
+
+    Raises:
+        ValueError: an argument is not finite, out of :func:`power`'s range, or outside the domain above.
     """
     target = _non_negative("power_w", power_w)
+    values = dict(
+        cda_m2=cda_m2, mass_kg=mass_kg, crr=crr, altitude_m=altitude_m, headwind_ms=headwind_ms
+    )
+    for name, (low, high) in SPEED_FOR_POWER_DOMAIN.items():
+        value = power_w if name == "power_w" else values[name]
+        array = target if name == "power_w" else _finite(name, value)
+        if np.any((array < low) | (array > high)):
+            raise ValueError(
+                f"{name} must be in [{low:g}, {high:g}] for speed_for_power, got {value!r}"
+            )
     r = _resistance(cda_m2, mass_kg, crr, grade, altitude_m, headwind_ms, drivetrain_efficiency)
-    # Validated by _resistance above. Rolling plus climbing as m·g·cos θ·(Crr + grade), which is exactly 0 where
-    # Crr = −grade (the sum of the two forces would leave rounding there, and its square root would move v_c).
+    # Validated above. Rolling plus climbing as m·g·cos θ·(Crr + grade), which is exactly 0 where Crr = −grade
+    # (the sum of the two forces would leave rounding there, and its square root would move v_c); the ratio
+    # (Crr + grade)/√(1 + grade²) is formed first, so a huge grade gives ±m·g instead of overflowing.
     slope = np.asarray(grade, dtype=np.float64)
-    road = np.asarray(mass_kg, dtype=np.float64) * G * (np.asarray(crr, dtype=np.float64) + slope)
+    road = (np.asarray(crr, dtype=np.float64) + slope) / np.hypot(1.0, slope)
     broadcast = np.broadcast_arrays(
-        r.drag, road / np.hypot(1.0, slope), r.wind, target * r.efficiency
+        r.drag, np.asarray(mass_kg, dtype=np.float64) * G * road, r.wind, target * r.efficiency
     )
     shape = broadcast[0].shape
     a, c, w, p = (np.array(x, dtype=np.float64).ravel() for x in broadcast)
     return _largest_root(a, c, w, p).reshape(shape)
+
+
+SPEED_FOR_POWER_DOMAIN: dict[str, tuple[float, float]] = {
+    "power_w": (0.0, 1e6),
+    "cda_m2": (1e-6, 1e4),
+    "mass_kg": (0.0, 1e6),
+    "crr": (0.0, 1.0),
+    "altitude_m": (-500.0, 30_000.0),
+    "headwind_ms": (-1000.0, 1000.0),
+}
+"""Closed ranges (SI units) on which :func:`speed_for_power` is defined; ``power``'s own checks (CdA, mass > 0,
+…) still apply. Within them no intermediate of the solver overflows or underflows to a wrong answer."""
 
 
 def _largest_root(
@@ -286,8 +319,16 @@ def _largest_root(
 
     Each step takes Newton's point when it stays in the bracket, else the bracket's secant point (Newton
     overshoots on the concave part of a tailwind branch, and the root may sit at the bracket's low end), else its
-    midpoint; the bracket shrinks on every evaluation.
+    midpoint; the bracket shrinks on every evaluation. It stops when f is at the rounding level of its terms or
+    the bracket is one ulp wide, then keeps whichever of v and its two float neighbours gives the smallest |f|.
     """
+    with np.errstate(all="ignore"):
+        return _largest_root_unguarded(a, c, w, p)
+
+
+def _largest_root_unguarded(
+    a: NDArray[np.float64], c: NDArray[np.float64], w: NDArray[np.float64], p: NDArray[np.float64]
+) -> NDArray[np.float64]:
     balance_air = np.sign(-c) * np.sqrt(np.abs(c) / a)  # air speed at which drag balances c: g = 0
     v0 = np.maximum(balance_air - w, 0.0)
     lo, f_lo = v0.copy(), -p  # P(v0) = 0
@@ -321,10 +362,22 @@ def _largest_root(
             newton,
             np.where((secant > lo_i) & (secant < hi_i), secant, 0.5 * (lo_i + hi_i)),
         )
-        # Converged: f at the rounding level of its terms and of v itself, or no move left.
-        moving = (np.abs(f) > noise + 8.0 * eps * vi * np.abs(df)) & (step != vi)
+        # Converged: f at the rounding level of its terms, a bracket one ulp wide, or no move left. (A test on
+        # v's own rounding, eps·v·|df|, stopped several ulps short where |df| is large: a fast tailwind.)
+        moving = (
+            (np.abs(f) > noise) & (step != vi) & (hi_i - lo_i > 2.0 * eps * np.maximum(hi_i, 0.0))
+        )
         v[idx[moving]] = step[moving]
         idx = idx[moving]
+    # The nearest float: v or one of its neighbours (within the bracket [v0, ∞)).
+    solved = np.flatnonzero(active)
+    if solved.size:
+        vs = v[solved]
+        candidates = np.stack([vs, np.nextafter(vs, -np.inf), np.nextafter(vs, np.inf)], axis=1)
+        candidates = np.maximum(candidates, v0[solved, None])
+        args = (a[solved, None], c[solved, None], w[solved, None], p[solved, None])
+        f_all = np.abs(_residual(candidates, *args)[0])
+        v[solved] = candidates[np.arange(solved.size), np.argmin(f_all, axis=1)]
     return v
 
 

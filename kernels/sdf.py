@@ -45,7 +45,9 @@ tracing", The Visual Computer 12 (1996); T. Lewiner et al., J. Graphics Tools 8(
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import math
+import numbers
 from collections.abc import Callable
 from typing import Literal
 
@@ -98,6 +100,12 @@ MIN_BLEND_WIDTH = float(np.finfo(np.float32).tiny)
 """Blend widths below this (float32's smallest normal, 1.2e-38 m) are the hard booleans, here and in the GLSL: their
 dip k/4 is below any distance's rounding, a float32 uniform cannot hold them reliably (subnormal or 0), and
 above it 0.5/k and the exp sharpness 4·ln 2/k stay finite in float32."""
+MAX_BLEND_WIDTH = 1e6
+"""Widest blend a :class:`Scene` takes (m). A union blended over k reaches k/4 beyond its primitives, so the mesh's
+grid spans about k: past ~1e18 m float32 squares of its coordinates overflow and the field is lost (the mesh came out
+empty from k ≈ 1e19). 1000 km is far beyond any gallery scene yet keeps every float32 value small."""
+MAX_FIELD_COORDINATE = 1e18
+"""Largest |coordinate| (m) of a mesh grid: float32 squares of differences of such coordinates stay finite."""
 
 _SIZE_COUNT: dict[str, int] = {
     "sphere": 1,
@@ -127,15 +135,22 @@ def _points(p: ArrayLike, name: str = "p") -> FloatArray:
     return arr
 
 
+def _real(value: float, name: str) -> float:
+    """``value`` as a float when it is a real number (a string, None, a bool or a sequence is refused)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise ValueError(f"{name} must be a real number, got {value!r}")
+    return float(value)
+
+
 def _positive(value: float, name: str) -> float:
-    number = float(value)
+    number = _real(value, name)
     if not math.isfinite(number) or number <= 0.0:
         raise ValueError(f"{name} must be finite and positive, got {value!r}")
     return number
 
 
 def _non_negative(value: float, name: str) -> float:
-    number = float(value)
+    number = _real(value, name)
     if not math.isfinite(number) or number < 0.0:
         raise ValueError(f"{name} must be finite and non-negative, got {value!r}")
     return number
@@ -241,16 +256,22 @@ def _smin_poly_weighted(
 ) -> tuple[AnyFloatArray, AnyFloatArray]:
     """Polynomial smooth min and the weight of ``b`` in it (``1 − h``), in the inputs' float dtype.
 
-    Finite for every finite k ≥ 0: a width below :data:`MIN_BLEND_WIDTH` is the hard minimum; above it
-    (b − a)/k overflows to ±inf at worst, which the clamp maps to 0 or 1, and is 0 where a = b. The result lies within
-    k/4 of min(a, b).
+    Finite for every finite k ≥ 0 and finite distances, and never NaN for infinite ones: a width below
+    :data:`MIN_BLEND_WIDTH` is the hard minimum; above it (b − a)/k overflows to ±inf at worst, which the clamp maps
+    to 0 or 1, and is 0 where a = b (the same infinity included, instead of inf − inf). Where h is 0 or 1 the result
+    is b or a outright (not 0·inf), and a width beyond the dtype's largest float is that float. The result lies
+    within k/4 of min(a, b).
     """
     if not k >= MIN_BLEND_WIDTH:
         return np.minimum(a, b), (b < a).astype(np.float64)
-    width = np.result_type(a, b).type(k)
-    with np.errstate(over="ignore"):
-        h = np.clip(0.5 + 0.5 * (b - a) / width, 0.0, 1.0)
-    return h * a + (1.0 - h) * b - width * h * (1.0 - h), 1.0 - h  # exact at h = 0 and h = 1
+    dtype = np.result_type(a, b)
+    width = dtype.type(min(k, float(np.finfo(dtype).max)))
+    with np.errstate(over="ignore", invalid="ignore"):
+        gap = np.where(a == b, dtype.type(0.0), b - a)
+        h = np.clip(0.5 + 0.5 * (gap / width), 0.0, 1.0)
+        blended = h * a + (1.0 - h) * b - width * h * (1.0 - h)
+    d = np.where(h == 0.0, b, np.where(h == 1.0, a, blended))
+    return d, 1.0 - h
 
 
 def _smin_exp_weighted(
@@ -258,17 +279,23 @@ def _smin_exp_weighted(
 ) -> tuple[AnyFloatArray, AnyFloatArray]:
     """Exponential smooth min (``k`` = sharpness) and the weight of ``b``: exp(−kb)/(exp(−ka) + exp(−kb)).
 
-    Finite for every sharpness in (0, ∞], in the inputs' float dtype: a sharpness that overflows it (4·ln 2 / k
-    for a tiny width k) is the hard minimum, with exp(−k·|a − b|) taken as 1 where a = b instead of exp(−∞·0).
+    Finite for every sharpness in (0, ∞] and finite distances, in the inputs' float dtype, and never NaN for
+    infinite ones: a sharpness that overflows it (4·ln 2 / k for a tiny width k) is the hard minimum, with
+    exp(−k·|a − b|) taken as 1 where a = b (the same infinity included) instead of exp(−∞·0); a sharpness below the
+    dtype's smallest normal (a huge width, or a subnormal sharpness) is that normal, so ln 2 / k stays finite.
     """
     dtype = np.result_type(a, b)
-    with np.errstate(over="ignore"):
-        sharpness = dtype.type(k)  # inf when it overflows the dtype
-    gap = np.abs(a - b)
+    tiny = np.finfo(dtype).tiny
+    with np.errstate(over="ignore", under="ignore"):
+        sharpness = max(dtype.type(k), tiny)  # inf when it overflows the dtype
+    # Overflow here is a true value beyond the dtype (a gap or a dip past its largest float), kept as ±inf.
     with np.errstate(over="ignore", invalid="ignore"):
+        gap = np.where(a == b, dtype.type(0.0), np.abs(a - b))
         e = np.exp(-sharpness * gap)  # in [0, 1]; −∞·0 (NaN) only at gap 0, set below
-    e = np.where(gap == 0.0, dtype.type(1.0), e)
-    d = np.minimum(a, b) - np.log1p(e) / sharpness  # log1p(e) ≤ ln 2: → 0 as the sharpness grows
+        e = np.where(gap == 0.0, dtype.type(1.0), e)
+        d = (
+            np.minimum(a, b) - np.log1p(e) / sharpness
+        )  # log1p(e) ≤ ln 2: → 0 as the sharpness grows
     w_b = np.where(a > b, 1.0, e) / (1.0 + e)
     return d, w_b
 
@@ -334,7 +361,11 @@ def _combine(
                 return _smin_poly_weighted(x, y, k)
             case "exp":
                 return _smin_exp_weighted(x, y, EXP_SHARPNESS_PER_WIDTH / k)
+            case _:
+                raise ValueError(f"blend must be one of {BLEND_FORMS}, got {blend!r}")
 
+    if blend not in BLEND_FORMS:  # also for k = 0, which never reaches the match above
+        raise ValueError(f"blend must be one of {BLEND_FORMS}, got {blend!r}")
     match op:
         case "union":
             return smin(a, b)
@@ -344,6 +375,8 @@ def _combine(
         case "intersect":
             d, w = smin(-a, -b)
             return -d, w
+        case _:
+            raise ValueError(f"op must be one of {BOOLEAN_OPS}, got {op!r}")
 
 
 def smooth_union(a: ArrayLike, b: ArrayLike, k: float, blend: BlendForm = "poly") -> FloatArray:
@@ -547,7 +580,12 @@ class Scene:
         if self.blend not in BLEND_FORMS:
             raise ValueError(f"blend must be one of {BLEND_FORMS}, got {self.blend!r}")
         object.__setattr__(self, "primitives", prims)
-        object.__setattr__(self, "k", _non_negative(self.k, "k"))
+        k = _non_negative(self.k, "k")
+        if k > MAX_BLEND_WIDTH:
+            raise ValueError(
+                f"k must be at most MAX_BLEND_WIDTH = {MAX_BLEND_WIDTH:g} m, got {self.k!r}"
+            )
+        object.__setattr__(self, "k", k)
 
 
 def _fold(
@@ -570,12 +608,15 @@ def _fold_xyz(
     with_color: bool,
 ) -> tuple[NDArray[np.floating], NDArray[np.floating] | None]:
     first = scene.primitives[0]
-    d = first._distance_xyz(x, y, z)
-    color = np.tile(np.asarray(first.color, dtype=d.dtype), (len(d), 1)) if with_color else None
-    for prim in scene.primitives[1:]:
-        d, w = _combine(d, prim._distance_xyz(x, y, z), prim.op, scene.k, scene.blend)
-        if color is not None:
-            color += w[:, None] * (np.asarray(prim.color, dtype=d.dtype) - color)
+    # A point far enough away (|p| beyond ~1e154 m in float64, ~1e19 m in float32) has an infinite distance; the
+    # blends take infinities without NaN, so that is the answer there, not a warning.
+    with np.errstate(over="ignore"):
+        d = first._distance_xyz(x, y, z)
+        color = np.tile(np.asarray(first.color, dtype=d.dtype), (len(d), 1)) if with_color else None
+        for prim in scene.primitives[1:]:
+            d, w = _combine(d, prim._distance_xyz(x, y, z), prim.op, scene.k, scene.blend)
+            if color is not None:
+                color += w[:, None] * (np.asarray(prim.color, dtype=d.dtype) - color)
     return d, color
 
 
@@ -742,6 +783,11 @@ def make_grid(scene: Scene, resolution: int, bounds: ArrayLike | None = None) ->
         box = np.asarray(bounds, dtype=np.float64)
         if box.shape != (2, 3) or not np.all(np.isfinite(box)) or np.any(box[1] <= box[0]):
             raise ValueError("bounds must be finite (2, 3) min and max corners with max > min")
+    if not np.all(np.abs(box) <= MAX_FIELD_COORDINATE):
+        raise ValueError(
+            f"bounds (given or the scene's) must lie within ±{MAX_FIELD_COORDINATE:g} m for the float32 field, "
+            f"got {box.tolist()}"
+        )
     extent = box[1] - box[0]
     spacing = float(extent.max()) / (int(resolution) - 1)
     counts = np.minimum(np.ceil(extent / spacing - 1e-9).astype(int) + 1, int(resolution))
@@ -871,10 +917,15 @@ def mesh(
 
     Returns:
         vertices (V, 3) in metres, faces (F, 3) vertex indices wound outward, vertex colours (V, 3) RGB in [0, 1].
-        Samples on (or within 1e-3 voxel of) the zero level are moved 1e-3 voxel off it first, a sample exactly
-        on it to the outside (see ``_polygonise``), so every vertex is distinct and a closed shape gives a
-        watertight mesh even where faces lie on grid planes. An empty field (no surface inside the bounds) gives
-        empty arrays.
+        Samples on (or within 1e-3 voxel of) the zero level are moved 1e-3 voxel off it first: inside where they
+        lie on a face along grid lines next to a grid cell whose centre is inside, else outside (see
+        ``_polygonise``), so every vertex is distinct, a closed shape gives a watertight mesh even where faces lie on
+        grid planes, and a feature one voxel thick between two grid planes keeps its volume. An empty field (no
+        surface inside the bounds) gives empty arrays.
+
+    Raises:
+        ValueError: a bad resolution, or bounds (given or the scene's) not finite or beyond
+            ±:data:`MAX_FIELD_COORDINATE`.
     """
     grid = make_grid(scene, resolution, bounds)
     mask = None
@@ -896,18 +947,37 @@ def _polygonise(
     scene: Scene, grid: Grid, field: NDArray[np.float32], mask: NDArray[np.bool_] | None
 ) -> tuple[FloatArray, NDArray[np.int64], FloatArray]:
     # A sample exactly on the level is a tie that marching cubes breaks differently in neighbouring cells (its
-    # classification and its face test disagree), which leaves holes (scikit-image issue 8116). Such a sample counts
-    # as outside, as in Lewiner's reference code (values below FLT_EPSILON become a small positive one): it moves to
-    # +δ, δ = 1e-3 voxel. Samples closer than δ to the level (rounding residue of a face on a grid plane) move out to
-    # ±δ on their own side, so no sign changes. Neighbouring samples differ by at most a voxel (the field is
-    # 1-Lipschitz), so each vertex lies at least ~δ/voxel inside its own edge: vertices stay distinct in float32 and
-    # the mesh is a plain marching-cubes mesh (no merging), the surface moving by at most δ. Both samplers' fields
-    # pass through here, so the coarse-to-fine output still equals the full grid's (its sign fill comes from blocks
-    # far from the surface, never within δ of it).
+    # classification and its face test disagree), which leaves holes (scikit-image issue 8116), so every sample
+    # closer than δ = 1e-3 voxel to the level moves to ±δ. Which side: a sample on the level is a boundary point of
+    # the hard solid {d ≤ 0}; when it lies on a face along grid lines (a level neighbour), it goes inside (−δ) if a
+    # grid cell it is a corner of has its centre inside (d < 0: the solid has volume in that cell), else outside
+    # (+δ, as in Lewiner's reference code). Pushing every such
+    # sample outside made a feature one voxel thick with both faces on grid planes vanish (no sample was left
+    # inside it); pushing every one inside would turn zero-volume sets (boxes touching in an intersection, A − A)
+    # into sheets. A sample a hair inside (d < 0) stays inside. Neighbouring samples differ by at most a voxel (the
+    # field is 1-Lipschitz), so each vertex lies at least ~δ/voxel inside its own edge: vertices stay distinct in
+    # float32 and the mesh is a plain marching-cubes mesh (no merging), the surface moving by at most δ. Both
+    # samplers' fields pass through here and level samples and their cells' corners are evaluated exactly by both
+    # (the sign fill comes from blocks far from the surface), so the coarse-to-fine output equals the full grid's.
     delta = np.float32(ISO_NUDGE_VOXELS * grid.spacing)
     near_level = np.abs(field) < delta
     if near_level.any():
-        field = np.where(near_level, np.where(field < 0.0, -delta, delta), field)
+        # Only samples with a level neighbour (a face or a feature's edge along grid lines) take that test; a lone
+        # one (a blend grazing a sample) stays outside, so a sub-voxel blend keeps the topology it always had.
+        # On the grid's outer layer a sample stays outside as well: the solid may go on beyond the bounds, and
+        # marching cubes only closes a surface that crosses inside them (a box that fills its bounds).
+        lined = near_level & (field >= 0.0) & _beside(near_level)
+        lined[[0, -1], :, :] = False
+        lined[:, [0, -1], :] = False
+        lined[:, :, [0, -1]] = False
+        inward = (field < 0.0) | _touches_solid(scene, grid, lined)
+        nudged = np.where(inward, -delta, delta)
+        # A level sample left outside next to one moved inside: the edge between them runs along a face that only
+        # the inside one bounds (a cut flush with another face), so the surface belongs at the inside sample, not
+        # halfway between ±δ. The outside one takes half a voxel instead, putting the vertex ~2δ from it.
+        beside = _beside(near_level & inward) & near_level & ~inward
+        nudged = np.where(beside, np.float32(0.5 * grid.spacing), nudged)
+        field = np.where(near_level, nudged, field)
     if not (field.min() < 0.0 < field.max()):
         return np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64), np.zeros((0, 3))
     verts, faces, _normals, _values = marching_cubes(
@@ -919,6 +989,40 @@ def _polygonise(
     verts = verts.astype(np.float64) + np.asarray(grid.origin)
     # scikit-image's default winding faces a field that is negative inside outward (tests check the volume's sign).
     return verts, faces.astype(np.int64), scene_color(scene, verts)
+
+
+def _beside(samples: NDArray[np.bool_]) -> NDArray[np.bool_]:
+    """True at grid samples with one of their six axis neighbours in ``samples``."""
+    out = np.zeros_like(samples)
+    for axis in range(3):
+        n = samples.shape[axis]
+        lower = [slice(None)] * 3
+        upper = [slice(None)] * 3
+        lower[axis], upper[axis] = slice(0, n - 1), slice(1, n)
+        out[tuple(lower)] |= samples[tuple(upper)]
+        out[tuple(upper)] |= samples[tuple(lower)]
+    return out
+
+
+def _touches_solid(scene: Scene, grid: Grid, samples: NDArray[np.bool_]) -> NDArray[np.bool_]:
+    """(nx, ny, nz) True at the ``samples`` that are a corner of a grid cell whose centre is inside (d < 0)."""
+    out = np.zeros(samples.shape, dtype=bool)
+    at = np.argwhere(samples)
+    if len(at) == 0:
+        return out
+    cells_shape = np.asarray(samples.shape) - 1
+    offsets = np.array(list(itertools.product((-1, 0), repeat=3)))
+    cells = (at[:, None, :] + offsets[None, :, :]).reshape(-1, 3)
+    valid = np.all((cells >= 0) & (cells < cells_shape), axis=1)
+    unique = np.unique(cells[valid], axis=0)
+    centres = np.asarray(grid.origin) + grid.spacing * (unique + 0.5)
+    inside_cell = np.zeros(tuple(cells_shape), dtype=bool)
+    inside_cell[unique[:, 0], unique[:, 1], unique[:, 2]] = _field_at(scene, centres) < 0.0
+    hit = np.zeros(len(cells), dtype=bool)
+    good = cells[valid]
+    hit[valid] = inside_cell[good[:, 0], good[:, 1], good[:, 2]]
+    out[at[:, 0], at[:, 1], at[:, 2]] = hit.reshape(len(at), len(offsets)).any(axis=1)
+    return out
 
 
 def mesh_trimesh(

@@ -64,22 +64,30 @@ float sd_capsule(vec3 p, vec3 a, vec3 b, float radius) {
 // to 0) is the hard minimum, its dip k/4 being below any distance's rounding; above it 0.5 / k stays finite.
 #define MIN_BLEND_WIDTH 1.17549435e-38
 
+// Distances may be infinite (a float32 length overflows past ~1.8e19 m): the gap is 0 where a = b, the same infinity
+// included (not inf - inf), and where h is 0 or 1 the result is b or a outright (not 0 * inf), as in kernels/sdf.py.
+#define FLOAT32_MAX 3.40282347e38
 vec2 smin_poly_weighted(float a, float b, float k) {
     bool hard = !(k >= MIN_BLEND_WIDTH);
-    float width = hard ? 1.0 : k;
-    // (b - a) * (0.5 / width) may overflow to +-inf, which the clamp maps to 0 or 1; it is 0 where a = b.
-    float h = clamp(0.5 + (b - a) * (0.5 / width), 0.0, 1.0);
-    vec2 smooth_min = vec2(h * a + (1.0 - h) * b - width * h * (1.0 - h), 1.0 - h);
+    float width = hard ? 1.0 : min(k, FLOAT32_MAX);
+    float gap = a == b ? 0.0 : b - a;
+    // (0.5 * gap) / width may overflow to +-inf, which the clamp maps to 0 or 1. Not gap * (0.5 / width): past
+    // width 4e37 that factor is subnormal, a GPU flushes it to 0, and inf * 0 is NaN.
+    float h = clamp(0.5 + (0.5 * gap) / width, 0.0, 1.0);
+    float blended = h * a + (1.0 - h) * b - width * h * (1.0 - h);
+    vec2 smooth_min = vec2(h == 0.0 ? b : (h == 1.0 ? a : blended), 1.0 - h);
     return hard ? vec2(min(a, b), b < a ? 1.0 : 0.0) : smooth_min;
 }
 
 // k is the sharpness (1/m); min(a, b) - log(1 + exp(-k|a - b|))/k cannot overflow, and the weight of b,
-// exp(-kb)/(exp(-ka) + exp(-kb)), reuses the same exponential. Where a = b the exponential is 1 outright, so an
-// infinite sharpness (the hard minimum) never meets inf * 0.
+// exp(-kb)/(exp(-ka) + exp(-kb)), reuses the same exponential. Where a = b (the same infinity included) the
+// exponential is 1 outright, so an infinite sharpness (the hard minimum) never meets inf * 0. A sharpness below
+// float32's smallest normal (a huge width; a GPU may flush it to 0) is that normal, so log(2)/k stays finite.
 vec2 smin_exp_weighted(float a, float b, float k) {
-    float gap = abs(a - b);
-    float e = gap == 0.0 ? 1.0 : exp(-k * gap);
-    float d = min(a, b) - log(1.0 + e) / k;
+    float sharpness = max(k, MIN_BLEND_WIDTH);
+    float gap = a == b ? 0.0 : abs(a - b);
+    float e = gap == 0.0 ? 1.0 : exp(-sharpness * gap);
+    float d = min(a, b) - log(1.0 + e) / sharpness;
     return vec2(d, a > b ? 1.0 / (1.0 + e) : e / (1.0 + e));
 }
 

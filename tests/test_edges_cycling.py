@@ -4,6 +4,7 @@ written here: a dense scan of ``cycling.power`` for the last sign change, refine
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Callable
 
 import numpy as np
@@ -156,6 +157,149 @@ def test_standing_still_needs_no_power_without_a_push() -> None:
     for p in (1e-300, 1e-9, 1.0):
         v = float(cycling.speed_for_power(p, 0.32, 80.0, 0.0))
         assert v == pytest.approx((p / a) ** (1 / 3), rel=1e-12)
+
+
+# ------------------------------------------------------------------------ the domain: overflow, underflow, last ulps
+# The kind (review of issue 8): finite accepted inputs whose intermediates (P/a, |c|/a, w², m·g·(Crr + grade),
+# ρ(h)) overflow or underflow, giving inf or a wrong finite speed, and a stopping rule that quit several ulps short
+# where dP/dv is large. Family: every argument at and beyond the ends of SPEED_FOR_POWER_DOMAIN, any finite grade.
+DOMAIN = cycling.SPEED_FOR_POWER_DOMAIN
+BASE = dict(power_w=100.0, cda_m2=0.32, mass_kg=80.0, crr=0.005, headwind_ms=0.0, altitude_m=0.0)
+
+
+def solve_without_warnings(**args: float) -> float:
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        return float(cycling.speed_for_power(**args))
+
+
+def assert_solves_to_the_nearest_float(v: float, **args: float) -> None:
+    """power(v) = P to rounding (1e-9 relative, 1e-9 W, or two ulps of v), and for P > 0 no float neighbour of v is
+    closer."""
+    assert math.isfinite(v) and v >= 0.0, v
+    target = args.pop("power_w")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        parts = cycling.power(
+            np.array([max(np.nextafter(v, -1.0), 0.0), v, np.nextafter(v, np.inf)]), **args
+        )
+    miss = np.abs(parts.total - target)
+    scale = np.abs(parts.aero[1]) + np.abs(parts.rolling[1]) + np.abs(parts.climbing[1])
+    per_ulp = 0.5 * abs(
+        parts.total[2] - parts.total[0]
+    )  # where one ulp of v moves P by more than 1e-9 W
+    assert miss[1] <= max(1e-9 * target, 1e-9, 1e-13 * scale, 2.0 * per_ulp), (
+        v,
+        parts.total[1],
+        target,
+    )
+    if target > 0.0 and v > 0.0:
+        # Up to the rounding of P·η and of power()'s division by η.
+        slack = 1e-15 * (scale / args.get("drivetrain_efficiency", 1.0) + target)
+        assert miss[1] <= miss.min() + slack, (miss, v)
+
+
+def edge(name: str) -> st.SearchStrategy[float]:
+    low, high = DOMAIN[name]
+    inside = st.floats(low, high) | st.sampled_from([low, high, 0.5 * (low + high)])
+    return inside.filter(lambda x: name not in ("cda_m2", "mass_kg") or x > 0.0)
+
+
+@given(
+    power_w=edge("power_w") | tiny_powers,
+    cda_m2=edge("cda_m2"),
+    mass_kg=edge("mass_kg") | st.sampled_from([5e-324, 1e-300, 80.0]),
+    crr=edge("crr"),
+    grade=st.floats(allow_nan=False, allow_infinity=False)
+    | st.sampled_from([-1.7e308, 1.7e308, -1e10, 0.0]),
+    altitude_m=edge("altitude_m"),
+    headwind_ms=edge("headwind_ms") | st.sampled_from([-300.0, -1000.0, 1000.0]),
+    drivetrain_efficiency=st.sampled_from([1.0, 0.9, 0.01]),
+)
+@settings(max_examples=400, deadline=None)
+def test_speed_for_power_is_finite_and_exact_over_its_whole_domain(**args: float) -> None:
+    v = solve_without_warnings(**args)
+    assert_solves_to_the_nearest_float(v, **args)
+
+
+@given(
+    name=st.sampled_from(sorted(DOMAIN)),
+    side=st.sampled_from([-1.0, 1.0]),
+    beyond=st.floats(1e-9, 1.0) | st.sampled_from([1e3, 1e150, 1e300]),
+)
+@settings(max_examples=200, deadline=None)
+def test_speed_for_power_rejects_values_outside_its_domain_by_name(
+    name: str, side: float, beyond: float
+) -> None:
+    low, high = DOMAIN[name]
+    end = high if side > 0.0 else low
+    value = end + side * max(beyond * max(abs(end), 1.0), 1e-300)
+    if side < 0.0 and name in ("cda_m2", "mass_kg"):
+        value = min(value, low * (1.0 - 1e-9)) if low > 0.0 else -beyond
+    args = dict(BASE, **{name: value})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(ValueError, match=name):
+            cycling.speed_for_power(**args)
+
+
+# The reviewer's inputs (args 0.32 m², 80 kg, Crr 0.005 unless shown), each with its right value.
+@pytest.mark.parametrize(
+    "name, value",
+    [
+        ("headwind_ms", 1e155),  # returned 8.47 m/s, the no-wind speed
+        ("headwind_ms", 1e200),
+        ("headwind_ms", 1.7e308),
+        ("headwind_ms", -1.7e308),  # returned inf
+        ("power_w", 1.7e308),  # returned inf (P/a overflowed)
+        ("altitude_m", 1e300),  # returned inf (density underflowed to 0)
+        ("altitude_m", -1e300),  # returned 0.0 (density overflowed)
+        ("cda_m2", 5e-324),  # returned inf
+        ("cda_m2", 1e-300),  # warned
+    ],
+)
+def test_absurd_inputs_are_refused_by_name(name: str, value: float) -> None:
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(ValueError, match=name):
+            cycling.speed_for_power(**dict(BASE, **{name: value}))
+
+
+@pytest.mark.parametrize("grade", [-1.7e308, -1e300, -1e10])
+def test_a_vertical_descent_falls_at_terminal_velocity(grade: float) -> None:
+    # m·g·(Crr + grade) overflowed to −inf (returned inf). A vertical road: gravity m·g against drag a·v², so
+    # at 0 W v = √(m·g / a) = 63.278 m/s, and at 100 W the root of v·(a·v² − m·g) = 100.
+    a = 0.5 * 1.225 * 0.32
+    v0 = solve_without_warnings(**dict(BASE, power_w=0.0, grade=grade))
+    assert v0 == pytest.approx(math.sqrt(80.0 * 9.81 / a), rel=1e-12)
+    assert v0 == pytest.approx(63.27781312, rel=1e-9)
+    v = solve_without_warnings(**dict(BASE, grade=grade))
+    root = brentq(lambda x: x * (a * x * x - 80.0 * 9.81) - 100.0, 63.0, 64.0, xtol=1e-13)
+    assert v == pytest.approx(root, rel=1e-12)
+
+
+def test_a_subnormal_efficiency_is_the_zero_power_speed() -> None:
+    # P·η underflows to (almost) nothing: the rider coasts (power() itself overflows dividing by such an η).
+    for grade, expected in (
+        (0.0, 0.0),
+        (-0.02, float(cycling.speed_for_power(0.0, 0.32, 80.0, 0.005, -0.02))),
+    ):
+        v = solve_without_warnings(**dict(BASE, grade=grade, drivetrain_efficiency=5e-324))
+        assert v == pytest.approx(expected, rel=1e-15, abs=1e-300)
+
+
+def test_a_fast_tailwind_lands_on_the_nearest_float() -> None:
+    # Stopped 15 ulps early: power(v) missed 0.001 W by 1.2e-8 W (one ulp of v is 1.5e-9 W here).
+    args = dict(
+        power_w=0.001,
+        cda_m2=0.3,
+        mass_kg=80.0,
+        crr=0.008023272163568376,
+        grade=0.0749270873968717,
+        headwind_ms=-1000.0,
+    )
+    v = solve_without_warnings(**args)
+    assert_solves_to_the_nearest_float(v, **args)
 
 
 # ------------------------------------------------------------------------------------------------ the scene's readout

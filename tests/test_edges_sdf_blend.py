@@ -7,6 +7,8 @@ scene's is.
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -153,3 +155,161 @@ def test_two_spheres_with_a_tiny_width_mesh_like_k_zero(k: float, blend: sdf.Ble
     assert np.all(np.isfinite(colors))
     at_origin = float(sdf.scene_distance(two_spheres(k, blend), [[0.0, 0.0, 0.0]])[0])
     assert np.isfinite(at_origin) and -k / 4 <= at_origin <= 0.0
+
+
+# ------------------------------------------------------------------------ infinite and huge distances, huge widths
+# The kind (review of issue 8): inf − inf and 0·inf inside the blends. A far point's distance overflows to inf
+# (float64 past ~1e154 m, float32 past ~1e19 m), and a huge width (or a subnormal sharpness) overflowed ln 2 / k.
+# Family: ±inf, ±huge and ordinary distances against widths from 0 to the largest float, every op, form and dtype.
+HUGE = [np.inf, -np.inf, 1.7e308, -1.7e308, 1e300, -1e300, 3.4e38, -3.4e38, 1e30, -1e30]
+extreme_distances = st.one_of(st.sampled_from(HUGE + [0.0, 0.5, -0.5]), st.floats(-3.0, 3.0))
+extreme_widths = st.one_of(
+    widths, st.sampled_from([1.0, 1e19, 1e30, 3.4e38, 3.5e38, 1e100, 1e300, 1.7976931348623157e308])
+)
+
+
+@given(
+    a=st.lists(extreme_distances, min_size=1, max_size=12),
+    b=st.lists(extreme_distances, min_size=1, max_size=12),
+    k=extreme_widths,
+    op=st.sampled_from(sdf.BOOLEAN_OPS),
+    blend=st.sampled_from(sdf.BLEND_FORMS),
+    dtype=st.sampled_from([np.float32, np.float64]),
+)
+@settings(max_examples=400, deadline=None)
+def test_blends_of_infinite_and_huge_distances_are_never_nan(
+    a: list[float],
+    b: list[float],
+    k: float,
+    op: sdf.BooleanOp,
+    blend: sdf.BlendForm,
+    dtype: type,
+) -> None:
+    n = min(len(a), len(b))
+    with np.errstate(over="ignore"):
+        x, y = np.asarray(a[:n]).astype(dtype), np.asarray(b[:n]).astype(dtype)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        if dtype is np.float64:
+            got = SMOOTH[op](x, y, k, blend)
+        else:
+            got, weight = sdf._combine(x, y, op, k, blend)
+            assert np.all((weight >= 0.0) & (weight <= 1.0))
+    hard = HARD[op](x.astype(np.float64), y.astype(np.float64))
+    got64 = np.asarray(got, dtype=np.float64)
+    assert not np.any(np.isnan(got64))
+    infinite = ~np.isfinite(hard)
+    np.testing.assert_array_equal(
+        got64[infinite], hard[infinite]
+    )  # inf blended with anything is the hard answer
+    big = float(np.finfo(dtype).max)
+    # Finite where the hard answer is, unless the true blend itself (within k/4 of it) lies beyond the dtype.
+    with np.errstate(over="ignore", invalid="ignore"):
+        ok = np.isfinite(got64) | (np.abs(hard) + min(k, big) / 4 > big)
+    assert np.all(ok[~infinite])
+    fin = ~infinite & np.isfinite(got64)
+    sign = 1.0 if op == "union" else -1.0
+    dev = sign * (hard[fin] - got64[fin])  # ≥ 0: a union only dips, the others only rise
+    rounding = 4 * np.finfo(dtype).eps * np.abs(hard[fin])
+    assert np.all(dev >= -rounding) and np.all(dev <= min(k, big) / 4 * (1 + 1e-6) + rounding)
+
+
+def test_an_infinite_distance_blends_to_the_other_one() -> None:
+    # Review of issue 8: smooth_union([inf], [1], 0.1) was NaN (the hard union gives 1).
+    for blend in sdf.BLEND_FORMS:
+        assert float(sdf.smooth_union([np.inf], [1.0], 0.1, blend)[0]) == 1.0
+        assert float(sdf.smooth_union([np.inf], [np.inf], 0.1, blend)[0]) == np.inf
+        assert float(sdf.smooth_union([np.inf], [-np.inf], 0.1, blend)[0]) == -np.inf
+        assert float(sdf.smooth_intersect([np.inf], [1.0], 0.1, blend)[0]) == np.inf
+        assert float(sdf.smooth_subtract([1.0], [np.inf], 0.1, blend)[0]) == 1.0
+
+
+@pytest.mark.parametrize("op", sdf.BOOLEAN_OPS)
+@pytest.mark.parametrize("blend", sdf.BLEND_FORMS)
+def test_a_far_point_has_an_infinite_distance_and_a_colour(
+    op: sdf.BooleanOp, blend: sdf.BlendForm
+) -> None:
+    # Review of issue 8: NaN for every op and form at [[1e200, 0, 0]] (both primitives' lengths overflow to inf).
+    scene = sdf.Scene(
+        (
+            sdf.Primitive("sphere", (0.0, 0.0, 0.0), (0.5,), color=(1.0, 0.0, 0.0)),
+            sdf.Primitive("box", (1.0, 0.0, 0.0), (0.5, 0.5, 0.5), op=op, color=(0.0, 0.0, 1.0)),
+        ),
+        k=0.1,
+        blend=blend,
+    )
+    far = [[1e200, 0.0, 0.0], [1e160, 1e160, 0.0], [0.0, 0.0, 1e154]]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        d = sdf.scene_distance(scene, far)
+        color = sdf.scene_color(scene, far)
+    # The sphere's distance is inf at the first two (and 1e154 − 0.5 at the third); subtracting a box far away
+    # leaves the sphere's, so every op gives inf there.
+    assert d[0] == np.inf and d[1] == np.inf
+    assert d[2] == pytest.approx(1e154, rel=1e-12)
+    assert np.all(np.isfinite(color)) and np.all((color >= 0.0) & (color <= 1.0))
+
+
+def test_smin_exp_with_a_subnormal_sharpness_is_finite_without_warnings() -> None:
+    # Review of issue 8: overflow warnings (ln 2 / 5e-324 overflows); the sharpness floors at the smallest normal.
+    a = np.array([0.0, 1.0, -2.0, 0.5])
+    b = np.array([0.0, 3.0, -2.0, 0.5 + 1e-16])
+    for sharpness in (5e-324, 1e-320, 1e-310):
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            got = sdf.smin_exp(a, b, sharpness)
+        with np.errstate(over="ignore"):
+            low = (
+                np.minimum(a, b) - np.log(2.0) / sharpness
+            )  # −inf: the bound says nothing at such sharpness
+        assert np.all(np.isfinite(got)) and np.all((low <= got) & (got <= np.minimum(a, b)))
+
+
+# ------------------------------------------------------------------------------------------------ bad arguments
+@pytest.mark.parametrize("blend", ["POLY", "quadratic", None, 0])
+@pytest.mark.parametrize("k", [0.0, 0.1])
+def test_an_unknown_blend_form_is_a_value_error_naming_blend(blend: object, k: float) -> None:
+    for fn in SMOOTH.values():
+        with pytest.raises(ValueError, match="blend"):
+            fn([0.0], [1.0], k, blend)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("k", [None, [0.1], "0.1", b"0.1", True, 1j, np.array([0.1])])
+def test_a_width_that_is_not_a_real_number_is_a_value_error_naming_k(k: object) -> None:
+    for fn in SMOOTH.values():
+        with pytest.raises(ValueError, match="k"):
+            fn([0.0], [1.0], k)  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match="k"):
+        sdf.Scene((sdf.Primitive("sphere", (0.0, 0.0, 0.0), (0.5,)),), k=k)  # type: ignore[arg-type]
+
+
+# ------------------------------------------------------------------------------------------------ huge widths
+def test_a_width_beyond_max_blend_width_is_refused_by_name() -> None:
+    # Review of issue 8: k ≥ ~1e19 gave an empty mesh (the float32 field overflowed); k = 1e30 warned too.
+    for k in (np.nextafter(sdf.MAX_BLEND_WIDTH, np.inf), 1e19, 1e30, 1e300):
+        with pytest.raises(ValueError, match="k"):
+            two_spheres(k, "poly")
+
+
+@pytest.mark.parametrize("blend", sdf.BLEND_FORMS)
+@pytest.mark.parametrize("k", [1.0, 1e3, 1e6])
+def test_the_widest_blends_still_mesh_closed(k: float, blend: sdf.BlendForm) -> None:
+    import trimesh
+
+    scene = two_spheres(k, blend)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        vertices, faces, colors = sdf.mesh(scene, 33)
+    assert len(faces) > 0
+    tri = trimesh.Trimesh(vertices, faces, process=False)
+    assert tri.is_watertight and tri.euler_number == 2
+    assert np.all(np.isfinite(colors))
+    # The blend dips by k/4 between the spheres: the blob reaches about k/4 beyond them.
+    assert float(np.abs(vertices).max()) == pytest.approx(k / 4, rel=0.5, abs=1.2)
+
+
+def test_bounds_beyond_float32_reach_are_refused_by_name() -> None:
+    scene = two_spheres(0.1, "poly")
+    for size in (2e18, 2e19, 1e30):
+        with pytest.raises(ValueError, match="bounds"):
+            sdf.mesh(scene, 16, [[-size] * 3, [size] * 3])

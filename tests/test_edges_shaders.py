@@ -186,3 +186,70 @@ def test_glsl_and_numpy_colour_a_tie_alike_at_every_width(
     np.testing.assert_allclose(color, sdf.scene_color(scene, points), atol=1e-5)
     expected_blue = 0.0 if k < sdf.MIN_BLEND_WIDTH else 0.5
     np.testing.assert_allclose(color[:, 2], expected_blue, atol=1e-5)
+
+
+# ------------------------------------------------------------------------ infinite and huge distances, huge widths
+# Review of issue 8: float32 lengths overflow to inf past ~1.8e19 m, and inf − inf or 0·inf in the blends gave NaN.
+# The same family as the numpy test: ±inf, ±huge and ordinary distances, widths up to float32's largest.
+FLOAT32_MAX = float(np.finfo(np.float32).max)
+
+
+@pytest.mark.gl
+@given(
+    k=st.one_of(
+        st.sampled_from([0.0, 1e-40, 1.2e-38, 0.1, 1.0, 1e19, 1e30, FLOAT32_MAX]),
+        st.floats(0.0, 1e6, width=32),
+    ),
+    values=st.lists(
+        st.sampled_from([np.inf, -np.inf, FLOAT32_MAX, -FLOAT32_MAX, 1e30, -1e30, 0.0, 0.5, -0.5]),
+        min_size=8,
+        max_size=8,
+    ),
+)
+@settings(max_examples=30, deadline=None)
+def test_glsl_blends_of_infinite_and_huge_distances_are_never_nan(
+    gl: Renderer, k: float, values: list[float]
+) -> None:
+    v = np.asarray(values, np.float32)
+    a_all, b_all = np.repeat(v, len(v)), np.tile(v, len(v))  # every pair, ties included
+    with np.errstate(divide="ignore", over="ignore", under="ignore"):
+        sharpness = np.float32(sdf.EXP_SHARPNESS_PER_WIDTH) / np.float32(k)
+    inputs = np.stack(
+        [a_all, b_all, np.full_like(a_all, k), np.full_like(a_all, sharpness)], axis=1
+    )
+    poly, expo = glsl_blends(gl, inputs)
+    assert not np.any(np.isnan(poly)) and not np.any(np.isnan(expo))
+    x, y = a_all.astype(np.float64), b_all.astype(np.float64)
+    hard = np.stack(
+        [np.minimum(x, y), np.minimum(x, y), np.maximum(x, -y), np.maximum(x, y)], axis=1
+    )
+    infinite = ~np.isfinite(hard)
+    for got in (poly, expo):
+        got64 = got.astype(np.float64)
+        np.testing.assert_array_equal(got64[infinite], hard[infinite])
+        fin = ~infinite & np.isfinite(got64)
+        dip = min(k, FLOAT32_MAX) / 4
+        # Finite wherever the true blend (within k/4 of the hard answer) fits in float32.
+        with np.errstate(over="ignore"):
+            fits = np.abs(hard) + dip * (1 + 1e-6) < FLOAT32_MAX * (1 - 1e-6)
+        assert np.all(np.isfinite(got64)[~infinite & fits])
+        slack = dip * (1 + 1e-5) + 4e-7 * np.abs(hard[fin]) + 1e-30
+        assert np.all(np.abs(got64[fin] - hard[fin]) <= slack)
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("blend", sdf.BLEND_FORMS)
+def test_glsl_scene_far_away_is_infinite_not_nan(gl: Renderer, blend: sdf.BlendForm) -> None:
+    # A float32 length overflows past ~1.8e19 m: both primitives' distances are inf there.
+    scene = sdf.Scene(
+        (
+            sdf.Primitive("sphere", (0.0, 0.0, 0.0), (0.5,)),
+            sdf.Primitive("box", (1.0, 0.0, 0.0), (0.5, 0.5, 0.5), op="union"),
+        ),
+        k=0.1,
+        blend=blend,
+    )
+    distance, color = gl.probe(scene, [[1e30, 0.0, 0.0], [0.0, 1e25, 1e25], [0.0, 0.0, 0.0]])
+    assert not np.any(np.isnan(distance)) and np.all(np.isfinite(color))
+    assert distance[0] == np.inf and distance[1] == np.inf
+    assert distance[2] == pytest.approx(-0.5, abs=1e-6)
