@@ -307,6 +307,10 @@ def load_gpx(
         raise ValueError(f"{label} is not a GPX file: not UTF-8 text") from error
     if _GPX_ROOT.search(text[:4096]) is None:
         raise ValueError(f"{label} is not a GPX file: no <gpx> element at its start")
+    # Count before parsing: gpxpy would build every point first.
+    tagged = text.count("<trkpt") + text.count("<rtept")
+    if tagged > MAX_POINTS:
+        raise ValueError(f"{label} has {tagged} points; the limit is {MAX_POINTS}")
     try:
         gpx = gpxpy.parse(text)
     except gpxpy.gpx.GPXException as error:
@@ -489,6 +493,9 @@ class Ride:
 
 
 _E_WORK, _E_AERO, _E_ROLL, _E_BEAR, _E_CLIMB, _E_BRAKE = range(6)
+_REFINE_RATIO = 0.5
+"""A step that changes the speed by more than this fraction is redone in halves (up to _REFINE_UP_TO)."""
+_REFINE_UP_TO = 64
 
 
 @numba.njit(cache=True)
@@ -569,7 +576,9 @@ def _ride_core(
     elapsed[0] = 0.0
     for i in range(length.shape[0]):
         force = rolling[i] + climbing[i]
-        n_sub = 1
+        # From rest v grows as s^(1/3) (v³ = 3ηP·s/M): cubically graded sub-steps follow it.
+        graded = v0 == 0.0
+        n_sub = 64 if graded else 1
         while True:
             ok = True
             v = v0
@@ -579,14 +588,24 @@ def _ride_core(
             roll = 0.0
             bear = 0.0
             brake = 0.0
-            sub = length[i] / n_sub
-            for _ in range(n_sub):
+            for k in range(n_sub):
+                if graded:
+                    sub = length[i] * ((k + 1.0) ** 3 - k**3) / n_sub**3
+                else:
+                    sub = length[i] / n_sub
                 p_in = efficiency * power_w[i]
                 vb = _step(v, sub, drag[i], force, wind[i], p_in, mass, b0, b1)
                 if vb <= 0.0:
                     ok = False
                     break
                 v1 = 2.0 * vb - v
+                if (
+                    not graded
+                    and n_sub < _REFINE_UP_TO
+                    and abs(v1 - v) > _REFINE_RATIO * max(v, v1)
+                ):
+                    ok = False  # an abrupt change of speed (a wall, a crest): finer steps, for accuracy
+                    break
                 rider_in = p_in
                 if v1 > v_cap:
                     v1 = v_cap
@@ -890,8 +909,9 @@ def paced_ride(
     """Vary power with the grade (Swain 1997) at the same time-averaged power as a constant ``power_w``.
 
     Segment i gets P_i = k·(1 + gain·tanh(grade_i / 0.05)): up to ``gain`` more on steep climbs and less on
-    descents, and k is set (a few fixed-point rescalings) so that Σ P_i·t_i / Σ t_i = ``power_w`` (what a
-    power meter would show for both rides).
+    descents, and k is set (a few fixed-point rescalings) so that the paced ride's time-averaged power
+    Σ P_i·t_i / Σ t_i equals the constant ride's (what a power meter would show for both rides; that is
+    ``power_w`` unless the constant ride eased off to hold the speed cap).
 
     Args:
         power_w: the constant ride's power and the paced ride's time-averaged power (W, > 0).
@@ -913,11 +933,13 @@ def paced_ride(
     n = course.n_points - 1
     constant = _ride(course, np.full(n, target), s, cap, start)
     shape = pacing_factors(course.grade, g)
+    # Match what the constant ride really averaged: where it eases off to hold the speed cap it is below target.
+    average = constant.average_power_w
     scale = target
     paced = constant
     for _ in range(30):
         paced = _ride(course, scale * shape, s, cap, start)
-        ratio = target / paced.average_power_w
+        ratio = average / paced.average_power_w
         scale *= ratio
         if abs(ratio - 1.0) < 1e-9:
             break
