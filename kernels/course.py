@@ -515,18 +515,24 @@ def _step(v0, length, drag, force, wind, power_in, mass, b0, b1):  # pragma: no 
         return -1.0
     if q_lo == 0.0 and lo > 0.0:
         return lo
-    hi = max(v0, 1.0)
-    for _ in range(80):
-        q_hi = 2.0 * mass * (hi - v0) * hi * hi + length * (
-            _wheel_power(hi, drag, force, wind, b0, b1) - power_in
-        )
-        if q_hi > 0.0:
-            break
-        lo = hi
-        hi *= 2.0
-    x = min(max(v0, lo), hi)
-    if x <= lo or x >= hi:
-        x = 0.5 * (lo + hi)
+    # Newton from v̄ = v0 (the answer for a short step), inside a bracket [lo, hi] that bisection falls back on.
+    x = v0 if v0 > lo else 1.0
+    q_x = 2.0 * mass * (x - v0) * x * x + length * (
+        _wheel_power(x, drag, force, wind, b0, b1) - power_in
+    )
+    if q_x > 0.0:
+        hi = x
+    else:
+        lo = x
+        hi = 1.25 * x + 0.5
+        for _ in range(80):
+            q_hi = 2.0 * mass * (hi - v0) * hi * hi + length * (
+                _wheel_power(hi, drag, force, wind, b0, b1) - power_in
+            )
+            if q_hi > 0.0:
+                break
+            lo = hi
+            hi *= 2.0
     for _ in range(100):
         air = x + wind
         q = 2.0 * mass * (x - v0) * x * x + length * (
