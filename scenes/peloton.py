@@ -777,9 +777,11 @@ POWER_MODEL_FROM_LABEL: dict[str, course_kernel.Model] = {
     "Seed (aero, rolling, climbing)": "seed",
 }
 SAMPLE_LABEL = "Alpe d'Huez (sample, from the published profile)"
-COURSE_BOX_M = 12.0
+COURSE_BOX_M = 6.0
 """The drawn course fits a square of this size (scene metres) where the line's camera looks."""
 COURSE_CENTRE = np.array([-3.2, 0.0])
+TERRAIN_HALF_WIDTH_M = 0.15
+"""Half width of the drawn terrain strip (scene m)."""
 COURSE_MARKER_SCALE = 0.35
 """Riders on the course are drawn at this fraction of life size (a marker, not to the map's scale)."""
 MAX_DRAWN_POINTS = 2000
@@ -816,7 +818,7 @@ class CourseParams:
     """Vary power with the grade (Swain 1997) at the same average."""
     pacing_gain_pct: float = 15.0
     """How much more power on steep climbs, and less on descents (%)."""
-    exaggeration: float = 3.0
+    exaggeration: float = 2.0
     """Vertical exaggeration of the drawn terrain."""
     playback: float = 60.0
     """Playback speed (× real time)."""
@@ -972,27 +974,37 @@ class CourseDrawing:
 
 
 def terrain_strip(points: np.ndarray, half_width: float) -> tuple[np.ndarray, np.ndarray]:
-    """A ribbon under the route with skirts down to z = 0: (4k, 3) vertices and faces."""
+    """A road-side strip along the route and a curtain under it down to z = 0: (4k, 3) vertices and faces.
+
+    The strip is the terrain the road crosses; the curtain shows the height above the valley floor.
+    """
     k = points.shape[0]
     direction = np.gradient(points[:, :2], axis=0)
     norm = np.linalg.norm(direction, axis=1, keepdims=True)
     direction = direction / np.where(norm > 1e-12, norm, 1.0)
     side = np.stack([-direction[:, 1], direction[:, 0]], axis=1) * half_width
-    top = points[:, 2] - 0.04
-    left = np.concatenate([points[:, :2] + side, top[:, None]], axis=1)
-    right = np.concatenate([points[:, :2] - side, top[:, None]], axis=1)
-    left_foot = left * [1.0, 1.0, 0.0]
-    right_foot = right * [1.0, 1.0, 0.0]
-    vertices = np.concatenate([left, right, left_foot, right_foot])
-    i = np.arange(k - 1)
-    a, b = i, i + 1
-    L, R, LF, RF = 0, k, 2 * k, 3 * k  # block offsets: top left, top right, feet
+    top = points[:, 2:3] - 0.03
+    left = np.concatenate([points[:, :2] + side, top], axis=1)
+    right = np.concatenate([points[:, :2] - side, top], axis=1)
+    centre = np.concatenate([points[:, :2], top - 0.01], axis=1)
+    foot = centre * [1.0, 1.0, 0.0]
+    vertices = np.concatenate([left, right, centre, foot])
+    a = np.arange(k - 1)
+    b = a + 1
+    L, R, C, F = 0, k, 2 * k, 3 * k  # block offsets: left edge, right edge, centre, its foot
     faces = np.concatenate([
-        np.stack([L + a, R + a, R + b], axis=1), np.stack([L + a, R + b, L + b], axis=1),  # top
-        np.stack([LF + a, L + a, L + b], axis=1), np.stack([LF + a, L + b, LF + b], axis=1),  # left skirt
-        np.stack([R + a, RF + a, RF + b], axis=1), np.stack([R + a, RF + b, R + b], axis=1),  # right skirt
+        np.stack([L + a, R + a, R + b], axis=1), np.stack([L + a, R + b, L + b], axis=1),  # strip
+        np.stack([F + a, C + a, C + b], axis=1), np.stack([F + a, C + b, F + b], axis=1),  # curtain
     ])  # fmt: skip
     return vertices.astype(np.float32), faces.astype(np.uint32)
+
+
+def ground_under(points: np.ndarray, margin: float = 0.6) -> tuple[np.ndarray, np.ndarray]:
+    """A thin slab under the route's bounding rectangle plus ``margin`` (scene m): vertices and faces."""
+    lo, hi = points[:, :2].min(axis=0) - margin, points[:, :2].max(axis=0) + margin
+    slab = trimesh.creation.box(extents=(*(hi - lo), 0.02))
+    slab.apply_translation((*((lo + hi) / 2), -0.011))
+    return slab.vertices.astype(np.float32), slab.faces.astype(np.uint32)
 
 
 def grade_colours(grade: np.ndarray) -> np.ndarray:
@@ -1040,79 +1052,16 @@ class CourseMode:
         gui, p = self.server.gui, self.params
         with self.scene.gui_root, gui.add_folder("Course mode (GPX route)", order=-1.0):
             self.enable = gui.add_checkbox("Ride a course", initial_value=False)
+            self.route_info = gui.add_markdown(self._route_markdown())
             self.sample = gui.add_button("Load the sample route")
             self.upload = gui.add_upload_button("Upload GPX", mime_type=".gpx,application/gpx+xml")
-            self.route_info = gui.add_markdown(self._route_markdown())
-            self.power = gui.add_number(
-                "Course power (W)", min=20.0, max=2000.0, step=5.0, initial_value=p.power_w
-            )
-            self.target = gui.add_number(
-                "Target time (min)", min=1.0, max=6000.0, step=1.0, initial_value=p.target_min
-            )
-            self.solve = gui.add_button("Find the power for this time")
-            self.power_model = gui.add_dropdown(
-                "Power model",
-                options=list(POWER_MODEL_FROM_LABEL),
-                initial_value="Martin et al. 1998 (full)",
-            )
-            self.air = gui.add_dropdown(
-                "Air", options=list(AIR_FROM_LABEL), initial_value="Seed (exponential)"
-            )
-            self.temperature = gui.add_slider(
-                "Temperature (°C)", min=-20.0, max=45.0, step=0.5, initial_value=p.temperature_c
-            )
-            self.pressure_source = gui.add_dropdown(
-                "Pressure from", options=list(PRESSURE_SOURCES), initial_value=PRESSURE_SOURCES[0]
-            )
-            self.pressure = gui.add_number(
-                "Pressure at the start (hPa)",
-                min=500.0,
-                max=1100.0,
-                step=0.5,
-                initial_value=p.pressure_hpa,
-            )
-            self.humidity = gui.add_slider(
-                "Humidity (%)", min=0.0, max=100.0, step=1.0, initial_value=p.humidity_pct
-            )
-            self.wind = gui.add_slider(
-                "Wind (m/s)", min=0.0, max=20.0, step=0.5, initial_value=p.wind_ms
-            )
-            self.wind_from = gui.add_slider(
-                "Wind from (° from north)",
-                min=0.0,
-                max=359.0,
-                step=1.0,
-                initial_value=p.wind_from_deg,
-            )
-            self.max_speed = gui.add_slider(
-                "Safe descending speed (km/h)",
-                min=20.0,
-                max=110.0,
-                step=1.0,
-                initial_value=p.max_speed_kmh,
-            )
-            self.pacing = gui.add_checkbox("Pace by grade", initial_value=p.pacing)
-            self.pacing_gain = gui.add_slider(
-                "Pacing gain (%)", min=0.0, max=50.0, step=1.0, initial_value=p.pacing_gain_pct
-            )
-            self.exaggeration = gui.add_slider(
-                "Elevation exaggeration (×)",
-                min=1.0,
-                max=10.0,
-                step=0.5,
-                initial_value=p.exaggeration,
-            )
             self.play = gui.add_button("Play")
             self.pause = gui.add_button("Pause")
             self.scrub = gui.add_slider(
                 "Position (km)", min=0.0, max=self._total_km(), step=0.01, initial_value=0.0
             )
-            self.playback = gui.add_slider(
-                "Playback speed (×)", min=1.0, max=600.0, step=1.0, initial_value=p.playback
-            )
             self.now = gui.add_markdown("")
             self.readout = gui.add_markdown("")
-            self.splits = gui.add_markdown("")
             self.chart = gui.add_uplot(
                 data=self._chart_data(),
                 series=(
@@ -1121,28 +1070,100 @@ class CourseMode:
                         label="Elevation (m)", stroke="rgb(120,90,60)", width=2, scale="m"
                     ),
                     viser.uplot.Series(
-                        label="Speed (km/h)", stroke="rgb(30,110,220)", width=1.5, scale="y"
+                        label="Speed (km/h)", stroke="rgb(30,110,220)", width=1.5, scale="kmh"
                     ),
                     viser.uplot.Series(
-                        label="Power (W)", stroke="rgb(220,40,40)", width=1.5, scale="y"
+                        label="Power (W)", stroke="rgb(220,40,40)", width=1.5, scale="W"
                     ),
                 ),
                 scales={
                     "x": viser.uplot.Scale(time=False, auto=True),
                     "m": viser.uplot.Scale(auto=True),
-                    "y": viser.uplot.Scale(auto=True),
+                    "kmh": viser.uplot.Scale(auto=True),
+                    "W": viser.uplot.Scale(auto=True),
                 },
                 axes=(
                     viser.uplot.Axis(scale="x", label="km"),
                     viser.uplot.Axis(scale="m", label="m", side=3),
                     viser.uplot.Axis(
-                        scale="y", label="km/h, W", side=1, grid=viser.uplot.Axis_Grid(show=False)
+                        scale="kmh", label="km/h", side=1, grid=viser.uplot.Axis_Grid(show=False)
+                    ),
+                    viser.uplot.Axis(
+                        scale="W", label="W", side=1, grid=viser.uplot.Axis_Grid(show=False)
                     ),
                 ),
                 legend=viser.uplot.Legend(show=True),
                 title="Elevation, speed and power along the course",
                 aspect=1.4,
             )
+            with gui.add_folder("Power, model and air"):
+                self.power = gui.add_number(
+                    "Course power (W)", min=20.0, max=2000.0, step=5.0, initial_value=p.power_w
+                )
+                self.target = gui.add_number(
+                    "Target time (min)", min=1.0, max=6000.0, step=1.0, initial_value=p.target_min
+                )
+                self.solve = gui.add_button("Find the power for this time")
+                self.power_model = gui.add_dropdown(
+                    "Power model",
+                    options=list(POWER_MODEL_FROM_LABEL),
+                    initial_value="Martin et al. 1998 (full)",
+                )
+                self.air = gui.add_dropdown(
+                    "Air", options=list(AIR_FROM_LABEL), initial_value="Seed (exponential)"
+                )
+                self.temperature = gui.add_slider(
+                    "Temperature (°C)", min=-20.0, max=45.0, step=0.5, initial_value=p.temperature_c
+                )
+                self.pressure_source = gui.add_dropdown(
+                    "Pressure from",
+                    options=list(PRESSURE_SOURCES),
+                    initial_value=PRESSURE_SOURCES[0],
+                )
+                self.pressure = gui.add_number(
+                    "Pressure at the start (hPa)",
+                    min=500.0,
+                    max=1100.0,
+                    step=0.5,
+                    initial_value=p.pressure_hpa,
+                )
+                self.humidity = gui.add_slider(
+                    "Humidity (%)", min=0.0, max=100.0, step=1.0, initial_value=p.humidity_pct
+                )
+            with gui.add_folder("Wind, descents, pacing, view", expand_by_default=False):
+                self.wind = gui.add_slider(
+                    "Wind (m/s)", min=0.0, max=20.0, step=0.5, initial_value=p.wind_ms
+                )
+                self.wind_from = gui.add_slider(
+                    "Wind from (° from north)",
+                    min=0.0,
+                    max=359.0,
+                    step=1.0,
+                    initial_value=p.wind_from_deg,
+                )
+                self.max_speed = gui.add_slider(
+                    "Safe descending speed (km/h)",
+                    min=20.0,
+                    max=110.0,
+                    step=1.0,
+                    initial_value=p.max_speed_kmh,
+                )
+                self.pacing = gui.add_checkbox("Pace by grade", initial_value=p.pacing)
+                self.pacing_gain = gui.add_slider(
+                    "Pacing gain (%)", min=0.0, max=50.0, step=1.0, initial_value=p.pacing_gain_pct
+                )
+                self.exaggeration = gui.add_slider(
+                    "Elevation exaggeration (×)",
+                    min=1.0,
+                    max=10.0,
+                    step=0.5,
+                    initial_value=p.exaggeration,
+                )
+                self.playback = gui.add_slider(
+                    "Playback speed (×)", min=1.0, max=600.0, step=1.0, initial_value=p.playback
+                )
+            with gui.add_folder("Splits", expand_by_default=False):
+                self.splits = gui.add_markdown("")
         cb = self.scene.callback
         self.enable.on_update(cb(self._on_enable))
         self.sample.on_click(cb(self._on_sample))
@@ -1174,13 +1195,21 @@ class CourseMode:
         )
         index = drawn_indices(self.route.n_points, MAX_DRAWN_POINTS)
         points = self._drawing.points(self.route, index, self.params.exaggeration)
-        vertices, faces = terrain_strip(points, 0.35)
+        vertices, faces = terrain_strip(points, TERRAIN_HALF_WIDTH_M)
+        ground_vertices, ground_faces = ground_under(points)
+        self.ground = scene.add_mesh_simple(
+            f"{self.frame.name}/ground", ground_vertices, ground_faces, color=(205, 210, 195)
+        )
         self.terrain = scene.add_mesh_simple(
-            f"{self.frame.name}/terrain", vertices, faces, color=(150, 175, 110), flat_shading=False
+            f"{self.frame.name}/terrain",
+            vertices,
+            faces,
+            color=(150, 175, 110),
+            side="double",
         )
         segments, colours = self._route_segments(index, points)
         self.route_line = scene.add_line_segments(
-            f"{self.frame.name}/route", segments, colors=colours, thickness=4.0
+            f"{self.frame.name}/route", segments, colors=colours, thickness=0.08
         )
         identity = np.tile([1.0, 0.0, 0.0, 0.0], (MAX_RIDERS, 1))
         colours_by_part = {
@@ -1421,14 +1450,15 @@ class CourseMode:
                 self.chart.data = self._chart_data()
         self.server.flush()
 
-    _drawn_exaggeration: float = 3.0
+    _drawn_exaggeration: float = 2.0
 
     def _draw_geometry(self) -> None:
         index = drawn_indices(self.route.n_points, MAX_DRAWN_POINTS)
         points = self._drawing.points(self.route, index, self.params.exaggeration)
-        vertices, faces = terrain_strip(points, 0.35)
+        vertices, faces = terrain_strip(points, TERRAIN_HALF_WIDTH_M)
         self.terrain.vertices = vertices
         self.terrain.faces = faces
+        self.ground.vertices, self.ground.faces = ground_under(points)
         segments, colours = self._route_segments(index, points)
         self.route_line.points = segments
         self.route_line.colors = colours
