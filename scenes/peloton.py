@@ -1377,6 +1377,8 @@ class CourseMode:
 
     def _on_pause(self) -> None:
         self.playing = False
+        self.scene._write_back(self.scrub, round(self._leader_km(), 2))  # where the riders stopped
+        self.redraw(readouts=False)
 
     def _on_scrub(self) -> None:
         if self.state is None:

@@ -4,6 +4,7 @@ loop, power_for_time against ride, pacing, the sample route, and every kind of b
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -25,7 +26,7 @@ def straight(length_m: float, step_m: float = 10.0, heading_deg: float = 90.0) -
     return course.course_from_xy(s * math.sin(h), s * math.cos(h), np.zeros_like(s))
 
 
-def gpx_text(points: list[tuple[float, float, float | None]], *, kind: str = "trk") -> str:
+def gpx_text(points: Sequence[tuple[float, float, float | None]], *, kind: str = "trk") -> str:
     def row(lat: float, lon: float, ele: float | None) -> str:
         tag = "trkpt" if kind == "trk" else "rtept"
         inner = "" if ele is None else f"<ele>{ele}</ele>"
@@ -341,7 +342,7 @@ def test_duplicate_points_and_noise_are_cleaned() -> None:
     pts = [p for p in pts for _ in (0, 1)]  # every point logged twice (a paused GPS)
     rng = np.random.default_rng(1)
     noisy = [(a, o, float(z) + float(rng.normal(0.0, 2.0))) for a, o, z in pts if z is not None]
-    c = course.load_gpx(gpx_text(noisy))  # type: ignore[arg-type]
+    c = course.load_gpx(gpx_text(noisy))
     assert c.n_points == 200 and np.all(c.run_m > 0)
     # Smoothing over 50 m takes most of the 2 m noise out of a 9 % slope.
     assert float(np.std(c.grade[20:-20] - 1.0 / 11.12)) < 0.05
