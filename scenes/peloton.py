@@ -1050,7 +1050,7 @@ class CourseMode:
     # ----------------------------------------------------------------------------------------- GUI
     def _build_gui(self) -> None:
         gui, p = self.server.gui, self.params
-        with self.scene.gui_root, gui.add_folder("Course mode (GPX route)", order=-1.0):
+        with self.scene.gui_root, gui.add_folder("Course mode (GPX route)"):
             self.enable = gui.add_checkbox("Ride a course", initial_value=False)
             self.route_info = gui.add_markdown(self._route_markdown())
             self.sample = gui.add_button("Load the sample route")
