@@ -782,7 +782,7 @@ COURSE_BOX_M = 6.0
 COURSE_CENTRE = np.array([-3.2, 0.0])
 TERRAIN_HALF_WIDTH_M = 0.15
 """Half width of the drawn terrain strip (scene m)."""
-COURSE_MARKER_SCALE = 0.35
+COURSE_MARKER_SCALE = 0.25
 """Riders on the course are drawn at this fraction of life size (a marker, not to the map's scale)."""
 MAX_DRAWN_POINTS = 2000
 MAX_CHART_POINTS = 1000
@@ -1080,16 +1080,13 @@ class CourseMode:
                     "x": viser.uplot.Scale(time=False, auto=True),
                     "m": viser.uplot.Scale(auto=True),
                     "kmh": viser.uplot.Scale(auto=True),
-                    "W": viser.uplot.Scale(auto=True),
+                    "W": viser.uplot.Scale(auto=True),  # no axis of its own: the legend gives watts
                 },
                 axes=(
                     viser.uplot.Axis(scale="x", label="km"),
                     viser.uplot.Axis(scale="m", label="m", side=3),
                     viser.uplot.Axis(
                         scale="kmh", label="km/h", side=1, grid=viser.uplot.Axis_Grid(show=False)
-                    ),
-                    viser.uplot.Axis(
-                        scale="W", label="W", side=1, grid=viser.uplot.Axis_Grid(show=False)
                     ),
                 ),
                 legend=viser.uplot.Legend(show=True),
@@ -1485,7 +1482,7 @@ class CourseMode:
             node.batched_positions = positions.astype(np.float32)
             node.batched_wxyzs = wxyz.astype(np.float32)
             node.batched_scales = scales.astype(np.float32)
-        self.leader_marker.position = tuple(where[0] + [0.0, 0.0, 0.75])
+        self.leader_marker.position = tuple(where[0] + [0.0, 0.0, 0.5])
 
     def _chart_data(self) -> tuple[np.ndarray, ...]:
         route = self.route

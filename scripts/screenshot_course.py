@@ -27,7 +27,9 @@ from scenes.peloton import PelotonScene  # noqa: E402
 from scenes.switcher import SceneSwitcher  # noqa: E402
 
 
-def main(out: Path = ROOT / "docs" / "peloton_course.png", at_km: float = 5.5, settle_s: float = 5.0) -> None:
+def main(
+    out: Path = ROOT / "docs" / "peloton_course.png", at_km: float = 5.5, settle_s: float = 5.0
+) -> None:
     """Screenshot the course mode.
 
     Args:
@@ -39,6 +41,7 @@ def main(out: Path = ROOT / "docs" / "peloton_course.png", at_km: float = 5.5, s
     from playwright.sync_api import sync_playwright
 
     server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
+    server.gui.configure_theme(control_width="large")  # as app.py serves it
     switcher = SceneSwitcher(server, "peloton")
     scene = switcher.scene
     assert isinstance(scene, PelotonScene)
@@ -61,10 +64,18 @@ def main(out: Path = ROOT / "docs" / "peloton_course.png", at_km: float = 5.5, s
             close_buttons = page.locator(".mantine-Notification-closeButton")
             for i in range(close_buttons.count()):
                 try:
-                    close_buttons.nth(i).click(timeout=2000)
+                    close_buttons.nth(i).click(timeout=2000, force=True)
                 except PlaywrightError:
                     pass  # already gone
-            time.sleep(0.5)
+            # Fold the line's own folders so the course mode's readouts and chart are in view.
+            for folder in ("Rider", "Course", "Drafting", "Results", "Speed at a power"):
+                try:
+                    page.get_by_text(folder, exact=True).first.click(timeout=20_000)
+                except PlaywrightError:
+                    print(f"could not fold {folder!r}; the picture shows it open")
+            chart = page.locator(".uplot", has_text="Elevation, speed and power along the course")
+            chart.first.scroll_into_view_if_needed(timeout=10_000)
+            time.sleep(1.0)
             page.screenshot(path=str(out))
             print(f"saved {out}")
         finally:
