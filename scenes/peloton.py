@@ -1293,7 +1293,9 @@ class CourseMode:
         self.redraw()
 
     def _on_input(self) -> None:
-        if not self.enabled:  # the line's sliders move often: ride the course only while it is shown
+        if (
+            not self.enabled
+        ):  # the line's sliders move often: ride the course only while it is shown
             self.state = None
             return
         self.recompute()
