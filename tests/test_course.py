@@ -423,3 +423,49 @@ def test_arbitrary_bytes_never_escape_as_anything_but_value_error(data: bytes) -
             course.load_gpx(source)
         except ValueError:
             pass
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    grades=st.lists(st.floats(-0.2, 0.2), min_size=2, max_size=40),
+    step=st.floats(1.0, 400.0),
+    power=st.floats(5.0, 1500.0),
+    wind=st.floats(-15.0, 15.0),
+    wind_from=st.floats(0.0, 360.0),
+    cap=st.floats(3.0, 30.0),
+    start=st.floats(0.0, 1.0),
+    model=st.sampled_from(["seed", "martin"]),
+)
+def test_any_course_balances_its_books_and_more_power_is_faster(
+    grades: list[float], step: float, power: float, wind: float, wind_from: float, cap: float,
+    start: float, model: str,
+) -> None:  # fmt: skip
+    """The family of integration faults (stalls, overshoot past the cap, energy leaks, NaN): any profile of
+    short or long segments, steep both ways, any wind, any cap, any entry speed."""
+    n = len(grades)
+    s = np.arange(n + 1) * step
+    z = np.concatenate(([0.0], np.cumsum(np.asarray(grades) * step)))
+    heading = np.linspace(0.0, 3.0, n + 1)
+    east = np.concatenate(([0.0], np.cumsum(step * np.sin(heading[:-1]))))
+    north = np.concatenate(([0.0], np.cumsum(step * np.cos(heading[:-1]))))
+    del s
+    c = course.course_from_xy(east, north, z)
+    rider = SEED if model == "seed" else MARTIN
+    v0 = start * cap
+    r = course.ride(c, power, rider, wind, wind_from, max_speed_ms=cap, start_speed_ms=v0)
+    assert math.isfinite(r.time_s) and r.time_s > 0.0
+    assert np.all(np.isfinite(r.speed_ms)) and np.all(r.speed_ms >= 0.0)
+    assert np.all(r.speed_ms <= cap * (1 + 1e-12))
+    assert np.all(np.diff(r.elapsed_s) > 0.0)
+    assert np.all(r.power_w <= power * (1 + 1e-9)) and np.all(r.power_w >= 0.0)
+    kinetic_in = 0.5 * rider.effective_mass_kg * v0**2
+    terms = r.aero_j + r.rolling_j + r.bearings_j + r.climbing_j + r.kinetic_j + r.brakes_j
+    scale = r.work_j + kinetic_in + abs(r.climbing_j) + abs(r.aero_j) + 1.0
+    assert r.work_j * rider.drivetrain_efficiency + kinetic_in == pytest.approx(
+        terms, abs=1e-9 * scale
+    )
+    assert r.brakes_j >= -1e-9 * scale
+    faster = course.ride(
+        c, power * 1.5, rider, wind, wind_from, max_speed_ms=cap, start_speed_ms=v0
+    )
+    assert faster.time_s <= r.time_s * (1 + 1e-9)
