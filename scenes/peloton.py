@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import logging
 import math
 from typing import Literal
 
@@ -777,6 +778,7 @@ POWER_MODEL_FROM_LABEL: dict[str, course_kernel.Model] = {
     "Seed (aero, rolling, climbing)": "seed",
 }
 SAMPLE_LABEL = "Alpe d'Huez (sample, from the published profile)"
+logger = logging.getLogger(__name__)
 COURSE_BOX_M = 6.0
 """The drawn course fits a square of this size (scene metres) where the line's camera looks."""
 COURSE_CENTRE = np.array([-3.2, 0.0])
@@ -1164,7 +1166,7 @@ class CourseMode:
         cb = self.scene.callback
         self.enable.on_update(cb(self._on_enable))
         self.sample.on_click(cb(self._on_sample))
-        self.upload.on_upload(cb(self._on_upload))
+        self.upload.on_upload(self._on_upload)  # parses off the lock, then installs through cb
         self.solve.on_click(cb(self._on_solve))
         self.play.on_click(cb(self._on_play))
         self.pause.on_click(cb(self._on_pause))
@@ -1321,23 +1323,50 @@ class CourseMode:
     def _on_sample(self) -> None:
         self.load(course_kernel.SAMPLE_ROUTE.read_bytes(), SAMPLE_LABEL)
 
-    def _on_upload(self) -> None:
-        uploaded = self.upload.value
-        name = str(getattr(uploaded, "name", "") or "upload")[:80]
-        content = getattr(uploaded, "content", b"")
-        if not isinstance(content, bytes):
-            self.message = f"{name}: the upload carried no file"
-            self.redraw()
-            return
-        self.load(content, name)
+    def _on_upload(self, _event: object = None) -> None:
+        """An upload arrived (viser's thread pool). Parse it off the scene's lock, since gpxpy needs seconds for a
+        large file, then install it (or the reason it failed) as a guarded callback. Nothing escapes."""
+        try:
+            uploaded = self.upload.value
+            name = str(getattr(uploaded, "name", "") or "upload")[:80]
+            content = getattr(uploaded, "content", b"")
+            route, error = None, None
+            if not isinstance(content, bytes):
+                error = "the upload carried no file"
+            else:
+                try:
+                    route = course_kernel.load_gpx(content)
+                except ValueError as failure:
+                    error = str(failure)
+        except Exception:  # a file must never take the scene down; say so and keep the course
+            logger.exception("peloton: reading an uploaded GPX failed")
+            name, route, error = "upload", None, "the file could not be read"
+
+        def install() -> None:
+            self._install(route, error, name)
+
+        self.scene.callback(install)(None)
 
     def load(self, data: bytes, label: str) -> bool:
         """Load a GPX file's bytes as the course; on a bad file keep the last good course and show why."""
         try:
-            route = course_kernel.load_gpx(data, name=None)
-            state = compute_course(route, self.read_params(), self.scene.read_params())
-        except ValueError as error:
-            self.message = f"**{_escape(label)}** was not loaded: {_escape(str(error))}. Still showing **{_escape(self.route.name)}**."
+            route, error = course_kernel.load_gpx(data), None
+        except ValueError as failure:
+            route, error = None, str(failure)
+        return self._install(route, error, label)
+
+    def _install(self, route: course_kernel.Course | None, error: str | None, label: str) -> bool:
+        state = None
+        if route is not None:
+            try:
+                state = compute_course(route, self.read_params(), self.scene.read_params())
+            except ValueError as failure:
+                error = str(failure)
+        if route is None or state is None:
+            self.message = (
+                f"**{_escape(label)}** was not loaded: {_escape(str(error))}. "
+                f"Still showing **{_escape(self.route.name)}**."
+            )
             self.redraw()
             return False
         self.route, self.route_label, self.state = route, label, state
