@@ -144,8 +144,7 @@ def test_model_and_air_choices_change_the_ride_and_the_readout_shows_both_densit
 
 def test_find_the_power_for_a_time(mode: CourseMode) -> None:
     mode.target.value = 50.0
-    mode.solve.value = True  # what a click does on the server
-    mode._on_solve()
+    mode.solve.value = True  # what a click does, on the server: runs on_click
     assert mode.state is not None
     assert mode.state.ride.time_s == pytest.approx(
         50 * 60.0, abs=1.0
