@@ -1,10 +1,14 @@
 """Benchmark the cycling kernel and the peloton scene's slider-to-screen latency.
 
-    python bench/bench_peloton.py
+    python bench/bench_peloton.py           # everything
+    python bench/bench_peloton.py course    # only the course kernel (issue 13)
 
 Prints a table: kernel times for ``power`` on 10⁶ speeds and ``speed_for_power`` (against a plain Python loop
 run in the same process), and, through the websocket test client, the time from a slider message to the
-redrawn scene arriving back (p50, p95), with the server-side handling time on its own.
+redrawn scene arriving back (p50, p95), with the server-side handling time on its own. The course rows ride a
+synthetic 100 km route at 10 m steps (10 000 segments of rolling hills and turns): ``ride`` (goal ≤ 50 ms),
+``power_for_time`` (goal ≤ 0.5 s) and ``paced_ride``, against the same loop run as plain Python (numba's
+``py_func``) in the same process.
 """
 
 from __future__ import annotations
@@ -25,7 +29,7 @@ sys.path.insert(0, str(ROOT / "tests"))
 import viser  # noqa: E402
 from wsclient import BrowserClient  # noqa: E402
 
-from kernels import cycling  # noqa: E402
+from kernels import course, cycling  # noqa: E402
 from scenes.peloton import PelotonScene  # noqa: E402
 from scenes.switcher import SceneSwitcher  # noqa: E402
 
@@ -58,9 +62,69 @@ def row(name: str, values: list[float], unit: float, unit_name: str, note: str =
     )
 
 
-def main() -> None:
+def hundred_km() -> course.Course:
+    """100 km at 10 m steps: rolling hills up to ±6 %, a heading that wanders, 10 001 points."""
+    s = np.arange(0.0, 100_000.0 + 5.0, 10.0)
+    heading = 0.8 * np.sin(2 * np.pi * s / 7000.0) + 0.3 * np.sin(2 * np.pi * s / 1300.0)
+    east = np.concatenate(([0.0], np.cumsum(10.0 * np.sin(heading[:-1]))))
+    north = np.concatenate(([0.0], np.cumsum(10.0 * np.cos(heading[:-1]))))
+    z = 300.0 + 60.0 * np.sin(2 * np.pi * s / 5000.0) + 15.0 * np.sin(2 * np.pi * s / 900.0)
+    return course.course_from_xy(east, north, z, name="100 km")
+
+
+def course_rows() -> None:
+    start = time.perf_counter()
+    course.warm_up()
+    row("course.warm_up (compile or load the cache)", [time.perf_counter() - start], 1e-3, "ms")
+    route = hundred_km()
+    rider = course.Rider()
+    air = course.Air("weather", temperature_c=22.0, pressure_hpa=980.0, relative_humidity=0.5)
+    rides = timings(lambda: course.ride(route, 250.0, rider, 4.0, 225.0, air), 30)
+    target = course.ride(route, 250.0, rider, 4.0, 225.0, air).time_s
+    inverse = timings(
+        lambda: course.power_for_time(route, target * 0.95, rider, 4.0, 225.0, air), 10
+    )
+    paced = timings(lambda: course.paced_ride(route, 250.0, rider, 0.15, 4.0, 225.0, air), 5)
+    # Baseline: the same loop as plain Python, on a tenth of the route, scaled up.
+    tenth = course.course_from_xy(
+        route.east_m[:1001], route.north_m[:1001], route.elevation_m[:1001]
+    )
+    seg = course._segments(tenth, rider, 4.0, 225.0, air)
+    n = tenth.n_points
+    power = np.full(n - 1, 250.0)
+
+    def python_ride() -> None:
+        course._ride_core.py_func(
+            seg.length, seg.drag, seg.rolling, seg.climbing, seg.wind, power, seg.efficiency, seg.mass,
+            seg.b0, seg.b1, 20.0, 0.0, np.empty(n), np.empty(n), np.empty(n - 1), np.zeros(6),
+        )  # fmt: skip
+
+    baseline = [t * 10 for t in timings(python_ride, 3)]
+    ratio = statistics.median(baseline) / statistics.median(rides)
+    row(
+        "course.ride, 100 km at 10 m (10^4 segments)",
+        rides,
+        1e-3,
+        "ms",
+        f"goal <= 50 ms; {ratio:.0f}x plain Python",
+    )
+    row("same loop as plain Python (10 km, scaled)", baseline, 1e-3, "ms", "baseline")
+    row("course.power_for_time, 100 km", inverse, 1e-3, "ms", "goal <= 0.5 s")
+    row("course.paced_ride, 100 km (constant + paced)", paced, 1e-3, "ms")
+
+
+def header() -> None:
     print("| measurement                                  |     median |        p95 | unit | note")
     print("|----------------------------------------------|-----------:|-----------:|------|-----")
+
+
+def main() -> None:
+    header()
+    if sys.argv[1:] == ["course"]:
+        course_rows()
+        machine()
+        return
+    course_rows()
     rng = np.random.default_rng(0)
     speeds = rng.uniform(0.0, 20.0, 1_000_000)
     kernel = timings(
@@ -131,8 +195,16 @@ def main() -> None:
     server.stop()
     row("slider -> callback -> redraw (server side)", handling, 1e-3, "ms", "goal p95 <= 5 ms")
     row("slider message -> redraw back at client", round_trips, 1e-3, "ms", "goal p95 <= 20 ms")
+    machine()
+
+
+def machine() -> None:
+    load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
+    import numba
+
     print(
-        f"\nmachine: {sys.platform}, {_cpus()} CPUs, Python {sys.version.split()[0]}, numpy {np.__version__}"
+        f"\nmachine: {sys.platform}, {_cpus()} CPUs, load {load:.1f}, Python {sys.version.split()[0]}, "
+        f"numpy {np.__version__}, numba {numba.__version__} ({numba.get_num_threads()} threads; the ride loop is serial)"
     )
 
 

@@ -486,3 +486,239 @@ def paceline(
         headwind_ms=headwind_ms,
         drivetrain_efficiency=drivetrain_efficiency,
     )
+
+
+# --------------------------------------------------------------------------------------------- weather air
+# Real air, for the course mode (issue 13): the ideal gas law for moist air, and the standard atmosphere.
+R_DRY_AIR = 287.058
+"""Specific gas constant of dry air (J/(kg·K)), R / 0.0289652 kg/mol (U.S. Standard Atmosphere 1976)."""
+R_WATER_VAPOUR = 461.495
+"""Specific gas constant of water vapour (J/(kg·K)), R / 0.018016 kg/mol."""
+ISA_SEA_LEVEL_PRESSURE_HPA = 1013.25
+"""Standard sea-level pressure (hPa)."""
+ISA_SEA_LEVEL_TEMPERATURE_C = 15.0
+"""Standard sea-level temperature (°C)."""
+ISA_LAPSE_RATE_K_PER_M = 0.0065
+"""Temperature lapse rate of the standard troposphere (K/m)."""
+_ISA_TROPOPAUSE_M = 11_000.0
+_ISA_TOP_M = 20_000.0
+_ISA_G0 = 9.80665
+_ISA_MOLAR_MASS = 0.0289644  # kg/mol, U.S. Standard Atmosphere 1976
+_ISA_R = 8.31432  # J/(mol·K), the constant the 1976 standard uses
+_ISA_EXPONENT = _ISA_G0 * _ISA_MOLAR_MASS / (_ISA_R * ISA_LAPSE_RATE_K_PER_M)  # 5.25588
+_KELVIN = 273.15
+
+
+def saturation_vapour_pressure_hpa(temperature_c: ArrayLike) -> NDArray[np.float64]:
+    """Saturation vapour pressure of water over liquid water, Buck (1981).
+
+    e_s = 6.1121·exp(17.502·T / (240.97 + T)) hPa, T in °C: Buck, A. L. (1981), "New equations for computing
+    vapor pressure and enhancement factor", J. Appl. Meteorol. 20, 1527–1532, eq. 8 (e_w, enhancement factor
+    left out; within 0.05 % of the Wexler/Goff–Gratch values from −20 to +50 °C, as Buck's table 2 reports).
+
+    Args:
+        temperature_c: air temperature (°C, −60 to 60), any shape.
+
+    Returns:
+        Pressure (hPa), same shape.
+
+    Raises:
+        ValueError: a temperature is not finite or outside −60…60 °C.
+    """
+    t = _finite("temperature_c", temperature_c)
+    if np.any((t < -60.0) | (t > 60.0)):
+        raise ValueError(f"temperature_c must be in [-60, 60] °C, got {temperature_c!r}")
+    return 6.1121 * np.exp(17.502 * t / (240.97 + t))
+
+
+def air_density_weather(
+    temperature_c: ArrayLike, pressure_hpa: ArrayLike, relative_humidity: ArrayLike = 0.0
+) -> NDArray[np.float64]:
+    """Density of moist air from a weather reading, by the ideal gas law for dry air plus water vapour.
+
+    ρ = (p − e)/(R_d·T) + e/(R_v·T), e = RH·e_s(T), with e_s from :func:`saturation_vapour_pressure_hpa`
+    (Buck 1981). Humid air is lighter than dry air at the same pressure and temperature (water's molar mass is
+    18 g/mol against air's 29). The non-ideality of air (compressibility Z ≈ 0.9996 near sea level, CIPM-2007,
+    Picard et al. 2008, Metrologia 45:149) is left out: 0.04 %.
+
+    Args:
+        temperature_c: air temperature (°C, −60 to 60).
+        pressure_hpa: station (not sea-level-reduced) pressure (hPa, 10 to 1100).
+        relative_humidity: relative humidity as a fraction in [0, 1] (0.5 is 50 %).
+
+    Returns:
+        Density (kg/m³) with the broadcast shape of the inputs.
+
+    Raises:
+        ValueError: an argument is not finite or out of its range; the message names it.
+    """
+    e_s = saturation_vapour_pressure_hpa(temperature_c)
+    t_k = _finite("temperature_c", temperature_c) + _KELVIN
+    p = _finite("pressure_hpa", pressure_hpa)
+    if np.any((p < 10.0) | (p > 1100.0)):
+        raise ValueError(f"pressure_hpa must be in [10, 1100] hPa, got {pressure_hpa!r}")
+    rh = _finite("relative_humidity", relative_humidity)
+    if np.any((rh < 0.0) | (rh > 1.0)):
+        raise ValueError(
+            f"relative_humidity must be a fraction in [0, 1], got {relative_humidity!r}"
+        )
+    e = rh * e_s
+    if np.any(e >= p):
+        raise ValueError("relative_humidity: the vapour pressure would reach the total pressure")
+    return 100.0 * ((p - e) / (R_DRY_AIR * t_k) + e / (R_WATER_VAPOUR * t_k))
+
+
+_EARTH_RADIUS_ISA_M = (
+    6_356_766.0  # r₀ of the geopotential conversion, U.S. Standard Atmosphere 1976
+)
+
+
+def _isa_altitude(altitude_m: ArrayLike) -> NDArray[np.float64]:
+    """Geopotential altitude H = r₀·h/(r₀ + h) of the geometric altitude h (what a map or a GPS gives)."""
+    h = _finite("altitude_m", altitude_m)
+    if np.any((h < -1000.0) | (h > _ISA_TOP_M)):
+        raise ValueError(f"altitude_m must be in [-1000, 20000] m, got {altitude_m!r}")
+    return _EARTH_RADIUS_ISA_M * h / (_EARTH_RADIUS_ISA_M + h)
+
+
+def isa_temperature_c(altitude_m: ArrayLike) -> NDArray[np.float64]:
+    """Temperature of the International Standard Atmosphere (°C): 15 − 6.5 K/km up to 11 km, −56.5 °C above.
+
+    Args:
+        altitude_m: geometric altitude above mean sea level (m, −1000 to 20 000), any shape; converted to
+            geopotential altitude H = r₀·h/(r₀ + h), r₀ = 6 356 766 m, as the standard's tables are.
+
+    Returns:
+        Temperature (°C), same shape.
+    """
+    h = _isa_altitude(altitude_m)
+    return ISA_SEA_LEVEL_TEMPERATURE_C - ISA_LAPSE_RATE_K_PER_M * np.minimum(h, _ISA_TROPOPAUSE_M)
+
+
+def isa_pressure_hpa(altitude_m: ArrayLike) -> NDArray[np.float64]:
+    """Pressure of the International Standard Atmosphere (ISO 2533:1975; U.S. Standard Atmosphere 1976).
+
+    Troposphere (H ≤ 11 km): p = 1013.25·(1 − L·H/T₀)^(g₀M/(R·L)) hPa, L = 6.5 K/km, T₀ = 288.15 K, exponent
+    5.25588; above, the isothermal layer at 216.65 K: p = p₁₁·exp(−g₀M·(H − 11 000)/(R·216.65)).
+
+    Args:
+        altitude_m: geometric altitude above mean sea level (m, −1000 to 20 000), any shape; converted to
+            geopotential altitude H = r₀·h/(r₀ + h), r₀ = 6 356 766 m, as the standard's tables are.
+
+    Returns:
+        Pressure (hPa), same shape.
+
+    Raises:
+        ValueError: an altitude is not finite or outside −1000…20 000 m.
+    """
+    h = _isa_altitude(altitude_m)
+    t0 = ISA_SEA_LEVEL_TEMPERATURE_C + _KELVIN
+    low = np.minimum(h, _ISA_TROPOPAUSE_M)
+    p = ISA_SEA_LEVEL_PRESSURE_HPA * (1.0 - ISA_LAPSE_RATE_K_PER_M * low / t0) ** _ISA_EXPONENT
+    t_tropopause = t0 - ISA_LAPSE_RATE_K_PER_M * _ISA_TROPOPAUSE_M
+    above = np.maximum(h - _ISA_TROPOPAUSE_M, 0.0)
+    return p * np.exp(-_ISA_G0 * _ISA_MOLAR_MASS * above / (_ISA_R * t_tropopause))
+
+
+# --------------------------------------------------------------------------------------------- Martin et al. 1998
+MARTIN_BEARING_W = (0.091, 0.0087)
+"""Wheel-bearing loss V·(91 + 8.7·V)·10⁻³ W (Martin et al. 1998, from Dahn et al. 1991): (W per m/s, W per (m/s)²)."""
+
+
+@dataclasses.dataclass(frozen=True)
+class MartinPower:
+    """Martin et al. (1998) power terms in watts; each field has the broadcast shape of the inputs."""
+
+    aero: NDArray[np.float64]
+    """½ρ·(CdA + F_w)·(v + w)|v + w|·v: air drag of rider and bike plus the spokes' drag area F_w (W)."""
+    rolling: NDArray[np.float64]
+    """Crr·m·g·cos θ·v (W)."""
+    bearings: NDArray[np.float64]
+    """Wheel-bearing friction v·(91 + 8.7·v)·10⁻³ (W)."""
+    climbing: NDArray[np.float64]
+    """Potential energy: m·g·sin θ·v (W); negative downhill."""
+    kinetic: NDArray[np.float64]
+    """Kinetic energy change (m + I/r²)·a·v, wheel inertia I about radius r (W); negative while slowing."""
+    wheel: NDArray[np.float64]
+    """Sum of the five terms: the power the rear wheel must deliver (W)."""
+    total: NDArray[np.float64]
+    """Power at the pedals: wheel / drivetrain efficiency when positive, the plain sum when not (W)."""
+
+
+def martin_power(
+    speed_ms: ArrayLike,
+    cda_m2: ArrayLike,
+    mass_kg: ArrayLike,
+    crr: ArrayLike,
+    grade: ArrayLike = 0.0,
+    headwind_ms: ArrayLike = 0.0,
+    air_density: ArrayLike = RHO_SEA_LEVEL,
+    drivetrain_efficiency: ArrayLike = 0.976,
+    spoke_drag_m2: ArrayLike = 0.0044,
+    wheel_inertia_kgm2: ArrayLike = 0.14,
+    wheel_radius_m: ArrayLike = 0.311,
+    acceleration_ms2: ArrayLike = 0.0,
+) -> MartinPower:
+    """Power to ride at ``speed_ms``: the full model of Martin et al. (1998), J. Appl. Biomech. 14:276–291.
+
+    P = (P_AT + P_RR + P_WB + P_PE + P_KE) / E_c, the paper's eq. 9 with
+
+    - P_AT = ½ρ·(C_D·A + F_w)·V_A²·V_G, here with V_A² written (v + w)|v + w| so a tailwind faster than the rider
+      pushes (the paper squares it);
+    - P_RR = V_G·μ_rr·m_T·g·cos(atan G_R);  P_WB = V_G·(91 + 8.7·V_G)·10⁻³;
+    - P_PE = V_G·m_T·g·sin(atan G_R);  P_KE = (m_T + I/r²)·a·V_G, the limit of the paper's
+      ½(m_T + I/r²)(V_f² − V_i²)/(t_f − t_i) over a short interval.
+
+    The paper's values are the defaults: E_c = 0.976, F_w = 0.0044 m², I = 0.14 kg·m² (both wheels), r = 0.311 m.
+    CdA here is yaw-free (the paper measured it in the wind tunnel at the ride's yaw).
+
+    Args:
+        speed_ms: ground speed V_G (m/s, ≥ 0).
+        cda_m2: drag area C_D·A of rider and bike (m², > 0).
+        mass_kg: rider plus bike m_T (kg, > 0).
+        crr: rolling-resistance coefficient μ_rr (≥ 0).
+        grade: rise over run G_R (0.05 = 5 %).
+        headwind_ms: wind against the rider (m/s); negative for a tailwind.
+        air_density: ρ (kg/m³, > 0); :func:`air_density_weather` gives it from a weather reading.
+        drivetrain_efficiency: E_c in (0, 1].
+        spoke_drag_m2: F_w, drag area of the rotating spokes (m², ≥ 0).
+        wheel_inertia_kgm2: I, moment of inertia of both wheels together (kg·m², ≥ 0).
+        wheel_radius_m: r, outer radius of the tyre (m, > 0).
+        acceleration_ms2: dV_G/dt (m/s²).
+
+    Returns:
+        :class:`MartinPower`, every field with the broadcast shape of the inputs.
+
+    Raises:
+        ValueError: an argument is not finite or out of its range; the message names it.
+    """
+    v = _non_negative("speed_ms", speed_ms)
+    mass = _positive("mass_kg", mass_kg)
+    cos_theta, sin_theta = _road(_finite("grade", grade))
+    rho = _positive("air_density", air_density)
+    drag_area = _positive("cda_m2", cda_m2) + _non_negative("spoke_drag_m2", spoke_drag_m2)
+    air_speed = v + _finite("headwind_ms", headwind_ms)
+    inertia = _non_negative("wheel_inertia_kgm2", wheel_inertia_kgm2)
+    radius = _positive("wheel_radius_m", wheel_radius_m)
+    acceleration = _finite("acceleration_ms2", acceleration_ms2)
+    efficiency = _efficiency(drivetrain_efficiency)
+
+    aero = 0.5 * rho * drag_area * air_speed * np.abs(air_speed) * v
+    rolling = _non_negative("crr", crr) * mass * G * cos_theta * v
+    bearings = v * (MARTIN_BEARING_W[0] + MARTIN_BEARING_W[1] * v)
+    climbing = mass * G * sin_theta * v
+    kinetic = (mass + inertia / radius**2) * acceleration * v
+    aero, rolling, bearings, climbing, kinetic, efficiency = np.broadcast_arrays(
+        aero, rolling, bearings, climbing, kinetic, efficiency
+    )
+    wheel = aero + rolling + bearings + climbing + kinetic
+    total = np.where(wheel > 0.0, wheel / efficiency, wheel)
+    return MartinPower(
+        aero=aero.copy(),
+        rolling=rolling.copy(),
+        bearings=bearings.copy(),
+        climbing=climbing.copy(),
+        kinetic=kinetic.copy(),
+        wheel=wheel,
+        total=total,
+    )

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import logging
 import math
 from typing import Literal
 
@@ -18,6 +19,7 @@ import trimesh
 import viser
 import viser.uplot
 
+from kernels import course as course_kernel
 from kernels import cycling
 from scenes._base import Scene
 
@@ -315,6 +317,7 @@ time-averaged power is the mean over positions, far below the leader's.
         self._build_world()
         self.redraw()
         self.start_loop(self._animate, 1.0 / 30.0)
+        self.course_mode = CourseMode(self)  # issue 13: ride a GPX course
 
     # ----------------------------------------------------------------------------------------- GUI
     def _build_gui(self) -> None:
@@ -757,3 +760,870 @@ time-averaged power is the mean over positions, far below the leader's.
         if self._ridden_s <= 0:
             return np.zeros(n)
         return self._energy_j[:n] / self._ridden_s
+
+
+# --------------------------------------------------------------------------------------------- course mode
+# Issue 13: ride a real route (a GPX file or the bundled sample) in real air with the full Martin model. The course
+# is drawn scaled into the box the camera already frames, riders ride it, and the chart shows the profile.
+CourseAirLabel = Literal[
+    "Seed (exponential)", "Weather (temperature, pressure or altitude, humidity)"
+]
+AIR_FROM_LABEL: dict[str, course_kernel.AirKind] = {
+    "Seed (exponential)": "seed",
+    "Weather (temperature, pressure or altitude, humidity)": "weather",
+}
+PRESSURE_SOURCES = ("Standard atmosphere at the route's altitude", "Barometer at the start (hPa)")
+POWER_MODEL_FROM_LABEL: dict[str, course_kernel.Model] = {
+    "Martin et al. 1998 (full)": "martin",
+    "Seed (aero, rolling, climbing)": "seed",
+}
+SAMPLE_LABEL = "Alpe d'Huez (sample, from the published profile)"
+logger = logging.getLogger(__name__)
+COURSE_BOX_M = 6.0
+"""The drawn course fits a square of this size (scene metres) where the line's camera looks."""
+COURSE_CENTRE = np.array([-3.2, 0.0])
+TERRAIN_HALF_WIDTH_M = 0.15
+"""Half width of the drawn terrain strip (scene m)."""
+COURSE_MARKER_SCALE = 0.25
+"""Riders on the course are drawn at this fraction of life size (a marker, not to the map's scale)."""
+MAX_DRAWN_POINTS = 2000
+MAX_CHART_POINTS = 1000
+
+
+@dataclasses.dataclass(frozen=True)
+class CourseParams:
+    """Course-mode inputs (the rider, the line and drafting come from :class:`PelotonParams`)."""
+
+    power_w: float = 250.0
+    """Constant pedal power of each rider (W)."""
+    target_min: float = 60.0
+    """Finish time that 'Find the power for this time' aims at (min)."""
+    model: course_kernel.Model = "martin"
+    """Power model: Martin et al. 1998's full terms or the seed's three."""
+    air: course_kernel.AirKind = "seed"
+    """Air along the route: the seed's exponential atmosphere or a weather reading."""
+    temperature_c: float = 15.0
+    """Air temperature at the start (°C), weather air."""
+    pressure_from_barometer: bool = False
+    """Weather air: the barometer's pressure, or the standard atmosphere's at the start's altitude."""
+    pressure_hpa: float = 1013.25
+    """Station pressure at the start (hPa), when read from a barometer."""
+    humidity_pct: float = 50.0
+    """Relative humidity (%), weather air."""
+    wind_ms: float = 0.0
+    """Wind speed (m/s)."""
+    wind_from_deg: float = 0.0
+    """Where the wind blows from, clockwise from north (°)."""
+    max_speed_kmh: float = 72.0
+    """Safe descending speed (km/h): riders brake to hold it."""
+    pacing: bool = False
+    """Vary power with the grade (Swain 1997) at the same average."""
+    pacing_gain_pct: float = 15.0
+    """How much more power on steep climbs, and less on descents (%)."""
+    exaggeration: float = 2.0
+    """Vertical exaggeration of the drawn terrain."""
+    playback: float = 60.0
+    """Playback speed (× real time)."""
+
+
+@dataclasses.dataclass(frozen=True)
+class CourseState:
+    """What the course mode shows for one route and parameter set."""
+
+    route: course_kernel.Course
+    ride: course_kernel.Ride
+    """The ride drawn and animated: paced when pacing is on, else constant."""
+    constant: course_kernel.Ride
+    solo: course_kernel.Ride
+    """One rider alone at the same power (no shelter)."""
+    pacing: course_kernel.Pacing | None
+    group_cda_m2: float
+    """CdA the group rides at when riders share the front equally (m²)."""
+    density_seed: float
+    """The seed's density at the start (kg/m³)."""
+    density_weather: float
+    """The weather reading's density at the start (kg/m³)."""
+
+
+def course_air(route: course_kernel.Course, p: CourseParams) -> course_kernel.Air:
+    """The :class:`kernels.course.Air` for the inputs; the reading is taken at the route's start."""
+    start = float(route.elevation_m[0])
+    pressure = (
+        p.pressure_hpa
+        if p.pressure_from_barometer
+        else float(cycling.isa_pressure_hpa(np.clip(start, -1000.0, 20_000.0)))
+    )
+    return course_kernel.Air(
+        p.air, p.temperature_c, pressure, p.humidity_pct / 100.0, altitude_m=start
+    )
+
+
+def group_cda(line: PelotonParams) -> float:
+    """CdA of a rider in a line that rotates evenly: the mean over the positions (the riders share the work)."""
+    if not line.drafting or line.n_riders < 2:
+        return line.cda_m2
+    reduction = cycling.drag_reduction(line.n_riders, line.gap_m, line.model)
+    return float(line.cda_m2 * (1.0 - np.mean(reduction)))
+
+
+def compute_course(
+    route: course_kernel.Course, p: CourseParams, line: PelotonParams
+) -> CourseState:
+    """Ride ``route`` for one parameter set (no viser: testable on its own)."""
+    air = course_air(route, p)
+    weather = dataclasses.replace(air, kind="weather")
+    start = float(route.elevation_m[0])
+
+    def rider(cda: float) -> course_kernel.Rider:
+        return course_kernel.Rider(
+            cda_m2=cda,
+            mass_kg=line.mass_kg,
+            crr=line.crr,
+            drivetrain_efficiency=line.drivetrain_pct / 100.0,
+            model=p.model,
+        )
+
+    cda = group_cda(line)
+    wind, wind_from, cap = p.wind_ms, p.wind_from_deg, p.max_speed_kmh / 3.6
+
+    def ride_at(cda_m2: float) -> course_kernel.Ride:
+        return course_kernel.ride(route, p.power_w, rider(cda_m2), wind, wind_from, air, cap)
+
+    pacing = None
+    if p.pacing:
+        pacing = course_kernel.paced_ride(
+            route, p.power_w, rider(cda), p.pacing_gain_pct / 100.0, wind, wind_from, air, cap
+        )
+        constant, shown = pacing.constant, pacing.paced
+    else:
+        constant = shown = ride_at(cda)
+    solo = constant if cda == line.cda_m2 else ride_at(line.cda_m2)
+    return CourseState(
+        route=route,
+        ride=shown,
+        constant=constant,
+        solo=solo,
+        pacing=pacing,
+        group_cda_m2=cda,
+        density_seed=float(cycling.air_density(start)),
+        density_weather=float(weather.density(start)),
+    )
+
+
+def format_duration(seconds: float) -> str:
+    """h:mm:ss (or m:ss under an hour)."""
+    total = round(seconds)
+    hours, rest = divmod(total, 3600)
+    minutes, secs = divmod(rest, 60)
+    return f"{hours:d}:{minutes:02d}:{secs:02d}" if hours else f"{minutes:d}:{secs:02d}"
+
+
+def split_every_m(total_m: float) -> float:
+    """Split length for the table: 1 km up to 30 km, 5 km up to 150 km, else 10 km."""
+    return 1000.0 if total_m <= 30_000.0 else 5000.0 if total_m <= 150_000.0 else 10_000.0
+
+
+def drawn_indices(n_points: int, limit: int) -> np.ndarray:
+    """Indices of at most ``limit`` points spread along the route, first and last included."""
+    return np.unique(np.linspace(0, n_points - 1, min(n_points, limit)).round().astype(np.int64))
+
+
+@dataclasses.dataclass(frozen=True)
+class CourseDrawing:
+    """The route mapped into the scene: map (east, north) scaled into the framed box, elevation exaggerated."""
+
+    scale: float
+    """Scene metres per map metre."""
+    offset: np.ndarray
+    """(2,) map point drawn at COURSE_CENTRE (m)."""
+    base_m: float
+    """Elevation drawn at z = 0 (m): the route's lowest point."""
+
+    @staticmethod
+    def of(route: course_kernel.Course) -> CourseDrawing:
+        east, north = route.east_m, route.north_m
+        extent = max(float(np.ptp(east)), float(np.ptp(north)), 1.0)
+        centre = np.array([0.5 * (east.min() + east.max()), 0.5 * (north.min() + north.max())])
+        return CourseDrawing(
+            scale=COURSE_BOX_M / extent, offset=centre, base_m=float(route.elevation_m.min())
+        )
+
+    def points(
+        self, route: course_kernel.Course, index: np.ndarray, exaggeration: float
+    ) -> np.ndarray:
+        """(k, 3) scene positions of route points ``index``."""
+        xy = (
+            np.stack([route.east_m[index], route.north_m[index]], axis=1) - self.offset
+        ) * self.scale
+        z = (route.elevation_m[index] - self.base_m) * self.scale * exaggeration + 0.05
+        return np.concatenate([xy + COURSE_CENTRE, z[:, None]], axis=1)
+
+    def at_distance(
+        self, route: course_kernel.Course, distance_m: np.ndarray, exaggeration: float
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """(k, 3) scene positions and (k,) yaw angles (rad, from +x) at distances along the route."""
+        d = np.clip(distance_m, 0.0, route.total_distance_m)
+        east = np.interp(d, route.distance_m, route.east_m)
+        north = np.interp(d, route.distance_m, route.north_m)
+        z = np.interp(d, route.distance_m, route.elevation_m)
+        segment = np.clip(
+            np.searchsorted(route.distance_m, d, side="right") - 1, 0, route.n_points - 2
+        )
+        yaw = math.pi / 2 - route.heading_rad[segment]
+        xy = (np.stack([east, north], axis=1) - self.offset) * self.scale + COURSE_CENTRE
+        zz = (z - self.base_m) * self.scale * exaggeration + 0.05
+        return np.concatenate([xy, zz[:, None]], axis=1), yaw
+
+
+def terrain_strip(points: np.ndarray, half_width: float) -> tuple[np.ndarray, np.ndarray]:
+    """A road-side strip along the route and a curtain under it down to z = 0: (4k, 3) vertices and faces.
+
+    The strip is the terrain the road crosses; the curtain shows the height above the valley floor.
+    """
+    k = points.shape[0]
+    direction = np.gradient(points[:, :2], axis=0)
+    norm = np.linalg.norm(direction, axis=1, keepdims=True)
+    direction = direction / np.where(norm > 1e-12, norm, 1.0)
+    side = np.stack([-direction[:, 1], direction[:, 0]], axis=1) * half_width
+    top = points[:, 2:3] - 0.03
+    left = np.concatenate([points[:, :2] + side, top], axis=1)
+    right = np.concatenate([points[:, :2] - side, top], axis=1)
+    centre = np.concatenate([points[:, :2], top - 0.01], axis=1)
+    foot = centre * [1.0, 1.0, 0.0]
+    vertices = np.concatenate([left, right, centre, foot])
+    a = np.arange(k - 1)
+    b = a + 1
+    L, R, C, F = 0, k, 2 * k, 3 * k  # block offsets: left edge, right edge, centre, its foot
+    faces = np.concatenate([
+        np.stack([L + a, R + a, R + b], axis=1), np.stack([L + a, R + b, L + b], axis=1),  # strip
+        np.stack([F + a, C + a, C + b], axis=1), np.stack([F + a, C + b, F + b], axis=1),  # curtain
+    ])  # fmt: skip
+    return vertices.astype(np.float32), faces.astype(np.uint32)
+
+
+def ground_under(points: np.ndarray, margin: float = 0.6) -> tuple[np.ndarray, np.ndarray]:
+    """A thin slab under the route's bounding rectangle plus ``margin`` (scene m): vertices and faces."""
+    lo, hi = points[:, :2].min(axis=0) - margin, points[:, :2].max(axis=0) + margin
+    slab = trimesh.creation.box(extents=(*(hi - lo), 0.02))
+    slab.apply_translation((*((lo + hi) / 2), -0.011))
+    return slab.vertices.astype(np.float32), slab.faces.astype(np.uint32)
+
+
+def grade_colours(grade: np.ndarray) -> np.ndarray:
+    """(k, 3) uint8: descents blue, flat white-green, climbs yellow to red at 12 %."""
+    g = np.clip(grade / 0.12, -1.0, 1.0)
+    up = np.clip(g, 0.0, 1.0)[:, None]
+    down = np.clip(-g, 0.0, 1.0)[:, None]
+    flat = np.array([90.0, 200.0, 90.0])
+    colour = (
+        flat
+        + up * (np.array([230.0, 40.0, 30.0]) - flat)
+        + down * (np.array([40.0, 110.0, 230.0]) - flat)
+    )
+    return colour.astype(np.uint8)
+
+
+class CourseMode:
+    """The course mode of :class:`PelotonScene`: its GUI folder, its nodes under ``/peloton/course_mode``.
+
+    Every input is cleaned through the scene's helpers; a bad file leaves the last good course in place with
+    a message saying why.
+    """
+
+    def __init__(self, scene: PelotonScene) -> None:
+        self.scene = scene
+        self.server = scene.server
+        self.params = CourseParams()
+        self.route = course_kernel.load_gpx(course_kernel.SAMPLE_ROUTE)
+        self.route_label = SAMPLE_LABEL
+        self.state: CourseState | None = None
+        """Computed when the mode is first shown (the compiled ride loop loads then)."""
+        self.enabled = False
+        self.playing = False
+        self.play_time_s = 0.0
+        self.message = ""
+        self._since_readout = 0.0
+        self._drawn_position: Position | None = None
+        self._drawing = CourseDrawing.of(self.route)
+        self._build_gui()
+        self._build_world()
+        scene.start_loop(self._animate, 1.0 / 30.0)
+
+    # ----------------------------------------------------------------------------------------- GUI
+    def _build_gui(self) -> None:
+        gui, p = self.server.gui, self.params
+        with self.scene.gui_root, gui.add_folder("Course mode (GPX route)"):
+            self.enable = gui.add_checkbox("Ride a course", initial_value=False)
+            self.route_info = gui.add_markdown(self._route_markdown())
+            self.sample = gui.add_button("Load the sample route")
+            self.upload = gui.add_upload_button("Upload GPX", mime_type=".gpx,application/gpx+xml")
+            self.play = gui.add_button("Play")
+            self.pause = gui.add_button("Pause")
+            self.scrub = gui.add_slider(
+                "Position (km)", min=0.0, max=self._total_km(), step=0.01, initial_value=0.0
+            )
+            self.now = gui.add_markdown("")
+            self.readout = gui.add_markdown("")
+            self.chart = gui.add_uplot(
+                data=self._chart_data(),
+                series=(
+                    viser.uplot.Series(label="Distance (km)"),
+                    viser.uplot.Series(
+                        label="Elevation (m)", stroke="rgb(120,90,60)", width=2, scale="m"
+                    ),
+                    viser.uplot.Series(
+                        label="Speed (km/h)", stroke="rgb(30,110,220)", width=1.5, scale="kmh"
+                    ),
+                    viser.uplot.Series(
+                        label="Power (W)", stroke="rgb(220,40,40)", width=1.5, scale="W"
+                    ),
+                ),
+                scales={
+                    "x": viser.uplot.Scale(time=False, auto=True),
+                    "m": viser.uplot.Scale(auto=True),
+                    "kmh": viser.uplot.Scale(auto=True),
+                    "W": viser.uplot.Scale(auto=True),  # no axis of its own: the legend gives watts
+                },
+                axes=(
+                    viser.uplot.Axis(scale="x", label="km"),
+                    viser.uplot.Axis(scale="m", label="m", side=3),
+                    viser.uplot.Axis(
+                        scale="kmh", label="km/h", side=1, grid=viser.uplot.Axis_Grid(show=False)
+                    ),
+                ),
+                legend=viser.uplot.Legend(show=True),
+                title="Elevation, speed and power along the course",
+                aspect=1.4,
+            )
+            with gui.add_folder("Power, model and air"):
+                self.power = gui.add_number(
+                    "Course power (W)", min=20.0, max=2000.0, step=5.0, initial_value=p.power_w
+                )
+                self.target = gui.add_number(
+                    "Target time (min)", min=1.0, max=6000.0, step=1.0, initial_value=p.target_min
+                )
+                self.solve = gui.add_button("Find the power for this time")
+                self.power_model = gui.add_dropdown(
+                    "Power model",
+                    options=list(POWER_MODEL_FROM_LABEL),
+                    initial_value="Martin et al. 1998 (full)",
+                )
+                self.air = gui.add_dropdown(
+                    "Air", options=list(AIR_FROM_LABEL), initial_value="Seed (exponential)"
+                )
+                self.temperature = gui.add_slider(
+                    "Temperature (°C)", min=-20.0, max=45.0, step=0.5, initial_value=p.temperature_c
+                )
+                self.pressure_source = gui.add_dropdown(
+                    "Pressure from",
+                    options=list(PRESSURE_SOURCES),
+                    initial_value=PRESSURE_SOURCES[0],
+                )
+                self.pressure = gui.add_number(
+                    "Pressure at the start (hPa)",
+                    min=500.0,
+                    max=1100.0,
+                    step=0.5,
+                    initial_value=p.pressure_hpa,
+                )
+                self.humidity = gui.add_slider(
+                    "Humidity (%)", min=0.0, max=100.0, step=1.0, initial_value=p.humidity_pct
+                )
+            with gui.add_folder("Wind, descents, pacing, view", expand_by_default=False):
+                self.wind = gui.add_slider(
+                    "Wind (m/s)", min=0.0, max=20.0, step=0.5, initial_value=p.wind_ms
+                )
+                self.wind_from = gui.add_slider(
+                    "Wind from (° from north)",
+                    min=0.0,
+                    max=359.0,
+                    step=1.0,
+                    initial_value=p.wind_from_deg,
+                )
+                self.max_speed = gui.add_slider(
+                    "Safe descending speed (km/h)",
+                    min=20.0,
+                    max=110.0,
+                    step=1.0,
+                    initial_value=p.max_speed_kmh,
+                )
+                self.pacing = gui.add_checkbox("Pace by grade", initial_value=p.pacing)
+                self.pacing_gain = gui.add_slider(
+                    "Pacing gain (%)", min=0.0, max=50.0, step=1.0, initial_value=p.pacing_gain_pct
+                )
+                self.exaggeration = gui.add_slider(
+                    "Elevation exaggeration (×)",
+                    min=1.0,
+                    max=10.0,
+                    step=0.5,
+                    initial_value=p.exaggeration,
+                )
+                self.playback = gui.add_slider(
+                    "Playback speed (×)", min=1.0, max=600.0, step=1.0, initial_value=p.playback
+                )
+            with gui.add_folder("Splits", expand_by_default=False):
+                self.splits = gui.add_markdown("")
+        cb = self.scene.callback
+        self.enable.on_update(cb(self._on_enable))
+        self.sample.on_click(cb(self._on_sample))
+        self.upload.on_upload(self._on_upload)  # parses off the lock, then installs through cb
+        self.solve.on_click(cb(self._on_solve))
+        self.play.on_click(cb(self._on_play))
+        self.pause.on_click(cb(self._on_pause))
+        self.scrub.on_update(cb(self._on_scrub))
+        for handle in (
+            self.power, self.power_model, self.air, self.temperature, self.pressure_source, self.pressure,
+            self.humidity, self.wind, self.wind_from, self.max_speed, self.pacing, self.pacing_gain,
+        ):  # fmt: skip
+            handle.on_update(cb(self._on_input))
+        self.exaggeration.on_update(cb(self._on_view))
+        self.playback.on_update(cb(self._on_view))
+        self.target.on_update(cb(self._on_view))
+        line = self.scene
+        for handle in (
+            line.cda, line.mass, line.crr, line.drivetrain, line.drafting, line.riders, line.gap, line.model,
+            line.position, line.crr_preset,
+        ):  # fmt: skip
+            handle.on_update(cb(self._on_input))  # the paceline options apply on the course
+
+    # ----------------------------------------------------------------------------------------- world
+    def _build_world(self) -> None:
+        scene = self.server.scene
+        self.frame = scene.add_frame(
+            f"{self.scene.root.name}/course_mode", show_axes=False, visible=False
+        )
+        index = drawn_indices(self.route.n_points, MAX_DRAWN_POINTS)
+        points = self._drawing.points(self.route, index, self.params.exaggeration)
+        vertices, faces = terrain_strip(points, TERRAIN_HALF_WIDTH_M)
+        ground_vertices, ground_faces = ground_under(points)
+        self.ground = scene.add_mesh_simple(
+            f"{self.frame.name}/ground", ground_vertices, ground_faces, color=(205, 210, 195)
+        )
+        self.terrain = scene.add_mesh_simple(
+            f"{self.frame.name}/terrain",
+            vertices,
+            faces,
+            color=(150, 175, 110),
+            side="double",
+        )
+        segments, colours = self._route_segments(index, points)
+        self.route_line = scene.add_line_segments(
+            f"{self.frame.name}/route", segments, colors=colours, thickness=0.08
+        )
+        identity = np.tile([1.0, 0.0, 0.0, 0.0], (MAX_RIDERS, 1))
+        colours_by_part = {
+            "bike": np.full((MAX_RIDERS, 3), 45, np.uint8),
+            "body": JERSEYS,
+            "head": np.full((MAX_RIDERS, 3), 235, np.uint8),
+        }
+        self.course_riders: dict[str, viser.BatchedMeshHandle] = {}
+        for part, mesh in rider_meshes(self.scene.params.position).items():
+            self.course_riders[part] = scene.add_batched_meshes_simple(
+                f"{self.frame.name}/riders_{part}",
+                vertices=mesh.vertices.astype(np.float32),
+                faces=mesh.faces.astype(np.uint32),
+                batched_wxyzs=identity,
+                batched_positions=np.zeros((MAX_RIDERS, 3)),
+                batched_scales=np.zeros((MAX_RIDERS, 3)),
+                batched_colors=colours_by_part[part],
+                lod="off",
+            )
+        self._drawn_position = self.scene.params.position
+        self.leader_marker = scene.add_icosphere(
+            f"{self.frame.name}/leader_marker",
+            radius=0.12,
+            color=(255, 60, 60),
+            position=(0.0, 0.0, 1.0),
+        )
+        self.start_label = scene.add_label(
+            f"{self.frame.name}/start", text="Start", position=tuple(points[0])
+        )
+        self.finish_label = scene.add_label(
+            f"{self.frame.name}/finish", text="Finish", position=tuple(points[-1])
+        )
+
+    def _route_segments(
+        self, index: np.ndarray, points: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        segments = np.stack([points[:-1], points[1:]], axis=1) + [0.0, 0.0, 0.02]
+        rise = np.diff(self.route.elevation_m[index])
+        run = np.maximum(np.diff(self.route.distance_m[index]), 1e-9)
+        colours = grade_colours(rise / run)
+        return segments.astype(np.float32), np.repeat(colours[:, None, :], 2, axis=1)
+
+    # ----------------------------------------------------------------------------------------- inputs
+    def read_params(self) -> CourseParams:
+        """The course inputs, cleaned: anything non-finite, out of range or unknown keeps the last good value."""
+        s, last = self.scene, self.params
+        model_label = s.read_choice(
+            self.power_model,
+            list(POWER_MODEL_FROM_LABEL),
+            next(k for k, v in POWER_MODEL_FROM_LABEL.items() if v == last.model),
+        )
+        air_label = s.read_choice(
+            self.air,
+            list(AIR_FROM_LABEL),
+            next(k for k, v in AIR_FROM_LABEL.items() if v == last.air),
+        )
+        source = s.read_choice(
+            self.pressure_source,
+            list(PRESSURE_SOURCES),
+            PRESSURE_SOURCES[1 if last.pressure_from_barometer else 0],
+        )
+        return CourseParams(
+            power_w=s.read_number(self.power, last.power_w),
+            target_min=s.read_number(self.target, last.target_min),
+            model=POWER_MODEL_FROM_LABEL[model_label],
+            air=AIR_FROM_LABEL[air_label],
+            temperature_c=s.read_number(self.temperature, last.temperature_c),
+            pressure_from_barometer=source == PRESSURE_SOURCES[1],
+            pressure_hpa=s.read_number(self.pressure, last.pressure_hpa),
+            humidity_pct=s.read_number(self.humidity, last.humidity_pct),
+            wind_ms=s.read_number(self.wind, last.wind_ms),
+            wind_from_deg=s.read_number(self.wind_from, last.wind_from_deg),
+            max_speed_kmh=s.read_number(self.max_speed, last.max_speed_kmh),
+            pacing=s.read_bool(self.pacing, last.pacing),
+            pacing_gain_pct=s.read_number(self.pacing_gain, last.pacing_gain_pct),
+            exaggeration=s.read_number(self.exaggeration, last.exaggeration),
+            playback=s.read_number(self.playback, last.playback),
+        )
+
+    def _on_enable(self) -> None:
+        self.enabled = self.scene.read_bool(self.enable, self.enabled)
+        if self.enabled and self.state is None:
+            self.recompute()
+        self.redraw()
+
+    def _on_input(self) -> None:
+        if (
+            not self.enabled
+        ):  # the line's sliders move often: ride the course only while it is shown
+            self.state = None
+            return
+        self.recompute()
+        self.redraw()
+
+    def _on_view(self) -> None:
+        self.params = self.read_params()
+        self.redraw()
+
+    def recompute(self) -> None:
+        """Ride the current route with the current inputs; on failure keep the last good state and say why."""
+        params = self.read_params()
+        line = self.scene.read_params()
+        try:
+            state = compute_course(self.route, params, line)
+        except ValueError as error:
+            self.message = f"Could not ride this course: {error}"
+            return
+        self.params, self.state = params, state
+        self.message = ""
+        self.play_time_s = min(self.play_time_s, state.ride.time_s)
+
+    def _on_sample(self) -> None:
+        self.load(course_kernel.SAMPLE_ROUTE.read_bytes(), SAMPLE_LABEL)
+
+    def _on_upload(self, _event: object = None) -> None:
+        """An upload arrived (viser's thread pool). Parse it off the scene's lock, since gpxpy needs seconds for a
+        large file, then install it (or the reason it failed) as a guarded callback. Nothing escapes."""
+        try:
+            uploaded = self.upload.value
+            name = str(getattr(uploaded, "name", "") or "upload")[:80]
+            content = getattr(uploaded, "content", b"")
+            route, error = None, None
+            if not isinstance(content, bytes):
+                error = "the upload carried no file"
+            else:
+                try:
+                    route = course_kernel.load_gpx(content)
+                except ValueError as failure:
+                    error = str(failure)
+        except Exception:  # a file must never take the scene down; say so and keep the course
+            logger.exception("peloton: reading an uploaded GPX failed")
+            name, route, error = "upload", None, "the file could not be read"
+
+        def install() -> None:
+            self._install(route, error, name)
+
+        self.scene.callback(install)(None)
+
+    def load(self, data: bytes, label: str) -> bool:
+        """Load a GPX file's bytes as the course; on a bad file keep the last good course and show why."""
+        try:
+            route, error = course_kernel.load_gpx(data), None
+        except ValueError as failure:
+            route, error = None, str(failure)
+        return self._install(route, error, label)
+
+    def _install(self, route: course_kernel.Course | None, error: str | None, label: str) -> bool:
+        state = None
+        if route is not None:
+            try:
+                state = compute_course(route, self.read_params(), self.scene.read_params())
+            except ValueError as failure:
+                error = str(failure)
+        if route is None or state is None:
+            self.message = (
+                f"**{_escape(label)}** was not loaded: {_escape(str(error))}. "
+                f"Still showing **{_escape(self.route.name)}**."
+            )
+            self.redraw()
+            return False
+        self.route, self.route_label, self.state = route, label, state
+        self.params = self.read_params()
+        self.message = ""
+        self.play_time_s = 0.0
+        self.playing = False
+        self._drawing = CourseDrawing.of(route)
+        self.scrub.max = self._total_km()
+        self.redraw(geometry=True)
+        return True
+
+    def _on_solve(self) -> None:
+        params = self.read_params()
+        line = self.scene.read_params()
+        air = course_air(self.route, params)
+        rider = course_kernel.Rider(
+            cda_m2=group_cda(line), mass_kg=line.mass_kg, crr=line.crr,
+            drivetrain_efficiency=line.drivetrain_pct / 100.0, model=params.model,
+        )  # fmt: skip
+        try:
+            power = course_kernel.power_for_time(
+                self.route, params.target_min * 60.0, rider, params.wind_ms, params.wind_from_deg, air,
+                max_speed_ms=params.max_speed_kmh / 3.6, tolerance_s=0.05,
+            )  # fmt: skip
+        except ValueError as error:
+            self.message = _escape(str(error))
+            self.redraw()
+            return
+        self.scene._write_back(self.power, float(np.clip(round(power, 1), 20.0, 2000.0)))
+        self._on_input()
+
+    def _on_play(self) -> None:
+        if self.state is None:
+            return
+        if self.play_time_s >= self.state.ride.time_s:
+            self.play_time_s = 0.0
+        self.playing = True
+
+    def _on_pause(self) -> None:
+        self.playing = False
+        self.scene._write_back(self.scrub, round(self._leader_km(), 2))  # where the riders stopped
+        self.redraw(readouts=False)
+
+    def _on_scrub(self) -> None:
+        if self.state is None:
+            return
+        raw = self.scrub.value
+        ok = isinstance(raw, (int, float)) and not isinstance(raw, bool) and math.isfinite(raw)
+        km = float(np.clip(raw if ok else self._leader_km(), 0.0, self._total_km()))
+        if not ok or km != raw:
+            self.scene._write_back(self.scrub, km)
+        ride = self.state.ride
+        self.play_time_s = float(np.interp(km * 1000.0, ride.distance_m, ride.elapsed_s))
+        self.redraw(readouts=False)
+
+    # ----------------------------------------------------------------------------------------- animation
+    def _animate(self, dt: float) -> None:
+        if not (self.enabled and self.playing and self.state is not None):
+            return
+        dt = min(dt, 0.2)
+        self.play_time_s = min(self.play_time_s + dt * self.params.playback, self.state.ride.time_s)
+        if self.play_time_s >= self.state.ride.time_s:
+            self.playing = False
+        self._since_readout += dt
+        if self._since_readout >= 0.2 or not self.playing:  # the slider and readout follow at 5 Hz
+            self._since_readout = 0.0
+            self.scene._write_back(self.scrub, round(self._leader_km(), 2))
+            self.redraw(readouts=False, now=True)
+        else:
+            self.redraw(readouts=False, now=False)
+
+    # ----------------------------------------------------------------------------------------- drawing
+    def _total_km(self) -> float:
+        return math.floor(self.route.total_distance_m / 10.0) / 100.0
+
+    def leader_distance_m(self) -> float:
+        if self.state is None:
+            return 0.0
+        ride = self.state.ride
+        return float(np.interp(self.play_time_s, ride.elapsed_s, ride.distance_m))
+
+    def _leader_km(self) -> float:
+        return self.leader_distance_m() / 1000.0
+
+    def rider_distances_m(self) -> np.ndarray:
+        """(n_riders,) distance along the route of each drawn rider, leader first (spaced as drawn)."""
+        n, gap = self.scene.params.n_riders, self.scene.params.gap_m
+        spacing_m = (BIKE_LENGTH_M + gap) * COURSE_MARKER_SCALE / self._drawing.scale
+        return self.leader_distance_m() - np.arange(n) * spacing_m
+
+    def redraw(self, *, geometry: bool = False, readouts: bool = True, now: bool = True) -> None:
+        """Show or hide the mode and push its state: riders always, geometry and readouts when asked."""
+        s = self.scene
+        with self.server.atomic():
+            s.course.visible = not self.enabled
+            if self.enabled:
+                s.wind_arrow.visible = False
+            self.frame.visible = self.enabled
+            if geometry or self._drawn_exaggeration != self.params.exaggeration:
+                self._draw_geometry()
+            if s.params.position != self._drawn_position:
+                for part, mesh in rider_meshes(s.params.position).items():
+                    self.course_riders[part].vertices = mesh.vertices.astype(np.float32)
+                    self.course_riders[part].faces = mesh.faces.astype(np.uint32)
+                self._drawn_position = s.params.position
+            self._draw_riders()
+            if now:
+                self.now.content = self._now_markdown()
+            if readouts:
+                self.route_info.content = self._route_markdown()
+                self.readout.content = self._readout_markdown()
+                self.splits.content = self._splits_markdown()
+                self.chart.data = self._chart_data()
+        self.server.flush()
+
+    _drawn_exaggeration: float = 2.0
+
+    def _draw_geometry(self) -> None:
+        index = drawn_indices(self.route.n_points, MAX_DRAWN_POINTS)
+        points = self._drawing.points(self.route, index, self.params.exaggeration)
+        vertices, faces = terrain_strip(points, TERRAIN_HALF_WIDTH_M)
+        self.terrain.vertices = vertices
+        self.terrain.faces = faces
+        self.ground.vertices, self.ground.faces = ground_under(points)
+        segments, colours = self._route_segments(index, points)
+        self.route_line.points = segments
+        self.route_line.colors = colours
+        self.start_label.position = tuple(points[0])
+        self.finish_label.position = tuple(points[-1])
+        self._drawn_exaggeration = self.params.exaggeration
+
+    def _draw_riders(self) -> None:
+        n = self.scene.params.n_riders
+        positions = np.zeros((MAX_RIDERS, 3))
+        wxyz = np.tile([1.0, 0.0, 0.0, 0.0], (MAX_RIDERS, 1))
+        where, yaw = self._drawing.at_distance(
+            self.route, self.rider_distances_m(), self.params.exaggeration
+        )
+        positions[:n] = where
+        wxyz[:n] = np.stack([np.cos(yaw / 2), np.zeros(n), np.zeros(n), np.sin(yaw / 2)], axis=1)
+        visible = (np.arange(MAX_RIDERS) < n).astype(np.float64)
+        # Riders behind the start wait there (hidden until the line has rolled out).
+        visible[:n] *= self.rider_distances_m() >= 0.0
+        scales = np.repeat(visible[:, None], 3, axis=1) * COURSE_MARKER_SCALE
+        for node in self.course_riders.values():
+            node.batched_positions = positions.astype(np.float32)
+            node.batched_wxyzs = wxyz.astype(np.float32)
+            node.batched_scales = scales.astype(np.float32)
+        self.leader_marker.position = tuple(where[0] + [0.0, 0.0, 0.5])
+
+    def _chart_data(self) -> tuple[np.ndarray, ...]:
+        route = self.route
+        index = drawn_indices(route.n_points, MAX_CHART_POINTS)
+        km = route.distance_m[index] / 1000.0
+        elevation = route.elevation_m[index]
+        if (
+            self.state is None
+        ):  # before the first ride: the profile, and zeros (never a NaN-only series)
+            zeros = np.zeros_like(km)
+            return km, elevation, zeros, zeros
+        ride = self.state.ride
+        return km, elevation, 3.6 * ride.speed_ms[index], ride.power_w[index]
+
+    def _route_markdown(self) -> str:
+        r = self.route
+        average = 100.0 * (r.elevation_m[-1] - r.elevation_m[0]) / r.total_distance_m
+        text = (
+            f"**{_escape(r.name)}**: {r.total_distance_m / 1000:.2f} km, +{r.climbing_m:.0f} m, "
+            f"{r.elevation_m[0]:.0f} → {r.elevation_m[-1]:.0f} m ({average:+.1f} % on average), {r.n_points} points"
+        )
+        if self.route_label == SAMPLE_LABEL:
+            text += (
+                "  \n*Sample route, built from Alpe d'Huez's published climb profile (13.2 km, 744 → 1815 m, "
+                "8.1 %); its plan shape is schematic.*"
+            )
+        if self.message:
+            text += f"  \n⚠️ {self.message}"
+        return text
+
+    def _readout_markdown(self) -> str:
+        state = self.state
+        if state is None:
+            return "Tick **Ride a course** to ride it."
+        ride, line = state.ride, self.scene.params
+        p = self.params
+        text = (
+            f"Finish **{format_duration(ride.time_s)}**, average **{3.6 * ride.average_speed_ms:.1f} km/h** "
+            f"at **{ride.average_power_w:.0f} W** ({p.model} model)"
+        )
+        if state.group_cda_m2 != line.cda_m2:
+            text += (
+                f"  \n{line.n_riders} riders sharing the front (mean CdA {state.group_cda_m2:.3f} m²): "
+                f"alone the same power takes {format_duration(state.solo.time_s)}"
+            )
+        if state.pacing is not None:
+            saved = state.pacing.time_saved_s
+            text += (
+                f"  \nPacing by grade (±{p.pacing_gain_pct:.0f} %): {format_duration(state.constant.time_s)} at constant "
+                f"power → {format_duration(ride.time_s)}, **{saved:.0f} s {'saved' if saved >= 0 else 'lost'}** at the same average power"
+            )
+        which = "weather" if p.air == "weather" else "seed"
+        text += (
+            f"  \nAir at the start ({state.route.elevation_m[0]:.0f} m): seed (exponential) **{state.density_seed:.3f}** kg/m³, "
+            f"weather **{state.density_weather:.3f}** kg/m³; riding in the {which} air"
+        )
+        if ride.brakes_j > 0.0:
+            text += (
+                f"  \nBraking to hold {p.max_speed_kmh:.0f} km/h took {ride.brakes_j / 1000:.0f} kJ"
+            )
+        return text
+
+    def _splits_markdown(self) -> str:
+        if self.state is None:
+            return ""
+        ride = self.state.ride
+        every = split_every_m(float(ride.distance_m[-1]))
+        marks, times = ride.splits(every)
+        rows = ["| km | elapsed | split | km/h |", "|---:|---:|---:|---:|"]
+        previous_mark, previous_time = 0.0, 0.0
+        shown = np.unique(
+            np.linspace(0, marks.shape[0] - 1, min(marks.shape[0], 20)).round().astype(int)
+        )
+        for i in range(marks.shape[0]):
+            split = times[i] - previous_time
+            speed = 3.6 * (marks[i] - previous_mark) / split if split > 0 else 0.0
+            if i in shown:
+                rows.append(
+                    f"| {marks[i] / 1000:.1f} | {format_duration(times[i])} | {format_duration(split)} | {speed:.1f} |"
+                )
+            previous_mark, previous_time = marks[i], times[i]
+        return "\n".join(rows)
+
+    def _now_markdown(self) -> str:
+        if self.state is None:
+            return ""
+        ride = self.state.ride
+        d = self.leader_distance_m()
+        speed = float(np.interp(d, ride.distance_m, ride.speed_ms))
+        power = float(
+            ride.power_w[
+                min(
+                    int(np.searchsorted(ride.distance_m, d, side="right")) - 1,
+                    ride.power_w.shape[0] - 1,
+                )
+            ]
+        )
+        elevation = float(np.interp(d, self.route.distance_m, self.route.elevation_m))
+        return (
+            f"Leader at **{d / 1000:.2f} km**, {format_duration(self.play_time_s)}: "
+            f"{3.6 * speed:.1f} km/h, {power:.0f} W, {elevation:.0f} m"
+        )
+
+
+def _escape(text: str) -> str:
+    """Text from a file, shown in markdown: no HTML, no markdown links or images."""
+    return (
+        text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
+        .replace("[", "&#91;").replace("]", "&#93;").replace("*", "&#42;").replace("|", "&#124;")
+    )  # fmt: skip

@@ -1,0 +1,89 @@
+"""Save a Chromium screenshot of the peloton scene's course mode to docs/peloton_course.png.
+
+python scripts/screenshot_course.py
+
+The sample route, four riders sharing the front, weather air, played to about 40 % of the way.
+"""
+
+from __future__ import annotations
+
+import shutil
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import tyro
+import viser
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "tests"))
+
+from browser import open_viser  # noqa: E402
+from conftest import CHROMIUM, CHROMIUM_ARGS  # noqa: E402
+
+from scenes.peloton import PelotonScene  # noqa: E402
+from scenes.switcher import SceneSwitcher  # noqa: E402
+
+
+def main(
+    out: Path = ROOT / "docs" / "peloton_course.png", at_km: float = 5.5, settle_s: float = 5.0
+) -> None:
+    """Screenshot the course mode.
+
+    Args:
+        out: where the PNG goes.
+        at_km: where the leader is shown (km).
+        settle_s: seconds to let the page render.
+    """
+    from playwright.sync_api import Error as PlaywrightError
+    from playwright.sync_api import sync_playwright
+
+    server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
+    server.gui.configure_theme(control_width="large")  # as app.py serves it
+    switcher = SceneSwitcher(server, "peloton")
+    scene = switcher.scene
+    assert isinstance(scene, PelotonScene)
+    mode = scene.course_mode
+    mode.enable.value = True
+    mode.air.value = "Weather (temperature, pressure or altitude, humidity)"
+    mode.temperature.value = 24.0
+    mode.humidity.value = 60.0
+    mode.scrub.value = at_km
+    with sync_playwright() as playwright:
+        profile = tempfile.mkdtemp(prefix="chromium-shot-")
+        context = playwright.chromium.launch_persistent_context(
+            profile, executable_path=CHROMIUM, headless=True, args=CHROMIUM_ARGS,
+            viewport={"width": 1600, "height": 1000},
+        )  # fmt: skip
+        try:
+            page = context.new_page()
+            open_viser(page, server.get_port(), "/peloton/course_mode/route")
+            time.sleep(settle_s)
+            close_buttons = page.locator(".mantine-Notification-closeButton")
+            for i in range(close_buttons.count()):
+                try:
+                    close_buttons.nth(i).click(timeout=2000, force=True)
+                except PlaywrightError:
+                    pass  # already gone
+            # Fold the line's own folders so the course mode's readouts and chart are in view.
+            for folder in ("Rider", "Course", "Drafting", "Results", "Speed at a power"):
+                try:
+                    page.get_by_text(folder, exact=True).first.click(timeout=20_000)
+                except PlaywrightError:
+                    print(f"could not fold {folder!r}; the picture shows it open")
+            chart = page.locator(".uplot", has_text="Elevation, speed and power along the course")
+            chart.first.scroll_into_view_if_needed(timeout=10_000)
+            time.sleep(1.0)
+            page.screenshot(path=str(out))
+            print(f"saved {out}")
+        finally:
+            context.close()
+            shutil.rmtree(profile, ignore_errors=True)
+    switcher.close()
+    server.stop()
+
+
+if __name__ == "__main__":
+    tyro.cli(main)

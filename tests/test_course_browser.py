@@ -1,0 +1,92 @@
+"""A real browser: Chromium ticks the course mode, uploads a GPX through viser's upload button and plays it."""
+
+from __future__ import annotations
+
+import io
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+import viser
+from browser import canvas_is_not_blank, open_viser
+from PIL import Image
+from test_course_scene import hill_gpx
+
+from scenes.peloton import PelotonScene
+from scenes.switcher import SceneSwitcher
+
+pytestmark = pytest.mark.browser
+
+
+def render(server: viser.ViserServer) -> np.ndarray:
+    clients = list(server.get_clients().values())
+    assert len(clients) == 1
+    return np.asarray(clients[0].get_render(height=360, width=640, transport_format="png"))
+
+
+def png(image: np.ndarray) -> bytes:
+    buffer = io.BytesIO()
+    Image.fromarray(image).save(buffer, format="PNG")
+    return buffer.getvalue()
+
+
+def wait_until(predicate: Any, timeout: float, what: str) -> None:
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        if predicate():
+            return
+        time.sleep(0.05)
+    raise AssertionError(f"timed out waiting for {what}")
+
+
+def test_upload_a_gpx_and_play_it(
+    server: viser.ViserServer, browser_page: Any, tmp_path: Path
+) -> None:
+    switcher = SceneSwitcher(server, "peloton")
+    scene = switcher.scene
+    assert isinstance(scene, PelotonScene)
+    mode = scene.course_mode
+    page = browser_page
+    open_viser(page, server.get_port(), "/peloton/course_mode/route")
+
+    page.get_by_text("Ride a course", exact=True).first.click()
+    wait_until(lambda: mode.enabled and mode.state is not None, 15.0, "course mode on")
+
+    path = tmp_path / "browser_hill.gpx"
+    path.write_bytes(hill_gpx("Browser hill", 1500))
+    with page.expect_file_chooser() as chooser:
+        page.get_by_text("Upload GPX", exact=True).first.click()
+    chooser.value.set_files(str(path))
+    wait_until(lambda: mode.route.name == "Browser hill", 20.0, "the uploaded course")
+    page.get_by_text("Browser hill", exact=False).first.wait_for(timeout=15_000)
+
+    time.sleep(1.0)  # let the new geometry reach the canvas
+    before = render(server)
+    assert canvas_is_not_blank(png(before))
+    with scene._lock:
+        start = mode.leader_distance_m()
+    mode.playback.value = 300.0  # fast forward, set on the server (its on_update and cleaning run)
+    page.get_by_role("button", name="Play").first.click()
+    wait_until(lambda: mode.leader_distance_m() > start + 500.0, 20.0, "the riders to ride")
+    page.get_by_role("button", name="Pause").first.click()
+    wait_until(lambda: not mode.playing, 10.0, "pause")
+    time.sleep(0.5)
+    after = render(server)
+    # The riders moved on screen: part of the picture changed.
+    changed = np.any(np.abs(after.astype(int) - before.astype(int)) > 30, axis=2)
+    assert changed.mean() > 0.0005, f"only {changed.mean():.5f} of the pixels changed"
+
+    # The profile chart shows the elevation line (brown) and the power line (red) in its canvas.
+    chart = page.locator(".uplot", has_text="Elevation, speed and power along the course").first
+    chart.scroll_into_view_if_needed(timeout=10_000)
+    shot = np.asarray(Image.open(io.BytesIO(chart.screenshot())).convert("RGB")).astype(int)
+
+    def has_colour(rgb: tuple[int, int, int]) -> bool:
+        return bool(np.any(np.all(np.abs(shot - np.array(rgb)) < 40, axis=2)))
+
+    assert has_colour((120, 90, 60)) and has_colour((220, 40, 40))
+    # The page tells the person where the leader is.
+    page.get_by_text("Leader at", exact=False).first.wait_for(timeout=10_000)
+    switcher.close()

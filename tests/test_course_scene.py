@@ -1,0 +1,340 @@
+"""The peloton scene's course mode through a real server: kernel agreement, uploads over the websocket (good and
+bad files), play / pause / scrub, air and model choices, the shared paceline, and crafted values."""
+
+from __future__ import annotations
+
+import math
+import time
+import uuid
+
+import numpy as np
+import pytest
+import viser
+from test_course import BAD_FILES, gpx_text
+from wsclient import BrowserClient
+
+from kernels import course as course_kernel
+from kernels import cycling
+from scenes.peloton import (
+    SAMPLE_LABEL,
+    CourseMode,
+    CourseParams,
+    PelotonParams,
+    PelotonScene,
+    compute_course,
+    group_cda,
+)
+from scenes.switcher import SceneSwitcher
+
+
+@pytest.fixture
+def scene(switcher: SceneSwitcher) -> PelotonScene:
+    shown = switcher.show("peloton")
+    assert isinstance(shown, PelotonScene)
+    return shown
+
+
+@pytest.fixture
+def mode(scene: PelotonScene) -> CourseMode:
+    scene.course_mode.enable.value = True
+    return scene.course_mode
+
+
+def upload(
+    client: BrowserClient, label: str, filename: str, data: bytes, part: int = 64_000
+) -> None:
+    """What the browser sends when a person picks a file for the upload button ``label``."""
+    source = client.uuid_of(label)
+    transfer = str(uuid.uuid4())
+    parts = [data[i : i + part] for i in range(0, len(data), part)]
+    client.send(
+        "FileTransferStartUpload",
+        source_component_uuid=source,
+        transfer_uuid=transfer,
+        filename=filename,
+        mime_type="application/gpx+xml",
+        part_count=len(parts),
+        size_bytes=len(data),
+    )
+    for index, content in enumerate(parts):
+        client.send(
+            "FileTransferPart",
+            source_component_uuid=source,
+            transfer_uuid=transfer,
+            part_index=index,
+            content=content,
+        )
+
+
+def hill_gpx(name: str = "Test hill", n: int = 300) -> bytes:
+    points = [
+        (45.0 + i * 1e-4, 6.0 + i * 5e-5, 200.0 + 40.0 * math.sin(i / 40.0)) for i in range(n)
+    ]
+    return gpx_text(points).replace("<name>t</name>", f"<name>{name}</name>").encode()
+
+
+# ------------------------------------------------------------------------------------------------ server side
+def test_course_mode_opens_off_and_shows_the_sample_when_ticked(scene: PelotonScene) -> None:
+    mode = scene.course_mode
+    assert not mode.enabled and not mode.frame.visible and scene.course.visible
+    assert mode.route_label == SAMPLE_LABEL and mode.state is None
+    mode.enable.value = True
+    assert mode.enabled and mode.frame.visible and not scene.course.visible
+    expected = compute_course(mode.route, CourseParams(), PelotonParams())
+    assert mode.state is not None
+    assert mode.state.ride.time_s == pytest.approx(expected.ride.time_s, rel=1e-12)
+    minutes, seconds = divmod(round(expected.ride.time_s), 60)
+    hours, minutes = divmod(minutes, 60)
+    assert f"Finish **{hours}:{minutes:02d}:{seconds:02d}**" in mode.readout.content
+    assert "published climb profile" in mode.route_info.content
+    # The chart: distance, elevation, speed, power, all finite, none NaN-only.
+    data = mode.chart.data
+    assert len(data) == 4 and all(np.all(np.isfinite(np.asarray(series))) for series in data)
+    assert float(np.max(data[0])) == pytest.approx(mode.route.total_distance_m / 1000.0)
+    np.testing.assert_allclose(np.asarray(data[3]).max(), 250.0, rtol=1e-6)
+    # Splits every km, last one at the finish.
+    assert mode.splits.content.count("\n") == 1 + 14
+    mode.enable.value = False
+    assert scene.course.visible and not mode.frame.visible
+
+
+def test_the_kernel_rides_with_the_paceline_sharing_the_work(mode: CourseMode) -> None:
+    scene = mode.scene
+    assert mode.state is not None
+    four = mode.state
+    line = scene.params
+    reduction = cycling.drag_reduction(line.n_riders, line.gap_m, line.model)
+    assert four.group_cda_m2 == pytest.approx(line.cda_m2 * (1 - reduction.mean()))
+    rider = course_kernel.Rider(
+        cda_m2=four.group_cda_m2, mass_kg=80.0, crr=0.004, drivetrain_efficiency=0.976
+    )
+    direct = course_kernel.ride(mode.route, 250.0, rider, max_speed_ms=72.0 / 3.6)
+    assert four.ride.time_s == pytest.approx(direct.time_s, rel=1e-12)
+    scene.riders.value = 1  # one rider alone: slower
+    assert mode.state.ride.time_s > four.ride.time_s
+    assert mode.state.group_cda_m2 == line.cda_m2
+    scene.riders.value = 6
+    assert mode.state.ride.time_s < four.ride.time_s
+    assert group_cda(scene.params) < four.group_cda_m2
+
+
+def test_model_and_air_choices_change_the_ride_and_the_readout_shows_both_densities(
+    mode: CourseMode,
+) -> None:
+    assert mode.state is not None
+    martin = mode.state.ride.time_s
+    mode.power_model.value = "Seed (aero, rolling, climbing)"
+    assert mode.params.model == "seed" and mode.state.ride.time_s < martin  # no bearings, no spokes
+    mode.air.value = "Weather (temperature, pressure or altitude, humidity)"
+    mode.temperature.value = 30.0
+    mode.humidity.value = 80.0
+    start = float(mode.route.elevation_m[0])
+    expected = float(cycling.air_density_weather(30.0, cycling.isa_pressure_hpa(start), 0.8))
+    assert mode.state.density_weather == pytest.approx(expected, rel=1e-12)
+    assert f"weather **{expected:.3f}**" in mode.readout.content
+    assert f"seed (exponential) **{float(cycling.air_density(start)):.3f}**" in mode.readout.content
+    np.testing.assert_allclose(mode.state.ride.air_density[0], expected, rtol=1e-3)
+    # A barometer reading replaces the standard atmosphere's pressure.
+    mode.pressure_source.value = "Barometer at the start (hPa)"
+    mode.pressure.value = 1000.0
+    assert mode.state.density_weather == pytest.approx(
+        float(cycling.air_density_weather(30.0, 1000.0, 0.8)), rel=1e-12
+    )
+
+
+def test_find_the_power_for_a_time(mode: CourseMode) -> None:
+    mode.target.value = 50.0
+    mode.solve.value = True  # what a click does, on the server: runs on_click
+    assert mode.state is not None
+    assert mode.state.ride.time_s == pytest.approx(
+        50 * 60.0, abs=1.0
+    )  # the power is rounded to 0.1 W
+    assert mode.power.value == pytest.approx(mode.params.power_w)
+
+
+def test_pacing_reports_the_time_saved(mode: CourseMode) -> None:
+    mode.pacing.value = True
+    assert mode.state is not None and mode.state.pacing is not None
+    saved = mode.state.pacing.time_saved_s
+    assert f"{saved:.0f} s saved" in mode.readout.content
+    assert mode.state.ride.average_power_w == pytest.approx(
+        mode.state.constant.average_power_w, rel=1e-6
+    )
+
+
+def test_exaggeration_stretches_the_drawn_heights(mode: CourseMode) -> None:
+    before = np.asarray(mode.route_line.points)[:, :, 2].copy()
+    mode.exaggeration.value = 6.0
+    after = np.asarray(mode.route_line.points)[:, :, 2]
+    base = 0.05 + 0.02
+    np.testing.assert_allclose(after - base, 3.0 * (before - base), rtol=1e-4, atol=1e-5)
+
+
+def test_play_pause_and_scrub_move_the_riders(mode: CourseMode) -> None:
+    scene = mode.scene
+    mode.playback.value = 600.0
+    body = mode.course_riders["body"]
+    start = np.asarray(body.batched_positions)[0].copy()
+    mode._on_play()
+    time.sleep(0.6)
+    with scene._lock:
+        moved = mode.leader_distance_m()
+        assert moved > 100.0  # 600× real time for half a second at ~12 km/h
+        assert not np.allclose(np.asarray(body.batched_positions)[0], start)
+    mode._on_pause()
+    with scene._lock:
+        held = mode.leader_distance_m()
+    time.sleep(0.3)
+    assert mode.leader_distance_m() == held
+    mode.scrub.value = 10.0
+    assert mode.leader_distance_m() == pytest.approx(10_000.0, abs=1.0)
+    assert mode.state is not None
+    assert "Leader at **10.00 km**" in mode.now.content
+    # The riders follow the route: the leader is drawn where the route is at 10 km.
+    where, _ = mode._drawing.at_distance(mode.route, np.array([10_000.0]), mode.params.exaggeration)
+    np.testing.assert_allclose(np.asarray(body.batched_positions)[0], where[0], atol=1e-4)
+
+
+def test_every_bad_file_keeps_the_last_good_course(mode: CourseMode) -> None:
+    assert mode.load(hill_gpx("Good hill"), "good.gpx")
+    good = mode.route
+    for kind, (text, message) in BAD_FILES.items():
+        assert not mode.load(text.encode(), f"{kind}.gpx"), kind
+        assert mode.route is good, kind
+        assert message.split()[0] in mode.route_info.content, kind
+        assert "Still showing **Good hill**" in mode.route_info.content
+    big = b"<gpx>" + b" " * (course_kernel.MAX_FILE_BYTES + 1)
+    assert not mode.load(big, "big.gpx") and "20 MiB" in mode.route_info.content
+    many = (
+        '<gpx version="1.1"><trk><trkseg>'
+        + '<trkpt lat="45" lon="6"><ele>1</ele></trkpt>' * (course_kernel.MAX_POINTS + 1)
+        + "</trkseg></trk></gpx>"
+    ).encode()
+    assert not mode.load(many, "many.gpx") and "200000" in mode.route_info.content
+    assert mode.route is good
+    # A good file afterwards clears the message.
+    mode._on_sample()
+    assert mode.route_label == SAMPLE_LABEL and "not loaded" not in mode.route_info.content
+
+
+def test_file_text_is_escaped_in_the_readouts(mode: CourseMode) -> None:
+    name = "&lt;img src=x onerror=alert(1)&gt; [link](http://x) **b**"  # XML-escaped in the file
+    assert mode.load(hill_gpx(name), "x.gpx")
+    assert mode.route.name.startswith("<img")
+    info = mode.route_info.content
+    assert "<img" not in info and "](" not in info and "&lt;img" in info
+
+
+# ------------------------------------------------------------------------------------------------ over the websocket
+def test_upload_a_gpx_from_a_browser(server: viser.ViserServer, mode: CourseMode) -> None:
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Upload GPX")
+        upload(client, "Upload GPX", "hill.gpx", hill_gpx("Browser hill", 3000), part=20_000)
+        client.wait_for(lambda: mode.route.name == "Browser hill", what="the uploaded course")
+        assert mode.route.n_points == 3000
+        client.wait_for(
+            lambda: any(
+                "Browser hill" in str(e["props"].get("_markdown", "")) for e in client.gui.values()
+            ),
+            what="the client to be shown the new course",
+        )
+        assert mode.scrub.max == pytest.approx(mode.route.total_distance_m / 1000.0, abs=0.01)
+
+
+@pytest.mark.parametrize(
+    "kind", ["plain text", "one point", "no elevation", "nan latitude", "no track points"]
+)
+def test_a_bad_upload_from_a_browser_is_reported(
+    server: viser.ViserServer, mode: CourseMode, kind: str, caplog: pytest.LogCaptureFixture
+) -> None:
+    good = mode.route
+    text, message = BAD_FILES[kind]
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Upload GPX")
+        upload(client, "Upload GPX", f"{kind}.gpx", text.encode())
+        client.wait_for(
+            lambda: any(
+                "was not loaded" in str(e["props"].get("_markdown", ""))
+                for e in client.gui.values()
+            ),
+            what="the message",
+        )
+    assert mode.route is good
+    assert message.split()[0] in mode.route_info.content
+    assert not [r for r in caplog.records if r.levelname == "ERROR"]
+
+
+CRAFTED = [
+    ("Course power (W)", float("nan"), "power_w", 250.0),
+    ("Course power (W)", 1e9, "power_w", 2000.0),
+    ("Course power (W)", -5.0, "power_w", 20.0),
+    ("Humidity (%)", float("inf"), "humidity_pct", 50.0),
+    ("Temperature (°C)", 1e6, "temperature_c", 45.0),
+    ("Air", "vacuum", "air", "seed"),
+    ("Power model", "<b>x</b>", "model", "martin"),
+    ("Pressure from", "guess", "pressure_from_barometer", False),
+    ("Safe descending speed (km/h)", 0.0, "max_speed_kmh", 20.0),
+    ("Elevation exaggeration (×)", float("nan"), "exaggeration", 2.0),
+]
+
+
+@pytest.mark.parametrize(("label", "value", "field", "expected"), CRAFTED)
+def test_crafted_course_values_keep_a_good_state(
+    server: viser.ViserServer,
+    mode: CourseMode,
+    label: str,
+    value: object,
+    field: str,
+    expected: object,
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui(label)
+        stamp = len(client.received)
+        client.set_value(label, value)
+        client.wait_for(lambda: len(client.received) > stamp, what="the server to answer")
+        time.sleep(0.15)
+        with mode.scene._lock:
+            assert getattr(mode.params, field) == expected
+            assert mode.state is not None and math.isfinite(mode.state.ride.time_s)
+    assert not [r for r in caplog.records if r.levelname == "ERROR"], "a callback failed"
+
+
+@pytest.mark.parametrize("value", [float("nan"), 1e9, -3.0, "far"])
+def test_crafted_scrub_positions_are_clamped(
+    server: viser.ViserServer, mode: CourseMode, value: object
+) -> None:
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Position (km)")
+        client.set_value("Position (km)", 4.0)
+        client.wait_for(lambda: abs(mode.leader_distance_m() - 4000.0) < 1.0, what="scrub to 4 km")
+        client.set_value("Position (km)", value)
+        time.sleep(0.2)
+        with mode.scene._lock:
+            d = mode.leader_distance_m()
+            assert 0.0 <= d <= mode.route.total_distance_m
+            if value == 1e9:
+                assert d == pytest.approx(mode.route.total_distance_m, abs=10.0)
+            elif value == -3.0:
+                assert d == 0.0
+            else:
+                assert d == pytest.approx(4000.0, abs=1.0)
+
+
+def test_play_from_a_browser(server: viser.ViserServer, mode: CourseMode) -> None:
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Play")
+        client.wait_for_gui("Playback speed (×)")
+        client.set_value("Playback speed (×)", 600.0)
+        client.click("Play")
+        client.wait_for(lambda: mode.leader_distance_m() > 200.0, what="the riders to ride")
+        client.click("Pause")
+        client.wait_for(lambda: not mode.playing, what="pause")
+        # The browser's scrub slider follows the leader.
+        client.wait_for(
+            lambda: (
+                isinstance(client.value_of("Position (km)"), float)
+                and client.value_of("Position (km)") > 0.1
+            ),
+            what="the slider to follow",
+        )
