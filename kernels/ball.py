@@ -32,11 +32,12 @@ C_L = 0.25). Two coefficient models:
 Knuckleball (``knuckle_seed`` set): a ball kicked with almost no spin at 24–30 m/s sheds an unsteady wake and
 zig-zags by about one ball diameter, one zig-zag per ~15 m of flight (Cohen, Darbois Texier, Quéré & Clanet, APS DFD
 2012; Texier et al. 2016, New J. Phys. 18). Modelled as a side force of coefficient C_K = 0.10 across the launch
-direction, ``½·ρ·A·|v|²·C_K·w·(cos θ·sin(Ωt + φ₁)·n₁ + sin θ·sin(Ωt + φ₂)·n₂)``, with Ω = 2π·|v₀|/15 m, n₁ the
-horizontal and n₂ the vertical normals to the launch velocity, and θ, φ₁, φ₂ drawn from ``numpy.random.default_rng(
-knuckle_seed)`` so a seed always gives the same flight. w = max(0, 1 − S₀/0.05) fades the effect out as launch spin
-grows (S₀ the launch spin parameter): any real spin steadies the wake. C_K is set so that the median peak lateral
-deviation at 25 m/s over 25 m is about one ball diameter.
+direction, ``½·ρ·A·|v|²·C_K·w·(cos θ·sin(Ωt + φ₁)·n₁ + sin θ·sin(Ωt + φ₂)·n₂)``, with Ω = 2π·|v₀|/15 m, n₁ = ẑ × v̂₀
+normalised (horizontal, to the left; +y for a vertical kick) and n₂ = v̂₀ × n₁, and θ, φ₁, φ₂ drawn in that order by
+``numpy.random.default_rng(knuckle_seed).uniform(0, 2π, 3)`` so a seed always gives the same flight.
+w = max(0, 1 − S₀/0.05) fades the effect out as launch spin grows (S₀ the launch spin parameter): any real spin
+steadies the wake. C_K is set so that the median peak lateral deviation at 25 m/s over 25 m is about one ball
+diameter.
 
 Assumptions: spin is constant in flight (spin decay over a 1–2 s free kick is a few percent); still air; the ball is
 rigid and stops at the first touch of the ground (no bounce or roll); a ball that touches the wall or the frame does
@@ -382,16 +383,25 @@ def _knuckle_angles(
 
 
 # --------------------------------------------------------------------------------------------- force law
+@njit(cache=True, inline="always")
+def _norm(v):
+    """|v| of a (3,) vector without overflow or underflow in the squares (a spin of 1e200 rad/s still has an axis)."""
+    scale = max(abs(v[0]), abs(v[1]), abs(v[2]))
+    if scale == 0.0 or not math.isfinite(scale):
+        return scale
+    return scale * math.sqrt((v[0] / scale) ** 2 + (v[1] / scale) ** 2 + (v[2] / scale) ** 2)
+
+
 @njit(cache=True)
 def _fill_kick(velocity, spin, angles, knuckled, config, kick):
     """One kick's (14,) constants (see the slots above) from its launch velocity, spin and knuckle angles."""
-    rate = math.sqrt(spin[0] * spin[0] + spin[1] * spin[1] + spin[2] * spin[2])
+    rate = _norm(spin)
     kick[:] = 0.0
     if rate > 0.0:
         for i in range(3):
             kick[_AXIS + i] = spin[i] / rate
     kick[_RATE] = rate
-    speed = math.sqrt(velocity[0] ** 2 + velocity[1] ** 2 + velocity[2] ** 2)
+    speed = _norm(velocity)
     if not knuckled or speed == 0.0:
         return
     weight = max(0.0, 1.0 - config[_RADIUS] * rate / speed / KNUCKLE_SPIN_LIMIT)
@@ -537,6 +547,18 @@ def _crossing_fraction(d0, dd0, d1, dd1, h):
     return s
 
 
+@njit(cache=True, inline="always")
+def _finite(a, b, c, d, e, f):
+    return (
+        math.isfinite(a)
+        and math.isfinite(b)
+        and math.isfinite(c)
+        and math.isfinite(d)
+        and math.isfinite(e)
+        and math.isfinite(f)
+    )
+
+
 @njit(cache=True)
 def _fly(p0, v0, kick, config, t_out, state_out):
     """Step one kick until it lands, passes ``x_stop`` or runs out of time.
@@ -545,18 +567,25 @@ def _fly(p0, v0, kick, config, t_out, state_out):
     with T = 0 it only counts.
 
     Returns:
-        (samples written, ending code: 0 ground, 1 x_stop, 2 t_max).
+        (samples written, ending code: 0 ground, 1 x_stop, 2 t_max, 3 diverged: gained energy, or inf/NaN).
     """
     store = len(t_out) > 0
     dt, ground, x_stop = config[_DT], config[_GROUND], config[_X_STOP]
     n_steps = int(config[_N_STEPS])
     x, y, z, vx, vy, vz = p0[0], p0[1], p0[2], v0[0], v0[1], v0[2]
+    # Drag dissipates and Magnus does no work, so |v|² + 2gz never grows but for the knuckle force's small push;
+    # a step that overshoots the drag makes it grow without bound. Stop that flight (ending 3) rather than draw it.
+    g = config[_GRAVITY]
+    energy_limit = vx * vx + vy * vy + vz * vz + 2.0 * g * z
+    energy_limit += 3.0 * (vx * vx + vy * vy + vz * vz + 2.0 * abs(g) * (abs(z) + 1.0)) + 100.0
     if store:
         t_out[0] = 0.0
         state_out[0, 0], state_out[0, 1], state_out[0, 2] = x, y, z
         state_out[0, 3], state_out[0, 4], state_out[0, 5] = vx, vy, vz
     for n in range(n_steps):
         x1, y1, z1, vx1, vy1, vz1 = _step(x, y, z, vx, vy, vz, n * dt, kick, config)
+        if vx1 * vx1 + vy1 * vy1 + vz1 * vz1 + 2.0 * g * z1 > energy_limit:
+            return n + 1, 3
         hit_ground, hit_stop = z1 <= ground, x < x_stop <= x1
         if hit_ground or hit_stop:
             # End on whichever of the ground and the stop plane the cubic through this step reaches first.
@@ -568,14 +597,16 @@ def _fly(p0, v0, kick, config, t_out, state_out):
             )
             ending = 0 if f_ground <= f_stop else 1
             f = min(f_ground, f_stop)
+            ex, evx = _hermite(x, vx, x1, vx1, dt, f)
+            ey, evy = _hermite(y, vy, y1, vy1, dt, f)
+            ez, evz = _hermite(z, vz, z1, vz1, dt, f)
+            if ending == 0:
+                ez = ground
+            else:
+                ex = x_stop
+            if not _finite(ex, ey, ez, evx, evy, evz):
+                ending = 3
             if store:
-                ex, evx = _hermite(x, vx, x1, vx1, dt, f)
-                ey, evy = _hermite(y, vy, y1, vy1, dt, f)
-                ez, evz = _hermite(z, vz, z1, vz1, dt, f)
-                if ending == 0:
-                    ez = ground
-                else:
-                    ex = x_stop
                 t_out[n + 1] = (n + f) * dt
                 state_out[n + 1, 0], state_out[n + 1, 1], state_out[n + 1, 2] = ex, ey, ez
                 state_out[n + 1, 3], state_out[n + 1, 4], state_out[n + 1, 5] = evx, evy, evz
@@ -585,7 +616,8 @@ def _fly(p0, v0, kick, config, t_out, state_out):
             t_out[n + 1] = (n + 1) * dt
             state_out[n + 1, 0], state_out[n + 1, 1], state_out[n + 1, 2] = x, y, z
             state_out[n + 1, 3], state_out[n + 1, 4], state_out[n + 1, 5] = vx, vy, vz
-    return n_steps + 1, 2
+    # A state that overflowed stays inf or NaN to the end (NaN fails the ground test, so it runs to t_max).
+    return n_steps + 1, 2 if _finite(x, y, z, vx, vy, vz) else 3
 
 
 @njit(cache=True)
@@ -595,6 +627,10 @@ def _simulate_one(p0, v0, spin, angles, knuckled, config, t_out, state_out, forc
     _fill_kick(v0, spin, angles, knuckled, config, kick)
     n, ending = _fly(p0, v0, kick, config, t_out, state_out)
     _forces(t_out[:n], state_out[:n], kick, config, forces_out[:n])
+    if not np.isfinite(
+        forces_out[:n]
+    ).all():  # a finite flight whose force overflows (a mass of 1e-300 kg)
+        ending = 3
     return n, ending
 
 
@@ -687,13 +723,15 @@ def _judge_batch(t, position, velocity, n_samples, wall, goal, radius, results, 
 
 
 @njit(cache=True, parallel=True)
-def _fly_and_judge(p0, v0, spins, angles, knuckled, config, wall, goal, radius, results, crossings):
+def _fly_and_judge(
+    p0, v0, spins, angles, knuckled, config, wall, goal, radius, results, crossings, endings
+):
     """Fly each kick into its own scratch buffer and judge it at once: no trajectory is kept."""
     rows = int(config[_N_STEPS]) + 1
     for k in prange(len(p0)):
         kick, t_scratch, state_scratch = np.empty(_N_KICK), np.empty(rows), np.empty((rows, 6))
         _fill_kick(v0[k], spins[k], angles[k], knuckled[k], config, kick)
-        n, _ = _fly(p0[k], v0[k], kick, config, t_scratch, state_scratch)
+        n, endings[k] = _fly(p0[k], v0[k], kick, config, t_scratch, state_scratch)
         results[k] = _judge(
             t_scratch,
             state_scratch[:, :3],
@@ -732,6 +770,17 @@ def _kick_rows(
             raise ValueError(f"knuckle_seeds must have {k} entries, got {len(seeds)}")
     angles, knuckled = _knuckle_angles(seeds)
     return p0, v0, w0, angles, knuckled
+
+
+def _refuse_overflow(endings: NDArray[np.int64], config: NDArray[np.float64]) -> None:
+    """Raise where a flight overflowed to inf or NaN: an explicit step too long for its drag, or absurd input."""
+    bad = np.flatnonzero(endings == 3)
+    if bad.size:
+        which = "the flight" if len(endings) == 1 else f"kicks {bad[:5].tolist()}"
+        raise ValueError(
+            f"dt = {config[_DT]:g} s is too long for {which}: each step overshoots the drag, so the ball gains "
+            "energy until it overflows; use a smaller dt (or a smaller air_density or a larger mass_kg)"
+        )
 
 
 def simulate(
@@ -779,7 +828,8 @@ def simulate(
 
     Raises:
         ValueError: naming the argument, for non-finite or wrongly shaped input, dt ≤ 0, mass or radius ≤ 0, an
-            unknown method or model.
+            unknown method or model; naming dt when the steps overshoot the drag and the ball gains energy without
+            bound (a step far too long for this speed, density and mass).
     """
     p0, v0, w0 = (
         _vector("position", position, 3),
@@ -804,6 +854,7 @@ def simulate(
     rows = int(config[_N_STEPS]) + 1
     t, state, forces = np.empty(rows), np.empty((rows, 6)), np.empty((rows, 12))
     n, ending = _simulate_one(p0, v0, w0, angles[0], knuckled[0], config, t, state, forces)
+    _refuse_overflow(np.array([ending]), config)
     state, forces = state[:n], forces[:n]
     return Trajectory(
         t=t[:n],
@@ -894,6 +945,7 @@ def simulate_batch(
         width = int(n_samples.max()) if k else 1
         t, state = t[:width], state[:width]
         _pad(t, state, n_samples)
+    _refuse_overflow(endings, config)
     state = state.transpose(1, 0, 2)  # (K, T, 6) view, no copy
     return BatchTrajectory(
         t=t.T,
@@ -1052,6 +1104,7 @@ def simulate_outcomes(
     )
     k = len(p0)
     results, crossings = np.empty(k, dtype=np.int64), np.empty((k, 2, 4))
+    endings = np.zeros(k, dtype=np.int64)
     wall_vector, goal_vector = _panel(wall, "wall"), _panel(goal, "goal")
     with _PARALLEL:
         _fly_and_judge(
@@ -1066,7 +1119,9 @@ def simulate_outcomes(
             config[_RADIUS],
             results,
             crossings,
+            endings,
         )
+    _refuse_overflow(endings, config)
     return _batch_outcome(results, crossings)
 
 
