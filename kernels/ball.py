@@ -750,7 +750,13 @@ def _kick_rows(
     velocities: ArrayLike,
     spins: ArrayLike,
     knuckle_seeds: Sequence[int | None] | None,
-) -> tuple[NDArray[np.float64], ...]:
+) -> tuple[
+    NDArray[np.float64],
+    NDArray[np.float64],
+    NDArray[np.float64],
+    NDArray[np.float64],
+    NDArray[np.bool_],
+]:
     """Validated (K, 3) launch positions, velocities and spins, and the knuckle angles and flags of each kick."""
     p0, v0, w0 = (
         _rows("positions", positions),
