@@ -56,10 +56,11 @@ in ``__pycache__`` beside this file, or, where that is read-only (an installed p
 from __future__ import annotations
 
 import dataclasses
+import logging
 import math
 import threading
-from collections.abc import Sequence
-from typing import Literal
+from collections.abc import Callable, Sequence
+from typing import Any, Literal
 
 import numpy as np
 from numba import njit, prange
@@ -120,6 +121,33 @@ _RESERVE_BYTES = 2**31
 # numba's workqueue threading layer (the fallback where neither TBB nor OpenMP is present) must not launch two
 # parallel kernels at once; the scene's workers and the app's warm-up may call from different threads.
 _PARALLEL = threading.Lock()
+
+
+_UNCACHED: list[str] = []
+"""Compiled cores that run without numba's disk cache (none where a cache directory is writable)."""
+
+
+def _compiled(**options: Any) -> Callable[[Callable[..., object]], Any]:
+    """``numba.njit(cache=True, **options)``; without the disk cache where numba finds no writable directory.
+
+    numba caches beside the module, else in ``~/.cache/numba`` (or ``NUMBA_CACHE_DIR``); where none of those is
+    writable it refuses ``cache=True`` outright, which would make this module fail to import.
+    """
+
+    def decorate(function: Callable[..., object]) -> Any:
+        try:
+            return njit(cache=True, **options)(function)
+        except RuntimeError as error:
+            if "no locator available" not in str(error):
+                raise
+            if not _UNCACHED:
+                logging.getLogger(__name__).warning(
+                    "no writable numba cache directory: the ball kernels compile at every start"
+                )
+            _UNCACHED.append(function.__name__)
+            return njit(**options)(function)
+
+    return decorate
 
 
 @dataclasses.dataclass(frozen=True)
@@ -383,7 +411,7 @@ def _knuckle_angles(
 
 
 # --------------------------------------------------------------------------------------------- force law
-@njit(cache=True, inline="always")
+@_compiled(inline="always")
 def _norm(v):
     """|v| of a (3,) vector without overflow or underflow in the squares (a spin of 1e200 rad/s still has an axis)."""
     scale = max(abs(v[0]), abs(v[1]), abs(v[2]))
@@ -392,7 +420,7 @@ def _norm(v):
     return scale * math.sqrt((v[0] / scale) ** 2 + (v[1] / scale) ** 2 + (v[2] / scale) ** 2)
 
 
-@njit(cache=True)
+@_compiled()
 def _fill_kick(velocity, spin, angles, knuckled, config, kick):
     """One kick's (14,) constants (see the slots above) from its launch velocity, spin and knuckle angles."""
     rate = _norm(spin)
@@ -421,7 +449,7 @@ def _fill_kick(velocity, spin, angles, knuckled, config, kick):
         kick[_N2 + i] = math.sin(theta) * vertical[i]
 
 
-@njit(cache=True, inline="always")
+@_compiled(inline="always")
 def _factors(speed, kick, config):
     """(−½ρA·C_D·|v|/m, ½ρA·C_L·|v|/m) at this speed: drag and lift per unit velocity and mass (1/s)."""
     q = config[_Q]
@@ -436,7 +464,7 @@ def _factors(speed, kick, config):
     return -q * drag * speed, q * lift * speed
 
 
-@njit(cache=True, inline="always")
+@_compiled(inline="always")
 def _knuckle(speed, t, kick):
     """Knuckle side force per unit mass (m/s², 3 values); zero when the kick has none."""
     gain = kick[_GAIN]
@@ -452,7 +480,7 @@ def _knuckle(speed, t, kick):
     )
 
 
-@njit(cache=True, inline="always")
+@_compiled(inline="always")
 def _acceleration(vx, vy, vz, t, kick, config):
     """Total acceleration (m/s²): drag, Magnus (ω̂ × v), knuckle and gravity."""
     speed = math.sqrt(vx * vx + vy * vy + vz * vz)
@@ -466,7 +494,7 @@ def _acceleration(vx, vy, vz, t, kick, config):
     )
 
 
-@njit(cache=True)
+@_compiled()
 def _forces(t, state, kick, config, forces):
     """Drag, Magnus, gravity and knuckle forces (N) at each sample: ``forces`` (N, 12) from ``state`` (N, 6)."""
     m = config[_MASS]
@@ -485,7 +513,7 @@ def _forces(t, state, kick, config, forces):
 
 
 # --------------------------------------------------------------------------------------------- flight
-@njit(cache=True, inline="always")
+@_compiled(inline="always")
 def _step(x, y, z, vx, vy, vz, t, kick, config):
     """One fixed step of the configured method: (x, y, z, vx, vy, vz) after ``dt``."""
     dt = config[_DT]
@@ -512,7 +540,7 @@ def _step(x, y, z, vx, vy, vz, t, kick, config):
     )
 
 
-@njit(cache=True, inline="always")
+@_compiled(inline="always")
 def _hermite(p0, v0, p1, v1, h, s):
     """Cubic Hermite value and derivative (per unit time) at fraction ``s`` of a step of length ``h``."""
     s2, s3 = s * s, s * s * s
@@ -531,7 +559,7 @@ def _hermite(p0, v0, p1, v1, h, s):
     return value, slope
 
 
-@njit(cache=True, inline="always")
+@_compiled(inline="always")
 def _crossing_fraction(d0, dd0, d1, dd1, h):
     """Fraction s ∈ [0, 1] of a step where the cubic through (d0, dd0) and (d1, dd1) reaches zero.
 
@@ -547,7 +575,7 @@ def _crossing_fraction(d0, dd0, d1, dd1, h):
     return s
 
 
-@njit(cache=True, inline="always")
+@_compiled(inline="always")
 def _finite(a, b, c, d, e, f):
     return (
         math.isfinite(a)
@@ -559,7 +587,7 @@ def _finite(a, b, c, d, e, f):
     )
 
 
-@njit(cache=True)
+@_compiled()
 def _fly(p0, v0, kick, config, t_out, state_out):
     """Step one kick until it lands, passes ``x_stop`` or runs out of time.
 
@@ -620,7 +648,7 @@ def _fly(p0, v0, kick, config, t_out, state_out):
     return n_steps + 1, 2 if _finite(x, y, z, vx, vy, vz) else 3
 
 
-@njit(cache=True)
+@_compiled()
 def _simulate_one(p0, v0, spin, angles, knuckled, config, t_out, state_out, forces_out):
     """:func:`simulate`'s compiled part: the kick's constants, its flight and the forces along it."""
     kick = np.empty(_N_KICK)
@@ -634,7 +662,7 @@ def _simulate_one(p0, v0, spin, angles, knuckled, config, t_out, state_out, forc
     return n, ending
 
 
-@njit(cache=True, parallel=True)
+@_compiled(parallel=True)
 def _fly_batch(p0, v0, spins, angles, knuckled, config, t_out, state_out, n_samples, endings):
     """Every kick's flight into column k of ``t_out`` (T, K) and ``state_out`` (T, K, 6), in parallel.
 
@@ -647,7 +675,7 @@ def _fly_batch(p0, v0, spins, angles, knuckled, config, t_out, state_out, n_samp
         n_samples[k], endings[k] = n, ending
 
 
-@njit(cache=True, parallel=True)
+@_compiled(parallel=True)
 def _pad(t, state, n_samples):
     """Repeat each flight's last sample to the end of ``t`` (T, K) and ``state`` (T, K, 6)."""
     for k in prange(len(n_samples)):
@@ -658,7 +686,7 @@ def _pad(t, state, n_samples):
 
 
 # --------------------------------------------------------------------------------------------- outcome
-@njit(cache=True)
+@_compiled()
 def _plane_crossing(t, position, velocity, n, panel):
     """First crossing of a panel's plane in its normal direction among the first ``n`` samples.
 
@@ -687,7 +715,7 @@ def _plane_crossing(t, position, velocity, n, panel):
     return np.nan, np.nan, np.nan, np.nan
 
 
-@njit(cache=True)
+@_compiled()
 def _judge(t, position, velocity, n, wall, goal, radius, crossings):
     """Result code (0 goal, 1 wall, 2 over, 3 wide, 4 short) of one flight's first ``n`` samples.
 
@@ -713,7 +741,7 @@ def _judge(t, position, velocity, n, wall, goal, radius, crossings):
     return 0 if crossings[1, 3] <= goal[5] - radius else 2
 
 
-@njit(cache=True, parallel=True)
+@_compiled(parallel=True)
 def _judge_batch(t, position, velocity, n_samples, wall, goal, radius, results, crossings):
     """:func:`_judge` for every flight of a batch, in parallel."""
     for k in prange(len(n_samples)):
@@ -722,7 +750,7 @@ def _judge_batch(t, position, velocity, n_samples, wall, goal, radius, results, 
         )
 
 
-@njit(cache=True, parallel=True)
+@_compiled(parallel=True)
 def _fly_and_judge(
     p0, v0, spins, angles, knuckled, config, wall, goal, radius, results, crossings, endings
 ):

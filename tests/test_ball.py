@@ -933,3 +933,32 @@ def test_after_warm_up_nothing_compiles() -> None:
     )
     before, after = map(int, result.stdout.split())
     assert before > 0 and after == before
+
+
+def test_without_a_writable_cache_directory_the_cores_compile_uncached(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # numba refuses cache=True when neither the package's __pycache__ nor ~/.cache/numba is writable (checked by
+    # hand as user nobody with a read-only HOME): the module must still import, just compiling at every start.
+    calls: list[dict[str, object]] = []
+
+    def refusing_njit(**options: object):
+        calls.append(options)
+        if options.get("cache"):
+            raise RuntimeError("cannot cache function 'f': no locator available for file 'ball.py'")
+        return lambda function: function
+
+    monkeypatch.setattr(ball, "njit", refusing_njit)
+    monkeypatch.setattr(ball, "_UNCACHED", [])
+
+    def core() -> int:
+        return 7
+
+    assert ball._compiled(parallel=True)(core)() == 7
+    assert calls == [{"cache": True, "parallel": True}, {"parallel": True}]
+    assert ball._UNCACHED == ["core"]
+    monkeypatch.setattr(
+        ball, "njit", lambda **options: (_ for _ in ()).throw(RuntimeError("other failure"))
+    )
+    with pytest.raises(RuntimeError, match="other failure"):
+        ball._compiled()(core)
