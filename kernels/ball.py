@@ -393,21 +393,24 @@ def _config(
     return config
 
 
-def _knuckle_angles(
+def _launches(
+    positions: NDArray[np.float64],
+    velocities: NDArray[np.float64],
+    spins: NDArray[np.float64],
     seeds: Sequence[int | None],
-) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
-    """(K, 3) knuckle angles θ, φ₁, φ₂ drawn from each seed, and (K,) which kicks have one.
+) -> NDArray[np.float64]:
+    """(K, 13) launch rows of the compiled cores: position, velocity, spin, knuckle angles θ φ₁ φ₂, knuckle flag.
 
-    ``numpy.random.default_rng(seed)`` stays in Python so a seed gives the same flight as it always has; the rest of
-    the per-kick constants is computed by the compiled :func:`_fill_kick`.
+    ``numpy.random.default_rng(seed)`` draws the angles here in Python, so a seed gives the same flight as it always
+    has; the compiled :func:`_fill_kick` derives the rest of each kick's constants.
     """
-    angles = np.zeros((len(seeds), 3))
-    knuckled = np.zeros(len(seeds), dtype=np.bool_)
+    launches = np.zeros((len(positions), 13))
+    launches[:, 0:3], launches[:, 3:6], launches[:, 6:9] = positions, velocities, spins
     for k, seed in enumerate(seeds):
         if seed is not None:
-            angles[k] = np.random.default_rng(seed).uniform(0.0, 2.0 * np.pi, size=3)
-            knuckled[k] = True
-    return angles, knuckled
+            launches[k, 9:12] = np.random.default_rng(seed).uniform(0.0, 2.0 * np.pi, size=3)
+            launches[k, 12] = 1.0
+    return launches
 
 
 # --------------------------------------------------------------------------------------------- force law
@@ -421,8 +424,9 @@ def _norm(v):
 
 
 @_compiled()
-def _fill_kick(velocity, spin, angles, knuckled, config, kick):
-    """One kick's (14,) constants (see the slots above) from its launch velocity, spin and knuckle angles."""
+def _fill_kick(launch, config, kick):
+    """One kick's (14,) constants (see the slots above) from its (13,) launch row."""
+    velocity, spin, angles = launch[3:6], launch[6:9], launch[9:12]
     rate = _norm(spin)
     kick[:] = 0.0
     if rate > 0.0:
@@ -430,7 +434,7 @@ def _fill_kick(velocity, spin, angles, knuckled, config, kick):
             kick[_AXIS + i] = spin[i] / rate
     kick[_RATE] = rate
     speed = _norm(velocity)
-    if not knuckled or speed == 0.0:
+    if launch[12] == 0.0 or speed == 0.0:
         return
     weight = max(0.0, 1.0 - config[_RADIUS] * rate / speed / KNUCKLE_SPIN_LIMIT)
     ux, uy, uz = velocity[0] / speed, velocity[1] / speed, velocity[2] / speed
@@ -575,21 +579,9 @@ def _crossing_fraction(d0, dd0, d1, dd1, h):
     return s
 
 
-@_compiled(inline="always")
-def _finite(a, b, c, d, e, f):
-    return (
-        math.isfinite(a)
-        and math.isfinite(b)
-        and math.isfinite(c)
-        and math.isfinite(d)
-        and math.isfinite(e)
-        and math.isfinite(f)
-    )
-
-
 @_compiled()
-def _fly(p0, v0, kick, config, t_out, state_out):
-    """Step one kick until it lands, passes ``x_stop`` or runs out of time.
+def _fly(launch, kick, config, t_out, state_out):
+    """Step one kick (its (13,) launch row and (14,) constants) until it lands, passes ``x_stop`` or runs out of time.
 
     Writes each sample's time to ``t_out`` (T,) and position then velocity to ``state_out`` (T, 6), T ≥ n_steps + 1;
     with T = 0 it only counts.
@@ -600,7 +592,7 @@ def _fly(p0, v0, kick, config, t_out, state_out):
     store = len(t_out) > 0
     dt, ground, x_stop = config[_DT], config[_GROUND], config[_X_STOP]
     n_steps = int(config[_N_STEPS])
-    x, y, z, vx, vy, vz = p0[0], p0[1], p0[2], v0[0], v0[1], v0[2]
+    x, y, z, vx, vy, vz = launch[0], launch[1], launch[2], launch[3], launch[4], launch[5]
     # Drag dissipates and Magnus does no work, so |v|² + 2gz never grows but for the knuckle force's small push;
     # a step that overshoots the drag makes it grow without bound. Stop that flight (ending 3) rather than draw it.
     g = config[_GRAVITY]
@@ -632,7 +624,7 @@ def _fly(p0, v0, kick, config, t_out, state_out):
                 ez = ground
             else:
                 ex = x_stop
-            if not _finite(ex, ey, ez, evx, evy, evz):
+            if not math.isfinite(ex + ey + ez + evx + evy + evz):  # inf or NaN (or ~1e308)
                 ending = 3
             if store:
                 t_out[n + 1] = (n + f) * dt
@@ -645,34 +637,33 @@ def _fly(p0, v0, kick, config, t_out, state_out):
             state_out[n + 1, 0], state_out[n + 1, 1], state_out[n + 1, 2] = x, y, z
             state_out[n + 1, 3], state_out[n + 1, 4], state_out[n + 1, 5] = vx, vy, vz
     # A state that overflowed stays inf or NaN to the end (NaN fails the ground test, so it runs to t_max).
-    return n_steps + 1, 2 if _finite(x, y, z, vx, vy, vz) else 3
+    return n_steps + 1, 2 if math.isfinite(x + y + z + vx + vy + vz) else 3
 
 
 @_compiled()
-def _simulate_one(p0, v0, spin, angles, knuckled, config, t_out, state_out, forces_out):
+def _simulate_one(launch, config, t_out, state_out, forces_out):
     """:func:`simulate`'s compiled part: the kick's constants, its flight and the forces along it."""
     kick = np.empty(_N_KICK)
-    _fill_kick(v0, spin, angles, knuckled, config, kick)
-    n, ending = _fly(p0, v0, kick, config, t_out, state_out)
+    _fill_kick(launch, config, kick)
+    n, ending = _fly(launch, kick, config, t_out, state_out)
     _forces(t_out[:n], state_out[:n], kick, config, forces_out[:n])
     if not np.isfinite(
         forces_out[:n]
-    ).all():  # a finite flight whose force overflows (a mass of 1e-300 kg)
+    ).all():  # a finite flight with an infinite force: a 1e-300 kg ball
         ending = 3
     return n, ending
 
 
 @_compiled(parallel=True)
-def _fly_batch(p0, v0, spins, angles, knuckled, config, t_out, state_out, n_samples, endings):
+def _fly_batch(launches, config, t_out, state_out, n_samples, endings):
     """Every kick's flight into column k of ``t_out`` (T, K) and ``state_out`` (T, K, 6), in parallel.
 
     T must hold each flight (n_steps + 1 always does); with T = 0 it only counts the samples.
     """
-    for k in prange(len(p0)):
+    for k in prange(len(launches)):
         kick = np.empty(_N_KICK)
-        _fill_kick(v0[k], spins[k], angles[k], knuckled[k], config, kick)
-        n, ending = _fly(p0[k], v0[k], kick, config, t_out[:, k], state_out[:, k])
-        n_samples[k], endings[k] = n, ending
+        _fill_kick(launches[k], config, kick)
+        n_samples[k], endings[k] = _fly(launches[k], kick, config, t_out[:, k], state_out[:, k])
 
 
 @_compiled(parallel=True)
@@ -687,12 +678,14 @@ def _pad(t, state, n_samples):
 
 # --------------------------------------------------------------------------------------------- outcome
 @_compiled()
-def _plane_crossing(t, position, velocity, n, panel):
+def _plane_crossing(t, position, velocity, n, panel, crossing):
     """First crossing of a panel's plane in its normal direction among the first ``n`` samples.
 
-    ``panel`` is (6,): centre x, y, unit normal x, y, width, height. Returns (time, x, y, z), NaN if none.
+    ``panel`` is (6,): centre x, y, unit normal x, y, width, height. Writes (time, x, y, z) to ``crossing`` (4,),
+    NaN if there is none.
     """
     cx, cy, nx, ny = panel[0], panel[1], panel[2], panel[3]
+    crossing[:] = np.nan
     d1 = (position[0, 0] - cx) * nx + (position[0, 1] - cy) * ny
     for i in range(n - 1):
         d0, d1 = d1, (position[i + 1, 0] - cx) * nx + (position[i + 1, 1] - cy) * ny
@@ -702,32 +695,28 @@ def _plane_crossing(t, position, velocity, n, panel):
             dd0 = velocity[i, 0] * nx + velocity[i, 1] * ny
             dd1 = velocity[i + 1, 0] * nx + velocity[i + 1, 1] * ny
             s = _crossing_fraction(d0, dd0, d1, dd1, h)
-            px, _ = _hermite(
-                position[i, 0], velocity[i, 0], position[i + 1, 0], velocity[i + 1, 0], h, s
-            )
-            py, _ = _hermite(
-                position[i, 1], velocity[i, 1], position[i + 1, 1], velocity[i + 1, 1], h, s
-            )
-            pz, _ = _hermite(
-                position[i, 2], velocity[i, 2], position[i + 1, 2], velocity[i + 1, 2], h, s
-            )
-            return t[i] + s * h, px, py, pz
-    return np.nan, np.nan, np.nan, np.nan
+            crossing[0] = t[i] + s * h
+            for c in range(3):
+                p0, v0, p1, v1 = (
+                    position[i, c],
+                    velocity[i, c],
+                    position[i + 1, c],
+                    velocity[i + 1, c],
+                )
+                crossing[1 + c], _ = _hermite(p0, v0, p1, v1, h, s)
+            return
 
 
 @_compiled()
-def _judge(t, position, velocity, n, wall, goal, radius, crossings):
+def _judge(t, position, velocity, n, panels, radius, crossings):
     """Result code (0 goal, 1 wall, 2 over, 3 wide, 4 short) of one flight's first ``n`` samples.
 
-    Writes the wall's and the goal's crossings (time, x, y, z) to ``crossings`` (2, 4).
+    ``panels`` (2, 6) are the wall and the goal; their crossings (time, x, y, z) go to ``crossings`` (2, 4).
     """
-    crossings[0, 0], crossings[0, 1], crossings[0, 2], crossings[0, 3] = _plane_crossing(
-        t, position, velocity, n, wall
-    )
-    crossings[1, 0], crossings[1, 1], crossings[1, 2], crossings[1, 3] = _plane_crossing(
-        t, position, velocity, n, goal
-    )
-    # Offset along each panel from its centre line (along = (−n_y, n_x)); NaN when never crossed.
+    for j in range(2):
+        _plane_crossing(t, position, velocity, n, panels[j], crossings[j])
+    # Offset of each crossing along its panel from the centre line (along = (−n_y, n_x)); NaN when none.
+    wall, goal = panels[0], panels[1]
     wall_lateral = -(crossings[0, 1] - wall[0]) * wall[3] + (crossings[0, 2] - wall[1]) * wall[2]
     goal_lateral = -(crossings[1, 1] - goal[0]) * goal[3] + (crossings[1, 2] - goal[1]) * goal[2]
     # The ball touches the wall if its centre comes within a radius of the defenders' outline.
@@ -742,34 +731,23 @@ def _judge(t, position, velocity, n, wall, goal, radius, crossings):
 
 
 @_compiled(parallel=True)
-def _judge_batch(t, position, velocity, n_samples, wall, goal, radius, results, crossings):
-    """:func:`_judge` for every flight of a batch, in parallel."""
+def _judge_batch(t, position, velocity, n_samples, panels, radius, results, crossings):
+    """:func:`_judge` for every flight of a (K, T) batch, in parallel."""
     for k in prange(len(n_samples)):
         results[k] = _judge(
-            t[k], position[k], velocity[k], n_samples[k], wall, goal, radius, crossings[k]
+            t[k], position[k], velocity[k], n_samples[k], panels, radius, crossings[k]
         )
 
 
 @_compiled(parallel=True)
-def _fly_and_judge(
-    p0, v0, spins, angles, knuckled, config, wall, goal, radius, results, crossings, endings
-):
-    """Fly each kick into its own scratch buffer and judge it at once: no trajectory is kept."""
+def _fly_and_judge(launches, config, panels, results, crossings, endings):
+    """Fly each kick into its own scratch buffer and judge it at once (ball radius from ``config``): nothing kept."""
     rows = int(config[_N_STEPS]) + 1
-    for k in prange(len(p0)):
-        kick, t_scratch, state_scratch = np.empty(_N_KICK), np.empty(rows), np.empty((rows, 6))
-        _fill_kick(v0[k], spins[k], angles[k], knuckled[k], config, kick)
-        n, endings[k] = _fly(p0[k], v0[k], kick, config, t_scratch, state_scratch)
-        results[k] = _judge(
-            t_scratch,
-            state_scratch[:, :3],
-            state_scratch[:, 3:],
-            n,
-            wall,
-            goal,
-            radius,
-            crossings[k],
-        )
+    for k in prange(len(launches)):
+        kick, t, state = np.empty(_N_KICK), np.empty(rows), np.empty((rows, 6))
+        _fill_kick(launches[k], config, kick)
+        n, endings[k] = _fly(launches[k], kick, config, t, state)
+        results[k] = _judge(t, state[:, :3], state[:, 3:], n, panels, config[_RADIUS], crossings[k])
 
 
 # --------------------------------------------------------------------------------------------- public API
@@ -778,14 +756,8 @@ def _kick_rows(
     velocities: ArrayLike,
     spins: ArrayLike,
     knuckle_seeds: Sequence[int | None] | None,
-) -> tuple[
-    NDArray[np.float64],
-    NDArray[np.float64],
-    NDArray[np.float64],
-    NDArray[np.float64],
-    NDArray[np.bool_],
-]:
-    """Validated (K, 3) launch positions, velocities and spins, and the knuckle angles and flags of each kick."""
+) -> NDArray[np.float64]:
+    """Validated kicks of a batch as (K, 13) launch rows (see :func:`_launches`)."""
     p0, v0, w0 = (
         _rows("positions", positions),
         _rows("velocities", velocities),
@@ -802,8 +774,7 @@ def _kick_rows(
         seeds = [_seed("knuckle_seeds", seed) for seed in knuckle_seeds]
         if len(seeds) != k:
             raise ValueError(f"knuckle_seeds must have {k} entries, got {len(seeds)}")
-    angles, knuckled = _knuckle_angles(seeds)
-    return p0, v0, w0, angles, knuckled
+    return _launches(p0, v0, w0, seeds)
 
 
 def _refuse_overflow(endings: NDArray[np.int64], config: NDArray[np.float64]) -> None:
@@ -884,10 +855,10 @@ def simulate(
         x_stop=x_stop,
         ground_m=ground_m,
     )
-    angles, knuckled = _knuckle_angles([_seed("knuckle_seed", knuckle_seed)])
+    launch = _launches(p0[None], v0[None], w0[None], [_seed("knuckle_seed", knuckle_seed)])[0]
     rows = int(config[_N_STEPS]) + 1
     t, state, forces = np.empty(rows), np.empty((rows, 6)), np.empty((rows, 12))
-    n, ending = _simulate_one(p0, v0, w0, angles[0], knuckled[0], config, t, state, forces)
+    n, ending = _simulate_one(launch, config, t, state, forces)
     _refuse_overflow(np.array([ending]), config)
     state, forces = state[:n], forces[:n]
     return Trajectory(
@@ -938,7 +909,7 @@ def simulate_batch(
     Returns:
         :class:`BatchTrajectory`.
     """
-    p0, v0, w0, angles, knuckled = _kick_rows(positions, velocities, spins, knuckle_seeds)
+    launches = _kick_rows(positions, velocities, spins, knuckle_seeds)
     config = _config(
         dt=dt,
         method=method,
@@ -953,7 +924,7 @@ def simulate_batch(
         x_stop=x_stop,
         ground_m=ground_m,
     )
-    k = len(p0)
+    k = len(launches)
     rows = int(config[_N_STEPS]) + 1
     n_samples, endings = np.ones(k, dtype=np.int64), np.full(k, 2, dtype=np.int64)
     with _PARALLEL:
@@ -961,21 +932,10 @@ def simulate_batch(
         # flight are never touched, so they never become memory. Where even that reservation is too large, count
         # the samples first.
         if rows * k * 56 > _RESERVE_BYTES:
-            _fly_batch(
-                p0,
-                v0,
-                w0,
-                angles,
-                knuckled,
-                config,
-                np.empty((0, k)),
-                np.empty((0, k, 6)),
-                n_samples,
-                endings,
-            )
+            _fly_batch(launches, config, np.empty((0, k)), np.empty((0, k, 6)), n_samples, endings)
             rows = int(n_samples.max())
         t, state = np.empty((rows, k)), np.empty((rows, k, 6))
-        _fly_batch(p0, v0, w0, angles, knuckled, config, t, state, n_samples, endings)
+        _fly_batch(launches, config, t, state, n_samples, endings)
         width = int(n_samples.max()) if k else 1
         t, state = t[:width], state[:width]
         _pad(t, state, n_samples)
@@ -990,16 +950,18 @@ def simulate_batch(
     )
 
 
-def _panel(panel: Panel, name: str) -> NDArray[np.float64]:
-    """A panel as the compiled cores' (6,) vector: centre x, y, unit normal x, y, width, height."""
-    normal = _vector(f"{name}.normal_xy", panel.normal_xy, 2)
-    length = float(np.hypot(*normal))
-    if length == 0.0:
-        raise ValueError(f"{name}.normal_xy must not be zero")
-    centre = _vector(f"{name}.centre_xy", panel.centre_xy, 2)
-    width = _positive_scalar(f"{name}.width_m", panel.width_m)
-    height = _finite_scalar(f"{name}.height_m", panel.height_m)
-    return np.array([centre[0], centre[1], normal[0] / length, normal[1] / length, width, height])
+def _panels(wall: Panel, goal: Panel) -> NDArray[np.float64]:
+    """The wall and the goal as the compiled cores' (2, 6) rows: centre x, y, unit normal x, y, width, height."""
+    rows = np.empty((2, 6))
+    for row, (name, panel) in zip(rows, (("wall", wall), ("goal", goal)), strict=True):
+        normal = _vector(f"{name}.normal_xy", panel.normal_xy, 2)
+        length = float(np.hypot(*normal))
+        if length == 0.0:
+            raise ValueError(f"{name}.normal_xy must not be zero")
+        row[0:2], row[2:4] = _vector(f"{name}.centre_xy", panel.centre_xy, 2), normal / length
+        row[4] = _positive_scalar(f"{name}.width_m", panel.width_m)
+        row[5] = _finite_scalar(f"{name}.height_m", panel.height_m)
+    return rows
 
 
 def outcome(
@@ -1024,16 +986,8 @@ def outcome(
     """
     radius = _positive_scalar("radius_m", radius_m)
     crossings = np.empty((2, 4))
-    code = _judge(
-        trajectory.t,
-        trajectory.position,
-        trajectory.velocity,
-        len(trajectory.t),
-        _panel(wall, "wall"),
-        _panel(goal, "goal"),
-        radius,
-        crossings,
-    )
+    t, position, velocity = trajectory.t, trajectory.position, trajectory.velocity
+    code = _judge(t, position, velocity, len(t), _panels(wall, goal), radius, crossings)
     wall_ok, goal_ok = not math.isnan(crossings[0, 0]), not math.isnan(crossings[1, 0])
     return Outcome(
         result=_RESULTS[code],
@@ -1060,15 +1014,18 @@ def outcome_batch(
     """
     radius = _positive_scalar("radius_m", radius_m)
     k = len(batch.n_samples)
-    results, crossings = np.empty(k, dtype=np.int64), np.empty((k, 2, 4))
+    results, crossings, panels = (
+        np.empty(k, dtype=np.int64),
+        np.empty((k, 2, 4)),
+        _panels(wall, goal),
+    )
     with _PARALLEL:
         _judge_batch(
             batch.t,
             batch.position,
             batch.velocity,
             batch.n_samples,
-            _panel(wall, "wall"),
-            _panel(goal, "goal"),
+            panels,
             radius,
             results,
             crossings,
@@ -1121,7 +1078,7 @@ def simulate_outcomes(
     Returns:
         :class:`BatchOutcome`.
     """
-    p0, v0, w0, angles, knuckled = _kick_rows(positions, velocities, spins, knuckle_seeds)
+    launches = _kick_rows(positions, velocities, spins, knuckle_seeds)
     config = _config(
         dt=dt,
         method=method,
@@ -1136,25 +1093,10 @@ def simulate_outcomes(
         x_stop=x_stop,
         ground_m=ground_m,
     )
-    k = len(p0)
-    results, crossings = np.empty(k, dtype=np.int64), np.empty((k, 2, 4))
-    endings = np.zeros(k, dtype=np.int64)
-    wall_vector, goal_vector = _panel(wall, "wall"), _panel(goal, "goal")
+    k, panels = len(launches), _panels(wall, goal)
+    results, crossings, endings = np.empty(k, np.int64), np.empty((k, 2, 4)), np.empty(k, np.int64)
     with _PARALLEL:
-        _fly_and_judge(
-            p0,
-            v0,
-            w0,
-            angles,
-            knuckled,
-            config,
-            wall_vector,
-            goal_vector,
-            config[_RADIUS],
-            results,
-            crossings,
-            endings,
-        )
+        _fly_and_judge(launches, config, panels, results, crossings, endings)
     _refuse_overflow(endings, config)
     return _batch_outcome(results, crossings)
 
