@@ -50,7 +50,9 @@ the verdict) is written once, on scalars, and compiled by numba (``@njit(cache=T
 same compiled flight; a batch runs its kicks in parallel (``prange``, :func:`numba.get_num_threads` threads). The
 Python functions below only validate (``ValueError`` naming the argument) and package arrays. Compiled code is cached
 in ``__pycache__`` beside this file, or, where that is read-only (an installed package), in numba's user-wide cache
-(``~/.cache/numba``; ``NUMBA_CACHE_DIR`` overrides both). :func:`warm_up` compiles (or loads) every core.
+(``~/.cache/numba``; ``NUMBA_CACHE_DIR`` overrides both; with neither writable, no disk cache). :func:`warm_up`
+compiles (or loads) every core. A flight whose steps overshoot the drag, so that |v|² + 2gz grows far past its launch
+value (or overflows), raises ``ValueError`` naming ``dt`` rather than returning an absurd path.
 """
 
 from __future__ import annotations
@@ -95,14 +97,9 @@ Ending = Literal["ground", "x_stop", "t_max"]
 Result = Literal["goal", "wall", "over", "wide", "short"]
 
 _MAX_STEPS = 1_000_000
-_ENDINGS: tuple[Ending, ...] = ("ground", "x_stop", "t_max")  # codes 0, 1, 2 of the compiled flight
-_RESULTS: tuple[Result, ...] = (
-    "goal",
-    "wall",
-    "over",
-    "wide",
-    "short",
-)  # codes 0..4 of the compiled verdict
+# Codes of the compiled flight's ending (3, diverged, raises) and of its verdict.
+_ENDINGS: tuple[Ending, ...] = ("ground", "x_stop", "t_max")
+_RESULTS: tuple[Result, ...] = ("goal", "wall", "over", "wide", "short")
 
 # Goff & Carré 2010 no-spin drag fit, in Reynolds number (see the module docstring).
 _RE_CRISIS = 1.815e5
