@@ -401,8 +401,7 @@ def _launches(
     ``numpy.random.default_rng(seed)`` draws the angles here in Python, so a seed gives the same flight as it always
     has; the compiled :func:`_fill_kick` derives the rest of each kick's constants.
     """
-    launches = np.zeros((len(positions), 13))
-    launches[:, 0:3], launches[:, 3:6], launches[:, 6:9] = positions, velocities, spins
+    launches = np.concatenate((positions, velocities, spins, np.zeros((len(positions), 4))), axis=1)
     for k, seed in enumerate(seeds):
         if seed is not None:
             launches[k, 9:12] = np.random.default_rng(seed).uniform(0.0, 2.0 * np.pi, size=3)
@@ -856,7 +855,8 @@ def simulate(
     rows = int(config[_N_STEPS]) + 1
     t, state, forces = np.empty(rows), np.empty((rows, 6)), np.empty((rows, 12))
     n, ending = _simulate_one(launch, config, t, state, forces)
-    _refuse_overflow(np.array([ending]), config)
+    if ending == 3:
+        _refuse_overflow(np.array([ending]), config)
     state, forces = state[:n], forces[:n]
     return Trajectory(
         t=t[:n],
