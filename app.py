@@ -9,10 +9,14 @@ from __future__ import annotations
 
 import ipaddress
 import logging
+import threading
+import time
+from types import ModuleType
 
 import tyro
 import viser
 
+from kernels import ball, course, fabrik
 from scenes import SceneName
 from scenes.sdf_gallery import set_editing_allowed
 from scenes.switcher import SceneSwitcher
@@ -47,6 +51,30 @@ def exposure_warning(host: str, port: int, *, allow_remote_glsl: bool = False) -
     )
 
 
+def warm_kernels(modules: tuple[ModuleType, ...] = (fabrik, ball, course)) -> threading.Thread:
+    """Run each module's ``warm_up()`` (where it has one) on one daemon thread, started here.
+
+    The compiled kernels then load from numba's cache (or compile, the first time) while the page is served, so
+    neither the first page nor the first drag waits for a compile.
+    """
+
+    def run() -> None:
+        start = time.perf_counter()
+        for module in modules:
+            warm_up = getattr(module, "warm_up", None)
+            if warm_up is None:
+                continue
+            try:
+                warm_up()
+            except Exception:  # the kernel then compiles on first use instead; say why
+                logger.exception("warming %s failed", module.__name__)
+        logger.info("compiled kernels ready in %.2f s", time.perf_counter() - start)
+
+    thread = threading.Thread(target=run, name="warm-kernels", daemon=True)
+    thread.start()
+    return thread
+
+
 def main(
     scene: SceneName = "peloton",
     host: str = "127.0.0.1",
@@ -66,6 +94,7 @@ def main(
     warning = exposure_warning(host, port, allow_remote_glsl=allow_remote_glsl)
     if warning is not None:
         print(warning, flush=True)
+    warm_kernels()
     server = viser.ViserServer(host=host, port=port, label="Physics scenes")
     server.gui.configure_theme(control_width="large")
     SceneSwitcher(server, scene)

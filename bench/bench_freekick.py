@@ -1,26 +1,35 @@
-"""Benchmark the ball-flight kernel and the free-kick scene's slider-to-screen latency.
+"""Benchmark the ball-flight kernel, the app's start and the free-kick scene's slider-to-screen latency.
 
-    python bench/bench_freekick.py
+    python bench/bench_freekick.py            # goal table, accuracy table, scene table
+    python bench/bench_freekick.py --goals    # goal table only (a minute)
 
-Prints a table:
+Prints:
 
-* accuracy and time of one 30 m curler (28 m/s, 19°, 9 rev/s sidespin, constant coefficients) for the seed's Euler
-  at 1 ms, RK4 at 10 ms and scipy's own solvers, the error being the distance at the plane x = 30 m from a DOP853
-  solution at rtol = atol = 1e-12 (goal: RK4 ≤ 0.1 mm in ≤ 1 ms);
-* ``simulate_batch`` on 10 000 kicks against a loop of single ``simulate`` calls in the same process (goal ≤ 1 s);
-* the scene: a spin-slider change recomputed and redrawn (trajectory, ghost, band, arrows, readouts) on the server
-  (goal p95 ≤ 16 ms) for each model and integrator, a speed-slider change (which also re-flies the no-spin ghost
-  that a spin change reuses) with the slowest pair, and a spin change from a websocket client's message to the new
-  path arriving back.
+* the goal table of issue 11: one 30 m curler (28 m/s, 19°, 9 rev/s sidespin, constant coefficients) at RK4 10 ms
+  and at the seed's Euler 1 ms; ``simulate_batch`` on 10 000 kicks (RK4 10 ms); the 41 × 31 outcome map; the app's
+  start to serving its page with numba's cache warm and cold (a fresh ``NUMBA_CACHE_DIR``), and when its background
+  warm-up finished. Each kernel row has a ratio against a plain numpy implementation of the same equations run in
+  this process (:func:`numpy_flight`, :func:`numpy_batch`); the machine's CPU, numba's thread count and the load
+  average are printed with it;
+* accuracy and time of the curler for Euler 1 ms, RK4 10 ms and scipy's own solvers, the error being the distance
+  at the plane x = 30 m from a DOP853 solution at rtol = atol = 1e-12;
+* the scene: a spin-slider change recomputed and redrawn on the server (goal p95 ≤ 16 ms) for each model and
+  integrator, a speed-slider change, and a spin change from a websocket client's message to the new path arriving
+  back; the outcome map and aiming on the scene's worker thread.
 """
 
 from __future__ import annotations
 
 import math
 import os
+import platform
+import re
 import statistics
+import subprocess
 import sys
+import tempfile
 import time
+import urllib.request
 from collections.abc import Callable
 from pathlib import Path
 
@@ -32,11 +41,12 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tests"))
 
+import numba  # noqa: E402
 import viser  # noqa: E402
 from wsclient import BrowserClient  # noqa: E402
 
 from kernels import ball  # noqa: E402
-from scenes.freekick import FreeKickScene  # noqa: E402
+from scenes.freekick import MAP_QUIET_S, FreeKickParams, FreeKickScene, outcome_map  # noqa: E402
 from scenes.switcher import SceneSwitcher  # noqa: E402
 
 M, R, RHO, G = 0.43, 0.11, 1.225, 9.81
@@ -45,6 +55,8 @@ START = np.array([0.0, 0.0, R])
 VELOCITY = ball.launch_velocity(28.0, math.radians(19.0), math.radians(-8.0))
 SPIN = ball.spin_vector(9.0, (0.0, 0.0, 1.0))
 LINE_M = 30.0
+MAP_SPEEDS = np.linspace(15.0, 35.0, 41)
+MAP_SPINS = np.linspace(0.0, 15.0, 31)
 
 
 def timings(func: Callable[[], object], repeat: int) -> list[float]:
@@ -131,54 +143,6 @@ def kernel_rows() -> None:
         if name.startswith("RK4 10 ms, one"):
             note += "; goal <= 0.1 mm in <= 1 ms"
         row(name, timings(run, repeat), 1e-3, "ms", note)
-
-
-def batch_rows() -> None:
-    rng = np.random.default_rng(0)
-    k = 10_000
-    speeds = rng.uniform(15.0, 35.0, k)
-    elevations = np.radians(rng.uniform(5.0, 30.0, k))
-    azimuths = np.radians(rng.uniform(-15.0, 15.0, k))
-    velocities = np.stack(
-        [speeds * np.cos(elevations) * np.cos(azimuths), speeds * np.cos(elevations) * np.sin(azimuths),
-         speeds * np.sin(elevations)], axis=1,
-    )  # fmt: skip
-    spins = np.zeros((k, 3))
-    spins[:, 2] = 2 * math.pi * rng.uniform(-12.0, 12.0, k)
-    starts = np.tile([-25.0, 0.0, R], (k, 1))
-    options = {"dt": 1e-2, "method": "rk4", "t_max": 4.0, "x_stop": 0.5, "ground_m": R}
-
-    def batch() -> object:
-        return ball.simulate_batch(starts, velocities, spins, **options)  # type: ignore[arg-type]
-
-    batch_times = timings(batch, 5)
-    n_loop = 1_000
-
-    def loop() -> object:
-        return [ball.simulate(starts[i], velocities[i], spins[i], **options) for i in range(n_loop)]  # type: ignore[arg-type]
-
-    loop_times = [t * k / n_loop for t in timings(loop, 3)]
-    ratio = statistics.median(loop_times) / statistics.median(batch_times)
-    row(
-        "simulate_batch, 10 000 kicks, RK4 10 ms",
-        batch_times,
-        1.0,
-        "s",
-        f"goal <= 1 s; {ratio:.1f}x a loop",
-    )
-    row(
-        "loop of simulate, 1 000 kicks scaled to 10 000",
-        loop_times,
-        1.0,
-        "s",
-        "baseline, same process",
-    )
-
-    wall, goal = ball.free_kick_panels((-25.0, 0.0), (0.0, 0.0), (1.0, 0.0))
-    result = batch()
-    assert isinstance(result, ball.BatchTrajectory)
-    judged = timings(lambda: ball.outcome_batch(result, wall, goal), 5)
-    row("outcome_batch on those 10 000 kicks", judged, 1e-3, "ms")
 
 
 def scene_rows() -> None:
@@ -268,14 +232,286 @@ def scene_rows() -> None:
     )
 
     map_times = timings(lambda: (scene._request_map(), scene.wait_idle()), 3)
-    row("outcome map, 41 x 31 kicks (worker thread)", map_times, 1e-3, "ms")
+    row(
+        "outcome map, 41 x 31 kicks (worker thread)",
+        map_times,
+        1e-3,
+        "ms",
+        f"includes the scene's {MAP_QUIET_S:g} s wait for the settings to be still",
+    )
     aim_times = timings(lambda: (scene.aim_at_point(-2.5, 1.9), scene.wait_idle()), 3)
-    row("aim at a clicked point (worker thread)", aim_times, 1e-3, "ms", scene.aim_message[:60])
+    row(
+        "aim at a clicked point (worker thread)",
+        aim_times,
+        1e-3,
+        "ms",
+        "includes the new kick's outcome map; " + scene.aim_message[:40],
+    )
     switcher.close()
     server.stop()
 
 
+# --------------------------------------------------------------------------------------------- plain numpy
+def numpy_acceleration(v: NDArray[np.float64], axis: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Constant-coefficient drag + Magnus + gravity (m/s²) for velocities (..., 3), plain numpy."""
+    speed = np.linalg.norm(v, axis=-1, keepdims=True)
+    a = -Q * 0.25 * speed * v + Q * 0.25 * speed * np.cross(axis, v)
+    a[..., 2] -= G
+    return a
+
+
+def numpy_flight(method: str, dt: float, x_stop: float) -> NDArray[np.float64]:
+    """The curler in plain numpy, one 3-vector step at a time, until it passes x_stop or lands: (N, 6) states."""
+    axis = SPIN / np.linalg.norm(SPIN)
+    p, v = START.copy(), VELOCITY.copy()
+    states = [np.concatenate((p, v))]
+    for _ in range(round(5.0 / dt)):
+        if method == "euler":
+            v = v + dt * numpy_acceleration(v, axis)
+            p = p + dt * v
+        else:
+            k1 = numpy_acceleration(v, axis)
+            k2 = numpy_acceleration(v + 0.5 * dt * k1, axis)
+            k3 = numpy_acceleration(v + 0.5 * dt * k2, axis)
+            k4 = numpy_acceleration(v + dt * k3, axis)
+            p = p + dt / 6 * (v + 2 * (v + 0.5 * dt * k1) + 2 * (v + 0.5 * dt * k2) + (v + dt * k3))
+            v = v + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+        states.append(np.concatenate((p, v)))
+        if p[2] <= 0.0 or p[0] >= x_stop:
+            break
+    return np.array(states)
+
+
+def numpy_batch(
+    starts: NDArray[np.float64],
+    velocities: NDArray[np.float64],
+    spins: NDArray[np.float64],
+    x_stop: float,
+) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+    """RK4 10 ms over all kicks at once in plain numpy until each lands or passes x_stop: (T, K, 6), samples."""
+    dt = 1e-2
+    rates = np.linalg.norm(spins, axis=1, keepdims=True)
+    axis = spins / np.where(rates > 0, rates, 1.0)
+    p, v = starts.copy(), velocities.copy()
+    flying = np.ones(len(p), dtype=bool)
+    n = np.ones(len(p), dtype=np.int64)
+    frames = [np.concatenate((p, v), axis=1)]
+    for _ in range(400):
+        k1 = numpy_acceleration(v, axis)
+        k2 = numpy_acceleration(v + 0.5 * dt * k1, axis)
+        k3 = numpy_acceleration(v + 0.5 * dt * k2, axis)
+        k4 = numpy_acceleration(v + dt * k3, axis)
+        p_new = p + dt / 6 * (v + 2 * (v + 0.5 * dt * k1) + 2 * (v + 0.5 * dt * k2) + (v + dt * k3))
+        v_new = v + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+        p = np.where(flying[:, None], p_new, p)
+        v = np.where(flying[:, None], v_new, v)
+        n += flying
+        frames.append(np.concatenate((p, v), axis=1))
+        flying &= (p[:, 2] > R) & (p[:, 0] < x_stop)
+        if not flying.any():
+            break
+    return np.stack(frames), n
+
+
+def numpy_outcomes(
+    states: NDArray[np.float64], wall: ball.Panel, goal: ball.Panel
+) -> NDArray[np.str_]:
+    """Results of :func:`numpy_batch` flights (linear interpolation at each plane: the cheap reference)."""
+    result = np.full(states.shape[1], "short", dtype="<U5")
+    crossings = []
+    for panel in (wall, goal):
+        normal = np.array([*panel.normal_xy]) / np.hypot(*panel.normal_xy)
+        d = (states[:, :, :2] - np.array(panel.centre_xy)) @ normal  # (T, K)
+        crosses = (d[:-1] < 0) & (d[1:] >= 0)
+        found = crosses.any(axis=0)
+        i = np.argmax(crosses, axis=0)
+        k = np.arange(states.shape[1])
+        s = -d[i, k] / np.where(found, d[i + 1, k] - d[i, k], 1.0)
+        point = states[i, k, :3] + s[:, None] * (states[i + 1, k, :3] - states[i, k, :3])
+        lateral = (point[:, :2] - np.array(panel.centre_xy)) @ np.array([-normal[1], normal[0]])
+        crossings.append((found, point, lateral))
+    (wall_found, wall_point, wall_lateral), (goal_found, goal_point, goal_lateral) = crossings
+    inside = np.abs(goal_lateral) <= 0.5 * goal.width_m - R
+    under = goal_point[:, 2] <= goal.height_m - R
+    result[goal_found & inside & under] = "goal"
+    result[goal_found & inside & ~under] = "over"
+    result[goal_found & ~inside] = "wide"
+    hit = (
+        wall_found
+        & (np.abs(wall_lateral) <= 0.5 * wall.width_m + R)
+        & (wall_point[:, 2] <= wall.height_m + R)
+    )
+    result[hit] = "wall"
+    return result
+
+
+# --------------------------------------------------------------------------------------------- goals
+def batch_kicks(k: int = 10_000) -> tuple[NDArray[np.float64], ...]:
+    rng = np.random.default_rng(0)
+    speeds = rng.uniform(15.0, 35.0, k)
+    elevations = np.radians(rng.uniform(5.0, 30.0, k))
+    azimuths = np.radians(rng.uniform(-15.0, 15.0, k))
+    velocities = np.stack(
+        [speeds * np.cos(elevations) * np.cos(azimuths), speeds * np.cos(elevations) * np.sin(azimuths),
+         speeds * np.sin(elevations)], axis=1,
+    )  # fmt: skip
+    spins = np.zeros((k, 3))
+    spins[:, 2] = 2 * math.pi * rng.uniform(-12.0, 12.0, k)
+    return np.tile([-25.0, 0.0, R], (k, 1)), velocities, spins
+
+
+def app_start(cache_dir: str | None) -> tuple[float, float | None]:
+    """Seconds from launching ``app.py`` to its page answering, and to its log saying the kernels are warm."""
+    env = dict(os.environ)
+    if cache_dir is not None:
+        env["NUMBA_CACHE_DIR"] = cache_dir
+    start = time.perf_counter()
+    process = subprocess.Popen(
+        [sys.executable, str(ROOT / "app.py"), "--port", "0"],
+        cwd=ROOT,
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+    )
+    try:
+        assert process.stdout is not None
+        serving = warm = None
+        port = None
+        deadline = time.perf_counter() + 300.0
+        while warm is None and time.perf_counter() < deadline:
+            line = process.stdout.readline()
+            if not line:
+                break
+            if port is None and (match := re.search(r"http://127\.0\.0\.1:(\d+)", line)):
+                port = int(match.group(1))
+                while serving is None:
+                    try:
+                        with urllib.request.urlopen(f"http://127.0.0.1:{port}/", timeout=5) as page:
+                            if page.status == 200:
+                                serving = time.perf_counter() - start
+                    except OSError:
+                        time.sleep(0.01)
+            if "compiled kernels ready" in line:
+                warm = time.perf_counter() - start
+        assert serving is not None, "the app never served its page"
+        return serving, warm
+    finally:
+        process.terminate()
+        process.wait(timeout=30)
+
+
+def goal_row(
+    name: str, values: list[float], unit: float, unit_name: str, goal: float | None, note: str
+) -> None:
+    """One row: median, p95 and best (the best is what an idle machine gives; this one is shared)."""
+    median, p95 = statistics.median(values) / unit, float(np.percentile(values, 95)) / unit
+    best = min(values) / unit
+    verdict = "" if goal is None else ("met" if median <= goal else "NOT met")
+    goal_text = "" if goal is None else f"<= {goal:g} {unit_name}"
+    print(
+        f"| {name:<44} | {median:>9.3f} | {p95:>9.3f} | {best:>9.3f} | {unit_name:<4} | {goal_text:<11} "
+        f"| {verdict:<7} | {note}"
+    )
+
+
+def goal_rows() -> None:
+    load_before = os.getloadavg()
+    cpu = platform.processor() or platform.machine()
+    with open("/proc/cpuinfo") as info:
+        models = [line.split(":", 1)[1].strip() for line in info if line.startswith("model name")]
+    cpu = models[0] if models else cpu
+    ball.warm_up()
+    print(
+        "| goal (issue 11)                              |    median |       p95 |      best | unit | goal        "
+        "| verdict | note"
+    )
+    print(
+        "|----------------------------------------------|----------:|----------:|----------:|------|-------------"
+        "|---------|-----"
+    )
+    kicks: tuple[tuple[ball.Method, float, float, int, str], ...] = (
+        ("rk4", 1e-2, 20.0, 3000, "one 30 m kick, RK4 10 ms"),
+        ("euler", 1e-3, 100.0, 1000, "one 30 m kick, the seed's Euler 1 ms"),
+    )
+    for method, dt, goal, repeat, label in kicks:
+        compiled = timings(
+            lambda method=method, dt=dt: ball.simulate(
+                START,
+                VELOCITY,
+                SPIN,
+                dt=dt,
+                method=method,
+                x_stop=LINE_M,
+            ),
+            repeat,
+        )
+        plain = timings(lambda method=method, dt=dt: numpy_flight(method, dt, LINE_M), 20)
+        ratio = statistics.median(plain) / statistics.median(compiled)
+        goal_row(
+            label,
+            compiled,
+            1e-6,
+            "µs",
+            goal,
+            f"{ratio:.0f}x plain numpy ({statistics.median(plain) * 1e3:.1f} ms)",
+        )
+
+    starts, velocities, spins = batch_kicks()
+    options = {"dt": 1e-2, "method": "rk4", "t_max": 4.0, "x_stop": 0.5, "ground_m": R}
+    batch = timings(lambda: ball.simulate_batch(starts, velocities, spins, **options), 9)  # type: ignore[arg-type]
+    plain = timings(lambda: numpy_batch(starts, velocities, spins, 0.5), 3)
+    ratio = statistics.median(plain) / statistics.median(batch)
+    goal_row("simulate_batch, 10 000 kicks, RK4 10 ms", batch, 1e-3, "ms", 60.0,
+             f"{ratio:.1f}x plain numpy over the kicks ({statistics.median(plain) * 1e3:.0f} ms)")  # fmt: skip
+    wall, goal = ball.free_kick_panels((-25.0, 0.0), (0.0, 0.0), (1.0, 0.0))
+    fused = timings(
+        lambda: ball.simulate_outcomes(starts, velocities, spins, wall, goal, **options), 9
+    )  # type: ignore[arg-type]
+    goal_row(
+        "  simulate_outcomes, same kicks (no storage)", fused, 1e-3, "ms", None, "verdicts only"
+    )
+
+    params = FreeKickParams()
+    grid = timings(lambda: outcome_map(params), 15)
+    speeds, rates = np.meshgrid(MAP_SPEEDS, MAP_SPINS)
+    heading = math.atan2(0.0, 22.0) + math.radians(params.azimuth_deg)
+    direction = ball.launch_velocity(1.0, math.radians(params.elevation_deg), heading)
+    map_starts = np.tile([-22.0, 0.0, R], (speeds.size, 1))
+    map_velocities = speeds.reshape(-1, 1) * direction
+    map_spins = 2 * math.pi * rates.reshape(-1, 1) * np.array([0.0, 0.0, 1.0])
+    map_wall, map_goal = ball.free_kick_panels(
+        (-22.0, 0.0), (0.0, 0.0), (1.0, 0.0), wall_width_m=2.0
+    )
+
+    def plain_map() -> NDArray[np.str_]:
+        states, _ = numpy_batch(map_starts, map_velocities, map_spins, 0.5)
+        return numpy_outcomes(states, map_wall, map_goal)
+
+    plain = timings(plain_map, 5)
+    agree = float(np.mean(plain_map().reshape(speeds.shape) == outcome_map(params)))
+    ratio = statistics.median(plain) / statistics.median(grid)
+    goal_row("outcome map 41 x 31 (scene's outcome_map)", grid, 1e-3, "ms", 20.0,
+             f"{ratio:.0f}x plain numpy ({statistics.median(plain) * 1e3:.0f} ms, {agree:.1%} same cells)")  # fmt: skip
+
+    warm = [app_start(None) for _ in range(3)]
+    goal_row("app start to serving, warm cache", [w[0] for w in warm], 1.0, "s", 3.0,
+             f"kernels warm after {statistics.median([w[1] or math.nan for w in warm]):.2f} s")  # fmt: skip
+    with tempfile.TemporaryDirectory() as empty:
+        serving, warmed = app_start(empty)
+    goal_row("app start to serving, cold cache", [serving], 1.0, "s", None,
+             f"kernels compiled after {warmed or math.nan:.1f} s (background thread)")  # fmt: skip
+    load_after = os.getloadavg()
+    print(
+        f"\nCPU: {cpu}, {os.cpu_count()} logical CPUs; numba {numba.__version__}, {numba.get_num_threads()} threads "
+        f"({numba.threading_layer()} layer); load average (1 min) {load_before[0]:.2f} before, {load_after[0]:.2f} after\n"
+    )
+
+
 def main() -> None:
+    goal_rows()
+    if "--goals" in sys.argv:
+        return
     print(
         "| measurement                                    |     median |        p95 | unit | note"
     )
@@ -283,7 +519,6 @@ def main() -> None:
         "|------------------------------------------------|-----------:|-----------:|------|-----"
     )
     kernel_rows()
-    batch_rows()
     scene_rows()
     cpus = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
     print(

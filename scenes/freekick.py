@@ -355,10 +355,12 @@ def outcome_map(p: FreeKickParams) -> NDArray[np.str_]:
     direction = ball.launch_velocity(1.0, elevation, heading)
     axis = spin_axis(p)
     k = speeds.size
-    batch = ball.simulate_batch(
+    judged = ball.simulate_outcomes(
         np.tile(ball_spot(p), (k, 1)),
         speeds.reshape(-1, 1) * direction,
         (2.0 * math.pi * spins.reshape(-1, 1)) * axis,
+        wall,
+        goal,
         dt=INTEGRATOR_STEP_S["rk4"],
         method="rk4",
         model=p.model,
@@ -366,7 +368,7 @@ def outcome_map(p: FreeKickParams) -> NDArray[np.str_]:
         x_stop=0.5,
         ground_m=ball.BALL_RADIUS_M,
     )
-    return ball.outcome_batch(batch, wall, goal).result.reshape(spins.shape)
+    return judged.result.reshape(spins.shape)
 
 
 def outcome_map_image(results: NDArray[np.str_], p: FreeKickParams) -> NDArray[np.uint8]:
@@ -388,7 +390,7 @@ def outcome_map_image(results: NDArray[np.str_], p: FreeKickParams) -> NDArray[n
 def aim_at(p: FreeKickParams, target_yz: tuple[float, float]) -> FreeKickParams | None:
     """A kick at the same speed that reaches ``target_yz`` (m) on the goal line over the wall, or None.
 
-    Searches elevation, azimuth and sidespin on a grid with :func:`kernels.ball.simulate_batch`, then polishes the
+    Searches elevation, azimuth and sidespin on a grid with :func:`kernels.ball.simulate_outcomes`, then polishes the
     best goal-scoring candidate's elevation and azimuth by Newton steps on the crossing point.
     """
     wall, goal = panels(p)
@@ -398,19 +400,24 @@ def aim_at(p: FreeKickParams, target_yz: tuple[float, float]) -> FreeKickParams 
     spins = np.array([-10.0, -7.0, -4.0, 0.0, 4.0, 7.0, 10.0])  # + curls left
     e, a, s = (g.ravel() for g in np.meshgrid(elevations, azimuths, spins, indexing="ij"))
     spot = ball_spot(p)
-    base = math.atan2(-spot[1], -spot[0])
-    velocities = np.stack(
+    heading = math.atan2(-spot[1], -spot[0]) + np.radians(a)
+    elevation = np.radians(e)
+    velocities = p.speed_ms * np.stack(
         [
-            ball.launch_velocity(p.speed_ms, math.radians(ei), base + math.radians(ai))
-            for ei, ai in zip(e, a, strict=True)
-        ]
+            np.cos(elevation) * np.cos(heading),
+            np.cos(elevation) * np.sin(heading),
+            np.sin(elevation),
+        ],
+        axis=1,
     )
     omegas = np.zeros((len(e), 3))
     omegas[:, 2] = 2.0 * math.pi * s
-    batch = ball.simulate_batch(
+    judged = ball.simulate_outcomes(
         np.tile(spot, (len(e), 1)),
         velocities,
         omegas,
+        wall,
+        goal,
         dt=1e-2,
         method="rk4",
         model=p.model,
@@ -418,7 +425,6 @@ def aim_at(p: FreeKickParams, target_yz: tuple[float, float]) -> FreeKickParams 
         x_stop=0.5,
         ground_m=ball.BALL_RADIUS_M,
     )
-    judged = ball.outcome_batch(batch, wall, goal)
     miss = np.linalg.norm(judged.goal_point[:, 1:] - target, axis=1)
     miss[judged.result != "goal"] = np.inf
     if not np.isfinite(miss).any():

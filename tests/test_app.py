@@ -3,8 +3,11 @@
 from __future__ import annotations
 
 import inspect
+import logging
 import subprocess
 import sys
+import threading
+import types
 from pathlib import Path
 
 import pytest
@@ -132,3 +135,27 @@ def test_switching_from_a_browser(server: viser.ViserServer) -> None:
             what="other scenes' nodes gone from the client",
         )
     switcher.close()
+
+
+def test_warm_kernels_runs_every_warm_up_on_one_daemon_thread(
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    from kernels import ball, fabrik
+
+    assert inspect.signature(app.warm_kernels).parameters["modules"].default == (ball, fabrik)
+    calls: list[tuple[str, threading.Thread]] = []
+    failing, plain, warming = (types.ModuleType(name) for name in ("failing", "plain", "warming"))
+
+    def fail() -> None:
+        calls.append(("failing", threading.current_thread()))
+        raise RuntimeError("no compiler today")
+
+    failing.warm_up = fail  # type: ignore[attr-defined]
+    warming.warm_up = lambda: calls.append(("warming", threading.current_thread()))  # type: ignore[attr-defined]
+    with caplog.at_level(logging.INFO, logger="app"):
+        thread = app.warm_kernels((failing, plain, warming))
+        thread.join(10)
+    assert not thread.is_alive() and thread.daemon
+    # A failing warm-up is logged and the next still runs; a module without one is skipped; all on that thread.
+    assert calls == [("failing", thread), ("warming", thread)]
+    assert "warming failing failed" in caplog.text and "compiled kernels ready" in caplog.text

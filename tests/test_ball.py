@@ -2,7 +2,12 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
+import subprocess
+import sys
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -18,6 +23,8 @@ AREA = math.pi * R**2
 Q = 0.5 * RHO * AREA / M  # ½ρA/m (1/m)
 START = np.array([0.0, 0.0, R])  # ball on the turf
 WALL, GOAL = ball.free_kick_panels((0.0, 0.0), (25.0, 0.0), (1.0, 0.0))
+GOAL_WIDTH_M, GOAL_HEIGHT_M = 7.32, 2.44  # FIFA, inside the posts and under the bar
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def kick(speed: float, elevation_deg: float, azimuth_deg: float = 0.0) -> NDArray[np.float64]:
@@ -417,3 +424,541 @@ def test_batch_rejects_mismatched_rows() -> None:
         ball.simulate_batch(np.zeros((2, 3)), np.zeros((2, 2)), np.zeros((2, 3)))
     with pytest.raises(ValueError, match="knuckle_seeds"):
         ball.simulate_batch(np.zeros((2, 3)), np.ones((2, 3)), np.zeros((2, 3)), knuckle_seeds=[1])
+
+
+# ------------------------------------------------------------------------------------------------ plain reference
+# A second implementation of the module docstring's equations, in plain numpy, one kick at a time and nothing
+# shared with kernels/ball.py: the compiled flight must agree with it sample for sample.
+def reference_acceleration(
+    v: NDArray[np.float64], t: float, spin: NDArray[np.float64], model: str, knuckle: tuple | None
+) -> NDArray[np.float64]:
+    speed = float(np.linalg.norm(v))
+    scale = float(
+        np.abs(spin).max()
+    )  # |ω| and ω̂ without under- or overflow: ω̂ is a unit vector for any ω ≠ 0
+    rate = scale * float(np.linalg.norm(spin / scale)) if scale > 0 else 0.0
+    axis = spin / scale / (rate / scale) if rate > 0 else np.zeros(3)
+    if model == "constant":
+        c_d, c_l = 0.25, 0.25
+    else:
+        s_param = R * rate / max(speed, 1e-9)
+        c_l = 0.9 * min(s_param, 0.3)
+        re = RHO * speed * 2 * R / 1.81e-5
+        still = 0.155 + 0.346 / (1 + math.exp(min((re - 1.815e5) / 1.949e4, 50.0)))
+        c_d = still + min(s_param / 0.05, 1.0) * (0.4127 * max(s_param, 0.05) ** 0.3056 - still)
+    a = -Q * c_d * speed * v + Q * c_l * speed * np.cross(axis, v) + np.array([0.0, 0.0, -G])
+    if knuckle is not None:
+        weight, omega, theta, phi1, phi2, n1, n2 = knuckle
+        side = math.cos(theta) * math.sin(omega * t + phi1) * n1
+        side = side + math.sin(theta) * math.sin(omega * t + phi2) * n2
+        a = a + Q * speed**2 * 0.10 * weight * side
+    return a
+
+
+def reference_knuckle(v0: NDArray[np.float64], spin: NDArray[np.float64], seed: int | None):
+    speed = float(np.linalg.norm(v0))
+    if seed is None or speed == 0.0:
+        return None
+    theta, phi1, phi2 = np.random.default_rng(seed).uniform(0.0, 2.0 * np.pi, size=3)
+    along = v0 / speed
+    n1 = np.cross([0.0, 0.0, 1.0], along)
+    n1 = n1 / np.linalg.norm(n1) if np.linalg.norm(n1) >= 1e-9 else np.array([0.0, 1.0, 0.0])
+    weight = max(0.0, 1.0 - R * float(np.linalg.norm(spin)) / speed / 0.05)
+    return weight, 2 * math.pi * speed / 15.0, theta, phi1, phi2, n1, np.cross(along, n1)
+
+
+def reference_flight(
+    p0, v0, spin, *, dt, method, model, t_max, seed=None, ground=0.0, x_stop=math.inf
+):
+    """(t, states (N, 6)) of the whole steps before the flight ends, and the (old, new) states of the last step."""
+    knuckle = reference_knuckle(np.asarray(v0, float), np.asarray(spin, float), seed)
+    y = np.concatenate((p0, v0)).astype(float)
+    samples = [y]
+
+    def f(t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
+        return np.concatenate((y[3:], reference_acceleration(y[3:], t, spin, model, knuckle)))
+
+    for n in range(math.ceil(t_max / dt - 1e-9)):
+        t = n * dt
+        if method == "euler":
+            v = y[3:] + dt * reference_acceleration(y[3:], t, spin, model, knuckle)
+            new = np.concatenate((y[:3] + dt * v, v))
+        else:
+            k1 = f(t, y)
+            k2 = f(t + dt / 2, y + dt / 2 * k1)
+            k3 = f(t + dt / 2, y + dt / 2 * k2)
+            k4 = f(t + dt, y + dt * k3)
+            new = y + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+        if new[2] <= ground or y[0] < x_stop <= new[0]:
+            return np.arange(len(samples)) * dt, np.array(samples), (y, new)
+        samples.append(new)
+        y = new
+    return np.arange(len(samples)) * dt, np.array(samples), None
+
+
+def hermite(p0, v0, p1, v1, h, s):
+    return (
+        (2 * s**3 - 3 * s**2 + 1) * p0
+        + (s**3 - 2 * s**2 + s) * h * v0
+        + (3 * s**2 - 2 * s**3) * p1
+        + (s**3 - s**2) * h * v1
+    )
+
+
+def hermite_root(d0: float, dd0: float, d1: float, dd1: float, h: float) -> float:
+    """Smallest root in [0, 1] of the cubic Hermite through (d0, h·dd0) and (d1, h·dd1), by numpy.roots."""
+    # h00 = 2s³ − 3s² + 1, h10 = s³ − 2s² + s, h01 = −2s³ + 3s², h11 = s³ − s².
+    a, b = h * dd0, h * dd1
+    coefficients = [2 * d0 + a - 2 * d1 + b, -3 * d0 - 2 * a + 3 * d1 - b, a, d0]
+    roots = [
+        r.real for r in np.roots(coefficients) if abs(r.imag) < 1e-9 and -1e-9 <= r.real <= 1 + 1e-9
+    ]
+    return min(roots)
+
+
+kick_settings = st.fixed_dictionaries(
+    {
+        "speed": st.floats(3.0, 38.0),
+        "elevation": st.floats(-5.0, 60.0),
+        "azimuth": st.floats(-40.0, 40.0),
+        "rev_s": st.floats(0.0, 15.0),
+        "axis": st.tuples(st.floats(-1, 1), st.floats(-1, 1), st.floats(0.1, 1)),
+        "model": st.sampled_from(["constant", "measured"]),
+        "seed": st.one_of(st.none(), st.integers(0, 1000)),
+    }
+)
+
+
+def kick_of(settings_: dict) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    velocity = kick(settings_["speed"], settings_["elevation"], settings_["azimuth"])
+    # Knuckleballs fly with (almost) no spin: keep the rate low for seeded kicks so the side force acts.
+    rate = settings_["rev_s"] / (50.0 if settings_["seed"] is not None else 1.0)
+    return velocity, ball.spin_vector(rate, settings_["axis"])
+
+
+@given(
+    kick_settings_=kick_settings,
+    method=st.sampled_from(["euler", "rk4"]),
+    dt=st.floats(2e-3, 4e-2),
+    x_stop=st.one_of(st.none(), st.floats(5.0, 30.0)),
+)
+@settings(max_examples=40, deadline=None)
+def test_every_sample_matches_a_plain_reference_of_the_equations(
+    kick_settings_: dict, method: str, dt: float, x_stop: float | None
+) -> None:
+    velocity, spin = kick_of(kick_settings_)
+    if method == "euler":
+        dt /= 8
+    seed, model = kick_settings_["seed"], kick_settings_["model"]
+    flight = ball.simulate(
+        START, velocity, spin, dt=dt, method=method, model=model, t_max=2.5,  # type: ignore[arg-type]
+        x_stop=x_stop, ground_m=R, knuckle_seed=seed,
+    )  # fmt: skip
+    t, states, last = reference_flight(
+        START, velocity, spin, dt=dt, method=method, model=model, t_max=2.5, seed=seed, ground=R,
+        x_stop=math.inf if x_stop is None else x_stop,
+    )  # fmt: skip
+    n = len(t)
+    assert len(flight.t) == n + (last is not None)
+    np.testing.assert_allclose(flight.t[:n], t, rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(flight.position[:n], states[:, :3], rtol=1e-10, atol=1e-10)
+    np.testing.assert_allclose(flight.velocity[:n], states[:, 3:], rtol=1e-10, atol=1e-10)
+    if last is None:
+        assert flight.ended == "t_max"
+        return
+    # The end: where the Hermite cubic of the last step meets the ground or the stop plane, whichever is first.
+    old, new = last
+    ends = []
+    if new[2] <= R:
+        ends.append((hermite_root(old[2] - R, old[5], new[2] - R, new[5], dt), "ground"))
+    if x_stop is not None and old[0] < x_stop <= new[0]:
+        ends.append((hermite_root(old[0] - x_stop, old[3], new[0] - x_stop, new[3], dt), "x_stop"))
+    s, ended = min(ends)
+    assert flight.ended == ended
+    assert flight.t[-1] == pytest.approx(t[-1] + s * dt, abs=1e-9)
+    expected = hermite(old[:3], old[3:], new[:3], new[3:], dt, s)
+    np.testing.assert_allclose(flight.position[-1], expected, atol=1e-8)
+    assert flight.position[-1, 2 if ended == "ground" else 0] == (
+        R if ended == "ground" else x_stop
+    )
+    # Forces along the flight are the reference's accelerations times the mass.
+    knuckle = reference_knuckle(velocity, spin, seed)
+    total = flight.drag + flight.magnus + flight.gravity + flight.knuckle
+    for i in (0, n // 2, len(flight.t) - 1):
+        expected_force = M * reference_acceleration(
+            flight.velocity[i], flight.t[i], spin, model, knuckle
+        )
+        np.testing.assert_allclose(total[i], expected_force, rtol=1e-9, atol=1e-12)
+
+
+def reference_outcome(
+    flight: ball.Trajectory, wall: ball.Panel, goal: ball.Panel, radius: float = R
+):
+    """(result, wall point, goal point, margin): the docstring's rules on the first crossing of each plane."""
+    points = []
+    for panel in (wall, goal):
+        normal = np.array([*panel.normal_xy, 0.0]) / math.hypot(*panel.normal_xy)
+        centre = np.array([*panel.centre_xy, 0.0])
+        d = (flight.position - centre) @ normal
+        dd = flight.velocity @ normal
+        point = None
+        for i in range(len(d) - 1):
+            if d[i] < 0 <= d[i + 1]:
+                h = flight.t[i + 1] - flight.t[i]
+                s = hermite_root(d[i], dd[i], d[i + 1], dd[i + 1], h)
+                point = hermite(
+                    flight.position[i],
+                    flight.velocity[i],
+                    flight.position[i + 1],
+                    flight.velocity[i + 1],
+                    h,
+                    s,
+                )
+                break
+        lateral = None if point is None else float((point - centre) @ [-normal[1], normal[0], 0.0])
+        points.append((point, lateral))
+    (wall_point, wall_lateral), (goal_point, goal_lateral) = points
+    margins = [math.inf]
+    if wall_point is not None:
+        assert wall_lateral is not None
+        margins += [
+            abs(abs(wall_lateral) - (wall.width_m / 2 + radius)),
+            abs(wall_point[2] - (wall.height_m + radius)),
+        ]
+        if (
+            abs(wall_lateral) <= wall.width_m / 2 + radius
+            and wall_point[2] <= wall.height_m + radius
+        ):
+            return "wall", wall_point, goal_point, min(margins)
+    if goal_point is None:
+        return "short", wall_point, goal_point, min(margins)
+    assert goal_lateral is not None
+    margins += [
+        abs(abs(goal_lateral) - (goal.width_m / 2 - radius)),
+        abs(goal_point[2] - (goal.height_m - radius)),
+    ]
+    if abs(goal_lateral) > goal.width_m / 2 - radius:
+        return "wide", wall_point, goal_point, min(margins)
+    return (
+        ("goal" if goal_point[2] <= goal.height_m - radius else "over"),
+        wall_point,
+        goal_point,
+        min(margins),
+    )
+
+
+@given(
+    kick_settings_=kick_settings, wall_height=st.floats(1.0, 2.4), wall_offset=st.floats(-2.0, 2.0)
+)
+@settings(max_examples=40, deadline=None)
+def test_outcome_matches_the_rules_applied_by_a_plain_reference(
+    kick_settings_: dict, wall_height: float, wall_offset: float
+) -> None:
+    velocity, spin = kick_of(kick_settings_)
+    wall, goal = ball.free_kick_panels(
+        (0.0, 0.0), (22.0, 0.0), (1.0, 0.0), wall_height_m=wall_height, wall_offset_m=wall_offset
+    )
+    flight = ball.simulate(
+        START, velocity, spin, dt=1e-2, method="rk4", model=kick_settings_["model"], t_max=4.0,
+        x_stop=23.0, ground_m=R, knuckle_seed=kick_settings_["seed"],
+    )  # fmt: skip
+    result, wall_point, goal_point, margin = reference_outcome(flight, wall, goal)
+    judged = ball.outcome(flight, wall, goal)
+    if margin > 1e-9:  # a crossing within rounding of an edge may fall either way
+        assert judged.result == result
+    for got, expected in ((judged.wall_point, wall_point), (judged.goal_point, goal_point)):
+        assert (got is None) == (expected is None)
+        if got is not None and expected is not None:
+            np.testing.assert_allclose(got, expected, atol=1e-9)
+
+
+def straight_flight(y: float, z: float) -> ball.Trajectory:
+    """A hand-made flight at 2 m/s along +x through the goal plane x = 0 at (y, z), at t = 0.5 s."""
+    n = 2
+    zeros = np.zeros((n, 3))
+    return ball.Trajectory(
+        t=np.array([0.0, 1.0]),
+        position=np.array([[-1.0, y, z], [1.0, y, z]]),
+        velocity=np.array([[2.0, 0.0, 0.0], [2.0, 0.0, 0.0]]),
+        drag=zeros, magnus=zeros, gravity=zeros, knuckle=zeros, ended="x_stop",
+    )  # fmt: skip
+
+
+def test_values_exactly_on_the_post_and_bar_thresholds() -> None:
+    wall, goal = ball.free_kick_panels((-20.0, 0.0), (0.0, 0.0), (1.0, 0.0), wall_width_m=0.5)
+    wall = dataclasses.replace(wall, centre_xy=(-10.0, 50.0))  # out of the way
+    bar, post = GOAL_HEIGHT_M - R, 0.5 * GOAL_WIDTH_M - R
+    on_bar = ball.outcome(straight_flight(0.0, bar), wall, goal)
+    assert on_bar.result == "goal" and on_bar.goal_point is not None
+    assert on_bar.goal_point.tolist() == [0.0, 0.0, bar] and on_bar.goal_time == 0.5
+    assert ball.outcome(straight_flight(0.0, math.nextafter(bar, 9.0)), wall, goal).result == "over"
+    assert ball.outcome(straight_flight(post, 1.0), wall, goal).result == "goal"
+    assert ball.outcome(straight_flight(-post, 1.0), wall, goal).result == "goal"
+    assert (
+        ball.outcome(straight_flight(math.nextafter(post, 9.0), 1.0), wall, goal).result == "wide"
+    )
+
+
+def test_a_sample_exactly_on_the_plane_is_the_crossing() -> None:
+    wall, goal = ball.free_kick_panels((-20.0, 0.0), (0.0, 0.0), (1.0, 0.0))
+    flight = ball.Trajectory(
+        t=np.array([0.0, 0.5, 1.0]),
+        position=np.array([[-1.0, 0.3, 1.0], [0.0, 0.3, 1.0], [1.0, 0.3, 1.0]]),
+        velocity=np.tile([2.0, 0.0, 0.0], (3, 1)),
+        drag=np.zeros((3, 3)), magnus=np.zeros((3, 3)), gravity=np.zeros((3, 3)), knuckle=np.zeros((3, 3)),
+        ended="x_stop",
+    )  # fmt: skip
+    judged = ball.outcome(flight, wall, goal)
+    assert judged.goal_time == 0.5 and judged.goal_point is not None
+    assert judged.goal_point.tolist() == [0.0, 0.3, 1.0]
+
+
+@given(
+    kicks=st.lists(kick_settings, min_size=0, max_size=6),
+    method=st.sampled_from(["euler", "rk4"]),
+)
+@settings(max_examples=15, deadline=None)
+def test_simulate_outcomes_equals_outcome_batch_of_simulate_batch(
+    kicks: list[dict], method: str
+) -> None:
+    pairs = [kick_of(k) for k in kicks]
+    velocities = np.array([p[0] for p in pairs]).reshape(-1, 3)
+    spins = np.array([p[1] for p in pairs]).reshape(-1, 3)
+    positions = np.tile(START, (len(pairs), 1))
+    seeds = [k["seed"] for k in kicks]
+    options = {
+        "dt": 1e-2 if method == "rk4" else 2e-3,
+        "method": method,
+        "t_max": 3.0,
+        "x_stop": 26.0,
+        "ground_m": R,
+    }
+    batch = ball.simulate_batch(positions, velocities, spins, knuckle_seeds=seeds, **options)  # type: ignore[arg-type]
+    assert batch.t.shape == (len(pairs), max([1, *batch.n_samples.tolist()]))
+    judged = ball.outcome_batch(batch, WALL, GOAL)
+    fused = ball.simulate_outcomes(
+        positions, velocities, spins, WALL, GOAL, knuckle_seeds=seeds, **options
+    )  # type: ignore[arg-type]
+    np.testing.assert_array_equal(fused.result, judged.result)
+    np.testing.assert_array_equal(fused.wall_point, judged.wall_point)
+    np.testing.assert_array_equal(fused.goal_point, judged.goal_point)
+    for i, k in enumerate(kicks):  # and each is the single kick's verdict
+        single = ball.simulate(
+            positions[i], velocities[i], spins[i], knuckle_seed=k["seed"], **options
+        )  # type: ignore[arg-type]
+        assert fused.result[i] == ball.outcome(single, WALL, GOAL).result
+
+
+def test_a_batch_too_large_to_reserve_counts_first_and_stores_the_same(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    velocities = np.array([kick(25, 16, -9), kick(30, 30, 0), kick(12, 20, 0)])
+    spins = np.array([ball.spin_vector(8, (0, 0, 1)), np.zeros(3), ball.spin_vector(5, (0, 1, 0))])
+    positions = np.tile(START, (3, 1))
+    reserved = ball.simulate_batch(positions, velocities, spins, dt=1e-2, method="rk4", ground_m=R)
+    monkeypatch.setattr(ball, "_RESERVE_BYTES", 0)
+    counted = ball.simulate_batch(positions, velocities, spins, dt=1e-2, method="rk4", ground_m=R)
+    for field in ("t", "position", "velocity", "n_samples", "ended"):
+        np.testing.assert_array_equal(getattr(counted, field), getattr(reserved, field))
+    # Padded with each flight's end, up to the longest flight.
+    k = int(np.argmin(reserved.n_samples))
+    assert reserved.t.shape[1] == reserved.n_samples.max() > reserved.n_samples[k]
+    np.testing.assert_array_equal(reserved.position[k, reserved.n_samples[k] :], reserved.position[k, -1:].repeat(
+        reserved.t.shape[1] - reserved.n_samples[k], axis=0))  # fmt: skip
+
+
+def test_threads_judging_at_once_get_the_results_of_one_at_a_time() -> None:
+    rng = np.random.default_rng(3)
+    velocities = np.array(
+        [kick(s, e, a) for s, e, a in rng.uniform([15, 5, -15], [35, 30, 15], (300, 3))]
+    )
+    spins = np.zeros((300, 3))
+    spins[:, 2] = rng.uniform(-60, 60, 300)
+    positions = np.tile(START, (300, 1))
+    options = {"dt": 1e-2, "method": "rk4", "x_stop": 26.0, "ground_m": R}
+    alone = ball.simulate_outcomes(positions, velocities, spins, WALL, GOAL, **options)  # type: ignore[arg-type]
+    with ThreadPoolExecutor(4) as pool:
+        runs = list(
+            pool.map(
+                lambda _: ball.simulate_outcomes(
+                    positions, velocities, spins, WALL, GOAL, **options
+                ),
+                range(8),
+            )
+        )  # type: ignore[arg-type]
+    for run in runs:
+        np.testing.assert_array_equal(run.result, alone.result)
+        np.testing.assert_array_equal(run.goal_point, alone.goal_point)
+
+
+# ------------------------------------------------------------------------------------------------ zero and huge
+def test_a_ball_dropped_from_rest_falls_straight_down_in_every_mode() -> None:
+    for model in ("constant", "measured"):
+        for seed in (None, 5):
+            flight = ball.simulate(
+                (1.0, 2.0, 3.0),
+                (0, 0, 0),
+                (0, 0, 0),
+                dt=1e-2,
+                method="rk4",
+                model=model,
+                knuckle_seed=seed,
+            )  # type: ignore[arg-type]
+            assert flight.ended == "ground"
+            np.testing.assert_array_equal(
+                flight.position[:, :2], np.tile([1.0, 2.0], (len(flight.t), 1))
+            )
+            # Drag slows the fall a little: it lands later than in a vacuum.
+            assert math.sqrt(2 * 3.0 / G) < flight.t[-1] < math.sqrt(2 * 3.0 / G) + 0.02
+
+
+@given(
+    exponent=st.integers(-300, 300),
+    axis=st.tuples(st.floats(-1, 1), st.floats(-1, 1), st.floats(0.1, 1)),
+)
+@settings(max_examples=30, deadline=None)
+def test_the_constant_model_curls_by_the_spin_axis_for_any_rate(exponent: int, axis: tuple) -> None:
+    # Constant C_L: the Magnus force is ½ρA·C_L·|v|·(ω̂ × v), whatever |ω|, from 1e-300 to 1e300 rad/s.
+    direction = np.array(axis) / np.linalg.norm(axis)
+    unit = flight_at(20.0, kick(25.0, 15.0), direction)
+    scaled = flight_at(20.0, kick(25.0, 15.0), direction * 10.0**exponent)
+    np.testing.assert_allclose(scaled.position, unit.position, rtol=1e-12, atol=1e-12)
+    subnormal = flight_at(20.0, kick(25.0, 15.0), np.array([0.0, 0.0, 5e-324]))
+    np.testing.assert_array_equal(
+        subnormal.position, flight_at(20.0, kick(25.0, 15.0), np.array([0.0, 0.0, 1.0])).position
+    )
+
+
+@given(
+    air_density=st.floats(0.0, 1e300),
+    mass=st.floats(1e-300, 10.0),
+    dt=st.floats(1e-3, 2.0),
+    speed=st.floats(0.0, 1e200),
+    method=st.sampled_from(["euler", "rk4"]),
+)
+@settings(max_examples=60, deadline=None)
+def test_huge_parameters_give_a_finite_flight_or_an_error_naming_dt(
+    air_density: float, mass: float, dt: float, speed: float, method: str
+) -> None:
+    arguments = {
+        "dt": dt,
+        "method": method,
+        "air_density": air_density,
+        "mass_kg": mass,
+        "t_max": 4.0,
+    }
+    velocity = (speed, 0.0, speed)
+    spin = (0.0, 0.0, 50.0)
+    try:
+        flight = ball.simulate(START, velocity, spin, **arguments)  # type: ignore[arg-type]
+    except ValueError as error:
+        assert "dt" in str(error) and "overshoots the drag" in str(error)
+        with pytest.raises(ValueError, match="dt"):
+            ball.simulate_batch(
+                [START, START], [velocity, (1.0, 0.0, 1.0)], [spin, spin], **arguments
+            )  # type: ignore[arg-type]
+        with pytest.raises(ValueError, match="dt"):
+            ball.simulate_outcomes([START], [velocity], [spin], WALL, GOAL, **arguments)  # type: ignore[arg-type]
+        return
+    for field in ("t", "position", "velocity", "drag", "magnus", "gravity", "knuckle"):
+        assert np.all(np.isfinite(getattr(flight, field))), field
+    batch = ball.simulate_batch([START], [velocity], [spin], **arguments)  # type: ignore[arg-type]
+    assert np.all(np.isfinite(batch.position))
+
+
+def test_the_overflow_that_used_to_be_silent() -> None:
+    # A thousand times sea-level air and no gravity: a 10 ms Euler step at 30 m/s overshoots the drag, so the
+    # velocity flips and grows each step until it is inf, then NaN. This came back as a NaN trajectory.
+    with pytest.raises(ValueError, match=r"dt = 0\.01 s is too long"):
+        ball.simulate(
+            START, (30.0, 0.0, 0.0), np.zeros(3), dt=1e-2, air_density=1225.0, gravity=0.0
+        )
+    # A 1e-300 kg ball: one 0.5 s Euler step flings it 2e294 m sideways, finite but absurd (hypothesis found it).
+    with pytest.raises(ValueError, match=r"dt = 0\.5 s is too long"):
+        ball.simulate_batch([START], [(0.5, 0.0, 0.5)], [(0.0, 0.0, 50.0)], dt=0.5, mass_kg=1e-300)
+    # The same guard leaves stiff but stable flights alone: RK4 at 10 ms in ten times sea-level air.
+    thick = ball.simulate(
+        START, kick(30.0, 15.0), np.zeros(3), dt=1e-2, method="rk4", air_density=12.25
+    )
+    assert thick.ended == "ground" and 0.0 < thick.position[-1, 0] < 15.0
+
+
+def test_a_huge_spin_still_curls() -> None:
+    # |ω|² overflowed to inf for a 1e200 rad/s spin, so ω̂ = ω/|ω| was 0 and the constant model did not curl.
+    huge = flight_at(20.0, kick(25.0, 15.0), np.array([0.0, 0.0, 1e200]))
+    assert (
+        huge.position[-1, 1]
+        == flight_at(20.0, kick(25.0, 15.0), np.array([0.0, 0.0, 1.0])).position[-1, 1]
+    )
+    assert huge.position[-1, 1] > 2.0
+
+
+# ------------------------------------------------------------------------------------------------ compiled cores
+WARM_CHECK = """
+import math, numpy as np
+from numba.core.registry import CPUDispatcher
+from kernels import ball
+
+cores = [f for f in vars(ball).values() if isinstance(f, CPUDispatcher)]
+ball.warm_up()
+before = sum(len(core.signatures) for core in cores)
+wall, goal = ball.free_kick_panels((0.0, 0.0), (20.0, 0.0), (1.0, 0.0))
+v = ball.launch_velocity(25.0, math.radians(15.0), 0.0)
+for method in ("euler", "rk4"):
+    for model in ("constant", "measured"):
+        for seed in (None, 3):
+            flight = ball.simulate((0, 0, 0.11), v, (0, 0, 50), method=method, model=model, knuckle_seed=seed)
+            ball.outcome(flight, wall, goal)
+            batch = ball.simulate_batch([(0, 0, 0.11)] * 3, [v] * 3, [(0, 0, 50)] * 3, method=method, model=model,
+                                        knuckle_seeds=[seed] * 3)
+            ball.outcome_batch(batch, wall, goal)
+            ball.simulate_outcomes([(0, 0, 0.11)] * 3, [v] * 3, [(0, 0, 50)] * 3, wall, goal, method=method,
+                                   model=model, knuckle_seeds=[seed] * 3, x_stop=21.0)
+ball._RESERVE_BYTES = 0
+ball.simulate_batch([(0, 0, 0.11)], [v], [(0, 0, 50)])
+print(before, sum(len(core.signatures) for core in cores))
+"""
+
+
+def test_after_warm_up_nothing_compiles() -> None:
+    # In a fresh process (loading numba's cache, or compiling once): every use of the public API afterwards runs
+    # code warm_up() already compiled, so the app's first page and first drag never wait for a compile.
+    result = subprocess.run(
+        [sys.executable, "-c", WARM_CHECK],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=600,
+        check=True,
+    )
+    before, after = map(int, result.stdout.split())
+    assert before > 0 and after == before
+
+
+def test_without_a_writable_cache_directory_the_cores_compile_uncached(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # numba refuses cache=True when neither the package's __pycache__ nor ~/.cache/numba is writable (checked by
+    # hand as user nobody with a read-only HOME): the module must still import, just compiling at every start.
+    calls: list[dict[str, object]] = []
+
+    def refusing_njit(**options: object):
+        calls.append(options)
+        if options.get("cache"):
+            raise RuntimeError("cannot cache function 'f': no locator available for file 'ball.py'")
+        return lambda function: function
+
+    monkeypatch.setattr(ball, "njit", refusing_njit)
+    monkeypatch.setattr(ball, "_UNCACHED", [])
+
+    def core() -> int:
+        return 7
+
+    assert ball._compiled(parallel=True)(core)() == 7
+    assert calls == [{"cache": True, "parallel": True}, {"parallel": True}]
+    assert ball._UNCACHED == ["core"]
+    monkeypatch.setattr(
+        ball, "njit", lambda **options: (_ for _ in ()).throw(RuntimeError("other failure"))
+    )
+    with pytest.raises(RuntimeError, match="other failure"):
+        ball._compiled()(core)
