@@ -140,9 +140,9 @@ def test_switching_from_a_browser(server: viser.ViserServer) -> None:
 def test_warm_kernels_runs_every_warm_up_on_one_daemon_thread(
     caplog: pytest.LogCaptureFixture,
 ) -> None:
-    from kernels import ball, fabrik
+    from kernels import ball, course, fabrik
 
-    assert inspect.signature(app.warm_kernels).parameters["modules"].default == (ball, fabrik)
+    assert inspect.signature(app.warm_kernels).parameters["modules"].default == (fabrik, ball, course)
     calls: list[tuple[str, threading.Thread]] = []
     failing, plain, warming = (types.ModuleType(name) for name in ("failing", "plain", "warming"))
 
