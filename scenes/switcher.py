@@ -1,4 +1,8 @@
-"""The scene switcher: a dropdown that tears the shown scene down completely and builds the chosen one."""
+"""The scene switcher: a dropdown that tears the shown scene down completely and builds the chosen one.
+
+One switcher serves one :class:`~scenes._session.Session`: a browser tab's own (the default; each tab switches and
+resets only its own scene) or the server's, shared by every tab (``--shared``).
+"""
 
 from __future__ import annotations
 
@@ -8,25 +12,30 @@ import threading
 import viser
 
 from scenes import SCENES, Scene
+from scenes._session import Session
 
 logger = logging.getLogger(__name__)
 
 
 class SceneSwitcher:
-    """Owns the one live scene on ``server`` and the dropdown that picks it."""
+    """Owns the one live scene of a session and the dropdown that picks it.
 
-    def __init__(self, server: viser.ViserServer, initial: str) -> None:
+    Given a plain ``viser.ViserServer`` it serves the server's shared session.
+    """
+
+    def __init__(self, server: viser.ViserServer | Session, initial: str) -> None:
         if initial not in SCENES:
             raise ValueError(f"scene must be one of {sorted(SCENES)}, got {initial!r}")
-        self.server = server
+        session = server if isinstance(server, Session) else Session.shared(server)
+        self.server = session
         self._lock = threading.RLock()
         titles = {cls.title: key for key, cls in SCENES.items()}
         self._key_from_title = titles
-        self.dropdown = server.gui.add_dropdown(
+        self.dropdown = session.gui.add_dropdown(
             "Scene", options=tuple(titles), initial_value=SCENES[initial].title, order=-100.0
         )
-        self.reset_button = server.gui.add_button("Reset scene to defaults", order=-99.0)
-        self.scene: Scene = SCENES[initial](server)
+        self.reset_button = session.gui.add_button("Reset scene to defaults", order=-99.0)
+        self.scene: Scene = SCENES[initial](session)
         self.dropdown.on_update(self._on_pick)
         self.reset_button.on_click(self._on_reset)
 
