@@ -3,6 +3,7 @@
 python app.py                      # http://127.0.0.1:8080, peloton first
 python app.py --scene peloton --port 8090
 python app.py --host 0.0.0.0       # exposes the server to the network: read the warning it prints
+python app.py --shared             # one scene for every browser tab (presenting to a room)
 """
 
 from __future__ import annotations
@@ -14,6 +15,8 @@ import tyro
 import viser
 
 from scenes import SceneName
+from scenes._gate import install_gate
+from scenes._session import Sessions
 from scenes.switcher import SceneSwitcher
 
 logger = logging.getLogger("app")
@@ -40,13 +43,25 @@ def exposure_warning(host: str, port: int) -> str | None:
     )
 
 
-def main(scene: SceneName = "peloton", host: str = "127.0.0.1", port: int = 8080) -> None:
+def serve_scenes(
+    server: viser.ViserServer, scene: SceneName, *, shared: bool
+) -> SceneSwitcher | Sessions:
+    """Put the scenes on ``server``: one switcher for every tab (``shared``), or one per tab, built as it connects."""
+    install_gate(server)
+    return SceneSwitcher(server, scene) if shared else Sessions(server, scene)
+
+
+def main(
+    scene: SceneName = "peloton", host: str = "127.0.0.1", port: int = 8080, shared: bool = False
+) -> None:
     """Serve the physics scenes in the browser.
 
     Args:
         scene: which scene opens first.
         host: address to bind; the default accepts connections from this machine only.
         port: TCP port to bind.
+        shared: one scene for every browser tab (a switch or Reset in one tab changes it for all); by default each
+            tab has its own scene.
     """
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s %(levelname)s %(message)s")
     warning = exposure_warning(host, port)
@@ -54,7 +69,7 @@ def main(scene: SceneName = "peloton", host: str = "127.0.0.1", port: int = 8080
         print(warning, flush=True)
     server = viser.ViserServer(host=host, port=port, label="Physics scenes")
     server.gui.configure_theme(control_width="large")
-    SceneSwitcher(server, scene)
+    serve_scenes(server, scene, shared=shared)
     shown_host = "127.0.0.1" if host in ("0.0.0.0", "::") else host
     print(
         f"Open http://{shown_host}:{server.get_port()} in a browser (Ctrl+C to stop).", flush=True

@@ -21,7 +21,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def test_defaults_bind_loopback_port_8080_and_open_peloton() -> None:
     defaults = {name: p.default for name, p in inspect.signature(app.main).parameters.items()}
-    assert defaults == {"scene": "peloton", "host": "127.0.0.1", "port": 8080}
+    assert defaults == {"scene": "peloton", "host": "127.0.0.1", "port": 8080, "shared": False}
 
 
 @pytest.mark.parametrize("host", ["127.0.0.1", "localhost", "::1", "127.0.0.2"])
@@ -44,7 +44,7 @@ def test_cli_help_lists_scene_host_and_port() -> None:
         timeout=60,
         check=True,
     )
-    for flag in ("--scene", "--host", "--port"):
+    for flag in ("--scene", "--host", "--port", "--shared"):
         assert flag in result.stdout
     for key in SCENES:
         assert key in result.stdout

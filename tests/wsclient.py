@@ -188,6 +188,19 @@ class BrowserClient:
             raise KeyError(f"no GUI element labelled {label!r}; have {sorted(self.labels())}")
         return uuid
 
+    def value_at(self, uuid: str) -> Any:
+        """The value this browser shows for the GUI element ``uuid``."""
+        with self._lock:
+            return self.gui[uuid]["value"]
+
+    def pose_of(self, name: str) -> tuple[tuple[float, ...], tuple[float, ...]]:
+        """(position, wxyz) this browser shows for the node ``name`` (viser's defaults where never sent)."""
+        with self._lock:
+            node = self.nodes[name]
+            position = node.get("position", (0.0, 0.0, 0.0))
+            wxyz = node.get("wxyz", (1.0, 0.0, 0.0, 0.0))
+        return tuple(float(v) for v in position), tuple(float(v) for v in wxyz)
+
     def labels(self) -> Iterable[str]:
         with self._lock:
             return [str(element["props"].get("label")) for element in self.gui.values()]
@@ -241,14 +254,17 @@ class BrowserClient:
     def drag_transform(
         self,
         name: str,
-        positions: Iterable[tuple[float, float, float]],
-        wxyz: tuple[float, float, float, float] = (1.0, 0.0, 0.0, 0.0),
+        positions: Iterable[Any],
+        wxyz: Any = (1.0, 0.0, 0.0, 0.0),
         period_s: float = 0.0,
     ) -> None:
         """Drag the transform-controls gizmo ``name`` through ``positions`` (parent frame), as a mouse drag does."""
         owner = str(self.wait_for_node(name).get("owner", "") or "")
         self.send("TransformControlsDragStartMessage", name=name, owner=owner)
         for position in positions:
+            with self._lock:  # the browser shows the gizmo where the mouse put it, as the real one does
+                self.nodes[name]["position"] = position
+                self.nodes[name]["wxyz"] = wxyz
             self.send(
                 "TransformControlsUpdateMessage",
                 name=name,
