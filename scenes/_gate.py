@@ -25,6 +25,7 @@ per-connection dispatch, the GUI and gizmo registries, and the frame decoder.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import logging
 import math
 import threading
@@ -207,11 +208,20 @@ def clean_value(spec: ControlSpec, value: object) -> tuple[bool, Any, str]:
             number = _finite_number(value)
             if number is None:
                 return False, None, "a number that is not finite or not a number"
+            if spec.integer:
+                # truncated, as viser's own cast to the control's int type does, then kept to the integers in range
+                lo = None if spec.lo is None else math.ceil(spec.lo)
+                hi = None if spec.hi is None else math.floor(spec.hi)
+                if lo is not None and hi is not None and lo > hi:
+                    return False, None, "a number for a control whose range holds no integer"
+                whole = int(number)
+                whole = whole if lo is None else max(whole, lo)
+                return True, (whole if hi is None else min(whole, hi)), ""
             if spec.lo is not None:
                 number = max(number, spec.lo)
             if spec.hi is not None:
                 number = min(number, spec.hi)
-            return True, (round(number) if spec.integer else number), ""
+            return True, number, ""
         case "choice":
             if isinstance(value, str) and value in spec.options:
                 return True, value, ""
@@ -404,12 +414,14 @@ class Gate:
         if not accepted:
             label = str(getattr(handle, "label", "?"))
             self.log.refuse(f"GUI value ({reason})", f"{label!r} got {updates['value']!r}"[:200])
-            return None, lambda: _send_value(
-                handle
-            )  # the sender shows its own edit: tell it the server's value
-        return _messages.GuiUpdateMessage(message.uuid, {"value": value}), lambda: _send_value(
-            handle
-        )
+        # After each change, and after each refusal (the sender shows its own edit), every viewer is sent the
+        # server's value: two viewers that moved one slider a few ms apart both end on the server's.
+        send_back = functools.partial(_send_value, handle)
+        if not accepted:
+            label = str(getattr(handle, "label", "?"))
+            self.log.refuse(f"GUI value ({reason})", f"{label!r} got {updates['value']!r}"[:200])
+            return None, send_back
+        return _messages.GuiUpdateMessage(message.uuid, {"value": value}), send_back
 
     def _gizmo_handle(
         self, server: viser.ViserServer, client_id: int, name: str, owner: str
@@ -451,7 +463,7 @@ class Gate:
             position=position if position is not None else last_position,
             wxyz=wxyz if wxyz is not None else last_wxyz,
         )
-        return cleaned, lambda: _send_pose(handle)
+        return cleaned, functools.partial(_send_pose, handle)
 
     def _clean_camera(
         self, server: viser.ViserServer, client_id: int, message: _messages.ViewerCameraMessage

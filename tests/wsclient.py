@@ -176,10 +176,14 @@ class BrowserClient:
 
     # ------------------------------------------------------------------------------------------ GUI
     def _find(self, label: str) -> str | None:
+        """The uuid of the element labelled ``label``; a control before a folder of the same name."""
+        found = None
         for uuid, element in self.gui.items():
             if element["props"].get("label") == label:
-                return uuid
-        return None
+                if element["type"] != "GuiFolderMessage":
+                    return uuid
+                found = found or uuid
+        return found
 
     def uuid_of(self, label: str) -> str:
         with self._lock:
@@ -262,7 +266,9 @@ class BrowserClient:
         owner = str(self.wait_for_node(name).get("owner", "") or "")
         self.send("TransformControlsDragStartMessage", name=name, owner=owner)
         for position in positions:
-            with self._lock:  # the browser shows the gizmo where the mouse put it, as the real one does
+            with (
+                self._lock
+            ):  # the browser shows the gizmo where the mouse put it, as the real one does
                 self.nodes[name]["position"] = position
                 self.nodes[name]["wxyz"] = wxyz
             self.send(
