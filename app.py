@@ -16,7 +16,7 @@ import viser
 
 from scenes import SceneName
 from scenes._gate import install_gate
-from scenes._session import Sessions
+from scenes._session import Sessions, limit_malloc_arenas
 from scenes.switcher import SceneSwitcher
 
 logger = logging.getLogger("app")
@@ -47,6 +47,7 @@ def serve_scenes(
     server: viser.ViserServer, scene: SceneName, *, shared: bool
 ) -> SceneSwitcher | Sessions:
     """Put the scenes on ``server``: one switcher for every tab (``shared``), or one per tab, built as it connects."""
+    limit_malloc_arenas()
     install_gate(server)
     return SceneSwitcher(server, scene) if shared else Sessions(server, scene)
 

@@ -82,6 +82,14 @@ class Scene(abc.ABC):
             self.root.remove()
             self.gui_root.remove()
 
+    def join(self, timeout_s: float) -> bool:
+        """After :meth:`close`, wait up to ``timeout_s`` for the scene's threads (a job in flight finishes first);
+        True when all have ended."""
+        deadline = time.monotonic() + timeout_s
+        for thread in self._threads:
+            thread.join(timeout=max(0.0, deadline - time.monotonic()))
+        return not any(thread.is_alive() for thread in self._threads)
+
     @property
     def closed(self) -> bool:
         return self._stop.is_set()

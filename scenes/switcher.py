@@ -31,13 +31,15 @@ class SceneSwitcher:
         self._lock = threading.RLock()
         titles = {cls.title: key for key, cls in SCENES.items()}
         self._key_from_title = titles
-        self.dropdown = session.gui.add_dropdown(
-            "Scene", options=tuple(titles), initial_value=SCENES[initial].title, order=-100.0
-        )
-        self.reset_button = session.gui.add_button("Reset scene to defaults", order=-99.0)
-        self.scene: Scene = SCENES[initial](session)
-        self.dropdown.on_update(self._on_pick)
-        self.reset_button.on_click(self._on_reset)
+        # Callbacks first, under the lock: a pick made while the first scene builds waits for it, then applies.
+        with self._lock:
+            self.dropdown = session.gui.add_dropdown(
+                "Scene", options=tuple(titles), initial_value=SCENES[initial].title, order=-100.0
+            )
+            self.reset_button = session.gui.add_button("Reset scene to defaults", order=-99.0)
+            self.dropdown.on_update(self._on_pick)
+            self.reset_button.on_click(self._on_reset)
+            self.scene: Scene = SCENES[initial](session)
 
     def show(self, key: str, *, rebuild: bool = False) -> Scene:
         """Replace the current scene with ``key``'s; when it is already shown, only ``rebuild`` rebuilds it."""
@@ -52,20 +54,22 @@ class SceneSwitcher:
             return self.scene
 
     def _on_pick(self, _event: object) -> None:
-        key = self._key_from_title.get(str(self.dropdown.value))
-        if key is None:  # not one of ours: a crafted message; show what is really on screen
-            self.dropdown.value = self.scene.title
-            return
-        try:
-            self.show(key)
-        except Exception:
-            logger.exception("switching to %s failed", key)
+        with self._lock:
+            key = self._key_from_title.get(str(self.dropdown.value))
+            if key is None:  # not one of ours: a crafted message; show what is really on screen
+                self.dropdown.value = self.scene.title
+                return
+            try:
+                self.show(key)
+            except Exception:
+                logger.exception("switching to %s failed", key)
 
     def _on_reset(self, _event: object) -> None:
-        try:
-            self.show(self.scene.key, rebuild=True)
-        except Exception:
-            logger.exception("resetting %s failed", self.scene.key)
+        with self._lock:
+            try:
+                self.show(self.scene.key, rebuild=True)
+            except Exception:
+                logger.exception("resetting %s failed", self.scene.key)
 
     def close(self) -> None:
         with self._lock:
