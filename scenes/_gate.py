@@ -411,9 +411,6 @@ class Gate:
             return None, None
         spec = control_spec(handle)
         accepted, value, reason = clean_value(spec, updates["value"])
-        if not accepted:
-            label = str(getattr(handle, "label", "?"))
-            self.log.refuse(f"GUI value ({reason})", f"{label!r} got {updates['value']!r}"[:200])
         # After each change, and after each refusal (the sender shows its own edit), every viewer is sent the
         # server's value: two viewers that moved one slider a few ms apart both end on the server's.
         send_back = functools.partial(_send_value, handle)
