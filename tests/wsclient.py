@@ -282,6 +282,21 @@ class BrowserClient:
                 time.sleep(period_s)
         self.send("TransformControlsDragEndMessage", name=name, owner=owner)
 
+    def drag_transform_step(
+        self,
+        name: str,
+        position: Any,
+        owner: str,
+        wxyz: Any = (1.0, 0.0, 0.0, 0.0),
+    ) -> None:
+        """One move of a drag already started (``TransformControlsDragStartMessage``), as a mouse move sends."""
+        with self._lock:
+            self.nodes[name]["position"] = position
+            self.nodes[name]["wxyz"] = wxyz
+        self.send(
+            "TransformControlsUpdateMessage", name=name, wxyz=wxyz, position=position, owner=owner
+        )
+
     def click_scene(
         self, ray_origin: tuple[float, float, float], ray_direction: tuple[float, float, float]
     ) -> None:
