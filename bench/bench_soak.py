@@ -5,8 +5,8 @@
 
 For each mode and scene it starts ``app.py`` in its own process (``--shared`` for the shared mode) and N fake
 browsers (``tests/wsclient.py``), each in its own process. Each browser moves its scene's main input at ``rate``
-messages per second for ``seconds``: the peloton's speed slider, the arm's target gizmo, the free kick's spin
-slider, the SDF gallery's second primitive's gizmo. It prints:
+messages per second for ``seconds``: the peloton's speed slider, the arm's target gizmo, the free kick's launch
+speed slider, the SDF gallery's second primitive's gizmo. It prints:
 
 - the app's RSS over the run (every 10 s) and its slope after the first minute (after the first third on runs
   shorter than three minutes), in MiB/min;
@@ -42,7 +42,7 @@ from wsclient import BrowserClient  # noqa: E402
 
 MIB = 1024 * 1024
 GOAL_P95_MS = {"peloton": 50.0, "arm": 50.0, "freekick": 50.0, "sdf": 150.0}
-SLIDERS = {"peloton": ("Speed (km/h)", 20.0, 60.0), "freekick": ("Spin rate (rev/s)", 1.0, 14.0)}
+SLIDERS = {"peloton": ("Speed (km/h)", 20.0, 60.0), "freekick": ("Launch speed (m/s)", 20.0, 32.0)}
 GIZMOS = {"arm": ("/arm/target", 0.35), "sdf": ("/sdf/gizmo_2", 0.15)}
 """Gizmo name and the radius (m) of the circle each browser drags it round."""
 

@@ -61,6 +61,7 @@ ALLOWED_MESSAGES: tuple[type[_messages.Message], ...] = (
     _messages.GetRenderResponseMessage,
 )
 """The only message types a browser may send this app; any other (share-URL requests, uploads...) is refused."""
+_ALLOWED_BY_NAME = {cls.__name__: cls for cls in ALLOWED_MESSAGES}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -273,6 +274,36 @@ def _camera_fields(message: _messages.ViewerCameraMessage) -> dict[str, Any] | N
     }
 
 
+def _ray(origin: object, direction: object) -> bool:
+    d = _finite_vector(direction, 3)
+    return _finite_vector(origin, 3) is not None and d is not None and math.hypot(*d) > 0.0
+
+
+def click_problem(message: _messages.ScenePointerMessage | _messages.SceneNodeClickMessage) -> str:
+    """Why a click cannot be used ("" when it can): rays are 3 finite numbers, screen points 2."""
+    if isinstance(message, _messages.ScenePointerMessage):
+        if message.event_type not in ("click", "rect-select"):
+            return "an unknown pointer event"
+        if (message.ray_origin is None) != (message.ray_direction is None):
+            return "half a ray"
+        if message.ray_origin is not None and not _ray(message.ray_origin, message.ray_direction):
+            return "a ray that is not finite"
+        points = message.screen_pos
+        if not isinstance(points, (list, tuple)) or not 1 <= len(points) <= 2:
+            return "screen points that are not one or two"
+        if any(_finite_vector(point, 2) is None for point in points):
+            return "a screen point that is not two finite numbers"
+        return ""
+    index = message.instance_index
+    if index is not None and (type(index) is not int or index < 0):
+        return "an instance index that is not a count"
+    if not _ray(message.ray_origin, message.ray_direction):
+        return "a ray that is not finite"
+    if _finite_vector(message.screen_pos, 2) is None:
+        return "a screen point that is not two finite numbers"
+    return ""
+
+
 # ------------------------------------------------------------------------------------------------ frames
 def decode_frame(raw: object) -> _messages.Message | None:
     """The message in one browser frame, or None (logged) when it is not one this app accepts."""
@@ -288,8 +319,7 @@ def decode_frame(raw: object) -> _messages.Message | None:
         refusals.refuse("malformed frame", str(error))
         return None
     kind = mapping.get("type") if isinstance(mapping, dict) else None
-    allowed = {cls.__name__: cls for cls in ALLOWED_MESSAGES}
-    if not isinstance(kind, str) or kind not in allowed:
+    if not isinstance(kind, str) or kind not in _ALLOWED_BY_NAME:
         refusals.refuse("message type", f"{str(kind)[:80]!r} is not one a browser may send")
         return None
     try:
@@ -303,7 +333,7 @@ def decode_frame(raw: object) -> _messages.Message | None:
     ) as error:  # the frame's fields do not fit the message: refused, the connection stays up
         refusals.refuse(f"malformed {kind}", f"{type(error).__name__}: {error}")
         return None
-    return message if isinstance(message, allowed[kind]) else None
+    return message if isinstance(message, _ALLOWED_BY_NAME[kind]) else None
 
 
 async def _gated_message_consumer(
@@ -382,6 +412,17 @@ class Gate:
             return self._clean_gizmo(server, client_id, message)
         if isinstance(message, _messages.ViewerCameraMessage):
             return self._clean_camera(server, client_id, message), None
+        if isinstance(message, _messages.TransformControlsDragEndMessage):
+            # A drag ends: every viewer, the dragging one too, is sent the gizmo's pose on the server (during the
+            # drag the sender is not, so its own gizmo does not fight the mouse).
+            handle = self._gizmo_handle(server, client_id, str(message.name), str(message.owner))
+            return message, None if handle is None else functools.partial(_send_pose, handle)
+        if isinstance(message, (_messages.ScenePointerMessage, _messages.SceneNodeClickMessage)):
+            reason = click_problem(message)
+            if reason:
+                self.log.refuse(f"click ({reason})", f"{type(message).__name__}")
+                return None, None
+            return message, None
         if isinstance(message, ALLOWED_MESSAGES):
             return message, None
         self.log.refuse("message type", f"{type(message).__name__} is not one a browser may send")

@@ -242,6 +242,35 @@ def hostile_barrage(attacker: BrowserClient, server: viser.ViserServer) -> int:
         wxyz=(1, 0, 0, 0),
         position=(0, 0, 0),
     )
+    bad_rays: list[Any] = [(NAN, 0.0, 1.0), (0.0, INF, 1.0), (0.0, 0.0), "up", None]
+    for ray in bad_rays:
+        attacker.send(
+            "ScenePointerMessage",
+            event_type="click",
+            ray_origin=ray,
+            ray_direction=(1.0, 0.0, 0.0),
+            screen_pos=((0.5, 0.5),),
+            modifier=None,
+        )
+        attacker.send(
+            "ScenePointerMessage",
+            event_type="click",
+            ray_origin=(0.0, 0.0, 1.0),
+            ray_direction=ray if ray is not None else (0.0, 0.0, 0.0),
+            screen_pos=((NAN, 0.5),),
+            modifier=None,
+        )
+        for name in list(attacker.nodes):
+            attacker.send(
+                "SceneNodeClickMessage",
+                name=name,
+                instance_index=-1 if ray is None else None,
+                ray_origin=ray,
+                ray_direction=(1.0, 0.0, 0.0),
+                screen_pos=(0.5, 0.5),
+                modifier=None,
+            )
+        sent += 2 + len(attacker.nodes)
     for camera in bad_cameras():
         attacker.send("ViewerCameraMessage", **camera)
         sent += 1

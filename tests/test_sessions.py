@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import ctypes
 import gc
+import math
 import os
 import re
 import socket
@@ -21,12 +22,13 @@ from pathlib import Path
 
 import pytest
 import viser
-from viser_private import node_names
+from viser_private import gizmos, node_names
 from wsclient import BrowserClient
 
 from app import serve_scenes
 from scenes import SCENES
 from scenes._session import Sessions
+from scenes.arm import MAX_LINKS
 from scenes.sdf_gallery import SdfGalleryScene
 from scenes.switcher import SceneSwitcher
 
@@ -69,7 +71,7 @@ def test_each_tab_switches_and_resets_only_its_own_scene(
 
         a.set_value("Scene", SCENES["arm"].title)
         a.wait_for(lambda: "/arm" in a.nodes and "/peloton" not in a.nodes, what="A shows the arm")
-        assert mine.scene.key == "arm"
+        a.wait_for(lambda: mine.scene.key == "arm", what="A's session holds the arm")
         assert theirs.scene is their_scene and their_scene.key == "peloton"
         assert "/arm" not in b.nodes and "/peloton" in b.nodes
         assert b.value_of("Scene") == SCENES["peloton"].title
@@ -84,6 +86,47 @@ def test_each_tab_switches_and_resets_only_its_own_scene(
         b.wait_for(lambda: their_scene.params.speed_kmh == 21.0, what="B's own edit")  # type: ignore[attr-defined]
         # Nothing is on the server's shared scene: each tab's nodes are its own.
         assert not [name for name in node_names(server) if name.startswith(("/peloton", "/arm"))]
+
+
+def test_the_gate_guards_a_tabs_own_controls_and_gizmos(
+    server: viser.ViserServer, sessions: Sessions, caplog: pytest.LogCaptureFixture
+) -> None:
+    """Client-scoped handles go through the same gate: crafted fields, NaN, a bad quaternion, a 2-vector."""
+    a, mine = connect(server, sessions)
+    with a:
+        a.set_value("Scene", SCENES["arm"].title)
+        a.wait_for(lambda: mine.scene.key == "arm", what="A shows the arm")
+        scene = mine.scene
+        target = a.wait_for_node("/arm/target")
+        assert target.get("owner"), "a tab's own gizmo carries its owner"
+        links = a.wait_for_gui("Links")
+        a.send("GuiUpdateMessage", uuid=links, updates={"props": {}})
+        a.send("GuiUpdateMessage", uuid=links, updates={"removed": True})
+        a.set_value("Links", float("nan"))
+        a.set_value("Links", 40)
+        a.drag_transform("/arm/target", [(0.1, 0.2)], wxyz=(1.0, 0.0, 0.0))
+        a.drag_transform("/arm/target", [(float("nan"), 0.0, 0.5)], wxyz=(0.0, 0.0, 0.0, 0.0))
+        a.set_value("Max iterations", 77)
+        a.wait_for(lambda: scene.params.max_iterations == 77, what="the honest edit")  # type: ignore[attr-defined]
+        a.wait_for(
+            lambda: a.value_of("Links") == MAX_LINKS, what="Links clamped to its declared max"
+        )
+        assert scene.params.n_links == MAX_LINKS  # type: ignore[attr-defined]
+        assert "Links" in a.labels()
+        handle = gizmos(mine.server.scene)["/arm/target"]
+        a.wait_for(
+            lambda: a.pose_of("/arm/target")[0] == tuple(float(v) for v in handle.position),
+            what="the tab shown its gizmo's last good pose",
+        )
+        assert all(math.isfinite(v) for v in handle.position)
+        kinds = {
+            str(r.args[0])
+            for r in caplog.records
+            if r.name == "scenes._gate" and isinstance(r.args, tuple)
+        }
+        assert "GUI update of a field other than value" in kinds
+        assert any("gizmo position" in kind for kind in kinds)
+        assert any("gizmo orientation" in kind for kind in kinds)
 
 
 def test_a_closed_tab_frees_its_session(server: viser.ViserServer, sessions: Sessions) -> None:
