@@ -30,6 +30,7 @@ import socket
 import statistics
 import subprocess
 import sys
+import tempfile
 import threading
 import time
 from pathlib import Path
@@ -174,37 +175,30 @@ def soak(mode: str, scene: str, clients: int, rate: float, seconds: float) -> di
     reader.start()
     samples: list[tuple[float, float]] = []
     try:
-        browsers = [
+        outputs = [tempfile.NamedTemporaryFile("r", suffix=".json") for _ in range(clients)]
+        browsers = [  # results go to files: a pipe would fill (64 KiB) and block the browser before it exits
             subprocess.Popen(
-                [
-                    sys.executable,
-                    __file__,
-                    "--client",
-                    str(port),
-                    scene,
-                    str(rate),
-                    str(seconds),
-                    str(i),
-                ],
+                [sys.executable, __file__, "--client", str(port), scene, str(rate), str(seconds)]
+                + [str(i), out.name],
                 cwd=ROOT,
-                stdout=subprocess.PIPE,
+                stdout=subprocess.DEVNULL,
                 stderr=subprocess.DEVNULL,
-                text=True,
             )
-            for i in range(clients)
+            for i, out in enumerate(outputs)
         ]
         start = time.monotonic()
         while any(b.poll() is None for b in browsers):
             samples.append((time.monotonic() - start, rss_mib(app.pid)))
             time.sleep(2.0)
         results = []
-        for b in browsers:
-            out = (b.stdout.read() if b.stdout else "").strip().splitlines()
+        for out in outputs:
+            text = out.read().strip()
             results.append(
-                json.loads(out[-1])
-                if out
+                json.loads(text)
+                if text
                 else {"errors": ["no result"], "latencies_ms": [], "sent": 0}
             )
+            out.close()
         converged = check_convergence(mode, scene, port, results)
         samples.append((time.monotonic() - start, rss_mib(app.pid)))
     finally:
@@ -259,8 +253,9 @@ def _same(a: Any, b: Any) -> bool:
 
 def main() -> None:
     if len(sys.argv) > 1 and sys.argv[1] == "--client":
-        port, scene, rate, seconds, index = sys.argv[2:7]
-        print(json.dumps(run_client(int(port), scene, float(rate), float(seconds), int(index))))
+        port, scene, rate, seconds, index, out_path = sys.argv[2:8]
+        result = run_client(int(port), scene, float(rate), float(seconds), int(index))
+        Path(out_path).write_text(json.dumps(result))
         return
     parser = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
     parser.add_argument("--clients", type=int, default=8)
