@@ -8,8 +8,8 @@ browsers (``tests/wsclient.py``), each in its own process. Each browser moves it
 messages per second for ``seconds``: the peloton's speed slider, the arm's target gizmo, the free kick's launch
 speed slider, the SDF gallery's second primitive's gizmo. It prints:
 
-- the app's RSS over the run (every 10 s) and its slope after the first minute (after the first third on runs
-  shorter than three minutes), in MiB/min;
+- the app's RSS over the run (every 10 s; the last figure is after the browsers closed) and its slope while they
+  ran, after the first minute (after the first third on runs shorter than three minutes), in MiB/min;
 - p50 and p95 from a message to the next scene update the sender receives (in the shared mode another browser's
   change can bring that update: the figure is a lower bound there);
 - errors: browser exceptions, connections the server closed, and ERROR or Traceback lines in the app's log;
@@ -199,8 +199,9 @@ def soak(mode: str, scene: str, clients: int, rate: float, seconds: float) -> di
                 else {"errors": ["no result"], "latencies_ms": [], "sent": 0}
             )
             out.close()
+        slope = slope_mib_per_min(samples, min(60.0, seconds / 3.0))  # while the browsers ran
         converged = check_convergence(mode, scene, port, results)
-        samples.append((time.monotonic() - start, rss_mib(app.pid)))
+        samples.append((time.monotonic() - start, rss_mib(app.pid)))  # after they closed
     finally:
         app.terminate()
         app.wait(timeout=30)
@@ -217,7 +218,7 @@ def soak(mode: str, scene: str, clients: int, rate: float, seconds: float) -> di
         "errors": errors,
         "converged": converged,
         "samples": samples,
-        "slope": slope_mib_per_min(samples, min(60.0, seconds / 3.0)),
+        "slope": slope,
     }
 
 
