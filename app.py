@@ -3,6 +3,7 @@
 python app.py                      # http://127.0.0.1:8080, peloton first
 python app.py --scene peloton --port 8090
 python app.py --host 0.0.0.0       # exposes the server to the network: read the warning it prints
+python app.py --shared             # one scene for every browser tab (presenting to a room)
 """
 
 from __future__ import annotations
@@ -18,6 +19,8 @@ import viser
 
 from kernels import ball, course, fabrik
 from scenes import SceneName
+from scenes._gate import install_gate
+from scenes._session import Sessions, limit_malloc_arenas
 from scenes.sdf_gallery import set_editing_allowed
 from scenes.switcher import SceneSwitcher
 
@@ -75,11 +78,21 @@ def warm_kernels(modules: tuple[ModuleType, ...] = (fabrik, ball, course)) -> th
     return thread
 
 
+def serve_scenes(
+    server: viser.ViserServer, scene: SceneName, *, shared: bool
+) -> SceneSwitcher | Sessions:
+    """Put the scenes on ``server``: one switcher for every tab (``shared``), or one per tab, built as it connects."""
+    limit_malloc_arenas()
+    install_gate(server)
+    return SceneSwitcher(server, scene) if shared else Sessions(server, scene)
+
+
 def main(
     scene: SceneName = "peloton",
     host: str = "127.0.0.1",
     port: int = 8080,
     allow_remote_glsl: bool = False,
+    shared: bool = False,
 ) -> None:
     """Serve the physics scenes in the browser.
 
@@ -88,6 +101,8 @@ def main(
         host: address to bind; the default accepts connections from this machine only.
         port: TCP port to bind.
         allow_remote_glsl: with a non-loopback host, still let browsers type GLSL into the SDF gallery's editor.
+        shared: one scene for every browser tab (a switch or Reset in one tab changes it for all); by default each
+            tab has its own scene.
     """
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s %(levelname)s %(message)s")
     set_editing_allowed(is_loopback(host) or allow_remote_glsl)
@@ -97,7 +112,7 @@ def main(
     warm_kernels()
     server = viser.ViserServer(host=host, port=port, label="Physics scenes")
     server.gui.configure_theme(control_width="large")
-    SceneSwitcher(server, scene)
+    serve_scenes(server, scene, shared=shared)
     shown_host = "127.0.0.1" if host in ("0.0.0.0", "::") else host
     print(
         f"Open http://{shown_host}:{server.get_port()} in a browser (Ctrl+C to stop).", flush=True

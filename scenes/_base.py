@@ -4,11 +4,15 @@ A scene owns every viser handle it creates. It puts its 3D nodes under the frame
 folder, so :meth:`Scene.close` removes everything with two calls (viser cascades removal to children) and stops
 any thread the scene started.
 
-Every value a browser sends is untrusted: a crafted client can send NaN, a number outside a slider's range, or an
-option that is not in a dropdown. Scenes read GUI values only through :meth:`Scene.read_number`,
-:meth:`Scene.read_choice` and :meth:`Scene.read_bool`, which clamp or fall back to the last good value and write the
-cleaned value back to the GUI, and wrap every callback in :meth:`Scene.callback`, which serialises callbacks (viser
-runs plain callbacks on a thread pool) and logs, rather than raises, anything that goes wrong.
+A scene is built on a :class:`~scenes._session.Session` (one browser tab's scene and GUI, or the server's, shared);
+given a plain ``viser.ViserServer`` it builds on the shared session of that server.
+
+Every value a browser sends is untrusted. The gate (:mod:`scenes._gate`) lets only a control's value, a gizmo's pose
+and a camera through, already checked against the control's recorded spec. Scenes still read GUI values only through
+:meth:`Scene.read_number`, :meth:`Scene.read_choice` and :meth:`Scene.read_bool`, which clamp to the recorded spec
+(never to a handle's props) or fall back to the last good value and write the cleaned value back, and wrap every
+callback in :meth:`Scene.callback`, which serialises callbacks (viser runs plain callbacks on a thread pool) and
+logs, rather than raises, anything that goes wrong.
 """
 
 from __future__ import annotations
@@ -19,67 +23,21 @@ import logging
 import math
 import threading
 import time
-import weakref
 from collections.abc import Callable, Sequence
 from typing import Any, ClassVar, TypeVar
 
 import numpy as np
 import viser
 
+from scenes._gate import control_spec
+from scenes._session import Session
+from scenes._session import (
+    camera_hub as camera_hub,  # re-exported: tests and older callers import it from here
+)
+
 logger = logging.getLogger(__name__)
 
 T = TypeVar("T")
-
-
-class _CameraHub:
-    """One set of viser camera callbacks per server, forwarding to whichever scenes listen now.
-
-    viser 1.1.1 cannot remove an ``on_client_connect`` or camera callback, so a scene that registered its own would
-    stay reachable (and keep being called) after it closed; scenes subscribe here instead.
-    """
-
-    def __init__(self, server: viser.ViserServer) -> None:
-        self._listeners: list[Callable[[viser.CameraHandle], None]] = []
-        self._lock = threading.Lock()
-        for client in server.get_clients().values():
-            self._attach(client)
-        server.on_client_connect(self._attach)
-
-    def _attach(self, client: viser.ClientHandle) -> None:
-        client.camera.on_update(self._dispatch)
-        self._dispatch(client.camera)
-
-    def _dispatch(self, camera: viser.CameraHandle) -> None:
-        with self._lock:
-            listeners = list(self._listeners)
-        for listener in listeners:
-            listener(camera)
-
-    def add(self, listener: Callable[[viser.CameraHandle], None]) -> None:
-        with self._lock:
-            self._listeners.append(listener)
-
-    def remove(self, listener: Callable[[viser.CameraHandle], None]) -> None:
-        with self._lock:
-            self._listeners = [other for other in self._listeners if other is not listener]
-
-    @property
-    def listener_count(self) -> int:
-        with self._lock:
-            return len(self._listeners)
-
-
-_camera_hubs: weakref.WeakKeyDictionary[viser.ViserServer, _CameraHub] = weakref.WeakKeyDictionary()
-_camera_hubs_lock = threading.Lock()
-
-
-def camera_hub(server: viser.ViserServer) -> _CameraHub:
-    """The server's one camera hub, made on first use."""
-    with _camera_hubs_lock:
-        hub = _camera_hubs.get(server)
-        if hub is None:
-            hub = _camera_hubs[server] = _CameraHub(server)
-        return hub
 
 
 class Scene(abc.ABC):
@@ -96,33 +54,26 @@ class Scene(abc.ABC):
     camera_look_at: ClassVar[tuple[float, float, float]] = (0.0, 0.0, 0.5)
     """What the camera opens looking at (world frame, m)."""
 
-    def __init__(self, server: viser.ViserServer) -> None:
-        self.server = server
-        self.root = server.scene.add_frame(f"/{self.key}", show_axes=False)
-        self.gui_root = server.gui.add_folder(self.title)
+    def __init__(self, server: viser.ViserServer | Session) -> None:
+        session = server if isinstance(server, Session) else Session.shared(server)
+        self.server = session
+        """What the scene draws on: ``.scene``, ``.gui``, ``.atomic()``, ``.flush()`` (one tab's or everyone's)."""
+        self.root = session.scene.add_frame(f"/{self.key}", show_axes=False)
+        self.gui_root = session.gui.add_folder(self.title)
         self._lock = threading.RLock()
         self._in_callback = False
         self._stop = threading.Event()
         self._threads: list[threading.Thread] = []
         self._camera_listeners: list[Callable[[viser.CameraHandle], None]] = []
-        with self.gui_root, server.gui.add_folder("About", expand_by_default=False):
-            server.gui.add_markdown(self.about)
-        self._frame_camera()
-
-    def _frame_camera(self) -> None:
-        """Point new clients, and the ones already watching, at this scene."""
-        self.server.initial_camera.position = self.camera_position
-        self.server.initial_camera.look_at = self.camera_look_at
-        for client in self.server.get_clients().values():
-            with client.atomic():
-                client.camera.position = self.camera_position
-                client.camera.look_at = self.camera_look_at
+        with self.gui_root, session.gui.add_folder("About", expand_by_default=False):
+            session.gui.add_markdown(self.about)
+        session.frame_camera(self.camera_position, self.camera_look_at)
 
     # ----------------------------------------------------------------------------------------- lifecycle
     def close(self) -> None:
         """Stop the scene's threads and remove every node and GUI element it created."""
         self._stop.set()
-        hub = camera_hub(self.server)
+        hub = self.server.cameras
         for listener in self._camera_listeners:
             hub.remove(listener)
         for thread in self._threads:
@@ -131,13 +82,21 @@ class Scene(abc.ABC):
             self.root.remove()
             self.gui_root.remove()
 
+    def join(self, timeout_s: float) -> bool:
+        """After :meth:`close`, wait up to ``timeout_s`` for the scene's threads (a job in flight finishes first);
+        True when all have ended."""
+        deadline = time.monotonic() + timeout_s
+        for thread in self._threads:
+            thread.join(timeout=max(0.0, deadline - time.monotonic()))
+        return not any(thread.is_alive() for thread in self._threads)
+
     @property
     def closed(self) -> bool:
         return self._stop.is_set()
 
     def watch_cameras(self, listener: Callable[[viser.CameraHandle], None]) -> None:
         """Call ``listener`` with every client's camera now and whenever one moves, until :meth:`close`."""
-        camera_hub(self.server).add(listener)
+        self.server.cameras.add(listener)
         self._camera_listeners.append(listener)
         for client in self.server.get_clients().values():
             listener(client.camera)
@@ -182,7 +141,7 @@ class Scene(abc.ABC):
                     logger.exception(
                         "%s: callback %s failed; keeping the last good state",
                         self.key,
-                        func.__name__,
+                        _describe(func),
                     )
                 finally:
                     self._in_callback = False
@@ -191,19 +150,21 @@ class Scene(abc.ABC):
 
     # ----------------------------------------------------------------------------------------- inputs
     def read_number(self, handle: Any, last_good: float, *, integer: bool = False) -> float:
-        """The handle's value as a finite number clamped to its ``min``/``max``; ``last_good`` if it is not a number.
+        """The handle's value as a finite number clamped to the range the scene gave the control; ``last_good`` if
+        it is not a number.
 
+        The range is the control's recorded spec (:func:`scenes._gate.control_spec`), never the handle's props.
         The cleaned value is written back to the GUI so every browser shows what the scene uses.
         """
         raw = handle.value
         value = _as_finite(raw)
         if value is None:
             value = float(last_good)
-        lo, hi = getattr(handle, "min", None), getattr(handle, "max", None)
-        if lo is not None:
-            value = max(value, float(lo))
-        if hi is not None:
-            value = min(value, float(hi))
+        spec = control_spec(handle)
+        if spec.lo is not None:
+            value = max(value, spec.lo)
+        if spec.hi is not None:
+            value = min(value, spec.hi)
         if integer:
             value = float(round(value))
         if not _same(raw, value):
@@ -211,9 +172,13 @@ class Scene(abc.ABC):
         return value
 
     def read_choice(self, handle: Any, options: Sequence[T], last_good: T) -> T:
-        """The handle's value if it is one of ``options``, else ``last_good`` (written back)."""
+        """The handle's value if it is one of ``options`` and of the control's recorded options, else ``last_good``
+        (written back)."""
         raw = handle.value
+        recorded = control_spec(handle).options
         for option in options:
+            if recorded and option not in recorded:
+                continue
             if raw == option and type(raw) is type(option):
                 return option
         self._write_back(handle, last_good)
@@ -259,6 +224,13 @@ class Scene(abc.ABC):
             handle.value = value
         finally:
             self._in_callback = was
+
+
+def _describe(func: Callable[..., object]) -> str:
+    """A callback's name for the log: ``functools.partial`` and other callables have no ``__name__``."""
+    while isinstance(func, functools.partial):
+        func = func.func
+    return str(getattr(func, "__qualname__", None) or getattr(func, "__name__", None) or repr(func))
 
 
 def _as_finite(value: object) -> float | None:

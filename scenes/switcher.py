@@ -1,4 +1,8 @@
-"""The scene switcher: a dropdown that tears the shown scene down completely and builds the chosen one."""
+"""The scene switcher: a dropdown that tears the shown scene down completely and builds the chosen one.
+
+One switcher serves one :class:`~scenes._session.Session`: a browser tab's own (the default; each tab switches and
+resets only its own scene) or the server's, shared by every tab (``--shared``).
+"""
 
 from __future__ import annotations
 
@@ -8,27 +12,34 @@ import threading
 import viser
 
 from scenes import SCENES, Scene
+from scenes._session import Session
 
 logger = logging.getLogger(__name__)
 
 
 class SceneSwitcher:
-    """Owns the one live scene on ``server`` and the dropdown that picks it."""
+    """Owns the one live scene of a session and the dropdown that picks it.
 
-    def __init__(self, server: viser.ViserServer, initial: str) -> None:
+    Given a plain ``viser.ViserServer`` it serves the server's shared session.
+    """
+
+    def __init__(self, server: viser.ViserServer | Session, initial: str) -> None:
         if initial not in SCENES:
             raise ValueError(f"scene must be one of {sorted(SCENES)}, got {initial!r}")
-        self.server = server
+        session = server if isinstance(server, Session) else Session.shared(server)
+        self.server = session
         self._lock = threading.RLock()
         titles = {cls.title: key for key, cls in SCENES.items()}
         self._key_from_title = titles
-        self.dropdown = server.gui.add_dropdown(
-            "Scene", options=tuple(titles), initial_value=SCENES[initial].title, order=-100.0
-        )
-        self.reset_button = server.gui.add_button("Reset scene to defaults", order=-99.0)
-        self.scene: Scene = SCENES[initial](server)
-        self.dropdown.on_update(self._on_pick)
-        self.reset_button.on_click(self._on_reset)
+        # Callbacks first, under the lock: a pick made while the first scene builds waits for it, then applies.
+        with self._lock:
+            self.dropdown = session.gui.add_dropdown(
+                "Scene", options=tuple(titles), initial_value=SCENES[initial].title, order=-100.0
+            )
+            self.reset_button = session.gui.add_button("Reset scene to defaults", order=-99.0)
+            self.dropdown.on_update(self._on_pick)
+            self.reset_button.on_click(self._on_reset)
+            self.scene: Scene = SCENES[initial](session)
 
     def show(self, key: str, *, rebuild: bool = False) -> Scene:
         """Replace the current scene with ``key``'s; when it is already shown, only ``rebuild`` rebuilds it."""
@@ -43,20 +54,22 @@ class SceneSwitcher:
             return self.scene
 
     def _on_pick(self, _event: object) -> None:
-        key = self._key_from_title.get(str(self.dropdown.value))
-        if key is None:  # not one of ours: a crafted message; show what is really on screen
-            self.dropdown.value = self.scene.title
-            return
-        try:
-            self.show(key)
-        except Exception:
-            logger.exception("switching to %s failed", key)
+        with self._lock:
+            key = self._key_from_title.get(str(self.dropdown.value))
+            if key is None:  # not one of ours: a crafted message; show what is really on screen
+                self.dropdown.value = self.scene.title
+                return
+            try:
+                self.show(key)
+            except Exception:
+                logger.exception("switching to %s failed", key)
 
     def _on_reset(self, _event: object) -> None:
-        try:
-            self.show(self.scene.key, rebuild=True)
-        except Exception:
-            logger.exception("resetting %s failed", self.scene.key)
+        with self._lock:
+            try:
+                self.show(self.scene.key, rebuild=True)
+            except Exception:
+                logger.exception("resetting %s failed", self.scene.key)
 
     def close(self) -> None:
         with self._lock:

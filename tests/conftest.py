@@ -15,6 +15,7 @@ import pytest
 import viser
 from hypothesis import settings
 
+from scenes._gate import install_gate
 from scenes.switcher import SceneSwitcher
 
 IN_CI = os.environ.get("CI", "").lower() in ("1", "true", "yes")
@@ -44,8 +45,9 @@ def skip_or_fail(reason: str) -> None:
 
 @pytest.fixture
 def server() -> Iterator[viser.ViserServer]:
-    """A real ViserServer on a free loopback port."""
+    """A real ViserServer on a free loopback port, behind the app's message gate (as app.py puts it)."""
     srv = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
+    install_gate(srv)
     try:
         yield srv
     finally:
@@ -54,7 +56,7 @@ def server() -> Iterator[viser.ViserServer]:
 
 @pytest.fixture
 def switcher(server: viser.ViserServer) -> Iterator[SceneSwitcher]:
-    """The app's scene switcher on ``server``, showing the first scene."""
+    """The app's scene switcher on ``server``'s shared session (what every tab sees), showing the first scene."""
     app = SceneSwitcher(server, "peloton")
     try:
         yield app

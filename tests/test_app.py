@@ -29,6 +29,7 @@ def test_defaults_bind_loopback_port_8080_and_open_peloton() -> None:
         "host": "127.0.0.1",
         "port": 8080,
         "allow_remote_glsl": False,
+        "shared": False,
     }
 
 
@@ -60,7 +61,7 @@ def test_cli_help_lists_scene_host_and_port() -> None:
         timeout=60,
         check=True,
     )
-    for flag in ("--scene", "--host", "--port"):
+    for flag in ("--scene", "--host", "--port", "--shared"):
         assert flag in result.stdout
     for key in SCENES:
         assert key in result.stdout
@@ -142,7 +143,11 @@ def test_warm_kernels_runs_every_warm_up_on_one_daemon_thread(
 ) -> None:
     from kernels import ball, course, fabrik
 
-    assert inspect.signature(app.warm_kernels).parameters["modules"].default == (fabrik, ball, course)
+    assert inspect.signature(app.warm_kernels).parameters["modules"].default == (
+        fabrik,
+        ball,
+        course,
+    )
     calls: list[tuple[str, threading.Thread]] = []
     failing, plain, warming = (types.ModuleType(name) for name in ("failing", "plain", "warming"))
 

@@ -31,3 +31,23 @@ def gui_uuids(server: viser.ViserServer) -> set[str]:
 def gui_uuid(handle: object) -> str:
     """The uuid a browser uses to address ``handle`` in GuiUpdateMessage."""
     return handle._impl.uuid  # type: ignore[attr-defined]
+
+
+def gui_inputs(api: viser.GuiApi) -> dict[str, object]:
+    """Every GUI input handle of ``api`` (the server's or a client's GUI), by uuid."""
+    return dict(api._gui_input_handle_from_uuid)
+
+
+def gizmos(api: viser.SceneApi) -> dict[str, viser.TransformControlsHandle]:
+    """Every transform-controls handle of ``api`` (the server's or a client's scene), by node name."""
+    return dict(api._handle_from_transform_controls_name)
+
+
+def control_state(handle: object) -> dict[str, object]:
+    """What a browser must not be able to change about a control: its props, callbacks and liveness."""
+    impl = handle._impl  # type: ignore[attr-defined]
+    return {
+        "props": repr(impl.props),
+        "callbacks": len(impl.update_cb),
+        "removed": impl.removed,
+    }

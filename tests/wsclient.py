@@ -176,10 +176,14 @@ class BrowserClient:
 
     # ------------------------------------------------------------------------------------------ GUI
     def _find(self, label: str) -> str | None:
+        """The uuid of the element labelled ``label``; a control before a folder of the same name."""
+        found = None
         for uuid, element in self.gui.items():
             if element["props"].get("label") == label:
-                return uuid
-        return None
+                if element["type"] != "GuiFolderMessage":
+                    return uuid
+                found = found or uuid
+        return found
 
     def uuid_of(self, label: str) -> str:
         with self._lock:
@@ -187,6 +191,19 @@ class BrowserClient:
         if uuid is None:
             raise KeyError(f"no GUI element labelled {label!r}; have {sorted(self.labels())}")
         return uuid
+
+    def value_at(self, uuid: str) -> Any:
+        """The value this browser shows for the GUI element ``uuid``."""
+        with self._lock:
+            return self.gui[uuid]["value"]
+
+    def pose_of(self, name: str) -> tuple[tuple[float, ...], tuple[float, ...]]:
+        """(position, wxyz) this browser shows for the node ``name`` (viser's defaults where never sent)."""
+        with self._lock:
+            node = self.nodes[name]
+            position = node.get("position", (0.0, 0.0, 0.0))
+            wxyz = node.get("wxyz", (1.0, 0.0, 0.0, 0.0))
+        return tuple(float(v) for v in position), tuple(float(v) for v in wxyz)
 
     def labels(self) -> Iterable[str]:
         with self._lock:
@@ -241,14 +258,19 @@ class BrowserClient:
     def drag_transform(
         self,
         name: str,
-        positions: Iterable[tuple[float, float, float]],
-        wxyz: tuple[float, float, float, float] = (1.0, 0.0, 0.0, 0.0),
+        positions: Iterable[Any],
+        wxyz: Any = (1.0, 0.0, 0.0, 0.0),
         period_s: float = 0.0,
     ) -> None:
         """Drag the transform-controls gizmo ``name`` through ``positions`` (parent frame), as a mouse drag does."""
         owner = str(self.wait_for_node(name).get("owner", "") or "")
         self.send("TransformControlsDragStartMessage", name=name, owner=owner)
         for position in positions:
+            with (
+                self._lock
+            ):  # the browser shows the gizmo where the mouse put it, as the real one does
+                self.nodes[name]["position"] = position
+                self.nodes[name]["wxyz"] = wxyz
             self.send(
                 "TransformControlsUpdateMessage",
                 name=name,
@@ -259,6 +281,21 @@ class BrowserClient:
             if period_s:
                 time.sleep(period_s)
         self.send("TransformControlsDragEndMessage", name=name, owner=owner)
+
+    def drag_transform_step(
+        self,
+        name: str,
+        position: Any,
+        owner: str,
+        wxyz: Any = (1.0, 0.0, 0.0, 0.0),
+    ) -> None:
+        """One move of a drag already started (``TransformControlsDragStartMessage``), as a mouse move sends."""
+        with self._lock:
+            self.nodes[name]["position"] = position
+            self.nodes[name]["wxyz"] = wxyz
+        self.send(
+            "TransformControlsUpdateMessage", name=name, wxyz=wxyz, position=position, owner=owner
+        )
 
     def click_scene(
         self, ray_origin: tuple[float, float, float], ray_direction: tuple[float, float, float]

@@ -1,0 +1,583 @@
+"""One gate for every message a browser sends, and every access to viser 1.1.1's private state the app makes.
+
+viser 1.1.1 applies whatever a client's message names: a ``GuiUpdateMessage`` may set any attribute of a GUI handle
+(``props``, ``update_cb``, ``removed``), a gizmo update carries arrays of any length, a camera any image size, and a
+frame that does not decode ends the sender's connection with a traceback. Only three things may come from a browser:
+
+- a control's **value**: of the control's own kind (a checkbox takes only ``True``/``False``, a slider only a finite
+  number, clamped to the range the scene declared, a dropdown only one of its options);
+- a gizmo's **pose**: 3 finite numbers for the position and 4 finite numbers for the orientation, normalised; a
+  zero or non-finite quaternion, or a wrong length, keeps the last good pose;
+- a **camera**: finite numbers, a unit quaternion, positive image sizes; otherwise the client's last good camera.
+
+Everything else is refused, and each kind of refusal is logged once (one line, no traceback) per
+:attr:`Gate.log_interval_s`, with a count of the ones left unlogged. After each accepted value the server's value is
+sent back to every viewer, so two browsers moving one slider a few milliseconds apart end on the same value.
+
+A control's limits and options are its :class:`ControlSpec`, recorded by :func:`record_spec` when the scene creates
+it (before any browser can touch it) and kept beside the handle; they are never read back from the handle's props,
+which a browser could once change.
+
+viser is pinned ``==1.1.1`` because this module reaches into its internals: the websocket server's dispatch, the
+per-connection dispatch, the GUI and gizmo registries, and the frame decoder.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import logging
+import math
+import threading
+import time
+import warnings
+import weakref
+from collections.abc import Callable, Coroutine
+from typing import Any, Literal
+
+import msgspec
+import viser
+from viser import _messages
+from viser.infra import _infra
+
+logger = logging.getLogger(__name__)
+
+ControlKind = Literal["number", "choice", "bool", "button", "rgb", "text", "vector", "display"]
+
+MAX_FRAME_BYTES = 32 * 1024 * 1024
+"""Larger frames are refused (the largest honest one is a canvas render sent back for ``get_render``)."""
+MAX_IMAGE_SIDE = 16384
+"""Largest camera image side (pixels) a browser may report."""
+MAX_TEXT_CHARS = 10_000
+
+ALLOWED_MESSAGES: tuple[type[_messages.Message], ...] = (
+    _messages.GuiUpdateMessage,
+    _messages.ViewerCameraMessage,
+    _messages.TransformControlsUpdateMessage,
+    _messages.TransformControlsDragStartMessage,
+    _messages.TransformControlsDragEndMessage,
+    _messages.ScenePointerMessage,
+    _messages.SceneNodeClickMessage,
+    _messages.GetRenderResponseMessage,
+)
+"""The only message types a browser may send this app; any other (share-URL requests, uploads...) is refused."""
+_ALLOWED_BY_NAME = {cls.__name__: cls for cls in ALLOWED_MESSAGES}
+
+
+@dataclasses.dataclass(frozen=True)
+class ControlSpec:
+    """What a scene declared for one control, recorded when it was created."""
+
+    kind: ControlKind
+    """How a browser's value is checked."""
+    lo: float | None = None
+    """Smallest value (numbers), or None."""
+    hi: float | None = None
+    """Largest value (numbers), or None."""
+    integer: bool = False
+    """Whether the number is an integer (viser casts to the initial value's type)."""
+    options: tuple[str, ...] = ()
+    """The dropdown's options."""
+    length: int = 0
+    """Number of components (RGB, vectors)."""
+
+
+_SPEC_ATTRIBUTE = "_scenes_control_spec"
+
+
+def spec_from_handle(handle: object) -> ControlSpec:
+    """The spec of ``handle`` as it stands now: call it only when the scene has just created the handle."""
+    if isinstance(handle, viser.GuiCheckboxHandle):
+        return ControlSpec("bool")
+    if isinstance(handle, viser.GuiButtonHandle):
+        return ControlSpec("button")
+    if isinstance(handle, (viser.GuiSliderHandle, viser.GuiNumberHandle)):
+        lo, hi = handle.min, handle.max
+        return ControlSpec(
+            "number",
+            lo=None if lo is None else float(lo),
+            hi=None if hi is None else float(hi),
+            integer=isinstance(handle.value, int),
+        )
+    if isinstance(handle, viser.GuiDropdownHandle):
+        return ControlSpec("choice", options=tuple(str(option) for option in handle.options))
+    if isinstance(handle, viser.GuiRgbHandle):
+        return ControlSpec("rgb", lo=0.0, hi=255.0, integer=True, length=3)
+    if isinstance(handle, viser.GuiTextHandle):
+        return ControlSpec("text")
+    if isinstance(handle, (viser.GuiVector2Handle, viser.GuiVector3Handle)):
+        return ControlSpec("vector", length=len(handle.value))
+    return ControlSpec(
+        "display"
+    )  # progress bars, uploads, button groups...: nothing a browser may set
+
+
+def record_spec(handle: object) -> ControlSpec:
+    """Record ``handle``'s spec beside it (call right after creating it); returns the spec."""
+    spec = spec_from_handle(handle)
+    setattr(_state(handle), _SPEC_ATTRIBUTE, spec)
+    return spec
+
+
+def control_spec(handle: object) -> ControlSpec:
+    """The spec recorded for ``handle``; a control made without the facade is recorded now, on first use."""
+    spec = getattr(_state(handle), _SPEC_ATTRIBUTE, None)
+    return spec if isinstance(spec, ControlSpec) else record_spec(handle)
+
+
+def _state(handle: object) -> Any:
+    return handle._impl  # type: ignore[attr-defined]
+
+
+def gui_uuid(handle: object) -> str:
+    """The uuid a browser uses to address ``handle``."""
+    return str(_state(handle).uuid)
+
+
+# ------------------------------------------------------------------------------------------------ logging
+class RefusalLog:
+    """One log line per kind of refusal per ``interval_s``; the ones in between are counted, not logged."""
+
+    def __init__(self, interval_s: float = 10.0) -> None:
+        self.interval_s = interval_s
+        self._lock = threading.Lock()
+        self._last: dict[str, tuple[float, int]] = {}
+
+    def refuse(self, kind: str, detail: str) -> None:
+        now = time.monotonic()
+        with self._lock:
+            last = self._last.get(kind)
+            if last is not None and now - last[0] < self.interval_s:
+                self._last[kind] = (last[0], last[1] + 1)
+                return
+            unlogged = 0 if last is None else last[1]
+            self._last[kind] = (now, 0)
+        more = f" ({unlogged} more of this kind since the last line)" if unlogged else ""
+        logger.warning("refused %s: %s%s", kind, detail[:200], more)
+
+    def reset(self) -> None:
+        """Forget what was logged (tests use it between cases)."""
+        with self._lock:
+            self._last.clear()
+
+
+refusals = RefusalLog()
+"""The process's refusal log (frames are refused before it is known which server they reached)."""
+
+
+# ------------------------------------------------------------------------------------------------ values
+def _finite_number(value: object) -> float | None:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return None
+    number = float(value)
+    return number if math.isfinite(number) else None
+
+
+def _finite_vector(value: object, length: int) -> tuple[float, ...] | None:
+    if not isinstance(value, (list, tuple)) or len(value) != length:
+        return None
+    numbers = tuple(_finite_number(item) for item in value)
+    if any(number is None for number in numbers):
+        return None
+    return tuple(float(number) for number in numbers if number is not None)
+
+
+def unit_quaternion(value: object) -> tuple[float, float, float, float] | None:
+    """``value`` as a unit wxyz quaternion, or None when it is not 4 finite numbers with a non-zero norm."""
+    q = _finite_vector(value, 4)
+    if q is None:
+        return None
+    norm = math.hypot(*q)  # overflow-safe for components near 1e308
+    if not (math.isfinite(norm) and norm > 1e-12):
+        return None
+    w, x, y, z = (component / norm for component in q)
+    return (w, x, y, z)
+
+
+def clean_value(spec: ControlSpec, value: object) -> tuple[bool, Any, str]:
+    """(accepted, cleaned value, reason refused) for a browser's ``value`` of a control with ``spec``."""
+    match spec.kind:
+        case "bool":
+            if type(value) is bool:
+                return True, value, ""
+            return False, None, "a checkbox value that is not true or false"
+        case "button":
+            if value is True:
+                return True, value, ""
+            return False, None, "a button value other than true"
+        case "number":
+            number = _finite_number(value)
+            if number is None:
+                return False, None, "a number that is not finite or not a number"
+            if spec.integer:
+                # truncated, as viser's own cast to the control's int type does, then kept to the integers in range
+                lo = None if spec.lo is None else math.ceil(spec.lo)
+                hi = None if spec.hi is None else math.floor(spec.hi)
+                if lo is not None and hi is not None and lo > hi:
+                    return False, None, "a number for a control whose range holds no integer"
+                whole = int(number)
+                whole = whole if lo is None else max(whole, lo)
+                return True, (whole if hi is None else min(whole, hi)), ""
+            if spec.lo is not None:
+                number = max(number, spec.lo)
+            if spec.hi is not None:
+                number = min(number, spec.hi)
+            return True, number, ""
+        case "choice":
+            if isinstance(value, str) and value in spec.options:
+                return True, value, ""
+            return False, None, "an option the dropdown does not have"
+        case "rgb":
+            rgb = _finite_vector(value, 3)
+            if rgb is None or not all(0.0 <= c <= 255.0 for c in rgb):
+                return False, None, "a colour that is not three numbers in 0..255"
+            return True, tuple(round(c) for c in rgb), ""
+        case "text":
+            if isinstance(value, str) and len(value) <= MAX_TEXT_CHARS:
+                return True, value, ""
+            return False, None, "text that is not a string of at most 10 000 characters"
+        case "vector":
+            vector = _finite_vector(value, spec.length)
+            if vector is None:
+                return False, None, f"a vector that is not {spec.length} finite numbers"
+            return True, vector, ""
+        case "display":
+            return False, None, "a value for a control a browser may not set"
+
+
+def _camera_fields(message: _messages.ViewerCameraMessage) -> dict[str, Any] | None:
+    wxyz = unit_quaternion(message.wxyz)
+    position = _finite_vector(message.position, 3)
+    look_at = _finite_vector(message.look_at, 3)
+    up = _finite_vector(message.up_direction, 3)
+    fov, near, far = (_finite_number(v) for v in (message.fov, message.near, message.far))
+    sizes = (message.image_height, message.image_width)
+    if wxyz is None or position is None or look_at is None or up is None:
+        return None
+    if fov is None or near is None or far is None or not (0.0 < fov < math.pi and 0.0 < near < far):
+        return None
+    if (
+        not all(type(s) is int and 1 <= s <= MAX_IMAGE_SIDE for s in sizes)
+        or math.hypot(*up) == 0.0
+    ):
+        return None
+    return {
+        "wxyz": wxyz,
+        "position": position,
+        "look_at": look_at,
+        "up_direction": up,
+        "fov": fov,
+        "near": near,
+        "far": far,
+        "image_height": sizes[0],
+        "image_width": sizes[1],
+    }
+
+
+def _ray(origin: object, direction: object) -> bool:
+    d = _finite_vector(direction, 3)
+    return _finite_vector(origin, 3) is not None and d is not None and math.hypot(*d) > 0.0
+
+
+def click_problem(message: _messages.ScenePointerMessage | _messages.SceneNodeClickMessage) -> str:
+    """Why a click cannot be used ("" when it can): rays are 3 finite numbers, screen points 2."""
+    if isinstance(message, _messages.ScenePointerMessage):
+        if message.event_type not in ("click", "rect-select"):
+            return "an unknown pointer event"
+        if (message.ray_origin is None) != (message.ray_direction is None):
+            return "half a ray"
+        if message.ray_origin is not None and not _ray(message.ray_origin, message.ray_direction):
+            return "a ray that is not finite"
+        points = message.screen_pos
+        if not isinstance(points, (list, tuple)) or not 1 <= len(points) <= 2:
+            return "screen points that are not one or two"
+        if any(_finite_vector(point, 2) is None for point in points):
+            return "a screen point that is not two finite numbers"
+        return ""
+    index = message.instance_index
+    if index is not None and (type(index) is not int or index < 0):
+        return "an instance index that is not a count"
+    if not _ray(message.ray_origin, message.ray_direction):
+        return "a ray that is not finite"
+    if _finite_vector(message.screen_pos, 2) is None:
+        return "a screen point that is not two finite numbers"
+    return ""
+
+
+# ------------------------------------------------------------------------------------------------ frames
+def decode_frame(raw: object) -> _messages.Message | None:
+    """The message in one browser frame, or None (logged) when it is not one this app accepts."""
+    if not isinstance(raw, bytes):
+        refusals.refuse("text frame", "browsers send binary frames only")
+        return None
+    if len(raw) > MAX_FRAME_BYTES:
+        refusals.refuse("oversized frame", f"{len(raw)} bytes")
+        return None
+    try:
+        mapping = msgspec.msgpack.decode(raw)
+    except msgspec.DecodeError as error:
+        refusals.refuse("malformed frame", str(error))
+        return None
+    kind = mapping.get("type") if isinstance(mapping, dict) else None
+    if not isinstance(kind, str) or kind not in _ALLOWED_BY_NAME:
+        refusals.refuse("message type", f"{str(kind)[:80]!r} is not one a browser may send")
+        return None
+    try:
+        with warnings.catch_warnings():
+            # viser warns (with the value in the text) when a field has the wrong type; the gate checks every
+            # field itself, so these warnings would only repeat what it refuses.
+            warnings.simplefilter("ignore")
+            message = _messages.Message.deserialize(raw)
+    except (
+        Exception
+    ) as error:  # the frame's fields do not fit the message: refused, the connection stays up
+        refusals.refuse(f"malformed {kind}", f"{type(error).__name__}: {error}")
+        return None
+    return message if isinstance(message, _ALLOWED_BY_NAME[kind]) else None
+
+
+async def _gated_message_consumer(
+    websocket: Any, handle_message: Callable[[Any], None], message_class: object
+) -> None:
+    """viser's receive loop, with frames decoded by :func:`decode_frame` (a bad frame no longer ends the connection)."""
+    del message_class  # every frame is decoded as a viser message by decode_frame
+    while True:
+        message = decode_frame(await websocket.recv())
+        if message is not None:
+            handle_message(message)
+
+
+def _install_frame_gate() -> None:
+    # A module-level function that viser's connection handler looks up on every new connection: one process-wide
+    # swap (idempotent), because the receive loop does not know which server it serves.
+    _infra._message_consumer = _gated_message_consumer  # type: ignore[attr-defined]
+
+
+# ------------------------------------------------------------------------------------------------ the gate
+Dispatch = Callable[[Any, Any], Coroutine[Any, Any, None]]
+
+
+class Gate:
+    """The one gate in front of one server's message dispatch. Made by :func:`install_gate`."""
+
+    def __init__(self, server: viser.ViserServer) -> None:
+        self._server_ref = weakref.ref(server)
+        self.log = refusals
+        ws = server._websock_server
+        self._server_dispatch: Dispatch = ws._handle_incoming_message
+        self._client_dispatch: dict[int, Dispatch] = {}
+        ws._handle_incoming_message = self._dispatch  # type: ignore[method-assign]
+        ws.on_client_connect(self._on_connect)
+        ws.on_client_disconnect(self._on_disconnect)
+
+    # Every message reaches viser's server-scoped and its connection-scoped handlers (two tasks). The gate takes
+    # the connection's dispatch for itself and runs both from one place, after cleaning.
+    def _on_connect(self, connection: Any) -> None:
+        self._client_dispatch[int(connection.client_id)] = connection._handle_incoming_message
+        connection._handle_incoming_message = _ignore
+
+    def _on_disconnect(self, connection: Any) -> None:
+        self._client_dispatch.pop(int(connection.client_id), None)
+
+    async def _dispatch(self, client_id: Any, message: Any) -> None:
+        server = self._server_ref()
+        if server is None:
+            return
+        try:
+            cleaned, after = self._clean(server, int(client_id), message)
+        except (
+            Exception
+        ) as error:  # a gate bug must not take the connection down, nor let the message through
+            self.log.refuse(
+                f"unreadable {type(message).__name__}", f"{type(error).__name__}: {error}"
+            )
+            return
+        if cleaned is not None:
+            await self._server_dispatch(client_id, cleaned)
+            client_dispatch = self._client_dispatch.get(int(client_id))
+            if client_dispatch is not None:
+                await client_dispatch(client_id, cleaned)
+        if after is not None:
+            after()
+
+    def _client(self, server: viser.ViserServer, client_id: int) -> viser.ClientHandle | None:
+        return server._connected_clients.get(client_id)
+
+    def _clean(
+        self, server: viser.ViserServer, client_id: int, message: Any
+    ) -> tuple[Any, Callable[[], None] | None]:
+        if isinstance(message, _messages.GuiUpdateMessage):
+            return self._clean_gui(server, client_id, message)
+        if isinstance(message, _messages.TransformControlsUpdateMessage):
+            return self._clean_gizmo(server, client_id, message)
+        if isinstance(message, _messages.ViewerCameraMessage):
+            return self._clean_camera(server, client_id, message), None
+        if isinstance(message, _messages.TransformControlsDragEndMessage):
+            # A drag ends: every viewer, the dragging one too, is sent the gizmo's pose on the server (during the
+            # drag the sender is not, so its own gizmo does not fight the mouse).
+            handle = self._gizmo_handle(server, client_id, str(message.name), str(message.owner))
+            return message, None if handle is None else functools.partial(_send_pose, handle)
+        if isinstance(message, (_messages.ScenePointerMessage, _messages.SceneNodeClickMessage)):
+            reason = click_problem(message)
+            if reason:
+                self.log.refuse(f"click ({reason})", f"{type(message).__name__}")
+                return None, None
+            return message, None
+        if isinstance(message, ALLOWED_MESSAGES):
+            return message, None
+        self.log.refuse("message type", f"{type(message).__name__} is not one a browser may send")
+        return None, None
+
+    def _gui_handle(self, server: viser.ViserServer, client_id: int, uuid: str) -> Any:
+        handle = server.gui._gui_input_handle_from_uuid.get(uuid)
+        if handle is None:
+            client = self._client(server, client_id)
+            if client is not None:
+                handle = client.gui._gui_input_handle_from_uuid.get(uuid)
+        return None if handle is None or _state(handle).removed else handle
+
+    def _clean_gui(
+        self, server: viser.ViserServer, client_id: int, message: _messages.GuiUpdateMessage
+    ) -> tuple[Any, Callable[[], None] | None]:
+        updates = message.updates
+        if not isinstance(updates, dict) or set(updates) != {"value"}:
+            fields = (
+                sorted(str(key)[:40] for key in updates) if isinstance(updates, dict) else updates
+            )
+            self.log.refuse("GUI update of a field other than value", f"fields {fields!r}")
+            return None, None
+        handle = self._gui_handle(server, client_id, str(message.uuid))
+        if handle is None:
+            self.log.refuse("GUI update for an unknown id", f"uuid {str(message.uuid)[:64]!r}")
+            return None, None
+        spec = control_spec(handle)
+        accepted, value, reason = clean_value(spec, updates["value"])
+        # After each change, and after each refusal (the sender shows its own edit), every viewer is sent the
+        # server's value: two viewers that moved one slider a few ms apart both end on the server's.
+        send_back = functools.partial(_send_value, handle)
+        if not accepted:
+            label = str(getattr(handle, "label", "?"))
+            self.log.refuse(f"GUI value ({reason})", f"{label!r} got {updates['value']!r}"[:200])
+            return None, send_back
+        return _messages.GuiUpdateMessage(message.uuid, {"value": value}), send_back
+
+    def _gizmo_handle(
+        self, server: viser.ViserServer, client_id: int, name: str, owner: str
+    ) -> Any:
+        apis = [server.scene]
+        client = self._client(server, client_id)
+        if client is not None:
+            apis.append(client.scene)
+        for api in apis:
+            if api._owner_id == owner:
+                return api._handle_from_transform_controls_name.get(name)
+        return None
+
+    def _clean_gizmo(
+        self,
+        server: viser.ViserServer,
+        client_id: int,
+        message: _messages.TransformControlsUpdateMessage,
+    ) -> tuple[Any, Callable[[], None] | None]:
+        handle = self._gizmo_handle(server, client_id, str(message.name), str(message.owner))
+        if handle is None:
+            self.log.refuse("gizmo update for an unknown gizmo", f"name {str(message.name)[:64]!r}")
+            return None, None
+        position = _finite_vector(message.position, 3)
+        wxyz = unit_quaternion(message.wxyz)
+        if position is not None and wxyz is not None:
+            return dataclasses.replace(message, position=position, wxyz=wxyz), None
+        if position is None:
+            self.log.refuse("gizmo position (not 3 finite numbers)", f"{message.position!r}"[:200])
+        if wxyz is None:
+            self.log.refuse(
+                "gizmo orientation (not 4 finite numbers with a non-zero norm)",
+                f"{message.wxyz!r}"[:200],
+            )
+        last_position = tuple(float(v) for v in handle.position)
+        last_wxyz = tuple(float(v) for v in handle.wxyz)
+        cleaned = dataclasses.replace(
+            message,
+            position=position if position is not None else last_position,
+            wxyz=wxyz if wxyz is not None else last_wxyz,
+        )
+        return cleaned, functools.partial(_send_pose, handle)
+
+    def _clean_camera(
+        self, server: viser.ViserServer, client_id: int, message: _messages.ViewerCameraMessage
+    ) -> _messages.ViewerCameraMessage | None:
+        fields = _camera_fields(message)
+        if fields is not None:
+            return _messages.ViewerCameraMessage(**fields)
+        client = self._client(server, client_id)
+        self.log.refuse(
+            "camera (non-finite, or an image size that is not a positive integer)",
+            f"image {message.image_height!r}x{message.image_width!r}",
+        )
+        if client is None:
+            return None  # a first camera that is unusable: the client is not registered until a good one comes
+        camera = client.camera
+        return _messages.ViewerCameraMessage(
+            wxyz=tuple(float(v) for v in camera.wxyz),  # type: ignore[arg-type]
+            position=tuple(float(v) for v in camera.position),  # type: ignore[arg-type]
+            fov=float(camera.fov),
+            near=float(camera.near),
+            far=float(camera.far),
+            image_height=int(camera.image_height),
+            image_width=int(camera.image_width),
+            look_at=tuple(float(v) for v in camera.look_at),  # type: ignore[arg-type]
+            up_direction=tuple(float(v) for v in camera.up_direction),  # type: ignore[arg-type]
+        )
+
+
+async def _ignore(_client_id: Any, _message: Any) -> None:
+    """The connection's own dispatch, now run by the gate instead."""
+
+
+def _send_value(handle: Any) -> None:
+    """Send the server's value of ``handle`` to every viewer of it (the sender included)."""
+    state = _state(handle)
+    if not state.removed and not state.is_button:
+        state.gui_api._websock_interface.queue_message(
+            _messages.GuiUpdateMessage(state.uuid, {"value": state.value})
+        )
+
+
+def _send_pose(handle: Any) -> None:
+    """Send the server's pose of gizmo ``handle`` to every viewer of it (the sender included)."""
+    state = handle._impl
+    if state.removed:
+        return
+    api = state.api
+    x, y, z = (float(v) for v in state.position)
+    w, i, j, k = (float(v) for v in state.wxyz)
+    api._queue_scene_message(_messages.SetPositionMessage(state.name, (x, y, z)))
+    api._queue_scene_message(_messages.SetOrientationMessage(state.name, (w, i, j, k)))
+
+
+_gates: weakref.WeakKeyDictionary[viser.ViserServer, Gate] = weakref.WeakKeyDictionary()
+_gates_lock = threading.Lock()
+
+
+def install_gate(server: viser.ViserServer) -> Gate:
+    """Put the gate in front of ``server``'s dispatch (once per server; later calls return the same gate).
+
+    Install it before browsers connect: a connection opened earlier keeps viser's own connection-scoped dispatch.
+    """
+    with _gates_lock:
+        gate = _gates.get(server)
+        if gate is None:
+            _install_frame_gate()
+            gate = _gates[server] = Gate(server)
+        return gate
+
+
+# ------------------------------------------------------------------------------------------------ registries
+def node_names(api: viser.SceneApi) -> set[str]:
+    """Names of every scene node ``api`` (a server's or a client's scene) holds."""
+    return set(api._handle_from_node_name)
+
+
+def live_controls(api: viser.GuiApi) -> int:
+    """How many GUI inputs ``api`` holds."""
+    return len(api._gui_input_handle_from_uuid)

@@ -1,0 +1,350 @@
+"""A scene per browser tab: isolation, ``--shared``, sessions freed when tabs close, and the memory budget.
+
+Budget on this machine (2 cores): 16 sessions open, each extra session ≤ 40 MiB (≤ 60 MiB for the SDF gallery);
+after they close, RSS is back within 10 % of where it started; 50 builds and closes of any scene grow RSS ≤ 20 MiB.
+The memory checks run the app in its own process (``app.py``), so the fake browsers' mirrors do not count.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import gc
+import math
+import os
+import re
+import socket
+import subprocess
+import sys
+import time
+import weakref
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+import viser
+from viser_private import gizmos, node_names
+from wsclient import BrowserClient
+
+from app import serve_scenes
+from scenes import SCENES
+from scenes._session import Sessions
+from scenes.arm import MAX_LINKS
+from scenes.sdf_gallery import SdfGalleryScene
+from scenes.switcher import SceneSwitcher
+
+ROOT = Path(__file__).resolve().parents[1]
+MIB = 1024 * 1024
+
+
+@pytest.fixture
+def sessions(server: viser.ViserServer) -> Iterator[Sessions]:
+    manager = serve_scenes(server, "peloton", shared=False)
+    assert isinstance(manager, Sessions)
+    try:
+        yield manager
+    finally:
+        manager.close()
+
+
+def connect(server: viser.ViserServer, sessions: Sessions) -> tuple[BrowserClient, SceneSwitcher]:
+    """A new tab, and the session built for it."""
+    known = set(server.get_clients())
+    client = BrowserClient(server.get_port())
+    client.wait_for(lambda: bool(set(server.get_clients()) - known), what="the client registered")
+    (client_id,) = set(server.get_clients()) - known
+    client.wait_for(lambda: sessions.switcher(client_id) is not None, what="its session built")
+    switcher = sessions.switcher(client_id)
+    assert switcher is not None
+    return client, switcher
+
+
+def test_each_tab_switches_and_resets_only_its_own_scene(
+    server: viser.ViserServer, sessions: Sessions
+) -> None:
+    a, mine = connect(server, sessions)
+    b, theirs = connect(server, sessions)
+    with a, b:
+        assert mine is not theirs
+        b.wait_for_node("/peloton")
+        a.wait_for_node("/peloton")
+        their_scene = theirs.scene
+
+        a.set_value("Scene", SCENES["arm"].title)
+        a.wait_for(lambda: "/arm" in a.nodes and "/peloton" not in a.nodes, what="A shows the arm")
+        a.wait_for(lambda: mine.scene.key == "arm", what="A's session holds the arm")
+        assert theirs.scene is their_scene and their_scene.key == "peloton"
+        assert "/arm" not in b.nodes and "/peloton" in b.nodes
+        assert b.value_of("Scene") == SCENES["peloton"].title
+        assert "Links" in a.labels() and "Links" not in b.labels()
+
+        stale = mine.scene
+        a.click("Reset scene to defaults")
+        a.wait_for(lambda: mine.scene is not stale, what="A's reset rebuilt A's scene")
+        assert theirs.scene is their_scene
+
+        b.set_value("Speed (km/h)", 21.0)
+        b.wait_for(lambda: their_scene.params.speed_kmh == 21.0, what="B's own edit")  # type: ignore[attr-defined]
+        # Nothing is on the server's shared scene: each tab's nodes are its own.
+        assert not [name for name in node_names(server) if name.startswith(("/peloton", "/arm"))]
+
+
+def test_the_gate_guards_a_tabs_own_controls_and_gizmos(
+    server: viser.ViserServer, sessions: Sessions, caplog: pytest.LogCaptureFixture
+) -> None:
+    """Client-scoped handles go through the same gate: crafted fields, NaN, a bad quaternion, a 2-vector."""
+    a, mine = connect(server, sessions)
+    with a:
+        a.set_value("Scene", SCENES["arm"].title)
+        a.wait_for(lambda: mine.scene.key == "arm", what="A shows the arm")
+        scene = mine.scene
+        target = a.wait_for_node("/arm/target")
+        assert target.get("owner"), "a tab's own gizmo carries its owner"
+        links = a.wait_for_gui("Links")
+        a.send("GuiUpdateMessage", uuid=links, updates={"props": {}})
+        a.send("GuiUpdateMessage", uuid=links, updates={"removed": True})
+        a.set_value("Links", float("nan"))
+        a.set_value("Links", 40)
+        a.drag_transform("/arm/target", [(0.1, 0.2)], wxyz=(1.0, 0.0, 0.0))
+        a.drag_transform("/arm/target", [(float("nan"), 0.0, 0.5)], wxyz=(0.0, 0.0, 0.0, 0.0))
+        a.set_value("Max iterations", 77)
+        a.wait_for(lambda: scene.params.max_iterations == 77, what="the honest edit")  # type: ignore[attr-defined]
+        a.wait_for(
+            lambda: a.value_of("Links") == MAX_LINKS, what="Links clamped to its declared max"
+        )
+        assert scene.params.n_links == MAX_LINKS  # type: ignore[attr-defined]
+        assert "Links" in a.labels()
+        handle = gizmos(mine.server.scene)["/arm/target"]
+        a.wait_for(
+            lambda: a.pose_of("/arm/target")[0] == tuple(float(v) for v in handle.position),
+            what="the tab shown its gizmo's last good pose",
+        )
+        assert all(math.isfinite(v) for v in handle.position)
+        kinds = {
+            str(r.args[0])
+            for r in caplog.records
+            if r.name == "scenes._gate" and isinstance(r.args, tuple)
+        }
+        assert "GUI update of a field other than value" in kinds
+        assert any("gizmo position" in kind for kind in kinds)
+        assert any("gizmo orientation" in kind for kind in kinds)
+
+
+def test_a_closed_tab_frees_its_session(server: viser.ViserServer, sessions: Sessions) -> None:
+    refs = []
+    for key in ("sdf", "arm"):
+        client, switcher = connect(server, sessions)
+        with client:
+            client.set_value("Scene", SCENES[key].title)
+            client.wait_for(
+                lambda switcher=switcher, key=key: switcher.scene.key == key, timeout=60
+            )
+            refs += [
+                weakref.ref(switcher),
+                weakref.ref(switcher.scene),
+                weakref.ref(switcher.server),
+            ]
+            del switcher
+        deadline = time.monotonic() + 30
+        while (sessions.count or server.get_clients()) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert sessions.count == 0
+    gc.collect()
+    assert [ref() for ref in refs] == [None] * len(refs)
+
+
+def test_shared_mode_is_one_scene_for_every_tab(server: viser.ViserServer) -> None:
+    switcher = serve_scenes(server, "peloton", shared=True)
+    assert isinstance(switcher, SceneSwitcher)
+    try:
+        with BrowserClient(server.get_port()) as a, BrowserClient(server.get_port()) as b:
+            a.wait_for_node("/peloton")
+            b.wait_for_node("/peloton")
+            a.set_value("Scene", SCENES["freekick"].title)
+            b.wait_for(lambda: "/freekick" in b.nodes, what="B sees A's switch")
+            b.wait_for(lambda: b.value_of("Scene") == SCENES["freekick"].title, what="B's dropdown")
+            b.wait_for(
+                lambda: switcher.scene.key == "freekick", what="the one scene is the free kick"
+            )
+    finally:
+        switcher.close()
+
+
+# ------------------------------------------------------------------------------------------------ memory
+def rss_bytes(pid: int | str = "self") -> int:
+    with open(f"/proc/{pid}/status") as status:
+        match = re.search(r"VmRSS:\s+(\d+) kB", status.read())
+    assert match is not None
+    return int(match.group(1)) * 1024
+
+
+def free_port() -> int:
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return int(sock.getsockname()[1])
+
+
+class AppProcess:
+    """``app.py`` in its own process, on a free port."""
+
+    def __init__(self, *args: str) -> None:
+        self.port = free_port()
+        self.process = subprocess.Popen(
+            [sys.executable, str(ROOT / "app.py"), "--port", str(self.port), *args],
+            cwd=ROOT,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+        )
+        assert self.process.stdout is not None
+        deadline = time.monotonic() + 120
+        for line in self.process.stdout:
+            if "Open http" in line or time.monotonic() > deadline:
+                break
+        assert self.process.poll() is None, "the app did not start"
+
+    @property
+    def rss(self) -> int:
+        return rss_bytes(self.process.pid)
+
+    def close(self) -> None:
+        self.process.terminate()
+        try:
+            self.process.wait(timeout=20)
+        except subprocess.TimeoutExpired:
+            self.process.kill()
+            self.process.wait(timeout=20)
+
+
+def open_tabs(app: AppProcess, count: int, scene: str) -> list[BrowserClient]:
+    tabs = []
+    for _ in range(count):
+        tab = BrowserClient(app.port)
+        tab.wait_for_gui("Scene", timeout=60)
+        if scene != "peloton":
+            tab.set_value("Scene", SCENES[scene].title)
+        tab.wait_for_node(f"/{scene}", timeout=120)
+        tabs.append(tab)
+    return tabs
+
+
+def cpu_seconds(pid: int) -> float:
+    with open(f"/proc/{pid}/stat") as stat:
+        fields = stat.read().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def settled_rss(app: AppProcess, timeout_s: float = 120.0) -> int:
+    """The app's RSS once it is idle (under 2 % of a core for a second): scene jobs in flight have ended."""
+    deadline = time.monotonic() + timeout_s
+    busy = cpu_seconds(app.process.pid)
+    while time.monotonic() < deadline:
+        time.sleep(1.0)
+        now = cpu_seconds(app.process.pid)
+        if now - busy < 0.02:
+            break
+        busy = now
+    return app.rss
+
+
+@pytest.mark.parametrize(
+    ("scene", "budget_mib"),
+    [
+        ("peloton", 40),
+        ("arm", 40),
+        ("freekick", 40),
+        pytest.param(
+            "sdf",
+            60,
+            marks=pytest.mark.xfail(
+                reason="each SDF build makes its own GL context and worker (~50 MiB) until the issue-12 branch "
+                "makes them once per process",
+                strict=False,
+            ),
+        ),
+    ],
+)
+def test_sixteen_sessions_fit_the_budget_and_are_given_back(scene: str, budget_mib: int) -> None:
+    app = AppProcess()
+    try:
+        warm = open_tabs(
+            app, 1, scene
+        )  # first use loads what every session shares (kernels, caches, shaders)
+        for tab in warm:
+            tab.close()
+        start = settled_rss(app)
+        tabs = open_tabs(app, 16, scene)
+        full = settled_rss(app)
+        for tab in tabs:
+            tab.close()
+        after = settled_rss(app)
+        per_session_mib = (full - start) / 16 / MIB
+        print(
+            f"{scene}: start {start / MIB:.0f} MiB, 16 sessions {full / MIB:.0f} MiB "
+            f"({per_session_mib:.1f} MiB each), closed {after / MIB:.0f} MiB"
+        )
+        assert per_session_mib <= budget_mib
+        assert after <= 1.10 * start
+    finally:
+        app.close()
+
+
+def _trim_heap() -> None:
+    """Hand freed heap pages back to the system, so RSS measures what is held, not what malloc keeps cached."""
+    gc.collect()
+    try:
+        ctypes.CDLL("libc.so.6").malloc_trim(0)
+    except (OSError, AttributeError):
+        pass
+
+
+@pytest.mark.parametrize(
+    "key",
+    [
+        "peloton",
+        "arm",
+        "freekick",
+        pytest.param(
+            "sdf",
+            marks=pytest.mark.xfail(
+                reason="each SDF build makes its own GL context and worker (~50 MiB) until the issue-12 branch "
+                "makes them once per process",
+                strict=False,
+            ),
+        ),
+    ],
+)
+def test_fifty_builds_and_closes_grow_rss_at_most_20_mib(
+    server: viser.ViserServer, key: str
+) -> None:
+    """Each build runs until the scene is fully up (the SDF gallery: its first reference image) before it closes."""
+
+    def build_and_close() -> None:
+        scene = SCENES[key](server)
+        deadline = time.monotonic() + 60
+        while not _fully_up(scene) and time.monotonic() < deadline:
+            time.sleep(0.02)
+        assert _fully_up(scene), f"{key} did not come up"
+        scene.close()
+
+    for _ in range(2):  # warm up: imports, compiled kernels and caches every build shares
+        build_and_close()
+    _trim_heap()
+    start = rss_bytes()
+    for build in range(50):
+        build_and_close()
+        if (
+            build % 5 == 4
+        ):  # a leak of whole megabytes per build shows early: stop before it eats the machine
+            grown_mib = (rss_bytes() - start) / MIB
+            assert grown_mib <= 100.0, f"{key}: {grown_mib:.0f} MiB after {build + 1} builds"
+    _trim_heap()
+    grown_mib = (rss_bytes() - start) / MIB
+    print(f"{key}: 50 builds and closes grew RSS by {grown_mib:.1f} MiB")
+    assert grown_mib <= 20.0
+
+
+def _fully_up(scene: object) -> bool:
+    """Whether a scene has done the work its build starts (the SDF gallery renders a reference image or gives up)."""
+    if isinstance(scene, SdfGalleryScene):
+        return scene.reference_serial >= 1 or scene.gl_error is not None
+    return True
