@@ -1775,22 +1775,96 @@ def solve_tree(
     """
     points = _check_joints("joints", joints, batched=False)
     count, dim = points.shape
+    if not isinstance(targets, Mapping) or not targets:
+        raise ValueError(
+            f"targets must be a non-empty mapping joint index → target, got {targets!r}"
+        )
     try:
-        raw_parents = np.asarray(parents)
+        key_parents = (
+            tuple(int(v) for v in np.asarray(parents).reshape(-1)) if _integers(parents) else None
+        )
+        keys = tuple(sorted(targets))
+        topology = _tree_topology(key_parents, count, keys) if key_parents is not None else None
+    except TypeError:  # unhashable or unorderable keys: checked (and refused) without the cache
+        topology = None
+    if topology is None:
+        topology = _tree_topology.__wrapped__(parents, count, tuple(targets))
+    order, parent, active, has_goal, effector_ids, is_chain = topology
+    goal = np.zeros((count, 3))
+    for key in effector_ids.tolist():
+        goal[key, :dim] = _check_vector(f"targets[{key}]", targets[key], dim)
+    setup = _Setup.build(dim, tolerance, max_iterations, None, obstacles, root_direction,
+                         _FABRIK, False)  # fmt: skip
+    root = int(order[0])
+    table = _tree_table(constraints, count, dim, root)
+    tol = float(setup.params[0])
+
+    if is_chain:  # one chain: solve's result
+        chain_constraints = None if constraints is None else [constraints[j] for j in order[1:]]
+        single = _solve_single("fabrik", points[order], goal[effector_ids[0], :dim], tol,
+                               setup.max_iterations, None, obstacles, root_direction, True,
+                               chain_constraints)  # fmt: skip
+        out = np.empty_like(points)
+        out[order] = single.joints
+        return TreeSolution(
+            joints=out,
+            effectors=effector_ids.copy(),
+            error=np.array([single.error]),
+            status=(single.status,),
+            iterations=single.iterations,
+            error_history=single.error_history[:, None].copy(),
+        )
+
+    p = np.zeros((count, 3))
+    p[:, :dim] = points
+    history = np.empty((setup.max_iterations + 1, len(effector_ids)))
+    codes = np.empty(len(effector_ids), dtype=np.int64)
+    iterations = _solve_tree_core(
+        p, parent, order, active, goal, has_goal, effector_ids, table, setup.root_direction,
+        setup.centres, setup.radii, tol, setup.max_iterations, dim, history, codes,
+    )  # fmt: skip
+    return TreeSolution(
+        joints=p[:, :dim].copy() if dim == 2 else p,
+        effectors=effector_ids.copy(),
+        error=history[iterations].copy(),
+        status=tuple(STATUSES[c] for c in codes.tolist()),
+        iterations=int(iterations),
+        error_history=history[: iterations + 1].copy(),
+    )
+
+
+def _integers(value: object) -> bool:
+    """Whether ``value`` is an array-like of integers (the cacheable form of ``parents``)."""
+    try:
+        return np.asarray(value).dtype.kind in "iu"
+    except (TypeError, ValueError):
+        return False
+
+
+@functools.lru_cache(maxsize=64)
+def _tree_topology(
+    parents: object, count: int, keys: tuple[object, ...]
+) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.bool_], NDArray[np.bool_],
+           NDArray[np.int64], bool]:  # fmt: skip
+    """Checked tree structure: breadth-first order, parents, the joints that take part in the forward stage (a
+    target beyond them), the targeted joints, the effectors (ascending) and whether the tree is one chain. Cached:
+    a dragged skeleton asks for the same every frame (the arrays are never written to)."""
+    try:
+        raw = np.asarray(parents)
     except (TypeError, ValueError) as error:
         raise ValueError(
             f"parents must be a ({count},) array of integers, got {parents!r}"
         ) from error
     if (
-        raw_parents.shape != (count,)
-        or raw_parents.dtype.kind not in "iu"
-        or np.any(raw_parents < -1)
-        or np.any(raw_parents >= count)
+        raw.shape != (count,)
+        or raw.dtype.kind not in "iu"
+        or np.any(raw < -1)
+        or np.any(raw >= count)
     ):
         raise ValueError(
             f"parents must be ({count},) integers in [−1, {count - 1}], got {parents!r}"
         )
-    parent = raw_parents.astype(np.int64)
+    parent = raw.astype(np.int64)
     roots = np.flatnonzero(parent == -1)
     if roots.size != 1:
         raise ValueError(f"parents must have exactly one root (−1), got {roots.size}")
@@ -1805,110 +1879,49 @@ def solve_tree(
         raise ValueError(
             "parents must form one tree: some joints are on a cycle, not under the root"
         )
-    if not isinstance(targets, Mapping) or not targets:
-        raise ValueError(
-            f"targets must be a non-empty mapping joint index → target, got {targets!r}"
-        )
-    effectors = sorted(targets)
-    goal = np.zeros((count, 3))
     has_goal = np.zeros(count, dtype=np.bool_)
-    for key in effectors:
+    for key in keys:
         if isinstance(key, bool) or not isinstance(key, (int, np.integer)) or not 0 <= key < count:
             raise ValueError(f"targets keys must be joint indices in [0, {count - 1}], got {key!r}")
         if children[key]:
             raise ValueError(
                 f"targets[{key}] is on a joint with children: targets go on end effectors"
             )
-        goal[key, :dim] = _check_vector(f"targets[{key}]", targets[key], dim)
         has_goal[key] = True
-    setup = _Setup.build(dim, tolerance, max_iterations, None, obstacles, root_direction,
-                         _FABRIK, False)  # fmt: skip
-    root = order[0]
-    if constraints is not None and (
-        isinstance(constraints, Sequence)
-        and len(constraints) == count
-        and constraints[root] is not None
-    ):
-        raise ValueError(f"constraints[{root}] must be None: the root has no segment")
-    table = (
-        np.zeros((count, _TABLE_WIDTH))
-        if constraints is None
-        else _limit_table(constraints, count, dim, "constraints", segment_offset=0)
-    )
-    tol = float(setup.params[0])
-
-    if all(len(c) <= 1 for c in children):  # one chain: solve's result
-        chain_constraints = None if constraints is None else [constraints[j] for j in order[1:]]
-        single = _solve_single("fabrik", points[order], goal[effectors[0], :dim], tol,
-                               setup.max_iterations, None, obstacles, root_direction, True,
-                               chain_constraints)  # fmt: skip
-        out = np.empty_like(points)
-        out[order] = single.joints
-        return TreeSolution(
-            joints=out,
-            effectors=np.array(effectors, dtype=np.int64),
-            error=np.array([single.error]),
-            status=(single.status,),
-            iterations=single.iterations,
-            error_history=single.error_history[:, None].copy(),
-        )
-
     active = has_goal.copy()
     for j in reversed(
         order
     ):  # a joint takes part in the forward stage when a target lies beyond it
         if active[j] and parent[j] >= 0:
             active[parent[j]] = True
-    p = np.zeros((count, 3))
-    p[:, :dim] = points
-    history = np.empty((setup.max_iterations + 1, len(effectors)))
-    effector_ids = np.array(effectors, dtype=np.int64)
-    iterations, stalled = _solve_tree_core(
-        p, parent, np.array(order, dtype=np.int64), active, goal, has_goal, effector_ids, table,
-        setup.root_direction, setup.centres, setup.radii, tol, setup.max_iterations, dim, history,
-    )  # fmt: skip
-    error = history[iterations].copy()
-    lengths = np.zeros(count)
-    nonroot = parent >= 0
-    lengths[nonroot] = np.linalg.norm(points[nonroot] - points[parent[nonroot]], axis=1)
-    live = np.array(
-        [
-            float(np.linalg.norm(c - p[root])) > r
-            for c, r in zip(setup.centres, setup.radii, strict=True)
-        ],
-        dtype=np.bool_,
-    )
-    statuses: list[Status] = []
-    for e, key in enumerate(effectors):
-        path = [key]
-        while parent[path[-1]] >= 0:
-            path.append(int(parent[path[-1]]))
-        reach = float(lengths[path].sum())
-        distance = float(np.linalg.norm(goal[key] - p[root]))
-        scale = _TINY * max(float(lengths.sum()), distance, 1.0)
-        inside = any(
-            live[k] and float(np.linalg.norm(setup.centres[k] - goal[key])) < setup.radii[k]
-            for k in range(len(setup.radii))
-        )
-        if error[e] < tol:
-            statuses.append("reached")
-        elif distance > reach + scale:
-            statuses.append("unreachable")
-        elif inside or (
-            live.any()
-            and _colliding(p[path[::-1]].copy(), setup.centres, setup.radii, live, 1.0 + _TOUCH)
-        ):
-            statuses.append("blocked")
-        else:
-            statuses.append("limited" if stalled else "max_iterations")
-    return TreeSolution(
-        joints=p[:, :dim].copy(),
-        effectors=effector_ids,
-        error=error,
-        status=tuple(statuses),
-        iterations=int(iterations),
-        error_history=history[: iterations + 1].copy(),
-    )
+    effectors = np.flatnonzero(has_goal).astype(np.int64)
+    is_chain = all(len(c) <= 1 for c in children)
+    return np.array(order, dtype=np.int64), parent, active, has_goal, effectors, is_chain
+
+
+def _tree_table(
+    constraints: Sequence[Constraint] | None, count: int, dim: int, root: int
+) -> NDArray[np.float64]:
+    """The checked limit table of a tree (one row per joint), cached on hashable constraints."""
+    if constraints is None:
+        return np.zeros((count, _TABLE_WIDTH))
+    try:
+        return _tree_table_cached(tuple(constraints), count, dim, root)
+    except TypeError:  # unhashable entries: checked (and refused) without the cache
+        return _tree_table_cached.__wrapped__(constraints, count, dim, root)
+
+
+@functools.lru_cache(maxsize=64)
+def _tree_table_cached(
+    constraints: Sequence[Constraint], count: int, dim: int, root: int
+) -> NDArray[np.float64]:
+    if (
+        isinstance(constraints, Sequence)
+        and len(constraints) == count
+        and constraints[root] is not None
+    ):
+        raise ValueError(f"constraints[{root}] must be None: the root has no segment")
+    return _limit_table(constraints, count, dim, "constraints", segment_offset=0)
 
 
 @numba.njit(cache=True, error_model="numpy")
@@ -1917,12 +1930,14 @@ def _solve_tree_core(
     active: NDArray[np.bool_], goal: NDArray[np.float64], has_goal: NDArray[np.bool_],
     effectors: NDArray[np.int64], table: NDArray[np.float64], rest: NDArray[np.float64],
     centres: NDArray[np.float64], radii: NDArray[np.float64], tolerance: float,
-    max_iterations: int, dim: int, history: NDArray[np.float64],
-) -> tuple[int, bool]:  # fmt: skip
+    max_iterations: int, dim: int, history: NDArray[np.float64], codes: NDArray[np.int64],
+) -> int:  # fmt: skip
     """Multi-end-effector FABRIK on ``p`` (J, 3), in place; ``order`` is breadth first from the root.
 
-    Fills ``history`` (max_iterations + 1, E) with the effectors' errors, NaN past the last iteration. Returns
-    (iterations, whether it stopped at a fixed point)."""
+    Fills ``history`` (max_iterations + 1, E) with the effectors' errors, NaN past the last iteration, and
+    ``codes`` (E,) with each effector's status: reached; unreachable (farther from the root than its path's
+    length); blocked (target inside a live obstacle, or the pose touching one); limited (stopped at a fixed point);
+    max_iterations. Returns the iterations run."""
     count = p.shape[0]
     root = int(order[0])
     history[:, :] = np.nan
@@ -1961,10 +1976,18 @@ def _solve_tree_core(
         directions[j, 0], directions[j, 1], directions[j, 2] = ux, uy, uz
     sums = np.zeros((count, 3))
     counts = np.zeros(count, dtype=np.int64)
+    only_child = np.full(count, -1, dtype=np.int64)  # the one active child, where a joint has one
+    for j in range(count):
+        up = int(parents[j])
+        if up >= 0 and active[j]:
+            only_child[up] = j if counts[up] == 0 else -1
+            counts[up] += 1
 
     worst = _tree_errors(p, goal, effectors, history, 0)
     if worst < tolerance:
-        return 0, False
+        _tree_statuses(p, parents, goal, effectors, lengths, centres, radii, live, tolerance, tiny,
+                       history[0], False, codes)  # fmt: skip
+        return 0
     stall = _STALL * tolerance + tiny
     iterations, stalled = 0, False
     for iteration in range(1, max_iterations + 1):
@@ -1984,9 +2007,22 @@ def _solve_tree_core(
             up = int(parents[j])
             dx, dy, dz, _ = _unit(p[up, 0] - x, p[up, 1] - y, p[up, 2] - z,
                                   -directions[j, 0], -directions[j, 1], -directions[j, 2], tiny)  # fmt: skip
+            c = only_child[j]
             if (
-                table[j, 0] == _KIND_HINGE
-            ):  # keep the segment in its hinge's plane (caliko's forward pass)
+                c >= 0 and not has_goal[j]
+            ):  # the joint to its one child holds this segment (as in a chain)
+                qx, qy, qz, _ = _unit(x - p[c, 0], y - p[c, 1], z - p[c, 2], dx, dy, dz, tiny)
+                if table[c, 0] == _KIND_CONE:
+                    dx, dy, dz = _clamp_cone(dx, dy, dz, qx, qy, qz, table[c, 1], table[c, 2], dim)
+                elif table[c, 0] == _KIND_HINGE and table[c, 12] == 0.0:
+                    ax, ay, az, rx, ry, rz = _hinge_axes(table, c, -dx, -dy, -dz, rest)
+                    low, high = table[c, 9], table[c, 10]
+                    theta = _hinge_angle(-qx, -qy, -qz, ax, ay, az, rx, ry, rz, low, high)
+                    if not low <= theta <= high:
+                        end = low if abs(_wrap(theta - low)) <= abs(_wrap(theta - high)) else high
+                        dx, dy, dz = _rotate(dx, dy, dz, ax, ay, az, theta - end)
+            # keep the segment in its hinge's plane (caliko's forward pass)
+            if table[j, 0] == _KIND_HINGE:
                 ax, ay, az, rx, ry, rz = _hinge_axes(
                     table, j, directions[up, 0], directions[up, 1], directions[up, 2], rest
                 )
@@ -2030,7 +2066,57 @@ def _solve_tree_core(
         if change < stall:
             stalled = True
             break
-    return iterations, stalled
+    _tree_statuses(p, parents, goal, effectors, lengths, centres, radii, live, tolerance, tiny,
+                   history[iterations], stalled, codes)  # fmt: skip
+    return iterations
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _tree_statuses(
+    p: NDArray[np.float64], parents: NDArray[np.int64], goal: NDArray[np.float64],
+    effectors: NDArray[np.int64], lengths: NDArray[np.float64], centres: NDArray[np.float64],
+    radii: NDArray[np.float64], live: NDArray[np.bool_], tolerance: float, tiny: float,
+    error: NDArray[np.float64], stalled: bool, codes: NDArray[np.int64],
+) -> None:  # fmt: skip
+    """Each effector's status code (see :func:`_solve_tree_core`)."""
+    touching = False
+    for j in range(p.shape[0]):
+        up = int(parents[j])
+        if up < 0 or radii.shape[0] == 0:
+            continue
+        x, y, z = p[up, 0], p[up, 1], p[up, 2]
+        sx, sy, sz = p[j, 0] - x, p[j, 1] - y, p[j, 2] - z
+        seg2 = sx * sx + sy * sy + sz * sz
+        for k in range(radii.shape[0]):
+            rx, ry, rz = centres[k, 0] - x, centres[k, 1] - y, centres[k, 2] - z
+            t = min(max((rx * sx + ry * sy + rz * sz) / (seg2 if seg2 > 0.0 else 1.0), 0.0), 1.0)
+            gx, gy, gz = rx - t * sx, ry - t * sy, rz - t * sz
+            grown = radii[k] * (1.0 + _TOUCH)
+            touching = touching or (live[k] and gx * gx + gy * gy + gz * gz < grown * grown)
+    root = 0
+    while parents[root] >= 0:
+        root = int(parents[root])
+    for e in range(effectors.shape[0]):
+        key = int(effectors[e])
+        reach, j = 0.0, key
+        while parents[j] >= 0:
+            reach += lengths[j]
+            j = int(parents[j])
+        dx, dy, dz = goal[key, 0] - p[root, 0], goal[key, 1] - p[root, 1], goal[key, 2] - p[root, 2]
+        inside = False
+        for k in range(radii.shape[0]):
+            ox = centres[k, 0] - goal[key, 0]
+            oy = centres[k, 1] - goal[key, 1]
+            oz = centres[k, 2] - goal[key, 2]
+            inside = inside or (live[k] and ox * ox + oy * oy + oz * oz < radii[k] * radii[k])
+        if error[e] < tolerance:
+            codes[e] = _REACHED
+        elif math.sqrt(dx * dx + dy * dy + dz * dz) > reach + tiny:
+            codes[e] = _UNREACHABLE
+        elif inside or touching:
+            codes[e] = _BLOCKED
+        else:
+            codes[e] = _LIMITED if stalled else _MAX_ITERATIONS
 
 
 @numba.njit(cache=True, error_model="numpy")

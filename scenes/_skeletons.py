@@ -269,17 +269,30 @@ def solve_skeleton(
     skeleton: Skeleton, pose: NDArray[np.float64], targets: NDArray[np.float64], *, tolerance_m: float,
     max_iterations: int,
 ) -> SkeletonReport:  # fmt: skip
-    """One frame: every effector toward its target, from the last pose (no viser)."""
+    """One frame: every effector toward its target, from the last pose (no viser); where an effector is stuck
+    ("limited" more than 10 tolerances away) also from the rest pose, keeping the closer result."""
+    goal = {e: targets[k] for k, e in enumerate(skeleton.effectors)}
     began = time.perf_counter()
-    result = fabrik.solve_tree(
+    solve = functools.partial(
+        fabrik.solve_tree,
         skeleton.parents,
-        pose,
-        {e: targets[k] for k, e in enumerate(skeleton.effectors)},
+        targets=goal,
         tolerance=tolerance_m,
         max_iterations=max_iterations,
         constraints=skeleton.constraints,
         root_direction=skeleton.root_direction,
     )
+    result = solve(pose)
+    stuck = any(
+        s == "limited" and e > 10.0 * tolerance_m
+        for s, e in zip(result.status, result.error, strict=True)
+    )
+    if stuck:
+        # A finger curled far past its target can settle at a fixed point of FABRIK's hinge passes (the forward
+        # pass flips its curled links); from the rest pose it opens. Keep whichever is closer.
+        retry = solve(skeleton.joints)
+        if float(retry.error.sum()) < float(result.error.sum()):
+            result = retry
     micros = (time.perf_counter() - began) * 1e6
     return SkeletonReport(result=result, micros=micros, usage=joint_usage(skeleton, result.joints))
 
