@@ -276,7 +276,7 @@ def tree_30() -> tuple[list[int], Array, list[fabrik.Constraint]]:
         for k in range(5):
             j = 5 + 5 * b + k
             joints[j] = joints[parents[j]] + 0.1 * direction
-    constraints: list[fabrik.Constraint] = [None] + [fabrik.Cone(math.radians(60.0))] * 29
+    constraints: list[fabrik.Constraint] = [None, *[fabrik.Cone(math.radians(60.0))] * 29]
     return parents, joints, constraints
 
 
