@@ -510,6 +510,10 @@ def warm_up() -> None:
                 max_iterations=3,
                 solver=solver,
             )
+    hinge = Hinge((0.0, 1.0, 0.0), -1.0, 1.0)
+    solve(chain, [0.8, 0.0, 1.2], constraints=[hinge, Cone(1.0)], max_iterations=3)
+    solve_tree([-1, 0, 1, 1], np.vstack([chain, [[-0.3, 0.0, 1.9]]]), {2: [0.8, 0.0, 1.2], 3: [-0.8, 0.0, 1.2]},
+               constraints=[None, hinge, Cone(1.0), hinge], obstacles=obstacles, max_iterations=3)  # fmt: skip
 
 
 def two_bone(
@@ -1404,6 +1408,8 @@ def _solve_chain(
                 return 1, _REACHED if candidate <= tolerance + tiny else _UNREACHABLE, candidate
 
     _unbend(p, target, lengths, tiny, rest, has_limits, cos_phi, dim)
+    # The extrapolation's first call moves by 0 × (p − previous): never 0 × uninitialised memory (NaN).
+    _copy(p, previous)
     stall = _STALL * tolerance + tiny
     progress = _PROGRESS * tolerance + tiny
     stall_applies = constrained or out_of_reach
