@@ -19,6 +19,15 @@ Model and method:
   first segment around ``root_direction``). The forward pass clamps each segment against the one placed just before
   it, the backward pass against its predecessor, so every iterate satisfies every limit (as Aristidou & Lasenby 2011
   apply constraints inside the passes, here with a symmetric cone; in 2D the cone is the angle range ``[−φ, φ]``).
+* Joint types per segment (``constraints=[...]``): :class:`Cone` (the cone above, per joint) or :class:`Hinge`
+  (caliko's hinge, Lansley 2016: the segment turns only about an axis, fixed in the world or turning with the
+  previous segment, within an angle range from a reference direction). The forward pass holds consecutive segments
+  by the cone between them, or turns a segment about the next joint's hinge axis until that joint's angle is in
+  range, and keeps each hinge's segment in its plane; the backward pass imposes every limit exactly, so every
+  iterate keeps every hinge. CCD and DLS keep them through the same backward pass.
+* Skeletons (:func:`solve_tree`): Aristidou & Lasenby 2011, §4.2, several end effectors: forward reaching from each
+  effector to its sub-base, the sub-base at the centroid of its branches' proposals, then on toward the root, and
+  backward reaching from the root along every branch.
 * Obstacles: circles (2D) or spheres (3D). Whenever a pass would place a segment through one, the segment is turned
   about its anchor, by the least angle, until it only touches it (tangent, or its far end on the surface).
   Obstacles that contain the root cannot be avoided and are ignored.
@@ -57,7 +66,7 @@ import dataclasses
 import functools
 import math
 import threading
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Literal
 
 import numba
@@ -157,6 +166,180 @@ class BatchSolution:
         )
 
 
+# ================================================================================================ joint types
+@dataclasses.dataclass(frozen=True)
+class Cone:
+    """A ball joint: the segment stays within ``half_angle_rad`` of the previous segment's direction (the first
+    segment of the root direction), as ``cone_half_angle_rad`` does for every joint at once."""
+
+    half_angle_rad: float
+    """Half-angle of the cone (rad), in [0, π]; π leaves the joint free."""
+
+    def __post_init__(self) -> None:
+        phi = _finite_number("half_angle_rad", self.half_angle_rad)
+        if not 0.0 <= phi <= math.pi:
+            raise ValueError(f"half_angle_rad must be in [0, π], got {self.half_angle_rad!r}")
+        object.__setattr__(self, "half_angle_rad", phi)
+
+
+HingeFrame = Literal["global", "local"]
+"""Where a hinge's axes are given: fixed in the world, or in the frame of the previous segment."""
+
+
+@dataclasses.dataclass(frozen=True)
+class Hinge:
+    """A hinge joint: the segment turns only about ``axis``, within an angle range (caliko's hinge, 2016).
+
+    The segment's direction is kept in the plane through its inner joint perpendicular to the axis; its signed angle
+    about the axis (right-handed), measured from the reference direction, stays in ``[min_angle_rad,
+    max_angle_rad]``. The reference direction is ``reference_axis`` (its part perpendicular to the axis), or, when
+    None, the previous segment's direction (the root direction for the first segment) projected onto that plane: the
+    angle is then the joint angle a robot's encoder reads, 0 for a straight joint.
+
+    ``frame="global"``: ``axis`` and ``reference_axis`` are fixed in the world (caliko's GLOBAL_HINGE).
+    ``frame="local"``: they are given for a chain at rest along the root direction and turn with the previous
+    segment, by the shortest rotation taking the root direction onto it (caliko's LOCAL_HINGE builds the previous
+    bone's frame from a fixed up vector instead; the two agree about the bone's axis and differ in twist, which
+    positions alone do not fix). For the first segment both frames are the world.
+
+    Where ours differs from caliko: a range need not contain 0 (caliko's clockwise/anticlockwise limits do); a
+    direction outside the range goes to the nearer end around the circle (caliko clamps to the end on its side);
+    the forward pass only keeps each segment in its hinge plane and the backward pass imposes the range, as caliko
+    does, so every returned pose keeps every hinge.
+    """
+
+    axis: ArrayLike
+    """(3,) rotation axis (any length > 0; unit once built). In 2D it must be ±z, the plane's normal."""
+    min_angle_rad: float = -math.pi
+    """Lower end of the range (rad), in [−π, π]."""
+    max_angle_rad: float = math.pi
+    """Upper end of the range (rad), in [min_angle_rad, π]."""
+    reference_axis: ArrayLike | None = None
+    """(3,) direction angle 0 is measured from (its part perpendicular to ``axis``); None: the previous segment."""
+    frame: HingeFrame = "global"
+    """"global" or "local"; see the class docstring."""
+
+    def __post_init__(self) -> None:
+        axis = _finite_array("axis", self.axis)
+        if axis.shape != (3,) or not float(np.linalg.norm(axis)) > _TINY:
+            raise ValueError(f"axis must be a non-zero (3,) vector, got {self.axis!r}")
+        axis = axis / float(np.linalg.norm(axis))
+        low = _finite_number("min_angle_rad", self.min_angle_rad)
+        high = _finite_number("max_angle_rad", self.max_angle_rad)
+        if not -math.pi <= low <= math.pi:
+            raise ValueError(f"min_angle_rad must be in [−π, π], got {self.min_angle_rad!r}")
+        if not low <= high <= math.pi:
+            raise ValueError(
+                f"max_angle_rad must be in [min_angle_rad, π] = [{low}, π], got {self.max_angle_rad!r}"
+            )
+        reference = None
+        if self.reference_axis is not None:
+            raw = _finite_array("reference_axis", self.reference_axis)
+            if raw.shape != (3,):
+                raise ValueError(
+                    f"reference_axis must be a (3,) vector, got {self.reference_axis!r}"
+                )
+            off = raw - float(raw @ axis) * axis
+            if not float(np.linalg.norm(off)) > 1e-9 * max(float(np.linalg.norm(raw)), _TINY):
+                raise ValueError(
+                    f"reference_axis must not be parallel to axis, got {self.reference_axis!r}"
+                )
+            reference = tuple(float(v) for v in off / float(np.linalg.norm(off)))
+        match self.frame:
+            case "global" | "local":
+                pass
+            case _:
+                raise ValueError(f"frame must be 'global' or 'local', got {self.frame!r}")
+        object.__setattr__(self, "axis", tuple(float(v) for v in axis))
+        object.__setattr__(self, "min_angle_rad", low)
+        object.__setattr__(self, "max_angle_rad", high)
+        object.__setattr__(self, "reference_axis", reference)
+
+
+Constraint = Cone | Hinge | None
+"""One segment's joint: a cone, a hinge, or None (free)."""
+
+_TABLE_WIDTH = 13
+"""Columns of a limit table row: kind, cos φ, sin φ, axis (3), reference (3), min, max, local, has reference."""
+_KIND_FREE, _KIND_CONE, _KIND_HINGE = 0.0, 1.0, 2.0
+_FREE_TABLE = np.zeros((1, _TABLE_WIDTH))
+_HINGE_SLACK = 1e-9
+"""Rounding allowed when checking a hinge: out of its plane by this much (of a unit direction), or past its range
+by this many radians."""
+
+
+def _limit_table(
+    constraints: Sequence[Constraint], count: int, dim: int, name: str, *, segment_offset: int
+) -> NDArray[np.float64]:
+    """(count, 13) rows the compiled core reads, one per segment, from checked constraints.
+
+    ``segment_offset`` rows are left free at the start (the root of a tree has no segment)."""
+    if isinstance(constraints, (str, bytes)) or not isinstance(constraints, Sequence):
+        raise ValueError(f"{name} must be a sequence of Cone, Hinge or None, got {constraints!r}")
+    if len(constraints) != count:
+        raise ValueError(
+            f"{name} must have one entry per segment ({count}), got {len(constraints)}"
+        )
+    table = np.zeros((count, _TABLE_WIDTH))
+    for i, item in enumerate(constraints):
+        if i < segment_offset and item is not None:
+            raise ValueError(f"{name}[{i}] must be None (the root has no segment), got {item!r}")
+        match item:
+            case None:
+                pass
+            case Cone(half_angle_rad=phi):
+                if phi < math.pi:
+                    table[i, :3] = _KIND_CONE, math.cos(phi), math.sin(phi)
+            case Hinge():
+                axis = np.asarray(item.axis)
+                if dim == 2 and abs(axis[2]) < 1.0 - 1e-12:
+                    raise ValueError(
+                        f"{name}[{i}].axis must be ±z for a 2D chain, got {item.axis!r}"
+                    )
+                table[i, 0] = _KIND_HINGE
+                table[i, 3:6] = axis
+                if item.reference_axis is not None:
+                    table[i, 6:9] = item.reference_axis
+                    table[i, 12] = 1.0
+                table[i, 9], table[i, 10] = item.min_angle_rad, item.max_angle_rad
+                table[i, 11] = 1.0 if item.frame == "local" else 0.0
+            case _:
+                raise ValueError(f"{name}[{i}] must be a Cone, a Hinge or None, got {item!r}")
+    return table
+
+
+def limit_usage(
+    joints: ArrayLike,
+    constraints: Sequence[Constraint],
+    root_direction: ArrayLike | None = None,
+) -> NDArray[np.float64]:
+    """How near each segment is to its joint's limit: 0 free or centred, 1 at the limit.
+
+    A cone's share is ``angle / φ``; a hinge's is ``1 − (distance to the nearer end) / (half the range)`` (1 for a
+    zero range). Free segments give 0.
+
+    Args:
+        joints: (n + 1, d) joint positions (m).
+        constraints: n entries as in :func:`solve`.
+        root_direction: (d,) as in :func:`solve`.
+
+    Returns:
+        (n,) shares in [0, 1].
+
+    Raises:
+        ValueError: as :func:`solve`.
+    """
+    chain = _check_joints("joints", joints, batched=False)
+    n, dim = chain.shape[0] - 1, chain.shape[1]
+    table = _limit_table(constraints, n, dim, "constraints", segment_offset=0)
+    rest = np.zeros(3)
+    rest[:dim] = _root_direction(root_direction, dim)
+    p = np.zeros((n + 1, 3))
+    p[:, :dim] = chain
+    scale = max(float(np.linalg.norm(np.diff(chain, axis=0), axis=1).sum()), 1.0)
+    return _usage(p, table, rest, _TINY * scale)
+
+
 # ================================================================================================ public API
 def solve(
     joints: ArrayLike,
@@ -167,6 +350,7 @@ def solve(
     cone_half_angle_rad: float | None = None,
     obstacles: Sequence[Obstacle] = (),
     root_direction: ArrayLike | None = None,
+    constraints: Sequence[Constraint] | None = None,
     extrapolate: bool = True,
 ) -> Solution:
     """Solve one chain with FABRIK.
@@ -183,16 +367,20 @@ def solve(
             (the plane's up), +z in 3D.
         extrapolate: move slowly converging iterates on along their last step (see the module docstring); False
             gives plain FABRIK as the paper writes it.
+        constraints: one :class:`Cone`, :class:`Hinge` or None (free) per segment, segment i being joints i to
+            i + 1; replaces ``cone_half_angle_rad`` (give one or the other). None: as ``cone_half_angle_rad``.
 
     Returns:
         The :class:`Solution`: the best admissible pose seen.
 
     Raises:
         ValueError: naming the argument, for non-finite values, wrong shapes, n < 1, a negative tolerance, a
-            half-angle outside [0, π], a non-positive radius or max_iterations < 1.
+            half-angle outside [0, π], a non-positive radius, max_iterations < 1, or constraints of the wrong
+            count or kind (a hinge axis off ±z in 2D).
     """
     return _solve_single("fabrik", joints, target, tolerance, max_iterations,
-                         cone_half_angle_rad, obstacles, root_direction, extrapolate)  # fmt: skip
+                         cone_half_angle_rad, obstacles, root_direction, extrapolate,
+                         constraints)  # fmt: skip
 
 
 def solve_batch(
@@ -204,6 +392,7 @@ def solve_batch(
     cone_half_angle_rad: float | None = None,
     obstacles: Sequence[Obstacle] = (),
     root_direction: ArrayLike | None = None,
+    constraints: Sequence[Constraint] | None = None,
     solver: Solver = "fabrik",
     extrapolate: bool = True,
 ) -> BatchSolution:
@@ -219,6 +408,7 @@ def solve_batch(
         root_direction: as in :func:`solve`, shared by every chain.
         solver: "fabrik", "ccd" or "jacobian_dls".
         extrapolate: as in :func:`solve` (FABRIK only).
+        constraints: as in :func:`solve`, the same for every chain.
 
     Returns:
         The :class:`BatchSolution`; ``result[i]`` is chain i's :class:`Solution`, the same as solving it alone.
@@ -237,6 +427,7 @@ def solve_batch(
         raise ValueError(f"solver must be one of 'fabrik', 'ccd', 'jacobian_dls', got {solver!r}")
     setup = _Setup.build(dim, tolerance, max_iterations, cone_half_angle_rad, obstacles,
                          root_direction, _SOLVER_IDS[solver], extrapolate)  # fmt: skip
+    setup = setup.constrained(constraints, count - 1, dim, cone_half_angle_rad)
     p = np.zeros((batch, count, 3))
     p[:, :, :dim] = chains
     goal = np.zeros((batch, 3))
@@ -247,7 +438,7 @@ def solve_batch(
     status = np.empty(batch, dtype=np.int64)
     error = np.empty(batch)
     args = (p, goal, setup.params, setup.flags, setup.root_direction, setup.centres, setup.radii,
-            out_p, history, iterations, status, error)  # fmt: skip
+            out_p, history, iterations, status, error, setup.table)  # fmt: skip
     if batch == 1:
         _solve_rows(0, 1, *args)
     else:
@@ -272,13 +463,15 @@ def ccd(
     cone_half_angle_rad: float | None = None,
     obstacles: Sequence[Obstacle] = (),
     root_direction: ArrayLike | None = None,
+    constraints: Sequence[Constraint] | None = None,
 ) -> Solution:
     """Cyclic coordinate descent: one iteration turns each joint, end to root, to point the end at the target.
 
     Arguments, result and errors are those of :func:`solve`.
     """
     return _solve_single("ccd", joints, target, tolerance, max_iterations,
-                         cone_half_angle_rad, obstacles, root_direction, False)  # fmt: skip
+                         cone_half_angle_rad, obstacles, root_direction, False,
+                         constraints)  # fmt: skip
 
 
 def jacobian_dls(
@@ -290,13 +483,15 @@ def jacobian_dls(
     cone_half_angle_rad: float | None = None,
     obstacles: Sequence[Obstacle] = (),
     root_direction: ArrayLike | None = None,
+    constraints: Sequence[Constraint] | None = None,
 ) -> Solution:
     """Damped-least-squares Jacobian IK: ``Δθ = Jᵀ(JJᵀ + λ²I)⁻¹e`` with ball joints (3D) or hinges (2D).
 
     Arguments, result and errors are those of :func:`solve`.
     """
     return _solve_single("jacobian_dls", joints, target, tolerance, max_iterations,
-                         cone_half_angle_rad, obstacles, root_direction, False)  # fmt: skip
+                         cone_half_angle_rad, obstacles, root_direction, False,
+                         constraints)  # fmt: skip
 
 
 def warm_up() -> None:
@@ -315,6 +510,10 @@ def warm_up() -> None:
                 max_iterations=3,
                 solver=solver,
             )
+    hinge = Hinge((0.0, 1.0, 0.0), -1.0, 1.0)
+    solve(chain, [0.8, 0.0, 1.2], constraints=[hinge, Cone(1.0)], max_iterations=3)
+    solve_tree([-1, 0, 1, 1], np.vstack([chain, [[-0.3, 0.0, 1.9]]]), {2: [0.8, 0.0, 1.2], 3: [-0.8, 0.0, 1.2]},
+               constraints=[None, hinge, Cone(1.0), hinge], obstacles=obstacles, max_iterations=3)  # fmt: skip
 
 
 def two_bone(
@@ -518,13 +717,41 @@ class _Setup:
     params: NDArray[np.float64]
     """(3,) tolerance (m), cos φ, sin φ."""
     flags: NDArray[np.int64]
-    """(5,) max_iterations, d, solver id, extrapolate, has limits."""
+    """(6,) max_iterations, d, solver id, extrapolate, has limits, has limits that can hold a chain at a fixed
+    point (a cone, or a hinge with less than the full turn: free hinges only keep a chain in their planes, where
+    it moves as freely as without them, so the fixed-point rule waits for the cap)."""
     root_direction: NDArray[np.float64]
     """(3,) unit rest direction of the root (z = 0 in 2D)."""
     centres: NDArray[np.float64]
     """(K, 3) obstacle centres (m)."""
     radii: NDArray[np.float64]
     """(K,) obstacle radii (m)."""
+    table: NDArray[np.float64] = dataclasses.field(default_factory=lambda: _FREE_TABLE)
+    """(T, 13) joint limits, one row per segment (T = n) or one row for all (T = 1); see :func:`_limit_table`."""
+
+    def constrained(
+        self, constraints: Sequence[Constraint] | None, n: int, dim: int, cone: float | None
+    ) -> _Setup:
+        """These options with per-segment ``constraints`` (checked) in place of the uniform cone."""
+        if constraints is None:
+            return self
+        if cone is not None:
+            raise ValueError(
+                "constraints and cone_half_angle_rad are alternatives: give one of them, not both"
+            )
+        table = _limit_table(constraints, n, dim, "constraints", segment_offset=0)
+        has_limits = bool(np.any(table[:, 0] != _KIND_FREE))
+        cones = table[table[:, 0] == _KIND_CONE, 1]
+        cos_phi = (
+            float(cones.max()) if cones.size else -1.0
+        )  # the tightest cone bounds the unbending arc
+        params = self.params.copy()
+        params[1], params[2] = cos_phi, math.sqrt(max(0.0, 1.0 - cos_phi * cos_phi))
+        flags = self.flags.copy()
+        flags[4] = int(has_limits)
+        full_turn = (table[:, 0] == _KIND_HINGE) & (table[:, 10] - table[:, 9] >= 2.0 * math.pi)
+        flags[5] = int(bool(np.any((table[:, 0] != _KIND_FREE) & ~full_turn)))
+        return dataclasses.replace(self, params=params, flags=flags, table=table)
 
     @staticmethod
     def build(
@@ -598,11 +825,16 @@ def _options(
             cos_phi, sin_phi, has_limits = math.cos(phi), math.sin(phi), 1
     rest = np.zeros(3)
     rest[:dim] = _root_direction(None, dim)
+    table = np.zeros((1, _TABLE_WIDTH))
+    if has_limits:
+        table[0, :3] = _KIND_CONE, cos_phi, sin_phi
     return _Setup(
         max_iterations=int(max_iterations),
+        table=table,
         params=np.array([tol, cos_phi, sin_phi]),
         flags=np.array(
-            [int(max_iterations), dim, solver, int(bool(extrapolate)), has_limits], dtype=np.int64
+            [int(max_iterations), dim, solver, int(bool(extrapolate)), has_limits, has_limits],
+            dtype=np.int64,
         ),
         root_direction=rest,
         centres=np.zeros((0, 3)),
@@ -620,6 +852,7 @@ def _solve_single(
     obstacles: Sequence[Obstacle],
     root_direction: ArrayLike | None,
     extrapolate: bool,
+    constraints: Sequence[Constraint] | None = None,
 ) -> Solution:
     """One chain: checked here, solved by the same compiled core as every chain of a batch."""
     chain = _check_joints("joints", joints, batched=False)
@@ -627,6 +860,7 @@ def _solve_single(
     point = _check_vector("target", target, dim)
     setup = _Setup.build(dim, tolerance, max_iterations, cone_half_angle_rad, obstacles,
                          root_direction, _SOLVER_IDS[solver], extrapolate)  # fmt: skip
+    setup = setup.constrained(constraints, count - 1, dim, cone_half_angle_rad)
     p = np.zeros((1, count, 3))
     p[0, :, :dim] = chain
     goal = np.zeros((1, 3))
@@ -637,7 +871,7 @@ def _solve_single(
     status = np.empty(1, dtype=np.int64)
     error = np.empty(1)
     _solve_rows(0, 1, p, goal, setup.params, setup.flags, setup.root_direction, setup.centres,
-                setup.radii, out_p, history, iterations, status, error)  # fmt: skip
+                setup.radii, out_p, history, iterations, status, error, setup.table)  # fmt: skip
     used = int(iterations[0])
     return Solution(
         joints=out_p[0, :, :dim].copy() if dim == 2 else out_p[0],
@@ -768,12 +1002,12 @@ def _deflect(
 @numba.njit(cache=True, error_model="numpy")
 def _forward_pass(
     p: NDArray[np.float64], target: NDArray[np.float64], lengths: NDArray[np.float64],
-    tiny: float, rest: NDArray[np.float64], limits: tuple[bool, float, float],
+    tiny: float, rest: NDArray[np.float64], limits: tuple[bool, NDArray[np.float64]],
     centres: NDArray[np.float64], radii: NDArray[np.float64], live: NDArray[np.bool_],
     has_zero: bool, dim: int,
 ) -> None:  # fmt: skip
     """End on the target, each joint back toward its old place at its link's length (the root is left)."""
-    has_limits, cos_phi, sin_phi = limits
+    has_limits, table = limits
     n = lengths.shape[0]
     p[n, 0], p[n, 1], p[n, 2] = target[0], target[1], target[2]
     qx, qy, qz, _ = _unit(p[0, 0] - p[n, 0], p[0, 1] - p[n, 1], p[0, 2] - p[n, 2],
@@ -785,8 +1019,8 @@ def _forward_pass(
             dx, dy, dz, _ = _deflect(
                 x, y, z, dx, dy, dz, lengths[i], centres, radii, live, tiny, dim
             )
-        if has_limits and i < n - 1:
-            dx, dy, dz = _clamp_cone(dx, dy, dz, qx, qy, qz, cos_phi, sin_phi, dim)
+        if has_limits:
+            dx, dy, dz = _forward_limits(p, i, n, dx, dy, dz, qx, qy, qz, table, rest, tiny, dim)
         length = lengths[i]
         x, y, z = x + length * dx, y + length * dy, z + length * dz
         p[i, 0], p[i, 1], p[i, 2] = x, y, z
@@ -797,22 +1031,22 @@ def _forward_pass(
 @numba.njit(cache=True, error_model="numpy")
 def _backward_pass(
     p: NDArray[np.float64], lengths: NDArray[np.float64], tiny: float,
-    rest: NDArray[np.float64], limits: tuple[bool, float, float], centres: NDArray[np.float64],
+    rest: NDArray[np.float64], limits: tuple[bool, NDArray[np.float64]], centres: NDArray[np.float64],
     radii: NDArray[np.float64], live: NDArray[np.bool_], has_zero: bool, dim: int,
 ) -> None:  # fmt: skip
     """Root back on its place, each joint outward toward its current place; limits and obstacles enforced."""
-    has_limits, cos_phi, sin_phi = limits
+    has_limits, table = limits
     qx, qy, qz = rest[0], rest[1], rest[2]
     x, y, z = p[0, 0], p[0, 1], p[0, 2]  # the anchor, carried in registers from joint to joint
     for i in range(1, lengths.shape[0] + 1):
         dx, dy, dz, _ = _unit(p[i, 0] - x, p[i, 1] - y, p[i, 2] - z, qx, qy, qz, tiny)
         if has_limits:
-            dx, dy, dz = _clamp_cone(dx, dy, dz, qx, qy, qz, cos_phi, sin_phi, dim)
+            dx, dy, dz = _constrain(dx, dy, dz, qx, qy, qz, table, i - 1, rest, tiny, dim)
         if radii.shape[0] > 0:
             dx, dy, dz, turned = _deflect(x, y, z, dx, dy, dz, lengths[i - 1], centres, radii, live,
                                           tiny, dim)  # fmt: skip
             if turned and has_limits:
-                dx, dy, dz = _clamp_cone(dx, dy, dz, qx, qy, qz, cos_phi, sin_phi, dim)
+                dx, dy, dz = _constrain(dx, dy, dz, qx, qy, qz, table, i - 1, rest, tiny, dim)
         length = lengths[i - 1]
         x, y, z = x + length * dx, y + length * dy, z + length * dz
         p[i, 0], p[i, 1], p[i, 2] = x, y, z
@@ -931,16 +1165,16 @@ def _dls_step(
 
 @numba.njit(cache=True, error_model="numpy")
 def _cone_ok(
-    p: NDArray[np.float64], tiny: float, rest: NDArray[np.float64], cos_phi: float
+    p: NDArray[np.float64], tiny: float, rest: NDArray[np.float64], table: NDArray[np.float64]
 ) -> bool:
-    """Whether every segment lies within its cone (zero-length segments have none and are skipped)."""
+    """Whether every segment keeps its joint's cone or hinge (zero-length segments have none and are skipped)."""
     qx, qy, qz = rest[0], rest[1], rest[2]
     for i in range(p.shape[0] - 1):
         dx, dy, dz, norm = _unit(p[i + 1, 0] - p[i, 0], p[i + 1, 1] - p[i, 1],
                                  p[i + 1, 2] - p[i, 2], qx, qy, qz, tiny)  # fmt: skip
         if norm <= tiny:
             continue
-        if not dx * qx + dy * qy + dz * qz >= cos_phi - _CONE_SLACK:
+        if not _joint_ok(dx, dy, dz, qx, qy, qz, table, i, rest, tiny):
             return False
         qx, qy, qz = dx, dy, dz
     return True
@@ -974,11 +1208,11 @@ def _colliding(
 @numba.njit(cache=True, error_model="numpy")
 def _admissible(
     p: NDArray[np.float64], tiny: float, rest: NDArray[np.float64], has_limits: bool,
-    cos_phi: float, centres: NDArray[np.float64], radii: NDArray[np.float64],
+    table: NDArray[np.float64], centres: NDArray[np.float64], radii: NDArray[np.float64],
     live: NDArray[np.bool_],
 ) -> bool:  # fmt: skip
     """Whether the pose keeps every joint limit and cuts no live obstacle."""
-    if has_limits and not _cone_ok(p, tiny, rest, cos_phi):
+    if has_limits and not _cone_ok(p, tiny, rest, table):
         return False
     return not _colliding(p, centres, radii, live, 1.0)
 
@@ -1092,7 +1326,7 @@ def _solve_chain(
     flags: NDArray[np.int64], rest: NDArray[np.float64], centres: NDArray[np.float64],
     radii: NDArray[np.float64], lengths: NDArray[np.float64], live: NDArray[np.bool_],
     best: NDArray[np.float64], previous: NDArray[np.float64], before: NDArray[np.float64],
-    out_p: NDArray[np.float64], history: NDArray[np.float64],
+    out_p: NDArray[np.float64], history: NDArray[np.float64], table: NDArray[np.float64],
 ) -> tuple[int, int, float]:  # fmt: skip
     """Solve one chain, starting from ``p`` (n + 1, 3), which it works on in place.
 
@@ -1100,11 +1334,11 @@ def _solve_chain(
     leaves NaN past the last iteration; ``lengths`` (n,), ``live`` (K,), ``best``, ``previous`` and ``before``
     (n + 1, 3) are scratch. Returns (iterations, status, error of the returned pose).
     """
-    tolerance, cos_phi, sin_phi = params[0], params[1], params[2]
+    tolerance, cos_phi = params[0], params[1]
     max_iterations, dim, solver = flags[0], flags[1], flags[2]
     extrapolate = flags[3] != 0 and solver == _FABRIK
     has_limits = flags[4] != 0
-    limits = (has_limits, cos_phi, sin_phi)
+    limits = (has_limits, table)
     n = p.shape[0] - 1
     history[:] = np.nan
 
@@ -1128,13 +1362,13 @@ def _solve_chain(
             centres[k, 2] - p[0, 2]
         ) ** 2 > radii[k] * radii[k]
         any_live = any_live or live[k]
-    constrained = has_limits or any_live
+    constrained = (has_limits and flags[5] != 0) or any_live
 
     error = _end_error(p, target)
     history[0] = error
     _copy(p, best)
     best_error = np.inf
-    if _admissible(p, tiny, rest, has_limits, cos_phi, centres, radii, live):
+    if _admissible(p, tiny, rest, has_limits, table, centres, radii, live):
         best_error = error
         if error < tolerance:
             _copy(p, out_p)
@@ -1146,13 +1380,15 @@ def _solve_chain(
         _place_on_line(before, p[0], lengths, ux, uy, uz, fold)
         candidate = _end_error(before, target)
         # Within tolerance (ΣL − r ≤ tolerance, to rounding; also for tolerance 0 at exactly ΣL) it reaches.
-        if _admissible(before, tiny, rest, has_limits, cos_phi, centres, radii, live):
+        if _admissible(before, tiny, rest, has_limits, table, centres, radii, live):
             if candidate <= tolerance + tiny or out_of_reach:
                 _copy(before, out_p)
                 history[1] = candidate
                 return 1, _REACHED if candidate <= tolerance + tiny else _UNREACHABLE, candidate
 
     _unbend(p, target, lengths, tiny, rest, has_limits, cos_phi, dim)
+    # The extrapolation's first call moves by 0 × (p − previous): never 0 × uninitialised memory (NaN).
+    _copy(p, previous)
     stall = _STALL * tolerance + tiny
     progress = _PROGRESS * tolerance + tiny
     stall_applies = constrained or out_of_reach
@@ -1178,10 +1414,8 @@ def _solve_chain(
         # A chain whose extrapolation made its error grow (a target the limits keep away, r → 1) is left to plain
         # FABRIK from then on, which settles at its fixed point.
         trusted = trusted and not (moved and error > last_error)
-        # Every iterate ends on the backward pass, whose last word on each segment is the cone clamp: it keeps the
-        # limits by construction, and only an obstacle can still be cut.
         if (error < best_error or error < tolerance) and (
-            not any_live or not _colliding(p, centres, radii, live, 1.0)
+            not constrained or _admissible(p, tiny, rest, has_limits, table, centres, radii, live)
         ):
             if error < best_error:
                 _copy(p, best)
@@ -1225,7 +1459,7 @@ def _solve_rows(
     params: NDArray[np.float64], flags: NDArray[np.int64], rest: NDArray[np.float64],
     centres: NDArray[np.float64], radii: NDArray[np.float64], out_p: NDArray[np.float64],
     history: NDArray[np.float64], iterations: NDArray[np.int64], status: NDArray[np.int64],
-    error: NDArray[np.float64],
+    error: NDArray[np.float64], table: NDArray[np.float64],
 ) -> None:  # fmt: skip
     """Solve rows ``lo`` to ``hi`` of a batch (p (B, n + 1, 3), target (B, 3)) with one set of scratch arrays."""
     count = p.shape[1]
@@ -1235,7 +1469,7 @@ def _solve_rows(
     for b in range(lo, hi):
         iterations[b], status[b], error[b] = _solve_chain(
             p[b], target[b], params, flags, rest, centres, radii, lengths, live, best, previous,
-            before, out_p[b], history[b],
+            before, out_p[b], history[b], table,
         )  # fmt: skip
 
 
@@ -1245,10 +1479,641 @@ def _solve_parallel(
     params: NDArray[np.float64], flags: NDArray[np.int64], rest: NDArray[np.float64],
     centres: NDArray[np.float64], radii: NDArray[np.float64], out_p: NDArray[np.float64],
     history: NDArray[np.float64], iterations: NDArray[np.int64], status: NDArray[np.int64],
-    error: NDArray[np.float64],
+    error: NDArray[np.float64], table: NDArray[np.float64],
 ) -> None:  # fmt: skip
     """:func:`_solve_rows` over a whole batch, in ``chunks`` contiguous chunks spread over numba's threads."""
     batch = p.shape[0]
     for c in numba.prange(chunks):
         _solve_rows(c * batch // chunks, (c + 1) * batch // chunks, p, target, params, flags, rest,
-                    centres, radii, out_p, history, iterations, status, error)  # fmt: skip
+                    centres, radii, out_p, history, iterations, status, error, table)  # fmt: skip
+
+
+# ================================================================================================ compiled joints
+# Per-segment limits, read from a (T, 13) table (see :func:`_limit_table`): row i for segment i, or row 0 for every
+# segment when T = 1 (the uniform cone). A tree's table has one row per joint, for the segment from its parent.
+@numba.njit(cache=True, error_model="numpy")
+def _row(table: NDArray[np.float64], i: int) -> int:
+    return i if table.shape[0] > 1 else 0
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _turn_shortest(
+    vx: float, vy: float, vz: float, s: NDArray[np.float64], tx: float, ty: float, tz: float
+) -> tuple[float, float, float]:
+    """v turned by the shortest rotation taking unit s onto unit t (π about a perpendicular where t = −s).
+
+    ``R v = v + c × v + c × (c × v) / (1 + s·t)`` with ``c = s × t`` (Rodrigues' formula without the angle)."""
+    cx, cy, cz = s[1] * tz - s[2] * ty, s[2] * tx - s[0] * tz, s[0] * ty - s[1] * tx
+    dot = s[0] * tx + s[1] * ty + s[2] * tz
+    if dot < -1.0 + 1e-12:
+        kx, ky, kz = _perpendicular(s[0], s[1], s[2], 3)
+        along = 2.0 * (kx * vx + ky * vy + kz * vz)
+        return along * kx - vx, along * ky - vy, along * kz - vz
+    wx, wy, wz = cy * vz - cz * vy, cz * vx - cx * vz, cx * vy - cy * vx
+    k = 1.0 / (1.0 + dot)
+    ux, uy, uz = cy * wz - cz * wy, cz * wx - cx * wz, cx * wy - cy * wx
+    return vx + wx + k * ux, vy + wy + k * uy, vz + wz + k * uz
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _hinge_axes(
+    table: NDArray[np.float64], row: int, qx: float, qy: float, qz: float,
+    rest: NDArray[np.float64],
+) -> tuple[float, float, float, float, float, float]:  # fmt: skip
+    """The hinge's world axis a and unit reference r ⊥ a, for a previous-segment direction q (unit)."""
+    ax, ay, az = table[row, 3], table[row, 4], table[row, 5]
+    rx, ry, rz = table[row, 6], table[row, 7], table[row, 8]
+    if table[row, 11] != 0.0:  # local: turn with the previous segment
+        ax, ay, az = _turn_shortest(ax, ay, az, rest, qx, qy, qz)
+        if table[row, 12] != 0.0:
+            rx, ry, rz = _turn_shortest(rx, ry, rz, rest, qx, qy, qz)
+    if table[row, 12] == 0.0:
+        rx, ry, rz = qx, qy, qz
+    along = rx * ax + ry * ay + rz * az
+    px, py, pz = _perpendicular(ax, ay, az, 3)
+    rx, ry, rz, _ = _unit(rx - along * ax, ry - along * ay, rz - along * az, px, py, pz, 1e-9)
+    return ax, ay, az, rx, ry, rz
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _rotate(
+    vx: float, vy: float, vz: float, ax: float, ay: float, az: float, angle: float
+) -> tuple[float, float, float]:
+    """v turned by ``angle`` (rad) about the unit axis a (Rodrigues' formula)."""
+    c, s = math.cos(angle), math.sin(angle)
+    dot = (ax * vx + ay * vy + az * vz) * (1.0 - c)
+    return (
+        vx * c + (ay * vz - az * vy) * s + ax * dot,
+        vy * c + (az * vx - ax * vz) * s + ay * dot,
+        vz * c + (ax * vy - ay * vx) * s + az * dot,
+    )
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _wrap(angle: float) -> float:
+    """``angle`` (rad) brought into [−π, π)."""
+    return (angle + math.pi) % (2.0 * math.pi) - math.pi
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _hinge_angle(
+    vx: float, vy: float, vz: float, ax: float, ay: float, az: float, rx: float, ry: float,
+    rz: float, low: float, high: float,
+) -> float:  # fmt: skip
+    """Signed angle of v about a from r (rad), as the representative in [low − 2π, high + 2π] nearest the range."""
+    bx, by, bz = ay * rz - az * ry, az * rx - ax * rz, ax * ry - ay * rx
+    theta = math.atan2(vx * bx + vy * by + vz * bz, vx * rx + vy * ry + vz * rz)
+    if theta < low and theta + 2.0 * math.pi <= high + _HINGE_SLACK:
+        theta += 2.0 * math.pi
+    elif theta > high and theta - 2.0 * math.pi >= low - _HINGE_SLACK:
+        theta -= 2.0 * math.pi
+    return theta
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _clamp_hinge(
+    vx: float, vy: float, vz: float, qx: float, qy: float, qz: float,
+    table: NDArray[np.float64], row: int, rest: NDArray[np.float64],
+) -> tuple[float, float, float]:  # fmt: skip
+    """The unit direction v brought onto the hinge: projected onto its plane (the nearest direction there), then,
+    outside the range, onto the nearer end around the circle."""
+    ax, ay, az, rx, ry, rz = _hinge_axes(table, row, qx, qy, qz, rest)
+    along = vx * ax + vy * ay + vz * az
+    ux, uy, uz, _ = _unit(vx - along * ax, vy - along * ay, vz - along * az, rx, ry, rz, 1e-12)
+    low, high = table[row, 9], table[row, 10]
+    theta = _hinge_angle(ux, uy, uz, ax, ay, az, rx, ry, rz, low, high)
+    if low <= theta <= high:
+        return ux, uy, uz
+    end = low if abs(_wrap(theta - low)) <= abs(_wrap(theta - high)) else high
+    bx, by, bz = ay * rz - az * ry, az * rx - ax * rz, ax * ry - ay * rx
+    c, s = math.cos(end), math.sin(end)
+    return c * rx + s * bx, c * ry + s * by, c * rz + s * bz
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _constrain(
+    vx: float, vy: float, vz: float, qx: float, qy: float, qz: float,
+    table: NDArray[np.float64], i: int, rest: NDArray[np.float64], tiny: float, dim: int,
+) -> tuple[float, float, float]:  # fmt: skip
+    """Segment i's unit direction v brought inside its joint's limit, q (unit) the previous segment's direction."""
+    row = _row(table, i)
+    kind = table[row, 0]
+    if kind == _KIND_CONE:
+        return _clamp_cone(vx, vy, vz, qx, qy, qz, table[row, 1], table[row, 2], dim)
+    if kind == _KIND_HINGE:
+        return _clamp_hinge(vx, vy, vz, qx, qy, qz, table, row, rest)
+    return vx, vy, vz
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _forward_limits(
+    p: NDArray[np.float64], i: int, n: int, dx: float, dy: float, dz: float, qx: float,
+    qy: float, qz: float, table: NDArray[np.float64], rest: NDArray[np.float64], tiny: float,
+    dim: int,
+) -> tuple[float, float, float]:  # fmt: skip
+    """The forward pass's limits on segment i, whose reversed unit direction is d (q: segment i + 1's, reversed).
+
+    The cone of the joint between segments i and i + 1 holds them together (it is symmetric); a hinge on segment i
+    keeps it in its plane, the plane taken from segment i − 1 as it stands (caliko's forward pass; the range waits
+    for the backward pass)."""
+    if i < n - 1:
+        row = _row(table, i + 1)
+        if table[row, 0] == _KIND_CONE:
+            dx, dy, dz = _clamp_cone(dx, dy, dz, qx, qy, qz, table[row, 1], table[row, 2], dim)
+        elif table[row, 0] == _KIND_HINGE and table[row, 12] == 0.0:
+            # A joint angle (measured from segment i): turn segment i about the axis until segment i + 1's
+            # angle from it is in range, as the cone does by symmetry.
+            ax, ay, az, rx, ry, rz = _hinge_axes(table, row, -dx, -dy, -dz, rest)
+            low, high = table[row, 9], table[row, 10]
+            theta = _hinge_angle(-qx, -qy, -qz, ax, ay, az, rx, ry, rz, low, high)
+            if not low <= theta <= high:
+                end = low if abs(_wrap(theta - low)) <= abs(_wrap(theta - high)) else high
+                dx, dy, dz = _rotate(dx, dy, dz, ax, ay, az, theta - end)
+    row = _row(table, i)
+    if table[row, 0] == _KIND_HINGE:
+        sx, sy, sz, _ = _unit(p[i, 0] - p[i - 1, 0], p[i, 1] - p[i - 1, 1], p[i, 2] - p[i - 1, 2],
+                              rest[0], rest[1], rest[2], tiny)  # fmt: skip
+        ax, ay, az, rx, ry, rz = _hinge_axes(table, row, sx, sy, sz, rest)
+        along = dx * ax + dy * ay + dz * az
+        dx, dy, dz, _ = _unit(
+            dx - along * ax, dy - along * ay, dz - along * az, -rx, -ry, -rz, 1e-12
+        )
+    return dx, dy, dz
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _joint_ok(
+    dx: float, dy: float, dz: float, qx: float, qy: float, qz: float,
+    table: NDArray[np.float64], i: int, rest: NDArray[np.float64], tiny: float,
+) -> bool:  # fmt: skip
+    """Whether segment i's unit direction d keeps its joint's limit, q the previous segment's unit direction."""
+    row = _row(table, i)
+    kind = table[row, 0]
+    if kind == _KIND_CONE:
+        return dx * qx + dy * qy + dz * qz >= table[row, 1] - _CONE_SLACK
+    if kind == _KIND_HINGE:
+        ax, ay, az, rx, ry, rz = _hinge_axes(table, row, qx, qy, qz, rest)
+        if abs(dx * ax + dy * ay + dz * az) > _HINGE_SLACK:
+            return False
+        low, high = table[row, 9], table[row, 10]
+        theta = _hinge_angle(dx, dy, dz, ax, ay, az, rx, ry, rz, low, high)
+        return low - _HINGE_SLACK <= theta <= high + _HINGE_SLACK
+    return True
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _usage(
+    p: NDArray[np.float64], table: NDArray[np.float64], rest: NDArray[np.float64], tiny: float
+) -> NDArray[np.float64]:
+    """(n,) share of each segment's limit used (see :func:`limit_usage`)."""
+    n = p.shape[0] - 1
+    share = np.zeros(n)
+    qx, qy, qz = rest[0], rest[1], rest[2]
+    for i in range(n):
+        dx, dy, dz, norm = _unit(p[i + 1, 0] - p[i, 0], p[i + 1, 1] - p[i, 1],
+                                 p[i + 1, 2] - p[i, 2], qx, qy, qz, tiny)  # fmt: skip
+        if norm <= tiny:
+            continue
+        row = _row(table, i)
+        kind = table[row, 0]
+        if kind == _KIND_CONE:
+            phi = math.atan2(table[row, 2], table[row, 1])
+            angle = math.acos(min(max(dx * qx + dy * qy + dz * qz, -1.0), 1.0))
+            share[i] = 1.0 if phi <= 0.0 else min(angle / phi, 1.0)
+        elif kind == _KIND_HINGE:
+            ax, ay, az, rx, ry, rz = _hinge_axes(table, row, qx, qy, qz, rest)
+            low, high = table[row, 9], table[row, 10]
+            theta = _hinge_angle(dx, dy, dz, ax, ay, az, rx, ry, rz, low, high)
+            half = 0.5 * (high - low)
+            gap = min(theta - low, high - theta)
+            share[i] = 1.0 if half <= 0.0 else min(max(1.0 - gap / half, 0.0), 1.0)
+        qx, qy, qz = dx, dy, dz
+    return share
+
+
+# ================================================================================================ skeletons
+@dataclasses.dataclass(frozen=True)
+class TreeSolution:
+    """One skeleton's solve (:func:`solve_tree`)."""
+
+    joints: NDArray[np.float64]
+    """(J, d) joint positions of the returned pose (m), in the order given."""
+    effectors: NDArray[np.int64]
+    """(E,) the joints that had targets, ascending; ``error`` and ``status`` follow this order."""
+    error: NDArray[np.float64]
+    """(E,) distance from each end effector to its target (m)."""
+    status: tuple[Status, ...]
+    """(E,) why each effector stopped where it did; see :data:`Status` ("limited" also covers an effector held
+    short of its target by the others' targets: a compromise of the centroid rule)."""
+    iterations: int
+    """Iterations run (0 when the start already met the tolerance)."""
+    error_history: NDArray[np.float64]
+    """(iterations + 1, E) every effector's error before the first iteration and after each one (m)."""
+
+
+def solve_tree(
+    parents: ArrayLike,
+    joints: ArrayLike,
+    targets: Mapping[int, ArrayLike],
+    *,
+    tolerance: float = 1e-3,
+    max_iterations: int = 50,
+    constraints: Sequence[Constraint] | None = None,
+    obstacles: Sequence[Obstacle] = (),
+    root_direction: ArrayLike | None = None,
+) -> TreeSolution:
+    """Solve a skeleton with several end effectors by FABRIK (Aristidou & Lasenby 2011, §4.2, multiple end
+    effectors).
+
+    Forward stage: from each end effector with a target, forward reaching up its branch to the sub-base (the
+    nearest joint with several children, or the root); each branch proposes a place for the sub-base and the
+    sub-base goes to their centroid, then forward reaching goes on from there toward the root. Backward stage: the
+    root back on its place and backward reaching outwards along every branch. Effectors without a target, and the
+    branches that only lead to them, take no part in the forward stage and follow in the backward one. Joint limits
+    are imposed inside the backward stage (the forward stage only keeps each hinge's segment in its plane), so every
+    iterate keeps every limit; obstacles as in :func:`solve`. Stops when every effector is within ``tolerance``, at
+    ``max_iterations``, or when no effector's error changes by more than 0.1 % of the tolerance in an iteration.
+
+    A tree that is one chain (no joint with two children) is solved by :func:`solve` itself, so it gives
+    ``solve``'s result (with its extrapolation, its best-pose rule and its closest pose for targets out of reach).
+
+    Args:
+        parents: (J,) int, the parent of each joint; −1 for the one root. Any order (joints need not follow their
+            parents).
+        joints: (J, d) starting joint positions (m), d = 2 or 3; the root is fixed and link lengths (joint to
+            parent) are kept.
+        targets: end-effector joint index (a joint with no children) → (d,) target (m); at least one.
+        tolerance: as in :func:`solve` (m), for every effector.
+        max_iterations: iteration cap, ≥ 1.
+        constraints: one entry per joint for the segment from its parent (None for the root and free joints):
+            :class:`Cone` or :class:`Hinge`, "previous segment" being the parent's segment (the root direction for
+            the root's children).
+        obstacles: as in :func:`solve`.
+        root_direction: as in :func:`solve`.
+
+    Returns:
+        The :class:`TreeSolution` (the last iterate).
+
+    Raises:
+        ValueError: naming the argument, for a ``parents`` that is not one tree over the joints, targets on joints
+            that are not end effectors, and everything :func:`solve` refuses.
+    """
+    points = _check_joints("joints", joints, batched=False)
+    count, dim = points.shape
+    if not isinstance(targets, Mapping) or not targets:
+        raise ValueError(
+            f"targets must be a non-empty mapping joint index → target, got {targets!r}"
+        )
+    try:
+        key_parents = (
+            tuple(int(v) for v in np.asarray(parents).reshape(-1)) if _integers(parents) else None
+        )
+        keys = tuple(sorted(targets))
+        topology = _tree_topology(key_parents, count, keys) if key_parents is not None else None
+    except TypeError:  # unhashable or unorderable keys: checked (and refused) without the cache
+        topology = None
+    if topology is None:
+        topology = _tree_topology.__wrapped__(parents, count, tuple(targets))
+    order, parent, active, has_goal, effector_ids, is_chain = topology
+    goal = np.zeros((count, 3))
+    for key in effector_ids.tolist():
+        goal[key, :dim] = _check_vector(f"targets[{key}]", targets[key], dim)
+    setup = _Setup.build(dim, tolerance, max_iterations, None, obstacles, root_direction,
+                         _FABRIK, False)  # fmt: skip
+    root = int(order[0])
+    table = _tree_table(constraints, count, dim, root)
+    tol = float(setup.params[0])
+
+    if is_chain:  # one chain: solve's result
+        chain_constraints = None if constraints is None else [constraints[j] for j in order[1:]]
+        single = _solve_single("fabrik", points[order], goal[effector_ids[0], :dim], tol,
+                               setup.max_iterations, None, obstacles, root_direction, True,
+                               chain_constraints)  # fmt: skip
+        out = np.empty_like(points)
+        out[order] = single.joints
+        return TreeSolution(
+            joints=out,
+            effectors=effector_ids.copy(),
+            error=np.array([single.error]),
+            status=(single.status,),
+            iterations=single.iterations,
+            error_history=single.error_history[:, None].copy(),
+        )
+
+    p = np.zeros((count, 3))
+    p[:, :dim] = points
+    history = np.empty((setup.max_iterations + 1, len(effector_ids)))
+    codes = np.empty(len(effector_ids), dtype=np.int64)
+    iterations = _solve_tree_core(
+        p, parent, order, active, goal, has_goal, effector_ids, table, setup.root_direction,
+        setup.centres, setup.radii, tol, setup.max_iterations, dim, history, codes,
+    )  # fmt: skip
+    return TreeSolution(
+        joints=p[:, :dim].copy() if dim == 2 else p,
+        effectors=effector_ids.copy(),
+        error=history[iterations].copy(),
+        status=tuple(STATUSES[c] for c in codes.tolist()),
+        iterations=int(iterations),
+        error_history=history[: iterations + 1].copy(),
+    )
+
+
+def _integers(value: object) -> bool:
+    """Whether ``value`` is an array-like of integers (the cacheable form of ``parents``)."""
+    try:
+        return np.asarray(value).dtype.kind in "iu"
+    except (TypeError, ValueError):
+        return False
+
+
+@functools.lru_cache(maxsize=64)
+def _tree_topology(
+    parents: object, count: int, keys: tuple[object, ...]
+) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.bool_], NDArray[np.bool_],
+           NDArray[np.int64], bool]:  # fmt: skip
+    """Checked tree structure: breadth-first order, parents, the joints that take part in the forward stage (a
+    target beyond them), the targeted joints, the effectors (ascending) and whether the tree is one chain. Cached:
+    a dragged skeleton asks for the same every frame (the arrays are never written to)."""
+    try:
+        raw = np.asarray(parents)
+    except (TypeError, ValueError) as error:
+        raise ValueError(
+            f"parents must be a ({count},) array of integers, got {parents!r}"
+        ) from error
+    if (
+        raw.shape != (count,)
+        or raw.dtype.kind not in "iu"
+        or np.any(raw < -1)
+        or np.any(raw >= count)
+    ):
+        raise ValueError(
+            f"parents must be ({count},) integers in [−1, {count - 1}], got {parents!r}"
+        )
+    parent = raw.astype(np.int64)
+    roots = np.flatnonzero(parent == -1)
+    if roots.size != 1:
+        raise ValueError(f"parents must have exactly one root (−1), got {roots.size}")
+    children: list[list[int]] = [[] for _ in range(count)]
+    for j, up in enumerate(parent.tolist()):
+        if up >= 0:
+            children[up].append(j)
+    order = [int(roots[0])]
+    for j in order:  # breadth first: every joint after its parent
+        order.extend(children[j])
+    if len(order) != count:
+        raise ValueError(
+            "parents must form one tree: some joints are on a cycle, not under the root"
+        )
+    has_goal = np.zeros(count, dtype=np.bool_)
+    for key in keys:
+        if isinstance(key, bool) or not isinstance(key, (int, np.integer)) or not 0 <= key < count:
+            raise ValueError(f"targets keys must be joint indices in [0, {count - 1}], got {key!r}")
+        if children[key]:
+            raise ValueError(
+                f"targets[{key}] is on a joint with children: targets go on end effectors"
+            )
+        has_goal[key] = True
+    active = has_goal.copy()
+    for j in reversed(
+        order
+    ):  # a joint takes part in the forward stage when a target lies beyond it
+        if active[j] and parent[j] >= 0:
+            active[parent[j]] = True
+    effectors = np.flatnonzero(has_goal).astype(np.int64)
+    is_chain = all(len(c) <= 1 for c in children)
+    return np.array(order, dtype=np.int64), parent, active, has_goal, effectors, is_chain
+
+
+def _tree_table(
+    constraints: Sequence[Constraint] | None, count: int, dim: int, root: int
+) -> NDArray[np.float64]:
+    """The checked limit table of a tree (one row per joint), cached on hashable constraints."""
+    if constraints is None:
+        return np.zeros((count, _TABLE_WIDTH))
+    try:
+        return _tree_table_cached(tuple(constraints), count, dim, root)
+    except TypeError:  # unhashable entries: checked (and refused) without the cache
+        return _tree_table_cached.__wrapped__(constraints, count, dim, root)
+
+
+@functools.lru_cache(maxsize=64)
+def _tree_table_cached(
+    constraints: Sequence[Constraint], count: int, dim: int, root: int
+) -> NDArray[np.float64]:
+    if (
+        isinstance(constraints, Sequence)
+        and len(constraints) == count
+        and constraints[root] is not None
+    ):
+        raise ValueError(f"constraints[{root}] must be None: the root has no segment")
+    return _limit_table(constraints, count, dim, "constraints", segment_offset=0)
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _solve_tree_core(
+    p: NDArray[np.float64], parents: NDArray[np.int64], order: NDArray[np.int64],
+    active: NDArray[np.bool_], goal: NDArray[np.float64], has_goal: NDArray[np.bool_],
+    effectors: NDArray[np.int64], table: NDArray[np.float64], rest: NDArray[np.float64],
+    centres: NDArray[np.float64], radii: NDArray[np.float64], tolerance: float,
+    max_iterations: int, dim: int, history: NDArray[np.float64], codes: NDArray[np.int64],
+) -> int:  # fmt: skip
+    """Multi-end-effector FABRIK on ``p`` (J, 3), in place; ``order`` is breadth first from the root.
+
+    Fills ``history`` (max_iterations + 1, E) with the effectors' errors, NaN past the last iteration, and
+    ``codes`` (E,) with each effector's status: reached; unreachable (farther from the root than its path's
+    length); blocked (target inside a live obstacle, or the pose touching one); limited (stopped at a fixed point);
+    max_iterations. Returns the iterations run."""
+    count = p.shape[0]
+    root = int(order[0])
+    history[:, :] = np.nan
+    has_limits = False
+    for j in range(count):
+        has_limits = has_limits or table[j, 0] != _KIND_FREE
+    lengths = np.zeros(count)
+    total = 0.0
+    for j in range(count):
+        if parents[j] >= 0:
+            up = int(parents[j])
+            dx, dy, dz = p[j, 0] - p[up, 0], p[j, 1] - p[up, 1], p[j, 2] - p[up, 2]
+            lengths[j] = math.sqrt(dx * dx + dy * dy + dz * dz)
+            total += lengths[j]
+    distance = 0.0
+    for e in range(effectors.shape[0]):
+        k = int(effectors[e])
+        dx, dy, dz = goal[k, 0] - p[root, 0], goal[k, 1] - p[root, 1], goal[k, 2] - p[root, 2]
+        distance = max(distance, math.sqrt(dx * dx + dy * dy + dz * dz))
+    tiny = _TINY * max(total, distance, 1.0)
+    live = np.empty(radii.shape[0], dtype=np.bool_)
+    for k in range(radii.shape[0]):
+        live[k] = (centres[k, 0] - p[root, 0]) ** 2 + (centres[k, 1] - p[root, 1]) ** 2 + (
+            centres[k, 2] - p[root, 2]
+        ) ** 2 > radii[k] * radii[k]
+    bx, by, bz = p[root, 0], p[root, 1], p[root, 2]
+    directions = np.zeros(
+        (count, 3)
+    )  # each joint's segment direction (its parent's where it has none)
+    directions[root, 0], directions[root, 1], directions[root, 2] = rest[0], rest[1], rest[2]
+    for k in range(1, count):
+        j = int(order[k])
+        up = int(parents[j])
+        ux, uy, uz, _ = _unit(p[j, 0] - p[up, 0], p[j, 1] - p[up, 1], p[j, 2] - p[up, 2],
+                              directions[up, 0], directions[up, 1], directions[up, 2], tiny)  # fmt: skip
+        directions[j, 0], directions[j, 1], directions[j, 2] = ux, uy, uz
+    sums = np.zeros((count, 3))
+    counts = np.zeros(count, dtype=np.int64)
+    only_child = np.full(count, -1, dtype=np.int64)  # the one active child, where a joint has one
+    for j in range(count):
+        up = int(parents[j])
+        if up >= 0 and active[j]:
+            only_child[up] = j if counts[up] == 0 else -1
+            counts[up] += 1
+
+    worst = _tree_errors(p, goal, effectors, history, 0)
+    if worst < tolerance:
+        _tree_statuses(p, parents, goal, effectors, lengths, centres, radii, live, tolerance, tiny,
+                       history[0], False, codes)  # fmt: skip
+        return 0
+    stall = _STALL * tolerance + tiny
+    iterations, stalled = 0, False
+    for iteration in range(1, max_iterations + 1):
+        iterations = iteration
+        # forward stage: effectors on their targets, sub-bases at the centroid of their branches' proposals
+        sums[:, :] = 0.0
+        counts[:] = 0
+        for k in range(count - 1, 0, -1):
+            j = int(order[k])
+            if not active[j]:
+                continue
+            if has_goal[j]:
+                x, y, z = goal[j, 0], goal[j, 1], goal[j, 2]
+            else:
+                x, y, z = sums[j, 0] / counts[j], sums[j, 1] / counts[j], sums[j, 2] / counts[j]
+            p[j, 0], p[j, 1], p[j, 2] = x, y, z
+            up = int(parents[j])
+            dx, dy, dz, _ = _unit(p[up, 0] - x, p[up, 1] - y, p[up, 2] - z,
+                                  -directions[j, 0], -directions[j, 1], -directions[j, 2], tiny)  # fmt: skip
+            c = only_child[j]
+            if (
+                c >= 0 and not has_goal[j]
+            ):  # the joint to its one child holds this segment (as in a chain)
+                qx, qy, qz, _ = _unit(x - p[c, 0], y - p[c, 1], z - p[c, 2], dx, dy, dz, tiny)
+                if table[c, 0] == _KIND_CONE:
+                    dx, dy, dz = _clamp_cone(dx, dy, dz, qx, qy, qz, table[c, 1], table[c, 2], dim)
+                elif table[c, 0] == _KIND_HINGE and table[c, 12] == 0.0:
+                    ax, ay, az, rx, ry, rz = _hinge_axes(table, c, -dx, -dy, -dz, rest)
+                    low, high = table[c, 9], table[c, 10]
+                    theta = _hinge_angle(-qx, -qy, -qz, ax, ay, az, rx, ry, rz, low, high)
+                    if not low <= theta <= high:
+                        end = low if abs(_wrap(theta - low)) <= abs(_wrap(theta - high)) else high
+                        dx, dy, dz = _rotate(dx, dy, dz, ax, ay, az, theta - end)
+            # keep the segment in its hinge's plane (caliko's forward pass)
+            if table[j, 0] == _KIND_HINGE:
+                ax, ay, az, rx, ry, rz = _hinge_axes(
+                    table, j, directions[up, 0], directions[up, 1], directions[up, 2], rest
+                )
+                along = dx * ax + dy * ay + dz * az
+                dx, dy, dz, _ = _unit(dx - along * ax, dy - along * ay, dz - along * az,
+                                      -rx, -ry, -rz, 1e-12)  # fmt: skip
+            if radii.shape[0] > 0:
+                dx, dy, dz, _ = _deflect(x, y, z, dx, dy, dz, lengths[j], centres, radii, live, tiny,
+                                         dim)  # fmt: skip
+            sums[up, 0] += x + lengths[j] * dx
+            sums[up, 1] += y + lengths[j] * dy
+            sums[up, 2] += z + lengths[j] * dz
+            counts[up] += 1
+        # backward stage: the root back on its place, every branch outwards
+        p[root, 0], p[root, 1], p[root, 2] = bx, by, bz
+        for k in range(1, count):
+            j = int(order[k])
+            up = int(parents[j])
+            qx, qy, qz = directions[up, 0], directions[up, 1], directions[up, 2]
+            ax, ay, az = p[up, 0], p[up, 1], p[up, 2]
+            dx, dy, dz, _ = _unit(p[j, 0] - ax, p[j, 1] - ay, p[j, 2] - az, qx, qy, qz, tiny)
+            if has_limits:
+                dx, dy, dz = _constrain(dx, dy, dz, qx, qy, qz, table, j, rest, tiny, dim)
+            if radii.shape[0] > 0:
+                dx, dy, dz, turned = _deflect(ax, ay, az, dx, dy, dz, lengths[j], centres, radii,
+                                              live, tiny, dim)  # fmt: skip
+                if turned and has_limits:
+                    dx, dy, dz = _constrain(dx, dy, dz, qx, qy, qz, table, j, rest, tiny, dim)
+            length = lengths[j]
+            p[j, 0], p[j, 1], p[j, 2] = ax + length * dx, ay + length * dy, az + length * dz
+            if length > tiny:
+                directions[j, 0], directions[j, 1], directions[j, 2] = dx, dy, dz
+            else:
+                directions[j, 0], directions[j, 1], directions[j, 2] = qx, qy, qz
+        worst = _tree_errors(p, goal, effectors, history, iteration)
+        if worst < tolerance:
+            break
+        change = 0.0
+        for e in range(effectors.shape[0]):
+            change = max(change, abs(history[iteration, e] - history[iteration - 1, e]))
+        if change < stall:
+            stalled = True
+            break
+    _tree_statuses(p, parents, goal, effectors, lengths, centres, radii, live, tolerance, tiny,
+                   history[iterations], stalled, codes)  # fmt: skip
+    return iterations
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _tree_statuses(
+    p: NDArray[np.float64], parents: NDArray[np.int64], goal: NDArray[np.float64],
+    effectors: NDArray[np.int64], lengths: NDArray[np.float64], centres: NDArray[np.float64],
+    radii: NDArray[np.float64], live: NDArray[np.bool_], tolerance: float, tiny: float,
+    error: NDArray[np.float64], stalled: bool, codes: NDArray[np.int64],
+) -> None:  # fmt: skip
+    """Each effector's status code (see :func:`_solve_tree_core`)."""
+    touching = False
+    for j in range(p.shape[0]):
+        up = int(parents[j])
+        if up < 0 or radii.shape[0] == 0:
+            continue
+        x, y, z = p[up, 0], p[up, 1], p[up, 2]
+        sx, sy, sz = p[j, 0] - x, p[j, 1] - y, p[j, 2] - z
+        seg2 = sx * sx + sy * sy + sz * sz
+        for k in range(radii.shape[0]):
+            rx, ry, rz = centres[k, 0] - x, centres[k, 1] - y, centres[k, 2] - z
+            t = min(max((rx * sx + ry * sy + rz * sz) / (seg2 if seg2 > 0.0 else 1.0), 0.0), 1.0)
+            gx, gy, gz = rx - t * sx, ry - t * sy, rz - t * sz
+            grown = radii[k] * (1.0 + _TOUCH)
+            touching = touching or (live[k] and gx * gx + gy * gy + gz * gz < grown * grown)
+    root = 0
+    while parents[root] >= 0:
+        root = int(parents[root])
+    for e in range(effectors.shape[0]):
+        key = int(effectors[e])
+        reach, j = 0.0, key
+        while parents[j] >= 0:
+            reach += lengths[j]
+            j = int(parents[j])
+        dx, dy, dz = goal[key, 0] - p[root, 0], goal[key, 1] - p[root, 1], goal[key, 2] - p[root, 2]
+        inside = False
+        for k in range(radii.shape[0]):
+            ox = centres[k, 0] - goal[key, 0]
+            oy = centres[k, 1] - goal[key, 1]
+            oz = centres[k, 2] - goal[key, 2]
+            inside = inside or (live[k] and ox * ox + oy * oy + oz * oz < radii[k] * radii[k])
+        if error[e] < tolerance:
+            codes[e] = _REACHED
+        elif math.sqrt(dx * dx + dy * dy + dz * dz) > reach + tiny:
+            codes[e] = _UNREACHABLE
+        elif inside or touching:
+            codes[e] = _BLOCKED
+        else:
+            codes[e] = _LIMITED if stalled else _MAX_ITERATIONS
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _tree_errors(
+    p: NDArray[np.float64], goal: NDArray[np.float64], effectors: NDArray[np.int64],
+    history: NDArray[np.float64], row: int,
+) -> float:  # fmt: skip
+    """Write each effector's distance to its target into ``history[row]``; return the largest."""
+    worst = 0.0
+    for e in range(effectors.shape[0]):
+        k = int(effectors[e])
+        x, y, z = p[k, 0] - goal[k, 0], p[k, 1] - goal[k, 1], p[k, 2] - goal[k, 2]
+        history[row, e] = math.sqrt(x * x + y * y + z * z)
+        worst = max(worst, history[row, e])
+    return worst

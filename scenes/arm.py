@@ -26,6 +26,7 @@ from numpy.typing import NDArray
 
 from kernels import fabrik
 from scenes._base import Scene
+from scenes._skeletons import SkeletonView
 
 MAX_LINKS = 12
 MAX_OBSTACLES = 4
@@ -269,6 +270,12 @@ it); "max_iterations" (still converging at the cap).
 **Compared with.** CCD (turn each joint, end to root, to aim the end at the target) and damped-least-squares
 Jacobian IK, Δθ = Jᵀ(JJᵀ + λ²I)⁻¹e. The paper's Table 1 (10 joints): FABRIK 15.5 iterations, CCD 26.3, DLS 999.
 
+**Skeletons** (the Preset menu): a planar robot arm of hinges with an industrial arm's ranges, a hand (five
+fingers of three hinges on a welded palm) and a humanoid upper body of ball joints, each with a draggable target per
+end effector, solved by multi-end-effector FABRIK (Aristidou & Lasenby 2011: each branch proposes a place for its
+sub-base, the sub-base goes to their centroid, then the backward pass from the root). Each chain has its own colour;
+joints turn red near their limits; the dark bars are the hinge axes. The table gives each effector's error and status.
+
 **Assumptions.** Rigid links, ball joints (hinges in the plane), symmetric cone limits, no dynamics: each frame
 is a static pose.
 """
@@ -287,6 +294,8 @@ is a static pose.
         self._build_gui()
         self._build_world()
         self._click = server.scene.on_click()(self._on_scene_click)
+        self.skeletons = SkeletonView(self)
+        """The robot-arm, hand and upper-body presets (issue 14), shown in place of the chain when chosen."""
         self.solve_and_draw()
 
     def close(self) -> None:
@@ -593,6 +602,7 @@ is a static pose.
         self.report = report
         self.solves += 1
         self._draw(report)
+        self.skeletons.after_chain_draw()
 
     def _draw(self, report: SolveReport) -> None:
         p, joints = self.params, report.result.joints

@@ -1,0 +1,577 @@
+"""Skeleton presets of the arm scene (issue 14): a planar robot arm of hinges, a hand, a humanoid upper body.
+
+Each preset is a tree of joints (:func:`kernels.fabrik.solve_tree`) with a joint type per segment, draggable targets
+on its end effectors, and colours: every chain (finger, limb) its own link colour, every joint from green to red as
+its segment nears its limit, and each hinge's axis drawn as a short dark bar at the joint it turns about.
+
+The pure part (presets, :func:`solve_skeleton`, :func:`joint_usage`) has no viser; :class:`SkeletonView` owns the
+handles, lives inside :class:`scenes.arm.ArmScene` and hides the scene's own chain while a preset is shown.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import math
+import time
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Literal
+
+import numpy as np
+import trimesh
+from numpy.typing import NDArray
+
+from kernels import fabrik
+
+if TYPE_CHECKING:
+    from scenes.arm import ArmScene
+
+PresetLabel = Literal["Chain", "Robot arm", "Hand", "Upper body"]
+PRESET_LABELS: tuple[PresetLabel, ...] = ("Chain", "Robot arm", "Hand", "Upper body")
+MAX_JOINTS = 24
+MAX_EFFECTORS = 5
+WORLD_LIMIT_M = 4.0
+"""Targets stay inside this box (±m on each axis), as the chain's do."""
+LINK_RADIUS_M = 0.016
+JOINT_RADIUS_M = 0.026
+AXIS_HALF_LENGTH_M = 0.05
+CHAIN_COLOURS = np.array(
+    [
+        (70, 110, 200),
+        (200, 120, 40),
+        (60, 160, 90),
+        (160, 70, 170),
+        (40, 160, 170),
+        (120, 120, 130),
+    ],
+    dtype=np.uint8,
+)
+"""Link colour of chain 0, 1, …; the last is the palm and trunk."""
+LIMIT_RAMP = np.array([(60, 200, 90), (250, 200, 40), (230, 50, 50)], dtype=np.float64)
+"""Joint colour at 0 %, 50 % and 100 % of its limit (as the chain's)."""
+FREE_COLOUR = (205, 210, 220)
+TARGET_COLOURS = ((230, 40, 60), (240, 140, 30), (40, 150, 230), (150, 60, 200), (30, 170, 120))
+
+
+@dataclasses.dataclass(frozen=True)
+class Skeleton:
+    """A preset: a tree of joints in the world (m, z up), its joint types and its effectors' starting targets."""
+
+    name: PresetLabel
+    parents: tuple[int, ...]
+    """(J,) parent of each joint, −1 for the root."""
+    joints: NDArray[np.float64]
+    """(J, 3) rest pose (m)."""
+    constraints: tuple[fabrik.Constraint, ...]
+    """(J,) joint type of the segment from each joint's parent (None for the root and free joints)."""
+    chain_of: tuple[int, ...]
+    """(J,) colour index of the segment ending at each joint (see :data:`CHAIN_COLOURS`)."""
+    effectors: tuple[int, ...]
+    """Joints with targets, ascending."""
+    effector_labels: tuple[str, ...]
+    targets: NDArray[np.float64]
+    """(E, 3) opening targets (m)."""
+    planar: bool
+    """True: targets slide in the x–z plane only."""
+    root_direction: tuple[float, float, float] = (0.0, 0.0, 1.0)
+
+
+def _chain(
+    start: NDArray[np.float64], directions: list[NDArray[np.float64]], lengths: list[float]
+) -> list:
+    points, here = [], start
+    for direction, length in zip(directions, lengths, strict=True):
+        here = here + length * direction / np.linalg.norm(direction)
+        points.append(here)
+    return points
+
+
+def _turned(u: NDArray[np.float64], axis: NDArray[np.float64], angle: float) -> NDArray[np.float64]:
+    """u turned by ``angle`` (rad) about the unit axis (Rodrigues)."""
+    return (
+        u * math.cos(angle)
+        + np.cross(axis, u) * math.sin(angle)
+        + axis * float(axis @ u) * (1.0 - math.cos(angle))
+    )
+
+
+def robot_arm() -> Skeleton:
+    """Four links in the x–z plane, every joint a hinge about the world's y axis with an industrial arm's range
+    (shoulder ±92°, elbow −11°…149°, wrist ±109°, flange ±92°, from the previous link)."""
+    y = np.array([0.0, 1.0, 0.0])
+    lengths = [0.55, 0.45, 0.25, 0.12]
+    ranges = [(-1.6, 1.6), (-0.2, 2.6), (-1.9, 1.9), (-1.6, 1.6)]
+    direction, points = np.array([0.0, 0.0, 1.0]), [np.zeros(3)]
+    for length in lengths:
+        direction = _turned(direction, y, 0.25)
+        points.append(points[-1] + length * direction)
+    hinges = [fabrik.Hinge(y, lo, hi) for lo, hi in ranges]
+    return Skeleton(
+        name="Robot arm",
+        parents=(-1, 0, 1, 2, 3),
+        joints=np.array(points),
+        constraints=(None, *hinges),
+        chain_of=(5, 0, 0, 0, 0),
+        effectors=(4,),
+        effector_labels=("Tool",),
+        targets=np.array([[0.8, 0.0, 0.5]]),
+        planar=True,
+    )
+
+
+HAND_SCALE = 5.0
+"""The hand is drawn five times life size, so the default camera sees the fingers."""
+
+
+def hand(curl_rad: float = 0.15, target_curl_rad: float = 0.6) -> Skeleton:
+    """A right hand, palm toward the camera (−y): a wrist root, five metacarpals welded to it (hinges of zero
+    range), and five fingers of three hinges each flexing toward the palm (MCP −17°…92°, PIP 0…109°, DIP 0…80°;
+    the thumb's links a little shorter, with a smaller range). The hand opens with every finger joint curled by
+    ``curl_rad`` and the targets where the fingertips are with every joint curled by ``target_curl_rad``."""
+    s = HAND_SCALE
+    wrist = np.array([0.0, 0.0, 0.2])
+    knuckles = [
+        np.array([0.032, -0.012, 0.045]),  # thumb (carpometacarpal)
+        np.array([0.030, 0.0, 0.090]),
+        np.array([0.010, 0.0, 0.094]),
+        np.array([-0.010, 0.0, 0.090]),
+        np.array([-0.028, 0.0, 0.082]),
+    ]
+    finger_lengths = [
+        [0.035, 0.030, 0.025],
+        [0.040, 0.025, 0.020],
+        [0.045, 0.028, 0.022],
+        [0.042, 0.026, 0.021],
+        [0.034, 0.020, 0.018],
+    ]
+    ranges = [[(-0.3, 0.9), (0.0, 1.2), (0.0, 1.2)]] + [[(-0.3, 1.6), (0.0, 1.9), (0.0, 1.4)]] * 4
+    curls = [np.array([-1.0, -0.8, 0.0]), *[np.array([0.0, -1.0, 0.0])] * 4]
+
+    def build(curl: float) -> tuple[list[int], list, list[fabrik.Constraint], list[int], list[int]]:
+        parents, chain_of, effectors = [-1], [5], []
+        points: list[NDArray[np.float64]] = [wrist]
+        constraints: list[fabrik.Constraint] = [None]
+        for f in range(5):
+            palm = knuckles[f] * s
+            u = np.array([0.6, -0.3, 0.75]) if f == 0 else palm / np.linalg.norm(palm)
+            u = u / np.linalg.norm(u)
+            bend = curls[f] - float(curls[f] @ u) * u
+            axis = np.cross(
+                u, bend / np.linalg.norm(bend)
+            )  # turning u about it by +θ curls toward the palm
+            metacarpal = palm / np.linalg.norm(palm)
+            weld_axis = np.cross(metacarpal, np.array([0.0, -1.0, 0.0]))
+            parents.append(0)
+            points.append(wrist + palm)
+            constraints.append(fabrik.Hinge(weld_axis, 0.0, 0.0, reference_axis=metacarpal))
+            chain_of.append(5)
+            direction = u
+            for k, length in enumerate(finger_lengths[f]):
+                direction = _turned(direction, axis, curl)
+                parents.append(len(points) - 1)
+                points.append(points[-1] + s * length * direction)
+                lo, hi = ranges[f][k]
+                # The first joint is measured from the finger's own rest direction (not the metacarpal's).
+                constraints.append(fabrik.Hinge(axis, lo, hi, reference_axis=u if k == 0 else None))
+                chain_of.append(f)
+            effectors.append(len(points) - 1)
+        return parents, points, constraints, chain_of, effectors
+
+    parents, points, constraints, chain_of, effectors = build(curl_rad)
+    joints = np.array(points)
+    targets = np.array(build(target_curl_rad)[1])[effectors]  # a pose the hand can take
+    return Skeleton(
+        name="Hand",
+        parents=tuple(parents),
+        joints=joints,
+        constraints=tuple(constraints),
+        chain_of=tuple(chain_of),
+        effectors=tuple(effectors),
+        effector_labels=("Thumb", "Index", "Middle", "Ring", "Little"),
+        targets=targets,
+        planar=False,
+    )
+
+
+def upper_body() -> Skeleton:
+    """A humanoid upper body of ball joints: pelvis root, a three-link spine, neck and head, and two arms
+    (clavicle, upper arm, forearm, hand) from the chest, the chest a sub-base of three branches. Cones: spine 20°,
+    neck 29°, head 34°, clavicle 100° and shoulder 80° from the previous link, elbow 137°, wrist 46°."""
+    pelvis = np.array([0.0, 0.0, 0.2])
+    parents = [-1, 0, 1, 2, 3, 4]
+    points = [pelvis, *_chain(pelvis, [np.array([0.0, 0.0, 1.0])] * 5, [0.2, 0.2, 0.2, 0.1, 0.2])]
+    cones = [None, 0.35, 0.35, 0.35, 0.5, 0.6]
+    chain_of = [5, 5, 5, 5, 2, 2]
+    for side, colour in ((-1.0, 0), (1.0, 1)):
+        start = len(points)
+        parents.extend([3, start, start + 1, start + 2])
+        arm = _chain(points[3], [np.array([side, 0.0, -0.1]), np.array([side, 0.0, -0.4]),
+                                 np.array([side * 0.6, -0.2, -1.0]), np.array([side * 0.3, -0.1, -1.0])],
+                     [0.18, 0.3, 0.28, 0.1])  # fmt: skip
+        points.extend(arm)
+        cones.extend([1.75, 1.4, 2.4, 0.8])
+        chain_of.extend([5, colour, colour, colour])
+    joints = np.array(points)
+    effectors = (5, 9, 13)
+    targets = joints[list(effectors)] + np.array(
+        [[0.05, -0.02, -0.03], [-0.1, -0.2, 0.3], [0.15, -0.2, 0.35]]
+    )
+    return Skeleton(
+        name="Upper body",
+        parents=tuple(parents),
+        joints=joints,
+        constraints=tuple(None if c is None else fabrik.Cone(c) for c in cones),
+        chain_of=tuple(chain_of),
+        effectors=effectors,
+        effector_labels=("Head", "Right hand", "Left hand"),
+        targets=targets,
+        planar=False,
+    )
+
+
+PRESETS: dict[PresetLabel, Callable[[], Skeleton]] = {
+    "Robot arm": robot_arm,
+    "Hand": hand,
+    "Upper body": upper_body,
+}
+
+
+@dataclasses.dataclass(frozen=True)
+class SkeletonReport:
+    """The last skeleton solve, as the readouts show it."""
+
+    result: fabrik.TreeSolution
+    micros: float
+    """Wall time of the kernel call (µs)."""
+    usage: NDArray[np.float64]
+    """(J,) share of its limit each joint's segment uses, in [0, 1] (0 for the root and free joints)."""
+
+
+def joint_usage(skeleton: Skeleton, joints: NDArray[np.float64]) -> NDArray[np.float64]:
+    """(J,) how near each segment (parent → joint) is to its limit: :func:`kernels.fabrik.limit_usage` on the
+    segment and its parent's."""
+    usage = np.zeros(len(skeleton.parents))
+    for j, up in enumerate(skeleton.parents):
+        constraint = skeleton.constraints[j]
+        if up < 0 or constraint is None:
+            continue
+        grand = skeleton.parents[up]
+        if grand < 0:
+            usage[j] = fabrik.limit_usage(joints[[up, j]], [constraint], skeleton.root_direction)[0]
+        else:
+            usage[j] = fabrik.limit_usage(
+                joints[[grand, up, j]], [None, constraint], skeleton.root_direction
+            )[1]
+    return usage
+
+
+def solve_skeleton(
+    skeleton: Skeleton, pose: NDArray[np.float64], targets: NDArray[np.float64], *, tolerance_m: float,
+    max_iterations: int,
+) -> SkeletonReport:  # fmt: skip
+    """One frame: every effector toward its target, from the last pose (no viser); where an effector is stuck
+    ("limited" more than 10 tolerances away) also from the rest pose, keeping the closer result."""
+    goal = {e: targets[k] for k, e in enumerate(skeleton.effectors)}
+    began = time.perf_counter()
+    solve = functools.partial(
+        fabrik.solve_tree,
+        skeleton.parents,
+        targets=goal,
+        tolerance=tolerance_m,
+        max_iterations=max_iterations,
+        constraints=skeleton.constraints,
+        root_direction=skeleton.root_direction,
+    )
+    result = solve(pose)
+    stuck = any(
+        s == "limited" and e > 10.0 * tolerance_m
+        for s, e in zip(result.status, result.error, strict=True)
+    )
+    if stuck:
+        # A finger curled far past its target can settle at a fixed point of FABRIK's hinge passes (the forward
+        # pass flips its curled links); from the rest pose it opens. Keep whichever is closer.
+        retry = solve(skeleton.joints)
+        if float(retry.error.sum()) < float(result.error.sum()):
+            result = retry
+    micros = (time.perf_counter() - began) * 1e6
+    return SkeletonReport(result=result, micros=micros, usage=joint_usage(skeleton, result.joints))
+
+
+def hinge_axes(skeleton: Skeleton, joints: NDArray[np.float64]) -> NDArray[np.float64]:
+    """(H, 2, 3) a short bar along each hinge's world axis, centred on the joint it turns about (m)."""
+    bars = []
+    rest = np.asarray(skeleton.root_direction)
+    for j, constraint in enumerate(skeleton.constraints):
+        if (
+            not isinstance(constraint, fabrik.Hinge)
+            or constraint.max_angle_rad == constraint.min_angle_rad
+        ):
+            continue  # a weld has no axis to show
+        up = skeleton.parents[j]
+        axis = np.asarray(constraint.axis, dtype=np.float64)
+        grand = skeleton.parents[up]
+        if constraint.frame == "local" and grand >= 0:
+            previous = joints[up] - joints[grand]
+            previous = previous / max(float(np.linalg.norm(previous)), 1e-12)
+            turn = np.cross(rest, previous)
+            sin_a, cos_a = float(np.linalg.norm(turn)), float(rest @ previous)
+            if sin_a > 1e-12:
+                axis = _turned(axis, turn / sin_a, math.atan2(sin_a, cos_a))
+        bars.append(
+            [joints[up] - AXIS_HALF_LENGTH_M * axis, joints[up] + AXIS_HALF_LENGTH_M * axis]
+        )
+    return np.array(bars, dtype=np.float64).reshape(-1, 2, 3)
+
+
+def usage_colours(usage: NDArray[np.float64], free: NDArray[np.bool_]) -> NDArray[np.uint8]:
+    """(J, 3) joint colours: the green–yellow–red ramp by usage, grey where the joint has no limit."""
+    ramp = np.stack([np.interp(usage, (0.0, 0.5, 1.0), LIMIT_RAMP[:, c]) for c in range(3)], axis=1)
+    ramp[free] = FREE_COLOUR
+    return ramp.round().astype(np.uint8)
+
+
+def clean_target(raw: object, planar: bool) -> NDArray[np.float64] | None:
+    """A browser-sent gizmo position as a world point: three finite numbers inside the world box (y put back to 0
+    for a planar preset), else None."""
+    try:
+        point = np.asarray(raw, dtype=np.float64)
+    except (TypeError, ValueError):
+        return None
+    if (
+        point.shape != (3,)
+        or not np.all(np.isfinite(point))
+        or np.any(np.abs(point) > WORLD_LIMIT_M)
+    ):
+        return None
+    if planar:
+        point = point.copy()
+        point[1] = 0.0
+    return point
+
+
+# --------------------------------------------------------------------------------------------- view
+class SkeletonView:
+    """The preset dropdown, the skeleton's meshes, hinge axes, target gizmos and readouts, inside the arm scene."""
+
+    def __init__(self, scene: ArmScene) -> None:
+        self.scene = scene
+        self.preset: PresetLabel = "Chain"
+        self.skeleton: Skeleton | None = None
+        self.pose = np.zeros((0, 3))
+        self.targets = np.zeros((0, 3))
+        self.report: SkeletonReport | None = None
+        self.solves = 0
+        """Skeleton solves so far (tests wait on it)."""
+        self.gizmo_events = 0
+        """Skeleton gizmo updates handled, accepted or refused (tests wait on it)."""
+        server, root = scene.server, scene.root.name
+        gui = server.gui
+        with scene.gui_root, gui.add_folder("Skeleton", order=-1):
+            self.dropdown = gui.add_dropdown(
+                "Preset", options=list(PRESET_LABELS), initial_value="Chain"
+            )
+            self.readout = gui.add_markdown("")
+        self.dropdown.on_update(scene.callback(self._on_preset))
+        cylinder = trimesh.creation.cylinder(radius=1.0, height=1.0, sections=12)
+        cylinder.apply_translation((0.0, 0.0, 0.5))
+        sphere = trimesh.creation.icosphere(subdivisions=2, radius=1.0)
+        identity = np.tile([1.0, 0.0, 0.0, 0.0], (MAX_JOINTS, 1))
+        self.link_nodes = server.scene.add_batched_meshes_simple(
+            f"{root}/skeleton/links",
+            vertices=cylinder.vertices.astype(np.float32),
+            faces=cylinder.faces.astype(np.uint32),
+            batched_wxyzs=identity,
+            batched_positions=np.zeros((MAX_JOINTS, 3)),
+            batched_scales=np.zeros((MAX_JOINTS, 3)),
+            batched_colors=np.tile(CHAIN_COLOURS[0], (MAX_JOINTS, 1)),
+            lod="off",
+            visible=False,
+        )
+        self.joint_nodes = server.scene.add_batched_meshes_simple(
+            f"{root}/skeleton/joints",
+            vertices=sphere.vertices.astype(np.float32),
+            faces=sphere.faces.astype(np.uint32),
+            batched_wxyzs=identity,
+            batched_positions=np.zeros((MAX_JOINTS, 3)),
+            batched_scales=np.zeros((MAX_JOINTS, 3)),
+            batched_colors=np.tile(np.array(FREE_COLOUR, np.uint8), (MAX_JOINTS, 1)),
+            lod="off",
+            visible=False,
+        )
+        self.axes = server.scene.add_line_segments(
+            f"{root}/skeleton/hinge_axes",
+            points=np.zeros((1, 2, 3), dtype=np.float32),
+            colors=(40, 40, 50),
+            thickness=0.01,
+            visible=False,
+        )
+        box = (-WORLD_LIMIT_M, WORLD_LIMIT_M)
+        self.gizmos = []
+        for k in range(MAX_EFFECTORS):
+            gizmo = server.scene.add_transform_controls(
+                f"{root}/skeleton/target_{k}",
+                scale=0.12,
+                disable_rotations=True,
+                translation_limits=(box, box, box),
+                visible=False,
+            )
+            server.scene.add_icosphere(
+                f"{root}/skeleton/target_{k}/marker", radius=0.025, color=TARGET_COLOURS[k]
+            )
+            gizmo.on_update(functools.partial(self._on_drag, k))
+            self.gizmos.append(gizmo)
+
+    @property
+    def active(self) -> bool:
+        """Whether a skeleton preset (not the scene's own chain) is shown."""
+        return self.skeleton is not None
+
+    # ----------------------------------------------------------------------------------------- callbacks
+    def _on_preset(self) -> None:
+        label = self.scene.read_choice(self.dropdown, PRESET_LABELS, self.preset)
+        for option in PRESET_LABELS:  # the Literal the cleaned string is
+            if option == label and option != self.preset:
+                self.show(option)
+
+    def show(self, label: PresetLabel) -> None:
+        """Switch to a preset (its rest pose and opening targets), or back to the chain."""
+        self.preset = label
+        self.skeleton = None if label == "Chain" else PRESETS[label]()
+        with self.scene.server.atomic():
+            self._show_chain(self.skeleton is None)
+            for node in (self.link_nodes, self.joint_nodes, self.axes):
+                node.visible = self.skeleton is not None
+            if self.skeleton is None:
+                for gizmo in self.gizmos:
+                    gizmo.visible = False
+                self.readout.content = ""
+        if self.skeleton is None:
+            self.report = None
+            self.scene.solve_and_draw()
+            return
+        sk = self.skeleton
+        self.pose = sk.joints.copy()
+        self.targets = sk.targets.copy()
+        axes = (True, False, True) if sk.planar else (True, True, True)
+        with self.scene.server.atomic():
+            for k, gizmo in enumerate(self.gizmos):
+                shown = k < len(sk.effectors)
+                gizmo.visible = shown
+                if shown:
+                    gizmo.active_axes = axes
+                    gizmo.position = self.targets[k]
+        self.solve_and_draw()
+
+    def _show_chain(self, visible: bool) -> None:
+        s = self.scene
+        for node in (s.link_nodes, s.joint_nodes, s.ghost_links, s.ghost_elbow, s.target_gizmo):
+            node.visible = visible
+        for k in range(len(s.obstacle_gizmos)):
+            shown = visible and k < s.params.n_obstacles
+            s.obstacle_gizmos[k].visible = shown
+            s.obstacle_discs[k].visible = shown and not s.params.three_d
+            s.obstacle_spheres[k].visible = shown and s.params.three_d
+
+    def after_chain_draw(self) -> None:
+        """The chain scene drew itself: keep it hidden while a preset is shown."""
+        if self.active:
+            with self.scene.server.atomic():
+                self._show_chain(False)
+
+    def _on_drag(self, k: int, _event: object) -> None:
+        self.scene.callback(functools.partial(self._apply_target, k))(None)
+
+    def _apply_target(self, k: int) -> None:
+        self.gizmo_events += 1
+        sk = self.skeleton
+        if sk is None or k >= len(sk.effectors):
+            return
+        gizmo = self.gizmos[k]
+        point = clean_target(gizmo.position, sk.planar)
+        if point is None:  # NaN, huge, wrong shape: keep the last good target and pose
+            gizmo.position = self.targets[k]
+            gizmo.wxyz = (1.0, 0.0, 0.0, 0.0)
+            return
+        if not np.array_equal(point, np.asarray(gizmo.position, dtype=np.float64)):
+            gizmo.position = point
+        if np.array_equal(point, self.targets[k]):
+            return
+        self.targets[k] = point
+        self.solve_and_draw()
+
+    # ----------------------------------------------------------------------------------------- solve + draw
+    def solve_and_draw(self) -> None:
+        sk = self.skeleton
+        if sk is None:
+            return
+        p = self.scene.params
+        report = solve_skeleton(
+            sk,
+            self.pose,
+            self.targets,
+            tolerance_m=p.tolerance_mm / 1000.0,
+            max_iterations=p.max_iterations,
+        )
+        self.pose = report.result.joints
+        self.report = report
+        self.solves += 1
+        self._draw(sk, report)
+
+    def _draw(self, sk: Skeleton, report: SkeletonReport) -> None:
+        from scenes.arm import (
+            segment_pose,
+        )  # the chain's own segment geometry (imported late: arm imports us)
+
+        joints = report.result.joints
+        count = len(sk.parents)
+        children = [j for j in range(count) if sk.parents[j] >= 0]
+        starts = joints[[sk.parents[j] for j in children]]
+        wxyz, lengths = segment_pose(starts, joints[children])
+        links = len(children)
+        link_wxyz = np.tile([1.0, 0.0, 0.0, 0.0], (MAX_JOINTS, 1))
+        link_wxyz[:links] = wxyz
+        link_pos = np.zeros((MAX_JOINTS, 3))
+        link_pos[:links] = starts
+        link_scale = np.zeros((MAX_JOINTS, 3))
+        link_scale[:links] = np.stack([np.full(links, LINK_RADIUS_M)] * 2 + [lengths], axis=1)
+        link_colour = np.tile(CHAIN_COLOURS[0], (MAX_JOINTS, 1))
+        link_colour[:links] = CHAIN_COLOURS[[sk.chain_of[j] for j in children]]
+        joint_pos = np.zeros((MAX_JOINTS, 3))
+        joint_pos[:count] = joints
+        joint_scale = np.zeros((MAX_JOINTS, 3))
+        joint_scale[:count] = JOINT_RADIUS_M
+        free = np.array([c is None for c in sk.constraints])
+        # A joint shows how near its outgoing segments are to their limits (the nearest of them).
+        nearness = np.zeros(count)
+        limited = np.ones(count, dtype=np.bool_)
+        for j in children:
+            up = sk.parents[j]
+            nearness[up] = max(nearness[up], report.usage[j])
+            limited[up] = limited[up] and free[j]
+        joint_colour = np.tile(np.array(FREE_COLOUR, np.uint8), (MAX_JOINTS, 1))
+        joint_colour[:count] = usage_colours(nearness, limited)
+        bars = hinge_axes(sk, joints)
+        with self.scene.server.atomic():
+            self.link_nodes.batched_wxyzs = link_wxyz.astype(np.float32)
+            self.link_nodes.batched_positions = link_pos.astype(np.float32)
+            self.link_nodes.batched_scales = link_scale.astype(np.float32)
+            self.link_nodes.batched_colors = link_colour
+            self.joint_nodes.batched_positions = joint_pos.astype(np.float32)
+            self.joint_nodes.batched_scales = joint_scale.astype(np.float32)
+            self.joint_nodes.batched_colors = joint_colour
+            if len(bars):
+                self.axes.points = bars.astype(np.float32)
+            self.axes.visible = bool(len(bars))
+            self.readout.content = self._readout(sk, report)
+        self.scene.server.flush()
+
+    def _readout(self, sk: Skeleton, report: SkeletonReport) -> str:
+        r = report.result
+        rows = "\n".join(
+            f"| {label} | {r.error[k] * 1000.0:.2f} | {r.status[k]} |"
+            for k, label in enumerate(sk.effector_labels)
+        )
+        return (
+            f"**{sk.name}**: {r.iterations} iteration{'s' if r.iterations != 1 else ''}, "
+            f"solve **{report.micros:,.0f} µs**\n\n| Effector | Error (mm) | Status |\n|---|---|---|\n{rows}"
+        )
