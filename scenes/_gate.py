@@ -49,6 +49,11 @@ MAX_FRAME_BYTES = 32 * 1024 * 1024
 MAX_IMAGE_SIDE = 16384
 """Largest camera image side (pixels) a browser may report."""
 MAX_TEXT_CHARS = 10_000
+MAX_UPLOAD_BYTES = 24 * 1024 * 1024
+"""Largest file a browser may upload (a scene may refuse smaller ones with its own message, e.g. GPX over 20 MB)."""
+MAX_UPLOADS_IN_FLIGHT = 4
+"""Uploads one browser may have started and not finished; viser keeps each one's parts in memory until then."""
+MAX_NAME_CHARS = 255
 
 ALLOWED_MESSAGES: tuple[type[_messages.Message], ...] = (
     _messages.GuiUpdateMessage,
@@ -59,8 +64,11 @@ ALLOWED_MESSAGES: tuple[type[_messages.Message], ...] = (
     _messages.ScenePointerMessage,
     _messages.SceneNodeClickMessage,
     _messages.GetRenderResponseMessage,
+    _messages.FileTransferStartUpload,
+    _messages.FileTransferPart,
 )
-"""The only message types a browser may send this app; any other (share-URL requests, uploads...) is refused."""
+"""The only message types a browser may send this app; any other (share-URL requests...) is refused. Uploads are
+taken only for an upload button the sender can see, within :data:`MAX_UPLOAD_BYTES`."""
 _ALLOWED_BY_NAME = {cls.__name__: cls for cls in ALLOWED_MESSAGES}
 
 
@@ -357,6 +365,16 @@ def _install_frame_gate() -> None:
 Dispatch = Callable[[Any, Any], Coroutine[Any, Any, None]]
 
 
+@dataclasses.dataclass
+class _Upload:
+    """One browser upload in flight, as its start message announced it."""
+
+    part_count: int
+    size_bytes: int
+    bytes_seen: int = 0
+    parts_seen: set[int] = dataclasses.field(default_factory=set)
+
+
 class Gate:
     """The one gate in front of one server's message dispatch. Made by :func:`install_gate`."""
 
@@ -366,6 +384,8 @@ class Gate:
         ws = server._websock_server
         self._server_dispatch: Dispatch = ws._handle_incoming_message
         self._client_dispatch: dict[int, Dispatch] = {}
+        self._uploads: dict[int, dict[str, _Upload]] = {}
+        """Per client, the uploads started and not finished, by transfer id."""
         ws._handle_incoming_message = self._dispatch  # type: ignore[method-assign]
         ws.on_client_connect(self._on_connect)
         ws.on_client_disconnect(self._on_disconnect)
@@ -378,6 +398,7 @@ class Gate:
 
     def _on_disconnect(self, connection: Any) -> None:
         self._client_dispatch.pop(int(connection.client_id), None)
+        self._uploads.pop(int(connection.client_id), None)
 
     async def _dispatch(self, client_id: Any, message: Any) -> None:
         server = self._server_ref()
@@ -423,6 +444,10 @@ class Gate:
                 self.log.refuse(f"click ({reason})", f"{type(message).__name__}")
                 return None, None
             return message, None
+        if isinstance(message, _messages.FileTransferStartUpload):
+            return self._clean_upload_start(server, client_id, message), None
+        if isinstance(message, _messages.FileTransferPart):
+            return self._clean_upload_part(client_id, message), None
         if isinstance(message, ALLOWED_MESSAGES):
             return message, None
         self.log.refuse("message type", f"{type(message).__name__} is not one a browser may send")
@@ -460,6 +485,58 @@ class Gate:
             self.log.refuse(f"GUI value ({reason})", f"{label!r} got {updates['value']!r}"[:200])
             return None, send_back
         return _messages.GuiUpdateMessage(message.uuid, {"value": value}), send_back
+
+    def _clean_upload_start(
+        self, server: viser.ViserServer, client_id: int, message: _messages.FileTransferStartUpload
+    ) -> Any:
+        handle = self._gui_handle(server, client_id, str(message.source_component_uuid))
+        size, parts = message.size_bytes, message.part_count
+        in_flight = self._uploads.setdefault(client_id, {})
+        if not isinstance(handle, viser.GuiUploadButtonHandle):
+            self.log.refuse(
+                "upload for an unknown id", f"uuid {str(message.source_component_uuid)[:64]!r}"
+            )
+            return None
+        if (
+            not all(isinstance(x, int) and not isinstance(x, bool) for x in (size, parts))
+            or not 0 <= size <= MAX_UPLOAD_BYTES
+            or not 0 <= parts <= max(1, size)
+            or (size > 0) != (parts > 0)
+        ):
+            self.log.refuse(
+                "upload size", f"{size!r} bytes in {parts!r} parts (limit {MAX_UPLOAD_BYTES})"
+            )
+            return None
+        if not all(
+            isinstance(x, str) and len(x) <= MAX_NAME_CHARS
+            for x in (message.filename, message.mime_type, message.transfer_uuid)
+        ):
+            self.log.refuse("upload name", "file name, type or transfer id is not short text")
+            return None
+        if len(in_flight) >= MAX_UPLOADS_IN_FLIGHT:
+            self.log.refuse("uploads in flight", f"more than {MAX_UPLOADS_IN_FLIGHT} at once")
+            return None
+        if parts > 0:
+            in_flight[message.transfer_uuid] = _Upload(parts, size)
+        return message
+
+    def _clean_upload_part(self, client_id: int, message: _messages.FileTransferPart) -> Any:
+        upload = self._uploads.get(client_id, {}).get(str(message.transfer_uuid))
+        index, content = message.part_index, message.content
+        if upload is None or not isinstance(index, int) or not 0 <= index < upload.part_count:
+            self.log.refuse("upload part", "for no upload in flight, or out of range")
+            return None
+        if index in upload.parts_seen:
+            self.log.refuse("upload part", "sent twice")
+            return None
+        if not isinstance(content, bytes) or upload.bytes_seen + len(content) > upload.size_bytes:
+            self.log.refuse("upload part", "more bytes than the upload announced")
+            return None
+        upload.bytes_seen += len(content)
+        upload.parts_seen.add(index)
+        if len(upload.parts_seen) == upload.part_count:
+            del self._uploads[client_id][str(message.transfer_uuid)]
+        return message
 
     def _gizmo_handle(
         self, server: viser.ViserServer, client_id: int, name: str, owner: str

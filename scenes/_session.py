@@ -63,6 +63,7 @@ class GuiFacade:
         self.add_vector2 = _recording(api.add_vector2)
         self.add_vector3 = _recording(api.add_vector3)
         self.add_button = _recording(api.add_button)
+        self.add_upload_button = _recording(api.add_upload_button)
         self.add_folder = api.add_folder
         self.add_markdown = api.add_markdown
         self.add_image = api.add_image

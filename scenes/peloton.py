@@ -22,6 +22,7 @@ import viser.uplot
 from kernels import course as course_kernel
 from kernels import cycling
 from scenes._base import Scene
+from scenes._gate import record_spec
 
 MAX_RIDERS = 8
 BIKE_LENGTH_M = 1.70
@@ -1376,6 +1377,9 @@ class CourseMode:
         self.playing = False
         self._drawing = CourseDrawing.of(route)
         self.scrub.max = self._total_km()
+        record_spec(
+            self.scrub
+        )  # the gate clamps a browser's scrub to the new course's length, not the first one's
         self.redraw(geometry=True)
         return True
 

@@ -108,7 +108,12 @@ def refused_kind(record: logging.LogRecord) -> str:
 
 
 def server_values(server: viser.ViserServer) -> dict[str, Any]:
-    return {uuid: handle.value for uuid, handle in gui_inputs(server.gui).items()}  # type: ignore[attr-defined]
+    """Every input's value on the server; an upload button's is the last file, which is never sent to a browser."""
+    return {
+        uuid: handle.value  # type: ignore[attr-defined]
+        for uuid, handle in gui_inputs(server.gui).items()
+        if not isinstance(handle, viser.GuiUploadButtonHandle)
+    }
 
 
 def same_value(a: Any, b: Any) -> bool:

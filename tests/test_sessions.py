@@ -252,15 +252,7 @@ def settled_rss(app: AppProcess, timeout_s: float = 120.0) -> int:
         ("peloton", 40),
         ("arm", 40),
         ("freekick", 40),
-        pytest.param(
-            "sdf",
-            60,
-            marks=pytest.mark.xfail(
-                reason="each SDF build makes its own GL context and worker (~50 MiB) until the issue-12 branch "
-                "makes them once per process",
-                strict=False,
-            ),
-        ),
+        ("sdf", 60),
     ],
 )
 def test_sixteen_sessions_fit_the_budget_and_are_given_back(scene: str, budget_mib: int) -> None:
@@ -303,14 +295,7 @@ def _trim_heap() -> None:
         "peloton",
         "arm",
         "freekick",
-        pytest.param(
-            "sdf",
-            marks=pytest.mark.xfail(
-                reason="each SDF build makes its own GL context and worker (~50 MiB) until the issue-12 branch "
-                "makes them once per process",
-                strict=False,
-            ),
-        ),
+        "sdf",
     ],
 )
 def test_fifty_builds_and_closes_grow_rss_at_most_20_mib(
