@@ -10,11 +10,12 @@ Model and method:
   Graphical Models 73(5)): a forward pass sets ``p_n`` on the target and re-places every joint on the line to the
   joint before it at the link's length; a backward pass sets ``p_0`` back on the root and does the same outwards.
 * Reach: a target at distance ``r`` from the root is reachable only if ``max(0, 2·max L − ΣL) ≤ r ≤ ΣL`` (the
-  reach annulus, to within 1e-12 of the chain's scale). Outside it FABRIK returns the closest pose at once
+  reach annulus, to within 1e-12 of the chain's scale ``max(ΣL, r)``). Outside it FABRIK returns the closest pose at once
   (stretched straight toward the target, or folded back onto the inner boundary), as the paper does for
   unreachable targets, unless joint limits or obstacles forbid that pose.
-* Full reach: a target within ``tolerance`` of full reach (``r ≥ ΣL − tolerance``) is first tried with the
-  straight pose toward it (error ``ΣL − r``); near that singular pose FABRIK itself converges only linearly.
+* Full and inner reach: a target within ``tolerance`` of full reach (``r ≥ ΣL − tolerance``) is first tried with
+  the straight pose toward it (error ``ΣL − r``), one within ``tolerance`` of a non-zero inner radius with the
+  folded pose (error ``r − inner``); near these singular poses FABRIK itself converges only linearly.
 * Joint limits: each segment stays within a cone of half-angle ``φ`` around the previous segment's direction (the
   first segment around ``root_direction``). The forward pass clamps each segment against the one placed just before
   it, the backward pass against its predecessor, so every iterate satisfies every limit (as Aristidou & Lasenby 2011
@@ -34,20 +35,27 @@ Model and method:
 * Best pose: a pose is admissible when it keeps every limit and cuts no obstacle. The solvers return the best
   admissible pose seen (the start, the closest-pose or straight candidates, or an iterate), so the returned error is
   never larger than an admissible start's nor than any admissible iterate's (caliko keeps the best pose too). Only
-  if no admissible pose was ever seen is the last iterate returned.
+  if no admissible pose was ever seen is the last iterate returned, with status ``"infeasible"``.
 * Extrapolation (our addition, not in the paper): near cone limits FABRIK converges linearly and slowly (the
   error shrinks by 0.8–0.95 per iteration). Where the error ratio ``r`` of the last iteration is in [0.5, 1), the
   joints are moved on along their last step by ``r / (1 − r)`` steps (the rest of the geometric series,
   Aitken-style, at most 8) before the next passes, which then re-impose lengths, limits and obstacles; a chain whose
-  error grew after an extrapolation is not extrapolated again. Only FABRIK is extrapolated, and only FABRIK tries
-  the closest-pose and straight candidates: ``ccd`` and ``jacobian_dls`` run as published.
-* Stopping: at the tolerance (``error < tolerance``), at ``max_iterations``, or, where limits or obstacles apply or
+  error grew after an extrapolation is not extrapolated again. Also ours: an extrapolated FABRIK chain under
+  limits that stalls short of a reachable target restarts once from the straight pose toward the target, clamped
+  into the cones (a stall is a fixed point of one start, not proof that the limits keep the target away; on
+  targets an admissible pose reaches, "limited" fell from 22 % to 2 %). Only FABRIK is extrapolated, and only
+  FABRIK tries the closest-pose, straight and folded candidates: ``ccd`` and ``jacobian_dls`` run as published.
+* Stopping: at the tolerance (``error ≤ tolerance``), at ``max_iterations``, or, where limits or obstacles apply or
   the target is out of reach, at a fixed point: when the error changes by less than 0.1 % of the tolerance in an
   iteration (caliko's "minimum change" rule), or the best admissible error has improved by less than 10 % of the
   tolerance in 10 iterations (the iterates creep toward, or circle, a fixed point). Without constraints the iterations converge and run to the cap.
 * Degenerate input never makes NaN: a zero-length link or coincident joints keep the last defined direction, a
   straight chain whose target lies on its own axis is first bent into a gentle arc (a straight chain otherwise never
   bends, a known FABRIK complaint), and a target on the root picks the root direction.
+* Scale: every test in the core is relative to the chain's scale ``max(ΣL, |target − root|)`` (no absolute length),
+  and the wrappers solve in units of a power of 2 near the problem's extent (exact), so a problem multiplied by
+  ``2^k`` is solved as the original times ``2^k``, bit for bit, and squared norms never overflow or underflow.
+  Domain: coordinates, lengths and radii of magnitude ≤ 1e300 m.
 * ``two_bone`` is the analytic law-of-cosines solution for two links; ``ccd`` (cyclic coordinate descent, Wang &
   Chen 1991) and ``jacobian_dls`` (damped least squares, Wampler 1986; Buss 2004) are the methods the FABRIK paper
   compared with (its Table 1: 10 joints, FABRIK 15.5 iterations, CCD 26.3, DLS 999). They take the same arguments,
@@ -73,20 +81,25 @@ import numba
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-Status = Literal["reached", "unreachable", "max_iterations", "blocked", "limited"]
+Status = Literal["reached", "unreachable", "max_iterations", "blocked", "limited", "infeasible"]
 """Why a solve stopped:
 
-* ``"reached"``: the end effector is within the tolerance of the target;
+* ``"reached"``: the end effector is within the tolerance of the target (error ≤ tolerance, exactly: no slack);
 * ``"unreachable"``: the target lies outside the reach annulus, farther than the tolerance from the closest pose
   (the closest admissible pose seen is returned);
 * ``"blocked"``: a reachable target not reached, with the returned pose resting against an obstacle (within 0.1 %
   of its radius) or the target inside one;
-* ``"limited"``: a reachable target not reached, at a fixed point where the joint limits (or obstacles, not
-  touched) keep the chain from it;
-* ``"max_iterations"``: the iteration cap came first (a reachable target, still converging).
+* ``"limited"``: a reachable target not reached, the iterates stalled under joint limits (or obstacles, not
+  touched) at a fixed point of the method: the error stopped changing, or the best error stopped improving (see
+  Stopping). It does not prove the limits keep the chain from the target; another start may reach it;
+* ``"max_iterations"``: the iteration cap came first (a reachable target, still converging);
+* ``"infeasible"``: no pose the solver saw (neither the start nor any iterate) keeps every limit and clears every
+  obstacle; the last iterate is returned, and it is not admissible.
 """
-STATUSES: tuple[Status, ...] = ("reached", "unreachable", "max_iterations", "blocked", "limited")
-_REACHED, _UNREACHABLE, _MAX_ITERATIONS, _BLOCKED, _LIMITED = range(5)
+STATUSES: tuple[Status, ...] = (
+    "reached", "unreachable", "max_iterations", "blocked", "limited", "infeasible"
+)  # fmt: skip
+_REACHED, _UNREACHABLE, _MAX_ITERATIONS, _BLOCKED, _LIMITED, _INFEASIBLE = range(6)
 
 Solver = Literal["fabrik", "ccd", "jacobian_dls"]
 """The iterative methods; they share arguments, constraints and result."""
@@ -97,8 +110,12 @@ Obstacle = tuple[ArrayLike, float]
 """``(centre (d,) m, radius m)``: a circle in 2D, a sphere in 3D."""
 
 _TINY = 1e-12
-"""Relative length below which a vector has no direction, and the rounding slack of reach and tolerance tests
-(times the chain's scale, ``max(ΣL, |target − root|, 1 m)``)."""
+"""Relative length below which a vector has no direction, and the rounding slack of the reach tests (times the
+chain's scale, ``max(ΣL, |target − root|)``; never added to the tolerance)."""
+_LARGEST = 1e300
+"""Largest magnitude accepted for a coordinate, length or radius (m): sums and differences stay finite."""
+_MAX_ITERATIONS_CAP = 100_000
+"""Largest ``max_iterations`` accepted (each chain keeps an error history of that length)."""
 _CLEARANCE = 1e-6
 """Segments are turned to clear an obstacle by this fraction of its radius, so rounding never leaves them inside."""
 _TOUCH = 1e-3
@@ -365,8 +382,8 @@ def solve(
         obstacles: circles (2D) or spheres (3D) as ``(centre (d,), radius)`` no segment may pass through.
         root_direction: (d,) rest direction of the root, the axis of the first segment's cone. Default: +y in 2D
             (the plane's up), +z in 3D.
-        extrapolate: move slowly converging iterates on along their last step (see the module docstring); False
-            gives plain FABRIK as the paper writes it.
+        extrapolate: move slowly converging iterates on along their last step, and restart a stall under limits
+            once (see the module docstring); False gives plain FABRIK as the paper writes it.
         constraints: one :class:`Cone`, :class:`Hinge` or None (free) per segment, segment i being joints i to
             i + 1; replaces ``cone_half_angle_rad`` (give one or the other). None: as ``cone_half_angle_rad``.
 
@@ -374,9 +391,10 @@ def solve(
         The :class:`Solution`: the best admissible pose seen.
 
     Raises:
-        ValueError: naming the argument, for non-finite values, wrong shapes, n < 1, a negative tolerance, a
-            half-angle outside [0, π], a non-positive radius, max_iterations < 1, or constraints of the wrong
-            count or kind (a hinge axis off ±z in 2D).
+        ValueError: naming the argument, for non-finite values or magnitudes above 1e300, bool or complex arrays,
+            wrong shapes, n < 1, a negative tolerance, a half-angle outside [0, π], a non-positive radius,
+            obstacles that are not (centre, radius) pairs, max_iterations outside [1, 100 000], or constraints of
+            the wrong count or kind (a hinge axis off ±z in 2D).
     """
     return _solve_single("fabrik", joints, target, tolerance, max_iterations,
                          cone_half_angle_rad, obstacles, root_direction, extrapolate,
@@ -437,7 +455,8 @@ def solve_batch(
     iterations = np.empty(batch, dtype=np.int64)
     status = np.empty(batch, dtype=np.int64)
     error = np.empty(batch)
-    args = (p, goal, setup.params, setup.flags, setup.root_direction, setup.centres, setup.radii,
+    scale, params, centres, radii = _to_unit_scale(p, goal, setup)
+    args = (p, goal, params, setup.flags, setup.root_direction, centres, radii,
             out_p, history, iterations, status, error, setup.table)  # fmt: skip
     if batch == 1:
         _solve_rows(0, 1, *args)
@@ -445,6 +464,10 @@ def solve_batch(
         # numba's workqueue threading layer (where OpenMP and TBB are missing) is not thread-safe
         with _PARALLEL_LOCK:
             _solve_parallel(min(batch, _CHUNKS), *args)
+    if scale != 1.0:
+        out_p *= scale
+        history *= scale
+        error *= scale
     return BatchSolution(
         joints=out_p[:, :, :dim].copy() if dim == 2 else out_p,
         iterations=iterations,
@@ -553,6 +576,12 @@ def two_bone(
     lower = _check_length("lower_length", lower_length)
 
     offset = p_target - p_root
+    # In units of a power of 2 near the problem's extent (exact), so squares neither overflow nor underflow.
+    extent = max(float(np.abs(offset).max()), upper, lower)
+    unit = math.ldexp(1.0, math.frexp(extent)[1]) if extent > 0.0 else 1.0
+    offset, upper, lower = offset / unit, upper / unit, lower / unit
+    largest = float(np.abs(bend).max())
+    bend = bend / largest if largest > 0.0 else bend
     distance = float(np.linalg.norm(offset))
     scale = max(upper + lower, distance, 1.0)
     axis = offset / distance if distance > _TINY * scale else _fallback_axis(bend, dim)
@@ -567,17 +596,20 @@ def two_bone(
         cos_alpha = (upper**2 + reach**2 - lower**2) / (2.0 * upper * reach)
     cos_alpha = min(1.0, max(-1.0, cos_alpha))
     sin_alpha = math.sqrt(max(0.0, 1.0 - cos_alpha**2))
-    elbow = p_root + upper * (cos_alpha * axis + sin_alpha * side)
-    end_offset = p_root + reach * axis - elbow
+    elbow = upper * (cos_alpha * axis + sin_alpha * side)
+    end_offset = reach * axis - elbow
     end_norm = float(np.linalg.norm(end_offset))
     direction = end_offset / end_norm if end_norm > _TINY * scale else axis
-    return np.stack([p_root, elbow, elbow + lower * direction])
+    return np.stack([p_root, p_root + unit * elbow, p_root + unit * (elbow + lower * direction)])
 
 
 def link_lengths(joints: ArrayLike) -> NDArray[np.float64]:
     """Link lengths (m): (n,) for (n + 1, d) joints, (B, n) for (B, n + 1, d)."""
-    chain = np.asarray(joints, dtype=np.float64)
-    return np.linalg.norm(np.diff(chain, axis=-2), axis=-1)
+    segments = np.diff(np.asarray(joints, dtype=np.float64), axis=-2)
+    # each segment first to max-abs 1, so its squared norm neither overflows (1e300) nor underflows (1e-160)
+    largest = np.abs(segments).max(axis=-1, keepdims=True)
+    largest = np.where(largest > 0.0, largest, 1.0)
+    return np.linalg.norm(segments / largest, axis=-1) * largest[..., 0]
 
 
 def joint_angles(joints: ArrayLike, root_direction: ArrayLike | None = None) -> NDArray[np.float64]:
@@ -597,7 +629,11 @@ def joint_angles(joints: ArrayLike, root_direction: ArrayLike | None = None) -> 
     dim = chain.shape[1]
     previous = _root_direction(root_direction, dim)
     segments = np.diff(chain, axis=0)
-    scale = max(float(np.add.reduce(np.linalg.norm(segments, axis=1))), 1.0)
+    largest = float(np.abs(segments).max())
+    # directions only: first to max-abs 1, so norms neither overflow nor underflow
+    if largest > 0.0:
+        segments = segments / largest
+    scale = float(np.add.reduce(np.linalg.norm(segments, axis=1)))
     angles = np.zeros(segments.shape[0])
     for i, segment in enumerate(segments):
         length = float(np.linalg.norm(segment))
@@ -610,30 +646,48 @@ def joint_angles(joints: ArrayLike, root_direction: ArrayLike | None = None) -> 
 
 
 def reach_limits(lengths: ArrayLike) -> tuple[float, float]:
-    """``(inner, outer)`` radii (m) of the annulus the end effector can reach: ``max(0, 2·max L − ΣL)`` and ``ΣL``."""
-    links = np.asarray(lengths, dtype=np.float64)
+    """``(inner, outer)`` radii (m) of the annulus the end effector can reach: ``max(0, 2·max L − ΣL)`` and ``ΣL``.
+
+    Args:
+        lengths: (n,) link lengths (m), n ≥ 1, each ≥ 0.
+
+    Raises:
+        ValueError: naming ``lengths``, for a wrong shape, an empty array, or negative or non-finite lengths.
+    """
+    links = _finite_array("lengths", lengths)
+    if links.ndim != 1 or links.shape[0] < 1 or not bool((links >= 0.0).all()):
+        raise ValueError(f"lengths must be a non-empty (n,) array of lengths ≥ 0, got {lengths!r}")
     total = float(links.sum())
     return max(0.0, 2.0 * float(links.max()) - total), total
 
 
 # ================================================================================================ checks
 def _finite_array(name: str, value: ArrayLike) -> NDArray[np.float64]:
+    """Real numbers (not bool, not complex) of magnitude ≤ 1e300 as float64, else ValueError naming them."""
     try:
-        array = np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError) as error:
-        raise ValueError(f"{name} must be an array of numbers, got {value!r}") from error
+        array = np.asarray(value)
+        # bool and complex would convert silently (True → 1, the imaginary part dropped); objects (Python ints
+        # beyond float64) convert below or overflow
+        if array.dtype.kind not in "fiuO":
+            raise TypeError(array.dtype)
+        array = np.asarray(array, dtype=np.float64)
+    except (TypeError, ValueError, OverflowError) as error:
+        raise ValueError(f"{name} must be an array of real numbers, got {value!r}") from error
     flat = array.reshape(-1)
     # A compiled scan costs a fraction of numpy's isfinite + all on the few numbers of one chain.
-    finite = _all_finite(flat) if flat.flags.writeable else bool(np.isfinite(flat).all())
+    if flat.flags.writeable:
+        finite = _all_within(flat, _LARGEST)
+    else:
+        finite = bool((np.abs(flat) <= _LARGEST).all())
     if not finite:
-        raise ValueError(f"{name} must be finite, got {value!r}")
+        raise ValueError(f"{name} must be finite, of magnitude ≤ {_LARGEST:g}, got {value!r}")
     return array
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _all_finite(values: NDArray[np.float64]) -> bool:
+def _all_within(values: NDArray[np.float64], bound: float) -> bool:
     for value in values:
-        if not math.isfinite(value):
+        if not abs(value) <= bound:  # NaN fails too
             return False
     return True
 
@@ -678,10 +732,12 @@ def _root_direction(value: ArrayLike | None, dim: int) -> NDArray[np.float64]:
         axis[-1] = 1.0
         return axis
     axis = _check_vector("root_direction", value, dim)
-    norm = float(np.linalg.norm(axis))
-    if norm <= _TINY:
+    largest = float(np.abs(axis).max())
+    if largest == 0.0:
         raise ValueError(f"root_direction must be non-zero, got {value!r}")
-    return axis / norm
+    # first to max-abs 1, so neither a huge nor a tiny vector over- or underflows its norm
+    axis = axis / largest
+    return axis / float(np.linalg.norm(axis))
 
 
 def _status_literal(text: str) -> Status:
@@ -774,6 +830,14 @@ class _Setup:
             options = _options.__wrapped__(
                 dim, tolerance, max_iterations, cone_half_angle_rad, solver, extrapolate
             )
+        # an array or an iterator: its items are the obstacles
+        if not isinstance(obstacles, (list, tuple)):
+            try:
+                obstacles = list(obstacles)
+            except TypeError as error:
+                raise ValueError(
+                    f"obstacles must be a sequence of (centre, radius), got {obstacles!r}"
+                ) from error
         if root_direction is None and not obstacles:
             return options
         count = len(obstacles)
@@ -787,9 +851,9 @@ class _Setup:
                 ) from error
             centres[k, :dim] = _check_vector(f"obstacles[{k}] centre", centre, dim)
             radii[k] = _finite_number(f"obstacles[{k}] radius", radius)
-            if not radii[k] > 0.0:
+            if not 0.0 < radii[k] <= _LARGEST:
                 raise ValueError(
-                    f"obstacles[{k}] radius must be a finite number > 0, got {radius!r}"
+                    f"obstacles[{k}] radius must be a finite number in (0, {_LARGEST:g}], got {radius!r}"
                 )
         rest = options.root_direction
         if root_direction is not None:
@@ -814,8 +878,10 @@ def _options(
         raise ValueError(f"tolerance must be a finite number ≥ 0, got {tolerance!r}")
     if isinstance(max_iterations, bool) or not isinstance(max_iterations, (int, np.integer)):
         raise ValueError(f"max_iterations must be an integer, got {max_iterations!r}")
-    if max_iterations < 1:
-        raise ValueError(f"max_iterations must be ≥ 1, got {max_iterations}")
+    if not 1 <= max_iterations <= _MAX_ITERATIONS_CAP:
+        raise ValueError(
+            f"max_iterations must be in [1, {_MAX_ITERATIONS_CAP}], got {max_iterations}"
+        )
     cos_phi, sin_phi, has_limits = -1.0, 0.0, 0
     if cone_half_angle_rad is not None:
         phi = _finite_number("cone_half_angle_rad", cone_half_angle_rad)
@@ -840,6 +906,34 @@ def _options(
         centres=np.zeros((0, 3)),
         radii=np.zeros(0),
     )
+
+
+_UNSCALED = 2.0**-16, 2.0**16
+"""Extents (m) solved as they are; outside, a problem is divided by a power of 2 near its extent first."""
+
+
+def _to_unit_scale(
+    p: NDArray[np.float64], goal: NDArray[np.float64], setup: _Setup
+) -> tuple[float, NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Divide the chains ``p`` (B, n + 1, 3) and targets ``goal`` (B, 3), in place, and the tolerance and obstacles,
+    by a power of 2 near the batch's extent (the largest coordinate offset from a root); returns that scale and the
+    scaled params, centres and radii.
+
+    The core's tests are all relative to the chain's scale, and dividing by a power of 2 is exact, so it gives the
+    same bits at any scale; scaling only keeps squared norms (and DLS's 3 × 3 determinant, ~ extent⁶) from
+    overflowing or underflowing for huge or tiny chains. Results are multiplied back by the caller.
+    """
+    root = p[:, :1, :]
+    extent = max(float(np.abs(p - root).max()), float(np.abs(goal - root[:, 0]).max()))
+    if extent == 0.0 or _UNSCALED[0] <= extent <= _UNSCALED[1]:
+        return 1.0, setup.params, setup.centres, setup.radii
+    scale = math.ldexp(1.0, math.frexp(extent)[1])  # ≥ extent, exact; division by it is exact
+    p /= scale
+    goal /= scale
+    params = setup.params.copy()
+    # the tolerance (inf beyond float range: then every error is within it)
+    params[0] = params[0] / scale
+    return scale, params, setup.centres / scale, setup.radii / scale
 
 
 def _solve_single(
@@ -870,8 +964,13 @@ def _solve_single(
     iterations = np.empty(1, dtype=np.int64)
     status = np.empty(1, dtype=np.int64)
     error = np.empty(1)
-    _solve_rows(0, 1, p, goal, setup.params, setup.flags, setup.root_direction, setup.centres,
-                setup.radii, out_p, history, iterations, status, error, setup.table)  # fmt: skip
+    scale, params, centres, radii = _to_unit_scale(p, goal, setup)
+    _solve_rows(0, 1, p, goal, params, setup.flags, setup.root_direction, centres,
+                radii, out_p, history, iterations, status, error, setup.table)  # fmt: skip
+    if scale != 1.0:
+        out_p *= scale
+        history *= scale
+        error *= scale
     used = int(iterations[0])
     return Solution(
         joints=out_p[0, :, :dim].copy() if dim == 2 else out_p[0],
@@ -1278,7 +1377,7 @@ def _unbend(
     along = tx * ax + ty * ay + tz * az
     ox, oy, oz = tx - along * ax, ty - along * ay, tz - along * az
     distance = math.sqrt(tx * tx + ty * ty + tz * tz)
-    if math.sqrt(ox * ox + oy * oy + oz * oz) > 1e-9 * max(distance, 1.0):
+    if math.sqrt(ox * ox + oy * oy + oz * oz) > 1e-9 * max(distance, tiny):
         return  # the target is off the chain's line: the passes bend it
     step = 0.1 if not has_limits else min(0.1, 0.5 * math.acos(cos_phi))
     if step <= 0.0:
@@ -1306,7 +1405,7 @@ def _extrapolate(
     moves: they still place every joint at its link's length, inside its cone and clear of obstacles. Nothing moves
     unless ``allowed``. Returns whether it moved the joints.
     """
-    ratio = error / max(previous_error, _TINY)
+    ratio = error / previous_error if previous_error > 0.0 else 0.0  # scale-free: no absolute floor
     slow = allowed and _EXTRAPOLATION_MIN_RATIO <= ratio < 1.0
     if not slow:  # (``previous`` is not yet set on the first call: only copy into it)
         _copy(p, previous)
@@ -1349,13 +1448,17 @@ def _solve_chain(
         total += lengths[i]
     ox, oy, oz = target[0] - p[0, 0], target[1] - p[0, 1], target[2] - p[0, 2]
     distance = math.sqrt(ox * ox + oy * oy + oz * oz)
-    tiny = _TINY * max(total, distance, 1.0)
+    # relative only: the core gives the same bits at any power-of-2 scale
+    tiny = _TINY * max(total, distance)
     for i in range(n):
         has_zero = has_zero or lengths[i] <= tiny
     inner = max(0.0, 2.0 * np.max(lengths) - total)
     beyond = distance > total + tiny
     fold = distance < inner - tiny
     out_of_reach = beyond or fold
+    # Within tolerance of the inner radius the folded pose is as good a candidate as the straight one at full reach.
+    near_inner = inner > 0.0 and distance <= inner + tolerance + tiny
+    fold = fold or (near_inner and distance - inner < total - distance)
     any_live = False
     for k in range(radii.shape[0]):
         live[k] = (centres[k, 0] - p[0, 0]) ** 2 + (centres[k, 1] - p[0, 1]) ** 2 + (
@@ -1370,21 +1473,21 @@ def _solve_chain(
     best_error = np.inf
     if _admissible(p, tiny, rest, has_limits, table, centres, radii, live):
         best_error = error
-        if error < tolerance:
+        if error <= tolerance:
             _copy(p, out_p)
             return 0, _REACHED, error
 
-    if solver == _FABRIK and (out_of_reach or distance >= total - tolerance - tiny):
+    if solver == _FABRIK and (out_of_reach or near_inner or distance >= total - tolerance - tiny):
         # The closest pose to a target out of reach; the straight pose toward one within tolerance of full reach.
         ux, uy, uz, _ = _unit(ox, oy, oz, rest[0], rest[1], rest[2], tiny)
         _place_on_line(before, p[0], lengths, ux, uy, uz, fold)
         candidate = _end_error(before, target)
-        # Within tolerance (ΣL − r ≤ tolerance, to rounding; also for tolerance 0 at exactly ΣL) it reaches.
+        # "reached" means error ≤ tolerance, with no slack: a candidate short of it by rounding iterates on.
         if _admissible(before, tiny, rest, has_limits, table, centres, radii, live):
-            if candidate <= tolerance + tiny or out_of_reach:
+            if candidate <= tolerance or out_of_reach:
                 _copy(before, out_p)
                 history[1] = candidate
-                return 1, _REACHED if candidate <= tolerance + tiny else _UNREACHABLE, candidate
+                return 1, _REACHED if candidate <= tolerance else _UNREACHABLE, candidate
 
     _unbend(p, target, lengths, tiny, rest, has_limits, cos_phi, dim)
     # The extrapolation's first call moves by 0 × (p − previous): never 0 × uninitialised memory (NaN).
@@ -1394,11 +1497,15 @@ def _solve_chain(
     stall_applies = constrained or out_of_reach
     trusted, moved, reached, stalled = True, False, False, False
     count, mark_iteration, mark_error = 0, 0, best_error
+    # Extrapolated FABRIK under limits, within reach, restarts once where it stalls (see below) at ``restart``
+    retry, restart = extrapolate and has_limits and not out_of_reach, 0
     for iteration in range(1, max_iterations + 1):
         count = iteration
         last_error = history[iteration - 1]
-        if extrapolate and iteration >= 2:  # from the third iteration on, and while trusted
-            allowed = iteration >= 3 and trusted
+        if (
+            extrapolate and iteration >= restart + 2
+        ):  # from the third iteration on, and while trusted
+            allowed = iteration >= restart + 3 and trusted
             moved = _extrapolate(p, previous, last_error, history[iteration - 2], allowed)
         if solver == _FABRIK:
             _forward_pass(
@@ -1414,18 +1521,35 @@ def _solve_chain(
         # A chain whose extrapolation made its error grow (a target the limits keep away, r → 1) is left to plain
         # FABRIK from then on, which settles at its fixed point.
         trusted = trusted and not (moved and error > last_error)
-        if (error < best_error or error < tolerance) and (
+        if (error < best_error or error <= tolerance) and (
             not constrained or _admissible(p, tiny, rest, has_limits, table, centres, radii, live)
         ):
             if error < best_error:
                 _copy(p, best)
                 best_error = error
-            reached = error < tolerance
+            reached = error <= tolerance
         if best_error < mark_error - progress:
             mark_iteration, mark_error = iteration, best_error
         stalled = stall_applies and (
             abs(last_error - error) < stall or iteration - mark_iteration >= _PATIENCE
         )
+        if stalled and not reached and retry:
+            # A stall under limits is a fixed point of this start, not proof that the limits keep the target
+            # away: go on once from the straight pose toward the target, clamped into the cones (another basin).
+            retry, stalled, restart, trusted, mark_iteration = (
+                False,
+                False,
+                iteration,
+                True,
+                iteration,
+            )
+            ux, uy, uz, _ = _unit(ox, oy, oz, rest[0], rest[1], rest[2], tiny)
+            _place_on_line(p, best[0], lengths, ux, uy, uz, False)
+            _unbend(
+                p, target, lengths, tiny, rest, has_limits, cos_phi, dim
+            )  # a straight chain never bends
+            _backward_pass(p, lengths, tiny, rest, limits, centres, radii, live, has_zero, dim)
+            continue
         if reached or stalled:
             break
 
@@ -1438,6 +1562,9 @@ def _solve_chain(
     final_error = _end_error(out_p, target)
     if reached:
         return count, _REACHED, final_error
+    # neither the start nor any iterate kept every limit and cleared every obstacle
+    if best_error == np.inf:
+        return count, _INFEASIBLE, final_error
     if out_of_reach:
         return count, _UNREACHABLE, final_error
     if any_live:

@@ -264,8 +264,9 @@ cut one is turned about its anchor by the least angle until it just clears it. T
 it saw that keeps every limit and clears every obstacle. **Status**: "reached" (within the tolerance);
 "unreachable" (the target lies outside the reach annulus max(0, 2·max L − ΣL) ≤ |target − root| ≤ ΣL; the chain
 stretches straight toward it at once); "blocked" (within reach, but the chain rests against an obstacle short of it, or the
-target is inside one); "limited" (within reach, but the joint limits hold the chain at a fixed point short of
-it); "max_iterations" (still converging at the cap).
+target is inside one); "limited" (within reach, but the iterates stalled at a fixed point under the joint limits
+short of it); "max_iterations" (still converging at the cap); "infeasible" (no pose seen kept every limit and
+cleared every obstacle).
 
 **Compared with.** CCD (turn each joint, end to root, to aim the end at the target) and damped-least-squares
 Jacobian IK, Δθ = Jᵀ(JJᵀ + λ²I)⁻¹e. The paper's Table 1 (10 joints): FABRIK 15.5 iterations, CCD 26.3, DLS 999.
