@@ -113,8 +113,10 @@ def test_choosing_the_hand_and_dragging_a_fingertip_target_curls_the_finger(
         client.wait_for(browser_shows_fingertip, what="the browser to receive the curled finger")
         # Back to the chain: the skeleton hides and the chain shows again.
         client.set_value("Preset", "Chain")
-        client.wait_for(lambda: not view.active, what="the chain back")
-        assert scene.link_nodes.visible and not view.link_nodes.visible
+        client.wait_for(
+            lambda: not view.active and scene.link_nodes.visible and not view.link_nodes.visible,
+            what="the chain back, the skeleton hidden",
+        )
 
 
 @pytest.mark.parametrize(
