@@ -1380,8 +1380,9 @@ class CourseMode:
             except ValueError as failure:
                 error = str(failure)
         if route is None or state is None:
+            reason = str(error).removeprefix("the file: ")  # the file is named already
             self.message = (
-                f"**{_escape(label)}** was not loaded: {_escape(str(error))}. "
+                f"**{_escape(label)}** was not loaded: {_escape(reason)}. "
                 f"Still showing **{_escape(self.route.name)}**."
             )
             self.redraw()

@@ -424,3 +424,33 @@ def test_the_readout_names_the_model_by_its_label_and_explains_coasting(mode: Co
     ) in mode.readout.content
     mode.scrub.value = 1.5
     assert "(coasting at the 72 km/h descent cap)" in mode.now.content
+
+
+# Kind: the reviewer's bad files, through the scene: refused in a rider's words, the last good course kept.
+REVIEW_FILES = {
+    "vertical": (
+        '<?xml version="1.0"?><gpx version="1.1" creator="r"><trk><trkseg><trkpt lat="45" lon="6"><ele>100</ele>'
+        '</trkpt><trkpt lat="45.0000001" lon="6"><ele>600</ele></trkpt><trkpt lat="45.0000002" lon="6">'
+        "<ele>1100</ele></trkpt></trkseg></trk></gpx>",
+        "was not loaded: the elevation changes 4 496 602 % of the distance near 0.00 km; no road is steeper",
+    ),
+    "nan elevation": (
+        gpx_text([(45.0, 6.0, 1.0), (45.001, 6.0, float("nan"))]),
+        "was not loaded: track point 2 has elevation nan, not a number",
+    ),
+    "not gpx": (
+        "<html><body>hi</body></html>",
+        "was not loaded: the file is not GPX: no &lt;gpx&gt;",
+    ),
+}
+
+
+@pytest.mark.parametrize("kind", list(REVIEW_FILES))
+def test_review_files_are_refused_in_a_riders_words(mode: CourseMode, kind: str) -> None:
+    good = mode.route
+    text, message = REVIEW_FILES[kind]
+    assert not mode.load(text.encode(), f"{kind}.gpx")
+    assert mode.route is good
+    assert message in mode.route_info.content
+    for word in ("elevation_m", "latitude_deg", "non-finite", "time_s", "GPX is not"):
+        assert word not in mode.route_info.content
