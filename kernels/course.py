@@ -33,10 +33,12 @@ first (ValueError naming it). :func:`warm_up` compiles it ahead of use.
 
 from __future__ import annotations
 
+import codecs
 import dataclasses
 import math
 import os
 import re
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Literal
 
@@ -69,7 +71,8 @@ class Course:
     name: str
     """Name from the file (or given)."""
     east_m: NDArray[np.float64]
-    """(N,) map position east of the first point (m), equirectangular about it; for drawing."""
+    """(N,) map position east of the first point (m), azimuthal equidistant about the route's centroid (true
+    shape at any place on Earth); for drawing."""
     north_m: NDArray[np.float64]
     """(N,) map position north of the first point (m)."""
     distance_m: NDArray[np.float64]
@@ -225,10 +228,38 @@ def course_from_points(
         np.sin(d_lam) * np.cos(phi[1:]),
         np.cos(phi[:-1]) * np.sin(phi[1:]) - np.sin(phi[:-1]) * np.cos(phi[1:]) * np.cos(d_lam),
     ) % (2.0 * np.pi)
-    unwrapped = lam[0] + np.concatenate(([0.0], np.cumsum(d_lam)))
-    east = EARTH_RADIUS_M * (unwrapped - lam[0]) * math.cos(phi[0])
-    north = EARTH_RADIUS_M * (phi - phi[0])
+    east, north = azimuthal_equidistant(lat, lon)
     return _finish(name, east, north, run, heading, p["elevation_m"], smoothing_m)
+
+
+def azimuthal_equidistant(
+    latitude_deg: NDArray[np.float64], longitude_deg: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Map positions (east, north) in m, the first point at the origin, for drawing a route in its true shape.
+
+    The azimuthal equidistant projection (Snyder 1987, USGS Prof. Paper 1395, §25) on the sphere about the route's
+    centroid (the normalised mean of the points' unit vectors; the first point where that mean vanishes):
+    distances and directions from the centre are exact, and a route a few hundred km across keeps its shape to
+    a fraction of a percent, over a pole or the antimeridian as anywhere else. (N,) inputs in degrees.
+    """
+    phi, lam = np.radians(latitude_deg), np.radians(longitude_deg)
+    unit = np.stack([np.cos(phi) * np.cos(lam), np.cos(phi) * np.sin(lam), np.sin(phi)], axis=1)
+    mean = unit.mean(axis=0)
+    norm = float(np.linalg.norm(mean))
+    centre = mean / norm if norm > 1e-9 else unit[0]
+    # Local east and north at the centre (at a pole, "north" is along longitude 180°, east along 90°).
+    up = np.array([0.0, 0.0, 1.0])
+    east_axis = np.cross(up, centre)
+    if float(np.linalg.norm(east_axis)) < 1e-12:
+        east_axis = np.array([0.0, 1.0, 0.0])
+    east_axis /= np.linalg.norm(east_axis)
+    north_axis = np.cross(centre, east_axis)
+    x, y, z = unit @ east_axis, unit @ north_axis, unit @ centre
+    angle = np.arctan2(np.hypot(x, y), z)  # great-circle angle from the centre
+    sideways = np.hypot(x, y)
+    k = np.where(sideways > 1e-15, angle / np.where(sideways > 1e-15, sideways, 1.0), 1.0)
+    east, north = EARTH_RADIUS_M * k * x, EARTH_RADIUS_M * k * y
+    return east - east[0], north - north[0]
 
 
 def course_from_xy(
@@ -257,7 +288,7 @@ def course_from_xy(
     return _finish(name, east, north, run, heading, p["elevation_m"], smoothing_m)
 
 
-_GPX_ROOT = re.compile(r"<(?:[A-Za-z_][\w.-]*:)?gpx[\s>/]")
+_GPX_ROOT = re.compile(r"<(?:([A-Za-z_][\w.-]*):)?gpx[\s>/]")
 
 
 def load_gpx(
@@ -275,10 +306,14 @@ def load_gpx(
 
     Raises:
         ValueError: with a message a person can act on: the file is larger than 20 MiB, not GPX (or not text),
-            has no track points, one point, points without elevation, non-finite or out-of-range values, or more
-            than 200 000 points. Nothing else escapes for a bad file.
+            has no track points, one point, points without elevation, non-finite or out-of-range values, more
+            than 200 000 points, a stretch steeper than :data:`MAX_GPX_GRADE` (50 %), or track segments more than
+            :data:`MAX_SEGMENT_GAP_M` (2 km) apart. Nothing else escapes for a bad file.
+
+    The text is decoded by its byte-order mark, else the XML declaration's encoding (ISO-8859-1, UTF-16...),
+    else as UTF-8; a namespace prefix on the GPX elements (``<g:gpx xmlns:g=...>``) is read too.
     """
-    label = "GPX"
+    label = "the file"
     if isinstance(source, bytes):
         if len(source) > MAX_FILE_BYTES:
             raise ValueError(f"the file is {len(source) / 2**20:.1f} MiB; the limit is 20 MiB")
@@ -301,16 +336,18 @@ def load_gpx(
         data = source.encode("utf-8")
     else:
         raise ValueError(f"source must be a path, bytes or GPX text, got {type(source).__name__}")
-    try:
-        text = data.decode("utf-8-sig")
-    except UnicodeDecodeError as error:
-        raise ValueError(f"{label} is not a GPX file: not UTF-8 text") from error
-    if _GPX_ROOT.search(text[:4096]) is None:
-        raise ValueError(f"{label} is not a GPX file: no <gpx> element at its start")
-    # Count before parsing: gpxpy would build every point first.
-    tagged = text.count("<trkpt") + text.count("<rtept")
+    text = _decode(data, label)
+    root = _GPX_ROOT.search(text[:4096])
+    if root is None:
+        raise ValueError(f"{label} is not GPX: no <gpx> element at its start")
+    # Count before parsing (gpxpy would build every point first), whatever the namespace prefix.
+    prefix = root.group(1)
+    tags = ("<trkpt", "<rtept") + ((f"<{prefix}:trkpt", f"<{prefix}:rtept") if prefix else ())
+    tagged = sum(text.count(tag) for tag in tags)
     if tagged > MAX_POINTS:
         raise ValueError(f"{label} has {tagged} points; the limit is {MAX_POINTS}")
+    if prefix:  # <g:gpx xmlns:g=...>: gpxpy reads only unprefixed names, so drop the prefix
+        text = text.replace(f"<{prefix}:", "<").replace(f"</{prefix}:", "</")
     try:
         gpx = gpxpy.parse(text)
     except gpxpy.gpx.GPXException as error:
@@ -318,11 +355,14 @@ def load_gpx(
     except (ValueError, TypeError, AttributeError, IndexError) as error:
         raise ValueError(f"{label} is not a valid GPX file: {type(error).__name__}") from error
 
-    points = [p for track in gpx.tracks for segment in track.segments for p in segment.points]
+    segments = [
+        segment.points for track in gpx.tracks for segment in track.segments if segment.points
+    ]
     kind = "track"
-    if not points:
-        points = [p for route in gpx.routes for p in route.points]
+    if not segments:
+        segments = [route.points for route in gpx.routes if route.points]
         kind = "route"
+    points = [p for segment in segments for p in segment]
     if not points:
         raise ValueError(f"{label} has no track points")
     if len(points) > MAX_POINTS:
@@ -338,9 +378,153 @@ def load_gpx(
     lat = np.array([p.latitude for p in points], dtype=np.float64)
     lon = np.array([p.longitude for p in points], dtype=np.float64)
     ele = np.array([p.elevation for p in points], dtype=np.float64)
+    _check_values(label, kind, lat, lon, ele)
+    if kind == "track":
+        _check_gaps(label, segments)
     title = name or next((t.name for t in gpx.tracks if t.name), None) or gpx.name
-    title = title or (label if label != "GPX" else "GPX course")
-    return course_from_points(lat, lon, ele, name=str(title)[:80], smoothing_m=smoothing_m)
+    title = title or (label if label != "the file" else "GPX course")
+    title = str(title)[:80]
+    try:
+        result = course_from_points(lat, lon, ele, name=title, smoothing_m=smoothing_m)
+    except ValueError as error:  # the builders name the course; a reader is told about the file
+        message = str(error).removeprefix(f"{title}: ")
+        raise ValueError(f"{label}: {message}") from error
+    _check_grades(label, result)
+    return result
+
+
+MAX_GPX_GRADE = 0.5
+"""Steepest grade :func:`load_gpx` accepts (50 %), over any stretch of :data:`GRADE_WINDOW_M` (or the whole route
+if shorter), raw and smoothed. The steepest paved streets are about 35–37 % (Baldwin Street, Canton Avenue), so a
+steeper stretch is a fault in the file (a GPS elevation jump, points logged in one place), not a road."""
+GRADE_WINDOW_M = 25.0
+"""Stretch over which :data:`MAX_GPX_GRADE` is checked on the raw elevation (m): long enough that ±2 m GPS noise
+between points a metre apart stays under 20 %, short enough that a real cliff cannot hide."""
+MAX_SEGMENT_GAP_M = 2000.0
+"""Largest jump :func:`load_gpx` accepts between the end of one track segment and the start of the next (m)."""
+
+_XML_ENCODING = re.compile(rb"""^<\?xml[^>]*?encoding\s*=\s*["']([A-Za-z0-9._-]+)["']""")
+
+
+def _decode(data: bytes, label: str) -> str:
+    """The file's text: by its byte-order mark, else its XML declaration's encoding, else UTF-8 (XML 1.0 §4.3.3)."""
+    for bom, codec in (
+        (codecs.BOM_UTF32_LE, "utf-32"), (codecs.BOM_UTF32_BE, "utf-32"), (codecs.BOM_UTF8, "utf-8-sig"),
+        (codecs.BOM_UTF16_LE, "utf-16"), (codecs.BOM_UTF16_BE, "utf-16"),
+    ):  # fmt: skip
+        if data.startswith(bom):
+            encoding = codec
+            break
+    else:
+        declared = _XML_ENCODING.match(data[:200])
+        encoding = declared.group(1).decode("ascii") if declared else "utf-8"
+        try:
+            codecs.lookup(encoding)
+        except LookupError as error:
+            raise ValueError(f"{label} declares an unknown text encoding {encoding!r}") from error
+    try:
+        text = data.decode(encoding)
+    except (UnicodeDecodeError, ValueError) as error:
+        raise ValueError(f"{label} is not GPX: it is not text in {encoding.upper()}") from error
+    # The text is decoded now: the declaration's encoding must not be applied a second time by the XML parser.
+    return re.sub(
+        r"""^(\ufeff?<\?xml[^>]*?)\s+encoding\s*=\s*["'][^"']*["']""", r"\1", text, count=1
+    )
+
+
+def _check_values(
+    label: str,
+    kind: str,
+    lat: NDArray[np.float64],
+    lon: NDArray[np.float64],
+    ele: NDArray[np.float64],
+) -> None:
+    """Refuse a point that is not on the map, in words a rider reads (point numbers from 1, as in the file)."""
+    for values, what, limit, unit in (
+        (lat, "latitude", 90.0, "°"), (lon, "longitude", 180.0, "°"), (ele, "elevation", 10_000.0, " m"),
+    ):  # fmt: skip
+        bad = ~np.isfinite(values)
+        if np.any(bad):
+            first = int(np.argmax(bad))
+            raise ValueError(
+                f"{label}: {kind} point {first + 1} has {what} {values[first]}, not a number; "
+                f"{int(bad.sum())} point(s) like it"
+            )
+        out = np.abs(values) > limit
+        if np.any(out):
+            first = int(np.argmax(out))
+            raise ValueError(
+                f"{label}: {kind} point {first + 1} has {what} {values[first]:g}{unit}, outside "
+                f"±{_spaced(limit)}{unit}"
+            )
+
+
+def _check_gaps(
+    label: str, segments: Sequence[Sequence[gpxpy.gpx.GPXTrackPoint | gpxpy.gpx.GPXRoutePoint]]
+) -> None:
+    """Refuse tracks or segments that do not follow on: the route would jump across the map."""
+    for i in range(1, len(segments)):
+        a, b = segments[i - 1][-1], segments[i][0]
+        gap = _great_circle_m(a.latitude, a.longitude, b.latitude, b.longitude)
+        if gap > MAX_SEGMENT_GAP_M:
+            raise ValueError(
+                f"{label}: track segment {i + 1} starts {_km(gap)} from where segment {i} ends "
+                f"(at most {MAX_SEGMENT_GAP_M / 1000:.0f} km is joined); load the pieces as separate files"
+            )
+
+
+def _great_circle_m(lat1: float, lon1: float, lat2: float, lon2: float) -> float:
+    """Haversine distance (m) between two points (°)."""
+    p1, p2 = math.radians(lat1), math.radians(lat2)
+    a = (
+        math.sin((p2 - p1) / 2) ** 2
+        + math.cos(p1) * math.cos(p2) * math.sin(math.radians(lon2 - lon1) / 2) ** 2
+    )
+    return 2.0 * EARTH_RADIUS_M * math.asin(math.sqrt(min(max(a, 0.0), 1.0)))
+
+
+def _spaced(number: float, digits: int = 0) -> str:
+    """12 345.6 style: thousands apart by a space."""
+    return f"{number:,.{digits}f}".replace(",", " ")
+
+
+def _km(metres: float) -> str:
+    return f"{_spaced(metres / 1000, 1)} km"
+
+
+def steepest_grade(
+    distance_m: ArrayLike, elevation_m: ArrayLike, window_m: float
+) -> tuple[float, int]:
+    """Largest |rise| / run over the stretches from each point to the first point at least ``window_m`` further on
+    (the whole route when it is shorter). A cliff anywhere lies inside one such stretch, so no moving average can
+    hide it. Returns the grade and the stretch's first point. (N,) inputs, distance strictly increasing (m)."""
+    distance_m = np.asarray(distance_m, dtype=np.float64)
+    elevation_m = np.asarray(elevation_m, dtype=np.float64)
+    n = distance_m.shape[0]
+    end = np.searchsorted(distance_m, distance_m + window_m, side="left")
+    full = end < n
+    if np.any(full):
+        start, end = np.flatnonzero(full), end[full]
+    else:
+        start, end = np.array([0]), np.array([n - 1])
+    grade = np.abs(elevation_m[end] - elevation_m[start]) / (distance_m[end] - distance_m[start])
+    k = int(np.argmax(grade))
+    return float(grade[k]), int(start[k])
+
+
+def _check_grades(label: str, route: Course) -> None:
+    """Refuse a profile steeper than any road (:data:`MAX_GPX_GRADE`), before smoothing can hide it."""
+    grade, first = steepest_grade(route.distance_m, route.elevation_raw_m, GRADE_WINDOW_M)
+    smoothed = float(np.max(np.abs(route.grade)))
+    if max(grade, smoothed) > MAX_GPX_GRADE:
+        if smoothed > grade:
+            first = int(np.argmax(np.abs(route.grade)))
+        at = route.distance_m[first]
+        raise ValueError(
+            f"{label}: the elevation changes {_spaced(100 * max(grade, smoothed))} % of the distance near "
+            f"{at / 1000:.2f} km; no road is steeper than about 40 % (the limit is "
+            f"{100 * MAX_GPX_GRADE:.0f} %), so the file's elevation or positions are wrong"
+        )
 
 
 # --------------------------------------------------------------------------------------------- rider and air

@@ -12,6 +12,7 @@ import dataclasses
 import functools
 import logging
 import math
+import threading
 from typing import Literal
 
 import numpy as np
@@ -778,6 +779,9 @@ POWER_MODEL_FROM_LABEL: dict[str, course_kernel.Model] = {
     "Martin et al. 1998 (full)": "martin",
     "Seed (aero, rolling, climbing)": "seed",
 }
+COURSE_POWER_RANGE_W = (20.0, 2000.0)
+"""What the Course power input takes (W); 'Find the power for this time' says when a target needs more or less."""
+MODEL_LABEL = {model: label for label, model in POWER_MODEL_FROM_LABEL.items()}
 SAMPLE_LABEL = "Alpe d'Huez (sample, from the published profile)"
 logger = logging.getLogger(__name__)
 COURSE_BOX_M = 6.0
@@ -1046,6 +1050,9 @@ class CourseMode:
         self._since_readout = 0.0
         self._drawn_position: Position | None = None
         self._drawing = CourseDrawing.of(self.route)
+        self._upload_lock = threading.Lock()
+        self._upload_seq = 0
+        """Number of the newest upload: parses run in parallel on viser's pool, and only the newest installs."""
         self._build_gui()
         self._build_world()
         scene.start_loop(self._animate, 1.0 / 30.0)
@@ -1098,7 +1105,11 @@ class CourseMode:
             )
             with gui.add_folder("Power, model and air"):
                 self.power = gui.add_number(
-                    "Course power (W)", min=20.0, max=2000.0, step=5.0, initial_value=p.power_w
+                    "Course power (W)",
+                    min=COURSE_POWER_RANGE_W[0],
+                    max=COURSE_POWER_RANGE_W[1],
+                    step=5.0,
+                    initial_value=p.power_w,
                 )
                 self.target = gui.add_number(
                     "Target time (min)", min=1.0, max=6000.0, step=1.0, initial_value=p.target_min
@@ -1327,8 +1338,12 @@ class CourseMode:
     def _on_upload(self, _event: object = None) -> None:
         """An upload arrived (viser's thread pool). Parse it off the scene's lock, since gpxpy needs seconds for a
         large file, then install it (or the reason it failed) as a guarded callback. Nothing escapes."""
-        try:
+        # The number and the file are taken together: a higher number is a newer file.
+        with self._upload_lock:
+            self._upload_seq += 1
+            seq = self._upload_seq
             uploaded = self.upload.value
+        try:
             name = str(getattr(uploaded, "name", "") or "upload")[:80]
             content = getattr(uploaded, "content", b"")
             route, error = None, None
@@ -1344,6 +1359,8 @@ class CourseMode:
             name, route, error = "upload", None, "the file could not be read"
 
         def install() -> None:
+            if seq != self._upload_seq:  # a newer upload arrived while this one parsed: it wins
+                return
             self._install(route, error, name)
 
         self.scene.callback(install)(None)
@@ -1364,8 +1381,9 @@ class CourseMode:
             except ValueError as failure:
                 error = str(failure)
         if route is None or state is None:
+            reason = str(error).removeprefix("the file: ")  # the file is named already
             self.message = (
-                f"**{_escape(label)}** was not loaded: {_escape(str(error))}. "
+                f"**{_escape(label)}** was not loaded: {_escape(reason)}. "
                 f"Still showing **{_escape(self.route.name)}**."
             )
             self.redraw()
@@ -1377,9 +1395,9 @@ class CourseMode:
         self.playing = False
         self._drawing = CourseDrawing.of(route)
         self.scrub.max = self._total_km()
-        record_spec(
-            self.scrub
-        )  # the gate clamps a browser's scrub to the new course's length, not the first one's
+        # The gate clamps a browser's scrub to the new course's length, not the first one's.
+        record_spec(self.scrub)
+        self.scene._write_back(self.scrub, 0.0)  # the riders are back at the start
         self.redraw(geometry=True)
         return True
 
@@ -1391,17 +1409,47 @@ class CourseMode:
             cda_m2=group_cda(line), mass_kg=line.mass_kg, crr=line.crr,
             drivetrain_efficiency=line.drivetrain_pct / 100.0, model=params.model,
         )  # fmt: skip
-        try:
-            power = course_kernel.power_for_time(
-                self.route, params.target_min * 60.0, rider, params.wind_ms, params.wind_from_deg, air,
-                max_speed_ms=params.max_speed_kmh / 3.6, tolerance_s=0.05,
-            )  # fmt: skip
-        except ValueError as error:
-            self.message = _escape(str(error))
-            self.redraw()
-            return
-        self.scene._write_back(self.power, float(np.clip(round(power, 1), 20.0, 2000.0)))
+        target_s, cap = params.target_min * 60.0, params.max_speed_kmh / 3.6
+        low, high = COURSE_POWER_RANGE_W
+
+        def finish_at(power_w: float) -> float:
+            try:
+                return course_kernel.ride(
+                    self.route, power_w, rider, params.wind_ms, params.wind_from_deg, air, cap
+                ).time_s
+            except ValueError:  # too little power to cross a wall: never finishes
+                return math.inf
+
+        fastest, slowest = finish_at(high), finish_at(low)
+        wanted = f"{params.target_min:g} min"
+        if target_s < fastest:
+            power = high
+            note = (
+                f"A {wanted} finish needs more than {high:.0f} W, the most this input takes: set to "
+                f"{high:.0f} W, which finishes in {format_duration(fastest)}."
+            )
+        elif target_s > slowest:
+            power = low
+            note = (
+                f"A {wanted} finish needs less than {low:.0f} W, the least this input takes: set to "
+                f"{low:.0f} W, which finishes in {format_duration(slowest)}."
+            )
+        else:
+            try:
+                power = course_kernel.power_for_time(
+                    self.route, target_s, rider, params.wind_ms, params.wind_from_deg, air,
+                    max_speed_ms=cap, tolerance_s=0.05,
+                )  # fmt: skip
+            except ValueError as error:
+                self.message = f"Could not find the power for {wanted}: {_escape(str(error))}"
+                self.redraw()
+                return
+            note = ""
+        self.scene._write_back(self.power, float(np.clip(round(power, 1), low, high)))
         self._on_input()
+        if note and not self.message:
+            self.message = note
+            self.redraw()
 
     def _on_play(self) -> None:
         if self.state is None:
@@ -1559,8 +1607,13 @@ class CourseMode:
         p = self.params
         text = (
             f"Finish **{format_duration(ride.time_s)}**, average **{3.6 * ride.average_speed_ms:.1f} km/h** "
-            f"at **{ride.average_power_w:.0f} W** ({p.model} model)"
+            f"at **{ride.average_power_w:.0f} W** ({MODEL_LABEL[p.model]})"
         )
+        if ride.average_power_w < 0.99 * p.power_w and state.pacing is None:
+            text += (
+                f"  \nAverage {ride.average_power_w:.0f} W of the {p.power_w:.0f} W set: the riders coast "
+                f"where the descent would take them over the {p.max_speed_kmh:.0f} km/h safe speed"
+            )
         if state.group_cda_m2 != line.cda_m2:
             text += (
                 f"  \n{line.n_riders} riders sharing the front (mean CdA {state.group_cda_m2:.3f} m²): "
@@ -1619,9 +1672,12 @@ class CourseMode:
             ]
         )
         elevation = float(np.interp(d, self.route.distance_m, self.route.elevation_m))
+        coasting = ""
+        if self.state.pacing is None and power < 0.99 * self.params.power_w:
+            coasting = f" (coasting at the {self.params.max_speed_kmh:.0f} km/h descent cap)"
         return (
             f"Leader at **{d / 1000:.2f} km**, {format_duration(self.play_time_s)}: "
-            f"{3.6 * speed:.1f} km/h, {power:.0f} W, {elevation:.0f} m"
+            f"{3.6 * speed:.1f} km/h, {power:.0f} W{coasting}, {elevation:.0f} m"
         )
 
 

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from scipy.integrate import solve_ivp
 
@@ -349,18 +349,18 @@ def test_duplicate_points_and_noise_are_cleaned() -> None:
 
 
 BAD_FILES = {
-    "plain text": ("hello, I am not a GPX file", "not a GPX file"),
-    "html": ("<html><body>hi</body></html>", "not a GPX file"),
+    "plain text": ("hello, I am not a GPX file", "not (a )?GPX"),
+    "html": ("<html><body>hi</body></html>", "is not GPX"),
     "broken xml": ('<?xml version="1.0"?><gpx><trk><trkseg><trkpt lat="1"', "not a valid GPX"),
-    "kml": ('<?xml version="1.0"?><kml><Document/></kml>', "not a GPX file"),
+    "kml": ('<?xml version="1.0"?><kml><Document/></kml>', "is not GPX"),
     "no track points": ('<?xml version="1.0"?><gpx version="1.1"><wpt lat="1" lon="2"/></gpx>', "no track points"),
     "empty segment": (gpx_text([]), "no track points"),
     "one point": (gpx_text(line_points(1)), "only one"),
     "one place": (gpx_text([(45.0, 6.0, 10.0)] * 5), "one place"),
     "no elevation": (gpx_text([(45.0 + i * 1e-4, 6.0, None) for i in range(5)]), "no elevation"),
     "some elevation missing": (gpx_text([(45.0, 6.0, 1.0), (45.001, 6.0, None), (45.002, 6.0, 3.0)]), "1 of 3"),
-    "nan latitude": (gpx_text([(45.0, 6.0, 1.0), (float("nan"), 6.0, 2.0)]), "non-finite"),
-    "inf elevation": (gpx_text([(45.0, 6.0, 1.0), (45.001, 6.0, float("inf"))]), "non-finite"),
+    "nan latitude": (gpx_text([(45.0, 6.0, 1.0), (float("nan"), 6.0, 2.0)]), "point 2 has latitude nan, not a number"),
+    "inf elevation": (gpx_text([(45.0, 6.0, 1.0), (45.001, 6.0, float("inf"))]), "point 2 has elevation inf, not a number"),
     "latitude out of range": (gpx_text([(45.0, 6.0, 1.0), (95.0, 6.0, 2.0)]), "latitude"),
     "bad number": (gpx_text([(45.0, 6.0, 1.0)]).replace('lat="45.0"', 'lat="abc"'), "not a valid GPX"),
     "elevation absurd": (gpx_text([(45.0, 6.0, 1.0), (45.001, 6.0, 1e7)]), "elevation"),
@@ -377,7 +377,7 @@ def test_every_bad_file_gets_a_clear_message(kind: str) -> None:
 
 
 def test_binary_and_missing_files(tmp_path: Path) -> None:
-    with pytest.raises(ValueError, match="not UTF-8"):
+    with pytest.raises(ValueError, match="not text in UTF-8"):
         course.load_gpx(b"\x89PNG\r\n\x1a\n\xff\xfe<gpx")
     with pytest.raises(ValueError, match="cannot read"):
         course.load_gpx(tmp_path / "missing.gpx")
@@ -469,3 +469,182 @@ def test_any_course_balances_its_books_and_more_power_is_faster(
         c, power * 1.5, rider, wind, wind_from, max_speed_ms=cap, start_speed_ms=v0
     )
     assert faster.time_s <= r.time_s * (1 + 1e-9)
+
+
+# ------------------------------------------------------------------------------------------------ review of issue 13
+# Kind: a profile steeper than any road. The reviewer's vertical.gpx (three points 1 cm apart rising 1000 m) loaded
+# as flat because the 50 m smoothing averaged the cliff away; wall.gpx (300 %) was ridden at 1 km/h.
+def test_a_vertical_profile_is_refused_before_smoothing_hides_it() -> None:
+    vertical = gpx_text([(45.0, 6.0, 100.0), (45.0000001, 6.0, 600.0), (45.0000002, 6.0, 1100.0)])
+    with pytest.raises(ValueError, match="no road is steeper"):
+        course.load_gpx(vertical)
+    wall = [
+        (45.0 + i * 1e-4, 6.0, 100.0 + max(0.0, i - 5) * 33.4) for i in range(10)
+    ]  # 300 % after 0.5 km
+    with pytest.raises(ValueError, match="300 %"):
+        course.load_gpx(gpx_text(wall))
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    grade=st.floats(0.0, 3.0),
+    spacing=st.sampled_from([0.01, 1.0, 11.12, 100.0]),
+    n=st.integers(2, 60),
+)
+def test_grades_are_refused_exactly_beyond_the_bound(grade: float, spacing: float, n: int) -> None:
+    """A steady slope of any length and point spacing: accepted up to 50 %, refused beyond (values on the bound
+    are accepted). The steepest-stretch check is exact on a straight slope."""
+    d = np.arange(n) * spacing
+    found, _ = course.steepest_grade(d, grade * d, course.GRADE_WINDOW_M)
+    assert found == pytest.approx(grade, rel=1e-9, abs=1e-12)
+    assume(grade * (n - 1) * spacing < 9000.0)  # elevations stay within ±10 000 m
+    step_deg = spacing / (course.EARTH_RADIUS_M * math.pi / 180.0)
+    points = [(45.0 + i * step_deg, 6.0, 100.0 + grade * i * spacing) for i in range(n)]
+    if grade > course.MAX_GPX_GRADE * 1.001:
+        with pytest.raises(ValueError, match="no road is steeper"):
+            course.load_gpx(gpx_text(points))
+    elif grade < course.MAX_GPX_GRADE * 0.999 and n * spacing > 1e-3:
+        assert course.load_gpx(gpx_text(points)).n_points == n
+
+
+def test_gps_noise_on_a_real_climb_is_not_refused() -> None:
+    rng = np.random.default_rng(3)
+    pts = [
+        (45.0 + i * 1e-5, 6.0, 100.0 + 0.1 * i * 1.112 + float(rng.normal(0.0, 2.0)))
+        for i in range(2000)
+    ]
+    c = course.load_gpx(gpx_text(pts))  # 1.1 m between points, ±2 m noise, 10 %
+    assert c.total_distance_m == pytest.approx(1999 * 1.112, rel=1e-3)
+
+
+# Kind: pieces of a route that do not follow on (two_far_tracks.gpx joined France and Sydney: 16 742 km).
+def two_tracks(gap_deg: float) -> str:
+    a = "".join(f'<trkpt lat="{45 + i * 1e-3}" lon="6"><ele>0</ele></trkpt>' for i in range(3))
+    b = "".join(
+        f'<trkpt lat="{45 + 2e-3 + gap_deg + i * 1e-3}" lon="6"><ele>0</ele></trkpt>'
+        for i in range(3)
+    )
+    return (
+        '<?xml version="1.0"?><gpx version="1.1" creator="t"><trk><trkseg>'
+        f"{a}</trkseg></trk><trk><trkseg>{b}</trkseg></trk></gpx>"
+    )
+
+
+def test_tracks_far_apart_are_refused_and_near_ones_joined() -> None:
+    far = (
+        '<?xml version="1.0"?><gpx version="1.1" creator="r"><trk><trkseg><trkpt lat="45" lon="6"><ele>0</ele>'
+        '</trkpt><trkpt lat="45.001" lon="6"><ele>0</ele></trkpt></trkseg></trk><trk><trkseg><trkpt lat="-33" '
+        'lon="151"><ele>0</ele></trkpt><trkpt lat="-33.001" lon="151"><ele>0</ele></trkpt></trkseg></trk></gpx>'
+    )
+    with pytest.raises(
+        ValueError, match=r"segment 2 starts 16 741\.9 km from where segment 1 ends"
+    ):
+        course.load_gpx(far)
+    metre_deg = 1.0 / (course.EARTH_RADIUS_M * math.pi / 180.0)
+    joined = course.load_gpx(two_tracks(1999.0 * metre_deg))  # just under the 2 km bound
+    assert joined.total_distance_m == pytest.approx(2 * 2 * 111.195 + 1999.0, rel=1e-3)
+    with pytest.raises(ValueError, match=r"segment 2 starts 2\.0 km"):
+        course.load_gpx(two_tracks(2001.0 * metre_deg))
+
+
+# Kind: text encodings XML allows (the declaration or a byte-order mark says which).
+ENCODED = '<?xml version="1.0" encoding="{enc}"?><gpx version="1.1" creator="t"><trk><name>Col de l\'Échelle</name><trkseg>{pts}</trkseg></trk></gpx>'
+PTS = "".join(
+    f'<trkpt lat="{45 + i * 1e-3}" lon="6"><ele>{100 + i}</ele></trkpt>' for i in range(5)
+)
+
+
+@pytest.mark.parametrize(
+    ("codec", "declared"),
+    [("iso-8859-1", "ISO-8859-1"), ("cp1252", "windows-1252"), ("utf-16", "UTF-16"), ("utf-16-be", "UTF-16"),
+     ("utf-8-sig", "UTF-8"), ("utf-8", "utf-8"), ("utf-32", "UTF-32")],
+)  # fmt: skip
+def test_declared_encodings_and_byte_order_marks_are_read(codec: str, declared: str) -> None:
+    data = ENCODED.format(enc=declared, pts=PTS).encode(codec)
+    if codec == "utf-16-be":
+        data = b"\xfe\xff" + data
+    c = course.load_gpx(data)
+    assert c.name == "Col de l'Échelle" and c.n_points == 5
+
+
+def test_a_wrong_or_unknown_encoding_gets_a_clear_message() -> None:
+    with pytest.raises(ValueError, match="unknown text encoding 'klingon'"):
+        course.load_gpx(ENCODED.format(enc="klingon", pts=PTS).encode())
+
+
+# Kind: namespace-prefixed GPX (<g:gpx xmlns:g=...>): read, and counted before parsing.
+def prefixed(n: int) -> bytes:
+    pts = "".join(
+        f'<g:trkpt lat="{45 + i * 1e-4:.6f}" lon="6"><g:ele>1</g:ele></g:trkpt>' for i in range(n)
+    )
+    return (
+        '<?xml version="1.0"?><g:gpx xmlns:g="http://www.topografix.com/GPX/1/1" version="1.1" creator="r">'
+        f"<g:trk><g:name>prefixed</g:name><g:trkseg>{pts}</g:trkseg></g:trk></g:gpx>"
+    ).encode()
+
+
+def test_a_namespace_prefixed_gpx_is_read_and_counted_before_parsing(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    c = course.load_gpx(prefixed(20))
+    assert c.n_points == 20 and c.name == "prefixed"
+    monkeypatch.setattr(course, "MAX_POINTS", 10)
+
+    def never(*_: object) -> None:
+        raise AssertionError("parsed before counting")
+
+    monkeypatch.setattr(course.gpxpy, "parse", never)
+    with pytest.raises(ValueError, match="has 20 points; the limit is 10"):
+        course.load_gpx(prefixed(20))
+
+
+# Kind: messages in a rider's words (no kernel argument names, no "GPX is not a GPX file").
+@pytest.mark.parametrize("kind", list(BAD_FILES))
+def test_bad_file_messages_name_no_kernel_arguments(kind: str) -> None:
+    text, _ = BAD_FILES[kind]
+    with pytest.raises(ValueError) as caught:
+        course.load_gpx(text.encode())
+    message = str(caught.value)
+    for word in ("_deg", "_m ", "elevation_m", "latitude_deg", "non-finite", "GPX is not"):
+        assert word not in message, message
+    assert message.startswith("the file")
+
+
+# Kind: the drawing projection keeps every route's true shape (north_pole.gpx drew a 3.5 km "U").
+@settings(max_examples=40, deadline=None)
+@given(
+    lat=st.floats(-90.0, 90.0),
+    lon=st.floats(-180.0, 180.0),
+    bearing=st.floats(0.0, 360.0),
+)
+def test_a_straight_route_is_drawn_straight_anywhere(
+    lat: float, lon: float, bearing: float
+) -> None:
+    """A 2 km great-circle route from any start in any direction (over a pole, across the antimeridian): the
+    drawn line is straight and its drawn length is the ground distance."""
+    s = np.linspace(0.0, 2000.0, 41) / course.EARTH_RADIUS_M
+    phi0, lam0, theta = math.radians(lat), math.radians(lon), math.radians(bearing)
+    phi = np.arcsin(np.sin(phi0) * np.cos(s) + np.cos(phi0) * np.sin(s) * np.cos(theta))
+    lam = lam0 + np.arctan2(
+        np.sin(theta) * np.sin(s) * np.cos(phi0), np.cos(s) - np.sin(phi0) * np.sin(phi)
+    )
+    lon_deg = (np.degrees(lam) + 180.0) % 360.0 - 180.0
+    east, north = course.azimuthal_equidistant(np.degrees(phi), lon_deg)
+    chord = math.hypot(east[-1] - east[0], north[-1] - north[0])
+    assert chord == pytest.approx(2000.0, rel=1e-4)
+    # Straight: every point within 1 cm of the chord.
+    ux, uy = (east[-1] - east[0]) / chord, (north[-1] - north[0]) / chord
+    off = np.abs((east - east[0]) * uy - (north - north[0]) * ux)
+    assert float(off.max()) < 0.01
+
+
+def test_the_route_over_the_north_pole_is_drawn_straight() -> None:
+    pts = [(89.99 + i * 1e-4, 0.0, 10.0) for i in range(100)] + [
+        (90.0 - i * 1e-4, 180.0, 10.0) for i in range(1, 101)
+    ]
+    c = course.load_gpx(gpx_text(pts))
+    assert c.total_distance_m == pytest.approx(200 * 11.1195, rel=1e-3)
+    assert float(np.ptp(c.north_m) + np.ptp(c.east_m)) == pytest.approx(
+        c.total_distance_m, rel=1e-3
+    )
+    assert min(float(np.ptp(c.north_m)), float(np.ptp(c.east_m))) < 0.01  # a line, not a "U"

@@ -4,6 +4,7 @@ bad files), play / pause / scrub, air and model choices, the shared paceline, an
 from __future__ import annotations
 
 import math
+import threading
 import time
 import uuid
 
@@ -22,6 +23,7 @@ from scenes.peloton import (
     PelotonParams,
     PelotonScene,
     compute_course,
+    format_duration,
     group_cda,
 )
 from scenes.switcher import SceneSwitcher
@@ -338,3 +340,117 @@ def test_play_from_a_browser(server: viser.ViserServer, mode: CourseMode) -> Non
             ),
             what="the slider to follow",
         )
+
+
+# ------------------------------------------------------------------------------------------------ review of issue 13
+# Kind: work that finishes out of order. Two uploads close together parse in parallel on viser's pool; the last
+# file picked must win even when its parse finishes first.
+def test_the_newest_upload_wins_when_an_older_parse_finishes_last(
+    server: viser.ViserServer, mode: CourseMode, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    real = course_kernel.load_gpx
+    older_done = threading.Event()
+
+    def slow_for_the_first(source: bytes, **kwargs: object) -> course_kernel.Course:
+        if b"Older hill" in source:
+            time.sleep(1.0)
+            try:
+                return real(source)
+            finally:
+                older_done.set()
+        return real(source)
+
+    monkeypatch.setattr(course_kernel, "load_gpx", slow_for_the_first)
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Upload GPX")
+        upload(client, "Upload GPX", "older.gpx", hill_gpx("Older hill"))
+        time.sleep(0.2)  # the older parse is under way
+        upload(client, "Upload GPX", "newer.gpx", hill_gpx("Newer hill"))
+        client.wait_for(lambda: mode.route.name == "Newer hill", what="the newer course")
+        assert older_done.wait(5.0)
+        time.sleep(0.3)  # the older parse's install, had it been allowed, has run by now
+    assert mode.route.name == "Newer hill" and mode.route_label == "newer.gpx"
+
+
+# Kind: state left over from the last course. The Position slider goes back to 0 with a new course.
+def test_a_new_course_puts_the_position_slider_back_to_the_start(mode: CourseMode) -> None:
+    mode.scrub.value = 1.04
+    assert mode.leader_distance_m() == pytest.approx(1040.0, abs=1.0)
+    assert mode.load(hill_gpx("Next hill"), "next.gpx")
+    assert mode.scrub.value == 0.0
+    assert mode.leader_distance_m() == 0.0
+    assert "Leader at **0.00 km**" in mode.now.content
+
+
+# Kind: a found value silently clipped to an input's range. Each target is solved within the input's range or
+# the message says plainly, in minutes, that it is out of it (12 min needed > 2000 W; 6000 min < 20 W).
+@pytest.mark.parametrize("target_min", [1.0, 12.0, 30.0, 50.0, 90.0, 600.0, 6000.0])
+def test_find_the_power_says_when_the_target_is_out_of_the_inputs_range(
+    mode: CourseMode, target_min: float
+) -> None:
+    mode.target.value = target_min
+    mode.solve.value = True
+    assert mode.state is not None
+    ride = mode.state.ride
+    content = mode.route_info.content
+    assert "out of reach" not in content and "time_s" not in content
+    if mode.power.value == 2000.0 and ride.time_s > target_min * 60.0 + 1.0:
+        assert f"A {target_min:g} min finish needs more than 2000 W" in content
+        assert format_duration(ride.time_s) in content
+    elif mode.power.value == 20.0 and ride.time_s < target_min * 60.0 - 1.0:
+        assert f"A {target_min:g} min finish needs less than 20 W" in content
+    else:
+        assert ride.time_s == pytest.approx(target_min * 60.0, rel=5e-4, abs=1.0)  # power to 0.1 W
+        assert "finish needs" not in content
+    assert (target_min <= 12.0) == ("more than 2000 W" in content)
+    assert (target_min >= 6000.0) == ("less than 20 W" in content)
+
+
+# Kind: code names and unexplained numbers in the readout.
+def test_the_readout_names_the_model_by_its_label_and_explains_coasting(mode: CourseMode) -> None:
+    assert "(Martin et al. 1998 (full))" in mode.readout.content
+    assert "martin model" not in mode.readout.content
+    mode.power_model.value = "Seed (aero, rolling, climbing)"
+    assert "(Seed (aero, rolling, climbing))" in mode.readout.content
+    # 2 km at −20 %: 250 W would go far past the 72 km/h cap, so the riders coast and brake.
+    down = [(45.0 + i * 1e-4, 6.0, 1000.0 - 0.2 * 11.1195 * i) for i in range(180)]
+    assert mode.load(gpx_text(down).encode(), "down.gpx")
+    assert mode.state is not None
+    average = mode.state.ride.average_power_w
+    assert average < 100.0
+    assert (
+        f"Average {average:.0f} W of the 250 W set: the riders coast where the descent would take them "
+        "over the 72 km/h safe speed"
+    ) in mode.readout.content
+    mode.scrub.value = 1.5
+    assert "(coasting at the 72 km/h descent cap)" in mode.now.content
+
+
+# Kind: the reviewer's bad files, through the scene: refused in a rider's words, the last good course kept.
+REVIEW_FILES = {
+    "vertical": (
+        '<?xml version="1.0"?><gpx version="1.1" creator="r"><trk><trkseg><trkpt lat="45" lon="6"><ele>100</ele>'
+        '</trkpt><trkpt lat="45.0000001" lon="6"><ele>600</ele></trkpt><trkpt lat="45.0000002" lon="6">'
+        "<ele>1100</ele></trkpt></trkseg></trk></gpx>",
+        "was not loaded: the elevation changes 4 496 602 % of the distance near 0.00 km; no road is steeper",
+    ),
+    "nan elevation": (
+        gpx_text([(45.0, 6.0, 1.0), (45.001, 6.0, float("nan"))]),
+        "was not loaded: track point 2 has elevation nan, not a number",
+    ),
+    "not gpx": (
+        "<html><body>hi</body></html>",
+        "was not loaded: the file is not GPX: no &lt;gpx&gt;",
+    ),
+}
+
+
+@pytest.mark.parametrize("kind", list(REVIEW_FILES))
+def test_review_files_are_refused_in_a_riders_words(mode: CourseMode, kind: str) -> None:
+    good = mode.route
+    text, message = REVIEW_FILES[kind]
+    assert not mode.load(text.encode(), f"{kind}.gpx")
+    assert mode.route is good
+    assert message in mode.route_info.content
+    for word in ("elevation_m", "latitude_deg", "non-finite", "time_s", "GPX is not"):
+        assert word not in mode.route_info.content
