@@ -290,12 +290,27 @@ def free_kick_panels(
 
 
 # --------------------------------------------------------------------------------------------- validation
+def _booleans(value: object) -> bool:
+    """Whether ``value`` is a boolean array or a sequence holding booleans (refused like a bool scalar)."""
+    if isinstance(value, np.ndarray):
+        return value.dtype == np.bool_
+    if isinstance(value, (list, tuple)):
+        for item in value:  # a plain loop: this runs on every kick's three vectors
+            kind = type(item)
+            if kind is bool or kind is np.bool_:
+                return True
+            if (kind is list or kind is tuple or kind is np.ndarray) and _booleans(item):
+                return True
+        return False
+    return isinstance(value, (bool, np.bool_))
+
+
 def _vector(name: str, value: ArrayLike, size: int) -> NDArray[np.float64]:
     try:
         array = np.array(value, dtype=np.float64)
     except (TypeError, ValueError) as error:
         raise ValueError(f"{name} must be {size} numbers, got {value!r}") from error
-    if np.asarray(value).dtype == np.bool_:
+    if _booleans(value):
         raise ValueError(f"{name} must be numbers, not booleans, got {value!r}")
     if array.shape != (size,):
         raise ValueError(f"{name} must have shape ({size},), got {array.shape}")
@@ -309,7 +324,7 @@ def _rows(name: str, value: ArrayLike) -> NDArray[np.float64]:
         array = np.array(value, dtype=np.float64)
     except (TypeError, ValueError) as error:
         raise ValueError(f"{name} must be an (N, 3) array of numbers") from error
-    if np.asarray(value).dtype == np.bool_:
+    if _booleans(value):
         raise ValueError(f"{name} must be numbers, not booleans")
     if array.size == 0 and array.ndim == 1:  # an empty list: no kicks
         array = array.reshape(0, 3)
@@ -877,6 +892,8 @@ def _check_launches(
     launches: NDArray[np.float64], config: NDArray[np.float64], batch: bool
 ) -> None:
     """Refuse a launch below the ground and, in the measured model, a spin far beyond its fits."""
+    if not batch and not config[_MEASURED] and launches[0, 2] >= config[_GROUND]:
+        return  # one kick in the constant model, above the ground: the common case, without array work
     low = np.flatnonzero(launches[:, 2] < config[_GROUND])
     if low.size:
         which = f"positions[{low[0]}]" if batch else "position"

@@ -526,8 +526,10 @@ def hermite_root(d0: float, dd0: float, d1: float, dd1: float, h: float) -> floa
     roots = [
         r.real for r in np.roots(coefficients) if abs(r.imag) < 1e-9 and -1e-9 <= r.real <= 1 + 1e-9
     ]
-    if d0 == 0.0 and dd0 > 0.0:
-        roots = [r for r in roots if r > 1e-12]
+    if (
+        d0 == 0.0 and dd0 > 0.0
+    ):  # (a rise far below 1e-12 of the step lands "at once": either root will do)
+        roots = [r for r in roots if r > 1e-12] or roots
     return min(roots)
 
 
