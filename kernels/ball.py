@@ -36,14 +36,21 @@ direction, ``½·ρ·A·|v|²·C_K·w·(cos θ·sin(Ωt + φ₁)·n₁ + sin θ�
 normalised (horizontal, to the left; +y for a vertical kick) and n₂ = v̂₀ × n₁, and θ, φ₁, φ₂ drawn in that order by
 ``numpy.random.default_rng(knuckle_seed).uniform(0, 2π, 3)`` so a seed always gives the same flight.
 w = max(0, 1 − S₀/0.05) fades the effect out as launch spin grows (S₀ the launch spin parameter): any real spin
-steadies the wake. C_K is set so that the median peak lateral deviation at 25 m/s over 25 m is about one ball
-diameter.
+steadies the wake. With C_K = 0.10 the median (over seeds) peak deviation from the spinless flight of a 25 m/s
+kick at 12° over 25 m is 0.18 m for seeds 0–29 and 0.21 m for seeds 0–199 (RK4, 10 ms): a little under the "about
+one ball diameter" (0.22 m) those papers report.
 
 Assumptions: spin is constant in flight (spin decay over a 1–2 s free kick is a few percent); still air; the ball is
 rigid and stops at the first touch of the ground (no bounce or roll); a ball that touches the wall or the frame does
 not rebound. Integrators: ``"euler"`` is the seed's fixed-step method (v += a·dt, then x += v·dt; first order),
 ``"rk4"`` the classical fourth-order Runge–Kutta. The last sample of a flight is placed on the ground (or on the
-``x_stop`` plane) by cubic Hermite interpolation of the last step, which keeps RK4's accuracy.
+``x_stop`` plane) by cubic Hermite interpolation of the last step, which keeps RK4's accuracy: the first root of
+that cubic in the step, bracketed between its turning points (a ball may rise, peak and land within one long step).
+Wall and goal crossings are found the same way. Every step is ``dt`` but the last, which is shortened to end exactly
+on ``t_max``. Planes are closed on the start side: a ball launched on the ``x_stop``, wall or goal plane and moving
+through it crosses at t = 0; one launched on the ground (``z = ground_m``) and not moving up lands at t = 0; one
+launched below it is refused. The measured model refuses a launch spin parameter r·|ω|/max(|v|, 1 m/s) above 10³
+(its fits stop at S ≈ 0.3; 10³ is ~2·10⁵ rev/s at 25 m/s) with a ``ValueError`` naming the spin.
 
 Implementation: every numeric core (force law, Euler and RK4 steps, the Hermite end of a flight, plane crossings and
 the verdict) is written once, on scalars, and compiled by numba (``@njit(cache=True)``). One kick and a batch run the
@@ -107,11 +114,15 @@ _RE_WIDTH = 1.949e4
 
 # The compiled cores read their settings from one float64 vector; these are its slots.
 _Q, _GRAVITY, _RADIUS, _RE_PER_SPEED, _C_D, _C_L, _MASS, _DT, _GROUND, _X_STOP = range(10)
-_N_STEPS, _RK4, _MEASURED = 10, 11, 12
+_N_STEPS, _RK4, _MEASURED, _T_MAX = 10, 11, 12, 13
 # ... and each kick's constants from one row of 14: ω̂, |ω|, knuckle gain ½ρA·C_K·w/m, rate Ω, phases φ₁ φ₂,
 # cos θ·n₁ and sin θ·n₂.
 _AXIS, _RATE, _GAIN, _OMEGA, _PHASE, _N1, _N2 = 0, 3, 4, 5, 6, 8, 11
 _N_KICK = 14
+
+_SPIN_PARAMETER_LIMIT = 1e3
+"""Largest spin parameter S = r·|ω|/|v| the measured model accepts at launch; its fits stop at S ≈ 0.3 (held
+constant beyond) and no kick comes near 10 (S = 1e3 is ~2·10⁵ rev/s at 25 m/s)."""
 
 _RESERVE_BYTES = 2**31
 """Largest time-major reservation :func:`simulate_batch` makes before it counts the samples first (bytes)."""
@@ -252,6 +263,8 @@ def free_kick_panels(
     ball = _vector("ball_xy", ball_xy, 2)
     centre = _vector("goal_centre_xy", goal_centre_xy, 2)
     normal = _vector("goal_normal_xy", goal_normal_xy, 2)
+    if not normal.any():
+        raise ValueError("goal_normal_xy must not be zero")
     aim = centre - ball
     distance = float(np.hypot(*aim))
     if distance <= WALL_DISTANCE_M:
@@ -277,11 +290,28 @@ def free_kick_panels(
 
 
 # --------------------------------------------------------------------------------------------- validation
+def _booleans(value: object) -> bool:
+    """Whether ``value`` is a boolean array or a sequence holding booleans (refused like a bool scalar)."""
+    if isinstance(value, np.ndarray):
+        return value.dtype == np.bool_
+    if isinstance(value, (list, tuple)):
+        for item in value:  # a plain loop: this runs on every kick's three vectors
+            kind = type(item)
+            if kind is bool or kind is np.bool_:
+                return True
+            if (kind is list or kind is tuple or kind is np.ndarray) and _booleans(item):
+                return True
+        return False
+    return isinstance(value, (bool, np.bool_))
+
+
 def _vector(name: str, value: ArrayLike, size: int) -> NDArray[np.float64]:
     try:
         array = np.array(value, dtype=np.float64)
     except (TypeError, ValueError) as error:
         raise ValueError(f"{name} must be {size} numbers, got {value!r}") from error
+    if _booleans(value):
+        raise ValueError(f"{name} must be numbers, not booleans, got {value!r}")
     if array.shape != (size,):
         raise ValueError(f"{name} must have shape ({size},), got {array.shape}")
     if not all(map(math.isfinite, array.tolist())):
@@ -294,6 +324,10 @@ def _rows(name: str, value: ArrayLike) -> NDArray[np.float64]:
         array = np.array(value, dtype=np.float64)
     except (TypeError, ValueError) as error:
         raise ValueError(f"{name} must be an (N, 3) array of numbers") from error
+    if _booleans(value):
+        raise ValueError(f"{name} must be numbers, not booleans")
+    if array.size == 0 and array.ndim == 1:  # an empty list: no kicks
+        array = array.reshape(0, 3)
     if array.ndim != 2 or array.shape[1] != 3:
         raise ValueError(f"{name} must have shape (N, 3), got {array.shape}")
     if not np.isfinite(array).all():
@@ -349,7 +383,7 @@ def _config(
     x_stop: object,
     ground_m: object,
 ) -> NDArray[np.float64]:
-    """The validated settings shared by every kick, as the compiled cores' (13,) settings vector."""
+    """The validated settings shared by every kick, as the compiled cores' (14,) settings vector."""
     step = _positive_scalar("dt", dt)
     duration = _positive_scalar("t_max", t_max)
     if duration / step > _MAX_STEPS:
@@ -369,7 +403,7 @@ def _config(
     stop = math.inf if x_stop is None else _finite_scalar("x_stop", x_stop)
     ground = _finite_scalar("ground_m", ground_m)
     # In slot order: _Q (½ρA/m, 1/m), _GRAVITY, _RADIUS, _RE_PER_SPEED, _C_D, _C_L, _MASS, _DT, _GROUND, _X_STOP,
-    # _N_STEPS, _RK4, _MEASURED.
+    # _N_STEPS, _RK4, _MEASURED, _T_MAX.
     config = np.array(
         [
             0.5 * density * math.pi * radius**2 / mass,
@@ -382,9 +416,10 @@ def _config(
             step,
             ground,
             stop,
-            math.ceil(duration / step - 1e-9),
+            max(1, math.ceil(duration / step - 1e-9)),
             method == "rk4",
             model == "measured",
+            duration,
         ]
     )
     return config
@@ -514,9 +549,8 @@ def _forces(t, state, kick, config, forces):
 
 # --------------------------------------------------------------------------------------------- flight
 @_compiled(inline="always")
-def _step(x, y, z, vx, vy, vz, t, kick, config):
-    """One fixed step of the configured method: (x, y, z, vx, vy, vz) after ``dt``."""
-    dt = config[_DT]
+def _step(x, y, z, vx, vy, vz, t, dt, kick, config):
+    """One step of length ``dt`` of the configured method: (x, y, z, vx, vy, vz) after it."""
     if config[_RK4] == 0.0:  # the seed's Euler: velocity first, then position with the new velocity
         ax, ay, az = _acceleration(vx, vy, vz, t, kick, config)
         vx1, vy1, vz1 = vx + ax * dt, vy + ay * dt, vz + az * dt
@@ -542,14 +576,18 @@ def _step(x, y, z, vx, vy, vz, t, kick, config):
 
 @_compiled(inline="always")
 def _hermite(p0, v0, p1, v1, h, s):
-    """Cubic Hermite value and derivative (per unit time) at fraction ``s`` of a step of length ``h``."""
+    """Cubic Hermite value and derivative (per unit time) at fraction ``s`` of a step of length ``h``.
+
+    The value is written as p0 + (p1 − p0)·(3s² − 2s³) + slope terms, so a coordinate constant over the step
+    (p0 = p1, no velocity) comes back exactly, whatever s; s = 0 and s = 1 give the samples exactly.
+    """
     s2, s3 = s * s, s * s * s
-    value = (
-        (2 * s3 - 3 * s2 + 1) * p0
-        + (s3 - 2 * s2 + s) * h * v0
-        + (3 * s2 - 2 * s3) * p1
-        + (s3 - s2) * h * v1
-    )
+    if s <= 0.0:
+        value = p0
+    elif s >= 1.0:
+        value = p1
+    else:
+        value = p0 + (p1 - p0) * (3 * s2 - 2 * s3) + h * ((s3 - 2 * s2 + s) * v0 + (s3 - s2) * v1)
     slope = (
         (6 * s2 - 6 * s) * p0
         + (3 * s2 - 4 * s + 1) * h * v0
@@ -560,18 +598,74 @@ def _hermite(p0, v0, p1, v1, h, s):
 
 
 @_compiled(inline="always")
-def _crossing_fraction(d0, dd0, d1, dd1, h):
-    """Fraction s ∈ [0, 1] of a step where the cubic through (d0, dd0) and (d1, dd1) reaches zero.
+def _cubic_value(d0, dd0, d1, dd1, h, s):
+    value, _ = _hermite(d0, dd0, d1, dd1, h, s)
+    return value
 
-    ``d0`` and ``d1`` should bracket zero; the answer is clamped to the step. Linear guess, then four Newton steps on
-    the Hermite cubic (its error is O(h⁴), below the integrators' own).
+
+@_compiled(inline="always")
+def _crossing_fraction(d0, dd0, d1, dd1, h):
+    """First fraction s ∈ [0, 1] of a step where the cubic Hermite through (d0, dd0) and (d1, dd1) reaches zero.
+
+    Call with ``d0 ≥ 0 ≥ d1`` (the far side of the plane is negative). ``d0 < 0``, or ``d0 = 0`` moving onto the
+    far side or along the plane (``dd0 ≤ 0``), gives 0; ``d0 = 0`` moving away (a kick from the ground) looks for
+    the later root. The cubic's turning points split [0, 1] into monotone pieces; the first piece whose end is ≤ 0
+    brackets the first root, which a safeguarded Newton iteration (bisection whenever a Newton step leaves the
+    bracket) finds to rounding. A ball that rises and lands within one step so finds its landing, not the launch
+    (a linear guess plus bare Newton stalled at s = 0 there).
     """
-    span = d1 - d0
-    s = min(max(-d0 / (span if span != 0.0 else 1.0), 0.0), 1.0)
-    for _ in range(4):
+    if d0 < 0.0 or (d0 == 0.0 and dd0 <= 0.0):
+        return 0.0
+    m0, m1 = h * dd0, h * dd1
+    # p(s) = a s³ + b s² + m0 s + d0, p'(s) = 3a s² + 2b s + m0.
+    a = 2.0 * d0 + m0 - 2.0 * d1 + m1
+    b = -3.0 * d0 - 2.0 * m0 + 3.0 * d1 - m1
+    c1, c2 = 2.0, 2.0  # turning points in (0, 1), ascending; 2.0 means none
+    qa, qb, qc = 3.0 * a, 2.0 * b, m0
+    if qa != 0.0:
+        disc = qb * qb - 4.0 * qa * qc
+        if disc >= 0.0:
+            root = math.sqrt(disc)
+            q = -0.5 * (qb + math.copysign(root, qb))
+            r1 = q / qa
+            r2 = qc / q if q != 0.0 else r1
+            lo_r, hi_r = min(r1, r2), max(r1, r2)
+            if 0.0 < lo_r < 1.0:
+                c1 = lo_r
+            if 0.0 < hi_r < 1.0:
+                if c1 == 2.0:
+                    c1 = hi_r
+                else:
+                    c2 = hi_r
+    elif qb != 0.0:
+        r = -qc / qb
+        if 0.0 < r < 1.0:
+            c1 = r
+    lo, hi = 0.0, 1.0
+    for edge in (c1, c2, 1.0):
+        if edge > 1.0:
+            continue
+        if edge == 1.0 or _cubic_value(d0, dd0, d1, dd1, h, edge) <= 0.0:
+            hi = edge
+            break
+        lo = edge
+    # p(lo) > 0 ≥ p(hi) and p is monotone on [lo, hi].
+    s = 0.5 * (lo + hi)
+    for _ in range(80):
         value, slope = _hermite(d0, dd0, d1, dd1, h, s)
+        if value == 0.0:
+            return s
+        if value > 0.0:
+            lo = s
+        else:
+            hi = s
         slope *= h  # per unit s
-        s = min(max(s - value / (slope if slope != 0.0 else 1.0), 0.0), 1.0)
+        trial = s - value / slope if slope != 0.0 else -1.0
+        if not lo < trial < hi:
+            trial = 0.5 * (lo + hi)
+        if trial == s or hi - lo <= 1e-16:
+            break
+        s = trial
     return s
 
 
@@ -598,24 +692,29 @@ def _fly(launch, kick, config, t_out, state_out):
         t_out[0] = 0.0
         state_out[0, 0], state_out[0, 1], state_out[0, 2] = x, y, z
         state_out[0, 3], state_out[0, 4], state_out[0, 5] = vx, vy, vz
+    t_max = config[_T_MAX]
     for n in range(n_steps):
-        x1, y1, z1, vx1, vy1, vz1 = _step(x, y, z, vx, vy, vz, n * dt, kick, config)
+        # Every step is dt but the last, which ends exactly on t_max.
+        h = dt if n < n_steps - 1 else t_max - (n_steps - 1) * dt
+        x1, y1, z1, vx1, vy1, vz1 = _step(x, y, z, vx, vy, vz, n * dt, h, kick, config)
         if vx1 * vx1 + vy1 * vy1 + vz1 * vz1 + 2.0 * g * z1 > energy_limit:
             return n + 1, 3
-        hit_ground, hit_stop = z1 <= ground, x < x_stop <= x1
+        # The stop plane is closed on the start side: a kick launched on it, moving on, stops at t = 0.
+        hit_ground = z1 <= ground
+        hit_stop = x < x_stop <= x1 or (n == 0 and x == x_stop and x1 > x)
         if hit_ground or hit_stop:
             # End on whichever of the ground and the stop plane the cubic through this step reaches first.
             f_ground = (
-                _crossing_fraction(z - ground, vz, z1 - ground, vz1, dt) if hit_ground else np.inf
+                _crossing_fraction(z - ground, vz, z1 - ground, vz1, h) if hit_ground else np.inf
             )
             f_stop = (
-                _crossing_fraction(x - x_stop, vx, x1 - x_stop, vx1, dt) if hit_stop else np.inf
+                _crossing_fraction(x_stop - x, -vx, x_stop - x1, -vx1, h) if hit_stop else np.inf
             )
             ending = 0 if f_ground <= f_stop else 1
             f = min(f_ground, f_stop)
-            ex, evx = _hermite(x, vx, x1, vx1, dt, f)
-            ey, evy = _hermite(y, vy, y1, vy1, dt, f)
-            ez, evz = _hermite(z, vz, z1, vz1, dt, f)
+            ex, evx = _hermite(x, vx, x1, vx1, h, f)
+            ey, evy = _hermite(y, vy, y1, vy1, h, f)
+            ez, evz = _hermite(z, vz, z1, vz1, h, f)
             if ending == 0:
                 ez = ground
             else:
@@ -623,13 +722,13 @@ def _fly(launch, kick, config, t_out, state_out):
             if not math.isfinite(ex + ey + ez + evx + evy + evz):  # inf or NaN (or ~1e308)
                 ending = 3
             if store:
-                t_out[n + 1] = (n + f) * dt
+                t_out[n + 1] = n * dt + f * h
                 state_out[n + 1, 0], state_out[n + 1, 1], state_out[n + 1, 2] = ex, ey, ez
                 state_out[n + 1, 3], state_out[n + 1, 4], state_out[n + 1, 5] = evx, evy, evz
             return n + 2, ending
         x, y, z, vx, vy, vz = x1, y1, z1, vx1, vy1, vz1
         if store:
-            t_out[n + 1] = (n + 1) * dt
+            t_out[n + 1] = (n + 1) * dt if n < n_steps - 1 else t_max
             state_out[n + 1, 0], state_out[n + 1, 1], state_out[n + 1, 2] = x, y, z
             state_out[n + 1, 3], state_out[n + 1, 4], state_out[n + 1, 5] = vx, vy, vz
     # A state that overflowed stays inf or NaN to the end (NaN fails the ground test, so it runs to t_max).
@@ -685,12 +784,13 @@ def _plane_crossing(t, position, velocity, n, panel, crossing):
     d1 = (position[0, 0] - cx) * nx + (position[0, 1] - cy) * ny
     for i in range(n - 1):
         d0, d1 = d1, (position[i + 1, 0] - cx) * nx + (position[i + 1, 1] - cy) * ny
-        if d0 < 0.0 <= d1:
+        # Closed on the start side: a ball launched on the plane and moving through it crosses at t = 0.
+        if d0 < 0.0 <= d1 or (i == 0 and d0 == 0.0 and d1 > 0.0):
             h = t[i + 1] - t[i]
             h = h if h > 0.0 else 1.0
             dd0 = velocity[i, 0] * nx + velocity[i, 1] * ny
             dd1 = velocity[i + 1, 0] * nx + velocity[i + 1, 1] * ny
-            s = _crossing_fraction(d0, dd0, d1, dd1, h)
+            s = _crossing_fraction(-d0, -dd0, -d1, -dd1, h)
             crossing[0] = t[i] + s * h
             for c in range(3):
                 p0, v0, p1, v1 = (
@@ -715,6 +815,8 @@ def _judge(t, position, velocity, n, panels, radius, crossings):
     wall, goal = panels[0], panels[1]
     wall_lateral = -(crossings[0, 1] - wall[0]) * wall[3] + (crossings[0, 2] - wall[1]) * wall[2]
     goal_lateral = -(crossings[1, 1] - goal[0]) * goal[3] + (crossings[1, 2] - goal[1]) * goal[2]
+    # Every edge is closed (touching counts). A coordinate that stays constant over the crossing step comes out of
+    # _hermite exactly, so a ball exactly on an edge gets the same verdict however its flight was sampled.
     # The ball touches the wall if its centre comes within a radius of the defenders' outline.
     if abs(wall_lateral) <= 0.5 * wall[4] + radius and crossings[0, 3] <= wall[5] + radius:
         return 1
@@ -722,7 +824,7 @@ def _judge(t, position, velocity, n, panels, radius, crossings):
         return 4
     if abs(goal_lateral) > 0.5 * goal[4] - radius:
         return 3
-    # A goal needs the whole ball inside the posts and under the bar.
+    # A goal needs the whole ball inside the posts and under the bar (touching them from inside counts).
     return 0 if crossings[1, 3] <= goal[5] - radius else 2
 
 
@@ -767,10 +869,47 @@ def _kick_rows(
     if knuckle_seeds is None:
         seeds: list[int | None] = [None] * k
     else:
+        if isinstance(knuckle_seeds, (str, bytes)) or not isinstance(
+            knuckle_seeds, (Sequence, np.ndarray)
+        ):
+            raise ValueError(
+                f"knuckle_seeds must be None or a sequence of K seeds, got {knuckle_seeds!r}"
+            )
         seeds = [_seed("knuckle_seeds", seed) for seed in knuckle_seeds]
         if len(seeds) != k:
             raise ValueError(f"knuckle_seeds must have {k} entries, got {len(seeds)}")
     return _launches(p0, v0, w0, seeds)
+
+
+def _safe_norms(rows: NDArray[np.float64]) -> NDArray[np.float64]:
+    """|row| of each row of a (K, 3) array without overflow or underflow in the squares."""
+    scale = np.abs(rows).max(axis=1, initial=0.0)
+    safe = np.where(scale > 0.0, scale, 1.0)
+    return scale * np.sqrt(((rows / safe[:, None]) ** 2).sum(axis=1))
+
+
+def _check_launches(
+    launches: NDArray[np.float64], config: NDArray[np.float64], batch: bool
+) -> None:
+    """Refuse a launch below the ground and, in the measured model, a spin far beyond its fits."""
+    if not batch and not config[_MEASURED] and launches[0, 2] >= config[_GROUND]:
+        return  # one kick in the constant model, above the ground: the common case, without array work
+    low = np.flatnonzero(launches[:, 2] < config[_GROUND])
+    if low.size:
+        which = f"positions[{low[0]}]" if batch else "position"
+        raise ValueError(
+            f"{which} starts below the ground: z = {launches[low[0], 2]:g} m < ground_m = {config[_GROUND]:g} m"
+        )
+    if config[_MEASURED]:
+        speeds = np.maximum(_safe_norms(launches[:, 3:6]), 1.0)
+        spin_parameter = config[_RADIUS] * _safe_norms(launches[:, 6:9]) / speeds
+        bad = np.flatnonzero(spin_parameter > _SPIN_PARAMETER_LIMIT)
+        if bad.size:
+            which = f"spins[{bad[0]}]" if batch else "spin"
+            raise ValueError(
+                f"{which} is too fast for the measured model: spin parameter S = r·|ω|/max(|v|, 1 m/s) = "
+                f"{spin_parameter[bad[0]]:.3g} > {_SPIN_PARAMETER_LIMIT:g} (its fits stop at S ≈ 0.3)"
+            )
 
 
 def _refuse_overflow(endings: NDArray[np.int64], config: NDArray[np.float64]) -> None:
@@ -828,8 +967,9 @@ def simulate(
         :class:`Trajectory`, sampled every ``dt`` plus the interpolated end.
 
     Raises:
-        ValueError: naming the argument, for non-finite or wrongly shaped input, dt ≤ 0, mass or radius ≤ 0, an
-            unknown method or model; naming dt when the steps overshoot the drag and the ball gains energy without
+        ValueError: naming the argument, for non-finite, boolean or wrongly shaped input, dt ≤ 0, mass or
+            radius ≤ 0, an unknown method or model, a position below ``ground_m``, a spin beyond the measured
+            model's range (see the module docstring); naming dt when the steps overshoot the drag and the ball gains energy without
             bound (a step far too long for this speed, density and mass).
     """
     p0, v0, w0 = (
@@ -851,7 +991,9 @@ def simulate(
         x_stop=x_stop,
         ground_m=ground_m,
     )
-    launch = _launches(p0[None], v0[None], w0[None], [_seed("knuckle_seed", knuckle_seed)])[0]
+    launches = _launches(p0[None], v0[None], w0[None], [_seed("knuckle_seed", knuckle_seed)])
+    _check_launches(launches, config, batch=False)
+    launch = launches[0]
     rows = int(config[_N_STEPS]) + 1
     t, state, forces = np.empty(rows), np.empty((rows, 6)), np.empty((rows, 12))
     n, ending = _simulate_one(launch, config, t, state, forces)
@@ -921,6 +1063,7 @@ def simulate_batch(
         x_stop=x_stop,
         ground_m=ground_m,
     )
+    _check_launches(launches, config, batch=True)
     k = len(launches)
     rows = int(config[_N_STEPS]) + 1
     n_samples, endings = np.ones(k, dtype=np.int64), np.full(k, 2, dtype=np.int64)
@@ -982,6 +1125,10 @@ def outcome(
         :class:`Outcome`.
     """
     radius = _positive_scalar("radius_m", radius_m)
+    if not isinstance(trajectory, Trajectory):
+        raise ValueError(
+            f"trajectory must be a Trajectory from simulate(), got {type(trajectory).__name__}"
+        )
     crossings = np.empty((2, 4))
     t, position, velocity = trajectory.t, trajectory.position, trajectory.velocity
     code = _judge(t, position, velocity, len(t), _panels(wall, goal), radius, crossings)
@@ -1010,6 +1157,10 @@ def outcome_batch(
         :class:`BatchOutcome`.
     """
     radius = _positive_scalar("radius_m", radius_m)
+    if not isinstance(batch, BatchTrajectory):
+        raise ValueError(
+            f"batch must be a BatchTrajectory from simulate_batch(), got {type(batch).__name__}"
+        )
     k = len(batch.n_samples)
     results, crossings, panels = (
         np.empty(k, dtype=np.int64),
@@ -1090,6 +1241,7 @@ def simulate_outcomes(
         x_stop=x_stop,
         ground_m=ground_m,
     )
+    _check_launches(launches, config, batch=True)
     k, panels = len(launches), _panels(wall, goal)
     results, crossings, endings = np.empty(k, np.int64), np.empty((k, 2, 4)), np.empty(k, np.int64)
     with _PARALLEL:
@@ -1110,10 +1262,13 @@ def spin_vector(rate_rev_s: float, axis: ArrayLike) -> NDArray[np.float64]:
     """
     rate = _non_negative_scalar("rate_rev_s", rate_rev_s)
     direction = _vector("axis", axis, 3)
-    length = float(np.linalg.norm(direction))
-    if length == 0.0:
+    scale = float(np.abs(direction).max())
+    if scale == 0.0:
         raise ValueError("axis must not be zero")
-    return 2.0 * math.pi * rate * direction / length
+    direction = (
+        direction / scale
+    )  # largest component ±1 first: neither overflows nor underflows when squared
+    return 2.0 * math.pi * rate * direction / float(np.linalg.norm(direction))
 
 
 def launch_velocity(

@@ -348,7 +348,11 @@ def deflection_m(state: KickState) -> float | None:
 
 
 def outcome_map(p: FreeKickParams) -> NDArray[np.str_]:
-    """(spins, speeds) results over :data:`MAP_SPEEDS_MS` × :data:`MAP_SPINS_REV_S` with the other settings kept."""
+    """(spins, speeds) results over :data:`MAP_SPEEDS_MS` × :data:`MAP_SPINS_REV_S` with the other settings kept.
+
+    With the knuckleball on, every cell flies with ``p.knuckle_seed`` (the side force fades out as the spin grows,
+    so it matters in the low-spin rows only), as the kick itself does.
+    """
     wall, goal = panels(p)
     speeds, spins = np.meshgrid(MAP_SPEEDS_MS, MAP_SPINS_REV_S)
     heading, elevation = aim_heading_rad(p), math.radians(p.elevation_deg)
@@ -367,6 +371,7 @@ def outcome_map(p: FreeKickParams) -> NDArray[np.str_]:
         t_max=4.0,
         x_stop=0.5,
         ground_m=ball.BALL_RADIUS_M,
+        knuckle_seeds=[p.knuckle_seed] * k if p.knuckle else None,
     )
     return judged.result.reshape(spins.shape)
 
@@ -387,11 +392,26 @@ def outcome_map_image(results: NDArray[np.str_], p: FreeKickParams) -> NDArray[n
     return image
 
 
+AIM_TOLERANCE_M = 0.15
+"""Largest miss (m) between the clicked point and the found kick's goal-line crossing; beyond it :func:`aim_at`
+returns None. About 1.4 ball radii: the ball still covers the point."""
+
+
+def aim_summary(kick: FreeKickParams) -> str:
+    """Words for a found kick's spin: ``"no spin"`` at 0 rev/s, else the rate and which way it curls."""
+    if kick.spin_rev_s == 0.0:
+        return "no spin"
+    return f"{kick.spin_rev_s:.0f} rev/s {SPIN_AXIS_LABELS[kick.spin_axis].lower()}"
+
+
 def aim_at(p: FreeKickParams, target_yz: tuple[float, float]) -> FreeKickParams | None:
     """A kick at the same speed that reaches ``target_yz`` (m) on the goal line over the wall, or None.
 
     Searches elevation, azimuth and sidespin on a grid with :func:`kernels.ball.simulate_outcomes`, then polishes the
-    best goal-scoring candidate's elevation and azimuth by Newton steps on the crossing point.
+    best goal-scoring candidate's elevation and azimuth by damped Newton steps on the crossing point (a step that
+    leaves the goal or misses by more is halved, up to five times). Returns None when no goal is found or the best
+    kick still misses the target by more than :data:`AIM_TOLERANCE_M`. A kick without spin keeps ``p``'s spin axis
+    (its direction is moot; :func:`aim_summary` says "no spin").
     """
     wall, goal = panels(p)
     target = np.array(target_yz, dtype=np.float64)
@@ -435,7 +455,7 @@ def aim_at(p: FreeKickParams, target_yz: tuple[float, float]) -> FreeKickParams 
         elevation_deg=float(e[best]),
         azimuth_deg=float(a[best]),
         spin_rev_s=abs(float(s[best])),
-        spin_axis="left" if s[best] >= 0 else "right",
+        spin_axis=p.spin_axis if s[best] == 0 else ("left" if s[best] > 0 else "right"),
         knuckle=False,
     )
 
@@ -443,8 +463,14 @@ def aim_at(p: FreeKickParams, target_yz: tuple[float, float]) -> FreeKickParams 
         point = ball.outcome(_fly(k, 1.0, knuckle=False), wall, goal).goal_point
         return None if point is None else point[1:]
 
-    for _ in range(6):  # Newton on (elevation, azimuth) -> (y, z) at the goal line
-        here = crossing(kick)
+    def goal_crossing(k: FreeKickParams) -> NDArray[np.float64] | None:
+        judged = ball.outcome(_fly(k, 1.0, knuckle=False), wall, goal)
+        return (
+            None if judged.result != "goal" or judged.goal_point is None else judged.goal_point[1:]
+        )
+
+    here = goal_crossing(kick)
+    for _ in range(8):  # damped Newton on (elevation, azimuth) -> (y, z) at the goal line
         if here is None:
             break
         error = target - here
@@ -461,14 +487,23 @@ def aim_at(p: FreeKickParams, target_yz: tuple[float, float]) -> FreeKickParams 
         except np.linalg.LinAlgError:
             break
         step = np.clip(step, -3.0, 3.0)
-        trial = dataclasses.replace(
-            kick,
-            elevation_deg=float(np.clip(kick.elevation_deg + step[0], -5.0, 50.0)),
-            azimuth_deg=float(np.clip(kick.azimuth_deg + step[1], -30.0, 30.0)),
-        )
-        if ball.outcome(_fly(trial, 1.0, knuckle=False), wall, goal).result != "goal":
+        for _halving in range(
+            6
+        ):  # backtrack: halve a step that leaves the goal or does not get closer
+            trial = dataclasses.replace(
+                kick,
+                elevation_deg=float(np.clip(kick.elevation_deg + step[0], -5.0, 50.0)),
+                azimuth_deg=float(np.clip(kick.azimuth_deg + step[1], -30.0, 30.0)),
+            )
+            there = goal_crossing(trial)
+            if there is not None and np.linalg.norm(target - there) < np.linalg.norm(error):
+                break
+            step = 0.5 * step
+        else:
             break
-        kick = trial
+        kick, here = trial, there
+    if here is None or np.linalg.norm(target - here) > AIM_TOLERANCE_M:
+        return None
     return kick
 
 

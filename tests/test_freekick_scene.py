@@ -13,6 +13,7 @@ from wsclient import BrowserClient
 
 from kernels import ball
 from scenes.freekick import (
+    AIM_TOLERANCE_M,
     ARROW_POINTS,
     JUMP_M,
     MAP_SPEEDS_MS,
@@ -22,7 +23,10 @@ from scenes.freekick import (
     RESULT_COLOURS,
     FreeKickParams,
     FreeKickScene,
+    aim_at,
+    aim_summary,
     compute_kick,
+    outcome_map,
     resample,
 )
 from scenes.switcher import SceneSwitcher
@@ -389,3 +393,47 @@ def test_wrong_types_and_crafted_clicks_leave_the_scene_serving(
         client.wait_for(
             lambda: scene.params.speed_ms == 27.0, what="a good value after the bad ones"
         )
+
+
+# ------------------------------------------------------------------------------------------------ aiming (review 2)
+def test_aiming_returns_none_for_a_point_no_kick_reaches_and_a_kick_within_the_tolerance_otherwise() -> (
+    None
+):
+    # Kind: no miss tolerance, so a kick crossing 1.28 m from the click came back as "Found".
+    p = FreeKickParams()
+    assert aim_at(p, (0.0, 0.2)) is None  # under the wall's shadow at 25 m/s
+    for target in ((0.0, 1.2), (-2.6, 1.9), (3.0, 2.0), (1.5, 1.0)):
+        found = aim_at(p, target)
+        assert found is not None, target
+        judged = compute_kick(found).outcome
+        assert judged.result == "goal" and judged.goal_point is not None
+        assert np.linalg.norm(judged.goal_point[1:] - target) <= AIM_TOLERANCE_M, target
+
+
+def test_aiming_at_the_top_corner_backtracks_instead_of_stopping() -> None:
+    # Kind: the Newton polish stopped at the first trial step that left the goal (0.21 m off); halving it
+    # reaches the corner (a ±1.5° scan finds 0.046 m).
+    found = aim_at(FreeKickParams(), (3.55, 2.33))
+    assert found is not None
+    point = compute_kick(found).outcome.goal_point
+    assert point is not None and np.linalg.norm(point[1:] - [3.55, 2.33]) < 0.046
+
+
+def test_an_aimed_kick_without_spin_says_no_spin() -> None:
+    found = aim_at(FreeKickParams(), (3.0, 2.0))
+    assert found is not None and found.spin_rev_s == 0.0
+    assert aim_summary(found) == "no spin"
+    assert aim_summary(dataclasses.replace(found, spin_rev_s=7.0, spin_axis="right")) == (
+        "7 rev/s sidespin, curls right"
+    )
+
+
+def test_the_outcome_map_flies_the_knuckleball_when_it_is_on() -> None:
+    knuckler = next(preset.params for preset in PRESETS if preset.params.knuckle)
+    on, off = outcome_map(knuckler), outcome_map(dataclasses.replace(knuckler, knuckle=False))
+    # The side force fades out with spin, so the spinning rows agree, and the map's no-spin row is the
+    # knuckleball's own verdicts (the same kernel call per cell, seeded by the params).
+    np.testing.assert_array_equal(on[5:], off[5:])
+    for col in (0, 10, 20, 30, 40):
+        params = dataclasses.replace(knuckler, speed_ms=float(MAP_SPEEDS_MS[col]), spin_rev_s=0.0)
+        assert on[0, col] == compute_kick(params).outcome.result, col
