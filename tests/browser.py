@@ -6,14 +6,20 @@ camera into CSS pixels, the control panel's rectangle, a chart's plot area, and 
 
 from __future__ import annotations
 
+import contextlib
+import dataclasses
 import io
 import re
-from collections.abc import Iterable, Sequence
+import time
+from collections.abc import Iterable, Iterator, Sequence
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
+DOCS = Path(__file__).resolve().parents[1] / "docs"
+"""Where the README's screenshots live: the browser tests write them."""
 VIEWPORTS: tuple[tuple[int, int], ...] = ((1600, 1000), (1280, 720))
 """The windows every scene is looked at in (CSS px)."""
 ERROR_TEXT = re.compile(r"\bNaN\b|\bnan\b|Traceback|Exception|undefined|\binf\b|Infinity|\[object")
@@ -137,7 +143,9 @@ def colour_pixels(image: NDArray[np.uint8], rgb: Sequence[int], tolerance: float
     return int(np.count_nonzero(distance <= tolerance))
 
 
-def changed_mask(a: NDArray[np.uint8], b: NDArray[np.uint8], threshold: int = 24) -> NDArray[np.bool_]:
+def changed_mask(
+    a: NDArray[np.uint8], b: NDArray[np.uint8], threshold: int = 24
+) -> NDArray[np.bool_]:
     """(H, W) pixels whose colour differs by more than ``threshold`` in some channel."""
     return np.abs(a.astype(np.int16) - b.astype(np.int16)).max(axis=-1) > threshold
 
@@ -169,6 +177,16 @@ def with_nodes_hidden(page: Any, names: Iterable[str]) -> NDArray[np.uint8]:
     return image
 
 
+def with_labels_hidden(page: Any) -> NDArray[np.uint8]:
+    """A screenshot without the scene's text labels (viser draws them all on one 2D canvas over the 3D one)."""
+    page.evaluate("() => { window.__viserMutable.canvas2d.style.visibility = 'hidden'; }")
+    wait_frames(page, 2)
+    image = screenshot(page)
+    page.evaluate("() => { window.__viserMutable.canvas2d.style.visibility = ''; }")
+    wait_frames(page, 2)
+    return image
+
+
 def bbox(mask: NDArray[np.bool_]) -> tuple[int, int, int, int] | None:
     """(left, top, right, bottom) px of the True pixels of ``mask``, or None when there are none."""
     ys, xs = np.nonzero(mask)
@@ -184,3 +202,138 @@ def canvas_is_not_blank(png: bytes) -> bool:
     image = np.asarray(Image.open(io.BytesIO(png)).convert("RGB"))
     colours = np.unique(image.reshape(-1, 3)[::7], axis=0)
     return colours.shape[0] > 50 and float(image.std()) > 5.0
+
+
+# --------------------------------------------------------------------------------------------- one scene, one page
+@dataclasses.dataclass
+class ScenePage:
+    """A scene served on its own viser server and shown in one Chromium page of a given size."""
+
+    server: Any
+    switcher: Any
+    page: Any
+    viewport: tuple[int, int]
+
+    @property
+    def scene(self) -> Any:
+        return self.switcher.scene
+
+    @property
+    def client_camera(self) -> Any:
+        clients = list(self.server.get_clients().values())
+        assert len(clients) == 1, clients
+        return clients[0].camera
+
+
+@contextlib.contextmanager
+def scene_page(context: Any, key: str, viewport: tuple[int, int]) -> Iterator[ScenePage]:
+    """Serve scene ``key``, open it in a new page of ``viewport`` (CSS px), and wait until it has settled."""
+    import viser
+
+    from scenes.switcher import SceneSwitcher
+
+    server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
+    switcher = SceneSwitcher(server, key)
+    page = context.new_page()
+    try:
+        page.set_viewport_size({"width": viewport[0], "height": viewport[1]})
+        open_viser(page, server.get_port(), f"/{key}")
+        close_notifications(page)
+        shown = ScenePage(server, switcher, page, viewport)
+        settle(shown)
+        yield shown
+    finally:
+        page.close()
+        switcher.close()
+        server.stop()
+
+
+def wait_until(predicate: Any, what: str, timeout_s: float = 30.0) -> None:
+    """Poll ``predicate()`` until it is true; AssertionError naming ``what`` on timeout."""
+    deadline = time.monotonic() + timeout_s
+    while not predicate():
+        if time.monotonic() > deadline:
+            raise AssertionError(f"timed out after {timeout_s} s waiting for {what}")
+        time.sleep(0.05)
+
+
+def settle(shown: ScenePage, timeout_s: float = 30.0) -> None:
+    """Wait until the scene has framed this page's camera, the camera holds still and the picture is drawn."""
+    scene = shown.scene
+    framing = getattr(scene, "framing", None)
+    if framing is not None:
+        wait_until(lambda: framing.frames >= 1, "the scene to frame the camera", timeout_s)
+    deadline = time.monotonic() + timeout_s
+    last = None
+    while time.monotonic() < deadline:
+        now = shown.page.evaluate(
+            "() => [...window.__viserMutable.camera.position.toArray(),"
+            " ...window.__viserMutable.camera.quaternion.toArray()]"
+        )
+        if last is not None and np.allclose(now, last, atol=1e-6):
+            break
+        last = now
+        time.sleep(0.3)
+    wait_frames(shown.page, 3)
+
+
+def assert_in_view(
+    shown: ScenePage, frame: str, points: NDArray[np.float64], what: str
+) -> NDArray[np.float64]:
+    """Assert that ``points`` (in node ``frame``'s coordinates) project inside the page and left of the panel.
+
+    Returns their (N, 2) CSS positions.
+    """
+    width, height = shown.viewport
+    projected = project(shown.page, frame, points)
+    xy, depth = projected[:, :2], projected[:, 2]
+    left, top, _, bottom = panel_rect(shown.page)
+    assert np.all(np.abs(depth) < 1.0), f"{what}: behind the camera or clipped"
+    assert xy[:, 0].min() >= 0.0 and xy[:, 1].min() >= 0.0, (what, xy.min(axis=0))
+    assert xy[:, 0].max() <= width and xy[:, 1].max() <= height, (what, xy.max(axis=0))
+    under_panel = (xy[:, 0] >= left) & (xy[:, 1] >= top) & (xy[:, 1] <= bottom)
+    assert not under_panel.any(), f"{what}: {under_panel.sum()} points under the control panel"
+    return xy
+
+
+def assert_seen(
+    shown: ScenePage,
+    image: NDArray[np.uint8],
+    nodes: Iterable[str],
+    xy: NDArray[np.float64],
+    what: str,
+) -> NDArray[np.bool_]:
+    """Assert that hiding ``nodes`` changes the picture inside the box around ``xy``: a person sees them there.
+
+    Returns the mask of pixels the nodes cover.
+    """
+    covered = changed_mask(image, with_nodes_hidden(shown.page, nodes))
+    x0, y0 = np.floor(xy.min(axis=0)).astype(int) - 4
+    x1, y1 = np.ceil(xy.max(axis=0)).astype(int) + 4
+    inside = covered[max(y0, 0) : max(y1, 0), max(x0, 0) : max(x1, 0)].sum()
+    area = max((x1 - x0) * (y1 - y0), 1)
+    assert inside > 200 and inside > 0.005 * area, (
+        f"{what}: only {inside} px of its {area} px box show it"
+    )
+    outside = covered.sum() - inside
+    assert outside <= 0.05 * covered.sum(), (
+        f"{what}: {outside} of {covered.sum()} px drawn outside its box"
+    )
+    return covered
+
+
+def assert_chart_draws(
+    page: Any, title: str, colours: dict[str, Sequence[int]], min_px: int = 25
+) -> None:
+    """Assert that the plot area of chart ``title`` shows every series' colour (at least ``min_px`` pixels)."""
+    image = chart_image(page, title)
+    counts = {name: colour_pixels(image, rgb) for name, rgb in colours.items()}
+    missing = {name: n for name, n in counts.items() if n < min_px}
+    assert not missing, f"chart {title!r}: series not drawn {missing} (all: {counts})"
+
+
+def save_docs_screenshot(shown: ScenePage, key: str) -> None:
+    """At 1600×1000, write the README's screenshot of scene ``key`` to docs/ from this very page."""
+    if shown.viewport != (1600, 1000):
+        return
+    screenshot(shown.page, path=str(DOCS / f"{key}.png"))
