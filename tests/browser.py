@@ -235,6 +235,7 @@ def scene_page(context: Any, key: str, viewport: tuple[int, int]) -> Iterator[Sc
     server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
     switcher = SceneSwitcher(server, key)
     page = context.new_page()
+    page.set_default_timeout(90_000)  # software WebGL on two busy cores: a screenshot can take many seconds
     try:
         page.set_viewport_size({"width": viewport[0], "height": viewport[1]})
         open_viser(page, server.get_port(), f"/{key}")
@@ -302,9 +303,11 @@ def assert_seen(
     nodes: Iterable[str],
     xy: NDArray[np.float64],
     what: str,
+    max_outside: float = 0.25,
 ) -> NDArray[np.bool_]:
     """Assert that hiding ``nodes`` changes the picture inside the box around ``xy``: a person sees them there.
 
+    At most ``max_outside`` of what they change may lie outside that box (their shadows, a gizmo's arrows).
     Returns the mask of pixels the nodes cover.
     """
     covered = changed_mask(image, with_nodes_hidden(shown.page, nodes))
@@ -316,7 +319,7 @@ def assert_seen(
         f"{what}: only {inside} px of its {area} px box show it"
     )
     outside = covered.sum() - inside
-    assert outside <= 0.05 * covered.sum(), (
+    assert outside <= max_outside * covered.sum(), (
         f"{what}: {outside} of {covered.sum()} px drawn outside its box"
     )
     return covered
