@@ -235,7 +235,9 @@ def scene_page(context: Any, key: str, viewport: tuple[int, int]) -> Iterator[Sc
     server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
     switcher = SceneSwitcher(server, key)
     page = context.new_page()
-    page.set_default_timeout(90_000)  # software WebGL on two busy cores: a screenshot can take many seconds
+    page.set_default_timeout(
+        90_000
+    )  # software WebGL on two busy cores: a screenshot can take many seconds
     try:
         page.set_viewport_size({"width": viewport[0], "height": viewport[1]})
         open_viser(page, server.get_port(), f"/{key}")
@@ -295,6 +297,33 @@ def assert_in_view(
     under_panel = (xy[:, 0] >= left) & (xy[:, 1] >= top) & (xy[:, 1] <= bottom)
     assert not under_panel.any(), f"{what}: {under_panel.sum()} points under the control panel"
     return xy
+
+
+def node_box_corners(page: Any, name: str) -> NDArray[np.float64]:
+    """(8, 3) corners of scene node ``name``'s bounding box in its own frame, from the geometry the page holds."""
+    corners = page.evaluate(
+        """name => {
+          const node = window.__viserMutable.nodeRefFromName[name];
+          let lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
+          node.updateWorldMatrix(true, true);
+          const inverse = node.matrixWorld.clone().invert();
+          node.traverse(o => {
+            if (!o.geometry || !o.geometry.attributes.position) return;
+            const p = o.geometry.attributes.position, v = new node.position.constructor();
+            const toNode = inverse.clone().multiply(o.matrixWorld);
+            for (let i = 0; i < p.count; i += 7) {
+              v.fromBufferAttribute(p, i).applyMatrix4(toNode);
+              lo = [Math.min(lo[0], v.x), Math.min(lo[1], v.y), Math.min(lo[2], v.z)];
+              hi = [Math.max(hi[0], v.x), Math.max(hi[1], v.y), Math.max(hi[2], v.z)];
+            }
+          });
+          const out = [];
+          for (const x of [lo[0], hi[0]]) for (const y of [lo[1], hi[1]]) for (const z of [lo[2], hi[2]]) out.push([x, y, z]);
+          return out;
+        }""",
+        name,
+    )
+    return np.asarray(corners, dtype=np.float64)
 
 
 def assert_seen(
