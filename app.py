@@ -60,6 +60,20 @@ def port_message(asked: int, bound: int, explicit: bool) -> str | None:
     return f"Port {asked} is already in use; serving on port {bound} instead."
 
 
+APP_LABEL = "Physics scenes"
+"""Shown as the title of the control panel."""
+
+
+def make_server(host: str, port: int, *, verbose: bool = True) -> viser.ViserServer:
+    """The viser server as the app serves it: its label on the panel and the wide control panel.
+
+    The browser tests build theirs with this too, so what they look at (and the README screenshots) is the app's.
+    """
+    server = viser.ViserServer(host=host, port=port, label=APP_LABEL, verbose=verbose)
+    server.gui.configure_theme(control_width="large")
+    return server
+
+
 def main(scene: SceneName = "peloton", host: str = "127.0.0.1", port: int | None = None) -> None:
     """Serve the physics scenes in the browser.
 
@@ -76,7 +90,7 @@ def main(scene: SceneName = "peloton", host: str = "127.0.0.1", port: int | None
         print(warning, flush=True)
     server = None
     try:
-        server = viser.ViserServer(host=host, port=asked, label="Physics scenes")
+        server = make_server(host, asked)
         message = port_message(asked, server.get_port(), explicit=port is not None)
         if message is not None and port is not None:
             _stop_quietly(server)
@@ -84,7 +98,6 @@ def main(scene: SceneName = "peloton", host: str = "127.0.0.1", port: int | None
             raise SystemExit(2)
         if message is not None:
             print(message, flush=True)
-        server.gui.configure_theme(control_width="large")
         SceneSwitcher(server, scene)
         shown_host = "127.0.0.1" if host in ("0.0.0.0", "::") else host
         print(

@@ -1,6 +1,6 @@
 """Camera framing: where to put a browser's camera so a set of points fills the part of the view a person can see.
 
-viser's control panel floats over the right of the canvas (320 px wide and 15 px from the edge at
+viser's control panel floats over the right of the canvas (384 px wide and 15 px from the edge at the app's
 ``control_width="large"``), so "in view" means inside the canvas and left of the panel. Framing is pure geometry
 on the client's vertical field of view and image size, so it works for any window; scenes call it from
 :meth:`~scenes._base.Scene.watch_cameras` once per client and again when what they show grows or moves.
@@ -21,7 +21,7 @@ from numpy.typing import NDArray
 
 logger = logging.getLogger(__name__)
 
-PANEL_PX = 350.0
+PANEL_PX = 410.0
 """Width the control panel covers at the right of the canvas, with a margin (px)."""
 MARGIN_PX = 24.0
 """Space kept free at the other edges (px)."""

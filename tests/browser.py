@@ -228,11 +228,10 @@ class ScenePage:
 @contextlib.contextmanager
 def scene_page(context: Any, key: str, viewport: tuple[int, int]) -> Iterator[ScenePage]:
     """Serve scene ``key``, open it in a new page of ``viewport`` (CSS px), and wait until it has settled."""
-    import viser
-
+    import app
     from scenes.switcher import SceneSwitcher
 
-    server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
+    server = app.make_server("127.0.0.1", 0, verbose=False)
     switcher = SceneSwitcher(server, key)
     page = context.new_page()
     page.set_default_timeout(

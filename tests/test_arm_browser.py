@@ -121,7 +121,9 @@ def test_three_d_shows_the_floor_grid_from_an_angle(shown: ScenePage) -> None:
     assert grid.sum() > 5_000, grid.sum()
     assert changed_mask(image, after).mean() > 0.02
     xy = assert_in_view(shown, "/arm", _chain_points(scene), "chain in 3D")
-    assert_seen(shown, after, MAIN[:2], xy, "chain in 3D", max_outside=0.6)  # its shadow on the floor
+    assert_seen(
+        shown, after, MAIN[:2], xy, "chain in 3D", max_outside=0.6
+    )  # its shadow on the floor
     assert error_text(shown.page) == []
     checkbox.click()
     wait_until(lambda: not scene.params.three_d, "back to the plane")

@@ -20,6 +20,7 @@ from browser import (
     colour_pixels,
     error_text,
     open_viser,
+    panel_rect,
     project,
     save_docs_screenshot,
     scene_page,
@@ -73,7 +74,7 @@ def test_the_kick_fills_the_view_clear_of_the_panel(shown: ScenePage) -> None:
     with scene._lock:
         points = view_points(scene.params, scene.state, scene._view)
     xy = project(shown.page, "/freekick", points)[:, :2]
-    width = shown.viewport[0] - 350
+    width = panel_rect(shown.page)[0]
     assert np.ptp(xy[:, 0]) > 0.6 * width, np.ptp(xy[:, 0])
     save_docs_screenshot(shown, "freekick")
 
