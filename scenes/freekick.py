@@ -1167,7 +1167,16 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
                 self.map_results, self.map_params = results, params
                 counts = {name: int(np.sum(results == name)) for name in RESULT_COLOURS}
                 self.map_image.image = outcome_map_image(results, params)
-                summary = ", ".join(f"{name} {n}" for name, n in counts.items() if n)
+                words = {
+                    "goal": "goals",
+                    "wall": "blocked by the wall",
+                    "over": "over the bar",
+                    "wide": "wide",
+                    "short": "short",
+                }
+                summary = f"Of {results.size} kicks: " + ", ".join(
+                    f"{n} {words[name]}" for name, n in counts.items() if n
+                )
                 if params.model == "constant":
                     summary += (
                         "  \nConstant C_L: any spin above zero curls the same, so the rows repeat. Pick the "

@@ -757,8 +757,10 @@ time-averaged power is the mean over positions, far below the leader's.
         rho = float(cycling.air_density(p.altitude_m))
         wheel = float(solo.aero + solo.rolling + solo.climbing)
         aero_share = 100.0 * float(solo.aero) / wheel if wheel > 0 else float("nan")
+        thinner = 100 * (1 - rho / cycling.RHO_SEA_LEVEL)
+        where = "sea level" if abs(thinner) < 0.05 else f"{thinner:.1f} % thinner than at sea level"
         return (
-            f"Air density **{rho:.3f} kg/m³** ({100 * (1 - rho / cycling.RHO_SEA_LEVEL):.1f} % thinner than sea level)  \n"
+            f"Air density **{rho:.3f} kg/m³** ({where})  \n"
             f"Solo rider: **{float(solo.total):.0f} W**, aero share of wheel power **{aero_share:.1f} %**"
         )
 
