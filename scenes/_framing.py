@@ -173,15 +173,17 @@ class ClientFraming:
     """Frames each browser's camera once, by its own image size, and all of them again on :meth:`reframe`.
 
     ``view_for(lens)`` gives the view for one camera. Feed :meth:`on_camera` to
-    :meth:`~scenes._base.Scene.watch_cameras`: a camera seen for the first time (a new tab) is framed, later moves
-    (the person orbiting) are left alone until the scene calls :meth:`reframe`, as when what it shows grows.
+    :meth:`~scenes._base.Scene.watch_cameras`: a camera seen for the first time (a new tab) or with a new canvas size
+    (a resized window) is framed; other moves (the person orbiting) are left alone until the scene calls
+    :meth:`reframe`, as when what it shows grows.
     """
 
     def __init__(self, view_for: Callable[[Lens], View]) -> None:
         self._view_for = view_for
         self._lock = threading.Lock()
         self._cameras: dict[int, Any] = {}
-        self._framed: set[int] = set()
+        self._framed: dict[int, tuple[int, int]] = {}
+        """Canvas size each client was last framed for."""
         self.frames = 0
         """How many times a camera was framed (tests wait on it)."""
 
@@ -190,11 +192,15 @@ class ClientFraming:
             client_id = int(camera.client.client_id)
         except (AttributeError, TypeError, ValueError):
             return
+        try:
+            size = (int(camera.image_width), int(camera.image_height))
+        except (AttributeError, TypeError, ValueError, AssertionError):
+            return
         with self._lock:
             self._cameras[client_id] = camera
-            if client_id in self._framed:
-                return
-            self._framed.add(client_id)
+            if self._framed.get(client_id) == size:
+                return  # the person orbiting, or our own write coming back: leave the view alone
+            self._framed[client_id] = size  # a new tab, or a resized window
         self._frame(camera)
 
     def reframe(self) -> None:
