@@ -266,16 +266,18 @@ def settle(shown: ScenePage, timeout_s: float = 30.0) -> None:
     if framing is not None:
         wait_until(lambda: framing.frames >= 1, "the scene to frame the camera", timeout_s)
     deadline = time.monotonic() + timeout_s
-    last = None
-    while time.monotonic() < deadline:
+    last, still = None, 0
+    while (
+        time.monotonic() < deadline and still < 3
+    ):  # the same pose over three drawn frames, not one glance
         now = shown.page.evaluate(
             "() => [...window.__viserMutable.camera.position.toArray(),"
             " ...window.__viserMutable.camera.quaternion.toArray()]"
         )
-        if last is not None and np.allclose(now, last, atol=1e-6):
-            break
+        still = still + 1 if last is not None and np.allclose(now, last, atol=1e-6) else 0
         last = now
-        time.sleep(0.3)
+        time.sleep(0.2)
+        wait_frames(shown.page, 1)
     wait_frames(shown.page, 3)
 
 

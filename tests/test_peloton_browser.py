@@ -118,8 +118,11 @@ def test_more_speed_lifts_the_now_line_and_the_bars(shown: ScenePage) -> None:
     before_row = red_row()
     with scene._lock:
         top_before = scene.line_points()[:, 2].max()
+    frames = scene.framing.frames
     set_number(shown.page, "Speed (km/h)", 55)
     wait_until(lambda: scene.params.speed_kmh == 55.0, "the speed to reach the scene")
+    # The taller bars outgrow the view, so the scene frames the camera again: wait for that, then for the page.
+    wait_until(lambda: scene.framing.frames > frames, "the camera to be framed for the taller bars")
     settle(shown)
     # The solo power's level line rose (screen y grows downward) and the bars grew: still all in view.
     assert red_row() < before_row - 5
