@@ -4,12 +4,18 @@ python app.py                      # http://127.0.0.1:8080, peloton first
 python app.py --scene peloton --port 8090
 python app.py --host 0.0.0.0       # exposes the server to the network: read the warning it prints
 python app.py --shared             # one scene for every browser tab (presenting to a room)
+
+Ctrl+C stops it with one line. When 8080 is taken the app says so and serves on the next free port; a port given
+with --port must be free, or the app refuses to start.
 """
 
 from __future__ import annotations
 
+import contextlib
+import io
 import ipaddress
 import logging
+import sys
 import threading
 import time
 from types import ModuleType
@@ -25,6 +31,10 @@ from scenes.sdf_gallery import set_editing_allowed
 from scenes.switcher import SceneSwitcher
 
 logger = logging.getLogger("app")
+
+DEFAULT_PORT = 8080
+APP_LABEL = "Physics scenes"
+"""Shown as the title of the control panel."""
 
 
 def is_loopback(host: str) -> bool:
@@ -87,10 +97,32 @@ def serve_scenes(
     return SceneSwitcher(server, scene) if shared else Sessions(server, scene)
 
 
+def port_message(asked: int, bound: int, explicit: bool) -> str | None:
+    """What to tell the user when viser bound another port than the one asked for (it moves on when one is busy)."""
+    if bound == asked:
+        return None
+    if explicit:
+        return (
+            f"Port {asked} is already in use (another copy of this app?). Stop that process, or choose a free "
+            "port with --port."
+        )
+    return f"Port {asked} is already in use; serving on port {bound} instead."
+
+
+def make_server(host: str, port: int, *, verbose: bool = True) -> viser.ViserServer:
+    """The viser server as the app serves it: its label on the panel and the wide control panel.
+
+    The browser tests build theirs with this too, so what they look at (and the README screenshots) is the app's.
+    """
+    server = viser.ViserServer(host=host, port=port, label=APP_LABEL, verbose=verbose)
+    server.gui.configure_theme(control_width="large")
+    return server
+
+
 def main(
     scene: SceneName = "peloton",
     host: str = "127.0.0.1",
-    port: int = 8080,
+    port: int | None = None,
     allow_remote_glsl: bool = False,
     shared: bool = False,
 ) -> None:
@@ -99,25 +131,46 @@ def main(
     Args:
         scene: which scene opens first.
         host: address to bind; the default accepts connections from this machine only.
-        port: TCP port to bind.
+        port: TCP port to bind (8080 when not given, or the next free one). A port given here must be free.
         allow_remote_glsl: with a non-loopback host, still let browsers type GLSL into the SDF gallery's editor.
         shared: one scene for every browser tab (a switch or Reset in one tab changes it for all); by default each
             tab has its own scene.
     """
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s %(levelname)s %(message)s")
+    logging.getLogger("websockets").setLevel(logging.WARNING)  # not a line per start and stop
+    asked = DEFAULT_PORT if port is None else port
     set_editing_allowed(is_loopback(host) or allow_remote_glsl)
-    warning = exposure_warning(host, port, allow_remote_glsl=allow_remote_glsl)
+    warning = exposure_warning(host, asked, allow_remote_glsl=allow_remote_glsl)
     if warning is not None:
         print(warning, flush=True)
     warm_kernels()
-    server = viser.ViserServer(host=host, port=port, label="Physics scenes")
-    server.gui.configure_theme(control_width="large")
-    serve_scenes(server, scene, shared=shared)
-    shown_host = "127.0.0.1" if host in ("0.0.0.0", "::") else host
-    print(
-        f"Open http://{shown_host}:{server.get_port()} in a browser (Ctrl+C to stop).", flush=True
-    )
-    server.sleep_forever()
+    server = None
+    try:
+        server = make_server(host, asked)
+        message = port_message(asked, server.get_port(), explicit=port is not None)
+        if message is not None and port is not None:
+            _stop_quietly(server)
+            print(message, file=sys.stderr, flush=True)
+            raise SystemExit(2)
+        if message is not None:
+            print(message, flush=True)
+        serve_scenes(server, scene, shared=shared)
+        shown_host = "127.0.0.1" if host in ("0.0.0.0", "::") else host
+        print(
+            f"Open http://{shown_host}:{server.get_port()} in a browser (Ctrl+C to stop).",
+            flush=True,
+        )
+        server.sleep_forever()
+    except KeyboardInterrupt:
+        if server is not None:
+            _stop_quietly(server)
+        print("Stopped.", flush=True)
+
+
+def _stop_quietly(server: viser.ViserServer) -> None:
+    """Stop the server without viser's own farewell line: Ctrl+C answers with exactly one line."""
+    with contextlib.redirect_stdout(io.StringIO()):
+        server.stop()
 
 
 def entrypoint() -> None:

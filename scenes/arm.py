@@ -26,6 +26,7 @@ from numpy.typing import NDArray
 
 from kernels import fabrik
 from scenes._base import Scene
+from scenes._framing import ClientFraming, Lens, View, frame_points
 from scenes._skeletons import SkeletonView
 
 MAX_LINKS = 12
@@ -46,6 +47,10 @@ REST_COLOUR = (205, 210, 220)
 GHOST_COLOUR = (120, 190, 255)
 OBSTACLE_COLOUR = (235, 120, 60)
 TARGET_COLOUR = (230, 40, 60)
+PLANE_VIEW = (0.0, 1.0, -0.12)
+"""Planar mode looks at the x–z plane from −y, a little from above."""
+SPACE_VIEW = (-0.55, 1.0, -0.6)
+"""3D mode looks from the front left and above, so depth reads at once without orbiting."""
 LIMIT_RAMP = np.array([(60, 200, 90), (250, 200, 40), (230, 50, 50)], dtype=np.float64)
 """Joint colour at 0 %, 50 % and 100 % of its limit."""
 
@@ -298,6 +303,8 @@ is a static pose.
         self.skeletons = SkeletonView(self)
         """The robot-arm, hand and upper-body presets (issue 14), shown in place of the chain when chosen."""
         self.solve_and_draw()
+        self.framing = ClientFraming(self._view_for)
+        self.watch_cameras(self.framing.on_camera)
 
     def close(self) -> None:
         self.server.scene.remove_click_callback(self._click)
@@ -323,6 +330,12 @@ is a static pose.
                     legend=viser.uplot.Legend(show=True),
                     title="Error after each iteration (log scale)",
                     aspect=1.6,
+                    padding=(
+                        18,
+                        14,
+                        0,
+                        0,
+                    ),  # room above the top tick, so its label ("1,000") is not cut
                 )
             with gui.add_folder("Chain"):
                 self.links = gui.add_slider(
@@ -392,6 +405,17 @@ is a static pose.
             plane_color=(235, 240, 250),
             plane_opacity=0.25,
         )
+        self.floor = scene.add_grid(
+            f"{root}/floor",
+            width=4.0,
+            height=4.0,
+            plane="xy",
+            cell_size=0.25,
+            section_size=1.0,
+            plane_color=(235, 240, 250),
+            plane_opacity=0.5,
+            visible=self.params.three_d,
+        )
         cylinder, sphere = _unit_cylinder(), trimesh.creation.icosphere(subdivisions=2, radius=1.0)
         identity = np.tile([1.0, 0.0, 0.0, 0.0], (MAX_LINKS, 1))
         self.link_nodes = scene.add_batched_meshes_simple(
@@ -436,6 +460,7 @@ is a static pose.
             scale=0.3,
             active_axes=(True, False, True),
             disable_rotations=True,
+            depth_test=False,
             translation_limits=limits,
             position=self.target,
         )
@@ -448,9 +473,10 @@ is a static pose.
         for k in range(MAX_OBSTACLES):
             gizmo = scene.add_transform_controls(
                 f"{root}/obstacle_{k}",
-                scale=0.2,
+                scale=0.3,
                 active_axes=(True, False, True),
                 disable_rotations=True,
+                depth_test=False,  # drawn over its own disc or sphere, so it can be seen and grabbed
                 translation_limits=limits,
                 position=self.obstacle_centres[k],
             )
@@ -557,12 +583,38 @@ is a static pose.
         if p.three_d != last.three_d:
             self._set_mode(p.three_d)
         self.solve_and_draw()
+        if (p.three_d, p.n_links, p.link_length_m) != (
+            last.three_d,
+            last.n_links,
+            last.link_length_m,
+        ):
+            self.framing.reframe()
+
+    def _view_for(self, lens: Lens) -> View:
+        """Frame the chain's whole reach (a half disc in the plane, a dome in 3D) and the obstacles."""
+        p = self.params
+        reach = p.n_links * p.link_length_m
+        depth = reach if p.three_d else 0.0
+        corners = np.array(
+            [[x, y, z] for x in (-reach, reach) for y in (-depth, depth) for z in (-0.05, reach)]
+        )
+        shown = self.obstacle_centres[: p.n_obstacles]
+        radii = np.asarray(p.radii_m[: p.n_obstacles])[:, None]
+        points = np.vstack([corners, self.target[None, :], shown - radii, shown + radii])
+        return frame_points(
+            points,
+            SPACE_VIEW if p.three_d else PLANE_VIEW,
+            fov_rad=lens.fov_rad,
+            aspect=lens.aspect,
+            ndc=lens.usable_ndc(),
+        )
 
     def _set_mode(self, three_d: bool) -> None:
         """Planar ↔ 3D: gizmo axes, obstacle shapes, the plane grid; leaving 3D flattens everything onto y = 0."""
         axes = (True, True, True) if three_d else (True, False, True)
         with self.server.atomic():
             self.grid.visible = not three_d
+            self.floor.visible = three_d
             self.target_gizmo.active_axes = axes
             for k in range(MAX_OBSTACLES):
                 self.obstacle_gizmos[k].active_axes = axes

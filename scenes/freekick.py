@@ -32,13 +32,14 @@ from numpy.typing import NDArray
 
 from kernels import ball
 from scenes._base import Scene
+from scenes._framing import ClientFraming, Lens, View, frame_points
 
 logger = logging.getLogger(__name__)
 
 PATH_POINTS = 160
 """Samples per drawn path (trajectory, ghost, band edges)."""
-ARROW_POINTS = 7
-"""Places along the path where force arrows are drawn."""
+ARROW_POINTS = 4
+"""Places along the path where force arrows are drawn (few enough that neighbouring arrows never overlap)."""
 METRES_PER_NEWTON = 0.3
 """Force-arrow length scale."""
 JUMP_M = 0.35
@@ -58,8 +59,8 @@ SPIN_AXIS_LABELS: dict[SpinAxis, str] = {
 }
 SPIN_AXIS_FROM_LABEL: dict[str, SpinAxis] = {label: key for key, label in SPIN_AXIS_LABELS.items()}
 MODEL_LABELS: dict[ball.Model, str] = {
-    "constant": "Constant C_D = C_L = 0.25 (seed)",
     "measured": "Measured C_D(Re, S), C_L(S)",
+    "constant": "Constant C_D = C_L = 0.25 (seed)",
 }
 MODEL_FROM_LABEL: dict[str, ball.Model] = {label: key for key, label in MODEL_LABELS.items()}
 Integrator = Literal["rk4", "euler"]
@@ -78,7 +79,31 @@ RESULT_COLOURS: dict[str, tuple[int, int, int]] = {
     "wide": (240, 215, 60),
     "short": (140, 140, 140),
 }
-FORCE_COLOURS = {"drag": (230, 60, 60), "magnus": (50, 110, 240), "gravity": (40, 170, 80)}
+FORCE_COLOURS = {"drag": (230, 40, 40), "magnus": (40, 90, 240), "gravity": (120, 50, 170)}
+"""Arrow and chart colours: red, blue and purple read on grass, sky and the white net alike."""
+KNUCKLE_COLOUR = (240, 150, 20)
+PATH_COLOUR = (255, 140, 0)
+"""The kick as set: a thick orange line."""
+GHOST_COLOUR = (40, 40, 40)
+"""The no-spin ghost: thin, dark and dashed, so it never reads as the kick itself."""
+
+ViewName = Literal["broadcast", "behind", "side", "goal", "above"]
+VIEW_LABELS: dict[ViewName, str] = {
+    "broadcast": "Three-quarter (as on TV)",
+    "behind": "Behind the ball",
+    "side": "Side-on",
+    "goal": "From the goal",
+    "above": "From above",
+}
+VIEW_FROM_LABEL: dict[str, ViewName] = {label: key for key, label in VIEW_LABELS.items()}
+VIEW_MIN_DEPTH_M: dict[ViewName, float] = {
+    "broadcast": 6.0,
+    "behind": 4.0,
+    "side": 3.0,
+    "goal": 1.5,
+    "above": 3.0,
+}
+"""How far in front of each view's camera everything stays (m): behind the ball means a few steps back."""
 
 MAP_SPEEDS_MS = np.linspace(15.0, 35.0, 41)
 """Outcome-map columns: launch speed (m/s)."""
@@ -111,8 +136,9 @@ class FreeKickParams:
     """Custom axis: tilt from vertical toward the kicker's left (°); 0 is sidespin left, 90 topspin."""
     axis_turn_deg: float = 0.0
     """Custom axis: turn of the tilted part toward the kick direction (°); 90 with tilt 90 is rifle spin."""
-    model: ball.Model = "constant"
-    """Coefficient model."""
+    model: ball.Model = "measured"
+    """Coefficient model: the measured one, under which the spin rate changes the flight; the seed's constant one
+    curls every spinning kick alike."""
     integrator: Integrator = "rk4"
     """Integrator and its step."""
     knuckle: bool = False
@@ -397,13 +423,6 @@ AIM_TOLERANCE_M = 0.15
 returns None. About 1.4 ball radii: the ball still covers the point."""
 
 
-def aim_summary(kick: FreeKickParams) -> str:
-    """Words for a found kick's spin: ``"no spin"`` at 0 rev/s, else the rate and which way it curls."""
-    if kick.spin_rev_s == 0.0:
-        return "no spin"
-    return f"{kick.spin_rev_s:.0f} rev/s {SPIN_AXIS_LABELS[kick.spin_axis].lower()}"
-
-
 def aim_at(p: FreeKickParams, target_yz: tuple[float, float]) -> FreeKickParams | None:
     """A kick at the same speed that reaches ``target_yz`` (m) on the goal line over the wall, or None.
 
@@ -411,7 +430,7 @@ def aim_at(p: FreeKickParams, target_yz: tuple[float, float]) -> FreeKickParams 
     best goal-scoring candidate's elevation and azimuth by damped Newton steps on the crossing point (a step that
     leaves the goal or misses by more is halved, up to five times). Returns None when no goal is found or the best
     kick still misses the target by more than :data:`AIM_TOLERANCE_M`. A kick without spin keeps ``p``'s spin axis
-    (its direction is moot; :func:`aim_summary` says "no spin").
+    (its direction is moot; :func:`spin_words` says "no spin").
     """
     wall, goal = panels(p)
     target = np.array(target_yz, dtype=np.float64)
@@ -507,6 +526,61 @@ def aim_at(p: FreeKickParams, target_yz: tuple[float, float]) -> FreeKickParams 
     return kick
 
 
+def spin_words(p: FreeKickParams) -> str:
+    """The spin as a person says it: "no spin", or "8.0 rev/s sidespin, curls left"."""
+    if p.spin_rev_s <= 0.0:
+        return "no spin"
+    return f"{p.spin_rev_s:.1f} rev/s {SPIN_AXIS_LABELS[p.spin_axis].lower()}"
+
+
+def view_direction(p: FreeKickParams, view: ViewName) -> NDArray[np.float64]:
+    """(3,) direction a camera looks in for ``view`` of the kick ``p`` (not unit)."""
+    spot = ball_spot(p)
+    forward = np.array([-spot[0], -spot[1], 0.0]) / max(math.hypot(spot[0], spot[1]), 1e-9)
+    left = np.array([-forward[1], forward[0], 0.0])
+    down = np.array([0.0, 0.0, -1.0])
+    match view:
+        case (
+            "broadcast"
+        ):  # from behind the kicker's right shoulder, high: the whole flight across the screen
+            return forward + 0.75 * left + 0.35 * down
+        case "behind":
+            return forward + 0.12 * down
+        case "side":  # from the kicker's right: the ball flies left to right across the screen
+            return left + 0.15 * down
+        case "goal":  # from behind the net, as the camera behind the goal does
+            return -forward + 0.25 * down
+        case "above":
+            return 0.35 * forward + down
+
+
+def view_points(p: FreeKickParams, state: KickState, view: ViewName) -> NDArray[np.float64]:
+    """(N, 3) what ``view`` keeps in frame: the ball on its spot, the path, the wall and the goal with its net (m)."""
+    half, h = 0.5 * ball.GOAL_WIDTH_M, ball.GOAL_HEIGHT_M
+    goal = np.array([[x, y, z] for x in (0.0, 2.0) for y in (-half, half) for z in (0.0, h)])
+    wall = state.wall
+    normal = np.array(wall.normal_xy) / np.hypot(*wall.normal_xy)
+    along = np.array([-normal[1], normal[0]])
+    centre, width = np.array(wall.centre_xy), 0.5 * DEFENDERS * DEFENDER_WIDTH_M
+    wall_pts = np.array(
+        [
+            [*(centre + side * width * along), z]
+            for side in (-1.0, 1.0)
+            for z in (0.0, wall.height_m)
+        ]
+    )
+    path, ghost = resample(state.flight, 24), resample(state.ghost, 24)
+    spot = ball_spot(p)
+    return np.vstack([goal, wall_pts, path, ghost, spot[None, :]])
+
+
+def dashed(segments: NDArray[np.float32]) -> NDArray[np.float32]:
+    """(S, 2, 3) the same segments with every other one shrunk to a point: a dashed line of the same node."""
+    out = segments.copy()
+    out[1::2, 1] = out[1::2, 0]
+    return out
+
+
 # --------------------------------------------------------------------------------------------- geometry
 def _cylinder(a: NDArray[np.float64], b: NDArray[np.float64], radius: float) -> trimesh.Trimesh:
     return trimesh.creation.cylinder(radius=radius, segment=np.array([a, b]), sections=12)
@@ -593,7 +667,7 @@ def defender_mesh() -> trimesh.Trimesh:
 
 
 def arrow_segments(
-    origins: NDArray[np.float64], vectors: NDArray[np.float64], head: float = 0.12
+    origins: NDArray[np.float64], vectors: NDArray[np.float64], head: float = 0.3
 ) -> NDArray[np.float64]:
     """(3K, 2, 3): a shaft and two barbs for each of K arrows."""
     tips = origins + vectors
@@ -614,6 +688,10 @@ def arrow_segments(
             np.stack([right, tips], axis=1),
         ]
     )
+
+
+def _css(rgb: tuple[int, int, int]) -> str:
+    return f"rgb({rgb[0]},{rgb[1]},{rgb[2]})"
 
 
 def _segments(points: NDArray[np.float64]) -> NDArray[np.float32]:
@@ -684,8 +762,9 @@ class FreeKickScene(Scene):
     camera_look_at = (-6.0, 0.0, 1.4)
     about = """
 **What it shows.** A free kick's flight in 3D over a four-man wall 9.15 m from the ball (1.8 m tall; 2.15 m when it
-jumps): the kick as set (white), the same kick with no spin (grey ghost), a faint band between 10 % less and 10 % more
-spin, and force arrows along the path: drag (red), Magnus (blue), gravity (green). **Kick** flies the ball, spinning,
+jumps): the kick as set (thick orange line), the same kick with no spin (dark dashed ghost), a faint band between 10 % less
+and 10 % more spin, and force arrows along the path: drag (red), Magnus (blue), gravity (purple). **View** frames
+the kick from behind the ball, side-on, from the goal or from above. **Kick** flies the ball, spinning,
 in real time. Click a point in the goal mouth to have the scene find a kick that reaches it over the wall. The
 outcome map colours each launch speed × spin rate by result: goal (green), wall (red), over (orange), wide (yellow),
 short (grey); the white cross is the current kick.
@@ -724,9 +803,12 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
         self._map_worker = _LatestWorker(self._stop, "freekick-map")
         self._aim_worker = _LatestWorker(self._stop, "freekick-aim")
         self._threads += [self._map_worker.thread, self._aim_worker.thread]
+        self._view: ViewName = "broadcast"
         self._build_gui()
         self._build_world()
         self.redraw()
+        self.framing = ClientFraming(self._view_for)
+        self.watch_cameras(self.framing.on_camera)
         self._map_worker.thread.start()
         self._aim_worker.thread.start()
         self._request_map()
@@ -737,6 +819,9 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
         gui, p = self.server.gui, self.params
         with self.gui_root:
             self.kick_button = gui.add_button("Kick", color="green")
+            self.view = gui.add_dropdown(
+                "View", options=list(VIEW_FROM_LABEL), initial_value=VIEW_LABELS[self._view]
+            )
             self.result = gui.add_markdown("")
             with gui.add_folder("Ball spot"):
                 self.distance = gui.add_slider(
@@ -809,10 +894,18 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
                     data=self._chart_data(),
                     series=(
                         viser.uplot.Series(label="t (s)"),
-                        viser.uplot.Series(label="Drag (N)", stroke="rgb(230,60,60)", width=2),
-                        viser.uplot.Series(label="Magnus (N)", stroke="rgb(50,110,240)", width=2),
-                        viser.uplot.Series(label="Gravity (N)", stroke="rgb(40,170,80)", width=2),
-                        viser.uplot.Series(label="Knuckle (N)", stroke="rgb(150,60,200)", width=1),
+                        viser.uplot.Series(
+                            label="Drag (N)", stroke=_css(FORCE_COLOURS["drag"]), width=2
+                        ),
+                        viser.uplot.Series(
+                            label="Magnus (N)", stroke=_css(FORCE_COLOURS["magnus"]), width=2
+                        ),
+                        viser.uplot.Series(
+                            label="Gravity (N)", stroke=_css(FORCE_COLOURS["gravity"]), width=2
+                        ),
+                        viser.uplot.Series(
+                            label="Knuckle (N)", stroke=_css(KNUCKLE_COLOUR), width=2
+                        ),
                     ),
                     scales={
                         "x": viser.uplot.Scale(time=False, auto=True),
@@ -850,6 +943,7 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
         ):  # fmt: skip
             handle.on_update(self.callback(self._on_input))
         self.kick_button.on_click(self.callback(self._on_kick))
+        self.view.on_update(self.callback(self._on_view))
         for preset, button in zip(PRESETS, self.preset_buttons, strict=True):
             button.on_click(self.callback(lambda preset=preset: self.apply(preset.params)))
 
@@ -919,10 +1013,10 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
 
         empty_path = np.zeros((PATH_POINTS - 1, 2, 3), np.float32)
         self.path = scene.add_line_segments(
-            f"{root}/path", empty_path, colors=(255, 255, 255), thickness=0.06
+            f"{root}/path", empty_path, colors=PATH_COLOUR, thickness=0.09
         )
         self.ghost = scene.add_line_segments(
-            f"{root}/ghost", empty_path, colors=(120, 120, 120), thickness=0.04
+            f"{root}/ghost", empty_path, colors=GHOST_COLOUR, thickness=0.04
         )
         strip_faces = []
         for i in range(PATH_POINTS - 1):
@@ -932,8 +1026,8 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
             f"{root}/band",
             np.zeros((2 * PATH_POINTS, 3), np.float32),
             np.array(strip_faces, np.uint32),
-            color=(255, 230, 120),
-            opacity=0.3,
+            color=(255, 200, 90),
+            opacity=0.35,
             side="double",
             cast_shadow=False,
             receive_shadow=False,
@@ -941,7 +1035,7 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
         empty_arrows = np.zeros((3 * ARROW_POINTS, 2, 3), np.float32)
         self.arrows = {
             name: scene.add_line_segments(
-                f"{root}/force_{name}", empty_arrows, colors=colour, thickness=0.035
+                f"{root}/force_{name}", empty_arrows, colors=colour, thickness=0.07
             )
             for name, colour in FORCE_COLOURS.items()
         }
@@ -983,10 +1077,33 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
         state = compute_kick(
             params
         )  # raises (and keeps the last state) if the kernels refuse the input
+        moved = (params.distance_m, params.angle_deg) != (
+            self.params.distance_m,
+            self.params.angle_deg,
+        )
         self.params, self.state = params, state
         self._kick_time_s = None
         self.redraw()
         self._request_map()
+        if moved:  # the ball is on another spot: every view moves with it
+            self.framing.reframe()
+
+    # ----------------------------------------------------------------------------------------- camera
+    def _on_view(self) -> None:
+        label = self.read_choice(self.view, list(VIEW_FROM_LABEL), VIEW_LABELS[self._view])
+        self._view = VIEW_FROM_LABEL[label]
+        self.framing.reframe()
+
+    def _view_for(self, lens: Lens) -> View:
+        d = view_direction(self.params, self._view)
+        return frame_points(
+            view_points(self.params, self.state, self._view),
+            (float(d[0]), float(d[1]), float(d[2])),
+            fov_rad=lens.fov_rad,
+            aspect=lens.aspect,
+            ndc=lens.usable_ndc(),
+            min_depth=VIEW_MIN_DEPTH_M[self._view],
+        )
 
     def apply(self, params: FreeKickParams) -> None:
         """Show ``params``: write every GUI control (without re-running callbacks) and redraw once."""
@@ -1064,7 +1181,7 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
                 )
                 self.aim_message = (
                     f"Found: elevation {found.elevation_deg:.1f}°, azimuth {found.azimuth_deg:+.1f}°, "
-                    f"{found.spin_rev_s:.0f} rev/s {SPIN_AXIS_LABELS[found.spin_axis].lower()}.{reached}"
+                    f"{spin_words(found)}.{reached}"
                 )
                 self.aim_status.content = self.aim_message
 
@@ -1084,7 +1201,16 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
                 self.map_results, self.map_params = results, params
                 counts = {name: int(np.sum(results == name)) for name in RESULT_COLOURS}
                 self.map_image.image = outcome_map_image(results, params)
-                summary = ", ".join(f"{name} {n}" for name, n in counts.items() if n)
+                words = {
+                    "goal": "goals",
+                    "wall": "blocked by the wall",
+                    "over": "over the bar",
+                    "wide": "wide",
+                    "short": "short",
+                }
+                summary = f"Of {results.size} kicks: " + ", ".join(
+                    f"{n} {words[name]}" for name, n in counts.items() if n
+                )
                 if params.model == "constant":
                     summary += (
                         "  \nConstant C_L: any spin above zero curls the same, so the rows repeat. Pick the "
@@ -1141,7 +1267,7 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
 
         with self.server.atomic():
             self.path.points = _segments(path)
-            self.ghost.points = _segments(resample(state.ghost))
+            self.ghost.points = dashed(_segments(resample(state.ghost)))
             self.band.vertices = strip.astype(np.float32)
             for name in FORCE_COLOURS:
                 forces = getattr(flight, name)

@@ -23,6 +23,7 @@ import viser.uplot
 from kernels import course as course_kernel
 from kernels import cycling
 from scenes._base import Scene
+from scenes._framing import ClientFraming, Lens, View, frame_points
 from scenes._gate import record_spec
 
 MAX_RIDERS = 8
@@ -30,6 +31,12 @@ BIKE_LENGTH_M = 1.70
 """Wheel-to-wheel length of one bike; the gap is measured from the front wheel to the wheel ahead."""
 BAR_METRES_PER_WATT = 1.0 / 400.0
 """Height of the stacked power bars above the riders."""
+VIEW_DIRECTION = (-1.2, 7.5, -1.8)
+"""The camera looks at the line from its left side, a little ahead of it and above."""
+LABEL_STAGGER_M = 0.4
+"""Every other rider's label sits this much higher (m), so labels of riders a wheel apart do not overlap."""
+LABEL_PX = (190.0, 30.0)
+"""Room a rider's label needs right of and above its anchor (px): framing keeps it clear of the panel."""
 
 Position = Literal["upright", "hoods", "drops", "tt", "hour"]
 
@@ -318,6 +325,10 @@ time-averaged power is the mean over positions, far below the leader's.
         self._build_gui()
         self._build_world()
         self.redraw()
+        self._framed_for = self._framing_key()
+        self._framed_points = self.line_points()
+        self.framing = ClientFraming(self._view_for)
+        self.watch_cameras(self.framing.on_camera)
         self.start_loop(self._animate, 1.0 / 30.0)
         self.course_mode = CourseMode(self)  # issue 13: ride a GPX course
 
@@ -403,10 +414,11 @@ time-averaged power is the mean over positions, far below the leader's.
                         viser.uplot.Series(label="Climbing (W)", stroke="rgb(60,190,90)", width=2),
                         viser.uplot.Series(label="Total (W)", stroke="black", width=2),
                         viser.uplot.Series(
-                            label="Now (W)",
-                            stroke="red",
-                            width=0,
-                            points=viser.uplot.Series_Points(show=True, size=9),
+                            label="Solo now (W)",
+                            stroke="rgb(220,30,30)",
+                            width=1.5,
+                            dash=(6.0, 4.0),
+                            points=viser.uplot.Series_Points(show=False),
                         ),
                     ),
                     scales={
@@ -544,6 +556,57 @@ time-averaged power is the mean over positions, far below the leader's.
             self.params, self.state = last_good  # never show one state while holding another
             self.redraw()
             raise
+        self._update_framing()
+
+    # ----------------------------------------------------------------------------------------- camera
+    def line_points(self) -> np.ndarray:
+        """(N, 3) world points the view must hold: every rider (also swinging off), bar tops and the wind arrow."""
+        p = self.params
+        n = p.n_riders
+        front, back = (
+            0.5 * BIKE_LENGTH_M,
+            float(slot_offsets(n, p.gap_m)[n - 1]) - 0.5 * BIKE_LENGTH_M,
+        )
+        top = 1.95 + LABEL_STAGGER_M + float(np.max(self.state.power.total)) * BAR_METRES_PER_WATT
+        x_hi = front + (3.0 + min(abs(p.headwind_ms), 15.0) * 0.25 if p.headwind_ms != 0 else 0.0)
+        lo, hi = np.array([back, -1.1, 0.0]), np.array([x_hi, 1.1, max(top, 2.2)])
+        corners = np.array(
+            [
+                [(lo, hi)[i][0], (lo, hi)[j][1], (lo, hi)[k][2]]
+                for i in (0, 1)
+                for j in (0, 1)
+                for k in (0, 1)
+            ]
+        )
+        theta = math.atan(p.grade_pct / 100.0)  # the course frame turns by −θ about y
+        c, s = math.cos(theta), math.sin(theta)
+        return np.stack(
+            [
+                c * corners[:, 0] - s * corners[:, 2],
+                corners[:, 1],
+                s * corners[:, 0] + c * corners[:, 2],
+            ],
+            axis=1,
+        )
+
+    def _view_for(self, lens: Lens) -> View:
+        ndc = lens.usable_ndc(right_px=LABEL_PX[0], top_px=LABEL_PX[1])
+        return frame_points(
+            self._framed_points, VIEW_DIRECTION, fov_rad=lens.fov_rad, aspect=lens.aspect, ndc=ndc
+        )
+
+    def _update_framing(self) -> None:
+        """Frame every browser again when the line changes length or tilt, or its bars outgrow the view."""
+        key = self._framing_key()
+        points = self.line_points()
+        if key == self._framed_for and points[:, 2].max() <= self._framed_points[:, 2].max() + 0.05:
+            return
+        self._framed_for, self._framed_points = key, points
+        self.framing.reframe()
+
+    def _framing_key(self) -> tuple[object, ...]:
+        p = self.params
+        return (p.n_riders, p.gap_m, p.grade_pct, p.headwind_ms != 0.0)
 
     def read_params(self) -> PelotonParams:
         """The current GUI values, cleaned: anything non-finite, out of range or unknown keeps the last good value."""
@@ -577,8 +640,9 @@ time-averaged power is the mean over positions, far below the leader's.
     def _chart_data(self) -> tuple[np.ndarray, ...]:
         p = self.params
         speeds_kmh, aero, rolling, climbing, total = _solo_curves(_solo_key(p))
-        now = np.full_like(speeds_kmh, np.nan)
-        now[int(np.argmin(np.abs(speeds_kmh - p.speed_kmh)))] = float(self.state.solo.total)
+        # A level line at the solo power now: it meets the total curve at the current speed. (A single marker needs
+        # NaN elsewhere, and one NaN makes uPlot's auto range NaN, so the chart drew nothing at all.)
+        now = np.full_like(speeds_kmh, float(self.state.solo.total))
         return speeds_kmh, aero, rolling, climbing, total, now
 
     def _slot_of_rider(self) -> tuple[np.ndarray, np.ndarray]:
@@ -663,7 +727,8 @@ time-averaged power is the mean over positions, far below the leader's.
                     text = f"{watts:.0f} W · {share}"
                     if label.text != text:
                         label.text = text
-                    label.position = (x[i], y[i], 1.95 + base[i])
+                    # Neighbours' labels alternate in height so close riders' labels never overlap.
+                    label.position = (x[i], y[i], 1.95 + base[i] + LABEL_STAGGER_M * (i % 2))
 
             rotation = self._rotation_markdown()
             if self.rotation.content != rotation:
@@ -697,20 +762,23 @@ time-averaged power is the mean over positions, far below the leader's.
         rho = float(cycling.air_density(p.altitude_m))
         wheel = float(solo.aero + solo.rolling + solo.climbing)
         aero_share = 100.0 * float(solo.aero) / wheel if wheel > 0 else float("nan")
+        thinner = 100 * (1 - rho / cycling.RHO_SEA_LEVEL)
+        where = "sea level" if abs(thinner) < 0.05 else f"{thinner:.1f} % thinner than at sea level"
         return (
-            f"Air density **{rho:.3f} kg/m³** ({100 * (1 - rho / cycling.RHO_SEA_LEVEL):.1f} % thinner than sea level)  \n"
+            f"Air density **{rho:.3f} kg/m³** ({where})  \n"
             f"Solo rider: **{float(solo.total):.0f} W**, aero share of wheel power **{aero_share:.1f} %**"
         )
 
     def _table_markdown(self) -> str:
         state = self.state
+        # Narrow columns run together in the panel ("RollClimb"), so the three parts share one cell with slashes.
         rows = [
-            "| Pos | CdA (m²) | Aero | Roll | Climb | Total (W) | Saving |",
-            "|---|---|---|---|---|---|---|",
+            "| Rider | CdA (m²) | Aero / rolling / climbing (W) | Total (W) | Saving |",
+            "|---|---|---|---|---|",
         ]
         for i in range(self.params.n_riders):
             rows.append(
-                f"| {i + 1} | {state.cda_m2[i]:.3f} | {state.power.aero[i]:.0f} | {state.power.rolling[i]:.0f} | "
+                f"| {i + 1} | {state.cda_m2[i]:.3f} | {state.power.aero[i]:.0f} / {state.power.rolling[i]:.0f} / "
                 f"{state.power.climbing[i]:.0f} | **{state.power.total[i]:.0f}** | {100 * state.saving[i]:.1f} % |"
             )
         return "\n".join(rows)

@@ -1,8 +1,44 @@
-"""Helpers for real-browser tests: open a viser page and wait for state, never for time."""
+"""Helpers for real-browser tests: open a viser page, wait for state (never for time), and look at what it shows.
+
+"Looking" means what a person sees: screenshots as RGB arrays, points projected through the page's own three.js
+camera into CSS pixels, the control panel's rectangle, a chart's plot area, and the page's visible text.
+"""
 
 from __future__ import annotations
 
+import contextlib
+import dataclasses
+import io
+import re
+import time
+from collections.abc import Iterable, Iterator, Sequence
+from pathlib import Path
 from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+DOCS = Path(__file__).resolve().parents[1] / "docs"
+"""Where the README's screenshots live: the browser tests write them."""
+VIEWPORTS: tuple[tuple[int, int], ...] = ((1600, 1000), (1280, 720))
+"""The windows every scene is looked at in (CSS px)."""
+ERROR_TEXT = re.compile(r"\bNaN\b|\bnan\b|Traceback|Exception|undefined|\binf\b|Infinity|\[object")
+"""Text that must never reach a person: numbers gone wrong and errors that leaked."""
+
+PROJECT = """
+args => {
+  const m = window.__viserMutable;
+  const node = m.nodeRefFromName[args.name];
+  node.updateWorldMatrix(true, false);
+  const rect = m.canvas.getBoundingClientRect();
+  return args.points.map(([x, y, z]) => {
+    const point = node.localToWorld(new node.position.constructor(x, y, z));
+    point.project(m.camera);
+    return [rect.left + (point.x + 1) / 2 * rect.width, rect.top + (1 - point.y) / 2 * rect.height, point.z];
+  });
+}
+"""
+"""CSS-pixel position (and NDC depth) of points given in a scene node's own frame, through the page's camera."""
 
 
 def open_viser(page: Any, port: int, node: str, timeout_ms: int = 60_000) -> None:
@@ -10,19 +46,327 @@ def open_viser(page: Any, port: int, node: str, timeout_ms: int = 60_000) -> Non
     page.goto(f"http://127.0.0.1:{port}/", wait_until="domcontentloaded", timeout=timeout_ms)
     page.wait_for_function(
         "name => !!(window.__viserMutable && window.__viserMutable.nodeRefFromName"
-        " && window.__viserMutable.nodeRefFromName[name])",
+        " && window.__viserMutable.nodeRefFromName[name] && window.__viserMutable.camera"
+        " && window.__viserMutable.canvas)",
         arg=node,
         timeout=timeout_ms,
     )
 
 
+def close_notifications(page: Any) -> None:
+    """Hide the toasts, as a person would close them: the software-WebGL notice covers the top left corner.
+
+    (Clicking each close button waits on Mantine's exit animation, seconds per toast under software rendering.)
+    """
+    page.add_style_tag(content=".mantine-Notifications-root { display: none !important; }")
+    wait_frames(page, 2)
+
+
+def wait_frames(page: Any, frames: int = 3) -> None:
+    """Wait until the page has drawn ``frames`` more animation frames (so a change on the page is on the canvas)."""
+    page.evaluate(
+        """n => new Promise(done => { const step = k => k <= 0 ? done() : requestAnimationFrame(() => step(k - 1));
+        step(n); })""",
+        frames,
+    )
+
+
+def screenshot(page: Any, path: str | None = None) -> NDArray[np.uint8]:
+    """(H, W, 3) RGB of the whole page as a person sees it; also saved to ``path`` when given."""
+    from PIL import Image
+
+    png = page.screenshot(path=path)
+    return np.asarray(Image.open(io.BytesIO(png)).convert("RGB"))
+
+
+def project(page: Any, frame: str, points: Iterable[Sequence[float]]) -> NDArray[np.float64]:
+    """(N, 3): CSS x, y and NDC depth of ``points`` (in scene node ``frame``'s coordinates) through the page's camera."""
+    pts = [[float(c) for c in p] for p in points]
+    return np.asarray(page.evaluate(PROJECT, {"name": frame, "points": pts}), dtype=np.float64)
+
+
+def panel_rect(page: Any) -> tuple[float, float, float, float]:
+    """(left, top, right, bottom) CSS px of viser's control panel."""
+    box = page.evaluate(
+        """() => {
+          const button = [...document.querySelectorAll('button')].find(
+              b => b.textContent.trim() === 'Reset scene to defaults');
+          let e = button;
+          while (e && !(e.className && e.className.toString().includes('mantine-Paper-root'))) e = e.parentElement;
+          const r = (e || button).getBoundingClientRect();
+          return [r.left, r.top, r.right, r.bottom];
+        }"""
+    )
+    return (float(box[0]), float(box[1]), float(box[2]), float(box[3]))
+
+
+def visible_text(page: Any) -> str:
+    """All text a person can read on the page (inner text of the body)."""
+    return str(page.evaluate("() => document.body.innerText"))
+
+
+def error_text(page: Any) -> list[str]:
+    """Lines of visible text that look like a number gone wrong or a leaked error."""
+    return [line for line in visible_text(page).splitlines() if ERROR_TEXT.search(line)]
+
+
+def set_number(page: Any, label: str, value: float) -> None:
+    """Type ``value`` into the number box of the control labelled ``label`` and press Enter, as a person would."""
+    box = control_row(page, label).locator("input:not([type=checkbox]):not([type=hidden])").last
+    box.scroll_into_view_if_needed()
+    box.click()
+    box.fill(f"{value:g}")
+    box.press("Enter")
+
+
+def control_row(page: Any, label: str) -> Any:
+    """The row of the control labelled exactly ``label``."""
+    text = page.get_by_text(label, exact=True).first
+    return text.locator("xpath=ancestor::*[.//input][1]")
+
+
+def chart_image(page: Any, title: str) -> NDArray[np.uint8]:
+    """(H, W, 3) RGB of the plot area (inside the axes) of the uPlot chart titled ``title``, scrolled into view."""
+    from PIL import Image
+
+    chart = page.locator(".uplot", has=page.locator(".u-title", has_text=title)).first
+    chart.scroll_into_view_if_needed()
+    wait_frames(page, 2)
+    plot = chart.locator(".u-over").first
+    png = plot.screenshot()
+    return np.asarray(Image.open(io.BytesIO(png)).convert("RGB"))
+
+
+def colour_pixels(image: NDArray[np.uint8], rgb: Sequence[int], tolerance: float = 40.0) -> int:
+    """How many pixels of ``image`` lie within ``tolerance`` (Euclidean, 0–255 per channel) of ``rgb``."""
+    distance = np.linalg.norm(image.astype(np.float64) - np.asarray(rgb, np.float64), axis=-1)
+    return int(np.count_nonzero(distance <= tolerance))
+
+
+def changed_mask(
+    a: NDArray[np.uint8], b: NDArray[np.uint8], threshold: int = 24
+) -> NDArray[np.bool_]:
+    """(H, W) pixels whose colour differs by more than ``threshold`` in some channel."""
+    return np.abs(a.astype(np.int16) - b.astype(np.int16)).max(axis=-1) > threshold
+
+
+HIDE = """
+args => {
+  const m = window.__viserMutable;
+  args.names.forEach(name => m.nodeRefFromName[name].traverse(o => {
+    if (args.hide) { if (o.userData.__layers === undefined) o.userData.__layers = o.layers.mask; o.layers.set(31); }
+    else if (o.userData.__layers !== undefined) { o.layers.mask = o.userData.__layers; delete o.userData.__layers; }
+  }));
+  m.requestRender();
+}
+"""
+"""Take scene nodes out of (or back into) the camera's layer: viser re-applies ``visible`` itself, not layers."""
+
+
+def with_nodes_hidden(page: Any, names: Iterable[str]) -> NDArray[np.uint8]:
+    """A screenshot with the three.js nodes ``names`` hidden (client side only), then shows them again.
+
+    Against a screenshot with them shown, the difference is exactly where a person sees those objects.
+    """
+    names = list(names)
+    page.evaluate(HIDE, {"names": names, "hide": True})
+    wait_frames(page, 3)
+    image = screenshot(page)
+    page.evaluate(HIDE, {"names": names, "hide": False})
+    wait_frames(page, 3)
+    return image
+
+
+def with_labels_hidden(page: Any) -> NDArray[np.uint8]:
+    """A screenshot without the scene's text labels (viser draws them all on one 2D canvas over the 3D one)."""
+    page.evaluate("() => { window.__viserMutable.canvas2d.style.visibility = 'hidden'; }")
+    wait_frames(page, 2)
+    image = screenshot(page)
+    page.evaluate("() => { window.__viserMutable.canvas2d.style.visibility = ''; }")
+    wait_frames(page, 2)
+    return image
+
+
+def bbox(mask: NDArray[np.bool_]) -> tuple[int, int, int, int] | None:
+    """(left, top, right, bottom) px of the True pixels of ``mask``, or None when there are none."""
+    ys, xs = np.nonzero(mask)
+    if len(xs) == 0:
+        return None
+    return int(xs.min()), int(ys.min()), int(xs.max()) + 1, int(ys.max()) + 1
+
+
 def canvas_is_not_blank(png: bytes) -> bool:
     """True when a PNG of the canvas has real content: many distinct colours, not one flat fill."""
-    import io
-
-    import numpy as np
     from PIL import Image
 
     image = np.asarray(Image.open(io.BytesIO(png)).convert("RGB"))
     colours = np.unique(image.reshape(-1, 3)[::7], axis=0)
     return colours.shape[0] > 50 and float(image.std()) > 5.0
+
+
+# --------------------------------------------------------------------------------------------- one scene, one page
+@dataclasses.dataclass
+class ScenePage:
+    """A scene served on its own viser server and shown in one Chromium page of a given size."""
+
+    server: Any
+    switcher: Any
+    page: Any
+    viewport: tuple[int, int]
+
+    @property
+    def scene(self) -> Any:
+        return self.switcher.scene
+
+    @property
+    def client_camera(self) -> Any:
+        clients = list(self.server.get_clients().values())
+        assert len(clients) == 1, clients
+        return clients[0].camera
+
+
+@contextlib.contextmanager
+def scene_page(context: Any, key: str, viewport: tuple[int, int]) -> Iterator[ScenePage]:
+    """Serve scene ``key``, open it in a new page of ``viewport`` (CSS px), and wait until it has settled."""
+    import app
+    from scenes.switcher import SceneSwitcher
+
+    server = app.make_server("127.0.0.1", 0, verbose=False)
+    switcher = SceneSwitcher(server, key)
+    page = context.new_page()
+    page.set_default_timeout(
+        90_000
+    )  # software WebGL on two busy cores: a screenshot can take many seconds
+    try:
+        page.set_viewport_size({"width": viewport[0], "height": viewport[1]})
+        open_viser(page, server.get_port(), f"/{key}")
+        close_notifications(page)
+        shown = ScenePage(server, switcher, page, viewport)
+        settle(shown)
+        yield shown
+    finally:
+        page.close()
+        switcher.close()
+        server.stop()
+
+
+def wait_until(predicate: Any, what: str, timeout_s: float = 30.0) -> None:
+    """Poll ``predicate()`` until it is true; AssertionError naming ``what`` on timeout."""
+    deadline = time.monotonic() + timeout_s
+    while not predicate():
+        if time.monotonic() > deadline:
+            raise AssertionError(f"timed out after {timeout_s} s waiting for {what}")
+        time.sleep(0.05)
+
+
+def settle(shown: ScenePage, timeout_s: float = 30.0) -> None:
+    """Wait until the scene has framed this page's camera, the camera holds still and the picture is drawn."""
+    scene = shown.scene
+    framing = getattr(scene, "framing", None)
+    if framing is not None:
+        wait_until(lambda: framing.frames >= 1, "the scene to frame the camera", timeout_s)
+    deadline = time.monotonic() + timeout_s
+    last, still = None, 0
+    while (
+        time.monotonic() < deadline and still < 3
+    ):  # the same pose over three drawn frames, not one glance
+        now = shown.page.evaluate(
+            "() => [...window.__viserMutable.camera.position.toArray(),"
+            " ...window.__viserMutable.camera.quaternion.toArray()]"
+        )
+        still = still + 1 if last is not None and np.allclose(now, last, atol=1e-6) else 0
+        last = now
+        time.sleep(0.2)
+        wait_frames(shown.page, 1)
+    wait_frames(shown.page, 3)
+
+
+def assert_in_view(
+    shown: ScenePage, frame: str, points: NDArray[np.float64], what: str
+) -> NDArray[np.float64]:
+    """Assert that ``points`` (in node ``frame``'s coordinates) project inside the page and left of the panel.
+
+    Returns their (N, 2) CSS positions.
+    """
+    width, height = shown.viewport
+    projected = project(shown.page, frame, points)
+    xy, depth = projected[:, :2], projected[:, 2]
+    left, top, _, bottom = panel_rect(shown.page)
+    assert np.all(np.abs(depth) < 1.0), f"{what}: behind the camera or clipped"
+    assert xy[:, 0].min() >= 0.0 and xy[:, 1].min() >= 0.0, (what, xy.min(axis=0))
+    assert xy[:, 0].max() <= width and xy[:, 1].max() <= height, (what, xy.max(axis=0))
+    under_panel = (xy[:, 0] >= left) & (xy[:, 1] >= top) & (xy[:, 1] <= bottom)
+    assert not under_panel.any(), f"{what}: {under_panel.sum()} points under the control panel"
+    return xy
+
+
+def node_box_corners(page: Any, name: str) -> NDArray[np.float64]:
+    """(8, 3) corners of scene node ``name``'s bounding box in its own frame, from the geometry the page holds."""
+    corners = page.evaluate(
+        """name => {
+          const node = window.__viserMutable.nodeRefFromName[name];
+          let lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
+          node.updateWorldMatrix(true, true);
+          const inverse = node.matrixWorld.clone().invert();
+          node.traverse(o => {
+            if (!o.geometry || !o.geometry.attributes.position) return;
+            const p = o.geometry.attributes.position, v = new node.position.constructor();
+            const toNode = inverse.clone().multiply(o.matrixWorld);
+            for (let i = 0; i < p.count; i += 7) {
+              v.fromBufferAttribute(p, i).applyMatrix4(toNode);
+              lo = [Math.min(lo[0], v.x), Math.min(lo[1], v.y), Math.min(lo[2], v.z)];
+              hi = [Math.max(hi[0], v.x), Math.max(hi[1], v.y), Math.max(hi[2], v.z)];
+            }
+          });
+          const out = [];
+          for (const x of [lo[0], hi[0]]) for (const y of [lo[1], hi[1]]) for (const z of [lo[2], hi[2]]) out.push([x, y, z]);
+          return out;
+        }""",
+        name,
+    )
+    return np.asarray(corners, dtype=np.float64)
+
+
+def assert_seen(
+    shown: ScenePage,
+    image: NDArray[np.uint8],
+    nodes: Iterable[str],
+    xy: NDArray[np.float64],
+    what: str,
+    max_outside: float = 0.25,
+) -> NDArray[np.bool_]:
+    """Assert that hiding ``nodes`` changes the picture inside the box around ``xy``: a person sees them there.
+
+    At most ``max_outside`` of what they change may lie outside that box (their shadows, a gizmo's arrows).
+    Returns the mask of pixels the nodes cover.
+    """
+    covered = changed_mask(image, with_nodes_hidden(shown.page, nodes))
+    x0, y0 = np.floor(xy.min(axis=0)).astype(int) - 4
+    x1, y1 = np.ceil(xy.max(axis=0)).astype(int) + 4
+    inside = covered[max(y0, 0) : max(y1, 0), max(x0, 0) : max(x1, 0)].sum()
+    area = max((x1 - x0) * (y1 - y0), 1)
+    assert inside > 200 and inside > 0.005 * area, (
+        f"{what}: only {inside} px of its {area} px box show it"
+    )
+    outside = covered.sum() - inside
+    assert outside <= max_outside * covered.sum(), (
+        f"{what}: {outside} of {covered.sum()} px drawn outside its box"
+    )
+    return covered
+
+
+def assert_chart_draws(
+    page: Any, title: str, colours: dict[str, Sequence[int]], min_px: int = 25
+) -> None:
+    """Assert that the plot area of chart ``title`` shows every series' colour (at least ``min_px`` pixels)."""
+    image = chart_image(page, title)
+    counts = {name: colour_pixels(image, rgb) for name, rgb in colours.items()}
+    missing = {name: n for name, n in counts.items() if n < min_px}
+    assert not missing, f"chart {title!r}: series not drawn {missing} (all: {counts})"
+
+
+def save_docs_screenshot(shown: ScenePage, key: str) -> None:
+    """At 1600×1000, write the README's screenshot of scene ``key`` to docs/ from this very page."""
+    if shown.viewport != (1600, 1000):
+        return
+    screenshot(shown.page, path=str(DOCS / f"{key}.png"))

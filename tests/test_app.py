@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import inspect
 import logging
+import signal
+import socket
 import subprocess
 import sys
 import threading
@@ -24,13 +26,15 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def test_defaults_bind_loopback_port_8080_and_open_peloton() -> None:
     defaults = {name: p.default for name, p in inspect.signature(app.main).parameters.items()}
+    # No port given means 8080, or the next free one; a port given must be free.
     assert defaults == {
         "scene": "peloton",
         "host": "127.0.0.1",
-        "port": 8080,
+        "port": None,
         "allow_remote_glsl": False,
         "shared": False,
     }
+    assert app.DEFAULT_PORT == 8080
 
 
 def test_remote_host_warning_says_whether_glsl_editing_is_on() -> None:
@@ -39,6 +43,64 @@ def test_remote_host_warning_says_whether_glsl_editing_is_on() -> None:
     assert off is not None and "GLSL editing in the SDF gallery is OFF" in off
     assert "--allow-remote-glsl" in off
     assert on is not None and "GLSL editing in the SDF gallery is ON" in on
+
+
+def test_port_messages_say_plainly_what_happened() -> None:
+    assert app.port_message(8080, 8080, explicit=False) is None
+    assert app.port_message(9000, 9000, explicit=True) is None
+    assert app.port_message(8080, 8081, explicit=False) == (
+        "Port 8080 is already in use; serving on port 8081 instead."
+    )
+    refusal = app.port_message(9000, 9001, explicit=True)
+    assert refusal is not None and "Port 9000 is already in use" in refusal and "--port" in refusal
+
+
+def _free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return int(probe.getsockname()[1])
+
+
+def test_ctrl_c_stops_the_app_with_one_line() -> None:
+    port = _free_port()
+    process = subprocess.Popen(
+        [sys.executable, str(ROOT / "app.py"), "--port", str(port)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+    )
+    try:
+        assert process.stdout is not None
+        started = []
+        for line in process.stdout:
+            started.append(line)
+            if "Open http" in line:
+                break
+        assert f"Open http://127.0.0.1:{port} " in started[-1], started
+        process.send_signal(signal.SIGINT)
+        rest, _ = process.communicate(timeout=60)
+    finally:
+        process.kill()
+    assert process.returncode == 0
+    assert rest == "Stopped.\n"  # no traceback, no farewell from viser or websockets
+    assert "Traceback" not in "".join(started)
+
+
+def test_a_busy_port_given_explicitly_is_refused_plainly() -> None:
+    with socket.socket() as holder:
+        holder.bind(("127.0.0.1", 0))
+        holder.listen()
+        port = int(holder.getsockname()[1])
+        result = subprocess.run(
+            [sys.executable, str(ROOT / "app.py"), "--port", str(port)],
+            capture_output=True,
+            text=True,
+            timeout=60,
+        )
+    assert result.returncode == 2
+    assert f"Port {port} is already in use" in result.stderr
+    assert "Traceback" not in result.stderr + result.stdout
+    assert "Open http" not in result.stdout  # it did not quietly serve elsewhere
 
 
 @pytest.mark.parametrize("host", ["127.0.0.1", "localhost", "::1", "127.0.0.2"])

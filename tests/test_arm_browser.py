@@ -1,36 +1,138 @@
-"""A real browser: Chromium opens the arm scene and a mouse drag on the target's gizmo makes the chain follow."""
+"""A real browser looks at the arm: chain, target and obstacle in view and clear of the panel, the obstacle's gizmo
+outside its disc, the error plot drawn with its top label whole, no error text, at 1600×1000 and 1280×720; the 3D
+toggle shows the floor grid from an angle; a mouse drag on the target's gizmo makes the chain follow on screen."""
 
 from __future__ import annotations
 
 import time
+from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
 import pytest
 import viser
-from browser import open_viser
+from browser import (
+    VIEWPORTS,
+    ScenePage,
+    assert_chart_draws,
+    assert_in_view,
+    assert_seen,
+    changed_mask,
+    close_notifications,
+    control_row,
+    error_text,
+    open_viser,
+    project,
+    save_docs_screenshot,
+    scene_page,
+    screenshot,
+    settle,
+    wait_frames,
+    wait_until,
+    with_nodes_hidden,
+)
 
 from scenes.arm import ArmScene
 from scenes.switcher import SceneSwitcher
 
 pytestmark = pytest.mark.browser
 
-PROJECT = """
-args => {
-  const m = window.__viserMutable;
-  const node = m.nodeRefFromName[args.name];
-  node.updateWorldMatrix(true, false);
-  const point = node.localToWorld(new node.position.constructor(args.x, args.y, args.z));
-  point.project(m.camera);
-  const rect = m.canvas.getBoundingClientRect();
-  return [rect.left + (point.x + 1) / 2 * rect.width, rect.top + (1 - point.y) / 2 * rect.height];
-}
-"""
-"""Screen position (CSS px) of a point given in a scene node's own frame, through the page's three.js camera."""
+MAIN = ["/arm/links", "/arm/joints", "/arm/target", "/arm/obstacle_0"]
+CHART = "Error after each iteration (log scale)"
+
+
+@pytest.fixture(scope="module", params=VIEWPORTS, ids=lambda v: f"{v[0]}x{v[1]}")
+def shown(request: pytest.FixtureRequest, chromium_browser: Any) -> Iterator[ScenePage]:
+    with scene_page(chromium_browser, "arm", request.param) as page:
+        yield page
+
+
+def _chain_points(scene: ArmScene) -> np.ndarray:
+    with scene._lock:
+        p = scene.params
+        shown_obstacles = scene.obstacle_centres[: p.n_obstacles]
+        radii = np.asarray(p.radii_m[: p.n_obstacles])[:, None]
+        return np.vstack(
+            [scene.pose, scene.target[None, :], shown_obstacles - radii, shown_obstacles + radii]
+        )
+
+
+def test_the_chain_is_in_view_clear_of_the_panel(shown: ScenePage) -> None:
+    scene = shown.scene
+    assert isinstance(scene, ArmScene)
+    image = screenshot(shown.page)
+    xy = assert_in_view(shown, "/arm", _chain_points(scene), "chain, target and obstacle")
+    assert_seen(shown, image, MAIN, xy, "chain, target and obstacle")
+    # The obstacle's gizmo shows outside its disc: its arrows' tips are drawn beyond the disc's rim.
+    with scene._lock:
+        radius = scene.params.radii_m[0]
+    gizmo = changed_mask(image, with_nodes_hidden(shown.page, ["/arm/obstacle_0"]))
+    disc = changed_mask(image, with_nodes_hidden(shown.page, ["/arm/obstacle_0/disc"]))
+    rim = project(shown.page, "/arm/obstacle_0", [(0, 0, 0), (radius, 0, 0)])
+    centre, rim_px = rim[0, :2], float(np.linalg.norm(rim[1, :2] - rim[0, :2]))
+    ys, xs = np.nonzero(gizmo & ~disc)
+    beyond = np.hypot(xs - centre[0], ys - centre[1]) > rim_px + 3
+    assert beyond.sum() > 30, f"gizmo hidden in its obstacle ({beyond.sum()} px outside the rim)"
+    save_docs_screenshot(shown, "arm")
+
+
+def test_the_error_plot_draws_and_its_top_label_fits(shown: ScenePage) -> None:
+    assert_chart_draws(shown.page, CHART, {"error": (230, 50, 50)})
+    # Every tick label of the y axis lies inside the chart's box (the top one, "1,000", was cut off).
+    cut = shown.page.evaluate(
+        """title => {
+          const chart = [...document.querySelectorAll('.uplot')].find(
+              c => c.querySelector('.u-title').textContent === title);
+          const box = chart.querySelector('canvas').getBoundingClientRect();
+          return chart.querySelector('.u-over').getBoundingClientRect().top - box.top;
+        }""",
+        CHART,
+    )
+    assert cut >= 10, f"only {cut} px above the plot area for the top tick label"
+
+
+def test_no_error_text_on_the_page(shown: ScenePage) -> None:
+    assert error_text(shown.page) == []
+
+
+def test_three_d_shows_the_floor_grid_from_an_angle(shown: ScenePage) -> None:
+    scene = shown.scene
+    frames = scene.framing.frames
+    image = screenshot(shown.page)
+    checkbox = control_row(shown.page, "3D (free target, sphere obstacles)").locator("input").first
+    checkbox.click()
+    wait_until(
+        lambda: scene.params.three_d and scene.framing.frames > frames, "3D mode and its camera"
+    )
+    settle(shown)
+    after = screenshot(shown.page)
+    # The camera left the front-on view: it looks across x as well as along y, and from above.
+    direction = np.asarray(
+        shown.page.evaluate(
+            "() => { const v = new window.__viserMutable.camera.position.constructor();"
+            " window.__viserMutable.camera.getWorldDirection(v); return v.toArray(); }"
+        )
+    )
+    assert abs(direction[0]) > 0.25 and direction[1] < -0.25, (
+        direction
+    )  # three.js is y-up: −y is down
+    # The floor grid is drawn, and much of the picture changed.
+    grid = changed_mask(after, with_nodes_hidden(shown.page, ["/arm/floor"]))
+    assert grid.sum() > 5_000, grid.sum()
+    assert changed_mask(image, after).mean() > 0.02
+    xy = assert_in_view(shown, "/arm", _chain_points(scene), "chain in 3D")
+    assert_seen(
+        shown, after, MAIN[:2], xy, "chain in 3D", max_outside=0.6
+    )  # its shadow on the floor
+    assert error_text(shown.page) == []
+    checkbox.click()
+    wait_until(lambda: not scene.params.three_d, "back to the plane")
+    settle(shown)
 
 
 def screen_of(page: Any, name: str, local: tuple[float, float, float]) -> tuple[float, float]:
-    x, y = page.evaluate(PROJECT, {"name": name, "x": local[0], "y": local[1], "z": local[2]})
+    """CSS position of a point in scene node ``name``'s own frame."""
+    x, y, _ = project(page, name, [local])[0]
     return float(x), float(y)
 
 
@@ -40,12 +142,14 @@ def test_drag_the_target_gizmo_with_the_mouse(server: viser.ViserServer, browser
     assert isinstance(scene, ArmScene)
     page = browser_page
     open_viser(page, server.get_port(), "/arm/target")
+    close_notifications(page)
     page.wait_for_function(
         "() => !!(window.__viserMutable && window.__viserMutable.camera && window.__viserMutable.canvas)",
         timeout=30_000,
     )
     target_before = scene.target.copy()
     end_before = scene.pose[-1].copy()
+    image_before = screenshot(page)
 
     # Grab the gizmo's x arrow (local +x, out along the shaft) and pull it to the left on screen.
     start = screen_of(page, "/arm/target", (0.2, 0.0, 0.0))
@@ -53,7 +157,9 @@ def test_drag_the_target_gizmo_with_the_mouse(server: viser.ViserServer, browser
     assert start[0] > origin[0] + 5  # the arrow points right on screen from this camera
     page.mouse.move(*start)
     page.mouse.down()
-    for step in range(1, 21):
+    for step in range(
+        1, 11
+    ):  # about 0.15 m to the left: clear of the obstacle, so the chain reaches it
         page.mouse.move(start[0] - 6 * step, start[1], steps=2)
         time.sleep(0.02)
     page.mouse.up()
@@ -108,4 +214,11 @@ def test_drag_the_target_gizmo_with_the_mouse(server: viser.ViserServer, browser
         shown = drawn_end()
     assert shown is not None
     np.testing.assert_allclose(shown, end, atol=1e-3)
+    # A person sees the chain's end move: the picture changed around the new end's place on the screen.
+    wait_frames(page, 3)
+    x, y = screen_of(page, "/arm", tuple(end))
+    was_x, _ = screen_of(page, "/arm", tuple(end_before))
+    assert was_x - x > 15  # dragged left on the screen
+    changed = changed_mask(image_before, screenshot(page))
+    assert changed[int(y) - 15 : int(y) + 15, int(x) - 15 : int(x) + 15].sum() > 40
     switcher.close()

@@ -1,20 +1,138 @@
-"""A real browser: Chromium opens the free-kick scene, a mouse click on "Kick" flies the ball in the page."""
+"""A real browser looks at the free kick: ball, wall, goal and path in view and clear of the panel, the force chart
+drawn, no error text, at 1600×1000 and 1280×720; 10 % more spin moves the path on the screen; every camera view
+keeps the kick in view; a mouse click on "Kick" flies the ball in the page."""
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from typing import Any
 
+import numpy as np
 import pytest
 import viser
-from browser import open_viser
+from browser import (
+    VIEWPORTS,
+    ScenePage,
+    assert_chart_draws,
+    assert_in_view,
+    assert_seen,
+    close_notifications,
+    colour_pixels,
+    error_text,
+    open_viser,
+    panel_rect,
+    project,
+    save_docs_screenshot,
+    scene_page,
+    screenshot,
+    set_number,
+    settle,
+    wait_until,
+)
 
-from scenes.freekick import FreeKickScene, ball_spot
+from scenes.freekick import (
+    FORCE_COLOURS,
+    KNUCKLE_COLOUR,
+    PATH_COLOUR,
+    VIEW_LABELS,
+    FreeKickScene,
+    ball_spot,
+    resample,
+    view_points,
+)
 from scenes.switcher import SceneSwitcher
 
 pytestmark = pytest.mark.browser
 
 BALL = "/freekick/ball"
 NODE = f"window.__viserMutable.nodeRefFromName[{BALL!r}]"
+MAIN = ["/freekick/wall", "/freekick/goal_frame", "/freekick/path", "/freekick/ball"]
+CHART = "Force magnitudes along the flight"
+CHART_COLOURS = {**FORCE_COLOURS, "knuckle": KNUCKLE_COLOUR}
+
+
+@pytest.fixture(scope="module", params=VIEWPORTS, ids=lambda v: f"{v[0]}x{v[1]}")
+def shown(request: pytest.FixtureRequest, chromium_browser: Any) -> Iterator[ScenePage]:
+    with scene_page(chromium_browser, "freekick", request.param) as page:
+        yield page
+
+
+def _look_at_the_kick(shown: ScenePage) -> None:
+    scene = shown.scene
+    assert isinstance(scene, FreeKickScene)
+    image = screenshot(shown.page)
+    with scene._lock:
+        points = view_points(scene.params, scene.state, scene._view)
+    xy = assert_in_view(shown, "/freekick", points, f"the kick ({scene._view})")
+    assert_seen(shown, image, MAIN, xy, "ball, wall, goal and path")
+
+
+def test_the_kick_fills_the_view_clear_of_the_panel(shown: ScenePage) -> None:
+    _look_at_the_kick(shown)
+    scene = shown.scene
+    # It fills the screen: the goal-to-ball extent spans most of the free width, not a postage stamp.
+    with scene._lock:
+        points = view_points(scene.params, scene.state, scene._view)
+    xy = project(shown.page, "/freekick", points)[:, :2]
+    width = panel_rect(shown.page)[0]
+    assert np.ptp(xy[:, 0]) > 0.6 * width, np.ptp(xy[:, 0])
+    save_docs_screenshot(shown, "freekick")
+
+
+def test_the_force_chart_draws_every_series(shown: ScenePage) -> None:
+    assert_chart_draws(shown.page, CHART, CHART_COLOURS)
+
+
+def test_no_error_text_on_the_page(shown: ScenePage) -> None:
+    assert error_text(shown.page) == []
+
+
+def test_ten_percent_more_spin_moves_the_path_on_the_screen(shown: ScenePage) -> None:
+    scene = shown.scene
+    with scene._lock:
+        before = resample(scene.state.flight, 40)
+        spin = scene.params.spin_rev_s
+    was = project(shown.page, "/freekick", before)[:, :2]
+    set_number(shown.page, "Spin rate (rev/s)", round(1.1 * spin, 1))
+    wait_until(
+        lambda: scene.params.spin_rev_s == round(1.1 * spin, 1), "the new spin to reach the scene"
+    )
+    settle(shown)
+    with scene._lock:
+        after = resample(scene.state.flight, 40)
+    now = project(shown.page, "/freekick", after)[:, :2]
+    # Where the ball crosses the goal line moved by several pixels on the screen...
+    assert np.linalg.norm(now[-1] - was[-1]) > 5.0, (was[-1], now[-1])
+    # ...and the orange path is drawn there, not where it was.
+    image = screenshot(shown.page)
+    samples = now[20:-2:2]
+    drawn = [
+        colour_pixels(image[int(y) - 4 : int(y) + 5, int(x) - 4 : int(x) + 5], PATH_COLOUR, 70) > 0
+        for x, y in samples
+    ]
+    assert np.mean(drawn) > 0.7, (
+        f"the path shows at only {sum(drawn)} of {len(drawn)} places"
+    )  # arrows cross it
+    assert error_text(shown.page) == []
+
+
+def test_every_camera_view_keeps_the_kick_in_view(shown: ScenePage) -> None:
+    scene = shown.scene
+    views = list(VIEW_LABELS)
+    for view in [
+        *views[1:],
+        views[0],
+    ]:  # the opening view last: choosing the shown one changes nothing
+        frames = scene.framing.frames
+        scene.view.value = VIEW_LABELS[view]  # type: ignore[index]
+        wait_until(
+            lambda view=view, frames=frames: scene._view == view and scene.framing.frames > frames,
+            f"the {view} view",
+        )
+        settle(shown)
+        with scene._lock:
+            points = view_points(scene.params, scene.state, scene._view)
+        assert_in_view(shown, "/freekick", points, f"the kick ({view})")
 
 
 def test_pressing_kick_flies_the_ball_in_the_page(
@@ -26,6 +144,7 @@ def test_pressing_kick_flies_the_ball_in_the_page(
         assert isinstance(scene, FreeKickScene)
         page = browser_page
         open_viser(page, server.get_port(), BALL)
+        close_notifications(page)
         spot_x = float(ball_spot(scene.params)[0])
         page.wait_for_function(
             f"() => Math.abs({NODE}.position.x - ({spot_x})) < 1e-3", timeout=20_000

@@ -24,10 +24,10 @@ from scenes.freekick import (
     FreeKickParams,
     FreeKickScene,
     aim_at,
-    aim_summary,
     compute_kick,
     outcome_map,
     resample,
+    spin_words,
 )
 from scenes.switcher import SceneSwitcher
 
@@ -59,7 +59,7 @@ def test_opening_state_is_the_kernels_curler(scene: FreeKickScene) -> None:
     np.testing.assert_allclose((ghost[:, 0] - expected.ghost.position[0]) @ across, 0.0, atol=1e-4)
     assert "**GOAL**" in scene.result.content
     assert f"{expected.outcome.wall_point[2]:.2f} m" in scene.result.content  # type: ignore[index]
-    assert "+3.38 m" in scene.result.content  # sideways against the no-spin kick, curled left
+    assert "+3.09 m" in scene.result.content  # sideways against the no-spin kick, curled left
     # Force chart: |drag|, |Magnus|, |gravity| against time, straight from the kernel.
     t, drag, magnus, gravity, _ = scene.chart.data
     np.testing.assert_allclose(t, expected.flight.t)
@@ -74,6 +74,8 @@ def test_opening_state_is_the_kernels_curler(scene: FreeKickScene) -> None:
 
 
 def test_spin_changes_path_band_and_outcome_with_the_measured_model(scene: FreeKickScene) -> None:
+    assert scene.params.model == "measured"  # the scene opens on the model under which spin matters
+    scene.model.value = "Constant C_D = C_L = 0.25 (seed)"
     band = np.asarray(scene.band.vertices)
     assert np.allclose(
         band[0::2], band[1::2], atol=1e-5
@@ -216,6 +218,8 @@ def test_a_click_ray_through_the_goal_mouth_aims_there(scene: FreeKickScene) -> 
 
 
 def test_outcome_map_matches_single_runs(scene: FreeKickScene) -> None:
+    scene.model.value = "Constant C_D = C_L = 0.25 (seed)"
+    assert scene.wait_idle()
     results = scene.map_results
     assert results is not None and results.shape == (len(MAP_SPINS_REV_S), len(MAP_SPEEDS_MS))
     assert {"goal", "wall", "over"} <= set(results.ravel().tolist())
@@ -307,7 +311,7 @@ CRAFTED = [
     ("Elevation (°)", float("nan"), "elevation_deg", 17.0),
     ("Distance to goal (m)", float("inf"), "distance_m", 22.0),
     ("Spin axis", "sideways-ish", "spin_axis", "left"),
-    ("Model", "magic", "model", "constant"),
+    ("Model", "magic", "model", "measured"),
     ("Integrator", "leapfrog", "integrator", "rk4"),
     ("Knuckle seed", -7, "knuckle_seed", 0),
 ]
@@ -422,9 +426,9 @@ def test_aiming_at_the_top_corner_backtracks_instead_of_stopping() -> None:
 def test_an_aimed_kick_without_spin_says_no_spin() -> None:
     found = aim_at(FreeKickParams(), (3.0, 2.0))
     assert found is not None and found.spin_rev_s == 0.0
-    assert aim_summary(found) == "no spin"
-    assert aim_summary(dataclasses.replace(found, spin_rev_s=7.0, spin_axis="right")) == (
-        "7 rev/s sidespin, curls right"
+    assert spin_words(found) == "no spin"
+    assert spin_words(dataclasses.replace(found, spin_rev_s=7.0, spin_axis="right")) == (
+        "7.0 rev/s sidespin, curls right"
     )
 
 

@@ -1,14 +1,27 @@
-"""A real browser: Chromium opens the SDF gallery, shows the mesh, and shows the GLSL reference image the server made."""
+"""A real browser: Chromium opens the SDF gallery, shows the mesh in view and clear of the panel with no error text at
+1600×1000 and 1280×720, and shows the GLSL reference image the server made."""
 
 from __future__ import annotations
 
 import time
+from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
 import pytest
 import viser
-from browser import open_viser
+from browser import (
+    VIEWPORTS,
+    ScenePage,
+    assert_in_view,
+    assert_seen,
+    error_text,
+    node_box_corners,
+    open_viser,
+    save_docs_screenshot,
+    scene_page,
+    screenshot,
+)
 from conftest import skip_or_fail
 
 from scenes.sdf_gallery import SdfGalleryScene
@@ -17,6 +30,29 @@ from shaders import gl_service
 from shaders.renderer import GLUnavailableError
 
 pytestmark = [pytest.mark.browser, pytest.mark.gl]
+
+MESH = "/sdf/mesh"
+
+
+@pytest.fixture(scope="module", params=VIEWPORTS, ids=lambda v: f"{v[0]}x{v[1]}")
+def shown(request: pytest.FixtureRequest, chromium_browser: Any) -> Iterator[ScenePage]:
+    try:
+        Renderer().release()
+    except GLUnavailableError as exc:
+        skip_or_fail(str(exc))
+    with scene_page(chromium_browser, "sdf", request.param) as page:
+        yield page
+
+
+def test_the_mesh_is_in_view_clear_of_the_panel(shown: ScenePage) -> None:
+    corners = node_box_corners(shown.page, MESH)
+    assert np.all(np.isfinite(corners)), "no mesh on the page"
+    image = screenshot(shown.page)
+    xy = assert_in_view(shown, MESH, corners, "the mesh's bounding box")
+    assert_seen(shown, image, [MESH], xy, "the mesh")
+    assert error_text(shown.page) == []
+    save_docs_screenshot(shown, "sdf")
+
 
 READ_IMAGE = """
 ([w, h]) => {

@@ -1,0 +1,232 @@
+"""Camera framing: where to put a browser's camera so a set of points fills the part of the view a person can see.
+
+viser's control panel floats over the right of the canvas (384 px wide and 15 px from the edge at the app's
+``control_width="large"``), so "in view" means inside the canvas and left of the panel. Framing is pure geometry
+on the client's vertical field of view and image size, so it works for any window; scenes call it from
+:meth:`~scenes._base.Scene.watch_cameras` once per client and again when what they show grows or moves.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import math
+import threading
+import warnings
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+logger = logging.getLogger(__name__)
+
+PANEL_PX = 410.0
+"""Width the control panel covers at the right of the canvas, with a margin (px)."""
+MARGIN_PX = 24.0
+"""Space kept free at the other edges (px)."""
+
+
+@dataclasses.dataclass(frozen=True)
+class View:
+    """A camera pose: where it sits and the point it orbits (world frame, m)."""
+
+    position: tuple[float, float, float]
+    look_at: tuple[float, float, float]
+
+
+def _basis(direction: NDArray[np.float64]) -> tuple[NDArray[np.float64], ...]:
+    d = direction / np.linalg.norm(direction)
+    right = np.cross(d, (0.0, 0.0, 1.0))
+    if np.linalg.norm(right) < 1e-9:  # looking straight down or up: pick +x as right
+        right = np.array([1.0, 0.0, 0.0])
+    right = right / np.linalg.norm(right)
+    return d, right, np.cross(right, d)
+
+
+@dataclasses.dataclass(frozen=True)
+class Lens:
+    """One browser's camera: vertical field of view and canvas size."""
+
+    fov_rad: float
+    width_px: int
+    height_px: int
+
+    @property
+    def aspect(self) -> float:
+        return self.width_px / self.height_px
+
+    def usable_ndc(
+        self, *, right_px: float = 0.0, top_px: float = 0.0
+    ) -> tuple[float, float, float, float]:
+        """(x0, x1, y0, y1) of the canvas left of the panel, in normalised device coordinates.
+
+        ``right_px`` and ``top_px`` keep extra room free for screen-sized things anchored at the points (labels).
+        A window narrower than twice the panel gets the whole width (viser then lays the panel out differently).
+        """
+        width, height = max(self.width_px, 1), max(self.height_px, 1)
+        panel = PANEL_PX if width > 2.0 * PANEL_PX else 0.0
+        mx, my = 2.0 * MARGIN_PX / width, 2.0 * MARGIN_PX / height
+        return (
+            -1.0 + mx,
+            1.0 - 2.0 * (panel + right_px) / width - mx,
+            -1.0 + my,
+            1.0 - 2.0 * top_px / height - my,
+        )
+
+
+def frame_points(
+    points: NDArray[np.float64],
+    direction: tuple[float, float, float],
+    *,
+    fov_rad: float,
+    aspect: float,
+    ndc: tuple[float, float, float, float] = (-0.9, 0.9, -0.9, 0.9),
+    min_depth: float = 0.0,
+) -> View:
+    """The camera looking along ``direction`` (z up) that shows every one of ``points`` inside ``ndc``, as close as it can.
+
+    Args:
+        points: (N, 3) world points that must be seen (m).
+        direction: view direction (any length, not vertical).
+        fov_rad: vertical field of view (rad), as viser's ``camera.fov``.
+        aspect: image width / height.
+        ndc: (x0, x1, y0, y1) rectangle of normalised device coordinates the points must project into.
+        min_depth: every point stays at least this far in front of the camera (m): "behind the ball", not in it.
+
+    Returns:
+        The camera position and orbit centre. The orbit centre sits on the view axis, so the points appear centred
+        in ``ndc`` rather than in the middle of the canvas.
+    """
+    pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    if not (math.isfinite(fov_rad) and 0.01 < fov_rad < 3.0):
+        fov_rad = math.radians(50.0)
+    if not (math.isfinite(aspect) and aspect > 0.05):
+        aspect = 1.6
+    x0, x1, y0, y1 = ndc
+    d, right, up = _basis(np.asarray(direction, dtype=np.float64))
+    centre = 0.5 * (pts.min(axis=0) + pts.max(axis=0))
+    rel = pts - centre
+    u, v, w = rel @ right, rel @ up, rel @ d
+    tan_y = math.tan(0.5 * fov_rad)
+    tan_x = aspect * tan_y
+    depth_extent = float(np.max(np.abs(w))) if len(w) else 0.0
+    size = float(np.max(np.linalg.norm(rel, axis=1))) if len(rel) else 0.0
+
+    def shift(
+        coord: NDArray[np.float64], scale: NDArray[np.float64], lo: float, hi: float
+    ) -> float:
+        """Offset s with the projections (coord − s)/scale centred in [lo, hi] (bisection; monotone in s)."""
+        a, b = -10.0 * (size + 1.0), 10.0 * (size + 1.0)
+        for _ in range(60):
+            s = 0.5 * (a + b)
+            p = (coord - s) / scale
+            if 0.5 * (p.min() + p.max()) > 0.5 * (lo + hi):
+                a = s
+            else:
+                b = s
+        return 0.5 * (a + b)
+
+    def fits(distance: float) -> tuple[bool, float, float]:
+        depth = distance + w
+        if np.any(depth <= max(min_depth, 1e-6)):
+            return False, 0.0, 0.0
+        sx = shift(u, depth * tan_x, x0, x1)
+        sy = shift(v, depth * tan_y, y0, y1)
+        px, py = (u - sx) / (depth * tan_x), (v - sy) / (depth * tan_y)
+        ok = px.min() >= x0 and px.max() <= x1 and py.min() >= y0 and py.max() <= y1
+        return bool(ok), sx, sy
+
+    near = depth_extent + 1e-3
+    far = near + max(min_depth, 0.0) + 1000.0 * (size + 1.0)
+    for _ in range(60):
+        mid = 0.5 * (near + far)
+        if fits(mid)[0]:
+            far = mid
+        else:
+            near = mid
+    _, sx, sy = fits(far)
+    look_at = centre + sx * right + sy * up
+    position = look_at - far * d
+    return View(
+        position=(float(position[0]), float(position[1]), float(position[2])),
+        look_at=(float(look_at[0]), float(look_at[1]), float(look_at[2])),
+    )
+
+
+def box_corners(
+    lo: NDArray[np.float64] | tuple, hi: NDArray[np.float64] | tuple
+) -> NDArray[np.float64]:
+    """(8, 3) corners of the axis-aligned box [lo, hi]."""
+    lo_a, hi_a = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
+    return np.array(
+        [
+            [(lo_a, hi_a)[i][0], (lo_a, hi_a)[j][1], (lo_a, hi_a)[k][2]]
+            for i in (0, 1)
+            for j in (0, 1)
+            for k in (0, 1)
+        ]
+    )
+
+
+class ClientFraming:
+    """Frames each browser's camera once, by its own image size, and all of them again on :meth:`reframe`.
+
+    ``view_for(lens)`` gives the view for one camera. Feed :meth:`on_camera` to
+    :meth:`~scenes._base.Scene.watch_cameras`: a camera seen for the first time (a new tab) or with a new canvas size
+    (a resized window) is framed; other moves (the person orbiting) are left alone until the scene calls
+    :meth:`reframe`, as when what it shows grows.
+    """
+
+    def __init__(self, view_for: Callable[[Lens], View]) -> None:
+        self._view_for = view_for
+        self._lock = threading.Lock()
+        self._cameras: dict[int, Any] = {}
+        self._framed: dict[int, tuple[int, int]] = {}
+        """Canvas size each client was last framed for."""
+        self.frames = 0
+        """How many times a camera was framed (tests wait on it)."""
+
+    def on_camera(self, camera: Any) -> None:
+        try:
+            client_id = int(camera.client.client_id)
+        except (AttributeError, TypeError, ValueError):
+            return
+        try:
+            size = (int(camera.image_width), int(camera.image_height))
+        except (AttributeError, TypeError, ValueError, AssertionError):
+            return
+        with self._lock:
+            self._cameras[client_id] = camera
+            if self._framed.get(client_id) == size:
+                return  # the person orbiting, or our own write coming back: leave the view alone
+            self._framed[client_id] = size  # a new tab, or a resized window
+        self._frame(camera)
+
+    def reframe(self) -> None:
+        """Frame every camera seen so far again (for cameras of closed tabs the write is dropped by viser)."""
+        with self._lock:
+            cameras = list(self._cameras.values())
+        for camera in cameras:
+            self._frame(camera)
+
+    def _frame(self, camera: Any) -> None:
+        try:
+            width, height = int(camera.image_width), int(camera.image_height)
+            fov = float(camera.fov)
+        except (AttributeError, TypeError, ValueError, AssertionError):
+            return
+        if width <= 0 or height <= 0:  # a crafted camera message: frame for a common window instead
+            width, height = 1600, 1000
+        view = self._view_for(Lens(fov, width, height))
+        try:
+            with warnings.catch_warnings(), camera.client.atomic():
+                # A tab closed since: viser drops the write and warns; there is nothing left to frame.
+                warnings.filterwarnings("ignore", message=".*closed connection.*")
+                camera.up_direction = (0.0, 0.0, 1.0)
+                camera.position = view.position
+                camera.look_at = view.look_at
+        except Exception:
+            logger.exception("framing a camera failed; it keeps its view")
+            return
+        self.frames += 1

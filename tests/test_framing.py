@@ -1,0 +1,100 @@
+"""Camera framing: every point lands inside the asked rectangle, as tightly as the view allows, for any cloud."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from scenes._framing import Lens, frame_points
+
+
+def _project(
+    points: np.ndarray, position: np.ndarray, look_at: np.ndarray, fov: float, aspect: float
+) -> np.ndarray:
+    """Pinhole projection with z up, written out independently of the module: (N, 3) ndc x, y and depth (m)."""
+    d = (look_at - position) / np.linalg.norm(look_at - position)
+    right = np.cross(d, [0.0, 0.0, 1.0])
+    right /= np.linalg.norm(right)
+    up = np.cross(right, d)
+    rel = points - position
+    depth = rel @ d
+    tan_y = math.tan(fov / 2)
+    return np.stack(
+        [(rel @ right) / (depth * tan_y * aspect), (rel @ up) / (depth * tan_y), depth], axis=1
+    )
+
+
+coordinate = st.floats(-50.0, 50.0, allow_nan=False)
+
+
+@given(
+    points=st.lists(st.tuples(coordinate, coordinate, coordinate), min_size=1, max_size=12),
+    azimuth=st.floats(-math.pi, math.pi),
+    pitch=st.floats(-1.2, 1.2),
+    fov_deg=st.floats(20.0, 90.0),
+    aspect=st.floats(0.5, 3.0),
+    min_depth=st.sampled_from([0.0, 3.0]),
+)
+def test_every_point_projects_inside_the_rectangle(
+    points: list[tuple[float, float, float]],
+    azimuth: float,
+    pitch: float,
+    fov_deg: float,
+    aspect: float,
+    min_depth: float,
+) -> None:
+    cloud = np.array(points)
+    direction = (
+        math.cos(azimuth) * math.cos(pitch),
+        math.sin(azimuth) * math.cos(pitch),
+        math.sin(pitch),
+    )
+    ndc = (-0.8, 0.4, -0.7, 0.9)
+    view = frame_points(
+        cloud, direction, fov_rad=math.radians(fov_deg), aspect=aspect, ndc=ndc, min_depth=min_depth
+    )
+    projected = _project(
+        cloud, np.array(view.position), np.array(view.look_at), math.radians(fov_deg), aspect
+    )
+    assert np.all(projected[:, 2] >= min_depth - 1e-6)
+    eps = 1e-6
+    assert projected[:, 0].min() >= ndc[0] - eps and projected[:, 0].max() <= ndc[1] + eps
+    assert projected[:, 1].min() >= ndc[2] - eps and projected[:, 1].max() <= ndc[3] + eps
+    # Tight: unless the minimum depth holds the camera back, some point reaches an edge of the rectangle.
+    spread = max(
+        np.ptp(projected[:, 0]) / (ndc[1] - ndc[0]), np.ptp(projected[:, 1]) / (ndc[3] - ndc[2])
+    )
+    if min_depth == 0.0 and np.ptp(cloud, axis=0).max() > 1e-3:
+        assert spread > 0.97
+
+
+def test_a_box_seen_side_on_is_centred_in_the_free_part_of_the_window() -> None:
+    # A 10 m × 1 m × 2 m box, seen along +y: its centre lands mid-way across the canvas left of the panel.
+    lo, hi = np.array([-5.0, -0.5, 0.0]), np.array([5.0, 0.5, 2.0])
+    corners = np.array(
+        [
+            [(lo, hi)[i][0], (lo, hi)[j][1], (lo, hi)[k][2]]
+            for i in (0, 1)
+            for j in (0, 1)
+            for k in (0, 1)
+        ]
+    )
+    lens = Lens(math.radians(50.0), 1600, 1000)
+    ndc = lens.usable_ndc()
+    view = frame_points(corners, (0.0, 1.0, 0.0), fov_rad=lens.fov_rad, aspect=lens.aspect, ndc=ndc)
+    projected = _project(
+        corners, np.array(view.position), np.array(view.look_at), lens.fov_rad, lens.aspect
+    )
+    centre_x = 0.5 * (projected[:, 0].min() + projected[:, 0].max())
+    assert centre_x == pytest.approx(0.5 * (ndc[0] + ndc[1]), abs=1e-6)
+    assert ndc[1] < 1.0 - 2 * 384 / 1600  # the free part ends left of the 384 px panel
+
+
+def test_a_narrow_window_uses_the_whole_width_and_bad_lenses_fall_back() -> None:
+    assert Lens(1.0, 600, 800).usable_ndc()[1] > 0.9  # viser moves the panel out of the way there
+    view = frame_points(np.zeros((1, 3)), (1.0, 0.0, 0.0), fov_rad=float("nan"), aspect=0.0)
+    assert all(math.isfinite(c) for c in (*view.position, *view.look_at))
