@@ -37,7 +37,9 @@ MESH = "/sdf/mesh"
 @pytest.fixture(scope="module", params=VIEWPORTS, ids=lambda v: f"{v[0]}x{v[1]}")
 def shown(request: pytest.FixtureRequest, chromium_browser: Any) -> Iterator[ScenePage]:
     try:
-        Renderer().release()
+        gl_service.run(
+            lambda _renderer: None
+        )  # the process's one GL context (made here if not yet)
     except GLUnavailableError as exc:
         skip_or_fail(str(exc))
     with scene_page(chromium_browser, "sdf", request.param) as page:
