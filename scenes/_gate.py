@@ -30,6 +30,7 @@ import logging
 import math
 import threading
 import time
+import typing
 import warnings
 import weakref
 from collections.abc import Callable, Coroutine
@@ -323,8 +324,8 @@ def decode_frame(raw: object) -> _messages.Message | None:
         return None
     try:
         mapping = msgspec.msgpack.decode(raw)
-    except msgspec.DecodeError as error:
-        refusals.refuse("malformed frame", str(error))
+    except Exception as error:  # DecodeError, or RecursionError for a frame nested thousands deep
+        refusals.refuse("malformed frame", f"{type(error).__name__}: {str(error)[:120]}")
         return None
     kind = mapping.get("type") if isinstance(mapping, dict) else None
     if not isinstance(kind, str) or kind not in _ALLOWED_BY_NAME:
@@ -341,7 +342,61 @@ def decode_frame(raw: object) -> _messages.Message | None:
     ) as error:  # the frame's fields do not fit the message: refused, the connection stays up
         refusals.refuse(f"malformed {kind}", f"{type(error).__name__}: {error}")
         return None
-    return message if isinstance(message, _ALLOWED_BY_NAME[kind]) else None
+    if not isinstance(message, _ALLOWED_BY_NAME[kind]):
+        return None
+    wrong = _misfit_field(message)
+    if wrong:
+        refusals.refuse(f"malformed {kind}", f"field {wrong!r} does not have its declared type")
+        return None
+    return message
+
+
+def _fits(value: object, hint: Any) -> bool:
+    """Whether ``value`` has the type ``hint`` that viser declares for a message field (the shapes browsers send)."""
+    origin, args = typing.get_origin(hint), typing.get_args(hint)
+    if hint is typing.Any:
+        return True
+    if hint is float:
+        return isinstance(value, (int, float)) and not isinstance(value, bool)
+    if hint in (int, str, bytes, bool):
+        return type(value) is hint
+    if origin is typing.Union:
+        return any(_fits(value, arg) for arg in args)
+    if origin is typing.Literal:
+        return any(value == arg and type(value) is type(arg) for arg in args)
+    if origin is tuple:
+        if not isinstance(value, (tuple, list)):
+            return False
+        if len(args) == 2 and args[1] is Ellipsis:
+            return all(_fits(item, args[0]) for item in value)
+        return len(value) == len(args) and all(_fits(v, a) for v, a in zip(value, args, strict=True))
+    if origin is dict:
+        return isinstance(value, dict)
+    return True  # a kind browsers do not send here; the message's own cleaner checks it
+
+
+def _misfit_field(message: _messages.Message) -> str:
+    """The first field of ``message`` whose value does not have its declared type, or "" (every field fits).
+
+    viser only warns about such fields and passes them on, where a dict as a node name (unhashable) raises deep in
+    its handlers: every field of every message is checked here, once, whatever its kind.
+    """
+    hints = _field_hints(type(message))
+    for field in dataclasses.fields(message):  # type: ignore[arg-type]  # viser's messages are dataclasses
+        hint = hints.get(field.name)
+        if hint is not None and not _fits(getattr(message, field.name), hint):
+            return field.name
+    return ""
+
+
+@functools.cache
+def _field_hints(cls: type) -> dict[str, Any]:
+    hints = typing.get_type_hints(cls)
+    return {
+        name: hint
+        for name, hint in hints.items()
+        if typing.get_origin(hint) is not typing.ClassVar and name != "excluded_self_client"
+    }
 
 
 async def _gated_message_consumer(
