@@ -335,7 +335,8 @@ class ShaderCompileError(ValueError):
 def check_source(source: object) -> str:
     """The editor source if the app will compile it, else :class:`ShaderCompileError` saying why and where.
 
-    Untrusted text: at most :data:`MAX_SOURCE_CHARS` printable ASCII characters (tabs and newlines too); no
+    Untrusted text: at most :data:`MAX_SOURCE_CHARS` printable ASCII characters (tabs and newlines too; no
+    backslash, which would join lines, and no carriage return, which Mesa takes as a line end); no ``#``, so no
     preprocessor lines (no ``#include``, ``#extension``, macros); no loops (``for``, ``while``, ``do``): without
     them, and without recursion (which GLSL forbids), every call of ``sdf`` ends, and its cost grows with the
     source's length; no ``uniform`` declarations, ``discard`` or ``main``. It must define
@@ -347,15 +348,28 @@ def check_source(source: object) -> str:
         raise ShaderCompileError(
             f"the source is {len(source)} characters; the limit is {MAX_SOURCE_CHARS}", None
         )
+    # Check the text the compiler will see. A backslash before a newline splices two lines into one (so
+    # "fo\<newline>r" is the word for) and Mesa ends a // comment at a lone carriage return (so a loop after one is
+    # code): neither has a use in sdf() text, so both are refused outright, and every line below is a line the
+    # compiler reads as one.
     for number, line in enumerate(source.split("\n"), start=1):
-        bad = next((c for c in line if not (" " <= c <= "~" or c in "\t\r")), None)
+        bad = next((c for c in line if not (" " <= c <= "~" or c == "\t")), None)
+        if bad == "\r":
+            raise ShaderCompileError(
+                "carriage returns are not allowed (end lines with a plain newline)", number
+            )
         if bad is not None:
             raise ShaderCompileError(
                 f"character {bad!r} is not allowed (printable ASCII only)", number
             )
-        if line.lstrip().startswith("#"):
-            raise ShaderCompileError("preprocessor lines (#…) are not allowed", number)
+        if "\\" in line:
+            raise ShaderCompileError(
+                "backslashes are not allowed (a backslash at a line's end joins it to the next)",
+                number,
+            )
         code = line.split("//", 1)[0]
+        if "#" in code:
+            raise ShaderCompileError("preprocessor lines (#…) are not allowed", number)
         for word in re.findall(r"[A-Za-z_]\w*", code):
             if word in _FORBIDDEN:
                 raise ShaderCompileError(_FORBIDDEN[word], number)

@@ -4,6 +4,7 @@ numpy, ``mesh_glsl`` against analytic shapes, and the ray-march of a typed field
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -69,6 +70,81 @@ def test_any_text_is_either_accepted_or_refused_cleanly(text: str) -> None:
         check_source("float sdf(vec3 p) { return 1.0; }\n" + text)
     except ShaderCompileError as exc:
         assert str(exc)
+
+
+# The reviewer's disguises (issue 12): a backslash-newline splices lines for the compiler, and Mesa ends a //
+# comment at a lone carriage return, so a check line by line saw other words than the compiler.
+@pytest.mark.parametrize(
+    ("source", "words"),
+    [
+        (
+            "float sdf(vec3 p){ float s=0.0; fo\\\nr(int i=0;i<3;i++){s+=0.1;} return s; }\n",
+            "backslash",
+        ),
+        ("float sdf(vec3 p){ disc\\\nard; return 1.0; }\n", "backslash"),
+        ("unif\\\norm float u;\nfloat sdf(vec3 p){ return u; }\n", "backslash"),
+        (
+            "float sdf(vec3 p){ return 1.0; } // hi\rfloat g(){ for(int i=0;i<3;i++){} return 0.0; }\n",
+            "carriage",
+        ),
+        ("float sdf(vec3 p){ return length(p)-F; }\r#define F 1.0\r", "carriage"),
+        ("float sdf(vec3 p){ return length(p)-1.0; } // x \\\n\n", "backslash"),
+        ("float sdf(vec3 p){ return 1.0; } # define X\n", "preprocessor"),
+    ],
+)
+def test_line_splices_and_carriage_returns_are_refused(source: str, words: str) -> None:
+    with pytest.raises(ShaderCompileError, match=words):
+        check_source(source)
+
+
+_CONSTRUCTS = [
+    "for(int i=0;i<3;i++){}",
+    "while(true){}",
+    "do{}while(true);",
+    "discard;",
+    "uniform float u;",
+    "#define X 1",
+    "void main(){}",
+]
+
+
+def _compiler_view(source: str) -> str:
+    """What a GLSL compiler reads: continuations spliced, a carriage return as a line end, // comments gone."""
+    spliced = re.sub(r"\\\r?\n", "", source).replace("\r", "\n")
+    return "\n".join(line.split("//", 1)[0] for line in spliced.split("\n"))
+
+
+@given(
+    st.sampled_from(_CONSTRUCTS),
+    st.lists(st.integers(0, 40), max_size=3),
+    st.sampled_from(["\\\n", "\\\r\n", "\r", "// c\r", "// c\\\n"]),
+)
+def test_no_disguise_of_a_forbidden_construct_gets_through(
+    construct: str, cuts: list[int], disguise: str
+) -> None:
+    # The construct cut anywhere by a continuation, or hidden after a comment a carriage return ends: the
+    # compiler would see it, so the check must refuse the text.
+    text = construct
+    for cut in sorted({c % (len(construct) + 1) for c in cuts}, reverse=True):
+        text = text[:cut] + disguise + text[cut:]
+    if not cuts:
+        text = disguise + text
+    source = "float sdf(vec3 p) { return 1.0; }\n" + text + "\n"
+    with pytest.raises(ShaderCompileError):
+        check_source(source)
+
+
+@given(st.text(alphabet=st.sampled_from(list("for wdiscaueUnm#/\\\r\n\t(){};x")), max_size=80))
+def test_accepted_text_shows_the_compiler_no_forbidden_word(text: str) -> None:
+    source = "float sdf(vec3 p) { return 1.0; }\n" + text
+    try:
+        check_source(source)
+    except ShaderCompileError:
+        return
+    seen = _compiler_view(source)
+    assert "#" not in seen
+    words = set(re.findall(r"[A-Za-z_]\w*", seen))
+    assert not words & {"for", "while", "do", "discard", "uniform", "main"}
 
 
 def test_compiler_logs_of_both_vendors_give_the_line() -> None:
