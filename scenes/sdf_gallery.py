@@ -39,6 +39,7 @@ from shaders.renderer import (
     Shading,
     check_source,
 )
+from shaders.trial import trial
 
 logger = logging.getLogger(__name__)
 
@@ -110,8 +111,9 @@ VIEW_WIDTH_PX = 640
 """Width of the ray-marched main view once the camera rests (px); its height follows the viewer's aspect."""
 MOVING_WIDTH_PX = 320
 """Width while the camera or a gizmo moves: a quarter of the pixels, and no shadows or AO, so the view keeps up."""
-COMPILE_LIMIT_S = 10.0
-"""An editor source whose programs take longer to compile is refused (s)."""
+COMPILE_LIMIT_S = 5.0
+"""An editor source whose programs (moving and fully shaded) take longer to compile in the trial process is refused
+(s); the trial process is killed at this limit plus FRAME_LIMIT_S (:mod:`shaders.trial`)."""
 FRAME_LIMIT_S = 1.0
 """An editor source whose test frame (MOVING_WIDTH_PX wide, moving shading) takes longer is refused (s); the fully
 shaded program at rest costs a few times more (its soft shadows and AO call sdf about twenty times a pixel more)."""
@@ -119,6 +121,7 @@ EDITOR_HALF_SIZE_M = 1.5
 """The editor's field is meshed and ray-marched inside the cube [−h, h]³ (m) by default."""
 EXAMPLES = gl_renderer.examples()
 """The editor's examples, by title."""
+EXAMPLE_SOURCES = frozenset(EXAMPLES.values())
 EDITOR_HELP = (
     "Write `float sdf(vec3 p)` (metres, Z up) and optionally `vec3 color(vec3 p)`, using the library's "
     "`sd_*` primitives and `op_*`, `smooth_*` operators, then **Apply**: the shape is meshed and ray-marched "
@@ -815,34 +818,26 @@ IoU is lowest when a box edge is on the silhouette.
         start = time.perf_counter()
         try:
             check_source(text)
-            # The moving frames' program (no shadows, no AO) first: the new shape appears with it, and the fully
-            # shaded program compiles when the view next rests.
+            # Compile and draw it once in a child process first, killed at the limits: a compiler can take
+            # minutes on a short source, and moderngl holds the GIL while it compiles, which would freeze every
+            # viewer. Only a source that passes is compiled here, the moving frames' program (no shadows, no AO)
+            # first: the new shape appears with it, and the fully shaded one compiles when the view next rests.
             moving_shading = _moving_shading(self.params.shading)
-            gl_service.run(lambda gl: gl.compile_field(text, moving_shading))
-            compile_s = time.perf_counter() - start
-            if compile_s > COMPILE_LIMIT_S:
-                raise ShaderCompileError(
-                    f"compiling took {compile_s:.1f} s; the limit is {COMPILE_LIMIT_S:.0f} s", None
-                )
             camera = self._camera or Camera(self.camera_position, self.camera_look_at)
-            frame_start = time.perf_counter()
-            gl_service.run(
-                lambda gl: gl.render_field(
+            if (
+                text not in EXAMPLE_SOURCES
+            ):  # the server's own examples are known to compile quickly
+                trial(
                     text,
-                    field.bounds,
+                    [moving_shading, self.params.shading],
                     camera,
+                    field.bounds,
                     MOVING_WIDTH_PX,
                     MOVING_WIDTH_PX * 5 // 8,
-                    moving_shading,
+                    COMPILE_LIMIT_S,
+                    FRAME_LIMIT_S,
                 )
-            )
-            frame_s = time.perf_counter() - frame_start
-            if frame_s > FRAME_LIMIT_S:
-                raise ShaderCompileError(
-                    f"one {MOVING_WIDTH_PX}-pixel-wide frame took {1e3 * frame_s:.0f} ms; the limit is "
-                    f"{1e3 * FRAME_LIMIT_S:.0f} ms",
-                    None,
-                )
+            gl_service.run(lambda gl: gl.compile_field(text, moving_shading))
             self._mesh_and_show(field, resolution)
         except ShaderCompileError as exc:
             self._show_editor_error(str(exc))

@@ -308,6 +308,46 @@ _FORBIDDEN = {
 }
 
 
+MAX_INLINED_TOKENS = 20000
+"""Largest ``sdf`` + ``color`` accepted once every call is inlined (tokens, the library's functions counted too).
+GLSL compilers inline every call, so a chain of functions each calling the one before twice doubles the code at
+each link: ten links of 679 characters took Mesa 76 s to compile. The examples count at most about 1600."""
+_DEFINITION = re.compile(r"\b([A-Za-z_]\w*)\s+([A-Za-z_]\w*)\s*\(([^()]*)\)\s*\{")
+_TOKEN = re.compile(r"\w+|[^\w\s]")
+_NOT_NAMES = frozenset({"if", "else", "return", "for", "while", "do", "switch"})
+
+
+def inlined_sizes(code: str, known: dict[str, int] | None = None) -> dict[str, int]:
+    """Tokens of each function defined in ``code`` (comments already removed) with every call to a function
+    defined before it (or in ``known``) replaced by that function's own inlined size, by name.
+
+    A call to a function not yet defined counts nothing (GLSL needs a declaration first and forbids recursion, so
+    the compiler refuses such a source anyway)."""
+    sizes = dict(known or {})
+    for match in _DEFINITION.finditer(code):
+        name = match.group(2)
+        if match.group(1) in _NOT_NAMES or name in _NOT_NAMES:
+            continue
+        depth, end = 1, match.end()
+        while end < len(code) and depth:
+            depth += {"{": 1, "}": -1}.get(code[end], 0)
+            end += 1
+        tokens = _TOKEN.findall(code[match.end() : end])
+        size = len(tokens)
+        for i, token in enumerate(tokens[:-1]):
+            if token != name and tokens[i + 1] == "(" and token in sizes:
+                size += sizes[token]
+        sizes[name] = size
+    return sizes
+
+
+_library_sizes: dict[str, int] = {}
+
+
+def _without_comments(source: str) -> str:
+    return "\n".join(line.split("//", 1)[0] for line in source.split("\n"))
+
+
 class ShaderCompileError(ValueError):
     """An editor source the checks or the GLSL compiler reject; ``line`` is 1-based in that source (or None)."""
 
@@ -339,7 +379,8 @@ def check_source(source: object) -> str:
     backslash, which would join lines, and no carriage return, which Mesa takes as a line end); no ``#``, so no
     preprocessor lines (no ``#include``, ``#extension``, macros); no loops (``for``, ``while``, ``do``): without
     them, and without recursion (which GLSL forbids), every call of ``sdf`` ends, and its cost grows with the
-    source's length; no ``uniform`` declarations, ``discard`` or ``main``. It must define
+    source's length, which :data:`MAX_INLINED_TOKENS` bounds once calls are inlined; no ``uniform`` declarations,
+    ``discard`` or ``main``. It must define
     ``float sdf(vec3 p)``; ``vec3 color(vec3 p)`` is optional.
     """
     if not isinstance(source, str):
@@ -379,6 +420,16 @@ def check_source(source: object) -> str:
         raise ShaderCompileError("block comments (/* */) are not allowed; use //", None)
     if not re.search(r"\bfloat\s+sdf\s*\(\s*vec3\s+\w+\s*\)", source):
         raise ShaderCompileError("define float sdf(vec3 p), the signed distance (m)", None)
+    if not _library_sizes:
+        _library_sizes.update(inlined_sizes(_without_comments(_source("sdf.glsl"))))
+    sizes = inlined_sizes(_without_comments(source), _library_sizes)
+    inlined = sizes.get("sdf", 0) + sizes.get("color", 0)
+    if inlined > MAX_INLINED_TOKENS:
+        raise ShaderCompileError(
+            f"sdf() and color() come to about {inlined} tokens once every call is inlined (a function that "
+            f"calls another several times multiplies its size); the limit is {MAX_INLINED_TOKENS}",
+            None,
+        )
     return source
 
 
@@ -446,7 +497,8 @@ def create_context() -> object:
 class Renderer:
     """Compiled programs on one EGL context; use it on the thread that created it."""
 
-    def __init__(self) -> None:
+    def __init__(self, builtin: bool = True) -> None:
+        """``builtin=False`` skips compiling the app's own programs (for a trial of an editor source alone)."""
         import moderngl
 
         ctx = create_context()
@@ -466,6 +518,11 @@ class Renderer:
             collections.OrderedDict()
         )
         """Compiled editor programs by (source, variant), least recently used first."""
+        self.renderer_name = str(self.ctx.info.get("GL_RENDERER", "unknown"))
+        self._target_size: tuple[int, int] | None = None
+        self._target_objects: list = []
+        if not builtin:
+            return
         for shadows, occlusion in ((True, True), (False, False)):  # the gallery's opening variants
             self._raymarch_program((shadows, occlusion, True, False))
         self._probe = self.ctx.program(
@@ -476,9 +533,6 @@ class Renderer:
             vertex_shader=_source("mesh.vert"), fragment_shader=_source("mesh.frag")
         )
         self._probe_vao = self.ctx.vertex_array(self._probe, [])
-        self.renderer_name = str(self.ctx.info.get("GL_RENDERER", "unknown"))
-        self._target_size: tuple[int, int] | None = None
-        self._target_objects: list = []
 
     def release(self) -> None:
         self.ctx.release()

@@ -147,6 +147,47 @@ def test_accepted_text_shows_the_compiler_no_forbidden_word(text: str) -> None:
     assert not words & {"for", "while", "do", "discard", "uniform", "main"}
 
 
+def _chain(links: int, calls: int = 2) -> str:
+    lines = ["float f0(vec3 p){ return length(p)-1.0; }"]
+    for i in range(1, links + 1):
+        args = ", ".join(f"f{i - 1}(p*{1 + j / 100:.2f})" for j in range(calls))
+        lines.append(
+            f"float f{i}(vec3 p){{ return min(0.0, min({args}, 1.0)); }}"
+            if calls > 1
+            else f"float f{i}(vec3 p){{ return f{i - 1}(p*1.01); }}"
+        )
+    lines.append(f"float sdf(vec3 p){{ return f{links}(p); }}")
+    return "\n".join(lines) + "\n"
+
+
+def test_the_reviewers_ten_link_chain_is_refused_for_its_inlined_size() -> None:
+    source = (
+        "float f0(vec3 p){ return length(p)-1.0; }\n"
+        + "".join(
+            f"float f{i}(vec3 p){{ return min(f{i - 1}(p*1.01), f{i - 1}(p.yzx+0.01)); }}\n"
+            for i in range(1, 11)
+        )
+        + "float sdf(vec3 p){ return f10(p); }\n"
+    )
+    assert len(source) == 679
+    with pytest.raises(ShaderCompileError, match=r"36846 tokens.*limit is 20000"):
+        check_source(source)
+
+
+@given(st.integers(1, 12), st.integers(1, 3))
+def test_inlined_size_multiplies_by_the_calls_at_each_link(links: int, calls: int) -> None:
+    sizes = gl_renderer.inlined_sizes(_chain(links, calls))
+    for i in range(1, links + 1):
+        own = sizes[f"f{i}"] - calls * sizes[f"f{i - 1}"]
+        assert own == sizes["f1"] - calls * sizes["f0"]  # every link's own tokens are the same
+    expected_ok = sizes["sdf"] <= gl_renderer.MAX_INLINED_TOKENS
+    try:
+        check_source(_chain(links, calls))
+        assert expected_ok
+    except ShaderCompileError as exc:
+        assert not expected_ok and "inlined" in str(exc)
+
+
 def test_compiler_logs_of_both_vendors_give_the_line() -> None:
     mesa = "GLSL Compiler failed\n\nfragment_shader\n===\n0:3(16): error: syntax error, unexpected ';'\n"
     nvidia = "0(2) : error C0000: syntax error, unexpected '}' at token \"}\"\n"

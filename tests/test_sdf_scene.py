@@ -662,3 +662,49 @@ def test_compile_and_frame_time_limits_refuse_a_slow_source(
         wait_until(lambda: scene.editor_error is not None, what="a refusal")
         assert words in str(scene.editor_error) and "limit" in str(scene.editor_error)
         assert scene.editor_serial == 0 and scene.params.shape_source == "primitives"
+
+
+def chain_source(links: int) -> str:
+    """The reviewer's loop-free chain (issue 12): each function calls the one before twice, so the inlined code
+    doubles at each link (ten links: 679 characters, 76 s for Mesa to compile)."""
+    lines = ["float f0(vec3 p){ return length(p)-1.0; }"]
+    for i in range(1, links + 1):
+        lines.append(f"float f{i}(vec3 p){{ return min(f{i - 1}(p*1.01), f{i - 1}(p.yzx+0.01)); }}")
+    lines.append(f"float sdf(vec3 p){{ return f{links}(p); }}")
+    return "\n".join(lines) + "\n"
+
+
+@pytest.mark.gl
+def test_a_slow_compile_is_stopped_at_the_limit_while_the_server_keeps_serving(
+    server: viser.ViserServer, scene: SdfGalleryScene, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import scenes.sdf_gallery as gallery
+
+    need_gl()
+    # Nine links pass the size bound but take Mesa several seconds: the trial process is killed at the limit.
+    monkeypatch.setattr(gallery, "COMPILE_LIMIT_S", 1.0)
+    monkeypatch.setattr(gallery, "FRAME_LIMIT_S", 0.5)
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("sdf(p) in GLSL")
+        client.set_value("sdf(p) in GLSL", chain_source(9))
+        start = time.monotonic()
+        client.click("Apply")
+        time.sleep(0.3)
+        # Meanwhile another callback answers at once: the compile is not in this process.
+        client.set_value("View", "Both")
+        wait_until(lambda: scene.wireframe_node.visible, timeout=2.0, what="the view switch")
+        assert scene.editor_error is None
+        wait_until(lambda: scene.editor_error is not None, timeout=30.0, what="the refusal")
+        refused_s = time.monotonic() - start
+        assert "stopped" in str(scene.editor_error) and "limit" in str(scene.editor_error)
+        assert (
+            refused_s < 20.0
+        )  # the limits plus the child's start (about 2 s here), not the 8 s compile
+        assert scene.editor_serial == 0 and scene.params.shape_source == "primitives"
+        # Ten links are refused before anything compiles, with the size and the limit.
+        scene.editor_error = None
+        client.set_value("sdf(p) in GLSL", chain_source(10))
+        start = time.monotonic()
+        client.click("Apply")
+        wait_until(lambda: scene.editor_error is not None, timeout=5.0, what="the size refusal")
+        assert "inlined" in str(scene.editor_error) and "20000" in str(scene.editor_error)
