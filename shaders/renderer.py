@@ -1051,7 +1051,17 @@ def mesh_glsl(source: str, resolution: int, bounds: ArrayLike) -> trimesh.Trimes
         field = gl.sample_field(source, grid)
         if not np.all(np.isfinite(field)):
             raise ShaderCompileError("sdf() returned NaN or infinity inside the bounds", None)
-        vertices, faces = sdf.mesh_samples(grid, field, _near_surface_mask(field, grid.spacing))
+        # Marching cubes places vertices from the corners' values by linear interpolation, so a positive scale of
+        # the field changes nothing but the kernel's level nudge (a thousandth of a voxel, in metres): a field far
+        # from a distance (|∇d| not near 1, e.g. 100·sdf or 0.001·sdf) is scaled to one first, so K·sdf meshes as
+        # sdf does.
+        lipschitz = _lipschitz_estimate(field, grid.spacing)
+        if math.isfinite(lipschitz) and (lipschitz > 1.5 or 0.0 < lipschitz < 0.5):
+            field = (field / np.float32(lipschitz)).astype(np.float32)
+        try:
+            vertices, faces = sdf.mesh_samples(grid, field, _near_surface_mask(field, grid.spacing))
+        except RuntimeError:  # scikit-image's "No surface found at the given iso value"
+            vertices, faces = np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64)
         colors = gl.probe_field(source, vertices)[1] if len(vertices) else np.zeros((0, 3))
         return sdf.mesh_trimesh(vertices, faces, np.clip(colors.astype(np.float64), 0.0, 1.0))
 
@@ -1059,9 +1069,45 @@ def mesh_glsl(source: str, resolution: int, bounds: ArrayLike) -> trimesh.Trimes
 
 
 def _near_surface_mask(field: NDArray[np.float32], spacing: float) -> NDArray[np.bool_]:
-    """Cells whose corners may straddle the surface (|d| within a cell diagonal at a corner): marching cubes skips
-    the rest, which it would find empty anyway for a distance bound."""
-    return np.abs(field) <= np.float32(math.sqrt(3.0) * spacing)
+    """(nx, ny, nz) samples marking the cells marching cubes must visit: every cell whose eight corners change
+    sign (or come within the kernel's level nudge of zero, which may move them across).
+
+    Only the corners' signs are used, never how far they are from zero: a typed ``sdf`` need not be a distance
+    bound (``3.0 * (length(p) - 1.0)`` grows three times as fast), and a threshold on |d| that assumed |∇d| ≤ 1
+    skipped cells the surface crosses, leaving holes. scikit-image 0.2x reads a cell's flag at its upper corner
+    (measured: flags at the lower corner lost half the faces); both corners are marked, so the mask does not hang
+    on that detail.
+    """
+    eps = np.float32(sdf.ISO_NUDGE_VOXELS * spacing)
+    lo = field
+    hi = field
+    for axis in range(3):
+        head = [slice(None)] * 3
+        tail = [slice(None)] * 3
+        head[axis] = slice(None, -1)
+        tail[axis] = slice(1, None)
+        lo = np.minimum(lo[tuple(head)], lo[tuple(tail)])
+        hi = np.maximum(hi[tuple(head)], hi[tuple(tail)])
+    crossing = (lo < eps) & (hi > -eps)  # (nx-1, ny-1, nz-1) cells
+    mask = np.zeros(field.shape, dtype=np.bool_)
+    mask[:-1, :-1, :-1] = crossing
+    mask[1:, 1:, 1:] |= crossing
+    return mask
+
+
+def _lipschitz_estimate(field: NDArray[np.float32], spacing: float) -> float:
+    """The largest gradient norm of ``field`` by forward differences over its grid (field units per m), in slabs of
+    float64 (no overflow for huge fields, a bounded extra memory)."""
+    nx = field.shape[0]
+    largest = 0.0
+    for x0 in range(0, nx - 1, 32):
+        x1 = min(nx, x0 + 33)
+        slab = field[x0:x1].astype(np.float64)
+        dx = np.diff(slab, axis=0)[:, :-1, :-1]
+        dy = np.diff(slab, axis=1)[:-1, :, :-1]
+        dz = np.diff(slab, axis=2)[:-1, :-1, :]
+        largest = max(largest, float(np.sqrt(dx * dx + dy * dy + dz * dz).max(initial=0.0)))
+    return largest / spacing
 
 
 def examples() -> dict[str, str]:

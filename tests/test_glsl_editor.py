@@ -9,7 +9,7 @@ import re
 import numpy as np
 import pytest
 from conftest import skip_or_fail
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from kernels import sdf
@@ -293,6 +293,55 @@ def test_mesh_glsl_equals_the_numpy_mesher_on_the_same_field() -> None:
 def test_empty_field_gives_an_empty_mesh() -> None:
     tri = mesh_glsl("float sdf(vec3 p) {\n    return 1.0;\n}\n", 32, BOUNDS)
     assert len(tri.faces) == 0
+
+
+# Issue 12: the mesher's cell mask kept only cells with a corner within a cell diagonal of zero, which assumes
+# |∇d| ≤ 1; a typed field need not be a distance, and K·(length(p) − 1) lost most of its faces for K = 3, 10, 100.
+WIDE = np.array([[-1.5, -1.5, -1.5], [1.5, 1.5, 1.5]])
+
+
+def scaled_sphere(k: float) -> str:
+    return f"float sdf(vec3 p) {{ return {k:.9g} * (length(p) - 1.0); }}"
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("k", [3.0, 10.0, 100.0, 1e30])
+def test_a_steep_field_meshes_watertight_with_the_spheres_area(k: float) -> None:
+    tri = mesh_glsl(scaled_sphere(k), 64, WIDE)
+    assert tri.is_watertight
+    assert tri.area == pytest.approx(4 * math.pi, rel=0.005)  # 12.57 m², not 8.05, 2.5 or 0.39
+
+
+@pytest.mark.gl
+def test_the_elongation_example_is_watertight() -> None:
+    source = next(
+        s for title, s in gl_renderer.examples().items() if title.startswith("Elongation")
+    )
+    tri = mesh_glsl(source, 64, WIDE)
+    assert tri.is_watertight and len(tri.faces) == 6500
+
+
+@pytest.mark.gl
+@settings(max_examples=25)
+@given(
+    st.floats(-6.0, 30.0),
+    st.sampled_from(
+        [
+            "length(p) - 1.0",
+            "sd_box(p - vec3(0.013, 0.021, 0.017), vec3(0.7, 0.5, 0.9))",
+            "sd_torus(p - vec3(0.011, 0.0, 0.023), 0.8, 0.3)",
+        ]
+    ),
+)
+def test_a_positive_scale_of_the_field_changes_nothing(exponent: float, body: str) -> None:
+    # Marching cubes interpolates linearly between corners, so K·sdf has sdf's mesh for every K > 0 (the shapes
+    # are moved off the grid's planes: a sample exactly on the level is a tie float rounding may break either way).
+    k = 10.0**exponent
+    reference = mesh_glsl(f"float sdf(vec3 p) {{ return {body}; }}", 40, WIDE)
+    scaled = mesh_glsl(f"float sdf(vec3 p) {{ return {k:.9g} * ({body}); }}", 40, WIDE)
+    assert scaled.is_watertight and reference.is_watertight
+    assert len(scaled.faces) == len(reference.faces)
+    assert scaled.area == pytest.approx(reference.area, rel=1e-4)
 
 
 # ------------------------------------------------------------------------------------------ ray-march
