@@ -122,6 +122,9 @@ EDITOR_HALF_SIZE_M = 1.5
 EXAMPLES = gl_renderer.examples()
 """The editor's examples, by title."""
 EXAMPLE_SOURCES = frozenset(EXAMPLES.values())
+EDITOR_KEEP_CHARS = 2 * MAX_SOURCE_CHARS
+"""Longest text the editor keeps (characters): room to paste a little too much and trim it; beyond, the previous
+text is put back at once."""
 EDITOR_HELP = (
     "Write `float sdf(vec3 p)` (metres, Z up) and optionally `vec3 color(vec3 p)`, using the library's "
     "`sd_*` primitives and `op_*`, `smooth_*` operators, then **Apply**: the shape is meshed and ray-marched "
@@ -500,6 +503,8 @@ IoU is lowest when a box edge is on the silhouette.
         for handle in (self.view_mode, self.shape_source):
             handle.on_update(self.callback(self._on_view_input))
         self.example.on_update(self.callback(self._on_example))
+        self._editor_text = p.editor.source
+        self.editor.on_update(self.callback(self._on_editor_text))
         self.apply.on_click(self.callback(self._on_apply))
 
     def _build_world(self) -> None:
@@ -667,6 +672,24 @@ IoU is lowest when a box edge is on the silhouette.
         self._write_back(self.editor, EXAMPLES[title])
         self._request_source(EXAMPLES[title])
 
+    def _on_editor_text(self) -> None:
+        """Keep the editor's text only if it is text of at most EDITOR_KEEP_CHARS characters (and editing is on);
+        else put the last kept text back, so a huge or crafted value is not kept for every viewer and late joiner
+        (viser relays an update to the other viewers before this runs; the write-back replaces it)."""
+        text = self.editor.value
+        if editing_allowed() and isinstance(text, str) and len(text) <= EDITOR_KEEP_CHARS:
+            self._editor_text = text
+            return
+        self._write_back(self.editor, self._editor_text)
+        if editing_allowed():
+            length = len(text) if isinstance(text, (str, bytes, list)) else None
+            self._show_editor_error(
+                f"That text was {length} characters long; the editor keeps at most {EDITOR_KEEP_CHARS} "
+                f"(and Apply takes at most {MAX_SOURCE_CHARS}), so the previous text is back."
+                if length is not None
+                else "The editor takes only text; the previous text is back."
+            )
+
     def _on_apply(self) -> None:
         if not editing_allowed():
             # Only the server's own examples compile: the browser's text is not read.
@@ -675,9 +698,13 @@ IoU is lowest when a box edge is on the silhouette.
             self._request_source(EXAMPLES[title])
             return
         text = self.editor.value
-        if not isinstance(text, str) or len(text) > MAX_SOURCE_CHARS:
+        if not isinstance(text, str):
+            self._show_editor_error("The source must be text.")
+            return
+        if len(text) > MAX_SOURCE_CHARS:
             self._show_editor_error(
-                f"The source must be text; the limit is {MAX_SOURCE_CHARS} characters."
+                f"The source is {len(text)} characters long; the limit is {MAX_SOURCE_CHARS} characters. "
+                f"Shorten it by {len(text) - MAX_SOURCE_CHARS} and apply again."
             )
             return
         self._request_source(text)

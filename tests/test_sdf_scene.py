@@ -708,3 +708,44 @@ def test_a_slow_compile_is_stopped_at_the_limit_while_the_server_keeps_serving(
         client.click("Apply")
         wait_until(lambda: scene.editor_error is not None, timeout=5.0, what="the size refusal")
         assert "inlined" in str(scene.editor_error) and "20000" in str(scene.editor_error)
+
+
+@pytest.mark.parametrize("extra", [1, 3 * 2**20])
+def test_an_over_long_editor_text_is_put_back_for_every_viewer(
+    server: viser.ViserServer, scene: SdfGalleryScene, extra: int
+) -> None:
+    from scenes.sdf_gallery import EDITOR_KEEP_CHARS
+
+    label = "sdf(p) in GLSL"
+    with BrowserClient(server.get_port()) as crafted, BrowserClient(server.get_port()) as other:
+        crafted.wait_for_gui(label)
+        other.wait_for_gui(label)
+        before = scene.editor.value
+        crafted.set_value(label, SPHERE_SOURCE)  # a text within the limit is kept
+        wait_until(lambda: scene.editor.value == SPHERE_SOURCE, what="the kept text")
+        crafted.set_value(label, "x" * (EDITOR_KEEP_CHARS + extra))
+        wait_until(lambda: scene.editor_error is not None, what="the refusal")
+        assert f"{EDITOR_KEEP_CHARS + extra} characters" in str(scene.editor_error)
+        assert scene.editor.value == SPHERE_SOURCE != before
+        other.wait_for(lambda: other.value_of(label) == SPHERE_SOURCE, what="the text put back")
+        crafted.wait_for(lambda: crafted.value_of(label) == SPHERE_SOURCE, what="the text put back")
+    with BrowserClient(server.get_port()) as late:
+        late.wait_for_gui(label)
+        assert late.value_of(label) == SPHERE_SOURCE
+
+
+def test_apply_of_a_text_over_the_source_limit_says_its_length_and_the_limit(
+    server: viser.ViserServer, scene: SdfGalleryScene
+) -> None:
+    from scenes.sdf_gallery import MAX_SOURCE_CHARS
+
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Apply")
+        text = SPHERE_SOURCE + " " * (MAX_SOURCE_CHARS + 1 - len(SPHERE_SOURCE))
+        client.set_value("sdf(p) in GLSL", text)
+        wait_until(lambda: scene.editor.value == text, what="the kept text")
+        client.click("Apply")
+        wait_until(lambda: scene.editor_error is not None, what="the refusal")
+        assert "8001 characters long; the limit is 8000 characters" in str(scene.editor_error)
+        assert "8001 characters long" in scene.editor_status.content
+        assert scene.editor_serial == 0
