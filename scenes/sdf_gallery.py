@@ -815,6 +815,8 @@ IoU is lowest when a box edge is on the silhouette.
                     self._render_reference()
             except GLUnavailableError as exc:
                 self._no_gl(exc)
+            except ShaderCompileError as exc:  # a remesh of the editor's field found no surface
+                self._show_editor_error(str(exc))
             except Exception:
                 # One failed mesh or render must not stop every later one: log it and wait for new input.
                 logger.exception("sdf: meshing or rendering failed; keeping the last good picture")
@@ -906,6 +908,15 @@ IoU is lowest when a box edge is on the silhouette.
     def _mesh_field_and_show(self, field: EditorField, resolution: int) -> None:
         start = time.perf_counter()
         tri = gl_renderer.mesh_glsl(field.source, resolution, field.bounds)
+        if len(tri.faces) == 0:
+            centre = gl_service.run(lambda gl: gl.probe_field(field.source, [[0.0, 0.0, 0.0]]))[0]
+            side = "outside (sdf > 0)" if float(centre[0]) > 0.0 else "inside (sdf ≤ 0)"
+            h = field.half_size
+            raise ShaderCompileError(
+                f"no surface lies inside the bounds: every sample of the ±{h:g} m box is {side}, so there "
+                "is nothing to mesh (change sdf() or the editor's bounds)",
+                None,
+            )
         vertices = np.asarray(tri.vertices, dtype=np.float64)
         faces = np.asarray(tri.faces, dtype=np.int64)
         rgba = getattr(tri.visual, "vertex_colors", np.zeros((len(vertices), 4)))

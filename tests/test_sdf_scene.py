@@ -749,3 +749,28 @@ def test_apply_of_a_text_over_the_source_limit_says_its_length_and_the_limit(
         assert "8001 characters long; the limit is 8000 characters" in str(scene.editor_error)
         assert "8001 characters long" in scene.editor_status.content
         assert scene.editor_serial == 0
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize(
+    ("body", "side"),
+    [("return 1.0;", "outside"), ("return -2.0;", "inside"), ("return 1e30;", "outside")],
+)
+def test_a_field_without_a_surface_in_the_bounds_is_not_applied(
+    server: viser.ViserServer, scene: SdfGalleryScene, body: str, side: str
+) -> None:
+    need_gl()
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Apply")
+        client.set_value("sdf(p) in GLSL", f"float sdf(vec3 p) {{ {body} }}\n")
+        client.click("Apply")
+        wait_until(lambda: scene.editor_error is not None, timeout=30.0, what="the refusal")
+        assert "no surface lies inside the bounds" in str(scene.editor_error)
+        assert side in str(scene.editor_error) and "±1.5 m" in str(scene.editor_error)
+        assert (
+            "0 triangles" not in scene.editor_status.content
+            and "Applied" not in scene.editor_status.content
+        )
+        assert (
+            scene.editor_serial == 0 and len(scene.mesh_faces) > 500
+        )  # the primitives' mesh stays
