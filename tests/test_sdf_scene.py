@@ -578,9 +578,12 @@ def test_raymarched_view_goes_to_the_background_with_depth(
         client.set_value("View", "Ray-marched")
         wait_until(lambda: scene.view_serial > 0, what="a main-view frame")
         assert scene.mesh_node.visible is False and scene.wireframe_node.visible is False
-        client.wait_for(lambda: len(background_images(client)) > 0, what="a background image")
-        message = background_images(client)[-1]
-        assert message["rgb_data"] and message["depth_data"]
+        # Wait for the frame itself: under load the last background message seen may still be an earlier one
+        # (the clearing of the mesh view's background), not yet the ray-marched frame with its depth.
+        client.wait_for(
+            lambda: any(m["rgb_data"] and m["depth_data"] for m in background_images(client)),
+            what="a background image with depth",
+        )
         # At rest the frame is the full width, with the viewer's aspect.
         wait_until(
             lambda: scene.view_rgb is not None and scene.view_rgb.shape[1] == 640,
