@@ -108,7 +108,12 @@ SOURCE_LABELS: dict[str, ShapeSource] = {
     "GLSL editor": "editor",
 }
 VIEW_WIDTH_PX = 640
-"""Width of the ray-marched main view once the camera rests (px); its height follows the viewer's aspect."""
+"""Narrowest ray-marched main view once the camera rests (px); its height follows the viewer's aspect."""
+MAX_VIEW_SIZE_PX = (1600, 1000)
+"""Largest rest frame (px): at rest the main view is drawn at the viewer's canvas width, within this box."""
+REST_FRAME_BUDGET_S = 0.6
+"""A rest frame is made smaller (not below VIEW_WIDTH_PX wide) when the last one's time per pixel says the
+viewer's full size would take longer than this (s)."""
 MOVING_WIDTH_PX = 320
 """Width while the camera or a gizmo moves: a quarter of the pixels, and no shadows or AO, so the view keeps up."""
 COMPILE_LIMIT_S = 5.0
@@ -280,6 +285,35 @@ def camera_from_viser(camera: Any) -> Camera | None:
         return None
 
 
+def _viewer_size(camera: Any) -> tuple[int, int] | None:
+    """The viewer's canvas (width, height) in px from a viser camera, or None if it sent something unusable (NaN,
+    zero, negative, absurd or not a number)."""
+    try:
+        width, height = float(camera.image_width), float(camera.image_height)
+    except (TypeError, ValueError, AttributeError, OverflowError):
+        return None
+    if not (
+        math.isfinite(width) and math.isfinite(height) and 1 <= width <= 2e4 and 1 <= height <= 2e4
+    ):
+        return None
+    return round(width), round(height)
+
+
+def _rest_size(viewer_width: int, aspect: float, s_per_pixel: float | None) -> tuple[int, int]:
+    """The rest frame's (width, height) in px: the viewer's width (at least VIEW_WIDTH_PX) at ``aspect`` (width /
+    height), made smaller (not below VIEW_WIDTH_PX) if ``s_per_pixel`` says it would take longer than
+    REST_FRAME_BUDGET_S, and always within MAX_VIEW_SIZE_PX."""
+    max_w, max_h = MAX_VIEW_SIZE_PX
+    width = float(min(max(viewer_width, VIEW_WIDTH_PX), max_w))
+    if s_per_pixel is not None and s_per_pixel > 0.0:
+        affordable = REST_FRAME_BUDGET_S / s_per_pixel
+        if width * width / aspect > affordable:
+            width = max(math.sqrt(affordable * aspect), float(VIEW_WIDTH_PX))
+    if width / aspect > max_h:  # a tall canvas: the height is the limit
+        width = max_h * aspect
+    return round(width), max(16, round(width / aspect))
+
+
 class SdfGalleryScene(Scene):
     key = "sdf"
     title = "SDF gallery (ray marching)"
@@ -344,6 +378,11 @@ IoU is lowest when a box edge is on the silhouette.
         self._wanted_resolution = self.params.resolution
         self._camera: Camera | None = None
         self._aspect = 4 / 3
+        self._viewer_width = VIEW_WIDTH_PX
+        """The viewer's canvas width (px), from its camera messages; the rest frame is drawn at it, within limits."""
+        self._rest_s_per_pixel: float | None = None
+        """Seconds a pixel of the last rest frame took: the next one is sized to REST_FRAME_BUDGET_S."""
+        self._moving_s_per_pixel: float | None = None
         self._camera_time = 0.0
         self._scene_time = 0.0
         self._reference_due = True
@@ -752,9 +791,13 @@ IoU is lowest when a box edge is on the silhouette.
         cam = camera_from_viser(camera)
         if cam is None:
             return
+        size = _viewer_size(camera)
+        if size is not None:
+            with self._work:
+                self._viewer_width = size[0]
         try:
-            aspect = float(camera.aspect)
-        except (TypeError, ValueError, AttributeError, ZeroDivisionError):
+            aspect = size[0] / size[1] if size is not None else float(camera.aspect)
+        except (TypeError, ValueError, AttributeError, ZeroDivisionError, OverflowError):
             aspect = 4 / 3
         self._on_camera_values(cam, aspect)
 
@@ -1011,22 +1054,30 @@ IoU is lowest when a box edge is on the silhouette.
             if params.view_mode == "mesh" or self._camera is None:
                 return
             moving = time.monotonic() - max(self._camera_time, self._scene_time) < CAMERA_REST_S
-            camera, aspect = self._camera, self._aspect
+            camera, aspect, viewer_width = self._camera, self._aspect, self._viewer_width
         shape = params.shape()
         if isinstance(shape, sdf.Scene) and self.mesh_shape is not None:
             try:
                 shape = self.params.scene()
             except ValueError:
                 return
-        key = (shape, camera, aspect, moving, params.shading, params.view_mode)
+        key = (shape, camera, aspect, viewer_width, moving, params.shading, params.view_mode)
         if key == self._view_key:
             return
-        width = MOVING_WIDTH_PX if moving else VIEW_WIDTH_PX
-        height = max(16, round(width / aspect))
+        if moving:
+            width, height = MOVING_WIDTH_PX, max(16, round(MOVING_WIDTH_PX / aspect))
+        else:
+            # Before the first rest frame, guess from the moving ones (the shadows and AO cost a few times more).
+            guess = None if self._moving_s_per_pixel is None else 4.0 * self._moving_s_per_pixel
+            width, height = _rest_size(viewer_width, aspect, self._rest_s_per_pixel or guess)
         shading = _moving_shading(params.shading) if moving else params.shading
         start = time.perf_counter()
         rgb, depth = gl_service.run(lambda gl: _march(gl, shape, camera, width, height, shading))
         view_ms = 1e3 * (time.perf_counter() - start)
+        if moving:
+            self._moving_s_per_pixel = view_ms / 1e3 / (width * height)
+        else:
+            self._rest_s_per_pixel = view_ms / 1e3 / (width * height)
         # viser encodes depth in fixed point up to 167 m: a miss goes to the far end.
         depth = np.where(np.isfinite(depth), depth, 1e3).astype(np.float32)
         with self._lock:

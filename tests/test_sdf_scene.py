@@ -13,6 +13,8 @@ import pytest
 import trimesh
 import viser
 from conftest import skip_or_fail
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 from trimesh.visual.color import ColorVisuals
 from viser_private import gui_uuid, gui_uuids, node_names
 from wsclient import BrowserClient
@@ -777,3 +779,93 @@ def test_a_field_without_a_surface_in_the_bounds_is_not_applied(
         assert (
             scene.editor_serial == 0 and len(scene.mesh_faces) > 500
         )  # the primitives' mesh stays
+
+
+_ODD = st.one_of(
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.integers(-(2**70), 2**70),
+    st.just(None),
+    st.text(max_size=3),
+    st.lists(st.floats(), max_size=4),
+)
+
+
+@given(
+    st.fixed_dictionaries(
+        {
+            "position": st.one_of(_ODD, st.tuples(*[st.floats()] * 3)),
+            "look_at": st.one_of(_ODD, st.tuples(*[st.floats()] * 3)),
+            "up_direction": st.one_of(_ODD, st.just((0.0, 0.0, 1.0))),
+            "fov": _ODD,
+            "image_width": _ODD,
+            "image_height": _ODD,
+        }
+    )
+)
+@settings(max_examples=200, suppress_health_check=[HealthCheck.function_scoped_fixture])
+def test_any_camera_message_fields_keep_the_view_sane(
+    scene: SdfGalleryScene, fields: dict[str, object]
+) -> None:
+    # Every field of a ViewerCameraMessage the scene reads, crafted: its handler never raises, and what it keeps
+    # is finite (a camera, an aspect in range and a rest frame of a sane size).
+    class Cam:
+        def __init__(self) -> None:
+            self.__dict__.update(fields)
+
+        @property
+        def aspect(self) -> float:
+            return self.image_width / self.image_height  # type: ignore[operator]
+
+    scene._on_camera(Cam())
+    assert 0.5 <= scene._aspect <= 2.5
+    assert 1 <= scene._viewer_width <= 2e4
+    width, height = gallery_rest_size(scene._viewer_width, scene._aspect, None)
+    assert width <= 1600 and 16 <= height <= 1000 and (width >= 640 or height == 1000)
+
+
+def test_the_reviewers_nan_height_camera_is_ignored(scene: SdfGalleryScene) -> None:
+    from types import SimpleNamespace
+
+    before = (scene._camera, scene._aspect, scene._viewer_width)
+    nan = float("nan")
+    scene._on_camera(
+        SimpleNamespace(
+            position=nan,
+            look_at=(0.0, 0.0, 0.0),
+            up_direction=(0.0, 0.0, 1.0),
+            fov=1.0,
+            image_width=1600,
+            image_height=nan,
+            aspect=nan,
+        )
+    )
+    assert (scene._camera, scene._aspect, scene._viewer_width) == before
+
+
+def gallery_rest_size(width: int, aspect: float, s_per_pixel: float | None) -> tuple[int, int]:
+    from scenes.sdf_gallery import _rest_size
+
+    return _rest_size(width, aspect, s_per_pixel)
+
+
+@pytest.mark.parametrize(
+    ("viewer", "aspect", "s_per_pixel", "size"),
+    [
+        (
+            1600,
+            1.6,
+            None,
+            (1600, 1000),
+        ),  # the reviewer's canvas: drawn at its size, not 640 stretched
+        (2400, 1.6, None, (1600, 1000)),  # capped
+        (1600, 2.5, None, (1600, 640)),
+        (1000, 0.5, None, (500, 1000)),  # a tall canvas: the height is the limit
+        (300, 1.6, None, (640, 400)),  # never below the old rest width
+        (1600, 1.6, 0.6 / (800 * 500), (800, 500)),  # the budget allows a quarter of the pixels
+        (1600, 1.6, 1.0, (640, 400)),  # a very slow field: the old rest size
+    ],
+)
+def test_rest_frame_size(
+    viewer: int, aspect: float, s_per_pixel: float | None, size: tuple[int, int]
+) -> None:
+    assert gallery_rest_size(viewer, aspect, s_per_pixel) == size
