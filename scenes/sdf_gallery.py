@@ -97,9 +97,11 @@ SIZE_MEANING = (
 )
 RESOLUTION_LABEL = "Mesh resolution (samples per side)"
 """Marching-cubes samples along the longest side of the scene's bounds."""
-GIZMO_SCALE = 0.8
-"""Gizmo arrow length (m): longer than every default primitive's reach from its centre (the torus ring, 0.72 m),
-so the arrow tips poke out of the mesh."""
+GIZMO_MARGIN_M = 0.12
+"""How far a gizmo's arrows reach beyond its primitive's surface (m): each gizmo is sized to its own primitive."""
+GIZMO_MARKER_RADIUS_M = 0.035
+"""Radius of the ball in the primitive's colour at the tip of each gizmo's z arrow (m)."""
+
 ViewMode = Literal["mesh", "raymarch", "both"]
 VIEW_LABELS: dict[str, ViewMode] = {"Mesh": "mesh", "Ray-marched": "raymarch", "Both": "both"}
 ShapeSource = Literal["primitives", "editor"]
@@ -312,6 +314,27 @@ def _rest_size(viewer_width: int, aspect: float, s_per_pixel: float | None) -> t
     if width / aspect > max_h:  # a tall canvas: the height is the limit
         width = max_h * aspect
     return round(width), max(16, round(width / aspect))
+
+
+def gizmo_reach(slot: PrimitiveParams) -> float:
+    """A gizmo's arrow length for ``slot`` (m): the farthest its primitive's surface lies from its centre along the
+    six local axis directions, plus GIZMO_MARGIN_M, so the arrow tips poke out of the primitive and no further."""
+    try:
+        prim = slot.primitive()
+    except ValueError:
+        return 0.5
+    t = np.linspace(0.0, 3.0, 301)
+    axes = sdf.rotation_matrix(slot.wxyz).T  # rows: the local axes in the world frame
+    reach = 0.0
+    for axis in (*axes, *(-axes)):
+        inside = prim.distance(np.asarray(slot.position) + t[:, None] * axis) <= 0.0
+        if inside.any():
+            reach = max(reach, float(t[np.nonzero(inside)[0].max()]))
+    return round(max(reach + GIZMO_MARGIN_M, 0.2), 3)
+
+
+def _gizmo_label(index: int, slot: PrimitiveParams) -> str:
+    return f"P{index + 1} {slot.kind}"
 
 
 class SdfGalleryScene(Scene):
@@ -564,12 +587,17 @@ IoU is lowest when a box edge is on the silhouette.
             visible=False,
         )
         self.gizmos = []
+        self.gizmo_markers = []
+        self.gizmo_labels = []
         for i, slot in enumerate(self.params.primitives):
+            reach = gizmo_reach(slot)
             gizmo = scene.add_transform_controls(
                 f"{self.root.name}/gizmo_{i + 1}",
-                scale=GIZMO_SCALE,
-                line_width=3.0,
-                # Drawn over the mesh: a gizmo sits at its primitive's centre, inside the surface.
+                scale=reach,
+                line_width=2.0,
+                disable_sliders=True,  # the plane handles of four gizmos cluttered the middle; arrows and rings stay
+                # Drawn over the mesh: a gizmo sits at its primitive's centre, inside the surface. Each is sized to
+                # its own primitive (its arrows just poke out of it), so the four do not pile up in the middle.
                 depth_test=False,
                 position=slot.position,
                 wxyz=slot.wxyz,
@@ -577,7 +605,26 @@ IoU is lowest when a box edge is on the silhouette.
             )
             gizmo.on_update(self.callback(self._on_scene_input))
             self.gizmos.append(gizmo)
-            scene.add_label(f"{gizmo.name}/label", f"P{i + 1}", position=(0.0, 0.0, GIZMO_SCALE))
+            # A ball in the primitive's colour at the tip of its local z arrow, and its name: which gizmo moves
+            # which primitive, at a glance.
+            self.gizmo_markers.append(
+                scene.add_icosphere(
+                    f"{gizmo.name}/marker",
+                    radius=GIZMO_MARKER_RADIUS_M,
+                    color=slot.color,
+                    subdivisions=2,
+                    position=(0.0, 0.0, reach),
+                    cast_shadow=False,
+                    receive_shadow=False,
+                )
+            )
+            self.gizmo_labels.append(
+                scene.add_label(
+                    f"{gizmo.name}/label",
+                    _gizmo_label(i, slot),
+                    position=(0.0, 0.0, reach + 2.5 * GIZMO_MARKER_RADIUS_M),
+                )
+            )
 
     def _watch_cameras(self) -> None:
         self.watch_cameras(self._on_camera)
@@ -820,6 +867,29 @@ IoU is lowest when a box edge is on the silhouette.
             gizmo.visible = slot.enabled and self.params.shape_source == "primitives"
             for j, axis in enumerate("abc"):
                 handles[f"size_{axis}"].disabled = j >= used[slot.kind] or not slot.enabled
+        self._sync_gizmo_looks()
+
+    def _sync_gizmo_looks(self) -> None:
+        """Each gizmo's size, marker colour and label follow its primitive's kind, size and colour."""
+        for i, (gizmo, marker, label, slot) in enumerate(
+            zip(
+                self.gizmos,
+                self.gizmo_markers,
+                self.gizmo_labels,
+                self.params.primitives,
+                strict=True,
+            )
+        ):
+            reach = gizmo_reach(slot)
+            if abs(gizmo.scale - reach) > 1e-6:
+                gizmo.scale = reach
+                marker.position = (0.0, 0.0, reach)
+                label.position = (0.0, 0.0, reach + 2.5 * GIZMO_MARKER_RADIUS_M)
+            if tuple(int(c) for c in marker.color) != slot.color:
+                marker.color = slot.color
+            text = _gizmo_label(i, slot)
+            if label.text != text:
+                label.text = text
 
     def _request_mesh(self) -> None:
         params = self.params

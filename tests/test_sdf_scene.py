@@ -379,12 +379,6 @@ def test_without_gl_the_panel_says_why_and_meshing_goes_on(
         scene.close()
 
 
-def scene_gizmo_scale() -> float:
-    from scenes.sdf_gallery import GIZMO_SCALE
-
-    return GIZMO_SCALE
-
-
 # ------------------------------------------------------------------------------------------ teardown
 def test_close_removes_everything_and_stops_the_worker(server: viser.ViserServer) -> None:
     nodes_before, gui_before = node_names(server), gui_uuids(server)
@@ -463,8 +457,39 @@ def test_gizmos_draw_over_the_mesh_and_reach_out_of_it(scene: SdfGalleryScene) -
         assert gizmo.depth_test is False
         prim = slot.primitive()
         # The arrow tips lie outside the primitive (positive distance): something to grab from outside.
-        tips = np.asarray(slot.position) + scene_gizmo_scale() * sdf.rotation_matrix(slot.wxyz).T
+        tips = np.asarray(slot.position) + gizmo.scale * sdf.rotation_matrix(slot.wxyz).T
         assert np.all(prim.distance(tips) > 0.0), slot.kind
+
+
+def test_each_gizmo_is_sized_coloured_and_named_for_its_own_primitive(
+    server: viser.ViserServer, scene: SdfGalleryScene
+) -> None:
+    # Issue 12: four 0.8 m gizmos drawn without depth test piled up over the middle. Each is now its primitive's
+    # size plus a margin, with a ball of its colour and its name.
+    from scenes.sdf_gallery import GIZMO_MARGIN_M
+
+    scales = [g.scale for g in scene.gizmos]
+    # Sphere r = 0.45 m, box half size 0.3 m, torus ring 0.6 + 0.12 m, capsule 0.35 + 0.15 m: each plus the margin.
+    reach = np.array([0.45, 0.3, 0.72, 0.5]) + GIZMO_MARGIN_M
+    assert scales == pytest.approx(reach, abs=0.011)
+    for i, (marker, label, slot) in enumerate(
+        zip(scene.gizmo_markers, scene.gizmo_labels, scene.params.primitives, strict=True)
+    ):
+        assert tuple(marker.color) == slot.color
+        assert label.text == f"P{i + 1} {slot.kind}"
+    assert len({tuple(m.color) for m in scene.gizmo_markers}) == 4
+    # The sphere's gizmo follows its radius: 0.45 m → 0.25 m.
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("P1 size a (m)")
+        client.set_value("P1 size a (m)", 0.25)
+        wait_until(
+            lambda: scene.gizmos[0].scale == pytest.approx(0.25 + GIZMO_MARGIN_M, abs=0.011),
+            what="the resized gizmo",
+        )
+        client.set_value("P1 colour", (10, 200, 30))
+        wait_until(
+            lambda: tuple(scene.gizmo_markers[0].color) == (10, 200, 30), what="the marker colour"
+        )
 
 
 @pytest.mark.parametrize(
