@@ -27,7 +27,7 @@ from kernels import ball, course, fabrik
 from scenes import SceneName
 from scenes._gate import install_gate
 from scenes._session import Sessions, limit_malloc_arenas
-from scenes.sdf_gallery import set_editing_allowed
+from scenes.sdf_gallery import COMPILE_LIMIT_S, FRAME_LIMIT_S, MAX_SOURCE_CHARS, set_editing_allowed
 from scenes.switcher import SceneSwitcher
 
 logger = logging.getLogger("app")
@@ -53,7 +53,11 @@ def exposure_warning(host: str, port: int, *, allow_remote_glsl: bool = False) -
         return None
     glsl = (
         "GLSL editing in the SDF gallery is ON (--allow-remote-glsl): anyone can make this machine compile and "
-        "run their shader code (length-, loop- and time-limited)."
+        f"run their shader code. What is enforced: at most {MAX_SOURCE_CHARS} characters, no loops, no # lines, a "
+        "bound on the code once calls are inlined, and a trial compile and frame in a child process killed after "
+        f"{COMPILE_LIMIT_S:.0f} s + {FRAME_LIMIT_S:.0f} s; "
+        "a source that passes is compiled again in the server (briefly blocking it) and its frames are not "
+        "stopped mid-draw."
         if allow_remote_glsl
         else "GLSL editing in the SDF gallery is OFF (its examples still work); --allow-remote-glsl turns it on."
     )

@@ -39,6 +39,7 @@ from shaders.renderer import (
     Shading,
     check_source,
 )
+from shaders.trial import trial
 
 logger = logging.getLogger(__name__)
 
@@ -96,9 +97,11 @@ SIZE_MEANING = (
 )
 RESOLUTION_LABEL = "Mesh resolution (samples per side)"
 """Marching-cubes samples along the longest side of the scene's bounds."""
-GIZMO_SCALE = 0.8
-"""Gizmo arrow length (m): longer than every default primitive's reach from its centre (the torus ring, 0.72 m),
-so the arrow tips poke out of the mesh."""
+GIZMO_MARGIN_M = 0.12
+"""How far a gizmo's arrows reach beyond its primitive's surface (m): each gizmo is sized to its own primitive."""
+GIZMO_MARKER_RADIUS_M = 0.035
+"""Radius of the ball in the primitive's colour at the tip of each gizmo's z arrow (m)."""
+
 ViewMode = Literal["mesh", "raymarch", "both"]
 VIEW_LABELS: dict[str, ViewMode] = {"Mesh": "mesh", "Ray-marched": "raymarch", "Both": "both"}
 ShapeSource = Literal["primitives", "editor"]
@@ -107,11 +110,17 @@ SOURCE_LABELS: dict[str, ShapeSource] = {
     "GLSL editor": "editor",
 }
 VIEW_WIDTH_PX = 640
-"""Width of the ray-marched main view once the camera rests (px); its height follows the viewer's aspect."""
+"""Narrowest ray-marched main view once the camera rests (px); its height follows the viewer's aspect."""
+MAX_VIEW_SIZE_PX = (1600, 1000)
+"""Largest rest frame (px): at rest the main view is drawn at the viewer's canvas width, within this box."""
+REST_FRAME_BUDGET_S = 0.6
+"""A rest frame is made smaller (not below VIEW_WIDTH_PX wide) when the last one's time per pixel says the
+viewer's full size would take longer than this (s)."""
 MOVING_WIDTH_PX = 320
 """Width while the camera or a gizmo moves: a quarter of the pixels, and no shadows or AO, so the view keeps up."""
-COMPILE_LIMIT_S = 10.0
-"""An editor source whose programs take longer to compile is refused (s)."""
+COMPILE_LIMIT_S = 5.0
+"""An editor source whose programs (moving and fully shaded) take longer to compile in the trial process is refused
+(s); the trial process is killed at this limit plus FRAME_LIMIT_S (:mod:`shaders.trial`)."""
 FRAME_LIMIT_S = 1.0
 """An editor source whose test frame (MOVING_WIDTH_PX wide, moving shading) takes longer is refused (s); the fully
 shaded program at rest costs a few times more (its soft shadows and AO call sdf about twenty times a pixel more)."""
@@ -119,6 +128,10 @@ EDITOR_HALF_SIZE_M = 1.5
 """The editor's field is meshed and ray-marched inside the cube [−h, h]³ (m) by default."""
 EXAMPLES = gl_renderer.examples()
 """The editor's examples, by title."""
+EXAMPLE_SOURCES = frozenset(EXAMPLES.values())
+EDITOR_KEEP_CHARS = 2 * MAX_SOURCE_CHARS
+"""Longest text the editor keeps (characters): room to paste a little too much and trim it; beyond, the previous
+text is put back at once."""
 EDITOR_HELP = (
     "Write `float sdf(vec3 p)` (metres, Z up) and optionally `vec3 color(vec3 p)`, using the library's "
     "`sd_*` primitives and `op_*`, `smooth_*` operators, then **Apply**: the shape is meshed and ray-marched "
@@ -274,6 +287,56 @@ def camera_from_viser(camera: Any) -> Camera | None:
         return None
 
 
+def _viewer_size(camera: Any) -> tuple[int, int] | None:
+    """The viewer's canvas (width, height) in px from a viser camera, or None if it sent something unusable (NaN,
+    zero, negative, absurd or not a number)."""
+    try:
+        width, height = float(camera.image_width), float(camera.image_height)
+    except (TypeError, ValueError, AttributeError, OverflowError):
+        return None
+    if not (
+        math.isfinite(width) and math.isfinite(height) and 1 <= width <= 2e4 and 1 <= height <= 2e4
+    ):
+        return None
+    return round(width), round(height)
+
+
+def _rest_size(viewer_width: int, aspect: float, s_per_pixel: float | None) -> tuple[int, int]:
+    """The rest frame's (width, height) in px: the viewer's width (at least VIEW_WIDTH_PX) at ``aspect`` (width /
+    height), made smaller (not below VIEW_WIDTH_PX) if ``s_per_pixel`` says it would take longer than
+    REST_FRAME_BUDGET_S, and always within MAX_VIEW_SIZE_PX."""
+    max_w, max_h = MAX_VIEW_SIZE_PX
+    width = float(min(max(viewer_width, VIEW_WIDTH_PX), max_w))
+    if s_per_pixel is not None and s_per_pixel > 0.0:
+        affordable = REST_FRAME_BUDGET_S / s_per_pixel
+        if width * width / aspect > affordable:
+            width = max(math.sqrt(affordable * aspect), float(VIEW_WIDTH_PX))
+    if width / aspect > max_h:  # a tall canvas: the height is the limit
+        width = max_h * aspect
+    return round(width), max(16, round(width / aspect))
+
+
+def gizmo_reach(slot: PrimitiveParams) -> float:
+    """A gizmo's arrow length for ``slot`` (m): the farthest its primitive's surface lies from its centre along the
+    six local axis directions, plus GIZMO_MARGIN_M, so the arrow tips poke out of the primitive and no further."""
+    try:
+        prim = slot.primitive()
+    except ValueError:
+        return 0.5
+    t = np.linspace(0.0, 3.0, 301)
+    axes = sdf.rotation_matrix(slot.wxyz).T  # rows: the local axes in the world frame
+    reach = 0.0
+    for axis in (*axes, *(-axes)):
+        inside = prim.distance(np.asarray(slot.position) + t[:, None] * axis) <= 0.0
+        if inside.any():
+            reach = max(reach, float(t[np.nonzero(inside)[0].max()]))
+    return round(max(reach + GIZMO_MARGIN_M, 0.2), 3)
+
+
+def _gizmo_label(index: int, slot: PrimitiveParams) -> str:
+    return f"P{index + 1} {slot.kind}"
+
+
 class SdfGalleryScene(Scene):
     key = "sdf"
     title = "SDF gallery (ray marching)"
@@ -338,6 +401,11 @@ IoU is lowest when a box edge is on the silhouette.
         self._wanted_resolution = self.params.resolution
         self._camera: Camera | None = None
         self._aspect = 4 / 3
+        self._viewer_width = VIEW_WIDTH_PX
+        """The viewer's canvas width (px), from its camera messages; the rest frame is drawn at it, within limits."""
+        self._rest_s_per_pixel: float | None = None
+        """Seconds a pixel of the last rest frame took: the next one is sized to REST_FRAME_BUDGET_S."""
+        self._moving_s_per_pixel: float | None = None
         self._camera_time = 0.0
         self._scene_time = 0.0
         self._reference_due = True
@@ -497,6 +565,8 @@ IoU is lowest when a box edge is on the silhouette.
         for handle in (self.view_mode, self.shape_source):
             handle.on_update(self.callback(self._on_view_input))
         self.example.on_update(self.callback(self._on_example))
+        self._editor_text = p.editor.source
+        self.editor.on_update(self.callback(self._on_editor_text))
         self.apply.on_click(self.callback(self._on_apply))
 
     def _build_world(self) -> None:
@@ -517,12 +587,17 @@ IoU is lowest when a box edge is on the silhouette.
             visible=False,
         )
         self.gizmos = []
+        self.gizmo_markers = []
+        self.gizmo_labels = []
         for i, slot in enumerate(self.params.primitives):
+            reach = gizmo_reach(slot)
             gizmo = scene.add_transform_controls(
                 f"{self.root.name}/gizmo_{i + 1}",
-                scale=GIZMO_SCALE,
-                line_width=3.0,
-                # Drawn over the mesh: a gizmo sits at its primitive's centre, inside the surface.
+                scale=reach,
+                line_width=2.0,
+                disable_sliders=True,  # the plane handles of four gizmos cluttered the middle; arrows and rings stay
+                # Drawn over the mesh: a gizmo sits at its primitive's centre, inside the surface. Each is sized to
+                # its own primitive (its arrows just poke out of it), so the four do not pile up in the middle.
                 depth_test=False,
                 position=slot.position,
                 wxyz=slot.wxyz,
@@ -530,7 +605,26 @@ IoU is lowest when a box edge is on the silhouette.
             )
             gizmo.on_update(self.callback(self._on_scene_input))
             self.gizmos.append(gizmo)
-            scene.add_label(f"{gizmo.name}/label", f"P{i + 1}", position=(0.0, 0.0, GIZMO_SCALE))
+            # A ball in the primitive's colour at the tip of its local z arrow, and its name: which gizmo moves
+            # which primitive, at a glance.
+            self.gizmo_markers.append(
+                scene.add_icosphere(
+                    f"{gizmo.name}/marker",
+                    radius=GIZMO_MARKER_RADIUS_M,
+                    color=slot.color,
+                    subdivisions=2,
+                    position=(0.0, 0.0, reach),
+                    cast_shadow=False,
+                    receive_shadow=False,
+                )
+            )
+            self.gizmo_labels.append(
+                scene.add_label(
+                    f"{gizmo.name}/label",
+                    _gizmo_label(i, slot),
+                    position=(0.0, 0.0, reach + 2.5 * GIZMO_MARKER_RADIUS_M),
+                )
+            )
 
     def _watch_cameras(self) -> None:
         self.watch_cameras(self._on_camera)
@@ -664,6 +758,24 @@ IoU is lowest when a box edge is on the silhouette.
         self._write_back(self.editor, EXAMPLES[title])
         self._request_source(EXAMPLES[title])
 
+    def _on_editor_text(self) -> None:
+        """Keep the editor's text only if it is text of at most EDITOR_KEEP_CHARS characters (and editing is on);
+        else put the last kept text back, so a huge or crafted value is not kept for every viewer and late joiner
+        (viser relays an update to the other viewers before this runs; the write-back replaces it)."""
+        text = self.editor.value
+        if editing_allowed() and isinstance(text, str) and len(text) <= EDITOR_KEEP_CHARS:
+            self._editor_text = text
+            return
+        self._write_back(self.editor, self._editor_text)
+        if editing_allowed():
+            length = len(text) if isinstance(text, (str, bytes, list)) else None
+            self._show_editor_error(
+                f"That text was {length} characters long; the editor keeps at most {EDITOR_KEEP_CHARS} "
+                f"(and Apply takes at most {MAX_SOURCE_CHARS}), so the previous text is back."
+                if length is not None
+                else "The editor takes only text; the previous text is back."
+            )
+
     def _on_apply(self) -> None:
         if not editing_allowed():
             # Only the server's own examples compile: the browser's text is not read.
@@ -672,9 +784,13 @@ IoU is lowest when a box edge is on the silhouette.
             self._request_source(EXAMPLES[title])
             return
         text = self.editor.value
-        if not isinstance(text, str) or len(text) > MAX_SOURCE_CHARS:
+        if not isinstance(text, str):
+            self._show_editor_error("The source must be text.")
+            return
+        if len(text) > MAX_SOURCE_CHARS:
             self._show_editor_error(
-                f"The source must be text; the limit is {MAX_SOURCE_CHARS} characters."
+                f"The source is {len(text)} characters long; the limit is {MAX_SOURCE_CHARS} characters. "
+                f"Shorten it by {len(text) - MAX_SOURCE_CHARS} and apply again."
             )
             return
         self._request_source(text)
@@ -722,9 +838,13 @@ IoU is lowest when a box edge is on the silhouette.
         cam = camera_from_viser(camera)
         if cam is None:
             return
+        size = _viewer_size(camera)
+        if size is not None:
+            with self._work:
+                self._viewer_width = size[0]
         try:
-            aspect = float(camera.aspect)
-        except (TypeError, ValueError, AttributeError, ZeroDivisionError):
+            aspect = size[0] / size[1] if size is not None else float(camera.aspect)
+        except (TypeError, ValueError, AttributeError, ZeroDivisionError, OverflowError):
             aspect = 4 / 3
         self._on_camera_values(cam, aspect)
 
@@ -747,6 +867,29 @@ IoU is lowest when a box edge is on the silhouette.
             gizmo.visible = slot.enabled and self.params.shape_source == "primitives"
             for j, axis in enumerate("abc"):
                 handles[f"size_{axis}"].disabled = j >= used[slot.kind] or not slot.enabled
+        self._sync_gizmo_looks()
+
+    def _sync_gizmo_looks(self) -> None:
+        """Each gizmo's size, marker colour and label follow its primitive's kind, size and colour."""
+        for i, (gizmo, marker, label, slot) in enumerate(
+            zip(
+                self.gizmos,
+                self.gizmo_markers,
+                self.gizmo_labels,
+                self.params.primitives,
+                strict=True,
+            )
+        ):
+            reach = gizmo_reach(slot)
+            if abs(gizmo.scale - reach) > 1e-6:
+                gizmo.scale = reach
+                marker.position = (0.0, 0.0, reach)
+                label.position = (0.0, 0.0, reach + 2.5 * GIZMO_MARKER_RADIUS_M)
+            if tuple(int(c) for c in marker.color) != slot.color:
+                marker.color = slot.color
+            text = _gizmo_label(i, slot)
+            if label.text != text:
+                label.text = text
 
     def _request_mesh(self) -> None:
         params = self.params
@@ -785,6 +928,8 @@ IoU is lowest when a box edge is on the silhouette.
                     self._render_reference()
             except GLUnavailableError as exc:
                 self._no_gl(exc)
+            except ShaderCompileError as exc:  # a remesh of the editor's field found no surface
+                self._show_editor_error(str(exc))
             except Exception:
                 # One failed mesh or render must not stop every later one: log it and wait for new input.
                 logger.exception("sdf: meshing or rendering failed; keeping the last good picture")
@@ -815,34 +960,26 @@ IoU is lowest when a box edge is on the silhouette.
         start = time.perf_counter()
         try:
             check_source(text)
-            # The moving frames' program (no shadows, no AO) first: the new shape appears with it, and the fully
-            # shaded program compiles when the view next rests.
+            # Compile and draw it once in a child process first, killed at the limits: a compiler can take
+            # minutes on a short source, and moderngl holds the GIL while it compiles, which would freeze every
+            # viewer. Only a source that passes is compiled here, the moving frames' program (no shadows, no AO)
+            # first: the new shape appears with it, and the fully shaded one compiles when the view next rests.
             moving_shading = _moving_shading(self.params.shading)
-            gl_service.run(lambda gl: gl.compile_field(text, moving_shading))
-            compile_s = time.perf_counter() - start
-            if compile_s > COMPILE_LIMIT_S:
-                raise ShaderCompileError(
-                    f"compiling took {compile_s:.1f} s; the limit is {COMPILE_LIMIT_S:.0f} s", None
-                )
             camera = self._camera or Camera(self.camera_position, self.camera_look_at)
-            frame_start = time.perf_counter()
-            gl_service.run(
-                lambda gl: gl.render_field(
+            if (
+                text not in EXAMPLE_SOURCES
+            ):  # the server's own examples are known to compile quickly
+                trial(
                     text,
-                    field.bounds,
+                    [moving_shading, self.params.shading],
                     camera,
+                    field.bounds,
                     MOVING_WIDTH_PX,
                     MOVING_WIDTH_PX * 5 // 8,
-                    moving_shading,
+                    COMPILE_LIMIT_S,
+                    FRAME_LIMIT_S,
                 )
-            )
-            frame_s = time.perf_counter() - frame_start
-            if frame_s > FRAME_LIMIT_S:
-                raise ShaderCompileError(
-                    f"one {MOVING_WIDTH_PX}-pixel-wide frame took {1e3 * frame_s:.0f} ms; the limit is "
-                    f"{1e3 * FRAME_LIMIT_S:.0f} ms",
-                    None,
-                )
+            gl_service.run(lambda gl: gl.compile_field(text, moving_shading))
             self._mesh_and_show(field, resolution)
         except ShaderCompileError as exc:
             self._show_editor_error(str(exc))
@@ -884,6 +1021,15 @@ IoU is lowest when a box edge is on the silhouette.
     def _mesh_field_and_show(self, field: EditorField, resolution: int) -> None:
         start = time.perf_counter()
         tri = gl_renderer.mesh_glsl(field.source, resolution, field.bounds)
+        if len(tri.faces) == 0:
+            centre = gl_service.run(lambda gl: gl.probe_field(field.source, [[0.0, 0.0, 0.0]]))[0]
+            side = "outside (sdf > 0)" if float(centre[0]) > 0.0 else "inside (sdf ≤ 0)"
+            h = field.half_size
+            raise ShaderCompileError(
+                f"no surface lies inside the bounds: every sample of the ±{h:g} m box is {side}, so there "
+                "is nothing to mesh (change sdf() or the editor's bounds)",
+                None,
+            )
         vertices = np.asarray(tri.vertices, dtype=np.float64)
         faces = np.asarray(tri.faces, dtype=np.int64)
         rgba = getattr(tri.visual, "vertex_colors", np.zeros((len(vertices), 4)))
@@ -978,22 +1124,30 @@ IoU is lowest when a box edge is on the silhouette.
             if params.view_mode == "mesh" or self._camera is None:
                 return
             moving = time.monotonic() - max(self._camera_time, self._scene_time) < CAMERA_REST_S
-            camera, aspect = self._camera, self._aspect
+            camera, aspect, viewer_width = self._camera, self._aspect, self._viewer_width
         shape = params.shape()
         if isinstance(shape, sdf.Scene) and self.mesh_shape is not None:
             try:
                 shape = self.params.scene()
             except ValueError:
                 return
-        key = (shape, camera, aspect, moving, params.shading, params.view_mode)
+        key = (shape, camera, aspect, viewer_width, moving, params.shading, params.view_mode)
         if key == self._view_key:
             return
-        width = MOVING_WIDTH_PX if moving else VIEW_WIDTH_PX
-        height = max(16, round(width / aspect))
+        if moving:
+            width, height = MOVING_WIDTH_PX, max(16, round(MOVING_WIDTH_PX / aspect))
+        else:
+            # Before the first rest frame, guess from the moving ones (the shadows and AO cost a few times more).
+            guess = None if self._moving_s_per_pixel is None else 4.0 * self._moving_s_per_pixel
+            width, height = _rest_size(viewer_width, aspect, self._rest_s_per_pixel or guess)
         shading = _moving_shading(params.shading) if moving else params.shading
         start = time.perf_counter()
         rgb, depth = gl_service.run(lambda gl: _march(gl, shape, camera, width, height, shading))
         view_ms = 1e3 * (time.perf_counter() - start)
+        if moving:
+            self._moving_s_per_pixel = view_ms / 1e3 / (width * height)
+        else:
+            self._rest_s_per_pixel = view_ms / 1e3 / (width * height)
         # viser encodes depth in fixed point up to 167 m: a miss goes to the far end.
         depth = np.where(np.isfinite(depth), depth, 1e3).astype(np.float32)
         with self._lock:

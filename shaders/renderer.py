@@ -308,6 +308,46 @@ _FORBIDDEN = {
 }
 
 
+MAX_INLINED_TOKENS = 20000
+"""Largest ``sdf`` + ``color`` accepted once every call is inlined (tokens, the library's functions counted too).
+GLSL compilers inline every call, so a chain of functions each calling the one before twice doubles the code at
+each link: ten links of 679 characters took Mesa 76 s to compile. The examples count at most about 1600."""
+_DEFINITION = re.compile(r"\b([A-Za-z_]\w*)\s+([A-Za-z_]\w*)\s*\(([^()]*)\)\s*\{")
+_TOKEN = re.compile(r"\w+|[^\w\s]")
+_NOT_NAMES = frozenset({"if", "else", "return", "for", "while", "do", "switch"})
+
+
+def inlined_sizes(code: str, known: dict[str, int] | None = None) -> dict[str, int]:
+    """Tokens of each function defined in ``code`` (comments already removed) with every call to a function
+    defined before it (or in ``known``) replaced by that function's own inlined size, by name.
+
+    A call to a function not yet defined counts nothing (GLSL needs a declaration first and forbids recursion, so
+    the compiler refuses such a source anyway)."""
+    sizes = dict(known or {})
+    for match in _DEFINITION.finditer(code):
+        name = match.group(2)
+        if match.group(1) in _NOT_NAMES or name in _NOT_NAMES:
+            continue
+        depth, end = 1, match.end()
+        while end < len(code) and depth:
+            depth += {"{": 1, "}": -1}.get(code[end], 0)
+            end += 1
+        tokens = _TOKEN.findall(code[match.end() : end])
+        size = len(tokens)
+        for i, token in enumerate(tokens[:-1]):
+            if token != name and tokens[i + 1] == "(" and token in sizes:
+                size += sizes[token]
+        sizes[name] = size
+    return sizes
+
+
+_library_sizes: dict[str, int] = {}
+
+
+def _without_comments(source: str) -> str:
+    return "\n".join(line.split("//", 1)[0] for line in source.split("\n"))
+
+
 class ShaderCompileError(ValueError):
     """An editor source the checks or the GLSL compiler reject; ``line`` is 1-based in that source (or None)."""
 
@@ -335,10 +375,12 @@ class ShaderCompileError(ValueError):
 def check_source(source: object) -> str:
     """The editor source if the app will compile it, else :class:`ShaderCompileError` saying why and where.
 
-    Untrusted text: at most :data:`MAX_SOURCE_CHARS` printable ASCII characters (tabs and newlines too); no
+    Untrusted text: at most :data:`MAX_SOURCE_CHARS` printable ASCII characters (tabs and newlines too; no
+    backslash, which would join lines, and no carriage return, which Mesa takes as a line end); no ``#``, so no
     preprocessor lines (no ``#include``, ``#extension``, macros); no loops (``for``, ``while``, ``do``): without
     them, and without recursion (which GLSL forbids), every call of ``sdf`` ends, and its cost grows with the
-    source's length; no ``uniform`` declarations, ``discard`` or ``main``. It must define
+    source's length, which :data:`MAX_INLINED_TOKENS` bounds once calls are inlined; no ``uniform`` declarations,
+    ``discard`` or ``main``. It must define
     ``float sdf(vec3 p)``; ``vec3 color(vec3 p)`` is optional.
     """
     if not isinstance(source, str):
@@ -347,15 +389,28 @@ def check_source(source: object) -> str:
         raise ShaderCompileError(
             f"the source is {len(source)} characters; the limit is {MAX_SOURCE_CHARS}", None
         )
+    # Check the text the compiler will see. A backslash before a newline splices two lines into one (so
+    # "fo\<newline>r" is the word for) and Mesa ends a // comment at a lone carriage return (so a loop after one is
+    # code): neither has a use in sdf() text, so both are refused outright, and every line below is a line the
+    # compiler reads as one.
     for number, line in enumerate(source.split("\n"), start=1):
-        bad = next((c for c in line if not (" " <= c <= "~" or c in "\t\r")), None)
+        bad = next((c for c in line if not (" " <= c <= "~" or c == "\t")), None)
+        if bad == "\r":
+            raise ShaderCompileError(
+                "carriage returns are not allowed (end lines with a plain newline)", number
+            )
         if bad is not None:
             raise ShaderCompileError(
                 f"character {bad!r} is not allowed (printable ASCII only)", number
             )
-        if line.lstrip().startswith("#"):
-            raise ShaderCompileError("preprocessor lines (#…) are not allowed", number)
+        if "\\" in line:
+            raise ShaderCompileError(
+                "backslashes are not allowed (a backslash at a line's end joins it to the next)",
+                number,
+            )
         code = line.split("//", 1)[0]
+        if "#" in code:
+            raise ShaderCompileError("preprocessor lines (#…) are not allowed", number)
         for word in re.findall(r"[A-Za-z_]\w*", code):
             if word in _FORBIDDEN:
                 raise ShaderCompileError(_FORBIDDEN[word], number)
@@ -365,6 +420,16 @@ def check_source(source: object) -> str:
         raise ShaderCompileError("block comments (/* */) are not allowed; use //", None)
     if not re.search(r"\bfloat\s+sdf\s*\(\s*vec3\s+\w+\s*\)", source):
         raise ShaderCompileError("define float sdf(vec3 p), the signed distance (m)", None)
+    if not _library_sizes:
+        _library_sizes.update(inlined_sizes(_without_comments(_source("sdf.glsl"))))
+    sizes = inlined_sizes(_without_comments(source), _library_sizes)
+    inlined = sizes.get("sdf", 0) + sizes.get("color", 0)
+    if inlined > MAX_INLINED_TOKENS:
+        raise ShaderCompileError(
+            f"sdf() and color() come to about {inlined} tokens once every call is inlined (a function that "
+            f"calls another several times multiplies its size); the limit is {MAX_INLINED_TOKENS}",
+            None,
+        )
     return source
 
 
@@ -432,7 +497,8 @@ def create_context() -> object:
 class Renderer:
     """Compiled programs on one EGL context; use it on the thread that created it."""
 
-    def __init__(self) -> None:
+    def __init__(self, builtin: bool = True) -> None:
+        """``builtin=False`` skips compiling the app's own programs (for a trial of an editor source alone)."""
         import moderngl
 
         ctx = create_context()
@@ -452,6 +518,11 @@ class Renderer:
             collections.OrderedDict()
         )
         """Compiled editor programs by (source, variant), least recently used first."""
+        self.renderer_name = str(self.ctx.info.get("GL_RENDERER", "unknown"))
+        self._target_size: tuple[int, int] | None = None
+        self._target_objects: list = []
+        if not builtin:
+            return
         for shadows, occlusion in ((True, True), (False, False)):  # the gallery's opening variants
             self._raymarch_program((shadows, occlusion, True, False))
         self._probe = self.ctx.program(
@@ -462,9 +533,6 @@ class Renderer:
             vertex_shader=_source("mesh.vert"), fragment_shader=_source("mesh.frag")
         )
         self._probe_vao = self.ctx.vertex_array(self._probe, [])
-        self.renderer_name = str(self.ctx.info.get("GL_RENDERER", "unknown"))
-        self._target_size: tuple[int, int] | None = None
-        self._target_objects: list = []
 
     def release(self) -> None:
         self.ctx.release()
@@ -983,7 +1051,17 @@ def mesh_glsl(source: str, resolution: int, bounds: ArrayLike) -> trimesh.Trimes
         field = gl.sample_field(source, grid)
         if not np.all(np.isfinite(field)):
             raise ShaderCompileError("sdf() returned NaN or infinity inside the bounds", None)
-        vertices, faces = sdf.mesh_samples(grid, field, _near_surface_mask(field, grid.spacing))
+        # Marching cubes places vertices from the corners' values by linear interpolation, so a positive scale of
+        # the field changes nothing but the kernel's level nudge (a thousandth of a voxel, in metres): a field far
+        # from a distance (|∇d| not near 1, e.g. 100·sdf or 0.001·sdf) is scaled to one first, so K·sdf meshes as
+        # sdf does.
+        lipschitz = _lipschitz_estimate(field, grid.spacing)
+        if math.isfinite(lipschitz) and (lipschitz > 1.5 or 0.0 < lipschitz < 0.5):
+            field = (field / np.float32(lipschitz)).astype(np.float32)
+        try:
+            vertices, faces = sdf.mesh_samples(grid, field, _near_surface_mask(field, grid.spacing))
+        except RuntimeError:  # scikit-image's "No surface found at the given iso value"
+            vertices, faces = np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64)
         colors = gl.probe_field(source, vertices)[1] if len(vertices) else np.zeros((0, 3))
         return sdf.mesh_trimesh(vertices, faces, np.clip(colors.astype(np.float64), 0.0, 1.0))
 
@@ -991,9 +1069,45 @@ def mesh_glsl(source: str, resolution: int, bounds: ArrayLike) -> trimesh.Trimes
 
 
 def _near_surface_mask(field: NDArray[np.float32], spacing: float) -> NDArray[np.bool_]:
-    """Cells whose corners may straddle the surface (|d| within a cell diagonal at a corner): marching cubes skips
-    the rest, which it would find empty anyway for a distance bound."""
-    return np.abs(field) <= np.float32(math.sqrt(3.0) * spacing)
+    """(nx, ny, nz) samples marking the cells marching cubes must visit: every cell whose eight corners change
+    sign (or come within the kernel's level nudge of zero, which may move them across).
+
+    Only the corners' signs are used, never how far they are from zero: a typed ``sdf`` need not be a distance
+    bound (``3.0 * (length(p) - 1.0)`` grows three times as fast), and a threshold on |d| that assumed |∇d| ≤ 1
+    skipped cells the surface crosses, leaving holes. scikit-image 0.2x reads a cell's flag at its upper corner
+    (measured: flags at the lower corner lost half the faces); both corners are marked, so the mask does not hang
+    on that detail.
+    """
+    eps = np.float32(sdf.ISO_NUDGE_VOXELS * spacing)
+    lo = field
+    hi = field
+    for axis in range(3):
+        head = [slice(None)] * 3
+        tail = [slice(None)] * 3
+        head[axis] = slice(None, -1)
+        tail[axis] = slice(1, None)
+        lo = np.minimum(lo[tuple(head)], lo[tuple(tail)])
+        hi = np.maximum(hi[tuple(head)], hi[tuple(tail)])
+    crossing = (lo < eps) & (hi > -eps)  # (nx-1, ny-1, nz-1) cells
+    mask = np.zeros(field.shape, dtype=np.bool_)
+    mask[:-1, :-1, :-1] = crossing
+    mask[1:, 1:, 1:] |= crossing
+    return mask
+
+
+def _lipschitz_estimate(field: NDArray[np.float32], spacing: float) -> float:
+    """The largest gradient norm of ``field`` by forward differences over its grid (field units per m), in slabs of
+    float64 (no overflow for huge fields, a bounded extra memory)."""
+    nx = field.shape[0]
+    largest = 0.0
+    for x0 in range(0, nx - 1, 32):
+        x1 = min(nx, x0 + 33)
+        slab = field[x0:x1].astype(np.float64)
+        dx = np.diff(slab, axis=0)[:, :-1, :-1]
+        dy = np.diff(slab, axis=1)[:-1, :, :-1]
+        dz = np.diff(slab, axis=2)[:-1, :-1, :]
+        largest = max(largest, float(np.sqrt(dx * dx + dy * dy + dz * dz).max(initial=0.0)))
+    return largest / spacing
 
 
 def examples() -> dict[str, str]:

@@ -13,6 +13,8 @@ import pytest
 import trimesh
 import viser
 from conftest import skip_or_fail
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 from trimesh.visual.color import ColorVisuals
 from viser_private import gui_uuid, gui_uuids, node_names
 from wsclient import BrowserClient
@@ -377,12 +379,6 @@ def test_without_gl_the_panel_says_why_and_meshing_goes_on(
         scene.close()
 
 
-def scene_gizmo_scale() -> float:
-    from scenes.sdf_gallery import GIZMO_SCALE
-
-    return GIZMO_SCALE
-
-
 # ------------------------------------------------------------------------------------------ teardown
 def test_close_removes_everything_and_stops_the_worker(server: viser.ViserServer) -> None:
     nodes_before, gui_before = node_names(server), gui_uuids(server)
@@ -461,8 +457,39 @@ def test_gizmos_draw_over_the_mesh_and_reach_out_of_it(scene: SdfGalleryScene) -
         assert gizmo.depth_test is False
         prim = slot.primitive()
         # The arrow tips lie outside the primitive (positive distance): something to grab from outside.
-        tips = np.asarray(slot.position) + scene_gizmo_scale() * sdf.rotation_matrix(slot.wxyz).T
+        tips = np.asarray(slot.position) + gizmo.scale * sdf.rotation_matrix(slot.wxyz).T
         assert np.all(prim.distance(tips) > 0.0), slot.kind
+
+
+def test_each_gizmo_is_sized_coloured_and_named_for_its_own_primitive(
+    server: viser.ViserServer, scene: SdfGalleryScene
+) -> None:
+    # Issue 12: four 0.8 m gizmos drawn without depth test piled up over the middle. Each is now its primitive's
+    # size plus a margin, with a ball of its colour and its name.
+    from scenes.sdf_gallery import GIZMO_MARGIN_M
+
+    scales = [g.scale for g in scene.gizmos]
+    # Sphere r = 0.45 m, box half size 0.3 m, torus ring 0.6 + 0.12 m, capsule 0.35 + 0.15 m: each plus the margin.
+    reach = np.array([0.45, 0.3, 0.72, 0.5]) + GIZMO_MARGIN_M
+    assert scales == pytest.approx(reach, abs=0.011)
+    for i, (marker, label, slot) in enumerate(
+        zip(scene.gizmo_markers, scene.gizmo_labels, scene.params.primitives, strict=True)
+    ):
+        assert tuple(marker.color) == slot.color
+        assert label.text == f"P{i + 1} {slot.kind}"
+    assert len({tuple(m.color) for m in scene.gizmo_markers}) == 4
+    # The sphere's gizmo follows its radius: 0.45 m → 0.25 m.
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("P1 size a (m)")
+        client.set_value("P1 size a (m)", 0.25)
+        wait_until(
+            lambda: scene.gizmos[0].scale == pytest.approx(0.25 + GIZMO_MARGIN_M, abs=0.011),
+            what="the resized gizmo",
+        )
+        client.set_value("P1 colour", (10, 200, 30))
+        wait_until(
+            lambda: tuple(scene.gizmo_markers[0].color) == (10, 200, 30), what="the marker colour"
+        )
 
 
 @pytest.mark.parametrize(
@@ -578,9 +605,12 @@ def test_raymarched_view_goes_to_the_background_with_depth(
         client.set_value("View", "Ray-marched")
         wait_until(lambda: scene.view_serial > 0, what="a main-view frame")
         assert scene.mesh_node.visible is False and scene.wireframe_node.visible is False
-        client.wait_for(lambda: len(background_images(client)) > 0, what="a background image")
-        message = background_images(client)[-1]
-        assert message["rgb_data"] and message["depth_data"]
+        # Wait for the frame itself: under load the last background message seen may still be an earlier one
+        # (the clearing of the mesh view's background), not yet the ray-marched frame with its depth.
+        client.wait_for(
+            lambda: any(m["rgb_data"] and m["depth_data"] for m in background_images(client)),
+            what="a background image with depth",
+        )
         # At rest the frame is the full width, with the viewer's aspect.
         wait_until(
             lambda: scene.view_rgb is not None and scene.view_rgb.shape[1] == 640,
@@ -662,3 +692,208 @@ def test_compile_and_frame_time_limits_refuse_a_slow_source(
         wait_until(lambda: scene.editor_error is not None, what="a refusal")
         assert words in str(scene.editor_error) and "limit" in str(scene.editor_error)
         assert scene.editor_serial == 0 and scene.params.shape_source == "primitives"
+
+
+def chain_source(links: int) -> str:
+    """The reviewer's loop-free chain (issue 12): each function calls the one before twice, so the inlined code
+    doubles at each link (ten links: 679 characters, 76 s for Mesa to compile)."""
+    lines = ["float f0(vec3 p){ return length(p)-1.0; }"]
+    for i in range(1, links + 1):
+        lines.append(f"float f{i}(vec3 p){{ return min(f{i - 1}(p*1.01), f{i - 1}(p.yzx+0.01)); }}")
+    lines.append(f"float sdf(vec3 p){{ return f{links}(p); }}")
+    return "\n".join(lines) + "\n"
+
+
+@pytest.mark.gl
+def test_a_slow_compile_is_stopped_at_the_limit_while_the_server_keeps_serving(
+    server: viser.ViserServer, scene: SdfGalleryScene, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import scenes.sdf_gallery as gallery
+
+    need_gl()
+    # Nine links pass the size bound but take Mesa several seconds: the trial process is killed at the limit.
+    monkeypatch.setattr(gallery, "COMPILE_LIMIT_S", 1.0)
+    monkeypatch.setattr(gallery, "FRAME_LIMIT_S", 0.5)
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("sdf(p) in GLSL")
+        client.set_value("sdf(p) in GLSL", chain_source(9))
+        start = time.monotonic()
+        client.click("Apply")
+        time.sleep(0.3)
+        # Meanwhile another callback answers at once: the compile is not in this process.
+        client.set_value("View", "Both")
+        wait_until(lambda: scene.wireframe_node.visible, timeout=2.0, what="the view switch")
+        assert scene.editor_error is None
+        wait_until(lambda: scene.editor_error is not None, timeout=30.0, what="the refusal")
+        refused_s = time.monotonic() - start
+        assert "stopped" in str(scene.editor_error) and "limit" in str(scene.editor_error)
+        assert (
+            refused_s < 20.0
+        )  # the limits plus the child's start (about 2 s here), not the 8 s compile
+        assert scene.editor_serial == 0 and scene.params.shape_source == "primitives"
+        # Ten links are refused before anything compiles, with the size and the limit.
+        scene.editor_error = None
+        client.set_value("sdf(p) in GLSL", chain_source(10))
+        start = time.monotonic()
+        client.click("Apply")
+        wait_until(lambda: scene.editor_error is not None, timeout=5.0, what="the size refusal")
+        assert "inlined" in str(scene.editor_error) and "20000" in str(scene.editor_error)
+
+
+@pytest.mark.parametrize("extra", [1, 3 * 2**20])
+def test_an_over_long_editor_text_is_put_back_for_every_viewer(
+    server: viser.ViserServer, scene: SdfGalleryScene, extra: int
+) -> None:
+    from scenes.sdf_gallery import EDITOR_KEEP_CHARS
+
+    label = "sdf(p) in GLSL"
+    with BrowserClient(server.get_port()) as crafted, BrowserClient(server.get_port()) as other:
+        crafted.wait_for_gui(label)
+        other.wait_for_gui(label)
+        before = scene.editor.value
+        crafted.set_value(label, SPHERE_SOURCE)  # a text within the limit is kept
+        wait_until(lambda: scene.editor.value == SPHERE_SOURCE, what="the kept text")
+        crafted.set_value(label, "x" * (EDITOR_KEEP_CHARS + extra))
+        wait_until(lambda: scene.editor_error is not None, what="the refusal")
+        assert f"{EDITOR_KEEP_CHARS + extra} characters" in str(scene.editor_error)
+        assert scene.editor.value == SPHERE_SOURCE != before
+        other.wait_for(lambda: other.value_of(label) == SPHERE_SOURCE, what="the text put back")
+        crafted.wait_for(lambda: crafted.value_of(label) == SPHERE_SOURCE, what="the text put back")
+    with BrowserClient(server.get_port()) as late:
+        late.wait_for_gui(label)
+        late.wait_for(lambda: late.value_of(label) == SPHERE_SOURCE, what="the kept text")
+        assert all(
+            len(str(m.get("updates", {}).get("value", ""))) < 10**5 for _, m in late.received
+        )
+
+
+def test_apply_of_a_text_over_the_source_limit_says_its_length_and_the_limit(
+    server: viser.ViserServer, scene: SdfGalleryScene
+) -> None:
+    from scenes.sdf_gallery import MAX_SOURCE_CHARS
+
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Apply")
+        text = SPHERE_SOURCE + " " * (MAX_SOURCE_CHARS + 1 - len(SPHERE_SOURCE))
+        client.set_value("sdf(p) in GLSL", text)
+        wait_until(lambda: scene.editor.value == text, what="the kept text")
+        client.click("Apply")
+        wait_until(lambda: scene.editor_error is not None, what="the refusal")
+        assert "8001 characters long; the limit is 8000 characters" in str(scene.editor_error)
+        assert "8001 characters long" in scene.editor_status.content
+        assert scene.editor_serial == 0
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize(
+    ("body", "side"),
+    [("return 1.0;", "outside"), ("return -2.0;", "inside"), ("return 1e30;", "outside")],
+)
+def test_a_field_without_a_surface_in_the_bounds_is_not_applied(
+    server: viser.ViserServer, scene: SdfGalleryScene, body: str, side: str
+) -> None:
+    need_gl()
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Apply")
+        client.set_value("sdf(p) in GLSL", f"float sdf(vec3 p) {{ {body} }}\n")
+        client.click("Apply")
+        wait_until(lambda: scene.editor_error is not None, timeout=30.0, what="the refusal")
+        assert "no surface lies inside the bounds" in str(scene.editor_error)
+        assert side in str(scene.editor_error) and "±1.5 m" in str(scene.editor_error)
+        assert (
+            "0 triangles" not in scene.editor_status.content
+            and "Applied" not in scene.editor_status.content
+        )
+        assert (
+            scene.editor_serial == 0 and len(scene.mesh_faces) > 500
+        )  # the primitives' mesh stays
+
+
+_ODD = st.one_of(
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.integers(-(2**70), 2**70),
+    st.just(None),
+    st.text(max_size=3),
+    st.lists(st.floats(), max_size=4),
+)
+
+
+@given(
+    st.fixed_dictionaries(
+        {
+            "position": st.one_of(_ODD, st.tuples(*[st.floats()] * 3)),
+            "look_at": st.one_of(_ODD, st.tuples(*[st.floats()] * 3)),
+            "up_direction": st.one_of(_ODD, st.just((0.0, 0.0, 1.0))),
+            "fov": _ODD,
+            "image_width": _ODD,
+            "image_height": _ODD,
+        }
+    )
+)
+@settings(max_examples=200, suppress_health_check=[HealthCheck.function_scoped_fixture])
+def test_any_camera_message_fields_keep_the_view_sane(
+    scene: SdfGalleryScene, fields: dict[str, object]
+) -> None:
+    # Every field of a ViewerCameraMessage the scene reads, crafted: its handler never raises, and what it keeps
+    # is finite (a camera, an aspect in range and a rest frame of a sane size).
+    class Cam:
+        def __init__(self) -> None:
+            self.__dict__.update(fields)
+
+        @property
+        def aspect(self) -> float:
+            return self.image_width / self.image_height  # type: ignore[operator]
+
+    scene._on_camera(Cam())
+    assert 0.5 <= scene._aspect <= 2.5
+    assert 1 <= scene._viewer_width <= 2e4
+    width, height = gallery_rest_size(scene._viewer_width, scene._aspect, None)
+    assert width <= 1600 and 16 <= height <= 1000 and (width >= 640 or height == 1000)
+
+
+def test_the_reviewers_nan_height_camera_is_ignored(scene: SdfGalleryScene) -> None:
+    from types import SimpleNamespace
+
+    before = (scene._camera, scene._aspect, scene._viewer_width)
+    nan = float("nan")
+    scene._on_camera(
+        SimpleNamespace(
+            position=nan,
+            look_at=(0.0, 0.0, 0.0),
+            up_direction=(0.0, 0.0, 1.0),
+            fov=1.0,
+            image_width=1600,
+            image_height=nan,
+            aspect=nan,
+        )
+    )
+    assert (scene._camera, scene._aspect, scene._viewer_width) == before
+
+
+def gallery_rest_size(width: int, aspect: float, s_per_pixel: float | None) -> tuple[int, int]:
+    from scenes.sdf_gallery import _rest_size
+
+    return _rest_size(width, aspect, s_per_pixel)
+
+
+@pytest.mark.parametrize(
+    ("viewer", "aspect", "s_per_pixel", "size"),
+    [
+        (
+            1600,
+            1.6,
+            None,
+            (1600, 1000),
+        ),  # the reviewer's canvas: drawn at its size, not 640 stretched
+        (2400, 1.6, None, (1600, 1000)),  # capped
+        (1600, 2.5, None, (1600, 640)),
+        (1000, 0.5, None, (500, 1000)),  # a tall canvas: the height is the limit
+        (300, 1.6, None, (640, 400)),  # never below the old rest width
+        (1600, 1.6, 0.6 / (800 * 500), (800, 500)),  # the budget allows a quarter of the pixels
+        (1600, 1.6, 1.0, (640, 400)),  # a very slow field: the old rest size
+    ],
+)
+def test_rest_frame_size(
+    viewer: int, aspect: float, s_per_pixel: float | None, size: tuple[int, int]
+) -> None:
+    assert gallery_rest_size(viewer, aspect, s_per_pixel) == size
