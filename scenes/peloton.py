@@ -1170,6 +1170,7 @@ class CourseMode:
                 legend=viser.uplot.Legend(show=True),
                 title="Elevation, speed and power along the course",
                 aspect=1.4,
+                visible=False,  # until the first ride: a profile over flat zeros reads as a rider not pedalling
             )
             with gui.add_folder("Power, model and air"):
                 self.power = gui.add_number(
@@ -1601,6 +1602,7 @@ class CourseMode:
                 self.readout.content = self._readout_markdown()
                 self.splits.content = self._splits_markdown()
                 self.chart.data = self._chart_data()
+                self.chart.visible = self.state is not None
         self.server.flush()
 
     _drawn_exaggeration: float = 2.0

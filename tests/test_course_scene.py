@@ -80,8 +80,13 @@ def test_course_mode_opens_off_and_shows_the_sample_when_ticked(scene: PelotonSc
     mode = scene.course_mode
     assert not mode.enabled and not mode.frame.visible and scene.course.visible
     assert mode.route_label == SAMPLE_LABEL and mode.state is None
+    assert not mode.chart.visible  # no ride yet: no profile over flat zeros
     mode.enable.value = True
     assert mode.enabled and mode.frame.visible and not scene.course.visible
+    # Ridden: the chart shows, with the rider's real speed and power along the course.
+    assert mode.chart.visible
+    _, _, speed_kmh, power_w = (np.asarray(series) for series in mode.chart.data)
+    assert np.all(speed_kmh >= 0.0) and speed_kmh.max() > 5.0 and power_w.max() > 100.0
     expected = compute_course(mode.route, CourseParams(), PelotonParams())
     assert mode.state is not None
     assert mode.state.ride.time_s == pytest.approx(expected.ride.time_s, rel=1e-12)
