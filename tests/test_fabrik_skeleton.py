@@ -405,7 +405,10 @@ def test_conflicting_targets_settle_at_a_fixed_point_of_the_centroid_rule(
     result = fabrik.solve_tree(parents, joints, targets, tolerance=1e-4, max_iterations=500)
     if all(s == "reached" for s in result.status):
         return
-    assert result.status[0] != "max_iterations"
+    # No limits: never "limited"; the fixed-point rule stops the tree only where a target is out of its reach,
+    # otherwise it goes on (restarting once from a turned pose) to the cap.
+    assert "limited" not in result.status
+    assert "unreachable" in result.status or result.iterations == 500
     again = tree_reference(parents, result.joints, targets, 1)[0]
     np.testing.assert_allclose(again, result.joints, atol=1e-3)
 
