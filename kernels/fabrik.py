@@ -2117,12 +2117,15 @@ def _solve_tree_core(
     out_of_reach = False
     for e in range(effectors.shape[0]):
         key = int(effectors[e])
-        reach, j = 0.0, key
+        reach, longest, j = 0.0, 0.0, key
         while parents[j] >= 0:
             reach += lengths[j]
+            longest = max(longest, lengths[j])
             j = int(parents[j])
+        inner = max(0.0, 2.0 * longest - reach)  # the path's annulus, as solve's
         dx, dy, dz = goal[key, 0] - p[root, 0], goal[key, 1] - p[root, 1], goal[key, 2] - p[root, 2]
-        out_of_reach = out_of_reach or math.sqrt(dx * dx + dy * dy + dz * dz) > reach + tiny
+        distance = math.sqrt(dx * dx + dy * dy + dz * dz)
+        out_of_reach = out_of_reach or distance > reach + tiny or distance < inner - tiny
     stall_applies = holding or any_live or out_of_reach
     best = p.copy()
     best_worst = np.inf
@@ -2238,14 +2241,18 @@ def _solve_tree_core(
             if stall_applies:
                 stalled = True
                 break
-            if retry:
+            if retry and iteration < max_iterations:
                 # A free tree within reach at a fixed point of the centroid rule (a mirror-symmetric start keeps
                 # it symmetric): go on once from every segment turned aside, another basin; then on to the cap.
                 retry = False
                 _tree_turn_aside(p, parents, order, lengths, tiny, dim)
     feasible = best_worst < np.inf
-    if feasible and not _tree_admissible(p, parents, order, table, rest, tiny, has_limits, centres,
-                                         radii, live):  # fmt: skip
+    if feasible and (
+        not retry  # restarted: never worse than the best before or after
+        or not _tree_admissible(
+            p, parents, order, table, rest, tiny, has_limits, centres, radii, live
+        )
+    ):
         p[:, :] = best  # never an inadmissible last iterate where an admissible one was seen
     for e in range(effectors.shape[0]):
         k = int(effectors[e])
@@ -2355,11 +2362,14 @@ def _tree_statuses(
         root = int(parents[root])
     for e in range(effectors.shape[0]):
         key = int(effectors[e])
-        reach, j = 0.0, key
+        reach, longest, j = 0.0, 0.0, key
         while parents[j] >= 0:
             reach += lengths[j]
+            longest = max(longest, lengths[j])
             j = int(parents[j])
+        inner = max(0.0, 2.0 * longest - reach)
         dx, dy, dz = goal[key, 0] - p[root, 0], goal[key, 1] - p[root, 1], goal[key, 2] - p[root, 2]
+        distance = math.sqrt(dx * dx + dy * dy + dz * dz)
         inside = False
         for k in range(radii.shape[0]):
             ox = centres[k, 0] - goal[key, 0]
@@ -2368,7 +2378,7 @@ def _tree_statuses(
             inside = inside or (live[k] and ox * ox + oy * oy + oz * oz < radii[k] * radii[k])
         if error[e] <= tolerance:
             codes[e] = _REACHED
-        elif math.sqrt(dx * dx + dy * dy + dz * dz) > reach + tiny:
+        elif distance > reach + tiny or distance < inner - tiny:
             codes[e] = _UNREACHABLE
         elif inside or touching:
             codes[e] = _BLOCKED
