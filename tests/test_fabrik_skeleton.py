@@ -408,9 +408,9 @@ def test_conflicting_targets_settle_at_a_fixed_point_of_the_centroid_rule(
     # No limits: never "limited"; the fixed-point rule stops the tree only where a target is out of its reach,
     # otherwise it goes on (restarting once from a turned pose) to the cap.
     assert "limited" not in result.status
-    # to the cap after a restart: the best pose seen (by largest error), none worse
+    # to the cap (a free tree within reach, creeping or restarted once): the last iterate or a better one
     if result.iterations == 500:
-        assert result.error.max() == np.nanmin(result.error_history.max(axis=1))
+        assert result.error.max() <= result.error_history[-1].max()
         return
     assert "unreachable" in result.status  # stopped at a fixed point: some target is out of reach
     again = tree_reference(parents, result.joints, targets, 1)[0]
