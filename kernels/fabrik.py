@@ -2227,8 +2227,13 @@ def _solve_tree_core(
             else:
                 directions[j, 0], directions[j, 1], directions[j, 2] = qx, qy, qz
         worst = _tree_errors(p, goal, effectors, history, iteration)
-        admissible = _tree_admissible(p, parents, order, table, rest, tiny, has_limits, centres,
-                                      radii, live)  # fmt: skip
+        # Checked only where it matters, since it costs a pass of its own: a pose within tolerance, or a better one
+        # where the last iterate may not be the one returned (live obstacles can leave it cutting one; after a
+        # restart the best is returned). The backward stage keeps every limit on every iterate.
+        track = any_live or not retry
+        admissible = (worst <= tolerance or (track and worst < best_worst)) and _tree_admissible(
+            p, parents, order, table, rest, tiny, has_limits, centres, radii, live
+        )
         if admissible and worst < best_worst:
             best[:, :] = p
             best_worst = worst
@@ -2304,6 +2309,8 @@ def _tree_admissible(
 ) -> bool:  # fmt: skip
     """Whether the tree's pose keeps every joint limit (each segment against its parent's, the root's against
     ``rest``; zero-length segments have none and pass their parent's on) and cuts no live obstacle."""
+    if not has_limits and radii.shape[0] == 0:
+        return True
     count = p.shape[0]
     directions = np.empty((count, 3))
     root = int(order[0])
