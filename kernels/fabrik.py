@@ -1907,9 +1907,12 @@ def solve_tree(
         if isinstance(key, bool) or not isinstance(key, (int, np.integer)) or not 0 <= key < count:
             raise ValueError(f"targets keys must be joint indices in [0, {count - 1}], got {key!r}")
     keys = tuple(sorted(int(key) for key in targets))
-    if _integers(parents) and np.shape(parents) == (count,):  # type: ignore[arg-type]
-        key_parents = tuple(int(v) for v in np.asarray(parents).tolist())
-        topology = _tree_topology(key_parents, count, keys)
+    try:
+        raw = np.asarray(parents)
+    except (TypeError, ValueError):
+        raw = None
+    if raw is not None and raw.dtype.kind in "iu" and raw.shape == (count,):
+        topology = _tree_topology(tuple(raw.tolist()), count, keys)
     else:  # refused (ValueError naming parents) without the cache
         topology = _tree_topology.__wrapped__(parents, count, keys)
     order, parent, active, has_goal, effector_ids, is_chain = topology
@@ -1944,9 +1947,7 @@ def solve_tree(
     codes = np.empty(len(effector_ids), dtype=np.int64)
     final = np.empty(len(effector_ids))
     # As solve: divided by a power of 2 near the extent (exact), so squared norms neither overflow nor underflow
-    extent = max(
-        float(np.abs(p - p[root]).max()), float(np.abs(goal[effector_ids] - p[root]).max())
-    )
+    extent = _tree_extent(p, goal, effector_ids, root)
     scale, centres, radii = 1.0, setup.centres, setup.radii
     if extent != 0.0 and not _UNSCALED[0] <= extent <= _UNSCALED[1]:
         scale = math.ldexp(1.0, math.frexp(extent)[1])
@@ -1969,14 +1970,6 @@ def solve_tree(
         iterations=int(iterations),
         error_history=history[: iterations + 1].copy(),
     )
-
-
-def _integers(value: object) -> bool:
-    """Whether ``value`` is an array-like of integers (the cacheable form of ``parents``)."""
-    try:
-        return np.asarray(value).dtype.kind in "iu"
-    except (TypeError, ValueError):
-        return False
 
 
 @functools.lru_cache(maxsize=64)
@@ -2268,6 +2261,21 @@ def _solve_tree_core(
     if not feasible:
         codes[:] = _INFEASIBLE
     return iterations
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _tree_extent(
+    p: NDArray[np.float64], goal: NDArray[np.float64], effectors: NDArray[np.int64], root: int
+) -> float:
+    """The largest coordinate offset from the root of a joint or a target (m)."""
+    extent = 0.0
+    for j in range(p.shape[0]):
+        for c in range(3):
+            extent = max(extent, abs(p[j, c] - p[root, c]))
+    for e in range(effectors.shape[0]):
+        for c in range(3):
+            extent = max(extent, abs(goal[int(effectors[e]), c] - p[root, c]))
+    return extent
 
 
 @numba.njit(cache=True, error_model="numpy")
