@@ -1830,8 +1830,12 @@ class TreeSolution:
     error: NDArray[np.float64]
     """(E,) distance from each end effector to its target (m)."""
     status: tuple[Status, ...]
-    """(E,) why each effector stopped where it did; see :data:`Status` ("limited" also covers an effector held
-    short of its target by the others' targets: a compromise of the centroid rule)."""
+    """(E,) why each effector stopped where it did; see :data:`Status`. A tree stops at a fixed point of the
+    centroid rule only where limits or live obstacles can hold it ("limited" then also covers an effector held short
+    of its target by the others' targets) or where some effector's target is out of its path's reach (an effector
+    held short by that compromise is "unreachable": its target cannot be met together with the others'). Never
+    "limited" without limits or obstacles; "infeasible" where no iterate kept every limit and cleared every
+    obstacle."""
     iterations: int
     """Iterations run (0 when the start already met the tolerance)."""
     error_history: NDArray[np.float64]
@@ -1859,7 +1863,13 @@ def solve_tree(
     branches that only lead to them, take no part in the forward stage and follow in the backward one. Joint limits
     are imposed inside the backward stage (the forward stage only keeps each hinge's segment in its plane), so every
     iterate keeps every limit; obstacles as in :func:`solve`. Stops when every effector is within ``tolerance``, at
-    ``max_iterations``, or when no effector's error changes by more than 0.1 % of the tolerance in an iteration.
+    ``max_iterations``, or when no effector's error changes by more than 0.1 % of the tolerance in an iteration
+    where limits or obstacles can hold the tree or a target is out of reach (as :func:`solve`); a free tree within
+    reach that stalls so goes on once from every segment turned aside (a mirror-symmetric start stays symmetric
+    under the centroid rule), then to the cap. "Reached" is error ≤ tolerance on a pose that keeps every limit (a
+    start that breaks one is iterated on); the returned pose is the last iterate, or the best admissible one where
+    the last is not. Huge or tiny trees are divided by a power of 2 first (as :func:`solve`): a tree scaled by 2^k
+    gives the same result scaled.
 
     A tree that is one chain (no joint with two children) is solved by :func:`solve` itself, so it gives
     ``solve``'s result (with its extrapolation, its best-pose rule and its closest pose for targets out of reach).
@@ -1879,7 +1889,7 @@ def solve_tree(
         root_direction: as in :func:`solve`.
 
     Returns:
-        The :class:`TreeSolution` (the last iterate).
+        The :class:`TreeSolution`.
 
     Raises:
         ValueError: naming the argument, for a ``parents`` that is not one tree over the joints, targets on joints
@@ -1891,16 +1901,20 @@ def solve_tree(
         raise ValueError(
             f"targets must be a non-empty mapping joint index → target, got {targets!r}"
         )
+    # Keys and parents are checked for type and shape before the cache: 2.0 and True hash as 2 and 1, and a
+    # flattened (1, J) array as its (J,) row, so the cache would otherwise answer for input it must refuse.
+    for key in targets:
+        if isinstance(key, bool) or not isinstance(key, (int, np.integer)) or not 0 <= key < count:
+            raise ValueError(f"targets keys must be joint indices in [0, {count - 1}], got {key!r}")
+    keys = tuple(sorted(int(key) for key in targets))
     try:
-        key_parents = (
-            tuple(int(v) for v in np.asarray(parents).reshape(-1)) if _integers(parents) else None
-        )
-        keys = tuple(sorted(targets))
-        topology = _tree_topology(key_parents, count, keys) if key_parents is not None else None
-    except TypeError:  # unhashable or unorderable keys: checked (and refused) without the cache
-        topology = None
-    if topology is None:
-        topology = _tree_topology.__wrapped__(parents, count, tuple(targets))
+        raw = np.asarray(parents)
+    except (TypeError, ValueError):
+        raw = None
+    if raw is not None and raw.dtype.kind in "iu" and raw.shape == (count,):
+        topology = _tree_topology(tuple(raw.tolist()), count, keys)
+    else:  # refused (ValueError naming parents) without the cache
+        topology = _tree_topology.__wrapped__(parents, count, keys)
     order, parent, active, has_goal, effector_ids, is_chain = topology
     goal = np.zeros((count, 3))
     for key in effector_ids.tolist():
@@ -1931,26 +1945,31 @@ def solve_tree(
     p[:, :dim] = points
     history = np.empty((setup.max_iterations + 1, len(effector_ids)))
     codes = np.empty(len(effector_ids), dtype=np.int64)
+    final = np.empty(len(effector_ids))
+    # As solve: divided by a power of 2 near the extent (exact), so squared norms neither overflow nor underflow
+    extent = _tree_extent(p, goal, effector_ids, root)
+    scale, centres, radii = 1.0, setup.centres, setup.radii
+    if extent != 0.0 and not _UNSCALED[0] <= extent <= _UNSCALED[1]:
+        scale = math.ldexp(1.0, math.frexp(extent)[1])
+        p /= scale
+        goal /= scale
+        tol, centres, radii = tol / scale, centres / scale, radii / scale
     iterations = _solve_tree_core(
         p, parent, order, active, goal, has_goal, effector_ids, table, setup.root_direction,
-        setup.centres, setup.radii, tol, setup.max_iterations, dim, history, codes,
+        centres, radii, tol, setup.max_iterations, dim, history, codes, final,
     )  # fmt: skip
+    if scale != 1.0:
+        p *= scale
+        history *= scale
+        final *= scale
     return TreeSolution(
         joints=p[:, :dim].copy() if dim == 2 else p,
         effectors=effector_ids.copy(),
-        error=history[iterations].copy(),
+        error=final,
         status=tuple(STATUSES[c] for c in codes.tolist()),
         iterations=int(iterations),
         error_history=history[: iterations + 1].copy(),
     )
-
-
-def _integers(value: object) -> bool:
-    """Whether ``value`` is an array-like of integers (the cacheable form of ``parents``)."""
-    try:
-        return np.asarray(value).dtype.kind in "iu"
-    except (TypeError, ValueError):
-        return False
 
 
 @functools.lru_cache(maxsize=64)
@@ -2043,19 +2062,27 @@ def _solve_tree_core(
     effectors: NDArray[np.int64], table: NDArray[np.float64], rest: NDArray[np.float64],
     centres: NDArray[np.float64], radii: NDArray[np.float64], tolerance: float,
     max_iterations: int, dim: int, history: NDArray[np.float64], codes: NDArray[np.int64],
+    final: NDArray[np.float64],
 ) -> int:  # fmt: skip
     """Multi-end-effector FABRIK on ``p`` (J, 3), in place; ``order`` is breadth first from the root.
 
-    Fills ``history`` (max_iterations + 1, E) with the effectors' errors, NaN past the last iteration, and
-    ``codes`` (E,) with each effector's status: reached; unreachable (farther from the root than its path's
-    length); blocked (target inside a live obstacle, or the pose touching one); limited (stopped at a fixed point);
-    max_iterations. Returns the iterations run."""
+    Leaves the returned pose in ``p``: the last iterate where it keeps every limit and clears every live obstacle,
+    else the best (smallest largest error) that did, else the last. Fills ``history`` (max_iterations + 1, E) with
+    the iterates' errors, NaN past the last iteration, ``final`` (E,) with the returned pose's errors and ``codes``
+    (E,) with each effector's status: reached (error ≤ tolerance, on an admissible pose); unreachable (farther from
+    the root than its path's length); blocked (target inside a live obstacle, or the pose touching one); limited
+    (stopped at a fixed point while limits or obstacles hold the tree); infeasible (no admissible pose seen);
+    max_iterations. Returns the iterations run. Every test is relative to the tree's size (no absolute floor), so
+    a tree scaled by a power of 2 gives the same bits scaled."""
     count = p.shape[0]
     root = int(order[0])
     history[:, :] = np.nan
-    has_limits = False
+    has_limits, holding = False, False
     for j in range(count):
         has_limits = has_limits or table[j, 0] != _KIND_FREE
+        # free hinges (a full turn) only keep a segment in its plane: no fixed point of their own (as solve)
+        full_turn = table[j, 0] == _KIND_HINGE and table[j, 10] - table[j, 9] >= 2.0 * math.pi
+        holding = holding or (table[j, 0] != _KIND_FREE and not full_turn)
     lengths = np.zeros(count)
     total = 0.0
     for j in range(count):
@@ -2069,12 +2096,32 @@ def _solve_tree_core(
         k = int(effectors[e])
         dx, dy, dz = goal[k, 0] - p[root, 0], goal[k, 1] - p[root, 1], goal[k, 2] - p[root, 2]
         distance = max(distance, math.sqrt(dx * dx + dy * dy + dz * dz))
-    tiny = _TINY * max(total, distance, 1.0)
+    # relative only (as solve): the core gives the same bits at any power-of-2 scale
+    tiny = _TINY * max(total, distance)
     live = np.empty(radii.shape[0], dtype=np.bool_)
+    any_live = False
     for k in range(radii.shape[0]):
         live[k] = (centres[k, 0] - p[root, 0]) ** 2 + (centres[k, 1] - p[root, 1]) ** 2 + (
             centres[k, 2] - p[root, 2]
         ) ** 2 > radii[k] * radii[k]
+        any_live = any_live or live[k]
+    # As solve, the fixed-point rule stops a tree only where limits or obstacles can hold it, or where some
+    # effector's target is out of its path's reach; a free tree within reach iterates on to the cap.
+    out_of_reach = False
+    for e in range(effectors.shape[0]):
+        key = int(effectors[e])
+        reach, longest, j = 0.0, 0.0, key
+        while parents[j] >= 0:
+            reach += lengths[j]
+            longest = max(longest, lengths[j])
+            j = int(parents[j])
+        inner = max(0.0, 2.0 * longest - reach)  # the path's annulus, as solve's
+        dx, dy, dz = goal[key, 0] - p[root, 0], goal[key, 1] - p[root, 1], goal[key, 2] - p[root, 2]
+        distance = math.sqrt(dx * dx + dy * dy + dz * dz)
+        out_of_reach = out_of_reach or distance > reach + tiny or distance < inner - tiny
+    stall_applies = holding or any_live or out_of_reach
+    best = p.copy()
+    best_worst = np.inf
     bx, by, bz = p[root, 0], p[root, 1], p[root, 2]
     directions = np.zeros(
         (count, 3)
@@ -2096,12 +2143,15 @@ def _solve_tree_core(
             counts[up] += 1
 
     worst = _tree_errors(p, goal, effectors, history, 0)
-    if worst < tolerance:
-        _tree_statuses(p, parents, goal, effectors, lengths, centres, radii, live, tolerance, tiny,
-                       history[0], False, codes)  # fmt: skip
-        return 0
+    if _tree_admissible(p, parents, order, table, rest, tiny, has_limits, centres, radii, live):
+        best_worst = worst
+        if worst <= tolerance:  # the start is returned as reached only where it keeps every limit
+            final[:] = history[0]
+            _tree_statuses(p, parents, goal, effectors, lengths, centres, radii, live, tolerance,
+                           tiny, final, False, False, codes)  # fmt: skip
+            return 0
     stall = _STALL * tolerance + tiny
-    iterations, stalled = 0, False
+    iterations, stalled, retry = 0, False, True
     for iteration in range(1, max_iterations + 1):
         iterations = iteration
         # forward stage: effectors on their targets, sub-bases at the centroid of their branches' proposals
@@ -2170,17 +2220,133 @@ def _solve_tree_core(
             else:
                 directions[j, 0], directions[j, 1], directions[j, 2] = qx, qy, qz
         worst = _tree_errors(p, goal, effectors, history, iteration)
-        if worst < tolerance:
+        # Checked only where it matters, since it costs a pass of its own: a pose within tolerance, or a better one
+        # where the last iterate may not be the one returned (live obstacles can leave it cutting one; after a
+        # restart the best is returned). The backward stage keeps every limit on every iterate.
+        track = any_live or not retry
+        admissible = (worst <= tolerance or (track and worst < best_worst)) and _tree_admissible(
+            p, parents, order, table, rest, tiny, has_limits, centres, radii, live
+        )
+        if admissible and worst < best_worst:
+            best[:, :] = p
+            best_worst = worst
+        if admissible and worst <= tolerance:
             break
         change = 0.0
         for e in range(effectors.shape[0]):
             change = max(change, abs(history[iteration, e] - history[iteration - 1, e]))
         if change < stall:
-            stalled = True
-            break
+            if stall_applies:
+                stalled = True
+                break
+            if retry and iteration < max_iterations:
+                # A free tree within reach at a fixed point of the centroid rule (a mirror-symmetric start keeps
+                # it symmetric): go on once from every segment turned aside, another basin; then on to the cap.
+                retry = False
+                _tree_turn_aside(p, parents, order, lengths, tiny, dim)
+    feasible = best_worst < np.inf
+    if feasible and (
+        not retry  # restarted: never worse than the best before or after
+        or not _tree_admissible(
+            p, parents, order, table, rest, tiny, has_limits, centres, radii, live
+        )
+    ):
+        p[:, :] = best  # never an inadmissible last iterate where an admissible one was seen
+    for e in range(effectors.shape[0]):
+        k = int(effectors[e])
+        x, y, z = p[k, 0] - goal[k, 0], p[k, 1] - goal[k, 1], p[k, 2] - goal[k, 2]
+        final[e] = math.sqrt(x * x + y * y + z * z)
     _tree_statuses(p, parents, goal, effectors, lengths, centres, radii, live, tolerance, tiny,
-                   history[iterations], stalled, codes)  # fmt: skip
+                   final, stalled, holding or any_live, codes)  # fmt: skip
+    if not feasible:
+        codes[:] = _INFEASIBLE
     return iterations
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _tree_extent(
+    p: NDArray[np.float64], goal: NDArray[np.float64], effectors: NDArray[np.int64], root: int
+) -> float:
+    """The largest coordinate offset from the root of a joint or a target (m)."""
+    extent = 0.0
+    for j in range(p.shape[0]):
+        for c in range(3):
+            extent = max(extent, abs(p[j, c] - p[root, c]))
+    for e in range(effectors.shape[0]):
+        for c in range(3):
+            extent = max(extent, abs(goal[int(effectors[e]), c] - p[root, c]))
+    return extent
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _tree_turn_aside(
+    p: NDArray[np.float64], parents: NDArray[np.int64], order: NDArray[np.int64],
+    lengths: NDArray[np.float64], tiny: float, dim: int,
+) -> None:  # fmt: skip
+    """Turn every segment of the pose ``p`` (in place, root fixed, lengths kept) by 1 to 2 rad about an axis
+    across it, the angles and axes spread by the golden ratio over the breadth-first order (deterministic, and
+    different for mirror-image branches)."""
+    old = p.copy()
+    golden = 0.6180339887498949
+    for k in range(1, p.shape[0]):
+        j = int(order[k])
+        up = int(parents[j])
+        dx, dy, dz, _ = _unit(old[j, 0] - old[up, 0], old[j, 1] - old[up, 1], old[j, 2] - old[up, 2],
+                              0.0, 0.0, 1.0, tiny)  # fmt: skip
+        spread = (k * golden) % 1.0
+        angle = 1.0 + spread
+        if dim == 2:
+            ax, ay, az = 0.0, 0.0, 1.0
+            angle = angle if k % 2 else -angle
+        else:
+            px, py, pz = _perpendicular(dx, dy, dz, 3)
+            ax, ay, az = _rotate(
+                px, py, pz, dx, dy, dz, 2.0 * math.pi * ((k * golden * golden) % 1.0)
+            )
+        dx, dy, dz = _rotate(dx, dy, dz, ax, ay, az, angle)
+        p[j, 0] = p[up, 0] + lengths[j] * dx
+        p[j, 1] = p[up, 1] + lengths[j] * dy
+        p[j, 2] = p[up, 2] + lengths[j] * dz
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _tree_admissible(
+    p: NDArray[np.float64], parents: NDArray[np.int64], order: NDArray[np.int64],
+    table: NDArray[np.float64], rest: NDArray[np.float64], tiny: float, has_limits: bool,
+    centres: NDArray[np.float64], radii: NDArray[np.float64], live: NDArray[np.bool_],
+) -> bool:  # fmt: skip
+    """Whether the tree's pose keeps every joint limit (each segment against its parent's, the root's against
+    ``rest``; zero-length segments have none and pass their parent's on) and cuts no live obstacle."""
+    if not has_limits and radii.shape[0] == 0:
+        return True
+    count = p.shape[0]
+    directions = np.empty((count, 3))
+    root = int(order[0])
+    directions[root, 0], directions[root, 1], directions[root, 2] = rest[0], rest[1], rest[2]
+    for k in range(1, count):
+        j = int(order[k])
+        up = int(parents[j])
+        qx, qy, qz = directions[up, 0], directions[up, 1], directions[up, 2]
+        dx, dy, dz, norm = _unit(p[j, 0] - p[up, 0], p[j, 1] - p[up, 1], p[j, 2] - p[up, 2],
+                                 qx, qy, qz, tiny)  # fmt: skip
+        if norm <= tiny:
+            directions[j, 0], directions[j, 1], directions[j, 2] = qx, qy, qz
+            continue
+        if has_limits and not _joint_ok(dx, dy, dz, qx, qy, qz, table, j, rest, tiny):
+            return False
+        directions[j, 0], directions[j, 1], directions[j, 2] = dx, dy, dz
+        x, y, z = p[up, 0], p[up, 1], p[up, 2]
+        sx, sy, sz = p[j, 0] - x, p[j, 1] - y, p[j, 2] - z
+        seg2 = sx * sx + sy * sy + sz * sz
+        for o in range(radii.shape[0]):
+            if not live[o]:
+                continue
+            rx, ry, rz = centres[o, 0] - x, centres[o, 1] - y, centres[o, 2] - z
+            t = min(max((rx * sx + ry * sy + rz * sz) / seg2, 0.0), 1.0)
+            gx, gy, gz = rx - t * sx, ry - t * sy, rz - t * sz
+            if gx * gx + gy * gy + gz * gz < radii[o] * radii[o]:
+                return False
+    return True
 
 
 @numba.njit(cache=True, error_model="numpy")
@@ -2188,9 +2354,10 @@ def _tree_statuses(
     p: NDArray[np.float64], parents: NDArray[np.int64], goal: NDArray[np.float64],
     effectors: NDArray[np.int64], lengths: NDArray[np.float64], centres: NDArray[np.float64],
     radii: NDArray[np.float64], live: NDArray[np.bool_], tolerance: float, tiny: float,
-    error: NDArray[np.float64], stalled: bool, codes: NDArray[np.int64],
+    error: NDArray[np.float64], stalled: bool, held: bool, codes: NDArray[np.int64],
 ) -> None:  # fmt: skip
-    """Each effector's status code (see :func:`_solve_tree_core`)."""
+    """Each effector's status code (see :func:`_solve_tree_core`); ``held``: limits or live obstacles can hold the
+    tree at a fixed point (else a stall is another effector's target out of reach: "unreachable")."""
     touching = False
     for j in range(p.shape[0]):
         up = int(parents[j])
@@ -2210,25 +2377,28 @@ def _tree_statuses(
         root = int(parents[root])
     for e in range(effectors.shape[0]):
         key = int(effectors[e])
-        reach, j = 0.0, key
+        reach, longest, j = 0.0, 0.0, key
         while parents[j] >= 0:
             reach += lengths[j]
+            longest = max(longest, lengths[j])
             j = int(parents[j])
+        inner = max(0.0, 2.0 * longest - reach)
         dx, dy, dz = goal[key, 0] - p[root, 0], goal[key, 1] - p[root, 1], goal[key, 2] - p[root, 2]
+        distance = math.sqrt(dx * dx + dy * dy + dz * dz)
         inside = False
         for k in range(radii.shape[0]):
             ox = centres[k, 0] - goal[key, 0]
             oy = centres[k, 1] - goal[key, 1]
             oz = centres[k, 2] - goal[key, 2]
             inside = inside or (live[k] and ox * ox + oy * oy + oz * oz < radii[k] * radii[k])
-        if error[e] < tolerance:
+        if error[e] <= tolerance:
             codes[e] = _REACHED
-        elif math.sqrt(dx * dx + dy * dy + dz * dz) > reach + tiny:
+        elif distance > reach + tiny or distance < inner - tiny:
             codes[e] = _UNREACHABLE
         elif inside or touching:
             codes[e] = _BLOCKED
         else:
-            codes[e] = _LIMITED if stalled else _MAX_ITERATIONS
+            codes[e] = (_LIMITED if held else _UNREACHABLE) if stalled else _MAX_ITERATIONS
 
 
 @numba.njit(cache=True, error_model="numpy")
