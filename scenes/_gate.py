@@ -24,6 +24,7 @@ per-connection dispatch, the GUI and gizmo registries, and the frame decoder.
 
 from __future__ import annotations
 
+import asyncio
 import dataclasses
 import functools
 import logging
@@ -50,10 +51,22 @@ MAX_FRAME_BYTES = 32 * 1024 * 1024
 MAX_IMAGE_SIDE = 16384
 """Largest camera image side (pixels) a browser may report."""
 MAX_TEXT_CHARS = 10_000
-MAX_UPLOAD_BYTES = 24 * 1024 * 1024
+MIB = 1024 * 1024
+MAX_UPLOAD_BYTES = 24 * MIB
 """Largest file a browser may upload (a scene may refuse smaller ones with its own message, e.g. GPX over 20 MB)."""
 MAX_UPLOADS_IN_FLIGHT = 4
 """Uploads one browser may have started and not finished; viser keeps each one's parts in memory until then."""
+MAX_UPLOADS_IN_FLIGHT_TOTAL = 8
+"""Uploads every browser together may have in flight on one server."""
+MAX_UPLOAD_BYTES_IN_FLIGHT_TOTAL = 64 * MIB
+"""Bytes the uploads in flight on one server may announce together (each is held in memory until it completes)."""
+UPLOAD_STALL_S = 30.0
+"""An upload that has received no part for this long is dropped (its parts freed), so it stops holding the
+server-wide budget."""
+COSTLY_BURST = 3
+"""Costly inputs (a scene rebuild, a long job: see :attr:`ControlSpec.costly`) one tab may send at once."""
+COSTLY_RATE_HZ = 1.0
+"""Costly inputs per second one tab is given beyond its burst (a token bucket); the rest wait, coalesced."""
 MAX_NAME_CHARS = 255
 
 ALLOWED_MESSAGES: tuple[type[_messages.Message], ...] = (
@@ -89,6 +102,9 @@ class ControlSpec:
     """The dropdown's options."""
     length: int = 0
     """Number of components (RGB, vectors)."""
+    costly: bool = False
+    """Whether a change rebuilds a scene or starts a long job: such inputs share a per-tab budget at the gate, and a
+    burst beyond it is coalesced (see :func:`mark_costly`)."""
 
 
 _SPEC_ATTRIBUTE = "_scenes_control_spec"
@@ -126,6 +142,22 @@ def record_spec(handle: object) -> ControlSpec:
     spec = spec_from_handle(handle)
     setattr(_state(handle), _SPEC_ATTRIBUTE, spec)
     return spec
+
+
+H = typing.TypeVar("H")
+
+
+def mark_costly(handle: H) -> H:
+    """Declare ``handle`` (a control just created) costly: each change rebuilds a scene or starts a long job.
+
+    The gate lets a tab send :data:`COSTLY_BURST` costly inputs at once, then :data:`COSTLY_RATE_HZ` a second;
+    beyond that it keeps only the latest value of each costly control (a burst of clicks is one click, the last pick
+    or resolution wins) and delivers it when the tab's budget allows, so every viewer still ends on the value the
+    browser sent last. Returns ``handle``.
+    """
+    spec = dataclasses.replace(control_spec(handle), costly=True)
+    setattr(_state(handle), _SPEC_ATTRIBUTE, spec)
+    return handle
 
 
 def control_spec(handle: object) -> ControlSpec:
@@ -428,12 +460,88 @@ class _Upload:
 
     part_count: int
     size_bytes: int
+    last_part_at: float
+    """When it started or last received a part (``time.monotonic()``)."""
     bytes_seen: int = 0
     parts_seen: set[int] = dataclasses.field(default_factory=set)
 
 
+Item = typing.TypeVar("Item")
+
+
+class CostlyBudget(typing.Generic[Item]):
+    """One tab's token bucket for costly inputs, holding back the latest value of each control beyond it.
+
+    ``burst`` inputs may go at once, then ``rate_hz`` a second. An input offered while the bucket is empty (or while
+    others wait) is held back in place of any earlier one of the same control, last in line; :meth:`take` hands the
+    oldest one out when a token is there. So a burst of clicks becomes one click, the latest value of a control is
+    always the last of it delivered, and a tab's costly work is bounded by ``burst + rate_hz * t`` in any ``t`` s.
+    Pure bookkeeping (times are passed in, e.g. ``time.monotonic()``); the gate runs it on the event loop.
+    """
+
+    def __init__(self, burst: int, rate_hz: float, now: float) -> None:
+        if burst < 1 or not rate_hz > 0.0:
+            raise ValueError(f"burst must be ≥ 1 and rate_hz > 0, got {burst}, {rate_hz}")
+        self.burst = burst
+        self.rate_hz = rate_hz
+        self._tokens = float(burst)
+        self._refilled_at = now
+        self._held: dict[str, Item] = {}
+        """By control key, in the order of each one's latest arrival."""
+
+    def _refill(self, now: float) -> None:
+        elapsed = max(0.0, now - self._refilled_at)
+        self._tokens = min(float(self.burst), self._tokens + elapsed * self.rate_hz)
+        self._refilled_at = max(now, self._refilled_at)
+
+    def offer(self, key: str, item: Item, now: float) -> tuple[bool, bool]:
+        """(goes now, replaced one held back) for ``item``, the new value of control ``key``."""
+        self._refill(now)
+        if not self._held and self._tokens >= 1.0:
+            self._tokens -= 1.0
+            return True, False
+        replaced = self._held.pop(key, None) is not None
+        self._held[key] = item
+        return False, replaced
+
+    def take(self, now: float) -> tuple[str, Item] | None:
+        """The oldest held-back (key, item) if the budget allows one now, else None."""
+        self._refill(now)
+        if not self._held or self._tokens < 1.0:
+            return None
+        self._tokens -= 1.0
+        key = next(iter(self._held))
+        return key, self._held.pop(key)
+
+    def wait_s(self, now: float) -> float | None:
+        """Seconds until :meth:`take` can hand out the next held-back input; None when none is held."""
+        if not self._held:
+            return None
+        self._refill(now)
+        return max(0.0, (1.0 - self._tokens) / self.rate_hz)
+
+    @property
+    def held(self) -> int:
+        """How many inputs are held back (one per control at most)."""
+        return len(self._held)
+
+
+Deferred = tuple[_messages.GuiUpdateMessage, Callable[[], None] | None]
+
+
+@dataclasses.dataclass
+class _TabBudget:
+    budget: CostlyBudget[Deferred]
+    timer: asyncio.TimerHandle | None = None
+
+
 class Gate:
-    """The one gate in front of one server's message dispatch. Made by :func:`install_gate`."""
+    """The one gate in front of one server's message dispatch. Made by :func:`install_gate`.
+
+    Besides cleaning, it shares two budgets out fairly: costly inputs per tab (:func:`mark_costly`), so one tab
+    flooding Reset or scene switches cannot fill viser's callback pool and delay every other tab; and uploads in
+    flight across all tabs (:data:`MAX_UPLOADS_IN_FLIGHT_TOTAL`, :data:`MAX_UPLOAD_BYTES_IN_FLIGHT_TOTAL`).
+    """
 
     def __init__(self, server: viser.ViserServer) -> None:
         self._server_ref = weakref.ref(server)
@@ -443,6 +551,9 @@ class Gate:
         self._client_dispatch: dict[int, Dispatch] = {}
         self._uploads: dict[int, dict[str, _Upload]] = {}
         """Per client, the uploads started and not finished, by transfer id."""
+        self._budgets: dict[int, _TabBudget] = {}
+        """Per client, its costly-input budget (only touched on the event loop)."""
+        self._deliveries: set[asyncio.Future[None]] = set()
         ws._handle_incoming_message = self._dispatch  # type: ignore[method-assign]
         ws.on_client_connect(self._on_connect)
         ws.on_client_disconnect(self._on_disconnect)
@@ -454,8 +565,12 @@ class Gate:
         connection._handle_incoming_message = _ignore
 
     def _on_disconnect(self, connection: Any) -> None:
-        self._client_dispatch.pop(int(connection.client_id), None)
-        self._uploads.pop(int(connection.client_id), None)
+        client_id = int(connection.client_id)
+        self._client_dispatch.pop(client_id, None)
+        self._uploads.pop(client_id, None)
+        tab = self._budgets.pop(client_id, None)
+        if tab is not None and tab.timer is not None:
+            tab.timer.cancel()
 
     async def _dispatch(self, client_id: Any, message: Any) -> None:
         server = self._server_ref()
@@ -463,6 +578,10 @@ class Gate:
             return
         try:
             cleaned, after = self._clean(server, int(client_id), message)
+            if isinstance(cleaned, _messages.GuiUpdateMessage) and not self._admit(
+                server, int(client_id), cleaned, after
+            ):
+                return  # held back, coalesced: delivered when the tab's budget allows
         except (
             Exception
         ) as error:  # a gate bug must not take the connection down, nor let the message through
@@ -470,6 +589,11 @@ class Gate:
                 f"unreadable {type(message).__name__}", f"{type(error).__name__}: {error}"
             )
             return
+        await self._deliver(client_id, cleaned, after)
+
+    async def _deliver(
+        self, client_id: Any, cleaned: Any, after: Callable[[], None] | None
+    ) -> None:
         if cleaned is not None:
             await self._server_dispatch(client_id, cleaned)
             client_dispatch = self._client_dispatch.get(int(client_id))
@@ -477,6 +601,64 @@ class Gate:
                 await client_dispatch(client_id, cleaned)
         if after is not None:
             after()
+
+    # ----------------------------------------------------------------------------------------- costly inputs
+    def _admit(
+        self,
+        server: viser.ViserServer,
+        client_id: int,
+        message: _messages.GuiUpdateMessage,
+        after: Callable[[], None] | None,
+    ) -> bool:
+        """Whether ``message`` goes through now; a costly input beyond the tab's budget is held back instead."""
+        handle = self._gui_handle(server, client_id, str(message.uuid))
+        if handle is None or not control_spec(handle).costly:
+            return True
+        now = time.monotonic()
+        tab = self._budgets.get(client_id)
+        if tab is None:
+            tab = self._budgets[client_id] = _TabBudget(
+                CostlyBudget(COSTLY_BURST, COSTLY_RATE_HZ, now)
+            )
+        goes, replaced = tab.budget.offer(str(message.uuid), (message, after), now)
+        if goes:
+            return True
+        self.log.refuse(
+            "costly input beyond the tab's budget (held back; the latest value is applied)",
+            f"{str(getattr(handle, 'label', '?'))!r} from client {client_id}"
+            f"{', replacing one held back' if replaced else ''} (budget {COSTLY_BURST} at once, "
+            f"{COSTLY_RATE_HZ:g}/s)",
+        )
+        self._schedule(client_id, tab)
+        return False
+
+    def _schedule(self, client_id: int, tab: _TabBudget) -> None:
+        wait_s = tab.budget.wait_s(time.monotonic())
+        if tab.timer is not None or wait_s is None:
+            return
+        tab.timer = asyncio.get_running_loop().call_later(wait_s, self._release, client_id)
+
+    def _release(self, client_id: int) -> None:
+        """Deliver the oldest held-back costly input of ``client_id`` (on the event loop, from its timer)."""
+        tab = self._budgets.get(client_id)
+        if tab is None:
+            return
+        tab.timer = None
+        taken = tab.budget.take(time.monotonic())
+        server = self._server_ref()
+        # The control may have gone meanwhile (its scene switched away): then there is nothing to apply.
+        if taken is not None and server is not None:
+            uuid, (message, after) = taken
+            if self._gui_handle(server, client_id, uuid) is not None:
+                task = asyncio.ensure_future(self._deliver(client_id, message, after))
+                self._deliveries.add(task)  # asyncio keeps only a weak reference to a running task
+                task.add_done_callback(self._deliveries.discard)
+        self._schedule(client_id, tab)
+
+    def costly_held_back(self, client_id: int) -> int:
+        """How many costly inputs of ``client_id`` wait for its budget (one per control at most)."""
+        tab = self._budgets.get(client_id)
+        return 0 if tab is None else tab.budget.held
 
     def _client(self, server: viser.ViserServer, client_id: int) -> viser.ClientHandle | None:
         return server._connected_clients.get(client_id)
@@ -502,7 +684,7 @@ class Gate:
                 return None, None
             return message, None
         if isinstance(message, _messages.FileTransferStartUpload):
-            return self._clean_upload_start(server, client_id, message), None
+            return self._clean_upload_start(server, client_id, message)
         if isinstance(message, _messages.FileTransferPart):
             return self._clean_upload_part(client_id, message), None
         if isinstance(message, ALLOWED_MESSAGES):
@@ -545,37 +727,92 @@ class Gate:
 
     def _clean_upload_start(
         self, server: viser.ViserServer, client_id: int, message: _messages.FileTransferStartUpload
-    ) -> Any:
+    ) -> tuple[Any, Callable[[], None] | None]:
         handle = self._gui_handle(server, client_id, str(message.source_component_uuid))
         size, parts = message.size_bytes, message.part_count
-        in_flight = self._uploads.setdefault(client_id, {})
         if not isinstance(handle, viser.GuiUploadButtonHandle):
             self.log.refuse(
                 "upload for an unknown id", f"uuid {str(message.source_component_uuid)[:64]!r}"
             )
-            return None
-        if (
-            not all(isinstance(x, int) and not isinstance(x, bool) for x in (size, parts))
-            or not 0 <= size <= MAX_UPLOAD_BYTES
-            or not 0 <= parts <= max(1, size)
-            or (size > 0) != (parts > 0)
+            return None, None
+        if not all(isinstance(x, int) and not isinstance(x, bool) for x in (size, parts)) or (
+            not 0 <= parts <= max(1, size) or (size > 0) != (parts > 0)
         ):
-            self.log.refuse(
-                "upload size", f"{size!r} bytes in {parts!r} parts (limit {MAX_UPLOAD_BYTES})"
+            self.log.refuse("upload size", f"{size!r} bytes in {parts!r} parts")
+            return None, None
+        if not 0 <= size <= MAX_UPLOAD_BYTES:
+            self.log.refuse("upload size", f"{size!r} bytes (limit {MAX_UPLOAD_BYTES})")
+            return None, self._tell(
+                server,
+                client_id,
+                f"The file is {size / MIB:.1f} MiB; this server takes files up to "
+                f"{MAX_UPLOAD_BYTES / MIB:.0f} MiB.",
             )
-            return None
         if not all(
             isinstance(x, str) and len(x) <= MAX_NAME_CHARS
             for x in (message.filename, message.mime_type, message.transfer_uuid)
         ):
             self.log.refuse("upload name", "file name, type or transfer id is not short text")
-            return None
+            return None, None
+        self._drop_stalled_uploads(server)
+        in_flight = self._uploads.setdefault(client_id, {})
         if len(in_flight) >= MAX_UPLOADS_IN_FLIGHT:
             self.log.refuse("uploads in flight", f"more than {MAX_UPLOADS_IN_FLIGHT} at once")
-            return None
+            return None, self._tell(
+                server,
+                client_id,
+                f"This tab already has {MAX_UPLOADS_IN_FLIGHT} uploads under way; wait for one to finish.",
+            )
+        everyone = [upload for uploads in self._uploads.values() for upload in uploads.values()]
+        total_bytes = sum(upload.size_bytes for upload in everyone)
+        if (
+            len(everyone) >= MAX_UPLOADS_IN_FLIGHT_TOTAL
+            or total_bytes + size > MAX_UPLOAD_BYTES_IN_FLIGHT_TOTAL
+        ):
+            self.log.refuse(
+                "uploads in flight across all tabs",
+                f"{len(everyone)} uploads of {total_bytes} bytes under way, {size} more asked (limits "
+                f"{MAX_UPLOADS_IN_FLIGHT_TOTAL} uploads, {MAX_UPLOAD_BYTES_IN_FLIGHT_TOTAL} bytes)",
+            )
+            return None, self._tell(
+                server,
+                client_id,
+                f"The server is receiving other uploads ({len(everyone)} files, "
+                f"{total_bytes / MIB:.1f} MiB in flight from all tabs; it takes "
+                f"{MAX_UPLOADS_IN_FLIGHT_TOTAL} files or {MAX_UPLOAD_BYTES_IN_FLIGHT_TOTAL / MIB:.0f} MiB at "
+                "once). Try again in a moment.",
+            )
         if parts > 0:
-            in_flight[message.transfer_uuid] = _Upload(parts, size)
-        return message
+            in_flight[message.transfer_uuid] = _Upload(parts, size, time.monotonic())
+        return message, None
+
+    def _tell(self, server: viser.ViserServer, client_id: int, body: str) -> Callable[[], None]:
+        """A notification of a refused upload for the tab that sent it (shown after the refusal)."""
+
+        def notify() -> None:
+            client = self._client(server, client_id)
+            if client is not None:
+                client.add_notification(
+                    "Upload refused", body, color="red", auto_close_seconds=15.0
+                )
+
+        return notify
+
+    def _drop_stalled_uploads(self, server: viser.ViserServer) -> None:
+        """Forget uploads that received no part for :data:`UPLOAD_STALL_S`, and free the parts viser holds."""
+        now = time.monotonic()
+        for client_id, uploads in list(self._uploads.items()):
+            for transfer, upload in list(uploads.items()):
+                if now - upload.last_part_at < UPLOAD_STALL_S:
+                    continue
+                del uploads[transfer]
+                self.log.refuse(
+                    "stalled upload", f"no part for {UPLOAD_STALL_S:g} s; its parts are dropped"
+                )
+                client = self._client(server, client_id)
+                for api in (server.gui, None if client is None else client.gui):
+                    if api is not None:
+                        api._current_file_upload_states.pop(transfer, None)
 
     def _clean_upload_part(self, client_id: int, message: _messages.FileTransferPart) -> Any:
         upload = self._uploads.get(client_id, {}).get(str(message.transfer_uuid))
@@ -591,6 +828,7 @@ class Gate:
             return None
         upload.bytes_seen += len(content)
         upload.parts_seen.add(index)
+        upload.last_part_at = time.monotonic()
         if len(upload.parts_seen) == upload.part_count:
             del self._uploads[client_id][str(message.transfer_uuid)]
         return message

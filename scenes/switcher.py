@@ -12,6 +12,7 @@ import threading
 import viser
 
 from scenes import SCENES, Scene
+from scenes._gate import mark_costly
 from scenes._session import Session
 
 logger = logging.getLogger(__name__)
@@ -33,10 +34,18 @@ class SceneSwitcher:
         self._key_from_title = titles
         # Callbacks first, under the lock: a pick made while the first scene builds waits for it, then applies.
         with self._lock:
-            self.dropdown = session.gui.add_dropdown(
-                "Scene", options=tuple(titles), initial_value=SCENES[initial].title, order=-100.0
+            # Both rebuild a scene: costly inputs, budgeted per tab at the gate (a burst of Resets is one Reset).
+            self.dropdown = mark_costly(
+                session.gui.add_dropdown(
+                    "Scene",
+                    options=tuple(titles),
+                    initial_value=SCENES[initial].title,
+                    order=-100.0,
+                )
             )
-            self.reset_button = session.gui.add_button("Reset scene to defaults", order=-99.0)
+            self.reset_button = mark_costly(
+                session.gui.add_button("Reset scene to defaults", order=-99.0)
+            )
             self.dropdown.on_update(self._on_pick)
             self.reset_button.on_click(self._on_reset)
             self.scene: Scene = SCENES[initial](session)
