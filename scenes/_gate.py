@@ -467,6 +467,8 @@ class _Upload:
 
 
 Item = typing.TypeVar("Item")
+_TOKEN_SLACK = 1e-9
+"""A token refilled to within this of 1 counts as whole: the timer set by :meth:`CostlyBudget.wait_s` fires then."""
 
 
 class CostlyBudget(typing.Generic[Item]):
@@ -497,8 +499,8 @@ class CostlyBudget(typing.Generic[Item]):
     def offer(self, key: str, item: Item, now: float) -> tuple[bool, bool]:
         """(goes now, replaced one held back) for ``item``, the new value of control ``key``."""
         self._refill(now)
-        if not self._held and self._tokens >= 1.0:
-            self._tokens -= 1.0
+        if not self._held and self._tokens >= 1.0 - _TOKEN_SLACK:
+            self._tokens = max(0.0, self._tokens - 1.0)
             return True, False
         replaced = self._held.pop(key, None) is not None
         self._held[key] = item
@@ -507,9 +509,9 @@ class CostlyBudget(typing.Generic[Item]):
     def take(self, now: float) -> tuple[str, Item] | None:
         """The oldest held-back (key, item) if the budget allows one now, else None."""
         self._refill(now)
-        if not self._held or self._tokens < 1.0:
+        if not self._held or self._tokens < 1.0 - _TOKEN_SLACK:
             return None
-        self._tokens -= 1.0
+        self._tokens = max(0.0, self._tokens - 1.0)
         key = next(iter(self._held))
         return key, self._held.pop(key)
 
@@ -655,6 +657,11 @@ class Gate:
                 task.add_done_callback(self._deliveries.discard)
         self._schedule(client_id, tab)
 
+    def uploads_in_flight(self) -> tuple[int, int]:
+        """(uploads, bytes they announced) started and not finished, across every tab of this server."""
+        everyone = [upload for uploads in self._uploads.values() for upload in uploads.values()]
+        return len(everyone), sum(upload.size_bytes for upload in everyone)
+
     def costly_held_back(self, client_id: int) -> int:
         """How many costly inputs of ``client_id`` wait for its budget (one per control at most)."""
         tab = self._budgets.get(client_id)
@@ -763,21 +770,20 @@ class Gate:
                 client_id,
                 f"This tab already has {MAX_UPLOADS_IN_FLIGHT} uploads under way; wait for one to finish.",
             )
-        everyone = [upload for uploads in self._uploads.values() for upload in uploads.values()]
-        total_bytes = sum(upload.size_bytes for upload in everyone)
+        count, total_bytes = self.uploads_in_flight()
         if (
-            len(everyone) >= MAX_UPLOADS_IN_FLIGHT_TOTAL
+            count >= MAX_UPLOADS_IN_FLIGHT_TOTAL
             or total_bytes + size > MAX_UPLOAD_BYTES_IN_FLIGHT_TOTAL
         ):
             self.log.refuse(
                 "uploads in flight across all tabs",
-                f"{len(everyone)} uploads of {total_bytes} bytes under way, {size} more asked (limits "
+                f"{count} uploads of {total_bytes} bytes under way, {size} more asked (limits "
                 f"{MAX_UPLOADS_IN_FLIGHT_TOTAL} uploads, {MAX_UPLOAD_BYTES_IN_FLIGHT_TOTAL} bytes)",
             )
             return None, self._tell(
                 server,
                 client_id,
-                f"The server is receiving other uploads ({len(everyone)} files, "
+                f"The server is receiving other uploads ({count} files, "
                 f"{total_bytes / MIB:.1f} MiB in flight from all tabs; it takes "
                 f"{MAX_UPLOADS_IN_FLIGHT_TOTAL} files or {MAX_UPLOAD_BYTES_IN_FLIGHT_TOTAL / MIB:.0f} MiB at "
                 "once). Try again in a moment.",

@@ -28,6 +28,7 @@ from PIL import Image
 
 from kernels import sdf
 from scenes._base import Scene
+from scenes._gate import mark_costly
 from shaders import gl_service
 from shaders import renderer as gl_renderer
 from shaders.renderer import (
@@ -458,7 +459,7 @@ IoU is lowest when a box edge is on the silhouette.
                 self.editor_half_size = gui.add_slider(
                     "Editor bounds half size (m)", 0.5, 3.0, 0.1, p.editor.half_size
                 )
-                self.apply = gui.add_button("Apply")
+                self.apply = mark_costly(gui.add_button("Apply"))  # compiles GLSL, remeshes
                 self.editor_status = gui.add_markdown(
                     EDITOR_HELP
                     if allowed
@@ -472,7 +473,9 @@ IoU is lowest when a box edge is on the silhouette.
                     initial_value=_label(BLEND_LABELS, p.blend),
                 )
                 self.k = gui.add_slider("Blend width k (m)", 0.0, 1.0, 0.01, p.k)
-                self.resolution = gui.add_slider(RESOLUTION_LABEL, 32, 256, 16, p.resolution)
+                self.resolution = mark_costly(  # a remesh: up to seconds at 256
+                    gui.add_slider(RESOLUTION_LABEL, 32, 256, 16, p.resolution)
+                )
                 self.progress = gui.add_progress_bar(0.0, visible=False)
                 self.readout = gui.add_markdown("")
             with gui.add_folder("Reference (GLSL ray-march)"):

@@ -55,13 +55,18 @@ class SceneSwitcher:
         if key not in SCENES:
             raise ValueError(f"scene must be one of {sorted(SCENES)}, got {key!r}")
         with self._lock:
-            if self.scene.key != key or rebuild:
-                self.scene.close()
-                self.scene = SCENES[key](self.server)
+            self._build(key, rebuild=rebuild)
             if self.dropdown.value != SCENES[key].title:
                 self.dropdown.value = SCENES[key].title
             return self.scene
 
+    def _build(self, key: str, *, rebuild: bool) -> None:
+        if self.scene.key != key or rebuild:
+            self.scene.close()
+            self.scene = SCENES[key](self.server)
+
+    # A browser's pick or Reset builds without writing the dropdown back: a newer pick that arrived during the
+    # build is in the dropdown already, and its own callback (next in line for the lock) builds it.
     def _on_pick(self, _event: object) -> None:
         with self._lock:
             key = self._key_from_title.get(str(self.dropdown.value))
@@ -69,14 +74,14 @@ class SceneSwitcher:
                 self.dropdown.value = self.scene.title
                 return
             try:
-                self.show(key)
+                self._build(key, rebuild=False)
             except Exception:
                 logger.exception("switching to %s failed", key)
 
     def _on_reset(self, _event: object) -> None:
         with self._lock:
             try:
-                self.show(self.scene.key, rebuild=True)
+                self._build(self.scene.key, rebuild=True)
             except Exception:
                 logger.exception("resetting %s failed", self.scene.key)
 

@@ -1,0 +1,474 @@
+"""One tab cannot starve the others: costly inputs are budgeted per tab, uploads in flight across all tabs.
+
+A flooding tab (a crafted client: the real browser sends at most one message per 50 ms) clicks "Reset scene to
+defaults" or switches scenes hundreds of times a second. Without a budget every click queued a full scene rebuild on
+viser's callback pool, and another tab's first GUI waited behind them (measured: 5 to 10 s). With it, a burst of
+costly inputs from one tab is coalesced (a burst of Resets is one Reset, the latest pick wins) and the rest of the
+server keeps serving.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+import uuid
+from collections.abc import Callable, Iterator
+from typing import Any
+
+import pytest
+import viser
+from hypothesis import given
+from hypothesis import strategies as st
+from test_course_scene import hill_gpx, upload
+from wsclient import BrowserClient
+
+from app import serve_scenes
+from scenes import SCENES
+from scenes._gate import (
+    COSTLY_BURST,
+    COSTLY_RATE_HZ,
+    MAX_UPLOAD_BYTES_IN_FLIGHT_TOTAL,
+    MAX_UPLOADS_IN_FLIGHT_TOTAL,
+    CostlyBudget,
+    install_gate,
+    refusals,
+)
+from scenes._session import Sessions
+from scenes.peloton import PelotonParams, PelotonScene
+
+FIRST_GUI_BOUND_S = 2.0
+"""The most another tab may wait for its first GUI while one tab floods (the issue's bound)."""
+FLOOD_HZ = 200.0
+
+
+@pytest.fixture(autouse=True)
+def _fresh_refusal_log() -> Iterator[None]:
+    refusals.reset()
+    yield
+    refusals.reset()
+
+
+@pytest.fixture
+def sessions(server: viser.ViserServer) -> Iterator[Sessions]:
+    manager = serve_scenes(server, "peloton", shared=False)
+    assert isinstance(manager, Sessions)
+    try:
+        yield manager
+    finally:
+        manager.close()
+
+
+def own_session(server: viser.ViserServer, sessions: Sessions, known: set[int]) -> int:
+    """The client id of the one tab that registered since ``known``, once its session is built."""
+    deadline = time.monotonic() + 20.0
+    while time.monotonic() < deadline:
+        new = set(server.get_clients()) - known
+        if new:
+            (client_id,) = new
+            if sessions.switcher(client_id) is not None:
+                return client_id
+        time.sleep(0.01)
+    raise AssertionError("the tab's session was never built")
+
+
+class Flood:
+    """Send ``messages()`` from ``client`` at ``hz`` on a thread until stopped."""
+
+    def __init__(self, send: Callable[[int], None], hz: float) -> None:
+        self._send = send
+        self._period = 1.0 / hz
+        self._stop = threading.Event()
+        self.sent = 0
+        self.last_sent_at = 0.0
+        self._thread = threading.Thread(target=self._run, name="flood", daemon=True)
+
+    def _run(self) -> None:
+        next_at = time.monotonic()
+        while not self._stop.is_set():
+            self._send(self.sent)
+            self.sent += 1
+            self.last_sent_at = time.monotonic()
+            next_at += self._period
+            self._stop.wait(max(0.0, next_at - time.monotonic()))
+
+    def __enter__(self) -> Flood:
+        self._thread.start()
+        return self
+
+    def __exit__(self, *_exc: object) -> None:
+        self._stop.set()
+        self._thread.join(timeout=5.0)
+
+
+def first_gui_delay(server: viser.ViserServer, sessions: Sessions) -> float:
+    """Seconds from a new tab's connection to the first control of its own session (then checks it is served)."""
+    known = set(server.get_clients())
+    start = time.monotonic()
+    with BrowserClient(server.get_port()) as late:
+        late.wait_for_gui("Reset scene to defaults", timeout=60.0)
+        delay = time.monotonic() - start
+        late.wait_for_node("/peloton", timeout=30.0)
+        switcher = sessions.switcher(own_session(server, sessions, known))
+        assert switcher is not None
+        late.set_value("Speed (km/h)", 31.0)  # a slider moved there reaches its own scene
+        late.wait_for(
+            lambda: switcher.scene.params.speed_kmh == 31.0,  # type: ignore[attr-defined]
+            what="the late tab's slider",
+        )
+    return delay
+
+
+def builds_of(client: BrowserClient, root: str) -> list[float]:
+    """When ``client`` was sent each new build of the scene whose root frame is ``root``."""
+    return [
+        at
+        for at, message in client.received
+        if message.get("type") == "FrameMessage" and message.get("name") == root
+    ]
+
+
+def wait_settled(server: viser.ViserServer, client_id: int) -> None:
+    """Until the gate holds back nothing of ``client_id`` and its callbacks have run."""
+    gate = install_gate(server)
+    deadline = time.monotonic() + 30.0
+    while gate.costly_held_back(client_id) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert gate.costly_held_back(client_id) == 0
+    time.sleep(0.5)  # the last delivered input's rebuild, on viser's callback pool
+
+
+def test_a_reset_flood_does_not_delay_another_tab_and_ends_in_a_reset_scene(
+    server: viser.ViserServer, sessions: Sessions, caplog: pytest.LogCaptureFixture
+) -> None:
+    flooder = BrowserClient(server.get_port())
+    with flooder, caplog.at_level(logging.WARNING):
+        client_id = own_session(server, sessions, set())
+        reset = flooder.wait_for_gui("Reset scene to defaults")
+        flooder.wait_for_node("/peloton")
+        flooder.set_value("Speed (km/h)", 33.0)  # an edit that a Reset undoes
+        switcher = sessions.switcher(client_id)
+        assert switcher is not None
+        flooder.wait_for(lambda: switcher.scene.params.speed_kmh == 33.0, what="the edit")  # type: ignore[attr-defined]
+        built_before = len(builds_of(flooder, "/peloton"))
+        started = time.monotonic()
+        with Flood(
+            lambda _i: flooder.send("GuiUpdateMessage", uuid=reset, updates={"value": True}),
+            FLOOD_HZ,
+        ) as flood:
+            time.sleep(0.5)  # the flood is under way
+            delay = first_gui_delay(server, sessions)
+        flood_s = flood.last_sent_at - started
+        assert flood.sent > 0.5 * FLOOD_HZ
+        assert delay <= FIRST_GUI_BOUND_S, f"the second tab's first GUI took {delay:.2f} s"
+
+        wait_settled(server, client_id)
+        builds = builds_of(flooder, "/peloton")[built_before:]
+        # A burst of Resets is a few rebuilds (the budget), not one per click...
+        assert 1 <= len(builds) <= COSTLY_BURST + flood_s * COSTLY_RATE_HZ + 2, (
+            f"{len(builds)} rebuilds for {flood.sent} Resets in {flood_s:.1f} s"
+        )
+        # ...and the last click is not dropped: a rebuild comes after it.
+        assert builds[-1] >= flood.last_sent_at
+        scene = switcher.scene
+        assert isinstance(scene, PelotonScene) and scene.params == PelotonParams()
+        flooder.wait_for(
+            lambda: flooder.value_of("Speed (km/h)") == PelotonParams().speed_kmh,
+            what="the flooder shows the reset scene",
+        )
+    kinds = [r.getMessage() for r in caplog.records if "costly input" in r.getMessage()]
+    assert 1 <= len(kinds) <= 2  # one rate-limited line, not one per click
+    assert "Traceback" not in caplog.text
+
+
+def test_a_scene_switch_flood_ends_on_the_last_pick_and_does_not_delay_another_tab(
+    server: viser.ViserServer, sessions: Sessions
+) -> None:
+    titles = [cls.title for cls in SCENES.values()]
+    flooder = BrowserClient(server.get_port())
+    with flooder:
+        client_id = own_session(server, sessions, set())
+        pick = flooder.wait_for_gui("Scene")
+        flooder.wait_for_node("/peloton")
+        picked: list[str] = []
+
+        def switch(i: int) -> None:
+            picked.append(titles[i % len(titles)])
+            flooder.send("GuiUpdateMessage", uuid=pick, updates={"value": picked[-1]})
+
+        with Flood(switch, FLOOD_HZ):
+            time.sleep(0.5)
+            delay = first_gui_delay(server, sessions)
+        assert delay <= FIRST_GUI_BOUND_S, f"the second tab's first GUI took {delay:.2f} s"
+
+        wait_settled(server, client_id)
+        (last_key,) = [key for key, cls in SCENES.items() if cls.title == picked[-1]]
+        switcher = sessions.switcher(client_id)
+        assert switcher is not None
+        flooder.wait_for(
+            lambda: switcher.scene.key == last_key and not switcher.scene.closed,
+            timeout=30.0,
+            what=f"the session shows {last_key}",
+        )
+        flooder.wait_for(
+            lambda: (
+                f"/{last_key}" in flooder.nodes
+                and not any(f"/{key}" in flooder.nodes for key in SCENES if key != last_key)
+            ),
+            timeout=20.0,
+            what="the flooder shows only the last pick",
+        )
+        assert flooder.value_of("Scene") == picked[-1]
+
+
+def test_a_slider_at_30_per_second_is_never_held_back(
+    server: viser.ViserServer, sessions: Sessions, caplog: pytest.LogCaptureFixture
+) -> None:
+    with BrowserClient(server.get_port()) as client, caplog.at_level(logging.WARNING):
+        client_id = own_session(server, sessions, set())
+        client.wait_for_node("/peloton")
+        switcher = sessions.switcher(client_id)
+        assert switcher is not None
+        values = [20.0 + 0.5 * i for i in range(45)]  # 1.5 s at 30 messages/s
+        seen: set[float] = set()
+        for value in values:
+            client.set_value("Speed (km/h)", value)
+            time.sleep(1.0 / 30.0)
+            seen.add(switcher.scene.params.speed_kmh)  # type: ignore[attr-defined]
+        client.wait_for(
+            lambda: switcher.scene.params.speed_kmh == values[-1],  # type: ignore[attr-defined]
+            what="the last value",
+        )
+        assert install_gate(server).costly_held_back(client_id) == 0
+        assert len(seen & set(values)) >= len(values) // 2  # applied as they came, not coalesced
+    assert "costly input" not in caplog.text and "refused" not in caplog.text
+
+
+# ------------------------------------------------------------------------------------------ the budget alone
+@given(
+    st.lists(
+        st.tuples(st.floats(0.0, 0.6), st.sampled_from("abc"), st.integers(0, 9)),
+        min_size=1,
+        max_size=80,
+    )
+)
+def test_the_budget_bounds_work_and_delivers_each_controls_last_value(
+    arrivals: list[tuple[float, str, int]],
+) -> None:
+    """Any arrivals of costly inputs (gap s, control, value): at most ``burst + rate·t`` go in any ``t`` s, and each
+    control's last value delivered is the last one sent."""
+    budget: CostlyBudget[int] = CostlyBudget(COSTLY_BURST, COSTLY_RATE_HZ, now=0.0)
+    delivered: list[tuple[float, str, int]] = []
+    now = 0.0
+
+    def release_until(t: float) -> None:
+        while (wait := budget.wait_s(now_box[0])) is not None and now_box[0] + wait <= t:
+            now_box[0] += wait
+            taken = budget.take(now_box[0])
+            assert taken is not None
+            delivered.append((now_box[0], *taken))
+
+    now_box = [0.0]
+    for gap, key, value in arrivals:
+        now += gap
+        release_until(now)
+        now_box[0] = now
+        goes, _ = budget.offer(key, value, now)
+        if goes:
+            delivered.append((now, key, value))
+    release_until(float("inf"))
+
+    last_sent = {key: value for _gap, key, value in arrivals}
+    last_delivered = {key: value for _t, key, value in delivered}
+    assert last_delivered == last_sent
+    times = [t for t, _key, _value in delivered]
+    for i, start in enumerate(times):
+        for j in range(i, len(times)):
+            span = times[j] - start
+            assert j - i + 1 <= COSTLY_BURST + span * COSTLY_RATE_HZ + 1e-9
+
+
+def test_a_burst_of_resets_is_one_held_back_reset() -> None:
+    budget: CostlyBudget[str] = CostlyBudget(3, 1.0, now=0.0)
+    assert [budget.offer("reset", f"click {i}", 0.0)[0] for i in range(200)] == [True] * 3 + [
+        False
+    ] * 197
+    assert budget.held == 1 and budget.wait_s(0.0) == pytest.approx(1.0)
+    assert budget.take(0.5) is None
+    assert budget.take(1.0) == ("reset", "click 199")
+    assert budget.held == 0 and budget.wait_s(1.0) is None
+
+
+@pytest.mark.parametrize(("burst", "rate_hz"), [(0, 1.0), (1, 0.0), (1, float("nan"))])
+def test_a_budget_that_lets_nothing_through_is_refused(burst: int, rate_hz: float) -> None:
+    with pytest.raises(ValueError, match="burst"):
+        CostlyBudget(burst, rate_hz, now=0.0)
+
+
+# ------------------------------------------------------------------------------------------ uploads
+def notifications(client: BrowserClient) -> list[dict[str, Any]]:
+    return [
+        message["props"]
+        for _at, message in list(client.received)
+        if message.get("type") == "NotificationShowMessage"
+    ]
+
+
+def start_upload(client: BrowserClient, size: int, parts: int) -> str:
+    transfer = str(uuid.uuid4())
+    client.send(
+        "FileTransferStartUpload",
+        source_component_uuid=client.uuid_of("Upload GPX"),
+        transfer_uuid=transfer,
+        filename="big.gpx",
+        mime_type="application/gpx+xml",
+        part_count=parts,
+        size_bytes=size,
+    )
+    return transfer
+
+
+def open_course_tabs(
+    server: viser.ViserServer, sessions: Sessions, count: int
+) -> list[tuple[BrowserClient, PelotonScene]]:
+    tabs = []
+    for _ in range(count):
+        known = set(server.get_clients())
+        client = BrowserClient(server.get_port())
+        switcher = sessions.switcher(own_session(server, sessions, known))
+        assert switcher is not None and isinstance(switcher.scene, PelotonScene)
+        switcher.scene.course_mode.enable.value = True
+        client.wait_for_gui("Upload GPX")
+        tabs.append((client, switcher.scene))
+    return tabs
+
+
+def send_part(client: BrowserClient, transfer: str, index: int, content: bytes) -> None:
+    client.send(
+        "FileTransferPart",
+        source_component_uuid=client.uuid_of("Upload GPX"),
+        transfer_uuid=transfer,
+        part_index=index,
+        content=content,
+    )
+
+
+def padded_gpx(name: str, size: int) -> bytes:
+    """A valid GPX course of exactly ``size`` bytes (an XML comment pads it)."""
+    data = hill_gpx(name, 300)
+    head, tail = data.split(b"<trk>", 1)
+    padding = size - len(data) - len(b"<!--  -->")
+    return head + b"<!-- " + b"x" * padding + b" -->" + b"<trk>" + tail
+
+
+def refusal_notice(client: BrowserClient) -> dict[str, Any]:
+    client.wait_for(lambda: bool(notifications(client)), what="the refusal notice")
+    note = notifications(client)[-1]
+    assert note["title"] == "Upload refused" and note["color"] == "red"
+    return note
+
+
+def test_uploads_beyond_the_server_wide_count_are_refused_with_a_notice_and_the_others_complete(
+    server: viser.ViserServer, sessions: Sessions, caplog: pytest.LogCaptureFixture
+) -> None:
+    gate = install_gate(server)
+    tabs = open_course_tabs(server, sessions, 5)
+    try:
+        with caplog.at_level(logging.WARNING):
+            data = [hill_gpx(f"Tab {i}", 300) for i in range(len(tabs))]
+            transfers: list[list[str]] = []
+            for i, (client, _scene) in enumerate(tabs):  # 5 tabs × 2 uploads: 10 > the cap of 8
+                transfers.append([start_upload(client, len(data[i]), 1) for _ in range(2)])
+                if i < 4:
+                    client.wait_for(
+                        lambda i=i: gate.uploads_in_flight()[0] == 2 * (i + 1), what="in flight"
+                    )
+            assert MAX_UPLOADS_IN_FLIGHT_TOTAL == 8
+            note = refusal_notice(tabs[4][0])
+            assert "other uploads" in note["body"] and "8 files" in note["body"]
+            assert gate.uploads_in_flight()[0] == 8
+            for i, (client, _scene) in enumerate(tabs):
+                for transfer in transfers[i]:
+                    send_part(client, transfer, 0, data[i])
+            for i, (client, scene) in enumerate(tabs[:4]):
+                client.wait_for(
+                    lambda s=scene, n=f"Tab {i}": s.course_mode.route.name == n,
+                    what=f"tab {i}'s upload",
+                )
+                assert not notifications(client)
+            assert gate.uploads_in_flight() == (0, 0)
+            assert tabs[4][1].course_mode.route.name != "Tab 4"
+            # Once the others are done, the refused tab's upload goes through.
+            upload(tabs[4][0], "Upload GPX", "again.gpx", data[4])
+            tabs[4][0].wait_for(
+                lambda: tabs[4][1].course_mode.route.name == "Tab 4", what="the retry"
+            )
+        assert "refused uploads in flight across all tabs" in caplog.text
+    finally:
+        for client, _scene in tabs:
+            client.close()
+
+
+def test_uploads_beyond_the_server_wide_bytes_are_refused_with_a_notice_and_the_others_complete(
+    server: viser.ViserServer, sessions: Sessions
+) -> None:
+    gate = install_gate(server)
+    big = 20 * 1024 * 1024
+    assert 3 * big <= MAX_UPLOAD_BYTES_IN_FLIGHT_TOTAL < 4 * big
+    tabs = open_course_tabs(server, sessions, 5)
+    try:
+        transfers = []
+        for i, (client, _scene) in enumerate(tabs[:3]):
+            transfers.append(start_upload(client, big, 1))
+            client.wait_for(lambda i=i: gate.uploads_in_flight()[0] == i + 1, what="in flight")
+        start_upload(tabs[3][0], big, 1)  # 60 + 20 MiB > 64 MiB
+        note = refusal_notice(tabs[3][0])
+        assert "60.0 MiB in flight" in note["body"] and "64 MiB" in note["body"]
+        # A small file still fits beside the three big ones.
+        upload(tabs[4][0], "Upload GPX", "small.gpx", hill_gpx("Small", 300))
+        tabs[4][0].wait_for(lambda: tabs[4][1].course_mode.route.name == "Small", what="small")
+        for i, (client, _scene) in enumerate(tabs[:3]):
+            send_part(client, transfers[i], 0, padded_gpx(f"Big {i}", big))
+        for i, (client, scene) in enumerate(tabs[:3]):
+            client.wait_for(
+                lambda s=scene, n=f"Big {i}": s.course_mode.route.name == n,
+                timeout=30.0,
+                what=f"tab {i}'s 20 MiB upload",
+            )
+            assert not notifications(client)
+        assert gate.uploads_in_flight() == (0, 0)
+        assert tabs[3][1].course_mode.route.name != "Big 3"
+    finally:
+        for client, _scene in tabs:
+            client.close()
+
+
+def test_a_stalled_upload_stops_holding_the_server_wide_budget(
+    server: viser.ViserServer,
+    sessions: Sessions,
+    monkeypatch: pytest.MonkeyPatch,
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    import scenes._gate
+
+    monkeypatch.setattr(scenes._gate, "UPLOAD_STALL_S", 0.3)  # 30 s in the app
+    gate = install_gate(server)
+    tabs = open_course_tabs(server, sessions, 2)
+    try:
+        with caplog.at_level(logging.WARNING):
+            (stalled, _), (honest, scene) = tabs
+            data = hill_gpx("Stalled", 300)
+            transfer = start_upload(stalled, len(data), 2)
+            stalled.wait_for(lambda: gate.uploads_in_flight()[0] == 1, what="in flight")
+            send_part(stalled, transfer, 0, data[:100])
+            time.sleep(0.5)
+            upload(honest, "Upload GPX", "honest.gpx", hill_gpx("Honest", 300))
+            honest.wait_for(lambda: scene.course_mode.route.name == "Honest", what="the upload")
+            assert gate.uploads_in_flight() == (0, 0)
+            send_part(stalled, transfer, 1, data[100:])  # too late: refused, the course stays
+            honest.wait_for(lambda: "refused upload part" in caplog.text, what="the late part")
+            assert tabs[0][1].course_mode.route.name != "Stalled"
+        assert "refused stalled upload" in caplog.text
+    finally:
+        for client, _scene in tabs:
+            client.close()
