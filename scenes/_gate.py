@@ -659,7 +659,9 @@ class Gate:
 
     def uploads_in_flight(self) -> tuple[int, int]:
         """(uploads, bytes they announced) started and not finished, across every tab of this server."""
-        everyone = [upload for uploads in self._uploads.values() for upload in uploads.values()]
+        # Mutated only on the event loop; list() copies each dict in one step under the GIL, so a test thread may
+        # read this while uploads come and go.
+        everyone = [u for uploads in list(self._uploads.values()) for u in list(uploads.values())]
         return len(everyone), sum(upload.size_bytes for upload in everyone)
 
     def costly_held_back(self, client_id: int) -> int:

@@ -118,5 +118,30 @@ def test_uploads_in_flight_are_bounded_per_browser(
     with BrowserClient(server.get_port()) as client, caplog.at_level(logging.WARNING):
         client.wait_for_gui("Upload GPX")
         for _ in range(MAX_UPLOADS_IN_FLIGHT + 3):
-            start(client, part_count=4, size_bytes=MAX_UPLOAD_BYTES)
+            start(client, part_count=4, size_bytes=10)
         client.wait_for(lambda: "refused uploads in flight" in caplog.text, what="the bound")
+        # The person at that tab is told why, once per refused upload.
+        client.wait_for(lambda: len(notices(client)) == 3, what="the refusal notices")
+        assert all(
+            note["title"] == "Upload refused" and f"{MAX_UPLOADS_IN_FLIGHT} uploads" in note["body"]
+            for note in notices(client)
+        )
+
+
+def notices(client: BrowserClient) -> list[dict[str, Any]]:
+    return [
+        message["props"]
+        for _at, message in list(client.received)
+        if message.get("type") == "NotificationShowMessage"
+    ]
+
+
+def test_a_file_over_the_size_limit_is_refused_with_a_notice(
+    server: viser.ViserServer, mode: CourseMode
+) -> None:
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Upload GPX")
+        start(client, part_count=25, size_bytes=MAX_UPLOAD_BYTES + 1)
+        client.wait_for(lambda: bool(notices(client)), what="the refusal notice")
+        (note,) = notices(client)
+        assert note["title"] == "Upload refused" and "up to 24 MiB" in note["body"]
