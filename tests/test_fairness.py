@@ -18,6 +18,7 @@ from typing import Any
 
 import pytest
 import viser
+from browser import open_viser
 from hypothesis import given
 from hypothesis import strategies as st
 from test_course_scene import hill_gpx, upload
@@ -36,6 +37,7 @@ from scenes._gate import (
 )
 from scenes._session import Sessions
 from scenes.peloton import PelotonScene
+from scenes.switcher import SceneSwitcher
 
 FIRST_GUI_BOUND_S = 2.0
 """The most another tab may wait for its first GUI while one tab floods (the issue's bound)."""
@@ -475,9 +477,7 @@ def test_a_stalled_upload_stops_holding_the_server_wide_budget(
     monkeypatch: pytest.MonkeyPatch,
     caplog: pytest.LogCaptureFixture,
 ) -> None:
-    import scenes._gate
-
-    monkeypatch.setattr(scenes._gate, "UPLOAD_STALL_S", 0.3)  # 30 s in the app
+    monkeypatch.setattr("scenes._gate.UPLOAD_STALL_S", 0.3)  # 30 s in the app
     gate = install_gate(server)
     tabs = open_course_tabs(server, sessions, 2)
     try:
@@ -498,3 +498,76 @@ def test_a_stalled_upload_stops_holding_the_server_wide_budget(
     finally:
         for client, _scene in tabs:
             client.close()
+
+
+def pick_file(page: Any, name: str, data: bytes) -> None:
+    """What picking a file for the page's upload button does (set in the page: under software WebGL on busy cores,
+    playwright's click waits on animation frames that may not come for a minute)."""
+    page.wait_for_selector("input[type=file]", state="attached", timeout=120_000)
+    page.evaluate(
+        """([name, text]) => {
+            const input = document.querySelector("input[type=file]");
+            const files = new DataTransfer();
+            files.items.add(new File([text], name, {type: "application/gpx+xml"}));
+            input.files = files.files;
+            input.dispatchEvent(new Event("change", {bubbles: true}));
+        }""",
+        [name, data.decode()],
+    )
+
+
+@pytest.mark.browser
+def test_a_person_whose_upload_is_refused_is_told_why_and_can_retry(
+    server: viser.ViserServer,
+    browser_page: Any,
+    caplog: pytest.LogCaptureFixture,
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Chromium uploads a GPX while crafted tabs hold the server-wide budget: a red notice, then a retry works."""
+    # Software WebGL on busy cores can take over 30 s to run the page's script: the hogs must not stall out first.
+    monkeypatch.setattr("scenes._gate.UPLOAD_STALL_S", 600.0)
+
+    switcher = SceneSwitcher(server, "peloton")
+    hogs: list[BrowserClient] = []
+    caplog.set_level(logging.WARNING)
+    try:
+        scene = switcher.scene
+        assert isinstance(scene, PelotonScene)
+        mode = scene.course_mode
+        mode.enable.value = True
+        gate = install_gate(server)
+        page = browser_page
+        open_viser(page, server.get_port(), "/peloton/course_mode/route", timeout_ms=120_000)
+        page.wait_for_selector("input[type=file]", state="attached", timeout=120_000)
+        # 2 tabs × 4 uploads that never send a part: the 8 the server takes at once.
+        hogs += [BrowserClient(server.get_port()) for _ in range(2)]
+        for hog in hogs:
+            hog.wait_for_gui("Upload GPX")
+            for _ in range(4):
+                start_upload(hog, 1000, 1)
+        hogs[0].wait_for(lambda: gate.uploads_in_flight()[0] == 8, what="the budget held")
+        data = hill_gpx("Browser retry", 300)
+        pick_file(page, "retry.gpx", data)
+        wait_logged = time.monotonic() + 60.0
+        while "across all tabs" not in caplog.text and time.monotonic() < wait_logged:
+            time.sleep(0.1)
+        assert "refused uploads in flight across all tabs" in caplog.text
+        page.get_by_text("Upload refused", exact=True).first.wait_for(timeout=60_000)
+        page.get_by_text("receiving other uploads", exact=False).first.wait_for(timeout=10_000)
+        assert mode.route.name != "Browser retry"
+
+        for hog in hogs:
+            hog.close()  # their uploads end with their tabs
+        deadline = time.monotonic() + 20.0
+        while gate.uploads_in_flight()[0] and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert gate.uploads_in_flight() == (0, 0)
+        pick_file(page, "retry.gpx", data)
+        deadline = time.monotonic() + 60.0
+        while mode.route.name != "Browser retry" and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert mode.route.name == "Browser retry"
+    finally:
+        for hog in hogs:
+            hog.close()
+        switcher.close()
