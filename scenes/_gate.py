@@ -18,6 +18,11 @@ A control's limits and options are its :class:`ControlSpec`, recorded by :func:`
 it (before any browser can touch it) and kept beside the handle; they are never read back from the handle's props,
 which a browser could once change.
 
+Two budgets keep one tab from starving the others. Costly inputs (a control the scene marked with
+:func:`mark_costly`: a scene switch, a Reset, a remesh) go through a per-tab token bucket (:class:`CostlyBudget`):
+beyond it only the latest value of each such control is held back and delivered later, never dropped. Uploads in
+flight are bounded per tab and across all tabs; a refused upload is told to its tab as a notification.
+
 viser is pinned ``==1.1.1`` because this module reaches into its internals: the websocket server's dispatch, the
 per-connection dispatch, the GUI and gizmo registries, and the frame decoder.
 """
