@@ -39,6 +39,9 @@ logger = logging.getLogger(__name__)
 
 T = TypeVar("T")
 
+BUILD_WAIT_S = 120.0
+"""How long a browser's callback waits for its scene to finish building before it gives up (s)."""
+
 
 class Scene(abc.ABC):
     """Base class of the four scenes. Subclasses set the class variables and build in ``__init__``."""
@@ -54,7 +57,27 @@ class Scene(abc.ABC):
     camera_look_at: ClassVar[tuple[float, float, float]] = (0.0, 0.0, 0.5)
     """What the camera opens looking at (world frame, m)."""
 
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        """Mark the scene built when the most-derived ``__init__`` returns (callbacks wait for it)."""
+        super().__init_subclass__(**kwargs)
+        init = cls.__dict__.get("__init__")
+        if init is None:
+            return
+
+        @functools.wraps(init)
+        def init_then_mark_built(self: Scene, *args: Any, **kw: Any) -> None:
+            init(self, *args, **kw)
+            # Only the outermost __init__ marks it (a subclass of a scene may or may not define its own).
+            if type(self).__init__ is init_then_mark_built:
+                self._built.set()
+
+        cls.__init__ = init_then_mark_built
+
     def __init__(self, server: viser.ViserServer | Session) -> None:
+        self._built = threading.Event()
+        """Set when the scene's ``__init__`` has finished: its GUI exists before its 3D nodes, and a browser can
+        move a control in between (8 tabs building at once on 2 cores leave a second or more for it)."""
+        self._build_thread = threading.get_ident()
         session = server if isinstance(server, Session) else Session.shared(server)
         self.server = session
         """What the scene draws on: ``.scene``, ``.gui``, ``.atomic()``, ``.flush()`` (one tab's or everyone's)."""
@@ -137,6 +160,9 @@ class Scene(abc.ABC):
         burst instead of a queue that grows without bound (and fills viser's 32 callback threads), and the scene
         still ends on the last value sent. A handler must therefore depend only on the scene's state, not on
         how many times it ran (true of every value, pose and button handler here).
+
+        A call that arrives while the scene is still being built (its controls exist before its nodes) waits for
+        the build to finish, then applies the newest value, rather than failing on half a scene or being lost.
         """
         pending = False
         """True while a call of this handler is queued for the scene's lock and has not read any input yet."""
@@ -148,6 +174,13 @@ class Scene(abc.ABC):
                 if pending:
                     return  # the queued call has not read the handles yet: it will see this value
                 pending = True
+            if threading.get_ident() != self._build_thread and not self._built.wait(BUILD_WAIT_S):
+                with self._pending_lock:
+                    pending = False
+                logger.warning(
+                    "%s: the scene took over %.0f s to build; input dropped", self.key, BUILD_WAIT_S
+                )
+                return
             with self._lock:
                 with self._pending_lock:
                     pending = False  # from here on a newer value needs a call of its own
