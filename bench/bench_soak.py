@@ -4,9 +4,12 @@
                                [--modes session shared]
 
 For each mode and scene it starts ``app.py`` in its own process (``--shared`` for the shared mode) and N fake
-browsers (``tests/wsclient.py``), each in its own process. Each browser moves its scene's main input at ``rate``
-messages per second for ``seconds``: the peloton's speed slider, the arm's target gizmo, the free kick's launch
-speed slider, the SDF gallery's second primitive's gizmo. It prints:
+browsers (``tests/wsclient.py``), each in its own process. Every browser connects and receives its scene first; then
+all start together (a barrier file) and each moves its scene's main input at ``rate`` messages per second for
+exactly ``seconds``: the peloton's speed slider, the arm's target gizmo, the free kick's launch speed slider, the SDF
+gallery's second primitive's gizmo. A browser keeps only the arrival times of the scene updates it receives (kept
+whole, a minute of SDF meshes is gigabytes per browser). It prints the date, the machine and the load average, then
+one Markdown row per mode and scene (ready to paste into the README, with the load average at its start and end):
 
 - the app's RSS over the run (every 10 s; the last figure is after the browsers closed) and its slope while they
   ran, after the first minute (after the first third on runs shorter than three minutes), in MiB/min;
