@@ -98,6 +98,7 @@ class Scene(abc.ABC):
     def close(self) -> None:
         """Stop the scene's threads and remove every node and GUI element it created."""
         self._stop.set()
+        self._built.set()  # callbacks still waiting for a build that failed go on, see the scene closed, return
         hub = self.server.cameras
         for listener in self._camera_listeners:
             hub.remove(listener)
