@@ -39,6 +39,9 @@ logger = logging.getLogger(__name__)
 
 T = TypeVar("T")
 
+BUILD_WAIT_S = 120.0
+"""How long a browser's callback waits for its scene to finish building before it gives up (s)."""
+
 
 class Scene(abc.ABC):
     """Base class of the four scenes. Subclasses set the class variables and build in ``__init__``."""
@@ -54,13 +57,35 @@ class Scene(abc.ABC):
     camera_look_at: ClassVar[tuple[float, float, float]] = (0.0, 0.0, 0.5)
     """What the camera opens looking at (world frame, m)."""
 
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        """Mark the scene built when the most-derived ``__init__`` returns (callbacks wait for it)."""
+        super().__init_subclass__(**kwargs)
+        init = cls.__dict__.get("__init__")
+        if init is None:
+            return
+
+        @functools.wraps(init)
+        def init_then_mark_built(self: Scene, *args: Any, **kw: Any) -> None:
+            init(self, *args, **kw)
+            # Only the outermost __init__ marks it (a subclass of a scene may or may not define its own).
+            if type(self).__init__ is init_then_mark_built:
+                self._built.set()
+
+        cls.__init__ = init_then_mark_built
+
     def __init__(self, server: viser.ViserServer | Session) -> None:
+        self._built = threading.Event()
+        """Set when the scene's ``__init__`` has finished: its GUI exists before its 3D nodes, and a browser can
+        move a control in between (8 tabs building at once on 2 cores leave a second or more for it)."""
+        self._build_thread = threading.get_ident()
         session = server if isinstance(server, Session) else Session.shared(server)
         self.server = session
         """What the scene draws on: ``.scene``, ``.gui``, ``.atomic()``, ``.flush()`` (one tab's or everyone's)."""
         self.root = session.scene.add_frame(f"/{self.key}", show_axes=False)
         self.gui_root = session.gui.add_folder(self.title)
         self._lock = threading.RLock()
+        self._pending_lock = threading.Lock()
+        """Guards each handler's "a call is queued" flag (:meth:`callback`); held only to read or set it."""
         self._in_callback = False
         self._stop = threading.Event()
         self._threads: list[threading.Thread] = []
@@ -73,6 +98,7 @@ class Scene(abc.ABC):
     def close(self) -> None:
         """Stop the scene's threads and remove every node and GUI element it created."""
         self._stop.set()
+        self._built.set()  # callbacks still waiting for a build that failed go on, see the scene closed, return
         hub = self.server.cameras
         for listener in self._camera_listeners:
             hub.remove(listener)
@@ -127,11 +153,38 @@ class Scene(abc.ABC):
 
         Callbacks are serialised, re-entrant calls (a write-back of a cleaned value runs ``on_update`` again,
         synchronously) are dropped, and no exception escapes: it is logged and the scene keeps its last state.
+
+        Bursts coalesce, latest value wins: viser stores a message's value on the handle before it queues the
+        callback, and a handler reads the handle, not the event. So while one call of this handler waits for the
+        scene (another callback runs), later calls return at once: the waiting call runs after their values
+        arrived and reads the newest. A flood of 30 messages/s from each of 8 tabs therefore costs one update per
+        burst instead of a queue that grows without bound (and fills viser's 32 callback threads), and the scene
+        still ends on the last value sent. A handler must therefore depend only on the scene's state, not on
+        how many times it ran (true of every value, pose and button handler here).
+
+        A call that arrives while the scene is still being built (its controls exist before its nodes) waits for
+        the build to finish, then applies the newest value, rather than failing on half a scene or being lost.
         """
+        pending = False
+        """True while a call of this handler is queued for the scene's lock and has not read any input yet."""
 
         @functools.wraps(func)
         def handler(_event: Any = None) -> None:
+            nonlocal pending
+            with self._pending_lock:
+                if pending:
+                    return  # the queued call has not read the handles yet: it will see this value
+                pending = True
+            if threading.get_ident() != self._build_thread and not self._built.wait(BUILD_WAIT_S):
+                with self._pending_lock:
+                    pending = False
+                logger.warning(
+                    "%s: the scene took over %.0f s to build; input dropped", self.key, BUILD_WAIT_S
+                )
+                return
             with self._lock:
+                with self._pending_lock:
+                    pending = False  # from here on a newer value needs a call of its own
                 if self._in_callback or self.closed:
                     return
                 self._in_callback = True
