@@ -177,6 +177,7 @@ def test_a_tab_closed_while_its_session_builds_is_torn_down_and_sent_nothing(
 
     monkeypatch.setitem(SCENES, "peloton", SlowPeloton)
     manager = serve_scenes(server, "peloton", shared=False)
+    assert isinstance(manager, Sessions)
     try:
         tab = BrowserClient(server.get_port())
         assert entered.wait(30.0), "the session's build began"
@@ -379,7 +380,9 @@ def test_tab_churn_leaves_rss_flat_and_sends_nothing_to_closed_tabs() -> None:
         # viser's callback pool grows toward its 32 threads as builds overlap, each thread adding its stack pages
         # (~0.4 MiB): measure over a run of tabs in which the pool no longer grew.
         churn(30)
-        measured = []
+        measured: list[str] = []
+        start = end = threads_before = threads_after = 0
+        per_tab_kib = math.inf
         for _ in range(4):
             start, threads_before = settled_rss(app), thread_count(app.process.pid)
             churn(30)
