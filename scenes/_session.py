@@ -285,15 +285,19 @@ class Sessions:
                 self._switchers[client.client_id] = switcher
         if gone:
             self._close_switcher(client, switcher)
+            del switcher  # the last reference: the collection below frees the session
+            give_memory_back()
 
     def _close(self, client: viser.ClientHandle) -> None:
         with self._lock:
             switcher = self._switchers.pop(client.client_id, None)
         if switcher is not None:
             self._close_switcher(client, switcher)
+            del switcher  # the last reference: the collection below frees the session
+            give_memory_back()
 
     def _close_switcher(self, client: viser.ClientHandle, switcher: SceneSwitcher) -> None:
-        """Close a tab's session, wait for its scene's threads (off the event loop) and hand its memory back."""
+        """Close a tab's session and wait for its scene's threads (a thread-pool callback: off the event loop)."""
         try:
             with _dead_writes_allowed(client):
                 switcher.close()
@@ -303,8 +307,6 @@ class Sessions:
                 )
         except Exception:
             logger.exception("closing the session of client %s failed", client.client_id)
-        del switcher
-        give_memory_back()
 
     def close(self) -> None:
         """Close every session (the server stays up)."""
