@@ -314,4 +314,9 @@ class Sessions:
             switchers = list(self._switchers.values())
             self._switchers.clear()
         for switcher in switchers:
-            switcher.close()
+            client = switcher.server.client
+            if client is None:
+                switcher.close()
+            else:  # its tab may be closing now, its disconnect callback still queued
+                with _dead_writes_allowed(client):
+                    switcher.close()
