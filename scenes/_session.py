@@ -222,6 +222,16 @@ def limit_malloc_arenas(count: int = 2) -> None:
         mallopt(M_ARENA_MAX, count)
 
 
+def _dead_writes_allowed(client: viser.ClientHandle) -> AbstractContextManager[object]:
+    """A scope in which messages queued for ``client`` after its tab closed do not warn (viser 1.1.1's own scope).
+
+    viser warns once per closed tab about a write through a stale handle; a session being built or closed when
+    its tab goes writes there by construction, and those messages are freed with the client.
+    """
+    buffer = client._websock_connection.get_message_buffer()  # pyright: ignore[reportPrivateUsage]
+    return buffer.sanctioned_dead_writes()
+
+
 class Sessions:
     """A :class:`~scenes.switcher.SceneSwitcher` per browser tab: built when it connects, closed when it goes."""
 
@@ -234,9 +244,6 @@ class Sessions:
         self.initial = initial
         self._lock = threading.Lock()
         self._switchers: dict[int, SceneSwitcher] = {}
-        self._building: set[int] = set()
-        self._gone: set[int] = set()
-        """Tabs that closed while their session was being built."""
         install_gate(server)
         server.on_client_connect(self._open)
         server.on_client_disconnect(self._close)
@@ -251,45 +258,55 @@ class Sessions:
         with self._lock:
             return len(self._switchers)
 
+    def _connected(self, client: viser.ClientHandle) -> bool:
+        """Whether ``client``'s tab is still open (viser forgets a client before its disconnect callbacks run)."""
+        return client.client_id in self.server.get_clients()
+
     def _open(self, client: viser.ClientHandle) -> None:
         from scenes.switcher import SceneSwitcher
 
-        with self._lock:
-            self._building.add(client.client_id)
+        # Connect and disconnect callbacks run on viser's thread pool, in any order: a tab that closed before its
+        # build began gets none, and one that closes during the build is torn down when the build ends.
+        if not self._connected(client):
+            return
         try:
-            switcher = SceneSwitcher(Session.for_client(self.server, client), self.initial)
+            # What the build queues after the tab went lies in that client's dead buffer, freed with it, and is
+            # torn down below: not the stale-handle writes viser's "closed connection" warning is for.
+            with _dead_writes_allowed(client):
+                switcher = SceneSwitcher(Session.for_client(self.server, client), self.initial)
         except Exception:
             logger.exception("building the session of client %s failed", client.client_id)
-            with self._lock:
-                self._building.discard(client.client_id)
-                self._gone.discard(client.client_id)
             return
         with self._lock:
-            self._building.discard(client.client_id)
-            gone = client.client_id in self._gone
-            self._gone.discard(client.client_id)
+            # Checked under the lock that _close takes: either the tab is still known here (and _close, which
+            # viser calls after forgetting it, finds this switcher) or it is gone and nobody else will close it.
+            gone = not self._connected(client)
             if not gone:
                 self._switchers[client.client_id] = switcher
-        if gone:  # the tab closed while its session was being built
-            switcher.close()
+        if gone:
+            self._close_switcher(client, switcher)
+            del switcher  # the last reference: the collection below frees the session
+            give_memory_back()
 
     def _close(self, client: viser.ClientHandle) -> None:
         with self._lock:
             switcher = self._switchers.pop(client.client_id, None)
-            if switcher is None and client.client_id in self._building:
-                self._gone.add(client.client_id)
         if switcher is not None:
-            try:
-                switcher.close()
-                # Off the event loop (a thread-pool callback): wait for a job in flight, then hand its memory back.
-                if not switcher.scene.join(timeout_s=120.0):
-                    logger.warning(
-                        "session of client %s: a scene thread is still running", client.client_id
-                    )
-            except Exception:
-                logger.exception("closing the session of client %s failed", client.client_id)
-            del switcher
+            self._close_switcher(client, switcher)
+            del switcher  # the last reference: the collection below frees the session
             give_memory_back()
+
+    def _close_switcher(self, client: viser.ClientHandle, switcher: SceneSwitcher) -> None:
+        """Close a tab's session and wait for its scene's threads (a thread-pool callback: off the event loop)."""
+        try:
+            with _dead_writes_allowed(client):
+                switcher.close()
+            if not switcher.scene.join(timeout_s=120.0):
+                logger.warning(
+                    "session of client %s: a scene thread is still running", client.client_id
+                )
+        except Exception:
+            logger.exception("closing the session of client %s failed", client.client_id)
 
     def close(self) -> None:
         """Close every session (the server stays up)."""
@@ -297,4 +314,9 @@ class Sessions:
             switchers = list(self._switchers.values())
             self._switchers.clear()
         for switcher in switchers:
-            switcher.close()
+            client = switcher.server.client
+            if client is None:
+                switcher.close()
+            else:  # its tab may be closing now, its disconnect callback still queued
+                with _dead_writes_allowed(client):
+                    switcher.close()
