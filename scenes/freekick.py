@@ -843,7 +843,7 @@ class FreeKickScene(Scene):
 **What it shows.** A free kick's flight in 3D over a four-man wall 9.15 m from the ball (1.8 m tall; 2.15 m when it
 jumps): the kick as set (thick orange line), the same kick with no spin (dark dashed ghost), a faint band between 10 % less
 and 10 % more spin, and force arrows along the path: drag (red), Magnus (blue), gravity (purple). **View** frames
-the kick from behind the ball, side-on, from the goal or from above. **Kick** flies the ball, spinning,
+the kick raised over the kicker's shoulder, from behind the ball, side-on, as the goalkeeper sees it or from above. **Kick** flies the ball, spinning,
 in real time. Click a point in the goal mouth to have the scene find a kick that reaches it over the wall. The
 outcome map colours each launch speed × spin rate by result: goal (green), wall (red), over (orange), wide (yellow),
 short (grey); the white cross is the current kick.
