@@ -154,6 +154,29 @@ def frame_points(
     )
 
 
+def project_points(view: View, lens: Lens, points: NDArray[np.float64]) -> NDArray[np.float64]:
+    """(N, 3) where ``points`` land on the canvas of a camera at ``view`` with up +z: x, y (px from the top left) and
+    depth along the view axis (m), as three.js's perspective camera draws them.
+
+    Args:
+        view: camera position and orbit centre (world frame, m).
+        lens: the browser's vertical field of view and canvas size.
+        points: (N, 3) world points (m).
+    """
+    pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    eye = np.asarray(view.position, dtype=np.float64)
+    d, right, up = _basis(np.asarray(view.look_at, dtype=np.float64) - eye)
+    rel = pts - eye
+    depth = rel @ d
+    safe = np.where(np.abs(depth) > 1e-9, depth, 1e-9)
+    tan_y = math.tan(0.5 * lens.fov_rad)
+    ndc_x = (rel @ right) / (safe * tan_y * lens.aspect)
+    ndc_y = (rel @ up) / (safe * tan_y)
+    return np.stack(
+        [0.5 * (ndc_x + 1.0) * lens.width_px, 0.5 * (1.0 - ndc_y) * lens.height_px, depth], axis=1
+    )
+
+
 def box_corners(
     lo: NDArray[np.float64] | tuple, hi: NDArray[np.float64] | tuple
 ) -> NDArray[np.float64]:

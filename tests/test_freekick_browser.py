@@ -1,6 +1,8 @@
 """A real browser looks at the free kick: ball, wall, goal and path in view and clear of the panel, the force chart
-drawn, no error text, at 1600×1000 and 1280×720; 10 % more spin moves the path on the screen; every camera view
-keeps the kick in view; a mouse click on "Kick" flies the ball in the page."""
+drawn, no error text, at 1600×1000 and 1280×720; in the opening view the path stands apart from its no-spin ghost and
+10 % more spin moves it on the screen; every camera view keeps the kick in view with the goal a real size, and the
+goalkeeper's view stands in front of the goal line with no net over the ball; a mouse click on "Kick" flies the ball
+in the page."""
 
 from __future__ import annotations
 
@@ -16,6 +18,7 @@ from browser import (
     assert_chart_draws,
     assert_in_view,
     assert_seen,
+    changed_mask,
     close_notifications,
     colour_pixels,
     error_text,
@@ -28,7 +31,9 @@ from browser import (
     set_number,
     settle,
     wait_until,
+    with_nodes_hidden,
 )
+from screen_geometry import GOAL_CORNERS, polyline_gap
 
 from scenes.freekick import (
     FORCE_COLOURS,
@@ -36,6 +41,7 @@ from scenes.freekick import (
     PATH_COLOUR,
     VIEW_LABELS,
     FreeKickScene,
+    ViewName,
     ball_spot,
     resample,
     view_points,
@@ -49,6 +55,20 @@ NODE = f"window.__viserMutable.nodeRefFromName[{BALL!r}]"
 MAIN = ["/freekick/wall", "/freekick/goal_frame", "/freekick/path", "/freekick/ball"]
 CHART = "Force magnitudes along the flight"
 CHART_COLOURS = {**FORCE_COLOURS, "knuckle": KNUCKLE_COLOUR}
+GOAL_SHARE: dict[ViewName, float] = {
+    "broadcast": 0.25,
+    "behind": 0.12,
+    "side": 0.12,
+    "above": 0.18,
+}
+"""Least share of the free canvas width (left of the panel) the goal's box spans in each view that shows it; the
+old opening view spanned 0.18–0.19. Behind the ball and side-on the goal is far off or seen edge on (0.15–0.18)."""
+OPENING_GAP_PX = 25.0
+"""Least on-screen distance of the path from its no-spin ghost over the flight's second half, opening view (the old
+one drew them 1–10 px apart)."""
+SPIN_SHIFT_SHARE = 0.006
+"""10 % more spin moves the crossing of the goal line by at least this share of the window width on the screen in
+the opening view (the old view: 8.2 px at 1600 and 5.8 px at 1280 wide, under it)."""
 
 
 @pytest.fixture(scope="module", params=VIEWPORTS, ids=lambda v: f"{v[0]}x{v[1]}")
@@ -67,15 +87,29 @@ def _look_at_the_kick(shown: ScenePage) -> None:
     assert_seen(shown, image, MAIN, xy, "ball, wall, goal and path")
 
 
+def _goal_share(shown: ScenePage) -> float:
+    xy = project(shown.page, "/freekick", GOAL_CORNERS)[:, :2]
+    return float(np.ptp(xy[:, 0])) / panel_rect(shown.page)[0]
+
+
 def test_the_kick_fills_the_view_clear_of_the_panel(shown: ScenePage) -> None:
     _look_at_the_kick(shown)
     scene = shown.scene
-    # It fills the screen: the goal-to-ball extent spans most of the free width, not a postage stamp.
+    assert scene._view == "broadcast"
+    # It fills the screen: the goal-to-ball extent spans most of the free width, not a postage stamp...
     with scene._lock:
         points = view_points(scene.params, scene.state, scene._view)
+        path, ghost = resample(scene.state.flight, 40), resample(scene.state.ghost, 40)
     xy = project(shown.page, "/freekick", points)[:, :2]
     width = panel_rect(shown.page)[0]
     assert np.ptp(xy[:, 0]) > 0.6 * width, np.ptp(xy[:, 0])
+    # ...with the goal a real size...
+    assert _goal_share(shown) >= GOAL_SHARE["broadcast"], _goal_share(shown)
+    # ...and the curl across the screen: the path stands apart from the no-spin ghost over the second half.
+    path_xy = project(shown.page, "/freekick", path)[20:, :2]
+    ghost_xy = project(shown.page, "/freekick", ghost)[:, :2]
+    gap = polyline_gap(path_xy, ghost_xy)
+    assert np.mean(gap >= OPENING_GAP_PX) >= 0.9, np.round(gap)
     save_docs_screenshot(shown, "freekick")
 
 
@@ -102,7 +136,9 @@ def test_ten_percent_more_spin_moves_the_path_on_the_screen(shown: ScenePage) ->
         after = resample(scene.state.flight, 40)
     now = project(shown.page, "/freekick", after)[:, :2]
     # Where the ball crosses the goal line moved by several pixels on the screen...
-    assert np.linalg.norm(now[-1] - was[-1]) > 5.0, (was[-1], now[-1])
+    assert scene._view == "broadcast"
+    shift = float(np.linalg.norm(now[-1] - was[-1]))
+    assert shift > SPIN_SHIFT_SHARE * shown.viewport[0], (was[-1], now[-1])
     # ...and the orange path is drawn there, not where it was.
     image = screenshot(shown.page)
     samples = now[20:-2:2]
@@ -118,11 +154,12 @@ def test_ten_percent_more_spin_moves_the_path_on_the_screen(shown: ScenePage) ->
 
 def test_every_camera_view_keeps_the_kick_in_view(shown: ScenePage) -> None:
     scene = shown.scene
-    views = list(VIEW_LABELS)
-    for view in [
+    views: list[ViewName] = list(VIEW_LABELS)
+    order: list[ViewName] = [
         *views[1:],
         views[0],
-    ]:  # the opening view last: choosing the shown one changes nothing
+    ]  # the opening view last: choosing it again changes nothing
+    for view in order:
         frames = scene.framing.frames
         scene.view.value = VIEW_LABELS[view]  # type: ignore[index]
         wait_until(
@@ -130,9 +167,27 @@ def test_every_camera_view_keeps_the_kick_in_view(shown: ScenePage) -> None:
             f"the {view} view",
         )
         settle(shown)
+        image = screenshot(shown.page)
         with scene._lock:
             points = view_points(scene.params, scene.state, scene._view)
-        assert_in_view(shown, "/freekick", points, f"the kick ({view})")
+            spot = ball_spot(scene.params)
+        xy = assert_in_view(shown, "/freekick", points, f"the kick ({view})")
+        assert_seen(shown, image, MAIN, xy, f"ball, wall, goal and path ({view})")
+        if view != "goal":
+            assert_in_view(shown, "/freekick", GOAL_CORNERS, f"the goal ({view})")
+            assert _goal_share(shown) >= GOAL_SHARE[view], (view, _goal_share(shown))
+            continue
+        # The goalkeeper's view: the camera stands on the pitch in front of the goal line (x < 0)...
+        eye = np.asarray(shown.client_camera.position)
+        assert eye[0] < -0.25, eye
+        # ...and no net or post is drawn over the ball.
+        ball_xy = project(shown.page, "/freekick", [spot.tolist()])[0, :2]
+        x, y = np.round(ball_xy).astype(int)
+        without_goal = with_nodes_hidden(shown.page, ["/freekick/net", "/freekick/goal_frame"])
+        over_ball = changed_mask(image, without_goal)[y - 6 : y + 7, x - 6 : x + 7]
+        assert not over_ball.any(), f"the goal is drawn over the ball at {x, y}"
+        ball_seen = changed_mask(image, with_nodes_hidden(shown.page, [BALL]))
+        assert ball_seen[y - 8 : y + 9, x - 8 : x + 9].sum() >= 5, "the ball is hidden"
 
 
 def test_pressing_kick_flies_the_ball_in_the_page(

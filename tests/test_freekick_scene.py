@@ -9,25 +9,40 @@ import math
 import numpy as np
 import pytest
 import viser
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from numpy.typing import NDArray
+from screen_geometry import GOAL_CORNERS, polyline_gap
 from wsclient import BrowserClient
 
 from kernels import ball
+from scenes._framing import MARGIN_PX, PANEL_PX, Lens, View, frame_points, project_points
 from scenes.freekick import (
     AIM_TOLERANCE_M,
     ARROW_POINTS,
     JUMP_M,
+    KEEPER_FRONT_M,
     MAP_SPEEDS_MS,
     MAP_SPINS_REV_S,
     PATH_POINTS,
     PRESETS,
     RESULT_COLOURS,
+    VIEW_LABELS,
+    VIEW_MIN_DEPTH_M,
     FreeKickParams,
     FreeKickScene,
+    KickState,
+    Preset,
+    ViewName,
     aim_at,
+    ball_spot,
     compute_kick,
+    frame_view,
     outcome_map,
     resample,
     spin_words,
+    view_points,
+    wall_hides,
 )
 from scenes.switcher import SceneSwitcher
 
@@ -442,3 +457,134 @@ def test_the_outcome_map_flies_the_knuckleball_when_it_is_on() -> None:
     for col in (0, 10, 20, 30, 40):
         params = dataclasses.replace(knuckler, speed_ms=float(MAP_SPEEDS_MS[col]), spin_rev_s=0.0)
         assert on[0, col] == compute_kick(params).outcome.result, col
+
+
+# ------------------------------------------------------------------------------------------------ camera views (issue 9)
+FOV_RAD = math.radians(75.0)
+"""The field of view viser's client opens with (measured in Chromium: 1.309 rad)."""
+LENSES = [Lens(FOV_RAD, 1600, 1000), Lens(FOV_RAD, 1280, 720)]
+OLD_BROADCAST_MIN_DEPTH_M = 6.0
+OPENING_GAP_PX = 25.0
+"""How far apart (px) the path and its no-spin ghost must be drawn in the opening view (the old one: 1–10 px)."""
+OPENING_GOAL_SHARE = 0.25
+"""Share of the free canvas width the goal must span in the opening view (the old one: 0.18–0.19)."""
+
+
+def _old_broadcast(p: FreeKickParams, state: KickState, lens: Lens) -> View:
+    """The opening view before issue 9's review: beside the kicker's right shoulder, 20° down."""
+    spot = ball_spot(p)
+    forward = np.array([-spot[0], -spot[1], 0.0]) / math.hypot(spot[0], spot[1])
+    left = np.array([-forward[1], forward[0], 0.0])
+    d = forward + 0.75 * left + 0.35 * np.array([0.0, 0.0, -1.0])
+    return frame_points(
+        view_points(p, state, "broadcast"),
+        (float(d[0]), float(d[1]), float(d[2])),
+        fov_rad=lens.fov_rad,
+        aspect=lens.aspect,
+        ndc=lens.usable_ndc(),
+        min_depth=OLD_BROADCAST_MIN_DEPTH_M,
+    )
+
+
+def _path_ghost_gap(state: KickState, view: View, lens: Lens) -> NDArray[np.float64]:
+    """(20,) on-screen distance (px) of each point of the path's second half to the drawn no-spin ghost."""
+    path = project_points(view, lens, resample(state.flight, 40))[20:, :2]
+    ghost = project_points(view, lens, resample(state.ghost, 40))[:, :2]
+    return polyline_gap(path, ghost)
+
+
+def _goal_width_share(view: View, lens: Lens) -> float:
+    """Width of the goal's projected box over the canvas width left of the panel."""
+    xy = project_points(view, lens, GOAL_CORNERS)
+    return float(np.ptp(xy[:, 0])) / (lens.width_px - PANEL_PX)
+
+
+def _assert_framed(p: FreeKickParams, view: ViewName, lens: Lens) -> View:
+    state = compute_kick(p)
+    framed = frame_view(p, state, view, lens)
+    xy = project_points(framed, lens, view_points(p, state, view))
+    where = (view, lens.width_px, p.distance_m, p.angle_deg)
+    assert xy[:, 2].min() >= VIEW_MIN_DEPTH_M[view] - 1e-6, where  # in front, not in the ball
+    assert xy[:, 0].min() >= MARGIN_PX - 0.5 and xy[:, 1].min() >= MARGIN_PX - 0.5, where
+    assert xy[:, 0].max() <= lens.width_px - PANEL_PX - MARGIN_PX + 0.5, where  # left of the panel
+    assert xy[:, 1].max() <= lens.height_px - MARGIN_PX + 0.5, where
+    if view == "goal":
+        # The goalkeeper's camera stands in front of the goal line (the pitch is x < 0), so neither net nor frame
+        # is between it and the ball, and it sees the ball past or over the wall.
+        assert framed.position[0] <= -KEEPER_FRONT_M, (where, framed.position)
+        assert not wall_hides(state, np.array(framed.position), ball_spot(p)), where
+    return framed
+
+
+@pytest.mark.parametrize("lens", LENSES, ids=lambda lens: f"{lens.width_px}x{lens.height_px}")
+@pytest.mark.parametrize("view", list(VIEW_LABELS))
+@pytest.mark.parametrize("preset", PRESETS, ids=lambda preset: preset.label)
+def test_every_view_frames_every_preset_left_of_the_panel(
+    preset: Preset, view: ViewName, lens: Lens
+) -> None:
+    _assert_framed(preset.params, view, lens)
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    distance=st.floats(12.0, 40.0),
+    angle=st.floats(-45.0, 45.0),
+    view=st.sampled_from(list(VIEW_LABELS)),
+    wide=st.booleans(),
+)
+def test_every_view_frames_every_ball_spot_left_of_the_panel(
+    distance: float, angle: float, view: ViewName, wide: bool
+) -> None:
+    _assert_framed(
+        FreeKickParams(distance_m=distance, angle_deg=angle), view, LENSES[0 if wide else 1]
+    )
+
+
+@pytest.mark.parametrize(("distance", "angle"), [(12.0, 45.0), (12.0, -45.0), (13.0, 45.0)])
+def test_the_goalkeepers_view_stands_in_front_of_the_line_for_a_close_wide_spot(
+    distance: float, angle: float
+) -> None:
+    """Close in and wide, the wall stands 3 m from the goal: framed flat, the camera ended up inside the net."""
+    for lens in LENSES:
+        _assert_framed(FreeKickParams(distance_m=distance, angle_deg=angle), "goal", lens)
+
+
+@pytest.mark.parametrize("lens", LENSES, ids=lambda lens: f"{lens.width_px}x{lens.height_px}")
+def test_the_opening_view_shows_the_curl_across_the_screen_and_a_large_goal(lens: Lens) -> None:
+    p = FreeKickParams()
+    state = compute_kick(p)
+    new, old = frame_view(p, state, "broadcast", lens), _old_broadcast(p, state, lens)
+    # The path and its no-spin ghost stand apart on the screen over the whole second half of the flight...
+    gap_new, gap_old = _path_ghost_gap(state, new, lens), _path_ghost_gap(state, old, lens)
+    assert np.mean(gap_new >= OPENING_GAP_PX) >= 0.9, np.round(gap_new)
+    assert np.mean(gap_old >= OPENING_GAP_PX) < 0.5, np.round(
+        gap_old
+    )  # the old view drew them on top of each other
+    # ...and the goal is not a stamp in the distance.
+    assert _goal_width_share(new, lens) >= OPENING_GOAL_SHARE > _goal_width_share(old, lens)
+    # Seen from behind the kicker: the camera is farther from the goal than the ball, and above it.
+    spot = ball_spot(p)
+    assert np.hypot(*new.position[:2]) > np.hypot(*spot[:2]) - 1.0 and new.position[2] > 3.0
+
+
+def test_project_points_agrees_with_frame_points() -> None:
+    """The framed points' projection fills the rectangle frame_points was asked for (touching two opposite sides)."""
+    rng = np.random.default_rng(3)
+    points = rng.uniform(-5.0, 5.0, (30, 3))
+    lens = LENSES[0]
+    ndc = lens.usable_ndc()
+    framed = frame_points(
+        points, (1.0, 0.3, -0.4), fov_rad=lens.fov_rad, aspect=lens.aspect, ndc=ndc
+    )
+    xy = project_points(framed, lens, points)
+    x_ndc = 2.0 * xy[:, 0] / lens.width_px - 1.0
+    y_ndc = 1.0 - 2.0 * xy[:, 1] / lens.height_px
+    assert x_ndc.min() >= ndc[0] - 1e-6 and x_ndc.max() <= ndc[1] + 1e-6
+    assert y_ndc.min() >= ndc[2] - 1e-6 and y_ndc.max() <= ndc[3] + 1e-6
+    touches_x = math.isclose(x_ndc.min(), ndc[0], abs_tol=1e-3) and math.isclose(
+        x_ndc.max(), ndc[1], abs_tol=1e-3
+    )
+    touches_y = math.isclose(y_ndc.min(), ndc[2], abs_tol=1e-3) and math.isclose(
+        y_ndc.max(), ndc[3], abs_tol=1e-3
+    )
+    assert touches_x or touches_y
