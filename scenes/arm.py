@@ -26,6 +26,7 @@ from numpy.typing import NDArray
 
 from kernels import fabrik
 from scenes._base import Scene
+from scenes._charts import FittedChart
 from scenes._framing import ClientFraming, Lens, View, frame_points
 from scenes._skeletons import SkeletonView
 
@@ -317,7 +318,8 @@ is a static pose.
             with gui.add_folder("This frame"):
                 self.readout = gui.add_markdown("")
                 self.ghost_readout = gui.add_markdown("")
-                self.plot = gui.add_uplot(
+                self.plot = FittedChart(
+                    gui,
                     data=(np.zeros(1), np.ones(1)),
                     series=(
                         viser.uplot.Series(label="Iteration"),
@@ -330,12 +332,6 @@ is a static pose.
                     legend=viser.uplot.Legend(show=True),
                     title="Error after each iteration (log scale)",
                     aspect=1.6,
-                    padding=(
-                        18,
-                        14,
-                        0,
-                        0,
-                    ),  # room above the top tick, so its label ("1,000") is not cut
                 )
             with gui.add_folder("Chain"):
                 self.links = gui.add_slider(
