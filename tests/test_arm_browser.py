@@ -222,3 +222,21 @@ def test_drag_the_target_gizmo_with_the_mouse(server: viser.ViserServer, browser
     changed = changed_mask(image_before, screenshot(page))
     assert changed[int(y) - 15 : int(y) + 15, int(x) - 15 : int(x) + 15].sum() > 40
     switcher.close()
+
+
+def test_the_error_plot_tick_labels_stay_inside_its_canvas(shown: ScenePage) -> None:
+    from browser import assert_tick_labels_inside, set_number, wait_chart_data
+
+    scene = shown.scene
+    assert isinstance(scene, ArmScene)
+    assert_tick_labels_inside(shown.page, CHART)
+    # A tighter tolerance: the log axis runs down to hundredths of a millimetre ("0.01", wider than "1").
+    set_number(shown.page, "Tolerance (mm)", 0.01)
+    wait_until(lambda: scene.params.tolerance_mm == 0.01, "the tolerance")
+    with scene._lock:
+        data = scene.plot.data
+    assert float(np.min(data[1])) < 0.1
+    wait_chart_data(shown.page, CHART, data)
+    assert_tick_labels_inside(shown.page, CHART)
+    set_number(shown.page, "Tolerance (mm)", 1)
+    wait_until(lambda: scene.params.tolerance_mm == 1.0, "the tolerance back")
