@@ -42,6 +42,8 @@ MAX_DECIMALS = 3
 """uPlot 1.6's labels come from ``Intl.NumberFormat().format``: at most 3 fraction digits."""
 Y_TICKS_MAX = 20
 """A y axis has at most this many ticks (30 px apart over at most 600 px of plot, the expanded view's height)."""
+FAINT_TICKS = "rgba(0,0,0,0.07)"
+"""uPlot's default tick colour (its grid's)."""
 X_TICKS_MAX = 16
 """An x axis has at most this many ticks (50 px apart over at most 800 px)."""
 
@@ -140,9 +142,11 @@ def fit_layout(
     """
     y_scales = _series_scales(series)
     if axes is None:
+        # uPlot's own faint ticks: viser's client darkens the ticks of axes given explicitly.
+        ticks = viser.uplot.Axis_Ticks(stroke=FAINT_TICKS)
         axes = (
-            viser.uplot.Axis(scale="x"),
-            viser.uplot.Axis(scale=y_scales[0] if y_scales else "y"),
+            viser.uplot.Axis(scale="x", ticks=ticks),
+            viser.uplot.Axis(scale=y_scales[0] if y_scales else "y", ticks=ticks),
         )
     fitted: list[viser.uplot.Axis] = []
     sides: set[int] = set()

@@ -259,7 +259,7 @@ def framed_points(
         obstacle_centres: (MAX_OBSTACLES, 3) obstacle centres (m); the first ``params.n_obstacles`` are shown.
     """
     axes = np.eye(3) if params.three_d else np.eye(3)[[0, 2]]
-    depth = BASE_HALF_M if params.three_d else 0.0
+    depth = BASE_HALF_M  # the plate is a box in the plane too: its near face must fit
     base = np.array(
         [
             [x, y, z]
