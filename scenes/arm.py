@@ -26,6 +26,7 @@ from numpy.typing import NDArray
 
 from kernels import fabrik
 from scenes._base import Scene
+from scenes._charts import FittedChart
 from scenes._framing import ClientFraming, Lens, View, frame_points
 from scenes._skeletons import SkeletonView
 
@@ -232,6 +233,51 @@ def clean_point(raw: object, three_d: bool) -> NDArray[np.float64] | None:
 
 
 # --------------------------------------------------------------------------------------------- geometry
+GIZMO_SCALE_M = 0.3
+"""Length of the target's and obstacles' gizmo arrows (m): the person must see them to grab them."""
+BASE_HALF_M = 0.08
+"""Half the width of the base plate the chain stands on (m)."""
+FRAME_SLACK = 0.15
+"""A framed view is kept until what it must show leaves the framed box grown by this fraction of its size."""
+
+
+def framed_points(
+    params: ArmParams,
+    pose: NDArray[np.float64],
+    target: NDArray[np.float64],
+    obstacle_centres: NDArray[np.float64],
+) -> NDArray[np.float64]:
+    """(N, 3) world points (m) the camera must show: what matters now, not the chain's whole reach.
+
+    The chain's joints and base, the target, each shown obstacle out to its radius, and the gizmo arrows of the
+    target and obstacles (along the axes they move on: x and z in the plane, all three in 3D).
+
+    Args:
+        params: the scene's parameters (count, radii, mode).
+        pose: (n_links + 1, 3) joint positions (m).
+        target: (3,) target position (m).
+        obstacle_centres: (MAX_OBSTACLES, 3) obstacle centres (m); the first ``params.n_obstacles`` are shown.
+    """
+    axes = np.eye(3) if params.three_d else np.eye(3)[[0, 2]]
+    depth = BASE_HALF_M  # the plate is a box in the plane too: its near face must fit
+    base = np.array(
+        [
+            [x, y, z]
+            for x in (-BASE_HALF_M, BASE_HALF_M)
+            for y in (-depth, depth)
+            for z in (-0.06, 0.0)
+        ]
+    )
+    shown = obstacle_centres[: params.n_obstacles]
+    radii = np.asarray(params.radii_m[: params.n_obstacles], dtype=np.float64)
+    rims = (shown[:, None, :] + radii[:, None, None] * np.vstack([axes, -axes])[None]).reshape(
+        -1, 3
+    )
+    handles = np.vstack([target[None, :], shown])
+    tips = (handles[:, None, :] + GIZMO_SCALE_M * axes[None]).reshape(-1, 3)
+    return np.vstack([pose, base, target[None, :], rims, tips])
+
+
 def _unit_cylinder() -> trimesh.Trimesh:
     """Radius 1 and length 1 along +z from the origin: scaled per instance to a link."""
     mesh = trimesh.creation.cylinder(radius=1.0, height=1.0, sections=14)
@@ -303,6 +349,8 @@ is a static pose.
         self.skeletons = SkeletonView(self)
         """The robot-arm, hand and upper-body presets (issue 14), shown in place of the chain when chosen."""
         self.solve_and_draw()
+        self._framed_box: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None
+        """(lo, hi) world box (m) of what the cameras were last framed to show."""
         self.framing = ClientFraming(self._view_for)
         self.watch_cameras(self.framing.on_camera)
 
@@ -317,7 +365,8 @@ is a static pose.
             with gui.add_folder("This frame"):
                 self.readout = gui.add_markdown("")
                 self.ghost_readout = gui.add_markdown("")
-                self.plot = gui.add_uplot(
+                self.plot = FittedChart(
+                    gui,
                     data=(np.zeros(1), np.ones(1)),
                     series=(
                         viser.uplot.Series(label="Iteration"),
@@ -330,12 +379,6 @@ is a static pose.
                     legend=viser.uplot.Legend(show=True),
                     title="Error after each iteration (log scale)",
                     aspect=1.6,
-                    padding=(
-                        18,
-                        14,
-                        0,
-                        0,
-                    ),  # room above the top tick, so its label ("1,000") is not cut
                 )
             with gui.add_folder("Chain"):
                 self.links = gui.add_slider(
@@ -504,8 +547,12 @@ is a static pose.
             self.obstacle_gizmos.append(gizmo)
 
     # ----------------------------------------------------------------------------------------- callbacks
-    def _on_target_drag(self, _event: object) -> None:
+    def _on_target_drag(self, event: object) -> None:
         self.callback(self._apply_target)(None)
+        if (
+            getattr(event, "phase", None) == "end"
+        ):  # not mid-drag: the view must not move under the mouse
+            self.callback(self._reframe_if_outgrown)(None)
 
     def _apply_target(self) -> None:
         self.gizmo_events += 1
@@ -522,8 +569,10 @@ is a static pose.
         self.target = point
         self.solve_and_draw()
 
-    def _on_obstacle_drag(self, k: int, _event: object) -> None:
+    def _on_obstacle_drag(self, k: int, event: object) -> None:
         self.callback(functools.partial(self._apply_obstacle, k))(None)
+        if getattr(event, "phase", None) == "end":
+            self.callback(self._reframe_if_outgrown)(None)
 
     def _apply_obstacle(self, k: int) -> None:
         self.gizmo_events += 1
@@ -569,6 +618,7 @@ is a static pose.
         self.target = point
         self.target_gizmo.position = point
         self.solve_and_draw()
+        self._reframe_if_outgrown()
 
     def _on_reset_pose(self) -> None:
         self.pose = rest_pose(self.params.n_links, self.params.link_length_m)
@@ -589,18 +639,15 @@ is a static pose.
             last.link_length_m,
         ):
             self.framing.reframe()
+        else:
+            self._reframe_if_outgrown()
 
     def _view_for(self, lens: Lens) -> View:
-        """Frame the chain's whole reach (a half disc in the plane, a dome in 3D) and the obstacles."""
+        """Frame the chain, its base, the target, the obstacles and their gizmos (:func:`framed_points`)."""
         p = self.params
-        reach = p.n_links * p.link_length_m
-        depth = reach if p.three_d else 0.0
-        corners = np.array(
-            [[x, y, z] for x in (-reach, reach) for y in (-depth, depth) for z in (-0.05, reach)]
-        )
-        shown = self.obstacle_centres[: p.n_obstacles]
-        radii = np.asarray(p.radii_m[: p.n_obstacles])[:, None]
-        points = np.vstack([corners, self.target[None, :], shown - radii, shown + radii])
+        points = framed_points(p, self.pose, self.target, self.obstacle_centres)
+        lo, hi = points.min(axis=0), points.max(axis=0)
+        self._framed_box = (lo, hi)
         return frame_points(
             points,
             SPACE_VIEW if p.three_d else PLANE_VIEW,
@@ -608,6 +655,17 @@ is a static pose.
             aspect=lens.aspect,
             ndc=lens.usable_ndc(),
         )
+
+    def _reframe_if_outgrown(self) -> None:
+        """Frame again when the chain, target or obstacles left the framed box (grown by :data:`FRAME_SLACK`)."""
+        box = self._framed_box
+        if box is None:
+            return
+        lo, hi = box
+        slack = FRAME_SLACK * float(np.max(hi - lo))
+        points = framed_points(self.params, self.pose, self.target, self.obstacle_centres)
+        if np.any(points < lo - slack) or np.any(points > hi + slack):
+            self.framing.reframe()
 
     def _set_mode(self, three_d: bool) -> None:
         """Planar ↔ 3D: gizmo axes, obstacle shapes, the plane grid; leaving 3D flattens everything onto y = 0."""

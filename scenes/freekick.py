@@ -32,6 +32,7 @@ from numpy.typing import NDArray
 
 from kernels import ball
 from scenes._base import Scene
+from scenes._charts import FittedChart
 from scenes._framing import ClientFraming, Lens, View, frame_points
 
 logger = logging.getLogger(__name__)
@@ -969,7 +970,8 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
             with gui.add_folder("Presets"):
                 self.preset_buttons = [gui.add_button(preset.label) for preset in PRESETS]
             with gui.add_folder("Forces"):
-                self.chart = gui.add_uplot(
+                self.chart = FittedChart(
+                    gui,
                     data=self._chart_data(),
                     series=(
                         viser.uplot.Series(label="t (s)"),

@@ -23,6 +23,7 @@ import viser.uplot
 from kernels import course as course_kernel
 from kernels import cycling
 from scenes._base import Scene
+from scenes._charts import FittedChart
 from scenes._framing import ClientFraming, Lens, View, frame_points
 from scenes._gate import record_spec
 
@@ -405,7 +406,8 @@ time-averaged power is the mean over positions, far below the leader's.
                 self.density = gui.add_markdown("")
                 self.table = gui.add_markdown("")
                 self.rotation = gui.add_markdown("")
-                self.chart = gui.add_uplot(
+                self.chart = FittedChart(
+                    gui,
                     data=self._chart_data(),
                     series=(
                         viser.uplot.Series(label="Speed (km/h)"),
@@ -1140,7 +1142,8 @@ class CourseMode:
             )
             self.now = gui.add_markdown("")
             self.readout = gui.add_markdown("")
-            self.chart = gui.add_uplot(
+            self.chart = FittedChart(
+                gui,
                 data=self._chart_data(),
                 series=(
                     viser.uplot.Series(label="Distance (km)"),

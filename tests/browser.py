@@ -370,3 +370,157 @@ def save_docs_screenshot(shown: ScenePage, key: str) -> None:
     if shown.viewport != (1600, 1000):
         return
     screenshot(shown.page, path=str(DOCS / f"{key}.png"))
+
+
+# ------------------------------------------------------------------------------------- chart tick labels (issue 9)
+TICK_LABEL_BOXES = """
+title => {
+  const entries = Object.values((window.__viserTestpoints || {}).uplots || {});
+  const found = entries.find(({chart}) => {
+    const t = chart.root.querySelector('.u-title');
+    return t && t.textContent === title;
+  });
+  if (!found) return null;
+  const u = found.chart, ratio = u.pxRatio || window.devicePixelRatio || 1;
+  const bb = u.bbox, measure = document.createElement('canvas').getContext('2d');
+  const boxes = [];
+  u.axes.forEach((axis, i) => {
+    if (!axis.show || !axis._values) return;
+    const side = axis.side, ori = side % 2, scale = u.scales[axis.scale];
+    // uPlot's drawAxesGrid: labels sit tick size + gap beyond the axis line, away from the plot.
+    const dir = side === 0 || side === 3 ? -1 : 1;
+    const tick = axis.ticks && axis.ticks.show !== false ? axis.ticks.size : 0;
+    const base = Math.round(axis._pos * ratio) + Math.round((tick + axis.gap) * ratio) * dir;
+    measure.font = axis.font[0];
+    measure.textAlign = ori === 0 ? 'center' : side === 3 ? 'right' : 'left';
+    measure.textBaseline = ori === 1 ? 'middle' : side === 2 ? 'top' : 'bottom';
+    axis._values.forEach((text, k) => {
+      if (text == null || text === '') return;
+      const at = u.valToPos(axis._splits[k], axis.scale, true);
+      const x = ori === 0 ? at : base, y = ori === 0 ? base : at;
+      String(text).split('\\n').forEach((line, row) => {
+        const m = measure.measureText(line), dy = row * axis.font[1] * (axis.lineGap || 1.5);
+        boxes.push({axis: i, text: line, left: x - m.actualBoundingBoxLeft, right: x + m.actualBoundingBoxRight,
+                    top: y + dy - m.actualBoundingBoxAscent, bottom: y + dy + m.actualBoundingBoxDescent,
+                    rotated: !!axis._rotate});
+      });
+    });
+    if (axis.label != null && axis._lpos != null) {  // the axis title, drawn centred along the axis
+      measure.font = axis.labelFont[0];
+      const m = measure.measureText(axis.label), lpos = Math.round(axis._lpos * ratio);
+      const half = (m.actualBoundingBoxLeft + m.actualBoundingBoxRight) / 2;
+      const height = m.actualBoundingBoxAscent + m.actualBoundingBoxDescent;
+      if (ori === 1) {  // rotated a quarter turn, its baseline on the lpos line
+        const mid = bb.top + bb.height / 2, inner = side === 3 ? [lpos - height, lpos] : [lpos, lpos + height];
+        boxes.push({axis: i, text: axis.label, left: inner[0], right: inner[1], top: mid - half, bottom: mid + half,
+                    rotated: false});
+      } else {
+        const mid = bb.left + bb.width / 2, inner = side === 2 ? [lpos, lpos + height] : [lpos - height, lpos];
+        boxes.push({axis: i, text: axis.label, left: mid - half, right: mid + half, top: inner[0], bottom: inner[1],
+                    rotated: false});
+      }
+    }
+  });
+  const stroke = u.axes.filter(a => a.show).map(a => typeof a.stroke === 'function' ? a.stroke(u, 0) : a.stroke);
+  return {width: u.ctx.canvas.width, height: u.ctx.canvas.height, ratio, boxes, stroke, uuid: Object.keys(
+    window.__viserTestpoints.uplots).find(k => window.__viserTestpoints.uplots[k] === found)};
+}
+"""
+"""Where uPlot drew each tick label and axis title of the chart with a given title: canvas-px boxes, measured with
+the axis's own font, placed as uPlot's drawAxesGrid places them (viser's client exposes each chart under
+``window.__viserTestpoints.uplots``)."""
+
+
+def tick_label_boxes(page: Any, title: str) -> dict[str, Any]:
+    """Canvas size, device-pixel ratio, axis colours and every tick label's box (canvas px) of chart ``title``."""
+    layout = page.evaluate(TICK_LABEL_BOXES, title)
+    assert layout is not None, f"no uPlot chart titled {title!r} on the page"
+    return layout
+
+
+def chart_canvas_image(page: Any, title: str) -> NDArray[np.uint8]:
+    """(H, W, 3) RGB, canvas px, of what uPlot drew on the canvas of the chart titled ``title``, over white.
+
+    Read from the canvas itself (its legend and the expand button, HTML laid over the canvas's edges, stay out).
+    """
+    import base64
+
+    from PIL import Image
+
+    wait_frames(page, 2)
+    url = page.evaluate(
+        """title => {
+          const chart = [...document.querySelectorAll('.uplot')].find(
+              c => (c.querySelector('.u-title') || {}).textContent === title);
+          return chart ? chart.querySelector('canvas').toDataURL('image/png') : null;
+        }""",
+        title,
+    )
+    assert url is not None, f"no uPlot chart titled {title!r} on the page"
+    rgba = Image.open(io.BytesIO(base64.b64decode(url.split(",", 1)[1]))).convert("RGBA")
+    white = Image.new("RGBA", rgba.size, (255, 255, 255, 255))
+    return np.asarray(Image.alpha_composite(white, rgba).convert("RGB"))
+
+
+def _css_rgb(colour: str) -> tuple[int, int, int]:
+    match = re.fullmatch(r"\s*#([0-9a-fA-F]{6})\s*", colour)
+    if match:
+        value = int(match.group(1), 16)
+        return (value >> 16) & 255, (value >> 8) & 255, value & 255
+    match = re.fullmatch(r"\s*rgba?\(\s*(\d+)\s*,\s*(\d+)\s*,\s*(\d+)[^)]*\)\s*", colour)
+    assert match, f"axis colour {colour!r} is not #rrggbb or rgb()"
+    return int(match.group(1)), int(match.group(2)), int(match.group(3))
+
+
+def assert_tick_labels_inside(page: Any, title: str, border_px: int = 2) -> None:
+    """Assert that every tick label and axis title of chart ``title`` lies wholly inside the chart's canvas.
+
+    Two looks: uPlot's own layout (each label's box, measured with its font, inside the canvas) and the pixels a
+    person sees (no pixel of the axes' text colour in the canvas's outer ``border_px`` rows and columns, where a
+    label running off the edge would be cut).
+    """
+    layout = tick_label_boxes(page, title)
+    width, height = layout["width"], layout["height"]
+    # The measured box is the glyphs' own; antialiasing reaches about a pixel beyond it.
+    inside = border_px - 1
+    outside = [
+        f"{box['text']!r} (axis {box['axis']}: x {box['left']:.1f}..{box['right']:.1f}, "
+        f"y {box['top']:.1f}..{box['bottom']:.1f})"
+        for box in layout["boxes"]
+        if min(box["left"], box["top"]) < inside
+        or box["right"] > width - inside
+        or box["bottom"] > height - inside
+    ]
+    assert layout["boxes"], f"chart {title!r}: no tick labels drawn"
+    assert not any(box["rotated"] for box in layout["boxes"]), "rotated tick labels: not measured"
+    assert not outside, (
+        f"chart {title!r} ({width}×{height} canvas px): labels cut at the edge: {outside}"
+    )
+    image = chart_canvas_image(page, title)
+    ring = np.ones(image.shape[:2], dtype=bool)
+    ring[border_px:-border_px, border_px:-border_px] = False
+    touching = {
+        colour: colour_pixels(image[ring], _css_rgb(colour), tolerance=30.0)
+        for colour in set(layout["stroke"])
+    }
+    assert not any(touching.values()), (
+        f"chart {title!r}: axis-text pixels on the canvas's outer {border_px} px: {touching}"
+    )
+
+
+def wait_chart_data(page: Any, title: str, data: Sequence[Any], timeout_ms: int = 30_000) -> None:
+    """Wait until the uPlot chart titled ``title`` holds ``data`` (the server's arrays) and has drawn it."""
+    ends = [[float(np.asarray(d)[0]), float(np.asarray(d)[-1]), len(d)] for d in data]
+    page.wait_for_function(
+        """([title, ends]) => Object.values((window.__viserTestpoints || {}).uplots || {}).some(({chart}) => {
+          const t = chart.root.querySelector('.u-title');
+          if (!t || t.textContent !== title || !chart.data || chart.data.length !== ends.length) return false;
+          const close = (a, b) => Math.abs(a - b) <= 1e-9 * Math.max(1, Math.abs(a), Math.abs(b));
+          return chart.data.every((d, i) => d.length === ends[i][2] && close(d[0], ends[i][0])
+                                            && close(d[d.length - 1], ends[i][1]));
+        })""",
+        arg=[title, ends],
+        timeout=timeout_ms,
+        polling=100,
+    )
+    wait_frames(page, 3)

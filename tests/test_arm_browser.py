@@ -222,3 +222,68 @@ def test_drag_the_target_gizmo_with_the_mouse(server: viser.ViserServer, browser
     changed = changed_mask(image_before, screenshot(page))
     assert changed[int(y) - 15 : int(y) + 15, int(x) - 15 : int(x) + 15].sum() > 40
     switcher.close()
+
+
+def test_the_error_plot_tick_labels_stay_inside_its_canvas(shown: ScenePage) -> None:
+    from browser import assert_tick_labels_inside, set_number, wait_chart_data
+
+    scene = shown.scene
+    assert isinstance(scene, ArmScene)
+    assert_tick_labels_inside(shown.page, CHART)
+    # A tighter tolerance: the log axis runs down to hundredths of a millimetre ("0.01", wider than "1").
+    set_number(shown.page, "Tolerance (mm)", 0.01)
+    wait_until(lambda: scene.params.tolerance_mm == 0.01, "the tolerance")
+    with scene._lock:
+        data = scene.plot.data
+    assert float(np.min(data[1])) < 0.1
+    wait_chart_data(shown.page, CHART, data)
+    assert_tick_labels_inside(shown.page, CHART)
+    set_number(shown.page, "Tolerance (mm)", 1)
+    wait_until(lambda: scene.params.tolerance_mm == 1.0, "the tolerance back")
+
+
+FILL = 0.5
+"""The chain's projected extent must cover at least this share of the free view's width or height (the old
+framing of the whole reach gave it about a third: 0.32 × 0.33 at 1600×1000)."""
+
+
+def _assert_chain_fills_the_view(shown: ScenePage, what: str) -> None:
+    from browser import panel_rect
+
+    scene = shown.scene
+    assert isinstance(scene, ArmScene)
+    with scene._lock:
+        joints, target = scene.pose.copy(), scene.target.copy()
+    xy = assert_in_view(shown, "/arm", np.vstack([joints, target[None, :]]), what)
+    chain = xy[: len(joints)]
+    left, _, _, _ = panel_rect(shown.page)
+    width, height = np.ptp(chain, axis=0)
+    fill = max(width / left, height / shown.viewport[1])
+    assert fill >= FILL, (
+        f"{what}: the chain spans {width:.0f}×{height:.0f} px, {fill:.2f} of the free view"
+    )
+
+
+def test_the_chain_fills_the_view_in_the_plane_and_in_3d(shown: ScenePage) -> None:
+    from browser import set_number
+
+    scene = shown.scene
+    assert isinstance(scene, ArmScene)
+    _assert_chain_fills_the_view(shown, "the chain in the plane")
+    checkbox = control_row(shown.page, "3D (free target, sphere obstacles)").locator("input").first
+    frames = scene.framing.frames
+    checkbox.click()
+    wait_until(lambda: scene.params.three_d and scene.framing.frames > frames, "3D and its camera")
+    settle(shown)
+    _assert_chain_fills_the_view(shown, "the chain in 3D")
+    checkbox.click()
+    wait_until(lambda: not scene.params.three_d, "back to the plane")
+    # A longer chain is framed again: it still fills the view, all of it in sight.
+    frames = scene.framing.frames
+    set_number(shown.page, "Links", 12)
+    wait_until(lambda: scene.params.n_links == 12 and scene.framing.frames > frames, "12 links")
+    settle(shown)
+    _assert_chain_fills_the_view(shown, "12 links in the plane")
+    set_number(shown.page, "Links", 6)
+    wait_until(lambda: scene.params.n_links == 6, "6 links again")
+    settle(shown)

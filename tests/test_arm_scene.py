@@ -321,3 +321,40 @@ def test_a_target_the_limits_keep_away_reads_limited_not_unreachable(scene: ArmS
     assert report.result.error <= report.result.error_history[1:].min()
     angles = fabrik.joint_angles(scene.pose[:, [0, 2]], [0.0, 1.0])
     assert np.all(angles <= math.radians(5.0) + 1e-6)
+
+
+def test_the_view_frames_what_matters_not_the_whole_reach(scene: ArmScene) -> None:
+    from scenes.arm import GIZMO_SCALE_M, framed_points
+
+    scene.links.value = 12
+    scene.length.value = 0.5  # a 6 m reach
+    with scene._lock:
+        points = framed_points(scene.params, scene.pose, scene.target, scene.obstacle_centres)
+        pose, target = scene.pose.copy(), scene.target.copy()
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    # Every joint, the target and its gizmo arrows are inside; the box is the chain's, not the 12 m wide reach.
+    assert np.all(pose >= lo) and np.all(pose <= hi)
+    assert np.all(target + GIZMO_SCALE_M * np.array([1.0, 0.0, 1.0]) <= hi + 1e-12)
+    reach = 12 * 0.5
+    width, height = hi[0] - lo[0], hi[2] - lo[2]
+    assert width < reach and height < reach, (
+        width,
+        height,
+    )  # the whole reach framed 2 × 6 m by 6 m
+
+
+def test_moving_the_target_out_of_the_framed_box_frames_again(scene: ArmScene) -> None:
+    from scenes._framing import Lens
+
+    calls: list[int] = []
+    scene.framing.reframe = lambda: calls.append(1)  # type: ignore[method-assign]
+    with scene._lock:
+        scene._view_for(Lens(0.9, 1600, 1000))
+        scene.target = scene.target + np.array([0.05, 0.0, 0.0])  # a small move stays in the frame
+        scene.solve_and_draw()
+        scene._reframe_if_outgrown()
+        assert calls == []
+        scene.target = np.array([-1.4, 0.0, 0.2])  # across to the other side
+        scene.solve_and_draw()
+        scene._reframe_if_outgrown()
+        assert calls == [1]

@@ -90,3 +90,32 @@ def test_upload_a_gpx_and_play_it(
     # The page tells the person where the leader is.
     page.get_by_text("Leader at", exact=False).first.wait_for(timeout=10_000)
     switcher.close()
+
+
+@pytest.mark.parametrize("viewport", [(1600, 1000), (1280, 720)], ids=["1600x1000", "1280x720"])
+def test_the_course_chart_tick_labels_stay_inside_its_canvas(
+    chromium_browser: Any, viewport: tuple[int, int]
+) -> None:
+    from browser import assert_tick_labels_inside, scene_page, set_number, wait_chart_data
+
+    title = "Elevation, speed and power along the course"
+    with scene_page(chromium_browser, "peloton", viewport) as shown:
+        scene = shown.scene
+        assert isinstance(scene, PelotonScene)
+        mode = scene.course_mode
+        shown.page.get_by_text("Ride a course", exact=True).first.click()
+        wait_until(lambda: mode.enabled and mode.state is not None, 15.0, "course mode on")
+        # The sample climb tops out at 1815 m: the "2,000" tick sits at the plot's top (its label was cut).
+        with scene._lock:
+            data = mode.chart.data
+        wait_chart_data(shown.page, title, data)
+        assert_tick_labels_inside(shown.page, title)
+        # More power: the speed axis on the right reaches higher.
+        before = float(np.max(data[2]))
+        set_number(shown.page, "Course power (W)", 2000)
+        wait_until(lambda: mode.params.power_w == 2000.0, 15.0, "the course power")
+        with scene._lock:
+            data = mode.chart.data
+        assert float(np.max(data[2])) > before + 10.0
+        wait_chart_data(shown.page, title, data)
+        assert_tick_labels_inside(shown.page, title)

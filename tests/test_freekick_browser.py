@@ -227,3 +227,28 @@ def test_pressing_kick_flies_the_ball_in_the_page(
         page.wait_for_function("() => window.__kick.minW < 0.999", timeout=20_000)
     finally:
         switcher.close()
+
+
+def test_the_force_chart_tick_labels_stay_inside_its_canvas(shown: ScenePage) -> None:
+    from browser import assert_tick_labels_inside, wait_chart_data
+
+    scene = shown.scene
+    assert isinstance(scene, FreeKickScene)
+    assert_tick_labels_inside(shown.page, CHART)
+    # The hardest, most spun kick: the force axis grows from a few newtons to over ten.
+    set_number(shown.page, "Launch speed (m/s)", 40)
+    set_number(shown.page, "Spin rate (rev/s)", 15)
+    wait_until(
+        lambda: scene.params.speed_ms == 40.0 and scene.params.spin_rev_s == 15.0, "speed and spin"
+    )
+    with scene._lock:
+        data = scene.chart.data
+    assert max(float(np.max(series)) for series in data[1:]) > 10.0
+    wait_chart_data(shown.page, CHART, data)
+    assert_tick_labels_inside(shown.page, CHART)
+    set_number(shown.page, "Launch speed (m/s)", 25)
+    set_number(shown.page, "Spin rate (rev/s)", 8)
+    wait_until(
+        lambda: scene.params.speed_ms == 25.0 and scene.params.spin_rev_s == 8.0,
+        "speed and spin back",
+    )

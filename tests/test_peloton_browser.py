@@ -195,3 +195,27 @@ def test_drag_speed_slider_with_the_mouse(server: viser.ViserServer, browser_pag
         polling=100,
     )
     switcher.close()
+
+
+def test_the_chart_tick_labels_stay_inside_its_canvas(shown: ScenePage) -> None:
+    from browser import assert_tick_labels_inside, wait_chart_data
+
+    scene = shown.scene
+    assert isinstance(scene, PelotonScene)
+    assert_tick_labels_inside(shown.page, CHART)
+    # A bigger rider into a gale: the power axis reaches "20,000" W (it ran 7 px off the canvas's left edge).
+    set_number(shown.page, "CdA (m²)", 0.8)
+    set_number(shown.page, "Headwind (m/s, − = tailwind)", 15)
+    wait_until(
+        lambda: scene.params.cda_m2 == 0.8 and scene.params.headwind_ms == 15.0, "CdA and wind"
+    )
+    with scene._lock:
+        data = scene.chart.data
+    assert max(float(np.max(series)) for series in data[1:]) > 10_000.0
+    wait_chart_data(shown.page, CHART, data)
+    assert_tick_labels_inside(shown.page, CHART)
+    set_number(shown.page, "CdA (m²)", 0.32)
+    set_number(shown.page, "Headwind (m/s, − = tailwind)", 0)
+    wait_until(
+        lambda: scene.params.cda_m2 == 0.32 and scene.params.headwind_ms == 0.0, "CdA and wind back"
+    )

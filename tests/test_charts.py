@@ -1,0 +1,44 @@
+"""The chart fitting's label widths and layout, without a browser (the browser tests look at the pixels)."""
+
+from __future__ import annotations
+
+import numpy as np
+import viser.uplot
+
+from scenes._charts import (
+    AXIS_SIZE_PX,
+    EDGE_PAD_PX,
+    fit_layout,
+    format_label,
+    label_px,
+    widest_linear_label,
+    widest_log_label,
+)
+
+
+def test_labels_are_no_narrower_than_uplot_writes_them() -> None:
+    assert format_label(20_000.0, 0) == "20,000"
+    assert format_label(0.25, 2) == "0.25"
+    assert format_label(1e-6, 6) == "0.000"  # Intl.NumberFormat keeps at most 3 decimals
+    # DejaVu Sans 12 px (Debian's system-ui) measures "20,000" 41.4 px wide in Chromium: the bound is above it.
+    assert 41.4 <= label_px("20,000") <= 45.0
+
+
+def test_the_widest_label_of_the_cut_charts() -> None:
+    assert widest_linear_label(0.0, 19_700.0, 20, 0.1) == "30,000"  # same width as uPlot's "20,000"
+    assert widest_linear_label(-4_900.0, 2_100.0, 20, 0.1).startswith("-")
+    assert (
+        widest_linear_label(0.0, 1.3, 20, 0.1) == "2.0"
+    )  # steps of 0.1 at the finest (uPlot writes "2", "1.5"…: never wider)
+    assert widest_log_label(0.004, 2_300.0) == "10,000"
+    assert widest_log_label(0.004, 0.9) == "0.001"
+
+
+def test_layout_widens_the_axis_and_pads_the_top() -> None:
+    x = np.linspace(0.0, 80.0, 20)
+    series = (viser.uplot.Series(label="x"), viser.uplot.Series(label="y"))
+    scales = {"x": viser.uplot.Scale(auto=True), "y": viser.uplot.Scale(auto=True)}
+    axes, padding = fit_layout((x, x * 10.0), series, scales, None)
+    assert axes[1].get("size") == AXIS_SIZE_PX and padding[0] == EDGE_PAD_PX
+    axes, _ = fit_layout((x, x * 250.0), series, scales, None)
+    assert float(axes[1].get("size", 0.0)) >= label_px("20,000") + 15
