@@ -25,6 +25,8 @@ PANEL_PX = 410.0
 """Width the control panel covers at the right of the canvas, with a margin (px)."""
 MARGIN_PX = 24.0
 """Space kept free at the other edges (px)."""
+FULL_NDC = (-0.9, 0.9, -0.9, 0.9)
+"""The rectangle framing uses when none is given, or when the one given is empty."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -81,7 +83,7 @@ def frame_points(
     *,
     fov_rad: float,
     aspect: float,
-    ndc: tuple[float, float, float, float] = (-0.9, 0.9, -0.9, 0.9),
+    ndc: tuple[float, float, float, float] = FULL_NDC,
     min_depth: float = 0.0,
 ) -> View:
     """The camera looking along ``direction`` (z up) that shows every one of ``points`` inside ``ndc``, as close as it can.
@@ -91,7 +93,8 @@ def frame_points(
         direction: view direction (any length, not vertical).
         fov_rad: vertical field of view (rad), as viser's ``camera.fov``.
         aspect: image width / height.
-        ndc: (x0, x1, y0, y1) rectangle of normalised device coordinates the points must project into.
+        ndc: (x0, x1, y0, y1) rectangle of normalised device coordinates the points must project into; an empty
+            one (x1 ≤ x0 or y1 ≤ y0) falls back to :data:`FULL_NDC`.
         min_depth: every point stays at least this far in front of the camera (m): "behind the ball", not in it.
 
     Returns:
@@ -117,7 +120,11 @@ def frame_points(
         coord: NDArray[np.float64], scale: NDArray[np.float64], lo: float, hi: float
     ) -> float:
         """Offset s with the projections (coord − s)/scale centred in [lo, hi] (bisection; monotone in s)."""
-        a, b = -10.0 * (size + 1.0), 10.0 * (size + 1.0)
+        # The centre sits |mid|·scale off the view axis: far away that is far more than the cloud's size, so the
+        # bracket grows with the depth (a fixed one left a rectangle that misses the axis, as left of the panel in a
+        # window narrower than ~1250 px, unreachable: the search then ran out to its 1000×size limit).
+        reach = size + 1.0 + float(np.max(scale)) * (abs(lo) + abs(hi) + 1.0)
+        a, b = -reach, reach
         for _ in range(60):
             s = 0.5 * (a + b)
             p = (coord - s) / scale
@@ -145,7 +152,13 @@ def frame_points(
             far = mid
         else:
             near = mid
-    _, sx, sy = fits(far)
+    ok, sx, sy = fits(far)
+    if not ok:
+        # The rectangle cannot hold the points at any distance (it is empty): frame in the whole view instead.
+        if ndc != FULL_NDC:
+            return frame_points(
+                pts, direction, fov_rad=fov_rad, aspect=aspect, ndc=FULL_NDC, min_depth=min_depth
+            )
     look_at = centre + sx * right + sy * up
     position = look_at - far * d
     return View(
