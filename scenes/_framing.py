@@ -197,6 +197,8 @@ class ClientFraming:
         self._cameras: dict[int, Any] = {}
         self._framed: dict[int, tuple[int, int]] = {}
         """Canvas size each client was last framed for."""
+        self._unconfirmed: dict[int, tuple[NDArray[np.float64], int]] = {}
+        """Position written to each client whose camera has not reported it back yet, and the re-frames left."""
         self.frames = 0
         """How many times a camera was framed (tests wait on it)."""
 
@@ -212,8 +214,18 @@ class ClientFraming:
         with self._lock:
             self._cameras[client_id] = camera
             if self._framed.get(client_id) == size:
-                return  # the person orbiting, or our own write coming back: leave the view alone
-            self._framed[client_id] = size  # a new tab, or a resized window
+                unconfirmed = self._unconfirmed.pop(client_id, None)
+                if unconfirmed is None:
+                    return  # the person orbiting, or our own write coming back: leave the view alone
+                written, tries = unconfirmed
+                if _reports(camera, written) or tries <= 0:
+                    return  # the tab shows the framed view: from now on every move is the person's
+                # Not there yet: on connect viser's client applies the server's initial camera in a React effect
+                # that can run after our first write, putting the tab back at the opening view. Frame it again.
+                self._unconfirmed[client_id] = (written, tries - 1)
+            else:
+                self._framed[client_id] = size  # a new tab, or a resized window
+                self._unconfirmed.pop(client_id, None)
         self._frame(camera)
 
     def reframe(self) -> None:
@@ -242,4 +254,23 @@ class ClientFraming:
         except Exception:
             logger.exception("framing a camera failed; it keeps its view")
             return
+        with self._lock:
+            client_id = int(camera.client.client_id)  # on_camera read it already: a real handle
+            tries = self._unconfirmed.get(client_id, (None, CONFIRM_TRIES))[1]
+            self._unconfirmed[client_id] = (np.asarray(view.position, dtype=np.float64), tries)
         self.frames += 1
+
+
+CONFIRM_TRIES = 5
+"""Camera reports a tab may send after a framing without showing it before it is framed no more (stale reports
+already on their way count too)."""
+
+
+def _reports(camera: Any, position: NDArray[np.float64]) -> bool:
+    """Whether ``camera`` (a viser camera handle) reports ``position`` (m), to a millimetre per metre of it."""
+    try:
+        reported = np.asarray(camera.position, dtype=np.float64)
+    except (AttributeError, TypeError, ValueError, AssertionError):
+        return True  # nothing to compare: count it as shown rather than frame forever
+    tolerance = 1e-3 * (1.0 + float(np.linalg.norm(position)))
+    return reported.shape == (3,) and bool(np.all(np.abs(reported - position) <= tolerance))

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import math
 
 import numpy as np
@@ -9,7 +10,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from scenes._framing import Lens, box_corners, frame_points
+from scenes._framing import ClientFraming, Lens, View, box_corners, frame_points
 
 
 def _project(
@@ -155,7 +156,9 @@ def test_eight_riders_six_metres_apart_in_a_1150_px_window_are_framed_near() -> 
     lens = Lens(math.radians(75.0), 1150, 720)
     ndc = lens.usable_ndc(right_px=190.0, top_px=30.0)
     assert ndc[1] < 0.0
-    view = frame_points(corners, (-1.2, 7.5, -1.8), fov_rad=lens.fov_rad, aspect=lens.aspect, ndc=ndc)
+    view = frame_points(
+        corners, (-1.2, 7.5, -1.8), fov_rad=lens.fov_rad, aspect=lens.aspect, ndc=ndc
+    )
     distance = float(np.linalg.norm(np.subtract(view.position, view.look_at)))
     assert 20.0 < distance < 80.0, distance
     projected = _project(
@@ -170,3 +173,38 @@ def test_an_empty_rectangle_frames_in_the_whole_view() -> None:
     projected = _project(cloud, np.array(view.position), np.array(view.look_at), 1.0, 1.5)
     assert np.abs(projected[:, :2]).max() <= 0.9 + 1e-6
     assert np.abs(projected[:, 0]).max() > 0.85  # framed tightly, not from far away
+
+
+class _Tab:
+    """A stand-in for one tab's viser camera handle: it reports what the test sets, and records the writes."""
+
+    def __init__(self) -> None:
+        self.client = self
+        self.client_id = 7
+        self.image_width, self.image_height, self.fov = 1280, 720, math.radians(75.0)
+        self.position, self.look_at, self.up_direction = (
+            (1.0, -7.5, 2.8),
+            (0.0, 0.0, 1.0),
+            (0.0, 0.0, 1.0),
+        )
+
+    def atomic(self) -> contextlib.AbstractContextManager[None]:
+        return contextlib.nullcontext()
+
+
+def test_a_tab_put_back_at_its_opening_view_before_showing_the_framing_is_framed_again() -> None:
+    # viser's client applies the server's initial camera in a React effect that can run after the first framing
+    # arrived: the tab then reports its opening view and, with an unchanged canvas, was never framed again.
+    framed = View(position=(5.0, -32.5, 11.2), look_at=(-0.9, 4.4, 2.4))
+    framing = ClientFraming(lambda lens: framed)
+    tab = _Tab()
+    opening = tab.position
+    framing.on_camera(tab)
+    assert framing.frames == 1 and tab.position == framed.position
+    tab.position = opening  # the client's reset, reported back
+    framing.on_camera(tab)
+    assert framing.frames == 2 and tab.position == framed.position
+    framing.on_camera(tab)  # now the tab reports the framed view
+    tab.position = (9.0, -9.0, 3.0)  # and from then on the person orbits: left alone
+    framing.on_camera(tab)
+    assert framing.frames == 2 and tab.position == (9.0, -9.0, 3.0)
