@@ -25,6 +25,8 @@ PANEL_PX = 410.0
 """Width the control panel covers at the right of the canvas, with a margin (px)."""
 MARGIN_PX = 24.0
 """Space kept free at the other edges (px)."""
+FULL_NDC = (-0.9, 0.9, -0.9, 0.9)
+"""The rectangle framing uses when none is given, or when the one given is empty."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -81,7 +83,7 @@ def frame_points(
     *,
     fov_rad: float,
     aspect: float,
-    ndc: tuple[float, float, float, float] = (-0.9, 0.9, -0.9, 0.9),
+    ndc: tuple[float, float, float, float] = FULL_NDC,
     min_depth: float = 0.0,
 ) -> View:
     """The camera looking along ``direction`` (z up) that shows every one of ``points`` inside ``ndc``, as close as it can.
@@ -91,7 +93,8 @@ def frame_points(
         direction: view direction (any length, not vertical).
         fov_rad: vertical field of view (rad), as viser's ``camera.fov``.
         aspect: image width / height.
-        ndc: (x0, x1, y0, y1) rectangle of normalised device coordinates the points must project into.
+        ndc: (x0, x1, y0, y1) rectangle of normalised device coordinates the points must project into; an empty
+            one (x1 ≤ x0 or y1 ≤ y0) falls back to :data:`FULL_NDC`.
         min_depth: every point stays at least this far in front of the camera (m): "behind the ball", not in it.
 
     Returns:
@@ -117,7 +120,11 @@ def frame_points(
         coord: NDArray[np.float64], scale: NDArray[np.float64], lo: float, hi: float
     ) -> float:
         """Offset s with the projections (coord − s)/scale centred in [lo, hi] (bisection; monotone in s)."""
-        a, b = -10.0 * (size + 1.0), 10.0 * (size + 1.0)
+        # The centre sits |mid|·scale off the view axis: far away that is far more than the cloud's size, so the
+        # bracket grows with the depth (a fixed one left a rectangle that misses the axis, as left of the panel in a
+        # window narrower than ~1250 px, unreachable: the search then ran out to its 1000×size limit).
+        reach = size + 1.0 + float(np.max(scale)) * (abs(lo) + abs(hi) + 1.0)
+        a, b = -reach, reach
         for _ in range(60):
             s = 0.5 * (a + b)
             p = (coord - s) / scale
@@ -145,7 +152,13 @@ def frame_points(
             far = mid
         else:
             near = mid
-    _, sx, sy = fits(far)
+    ok, sx, sy = fits(far)
+    if not ok:
+        # The rectangle cannot hold the points at any distance (it is empty): frame in the whole view instead.
+        if ndc != FULL_NDC:
+            return frame_points(
+                pts, direction, fov_rad=fov_rad, aspect=aspect, ndc=FULL_NDC, min_depth=min_depth
+            )
     look_at = centre + sx * right + sy * up
     position = look_at - far * d
     return View(
@@ -207,6 +220,8 @@ class ClientFraming:
         self._cameras: dict[int, Any] = {}
         self._framed: dict[int, tuple[int, int]] = {}
         """Canvas size each client was last framed for."""
+        self._unconfirmed: dict[int, tuple[NDArray[np.float64], int]] = {}
+        """Position written to each client whose camera has not reported it back yet, and the re-frames left."""
         self.frames = 0
         """How many times a camera was framed (tests wait on it)."""
 
@@ -222,8 +237,18 @@ class ClientFraming:
         with self._lock:
             self._cameras[client_id] = camera
             if self._framed.get(client_id) == size:
-                return  # the person orbiting, or our own write coming back: leave the view alone
-            self._framed[client_id] = size  # a new tab, or a resized window
+                unconfirmed = self._unconfirmed.pop(client_id, None)
+                if unconfirmed is None:
+                    return  # the person orbiting, or our own write coming back: leave the view alone
+                written, tries = unconfirmed
+                if _reports(camera, written) or tries <= 0:
+                    return  # the tab shows the framed view: from now on every move is the person's
+                # Not there yet: on connect viser's client applies the server's initial camera in a React effect
+                # that can run after our first write, putting the tab back at the opening view. Frame it again.
+                self._unconfirmed[client_id] = (written, tries - 1)
+            else:
+                self._framed[client_id] = size  # a new tab, or a resized window
+                self._unconfirmed.pop(client_id, None)
         self._frame(camera)
 
     def reframe(self) -> None:
@@ -252,4 +277,23 @@ class ClientFraming:
         except Exception:
             logger.exception("framing a camera failed; it keeps its view")
             return
+        with self._lock:
+            client_id = int(camera.client.client_id)  # on_camera read it already: a real handle
+            tries = self._unconfirmed.get(client_id, (None, CONFIRM_TRIES))[1]
+            self._unconfirmed[client_id] = (np.asarray(view.position, dtype=np.float64), tries)
         self.frames += 1
+
+
+CONFIRM_TRIES = 5
+"""Camera reports a tab may send after a framing without showing it before it is framed no more (stale reports
+already on their way count too)."""
+
+
+def _reports(camera: Any, position: NDArray[np.float64]) -> bool:
+    """Whether ``camera`` (a viser camera handle) reports ``position`` (m), to a millimetre per metre of it."""
+    try:
+        reported = np.asarray(camera.position, dtype=np.float64)
+    except (AttributeError, TypeError, ValueError, AssertionError):
+        return True  # nothing to compare: count it as shown rather than frame forever
+    tolerance = 1e-3 * (1.0 + float(np.linalg.norm(position)))
+    return reported.shape == (3,) and bool(np.all(np.abs(reported - position) <= tolerance))

@@ -35,7 +35,7 @@ BAR_METRES_PER_WATT = 1.0 / 400.0
 VIEW_DIRECTION = (-1.2, 7.5, -1.8)
 """The camera looks at the line from its left side, a little ahead of it and above."""
 LABEL_STAGGER_M = 0.4
-"""Every other rider's label sits this much higher (m), so labels of riders a wheel apart do not overlap."""
+"""Every other rider's label sits this much higher (m) until a camera is framed and the labels laid out for it."""
 LABEL_PX = (190.0, 30.0)
 """Room a rider's label needs right of and above its anchor (px): framing keeps it clear of the panel."""
 
@@ -284,6 +284,84 @@ def slot_offsets(n_riders: int, gap_m: float) -> np.ndarray:
     return -np.arange(MAX_RIDERS) * (BIKE_LENGTH_M + gap_m)
 
 
+LABEL_PAD_PX = 4.0
+"""Clear space kept between two riders' labels (px)."""
+
+
+def course_to_world(points: np.ndarray, grade_pct: float) -> np.ndarray:
+    """(N, 3) points of the course frame (m) in the world: the course frame turns by −atan(grade) about y."""
+    theta = math.atan(grade_pct / 100.0)
+    c, s = math.cos(theta), math.sin(theta)
+    pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    return np.stack(
+        [c * pts[:, 0] - s * pts[:, 2], pts[:, 1], s * pts[:, 0] + c * pts[:, 2]], axis=1
+    )
+
+
+def label_lifts_px(anchors_px: np.ndarray, label_px: tuple[float, float] = LABEL_PX) -> np.ndarray:
+    """(N,) how far (px, upward) to lift each label so no two overlap, leader first: each takes the lowest free place.
+
+    Args:
+        anchors_px: (N, 2) screen x, y (px, y down) of each label's anchor; its box spans ``label_px`` right of and
+            above it.
+        label_px: (width, height) of a label's box (px).
+    """
+    width, height = label_px[0] + LABEL_PAD_PX, label_px[1] + LABEL_PAD_PX
+    lifts = np.zeros(len(anchors_px))
+    for i, (x, y) in enumerate(np.asarray(anchors_px, dtype=np.float64)):
+        # Label j, placed, forbids lifts in (low, high): where the two boxes would share rows.
+        blocked = [
+            (y - yj + lifts[j] - height, y - yj + lifts[j] + height)
+            for j, (xj, yj) in enumerate(anchors_px[:i])
+            if abs(x - xj) < width
+        ]
+        for lift in sorted({0.0, *(high for _, high in blocked)}):
+            if lift >= 0.0 and not any(low < lift < high for low, high in blocked):
+                lifts[i] = lift
+                break
+    return lifts
+
+
+def project_px(points_world: np.ndarray, view: View, lens: Lens) -> np.ndarray:
+    """(N, 2) screen x, y (px, y down) of world points (m) seen from ``view`` through ``lens`` (pinhole, z up)."""
+    position, look_at = np.asarray(view.position), np.asarray(view.look_at)
+    d = (look_at - position) / np.linalg.norm(look_at - position)
+    right = np.cross(d, (0.0, 0.0, 1.0))
+    right /= np.linalg.norm(right)
+    up = np.cross(right, d)
+    rel = np.asarray(points_world, dtype=np.float64) - position
+    depth = rel @ d
+    tan_y = math.tan(0.5 * lens.fov_rad)
+    x = (rel @ right) / (depth * tan_y * lens.aspect)
+    y = (rel @ up) / (depth * tan_y)
+    return np.stack([(x + 1.0) / 2.0 * lens.width_px, (1.0 - y) / 2.0 * lens.height_px], axis=1)
+
+
+def lift_to_metres(
+    anchors_world: np.ndarray,
+    lifts_px: np.ndarray,
+    up_world: np.ndarray,
+    view: View,
+    lens: Lens,
+) -> np.ndarray:
+    """(N,) distances (m) along ``up_world`` that raise each anchor by its lift (px) in ``lens`` from ``view``.
+
+    Exact for the pinhole camera: the screen height of a point moved along a line is a ratio of linear functions
+    of the distance, solved for the target height.
+    """
+    position, look_at = np.asarray(view.position), np.asarray(view.look_at)
+    d = (look_at - position) / np.linalg.norm(look_at - position)
+    right = np.cross(d, (0.0, 0.0, 1.0))
+    right /= np.linalg.norm(right)
+    up = np.cross(right, d)
+    tan_y = math.tan(0.5 * lens.fov_rad)
+    rel = np.asarray(anchors_world, dtype=np.float64) - position
+    a, b = rel @ up, float(up_world @ up)
+    c, e = (rel @ d) * tan_y, float(up_world @ d) * tan_y
+    target = a / c + 2.0 * np.asarray(lifts_px, dtype=np.float64) / max(lens.height_px, 1)
+    return np.maximum((target * c - a) / (b - target * e), 0.0)
+
+
 # --------------------------------------------------------------------------------------------- scene
 class PelotonScene(Scene):
     key = "peloton"
@@ -323,6 +401,8 @@ time-averaged power is the mean over positions, far below the leader's.
         """Seconds each rider leads (the cleaned slider)."""
         self._energy_j = np.zeros(MAX_RIDERS)
         self._ridden_s = 0.0
+        self._label_lift_m = LABEL_STAGGER_M * (np.arange(MAX_RIDERS) % 2)
+        """How far each slot's label sits above its bar (m): laid out for the camera framed last."""
         self._build_gui()
         self._build_world()
         self.redraw()
@@ -569,7 +649,7 @@ time-averaged power is the mean over positions, far below the leader's.
             0.5 * BIKE_LENGTH_M,
             float(slot_offsets(n, p.gap_m)[n - 1]) - 0.5 * BIKE_LENGTH_M,
         )
-        top = 1.95 + LABEL_STAGGER_M + float(np.max(self.state.power.total)) * BAR_METRES_PER_WATT
+        top = 1.95 + LABEL_STAGGER_M + float(np.max(self._bar_heights_m()))
         x_hi = front + (3.0 + min(abs(p.headwind_ms), 15.0) * 0.25 if p.headwind_ms != 0 else 0.0)
         lo, hi = np.array([back, -1.1, 0.0]), np.array([x_hi, 1.1, max(top, 2.2)])
         corners = np.array(
@@ -591,11 +671,48 @@ time-averaged power is the mean over positions, far below the leader's.
             axis=1,
         )
 
+    def _bar_heights_m(self) -> np.ndarray:
+        """(n_riders,) height of each slot's stacked bars (m): the positive parts only, as drawn (downhill the
+        climbing part is negative and the stack stands taller than the total)."""
+        power = self.state.power
+        parts = [np.maximum(np.asarray(getattr(power, c)), 0.0) for c in COMPONENT_COLOURS]
+        return np.sum(parts, axis=0)[: self.params.n_riders] * BAR_METRES_PER_WATT
+
+    def label_anchors(self) -> np.ndarray:
+        """(n_riders, 3) world points where each slot's label sits before it is lifted: just above its bar."""
+        p, n = self.params, self.params.n_riders
+        x = slot_offsets(n, p.gap_m)[:n]
+        local = np.stack([x, np.zeros(n), 1.95 + self._bar_heights_m()], 1)
+        return course_to_world(local, p.grade_pct)
+
     def _view_for(self, lens: Lens) -> View:
-        ndc = lens.usable_ndc(right_px=LABEL_PX[0], top_px=LABEL_PX[1])
-        return frame_points(
-            self._framed_points, VIEW_DIRECTION, fov_rad=lens.fov_rad, aspect=lens.aspect, ndc=ndc
-        )
+        """The view of the line for ``lens``, with room above it for the labels, which it lays out for that lens."""
+        with self._lock:
+            anchors = self.label_anchors()
+            up_world = course_to_world(np.array([[0.0, 0.0, 1.0]]), self.params.grade_pct)[0]
+            top_px, view, lifts_m = LABEL_PX[1], None, np.zeros(len(anchors))
+            for _ in range(
+                MAX_RIDERS + 1
+            ):  # more room above shrinks the line, which may stack labels higher
+                ndc = lens.usable_ndc(right_px=LABEL_PX[0], top_px=top_px)
+                view = frame_points(
+                    self._framed_points,
+                    VIEW_DIRECTION,
+                    fov_rad=lens.fov_rad,
+                    aspect=lens.aspect,
+                    ndc=ndc,
+                )
+                lifts_px = label_lifts_px(project_px(anchors, view, lens))
+                lifts_m = lift_to_metres(anchors, lifts_px, up_world, view, lens)
+                need = LABEL_PX[1] + float(lifts_px.max(initial=0.0))
+                if need <= top_px + 0.5:
+                    break
+                top_px = need
+            assert view is not None
+            self._label_lift_m = np.zeros(MAX_RIDERS)
+            self._label_lift_m[: len(lifts_m)] = lifts_m
+            self.redraw(readouts=False)
+            return view
 
     def _update_framing(self) -> None:
         """Frame every browser again when the line changes length or tilt, or its bars outgrow the view."""
@@ -730,7 +847,8 @@ time-averaged power is the mean over positions, far below the leader's.
                     if label.text != text:
                         label.text = text
                     # Neighbours' labels alternate in height so close riders' labels never overlap.
-                    label.position = (x[i], y[i], 1.95 + base[i] + LABEL_STAGGER_M * (i % 2))
+                    # Lifted by the layout for the framed camera, so no two labels overlap.
+                    label.position = (x[i], y[i], 1.95 + base[i] + self._label_lift_m[slots[i]])
 
             rotation = self._rotation_markdown()
             if self.rotation.content != rotation:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import math
 
 import numpy as np
@@ -9,7 +10,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from scenes._framing import Lens, frame_points
+from scenes._framing import ClientFraming, Lens, View, box_corners, frame_points
 
 
 def _project(
@@ -98,3 +99,112 @@ def test_a_narrow_window_uses_the_whole_width_and_bad_lenses_fall_back() -> None
     assert Lens(1.0, 600, 800).usable_ndc()[1] > 0.9  # viser moves the panel out of the way there
     view = frame_points(np.zeros((1, 3)), (1.0, 0.0, 0.0), fov_rad=float("nan"), aspect=0.0)
     assert all(math.isfinite(c) for c in (*view.position, *view.look_at))
+
+
+@given(
+    points=st.lists(st.tuples(coordinate, coordinate, coordinate), min_size=2, max_size=12),
+    azimuth=st.floats(-math.pi, math.pi),
+    pitch=st.floats(-1.0, 1.0),
+    fov_deg=st.floats(20.0, 90.0),
+    aspect=st.floats(0.5, 3.0),
+    x0=st.floats(-0.99, 0.9),
+    width=st.floats(0.05, 1.0),
+    y0=st.floats(-0.99, 0.9),
+    height=st.floats(0.05, 1.0),
+)
+def test_a_rectangle_off_the_view_axis_is_filled_too(
+    points: list[tuple[float, float, float]],
+    azimuth: float,
+    pitch: float,
+    fov_deg: float,
+    aspect: float,
+    x0: float,
+    width: float,
+    y0: float,
+    height: float,
+) -> None:
+    # The fault's family: any rectangle, also one that misses the centre of the view (the part of a narrow window
+    # left of the panel and the labels' room lies wholly left of it). Every point lands inside, and tightly.
+    ndc = (x0, min(x0 + width, 0.99), y0, min(y0 + height, 0.99))
+    cloud = np.array(points)
+    if np.ptp(cloud, axis=0).max() < 1e-2:
+        return
+    direction = (
+        math.cos(azimuth) * math.cos(pitch),
+        math.sin(azimuth) * math.cos(pitch),
+        math.sin(pitch),
+    )
+    fov = math.radians(fov_deg)
+    view = frame_points(cloud, direction, fov_rad=fov, aspect=aspect, ndc=ndc)
+    projected = _project(cloud, np.array(view.position), np.array(view.look_at), fov, aspect)
+    eps = 1e-6
+    assert np.all(projected[:, 2] > 0.0)
+    assert projected[:, 0].min() >= ndc[0] - eps and projected[:, 0].max() <= ndc[1] + eps
+    assert projected[:, 1].min() >= ndc[2] - eps and projected[:, 1].max() <= ndc[3] + eps
+    spread = max(
+        np.ptp(projected[:, 0]) / (ndc[1] - ndc[0]), np.ptp(projected[:, 1]) / (ndc[3] - ndc[2])
+    )
+    assert spread > 0.97
+
+
+def test_eight_riders_six_metres_apart_in_a_1150_px_window_are_framed_near() -> None:
+    # The failing input: the line's box (8 riders 6 m apart at 55 km/h) in a 1150×720 canvas, where the room left of
+    # the panel and the labels ends left of the view axis (x1 = −0.085). The camera went 28 km away (0 px of the
+    # riders drawn); the line is 56 m long, so about 40 m is right.
+    lo, hi = np.array([-54.75, -1.1, 0.0]), np.array([0.85, 1.1, 4.26])
+    corners = box_corners(lo, hi)
+    lens = Lens(math.radians(75.0), 1150, 720)
+    ndc = lens.usable_ndc(right_px=190.0, top_px=30.0)
+    assert ndc[1] < 0.0
+    view = frame_points(
+        corners, (-1.2, 7.5, -1.8), fov_rad=lens.fov_rad, aspect=lens.aspect, ndc=ndc
+    )
+    distance = float(np.linalg.norm(np.subtract(view.position, view.look_at)))
+    assert 20.0 < distance < 80.0, distance
+    projected = _project(
+        corners, np.array(view.position), np.array(view.look_at), lens.fov_rad, lens.aspect
+    )
+    assert projected[:, 0].min() >= ndc[0] - 1e-6 and projected[:, 0].max() <= ndc[1] + 1e-6
+
+
+def test_an_empty_rectangle_frames_in_the_whole_view() -> None:
+    cloud = box_corners((-5.0, -1.0, 0.0), (5.0, 1.0, 2.0))
+    view = frame_points(cloud, (0.0, 1.0, 0.0), fov_rad=1.0, aspect=1.5, ndc=(0.3, 0.1, -0.5, 0.5))
+    projected = _project(cloud, np.array(view.position), np.array(view.look_at), 1.0, 1.5)
+    assert np.abs(projected[:, :2]).max() <= 0.9 + 1e-6
+    assert np.abs(projected[:, 0]).max() > 0.85  # framed tightly, not from far away
+
+
+class _Tab:
+    """A stand-in for one tab's viser camera handle: it reports what the test sets, and records the writes."""
+
+    def __init__(self) -> None:
+        self.client = self
+        self.client_id = 7
+        self.image_width, self.image_height, self.fov = 1280, 720, math.radians(75.0)
+        self.position, self.look_at, self.up_direction = (
+            (1.0, -7.5, 2.8),
+            (0.0, 0.0, 1.0),
+            (0.0, 0.0, 1.0),
+        )
+
+    def atomic(self) -> contextlib.AbstractContextManager[None]:
+        return contextlib.nullcontext()
+
+
+def test_a_tab_put_back_at_its_opening_view_before_showing_the_framing_is_framed_again() -> None:
+    # viser's client applies the server's initial camera in a React effect that can run after the first framing
+    # arrived: the tab then reports its opening view and, with an unchanged canvas, was never framed again.
+    framed = View(position=(5.0, -32.5, 11.2), look_at=(-0.9, 4.4, 2.4))
+    framing = ClientFraming(lambda lens: framed)
+    tab = _Tab()
+    opening = tab.position
+    framing.on_camera(tab)
+    assert framing.frames == 1 and tab.position == framed.position
+    tab.position = opening  # the client's reset, reported back
+    framing.on_camera(tab)
+    assert framing.frames == 2 and tab.position == framed.position
+    framing.on_camera(tab)  # now the tab reports the framed view
+    tab.position = (9.0, -9.0, 3.0)  # and from then on the person orbits: left alone
+    framing.on_camera(tab)
+    assert framing.frames == 2 and tab.position == (9.0, -9.0, 3.0)
