@@ -87,6 +87,9 @@ class Scene(abc.ABC):
         self._pending_lock = threading.Lock()
         """Guards each handler's "a call is queued" flag (:meth:`callback`); held only to read or set it."""
         self._in_callback = False
+        self.messages_in_call = 1
+        """How many input messages the handler running now stands for (a burst coalesced into one call): a handler
+        that counts the messages it handled adds this, not 1. Read it only inside a callback."""
         self._stop = threading.Event()
         self._threads: list[threading.Thread] = []
         self._camera_listeners: list[Callable[[viser.CameraHandle], None]] = []
@@ -167,11 +170,14 @@ class Scene(abc.ABC):
         """
         pending = False
         """True while a call of this handler is queued for the scene's lock and has not read any input yet."""
+        arrived = 0
+        """Messages since the last call read the handles: the burst the next call stands for."""
 
         @functools.wraps(func)
         def handler(_event: Any = None) -> None:
-            nonlocal pending
+            nonlocal pending, arrived
             with self._pending_lock:
+                arrived += 1
                 if pending:
                     return  # the queued call has not read the handles yet: it will see this value
                 pending = True
@@ -185,9 +191,11 @@ class Scene(abc.ABC):
             with self._lock:
                 with self._pending_lock:
                     pending = False  # from here on a newer value needs a call of its own
+                    burst, arrived = arrived, 0
                 if self._in_callback or self.closed:
                     return
                 self._in_callback = True
+                self.messages_in_call = burst
                 try:
                     func()
                 except Exception:

@@ -418,7 +418,8 @@ class SkeletonView:
             server.scene.add_icosphere(
                 f"{root}/skeleton/target_{k}/marker", radius=0.025, color=TARGET_COLOURS[k]
             )
-            gizmo.on_update(functools.partial(self._on_drag, k))
+            # One wrapper per gizmo, made once, so a burst of drag messages coalesces (Scene.callback).
+            gizmo.on_update(self.scene.callback(functools.partial(self._apply_target, k)))
             self.gizmos.append(gizmo)
 
     @property
@@ -478,11 +479,8 @@ class SkeletonView:
             with self.scene.server.atomic():
                 self._show_chain(False)
 
-    def _on_drag(self, k: int, _event: object) -> None:
-        self.scene.callback(functools.partial(self._apply_target, k))(None)
-
     def _apply_target(self, k: int) -> None:
-        self.gizmo_events += 1
+        self.gizmo_events += self.scene.messages_in_call
         sk = self.skeleton
         if sk is None or k >= len(sk.effectors):
             return

@@ -508,6 +508,12 @@ is a static pose.
             position=self.target,
         )
         scene.add_icosphere(f"{root}/target/marker", radius=0.035, color=TARGET_COLOUR)
+        # One wrapper per gizmo, made once, so a burst of drag messages coalesces (Scene.callback).
+        self._apply_target_cb = self.callback(self._apply_target)
+        self._reframe_cb = self.callback(self._reframe_if_outgrown)
+        self._apply_obstacle_cbs = [
+            self.callback(functools.partial(self._apply_obstacle, k)) for k in range(MAX_OBSTACLES)
+        ]
         self.target_gizmo.on_update(self._on_target_drag)
         self.obstacle_gizmos = []
         self.obstacle_discs = []
@@ -548,14 +554,14 @@ is a static pose.
 
     # ----------------------------------------------------------------------------------------- callbacks
     def _on_target_drag(self, event: object) -> None:
-        self.callback(self._apply_target)(None)
+        self._apply_target_cb(None)
         if (
             getattr(event, "phase", None) == "end"
         ):  # not mid-drag: the view must not move under the mouse
-            self.callback(self._reframe_if_outgrown)(None)
+            self._reframe_cb(None)
 
     def _apply_target(self) -> None:
-        self.gizmo_events += 1
+        self.gizmo_events += self.messages_in_call
         point = clean_point(self.target_gizmo.position, self.params.three_d)
         if point is None:  # NaN, huge, wrong shape: keep the last good target and pose
             self.target_gizmo.position = self.target
@@ -570,12 +576,12 @@ is a static pose.
         self.solve_and_draw()
 
     def _on_obstacle_drag(self, k: int, event: object) -> None:
-        self.callback(functools.partial(self._apply_obstacle, k))(None)
+        self._apply_obstacle_cbs[k](None)
         if getattr(event, "phase", None) == "end":
-            self.callback(self._reframe_if_outgrown)(None)
+            self._reframe_cb(None)
 
     def _apply_obstacle(self, k: int) -> None:
-        self.gizmo_events += 1
+        self.gizmo_events += self.messages_in_call
         gizmo = self.obstacle_gizmos[k]
         point = clean_point(gizmo.position, self.params.three_d)
         if point is None:

@@ -15,6 +15,7 @@ import time
 from collections.abc import Callable
 
 import numpy as np
+import pytest
 import viser
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -22,6 +23,7 @@ from wsclient import BrowserClient
 
 from kernels import sdf
 from scenes._base import Scene
+from scenes.arm import ArmScene
 from scenes.freekick import FreeKickParams, FreeKickScene, _segments, compute_kick, resample
 from scenes.sdf_gallery import PREVIEW_RESOLUTION, SdfGalleryScene
 from scenes.switcher import SceneSwitcher
@@ -228,3 +230,46 @@ def test_sdf_preview_while_dragging_ends_on_the_full_mesh_and_reference(
             assert scene.reference_rgb is not None
             assert scene.reference_rgb.shape[1] == scene.params.reference_width
             assert scene.agreement.iou is not None and scene.agreement.iou > 0.9
+
+
+@pytest.mark.parametrize("gizmo", ["/arm/target", "/arm/obstacle_0"])
+def test_a_drag_burst_on_an_arm_gizmo_coalesces_and_ends_on_its_last_pose(
+    server: viser.ViserServer,
+    switcher: SceneSwitcher,
+    gizmo: str,
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Every gizmo's handler is made once, so a burst of drag messages queued behind a busy scene runs the handler
+    a few times, not once a message, and the chain ends on the last pose sent. Before, the arm made a new wrapper
+    per message: 40 messages, 40 handler runs, each holding one of viser's callback threads while it waited (the
+    kind: a per-message wrapper defeats coalescing)."""
+    runs: list[int] = []
+    for name in ("_apply_target", "_apply_obstacle"):
+        original = getattr(ArmScene, name)
+
+        def counted(self: ArmScene, *args: int, _original: Callable[..., None] = original) -> None:
+            runs.append(self.messages_in_call)
+            _original(self, *args)
+
+        monkeypatch.setattr(ArmScene, name, counted)
+    scene = switcher.show("arm")
+    assert isinstance(scene, ArmScene)
+    handle = scene.target_gizmo if gizmo == "/arm/target" else scene.obstacle_gizmos[0]
+    path = [(0.45 + 0.2 * math.cos(t), 0.0, 0.8 + 0.2 * math.sin(t)) for t in np.linspace(0, 3, 40)]
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_node(gizmo)
+        runs.clear()
+        with scene._lock:  # the scene is busy: every message queues behind the lock
+            client.drag_transform(gizmo, path)
+            wait_until(
+                lambda: np.allclose(np.asarray(handle.position), path[-1]),
+                what="the last message to reach the server",
+            )
+            time.sleep(
+                0.2
+            )  # let viser's pool start the queued calls (each returns or waits on the lock)
+        wait_until(lambda: sum(runs) >= len(path), what="every message handled")
+        with scene._lock:
+            shown = scene.target if gizmo == "/arm/target" else scene.obstacle_centres[0]
+            np.testing.assert_allclose(shown, path[-1])
+            assert len(runs) <= 3, runs

@@ -49,7 +49,7 @@ class Probe(Scene):
 
     def _on_gizmo(self) -> None:
         self.point = self.read_position(self.gizmo, self.point, (-5.0, -5.0, 0.0), (5.0, 5.0, 5.0))
-        self.gizmo_events += 1
+        self.gizmo_events += self.messages_in_call
 
     def _tick(self, _dt: float) -> None:
         self.ticks += 1
