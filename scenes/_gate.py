@@ -65,6 +65,15 @@ MAX_UPLOADS_IN_FLIGHT_TOTAL = 8
 """Uploads every browser together may have in flight on one server."""
 MAX_UPLOAD_BYTES_IN_FLIGHT_TOTAL = 64 * MIB
 """Bytes the uploads in flight on one server may announce together (each is held in memory until it completes)."""
+MAX_UPLOAD_BYTES_IN_FLIGHT_PER_TAB = MAX_UPLOAD_BYTES
+"""Bytes one tab's uploads in flight may announce together: one tab holds at most this share of the server-wide
+budget, however slowly it sends."""
+MIN_PART_BYTES = 4096
+"""Smallest average part an upload may announce (viser's browser sends 512 KiB parts): viser keeps ~100 bytes of
+bookkeeping a part, so an upload of 1-byte parts would hold ~100× the bytes the budget counts."""
+UPLOAD_DEADLINE_S = 120.0
+"""An upload not finished this long after its start is dropped (24 MiB needs 200 KiB/s): a tab trickling one byte
+every few seconds would otherwise hold its share of the budget for good."""
 UPLOAD_STALL_S = 30.0
 """An upload that has received no part for this long is dropped (its parts freed), so it stops holding the
 server-wide budget."""
@@ -467,6 +476,8 @@ class _Upload:
     size_bytes: int
     last_part_at: float
     """When it started or last received a part (``time.monotonic()``)."""
+    started_at: float = dataclasses.field(default_factory=time.monotonic)
+    """When its start message was taken (``time.monotonic()``)."""
     bytes_seen: int = 0
     parts_seen: set[int] = dataclasses.field(default_factory=set)
 
@@ -750,7 +761,7 @@ class Gate:
             )
             return None, None
         if not all(isinstance(x, int) and not isinstance(x, bool) for x in (size, parts)) or (
-            not 0 <= parts <= max(1, size) or (size > 0) != (parts > 0)
+            not 0 <= parts <= max(1, -(-size // MIN_PART_BYTES)) or (size > 0) != (parts > 0)
         ):
             self.log.refuse("upload size", f"{size!r} bytes in {parts!r} parts")
             return None, None
@@ -769,6 +780,11 @@ class Gate:
             self.log.refuse("upload name", "file name, type or transfer id is not short text")
             return None, None
         self._drop_stalled_uploads(server)
+        if any(message.transfer_uuid in uploads for uploads in list(self._uploads.values())):
+            # Every tab sees a shared upload button's part acks, with their transfer id: a second start under
+            # that id would mix another tab's parts into the first tab's file.
+            self.log.refuse("upload transfer id", "already in flight")
+            return None, None
         in_flight = self._uploads.setdefault(client_id, {})
         if len(in_flight) >= MAX_UPLOADS_IN_FLIGHT:
             self.log.refuse("uploads in flight", f"more than {MAX_UPLOADS_IN_FLIGHT} at once")
@@ -776,6 +792,18 @@ class Gate:
                 server,
                 client_id,
                 f"This tab already has {MAX_UPLOADS_IN_FLIGHT} uploads under way; wait for one to finish.",
+            )
+        own_bytes = sum(upload.size_bytes for upload in list(in_flight.values()))
+        if own_bytes + size > MAX_UPLOAD_BYTES_IN_FLIGHT_PER_TAB:
+            self.log.refuse(
+                "upload bytes in flight",
+                f"{own_bytes} + {size} bytes from one tab (limit {MAX_UPLOAD_BYTES_IN_FLIGHT_PER_TAB})",
+            )
+            return None, self._tell(
+                server,
+                client_id,
+                f"This tab's uploads under way already announce {own_bytes / MIB:.1f} MiB; it takes "
+                f"{MAX_UPLOAD_BYTES_IN_FLIGHT_PER_TAB / MIB:.0f} MiB at once. Wait for them to finish.",
             )
         count, total_bytes = self.uploads_in_flight()
         if (
@@ -816,11 +844,16 @@ class Gate:
         now = time.monotonic()
         for client_id, uploads in list(self._uploads.items()):
             for transfer, upload in list(uploads.items()):
-                if now - upload.last_part_at < UPLOAD_STALL_S:
+                stalled = now - upload.last_part_at >= UPLOAD_STALL_S
+                late = now - upload.started_at >= UPLOAD_DEADLINE_S
+                if not (stalled or late):
                     continue
                 del uploads[transfer]
                 self.log.refuse(
-                    "stalled upload", f"no part for {UPLOAD_STALL_S:g} s; its parts are dropped"
+                    "stalled upload",
+                    f"no part for {UPLOAD_STALL_S:g} s"
+                    if stalled
+                    else f"not finished {UPLOAD_DEADLINE_S:g} s after its start",
                 )
                 client = self._client(server, client_id)
                 for api in (server.gui, None if client is None else client.gui):

@@ -30,6 +30,9 @@ class SceneSwitcher:
         session = server if isinstance(server, Session) else Session.shared(server)
         self.server = session
         self._lock = threading.RLock()
+        self.closed = False
+        """Set by :meth:`close`: a pick or Reset handled after it (its tab closed while the input waited on viser's
+        callback pool or the gate's budget) builds nothing, else it would build a scene that nobody closes."""
         titles = {cls.title: key for key, cls in SCENES.items()}
         self._key_from_title = titles
         # Callbacks first, under the lock: a pick made while the first scene builds waits for it, then applies.
@@ -61,6 +64,8 @@ class SceneSwitcher:
             return self.scene
 
     def _build(self, key: str, *, rebuild: bool) -> None:
+        if self.closed:
+            return
         if self.scene.key != key or rebuild:
             self.scene.close()
             self.scene = SCENES[key](self.server)
@@ -87,6 +92,7 @@ class SceneSwitcher:
 
     def close(self) -> None:
         with self._lock:
+            self.closed = True
             self.scene.close()
             self.dropdown.remove()
             self.reset_button.remove()

@@ -7,6 +7,7 @@ two upload messages is bent, one at a time, and the course stays what it was whi
 from __future__ import annotations
 
 import logging
+import time
 import uuid
 from typing import Any
 
@@ -15,7 +16,15 @@ import viser
 from test_course_scene import hill_gpx, upload
 from wsclient import BrowserClient
 
-from scenes._gate import MAX_UPLOAD_BYTES, MAX_UPLOADS_IN_FLIGHT, refusals
+import scenes._gate as gate_module
+from scenes._gate import (
+    MAX_UPLOAD_BYTES,
+    MAX_UPLOAD_BYTES_IN_FLIGHT_PER_TAB,
+    MAX_UPLOADS_IN_FLIGHT,
+    MIN_PART_BYTES,
+    install_gate,
+    refusals,
+)
 from scenes.peloton import CourseMode, PelotonScene
 from scenes.switcher import SceneSwitcher
 
@@ -118,7 +127,7 @@ def test_uploads_in_flight_are_bounded_per_browser(
     with BrowserClient(server.get_port()) as client, caplog.at_level(logging.WARNING):
         client.wait_for_gui("Upload GPX")
         for _ in range(MAX_UPLOADS_IN_FLIGHT + 3):
-            start(client, part_count=4, size_bytes=10)
+            start(client, part_count=1, size_bytes=10)
         client.wait_for(lambda: "refused uploads in flight" in caplog.text, what="the bound")
         # The person at that tab is told why, once per refused upload.
         client.wait_for(lambda: len(notices(client)) == 3, what="the refusal notices")
@@ -145,3 +154,86 @@ def test_a_file_over_the_size_limit_is_refused_with_a_notice(
         client.wait_for(lambda: bool(notices(client)), what="the refusal notice")
         (note,) = notices(client)
         assert note["title"] == "Upload refused" and "up to 24 MiB" in note["body"]
+
+
+# ---------------------------------------------------- what one tab's uploads may hold (review of issue 10)
+@pytest.mark.parametrize(
+    ("size", "parts"),
+    [(300_000, 300_000), (MAX_UPLOAD_BYTES, MAX_UPLOAD_BYTES), (2 * MIN_PART_BYTES, 3), (1, 2)],
+)
+def test_an_upload_of_tiny_parts_is_refused(
+    server: viser.ViserServer,
+    mode: CourseMode,
+    caplog: pytest.LogCaptureFixture,
+    size: int,
+    parts: int,
+) -> None:
+    """The kind: memory the budget does not count. viser keeps ~100 bytes a part, so 300 000 one-byte parts held
+    32 MiB for a 300 kB upload; an upload may announce at most one part per MIN_PART_BYTES (viser's own browser
+    sends 512 KiB parts)."""
+    with BrowserClient(server.get_port()) as client, caplog.at_level(logging.WARNING):
+        client.wait_for_gui("Upload GPX")
+        start(client, part_count=parts, size_bytes=size)
+        client.wait_for(lambda: "refused upload size" in caplog.text, what="the refusal")
+        assert install_gate(server).uploads_in_flight() == (0, 0)
+
+
+def test_a_transfer_id_in_flight_cannot_be_taken_by_another_tab(
+    server: viser.ViserServer, mode: CourseMode, caplog: pytest.LogCaptureFixture
+) -> None:
+    """Every tab sees a shared upload button's part acks (with the transfer id): a second tab's start under that id
+    is refused, so its parts cannot mix into the first tab's file."""
+    data = hill_gpx("Mine", 300)
+    half = len(data) // 2
+    with (
+        BrowserClient(server.get_port()) as a,
+        BrowserClient(server.get_port()) as b,
+        caplog.at_level(logging.WARNING),
+    ):
+        a.wait_for_gui("Upload GPX")
+        b.wait_for_gui("Upload GPX")
+        transfer = start(a, part_count=2, size_bytes=len(data), filename="mine.gpx")
+        part(a, transfer, 0, data[:half])
+        start(b, part_count=2, size_bytes=len(data), filename="theirs.gpx", transfer_uuid=transfer)
+        client_b_part = hill_gpx("Theirs", 300)
+        part(b, transfer, 1, client_b_part[half:])  # refused: b has no upload under that id
+        b.wait_for(lambda: "refused upload transfer id" in caplog.text, what="the refusal")
+        part(a, transfer, 1, data[half:])
+        a.wait_for(lambda: mode.route.name == "Mine", what="a's own course, whole")
+
+
+def test_one_tab_holds_at_most_its_share_of_the_upload_budget(
+    server: viser.ViserServer, mode: CourseMode
+) -> None:
+    big = MAX_UPLOAD_BYTES_IN_FLIGHT_PER_TAB // 2 + 1
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Upload GPX")
+        start(client, part_count=1, size_bytes=big)
+        start(client, part_count=1, size_bytes=big)  # over the tab's share
+        client.wait_for(lambda: bool(notices(client)), what="the refusal notice")
+        (note,) = notices(client)
+        assert note["title"] == "Upload refused" and "MiB at once" in note["body"]
+        assert install_gate(server).uploads_in_flight() == (1, big)
+
+
+def test_an_upload_trickled_past_its_deadline_is_dropped(
+    server: viser.ViserServer, mode: CourseMode, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A part every few seconds is progress, so the stall rule never fires; the deadline does (120 s, here 0.5 s),
+    and frees the budget for the next tab's upload."""
+    monkeypatch.setattr(gate_module, "UPLOAD_DEADLINE_S", 0.5)
+    data = hill_gpx("Late", 300)
+    with BrowserClient(server.get_port()) as hog, BrowserClient(server.get_port()) as other:
+        hog.wait_for_gui("Upload GPX")
+        other.wait_for_gui("Upload GPX")
+        transfer = start(hog, part_count=2, size_bytes=len(data))
+        part(hog, transfer, 0, data[: len(data) // 2])
+        gate = install_gate(server)
+        hog.wait_for(lambda: gate.uploads_in_flight()[0] == 1, what="the hog's upload in flight")
+        time.sleep(0.6)
+        upload(other, "Upload GPX", "next.gpx", hill_gpx("Next", 300))
+        other.wait_for(lambda: mode.route.name == "Next", what="the next tab's course")
+        assert gate.uploads_in_flight() == (0, 0)
+        part(hog, transfer, 1, data[len(data) // 2 :])  # too late: refused, the course stays
+        time.sleep(0.3)
+        assert mode.route.name == "Next"

@@ -195,6 +195,37 @@ def test_a_tab_closed_while_its_session_builds_is_torn_down_and_sent_nothing(
         manager.close()
 
 
+@pytest.mark.parametrize("action", ["pick", "reset"])
+def test_a_pick_or_reset_handled_after_its_tab_closed_builds_nothing(
+    server: viser.ViserServer, monkeypatch: pytest.MonkeyPatch, action: str
+) -> None:
+    """The kind: an input that waited on viser's callback pool (or the gate's budget) while its tab closed. Before,
+    the switcher built the picked scene after the session had closed it: nobody closed that scene, and its loop and
+    workers ran for good (12 such tabs: 7 → 50 threads). Now a closed switcher builds nothing."""
+    built: list[Scene] = []
+    arm = SCENES["arm"]
+
+    class CountedArm(arm):  # type: ignore[valid-type,misc]
+        def __init__(self, session: Session) -> None:
+            super().__init__(session)
+            built.append(self)
+
+    monkeypatch.setitem(SCENES, "arm", CountedArm)
+    switcher = SceneSwitcher(server, "arm")
+    assert len(built) == 1
+    threads = threading.active_count()
+    picked = switcher.dropdown
+    switcher.close()
+    assert switcher.scene.closed
+    picked._impl.value = SCENES["peloton"].title  # what viser stores before it runs the queued callback
+    if action == "pick":
+        switcher._on_pick(None)  # pyright: ignore[reportPrivateUsage]
+    else:
+        switcher._on_reset(None)  # pyright: ignore[reportPrivateUsage]
+    assert len(built) == 1 and switcher.scene is built[0] and switcher.scene.closed
+    wait_until(lambda: threading.active_count() <= threads, "no scene thread left running")
+
+
 def wait_until(predicate: Callable[[], bool], what: str, timeout_s: float = 30.0) -> None:
     deadline = time.monotonic() + timeout_s
     while not predicate():
