@@ -217,7 +217,9 @@ def test_a_pick_or_reset_handled_after_its_tab_closed_builds_nothing(
     picked = switcher.dropdown
     switcher.close()
     assert switcher.scene.closed
-    picked._impl.value = SCENES["peloton"].title  # what viser stores before it runs the queued callback
+    picked._impl.value = SCENES[
+        "peloton"
+    ].title  # what viser stores before it runs the queued callback
     if action == "pick":
         switcher._on_pick(None)  # pyright: ignore[reportPrivateUsage]
     else:
