@@ -29,6 +29,11 @@ from scenes._gate import record_spec
 
 MAX_RIDERS = 8
 BIKE_LENGTH_M = 1.70
+MAX_GAP_M = 15.0
+"""Largest wheel-to-wheel gap the slider offers (m): beyond ~3 m drafting is gone (Blocken et al. 2013)."""
+ROAD_X_M = (-(MAX_RIDERS - 1) * (BIKE_LENGTH_M + MAX_GAP_M) - 15.0, 15.0)
+"""(start, end) x of the drawn road (m): the longest line (8 riders, the largest gap) rides on it, with 15 m spare
+at each end."""
 """Wheel-to-wheel length of one bike; the gap is measured from the front wheel to the wheel ahead."""
 BAR_METRES_PER_WATT = 1.0 / 400.0
 """Height of the stacked power bars above the riders."""
@@ -471,7 +476,7 @@ time-averaged power is the mean over positions, far below the leader's.
                     "Riders", min=1, max=MAX_RIDERS, step=1, initial_value=p.n_riders
                 )
                 self.gap = gui.add_slider(
-                    "Gap (m)", min=0.0, max=15.0, step=0.1, initial_value=p.gap_m
+                    "Gap (m)", min=0.0, max=MAX_GAP_M, step=0.1, initial_value=p.gap_m
                 )
                 self.model = gui.add_dropdown(
                     "Draft model",
@@ -531,24 +536,29 @@ time-averaged power is the mean over positions, far below the leader's.
     def _build_world(self) -> None:
         scene = self.server.scene
         self.course = scene.add_frame(f"{self.root.name}/course", show_axes=False)
-        grass = trimesh.creation.box(extents=(90.0, 60.0, 0.02))
-        grass.apply_translation((-15.0, 0.0, -0.03))
+        start, end = ROAD_X_M
+        length, middle = end - start, 0.5 * (start + end)
+        grass = trimesh.creation.box(extents=(length + 30.0, 60.0, 0.02))
+        grass.apply_translation((middle, 0.0, -0.03))
         scene.add_mesh_simple(
             f"{self.course.name}/grass", grass.vertices, grass.faces, color=(120, 165, 95)
         )
-        road = trimesh.creation.box(extents=(60.0, 3.0, 0.02))
-        road.apply_translation((-15.0, 0.0, -0.01))
-        scene.add_mesh_simple(
+        road = trimesh.creation.box(extents=(length, 3.0, 0.02))
+        road.apply_translation((middle, 0.0, -0.01))
+        self.road = scene.add_mesh_simple(
             f"{self.course.name}/road", road.vertices, road.faces, color=(70, 72, 78)
         )
         dashes = np.array(
-            [[[x, 0.0, 0.002], [x + 1.5, 0.0, 0.002]] for x in np.arange(-44.0, 14.0, 3.0)]
+            [
+                [[x, 0.0, 0.002], [x + 1.5, 0.0, 0.002]]
+                for x in np.arange(start + 1.0, end - 1.0, 3.0)
+            ]
         )
         scene.add_line_segments(
             f"{self.course.name}/centre_line", dashes, colors=(240, 240, 240), thickness=0.08
         )
         for side in (-1.5, 1.5):
-            edge = np.array([[[-45.0, side, 0.003], [15.0, side, 0.003]]])
+            edge = np.array([[[start, side, 0.003], [end, side, 0.003]]])
             scene.add_line_segments(
                 f"{self.course.name}/edge_{side:+.0f}", edge, colors=(250, 250, 250), thickness=0.06
             )

@@ -18,6 +18,7 @@ from scenes._framing import PANEL_PX, Lens
 from scenes.peloton import (
     BAR_METRES_PER_WATT,
     LABEL_PX,
+    MAX_GAP_M,
     MAX_RIDERS,
     PelotonParams,
     PelotonScene,
@@ -334,3 +335,21 @@ def test_eight_riders_six_metres_apart_at_1280x720_have_labels_apart(scene: Pelo
     boxes = label_boxes_px(scene, lens)
     assert_labels_apart_and_in_view(boxes, lens)
     assert np.ptp(boxes[:, 1]) >= LABEL_PX[1]  # they had to stack
+
+
+@settings(max_examples=30, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(n=st.integers(1, MAX_RIDERS), gap_tenths=st.integers(0, round(10 * MAX_GAP_M)))
+def test_every_rider_rides_on_the_drawn_road(scene: PelotonScene, n: int, gap_tenths: int) -> None:
+    """The kind: scenery sized for the opening state. The road was 60 m long, so from 8 riders ~4 m apart the last
+    rode on the grass, and at the 15 m gap the rear riders floated past the ground's edge."""
+    scene.riders.value, scene.gap.value = n, gap_tenths / 10
+    road_x = np.asarray(scene.road.vertices)[:, 0]
+    with scene._lock:
+        x = np.asarray(scene.line_points())[:, 0]
+    assert road_x.min() <= x.min() - 1.0 and x.max() + 1.0 <= road_x.max(), (x.min(), road_x.min())
+
+
+def test_eight_riders_at_the_largest_gap_ride_on_the_road(scene: PelotonScene) -> None:
+    scene.riders.value, scene.gap.value = 8, MAX_GAP_M
+    tail = 7 * (1.70 + 15.0)  # the last rider's slot, 116.9 m behind the leader
+    assert np.asarray(scene.road.vertices)[:, 0].min() <= -tail - 1.0
