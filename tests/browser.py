@@ -334,13 +334,24 @@ def assert_seen(
     xy: NDArray[np.float64],
     what: str,
     max_outside: float = 0.25,
+    *,
+    without_labels: bool = False,
 ) -> NDArray[np.bool_]:
     """Assert that hiding ``nodes`` changes the picture inside the box around ``xy``: a person sees them there.
 
     At most ``max_outside`` of what they change may lie outside that box (their shadows, a gizmo's arrows).
+    With ``without_labels``, ``image`` was taken with the text labels hidden (:func:`with_labels_hidden`) and so is
+    the comparison: viser hides a label its 3D objects occlude, so hiding those objects shows labels elsewhere.
     Returns the mask of pixels the nodes cover.
     """
-    covered = changed_mask(image, with_nodes_hidden(shown.page, nodes))
+    if without_labels:
+        shown.page.evaluate("() => { window.__viserMutable.canvas2d.style.visibility = 'hidden'; }")
+    try:
+        hidden = with_nodes_hidden(shown.page, nodes)
+    finally:
+        if without_labels:
+            shown.page.evaluate("() => { window.__viserMutable.canvas2d.style.visibility = ''; }")
+    covered = changed_mask(image, hidden)
     x0, y0 = np.floor(xy.min(axis=0)).astype(int) - 4
     x1, y1 = np.ceil(xy.max(axis=0)).astype(int) + 4
     inside = covered[max(y0, 0) : max(y1, 0), max(x0, 0) : max(x1, 0)].sum()

@@ -29,6 +29,7 @@ from browser import (
     set_number,
     settle,
     wait_until,
+    with_labels_hidden,
 )
 from PIL import Image
 
@@ -64,7 +65,14 @@ def _look_at_the_line(shown: ScenePage) -> None:
         points = scene.line_points()
         n = scene.params.n_riders
     xy = assert_in_view(shown, "/peloton", points, f"the line of {n} riders, bars and labels")
-    assert_seen(shown, image, RIDERS + BARS, xy, f"{n} riders and their bars")
+    assert_seen(
+        shown,
+        with_labels_hidden(shown.page),
+        RIDERS + BARS,
+        xy,
+        f"{n} riders and their bars",
+        without_labels=True,
+    )
     # Every label (drawn at its anchor, extending right and up) lies inside the page and left of the panel, and
     # there is dark text there.
     with scene._lock:
@@ -101,7 +109,7 @@ def test_no_error_text_on_the_page(shown: ScenePage) -> None:
 
 
 @pytest.mark.xfail(
-    reason="issue 9 open: failed in the fresh-clone CI=true run on 2 loaded cores (passes alone); 8 riders 6 m apart at 1280x720",
+    reason="issue 9 open: at 1280x720 with 8 riders 6 m apart, ~2090 of ~4800 px that hiding the riders and bars changes lie outside their projected box, in every run (not load; not the labels: it fails with them hidden too); not yet diagnosed",
     strict=False,
 )
 def test_eight_riders_far_apart_stay_in_view(shown: ScenePage) -> None:
