@@ -22,6 +22,8 @@ from browser import open_viser
 from hypothesis import given
 from hypothesis import strategies as st
 from test_course_scene import hill_gpx, upload
+from test_hostile_uploads import notices as notifications
+from test_hostile_uploads import part as send_part
 from wsclient import BrowserClient
 
 from app import serve_scenes
@@ -334,14 +336,6 @@ def test_a_budget_that_lets_nothing_through_is_refused(burst: int, rate_hz: floa
 
 
 # ------------------------------------------------------------------------------------------ uploads
-def notifications(client: BrowserClient) -> list[dict[str, Any]]:
-    return [
-        message["props"]
-        for _at, message in list(client.received)
-        if message.get("type") == "NotificationShowMessage"
-    ]
-
-
 def start_upload(client: BrowserClient, size: int, parts: int) -> str:
     transfer = str(uuid.uuid4())
     client.send(
@@ -369,16 +363,6 @@ def open_course_tabs(
         client.wait_for_gui("Upload GPX")
         tabs.append((client, switcher.scene))
     return tabs
-
-
-def send_part(client: BrowserClient, transfer: str, index: int, content: bytes) -> None:
-    client.send(
-        "FileTransferPart",
-        source_component_uuid=client.uuid_of("Upload GPX"),
-        transfer_uuid=transfer,
-        part_index=index,
-        content=content,
-    )
 
 
 def padded_gpx(name: str, size: int) -> bytes:
