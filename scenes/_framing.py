@@ -25,6 +25,10 @@ PANEL_PX = 410.0
 """Width the control panel covers at the right of the canvas, with a margin (px)."""
 MARGIN_PX = 24.0
 """Space kept free at the other edges (px)."""
+NEAR_M = 0.05
+"""Least distance of a framed point in front of the camera (m), whatever ``min_depth`` says: viser's near clipping
+plane is 0.01 m, and a cloud lying along the view direction would otherwise get the camera 1 mm from its nearest
+point, which the near plane then cuts away."""
 FULL_NDC = (-0.9, 0.9, -0.9, 0.9)
 """The rectangle framing uses when none is given, or when the one given is empty."""
 
@@ -95,7 +99,8 @@ def frame_points(
         aspect: image width / height.
         ndc: (x0, x1, y0, y1) rectangle of normalised device coordinates the points must project into; an empty
             one (x1 ≤ x0 or y1 ≤ y0) falls back to :data:`FULL_NDC`.
-        min_depth: every point stays at least this far in front of the camera (m): "behind the ball", not in it.
+        min_depth: every point stays at least this far in front of the camera (m): "behind the ball", not in it;
+            never under :data:`NEAR_M`.
 
     Returns:
         The camera position and orbit centre. The orbit centre sits on the view axis, so the points appear centred
@@ -134,9 +139,11 @@ def frame_points(
                 b = s
         return 0.5 * (a + b)
 
+    least_depth = max(min_depth, NEAR_M) if math.isfinite(min_depth) else NEAR_M
+
     def fits(distance: float) -> tuple[bool, float, float]:
         depth = distance + w
-        if np.any(depth <= max(min_depth, 1e-6)):
+        if np.any(depth < least_depth):
             return False, 0.0, 0.0
         sx = shift(u, depth * tan_x, x0, x1)
         sy = shift(v, depth * tan_y, y0, y1)
@@ -144,8 +151,8 @@ def frame_points(
         ok = px.min() >= x0 and px.max() <= x1 and py.min() >= y0 and py.max() <= y1
         return bool(ok), sx, sy
 
-    near = depth_extent + 1e-3
-    far = near + max(min_depth, 0.0) + 1000.0 * (size + 1.0)
+    near = depth_extent + NEAR_M
+    far = depth_extent + least_depth + 1000.0 * (size + 1.0)
     for _ in range(60):
         mid = 0.5 * (near + far)
         if fits(mid)[0]:
@@ -212,16 +219,29 @@ class ClientFraming:
     :meth:`~scenes._base.Scene.watch_cameras`: a camera seen for the first time (a new tab) or with a new canvas size
     (a resized window) is framed; other moves (the person orbiting) are left alone until the scene calls
     :meth:`reframe`, as when what it shows grows.
+
+    ``opening`` is the position (m) viser's client puts a tab back to: the server's ``initial_camera``. A tab that
+    reports it is framed again, whenever that happens: viser's client can apply its opening camera after our first
+    framing arrived and was reported back (its ``InitialCameraSetter`` effect runs when the server's initial camera
+    first reaches the tab, and again whenever the scene root turns), and its "Reset View" button goes there too. A
+    person orbiting does not stop at exactly that pose.
     """
 
-    def __init__(self, view_for: Callable[[Lens], View]) -> None:
+    def __init__(
+        self,
+        view_for: Callable[[Lens], View],
+        opening: tuple[float, float, float] | None = None,
+    ) -> None:
         self._view_for = view_for
+        self._opening = None if opening is None else np.asarray(opening, dtype=np.float64)
         self._lock = threading.Lock()
         self._cameras: dict[int, Any] = {}
         self._framed: dict[int, tuple[int, int]] = {}
         """Canvas size each client was last framed for."""
         self._unconfirmed: dict[int, tuple[NDArray[np.float64], int]] = {}
         """Position written to each client whose camera has not reported it back yet, and the re-frames left."""
+        self._written: dict[int, NDArray[np.float64]] = {}
+        """Position last written to each client."""
         self.frames = 0
         """How many times a camera was framed (tests wait on it)."""
 
@@ -239,7 +259,9 @@ class ClientFraming:
             if self._framed.get(client_id) == size:
                 unconfirmed = self._unconfirmed.pop(client_id, None)
                 if unconfirmed is None:
-                    return  # the person orbiting, or our own write coming back: leave the view alone
+                    if not self._put_back(camera, client_id):
+                        return  # the person orbiting, or our own write coming back: leave the view alone
+                    unconfirmed = (self._written[client_id], CONFIRM_TRIES)
                 written, tries = unconfirmed
                 if _reports(camera, written) or tries <= 0:
                     return  # the tab shows the framed view: from now on every move is the person's
@@ -250,6 +272,18 @@ class ClientFraming:
                 self._framed[client_id] = size  # a new tab, or a resized window
                 self._unconfirmed.pop(client_id, None)
         self._frame(camera)
+
+    def pending(self, client_id: int) -> bool:
+        """Whether a framing was written to client ``client_id`` that its camera has not reported back yet."""
+        with self._lock:
+            return client_id in self._unconfirmed
+
+    def _put_back(self, camera: Any, client_id: int) -> bool:
+        """Whether ``camera`` reports the opening view instead of the one last written to it (call under the lock)."""
+        written = self._written.get(client_id)
+        if self._opening is None or written is None:
+            return False
+        return _reports(camera, self._opening, strict=True) and not _reports(camera, written)
 
     def reframe(self) -> None:
         """Frame every camera seen so far again (for cameras of closed tabs the write is dropped by viser)."""
@@ -280,7 +314,9 @@ class ClientFraming:
         with self._lock:
             client_id = int(camera.client.client_id)  # on_camera read it already: a real handle
             tries = self._unconfirmed.get(client_id, (None, CONFIRM_TRIES))[1]
-            self._unconfirmed[client_id] = (np.asarray(view.position, dtype=np.float64), tries)
+            position = np.asarray(view.position, dtype=np.float64)
+            self._unconfirmed[client_id] = (position, tries)
+            self._written[client_id] = position
         self.frames += 1
 
 
@@ -289,11 +325,14 @@ CONFIRM_TRIES = 5
 already on their way count too)."""
 
 
-def _reports(camera: Any, position: NDArray[np.float64]) -> bool:
-    """Whether ``camera`` (a viser camera handle) reports ``position`` (m), to a millimetre per metre of it."""
+def _reports(camera: Any, position: NDArray[np.float64], *, strict: bool = False) -> bool:
+    """Whether ``camera`` (a viser camera handle) reports ``position`` (m), to a millimetre per metre of it.
+
+    A camera whose position cannot be read counts as reporting it, so that nothing is framed forever, unless
+    ``strict``."""
     try:
         reported = np.asarray(camera.position, dtype=np.float64)
     except (AttributeError, TypeError, ValueError, AssertionError):
-        return True  # nothing to compare: count it as shown rather than frame forever
+        return not strict
     tolerance = 1e-3 * (1.0 + float(np.linalg.norm(position)))
     return reported.shape == (3,) and bool(np.all(np.abs(reported - position) <= tolerance))

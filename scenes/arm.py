@@ -351,7 +351,7 @@ is a static pose.
         self.solve_and_draw()
         self._framed_box: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None
         """(lo, hi) world box (m) of what the cameras were last framed to show."""
-        self.framing = ClientFraming(self._view_for)
+        self.framing = ClientFraming(self._view_for, opening=self.camera_position)
         self.watch_cameras(self.framing.on_camera)
 
     def close(self) -> None:

@@ -887,7 +887,7 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
         self._build_gui()
         self._build_world()
         self.redraw()
-        self.framing = ClientFraming(self._view_for)
+        self.framing = ClientFraming(self._view_for, opening=self.camera_position)
         self.watch_cameras(self.framing.on_camera)
         self._map_worker.thread.start()
         self._aim_worker.thread.start()

@@ -413,7 +413,7 @@ time-averaged power is the mean over positions, far below the leader's.
         self.redraw()
         self._framed_for = self._framing_key()
         self._framed_points = self.line_points()
-        self.framing = ClientFraming(self._view_for)
+        self.framing = ClientFraming(self._view_for, opening=self.camera_position)
         self.watch_cameras(self.framing.on_camera)
         self.start_loop(self._animate, 1.0 / 30.0)
         self.course_mode = CourseMode(self)  # issue 13: ride a GPX course
