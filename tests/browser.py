@@ -260,11 +260,17 @@ def wait_until(predicate: Any, what: str, timeout_s: float = 30.0) -> None:
 
 
 def settle(shown: ScenePage, timeout_s: float = 30.0) -> None:
-    """Wait until the scene has framed this page's camera, the camera holds still and the picture is drawn."""
+    """Wait until the scene has framed this page's camera, the page reported the framed view back, the camera holds
+    still and the picture is drawn.
+
+    Without the report, a page under load could be looked at while the framing was still on its way, or just
+    after viser's client had put it back at its opening view (the scene then frames it again).
+    """
     scene = shown.scene
     framing = getattr(scene, "framing", None)
     if framing is not None:
         wait_until(lambda: framing.frames >= 1, "the scene to frame the camera", timeout_s)
+    client_ids = list(shown.server.get_clients())
     deadline = time.monotonic() + timeout_s
     last, still = None, 0
     while (
@@ -274,7 +280,9 @@ def settle(shown: ScenePage, timeout_s: float = 30.0) -> None:
             "() => [...window.__viserMutable.camera.position.toArray(),"
             " ...window.__viserMutable.camera.quaternion.toArray()]"
         )
-        still = still + 1 if last is not None and np.allclose(now, last, atol=1e-6) else 0
+        framing_pending = framing is not None and any(framing.pending(c) for c in client_ids)
+        steady = last is not None and np.allclose(now, last, atol=1e-6) and not framing_pending
+        still = still + 1 if steady else 0
         last = now
         time.sleep(0.2)
         wait_frames(shown.page, 1)

@@ -136,10 +136,6 @@ def screen_of(page: Any, name: str, local: tuple[float, float, float]) -> tuple[
     return float(x), float(y)
 
 
-@pytest.mark.xfail(
-    reason="issue 9 open: failed in the fresh-clone CI=true run on 2 loaded cores (passes alone); the mouse drag of the target gizmo, after the arm's re-framing at a drag end was added",
-    strict=False,
-)
 def test_drag_the_target_gizmo_with_the_mouse(server: viser.ViserServer, browser_page: Any) -> None:
     switcher = SceneSwitcher(server, "arm")
     scene = switcher.scene

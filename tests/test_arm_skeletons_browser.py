@@ -32,10 +32,6 @@ args => {
 """World position of instance ``i`` of a batched mesh, as the page's three.js scene holds it."""
 
 
-@pytest.mark.xfail(
-    reason="issue 9 open: failed in the fresh-clone CI=true run on 2 loaded cores (passes alone); the mouse drag of a fingertip target, after the arm's re-framing at a drag end was added",
-    strict=False,
-)
 def test_drag_a_fingertip_target_with_the_mouse(
     server: viser.ViserServer, browser_page: Any
 ) -> None:

@@ -43,9 +43,11 @@ from scenes.freekick import (
     FreeKickScene,
     ViewName,
     ball_spot,
+    frame_view,
     resample,
     view_points,
 )
+from scenes._framing import Lens, project_points
 from scenes.switcher import SceneSwitcher
 
 pytestmark = pytest.mark.browser
@@ -55,14 +57,14 @@ NODE = f"window.__viserMutable.nodeRefFromName[{BALL!r}]"
 MAIN = ["/freekick/wall", "/freekick/goal_frame", "/freekick/path", "/freekick/ball"]
 CHART = "Force magnitudes along the flight"
 CHART_COLOURS = {**FORCE_COLOURS, "knuckle": KNUCKLE_COLOUR}
-GOAL_SHARE: dict[ViewName, float] = {
-    "broadcast": 0.25,
-    "behind": 0.12,
-    "side": 0.12,
-    "above": 0.18,
-}
-"""Least share of the free canvas width (left of the panel) the goal's box spans in each view that shows it; the
-old opening view spanned 0.18–0.19. Behind the ball and side-on the goal is far off or seen edge on (0.15–0.18)."""
+OPENING_GOAL_SHARE = 0.25
+"""Least share of the free canvas width (left of the panel) the goal's box spans in the opening view at the
+defaults (the old opening view: 0.18–0.19)."""
+GOAL_SHARE_AGREES = 0.03
+"""In every other view the goal's width on the page must match the width the pure projection of the scene's
+framing gives (tests/test_freekick_scene.py bounds it over presets and ball spots) to this relative tolerance. A
+fixed floor here tested one state only: side-on it is 0.12–0.15 at the defaults, depending on the spin the
+earlier tests left, and 0.06 for a ball 40 m out."""
 OPENING_GAP_PX = 25.0
 """Least on-screen distance of the path from its no-spin ghost over the flight's second half, opening view (the old
 one drew them 1–10 px apart)."""
@@ -104,7 +106,7 @@ def test_the_kick_fills_the_view_clear_of_the_panel(shown: ScenePage) -> None:
     width = panel_rect(shown.page)[0]
     assert np.ptp(xy[:, 0]) > 0.6 * width, np.ptp(xy[:, 0])
     # ...with the goal a real size...
-    assert _goal_share(shown) >= GOAL_SHARE["broadcast"], _goal_share(shown)
+    assert _goal_share(shown) >= OPENING_GOAL_SHARE, _goal_share(shown)
     # ...and the curl across the screen: the path stands apart from the no-spin ghost over the second half.
     path_xy = project(shown.page, "/freekick", path)[20:, :2]
     ghost_xy = project(shown.page, "/freekick", ghost)[:, :2]
@@ -152,10 +154,6 @@ def test_ten_percent_more_spin_moves_the_path_on_the_screen(shown: ScenePage) ->
     assert error_text(shown.page) == []
 
 
-@pytest.mark.xfail(
-    reason="issue 9 open: failed in the fresh-clone CI=true run on 2 loaded cores (passes alone); every View entry at 1280x720",
-    strict=False,
-)
 def test_every_camera_view_keeps_the_kick_in_view(shown: ScenePage) -> None:
     scene = shown.scene
     views: list[ViewName] = list(VIEW_LABELS)
@@ -179,7 +177,16 @@ def test_every_camera_view_keeps_the_kick_in_view(shown: ScenePage) -> None:
         assert_seen(shown, image, MAIN, xy, f"ball, wall, goal and path ({view})")
         if view != "goal":
             assert_in_view(shown, "/freekick", GOAL_CORNERS, f"the goal ({view})")
-            assert _goal_share(shown) >= GOAL_SHARE[view], (view, _goal_share(shown))
+            camera = shown.client_camera
+            lens = Lens(float(camera.fov), int(camera.image_width), int(camera.image_height))
+            with scene._lock:
+                framed = frame_view(scene.params, scene.state, view, lens)
+            # The camera reports its canvas in device pixels, which viser's client scales down (to 0.75–1 of the
+            # CSS size here) while it draws slowly: the pure projection is in those, the page's in CSS px.
+            css_per_px = shown.viewport[0] / lens.width_px
+            expected = css_per_px * float(np.ptp(project_points(framed, lens, GOAL_CORNERS)[:, 0]))
+            seen = float(np.ptp(project(shown.page, "/freekick", GOAL_CORNERS)[:, 0]))
+            assert seen == pytest.approx(expected, rel=GOAL_SHARE_AGREES), view
             continue
         # The goalkeeper's view: the camera stands on the pitch in front of the goal line (x < 0)...
         eye = np.asarray(shown.client_camera.position)
@@ -194,10 +201,6 @@ def test_every_camera_view_keeps_the_kick_in_view(shown: ScenePage) -> None:
         assert ball_seen[y - 8 : y + 9, x - 8 : x + 9].sum() >= 5, "the ball is hidden"
 
 
-@pytest.mark.xfail(
-    reason="issue 9 open: failed in the fresh-clone CI=true run on 2 loaded cores (passes alone); Kick flies the ball in the page",
-    strict=False,
-)
 def test_pressing_kick_flies_the_ball_in_the_page(
     server: viser.ViserServer, browser_page: Any
 ) -> None:

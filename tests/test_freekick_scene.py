@@ -470,6 +470,12 @@ OPENING_GOAL_SHARE = 0.25
 """Share of the free canvas width the goal must span in the opening view (the old one: 0.18–0.19)."""
 
 
+GOAL_SHARE_FLOOR: dict[ViewName, float] = {"broadcast": 0.15, "behind": 0.07, "side": 0.05, "above": 0.10}
+"""Least share of the free canvas width the goal spans in each view that shows it, for every preset and ball spot
+(12–40 m, ±45°; measured minima 0.157, 0.078, 0.060, 0.105, each for a ball 40 m out). Side-on the goal is seen
+edge on; the goalkeeper's view stands in front of it."""
+
+
 def _old_broadcast(p: FreeKickParams, state: KickState, lens: Lens) -> View:
     """The opening view before issue 9's review: beside the kicker's right shoulder, 20° down."""
     spot = ball_spot(p)
@@ -508,6 +514,8 @@ def _assert_framed(p: FreeKickParams, view: ViewName, lens: Lens) -> View:
     assert xy[:, 0].min() >= MARGIN_PX - 0.5 and xy[:, 1].min() >= MARGIN_PX - 0.5, where
     assert xy[:, 0].max() <= lens.width_px - PANEL_PX - MARGIN_PX + 0.5, where  # left of the panel
     assert xy[:, 1].max() <= lens.height_px - MARGIN_PX + 0.5, where
+    if view != "goal":
+        assert _goal_width_share(framed, lens) >= GOAL_SHARE_FLOOR[view], where
     if view == "goal":
         # The goalkeeper's camera stands in front of the goal line (the pitch is x < 0), so neither net nor frame
         # is between it and the ball, and it sees the ball past or over the wall.
