@@ -80,6 +80,31 @@ def test_changing_values_updates_every_output(scene: PelotonScene) -> None:
     assert 2 * math.atan2(-y, w) == pytest.approx(math.atan(0.06), rel=1e-6)
 
 
+@pytest.mark.parametrize("grade", [0.0, 8.0])
+def test_dragging_the_speed_up_reframes_every_few_kmh_and_keeps_the_bars_framed(
+    scene: PelotonScene, grade: float
+) -> None:
+    # The kind: a continuous drag of a slider that grows the bars. Each step re-framed every tab before (at 8
+    # tabs a second's stall); with headroom it re-frames only when the bars pass the room left, and the framed
+    # box always holds the bars drawn.
+    scene.grade.value = grade
+    reframes = 0
+    reframe = scene.framing.reframe
+
+    def counting() -> None:
+        nonlocal reframes
+        reframes += 1
+        reframe()
+
+    scene.framing.reframe = counting  # type: ignore[method-assign]
+    for speed in np.arange(30.0, 50.01, 0.5):
+        scene.speed.value = float(speed)
+        assert scene.params.speed_kmh == pytest.approx(speed)
+        assert scene.line_points()[:, 2].max() <= scene._framed_points[:, 2].max() + 0.05
+    steps = len(np.arange(30.0, 50.01, 0.5))
+    assert 1 <= reframes <= 10 < steps, reframes
+
+
 def test_position_preset_sets_cda_and_redraws_the_rider(scene: PelotonScene) -> None:
     before = np.array(scene.riders_nodes["body"].vertices)
     scene.position.value = "Time-trial tuck"
