@@ -581,6 +581,7 @@ class Gate:
     def _on_connect(self, connection: Any) -> None:
         self._client_dispatch[int(connection.client_id)] = connection._handle_incoming_message
         connection._handle_incoming_message = _ignore
+        connection.queue_message(_messages.RunJavascriptMessage(source=CSS_CAMERA_JS))
 
     def _on_disconnect(self, connection: Any) -> None:
         client_id = int(connection.client_id)
@@ -988,6 +989,33 @@ def install_gate(server: viser.ViserServer) -> Gate:
             _install_frame_gate()
             gate = _gates[server] = Gate(server)
         return gate
+
+
+CSS_CAMERA_JS = """(() => {
+  const viewer = window.__viserMutable;
+  if (!viewer || typeof viewer.sendMessage !== "function" || viewer.sendMessage.cssCamera) return;
+  const send = viewer.sendMessage;
+  const wrapped = (message) => {
+    const canvas = viewer.canvas;
+    if (message && message.type === "ViewerCameraMessage" && canvas
+        && canvas.clientWidth > 0 && canvas.clientHeight > 0) {
+      message = Object.assign({}, message,
+        { image_width: canvas.clientWidth, image_height: canvas.clientHeight });
+    }
+    return send(message);
+  };
+  wrapped.cssCamera = true;
+  viewer.sendMessage = wrapped;
+  if (typeof viewer.sendCamera === "function") viewer.sendCamera();
+})();"""
+"""Sent to every tab as it connects: its camera reports then give the canvas size in CSS pixels.
+
+viser 1.1.1's client reports ``canvas.width``, in device pixels: twice the CSS size on a HiDPI screen, and 0.75–1
+of it while its adaptive resolution drops on a slow machine. The control panel is a fixed CSS width, so framing in
+device pixels put the scene under the panel on HiDPI screens, and each resolution change re-framed the camera
+(during a drag, too). The script wraps the client's ``sendMessage`` (reassigned on each connection, so each
+connection gets the script again) and sends the camera once at once.
+"""
 
 
 # ------------------------------------------------------------------------------------------------ registries
