@@ -118,60 +118,81 @@ def frame_points(
     u, v, w = rel @ right, rel @ up, rel @ d
     tan_y = math.tan(0.5 * fov_rad)
     tan_x = aspect * tan_y
-    depth_extent = float(np.max(np.abs(w))) if len(w) else 0.0
-    size = float(np.max(np.linalg.norm(rel, axis=1))) if len(rel) else 0.0
-
-    def shift(
-        coord: NDArray[np.float64], scale: NDArray[np.float64], lo: float, hi: float
-    ) -> float:
-        """Offset s with the projections (coord − s)/scale centred in [lo, hi] (bisection; monotone in s)."""
-        # The centre sits |mid|·scale off the view axis: far away that is far more than the cloud's size, so the
-        # bracket grows with the depth (a fixed one left a rectangle that misses the axis, as left of the panel in a
-        # window narrower than ~1250 px, unreachable: the search then ran out to its 1000×size limit).
-        reach = size + 1.0 + float(np.max(scale)) * (abs(lo) + abs(hi) + 1.0)
-        a, b = -reach, reach
-        for _ in range(60):
-            s = 0.5 * (a + b)
-            p = (coord - s) / scale
-            if 0.5 * (p.min() + p.max()) > 0.5 * (lo + hi):
-                a = s
-            else:
-                b = s
-        return 0.5 * (a + b)
-
+    depth_extent = float(np.max(np.abs(w)))
+    size = float(np.max(np.linalg.norm(rel, axis=1)))
     least_depth = max(min_depth, NEAR_M) if math.isfinite(min_depth) else NEAR_M
-
-    def fits(distance: float) -> tuple[bool, float, float]:
-        depth = distance + w
-        if np.any(depth < least_depth):
-            return False, 0.0, 0.0
-        sx = shift(u, depth * tan_x, x0, x1)
-        sy = shift(v, depth * tan_y, y0, y1)
-        px, py = (u - sx) / (depth * tan_x), (v - sy) / (depth * tan_y)
-        ok = px.min() >= x0 and px.max() <= x1 and py.min() >= y0 and py.max() <= y1
-        return bool(ok), sx, sy
-
-    near = depth_extent + NEAR_M
+    # The camera at distance D behind the centre sees point i at depth D + w_i and, shifted by s across the view, at
+    # ndc (u_i − s)/((D + w_i)·tan_x) on x (likewise on y). Some s puts every point inside [lo, hi] iff
+    # max_i(u_i − hi·k_i) ≤ min_j(u_j − lo·k_j) with k = (D + w)·tan_x, which is linear in D: the least distance is
+    # closed-form (_least_distance). The nearest distance is never under the one the depths allow, nor (as the
+    # bracket of the former bisection) under depth_extent + NEAR_M; it is never over `far`, beyond which the
+    # rectangle counts as unable to hold the points.
     far = depth_extent + least_depth + 1000.0 * (size + 1.0)
-    for _ in range(60):
-        mid = 0.5 * (near + far)
-        if fits(mid)[0]:
-            far = mid
-        else:
-            near = mid
-    ok, sx, sy = fits(far)
-    if not ok:
-        # The rectangle cannot hold the points at any distance (it is empty): frame in the whole view instead.
+    distance = max(
+        depth_extent + NEAR_M,
+        least_depth - float(np.min(w)),
+        _least_distance(u, w, tan_x, x0, x1),
+        _least_distance(v, w, tan_y, y0, y1),
+    )
+    # Also NaN: the rectangle is empty, or too small to hold the points from `far`.
+    if not distance <= far:
         if ndc != FULL_NDC:
             return frame_points(
                 pts, direction, fov_rad=fov_rad, aspect=aspect, ndc=FULL_NDC, min_depth=min_depth
             )
+        distance = far
+    depth = distance + w
+    sx = _centring_shift(u, depth * tan_x, x0, x1)
+    sy = _centring_shift(v, depth * tan_y, y0, y1)
     look_at = centre + sx * right + sy * up
-    position = look_at - far * d
+    position = look_at - distance * d
     return View(
         position=(float(position[0]), float(position[1]), float(position[2])),
         look_at=(float(look_at[0]), float(look_at[1]), float(look_at[2])),
     )
+
+
+def _least_distance(
+    coord: NDArray[np.float64], w: NDArray[np.float64], tan: float, lo: float, hi: float
+) -> float:
+    """Least distance D at which some shift s puts every (coord_i − s)/((D + w_i)·tan) inside [lo, hi] (m).
+
+    Feasible iff coord_i − hi·k_i ≤ coord_j − lo·k_j for every pair (i, j), with k = (D + w)·tan; the pairs separate,
+    so D = (max_i(coord_i/tan − hi·w_i) + max_j(lo·w_j − coord_j/tan)) / (hi − lo). An empty interval (hi ≤ lo)
+    gives +inf; NaN bounds give NaN.
+    """
+    if not hi > lo:
+        return math.nan if math.isnan(hi - lo) else math.inf
+    scaled = coord / tan
+    return (float(np.max(scaled - hi * w)) + float(np.max(lo * w - scaled))) / (hi - lo)
+
+
+def _centring_shift(
+    coord: NDArray[np.float64], scale: NDArray[np.float64], lo: float, hi: float
+) -> float:
+    """The shift s with the projections p_i = (coord_i − s)/scale_i (scale > 0) centred in [lo, hi]:
+    max p + min p = lo + hi, exactly (to rounding).
+
+    That s is the one keeping every p_i inside [lo + δ, hi − δ] for the largest margin δ: such an s exists iff
+    h(δ) = max_i(coord_i − hi·scale_i + δ·scale_i) + max_j(lo·scale_j − coord_j + δ·scale_j) ≤ 0, and h is convex,
+    piecewise linear and strictly increasing in δ. Newton's method on it from δ = (hi − lo)/2 (where h ≥ 0) stays
+    right of the root and lands on it exactly once it uses the root's linear piece: a few steps, at most one a piece.
+    """
+    alpha, beta = coord - hi * scale, lo * scale - coord
+    delta = 0.5 * (hi - lo)
+    active = (-1, -1)
+    for _ in range(2 * len(coord) + 2):
+        upper, lower = alpha + delta * scale, beta + delta * scale
+        i, j = int(np.argmax(upper)), int(np.argmax(lower))
+        excess = float(upper[i] + lower[j])
+        if not excess > 0.0 or (i, j) == active:
+            break
+        active = (i, j)
+        delta -= excess / float(scale[i] + scale[j])
+    else:
+        upper, lower = alpha + delta * scale, beta + delta * scale
+    # At the root max(coord − (hi − δ)·scale) = min(coord − (lo + δ)·scale) = s; average the two against rounding.
+    return 0.5 * (float(np.max(upper)) - float(np.max(lower)))
 
 
 def project_points(view: View, lens: Lens, points: NDArray[np.float64]) -> NDArray[np.float64]:

@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from scenes._framing import NEAR_M, ClientFraming, Lens, View, box_corners, frame_points
@@ -89,7 +89,9 @@ def test_a_cloud_along_the_view_direction_stays_beyond_the_near_plane() -> None:
     view = frame_points(
         cloud, direction, fov_rad=math.radians(20.0), aspect=1.0, ndc=(-0.8, 0.4, -0.7, 0.9)
     )
-    projected = _project(cloud, np.array(view.position), np.array(view.look_at), math.radians(20.0), 1.0)
+    projected = _project(
+        cloud, np.array(view.position), np.array(view.look_at), math.radians(20.0), 1.0
+    )
     assert projected[:, 2].min() == pytest.approx(NEAR_M, rel=1e-3)
 
 
@@ -265,3 +267,119 @@ def test_without_an_opening_view_a_move_after_the_confirmation_is_the_persons() 
     tab.position = opening
     framing.on_camera(tab)
     assert framing.frames == 1 and tab.position == opening
+
+
+def _reference_view(
+    cloud: np.ndarray,
+    direction: tuple[float, float, float],
+    fov: float,
+    aspect: float,
+    ndc: tuple[float, float, float, float],
+    min_depth: float,
+) -> tuple[np.ndarray, np.ndarray]:
+    """(position, look_at) by brute force, as frame_points once searched: bisect the distance between the depth
+    extent and 1000× the cloud's size, at each one bisecting each shift across the view until the points' ndc are
+    centred in the rectangle and checking they fit; an empty (x1 ≤ x0 or y1 ≤ y0) or unreachable rectangle falls back
+    to the whole view."""
+    d = np.asarray(direction) / np.linalg.norm(direction)
+    right = np.cross(d, [0.0, 0.0, 1.0])
+    right /= np.linalg.norm(right)
+    up = np.cross(right, d)
+    centre = 0.5 * (cloud.min(axis=0) + cloud.max(axis=0))
+    rel = cloud - centre
+    u, v, w = rel @ right, rel @ up, rel @ d
+    tan_y = math.tan(fov / 2)
+    size = float(np.linalg.norm(rel, axis=1).max())
+    least = max(min_depth, NEAR_M)
+
+    def centred(coord: np.ndarray, scale: np.ndarray, lo: float, hi: float) -> float:
+        a, b = -1e4 * (size + 1.0), 1e4 * (size + 1.0)
+        for _ in range(64):
+            s = 0.5 * (a + b)
+            p = (coord - s) / scale
+            a, b = (s, b) if p.min() + p.max() > lo + hi else (a, s)
+        return 0.5 * (a + b)
+
+    def fit(distance: float, rect: tuple[float, float, float, float]) -> tuple[bool, float, float]:
+        depth = distance + w
+        if depth.min() < least:
+            return False, 0.0, 0.0
+        kx, ky = depth * tan_y * aspect, depth * tan_y
+        sx, sy = centred(u, kx, rect[0], rect[1]), centred(v, ky, rect[2], rect[3])
+        px, py = (u - sx) / kx, (v - sy) / ky
+        inside = (
+            px.min() >= rect[0]
+            and px.max() <= rect[1]
+            and py.min() >= rect[2]
+            and py.max() <= rect[3]
+        )
+        return bool(inside), sx, sy
+
+    empty = not (
+        ndc[1] > ndc[0] and ndc[3] > ndc[2]
+    )  # the docstring's rule (a lone point fits a line by luck)
+    for rect in [(-0.9, 0.9, -0.9, 0.9)] if empty else [ndc, (-0.9, 0.9, -0.9, 0.9)]:
+        near = float(np.abs(w).max()) + NEAR_M
+        far = float(np.abs(w).max()) + least + 1000.0 * (size + 1.0)
+        for _ in range(64):
+            mid = 0.5 * (near + far)
+            near, far = (near, mid) if fit(mid, rect)[0] else (mid, far)
+        ok, sx, sy = fit(far, rect)
+        if ok or rect == (-0.9, 0.9, -0.9, 0.9):
+            look_at = centre + sx * right + sy * up
+            return look_at - far * d, look_at
+    raise AssertionError("unreachable")
+
+
+# The peloton's line box in a 1150 px window (rectangle left of the view axis), the same box from further off
+# with min_depth 3, and an empty rectangle.
+# A rectangle's side is empty (≤ 0) or at least 0.01: a narrower one is below what the brute force resolves (with one
+# point it takes a 1e-210 wide rectangle for empty, as the bisection's shift never lands the point inside).
+_side = st.one_of(st.floats(-0.3, 0.0), st.floats(0.01, 1.0))
+_LINE = [tuple(c) for c in box_corners((-54.75, -1.1, 0.0), (0.85, 1.1, 4.26)).tolist()]
+
+
+@given(
+    points=st.lists(st.tuples(coordinate, coordinate, coordinate), min_size=1, max_size=16),
+    azimuth=st.floats(-math.pi, math.pi),
+    pitch=st.floats(-1.2, 1.2),
+    fov_deg=st.floats(20.0, 90.0),
+    aspect=st.floats(0.5, 3.0),
+    x0=st.floats(-0.99, 0.9),
+    width=_side,
+    y0=st.floats(-0.99, 0.9),
+    height=_side,
+    min_depth=st.sampled_from([0.0, 3.0]),
+)
+@settings(deadline=None)  # the brute force takes ~40 ms an example
+@example(_LINE, 1.73, -0.23, 75.0, 1150 / 720, -0.917, 0.832, -0.867, 1.65, 0.0)
+@example(_LINE, 0.4, 0.3, 50.0, 1.6, -0.8, 1.6, -0.8, 1.6, 3.0)
+@example(_LINE, 0.4, 0.3, 50.0, 1.6, 0.3, -0.2, -0.5, 1.0, 0.0)
+def test_frame_points_agrees_with_a_brute_force_search(
+    points: list[tuple[float, float, float]],
+    azimuth: float,
+    pitch: float,
+    fov_deg: float,
+    aspect: float,
+    x0: float,
+    width: float,
+    y0: float,
+    height: float,
+    min_depth: float,
+) -> None:
+    # The fault's kind: a closed-form search that differs from the nested bisections it replaced, for any cloud,
+    # direction, lens or rectangle (off the view axis, or empty: x1 ≤ x0 or y1 ≤ y0). The nearest distance and the
+    # centring shift are both unique, so the views agree to rounding.
+    cloud = np.array(points)
+    direction = (
+        math.cos(azimuth) * math.cos(pitch),
+        math.sin(azimuth) * math.cos(pitch),
+        math.sin(pitch),
+    )
+    fov = math.radians(fov_deg)
+    ndc = (x0, min(x0 + width, 0.99), y0, min(y0 + height, 0.99))
+    view = frame_points(cloud, direction, fov_rad=fov, aspect=aspect, ndc=ndc, min_depth=min_depth)
+    position, look_at = _reference_view(cloud, direction, fov, aspect, ndc, min_depth)
+    scale = 1.0 + float(np.linalg.norm(position - look_at)) + float(np.ptp(cloud, axis=0).max())
+    assert np.abs(np.subtract(view.position, position)).max() <= 1e-9 * scale, (view, position)
+    assert np.abs(np.subtract(view.look_at, look_at)).max() <= 1e-9 * scale, (view, look_at)

@@ -1,0 +1,165 @@
+"""Benchmark camera framing: ``frame_points`` against the nested bisections it replaced (run in the same process).
+
+    python bench/bench_framing.py
+
+Prints median and p95 milliseconds per call for the peloton's framing (the line's 8 box corners, fov 1.3 rad, aspect
+1.6, the rectangle left of the panel and the labels in a 1600 × 1000 canvas) and for a 200-point cloud, for the
+closed-form ``frame_points`` and for the former implementation (copied below as the baseline: a 60-step bisection on
+the distance, each step running two 60-step bisections of the centring shift), with their ratio and the largest
+difference between the two views (m).
+"""
+
+from __future__ import annotations
+
+import math
+import statistics
+import sys
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from scenes._framing import (  # noqa: E402
+    FULL_NDC,
+    NEAR_M,
+    Lens,
+    View,
+    _basis,  # pyright: ignore[reportPrivateUsage]
+    box_corners,
+    frame_points,
+)
+
+
+def baseline_frame_points(
+    points: NDArray[np.float64],
+    direction: tuple[float, float, float],
+    *,
+    fov_rad: float,
+    aspect: float,
+    ndc: tuple[float, float, float, float] = FULL_NDC,
+    min_depth: float = 0.0,
+) -> View:
+    """``scenes._framing.frame_points`` as it was before the closed form (commit 3b41d9e), unchanged."""
+    pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    if not (math.isfinite(fov_rad) and 0.01 < fov_rad < 3.0):
+        fov_rad = math.radians(50.0)
+    if not (math.isfinite(aspect) and aspect > 0.05):
+        aspect = 1.6
+    x0, x1, y0, y1 = ndc
+    d, right, up = _basis(np.asarray(direction, dtype=np.float64))
+    centre = 0.5 * (pts.min(axis=0) + pts.max(axis=0))
+    rel = pts - centre
+    u, v, w = rel @ right, rel @ up, rel @ d
+    tan_y = math.tan(0.5 * fov_rad)
+    tan_x = aspect * tan_y
+    depth_extent = float(np.max(np.abs(w))) if len(w) else 0.0
+    size = float(np.max(np.linalg.norm(rel, axis=1))) if len(rel) else 0.0
+
+    def shift(
+        coord: NDArray[np.float64], scale: NDArray[np.float64], lo: float, hi: float
+    ) -> float:
+        reach = size + 1.0 + float(np.max(scale)) * (abs(lo) + abs(hi) + 1.0)
+        a, b = -reach, reach
+        for _ in range(60):
+            s = 0.5 * (a + b)
+            p = (coord - s) / scale
+            if 0.5 * (p.min() + p.max()) > 0.5 * (lo + hi):
+                a = s
+            else:
+                b = s
+        return 0.5 * (a + b)
+
+    least_depth = max(min_depth, NEAR_M) if math.isfinite(min_depth) else NEAR_M
+
+    def fits(distance: float) -> tuple[bool, float, float]:
+        depth = distance + w
+        if np.any(depth < least_depth):
+            return False, 0.0, 0.0
+        sx = shift(u, depth * tan_x, x0, x1)
+        sy = shift(v, depth * tan_y, y0, y1)
+        px, py = (u - sx) / (depth * tan_x), (v - sy) / (depth * tan_y)
+        ok = px.min() >= x0 and px.max() <= x1 and py.min() >= y0 and py.max() <= y1
+        return bool(ok), sx, sy
+
+    near = depth_extent + NEAR_M
+    far = depth_extent + least_depth + 1000.0 * (size + 1.0)
+    for _ in range(60):
+        mid = 0.5 * (near + far)
+        if fits(mid)[0]:
+            far = mid
+        else:
+            near = mid
+    ok, sx, sy = fits(far)
+    if not ok:
+        if ndc != FULL_NDC:
+            return baseline_frame_points(
+                pts, direction, fov_rad=fov_rad, aspect=aspect, ndc=FULL_NDC, min_depth=min_depth
+            )
+    look_at = centre + sx * right + sy * up
+    position = look_at - far * d
+    return View(
+        position=(float(position[0]), float(position[1]), float(position[2])),
+        look_at=(float(look_at[0]), float(look_at[1]), float(look_at[2])),
+    )
+
+
+def per_call_ms(func: Callable[[], View], repeat: int) -> list[float]:
+    func()  # warm
+    out = []
+    for _ in range(repeat):
+        start = time.perf_counter()
+        func()
+        out.append(1e3 * (time.perf_counter() - start))
+    return out
+
+
+def p95(values: list[float]) -> float:
+    return float(np.percentile(values, 95))
+
+
+def main() -> None:
+    lens = Lens(1.3, 1600, 1000)
+    peloton = box_corners((-54.75, -1.1, 0.0), (0.85, 1.1, 4.26))
+    cloud = np.random.default_rng(0).normal(0.0, 5.0, (200, 3))
+    cases: list[tuple[str, NDArray[np.float64], tuple[float, float, float, float]]] = [
+        ("peloton line, 8 corners", peloton, lens.usable_ndc(right_px=190.0, top_px=30.0)),
+        ("200-point cloud", cloud, lens.usable_ndc()),
+    ]
+    direction = (-1.2, 7.5, -1.8)
+    print(
+        f"{'case':<26} {'new median':>11} {'new p95':>9} {'old median':>11} {'old p95':>9} {'ratio':>7} {'Δ view':>9}"
+    )
+    for name, pts, ndc in cases:
+
+        def new(
+            pts: NDArray[np.float64] = pts, ndc: tuple[float, float, float, float] = ndc
+        ) -> View:
+            return frame_points(pts, direction, fov_rad=lens.fov_rad, aspect=lens.aspect, ndc=ndc)
+
+        def old(
+            pts: NDArray[np.float64] = pts, ndc: tuple[float, float, float, float] = ndc
+        ) -> View:
+            return baseline_frame_points(
+                pts, direction, fov_rad=lens.fov_rad, aspect=lens.aspect, ndc=ndc
+            )
+
+        fast, slow = per_call_ms(new, 2000), per_call_ms(old, 40)
+        a, b = new(), old()
+        diff = max(
+            float(np.abs(np.subtract(a.position, b.position)).max()),
+            float(np.abs(np.subtract(a.look_at, b.look_at)).max()),
+        )
+        ratio = statistics.median(slow) / statistics.median(fast)
+        print(
+            f"{name:<26} {statistics.median(fast):>8.3f} ms {p95(fast):>6.3f} ms "
+            f"{statistics.median(slow):>8.2f} ms {p95(slow):>6.2f} ms {ratio:>6.0f}× {diff:>9.1e}"
+        )
+
+
+if __name__ == "__main__":
+    main()
