@@ -46,14 +46,18 @@ def test_the_camera_reports_css_pixels_and_the_line_is_framed_clear_of_the_panel
     try:
         scene = switcher.scene
         assert isinstance(scene, PelotonScene)
-        scene.riders.value = 8  # the longest line: the last rider is the first to go under the panel
+        scene.riders.value = (
+            8  # the longest line: the last rider is the first to go under the panel
+        )
         open_viser(page, server.get_port(), "/peloton")
         close_notifications(page)
         shown = ScenePage(server, switcher, page, VIEWPORT)
         settle(shown)
         device, css = _canvas(page)
         assert css == VIEWPORT[0]
-        assert device >= 0.7 * ratio * css  # the screen really is HiDPI (viser may draw at 0.75 of it)
+        assert (
+            device >= 0.7 * ratio * css
+        )  # the screen really is HiDPI (viser may draw at 0.75 of it)
         camera = shown.client_camera
         assert (camera.image_width, camera.image_height) == VIEWPORT
         with scene._lock:
@@ -62,12 +66,9 @@ def test_the_camera_reports_css_pixels_and_the_line_is_framed_clear_of_the_panel
 
         # viser's client drops its resolution while it draws slowly: the camera stays where it was framed.
         frames, position = scene.framing.frames, np.asarray(camera.position).copy()
-        page.evaluate(
-            "() => window.__viserTestpoints.devSettings.set({ fixedDpr: 0.6 })"
-        )
+        page.evaluate("() => window.__viserTestpoints.devSettings.set({ fixedDpr: 0.6 })")
         page.wait_for_function(
-            "() => Math.abs(window.__viserMutable.canvas.width"
-            f" - 0.6 * {VIEWPORT[0]}) <= 2",
+            f"() => Math.abs(window.__viserMutable.canvas.width - 0.6 * {VIEWPORT[0]}) <= 2",
             timeout=30_000,
         )
         stamp = camera.update_timestamp

@@ -35,6 +35,7 @@ from browser import (
 )
 from screen_geometry import GOAL_CORNERS, polyline_gap
 
+from scenes._framing import Lens, project_points
 from scenes.freekick import (
     FORCE_COLOURS,
     KNUCKLE_COLOUR,
@@ -47,7 +48,6 @@ from scenes.freekick import (
     resample,
     view_points,
 )
-from scenes._framing import Lens, project_points
 from scenes.switcher import SceneSwitcher
 
 pytestmark = pytest.mark.browser

@@ -470,7 +470,12 @@ OPENING_GOAL_SHARE = 0.25
 """Share of the free canvas width the goal must span in the opening view (the old one: 0.18–0.19)."""
 
 
-GOAL_SHARE_FLOOR: dict[ViewName, float] = {"broadcast": 0.15, "behind": 0.07, "side": 0.05, "above": 0.10}
+GOAL_SHARE_FLOOR: dict[ViewName, float] = {
+    "broadcast": 0.15,
+    "behind": 0.07,
+    "side": 0.05,
+    "above": 0.10,
+}
 """Least share of the free canvas width the goal spans in each view that shows it, for every preset and ball spot
 (12–40 m, ±45°; measured minima 0.157, 0.078, 0.060, 0.105, each for a ball 40 m out). Side-on the goal is seen
 edge on; the goalkeeper's view stands in front of it."""
