@@ -13,7 +13,7 @@ import functools
 import logging
 import math
 import threading
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 import trimesh
@@ -830,15 +830,17 @@ time-averaged power is the mean over positions, far below the leader's.
 
         with self.server.atomic():
             theta = math.atan(p.grade_pct / 100.0)
-            self.course.wxyz = (math.cos(-theta / 2), 0.0, math.sin(-theta / 2), 0.0)
+            _set_if_changed(
+                self.course, "wxyz", (math.cos(-theta / 2), 0.0, math.sin(-theta / 2), 0.0)
+            )
             if p.position != self._drawn_position:
                 for part, mesh in rider_meshes(p.position).items():
                     self.riders_nodes[part].vertices = mesh.vertices.astype(np.float32)
                     self.riders_nodes[part].faces = mesh.faces.astype(np.uint32)
                 self._drawn_position = p.position
             for node in self.riders_nodes.values():
-                node.batched_positions = positions.astype(np.float32)
-                node.batched_scales = scales.astype(np.float32)
+                _set_if_changed(node, "batched_positions", positions.astype(np.float32))
+                _set_if_changed(node, "batched_scales", scales.astype(np.float32))
 
             base = np.zeros(MAX_RIDERS)
             for component in ("aero", "rolling", "climbing"):
@@ -868,7 +870,11 @@ time-averaged power is the mean over positions, far below the leader's.
                         label.text = text
                     # Neighbours' labels alternate in height so close riders' labels never overlap.
                     # Lifted by the layout for the framed camera, so no two labels overlap.
-                    label.position = (x[i], y[i], 1.95 + base[i] + self._label_lift_m[slots[i]])
+                    _set_if_changed(
+                        label,
+                        "position",
+                        (x[i], y[i], 1.95 + base[i] + self._label_lift_m[slots[i]]),
+                    )
 
             rotation = self._rotation_markdown()
             if self.rotation.content != rotation:
@@ -893,8 +899,10 @@ time-averaged power is the mean over positions, far below the leader's.
         direction = -1.0 if w > 0 else 1.0
         tip = np.array([tip_x, 0.0, 1.2])
         head = [tip - [direction * 0.3, 0.0, -0.2], tip - [direction * 0.3, 0.0, 0.2]]
-        self.wind_arrow.points = np.array(
-            [[[tail_x, 0.0, 1.2], tip], [head[0], tip], [head[1], tip]]
+        _set_if_changed(
+            self.wind_arrow,
+            "points",
+            np.array([[[tail_x, 0.0, 1.2], tip], [head[0], tip], [head[1], tip]]),
         )
 
     def _density_markdown(self) -> str:
@@ -970,6 +978,17 @@ time-averaged power is the mean over positions, far below the leader's.
         if self._ridden_s <= 0:
             return np.zeros(n)
         return self._energy_j[:n] / self._ridden_s
+
+
+def _set_if_changed(handle: Any, name: str, value: Any) -> None:
+    """Write a node's property only when it changed. viser skips a write of the same value too, but only after
+    casting it through its type hints, which cost more than the rest of a redraw (measured: ~40 % of a speed
+    change's 2.2 ms)."""
+    old = getattr(handle, name)
+    new = np.asarray(value, dtype=np.asarray(old).dtype) if old is not None else None
+    if old is not None and np.shape(old) == np.shape(new) and np.array_equal(old, new):
+        return
+    setattr(handle, name, value)
 
 
 # --------------------------------------------------------------------------------------------- course mode
