@@ -14,7 +14,9 @@ one Markdown row per mode and scene (ready to paste into the README, with the lo
 - the app's RSS over the run (every 10 s; the last figure is after the browsers closed) and its slope while they
   ran, after the first minute (after the first third on runs shorter than three minutes), in MiB/min;
 - p50 and p95 from a message to the next scene update the sender receives (in the shared mode another browser's
-  change can bring that update: the figure is a lower bound there);
+  change can bring that update: the figure is a lower bound there). A message that repeats the value before it (at
+  the sweep's turning points the rounded value repeats for a few steps) changes nothing, so no update follows it:
+  it is sent but not timed (timed, it measured the wait for the next different value: ~70–100 ms);
 - errors: browser exceptions, connections the server closed, and ERROR or Traceback lines in the app's log;
 - whether every viewer ends on the server's values: per tab, the value (or pose) it shows is the last it sent; shared,
   every viewer shows what a browser that connects after the run is told.
@@ -95,6 +97,7 @@ def run_client(
         start = time.monotonic()
         next_prune = start + 1.0
         k = 0
+        previous: Any = None
         while (now := time.monotonic()) - start < seconds:
             phase = (
                 2 * math.pi * (k / (rate * 4.0) + index / 8.0)
@@ -112,7 +115,11 @@ def run_client(
                     round(z + radius * math.sin(phase), 4),
                 )
                 client.drag_transform_step(name, last, owner)
-            sends.append(time.monotonic())
+            if (
+                last != previous
+            ):  # a repeated value changes nothing: no update follows it, so it is not timed
+                sends.append(time.monotonic())
+            previous = last
             k += 1
             if client.closed_by_server:
                 result["errors"].append("the server closed the connection")
@@ -125,7 +132,7 @@ def run_client(
             client.send("TransformControlsDragEndMessage", name=GIZMOS[scene][0], owner=owner)
         time.sleep(QUIET_S)  # let the last updates arrive
         drain_arrivals(client, scene, arrivals)
-        result["sent"] = len(sends)
+        result["sent"] = k
         result["latencies_ms"] = latencies_ms(arrivals, sends)
         result["last"] = last
         result["shown"] = (
