@@ -704,24 +704,33 @@ time-averaged power is the mean over positions, far below the leader's.
         with self._lock:
             anchors = self.label_anchors()
             up_world = course_to_world(np.array([[0.0, 0.0, 1.0]]), self.params.grade_pct)[0]
-            top_px, view, lifts_m = LABEL_PX[1], None, np.zeros(len(anchors))
-            for _ in range(
-                MAX_RIDERS + 1
-            ):  # more room above shrinks the line, which may stack labels higher
-                ndc = lens.usable_ndc(right_px=LABEL_PX[0], top_px=top_px)
+            ndc = lens.usable_ndc(right_px=LABEL_PX[0], top_px=LABEL_PX[1])
+            x0, x1 = (ndc[0] + 1.0) / 2.0 * lens.width_px, (ndc[1] + 1.0) / 2.0 * lens.width_px
+            y_top, y_bottom = (
+                (1.0 - ndc[3]) / 2.0 * lens.height_px,
+                (1.0 - ndc[2]) / 2.0 * lens.height_px,
+            )
+            framed, view, lifts_m = self._framed_points, None, np.zeros(len(anchors))
+            # Frame the line with the lifted label anchors, which lean with the road's tilt (a fresh review: up a
+            # 20 % grade the last label started left of the window); the box of each label lies right of and
+            # above its anchor, in the room the rectangle leaves. Framing the anchors shrinks the line, which may
+            # stack the labels differently: repeat until the lifted anchors fit.
+            for _ in range(MAX_RIDERS + 2):
                 view = frame_points(
-                    self._framed_points,
-                    VIEW_DIRECTION,
-                    fov_rad=lens.fov_rad,
-                    aspect=lens.aspect,
-                    ndc=ndc,
+                    framed, VIEW_DIRECTION, fov_rad=lens.fov_rad, aspect=lens.aspect, ndc=ndc
                 )
                 lifts_px = label_lifts_px(project_px(anchors, view, lens))
                 lifts_m = lift_to_metres(anchors, lifts_px, up_world, view, lens)
-                need = LABEL_PX[1] + float(lifts_px.max(initial=0.0))
-                if need <= top_px + 0.5:
+                lifted = anchors + lifts_m[:, None] * up_world
+                px = project_px(lifted, view, lens)
+                if (
+                    px[:, 0].min(initial=x0) >= x0 - 0.5
+                    and px[:, 0].max(initial=x1) <= x1 + 0.5
+                    and px[:, 1].min(initial=y_top) >= y_top - 0.5
+                    and px[:, 1].max(initial=y_bottom) <= y_bottom + 0.5
+                ):
                     break
-                top_px = need
+                framed = np.vstack([framed, lifted])
             assert view is not None
             self._label_lift_m = np.zeros(MAX_RIDERS)
             self._label_lift_m[: len(lifts_m)] = lifts_m

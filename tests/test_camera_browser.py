@@ -4,7 +4,8 @@ viser 1.1.1's client reports its canvas in device pixels (``canvas.width``): twi
 ratio of 2, and 0.75–1 of it while its adaptive resolution drops on a slow machine. The control panel is a fixed
 CSS width, so framing in device pixels put the peloton under the panel on a HiDPI screen (it framed for a window
 twice as wide), and each resolution change moved the camera. The app sends each tab a script
-(:data:`scenes._gate.CSS_CAMERA_JS`) that makes its camera report the CSS size.
+(:data:`scenes._gate.CSS_CAMERA_JS`) that makes its camera report the CSS size. viser's "Reset View" puts the tab
+back at the server's opening camera; the scene then frames it again.
 """
 
 from __future__ import annotations
@@ -77,5 +78,11 @@ def test_the_camera_reports_css_pixels_and_the_line_is_framed_clear_of_the_panel
         assert (camera.image_width, camera.image_height) == VIEWPORT
         assert scene.framing.frames == frames
         np.testing.assert_allclose(camera.position, position, atol=1e-6)
+
+        # viser's own "Reset View" flies the tab to the server's opening camera: the scene frames it again.
+        page.evaluate("() => window.__viserMutable.resetCameraPose(true)")
+        wait_until(lambda: scene.framing.frames > frames, "the reset tab to be framed again")
+        settle(shown)
+        np.testing.assert_allclose(camera.position, position, atol=1e-3)
     finally:
         switcher.close()

@@ -327,9 +327,9 @@ def assert_labels_apart_and_in_view(boxes: np.ndarray, lens: Lens) -> None:
 @given(
     n=st.integers(2, MAX_RIDERS),
     gap_tenths=st.integers(0, 150),
-    viewport=st.sampled_from(VIEWPORTS),
-    speed=st.sampled_from([25.0, 40.0, 60.0]),
-    grade=st.sampled_from([-8.0, 0.0, 12.0]),
+    viewport=st.sampled_from([*VIEWPORTS, (1000, 800)]),
+    speed=st.sampled_from([5.0, 25.0, 40.0, 60.0, 80.0]),
+    grade=st.sampled_from([-15.0, -8.0, 0.0, 12.0, 20.0]),
 )
 def test_labels_never_overlap_and_stay_in_view_clear_of_the_panel(
     switcher: SceneSwitcher,
@@ -349,6 +349,17 @@ def test_labels_never_overlap_and_stay_in_view_clear_of_the_panel(
         speed,
         grade,
     )
+    lens = Lens(math.radians(75.0), *viewport)
+    assert_labels_apart_and_in_view(label_boxes_px(scene, lens), lens)
+
+
+@pytest.mark.parametrize("viewport", [(1280, 720), (1000, 800)])
+def test_a_steep_fast_long_line_keeps_its_last_label_in_view(
+    scene: PelotonScene, viewport: tuple[int, int]
+) -> None:
+    # The failing input (a fresh review): 8 riders 15 m apart at 80 km/h up 20 %: the labels, lifted along the
+    # tilted road's up, leaned out of the framed box, and the last one started left of the window.
+    scene.riders.value, scene.gap.value, scene.speed.value, scene.grade.value = 8, 15.0, 80.0, 20.0
     lens = Lens(math.radians(75.0), *viewport)
     assert_labels_apart_and_in_view(label_boxes_px(scene, lens), lens)
 
