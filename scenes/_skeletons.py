@@ -34,6 +34,8 @@ WORLD_LIMIT_M = 4.0
 """Targets stay inside this box (±m on each axis), as the chain's do."""
 LINK_RADIUS_M = 0.016
 JOINT_RADIUS_M = 0.026
+GIZMO_SCALE_M = 0.12
+"""Length of a target gizmo's arrows (m); the camera frames their tips."""
 AXIS_HALF_LENGTH_M = 0.05
 CHAIN_COLOURS = np.array(
     [
@@ -410,7 +412,7 @@ class SkeletonView:
         for k in range(MAX_EFFECTORS):
             gizmo = server.scene.add_transform_controls(
                 f"{root}/skeleton/target_{k}",
-                scale=0.12,
+                scale=GIZMO_SCALE_M,
                 disable_rotations=True,
                 translation_limits=(box, box, box),
                 visible=False,
@@ -435,7 +437,7 @@ class SkeletonView:
                 self.show(option)
 
     def show(self, label: PresetLabel) -> None:
-        """Switch to a preset (its rest pose and opening targets), or back to the chain."""
+        """Switch to a preset (its rest pose and opening targets), or back to the chain; the camera frames it."""
         self.preset = label
         self.skeleton = None if label == "Chain" else PRESETS[label]()
         with self.scene.server.atomic():
@@ -449,6 +451,7 @@ class SkeletonView:
         if self.skeleton is None:
             self.report = None
             self.scene.solve_and_draw()
+            self.scene.framing.reframe()
             return
         sk = self.skeleton
         self.pose = sk.joints.copy()
@@ -462,6 +465,7 @@ class SkeletonView:
                     gizmo.active_axes = axes
                     gizmo.position = self.targets[k]
         self.solve_and_draw()
+        self.scene.framing.reframe()
 
     def _show_chain(self, visible: bool) -> None:
         s = self.scene

@@ -28,6 +28,7 @@ from kernels import fabrik
 from scenes._base import Scene
 from scenes._charts import FittedChart
 from scenes._framing import ClientFraming, Lens, View, frame_points
+from scenes._skeletons import GIZMO_SCALE_M as SKELETON_GIZMO_M
 from scenes._skeletons import SkeletonView
 
 MAX_LINKS = 12
@@ -651,7 +652,7 @@ is a static pose.
     def _view_for(self, lens: Lens) -> View:
         """Frame the chain, its base, the target, the obstacles and their gizmos (:func:`framed_points`)."""
         p = self.params
-        points = framed_points(p, self.pose, self.target, self.obstacle_centres)
+        points = self._points_to_frame()
         lo, hi = points.min(axis=0), points.max(axis=0)
         self._framed_box = (lo, hi)
         return frame_points(
@@ -662,6 +663,17 @@ is a static pose.
             ndc=lens.usable_ndc(),
         )
 
+    def _points_to_frame(self) -> NDArray[np.float64]:
+        """(N, 3) world points (m) the camera frames: the chain's (:func:`framed_points`), or, while a skeleton
+        preset is shown instead, its joints, its targets and their gizmo arrows."""
+        view = self.skeletons
+        if not view.active:
+            return framed_points(self.params, self.pose, self.target, self.obstacle_centres)
+        arrows = (view.targets[:, None, :] + SKELETON_GIZMO_M * np.eye(3)[None, :, :]).reshape(
+            -1, 3
+        )
+        return np.vstack([view.pose, view.targets, arrows])
+
     def _reframe_if_outgrown(self) -> None:
         """Frame again when the chain, target or obstacles left the framed box (grown by :data:`FRAME_SLACK`)."""
         box = self._framed_box
@@ -669,7 +681,7 @@ is a static pose.
             return
         lo, hi = box
         slack = FRAME_SLACK * float(np.max(hi - lo))
-        points = framed_points(self.params, self.pose, self.target, self.obstacle_centres)
+        points = self._points_to_frame()
         if np.any(points < lo - slack) or np.any(points > hi + slack):
             self.framing.reframe()
 

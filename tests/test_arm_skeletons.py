@@ -144,3 +144,28 @@ def test_crafted_skeleton_gizmo_and_preset_messages_keep_the_last_good_state(
             np.testing.assert_array_equal(view.targets, targets)
             assert view.solves == solves
             np.testing.assert_array_equal(np.asarray(view.gizmos[0].position), targets[0])
+
+
+@pytest.mark.parametrize("label", [label for label in _skeletons.PRESET_LABELS if label != "Chain"])
+@pytest.mark.parametrize("size", [(1600, 1000), (1280, 720)])
+def test_the_camera_frames_the_shown_skeleton(
+    scene: ArmScene, label: _skeletons.PresetLabel, size: tuple[int, int]
+) -> None:
+    # The kind: a view framed for what is hidden. With a preset shown the camera framed the hidden chain, 0.9 m
+    # off, and the hand's gizmos lay off the window (a mouse drag of a fingertip grabbed nothing).
+    import math
+
+    from scenes._framing import MARGIN_PX, PANEL_PX, Lens, project_points
+
+    scene.skeletons.show(label)
+    lens = Lens(math.radians(75.0), *size)
+    view = scene._view_for(lens)
+    points = np.vstack([scene.skeletons.pose, scene.skeletons.targets])
+    xy = project_points(view, lens, points)
+    assert xy[:, 0].min() >= MARGIN_PX - 0.5 and xy[:, 1].min() >= MARGIN_PX - 0.5, label
+    assert xy[:, 0].max() <= size[0] - PANEL_PX - MARGIN_PX + 0.5, label
+    assert xy[:, 1].max() <= size[1] - MARGIN_PX + 0.5, label
+    # Back on the chain, the chain is framed again.
+    scene.skeletons.show("Chain")
+    xy = project_points(scene._view_for(lens), lens, scene.pose)
+    assert xy[:, 0].max() <= size[0] - PANEL_PX - MARGIN_PX + 0.5
