@@ -143,10 +143,10 @@ def test_drag_the_target_gizmo_with_the_mouse(server: viser.ViserServer, browser
     page = browser_page
     open_viser(page, server.get_port(), "/arm/target")
     close_notifications(page)
-    page.wait_for_function(
-        "() => !!(window.__viserMutable && window.__viserMutable.camera && window.__viserMutable.canvas)",
-        timeout=30_000,
-    )
+    # The drag aims at the gizmo on the screen: the camera must be framed and still first, or it moves under the
+    # mouse (CI: the drag missed the gizmo while the framing was still arriving).
+    size = page.viewport_size
+    settle(ScenePage(server, switcher, page, (size["width"], size["height"])))
     target_before = scene.target.copy()
     end_before = scene.pose[-1].copy()
     image_before = screenshot(page)

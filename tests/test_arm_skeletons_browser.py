@@ -8,7 +8,7 @@ from typing import Any
 import numpy as np
 import pytest
 import viser
-from browser import open_viser
+from browser import ScenePage, open_viser, settle
 from test_arm_browser import screen_of
 
 from scenes._skeletons import hand
@@ -44,15 +44,14 @@ def test_drag_a_fingertip_target_with_the_mouse(
     page = browser_page
     name = "/arm/skeleton/target_1"  # the index finger's
     open_viser(page, server.get_port(), name)
-    page.wait_for_function(
-        "() => !!(window.__viserMutable && window.__viserMutable.camera && window.__viserMutable.canvas)",
-        timeout=30_000,
-    )
+    # The drag aims at the gizmo on the screen: the camera must be framed and still first, or it moves under the
+    # mouse (CI: the drag missed the gizmo and the fingertip never moved).
+    size = page.viewport_size
+    settle(ScenePage(server, switcher, page, (size["width"], size["height"])))
     effector = hand().effectors[1]
     with scene._lock:
         target_before = view.targets[1].copy()
         tip_before = view.pose[effector].copy()
-    time.sleep(1.0)
     picture_before = page.screenshot()
 
     # Grab the gizmo's z arrow (local +z, along the shaft) and pull it down on screen.
