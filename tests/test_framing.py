@@ -32,6 +32,15 @@ def _project(
 coordinate = st.floats(-50.0, 50.0, allow_nan=False)
 
 
+def _direction(azimuth: float, pitch: float) -> tuple[float, float, float]:
+    """Unit view direction at ``azimuth`` about z and ``pitch`` above the horizontal (rad)."""
+    return (
+        math.cos(azimuth) * math.cos(pitch),
+        math.sin(azimuth) * math.cos(pitch),
+        math.sin(pitch),
+    )
+
+
 def _assert_tight_or_held_back(
     projected: np.ndarray, ndc: tuple[float, float, float, float], least_depth: float
 ) -> None:
@@ -61,11 +70,7 @@ def test_every_point_projects_inside_the_rectangle(
     min_depth: float,
 ) -> None:
     cloud = np.array(points)
-    direction = (
-        math.cos(azimuth) * math.cos(pitch),
-        math.sin(azimuth) * math.cos(pitch),
-        math.sin(pitch),
-    )
+    direction = _direction(azimuth, pitch)
     ndc = (-0.8, 0.4, -0.7, 0.9)
     view = frame_points(
         cloud, direction, fov_rad=math.radians(fov_deg), aspect=aspect, ndc=ndc, min_depth=min_depth
@@ -151,11 +156,7 @@ def test_a_rectangle_off_the_view_axis_is_filled_too(
     cloud = np.array(points)
     if np.ptp(cloud, axis=0).max() < 1e-2:
         return
-    direction = (
-        math.cos(azimuth) * math.cos(pitch),
-        math.sin(azimuth) * math.cos(pitch),
-        math.sin(pitch),
-    )
+    direction = _direction(azimuth, pitch)
     fov = math.radians(fov_deg)
     view = frame_points(cloud, direction, fov_rad=fov, aspect=aspect, ndc=ndc)
     projected = _project(cloud, np.array(view.position), np.array(view.look_at), fov, aspect)
@@ -371,11 +372,7 @@ def test_frame_points_agrees_with_a_brute_force_search(
     # direction, lens or rectangle (off the view axis, or empty: x1 ≤ x0 or y1 ≤ y0). The nearest distance and the
     # centring shift are both unique, so the views agree to rounding.
     cloud = np.array(points)
-    direction = (
-        math.cos(azimuth) * math.cos(pitch),
-        math.sin(azimuth) * math.cos(pitch),
-        math.sin(pitch),
-    )
+    direction = _direction(azimuth, pitch)
     fov = math.radians(fov_deg)
     ndc = (x0, min(x0 + width, 0.99), y0, min(y0 + height, 0.99))
     view = frame_points(cloud, direction, fov_rad=fov, aspect=aspect, ndc=ndc, min_depth=min_depth)
