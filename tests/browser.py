@@ -42,7 +42,8 @@ args => {
 
 
 def open_viser(page: Any, port: int, node: str, timeout_ms: int = 60_000) -> None:
-    """Open the viser client on ``port`` and wait until scene node ``node`` exists in its three.js scene."""
+    """Open the viser client on ``port``, wait until scene node ``node`` exists in its three.js scene, and hold its
+    drawing resolution (:func:`hold_resolution`)."""
     page.goto(f"http://127.0.0.1:{port}/", wait_until="domcontentloaded", timeout=timeout_ms)
     page.wait_for_function(
         "name => !!(window.__viserMutable && window.__viserMutable.nodeRefFromName"
@@ -51,6 +52,33 @@ def open_viser(page: Any, port: int, node: str, timeout_ms: int = 60_000) -> Non
         arg=node,
         timeout=timeout_ms,
     )
+    hold_resolution(page)
+
+
+HOLD_RESOLUTION = """
+() => {
+  window.__viserTestpoints.devSettings.set({ fixedDpr: window.devicePixelRatio });
+  const c = window.__viserMutable.canvas;
+  return new Promise(done => { const check = () => Math.abs(c.width - c.clientWidth * window.devicePixelRatio) <= 1
+    ? done() : requestAnimationFrame(check); check(); });
+}
+"""
+
+
+def hold_resolution(page: Any) -> None:
+    """Make the page draw at its full resolution from now on, as on a fast machine.
+
+    viser's client lowers its drawing resolution (0.75–1× the device pixels) while software WebGL draws slowly,
+    and raises it again later: two screenshots compared pixel by pixel (an object shown, then hidden) could then
+    differ at every edge of the picture (CI: 2075 of 4821 "peloton" pixels outside the riders' box). Framing under
+    a changing resolution is checked on its own, in ``test_camera_browser.py``.
+    """
+    page.evaluate(HOLD_RESOLUTION)
+
+
+def drawn_width(page: Any) -> int:
+    """The width of viser's canvas in device pixels: what its drawing resolution is now."""
+    return int(page.evaluate("() => window.__viserMutable.canvas.width"))
 
 
 def close_notifications(page: Any) -> None:
@@ -169,11 +197,15 @@ def with_nodes_hidden(page: Any, names: Iterable[str]) -> NDArray[np.uint8]:
     Against a screenshot with them shown, the difference is exactly where a person sees those objects.
     """
     names = list(names)
+    width = drawn_width(page)
     page.evaluate(HIDE, {"names": names, "hide": True})
     wait_frames(page, 3)
     image = screenshot(page)
     page.evaluate(HIDE, {"names": names, "hide": False})
     wait_frames(page, 3)
+    assert drawn_width(page) == width, (
+        "the drawing resolution changed: open the page with open_viser"
+    )
     return image
 
 
