@@ -13,7 +13,7 @@ import functools
 import logging
 import math
 import threading
-from typing import Any, Literal
+from typing import Literal
 
 import numpy as np
 import trimesh
@@ -22,7 +22,7 @@ import viser.uplot
 
 from kernels import course as course_kernel
 from kernels import cycling
-from scenes._base import Scene
+from scenes._base import Scene, set_if_changed
 from scenes._charts import FittedChart
 from scenes._framing import ClientFraming, Lens, View, frame_points
 from scenes._gate import record_spec
@@ -839,7 +839,7 @@ time-averaged power is the mean over positions, far below the leader's.
 
         with self.server.atomic():
             theta = math.atan(p.grade_pct / 100.0)
-            _set_if_changed(
+            set_if_changed(
                 self.course, "wxyz", (math.cos(-theta / 2), 0.0, math.sin(-theta / 2), 0.0)
             )
             if p.position != self._drawn_position:
@@ -848,8 +848,8 @@ time-averaged power is the mean over positions, far below the leader's.
                     self.riders_nodes[part].faces = mesh.faces.astype(np.uint32)
                 self._drawn_position = p.position
             for node in self.riders_nodes.values():
-                _set_if_changed(node, "batched_positions", positions.astype(np.float32))
-                _set_if_changed(node, "batched_scales", scales.astype(np.float32))
+                set_if_changed(node, "batched_positions", positions.astype(np.float32))
+                set_if_changed(node, "batched_scales", scales.astype(np.float32))
 
             base = np.zeros(MAX_RIDERS)
             for component in ("aero", "rolling", "climbing"):
@@ -879,7 +879,7 @@ time-averaged power is the mean over positions, far below the leader's.
                         label.text = text
                     # Neighbours' labels alternate in height so close riders' labels never overlap.
                     # Lifted by the layout for the framed camera, so no two labels overlap.
-                    _set_if_changed(
+                    set_if_changed(
                         label,
                         "position",
                         (x[i], y[i], 1.95 + base[i] + self._label_lift_m[slots[i]]),
@@ -908,7 +908,7 @@ time-averaged power is the mean over positions, far below the leader's.
         direction = -1.0 if w > 0 else 1.0
         tip = np.array([tip_x, 0.0, 1.2])
         head = [tip - [direction * 0.3, 0.0, -0.2], tip - [direction * 0.3, 0.0, 0.2]]
-        _set_if_changed(
+        set_if_changed(
             self.wind_arrow,
             "points",
             np.array([[[tail_x, 0.0, 1.2], tip], [head[0], tip], [head[1], tip]]),
@@ -987,19 +987,6 @@ time-averaged power is the mean over positions, far below the leader's.
         if self._ridden_s <= 0:
             return np.zeros(n)
         return self._energy_j[:n] / self._ridden_s
-
-
-def _set_if_changed(handle: Any, name: str, value: Any) -> None:
-    """Write a node's property only when it changed. viser skips a write of the same value too, but only after
-    casting it through its type hints, which cost more than the rest of a redraw (measured: ~40 % of a speed
-    change's 2.2 ms)."""
-    old = getattr(handle, name)
-    if old is not None:
-        current = np.asarray(old)
-        new = np.asarray(value, dtype=current.dtype)
-        if current.shape == new.shape and np.array_equal(current, new):
-            return
-    setattr(handle, name, value)
 
 
 # --------------------------------------------------------------------------------------------- course mode

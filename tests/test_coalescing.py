@@ -22,7 +22,7 @@ from hypothesis import strategies as st
 from wsclient import BrowserClient
 
 from kernels import sdf
-from scenes._base import Scene
+from scenes._base import Scene, Turns
 from scenes.arm import ArmScene
 from scenes.freekick import FreeKickParams, FreeKickScene, _segments, compute_kick, resample
 from scenes.sdf_gallery import PREVIEW_RESOLUTION, SdfGalleryScene
@@ -114,6 +114,76 @@ def test_200_values_coalesce_to_the_last() -> None:
         assert held.read == [0.0, 7.3]
     finally:
         server.stop()
+
+
+@settings(max_examples=10, deadline=None)
+@given(values=st.lists(st.floats(0.0, 10.0, allow_nan=False), min_size=1, max_size=40))
+def test_two_scenes_take_turns_and_a_burst_that_waits_merges(values: list[float]) -> None:
+    """While one tab's callback runs, another tab's scene does not run its own (one turn per process), and the burst
+    that waits meanwhile merges into at most two calls, both reading the last value."""
+    servers = [viser.ViserServer(host="127.0.0.1", port=0, verbose=False) for _ in range(2)]
+    try:
+        running, waiting = Held(servers[0]), Held(servers[1])
+        waiting.release.set()  # its calls never block: only the turn holds them
+        first = threading.Thread(target=running.handler)
+        first.start()
+        running.entered.wait()
+        threads = []
+        for value in values:
+            waiting.latest = value
+            thread = threading.Thread(target=waiting.handler)
+            thread.start()
+            threads.append(thread)
+        # One call holds its scene and waits for the turn, one more waits for the scene; the rest merged.
+        wait_until(lambda: sum(t.is_alive() for t in threads) <= 2, what="the burst to merge")
+        assert waiting.read == []
+        running.release.set()
+        for thread in [first, *threads]:
+            thread.join()
+        assert 1 <= len(waiting.read) <= 2 and set(waiting.read) == {values[-1]}
+    finally:
+        for server in servers:
+            server.stop()
+
+
+def test_turns_go_in_the_order_asked_are_reentrant_and_survive_an_exception() -> None:
+    turns = Turns()
+    order: list[int] = []
+    inside = 0
+    most_inside = 0
+    lock = threading.Lock()
+
+    def take(k: int) -> None:
+        nonlocal inside, most_inside
+        with turns.turn():
+            with lock:
+                inside += 1
+                most_inside = max(most_inside, inside)
+            with turns.turn():  # re-entrant: the holder's own nested turn goes at once
+                order.append(k)
+            with lock:
+                inside -= 1
+
+    with turns.turn():
+        threads = []
+        for k in range(12):
+            thread = threading.Thread(target=take, args=(k,))
+            thread.start()
+            wait_until(lambda k=k: len(turns._waiting) == k + 1, what=f"caller {k} to queue")
+            threads.append(thread)
+    for thread in threads:
+        thread.join()
+    assert order == list(range(12)) and most_inside == 1
+    with pytest.raises(RuntimeError), turns.turn():
+        raise RuntimeError("a failing callback")
+    done = threading.Event()
+
+    def take_once() -> None:
+        with turns.turn():
+            done.set()
+
+    threading.Thread(target=take_once).start()
+    assert done.wait(5.0), "the turn stayed held after an exception"
 
 
 class SlowBuild(Scene):

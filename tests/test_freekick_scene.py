@@ -40,6 +40,7 @@ from scenes.freekick import (
     frame_view,
     outcome_map,
     resample,
+    sample_rows,
     spin_words,
     view_points,
     wall_hides,
@@ -53,6 +54,39 @@ def scene(switcher: SceneSwitcher) -> FreeKickScene:
     assert isinstance(shown, FreeKickScene)
     assert shown.wait_idle()
     return shown
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    steps=st.lists(
+        st.floats(1e-9, 10.0, allow_nan=False, allow_infinity=False), min_size=0, max_size=30
+    ),
+    start=st.floats(-5.0, 5.0),
+    columns=st.integers(1, 6),
+    queries=st.lists(st.floats(-20.0, 320.0, allow_nan=False), min_size=0, max_size=20),
+    seed=st.integers(0, 2**32 - 1),
+)
+def test_sample_rows_is_np_interp_on_every_column(
+    steps: list[float], start: float, columns: int, queries: list[float], seed: int
+) -> None:
+    """The redraw's one-search interpolation against numpy's own, column by column: sample times exactly on a
+    node, at both ends, outside the flight (clamped), one-sample flights and tiny steps included."""
+    t = start + np.concatenate([[0.0], np.cumsum(steps)])
+    t = np.unique(t)  # a step under float resolution would repeat a time: flights never do
+    values = np.random.default_rng(seed).normal(size=(len(t), columns)) * 50.0
+    at = np.array([*queries, *t[:3], t[-1]], dtype=np.float64)
+    got = sample_rows(at, t, values)
+    expected = np.stack([np.interp(at, t, values[:, k]) for k in range(columns)], axis=1)
+    np.testing.assert_allclose(got, expected, rtol=1e-12, atol=1e-9)
+
+
+def test_sample_rows_at_a_node_and_beyond_the_ends() -> None:
+    t = np.array([0.0, 0.5, 2.0])
+    values = np.array([[0.0, 10.0], [1.0, 20.0], [4.0, -10.0]])
+    got = sample_rows(np.array([-1.0, 0.5, 1.25, 2.0, 9.0]), t, values)
+    np.testing.assert_array_equal(
+        got, [[0.0, 10.0], [1.0, 20.0], [2.5, 5.0], [4.0, -10.0], [4.0, -10.0]]
+    )
 
 
 def drawn_path(scene: FreeKickScene) -> np.ndarray:
