@@ -14,6 +14,7 @@ thread per process, shared by every gallery (a context per build leaked ~50 MiB 
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import functools
 import io
@@ -30,7 +31,7 @@ import viser
 from PIL import Image
 
 from kernels import sdf
-from scenes._base import Scene
+from scenes._base import TURNS, Scene
 from scenes._gate import mark_costly
 from shaders import gl_service
 from shaders import renderer as gl_renderer
@@ -616,6 +617,8 @@ IoU is lowest when a box edge is on the silhouette.
             wireframe=True,
             visible=False,
         )
+        self._wire: tuple[np.ndarray, np.ndarray] | None = None
+        """The latest mesh's (vertices, faces) for the wireframe, drawn only while it shows."""
         self.gizmos = []
         self.gizmo_markers = []
         self.gizmo_labels = []
@@ -842,6 +845,8 @@ IoU is lowest when a box edge is on the silhouette.
         mode = self.params.view_mode
         with self.server.atomic():
             self.mesh_node.visible = mode == "mesh"
+            if mode == "both":
+                self._draw_wire()
             self.wireframe_node.visible = mode == "both"
             if mode == "mesh":
                 self.server.scene.set_background_image(None)
@@ -852,6 +857,11 @@ IoU is lowest when a box edge is on the silhouette.
                 "both": "The GLSL ray-march with the mesh as a wireframe over it: where they agree, the "
                 "wireframe hugs the surface.",
             }[mode]
+
+    def _draw_wire(self) -> None:
+        """Put the latest mesh (preview or full) on the wireframe node."""
+        if self._wire is not None:
+            self.wireframe_node.vertices, self.wireframe_node.faces = self._wire
 
     def _on_shading_input(self) -> None:
         shading, mode, width = self.read_shading()
@@ -946,27 +956,44 @@ IoU is lowest when a box edge is on the silhouette.
                     self._work.wait(
                         timeout=0.05
                     )  # a request that came during the last job is taken at once
-                scene, resolution = self._wanted_scene, self._wanted_resolution
-                source, preview = self._wanted_source, self._wanted_preview
-                self._wanted_scene = self._wanted_source = None
-                refine = self._refine
-                rested = time.monotonic() - self._scene_time >= CAMERA_REST_S
+                # A drag's preview (≤ 32³, a few ms) takes the process's turn, as callbacks do (TURNS): eight tabs'
+                # workers interleaving made each mesh eight times slower, and a tab's newer pose, arriving while
+                # its worker waits for the turn, replaces the one it would have meshed. Full meshes (up to seconds)
+                # run outside the turn, so they never hold up other tabs' inputs.
+                quick = (
+                    self._wanted_source is None
+                    and self._wanted_scene is not None
+                    and (self._wanted_preview or self._wanted_resolution <= PREVIEW_RESOLUTION)
+                )
             if self._stop.is_set():
                 return
+            turn = contextlib.ExitStack()
+            if quick:  # the scene's lock first, then the turn: the order callbacks take them in
+                turn.enter_context(self._lock)
+                turn.enter_context(TURNS.turn())
             try:
+                with turn:
+                    with self._work:
+                        scene, resolution = self._wanted_scene, self._wanted_resolution
+                        source, preview = self._wanted_source, self._wanted_preview
+                        self._wanted_scene = self._wanted_source = None
+                        refine = self._refine
+                        rested = time.monotonic() - self._scene_time >= CAMERA_REST_S
+                    if source is None and scene is not None:
+                        preview = preview and resolution > PREVIEW_RESOLUTION
+                        self._refine = (scene, resolution) if preview else None
+                        self._mesh_and_show(
+                            scene, PREVIEW_RESOLUTION if preview else resolution, preview=preview
+                        )
+                        with self._work:
+                            self._reference_due = True
+                if self._stop.is_set():
+                    return
                 if source is not None:
                     self._refine = None
                     self._apply_source(source, resolution)
-                elif scene is not None:
-                    preview = preview and resolution > PREVIEW_RESOLUTION
-                    self._refine = (scene, resolution) if preview else None
-                    self._mesh_and_show(
-                        scene, PREVIEW_RESOLUTION if preview else resolution, preview=preview
-                    )
-                    with self._work:
-                        self._reference_due = True
                 elif (
-                    refine is not None and rested
+                    scene is None and refine is not None and rested
                 ):  # the inputs rested: the full mesh of the latest scene
                     self._refine = None
                     self._mesh_and_show(*refine)
@@ -1116,8 +1143,11 @@ IoU is lowest when a box edge is on the silhouette.
                 return
             with self.server.atomic():
                 self.mesh_node.glb_data = glb
-                self.wireframe_node.vertices = vertices.astype(np.float32)
-                self.wireframe_node.faces = faces.astype(np.uint32)
+                # The wireframe shows only in the "Both" view: a hidden one is not sent (40 % of a preview's bytes
+                # to every viewer), it is drawn from the latest mesh when it is shown.
+                self._wire = (vertices.astype(np.float32), faces.astype(np.uint32))
+                if self.wireframe_node.visible:
+                    self._draw_wire()
                 self.progress.visible = False
                 self.shown_resolution = resolution
                 if preview:

@@ -279,9 +279,12 @@ def test_sdf_preview_while_dragging_ends_on_the_full_mesh_and_reference(
         assert scene.shown_resolution == full  # and ended on the full resolution
         vertices, faces, _colors = sdf.mesh(scene.params.scene(), full)
         np.testing.assert_array_equal(scene.mesh_vertices, vertices)
-        assert (
-            scene.wireframe_node.faces.shape == faces.shape
-        )  # the 3D view shows the full mesh, not a preview
+        client.set_value("View", "Both")
+        wait_until(lambda: scene.wireframe_node.visible, what="the wireframe")
+        # The wireframe, drawn only once shown, shows the full mesh, not a preview.
+        assert scene.wireframe_node.faces.shape == faces.shape
+        client.set_value("View", "Mesh")
+        wait_until(lambda: scene.mesh_node.visible, what="the mesh back")
         client.wait_for(
             lambda: (
                 client.nodes["/sdf/mesh"].get("props", {}).get("glb_data")
