@@ -960,11 +960,7 @@ IoU is lowest when a box edge is on the silhouette.
                 # workers interleaving made each mesh eight times slower, and a tab's newer pose, arriving while
                 # its worker waits for the turn, replaces the one it would have meshed. Full meshes (up to seconds)
                 # run outside the turn, so they never hold up other tabs' inputs.
-                quick = (
-                    self._wanted_source is None
-                    and self._wanted_scene is not None
-                    and (self._wanted_preview or self._wanted_resolution <= PREVIEW_RESOLUTION)
-                )
+                quick = self._quick_job()
             if self._stop.is_set():
                 return
             turn = contextlib.ExitStack()
@@ -974,22 +970,20 @@ IoU is lowest when a box edge is on the silhouette.
             try:
                 with turn:
                     with self._work:
+                        # Asked again under the turn: a request that came meanwhile may be a full mesh.
+                        meshed_here = quick and self._quick_job()
                         scene, resolution = self._wanted_scene, self._wanted_resolution
                         source, preview = self._wanted_source, self._wanted_preview
                         self._wanted_scene = self._wanted_source = None
                         refine = self._refine
                         rested = time.monotonic() - self._scene_time >= CAMERA_REST_S
-                    if source is None and scene is not None:
-                        preview = preview and resolution > PREVIEW_RESOLUTION
-                        self._refine = (scene, resolution) if preview else None
-                        self._mesh_and_show(
-                            scene, PREVIEW_RESOLUTION if preview else resolution, preview=preview
-                        )
-                        with self._work:
-                            self._reference_due = True
+                    if meshed_here and scene is not None:
+                        self._mesh_request(scene, resolution, preview)
                 if self._stop.is_set():
                     return
-                if source is not None:
+                if source is None and scene is not None and not meshed_here:
+                    self._mesh_request(scene, resolution, preview)
+                elif source is not None:
                     self._refine = None
                     self._apply_source(source, resolution)
                 elif (
@@ -1012,6 +1006,24 @@ IoU is lowest when a box edge is on the silhouette.
                 logger.exception("sdf: meshing or rendering failed; keeping the last good picture")
                 with self._work:
                     self._reference_due = False
+
+    def _quick_job(self) -> bool:
+        """Whether the job wanted now (call under ``self._work``) is a drag's preview of the primitives (≤ 32³, a
+        few ms): the kind that takes the process's turn. Editor fields mesh on the GL thread, which may be busy with
+        other tabs' renders: they never take it."""
+        return (
+            self._wanted_source is None
+            and isinstance(self._wanted_scene, sdf.Scene)
+            and (self._wanted_preview or self._wanted_resolution <= PREVIEW_RESOLUTION)
+        )
+
+    def _mesh_request(self, scene: Shape, resolution: int, preview: bool) -> None:
+        """Mesh a wanted scene: a preview at 32³ while a drag's inputs keep coming, else at ``resolution``."""
+        preview = preview and resolution > PREVIEW_RESOLUTION
+        self._refine = (scene, resolution) if preview else None
+        self._mesh_and_show(scene, PREVIEW_RESOLUTION if preview else resolution, preview=preview)
+        with self._work:
+            self._reference_due = True
 
     def _reference_ready(self) -> bool:
         with self._work:
