@@ -504,39 +504,58 @@ class CostlyBudget(typing.Generic[Item]):
         self.rate_hz = rate_hz
         self._tokens = float(burst)
         self._refilled_at = now
-        self._held: dict[str, Item] = {}
-        """By control key, in the order of each one's latest arrival."""
+        self._held: dict[str, tuple[Item, bool]] = {}
+        """By control key, in the order of each one's latest arrival: (item, free)."""
 
     def _refill(self, now: float) -> None:
         elapsed = max(0.0, now - self._refilled_at)
         self._tokens = min(float(self.burst), self._tokens + elapsed * self.rate_hz)
         self._refilled_at = max(now, self._refilled_at)
 
-    def offer(self, key: str, item: Item, now: float) -> tuple[bool, bool]:
-        """(goes now, replaced one held back) for ``item``, the new value of control ``key``."""
+    def offer(
+        self, key: str, item: Item, now: float, *, free: bool = False, hold: bool = False
+    ) -> tuple[bool, bool]:
+        """(goes now, replaced one held back) for ``item``, the new value of control ``key``.
+
+        A ``free`` input (a cheap control, a gizmo) costs no token: it goes at once unless inputs are held back,
+        and then waits in line behind them, so an edit made after a held-back Reset is applied after the Reset
+        rather than undone by it. ``hold`` holds it even then (the caller knows of costly work still running)."""
         self._refill(now)
-        if not self._held and self._tokens >= 1.0 - _TOKEN_SLACK:
-            self._tokens = max(0.0, self._tokens - 1.0)
+        if not hold and not self._held and (free or self._tokens >= 1.0 - _TOKEN_SLACK):
+            if not free:
+                self._tokens = max(0.0, self._tokens - 1.0)
             return True, False
         replaced = self._held.pop(key, None) is not None
-        self._held[key] = item
+        self._held[key] = (item, free)
         return False, replaced
 
     def take(self, now: float) -> tuple[str, Item] | None:
-        """The oldest held-back (key, item) if the budget allows one now, else None."""
-        self._refill(now)
-        if not self._held or self._tokens < 1.0 - _TOKEN_SLACK:
+        """The oldest held-back (key, item) if the budget allows it now (a free one always), else None."""
+        if not self._held:
             return None
-        self._tokens = max(0.0, self._tokens - 1.0)
         key = next(iter(self._held))
-        return key, self._held.pop(key)
+        item, free = self._held[key]
+        if not free:
+            self._refill(now)
+            if self._tokens < 1.0 - _TOKEN_SLACK:
+                return None
+            self._tokens = max(0.0, self._tokens - 1.0)
+        del self._held[key]
+        return key, item
 
     def wait_s(self, now: float) -> float | None:
         """Seconds until :meth:`take` can hand out the next held-back input; None when none is held."""
         if not self._held:
             return None
+        if self._held[next(iter(self._held))][1]:
+            return 0.0
         self._refill(now)
         return max(0.0, (1.0 - self._tokens) / self.rate_hz)
+
+    @property
+    def next_is_free(self) -> bool:
+        """Whether the next held-back input in line is a free one."""
+        return bool(self._held) and self._held[next(iter(self._held))][1]
 
     @property
     def held(self) -> int:
@@ -544,13 +563,27 @@ class CostlyBudget(typing.Generic[Item]):
         return len(self._held)
 
 
-Deferred = tuple[_messages.GuiUpdateMessage, Callable[[], None] | None]
+IN_LINE = (
+    _messages.GuiUpdateMessage,
+    _messages.TransformControlsUpdateMessage,
+    _messages.TransformControlsDragStartMessage,
+    _messages.TransformControlsDragEndMessage,
+    _messages.SceneNodeClickMessage,
+    _messages.ScenePointerMessage,
+)
+"""The inputs a tab's held-back or running scene switch or Reset keeps in line behind it: values, drags, clicks."""
+Deferred = tuple[Any, Callable[[], None] | None, tuple[type, str] | None]
+"""A held-back input: the cleaned message, what to do after it, and for a cheap GUI edit its control's (handle
+type, label), to find the control again when a Reset rebuilt it."""
 
 
 @dataclasses.dataclass
 class _TabBudget:
     budget: CostlyBudget[Deferred]
     timer: asyncio.TimerHandle | None = None
+    in_flight: int = 0
+    """Costly inputs delivered whose handlers have not finished (a scene switch or Reset still building): the tab's
+    later inputs wait in line until they have, or they would reach the scene being replaced."""
 
 
 class Gate:
@@ -597,7 +630,7 @@ class Gate:
             return
         try:
             cleaned, after = self._clean(server, int(client_id), message)
-            if isinstance(cleaned, _messages.GuiUpdateMessage) and not self._admit(
+            if isinstance(cleaned, IN_LINE) and not self._admit(
                 server, int(client_id), cleaned, after
             ):
                 return  # held back, coalesced: delivered when the tab's budget allows
@@ -626,22 +659,36 @@ class Gate:
         self,
         server: viser.ViserServer,
         client_id: int,
-        message: _messages.GuiUpdateMessage,
+        message: Any,
         after: Callable[[], None] | None,
     ) -> bool:
-        """Whether ``message`` goes through now; a costly input beyond the tab's budget is held back instead."""
-        handle = self._gui_handle(server, client_id, str(message.uuid))
-        if handle is None or not control_spec(handle).costly:
-            return True
-        now = time.monotonic()
+        """Whether ``message`` goes through now; a costly input beyond the tab's budget is held back instead, and
+        so is any input of that tab behind it (in line, free of the budget): a cheap edit or a drag that follows a
+        held-back Reset or scene switch would otherwise be applied first and then undone by it."""
         tab = self._budgets.get(client_id)
+        if isinstance(message, _messages.GuiUpdateMessage):
+            key = str(message.uuid)
+            handle = self._gui_handle(server, client_id, key)
+            costly = handle is not None and control_spec(handle).costly
+        else:  # a drag, a click: one in line per kind and node, the latest
+            key, handle = f"{type(message).__name__} {getattr(message, 'name', '')}", None
+            costly = False
+        if not costly:
+            if tab is None or (tab.budget.held == 0 and tab.in_flight == 0):
+                return True
+            label = None if handle is None else self._control_path(server, client_id, handle)
+            tab.budget.offer(key, (message, after, label), time.monotonic(), free=True, hold=True)
+            self._schedule(client_id, tab)
+            return False
+        now = time.monotonic()
         if tab is None:
             tab = self._budgets[client_id] = _TabBudget(
                 CostlyBudget(COSTLY_BURST, COSTLY_RATE_HZ, now)
             )
-        goes, replaced = tab.budget.offer(str(message.uuid), (message, after), now)
+        goes, replaced = tab.budget.offer(key, (message, after, None), now)
         if goes:
-            return True
+            self._deliver_costly(client_id, tab, message, after)
+            return False  # on its way, tracked
         self.log.refuse(
             "costly input beyond the tab's budget (held back; the latest value is applied)",
             f"{str(getattr(handle, 'label', '?'))!r} from client {client_id}"
@@ -651,10 +698,39 @@ class Gate:
         self._schedule(client_id, tab)
         return False
 
+    def _is_costly(self, server: viser.ViserServer, client_id: int, message: Any) -> bool:
+        if not isinstance(message, _messages.GuiUpdateMessage):
+            return False
+        handle = self._gui_handle(server, client_id, str(message.uuid))
+        return handle is not None and control_spec(handle).costly
+
+    def _deliver_costly(
+        self, client_id: int, tab: _TabBudget, message: Any, after: Callable[[], None] | None
+    ) -> None:
+        """Deliver a costly input as a task; until its handler has finished, the tab's cheap inputs wait."""
+        tab.in_flight += 1
+
+        def finished(_task: object) -> None:
+            tab.in_flight -= 1
+            if self._budgets.get(client_id) is tab:
+                self._schedule(client_id, tab)
+
+        self._start(client_id, message, after).add_done_callback(finished)
+
+    def _start(
+        self, client_id: int, message: Any, after: Callable[[], None] | None
+    ) -> asyncio.Future[None]:
+        task = asyncio.ensure_future(self._deliver(client_id, message, after))
+        self._deliveries.add(task)  # asyncio keeps only a weak reference to a running task
+        task.add_done_callback(self._deliveries.discard)
+        return task
+
     def _schedule(self, client_id: int, tab: _TabBudget) -> None:
         wait_s = tab.budget.wait_s(time.monotonic())
         if tab.timer is not None or wait_s is None:
             return
+        if wait_s == 0.0 and tab.in_flight and tab.budget.next_is_free:
+            return  # a cheap input waits for the costly ones in flight: their end schedules it
         tab.timer = asyncio.get_running_loop().call_later(wait_s, self._release, client_id)
 
     def _release(self, client_id: int) -> None:
@@ -663,16 +739,82 @@ class Gate:
         if tab is None:
             return
         tab.timer = None
+        if tab.in_flight and tab.budget.next_is_free:
+            return  # scheduled again when the costly inputs in flight finish
         taken = tab.budget.take(time.monotonic())
         server = self._server_ref()
-        # The control may have gone meanwhile (its scene switched away): then there is nothing to apply.
-        if taken is not None and server is not None:
-            uuid, (message, after) = taken
-            if self._gui_handle(server, client_id, uuid) is not None:
-                task = asyncio.ensure_future(self._deliver(client_id, message, after))
-                self._deliveries.add(task)  # asyncio keeps only a weak reference to a running task
-                task.add_done_callback(self._deliveries.discard)
-        self._schedule(client_id, tab)
+        try:
+            if taken is not None and server is not None:
+                key, (message, after, label) = taken
+                if (
+                    isinstance(message, _messages.GuiUpdateMessage)
+                    and self._gui_handle(server, client_id, key) is None
+                ):
+                    # The control went meanwhile: a Reset or scene switch held back before it rebuilt its scene.
+                    # An edit made after it goes to the rebuilt scene's control of the same kind, label and
+                    # folders (a person who clicked Reset, then moved Speed, expects Speed to stick); with none,
+                    # or more than one, there is nothing to apply.
+                    message, after = self._retarget(server, client_id, message, label)
+                if message is not None and self._is_costly(server, client_id, message):
+                    self._deliver_costly(client_id, tab, message, after)
+                elif message is not None:
+                    self._start(client_id, message, after)
+        except Exception as error:  # a gate bug must not stall the tab's line
+            self.log.refuse("held-back input", f"{type(error).__name__}: {error}")
+        finally:
+            self._schedule(client_id, tab)
+
+    def _control_path(
+        self, server: viser.ViserServer, client_id: int, handle: Any
+    ) -> tuple[type, str]:
+        """(handle type, its label under the labels of the folders it sits in): which control it is to a person,
+        the same for a control rebuilt by a Reset and different in another scene (under another scene's folder)."""
+        client = self._client(server, client_id)
+        containers = [server.gui._container_handle_from_uuid]
+        if client is not None:
+            containers.append(client.gui._container_handle_from_uuid)
+        names = [str(getattr(handle, "label", ""))]
+        parent = getattr(_state(handle), "parent_container_id", "root")
+        for _ in range(
+            32
+        ):  # folders nest a few deep; a cycle would be viser's bug, not a hang here
+            if parent == "root":
+                break
+            container = next((c[parent] for c in containers if parent in c), None)
+            if container is None:
+                break
+            names.append(str(getattr(container, "label", type(container).__name__)))
+            parent = getattr(getattr(container, "_impl", None), "parent_container_id", "root")
+        return type(handle), " / ".join(reversed(names))
+
+    def _retarget(
+        self,
+        server: viser.ViserServer,
+        client_id: int,
+        message: _messages.GuiUpdateMessage,
+        label: tuple[type, str] | None,
+    ) -> tuple[Any, Callable[[], None] | None]:
+        """``message`` sent to the one live control of ``label`` (its handle type and label) instead, cleaned
+        against that control's own spec; (None, None) when there is no such control or more than one."""
+        if label is None:
+            return None, None
+        client = self._client(server, client_id)
+        registries = [server.gui._gui_input_handle_from_uuid]
+        if client is not None:
+            registries.append(client.gui._gui_input_handle_from_uuid)
+        matches = [
+            uuid
+            for registry in registries
+            for uuid, handle in list(registry.items())
+            if type(handle) is label[0]
+            and not _state(handle).removed
+            and self._control_path(server, client_id, handle) == label
+        ]
+        if len(matches) != 1:
+            return None, None
+        return self._clean_gui(
+            server, client_id, _messages.GuiUpdateMessage(matches[0], message.updates)
+        )
 
     def uploads_in_flight(self) -> tuple[int, int]:
         """(uploads, bytes they announced) started and not finished, across every tab of this server."""

@@ -6,8 +6,11 @@ resets only its own scene) or the server's, shared by every tab (``--shared``).
 
 from __future__ import annotations
 
+import asyncio
 import logging
 import threading
+from collections.abc import Callable, Coroutine
+from typing import Any
 
 import viser
 
@@ -16,6 +19,20 @@ from scenes._gate import mark_costly
 from scenes._session import Session
 
 logger = logging.getLogger(__name__)
+
+
+def _in_a_thread(
+    handler: Callable[[object], None],
+) -> Callable[[object], Coroutine[Any, Any, None]]:
+    """``handler`` as a coroutine function that runs it on the event loop's worker threads and returns when done."""
+
+    async def run(event: object) -> None:
+        try:
+            await asyncio.get_running_loop().run_in_executor(None, handler, event)
+        except Exception:  # no exception escapes a callback (nobody awaits the gate's delivery)
+            logger.exception("scene switcher: handling %r failed", event)
+
+    return run
 
 
 class SceneSwitcher:
@@ -49,8 +66,10 @@ class SceneSwitcher:
             self.reset_button = mark_costly(
                 session.gui.add_button("Reset scene to defaults", order=-99.0)
             )
-            self.dropdown.on_update(self._on_pick)
-            self.reset_button.on_click(self._on_reset)
+            # Awaited by viser (coroutines), the builds running on a worker thread: the gate then knows when a
+            # pick or Reset has finished, and holds that tab's later inputs until it has (scenes._gate).
+            self.dropdown.on_update(_in_a_thread(self._on_pick))
+            self.reset_button.on_click(_in_a_thread(self._on_reset))
             self.scene: Scene = SCENES[initial](session)
 
     def show(self, key: str, *, rebuild: bool = False) -> Scene:

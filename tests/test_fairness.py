@@ -9,6 +9,7 @@ server keeps serving.
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import threading
 import time
@@ -210,6 +211,39 @@ def test_a_reset_flood_does_not_delay_another_tab_and_ends_in_a_reset_scene(
     assert "Traceback" not in caplog.text
 
 
+def test_an_edit_sent_after_resets_beyond_the_budget_is_not_undone(
+    server: viser.ViserServer, sessions: Sessions
+) -> None:
+    """Five Resets at once (the budget lets three through, holds back the last), then a speed: the held-back Reset
+    goes first and the speed after it, so the tab ends on a reset scene at the speed it sent last."""
+    with BrowserClient(server.get_port()) as client:
+        client_id = own_session(server, sessions, set())
+        switcher = sessions.switcher(client_id)
+        assert switcher is not None
+        reset = client.wait_for_gui("Reset scene to defaults")
+        client.wait_for_node("/peloton")
+        for _ in range(COSTLY_BURST + 2):
+            client.send("GuiUpdateMessage", uuid=reset, updates={"value": True})
+        client.wait_for(
+            lambda: install_gate(server).costly_held_back(client_id) >= 1,
+            what="a Reset held back",
+        )
+        client.set_value("Speed (km/h)", 33.0)
+        wait_settled(server, client_id)
+        client.wait_for(
+            lambda: (
+                not switcher.scene.closed
+                and switcher.scene.params.speed_kmh == 33.0  # type: ignore[attr-defined]
+                and client.value_of("Speed (km/h)") == 33.0
+            ),
+            timeout=30.0,
+            what="the speed sent after the Resets, in the reset scene",
+        )
+        time.sleep(1.0)  # nothing left to undo it
+        scene = switcher.scene
+        assert scene.params == dataclasses.replace(type(scene.params)(), speed_kmh=33.0)  # type: ignore[attr-defined]
+
+
 def test_a_scene_switch_flood_ends_on_the_last_pick_and_does_not_delay_another_tab(
     server: viser.ViserServer, sessions: Sessions
 ) -> None:
@@ -316,6 +350,70 @@ def test_the_budget_bounds_work_and_delivers_each_controls_last_value(
         for j in range(i, len(times)):
             span = times[j] - start
             assert j - i + 1 <= COSTLY_BURST + span * COSTLY_RATE_HZ + 1e-9
+
+
+@given(
+    st.lists(
+        st.tuples(st.floats(0.0, 0.6), st.sampled_from("abcxy"), st.integers(0, 9)),
+        min_size=1,
+        max_size=80,
+    )
+)
+def test_an_input_after_a_held_back_one_is_applied_after_it(
+    arrivals: list[tuple[float, str, int]],
+) -> None:
+    """Costly controls a, b, c and free ones x, y (cheap sliders, gizmos) arriving in any order: each control ends
+    on its last value, free inputs never spend the budget, and an input sent after a costly control's last value is
+    delivered after it (an edit after a Reset is not undone by the Reset)."""
+    budget: CostlyBudget[int] = CostlyBudget(COSTLY_BURST, COSTLY_RATE_HZ, now=0.0)
+    delivered: list[tuple[float, str, int]] = []
+    now = [0.0]
+
+    def release_until(t: float) -> None:
+        while (wait := budget.wait_s(now[0])) is not None and now[0] + wait <= t:
+            now[0] += wait
+            taken = budget.take(now[0])
+            assert taken is not None
+            delivered.append((now[0], *taken))
+
+    sent_at: dict[str, int] = {}
+    for i, (gap, key, value) in enumerate(arrivals):
+        release_until(now[0] + gap)
+        now[0] += gap
+        sent_at[key] = i
+        goes, _ = budget.offer(key, value, now[0], free=key in "xy")
+        if goes:
+            delivered.append((now[0], key, value))
+    release_until(float("inf"))
+
+    assert {key: v for _t, key, v in delivered} == {key: v for _g, key, v in arrivals}
+    last_delivery = {key: i for i, (_t, key, _v) in enumerate(delivered)}
+    for costly in set(sent_at) & set("abc"):
+        for other in sent_at:
+            if sent_at[other] > sent_at[costly]:
+                assert last_delivery[other] > last_delivery[costly], (costly, other, delivered)
+    times = [t for t, key, _v in delivered if key in "abc"]
+    for i, start in enumerate(times):
+        for j in range(i, len(times)):
+            assert j - i + 1 <= COSTLY_BURST + (times[j] - start) * COSTLY_RATE_HZ + 1e-9
+
+
+def test_an_edit_after_a_held_back_reset_waits_for_it() -> None:
+    budget: CostlyBudget[str] = CostlyBudget(1, 1.0, now=0.0)
+    assert budget.offer("reset", "first reset", 0.0) == (True, False)
+    assert budget.offer("reset", "second reset", 0.1) == (
+        False,
+        False,
+    )  # beyond the budget: held back
+    assert budget.offer("speed", "33 km/h", 0.2, free=True) == (False, False)  # behind it, in line
+    assert budget.wait_s(0.2) == pytest.approx(0.8)
+    assert budget.take(1.0) == ("reset", "second reset")
+    assert budget.wait_s(1.0) == 0.0  # a free input goes as soon as it is first in line
+    assert budget.take(1.0) == ("speed", "33 km/h")
+    assert budget.offer("speed", "34 km/h", 1.0, free=True) == (
+        True,
+        False,
+    )  # nothing held: at once
 
 
 def test_a_burst_of_resets_is_one_held_back_reset() -> None:
