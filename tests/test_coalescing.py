@@ -66,16 +66,16 @@ class Held(Scene):
         self.release.wait()
 
 
-def flood(held: Held, values: list[float]) -> list[threading.Thread]:
+def flood(held: Held, values: list[float], queued: int = 1) -> list[threading.Thread]:
     """Call the handler once per value from its own thread (viser's pool), the value set first, while the first
-    call is still running; return the threads once all but the one queued for the scene have returned."""
+    call is still running; return the threads once all but the ``queued`` ones still waiting have returned."""
     threads = []
     for value in values:
         held.latest = value
         thread = threading.Thread(target=held.handler)
         thread.start()
         threads.append(thread)
-    wait_until(lambda: sum(t.is_alive() for t in threads) <= 1, what="the flood to coalesce")
+    wait_until(lambda: sum(t.is_alive() for t in threads) <= queued, what="the flood to coalesce")
     return threads
 
 
@@ -128,14 +128,8 @@ def test_two_scenes_take_turns_and_a_burst_that_waits_merges(values: list[float]
         first = threading.Thread(target=running.handler)
         first.start()
         running.entered.wait()
-        threads = []
-        for value in values:
-            waiting.latest = value
-            thread = threading.Thread(target=waiting.handler)
-            thread.start()
-            threads.append(thread)
         # One call holds its scene and waits for the turn, one more waits for the scene; the rest merged.
-        wait_until(lambda: sum(t.is_alive() for t in threads) <= 2, what="the burst to merge")
+        threads = flood(waiting, values, queued=2)
         assert waiting.read == []
         running.release.set()
         for thread in [first, *threads]:

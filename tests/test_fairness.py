@@ -27,6 +27,7 @@ from test_hostile_uploads import notices as notifications
 from test_hostile_uploads import part as send_part
 from wsclient import BrowserClient
 
+import scenes._gate as gate_module
 from app import serve_scenes
 from scenes import SCENES
 from scenes._gate import (
@@ -212,10 +213,12 @@ def test_a_reset_flood_does_not_delay_another_tab_and_ends_in_a_reset_scene(
 
 
 def test_an_edit_sent_after_resets_beyond_the_budget_is_not_undone(
-    server: viser.ViserServer, sessions: Sessions
+    server: viser.ViserServer, sessions: Sessions, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """Five Resets at once (the budget lets three through, holds back the last), then a speed: the held-back Reset
     goes first and the speed after it, so the tab ends on a reset scene at the speed it sent last."""
+    # A token every 5 s: the held-back Reset still waits once the three let through have rebuilt, on any machine.
+    monkeypatch.setattr(gate_module, "COSTLY_RATE_HZ", 0.2)
     with BrowserClient(server.get_port()) as client:
         client_id = own_session(server, sessions, set())
         switcher = sessions.switcher(client_id)
@@ -224,10 +227,23 @@ def test_an_edit_sent_after_resets_beyond_the_budget_is_not_undone(
         client.wait_for_node("/peloton")
         for _ in range(COSTLY_BURST + 2):
             client.send("GuiUpdateMessage", uuid=reset, updates={"value": True})
-        client.wait_for(
-            lambda: install_gate(server).costly_held_back(client_id) >= 1,
-            what="a Reset held back",
-        )
+        gate = install_gate(server)
+
+        def held_with_the_tab_on_a_built_scene() -> bool:
+            # Only the held-back Reset is pending, and the tab's Speed is the live control: the case this test
+            # is about. (An edit aimed at a control that a Reset still running has removed is refused as unknown;
+            # the tab is sent the rebuilt scene: README, Known limits.)
+            tab = gate._budgets.get(client_id)  # pyright: ignore[reportPrivateUsage]
+            uuid = client._find("Speed (km/h)")  # pyright: ignore[reportPrivateUsage]
+            return (
+                tab is not None
+                and tab.budget.held >= 1
+                and tab.in_flight == 0
+                and uuid is not None
+                and gate._gui_handle(server, client_id, uuid) is not None  # pyright: ignore[reportPrivateUsage]
+            )
+
+        client.wait_for(held_with_the_tab_on_a_built_scene, what="a Reset held back")
         client.set_value("Speed (km/h)", 33.0)
         wait_settled(server, client_id)
         client.wait_for(
@@ -309,6 +325,37 @@ def test_a_slider_at_30_per_second_is_never_held_back(
 
 
 # ------------------------------------------------------------------------------------------ the budget alone
+def replay(arrivals: list[tuple[float, str, int]], free: str = "") -> list[tuple[float, str, int]]:
+    """Offer (gap s, control, value) arrivals to a fresh budget (controls named in ``free`` cost no token), taking
+    each held-back one as soon as the budget hands it out; (time, control, value) in delivery order."""
+    budget: CostlyBudget[int] = CostlyBudget(COSTLY_BURST, COSTLY_RATE_HZ, now=0.0)
+    delivered: list[tuple[float, str, int]] = []
+    now = [0.0]
+
+    def release_until(t: float) -> None:
+        while (wait := budget.wait_s(now[0])) is not None and now[0] + wait <= t:
+            now[0] += wait
+            taken = budget.take(now[0])
+            assert taken is not None
+            delivered.append((now[0], *taken))
+
+    for gap, key, value in arrivals:
+        release_until(now[0] + gap)
+        now[0] += gap
+        goes, _ = budget.offer(key, value, now[0], free=key in free)
+        if goes:
+            delivered.append((now[0], key, value))
+    release_until(float("inf"))
+    return delivered
+
+
+def assert_within_the_budget(times: list[float]) -> None:
+    """At most ``burst + rate·t`` of these delivery times in any ``t`` s."""
+    for i, start in enumerate(times):
+        for j in range(i, len(times)):
+            assert j - i + 1 <= COSTLY_BURST + (times[j] - start) * COSTLY_RATE_HZ + 1e-9
+
+
 @given(
     st.lists(
         st.tuples(st.floats(0.0, 0.6), st.sampled_from("abc"), st.integers(0, 9)),
@@ -321,35 +368,11 @@ def test_the_budget_bounds_work_and_delivers_each_controls_last_value(
 ) -> None:
     """Any arrivals of costly inputs (gap s, control, value): at most ``burst + rate·t`` go in any ``t`` s, and each
     control's last value delivered is the last one sent."""
-    budget: CostlyBudget[int] = CostlyBudget(COSTLY_BURST, COSTLY_RATE_HZ, now=0.0)
-    delivered: list[tuple[float, str, int]] = []
-    now = 0.0
-
-    def release_until(t: float) -> None:
-        while (wait := budget.wait_s(now_box[0])) is not None and now_box[0] + wait <= t:
-            now_box[0] += wait
-            taken = budget.take(now_box[0])
-            assert taken is not None
-            delivered.append((now_box[0], *taken))
-
-    now_box = [0.0]
-    for gap, key, value in arrivals:
-        now += gap
-        release_until(now)
-        now_box[0] = now
-        goes, _ = budget.offer(key, value, now)
-        if goes:
-            delivered.append((now, key, value))
-    release_until(float("inf"))
-
+    delivered = replay(arrivals)
     last_sent = {key: value for _gap, key, value in arrivals}
     last_delivered = {key: value for _t, key, value in delivered}
     assert last_delivered == last_sent
-    times = [t for t, _key, _value in delivered]
-    for i, start in enumerate(times):
-        for j in range(i, len(times)):
-            span = times[j] - start
-            assert j - i + 1 <= COSTLY_BURST + span * COSTLY_RATE_HZ + 1e-9
+    assert_within_the_budget([t for t, _key, _value in delivered])
 
 
 @given(
@@ -365,37 +388,15 @@ def test_an_input_after_a_held_back_one_is_applied_after_it(
     """Costly controls a, b, c and free ones x, y (cheap sliders, gizmos) arriving in any order: each control ends
     on its last value, free inputs never spend the budget, and an input sent after a costly control's last value is
     delivered after it (an edit after a Reset is not undone by the Reset)."""
-    budget: CostlyBudget[int] = CostlyBudget(COSTLY_BURST, COSTLY_RATE_HZ, now=0.0)
-    delivered: list[tuple[float, str, int]] = []
-    now = [0.0]
-
-    def release_until(t: float) -> None:
-        while (wait := budget.wait_s(now[0])) is not None and now[0] + wait <= t:
-            now[0] += wait
-            taken = budget.take(now[0])
-            assert taken is not None
-            delivered.append((now[0], *taken))
-
-    sent_at: dict[str, int] = {}
-    for i, (gap, key, value) in enumerate(arrivals):
-        release_until(now[0] + gap)
-        now[0] += gap
-        sent_at[key] = i
-        goes, _ = budget.offer(key, value, now[0], free=key in "xy")
-        if goes:
-            delivered.append((now[0], key, value))
-    release_until(float("inf"))
-
+    delivered = replay(arrivals, free="xy")
+    sent_at = {key: i for i, (_gap, key, _value) in enumerate(arrivals)}
     assert {key: v for _t, key, v in delivered} == {key: v for _g, key, v in arrivals}
     last_delivery = {key: i for i, (_t, key, _v) in enumerate(delivered)}
     for costly in set(sent_at) & set("abc"):
         for other in sent_at:
             if sent_at[other] > sent_at[costly]:
                 assert last_delivery[other] > last_delivery[costly], (costly, other, delivered)
-    times = [t for t, key, _v in delivered if key in "abc"]
-    for i, start in enumerate(times):
-        for j in range(i, len(times)):
-            assert j - i + 1 <= COSTLY_BURST + (times[j] - start) * COSTLY_RATE_HZ + 1e-9
+    assert_within_the_budget([t for t, key, _v in delivered if key in "abc"])
 
 
 def test_an_edit_after_a_held_back_reset_waits_for_it() -> None:
