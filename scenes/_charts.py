@@ -12,6 +12,14 @@ Debian): uPlot pads an auto y range by 10 % of the span, rounds it to "nice" val
 ``Intl.NumberFormat`` (grouping commas, at most 3 decimals), and spaces ticks at least 30 px (y) / 50 px (x) apart.
 A y range narrowed by drag-zooming into a small part of the x range can call for more decimals than the full data
 do; those labels can still overrun.
+
+The x range is pinned to the data's (:func:`fit_x_scale`). viser 1.1.1's client keeps an auto x scale's window
+*relative* to the data across updates, in a React effect that also runs when the chart is rebuilt (any change of
+axes or padding rebuilds it). When a rebuild and a new x extent arrive together, that effect can read the old
+chart's window before uPlot has committed the new one, and the new chart opens zoomed into the old extent: the
+labels' chart opened on x 0..1 of 0..80 and showed y "-4,899.999" to "-4,899.996" for data from -4,900 to 2,100.
+A pinned range (``auto: false``, a ``range`` tuple) skips that effect; a new x extent sends new scales, which
+rebuild the chart on the new range. Drag-zoom still works and a double click returns to the whole range.
 """
 
 from __future__ import annotations
@@ -122,6 +130,30 @@ def _range(values: Sequence[np.ndarray], log: bool) -> tuple[float, float] | Non
     return float(min(v.min() for v in finite)), float(max(v.max() for v in finite))
 
 
+def fit_x_scale(
+    data: Sequence[np.ndarray], scales: Mapping[str, Mapping[str, Any]]
+) -> dict[str, viser.uplot.Scale]:
+    """``scales`` with the x scale pinned to the finite extent of ``data[0]`` (see the module's note).
+
+    A flat x (one value) is widened by half a unit or 1 % of its size, whichever is more; an x with no finite
+    value (positive, on a log scale) leaves the x scale as given. Other scales are returned as they are.
+    """
+    out = {key: viser.uplot.Scale(**scale) for key, scale in scales.items()}  # type: ignore[typeddict-item]
+    x_scale = out.get("x", viser.uplot.Scale())
+    found = _range([np.asarray(data[0], dtype=np.float64)], x_scale.get("distr") == 3)
+    if found is None:
+        return out
+    lo, hi = found
+    if hi <= lo:
+        half = max(0.5, 0.01 * abs(lo))
+        lo, hi = (lo / 2.0, lo * 2.0) if x_scale.get("distr") == 3 else (lo - half, hi + half)
+    x_scale = viser.uplot.Scale(**x_scale)  # type: ignore[typeddict-item]
+    x_scale["auto"] = False
+    x_scale["range"] = (lo, hi)
+    out["x"] = x_scale
+    return out
+
+
 def fit_layout(
     data: Sequence[np.ndarray],
     series: Sequence[Mapping[str, Any]],
@@ -189,7 +221,8 @@ def fit_layout(
 
 
 class FittedChart:
-    """A uPlot chart in the GUI whose axes are refitted (:func:`fit_layout`) whenever its data are set."""
+    """A uPlot chart in the GUI whose axes and x range are refitted (:func:`fit_layout`, :func:`fit_x_scale`)
+    whenever its data are set."""
 
     def __init__(
         self,
@@ -206,7 +239,12 @@ class FittedChart:
         self._series, self._scales, self._axes = series, scales, axes
         fitted, padding = fit_layout(data, series, scales, axes)
         self.handle = gui.add_uplot(
-            data=data, series=series, scales=scales, axes=fitted, padding=padding, **kwargs
+            data=data,
+            series=series,
+            scales=fit_x_scale(data, scales),
+            axes=fitted,
+            padding=padding,
+            **kwargs,
         )
         """The viser handle underneath."""
 
@@ -218,6 +256,9 @@ class FittedChart:
     @data.setter
     def data(self, data: tuple[np.ndarray, ...]) -> None:
         fitted, padding = fit_layout(data, self._series, self._scales, self._axes)
+        pinned = fit_x_scale(data, self._scales)
+        if pinned != self.handle.scales:
+            self.handle.scales = pinned
         if fitted != self.handle.axes:
             self.handle.axes = fitted
         if padding != self.handle.padding:

@@ -559,6 +559,51 @@ def assert_tick_labels_inside(page: Any, title: str, border_px: int = 2) -> None
     )
 
 
+CHART_WINDOW = """
+title => {
+  const found = Object.values((window.__viserTestpoints || {}).uplots || {}).find(({chart}) => {
+    const t = chart.root.querySelector('.u-title');
+    return t && t.textContent === title;
+  });
+  if (!found) return null;
+  const u = found.chart;
+  return u.series.map(s => {
+    const scale = u.scales[s.scale];
+    return {scale: s.scale, min: scale.min, max: scale.max, log: scale.distr === 3};
+  });
+}
+"""
+
+
+def assert_chart_shows_its_data(page: Any, title: str, data: Sequence[Any]) -> None:
+    """Assert that chart ``title`` opens on all of ``data`` (the server's arrays): its x window is the data's x
+    extent, and every series' scale spans that series' finite values (positive ones on a log scale).
+
+    A chart left zoomed into part of its data by a client's stale state shows tick labels and curves that look
+    fine but describe a sliver (the labels' chart once showed y "-4,899.999" for data from -4,900 to 2,100).
+    """
+    windows = page.evaluate(CHART_WINDOW, title)
+    assert windows is not None, f"no uPlot chart titled {title!r} on the page"
+    x = np.asarray(data[0], dtype=np.float64)
+    x = x[np.isfinite(x)]
+    if x.size and x.max() > x.min():
+        shown = windows[0]
+        tol = 1e-9 * max(1.0, abs(float(x.min())), abs(float(x.max())))
+        assert abs(shown["min"] - x.min()) <= tol and abs(shown["max"] - x.max()) <= tol, (
+            f"chart {title!r}: x window {shown['min']}..{shown['max']}, data {x.min()}..{x.max()}"
+        )
+    for k, (window, values) in enumerate(zip(windows[1:], data[1:], strict=True), start=1):
+        v = np.asarray(values, dtype=np.float64)
+        v = v[np.isfinite(v) & ((v > 0.0) if window["log"] else True)]
+        if not v.size:
+            continue
+        tol = 1e-9 * max(abs(float(v.min())), abs(float(v.max())), 1e-300)
+        assert window["min"] <= v.min() + tol and window["max"] >= v.max() - tol, (
+            f"chart {title!r}: series {k} (scale {window['scale']!r}) shows "
+            f"{window['min']}..{window['max']}, data {v.min()}..{v.max()}"
+        )
+
+
 def wait_chart_data(page: Any, title: str, data: Sequence[Any], timeout_ms: int = 30_000) -> None:
     """Wait until the uPlot chart titled ``title`` holds ``data`` (the server's arrays) and has drawn it."""
     ends = [[float(np.asarray(d)[0]), float(np.asarray(d)[-1]), len(d)] for d in data]

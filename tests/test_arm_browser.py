@@ -225,7 +225,12 @@ def test_drag_the_target_gizmo_with_the_mouse(server: viser.ViserServer, browser
 
 
 def test_the_error_plot_tick_labels_stay_inside_its_canvas(shown: ScenePage) -> None:
-    from browser import assert_tick_labels_inside, set_number, wait_chart_data
+    from browser import (
+        assert_chart_shows_its_data,
+        assert_tick_labels_inside,
+        set_number,
+        wait_chart_data,
+    )
 
     scene = shown.scene
     assert isinstance(scene, ArmScene)
@@ -237,6 +242,7 @@ def test_the_error_plot_tick_labels_stay_inside_its_canvas(shown: ScenePage) -> 
         data = scene.plot.data
     assert float(np.min(data[1])) < 0.1
     wait_chart_data(shown.page, CHART, data)
+    assert_chart_shows_its_data(shown.page, CHART, data)
     assert_tick_labels_inside(shown.page, CHART)
     set_number(shown.page, "Tolerance (mm)", 1)
     wait_until(lambda: scene.params.tolerance_mm == 1.0, "the tolerance back")

@@ -9,6 +9,7 @@ from scenes._charts import (
     AXIS_SIZE_PX,
     EDGE_PAD_PX,
     fit_layout,
+    fit_x_scale,
     format_label,
     label_px,
     widest_linear_label,
@@ -42,3 +43,29 @@ def test_layout_widens_the_axis_and_pads_the_top() -> None:
     assert axes[1].get("size") == AXIS_SIZE_PX and padding[0] == EDGE_PAD_PX
     axes, _ = fit_layout((x, x * 250.0), series, scales, None)
     assert float(axes[1].get("size", 0.0)) >= label_px("20,000") + 15
+
+
+def test_the_x_range_is_pinned_to_the_data() -> None:
+    # viser's client keeps an auto x window relative to the data, and can open a rebuilt chart zoomed into the
+    # old extent: a pinned range (auto off, the data's extent) is rebuilt on the new one.
+    x = np.linspace(2.0, 80.0, 20)
+    scales = {"x": viser.uplot.Scale(time=False, auto=True), "y": viser.uplot.Scale(auto=True)}
+    pinned = fit_x_scale((x, x), scales)
+    assert pinned["x"] == {"time": False, "auto": False, "range": (2.0, 80.0)}
+    # The caller's scales are left as they were.
+    assert pinned["y"] == scales["y"] and scales["x"]["auto"] is True
+    with_gaps = np.array([np.nan, 3.0, -np.inf, 5.0])
+    assert fit_x_scale((with_gaps, with_gaps), scales)["x"]["range"] == (3.0, 5.0)
+
+
+def test_a_flat_or_empty_x_range_is_widened_or_left_alone() -> None:
+    scales = {"x": viser.uplot.Scale(auto=True), "y": viser.uplot.Scale(auto=True)}
+    assert fit_x_scale((np.full(3, 0.0), np.zeros(3)), scales)["x"]["range"] == (-0.5, 0.5)
+    assert fit_x_scale((np.full(3, 1e308), np.zeros(3)), scales)["x"]["range"] == (
+        1e308 - 1e306,
+        1e308 + 1e306,
+    )
+    assert fit_x_scale((np.full(3, np.nan), np.zeros(3)), scales) == scales
+    log = {"x": viser.uplot.Scale(distr=3, auto=True)}
+    assert fit_x_scale((np.full(3, 10.0), np.zeros(3)), log)["x"]["range"] == (5.0, 20.0)
+    assert fit_x_scale((np.array([-1.0, 0.0]), np.zeros(2)), log) == log

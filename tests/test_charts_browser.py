@@ -11,7 +11,13 @@ import numpy as np
 import pytest
 import viser
 import viser.uplot
-from browser import VIEWPORTS, assert_tick_labels_inside, open_viser, wait_chart_data
+from browser import (
+    VIEWPORTS,
+    assert_chart_shows_its_data,
+    assert_tick_labels_inside,
+    open_viser,
+    wait_chart_data,
+)
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -80,6 +86,7 @@ class Probe:
         chart.data = data
         self.server.flush()
         wait_chart_data(self.page, title, data)
+        assert_chart_shows_its_data(self.page, title, data)
         assert_tick_labels_inside(self.page, title)
 
 

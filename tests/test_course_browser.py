@@ -96,7 +96,13 @@ def test_upload_a_gpx_and_play_it(
 def test_the_course_chart_tick_labels_stay_inside_its_canvas(
     chromium_browser: Any, viewport: tuple[int, int]
 ) -> None:
-    from browser import assert_tick_labels_inside, scene_page, set_number, wait_chart_data
+    from browser import (
+        assert_chart_shows_its_data,
+        assert_tick_labels_inside,
+        scene_page,
+        set_number,
+        wait_chart_data,
+    )
 
     title = "Elevation, speed and power along the course"
     with scene_page(chromium_browser, "peloton", viewport) as shown:
@@ -109,6 +115,7 @@ def test_the_course_chart_tick_labels_stay_inside_its_canvas(
         with scene._lock:
             data = mode.chart.data
         wait_chart_data(shown.page, title, data)
+        assert_chart_shows_its_data(shown.page, title, data)
         assert_tick_labels_inside(shown.page, title)
         # More power: the speed axis on the right reaches higher.
         before = float(np.max(data[2]))
@@ -118,4 +125,5 @@ def test_the_course_chart_tick_labels_stay_inside_its_canvas(
             data = mode.chart.data
         assert float(np.max(data[2])) > before + 10.0
         wait_chart_data(shown.page, title, data)
+        assert_chart_shows_its_data(shown.page, title, data)
         assert_tick_labels_inside(shown.page, title)

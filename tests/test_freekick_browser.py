@@ -250,7 +250,7 @@ def test_pressing_kick_flies_the_ball_in_the_page(
 
 
 def test_the_force_chart_tick_labels_stay_inside_its_canvas(shown: ScenePage) -> None:
-    from browser import assert_tick_labels_inside, wait_chart_data
+    from browser import assert_chart_shows_its_data, assert_tick_labels_inside, wait_chart_data
 
     scene = shown.scene
     assert isinstance(scene, FreeKickScene)
@@ -265,6 +265,7 @@ def test_the_force_chart_tick_labels_stay_inside_its_canvas(shown: ScenePage) ->
         data = scene.chart.data
     assert max(float(np.max(series)) for series in data[1:]) > 10.0
     wait_chart_data(shown.page, CHART, data)
+    assert_chart_shows_its_data(shown.page, CHART, data)
     assert_tick_labels_inside(shown.page, CHART)
     set_number(shown.page, "Launch speed (m/s)", 25)
     set_number(shown.page, "Spin rate (rev/s)", 8)

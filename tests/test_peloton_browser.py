@@ -203,7 +203,7 @@ def test_drag_speed_slider_with_the_mouse(server: viser.ViserServer, browser_pag
 
 
 def test_the_chart_tick_labels_stay_inside_its_canvas(shown: ScenePage) -> None:
-    from browser import assert_tick_labels_inside, wait_chart_data
+    from browser import assert_chart_shows_its_data, assert_tick_labels_inside, wait_chart_data
 
     scene = shown.scene
     assert isinstance(scene, PelotonScene)
@@ -218,6 +218,7 @@ def test_the_chart_tick_labels_stay_inside_its_canvas(shown: ScenePage) -> None:
         data = scene.chart.data
     assert max(float(np.max(series)) for series in data[1:]) > 10_000.0
     wait_chart_data(shown.page, CHART, data)
+    assert_chart_shows_its_data(shown.page, CHART, data)
     assert_tick_labels_inside(shown.page, CHART)
     set_number(shown.page, "CdA (m²)", 0.32)
     set_number(shown.page, "Headwind (m/s, − = tailwind)", 0)
