@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from typing import Literal
 
+from scenes import _viser_patches
 from scenes._base import Scene
 from scenes.arm import ArmScene
 from scenes.freekick import FreeKickScene
@@ -24,5 +25,7 @@ SCENES: dict[str, type[Scene]] = {
     FreeKickScene.key: FreeKickScene,
 }
 """Every scene that exists, in switcher order."""
+
+_viser_patches.apply()
 
 __all__ = ["SCENES", "Scene", "SceneName"]
