@@ -45,6 +45,7 @@ tracing", The Visual Computer 12 (1996); T. Lewiner et al., J. Graphics Tools 8(
 from __future__ import annotations
 
 import dataclasses
+import functools
 import itertools
 import math
 import numbers
@@ -524,6 +525,13 @@ class Primitive:
             np.float64, copy=False
         )
 
+    @functools.cached_property
+    def _turned(self) -> FloatArray | None:
+        """The (3, 3) :func:`rotation_matrix` of ``rotation``, or None for none; built once per primitive (a mesh
+        evaluates the field a dozen times, and building it took 10 % of a 32³ preview)."""
+        r = rotation_matrix(self.rotation)
+        return None if np.array_equal(r, np.eye(3)) else r
+
     def _distance_xyz(
         self, x: NDArray[np.floating], y: NDArray[np.floating], z: NDArray[np.floating]
     ) -> NDArray[np.floating]:
@@ -532,9 +540,9 @@ class Primitive:
         The same formulas as the ``sd_*`` functions, written per coordinate (no (N, 3) temporaries, no
         re-validation); the tests hold the two equal.
         """
-        r = rotation_matrix(self.rotation)
+        r = self._turned
         dx, dy, dz = x - self.center[0], y - self.center[1], z - self.center[2]
-        if np.array_equal(r, np.eye(3)):
+        if r is None:
             lx, ly, lz = dx, dy, dz
         else:  # p_local = Rᵀ·(p − c)
             lx = dx * r[0, 0] + dy * r[1, 0] + dz * r[2, 0]
