@@ -1209,6 +1209,7 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
 
     def _on_kick(self) -> None:
         self._kick_time_s = 0.0
+        self.wake_loops()
 
     def _on_goal_click(self, event: viser.SceneNodePointerEvent) -> None:
         origin, direction = event.ray_origin, event.ray_direction
@@ -1429,9 +1430,10 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
         return "  \n".join(lines)
 
     # ----------------------------------------------------------------------------------------- animation
-    def _animate(self, dt: float) -> None:
+    def _animate(self, dt: float) -> bool:
+        """One frame of the kick's replay; False (the loop sleeps) when no kick is playing."""
         if self._kick_time_s is None:
-            return
+            return False
         flight = self.state.flight
         self._kick_time_s += min(dt, 0.1)
         t = min(self._kick_time_s, float(flight.t[-1]))
@@ -1444,3 +1446,4 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
             self._kick_time_s = None  # rest a moment where it landed, then go back to the spot
             self.ball_frame.position = tuple(ball_spot(self.params))
             self.ball_frame.wxyz = (1.0, 0.0, 0.0, 0.0)
+        return True

@@ -638,6 +638,7 @@ time-averaged power is the mean over positions, far below the leader's.
         self._energy_j[:] = 0.0
         self._ridden_s = 0.0
         self.redraw()
+        self.wake_loops()
 
     def _on_input(self) -> None:
         last_good = (self.params, self.state)
@@ -971,15 +972,17 @@ time-averaged power is the mean over positions, far below the leader's.
         return text + "."
 
     # ----------------------------------------------------------------------------------------- animation
-    def _animate(self, dt: float) -> None:
+    def _animate(self, dt: float) -> bool:
+        """One frame of the rotating lead; False (the loop sleeps) when the lead does not rotate."""
         if not (self._rotating and self.params.n_riders > 1):
-            return
+            return False
         dt = min(dt, 0.2)
         slots = self.current_slots()
         self._energy_j[: self.params.n_riders] += np.asarray(self.state.power.total)[slots] * dt
         self._ridden_s += dt
         self._rotation_time_s += dt
         self.redraw(readouts=False)
+        return True
 
     def rider_average_power(self) -> np.ndarray:
         """(n_riders,) time-averaged power of each rider since the rotation started (W); zeros before."""
@@ -1532,6 +1535,7 @@ class CourseMode:
         if self.enabled and self.state is None:
             self.recompute()
         self.redraw()
+        self.scene.wake_loops()
 
     def _on_input(self) -> None:
         if (
@@ -1684,6 +1688,7 @@ class CourseMode:
         if self.play_time_s >= self.state.ride.time_s:
             self.play_time_s = 0.0
         self.playing = True
+        self.scene.wake_loops()
 
     def _on_pause(self) -> None:
         self.playing = False
@@ -1703,9 +1708,10 @@ class CourseMode:
         self.redraw(readouts=False)
 
     # ----------------------------------------------------------------------------------------- animation
-    def _animate(self, dt: float) -> None:
+    def _animate(self, dt: float) -> bool:
+        """One frame of the ride's playback; False (the loop sleeps) when it is not playing."""
         if not (self.enabled and self.playing and self.state is not None):
-            return
+            return False
         dt = min(dt, 0.2)
         self.play_time_s = min(self.play_time_s + dt * self.params.playback, self.state.ride.time_s)
         if self.play_time_s >= self.state.ride.time_s:
@@ -1717,6 +1723,7 @@ class CourseMode:
             self.redraw(readouts=False, now=True)
         else:
             self.redraw(readouts=False, now=False)
+        return True
 
     # ----------------------------------------------------------------------------------------- drawing
     def _total_km(self) -> float:

@@ -27,6 +27,8 @@ class Probe(Scene):
         self.point = (0.0, 0.0, 0.0)
         self.calls = 0
         self.ticks = 0
+        self.animating = True
+        """What the loop's step reports: False puts the loop to sleep until wake_loops()."""
         self.gizmo_events = 0
         with self.gui_root:
             self.slider = server.gui.add_slider(
@@ -51,8 +53,42 @@ class Probe(Scene):
         self.point = self.read_position(self.gizmo, self.point, (-5.0, -5.0, 0.0), (5.0, 5.0, 5.0))
         self.gizmo_events += self.messages_in_call
 
-    def _tick(self, _dt: float) -> None:
+    def _tick(self, _dt: float) -> bool:
         self.ticks += 1
+        return self.animating
+
+
+def _wait_ticks(probe: Probe, at_least: int) -> None:
+    deadline = time.monotonic() + 5
+    while probe.ticks < at_least and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert probe.ticks >= at_least
+
+
+def test_an_idle_loop_sleeps_until_woken_and_a_sleeping_loop_still_stops(
+    server: viser.ViserServer,
+) -> None:
+    probe = Probe(server)
+    _wait_ticks(probe, 2)
+    with probe._lock:
+        probe.animating = False
+    _wait_ticks(probe, probe.ticks + 1)  # the step that reports "idle"
+    asleep = probe.ticks
+    time.sleep(0.3)  # 30 periods: an awake loop would have stepped ~30 times
+    assert probe.ticks == asleep
+    probe.wake_loops()  # a wake-up while idle runs one step, which reports idle again
+    _wait_ticks(probe, asleep + 1)
+    time.sleep(0.1)
+    assert probe.ticks == asleep + 1
+    with probe._lock:
+        probe.animating = True
+    probe.wake_loops()
+    _wait_ticks(probe, asleep + 5)  # animating again: it steps every period
+    with probe._lock:
+        probe.animating = False
+    _wait_ticks(probe, probe.ticks + 1)
+    probe.close()  # the loop sleeps: close wakes it to end
+    assert not any(t.name == "probe-loop" and t.is_alive() for t in threading.enumerate())
 
 
 def test_numbers_are_cleaned_and_written_back(server: viser.ViserServer) -> None:
