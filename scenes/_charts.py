@@ -135,11 +135,16 @@ def fit_x_scale(
 ) -> dict[str, viser.uplot.Scale]:
     """``scales`` with the x scale pinned to the finite extent of ``data[0]`` (see the module's note).
 
-    A flat x (one value) is widened by half a unit or 1 % of its size, whichever is more; an x with no finite
-    value (positive, on a log scale) leaves the x scale as given. Other scales are returned as they are.
+    A flat x (one value) is widened by half a unit or 1 % of its size, whichever is more. The x scale is left as
+    given when it has a range of its own, is ordinal, has no finite value (positive, on a log scale), or would be
+    widened past the largest float. Other scales are returned as they are.
     """
     out = {key: viser.uplot.Scale(**scale) for key, scale in scales.items()}  # type: ignore[typeddict-item]
     x_scale = out.get("x", viser.uplot.Scale())
+    if (
+        "range" in x_scale or x_scale.get("distr") == 2
+    ):  # the caller's own range; ordinal x (index units)
+        return out
     found = _range([np.asarray(data[0], dtype=np.float64)], x_scale.get("distr") == 3)
     if found is None:
         return out
@@ -147,6 +152,8 @@ def fit_x_scale(
     if hi <= lo:
         half = max(0.5, 0.01 * abs(lo))
         lo, hi = (lo / 2.0, lo * 2.0) if x_scale.get("distr") == 3 else (lo - half, hi + half)
+    if not (math.isfinite(lo) and math.isfinite(hi)):  # widened past the largest float
+        return out
     x_scale = viser.uplot.Scale(**x_scale)  # type: ignore[typeddict-item]
     x_scale["auto"] = False
     x_scale["range"] = (lo, hi)

@@ -653,6 +653,9 @@ time-averaged power is the mean over positions, far below the leader's.
             self.redraw()
             raise
         self._update_framing()
+        # An input can start the rotation (Riders raised from 1 while Rotate is on): wake the loop.
+        if self._rotating and self.params.n_riders > 1:
+            self.wake_loops()
 
     # ----------------------------------------------------------------------------------------- camera
     def line_points(self, bar_headroom: float = 1.0) -> np.ndarray:
@@ -1562,6 +1565,8 @@ class CourseMode:
         self.params, self.state = params, state
         self.message = ""
         self.play_time_s = min(self.play_time_s, state.ride.time_s)
+        if self.enabled and self.playing:  # a ride that had none to play now has one
+            self.scene.wake_loops()
 
     def _on_sample(self) -> None:
         self.load(course_kernel.SAMPLE_ROUTE.read_bytes(), SAMPLE_LABEL)

@@ -69,3 +69,8 @@ def test_a_flat_or_empty_x_range_is_widened_or_left_alone() -> None:
     log = {"x": viser.uplot.Scale(distr=3, auto=True)}
     assert fit_x_scale((np.full(3, 10.0), np.zeros(3)), log)["x"].get("range") == (5.0, 20.0)
     assert fit_x_scale((np.array([-1.0, 0.0]), np.zeros(2)), log) == log
+    assert fit_x_scale((np.full(2, 1.7e308), np.zeros(2)), log) == log  # 2 × 1.7e308 overflows
+    own = {"x": viser.uplot.Scale(auto=False, range=(0.0, 1.0))}
+    assert fit_x_scale((np.arange(5.0), np.zeros(5)), own) == own
+    ordinal = {"x": viser.uplot.Scale(distr=2)}
+    assert fit_x_scale((np.arange(5.0), np.zeros(5)), ordinal) == ordinal

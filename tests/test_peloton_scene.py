@@ -389,3 +389,22 @@ def test_eight_riders_at_the_largest_gap_ride_on_the_road(scene: PelotonScene) -
     scene.riders.value, scene.gap.value = 8, MAX_GAP_M
     tail = 7 * (1.70 + 15.0)  # the last rider's slot, 116.9 m behind the leader
     assert np.asarray(scene.road.vertices)[:, 0].min() <= -tail - 1.0
+
+
+def test_the_lead_starts_rotating_when_riders_join_with_rotate_on(scene: PelotonScene) -> None:
+    """An idle animation loop sleeps until woken: every input that can start the animation must wake it (a fresh
+    review found raising Riders from 1 with Rotate on left the lead still until Rotate was touched)."""
+    scene.riders.value = 1
+    scene.rotate.value = True  # one rider: nothing to rotate, the loop goes to sleep
+    time.sleep(0.3)
+    with scene._lock:
+        assert scene._rotation_time_s == 0.0
+    scene.riders.value = 3
+    deadline = time.monotonic() + 10.0
+    while time.monotonic() < deadline:
+        with scene._lock:
+            if scene._rotation_time_s > 0.1:
+                break
+        time.sleep(0.02)
+    with scene._lock:
+        assert scene._rotation_time_s > 0.1, "the rotation did not start when riders joined"

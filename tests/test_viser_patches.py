@@ -74,7 +74,8 @@ def test_there_are_hints_of_every_kind_the_cast_handles() -> None:
 def test_the_patched_cast_returns_what_viser_returns(value: Any) -> None:
     viser_self = _Viser()
     for cls, prop, hint in HINTS:
-        for name in (prop, prop + "_color"):  # viser casts uint8 arrays only for names with "color"
+        # viser casts uint8 arrays only for names with "color": every uint8 prop's name has it, so try one without.
+        for name in (prop, prop + "_color", "points"):
             try:
                 expected: Any = ORIGINAL_CAST(viser_self, hint, value, name)
             except Exception as error:  # the same failure, of the same type
