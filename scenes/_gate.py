@@ -390,11 +390,22 @@ def decode_frame(raw: object) -> _messages.Message | None:
         return None
     if not isinstance(message, _ALLOWED_BY_NAME[kind]):
         return None
-    wrong = _misfit_field(message)
+    # Checked on the frame's own values as well as on the decoded message: viser's decoding turns some values
+    # into the declared type first (a camera's image_height True arrived as the int 1, a 1280×1 camera).
+    wrong = _misfit_raw_field(mapping, type(message)) or _misfit_field(message)
     if wrong:
         refusals.refuse(f"malformed {kind}", f"field {wrong!r} does not have its declared type")
         return None
     return message
+
+
+def _misfit_raw_field(mapping: dict[str, Any], kind: type) -> str:
+    """The first field of a decoded frame ``mapping`` whose raw value does not have the type message class
+    ``kind`` declares for it, or "" (fields the frame does not carry are left to the message's own decoding)."""
+    for name, hint in _field_hints(kind).items():
+        if name in mapping and not _fits(mapping[name], hint):
+            return name
+    return ""
 
 
 def _fits(value: object, hint: Any) -> bool:

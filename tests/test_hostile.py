@@ -323,7 +323,11 @@ def test_every_hostile_message_leaves_every_viewer_on_the_last_good_state(
                 for u, e in observer.gui.items()
                 if e["type"] in INPUT_TYPES or e["type"] == "GuiButtonMessage"
             }
-            camera_before = server.get_clients()[max(server.get_clients())].camera.image_height
+            # Every tab's camera, the attacker's too: its crafted cameras (a zero height) must not be applied.
+            cameras_before = {
+                cid: (c.camera.image_width, c.camera.image_height)
+                for cid, c in server.get_clients().items()
+            }
             caplog.clear()
 
             sent = hostile_barrage(attacker, server)
@@ -362,9 +366,10 @@ def test_every_hostile_message_leaves_every_viewer_on_the_last_good_state(
                 )
             for uuid, props in observer_props.items():
                 assert observer.gui[uuid]["props"] == props, uuid
-            assert (
-                server.get_clients()[max(server.get_clients())].camera.image_height == camera_before
-            )
+            assert {
+                cid: (c.camera.image_width, c.camera.image_height)
+                for cid, c in server.get_clients().items()
+            } == cameras_before
 
             # One line per kind of refusal, and no tracebacks anywhere.
             lines = refused_lines(caplog)
@@ -669,6 +674,41 @@ def test_an_orientation_is_four_finite_numbers_normalised_or_refused(q: Any) -> 
             math.isclose(u, c / norm, rel_tol=1e-9, abs_tol=1e-12)
             for u, c in zip(unit, q, strict=True)
         )
+
+
+@pytest.mark.parametrize("key", ["arm", "sdf"])  # the scenes with gizmos
+def test_a_valid_but_not_unit_orientation_reaches_every_viewer_normalised(
+    server: viser.ViserServer, key: str
+) -> None:
+    """(2, 0, 0, 0) and the like are valid rotations, so they are not refused, but no viewer may be left holding
+    them un-normalised: the sender's own copy included, every viewer ends on the server's unit quaternion."""
+    switcher = SceneSwitcher(server, key)
+    try:
+        with (
+            BrowserClient(server.get_port()) as sender,
+            BrowserClient(server.get_port()) as observer,
+        ):
+            label = SENTINELS[key][0]
+            sender.wait_for_gui(label)
+            observer.wait_for_gui(label)
+            sender.wait_for(lambda: len(server.get_clients()) == 2, what="both clients registered")
+            time.sleep(0.3)
+            assert gizmos(server.scene), "a scene with no gizmo has nothing to check here"
+            for name, gizmo in gizmos(server.scene).items():
+                position = tuple(float(v) for v in gizmo.position)
+                for wxyz in ((2.0, 0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 3.0), (0.3, 0.0, 0.4, 0.0)):
+                    sender.drag_transform(name, [position], wxyz=wxyz)
+                    for viewer in (sender, observer):
+                        viewer.wait_for(
+                            lambda v=viewer: shows_server_poses(v, server),
+                            what=f"{name} {wxyz}: the viewers converge",
+                        )
+                    norm = float(np.linalg.norm(np.asarray(gizmo.wxyz, dtype=np.float64)))
+                    assert abs(norm - 1.0) < 1e-9, (name, wxyz, gizmo.wxyz)
+                    _, shown = sender.pose_of(name)
+                    assert abs(float(np.linalg.norm(shown)) - 1.0) < 1e-9, (name, wxyz, shown)
+    finally:
+        switcher.close()
 
 
 def test_orientations_on_the_issue_list() -> None:
