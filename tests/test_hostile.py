@@ -719,3 +719,111 @@ def test_orientations_on_the_issue_list() -> None:
     assert unit_quaternion((1e308, 1e308, 0.0, 0.0)) == pytest.approx(
         (0.5**0.5, 0.5**0.5, 0.0, 0.0)
     )
+
+
+class _TabView:
+    """A tab's own GUI and scene APIs, in the shape the helpers above read from a server (``.gui``, ``.scene``)."""
+
+    def __init__(self, switcher: SceneSwitcher) -> None:
+        session: Any = switcher.server
+        self.gui = session.gui.api
+        self.scene = session.scene
+
+
+def _connect_tab(server: viser.ViserServer, sessions: Any) -> tuple[BrowserClient, SceneSwitcher]:
+    """A new tab, and the session built for it (per-tab mode)."""
+    known = set(server.get_clients())
+    client = BrowserClient(server.get_port())
+    client.wait_for(lambda: bool(set(server.get_clients()) - known), what="the client registered")
+    (client_id,) = set(server.get_clients()) - known
+    client.wait_for(lambda: sessions.switcher(client_id) is not None, what="its session built")
+    switcher = sessions.switcher(client_id)
+    assert switcher is not None
+    return client, switcher
+
+
+@pytest.mark.parametrize("key", list(SCENES))
+def test_every_hostile_message_leaves_each_tab_on_its_last_good_state(
+    server: viser.ViserServer,
+    key: str,
+    caplog: pytest.LogCaptureFixture,
+    capfd: pytest.CaptureFixture[str],
+) -> None:
+    """The default mode, a scene per tab: the same barrage at a tab's own controls and gizmos (looked up through
+    the tab's own registries), plus edits aimed at another tab's controls, which must not reach that tab."""
+    from app import serve_scenes
+
+    sessions = serve_scenes(server, key, shared=False)  # type: ignore[arg-type]  # a key of SCENES
+    try:
+        attacker, mine = _connect_tab(server, sessions)
+        other, theirs = _connect_tab(server, sessions)
+        with attacker, other:
+            label, good, field = SENTINELS[key]
+            attacker.wait_for_gui(label)
+            other.wait_for_gui(label)
+            time.sleep(0.3)  # the scenes' first callbacks settle
+            scene, their_scene = mine.scene, theirs.scene
+            assert scene is not their_scene
+            with scene._lock:
+                params_before = scene.params  # type: ignore[attr-defined]
+            with their_scene._lock:
+                their_params = their_scene.params  # type: ignore[attr-defined]
+            view = _TabView(mine)  # the attacker tab's own GUI and scene
+            values_before = server_values(view)  # type: ignore[arg-type]
+            poses_before = scene_poses(view)  # type: ignore[arg-type]
+            caplog.clear()
+
+            if key in ("arm", "sdf"):  # the tab's own gizmos are found, so the barrage reaches them
+                assert gizmos(view.scene)
+            assert gui_inputs(view.gui)
+            sent = hostile_barrage(attacker, view)  # type: ignore[arg-type]
+            # Another tab's controls are unknown to this one: edits aimed at them reach nothing.
+            for uuid, element in list(other.gui.items()):
+                if element["type"] in INPUT_TYPES:
+                    attacker.send(
+                        "GuiUpdateMessage", uuid=uuid, updates={"value": element["value"]}
+                    )
+                    attacker.send("GuiUpdateMessage", uuid=uuid, updates={"value": 1e308})
+                    sent += 2
+            assert sent > 100
+            attacker.set_value(label, good)
+            attacker.wait_for(
+                lambda: getattr(scene.params, field) == good,  # type: ignore[attr-defined]
+                timeout=60,
+                what=f"the honest {label} edit after {sent} hostile messages",
+            )
+            assert not attacker.closed_by_server
+            assert mine.scene is scene and theirs.scene is their_scene
+            with scene._lock:
+                assert scene.params == dataclass_replace(params_before, field, good)  # type: ignore[attr-defined]
+            with their_scene._lock:
+                assert their_scene.params == their_params  # type: ignore[attr-defined]
+            sentinel = attacker.uuid_of(label)
+            values_after = server_values(view)  # type: ignore[arg-type]
+            for uuid, value in values_before.items():
+                if uuid != sentinel:
+                    assert same_value(values_after[uuid], value), (uuid, value, values_after[uuid])
+            for name, (position, wxyz) in scene_poses(view).items():  # type: ignore[arg-type]
+                np.testing.assert_array_equal(position, poses_before[name][0], err_msg=name)
+                np.testing.assert_allclose(wxyz, poses_before[name][1], atol=1e-12, err_msg=name)
+            attacker.wait_for(
+                lambda: shows_server_values(attacker, view),  # type: ignore[arg-type]
+                what="the attacker's values converge",
+            )
+            attacker.wait_for(
+                lambda: shows_server_poses(attacker, view),  # type: ignore[arg-type]
+                what="the attacker's poses converge",
+            )
+            theirs_view = _TabView(theirs)
+            other.wait_for(
+                lambda: shows_server_values(other, theirs_view),  # type: ignore[arg-type]
+                what="the other tab still shows its own scene's values",
+            )
+            lines = refused_lines(caplog)
+            kinds = [refused_kind(r) for r in lines]
+            assert len(kinds) == len(set(kinds)), kinds
+            assert not [r for r in caplog.records if r.exc_info or r.levelno >= logging.ERROR]
+            out, err = capfd.readouterr()
+            assert "Traceback" not in out + err
+    finally:
+        sessions.close()

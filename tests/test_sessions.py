@@ -312,10 +312,17 @@ class AppProcess:
             self.process.wait(timeout=20)
 
 
+GL_REQUIRED = os.environ.get("CI", "").lower() in ("1", "true", "yes")
+"""Under CI=true Mesa's EGL is there: an SDF tab is up only once its reference is rendered, so the memory budgets
+below measure sessions that share the one GL context, never sessions that gave up on GL."""
+
+
 def reference_shown(tab: BrowserClient) -> bool:
-    """Whether the tab shows the SDF gallery's reference note after a render (or the reason there is none)."""
+    """Whether the tab shows the SDF gallery's reference note after a render (or, outside CI, the reason there is
+    none)."""
+    notes = (" px on ",) if GL_REQUIRED else (" px on ", "No reference image")
     return any(
-        isinstance(value, str) and (" px on " in value or "No reference image" in value)
+        isinstance(value, str) and any(note in value for note in notes)
         for element in tab.gui.values()
         for value in element["props"].values()
     )
@@ -486,5 +493,5 @@ def test_fifty_builds_and_closes_grow_rss_at_most_20_mib(
 def _fully_up(scene: object) -> bool:
     """Whether a scene has done the work its build starts (the SDF gallery renders a reference image or gives up)."""
     if isinstance(scene, SdfGalleryScene):
-        return scene.reference_serial >= 1 or scene.gl_error is not None
+        return scene.reference_serial >= 1 or (scene.gl_error is not None and not GL_REQUIRED)
     return True
