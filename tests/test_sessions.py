@@ -21,6 +21,7 @@ import weakref
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
+import numpy as np
 import pytest
 import viser
 from viser_private import gizmos, node_names
@@ -495,3 +496,58 @@ def _fully_up(scene: object) -> bool:
     if isinstance(scene, SdfGalleryScene):
         return scene.reference_serial >= 1 or (scene.gl_error is not None and not GL_REQUIRED)
     return True
+
+
+@pytest.mark.gl
+def test_each_tab_s_sdf_reference_is_rendered_from_that_tab_s_camera(
+    server: viser.ViserServer,
+) -> None:
+    """Per tab, the SDF gallery renders its reference from its own tab's camera: a landscape tab gets a landscape
+    image and a portrait tab a portrait one, and moving one tab's camera re-renders that tab's reference only."""
+    from conftest import skip_or_fail
+
+    from shaders import gl_service
+    from shaders.renderer import GLUnavailableError
+
+    try:
+        gl_service.run(lambda _renderer: None)
+    except GLUnavailableError as exc:
+        skip_or_fail(str(exc))
+    manager = serve_scenes(server, "sdf", shared=False)
+    assert isinstance(manager, Sessions)
+    try:
+        a, mine = connect(server, manager)
+        b, theirs = connect(server, manager)
+        with a, b:
+            a.send_camera(position=(2.3, -2.5, 1.7), look_at=(0.05, 0.0, 0.3), size=(600, 800))
+            b.send_camera(position=(-2.0, 2.6, 1.2), look_at=(0.0, 0.0, 0.3), size=(800, 600))
+            scene_a, scene_b = mine.scene, theirs.scene
+            assert isinstance(scene_a, SdfGalleryScene) and isinstance(scene_b, SdfGalleryScene)
+
+            def shape(scene: SdfGalleryScene) -> tuple[int, ...] | None:
+                rgb = scene.reference_rgb
+                return None if rgb is None else rgb.shape
+
+            def aspect_is(scene: SdfGalleryScene, height_over_width: float) -> bool:
+                s = shape(scene)
+                return s is not None and abs(s[0] / s[1] - height_over_width) < 0.02
+
+            a.wait_for(
+                lambda: aspect_is(scene_a, 600 / 800), timeout=120, what="A's landscape reference"
+            )
+            b.wait_for(
+                lambda: aspect_is(scene_b, 800 / 600), timeout=120, what="B's portrait reference"
+            )
+            first_b = scene_b.reference_rgb
+            serial_a = scene_a.reference_serial
+            serial_b = scene_b.reference_serial
+            b.send_camera(position=(0.0, -3.5, 0.4), look_at=(0.0, 0.0, 0.3), size=(800, 600))
+            b.wait_for(
+                lambda: scene_b.reference_serial > serial_b, timeout=60, what="B re-rendered"
+            )
+            assert scene_b.reference_rgb is not None and first_b is not None
+            assert not np.array_equal(scene_b.reference_rgb, first_b)
+            time.sleep(0.5)  # A's camera did not move: nothing re-renders A's reference
+            assert scene_a.reference_serial == serial_a
+    finally:
+        manager.close()
