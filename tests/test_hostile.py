@@ -8,6 +8,7 @@ good state, be logged once per kind (one line, no traceback), and keep the serve
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import logging
 import math
@@ -22,7 +23,7 @@ import viser
 from hypothesis import given
 from hypothesis import strategies as st
 from viser_private import control_state, gizmos, gui_inputs
-from wsclient import BrowserClient
+from wsclient import BrowserClient, connect_tab
 
 from scenes import SCENES, Scene
 from scenes._gate import (
@@ -292,6 +293,28 @@ def scene_poses(server: viser.ViserServer) -> dict[str, tuple[np.ndarray, np.nda
     }
 
 
+@contextlib.contextmanager
+def two_viewers(
+    server: viser.ViserServer, key: str
+) -> Iterator[tuple[SceneSwitcher, BrowserClient, BrowserClient]]:
+    """Scene ``key`` on ``server`` and two browsers showing it, both registered and past the scene's first
+    callbacks: the first sends, the second watches. The scene closes after the browsers."""
+    switcher = SceneSwitcher(server, key)
+    try:
+        with (
+            BrowserClient(server.get_port()) as first,
+            BrowserClient(server.get_port()) as second,
+        ):
+            label = SENTINELS[key][0]
+            first.wait_for_gui(label)
+            second.wait_for_gui(label)
+            first.wait_for(lambda: len(server.get_clients()) == 2, what="both clients registered")
+            time.sleep(0.3)  # the scene's first callbacks settle
+            yield switcher, first, second
+    finally:
+        switcher.close()
+
+
 @pytest.mark.parametrize("key", list(SCENES))
 def test_every_hostile_message_leaves_every_viewer_on_the_last_good_state(
     server: viser.ViserServer,
@@ -299,86 +322,69 @@ def test_every_hostile_message_leaves_every_viewer_on_the_last_good_state(
     caplog: pytest.LogCaptureFixture,
     capfd: pytest.CaptureFixture[str],
 ) -> None:
-    switcher = SceneSwitcher(server, key)
-    try:
-        with (
-            BrowserClient(server.get_port()) as attacker,
-            BrowserClient(server.get_port()) as observer,
-        ):
-            label, good, field = SENTINELS[key]
-            attacker.wait_for_gui(label)
-            observer.wait_for_gui(label)
-            attacker.wait_for(
-                lambda: len(server.get_clients()) == 2, what="both clients registered"
-            )
-            time.sleep(0.3)  # the scene's first callbacks settle
-            scene = switcher.scene
-            with scene._lock:
-                params_before = scene.params  # type: ignore[attr-defined]
-            values_before = server_values(server)
-            controls_before = {u: control_state(h) for u, h in gui_inputs(server.gui).items()}
-            poses_before = scene_poses(server)
-            observer_props = {
-                u: dict(e["props"])
-                for u, e in observer.gui.items()
-                if e["type"] in INPUT_TYPES or e["type"] == "GuiButtonMessage"
-            }
-            # Every tab's camera, the attacker's too: its crafted cameras (a zero height) must not be applied.
-            cameras_before = {
-                cid: (c.camera.image_width, c.camera.image_height)
-                for cid, c in server.get_clients().items()
-            }
-            caplog.clear()
+    label, good, field = SENTINELS[key]
+    with two_viewers(server, key) as (switcher, attacker, observer):
+        scene = switcher.scene
+        with scene._lock:
+            params_before = scene.params  # type: ignore[attr-defined]
+        values_before = server_values(server)
+        controls_before = {u: control_state(h) for u, h in gui_inputs(server.gui).items()}
+        poses_before = scene_poses(server)
+        observer_props = {
+            u: dict(e["props"])
+            for u, e in observer.gui.items()
+            if e["type"] in INPUT_TYPES or e["type"] == "GuiButtonMessage"
+        }
+        # Every tab's camera, the attacker's too: its crafted cameras (a zero height) must not be applied.
+        cameras_before = {
+            cid: (c.camera.image_width, c.camera.image_height)
+            for cid, c in server.get_clients().items()
+        }
+        caplog.clear()
 
-            sent = hostile_barrage(attacker, server)
-            assert sent > 100
-            attacker.set_value(label, good)
-            attacker.wait_for(
-                lambda: getattr(scene.params, field) == good,  # type: ignore[attr-defined]
-                timeout=60,
-                what=f"the honest {label} edit after {sent} hostile messages",
-            )
+        sent = hostile_barrage(attacker, server)
+        assert sent > 100
+        attacker.set_value(label, good)
+        attacker.wait_for(
+            lambda: getattr(scene.params, field) == good,  # type: ignore[attr-defined]
+            timeout=60,
+            what=f"the honest {label} edit after {sent} hostile messages",
+        )
 
-            # The server keeps serving the attacker too: its connection is still up and answered.
-            assert not attacker.closed_by_server
-            # The scene is the one it was, with only the honest edit applied.
-            assert switcher.scene is scene
-            with scene._lock:
-                assert scene.params == dataclass_replace(params_before, field, good)  # type: ignore[attr-defined]
-            sentinel = attacker.uuid_of(label)
-            values_after = server_values(server)
-            for uuid, value in values_before.items():
-                if uuid != sentinel:
-                    assert same_value(values_after[uuid], value), (uuid, value, values_after[uuid])
-            assert {
-                u: control_state(h) for u, h in gui_inputs(server.gui).items()
-            } == controls_before
-            for name, (position, wxyz) in scene_poses(server).items():
-                np.testing.assert_array_equal(position, poses_before[name][0], err_msg=name)
-                np.testing.assert_allclose(wxyz, poses_before[name][1], atol=1e-12, err_msg=name)
-            # Every viewer shows the server's values and poses; the observer saw no crafted props.
-            for viewer in (attacker, observer):
-                viewer.wait_for(
-                    lambda v=viewer: shows_server_values(v, server), what="values converge"
-                )
-                viewer.wait_for(
-                    lambda v=viewer: shows_server_poses(v, server), what="poses converge"
-                )
-            for uuid, props in observer_props.items():
-                assert observer.gui[uuid]["props"] == props, uuid
-            assert {
-                cid: (c.camera.image_width, c.camera.image_height)
-                for cid, c in server.get_clients().items()
-            } == cameras_before
+        # The server keeps serving the attacker too: its connection is still up and answered.
+        assert not attacker.closed_by_server
+        # The scene is the one it was, with only the honest edit applied.
+        assert switcher.scene is scene
+        with scene._lock:
+            assert scene.params == dataclass_replace(params_before, field, good)  # type: ignore[attr-defined]
+        sentinel = attacker.uuid_of(label)
+        values_after = server_values(server)
+        for uuid, value in values_before.items():
+            if uuid != sentinel:
+                assert same_value(values_after[uuid], value), (uuid, value, values_after[uuid])
+        assert {u: control_state(h) for u, h in gui_inputs(server.gui).items()} == controls_before
+        for name, (position, wxyz) in scene_poses(server).items():
+            np.testing.assert_array_equal(position, poses_before[name][0], err_msg=name)
+            np.testing.assert_allclose(wxyz, poses_before[name][1], atol=1e-12, err_msg=name)
+        # Every viewer shows the server's values and poses; the observer saw no crafted props.
+        for viewer in (attacker, observer):
+            viewer.wait_for(lambda v=viewer: shows_server_values(v, server), what="values converge")
+            viewer.wait_for(lambda v=viewer: shows_server_poses(v, server), what="poses converge")
+        for uuid, props in observer_props.items():
+            assert observer.gui[uuid]["props"] == props, uuid
+        assert {
+            cid: (c.camera.image_width, c.camera.image_height)
+            for cid, c in server.get_clients().items()
+        } == cameras_before
 
-            # One line per kind of refusal, and no tracebacks anywhere.
-            lines = refused_lines(caplog)
-            kinds = [refused_kind(r) for r in lines]
-            assert len(kinds) == len(set(kinds)), kinds
-            assert len(kinds) >= 10, kinds
-            assert not [r for r in caplog.records if r.exc_info or r.levelno >= logging.ERROR]
-            out, err = capfd.readouterr()
-            assert "Traceback" not in out + err
+        # One line per kind of refusal, and no tracebacks anywhere.
+        lines = refused_lines(caplog)
+        kinds = [refused_kind(r) for r in lines]
+        assert len(kinds) == len(set(kinds)), kinds
+        assert len(kinds) >= 10, kinds
+        assert not [r for r in caplog.records if r.exc_info or r.levelno >= logging.ERROR]
+        out, err = capfd.readouterr()
+        assert "Traceback" not in out + err
 
         # A new browser connects and drives the scene.
         with BrowserClient(server.get_port()) as late:
@@ -386,8 +392,6 @@ def test_every_hostile_message_leaves_every_viewer_on_the_last_good_state(
             late.wait_for(
                 lambda: same_value(late.value_of(label), good), what="the late tab's value"
             )
-    finally:
-        switcher.close()
 
 
 def dataclass_replace(params: Any, field: str, value: Any) -> Any:
@@ -401,48 +405,38 @@ def test_huge_numbers_clamp_to_the_range_the_scene_declared(
     server: viser.ViserServer, key: str
 ) -> None:
     """±1e308 are finite: every number control ends on the bound of its declared range, in every viewer."""
-    switcher = SceneSwitcher(server, key)
-    try:
-        with (
-            BrowserClient(server.get_port()) as attacker,
-            BrowserClient(server.get_port()) as observer,
-        ):
-            label = SENTINELS[key][0]
-            attacker.wait_for_gui(label)
-            observer.wait_for_gui(label)
-            handles = gui_inputs(server.gui)
-            numbers = {
-                uuid: control_spec(handles[uuid])
-                for uuid, e in attacker.gui.items()
-                if e["type"] in ("GuiSliderMessage", "GuiNumberMessage")
-            }
-            for huge in (1e308, -1e308):
-                for uuid in numbers:
-                    attacker.send("GuiUpdateMessage", uuid=uuid, updates={"value": huge})
-                for uuid, spec in numbers.items():
-                    bound = spec.hi if huge > 0 else spec.lo
-                    handle = handles[uuid]
-                    if bound is None:
-                        continue
-                    attacker.wait_for(
-                        lambda h=handle, b=bound: float(h.value) == b,  # type: ignore[attr-defined]
-                        timeout=60,
-                        what=f"{getattr(handle, 'label', uuid)} clamped to {bound}",
-                    )
-            for viewer in (attacker, observer):
-                viewer.wait_for(
-                    lambda v=viewer: shows_server_values(v, server),
+    with two_viewers(server, key) as (switcher, attacker, observer):
+        handles = gui_inputs(server.gui)
+        numbers = {
+            uuid: control_spec(handles[uuid])
+            for uuid, e in attacker.gui.items()
+            if e["type"] in ("GuiSliderMessage", "GuiNumberMessage")
+        }
+        for huge in (1e308, -1e308):
+            for uuid in numbers:
+                attacker.send("GuiUpdateMessage", uuid=uuid, updates={"value": huge})
+            for uuid, spec in numbers.items():
+                bound = spec.hi if huge > 0 else spec.lo
+                handle = handles[uuid]
+                if bound is None:
+                    continue
+                attacker.wait_for(
+                    lambda h=handle, b=bound: float(h.value) == b,  # type: ignore[attr-defined]
                     timeout=60,
-                    what="values converge",
+                    what=f"{getattr(handle, 'label', uuid)} clamped to {bound}",
                 )
-            scene = switcher.scene
-            with scene._lock:
-                for name in scene.params.__dataclass_fields__:  # type: ignore[attr-defined]
-                    value = getattr(scene.params, name)  # type: ignore[attr-defined]
-                    if isinstance(value, float):
-                        assert math.isfinite(value), name
-    finally:
-        switcher.close()
+        for viewer in (attacker, observer):
+            viewer.wait_for(
+                lambda v=viewer: shows_server_values(v, server),
+                timeout=60,
+                what="values converge",
+            )
+        scene = switcher.scene
+        with scene._lock:
+            for name in scene.params.__dataclass_fields__:  # type: ignore[attr-defined]
+                value = getattr(scene.params, name)  # type: ignore[attr-defined]
+                if isinstance(value, float):
+                    assert math.isfinite(value), name
 
 
 @pytest.mark.parametrize(
@@ -682,33 +676,21 @@ def test_a_valid_but_not_unit_orientation_reaches_every_viewer_normalised(
 ) -> None:
     """(2, 0, 0, 0) and the like are valid rotations, so they are not refused, but no viewer may be left holding
     them un-normalised: the sender's own copy included, every viewer ends on the server's unit quaternion."""
-    switcher = SceneSwitcher(server, key)
-    try:
-        with (
-            BrowserClient(server.get_port()) as sender,
-            BrowserClient(server.get_port()) as observer,
-        ):
-            label = SENTINELS[key][0]
-            sender.wait_for_gui(label)
-            observer.wait_for_gui(label)
-            sender.wait_for(lambda: len(server.get_clients()) == 2, what="both clients registered")
-            time.sleep(0.3)
-            assert gizmos(server.scene), "a scene with no gizmo has nothing to check here"
-            for name, gizmo in gizmos(server.scene).items():
-                position = tuple(float(v) for v in gizmo.position)
-                for wxyz in ((2.0, 0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 3.0), (0.3, 0.0, 0.4, 0.0)):
-                    sender.drag_transform(name, [position], wxyz=wxyz)
-                    for viewer in (sender, observer):
-                        viewer.wait_for(
-                            lambda v=viewer: shows_server_poses(v, server),
-                            what=f"{name} {wxyz}: the viewers converge",
-                        )
-                    norm = float(np.linalg.norm(np.asarray(gizmo.wxyz, dtype=np.float64)))
-                    assert abs(norm - 1.0) < 1e-9, (name, wxyz, gizmo.wxyz)
-                    _, shown = sender.pose_of(name)
-                    assert abs(float(np.linalg.norm(shown)) - 1.0) < 1e-9, (name, wxyz, shown)
-    finally:
-        switcher.close()
+    with two_viewers(server, key) as (_switcher, sender, observer):
+        assert gizmos(server.scene), "a scene with no gizmo has nothing to check here"
+        for name, gizmo in gizmos(server.scene).items():
+            position = tuple(float(v) for v in gizmo.position)
+            for wxyz in ((2.0, 0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 3.0), (0.3, 0.0, 0.4, 0.0)):
+                sender.drag_transform(name, [position], wxyz=wxyz)
+                for viewer in (sender, observer):
+                    viewer.wait_for(
+                        lambda v=viewer: shows_server_poses(v, server),
+                        what=f"{name} {wxyz}: the viewers converge",
+                    )
+                norm = float(np.linalg.norm(np.asarray(gizmo.wxyz, dtype=np.float64)))
+                assert abs(norm - 1.0) < 1e-9, (name, wxyz, gizmo.wxyz)
+                _, shown = sender.pose_of(name)
+                assert abs(float(np.linalg.norm(shown)) - 1.0) < 1e-9, (name, wxyz, shown)
 
 
 def test_orientations_on_the_issue_list() -> None:
@@ -730,18 +712,6 @@ class _TabView:
         self.scene = session.scene
 
 
-def _connect_tab(server: viser.ViserServer, sessions: Any) -> tuple[BrowserClient, SceneSwitcher]:
-    """A new tab, and the session built for it (per-tab mode)."""
-    known = set(server.get_clients())
-    client = BrowserClient(server.get_port())
-    client.wait_for(lambda: bool(set(server.get_clients()) - known), what="the client registered")
-    (client_id,) = set(server.get_clients()) - known
-    client.wait_for(lambda: sessions.switcher(client_id) is not None, what="its session built")
-    switcher = sessions.switcher(client_id)
-    assert switcher is not None
-    return client, switcher
-
-
 @pytest.mark.parametrize("key", list(SCENES))
 def test_every_hostile_message_leaves_each_tab_on_its_last_good_state(
     server: viser.ViserServer,
@@ -755,8 +725,8 @@ def test_every_hostile_message_leaves_each_tab_on_its_last_good_state(
 
     sessions = serve_scenes(server, key, shared=False)  # type: ignore[arg-type]  # a key of SCENES
     try:
-        attacker, mine = _connect_tab(server, sessions)
-        other, theirs = _connect_tab(server, sessions)
+        attacker, mine = connect_tab(server, sessions)
+        other, theirs = connect_tab(server, sessions)
         with attacker, other:
             label, good, field = SENTINELS[key]
             attacker.wait_for_gui(label)

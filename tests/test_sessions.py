@@ -25,7 +25,7 @@ import numpy as np
 import pytest
 import viser
 from viser_private import gizmos, node_names
-from wsclient import BrowserClient
+from wsclient import BrowserClient, connect_tab
 
 from app import serve_scenes
 from scenes import SCENES, Scene
@@ -48,23 +48,11 @@ def sessions(server: viser.ViserServer) -> Iterator[Sessions]:
         manager.close()
 
 
-def connect(server: viser.ViserServer, sessions: Sessions) -> tuple[BrowserClient, SceneSwitcher]:
-    """A new tab, and the session built for it."""
-    known = set(server.get_clients())
-    client = BrowserClient(server.get_port())
-    client.wait_for(lambda: bool(set(server.get_clients()) - known), what="the client registered")
-    (client_id,) = set(server.get_clients()) - known
-    client.wait_for(lambda: sessions.switcher(client_id) is not None, what="its session built")
-    switcher = sessions.switcher(client_id)
-    assert switcher is not None
-    return client, switcher
-
-
 def test_each_tab_switches_and_resets_only_its_own_scene(
     server: viser.ViserServer, sessions: Sessions
 ) -> None:
-    a, mine = connect(server, sessions)
-    b, theirs = connect(server, sessions)
+    a, mine = connect_tab(server, sessions)
+    b, theirs = connect_tab(server, sessions)
     with a, b:
         assert mine is not theirs
         b.wait_for_node("/peloton")
@@ -94,7 +82,7 @@ def test_the_gate_guards_a_tabs_own_controls_and_gizmos(
     server: viser.ViserServer, sessions: Sessions, caplog: pytest.LogCaptureFixture
 ) -> None:
     """Client-scoped handles go through the same gate: crafted fields, NaN, a bad quaternion, a 2-vector."""
-    a, mine = connect(server, sessions)
+    a, mine = connect_tab(server, sessions)
     with a:
         a.set_value("Scene", SCENES["arm"].title)
         a.wait_for(lambda: mine.scene.key == "arm", what="A shows the arm")
@@ -134,7 +122,7 @@ def test_the_gate_guards_a_tabs_own_controls_and_gizmos(
 def test_a_closed_tab_frees_its_session(server: viser.ViserServer, sessions: Sessions) -> None:
     refs = []
     for key in ("sdf", "arm"):
-        client, switcher = connect(server, sessions)
+        client, switcher = connect_tab(server, sessions)
         with client:
             client.set_value("Scene", SCENES[key].title)
             client.wait_for(
@@ -516,8 +504,8 @@ def test_each_tab_s_sdf_reference_is_rendered_from_that_tab_s_camera(
     manager = serve_scenes(server, "sdf", shared=False)
     assert isinstance(manager, Sessions)
     try:
-        a, mine = connect(server, manager)
-        b, theirs = connect(server, manager)
+        a, mine = connect_tab(server, manager)
+        b, theirs = connect_tab(server, manager)
         with a, b:
             a.send_camera(position=(2.3, -2.5, 1.7), look_at=(0.05, 0.0, 0.3), size=(600, 800))
             b.send_camera(position=(-2.0, 2.6, 1.2), look_at=(0.0, 0.0, 0.3), size=(800, 600))

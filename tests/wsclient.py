@@ -309,3 +309,15 @@ class BrowserClient:
             screen_pos=((0.5, 0.5),),
             modifier=None,
         )
+
+
+def connect_tab(server: Any, sessions: Any) -> tuple[BrowserClient, Any]:
+    """A new tab on ``server`` (per-tab mode), and the scene switcher ``sessions`` built for it."""
+    known = set(server.get_clients())
+    client = BrowserClient(server.get_port())
+    client.wait_for(lambda: bool(set(server.get_clients()) - known), what="the client registered")
+    (client_id,) = set(server.get_clients()) - known
+    client.wait_for(lambda: sessions.switcher(client_id) is not None, what="its session built")
+    switcher = sessions.switcher(client_id)
+    assert switcher is not None
+    return client, switcher
