@@ -55,6 +55,9 @@ MAX_FRAME_BYTES = 32 * 1024 * 1024
 """Larger frames are refused (the largest honest one is a canvas render sent back for ``get_render``)."""
 MAX_IMAGE_SIDE = 16384
 """Largest camera image side (pixels) a browser may report."""
+MAX_CAMERA_M = 1e6
+"""A camera's position, target and up vector stay within this many metres of the origin (every scene is a few
+tens of metres across; viser's orbit controls cannot reach 1000 km)."""
 MAX_TEXT_CHARS = 10_000
 MIB = 1024 * 1024
 MAX_UPLOAD_BYTES = 24 * MIB
@@ -300,33 +303,40 @@ def clean_value(spec: ControlSpec, value: object) -> tuple[bool, Any, str]:
             return False, None, "a value for a control a browser may not set"
 
 
-def _camera_fields(message: _messages.ViewerCameraMessage) -> dict[str, Any] | None:
+def _camera_fields(message: _messages.ViewerCameraMessage) -> tuple[dict[str, Any] | None, str]:
+    """(the camera's fields, cleaned, or None; the first field that is not a camera a browser can have, or "")."""
     wxyz = unit_quaternion(message.wxyz)
-    position = _finite_vector(message.position, 3)
-    look_at = _finite_vector(message.look_at, 3)
-    up = _finite_vector(message.up_direction, 3)
+    points = {
+        name: _finite_vector(getattr(message, name), 3)
+        for name in ("position", "look_at", "up_direction")
+    }
     fov, near, far = (_finite_number(v) for v in (message.fov, message.near, message.far))
-    sizes = (message.image_height, message.image_width)
-    if wxyz is None or position is None or look_at is None or up is None:
-        return None
-    if fov is None or near is None or far is None or not (0.0 < fov < math.pi and 0.0 < near < far):
-        return None
-    if (
-        not all(type(s) is int and 1 <= s <= MAX_IMAGE_SIDE for s in sizes)
-        or math.hypot(*up) == 0.0
-    ):
-        return None
+    sizes = {"image_height": message.image_height, "image_width": message.image_width}
+    if wxyz is None:
+        return None, "wxyz"
+    for name, point in points.items():
+        # Finite is not enough: a camera 1e308 m out overflows every distance the scenes take from it.
+        if point is None or max(abs(v) for v in point) > MAX_CAMERA_M:
+            return None, name
+    if fov is None or not (0.0 < fov < math.pi):
+        return None, "fov"
+    if near is None or far is None or not (0.0 < near < far):
+        return None, "near/far"
+    for name, side in sizes.items():
+        if not (type(side) is int and 1 <= side <= MAX_IMAGE_SIDE):
+            return None, name
+    up = points["up_direction"]
+    assert up is not None
+    if math.hypot(*up) == 0.0:
+        return None, "up_direction"
     return {
         "wxyz": wxyz,
-        "position": position,
-        "look_at": look_at,
-        "up_direction": up,
+        **points,
         "fov": fov,
         "near": near,
         "far": far,
-        "image_height": sizes[0],
-        "image_width": sizes[1],
-    }
+        **sizes,
+    }, ""
 
 
 def _ray(origin: object, direction: object) -> bool:
@@ -1078,13 +1088,13 @@ class Gate:
     def _clean_camera(
         self, server: viser.ViserServer, client_id: int, message: _messages.ViewerCameraMessage
     ) -> _messages.ViewerCameraMessage | None:
-        fields = _camera_fields(message)
+        fields, wrong = _camera_fields(message)
         if fields is not None:
             return _messages.ViewerCameraMessage(**fields)
         client = self._client(server, client_id)
         self.log.refuse(
-            "camera (non-finite, or an image size that is not a positive integer)",
-            f"image {message.image_height!r}x{message.image_width!r}",
+            "camera (non-finite, out of bounds, or an image size that is not a positive integer)",
+            f"{wrong} = {str(getattr(message, wrong.split('/')[0], ''))[:80]}",
         )
         if client is None:
             return None  # a first camera that is unusable: the client is not registered until a good one comes

@@ -209,6 +209,8 @@ def bad_cameras() -> list[dict[str, Any]]:
         {"wxyz": (1.0, 0.0, 0.0)},
         {"position": (NAN, 0.0, 0.0)},
         {"position": (INF, 0.0, 0.0)},
+        {"position": (1e308, 1e308, 1e308)},  # finite, but every distance from it overflows
+        {"look_at": (1e300, -1e300, 0.0)},
         {"look_at": "origin"},
         {"up_direction": (0.0, 0.0, 0.0)},
     ]
@@ -797,3 +799,39 @@ def test_every_hostile_message_leaves_each_tab_on_its_last_good_state(
             assert "Traceback" not in out + err
     finally:
         sessions.close()
+
+
+@pytest.mark.parametrize(
+    ("change", "field"),
+    [
+        ({"wxyz": (0.0, 0.0, 0.0, 0.0)}, "wxyz"),
+        ({"position": (1e308, 0.0, 0.0)}, "position"),
+        ({"position": (0.0, -1.1e6, 0.0)}, "position"),
+        ({"look_at": (1e300, -1e300, 0.0)}, "look_at"),
+        ({"up_direction": (0.0, 0.0, 1e7)}, "up_direction"),
+        ({"up_direction": (0.0, 0.0, 0.0)}, "up_direction"),
+        ({"fov": 0.0}, "fov"),
+        ({"near": 0.0}, "near/far"),
+        ({"far": 0.001}, "near/far"),
+        ({"image_height": 0}, "image_height"),
+        ({"image_width": 10**12}, "image_width"),
+    ],
+)
+def test_a_camera_out_of_bounds_is_refused_naming_its_field(
+    change: dict[str, Any], field: str
+) -> None:
+    """The refusal's log line names the field that was wrong (a fresh user found it quoting the valid image size
+    for a camera refused for its position), and a finite camera 1e308 m out is refused: every distance the
+    scenes take from it overflowed (numpy's RuntimeWarning in the log)."""
+    from viser import _messages as messages
+
+    from scenes._gate import MAX_CAMERA_M, _camera_fields
+
+    def camera(fields: dict[str, Any]) -> Any:
+        return messages.ViewerCameraMessage(**fields)
+
+    good = bad_cameras()[0] | {"image_height": 720}
+    fields, wrong = _camera_fields(camera(good))
+    assert fields is not None and wrong == ""
+    assert _camera_fields(camera(good | {"position": (MAX_CAMERA_M, 0.0, 1.0)}))[1] == ""
+    assert _camera_fields(camera(good | change)) == (None, field)
