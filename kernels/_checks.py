@@ -18,11 +18,14 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 __all__ = [
+    "bounded_array",
     "finite_array",
     "finite_number",
     "non_negative",
+    "non_negative_array",
     "points",
     "positive",
+    "positive_array",
     "vector",
 ]
 
@@ -70,6 +73,30 @@ def finite_array(name: str, value: ArrayLike) -> NDArray[np.float64]:
         raise ValueError(f"{name} must be an array of real numbers, got {value!r}") from error
     if not np.isfinite(array).all():
         raise ValueError(f"{name} must be finite, got {value!r}")
+    return array
+
+
+def bounded_array(name: str, value: ArrayLike, bound: float) -> NDArray[np.float64]:
+    """As :func:`finite_array`, and every magnitude ≤ ``bound``, so sums and differences of them stay finite."""
+    array = finite_array(name, value)
+    if not (np.abs(array) <= bound).all():
+        raise ValueError(f"{name} must be of magnitude ≤ {bound:g}, got {value!r}")
+    return array
+
+
+def positive_array(name: str, value: ArrayLike) -> NDArray[np.float64]:
+    """:func:`finite_array` with every element > 0, else ``ValueError`` naming it."""
+    array = finite_array(name, value)
+    if np.any(array <= 0.0):
+        raise ValueError(f"{name} must be > 0, got {value!r}")
+    return array
+
+
+def non_negative_array(name: str, value: ArrayLike) -> NDArray[np.float64]:
+    """:func:`finite_array` with every element ≥ 0, else ``ValueError`` naming it."""
+    array = finite_array(name, value)
+    if np.any(array < 0.0):
+        raise ValueError(f"{name} must be >= 0, got {value!r}")
     return array
 
 

@@ -48,7 +48,7 @@ import numba
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from kernels import cycling
+from kernels import _checks, cycling
 
 EARTH_RADIUS_M = 6_371_008.8
 """IUGG mean Earth radius (m), for haversine distances."""
@@ -126,6 +126,11 @@ def _smooth(
 def _checked_points(
     name: str, arrays: dict[str, ArrayLike], n_min: int = 2
 ) -> dict[str, NDArray[np.float64]]:
+    """(N,) arrays of one length, finite, n_min ≤ N ≤ MAX_POINTS; else ValueError.
+
+    Kept here rather than in :mod:`kernels._checks`: a route's messages say how many points are bad and where the
+    first is, prefixed with the course name, which :func:`load_gpx` rewrites into words about the file.
+    """
     out: dict[str, NDArray[np.float64]] = {}
     shape = None
     for key, value in arrays.items():
@@ -683,17 +688,21 @@ _REFINE_UP_TO = 64
 
 
 @numba.njit(cache=True)
-def _wheel_power(v, drag, force, wind, b0, b1):  # pragma: no cover - compiled
-    air = v + wind
-    return drag * air * abs(air) * v + force * v + b0 * v + b1 * v * v
+def _wheel_power(v, drag, rolling, climbing, wind, b0, b1):  # pragma: no cover - compiled
+    """P_wheel(v) (W): the sum of :func:`kernels.cycling.wheel_power_terms`, the one power law, compiled."""
+    aero, roll, bearings, climb = cycling.wheel_power_terms_compiled(
+        v, drag, rolling, climbing, wind, b0, b1
+    )
+    return aero + roll + bearings + climb
 
 
 @numba.njit(cache=True)
-def _step(v0, length, drag, force, wind, power_in, mass, b0, b1):  # pragma: no cover - compiled
+def _step(v0, length, drag, rolling, climbing, wind, power_in, mass, b0, b1):  # pragma: no cover
     """Mean speed v̄ ≥ v0/2 solving 2M(v̄ − v0)v̄² + L·(P_wheel(v̄) − P_in) = 0; −1 when none exists."""
+    force = rolling + climbing
     lo = 0.5 * v0
     q_lo = 2.0 * mass * (lo - v0) * lo * lo + length * (
-        _wheel_power(lo, drag, force, wind, b0, b1) - power_in
+        _wheel_power(lo, drag, rolling, climbing, wind, b0, b1) - power_in
     )
     if q_lo > 0.0:
         return -1.0
@@ -702,7 +711,7 @@ def _step(v0, length, drag, force, wind, power_in, mass, b0, b1):  # pragma: no 
     # Newton from v̄ = v0 (the answer for a short step), inside a bracket [lo, hi] that bisection falls back on.
     x = v0 if v0 > lo else 1.0
     q_x = 2.0 * mass * (x - v0) * x * x + length * (
-        _wheel_power(x, drag, force, wind, b0, b1) - power_in
+        _wheel_power(x, drag, rolling, climbing, wind, b0, b1) - power_in
     )
     if q_x > 0.0:
         hi = x
@@ -711,7 +720,7 @@ def _step(v0, length, drag, force, wind, power_in, mass, b0, b1):  # pragma: no 
         hi = 1.25 * x + 0.5
         for _ in range(80):
             q_hi = 2.0 * mass * (hi - v0) * hi * hi + length * (
-                _wheel_power(hi, drag, force, wind, b0, b1) - power_in
+                _wheel_power(hi, drag, rolling, climbing, wind, b0, b1) - power_in
             )
             if q_hi > 0.0:
                 break
@@ -720,7 +729,7 @@ def _step(v0, length, drag, force, wind, power_in, mass, b0, b1):  # pragma: no 
     for _ in range(100):
         air = x + wind
         q = 2.0 * mass * (x - v0) * x * x + length * (
-            _wheel_power(x, drag, force, wind, b0, b1) - power_in
+            _wheel_power(x, drag, rolling, climbing, wind, b0, b1) - power_in
         )
         if q <= 0.0:
             lo = x
@@ -765,7 +774,6 @@ def _ride_core(
     speed[0] = v0
     elapsed[0] = 0.0
     for i in range(length.shape[0]):
-        force = rolling[i] + climbing[i]
         # From rest v grows as s^(1/3) (v³ = 3ηP·s/M): cubically graded sub-steps follow it.
         graded = v0 == 0.0
         n_sub = 64 if graded else 1
@@ -784,7 +792,7 @@ def _ride_core(
                 else:
                     sub = length[i] / n_sub
                 p_in = efficiency * power_w[i]
-                vb = _step(v, sub, drag[i], force, wind[i], p_in, mass, b0, b1)
+                vb = _step(v, sub, drag[i], rolling[i], climbing[i], wind[i], p_in, mass, b0, b1)
                 if vb <= 0.0:
                     ok = False
                     break
@@ -802,17 +810,19 @@ def _ride_core(
                     vb = 0.5 * (v + v1)
                     need = (
                         2.0 * mass * (vb - v) * vb * vb
-                        + sub * _wheel_power(vb, drag[i], force, wind[i], b0, b1)
+                        + sub * _wheel_power(vb, drag[i], rolling[i], climbing[i], wind[i], b0, b1)
                     ) / sub
                     rider_in = min(max(need, 0.0), p_in)
                     brake += (rider_in - need) * sub / vb
                 dt = sub / vb
-                air = vb + wind[i]
+                p_aero, p_roll, p_bear, _ = cycling.wheel_power_terms_compiled(
+                    vb, drag[i], rolling[i], climbing[i], wind[i], b0, b1
+                )
                 dt_total += dt
                 work += rider_in / efficiency * dt
-                aero += drag[i] * air * abs(air) * sub
-                roll += rolling[i] * sub
-                bear += (b0 + b1 * vb) * sub
+                aero += p_aero * dt
+                roll += p_roll * dt
+                bear += p_bear * dt
                 v = max(v1, 0.0)
             if ok:
                 break
@@ -834,24 +844,6 @@ def _ride_core(
 
 
 _MIN_POWER_W, _MAX_POWER_W = 1.0, 5000.0
-
-
-def _positive_float(name: str, value: float) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
-        raise ValueError(f"{name} must be a number, got {value!r}")
-    number = float(value)
-    if not (math.isfinite(number) and number > 0.0):
-        raise ValueError(f"{name} must be finite and > 0, got {value!r}")
-    return number
-
-
-def _finite_float(name: str, value: float) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
-        raise ValueError(f"{name} must be a number, got {value!r}")
-    number = float(value)
-    if not math.isfinite(number):
-        raise ValueError(f"{name} must be finite, got {value!r}")
-    return number
 
 
 @dataclasses.dataclass(frozen=True)
@@ -879,9 +871,9 @@ def _segments(
         raise ValueError(f"rider must be a Rider, got {type(rider).__name__}")
     if not isinstance(air, Air):
         raise ValueError(f"air must be an Air, got {type(air).__name__}")
-    wind = _finite_float("wind_ms", wind_ms)
-    wind_from = math.radians(_finite_float("wind_from_deg", wind_from_deg))
-    theta = np.arctan(course.grade)
+    wind = _checks.finite_number("wind_ms", wind_ms)
+    wind_from = math.radians(_checks.finite_number("wind_from_deg", wind_from_deg))
+    rolling, climbing = cycling.road_forces(rider.mass_kg, rider.crr, course.grade)
     mid_elevation = 0.5 * (course.elevation_m[1:] + course.elevation_m[:-1])
     density = air.density(mid_elevation)
     drag_area = rider.cda_m2 + (rider.spoke_drag_m2 if rider.model == "martin" else 0.0)
@@ -889,8 +881,8 @@ def _segments(
     return _Segments(
         length=np.ascontiguousarray(course.length_m),
         drag=0.5 * density * drag_area,
-        rolling=rider.crr * rider.mass_kg * cycling.G * np.cos(theta),
-        climbing=rider.mass_kg * cycling.G * np.sin(theta),
+        rolling=rolling,
+        climbing=climbing,
         wind=wind * np.cos(wind_from - course.heading_rad),
         density=density,
         efficiency=float(rider.drivetrain_efficiency),
@@ -901,6 +893,7 @@ def _segments(
 
 
 def _segment_power(power_w: ArrayLike, n_segments: int) -> NDArray[np.float64]:
+    # Special to a ride: one number for the whole course or one per segment, so not a kernels._checks shape.
     try:
         power = np.asarray(power_w, dtype=np.float64)
     except (TypeError, ValueError) as error:
@@ -951,8 +944,8 @@ def _ride(
 
 
 def _speeds(max_speed_ms: float, start_speed_ms: float) -> tuple[float, float]:
-    cap = _positive_float("max_speed_ms", max_speed_ms)
-    start = _finite_float("start_speed_ms", start_speed_ms)
+    cap = _checks.positive("max_speed_ms", max_speed_ms)
+    start = _checks.finite_number("start_speed_ms", start_speed_ms)
     if start < 0.0 or start > cap:
         raise ValueError(f"start_speed_ms must be in [0, max_speed_ms], got {start_speed_ms!r}")
     return cap, start
@@ -1020,8 +1013,8 @@ def power_for_time(
         ValueError: an argument is invalid, or the time is out of reach (faster than 5000 W rides it, or slower
             than 1 W); the message says which.
     """
-    target = _positive_float("time_s", time_s)
-    tol = _positive_float("tolerance_s", tolerance_s)
+    target = _checks.positive("time_s", time_s)
+    tol = _checks.positive("tolerance_s", tolerance_s)
     s = _segments(course, rider, wind_ms, wind_from_deg, air)
     cap, start = _speeds(max_speed_ms, start_speed_ms)
     n = course.n_points - 1
@@ -1114,8 +1107,8 @@ def paced_ride(
     Raises:
         ValueError: an argument is invalid (the message names it).
     """
-    target = _positive_float("power_w", power_w)
-    g = _finite_float("gain", gain)
+    target = _checks.positive("power_w", power_w)
+    g = _checks.finite_number("gain", gain)
     if not 0.0 <= g <= 0.5:
         raise ValueError(f"gain must be in [0, 0.5], got {gain!r}")
     s = _segments(course, rider, wind_ms, wind_from_deg, air)

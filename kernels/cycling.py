@@ -37,8 +37,11 @@ from __future__ import annotations
 import dataclasses
 from typing import Literal
 
+import numba
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+
+from kernels import _checks
 
 G = 9.81
 """Gravitational acceleration (m/s²)."""
@@ -70,30 +73,10 @@ class Power:
     """Power at the pedals: (aero + rolling + climbing) / drivetrain efficiency (W); the plain sum when negative."""
 
 
-def _finite(name: str, value: ArrayLike) -> NDArray[np.float64]:
-    try:
-        array = np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError) as error:
-        raise ValueError(
-            f"{name} must be a number or an array of numbers, got {value!r}"
-        ) from error
-    if not np.all(np.isfinite(array)):
-        raise ValueError(f"{name} must be finite, got {value!r}")
-    return array
-
-
-def _positive(name: str, value: ArrayLike) -> NDArray[np.float64]:
-    array = _finite(name, value)
-    if np.any(array <= 0.0):
-        raise ValueError(f"{name} must be > 0, got {value!r}")
-    return array
-
-
-def _non_negative(name: str, value: ArrayLike) -> NDArray[np.float64]:
-    array = _finite(name, value)
-    if np.any(array < 0.0):
-        raise ValueError(f"{name} must be >= 0, got {value!r}")
-    return array
+# Every function here broadcasts, so its arguments are arrays of any shape: the array checks of kernels._checks.
+_finite = _checks.finite_array
+_positive = _checks.positive_array
+_non_negative = _checks.non_negative_array
 
 
 def _efficiency(value: ArrayLike) -> NDArray[np.float64]:
@@ -155,9 +138,43 @@ def drag_reduction(
     return reduction
 
 
-def _road(grade: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+# --------------------------------------------------------------------------------------------- the power law
+def wheel_power_terms(v, drag, rolling_force, climbing_force, wind, b0, b1):
+    """The cyclist power law, its one implementation: the power the rear wheel delivers, term by term (W).
+
+    Returns ``(aero, rolling, bearings, climbing)`` at ground speed ``v`` (m/s, ≥ 0)::
+
+        aero     = drag·(v + wind)·|v + wind|·v      drag = ½ρ·CdA (kg/m), wind = headwind (m/s)
+        rolling  = rolling_force·v                   rolling_force = Crr·m·g·cos θ (N)
+        bearings = b0·v + b1·v²                      wheel bearings (W); 0, 0 in the seed's model
+        climbing = climbing_force·v                  climbing_force = m·g·sin θ (N)
+
+    Martin et al. (1998), J. Appl. Biomech. 14:276–291, eq. 9 without its kinetic term (the ride loop of
+    :mod:`kernels.course` integrates that one); their sum over the drivetrain efficiency is the pedal power.
+    Inputs are trusted (checked by the callers) and broadcast; see :func:`road_forces` for the forces.
+
+    Written with arithmetic and ``abs`` only, so one source runs on numpy arrays (in :func:`power` and
+    :func:`martin_power`) and, compiled as :data:`wheel_power_terms_compiled`, on floats inside
+    :mod:`kernels.course`'s compiled ride loop.
+    """
+    air = v + wind
+    return drag * air * abs(air) * v, rolling_force * v, b0 * v + b1 * v * v, climbing_force * v
+
+
+wheel_power_terms_compiled = numba.njit(cache=True, inline="always")(wheel_power_terms)
+"""The very same :func:`wheel_power_terms`, compiled by numba for scalar calls from compiled loops."""
+
+
+def road_forces(
+    mass_kg: ArrayLike, crr: ArrayLike, grade: ArrayLike
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Rolling and climbing forces along the road (N): Crr·m·g·cos θ and m·g·sin θ, with θ = atan(grade).
+
+    Inputs are trusted (checked by the caller: mass > 0, Crr ≥ 0, grade finite); outputs broadcast.
+    """
     theta = np.arctan(grade)
-    return np.cos(theta), np.sin(theta)
+    mass = np.asarray(mass_kg, dtype=np.float64)
+    return np.asarray(crr, dtype=np.float64) * mass * G * np.cos(theta), mass * G * np.sin(theta)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -183,12 +200,13 @@ def _resistance(
     headwind_ms: ArrayLike,
     drivetrain_efficiency: ArrayLike,
 ) -> _Resistance:
-    mass = _positive("mass_kg", mass_kg)
-    cos_theta, sin_theta = _road(_finite("grade", grade))
+    rolling_force, climbing_force = road_forces(
+        _positive("mass_kg", mass_kg), _non_negative("crr", crr), _finite("grade", grade)
+    )
     return _Resistance(
         drag=0.5 * air_density(altitude_m) * _positive("cda_m2", cda_m2),
-        rolling_force=_non_negative("crr", crr) * mass * G * cos_theta,
-        climbing_force=mass * G * sin_theta,
+        rolling_force=rolling_force,
+        climbing_force=climbing_force,
         wind=_finite("headwind_ms", headwind_ms),
         efficiency=_efficiency(drivetrain_efficiency),
     )
@@ -222,10 +240,9 @@ def power(
     v = _non_negative("speed_ms", speed_ms)
     r = _resistance(cda_m2, mass_kg, crr, grade, altitude_m, headwind_ms, drivetrain_efficiency)
 
-    air_speed = v + r.wind
-    aero = r.drag * air_speed * np.abs(air_speed) * v
-    rolling = r.rolling_force * v
-    climbing = r.climbing_force * v
+    aero, rolling, _, climbing = wheel_power_terms(
+        v, r.drag, r.rolling_force, r.climbing_force, r.wind, 0.0, 0.0
+    )
     aero, rolling, climbing, efficiency = np.broadcast_arrays(aero, rolling, climbing, r.efficiency)
     wheel = aero + rolling + climbing
     # The drivetrain loses a share of what the rider puts in; when the wheel needs no power (a descent),
@@ -694,19 +711,19 @@ def martin_power(
     """
     v = _non_negative("speed_ms", speed_ms)
     mass = _positive("mass_kg", mass_kg)
-    cos_theta, sin_theta = _road(_finite("grade", grade))
+    slope = _finite("grade", grade)
     rho = _positive("air_density", air_density)
     drag_area = _positive("cda_m2", cda_m2) + _non_negative("spoke_drag_m2", spoke_drag_m2)
-    air_speed = v + _finite("headwind_ms", headwind_ms)
+    wind = _finite("headwind_ms", headwind_ms)
     inertia = _non_negative("wheel_inertia_kgm2", wheel_inertia_kgm2)
     radius = _positive("wheel_radius_m", wheel_radius_m)
     acceleration = _finite("acceleration_ms2", acceleration_ms2)
     efficiency = _efficiency(drivetrain_efficiency)
 
-    aero = 0.5 * rho * drag_area * air_speed * np.abs(air_speed) * v
-    rolling = _non_negative("crr", crr) * mass * G * cos_theta * v
-    bearings = v * (MARTIN_BEARING_W[0] + MARTIN_BEARING_W[1] * v)
-    climbing = mass * G * sin_theta * v
+    rolling_force, climbing_force = road_forces(mass, _non_negative("crr", crr), slope)
+    aero, rolling, bearings, climbing = wheel_power_terms(
+        v, 0.5 * rho * drag_area, rolling_force, climbing_force, wind, *MARTIN_BEARING_W
+    )
     kinetic = (mass + inertia / radius**2) * acceleration * v
     aero, rolling, bearings, climbing, kinetic, efficiency = np.broadcast_arrays(
         aero, rolling, bearings, climbing, kinetic, efficiency

@@ -124,6 +124,54 @@ def test_a_steady_climb_settles_at_the_steady_climbing_speed() -> None:
     )  # density changes a little along the climb
 
 
+def martin_1998_pedal_power(
+    v: np.ndarray, rho: np.ndarray, grade: np.ndarray, headwind: np.ndarray, rider: Rider
+) -> np.ndarray:
+    """Independent reference: P = (½ρ·CdA·v_air²·v + Crr·m·g·cos θ·v + m·g·sin θ·v [+ bearings]) / η.
+
+    Martin et al. 1998 (J. Appl. Biomech. 14:276), eq. 9 at steady speed; v_air² signed, (v + w)|v + w|; the
+    Martin model adds the spokes' drag area and the bearings' v·(91 + 8.7·v)·10⁻³ W."""
+    theta = np.arctan(grade)
+    cda = rider.cda_m2 + (rider.spoke_drag_m2 if rider.model == "martin" else 0.0)
+    bearings = v * (0.091 + 0.0087 * v) if rider.model == "martin" else 0.0
+    air = v + headwind
+    wheel = (
+        0.5 * rho * cda * air * np.abs(air) * v
+        + rider.crr * rider.mass_kg * 9.81 * np.cos(theta) * v
+        + rider.mass_kg * 9.81 * np.sin(theta) * v
+        + bearings
+    )
+    return wheel / rider.drivetrain_efficiency
+
+
+@pytest.mark.parametrize("rider", [SEED, MARTIN], ids=["seed", "martin"])
+def test_per_point_power_is_the_cycling_law(rider: Rider) -> None:
+    """Each segment's power, less the kinetic energy it stored, is cycling's law at the segment's mean speed."""
+    s = np.arange(0.0, 3000.0 + 5, 10.0)
+    grade = np.where(s < 1500.0, 0.04, -0.02)
+    c = course.course_from_xy(
+        s, np.zeros_like(s), np.concatenate(([0.0], np.cumsum(np.diff(s) * grade[:-1])))
+    )
+    r = course.ride(c, 280.0, rider, wind_ms=4.0, wind_from_deg=60.0, start_speed_ms=7.0)
+    mean = 0.5 * (r.speed_ms[1:] + r.speed_ms[:-1])
+    # The ride's step: ½M(v₁² − v₀²) = L·(η·P − P_wheel(v̄))/v̄, so P_wheel(v̄)/η is what the pedals left after
+    # the kinetic energy.
+    kinetic = 0.5 * rider.effective_mass_kg * np.diff(r.speed_ms**2) * mean / c.length_m
+    eta = rider.drivetrain_efficiency
+    law = (eta * r.power_w[:-1] - kinetic) / eta
+    assert np.all(r.brakes_j == 0.0)
+    reference = martin_1998_pedal_power(mean, r.air_density, c.grade, r.headwind_ms, rider)
+    np.testing.assert_allclose(law, reference, rtol=1e-9)
+    altitude = 0.5 * (c.elevation_m[1:] + c.elevation_m[:-1])
+    if rider.model == "seed":
+        kernel = cycling.power(mean, rider.cda_m2, rider.mass_kg, rider.crr, c.grade, altitude,
+                               r.headwind_ms, eta).total  # fmt: skip
+    else:
+        kernel = cycling.martin_power(mean, rider.cda_m2, rider.mass_kg, rider.crr, c.grade, r.headwind_ms,
+                                      r.air_density, eta).total  # fmt: skip
+    np.testing.assert_allclose(law, kernel, rtol=1e-9)
+
+
 # ------------------------------------------------------------------------------------------------ energy
 def loop_course(n: int = 2000, radius: float = 800.0) -> course.Course:
     theta = np.linspace(0.0, 2 * np.pi, n + 1)
