@@ -53,30 +53,8 @@ BOX_M = 1.5
 BOX_LO: tuple[float, float, float] = (-BOX_M, -BOX_M, -BOX_M)
 BOX_HI: tuple[float, float, float] = (BOX_M, BOX_M, BOX_M)
 SIZE_RANGE_M = (0.05, 1.0)
-KIND_LABELS: dict[str, sdf.PrimitiveKind] = {
-    "Sphere": "sphere",
-    "Box": "box",
-    "Torus": "torus",
-    "Capsule": "capsule",
-    "Cylinder": "cylinder",
-    "Round box": "round_box",
-    "Octahedron": "octahedron",
-    "Cone": "cone",
-    "Hexagonal prism": "hex_prism",
-    "Ellipsoid (bound)": "ellipsoid",
-}
-SIZES_USED: dict[sdf.PrimitiveKind, int] = {
-    "sphere": 1,
-    "box": 3,
-    "torus": 2,
-    "capsule": 2,
-    "cylinder": 2,
-    "round_box": 3,
-    "octahedron": 1,
-    "cone": 2,
-    "hex_prism": 2,
-    "ellipsoid": 3,
-}
+KIND_LABELS: dict[str, sdf.PrimitiveKind] = {s.label: s.kind for s in sdf.PRIMITIVES.values()}
+SIZES_USED: dict[sdf.PrimitiveKind, int] = {s.kind: s.size_count for s in sdf.PRIMITIVES.values()}
 """How many of the sliders a, b, c each kind reads."""
 OP_LABELS: dict[str, sdf.BooleanOp] = {
     "Union": "union",

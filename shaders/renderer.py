@@ -4,9 +4,9 @@ It uses moderngl's standalone context on EGL: Mesa llvmpipe on a machine without
 Programs are compiled once per :class:`Renderer`; the scene reaches ``sdf.glsl`` as uniforms, so moving or changing
 a primitive never recompiles anything.
 
-Camera model: a pinhole at ``position`` looking at ``look_at`` with ``up`` and a vertical field of view. Pixel
-``(row, col)`` (row 0 at the top) looks along ``forward + x·tan(fov/2)·aspect·right + y·tan(fov/2)·up`` with
-``x = 2(col + ½)/W − 1`` and ``y = 1 − 2(row + ½)/H``; :func:`camera_rays` gives the same rays in numpy. Depth is
+The camera is :mod:`shaders.camera`'s pinhole (:func:`camera_rays` gives its rays in numpy); the editor's sources
+are checked by :mod:`shaders.glsl_sandbox`; ``sdf.glsl`` is completed from the kernel's primitive registry by
+:mod:`shaders.glsl_library`. These names are re-exported here for callers of this module. Depth is
 the distance along the view axis (m), ``inf`` where nothing is hit; the rasterised mesh uses the same convention,
 so the two images compare pixel for pixel.
 
@@ -17,173 +17,64 @@ module-level :func:`render` keeps one per thread).
 from __future__ import annotations
 
 import collections
-import dataclasses
 import math
-import re
 import threading
-from pathlib import Path
 
 import numpy as np
 import trimesh
 from numpy.typing import ArrayLike, NDArray
 
 from kernels import sdf
+from shaders.camera import Camera, Shading, camera_rays, check_image_size, screen_rectangle
+from shaders.glsl_library import SHADER_DIR, read_source, sdf_library, with_defines
+from shaders.glsl_sandbox import (
+    DEFAULT_COLOR_GLSL,
+    MAX_INLINED_TOKENS,
+    MAX_SOURCE_CHARS,
+    ShaderCompileError,
+    check_field_bounds,
+    check_source,
+    examples,
+    inlined_sizes,
+    user_glsl,
+)
 
-KIND_CODE: dict[str, int] = {
-    "sphere": 0,
-    "box": 1,
-    "torus": 2,
-    "capsule": 3,
-    "cylinder": 4,
-    "round_box": 5,
-    "octahedron": 6,
-    "cone": 7,
-    "hex_prism": 8,
-    "ellipsoid": 9,
-}
-BASIC_KINDS = frozenset({"sphere", "box", "torus", "capsule"})
-"""Kinds the fast single-formula path of sdf.glsl's primitive_distance handles; others need EXTRA_KINDS."""
+__all__ = [
+    "BLEND_CODE",
+    "DEFAULT_COLOR_GLSL",
+    "MAX_INLINED_TOKENS",
+    "MAX_SOURCE_CHARS",
+    "OP_CODE",
+    "SHADER_DIR",
+    "Camera",
+    "GLUnavailableError",
+    "Renderer",
+    "ShaderCompileError",
+    "Shading",
+    "camera_rays",
+    "check_source",
+    "create_context",
+    "examples",
+    "inlined_sizes",
+    "mesh_glsl",
+    "render",
+    "renderer",
+    "user_glsl",
+]
+
 OP_CODE: dict[str, int] = {"union": 0, "subtract": 1, "intersect": 2}
 BLEND_CODE: dict[str, int] = {"poly": 0, "exp": 1}
 _MISS = -1.0
 """Depth the shaders write where no surface is hit; read back as inf."""
 _PROBE_WIDTH = 256
+_FIELD_CACHE = 12
+"""Editor programs kept compiled (a few sources × their variants)."""
+_MAX_ROWS = 8192
+"""Rows of one grid-sampling draw (GL_MAX_TEXTURE_SIZE is at least this on every driver we meet)."""
 
 
 class GLUnavailableError(RuntimeError):
     """No OpenGL 3.3 context could be created; the mesh side of the app keeps working without one."""
-
-
-@dataclasses.dataclass(frozen=True)
-class Camera:
-    """A pinhole camera in the world frame (Z up)."""
-
-    position: tuple[float, float, float]
-    """Eye position (m)."""
-    look_at: tuple[float, float, float]
-    """Point the view axis passes through (m)."""
-    up: tuple[float, float, float] = (0.0, 0.0, 1.0)
-    """Approximate up direction; made orthogonal to the view axis."""
-    fov_y_rad: float = math.radians(50.0)
-    """Vertical field of view (rad), in (0, π)."""
-
-    def __post_init__(self) -> None:
-        eye, target, up = (
-            np.asarray(v, dtype=np.float64) for v in (self.position, self.look_at, self.up)
-        )
-        for name, v in (("position", eye), ("look_at", target), ("up", up)):
-            if v.shape != (3,) or not np.all(np.isfinite(v)):
-                raise ValueError(f"{name} must be 3 finite numbers, got {v.tolist()}")
-        forward = target - eye
-        if np.linalg.norm(forward) < 1e-9:
-            raise ValueError("look_at must differ from position")
-        if np.linalg.norm(np.cross(forward, up)) < 1e-9 * np.linalg.norm(forward) * max(
-            np.linalg.norm(up), 1e-30
-        ):
-            raise ValueError("up must not be parallel to the view axis")
-        if not (math.isfinite(self.fov_y_rad) and 0.0 < self.fov_y_rad < math.pi):
-            raise ValueError(f"fov_y_rad must be in (0, π), got {self.fov_y_rad}")
-
-    def basis(self) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
-        """Unit (forward, right, up) vectors of the image."""
-        forward = np.subtract(self.look_at, self.position).astype(np.float64)
-        forward /= np.linalg.norm(forward)
-        right = np.cross(forward, self.up)
-        right /= np.linalg.norm(right)
-        return forward, right, np.cross(right, forward)
-
-    def view_projection(self, aspect: float, near: float, far: float) -> NDArray[np.float64]:
-        """(4, 4) OpenGL clip-from-world matrix for this camera."""
-        forward, right, up = self.basis()
-        eye = np.asarray(self.position, dtype=np.float64)
-        view = np.eye(4)
-        view[0, :3], view[1, :3], view[2, :3] = right, up, -forward
-        view[:3, 3] = -view[:3, :3] @ eye
-        f = 1.0 / math.tan(self.fov_y_rad / 2)
-        proj = np.zeros((4, 4))
-        proj[0, 0], proj[1, 1] = f / aspect, f
-        proj[2, 2], proj[2, 3] = (far + near) / (near - far), 2 * far * near / (near - far)
-        proj[3, 2] = -1.0
-        return proj @ view
-
-
-@dataclasses.dataclass(frozen=True)
-class Shading:
-    """Lighting and marching parameters of the reference image; defaults are the gallery's opening values."""
-
-    ambient: float = 0.2
-    """k_a, ambient reflection."""
-    diffuse: float = 0.75
-    """k_d, diffuse reflection."""
-    specular: float = 0.3
-    """k_s, specular reflection."""
-    shininess: float = 32.0
-    """α, Phong exponent."""
-    light_direction: tuple[float, float, float] = (0.45, -0.35, 0.82)
-    """Direction toward the light (world), normalised on use."""
-    shadows: bool = True
-    """Soft shadows (Quilez's improved technique)."""
-    shadow_sharpness: float = 8.0
-    """k of the soft shadow: penumbra width ∝ 1/k."""
-    occlusion: bool = True
-    """Ambient occlusion along the normal."""
-    occlusion_strength: float = 3.0
-    """How strongly occluded samples darken the ambient term."""
-    occlusion_step: float = 0.04
-    """Distance between the five AO samples (m)."""
-    background: tuple[float, float, float] = (0.93, 0.94, 0.96)
-    """Linear RGB where no surface is hit."""
-    max_steps: int = 256
-    """Sphere-tracing steps before a ray counts as a miss."""
-    hit_epsilon: float = 1e-4
-    """Hit threshold (m at t ≤ 1, relative beyond)."""
-    max_distance: float = 100.0
-    """Rays longer than this miss (m)."""
-    normal_epsilon: float = 1e-3
-    """Central-difference step for normals (m)."""
-
-    def __post_init__(self) -> None:
-        for name in ("ambient", "diffuse", "specular", "occlusion_strength"):
-            value = getattr(self, name)
-            if not (math.isfinite(value) and 0.0 <= value <= 10.0):
-                raise ValueError(f"{name} must be in [0, 10], got {value}")
-        for name in (
-            "shininess",
-            "shadow_sharpness",
-            "occlusion_step",
-            "hit_epsilon",
-            "max_distance",
-        ):
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value > 0.0):
-                raise ValueError(f"{name} must be finite and positive, got {value}")
-        if not (math.isfinite(self.normal_epsilon) and self.normal_epsilon > 0.0):
-            raise ValueError(
-                f"normal_epsilon must be finite and positive, got {self.normal_epsilon}"
-            )
-        light = np.asarray(self.light_direction, dtype=np.float64)
-        if light.shape != (3,) or not np.all(np.isfinite(light)) or np.linalg.norm(light) < 1e-9:
-            raise ValueError(
-                f"light_direction must be a finite non-zero 3-vector, got {light.tolist()}"
-            )
-        if not 1 <= self.max_steps <= 4096:
-            raise ValueError(f"max_steps must be in 1..4096, got {self.max_steps}")
-
-
-def camera_rays(
-    camera: Camera, width: int, height: int
-) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """The renderer's rays in numpy: origins and unit directions, (H·W, 3) each, row-major from the top row."""
-    _check_size(width, height)
-    forward, right, up = camera.basis()
-    tan_half = math.tan(camera.fov_y_rad / 2)
-    x = (2 * (np.arange(width) + 0.5) / width - 1) * tan_half * width / height
-    y = (1 - 2 * (np.arange(height) + 0.5) / height) * tan_half
-    dirs = forward + x[None, :, None] * right + y[:, None, None] * up
-    dirs = dirs.reshape(-1, 3)
-    dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
-    origins = np.broadcast_to(np.asarray(camera.position, dtype=np.float64), dirs.shape).copy()
-    return origins, dirs
 
 
 def _bounding_boxes(
@@ -199,27 +90,7 @@ def _bounding_boxes(
     :func:`kernels.sdf.scene_bounding_spheres` grow by k, the same bound with slack.) A flat torus's box is far
     thinner than its sphere, so fewer rays march beside the shape and miss.
     """
-    half = np.zeros((len(scene.primitives), 3))
-    for i, prim in enumerate(scene.primitives):
-        s = prim.size
-        match prim.kind:
-            case "sphere":
-                half[i] = (s[0], s[0], s[0])
-            case "box":
-                half[i] = s[:3]
-            case "torus":
-                half[i] = (s[0] + s[1], s[1], s[0] + s[1])
-            case "capsule":
-                half[i] = (s[1], s[0] + s[1], s[1])
-            case "cylinder" | "cone":
-                radius, half_height = (s[1], s[0]) if prim.kind == "cylinder" else (s[0], s[1] / 2)
-                half[i] = (radius, half_height, radius)
-            case "round_box" | "ellipsoid":
-                half[i] = s[:3]
-            case "octahedron":
-                half[i] = (s[0], s[0], s[0])
-            case "hex_prism":
-                half[i] = (2 * s[0] / math.sqrt(3.0), s[0], s[1])
+    half = np.array([sdf.primitive_spec(p.kind).half_extents(p.size) for p in scene.primitives])
     centers = np.array([p.center for p in scene.primitives], dtype=np.float64)
     rotations = np.array([sdf.rotation_matrix(p.rotation) for p in scene.primitives])
     unions = sum(prim.op == "union" for prim in scene.primitives[1:])
@@ -241,214 +112,13 @@ def _bounds_scissor(
     corners = (
         centers[:, None, :] + np.einsum("pij,pcj->pci", rotations, half[:, None, :] * unit[None])
     ).reshape(-1, 3)
-    forward, right, up = camera.basis()
-    rel = corners - np.asarray(camera.position)
-    z = rel @ forward
-    if np.all(z <= 0.0):
-        return (0, 0, 0, 0)  # wholly behind the eye: nothing to draw
-    if np.any(z < 1e-3):
-        return (0, 0, width, height)
-    tan_half = math.tan(camera.fov_y_rad / 2)
-    x_ndc = (rel @ right) / (z * tan_half * width / height)
-    y_ndc = (rel @ up) / (z * tan_half)
-    x0 = int(np.clip(math.floor((x_ndc.min() + 1) / 2 * width) - 1, 0, width))
-    x1 = int(np.clip(math.ceil((x_ndc.max() + 1) / 2 * width) + 1, 0, width))
-    y0 = int(np.clip(math.floor((y_ndc.min() + 1) / 2 * height) - 1, 0, height))
-    y1 = int(np.clip(math.ceil((y_ndc.max() + 1) / 2 * height) + 1, 0, height))
-    return (x0, y0, max(x1 - x0, 0), max(y1 - y0, 0))
+    return screen_rectangle(camera, corners, width, height)
 
 
 def _background_levels(shading: Shading) -> tuple[int, int, int]:
     """The background colour in 8-bit levels, as the images hold it."""
     red, green, blue = (int(np.clip(round(c * 255), 0, 255)) for c in shading.background)
     return red, green, blue
-
-
-def _check_size(width: int, height: int) -> None:
-    for name, value in (("width", width), ("height", height)):
-        if (
-            isinstance(value, bool)
-            or not isinstance(value, (int, np.integer))
-            or not 1 <= value <= 8192
-        ):
-            raise ValueError(f"{name} must be an integer in 1..8192, got {value!r}")
-
-
-SHADER_DIR = Path(__file__).resolve().parent
-"""Where the GLSL files live (installed as package data next to this module)."""
-
-
-def _source(name: str) -> str:
-    return (SHADER_DIR / name).read_text(encoding="utf-8")
-
-
-def _with_defines(source: str, **defines: int) -> str:
-    """``source`` with ``#define NAME value`` lines after its ``#version`` line."""
-    version, rest = source.split("\n", 1)
-    assert version.startswith("#version")
-    return "\n".join([version, *(f"#define {k} {v}" for k, v in defines.items()), rest])
-
-
-# ------------------------------------------------------------------------------------------ the editor's source
-MAX_SOURCE_CHARS = 8000
-"""Longest editor source accepted (characters)."""
-_FIELD_CACHE = 12
-"""Editor programs kept compiled (a few sources × their variants)."""
-_MAX_ROWS = 8192
-"""Rows of one grid-sampling draw (GL_MAX_TEXTURE_SIZE is at least this on every driver we meet)."""
-DEFAULT_COLOR_GLSL = "vec3 color(vec3 p) {\n    return vec3(0.85, 0.55, 0.35);\n}\n"
-"""The colour an editor source gets when it defines no ``color``."""
-_FORBIDDEN = {
-    "for": "loops are not allowed (a loop could run forever and stall every viewer); use op_repeat_finite",
-    "while": "loops are not allowed (a loop could run forever and stall every viewer)",
-    "do": "loops are not allowed (a loop could run forever and stall every viewer)",
-    "discard": "discard is not allowed in sdf() or color()",
-    "uniform": "declaring uniforms is not allowed",
-    "main": "main() is the app's; write float sdf(vec3 p) and optionally vec3 color(vec3 p)",
-}
-
-
-MAX_INLINED_TOKENS = 20000
-"""Largest ``sdf`` + ``color`` accepted once every call is inlined (tokens, the library's functions counted too).
-GLSL compilers inline every call, so a chain of functions each calling the one before twice doubles the code at
-each link: ten links of 679 characters took Mesa 76 s to compile. The examples count at most about 1600."""
-_DEFINITION = re.compile(r"\b([A-Za-z_]\w*)\s+([A-Za-z_]\w*)\s*\(([^()]*)\)\s*\{")
-_TOKEN = re.compile(r"\w+|[^\w\s]")
-_NOT_NAMES = frozenset({"if", "else", "return", "for", "while", "do", "switch"})
-
-
-def inlined_sizes(code: str, known: dict[str, int] | None = None) -> dict[str, int]:
-    """Tokens of each function defined in ``code`` (comments already removed) with every call to a function
-    defined before it (or in ``known``) replaced by that function's own inlined size, by name.
-
-    A call to a function not yet defined counts nothing (GLSL needs a declaration first and forbids recursion, so
-    the compiler refuses such a source anyway)."""
-    sizes = dict(known or {})
-    for match in _DEFINITION.finditer(code):
-        name = match.group(2)
-        if match.group(1) in _NOT_NAMES or name in _NOT_NAMES:
-            continue
-        depth, end = 1, match.end()
-        while end < len(code) and depth:
-            depth += {"{": 1, "}": -1}.get(code[end], 0)
-            end += 1
-        tokens = _TOKEN.findall(code[match.end() : end])
-        size = len(tokens)
-        for i, token in enumerate(tokens[:-1]):
-            if token != name and tokens[i + 1] == "(" and token in sizes:
-                size += sizes[token]
-        sizes[name] = size
-    return sizes
-
-
-_library_sizes: dict[str, int] = {}
-
-
-def _without_comments(source: str) -> str:
-    return "\n".join(line.split("//", 1)[0] for line in source.split("\n"))
-
-
-class ShaderCompileError(ValueError):
-    """An editor source the checks or the GLSL compiler reject; ``line`` is 1-based in that source (or None)."""
-
-    def __init__(self, message: str, line: int | None) -> None:
-        super().__init__(message if line is None else f"line {line}: {message}")
-        self.line = line
-        self.reason = message
-
-    @classmethod
-    def from_compiler(cls, log: str, source: str) -> ShaderCompileError:
-        """The first error of a compiler log (Mesa "0:LINE(COL): error: …"; NVIDIA "0(LINE) : error …")."""
-        lines = source.count("\n") + 1
-        for match in re.finditer(
-            r"^\s*\d+[:(](\d+)\)?(?:\(\d+\))?\s*:\s*error\s*:?\s*(.+)$", log, re.M
-        ):
-            line, message = int(match.group(1)), match.group(2).strip()
-            return cls(message, line if 1 <= line <= lines else None)
-        text = (
-            " ".join(log.replace("GLSL Compiler failed", "").split())
-            or "the shader did not compile"
-        )
-        return cls(text, None)
-
-
-def check_source(source: object) -> str:
-    """The editor source if the app will compile it, else :class:`ShaderCompileError` saying why and where.
-
-    Untrusted text: at most :data:`MAX_SOURCE_CHARS` printable ASCII characters (tabs and newlines too; no
-    backslash, which would join lines, and no carriage return, which Mesa takes as a line end); no ``#``, so no
-    preprocessor lines (no ``#include``, ``#extension``, macros); no loops (``for``, ``while``, ``do``): without
-    them, and without recursion (which GLSL forbids), every call of ``sdf`` ends, and its cost grows with the
-    source's length, which :data:`MAX_INLINED_TOKENS` bounds once calls are inlined; no ``uniform`` declarations,
-    ``discard`` or ``main``. It must define
-    ``float sdf(vec3 p)``; ``vec3 color(vec3 p)`` is optional.
-    """
-    if not isinstance(source, str):
-        raise ShaderCompileError("the source must be text", None)
-    if len(source) > MAX_SOURCE_CHARS:
-        raise ShaderCompileError(
-            f"the source is {len(source)} characters; the limit is {MAX_SOURCE_CHARS}", None
-        )
-    # Check the text the compiler will see. A backslash before a newline splices two lines into one (so
-    # "fo\<newline>r" is the word for) and Mesa ends a // comment at a lone carriage return (so a loop after one is
-    # code): neither has a use in sdf() text, so both are refused outright, and every line below is a line the
-    # compiler reads as one.
-    for number, line in enumerate(source.split("\n"), start=1):
-        bad = next((c for c in line if not (" " <= c <= "~" or c == "\t")), None)
-        if bad == "\r":
-            raise ShaderCompileError(
-                "carriage returns are not allowed (end lines with a plain newline)", number
-            )
-        if bad is not None:
-            raise ShaderCompileError(
-                f"character {bad!r} is not allowed (printable ASCII only)", number
-            )
-        if "\\" in line:
-            raise ShaderCompileError(
-                "backslashes are not allowed (a backslash at a line's end joins it to the next)",
-                number,
-            )
-        code = line.split("//", 1)[0]
-        if "#" in code:
-            raise ShaderCompileError("preprocessor lines (#…) are not allowed", number)
-        for word in re.findall(r"[A-Za-z_]\w*", code):
-            if word in _FORBIDDEN:
-                raise ShaderCompileError(_FORBIDDEN[word], number)
-            if word.startswith("gl_"):
-                raise ShaderCompileError(f"{word} is not available here", number)
-    if "/*" in source:
-        raise ShaderCompileError("block comments (/* */) are not allowed; use //", None)
-    if not re.search(r"\bfloat\s+sdf\s*\(\s*vec3\s+\w+\s*\)", source):
-        raise ShaderCompileError("define float sdf(vec3 p), the signed distance (m)", None)
-    if not _library_sizes:
-        _library_sizes.update(inlined_sizes(_without_comments(_source("sdf.glsl"))))
-    sizes = inlined_sizes(_without_comments(source), _library_sizes)
-    inlined = sizes.get("sdf", 0) + sizes.get("color", 0)
-    if inlined > MAX_INLINED_TOKENS:
-        raise ShaderCompileError(
-            f"sdf() and color() come to about {inlined} tokens once every call is inlined (a function that "
-            f"calls another several times multiplies its size); the limit is {MAX_INLINED_TOKENS}",
-            None,
-        )
-    return source
-
-
-def user_glsl(source: str) -> str:
-    """What a template gets appended: ``#line 1`` so compiler lines count from the source's first line, the
-    source, and the default ``color`` if it defines none."""
-    has_color = re.search(r"\bvec3\s+color\s*\(\s*vec3\s+\w+\s*\)", source) is not None
-    return "\n#line 1\n" + source + "\n" + ("" if has_color else DEFAULT_COLOR_GLSL)
-
-
-def _check_bounds(bounds: ArrayLike) -> NDArray[np.float64]:
-    box = np.asarray(bounds, dtype=np.float64)
-    if box.shape != (2, 3) or not np.all(np.isfinite(box)) or np.any(box[1] <= box[0]):
-        raise ValueError(
-            f"bounds must be finite (2, 3) min and max corners with max > min, got {box.tolist()}"
-        )
-    if np.any(np.abs(box) > 1e3):
-        raise ValueError("bounds must lie within ±1000 m")
-    return box
 
 
 def _box_scissor(
@@ -458,21 +128,7 @@ def _box_scissor(
     corners = np.array(
         [[box[i, 0], box[j, 1], box[k, 2]] for i in (0, 1) for j in (0, 1) for k in (0, 1)]
     )
-    forward, right, up = camera.basis()
-    rel = corners - np.asarray(camera.position)
-    z = rel @ forward
-    if np.all(z <= 0.0):
-        return (0, 0, 0, 0)
-    if np.any(z < 1e-3):
-        return (0, 0, width, height)
-    tan_half = math.tan(camera.fov_y_rad / 2)
-    x_ndc = (rel @ right) / (z * tan_half * width / height)
-    y_ndc = (rel @ up) / (z * tan_half)
-    x0 = int(np.clip(math.floor((x_ndc.min() + 1) / 2 * width) - 1, 0, width))
-    x1 = int(np.clip(math.ceil((x_ndc.max() + 1) / 2 * width) + 1, 0, width))
-    y0 = int(np.clip(math.floor((y_ndc.min() + 1) / 2 * height) - 1, 0, height))
-    y1 = int(np.clip(math.ceil((y_ndc.max() + 1) / 2 * height) + 1, 0, height))
-    return (x0, y0, max(x1 - x0, 0), max(y1 - y0, 0))
+    return screen_rectangle(camera, corners, width, height)
 
 
 def create_context() -> object:
@@ -504,14 +160,14 @@ class Renderer:
         ctx = create_context()
         assert isinstance(ctx, moderngl.Context)
         self.ctx = ctx
-        self.ctx.includes["sdf.glsl"] = _source("sdf.glsl")
-        self.ctx.includes["shading.glsl"] = _source("shading.glsl")
-        fullscreen = _source("fullscreen.vert")
+        self.ctx.includes["sdf.glsl"] = sdf_library()
+        self.ctx.includes["shading.glsl"] = read_source("shading.glsl")
+        fullscreen = read_source("fullscreen.vert")
         # One program per (shadows, occlusion, polynomial blend only), compiled on first use and kept: under
         # llvmpipe a term switched off by a uniform would still be paid for, and the exponential blend's exp and log
         # cost as much as the rest of the scene, so poly and hard scenes use a program without them.
-        self._raymarch_source = _source("raymarch.frag")
-        self._fullscreen = _source("fullscreen.vert")
+        self._raymarch_source = read_source("raymarch.frag")
+        self._fullscreen = read_source("fullscreen.vert")
         self._raymarch: dict[tuple[bool, bool, bool, bool], object] = {}
         self._raymarch_vao: dict[tuple[bool, bool, bool, bool], object] = {}
         self._fields: collections.OrderedDict[tuple[str, str], tuple[object, object]] = (
@@ -527,10 +183,10 @@ class Renderer:
             self._raymarch_program((shadows, occlusion, True, False))
         self._probe = self.ctx.program(
             vertex_shader=fullscreen,
-            fragment_shader=_with_defines(_source("probe.frag"), EXTRA_KINDS=1),
+            fragment_shader=with_defines(read_source("probe.frag"), EXTRA_KINDS=1),
         )
         self._mesh = self.ctx.program(
-            vertex_shader=_source("mesh.vert"), fragment_shader=_source("mesh.frag")
+            vertex_shader=read_source("mesh.vert"), fragment_shader=read_source("mesh.frag")
         )
         self._probe_vao = self.ctx.vertex_array(self._probe, [])
 
@@ -543,7 +199,7 @@ class Renderer:
             shadows, occlusion, poly_only, extra = variant
             prog = self.ctx.program(
                 vertex_shader=self._fullscreen,
-                fragment_shader=_with_defines(
+                fragment_shader=with_defines(
                     self._raymarch_source,
                     SHADOWS=int(shadows),
                     OCCLUSION=int(occlusion),
@@ -584,7 +240,7 @@ class Renderer:
         )
         rotation = np.tile(np.eye(3, dtype=np.float32), (n, 1, 1))
         for i, prim in enumerate(scene.primitives):
-            kind[i], op[i] = KIND_CODE[prim.kind], OP_CODE[prim.op]
+            kind[i], op[i] = sdf.primitive_spec(prim.kind).code, OP_CODE[prim.op]
             center[i], color[i] = prim.center, prim.color
             size[i, : len(prim.size)] = prim.size
             # GLSL mat3 is column-major: writing R row by row gives the matrix Rᵀ (world to local).
@@ -682,14 +338,14 @@ class Renderer:
         """
         import moderngl
 
-        _check_size(width, height)
+        check_image_size(width, height)
         shading = shading or Shading()
         # sdf.glsl's smin_blend uses the polynomial form for hard scenes (k = 0) whatever the blend.
         variant = (
             shading.shadows,
             shading.occlusion,
             scene.blend == "poly" or scene.k == 0.0,
-            any(p.kind not in BASIC_KINDS for p in scene.primitives),
+            any(not sdf.primitive_spec(p.kind).fused for p in scene.primitives),
         )
         prog, vao = self._raymarch_program(variant)
         self._set_scene(prog, scene)
@@ -750,7 +406,7 @@ class Renderer:
         """
         import moderngl
 
-        _check_size(width, height)
+        check_image_size(width, height)
         shading = shading or Shading()
         v = np.asarray(vertices, dtype=np.float64)
         f = np.asarray(faces, dtype=np.int64)
@@ -848,10 +504,10 @@ class Renderer:
             self._fields.move_to_end(key)
             return cached
         if variant == "sample":
-            template = _source("field_sample.frag")
+            template = read_source("field_sample.frag")
         else:
             _, shadows, occlusion = variant.split(":")
-            template = _with_defines(
+            template = with_defines(
                 self._raymarch_source,
                 USER_FIELD=1,
                 SHADOWS=int(shadows),
@@ -981,9 +637,9 @@ class Renderer:
         """
         import moderngl
 
-        _check_size(width, height)
+        check_image_size(width, height)
         check_source(source)
-        box = _check_bounds(bounds)
+        box = check_field_bounds(bounds)
         shading = shading or Shading()
         prog, vao = self._field_program(
             source, f"march:{int(shading.shadows)}:{int(shading.occlusion)}"
@@ -1042,7 +698,7 @@ def mesh_glsl(source: str, resolution: int, bounds: ArrayLike) -> trimesh.Trimes
     from shaders import gl_service
 
     check_source(source)
-    box = _check_bounds(bounds)
+    box = check_field_bounds(bounds)
     grid = sdf.make_grid(
         sdf.default_scene(), resolution, box
     )  # the scene is unused when bounds are given
@@ -1108,13 +764,3 @@ def _lipschitz_estimate(field: NDArray[np.float32], spacing: float) -> float:
         dz = np.diff(slab, axis=2)[:-1, :-1, :]
         largest = max(largest, float(np.sqrt(dx * dx + dy * dy + dz * dz).max(initial=0.0)))
     return largest / spacing
-
-
-def examples() -> dict[str, str]:
-    """The editor's example sources (``shaders/example_*.glsl``) by title (each file's first comment line)."""
-    out: dict[str, str] = {}
-    for path in sorted(SHADER_DIR.glob("example_*.glsl")):
-        source = path.read_text(encoding="utf-8")
-        title = source.split("\n", 1)[0].removeprefix("//").strip()
-        out[title] = source
-    return out

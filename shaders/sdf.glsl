@@ -1,26 +1,19 @@
-// Signed distance functions: mirrors kernels/sdf.py name for name (float32 here, float64 there).
+// Signed distance functions: mirrors kernels/sdf/ name for name (float32 here, float64 there).
 // Included with moderngl's ctx.includes by raymarch.frag, probe.frag and mesh.frag; it has no #version of its own.
 // The scene arrives as uniforms, so changing it never recompiles a program.
 
 #define MAX_PRIMITIVES 4
-#define KIND_SPHERE 0
-#define KIND_BOX 1
-#define KIND_TORUS 2
-#define KIND_CAPSULE 3
-#define KIND_CYLINDER 4
-#define KIND_ROUND_BOX 5
-#define KIND_OCTAHEDRON 6
-#define KIND_CONE 7
-#define KIND_HEX_PRISM 8
-#define KIND_ELLIPSOID 9
-// kernels/sdf.py ROUND_BOX_ROUNDING: a scene's round box is rounded by this fraction of its smallest half size.
+// The kinds' codes, KIND_<NAME>, and FIRST_CATALOGUE_KIND: written from kernels/sdf/primitives.py's registry
+// (shaders/glsl_library.py) in place of the next line.
+// @KIND_DEFINES
+// kernels/sdf ROUND_BOX_ROUNDING: a scene's round box is rounded by this fraction of its smallest half size.
 #define ROUND_BOX_ROUNDING 0.25
 #define OP_UNION 0
 #define OP_SUBTRACT 1
 #define OP_INTERSECT 2
 #define BLEND_POLY 0
 #define BLEND_EXP 1
-// kernels/sdf.py EXP_SHARPNESS_PER_WIDTH = 4 ln 2: both blends dip by k/4 where two surfaces meet.
+// kernels/sdf EXP_SHARPNESS_PER_WIDTH = 4 ln 2: both blends dip by k/4 where two surfaces meet.
 #define EXP_SHARPNESS_PER_WIDTH 2.772588722239781
 
 uniform int u_count;                              // primitives in use, 1..4
@@ -59,13 +52,13 @@ float sd_capsule(vec3 p, vec3 a, vec3 b, float radius) {
 
 // ------------------------------------------------------------------------------ blends
 // Each *_weighted form returns (distance, weight of b), the weight that blends colours. Both are finite for every
-// finite width k >= 0 and tend to the hard minimum as k -> 0 (kernels/sdf.py holds the same property).
-// kernels/sdf.py MIN_BLEND_WIDTH, float32's smallest normal: a width below it (0, or a subnormal that a GPU may flush
+// finite width k >= 0 and tend to the hard minimum as k -> 0 (kernels/sdf holds the same property).
+// kernels/sdf MIN_BLEND_WIDTH, float32's smallest normal: a width below it (0, or a subnormal that a GPU may flush
 // to 0) is the hard minimum, its dip k/4 being below any distance's rounding; above it 0.5 / k stays finite.
 #define MIN_BLEND_WIDTH 1.17549435e-38
 
 // Distances may be infinite (a float32 length overflows past ~1.8e19 m): the gap is 0 where a = b, the same infinity
-// included (not inf - inf), and where h is 0 or 1 the result is b or a outright (not 0 * inf), as in kernels/sdf.py.
+// included (not inf - inf), and where h is 0 or 1 the result is b or a outright (not 0 * inf), as in kernels/sdf.
 #define FLOAT32_MAX 3.40282347e38
 vec2 smin_poly_weighted(float a, float b, float k) {
     bool hard = !(k >= MIN_BLEND_WIDTH);
@@ -151,7 +144,7 @@ float smooth_intersect(float a, float b, float k, int blend) {
 }
 
 // ------------------------------------------------------------------------------ more primitives
-// After I. Quilez, "distance functions" (iquilezles.org/articles/distfunctions); kernels/sdf.py has the same names,
+// After I. Quilez, "distance functions" (iquilezles.org/articles/distfunctions); kernels/sdf has the same names,
 // arguments and frames, and says which are exact and which only bounds.
 float sd_cylinder(vec3 p, float half_height, float radius) {  // exact; capped, along y
     vec2 d = vec2(length(p.xz) - radius, abs(p.y) - half_height);
@@ -215,7 +208,7 @@ float sd_plane(vec3 p, vec3 normal, float offset) {  // exact; n·p + offset, n 
 
 // ------------------------------------------------------------------------------ operators
 // Rounding and onion act on a distance; the rest map the query point (GLSL has no function arguments), as in
-// kernels/sdf.py.
+// kernels/sdf.
 float op_round(float d, float radius) {
     return d - radius;
 }
@@ -262,14 +255,9 @@ vec3 op_symmetry(vec3 p, vec3 axes) {  // axes: 1 mirrors that coordinate, 0 lea
 #define EXTRA_KINDS 0
 #endif
 #if EXTRA_KINDS
-float catalogue_distance(int kind, vec3 p, vec3 s) {
-    if (kind == KIND_CYLINDER) return sd_cylinder(p, s.x, s.y);
-    if (kind == KIND_ROUND_BOX) return sd_round_box(p, s, ROUND_BOX_ROUNDING * min(s.x, min(s.y, s.z)));
-    if (kind == KIND_OCTAHEDRON) return sd_octahedron(p, s.x);
-    if (kind == KIND_CONE) return sd_cone(p, s.x, s.y);
-    if (kind == KIND_HEX_PRISM) return sd_hex_prism(p, s.x, s.y);
-    return sd_ellipsoid_lipschitz(p, s);
-}
+// catalogue_distance(kind, p, s): written from the registry in place of the next line, calling each kind's
+// sd_* function with its arguments (and preceded by the formulas of kinds registered with a .glsl file).
+// @CATALOGUE_DISTANCE
 #endif
 
 float primitive_distance(int i, vec3 p_world) {
@@ -281,7 +269,7 @@ float primitive_distance(int i, vec3 p_world) {
     vec3 e = kind == KIND_BOX ? s : (kind == KIND_CAPSULE ? vec3(0.0, s.x, 0.0) : vec3(0.0));
     float r = kind == KIND_BOX ? 0.0 : (kind == KIND_CAPSULE || torus ? s.y : s.x);
 #if EXTRA_KINDS
-    if (kind >= KIND_CYLINDER) {
+    if (kind >= FIRST_CATALOGUE_KIND) {
         return catalogue_distance(kind, p, s);
     }
 #endif

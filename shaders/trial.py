@@ -27,7 +27,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from shaders.renderer import Camera, GLUnavailableError, ShaderCompileError, Shading
+from shaders.camera import Camera, Shading
+from shaders.glsl_sandbox import ShaderCompileError
+from shaders.renderer import GLUnavailableError
 
 START_LIMIT_S = 60.0
 """Longest wait for the child's Python and EGL context to start (s); not part of the source's limits."""

@@ -70,7 +70,7 @@ def test_every_blend_is_finite_and_near_the_hard_operation_for_every_width(
             if dtype is np.float64:
                 got = SMOOTH[op](x_t, y_t, k, blend)
             else:  # the mesher's float32 path
-                got, weight = sdf._combine(x_t, y_t, op, k, blend)
+                got, weight = sdf.combine_weighted(x_t, y_t, op, k, blend)
                 assert got.dtype == np.float32 and np.all(np.isfinite(weight))
                 assert np.all((weight >= 0.0) & (weight <= 1.0))
         hard = HARD[op](x_t.astype(np.float64), y_t.astype(np.float64))
@@ -193,7 +193,7 @@ def test_blends_of_infinite_and_huge_distances_are_never_nan(
         if dtype is np.float64:
             got = SMOOTH[op](x, y, k, blend)
         else:
-            got, weight = sdf._combine(x, y, op, k, blend)
+            got, weight = sdf.combine_weighted(x, y, op, k, blend)
             assert np.all((weight >= 0.0) & (weight <= 1.0))
     hard = HARD[op](x.astype(np.float64), y.astype(np.float64))
     got64 = np.asarray(got, dtype=np.float64)

@@ -1,0 +1,183 @@
+"""Signed distance fields: primitives, hard and smooth booleans, a scene of up to four, and its mesh.
+
+One package, a module per concern; this module re-exports their public names (``kernels.sdf.mesh``,
+``kernels.sdf.Scene``, ``kernels.sdf.sd_sphere``, ...):
+
+- :mod:`kernels.sdf.primitives`: the ``sd_*`` distances and :data:`PRIMITIVES`, the one registry of a scene's kinds
+  (name, GUI label, sizes, numpy and GLSL formulas, integer code);
+- :mod:`kernels.sdf.blend`: smooth minimum (polynomial and exponential) and the booleans;
+- :mod:`kernels.sdf.operators`: rounding, onion and the point transforms;
+- :mod:`kernels.sdf.scene`: :class:`Primitive`, :class:`Scene`, the folded distance and colours, sphere tracing;
+- :mod:`kernels.sdf.meshing`: the sample grid, the coarse-to-fine sampler and marching cubes.
+
+Points are ``(N, 3)`` float arrays in metres; distances are ``(N,)`` in metres, negative inside.
+
+Sources: I. Quilez, "distance functions" and "smooth minimum" (iquilezles.org, 2008–2024); J. C. Hart, "Sphere
+tracing", The Visual Computer 12 (1996); T. Lewiner et al., J. Graphics Tools 8(2) (2003).
+"""
+
+from __future__ import annotations
+
+from kernels.sdf.blend import (
+    BLEND_FORMS,
+    BOOLEAN_OPS,
+    EXP_SHARPNESS_PER_WIDTH,
+    MIN_BLEND_WIDTH,
+    BlendForm,
+    BooleanOp,
+    combine_weighted,
+    op_intersect,
+    op_subtract,
+    op_union,
+    smin_exp,
+    smin_poly,
+    smooth_intersect,
+    smooth_subtract,
+    smooth_union,
+)
+from kernels.sdf.meshing import (
+    ISO_NUDGE_VOXELS,
+    MAX_FIELD_COORDINATE,
+    MAX_RESOLUTION,
+    MIN_RESOLUTION,
+    Grid,
+    NearSurfaceField,
+    make_grid,
+    mesh,
+    mesh_samples,
+    mesh_trimesh,
+    sample_full,
+    sample_near_surface,
+)
+from kernels.sdf.operators import (
+    op_bend,
+    op_elongate,
+    op_onion,
+    op_repeat_finite,
+    op_round,
+    op_symmetry,
+    op_twist,
+)
+from kernels.sdf.primitives import (
+    BUILT_IN_KINDS,
+    PRIMITIVES,
+    ROUND_BOX_ROUNDING,
+    AnyFloatArray,
+    CoordinateDistance,
+    FloatArray,
+    LocalDistance,
+    PrimitiveKind,
+    PrimitiveSpec,
+    Sizes,
+    primitive_kinds,
+    primitive_spec,
+    register_primitive,
+    sd_box,
+    sd_capsule,
+    sd_cone,
+    sd_cylinder,
+    sd_ellipsoid,
+    sd_ellipsoid_lipschitz,
+    sd_hex_prism,
+    sd_octahedron,
+    sd_plane,
+    sd_round_box,
+    sd_sphere,
+    sd_torus,
+    unregister_primitive,
+)
+from kernels.sdf.scene import (
+    MAX_BLEND_WIDTH,
+    MAX_PRIMITIVES,
+    Primitive,
+    Scene,
+    default_scene,
+    fold_xyz,
+    ray_spheres_interval,
+    rotation_matrix,
+    scene_bounding_spheres,
+    scene_bounds,
+    scene_color,
+    scene_distance,
+    sphere_trace,
+)
+
+PRIMITIVE_KINDS: tuple[PrimitiveKind, ...] = BUILT_IN_KINDS
+"""The built-in kinds, in code order (:func:`primitive_kinds` also lists registered ones)."""
+
+__all__ = [
+    "BLEND_FORMS",
+    "BOOLEAN_OPS",
+    "BUILT_IN_KINDS",
+    "EXP_SHARPNESS_PER_WIDTH",
+    "ISO_NUDGE_VOXELS",
+    "MAX_BLEND_WIDTH",
+    "MAX_FIELD_COORDINATE",
+    "MAX_PRIMITIVES",
+    "MAX_RESOLUTION",
+    "MIN_BLEND_WIDTH",
+    "MIN_RESOLUTION",
+    "PRIMITIVES",
+    "PRIMITIVE_KINDS",
+    "ROUND_BOX_ROUNDING",
+    "AnyFloatArray",
+    "BlendForm",
+    "BooleanOp",
+    "CoordinateDistance",
+    "FloatArray",
+    "Grid",
+    "LocalDistance",
+    "NearSurfaceField",
+    "Primitive",
+    "PrimitiveKind",
+    "PrimitiveSpec",
+    "Scene",
+    "Sizes",
+    "combine_weighted",
+    "default_scene",
+    "fold_xyz",
+    "make_grid",
+    "mesh",
+    "mesh_samples",
+    "mesh_trimesh",
+    "op_bend",
+    "op_elongate",
+    "op_intersect",
+    "op_onion",
+    "op_repeat_finite",
+    "op_round",
+    "op_subtract",
+    "op_symmetry",
+    "op_twist",
+    "op_union",
+    "primitive_kinds",
+    "primitive_spec",
+    "ray_spheres_interval",
+    "register_primitive",
+    "rotation_matrix",
+    "sample_full",
+    "sample_near_surface",
+    "scene_bounding_spheres",
+    "scene_bounds",
+    "scene_color",
+    "scene_distance",
+    "sd_box",
+    "sd_capsule",
+    "sd_cone",
+    "sd_cylinder",
+    "sd_ellipsoid",
+    "sd_ellipsoid_lipschitz",
+    "sd_hex_prism",
+    "sd_octahedron",
+    "sd_plane",
+    "sd_round_box",
+    "sd_sphere",
+    "sd_torus",
+    "smin_exp",
+    "smin_poly",
+    "smooth_intersect",
+    "smooth_subtract",
+    "smooth_union",
+    "sphere_trace",
+    "unregister_primitive",
+]

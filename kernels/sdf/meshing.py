@@ -1,0 +1,348 @@
+"""Meshing a scene's zero level set: a sample grid, a coarse-to-fine sampler, and marching cubes.
+
+:func:`mesh` samples the field on a grid and runs scikit-image's marching cubes (Lewiner et al. 2003) on the float
+field, which keeps sub-voxel accuracy. It evaluates the field only near the surface: a block of samples whose centre
+is farther from the surface than the block's radius plus one voxel diagonal cannot hold a corner of a cell the
+surface crosses (the field is 1-Lipschitz), so the block gets the sign of its centre and is not refined. Marching
+cubes reads values only at corners of crossed cells, so the output equals the full-grid output exactly; it is also
+told to skip cells outside the evaluated region (its ``mask``).
+
+Grid samples are in metres; fields are ``(nx, ny, nz)`` float32 distances (m), negative inside; meshes are
+vertices ``(V, 3)`` (m), faces ``(F, 3)`` wound outward and vertex colours ``(V, 3)`` RGB in [0, 1].
+
+Source: T. Lewiner, H. Lopes, A. W. Vieira, G. Tavares, "Efficient implementation of marching cubes' cases with
+topological guarantees", J. Graphics Tools 8(2) (2003).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+import math
+from collections.abc import Callable
+
+import numpy as np
+import trimesh
+from numpy.typing import ArrayLike, NDArray
+from skimage.measure import marching_cubes
+
+from kernels.sdf.primitives import FloatArray
+from kernels.sdf.scene import Primitive, Scene, fold_xyz, scene_bounds, scene_color
+
+MIN_RESOLUTION = 16
+MAX_RESOLUTION = 512
+MAX_FIELD_COORDINATE = 1e18
+"""Largest |coordinate| (m) of a mesh grid: float32 squares of differences of such coordinates stay finite."""
+
+
+@dataclasses.dataclass(frozen=True)
+class Grid:
+    """A regular sample grid: ``origin + index·spacing``, ``shape`` samples per axis."""
+
+    origin: tuple[float, float, float]
+    """World position of sample (0, 0, 0) (m)."""
+    spacing: float
+    """Distance between neighbouring samples (m)."""
+    shape: tuple[int, int, int]
+    """Samples along x, y, z."""
+
+
+def make_grid(scene: Scene, resolution: int, bounds: ArrayLike | None = None) -> Grid:
+    """The grid :func:`mesh` samples: cubic voxels, ``resolution`` samples along the box's longest side.
+
+    Args:
+        scene: the scene (its bounds are used when ``bounds`` is None).
+        resolution: samples along the longest side, 16..512.
+        bounds: optional (2, 3) min and max corners (m).
+    """
+    if isinstance(resolution, bool) or not isinstance(resolution, (int, np.integer)):
+        raise ValueError(f"resolution must be an integer, got {resolution!r}")
+    if not MIN_RESOLUTION <= int(resolution) <= MAX_RESOLUTION:
+        raise ValueError(
+            f"resolution must be in {MIN_RESOLUTION}..{MAX_RESOLUTION}, got {resolution}"
+        )
+    if bounds is None:
+        box = scene_bounds(scene)
+    else:
+        box = np.asarray(bounds, dtype=np.float64)
+        if box.shape != (2, 3) or not np.all(np.isfinite(box)) or np.any(box[1] <= box[0]):
+            raise ValueError("bounds must be finite (2, 3) min and max corners with max > min")
+    if not np.all(np.abs(box) <= MAX_FIELD_COORDINATE):
+        raise ValueError(
+            f"bounds (given or the scene's) must lie within ±{MAX_FIELD_COORDINATE:g} m for the float32 field, "
+            f"got {box.tolist()}"
+        )
+    extent = box[1] - box[0]
+    spacing = float(extent.max()) / (int(resolution) - 1)
+    counts = np.minimum(np.ceil(extent / spacing - 1e-9).astype(int) + 1, int(resolution))
+    center = 0.5 * (box[0] + box[1])
+    origin = center - 0.5 * (counts - 1) * spacing
+    return Grid(
+        origin=(float(origin[0]), float(origin[1]), float(origin[2])),
+        spacing=spacing,
+        shape=(int(counts[0]), int(counts[1]), int(counts[2])),
+    )
+
+
+def sample_full(scene: Scene, grid: Grid) -> NDArray[np.float32]:
+    """The field at every grid sample, (nx, ny, nz) float32: the plain baseline the coarse-to-fine pass matches."""
+    axes = [grid.origin[i] + grid.spacing * np.arange(grid.shape[i]) for i in range(3)]
+    xs, ys, zs = np.meshgrid(*axes, indexing="ij")
+    return _field_at(scene, np.stack([xs.ravel(), ys.ravel(), zs.ravel()], axis=1)).reshape(
+        grid.shape
+    )
+
+
+def _field_at(scene: Scene, points: NDArray[np.floating]) -> NDArray[np.float32]:
+    """The field at (N, 3) sample points, evaluated in float32 (what marching cubes reads) on coordinate arrays.
+
+    Both samplers call this with coordinates computed the same way, so equal points give bit-equal values.
+    """
+    p32 = points.astype(np.float32)
+    d, _ = fold_xyz(scene, p32[:, 0].copy(), p32[:, 1].copy(), p32[:, 2].copy(), with_color=False)
+    return d.astype(np.float32, copy=False)
+
+
+_LEVELS = (16, 4)
+"""Block sizes (samples per side) of the coarse passes; the last level's surviving blocks are sampled in full."""
+
+
+@dataclasses.dataclass(frozen=True)
+class NearSurfaceField:
+    """The grid field from the coarse-to-fine pass."""
+
+    field: NDArray[np.float32]
+    """(nx, ny, nz) values (m): exact at every corner of a cell the surface crosses, sign-correct elsewhere."""
+    mask: NDArray[np.bool_]
+    """(nx, ny, nz) True where the value was evaluated exactly; it holds every corner of every crossed cell, so
+    marching cubes may skip cells whose far corner is False."""
+    evaluated: int
+    """Points evaluated, block centres included."""
+
+
+def sample_near_surface(
+    scene: Scene, grid: Grid, progress: Callable[[float], None] | None = None
+) -> NearSurfaceField:
+    """The field, evaluated exactly where marching cubes reads it and sign-filled elsewhere.
+
+    Args:
+        scene: the scene.
+        grid: the grid.
+        progress: optional callback receiving the fraction done, 0..1.
+    """
+    h = grid.spacing
+    # A corner of a crossed cell lies within one voxel diagonal of the surface.
+    margin = math.sqrt(3.0) * h * (1.0 + 1e-3) + 1e-6  # slack for float32 rounding
+    top = _LEVELS[0]
+    padded = tuple(-(-n // top) * top for n in grid.shape)
+    field = np.empty(padded, dtype=np.float32)
+    origin = np.asarray(grid.origin)
+    evaluated = 0
+
+    def block_centers(corners: NDArray[np.int64], size: int) -> FloatArray:
+        return origin + h * (corners + 0.5 * (size - 1)).astype(np.float64)
+
+    def view(size: int) -> NDArray[np.float32]:
+        n = [m // size for m in padded]
+        return field.reshape(n[0], size, n[1], size, n[2], size)
+
+    # Level 0: every top block, written as a whole-field fill of its centre's value.
+    n0 = [m // top for m in padded]
+    idx = np.stack(np.meshgrid(*[np.arange(c) for c in n0], indexing="ij"), axis=-1).reshape(-1, 3)
+    corners = idx * top
+    d = _field_at(scene, block_centers(corners, top))
+    evaluated += len(d)
+    view(top)[...] = d.astype(np.float32).reshape(n0[0], 1, n0[1], 1, n0[2], 1)
+    keep = np.abs(d) <= math.sqrt(3.0) * 0.5 * (top - 1) * h + margin
+    corners = corners[keep]
+    size = top
+    for child in (*_LEVELS[1:], 1):
+        if progress is not None:
+            progress(0.2 + 0.6 * (1 - child / top))
+        ratio = size // child
+        offsets = (
+            np.stack(np.meshgrid(*[np.arange(ratio)] * 3, indexing="ij"), axis=-1).reshape(-1, 3)
+            * child
+        )
+        corners = (corners[:, None, :] + offsets[None, :, :]).reshape(-1, 3)
+        d = _field_at(scene, block_centers(corners, child))
+        evaluated += len(d)
+        blocks = corners // child
+        fill = d.astype(np.float32)[:, None, None, None]
+        view(child)[blocks[:, 0], :, blocks[:, 1], :, blocks[:, 2], :] = fill
+        if child == 1:
+            mask = np.zeros(padded, dtype=bool)
+            mask[corners[:, 0], corners[:, 1], corners[:, 2]] = True
+            break
+        keep = np.abs(d) <= math.sqrt(3.0) * 0.5 * (child - 1) * h + margin
+        corners = corners[keep]
+        size = child
+    nx, ny, nz = grid.shape
+    return NearSurfaceField(field[:nx, :ny, :nz], mask[:nx, :ny, :nz], evaluated)
+
+
+def mesh(
+    scene: Scene,
+    resolution: int,
+    bounds: ArrayLike | None = None,
+    *,
+    near_surface: bool = True,
+    progress: Callable[[float], None] | None = None,
+) -> tuple[FloatArray, NDArray[np.int64], FloatArray]:
+    """Triangle mesh of the scene's zero level set by marching cubes on the float field.
+
+    Args:
+        scene: the scene.
+        resolution: samples along the longest side of the bounds, 16..512.
+        bounds: optional (2, 3) min and max corners (m); by default found from the primitives with room for the
+            blend, so closed shapes give closed meshes.
+        near_surface: evaluate only near the surface (coarse to fine; same output); False samples every point.
+        progress: optional callback receiving the fraction done, 0..1.
+
+    Returns:
+        vertices (V, 3) in metres, faces (F, 3) vertex indices wound outward, vertex colours (V, 3) RGB in [0, 1].
+        Samples on (or within 1e-3 voxel of) the zero level are moved 1e-3 voxel off it first: inside where they
+        lie on a face along grid lines next to a grid cell whose centre is inside, else outside (see
+        ``_polygonise``), so every vertex is distinct, a closed shape gives a watertight mesh even where faces lie on
+        grid planes, and a feature one voxel thick between two grid planes keeps its volume. An empty field (no
+        surface inside the bounds) gives empty arrays.
+
+    Raises:
+        ValueError: a bad resolution, or bounds (given or the scene's) not finite or beyond
+            ±:data:`MAX_FIELD_COORDINATE`.
+    """
+    grid = make_grid(scene, resolution, bounds)
+    mask = None
+    if near_surface:
+        sampled = sample_near_surface(scene, grid, progress)
+        field, mask = sampled.field, sampled.mask
+    else:
+        field = sample_full(scene, grid)
+    if progress is not None:
+        progress(0.8)
+    return _polygonise(scene, grid, field, mask)
+
+
+ISO_NUDGE_VOXELS = 1e-3
+"""Samples within this fraction of a voxel of the zero level move to that distance from it before marching cubes."""
+
+
+def _polygonise(
+    scene: Scene, grid: Grid, field: NDArray[np.float32], mask: NDArray[np.bool_] | None
+) -> tuple[FloatArray, NDArray[np.int64], FloatArray]:
+    # A sample exactly on the level is a tie that marching cubes breaks differently in neighbouring cells (its
+    # classification and its face test disagree), which leaves holes (scikit-image issue 8116), so every sample
+    # closer than δ = 1e-3 voxel to the level moves to ±δ. Which side: a sample on the level is a boundary point of
+    # the hard solid {d ≤ 0}; when it lies on a face along grid lines (a level neighbour), it goes inside (−δ) if a
+    # grid cell it is a corner of has its centre inside (d < 0: the solid has volume in that cell), else outside
+    # (+δ, as in Lewiner's reference code). Pushing every such
+    # sample outside made a feature one voxel thick with both faces on grid planes vanish (no sample was left
+    # inside it); pushing every one inside would turn zero-volume sets (boxes touching in an intersection, A − A)
+    # into sheets. A sample a hair inside (d < 0) stays inside. Neighbouring samples differ by at most a voxel (the
+    # field is 1-Lipschitz), so each vertex lies at least ~δ/voxel inside its own edge: vertices stay distinct in
+    # float32 and the mesh is a plain marching-cubes mesh (no merging), the surface moving by at most δ. Both
+    # samplers' fields pass through here and level samples and their cells' corners are evaluated exactly by both
+    # (the sign fill comes from blocks far from the surface), so the coarse-to-fine output equals the full grid's.
+    delta = np.float32(ISO_NUDGE_VOXELS * grid.spacing)
+    near_level = np.abs(field) < delta
+    if near_level.any():
+        # Only samples with a level neighbour (a face or a feature's edge along grid lines) take that test; a lone
+        # one (a blend grazing a sample) stays outside, so a sub-voxel blend keeps the topology it always had.
+        # On the grid's outer layer a sample stays outside as well: the solid may go on beyond the bounds, and
+        # marching cubes only closes a surface that crosses inside them (a box that fills its bounds).
+        lined = near_level & (field >= 0.0) & _beside(near_level)
+        lined[[0, -1], :, :] = False
+        lined[:, [0, -1], :] = False
+        lined[:, :, [0, -1]] = False
+        inward = (field < 0.0) | _touches_solid(scene, grid, lined)
+        nudged = np.where(inward, -delta, delta)
+        # A level sample left outside next to one moved inside: the edge between them runs along a face that only
+        # the inside one bounds (a cut flush with another face), so the surface belongs at the inside sample, not
+        # halfway between ±δ. The outside one takes half a voxel instead, putting the vertex ~2δ from it.
+        beside = _beside(near_level & inward) & near_level & ~inward
+        nudged = np.where(beside, np.float32(0.5 * grid.spacing), nudged)
+        field = np.where(near_level, nudged, field)
+    if not (field.min() < 0.0 < field.max()):
+        return np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64), np.zeros((0, 3))
+    verts, faces, _normals, _values = marching_cubes(
+        np.ascontiguousarray(field, dtype=np.float32),
+        level=0.0,
+        spacing=(grid.spacing,) * 3,
+        mask=None if mask is None else np.ascontiguousarray(mask),
+    )
+    verts = verts.astype(np.float64) + np.asarray(grid.origin)
+    # scikit-image's default winding faces a field that is negative inside outward (tests check the volume's sign).
+    return verts, faces.astype(np.int64), scene_color(scene, verts)
+
+
+def _beside(samples: NDArray[np.bool_]) -> NDArray[np.bool_]:
+    """True at grid samples with one of their six axis neighbours in ``samples``."""
+    out = np.zeros_like(samples)
+    for axis in range(3):
+        n = samples.shape[axis]
+        lower = [slice(None)] * 3
+        upper = [slice(None)] * 3
+        lower[axis], upper[axis] = slice(0, n - 1), slice(1, n)
+        out[tuple(lower)] |= samples[tuple(upper)]
+        out[tuple(upper)] |= samples[tuple(lower)]
+    return out
+
+
+def _touches_solid(scene: Scene, grid: Grid, samples: NDArray[np.bool_]) -> NDArray[np.bool_]:
+    """(nx, ny, nz) True at the ``samples`` that are a corner of a grid cell whose centre is inside (d < 0)."""
+    out = np.zeros(samples.shape, dtype=bool)
+    at = np.argwhere(samples)
+    if len(at) == 0:
+        return out
+    cells_shape = np.asarray(samples.shape) - 1
+    offsets = np.array(list(itertools.product((-1, 0), repeat=3)))
+    cells = (at[:, None, :] + offsets[None, :, :]).reshape(-1, 3)
+    valid = np.all((cells >= 0) & (cells < cells_shape), axis=1)
+    unique = np.unique(cells[valid], axis=0)
+    centres = np.asarray(grid.origin) + grid.spacing * (unique + 0.5)
+    inside_cell = np.zeros(tuple(cells_shape), dtype=bool)
+    inside_cell[unique[:, 0], unique[:, 1], unique[:, 2]] = _field_at(scene, centres) < 0.0
+    hit = np.zeros(len(cells), dtype=bool)
+    good = cells[valid]
+    hit[valid] = inside_cell[good[:, 0], good[:, 1], good[:, 2]]
+    out[at[:, 0], at[:, 1], at[:, 2]] = hit.reshape(len(at), len(offsets)).any(axis=1)
+    return out
+
+
+def mesh_trimesh(
+    vertices: FloatArray, faces: NDArray[np.int64], colors: FloatArray
+) -> trimesh.Trimesh:
+    """The output of :func:`mesh` as a ``trimesh.Trimesh`` with 8-bit vertex colours (for export)."""
+    rgba = np.concatenate([np.clip(colors, 0.0, 1.0), np.ones((len(colors), 1))], axis=1)
+    return trimesh.Trimesh(
+        vertices=vertices,
+        faces=faces,
+        vertex_colors=(rgba * 255).round().astype(np.uint8),
+        process=False,
+    )
+
+
+# ------------------------------------------------------------------------------------------ sampled fields
+def mesh_samples(
+    grid: Grid, field: NDArray[np.float32], mask: NDArray[np.bool_] | None = None
+) -> tuple[FloatArray, NDArray[np.int64]]:
+    """Marching cubes of a field sampled elsewhere (the GLSL editor's, sampled on the GPU), by :func:`mesh`'s pass.
+
+    Args:
+        grid: where the samples are (:func:`make_grid`).
+        field: (nx, ny, nz) float32 distances (m), negative inside, shaped like ``grid.shape``.
+        mask: optional (nx, ny, nz) cells marching cubes may visit.
+
+    Returns:
+        vertices (V, 3) in metres and faces (F, 3) wound outward; empty when no surface crosses the grid.
+    """
+    if field.shape != grid.shape:
+        raise ValueError(f"field must have the grid's shape {grid.shape}, got {field.shape}")
+    if not np.all(np.isfinite(field)):
+        raise ValueError("field must be finite")
+    # _polygonise colours its vertices from a scene; one small sphere keeps that cost to a few ms.
+    verts, faces, _ = _polygonise(_COLOURLESS, grid, field.astype(np.float32, copy=False), mask)
+    return verts, faces
+
+
+_COLOURLESS = Scene((Primitive("sphere", (0.0, 0.0, 0.0), (1.0,)),))

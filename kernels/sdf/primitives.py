@@ -1,0 +1,514 @@
+"""SDF primitives: exact distances (and two bounds) after Inigo Quilez, and the registry of a scene's kinds.
+
+Points are ``(N, 3)`` float arrays in metres, in the primitive's local frame; distances are ``(N,)`` in metres,
+negative inside. Each ``sd_*`` function is mirrored name for name in ``shaders/sdf.glsl`` (float32 there).
+
+    sphere   |p| − r
+    box      |max(q, 0)| + min(max(q.x, q.y, q.z), 0),   q = |p| − b
+    torus    |(|p.xz| − R, p.y)| − r                      (the ring lies in the local xz plane; axis local y)
+    capsule  |pa − ba·h| − r,   h = clamp(pa·ba / ba·ba, 0, 1)   (a scene's capsule runs along local y)
+
+:data:`PRIMITIVES` is the one table of the kinds a :class:`~kernels.sdf.scene.Primitive` may be: per kind its GUI
+label, its size parameters (names and units), its numpy distance, its GLSL function and arguments, and the stable
+integer code the renderer passes to the GLSL. The kernel's evaluation, the gallery's menus, the renderer's codes and
+the GLSL dispatch (``shaders/glsl_library.py``) are all read from it, so adding a kind is one
+:class:`PrimitiveSpec` (:func:`register_primitive`) plus its two formulas, numpy and GLSL.
+
+Source: I. Quilez, "distance functions" (iquilezles.org/articles/distfunctions, 2008–2024).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable
+from pathlib import Path
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from kernels import _checks
+
+PrimitiveKind = Literal[
+    "sphere",
+    "box",
+    "torus",
+    "capsule",
+    "cylinder",
+    "round_box",
+    "octahedron",
+    "cone",
+    "hex_prism",
+    "ellipsoid",
+]
+"""The built-in kinds of primitive; see :data:`PRIMITIVES` for what each one's sizes mean."""
+
+FloatArray = NDArray[np.float64]
+AnyFloatArray = NDArray[np.floating]
+"""Internal fast paths keep their input's float dtype (float32 for the mesher's grid)."""
+
+ROUND_BOX_ROUNDING = 0.25
+"""A scene's round box is rounded by this fraction of its smallest half size."""
+
+
+def sd_sphere(p: ArrayLike, radius: float) -> FloatArray:
+    """Exact distance to a sphere at the origin.
+
+    Args:
+        p: (N, 3) points in the local frame (m).
+        radius: radius (m), > 0.
+
+    Returns:
+        (N,) signed distances (m).
+    """
+    pts = _checks.points("p", p)
+    r = _checks.positive("radius", radius)
+    return np.linalg.norm(pts, axis=1) - r
+
+
+def sd_box(p: ArrayLike, half_size: ArrayLike) -> FloatArray:
+    """Exact distance to an axis-aligned box centred at the origin.
+
+    Args:
+        p: (N, 3) points in the local frame (m).
+        half_size: (3,) half extents along x, y, z (m), each > 0.
+
+    Returns:
+        (N,) signed distances (m).
+    """
+    pts = _checks.points("p", p)
+    b = _checks.vector("half_size", half_size, 3)
+    if np.any(b <= 0.0):
+        raise ValueError(f"half_size must be positive, got {b.tolist()}")
+    q = np.abs(pts) - b
+    outside = np.linalg.norm(np.maximum(q, 0.0), axis=1)
+    inside = np.minimum(q.max(axis=1), 0.0)
+    return outside + inside
+
+
+def sd_torus(p: ArrayLike, major_radius: float, minor_radius: float) -> FloatArray:
+    """Exact distance to a torus whose ring lies in the local xz plane (axis along local y).
+
+    Args:
+        p: (N, 3) points in the local frame (m).
+        major_radius: distance from the centre to the tube's centre line (m), > 0.
+        minor_radius: tube radius (m), > 0.
+
+    Returns:
+        (N,) signed distances (m).
+    """
+    pts = _checks.points("p", p)
+    big_r = _checks.positive("major_radius", major_radius)
+    small_r = _checks.positive("minor_radius", minor_radius)
+    qx = np.hypot(pts[:, 0], pts[:, 2]) - big_r
+    return np.hypot(qx, pts[:, 1]) - small_r
+
+
+def sd_capsule(p: ArrayLike, a: ArrayLike, b: ArrayLike, radius: float) -> FloatArray:
+    """Exact distance to a capsule: the points within ``radius`` of segment ab.
+
+    Args:
+        p: (N, 3) points (m).
+        a: (3,) one end of the segment (m).
+        b: (3,) the other end (m); may equal ``a`` (a sphere).
+        radius: radius (m), > 0.
+
+    Returns:
+        (N,) signed distances (m).
+    """
+    pts = _checks.points("p", p)
+    a_vec, b_vec = _checks.vector("a", a, 3), _checks.vector("b", b, 3)
+    r = _checks.positive("radius", radius)
+    pa = pts - a_vec
+    ba = b_vec - a_vec
+    length_sq = float(ba @ ba)
+    h = np.zeros(len(pts)) if length_sq == 0.0 else np.clip(pa @ ba / length_sq, 0.0, 1.0)
+    return np.linalg.norm(pa - h[:, None] * ba, axis=1) - r
+
+
+# ------------------------------------------------------------------------------------------ more primitives
+# After I. Quilez, "distance functions" (iquilezles.org/articles/distfunctions, 2008–2024), mirrored name for name
+# in shaders/sdf.glsl. Each says whether it is an exact distance or only a bound (≤ the true distance outside and
+# 1-Lipschitz, so sphere tracing stays safe).
+def sd_cylinder(p: ArrayLike, half_height: float, radius: float) -> FloatArray:
+    """Exact distance to a capped cylinder along local y, centred at the origin (Quilez, "Capped Cylinder").
+
+    Args:
+        p: (N, 3) points in the local frame (m).
+        half_height: half its length along y (m), > 0.
+        radius: radius (m), > 0.
+
+    Returns:
+        (N,) signed distances (m).
+    """
+    pts = _checks.points("p", p)
+    h, r = _checks.positive("half_height", half_height), _checks.positive("radius", radius)
+    dx = np.hypot(pts[:, 0], pts[:, 2]) - r
+    dy = np.abs(pts[:, 1]) - h
+    return np.minimum(np.maximum(dx, dy), 0.0) + np.hypot(np.maximum(dx, 0.0), np.maximum(dy, 0.0))
+
+
+def sd_round_box(p: ArrayLike, half_size: ArrayLike, radius: float) -> FloatArray:
+    """Exact distance to a box with rounded edges (Quilez, "Rounded Box").
+
+    The box's outer half extents are ``half_size``; its edges and corners are rounded with ``radius``.
+
+    Args:
+        p: (N, 3) points in the local frame (m).
+        half_size: (3,) outer half extents (m), each > 0.
+        radius: rounding radius (m), in [0, min(half_size)].
+
+    Returns:
+        (N,) signed distances (m).
+    """
+    pts = _checks.points("p", p)
+    b = _checks.vector("half_size", half_size, 3)
+    if np.any(b <= 0.0):
+        raise ValueError(f"half_size must be positive, got {b.tolist()}")
+    r = _checks.non_negative("radius", radius)
+    if r > b.min():
+        raise ValueError(f"radius must be at most min(half_size) = {b.min()}, got {radius!r}")
+    q = np.abs(pts) - b + r
+    return np.linalg.norm(np.maximum(q, 0.0), axis=1) + np.minimum(q.max(axis=1), 0.0) - r
+
+
+def sd_octahedron(p: ArrayLike, size: float) -> FloatArray:
+    """Exact distance to the regular octahedron |x| + |y| + |z| = size (Quilez, "Octahedron - exact").
+
+    Args:
+        p: (N, 3) points in the local frame (m).
+        size: distance from the centre to each vertex (m), > 0.
+
+    Returns:
+        (N,) signed distances (m).
+    """
+    pts = np.abs(_checks.points("p", p))
+    s = _checks.positive("size", size)
+    m = pts.sum(axis=1) - s
+    x, y, z = pts[:, 0], pts[:, 1], pts[:, 2]
+    # Pick the face region: q is p with its axes cycled so the nearest edge is the one the formula handles.
+    use_x, use_y, use_z = 3.0 * x < m, 3.0 * y < m, 3.0 * z < m
+    q = np.where(
+        use_x[:, None],
+        pts,
+        np.where(use_y[:, None], pts[:, [1, 2, 0]], pts[:, [2, 0, 1]]),
+    )
+    k = np.clip(0.5 * (q[:, 2] - q[:, 1] + s), 0.0, s)
+    edge = np.sqrt(q[:, 0] ** 2 + (q[:, 1] - s + k) ** 2 + (q[:, 2] - k) ** 2)
+    return np.where(use_x | use_y | use_z, edge, m * (1.0 / math.sqrt(3.0)))
+
+
+def sd_cone(p: ArrayLike, radius: float, height: float) -> FloatArray:
+    """Exact distance to a solid cone along local y (Quilez, "Cone - exact").
+
+    Its base, a disc of ``radius``, lies in the plane y = −height/2 and its apex at y = +height/2, so the origin is
+    the middle of its axis.
+
+    Args:
+        p: (N, 3) points in the local frame (m).
+        radius: base radius (m), > 0.
+        height: apex to base (m), > 0.
+
+    Returns:
+        (N,) signed distances (m).
+    """
+    pts = _checks.points("p", p)
+    r, h = _checks.positive("radius", radius), _checks.positive("height", height)
+    # Quilez's frame: apex at the origin, base at y = −h; q is the base rim in the (radial, y) half-plane.
+    qx, qy = r, -h
+    wx = np.hypot(pts[:, 0], pts[:, 2])
+    wy = pts[:, 1] - 0.5 * h
+    t = np.clip((wx * qx + wy * qy) / (qx * qx + qy * qy), 0.0, 1.0)
+    ax, ay = wx - qx * t, wy - qy * t
+    bx, by = wx - qx * np.clip(wx / qx, 0.0, 1.0), wy - qy
+    d = np.minimum(ax * ax + ay * ay, bx * bx + by * by)
+    # k = sign(q.y) = −1
+    s = np.maximum(-(wx * qy - wy * qx), -(wy - qy))
+    return np.sqrt(d) * np.sign(s)
+
+
+def sd_hex_prism(p: ArrayLike, apothem: float, half_height: float) -> FloatArray:
+    """Exact distance to a regular hexagonal prism along local z (Quilez, "Hexagonal Prism - exact").
+
+    Args:
+        p: (N, 3) points in the local frame (m).
+        apothem: distance from the axis to each flat side (m), > 0; two sides are parallel to the x axis.
+        half_height: half its length along z (m), > 0.
+
+    Returns:
+        (N,) signed distances (m).
+    """
+    pts = np.abs(_checks.points("p", p))
+    a, h = _checks.positive("apothem", apothem), _checks.positive("half_height", half_height)
+    kx, ky, kz = -math.sqrt(3.0) / 2.0, 0.5, 1.0 / math.sqrt(3.0)
+    fold = 2.0 * np.minimum(kx * pts[:, 0] + ky * pts[:, 1], 0.0)
+    x, y = pts[:, 0] - fold * kx, pts[:, 1] - fold * ky
+    dx = np.hypot(x - np.clip(x, -kz * a, kz * a), y - a) * np.sign(y - a)
+    dy = pts[:, 2] - h
+    return np.minimum(np.maximum(dx, dy), 0.0) + np.hypot(np.maximum(dx, 0.0), np.maximum(dy, 0.0))
+
+
+def sd_ellipsoid(p: ArrayLike, radii: ArrayLike) -> FloatArray:
+    """A distance bound (not exact) for an axis-aligned ellipsoid (Quilez, "Ellipsoid - bound (not exact)", 2008).
+
+    ``k0·(k0 − 1)/k1`` with ``k0 = |p/r|``, ``k1 = |p/r²|``: zero exactly on the surface and of the right sign,
+    but only an approximation of the distance away from it (exact for a sphere), and not 1-Lipschitz for an
+    elongated ellipsoid (scenes use :func:`sd_ellipsoid_lipschitz`). At the centre, where the formula is 0/0, it is
+    −min(radii), the exact value there.
+
+    Args:
+        p: (N, 3) points in the local frame (m).
+        radii: (3,) semi-axes along x, y, z (m), each > 0.
+
+    Returns:
+        (N,) signed distance estimates (m).
+    """
+    pts = _checks.points("p", p)
+    r = _checks.vector("radii", radii, 3)
+    if np.any(r <= 0.0):
+        raise ValueError(f"radii must be positive, got {r.tolist()}")
+    k0 = np.linalg.norm(pts / r, axis=1)
+    k1 = np.linalg.norm(pts / (r * r), axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        d = k0 * (k0 - 1.0) / k1
+    return np.where(k1 > 0.0, d, -r.min())
+
+
+def sd_ellipsoid_lipschitz(p: ArrayLike, radii: ArrayLike) -> FloatArray:
+    """A 1-Lipschitz distance bound for an axis-aligned ellipsoid: (|p/r| − 1)·min(r) (Quilez, "Ellipsoid SDF",
+    iquilezles.org/articles/ellipsoids, 2008: the first, simplest bound).
+
+    |∇|p/r|| ≤ 1/min(r), so the value is 1-Lipschitz; it is zero on the surface, hence never more than the true
+    distance: what sphere tracing and the coarse-to-fine mesher need. :func:`sd_ellipsoid` (Quilez's estimate)
+    is closer to the distance but can grow faster than 1 per metre (by up to max(r)/min(r)). Equal radii give
+    the sphere's distance.
+
+    Args:
+        p: (N, 3) points in the local frame (m).
+        radii: (3,) semi-axes along x, y, z (m), each > 0.
+
+    Returns:
+        (N,) signed distance bounds (m).
+    """
+    pts = _checks.points("p", p)
+    r = _checks.vector("radii", radii, 3)
+    if np.any(r <= 0.0):
+        raise ValueError(f"radii must be positive, got {r.tolist()}")
+    return (np.linalg.norm(pts / r, axis=1) - 1.0) * r.min()
+
+
+def sd_plane(p: ArrayLike, normal: ArrayLike, offset: float) -> FloatArray:
+    """Exact distance to the plane n·p + offset = 0, negative on the side −n points to (Quilez, "Plane").
+
+    Args:
+        p: (N, 3) points (m).
+        normal: (3,) normal; normalised here (must be non-zero).
+        offset: the plane's signed distance from the origin along −n (m).
+
+    Returns:
+        (N,) signed distances (m).
+    """
+    pts = _checks.points("p", p)
+    n = _checks.vector("normal", normal, 3)
+    length = float(np.linalg.norm(n))
+    if length < 1e-12:
+        raise ValueError("normal must be non-zero")
+    off = float(offset)
+    if not math.isfinite(off):
+        raise ValueError(f"offset must be finite, got {offset!r}")
+    return pts @ (n / length) + off
+
+
+# ------------------------------------------------------------------------------------------ the registry
+Sizes = tuple[float, ...]
+LocalDistance = Callable[[FloatArray, Sizes], FloatArray]
+"""(N, 3) local points (m) and a kind's sizes (m) → (N,) distances (m)."""
+CoordinateDistance = Callable[[AnyFloatArray, AnyFloatArray, AnyFloatArray, Sizes], AnyFloatArray]
+"""Local x, y, z coordinate arrays (m, any float dtype) and sizes → distances in that dtype."""
+
+
+@dataclasses.dataclass(frozen=True)
+class PrimitiveSpec:
+    """One kind of scene primitive: everything the kernel, the GUI and the GLSL need to know about it."""
+
+    kind: PrimitiveKind
+    """Its name in a :class:`~kernels.sdf.scene.Primitive` (``"sphere"``)."""
+    label: str
+    """The GUI's name for it ("Hexagonal prism")."""
+    code: int
+    """Stable integer code the renderer writes to ``u_kind`` (the GLSL's ``KIND_<NAME>``)."""
+    sizes: tuple[tuple[str, str], ...]
+    """Name and unit of each size parameter, in order (1 to 3: the GLSL holds them in a vec3)."""
+    distance: LocalDistance
+    """The numpy distance of points in the local frame, from its ``sd_*`` function."""
+    bounding_radius: Callable[[Sizes], float]
+    """Radius (m) of a sphere about the local origin that holds the primitive."""
+    half_extents: Callable[[Sizes], tuple[float, float, float]]
+    """Half extents (m) of a local-frame box about the origin that holds the primitive."""
+    glsl_function: str
+    """The GLSL function of its distance (the ``sd_*`` of the same name in ``shaders/sdf.glsl``, or of
+    ``glsl_file``)."""
+    glsl_arguments: str
+    """The GLSL call's arguments in terms of the local point ``p`` and the sizes ``vec3 s``."""
+    glsl_file: Path | None = None
+    """A ``.glsl`` file defining ``glsl_function``; None for the functions of ``shaders/sdf.glsl``."""
+    fused: bool = False
+    """True for the kinds sdf.glsl's ``primitive_distance`` evaluates by its one shared formula (the first four
+    codes); every other kind goes through the generated ``catalogue_distance`` (programs with EXTRA_KINDS)."""
+    distance_xyz: CoordinateDistance | None = None
+    """Optional fast path on coordinate arrays (no (N, 3) temporaries, dtype kept), equal to ``distance``."""
+
+    @property
+    def size_count(self) -> int:
+        """How many size parameters it takes."""
+        return len(self.sizes)
+
+
+def _sphere_xyz(x: AnyFloatArray, y: AnyFloatArray, z: AnyFloatArray, s: Sizes) -> AnyFloatArray:
+    return np.sqrt(x * x + y * y + z * z) - s[0]
+
+
+def _box_xyz(x: AnyFloatArray, y: AnyFloatArray, z: AnyFloatArray, s: Sizes) -> AnyFloatArray:
+    qx, qy, qz = np.abs(x) - s[0], np.abs(y) - s[1], np.abs(z) - s[2]
+    ox, oy, oz = np.maximum(qx, 0.0), np.maximum(qy, 0.0), np.maximum(qz, 0.0)
+    inside = np.minimum(np.maximum(np.maximum(qx, qy), qz), 0.0)
+    return np.sqrt(ox * ox + oy * oy + oz * oz) + inside
+
+
+def _torus_xyz(x: AnyFloatArray, y: AnyFloatArray, z: AnyFloatArray, s: Sizes) -> AnyFloatArray:
+    qx = np.sqrt(x * x + z * z) - s[0]
+    return np.sqrt(qx * qx + y * y) - s[1]
+
+
+def _capsule_xyz(x: AnyFloatArray, y: AnyFloatArray, z: AnyFloatArray, s: Sizes) -> AnyFloatArray:
+    off = y - np.clip(y, -s[0], s[0])  # the segment runs from (0, −h, 0) to (0, h, 0)
+    return np.sqrt(x * x + off * off + z * z) - s[1]
+
+
+def _norm3(s: Sizes) -> float:
+    return math.sqrt(s[0] ** 2 + s[1] ** 2 + s[2] ** 2)
+
+
+_M = "m"
+# fmt: off
+_BUILT_IN = (
+    PrimitiveSpec(
+        "sphere", "Sphere", 0, (("radius", _M),),
+        lambda p, s: sd_sphere(p, s[0]),
+        lambda s: s[0],
+        lambda s: (s[0], s[0], s[0]),
+        "sd_sphere", "p, s.x", fused=True, distance_xyz=_sphere_xyz,
+    ),
+    PrimitiveSpec(
+        "box", "Box", 1, (("half_x", _M), ("half_y", _M), ("half_z", _M)),
+        lambda p, s: sd_box(p, s),
+        _norm3,
+        lambda s: (s[0], s[1], s[2]),
+        "sd_box", "p, s", fused=True, distance_xyz=_box_xyz,
+    ),
+    PrimitiveSpec(
+        "torus", "Torus", 2, (("major_radius", _M), ("minor_radius", _M)),
+        lambda p, s: sd_torus(p, s[0], s[1]),
+        lambda s: s[0] + s[1],
+        lambda s: (s[0] + s[1], s[1], s[0] + s[1]),
+        "sd_torus", "p, s.x, s.y", fused=True, distance_xyz=_torus_xyz,
+    ),
+    PrimitiveSpec(
+        "capsule", "Capsule", 3, (("half_length", _M), ("radius", _M)),
+        lambda p, s: sd_capsule(p, (0.0, -s[0], 0.0), (0.0, s[0], 0.0), s[1]),
+        lambda s: s[0] + s[1],
+        lambda s: (s[1], s[0] + s[1], s[1]),
+        "sd_capsule", "p, vec3(0.0, -s.x, 0.0), vec3(0.0, s.x, 0.0), s.y",
+        fused=True, distance_xyz=_capsule_xyz,
+    ),
+    PrimitiveSpec(
+        "cylinder", "Cylinder", 4, (("half_height", _M), ("radius", _M)),
+        lambda p, s: sd_cylinder(p, s[0], s[1]),
+        lambda s: math.hypot(s[0], s[1]),
+        lambda s: (s[1], s[0], s[1]),
+        "sd_cylinder", "p, s.x, s.y",
+    ),
+    PrimitiveSpec(
+        "round_box", "Round box", 5, (("half_x", _M), ("half_y", _M), ("half_z", _M)),
+        lambda p, s: sd_round_box(p, s, ROUND_BOX_ROUNDING * min(s)),
+        _norm3,
+        lambda s: (s[0], s[1], s[2]),
+        "sd_round_box", "p, s, ROUND_BOX_ROUNDING * min(s.x, min(s.y, s.z))",
+    ),
+    PrimitiveSpec(
+        "octahedron", "Octahedron", 6, (("size", _M),),
+        lambda p, s: sd_octahedron(p, s[0]),
+        lambda s: s[0],
+        lambda s: (s[0], s[0], s[0]),
+        "sd_octahedron", "p, s.x",
+    ),
+    PrimitiveSpec(
+        "cone", "Cone", 7, (("radius", _M), ("height", _M)),
+        lambda p, s: sd_cone(p, s[0], s[1]),
+        lambda s: math.hypot(s[0], s[1] / 2),
+        lambda s: (s[0], s[1] / 2, s[0]),
+        "sd_cone", "p, s.x, s.y",
+    ),
+    PrimitiveSpec(
+        "hex_prism", "Hexagonal prism", 8, (("apothem", _M), ("half_height", _M)),
+        lambda p, s: sd_hex_prism(p, s[0], s[1]),
+        lambda s: math.hypot(2 * s[0] / math.sqrt(3.0), s[1]),
+        lambda s: (2 * s[0] / math.sqrt(3.0), s[0], s[1]),
+        "sd_hex_prism", "p, s.x, s.y",
+    ),
+    # A scene's ellipsoid uses the 1-Lipschitz bound: Quilez's estimate is not 1-Lipschitz when elongated.
+    PrimitiveSpec(
+        "ellipsoid", "Ellipsoid (bound)", 9, (("radius_x", _M), ("radius_y", _M), ("radius_z", _M)),
+        lambda p, s: sd_ellipsoid_lipschitz(p, s),
+        lambda s: max(s),
+        lambda s: (s[0], s[1], s[2]),
+        "sd_ellipsoid_lipschitz", "p, s",
+    ),
+)
+# fmt: on
+
+PRIMITIVES: dict[str, PrimitiveSpec] = {spec.kind: spec for spec in _BUILT_IN}
+"""Every kind a scene primitive may be, by name, in code order: the built-in ten and any registered since."""
+BUILT_IN_KINDS: tuple[PrimitiveKind, ...] = tuple(spec.kind for spec in _BUILT_IN)
+
+
+def primitive_kinds() -> tuple[str, ...]:
+    """The names of every registered kind, in code order."""
+    return tuple(PRIMITIVES)
+
+
+def primitive_spec(kind: str) -> PrimitiveSpec:
+    """The registry entry of ``kind``, or ``ValueError`` naming the kinds there are."""
+    spec = PRIMITIVES.get(kind)
+    if spec is None:
+        raise ValueError(f"kind must be one of {primitive_kinds()}, got {kind!r}")
+    return spec
+
+
+def register_primitive(spec: PrimitiveSpec) -> None:
+    """Add a kind to :data:`PRIMITIVES`: a new name and the next free code, 1 to 3 sizes, not ``fused``.
+
+    Its GLSL function must be defined in ``spec.glsl_file`` (or already in ``shaders/sdf.glsl``); renderers created
+    afterwards dispatch to it.
+    """
+    if spec.kind in PRIMITIVES:
+        raise ValueError(f"kind {spec.kind!r} is already registered")
+    next_code = max(s.code for s in PRIMITIVES.values()) + 1
+    if spec.code != next_code:
+        raise ValueError(f"code must be the next free code {next_code}, got {spec.code!r}")
+    if not 1 <= spec.size_count <= 3:
+        raise ValueError(f"sizes must name 1 to 3 parameters, got {spec.size_count}")
+    if spec.fused:
+        raise ValueError("fused must be False: only the built-in four share sdf.glsl's one formula")
+    if not spec.glsl_function.isidentifier():
+        raise ValueError(f"glsl_function must be a GLSL name, got {spec.glsl_function!r}")
+    PRIMITIVES[spec.kind] = spec
+
+
+def unregister_primitive(kind: str) -> None:
+    """Remove a kind added by :func:`register_primitive` (the built-in ten stay)."""
+    if kind in BUILT_IN_KINDS:
+        raise ValueError(f"kind {kind!r} is built in")
+    primitive_spec(kind)
+    del PRIMITIVES[kind]
