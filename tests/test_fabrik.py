@@ -834,9 +834,14 @@ def test_issue_8_full_reach_targets_of_the_default_arm_are_reached(
 def test_warm_up_compiles_every_core_with_a_cache() -> None:
     from numba.core.registry import CPUDispatcher
 
+    from kernels.fabrik import chain, geometry, limits, tree
+
     fabrik.warm_up()
     cores = {
-        name: value for name, value in vars(fabrik).items() if isinstance(value, CPUDispatcher)
+        name: value
+        for module in (chain, geometry, limits, tree)
+        for name, value in vars(module).items()
+        if isinstance(value, CPUDispatcher)
     }
     assert {"_solve_rows", "_solve_parallel", "_forward_pass", "_ccd_sweep", "_dls_step"} <= set(
         cores
@@ -845,7 +850,7 @@ def test_warm_up_compiles_every_core_with_a_cache() -> None:
         cache = core._cache  # pyright: ignore[reportAttributeAccessIssue]
         assert type(cache).__name__ == "FunctionCache", name  # cache=True on every core
     # The two entry points are compiled (or loaded); the cores they call are linked into them.
-    assert fabrik._solve_rows.signatures and fabrik._solve_parallel.signatures
+    assert chain._solve_rows.signatures and chain._solve_parallel.signatures
 
 
 def test_compile_cache_falls_back_to_a_user_directory_when_the_package_is_read_only(
