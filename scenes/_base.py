@@ -4,38 +4,43 @@ A scene owns every viser handle it creates. It puts its 3D nodes under the frame
 folder, so :meth:`Scene.close` removes everything with two calls (viser cascades removal to children) and stops
 any thread the scene started.
 
-A scene is built on a :class:`~scenes._session.Session` (one browser tab's scene and GUI, or the server's, shared);
+A scene is built on a :class:`~server.sessions.Session` (one browser tab's scene and GUI, or the server's, shared);
 given a plain ``viser.ViserServer`` it builds on the shared session of that server.
 
-Every value a browser sends is untrusted. The gate (:mod:`scenes._gate`) lets only a control's value, a gizmo's pose
+Every value a browser sends is untrusted. The gate (:mod:`server.gate`) lets only a control's value, a gizmo's pose
 and a camera through, already checked against the control's recorded spec. Scenes still read GUI values only through
-:meth:`Scene.read_number`, :meth:`Scene.read_choice` and :meth:`Scene.read_bool`, which clamp to the recorded spec
-(never to a handle's props) or fall back to the last good value and write the cleaned value back, and wrap every
-callback in :meth:`Scene.callback`, which serialises callbacks (viser runs plain callbacks on a thread pool) and
-logs, rather than raises, anything that goes wrong.
+:meth:`Scene.read_controls` (the controls declared on the scene's parameter dataclass, :mod:`scenes._controls`) or
+:meth:`Scene.read_number`, :meth:`Scene.read_choice` and :meth:`Scene.read_bool`, which clean a value with the gate's
+own :func:`server.clean.clean_value` against the recorded spec (never a handle's props), fall back to the last good
+value for anything unusable and write the cleaned value back. They wrap every callback in :meth:`Scene.callback`,
+which serialises callbacks (viser runs plain callbacks on a thread pool) and logs, rather than raises, anything that
+goes wrong.
 """
 
 from __future__ import annotations
 
 import abc
-import collections
-import contextlib
+import dataclasses
 import functools
 import logging
-import math
 import threading
 import time
-from collections.abc import Callable, Iterator, Sequence
-from typing import Any, ClassVar, TypeVar
+from collections.abc import Callable, Sequence
+from typing import Any, ClassVar, Generic, TypeVar
 
 import numpy as np
 import viser
 
-from scenes._gate import control_spec
-from scenes._session import Session
-from scenes._session import (
-    camera_hub as camera_hub,  # re-exported: tests and older callers import it from here
-)
+from scenes import _controls
+from scenes._controls import Controls, P
+
+# The one bridge from the scenes to server/: a scene module imports what it needs of server/ from here.
+from server.clean import ControlSpec as ControlSpec
+from server.clean import clean_value, control_spec
+from server.clean import mark_costly as mark_costly
+from server.clean import record_spec as record_spec
+from server.sessions import Session
+from server.turns import TURNS as TURNS
 
 logger = logging.getLogger(__name__)
 
@@ -45,55 +50,12 @@ BUILD_WAIT_S = 120.0
 """How long a browser's callback waits for its scene to finish building before it gives up (s)."""
 
 
-class Turns:
-    """A process-wide turn to run a scene's callback: one at a time, in the order they asked, re-entrant per thread.
+class Scene(abc.ABC, Generic[P]):
+    """Base class of the four scenes. Subclasses set the class variables and build in ``__init__``.
 
-    Python runs one thread at a time anyway. Left to interleave, the callbacks of 8 tabs at 30 inputs/s each ran
-    about four at once, each about four times slower (a free kick input: 2.8 ms alone, a median of 19 ms in the
-    soak), so a tab's next input arrived while its last was still running and latest-wins coalescing
-    (:meth:`Scene.callback`) never had a burst to merge. Taking turns, each callback runs at its own speed and the
-    inputs that arrive meanwhile wait, to be merged. A turn is handed to the longest waiter (no tab starves).
+    ``P`` is the scene's frozen parameter dataclass (``class ArmScene(Scene[ArmParams])``): ``self.params`` has its
+    type, and :meth:`read_controls` reads its declared controls (:mod:`scenes._controls`).
     """
-
-    def __init__(self) -> None:
-        self._mutex = threading.Lock()
-        self._owner: int | None = None
-        self._depth = 0
-        self._waiting: collections.deque[tuple[int, threading.Event]] = collections.deque()
-
-    @contextlib.contextmanager
-    def turn(self) -> Iterator[None]:
-        """Hold the turn for the ``with`` block (at once when this thread holds it already)."""
-        me = threading.get_ident()
-        with self._mutex:
-            if self._owner == me or (self._owner is None and not self._waiting):
-                self._owner, self._depth = me, self._depth + 1
-                handed = None
-            else:
-                handed = threading.Event()
-                self._waiting.append((me, handed))
-        if handed is not None:
-            handed.wait()  # the holder hands the turn over: owner and depth are already ours
-        try:
-            yield
-        finally:
-            with self._mutex:
-                self._depth -= 1
-                if self._depth == 0:
-                    if self._waiting:
-                        self._owner, event = self._waiting.popleft()
-                        self._depth = 1
-                        event.set()
-                    else:
-                        self._owner = None
-
-
-TURNS = Turns()
-"""The one :class:`Turns` of the process: every scene's callbacks take it (a scene's own lock first)."""
-
-
-class Scene(abc.ABC):
-    """Base class of the four scenes. Subclasses set the class variables and build in ``__init__``."""
 
     key: ClassVar[str]
     """Registry key and root node name, e.g. ``"peloton"``."""
@@ -105,6 +67,8 @@ class Scene(abc.ABC):
     """Where the camera opens (world frame, m)."""
     camera_look_at: ClassVar[tuple[float, float, float]] = (0.0, 0.0, 0.5)
     """What the camera opens looking at (world frame, m)."""
+    params: P
+    """What the user set, cleaned: the scene shows a function of it (set by the subclass before it builds)."""
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
         """Mark the scene built when the most-derived ``__init__`` returns (callbacks wait for it)."""
@@ -285,43 +249,46 @@ class Scene(abc.ABC):
         """The handle's value as a finite number clamped to the range the scene gave the control; ``last_good`` if
         it is not a number.
 
-        The range is the control's recorded spec (:func:`scenes._gate.control_spec`), never the handle's props.
-        The cleaned value is written back to the GUI so every browser shows what the scene uses.
+        The range is the control's recorded spec (:func:`server.clean.control_spec`), never the handle's props, and
+        the value is cleaned by the gate's own :func:`server.clean.clean_value`. The cleaned value is written back to
+        the GUI so every browser shows what the scene uses.
         """
         raw = handle.value
-        value = _as_finite(raw)
-        if value is None:
-            value = float(last_good)
         spec = control_spec(handle)
-        if spec.lo is not None:
-            value = max(value, spec.lo)
-        if spec.hi is not None:
-            value = min(value, spec.hi)
-        if integer:
-            value = float(round(value))
-        if not _same(raw, value):
-            self._write_back(handle, int(value) if integer else value)
-        return value
+        if integer and not spec.integer:
+            spec = dataclasses.replace(spec, integer=True)
+        accepted, cleaned, _reason = clean_value(spec, raw)
+        if not accepted:
+            self.write_back(handle, int(last_good) if integer else float(last_good))
+            return float(last_good)
+        if not _controls.same_value(raw, cleaned):
+            self.write_back(handle, cleaned)
+        return float(cleaned)
 
     def read_choice(self, handle: Any, options: Sequence[T], last_good: T) -> T:
         """The handle's value if it is one of ``options`` and of the control's recorded options, else ``last_good``
         (written back)."""
-        raw = handle.value
-        recorded = control_spec(handle).options
-        for option in options:
-            if recorded and option not in recorded:
-                continue
-            if raw == option and type(raw) is type(option):
-                return option
-        self._write_back(handle, last_good)
+        accepted, cleaned, _reason = clean_value(control_spec(handle), handle.value)
+        if accepted:
+            for option in options:
+                if option == cleaned:
+                    return option
+        self.write_back(handle, last_good)
         return last_good
 
     def read_bool(self, handle: Any, last_good: bool) -> bool:
-        raw = handle.value
-        if isinstance(raw, bool):
-            return raw
-        self._write_back(handle, last_good)
+        """The checkbox's value if it is a bool, else ``last_good`` (written back)."""
+        accepted, cleaned, _reason = clean_value(control_spec(handle), handle.value)
+        if accepted and isinstance(cleaned, bool):
+            return cleaned
+        self.write_back(handle, last_good)
         return last_good
+
+    def read_controls(self, controls: Controls[P]) -> P:
+        """The scene's parameters as its declared controls hold them now, cleaned as the gate cleans them: out of
+        range is clamped, unusable keeps ``self.params``'s value, and what differs is written back
+        (:func:`scenes._controls.read_controls`)."""
+        return _controls.read_controls(controls, self.params, write_back=self.write_back)
 
     def read_position(
         self,
@@ -347,7 +314,9 @@ class Scene(abc.ABC):
             handle.position = tuple(cleaned)
         return (float(cleaned[0]), float(cleaned[1]), float(cleaned[2]))
 
-    def _write_back(self, handle: Any, value: Any) -> None:
+    def write_back(self, handle: Any, value: Any) -> None:
+        """Set GUI ``handle``'s value to ``value`` (a cleaned value, shown to every browser) without running this
+        scene's handler of it again (the ``on_update`` the write triggers returns at once)."""
         was = self._in_callback
         self._in_callback = (
             True  # the synchronous on_update this triggers must not re-run the handler
@@ -356,6 +325,8 @@ class Scene(abc.ABC):
             handle.value = value
         finally:
             self._in_callback = was
+
+    _write_back = write_back  # the name a scene's own methods still call it by
 
 
 def set_if_changed(handle: Any, name: str, value: Any) -> None:
@@ -377,14 +348,3 @@ def _describe(func: Callable[..., object]) -> str:
     while isinstance(func, functools.partial):
         func = func.func
     return str(getattr(func, "__qualname__", None) or getattr(func, "__name__", None) or repr(func))
-
-
-def _as_finite(value: object) -> float | None:
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        return None
-    number = float(value)
-    return number if math.isfinite(number) else None
-
-
-def _same(raw: object, value: float) -> bool:
-    return isinstance(raw, (int, float)) and not isinstance(raw, bool) and float(raw) == value

@@ -16,6 +16,7 @@ import dataclasses
 import functools
 import math
 import time
+from dataclasses import field
 from typing import Any, Literal
 
 import numpy as np
@@ -27,6 +28,7 @@ from numpy.typing import NDArray
 from kernels import fabrik
 from scenes._base import Scene
 from scenes._charts import FittedChart
+from scenes._controls import build_controls, checkbox, dropdown, slider
 from scenes._framing import ClientFraming, Lens, View, frame_points
 from scenes._skeletons import GIZMO_SCALE_M as SKELETON_GIZMO_M
 from scenes._skeletons import SkeletonView
@@ -59,29 +61,50 @@ LIMIT_RAMP = np.array([(60, 200, 90), (250, 200, 40), (230, 50, 50)], dtype=np.f
 
 @dataclasses.dataclass(frozen=True)
 class ArmParams:
-    """Everything the scene shows is a function of these, the target and the obstacles; defaults open the scene."""
+    """Everything the scene shows is a function of these, the target and the obstacles; defaults open the scene.
 
-    n_links: int = 6
+    Each field is also its GUI control, declared once (:mod:`scenes._controls`), in the order and folder shown.
+    """
+
+    n_links: int = field(default=6, metadata=slider("Links", 2, MAX_LINKS, 1, folder="Chain"))
     """Links in the chain (2–12)."""
-    link_length_m: float = 0.25
+    link_length_m: float = field(
+        default=0.25, metadata=slider("Link length (m)", 0.05, 0.5, 0.01, folder="Chain")
+    )
     """Length of every link (m)."""
-    three_d: bool = False
+    three_d: bool = field(
+        default=False, metadata=checkbox("3D (free target, sphere obstacles)", folder="Chain")
+    )
     """False: the chain moves in the vertical x–z plane; True: in 3D."""
-    limits: bool = False
+    limits: bool = field(default=False, metadata=checkbox("Joint limits", folder="Joint limits"))
     """Whether joint limits (cones) apply."""
-    half_angle_deg: float = 45.0
+    half_angle_deg: float = field(
+        default=45.0,
+        metadata=slider("Cone half-angle (°)", 0.0, 180.0, 1.0, folder="Joint limits"),
+    )
     """Cone half-angle of every joint (degrees)."""
-    avoid: bool = True
+    avoid: bool = field(default=True, metadata=checkbox("Avoid obstacles", folder="Obstacles"))
     """Whether the solver avoids the obstacles (when off they are drawn but ignored)."""
-    n_obstacles: int = 1
+    n_obstacles: int = field(
+        default=1, metadata=slider("Obstacles", 0, MAX_OBSTACLES, 1, folder="Obstacles")
+    )
     """Obstacles shown (0–4)."""
-    radii_m: tuple[float, ...] = (0.18, 0.15, 0.12, 0.2)
-    """Radius of each obstacle (m)."""
-    solver: SolverLabel = "FABRIK"
+    radii_m: tuple[float, ...] = field(
+        default=(0.18, 0.15, 0.12, 0.2),
+        metadata=slider("Obstacle {n} radius (m)", 0.03, 0.6, 0.01, folder="Obstacles"),
+    )
+    """Radius of each obstacle (m): one slider each."""
+    solver: SolverLabel = field(
+        default="FABRIK", metadata=dropdown("Solver", tuple(SOLVER_FROM_LABEL), folder="Solver")
+    )
     """Iterative method."""
-    tolerance_mm: float = 1.0
+    tolerance_mm: float = field(
+        default=1.0, metadata=slider("Tolerance (mm)", 0.01, 50.0, 0.01, folder="Solver")
+    )
     """Stop when the end effector is this close to the target (mm)."""
-    max_iterations: int = 50
+    max_iterations: int = field(
+        default=50, metadata=slider("Max iterations", 1, 500, 1, folder="Solver")
+    )
     """Iteration cap per solve."""
 
 
@@ -294,7 +317,7 @@ def _disc() -> trimesh.Trimesh:
 
 
 # --------------------------------------------------------------------------------------------- scene
-class ArmScene(Scene):
+class ArmScene(Scene[ArmParams]):
     key = "arm"
     title = "Arm: FABRIK inverse kinematics"
     camera_position = (0.3, -2.9, 1.0)
@@ -381,55 +404,10 @@ is a static pose.
                     title="Error after each iteration (log scale)",
                     aspect=1.6,
                 )
-            with gui.add_folder("Chain"):
-                self.links = gui.add_slider(
-                    "Links", min=2, max=MAX_LINKS, step=1, initial_value=p.n_links
-                )
-                self.length = gui.add_slider(
-                    "Link length (m)", min=0.05, max=0.5, step=0.01, initial_value=p.link_length_m
-                )
-                self.three_d = gui.add_checkbox(
-                    "3D (free target, sphere obstacles)", initial_value=p.three_d
-                )
+            self.controls = build_controls(gui, p)
+            with self.controls.folders["Chain"]:  # after the chain's controls
                 self.reset_pose = gui.add_button("Straighten the chain")
-            with gui.add_folder("Joint limits"):
-                self.limits = gui.add_checkbox("Joint limits", initial_value=p.limits)
-                self.half_angle = gui.add_slider(
-                    "Cone half-angle (°)",
-                    min=0.0,
-                    max=180.0,
-                    step=1.0,
-                    initial_value=p.half_angle_deg,
-                )
-            with gui.add_folder("Obstacles"):
-                self.avoid = gui.add_checkbox("Avoid obstacles", initial_value=p.avoid)
-                self.obstacle_count = gui.add_slider(
-                    "Obstacles", min=0, max=MAX_OBSTACLES, step=1, initial_value=p.n_obstacles
-                )
-                self.radii = [
-                    gui.add_slider(
-                        f"Obstacle {k + 1} radius (m)",
-                        min=0.03,
-                        max=0.6,
-                        step=0.01,
-                        initial_value=p.radii_m[k],
-                    )
-                    for k in range(MAX_OBSTACLES)
-                ]
-            with gui.add_folder("Solver"):
-                self.solver = gui.add_dropdown(
-                    "Solver", options=list(SOLVER_FROM_LABEL), initial_value=p.solver
-                )
-                self.tolerance = gui.add_slider(
-                    "Tolerance (mm)", min=0.01, max=50.0, step=0.01, initial_value=p.tolerance_mm
-                )
-                self.max_iterations = gui.add_slider(
-                    "Max iterations", min=1, max=500, step=1, initial_value=p.max_iterations
-                )
-        for handle in (
-            self.links, self.length, self.three_d, self.limits, self.half_angle, self.avoid,
-            self.obstacle_count, *self.radii, self.solver, self.tolerance, self.max_iterations,
-        ):  # fmt: skip
+        for handle in self.controls:  # a wrapper each, so a burst on one control coalesces
             handle.on_update(self.callback(self._on_input))
         self.reset_pose.on_click(self.callback(self._on_reset_pose))
 
@@ -704,24 +682,7 @@ is a static pose.
 
     def read_params(self) -> ArmParams:
         """The current GUI values, cleaned: anything non-finite, out of range or unknown keeps the last good value."""
-        last = self.params
-        return ArmParams(
-            n_links=int(self.read_number(self.links, last.n_links, integer=True)),
-            link_length_m=self.read_number(self.length, last.link_length_m),
-            three_d=self.read_bool(self.three_d, last.three_d),
-            limits=self.read_bool(self.limits, last.limits),
-            half_angle_deg=self.read_number(self.half_angle, last.half_angle_deg),
-            avoid=self.read_bool(self.avoid, last.avoid),
-            n_obstacles=int(self.read_number(self.obstacle_count, last.n_obstacles, integer=True)),
-            radii_m=tuple(
-                self.read_number(handle, last.radii_m[k]) for k, handle in enumerate(self.radii)
-            ),
-            solver=self.read_choice(self.solver, list(SOLVER_FROM_LABEL), last.solver),
-            tolerance_mm=self.read_number(self.tolerance, last.tolerance_mm),
-            max_iterations=int(
-                self.read_number(self.max_iterations, last.max_iterations, integer=True)
-            ),
-        )
+        return self.read_controls(self.controls)
 
     # ----------------------------------------------------------------------------------------- solve + draw
     def solve_and_draw(self) -> None:

@@ -19,7 +19,7 @@ from scenes.arm import (
     rest_pose,
     solve_arm,
 )
-from scenes.switcher import SceneSwitcher
+from server.switcher import SceneSwitcher
 
 
 @pytest.fixture
@@ -71,10 +71,10 @@ def test_opening_state_reaches_the_target_around_the_obstacle(scene: ArmScene) -
 
 
 def test_two_links_ghost_is_the_fabrik_solution(scene: ArmScene) -> None:
-    scene.obstacle_count.value = 0
-    scene.tolerance.value = 0.01
-    scene.max_iterations.value = 500
-    scene.links.value = 2
+    scene.controls["n_obstacles"].value = 0
+    scene.controls["tolerance_mm"].value = 0.01
+    scene.controls["max_iterations"].value = 500
+    scene.controls["n_links"].value = 2
     scene.target_gizmo.position = (0.3, 0.0, 0.2)  # inside the 0.5 m reach
     scene._apply_target()
     report = scene.report
@@ -84,9 +84,9 @@ def test_two_links_ghost_is_the_fabrik_solution(scene: ArmScene) -> None:
 
 
 def test_more_links_and_joint_limits(scene: ArmScene) -> None:
-    scene.links.value = MAX_LINKS
-    scene.half_angle.value = 30.0
-    scene.limits.value = True
+    scene.controls["n_links"].value = MAX_LINKS
+    scene.controls["half_angle_deg"].value = 30.0
+    scene.controls["limits"].value = True
     assert len(drawn_joints(scene)) == MAX_LINKS + 1
     angles = fabrik.joint_angles(scene.pose[:, [0, 2]], [0.0, 1.0])
     assert np.all(angles <= math.radians(30.0) + 1e-6)
@@ -105,18 +105,18 @@ def test_more_links_and_joint_limits(scene: ArmScene) -> None:
 
 
 def test_obstacles_are_avoided_and_ignored_when_avoidance_is_off(scene: ArmScene) -> None:
-    scene.avoid.value = False
+    scene.controls["avoid"].value = False
     free_pose = scene.pose.copy()
     # Put the obstacle on the middle joint of the unobstructed solution, then let the chain avoid it.
     scene.obstacle_gizmos[0].position = tuple(free_pose[3])
     scene._apply_obstacle(0)
     # Avoidance off: the chain goes straight through the obstacle's centre.
     assert clearance(scene.pose, free_pose[3]) == 0.0
-    scene.avoid.value = True
+    scene.controls["avoid"].value = True
     report = scene.report
     assert report is not None and report.result.status == "reached"
     assert clearance(scene.pose, free_pose[3]) >= scene.params.radii_m[0]
-    scene.obstacle_count.value = 4
+    scene.controls["n_obstacles"].value = 4
     for k in range(4):
         assert clearance(scene.pose, scene.obstacle_centres[k]) >= scene.params.radii_m[k]
         assert scene.obstacle_discs[k].visible and not scene.obstacle_spheres[k].visible
@@ -133,7 +133,7 @@ def test_an_obstacle_over_the_root_is_ignored_and_said_so(scene: ArmScene) -> No
 def test_solvers_all_reach_the_target(scene: ArmScene) -> None:
     for label in ("CCD", "Jacobian DLS", "FABRIK"):
         scene.pose = rest_pose(6, 0.25)
-        scene.solver.value = label
+        scene.controls["solver"].value = label
         report = scene.report
         assert report is not None
         assert report.result.status == "reached", label
@@ -141,7 +141,7 @@ def test_solvers_all_reach_the_target(scene: ArmScene) -> None:
 
 
 def test_three_d_mode_frees_the_target(scene: ArmScene) -> None:
-    scene.three_d.value = True
+    scene.controls["three_d"].value = True
     assert scene.target_gizmo.active_axes == (True, True, True)
     assert scene.obstacle_spheres[0].visible and not scene.obstacle_discs[0].visible
     assert not scene.grid.visible
@@ -149,7 +149,7 @@ def test_three_d_mode_frees_the_target(scene: ArmScene) -> None:
     scene._apply_target()
     assert np.linalg.norm(scene.pose[-1] - [0.4, 0.5, 0.9]) < 1e-3
     # Back to the plane: everything is flattened onto y = 0 and solved there.
-    scene.three_d.value = False
+    scene.controls["three_d"].value = False
     assert scene.target[1] == 0.0 and np.all(scene.pose[:, 1] == 0.0)
     assert scene.target_gizmo.active_axes == (True, False, True)
 
@@ -309,9 +309,9 @@ def test_clicking_in_the_plane_places_the_target(
 
 def test_a_target_the_limits_keep_away_reads_limited_not_unreachable(scene: ArmScene) -> None:
     """Issue 8: a target inside the reach that 5° cones cannot bend to is "limited", with the best pose seen."""
-    scene.obstacle_count.value = 0
-    scene.limits.value = True
-    scene.half_angle.value = 5.0
+    scene.controls["n_obstacles"].value = 0
+    scene.controls["limits"].value = True
+    scene.controls["half_angle_deg"].value = 5.0
     report = scene.report
     assert report is not None
     assert np.linalg.norm(TARGET_START) < 6 * 0.25  # inside the reach
@@ -326,8 +326,8 @@ def test_a_target_the_limits_keep_away_reads_limited_not_unreachable(scene: ArmS
 def test_the_view_frames_what_matters_not_the_whole_reach(scene: ArmScene) -> None:
     from scenes.arm import GIZMO_SCALE_M, framed_points
 
-    scene.links.value = 12
-    scene.length.value = 0.5  # a 6 m reach
+    scene.controls["n_links"].value = 12
+    scene.controls["link_length_m"].value = 0.5  # a 6 m reach
     with scene._lock:
         points = framed_points(scene.params, scene.pose, scene.target, scene.obstacle_centres)
         pose, target = scene.pose.copy(), scene.target.copy()
