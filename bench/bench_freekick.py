@@ -2,6 +2,7 @@
 
     python bench/bench_freekick.py            # goal table, accuracy table, scene table
     python bench/bench_freekick.py --goals    # goal table only (a minute)
+    python bench/bench_freekick.py --overhead # single-kick overhead: compiled core vs public simulate
 
 Prints:
 
@@ -13,6 +14,8 @@ Prints:
   average are printed with it;
 * accuracy and time of the curler for Euler 1 ms, RK4 10 ms and scipy's own solvers, the error being the distance
   at the plane x = 30 m from a DOP853 solution at rtol = atol = 1e-12;
+* the single kick's overhead: median and p95 of the compiled core alone and of a full public ``simulate`` call
+  (with a reused ``FlightConfig`` and with keyword options) for a typical free kick, and their ratio;
 * the scene: a spin-slider change recomputed and redrawn on the server (goal p95 ≤ 16 ms) for each model and
   integrator, a speed-slider change, and a spin change from a websocket client's message to the new path arriving
   back; the outcome map and aiming on the scene's worker thread.
@@ -47,7 +50,7 @@ from wsclient import BrowserClient  # noqa: E402
 
 from kernels import ball  # noqa: E402
 from scenes.freekick import MAP_QUIET_S, FreeKickParams, FreeKickScene, outcome_map  # noqa: E402
-from scenes.switcher import SceneSwitcher  # noqa: E402
+from server.switcher import SceneSwitcher  # noqa: E402
 
 M, R, RHO, G = 0.43, 0.11, 1.225, 9.81
 Q = 0.5 * RHO * math.pi * R**2 / M
@@ -508,8 +511,56 @@ def goal_rows() -> None:
     )
 
 
+def overhead_rows(calls: int = 20_000) -> None:
+    """The Python around one kick: the compiled core alone against a full public ``simulate`` call, in turns.
+
+    A typical free kick: the scene's RK4 at 10 ms, a 30 m curler to the plane x = 30 m, t_max 4 s, the ball's
+    underside on the turf. (a) is ``ball._simulate_one`` on a prepared launch row and preallocated buffers; (b) is
+    ``ball.simulate`` with a reused :class:`kernels.ball.FlightConfig`, (c) with the same settings as keywords.
+    Each call is timed on its own; the three alternate, so a neighbour's load falls on all of them alike.
+    """
+    config = ball.FlightConfig(dt=1e-2, method="rk4", t_max=4.0, x_stop=LINE_M, ground_m=R)
+    options = {"dt": 1e-2, "method": "rk4", "t_max": 4.0, "x_stop": LINE_M, "ground_m": R}
+    settings = config.settings
+    launch = np.concatenate((START, VELOCITY, SPIN, np.zeros(4)))
+    rows = int(settings[ball._N_STEPS]) + 1
+    t, state, forces = np.empty(rows), np.empty((rows, 6)), np.empty((rows, 12))
+    ball.simulate(START, VELOCITY, SPIN, config)  # compiled already; warm the caches
+    ball.simulate(START, VELOCITY, SPIN, **options)
+    core_s, public_s, keywords_s = [], [], []
+    clock = time.perf_counter_ns
+    for _ in range(calls):
+        start = clock()
+        ball._simulate_one(launch, settings, t, state, forces)
+        middle = clock()
+        ball.simulate(START, VELOCITY, SPIN, config)
+        end = clock()
+        ball.simulate(START, VELOCITY, SPIN, **options)
+        last = clock()
+        core_s.append((middle - start) * 1e-9)
+        public_s.append((end - middle) * 1e-9)
+        keywords_s.append((last - end) * 1e-9)
+    core = statistics.median(core_s)
+    print(
+        "| measurement                                    |     median |        p95 | unit | note"
+    )
+    print(
+        "|------------------------------------------------|-----------:|-----------:|------|-----"
+    )
+    row("(a) compiled core alone, RK4 10 ms, 30 m", core_s, 1e-6, "us", f"{calls} calls")
+    row("(b) simulate(..., config)", public_s, 1e-6, "us",
+        f"{statistics.median(public_s) / core:.2f}x the core (goal <= 2x)")  # fmt: skip
+    row("(c) simulate(..., dt=..., method=...)", keywords_s, 1e-6, "us",
+        f"{statistics.median(keywords_s) / core:.2f}x the core")  # fmt: skip
+    print(f"load average (1 min) {os.getloadavg()[0]:.2f}\n")
+
+
 def main() -> None:
+    if "--overhead" in sys.argv:
+        overhead_rows()
+        return
     goal_rows()
+    overhead_rows()
     if "--goals" in sys.argv:
         return
     print(

@@ -75,6 +75,8 @@ import numpy as np
 from numba import njit, prange
 from numpy.typing import ArrayLike, NDArray
 
+from kernels import _checks
+
 G = 9.81
 """Gravitational acceleration (m/s²)."""
 BALL_MASS_KG = 0.43
@@ -273,12 +275,14 @@ def free_kick_panels(
         )
     aim /= distance
     left = np.array([-aim[1], aim[0]])
-    wall_foot = ball + WALL_DISTANCE_M * aim + _finite_scalar("wall_offset_m", wall_offset_m) * left
+    wall_foot = (
+        ball + WALL_DISTANCE_M * aim + _checks.finite_number("wall_offset_m", wall_offset_m) * left
+    )
     wall = Panel(
         (float(wall_foot[0]), float(wall_foot[1])),
         (float(aim[0]), float(aim[1])),
-        _positive_scalar("wall_width_m", wall_width_m),
-        _positive_scalar("wall_height_m", wall_height_m),
+        _checks.positive("wall_width_m", wall_width_m),
+        _checks.positive("wall_height_m", wall_height_m),
     )
     goal = Panel(
         (float(centre[0]), float(centre[1])),
@@ -306,58 +310,39 @@ def _booleans(value: object) -> bool:
 
 
 def _vector(name: str, value: ArrayLike, size: int) -> NDArray[np.float64]:
-    try:
-        array = np.array(value, dtype=np.float64)
-    except (TypeError, ValueError) as error:
-        raise ValueError(f"{name} must be {size} numbers, got {value!r}") from error
+    """:func:`kernels._checks.vector`, and no boolean anywhere inside (special to this kernel: numpy turns a
+    ``[1.0, True, 2.0]`` into floats, and a flag where a coordinate belongs is a caller's bug)."""
     if _booleans(value):
         raise ValueError(f"{name} must be numbers, not booleans, got {value!r}")
-    if array.shape != (size,):
-        raise ValueError(f"{name} must have shape ({size},), got {array.shape}")
-    if not all(map(math.isfinite, array.tolist())):
-        raise ValueError(f"{name} must be finite, got {value!r}")
-    return array
+    return _checks.vector(name, value, size)
 
 
 def _rows(name: str, value: ArrayLike) -> NDArray[np.float64]:
-    try:
-        array = np.array(value, dtype=np.float64)
-    except (TypeError, ValueError) as error:
-        raise ValueError(f"{name} must be an (N, 3) array of numbers") from error
+    """:func:`kernels._checks.points` with the same boolean guard as :func:`_vector`."""
     if _booleans(value):
         raise ValueError(f"{name} must be numbers, not booleans")
-    if array.size == 0 and array.ndim == 1:  # an empty list: no kicks
-        array = array.reshape(0, 3)
-    if array.ndim != 2 or array.shape[1] != 3:
-        raise ValueError(f"{name} must have shape (N, 3), got {array.shape}")
-    if not np.isfinite(array).all():
-        raise ValueError(f"{name} must be finite")
-    return array
+    return _checks.points(name, value, 3)
 
 
-def _finite_scalar(name: str, value: object) -> float:
-    if type(value) is float and math.isfinite(value):  # the common case, first
-        return value
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise ValueError(f"{name} must be a number, got {value!r}")
-    number = float(value)
-    if not math.isfinite(number):
-        raise ValueError(f"{name} must be finite, got {value!r}")
-    return number
-
-
-def _positive_scalar(name: str, value: object) -> float:
-    number = _finite_scalar(name, value)
-    if number <= 0.0:
-        raise ValueError(f"{name} must be > 0, got {value!r}")
-    return number
-
-
-def _non_negative_scalar(name: str, value: object) -> float:
-    number = _finite_scalar(name, value)
-    if number < 0.0:
-        raise ValueError(f"{name} must be >= 0, got {value!r}")
-    return number
+def _fast_floats(value: object) -> list[float] | None:
+    """The three finite floats of a tuple, list or float64 (3,) array, or None for anything else (then checked in
+    full by :func:`_vector`): the common case of a single kick, at a fraction of a microsecond."""
+    kind = type(value)
+    if kind is np.ndarray:
+        array: Any = value
+        if array.dtype != np.float64 or array.shape != (3,):
+            return None
+        items = array.tolist()
+    elif kind is tuple or kind is list:
+        items: Any = value
+        if len(items) != 3:
+            return None
+    else:
+        return None
+    x, y, z = items
+    if type(x) is float and type(y) is float and type(z) is float and math.isfinite(x + y + z):
+        return [x, y, z]
+    return None
 
 
 def _seed(name: str, value: object) -> int | None:
@@ -368,61 +353,120 @@ def _seed(name: str, value: object) -> int | None:
     return int(value)
 
 
-def _config(
-    *,
-    dt: object,
-    method: object,
-    model: object,
-    drag_coefficient: object,
-    lift_coefficient: object,
-    mass_kg: object,
-    radius_m: object,
-    air_density: object,
-    gravity: object,
-    t_max: object,
-    x_stop: object,
-    ground_m: object,
-) -> NDArray[np.float64]:
-    """The validated settings shared by every kick, as the compiled cores' (14,) settings vector."""
-    step = _positive_scalar("dt", dt)
-    duration = _positive_scalar("t_max", t_max)
-    if duration / step > _MAX_STEPS:
-        raise ValueError(
-            f"dt must be at least t_max/{_MAX_STEPS} = {duration / _MAX_STEPS:g} s, got {step:g}"
+@dataclasses.dataclass(frozen=True)
+class FlightConfig:
+    """Settings shared by every kick of a flight or a batch: the ball, the air, the integrator and the end.
+
+    Validated once, here (``ValueError`` naming the field); :func:`simulate`, :func:`simulate_batch` and
+    :func:`simulate_outcomes` then reuse it without checking again, so build one and pass it to many calls.
+    """
+
+    dt: float = 1e-3
+    """Fixed step (s, > 0), at least ``t_max``/10⁶."""
+    method: Method = "euler"
+    """``"euler"`` (the seed's: v += a·dt, then x += v·dt) or ``"rk4"``."""
+    model: Model = "constant"
+    """``"constant"`` coefficients or ``"measured"`` spin- and Reynolds-dependent fits (module docstring)."""
+    drag_coefficient: float = 0.25
+    """C_D of the constant model (dimensionless, ≥ 0)."""
+    lift_coefficient: float = 0.25
+    """C_L of the constant model (dimensionless, ≥ 0)."""
+    mass_kg: float = BALL_MASS_KG
+    """Ball mass (kg, > 0)."""
+    radius_m: float = BALL_RADIUS_M
+    """Ball radius (m, > 0)."""
+    air_density: float = AIR_DENSITY
+    """ρ (kg/m³, ≥ 0; 0 is a vacuum)."""
+    gravity: float = G
+    """g (m/s², downward when positive)."""
+    t_max: float = 5.0
+    """Longest flight to integrate (s, > 0)."""
+    x_stop: float | None = None
+    """Optional plane x = x_stop (m) that ends a flight when crossed in +x."""
+    ground_m: float = 0.0
+    """Height of the ball's centre at which it touches the ground (m); the radius for a ball whose underside
+    meets the turf at z = 0."""
+    settings: NDArray[np.float64] = dataclasses.field(init=False, repr=False, compare=False)
+    """(14,) the compiled cores' settings vector (slots ``_Q`` … ``_T_MAX``), read-only; derived, not an argument."""
+
+    def __post_init__(self) -> None:
+        step = _checks.positive("dt", self.dt)
+        duration = _checks.positive("t_max", self.t_max)
+        if duration / step > _MAX_STEPS:
+            raise ValueError(
+                f"dt must be at least t_max/{_MAX_STEPS} = {duration / _MAX_STEPS:g} s, got {step:g}"
+            )
+        if self.method not in ("euler", "rk4"):
+            raise ValueError(f"method must be 'euler' or 'rk4', got {self.method!r}")
+        if self.model not in ("constant", "measured"):
+            raise ValueError(f"model must be 'constant' or 'measured', got {self.model!r}")
+        c_d = _checks.non_negative("drag_coefficient", self.drag_coefficient)
+        c_l = _checks.non_negative("lift_coefficient", self.lift_coefficient)
+        mass = _checks.positive("mass_kg", self.mass_kg)
+        radius = _checks.positive("radius_m", self.radius_m)
+        density = _checks.non_negative("air_density", self.air_density)
+        g = _checks.finite_number("gravity", self.gravity)
+        stop = math.inf if self.x_stop is None else _checks.finite_number("x_stop", self.x_stop)
+        ground = _checks.finite_number("ground_m", self.ground_m)
+        # In slot order: _Q (½ρA/m, 1/m), _GRAVITY, _RADIUS, _RE_PER_SPEED, _C_D, _C_L, _MASS, _DT, _GROUND,
+        # _X_STOP, _N_STEPS, _RK4, _MEASURED, _T_MAX.
+        settings = np.array(
+            [
+                0.5 * density * math.pi * radius**2 / mass,
+                g,
+                radius,
+                density * 2.0 * radius / AIR_VISCOSITY,
+                c_d,
+                c_l,
+                mass,
+                step,
+                ground,
+                stop,
+                max(1, math.ceil(duration / step - 1e-9)),
+                self.method == "rk4",
+                self.model == "measured",
+                duration,
+            ]
         )
-    if method not in ("euler", "rk4"):
-        raise ValueError(f"method must be 'euler' or 'rk4', got {method!r}")
-    if model not in ("constant", "measured"):
-        raise ValueError(f"model must be 'constant' or 'measured', got {model!r}")
-    c_d = _non_negative_scalar("drag_coefficient", drag_coefficient)
-    c_l = _non_negative_scalar("lift_coefficient", lift_coefficient)
-    mass = _positive_scalar("mass_kg", mass_kg)
-    radius = _positive_scalar("radius_m", radius_m)
-    density = _non_negative_scalar("air_density", air_density)
-    g = _finite_scalar("gravity", gravity)
-    stop = math.inf if x_stop is None else _finite_scalar("x_stop", x_stop)
-    ground = _finite_scalar("ground_m", ground_m)
-    # In slot order: _Q (½ρA/m, 1/m), _GRAVITY, _RADIUS, _RE_PER_SPEED, _C_D, _C_L, _MASS, _DT, _GROUND, _X_STOP,
-    # _N_STEPS, _RK4, _MEASURED, _T_MAX.
-    config = np.array(
-        [
-            0.5 * density * math.pi * radius**2 / mass,
-            g,
-            radius,
-            density * 2.0 * radius / AIR_VISCOSITY,
-            c_d,
-            c_l,
-            mass,
-            step,
-            ground,
-            stop,
-            max(1, math.ceil(duration / step - 1e-9)),
-            method == "rk4",
-            model == "measured",
-            duration,
-        ]
-    )
-    return config
+        settings.setflags(write=False)
+        object.__setattr__(self, "settings", settings)
+
+
+_DEFAULT_CONFIG = FlightConfig()
+
+_CONFIGS: dict[object, FlightConfig] = {}
+"""Configs already built from keyword options, keyed by (name, type, value) of each: a caller that passes the same
+options on every call validates them once."""
+_CONFIGS_MAX = 256
+
+
+def _flight_config(config: FlightConfig | None, options: dict[str, Any]) -> FlightConfig:
+    """``config``, or one built from ``options`` (:class:`FlightConfig` fields; both together is refused)."""
+    if not options:
+        if config is None:
+            return _DEFAULT_CONFIG
+        if type(config) is not FlightConfig:
+            raise ValueError(f"config must be a FlightConfig, got {type(config).__name__}")
+        return config
+    if config is not None:
+        raise ValueError(
+            f"pass either config or its fields as keywords, not both: {sorted(options)}"
+        )
+    try:
+        key: object = tuple((name, type(value), value) for name, value in options.items())
+        hash(key)
+    except TypeError:  # an unhashable value (an array): validated below, never cached
+        key = None
+    if key is not None:
+        cached = _CONFIGS.get(key)
+        if cached is not None:
+            return cached
+    built = FlightConfig(**options)  # an unknown keyword is a TypeError, as for any function
+    if key is not None:
+        if len(_CONFIGS) >= _CONFIGS_MAX:
+            _CONFIGS.clear()
+        _CONFIGS[key] = built
+    return built
 
 
 def _launches(
@@ -927,20 +971,10 @@ def simulate(
     position: ArrayLike,
     velocity: ArrayLike,
     spin: ArrayLike,
+    config: FlightConfig | None = None,
     *,
-    dt: float = 1e-3,
-    method: Method = "euler",
-    model: Model = "constant",
-    drag_coefficient: float = 0.25,
-    lift_coefficient: float = 0.25,
-    mass_kg: float = BALL_MASS_KG,
-    radius_m: float = BALL_RADIUS_M,
-    air_density: float = AIR_DENSITY,
-    gravity: float = G,
-    t_max: float = 5.0,
-    x_stop: float | None = None,
-    ground_m: float = 0.0,
     knuckle_seed: int | None = None,
+    **options: Any,
 ) -> Trajectory:
     """Integrate one kick until the ball's centre reaches ``ground_m``, passes ``x_stop``, or ``t_max`` runs out.
 
@@ -948,57 +982,44 @@ def simulate(
         position: (3,) launch position of the ball's centre (m).
         velocity: (3,) launch velocity (m/s).
         spin: (3,) angular velocity (rad/s); +z curls a ball kicked along +x to the left (+y), +y is topspin.
-        dt: fixed step (s, > 0).
-        method: ``"euler"`` (the seed's: v += a·dt, then x += v·dt) or ``"rk4"``.
-        model: ``"constant"`` coefficients or ``"measured"`` spin- and Reynolds-dependent fits.
-        drag_coefficient: C_D of the constant model (≥ 0).
-        lift_coefficient: C_L of the constant model (≥ 0).
-        mass_kg: ball mass (kg, > 0).
-        radius_m: ball radius (m, > 0).
-        air_density: ρ (kg/m³, ≥ 0; 0 is a vacuum).
-        gravity: g (m/s², downward when positive).
-        t_max: longest flight to integrate (s, > 0).
-        x_stop: optional plane x = x_stop (m) that ends the flight when crossed in +x.
-        ground_m: height of the ball's centre at which it touches the ground (m); pass the radius for a ball
-            whose underside meets the turf at z = 0.
+        config: the ball, air, integrator and end of the flight (:class:`FlightConfig`, validated once); default
+            ``FlightConfig()``.
         knuckle_seed: turn on the knuckleball side force (near-zero spin only), drawn from this seed.
+        **options: instead of ``config``, any of :class:`FlightConfig`'s fields as keywords (``dt=1e-2,
+            method="rk4"``); the config built from them is cached, so repeating the same options costs no
+            validation.
 
     Returns:
         :class:`Trajectory`, sampled every ``dt`` plus the interpolated end.
 
     Raises:
-        ValueError: naming the argument, for non-finite, boolean or wrongly shaped input, dt ≤ 0, mass or
-            radius ≤ 0, an unknown method or model, a position below ``ground_m``, a spin beyond the measured
-            model's range (see the module docstring); naming dt when the steps overshoot the drag and the ball gains energy without
-            bound (a step far too long for this speed, density and mass).
+        ValueError: naming the argument, for non-finite, boolean or wrongly shaped input, an invalid
+            :class:`FlightConfig` field, a position below ``ground_m``, a spin beyond the measured model's range
+            (see the module docstring); naming dt when the steps overshoot the drag and the ball gains energy
+            without bound (a step far too long for this speed, density and mass).
+        TypeError: an unknown keyword.
     """
-    p0, v0, w0 = (
-        _vector("position", position, 3),
-        _vector("velocity", velocity, 3),
-        _vector("spin", spin, 3),
-    )
-    config = _config(
-        dt=dt,
-        method=method,
-        model=model,
-        drag_coefficient=drag_coefficient,
-        lift_coefficient=lift_coefficient,
-        mass_kg=mass_kg,
-        radius_m=radius_m,
-        air_density=air_density,
-        gravity=gravity,
-        t_max=t_max,
-        x_stop=x_stop,
-        ground_m=ground_m,
-    )
-    launches = _launches(p0[None], v0[None], w0[None], [_seed("knuckle_seed", knuckle_seed)])
-    _check_launches(launches, config, batch=False)
-    launch = launches[0]
-    rows = int(config[_N_STEPS]) + 1
+    flight = _flight_config(config, options)
+    settings = flight.settings
+    p0, v0, w0 = _fast_floats(position), _fast_floats(velocity), _fast_floats(spin)
+    if p0 is None or v0 is None or w0 is None or knuckle_seed is not None:
+        launch = _launches(
+            _vector("position", position, 3)[None],
+            _vector("velocity", velocity, 3)[None],
+            _vector("spin", spin, 3)[None],
+            [_seed("knuckle_seed", knuckle_seed)],
+        )
+        _check_launches(launch, settings, batch=False)
+        launch = launch[0]
+    else:  # three plain vectors and no knuckle: the launch row at once
+        launch = np.array(p0 + v0 + w0 + _NO_KNUCKLE)
+        if settings[_MEASURED] or p0[2] < settings[_GROUND]:
+            _check_launches(launch[None], settings, batch=False)
+    rows = int(settings[_N_STEPS]) + 1
     t, state, forces = np.empty(rows), np.empty((rows, 6)), np.empty((rows, 12))
-    n, ending = _simulate_one(launch, config, t, state, forces)
+    n, ending = _simulate_one(launch, settings, t, state, forces)
     if ending == 3:
-        _refuse_overflow(np.array([ending]), config)
+        _refuse_overflow(np.array([ending]), settings)
     state, forces = state[:n], forces[:n]
     return Trajectory(
         t=t[:n],
@@ -1012,24 +1033,18 @@ def simulate(
     )
 
 
+_NO_KNUCKLE = [0.0, 0.0, 0.0, 0.0]
+"""Knuckle angles θ φ₁ φ₂ and flag of a launch row without the knuckle force."""
+
+
 def simulate_batch(
     positions: ArrayLike,
     velocities: ArrayLike,
     spins: ArrayLike,
+    config: FlightConfig | None = None,
     *,
-    dt: float = 1e-3,
-    method: Method = "euler",
-    model: Model = "constant",
-    drag_coefficient: float = 0.25,
-    lift_coefficient: float = 0.25,
-    mass_kg: float = BALL_MASS_KG,
-    radius_m: float = BALL_RADIUS_M,
-    air_density: float = AIR_DENSITY,
-    gravity: float = G,
-    t_max: float = 5.0,
-    x_stop: float | None = None,
-    ground_m: float = 0.0,
     knuckle_seeds: Sequence[int | None] | None = None,
+    **options: Any,
 ) -> BatchTrajectory:
     """Integrate K kicks, in parallel over the kicks; each flight is :func:`simulate`'s, bit for bit.
 
@@ -1042,44 +1057,32 @@ def simulate_batch(
         velocities: (K, 3) launch velocities (m/s).
         spins: (K, 3) angular velocities (rad/s).
         knuckle_seeds: None, or K seeds (each None or an int) as :func:`simulate`'s ``knuckle_seed``.
-        dt, method, model, drag_coefficient, lift_coefficient, mass_kg, radius_m, air_density, gravity, t_max,
-            x_stop, ground_m: as for :func:`simulate`, shared by every kick.
+        config, options: as for :func:`simulate`, shared by every kick.
 
     Returns:
         :class:`BatchTrajectory`.
     """
+    settings = _flight_config(config, options).settings
     launches = _kick_rows(positions, velocities, spins, knuckle_seeds)
-    config = _config(
-        dt=dt,
-        method=method,
-        model=model,
-        drag_coefficient=drag_coefficient,
-        lift_coefficient=lift_coefficient,
-        mass_kg=mass_kg,
-        radius_m=radius_m,
-        air_density=air_density,
-        gravity=gravity,
-        t_max=t_max,
-        x_stop=x_stop,
-        ground_m=ground_m,
-    )
-    _check_launches(launches, config, batch=True)
+    _check_launches(launches, settings, batch=True)
     k = len(launches)
-    rows = int(config[_N_STEPS]) + 1
+    rows = int(settings[_N_STEPS]) + 1
     n_samples, endings = np.ones(k, dtype=np.int64), np.full(k, 2, dtype=np.int64)
     with _PARALLEL:
         # Time-major (T, K) storage with room for the longest flight t_max allows: rows past this batch's longest
         # flight are never touched, so they never become memory. Where even that reservation is too large, count
         # the samples first.
         if rows * k * 56 > _RESERVE_BYTES:
-            _fly_batch(launches, config, np.empty((0, k)), np.empty((0, k, 6)), n_samples, endings)
+            _fly_batch(
+                launches, settings, np.empty((0, k)), np.empty((0, k, 6)), n_samples, endings
+            )
             rows = int(n_samples.max())
         t, state = np.empty((rows, k)), np.empty((rows, k, 6))
-        _fly_batch(launches, config, t, state, n_samples, endings)
+        _fly_batch(launches, settings, t, state, n_samples, endings)
         width = int(n_samples.max()) if k else 1
         t, state = t[:width], state[:width]
         _pad(t, state, n_samples)
-    _refuse_overflow(endings, config)
+    _refuse_overflow(endings, settings)
     state = state.transpose(1, 0, 2)  # (K, T, 6) view, no copy
     return BatchTrajectory(
         t=t.T,
@@ -1099,8 +1102,8 @@ def _panels(wall: Panel, goal: Panel) -> NDArray[np.float64]:
         if length == 0.0:
             raise ValueError(f"{name}.normal_xy must not be zero")
         row[0:2], row[2:4] = _vector(f"{name}.centre_xy", panel.centre_xy, 2), normal / length
-        row[4] = _positive_scalar(f"{name}.width_m", panel.width_m)
-        row[5] = _finite_scalar(f"{name}.height_m", panel.height_m)
+        row[4] = _checks.positive(f"{name}.width_m", panel.width_m)
+        row[5] = _checks.finite_number(f"{name}.height_m", panel.height_m)
     return rows
 
 
@@ -1124,7 +1127,7 @@ def outcome(
     Returns:
         :class:`Outcome`.
     """
-    radius = _positive_scalar("radius_m", radius_m)
+    radius = _checks.positive("radius_m", radius_m)
     if not isinstance(trajectory, Trajectory):
         raise ValueError(
             f"trajectory must be a Trajectory from simulate(), got {type(trajectory).__name__}"
@@ -1156,7 +1159,7 @@ def outcome_batch(
     Returns:
         :class:`BatchOutcome`.
     """
-    radius = _positive_scalar("radius_m", radius_m)
+    radius = _checks.positive("radius_m", radius_m)
     if not isinstance(batch, BatchTrajectory):
         raise ValueError(
             f"batch must be a BatchTrajectory from simulate_batch(), got {type(batch).__name__}"
@@ -1195,20 +1198,10 @@ def simulate_outcomes(
     spins: ArrayLike,
     wall: Panel,
     goal: Panel,
+    config: FlightConfig | None = None,
     *,
-    dt: float = 1e-3,
-    method: Method = "euler",
-    model: Model = "constant",
-    drag_coefficient: float = 0.25,
-    lift_coefficient: float = 0.25,
-    mass_kg: float = BALL_MASS_KG,
-    radius_m: float = BALL_RADIUS_M,
-    air_density: float = AIR_DENSITY,
-    gravity: float = G,
-    t_max: float = 5.0,
-    x_stop: float | None = None,
-    ground_m: float = 0.0,
     knuckle_seeds: Sequence[int | None] | None = None,
+    **options: Any,
 ) -> BatchOutcome:
     """``outcome_batch(simulate_batch(...), wall, goal)`` without keeping the flights: the same verdicts and crossings.
 
@@ -1219,34 +1212,20 @@ def simulate_outcomes(
         positions, velocities, spins, knuckle_seeds: the K kicks, as for :func:`simulate_batch`.
         wall: the wall.
         goal: the goal mouth.
-        dt, method, model, drag_coefficient, lift_coefficient, mass_kg, radius_m, air_density, gravity, t_max,
-            x_stop, ground_m: as for :func:`simulate`, shared by every kick; ``radius_m`` also sizes the ball for
-            the verdict.
+        config, options: as for :func:`simulate`, shared by every kick; its ``radius_m`` also sizes the ball
+            for the verdict.
 
     Returns:
         :class:`BatchOutcome`.
     """
+    settings = _flight_config(config, options).settings
     launches = _kick_rows(positions, velocities, spins, knuckle_seeds)
-    config = _config(
-        dt=dt,
-        method=method,
-        model=model,
-        drag_coefficient=drag_coefficient,
-        lift_coefficient=lift_coefficient,
-        mass_kg=mass_kg,
-        radius_m=radius_m,
-        air_density=air_density,
-        gravity=gravity,
-        t_max=t_max,
-        x_stop=x_stop,
-        ground_m=ground_m,
-    )
-    _check_launches(launches, config, batch=True)
+    _check_launches(launches, settings, batch=True)
     k, panels = len(launches), _panels(wall, goal)
     results, crossings, endings = np.empty(k, np.int64), np.empty((k, 2, 4)), np.empty(k, np.int64)
     with _PARALLEL:
-        _fly_and_judge(launches, config, panels, results, crossings, endings)
-    _refuse_overflow(endings, config)
+        _fly_and_judge(launches, settings, panels, results, crossings, endings)
+    _refuse_overflow(endings, settings)
     return _batch_outcome(results, crossings)
 
 
@@ -1260,7 +1239,7 @@ def spin_vector(rate_rev_s: float, axis: ArrayLike) -> NDArray[np.float64]:
     Returns:
         (3,) ω (rad/s).
     """
-    rate = _non_negative_scalar("rate_rev_s", rate_rev_s)
+    rate = _checks.non_negative("rate_rev_s", rate_rev_s)
     direction = _vector("axis", axis, 3)
     scale = float(np.abs(direction).max())
     if scale == 0.0:
@@ -1275,9 +1254,9 @@ def launch_velocity(
     speed_ms: float, elevation_rad: float, azimuth_rad: float
 ) -> NDArray[np.float64]:
     """Velocity (3,) in m/s from speed, elevation above the ground and azimuth to the left of +x."""
-    speed = _non_negative_scalar("speed_ms", speed_ms)
-    elevation = _finite_scalar("elevation_rad", elevation_rad)
-    azimuth = _finite_scalar("azimuth_rad", azimuth_rad)
+    speed = _checks.non_negative("speed_ms", speed_ms)
+    elevation = _checks.finite_number("elevation_rad", elevation_rad)
+    azimuth = _checks.finite_number("azimuth_rad", azimuth_rad)
     return speed * np.array(
         [
             math.cos(elevation) * math.cos(azimuth),
