@@ -666,3 +666,53 @@ def test_parents_of_the_wrong_shape_are_refused_after_the_right_one() -> None:
     for bad in (np.array(Y3_PARENTS).reshape(1, 7), np.array(Y3_PARENTS).reshape(7, 1)):
         with pytest.raises(ValueError, match="parents"):
             fabrik.solve_tree(bad, Y3, targets)
+
+
+# ------------------------------------------------------------------------------------------------ one implementation
+@PROPERTY
+@given(SEEDS, st.integers(2, 7), st.booleans())
+def test_chain_and_one_branch_tree_judge_a_pose_alike(seed: int, n: int, limited: bool) -> None:
+    """The chain's and the tree's admissibility (joint limits, and the segment–sphere test, zero-length segments
+    included) are one compiled implementation: a chain read as a one-branch tree gets the same verdict."""
+    from kernels.fabrik import chain, geometry, tree
+    from kernels.fabrik.limits import _limit_table
+
+    rng = np.random.default_rng(seed)
+    p = np.zeros((n + 1, 3))
+    for i in range(n):
+        step = rng.normal(size=3) * (0.0 if rng.random() < 0.3 else 1.0)  # some zero-length links
+        p[i + 1] = p[i] + step
+    centres = p[rng.integers(0, n + 1, size=3)] + 0.3 * rng.normal(size=(3, 3))
+    radii = rng.uniform(0.05, 0.6, size=3)
+    live = (np.linalg.norm(centres - p[0], axis=1) > radii).astype(np.bool_)
+    constraints = [fabrik.Cone(float(rng.uniform(0.3, 2.5))) if limited else None for _ in range(n)]
+    table = _limit_table(constraints, n, 3, "constraints", segment_offset=0)
+    rest, tiny = np.array([0.0, 0.0, 1.0]), 1e-12
+    parents = np.arange(-1, n, dtype=np.int64)
+    order = np.arange(n + 1, dtype=np.int64)
+    tree_table = np.vstack([np.zeros((1, table.shape[1])), table])
+    as_chain = chain._admissible(p, tiny, rest, limited, table, centres, radii, live)
+    as_tree = tree._tree_admissible(p, parents, order, tree_table, rest, tiny, limited, centres,
+                                    radii, live)  # fmt: skip
+    assert as_chain == as_tree
+    for i in range(n):  # the one segment test, zero-length segments included, never NaN
+        cut = geometry._segment_cuts(p, i, i + 1, centres, radii, live, 1.0)
+        length = float(np.linalg.norm(p[i + 1] - p[i]))
+        if length == 0.0:
+            inside = bool(np.any(live & (np.linalg.norm(centres - p[i], axis=1) < radii)))
+            assert cut == inside
+
+
+def test_a_zero_length_segment_inside_a_sphere_cuts_it_for_chain_and_tree() -> None:
+    from kernels.fabrik import chain, geometry, tree
+
+    p = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, 1.0]])
+    centres, radii, live = np.array([[0.05, 0.0, 1.0]]), np.array([0.1]), np.array([True])
+    assert geometry._segment_cuts(p, 1, 2, centres, radii, live, 1.0)
+    assert not geometry._segment_cuts(p, 1, 2, centres + 1.0, radii, live, 1.0)
+    table = np.zeros((1, 13))
+    rest = np.array([0.0, 0.0, 1.0])
+    parents, order = np.array([-1, 0, 1]), np.array([0, 1, 2])
+    assert not chain._admissible(p, 1e-12, rest, False, table, centres, radii, live)
+    assert not tree._tree_admissible(p, parents, order, np.zeros((3, 13)), rest, 1e-12, False,
+                                     centres, radii, live)  # fmt: skip
