@@ -1246,3 +1246,40 @@ def test_spin_vector_cases_the_reviewer_found() -> None:
         ball.spin_vector(1, (1e300, 1e300, 0)), 2 * math.pi / math.sqrt(2) * np.array([1, 1, 0])
     )
     np.testing.assert_allclose(ball.spin_vector(1, (3e-200, 0, 0)), [2 * math.pi, 0.0, 0.0])
+
+
+def test_a_flight_config_is_checked_once_and_flies_as_its_keywords() -> None:
+    config = ball.FlightConfig(
+        dt=1e-2, method="rk4", model="measured", t_max=3.0, x_stop=20.0, ground_m=R
+    )
+    velocity, spin = (25.0, 1.0, 6.0), (0.0, 0.0, 40.0)
+    by_config = ball.simulate(START, velocity, spin, config)
+    by_keywords = ball.simulate(
+        START,
+        velocity,
+        spin,
+        dt=1e-2,
+        method="rk4",
+        model="measured",
+        t_max=3.0,
+        x_stop=20.0,
+        ground_m=R,
+    )
+    np.testing.assert_array_equal(by_config.position, by_keywords.position)
+    np.testing.assert_array_equal(by_config.drag, by_keywords.drag)
+    batch = ball.simulate_batch([START], [velocity], [spin], config)
+    np.testing.assert_array_equal(batch.position[0, : batch.n_samples[0]], by_config.position)
+    assert not config.settings.flags.writeable
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        config.dt = 1.0  # type: ignore[misc]
+    for field, bad in (("dt", 0.0), ("mass_kg", True), ("air_density", -1.0), ("x_stop", math.nan)):
+        with pytest.raises(ValueError, match=field):
+            ball.FlightConfig(**{field: bad})  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match="method"):
+        ball.FlightConfig(method="verlet")  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match="config"):
+        ball.simulate(START, velocity, spin, config, dt=1e-3)
+    with pytest.raises(ValueError, match="dt"):  # the cache of keyword configs keeps no bad one
+        ball.simulate(START, velocity, spin, dt=True)
+    with pytest.raises(TypeError):
+        ball.simulate(START, velocity, spin, wind=3.0)
