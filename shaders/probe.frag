@@ -1,6 +1,6 @@
 #version 330
 // Evaluates scene_distance and scene_color at points read from a float texture, one point per pixel, so tests can
-// compare the GLSL with kernels/sdf.py.
+// compare the GLSL with kernels/sdf.
 
 #include "sdf.glsl"
 

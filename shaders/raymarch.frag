@@ -1,6 +1,6 @@
 #version 330
 // Sphere-traces the scene in sdf.glsl (Hart 1996) from a pinhole camera, one ray per pixel centre, the same loop
-// as kernels/sdf.py sphere_trace. Normals by central differences; Phong shading; soft shadows with Quilez's improved
+// as kernels/sdf sphere_trace. Normals by central differences; Phong shading; soft shadows with Quilez's improved
 // technique (2018: track the previous step to find the closest approach between samples, no banding); ambient
 // occlusion from five samples along the normal.
 
@@ -41,7 +41,7 @@ uniform float u_normal_epsilon;  // central-difference step (m)
 uniform float u_shadow_sharpness;  // k of the soft shadow: larger is harder
 uniform float u_occlusion_strength;
 uniform float u_occlusion_step;  // m between AO samples
-uniform vec4 u_bounds[MAX_PRIMITIVES];  // kernels/sdf.py scene_bounding_spheres: centre, radius; march inside
+uniform vec4 u_bounds[MAX_PRIMITIVES];  // kernels/sdf scene_bounding_spheres: centre, radius; march inside
 uniform vec3 u_box_half[MAX_PRIMITIVES];  // renderer.py _bounding_boxes: half extents in the primitive's frame (m)
 
 layout(location = 0) out vec4 out_color;
@@ -56,10 +56,10 @@ vec3 scene_normal(vec3 p) {
 }
 
 // Where a unit ray first enters and last leaves the bounds: per primitive, its bounding sphere
-// (kernels/sdf.py ray_spheres_interval) cut by its bounding box (renderer.py _bounding_boxes, a slab test in the
+// (kernels/sdf ray_spheres_interval) cut by its bounding box (renderer.py _bounding_boxes, a slab test in the
 // primitive's frame); over the primitives, the union. (t_enter >= 0, t_exit), t_exit < t_enter where it meets none
 // ahead. A sphere tracer started at any point before the first surface finds the same surface, so the image
-// equals kernels/sdf.py sphere_trace's from the spheres alone, while fewer steps are spent beside the shape.
+// equals kernels/sdf sphere_trace's from the spheres alone, while fewer steps are spent beside the shape.
 #if USER_FIELD
 // The editor's field: the slab test against its bounds box.
 vec2 bound_interval(vec3 origin, vec3 dir) {

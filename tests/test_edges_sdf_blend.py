@@ -1,4 +1,4 @@
-"""Issue 8, item 5: every blend form and boolean of kernels/sdf.py at tiny blend widths, in float32 and float64.
+"""Every blend form and boolean of kernels/sdf at tiny blend widths, in float32 and float64.
 
 Property: for every finite k ≥ 0, subnormals included, distances are finite and lie within k/4 (plus the rounding
 of the mix) of the hard operation, so they approach it as k → 0; a scene's mesh is empty only where the hard

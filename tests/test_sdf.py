@@ -1,4 +1,4 @@
-"""kernels/sdf.py against exact distances, independent constructions and the properties the mesher relies on."""
+"""kernels/sdf against exact distances, independent constructions and the properties the mesher relies on."""
 
 from __future__ import annotations
 

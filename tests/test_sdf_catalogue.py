@@ -1,4 +1,4 @@
-"""Quilez's primitives and operators (kernels/sdf.py and shaders/sdf.glsl, name for name).
+"""Quilez's primitives and operators (kernels/sdf and shaders/sdf.glsl, name for name).
 
 Every function: numpy against GLSL within 1e-5 at random points. Exact primitives: analytic distances at points
 whose nearest surface point is known, and the eikonal property (|∇d| = 1, and p − d·∇d lands on the surface) at

@@ -1,4 +1,4 @@
-"""The GLSL against kernels/sdf.py: distances at points, ray-marched depth, mesh vs ray-march, and the shading terms.
+"""The GLSL against kernels/sdf: distances at points, ray-marched depth, mesh vs ray-march, and the shading terms.
 
 These need an OpenGL 3.3 context (moderngl, EGL: Mesa llvmpipe without a GPU). Outside CI a missing context skips
 with the renderer's reason; under CI=true it fails.
