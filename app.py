@@ -25,10 +25,11 @@ import viser
 
 from kernels import ball, course, fabrik
 from scenes import SceneName
-from scenes._gate import install_gate
-from scenes._session import Sessions, limit_malloc_arenas
 from scenes.sdf_gallery import COMPILE_LIMIT_S, FRAME_LIMIT_S, MAX_SOURCE_CHARS, set_editing_allowed
-from scenes.switcher import SceneSwitcher
+from server.gate import install_gate
+from server.memory import limit_malloc_arenas
+from server.sessions import Sessions
+from server.switcher import SceneSwitcher
 
 logger = logging.getLogger("app")
 

@@ -31,7 +31,7 @@ from wsclient import BrowserClient  # noqa: E402
 
 from kernels import course, cycling  # noqa: E402
 from scenes.peloton import PelotonScene  # noqa: E402
-from scenes.switcher import SceneSwitcher  # noqa: E402
+from server.switcher import SceneSwitcher  # noqa: E402
 
 
 def timings(func: Callable[[], object], repeat: int) -> list[float]:

@@ -1,4 +1,4 @@
-"""The scenes, one registry, and the switcher that shows one scene at a time on a viser server.
+"""The scenes and their one registry (:mod:`server.switcher` shows one scene at a time on a viser server).
 
 Add a scene by writing ``scenes/<name>.py`` with a :class:`~scenes._base.Scene` subclass and one line in
 :data:`SCENES` (and its key in :data:`SceneName`, which the CLI offers).
@@ -8,7 +8,6 @@ from __future__ import annotations
 
 from typing import Literal
 
-from scenes import _viser_patches
 from scenes._base import Scene
 from scenes.arm import ArmScene
 from scenes.freekick import FreeKickScene
@@ -25,7 +24,5 @@ SCENES: dict[str, type[Scene]] = {
     FreeKickScene.key: FreeKickScene,
 }
 """Every scene that exists, in switcher order."""
-
-_viser_patches.apply()
 
 __all__ = ["SCENES", "Scene", "SceneName"]

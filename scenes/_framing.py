@@ -52,7 +52,7 @@ def _basis(direction: NDArray[np.float64]) -> tuple[NDArray[np.float64], ...]:
 
 @dataclasses.dataclass(frozen=True)
 class Lens:
-    """One browser's camera: vertical field of view and canvas size (CSS px: :data:`scenes._gate.CSS_CAMERA_JS`)."""
+    """One browser's camera: vertical field of view and canvas size (CSS px: :data:`server.gate.CSS_CAMERA_JS`)."""
 
     fov_rad: float
     width_px: int

@@ -22,10 +22,9 @@ import viser.uplot
 
 from kernels import course as course_kernel
 from kernels import cycling
-from scenes._base import Scene, set_if_changed
+from scenes._base import Scene, record_spec, set_if_changed
 from scenes._charts import FittedChart
 from scenes._framing import ClientFraming, Lens, View, frame_points
-from scenes._gate import record_spec
 
 MAX_RIDERS = 8
 BIKE_LENGTH_M = 1.70
@@ -1633,7 +1632,7 @@ class CourseMode:
         self.scrub.max = self._total_km()
         # The gate clamps a browser's scrub to the new course's length, not the first one's.
         record_spec(self.scrub)
-        self.scene._write_back(self.scrub, 0.0)  # the riders are back at the start
+        self.scene.write_back(self.scrub, 0.0)  # the riders are back at the start
         self.redraw(geometry=True)
         return True
 
@@ -1681,7 +1680,7 @@ class CourseMode:
                 self.redraw()
                 return
             note = ""
-        self.scene._write_back(self.power, float(np.clip(round(power, 1), low, high)))
+        self.scene.write_back(self.power, float(np.clip(round(power, 1), low, high)))
         self._on_input()
         if note and not self.message:
             self.message = note
@@ -1697,7 +1696,7 @@ class CourseMode:
 
     def _on_pause(self) -> None:
         self.playing = False
-        self.scene._write_back(self.scrub, round(self._leader_km(), 2))  # where the riders stopped
+        self.scene.write_back(self.scrub, round(self._leader_km(), 2))  # where the riders stopped
         self.redraw(readouts=False)
 
     def _on_scrub(self) -> None:
@@ -1707,7 +1706,7 @@ class CourseMode:
         ok = isinstance(raw, (int, float)) and not isinstance(raw, bool) and math.isfinite(raw)
         km = float(np.clip(raw if ok else self._leader_km(), 0.0, self._total_km()))
         if not ok or km != raw:
-            self.scene._write_back(self.scrub, km)
+            self.scene.write_back(self.scrub, km)
         ride = self.state.ride
         self.play_time_s = float(np.interp(km * 1000.0, ride.distance_m, ride.elapsed_s))
         self.redraw(readouts=False)
@@ -1724,7 +1723,7 @@ class CourseMode:
         self._since_readout += dt
         if self._since_readout >= 0.2 or not self.playing:  # the slider and readout follow at 5 Hz
             self._since_readout = 0.0
-            self.scene._write_back(self.scrub, round(self._leader_km(), 2))
+            self.scene.write_back(self.scrub, round(self._leader_km(), 2))
             self.redraw(readouts=False, now=True)
         else:
             self.redraw(readouts=False, now=False)

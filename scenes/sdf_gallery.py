@@ -31,8 +31,7 @@ import viser
 from PIL import Image
 
 from kernels import sdf
-from scenes._base import TURNS, Scene
-from scenes._gate import mark_costly
+from scenes._base import TURNS, Scene, mark_costly
 from shaders import gl_service
 from shaders import renderer as gl_renderer
 from shaders.renderer import (

@@ -24,7 +24,7 @@ from browser import open_viser  # noqa: E402
 from conftest import CHROMIUM, CHROMIUM_ARGS  # noqa: E402
 
 from scenes.peloton import PelotonScene  # noqa: E402
-from scenes.switcher import SceneSwitcher  # noqa: E402
+from server.switcher import SceneSwitcher  # noqa: E402
 
 
 def main(

@@ -1,12 +1,12 @@
 """What a scene is built on: one browser tab's scene and GUI (a session), or the server's, shared by every tab.
 
 A scene only uses ``self.server.scene``, ``.gui``, ``.atomic()``, ``.flush()`` and the helpers of
-:class:`~scenes._base.Scene`. :class:`Session` gives it exactly that API over either viser's per-client handles
+:class:`scenes._base.Scene`. :class:`Session` gives it exactly that API over either viser's per-client handles
 (``client.scene``, ``client.gui``: only that tab sees them) or the server's (every tab sees them, ``--shared``).
 Its ``gui`` is a :class:`GuiFacade`, which records each control's spec (range, options) the moment the scene
 creates it, so the gate and the scene's readers clean a browser's value against what the scene declared.
 
-:class:`Sessions` gives each browser tab its own :class:`~scenes.switcher.SceneSwitcher` when it connects and closes
+:class:`Sessions` gives each browser tab its own :class:`~server.switcher.SceneSwitcher` when it connects and closes
 it when the tab goes. viser 1.1.1 cannot remove a connect/disconnect or camera callback, so those are registered
 once per server (here and in :class:`CameraHub`) and forward to whatever lives now; nothing a closed session owns
 stays reachable from viser.
@@ -14,9 +14,6 @@ stays reachable from viser.
 
 from __future__ import annotations
 
-import ctypes
-import ctypes.util
-import gc
 import logging
 import threading
 import weakref
@@ -26,10 +23,13 @@ from typing import TYPE_CHECKING, ParamSpec, TypeVar
 
 import viser
 
-from scenes._gate import install_gate, record_spec
+from server.clean import record_spec
+from server.gate import install_gate
+from server.memory import give_memory_back
+from server.viser_compat import dead_writes_allowed
 
 if TYPE_CHECKING:
-    from scenes.switcher import SceneSwitcher
+    from server.switcher import SceneSwitcher
 
 logger = logging.getLogger(__name__)
 
@@ -183,57 +183,8 @@ class Session:
                 client.camera.look_at = look_at
 
 
-def _load_libc() -> ctypes.CDLL | None:
-    name = ctypes.util.find_library("c")
-    try:
-        return ctypes.CDLL(name) if name else None
-    except OSError:
-        return None
-
-
-_libc = _load_libc()
-
-
-def give_memory_back() -> None:
-    """Free a closed session's objects now and return the heap pages they held to the system.
-
-    viser runs callbacks on a pool of 32 threads, each with its own malloc arena: a session's small arrays freed
-    there stay counted in the process's RSS until trimmed. A no-op where the C library has no ``malloc_trim``.
-    """
-    gc.collect()  # a scene's handles and callbacks refer to each other: only the cycle collector frees them
-    trim = getattr(_libc, "malloc_trim", None)
-    if trim is not None:
-        trim(0)
-
-
-M_ARENA_MAX = -8
-"""glibc's ``mallopt`` parameter for the most malloc arenas (``<malloc.h>``)."""
-
-
-def limit_malloc_arenas(count: int = 2) -> None:
-    """Let at most ``count`` malloc arenas exist from now on (glibc; a no-op elsewhere).
-
-    glibc gives each thread that allocates under contention an arena of its own and never hands one back; with
-    viser's 32 callback threads building and closing sessions, the pages freed in those arenas fragment and RSS
-    climbs with each wave of tabs (measured: +30 to +55 MiB per 16 sessions opened and closed, none with 2 arenas).
-    """
-    mallopt = getattr(_libc, "mallopt", None)
-    if mallopt is not None:
-        mallopt(M_ARENA_MAX, count)
-
-
-def _dead_writes_allowed(client: viser.ClientHandle) -> AbstractContextManager[object]:
-    """A scope in which messages queued for ``client`` after its tab closed do not warn (viser 1.1.1's own scope).
-
-    viser warns once per closed tab about a write through a stale handle; a session being built or closed when
-    its tab goes writes there by construction, and those messages are freed with the client.
-    """
-    buffer = client._websock_connection.get_message_buffer()  # pyright: ignore[reportPrivateUsage]
-    return buffer.sanctioned_dead_writes()
-
-
 class Sessions:
-    """A :class:`~scenes.switcher.SceneSwitcher` per browser tab: built when it connects, closed when it goes."""
+    """A :class:`~server.switcher.SceneSwitcher` per browser tab: built when it connects, closed when it goes."""
 
     def __init__(self, server: viser.ViserServer, initial: str) -> None:
         from scenes import SCENES
@@ -263,7 +214,7 @@ class Sessions:
         return client.client_id in self.server.get_clients()
 
     def _open(self, client: viser.ClientHandle) -> None:
-        from scenes.switcher import SceneSwitcher
+        from server.switcher import SceneSwitcher
 
         # Connect and disconnect callbacks run on viser's thread pool, in any order: a tab that closed before its
         # build began gets none, and one that closes during the build is torn down when the build ends.
@@ -272,7 +223,7 @@ class Sessions:
         try:
             # What the build queues after the tab went lies in that client's dead buffer, freed with it, and is
             # torn down below: not the stale-handle writes viser's "closed connection" warning is for.
-            with _dead_writes_allowed(client):
+            with dead_writes_allowed(client):
                 switcher = SceneSwitcher(Session.for_client(self.server, client), self.initial)
         except Exception:
             logger.exception("building the session of client %s failed", client.client_id)
@@ -299,7 +250,7 @@ class Sessions:
     def _close_switcher(self, client: viser.ClientHandle, switcher: SceneSwitcher) -> None:
         """Close a tab's session and wait for its scene's threads (a thread-pool callback: off the event loop)."""
         try:
-            with _dead_writes_allowed(client):
+            with dead_writes_allowed(client):
                 switcher.close()
             if not switcher.scene.join(timeout_s=120.0):
                 logger.warning(
@@ -318,5 +269,5 @@ class Sessions:
             if client is None:
                 switcher.close()
             else:  # its tab may be closing now, its disconnect callback still queued
-                with _dead_writes_allowed(client):
+                with dead_writes_allowed(client):
                     switcher.close()

@@ -1,6 +1,6 @@
 """The scene switcher: a dropdown that tears the shown scene down completely and builds the chosen one.
 
-One switcher serves one :class:`~scenes._session.Session`: a browser tab's own (the default; each tab switches and
+One switcher serves one :class:`~server.sessions.Session`: a browser tab's own (the default; each tab switches and
 resets only its own scene) or the server's, shared by every tab (``--shared``).
 """
 
@@ -15,8 +15,8 @@ from typing import Any
 import viser
 
 from scenes import SCENES, Scene
-from scenes._gate import mark_costly
-from scenes._session import Session
+from server.clean import mark_costly
+from server.sessions import Session
 
 logger = logging.getLogger(__name__)
 
@@ -67,7 +67,7 @@ class SceneSwitcher:
                 session.gui.add_button("Reset scene to defaults", order=-99.0)
             )
             # Awaited by viser (coroutines), the builds running on a worker thread: the gate then knows when a
-            # pick or Reset has finished, and holds that tab's later inputs until it has (scenes._gate).
+            # pick or Reset has finished, and holds that tab's later inputs until it has (server.gate).
             self.dropdown.on_update(_in_a_thread(self._on_pick))
             self.reset_button.on_click(_in_a_thread(self._on_reset))
             self.scene: Scene = SCENES[initial](session)

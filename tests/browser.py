@@ -261,7 +261,7 @@ class ScenePage:
 def scene_page(context: Any, key: str, viewport: tuple[int, int]) -> Iterator[ScenePage]:
     """Serve scene ``key``, open it in a new page of ``viewport`` (CSS px), and wait until it has settled."""
     import app
-    from scenes.switcher import SceneSwitcher
+    from server.switcher import SceneSwitcher
 
     server = app.make_server("127.0.0.1", 0, verbose=False)
     switcher = SceneSwitcher(server, key)

@@ -15,8 +15,8 @@ import pytest
 import viser
 from hypothesis import settings
 
-from scenes._gate import install_gate
-from scenes.switcher import SceneSwitcher
+from server.gate import install_gate
+from server.switcher import SceneSwitcher
 
 IN_CI = os.environ.get("CI", "").lower() in ("1", "true", "yes")
 

@@ -19,7 +19,7 @@ from wsclient import BrowserClient
 
 import app
 from scenes import SCENES
-from scenes.switcher import SceneSwitcher
+from server.switcher import SceneSwitcher
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -33,7 +33,7 @@ from browser import (
 )
 
 from scenes.arm import ArmScene
-from scenes.switcher import SceneSwitcher
+from server.switcher import SceneSwitcher
 
 pytestmark = pytest.mark.browser
 

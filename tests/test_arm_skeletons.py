@@ -10,7 +10,7 @@ from wsclient import BrowserClient
 from kernels import fabrik
 from scenes import _skeletons
 from scenes.arm import ArmScene
-from scenes.switcher import SceneSwitcher
+from server.switcher import SceneSwitcher
 
 
 @pytest.fixture

@@ -13,7 +13,7 @@ from test_arm_browser import screen_of
 
 from scenes._skeletons import hand
 from scenes.arm import ArmScene
-from scenes.switcher import SceneSwitcher
+from server.switcher import SceneSwitcher
 
 pytestmark = pytest.mark.browser
 

@@ -4,7 +4,7 @@ viser 1.1.1's client reports its canvas in device pixels (``canvas.width``): twi
 ratio of 2, and 0.75–1 of it while its adaptive resolution drops on a slow machine. The control panel is a fixed
 CSS width, so framing in device pixels put the peloton under the panel on a HiDPI screen (it framed for a window
 twice as wide), and each resolution change moved the camera. The app sends each tab a script
-(:data:`scenes._gate.CSS_CAMERA_JS`) that makes its camera report the CSS size. viser's "Reset View" puts the tab
+(:data:`server.gate.CSS_CAMERA_JS`) that makes its camera report the CSS size. viser's "Reset View" puts the tab
 back at the server's opening camera; the scene then frames it again.
 """
 
@@ -18,7 +18,7 @@ import viser
 from browser import ScenePage, assert_in_view, close_notifications, open_viser, settle, wait_until
 
 from scenes.peloton import PelotonScene
-from scenes.switcher import SceneSwitcher
+from server.switcher import SceneSwitcher
 
 pytestmark = pytest.mark.browser
 

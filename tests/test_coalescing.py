@@ -22,11 +22,12 @@ from hypothesis import strategies as st
 from wsclient import BrowserClient
 
 from kernels import sdf
-from scenes._base import Scene, Turns
+from scenes._base import Scene
 from scenes.arm import ArmScene
 from scenes.freekick import FreeKickParams, FreeKickScene, _segments, compute_kick, resample
 from scenes.sdf_gallery import PREVIEW_RESOLUTION, SdfGalleryScene
-from scenes.switcher import SceneSwitcher
+from server.switcher import SceneSwitcher
+from server.turns import Turns
 from shaders import gl_service
 from shaders.renderer import GLUnavailableError
 

@@ -15,7 +15,7 @@ from PIL import Image
 from test_course_scene import hill_gpx
 
 from scenes.peloton import PelotonScene
-from scenes.switcher import SceneSwitcher
+from server.switcher import SceneSwitcher
 
 pytestmark = pytest.mark.browser
 

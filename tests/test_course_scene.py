@@ -26,7 +26,7 @@ from scenes.peloton import (
     format_duration,
     group_cda,
 )
-from scenes.switcher import SceneSwitcher
+from server.switcher import SceneSwitcher
 
 
 @pytest.fixture

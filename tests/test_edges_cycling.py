@@ -17,7 +17,7 @@ from wsclient import BrowserClient
 
 from kernels import cycling
 from scenes.peloton import PelotonScene
-from scenes.switcher import SceneSwitcher
+from server.switcher import SceneSwitcher
 
 # m/s: every input drawn below needs more than its power here (the reference checks it).
 V_MAX = 200.0

@@ -15,7 +15,7 @@ from wsclient import BrowserClient
 
 from kernels import sdf
 from scenes.sdf_gallery import SdfGalleryScene
-from scenes.switcher import SceneSwitcher
+from server.switcher import SceneSwitcher
 
 
 def wait_until(

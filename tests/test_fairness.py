@@ -27,21 +27,21 @@ from test_hostile_uploads import notices as notifications
 from test_hostile_uploads import part as send_part
 from wsclient import BrowserClient
 
-import scenes._gate as gate_module
+import server.budget as budget_module
 from app import serve_scenes
 from scenes import SCENES
-from scenes._gate import (
+from scenes.peloton import PelotonScene
+from server.budget import (
     COSTLY_BURST,
     COSTLY_RATE_HZ,
     MAX_UPLOAD_BYTES_IN_FLIGHT_TOTAL,
     MAX_UPLOADS_IN_FLIGHT_TOTAL,
     CostlyBudget,
-    install_gate,
-    refusals,
 )
-from scenes._session import Sessions
-from scenes.peloton import PelotonScene
-from scenes.switcher import SceneSwitcher
+from server.gate import install_gate
+from server.refusals import refusals
+from server.sessions import Sessions
+from server.switcher import SceneSwitcher
 
 FIRST_GUI_BOUND_S = 2.0
 """The most another tab may wait for its first GUI while one tab floods (the issue's bound)."""
@@ -218,7 +218,7 @@ def test_an_edit_sent_after_resets_beyond_the_budget_is_not_undone(
     """Five Resets at once (the budget lets three through, holds back the last), then a speed: the held-back Reset
     goes first and the speed after it, so the tab ends on a reset scene at the speed it sent last."""
     # A token every 5 s: the held-back Reset still waits once the three let through have rebuilt, on any machine.
-    monkeypatch.setattr(gate_module, "COSTLY_RATE_HZ", 0.2)
+    monkeypatch.setattr(budget_module, "COSTLY_RATE_HZ", 0.2)
     with BrowserClient(server.get_port()) as client:
         client_id = own_session(server, sessions, set())
         switcher = sessions.switcher(client_id)
@@ -560,7 +560,7 @@ def test_a_stalled_upload_stops_holding_the_server_wide_budget(
     monkeypatch: pytest.MonkeyPatch,
     caplog: pytest.LogCaptureFixture,
 ) -> None:
-    monkeypatch.setattr("scenes._gate.UPLOAD_STALL_S", 0.3)  # 30 s in the app
+    monkeypatch.setattr("server.budget.UPLOAD_STALL_S", 0.3)  # 30 s in the app
     gate = install_gate(server)
     tabs = open_course_tabs(server, sessions, 2)
     try:
@@ -608,7 +608,7 @@ def test_a_person_whose_upload_is_refused_is_told_why_and_can_retry(
 ) -> None:
     """Chromium uploads a GPX while crafted tabs hold the server-wide budget: a red notice, then a retry works."""
     # Software WebGL on busy cores can take over 30 s to run the page's script: the hogs must not stall out first.
-    monkeypatch.setattr("scenes._gate.UPLOAD_STALL_S", 600.0)
+    monkeypatch.setattr("server.budget.UPLOAD_STALL_S", 600.0)
 
     switcher = SceneSwitcher(server, "peloton")
     hogs: list[BrowserClient] = []

@@ -48,7 +48,7 @@ from scenes.freekick import (
     resample,
     view_points,
 )
-from scenes.switcher import SceneSwitcher
+from server.switcher import SceneSwitcher
 
 pytestmark = pytest.mark.browser
 

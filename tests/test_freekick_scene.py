@@ -45,7 +45,7 @@ from scenes.freekick import (
     view_points,
     wall_hides,
 )
-from scenes.switcher import SceneSwitcher
+from server.switcher import SceneSwitcher
 
 
 @pytest.fixture

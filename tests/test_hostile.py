@@ -26,14 +26,14 @@ from viser_private import control_state, gizmos, gui_inputs
 from wsclient import BrowserClient, connect_tab
 
 from scenes import SCENES, Scene
-from scenes._gate import (
+from server.clean import (
     ControlSpec,
     clean_value,
     control_spec,
-    refusals,
     unit_quaternion,
 )
-from scenes.switcher import SceneSwitcher
+from server.refusals import refusals
+from server.switcher import SceneSwitcher
 
 INPUT_TYPES = {
     "GuiSliderMessage",
@@ -101,7 +101,7 @@ def _fresh_refusal_log() -> Iterator[None]:
 
 
 def refused_lines(caplog: pytest.LogCaptureFixture) -> list[logging.LogRecord]:
-    return [r for r in caplog.records if r.name == "scenes._gate"]
+    return [r for r in caplog.records if r.name == "server.refusals"]
 
 
 def refused_kind(record: logging.LogRecord) -> str:
@@ -823,15 +823,14 @@ def test_a_camera_out_of_bounds_is_refused_naming_its_field(
     """The refusal's log line names the field that was wrong (a fresh user found it quoting the valid image size
     for a camera refused for its position), and a finite camera 1e308 m out is refused: every distance the
     scenes take from it overflowed (numpy's RuntimeWarning in the log)."""
-    from viser import _messages as messages
-
-    from scenes._gate import MAX_CAMERA_M, _camera_fields
+    from server.decode import MAX_CAMERA_M, camera_fields
+    from server.viser_compat import messages
 
     def camera(fields: dict[str, Any]) -> Any:
         return messages.ViewerCameraMessage(**fields)
 
     good = bad_cameras()[0] | {"image_height": 720}
-    fields, wrong = _camera_fields(camera(good))
+    fields, wrong = camera_fields(camera(good))
     assert fields is not None and wrong == ""
-    assert _camera_fields(camera(good | {"position": (MAX_CAMERA_M, 0.0, 1.0)}))[1] == ""
-    assert _camera_fields(camera(good | change)) == (None, field)
+    assert camera_fields(camera(good | {"position": (MAX_CAMERA_M, 0.0, 1.0)}))[1] == ""
+    assert camera_fields(camera(good | change)) == (None, field)

@@ -15,13 +15,14 @@ from typing import Any
 
 import pytest
 import viser
-from viser import _messages
 from wsclient import BrowserClient
 
-from scenes._gate import ALLOWED_MESSAGES, _field_hints, decode_frame, refusals
 from scenes.freekick import FreeKickScene
 from scenes.peloton import PelotonScene
-from scenes.switcher import SceneSwitcher
+from server.decode import ALLOWED_MESSAGES, decode_frame, field_hints, fits
+from server.refusals import refusals
+from server.switcher import SceneSwitcher
+from server.viser_compat import messages
 
 WRONG_VALUES: list[Any] = [{"a": 1}, [[1, 2], [3]], None, "text", 1e308, -7, True, b"\x00"]
 
@@ -60,18 +61,16 @@ def honest_fields(cls: type) -> dict[str, Any]:
             return {"value": 1.0}
         return None
 
-    return {name: sample(hint) for name, hint in _field_hints(cls).items()}
+    return {name: sample(hint) for name, hint in field_hints(cls).items()}
 
 
 def bent_messages() -> list[tuple[str, str, Any]]:
     """(message type, field, wrong value) for every field of every allowed message, where the value is wrong."""
-    from scenes._gate import _fits
-
     cases = []
     for cls in ALLOWED_MESSAGES:
-        for name, hint in _field_hints(cls).items():
+        for name, hint in field_hints(cls).items():
             for value in WRONG_VALUES:
-                if not _fits(value, hint):
+                if not fits(value, hint):
                     cases.append((cls.__name__, name, value))
     return cases
 
@@ -127,7 +126,7 @@ def test_dict_names_on_drags_and_clicks_are_refused_without_a_traceback(
         client.wait_for(lambda: switcher.scene.key == "peloton", what="the honest switch")
     errors = [r for r in caplog.records if r.levelno >= logging.ERROR]
     assert errors == []
-    gate_lines = [r for r in caplog.records if r.name == "scenes._gate"]
+    gate_lines = [r for r in caplog.records if r.name == "server.refusals"]
     assert 1 <= len(gate_lines) <= 6  # one line per kind of refusal, not one per message
 
 
@@ -149,5 +148,5 @@ def test_a_frame_nested_thousands_deep_is_one_refusal_and_the_connection_stays(
 
 def test_every_allowed_message_is_a_dataclass_the_check_can_read() -> None:
     for cls in ALLOWED_MESSAGES:
-        assert dataclasses.is_dataclass(cls) and issubclass(cls, _messages.Message)
-        assert _field_hints(cls), cls
+        assert dataclasses.is_dataclass(cls) and issubclass(cls, messages.Message)
+        assert field_hints(cls), cls

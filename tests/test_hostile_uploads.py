@@ -16,17 +16,17 @@ import viser
 from test_course_scene import hill_gpx, upload
 from wsclient import BrowserClient
 
-import scenes._gate as gate_module
-from scenes._gate import (
+import server.budget as budget_module
+from scenes.peloton import CourseMode, PelotonScene
+from server.budget import (
     MAX_UPLOAD_BYTES,
     MAX_UPLOAD_BYTES_IN_FLIGHT_PER_TAB,
     MAX_UPLOADS_IN_FLIGHT,
     MIN_PART_BYTES,
-    install_gate,
-    refusals,
 )
-from scenes.peloton import CourseMode, PelotonScene
-from scenes.switcher import SceneSwitcher
+from server.gate import install_gate
+from server.refusals import refusals
+from server.switcher import SceneSwitcher
 
 
 @pytest.fixture(autouse=True)
@@ -221,7 +221,7 @@ def test_an_upload_trickled_past_its_deadline_is_dropped(
 ) -> None:
     """A part every few seconds is progress, so the stall rule never fires; the deadline does (120 s, here 0.5 s),
     and frees the budget for the next tab's upload."""
-    monkeypatch.setattr(gate_module, "UPLOAD_DEADLINE_S", 0.5)
+    monkeypatch.setattr(budget_module, "UPLOAD_DEADLINE_S", 0.5)
     data = hill_gpx("Late", 300)
     with BrowserClient(server.get_port()) as hog, BrowserClient(server.get_port()) as other:
         hog.wait_for_gui("Upload GPX")

@@ -34,7 +34,7 @@ from browser import (
 from PIL import Image
 
 from scenes.peloton import COMPONENT_COLOURS, LABEL_PX, PelotonScene
-from scenes.switcher import SceneSwitcher
+from server.switcher import SceneSwitcher
 
 pytestmark = pytest.mark.browser
 

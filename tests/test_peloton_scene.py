@@ -24,7 +24,7 @@ from scenes.peloton import (
     PelotonScene,
     compute_line,
 )
-from scenes.switcher import SceneSwitcher
+from server.switcher import SceneSwitcher
 
 
 @pytest.fixture

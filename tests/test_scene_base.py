@@ -13,7 +13,8 @@ from viser_private import gui_uuids, node_names
 from wsclient import BrowserClient
 
 from scenes import SCENES
-from scenes._base import Scene, camera_hub
+from scenes._base import Scene
+from server.sessions import camera_hub
 
 
 class Probe(Scene):

@@ -25,7 +25,7 @@ from browser import (
 from conftest import skip_or_fail
 
 from scenes.sdf_gallery import SdfGalleryScene
-from scenes.switcher import SceneSwitcher
+from server.switcher import SceneSwitcher
 from shaders import gl_service
 from shaders.renderer import GLUnavailableError
 

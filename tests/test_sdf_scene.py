@@ -21,7 +21,7 @@ from wsclient import BrowserClient
 
 from kernels import sdf
 from scenes.sdf_gallery import RESOLUTION_LABEL, SdfGalleryParams, SdfGalleryScene
-from scenes.switcher import SceneSwitcher
+from server.switcher import SceneSwitcher
 from shaders import gl_service
 from shaders.renderer import Camera, GLUnavailableError
 

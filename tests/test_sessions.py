@@ -24,15 +24,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 import viser
-from viser_private import gizmos, node_names
+from viser_private import gizmos, node_names, store_value
 from wsclient import BrowserClient, connect_tab
 
 from app import serve_scenes
 from scenes import SCENES, Scene
-from scenes._session import Session, Sessions
 from scenes.arm import MAX_LINKS
 from scenes.sdf_gallery import SdfGalleryScene
-from scenes.switcher import SceneSwitcher
+from server.sessions import Session, Sessions
+from server.switcher import SceneSwitcher
 
 ROOT = Path(__file__).resolve().parents[1]
 MIB = 1024 * 1024
@@ -112,7 +112,7 @@ def test_the_gate_guards_a_tabs_own_controls_and_gizmos(
         kinds = {
             str(r.args[0])
             for r in caplog.records
-            if r.name == "scenes._gate" and isinstance(r.args, tuple)
+            if r.name == "server.refusals" and isinstance(r.args, tuple)
         }
         assert "GUI update of a field other than value" in kinds
         assert any("gizmo position" in kind for kind in kinds)
@@ -206,9 +206,9 @@ def test_a_pick_or_reset_handled_after_its_tab_closed_builds_nothing(
     picked = switcher.dropdown
     switcher.close()
     assert switcher.scene.closed
-    picked._impl.value = SCENES[
-        "peloton"
-    ].title  # what viser stores before it runs the queued callback
+    store_value(
+        picked, SCENES["peloton"].title
+    )  # what viser stores before it runs the queued callback
     if action == "pick":
         switcher._on_pick(None)  # pyright: ignore[reportPrivateUsage]
     else:

@@ -1,4 +1,4 @@
-"""The patched property cast (:mod:`scenes._viser_patches`) returns what viser 1.1.1's own does, for every property
+"""The patched property cast (:func:`server.viser_compat.cast_value_recursive`) returns what viser 1.1.1's own does, for every property
 hint viser declares and values of every shape the scenes write, and it is the one in use."""
 
 from __future__ import annotations
@@ -9,11 +9,10 @@ from typing import Any, get_type_hints
 import numpy as np
 import pytest
 import viser
-from viser import _assignable_props_api as props_api
-from viser import _messages
 
-import scenes  # noqa: F401  (applies the patch)
-from scenes._viser_patches import ORIGINAL_CAST, cast_value_recursive
+# Importing server (the package) applies the patch.
+from server.viser_compat import ORIGINAL_CAST, cast_value_recursive, installed_property_cast
+from server.viser_compat import messages as _messages
 
 
 class _Viser:
@@ -88,7 +87,7 @@ def test_the_patched_cast_returns_what_viser_returns(value: Any) -> None:
 
 def test_the_patch_is_in_use_and_writes_cast() -> None:
     assert viser.__version__ == "1.1.1"
-    assert props_api.AssignablePropsBase._cast_value_recursive is cast_value_recursive
+    assert installed_property_cast() is cast_value_recursive
     server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
     try:
         cloud = server.scene.add_point_cloud(

@@ -43,6 +43,12 @@ def gizmos(api: viser.SceneApi) -> dict[str, viser.TransformControlsHandle]:
     return dict(api._handle_from_transform_controls_name)
 
 
+def store_value(handle: object, value: object) -> None:
+    """Store ``value`` on GUI ``handle`` as viser does on a browser's update, before it runs the callbacks (none
+    run here)."""
+    handle._impl.value = value  # type: ignore[attr-defined]
+
+
 def control_state(handle: object) -> dict[str, object]:
     """What a browser must not be able to change about a control: its props, callbacks and liveness."""
     impl = handle._impl  # type: ignore[attr-defined]
