@@ -18,10 +18,14 @@ from numpy.typing import ArrayLike, NDArray
 
 from kernels._checks import bounded_array, finite_number
 from kernels.fabrik.chain import (
+    _BAD_JOINTS,
+    _BAD_TARGET,
     _SOLVER_IDS,
+    _UNSCALED,
     STATUSES,
     Solver,
     Status,
+    _solve_one,
     _solve_parallel,
     _solve_rows,
 )
@@ -613,10 +617,6 @@ def _options(
     )
 
 
-_UNSCALED = 2.0**-16, 2.0**16
-"""Extents (m) solved as they are; outside, a problem is divided by a power of 2 near its extent first."""
-
-
 def _to_unit_scale(
     p: NDArray[np.float64], goal: NDArray[np.float64], setup: _Setup
 ) -> tuple[float, NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
@@ -653,34 +653,30 @@ def _solve_single(
     extrapolate: bool,
     constraints: Sequence[Constraint] | None = None,
 ) -> Solution:
-    """One chain: checked here, solved by the same compiled core as every chain of a batch."""
-    chain = _check_joints("joints", joints, batched=False)
+    """One chain: checked here, solved by the same compiled core as every chain of a batch.
+
+    The common case, float64 arrays of the right shapes, goes straight to one compiled call that also scans the
+    numbers (finite, magnitude ≤ 1e300); anything else, or a refused number, goes through the checks of
+    :mod:`kernels._checks` first, which name the argument in their error."""
+    chain = joints
+    if not (type(chain) is np.ndarray and chain.dtype == np.float64 and chain.ndim == 2
+            and chain.shape[1] in (2, 3) and chain.shape[0] >= 2):  # fmt: skip
+        chain = _check_joints("joints", joints, batched=False)
     count, dim = chain.shape
-    point = _check_vector("target", target, dim)
+    point = target
+    if not (type(point) is np.ndarray and point.dtype == np.float64 and point.shape == (dim,)):
+        point = _check_vector("target", target, dim)
     setup = _Setup.build(dim, tolerance, max_iterations, cone_half_angle_rad, obstacles,
                          root_direction, _SOLVER_IDS[solver], extrapolate)  # fmt: skip
     setup = setup.constrained(constraints, count - 1, dim, cone_half_angle_rad)
-    p = np.zeros((1, count, 3))
-    p[0, :, :dim] = chain
-    goal = np.zeros((1, 3))
-    goal[0, :dim] = point
-    out_p = np.empty_like(p)
-    history = np.empty((1, setup.max_iterations + 1))
-    iterations = np.empty(1, dtype=np.int64)
-    status = np.empty(1, dtype=np.int64)
-    error = np.empty(1)
-    scale, params, centres, radii = _to_unit_scale(p, goal, setup)
-    _solve_rows(0, 1, p, goal, params, setup.flags, setup.root_direction, centres,
-                radii, out_p, history, iterations, status, error, setup.table)  # fmt: skip
-    if scale != 1.0:
-        out_p *= scale
-        history *= scale
-        error *= scale
-    used = int(iterations[0])
+    code, out, history, used, status, error = _solve_one(
+        np.ascontiguousarray(chain), np.ascontiguousarray(point), _LARGEST, setup.params,
+        setup.flags, setup.root_direction, setup.centres, setup.radii, setup.table,
+    )  # fmt: skip
+    if code == _BAD_JOINTS:
+        _check_joints("joints", joints, batched=False)  # raises, naming it
+    if code == _BAD_TARGET:
+        _check_vector("target", target, dim)
     return Solution(
-        joints=out_p[0, :, :dim].copy() if dim == 2 else out_p[0],
-        iterations=used,
-        error=float(error[0]),
-        status=STATUSES[int(status[0])],
-        error_history=history[0, : used + 1],
+        joints=out, iterations=used, error=error, status=STATUSES[status], error_history=history
     )

@@ -573,3 +573,68 @@ def _solve_parallel(
     for c in numba.prange(chunks):
         _solve_rows(c * batch // chunks, (c + 1) * batch // chunks, p, target, params, flags, rest,
                     centres, radii, out_p, history, iterations, status, error, table)  # fmt: skip
+
+
+_UNSCALED = 2.0**-16, 2.0**16
+"""Extents (m) solved as they are; outside, a problem is divided by a power of 2 near its extent first."""
+_BAD_JOINTS, _BAD_TARGET = 1, 2
+"""What :func:`_solve_one` found wrong with its input (0: nothing); the caller raises the error that names it."""
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _within(values: NDArray[np.float64], bound: float) -> bool:
+    """Whether every value is finite and of magnitude ≤ ``bound`` (NaN fails)."""
+    for value in values.flat:
+        if not abs(value) <= bound:
+            return False
+    return True
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _solve_one(
+    joints: NDArray[np.float64], target: NDArray[np.float64], bound: float,
+    params: NDArray[np.float64], flags: NDArray[np.int64], rest: NDArray[np.float64],
+    centres: NDArray[np.float64], radii: NDArray[np.float64], table: NDArray[np.float64],
+) -> tuple[int, NDArray[np.float64], NDArray[np.float64], int, int, float]:  # fmt: skip
+    """One chain from shape-checked ``joints`` (n + 1, d) and ``target`` (d,), d = 2 or 3 (m): the whole single
+    solve in one compiled call, so a small chain spends little time outside the core.
+
+    Scans the input (finite, magnitude ≤ ``bound``), pads it to 3D, divides it by a power of 2 near its extent
+    where that lies outside :data:`_UNSCALED` (exact; see ``api._to_unit_scale``, the batch's same rule), solves it
+    with :func:`_solve_chain` and scales back. Returns (input code: 0, :data:`_BAD_JOINTS` or :data:`_BAD_TARGET`;
+    joints (n + 1, d); error history (iterations + 1,); iterations; status; error); on a bad input the rest is empty.
+    """
+    count, dim = joints.shape[0], joints.shape[1]
+    if not _within(joints, bound):
+        return _BAD_JOINTS, np.empty((0, dim)), np.empty(0), 0, 0, 0.0
+    if not _within(target, bound):
+        return _BAD_TARGET, np.empty((0, dim)), np.empty(0), 0, 0, 0.0
+    p = np.zeros((count, 3))
+    goal = np.zeros(3)
+    extent = 0.0
+    for c in range(dim):
+        for i in range(count):
+            p[i, c] = joints[i, c]
+            extent = max(extent, abs(joints[i, c] - joints[0, c]))
+        goal[c] = target[c]
+        extent = max(extent, abs(target[c] - joints[0, c]))
+    scale = 1.0
+    if extent != 0.0 and not _UNSCALED[0] <= extent <= _UNSCALED[1]:
+        scale = math.ldexp(1.0, math.frexp(extent)[1])  # ≥ extent, exact; division by it is exact
+        p /= scale
+        goal /= scale
+        params = params.copy()
+        params[0] = params[0] / scale
+        centres, radii = centres / scale, radii / scale
+    history = np.empty(flags[0] + 1)
+    out_p = np.empty((count, 3))
+    lengths = np.empty(count - 1)
+    live = np.empty(radii.shape[0], dtype=np.bool_)
+    best, previous, before = np.empty((count, 3)), np.empty((count, 3)), np.empty((count, 3))
+    iterations, status, error = _solve_chain(p, goal, params, flags, rest, centres, radii, lengths,
+                                             live, best, previous, before, out_p, history, table)  # fmt: skip
+    if scale != 1.0:
+        out_p *= scale
+        history *= scale
+        error *= scale
+    return 0, out_p[:, :dim].copy(), history[: iterations + 1], iterations, status, error
