@@ -13,7 +13,9 @@ Kinds: :func:`slider`, :func:`number`, :func:`dropdown` (the field holds the opt
 :func:`checkbox`, :func:`text` and :func:`rgb`. A number is an integer when the field's default is an ``int``. A
 field whose default is a tuple of scalars gets one control per element, its label formatted with ``n`` (1, 2, ...).
 A declaration's ``folder`` puts the control in a folder of that name, opened around consecutive fields that name it
-(its handle is in :attr:`Controls.folders`, to add buttons or readouts to it).
+(its handle is in :attr:`Controls.folders`, to add buttons or readouts to it). ``names`` builds only some fields,
+where the caller is; ``a | b`` joins two builds so one read covers both. A control whose greyed-out state depends on
+another's value is declared with its opening state and its ``handle.disabled`` set by the scene.
 
 Adding a control is one declaration. To let the arm's user set a damping factor, add to ``ArmParams``::
 
@@ -329,6 +331,15 @@ class Controls(Generic[P]):
     def each(self, name: str) -> tuple[Handle, ...]:
         """Every control of field ``name`` (one per element of a tuple field)."""
         return self.fields[name].handles
+
+    def __or__(self, other: Controls[P]) -> Controls[P]:
+        """Both sets of controls as one (built by separate calls, e.g. with a button between them), so one
+        :func:`read_controls` reads them all."""
+        assert self.params_type is other.params_type, "controls of two parameter types"
+        assert not self.fields.keys() & other.fields.keys(), "a field built twice"
+        return Controls(
+            self.params_type, {**self.fields, **other.fields}, {**self.folders, **other.folders}
+        )
 
     def __iter__(self) -> Iterator[Handle]:
         """Every handle, in field order."""

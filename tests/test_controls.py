@@ -281,6 +281,11 @@ def test_some_fields_can_be_built_where_the_caller_is(server: viser.ViserServer)
     assert (
         list(declared(Demo)) == [*Demo.__dataclass_fields__][:-1]
     )  # every field but the undeclared note
+    rest = build_controls(server.gui, Demo(), ("speed_kmh", "riders"))
+    both = some | rest
+    assert list(both.fields) == ["power_w", "source", "speed_kmh", "riders"]
+    store_value(rest["riders"], 99)
+    assert read_controls(both, Demo()).riders == 16
     with pytest.raises(AssertionError, match="no declared control"):
         build_controls(server.gui, Demo(), ("note",))
 
