@@ -155,8 +155,7 @@ def drain_arrivals(client: BrowserClient, scene: str, arrivals: list[float]) -> 
     The client keeps every message it receives, meshes and images included; over a minute of updates that is
     gigabytes per browser, so the run keeps only the times it needs (the mirrored GUI and nodes stay)."""
     prefix = f"/{scene}"
-    with client._lock:
-        received, client.received = client.received, []
+    received = client.take_received()
     arrivals.extend(
         t
         for t, message in received

@@ -192,6 +192,13 @@ class BrowserClient:
             raise KeyError(f"no GUI element labelled {label!r}; have {sorted(self.labels())}")
         return uuid
 
+    def take_received(self) -> list[tuple[float, dict[str, Any]]]:
+        """Every message received since the last call, oldest first, handed over and forgotten here (the mirrored
+        GUI and nodes stay): a long run keeps only what it needs instead of every mesh and image."""
+        with self._lock:
+            received, self.received = self.received, []
+        return received
+
     def value_at(self, uuid: str) -> Any:
         """The value this browser shows for the GUI element ``uuid``."""
         with self._lock:
