@@ -12,7 +12,7 @@ numba's threads and threading layer, the load average before and after), then:
    limits and 4 obstacles (goal ≥ 300 k chains/s).
 4. Cold start: compiling every core in a fresh process with an empty cache, and loading them from the cache.
 5. The Python around the core: for chains of 2, 4, 8 and 16 links, the median and p95 of the compiled single-chain
-   entry alone (``chain._solve_one`` on prepared arguments, numba's dispatch included) and of a full public
+   entry alone (``kernels.fabrik.api.compiled_single_solve``: the compiled call on prepared arguments, numba's dispatch included) and of a full public
    ``solve`` call on the same chain and target, and their ratio. Goal: ``solve`` within 2× of the core.
 6. The goal table.
 
@@ -352,7 +352,7 @@ def skeletons(frames: int) -> dict[str, float]:
 
 def overhead(calls: int) -> dict[str, float]:
     """Median and p95 of the compiled single-chain entry alone and of a full ``solve`` call, same chain and target."""
-    from kernels.fabrik import api, chain
+    from kernels.fabrik.api import compiled_single_solve
 
     print(
         f"\n## Python around the core: one solve, links of 0.1 m, 3D, no limits, {calls} calls each, "
@@ -366,13 +366,11 @@ def overhead(calls: int) -> dict[str, float]:
     for n in (2, 4, 8, 16):
         joints = arc_chain(n, 0.1)
         target = np.array([0.05, 0.02, 0.07 * n])
-        setup = api._options(3, 1e-3, 50, None, 0, True)
-        args = (joints, target, 1e300, setup.params, setup.flags, setup.root_direction,
-                setup.centres, setup.radii, setup.table)  # fmt: skip
+        solve_core, args = compiled_single_solve(joints, target)
         core, full = np.empty(calls), np.empty(calls)
         for i in range(calls):  # interleaved, so a busy moment on the shared machine hits both
             start = time.perf_counter()
-            chain._solve_one(*args)
+            solve_core(*args)
             middle = time.perf_counter()
             fabrik.solve(joints, target)
             core[i], full[i] = middle - start, time.perf_counter() - middle

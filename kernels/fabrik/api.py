@@ -11,7 +11,7 @@ import dataclasses
 import functools
 import math
 import threading
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -639,6 +639,23 @@ def _to_unit_scale(
     # the tolerance (inf beyond float range: then every error is within it)
     params[0] = params[0] / scale
     return scale, params, setup.centres / scale, setup.radii / scale
+
+
+def compiled_single_solve(
+    joints: NDArray[np.float64], target: NDArray[np.float64]
+) -> tuple[Callable[..., object], tuple[object, ...]]:
+    """The compiled call one default :func:`solve` makes, and its prepared arguments, for timing the core alone.
+
+    ``joints`` (n + 1, d) and ``target`` (d,) float64 arrays, d = 2 or 3 (m); default options (no limits, no
+    obstacles). ``core(*args)`` runs exactly the compiled work of ``solve(joints, target)``, so a benchmark can
+    print how much the Python around it costs. Raises ``ValueError`` naming a bad argument, as :func:`solve` does.
+    """
+    chain = _check_joints("joints", joints, batched=False)
+    point = _check_vector("target", target, chain.shape[1])
+    setup = _Setup.build(chain.shape[1], 1e-3, 50, None, (), None, _SOLVER_IDS["fabrik"], True)
+    args = (np.ascontiguousarray(chain), np.ascontiguousarray(point), _LARGEST, setup.params,
+            setup.flags, setup.root_direction, setup.centres, setup.radii, setup.table)  # fmt: skip
+    return _solve_one, args
 
 
 def _solve_single(
