@@ -155,14 +155,14 @@ def scene_rows() -> None:
     assert isinstance(scene, FreeKickScene)
     scene.wait_idle()
     handling: list[float] = []
-    inner = scene._on_input
+    inner = scene.apply_inputs
 
     def timed_on_input() -> None:
         start = time.perf_counter()
         inner()
         handling.append(time.perf_counter() - start)
 
-    for slider in (scene.spin, scene.speed):
+    for slider in (scene.controls["spin_rev_s"], scene.controls["speed_ms"]):
         slider.remove_update_callback()
         slider.on_update(scene.callback(timed_on_input))
 
@@ -177,7 +177,7 @@ def scene_rows() -> None:
             client.wait_for(lambda done=done: len(handling) > done, what="the callback")
             time.sleep(0.02)
         constant = handling[:]
-        scene.model.value = "Measured C_D(Re, S), C_L(S)"
+        scene.controls["model"].value = "Measured C_D(Re, S), C_L(S)"
         scene.wait_idle()
         round_trips: list[float] = []
         for i in range(120):
@@ -195,7 +195,7 @@ def scene_rows() -> None:
             round_trips.append(time.perf_counter() - start)
             time.sleep(0.02)
         measured = handling[len(constant) :]
-        scene.integrator.value = "Euler, 1 ms (seed)"
+        scene.controls["integrator"].value = "Euler, 1 ms (seed)"
         scene.wait_idle()
         for i in range(120):
             done = len(handling)
@@ -234,7 +234,7 @@ def scene_rows() -> None:
         "measured model, websocket client",
     )
 
-    map_times = timings(lambda: (scene._request_map(), scene.wait_idle()), 3)
+    map_times = timings(lambda: (scene.request_outcome_map(), scene.wait_idle()), 3)
     row(
         "outcome map, 41 x 31 kicks (worker thread)",
         map_times,

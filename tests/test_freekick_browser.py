@@ -84,8 +84,8 @@ def _look_at_the_kick(shown: ScenePage) -> None:
     assert isinstance(scene, FreeKickScene)
     image = screenshot(shown.page)
     with scene._lock:
-        points = view_points(scene.params, scene.state, scene._view)
-    xy = assert_in_view(shown, "/freekick", points, f"the kick ({scene._view})")
+        points = view_points(scene.params, scene.state, scene.params.view)
+    xy = assert_in_view(shown, "/freekick", points, f"the kick ({scene.params.view})")
     assert_seen(shown, image, MAIN, xy, "ball, wall, goal and path")
 
 
@@ -97,10 +97,10 @@ def _goal_share(shown: ScenePage) -> float:
 def test_the_kick_fills_the_view_clear_of_the_panel(shown: ScenePage) -> None:
     _look_at_the_kick(shown)
     scene = shown.scene
-    assert scene._view == "broadcast"
+    assert scene.params.view == "broadcast"
     # It fills the screen: the goal-to-ball extent spans most of the free width, not a postage stamp...
     with scene._lock:
-        points = view_points(scene.params, scene.state, scene._view)
+        points = view_points(scene.params, scene.state, scene.params.view)
         path, ghost = resample(scene.state.flight, 40), resample(scene.state.ghost, 40)
     xy = project(shown.page, "/freekick", points)[:, :2]
     width = panel_rect(shown.page)[0]
@@ -138,7 +138,7 @@ def test_ten_percent_more_spin_moves_the_path_on_the_screen(shown: ScenePage) ->
         after = resample(scene.state.flight, 40)
     now = project(shown.page, "/freekick", after)[:, :2]
     # Where the ball crosses the goal line moved by several pixels on the screen...
-    assert scene._view == "broadcast"
+    assert scene.params.view == "broadcast"
     shift = float(np.linalg.norm(now[-1] - was[-1]))
     assert shift > SPIN_SHIFT_SHARE * shown.viewport[0], (was[-1], now[-1])
     # ...and the orange path is drawn there, not where it was.
@@ -163,15 +163,17 @@ def test_every_camera_view_keeps_the_kick_in_view(shown: ScenePage) -> None:
     ]  # the opening view last: choosing it again changes nothing
     for view in order:
         frames = scene.framing.frames
-        scene.view.value = VIEW_LABELS[view]  # type: ignore[index]
+        scene.controls["view"].value = VIEW_LABELS[view]  # type: ignore[index]
         wait_until(
-            lambda view=view, frames=frames: scene._view == view and scene.framing.frames > frames,
+            lambda view=view, frames=frames: (
+                scene.params.view == view and scene.framing.frames > frames
+            ),
             f"the {view} view",
         )
         settle(shown)
         image = screenshot(shown.page)
         with scene._lock:
-            points = view_points(scene.params, scene.state, scene._view)
+            points = view_points(scene.params, scene.state, scene.params.view)
             spot = ball_spot(scene.params)
         xy = assert_in_view(shown, "/freekick", points, f"the kick ({view})")
         assert_seen(shown, image, MAIN, xy, f"ball, wall, goal and path ({view})")

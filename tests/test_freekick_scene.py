@@ -124,19 +124,19 @@ def test_opening_state_is_the_kernels_curler(scene: FreeKickScene) -> None:
 
 def test_spin_changes_path_band_and_outcome_with_the_measured_model(scene: FreeKickScene) -> None:
     assert scene.params.model == "measured"  # the scene opens on the model under which spin matters
-    scene.model.value = "Constant C_D = C_L = 0.25 (seed)"
+    scene.controls["model"].value = "Constant C_D = C_L = 0.25 (seed)"
     band = np.asarray(scene.band.vertices)
     assert np.allclose(
         band[0::2], band[1::2], atol=1e-5
     )  # constant model: ±10 % spin flies the same path
-    scene.model.value = "Measured C_D(Re, S), C_L(S)"
-    scene.azimuth.value = -12.0
+    scene.controls["model"].value = "Measured C_D(Re, S), C_L(S)"
+    scene.controls["azimuth_deg"].value = -12.0
     assert scene.params.model == "measured" and scene.state.outcome.result == "goal"
     band = np.asarray(scene.band.vertices)
     width_at_goal = np.linalg.norm(band[-2] - band[-1])
     assert width_at_goal > 0.4  # a tenth more or less spin moves the ball tens of centimetres
     before = drawn_path(scene)
-    scene.spin.value = 2.0
+    scene.controls["spin_rev_s"].value = 2.0
     assert scene.state.outcome.result == "wide" and "Wide of the post" in scene.result.content
     assert np.abs(drawn_path(scene) - before).max() > 1.0
 
@@ -169,12 +169,12 @@ def test_drawn_path_ghost_and_band_are_the_kernels_flights(
     scene: FreeKickScene, integrator: str, method: ball.Method, dt: float, model_label: str
 ) -> None:
     model: ball.Model = "measured" if model_label.startswith("Measured") else "constant"
-    scene.integrator.value = integrator
-    scene.model.value = model_label
+    scene.controls["integrator"].value = integrator
+    scene.controls["model"].value = model_label
     # A spin change keeps the no-spin ghost; a speed change flies it again. Both must draw the kernel's flights.
     for speed, spin in ((25.0, 6.5), (25.0, 9.5), (27.0, 9.5)):
-        scene.speed.value = speed
-        scene.spin.value = spin
+        scene.controls["speed_ms"].value = speed
+        scene.controls["spin_rev_s"].value = spin
         assert (scene.params.speed_ms, scene.params.spin_rev_s) == (speed, spin)
         flight = _kernel_flight(speed, spin, method, dt, model)
         np.testing.assert_array_equal(scene.state.flight.position, flight.position)
@@ -198,7 +198,7 @@ def test_presets_score_and_set_every_control(scene: FreeKickScene) -> None:
         scene.wait_idle()
         assert scene.params == preset.params, preset.label
         assert scene.state.outcome.result == "goal", preset.label
-        assert scene.spin.value == preset.params.spin_rev_s
+        assert scene.controls["spin_rev_s"].value == preset.params.spin_rev_s
         if preset.params.knuckle:  # the knuckle force acts, not just the label
             assert preset.params.spin_rev_s == 0.0
             assert np.abs(scene.state.flight.knuckle).max() > 0.1
@@ -207,7 +207,7 @@ def test_presets_score_and_set_every_control(scene: FreeKickScene) -> None:
 
 
 def test_a_jumping_wall_blocks_the_curler(scene: FreeKickScene) -> None:
-    scene.jump.value = True
+    scene.controls["wall_jumps"].value = True
     assert scene.state.wall.height_m == pytest.approx(1.8 + JUMP_M)
     positions = np.asarray(scene.wall_nodes.batched_positions)
     np.testing.assert_allclose(positions[:, 2], JUMP_M)
@@ -219,8 +219,8 @@ def test_kick_flies_the_ball_spinning_along_its_path(scene: FreeKickScene) -> No
     spot = np.array(scene.ball_frame.position)
     scene.kick_button.value = True
     with scene._lock:  # step the animation deterministically, with the scene's own loop held off
-        assert scene._kick_time_s is not None
-        scene._kick_time_s = 0.0
+        assert scene.kick_time_s is not None
+        scene.kick_time_s = 0.0
         for _ in range(5):
             scene._animate(0.1)
         mid = np.array(scene.ball_frame.position)
@@ -236,7 +236,7 @@ def test_kick_flies_the_ball_spinning_along_its_path(scene: FreeKickScene) -> No
         )
         for _ in range(40):
             scene._animate(0.1)
-        assert scene._kick_time_s is None  # landed, rested, and went back to the spot
+        assert scene.kick_time_s is None  # landed, rested, and went back to the spot
         np.testing.assert_allclose(scene.ball_frame.position, spot)
 
 
@@ -248,8 +248,8 @@ def test_aiming_at_a_point_of_the_goal_mouth_finds_a_kick_over_the_wall(
     point = scene.state.outcome.goal_point
     assert scene.state.outcome.result == "goal" and point is not None
     assert np.linalg.norm(point[1:] - [-2.6, 1.9]) < 0.05
-    assert scene.speed.value == 25.0  # the speed is kept
-    assert scene.elevation.value == pytest.approx(scene.params.elevation_deg)
+    assert scene.controls["speed_ms"].value == 25.0  # the speed is kept
+    assert scene.controls["elevation_deg"].value == pytest.approx(scene.params.elevation_deg)
     assert "Found" in scene.aim_status.content
     np.testing.assert_allclose(scene.target_marker.position, (0.0, -2.6, 1.9))
 
@@ -267,7 +267,7 @@ def test_a_click_ray_through_the_goal_mouth_aims_there(scene: FreeKickScene) -> 
 
 
 def test_outcome_map_matches_single_runs(scene: FreeKickScene) -> None:
-    scene.model.value = "Constant C_D = C_L = 0.25 (seed)"
+    scene.controls["model"].value = "Constant C_D = C_L = 0.25 (seed)"
     assert scene.wait_idle()
     results = scene.map_results
     assert results is not None and results.shape == (len(MAP_SPINS_REV_S), len(MAP_SPEEDS_MS))
@@ -287,7 +287,7 @@ def test_outcome_map_matches_single_runs(scene: FreeKickScene) -> None:
     cell = image.shape[0] // rows
     colour = image[(rows - 1 - 10) * cell + 1, 25 * cell + 1]
     assert tuple(colour) == RESULT_COLOURS[str(results[10, 25])]
-    scene.jump.value = True  # the map follows the settings
+    scene.controls["wall_jumps"].value = True  # the map follows the settings
     assert scene.wait_idle()
     assert np.sum(scene.map_results == "wall") > np.sum(results == "wall")  # type: ignore[operator]
 
@@ -297,7 +297,9 @@ def test_a_burst_of_slider_changes_computes_one_outcome_map_for_the_last(
 ) -> None:
     runs = scene.map_runs
     for spin in np.linspace(5.0, 9.0, 12):
-        scene.spin.value = float(spin)  # each redraws at once; the map waits for the burst to end
+        scene.controls["spin_rev_s"].value = float(
+            spin
+        )  # each redraws at once; the map waits for the burst to end
     assert scene.wait_idle()
     # Twelve changes, one map (a few at most if this machine stalls for a quarter second mid-burst).
     assert runs < scene.map_runs <= runs + 3

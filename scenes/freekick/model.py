@@ -1,0 +1,575 @@
+"""The free kick as numbers: its parameters (each one's GUI control declared on it), presets, and the pure functions
+from parameters to a kick state (spot, launch, spin axis, wall and goal panels, flights, outcome map, aim). No viser.
+
+Physics comes from :mod:`kernels.ball`. The world frame is the pitch's: the goal line is x = 0 with the goal centred
+on y = 0 and its net toward +x, the ball sits on the pitch (x < 0), y is to the kicker's left when facing the goal,
+z is up. Paths are resampled to a fixed number of points so every redraw writes arrays of the same shapes.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import math
+from dataclasses import field
+from typing import Literal
+
+import numpy as np
+from numpy.typing import NDArray
+
+from kernels import ball
+from scenes._controls import checkbox, dropdown, number, slider
+
+PATH_POINTS = 160
+"""Samples per drawn path (trajectory, ghost, band edges)."""
+JUMP_M = 0.35
+"""How much higher a jumping wall reaches (m)."""
+DEFENDER_HEIGHT_M = 1.8
+"""Top of a standing defender's head (m)."""
+DEFENDERS = 4
+DEFENDER_WIDTH_M = 0.5
+
+SpinAxis = Literal["left", "right", "top", "back", "custom"]
+SPIN_AXIS_LABELS: dict[SpinAxis, str] = {
+    "left": "Sidespin, curls left",
+    "right": "Sidespin, curls right",
+    "top": "Topspin (dips)",
+    "back": "Backspin (floats)",
+    "custom": "Custom (two angles)",
+}
+MODEL_LABELS: dict[ball.Model, str] = {
+    "measured": "Measured C_D(Re, S), C_L(S)",
+    "constant": "Constant C_D = C_L = 0.25 (seed)",
+}
+Integrator = Literal["rk4", "euler"]
+INTEGRATOR_LABELS: dict[Integrator, str] = {"rk4": "RK4, 10 ms", "euler": "Euler, 1 ms (seed)"}
+INTEGRATOR_STEP_S: dict[Integrator, float] = {"rk4": 1e-2, "euler": 1e-3}
+BAND_STEP_S = 2e-2
+"""Step of the ±10 % spin band's flights (RK4): they are drawn, not measured, and must not slow a redraw."""
+
+ViewName = Literal["broadcast", "behind", "side", "goal", "above"]
+VIEW_LABELS: dict[ViewName, str] = {
+    "broadcast": "Raised, behind and to the side",
+    "behind": "Behind the ball",
+    "side": "Side-on",
+    "goal": "From the goal",
+    "above": "From above",
+}
+
+RESULT_COLOURS: dict[str, tuple[int, int, int]] = {
+    "goal": (40, 180, 70),
+    "wall": (210, 50, 50),
+    "over": (245, 150, 40),
+    "wide": (240, 215, 60),
+    "short": (140, 140, 140),
+}
+
+MAP_SPEEDS_MS = np.linspace(15.0, 35.0, 41)
+"""Outcome-map columns: launch speed (m/s)."""
+MAP_SPINS_REV_S = np.linspace(0.0, 15.0, 31)
+"""Outcome-map rows: spin rate (rev/s), bottom to top."""
+MAP_CELL_PX = 6
+MAP_QUIET_S = 0.25
+"""The outcome map is recomputed once the settings have been still this long (s), not on every slider step."""
+
+
+@dataclasses.dataclass(frozen=True)
+class FreeKickParams:
+    """Everything the scene shows is a function of these; defaults are the opening state (a curler).
+
+    Each field is also its GUI control, declared once (:mod:`scenes._controls`), in the order and folder shown; the
+    view's dropdown stands above the folders, under the Kick button.
+    """
+
+    distance_m: float = field(
+        default=22.0, metadata=slider("Distance to goal (m)", 12.0, 40.0, 0.5, folder="Ball spot")
+    )
+    """Distance from the ball to the centre of the goal line (m)."""
+    angle_deg: float = field(
+        default=0.0,
+        metadata=slider("Spot angle (°, + = left)", -45.0, 45.0, 1.0, folder="Ball spot"),
+    )
+    """Where the spot is, seen from the goal: angle off the pitch's centre line, + toward the kicker's left (°)."""
+    speed_ms: float = field(
+        default=25.0, metadata=slider("Launch speed (m/s)", 5.0, 40.0, 0.5, folder="Strike")
+    )
+    """Launch speed (m/s)."""
+    elevation_deg: float = field(
+        default=17.0, metadata=slider("Elevation (°)", -5.0, 50.0, 0.5, folder="Strike")
+    )
+    """Launch angle above the ground (°)."""
+    azimuth_deg: float = field(
+        default=-9.0, metadata=slider("Azimuth (°, + = left)", -30.0, 30.0, 0.5, folder="Strike")
+    )
+    """Launch direction relative to the line from ball to goal centre, + to the left (°)."""
+    spin_rev_s: float = field(
+        default=8.0, metadata=slider("Spin rate (rev/s)", 0.0, 15.0, 0.1, folder="Strike")
+    )
+    """Spin rate (rev/s)."""
+    spin_axis: SpinAxis = field(
+        default="left",
+        metadata=dropdown(
+            "Spin axis", tuple(SPIN_AXIS_LABELS), tuple(SPIN_AXIS_LABELS.values()), folder="Strike"
+        ),
+    )
+    """Spin axis: sidespin either way, topspin, backspin, or custom."""
+    axis_tilt_deg: float = field(
+        default=0.0,
+        metadata=slider(
+            "Axis tilt from vertical (°)", -180.0, 180.0, 1.0, folder="Strike", disabled=True
+        ),
+    )
+    """Custom axis: tilt from vertical toward the kicker's left (°); 0 is sidespin left, 90 topspin. Its control is
+    greyed out unless the spin axis is custom."""
+    axis_turn_deg: float = field(
+        default=0.0,
+        metadata=slider(
+            "Axis turn toward the kick (°)", -90.0, 90.0, 1.0, folder="Strike", disabled=True
+        ),
+    )
+    """Custom axis: turn of the tilted part toward the kick direction (°); 90 with tilt 90 is rifle spin. Greyed out
+    unless the spin axis is custom."""
+    model: ball.Model = field(
+        default="measured",
+        metadata=dropdown(
+            "Model", tuple(MODEL_LABELS), tuple(MODEL_LABELS.values()), folder="Physics"
+        ),
+    )
+    """Coefficient model: the measured one, under which the spin rate changes the flight; the seed's constant one
+    curls every spinning kick alike."""
+    integrator: Integrator = field(
+        default="rk4",
+        metadata=dropdown(
+            "Integrator",
+            tuple(INTEGRATOR_LABELS),
+            tuple(INTEGRATOR_LABELS.values()),
+            folder="Physics",
+        ),
+    )
+    """Integrator and its step."""
+    knuckle: bool = field(default=False, metadata=checkbox("Knuckleball", folder="Physics"))
+    """Unsteady knuckleball side force (only acts with near-zero spin)."""
+    knuckle_seed: int = field(
+        default=1, metadata=number("Knuckle seed", 0, 9999, 1, folder="Physics", disabled=True)
+    )
+    """Seed of the knuckleball's side force: the same seed, the same flight. Greyed out without the knuckleball."""
+    wall_jumps: bool = field(default=False, metadata=checkbox("Wall jumps", folder="Physics"))
+    """Whether the wall jumps (its top rises by 0.35 m)."""
+    show_forces: bool = field(default=True, metadata=checkbox("Force arrows", folder="Physics"))
+    """Whether the force arrows are drawn along the path (how the kick is shown, not what it is)."""
+    view: ViewName = field(
+        default="broadcast",
+        metadata=dropdown("View", tuple(VIEW_LABELS), tuple(VIEW_LABELS.values())),
+    )
+    """Where each browser's camera frames the kick from (how the kick is shown, not what it is)."""
+
+    def shown_as(self, shown: FreeKickParams) -> FreeKickParams:
+        """This kick, shown as ``shown`` is (its force arrows and view): what a preset or an aim changes."""
+        return dataclasses.replace(self, show_forces=shown.show_forces, view=shown.view)
+
+
+@dataclasses.dataclass(frozen=True)
+class Preset:
+    label: str
+    """Button text."""
+    params: FreeKickParams
+    """The kick, from the default spot unless it names another."""
+
+
+PRESETS: tuple[Preset, ...] = (
+    Preset("Curler round the wall", FreeKickParams()),
+    Preset(
+        "Dipping topspin",
+        FreeKickParams(
+            speed_ms=28.0, elevation_deg=21.0, azimuth_deg=0.0, spin_rev_s=8.0, spin_axis="top"
+        ),
+    ),
+    Preset(
+        "Knuckleball",
+        FreeKickParams(
+            distance_m=27.0,
+            speed_ms=29.0,
+            elevation_deg=15.0,
+            azimuth_deg=0.0,
+            spin_rev_s=0.0,
+            model="measured",
+            knuckle=True,
+            knuckle_seed=4,
+        ),
+    ),
+    Preset(
+        "Long-range swerve",
+        FreeKickParams(
+            distance_m=32.0,
+            angle_deg=-10.0,
+            speed_ms=30.0,
+            elevation_deg=18.5,
+            azimuth_deg=-10.0,
+            spin_rev_s=9.0,
+            spin_axis="custom",
+            axis_tilt_deg=8.0,
+            axis_turn_deg=0.0,
+        ),
+    ),
+)
+
+
+# --------------------------------------------------------------------------------------------- kick geometry
+def ball_spot(p: FreeKickParams) -> NDArray[np.float64]:
+    """(3,) centre of the ball on its spot (m)."""
+    a = math.radians(p.angle_deg)
+    return np.array([-p.distance_m * math.cos(a), p.distance_m * math.sin(a), ball.BALL_RADIUS_M])
+
+
+def goal_heading_rad(p: FreeKickParams) -> float:
+    """Heading (rad, from +x toward +y) of the line from the ball to the centre of the goal line."""
+    spot = ball_spot(p)
+    return math.atan2(-spot[1], -spot[0])
+
+
+def aim_heading_rad(p: FreeKickParams) -> float:
+    """Heading (rad, from +x toward +y) of the launch direction."""
+    return goal_heading_rad(p) + math.radians(p.azimuth_deg)
+
+
+def launch_velocity(p: FreeKickParams, speed_ms: float | None = None) -> NDArray[np.float64]:
+    return ball.launch_velocity(
+        p.speed_ms if speed_ms is None else speed_ms,
+        math.radians(p.elevation_deg),
+        aim_heading_rad(p),
+    )
+
+
+def spin_axis(p: FreeKickParams) -> NDArray[np.float64]:
+    """(3,) unit spin axis in the world, from the preset kind or the two custom angles, relative to the kick."""
+    heading = aim_heading_rad(p)
+    forward = np.array([math.cos(heading), math.sin(heading), 0.0])
+    left = np.array([-math.sin(heading), math.cos(heading), 0.0])
+    up = np.array([0.0, 0.0, 1.0])
+    match p.spin_axis:
+        case "left":
+            return up
+        case "right":
+            return -up
+        case "top":
+            return left
+        case "back":
+            return -left
+        case "custom":
+            tilt, turn = math.radians(p.axis_tilt_deg), math.radians(p.axis_turn_deg)
+            return math.cos(tilt) * up + math.sin(tilt) * (
+                math.cos(turn) * left + math.sin(turn) * forward
+            )
+
+
+def spin_vector(p: FreeKickParams, scale: float = 1.0) -> NDArray[np.float64]:
+    """(3,) ω (rad/s)."""
+    return ball.spin_vector(p.spin_rev_s * scale, spin_axis(p))
+
+
+def panels(p: FreeKickParams) -> tuple[ball.Panel, ball.Panel]:
+    """The wall (shifted to cover the near post once the spot is off-centre) and the goal mouth."""
+    spot = ball_spot(p)
+    height = DEFENDER_HEIGHT_M + (JUMP_M if p.wall_jumps else 0.0)
+    width = DEFENDERS * DEFENDER_WIDTH_M
+    offset = 0.0
+    if abs(p.angle_deg) >= 5.0:
+        # The wall's outside defender stands on the line from the ball to the near post.
+        near_post = np.array([0.0, math.copysign(0.5 * ball.GOAL_WIDTH_M, spot[1])])
+        aim = -spot[:2] / np.linalg.norm(spot[:2])
+        to_post = near_post - spot[:2]
+        left = np.array([-aim[1], aim[0]])
+        post_lateral = ball.WALL_DISTANCE_M * float(to_post @ left) / float(to_post @ aim)
+        offset = post_lateral - math.copysign(0.5 * width - 0.5 * DEFENDER_WIDTH_M, post_lateral)
+    return ball.free_kick_panels(
+        spot[:2],
+        (0.0, 0.0),
+        (1.0, 0.0),
+        wall_width_m=width,
+        wall_height_m=height,
+        wall_offset_m=offset,
+    )
+
+
+def wall_axes(wall: ball.Panel) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """(2,) unit normal of the wall (toward the goal) and (2,) unit direction along it, + to the kicker's left."""
+    normal = np.array(wall.normal_xy) / np.hypot(*wall.normal_xy)
+    return normal, np.array([-normal[1], normal[0]])
+
+
+# --------------------------------------------------------------------------------------------- flight
+@dataclasses.dataclass(frozen=True)
+class KickState:
+    """The kick, its comparisons and its verdict for one parameter set."""
+
+    flight: ball.Trajectory
+    """The kick as set."""
+    ghost: ball.Trajectory
+    """The same kick with no spin."""
+    less_spin: ball.Trajectory
+    """Spin × 0.9."""
+    more_spin: ball.Trajectory
+    """Spin × 1.1."""
+    outcome: ball.Outcome
+    """What the kick did."""
+    ghost_outcome: ball.Outcome
+    """What the no-spin kick did."""
+    wall: ball.Panel
+    goal: ball.Panel
+
+
+def _fly(
+    p: FreeKickParams, spin_scale: float, *, knuckle: bool, band: bool = False
+) -> ball.Trajectory:
+    """One flight; ``band`` flights (only drawn, never measured) use RK4 at 20 ms, well under a millimetre off."""
+    return ball.simulate(
+        ball_spot(p),
+        launch_velocity(p),
+        spin_vector(p, spin_scale),
+        dt=BAND_STEP_S if band else INTEGRATOR_STEP_S[p.integrator],
+        method="rk4" if band else p.integrator,
+        model=p.model,
+        t_max=4.0,
+        x_stop=2.0,  # two metres into the net: far enough to see the ball cross the line
+        ground_m=ball.BALL_RADIUS_M,
+        knuckle_seed=p.knuckle_seed if (knuckle and p.knuckle) else None,
+    )
+
+
+def compute_kick(p: FreeKickParams) -> KickState:
+    """Run the kernels for one parameter set (no viser: testable on its own).
+
+    The no-spin ghost is flown once per launch and wall (:func:`_ghost_kick`): while only the spin or the knuckleball
+    settings change, as when the spin slider is dragged, it is reused rather than flown again.
+    """
+    wall, goal = panels(p)
+    flight = _fly(p, 1.0, knuckle=True)
+    ghost, ghost_outcome = _ghost_kick(_without_spin(p))
+    return KickState(
+        flight=flight,
+        ghost=ghost,
+        less_spin=_fly(p, 0.9, knuckle=True, band=True),
+        more_spin=_fly(p, 1.1, knuckle=True, band=True),
+        outcome=ball.outcome(flight, wall, goal),
+        ghost_outcome=ghost_outcome,
+        wall=wall,
+        goal=goal,
+    )
+
+
+def _without_spin(p: FreeKickParams) -> FreeKickParams:
+    """``p`` with its spin, knuckleball and display settings at their defaults: all its no-spin ghost depends on."""
+    plain = FreeKickParams()
+    return dataclasses.replace(
+        p,
+        spin_rev_s=0.0,
+        spin_axis=plain.spin_axis,
+        axis_tilt_deg=plain.axis_tilt_deg,
+        axis_turn_deg=plain.axis_turn_deg,
+        knuckle=False,
+        knuckle_seed=plain.knuckle_seed,
+        show_forces=plain.show_forces,
+        view=plain.view,
+    )
+
+
+@functools.lru_cache(maxsize=8)
+def _ghost_kick(p: FreeKickParams) -> tuple[ball.Trajectory, ball.Outcome]:
+    """The kick ``p`` with no spin and its outcome, kept for the last few launches (its arrays are read-only)."""
+    wall, goal = panels(p)
+    ghost = _fly(p, 0.0, knuckle=False)
+    # Shared by every state of this launch: a write would corrupt them all, so refuse it.
+    for member in dataclasses.fields(ghost):
+        value = getattr(ghost, member.name)
+        if isinstance(value, np.ndarray):
+            value.flags.writeable = False
+    return ghost, ball.outcome(ghost, wall, goal)
+
+
+def sample_rows(
+    times: NDArray[np.float64], t: NDArray[np.float64], values: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """(M, C) ``values`` (N, C), given at the increasing sample times ``t`` (N,), interpolated linearly at ``times``
+    (M,), clamped to ``[t[0], t[-1]]``: ``np.interp`` on every column at once. One ``np.interp`` finds each time's
+    fractional row (``np.interp`` clamps, and is compiled); the columns are then blended in one step (a redraw
+    once called ``np.interp`` 33 times; a search and masks of our own took 59 µs a path, this 17 µs)."""
+    if len(t) == 1:
+        return np.repeat(values[:1], len(times), axis=0)
+    row = np.interp(times, t, np.arange(len(t), dtype=np.float64))
+    i = np.minimum(row.astype(np.intp), len(t) - 2)
+    w = (row - i)[:, None]
+    return values[i] + w * (values[i + 1] - values[i])
+
+
+def resample(flight: ball.Trajectory, n: int = PATH_POINTS) -> NDArray[np.float64]:
+    """(n, 3) positions at n evenly spaced times over the flight."""
+    return sample_rows(np.linspace(0.0, float(flight.t[-1]), n), flight.t, flight.position)
+
+
+def position_at(flight: ball.Trajectory, t: float) -> NDArray[np.float64]:
+    """(3,) ball centre at time t (clamped to the flight)."""
+    return sample_rows(np.array([float(t)]), flight.t, flight.position)[0]
+
+
+def deflection_m(state: KickState) -> float | None:
+    """Sideways distance at the goal line between the kick and its no-spin ghost (m, + = left)."""
+    a, b = state.outcome.goal_point, state.ghost_outcome.goal_point
+    if a is None or b is None:
+        return None
+    return float(a[1] - b[1])
+
+
+def outcome_map(p: FreeKickParams) -> NDArray[np.str_]:
+    """(spins, speeds) results over :data:`MAP_SPEEDS_MS` × :data:`MAP_SPINS_REV_S` with the other settings kept.
+
+    With the knuckleball on, every cell flies with ``p.knuckle_seed`` (the side force fades out as the spin grows,
+    so it matters in the low-spin rows only), as the kick itself does.
+    """
+    wall, goal = panels(p)
+    speeds, spins = np.meshgrid(MAP_SPEEDS_MS, MAP_SPINS_REV_S)
+    heading, elevation = aim_heading_rad(p), math.radians(p.elevation_deg)
+    direction = ball.launch_velocity(1.0, elevation, heading)
+    axis = spin_axis(p)
+    k = speeds.size
+    judged = ball.simulate_outcomes(
+        np.tile(ball_spot(p), (k, 1)),
+        speeds.reshape(-1, 1) * direction,
+        (2.0 * math.pi * spins.reshape(-1, 1)) * axis,
+        wall,
+        goal,
+        dt=INTEGRATOR_STEP_S["rk4"],
+        method="rk4",
+        model=p.model,
+        t_max=4.0,
+        x_stop=0.5,
+        ground_m=ball.BALL_RADIUS_M,
+        knuckle_seeds=[p.knuckle_seed] * k if p.knuckle else None,
+    )
+    return judged.result.reshape(spins.shape)
+
+
+def outcome_map_image(results: NDArray[np.str_], p: FreeKickParams) -> NDArray[np.uint8]:
+    """RGB image of an outcome map, speed left to right, spin bottom to top, the current kick marked in white."""
+    rows, cols = results.shape
+    image = np.zeros((rows, cols, 3), np.uint8)
+    for name, colour in RESULT_COLOURS.items():
+        image[results == name] = colour
+    image = image[::-1]  # spin grows upward
+    image = np.repeat(np.repeat(image, MAP_CELL_PX, axis=0), MAP_CELL_PX, axis=1)
+    col = int(np.argmin(np.abs(MAP_SPEEDS_MS - p.speed_ms)))
+    row = rows - 1 - int(np.argmin(np.abs(MAP_SPINS_REV_S - p.spin_rev_s)))
+    cy, cx = row * MAP_CELL_PX + MAP_CELL_PX // 2, col * MAP_CELL_PX + MAP_CELL_PX // 2
+    image[cy, max(cx - 6, 0) : cx + 7] = 255
+    image[max(cy - 6, 0) : cy + 7, cx] = 255
+    return image
+
+
+AIM_TOLERANCE_M = 0.15
+"""Largest miss (m) between the clicked point and the found kick's goal-line crossing; beyond it :func:`aim_at`
+returns None. About 1.4 ball radii: the ball still covers the point."""
+
+
+def aim_at(p: FreeKickParams, target_yz: tuple[float, float]) -> FreeKickParams | None:
+    """A kick at the same speed that reaches ``target_yz`` (m) on the goal line over the wall, or None.
+
+    Searches elevation, azimuth and sidespin on a grid with :func:`kernels.ball.simulate_outcomes`, then polishes the
+    best goal-scoring candidate's elevation and azimuth by damped Newton steps on the crossing point (a step that
+    leaves the goal or misses by more is halved, up to five times). Returns None when no goal is found or the best
+    kick still misses the target by more than :data:`AIM_TOLERANCE_M`. A kick without spin keeps ``p``'s spin axis
+    (its direction is moot; :func:`spin_words` says "no spin").
+    """
+    wall, goal = panels(p)
+    target = np.array(target_yz, dtype=np.float64)
+    elevations = np.linspace(4.0, 35.0, 16)
+    azimuths = np.linspace(-25.0, 25.0, 21)
+    spins = np.array([-10.0, -7.0, -4.0, 0.0, 4.0, 7.0, 10.0])  # + curls left
+    e, a, s = (g.ravel() for g in np.meshgrid(elevations, azimuths, spins, indexing="ij"))
+    spot = ball_spot(p)
+    heading = goal_heading_rad(p) + np.radians(a)
+    elevation = np.radians(e)
+    velocities = p.speed_ms * np.stack(
+        [
+            np.cos(elevation) * np.cos(heading),
+            np.cos(elevation) * np.sin(heading),
+            np.sin(elevation),
+        ],
+        axis=1,
+    )
+    omegas = np.zeros((len(e), 3))
+    omegas[:, 2] = 2.0 * math.pi * s
+    judged = ball.simulate_outcomes(
+        np.tile(spot, (len(e), 1)),
+        velocities,
+        omegas,
+        wall,
+        goal,
+        dt=1e-2,
+        method="rk4",
+        model=p.model,
+        t_max=4.0,
+        x_stop=0.5,
+        ground_m=ball.BALL_RADIUS_M,
+    )
+    miss = np.linalg.norm(judged.goal_point[:, 1:] - target, axis=1)
+    miss[judged.result != "goal"] = np.inf
+    if not np.isfinite(miss).any():
+        return None
+    best = int(np.argmin(miss))
+    kick = dataclasses.replace(
+        p,
+        elevation_deg=float(e[best]),
+        azimuth_deg=float(a[best]),
+        spin_rev_s=abs(float(s[best])),
+        spin_axis=p.spin_axis if s[best] == 0 else ("left" if s[best] > 0 else "right"),
+        knuckle=False,
+    )
+
+    def crossing(k: FreeKickParams, *, goal_only: bool = False) -> NDArray[np.float64] | None:
+        """(y, z) where ``k`` crosses the goal line (m), or None (also when ``goal_only`` and it is no goal)."""
+        judged = ball.outcome(_fly(k, 1.0, knuckle=False), wall, goal)
+        if judged.goal_point is None or (goal_only and judged.result != "goal"):
+            return None
+        return judged.goal_point[1:]
+
+    here = crossing(kick, goal_only=True)
+    for _ in range(8):  # damped Newton on (elevation, azimuth) -> (y, z) at the goal line
+        if here is None:
+            break
+        error = target - here
+        if np.linalg.norm(error) < 0.01:
+            break
+        h = 0.05
+        de = crossing(dataclasses.replace(kick, elevation_deg=kick.elevation_deg + h))
+        da = crossing(dataclasses.replace(kick, azimuth_deg=kick.azimuth_deg + h))
+        if de is None or da is None:
+            break
+        jacobian = np.column_stack([(de - here) / h, (da - here) / h])
+        try:
+            step = np.linalg.solve(jacobian, error)
+        except np.linalg.LinAlgError:
+            break
+        step = np.clip(step, -3.0, 3.0)
+        # Backtrack: halve a step that leaves the goal or does not get closer.
+        for _halving in range(6):
+            trial = dataclasses.replace(
+                kick,
+                elevation_deg=float(np.clip(kick.elevation_deg + step[0], -5.0, 50.0)),
+                azimuth_deg=float(np.clip(kick.azimuth_deg + step[1], -30.0, 30.0)),
+            )
+            there = crossing(trial, goal_only=True)
+            if there is not None and np.linalg.norm(target - there) < np.linalg.norm(error):
+                break
+            step = 0.5 * step
+        else:
+            break
+        kick, here = trial, there
+    if here is None or np.linalg.norm(target - here) > AIM_TOLERANCE_M:
+        return None
+    return kick
+
+
+def spin_words(p: FreeKickParams) -> str:
+    """The spin as a person says it: "no spin", or "8.0 rev/s sidespin, curls left"."""
+    if p.spin_rev_s <= 0.0:
+        return "no spin"
+    return f"{p.spin_rev_s:.1f} rev/s {SPIN_AXIS_LABELS[p.spin_axis].lower()}"

@@ -1,0 +1,586 @@
+"""The free-kick scene: a spinning ball's 3D flight over a wall, with its forces, a no-spin ghost, a ±10 % spin band
+and the knuckleball, drawn from :mod:`scenes.freekick.model` onto viser.
+
+Every redraw writes the same nodes' arrays (line-segment points, one band mesh's vertices) and never re-adds a node.
+Two searches run on :class:`~scenes._worker.LatestWorker` threads, never on a callback: the outcome map (a speed ×
+spin grid through :func:`kernels.ball.simulate_batch`) and "aim at a clicked point of the goal mouth". Each worker
+runs only the latest request; a newer request makes an older one's result be dropped, and the map waits for the
+settings to be still for a moment so dragging a slider redraws at full speed.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+import trimesh
+import viser
+import viser.uplot
+from numpy.typing import NDArray
+
+from kernels import ball
+from scenes._base import Scene, set_if_changed
+from scenes._charts import FittedChart
+from scenes._controls import build_controls, declared
+from scenes._framing import ClientFraming, Lens, View
+from scenes._worker import LatestWorker
+from scenes.freekick.model import (
+    DEFENDER_WIDTH_M,
+    DEFENDERS,
+    JUMP_M,
+    MAP_CELL_PX,
+    MAP_QUIET_S,
+    MAP_SPEEDS_MS,
+    MAP_SPINS_REV_S,
+    PATH_POINTS,
+    PRESETS,
+    RESULT_COLOURS,
+    FreeKickParams,
+    aim_at,
+    ball_spot,
+    compute_kick,
+    deflection_m,
+    outcome_map,
+    outcome_map_image,
+    position_at,
+    resample,
+    sample_rows,
+    spin_axis,
+    spin_vector,
+    spin_words,
+    wall_axes,
+)
+from scenes.freekick.props import (
+    ARROW_POINTS,
+    FORCE_COLOURS,
+    GHOST_COLOUR,
+    KNUCKLE_COLOUR,
+    METRES_PER_NEWTON,
+    PATH_COLOUR,
+    arrow_segments,
+    axis_angle_wxyz,
+    dashed,
+    defender_mesh,
+    goal_frame_mesh,
+    net_segments,
+    pitch_markings,
+    polyline_segments,
+    strip_faces,
+)
+from scenes.freekick.views import frame_view
+
+
+def _css(rgb: tuple[int, int, int]) -> str:
+    return f"rgb({rgb[0]},{rgb[1]},{rgb[2]})"
+
+
+class FreeKickScene(Scene[FreeKickParams]):
+    key = "freekick"
+    title = "Free kick: Magnus effect"
+    camera_position = (-31.0, -4.0, 3.6)
+    camera_look_at = (-6.0, 0.0, 1.4)
+    about = """
+**What it shows.** A free kick's flight in 3D over a four-man wall 9.15 m from the ball (1.8 m tall; 2.15 m when it
+jumps): the kick as set (thick orange line), the same kick with no spin (dark dashed ghost), a faint band between 10 % less
+and 10 % more spin, and force arrows along the path: drag (red), Magnus (blue), gravity (purple). **View** frames
+the kick raised over the kicker's shoulder, from behind the ball, side-on, as the goalkeeper sees it or from above. **Kick** flies the ball, spinning,
+in real time. Click a point in the goal mouth to have the scene find a kick that reaches it over the wall. The
+outcome map colours each launch speed × spin rate by result: goal (green), wall (red), over (orange), wide (yellow),
+short (grey); the white cross is the current kick.
+
+**Equations** (A = πr², ω̂ = ω/|ω|): F_drag = −½ρA·C_D·|v|·v, F_Magnus = ½ρA·C_L·|v|·(ω̂ × v), F_g = −m·g·ẑ;
+m = 0.43 kg, r = 0.11 m, ρ = 1.225 kg/m³. The seed's Magnus formula (C_L·ρπr²·|v×ω|/|ω|) is not a force; this form
+keeps its direction and gives its 3–5 m of curl over 25 m.
+
+**Models.** *Constant*: C_D = C_L = 0.25; the curl radius is then 2m/(ρA·C_L) ≈ 74 m whatever the spin rate, so the
+spin rate changes nothing but the direction. *Measured*: C_L = 0.9·S (S = r|ω|/|v|, up to S = 0.3; Asai et al.
+2007), C_D from Goff & Carré 2010 (drag crisis near Re 2–3·10⁵, 0.4127·S^0.3056 when spinning): 10 % more spin
+visibly moves the ball. *Knuckleball*: with almost no spin, an unsteady side force zig-zags the ball by about a
+diameter per ~15 m (Cohen, Texier, Quéré & Clanet 2012; Texier et al. 2016), drawn from a seed.
+
+**Integrators.** RK4 at 10 ms is within a micrometre of a DOP853 reference over 30 m; the seed's Euler at 1 ms is
+off by about 1.4 cm, not "within a centimetre".
+
+**Assumptions.** Constant spin, still air, no bounce: the flight ends when the ball touches the turf; posts, bar and
+wall do not deflect it. A goal needs the whole ball inside the posts and under the bar.
+"""
+
+    def __init__(self, server: viser.ViserServer) -> None:
+        super().__init__(server)
+        self.params = FreeKickParams()
+        self.state = compute_kick(self.params)
+        self.kick_time_s: float | None = None
+        """How far the kick's replay has got (s), or None when the ball rests on its spot."""
+        self._map_version = 0
+        self._aim_version = 0
+        self.map_results: NDArray[np.str_] | None = None
+        self.map_runs = 0
+        """How many outcome maps have been computed (a burst of changes computes one)."""
+        self.map_params: FreeKickParams | None = None
+        """The settings the shown outcome map was computed for."""
+        self.last_target: tuple[float, float] | None = None
+        self.aim_message = ""
+        self._map_worker = LatestWorker("freekick-map")
+        self._aim_worker = LatestWorker("freekick-aim")
+        # The scene's join() waits for a search in flight, as for its animation loop.
+        self._threads += [self._map_worker.thread, self._aim_worker.thread]
+        self._build_gui()
+        self._build_world()
+        self.redraw()
+        self.framing = ClientFraming(self._view_for, opening=self.camera_position)
+        self.watch_cameras(self.framing.on_camera)
+        self.request_outcome_map()
+        self.start_loop(self._animate, 1.0 / 30.0)
+
+    # ----------------------------------------------------------------------------------------- GUI
+    def _build_gui(self) -> None:
+        gui, p = self.server.gui, self.params
+        with self.gui_root:
+            self.kick_button = gui.add_button("Kick", color="green")
+            self.view_controls = build_controls(gui, p, names=("view",))
+            """The View dropdown: a change reframes the kick, which stays as it is."""
+            self.result = gui.add_markdown("")
+            self.kick_controls = build_controls(
+                gui, p, names=[name for name in declared(FreeKickParams) if name != "view"]
+            )
+            """Every other control, in its folder: a change recomputes the kick."""
+            self.controls = self.kick_controls | self.view_controls
+            """Every control the user sets, by field name."""
+            with gui.add_folder("Presets"):
+                self.preset_buttons = [gui.add_button(preset.label) for preset in PRESETS]
+            with gui.add_folder("Forces"):
+                self.chart = FittedChart(
+                    gui,
+                    data=self._chart_data(),
+                    series=(
+                        viser.uplot.Series(label="t (s)"),
+                        viser.uplot.Series(
+                            label="Drag (N)", stroke=_css(FORCE_COLOURS["drag"]), width=2
+                        ),
+                        viser.uplot.Series(
+                            label="Magnus (N)", stroke=_css(FORCE_COLOURS["magnus"]), width=2
+                        ),
+                        viser.uplot.Series(
+                            label="Gravity (N)", stroke=_css(FORCE_COLOURS["gravity"]), width=2
+                        ),
+                        viser.uplot.Series(
+                            label="Knuckle (N)", stroke=_css(KNUCKLE_COLOUR), width=2
+                        ),
+                    ),
+                    scales={
+                        "x": viser.uplot.Scale(time=False, auto=True),
+                        "y": viser.uplot.Scale(auto=True),
+                    },
+                    legend=viser.uplot.Legend(show=True),
+                    title="Force magnitudes along the flight",
+                    aspect=1.6,
+                )
+            with gui.add_folder("Aim at the goal mouth"):
+                self.aim_help = gui.add_markdown(
+                    "Click a point in the goal mouth: the scene searches elevation, azimuth and sidespin at this "
+                    "launch speed for a kick that reaches it over the wall."
+                )
+                self.aim_status = gui.add_markdown("")
+            with gui.add_folder("Outcome map"):
+                self.map_legend = gui.add_markdown(
+                    "Launch speed 15–35 m/s left to right, spin 0–15 rev/s bottom to top, other settings as set. "
+                    "Green goal, red wall, orange over, yellow wide, grey short; white cross: this kick."
+                )
+                self.map_image = gui.add_image(
+                    np.full(
+                        (len(MAP_SPINS_REV_S) * MAP_CELL_PX, len(MAP_SPEEDS_MS) * MAP_CELL_PX, 3),
+                        200,
+                        np.uint8,
+                    ),
+                    label="Speed × spin",
+                    format="png",
+                )
+                self.map_status = gui.add_markdown("Computing…")
+
+        self.kick_controls.on_update(self.callback(self.apply_inputs))
+        self.kick_button.on_click(self.callback(self._on_kick))
+        self.view_controls.on_update(self.callback(self._on_view))
+        for preset, button in zip(PRESETS, self.preset_buttons, strict=True):
+            button.on_click(
+                self.callback(lambda preset=preset: self.apply(preset.params.shown_as(self.params)))
+            )
+
+    # ----------------------------------------------------------------------------------------- world
+    def _build_world(self) -> None:
+        scene, root = self.server.scene, self.root.name
+        grass = trimesh.creation.box(extents=(50.0, 70.0, 0.02))
+        grass.apply_translation((-22.0, 0.0, -0.011))
+        scene.add_mesh_simple(f"{root}/grass", grass.vertices, grass.faces, color=(70, 140, 60))
+        scene.add_line_segments(
+            f"{root}/markings", pitch_markings(), colors=(245, 245, 245), thickness=0.12
+        )
+        frame = goal_frame_mesh()
+        scene.add_mesh_simple(
+            f"{root}/goal_frame", frame.vertices, frame.faces, color=(250, 250, 250)
+        )
+        scene.add_line_segments(
+            f"{root}/net", net_segments(), colors=(225, 225, 225), thickness=0.02
+        )
+        half, h = 0.5 * ball.GOAL_WIDTH_M, ball.GOAL_HEIGHT_M
+        # A nearly invisible pane across the goal mouth: clicking it aims a kick there.
+        self.goal_mouth = scene.add_mesh_simple(
+            f"{root}/goal_mouth",
+            np.array([[0.0, -half, 0.0], [0.0, half, 0.0], [0.0, half, h], [0.0, -half, h]]),
+            np.array([[0, 1, 2], [0, 2, 3]]),
+            color=(255, 255, 255),
+            opacity=0.08,
+            side="double",
+            cast_shadow=False,
+            receive_shadow=False,
+        )
+        self.goal_mouth.on_click(self._on_goal_click)
+        self.target_marker = scene.add_icosphere(
+            f"{root}/target",
+            radius=0.12,
+            color=(255, 60, 200),
+            position=(0.0, 0.0, 1.0),
+            visible=False,
+        )
+
+        defender = defender_mesh()
+        self.wall_nodes = scene.add_batched_meshes_simple(
+            f"{root}/wall",
+            vertices=defender.vertices.astype(np.float32),
+            faces=defender.faces.astype(np.uint32),
+            batched_wxyzs=np.tile([1.0, 0.0, 0.0, 0.0], (DEFENDERS, 1)),
+            batched_positions=np.zeros((DEFENDERS, 3)),
+            batched_colors=np.tile(np.array([30, 60, 170], np.uint8), (DEFENDERS, 1)),
+            lod="off",
+        )
+
+        self.ball_frame = scene.add_frame(
+            f"{root}/ball", show_axes=False, position=tuple(ball_spot(self.params))
+        )
+        sphere = trimesh.creation.icosphere(subdivisions=3, radius=ball.BALL_RADIUS_M)
+        scene.add_mesh_simple(
+            f"{self.ball_frame.name}/sphere", sphere.vertices, sphere.faces, color=(250, 250, 250)
+        )
+        # A dark band round the ball's equator makes its spin visible.
+        band = trimesh.creation.torus(
+            major_radius=ball.BALL_RADIUS_M, minor_radius=0.018, major_sections=32, minor_sections=6
+        )
+        band.apply_transform(trimesh.transformations.rotation_matrix(math.pi / 2, [1, 0, 0]))
+        scene.add_mesh_simple(
+            f"{self.ball_frame.name}/band", band.vertices, band.faces, color=(20, 20, 20)
+        )
+
+        empty_path = np.zeros((PATH_POINTS - 1, 2, 3), np.float32)
+        self.path = scene.add_line_segments(
+            f"{root}/path", empty_path, colors=PATH_COLOUR, thickness=0.09
+        )
+        self.ghost = scene.add_line_segments(
+            f"{root}/ghost", empty_path, colors=GHOST_COLOUR, thickness=0.04
+        )
+        self.band = scene.add_mesh_simple(
+            f"{root}/band",
+            np.zeros((2 * PATH_POINTS, 3), np.float32),
+            strip_faces(PATH_POINTS),
+            color=(255, 200, 90),
+            opacity=0.35,
+            side="double",
+            cast_shadow=False,
+            receive_shadow=False,
+        )
+        empty_arrows = np.zeros((3 * ARROW_POINTS, 2, 3), np.float32)
+        self.arrows = {
+            name: scene.add_line_segments(
+                f"{root}/force_{name}", empty_arrows, colors=colour, thickness=0.07
+            )
+            for name, colour in FORCE_COLOURS.items()
+        }
+
+    # ----------------------------------------------------------------------------------------- inputs
+    def read_params(self) -> FreeKickParams:
+        """The current GUI values, cleaned: anything non-finite or unknown keeps the last good value, a number out of
+        range is clamped."""
+        return self.read_controls(self.controls)
+
+    def apply_inputs(self) -> None:
+        """Read the controls and show the kick they set (what a change of any control but the view runs)."""
+        self._set_params(self.read_params())
+
+    def _set_params(self, params: FreeKickParams) -> None:
+        state = compute_kick(
+            params
+        )  # raises (and keeps the last state) if the kernels refuse the input
+        moved = (params.distance_m, params.angle_deg) != (
+            self.params.distance_m,
+            self.params.angle_deg,
+        )
+        self.params, self.state = params, state
+        self.kick_time_s = None
+        self.redraw()
+        self.request_outcome_map()
+        if moved:  # the ball is on another spot: every view moves with it
+            self.framing.reframe()
+
+    # ----------------------------------------------------------------------------------------- camera
+    def _on_view(self) -> None:
+        self.params = self.read_controls(self.view_controls)  # the kick itself is unchanged
+        self.framing.reframe()
+
+    def _view_for(self, lens: Lens) -> View:
+        return frame_view(self.params, self.state, self.params.view, lens)
+
+    def apply(self, params: FreeKickParams) -> None:
+        """Show ``params``: write every GUI control (without re-running callbacks) and redraw once."""
+        with self.server.atomic():
+            for name, built in self.controls.fields.items():
+                self.write_back(built.handles[0], built.control.to_gui(getattr(params, name)))
+        view = self.params.view
+        self._set_params(self.read_params())
+        if self.params.view != view:
+            self.framing.reframe()
+
+    def _on_kick(self) -> None:
+        self.kick_time_s = 0.0
+        self.wake_loops()
+
+    def _on_goal_click(self, event: viser.SceneNodePointerEvent) -> None:
+        origin, direction = event.ray_origin, event.ray_direction
+        self.callback(lambda: self.aim_from_ray(origin, direction))(None)
+
+    def aim_from_ray(self, ray_origin: object, ray_direction: object) -> None:
+        """Intersect a click ray with the goal mouth and queue the search for a kick reaching that point."""
+        try:
+            o = np.asarray(ray_origin, dtype=np.float64)
+            d = np.asarray(ray_direction, dtype=np.float64)
+        except (TypeError, ValueError):
+            return  # not a ray: a crafted message
+        if (
+            o.shape != (3,)
+            or d.shape != (3,)
+            or not (np.all(np.isfinite(o)) and np.all(np.isfinite(d)))
+        ):
+            return
+        if abs(d[0]) < 1e-9:
+            return
+        s = -o[0] / d[0]
+        if s <= 0:
+            return
+        y, z = float(o[1] + s * d[1]), float(o[2] + s * d[2])
+        half, h = 0.5 * ball.GOAL_WIDTH_M, ball.GOAL_HEIGHT_M
+        if not (-half <= y <= half and 0.0 <= z <= h):
+            return
+        self.aim_at_point(y, z)
+
+    def aim_at_point(self, y: float, z: float) -> None:
+        """Queue a search for a kick reaching (y, z) on the goal line; its result is applied when it finishes."""
+        self.last_target = (y, z)
+        self._aim_version += 1
+        version, params = self._aim_version, self.params
+        with self.server.atomic():
+            self.target_marker.position = (0.0, y, z)
+            self.target_marker.visible = True
+            self.aim_status.content = f"Searching for a kick to y = {y:+.2f} m, z = {z:.2f} m…"
+
+        def job() -> None:
+            found = aim_at(params, (y, z))
+            with self._lock:
+                if self.closed or version != self._aim_version:
+                    return
+                if found is None:
+                    self.aim_message = (
+                        "No kick at this speed reaches that point over the wall; try another speed."
+                    )
+                    self.aim_status.content = self.aim_message
+                    return
+                self.apply(found.shown_as(self.params))  # as shown now, not when the click came
+                point = self.state.outcome.goal_point
+                reached = (
+                    ""
+                    if point is None
+                    else f" It crosses at y = {point[1]:+.2f} m, z = {point[2]:.2f} m."
+                )
+                self.aim_message = (
+                    f"Found: elevation {found.elevation_deg:.1f}°, azimuth {found.azimuth_deg:+.1f}°, "
+                    f"{spin_words(found)}.{reached}"
+                )
+                self.aim_status.content = self.aim_message
+
+        self._aim_worker.submit(job)
+
+    # ----------------------------------------------------------------------------------------- outcome map
+    def request_outcome_map(self) -> None:
+        """Queue the outcome map of the current settings; it is computed once they have been still for
+        :data:`~scenes.freekick.model.MAP_QUIET_S`, and a newer request drops this one's result."""
+        self._map_version += 1
+        version, params = self._map_version, self.params
+
+        def job() -> None:
+            self.map_runs += 1
+            results = outcome_map(params)
+            with self._lock:
+                if self.closed or version != self._map_version:
+                    return
+                self.map_results, self.map_params = results, params
+                counts = {name: int(np.sum(results == name)) for name in RESULT_COLOURS}
+                self.map_image.image = outcome_map_image(results, params)
+                words = {
+                    "goal": "goals",
+                    "wall": "blocked by the wall",
+                    "over": "over the bar",
+                    "wide": "wide",
+                    "short": "short",
+                }
+                summary = f"Of {results.size} kicks: " + ", ".join(
+                    f"{n} {words[name]}" for name, n in counts.items() if n
+                )
+                if params.model == "constant":
+                    summary += (
+                        "  \nConstant C_L: any spin above zero curls the same, so the rows repeat. Pick the "
+                        "measured model to see the spin rate matter."
+                    )
+                self.map_status.content = summary
+
+        self._map_worker.submit(job, delay_s=MAP_QUIET_S)
+
+    def wait_idle(self, timeout_s: float = 30.0) -> bool:
+        """Sleep until no search is queued or running (True), or ``timeout_s`` has passed (False); for tests and
+        benchmarks. An aim's result queues a new outcome map, so the aim worker is waited for first, and both again
+        should a search have been queued meanwhile."""
+        deadline = time.monotonic() + timeout_s
+        workers = (self._aim_worker, self._map_worker)
+        while True:
+            for worker in workers:
+                if not worker.wait_idle(max(0.0, deadline - time.monotonic())):
+                    return False
+            if all(worker.idle() or worker.closed for worker in workers):
+                return True
+
+    def close(self) -> None:
+        """Drop any waiting search and stop the workers, then remove the scene (a search in flight finishes, and
+        finds the scene closed)."""
+        for worker in (self._aim_worker, self._map_worker):
+            worker.close(timeout_s=0.0)  # the base's close joins their threads
+        super().close()
+
+    # ----------------------------------------------------------------------------------------- drawing
+    def _chart_data(self) -> tuple[NDArray[np.float64], ...]:
+        f = self.state.flight
+        return (
+            f.t,
+            np.linalg.norm(f.drag, axis=1),
+            np.linalg.norm(f.magnus, axis=1),
+            np.linalg.norm(f.gravity, axis=1),
+            np.linalg.norm(f.knuckle, axis=1),
+        )
+
+    def redraw(self) -> None:
+        """Push the current state to the path, ghost, band, arrows, wall, ball and readouts, in one atomic update."""
+        p, state = self.params, self.state
+        path = resample(state.flight)
+        less, more = resample(state.less_spin), resample(state.more_spin)
+        strip = np.empty((2 * PATH_POINTS, 3))
+        strip[0::2], strip[1::2] = less, more
+        flight = state.flight
+        times = np.linspace(0.0, float(flight.t[-1]), ARROW_POINTS + 2)[1:-1]
+        names = list(FORCE_COLOURS)
+        at = sample_rows(
+            times, flight.t, np.hstack([flight.position, *(getattr(flight, n) for n in names)])
+        )
+        origins, forces = at[:, :3], at[:, 3:].reshape(ARROW_POINTS, len(names), 3)
+        # Every force's arrows in one call: (3 parts, force, arrow, 2, 3), each force's (3K, 2, 3) a slice.
+        arrows = arrow_segments(
+            np.tile(origins, (len(names), 1)),
+            METRES_PER_NEWTON * forces.transpose(1, 0, 2).reshape(-1, 3),
+        ).reshape(3, len(names), ARROW_POINTS, 2, 3)
+        wall = state.wall
+        normal, along = wall_axes(wall)
+        offsets = (np.arange(DEFENDERS) - 0.5 * (DEFENDERS - 1)) * DEFENDER_WIDTH_M
+        feet = np.array(wall.centre_xy) + offsets[:, None] * along
+        lift = JUMP_M if p.wall_jumps else 0.0
+        heading = math.atan2(normal[1], normal[0])
+
+        with self.server.atomic():
+            self.path.points = polyline_segments(path)
+            self.ghost.points = dashed(polyline_segments(resample(state.ghost)))
+            self.band.vertices = strip.astype(np.float32)
+            for k, name in enumerate(names):
+                self.arrows[name].points = arrows[:, k].reshape(-1, 2, 3).astype(np.float32)
+                set_if_changed(self.arrows[name], "visible", p.show_forces)
+            # Only what changed: viser casts every write through its type hints first (~0.1 ms each).
+            set_if_changed(
+                self.wall_nodes,
+                "batched_positions",
+                np.column_stack([feet, np.full(DEFENDERS, lift)]).astype(np.float32),
+            )
+            set_if_changed(
+                self.wall_nodes,
+                "batched_wxyzs",
+                np.tile(
+                    [math.cos(heading / 2), 0.0, 0.0, math.sin(heading / 2)], (DEFENDERS, 1)
+                ).astype(np.float32),
+            )
+            set_if_changed(self.ball_frame, "position", tuple(ball_spot(p)))
+            set_if_changed(self.ball_frame, "wxyz", (1.0, 0.0, 0.0, 0.0))
+            for name, disabled in (
+                ("axis_tilt_deg", p.spin_axis != "custom"),
+                ("axis_turn_deg", p.spin_axis != "custom"),
+                ("knuckle_seed", not p.knuckle),
+            ):
+                handle = self.controls[name]
+                if handle.disabled != disabled:
+                    handle.disabled = disabled
+            self.result.content = self.readout_markdown()
+            self.chart.data = self._chart_data()
+        self.server.flush()
+
+    def readout_markdown(self) -> str:
+        state, p = self.state, self.params
+        o = state.outcome
+        verdict = {
+            "goal": "GOAL",
+            "wall": "Blocked by the wall",
+            "over": "Over the bar",
+            "wide": "Wide of the post",
+            "short": "Lands short of the goal",
+        }[o.result]
+        wall_height = (
+            "never reaches the wall" if o.wall_point is None else f"{o.wall_point[2]:.2f} m"
+        )
+        lines = [
+            f"**{verdict}**",
+            "",
+            f"Height at the wall: **{wall_height}** (wall top {state.wall.height_m:.2f} m)",
+        ]
+        if o.goal_point is not None and o.goal_time is not None:
+            lines.append(
+                f"At the goal line: **y = {o.goal_point[1]:+.2f} m, z = {o.goal_point[2]:.2f} m** after "
+                f"**{o.goal_time:.2f} s**"
+            )
+        else:
+            lines.append(
+                f"Lands after **{float(state.flight.t[-1]):.2f} s**, {-state.flight.position[-1, 0]:.1f} m short"
+            )
+        deflection = deflection_m(state)
+        if deflection is not None:
+            lines.append(f"Sideways against the no-spin kick: **{deflection:+.2f} m** (+ = left)")
+        s_param = ball.BALL_RADIUS_M * 2 * math.pi * p.spin_rev_s / max(p.speed_ms, 1e-9)
+        lines.append(f"Spin parameter S = r·ω/v = {s_param:.3f}")
+        return "  \n".join(lines)
+
+    # ----------------------------------------------------------------------------------------- animation
+    def _animate(self, dt: float) -> bool:
+        """One frame of the kick's replay; False (the loop sleeps) when no kick is playing."""
+        if self.kick_time_s is None:
+            return False
+        flight = self.state.flight
+        self.kick_time_s += min(dt, 0.1)
+        t = min(self.kick_time_s, float(flight.t[-1]))
+        angle = float(np.linalg.norm(spin_vector(self.params))) * t
+        with self.server.atomic():
+            self.ball_frame.position = tuple(position_at(flight, t))
+            self.ball_frame.wxyz = axis_angle_wxyz(spin_axis(self.params), angle)
+        self.server.flush()
+        if self.kick_time_s >= float(flight.t[-1]) + 1.5:
+            self.kick_time_s = None  # rest a moment where it landed, then go back to the spot
+            self.ball_frame.position = tuple(ball_spot(self.params))
+            self.ball_frame.wxyz = (1.0, 0.0, 0.0, 0.0)
+        return True
