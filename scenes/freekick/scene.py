@@ -70,6 +70,9 @@ from scenes.freekick.props import (
 )
 from scenes.freekick.views import frame_view
 
+CHART_COLOURS = {**FORCE_COLOURS, "knuckle": KNUCKLE_COLOUR}
+"""The force chart's series after time, by the flight's force field: its arrows' colours and the knuckle's."""
+
 
 def _css(rgb: tuple[int, int, int]) -> str:
     return f"rgb({rgb[0]},{rgb[1]},{rgb[2]})"
@@ -155,17 +158,11 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
                     data=self._chart_data(),
                     series=(
                         viser.uplot.Series(label="t (s)"),
-                        viser.uplot.Series(
-                            label="Drag (N)", stroke=_css(FORCE_COLOURS["drag"]), width=2
-                        ),
-                        viser.uplot.Series(
-                            label="Magnus (N)", stroke=_css(FORCE_COLOURS["magnus"]), width=2
-                        ),
-                        viser.uplot.Series(
-                            label="Gravity (N)", stroke=_css(FORCE_COLOURS["gravity"]), width=2
-                        ),
-                        viser.uplot.Series(
-                            label="Knuckle (N)", stroke=_css(KNUCKLE_COLOUR), width=2
+                        *(
+                            viser.uplot.Series(
+                                label=f"{name.title()} (N)", stroke=_css(colour), width=2
+                            )
+                            for name, colour in CHART_COLOURS.items()
                         ),
                     ),
                     scales={
@@ -464,13 +461,7 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
     # ----------------------------------------------------------------------------------------- drawing
     def _chart_data(self) -> tuple[NDArray[np.float64], ...]:
         f = self.state.flight
-        return (
-            f.t,
-            np.linalg.norm(f.drag, axis=1),
-            np.linalg.norm(f.magnus, axis=1),
-            np.linalg.norm(f.gravity, axis=1),
-            np.linalg.norm(f.knuckle, axis=1),
-        )
+        return (f.t, *(np.linalg.norm(getattr(f, name), axis=1) for name in CHART_COLOURS))
 
     def redraw(self) -> None:
         """Push the current state to the path, ghost, band, arrows, wall, ball and readouts, in one atomic update."""
