@@ -384,7 +384,7 @@ def test_close_removes_everything_and_stops_the_worker(server: viser.ViserServer
     nodes_before, gui_before = node_names(server), gui_uuids(server)
     scene = SdfGalleryScene(server)
     assert MESH in node_names(server)
-    worker = scene._threads[0]
+    worker = scene.worker.thread
     scene.close()
     assert not worker.is_alive()
     assert node_names(server) == nodes_before
@@ -411,7 +411,7 @@ def test_fifty_builds_share_one_gl_context_and_do_not_grow_memory(
     def build_render_close() -> None:
         scene = SdfGalleryScene(server)
         try:
-            scene._on_camera_values(Camera((1.9, -2.1, 1.4), (0.0, 0.0, 0.3)), 4 / 3)
+            scene.on_camera_values(Camera((1.9, -2.1, 1.4), (0.0, 0.0, 0.3)), 4 / 3)
             wait_until(lambda: scene.reference_serial > 0, what="a reference image")
         finally:
             scene.close()
@@ -434,8 +434,12 @@ def test_fifty_builds_share_one_gl_context_and_do_not_grow_memory(
 def test_blend_dropdown_says_hard_and_smooth_and_hard_ignores_k(
     server: viser.ViserServer, scene: SdfGalleryScene
 ) -> None:
-    assert scene.blend.options == ("Hard", "Smooth (polynomial)", "Smooth (exponential)")
-    assert "samples per side" in scene.resolution.label
+    assert scene.scene_controls["blend"].options == (
+        "Hard",
+        "Smooth (polynomial)",
+        "Smooth (exponential)",
+    )
+    assert "samples per side" in scene.scene_controls["resolution"].label
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("Blend")
         client.set_value("Blend", "Hard")
@@ -443,7 +447,7 @@ def test_blend_dropdown_says_hard_and_smooth_and_hard_ignores_k(
             lambda: scene.mesh_scene is not None and scene.mesh_scene.k == 0.0,
             what="a hard mesh",
         )
-        assert scene.k.disabled
+        assert scene.scene_controls["k"].disabled
         meshed = scene.mesh_scene
         assert meshed is not None
         # The hard scene's distance is the plain minimum of the four primitives' distances.
@@ -651,10 +655,10 @@ def test_camera_with_zero_height_or_nan_is_ignored(
 def test_with_editing_off_apply_uses_only_the_servers_examples(
     server: viser.ViserServer, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    import scenes.sdf_gallery as gallery
+    import scenes.sdf_gallery.editor as gallery
 
     need_gl()
-    monkeypatch.setattr(gallery, "_editing", {"allowed": False})
+    monkeypatch.setattr(gallery, "editing_allowed", lambda: False)
     scene = SdfGalleryScene(server)
     try:
         assert scene.editor.disabled and "Editing is off" in scene.editor_status.content
@@ -681,7 +685,7 @@ def test_compile_and_frame_time_limits_refuse_a_slow_source(
     limit: str,
     words: str,
 ) -> None:
-    import scenes.sdf_gallery as gallery
+    import scenes.sdf_gallery.editor as gallery
 
     need_gl()
     monkeypatch.setattr(gallery, limit, 1e-9)  # every source is too slow now
@@ -708,7 +712,7 @@ def chain_source(links: int) -> str:
 def test_a_slow_compile_is_stopped_at_the_limit_while_the_server_keeps_serving(
     server: viser.ViserServer, scene: SdfGalleryScene, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    import scenes.sdf_gallery as gallery
+    import scenes.sdf_gallery.editor as gallery
 
     need_gl()
     # Nine links pass the size bound but take Mesa several seconds: the trial process is killed at the limit.
@@ -845,19 +849,19 @@ def test_any_camera_message_fields_keep_the_view_sane(
         def aspect(self) -> float:
             return self.image_width / self.image_height  # type: ignore[operator]
 
-    scene._on_camera(Cam())
-    assert 0.5 <= scene._aspect <= 2.5
-    assert 1 <= scene._viewer_width <= 2e4
-    width, height = gallery_rest_size(scene._viewer_width, scene._aspect, None)
+    scene.on_camera(Cam())
+    assert 0.5 <= scene.viewer.aspect <= 2.5
+    assert 1 <= scene.viewer.width_px <= 2e4
+    width, height = gallery_rest_size(scene.viewer.width_px, scene.viewer.aspect, None)
     assert width <= 1600 and 16 <= height <= 1000 and (width >= 640 or height == 1000)
 
 
 def test_the_reviewers_nan_height_camera_is_ignored(scene: SdfGalleryScene) -> None:
     from types import SimpleNamespace
 
-    before = (scene._camera, scene._aspect, scene._viewer_width)
+    before = (scene.viewer.camera, scene.viewer.aspect, scene.viewer.width_px)
     nan = float("nan")
-    scene._on_camera(
+    scene.on_camera(
         SimpleNamespace(
             position=nan,
             look_at=(0.0, 0.0, 0.0),
@@ -868,13 +872,13 @@ def test_the_reviewers_nan_height_camera_is_ignored(scene: SdfGalleryScene) -> N
             aspect=nan,
         )
     )
-    assert (scene._camera, scene._aspect, scene._viewer_width) == before
+    assert (scene.viewer.camera, scene.viewer.aspect, scene.viewer.width_px) == before
 
 
 def gallery_rest_size(width: int, aspect: float, s_per_pixel: float | None) -> tuple[int, int]:
-    from scenes.sdf_gallery import _rest_size
+    from scenes.sdf_gallery import rest_size
 
-    return _rest_size(width, aspect, s_per_pixel)
+    return rest_size(width, aspect, s_per_pixel)
 
 
 @pytest.mark.parametrize(

@@ -1,0 +1,144 @@
+"""The gallery's GLSL editor: its field, the switch that lets browsers send GLSL, and what it checks of a source.
+
+:class:`EditorField` is an applied source and the box it is meshed and ray-marched in. :func:`set_editing_allowed`
+is the server-wide switch (app.py turns it off for a non-loopback host unless asked). :func:`kept_text_problem` and
+:func:`apply_problem` say why the editor's text is not kept or not applied; :func:`trial_source` compiles and draws
+a source once in a child process killed at COMPILE_LIMIT_S and FRAME_LIMIT_S; :func:`mesh_field` meshes an applied
+field on the GL thread.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from shaders import gl_service
+from shaders import renderer as gl_renderer
+from shaders.renderer import MAX_SOURCE_CHARS, Camera, ShaderCompileError, Shading
+from shaders.trial import trial
+
+COMPILE_LIMIT_S = 5.0
+"""An editor source whose programs (moving and fully shaded) take longer to compile in the trial process is refused
+(s); the trial process is killed at this limit plus FRAME_LIMIT_S (:mod:`shaders.trial`)."""
+FRAME_LIMIT_S = 1.0
+"""An editor source whose test frame (MOVING_WIDTH_PX wide, moving shading) takes longer is refused (s); the fully
+shaded program at rest costs a few times more (its soft shadows and AO call sdf about twenty times a pixel more)."""
+EDITOR_HALF_SIZE_M = 1.5
+"""The editor's field is meshed and ray-marched inside the cube [−h, h]³ (m) by default."""
+EXAMPLES = gl_renderer.examples()
+"""The editor's examples, by title."""
+EXAMPLE_SOURCES = frozenset(EXAMPLES.values())
+EDITOR_KEEP_CHARS = 2 * MAX_SOURCE_CHARS
+"""Longest text the editor keeps (characters): room to paste a little too much and trim it; beyond, the previous
+text is put back at once."""
+EDITOR_HELP = (
+    "Write `float sdf(vec3 p)` (metres, Z up) and optionally `vec3 color(vec3 p)`, using the library's "
+    "`sd_*` primitives and `op_*`, `smooth_*` operators, then **Apply**: the shape is meshed and ray-marched "
+    f"from the same source. At most {MAX_SOURCE_CHARS} characters; no loops, no `#` lines."
+)
+EDITING_OFF = (
+    "**Editing is off**: this server is reachable from other machines. The examples "
+    "still work; start the app with `--allow-remote-glsl` to allow typing GLSL."
+)
+_editing = {"allowed": True}
+
+
+def set_editing_allowed(allowed: bool) -> None:
+    """Whether browsers may send GLSL to compile (app.py turns it off for a non-loopback host unless asked)."""
+    _editing["allowed"] = bool(allowed)
+
+
+def editing_allowed() -> bool:
+    return _editing["allowed"]
+
+
+@dataclasses.dataclass(frozen=True)
+class EditorField:
+    """The editor's shape: a GLSL source that compiled, and the box it is meshed and ray-marched in."""
+
+    source: str
+    """Defines float sdf(vec3 p) (m) and optionally vec3 color(vec3 p)."""
+    half_size: float
+    """The bounds are the cube [−half_size, half_size]³ (m)."""
+
+    @property
+    def bounds(self) -> np.ndarray:
+        return np.array([[-self.half_size] * 3, [self.half_size] * 3])
+
+
+def kept_text_problem(text: object) -> str | None:
+    """Why the editor's text is not kept (None when it is: text of at most EDITOR_KEEP_CHARS, editing on); with
+    editing off the answer is "" (put the kept text back without a word)."""
+    if not editing_allowed():
+        return ""
+    if isinstance(text, str) and len(text) <= EDITOR_KEEP_CHARS:
+        return None
+    length = len(text) if isinstance(text, (str, bytes, list)) else None
+    if length is None:
+        return "The editor takes only text; the previous text is back."
+    return (
+        f"That text was {length} characters long; the editor keeps at most {EDITOR_KEEP_CHARS} "
+        f"(and Apply takes at most {MAX_SOURCE_CHARS}), so the previous text is back."
+    )
+
+
+def apply_problem(text: object) -> str | None:
+    """Why ``text`` is not applied before any compiling (None: it is short enough text to try)."""
+    if not isinstance(text, str):
+        return "The source must be text."
+    if len(text) > MAX_SOURCE_CHARS:
+        return (
+            f"The source is {len(text)} characters long; the limit is {MAX_SOURCE_CHARS} characters. "
+            f"Shorten it by {len(text) - MAX_SOURCE_CHARS} and apply again."
+        )
+    return None
+
+
+def trial_source(
+    text: str,
+    shadings: list[Shading],
+    camera: Camera,
+    field: EditorField,
+    width: int,
+) -> None:
+    """Compile ``text`` with each of ``shadings`` and draw one ``width``-wide frame in a child process, killed at
+    COMPILE_LIMIT_S plus FRAME_LIMIT_S; ShaderCompileError says why it is refused. The server's own examples are
+    known to compile quickly and skip it.
+
+    A compiler can take minutes on a short source, and moderngl holds the GIL while it compiles, which would freeze
+    every viewer: only a source that passes is compiled in this process.
+    """
+    if text in EXAMPLE_SOURCES:
+        return
+    trial(
+        text,
+        shadings,
+        camera,
+        field.bounds,
+        width,
+        width * 5 // 8,
+        COMPILE_LIMIT_S,
+        FRAME_LIMIT_S,
+    )
+
+
+def mesh_field(field: EditorField, resolution: int) -> tuple[np.ndarray, ...]:
+    """Mesh the editor's field at ``resolution`` on the GL thread: vertices (V, 3) (m), faces (F, 3), colours
+    (V, 3) in [0, 1] and normals (V, 3). ShaderCompileError when no surface lies inside the bounds."""
+    tri = gl_renderer.mesh_glsl(field.source, resolution, field.bounds)
+    if len(tri.faces) == 0:
+        centre = gl_service.run(lambda gl: gl.probe_field(field.source, [[0.0, 0.0, 0.0]]))[0]
+        side = "outside (sdf > 0)" if float(centre[0]) > 0.0 else "inside (sdf ≤ 0)"
+        h = field.half_size
+        raise ShaderCompileError(
+            f"no surface lies inside the bounds: every sample of the ±{h:g} m box is {side}, so there "
+            "is nothing to mesh (change sdf() or the editor's bounds)",
+            None,
+        )
+    vertices = np.asarray(tri.vertices, dtype=np.float64)
+    faces = np.asarray(tri.faces, dtype=np.int64)
+    rgba = getattr(tri.visual, "vertex_colors", np.zeros((len(vertices), 4)))
+    colors = np.asarray(rgba, dtype=np.float64)[:, :3] / 255.0
+    normals = np.asarray(tri.vertex_normals) if len(faces) else np.zeros_like(vertices)
+    return vertices, faces, colors, normals

@@ -1,0 +1,899 @@
+"""The SDF gallery scene: up to four primitives blended with smooth-min, meshed for the 3D view and ray-marched in
+GLSL, or a shape written in the GLSL editor.
+
+The distance field comes from :mod:`kernels.sdf`; the mesh is its marching-cubes surface, shown with blended vertex
+colours; the "Reference" panel is the same scene sphere-traced by ``shaders/raymarch.frag`` from the viewer's
+camera, and the readouts say how well the two agree (:mod:`scenes.sdf_gallery.compare`).
+
+Threads: GUI, gizmo and camera callbacks only record the new state and submit one job, :meth:`SdfGalleryScene.step`,
+to the scene's :class:`~scenes._worker.LatestWorker` (a burst of drags coalesces: only the newest state is meshed).
+A step meshes the wanted shape, draws the ray-marched main view and renders the reference when it is due; whatever
+waits for the inputs to rest (the full-resolution mesh after a drag's previews, the main view's rest frame, the
+reference once camera and primitives are still) is scheduled as a later step, CAMERA_REST_S after the last input,
+so the worker sleeps between. Refinement is progressive: while a burst of inputs keeps arriving a step meshes at
+PREVIEW_RESOLUTION, and once they rest it meshes the latest scene at full resolution (a single change is meshed at
+full resolution at once). The GL work goes to :mod:`shaders.gl_service`: one context and one thread per process,
+shared by every gallery.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import logging
+import math
+import threading
+import time
+from typing import Any
+
+import numpy as np
+import viser
+
+from kernels import sdf
+from scenes import _controls
+from scenes._base import TURNS, Scene, mark_costly, record_spec
+from scenes._controls import Built, Controls, build_controls, declared
+from scenes._worker import LatestWorker
+from scenes.sdf_gallery import editor
+from scenes.sdf_gallery.compare import Agreement, compare, readout_markdown
+from scenes.sdf_gallery.editor import EDITING_OFF, EDITOR_HELP, EXAMPLES, EditorField
+from scenes.sdf_gallery.export import mesh_file, png_bytes, scene_normals, viewer_glb
+from scenes.sdf_gallery.params import (
+    BOX_HI,
+    BOX_LO,
+    CAMERA_REST_S,
+    GIZMO_MARKER_RADIUS_M,
+    MOVING_WIDTH_PX,
+    PREVIEW_RESOLUTION,
+    REFERENCE_FOLDER,
+    SCENE_FIELDS,
+    SHADING_FIELDS,
+    SIZE_MEANING,
+    SIZES_USED,
+    PrimitiveParams,
+    SdfGalleryParams,
+    Shape,
+    Viewer,
+    camera_from_viser,
+    gizmo_label,
+    gizmo_reach,
+    gizmo_tips,
+    moving_shading,
+    rest_size,
+    viewer_size,
+)
+from shaders import gl_service
+from shaders.renderer import (
+    Camera,
+    GLUnavailableError,
+    Renderer,
+    ShaderCompileError,
+    Shading,
+    check_source,
+)
+
+logger = logging.getLogger(__name__)
+
+VIEW_NOTES = {
+    "mesh": "The 3D view shows the marching-cubes mesh.",
+    "raymarch": "The 3D view shows the GLSL ray-march, rendered from your camera (coarser while it moves).",
+    "both": "The GLSL ray-march with the mesh as a wireframe over it: where they agree, the wireframe hugs the "
+    "surface.",
+}
+"""What the note under the View dropdown says for each view."""
+
+
+class SdfGalleryScene(Scene[SdfGalleryParams]):
+    key = "sdf"
+    title = "SDF gallery (ray marching)"
+    camera_position = (1.9, -2.1, 1.4)
+    camera_look_at = (0.05, 0.0, 0.3)
+    about = """
+**What it shows.** A scene of up to four signed-distance primitives (sphere, box, torus, capsule and Quilez's
+cylinder, round box, octahedron, cone, hexagonal prism, ellipsoid) combined by union, subtraction or intersection,
+hard or with a smooth minimum; or any shape you write in GLSL in the **GLSL editor** (`float sdf(vec3 p)`, with the
+same primitives and operators). The 3D view shows its marching-cubes mesh, the GLSL ray-march rendered from your
+camera (**View: Ray-marched**, composited by depth with the gizmos), or both (the mesh as a wireframe over the
+ray-march). The **Reference** panel shows the ray-march as an image and the readouts measure how well mesh and
+ray-march agree. Drag a gizmo: the mesh follows.
+
+**Equations.** Sphere |p| − r; box |max(q,0)| + min(max(q.x,q.y,q.z),0), q = |p| − b; torus |(|p.xz| − R, p.y)| − r;
+capsule |pa − ba·h| − r. Smooth union, polynomial: h = clamp(½ + ½(b − a)/k, 0, 1),
+smin = mix(b, a, h) − k·h·(1 − h); exponential: −ln(e^(−sa) + e^(−sb))/s with sharpness s = 4 ln 2 / k, so both
+dip by k/4 where surfaces meet. Subtraction −smin(−a, b), intersection −smin(−a, −b). Colours blend by the same
+weights. Shading: I = k_a·AO·albedo + (k_d·albedo·max(n·L, 0) + k_s·max(r·v, 0)^α)·shadow; normals by central
+differences; soft shadows by Quilez's improved technique; AO from five samples along the normal.
+
+**Assumptions.** Smooth blends are distance bounds, not exact distances (1-Lipschitz), which is all sphere tracing
+and the mesher's coarse-to-fine pass need. Marching cubes bevels sharp box edges by up to about half a voxel, so
+IoU is lowest when a box edge is on the silhouette.
+
+**Sources.** I. Quilez, *distance functions*, *smooth minimum*, *soft shadows* (iquilezles.org); J. C. Hart,
+*Sphere tracing* (1996); T. Lewiner et al., marching cubes (2003), via scikit-image.
+"""
+
+    def __init__(self, server: viser.ViserServer) -> None:
+        super().__init__(server)
+        self.params = SdfGalleryParams()
+        self.mesh_vertices = np.zeros((0, 3))
+        self.mesh_faces = np.zeros((0, 3), dtype=np.int64)
+        self.mesh_colors = np.zeros((0, 3))
+        self.mesh_scene: sdf.Scene | None = None
+        """The scene the shown mesh was made from (None when it came from the editor)."""
+        self.mesh_shape: Shape | None = None
+        """The scene or editor field the shown mesh was made from."""
+        self.view_serial = 0
+        """How many ray-marched main-view frames have been sent."""
+        self.view_rgb: np.ndarray | None = None
+        """The latest main-view frame."""
+        self.view_ms: float | None = None
+        """Time to ray-march it (ms)."""
+        self.editor_error: str | None = None
+        """Why the latest editor source was refused (None once one is applied)."""
+        self.editor_serial = 0
+        """How many editor sources have been applied."""
+        self.mesh_serial = 0
+        """How many full-resolution meshes have been shown (``mesh_vertices`` … describe the latest)."""
+        self.preview_serial = 0
+        """How many preview meshes (PREVIEW_RESOLUTION, during a burst of inputs) have been shown."""
+        self.shown_resolution = self.params.resolution
+        """Samples per side of the mesh on screen now: PREVIEW_RESOLUTION during a drag, the slider's value after."""
+        self.reference_serial = 0
+        """How many reference images have been shown."""
+        self.reference_mesh_serial = 0
+        """The ``mesh_serial`` of the full mesh the shown reference was compared against."""
+        self.reference_rgb: np.ndarray | None = None
+        self.agreement = Agreement(0, 0.0, None, None, None)
+        self.gl_error: str | None = None
+        self.viewer = Viewer()
+        """What the latest usable camera message said (replaced whole, under the worker's state lock)."""
+        self._mesh_voxel = 1.0
+        # What the worker is asked to do, guarded by _state (taken after the scene lock and the turn, never before).
+        self._state = threading.Lock()
+        self._wanted_scene: Shape | None = None
+        self._wanted_source: str | None = None
+        self._wanted_resolution = self.params.resolution
+        self._wanted_preview = False
+        """Whether the wanted mesh came in a burst of inputs (mesh it as a preview)."""
+        self._refine: tuple[Shape, int] | None = None
+        """The scene and resolution to mesh in full once the inputs rest (a preview is on screen)."""
+        self._scene_time = 0.0
+        self._reference_due = True
+        self._view_key: tuple[Any, ...] | None = None
+        self._view_moving = False
+        """Whether the main view's last frame was a moving one (its rest frame is still to come)."""
+        self._rest_s_per_pixel: float | None = None
+        """Seconds a pixel of the last rest frame took: the next one is sized to REST_FRAME_BUDGET_S."""
+        self._moving_s_per_pixel: float | None = None
+        self._build_gui()
+        self._build_world()
+        self._sync_enabled_inputs()
+        self._mesh_and_show(self.params.scene(), self.params.resolution)
+        self.worker = LatestWorker("sdf-worker")
+        """Runs :meth:`step`: the meshing and ray-marching, off the callback threads."""
+        self._threads.append(self.worker.thread)
+        self.watch_cameras(self.on_camera)
+        self._wake()
+
+    def close(self) -> None:
+        """Stop the worker and wait for it (a reference render in flight finishes first), then remove everything."""
+        self._stop.set()
+        self.worker.close(timeout_s=60.0)
+        with self._lock:
+            self.server.scene.set_background_image(None)
+        super().close()
+
+    def wait_idle(self, timeout_s: float = 60.0) -> bool:
+        """Sleep until the worker has nothing waiting or running (True), or ``timeout_s`` has passed (False)."""
+        return self.worker.wait_idle(timeout_s)
+
+    # ----------------------------------------------------------------------------------------- GUI
+    def _build_gui(self) -> None:
+        gui = self.server.gui
+        p = self.params
+        allowed = editor.editing_allowed()
+        with self.gui_root:
+            self.view_controls = build_controls(gui, p, ("view_mode", "shape_source"))
+            with self.view_controls.folders["Shape and view"]:
+                self.view_note = gui.add_markdown("")
+            self.example_controls = build_controls(gui, p, ("example",), collapsed=("GLSL editor",))
+            folders = self.example_controls.folders
+            self.editor = build_controls(gui, p, ("editor_text",), folders_open=folders)[
+                "editor_text"
+            ]
+            self.editor.disabled = not allowed
+            self.half_size_controls = build_controls(
+                gui, p, ("editor_half_size",), folders_open=folders
+            )
+            with folders["GLSL editor"]:
+                self.apply = mark_costly(gui.add_button("Apply"))  # compiles GLSL, remeshes
+                self.editor_status = gui.add_markdown(EDITOR_HELP if allowed else EDITING_OFF)
+            self.scene_controls = build_controls(gui, p, SCENE_FIELDS)
+            with self.scene_controls.folders["Blend and mesh"]:
+                self.progress = gui.add_progress_bar(0.0, visible=False)
+                self.readout = gui.add_markdown("")
+            with gui.add_folder(REFERENCE_FOLDER) as reference_folder:
+                self.reference = gui.add_image(
+                    np.full((120, 160, 3), 235, np.uint8), label="Reference", format="png"
+                )
+                self.reference_note = gui.add_markdown("")
+            self.shading_controls = build_controls(
+                gui, p, SHADING_FIELDS, folders_open={REFERENCE_FOLDER: reference_folder}
+            )
+            self.slot_controls = [
+                self._build_slot(gui, i, slot) for i, slot in enumerate(p.primitives)
+            ]
+            gui.add_markdown(SIZE_MEANING)
+            with gui.add_folder("Downloads", expand_by_default=False):
+                self.downloads = {
+                    "glb": gui.add_button("Download mesh (GLB)"),
+                    "stl": gui.add_button("Download mesh (STL)"),
+                    "obj": gui.add_button("Download mesh (OBJ)"),
+                    "png": gui.add_button("Download reference (PNG)"),
+                }
+        self._on_scene = self.callback(self._on_scene_input)
+        """The one handler of every scene input (controls and gizmos): a burst of them costs one read."""
+        self.scene_controls.on_update(self._on_scene)
+        for controls in self.slot_controls:
+            controls.on_update(self._on_scene)
+        self.shading_controls.on_update(self.callback(self._on_shading_input))
+        for fmt, button in self.downloads.items():
+            button.on_click(self._download_handler(fmt))
+        self.view_controls.on_update(self.callback(self._on_view_input))
+        self.example_controls.on_update(self.callback(self._on_example))
+        self.editor.on_update(self.callback(self._on_editor_text))
+        self.apply.on_click(self.callback(self._on_apply))
+
+    @staticmethod
+    def _build_slot(gui: Any, index: int, slot: PrimitiveParams) -> Controls[PrimitiveParams]:
+        """The controls of primitive slot ``index`` (from 0) in its own folder, from PrimitiveParams' declarations:
+        labels formatted with the slot's number and the size's axis; the first slot has no "on" checkbox (it is
+        always on) and its "combine" is greyed out (nothing comes before it)."""
+        n = index + 1
+        declarations = declared(PrimitiveParams)
+        label = str(declarations["kind"].folder).format(slot=n)
+        folder = gui.add_folder(label, expand_by_default=False)
+        fields: dict[str, Built] = {}
+        for name, control in declarations.items():
+            if name == "enabled" and index == 0:
+                continue
+            shown = dataclasses.replace(control, disabled=name == "op" and index == 0)
+            value = getattr(slot, name)
+            per_element = isinstance(value, tuple) and control.per_element
+            handles, specs = [], []
+            with folder:
+                for axis, element in zip("abc", value if per_element else (value,), strict=False):
+                    handle = shown.add(gui, control.label.format(slot=n, axis=axis), element)
+                    handles.append(handle)
+                    specs.append(record_spec(handle, control.spec(element)))
+            fields[name] = Built(control, tuple(handles), tuple(specs), per_element)
+        return Controls(PrimitiveParams, fields, {label: folder})
+
+    def _build_world(self) -> None:
+        scene = self.server.scene
+        vertices, faces, colors = sdf.mesh(self.params.scene(), self.params.resolution)
+        self.mesh_node = scene.add_mesh_trimesh(
+            f"{self.root.name}/mesh", sdf.mesh_trimesh(vertices, faces, colors)
+        )
+        self.mesh_node.glb_data = viewer_glb(
+            vertices, faces, colors, scene_normals(self.params.scene(), vertices)
+        )
+        self.wireframe_node = scene.add_mesh_simple(
+            f"{self.root.name}/wireframe",
+            vertices.astype(np.float32),
+            faces.astype(np.uint32),
+            color=(40, 40, 40),
+            wireframe=True,
+            visible=False,
+        )
+        self._wire: tuple[np.ndarray, np.ndarray] | None = None
+        """The latest mesh's (vertices, faces) for the wireframe, drawn only while it shows."""
+        self.gizmos: list[viser.TransformControlsHandle] = []
+        self.gizmo_markers: list[viser.IcosphereHandle] = []
+        self.gizmo_labels: list[viser.LabelHandle] = []
+        for i, slot in enumerate(self.params.primitives):
+            reach = gizmo_reach(slot)
+            marker_at, label_at = gizmo_tips(reach)
+            gizmo = scene.add_transform_controls(
+                f"{self.root.name}/gizmo_{i + 1}",
+                scale=reach,
+                line_width=2.0,
+                disable_sliders=True,  # the plane handles of four gizmos cluttered the middle; arrows and rings stay
+                # Drawn over the mesh: a gizmo sits at its primitive's centre, inside the surface. Each is sized to
+                # its own primitive (its arrows just poke out of it), so the four do not pile up in the middle.
+                depth_test=False,
+                position=slot.position,
+                wxyz=slot.wxyz,
+                visible=slot.enabled,
+            )
+            gizmo.on_update(self._on_scene)
+            self.gizmos.append(gizmo)
+            # A ball in the primitive's colour at the tip of its local z arrow, and its name: which gizmo moves
+            # which primitive, at a glance.
+            self.gizmo_markers.append(
+                scene.add_icosphere(
+                    f"{gizmo.name}/marker",
+                    radius=GIZMO_MARKER_RADIUS_M,
+                    color=slot.color,
+                    subdivisions=2,
+                    position=marker_at,
+                    cast_shadow=False,
+                    receive_shadow=False,
+                )
+            )
+            self.gizmo_labels.append(
+                scene.add_label(f"{gizmo.name}/label", gizmo_label(i, slot), position=label_at)
+            )
+
+    # ----------------------------------------------------------------------------------------- inputs
+    def read_params(self) -> SdfGalleryParams:
+        """The current scene controls' and gizmos' values, cleaned: anything unusable keeps the last good value."""
+        last = self.params
+        slots = []
+        for i, (controls, gizmo, old) in enumerate(
+            zip(self.slot_controls, self.gizmos, last.primitives, strict=True)
+        ):
+            slot = _controls.read_controls(controls, old, write_back=self.write_back)
+            slots.append(
+                dataclasses.replace(
+                    slot,
+                    enabled=True if i == 0 else slot.enabled,
+                    position=self.read_position(gizmo, old.position, BOX_LO, BOX_HI),
+                    wxyz=self._read_wxyz(gizmo, old.wxyz),
+                )
+            )
+        return dataclasses.replace(self.read_controls(self.scene_controls), primitives=tuple(slots))
+
+    @staticmethod
+    def _read_wxyz(
+        gizmo: Any, last_good: tuple[float, float, float, float]
+    ) -> tuple[float, float, float, float]:
+        try:
+            q = np.asarray(gizmo.wxyz, dtype=np.float64).reshape(4)
+        except (TypeError, ValueError):
+            q = np.full(4, np.nan)
+        norm = float(np.linalg.norm(q)) if np.all(np.isfinite(q)) else 0.0
+        if norm < 1e-6:
+            gizmo.wxyz = last_good
+            return last_good
+        q = q / norm
+        return (float(q[0]), float(q[1]), float(q[2]), float(q[3]))
+
+    def _on_scene_input(self) -> None:
+        params = self.read_params()
+        try:
+            params.scene()
+        except ValueError:
+            logger.warning("sdf: rejected scene input; keeping the last good scene", exc_info=True)
+            return
+        self.params = params
+        self._sync_enabled_inputs()
+        self._request_mesh()
+
+    def _on_view_input(self) -> None:
+        before = self.params
+        self.params = self.read_controls(self.view_controls)
+        self._show_view_mode()
+        if self.params.shape_source != before.shape_source:
+            self._sync_enabled_inputs()
+            self._request_mesh()
+        with self._state:
+            self._view_key = None
+        self._wake()
+
+    def _on_example(self) -> None:
+        self.params = self.read_controls(self.example_controls)
+        self._apply_example()
+
+    def _apply_example(self) -> None:
+        """Put the chosen example's source in the editor and apply it."""
+        source = EXAMPLES[self.params.example]
+        self.write_back(self.editor, source)
+        self.params = dataclasses.replace(self.params, editor_text=source)
+        self._request_source(source)
+
+    def _on_editor_text(self) -> None:
+        """Keep the editor's text only if it is text of at most EDITOR_KEEP_CHARS characters (and editing is on);
+        else put the last kept text back, so a huge or crafted value is not kept for every viewer and late joiner
+        (viser relays an update to the other viewers before this runs; the write-back replaces it)."""
+        text = self.editor.value
+        problem = editor.kept_text_problem(text)
+        if problem is None:
+            self.params = dataclasses.replace(self.params, editor_text=text)
+            return
+        self.write_back(self.editor, self.params.editor_text)
+        if problem:
+            self._show_editor_error(problem)
+
+    def _on_apply(self) -> None:
+        if not editor.editing_allowed():
+            # Only the server's own examples compile: the browser's text is not read.
+            self.params = self.read_controls(self.example_controls)
+            self._apply_example()
+            return
+        text = self.editor.value
+        problem = editor.apply_problem(text)
+        if problem is not None:
+            self._show_editor_error(problem)
+            return
+        self._request_source(text)
+
+    def _on_shading_input(self) -> None:
+        params = self.read_controls(self.shading_controls)
+        self.params = dataclasses.replace(params, shading=params.shading_from_controls())
+        with self._state:
+            self._reference_due = True
+        self._wake()
+
+    def on_camera(self, camera: Any) -> None:
+        """Take a viewer's camera message (any of its fields may be crafted): unusable ones are ignored."""
+        if self.closed:
+            return
+        cam = camera_from_viser(camera)
+        if cam is None:
+            return
+        size = viewer_size(camera)
+        try:
+            aspect = size[0] / size[1] if size is not None else float(camera.aspect)
+        except (TypeError, ValueError, AttributeError, ZeroDivisionError, OverflowError):
+            aspect = 4 / 3
+        self.on_camera_values(cam, aspect, None if size is None else size[0])
+
+    def on_camera_values(self, cam: Camera, aspect: float, width_px: int | None = None) -> None:
+        """Take a cleaned camera, its image aspect (width / height) and canvas width (px; None keeps the last) and
+        ask for a new reference."""
+        with self._state:
+            self.viewer = Viewer(
+                cam,
+                min(max(aspect, 0.5), 2.5) if math.isfinite(aspect) else 4 / 3,
+                self.viewer.width_px if width_px is None else width_px,
+                time.monotonic(),
+            )
+            self._reference_due = True
+        self._wake()
+
+    def _request_mesh(self) -> None:
+        params = self.params
+        half_size = self.read_controls(self.half_size_controls).editor_half_size
+        if half_size != params.editor.half_size:
+            params = dataclasses.replace(
+                params,
+                editor_half_size=half_size,
+                editor=dataclasses.replace(params.editor, half_size=half_size),
+            )
+            self.params = params
+        with self._state:
+            now = time.monotonic()
+            # A request within CAMERA_REST_S of the one before is part of a burst (a drag): preview it.
+            self._wanted_preview = now - self._scene_time < CAMERA_REST_S
+            self._scene_time = now
+            self._wanted_scene = params.shape()
+            self._wanted_resolution = params.resolution
+        self._wake()
+
+    def _request_source(self, text: str) -> None:
+        with self._state:
+            self._wanted_source = text
+        self._wake()
+
+    # ----------------------------------------------------------------------------------------- showing inputs
+    def _show_editor_error(self, message: str) -> None:
+        self.editor_error = message
+        with self._lock:
+            if not self.closed:
+                self.editor_status.content = (
+                    f"**Not applied.** {message}\n\nThe last good shape stays on screen."
+                )
+
+    def _show_view_mode(self) -> None:
+        mode = self.params.view_mode
+        with self.server.atomic():
+            self.mesh_node.visible = mode == "mesh"
+            if mode == "both":
+                self._draw_wire()
+            self.wireframe_node.visible = mode == "both"
+            if mode == "mesh":
+                self.server.scene.set_background_image(None)
+            self.view_note.content = VIEW_NOTES[mode]
+
+    def _draw_wire(self) -> None:
+        """Put the latest mesh (preview or full) on the wireframe node."""
+        if self._wire is not None:
+            self.wireframe_node.vertices, self.wireframe_node.faces = self._wire
+
+    def _sync_enabled_inputs(self) -> None:
+        """Show gizmos of enabled primitives; grey out sizes the kind does not use."""
+        self.scene_controls["k"].disabled = self.params.blend == "hard"
+        for controls, gizmo, slot in zip(
+            self.slot_controls, self.gizmos, self.params.primitives, strict=True
+        ):
+            gizmo.visible = slot.enabled and self.params.shape_source == "primitives"
+            for j, handle in enumerate(controls.each("size")):
+                handle.disabled = j >= SIZES_USED[slot.kind] or not slot.enabled
+        self._sync_gizmo_looks()
+
+    def _sync_gizmo_looks(self) -> None:
+        """Each gizmo's size, marker colour and label follow its primitive's kind, size and colour."""
+        for i, (gizmo, marker, label, slot) in enumerate(
+            zip(
+                self.gizmos,
+                self.gizmo_markers,
+                self.gizmo_labels,
+                self.params.primitives,
+                strict=True,
+            )
+        ):
+            reach = gizmo_reach(slot)
+            if abs(gizmo.scale - reach) > 1e-6:
+                gizmo.scale = reach
+                marker.position, label.position = gizmo_tips(reach)
+            if tuple(int(c) for c in marker.color) != slot.color:
+                marker.color = slot.color
+            text = gizmo_label(i, slot)
+            if label.text != text:
+                label.text = text
+
+    # ----------------------------------------------------------------------------------------- worker
+    def _wake(self) -> None:
+        """Ask for a step now (it replaces a step waiting for the inputs to rest: it will ask again)."""
+        self.worker.submit(self.step)
+
+    def step(self) -> None:
+        """One worker job: mesh what is wanted, draw the main view, render the reference if it is due, then ask
+        for a later step if something waits for the inputs to rest. A failure is logged (or shown, for GL and
+        editor errors) and the last good picture stays."""
+        if self.closed:
+            return
+        try:
+            self._mesh_wanted()
+            if self.closed:
+                return
+            if self.gl_error is None:
+                self._render_view()
+            if self.gl_error is None and self._reference_ready():
+                self._render_reference()
+        except GLUnavailableError as exc:
+            self._no_gl(exc)
+        except ShaderCompileError as exc:  # a remesh of the editor's field found no surface
+            self._show_editor_error(str(exc))
+        except Exception:
+            # One failed mesh or render must not stop every later one: log it and wait for new input.
+            logger.exception("sdf: meshing or rendering failed; keeping the last good picture")
+            with self._state:
+                self._reference_due = False
+            return
+        self._schedule_rest()
+
+    def _mesh_wanted(self) -> None:
+        """Mesh the wanted scene or apply the wanted editor source; or, once the inputs rest, the full mesh of the
+        scene a drag's previews showed."""
+        with self._state:
+            # A drag's preview (≤ 32³, a few ms) takes the process's turn, as callbacks do (TURNS): eight tabs'
+            # workers interleaving made each mesh eight times slower, and a tab's newer pose, arriving while its
+            # worker waits for the turn, replaces the one it would have meshed. Full meshes (up to seconds) run
+            # outside the turn, so they never hold up other tabs' inputs.
+            quick = self._quick_job()
+        turn = contextlib.ExitStack()
+        if quick:  # the scene's lock first, then the turn: the order callbacks take them in
+            turn.enter_context(self._lock)
+            turn.enter_context(TURNS.turn())
+        with turn:
+            with self._state:
+                # Asked again under the turn: a request that came meanwhile may be a full mesh.
+                meshed_here = quick and self._quick_job()
+                scene, resolution = self._wanted_scene, self._wanted_resolution
+                source, preview = self._wanted_source, self._wanted_preview
+                self._wanted_scene = self._wanted_source = None
+                refine = self._refine
+                rested = time.monotonic() - self._scene_time >= CAMERA_REST_S
+            if meshed_here and scene is not None:
+                self._mesh_request(scene, resolution, preview)
+        if self.closed:
+            return
+        if source is None and scene is not None and not meshed_here:
+            self._mesh_request(scene, resolution, preview)
+        elif source is not None:
+            self._refine = None
+            self._apply_source(source, resolution)
+        elif scene is None and refine is not None and rested:
+            self._refine = None
+            self._mesh_and_show(*refine)
+            with self._state:
+                self._reference_due = True
+
+    def _schedule_rest(self) -> None:
+        """Ask for a step when the next thing waiting for the inputs to rest is due: the full mesh after a drag's
+        previews, the main view's rest frame, the reference (once camera and primitives are still)."""
+        with self._state:
+            rest_at = max(self.viewer.moved_at, self._scene_time) + CAMERA_REST_S
+            due: list[float] = []
+            if self._refine is not None:
+                due.append(self._scene_time + CAMERA_REST_S)
+            elif self._reference_due and self.gl_error is None and self.mesh_shape is not None:
+                due.append(rest_at)
+            if self._view_moving and self.gl_error is None:
+                due.append(rest_at)
+        if due:
+            self.worker.schedule(self.step, min(due) - time.monotonic())
+
+    def _quick_job(self) -> bool:
+        """Whether the job wanted now (call under ``self._state``) is a drag's preview of the primitives (≤ 32³, a
+        few ms): the kind that takes the process's turn. Editor fields mesh on the GL thread, which may be busy with
+        other tabs' renders: they never take it."""
+        return (
+            self._wanted_source is None
+            and isinstance(self._wanted_scene, sdf.Scene)
+            and (self._wanted_preview or self._wanted_resolution <= PREVIEW_RESOLUTION)
+        )
+
+    def _mesh_request(self, scene: Shape, resolution: int, preview: bool) -> None:
+        """Mesh a wanted scene: a preview at 32³ while a drag's inputs keep coming, else at ``resolution``."""
+        preview = preview and resolution > PREVIEW_RESOLUTION
+        self._refine = (scene, resolution) if preview else None
+        self._mesh_and_show(scene, PREVIEW_RESOLUTION if preview else resolution, preview=preview)
+        with self._state:
+            self._reference_due = True
+
+    def _reference_ready(self) -> bool:
+        with self._state:
+            if (
+                not self._reference_due
+                or self.mesh_shape is None
+                or self._wanted_scene is not None
+                or self._refine
+                is not None  # the reference compares against the full mesh, not a preview
+            ):
+                return False
+            if self.params.reference_mode == "live":
+                return True
+            # Wait until the camera and the primitives have both been still for a moment: a render started in
+            # the middle of a drag would hold up the next mesh.
+            return time.monotonic() - max(self.viewer.moved_at, self._scene_time) >= CAMERA_REST_S
+
+    def _no_gl(self, exc: GLUnavailableError) -> None:
+        self.gl_error = str(exc)
+        logger.warning("sdf: %s", exc)
+        with self._lock:
+            if not self.closed:
+                self.reference_note.content = f"**No reference image.** {exc}"
+
+    def _camera_or_default(self) -> Camera:
+        """The latest viewer's camera, or the scene's opening one before any viewer sent one."""
+        return self.viewer.camera or Camera(self.camera_position, self.camera_look_at)
+
+    def _apply_source(self, text: str, resolution: int) -> None:
+        """Check, compile, time and mesh an editor source; show it, or say why not and keep the last good one."""
+        field = EditorField(text, self.params.editor.half_size)
+        start = time.perf_counter()
+        try:
+            check_source(text)
+            # Trial it in a child process first; then compile the moving frames' program (no shadows, no AO)
+            # here: the new shape appears with it, and the fully shaded one compiles when the view next rests.
+            shading = self.params.shading
+            editor.trial_source(
+                text,
+                [moving_shading(shading), shading],
+                self._camera_or_default(),
+                field,
+                MOVING_WIDTH_PX,
+            )
+            gl_service.run(lambda gl: gl.compile_field(text, moving_shading(shading)))
+            self._mesh_and_show(field, resolution)
+        except ShaderCompileError as exc:
+            self._show_editor_error(str(exc))
+            return
+        total_ms = 1e3 * (time.perf_counter() - start)
+        with self._lock:
+            if self.closed:
+                return
+            self.params = dataclasses.replace(self.params, editor=field, shape_source="editor")
+            self.editor_error = None
+            self.editor_serial += 1
+            source_control = self.view_controls.fields["shape_source"].control
+            self.write_back(self.view_controls["shape_source"], source_control.to_gui("editor"))
+            self._sync_enabled_inputs()
+            self.editor_status.content = f"**Applied** in {total_ms:.0f} ms (compile, a test frame and a {resolution}³ mesh)."
+        with self._state:
+            self._reference_due = True
+            self._view_key = None
+            self._scene_time = time.monotonic()
+
+    def _mesh_and_show(self, scene: Shape, resolution: int, *, preview: bool = False) -> None:
+        """Mesh ``scene`` at ``resolution`` and show it; a ``preview`` goes to the 3D view only (the readouts, the
+        export and the reference keep the last full mesh)."""
+        start = time.perf_counter()
+        if isinstance(scene, EditorField):
+            vertices, faces, colors, normals = editor.mesh_field(scene, resolution)
+        else:
+            big = resolution >= 128
+
+            def progress(fraction: float) -> None:
+                if big and not self.closed:
+                    self.progress.value = 100.0 * fraction
+
+            if big:
+                self.progress.value = 0.0
+                self.progress.visible = True
+            vertices, faces, colors = sdf.mesh(scene, resolution, progress=progress)
+            normals = scene_normals(scene, vertices)
+        glb = viewer_glb(vertices, faces, colors, normals)
+        mesh_ms = 1e3 * (time.perf_counter() - start)
+        self._show_mesh(scene, vertices, faces, colors, glb, mesh_ms, resolution, preview=preview)
+
+    def _show_mesh(
+        self,
+        shape: Shape,
+        vertices: np.ndarray,
+        faces: np.ndarray,
+        colors: np.ndarray,
+        glb: bytes,
+        mesh_ms: float,
+        resolution: int,
+        *,
+        preview: bool = False,
+    ) -> None:
+        with self._lock:
+            if self.closed:
+                return
+            with self.server.atomic():
+                self.mesh_node.glb_data = glb
+                # The wireframe shows only in the "Both" view: a hidden one is not sent (40 % of a preview's bytes
+                # to every viewer), it is drawn from the latest mesh when it is shown.
+                self._wire = (vertices.astype(np.float32), faces.astype(np.uint32))
+                if self.wireframe_node.visible:
+                    self._draw_wire()
+                self.progress.visible = False
+                self.shown_resolution = resolution
+                if preview:
+                    self.preview_serial += 1
+                else:
+                    self.mesh_vertices, self.mesh_faces, self.mesh_colors = vertices, faces, colors
+                    self.mesh_shape = shape
+                    self.mesh_scene = shape if isinstance(shape, sdf.Scene) else None
+                    grid_scene = shape if isinstance(shape, sdf.Scene) else sdf.default_scene()
+                    bounds = None if isinstance(shape, sdf.Scene) else shape.bounds
+                    self._mesh_voxel = sdf.make_grid(grid_scene, resolution, bounds).spacing
+                    self.mesh_serial += 1
+                    self.agreement = dataclasses.replace(
+                        self.agreement, triangles=len(faces), mesh_ms=mesh_ms
+                    )
+                    self.readout.content = readout_markdown(self.agreement)
+            self.server.flush()
+
+    def _render_reference(self) -> None:
+        with self._state:
+            self._reference_due = False
+            camera, aspect = self._camera_or_default(), self.viewer.aspect
+        with (
+            self._lock
+        ):  # one consistent mesh: the worker replaces all four together under this lock
+            params = self.params
+            scene, vertices, faces, colors = (
+                self.mesh_shape,
+                self.mesh_vertices,
+                self.mesh_faces,
+                self.mesh_colors,
+            )
+            mesh_serial = self.mesh_serial
+        assert scene is not None
+        width = params.reference_width
+        height = max(16, round(width / aspect))
+
+        def job(renderer: Renderer) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, str]:
+            start = time.perf_counter()
+            rgb, depth = march(renderer, scene, camera, width, height, params.shading)
+            render_ms = 1e3 * (time.perf_counter() - start)
+            _, mesh_depth = renderer.render_mesh(
+                vertices, faces, colors, camera, width, height, params.shading
+            )
+            return rgb, depth, mesh_depth, render_ms, renderer.renderer_name
+
+        rgb, depth, mesh_depth, render_ms, renderer_name = gl_service.run(job)
+        iou, depth_diff = compare(depth, mesh_depth)
+        with self._lock:
+            if self.closed:
+                return
+            with self.server.atomic():
+                self.reference.image = rgb
+                self.reference_rgb = rgb
+                self.reference_serial += 1
+                self.reference_mesh_serial = mesh_serial
+                self.agreement = dataclasses.replace(
+                    self.agreement,
+                    render_ms=render_ms,
+                    iou=iou,
+                    depth_diff_voxels=None if depth_diff is None else depth_diff / self._mesh_voxel,
+                )
+                self.readout.content = readout_markdown(self.agreement)
+                self.reference_note.content = f"{width}×{height} px on {renderer_name}."
+            self.server.flush()
+
+    def _render_view(self) -> None:
+        """The ray-marched main view: a coarse frame while the camera or the shape moves, a full one at rest."""
+        with self._state:
+            params, viewer = self.params, self.viewer
+            camera = viewer.camera
+            if params.view_mode == "mesh" or camera is None:
+                self._view_moving = False
+                return
+            moving = time.monotonic() - max(viewer.moved_at, self._scene_time) < CAMERA_REST_S
+        shape = params.shape()
+        if isinstance(shape, sdf.Scene) and self.mesh_shape is not None:
+            try:
+                shape = self.params.scene()
+            except ValueError:
+                self._view_moving = False
+                return
+        aspect, viewer_width = viewer.aspect, viewer.width_px
+        key = (shape, camera, aspect, viewer_width, moving, params.shading, params.view_mode)
+        self._view_moving = moving
+        if key == self._view_key:
+            return
+        if moving:
+            width, height = MOVING_WIDTH_PX, max(16, round(MOVING_WIDTH_PX / aspect))
+        else:
+            # Before the first rest frame, guess from the moving ones (the shadows and AO cost a few times more).
+            guess = None if self._moving_s_per_pixel is None else 4.0 * self._moving_s_per_pixel
+            width, height = rest_size(viewer_width, aspect, self._rest_s_per_pixel or guess)
+        shading = moving_shading(params.shading) if moving else params.shading
+        start = time.perf_counter()
+        rgb, depth = gl_service.run(lambda gl: march(gl, shape, camera, width, height, shading))
+        view_ms = 1e3 * (time.perf_counter() - start)
+        if moving:
+            self._moving_s_per_pixel = view_ms / 1e3 / (width * height)
+        else:
+            self._rest_s_per_pixel = view_ms / 1e3 / (width * height)
+        # viser encodes depth in fixed point up to 167 m: a miss goes to the far end.
+        depth = np.where(np.isfinite(depth), depth, 1e3).astype(np.float32)
+        with self._lock:
+            if self.closed or self.params.view_mode == "mesh":
+                return
+            self.server.scene.set_background_image(rgb, format="jpeg", jpeg_quality=90, depth=depth)
+            self.view_rgb, self.view_ms = rgb, view_ms
+            self.view_serial += 1
+            self._view_key = key
+            self.server.flush()
+
+    # ----------------------------------------------------------------------------------------- downloads
+    def _download_handler(self, fmt: str) -> Any:
+        def handler(event: Any) -> None:
+            client = getattr(event, "client", None)
+            if client is None or self.closed:
+                return
+            try:
+                name, content = self.export(fmt)
+            except Exception:
+                logger.exception("sdf: export %s failed", fmt)
+                return
+            if content is None:
+                client.add_notification(
+                    "Nothing to download yet", "The reference image has not been rendered."
+                )
+                return
+            client.send_file_download(name, content)
+
+        return handler
+
+    def export(self, fmt: str) -> tuple[str, bytes | None]:
+        """File name and bytes of the current mesh (glb, stl, obj) or reference image (png)."""
+        with (
+            self._lock
+        ):  # a consistent snapshot: the worker replaces these together under this lock
+            reference, vertices, faces, colors = (
+                self.reference_rgb,
+                self.mesh_vertices,
+                self.mesh_faces,
+                self.mesh_colors,
+            )
+        if fmt == "png":
+            return "sdf_reference.png", None if reference is None else png_bytes(reference)
+        return f"sdf_mesh.{fmt}", mesh_file(fmt, vertices, faces, colors)
+
+
+def march(
+    gl: Renderer, shape: Shape, camera: Camera, width: int, height: int, shading: Shading
+) -> tuple[np.ndarray, np.ndarray]:
+    """Ray-march the primitives' scene or the editor's field: RGB (H, W, 3) uint8 and depth (H, W) (m)."""
+    if isinstance(shape, EditorField):
+        return gl.render_field(shape.source, shape.bounds, camera, width, height, shading)
+    return gl.render(shape, camera, width, height, shading)
