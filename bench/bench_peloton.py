@@ -1,14 +1,13 @@
 """Benchmark the cycling kernel and the peloton scene's slider-to-screen latency.
 
     python bench/bench_peloton.py           # everything
-    python bench/bench_peloton.py course    # only the course kernel (issue 13)
+    python bench/bench_peloton.py course    # only the course kernel
 
 Prints a table: kernel times for ``power`` on 10⁶ speeds and ``speed_for_power`` (against a plain Python loop
 run in the same process), and, through the websocket test client, the time from a slider message to the
 redrawn scene arriving back (p50, p95), with the server-side handling time on its own. The course rows ride a
 synthetic 100 km route at 10 m steps (10 000 segments of rolling hills and turns): ``ride`` (goal ≤ 50 ms),
-``power_for_time`` (goal ≤ 0.5 s) and ``paced_ride``, against the same loop run as plain Python (numba's
-``py_func``) in the same process.
+``power_for_time`` (goal ≤ 0.5 s) and ``paced_ride``.
 """
 
 from __future__ import annotations
@@ -85,30 +84,7 @@ def course_rows() -> None:
         lambda: course.power_for_time(route, target * 0.95, rider, 4.0, 225.0, air), 10
     )
     paced = timings(lambda: course.paced_ride(route, 250.0, rider, 0.15, 4.0, 225.0, air), 5)
-    # Baseline: the same loop as plain Python, on a tenth of the route, scaled up.
-    tenth = course.course_from_xy(
-        route.east_m[:1001], route.north_m[:1001], route.elevation_m[:1001]
-    )
-    seg = course._segments(tenth, rider, 4.0, 225.0, air)
-    n = tenth.n_points
-    power = np.full(n - 1, 250.0)
-
-    def python_ride() -> None:
-        course._ride_core.py_func(
-            seg.length, seg.drag, seg.rolling, seg.climbing, seg.wind, power, seg.efficiency, seg.mass,
-            seg.b0, seg.b1, 20.0, 0.0, np.empty(n), np.empty(n), np.empty(n - 1), np.zeros(6),
-        )  # fmt: skip
-
-    baseline = [t * 10 for t in timings(python_ride, 3)]
-    ratio = statistics.median(baseline) / statistics.median(rides)
-    row(
-        "course.ride, 100 km at 10 m (10^4 segments)",
-        rides,
-        1e-3,
-        "ms",
-        f"goal <= 50 ms; {ratio:.0f}x plain Python",
-    )
-    row("same loop as plain Python (10 km, scaled)", baseline, 1e-3, "ms", "baseline")
+    row("course.ride, 100 km at 10 m (10^4 segments)", rides, 1e-3, "ms", "goal <= 50 ms")
     row("course.power_for_time, 100 km", inverse, 1e-3, "ms", "goal <= 0.5 s")
     row("course.paced_ride, 100 km (constant + paced)", paced, 1e-3, "ms")
 
@@ -164,15 +140,16 @@ def main() -> None:
     scene = switcher.scene
     assert isinstance(scene, PelotonScene)
     handling: list[float] = []
-    inner = scene._on_input
+    inner = scene.apply_inputs
 
     def timed_on_input() -> None:
         start = time.perf_counter()
         inner()
         handling.append(time.perf_counter() - start)
 
-    scene.speed.remove_update_callback()
-    scene.speed.on_update(scene.callback(timed_on_input))
+    speed = scene.controls["speed_kmh"]
+    speed.remove_update_callback()
+    speed.on_update(scene.callback(timed_on_input))
 
     round_trips: list[float] = []
     with BrowserClient(server.get_port()) as client:

@@ -358,13 +358,15 @@ def build_controls(
     names: Collection[str] | None = None,
     *,
     collapsed: Collection[str] = (),
+    folders_open: Mapping[str, viser.GuiFolderHandle] | None = None,
 ) -> Controls[P]:
     """Make the declared controls of ``params`` (all of them, or the fields in ``names``), in field order.
 
     Each shows its field's value in ``params`` and gets the spec of its declaration recorded for the gate. Controls
     go where ``gui`` adds them now (inside a ``with folder:`` block of the caller's), or into a folder of the name
     their declaration gives, opened once around consecutive fields that name it; folders in ``collapsed`` open
-    closed.
+    closed. A folder in ``folders_open`` (an earlier build's :attr:`Controls.folders`) is filled on instead of
+    opened again, so a scene can put a control of its own between two builds of one folder.
     """
     params_type = type(params)
     controls = declared(params_type)
@@ -373,7 +375,7 @@ def build_controls(
         assert not unknown, f"no declared control for {sorted(unknown)} in {params_type.__name__}"
     chosen = [(name, c) for name, c in controls.items() if names is None or name in names]
     fields: dict[str, Built] = {}
-    folders: dict[str, viser.GuiFolderHandle] = {}
+    folders: dict[str, viser.GuiFolderHandle] = dict(folders_open or {})
     for label, group in itertools.groupby(chosen, key=lambda item: item[1].folder):
         if label is not None and label not in folders:
             folders[label] = gui.add_folder(label, expand_by_default=label not in collapsed)

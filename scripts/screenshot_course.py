@@ -47,9 +47,9 @@ def main(
     assert isinstance(scene, PelotonScene)
     mode = scene.course_mode
     mode.enable.value = True
-    mode.air.value = "Weather (temperature, pressure or altitude, humidity)"
-    mode.temperature.value = 24.0
-    mode.humidity.value = 60.0
+    mode.controls["air"].value = "Weather (temperature, pressure or altitude, humidity)"
+    mode.controls["temperature_c"].value = 24.0
+    mode.controls["humidity_pct"].value = 60.0
     mode.scrub.value = at_km
     with sync_playwright() as playwright:
         profile = tempfile.mkdtemp(prefix="chromium-shot-")

@@ -47,9 +47,8 @@ def test_the_camera_reports_css_pixels_and_the_line_is_framed_clear_of_the_panel
     try:
         scene = switcher.scene
         assert isinstance(scene, PelotonScene)
-        scene.riders.value = (
-            8  # the longest line: the last rider is the first to go under the panel
-        )
+        # The longest line: the last rider is the first to go under the panel.
+        scene.controls["n_riders"].value = 8
         open_viser(page, server.get_port(), "/peloton")
         close_notifications(page)
         shown = ScenePage(server, switcher, page, VIEWPORT)

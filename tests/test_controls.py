@@ -290,6 +290,16 @@ def test_some_fields_can_be_built_where_the_caller_is(server: viser.ViserServer)
         build_controls(server.gui, Demo(), ("note",))
 
 
+def test_a_later_build_fills_a_folder_an_earlier_one_opened(server: viser.ViserServer) -> None:
+    first = build_controls(server.gui, Demo(), ("speed_kmh",))
+    with first.folders["A"]:
+        between = server.gui.add_button("Between")
+    rest = build_controls(server.gui, Demo(), ("riders",), folders_open=first.folders)
+    assert rest.folders["A"] is first.folders["A"]  # no second "A" folder
+    assert first["speed_kmh"].order < between.order < rest["riders"].order
+    assert read_controls(first | rest, Demo()).riders == 8
+
+
 def test_a_browser_value_is_cleaned_once_by_the_declared_spec(server: viser.ViserServer) -> None:
     """Through the gate: out of range is clamped there, NaN refused there, and the reader agrees with both."""
     demo = build_controls(server.gui, Demo())

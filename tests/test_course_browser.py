@@ -67,7 +67,8 @@ def test_upload_a_gpx_and_play_it(
     assert canvas_is_not_blank(png(before))
     with scene._lock:
         start = mode.leader_distance_m()
-    mode.playback.value = 300.0  # fast forward, set on the server (its on_update and cleaning run)
+    # Fast forward, set on the server (its on_update and cleaning run).
+    mode.controls["playback"].value = 300.0
     page.get_by_role("button", name="Play").first.click()
     wait_until(lambda: mode.leader_distance_m() > start + 500.0, 20.0, "the riders to ride")
     page.get_by_role("button", name="Pause").first.click()

@@ -117,10 +117,10 @@ def test_the_kernel_rides_with_the_paceline_sharing_the_work(mode: CourseMode) -
     )
     direct = course_kernel.ride(mode.route, 250.0, rider, max_speed_ms=72.0 / 3.6)
     assert four.ride.time_s == pytest.approx(direct.time_s, rel=1e-12)
-    scene.riders.value = 1  # one rider alone: slower
+    scene.controls["n_riders"].value = 1  # one rider alone: slower
     assert mode.state.ride.time_s > four.ride.time_s
     assert mode.state.group_cda_m2 == line.cda_m2
-    scene.riders.value = 6
+    scene.controls["n_riders"].value = 6
     assert mode.state.ride.time_s < four.ride.time_s
     assert group_cda(scene.params) < four.group_cda_m2
 
@@ -130,11 +130,11 @@ def test_model_and_air_choices_change_the_ride_and_the_readout_shows_both_densit
 ) -> None:
     assert mode.state is not None
     martin = mode.state.ride.time_s
-    mode.power_model.value = "Seed (aero, rolling, climbing)"
+    mode.controls["model"].value = "Seed (aero, rolling, climbing)"
     assert mode.params.model == "seed" and mode.state.ride.time_s < martin  # no bearings, no spokes
-    mode.air.value = "Weather (temperature, pressure or altitude, humidity)"
-    mode.temperature.value = 30.0
-    mode.humidity.value = 80.0
+    mode.controls["air"].value = "Weather (temperature, pressure or altitude, humidity)"
+    mode.controls["temperature_c"].value = 30.0
+    mode.controls["humidity_pct"].value = 80.0
     start = float(mode.route.elevation_m[0])
     expected = float(cycling.air_density_weather(30.0, cycling.isa_pressure_hpa(start), 0.8))
     assert mode.state.density_weather == pytest.approx(expected, rel=1e-12)
@@ -142,25 +142,25 @@ def test_model_and_air_choices_change_the_ride_and_the_readout_shows_both_densit
     assert f"seed (exponential) **{float(cycling.air_density(start)):.3f}**" in mode.readout.content
     np.testing.assert_allclose(mode.state.ride.air_density[0], expected, rtol=1e-3)
     # A barometer reading replaces the standard atmosphere's pressure.
-    mode.pressure_source.value = "Barometer at the start (hPa)"
-    mode.pressure.value = 1000.0
+    mode.controls["pressure_from_barometer"].value = "Barometer at the start (hPa)"
+    mode.controls["pressure_hpa"].value = 1000.0
     assert mode.state.density_weather == pytest.approx(
         float(cycling.air_density_weather(30.0, 1000.0, 0.8)), rel=1e-12
     )
 
 
 def test_find_the_power_for_a_time(mode: CourseMode) -> None:
-    mode.target.value = 50.0
+    mode.controls["target_min"].value = 50.0
     mode.solve.value = True  # what a click does, on the server: runs on_click
     assert mode.state is not None
     assert mode.state.ride.time_s == pytest.approx(
         50 * 60.0, abs=1.0
     )  # the power is rounded to 0.1 W
-    assert mode.power.value == pytest.approx(mode.params.power_w)
+    assert mode.controls["power_w"].value == pytest.approx(mode.params.power_w)
 
 
 def test_pacing_reports_the_time_saved(mode: CourseMode) -> None:
-    mode.pacing.value = True
+    mode.controls["pacing"].value = True
     assert mode.state is not None and mode.state.pacing is not None
     saved = mode.state.pacing.time_saved_s
     assert f"{saved:.0f} s saved" in mode.readout.content
@@ -171,7 +171,7 @@ def test_pacing_reports_the_time_saved(mode: CourseMode) -> None:
 
 def test_exaggeration_stretches_the_drawn_heights(mode: CourseMode) -> None:
     before = np.asarray(mode.route_line.points)[:, :, 2].copy()
-    mode.exaggeration.value = 6.0
+    mode.controls["exaggeration"].value = 6.0
     after = np.asarray(mode.route_line.points)[:, :, 2]
     base = 0.05 + 0.02
     np.testing.assert_allclose(after - base, 3.0 * (before - base), rtol=1e-4, atol=1e-5)
@@ -179,7 +179,7 @@ def test_exaggeration_stretches_the_drawn_heights(mode: CourseMode) -> None:
 
 def test_play_pause_and_scrub_move_the_riders(mode: CourseMode) -> None:
     scene = mode.scene
-    mode.playback.value = 600.0
+    mode.controls["playback"].value = 600.0
     body = mode.course_riders["body"]
     start = np.asarray(body.batched_positions)[0].copy()
     mode._on_play()
@@ -393,16 +393,16 @@ def test_a_new_course_puts_the_position_slider_back_to_the_start(mode: CourseMod
 def test_find_the_power_says_when_the_target_is_out_of_the_inputs_range(
     mode: CourseMode, target_min: float
 ) -> None:
-    mode.target.value = target_min
+    mode.controls["target_min"].value = target_min
     mode.solve.value = True
     assert mode.state is not None
     ride = mode.state.ride
     content = mode.route_info.content
     assert "out of reach" not in content and "time_s" not in content
-    if mode.power.value == 2000.0 and ride.time_s > target_min * 60.0 + 1.0:
+    if mode.controls["power_w"].value == 2000.0 and ride.time_s > target_min * 60.0 + 1.0:
         assert f"A {target_min:g} min finish needs more than 2000 W" in content
         assert format_duration(ride.time_s) in content
-    elif mode.power.value == 20.0 and ride.time_s < target_min * 60.0 - 1.0:
+    elif mode.controls["power_w"].value == 20.0 and ride.time_s < target_min * 60.0 - 1.0:
         assert f"A {target_min:g} min finish needs less than 20 W" in content
     else:
         assert ride.time_s == pytest.approx(target_min * 60.0, rel=5e-4, abs=1.0)  # power to 0.1 W
@@ -415,7 +415,7 @@ def test_find_the_power_says_when_the_target_is_out_of_the_inputs_range(
 def test_the_readout_names_the_model_by_its_label_and_explains_coasting(mode: CourseMode) -> None:
     assert "(Martin et al. 1998 (full))" in mode.readout.content
     assert "martin model" not in mode.readout.content
-    mode.power_model.value = "Seed (aero, rolling, climbing)"
+    mode.controls["model"].value = "Seed (aero, rolling, climbing)"
     assert "(Seed (aero, rolling, climbing))" in mode.readout.content
     # 2 km at −20 %: 250 W would go far past the 72 km/h cap, so the riders coast and brake.
     down = [(45.0 + i * 1e-4, 6.0, 1000.0 - 0.2 * 11.1195 * i) for i in range(180)]

@@ -60,9 +60,9 @@ def test_opening_state_matches_the_kernel(scene: PelotonScene) -> None:
 
 
 def test_changing_values_updates_every_output(scene: PelotonScene) -> None:
-    scene.speed.value = 50.0
-    scene.riders.value = 6
-    scene.grade.value = 6.0
+    scene.controls["speed_kmh"].value = 50.0
+    scene.controls["n_riders"].value = 6
+    scene.controls["grade_pct"].value = 6.0
     assert scene.params.speed_kmh == 50.0 and scene.params.n_riders == 6
     line = compute_line(scene.params)
     np.testing.assert_allclose(scene.state.power.total, line.power.total)
@@ -87,7 +87,7 @@ def test_dragging_the_speed_up_reframes_every_few_kmh_and_keeps_the_bars_framed(
     # The kind: a continuous drag of a slider that grows the bars. Each step re-framed every tab before (at 8
     # tabs a second's stall); with headroom it re-frames only when the bars pass the room left, and the framed
     # box always holds the bars drawn.
-    scene.grade.value = grade
+    scene.controls["grade_pct"].value = grade
     reframes = 0
     reframe = scene.framing.reframe
 
@@ -98,7 +98,7 @@ def test_dragging_the_speed_up_reframes_every_few_kmh_and_keeps_the_bars_framed(
 
     scene.framing.reframe = counting  # type: ignore[method-assign]
     for speed in np.arange(30.0, 50.01, 0.5):
-        scene.speed.value = float(speed)
+        scene.controls["speed_kmh"].value = float(speed)
         assert scene.params.speed_kmh == pytest.approx(speed)
         assert scene.line_points()[:, 2].max() <= scene._framed_points[:, 2].max() + 0.05
     steps = len(np.arange(30.0, 50.01, 0.5))
@@ -107,8 +107,9 @@ def test_dragging_the_speed_up_reframes_every_few_kmh_and_keeps_the_bars_framed(
 
 def test_position_preset_sets_cda_and_redraws_the_rider(scene: PelotonScene) -> None:
     before = np.array(scene.riders_nodes["body"].vertices)
-    scene.position.value = "Time-trial tuck"
-    assert scene.cda.value == pytest.approx(0.22) and scene.params.cda_m2 == pytest.approx(0.22)
+    scene.controls["position"].value = "Time-trial tuck"
+    assert scene.controls["cda_m2"].value == pytest.approx(0.22)
+    assert scene.params.cda_m2 == pytest.approx(0.22)
     after = np.array(scene.riders_nodes["body"].vertices)
     assert before.shape != after.shape or not np.allclose(before, after)  # the torso changed angle
 
@@ -122,7 +123,7 @@ def test_crr_preset_sets_crr(scene: PelotonScene) -> None:
 
 
 def test_speed_at_a_power_readout(scene: PelotonScene) -> None:
-    scene.target_power.value = 300.0
+    scene.controls["target_power_w"].value = 300.0
     v = float(cycling.speed_for_power(300.0, 0.32, 80.0, 0.004, drivetrain_efficiency=0.976))
     assert f"{3.6 * v:.1f} km/h" in scene.speed_out.content
     minutes, seconds = divmod(round(40_000 / v), 60)
@@ -131,8 +132,8 @@ def test_speed_at_a_power_readout(scene: PelotonScene) -> None:
 
 
 def test_rotating_the_lead_equalises_time_averaged_power(scene: PelotonScene) -> None:
-    scene.turn.value = 2.0
-    scene.rotate.value = True
+    scene.controls["turn_s"].value = 2.0
+    scene.controls["rotate"].value = True
     with scene._lock:  # step the animation deterministically, with the scene's own loop held off
         scene._energy_j[:] = 0.0
         scene._ridden_s = 0.0
@@ -343,7 +344,8 @@ def test_labels_never_overlap_and_stay_in_view_clear_of_the_panel(
     # for the camera the scene frames and read back from the label handles.
     scene = switcher.show("peloton")
     assert isinstance(scene, PelotonScene)
-    scene.riders.value, scene.gap.value, scene.speed.value, scene.grade.value = (
+    c = scene.controls
+    c["n_riders"].value, c["gap_m"].value, c["speed_kmh"].value, c["grade_pct"].value = (
         n,
         gap_tenths / 10,
         speed,
@@ -359,14 +361,17 @@ def test_a_steep_fast_long_line_keeps_its_last_label_in_view(
 ) -> None:
     # The failing input (a fresh review): 8 riders 15 m apart at 80 km/h up 20 %: the labels, lifted along the
     # tilted road's up, leaned out of the framed box, and the last one started left of the window.
-    scene.riders.value, scene.gap.value, scene.speed.value, scene.grade.value = 8, 15.0, 80.0, 20.0
+    c = scene.controls
+    c["n_riders"].value, c["gap_m"].value, c["speed_kmh"].value, c["grade_pct"].value = (
+        8, 15.0, 80.0, 20.0
+    )  # fmt: skip
     lens = Lens(math.radians(75.0), *viewport)
     assert_labels_apart_and_in_view(label_boxes_px(scene, lens), lens)
 
 
 def test_eight_riders_six_metres_apart_at_1280x720_have_labels_apart(scene: PelotonScene) -> None:
     # The failing input: neighbours' labels 71 px apart, lifted 8 px by the old every-other-rider stagger.
-    scene.riders.value, scene.gap.value = 8, 6.0
+    scene.controls["n_riders"].value, scene.controls["gap_m"].value = 8, 6.0
     lens = Lens(math.radians(75.0), 1280, 720)
     boxes = label_boxes_px(scene, lens)
     assert_labels_apart_and_in_view(boxes, lens)
@@ -378,7 +383,7 @@ def test_eight_riders_six_metres_apart_at_1280x720_have_labels_apart(scene: Pelo
 def test_every_rider_rides_on_the_drawn_road(scene: PelotonScene, n: int, gap_tenths: int) -> None:
     """The kind: scenery sized for the opening state. The road was 60 m long, so from 8 riders ~4 m apart the last
     rode on the grass, and at the 15 m gap the rear riders floated past the ground's edge."""
-    scene.riders.value, scene.gap.value = n, gap_tenths / 10
+    scene.controls["n_riders"].value, scene.controls["gap_m"].value = n, gap_tenths / 10
     road_x = np.asarray(scene.road.vertices)[:, 0]
     with scene._lock:
         x = np.asarray(scene.line_points())[:, 0]
@@ -386,7 +391,7 @@ def test_every_rider_rides_on_the_drawn_road(scene: PelotonScene, n: int, gap_te
 
 
 def test_eight_riders_at_the_largest_gap_ride_on_the_road(scene: PelotonScene) -> None:
-    scene.riders.value, scene.gap.value = 8, MAX_GAP_M
+    scene.controls["n_riders"].value, scene.controls["gap_m"].value = 8, MAX_GAP_M
     tail = 7 * (1.70 + 15.0)  # the last rider's slot, 116.9 m behind the leader
     assert np.asarray(scene.road.vertices)[:, 0].min() <= -tail - 1.0
 
@@ -394,12 +399,12 @@ def test_eight_riders_at_the_largest_gap_ride_on_the_road(scene: PelotonScene) -
 def test_the_lead_starts_rotating_when_riders_join_with_rotate_on(scene: PelotonScene) -> None:
     """An idle animation loop sleeps until woken: every input that can start the animation must wake it (a fresh
     review found raising Riders from 1 with Rotate on left the lead still until Rotate was touched)."""
-    scene.riders.value = 1
-    scene.rotate.value = True  # one rider: nothing to rotate, the loop goes to sleep
+    scene.controls["n_riders"].value = 1
+    scene.controls["rotate"].value = True  # one rider: nothing to rotate, the loop goes to sleep
     time.sleep(0.3)
     with scene._lock:
         assert scene._rotation_time_s == 0.0
-    scene.riders.value = 3
+    scene.controls["n_riders"].value = 3
     deadline = time.monotonic() + 10.0
     while time.monotonic() < deadline:
         with scene._lock:

@@ -1,0 +1,934 @@
+"""The peloton's course mode: ride a real route (a GPX file or the bundled sample) in real air, Martin et al. 1998.
+
+:class:`CourseParams` is what the user sets in the mode (each field declares its GUI control, :mod:`scenes._controls`);
+:func:`compute_course` rides a route for it and the line's :class:`~scenes.peloton.model.PelotonParams` into a
+:class:`CourseState` (no viser). :class:`CourseDrawing`, :func:`terrain_strip`, :func:`ground_under` and
+:func:`grade_colours` map the route into the box the line's camera already frames (map metres scaled, elevation
+exaggerated). :class:`CourseMode` owns the mode's GUI folder and nodes under ``/peloton/course_mode``: uploads, the
+power solver and playback.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import math
+import threading
+from dataclasses import field
+from typing import TYPE_CHECKING, Literal
+
+import numpy as np
+import trimesh
+import viser
+import viser.uplot
+
+from kernels import course as course_kernel
+from kernels import cycling
+from scenes._base import record_spec
+from scenes._charts import FittedChart
+from scenes._controls import (
+    build_controls,
+    checkbox,
+    declared,
+    dropdown,
+    number,
+    read_controls,
+    slider,
+)
+from scenes.peloton.meshes import add_riders, show_position
+from scenes.peloton.model import BIKE_LENGTH_M, MAX_RIDERS, PelotonParams, Position, group_cda
+
+if TYPE_CHECKING:
+    from scenes.peloton.scene import PelotonScene
+
+logger = logging.getLogger(__name__)
+
+CourseAirLabel = Literal[
+    "Seed (exponential)", "Weather (temperature, pressure or altitude, humidity)"
+]
+AIR_FROM_LABEL: dict[str, course_kernel.AirKind] = {
+    "Seed (exponential)": "seed",
+    "Weather (temperature, pressure or altitude, humidity)": "weather",
+}
+PRESSURE_SOURCES = ("Standard atmosphere at the route's altitude", "Barometer at the start (hPa)")
+"""What the "Pressure from" dropdown shows for :attr:`CourseParams.pressure_from_barometer` False and True."""
+POWER_MODEL_FROM_LABEL: dict[str, course_kernel.Model] = {
+    "Martin et al. 1998 (full)": "martin",
+    "Seed (aero, rolling, climbing)": "seed",
+}
+COURSE_POWER_RANGE_W = (20.0, 2000.0)
+"""What the Course power input takes (W); 'Find the power for this time' says when a target needs more or less."""
+MODEL_LABEL = {model: label for label, model in POWER_MODEL_FROM_LABEL.items()}
+SAMPLE_LABEL = "Alpe d'Huez (sample, from the published profile)"
+COURSE_BOX_M = 6.0
+"""The drawn course fits a square of this size (scene metres) where the line's camera looks."""
+COURSE_CENTRE = np.array([-3.2, 0.0])
+TERRAIN_HALF_WIDTH_M = 0.15
+"""Half width of the drawn terrain strip (scene m)."""
+COURSE_MARKER_SCALE = 0.25
+"""Riders on the course are drawn at this fraction of life size (a marker, not to the map's scale)."""
+MAX_DRAWN_POINTS = 2000
+MAX_CHART_POINTS = 1000
+
+MODE_FOLDER = "Course mode (GPX route)"
+POWER_FOLDER = "Power, model and air"
+MORE_FOLDER = "Wind, descents, pacing, view"
+"""Opens collapsed."""
+
+
+@dataclasses.dataclass(frozen=True)
+class CourseParams:
+    """Course-mode inputs (the rider, the line and drafting come from :class:`PelotonParams`).
+
+    Each field is also its GUI control, declared once (:mod:`scenes._controls`), in the order and folder shown.
+    """
+
+    enabled: bool = field(default=False, metadata=checkbox("Ride a course", folder=MODE_FOLDER))
+    """Whether the course mode is shown (and ridden) instead of the line."""
+    power_w: float = field(
+        default=250.0,
+        metadata=number("Course power (W)", *COURSE_POWER_RANGE_W, 5.0, folder=POWER_FOLDER),
+    )
+    """Constant pedal power of each rider (W)."""
+    target_min: float = field(
+        default=60.0, metadata=number("Target time (min)", 1.0, 6000.0, 1.0, folder=POWER_FOLDER)
+    )
+    """Finish time that 'Find the power for this time' aims at (min)."""
+    model: course_kernel.Model = field(
+        default="martin",
+        metadata=dropdown(
+            "Power model",
+            tuple(POWER_MODEL_FROM_LABEL.values()),
+            tuple(POWER_MODEL_FROM_LABEL),
+            folder=POWER_FOLDER,
+        ),
+    )
+    """Power model: Martin et al. 1998's full terms or the seed's three."""
+    air: course_kernel.AirKind = field(
+        default="seed",
+        metadata=dropdown(
+            "Air", tuple(AIR_FROM_LABEL.values()), tuple(AIR_FROM_LABEL), folder=POWER_FOLDER
+        ),
+    )
+    """Air along the route: the seed's exponential atmosphere or a weather reading."""
+    temperature_c: float = field(
+        default=15.0, metadata=slider("Temperature (°C)", -20.0, 45.0, 0.5, folder=POWER_FOLDER)
+    )
+    """Air temperature at the start (°C), weather air."""
+    pressure_from_barometer: bool = field(
+        default=False,
+        metadata=dropdown("Pressure from", (False, True), PRESSURE_SOURCES, folder=POWER_FOLDER),
+    )
+    """Weather air: the barometer's pressure, or the standard atmosphere's at the start's altitude."""
+    pressure_hpa: float = field(
+        default=1013.25,
+        metadata=number("Pressure at the start (hPa)", 500.0, 1100.0, 0.5, folder=POWER_FOLDER),
+    )
+    """Station pressure at the start (hPa), when read from a barometer."""
+    humidity_pct: float = field(
+        default=50.0, metadata=slider("Humidity (%)", 0.0, 100.0, 1.0, folder=POWER_FOLDER)
+    )
+    """Relative humidity (%), weather air."""
+    wind_ms: float = field(
+        default=0.0, metadata=slider("Wind (m/s)", 0.0, 20.0, 0.5, folder=MORE_FOLDER)
+    )
+    """Wind speed (m/s)."""
+    wind_from_deg: float = field(
+        default=0.0,
+        metadata=slider("Wind from (° from north)", 0.0, 359.0, 1.0, folder=MORE_FOLDER),
+    )
+    """Where the wind blows from, clockwise from north (°)."""
+    max_speed_kmh: float = field(
+        default=72.0,
+        metadata=slider("Safe descending speed (km/h)", 20.0, 110.0, 1.0, folder=MORE_FOLDER),
+    )
+    """Safe descending speed (km/h): riders brake to hold it."""
+    pacing: bool = field(default=False, metadata=checkbox("Pace by grade", folder=MORE_FOLDER))
+    """Vary power with the grade (Swain 1997) at the same average."""
+    pacing_gain_pct: float = field(
+        default=15.0, metadata=slider("Pacing gain (%)", 0.0, 50.0, 1.0, folder=MORE_FOLDER)
+    )
+    """How much more power on steep climbs, and less on descents (%)."""
+    exaggeration: float = field(
+        default=2.0,
+        metadata=slider("Elevation exaggeration (×)", 1.0, 10.0, 0.5, folder=MORE_FOLDER),
+    )
+    """Vertical exaggeration of the drawn terrain."""
+    playback: float = field(
+        default=60.0, metadata=slider("Playback speed (×)", 1.0, 600.0, 1.0, folder=MORE_FOLDER)
+    )
+    """Playback speed (× real time)."""
+
+
+RIDE_INPUTS = (
+    "power_w", "model", "air", "temperature_c", "pressure_from_barometer", "pressure_hpa",
+    "humidity_pct", "wind_ms", "wind_from_deg", "max_speed_kmh", "pacing", "pacing_gain_pct",
+)  # fmt: skip
+"""The course inputs that change the ride (the rest change only the view or the solver's target)."""
+LINE_INPUTS = (
+    "cda_m2", "mass_kg", "crr", "drivetrain_pct", "drafting", "n_riders", "gap_m", "model", "position",
+)  # fmt: skip
+"""The line's inputs that change the ride on the course (the paceline options apply there too)."""
+
+
+@dataclasses.dataclass(frozen=True)
+class CourseState:
+    """What the course mode shows for one route and parameter set."""
+
+    route: course_kernel.Course
+    ride: course_kernel.Ride
+    """The ride drawn and animated: paced when pacing is on, else constant."""
+    constant: course_kernel.Ride
+    solo: course_kernel.Ride
+    """One rider alone at the same power (no shelter)."""
+    pacing: course_kernel.Pacing | None
+    group_cda_m2: float
+    """CdA the group rides at when riders share the front equally (m²)."""
+    density_seed: float
+    """The seed's density at the start (kg/m³)."""
+    density_weather: float
+    """The weather reading's density at the start (kg/m³)."""
+
+
+def course_air(route: course_kernel.Course, p: CourseParams) -> course_kernel.Air:
+    """The :class:`kernels.course.Air` for the inputs; the reading is taken at the route's start."""
+    start = float(route.elevation_m[0])
+    pressure = (
+        p.pressure_hpa
+        if p.pressure_from_barometer
+        else float(cycling.isa_pressure_hpa(np.clip(start, -1000.0, 20_000.0)))
+    )
+    return course_kernel.Air(
+        p.air, p.temperature_c, pressure, p.humidity_pct / 100.0, altitude_m=start
+    )
+
+
+def compute_course(
+    route: course_kernel.Course, p: CourseParams, line: PelotonParams
+) -> CourseState:
+    """Ride ``route`` for one parameter set (no viser: testable on its own)."""
+    air = course_air(route, p)
+    weather = dataclasses.replace(air, kind="weather")
+    start = float(route.elevation_m[0])
+
+    def rider(cda: float) -> course_kernel.Rider:
+        return course_kernel.Rider(
+            cda_m2=cda,
+            mass_kg=line.mass_kg,
+            crr=line.crr,
+            drivetrain_efficiency=line.drivetrain_pct / 100.0,
+            model=p.model,
+        )
+
+    cda = group_cda(line)
+    wind, wind_from, cap = p.wind_ms, p.wind_from_deg, p.max_speed_kmh / 3.6
+
+    def ride_at(cda_m2: float) -> course_kernel.Ride:
+        return course_kernel.ride(route, p.power_w, rider(cda_m2), wind, wind_from, air, cap)
+
+    pacing = None
+    if p.pacing:
+        pacing = course_kernel.paced_ride(
+            route, p.power_w, rider(cda), p.pacing_gain_pct / 100.0, wind, wind_from, air, cap
+        )
+        constant, shown = pacing.constant, pacing.paced
+    else:
+        constant = shown = ride_at(cda)
+    solo = constant if cda == line.cda_m2 else ride_at(line.cda_m2)
+    return CourseState(
+        route=route,
+        ride=shown,
+        constant=constant,
+        solo=solo,
+        pacing=pacing,
+        group_cda_m2=cda,
+        density_seed=float(cycling.air_density(start)),
+        density_weather=float(weather.density(start)),
+    )
+
+
+def format_duration(seconds: float) -> str:
+    """h:mm:ss (or m:ss under an hour)."""
+    total = round(seconds)
+    hours, rest = divmod(total, 3600)
+    minutes, secs = divmod(rest, 60)
+    return f"{hours:d}:{minutes:02d}:{secs:02d}" if hours else f"{minutes:d}:{secs:02d}"
+
+
+def split_every_m(total_m: float) -> float:
+    """Split length for the table: 1 km up to 30 km, 5 km up to 150 km, else 10 km."""
+    return 1000.0 if total_m <= 30_000.0 else 5000.0 if total_m <= 150_000.0 else 10_000.0
+
+
+def drawn_indices(n_points: int, limit: int) -> np.ndarray:
+    """Indices of at most ``limit`` points spread along the route, first and last included."""
+    return np.unique(np.linspace(0, n_points - 1, min(n_points, limit)).round().astype(np.int64))
+
+
+@dataclasses.dataclass(frozen=True)
+class CourseDrawing:
+    """The route mapped into the scene: map (east, north) scaled into the framed box, elevation exaggerated."""
+
+    scale: float
+    """Scene metres per map metre."""
+    offset: np.ndarray
+    """(2,) map point drawn at COURSE_CENTRE (m)."""
+    base_m: float
+    """Elevation drawn at z = 0 (m): the route's lowest point."""
+
+    @staticmethod
+    def of(route: course_kernel.Course) -> CourseDrawing:
+        east, north = route.east_m, route.north_m
+        extent = max(float(np.ptp(east)), float(np.ptp(north)), 1.0)
+        centre = np.array([0.5 * (east.min() + east.max()), 0.5 * (north.min() + north.max())])
+        return CourseDrawing(
+            scale=COURSE_BOX_M / extent, offset=centre, base_m=float(route.elevation_m.min())
+        )
+
+    def points(
+        self, route: course_kernel.Course, index: np.ndarray, exaggeration: float
+    ) -> np.ndarray:
+        """(k, 3) scene positions of route points ``index``."""
+        xy = (
+            np.stack([route.east_m[index], route.north_m[index]], axis=1) - self.offset
+        ) * self.scale
+        z = (route.elevation_m[index] - self.base_m) * self.scale * exaggeration + 0.05
+        return np.concatenate([xy + COURSE_CENTRE, z[:, None]], axis=1)
+
+    def at_distance(
+        self, route: course_kernel.Course, distance_m: np.ndarray, exaggeration: float
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """(k, 3) scene positions and (k,) yaw angles (rad, from +x) at distances along the route."""
+        d = np.clip(distance_m, 0.0, route.total_distance_m)
+        east = np.interp(d, route.distance_m, route.east_m)
+        north = np.interp(d, route.distance_m, route.north_m)
+        z = np.interp(d, route.distance_m, route.elevation_m)
+        segment = np.clip(
+            np.searchsorted(route.distance_m, d, side="right") - 1, 0, route.n_points - 2
+        )
+        yaw = math.pi / 2 - route.heading_rad[segment]
+        xy = (np.stack([east, north], axis=1) - self.offset) * self.scale + COURSE_CENTRE
+        zz = (z - self.base_m) * self.scale * exaggeration + 0.05
+        return np.concatenate([xy, zz[:, None]], axis=1), yaw
+
+
+def terrain_strip(points: np.ndarray, half_width: float) -> tuple[np.ndarray, np.ndarray]:
+    """A road-side strip along the route and a curtain under it down to z = 0: (4k, 3) vertices and faces.
+
+    The strip is the terrain the road crosses; the curtain shows the height above the valley floor.
+    """
+    k = points.shape[0]
+    direction = np.gradient(points[:, :2], axis=0)
+    norm = np.linalg.norm(direction, axis=1, keepdims=True)
+    direction = direction / np.where(norm > 1e-12, norm, 1.0)
+    side = np.stack([-direction[:, 1], direction[:, 0]], axis=1) * half_width
+    top = points[:, 2:3] - 0.03
+    left = np.concatenate([points[:, :2] + side, top], axis=1)
+    right = np.concatenate([points[:, :2] - side, top], axis=1)
+    centre = np.concatenate([points[:, :2], top - 0.01], axis=1)
+    foot = centre * [1.0, 1.0, 0.0]
+    vertices = np.concatenate([left, right, centre, foot])
+    a = np.arange(k - 1)
+    b = a + 1
+    L, R, C, F = 0, k, 2 * k, 3 * k  # block offsets: left edge, right edge, centre, its foot
+    faces = np.concatenate([
+        np.stack([L + a, R + a, R + b], axis=1), np.stack([L + a, R + b, L + b], axis=1),  # strip
+        np.stack([F + a, C + a, C + b], axis=1), np.stack([F + a, C + b, F + b], axis=1),  # curtain
+    ])  # fmt: skip
+    return vertices.astype(np.float32), faces.astype(np.uint32)
+
+
+def ground_under(points: np.ndarray, margin: float = 0.6) -> tuple[np.ndarray, np.ndarray]:
+    """A thin slab under the route's bounding rectangle plus ``margin`` (scene m): vertices and faces."""
+    lo, hi = points[:, :2].min(axis=0) - margin, points[:, :2].max(axis=0) + margin
+    slab = trimesh.creation.box(extents=(*(hi - lo), 0.02))
+    slab.apply_translation((*((lo + hi) / 2), -0.011))
+    return slab.vertices.astype(np.float32), slab.faces.astype(np.uint32)
+
+
+def grade_colours(grade: np.ndarray) -> np.ndarray:
+    """(k, 3) uint8: descents blue, flat white-green, climbs yellow to red at 12 %."""
+    g = np.clip(grade / 0.12, -1.0, 1.0)
+    up = np.clip(g, 0.0, 1.0)[:, None]
+    down = np.clip(-g, 0.0, 1.0)[:, None]
+    flat = np.array([90.0, 200.0, 90.0])
+    colour = (
+        flat
+        + up * (np.array([230.0, 40.0, 30.0]) - flat)
+        + down * (np.array([40.0, 110.0, 230.0]) - flat)
+    )
+    return colour.astype(np.uint8)
+
+
+class CourseMode:
+    """The course mode of :class:`PelotonScene`: its GUI folder, its nodes under ``/peloton/course_mode``.
+
+    Every input is cleaned as the gate cleans it (:func:`scenes._controls.read_controls`); a bad file leaves the
+    last good course in place with a message saying why.
+    """
+
+    def __init__(self, scene: PelotonScene) -> None:
+        self.scene = scene
+        self.server = scene.server
+        self.params = CourseParams()
+        self.route = course_kernel.load_gpx(course_kernel.SAMPLE_ROUTE)
+        self.route_label = SAMPLE_LABEL
+        self.state: CourseState | None = None
+        """Computed when the mode is first shown (the compiled ride loop loads then)."""
+        self.playing = False
+        self.play_time_s = 0.0
+        self.message = ""
+        self._since_readout = 0.0
+        self._drawn_position: Position | None = None
+        self._drawing = CourseDrawing.of(self.route)
+        self._upload_lock = threading.Lock()
+        self._upload_seq = 0
+        """Number of the newest upload: parses run in parallel on viser's pool, and only the newest installs."""
+        self._build_gui()
+        self._build_world()
+        scene.start_loop(self._animate, 1.0 / 30.0)
+
+    # ----------------------------------------------------------------------------------------- GUI
+    def _build_gui(self) -> None:
+        gui, p = self.server.gui, self.params
+        with self.scene.gui_root:
+            head = build_controls(gui, p, ("enabled",))
+        with head.folders[MODE_FOLDER]:
+            self.route_info = gui.add_markdown(self._route_markdown())
+            self.sample = gui.add_button("Load the sample route")
+            self.upload = gui.add_upload_button("Upload GPX", mime_type=".gpx,application/gpx+xml")
+            self.play = gui.add_button("Play")
+            self.pause = gui.add_button("Pause")
+            # Hand-built, not a parameter: playback moves it, and its range is the loaded route's length.
+            self.scrub = gui.add_slider(
+                "Position (km)", min=0.0, max=self._total_km(), step=0.01, initial_value=0.0
+            )
+            self.now = gui.add_markdown("")
+            self.readout = gui.add_markdown("")
+            self.chart = FittedChart(
+                gui,
+                data=self._chart_data(),
+                series=(
+                    viser.uplot.Series(label="Distance (km)"),
+                    viser.uplot.Series(
+                        label="Elevation (m)", stroke="rgb(120,90,60)", width=2, scale="m"
+                    ),
+                    viser.uplot.Series(
+                        label="Speed (km/h)", stroke="rgb(30,110,220)", width=1.5, scale="kmh"
+                    ),
+                    viser.uplot.Series(
+                        label="Power (W)", stroke="rgb(220,40,40)", width=1.5, scale="W"
+                    ),
+                ),
+                scales={
+                    "x": viser.uplot.Scale(time=False, auto=True),
+                    "m": viser.uplot.Scale(auto=True),
+                    "kmh": viser.uplot.Scale(auto=True),
+                    "W": viser.uplot.Scale(auto=True),  # no axis of its own: the legend gives watts
+                },
+                axes=(
+                    viser.uplot.Axis(scale="x", label="km"),
+                    viser.uplot.Axis(scale="m", label="m", side=3),
+                    viser.uplot.Axis(
+                        scale="kmh", label="km/h", side=1, grid=viser.uplot.Axis_Grid(show=False)
+                    ),
+                ),
+                legend=viser.uplot.Legend(show=True),
+                title="Elevation, speed and power along the course",
+                aspect=1.4,
+                visible=False,  # until the first ride: a profile over flat zeros reads as a rider not pedalling
+            )
+            power = build_controls(gui, p, ("power_w", "target_min"))
+            with power.folders[POWER_FOLDER]:  # between the target and the model
+                self.solve = gui.add_button("Find the power for this time")
+            rest = build_controls(
+                gui,
+                p,
+                [
+                    name
+                    for name in declared(CourseParams)
+                    if name not in {*head.fields, *power.fields}
+                ],
+                collapsed=(MORE_FOLDER,),
+                folders_open=power.folders,
+            )
+            with gui.add_folder("Splits", expand_by_default=False):
+                self.splits = gui.add_markdown("")
+        self.head = head
+        """The "Ride a course" checkbox, read on its own (:meth:`_on_enable`)."""
+        self.controls = head | power | rest
+        """Every declared control of :class:`CourseParams`, by field name."""
+        cb = self.scene.callback
+        self.enable.on_update(cb(self._on_enable))
+        self.sample.on_click(cb(self._on_sample))
+        self.upload.on_upload(self._on_upload)  # parses off the lock, then installs through cb
+        self.solve.on_click(cb(self._on_solve))
+        self.play.on_click(cb(self._on_play))
+        self.pause.on_click(cb(self._on_pause))
+        self.scrub.on_update(cb(self._on_scrub))
+        for name in RIDE_INPUTS:
+            self.controls[name].on_update(cb(self._on_input))
+        for name in ("exaggeration", "playback", "target_min"):
+            self.controls[name].on_update(cb(self._on_view))
+        line = self.scene.controls
+        for name in LINE_INPUTS:
+            line[name].on_update(cb(self._on_input))  # the paceline options apply on the course
+        self.scene.crr_preset.on_update(cb(self._on_input))
+
+    @property
+    def enable(self) -> viser.GuiInputHandle[bool]:
+        """The "Ride a course" checkbox."""
+        return self.controls["enabled"]
+
+    @property
+    def enabled(self) -> bool:
+        """Whether the mode is shown (the cleaned checkbox)."""
+        return self.params.enabled
+
+    # ----------------------------------------------------------------------------------------- world
+    def _build_world(self) -> None:
+        scene = self.server.scene
+        self.frame = scene.add_frame(
+            f"{self.scene.root.name}/course_mode", show_axes=False, visible=False
+        )
+        index = drawn_indices(self.route.n_points, MAX_DRAWN_POINTS)
+        points = self._drawing.points(self.route, index, self.params.exaggeration)
+        vertices, faces = terrain_strip(points, TERRAIN_HALF_WIDTH_M)
+        ground_vertices, ground_faces = ground_under(points)
+        self.ground = scene.add_mesh_simple(
+            f"{self.frame.name}/ground", ground_vertices, ground_faces, color=(205, 210, 195)
+        )
+        self.terrain = scene.add_mesh_simple(
+            f"{self.frame.name}/terrain",
+            vertices,
+            faces,
+            color=(150, 175, 110),
+            side="double",
+        )
+        segments, colours = self._route_segments(index, points)
+        self.route_line = scene.add_line_segments(
+            f"{self.frame.name}/route", segments, colors=colours, thickness=0.08
+        )
+        self.course_riders = add_riders(
+            scene, f"{self.frame.name}/riders", self.scene.params.position, 0.0
+        )
+        self._drawn_position = self.scene.params.position
+        self.leader_marker = scene.add_icosphere(
+            f"{self.frame.name}/leader_marker",
+            radius=0.12,
+            color=(255, 60, 60),
+            position=(0.0, 0.0, 1.0),
+        )
+        self.start_label = scene.add_label(
+            f"{self.frame.name}/start", text="Start", position=tuple(points[0])
+        )
+        self.finish_label = scene.add_label(
+            f"{self.frame.name}/finish", text="Finish", position=tuple(points[-1])
+        )
+
+    def _route_segments(
+        self, index: np.ndarray, points: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        segments = np.stack([points[:-1], points[1:]], axis=1) + [0.0, 0.0, 0.02]
+        rise = np.diff(self.route.elevation_m[index])
+        run = np.maximum(np.diff(self.route.distance_m[index]), 1e-9)
+        colours = grade_colours(rise / run)
+        return segments.astype(np.float32), np.repeat(colours[:, None, :], 2, axis=1)
+
+    # ----------------------------------------------------------------------------------------- inputs
+    def read_params(self) -> CourseParams:
+        """The course inputs, cleaned: anything non-finite, out of range or unknown keeps the last good value."""
+        return read_controls(self.controls, self.params, write_back=self.scene.write_back)
+
+    def _on_enable(self) -> None:
+        self.params = read_controls(self.head, self.params, write_back=self.scene.write_back)
+        if self.enabled and self.state is None:
+            self.recompute()
+        self.redraw()
+        self.scene.wake_loops()
+
+    def _on_input(self) -> None:
+        if (
+            not self.enabled
+        ):  # the line's sliders move often: ride the course only while it is shown
+            self.state = None
+            return
+        self.recompute()
+        self.redraw()
+
+    def _on_view(self) -> None:
+        self.params = self.read_params()
+        self.redraw()
+
+    def recompute(self) -> None:
+        """Ride the current route with the current inputs; on failure keep the last good state and say why."""
+        params = self.read_params()
+        line = self.scene.read_params()
+        try:
+            state = compute_course(self.route, params, line)
+        except ValueError as error:
+            self.message = f"Could not ride this course: {error}"
+            return
+        self.params, self.state = params, state
+        self.message = ""
+        self.play_time_s = min(self.play_time_s, state.ride.time_s)
+        if self.enabled and self.playing:  # a ride that had none to play now has one
+            self.scene.wake_loops()
+
+    def _on_sample(self) -> None:
+        self.load(course_kernel.SAMPLE_ROUTE.read_bytes(), SAMPLE_LABEL)
+
+    def _on_upload(self, _event: object = None) -> None:
+        """An upload arrived (viser's thread pool). Parse it off the scene's lock, since gpxpy needs seconds for a
+        large file, then install it (or the reason it failed) as a guarded callback. Nothing escapes."""
+        # The number and the file are taken together: a higher number is a newer file.
+        with self._upload_lock:
+            self._upload_seq += 1
+            seq = self._upload_seq
+            uploaded = self.upload.value
+        try:
+            name = str(getattr(uploaded, "name", "") or "upload")[:80]
+            content = getattr(uploaded, "content", b"")
+            route, error = None, None
+            if not isinstance(content, bytes):
+                error = "the upload carried no file"
+            else:
+                try:
+                    route = course_kernel.load_gpx(content)
+                except ValueError as failure:
+                    error = str(failure)
+        except Exception:  # a file must never take the scene down; say so and keep the course
+            logger.exception("peloton: reading an uploaded GPX failed")
+            name, route, error = "upload", None, "the file could not be read"
+
+        def install() -> None:
+            if seq != self._upload_seq:  # a newer upload arrived while this one parsed: it wins
+                return
+            self._install(route, error, name)
+
+        self.scene.callback(install)(None)
+
+    def load(self, data: bytes, label: str) -> bool:
+        """Load a GPX file's bytes as the course; on a bad file keep the last good course and show why."""
+        try:
+            route, error = course_kernel.load_gpx(data), None
+        except ValueError as failure:
+            route, error = None, str(failure)
+        return self._install(route, error, label)
+
+    def _install(self, route: course_kernel.Course | None, error: str | None, label: str) -> bool:
+        state = None
+        if route is not None:
+            try:
+                state = compute_course(route, self.read_params(), self.scene.read_params())
+            except ValueError as failure:
+                error = str(failure)
+        if route is None or state is None:
+            reason = str(error).removeprefix("the file: ")  # the file is named already
+            self.message = (
+                f"**{_escape(label)}** was not loaded: {_escape(reason)}. "
+                f"Still showing **{_escape(self.route.name)}**."
+            )
+            self.redraw()
+            return False
+        self.route, self.route_label, self.state = route, label, state
+        self.params = self.read_params()
+        self.message = ""
+        self.play_time_s = 0.0
+        self.playing = False
+        self._drawing = CourseDrawing.of(route)
+        self.scrub.max = self._total_km()
+        # The gate clamps a browser's scrub to the new course's length, not the first one's.
+        record_spec(self.scrub)
+        self.scene.write_back(self.scrub, 0.0)  # the riders are back at the start
+        self.redraw(geometry=True)
+        return True
+
+    def _on_solve(self) -> None:
+        params = self.read_params()
+        line = self.scene.read_params()
+        air = course_air(self.route, params)
+        rider = course_kernel.Rider(
+            cda_m2=group_cda(line), mass_kg=line.mass_kg, crr=line.crr,
+            drivetrain_efficiency=line.drivetrain_pct / 100.0, model=params.model,
+        )  # fmt: skip
+        target_s, cap = params.target_min * 60.0, params.max_speed_kmh / 3.6
+        low, high = COURSE_POWER_RANGE_W
+
+        def finish_at(power_w: float) -> float:
+            try:
+                return course_kernel.ride(
+                    self.route, power_w, rider, params.wind_ms, params.wind_from_deg, air, cap
+                ).time_s
+            except ValueError:  # too little power to cross a wall: never finishes
+                return math.inf
+
+        fastest, slowest = finish_at(high), finish_at(low)
+        wanted = f"{params.target_min:g} min"
+        if target_s < fastest:
+            power = high
+            note = (
+                f"A {wanted} finish needs more than {high:.0f} W, the most this input takes: set to "
+                f"{high:.0f} W, which finishes in {format_duration(fastest)}."
+            )
+        elif target_s > slowest:
+            power = low
+            note = (
+                f"A {wanted} finish needs less than {low:.0f} W, the least this input takes: set to "
+                f"{low:.0f} W, which finishes in {format_duration(slowest)}."
+            )
+        else:
+            try:
+                power = course_kernel.power_for_time(
+                    self.route, target_s, rider, params.wind_ms, params.wind_from_deg, air,
+                    max_speed_ms=cap, tolerance_s=0.05,
+                )  # fmt: skip
+            except ValueError as error:
+                self.message = f"Could not find the power for {wanted}: {_escape(str(error))}"
+                self.redraw()
+                return
+            note = ""
+        self.scene.write_back(self.controls["power_w"], float(np.clip(round(power, 1), low, high)))
+        self._on_input()
+        if note and not self.message:
+            self.message = note
+            self.redraw()
+
+    def _on_play(self) -> None:
+        if self.state is None:
+            return
+        if self.play_time_s >= self.state.ride.time_s:
+            self.play_time_s = 0.0
+        self.playing = True
+        self.scene.wake_loops()
+
+    def _on_pause(self) -> None:
+        self.playing = False
+        self.scene.write_back(self.scrub, round(self._leader_km(), 2))  # where the riders stopped
+        self.redraw(readouts=False)
+
+    def _on_scrub(self) -> None:
+        if self.state is None:
+            return
+        raw = self.scrub.value
+        ok = isinstance(raw, (int, float)) and not isinstance(raw, bool) and math.isfinite(raw)
+        km = float(np.clip(raw if ok else self._leader_km(), 0.0, self._total_km()))
+        if not ok or km != raw:
+            self.scene.write_back(self.scrub, km)
+        ride = self.state.ride
+        self.play_time_s = float(np.interp(km * 1000.0, ride.distance_m, ride.elapsed_s))
+        self.redraw(readouts=False)
+
+    # ----------------------------------------------------------------------------------------- animation
+    def _animate(self, dt: float) -> bool:
+        """One frame of the ride's playback; False (the loop sleeps) when it is not playing."""
+        if not (self.enabled and self.playing and self.state is not None):
+            return False
+        dt = min(dt, 0.2)
+        self.play_time_s = min(self.play_time_s + dt * self.params.playback, self.state.ride.time_s)
+        if self.play_time_s >= self.state.ride.time_s:
+            self.playing = False
+        self._since_readout += dt
+        if self._since_readout >= 0.2 or not self.playing:  # the slider and readout follow at 5 Hz
+            self._since_readout = 0.0
+            self.scene.write_back(self.scrub, round(self._leader_km(), 2))
+            self.redraw(readouts=False, now=True)
+        else:
+            self.redraw(readouts=False, now=False)
+        return True
+
+    # ----------------------------------------------------------------------------------------- drawing
+    def _total_km(self) -> float:
+        return math.floor(self.route.total_distance_m / 10.0) / 100.0
+
+    def leader_distance_m(self) -> float:
+        if self.state is None:
+            return 0.0
+        ride = self.state.ride
+        return float(np.interp(self.play_time_s, ride.elapsed_s, ride.distance_m))
+
+    def _leader_km(self) -> float:
+        return self.leader_distance_m() / 1000.0
+
+    def rider_distances_m(self) -> np.ndarray:
+        """(n_riders,) distance along the route of each drawn rider, leader first (spaced as drawn)."""
+        n, gap = self.scene.params.n_riders, self.scene.params.gap_m
+        spacing_m = (BIKE_LENGTH_M + gap) * COURSE_MARKER_SCALE / self._drawing.scale
+        return self.leader_distance_m() - np.arange(n) * spacing_m
+
+    def redraw(self, *, geometry: bool = False, readouts: bool = True, now: bool = True) -> None:
+        """Show or hide the mode and push its state: riders always, geometry and readouts when asked."""
+        s = self.scene
+        with self.server.atomic():
+            s.course.visible = not self.enabled
+            if self.enabled:
+                s.wind_arrow.visible = False
+            self.frame.visible = self.enabled
+            if geometry or self._drawn_exaggeration != self.params.exaggeration:
+                self._draw_geometry()
+            if s.params.position != self._drawn_position:
+                show_position(self.course_riders, s.params.position)
+                self._drawn_position = s.params.position
+            self._draw_riders()
+            if now:
+                self.now.content = self._now_markdown()
+            if readouts:
+                self.route_info.content = self._route_markdown()
+                self.readout.content = self._readout_markdown()
+                self.splits.content = self._splits_markdown()
+                self.chart.data = self._chart_data()
+                self.chart.visible = self.state is not None
+        self.server.flush()
+
+    _drawn_exaggeration: float = 2.0
+
+    def _draw_geometry(self) -> None:
+        index = drawn_indices(self.route.n_points, MAX_DRAWN_POINTS)
+        points = self._drawing.points(self.route, index, self.params.exaggeration)
+        vertices, faces = terrain_strip(points, TERRAIN_HALF_WIDTH_M)
+        self.terrain.vertices = vertices
+        self.terrain.faces = faces
+        self.ground.vertices, self.ground.faces = ground_under(points)
+        segments, colours = self._route_segments(index, points)
+        self.route_line.points = segments
+        self.route_line.colors = colours
+        self.start_label.position = tuple(points[0])
+        self.finish_label.position = tuple(points[-1])
+        self._drawn_exaggeration = self.params.exaggeration
+
+    def _draw_riders(self) -> None:
+        n = self.scene.params.n_riders
+        positions = np.zeros((MAX_RIDERS, 3))
+        wxyz = np.tile([1.0, 0.0, 0.0, 0.0], (MAX_RIDERS, 1))
+        where, yaw = self._drawing.at_distance(
+            self.route, self.rider_distances_m(), self.params.exaggeration
+        )
+        positions[:n] = where
+        wxyz[:n] = np.stack([np.cos(yaw / 2), np.zeros(n), np.zeros(n), np.sin(yaw / 2)], axis=1)
+        visible = (np.arange(MAX_RIDERS) < n).astype(np.float64)
+        # Riders behind the start wait there (hidden until the line has rolled out).
+        visible[:n] *= self.rider_distances_m() >= 0.0
+        scales = np.repeat(visible[:, None], 3, axis=1) * COURSE_MARKER_SCALE
+        for node in self.course_riders.values():
+            node.batched_positions = positions.astype(np.float32)
+            node.batched_wxyzs = wxyz.astype(np.float32)
+            node.batched_scales = scales.astype(np.float32)
+        self.leader_marker.position = tuple(where[0] + [0.0, 0.0, 0.5])
+
+    def _chart_data(self) -> tuple[np.ndarray, ...]:
+        route = self.route
+        index = drawn_indices(route.n_points, MAX_CHART_POINTS)
+        km = route.distance_m[index] / 1000.0
+        elevation = route.elevation_m[index]
+        if (
+            self.state is None
+        ):  # before the first ride: the profile, and zeros (never a NaN-only series)
+            zeros = np.zeros_like(km)
+            return km, elevation, zeros, zeros
+        ride = self.state.ride
+        return km, elevation, 3.6 * ride.speed_ms[index], ride.power_w[index]
+
+    def _route_markdown(self) -> str:
+        r = self.route
+        average = 100.0 * (r.elevation_m[-1] - r.elevation_m[0]) / r.total_distance_m
+        text = (
+            f"**{_escape(r.name)}**: {r.total_distance_m / 1000:.2f} km, +{r.climbing_m:.0f} m, "
+            f"{r.elevation_m[0]:.0f} → {r.elevation_m[-1]:.0f} m ({average:+.1f} % on average), {r.n_points} points"
+        )
+        if self.route_label == SAMPLE_LABEL:
+            text += (
+                "  \n*Sample route, built from Alpe d'Huez's published climb profile (13.2 km, 744 → 1815 m, "
+                "8.1 %); its plan shape is schematic.*"
+            )
+        if self.message:
+            text += f"  \n⚠️ {self.message}"
+        return text
+
+    def _readout_markdown(self) -> str:
+        state = self.state
+        if state is None:
+            return "Tick **Ride a course** to ride it."
+        ride, line = state.ride, self.scene.params
+        p = self.params
+        text = (
+            f"Finish **{format_duration(ride.time_s)}**, average **{3.6 * ride.average_speed_ms:.1f} km/h** "
+            f"at **{ride.average_power_w:.0f} W** ({MODEL_LABEL[p.model]})"
+        )
+        if ride.average_power_w < 0.99 * p.power_w and state.pacing is None:
+            text += (
+                f"  \nAverage {ride.average_power_w:.0f} W of the {p.power_w:.0f} W set: the riders coast "
+                f"where the descent would take them over the {p.max_speed_kmh:.0f} km/h safe speed"
+            )
+        if state.group_cda_m2 != line.cda_m2:
+            text += (
+                f"  \n{line.n_riders} riders sharing the front (mean CdA {state.group_cda_m2:.3f} m²): "
+                f"alone the same power takes {format_duration(state.solo.time_s)}"
+            )
+        if state.pacing is not None:
+            saved = state.pacing.time_saved_s
+            text += (
+                f"  \nPacing by grade (±{p.pacing_gain_pct:.0f} %): {format_duration(state.constant.time_s)} at constant "
+                f"power → {format_duration(ride.time_s)}, **{saved:.0f} s {'saved' if saved >= 0 else 'lost'}** at the same average power"
+            )
+        which = "weather" if p.air == "weather" else "seed"
+        text += (
+            f"  \nAir at the start ({state.route.elevation_m[0]:.0f} m): seed (exponential) **{state.density_seed:.3f}** kg/m³, "
+            f"weather **{state.density_weather:.3f}** kg/m³; riding in the {which} air"
+        )
+        if ride.brakes_j > 0.0:
+            text += (
+                f"  \nBraking to hold {p.max_speed_kmh:.0f} km/h took {ride.brakes_j / 1000:.0f} kJ"
+            )
+        return text
+
+    def _splits_markdown(self) -> str:
+        if self.state is None:
+            return ""
+        ride = self.state.ride
+        every = split_every_m(float(ride.distance_m[-1]))
+        marks, times = ride.splits(every)
+        rows = ["| km | elapsed | split | km/h |", "|---:|---:|---:|---:|"]
+        previous_mark, previous_time = 0.0, 0.0
+        shown = np.unique(
+            np.linspace(0, marks.shape[0] - 1, min(marks.shape[0], 20)).round().astype(int)
+        )
+        for i in range(marks.shape[0]):
+            split = times[i] - previous_time
+            speed = 3.6 * (marks[i] - previous_mark) / split if split > 0 else 0.0
+            if i in shown:
+                rows.append(
+                    f"| {marks[i] / 1000:.1f} | {format_duration(times[i])} | {format_duration(split)} | {speed:.1f} |"
+                )
+            previous_mark, previous_time = marks[i], times[i]
+        return "\n".join(rows)
+
+    def _now_markdown(self) -> str:
+        if self.state is None:
+            return ""
+        ride = self.state.ride
+        d = self.leader_distance_m()
+        speed = float(np.interp(d, ride.distance_m, ride.speed_ms))
+        power = float(
+            ride.power_w[
+                min(
+                    int(np.searchsorted(ride.distance_m, d, side="right")) - 1,
+                    ride.power_w.shape[0] - 1,
+                )
+            ]
+        )
+        elevation = float(np.interp(d, self.route.distance_m, self.route.elevation_m))
+        coasting = ""
+        if self.state.pacing is None and power < 0.99 * self.params.power_w:
+            coasting = f" (coasting at the {self.params.max_speed_kmh:.0f} km/h descent cap)"
+        return (
+            f"Leader at **{d / 1000:.2f} km**, {format_duration(self.play_time_s)}: "
+            f"{3.6 * speed:.1f} km/h, {power:.0f} W{coasting}, {elevation:.0f} m"
+        )
+
+
+def _escape(text: str) -> str:
+    """Text from a file, shown in markdown: no HTML, no markdown links or images."""
+    return (
+        text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
+        .replace("[", "&#91;").replace("]", "&#93;").replace("*", "&#42;").replace("|", "&#124;")
+    )  # fmt: skip

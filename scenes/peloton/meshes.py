@@ -1,0 +1,147 @@
+"""Rider meshes: a low-poly bike, body and head per riding position, and the batched nodes that draw a line of them.
+
+Meshes are in the bike frame (x forward, z up, ground at z = 0, m). :func:`add_riders` makes one batched mesh per part
+with an instance per rider slot (:data:`~scenes.peloton.model.MAX_RIDERS`), so the line and the course draw their
+riders the same way, and :func:`show_position` re-meshes them when the riding position changes.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import trimesh
+import viser
+
+from scenes.peloton.model import MAX_RIDERS, POSITIONS, Position
+
+JERSEYS = np.array(
+    [
+        (220, 40, 40),
+        (30, 110, 220),
+        (250, 200, 30),
+        (40, 170, 90),
+        (150, 60, 200),
+        (250, 130, 30),
+        (30, 190, 200),
+        (230, 90, 160),
+    ],
+    dtype=np.uint8,
+)
+RIDER_COLOURS = {
+    "bike": np.full((MAX_RIDERS, 3), 45, np.uint8),
+    "body": JERSEYS,
+    "head": np.full((MAX_RIDERS, 3), 235, np.uint8),
+}
+"""(MAX_RIDERS, 3) uint8 colour of each part, per rider slot: bikes dark, bodies in team jerseys, heads pale."""
+
+
+def rod(a: np.ndarray, b: np.ndarray, radius: float) -> trimesh.Trimesh:
+    """An eight-sided cylinder of ``radius`` from (3,) point ``a`` to ``b`` (m)."""
+    return trimesh.creation.cylinder(radius=radius, segment=np.array([a, b]), sections=8)
+
+
+def two_bone_knee(hip: np.ndarray, foot: np.ndarray, thigh: float, shin: float) -> np.ndarray:
+    """Knee position in the xz plane by the law of cosines, bending forward (as a rider's knee does)."""
+    d_vec = foot - hip
+    d = float(np.clip(np.linalg.norm(d_vec), 1e-6, thigh + shin - 1e-6))
+    along = (thigh**2 - shin**2 + d**2) / (2 * d)
+    height = math.sqrt(max(thigh**2 - along**2, 0.0))
+    u = d_vec / np.linalg.norm(d_vec)
+    forward = np.array(
+        [u[2], 0.0, -u[0]]
+    )  # u rotated by −90° about y: in front of the hip–foot line
+    if forward[0] < 0:
+        forward = -forward
+    return hip + along * u + height * forward
+
+
+def rider_meshes(position: Position) -> dict[str, trimesh.Trimesh]:
+    """Low-poly bike, body and head for one rider, in the bike frame (x forward, z up, ground at z = 0)."""
+    pose = POSITIONS[position]
+    wheel_r = 0.34
+    rear, front = np.array([-0.51, 0.0, wheel_r]), np.array([0.51, 0.0, wheel_r])
+    bb = np.array([-0.04, 0.0, 0.27])
+    seat = np.array([-0.20, 0.0, 0.86])
+    head_top = np.array([0.40, 0.0, 0.80])
+    bars = np.array([pose.hands[0] - 0.02, 0.0, pose.hands[2] - 0.02])
+
+    bike_parts = []
+    for centre in (rear, front):
+        wheel = trimesh.creation.torus(
+            major_radius=wheel_r - 0.015, minor_radius=0.018, major_sections=24, minor_sections=6
+        )
+        wheel.apply_transform(trimesh.transformations.rotation_matrix(math.pi / 2, [1, 0, 0]))
+        wheel.apply_translation(centre)
+        bike_parts.append(wheel)
+    for a, b in (
+        (rear, bb),
+        (rear, seat),
+        (bb, seat),
+        (bb, head_top),
+        (seat, head_top),
+        (head_top, front),
+    ):
+        bike_parts.append(rod(a, b, 0.016))
+    bike_parts.append(rod(head_top, bars, 0.014))
+    bike_parts.append(rod(bars + [0, -0.2, 0], bars + [0, 0.2, 0], 0.012))
+    bike_parts.append(rod(seat + [-0.08, 0, 0.03], seat + [0.08, 0, 0.03], 0.03))
+
+    theta = math.radians(pose.torso_deg)
+    hip = seat + np.array([0.0, 0.0, 0.08])
+    shoulder = hip + 0.58 * np.array([math.cos(theta), 0.0, math.sin(theta)])
+    torso = trimesh.creation.capsule(height=0.58, radius=0.12, count=[8, 8])
+    torso.apply_transform(
+        trimesh.geometry.align_vectors([0, 0, 1], shoulder - hip)  # capsule axis along the torso
+    )
+    torso.apply_translation((hip + shoulder) / 2)
+    body_parts = [torso]
+    hands = np.array(pose.hands)
+    for side in (-1.0, 1.0):
+        s = shoulder + [0.0, side * 0.17, 0.0]
+        h = hands * [1.0, side, 1.0]
+        if position in ("tt", "hour"):  # elbows on the pads: upper arm down, forearm forward
+            elbow = np.array([s[0] + 0.05, side * 0.09, hands[2] - 0.02])
+            body_parts += [rod(s, elbow, 0.045), rod(elbow, h, 0.04)]
+        else:
+            body_parts.append(rod(s, h, 0.045))
+        crank = np.array([side * 0.17 * 0.7, 0.0, -side * 0.17 * 0.7])
+        foot = bb + crank + [0.0, side * 0.12, 0.0]
+        h_side = hip + [0.0, side * 0.1, 0.0]
+        knee = two_bone_knee(h_side, foot, 0.46, 0.46)
+        body_parts += [rod(h_side, knee, 0.065), rod(knee, foot, 0.05)]
+    head_centre = shoulder + 0.17 * np.array(
+        [math.cos(theta * 0.5), 0.0, math.sin(theta * 0.5) + 0.6]
+    )
+    head = trimesh.creation.icosphere(subdivisions=2, radius=0.12)
+    head.apply_translation(head_centre)
+    bike, body = trimesh.util.concatenate(bike_parts), trimesh.util.concatenate(body_parts)
+    assert isinstance(bike, trimesh.Trimesh) and isinstance(body, trimesh.Trimesh)
+    return {"bike": bike, "body": body, "head": head}
+
+
+def add_riders(
+    scene: viser.SceneApi, prefix: str, position: Position, scale: float
+) -> dict[str, viser.BatchedMeshHandle]:
+    """One batched mesh per part (``<prefix>_bike``, ``_body``, ``_head``), an instance per rider slot, all at the
+    origin and scaled by ``scale`` (0 hides them until they are placed)."""
+    nodes: dict[str, viser.BatchedMeshHandle] = {}
+    for part, mesh in rider_meshes(position).items():
+        nodes[part] = scene.add_batched_meshes_simple(
+            f"{prefix}_{part}",
+            vertices=mesh.vertices.astype(np.float32),
+            faces=mesh.faces.astype(np.uint32),
+            batched_wxyzs=np.tile([1.0, 0.0, 0.0, 0.0], (MAX_RIDERS, 1)),
+            batched_positions=np.zeros((MAX_RIDERS, 3)),
+            batched_scales=np.full((MAX_RIDERS, 3), scale),
+            batched_colors=RIDER_COLOURS[part],
+            lod="off",
+        )
+    return nodes
+
+
+def show_position(nodes: dict[str, viser.BatchedMeshHandle], position: Position) -> None:
+    """Re-mesh the riders of :func:`add_riders` for another riding position."""
+    for part, mesh in rider_meshes(position).items():
+        nodes[part].vertices = mesh.vertices.astype(np.float32)
+        nodes[part].faces = mesh.faces.astype(np.uint32)

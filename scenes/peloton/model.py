@@ -1,0 +1,218 @@
+"""The peloton's line model: riding positions, the scene's parameters, and pure functions from them to a state.
+
+:class:`PelotonParams` is everything a user sets (each field also declares its GUI control, :mod:`scenes._controls`);
+:func:`compute_line` turns it into a :class:`LineState` of per-rider drag and power, leader first, through
+:mod:`kernels.cycling`; :func:`solo_curves` and :func:`solo_speed` give the lone rider's power curve and speed at a
+power for the chart and readout. Nothing here touches a viser handle: every function is testable alone. SI units
+inside (m, s, W); km/h, % and the like only in the parameters, as the GUI shows them.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+from dataclasses import field
+from typing import Literal
+
+import numpy as np
+
+from kernels import cycling
+from scenes._controls import checkbox, dropdown, number, slider
+
+MAX_RIDERS = 8
+BIKE_LENGTH_M = 1.70
+"""Wheel-to-wheel length of one bike; the gap is measured from the front wheel to the wheel ahead."""
+MAX_GAP_M = 15.0
+"""Largest wheel-to-wheel gap the slider offers (m): beyond ~3 m drafting is gone (Blocken et al. 2013)."""
+
+Position = Literal["upright", "hoods", "drops", "tt", "hour"]
+
+
+@dataclasses.dataclass(frozen=True)
+class RidingPosition:
+    label: str
+    cda_m2: float
+    """Typical drag area for the position (seed's table; hour record from Bigham 2022)."""
+    torso_deg: float
+    """Torso angle above horizontal, for the drawing."""
+    hands: tuple[float, float, float]
+    """Where the hands rest, in the bike frame (m)."""
+
+
+POSITIONS: dict[Position, RidingPosition] = {
+    "upright": RidingPosition("Upright (commuting)", 0.55, 62.0, (0.42, 0.20, 1.00)),
+    "hoods": RidingPosition("Hoods", 0.42, 42.0, (0.50, 0.19, 0.95)),
+    "drops": RidingPosition("Drops", 0.32, 28.0, (0.50, 0.17, 0.84)),
+    "tt": RidingPosition("Time-trial tuck", 0.22, 12.0, (0.62, 0.06, 0.98)),
+    "hour": RidingPosition("Hour record", 0.16, 6.0, (0.66, 0.05, 0.96)),
+}
+POSITION_FROM_LABEL: dict[str, Position] = {p.label: key for key, p in POSITIONS.items()}
+
+CRR_PRESETS: dict[str, float] = {
+    "Track, wooden velodrome (0.0020)": 0.0020,
+    "Race tyre, smooth asphalt (0.0040)": 0.0040,
+    "Training tyre (0.0060)": 0.0060,
+    "Gravel tyre (0.0080)": 0.0080,
+    "Mountain bike, knobbly (0.0120)": 0.0120,
+}
+DraftModelLabel = Literal["Seed formula", "Measured (by position)"]
+MODEL_FROM_LABEL: dict[str, cycling.DraftModel] = {
+    "Seed formula": "seed",
+    "Measured (by position)": "measured",
+}
+
+
+@dataclasses.dataclass(frozen=True)
+class PelotonParams:
+    """Everything the scene shows is a function of these; defaults are the opening state.
+
+    Each field is also its GUI control, declared once (:mod:`scenes._controls`), in the order and folder shown.
+    """
+
+    speed_kmh: float = field(
+        default=40.0, metadata=slider("Speed (km/h)", 0.0, 80.0, 0.5, folder="Rider")
+    )
+    """Ground speed of the line (km/h)."""
+    position: Position = field(
+        default="drops",
+        metadata=dropdown(
+            "Position", tuple(POSITIONS), tuple(p.label for p in POSITIONS.values()), folder="Rider"
+        ),
+    )
+    """Riding position: sets the drawing and, when chosen, the CdA."""
+    cda_m2: float = field(
+        default=0.32, metadata=slider("CdA (m²)", 0.10, 0.80, 0.005, folder="Rider")
+    )
+    """Drag area of one rider riding alone (m²)."""
+    mass_kg: float = field(
+        default=80.0, metadata=slider("Mass, rider + bike (kg)", 30.0, 150.0, 0.5, folder="Rider")
+    )
+    """Rider plus bike (kg)."""
+    crr: float = field(default=0.0040, metadata=slider("Crr", 0.0, 0.02, 0.0005, folder="Rider"))
+    """Rolling-resistance coefficient (the "Tyres / surface" presets above it set it)."""
+    drivetrain_pct: float = field(
+        default=97.6, metadata=slider("Drivetrain efficiency (%)", 80.0, 100.0, 0.1, folder="Rider")
+    )
+    """Drivetrain efficiency (%), Martin et al. 1998."""
+    grade_pct: float = field(
+        default=0.0, metadata=slider("Grade (%)", -15.0, 20.0, 0.5, folder="Course")
+    )
+    """Road grade (%), rise over run."""
+    altitude_m: float = field(
+        default=0.0, metadata=slider("Altitude (m)", 0.0, 4000.0, 50.0, folder="Course")
+    )
+    """Altitude (m): sets air density."""
+    headwind_ms: float = field(
+        default=0.0,
+        metadata=slider("Headwind (m/s, − = tailwind)", -15.0, 15.0, 0.5, folder="Course"),
+    )
+    """Wind against the riders (m/s); negative is a tailwind."""
+    drafting: bool = field(default=True, metadata=checkbox("Drafting", folder="Drafting"))
+    """Whether riders behind the leader draft."""
+    n_riders: int = field(default=4, metadata=slider("Riders", 1, MAX_RIDERS, 1, folder="Drafting"))
+    """Riders in the line."""
+    gap_m: float = field(
+        default=0.5, metadata=slider("Gap (m)", 0.0, MAX_GAP_M, 0.1, folder="Drafting")
+    )
+    """Wheel-to-wheel gap between riders (m)."""
+    model: cycling.DraftModel = field(
+        default="measured",
+        metadata=dropdown(
+            "Draft model",
+            tuple(MODEL_FROM_LABEL.values()),
+            tuple(MODEL_FROM_LABEL),
+            folder="Drafting",
+        ),
+    )
+    """Drafting model: the seed's formula or the position-dependent fit to measurements."""
+    rotate: bool = field(default=False, metadata=checkbox("Rotate the lead", folder="Drafting"))
+    """Whether the lead rotates: every turn the leader swings off and drops to the back."""
+    turn_s: float = field(
+        default=6.0, metadata=slider("Turn at the front (s)", 2.0, 30.0, 1.0, folder="Drafting")
+    )
+    """Seconds each rider leads when the lead rotates."""
+    target_power_w: float = field(
+        default=250.0, metadata=number("Power (W)", 0.0, 2500.0, 5.0, folder="Speed at a power")
+    )
+    """Power for the 'speed at this power' readout (W)."""
+
+
+@dataclasses.dataclass(frozen=True)
+class LineState:
+    """Per-rider results for the current parameters, leader first."""
+
+    reduction: np.ndarray
+    cda_m2: np.ndarray
+    power: cycling.Power
+    solo: cycling.Power
+
+    @property
+    def saving(self) -> np.ndarray:
+        """(n,) fraction of the solo rider's power each rider saves; zero when riding alone costs nothing."""
+        solo = float(self.solo.total)
+        if solo <= 0.0:
+            return np.zeros_like(self.power.total)
+        return 1.0 - self.power.total / solo
+
+
+def compute_line(p: PelotonParams) -> LineState:
+    """Run the kernels for one parameter set (no viser: testable on its own)."""
+    n = p.n_riders
+    common = dict(
+        mass_kg=p.mass_kg,
+        crr=p.crr,
+        grade=p.grade_pct / 100.0,
+        altitude_m=p.altitude_m,
+        headwind_ms=p.headwind_ms,
+        drivetrain_efficiency=p.drivetrain_pct / 100.0,
+    )
+    speed = p.speed_kmh / 3.6
+    reduction = cycling.drag_reduction(n, p.gap_m, p.model) if p.drafting else np.zeros(n)
+    cda = p.cda_m2 * (1.0 - reduction)
+    power = cycling.power(np.full(n, speed), cda, **common)
+    solo = cycling.power(speed, p.cda_m2, **common)
+    return LineState(reduction=reduction, cda_m2=cda, power=power, solo=solo)
+
+
+def group_cda(line: PelotonParams) -> float:
+    """CdA of a rider in a line that rotates evenly: the mean over the positions (the riders share the work)."""
+    if not line.drafting or line.n_riders < 2:
+        return line.cda_m2
+    reduction = cycling.drag_reduction(line.n_riders, line.gap_m, line.model)
+    return float(line.cda_m2 * (1.0 - np.mean(reduction)))
+
+
+# The solo rider's curve and speed-at-power depend on neither the speed nor the line: moving the speed slider (the
+# control people move most) reuses them.
+SoloKey = tuple[float, float, float, float, float, float, float]
+"""What the solo rider's curve depends on: CdA, mass, Crr, grade (%), altitude, headwind, drivetrain (%)."""
+
+
+def solo_key(p: PelotonParams) -> SoloKey:
+    """The parameters the solo rider's curve and speed at a power depend on (a cache key)."""
+    return (p.cda_m2, p.mass_kg, p.crr, p.grade_pct, p.altitude_m, p.headwind_ms, p.drivetrain_pct)
+
+
+@functools.lru_cache(maxsize=64)
+def solo_curves(key: SoloKey) -> tuple[np.ndarray, ...]:
+    """(speeds in km/h, aero, rolling, climbing, total) of one rider from 0 to 80 km/h, for the chart."""
+    cda, mass, crr, grade_pct, altitude, wind, drivetrain_pct = key
+    speeds_kmh = np.linspace(0.0, 80.0, 161)
+    solo = cycling.power(
+        speeds_kmh / 3.6, cda, mass, crr, grade_pct / 100.0, altitude, wind, drivetrain_pct / 100.0
+    )
+    curves = (speeds_kmh, solo.aero, solo.rolling, solo.climbing, solo.total)
+    for curve in curves:
+        curve.setflags(write=False)  # shared between calls
+    return curves
+
+
+@functools.lru_cache(maxsize=64)
+def solo_speed(key: SoloKey, power_w: float) -> float:
+    """Speed (m/s) at which one rider alone holds ``power_w`` (W)."""
+    cda, mass, crr, grade_pct, altitude, wind, drivetrain_pct = key
+    return float(
+        cycling.speed_for_power(
+            power_w, cda, mass, crr, grade_pct / 100.0, altitude, wind, drivetrain_pct / 100.0
+        )
+    )

@@ -1,0 +1,593 @@
+"""Peloton: riders in a line, their power split into aero / rolling / climbing, drafting by gap, live.
+
+Physics comes from :mod:`kernels.cycling` through :mod:`scenes.peloton.model`; this module owns the viser handles.
+The riders are three batched meshes (bodies in team colours, bikes, heads) with one instance per rider
+(:mod:`scenes.peloton.meshes`), so a redraw is a handful of array writes. The scene opens with eight instances and
+hides the unused ones by scaling them to zero, so changing the rider count never re-adds a node. Its course mode
+(:mod:`scenes.peloton.course`) rides a real route with the same riders.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import trimesh
+import viser
+import viser.uplot
+
+from kernels import cycling
+from scenes._base import Scene, set_if_changed
+from scenes._charts import FittedChart
+from scenes._controls import Controls, build_controls
+from scenes._framing import ClientFraming, Lens, View, frame_points
+from scenes.peloton.course import CourseMode
+from scenes.peloton.meshes import add_riders, show_position
+from scenes.peloton.model import (
+    BIKE_LENGTH_M,
+    CRR_PRESETS,
+    MAX_GAP_M,
+    MAX_RIDERS,
+    POSITIONS,
+    PelotonParams,
+    Position,
+    compute_line,
+    solo_curves,
+    solo_key,
+    solo_speed,
+)
+from scenes.peloton.projection import (
+    LABEL_PX,
+    course_to_world,
+    label_lifts_px,
+    lift_to_metres,
+    project_px,
+    slot_offsets,
+)
+
+ROAD_X_M = (-(MAX_RIDERS - 1) * (BIKE_LENGTH_M + MAX_GAP_M) - 15.0, 15.0)
+"""(start, end) x of the drawn road (m): the longest line (8 riders, the largest gap) rides on it, with 15 m spare
+at each end."""
+BAR_METRES_PER_WATT = 1.0 / 400.0
+"""Height of the stacked power bars above the riders."""
+VIEW_DIRECTION = (-1.2, 7.5, -1.8)
+"""The camera looks at the line from its left side, a little ahead of it and above."""
+LABEL_STAGGER_M = 0.4
+"""Every other rider's label sits this much higher (m) until a camera is framed and the labels laid out for it."""
+BAR_HEADROOM = 1.3
+"""Bars that outgrow the framed view are framed again this many times as tall: power goes with the cube of speed, so
+a drag from 30 to 50 km/h re-frames about 7 times instead of 20."""
+COMPONENT_COLOURS = {"aero": (60, 130, 240), "rolling": (245, 160, 40), "climbing": (60, 190, 90)}
+ROTATION = ("rotate", "turn_s")
+"""The paceline's rotation controls: they restart the rotation and leave the line's power as it is."""
+
+
+# --------------------------------------------------------------------------------------------- scene
+class PelotonScene(Scene[PelotonParams]):
+    key = "peloton"
+    title = "Peloton: cycling power"
+    camera_position = (-2.0, -7.5, 2.8)
+    camera_look_at = (-3.2, 0.0, 1.0)
+    about = """
+**What it shows.** Riders in a line at one speed. Each rider's power is split into pushing air (aero), tyre
+rolling resistance and climbing; riders behind draft. The bars above the riders stack aero (blue), rolling
+(orange) and climbing (green); the label gives watts and the share of the solo rider's power.
+
+**Equations** (SI, θ = atan(grade), w = headwind):
+P_aero = ½ρ·CdA·(v+w)|v+w|·v, P_roll = Crr·m·g·cos θ·v, P_climb = m·g·sin θ·v,
+P = (P_aero + P_roll + P_climb)/η, ρ = 1.225·exp(−h/8500).
+
+**Drafting.** *Seed formula*: CdA·(1 − 0.27·exp(−gap/3.5)) for every follower (27 % at 0 m, 6.5 % at 5 m; the
+seed's prose overstates it). *Measured*: position-dependent, fitted to team-pursuit measurements (Barry et al. 2015;
+Fitton et al. 2018; Broker, Kyle & Burke 1999), fading with gap as Swiss Side's CFD does; the leader gains ~3 %
+from the rider behind (Blocken et al. 2013).
+
+**Assumptions.** Steady speed, no bearing or wheel-rotation losses, CdA independent of yaw; the exponential
+atmosphere is the seed's (ISA gives ρ about 4 % higher at 2000 m).
+
+**Rotate the lead** animates a paceline: every turn the leader swings off and drops to the back, so each rider's
+time-averaged power is the mean over positions, far below the leader's.
+"""
+
+    def __init__(self, server: viser.ViserServer) -> None:
+        super().__init__(server)
+        self.params = PelotonParams()
+        self.state = compute_line(self.params)
+        self._drawn_position: Position | None = None
+        self._rotation_time_s = 0.0
+        self._energy_j = np.zeros(MAX_RIDERS)
+        self._ridden_s = 0.0
+        self._label_lift_m = LABEL_STAGGER_M * (np.arange(MAX_RIDERS) % 2)
+        """How far each slot's label sits above its bar (m): laid out for the camera framed last."""
+        self._build_gui()
+        self._build_world()
+        self.redraw()
+        self._framed_for = self._framing_key()
+        self._framed_points = self.line_points()
+        self.framing = ClientFraming(self._view_for, opening=self.camera_position)
+        self.watch_cameras(self.framing.on_camera)
+        self.start_loop(self._animate, 1.0 / 30.0)
+        self.course_mode = CourseMode(self)
+
+    # ----------------------------------------------------------------------------------------- GUI
+    def _build_gui(self) -> None:
+        gui, p = self.server.gui, self.params
+        with self.gui_root:
+            rider = build_controls(gui, p, ("speed_kmh", "position", "cda_m2", "mass_kg"))
+            with rider.folders["Rider"]:
+                # Hand-built, not a parameter: a preset that sets the Crr slider, which holds the value used.
+                self.crr_preset = gui.add_dropdown(
+                    "Tyres / surface",
+                    options=list(CRR_PRESETS),
+                    initial_value=next(iter(k for k, v in CRR_PRESETS.items() if v == p.crr)),
+                )
+            line = build_controls(
+                gui,
+                p,
+                ("crr", "drivetrain_pct", "grade_pct", "altitude_m", "headwind_ms", "drafting")
+                + ("n_riders", "gap_m", "model", *ROTATION),
+                folders_open=rider.folders,
+            )
+            with gui.add_folder("Results"):
+                self.density = gui.add_markdown("")
+                self.table = gui.add_markdown("")
+                self.rotation = gui.add_markdown("")
+                self.chart = FittedChart(
+                    gui,
+                    data=self._chart_data(),
+                    series=(
+                        viser.uplot.Series(label="Speed (km/h)"),
+                        viser.uplot.Series(label="Aero (W)", stroke="rgb(60,130,240)", width=2),
+                        viser.uplot.Series(label="Rolling (W)", stroke="rgb(245,160,40)", width=2),
+                        viser.uplot.Series(label="Climbing (W)", stroke="rgb(60,190,90)", width=2),
+                        viser.uplot.Series(label="Total (W)", stroke="black", width=2),
+                        viser.uplot.Series(
+                            label="Solo now (W)",
+                            stroke="rgb(220,30,30)",
+                            width=1.5,
+                            dash=(6.0, 4.0),
+                            points=viser.uplot.Series_Points(show=False),
+                        ),
+                    ),
+                    scales={
+                        "x": viser.uplot.Scale(time=False, auto=True),
+                        "y": viser.uplot.Scale(auto=True),
+                    },
+                    legend=viser.uplot.Legend(show=True),
+                    title="Solo power vs speed (cube law)",
+                    aspect=1.4,
+                )
+            power = build_controls(gui, p, ("target_power_w",))
+            with power.folders["Speed at a power"]:
+                self.speed_out = gui.add_markdown("")
+        self.controls: Controls[PelotonParams] = rider | line | power
+        """Every declared control of :class:`PelotonParams`, by field name."""
+        for name, built in self.controls.fields.items():
+            on_update = {"position": self._on_position}.get(
+                name, self._on_rotate if name in ROTATION else self.apply_inputs
+            )
+            for handle in built.handles:
+                handle.on_update(self.callback(on_update))
+        self.crr_preset.on_update(self.callback(self._on_crr_preset))
+
+    # ----------------------------------------------------------------------------------------- world
+    def _build_world(self) -> None:
+        scene = self.server.scene
+        self.course = scene.add_frame(f"{self.root.name}/course", show_axes=False)
+        start, end = ROAD_X_M
+        length, middle = end - start, 0.5 * (start + end)
+        grass = trimesh.creation.box(extents=(length + 30.0, 60.0, 0.02))
+        grass.apply_translation((middle, 0.0, -0.03))
+        scene.add_mesh_simple(
+            f"{self.course.name}/grass", grass.vertices, grass.faces, color=(120, 165, 95)
+        )
+        road = trimesh.creation.box(extents=(length, 3.0, 0.02))
+        road.apply_translation((middle, 0.0, -0.01))
+        self.road = scene.add_mesh_simple(
+            f"{self.course.name}/road", road.vertices, road.faces, color=(70, 72, 78)
+        )
+        dashes = np.array(
+            [
+                [[x, 0.0, 0.002], [x + 1.5, 0.0, 0.002]]
+                for x in np.arange(start + 1.0, end - 1.0, 3.0)
+            ]
+        )
+        scene.add_line_segments(
+            f"{self.course.name}/centre_line", dashes, colors=(240, 240, 240), thickness=0.08
+        )
+        for side in (-1.5, 1.5):
+            edge = np.array([[[start, side, 0.003], [end, side, 0.003]]])
+            scene.add_line_segments(
+                f"{self.course.name}/edge_{side:+.0f}", edge, colors=(250, 250, 250), thickness=0.06
+            )
+
+        self.riders_nodes = add_riders(
+            scene, f"{self.course.name}/riders", self.params.position, 1.0
+        )
+        identity = np.tile([1.0, 0.0, 0.0, 0.0], (MAX_RIDERS, 1))
+        zeros = np.zeros((MAX_RIDERS, 3))
+        self._drawn_position = self.params.position
+
+        unit_box = trimesh.creation.box(extents=(1.0, 1.0, 1.0))
+        unit_box.apply_translation((0.0, 0.0, 0.5))  # grows upward from its base
+        self.bars: dict[str, viser.BatchedMeshHandle] = {}
+        for component, colour in COMPONENT_COLOURS.items():
+            self.bars[component] = scene.add_batched_meshes_simple(
+                f"{self.course.name}/bars_{component}",
+                vertices=unit_box.vertices.astype(np.float32),
+                faces=unit_box.faces.astype(np.uint32),
+                batched_wxyzs=identity,
+                batched_positions=zeros,
+                batched_scales=np.zeros((MAX_RIDERS, 3)),
+                batched_colors=np.tile(np.array(colour, np.uint8), (MAX_RIDERS, 1)),
+                lod="off",
+                cast_shadow=False,
+            )
+        self.labels = [
+            scene.add_label(
+                f"{self.course.name}/label_{i}",
+                text="",
+                position=(0.0, 0.0, 2.0),
+                font_screen_scale=0.9,
+            )
+            for i in range(MAX_RIDERS)
+        ]
+        self.wind_arrow = scene.add_line_segments(
+            f"{self.root.name}/wind", np.zeros((3, 2, 3)), colors=(120, 200, 255), thickness=0.05
+        )
+
+    # ----------------------------------------------------------------------------------------- callbacks
+    def _on_position(self) -> None:
+        """A riding position brings its typical CdA with it."""
+        position = self.read_params().position
+        self.write_back(self.controls["cda_m2"], POSITIONS[position].cda_m2)
+        self.apply_inputs()
+
+    def _on_crr_preset(self) -> None:
+        closest = min(CRR_PRESETS, key=lambda label: abs(CRR_PRESETS[label] - self.params.crr))
+        label = self.read_choice(self.crr_preset, list(CRR_PRESETS), closest)
+        self.write_back(self.controls["crr"], CRR_PRESETS[label])
+        self.apply_inputs()
+
+    def _on_rotate(self) -> None:
+        rotation = (
+            self.read_params()
+        )  # only the rotation is taken: the line's power stays as computed
+        self.params = dataclasses.replace(
+            self.params, rotate=rotation.rotate, turn_s=rotation.turn_s
+        )
+        self._rotation_time_s = 0.0
+        self._energy_j[:] = 0.0
+        self._ridden_s = 0.0
+        self.redraw()
+        self.wake_loops()
+
+    def apply_inputs(self) -> None:
+        """Read every control, compute the line and redraw (what any input's change does)."""
+        last_good = (self.params, self.state)
+        self.params = self.read_params()
+        self.state = compute_line(self.params)
+        self._energy_j[:] = 0.0
+        self._ridden_s = 0.0
+        try:
+            self.redraw()
+        except Exception:
+            self.params, self.state = last_good  # never show one state while holding another
+            self.redraw()
+            raise
+        self._update_framing()
+        # An input can start the rotation (Riders raised from 1 while Rotate is on): wake the loop.
+        if self.params.rotate and self.params.n_riders > 1:
+            self.wake_loops()
+
+    # ----------------------------------------------------------------------------------------- camera
+    def line_points(self, bar_headroom: float = 1.0) -> np.ndarray:
+        """(N, 3) world points the view must hold: every rider (also swinging off), bar tops (``bar_headroom`` times
+        as tall as now) and the wind arrow."""
+        p = self.params
+        n = p.n_riders
+        front, back = (
+            0.5 * BIKE_LENGTH_M,
+            float(slot_offsets(n, p.gap_m)[n - 1]) - 0.5 * BIKE_LENGTH_M,
+        )
+        top = 1.95 + LABEL_STAGGER_M + bar_headroom * float(np.max(self._bar_heights_m()))
+        x_hi = front + (3.0 + min(abs(p.headwind_ms), 15.0) * 0.25 if p.headwind_ms != 0 else 0.0)
+        lo, hi = np.array([back, -1.1, 0.0]), np.array([x_hi, 1.1, max(top, 2.2)])
+        corners = np.array(
+            [
+                [(lo, hi)[i][0], (lo, hi)[j][1], (lo, hi)[k][2]]
+                for i in (0, 1)
+                for j in (0, 1)
+                for k in (0, 1)
+            ]
+        )
+        theta = math.atan(p.grade_pct / 100.0)  # the course frame turns by −θ about y
+        c, s = math.cos(theta), math.sin(theta)
+        return np.stack(
+            [
+                c * corners[:, 0] - s * corners[:, 2],
+                corners[:, 1],
+                s * corners[:, 0] + c * corners[:, 2],
+            ],
+            axis=1,
+        )
+
+    def _bar_heights_m(self) -> np.ndarray:
+        """(n_riders,) height of each slot's stacked bars (m): the positive parts only, as drawn (downhill the
+        climbing part is negative and the stack stands taller than the total)."""
+        power = self.state.power
+        parts = [np.maximum(np.asarray(getattr(power, c)), 0.0) for c in COMPONENT_COLOURS]
+        return np.sum(parts, axis=0)[: self.params.n_riders] * BAR_METRES_PER_WATT
+
+    def label_anchors(self) -> np.ndarray:
+        """(n_riders, 3) world points where each slot's label sits before it is lifted: just above its bar."""
+        p, n = self.params, self.params.n_riders
+        x = slot_offsets(n, p.gap_m)[:n]
+        local = np.stack([x, np.zeros(n), 1.95 + self._bar_heights_m()], 1)
+        return course_to_world(local, p.grade_pct)
+
+    def _view_for(self, lens: Lens) -> View:
+        """The view of the line for ``lens``, with room above it for the labels, which it lays out for that lens."""
+        with self._lock:
+            anchors = self.label_anchors()
+            up_world = course_to_world(np.array([[0.0, 0.0, 1.0]]), self.params.grade_pct)[0]
+            ndc = lens.usable_ndc(right_px=LABEL_PX[0], top_px=LABEL_PX[1])
+            x0, x1 = (ndc[0] + 1.0) / 2.0 * lens.width_px, (ndc[1] + 1.0) / 2.0 * lens.width_px
+            y_top, y_bottom = (
+                (1.0 - ndc[3]) / 2.0 * lens.height_px,
+                (1.0 - ndc[2]) / 2.0 * lens.height_px,
+            )
+            framed, view, lifts_m = self._framed_points, None, np.zeros(len(anchors))
+            # Frame the line with the lifted label anchors, which lean with the road's tilt (a fresh review: up a
+            # 20 % grade the last label started left of the window); the box of each label lies right of and
+            # above its anchor, in the room the rectangle leaves. Framing the anchors shrinks the line, which may
+            # stack the labels differently: repeat until the lifted anchors fit.
+            for _ in range(MAX_RIDERS + 2):
+                view = frame_points(
+                    framed, VIEW_DIRECTION, fov_rad=lens.fov_rad, aspect=lens.aspect, ndc=ndc
+                )
+                lifts_px = label_lifts_px(project_px(anchors, view, lens))
+                lifts_m = lift_to_metres(anchors, lifts_px, up_world, view, lens)
+                lifted = anchors + lifts_m[:, None] * up_world
+                px = project_px(lifted, view, lens)
+                if (
+                    px[:, 0].min(initial=x0) >= x0 - 0.5
+                    and px[:, 0].max(initial=x1) <= x1 + 0.5
+                    and px[:, 1].min(initial=y_top) >= y_top - 0.5
+                    and px[:, 1].max(initial=y_bottom) <= y_bottom + 0.5
+                ):
+                    break
+                framed = np.vstack([framed, lifted])
+            assert view is not None
+            self._label_lift_m = np.zeros(MAX_RIDERS)
+            self._label_lift_m[: len(lifts_m)] = lifts_m
+            self.redraw(readouts=False)
+            return view
+
+    def _update_framing(self) -> None:
+        """Frame every browser again when the line changes length or tilt, or its bars outgrow the view.
+
+        Bars that outgrow it are framed with :data:`BAR_HEADROOM`: dragging the speed up then moves the camera
+        every few km/h, not at each step (each framing lays out the labels for every tab: ~60 ms a tab)."""
+        key = self._framing_key()
+        points = self.line_points()
+        if key != self._framed_for:
+            self._framed_for, self._framed_points = key, points
+        elif points[:, 2].max() > self._framed_points[:, 2].max() + 0.05:
+            self._framed_points = self.line_points(bar_headroom=BAR_HEADROOM)
+        else:
+            return
+        self.framing.reframe()
+
+    def _framing_key(self) -> tuple[object, ...]:
+        p = self.params
+        return (p.n_riders, p.gap_m, p.grade_pct, p.headwind_ms != 0.0)
+
+    def read_params(self) -> PelotonParams:
+        """The current GUI values, cleaned: anything non-finite, out of range or unknown keeps the last good value."""
+        return self.read_controls(self.controls)
+
+    # ----------------------------------------------------------------------------------------- drawing
+    def _chart_data(self) -> tuple[np.ndarray, ...]:
+        p = self.params
+        speeds_kmh, aero, rolling, climbing, total = solo_curves(solo_key(p))
+        # A level line at the solo power now: it meets the total curve at the current speed. (A single marker needs
+        # NaN elsewhere, and one NaN makes uPlot's auto range NaN, so the chart drew nothing at all.)
+        now = np.full_like(speeds_kmh, float(self.state.solo.total))
+        return speeds_kmh, aero, rolling, climbing, total, now
+
+    def _slot_of_rider(self) -> tuple[np.ndarray, np.ndarray]:
+        """(x, y) of each rider now: the plain line, or mid-rotation when the lead rotates."""
+        n, p = self.params.n_riders, self.params
+        slots = slot_offsets(n, p.gap_m)
+        x, y = slots.copy(), np.zeros(MAX_RIDERS)
+        if not (p.rotate and n > 1):
+            return x, y
+        turn = p.turn_s
+        k, phase = divmod(self._rotation_time_s / turn, 1.0)
+        order = (np.arange(n) - int(k)) % n  # slot each rider holds this turn
+        swap = 0.25  # last quarter of a turn: leader swings off and drifts back, others move up
+        u = max(0.0, (phase - (1.0 - swap)) / swap)
+        ease = 0.5 - 0.5 * math.cos(math.pi * u)
+        for rider in range(n):
+            slot = int(order[rider])
+            if slot == 0:
+                x[rider] = slots[0] + ease * (slots[n - 1] - slots[0])
+                y[rider] = 0.9 * math.sin(math.pi * ease)
+            else:
+                x[rider] = slots[slot] + ease * (slots[slot - 1] - slots[slot])
+        return x, y
+
+    def current_slots(self) -> np.ndarray:
+        """(n_riders,) slot index each rider holds (0 = leader); the identity unless the lead rotates."""
+        n = self.params.n_riders
+        if not (self.params.rotate and n > 1):
+            return np.arange(n)
+        k = int(self._rotation_time_s // self.params.turn_s)
+        return (np.arange(n) - k) % n
+
+    def redraw(self, *, readouts: bool = True) -> None:
+        """Push the current state to the riders, bars and labels and, with ``readouts``, to the GUI outputs.
+
+        One atomic update; the animation redraws without readouts, which do not change as riders move.
+        """
+        p, state = self.params, self.state
+        n = p.n_riders
+        slots = self.current_slots()
+        total = np.asarray(state.power.total)
+        x, y = self._slot_of_rider()
+        positions = np.stack([x, y, np.zeros(MAX_RIDERS)], axis=1)
+        visible = (np.arange(MAX_RIDERS) < n).astype(np.float64)
+        scales = np.repeat(visible[:, None], 3, axis=1)
+
+        with self.server.atomic():
+            theta = math.atan(p.grade_pct / 100.0)
+            set_if_changed(
+                self.course, "wxyz", (math.cos(-theta / 2), 0.0, math.sin(-theta / 2), 0.0)
+            )
+            if p.position != self._drawn_position:
+                show_position(self.riders_nodes, p.position)
+                self._drawn_position = p.position
+            for node in self.riders_nodes.values():
+                set_if_changed(node, "batched_positions", positions.astype(np.float32))
+                set_if_changed(node, "batched_scales", scales.astype(np.float32))
+
+            base = np.zeros(MAX_RIDERS)
+            for component in ("aero", "rolling", "climbing"):
+                watts = np.zeros(MAX_RIDERS)
+                watts[:n] = np.maximum(np.asarray(getattr(state.power, component))[slots], 0.0)
+                height = watts * BAR_METRES_PER_WATT
+                bar_pos = positions + np.stack(
+                    [np.zeros(MAX_RIDERS), np.zeros(MAX_RIDERS), 1.75 + base], axis=1
+                )
+                self.bars[component].batched_positions = bar_pos.astype(np.float32)
+                self.bars[component].batched_scales = np.stack(
+                    [0.35 * visible, 0.35 * visible, np.maximum(height, 1e-4) * visible], axis=1
+                ).astype(np.float32)
+                base = base + height
+            for i, label in enumerate(self.labels):
+                # Only write what changed: every property write is a message to every browser.
+                if label.visible != (i < n):
+                    label.visible = i < n
+                if i < n:
+                    watts = float(total[slots[i]])
+                    solo = float(state.solo.total)
+                    share = (
+                        f"{100.0 * watts / solo:.0f} % of solo" if solo > 0 else "solo needs 0 W"
+                    )
+                    text = f"{watts:.0f} W · {share}"
+                    if label.text != text:
+                        label.text = text
+                    # Neighbours' labels alternate in height so close riders' labels never overlap.
+                    # Lifted by the layout for the framed camera, so no two labels overlap.
+                    set_if_changed(
+                        label,
+                        "position",
+                        (x[i], y[i], 1.95 + base[i] + self._label_lift_m[slots[i]]),
+                    )
+
+            rotation = self._rotation_markdown()
+            if self.rotation.content != rotation:
+                self.rotation.content = rotation
+            if readouts:
+                self._draw_wind()
+                self.density.content = self._density_markdown()
+                self.table.content = self._table_markdown()
+                self.chart.data = self._chart_data()
+                self.speed_out.content = self._speed_markdown()
+        self.server.flush()
+
+    def _draw_wind(self) -> None:
+        w = self.params.headwind_ms
+        length = min(abs(w), 15.0) * 0.25
+        if length < 1e-6:
+            self.wind_arrow.visible = False
+            return
+        self.wind_arrow.visible = True
+        tip_x = 3.0 if w > 0 else 3.0 + length
+        tail_x = tip_x + length if w > 0 else tip_x - length
+        direction = -1.0 if w > 0 else 1.0
+        tip = np.array([tip_x, 0.0, 1.2])
+        head = [tip - [direction * 0.3, 0.0, -0.2], tip - [direction * 0.3, 0.0, 0.2]]
+        set_if_changed(
+            self.wind_arrow,
+            "points",
+            np.array([[[tail_x, 0.0, 1.2], tip], [head[0], tip], [head[1], tip]]),
+        )
+
+    def _density_markdown(self) -> str:
+        p, solo = self.params, self.state.solo
+        rho = float(cycling.air_density(p.altitude_m))
+        wheel = float(solo.aero + solo.rolling + solo.climbing)
+        aero_share = 100.0 * float(solo.aero) / wheel if wheel > 0 else float("nan")
+        thinner = 100 * (1 - rho / cycling.RHO_SEA_LEVEL)
+        where = "sea level" if abs(thinner) < 0.05 else f"{thinner:.1f} % thinner than at sea level"
+        return (
+            f"Air density **{rho:.3f} kg/m³** ({where})  \n"
+            f"Solo rider: **{float(solo.total):.0f} W**, aero share of wheel power **{aero_share:.1f} %**"
+        )
+
+    def _table_markdown(self) -> str:
+        state = self.state
+        # Narrow columns run together in the panel ("RollClimb"), so the three parts share one cell with slashes.
+        rows = [
+            "| Rider | CdA (m²) | Aero / rolling / climbing (W) | Total (W) | Saving |",
+            "|---|---|---|---|---|",
+        ]
+        for i in range(self.params.n_riders):
+            rows.append(
+                f"| {i + 1} | {state.cda_m2[i]:.3f} | {state.power.aero[i]:.0f} / {state.power.rolling[i]:.0f} / "
+                f"{state.power.climbing[i]:.0f} | **{state.power.total[i]:.0f}** | {100 * state.saving[i]:.1f} % |"
+            )
+        return "\n".join(rows)
+
+    def _rotation_markdown(self) -> str:
+        n = self.params.n_riders
+        if n < 2:
+            return ""
+        mean = float(np.mean(self.state.power.total))
+        lead = float(self.state.power.total[0])
+        if lead > 0:
+            text = (
+                f"Rotating evenly, each rider averages **{mean:.0f} W** against the leader's {lead:.0f} W "
+                f"({100 * (1 - mean / lead):.0f} % less): the reason teams rotate."
+            )
+        else:
+            text = f"Here the leader needs {lead:.0f} W: gravity does the work and nobody needs shelter."
+        if self.params.rotate and self._ridden_s > 0:
+            averages = self._energy_j[:n] / self._ridden_s
+            text += "  \nTime-averaged so far: " + ", ".join(
+                f"R{i + 1} {a:.0f} W" for i, a in enumerate(averages)
+            )
+        return text
+
+    def _speed_markdown(self) -> str:
+        p = self.params
+        v = solo_speed(solo_key(p), p.target_power_w)
+        text = f"Riding alone, {p.target_power_w:.0f} W ({p.target_power_w / p.mass_kg:.2f} W/kg of system mass) holds **{3.6 * v:.1f} km/h** here"
+        if v > 0.1:
+            minutes, seconds = divmod(round(40_000.0 / v), 60)
+            hours, minutes = divmod(minutes, 60)
+            text += f": a 40 km time trial in {hours:d}:{minutes:02d}:{seconds:02d}"
+        return text + "."
+
+    # ----------------------------------------------------------------------------------------- animation
+    def _animate(self, dt: float) -> bool:
+        """One frame of the rotating lead; False (the loop sleeps) when the lead does not rotate."""
+        if not (self.params.rotate and self.params.n_riders > 1):
+            return False
+        dt = min(dt, 0.2)
+        slots = self.current_slots()
+        self._energy_j[: self.params.n_riders] += np.asarray(self.state.power.total)[slots] * dt
+        self._ridden_s += dt
+        self._rotation_time_s += dt
+        self.redraw(readouts=False)
+        return True
+
+    def rider_average_power(self) -> np.ndarray:
+        """(n_riders,) time-averaged power of each rider since the rotation started (W); zeros before."""
+        n = self.params.n_riders
+        if self._ridden_s <= 0:
+            return np.zeros(n)
+        return self._energy_j[:n] / self._ridden_s
