@@ -31,8 +31,8 @@ import viser
 
 from kernels import sdf
 from scenes import _controls
-from scenes._base import TURNS, Scene, mark_costly, record_spec
-from scenes._controls import Built, Controls, build_controls, declared
+from scenes._base import TURNS, Scene, mark_costly
+from scenes._controls import build_controls
 from scenes._worker import LatestWorker
 from scenes.sdf_gallery import editor
 from scenes.sdf_gallery.compare import Agreement, compare, readout_markdown
@@ -42,7 +42,6 @@ from scenes.sdf_gallery.params import (
     BOX_HI,
     BOX_LO,
     CAMERA_REST_S,
-    GIZMO_MARKER_RADIUS_M,
     MOVING_WIDTH_PX,
     PREVIEW_RESOLUTION,
     REFERENCE_FOLDER,
@@ -50,17 +49,19 @@ from scenes.sdf_gallery.params import (
     SHADING_FIELDS,
     SIZE_MEANING,
     SIZES_USED,
-    PrimitiveParams,
     SdfGalleryParams,
     Shape,
     Viewer,
     camera_from_viser,
-    gizmo_label,
-    gizmo_reach,
-    gizmo_tips,
     moving_shading,
     rest_size,
     viewer_size,
+)
+from scenes.sdf_gallery.slots import (
+    add_slot_gizmo,
+    build_slot_controls,
+    read_wxyz,
+    update_gizmo_looks,
 )
 from shaders import gl_service
 from shaders.renderer import (
@@ -221,7 +222,7 @@ IoU is lowest when a box edge is on the silhouette.
                 gui, p, SHADING_FIELDS, folders_open={REFERENCE_FOLDER: reference_folder}
             )
             self.slot_controls = [
-                self._build_slot(gui, i, slot) for i, slot in enumerate(p.primitives)
+                build_slot_controls(gui, i, slot) for i, slot in enumerate(p.primitives)
             ]
             gui.add_markdown(SIZE_MEANING)
             with gui.add_folder("Downloads", expand_by_default=False):
@@ -243,31 +244,6 @@ IoU is lowest when a box edge is on the silhouette.
         self.example_controls.on_update(self.callback(self._on_example))
         self.editor.on_update(self.callback(self._on_editor_text))
         self.apply.on_click(self.callback(self._on_apply))
-
-    @staticmethod
-    def _build_slot(gui: Any, index: int, slot: PrimitiveParams) -> Controls[PrimitiveParams]:
-        """The controls of primitive slot ``index`` (from 0) in its own folder, from PrimitiveParams' declarations:
-        labels formatted with the slot's number and the size's axis; the first slot has no "on" checkbox (it is
-        always on) and its "combine" is greyed out (nothing comes before it)."""
-        n = index + 1
-        declarations = declared(PrimitiveParams)
-        label = str(declarations["kind"].folder).format(slot=n)
-        folder = gui.add_folder(label, expand_by_default=False)
-        fields: dict[str, Built] = {}
-        for name, control in declarations.items():
-            if name == "enabled" and index == 0:
-                continue
-            shown = dataclasses.replace(control, disabled=name == "op" and index == 0)
-            value = getattr(slot, name)
-            per_element = isinstance(value, tuple) and control.per_element
-            handles, specs = [], []
-            with folder:
-                for axis, element in zip("abc", value if per_element else (value,), strict=False):
-                    handle = shown.add(gui, control.label.format(slot=n, axis=axis), element)
-                    handles.append(handle)
-                    specs.append(record_spec(handle, control.spec(element)))
-            fields[name] = Built(control, tuple(handles), tuple(specs), per_element)
-        return Controls(PrimitiveParams, fields, {label: folder})
 
     def _build_world(self) -> None:
         scene = self.server.scene
@@ -292,38 +268,11 @@ IoU is lowest when a box edge is on the silhouette.
         self.gizmo_markers: list[viser.IcosphereHandle] = []
         self.gizmo_labels: list[viser.LabelHandle] = []
         for i, slot in enumerate(self.params.primitives):
-            reach = gizmo_reach(slot)
-            marker_at, label_at = gizmo_tips(reach)
-            gizmo = scene.add_transform_controls(
-                f"{self.root.name}/gizmo_{i + 1}",
-                scale=reach,
-                line_width=2.0,
-                disable_sliders=True,  # the plane handles of four gizmos cluttered the middle; arrows and rings stay
-                # Drawn over the mesh: a gizmo sits at its primitive's centre, inside the surface. Each is sized to
-                # its own primitive (its arrows just poke out of it), so the four do not pile up in the middle.
-                depth_test=False,
-                position=slot.position,
-                wxyz=slot.wxyz,
-                visible=slot.enabled,
-            )
+            gizmo, marker, label = add_slot_gizmo(scene, f"{self.root.name}/gizmo_{i + 1}", i, slot)
             gizmo.on_update(self._on_scene)
             self.gizmos.append(gizmo)
-            # A ball in the primitive's colour at the tip of its local z arrow, and its name: which gizmo moves
-            # which primitive, at a glance.
-            self.gizmo_markers.append(
-                scene.add_icosphere(
-                    f"{gizmo.name}/marker",
-                    radius=GIZMO_MARKER_RADIUS_M,
-                    color=slot.color,
-                    subdivisions=2,
-                    position=marker_at,
-                    cast_shadow=False,
-                    receive_shadow=False,
-                )
-            )
-            self.gizmo_labels.append(
-                scene.add_label(f"{gizmo.name}/label", gizmo_label(i, slot), position=label_at)
-            )
+            self.gizmo_markers.append(marker)
+            self.gizmo_labels.append(label)
 
     # ----------------------------------------------------------------------------------------- inputs
     def read_params(self) -> SdfGalleryParams:
@@ -339,25 +288,10 @@ IoU is lowest when a box edge is on the silhouette.
                     slot,
                     enabled=True if i == 0 else slot.enabled,
                     position=self.read_position(gizmo, old.position, BOX_LO, BOX_HI),
-                    wxyz=self._read_wxyz(gizmo, old.wxyz),
+                    wxyz=read_wxyz(gizmo, old.wxyz),
                 )
             )
         return dataclasses.replace(self.read_controls(self.scene_controls), primitives=tuple(slots))
-
-    @staticmethod
-    def _read_wxyz(
-        gizmo: Any, last_good: tuple[float, float, float, float]
-    ) -> tuple[float, float, float, float]:
-        try:
-            q = np.asarray(gizmo.wxyz, dtype=np.float64).reshape(4)
-        except (TypeError, ValueError):
-            q = np.full(4, np.nan)
-        norm = float(np.linalg.norm(q)) if np.all(np.isfinite(q)) else 0.0
-        if norm < 1e-6:
-            gizmo.wxyz = last_good
-            return last_good
-        q = q / norm
-        return (float(q[0]), float(q[1]), float(q[2]), float(q[3]))
 
     def _on_scene_input(self) -> None:
         params = self.read_params()
@@ -502,7 +436,7 @@ IoU is lowest when a box edge is on the silhouette.
             self.wireframe_node.vertices, self.wireframe_node.faces = self._wire
 
     def _sync_enabled_inputs(self) -> None:
-        """Show gizmos of enabled primitives; grey out sizes the kind does not use."""
+        """Show gizmos of enabled primitives, sized and named for them; grey out sizes the kind does not use."""
         self.scene_controls["k"].disabled = self.params.blend == "hard"
         for controls, gizmo, slot in zip(
             self.slot_controls, self.gizmos, self.params.primitives, strict=True
@@ -510,28 +444,10 @@ IoU is lowest when a box edge is on the silhouette.
             gizmo.visible = slot.enabled and self.params.shape_source == "primitives"
             for j, handle in enumerate(controls.each("size")):
                 handle.disabled = j >= SIZES_USED[slot.kind] or not slot.enabled
-        self._sync_gizmo_looks()
-
-    def _sync_gizmo_looks(self) -> None:
-        """Each gizmo's size, marker colour and label follow its primitive's kind, size and colour."""
-        for i, (gizmo, marker, label, slot) in enumerate(
-            zip(
-                self.gizmos,
-                self.gizmo_markers,
-                self.gizmo_labels,
-                self.params.primitives,
-                strict=True,
-            )
-        ):
-            reach = gizmo_reach(slot)
-            if abs(gizmo.scale - reach) > 1e-6:
-                gizmo.scale = reach
-                marker.position, label.position = gizmo_tips(reach)
-            if tuple(int(c) for c in marker.color) != slot.color:
-                marker.color = slot.color
-            text = gizmo_label(i, slot)
-            if label.text != text:
-                label.text = text
+        # Each gizmo's size, marker colour and label follow its primitive's kind, size and colour.
+        handles = zip(self.gizmos, self.gizmo_markers, self.gizmo_labels, strict=True)
+        for i, (gizmo, marker, label) in enumerate(handles):
+            update_gizmo_looks(gizmo, marker, label, i, self.params.primitives[i])
 
     # ----------------------------------------------------------------------------------------- worker
     def _wake(self) -> None:

@@ -1,0 +1,120 @@
+"""The gallery's four primitive slots in the GUI and the 3D view: each slot's folder of controls, built from the
+declarations on :class:`~scenes.sdf_gallery.params.PrimitiveParams`, and its gizmo with a marker ball and a name.
+
+The slots' controls are built by a small loop here rather than :func:`scenes._controls.build_controls`: one
+folder per slot, labels formatted with the slot's number and the size's axis ("P2 size b (m)"), the first slot
+without an "on" checkbox and with "combine" greyed out. What it returns is an ordinary
+:class:`~scenes._controls.Controls`, read with :func:`scenes._controls.read_controls`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any
+
+import numpy as np
+import viser
+
+from scenes._base import record_spec
+from scenes._controls import Built, Controls, declared
+from scenes.sdf_gallery.params import (
+    GIZMO_MARKER_RADIUS_M,
+    PrimitiveParams,
+    gizmo_label,
+    gizmo_reach,
+    gizmo_tips,
+)
+
+
+def build_slot_controls(gui: Any, index: int, slot: PrimitiveParams) -> Controls[PrimitiveParams]:
+    """The controls of primitive slot ``index`` (from 0) in its own folder, from PrimitiveParams' declarations:
+    labels formatted with the slot's number and the size's axis; the first slot has no "on" checkbox (it is
+    always on) and its "combine" is greyed out (nothing comes before it)."""
+    n = index + 1
+    declarations = declared(PrimitiveParams)
+    label = str(declarations["kind"].folder).format(slot=n)
+    folder = gui.add_folder(label, expand_by_default=False)
+    fields: dict[str, Built] = {}
+    for name, control in declarations.items():
+        if name == "enabled" and index == 0:
+            continue
+        shown = dataclasses.replace(control, disabled=name == "op" and index == 0)
+        value = getattr(slot, name)
+        per_element = isinstance(value, tuple) and control.per_element
+        handles, specs = [], []
+        with folder:
+            for axis, element in zip("abc", value if per_element else (value,), strict=False):
+                handle = shown.add(gui, control.label.format(slot=n, axis=axis), element)
+                handles.append(handle)
+                specs.append(record_spec(handle, control.spec(element)))
+        fields[name] = Built(control, tuple(handles), tuple(specs), per_element)
+    return Controls(PrimitiveParams, fields, {label: folder})
+
+
+def add_slot_gizmo(
+    scene: Any, name: str, index: int, slot: PrimitiveParams
+) -> tuple[viser.TransformControlsHandle, viser.IcosphereHandle, viser.LabelHandle]:
+    """Add the gizmo of slot ``index`` (from 0) at node ``name``, with its marker ball and label."""
+    reach = gizmo_reach(slot)
+    marker_at, label_at = gizmo_tips(reach)
+    gizmo = scene.add_transform_controls(
+        name,
+        scale=reach,
+        line_width=2.0,
+        disable_sliders=True,  # the plane handles of four gizmos cluttered the middle; arrows and rings stay
+        # Drawn over the mesh: a gizmo sits at its primitive's centre, inside the surface. Each is sized to its own
+        # primitive (its arrows just poke out of it), so the four do not pile up in the middle.
+        depth_test=False,
+        position=slot.position,
+        wxyz=slot.wxyz,
+        visible=slot.enabled,
+    )
+    # A ball in the primitive's colour at the tip of its local z arrow, and its name: which gizmo moves which
+    # primitive, at a glance.
+    marker = scene.add_icosphere(
+        f"{gizmo.name}/marker",
+        radius=GIZMO_MARKER_RADIUS_M,
+        color=slot.color,
+        subdivisions=2,
+        position=marker_at,
+        cast_shadow=False,
+        receive_shadow=False,
+    )
+    label = scene.add_label(f"{gizmo.name}/label", gizmo_label(index, slot), position=label_at)
+    return gizmo, marker, label
+
+
+def update_gizmo_looks(
+    gizmo: viser.TransformControlsHandle,
+    marker: viser.IcosphereHandle,
+    label: viser.LabelHandle,
+    index: int,
+    slot: PrimitiveParams,
+) -> None:
+    """Make a slot's gizmo size, marker colour and label follow its primitive's kind, size and colour (each
+    written only when it changed)."""
+    reach = gizmo_reach(slot)
+    if abs(gizmo.scale - reach) > 1e-6:
+        gizmo.scale = reach
+        marker.position, label.position = gizmo_tips(reach)
+    if tuple(int(c) for c in marker.color) != slot.color:
+        marker.color = slot.color
+    text = gizmo_label(index, slot)
+    if label.text != text:
+        label.text = text
+
+
+def read_wxyz(
+    gizmo: Any, last_good: tuple[float, float, float, float]
+) -> tuple[float, float, float, float]:
+    """A gizmo's orientation, normalised; ``last_good`` (put back on the gizmo) if it is not a usable quaternion."""
+    try:
+        q = np.asarray(gizmo.wxyz, dtype=np.float64).reshape(4)
+    except (TypeError, ValueError):
+        q = np.full(4, np.nan)
+    norm = float(np.linalg.norm(q)) if np.all(np.isfinite(q)) else 0.0
+    if norm < 1e-6:
+        gizmo.wxyz = last_good
+        return last_good
+    q = q / norm
+    return (float(q[0]), float(q[1]), float(q[2]), float(q[3]))
