@@ -2,15 +2,16 @@
 
 Split by concern: :mod:`~scenes.peloton.model` (parameters and the pure line model), :mod:`~scenes.peloton.projection`
 (slots, the tilted course frame, label layout), :mod:`~scenes.peloton.meshes` (rider meshes),
-:mod:`~scenes.peloton.scene` (:class:`PelotonScene`) and :mod:`~scenes.peloton.course` (the course mode). The names
-callers use are re-exported here.
+:mod:`~scenes.peloton.scene` (:class:`PelotonScene`), :mod:`~scenes.peloton.course_model` (the course mode's
+parameters, ride and drawn geometry) and :mod:`~scenes.peloton.course` (:class:`CourseMode`). The names callers use
+are re-exported here.
 """
 
 from __future__ import annotations
 
-from scenes.peloton.course import (
+from scenes.peloton.course import CourseMode
+from scenes.peloton.course_model import (
     SAMPLE_LABEL,
-    CourseMode,
     CourseParams,
     CourseState,
     compute_course,

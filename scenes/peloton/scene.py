@@ -20,7 +20,7 @@ import viser.uplot
 from kernels import cycling
 from scenes._base import Scene, set_if_changed
 from scenes._charts import FittedChart
-from scenes._controls import Controls, build_controls
+from scenes._controls import Controls, build_controls, declared
 from scenes._framing import ClientFraming, Lens, View, frame_points
 from scenes.peloton.course import CourseMode
 from scenes.peloton.meshes import add_riders, show_position
@@ -61,6 +61,8 @@ a drag from 30 to 50 km/h re-frames about 7 times instead of 20."""
 COMPONENT_COLOURS = {"aero": (60, 130, 240), "rolling": (245, 160, 40), "climbing": (60, 190, 90)}
 ROTATION = ("rotate", "turn_s")
 """The paceline's rotation controls: they restart the rotation and leave the line's power as it is."""
+LAST = ("target_power_w",)
+"""The controls built after the Results folder (in their own folder, with the speed-at-a-power readout)."""
 
 
 # --------------------------------------------------------------------------------------------- scene
@@ -125,8 +127,7 @@ time-averaged power is the mean over positions, far below the leader's.
             line = build_controls(
                 gui,
                 p,
-                ("crr", "drivetrain_pct", "grade_pct", "altitude_m", "headwind_ms", "drafting")
-                + ("n_riders", "gap_m", "model", *ROTATION),
+                [name for name in declared(PelotonParams) if name not in (*rider.fields, *LAST)],
                 folders_open=rider.folders,
             )
             with gui.add_folder("Results"):
@@ -158,17 +159,19 @@ time-averaged power is the mean over positions, far below the leader's.
                     title="Solo power vs speed (cube law)",
                     aspect=1.4,
                 )
-            power = build_controls(gui, p, ("target_power_w",))
+            power = build_controls(gui, p, LAST)
             with power.folders["Speed at a power"]:
                 self.speed_out = gui.add_markdown("")
         self.controls: Controls[PelotonParams] = rider | line | power
         """Every declared control of :class:`PelotonParams`, by field name."""
-        for name, built in self.controls.fields.items():
-            on_update = {"position": self._on_position}.get(
-                name, self._on_rotate if name in ROTATION else self.apply_inputs
-            )
-            for handle in built.handles:
-                handle.on_update(self.callback(on_update))
+        for name in self.controls.fields:
+            if name == "position":
+                handler = self._on_position
+            elif name in ROTATION:
+                handler = self._on_rotate
+            else:
+                handler = self.apply_inputs
+            self.controls[name].on_update(self.callback(handler))
         self.crr_preset.on_update(self.callback(self._on_crr_preset))
 
     # ----------------------------------------------------------------------------------------- world
@@ -302,16 +305,7 @@ time-averaged power is the mean over positions, far below the leader's.
                 for k in (0, 1)
             ]
         )
-        theta = math.atan(p.grade_pct / 100.0)  # the course frame turns by −θ about y
-        c, s = math.cos(theta), math.sin(theta)
-        return np.stack(
-            [
-                c * corners[:, 0] - s * corners[:, 2],
-                corners[:, 1],
-                s * corners[:, 0] + c * corners[:, 2],
-            ],
-            axis=1,
-        )
+        return course_to_world(corners, p.grade_pct)
 
     def _bar_heights_m(self) -> np.ndarray:
         """(n_riders,) height of each slot's stacked bars (m): the positive parts only, as drawn (downhill the
