@@ -1,4 +1,4 @@
-"""Skeleton presets of the arm scene (issue 14): a planar robot arm of hinges, a hand, a humanoid upper body.
+"""Skeleton presets of the arm scene: a planar robot arm of hinges, a hand, a humanoid upper body.
 
 Each preset is a tree of joints (:func:`kernels.fabrik.solve_tree`) with a joint type per segment, draggable targets
 on its end effectors, and colours: every chain (finger, limb) its own link colour, every joint from green to red as
@@ -24,6 +24,8 @@ from numpy.typing import NDArray
 from kernels import fabrik
 
 if TYPE_CHECKING:
+    import viser
+
     from scenes.arm import ArmScene
 
 PresetLabel = Literal["Chain", "Robot arm", "Hand", "Upper body"]
@@ -355,7 +357,8 @@ def clean_target(raw: object, planar: bool) -> NDArray[np.float64] | None:
 class SkeletonView:
     """The preset dropdown, the skeleton's meshes, hinge axes, target gizmos and readouts, inside the arm scene."""
 
-    def __init__(self, scene: ArmScene) -> None:
+    def __init__(self, scene: ArmScene, folder: viser.GuiFolderHandle) -> None:
+        """Build inside ``scene``; the readout goes in ``folder``, beneath the scene's declared Preset menu."""
         self.scene = scene
         self.preset: PresetLabel = "Chain"
         self.skeleton: Skeleton | None = None
@@ -368,12 +371,8 @@ class SkeletonView:
         """Skeleton gizmo updates handled, accepted or refused (tests wait on it)."""
         server, root = scene.server, scene.root.name
         gui = server.gui
-        with scene.gui_root, gui.add_folder("Skeleton", order=-1):
-            self.dropdown = gui.add_dropdown(
-                "Preset", options=list(PRESET_LABELS), initial_value="Chain"
-            )
+        with folder:
             self.readout = gui.add_markdown("")
-        self.dropdown.on_update(scene.callback(self._on_preset))
         cylinder = trimesh.creation.cylinder(radius=1.0, height=1.0, sections=12)
         cylinder.apply_translation((0.0, 0.0, 0.5))
         sphere = trimesh.creation.icosphere(subdivisions=2, radius=1.0)
@@ -430,12 +429,6 @@ class SkeletonView:
         return self.skeleton is not None
 
     # ----------------------------------------------------------------------------------------- callbacks
-    def _on_preset(self) -> None:
-        label = self.scene.read_choice(self.dropdown, PRESET_LABELS, self.preset)
-        for option in PRESET_LABELS:  # the Literal the cleaned string is
-            if option == label and option != self.preset:
-                self.show(option)
-
     def show(self, label: PresetLabel) -> None:
         """Switch to a preset (its rest pose and opening targets), or back to the chain; the camera frames it."""
         self.preset = label

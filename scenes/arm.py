@@ -31,7 +31,7 @@ from scenes._charts import FittedChart
 from scenes._controls import build_controls, checkbox, dropdown, slider
 from scenes._framing import ClientFraming, Lens, View, frame_points
 from scenes._skeletons import GIZMO_SCALE_M as SKELETON_GIZMO_M
-from scenes._skeletons import SkeletonView
+from scenes._skeletons import PRESET_LABELS, PresetLabel, SkeletonView
 
 MAX_LINKS = 12
 MAX_OBSTACLES = 4
@@ -66,6 +66,10 @@ class ArmParams:
     Each field is also its GUI control, declared once (:mod:`scenes._controls`), in the order and folder shown.
     """
 
+    preset: PresetLabel = field(
+        default="Chain", metadata=dropdown("Preset", PRESET_LABELS, folder="Skeleton")
+    )
+    """What is shown: the scene's own chain, or a skeleton preset (:mod:`scenes._skeletons`) in its place."""
     n_links: int = field(default=6, metadata=slider("Links", 2, MAX_LINKS, 1, folder="Chain"))
     """Links in the chain (2–12)."""
     link_length_m: float = field(
@@ -370,8 +374,8 @@ is a static pose.
         self._build_gui()
         self._build_world()
         self._click = server.scene.on_click()(self._on_scene_click)
-        self.skeletons = SkeletonView(self)
-        """The robot-arm, hand and upper-body presets (issue 14), shown in place of the chain when chosen."""
+        self.skeletons = SkeletonView(self, self.controls.folders["Skeleton"])
+        """The robot-arm, hand and upper-body presets, shown in place of the chain when chosen."""
         self.solve_and_draw()
         self._framed_box: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None
         """(lo, hi) world box (m) of what the cameras were last framed to show."""
@@ -386,6 +390,9 @@ is a static pose.
     def _build_gui(self) -> None:
         gui, p = self.server.gui, self.params
         with self.gui_root:
+            skeleton = build_controls(
+                gui, p, names=("preset",)
+            )  # first: the panel opens with the menu on top
             with gui.add_folder("This frame"):
                 self.readout = gui.add_markdown("")
                 self.ghost_readout = gui.add_markdown("")
@@ -404,7 +411,8 @@ is a static pose.
                     title="Error after each iteration (log scale)",
                     aspect=1.6,
                 )
-            self.controls = build_controls(gui, p)
+            chain = [f.name for f in dataclasses.fields(ArmParams) if f.name != "preset"]
+            self.controls = skeleton | build_controls(gui, p, names=chain)
             with self.controls.folders["Chain"]:  # after the chain's controls
                 self.reset_pose = gui.add_button("Straighten the chain")
         for handle in self.controls:  # a wrapper each, so a burst on one control coalesces
@@ -613,6 +621,9 @@ is a static pose.
         last = self.params
         self.params = self.read_params()
         p = self.params
+        if p.preset != last.preset:
+            self.skeletons.show(p.preset)
+            return
         if (p.n_links, p.link_length_m) != (last.n_links, last.link_length_m):
             self.pose = rest_pose(p.n_links, p.link_length_m)
         if p.three_d != last.three_d:
