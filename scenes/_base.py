@@ -326,8 +326,6 @@ class Scene(abc.ABC, Generic[P]):
         finally:
             self._in_callback = was
 
-    _write_back = write_back  # the name a scene's own methods still call it by
-
 
 def set_if_changed(handle: Any, name: str, value: Any) -> None:
     """Write a handle's property ``name`` only when ``value`` differs from it.
