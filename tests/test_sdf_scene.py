@@ -434,7 +434,9 @@ def test_fifty_builds_share_one_gl_context_and_do_not_grow_memory(
 def test_blend_dropdown_says_hard_and_smooth_and_hard_ignores_k(
     server: viser.ViserServer, scene: SdfGalleryScene
 ) -> None:
-    assert scene.scene_controls["blend"].options == (
+    blend = scene.scene_controls["blend"]
+    assert isinstance(blend, viser.GuiDropdownHandle)
+    assert blend.options == (
         "Hard",
         "Smooth (polynomial)",
         "Smooth (exponential)",
