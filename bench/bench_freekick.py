@@ -49,6 +49,8 @@ import viser  # noqa: E402
 from wsclient import BrowserClient  # noqa: E402
 
 from kernels import ball  # noqa: E402
+from kernels.ball.config import N_STEPS  # noqa: E402
+from kernels.ball.core import simulate_one  # noqa: E402
 from scenes.freekick import MAP_QUIET_S, FreeKickParams, FreeKickScene, outcome_map  # noqa: E402
 from server.switcher import SceneSwitcher  # noqa: E402
 
@@ -515,7 +517,7 @@ def overhead_rows(calls: int = 20_000) -> None:
     """The Python around one kick: the compiled core alone against a full public ``simulate`` call, in turns.
 
     A typical free kick: the scene's RK4 at 10 ms, a 30 m curler to the plane x = 30 m, t_max 4 s, the ball's
-    underside on the turf. (a) is ``ball._simulate_one`` on a prepared launch row and preallocated buffers; (b) is
+    underside on the turf. (a) is :func:`kernels.ball.core.simulate_one` on a prepared launch row and preallocated buffers; (b) is
     ``ball.simulate`` with a reused :class:`kernels.ball.FlightConfig`, (c) with the same settings as keywords.
     Each call is timed on its own; the three alternate, so a neighbour's load falls on all of them alike.
     """
@@ -523,7 +525,7 @@ def overhead_rows(calls: int = 20_000) -> None:
     options = {"dt": 1e-2, "method": "rk4", "t_max": 4.0, "x_stop": LINE_M, "ground_m": R}
     settings = config.settings
     launch = np.concatenate((START, VELOCITY, SPIN, np.zeros(4)))
-    rows = int(settings[ball._N_STEPS]) + 1
+    rows = int(settings[N_STEPS]) + 1
     t, state, forces = np.empty(rows), np.empty((rows, 6)), np.empty((rows, 12))
     ball.simulate(START, VELOCITY, SPIN, config)  # compiled already; warm the caches
     ball.simulate(START, VELOCITY, SPIN, **options)
@@ -531,7 +533,7 @@ def overhead_rows(calls: int = 20_000) -> None:
     clock = time.perf_counter_ns
     for _ in range(calls):
         start = clock()
-        ball._simulate_one(launch, settings, t, state, forces)
+        simulate_one(launch, settings, t, state, forces)
         middle = clock()
         ball.simulate(START, VELOCITY, SPIN, config)
         end = clock()

@@ -17,6 +17,8 @@ from numpy.typing import NDArray
 from scipy.integrate import solve_ivp
 
 from kernels import ball
+from kernels.ball import api, jit
+from kernels.ball.core import crossing_fraction
 
 M, R, RHO, G = 0.43, 0.11, 1.225, 9.81
 AREA = math.pi * R**2
@@ -47,7 +49,7 @@ def reference_at_x(
         speed = float(np.linalg.norm(v))
         if model == "constant":
             c_d, c_l = 0.25, 0.25
-        else:  # Goff & Carré 2010 and a lift slope of 0.9 (see kernels/ball.py's docstring)
+        else:  # Goff & Carré 2010 and a lift slope of 0.9 (see kernels.ball's docstring)
             s_param = R * rate / speed
             c_l = 0.9 * min(s_param, 0.3)
             re = RHO * speed * 2 * R / 1.81e-5
@@ -429,7 +431,7 @@ def test_batch_rejects_mismatched_rows() -> None:
 
 # ------------------------------------------------------------------------------------------------ plain reference
 # A second implementation of the module docstring's equations, in plain numpy, one kick at a time and nothing
-# shared with kernels/ball.py: the compiled flight must agree with it sample for sample.
+# shared with kernels.ball: the compiled flight must agree with it sample for sample.
 def reference_acceleration(
     v: NDArray[np.float64], t: float, spin: NDArray[np.float64], model: str, knuckle: tuple | None
 ) -> NDArray[np.float64]:
@@ -773,7 +775,7 @@ def test_a_batch_too_large_to_reserve_counts_first_and_stores_the_same(
     spins = np.array([ball.spin_vector(8, (0, 0, 1)), np.zeros(3), ball.spin_vector(5, (0, 1, 0))])
     positions = np.tile(START, (3, 1))
     reserved = ball.simulate_batch(positions, velocities, spins, dt=1e-2, method="rk4", ground_m=R)
-    monkeypatch.setattr(ball, "_RESERVE_BYTES", 0)
+    monkeypatch.setattr(api, "RESERVE_BYTES", 0)
     counted = ball.simulate_batch(positions, velocities, spins, dt=1e-2, method="rk4", ground_m=R)
     for field in ("t", "position", "velocity", "n_samples", "ended"):
         np.testing.assert_array_equal(getattr(counted, field), getattr(reserved, field))
@@ -915,8 +917,9 @@ WARM_CHECK = """
 import math, numpy as np
 from numba.core.registry import CPUDispatcher
 from kernels import ball
+from kernels.ball import aero, api, core
 
-cores = [f for f in vars(ball).values() if isinstance(f, CPUDispatcher)]
+cores = [f for m in (aero, core) for f in vars(m).values() if isinstance(f, CPUDispatcher)]
 ball.warm_up()
 before = sum(len(core.signatures) for core in cores)
 wall, goal = ball.free_kick_panels((0.0, 0.0), (20.0, 0.0), (1.0, 0.0))
@@ -931,7 +934,7 @@ for method in ("euler", "rk4"):
             ball.outcome_batch(batch, wall, goal)
             ball.simulate_outcomes([(0, 0, 0.11)] * 3, [v] * 3, [(0, 0, 50)] * 3, wall, goal, method=method,
                                    model=model, knuckle_seeds=[seed] * 3, x_stop=21.0)
-ball._RESERVE_BYTES = 0
+api.RESERVE_BYTES = 0
 ball.simulate_batch([(0, 0, 0.11)], [v], [(0, 0, 50)])
 print(before, sum(len(core.signatures) for core in cores))
 """
@@ -965,20 +968,20 @@ def test_without_a_writable_cache_directory_the_cores_compile_uncached(
             raise RuntimeError("cannot cache function 'f': no locator available for file 'ball.py'")
         return lambda function: function
 
-    monkeypatch.setattr(ball, "njit", refusing_njit)
-    monkeypatch.setattr(ball, "_UNCACHED", [])
+    monkeypatch.setattr(jit, "njit", refusing_njit)
+    monkeypatch.setattr(jit, "UNCACHED", [])
 
     def core() -> int:
         return 7
 
-    assert ball._compiled(parallel=True)(core)() == 7
+    assert jit.compiled(parallel=True)(core)() == 7
     assert calls == [{"cache": True, "parallel": True}, {"parallel": True}]
-    assert ball._UNCACHED == ["core"]
+    assert jit.UNCACHED == ["core"]
     monkeypatch.setattr(
-        ball, "njit", lambda **options: (_ for _ in ()).throw(RuntimeError("other failure"))
+        jit, "njit", lambda **options: (_ for _ in ()).throw(RuntimeError("other failure"))
     )
     with pytest.raises(RuntimeError, match="other failure"):
-        ball._compiled()(core)
+        jit.compiled()(core)
 
 
 # ------------------------------------------------------------------------------------------------ review 2
@@ -1056,7 +1059,7 @@ def test_the_crossing_is_the_first_root_of_the_step_cubic(
 ) -> None:
     # For any step with the plane bracketed (d0 ≥ 0 ≥ d1), the fraction lies in [0, 1], the cubic is (to rounding)
     # on the plane there, and it is on the near side everywhere before it.
-    s = ball._crossing_fraction(d0, dd0, d1, dd1, h)
+    s = crossing_fraction(d0, dd0, d1, dd1, h)
     assert 0.0 <= s <= 1.0
 
     def cubic(

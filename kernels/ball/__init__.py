@@ -1,0 +1,133 @@
+"""Flight of a spinning football: drag, Magnus lift, gravity and the knuckleball's unsteady side force.
+
+Frame and units: world frame with x from the ball toward the goal, y to the left, z up; SI throughout (m, s, kg,
+rad/s). A position is the ball's centre, (3,) or (N, 3); spin ω is the angular-velocity vector in rad/s.
+
+Model (per unit mass, A = π r², v̂ = v/|v|, ω̂ = ω/|ω|, zero when ω = 0)::
+
+    F_drag   = −½·ρ·A·C_D·|v|·v
+    F_Magnus = ½·ρ·A·C_L·|v|·(ω̂ × v)
+    F_grav   = (0, 0, −m·g)
+
+The seed writes the Magnus force as C_L·ρ·π·r²·|v×ω|/|ω|, which has units of kg/s, not newtons; the form above keeps
+its direction (ω × v) and its sin-angle factor and gives the seed's "3–5 m sideways over 25 m" (about 4.4 m at
+C_L = 0.25). Two coefficient models:
+
+* ``"constant"``: C_D and C_L as given (defaults 0.25 and 0.25). The curl radius is then fixed at 2m/(ρ·A·C_L)
+  ≈ 73.9 m whatever the spin rate, so spin changes nothing but the direction of the curl.
+* ``"measured"``: coefficients from published fits, so the spin rate matters. With S = r·|ω|/|v| the spin parameter
+  and Re = ρ·|v|·2r/μ (μ = 1.81·10⁻⁵ Pa·s):
+
+      C_L(S) = 0.9·min(S, 0.3)
+          Lift grows roughly as 0.8–1.0·S up to S ≈ 0.3 in wind-tunnel measurements (Asai et al. 2007, Sports Eng.
+          10; Carré, Goff et al. 2005–2010). Beyond S = 0.3 data are sparse; the value is held at 0.27.
+      C_D(Re, S) = C_D0(Re) + min(S/0.05, 1)·(C_Ds(max(S, 0.05)) − C_D0(Re))
+      C_D0(Re)   = 0.155 + 0.346 / (1 + exp((Re − 1.815·10⁵) / 1.949·10⁴))
+      C_Ds(S)    = 0.4127·S^0.3056
+          Goff & Carré 2010 (Eur. J. Phys. 31): the non-spinning fit 0.155 + 0.346/(1 + exp((v − 12.19)/1.309)),
+          re-expressed in Re for a 0.22 m ball in air of 1.225 kg/m³, puts the drag crisis at Re 2.2–3.3·10⁵ as Hong
+          & Asai 2013 measured; the spinning fit (S > 0.05) is theirs too. Between S = 0 and 0.05 the two are blended
+          linearly so C_D is continuous.
+
+Knuckleball (``knuckle_seed`` set): a ball kicked with almost no spin at 24–30 m/s sheds an unsteady wake and
+zig-zags by about one ball diameter, one zig-zag per ~15 m of flight (Cohen, Darbois Texier, Quéré & Clanet, APS DFD
+2012; Texier et al. 2016, New J. Phys. 18). Modelled as a side force of coefficient C_K = 0.10 across the launch
+direction, ``½·ρ·A·|v|²·C_K·w·(cos θ·sin(Ωt + φ₁)·n₁ + sin θ·sin(Ωt + φ₂)·n₂)``, with Ω = 2π·|v₀|/15 m, n₁ = ẑ × v̂₀
+normalised (horizontal, to the left; +y for a vertical kick) and n₂ = v̂₀ × n₁, and θ, φ₁, φ₂ drawn in that order by
+``numpy.random.default_rng(knuckle_seed).uniform(0, 2π, 3)`` so a seed always gives the same flight.
+w = max(0, 1 − S₀/0.05) fades the effect out as launch spin grows (S₀ the launch spin parameter): any real spin
+steadies the wake. With C_K = 0.10 the median (over seeds) peak deviation from the spinless flight of a 25 m/s
+kick at 12° over 25 m is 0.18 m for seeds 0–29 and 0.21 m for seeds 0–199 (RK4, 10 ms): a little under the "about
+one ball diameter" (0.22 m) those papers report.
+
+Assumptions: spin is constant in flight (spin decay over a 1–2 s free kick is a few percent); still air; the ball is
+rigid and stops at the first touch of the ground (no bounce or roll); a ball that touches the wall or the frame does
+not rebound. Integrators: ``"euler"`` is the seed's fixed-step method (v += a·dt, then x += v·dt; first order),
+``"rk4"`` the classical fourth-order Runge–Kutta. The last sample of a flight is placed on the ground (or on the
+``x_stop`` plane) by cubic Hermite interpolation of the last step, which keeps RK4's accuracy: the first root of
+that cubic in the step, bracketed between its turning points (a ball may rise, peak and land within one long step).
+Wall and goal crossings are found the same way. Every step is ``dt`` but the last, which is shortened to end exactly
+on ``t_max``. Planes are closed on the start side: a ball launched on the ``x_stop``, wall or goal plane and moving
+through it crosses at t = 0; one launched on the ground (``z = ground_m``) and not moving up lands at t = 0; one
+launched below it is refused. The measured model refuses a launch spin parameter r·|ω|/max(|v|, 1 m/s) above 10³
+(its fits stop at S ≈ 0.3; 10³ is ~2·10⁵ rev/s at 25 m/s) with a ``ValueError`` naming the spin.
+
+Implementation: every numeric core (force law, Euler and RK4 steps, the Hermite end of a flight, plane crossings and
+the verdict) is written once, on scalars, and compiled by numba (``@njit(cache=True)``). One kick and a batch run the
+same compiled flight; a batch runs its kicks in parallel (``prange``, :func:`numba.get_num_threads` threads). The
+Python functions around them only validate (``ValueError`` naming the argument) and package arrays. Compiled code is cached
+in ``__pycache__`` beside each module, or, where that is read-only (an installed package), in numba's user-wide cache
+(``~/.cache/numba``; ``NUMBA_CACHE_DIR`` overrides both; with neither writable, no disk cache). :func:`warm_up`
+compiles (or loads) every core. A flight whose steps overshoot the drag, so that |v|² + 2gz grows far past its launch
+value (or overflows), raises ``ValueError`` naming ``dt`` rather than returning an absurd path.
+
+Modules: :mod:`~kernels.ball.config` (constants, :class:`FlightConfig`, input checks), :mod:`~kernels.ball.pitch` (goal
+and wall panels), :mod:`~kernels.ball.aero` (the compiled force law), :mod:`~kernels.ball.core` (the compiled flight,
+crossings and verdict), :mod:`~kernels.ball.api` (:func:`simulate`, the batch functions and their results),
+:mod:`~kernels.ball.jit` (numba with or without its disk cache). Everything public is importable from here.
+"""
+
+from __future__ import annotations
+
+from kernels.ball.api import (
+    BatchOutcome,
+    BatchTrajectory,
+    Outcome,
+    Trajectory,
+    launch_velocity,
+    outcome,
+    outcome_batch,
+    simulate,
+    simulate_batch,
+    simulate_outcomes,
+    spin_vector,
+    warm_up,
+)
+from kernels.ball.config import (
+    AIR_DENSITY,
+    AIR_VISCOSITY,
+    BALL_MASS_KG,
+    BALL_RADIUS_M,
+    KNUCKLE_COEFFICIENT,
+    KNUCKLE_SPIN_LIMIT,
+    KNUCKLE_WAVELENGTH_M,
+    FlightConfig,
+    G,
+    Method,
+    Model,
+)
+from kernels.ball.core import Ending, Result
+from kernels.ball.pitch import GOAL_HEIGHT_M, GOAL_WIDTH_M, WALL_DISTANCE_M, Panel, free_kick_panels
+
+__all__ = [
+    "AIR_DENSITY",
+    "AIR_VISCOSITY",
+    "BALL_MASS_KG",
+    "BALL_RADIUS_M",
+    "GOAL_HEIGHT_M",
+    "GOAL_WIDTH_M",
+    "KNUCKLE_COEFFICIENT",
+    "KNUCKLE_SPIN_LIMIT",
+    "KNUCKLE_WAVELENGTH_M",
+    "WALL_DISTANCE_M",
+    "BatchOutcome",
+    "BatchTrajectory",
+    "Ending",
+    "FlightConfig",
+    "G",
+    "Method",
+    "Model",
+    "Outcome",
+    "Panel",
+    "Result",
+    "Trajectory",
+    "free_kick_panels",
+    "launch_velocity",
+    "outcome",
+    "outcome_batch",
+    "simulate",
+    "simulate_batch",
+    "simulate_outcomes",
+    "spin_vector",
+    "warm_up",
+]

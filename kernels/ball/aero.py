@@ -1,0 +1,140 @@
+"""The force law, compiled: drag and Magnus lift (constant or measured coefficients), the knuckleball's side force,
+and gravity.
+
+Scalar cores on the (14,) settings vector of :class:`kernels.ball.config.FlightConfig` and each kick's (14,)
+constants (slots :data:`AXIS` … :data:`N2`: ω̂, |ω|, knuckle gain, rate, phases, directions). Accelerations are per
+unit mass (m/s²), forces in N. Coefficients: constant C_D and C_L, or the measured fits C_L(S) of Asai et al. 2007
+(Sports Eng. 10) and C_D(Re, S) of Goff & Carré 2010 (Eur. J. Phys. 31); knuckle force after Cohen et al. 2012 and
+Texier et al. 2016 (New J. Phys. 18). The model, its assumptions and its sources in full: :mod:`kernels.ball`.
+"""
+
+from __future__ import annotations
+
+import math
+
+from kernels.ball.config import (
+    C_D,
+    C_L,
+    GRAVITY,
+    KNUCKLE_COEFFICIENT,
+    KNUCKLE_SPIN_LIMIT,
+    KNUCKLE_WAVELENGTH_M,
+    MASS,
+    MEASURED,
+    RADIUS,
+    RE_PER_SPEED,
+    Q,
+)
+from kernels.ball.jit import compiled
+
+# Goff & Carré 2010 no-spin drag fit, in Reynolds number (see :mod:`kernels.ball`).
+_RE_CRISIS = 1.815e5
+_RE_WIDTH = 1.949e4
+
+# Each kick's constants are one row of 14 (beside the settings vector of FlightConfig): ω̂, |ω|, knuckle gain ½ρA·C_K·w/m, rate Ω, phases φ₁ φ₂,
+# cos θ·n₁ and sin θ·n₂.
+AXIS, RATE, GAIN, OMEGA, PHASE, N1, N2 = 0, 3, 4, 5, 6, 8, 11
+N_KICK = 14
+
+
+# --------------------------------------------------------------------------------------------- force law
+@compiled(inline="always")
+def _norm(v):
+    """|v| of a (3,) vector without overflow or underflow in the squares (a spin of 1e200 rad/s still has an axis)."""
+    scale = max(abs(v[0]), abs(v[1]), abs(v[2]))
+    if scale == 0.0 or not math.isfinite(scale):
+        return scale
+    return scale * math.sqrt((v[0] / scale) ** 2 + (v[1] / scale) ** 2 + (v[2] / scale) ** 2)
+
+
+@compiled()
+def fill_kick(launch, config, kick):
+    """One kick's (14,) constants (see the slots above) from its (13,) launch row."""
+    velocity, spin, angles = launch[3:6], launch[6:9], launch[9:12]
+    rate = _norm(spin)
+    kick[:] = 0.0
+    if rate > 0.0:
+        for i in range(3):
+            kick[AXIS + i] = spin[i] / rate
+    kick[RATE] = rate
+    speed = _norm(velocity)
+    if launch[12] == 0.0 or speed == 0.0:
+        return
+    weight = max(0.0, 1.0 - config[RADIUS] * rate / speed / KNUCKLE_SPIN_LIMIT)
+    ux, uy, uz = velocity[0] / speed, velocity[1] / speed, velocity[2] / speed
+    hx, hy = -uy, ux  # horizontal normal to the launch direction
+    length = math.sqrt(hx * hx + hy * hy)
+    if length < 1e-9:  # kicked straight up: any horizontal direction will do
+        hx, hy, length = 0.0, 1.0, 1.0
+    hx, hy = hx / length, hy / length
+    vertical = (-uz * hy, uz * hx, ux * hy - uy * hx)  # u × h
+    theta = angles[0]
+    kick[GAIN] = config[Q] * KNUCKLE_COEFFICIENT * weight
+    kick[OMEGA] = 2.0 * math.pi * speed / KNUCKLE_WAVELENGTH_M
+    kick[PHASE], kick[PHASE + 1] = angles[1], angles[2]
+    kick[N1], kick[N1 + 1] = math.cos(theta) * hx, math.cos(theta) * hy
+    for i in range(3):
+        kick[N2 + i] = math.sin(theta) * vertical[i]
+
+
+@compiled(inline="always")
+def _factors(speed, kick, config):
+    """(−½ρA·C_D·|v|/m, ½ρA·C_L·|v|/m) at this speed: drag and lift per unit velocity and mass (1/s)."""
+    q = config[Q]
+    if config[MEASURED] == 0.0:
+        return -q * config[C_D] * speed, q * config[C_L] * speed
+    spin_parameter = config[RADIUS] * kick[RATE] / max(speed, 1e-9)
+    lift = 0.9 * min(spin_parameter, 0.3)  # Asai et al. 2007
+    arg = min((config[RE_PER_SPEED] * speed - _RE_CRISIS) / _RE_WIDTH, 50.0)
+    still = 0.155 + 0.346 / (1.0 + math.exp(arg))  # Goff & Carré 2010
+    spinning = 0.4127 * max(spin_parameter, 0.05) ** 0.3056
+    drag = still + min(spin_parameter / 0.05, 1.0) * (spinning - still)
+    return -q * drag * speed, q * lift * speed
+
+
+@compiled(inline="always")
+def _knuckle(speed, t, kick):
+    """Knuckle side force per unit mass (m/s², 3 values); zero when the kick has none."""
+    gain = kick[GAIN]
+    if gain == 0.0:
+        return 0.0, 0.0, 0.0
+    kk = gain * speed * speed
+    s1 = kk * math.sin(kick[OMEGA] * t + kick[PHASE])
+    s2 = kk * math.sin(kick[OMEGA] * t + kick[PHASE + 1])
+    return (
+        s1 * kick[N1] + s2 * kick[N2],
+        s1 * kick[N1 + 1] + s2 * kick[N2 + 1],
+        s1 * kick[N1 + 2] + s2 * kick[N2 + 2],
+    )
+
+
+@compiled(inline="always")
+def acceleration(vx, vy, vz, t, kick, config):
+    """Total acceleration (m/s²): drag, Magnus (ω̂ × v), knuckle and gravity."""
+    speed = math.sqrt(vx * vx + vy * vy + vz * vz)
+    kd, kl = _factors(speed, kick, config)
+    wx, wy, wz = kick[AXIS], kick[AXIS + 1], kick[AXIS + 2]
+    sx, sy, sz = _knuckle(speed, t, kick)
+    return (
+        kd * vx + kl * (wy * vz - wz * vy) + sx,
+        kd * vy + kl * (wz * vx - wx * vz) + sy,
+        kd * vz + kl * (wx * vy - wy * vx) + sz - config[GRAVITY],
+    )
+
+
+@compiled()
+def sample_forces(t, state, kick, config, forces):
+    """Drag, Magnus, gravity and knuckle forces (N) at each sample: ``forces`` (N, 12) from ``state`` (N, 6)."""
+    m = config[MASS]
+    wx, wy, wz = kick[AXIS], kick[AXIS + 1], kick[AXIS + 2]
+    for i in range(len(t)):
+        vx, vy, vz = state[i, 3], state[i, 4], state[i, 5]
+        speed = math.sqrt(vx * vx + vy * vy + vz * vz)
+        kd, kl = _factors(speed, kick, config)
+        sx, sy, sz = _knuckle(speed, t[i], kick)
+        forces[i, 0], forces[i, 1], forces[i, 2] = m * kd * vx, m * kd * vy, m * kd * vz
+        forces[i, 3] = m * kl * (wy * vz - wz * vy)
+        forces[i, 4] = m * kl * (wz * vx - wx * vz)
+        forces[i, 5] = m * kl * (wx * vy - wy * vx)
+        forces[i, 6], forces[i, 7], forces[i, 8] = 0.0, 0.0, -m * config[GRAVITY]
+        forces[i, 9], forces[i, 10], forces[i, 11] = m * sx, m * sy, m * sz

@@ -1,0 +1,432 @@
+"""Kick a ball: :func:`simulate` one flight, :func:`simulate_batch` many, judge them against the wall and the goal.
+
+Python around the compiled cores of :mod:`kernels.ball.core`: it validates (``ValueError`` naming the argument),
+packs arrays and returns frozen dataclasses: :class:`Trajectory` ((N,) times, (N, 3) positions, velocities and forces
+in m, m/s and N), :class:`BatchTrajectory` ((K, T) and (K, T, 3)), :class:`Outcome` and :class:`BatchOutcome`.
+:func:`warm_up` compiles (or loads) every core. Frame, units, model and sources: :mod:`kernels.ball`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import threading
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from kernels import _checks
+from kernels.ball.config import (
+    BALL_RADIUS_M,
+    DT,
+    GROUND,
+    MEASURED,
+    N_STEPS,
+    FlightConfig,
+    check_launches,
+    checked_seed,
+    checked_vector,
+    fast_floats,
+    flight_config,
+    kick_rows,
+    launch_rows,
+)
+from kernels.ball.core import (
+    ENDINGS,
+    RESULTS,
+    Ending,
+    Result,
+    fly_and_judge,
+    fly_batch,
+    judge,
+    judge_batch,
+    pad,
+    simulate_one,
+)
+from kernels.ball.pitch import Panel, free_kick_panels, panel_rows
+
+RESERVE_BYTES = 2**31
+"""Largest time-major reservation :func:`simulate_batch` makes before it counts the samples first (bytes)."""
+# numba's workqueue threading layer (the fallback where neither TBB nor OpenMP is present) must not launch two
+# parallel kernels at once; the scene's workers and the app's warm-up may call from different threads.
+_PARALLEL = threading.Lock()
+
+
+@dataclasses.dataclass(frozen=True)
+class Trajectory:
+    """One flight sampled every ``dt``; the last sample is the interpolated end (ground contact or ``x_stop``)."""
+
+    t: NDArray[np.float64]
+    """(N,) time since the kick (s)."""
+    position: NDArray[np.float64]
+    """(N, 3) ball centre (m)."""
+    velocity: NDArray[np.float64]
+    """(N, 3) ball velocity (m/s)."""
+    drag: NDArray[np.float64]
+    """(N, 3) drag force (N)."""
+    magnus: NDArray[np.float64]
+    """(N, 3) Magnus force (N)."""
+    gravity: NDArray[np.float64]
+    """(N, 3) weight (N)."""
+    knuckle: NDArray[np.float64]
+    """(N, 3) knuckleball side force (N); zero unless ``knuckle_seed`` was set and the spin is near zero."""
+    ended: Ending
+    """Why the flight stopped: it touched the ground, passed ``x_stop``, or reached ``t_max``."""
+
+
+@dataclasses.dataclass(frozen=True)
+class BatchTrajectory:
+    """Many flights integrated together, padded after each one's end with its final state."""
+
+    t: NDArray[np.float64]
+    """(K, T) time of each sample (s); kick k's samples are ``[:n_samples[k]]``."""
+    position: NDArray[np.float64]
+    """(K, T, 3) ball centre (m)."""
+    velocity: NDArray[np.float64]
+    """(K, T, 3) ball velocity (m/s)."""
+    n_samples: NDArray[np.int64]
+    """(K,) samples that belong to each flight; the last is its interpolated end."""
+    ended: NDArray[np.str_]
+    """(K,) ``"ground"``, ``"x_stop"`` or ``"t_max"``."""
+
+
+@dataclasses.dataclass(frozen=True)
+class Outcome:
+    """What a kick did, and where it crossed the wall's and the goal's planes."""
+
+    result: Result
+    """``"goal"``, ``"wall"`` (hit it), ``"over"`` the bar, ``"wide"`` of a post, or ``"short"`` (landed first)."""
+    wall_point: NDArray[np.float64] | None
+    """(3,) ball centre where it crossed the wall's plane (m), None if it never got there."""
+    goal_point: NDArray[np.float64] | None
+    """(3,) ball centre where it crossed the goal's plane (m), None if it never got there."""
+    wall_time: float | None
+    """Time of the wall crossing (s)."""
+    goal_time: float | None
+    """Time of the goal crossing (s)."""
+
+
+@dataclasses.dataclass(frozen=True)
+class BatchOutcome:
+    """:class:`Outcome` for each kick of a batch; crossings are NaN where there was none."""
+
+    result: NDArray[np.str_]
+    """(K,) one of the five results."""
+    wall_point: NDArray[np.float64]
+    """(K, 3) crossing of the wall's plane (m)."""
+    goal_point: NDArray[np.float64]
+    """(K, 3) crossing of the goal's plane (m)."""
+
+
+def _refuse_overflow(endings: NDArray[np.int64], config: NDArray[np.float64]) -> None:
+    """Raise where a flight overflowed to inf or NaN: an explicit step too long for its drag, or absurd input."""
+    bad = np.flatnonzero(endings == 3)
+    if bad.size:
+        which = "the flight" if len(endings) == 1 else f"kicks {bad[:5].tolist()}"
+        raise ValueError(
+            f"dt = {config[DT]:g} s is too long for {which}: each step overshoots the drag, so the ball gains "
+            "energy until it overflows; use a smaller dt (or a smaller air_density or a larger mass_kg)"
+        )
+
+
+def simulate(
+    position: ArrayLike,
+    velocity: ArrayLike,
+    spin: ArrayLike,
+    config: FlightConfig | None = None,
+    *,
+    knuckle_seed: int | None = None,
+    **options: Any,
+) -> Trajectory:
+    """Integrate one kick until the ball's centre reaches ``ground_m``, passes ``x_stop``, or ``t_max`` runs out.
+
+    Args:
+        position: (3,) launch position of the ball's centre (m).
+        velocity: (3,) launch velocity (m/s).
+        spin: (3,) angular velocity (rad/s); +z curls a ball kicked along +x to the left (+y), +y is topspin.
+        config: the ball, air, integrator and end of the flight (:class:`FlightConfig`, validated once); default
+            ``FlightConfig()``.
+        knuckle_seed: turn on the knuckleball side force (near-zero spin only), drawn from this seed.
+        **options: instead of ``config``, any of :class:`FlightConfig`'s fields as keywords (``dt=1e-2,
+            method="rk4"``); the config built from them is cached, so repeating the same options costs no
+            validation.
+
+    Returns:
+        :class:`Trajectory`, sampled every ``dt`` plus the interpolated end.
+
+    Raises:
+        ValueError: naming the argument, for non-finite, boolean or wrongly shaped input, an invalid
+            :class:`FlightConfig` field, a position below ``ground_m``, a spin beyond the measured model's range
+            (see :mod:`kernels.ball`); naming dt when the steps overshoot the drag and the ball gains energy
+            without bound (a step far too long for this speed, density and mass).
+        TypeError: an unknown keyword.
+    """
+    flight = flight_config(config, options)
+    settings = flight.settings
+    p0, v0, w0 = fast_floats(position), fast_floats(velocity), fast_floats(spin)
+    if p0 is None or v0 is None or w0 is None or knuckle_seed is not None:
+        launch = launch_rows(
+            checked_vector("position", position, 3)[None],
+            checked_vector("velocity", velocity, 3)[None],
+            checked_vector("spin", spin, 3)[None],
+            [checked_seed("knuckle_seed", knuckle_seed)],
+        )
+        check_launches(launch, settings, batch=False)
+        launch = launch[0]
+    else:  # three plain vectors and no knuckle: the launch row at once
+        launch = np.array(p0 + v0 + w0 + _NO_KNUCKLE)
+        if settings[MEASURED] or p0[2] < settings[GROUND]:
+            check_launches(launch[None], settings, batch=False)
+    rows = int(settings[N_STEPS]) + 1
+    t, state, forces = np.empty(rows), np.empty((rows, 6)), np.empty((rows, 12))
+    n, ending = simulate_one(launch, settings, t, state, forces)
+    if ending == 3:
+        _refuse_overflow(np.array([ending]), settings)
+    state, forces = state[:n], forces[:n]
+    return Trajectory(
+        t=t[:n],
+        position=state[:, :3],
+        velocity=state[:, 3:],
+        drag=forces[:, 0:3],
+        magnus=forces[:, 3:6],
+        gravity=forces[:, 6:9],
+        knuckle=forces[:, 9:12],
+        ended=ENDINGS[ending],
+    )
+
+
+_NO_KNUCKLE = [0.0, 0.0, 0.0, 0.0]
+"""Knuckle angles θ φ₁ φ₂ and flag of a launch row without the knuckle force."""
+
+
+def simulate_batch(
+    positions: ArrayLike,
+    velocities: ArrayLike,
+    spins: ArrayLike,
+    config: FlightConfig | None = None,
+    *,
+    knuckle_seeds: Sequence[int | None] | None = None,
+    **options: Any,
+) -> BatchTrajectory:
+    """Integrate K kicks, in parallel over the kicks; each flight is :func:`simulate`'s, bit for bit.
+
+    Memory is K·T·7 floats (T the longest flight's samples): 10 000 kicks of 1.9 s at RK4 10 ms take ~110 MB, at
+    Euler 1 ms ten times that; use ``x_stop`` and a coarser ``dt`` for large sweeps, or :func:`simulate_outcomes`
+    when only the verdicts matter. Forces are not stored; run :func:`simulate` on a kick of interest for them.
+
+    Args:
+        positions: (K, 3) launch positions (m).
+        velocities: (K, 3) launch velocities (m/s).
+        spins: (K, 3) angular velocities (rad/s).
+        knuckle_seeds: None, or K seeds (each None or an int) as :func:`simulate`'s ``knuckle_seed``.
+        config, options: as for :func:`simulate`, shared by every kick.
+
+    Returns:
+        :class:`BatchTrajectory`.
+    """
+    settings = flight_config(config, options).settings
+    launches = kick_rows(positions, velocities, spins, knuckle_seeds)
+    check_launches(launches, settings, batch=True)
+    k = len(launches)
+    rows = int(settings[N_STEPS]) + 1
+    n_samples, endings = np.ones(k, dtype=np.int64), np.full(k, 2, dtype=np.int64)
+    with _PARALLEL:
+        # Time-major (T, K) storage with room for the longest flight t_max allows: rows past this batch's longest
+        # flight are never touched, so they never become memory. Where even that reservation is too large, count
+        # the samples first.
+        if rows * k * 56 > RESERVE_BYTES:
+            fly_batch(launches, settings, np.empty((0, k)), np.empty((0, k, 6)), n_samples, endings)
+            rows = int(n_samples.max())
+        t, state = np.empty((rows, k)), np.empty((rows, k, 6))
+        fly_batch(launches, settings, t, state, n_samples, endings)
+        width = int(n_samples.max()) if k else 1
+        t, state = t[:width], state[:width]
+        pad(t, state, n_samples)
+    _refuse_overflow(endings, settings)
+    state = state.transpose(1, 0, 2)  # (K, T, 6) view, no copy
+    return BatchTrajectory(
+        t=t.T,
+        position=state[:, :, :3],
+        velocity=state[:, :, 3:],
+        n_samples=n_samples,
+        ended=np.array(ENDINGS, dtype="<U6")[endings],
+    )
+
+
+def outcome(
+    trajectory: Trajectory, wall: Panel, goal: Panel, *, radius_m: float = BALL_RADIUS_M
+) -> Outcome:
+    """Judge one flight against the wall and the goal.
+
+    The ball hits the wall when its centre crosses the wall's plane within a radius of the defenders' outline
+    (width × height). Otherwise, where its centre crosses the goal's plane decides: the whole ball inside the posts
+    and under the bar is a goal; outside a post is wide; inside the posts but touching or above the bar is over. A
+    flight that ends (lands, or reaches ``t_max``) before the goal's plane is short. Posts and bar do not rebound.
+    Each crossing is the root of the cubic Hermite interpolant of the step that crosses the plane.
+
+    Args:
+        trajectory: from :func:`simulate`.
+        wall: the wall, e.g. from :func:`free_kick_panels`.
+        goal: the goal mouth.
+        radius_m: ball radius (m).
+
+    Returns:
+        :class:`Outcome`.
+    """
+    radius = _checks.positive("radius_m", radius_m)
+    if not isinstance(trajectory, Trajectory):
+        raise ValueError(
+            f"trajectory must be a Trajectory from simulate(), got {type(trajectory).__name__}"
+        )
+    crossings = np.empty((2, 4))
+    t, position, velocity = trajectory.t, trajectory.position, trajectory.velocity
+    code = judge(t, position, velocity, len(t), panel_rows(wall, goal), radius, crossings)
+    wall_ok, goal_ok = not math.isnan(crossings[0, 0]), not math.isnan(crossings[1, 0])
+    return Outcome(
+        result=RESULTS[code],
+        wall_point=crossings[0, 1:] if wall_ok else None,
+        goal_point=crossings[1, 1:] if goal_ok else None,
+        wall_time=float(crossings[0, 0]) if wall_ok else None,
+        goal_time=float(crossings[1, 0]) if goal_ok else None,
+    )
+
+
+def outcome_batch(
+    batch: BatchTrajectory, wall: Panel, goal: Panel, *, radius_m: float = BALL_RADIUS_M
+) -> BatchOutcome:
+    """:func:`outcome` for every kick of a batch, in parallel.
+
+    Args:
+        batch: from :func:`simulate_batch`.
+        wall: the wall.
+        goal: the goal mouth.
+        radius_m: ball radius (m).
+
+    Returns:
+        :class:`BatchOutcome`.
+    """
+    radius = _checks.positive("radius_m", radius_m)
+    if not isinstance(batch, BatchTrajectory):
+        raise ValueError(
+            f"batch must be a BatchTrajectory from simulate_batch(), got {type(batch).__name__}"
+        )
+    k = len(batch.n_samples)
+    results, crossings, panels = (
+        np.empty(k, dtype=np.int64),
+        np.empty((k, 2, 4)),
+        panel_rows(wall, goal),
+    )
+    with _PARALLEL:
+        judge_batch(
+            batch.t,
+            batch.position,
+            batch.velocity,
+            batch.n_samples,
+            panels,
+            radius,
+            results,
+            crossings,
+        )
+    return _batch_outcome(results, crossings)
+
+
+def _batch_outcome(results: NDArray[np.int64], crossings: NDArray[np.float64]) -> BatchOutcome:
+    return BatchOutcome(
+        result=np.array(RESULTS, dtype="<U5")[results],
+        wall_point=crossings[:, 0, 1:],
+        goal_point=crossings[:, 1, 1:],
+    )
+
+
+def simulate_outcomes(
+    positions: ArrayLike,
+    velocities: ArrayLike,
+    spins: ArrayLike,
+    wall: Panel,
+    goal: Panel,
+    config: FlightConfig | None = None,
+    *,
+    knuckle_seeds: Sequence[int | None] | None = None,
+    **options: Any,
+) -> BatchOutcome:
+    """``outcome_batch(simulate_batch(...), wall, goal)`` without keeping the flights: the same verdicts and crossings.
+
+    Each kick flies into a scratch buffer of its own and is judged at once, in parallel over the kicks, so memory
+    stays K·(a few floats) however long the flights. This is what a sweep (an outcome map, an aiming search) wants.
+
+    Args:
+        positions, velocities, spins, knuckle_seeds: the K kicks, as for :func:`simulate_batch`.
+        wall: the wall.
+        goal: the goal mouth.
+        config, options: as for :func:`simulate`, shared by every kick; its ``radius_m`` also sizes the ball
+            for the verdict.
+
+    Returns:
+        :class:`BatchOutcome`.
+    """
+    settings = flight_config(config, options).settings
+    launches = kick_rows(positions, velocities, spins, knuckle_seeds)
+    check_launches(launches, settings, batch=True)
+    k, panels = len(launches), panel_rows(wall, goal)
+    results, crossings, endings = np.empty(k, np.int64), np.empty((k, 2, 4)), np.empty(k, np.int64)
+    with _PARALLEL:
+        fly_and_judge(launches, settings, panels, results, crossings, endings)
+    _refuse_overflow(endings, settings)
+    return _batch_outcome(results, crossings)
+
+
+def spin_vector(rate_rev_s: float, axis: ArrayLike) -> NDArray[np.float64]:
+    """Angular velocity (rad/s) from a spin rate in rev/s about ``axis`` (any length, normalised here).
+
+    Args:
+        rate_rev_s: spin rate (rev/s, ≥ 0).
+        axis: (3,) spin axis; +z is sidespin curling a ball kicked along +x to the left.
+
+    Returns:
+        (3,) ω (rad/s).
+    """
+    rate = _checks.non_negative("rate_rev_s", rate_rev_s)
+    direction = checked_vector("axis", axis, 3)
+    scale = float(np.abs(direction).max())
+    if scale == 0.0:
+        raise ValueError("axis must not be zero")
+    direction = (
+        direction / scale
+    )  # largest component ±1 first: neither overflows nor underflows when squared
+    return 2.0 * math.pi * rate * direction / float(np.linalg.norm(direction))
+
+
+def launch_velocity(
+    speed_ms: float, elevation_rad: float, azimuth_rad: float
+) -> NDArray[np.float64]:
+    """Velocity (3,) in m/s from speed, elevation above the ground and azimuth to the left of +x."""
+    speed = _checks.non_negative("speed_ms", speed_ms)
+    elevation = _checks.finite_number("elevation_rad", elevation_rad)
+    azimuth = _checks.finite_number("azimuth_rad", azimuth_rad)
+    return speed * np.array(
+        [
+            math.cos(elevation) * math.cos(azimuth),
+            math.cos(elevation) * math.sin(azimuth),
+            math.sin(elevation),
+        ]
+    )
+
+
+def warm_up() -> None:
+    """Compile, or load from the cache, every compiled core, on tiny inputs (both models, both methods, a knuckle).
+
+    Call once at start-up, off the thread that serves users: the first kick then runs at full speed. A cold compile
+    takes several seconds; a warm cache loads in well under one.
+    """
+    wall, goal = free_kick_panels((0.0, 0.0), (12.0, 0.0), (1.0, 0.0))
+    start, velocity, spin = (0.0, 0.0, BALL_RADIUS_M), (20.0, 0.0, 4.0), (0.0, 0.0, 30.0)
+    flight = simulate(
+        start, velocity, spin, dt=0.05, method="rk4", model="measured", knuckle_seed=0
+    )
+    outcome(flight, wall, goal)
+    rows = np.array([start, start])
+    batch = simulate_batch(rows, [velocity, velocity], [spin, spin], dt=0.05, t_max=0.2)
+    outcome_batch(batch, wall, goal)
+    simulate_outcomes(rows, [velocity, velocity], [spin, spin], wall, goal, dt=0.05, x_stop=13.0)

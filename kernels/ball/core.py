@@ -1,0 +1,328 @@
+"""The compiled flight and its verdict: Euler or RK4 steps, the Hermite end of a flight, plane crossings, the judge.
+
+A flight writes its samples' times (T,) and states (T, 6: position then velocity, m and m/s) into buffers the caller
+gives; a batch runs its K kicks in parallel (``prange``) into (T, K) and (T, K, 6) time-major buffers. Each flight
+ends with a code in :data:`ENDINGS` order (3: diverged), each verdict with one in :data:`RESULTS` order. Crossings are
+the first root of the cubic Hermite interpolant of the step (:func:`crossing_fraction`). Method and assumptions:
+:mod:`kernels.ball`.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Literal
+
+import numpy as np
+from numba import prange
+
+from kernels.ball.aero import N_KICK, acceleration, fill_kick, sample_forces
+from kernels.ball.config import DT, GRAVITY, GROUND, N_STEPS, RADIUS, RK4, T_MAX, X_STOP
+from kernels.ball.jit import compiled
+
+Ending = Literal["ground", "x_stop", "t_max"]
+Result = Literal["goal", "wall", "over", "wide", "short"]
+
+# Codes of the compiled flight's ending (3, diverged, raises) and of its verdict.
+ENDINGS: tuple[Ending, ...] = ("ground", "x_stop", "t_max")
+RESULTS: tuple[Result, ...] = ("goal", "wall", "over", "wide", "short")
+
+
+# --------------------------------------------------------------------------------------------- flight
+@compiled(inline="always")
+def _step(x, y, z, vx, vy, vz, t, dt, kick, config):
+    """One step of length ``dt`` of the configured method: (x, y, z, vx, vy, vz) after it."""
+    if config[RK4] == 0.0:  # the seed's Euler: velocity first, then position with the new velocity
+        ax, ay, az = acceleration(vx, vy, vz, t, kick, config)
+        vx1, vy1, vz1 = vx + ax * dt, vy + ay * dt, vz + az * dt
+        return x + vx1 * dt, y + vy1 * dt, z + vz1 * dt, vx1, vy1, vz1
+    half, sixth = 0.5 * dt, dt / 6.0
+    # The acceleration does not depend on position, so each stage's position slope is its velocity.
+    a1x, a1y, a1z = acceleration(vx, vy, vz, t, kick, config)
+    v2x, v2y, v2z = vx + half * a1x, vy + half * a1y, vz + half * a1z
+    a2x, a2y, a2z = acceleration(v2x, v2y, v2z, t + half, kick, config)
+    v3x, v3y, v3z = vx + half * a2x, vy + half * a2y, vz + half * a2z
+    a3x, a3y, a3z = acceleration(v3x, v3y, v3z, t + half, kick, config)
+    v4x, v4y, v4z = vx + dt * a3x, vy + dt * a3y, vz + dt * a3z
+    a4x, a4y, a4z = acceleration(v4x, v4y, v4z, t + dt, kick, config)
+    return (
+        x + sixth * (vx + 2.0 * (v2x + v3x) + v4x),
+        y + sixth * (vy + 2.0 * (v2y + v3y) + v4y),
+        z + sixth * (vz + 2.0 * (v2z + v3z) + v4z),
+        vx + sixth * (a1x + 2.0 * (a2x + a3x) + a4x),
+        vy + sixth * (a1y + 2.0 * (a2y + a3y) + a4y),
+        vz + sixth * (a1z + 2.0 * (a2z + a3z) + a4z),
+    )
+
+
+@compiled(inline="always")
+def _hermite(p0, v0, p1, v1, h, s):
+    """Cubic Hermite value and derivative (per unit time) at fraction ``s`` of a step of length ``h``.
+
+    The value is written as p0 + (p1 − p0)·(3s² − 2s³) + slope terms, so a coordinate constant over the step
+    (p0 = p1, no velocity) comes back exactly, whatever s; s = 0 and s = 1 give the samples exactly.
+    """
+    s2, s3 = s * s, s * s * s
+    if s <= 0.0:
+        value = p0
+    elif s >= 1.0:
+        value = p1
+    else:
+        value = p0 + (p1 - p0) * (3 * s2 - 2 * s3) + h * ((s3 - 2 * s2 + s) * v0 + (s3 - s2) * v1)
+    slope = (
+        (6 * s2 - 6 * s) * p0
+        + (3 * s2 - 4 * s + 1) * h * v0
+        + (6 * s - 6 * s2) * p1
+        + (3 * s2 - 2 * s) * h * v1
+    ) / h
+    return value, slope
+
+
+@compiled(inline="always")
+def _cubic_value(d0, dd0, d1, dd1, h, s):
+    value, _ = _hermite(d0, dd0, d1, dd1, h, s)
+    return value
+
+
+@compiled(inline="always")
+def crossing_fraction(d0, dd0, d1, dd1, h):
+    """First fraction s ∈ [0, 1] of a step where the cubic Hermite through (d0, dd0) and (d1, dd1) reaches zero.
+
+    Call with ``d0 ≥ 0 ≥ d1`` (the far side of the plane is negative). ``d0 < 0``, or ``d0 = 0`` moving onto the
+    far side or along the plane (``dd0 ≤ 0``), gives 0; ``d0 = 0`` moving away (a kick from the ground) looks for
+    the later root. The cubic's turning points split [0, 1] into monotone pieces; the first piece whose end is ≤ 0
+    brackets the first root, which a safeguarded Newton iteration (bisection whenever a Newton step leaves the
+    bracket) finds to rounding. A ball that rises and lands within one step so finds its landing, not the launch
+    (a linear guess plus bare Newton stalled at s = 0 there).
+    """
+    if d0 < 0.0 or (d0 == 0.0 and dd0 <= 0.0):
+        return 0.0
+    m0, m1 = h * dd0, h * dd1
+    # p(s) = a s³ + b s² + m0 s + d0, p'(s) = 3a s² + 2b s + m0.
+    a = 2.0 * d0 + m0 - 2.0 * d1 + m1
+    b = -3.0 * d0 - 2.0 * m0 + 3.0 * d1 - m1
+    c1, c2 = 2.0, 2.0  # turning points in (0, 1), ascending; 2.0 means none
+    qa, qb, qc = 3.0 * a, 2.0 * b, m0
+    if qa != 0.0:
+        disc = qb * qb - 4.0 * qa * qc
+        if disc >= 0.0:
+            root = math.sqrt(disc)
+            q = -0.5 * (qb + math.copysign(root, qb))
+            r1 = q / qa
+            r2 = qc / q if q != 0.0 else r1
+            lo_r, hi_r = min(r1, r2), max(r1, r2)
+            if 0.0 < lo_r < 1.0:
+                c1 = lo_r
+            if 0.0 < hi_r < 1.0:
+                if c1 == 2.0:
+                    c1 = hi_r
+                else:
+                    c2 = hi_r
+    elif qb != 0.0:
+        r = -qc / qb
+        if 0.0 < r < 1.0:
+            c1 = r
+    lo, hi = 0.0, 1.0
+    for edge in (c1, c2, 1.0):
+        if edge > 1.0:
+            continue
+        if edge == 1.0 or _cubic_value(d0, dd0, d1, dd1, h, edge) <= 0.0:
+            hi = edge
+            break
+        lo = edge
+    # p(lo) > 0 ≥ p(hi) and p is monotone on [lo, hi].
+    s = 0.5 * (lo + hi)
+    for _ in range(80):
+        value, slope = _hermite(d0, dd0, d1, dd1, h, s)
+        if value == 0.0:
+            return s
+        if value > 0.0:
+            lo = s
+        else:
+            hi = s
+        slope *= h  # per unit s
+        trial = s - value / slope if slope != 0.0 else -1.0
+        if not lo < trial < hi:
+            trial = 0.5 * (lo + hi)
+        if trial == s or hi - lo <= 1e-16:
+            break
+        s = trial
+    return s
+
+
+@compiled()
+def _fly(launch, kick, config, t_out, state_out):
+    """Step one kick (its (13,) launch row and (14,) constants) until it lands, passes ``x_stop`` or runs out of time.
+
+    Writes each sample's time to ``t_out`` (T,) and position then velocity to ``state_out`` (T, 6), T ≥ n_steps + 1;
+    with T = 0 it only counts.
+
+    Returns:
+        (samples written, ending code: 0 ground, 1 x_stop, 2 t_max, 3 diverged: gained energy, or inf/NaN).
+    """
+    store = len(t_out) > 0
+    dt, ground, x_stop = config[DT], config[GROUND], config[X_STOP]
+    n_steps = int(config[N_STEPS])
+    x, y, z, vx, vy, vz = launch[0], launch[1], launch[2], launch[3], launch[4], launch[5]
+    # Drag dissipates and Magnus does no work, so |v|² + 2gz never grows but for the knuckle force's small push;
+    # a step that overshoots the drag makes it grow without bound. Stop that flight (ending 3) rather than draw it.
+    g = config[GRAVITY]
+    energy_limit = vx * vx + vy * vy + vz * vz + 2.0 * g * z
+    energy_limit += 3.0 * (vx * vx + vy * vy + vz * vz + 2.0 * abs(g) * (abs(z) + 1.0)) + 100.0
+    if store:
+        t_out[0] = 0.0
+        state_out[0, 0], state_out[0, 1], state_out[0, 2] = x, y, z
+        state_out[0, 3], state_out[0, 4], state_out[0, 5] = vx, vy, vz
+    t_max = config[T_MAX]
+    for n in range(n_steps):
+        # Every step is dt but the last, which ends exactly on t_max.
+        h = dt if n < n_steps - 1 else t_max - (n_steps - 1) * dt
+        x1, y1, z1, vx1, vy1, vz1 = _step(x, y, z, vx, vy, vz, n * dt, h, kick, config)
+        if vx1 * vx1 + vy1 * vy1 + vz1 * vz1 + 2.0 * g * z1 > energy_limit:
+            return n + 1, 3
+        # The stop plane is closed on the start side: a kick launched on it, moving on, stops at t = 0.
+        hit_ground = z1 <= ground
+        hit_stop = x < x_stop <= x1 or (n == 0 and x == x_stop and x1 > x)
+        if hit_ground or hit_stop:
+            # End on whichever of the ground and the stop plane the cubic through this step reaches first.
+            f_ground = (
+                crossing_fraction(z - ground, vz, z1 - ground, vz1, h) if hit_ground else np.inf
+            )
+            f_stop = (
+                crossing_fraction(x_stop - x, -vx, x_stop - x1, -vx1, h) if hit_stop else np.inf
+            )
+            ending = 0 if f_ground <= f_stop else 1
+            f = min(f_ground, f_stop)
+            ex, evx = _hermite(x, vx, x1, vx1, h, f)
+            ey, evy = _hermite(y, vy, y1, vy1, h, f)
+            ez, evz = _hermite(z, vz, z1, vz1, h, f)
+            if ending == 0:
+                ez = ground
+            else:
+                ex = x_stop
+            if not math.isfinite(ex + ey + ez + evx + evy + evz):  # inf or NaN (or ~1e308)
+                ending = 3
+            if store:
+                t_out[n + 1] = n * dt + f * h
+                state_out[n + 1, 0], state_out[n + 1, 1], state_out[n + 1, 2] = ex, ey, ez
+                state_out[n + 1, 3], state_out[n + 1, 4], state_out[n + 1, 5] = evx, evy, evz
+            return n + 2, ending
+        x, y, z, vx, vy, vz = x1, y1, z1, vx1, vy1, vz1
+        if store:
+            t_out[n + 1] = (n + 1) * dt if n < n_steps - 1 else t_max
+            state_out[n + 1, 0], state_out[n + 1, 1], state_out[n + 1, 2] = x, y, z
+            state_out[n + 1, 3], state_out[n + 1, 4], state_out[n + 1, 5] = vx, vy, vz
+    # A state that overflowed stays inf or NaN to the end (NaN fails the ground test, so it runs to t_max).
+    return n_steps + 1, 2 if math.isfinite(x + y + z + vx + vy + vz) else 3
+
+
+@compiled()
+def simulate_one(launch, config, t_out, state_out, forces_out):
+    """:func:`simulate`'s compiled part: the kick's constants, its flight and the forces along it."""
+    kick = np.empty(N_KICK)
+    fill_kick(launch, config, kick)
+    n, ending = _fly(launch, kick, config, t_out, state_out)
+    sample_forces(t_out[:n], state_out[:n], kick, config, forces_out[:n])
+    if not np.isfinite(
+        forces_out[:n]
+    ).all():  # a finite flight with an infinite force: a 1e-300 kg ball
+        ending = 3
+    return n, ending
+
+
+@compiled(parallel=True)
+def fly_batch(launches, config, t_out, state_out, n_samples, endings):
+    """Every kick's flight into column k of ``t_out`` (T, K) and ``state_out`` (T, K, 6), in parallel.
+
+    T must hold each flight (n_steps + 1 always does); with T = 0 it only counts the samples.
+    """
+    for k in prange(len(launches)):
+        kick = np.empty(N_KICK)
+        fill_kick(launches[k], config, kick)
+        n_samples[k], endings[k] = _fly(launches[k], kick, config, t_out[:, k], state_out[:, k])
+
+
+@compiled(parallel=True)
+def pad(t, state, n_samples):
+    """Repeat each flight's last sample to the end of ``t`` (T, K) and ``state`` (T, K, 6)."""
+    for k in prange(len(n_samples)):
+        last = n_samples[k] - 1
+        for i in range(last + 1, t.shape[0]):
+            t[i, k] = t[last, k]
+            state[i, k, :] = state[last, k, :]
+
+
+# --------------------------------------------------------------------------------------------- outcome
+@compiled()
+def _plane_crossing(t, position, velocity, n, panel, crossing):
+    """First crossing of a panel's plane in its normal direction among the first ``n`` samples.
+
+    ``panel`` is (6,): centre x, y, unit normal x, y, width, height. Writes (time, x, y, z) to ``crossing`` (4,),
+    NaN if there is none.
+    """
+    cx, cy, nx, ny = panel[0], panel[1], panel[2], panel[3]
+    crossing[:] = np.nan
+    d1 = (position[0, 0] - cx) * nx + (position[0, 1] - cy) * ny
+    for i in range(n - 1):
+        d0, d1 = d1, (position[i + 1, 0] - cx) * nx + (position[i + 1, 1] - cy) * ny
+        # Closed on the start side: a ball launched on the plane and moving through it crosses at t = 0.
+        if d0 < 0.0 <= d1 or (i == 0 and d0 == 0.0 and d1 > 0.0):
+            h = t[i + 1] - t[i]
+            h = h if h > 0.0 else 1.0
+            dd0 = velocity[i, 0] * nx + velocity[i, 1] * ny
+            dd1 = velocity[i + 1, 0] * nx + velocity[i + 1, 1] * ny
+            s = crossing_fraction(-d0, -dd0, -d1, -dd1, h)
+            crossing[0] = t[i] + s * h
+            for c in range(3):
+                p0, v0, p1, v1 = (
+                    position[i, c],
+                    velocity[i, c],
+                    position[i + 1, c],
+                    velocity[i + 1, c],
+                )
+                crossing[1 + c], _ = _hermite(p0, v0, p1, v1, h, s)
+            return
+
+
+@compiled()
+def judge(t, position, velocity, n, panels, radius, crossings):
+    """Result code (0 goal, 1 wall, 2 over, 3 wide, 4 short) of one flight's first ``n`` samples.
+
+    ``panels`` (2, 6) are the wall and the goal; their crossings (time, x, y, z) go to ``crossings`` (2, 4).
+    """
+    for j in range(2):
+        _plane_crossing(t, position, velocity, n, panels[j], crossings[j])
+    # Offset of each crossing along its panel from the centre line (along = (−n_y, n_x)); NaN when none.
+    wall, goal = panels[0], panels[1]
+    wall_lateral = -(crossings[0, 1] - wall[0]) * wall[3] + (crossings[0, 2] - wall[1]) * wall[2]
+    goal_lateral = -(crossings[1, 1] - goal[0]) * goal[3] + (crossings[1, 2] - goal[1]) * goal[2]
+    # Every edge is closed (touching counts). A coordinate that stays constant over the crossing step comes out of
+    # _hermite exactly, so a ball exactly on an edge gets the same verdict however its flight was sampled.
+    # The ball touches the wall if its centre comes within a radius of the defenders' outline.
+    if abs(wall_lateral) <= 0.5 * wall[4] + radius and crossings[0, 3] <= wall[5] + radius:
+        return 1
+    if np.isnan(crossings[1, 0]):
+        return 4
+    if abs(goal_lateral) > 0.5 * goal[4] - radius:
+        return 3
+    # A goal needs the whole ball inside the posts and under the bar (touching them from inside counts).
+    return 0 if crossings[1, 3] <= goal[5] - radius else 2
+
+
+@compiled(parallel=True)
+def judge_batch(t, position, velocity, n_samples, panels, radius, results, crossings):
+    """:func:`judge` for every flight of a (K, T) batch, in parallel."""
+    for k in prange(len(n_samples)):
+        results[k] = judge(
+            t[k], position[k], velocity[k], n_samples[k], panels, radius, crossings[k]
+        )
+
+
+@compiled(parallel=True)
+def fly_and_judge(launches, config, panels, results, crossings, endings):
+    """Fly each kick into its own scratch buffer and judge it at once (ball radius from ``config``): nothing kept."""
+    rows = int(config[N_STEPS]) + 1
+    for k in prange(len(launches)):
+        kick, t, state = np.empty(N_KICK), np.empty(rows), np.empty((rows, 6))
+        fill_kick(launches[k], config, kick)
+        n, endings[k] = _fly(launches[k], kick, config, t, state)
+        results[k] = judge(t, state[:, :3], state[:, 3:], n, panels, config[RADIUS], crossings[k])
