@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 from scipy.integrate import solve_ivp
 
 from kernels import course, cycling
-from kernels.course import Air, Rider
+from kernels.course import Air, Rider, gpx
 
 SEED = Rider(cda_m2=0.32, mass_kg=80.0, crr=0.004, drivetrain_efficiency=0.976, model="seed")
 MARTIN = Rider(cda_m2=0.32, mass_kg=80.0, crr=0.004, model="martin")
@@ -636,12 +636,12 @@ def test_a_namespace_prefixed_gpx_is_read_and_counted_before_parsing(
 ) -> None:
     c = course.load_gpx(prefixed(20))
     assert c.n_points == 20 and c.name == "prefixed"
-    monkeypatch.setattr(course, "MAX_POINTS", 10)
+    monkeypatch.setattr(gpx, "MAX_POINTS", 10)
 
     def never(*_: object) -> None:
         raise AssertionError("parsed before counting")
 
-    monkeypatch.setattr(course.gpxpy, "parse", never)
+    monkeypatch.setattr(gpx.gpxpy, "parse", never)
     with pytest.raises(ValueError, match="has 20 points; the limit is 10"):
         course.load_gpx(prefixed(20))
 

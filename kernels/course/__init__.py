@@ -1,0 +1,96 @@
+"""Ride a real course: a GPX route, the speed integrated along it, and the power that rides it in a given time.
+
+A course of N points has per-point arrays of shape (N,) (distance, elevation, map position) and per-segment arrays of
+shape (N − 1,) (grade, heading, length); segment i runs from point i to point i + 1. SI units throughout (m, s, kg,
+W, rad); headings are compass bearings, clockwise from north, in radians.
+
+**Course.** :func:`load_gpx` reads the track points of a GPX file with gpxpy. Segment lengths on the map are great-circle
+(haversine) distances on a sphere of radius 6 371 008.8 m (the IUGG mean Earth radius); headings are the initial
+great-circle bearings. GPS elevation is noisy, so it is smoothed by a moving average over a distance window
+(``smoothing_m``, 50 m by default); grade is the smoothed rise over the map distance, and the rider travels the
+slope length run·√(1 + grade²).
+
+**Ride.** Along each segment the rider's kinetic energy changes by the work of the pedals minus the resistances
+(the power terms of :mod:`kernels.cycling`, the seed's or Martin et al. 1998's):
+
+    d(½·M·v²)/ds = η·P/v − F(v),    M = m + I/r² (wheel inertia, Martin model),  F·v = P_wheel(v)
+
+integrated per segment with an implicit midpoint step on the segment's mean speed v̄ = (v₀ + v₁)/2:
+½·M·(v₁² − v₀²) = L·(η·P − P_wheel(v̄))/v̄, time L/v̄. The step is stable at any length (a rider starting from rest
+or entering a 20 % wall at speed needs no tiny steps), and the energy books balance exactly: the work of the pedals
+equals the kinetic energy gained plus aero, rolling, bearing and climbing work plus what the brakes take, which the
+tests check over a closed loop. A segment that cannot be crossed in one step is split in halves until it can.
+The rider starts from rest (or ``start_speed_ms``) and brakes to hold ``max_speed_ms`` on descents, easing off the
+pedals as needed. The wind blows from ``wind_from_deg`` (meteorological convention); each segment feels its
+headwind component w = wind·cos(from − heading); the crosswind is ignored (yaw-free CdA).
+
+**Pacing.** :func:`paced_ride` varies power with the grade, more uphill and less downhill at the same time-averaged
+power, as Swain (1997, Med. Sci. Sports Exerc. 29:1104) proposed: time is won where the rider is slow.
+
+The integration loop is compiled with numba (``@njit(cache=True)``); the Python wrappers validate every argument
+first (ValueError naming it). :func:`warm_up` compiles it ahead of use.
+
+Modules: :mod:`~kernels.course.route` (:class:`Course` and its geometry), :mod:`~kernels.course.gpx` (reading and
+checking GPX files), :mod:`~kernels.course.ride` (:class:`Rider`, :class:`Air`, :class:`Ride`, the compiled ride loop
+and the power solvers). Everything public is importable from here.
+"""
+
+from __future__ import annotations
+
+from kernels.course.gpx import (
+    GRADE_WINDOW_M,
+    MAX_FILE_BYTES,
+    MAX_GPX_GRADE,
+    MAX_SEGMENT_GAP_M,
+    SAMPLE_ROUTE,
+    load_gpx,
+)
+from kernels.course.ride import (
+    Air,
+    AirKind,
+    Model,
+    Pacing,
+    Ride,
+    Rider,
+    paced_ride,
+    pacing_factors,
+    power_for_time,
+    ride,
+    warm_up,
+)
+from kernels.course.route import (
+    EARTH_RADIUS_M,
+    MAX_POINTS,
+    Course,
+    azimuthal_equidistant,
+    course_from_points,
+    course_from_xy,
+    steepest_grade,
+)
+
+__all__ = [
+    "EARTH_RADIUS_M",
+    "GRADE_WINDOW_M",
+    "MAX_FILE_BYTES",
+    "MAX_GPX_GRADE",
+    "MAX_POINTS",
+    "MAX_SEGMENT_GAP_M",
+    "SAMPLE_ROUTE",
+    "Air",
+    "AirKind",
+    "Course",
+    "Model",
+    "Pacing",
+    "Ride",
+    "Rider",
+    "azimuthal_equidistant",
+    "course_from_points",
+    "course_from_xy",
+    "load_gpx",
+    "paced_ride",
+    "pacing_factors",
+    "power_for_time",
+    "ride",
+    "steepest_grade",
+    "warm_up",
+]

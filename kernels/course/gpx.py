@@ -1,0 +1,252 @@
+"""Read a GPX file into a :class:`kernels.course.route.Course`, refusing a bad file in words a rider can act on.
+
+:func:`load_gpx` takes a path, bytes or text (at most 20 MiB and 200 000 points), decodes it by its byte-order mark or
+XML declaration (XML 1.0 §4.3.3), parses it with gpxpy, and refuses points off the map, track segments more than
+2 km apart, and any stretch steeper than 50 % (:data:`MAX_GPX_GRADE`), which no road is. :data:`SAMPLE_ROUTE` is the
+bundled Alpe d'Huez course in ``kernels/routes/``.
+"""
+
+from __future__ import annotations
+
+import codecs
+import math
+import os
+import re
+from collections.abc import Sequence
+from pathlib import Path
+
+import gpxpy
+import gpxpy.gpx
+import numpy as np
+from numpy.typing import NDArray
+
+from kernels.course.route import (
+    EARTH_RADIUS_M,
+    MAX_POINTS,
+    Course,
+    course_from_points,
+    steepest_grade,
+)
+
+MAX_FILE_BYTES = 20 * 1024 * 1024
+"""Largest GPX file :func:`load_gpx` reads (20 MiB)."""
+SAMPLE_ROUTE = Path(__file__).parent.with_name("routes") / "alpe_dhuez.gpx"
+"""The bundled sample: Alpe d'Huez rebuilt from its published profile (see the file's description)."""
+
+_GPX_ROOT = re.compile(r"<(?:([A-Za-z_][\w.-]*):)?gpx[\s>/]")
+
+
+def load_gpx(
+    source: str | os.PathLike[str] | bytes, *, name: str | None = None, smoothing_m: float = 50.0
+) -> Course:
+    """Read a GPX file's track points (or, when it has no track, its route points) into a :class:`Course`.
+
+    Args:
+        source: a path, the file's bytes, or the file's text (a string that starts with ``<``).
+        name: course name; default the track's name, else the file name, else "GPX course".
+        smoothing_m: elevation moving-average window (m).
+
+    Returns:
+        The course, every track segment joined in file order.
+
+    Raises:
+        ValueError: with a message a person can act on: the file is larger than 20 MiB, not GPX (or not text),
+            has no track points, one point, points without elevation, non-finite or out-of-range values, more
+            than 200 000 points, a stretch steeper than :data:`MAX_GPX_GRADE` (50 %), or track segments more than
+            :data:`MAX_SEGMENT_GAP_M` (2 km) apart. Nothing else escapes for a bad file.
+
+    The text is decoded by its byte-order mark, else the XML declaration's encoding (ISO-8859-1, UTF-16...),
+    else as UTF-8; a namespace prefix on the GPX elements (``<g:gpx xmlns:g=...>``) is read too.
+    """
+    label = "the file"
+    if isinstance(source, bytes):
+        if len(source) > MAX_FILE_BYTES:
+            raise ValueError(f"the file is {len(source) / 2**20:.1f} MiB; the limit is 20 MiB")
+        data = source
+    elif isinstance(source, os.PathLike) or (
+        isinstance(source, str) and not source.lstrip("\ufeff \t\r\n").startswith("<")
+    ):
+        path = Path(source)
+        label = path.name
+        try:
+            size = path.stat().st_size
+        except OSError as error:
+            raise ValueError(f"cannot read {path}: {error.strerror}") from error
+        if size > MAX_FILE_BYTES:
+            raise ValueError(f"{label} is {size / 2**20:.1f} MiB; the limit is 20 MiB")
+        data = path.read_bytes()
+    elif isinstance(source, str):
+        if len(source) > MAX_FILE_BYTES or len(source.encode("utf-8")) > MAX_FILE_BYTES:
+            raise ValueError("the file is larger than the 20 MiB limit")
+        data = source.encode("utf-8")
+    else:
+        raise ValueError(f"source must be a path, bytes or GPX text, got {type(source).__name__}")
+    text = _decode(data, label)
+    root = _GPX_ROOT.search(text[:4096])
+    if root is None:
+        raise ValueError(f"{label} is not GPX: no <gpx> element at its start")
+    # Count before parsing (gpxpy would build every point first), whatever the namespace prefix.
+    prefix = root.group(1)
+    tags = ("<trkpt", "<rtept") + ((f"<{prefix}:trkpt", f"<{prefix}:rtept") if prefix else ())
+    tagged = sum(text.count(tag) for tag in tags)
+    if tagged > MAX_POINTS:
+        raise ValueError(f"{label} has {tagged} points; the limit is {MAX_POINTS}")
+    if prefix:  # <g:gpx xmlns:g=...>: gpxpy reads only unprefixed names, so drop the prefix
+        text = text.replace(f"<{prefix}:", "<").replace(f"</{prefix}:", "</")
+    try:
+        gpx = gpxpy.parse(text)
+    except gpxpy.gpx.GPXException as error:
+        raise ValueError(f"{label} is not a valid GPX file: {str(error)[:200]}") from error
+    except (ValueError, TypeError, AttributeError, IndexError) as error:
+        raise ValueError(f"{label} is not a valid GPX file: {type(error).__name__}") from error
+
+    segments = [
+        segment.points for track in gpx.tracks for segment in track.segments if segment.points
+    ]
+    kind = "track"
+    if not segments:
+        segments = [route.points for route in gpx.routes if route.points]
+        kind = "route"
+    points = [p for segment in segments for p in segment]
+    if not points:
+        raise ValueError(f"{label} has no track points")
+    if len(points) > MAX_POINTS:
+        raise ValueError(f"{label} has {len(points)} {kind} points; the limit is {MAX_POINTS}")
+    if len(points) < 2:
+        raise ValueError(f"{label} has only one {kind} point; a course needs two or more")
+    missing = sum(p.elevation is None for p in points)
+    if missing:
+        raise ValueError(
+            f"{label}: {missing} of {len(points)} {kind} points have no elevation (<ele>); "
+            "export the file with elevation"
+        )
+    lat = np.array([p.latitude for p in points], dtype=np.float64)
+    lon = np.array([p.longitude for p in points], dtype=np.float64)
+    ele = np.array([p.elevation for p in points], dtype=np.float64)
+    _check_values(label, kind, lat, lon, ele)
+    if kind == "track":
+        _check_gaps(label, segments)
+    title = name or next((t.name for t in gpx.tracks if t.name), None) or gpx.name
+    title = title or (label if label != "the file" else "GPX course")
+    title = str(title)[:80]
+    try:
+        result = course_from_points(lat, lon, ele, name=title, smoothing_m=smoothing_m)
+    except ValueError as error:  # the builders name the course; a reader is told about the file
+        message = str(error).removeprefix(f"{title}: ")
+        raise ValueError(f"{label}: {message}") from error
+    _check_grades(label, result)
+    return result
+
+
+MAX_GPX_GRADE = 0.5
+"""Steepest grade :func:`load_gpx` accepts (50 %), over any stretch of :data:`GRADE_WINDOW_M` (or the whole route
+if shorter), raw and smoothed. The steepest paved streets are about 35–37 % (Baldwin Street, Canton Avenue), so a
+steeper stretch is a fault in the file (a GPS elevation jump, points logged in one place), not a road."""
+GRADE_WINDOW_M = 25.0
+"""Stretch over which :data:`MAX_GPX_GRADE` is checked on the raw elevation (m): long enough that ±2 m GPS noise
+between points a metre apart stays under 20 %, short enough that a real cliff cannot hide."""
+MAX_SEGMENT_GAP_M = 2000.0
+"""Largest jump :func:`load_gpx` accepts between the end of one track segment and the start of the next (m)."""
+
+_XML_ENCODING = re.compile(rb"""^<\?xml[^>]*?encoding\s*=\s*["']([A-Za-z0-9._-]+)["']""")
+
+
+def _decode(data: bytes, label: str) -> str:
+    """The file's text: by its byte-order mark, else its XML declaration's encoding, else UTF-8 (XML 1.0 §4.3.3)."""
+    for bom, codec in (
+        (codecs.BOM_UTF32_LE, "utf-32"), (codecs.BOM_UTF32_BE, "utf-32"), (codecs.BOM_UTF8, "utf-8-sig"),
+        (codecs.BOM_UTF16_LE, "utf-16"), (codecs.BOM_UTF16_BE, "utf-16"),
+    ):  # fmt: skip
+        if data.startswith(bom):
+            encoding = codec
+            break
+    else:
+        declared = _XML_ENCODING.match(data[:200])
+        encoding = declared.group(1).decode("ascii") if declared else "utf-8"
+        try:
+            codecs.lookup(encoding)
+        except LookupError as error:
+            raise ValueError(f"{label} declares an unknown text encoding {encoding!r}") from error
+    try:
+        text = data.decode(encoding)
+    except (UnicodeDecodeError, ValueError) as error:
+        raise ValueError(f"{label} is not GPX: it is not text in {encoding.upper()}") from error
+    # The text is decoded now: the declaration's encoding must not be applied a second time by the XML parser.
+    return re.sub(
+        r"""^(\ufeff?<\?xml[^>]*?)\s+encoding\s*=\s*["'][^"']*["']""", r"\1", text, count=1
+    )
+
+
+def _check_values(
+    label: str,
+    kind: str,
+    lat: NDArray[np.float64],
+    lon: NDArray[np.float64],
+    ele: NDArray[np.float64],
+) -> None:
+    """Refuse a point that is not on the map, in words a rider reads (point numbers from 1, as in the file)."""
+    for values, what, limit, unit in (
+        (lat, "latitude", 90.0, "°"), (lon, "longitude", 180.0, "°"), (ele, "elevation", 10_000.0, " m"),
+    ):  # fmt: skip
+        bad = ~np.isfinite(values)
+        if np.any(bad):
+            first = int(np.argmax(bad))
+            raise ValueError(
+                f"{label}: {kind} point {first + 1} has {what} {values[first]}, not a number; "
+                f"{int(bad.sum())} point(s) like it"
+            )
+        out = np.abs(values) > limit
+        if np.any(out):
+            first = int(np.argmax(out))
+            raise ValueError(
+                f"{label}: {kind} point {first + 1} has {what} {values[first]:g}{unit}, outside "
+                f"±{_spaced(limit)}{unit}"
+            )
+
+
+def _check_gaps(
+    label: str, segments: Sequence[Sequence[gpxpy.gpx.GPXTrackPoint | gpxpy.gpx.GPXRoutePoint]]
+) -> None:
+    """Refuse tracks or segments that do not follow on: the route would jump across the map."""
+    for i in range(1, len(segments)):
+        a, b = segments[i - 1][-1], segments[i][0]
+        gap = _great_circle_m(a.latitude, a.longitude, b.latitude, b.longitude)
+        if gap > MAX_SEGMENT_GAP_M:
+            raise ValueError(
+                f"{label}: track segment {i + 1} starts {_km(gap)} from where segment {i} ends "
+                f"(at most {MAX_SEGMENT_GAP_M / 1000:.0f} km is joined); load the pieces as separate files"
+            )
+
+
+def _great_circle_m(lat1: float, lon1: float, lat2: float, lon2: float) -> float:
+    """Haversine distance (m) between two points (°)."""
+    p1, p2 = math.radians(lat1), math.radians(lat2)
+    a = (
+        math.sin((p2 - p1) / 2) ** 2
+        + math.cos(p1) * math.cos(p2) * math.sin(math.radians(lon2 - lon1) / 2) ** 2
+    )
+    return 2.0 * EARTH_RADIUS_M * math.asin(math.sqrt(min(max(a, 0.0), 1.0)))
+
+
+def _spaced(number: float, digits: int = 0) -> str:
+    """12 345.6 style: thousands apart by a space."""
+    return f"{number:,.{digits}f}".replace(",", " ")
+
+
+def _km(metres: float) -> str:
+    return f"{_spaced(metres / 1000, 1)} km"
+
+
+def _check_grades(label: str, route: Course) -> None:
+    """Refuse a profile steeper than any road (:data:`MAX_GPX_GRADE`), before smoothing can hide it."""
+    grade, first = steepest_grade(route.distance_m, route.elevation_raw_m, GRADE_WINDOW_M)
+    smoothed = float(np.max(np.abs(route.grade)))
+    if max(grade, smoothed) > MAX_GPX_GRADE:
+        if smoothed > grade:
+            first = int(np.argmax(np.abs(route.grade)))
+        at = route.distance_m[first]
+        raise ValueError(
+            f"{label}: the elevation changes {_spaced(100 * max(grade, smoothed))} % of the distance near "
+            f"{at / 1000:.2f} km; no road is steeper than about 40 % (the limit is "
+            f"{100 * MAX_GPX_GRADE:.0f} %), so the file's elevation or positions are wrong"
+        )
