@@ -15,10 +15,12 @@ import contextlib
 import io
 import ipaddress
 import logging
+import socket
 import sys
 import threading
 import time
 from types import ModuleType
+from typing import Annotated
 
 import tyro
 import viser
@@ -114,6 +116,23 @@ def port_message(asked: int, bound: int, explicit: bool) -> str | None:
     return f"Port {asked} is already in use; serving on port {bound} instead."
 
 
+def port_is_free(host: str, port: int) -> bool:
+    """Whether ``port`` on ``host`` can be bound now, as viser would bind it (address reuse on, so a port whose last
+    connections are closing still counts as free; one another process listens on does not)."""
+    try:
+        infos = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM, flags=socket.AI_PASSIVE)
+    except socket.gaierror:
+        return True  # viser reports an address it cannot resolve in its own words
+    family, kind, proto, _name, address = infos[0]
+    with socket.socket(family, kind, proto) as probe:
+        probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        try:
+            probe.bind(address)
+        except OSError:
+            return False
+    return True
+
+
 def make_server(host: str, port: int, *, verbose: bool = True) -> viser.ViserServer:
     """The viser server as the app serves it: its label on the panel and the wide control panel.
 
@@ -127,7 +146,10 @@ def make_server(host: str, port: int, *, verbose: bool = True) -> viser.ViserSer
 def main(
     scene: SceneName = "peloton",
     host: str = "127.0.0.1",
-    port: int | None = None,
+    port: Annotated[
+        int | None,
+        tyro.conf.arg(metavar="INT", help_behavior_hint="(default: 8080, or the next free port)"),
+    ] = None,
     allow_remote_glsl: bool = False,
     shared: bool = False,
 ) -> None:
@@ -136,7 +158,7 @@ def main(
     Args:
         scene: which scene opens first.
         host: address to bind; the default accepts connections from this machine only.
-        port: TCP port to bind (8080 when not given, or the next free one). A port given here must be free.
+        port: TCP port to bind. A port given here must be free, or the app refuses to start.
         allow_remote_glsl: with a non-loopback host, still let browsers type GLSL into the SDF gallery's editor.
         shared: one scene for every browser tab (a switch or Reset in one tab changes it for all); by default each
             tab has its own scene.
@@ -148,12 +170,17 @@ def main(
     warning = exposure_warning(host, asked, allow_remote_glsl=allow_remote_glsl)
     if warning is not None:
         print(warning, flush=True)
+    if port is not None and not port_is_free(
+        host, port
+    ):  # refuse before viser prints a URL it will not serve
+        print(port_message(port, port + 1, explicit=True), file=sys.stderr, flush=True)
+        raise SystemExit(2)
     warm_kernels()
     server = None
     try:
         server = make_server(host, asked)
         message = port_message(asked, server.get_port(), explicit=port is not None)
-        if message is not None and port is not None:
+        if message is not None and port is not None:  # taken between the check and the bind
             _stop_quietly(server)
             print(message, file=sys.stderr, flush=True)
             raise SystemExit(2)
