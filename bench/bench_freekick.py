@@ -42,17 +42,16 @@ from scipy.integrate import solve_ivp
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
-sys.path.insert(0, str(ROOT / "tests"))
 
 import numba  # noqa: E402
 import viser  # noqa: E402
-from wsclient import BrowserClient  # noqa: E402
 
 from kernels import ball  # noqa: E402
 from kernels.ball.config import N_STEPS  # noqa: E402
 from kernels.ball.core import simulate_one  # noqa: E402
 from scenes.freekick import MAP_QUIET_S, FreeKickParams, FreeKickScene, outcome_map  # noqa: E402
 from server.switcher import SceneSwitcher  # noqa: E402
+from tests.helpers.wsclient import BrowserClient  # noqa: E402
 
 M, R, RHO, G = 0.43, 0.11, 1.225, 9.81
 Q = 0.5 * RHO * math.pi * R**2 / M

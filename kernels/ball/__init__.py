@@ -58,8 +58,16 @@ same compiled flight; a batch runs its kicks in parallel (``prange``, :func:`num
 Python functions around them only validate (``ValueError`` naming the argument) and package arrays. Compiled code is cached
 in ``__pycache__`` beside each module, or, where that is read-only (an installed package), in numba's user-wide cache
 (``~/.cache/numba``; ``NUMBA_CACHE_DIR`` overrides both; with neither writable, no disk cache). :func:`warm_up`
-compiles (or loads) every core. A flight whose steps overshoot the drag, so that |v|² + 2gz grows far past its launch
-value (or overflows), raises ``ValueError`` naming ``dt`` rather than returning an absurd path.
+compiles (or loads) every core.
+
+Step limit: a kick whose ``dt`` is beyond the method's stability limit for its drag is refused before it flies, with a
+``ValueError`` naming ``dt`` and the limit (:func:`kernels.ball.aero.max_stable_step`). Drag alone on a ball at speed
+|v| has velocity-Jacobian eigenvalues −k|v| and −2k|v| (k = ½ρA·C_D/m); forward Euler is stable for λ·dt in [−2, 0]
+and classical RK4 in [−2.7853, 0] (Hairer & Wanner, Solving ODEs II, §IV.2), so dt ≤ β/(2k|v|), which for Euler is
+k|v|·dt ≤ 1: a step never reverses the velocity. The lift and knuckle factors are added to k, and |v| is the fastest
+the ball can fly (its launch speed, or the terminal speed, or the speed a fall from its height gives: whichever
+bound is least). A flight whose steps still overshoot, so that |v|² + 2gz grows far past its launch value (or
+overflows), also raises ``ValueError`` naming ``dt`` rather than returning an absurd path.
 
 Modules: :mod:`~kernels.ball.config` (constants, :class:`FlightConfig`, input checks), :mod:`~kernels.ball.pitch` (goal
 and wall panels), :mod:`~kernels.ball.aero` (the compiled force law), :mod:`~kernels.ball.core` (the compiled flight,

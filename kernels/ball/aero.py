@@ -16,6 +16,7 @@ from kernels.ball.config import (
     C_D,
     C_L,
     GRAVITY,
+    GROUND,
     KNUCKLE_COEFFICIENT,
     KNUCKLE_SPIN_LIMIT,
     KNUCKLE_WAVELENGTH_M,
@@ -23,6 +24,8 @@ from kernels.ball.config import (
     MEASURED,
     RADIUS,
     RE_PER_SPEED,
+    RK4,
+    T_MAX,
     Q,
 )
 from kernels.ball.jit import compiled
@@ -30,6 +33,18 @@ from kernels.ball.jit import compiled
 # Goff & Carré 2010 no-spin drag fit, in Reynolds number (see :mod:`kernels.ball`).
 _RE_CRISIS = 1.815e5
 _RE_WIDTH = 1.949e4
+
+# Bounds of the measured fits below (Goff & Carré 2010, Asai et al. 2007): C_D0 lies in (0.155, 0.501), the spinning
+# C_D is 0.4127·S^0.3056 (0.165 at S = 0.05, growing with S), C_L at most 0.9·0.3.
+_MEASURED_DRAG_MIN = 0.155
+_MEASURED_STILL_DRAG_MAX = 0.501
+_MEASURED_LIFT_MAX = 0.27
+
+EULER_STABILITY = 2.0
+"""Forward Euler's stability interval on the negative real axis, |1 + z| ≤ 1 for z ∈ [−2, 0]."""
+RK4_STABILITY = 2.785293563405289
+"""Classical RK4's: |1 + z + z²/2 + z³/6 + z⁴/24| ≤ 1 for z ∈ [−2.7853, 0], the real root of z³ + 4z² + 12z + 24
+(Hairer & Wanner, Solving ODEs II, 2nd ed. 1996, §IV.2, Fig. 2.1)."""
 
 # Each kick's constants are one row of 14 (beside the settings vector of FlightConfig): ω̂, |ω|, knuckle gain ½ρA·C_K·w/m, rate Ω, phases φ₁ φ₂,
 # cos θ·n₁ and sin θ·n₂.
@@ -75,6 +90,50 @@ def fill_kick(launch, config, kick):
     kick[N1], kick[N1 + 1] = math.cos(theta) * hx, math.cos(theta) * hy
     for i in range(3):
         kick[N2 + i] = math.sin(theta) * vertical[i]
+
+
+@compiled()
+def max_stable_step(launch, kick, config):
+    """(longest stable dt (s), fastest speed bound (m/s)) of one kick: its launch row, constants and the settings.
+
+    The acceleration's velocity-dependent part a(v) = |v|·(−k_D·v + k_L·ω̂ × v + knuckle), k = ½ρA·C/m, has the
+    Jacobian ∂a/∂v; for drag alone its eigenvalues are −k_D|v| (twice, across the motion) and −2k_D|v| (along it).
+    A fixed-step method stays stable while every λ·dt lies in its stability region; on the negative real axis that
+    is z ∈ [−β, 0] with β = 2 for forward Euler and 2.7853 for RK4 (:data:`EULER_STABILITY`, :data:`RK4_STABILITY`).
+    So dt ≤ β / (2·k·|v|), with k the sum of the drag, lift and knuckle factors' bounds (the lift's and knuckle's
+    magnitudes rotate the velocity but add to ‖∂a/∂v‖ ≤ 2k|v|). For Euler and drag alone this is k_D·|v|·dt ≤ 1: a
+    step never reverses the velocity (v·(1 − k_D|v|dt)); past 2 the error grows every step. With C_L ≤ (1 + √2)·C_D
+    (both models' defaults) the bound also keeps Euler's Magnus pair −k_D|v| ± i·k_L|v| in |1 + z| ≤ 1.
+
+    |v| is the fastest the ball can fly: drag and Magnus do no positive work, so with damping c = k_D,min − k_K > 0
+    the speed never passes max(|v₀|, √(|g|/c)) (d|v|²/dt ≤ 2|v|(|g| − c|v|²)) nor, under downward gravity,
+    √(|v₀|² + 2g·(z₀ − ground)) (|v|² + 2gz never grows); and never |v₀| + |g|·t_max. The measured C_D's bound at
+    that speed is max(0.501, 0.4127·max(S, 0.05)^0.3056), S = r|ω|/|v| (C_D·|v| grows with |v| under both fits).
+    """
+    q, g = config[Q], config[GRAVITY]
+    speed = _norm(launch[3:6])
+    knuckle = kick[GAIN]  # ½ρA·C_K·w/m, zero without the knuckle force
+    if config[MEASURED] == 0.0:
+        damping = q * config[C_D] - knuckle
+    else:
+        damping = q * _MEASURED_DRAG_MIN - knuckle
+    fastest = speed + abs(g) * config[T_MAX]
+    if damping > 0.0:
+        fastest = min(fastest, max(speed, math.sqrt(abs(g) / damping)))
+        if g > 0.0:
+            height = max(launch[2] - config[GROUND], 0.0)
+            fastest = min(fastest, math.sqrt(speed * speed + 2.0 * g * height))
+    if config[MEASURED] == 0.0:
+        drag, lift = config[C_D], config[C_L]
+    else:
+        spin_parameter = config[RADIUS] * kick[RATE] / max(fastest, 1e-9)
+        drag = max(_MEASURED_STILL_DRAG_MAX, 0.4127 * max(spin_parameter, 0.05) ** 0.3056)
+        lift = _MEASURED_LIFT_MAX
+    if kick[RATE] == 0.0:
+        lift = 0.0  # no spin, no Magnus force
+    rate = (q * (drag + lift) + knuckle) * fastest  # 1/s, ≥ ‖∂a/∂v‖ / 2
+    beta = RK4_STABILITY if config[RK4] != 0.0 else EULER_STABILITY
+    return (beta / (2.0 * rate) if rate > 0.0 else math.inf), fastest
 
 
 @compiled(inline="always")

@@ -24,6 +24,7 @@ from kernels.ball.config import (
     GROUND,
     MEASURED,
     N_STEPS,
+    RK4,
     FlightConfig,
     check_launches,
     checked_seed,
@@ -44,6 +45,7 @@ from kernels.ball.core import (
     judge_batch,
     pad,
     simulate_one,
+    stable_step,
 )
 from kernels.ball.pitch import Panel, free_kick_panels, panel_rows
 
@@ -120,8 +122,32 @@ class BatchOutcome:
     """(K, 3) crossing of the goal's plane (m)."""
 
 
-def _refuse_overflow(endings: NDArray[np.int64], config: NDArray[np.float64]) -> None:
-    """Raise where a flight overflowed to inf or NaN: an explicit step too long for its drag, or absurd input."""
+def _round_down(value: float) -> float:
+    """``value`` cut (not rounded) to three significant digits, so a printed limit is one a caller can use."""
+    if not 0.0 < value < math.inf:
+        return value
+    scale = 10.0 ** (math.floor(math.log10(value)) - 2)
+    return math.floor(value / scale) * scale
+
+
+def _refuse_overflow(
+    endings: NDArray[np.int64], config: NDArray[np.float64], launches: NDArray[np.float64]
+) -> None:
+    """Raise where a kick's step was beyond the method's stability limit (ending 4, not flown), or where a flight
+    overflowed to inf or NaN (ending 3: a step too long for its drag that the limit does not bound, or absurd input).
+    ``launches`` are the (K, 13) launch rows, for the limit the message names."""
+    refused = np.flatnonzero(endings == 4)
+    if refused.size:
+        first = int(refused[0])
+        limit, fastest = stable_step(launches[first], config)
+        which = "" if len(endings) == 1 else f" of kicks {refused[:5].tolist()}"
+        method = "rk4" if config[RK4] else "euler"
+        raise ValueError(
+            f"dt = {config[DT]:g} s is too long for this drag{which}: at most {_round_down(limit):.3g} s for "
+            f"{method}, the method's stability limit with the drag at {fastest:.3g} m/s (the fastest this ball "
+            "can fly; see kernels.ball): a longer step overshoots the drag, reversing or amplifying the velocity; "
+            "use a smaller dt, or a smaller air_density or a larger mass_kg"
+        )
     bad = np.flatnonzero(endings == 3)
     if bad.size:
         which = "the flight" if len(endings) == 1 else f"kicks {bad[:5].tolist()}"
@@ -159,8 +185,9 @@ def simulate(
     Raises:
         ValueError: naming the argument, for non-finite, boolean or wrongly shaped input, an invalid
             :class:`FlightConfig` field, a position below ``ground_m``, a spin beyond the measured model's range
-            (see :mod:`kernels.ball`); naming dt when the steps overshoot the drag and the ball gains energy
-            without bound (a step far too long for this speed, density and mass).
+            (see :mod:`kernels.ball`); naming dt and its limit when dt is beyond the method's stability limit for
+            this kick's drag (a step that would reverse or amplify the velocity; see :mod:`kernels.ball`), or when
+            the steps still overshoot and the ball gains energy without bound.
         TypeError: an unknown keyword.
     """
     flight = flight_config(config, options)
@@ -182,8 +209,8 @@ def simulate(
     rows = int(settings[N_STEPS]) + 1
     t, state, forces = np.empty(rows), np.empty((rows, 6)), np.empty((rows, 12))
     n, ending = simulate_one(launch, settings, t, state, forces)
-    if ending == 3:
-        _refuse_overflow(np.array([ending]), settings)
+    if ending >= 3:
+        _refuse_overflow(np.array([ending]), settings, launch[None])
     state, forces = state[:n], forces[:n]
     return Trajectory(
         t=t[:n],
@@ -244,7 +271,7 @@ def simulate_batch(
         width = int(n_samples.max()) if k else 1
         t, state = t[:width], state[:width]
         pad(t, state, n_samples)
-    _refuse_overflow(endings, settings)
+    _refuse_overflow(endings, settings, launches)
     state = state.transpose(1, 0, 2)  # (K, T, 6) view, no copy
     return BatchTrajectory(
         t=t.T,
@@ -373,7 +400,7 @@ def simulate_outcomes(
     results, crossings, endings = np.empty(k, np.int64), np.empty((k, 2, 4)), np.empty(k, np.int64)
     with _PARALLEL:
         fly_and_judge(launches, settings, panels, results, crossings, endings)
-    _refuse_overflow(endings, settings)
+    _refuse_overflow(endings, settings, launches)
     return _batch_outcome(results, crossings)
 
 

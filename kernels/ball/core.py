@@ -2,9 +2,9 @@
 
 A flight writes its samples' times (T,) and states (T, 6: position then velocity, m and m/s) into buffers the caller
 gives; a batch runs its K kicks in parallel (``prange``) into (T, K) and (T, K, 6) time-major buffers. Each flight
-ends with a code in :data:`ENDINGS` order (3: diverged), each verdict with one in :data:`RESULTS` order. Crossings are
-the first root of the cubic Hermite interpolant of the step (:func:`crossing_fraction`). Method and assumptions:
-:mod:`kernels.ball`.
+ends with a code in :data:`ENDINGS` order (3: diverged; 4: not flown, its step beyond the method's stability limit),
+each verdict with one in :data:`RESULTS` order. Crossings are the first root of the cubic Hermite interpolant of the
+step (:func:`crossing_fraction`). Method and assumptions: :mod:`kernels.ball`.
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from typing import Literal
 import numpy as np
 from numba import prange
 
-from kernels.ball.aero import N_KICK, acceleration, fill_kick, sample_forces
+from kernels.ball.aero import N_KICK, acceleration, fill_kick, max_stable_step, sample_forces
 from kernels.ball.config import DT, GRAVITY, GROUND, N_STEPS, RADIUS, RK4, T_MAX, X_STOP
 from kernels.ball.jit import compiled
 
@@ -157,14 +157,17 @@ def _fly(launch, kick, config, t_out, state_out):
     with T = 0 it only counts.
 
     Returns:
-        (samples written, ending code: 0 ground, 1 x_stop, 2 t_max, 3 diverged: gained energy, or inf/NaN).
+        (samples written, ending code: 0 ground, 1 x_stop, 2 t_max, 3 diverged: gained energy, or inf/NaN; 4 not
+        flown: dt exceeds :func:`~kernels.ball.aero.max_stable_step`, only the launch sample written).
     """
     store = len(t_out) > 0
     dt, ground, x_stop = config[DT], config[GROUND], config[X_STOP]
+    refused = dt > max_stable_step(launch, kick, config)[0]
     n_steps = int(config[N_STEPS])
     x, y, z, vx, vy, vz = launch[0], launch[1], launch[2], launch[3], launch[4], launch[5]
     # Drag dissipates and Magnus does no work, so |v|² + 2gz never grows but for the knuckle force's small push;
-    # a step that overshoots the drag makes it grow without bound. Stop that flight (ending 3) rather than draw it.
+    # a step that overshoots the drag makes it grow without bound. The stability limit refuses such a step before
+    # the flight; this guard stays for what it does not bound (Euler with much lift and little drag).
     g = config[GRAVITY]
     energy_limit = vx * vx + vy * vy + vz * vz + 2.0 * g * z
     energy_limit += 3.0 * (vx * vx + vy * vy + vz * vz + 2.0 * abs(g) * (abs(z) + 1.0)) + 100.0
@@ -172,6 +175,8 @@ def _fly(launch, kick, config, t_out, state_out):
         t_out[0] = 0.0
         state_out[0, 0], state_out[0, 1], state_out[0, 2] = x, y, z
         state_out[0, 3], state_out[0, 4], state_out[0, 5] = vx, vy, vz
+    if refused:
+        return 1, 4
     t_max = config[T_MAX]
     for n in range(n_steps):
         # Every step is dt but the last, which ends exactly on t_max.
@@ -227,6 +232,14 @@ def simulate_one(launch, config, t_out, state_out, forces_out):
     ).all():  # a finite flight with an infinite force: a 1e-300 kg ball
         ending = 3
     return n, ending
+
+
+@compiled()
+def stable_step(launch, config):
+    """(longest stable dt (s), fastest speed bound (m/s)) of one kick's (13,) launch row: what ending 4 compared."""
+    kick = np.empty(N_KICK)
+    fill_kick(launch, config, kick)
+    return max_stable_step(launch, kick, config)
 
 
 @compiled(parallel=True)
