@@ -33,7 +33,8 @@ EDITOR_KEEP_CHARS = 2 * MAX_SOURCE_CHARS
 """Longest text the editor keeps (characters): room to paste a little too much and trim it; beyond, the previous
 text is put back at once."""
 EDITOR_HELP = (
-    "Write `float sdf(vec3 p)` (metres, Z up) and optionally `vec3 color(vec3 p)`, using the library's "
+    "Write `float sdf(vec3 p)` (metres, Z up) and optionally `vec3 color(vec3 p)` (`in`, `const in` and "
+    "`highp` before `vec3` are fine), using the library's "
     "`sd_*` primitives and `op_*`, `smooth_*` operators, then **Apply**: the shape is meshed and ray-marched "
     f"from the same source. At most {MAX_SOURCE_CHARS} characters; no loops, no `#` lines."
 )
