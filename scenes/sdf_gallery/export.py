@@ -1,23 +1,76 @@
 """The gallery's mesh as bytes: the GLB the 3D view gets on every remesh, and the downloads (GLB, STL, OBJ, PNG).
 
 Meshes are vertices (V, 3) float (m, world frame), faces (F, 3) int and vertex colours (V, 3) in [0, 1] (sRGB-like,
-as :mod:`kernels.sdf` gives them).
+as :mod:`kernels.sdf` gives them). Every download follows one rule (:func:`download`): with nothing to export (a
+mesh of no triangles, no reference image yet) there is no file, and the answer says why.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import io
 import json
 import struct
+from typing import Literal
 
 import numpy as np
 from PIL import Image
 
 from kernels import sdf
 
+MeshFormat = Literal["glb", "stl", "obj"]
+"""The mesh's download formats."""
+DownloadFormat = MeshFormat | Literal["png"]
+"""The gallery's downloads: the mesh in three formats, the reference image as PNG."""
+NOTHING_TO_DOWNLOAD = "Nothing to download yet"
+"""The title of the notification a download button gives when there is nothing to export."""
 
-def mesh_file(fmt: str, vertices: np.ndarray, faces: np.ndarray, colors: np.ndarray) -> bytes:
-    """The mesh as a file of format ``fmt`` ("glb", "stl" or "obj"), with its colours where the format has them."""
+
+@dataclasses.dataclass(frozen=True)
+class Download:
+    """What a download button gives: a file, or why there is none."""
+
+    name: str
+    """The file's name."""
+    content: bytes | None
+    """The file's bytes; None when there is nothing to export."""
+    why_not: str = ""
+    """Why there is no file (the notification's text), when ``content`` is None."""
+
+
+def download(
+    fmt: DownloadFormat,
+    vertices: np.ndarray,
+    faces: np.ndarray,
+    colors: np.ndarray,
+    reference: np.ndarray | None,
+) -> Download:
+    """The download of format ``fmt``: the mesh (vertices (V, 3) m, faces (F, 3), colours (V, 3) in [0, 1]) as GLB,
+    STL or OBJ, or the reference image ((H, W, 3) uint8, None before one is rendered) as PNG; no file when there is
+    nothing to export."""
+    match fmt:
+        case "png":
+            if reference is None or reference.size == 0:
+                return Download(
+                    "sdf_reference.png", None, "The reference image has not been rendered."
+                )
+            return Download("sdf_reference.png", png_bytes(reference))
+        case "glb" | "stl" | "obj":
+            name = f"sdf_mesh.{fmt}"
+            if len(faces) == 0:
+                return Download(
+                    name, None, "The shape is empty (0 triangles): there is no surface to export."
+                )
+            return Download(name, mesh_file(fmt, vertices, faces, colors))
+
+
+def mesh_file(
+    fmt: MeshFormat, vertices: np.ndarray, faces: np.ndarray, colors: np.ndarray
+) -> bytes:
+    """The mesh as a file of format ``fmt``, with its colours where the format has them; ValueError for a mesh of
+    no triangles (its files would be broken: an OBJ of bare ``v``/``f`` lines, a GLB node with no mesh)."""
+    if len(faces) == 0:
+        raise ValueError("a mesh of no triangles has no file")
     data = sdf.mesh_trimesh(vertices, faces, colors).export(file_type=fmt)
     return data.encode() if isinstance(data, str) else bytes(data)
 

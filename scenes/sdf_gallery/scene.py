@@ -37,7 +37,14 @@ from scenes._worker import LatestWorker
 from scenes.sdf_gallery import editor
 from scenes.sdf_gallery.compare import Agreement, compare, readout_markdown
 from scenes.sdf_gallery.editor import EDITING_OFF, EDITOR_HELP, EXAMPLES, EditorField
-from scenes.sdf_gallery.export import mesh_file, png_bytes, scene_normals, viewer_glb
+from scenes.sdf_gallery.export import (
+    NOTHING_TO_DOWNLOAD,
+    Download,
+    DownloadFormat,
+    download,
+    scene_normals,
+    viewer_glb,
+)
 from scenes.sdf_gallery.params import (
     BOX_HI,
     BOX_LO,
@@ -226,7 +233,7 @@ IoU is lowest when a box edge is on the silhouette.
             ]
             gui.add_markdown(SIZE_MEANING)
             with gui.add_folder("Downloads", expand_by_default=False):
-                self.downloads = {
+                self.downloads: dict[DownloadFormat, viser.GuiButtonHandle] = {
                     "glb": gui.add_button("Download mesh (GLB)"),
                     "stl": gui.add_button("Download mesh (STL)"),
                     "obj": gui.add_button("Download mesh (OBJ)"),
@@ -771,27 +778,27 @@ IoU is lowest when a box edge is on the silhouette.
             self.server.flush()
 
     # ----------------------------------------------------------------------------------------- downloads
-    def _download_handler(self, fmt: str) -> Any:
+    def _download_handler(self, fmt: DownloadFormat) -> Any:
         def handler(event: Any) -> None:
             client = getattr(event, "client", None)
             if client is None or self.closed:
                 return
             try:
-                name, content = self.export(fmt)
+                answer = self.download(fmt)
             except Exception:
                 logger.exception("sdf: export %s failed", fmt)
+                client.add_notification("The download failed", "See the server's log.")
                 return
-            if content is None:
-                client.add_notification(
-                    "Nothing to download yet", "The reference image has not been rendered."
-                )
+            if answer.content is None:
+                client.add_notification(NOTHING_TO_DOWNLOAD, answer.why_not)
                 return
-            client.send_file_download(name, content)
+            client.send_file_download(answer.name, answer.content)
 
         return handler
 
-    def export(self, fmt: str) -> tuple[str, bytes | None]:
-        """File name and bytes of the current mesh (glb, stl, obj) or reference image (png)."""
+    def download(self, fmt: DownloadFormat) -> Download:
+        """The file of a download button (the current mesh as glb, stl or obj, the reference image as png), or why
+        there is none (an empty mesh, no reference yet)."""
         with (
             self._lock
         ):  # a consistent snapshot: the worker replaces these together under this lock
@@ -801,9 +808,12 @@ IoU is lowest when a box edge is on the silhouette.
                 self.mesh_faces,
                 self.mesh_colors,
             )
-        if fmt == "png":
-            return "sdf_reference.png", None if reference is None else png_bytes(reference)
-        return f"sdf_mesh.{fmt}", mesh_file(fmt, vertices, faces, colors)
+        return download(fmt, vertices, faces, colors, reference)
+
+    def export(self, fmt: DownloadFormat) -> tuple[str, bytes | None]:
+        """File name and bytes of :meth:`download` (None when there is nothing to export)."""
+        answer = self.download(fmt)
+        return answer.name, answer.content
 
 
 def march(

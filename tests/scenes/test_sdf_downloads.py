@@ -1,0 +1,181 @@
+"""The SDF gallery's downloads follow one rule: a file that parses back to what is shown, or, with nothing to
+export (an empty shape, no reference image yet), no file and the same plain notification for every format."""
+
+from __future__ import annotations
+
+import io
+from typing import Any
+
+import numpy as np
+import pytest
+import trimesh
+import viser
+from helpers.scenes import MakeScene
+from helpers.waiting import wait_until
+from helpers.wsclient import BrowserClient
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from kernels import sdf
+from scenes.sdf_gallery import SdfGalleryScene
+from scenes.sdf_gallery.export import (
+    NOTHING_TO_DOWNLOAD,
+    DownloadFormat,
+    MeshFormat,
+    download,
+    mesh_file,
+)
+from shaders import gl_service
+from shaders.renderer import GLUnavailableError
+
+BUTTONS: dict[DownloadFormat, str] = {
+    "glb": "Download mesh (GLB)",
+    "stl": "Download mesh (STL)",
+    "obj": "Download mesh (OBJ)",
+    "png": "Download reference (PNG)",
+}
+MESH_FORMATS: tuple[MeshFormat, ...] = ("glb", "stl", "obj")
+
+
+def press(client: BrowserClient, label: str) -> tuple[str, str, Any]:
+    """Click a download button as a browser does and wait for its answer: ("file", name, bytes) once every part
+    has come, or ("notice", title, body)."""
+    client.take_received()
+    client.click(label)
+    answer: dict[str, Any] = {}
+
+    def answered() -> bool:
+        for _, m in client.received:
+            if m.get("type") == "NotificationShowMessage":
+                answer["notice"] = m
+            elif m.get("type") == "FileTransferStartDownload":
+                parts = [
+                    p
+                    for _, p in client.received
+                    if p.get("type") == "FileTransferPart"
+                    and p["transfer_uuid"] == m["transfer_uuid"]
+                ]
+                if len(parts) == m["part_count"]:
+                    answer["file"] = (m, parts)
+        return bool(answer)
+
+    client.wait_for(answered, what=f"the answer to {label}")
+    if "notice" in answer:
+        props = answer["notice"]["props"]
+        return "notice", props["title"], props["body"]
+    start, parts = answer["file"]
+    data = b"".join(p["content"] for p in sorted(parts, key=lambda p: p["part_index"]))
+    assert len(data) == start["size_bytes"]
+    return "file", start["filename"], data
+
+
+def triangles_in(data: bytes, fmt: str) -> int:
+    loaded = trimesh.load(io.BytesIO(data), file_type=fmt, force="mesh", process=False)
+    assert isinstance(loaded, trimesh.Trimesh)
+    return len(loaded.faces)
+
+
+# ------------------------------------------------------------------------------------------ through the scene
+def test_an_empty_shape_downloads_nothing_and_says_so_for_every_mesh_format(
+    server: viser.ViserServer, show_scene: MakeScene
+) -> None:
+    scene = show_scene(SdfGalleryScene)
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("P4 combine")
+        for slot in (2, 3, 4):
+            client.set_value(f"P{slot} combine", "Intersect")
+        wait_until(
+            lambda: (
+                scene.mesh_scene is not None
+                and all(p.op == "intersect" for p in scene.mesh_scene.primitives[1:])
+                and scene.agreement.triangles == 0
+            ),
+            "the empty intersection meshed",
+        )
+        assert len(scene.mesh_faces) == 0 and "0" in scene.readout.content
+        for fmt in MESH_FORMATS:
+            kind, title, body = press(client, BUTTONS[fmt])
+            assert kind == "notice", f"{fmt}: a file was sent for an empty shape"
+            assert title == NOTHING_TO_DOWNLOAD
+            assert "empty" in body and "0 triangles" in body
+            assert scene.export(fmt) == (f"sdf_mesh.{fmt}", None)
+
+
+def test_a_shape_downloads_as_files_that_parse_back_with_its_triangles(
+    server: viser.ViserServer, show_scene: MakeScene
+) -> None:
+    scene = show_scene(SdfGalleryScene)
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Download mesh (GLB)")
+        triangles = len(scene.mesh_faces)
+        assert triangles > 1000
+        for fmt in MESH_FORMATS:
+            kind, name, data = press(client, BUTTONS[fmt])
+            assert (kind, name) == ("file", f"sdf_mesh.{fmt}")
+            assert triangles_in(data, fmt) == triangles
+
+
+def test_no_reference_image_downloads_nothing_with_the_same_notice(
+    server: viser.ViserServer, show_scene: MakeScene, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    def no_gl(job: object, timeout_s: float | None = None) -> None:
+        raise GLUnavailableError("No OpenGL context (test): no reference image")
+
+    monkeypatch.setattr(gl_service, "run", no_gl)
+    scene = show_scene(SdfGalleryScene)
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui(BUTTONS["png"])
+        wait_until(lambda: scene.gl_error is not None, "the renderer to be tried")
+        kind, title, body = press(client, BUTTONS["png"])
+        assert (kind, title) == ("notice", NOTHING_TO_DOWNLOAD)
+        assert "reference image" in body
+        assert scene.export("png") == ("sdf_reference.png", None)
+
+
+# ------------------------------------------------------------------------------------------ the rule, over shapes
+_OPS: st.SearchStrategy[sdf.BooleanOp] = st.sampled_from(["union", "subtract", "intersect"])
+_COORDINATES = st.floats(-0.8, 0.8)
+
+
+@st.composite
+def scenes(draw: st.DrawFn) -> sdf.Scene:
+    """One to four spheres and boxes anywhere in the gallery's box, combined by any operation: often empty."""
+    count = draw(st.integers(1, 4))
+    primitives = []
+    for i in range(count):
+        kind: sdf.PrimitiveKind = draw(st.sampled_from(["sphere", "box"]))
+        centre = (draw(_COORDINATES), draw(_COORDINATES), draw(_COORDINATES))
+        size = (draw(st.floats(0.1, 0.6)),) if kind == "sphere" else (0.3, 0.2, 0.25)
+        op: sdf.BooleanOp = "union" if i == 0 else draw(_OPS)
+        primitives.append(sdf.Primitive(kind, centre, size, op=op))
+    return sdf.Scene(tuple(primitives), k=draw(st.sampled_from([0.0, 0.1])))
+
+
+@settings(max_examples=30, deadline=None)
+@given(scenes(), st.sampled_from(MESH_FORMATS))
+def test_every_mesh_download_is_a_file_with_its_triangles_or_nothing(
+    scene: sdf.Scene, fmt: MeshFormat
+) -> None:
+    vertices, faces, colors = sdf.mesh(scene, 24)
+    answer = download(fmt, vertices, faces, colors, None)
+    assert answer.name == f"sdf_mesh.{fmt}"
+    if len(faces) == 0:
+        assert answer.content is None and "empty" in answer.why_not
+        with pytest.raises(ValueError, match="no triangles"):
+            mesh_file(fmt, vertices, faces, colors)
+    else:
+        assert answer.content is not None and answer.why_not == ""
+        assert triangles_in(answer.content, fmt) == len(faces)
+
+
+@given(st.one_of(st.none(), st.integers(1, 8).map(lambda n: np.full((n, n + 1, 3), 9, np.uint8))))
+def test_the_png_download_is_the_image_or_nothing(image: np.ndarray | None) -> None:
+    empty = np.zeros((0, 3)), np.zeros((0, 3), np.int64), np.zeros((0, 3))
+    answer = download("png", *empty, image)
+    if image is None:
+        assert answer.content is None and "reference image" in answer.why_not
+    else:
+        from PIL import Image
+
+        assert answer.content is not None
+        np.testing.assert_array_equal(np.asarray(Image.open(io.BytesIO(answer.content))), image)
