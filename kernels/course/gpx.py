@@ -1,19 +1,23 @@
 """Read a GPX file into a :class:`kernels.course.route.Course`, refusing a bad file in words a rider can act on.
 
 :func:`load_gpx` takes a path, bytes or text (at most 20 MiB and 200 000 points), decodes it by its byte-order mark or
-XML declaration (XML 1.0 §4.3.3), parses it with gpxpy, and refuses points off the map, track segments more than
-2 km apart, and any stretch steeper than 50 % (:data:`MAX_GPX_GRADE`), which no road is. :data:`SAMPLE_ROUTE` is the
+XML declaration (XML 1.0 §4.3.3), parses it with gpxpy, and refuses points off the map, pieces more than 2 km
+apart, and any stretch steeper than 50 % (:data:`MAX_GPX_GRADE`), which no road is. The pieces are every track
+segment and every route, joined in the order the file gives them: points arriving as tracks, as segments of one
+track, as routes or as a mix of them make the same course, under the same rule. :data:`SAMPLE_ROUTE` is the
 bundled Alpe d'Huez course in ``kernels/routes/``.
 """
 
 from __future__ import annotations
 
 import codecs
+import dataclasses
 import math
 import os
 import re
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Literal
 
 import gpxpy
 import gpxpy.gpx
@@ -39,7 +43,7 @@ _GPX_ROOT = re.compile(r"<(?:([A-Za-z_][\w.-]*):)?gpx[\s>/]")
 def load_gpx(
     source: str | os.PathLike[str] | bytes, *, name: str | None = None, smoothing_m: float = 50.0
 ) -> Course:
-    """Read a GPX file's track points (or, when it has no track, its route points) into a :class:`Course`.
+    """Read a GPX file's track and route points into a :class:`Course`.
 
     Args:
         source: a path, the file's bytes, or the file's text (a string that starts with ``<``).
@@ -47,13 +51,14 @@ def load_gpx(
         smoothing_m: elevation moving-average window (m).
 
     Returns:
-        The course, every track segment joined in file order.
+        The course: every track segment and every route joined in the order the file gives them.
 
     Raises:
         ValueError: with a message a person can act on: the file is larger than 20 MiB, not GPX (or not text),
             has no track points, one point, points without elevation, non-finite or out-of-range values, more
-            than 200 000 points, a stretch steeper than :data:`MAX_GPX_GRADE` (50 %), or track segments more than
-            :data:`MAX_SEGMENT_GAP_M` (2 km) apart. Nothing else escapes for a bad file.
+            than 200 000 points, a stretch steeper than :data:`MAX_GPX_GRADE` (50 %), or consecutive pieces (track
+            segments or routes, in any mix) more than :data:`MAX_SEGMENT_GAP_M` (2 km) apart; the message names
+            both pieces and the gap. Nothing else escapes for a bad file.
 
     The text is decoded by its byte-order mark, else the XML declaration's encoding (ISO-8859-1, UTF-16...),
     else as UTF-8; a namespace prefix on the GPX elements (``<g:gpx xmlns:g=...>``) is read too.
@@ -100,14 +105,10 @@ def load_gpx(
     except (ValueError, TypeError, AttributeError, IndexError) as error:
         raise ValueError(f"{label} is not a valid GPX file: {type(error).__name__}") from error
 
-    segments = [
-        segment.points for track in gpx.tracks for segment in track.segments if segment.points
-    ]
-    kind = "track"
-    if not segments:
-        segments = [route.points for route in gpx.routes if route.points]
-        kind = "route"
-    points = [p for segment in segments for p in segment]
+    pieces = _pieces(gpx, text)
+    kinds = {piece.kind for piece in pieces}
+    kind = " and ".join(sorted(kinds)) if kinds else "track"
+    points = [p for piece in pieces for p in piece.points]
     if not points:
         raise ValueError(f"{label} has no track points")
     if len(points) > MAX_POINTS:
@@ -124,9 +125,9 @@ def load_gpx(
     lon = np.array([p.longitude for p in points], dtype=np.float64)
     ele = np.array([p.elevation for p in points], dtype=np.float64)
     _check_values(label, kind, lat, lon, ele)
-    if kind == "track":
-        _check_gaps(label, segments)
-    title = name or next((t.name for t in gpx.tracks if t.name), None) or gpx.name
+    _check_gaps(label, pieces)
+    named = [*gpx.tracks, *gpx.routes]
+    title = name or next((t.name for t in named if t.name), None) or gpx.name
     title = title or (label if label != "the file" else "GPX course")
     title = str(title)[:80]
     try:
@@ -146,7 +147,8 @@ GRADE_WINDOW_M = 25.0
 """Stretch over which :data:`MAX_GPX_GRADE` is checked on the raw elevation (m): long enough that ±2 m GPS noise
 between points a metre apart stays under 20 %, short enough that a real cliff cannot hide."""
 MAX_SEGMENT_GAP_M = 2000.0
-"""Largest jump :func:`load_gpx` accepts between the end of one track segment and the start of the next (m)."""
+"""Largest jump :func:`load_gpx` accepts between the end of one piece (track segment or route) and the start of the
+next (m)."""
 
 _XML_ENCODING = re.compile(rb"""^<\?xml[^>]*?encoding\s*=\s*["']([A-Za-z0-9._-]+)["']""")
 
@@ -204,17 +206,60 @@ def _check_values(
             )
 
 
-def _check_gaps(
-    label: str, segments: Sequence[Sequence[gpxpy.gpx.GPXTrackPoint | gpxpy.gpx.GPXRoutePoint]]
-) -> None:
-    """Refuse tracks or segments that do not follow on: the route would jump across the map."""
-    for i in range(1, len(segments)):
-        a, b = segments[i - 1][-1], segments[i][0]
+@dataclasses.dataclass(frozen=True)
+class _Piece:
+    """One run of points the file gives: a track segment or a route."""
+
+    kind: Literal["track", "route"]
+    name: str
+    """How a reader finds it in the file: "track 2, segment 1", "route 1" (numbered from 1, empty ones included)."""
+    points: Sequence[gpxpy.gpx.GPXTrackPoint | gpxpy.gpx.GPXRoutePoint]
+
+
+# A <trk> or <rte> start tag (not <trkpt>, <trkseg>, <rtept>), outside comments and CDATA.
+_PIECE_TAG = re.compile(r"<(trk|rte)[\s>/]")
+_NOT_MARKUP = re.compile(r"<!--.*?-->|<!\[CDATA\[.*?\]\]>", re.DOTALL)
+
+
+def _pieces(gpx: gpxpy.gpx.GPX, text: str) -> list[_Piece]:
+    """The file's non-empty track segments and routes, in the order the file gives them.
+
+    gpxpy keeps tracks and routes in two lists, so the order of ``<trk>`` and ``<rte>`` elements is read from the
+    text; where that reading does not match what gpxpy found, GPX 1.1's schema order is used (routes, then tracks).
+    """
+    tracks = [
+        [
+            _Piece(
+                "track",
+                f"track {i + 1}" + (f", segment {j + 1}" if len(track.segments) > 1 else ""),
+                seg.points,
+            )
+            for j, seg in enumerate(track.segments)
+        ]
+        for i, track in enumerate(gpx.tracks)
+    ]
+    routes = [
+        [_Piece("route", f"route {i + 1}", route.points)] for i, route in enumerate(gpx.routes)
+    ]
+    order = _PIECE_TAG.findall(_NOT_MARKUP.sub("", text))
+    if order.count("trk") == len(tracks) and order.count("rte") == len(routes):
+        queues = {"trk": iter(tracks), "rte": iter(routes)}
+        elements = [next(queues[tag]) for tag in order]
+    else:
+        elements = [*routes, *tracks]
+    return [piece for element in elements for piece in element if piece.points]
+
+
+def _check_gaps(label: str, pieces: Sequence[_Piece]) -> None:
+    """Refuse pieces that do not follow on, however they arrive: the route would jump across the map."""
+    for i in range(1, len(pieces)):
+        a, b = pieces[i - 1].points[-1], pieces[i].points[0]
         gap = _great_circle_m(a.latitude, a.longitude, b.latitude, b.longitude)
         if gap > MAX_SEGMENT_GAP_M:
             raise ValueError(
-                f"{label}: track segment {i + 1} starts {_km(gap)} from where segment {i} ends "
-                f"(at most {MAX_SEGMENT_GAP_M / 1000:.0f} km is joined); load the pieces as separate files"
+                f"{label}: segment {i + 1} starts {_km(gap)} from where segment {i} ends (segment {i} is "
+                f"{pieces[i - 1].name}, segment {i + 1} is {pieces[i].name}; at most "
+                f"{MAX_SEGMENT_GAP_M / 1000:.0f} km is joined); load the pieces as separate files"
             )
 
 
