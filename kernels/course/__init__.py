@@ -4,11 +4,13 @@ A course of N points has per-point arrays of shape (N,) (distance, elevation, ma
 shape (N − 1,) (grade, heading, length); segment i runs from point i to point i + 1. SI units throughout (m, s, kg,
 W, rad); headings are compass bearings, clockwise from north, in radians.
 
-**Course.** :func:`load_gpx` reads the track points of a GPX file with gpxpy. Segment lengths on the map are great-circle
+**Course.** :func:`load_gpx` reads the track and route points of a GPX file with gpxpy. Segment lengths on the map are great-circle
 (haversine) distances on a sphere of radius 6 371 008.8 m (the IUGG mean Earth radius); headings are the initial
 great-circle bearings. GPS elevation is noisy, so it is smoothed by a moving average over a distance window
 (``smoothing_m``, 50 m by default); grade is the smoothed rise over the map distance, and the rider travels the
-slope length run·√(1 + grade²).
+slope length run·√(1 + grade²). A GPX file's track segments and routes are joined in file order, and pieces more
+than 2 km apart are refused, however they arrive. :attr:`Course.climbing_m` is the noise-aware total ascent
+(:func:`total_ascent`: spikes out, a 100 m moving average, climbs counted past a 5 m hysteresis threshold).
 
 **Ride.** Along each segment the rider's kinetic energy changes by the work of the pedals minus the resistances
 (the power terms of :mod:`kernels.cycling`, the seed's or Martin et al. 1998's):
@@ -59,6 +61,9 @@ from kernels.course.ride import (
     warm_up,
 )
 from kernels.course.route import (
+    ASCENT_SPIKE_GRADE,
+    ASCENT_THRESHOLD_M,
+    ASCENT_WINDOW_M,
     EARTH_RADIUS_M,
     MAX_POINTS,
     Course,
@@ -66,9 +71,13 @@ from kernels.course.route import (
     course_from_points,
     course_from_xy,
     steepest_grade,
+    total_ascent,
 )
 
 __all__ = [
+    "ASCENT_SPIKE_GRADE",
+    "ASCENT_THRESHOLD_M",
+    "ASCENT_WINDOW_M",
     "EARTH_RADIUS_M",
     "GRADE_WINDOW_M",
     "MAX_FILE_BYTES",
@@ -92,5 +101,6 @@ __all__ = [
     "power_for_time",
     "ride",
     "steepest_grade",
+    "total_ascent",
     "warm_up",
 ]
