@@ -16,7 +16,7 @@ numba's threads and threading layer, the load average before and after), then:
    ``solve`` call on the same chain and target, and their ratio. Goal: ``solve`` within 2× of the core.
 6. The goal table.
 
-The baseline is ``tests/ik_reference.py``'s FABRIK: Aristidou & Lasenby's Algorithm 1 in plain numpy, one joint at a
+The baseline is ``tests/helpers/ik_reference.py``'s FABRIK: Aristidou & Lasenby's Algorithm 1 in plain numpy, one joint at a
 time, with the same cone limits (it has no obstacles), iterated to the same tolerance and cap in the same process;
 ``× baseline`` is its time over ours. Every single-solve time is the fastest of three runs (timeit's rule: another
 process taking the core mid-solve says nothing about the solver). The machine may be shared: read the figures with
@@ -43,8 +43,8 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tests"))
 
-import ik_reference  # noqa: E402
 import numba  # noqa: E402
+from helpers import ik_reference  # noqa: E402
 
 from kernels import fabrik  # noqa: E402
 

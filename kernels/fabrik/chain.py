@@ -24,8 +24,11 @@ from kernels.fabrik.geometry import (
     _unit,
 )
 from kernels.fabrik.limits import (
+    _bend_within,
     _constrain,
     _forward_limits,
+    _holding_hinge,
+    _inside_limit,
     _joint_ok,
 )
 
@@ -69,6 +72,17 @@ _EXTRAPOLATION_MIN_RATIO = 0.5
 """Error ratio per iteration below which FABRIK iterates are left as they are."""
 _DLS_DAMPING = 0.1
 """Damping of the DLS step, times the mean link length (Buss 2004 suggests λ of the order of the link size)."""
+_POLISH_STARTS = 4
+"""Starts of the polish of a FABRIK chain under hinges that stalls or creeps: the best pose, then admissible poses."""
+_POLISH_STEPS = 50
+"""Most damped-least-squares steps of the polish from each start (not ``max_iterations``: a longer run must repeat
+a shorter one's polish)."""
+_CREEP = 0.5
+"""A chain under hinges whose best error has not halved in :data:`_PATIENCE` iterations creeps (FABRIK under
+one-sided ranges can close in as slowly as 1/k): it is polished."""
+_GOLDEN = 0.6180339887498949, 0.7548776662466927, 0.5698402909980532
+"""Steps of the additive recurrences (golden ratio; plastic number) that spread the admissible starts' joint angles
+evenly and deterministically: the same starts in every call, every thread."""
 
 
 @numba.njit(cache=True, error_model="numpy")
@@ -315,10 +329,16 @@ def _place_on_line(
 @numba.njit(cache=True, error_model="numpy")
 def _unbend(
     p: NDArray[np.float64], target: NDArray[np.float64], lengths: NDArray[np.float64],
-    tiny: float, rest: NDArray[np.float64], has_limits: bool, cos_phi: float, dim: int,
+    tiny: float, rest: NDArray[np.float64], limits: tuple[bool, NDArray[np.float64]], cos_phi: float,
+    dim: int,
 ) -> None:  # fmt: skip
-    """Bend a straight chain whose target lies on its own line into a gentle symmetric arc, so the passes can bend
-    it (every interior joint leaves the line; an arc starting along it would leave p_1 on it)."""
+    """Bend a straight chain whose target lies on its own line into a gentle arc centred on that line, so the
+    passes can bend it (every interior joint leaves the line; an arc starting along it would leave p_1 on it).
+
+    Each joint bends by the same step, at most half the tightest cone, and a hinge about the arc's normal toward
+    the inside of its range (:func:`~kernels.fabrik.limits._bend_within`): a bend past a one-sided range's end,
+    or any bend of a zero range, would be clamped straight again, leaving the chain rotated off its line."""
+    has_limits, table = limits
     n = p.shape[0] - 1
     ax, ay, az = rest[0], rest[1], rest[2]
     for i in range(n):  # the axis: the first segment with a direction
@@ -343,8 +363,25 @@ def _unbend(
     if step <= 0.0:
         return
     sx, sy, sz = _perpendicular(ax, ay, az, dim)
+    nx, ny, nz = ay * sz - az * sy, az * sx - ax * sz, ax * sy - ay * sx
+    # The arc turns by each joint's bend; centred, its first and last segments straddle the line.
+    turn, bent = 0.0, False
+    for i in range(1, n):
+        bend = (
+            step if not has_limits else _bend_within(table, i, ax, ay, az, nx, ny, nz, rest, step)
+        )
+        bent = bent or bend != 0.0
+        turn += bend
+    if not bent:
+        return
+    angle = -0.5 * turn
     for i in range(n):
-        angle = step * (i - 0.5 * (n - 1))
+        if i > 0:
+            angle += (
+                step
+                if not has_limits
+                else _bend_within(table, i, ax, ay, az, nx, ny, nz, rest, step)
+            )
         c, s = math.cos(angle) * lengths[i], math.sin(angle) * lengths[i]
         p[i + 1, 0] = p[i, 0] + c * ax + s * sx
         p[i + 1, 1] = p[i, 1] + c * ay + s * sy
@@ -377,6 +414,81 @@ def _extrapolate(
             p[i, c] = now + weight * (now - previous[i, c])
             previous[i, c] = now
     return True
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _admissible_start(
+    p: NDArray[np.float64], lengths: NDArray[np.float64], tiny: float, rest: NDArray[np.float64],
+    table: NDArray[np.float64], has_zero: bool, start: int, dim: int,
+) -> None:  # fmt: skip
+    """Rebuild ``p`` from its root as the ``start``-th admissible pose: every joint at an angle inside its limit
+    (:func:`~kernels.fabrik.limits._inside_limit`), the fractions taken from additive recurrences over the start
+    and the joint, kept off a range's ends (a one-sided range's end is often a fixed point)."""
+    qx, qy, qz = rest[0], rest[1], rest[2]
+    for i in range(lengths.shape[0]):
+        u = 0.1 + 0.8 * ((0.5 + start * _GOLDEN[0] + i * _GOLDEN[1]) % 1.0)
+        v = (start * _GOLDEN[2] + i * _GOLDEN[1]) % 1.0
+        dx, dy, dz = _inside_limit(qx, qy, qz, table, i, rest, u, v, dim)
+        length = lengths[i]
+        p[i + 1, 0], p[i + 1, 1], p[i + 1, 2] = (
+            p[i, 0] + length * dx,
+            p[i, 1] + length * dy,
+            p[i, 2] + length * dz,
+        )
+        if not has_zero or length > tiny:
+            qx, qy, qz = dx, dy, dz
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _polish(
+    p: NDArray[np.float64], best: NDArray[np.float64], best_error: float,
+    target: NDArray[np.float64], tolerance: float, budget: int, lengths: NDArray[np.float64],
+    tiny: float, rest: NDArray[np.float64], limits: tuple[bool, NDArray[np.float64]],
+    centres: NDArray[np.float64], radii: NDArray[np.float64], live: NDArray[np.bool_],
+    has_zero: bool, dim: int, turns: NDArray[np.float64],
+) -> float:  # fmt: skip
+    """Damped least squares (:func:`_dls_step`, each iterate projected by the constrained backward pass) from the
+    best pose, then from admissible poses (:func:`_admissible_start`), once FABRIK under hinges stalls or creeps
+    short of a reachable target. FABRIK's fixed points under one-sided or narrow hinge ranges are many (a joint resting at a
+    range's end, a near-rigid chain pulled along a line), and its outcome there depended on which side a tie fell
+    (a chain and its mirror image missed 1 % and 24 % of reachable targets); joint-space steps from a few
+    admissible starts leave those basins. Each start runs up to ``budget`` steps and stops once its error has not
+    improved by :data:`_PROGRESS` of the tolerance in :data:`_PATIENCE` steps; the first iterate within the
+    tolerance ends it. Updates ``best`` (n + 1, 3) in place and returns its error; ``p`` and ``turns`` (n + 1, 3)
+    are scratch."""
+    has_limits, table = limits
+    progress = _PROGRESS * tolerance + tiny
+    for start in range(_POLISH_STARTS):
+        if start == 0:
+            _copy(best, p)
+        else:
+            _admissible_start(p, lengths, tiny, rest, table, has_zero, start, dim)
+            _backward_pass(p, lengths, tiny, rest, limits, centres, radii, live, has_zero, dim)
+            error = _end_error(p, target)
+            if error < best_error and _admissible(
+                p, tiny, rest, has_limits, table, centres, radii, live
+            ):
+                _copy(p, best)
+                best_error = error
+                if error <= tolerance:
+                    return best_error
+        mark_iteration, mark_error = 0, _end_error(p, target)
+        for iteration in range(1, budget + 1):
+            _dls_step(p, target, lengths, tiny, turns)
+            _backward_pass(p, lengths, tiny, rest, limits, centres, radii, live, has_zero, dim)
+            error = _end_error(p, target)
+            if error < best_error and _admissible(
+                p, tiny, rest, has_limits, table, centres, radii, live
+            ):
+                _copy(p, best)
+                best_error = error
+                if error <= tolerance:
+                    return best_error
+            if error < mark_error - progress:
+                mark_iteration, mark_error = iteration, error
+            elif iteration - mark_iteration >= _PATIENCE:
+                break
+    return best_error
 
 
 @numba.njit(cache=True, error_model="numpy")
@@ -449,7 +561,7 @@ def _solve_chain(
                 history[1] = candidate
                 return 1, _REACHED if candidate <= tolerance else _UNREACHABLE, candidate
 
-    _unbend(p, target, lengths, tiny, rest, has_limits, cos_phi, dim)
+    _unbend(p, target, lengths, tiny, rest, limits, cos_phi, dim)
     # The extrapolation's first call moves by 0 × (p − previous): never 0 × uninitialised memory (NaN).
     _copy(p, previous)
     stall = _STALL * tolerance + tiny
@@ -459,6 +571,9 @@ def _solve_chain(
     count, mark_iteration, mark_error = 0, 0, best_error
     # Extrapolated FABRIK under limits, within reach, restarts once where it stalls (see below) at ``restart``
     retry, restart = extrapolate and has_limits and not out_of_reach, 0
+    # ... and under hinges, polishes once where it stalls after that or creeps (see _polish), at ``creep_iteration``
+    polish = retry and _holding_hinge(table)
+    creep_iteration, creep_error, creeping = 0, best_error, False
     for iteration in range(1, max_iterations + 1):
         count = iteration
         last_error = history[iteration - 1]
@@ -506,10 +621,33 @@ def _solve_chain(
             ux, uy, uz, _ = _unit(ox, oy, oz, rest[0], rest[1], rest[2], tiny)
             _place_on_line(p, best[0], lengths, ux, uy, uz, False)
             _unbend(
-                p, target, lengths, tiny, rest, has_limits, cos_phi, dim
+                p, target, lengths, tiny, rest, limits, cos_phi, dim
             )  # a straight chain never bends
             _backward_pass(p, lengths, tiny, rest, limits, centres, radii, live, has_zero, dim)
+            # The restart pose is a candidate too: where the limits leave the chain nearly rigid, the passes from
+            # it may move away from the best pose it already is.
+            error = _end_error(p, target)
+            if error < best_error and _admissible(
+                p, tiny, rest, has_limits, table, centres, radii, live
+            ):
+                _copy(p, best)
+                best_error = error
+                reached = error <= tolerance
+                if reached:
+                    break
             continue
+        if polish and not reached:
+            if iteration - creep_iteration >= _PATIENCE:
+                creeping = best_error > _CREEP * creep_error
+                creep_iteration, creep_error = iteration, best_error
+            if (stalled and not retry) or creeping:
+                # Decided by the iterates alone, which a longer run repeats: more iterations are never worse.
+                polish = False
+                best_error = _polish(out_p, best, best_error, target, tolerance, _POLISH_STEPS, lengths, tiny,
+                                     rest, limits, centres, radii, live, has_zero, dim, before)  # fmt: skip
+                if best_error <= tolerance:
+                    reached = True
+                    _copy(best, p)
         if reached or stalled:
             break
 

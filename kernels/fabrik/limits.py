@@ -394,3 +394,74 @@ def _usage(
             share[i] = 1.0 if half <= 0.0 else min(max(1.0 - gap / half, 0.0), 1.0)
         qx, qy, qz = dx, dy, dz
     return share
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _inside_limit(
+    qx: float, qy: float, qz: float, table: NDArray[np.float64], i: int,
+    rest: NDArray[np.float64], u: float, v: float, dim: int,
+) -> tuple[float, float, float]:  # fmt: skip
+    """A unit direction for segment i that keeps its joint's limit, q (unit) the previous segment's direction, picked
+    by two numbers u, v in [0, 1): a hinge's angle at the fraction u of its range; a cone's (or a free joint's,
+    the cone of π) angle from q at ``(2u − 1) φ`` in the plane, or at ``u φ`` with azimuth ``2π v`` in 3D.
+
+    The chain's restarts from admissible poses build their poses with it, segment by segment from the root."""
+    row = _row(table, i)
+    kind = table[row, 0]
+    if kind == _KIND_HINGE:
+        ax, ay, az, rx, ry, rz = _hinge_axes(table, row, qx, qy, qz, rest)
+        low, high = table[row, 9], table[row, 10]
+        angle = low + u * (high - low)
+        bx, by, bz = ay * rz - az * ry, az * rx - ax * rz, ax * ry - ay * rx
+        c, s = math.cos(angle), math.sin(angle)
+        return c * rx + s * bx, c * ry + s * by, c * rz + s * bz
+    phi = math.atan2(table[row, 2], table[row, 1]) if kind == _KIND_CONE else math.pi
+    sx, sy, sz = _perpendicular(qx, qy, qz, dim)
+    if dim == 2:
+        angle = (2.0 * u - 1.0) * phi
+    else:
+        angle = u * phi
+        tx, ty, tz = qy * sz - qz * sy, qz * sx - qx * sz, qx * sy - qy * sx
+        c, s = math.cos(2.0 * math.pi * v), math.sin(2.0 * math.pi * v)
+        sx, sy, sz = c * sx + s * tx, c * sy + s * ty, c * sz + s * tz
+    c, s = math.cos(angle), math.sin(angle)
+    dx, dy, dz = c * qx + s * sx, c * qy + s * sy, c * qz + s * sz
+    norm = math.sqrt(dx * dx + dy * dy + dz * dz)
+    return dx / norm, dy / norm, dz / norm
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _holding_hinge(table: NDArray[np.float64]) -> bool:
+    """Whether some joint is a hinge with less than the full turn (see :func:`_holds`)."""
+    for row in range(table.shape[0]):
+        if table[row, 0] == _KIND_HINGE and _holds(table, row):
+            return True
+    return False
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _bend_within(
+    table: NDArray[np.float64], i: int, qx: float, qy: float, qz: float, nx: float, ny: float,
+    nz: float, rest: NDArray[np.float64], step: float,
+) -> float:  # fmt: skip
+    """The signed bend (rad, right-handed about the unit normal n) that segment i takes from the straight
+    continuation q (unit) of the segment before it when a straight chain is bent into an arc: ``step`` toward the
+    centre of a hinge's range about ±n, at most half way to that side's end (0 for a zero range, the feasible side
+    of a one-sided range); ``step`` for other joints (a cone bounds ``step`` itself), and for a hinge about another
+    axis (the backward pass brings the bend into its plane) at most half its range's larger side."""
+    row = _row(table, i)
+    if table[row, 0] != _KIND_HINGE:
+        return step
+    ax, ay, az, rx, ry, rz = _hinge_axes(table, row, qx, qy, qz, rest)
+    along = ax * nx + ay * ny + az * nz
+    low, high = table[row, 9], table[row, 10]
+    straight = _hinge_angle(qx, qy, qz, ax, ay, az, rx, ry, rz, low, high)
+    low, high = low - straight, high - straight
+    # About another axis, the backward pass turns the bend into the hinge's plane: keep it that small.
+    if abs(along) < 1.0 - 1e-9:
+        return min(step, max(0.5 * high, -0.5 * low, 0.0))
+    if along < 0.0:
+        low, high = -high, -low
+    if low + high >= 0.0:
+        return min(step, max(0.5 * high, 0.0))
+    return max(-step, min(0.5 * low, 0.0))
