@@ -13,12 +13,16 @@ from pathlib import Path
 
 import pytest
 import viser
+from helpers.ci import IN_CI, fresh_renderer, skip_or_fail
+from helpers.scenes import MakeScene, S
 from hypothesis import settings
 
+from app import serve_scenes
+from scenes._base import Scene
 from server.gate import install_gate
+from server.sessions import Sessions
 from server.switcher import SceneSwitcher
-
-IN_CI = os.environ.get("CI", "").lower() in ("1", "true", "yes")
+from shaders.renderer import Renderer
 
 # CI must not be flaky: under CI=true hypothesis draws the same examples on every run (locally it explores anew).
 settings.register_profile("ci", derandomize=True, deadline=None, print_blob=True)
@@ -34,13 +38,6 @@ CHROMIUM_ARGS = [
     "--disable-sync",
     "--enable-unsafe-swiftshader",
 ]
-
-
-def skip_or_fail(reason: str) -> None:
-    """Skip outside CI; under CI=true a missing capability is a failure, never a silent skip."""
-    if IN_CI:
-        pytest.fail(f"{reason} (CI=true: this test must run)")
-    pytest.skip(reason)
 
 
 @pytest.fixture
@@ -62,6 +59,54 @@ def switcher(server: viser.ViserServer) -> Iterator[SceneSwitcher]:
         yield app
     finally:
         app.close()
+
+
+@pytest.fixture
+def sessions(server: viser.ViserServer) -> Iterator[Sessions]:
+    """The app's per-tab sessions on ``server`` (each tab its own scene), opening on the peloton."""
+    manager = serve_scenes(server, "peloton", shared=False)
+    assert isinstance(manager, Sessions)
+    try:
+        yield manager
+    finally:
+        manager.close()
+
+
+@pytest.fixture
+def show_scene(switcher: SceneSwitcher) -> MakeScene:
+    """Shows a scene class on ``switcher`` (closed with it) and returns the scene, checked to be of that class."""
+
+    def show(kind: type[S]) -> S:
+        shown = switcher.show(kind.key)
+        assert isinstance(shown, kind)
+        return shown
+
+    return show
+
+
+@pytest.fixture
+def scene_on(server: viser.ViserServer) -> Iterator[MakeScene]:
+    """Builds a scene class directly on ``server`` (no switcher) and closes what is still open afterwards."""
+    built: list[Scene] = []
+
+    def build(kind: type[S]) -> S:
+        scene = kind(server)
+        built.append(scene)
+        return scene
+
+    try:
+        yield build
+    finally:
+        for scene in built:
+            if not scene.closed:
+                scene.close()
+
+
+@pytest.fixture(scope="module")
+def gl() -> Iterator[Renderer]:
+    """A renderer of the module's own (an OpenGL context: skipped locally without one, a failure under CI)."""
+    with fresh_renderer() as renderer:
+        yield renderer
 
 
 @pytest.fixture(scope="session")

@@ -1,5 +1,5 @@
 #version 330
-// Test harness for tests/test_edges_shaders.py: evaluates sdf.glsl's blend functions themselves (not a scene) at
+// Test harness for tests/shaders/test_edges_shaders.py: evaluates sdf.glsl's blend functions themselves (not a scene) at
 // inputs read from a float texture, one (a, b, k, sharpness) per texel: a and b distances (m), k a blend width (m),
 // sharpness the exponential blend's (1/m, possibly +inf).
 

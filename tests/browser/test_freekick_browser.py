@@ -1,0 +1,272 @@
+"""A real browser looks at the free kick: ball, wall, goal and path in view and clear of the panel, the force chart
+drawn, no error text, at 1600×1000 and 1280×720; in the opening view the path stands apart from its no-spin ghost and
+10 % more spin moves it on the screen; every camera view keeps the kick in view with the goal a real size, and the
+goalkeeper's view stands in front of the goal line with no net over the ball; a mouse click on "Kick" flies the ball
+in the page."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from typing import Any
+
+import numpy as np
+import pytest
+import viser
+from helpers.browser import (
+    VIEWPORTS,
+    NumberChange,
+    ScenePage,
+    assert_chart_draws,
+    assert_chart_fits_after,
+    assert_in_view,
+    assert_seen,
+    changed_mask,
+    close_notifications,
+    colour_pixels,
+    error_text,
+    open_viser,
+    panel_rect,
+    project,
+    save_docs_screenshot,
+    scene_page,
+    screenshot,
+    set_number,
+    settle,
+    with_nodes_hidden,
+)
+from helpers.screen_geometry import GOAL_CORNERS, polyline_gap
+from helpers.waiting import wait_until
+
+from scenes._framing import Lens, project_points
+from scenes.freekick import (
+    FORCE_COLOURS,
+    KNUCKLE_COLOUR,
+    PATH_COLOUR,
+    VIEW_LABELS,
+    FreeKickScene,
+    ViewName,
+    ball_spot,
+    frame_view,
+    resample,
+    view_points,
+)
+from server.switcher import SceneSwitcher
+
+pytestmark = pytest.mark.browser
+
+BALL = "/freekick/ball"
+NODE = f"window.__viserMutable.nodeRefFromName[{BALL!r}]"
+MAIN = ["/freekick/wall", "/freekick/goal_frame", "/freekick/path", "/freekick/ball"]
+CHART = "Force magnitudes along the flight"
+CHART_COLOURS = {**FORCE_COLOURS, "knuckle": KNUCKLE_COLOUR}
+OPENING_GOAL_SHARE = 0.25
+"""Least share of the free canvas width (left of the panel) the goal's box spans in the opening view at the
+defaults (the old opening view: 0.18–0.19)."""
+GOAL_SHARE_AGREES = 0.03
+"""In every other view the goal's width on the page must match the width the pure projection of the scene's
+framing gives (tests/scenes/test_freekick_scene.py bounds it over presets and ball spots) to this relative tolerance. A
+fixed floor here tested one state only: side-on it is 0.12–0.15 at the defaults, depending on the spin the
+earlier tests left, and 0.06 for a ball 40 m out."""
+OPENING_GAP_PX = 25.0
+"""Least on-screen distance of the path from its no-spin ghost over the flight's second half, opening view (the old
+one drew them 1–10 px apart)."""
+SPIN_SHIFT_SHARE = 0.006
+"""10 % more spin moves the crossing of the goal line by at least this share of the window width on the screen in
+the opening view (the old view: 8.2 px at 1600 and 5.8 px at 1280 wide, under it)."""
+
+
+@pytest.fixture(scope="module", params=VIEWPORTS, ids=lambda v: f"{v[0]}x{v[1]}")
+def shown(request: pytest.FixtureRequest, chromium_browser: Any) -> Iterator[ScenePage]:
+    with scene_page(chromium_browser, "freekick", request.param) as page:
+        yield page
+
+
+def _look_at_the_kick(shown: ScenePage) -> None:
+    scene = shown.scene
+    assert isinstance(scene, FreeKickScene)
+    image = screenshot(shown.page)
+    with scene._lock:
+        points = view_points(scene.params, scene.state, scene.params.view)
+    xy = assert_in_view(shown, "/freekick", points, f"the kick ({scene.params.view})")
+    assert_seen(shown, image, MAIN, xy, "ball, wall, goal and path")
+
+
+def _goal_share(shown: ScenePage) -> float:
+    xy = project(shown.page, "/freekick", GOAL_CORNERS)[:, :2]
+    return float(np.ptp(xy[:, 0])) / panel_rect(shown.page)[0]
+
+
+def test_the_kick_fills_the_view_clear_of_the_panel(shown: ScenePage) -> None:
+    _look_at_the_kick(shown)
+    scene = shown.scene
+    assert scene.params.view == "broadcast"
+    # It fills the screen: the goal-to-ball extent spans most of the free width, not a postage stamp...
+    with scene._lock:
+        points = view_points(scene.params, scene.state, scene.params.view)
+        path, ghost = resample(scene.state.flight, 40), resample(scene.state.ghost, 40)
+    xy = project(shown.page, "/freekick", points)[:, :2]
+    width = panel_rect(shown.page)[0]
+    assert np.ptp(xy[:, 0]) > 0.6 * width, np.ptp(xy[:, 0])
+    # ...with the goal a real size...
+    assert _goal_share(shown) >= OPENING_GOAL_SHARE, _goal_share(shown)
+    # ...and the curl across the screen: the path stands apart from the no-spin ghost over the second half.
+    path_xy = project(shown.page, "/freekick", path)[20:, :2]
+    ghost_xy = project(shown.page, "/freekick", ghost)[:, :2]
+    gap = polyline_gap(path_xy, ghost_xy)
+    assert np.mean(gap >= OPENING_GAP_PX) >= 0.9, np.round(gap)
+    save_docs_screenshot(shown, "freekick")
+
+
+def test_the_force_chart_draws_every_series(shown: ScenePage) -> None:
+    assert_chart_draws(shown.page, CHART, CHART_COLOURS)
+
+
+def test_no_error_text_on_the_page(shown: ScenePage) -> None:
+    assert error_text(shown.page) == []
+
+
+def test_ten_percent_more_spin_moves_the_path_on_the_screen(shown: ScenePage) -> None:
+    scene = shown.scene
+    with scene._lock:
+        before = resample(scene.state.flight, 40)
+        spin = scene.params.spin_rev_s
+    was = project(shown.page, "/freekick", before)[:, :2]
+    set_number(shown.page, "Spin rate (rev/s)", round(1.1 * spin, 1))
+    wait_until(
+        lambda: scene.params.spin_rev_s == round(1.1 * spin, 1), "the new spin to reach the scene"
+    )
+    settle(shown)
+    with scene._lock:
+        after = resample(scene.state.flight, 40)
+    now = project(shown.page, "/freekick", after)[:, :2]
+    # Where the ball crosses the goal line moved by several pixels on the screen...
+    assert scene.params.view == "broadcast"
+    shift = float(np.linalg.norm(now[-1] - was[-1]))
+    assert shift > SPIN_SHIFT_SHARE * shown.viewport[0], (was[-1], now[-1])
+    # ...and the orange path is drawn there, not where it was.
+    image = screenshot(shown.page)
+    samples = now[20:-2:2]
+    drawn = [
+        colour_pixels(image[int(y) - 4 : int(y) + 5, int(x) - 4 : int(x) + 5], PATH_COLOUR, 70) > 0
+        for x, y in samples
+    ]
+    assert np.mean(drawn) > 0.7, (
+        f"the path shows at only {sum(drawn)} of {len(drawn)} places"
+    )  # arrows cross it
+    assert error_text(shown.page) == []
+
+
+def test_every_camera_view_keeps_the_kick_in_view(shown: ScenePage) -> None:
+    scene = shown.scene
+    views: list[ViewName] = list(VIEW_LABELS)
+    order: list[ViewName] = [
+        *views[1:],
+        views[0],
+    ]  # the opening view last: choosing it again changes nothing
+    for view in order:
+        frames = scene.framing.frames
+        scene.controls["view"].value = VIEW_LABELS[view]  # type: ignore[index]
+        wait_until(
+            lambda view=view, frames=frames: (
+                scene.params.view == view and scene.framing.frames > frames
+            ),
+            f"the {view} view",
+        )
+        settle(shown)
+        image = screenshot(shown.page)
+        with scene._lock:
+            points = view_points(scene.params, scene.state, scene.params.view)
+            spot = ball_spot(scene.params)
+        xy = assert_in_view(shown, "/freekick", points, f"the kick ({view})")
+        assert_seen(shown, image, MAIN, xy, f"ball, wall, goal and path ({view})")
+        if view != "goal":
+            assert_in_view(shown, "/freekick", GOAL_CORNERS, f"the goal ({view})")
+            camera = shown.client_camera
+            lens = Lens(float(camera.fov), int(camera.image_width), int(camera.image_height))
+            with scene._lock:
+                framed = frame_view(scene.params, scene.state, view, lens)
+            # The camera reports its canvas in device pixels, which viser's client scales down (to 0.75–1 of the
+            # CSS size here) while it draws slowly: the pure projection is in those, the page's in CSS px.
+            css_per_px = shown.viewport[0] / lens.width_px
+            expected = css_per_px * float(np.ptp(project_points(framed, lens, GOAL_CORNERS)[:, 0]))
+            seen = float(np.ptp(project(shown.page, "/freekick", GOAL_CORNERS)[:, 0]))
+            assert seen == pytest.approx(expected, rel=GOAL_SHARE_AGREES), view
+            continue
+        # The goalkeeper's view: the camera stands on the pitch in front of the goal line (x < 0)...
+        eye = np.asarray(shown.client_camera.position)
+        assert eye[0] < -0.25, eye
+        # ...the ball is seen, and no net or post is drawn over it. From 20-odd metres the ball is a few pixels
+        # across and its own path and force arrows start on it, so both pictures leave those out: the ball's pixels
+        # are what hiding it changes, and none of them may change when the goal is hidden too.
+        ball_xy = project(shown.page, "/freekick", [spot.tolist()])[0, :2]
+        x, y = np.round(ball_xy).astype(int)
+        overlays = ["/freekick/path", "/freekick/ghost", "/freekick/band"] + [
+            f"/freekick/force_{name}" for name in FORCE_COLOURS
+        ]
+        plain = with_nodes_hidden(shown.page, overlays)
+        ball = changed_mask(plain, with_nodes_hidden(shown.page, [*overlays, BALL]))
+        near = np.zeros_like(ball)
+        near[max(y - 12, 0) : y + 13, max(x - 12, 0) : x + 13] = True
+        ball &= near
+        assert ball.sum() >= 5, f"the ball is hidden at {x, y}"
+        goal = ["/freekick/net", "/freekick/goal_frame"]
+        over_ball = changed_mask(plain, with_nodes_hidden(shown.page, [*overlays, *goal])) & ball
+        assert not over_ball.any(), f"the goal is drawn over the ball at {x, y}"
+
+
+def test_pressing_kick_flies_the_ball_in_the_page(
+    server: viser.ViserServer, browser_page: Any
+) -> None:
+    switcher = SceneSwitcher(server, "freekick")
+    try:
+        scene = switcher.scene
+        assert isinstance(scene, FreeKickScene)
+        page = browser_page
+        open_viser(page, server.get_port(), BALL)
+        close_notifications(page)
+        spot_x = float(ball_spot(scene.params)[0])
+        page.wait_for_function(
+            f"() => Math.abs({NODE}.position.x - ({spot_x})) < 1e-3", timeout=20_000
+        )
+
+        # Record what the page draws, every animation frame, from before the click on.
+        page.evaluate(
+            f"""() => {{
+                window.__kick = {{ maxX: -1e9, minW: 1.0 }};
+                const sample = () => {{
+                    const node = {NODE};
+                    window.__kick.maxX = Math.max(window.__kick.maxX, node.position.x);
+                    window.__kick.minW = Math.min(window.__kick.minW, Math.abs(node.quaternion.w));
+                    requestAnimationFrame(sample);
+                }};
+                sample();
+            }}"""
+        )
+        page.get_by_role("button", name="Kick", exact=True).click()
+
+        # The three.js ball left its spot and travelled toward the goal (x = 0), several metres on...
+        page.wait_for_function(f"() => window.__kick.maxX > {spot_x + 5.0}", timeout=20_000)
+        assert spot_x + 5.0 < float(page.evaluate("() => window.__kick.maxX")) <= 2.0 + 1e-6
+        # ...spinning: its orientation left the identity during the flight.
+        page.wait_for_function("() => window.__kick.minW < 0.999", timeout=20_000)
+    finally:
+        switcher.close()
+
+
+def test_the_force_chart_tick_labels_stay_inside_its_canvas(shown: ScenePage) -> None:
+    assert isinstance(shown.scene, FreeKickScene)
+
+    def over_ten_newtons(data: Any) -> None:
+        assert max(float(np.max(series)) for series in data[1:]) > 10.0
+
+    # The hardest, most spun kick: the force axis grows from a few newtons to over ten.
+    assert_chart_fits_after(
+        shown,
+        CHART,
+        [
+            NumberChange("Launch speed (m/s)", "speed_ms", 40.0, 25.0),
+            NumberChange("Spin rate (rev/s)", "spin_rev_s", 15.0, 8.0),
+        ],
+        lambda scene: scene.chart.data,
+        over_ten_newtons,
+    )

@@ -1,0 +1,223 @@
+"""A real browser looks at the peloton: the line in view and clear of the panel, the chart's curves drawn, no error
+text, at 1600×1000 and 1280×720; a typed rider count and speed change the picture where they should; a mouse drag
+on the speed slider changes the power."""
+
+from __future__ import annotations
+
+import io
+import time
+from collections.abc import Iterator
+from typing import Any
+
+import numpy as np
+import pytest
+import viser
+from helpers.browser import (
+    VIEWPORTS,
+    NumberChange,
+    ScenePage,
+    assert_chart_draws,
+    assert_chart_fits_after,
+    assert_in_view,
+    assert_seen,
+    canvas_is_not_blank,
+    chart_image,
+    error_text,
+    open_viser,
+    panel_rect,
+    save_docs_screenshot,
+    scene_page,
+    screenshot,
+    set_number,
+    settle,
+    with_labels_hidden,
+)
+from helpers.waiting import wait_until
+from PIL import Image
+
+from scenes.peloton import COMPONENT_COLOURS, LABEL_PX, PelotonScene
+from server.switcher import SceneSwitcher
+
+pytestmark = pytest.mark.browser
+
+RIDERS = [f"/peloton/course/riders_{part}" for part in ("body", "bike", "head")]
+BARS = [f"/peloton/course/bars_{c}" for c in COMPONENT_COLOURS]
+CHART = "Solo power vs speed (cube law)"
+NOW_RED = (220, 30, 30)
+CHART_COLOURS = {
+    "aero": COMPONENT_COLOURS["aero"],
+    "rolling": COMPONENT_COLOURS["rolling"],
+    "climbing": COMPONENT_COLOURS["climbing"],
+    "total": (0, 0, 0),
+    "solo now": NOW_RED,
+}
+
+
+@pytest.fixture(scope="module", params=VIEWPORTS, ids=lambda v: f"{v[0]}x{v[1]}")
+def shown(request: pytest.FixtureRequest, chromium_browser: Any) -> Iterator[ScenePage]:
+    with scene_page(chromium_browser, "peloton", request.param) as page:
+        yield page
+
+
+def _look_at_the_line(shown: ScenePage) -> None:
+    scene = shown.scene
+    assert isinstance(scene, PelotonScene)
+    image = screenshot(shown.page)
+    with scene._lock:
+        points = scene.line_points()
+        n = scene.params.n_riders
+    xy = assert_in_view(shown, "/peloton", points, f"the line of {n} riders, bars and labels")
+    assert_seen(
+        shown,
+        with_labels_hidden(shown.page),
+        RIDERS + BARS,
+        xy,
+        f"{n} riders and their bars",
+        without_labels=True,
+    )
+    # Every label (drawn at its anchor, extending right and up) lies inside the page and left of the panel, and
+    # there is dark text there.
+    with scene._lock:
+        anchors = np.array([scene.labels[i].position for i in range(n)], dtype=np.float64)
+    corners = assert_in_view(shown, "/peloton/course", anchors, "label anchors")
+    reach_x, reach_y = LABEL_PX
+    left, _, _, _ = panel_rect(shown.page)
+    assert corners[:, 0].max() + reach_x <= left and corners[:, 1].min() - reach_y >= 0, corners
+    # No two labels' boxes overlap where the page's own camera puts them.
+    for i in range(n):
+        for j in range(i + 1, n):
+            (xi, yi), (xj, yj) = corners[i], corners[j]
+            assert abs(xi - xj) >= reach_x or abs(yi - yj) >= reach_y, (
+                f"labels {i} and {j} overlap at ({xi:.0f}, {yi:.0f}) and ({xj:.0f}, {yj:.0f})"
+            )
+    for x, y in corners:
+        box = image[max(int(y) - 40, 0) : int(y) + 10, int(x) - 10 : int(x + reach_x)]
+        assert np.count_nonzero(box.max(axis=-1) < 120) > 10, (
+            f"no label text near ({x:.0f}, {y:.0f})"
+        )
+
+
+def test_the_line_is_in_view_clear_of_the_panel(shown: ScenePage) -> None:
+    _look_at_the_line(shown)
+    save_docs_screenshot(shown, "peloton")
+
+
+def test_the_chart_draws_every_curve(shown: ScenePage) -> None:
+    assert_chart_draws(shown.page, CHART, CHART_COLOURS)
+
+
+def test_no_error_text_on_the_page(shown: ScenePage) -> None:
+    assert error_text(shown.page) == []
+
+
+def test_eight_riders_far_apart_stay_in_view(shown: ScenePage) -> None:
+    scene = shown.scene
+    set_number(shown.page, "Riders", 8)
+    set_number(shown.page, "Gap (m)", 6)
+    wait_until(
+        lambda: scene.params.n_riders == 8 and scene.params.gap_m == 6.0, "8 riders, 6 m apart"
+    )
+    settle(shown)
+    _look_at_the_line(shown)
+    assert error_text(shown.page) == []
+
+
+def test_more_speed_lifts_the_now_line_and_the_bars(shown: ScenePage) -> None:
+    scene = shown.scene
+
+    def red_row() -> float:
+        rows = np.nonzero(
+            np.linalg.norm(chart_image(shown.page, CHART).astype(float) - NOW_RED, axis=-1) < 40
+        )[0]
+        assert len(rows) > 20
+        return float(np.median(rows))
+
+    before_row = red_row()
+    with scene._lock:
+        top_before = scene.line_points()[:, 2].max()
+    frames = scene.framing.frames
+    set_number(shown.page, "Speed (km/h)", 55)
+    wait_until(lambda: scene.params.speed_kmh == 55.0, "the speed to reach the scene")
+    # The taller bars outgrow the view, so the scene frames the camera again: wait for that, then for the page.
+    wait_until(lambda: scene.framing.frames > frames, "the camera to be framed for the taller bars")
+    settle(shown)
+    # The solo power's level line rose (screen y grows downward) and the bars grew: still all in view.
+    assert red_row() < before_row - 5
+    with scene._lock:
+        assert scene.line_points()[:, 2].max() > top_before
+    _look_at_the_line(shown)
+    assert_chart_draws(shown.page, CHART, CHART_COLOURS)
+
+
+def test_drag_speed_slider_with_the_mouse(server: viser.ViserServer, browser_page: Any) -> None:
+    switcher = SceneSwitcher(server, "peloton")
+    scene = switcher.scene
+    assert isinstance(scene, PelotonScene)
+    page = browser_page
+    open_viser(page, server.get_port(), "/peloton/course/riders_body")
+
+    # The canvas shows the scene, not a blank page.
+    clients = list(server.get_clients().values())
+    assert len(clients) == 1
+    render = clients[0].get_render(height=360, width=640, transport_format="png")
+    buffer = io.BytesIO()
+    Image.fromarray(render).save(buffer, format="PNG")
+    assert canvas_is_not_blank(buffer.getvalue())
+
+    before_speed = scene.params.speed_kmh
+    before_power = float(scene.state.power.total[0])
+    label = page.get_by_text("Speed (km/h)", exact=True).first
+    row = label.locator("xpath=ancestor::*[.//*[@role='slider']][1]")
+    thumb = row.locator("[role='slider']").first
+    box = thumb.bounding_box()
+    assert box is not None
+    x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+    page.mouse.move(x, y)
+    page.mouse.down()
+    for step in range(1, 11):
+        page.mouse.move(x + 4 * step, y)
+    page.mouse.up()
+
+    # Wait until the drag's messages have all been handled: the speed has moved and then held still.
+    end = time.monotonic() + 15.0
+    last, still_since = before_speed, time.monotonic()
+    while time.monotonic() < end:
+        with scene._lock:
+            speed = scene.params.speed_kmh
+        if speed != last:
+            last, still_since = speed, time.monotonic()
+        elif speed != before_speed and time.monotonic() - still_since > 0.5:
+            break
+        time.sleep(0.05)
+    with scene._lock:
+        final_speed = scene.params.speed_kmh
+        final_power = float(scene.state.power.total[0])
+    assert final_speed > before_speed
+    assert final_power > before_power
+    # The page shows the server's new value in the slider's number box.
+    page.wait_for_function(
+        "v => [...document.querySelectorAll('[role=slider]')].some(e => Number(e.getAttribute('aria-valuenow')) === v)",
+        arg=final_speed,
+        timeout=10_000,
+        polling=100,
+    )
+    switcher.close()
+
+
+def test_the_chart_tick_labels_stay_inside_its_canvas(shown: ScenePage) -> None:
+    assert isinstance(shown.scene, PelotonScene)
+
+    def over_ten_kilowatts(data: Any) -> None:
+        assert max(float(np.max(series)) for series in data[1:]) > 10_000.0
+
+    # A bigger rider into a gale: the power axis reaches "20,000" W (it ran 7 px off the canvas's left edge).
+    assert_chart_fits_after(
+        shown,
+        CHART,
+        [
+            NumberChange("CdA (m²)", "cda_m2", 0.8, 0.32),
+            NumberChange("Headwind (m/s, − = tailwind)", "headwind_ms", 15.0, 0.0),
+        ],
+        lambda scene: scene.chart.data,
+        over_ten_kilowatts,
+    )

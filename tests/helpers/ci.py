@@ -1,0 +1,44 @@
+"""Missing capabilities (Chromium, an OpenGL context): skipped locally, a failure under CI=true."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+from collections.abc import Iterator
+from typing import NoReturn
+
+import pytest
+
+from shaders import gl_service
+from shaders.renderer import GLUnavailableError, Renderer
+
+IN_CI = os.environ.get("CI", "").lower() in ("1", "true", "yes")
+"""Whether this run is CI's: then nothing may be skipped for want of a capability."""
+
+
+def skip_or_fail(reason: str) -> NoReturn:
+    """Skip outside CI; under CI=true a missing capability is a failure, never a silent skip."""
+    if IN_CI:
+        pytest.fail(f"{reason} (CI=true: this test must run)")
+    pytest.skip(reason)
+
+
+def need_gl() -> None:
+    """Make sure the process's shared GL context exists (made here if not yet), or skip or fail."""
+    try:
+        gl_service.run(lambda _renderer: None)
+    except GLUnavailableError as exc:
+        skip_or_fail(str(exc))
+
+
+@contextlib.contextmanager
+def fresh_renderer() -> Iterator[Renderer]:
+    """A renderer of its own (not the shared one), released afterwards; skip or fail without a GL context."""
+    try:
+        renderer = Renderer()
+    except GLUnavailableError as exc:
+        skip_or_fail(str(exc))
+    try:
+        yield renderer
+    finally:
+        renderer.release()

@@ -1,0 +1,661 @@
+"""The course kernel: riding a route against the steady model and an independent ODE, energy books over a closed
+loop, power_for_time against ride, pacing, the sample route, and every kind of bad GPX file."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from helpers.gpx import BAD_FILES, gpx_text, line_points
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
+from scipy.integrate import solve_ivp
+
+from kernels import course, cycling
+from kernels.course import Air, Rider, gpx
+
+SEED = Rider(cda_m2=0.32, mass_kg=80.0, crr=0.004, drivetrain_efficiency=0.976, model="seed")
+MARTIN = Rider(cda_m2=0.32, mass_kg=80.0, crr=0.004, model="martin")
+
+
+def straight(length_m: float, step_m: float = 10.0, heading_deg: float = 90.0) -> course.Course:
+    s = np.arange(0.0, length_m + step_m / 2, step_m)
+    h = math.radians(heading_deg)
+    return course.course_from_xy(s * math.sin(h), s * math.cos(h), np.zeros_like(s))
+
+
+# ------------------------------------------------------------------------------------------------ steady state
+def lost_time_by_ode(power: float, rider: Rider, v_star: float) -> float:
+    """Time lost to the start from rest, t − x/v*, from scipy's DOP853 in time (independent of the kernel).
+
+    Near v = 0 the force η·P/v is singular; the first 1 ms is the analytic start v = √(2ηP·t/M)."""
+    m, eta = rider.effective_mass_kg, rider.drivetrain_efficiency
+    drag = 0.5 * cycling.RHO_SEA_LEVEL * rider.cda_m2
+    roll = rider.crr * rider.mass_kg * cycling.G
+
+    def rhs(_t: float, y: np.ndarray) -> list[float]:
+        v = y[1]
+        return [v, (eta * power / v - drag * v * v - roll) / m]
+
+    t0 = 1e-3
+    v0 = math.sqrt(2 * eta * power * t0 / m)
+    x0 = (2.0 / 3.0) * v0 * t0
+    sol = solve_ivp(rhs, (t0, 600.0), [x0, v0], method="DOP853", rtol=1e-11, atol=1e-11)
+    t_end, x_end = float(sol.t[-1]), float(sol.y[0, -1])
+    assert abs(sol.y[1, -1] - v_star) < 1e-6 * v_star
+    return t_end - x_end / v_star
+
+
+@pytest.mark.parametrize("power", [120.0, 250.0, 400.0])
+def test_flat_straight_route_matches_distance_over_steady_speed(power: float) -> None:
+    v_star = float(cycling.speed_for_power(power, 0.32, 80.0, 0.004, drivetrain_efficiency=0.976))
+    lost = []
+    for length in (10_000.0, 20_000.0):
+        r = course.ride(straight(length), power, SEED)
+        assert r.speed_ms[0] == 0.0
+        assert r.speed_ms[-1] == pytest.approx(v_star, rel=1e-7)
+        lost.append(r.time_s - length / v_star)
+    # The only difference is the start from rest: a fixed time lost, the same on both lengths...
+    assert lost[0] > 0.0 and lost[1] == pytest.approx(lost[0], abs=1e-6)
+    # ...and equal to what an accurate integration in time loses (10 m steps cost a few hundredths of a s).
+    assert lost[0] == pytest.approx(lost_time_by_ode(power, SEED, v_star), abs=0.03)
+
+
+def test_a_rolling_start_loses_nothing() -> None:
+    v_star = float(cycling.speed_for_power(250.0, 0.32, 80.0, 0.004, drivetrain_efficiency=0.976))
+    r = course.ride(straight(5000.0), 250.0, SEED, start_speed_ms=v_star)
+    assert r.time_s == pytest.approx(5000.0 / v_star, rel=1e-12)
+    np.testing.assert_allclose(r.speed_ms, v_star, rtol=1e-12)
+
+
+@pytest.mark.parametrize(("heading", "wind_from", "headwind"), [
+    (0.0, 0.0, 5.0),  # riding north into a north wind
+    (0.0, 180.0, -5.0),  # riding north, wind from the south: tailwind
+    (90.0, 0.0, 0.0),  # riding east, north wind: pure crosswind, ignored
+    (45.0, 90.0, 5.0 * math.cos(math.radians(45.0))),
+])  # fmt: skip
+def test_headwind_component_from_the_wind_direction(
+    heading: float, wind_from: float, headwind: float
+) -> None:
+    c = straight(3000.0, heading_deg=heading)
+    r = course.ride(c, 250.0, SEED, wind_ms=5.0, wind_from_deg=wind_from)
+    np.testing.assert_allclose(r.headwind_ms, headwind, atol=1e-12)
+    v_star = float(
+        cycling.speed_for_power(
+            250.0, 0.32, 80.0, 0.004, headwind_ms=headwind, drivetrain_efficiency=0.976
+        )
+    )
+    assert r.speed_ms[-1] == pytest.approx(v_star, rel=1e-6)
+
+
+def test_a_steady_climb_settles_at_the_steady_climbing_speed() -> None:
+    s = np.arange(0.0, 5000.0 + 5, 10.0)
+    c = course.course_from_xy(s, np.zeros_like(s), 0.08 * s)
+    r = course.ride(c, 300.0, SEED, start_speed_ms=8.0)
+    altitude = float(np.mean(c.elevation_m[-30:]))
+    # The kernel's speed follows the slope length; speed_for_power takes the same ground speed.
+    v_star = float(
+        cycling.speed_for_power(
+            300.0, 0.32, 80.0, 0.004, grade=0.08, altitude_m=altitude, drivetrain_efficiency=0.976
+        )
+    )
+    assert r.speed_ms[-1] == pytest.approx(
+        v_star, rel=2e-3
+    )  # density changes a little along the climb
+
+
+def martin_1998_pedal_power(
+    v: np.ndarray, rho: np.ndarray, grade: np.ndarray, headwind: np.ndarray, rider: Rider
+) -> np.ndarray:
+    """Independent reference: P = (½ρ·CdA·v_air²·v + Crr·m·g·cos θ·v + m·g·sin θ·v [+ bearings]) / η.
+
+    Martin et al. 1998 (J. Appl. Biomech. 14:276), eq. 9 at steady speed; v_air² signed, (v + w)|v + w|; the
+    Martin model adds the spokes' drag area and the bearings' v·(91 + 8.7·v)·10⁻³ W."""
+    theta = np.arctan(grade)
+    cda = rider.cda_m2 + (rider.spoke_drag_m2 if rider.model == "martin" else 0.0)
+    bearings = v * (0.091 + 0.0087 * v) if rider.model == "martin" else 0.0
+    air = v + headwind
+    wheel = (
+        0.5 * rho * cda * air * np.abs(air) * v
+        + rider.crr * rider.mass_kg * 9.81 * np.cos(theta) * v
+        + rider.mass_kg * 9.81 * np.sin(theta) * v
+        + bearings
+    )
+    return wheel / rider.drivetrain_efficiency
+
+
+@pytest.mark.parametrize("rider", [SEED, MARTIN], ids=["seed", "martin"])
+def test_per_point_power_is_the_cycling_law(rider: Rider) -> None:
+    """Each segment's power, less the kinetic energy it stored, is cycling's law at the segment's mean speed."""
+    s = np.arange(0.0, 3000.0 + 5, 10.0)
+    grade = np.where(s < 1500.0, 0.04, -0.02)
+    c = course.course_from_xy(
+        s, np.zeros_like(s), np.concatenate(([0.0], np.cumsum(np.diff(s) * grade[:-1])))
+    )
+    r = course.ride(c, 280.0, rider, wind_ms=4.0, wind_from_deg=60.0, start_speed_ms=7.0)
+    mean = 0.5 * (r.speed_ms[1:] + r.speed_ms[:-1])
+    # The ride's step: ½M(v₁² − v₀²) = L·(η·P − P_wheel(v̄))/v̄, so P_wheel(v̄)/η is what the pedals left after
+    # the kinetic energy.
+    kinetic = 0.5 * rider.effective_mass_kg * np.diff(r.speed_ms**2) * mean / c.length_m
+    eta = rider.drivetrain_efficiency
+    law = (eta * r.power_w[:-1] - kinetic) / eta
+    assert np.all(r.brakes_j == 0.0)
+    reference = martin_1998_pedal_power(mean, r.air_density, c.grade, r.headwind_ms, rider)
+    np.testing.assert_allclose(law, reference, rtol=1e-9)
+    altitude = 0.5 * (c.elevation_m[1:] + c.elevation_m[:-1])
+    if rider.model == "seed":
+        kernel = cycling.power(mean, rider.cda_m2, rider.mass_kg, rider.crr, c.grade, altitude,
+                               r.headwind_ms, eta).total  # fmt: skip
+    else:
+        kernel = cycling.martin_power(mean, rider.cda_m2, rider.mass_kg, rider.crr, c.grade, r.headwind_ms,
+                                      r.air_density, eta).total  # fmt: skip
+    np.testing.assert_allclose(law, kernel, rtol=1e-9)
+
+
+# ------------------------------------------------------------------------------------------------ energy
+def loop_course(n: int = 2000, radius: float = 800.0) -> course.Course:
+    theta = np.linspace(0.0, 2 * np.pi, n + 1)
+    east, north = radius * np.sin(theta), radius * (1 - np.cos(theta))
+    elevation = 40.0 * np.sin(theta) + 15.0 * np.sin(
+        3 * theta
+    )  # climbs, and descents steep enough to brake
+    return course.course_from_xy(east, north, elevation, name="loop")
+
+
+@pytest.mark.parametrize("rider", [SEED, MARTIN], ids=["seed", "martin"])
+def test_energy_balance_over_a_closed_loop(rider: Rider) -> None:
+    c = loop_course()
+    air = Air(
+        "weather", temperature_c=25.0, pressure_hpa=950.0, relative_humidity=0.6, altitude_m=500.0
+    )
+    # A rolling start: from rest the first segment is cut into graded sub-steps that per-point speeds cannot show.
+    r = course.ride(
+        c,
+        280.0,
+        rider,
+        wind_ms=4.0,
+        wind_from_deg=30.0,
+        air=air,
+        max_speed_ms=11.0,
+        start_speed_ms=6.0,
+    )
+    assert c.elevation_m[0] == pytest.approx(c.elevation_m[-1], abs=1e-9)
+    assert r.brakes_j > 0.0  # the cap engaged on the descents
+    # Reconstruct everything from the per-point speeds, independently of the kernel's own sums.
+    v = r.speed_ms
+    v_mean = 0.5 * (v[1:] + v[:-1])
+    length = c.length_m
+    dt = np.diff(r.elapsed_s)
+    np.testing.assert_allclose(dt, length / v_mean, rtol=1e-12)
+    work = float(np.sum(r.power_w[:-1] * dt))
+    assert work == pytest.approx(r.work_j, rel=1e-12)
+    theta = np.arctan(c.grade)
+    drag_area = rider.cda_m2 + (rider.spoke_drag_m2 if rider.model == "martin" else 0.0)
+    rho = air.density(0.5 * (c.elevation_m[1:] + c.elevation_m[:-1]))
+    air_speed = v_mean + r.headwind_ms
+    aero = float(np.sum(0.5 * rho * drag_area * air_speed * np.abs(air_speed) * length))
+    rolling = float(np.sum(rider.crr * rider.mass_kg * 9.81 * np.cos(theta) * length))
+    climbing = float(np.sum(rider.mass_kg * 9.81 * np.sin(theta) * length))
+    bearings = float(np.sum((0.091 + 0.0087 * v_mean) * length)) if rider.model == "martin" else 0.0
+    kinetic = 0.5 * rider.effective_mass_kg * (v[-1] ** 2 - 6.0**2)
+    assert r.kinetic_j == pytest.approx(0.5 * rider.effective_mass_kg * v[-1] ** 2, rel=1e-12)
+    assert aero == pytest.approx(r.aero_j, rel=1e-10)
+    assert rolling == pytest.approx(r.rolling_j, rel=1e-10)
+    assert bearings == pytest.approx(r.bearings_j, rel=1e-10, abs=1e-9)
+    assert (
+        abs(climbing) < 1e-6 * rider.mass_kg * 9.81 * 40.0 * 2000
+    )  # a closed loop: no net climbing
+    balance = aero + rolling + bearings + climbing + kinetic + r.brakes_j
+    assert work * rider.drivetrain_efficiency == pytest.approx(balance, rel=1e-9)
+    assert r.drivetrain_j == pytest.approx(work * (1 - rider.drivetrain_efficiency), rel=1e-12)
+    assert np.all(v <= 11.0 + 1e-12)
+
+
+def test_energy_books_balance_from_rest() -> None:
+    """From rest the kernel's own sums still balance (the graded first segment included)."""
+    r = course.ride(loop_course(), 250.0, MARTIN, wind_ms=3.0, max_speed_ms=10.0)
+    assert r.speed_ms[0] == 0.0
+    terms = r.aero_j + r.rolling_j + r.bearings_j + r.climbing_j + r.kinetic_j + r.brakes_j
+    assert r.work_j * MARTIN.drivetrain_efficiency == pytest.approx(terms, rel=1e-9)
+
+
+def test_martin_terms_cost_time_against_the_seed_model() -> None:
+    c = loop_course()
+    seed = course.ride(c, 250.0, SEED)
+    martin = course.ride(c, 250.0, MARTIN)
+    assert martin.time_s > seed.time_s  # spokes and bearings take watts
+    assert martin.bearings_j > 0.0 and seed.bearings_j == 0.0
+
+
+# ------------------------------------------------------------------------------------------------ inverse, pacing
+@settings(max_examples=20, deadline=None)
+@given(
+    power=st.floats(40.0, 900.0),
+    wind=st.floats(-8.0, 8.0),
+    model=st.sampled_from(["seed", "martin"]),
+)
+def test_power_for_time_inverts_ride(power: float, wind: float, model: str) -> None:
+    c = loop_course(600)
+    rider = SEED if model == "seed" else MARTIN
+    t = course.ride(c, power, rider, wind_ms=wind, wind_from_deg=200.0).time_s
+    found = course.power_for_time(c, t, rider, wind_ms=wind, wind_from_deg=200.0, tolerance_s=1e-3)
+    assert course.ride(c, found, rider, wind_ms=wind, wind_from_deg=200.0).time_s == pytest.approx(
+        t, abs=1e-3
+    )
+    assert found == pytest.approx(power, rel=1e-3)
+
+
+def test_power_for_time_out_of_reach_says_so() -> None:
+    c = course.load_gpx(course.SAMPLE_ROUTE)
+    with pytest.raises(ValueError, match="more than 5000 W"):
+        course.power_for_time(c, 60.0)
+    with pytest.raises(ValueError, match="time_s"):
+        course.power_for_time(c, float("nan"))
+
+
+def test_pacing_keeps_the_average_power_and_saves_time_on_hills() -> None:
+    s = np.arange(0.0, 20_000.0 + 5, 10.0)
+    c = course.course_from_xy(s, np.zeros_like(s), 60.0 * np.sin(2 * np.pi * s / 4000.0))
+    pacing = course.paced_ride(c, 250.0, MARTIN, gain=0.15)
+    # Same power-meter average (the constant ride eases off a little to hold 72 km/h on the descents).
+    assert pacing.paced.average_power_w == pytest.approx(pacing.constant.average_power_w, rel=1e-6)
+    assert pacing.constant.average_power_w == pytest.approx(250.0, rel=1e-3)
+    assert pacing.time_saved_s == pytest.approx(pacing.constant.time_s - pacing.paced.time_s)
+    assert pacing.time_saved_s > 5.0  # tens of seconds over 20 km of 6 % hills
+    up = c.grade > 0.03
+    down = c.grade < -0.03
+    assert np.all(pacing.paced.power_w[:-1][up] > 250.0)
+    assert np.all(pacing.paced.power_w[:-1][down] < 250.0)
+    flat = course.paced_ride(c, 250.0, MARTIN, gain=0.0)
+    assert flat.time_saved_s == 0.0
+    with pytest.raises(ValueError, match="gain"):
+        course.paced_ride(c, 250.0, MARTIN, gain=0.9)
+
+
+def test_splits_are_the_times_at_each_kilometre() -> None:
+    v_star = float(cycling.speed_for_power(250.0, 0.32, 80.0, 0.004, drivetrain_efficiency=0.976))
+    r = course.ride(straight(3500.0), 250.0, SEED, start_speed_ms=v_star)
+    marks, times = r.splits(1000.0)
+    np.testing.assert_allclose(marks, [1000.0, 2000.0, 3000.0, 3500.0])
+    np.testing.assert_allclose(times, marks / v_star, rtol=1e-9)
+    with pytest.raises(ValueError, match="every_m"):
+        r.splits(0.0)
+
+
+def test_bad_ride_arguments_name_themselves() -> None:
+    c = straight(100.0)
+    for kwargs, name in [
+        ({"power_w": 0.0}, "power_w"),
+        ({"power_w": float("nan")}, "power_w"),
+        ({"power_w": np.ones(3)}, "power_w"),
+        ({"wind_ms": float("inf")}, "wind_ms"),
+        ({"wind_from_deg": "north"}, "wind_from_deg"),
+        ({"max_speed_ms": 0.0}, "max_speed_ms"),
+        ({"start_speed_ms": -1.0}, "start_speed_ms"),
+        ({"start_speed_ms": 50.0}, "start_speed_ms"),
+    ]:
+        args = {"power_w": 200.0, **kwargs}
+        with pytest.raises(ValueError, match=name):
+            course.ride(c, **args)
+    for kwargs, name in [
+        ({"cda_m2": 0.0}, "cda_m2"),
+        ({"mass_kg": float("nan")}, "mass_kg"),
+        ({"crr": -0.1}, "crr"),
+        ({"drivetrain_efficiency": 0.0}, "drivetrain_efficiency"),
+        ({"model": "magic"}, "model"),
+    ]:
+        with pytest.raises(ValueError, match=name):
+            Rider(**kwargs)  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match="relative_humidity"):
+        Air("weather", relative_humidity=2.0)
+    with pytest.raises(ValueError, match="kind"):
+        Air("vacuum")  # type: ignore[arg-type]
+
+
+def test_a_very_low_power_on_a_wall_still_finishes() -> None:
+    """A 25 % wall at 30 W and a fast entry: segments split until they can be crossed, and the books balance."""
+    s = np.arange(0.0, 300.0 + 5, 50.0)
+    c = course.course_from_xy(s, np.zeros_like(s), 0.25 * s)
+    r = course.ride(c, 30.0, SEED, start_speed_ms=15.0)
+    balance = r.aero_j + r.rolling_j + r.climbing_j + r.kinetic_j + r.brakes_j
+    kinetic_in = 0.5 * SEED.effective_mass_kg * 15.0**2
+    assert r.work_j * 0.976 + kinetic_in == pytest.approx(balance, rel=1e-9)
+    assert np.all(np.isfinite(r.elapsed_s)) and r.speed_ms[-1] > 0.0
+
+
+# ------------------------------------------------------------------------------------------------ loading
+def test_the_sample_route_is_the_published_profile() -> None:
+    c = course.load_gpx(course.SAMPLE_ROUTE)
+    assert "Alpe d'Huez" in c.name and "published profile" in c.name
+    assert c.total_distance_m == pytest.approx(13_200.0, rel=0.01)
+    assert c.elevation_raw_m[0] == pytest.approx(744.0, abs=0.1)
+    assert c.elevation_raw_m[-1] == pytest.approx(1815.0, abs=1.0)
+    average = (c.elevation_m[-1] - c.elevation_m[0]) / c.total_distance_m
+    assert average == pytest.approx(0.081, abs=0.002)
+    assert course.SAMPLE_ROUTE.stat().st_size < 100_000
+
+
+def test_load_gpx_reads_a_path_text_and_bytes_alike(tmp_path: Path) -> None:
+    text = gpx_text(line_points(50))
+    path = tmp_path / "ride.gpx"
+    path.write_text(text)
+    from_path = course.load_gpx(path)
+    from_str_path = course.load_gpx(str(path))
+    from_text = course.load_gpx(text)
+    from_bytes = course.load_gpx(b"\xef\xbb\xbf" + text.encode())
+    for c in (from_str_path, from_text, from_bytes):
+        np.testing.assert_array_equal(c.distance_m, from_path.distance_m)
+    # 1e-4° of latitude is 11.12 m on the IUGG sphere; heading north.
+    np.testing.assert_allclose(from_path.run_m, 6_371_008.8 * math.radians(1e-4), rtol=1e-9)
+    np.testing.assert_allclose(from_path.heading_rad, 0.0, atol=1e-9)
+    assert from_path.name == "t"
+
+
+def test_haversine_distance_and_heading_between_known_places() -> None:
+    # Paris (48.8566 N, 2.3522 E) to London (51.5074 N, 0.1278 W): 343.5 km on the mean sphere, bearing ~330°.
+    c = course.course_from_points(
+        [48.8566, 51.5074], [2.3522, -0.1278], [35.0, 11.0], smoothing_m=0.0
+    )
+    assert c.total_distance_m == pytest.approx(343_500.0, rel=2e-3)
+    assert math.degrees(float(c.heading_rad[0])) == pytest.approx(330.0, abs=1.0)
+
+
+def test_route_points_are_used_when_there_is_no_track() -> None:
+    c = course.load_gpx(gpx_text(line_points(10), kind="rte"))
+    assert c.n_points == 10
+
+
+def test_duplicate_points_and_noise_are_cleaned() -> None:
+    pts = line_points(200)
+    pts = [p for p in pts for _ in (0, 1)]  # every point logged twice (a paused GPS)
+    rng = np.random.default_rng(1)
+    noisy = [(a, o, float(z) + float(rng.normal(0.0, 2.0))) for a, o, z in pts if z is not None]
+    c = course.load_gpx(gpx_text(noisy))
+    assert c.n_points == 200 and np.all(c.run_m > 0)
+    # Smoothing over 50 m takes most of the 2 m noise out of a 9 % slope.
+    assert float(np.std(c.grade[20:-20] - 1.0 / 11.12)) < 0.05
+
+
+@pytest.mark.parametrize("kind", list(BAD_FILES))
+def test_every_bad_file_gets_a_clear_message(kind: str) -> None:
+    text, message = BAD_FILES[kind]
+    with pytest.raises(ValueError, match=message):
+        course.load_gpx(text)
+    with pytest.raises(ValueError, match=message):
+        course.load_gpx(text.encode())
+
+
+def test_binary_and_missing_files(tmp_path: Path) -> None:
+    with pytest.raises(ValueError, match="not text in UTF-8"):
+        course.load_gpx(b"\x89PNG\r\n\x1a\n\xff\xfe<gpx")
+    with pytest.raises(ValueError, match="cannot read"):
+        course.load_gpx(tmp_path / "missing.gpx")
+    with pytest.raises(ValueError, match="source"):
+        course.load_gpx(12)  # type: ignore[arg-type]
+
+
+def test_over_20_mib_is_refused_before_parsing(tmp_path: Path) -> None:
+    head = gpx_text(line_points(3))
+    big = head + "<!--" + "x" * (course.MAX_FILE_BYTES + 1) + "-->"
+    with pytest.raises(ValueError, match="20 MiB"):
+        course.load_gpx(big)
+    with pytest.raises(ValueError, match="20 MiB"):
+        course.load_gpx(big.encode())
+    path = tmp_path / "big.gpx"
+    path.write_text(big)
+    with pytest.raises(ValueError, match="20 MiB"):
+        course.load_gpx(path)
+    # Exactly at the limit is fine (as far as size goes).
+    exact = head + "<!--" + "x" * (course.MAX_FILE_BYTES - len(head) - 7) + "-->"
+    assert len(exact.encode()) == course.MAX_FILE_BYTES
+    assert course.load_gpx(exact).n_points == 3
+
+
+def test_more_than_200_000_points_is_refused() -> None:
+    row = '<trkpt lat="45" lon="6"><ele>1</ele></trkpt>'
+    text = f'<gpx version="1.1"><trk><trkseg>{row * (course.MAX_POINTS + 1)}</trkseg></trk></gpx>'
+    with pytest.raises(ValueError, match="200000"):
+        course.load_gpx(text)
+    with pytest.raises(ValueError, match="200000"):
+        course.course_from_xy(
+            np.arange(course.MAX_POINTS + 1.0),
+            np.zeros(course.MAX_POINTS + 1),
+            np.zeros(course.MAX_POINTS + 1),
+        )
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.binary(max_size=400))
+def test_arbitrary_bytes_never_escape_as_anything_but_value_error(data: bytes) -> None:
+    for source in (data, b"<gpx>" + data):
+        try:
+            course.load_gpx(source)
+        except ValueError:
+            pass
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    grades=st.lists(st.floats(-0.2, 0.2), min_size=2, max_size=40),
+    step=st.floats(1.0, 400.0),
+    power=st.floats(5.0, 1500.0),
+    wind=st.floats(-15.0, 15.0),
+    wind_from=st.floats(0.0, 360.0),
+    cap=st.floats(3.0, 30.0),
+    start=st.floats(0.0, 1.0),
+    model=st.sampled_from(["seed", "martin"]),
+)
+def test_any_course_balances_its_books_and_more_power_is_faster(
+    grades: list[float], step: float, power: float, wind: float, wind_from: float, cap: float,
+    start: float, model: str,
+) -> None:  # fmt: skip
+    """The family of integration faults (stalls, overshoot past the cap, energy leaks, NaN): any profile of
+    short or long segments, steep both ways, any wind, any cap, any entry speed."""
+    n = len(grades)
+    s = np.arange(n + 1) * step
+    z = np.concatenate(([0.0], np.cumsum(np.asarray(grades) * step)))
+    heading = np.linspace(0.0, 3.0, n + 1)
+    east = np.concatenate(([0.0], np.cumsum(step * np.sin(heading[:-1]))))
+    north = np.concatenate(([0.0], np.cumsum(step * np.cos(heading[:-1]))))
+    del s
+    c = course.course_from_xy(east, north, z)
+    rider = SEED if model == "seed" else MARTIN
+    v0 = start * cap
+    r = course.ride(c, power, rider, wind, wind_from, max_speed_ms=cap, start_speed_ms=v0)
+    assert math.isfinite(r.time_s) and r.time_s > 0.0
+    assert np.all(np.isfinite(r.speed_ms)) and np.all(r.speed_ms >= 0.0)
+    assert np.all(r.speed_ms <= cap * (1 + 1e-12))
+    assert np.all(np.diff(r.elapsed_s) > 0.0)
+    assert np.all(r.power_w <= power * (1 + 1e-9)) and np.all(r.power_w >= 0.0)
+    kinetic_in = 0.5 * rider.effective_mass_kg * v0**2
+    terms = r.aero_j + r.rolling_j + r.bearings_j + r.climbing_j + r.kinetic_j + r.brakes_j
+    scale = r.work_j + kinetic_in + abs(r.climbing_j) + abs(r.aero_j) + 1.0
+    assert r.work_j * rider.drivetrain_efficiency + kinetic_in == pytest.approx(
+        terms, abs=1e-9 * scale
+    )
+    assert r.brakes_j >= -1e-9 * scale
+    faster = course.ride(
+        c, power * 1.5, rider, wind, wind_from, max_speed_ms=cap, start_speed_ms=v0
+    )
+    assert faster.time_s <= r.time_s * (1 + 1e-9)
+
+
+# ------------------------------------------------------------------------------------------------ review of issue 13
+# Kind: a profile steeper than any road. The reviewer's vertical.gpx (three points 1 cm apart rising 1000 m) loaded
+# as flat because the 50 m smoothing averaged the cliff away; wall.gpx (300 %) was ridden at 1 km/h.
+def test_a_vertical_profile_is_refused_before_smoothing_hides_it() -> None:
+    vertical = gpx_text([(45.0, 6.0, 100.0), (45.0000001, 6.0, 600.0), (45.0000002, 6.0, 1100.0)])
+    with pytest.raises(ValueError, match="no road is steeper"):
+        course.load_gpx(vertical)
+    wall = [
+        (45.0 + i * 1e-4, 6.0, 100.0 + max(0.0, i - 5) * 33.4) for i in range(10)
+    ]  # 300 % after 0.5 km
+    with pytest.raises(ValueError, match="300 %"):
+        course.load_gpx(gpx_text(wall))
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    grade=st.floats(0.0, 3.0),
+    spacing=st.sampled_from([0.01, 1.0, 11.12, 100.0]),
+    n=st.integers(2, 60),
+)
+def test_grades_are_refused_exactly_beyond_the_bound(grade: float, spacing: float, n: int) -> None:
+    """A steady slope of any length and point spacing: accepted up to 50 %, refused beyond (values on the bound
+    are accepted). The steepest-stretch check is exact on a straight slope."""
+    d = np.arange(n) * spacing
+    found, _ = course.steepest_grade(d, grade * d, course.GRADE_WINDOW_M)
+    assert found == pytest.approx(grade, rel=1e-9, abs=1e-12)
+    assume(grade * (n - 1) * spacing < 9000.0)  # elevations stay within ±10 000 m
+    step_deg = spacing / (course.EARTH_RADIUS_M * math.pi / 180.0)
+    points = [(45.0 + i * step_deg, 6.0, 100.0 + grade * i * spacing) for i in range(n)]
+    if grade > course.MAX_GPX_GRADE * 1.001:
+        with pytest.raises(ValueError, match="no road is steeper"):
+            course.load_gpx(gpx_text(points))
+    elif grade < course.MAX_GPX_GRADE * 0.999 and n * spacing > 1e-3:
+        assert course.load_gpx(gpx_text(points)).n_points == n
+
+
+def test_gps_noise_on_a_real_climb_is_not_refused() -> None:
+    rng = np.random.default_rng(3)
+    pts = [
+        (45.0 + i * 1e-5, 6.0, 100.0 + 0.1 * i * 1.112 + float(rng.normal(0.0, 2.0)))
+        for i in range(2000)
+    ]
+    c = course.load_gpx(gpx_text(pts))  # 1.1 m between points, ±2 m noise, 10 %
+    assert c.total_distance_m == pytest.approx(1999 * 1.112, rel=1e-3)
+
+
+# Kind: pieces of a route that do not follow on (two_far_tracks.gpx joined France and Sydney: 16 742 km).
+def two_tracks(gap_deg: float) -> str:
+    a = "".join(f'<trkpt lat="{45 + i * 1e-3}" lon="6"><ele>0</ele></trkpt>' for i in range(3))
+    b = "".join(
+        f'<trkpt lat="{45 + 2e-3 + gap_deg + i * 1e-3}" lon="6"><ele>0</ele></trkpt>'
+        for i in range(3)
+    )
+    return (
+        '<?xml version="1.0"?><gpx version="1.1" creator="t"><trk><trkseg>'
+        f"{a}</trkseg></trk><trk><trkseg>{b}</trkseg></trk></gpx>"
+    )
+
+
+def test_tracks_far_apart_are_refused_and_near_ones_joined() -> None:
+    far = (
+        '<?xml version="1.0"?><gpx version="1.1" creator="r"><trk><trkseg><trkpt lat="45" lon="6"><ele>0</ele>'
+        '</trkpt><trkpt lat="45.001" lon="6"><ele>0</ele></trkpt></trkseg></trk><trk><trkseg><trkpt lat="-33" '
+        'lon="151"><ele>0</ele></trkpt><trkpt lat="-33.001" lon="151"><ele>0</ele></trkpt></trkseg></trk></gpx>'
+    )
+    with pytest.raises(
+        ValueError, match=r"segment 2 starts 16 741\.9 km from where segment 1 ends"
+    ):
+        course.load_gpx(far)
+    metre_deg = 1.0 / (course.EARTH_RADIUS_M * math.pi / 180.0)
+    joined = course.load_gpx(two_tracks(1999.0 * metre_deg))  # just under the 2 km bound
+    assert joined.total_distance_m == pytest.approx(2 * 2 * 111.195 + 1999.0, rel=1e-3)
+    with pytest.raises(ValueError, match=r"segment 2 starts 2\.0 km"):
+        course.load_gpx(two_tracks(2001.0 * metre_deg))
+
+
+# Kind: text encodings XML allows (the declaration or a byte-order mark says which).
+ENCODED = '<?xml version="1.0" encoding="{enc}"?><gpx version="1.1" creator="t"><trk><name>Col de l\'Échelle</name><trkseg>{pts}</trkseg></trk></gpx>'
+PTS = "".join(
+    f'<trkpt lat="{45 + i * 1e-3}" lon="6"><ele>{100 + i}</ele></trkpt>' for i in range(5)
+)
+
+
+@pytest.mark.parametrize(
+    ("codec", "declared"),
+    [("iso-8859-1", "ISO-8859-1"), ("cp1252", "windows-1252"), ("utf-16", "UTF-16"), ("utf-16-be", "UTF-16"),
+     ("utf-8-sig", "UTF-8"), ("utf-8", "utf-8"), ("utf-32", "UTF-32")],
+)  # fmt: skip
+def test_declared_encodings_and_byte_order_marks_are_read(codec: str, declared: str) -> None:
+    data = ENCODED.format(enc=declared, pts=PTS).encode(codec)
+    if codec == "utf-16-be":
+        data = b"\xfe\xff" + data
+    c = course.load_gpx(data)
+    assert c.name == "Col de l'Échelle" and c.n_points == 5
+
+
+def test_a_wrong_or_unknown_encoding_gets_a_clear_message() -> None:
+    with pytest.raises(ValueError, match="unknown text encoding 'klingon'"):
+        course.load_gpx(ENCODED.format(enc="klingon", pts=PTS).encode())
+
+
+# Kind: namespace-prefixed GPX (<g:gpx xmlns:g=...>): read, and counted before parsing.
+def prefixed(n: int) -> bytes:
+    pts = "".join(
+        f'<g:trkpt lat="{45 + i * 1e-4:.6f}" lon="6"><g:ele>1</g:ele></g:trkpt>' for i in range(n)
+    )
+    return (
+        '<?xml version="1.0"?><g:gpx xmlns:g="http://www.topografix.com/GPX/1/1" version="1.1" creator="r">'
+        f"<g:trk><g:name>prefixed</g:name><g:trkseg>{pts}</g:trkseg></g:trk></g:gpx>"
+    ).encode()
+
+
+def test_a_namespace_prefixed_gpx_is_read_and_counted_before_parsing(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    c = course.load_gpx(prefixed(20))
+    assert c.n_points == 20 and c.name == "prefixed"
+    monkeypatch.setattr(gpx, "MAX_POINTS", 10)
+
+    def never(*_: object) -> None:
+        raise AssertionError("parsed before counting")
+
+    monkeypatch.setattr(gpx.gpxpy, "parse", never)
+    with pytest.raises(ValueError, match="has 20 points; the limit is 10"):
+        course.load_gpx(prefixed(20))
+
+
+# Kind: messages in a rider's words (no kernel argument names, no "GPX is not a GPX file").
+@pytest.mark.parametrize("kind", list(BAD_FILES))
+def test_bad_file_messages_name_no_kernel_arguments(kind: str) -> None:
+    text, _ = BAD_FILES[kind]
+    with pytest.raises(ValueError) as caught:
+        course.load_gpx(text.encode())
+    message = str(caught.value)
+    for word in ("_deg", "_m ", "elevation_m", "latitude_deg", "non-finite", "GPX is not"):
+        assert word not in message, message
+    assert message.startswith("the file")
+
+
+# Kind: the drawing projection keeps every route's true shape (north_pole.gpx drew a 3.5 km "U").
+@settings(max_examples=40, deadline=None)
+@given(
+    lat=st.floats(-90.0, 90.0),
+    lon=st.floats(-180.0, 180.0),
+    bearing=st.floats(0.0, 360.0),
+)
+def test_a_straight_route_is_drawn_straight_anywhere(
+    lat: float, lon: float, bearing: float
+) -> None:
+    """A 2 km great-circle route from any start in any direction (over a pole, across the antimeridian): the
+    drawn line is straight and its drawn length is the ground distance."""
+    s = np.linspace(0.0, 2000.0, 41) / course.EARTH_RADIUS_M
+    phi0, lam0, theta = math.radians(lat), math.radians(lon), math.radians(bearing)
+    phi = np.arcsin(np.sin(phi0) * np.cos(s) + np.cos(phi0) * np.sin(s) * np.cos(theta))
+    lam = lam0 + np.arctan2(
+        np.sin(theta) * np.sin(s) * np.cos(phi0), np.cos(s) - np.sin(phi0) * np.sin(phi)
+    )
+    lon_deg = (np.degrees(lam) + 180.0) % 360.0 - 180.0
+    east, north = course.azimuthal_equidistant(np.degrees(phi), lon_deg)
+    chord = math.hypot(east[-1] - east[0], north[-1] - north[0])
+    assert chord == pytest.approx(2000.0, rel=1e-4)
+    # Straight: every point within 1 cm of the chord.
+    ux, uy = (east[-1] - east[0]) / chord, (north[-1] - north[0]) / chord
+    off = np.abs((east - east[0]) * uy - (north - north[0]) * ux)
+    assert float(off.max()) < 0.01
+
+
+def test_the_route_over_the_north_pole_is_drawn_straight() -> None:
+    pts = [(89.99 + i * 1e-4, 0.0, 10.0) for i in range(100)] + [
+        (90.0 - i * 1e-4, 180.0, 10.0) for i in range(1, 101)
+    ]
+    c = course.load_gpx(gpx_text(pts))
+    assert c.total_distance_m == pytest.approx(200 * 11.1195, rel=1e-3)
+    assert float(np.ptp(c.north_m) + np.ptp(c.east_m)) == pytest.approx(
+        c.total_distance_m, rel=1e-3
+    )
+    assert min(float(np.ptp(c.north_m)), float(np.ptp(c.east_m))) < 0.01  # a line, not a "U"

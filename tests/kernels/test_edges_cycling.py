@@ -1,0 +1,336 @@
+"""Issue 8, item 1: ``cycling.speed_for_power`` at its edges (P = 0, tangencies, tiny powers), against a reference
+written here: a dense scan of ``cycling.power`` for the last sign change, refined by scipy's brentq."""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Callable
+
+import numpy as np
+import pytest
+import viser
+from helpers.wsclient import BrowserClient
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy.optimize import brentq
+
+from kernels import cycling
+from scenes.peloton import PelotonScene
+from server.switcher import SceneSwitcher
+
+# m/s: every input drawn below needs more than its power here (the reference checks it).
+V_MAX = 200.0
+
+
+def bracketed_root(f: Callable[[float], float], lo: float, hi: float) -> float:
+    root, info = brentq(f, lo, hi, xtol=1e-14, maxiter=1000, full_output=True)
+    assert info.converged
+    return float(root)
+
+
+def largest_root_reference(power_w: float, **args: float) -> float:
+    """Largest v in [0, V_MAX] with power(v) = power_w, by scanning and brentq; independent of the kernel's solver."""
+
+    def f(v: float) -> float:
+        return float(cycling.power(v, **args).total) - power_w
+
+    speeds = np.linspace(0.0, V_MAX, 40_001)
+    values = cycling.power(speeds, **args).total - power_w
+    assert values[-1] > 0.0, "V_MAX too small for this input"
+    at_or_below = np.flatnonzero(values <= 0.0)
+    if at_or_below.size == 0:
+        return 0.0  # cannot happen for P ≥ 0 (power(0) = 0), kept for clarity
+    i = int(at_or_below[-1])
+    if values[i] == 0.0:
+        lo = float(speeds[i])
+        # An exact zero on the grid: it is the largest root unless another lies inside the next cell.
+        return (
+            lo
+            if f(lo + 1e-12) > 0.0 or i + 1 == len(speeds)
+            else bracketed_root(f, lo + 1e-12, float(speeds[i + 1]))
+        )
+    return bracketed_root(f, float(speeds[i]), float(speeds[i + 1]))
+
+
+def assert_is_the_largest_root(v: float, power_w: float, **args: float) -> None:
+    assert math.isfinite(v) and v >= 0.0
+    back = float(cycling.power(v, **args).total)
+    assert abs(back - power_w) <= max(1e-9 * power_w, 1e-9), (v, back, power_w)
+    reference = largest_root_reference(power_w, **args)
+    # Near a tangency every v within about sqrt(rounding) of the root gives power_w to rounding: 1e-6 m/s of slack.
+    assert v == pytest.approx(reference, rel=1e-6, abs=1e-6), (v, reference)
+
+
+# Inputs from the issue plus their whole family: rolling that cancels the grade exactly (Crr = −grade, or Crr 0 on
+# the flat), grades a hair either side of it, tailwinds, zero, subnormal and tiny powers.
+crrs = st.one_of(st.sampled_from([0.0, 0.004, 0.005, 0.012]), st.floats(0.0, 0.02))
+tiny_powers = st.sampled_from([0.0, 5e-324, 1e-300, 1e-15, 1e-12, 1e-9, 1e-6, 1e-3])
+powers = st.one_of(tiny_powers, st.floats(0.0, 1500.0))
+
+
+@st.composite
+def courses(draw: st.DrawFn) -> dict[str, float]:
+    crr = draw(crrs)
+    grade = draw(
+        st.one_of(
+            st.just(-crr),  # rolling cancels the grade: a double root of the cubic at v = −w
+            st.builds(lambda d: -crr + d, st.sampled_from([-1e-12, 1e-12, -1e-6, 1e-6])),
+            st.floats(-0.15, 0.2),
+        )
+    )
+    return dict(
+        cda_m2=draw(st.floats(0.1, 0.8)),
+        mass_kg=draw(st.floats(40.0, 150.0)),
+        crr=crr,
+        grade=grade,
+        altitude_m=draw(st.sampled_from([0.0, 2000.0])),
+        headwind_ms=draw(
+            st.one_of(st.sampled_from([0.0, -1.0, -2.0, -13.5, -15.0]), st.floats(-15.0, 15.0))
+        ),
+        drivetrain_efficiency=draw(st.sampled_from([1.0, 0.976, 0.8])),
+    )
+
+
+@given(power_w=powers, course=courses())
+@settings(max_examples=300, deadline=None)
+def test_speed_for_power_is_the_largest_root_everywhere(
+    power_w: float, course: dict[str, float]
+) -> None:
+    v = float(cycling.speed_for_power(power_w, **course))
+    assert_is_the_largest_root(v, power_w, **course)
+
+
+@given(course=courses(), fraction=st.sampled_from([0.5, 1e-3, 1e-9]))
+@settings(max_examples=150, deadline=None)
+def test_speed_for_power_is_continuous_as_power_goes_to_zero(
+    course: dict[str, float], fraction: float
+) -> None:
+    """ε-δ: for δ > 0 every power below power(v(0) + δ) gives a speed within δ above v(0), and never below it."""
+    v_zero = float(cycling.speed_for_power(0.0, **course))
+    for delta in (1e-2, 1e-4, 1e-6):
+        limit = float(cycling.power(v_zero + delta, **course).total)
+        assert limit > 0.0  # beyond the largest root more speed costs more power
+        v = float(cycling.speed_for_power(fraction * limit, **course))
+        assert v_zero <= v <= v_zero + delta
+
+
+def test_vectorised_call_equals_one_value_at_a_time() -> None:
+    rng = np.random.default_rng(3)
+    crr = rng.choice([0.0, 0.005], 400)
+    grade = np.where(rng.random(400) < 0.5, -crr, rng.uniform(-0.1, 0.1, 400))
+    wind = rng.choice([-13.5, -2.0, -1.0, 0.0, 4.0], 400)
+    p = rng.choice([0.0, 1e-9, 50.0, 300.0], 400)
+    batch = cycling.speed_for_power(p, 0.32, 80.0, crr, grade=grade, headwind_ms=wind)
+    single = [
+        float(
+            cycling.speed_for_power(p[i], 0.32, 80.0, crr[i], grade=grade[i], headwind_ms=wind[i])
+        )
+        for i in range(400)
+    ]
+    np.testing.assert_array_equal(batch, single)
+
+
+# ------------------------------------------------------------------------------------------------ the issue's inputs
+def test_rolling_cancelling_the_grade_carries_the_rider_at_the_tailwind_speed() -> None:
+    # Issue 8: returned 0.0 m/s, while 1e-9 W returned 2.00005 m/s.
+    v = float(cycling.speed_for_power(0.0, 0.32, 80.0, 0.005, grade=-0.005, headwind_ms=-2.0))
+    assert v == 2.0
+    near = float(cycling.speed_for_power(1e-9, 0.32, 80.0, 0.005, grade=-0.005, headwind_ms=-2.0))
+    assert 2.0 < near < 2.0001
+
+
+@pytest.mark.parametrize("tailwind_ms", [1.0, 13.5])
+def test_no_rolling_on_the_flat_carries_the_rider_at_the_tailwind_speed(tailwind_ms: float) -> None:
+    v = float(cycling.speed_for_power(0.0, 0.32, 80.0, 0.0, grade=0.0, headwind_ms=-tailwind_ms))
+    assert v == tailwind_ms
+
+
+def test_standing_still_needs_no_power_without_a_push() -> None:
+    assert float(cycling.speed_for_power(0.0, 0.32, 80.0, 0.004)) == 0.0
+    assert float(cycling.speed_for_power(0.0, 0.32, 80.0, 0.0)) == 0.0
+    assert (
+        float(cycling.speed_for_power(0.0, 0.32, 80.0, 0.004, headwind_ms=-1.0)) == 0.0
+    )  # rolling holds
+    # Flat, no rolling, no wind: P = a·v³, so v = ∛(P/a) for the smallest powers too.
+    a = 0.5 * 1.225 * 0.32
+    for p in (1e-300, 1e-9, 1.0):
+        v = float(cycling.speed_for_power(p, 0.32, 80.0, 0.0))
+        assert v == pytest.approx((p / a) ** (1 / 3), rel=1e-12)
+
+
+# ------------------------------------------------------------------------ the domain: overflow, underflow, last ulps
+# The kind (review of issue 8): finite accepted inputs whose intermediates (P/a, |c|/a, w², m·g·(Crr + grade),
+# ρ(h)) overflow or underflow, giving inf or a wrong finite speed, and a stopping rule that quit several ulps short
+# where dP/dv is large. Family: every argument at and beyond the ends of SPEED_FOR_POWER_DOMAIN, any finite grade.
+DOMAIN = cycling.SPEED_FOR_POWER_DOMAIN
+BASE = dict(power_w=100.0, cda_m2=0.32, mass_kg=80.0, crr=0.005, headwind_ms=0.0, altitude_m=0.0)
+
+
+def solve_without_warnings(**args: float) -> float:
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        return float(cycling.speed_for_power(**args))
+
+
+def assert_solves_to_the_nearest_float(v: float, **args: float) -> None:
+    """power(v) = P to rounding (1e-9 relative, 1e-9 W, or two ulps of v), and for P > 0 no float neighbour of v is
+    closer."""
+    assert math.isfinite(v) and v >= 0.0, v
+    target = args.pop("power_w")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        parts = cycling.power(
+            np.array([max(np.nextafter(v, -1.0), 0.0), v, np.nextafter(v, np.inf)]), **args
+        )
+    miss = np.abs(parts.total - target)
+    scale = np.abs(parts.aero[1]) + np.abs(parts.rolling[1]) + np.abs(parts.climbing[1])
+    per_ulp = 0.5 * abs(
+        parts.total[2] - parts.total[0]
+    )  # where one ulp of v moves P by more than 1e-9 W
+    assert miss[1] <= max(1e-9 * target, 1e-9, 1e-13 * scale, 2.0 * per_ulp), (
+        v,
+        parts.total[1],
+        target,
+    )
+    # (The speed is the root to a few ulps; the nearest float is not promised: near v the float power() rounds
+    # by about an ulp of v itself.)
+
+
+def edge(name: str) -> st.SearchStrategy[float]:
+    low, high = DOMAIN[name]
+    inside = st.floats(low, high) | st.sampled_from([low, high, 0.5 * (low + high)])
+    return inside.filter(lambda x: name not in ("cda_m2", "mass_kg") or x > 0.0)
+
+
+@given(
+    power_w=edge("power_w") | tiny_powers,
+    cda_m2=edge("cda_m2"),
+    mass_kg=edge("mass_kg") | st.sampled_from([5e-324, 1e-300, 80.0]),
+    crr=edge("crr"),
+    grade=st.floats(allow_nan=False, allow_infinity=False)
+    | st.sampled_from([-1.7e308, 1.7e308, -1e10, 0.0]),
+    altitude_m=edge("altitude_m"),
+    headwind_ms=edge("headwind_ms") | st.sampled_from([-300.0, -1000.0, 1000.0]),
+    drivetrain_efficiency=st.sampled_from([1.0, 0.9, 0.01]),
+)
+@settings(max_examples=400, deadline=None)
+def test_speed_for_power_is_finite_and_exact_over_its_whole_domain(**args: float) -> None:
+    v = solve_without_warnings(**args)
+    assert_solves_to_the_nearest_float(v, **args)
+
+
+@given(
+    name=st.sampled_from(sorted(DOMAIN)),
+    side=st.sampled_from([-1.0, 1.0]),
+    beyond=st.floats(1e-9, 1.0) | st.sampled_from([1e3, 1e150, 1e300]),
+)
+@settings(max_examples=200, deadline=None)
+def test_speed_for_power_rejects_values_outside_its_domain_by_name(
+    name: str, side: float, beyond: float
+) -> None:
+    low, high = DOMAIN[name]
+    end = high if side > 0.0 else low
+    value = end + side * max(beyond * max(abs(end), 1.0), 1e-300)
+    if side < 0.0 and name in ("cda_m2", "mass_kg"):
+        value = min(value, low * (1.0 - 1e-9)) if low > 0.0 else -beyond
+    args = dict(BASE, **{name: value})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(ValueError, match=name):
+            cycling.speed_for_power(**args)
+
+
+# The reviewer's inputs (args 0.32 m², 80 kg, Crr 0.005 unless shown), each with its right value.
+@pytest.mark.parametrize(
+    "name, value",
+    [
+        ("headwind_ms", 1e155),  # returned 8.47 m/s, the no-wind speed
+        ("headwind_ms", 1e200),
+        ("headwind_ms", 1.7e308),
+        ("headwind_ms", -1.7e308),  # returned inf
+        ("power_w", 1.7e308),  # returned inf (P/a overflowed)
+        ("altitude_m", 1e300),  # returned inf (density underflowed to 0)
+        ("altitude_m", -1e300),  # returned 0.0 (density overflowed)
+        ("cda_m2", 5e-324),  # returned inf
+        ("cda_m2", 1e-300),  # warned
+    ],
+)
+def test_absurd_inputs_are_refused_by_name(name: str, value: float) -> None:
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(ValueError, match=name):
+            cycling.speed_for_power(**dict(BASE, **{name: value}))
+
+
+@pytest.mark.parametrize("grade", [-1.7e308, -1e300, -1e10])
+def test_a_vertical_descent_falls_at_terminal_velocity(grade: float) -> None:
+    # m·g·(Crr + grade) overflowed to −inf (returned inf). A vertical road: gravity m·g against drag a·v², so
+    # at 0 W v = √(m·g / a) = 63.278 m/s, and at 100 W the root of v·(a·v² − m·g) = 100.
+    a = 0.5 * 1.225 * 0.32
+    v0 = solve_without_warnings(**dict(BASE, power_w=0.0, grade=grade))
+    assert v0 == pytest.approx(math.sqrt(80.0 * 9.81 / a), rel=1e-12)
+    assert v0 == pytest.approx(63.27781312, rel=1e-9)
+    v = solve_without_warnings(**dict(BASE, grade=grade))
+    root = brentq(lambda x: x * (a * x * x - 80.0 * 9.81) - 100.0, 63.0, 64.0, xtol=1e-13)
+    assert v == pytest.approx(root, rel=1e-12)
+
+
+def test_a_subnormal_efficiency_is_the_zero_power_speed() -> None:
+    # P·η underflows to (almost) nothing: the rider coasts (power() itself overflows dividing by such an η).
+    for grade, expected in (
+        (0.0, 0.0),
+        (-0.02, float(cycling.speed_for_power(0.0, 0.32, 80.0, 0.005, -0.02))),
+    ):
+        v = solve_without_warnings(**dict(BASE, grade=grade, drivetrain_efficiency=5e-324))
+        assert v == pytest.approx(expected, rel=1e-15, abs=1e-300)
+
+
+def test_a_fast_tailwind_lands_on_the_nearest_float() -> None:
+    # Stopped 15 ulps early: power(v) missed 0.001 W by 1.2e-8 W (one ulp of v is 1.5e-9 W here).
+    args = dict(
+        power_w=0.001,
+        cda_m2=0.3,
+        mass_kg=80.0,
+        crr=0.008023272163568376,
+        grade=0.0749270873968717,
+        headwind_ms=-1000.0,
+    )
+    v = solve_without_warnings(**args)
+    assert_solves_to_the_nearest_float(v, **args)
+
+
+# ------------------------------------------------------------------------------------------------ the scene's readout
+def test_peloton_readout_at_zero_watts_on_a_cancelling_grade(server: viser.ViserServer) -> None:
+    """Crr 0.005, grade −0.5 %, headwind −2 m/s, 0 W: the rider is carried at 7.2 km/h (it read 0.0 km/h)."""
+    switcher = SceneSwitcher(server, "peloton")
+    try:
+        scene = switcher.scene
+        assert isinstance(scene, PelotonScene)
+        with BrowserClient(server.get_port()) as client:
+            client.wait_for_gui("Power (W)")
+            for label, value in (
+                ("Crr", 0.005),
+                ("Grade (%)", -0.5),
+                ("Headwind (m/s, − = tailwind)", -2.0),
+                ("Power (W)", 0.0),
+            ):
+                client.set_value(label, value)
+            client.wait_for(
+                lambda: (
+                    (scene.params.crr, scene.params.grade_pct, scene.params.headwind_ms)
+                    == (0.005, -0.5, -2.0)
+                    and scene.params.target_power_w == 0.0
+                ),
+                what="the server to apply the course",
+            )
+            client.wait_for(
+                lambda: any(
+                    "holds **7.2 km/h**" in str(e["props"].get("_markdown", ""))
+                    for e in client.gui.values()
+                ),
+                what="the client to receive 7.2 km/h",
+            )
+            assert "**0.0 km/h**" not in scene.speed_out.content
+    finally:
+        switcher.close()

@@ -1,0 +1,1288 @@
+"""FABRIK, CCD, DLS and the two-bone solver against geometry: properties over random chains, and exact cases."""
+
+from __future__ import annotations
+
+import itertools
+import math
+import os
+import subprocess
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from helpers import ik_reference
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from numpy.typing import NDArray
+
+from kernels import fabrik
+
+PROPERTY = settings(max_examples=60, deadline=None)
+BAD_SOLVER: Any = "newton"
+"""A solver name a caller could send that is not a :data:`fabrik.Solver`."""
+
+
+# ------------------------------------------------------------------------------------------------ helpers
+def random_chain(
+    rng: np.random.Generator, n: int, d: int, *, bend: float = 0.6
+) -> NDArray[np.float64]:
+    """A chain of n links, lengths 0.2–1.5 m, each turning by up to ``bend`` rad from the last, rooted at a random place."""
+    lengths = rng.uniform(0.2, 1.5, n)
+    direction = np.zeros(d)
+    direction[-1] = 1.0
+    joints = [rng.uniform(-1.0, 1.0, d)]
+    for length in lengths:
+        turn = rng.normal(size=d) * bend
+        direction = direction + turn - (turn @ direction) * direction
+        direction /= np.linalg.norm(direction)
+        joints.append(joints[-1] + length * direction)
+    return np.array(joints)
+
+
+def random_direction(rng: np.random.Generator, d: int) -> NDArray[np.float64]:
+    v = rng.normal(size=d)
+    return v / np.linalg.norm(v)
+
+
+def segment_clearance(joints: NDArray[np.float64], centre: NDArray[np.float64]) -> float:
+    """Smallest distance from ``centre`` to any segment of the chain."""
+    best = math.inf
+    for a, b in itertools.pairwise(joints):
+        seg = b - a
+        t = 0.0 if seg @ seg == 0.0 else min(1.0, max(0.0, float((centre - a) @ seg / (seg @ seg))))
+        best = min(best, float(np.linalg.norm(a + t * seg - centre)))
+    return best
+
+
+chains = st.tuples(st.integers(1, 12), st.sampled_from([2, 3]), st.integers(0, 2**32 - 1))
+
+
+# ------------------------------------------------------------------------------------------------ properties
+@PROPERTY
+@given(chains, st.floats(0.0, 1.0), st.booleans(), st.booleans())
+def test_lengths_preserved_and_finite(
+    chain: tuple[int, int, int], where: float, limits: bool, obstacle: bool
+) -> None:
+    n, d, seed = chain
+    rng = np.random.default_rng(seed)
+    joints = random_chain(rng, n, d)
+    total = fabrik.link_lengths(joints).sum()
+    target = joints[0] + random_direction(rng, d) * where * 1.3 * total
+    obstacles = (
+        [(joints[0] + random_direction(rng, d) * 0.5 * total, 0.1 * total)] if obstacle else []
+    )
+    obstacles = [o for o in obstacles if np.linalg.norm(o[0] - joints[0]) > o[1]]
+    result = fabrik.solve(
+        joints,
+        target,
+        cone_half_angle_rad=0.7 if limits else None,
+        obstacles=obstacles,
+        max_iterations=200,
+    )
+    assert np.all(np.isfinite(result.joints))
+    assert np.all(np.isfinite(result.error_history))
+    np.testing.assert_allclose(
+        fabrik.link_lengths(result.joints), fabrik.link_lengths(joints), rtol=1e-9
+    )
+    np.testing.assert_array_equal(result.joints[0], joints[0])
+    assert result.error == pytest.approx(np.linalg.norm(result.joints[-1] - target), abs=1e-12)
+
+
+@PROPERTY
+@given(chains, st.floats(0.0, 1.0), st.sampled_from(["fabrik", "ccd", "jacobian_dls"]))
+def test_reachable_targets_are_reached(
+    chain: tuple[int, int, int], where: float, solver: fabrik.Solver
+) -> None:
+    n, d, seed = chain
+    n = max(n, 2)  # one link reaches only its own circle
+    rng = np.random.default_rng(seed)
+    joints = random_chain(rng, n, d)
+    inner, outer = fabrik.reach_limits(fabrik.link_lengths(joints))
+    # Stay clear of the annulus edges, where every iterative solver slows down (see the physics notes).
+    radius = inner + (0.05 + 0.9 * where) * (outer - inner)
+    target = joints[0] + random_direction(rng, d) * radius
+    tolerance = 1e-3 * outer
+    result = fabrik.solve_batch(
+        joints[None], target[None], tolerance=tolerance, max_iterations=3000, solver=solver
+    )[0]
+    assert result.status == "reached"
+    assert result.error < tolerance
+    assert np.linalg.norm(result.joints[-1] - target) < tolerance
+
+
+@PROPERTY
+@given(chains, st.floats(1.001, 5.0))
+def test_targets_beyond_reach_give_a_straight_chain_at_once(
+    chain: tuple[int, int, int], factor: float
+) -> None:
+    n, d, seed = chain
+    rng = np.random.default_rng(seed)
+    joints = random_chain(rng, n, d)
+    lengths = fabrik.link_lengths(joints)
+    direction = random_direction(rng, d)
+    target = joints[0] + direction * factor * lengths.sum()
+    result = fabrik.solve(joints, target)
+    # A straight pose within the tolerance of the target reaches it, even from beyond the reach.
+    assert result.status == ("reached" if result.error <= 1e-3 else "unreachable")
+    assert result.iterations <= 1
+    expected = joints[0] + np.concatenate([[0.0], np.cumsum(lengths)])[:, None] * direction
+    np.testing.assert_allclose(result.joints, expected, atol=1e-9 * lengths.sum())
+    assert result.error == pytest.approx((factor - 1.0) * lengths.sum(), rel=1e-9)
+
+
+def test_target_in_the_inner_hole_gives_the_folded_closest_pose() -> None:
+    # Links 3, 1, 0.5: the end can come no closer to the root than 3 − 1.5 = 1.5 m.
+    joints = np.array([[0.0, 0.0], [0.0, 3.0], [1.0, 3.0], [1.0, 3.5]])
+    target = np.array([0.5, 0.0])
+    result = fabrik.solve(joints, target)
+    assert result.status == "unreachable"
+    assert result.iterations == 1
+    np.testing.assert_allclose(result.joints[-1], [1.5, 0.0], atol=1e-12)
+    assert result.error == pytest.approx(1.0)
+    np.testing.assert_allclose(fabrik.link_lengths(result.joints), [3.0, 1.0, 0.5])
+
+
+@PROPERTY
+@given(chains, st.floats(0.0, 1.5), st.floats(0.05, math.pi))
+def test_cone_limits_never_violated(chain: tuple[int, int, int], where: float, phi: float) -> None:
+    n, d, seed = chain
+    rng = np.random.default_rng(seed)
+    joints = random_chain(rng, n, d, bend=2.0)  # starting poses are often outside the limits
+    total = fabrik.link_lengths(joints).sum()
+    target = joints[0] + random_direction(rng, d) * where * total
+    root_direction = random_direction(rng, d)
+    for solver in ("fabrik", "ccd", "jacobian_dls"):
+        result = fabrik.solve_batch(
+            joints[None],
+            target[None],
+            cone_half_angle_rad=phi,
+            root_direction=root_direction,
+            max_iterations=60,
+            solver=solver,
+        )[0]
+        angles = fabrik.joint_angles(result.joints, root_direction)
+        assert np.all(angles <= phi + 1e-6), (solver, angles.max(), phi)
+        np.testing.assert_allclose(
+            fabrik.link_lengths(result.joints), fabrik.link_lengths(joints), rtol=1e-9
+        )
+
+
+@PROPERTY
+@given(chains, st.floats(0.0, 1.3), st.integers(1, 4), st.booleans())
+def test_no_segment_passes_through_an_obstacle(
+    chain: tuple[int, int, int], where: float, count: int, limits: bool
+) -> None:
+    n, d, seed = chain
+    rng = np.random.default_rng(seed)
+    joints = random_chain(rng, n, d, bend=0.3)
+    total = fabrik.link_lengths(joints).sum()
+    target = joints[0] + random_direction(rng, d) * where * total
+    obstacles = []
+    for _ in range(20 * count):
+        centre = joints[0] + random_direction(rng, d) * rng.uniform(0.1, 1.0) * total
+        radius = rng.uniform(0.03, 0.25) * total
+        if segment_clearance(joints, centre) > radius and len(obstacles) < count:
+            obstacles.append((centre, radius))
+    phi = 0.8 if limits else None
+    result = fabrik.solve(
+        joints, target, obstacles=obstacles, cone_half_angle_rad=phi, max_iterations=100
+    )
+    for centre, radius in obstacles:
+        assert segment_clearance(result.joints, centre) >= radius * (1.0 - 1e-9), result.status
+    if limits:
+        assert np.all(fabrik.joint_angles(result.joints) <= 0.8 + 1e-6)
+
+
+@PROPERTY
+@given(st.integers(1, 12), st.sampled_from([2, 3]), st.integers(0, 2**32 - 1), st.booleans())
+def test_batch_equals_single_solves(n: int, d: int, seed: int, limits: bool) -> None:
+    rng = np.random.default_rng(seed)
+    joints = np.stack([random_chain(rng, n, d) for _ in range(6)])
+    joints -= joints[:, :1]  # one root, so the shared obstacle means the same to every chain
+    total = fabrik.link_lengths(joints).sum(axis=1)
+    targets = np.stack([random_direction(rng, d) * rng.uniform(0.0, 1.3) * t for t in total])
+    obstacles = [(random_direction(rng, d) * 0.6 * total.min(), 0.1 * total.min())]
+    kwargs = {
+        "cone_half_angle_rad": 0.9 if limits else None,
+        "obstacles": obstacles,
+        "max_iterations": 40,
+    }
+    batch = fabrik.solve_batch(joints, targets, **kwargs)
+    for i in range(len(joints)):
+        single = fabrik.solve(joints[i], targets[i], **kwargs)
+        np.testing.assert_allclose(batch.joints[i], single.joints, rtol=0, atol=1e-12)
+        assert batch.iterations[i] == single.iterations
+        assert batch.status[i] == single.status
+        assert batch.error[i] == pytest.approx(single.error, abs=1e-12)
+        np.testing.assert_allclose(batch[i].error_history, single.error_history, atol=1e-12)
+
+
+def test_single_solve_gives_the_batch_paths_bits_while_dragging_past_obstacles() -> None:
+    """``solve`` runs its own one-chain driver; every field must equal a batch of one, bit for bit, on every status."""
+    rng = np.random.default_rng(7)
+    angles = 0.15 * np.arange(12)
+    joints = np.vstack(
+        [np.zeros(3), np.cumsum(0.1 * np.stack([np.sin(angles), 0 * angles, np.cos(angles)], 1), 0)]
+    )
+    obstacles = [
+        (np.array([0.35, 0.0, 0.55]), 0.08),
+        (np.array([-0.3, 0.1, 0.6]), 0.1),
+        (np.array([0.0, 0.35, 0.8]), 0.07),
+        (np.array([0.3, 0.3, 0.25]), 0.09),
+        (joints[6] + 0.01, 0.05),  # cuts the starting pose
+    ]
+    kwargs: dict[str, Any] = {"cone_half_angle_rad": math.radians(30.0), "obstacles": obstacles}
+    pose, statuses = joints, set()
+    for k in range(120):
+        s = 2.0 * math.pi * k / 120
+        target = np.array([0.45 * math.sin(s), 0.25 * math.sin(2 * s), 0.75 + 0.2 * math.cos(s)])
+        if k % 10 == 0:
+            target = random_direction(rng, 3) * rng.uniform(0.0, 1.5)
+        elif k % 10 == 5:
+            target = obstacles[k % 4][0]  # inside an obstacle: "blocked"
+        single = fabrik.solve(pose, target, **kwargs)
+        batch = fabrik.solve_batch(pose[None], target[None], **kwargs)[0]
+        assert single.joints.tobytes() == batch.joints.tobytes()
+        assert single.error_history.tobytes() == batch.error_history.tobytes()
+        assert (single.iterations, single.status) == (batch.iterations, batch.status)
+        assert np.float64(single.error).tobytes() == np.float64(batch.error).tobytes()
+        statuses.add(single.status)
+        pose = single.joints
+    assert {"reached", "blocked", "unreachable"} <= statuses
+
+
+# ------------------------------------------------------------------------------------------------ degenerate input
+@pytest.mark.parametrize("d", [2, 3])
+def test_straight_chain_bends_toward_a_closer_target_on_its_axis(d: int) -> None:
+    joints = np.zeros((6, d))
+    joints[:, -1] = np.arange(6.0)  # straight up, reach 5
+    # On the chain's own axis, closer than its reach (with 34° limits, no closer than they allow).
+    for phi, distance in ((None, 3.0), (0.6, 4.0)):
+        target = np.zeros(d)
+        target[-1] = distance
+        result = fabrik.solve(joints, target, cone_half_angle_rad=phi, max_iterations=200)
+        assert result.status == "reached"
+        assert result.error < 1e-3
+        off_axis = np.linalg.norm(result.joints[:, :-1], axis=1)
+        assert off_axis.max() > 0.1  # it really bent
+
+
+def test_two_straight_links_bend_toward_a_target_on_their_axis() -> None:
+    axis = np.array([0.9, 0.6]) / np.linalg.norm([0.9, 0.6])
+    joints = np.array([[0.0, 0.0], 0.25 * axis, 0.5 * axis])
+    result = fabrik.solve(joints, 0.36 * axis, tolerance=1e-6, max_iterations=100)
+    assert result.status == "reached"
+    assert result.error < 1e-6
+
+
+@pytest.mark.parametrize("solver", ["fabrik", "ccd", "jacobian_dls"])
+def test_inputs_are_not_modified(solver: fabrik.Solver) -> None:
+    # Straight, with the target on its axis: the solver bends it, on its own copy.
+    joints = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, 2.0]])
+    target = np.array([0.0, 0.0, 1.5])
+    joints_before, target_before = joints.copy(), target.copy()
+    fabrik.solve_batch(joints[None], target[None], solver=solver, cone_half_angle_rad=0.5)
+    fabrik.solve(joints, target)
+    np.testing.assert_array_equal(joints, joints_before)
+    np.testing.assert_array_equal(target, target_before)
+
+
+@pytest.mark.parametrize("d", [2, 3])
+def test_degenerate_inputs_never_give_nan(d: int) -> None:
+    zero = np.zeros((4, d))
+    coincident = np.zeros((4, d))
+    coincident[2:, 0] = 1.0  # links of length 0, 1, 0
+    folded = np.zeros((3, d))
+    folded[1, -1] = 1.0  # up and straight back down onto the root
+    cases = [
+        (zero, np.ones(d)),  # every link of zero length
+        (zero, np.zeros(d)),
+        (coincident, np.full(d, 0.5)),
+        (coincident, np.zeros(d)),  # target on the root
+        (folded, np.zeros(d)),
+        (folded, np.full(d, 0.3)),
+    ]
+    for joints, target in cases:
+        for phi in (None, 0.5):
+            for solver in ("fabrik", "ccd", "jacobian_dls"):
+                result = fabrik.solve_batch(
+                    joints[None], target[None], cone_half_angle_rad=phi, solver=solver
+                )[0]
+                assert np.all(np.isfinite(result.joints)), (joints, target, phi, solver)
+                assert np.isfinite(result.error)
+                np.testing.assert_allclose(
+                    fabrik.link_lengths(result.joints), fabrik.link_lengths(joints), atol=1e-12
+                )
+    # A target on the root of an equal two-link chain is reachable: the chain folds onto itself.
+    result = fabrik.solve(np.array([[0.0, 0.0], [0.0, 1.0], [1.0, 1.0]]), np.zeros(2))
+    assert result.status == "reached"
+    # The zero-reach chain cannot move: everything stays on the root.
+    result = fabrik.solve(zero, np.ones(d))
+    np.testing.assert_array_equal(result.joints, zero)
+    assert result.status == "unreachable"
+
+
+def test_obstacle_on_the_target_is_blocked_and_clear() -> None:
+    joints = np.array([[0.0, 0.0], [0.0, 1.0], [0.0, 2.0], [0.0, 3.0]])
+    centre = np.array([1.5, 1.5])
+    result = fabrik.solve(joints, centre, obstacles=[(centre, 0.4)], max_iterations=100)
+    assert result.status == "blocked"
+    assert segment_clearance(result.joints, centre) >= 0.4
+    # The best clear pose rests against the obstacle, as close to the target as it can get.
+    assert result.error == pytest.approx(0.4, abs=0.05)
+
+
+def test_obstacle_on_the_free_path_is_avoided_and_the_target_still_reached() -> None:
+    joints = np.array([[0.0, 0.0], [0.0, 1.0], [0.0, 2.0], [0.0, 3.0], [0.0, 4.0]])
+    target = np.array([2.5, 0.5])
+    free = fabrik.solve(joints, target, max_iterations=200)
+    centre = free.joints[2]  # right where the unobstructed solution puts its middle joint
+    result = fabrik.solve(joints, target, obstacles=[(centre, 0.3)], max_iterations=200)
+    assert result.status == "reached"
+    assert result.error < 1e-3
+    assert segment_clearance(result.joints, centre) >= 0.3
+
+
+def test_starting_pose_that_already_reaches_stops_at_zero_iterations() -> None:
+    joints = np.array([[0.0, 0.0], [0.0, 1.0], [1.0, 1.0]])
+    result = fabrik.solve(joints, np.array([1.0, 1.0 + 1e-5]))
+    assert result.iterations == 0
+    assert result.status == "reached"
+    # The same pose outside a 30° limit is first brought inside it.
+    limited = fabrik.solve(joints, np.array([1.0, 1.0]), cone_half_angle_rad=math.radians(30))
+    assert limited.iterations >= 1
+    assert np.all(fabrik.joint_angles(limited.joints) <= math.radians(30) + 1e-9)
+
+
+def test_max_iterations_is_respected_and_error_history_decreases() -> None:
+    rng = np.random.default_rng(3)
+    joints = random_chain(rng, 10, 3)
+    target = joints[0] + np.array([0.5, 0.5, 0.5])
+    result = fabrik.solve(joints, target, tolerance=0.0, max_iterations=7)
+    assert result.iterations == 7
+    assert result.status in ("max_iterations", "unreachable")
+    assert result.error_history.shape == (8,)
+    assert result.error_history[-1] < result.error_history[0]
+
+
+# ------------------------------------------------------------------------------------------------ convergence near limits
+def test_dragged_target_near_the_cone_limits_is_followed_in_few_iterations() -> None:
+    """The benchmark's drag: the chain's tip curls onto its 30° limits, where plain FABRIK needed up to 48
+    iterations a frame (error ratio 0.8–0.95 per iteration); the extrapolated iterates need a few."""
+    n, link, phi = 12, 0.1, math.radians(30.0)
+    angles = 0.15 * np.arange(n)
+    steps = link * np.stack([np.sin(angles), np.zeros(n), np.cos(angles)], axis=1)
+    pose = np.vstack([np.zeros(3), np.cumsum(steps, axis=0)])
+    worst = 0
+    for k in range(
+        260
+    ):  # the first half of the figure-eight, through the frames where the limits bind
+        s = 2.0 * math.pi * k / 500
+        target = np.array([0.45 * math.sin(s), 0.25 * math.sin(2 * s), 0.75 + 0.2 * math.cos(s)])
+        result = fabrik.solve(pose, target, cone_half_angle_rad=phi)
+        assert result.status == "reached", k
+        assert np.all(fabrik.joint_angles(result.joints) <= phi + 1e-6)
+        np.testing.assert_allclose(fabrik.link_lengths(result.joints), link, rtol=1e-9)
+        worst = max(worst, result.iterations)
+        pose = result.joints
+    assert worst <= 10
+
+
+def test_plain_fabrik_is_still_available_and_slower_near_the_limits() -> None:
+    """``extrapolate=False`` is FABRIK as the paper writes it: same guarantees, more iterations where limits bind."""
+    n, link, phi = 12, 0.1, math.radians(30.0)
+    angles = 0.15 * np.arange(n)
+    steps = link * np.stack([np.sin(angles), np.zeros(n), np.cos(angles)], axis=1)
+    start = np.vstack([np.zeros(3), np.cumsum(steps, axis=0)])
+    totals = {}
+    for extrapolate in (True, False):
+        pose, total = start, 0
+        for k in range(0, 260, 4):
+            s = 2.0 * math.pi * k / 500
+            target = np.array(
+                [0.45 * math.sin(s), 0.25 * math.sin(2 * s), 0.75 + 0.2 * math.cos(s)]
+            )
+            result = fabrik.solve(pose, target, cone_half_angle_rad=phi, extrapolate=extrapolate)
+            assert np.all(fabrik.joint_angles(result.joints) <= phi + 1e-6)
+            np.testing.assert_allclose(fabrik.link_lengths(result.joints), link, rtol=1e-9)
+            total += result.iterations
+            pose = result.joints
+        totals[extrapolate] = total
+    assert totals[True] < totals[False]
+
+
+@pytest.mark.parametrize("d", [2, 3])
+def test_targets_the_limits_put_out_of_reach_settle_limited_before_the_cap(d: int) -> None:
+    """Within the reach annulus but too far round for the limits: "limited" ("unreachable" is only for
+    targets outside the annulus), at a fixed point well before the cap, with the best pose seen."""
+    joints = np.zeros((7, d))
+    joints[:, -1] = 0.5 * np.arange(7.0)  # straight up, reach 3
+    for sideways in (1.0, 2.0, -1.5):  # within reach, but too far round for six joints of 0.25 rad
+        target = np.zeros(d)
+        target[0], target[-1] = sideways, 0.2
+        result = fabrik.solve(joints, target, cone_half_angle_rad=0.25, max_iterations=200)
+        assert result.status == "limited"
+        assert result.iterations < 50
+        assert np.all(fabrik.joint_angles(result.joints) <= 0.25 + 1e-6)
+        assert result.error == pytest.approx(result.error_history.min(), rel=0.05)
+
+
+# ------------------------------------------------------------------------------------------------ two-bone
+def test_two_bone_matches_the_law_of_cosines() -> None:
+    joints = fabrik.two_bone([0.0, 0.0], 1.0, 1.0, [math.sqrt(2.0), 0.0], [0.0, 1.0])
+    np.testing.assert_allclose(
+        joints, [[0, 0], [math.sqrt(0.5), math.sqrt(0.5)], [math.sqrt(2.0), 0]], atol=1e-12
+    )
+    # 3-4-5 triangle: the elbow angle at the root is acos(3/5) off the root–target line.
+    joints = fabrik.two_bone([0.0, 0.0, 0.0], 3.0, 4.0, [5.0, 0.0, 0.0], [0.0, 0.0, -1.0])
+    np.testing.assert_allclose(joints[1], [3.0 * 0.6, 0.0, -3.0 * 0.8], atol=1e-12)
+    # Out of reach: straight toward the target; inside the hole: folded.
+    np.testing.assert_allclose(
+        fabrik.two_bone([0, 0], 1.0, 2.0, [10.0, 0.0], [0, 1])[2], [3.0, 0.0], atol=1e-12
+    )
+    np.testing.assert_allclose(
+        fabrik.two_bone([0, 0], 1.0, 2.0, [0.5, 0.0], [0, 1])[2], [1.0, 0.0], atol=1e-12
+    )
+
+
+@PROPERTY
+@given(st.sampled_from([2, 3]), st.integers(0, 2**32 - 1), st.floats(0.2, 0.9))
+def test_two_bone_equals_fabrik_at_two_links(d: int, seed: int, where: float) -> None:
+    rng = np.random.default_rng(seed)
+    joints = random_chain(rng, 2, d, bend=1.0)
+    upper, lower = fabrik.link_lengths(joints)
+    inner, outer = fabrik.reach_limits([upper, lower])
+    target = joints[0] + random_direction(rng, d) * (inner + where * (outer - inner))
+    result = fabrik.solve(joints, target, tolerance=1e-9 * outer, max_iterations=20000)
+    assert result.status == "reached"
+    # FABRIK keeps the elbow on its starting side; the analytic solver is told that side.
+    bend = result.joints[1] - joints[0]
+    analytic = fabrik.two_bone(joints[0], upper, lower, target, bend)
+    np.testing.assert_allclose(result.joints, analytic, atol=1e-5 * outer)
+    np.testing.assert_allclose(np.linalg.norm(analytic[1] - analytic[0]), upper, rtol=1e-12)
+    np.testing.assert_allclose(np.linalg.norm(analytic[2] - analytic[1]), lower, rtol=1e-12)
+    np.testing.assert_allclose(analytic[2], target, atol=1e-9 * outer)
+
+
+# ------------------------------------------------------------------------------------------------ invalid input
+@pytest.mark.parametrize(
+    ("call", "name"),
+    [
+        (lambda: fabrik.solve([[0, 0], [np.nan, 1]], [0, 1]), "joints"),
+        (lambda: fabrik.solve([[0, 0]], [0, 1]), "joints"),
+        (lambda: fabrik.solve([[0, 0, 0, 0], [1, 1, 1, 1]], [0, 1, 0, 0]), "joints"),
+        (lambda: fabrik.solve([[0, 0], [0, 1]], [0, 1, 2]), "target"),
+        (lambda: fabrik.solve([[0, 0], [0, 1]], [np.inf, 1]), "target"),
+        (lambda: fabrik.solve([[0, 0], [0, 1]], [0, 1], tolerance=-1.0), "tolerance"),
+        (lambda: fabrik.solve([[0, 0], [0, 1]], [0, 1], max_iterations=0), "max_iterations"),
+        (
+            lambda: fabrik.solve([[0, 0], [0, 1]], [0, 1], cone_half_angle_rad=4.0),
+            "cone_half_angle_rad",
+        ),
+        (
+            lambda: fabrik.solve([[0, 0], [0, 1]], [0, 1], obstacles=[([1, 1], -0.5)]),
+            "obstacles[0] radius",
+        ),
+        (
+            lambda: fabrik.solve([[0, 0], [0, 1]], [0, 1], obstacles=[([1, 1, 1], 0.5)]),
+            "obstacles[0] centre",
+        ),
+        (lambda: fabrik.solve([[0, 0], [0, 1]], [0, 1], root_direction=[0, 0]), "root_direction"),
+        (lambda: fabrik.solve_batch(np.zeros((2, 3, 2)), np.zeros((3, 2))), "targets"),
+        (
+            lambda: fabrik.solve_batch(np.zeros((1, 3, 2)), np.zeros((1, 2)), solver=BAD_SOLVER),
+            "solver",
+        ),
+        (lambda: fabrik.ccd([[0, 0], [0, 1]], [0, 1], tolerance=np.nan), "tolerance"),
+        (lambda: fabrik.jacobian_dls([[0, 0], [0, 1]], [[0, 1]]), "target"),
+        (lambda: fabrik.two_bone([0, 0], -1.0, 1.0, [1, 0], [0, 1]), "upper_length"),
+        (lambda: fabrik.two_bone([0, 0], 1.0, 1.0, [1, 0, 0], [0, 1]), "target"),
+    ],
+)
+def test_invalid_input_names_the_argument(call: object, name: str) -> None:
+    with pytest.raises(ValueError, match=name.replace("[", r"\[").replace("]", r"\]")):
+        call()  # type: ignore[operator]
+
+
+# ------------------------------------------------------------------------------------------------ plain references
+SOLVERS: tuple[fabrik.Solver, ...] = ("fabrik", "ccd", "jacobian_dls")
+
+
+def reachable_target(
+    rng: np.random.Generator, joints: NDArray[np.float64], where: float
+) -> NDArray[np.float64]:
+    """A target inside the reach annulus, ``where`` ∈ [0, 1] of the way out, clear of both edges."""
+    inner, outer = fabrik.reach_limits(fabrik.link_lengths(joints))
+    radius = inner + (0.05 + 0.9 * where) * (outer - inner)
+    return joints[0] + random_direction(rng, joints.shape[1]) * radius
+
+
+@PROPERTY
+@given(chains, st.floats(0.0, 1.0), st.sampled_from([None, 0.4, 1.2]), st.integers(1, 20))
+def test_fabrik_iterates_are_the_papers_algorithm(
+    chain: tuple[int, int, int], where: float, phi: float | None, cap: int
+) -> None:
+    """Plain FABRIK (extrapolate=False) takes the steps of Aristidou & Lasenby's Algorithm 1 (with the documented
+    cone), and returns the best pose among the start and those steps."""
+    n, d, seed = chain
+    n = max(n, 2)
+    rng = np.random.default_rng(seed)
+    joints = random_chain(rng, n, d, bend=1.0)
+    target = reachable_target(rng, joints, where)
+    result = fabrik.solve(
+        joints,
+        target,
+        tolerance=0.0,
+        max_iterations=cap,
+        cone_half_angle_rad=phi,
+        extrapolate=False,
+    )
+    poses = ik_reference.fabrik(joints, target, result.iterations, phi)
+    scale = fabrik.link_lengths(joints).sum()
+    errors = [float(np.linalg.norm(pose[-1] - target)) for pose in poses]
+    np.testing.assert_allclose(result.error_history[1:], errors, rtol=0, atol=1e-9 * scale)
+    if phi is None:  # every iterate is admissible: the best of them, or the start, comes back
+        candidates = [joints, *poses]
+        best = candidates[int(np.argmin(result.error_history))]
+        np.testing.assert_allclose(result.joints, best, rtol=0, atol=1e-9 * scale)
+
+
+@PROPERTY
+@given(chains, st.floats(0.0, 1.0), st.sampled_from(["ccd", "jacobian_dls"]), st.integers(1, 15))
+def test_ccd_and_dls_iterates_are_the_published_methods(
+    chain: tuple[int, int, int], where: float, solver: fabrik.Solver, cap: int
+) -> None:
+    n, d, seed = chain
+    n = max(n, 2)
+    rng = np.random.default_rng(seed)
+    joints = random_chain(rng, n, d, bend=1.0)
+    target = reachable_target(rng, joints, where)
+    result = fabrik.solve_batch(
+        joints[None], target[None], tolerance=0.0, max_iterations=cap, solver=solver
+    )[0]
+    reference = ik_reference.ccd if solver == "ccd" else ik_reference.dls
+    poses = reference(joints, target, result.iterations)
+    scale = fabrik.link_lengths(joints).sum()
+    errors = [float(np.linalg.norm(pose[-1] - target)) for pose in poses]
+    np.testing.assert_allclose(result.error_history[1:], errors, rtol=0, atol=1e-8 * scale)
+    best = [joints, *poses][int(np.argmin(result.error_history))]
+    # Joints can drift along the redundant directions by rounding that CCD amplifies; the end does not.
+    np.testing.assert_allclose(result.joints, best, rtol=0, atol=1e-6 * scale)
+
+
+def test_paper_setup_reaches_in_fewer_iterations_than_table_1() -> None:
+    """Aristidou & Lasenby 2011, Table 1: 10 joints, reachable targets, FABRIK 15.5 mean iterations, CCD 26.3."""
+    rng = np.random.default_rng(0)
+    joints = np.zeros((11, 3))
+    joints[:, 2] = np.arange(11.0)
+    joints[:, 0] = 0.05 * np.arange(11.0) ** 2  # a gentle arc, as the benchmark's
+    targets = np.stack([random_direction(rng, 3) * rng.uniform(1.0, 9.0) for _ in range(40)])
+    counts = []
+    for plain in (False, True):
+        batch = fabrik.solve_batch(
+            np.repeat(joints[None], 40, axis=0), targets, tolerance=0.01, max_iterations=1000,
+            extrapolate=not plain,
+        )  # fmt: skip
+        assert np.all(batch.status == "reached")
+        counts.append(batch.iterations.mean())
+    assert counts[1] <= 15.5
+    assert counts[0] <= counts[1]
+
+
+@PROPERTY
+@given(st.integers(1, 12), st.sampled_from([2, 3]), st.integers(0, 2**32 - 1), st.booleans())
+def test_every_solver_gives_a_batch_the_bits_of_single_solves(
+    n: int, d: int, seed: int, limits: bool
+) -> None:
+    rng = np.random.default_rng(seed)
+    joints = np.stack([random_chain(rng, n, d) for _ in range(5)])
+    joints -= joints[:, :1]
+    total = fabrik.link_lengths(joints).sum(axis=1)
+    targets = np.stack([random_direction(rng, d) * rng.uniform(0.0, 1.3) * t for t in total])
+    kwargs: dict[str, Any] = {
+        "cone_half_angle_rad": 0.9 if limits else None,
+        "obstacles": [(random_direction(rng, d) * 0.6 * total.min(), 0.1 * total.min())],
+        "max_iterations": 30,
+    }
+    singles = {"fabrik": fabrik.solve, "ccd": fabrik.ccd, "jacobian_dls": fabrik.jacobian_dls}
+    for solver in SOLVERS:
+        batch = fabrik.solve_batch(joints, targets, solver=solver, **kwargs)
+        for i in range(len(joints)):
+            single = singles[solver](joints[i], targets[i], **kwargs)
+            assert single.joints.tobytes() == batch.joints[i].tobytes()
+            assert single.error_history.tobytes() == batch[i].error_history.tobytes()
+            assert (single.iterations, single.status) == (batch[i].iterations, batch[i].status)
+
+
+# ------------------------------------------------------------------------------------------------ limited chains keep their best pose
+def admissible(
+    joints: NDArray[np.float64],
+    phi: float | None,
+    root_direction: NDArray[np.float64],
+    obstacles: list[tuple[NDArray[np.float64], float]],
+) -> bool:
+    """The test's own check: every joint within its cone (cos θ ≥ cos φ − 1e-12, as documented) and no segment
+    through an obstacle."""
+    if phi is not None:
+        segments = np.diff(joints, axis=0)
+        directions = segments / np.linalg.norm(segments, axis=1, keepdims=True)
+        axes = np.vstack([root_direction, directions[:-1]])
+        if np.any(np.sum(directions * axes, axis=1) < math.cos(phi) - 1e-12):
+            return False
+    return all(segment_clearance(joints, c) >= r * (1.0 - 1e-9) for c, r in obstacles)
+
+
+def random_obstacles(
+    rng: np.random.Generator, joints: NDArray[np.float64], count: int
+) -> list[tuple[NDArray[np.float64], float]]:
+    """Up to ``count`` circles or spheres near the chain, none containing its root."""
+    total = fabrik.link_lengths(joints).sum()
+    found = []
+    for _ in range(count):
+        centre = joints[0] + random_direction(rng, joints.shape[1]) * rng.uniform(0.2, 1.0) * total
+        radius = rng.uniform(0.03, 0.2) * total
+        if np.linalg.norm(centre - joints[0]) > radius * 1.01:
+            found.append((centre, radius))
+    return found
+
+
+CAPS = (1, 2, 3, 5, 8, 13, 21, 34)
+
+
+@PROPERTY
+@given(
+    chains,
+    st.floats(0.0, 1.3),
+    st.one_of(st.none(), st.floats(0.05, 3.1)),
+    st.integers(0, 4),
+    st.sampled_from(SOLVERS),
+    st.booleans(),
+    st.floats(0.1, 2.0),
+)
+def test_the_returned_pose_is_the_best_admissible_pose_seen(
+    chain: tuple[int, int, int],
+    where: float,
+    phi: float | None,
+    count: int,
+    solver: fabrik.Solver,
+    extrapolate: bool,
+    bend: float,
+) -> None:
+    """Limited chains keep their best pose, over the whole family: never worse than an admissible start, never worse than an admissible
+    iterate, admissible whenever an admissible pose was seen, and status words that say what happened."""
+    n, d, seed = chain
+    rng = np.random.default_rng(seed)
+    joints = random_chain(rng, n, d, bend=bend)
+    lengths = fabrik.link_lengths(joints)
+    inner, outer = fabrik.reach_limits(lengths)
+    target = joints[0] + random_direction(rng, d) * where * outer
+    root_direction = random_direction(rng, d)
+    obstacles = random_obstacles(rng, joints, count)
+    start_ok = admissible(joints, phi, root_direction, obstacles)
+    start_error = float(np.linalg.norm(joints[-1] - target))
+    distance = float(np.linalg.norm(target - joints[0]))
+    previous = math.inf
+    for cap in CAPS:
+        result = fabrik.solve_batch(
+            joints[None], target[None], tolerance=1e-3 * outer, max_iterations=cap,
+            cone_half_angle_rad=phi, obstacles=obstacles, root_direction=root_direction,
+            solver=solver, extrapolate=extrapolate,
+        )[0]  # fmt: skip
+        # More iterations never give a worse admissible pose: each run repeats the shorter one's iterates first.
+        # (Only where no admissible pose was ever seen is the last iterate returned, whatever its error.)
+        if admissible(result.joints, phi, root_direction, obstacles):
+            assert result.error <= previous + 1e-12 * outer
+            previous = result.error
+        else:
+            assert previous == math.inf, "an admissible pose was seen with fewer iterations"
+        if start_ok:
+            assert result.error <= start_error + 1e-12 * outer
+            assert admissible(result.joints, phi, root_direction, obstacles), result.status
+        if not obstacles and result.iterations > 0:  # limits alone: every iterate is admissible
+            assert result.error <= result.error_history[1:].min() + 1e-12 * outer
+        if result.status == "reached":
+            assert result.error <= 1e-3 * outer * (1 + 1e-9)
+        if distance > outer * (1 + 1e-9) or distance < inner * (1 - 1e-9):
+            assert result.status in ("unreachable", "reached", "infeasible")
+        elif inner * (1 + 1e-9) < distance < outer * (1 - 1e-9):
+            assert result.status != "unreachable"
+        if result.status in ("limited", "blocked"):
+            assert phi is not None or obstacles
+        if result.status == "blocked":
+            assert obstacles
+
+
+def test_a_limited_chain_returns_its_best_pose_not_its_last() -> None:
+    """The case that showed it: it ended "unreachable" at 0.724 m from a 0.600 m start; its best iterate was
+    0.412 m. The target is within reach, so the status is "limited", with the best pose (0.412 m)."""
+    joints = np.array([[0.0, 0.0], [0.0, 1.0], [0.0, 2.0], [0.0, 3.0]])
+    result = fabrik.solve(joints, [0.0, 2.4], cone_half_angle_rad=math.radians(30.0))
+    assert result.status == "limited"
+    assert result.error <= 0.6
+    assert result.error <= result.error_history.min()
+    assert result.error == pytest.approx(0.412, abs=1e-3)
+    assert np.all(fabrik.joint_angles(result.joints, [0.0, 1.0]) <= math.radians(30.0) + 1e-9)
+    batch = fabrik.solve_batch(joints[None], [[0.0, 2.4]], cone_half_angle_rad=math.radians(30.0))
+    assert batch[0].error == result.error and batch[0].status == "limited"
+
+
+@pytest.mark.parametrize("solver", SOLVERS)
+def test_ccd_with_limits_and_obstacles_is_not_unreachable(solver: fabrik.Solver) -> None:
+    """CCD on the arm scene's 12 links, 28° limits, its 4 obstacles, a target 1 m from the root read
+    "unreachable, 540 mm". 1 m is well inside the 3 m reach."""
+    from scenes.arm import OBSTACLE_STARTS, ArmParams, rest_pose
+
+    joints = rest_pose(12, 0.25)[:, [0, 2]]
+    radii = ArmParams().radii_m
+    obstacles = [(OBSTACLE_STARTS[k][[0, 2]], radii[k]) for k in range(4)]
+    for target in ([0.8, 0.6], [0.0, 1.0], [1.0, 0.0]):
+        result = fabrik.solve_batch(
+            joints[None], np.array([target]), cone_half_angle_rad=math.radians(28.0),
+            obstacles=obstacles, root_direction=[0.0, 1.0], solver=solver,
+        )[0]  # fmt: skip
+        assert result.status in ("reached", "limited", "blocked", "max_iterations"), target
+        assert result.error <= np.linalg.norm(joints[-1] - target)
+
+
+# ------------------------------------------------------------------------------------------------ targets at full reach
+@PROPERTY
+@given(
+    chains,
+    st.one_of(st.just(0.0), st.just(1.0), st.floats(0.0, 1.0)),
+    st.floats(1e-7, 1e-2),
+    st.one_of(st.none(), st.floats(0.0, 3.1)),
+    st.integers(0, 3),
+    st.integers(1, 50),
+    st.booleans(),
+)
+def test_targets_within_tolerance_of_full_reach_are_reached(
+    chain: tuple[int, int, int],
+    fraction: float,
+    relative_tolerance: float,
+    phi: float | None,
+    count: int,
+    cap: int,
+    batched: bool,
+) -> None:
+    """Targets at full reach, over the whole family: a target at ΣL − δ, 0 ≤ δ ≤ tolerance, in any direction, is
+    "reached" within max_iterations whenever the straight pose toward it is admissible. "reached" has no slack
+    (error ≤ tolerance exactly), so δ stops a rounding (1e-12 of the coordinates) short of the tolerance (at
+    δ = tolerance the straight pose's error lands on either side of it)."""
+    n, d, seed = chain
+    rng = np.random.default_rng(seed)
+    joints = random_chain(rng, n, d, bend=1.0)
+    lengths = fabrik.link_lengths(joints)
+    total = lengths.sum()
+    tolerance = relative_tolerance * total
+    direction = random_direction(rng, d)
+    rounding = 1e-12 * (total + np.abs(joints[0]).max())
+    target = joints[0] + direction * (total - max(fraction * tolerance - rounding, 0.0))
+    straight = joints[0] + np.concatenate([[0.0], np.cumsum(lengths)])[:, None] * direction
+    # A rest direction the straight pose's first link keeps within its cone.
+    side = random_direction(rng, d)
+    side -= (side @ direction) * direction
+    tilt = 0.0 if phi is None else 0.99 * phi * rng.uniform()
+    root_direction = math.cos(tilt) * direction + math.sin(tilt) * side / np.linalg.norm(side)
+    obstacles = [
+        (c, r)
+        for c, r in random_obstacles(rng, joints, count)
+        if segment_clearance(straight, c) > r
+    ]
+    assert admissible(straight, phi, root_direction, obstacles)
+    kwargs: dict[str, Any] = {
+        "tolerance": tolerance, "max_iterations": cap, "cone_half_angle_rad": phi,
+        "obstacles": obstacles, "root_direction": root_direction,
+    }  # fmt: skip
+    if batched:
+        result = fabrik.solve_batch(joints[None], target[None], **kwargs)[0]
+    else:
+        result = fabrik.solve(joints, target, **kwargs)
+    assert result.status == "reached"
+    assert 0 <= result.iterations <= cap
+    assert result.error <= tolerance
+    assert admissible(result.joints, phi, root_direction, obstacles)
+
+
+@pytest.mark.parametrize("d", [2, 3])
+@pytest.mark.parametrize(
+    ("degrees", "short_of_reach"), [(90.0, 0.5e-3), (135.0, 0.9e-3), (90.0, 0.0), (180.0, 0.0)]
+)
+def test_full_reach_targets_of_the_default_arm_are_reached(
+    d: int, degrees: float, short_of_reach: float
+) -> None:
+    """The cases that showed it: 6 links of 0.25 m straight up, tolerance 1 mm, the target at ΣL − 0.5 mm at 90° to
+    the chain, ΣL − 0.9 mm at 135°, or exactly ΣL: "max_iterations" at 1.57, 5.07 and 7.94 mm before. The straight
+    pose toward the target is within tolerance: reached, its error exactly the shortfall."""
+    joints = np.zeros((7, d))
+    joints[:, -1] = 0.25 * np.arange(7.0)
+    direction = np.zeros(d)
+    direction[0], direction[-1] = math.sin(math.radians(degrees)), math.cos(math.radians(degrees))
+    target = direction * (1.5 - short_of_reach)
+    for result in (
+        fabrik.solve(joints, target, tolerance=1e-3),
+        fabrik.solve_batch(joints[None], target[None], tolerance=1e-3)[0],
+    ):
+        assert result.status == "reached"
+        assert result.iterations <= 50
+        assert result.error == pytest.approx(short_of_reach, abs=1e-12)
+        np.testing.assert_allclose(fabrik.link_lengths(result.joints), 0.25, rtol=1e-12)
+
+
+# ------------------------------------------------------------------------------------------------ compiled cores
+def test_warm_up_compiles_every_core_with_a_cache() -> None:
+    from numba.core.registry import CPUDispatcher
+
+    from kernels.fabrik import chain, geometry, limits, tree
+
+    fabrik.warm_up()
+    cores = {
+        name: value
+        for module in (chain, geometry, limits, tree)
+        for name, value in vars(module).items()
+        if isinstance(value, CPUDispatcher)
+    }
+    assert {"_solve_rows", "_solve_parallel", "_forward_pass", "_ccd_sweep", "_dls_step"} <= set(
+        cores
+    )
+    for name, core in cores.items():
+        cache = core._cache  # pyright: ignore[reportAttributeAccessIssue]
+        assert type(cache).__name__ == "FunctionCache", name  # cache=True on every core
+    # The two entry points are compiled (or loaded); the cores they call are linked into them.
+    assert chain._solve_rows.signatures and chain._solve_parallel.signatures
+
+
+def test_compile_cache_falls_back_to_a_user_directory_when_the_package_is_read_only(
+    tmp_path: Path,
+) -> None:
+    """numba's cache=True writes beside the module; where that cannot be written (a read-only site-packages),
+    it uses the user-wide cache directory. A ``__pycache__`` that is a file stands in for the read-only directory
+    (chmod would not stop root); the second process must load the machine code from the user cache."""
+    package = tmp_path / "site"
+    package.mkdir()
+    (package / "__pycache__").write_text("not a directory")
+    (package / "cached_core.py").write_text(
+        "import numba\n\n@numba.njit(cache=True)\ndef twice(x):\n    return 2.0 * x\n"
+    )
+    script = (
+        "import cached_core\n"
+        "assert cached_core.twice(2.0) == 4.0\n"
+        "print(sum(cached_core.twice.stats.cache_hits.values()), cached_core.twice._cache._cache_path)\n"
+    )
+    environment = {
+        **os.environ,
+        "PYTHONPATH": str(package),
+        "XDG_CACHE_HOME": str(tmp_path / "user-cache"),
+    }
+    environment.pop("NUMBA_CACHE_DIR", None)
+    runs = [
+        subprocess.run(
+            [sys.executable, "-c", script], env=environment, capture_output=True, text=True,
+            timeout=120, check=True,
+        ).stdout.split()
+        for _ in range(2)
+    ]  # fmt: skip
+    assert runs[0][1].startswith(str(tmp_path / "user-cache" / "numba"))
+    assert any(path.suffix == ".nbc" for path in (tmp_path / "user-cache").rglob("*"))
+    assert (runs[0][0], runs[1][0]) == ("0", "1")  # compiled once, then loaded from the user cache
+
+
+# ------------------------------------------------------------------------------------------------ review 2
+def folded_pose(
+    root: NDArray[np.float64], lengths: NDArray[np.float64], direction: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """The longest link toward ``direction``, every other folded back along it: the end at the inner radius."""
+    signs = np.where(np.arange(lengths.shape[0]) == np.argmax(lengths), 1.0, -1.0)
+    return root + np.concatenate([[0.0], np.cumsum(signs * lengths)])[:, None] * direction
+
+
+@PROPERTY
+@given(
+    chains,
+    st.floats(-1.0, 1.0),
+    st.floats(1e-6, 0.1),
+    st.integers(0, 3),
+    st.floats(1.05, 3.0),
+    st.booleans(),
+)
+def test_targets_within_tolerance_of_the_inner_radius_are_reached(
+    chain: tuple[int, int, int],
+    fraction: float,
+    relative_tolerance: float,
+    count: int,
+    dominance: float,
+    batched: bool,
+) -> None:
+    """Targets at the inner reach, the mirror of full reach, over the whole family: where one link is longer than all
+    the others together (inner radius > 0), a target at inner + δ, |δ| ≤ tolerance, in any direction, is "reached"
+    whenever the folded pose toward it is admissible. FABRIK crawled there (linear convergence at the folded
+    singular pose) and tried the folded pose only strictly inside the inner radius."""
+    n, d, seed = chain
+    rng = np.random.default_rng(seed)
+    joints = random_chain(rng, max(n, 2), d, bend=1.0)
+    lengths = fabrik.link_lengths(joints)
+    longest = int(rng.integers(0, lengths.shape[0]))
+    rest = lengths.sum() - lengths[longest]
+    # Stretch the longest link along its own direction so that it beats the rest by the factor ``dominance``.
+    scaled = joints.copy()
+    scaled[longest + 1 :] += (joints[longest + 1] - joints[longest]) * (
+        dominance * rest / lengths[longest] - 1.0
+    )
+    joints, lengths = scaled, fabrik.link_lengths(scaled)
+    inner, outer = fabrik.reach_limits(lengths)
+    assert inner > 0.0
+    tolerance = relative_tolerance * inner
+    direction = random_direction(rng, d)
+    rounding = 1e-12 * (
+        outer + np.abs(joints[0]).max()
+    )  # the target stops that far inside the band
+    target = joints[0] + direction * (inner + fraction * max(tolerance - rounding, 0.0))
+    obstacles = [
+        (c, r)
+        for c, r in random_obstacles(rng, joints, count)
+        if segment_clearance(folded_pose(joints[0], lengths, direction), c) > r
+    ]
+    kwargs: dict[str, Any] = {"tolerance": tolerance, "obstacles": obstacles}
+    if batched:
+        result = fabrik.solve_batch(joints[None], target[None], **kwargs)[0]
+    else:
+        result = fabrik.solve(joints, target, **kwargs)
+    assert result.status == "reached"
+    assert result.error <= tolerance
+    assert admissible(result.joints, None, direction, obstacles)
+    np.testing.assert_allclose(fabrik.link_lengths(result.joints), lengths, rtol=1e-12)
+
+
+@pytest.mark.parametrize("d", [2, 3])
+@pytest.mark.parametrize(("x", "right_error"), [(1.0, 0.0), (1.0005, 0.0005)])
+def test_inner_radius_targets_are_reached_at_once(d: int, x: float, right_error: float) -> None:
+    """F1's inputs: links 2, 0.5, 0.5 straight up (inner radius 1 m), target (1, 0) or (1.0005, 0): it ended
+    "max_iterations" at 23 mm after 50 iterations. The folded pose toward the target reaches it."""
+    joints = np.zeros((4, d))
+    joints[:, -1] = [0.0, 2.0, 2.5, 3.0]
+    target = np.zeros(d)
+    target[0] = x
+    for result in (
+        fabrik.solve(joints, target),
+        fabrik.solve_batch(joints[None], target[None])[0],
+    ):
+        assert result.status == "reached"
+        assert result.iterations == 1
+        assert result.error == pytest.approx(right_error, abs=1e-15)
+        np.testing.assert_allclose(fabrik.link_lengths(result.joints), [2.0, 0.5, 0.5], rtol=1e-15)
+
+
+@PROPERTY
+@given(
+    chains,
+    st.integers(-900, 900),
+    st.floats(0.0, 1.3),
+    st.one_of(st.none(), st.floats(0.05, 3.1)),
+    st.integers(0, 3),
+    st.sampled_from(SOLVERS),
+    st.sampled_from([0.0, 1e-6, 1e-3, 0.1]),
+)
+def test_solves_at_any_power_of_two_scale_are_the_unit_solve_scaled(
+    chain: tuple[int, int, int],
+    exponent: int,
+    where: float,
+    phi: float | None,
+    count: int,
+    solver: fabrik.Solver,
+    relative_tolerance: float,
+) -> None:
+    """Scale (overflowing squares at 1e154–1e300, absolute slack floors on tiny chains), over the
+    whole family: a problem multiplied by 2^k, k ∈ [−900, 900] (chains from 1e-271 m to 1e271 m), is solved as the
+    unit problem multiplied by 2^k, bit for bit (same status, iterations, joints × 2^k, error × 2^k); the core has
+    no absolute length anywhere. Every "reached" has error ≤ tolerance, exactly."""
+    n, d, seed = chain
+    rng = np.random.default_rng(seed)
+    joints = random_chain(rng, n, d)
+    outer = fabrik.link_lengths(joints).sum()
+    target = joints[0] + random_direction(rng, d) * where * outer
+    root_direction = random_direction(rng, d)
+    obstacles = random_obstacles(rng, joints, count)
+    s = math.ldexp(1.0, exponent)
+    common: dict[str, Any] = {"cone_half_angle_rad": phi, "root_direction": root_direction * s}
+    unit = fabrik.solve_batch(
+        joints[None], target[None], tolerance=relative_tolerance * outer, solver=solver,
+        obstacles=obstacles, **common,
+    )[0]  # fmt: skip
+    scaled = fabrik.solve_batch(
+        joints[None] * s, target[None] * s, tolerance=relative_tolerance * outer * s,
+        solver=solver, obstacles=[(c * s, r * s) for c, r in obstacles], **common,
+    )[0]  # fmt: skip
+    assert (scaled.status, scaled.iterations) == (unit.status, unit.iterations)
+    np.testing.assert_array_equal(scaled.joints, unit.joints * s)
+    assert scaled.error == unit.error * s
+    for result, tolerance in (
+        (unit, relative_tolerance * outer),
+        (scaled, relative_tolerance * outer * s),
+    ):
+        assert (result.status == "reached") == (
+            result.error <= tolerance and result.status != "infeasible"
+        )
+
+
+@pytest.mark.parametrize("scale", [1e-300, 1e-160, 1e-20, 1e154, 4e299])
+@pytest.mark.parametrize("solver", SOLVERS)
+def test_huge_and_tiny_chains_are_solved(scale: float, solver: fabrik.Solver) -> None:
+    """F2/F3's inputs: s·[[0, 0], [0, 1], [0, 2]], target s·(1, 1), tolerance s·1e-3. At 1e154 and up squared norms
+    overflowed (NaN joints, inf error); at 1e-20 and below "reached" came with errors 1000× the tolerance. Right:
+    reached, error ≤ s·1e-3, finite joints with the links' lengths."""
+    joints = scale * np.array([[0.0, 0.0], [0.0, 1.0], [0.0, 2.0]])
+    result = fabrik.solve_batch(
+        joints[None], scale * np.array([[1.0, 1.0]]), tolerance=scale * 1e-3, solver=solver
+    )[0]
+    assert result.status == "reached"
+    assert result.error <= scale * 1e-3
+    assert np.isfinite(result.joints).all()
+    np.testing.assert_allclose(fabrik.link_lengths(result.joints) / scale, [1.0, 1.0], rtol=1e-9)
+    assert result.error == pytest.approx(
+        float(np.hypot(*(result.joints[-1] - scale * np.array([1.0, 1.0])))), rel=1e-12, abs=0.0
+    )
+
+
+def test_reached_has_no_slack_beyond_the_tolerance() -> None:
+    """F3's input: 3 × 1 m, target (3 − 5e-13, 0), tolerance 1e-15 was "reached" with error 5e-13 (an absolute
+    1e-12 slack). Its straight pose misses by 5e-13 > tolerance: not "reached", and never worse than that."""
+    joints = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [3.0, 0.0]])
+    result = fabrik.solve(joints, [3.0 - 5e-13, 0.0], tolerance=1e-15)
+    assert result.status != "reached"
+    assert 1e-15 < result.error <= 5.01e-13
+
+
+@pytest.mark.parametrize("length", [1e300, 1e-300, 5e-324, 1.0])
+def test_root_direction_of_any_length_keeps_the_cone(length: float) -> None:
+    """F4: root_direction (0, 1e300) normalised to (0, 0) (its squared norm overflowed) and silently removed the
+    root cone. Any non-zero length gives the same direction: the first link stays within 0.1 rad of +y."""
+    result = fabrik.solve(
+        [[0.0, 0.0], [0.0, 1.0]], [1.0, 0.0], cone_half_angle_rad=0.1, root_direction=[0.0, length]
+    )
+    assert result.status == "limited"
+    np.testing.assert_allclose(result.joints[1], [math.sin(0.1), math.cos(0.1)], rtol=1e-12)
+
+
+def test_huge_two_bone_points_at_its_target() -> None:
+    """F4's two-bone input: links of 1e300 from the origin to (1e300, 1e300), bending toward +y, pointed away
+    from the target (L² overflowed). Right: elbow (0, 1e300), end on the target."""
+    pose = fabrik.two_bone([0.0, 0.0], 1e300, 1e300, [1e300, 1e300], [0.0, 1.0])
+    np.testing.assert_allclose(
+        pose, [[0.0, 0.0], [0.0, 1e300], [1e300, 1e300]], rtol=1e-12, atol=0.0
+    )
+
+
+@PROPERTY
+@given(
+    st.integers(-900, 900), st.integers(0, 2**32 - 1), st.floats(0.0, 1.2), st.sampled_from([2, 3])
+)
+def test_two_bone_at_any_power_of_two_scale_is_the_unit_solve_scaled(
+    exponent: int, seed: int, where: float, d: int
+) -> None:
+    rng = np.random.default_rng(seed)
+    root = rng.uniform(-1.0, 1.0, d)
+    upper, lower = rng.uniform(0.2, 1.5, 2)
+    target = root + random_direction(rng, d) * where * (upper + lower)
+    bend = random_direction(rng, d)
+    s = math.ldexp(1.0, exponent)
+    unit = fabrik.two_bone(root, upper, lower, target, bend)
+    np.testing.assert_array_equal(
+        fabrik.two_bone(root * s, upper * s, lower * s, target * s, bend * s), unit * s
+    )
+
+
+@PROPERTY
+@given(chains, st.one_of(st.none(), st.floats(0.05, 3.1)), st.sampled_from(SOLVERS), st.booleans())
+def test_a_start_on_the_target_is_reached_at_tolerance_zero(
+    chain: tuple[int, int, int], phi: float | None, solver: fabrik.Solver, batched: bool
+) -> None:
+    """Zero tolerance, over the whole family: with tolerance 0, "reached" means error exactly 0 (≤, not <).
+    A start whose end is on the target is reached at 0 iterations by every solver; CCD and DLS ran 50 iterations
+    to "max_iterations" at error 0 while FABRIK said "reached"."""
+    n, d, seed = chain
+    rng = np.random.default_rng(seed)
+    joints = random_chain(rng, n, d, bend=0.3)
+    # A root direction along the first link keeps a bend-0.3 chain inside cones of ≥ 0.05 rad only sometimes:
+    # no limits where the start breaks them (a start outside them is not "reached" as it stands).
+    root_direction = (joints[1] - joints[0]) / np.linalg.norm(joints[1] - joints[0])
+    if phi is not None and not admissible(joints, phi, root_direction, []):
+        phi = None
+    kwargs: dict[str, Any] = {
+        "tolerance": 0.0, "cone_half_angle_rad": phi, "root_direction": root_direction
+    }  # fmt: skip
+    if batched:
+        result = fabrik.solve_batch(joints[None], joints[-1:], solver=solver, **kwargs)[0]
+    else:
+        call = {"fabrik": fabrik.solve, "ccd": fabrik.ccd, "jacobian_dls": fabrik.jacobian_dls}[
+            solver
+        ]
+        result = call(joints, joints[-1], **kwargs)
+    assert (result.status, result.iterations, result.error) == ("reached", 0, 0.0)
+    np.testing.assert_array_equal(result.joints, joints)
+
+
+@pytest.mark.parametrize("solver", SOLVERS)
+def test_start_on_the_target_with_tolerance_zero(solver: fabrik.Solver) -> None:
+    """F5's input: chain (0, 0), (0, 1), (1, 1), target (1, 1), tolerance 0."""
+    joints = np.array([[0.0, 0.0], [0.0, 1.0], [1.0, 1.0]])
+    result = fabrik.solve_batch(joints[None], np.array([[1.0, 1.0]]), tolerance=0.0, solver=solver)[
+        0
+    ]
+    assert (result.status, result.iterations, result.error) == ("reached", 0, 0.0)
+
+
+@PROPERTY
+@given(
+    chains,
+    st.floats(0.0, 1.3),
+    st.one_of(st.none(), st.floats(0.05, 3.1)),
+    st.integers(1, 6),
+    st.sampled_from(SOLVERS),
+    st.floats(0.1, 2.0),
+)
+def test_only_infeasible_solves_return_a_pose_that_breaks_a_constraint(
+    chain: tuple[int, int, int],
+    where: float,
+    phi: float | None,
+    count: int,
+    solver: fabrik.Solver,
+    bend: float,
+) -> None:
+    """Feasible poses only, over the whole family: a returned pose that cuts an obstacle or breaks a limit comes
+    only with status "infeasible" (no admissible pose was ever seen), never "blocked" or "reached"; an admissible
+    start is never "infeasible". Starts here are random, often through the obstacles."""
+    n, d, seed = chain
+    rng = np.random.default_rng(seed)
+    joints = random_chain(rng, n, d, bend=bend)
+    outer = fabrik.link_lengths(joints).sum()
+    target = joints[0] + random_direction(rng, d) * where * outer
+    root_direction = random_direction(rng, d)
+    obstacles = random_obstacles(rng, joints, count)
+    result = fabrik.solve_batch(
+        joints[None], target[None], tolerance=1e-2 * outer, cone_half_angle_rad=phi,
+        obstacles=obstacles, root_direction=root_direction, solver=solver,
+    )[0]  # fmt: skip
+    if result.status != "infeasible":
+        assert admissible(result.joints, phi, root_direction, obstacles), result.status
+    if admissible(joints, phi, root_direction, obstacles):
+        assert result.status != "infeasible"
+
+
+def test_a_dls_pose_through_an_obstacle_is_infeasible() -> None:
+    """The case that showed it: DLS returned a pose cutting an obstacle by 0.025 m with status
+    "blocked" and error < tolerance. The start cuts one too, and no iterate clears them all: "infeasible"."""
+    joints = np.array([
+        [0.0, 0.0], [0.6891671438919661, 0.5236051652449843], [0.2882144032837863, 0.024944821000129125],
+        [0.15713216682656647, 0.21905153446984119], [-0.38456598998267744, 0.667941055707956],
+        [-1.0444604674055584, 1.0667592091512175], [-1.1148908635415238, 1.1659096698694158],
+        [-1.4713856155887348, 1.3694575772849973], [-1.607000108026135, 1.703482813456145],
+    ])  # fmt: skip
+    obstacles = [
+        (np.array([-3.731, 2.542]), 1.51), (np.array([2.075, -0.036]), 1.418),
+        (np.array([-4.075, 1.363]), 1.308),
+    ]  # fmt: skip
+    phi = 2.270989480013398
+    result = fabrik.jacobian_dls(
+        joints, [-0.000632119904869785, 6.225565368868713e-07], tolerance=0.01,
+        cone_half_angle_rad=phi, obstacles=obstacles,
+    )  # fmt: skip
+    assert not admissible(joints, phi, np.array([0.0, 1.0]), obstacles)
+    assert not admissible(result.joints, phi, np.array([0.0, 1.0]), obstacles)
+    assert result.status == "infeasible"
+
+
+ARRAY_OBSTACLES: Any = np.array([[1.0, 1.0, 0.5]])
+"""One obstacle written as a row (centre x, y, radius): numpy's ambiguous-truth error before."""
+NOT_OBSTACLES: Any = 3
+
+
+@pytest.mark.parametrize(
+    ("call", "name"),
+    [
+        (lambda: fabrik.solve([[0, 0], [0, 1]], [1, 0], max_iterations=10**12), "max_iterations"),
+        (lambda: fabrik.solve([[0, 0], [0, 1]], [1, 0], max_iterations=2**63), "max_iterations"),
+        (lambda: fabrik.solve([[0, 0], [0, 10**400]], [1, 0]), "joints"),
+        (lambda: fabrik.solve([[0, 0], [0, 2e300]], [1, 0]), "joints"),
+        (lambda: fabrik.solve([[0, 0], [0, 1j]], [1, 0]), "joints"),
+        (lambda: fabrik.solve(np.array([[0, 0], [0, 1]], dtype=bool), [1, 0]), "joints"),
+        (lambda: fabrik.solve([[0, 0], [0, 1]], [True, False]), "target"),
+        (lambda: fabrik.solve([[0, 0], [0, 1]], [1, 0], obstacles=ARRAY_OBSTACLES), "obstacles"),
+        (lambda: fabrik.solve([[0, 0], [0, 1]], [1, 0], obstacles=[([1, 1], 1e301)]), "obstacles"),
+        (lambda: fabrik.solve([[0, 0], [0, 1]], [1, 0], obstacles=NOT_OBSTACLES), "obstacles"),
+        (lambda: fabrik.reach_limits([]), "lengths"),
+        (lambda: fabrik.reach_limits([-1.0, 2.0]), "lengths"),
+        (lambda: fabrik.reach_limits([[1.0, 2.0]]), "lengths"),
+    ],
+)
+def test_odd_types_and_overflowing_input_name_the_argument(call: object, name: str) -> None:
+    with pytest.raises(ValueError, match=name):
+        call()  # type: ignore[operator]
+
+
+def test_obstacles_may_be_any_iterable_of_pairs() -> None:
+    """A generator of obstacles (a TypeError before) is read like the list it yields."""
+    obstacles = [(np.array([0.5, 0.5]), 0.2)]
+    joints, target = np.array([[0.0, 0.0], [0.0, 1.0], [0.0, 2.0]]), np.array([1.0, 1.0])
+    from_list = fabrik.solve(joints, target, obstacles=obstacles)
+    generator: Any = (o for o in obstacles)
+    from_generator = fabrik.solve(joints, target, obstacles=generator)
+    np.testing.assert_array_equal(from_generator.joints, from_list.joints)
+    assert fabrik.reach_limits([2.0, 0.5, 0.5]) == (1.0, 3.0)
+
+
+def witness_target(
+    rng: np.random.Generator, n: int, d: int, phi: float
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """A chain of n links straight up along +last axis and the end of an admissible pose of the same links
+    (every joint turned by less than 0.95 φ): a target the limits do not keep away."""
+    lengths = rng.uniform(0.2, 1.0, n)
+    axis = np.zeros(d)
+    axis[-1] = 1.0
+    points, q = [np.zeros(d)], axis
+    for length in lengths:
+        v = rng.normal(size=d)
+        side = v - (v @ q) * q
+        side /= np.linalg.norm(side)
+        angle = rng.uniform(0.0, 0.95 * phi)
+        q = math.cos(angle) * q + math.sin(angle) * side
+        points.append(points[-1] + length * q)
+    joints = np.zeros((n + 1, d))
+    joints[:, -1] = np.concatenate([[0.0], np.cumsum(lengths)])
+    return joints, points[-1]
+
+
+def test_targets_an_admissible_pose_reaches_are_seldom_limited() -> None:
+    """Stalls under limits: "limited" was claimed for targets that an admissible pose
+    reaches exactly (the solver had stalled). A stall under limits now restarts once from the straight pose toward
+    the target, clamped into the cones. Over 300 such targets (φ = 0.3 rad, 3–8 links, 2D and 3D, from the
+    straight start): 134 of 600 ended "limited" before (mean error 75 mm), 14 after (mean error 3.7 mm)."""
+    rng = np.random.default_rng(1)
+    statuses, errors = [], []
+    for _ in range(300):
+        joints, target = witness_target(rng, int(rng.integers(3, 9)), int(rng.choice([2, 3])), 0.3)
+        result = fabrik.solve(joints, target, cone_half_angle_rad=0.3)
+        statuses.append(result.status)
+        errors.append(result.error)
+    assert statuses.count("limited") <= 15  # 5 %
+    assert statuses.count("reached") >= 255  # 85 %
+    assert float(np.mean(errors)) < 0.01
+
+
+@pytest.mark.parametrize(
+    ("lengths", "target", "before"),
+    [
+        ([0.2652, 0.8842, 0.889, 0.9012], [0.9685, 2.7443], 0.708),
+        ([0.6049, 0.8281, 0.436], [-0.2333, 1.8494], 0.154),
+    ],
+)
+def test_stalled_limited_chains_restart(
+    lengths: list[float], target: list[float], before: float
+) -> None:
+    """F7's inputs (p9.py), φ = 0.3 rad, from straight up: "limited" at 0.708 m and 0.154 m, while an admissible
+    pose (every joint within 0.24 rad) ends on the target. After the restart the error is below 2 % of that."""
+    joints = np.zeros((len(lengths) + 1, 2))
+    joints[:, 1] = np.concatenate([[0.0], np.cumsum(lengths)])
+    result = fabrik.solve(joints, target, cone_half_angle_rad=0.3)
+    assert result.error < 0.03 * before
+    assert admissible(result.joints, 0.3, np.array([0.0, 1.0]), [])

@@ -1,0 +1,338 @@
+"""The arm scene through a real ViserServer: handles read back, a browser-like websocket client, bad input."""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import numpy as np
+import pytest
+import viser
+from helpers.scenes import MakeScene
+from helpers.wsclient import BrowserClient
+
+from kernels import fabrik
+from scenes.arm import (
+    MAX_LINKS,
+    TARGET_START,
+    ArmParams,
+    ArmScene,
+    rest_pose,
+    solve_arm,
+)
+
+
+@pytest.fixture
+def scene(show_scene: MakeScene) -> ArmScene:
+    return show_scene(ArmScene)
+
+
+def drawn_joints(scene: ArmScene) -> np.ndarray:
+    """World joint positions as the batched joint mesh shows them (visible instances only)."""
+    positions = np.asarray(scene.joint_nodes.batched_positions)
+    scales = np.asarray(scene.joint_nodes.batched_scales)
+    return positions[scales[:, 0] > 0]
+
+
+def clearance(joints: np.ndarray, centre: np.ndarray) -> float:
+    best = math.inf
+    for a, b in itertools.pairwise(joints):
+        seg = b - a
+        t = min(1.0, max(0.0, float((centre - a) @ seg / (seg @ seg))))
+        best = min(best, float(np.linalg.norm(a + t * seg - centre)))
+    return best
+
+
+# ------------------------------------------------------------------------------------------------ server side
+def test_opening_state_reaches_the_target_around_the_obstacle(scene: ArmScene) -> None:
+    p = ArmParams()
+    report = scene.report
+    assert report is not None
+    assert report.result.status == "reached"
+    assert np.linalg.norm(scene.pose[-1] - TARGET_START) < p.tolerance_mm / 1000.0
+    np.testing.assert_allclose(fabrik.link_lengths(scene.pose), p.link_length_m, rtol=1e-9)
+    assert np.all(scene.pose[:, 1] == 0.0)  # planar: the chain stays in the x–z plane
+    # The obstacle sits on the straight line to the target: the chain goes round it.
+    assert clearance(scene.pose, scene.obstacle_centres[0]) >= p.radii_m[0]
+    # What is drawn is what was solved: 7 joints shown, the other instances scaled to zero.
+    np.testing.assert_allclose(drawn_joints(scene), scene.pose, atol=1e-6)
+    link_scales = np.asarray(scene.link_nodes.batched_scales)
+    np.testing.assert_allclose(link_scales[: p.n_links, 2], p.link_length_m, rtol=1e-5)
+    assert np.all(link_scales[p.n_links :] == 0.0)
+    # The ghost is the exact two-bone answer: its end is on the target.
+    assert report.ghost_error_m < 1e-9
+    assert "status **reached**" in scene.readout.content
+    assert f"{report.result.iterations} iteration" in scene.readout.content
+    history = np.asarray(scene.plot.data[1])
+    assert len(history) == report.result.iterations + 1
+    assert history[-1] < 1.0  # mm, below the tolerance
+
+
+def test_two_links_ghost_is_the_fabrik_solution(scene: ArmScene) -> None:
+    scene.controls["n_obstacles"].value = 0
+    scene.controls["tolerance_mm"].value = 0.01
+    scene.controls["max_iterations"].value = 500
+    scene.controls["n_links"].value = 2
+    scene.target_gizmo.position = (0.3, 0.0, 0.2)  # inside the 0.5 m reach
+    scene._apply_target()
+    report = scene.report
+    assert report is not None and report.result.status == "reached"
+    assert report.ghost_gap_m < 1e-3  # the analytic elbow is FABRIK's elbow, to within a millimetre
+    assert "FABRIK's elbow" in scene.ghost_readout.content
+
+
+def test_more_links_and_joint_limits(scene: ArmScene) -> None:
+    scene.controls["n_links"].value = MAX_LINKS
+    scene.controls["half_angle_deg"].value = 30.0
+    scene.controls["limits"].value = True
+    assert len(drawn_joints(scene)) == MAX_LINKS + 1
+    angles = fabrik.joint_angles(scene.pose[:, [0, 2]], [0.0, 1.0])
+    assert np.all(angles <= math.radians(30.0) + 1e-6)
+    report = scene.report
+    assert report is not None and report.result.status == "reached"
+    # 3 m of chain curled onto a target 1.08 m away: several joints sit at their limit, drawn red; the free end grey.
+    colours = np.asarray(scene.joint_nodes.batched_colors)[: MAX_LINKS + 1]
+    at_limit = angles > math.radians(29.9)
+    assert at_limit.sum() >= 3
+    assert np.all(colours[:-1][at_limit][:, 0] >= 220) and np.all(
+        colours[:-1][at_limit][:, 1] <= 60
+    )
+    relaxed = angles < math.radians(5.0)
+    assert np.all(colours[:-1][relaxed][:, 1] >= 190)  # green
+    np.testing.assert_array_equal(colours[-1], (205, 210, 220))
+
+
+def test_obstacles_are_avoided_and_ignored_when_avoidance_is_off(scene: ArmScene) -> None:
+    scene.controls["avoid"].value = False
+    free_pose = scene.pose.copy()
+    # Put the obstacle on the middle joint of the unobstructed solution, then let the chain avoid it.
+    scene.obstacle_gizmos[0].position = tuple(free_pose[3])
+    scene._apply_obstacle(0)
+    # Avoidance off: the chain goes straight through the obstacle's centre.
+    assert clearance(scene.pose, free_pose[3]) == 0.0
+    scene.controls["avoid"].value = True
+    report = scene.report
+    assert report is not None and report.result.status == "reached"
+    assert clearance(scene.pose, free_pose[3]) >= scene.params.radii_m[0]
+    scene.controls["n_obstacles"].value = 4
+    for k in range(4):
+        assert clearance(scene.pose, scene.obstacle_centres[k]) >= scene.params.radii_m[k]
+        assert scene.obstacle_discs[k].visible and not scene.obstacle_spheres[k].visible
+
+
+def test_an_obstacle_over_the_root_is_ignored_and_said_so(scene: ArmScene) -> None:
+    scene.obstacle_gizmos[0].position = (0.05, 0.0, 0.05)
+    scene._apply_obstacle(0)
+    report = scene.report
+    assert report is not None and report.result.status == "reached"
+    assert "Obstacle 1 covers the root" in scene.readout.content
+
+
+def test_solvers_all_reach_the_target(scene: ArmScene) -> None:
+    for label in ("CCD", "Jacobian DLS", "FABRIK"):
+        scene.pose = rest_pose(6, 0.25)
+        scene.controls["solver"].value = label
+        report = scene.report
+        assert report is not None
+        assert report.result.status == "reached", label
+        assert f"**{label}**" in scene.readout.content
+
+
+def test_three_d_mode_frees_the_target(scene: ArmScene) -> None:
+    scene.controls["three_d"].value = True
+    assert scene.target_gizmo.active_axes == (True, True, True)
+    assert scene.obstacle_spheres[0].visible and not scene.obstacle_discs[0].visible
+    assert not scene.grid.visible
+    scene.target_gizmo.position = (0.4, 0.5, 0.9)
+    scene._apply_target()
+    assert np.linalg.norm(scene.pose[-1] - [0.4, 0.5, 0.9]) < 1e-3
+    # Back to the plane: everything is flattened onto y = 0 and solved there.
+    scene.controls["three_d"].value = False
+    assert scene.target[1] == 0.0 and np.all(scene.pose[:, 1] == 0.0)
+    assert scene.target_gizmo.active_axes == (True, False, True)
+
+
+def test_solve_arm_is_pure() -> None:
+    report = solve_arm(ArmParams(n_obstacles=0), rest_pose(6, 0.25), TARGET_START, np.zeros((4, 3)))
+    assert report.result.status == "reached"
+    assert report.result.joints.shape == (7, 3)
+
+
+# ------------------------------------------------------------------------------------------------ over the websocket
+def client_joints(client: BrowserClient) -> np.ndarray | None:
+    """Joint positions of the visible instances as the fake browser last received them."""
+    return client.visible_instances("/arm/joints")
+
+
+def test_dragging_the_target_gizmo_moves_the_chain_end_onto_it(
+    server: viser.ViserServer, scene: ArmScene
+) -> None:
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_node("/arm/target")
+        path = [(0.9 - 0.05 * i, 0.0, 0.6 + 0.04 * i) for i in range(1, 13)]
+        client.drag_transform("/arm/target", path, period_s=0.01)
+        goal = np.array(path[-1])
+        client.wait_for(
+            lambda: bool(np.linalg.norm(scene.pose[-1] - goal) < 1e-3),
+            what="the chain end on the target",
+        )
+        assert scene.report is not None and scene.report.result.status == "reached"
+
+        def browser_shows_end_on_target() -> bool:
+            joints = client_joints(client)
+            return joints is not None and float(np.linalg.norm(joints[-1] - goal)) < 2e-3
+
+        client.wait_for(browser_shows_end_on_target, what="the browser to receive the new pose")
+
+
+def test_an_off_plane_drag_is_put_back_in_the_plane(
+    server: viser.ViserServer, scene: ArmScene
+) -> None:
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_node("/arm/target")
+        client.drag_transform(
+            "/arm/target", [(0.7, 0.4, 0.9)]
+        )  # y = 0.4: a crafted client, out of the plane
+        client.wait_for(lambda: scene.gizmo_events >= 3, what="the drag handled")
+        with scene._lock:
+            np.testing.assert_array_equal(scene.target, (0.7, 0.0, 0.9))
+            # The gizmo is drawn where the chain solves, not where the message put it.
+            np.testing.assert_array_equal(np.asarray(scene.target_gizmo.position), (0.7, 0.0, 0.9))
+
+
+@pytest.mark.parametrize(
+    "bad",
+    [
+        (float("nan"), 0.0, 0.5),
+        (float("inf"), 0.0, 0.5),
+        (1e12, 0.0, 0.5),
+        (0.3, -1e300, 0.5),
+    ],
+)
+def test_crafted_gizmo_messages_keep_the_last_good_pose(
+    server: viser.ViserServer, scene: ArmScene, bad: tuple[float, float, float]
+) -> None:
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_node("/arm/target")
+        good = (0.7, 0.0, 0.9)
+        client.drag_transform("/arm/target", [good])
+        # A drag is three messages (start, move, end), each running the gizmo's callback once.
+        client.wait_for(lambda: scene.gizmo_events >= 3, what="the good drag handled")
+        assert np.linalg.norm(scene.pose[-1] - good) < 1e-3
+        pose_before = scene.pose.copy()
+        solves = scene.solves
+        client.drag_transform("/arm/target", [bad])
+        client.wait_for(lambda: scene.gizmo_events >= 6, what="the crafted drag handled")
+        with scene._lock:
+            np.testing.assert_array_equal(scene.pose, pose_before)
+            np.testing.assert_array_equal(scene.target, good)
+            assert scene.solves == solves
+            # What every browser is told is the last good target.
+            np.testing.assert_array_equal(np.asarray(scene.target_gizmo.position), good)
+
+
+def test_crafted_obstacle_message_and_slider_values_keep_a_good_state(
+    server: viser.ViserServer, scene: ArmScene
+) -> None:
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_node("/arm/obstacle_0")
+        centre = scene.obstacle_centres[0].copy()
+        client.drag_transform("/arm/obstacle_0", [(float("nan"), 0.0, 0.0)])
+        client.wait_for(lambda: scene.gizmo_events >= 3, what="the crafted obstacle drag handled")
+        client.wait_for_gui("Links")
+        for label, value in (
+            ("Links", float("nan")),  # viser itself drops a NaN for an int slider
+            ("Links", 1000),
+            ("Tolerance (mm)", -5.0),
+            ("Solver", "Newton"),
+            ("Cone half-angle (°)", float("inf")),
+            ("Joint limits", "yes"),
+        ):
+            client.set_value(label, value)
+        # Every callback re-reads every control, so once this last, honest edit shows, the crafted ones are cleaned.
+        client.set_value("Max iterations", 77)
+        client.wait_for(lambda: scene.params.max_iterations == 77, what="the sentinel edit applied")
+        with scene._lock:
+            p = scene.params
+            np.testing.assert_array_equal(scene.obstacle_centres[0], centre)
+            # 1000 is clamped to the slider's max; NaN kept the last value.
+            assert p.n_links == MAX_LINKS
+            assert p.tolerance_mm == pytest.approx(0.01)  # clamped to the slider's min
+            assert p.solver == "FABRIK"
+            assert p.half_angle_deg == 45.0
+            assert p.limits is False
+            assert np.all(np.isfinite(scene.pose)) and scene.pose.shape == (MAX_LINKS + 1, 3)
+            report = scene.report
+            assert report is not None and report.result.status == "reached"
+
+
+def test_clicking_in_the_plane_places_the_target(
+    server: viser.ViserServer, scene: ArmScene
+) -> None:
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_node("/arm/target")
+        # A ray from the camera side (−y) through (−0.5, 0, 1.0).
+        origin = (-0.5, -4.0, 1.0)
+        client.click_scene(origin, (0.0, 1.0, 0.0))
+        client.wait_for(
+            lambda: bool(np.allclose(scene.target, (-0.5, 0.0, 1.0))),
+            what="the target placed by the click",
+        )
+        client.wait_for(
+            lambda: bool(np.linalg.norm(scene.pose[-1] - (-0.5, 0.0, 1.0)) < 1e-3),
+            what="the chain to follow",
+        )
+        np.testing.assert_allclose(np.asarray(scene.target_gizmo.position), (-0.5, 0.0, 1.0))
+
+
+def test_a_target_the_limits_keep_away_reads_limited_not_unreachable(scene: ArmScene) -> None:
+    """A target inside the reach that 5° cones cannot bend to is "limited", with the best pose seen."""
+    scene.controls["n_obstacles"].value = 0
+    scene.controls["limits"].value = True
+    scene.controls["half_angle_deg"].value = 5.0
+    report = scene.report
+    assert report is not None
+    assert np.linalg.norm(TARGET_START) < 6 * 0.25  # inside the reach
+    assert report.result.status == "limited"
+    assert "status **limited**" in scene.readout.content
+    # The starting pose (the last frame's) breaks the new limits; of the iterates, the best comes back.
+    assert report.result.error <= report.result.error_history[1:].min()
+    angles = fabrik.joint_angles(scene.pose[:, [0, 2]], [0.0, 1.0])
+    assert np.all(angles <= math.radians(5.0) + 1e-6)
+
+
+def test_the_view_frames_what_matters_not_the_whole_reach(scene: ArmScene) -> None:
+    from scenes.arm import GIZMO_SCALE_M, framed_points
+
+    scene.controls["n_links"].value = 12
+    scene.controls["link_length_m"].value = 0.5  # a 6 m reach
+    with scene._lock:
+        points = framed_points(scene.params, scene.pose, scene.target, scene.obstacle_centres)
+        pose, target = scene.pose.copy(), scene.target.copy()
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    # Every joint, the target and its gizmo arrows are inside; the box is the chain's, not the 12 m wide reach.
+    assert np.all(pose >= lo) and np.all(pose <= hi)
+    assert np.all(target + GIZMO_SCALE_M * np.array([1.0, 0.0, 1.0]) <= hi + 1e-12)
+    reach = 12 * 0.5
+    width, height = hi[0] - lo[0], hi[2] - lo[2]
+    assert width < reach and height < reach, (
+        width,
+        height,
+    )  # the whole reach framed 2 × 6 m by 6 m
+
+
+def test_moving_the_target_out_of_the_framed_box_frames_again(scene: ArmScene) -> None:
+    from scenes._framing import Lens
+
+    calls: list[int] = []
+    scene.framing.reframe = lambda: calls.append(1)  # type: ignore[method-assign]
+    with scene._lock:
+        scene._view_for(Lens(0.9, 1600, 1000))
+        scene.target = scene.target + np.array([0.05, 0.0, 0.0])  # a small move stays in the frame
+        scene.solve_and_draw()
+        scene._reframe_if_outgrown()
+        assert calls == []
+        scene.target = np.array([-1.4, 0.0, 0.2])  # across to the other side
+        scene.solve_and_draw()
+        scene._reframe_if_outgrown()
+        assert calls == [1]

@@ -1,0 +1,161 @@
+"""The arm scene's skeleton presets: pure solves, and through a real server and a browser-like client."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import viser
+from helpers.scenes import MakeScene
+from helpers.wsclient import BrowserClient
+
+from kernels import fabrik
+from scenes import _skeletons
+from scenes.arm import ArmScene
+
+
+@pytest.fixture
+def scene(show_scene: MakeScene) -> ArmScene:
+    return show_scene(ArmScene)
+
+
+def link_lengths(skeleton: _skeletons.Skeleton, joints: np.ndarray) -> np.ndarray:
+    return np.array(
+        [np.linalg.norm(joints[j] - joints[up]) for j, up in enumerate(skeleton.parents) if up >= 0]
+    )
+
+
+# ------------------------------------------------------------------------------------------------ pure
+@pytest.mark.parametrize("label", ["Robot arm", "Hand", "Upper body"])
+def test_presets_open_in_a_pose_that_keeps_their_limits_and_lengths(
+    label: _skeletons.PresetLabel,
+) -> None:
+    skeleton = _skeletons.PRESETS[label]()
+    report = _skeletons.solve_skeleton(
+        skeleton, skeleton.joints, skeleton.targets, tolerance_m=1e-3, max_iterations=50
+    )
+    np.testing.assert_allclose(
+        link_lengths(skeleton, report.result.joints),
+        link_lengths(skeleton, skeleton.joints),
+        rtol=1e-9,
+    )
+    assert np.all((report.usage >= 0.0) & (report.usage <= 1.0))
+    # Every segment keeps its joint type: checked segment by segment with the kernel's own usage (≤ 1 + rounding)
+    # and, for hinges, by the segment staying perpendicular to the world axis (all presets' hinges are global).
+    for j, constraint in enumerate(skeleton.constraints):
+        if isinstance(constraint, fabrik.Hinge):
+            segment = report.result.joints[j] - report.result.joints[skeleton.parents[j]]
+            assert abs(float(segment @ np.asarray(constraint.axis))) < 1e-9
+    if label in ("Robot arm", "Hand"):  # targets the skeleton can reach without conflict
+        assert all(s == "reached" for s in report.result.status)
+    if label == "Robot arm":
+        assert np.all(
+            report.result.joints[:, 1] == 0.0
+        )  # the hinges about y keep it in the x–z plane
+
+
+def test_clean_target_refuses_what_is_not_three_finite_numbers_in_the_box() -> None:
+    for bad in ([np.nan, 0, 0], [0, 0], "abc", [0, 0, 1e9], [[0, 0, 0]], None):
+        assert _skeletons.clean_target(bad, planar=False) is None
+    np.testing.assert_array_equal(
+        _skeletons.clean_target([0.1, 0.5, 0.2], planar=True), [0.1, 0.0, 0.2]
+    )
+
+
+# ------------------------------------------------------------------------------------------------ websocket
+def client_joints(client: BrowserClient) -> np.ndarray | None:
+    """Joint positions of the visible instances as the fake browser last received them."""
+    return client.visible_instances("/arm/skeleton/joints")
+
+
+def test_choosing_the_hand_and_dragging_a_fingertip_target_curls_the_finger(
+    server: viser.ViserServer, scene: ArmScene
+) -> None:
+    view = scene.skeletons
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Preset")
+        client.set_value("Preset", "Hand")
+        client.wait_for(lambda: view.preset == "Hand" and view.solves >= 1, what="the hand shown")
+        assert (
+            not scene.link_nodes.visible and not scene.target_gizmo.visible
+        )  # the chain is hidden
+        index = 1
+        start = view.targets[index].copy()
+        goal = _skeletons.hand(target_curl_rad=1.0).targets[
+            index
+        ]  # the index finger curled further
+        points = [start + (goal - start) * t for t in np.linspace(0.1, 1.0, 8)]
+        path = [(float(x), float(y), float(z)) for x, y, z in points]
+        client.wait_for_node(f"/arm/skeleton/target_{index}")
+        client.drag_transform(f"/arm/skeleton/target_{index}", path, period_s=0.01)
+        effector = _skeletons.hand().effectors[index]
+        client.wait_for(
+            lambda: bool(np.linalg.norm(view.pose[effector] - goal) < 1e-3),
+            what="the index fingertip on its target",
+        )
+        report = view.report
+        assert report is not None and report.result.status[index] == "reached"
+        assert "| Index |" in view.readout.content and "reached" in view.readout.content
+
+        def browser_shows_fingertip() -> bool:
+            joints = client_joints(client)
+            return joints is not None and float(np.linalg.norm(joints[effector] - goal)) < 2e-3
+
+        client.wait_for(browser_shows_fingertip, what="the browser to receive the curled finger")
+        # Back to the chain: the skeleton hides and the chain shows again.
+        client.set_value("Preset", "Chain")
+        client.wait_for(
+            lambda: not view.active and scene.link_nodes.visible and not view.link_nodes.visible,
+            what="the chain back, the skeleton hidden",
+        )
+
+
+@pytest.mark.parametrize(
+    "bad", [(float("nan"), 0.0, 0.5), (1e12, 0.0, 0.5), (0.3, float("-inf"), 0.5)]
+)
+def test_crafted_skeleton_gizmo_and_preset_messages_keep_the_last_good_state(
+    server: viser.ViserServer, scene: ArmScene, bad: tuple[float, float, float]
+) -> None:
+    view = scene.skeletons
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Preset")
+        client.set_value("Preset", "Upper body")
+        client.wait_for(
+            lambda: view.preset == "Upper body" and view.solves >= 1, what="the body shown"
+        )
+        pose, targets, solves = view.pose.copy(), view.targets.copy(), view.solves
+        client.drag_transform("/arm/skeleton/target_0", [bad])
+        client.wait_for(lambda: view.gizmo_events >= 3, what="the crafted drag handled")
+        client.set_value("Preset", "Octopus")
+        client.set_value("Max iterations", 60)  # an honest sentinel edit after the crafted ones
+        client.wait_for(lambda: scene.params.max_iterations == 60, what="the sentinel edit")
+        with scene._lock:
+            assert view.preset == "Upper body"
+            np.testing.assert_array_equal(view.pose, pose)
+            np.testing.assert_array_equal(view.targets, targets)
+            assert view.solves == solves
+            np.testing.assert_array_equal(np.asarray(view.gizmos[0].position), targets[0])
+
+
+@pytest.mark.parametrize("label", [label for label in _skeletons.PRESET_LABELS if label != "Chain"])
+@pytest.mark.parametrize("size", [(1600, 1000), (1280, 720)])
+def test_the_camera_frames_the_shown_skeleton(
+    scene: ArmScene, label: _skeletons.PresetLabel, size: tuple[int, int]
+) -> None:
+    # The kind: a view framed for what is hidden. With a preset shown the camera framed the hidden chain, 0.9 m
+    # off, and the hand's gizmos lay off the window (a mouse drag of a fingertip grabbed nothing).
+    import math
+
+    from scenes._framing import MARGIN_PX, PANEL_PX, Lens, project_points
+
+    scene.skeletons.show(label)
+    lens = Lens(math.radians(75.0), *size)
+    view = scene._view_for(lens)
+    points = np.vstack([scene.skeletons.pose, scene.skeletons.targets])
+    xy = project_points(view, lens, points)
+    assert xy[:, 0].min() >= MARGIN_PX - 0.5 and xy[:, 1].min() >= MARGIN_PX - 0.5, label
+    assert xy[:, 0].max() <= size[0] - PANEL_PX - MARGIN_PX + 0.5, label
+    assert xy[:, 1].max() <= size[1] - MARGIN_PX + 0.5, label
+    # Back on the chain, the chain is framed again.
+    scene.skeletons.show("Chain")
+    xy = project_points(scene._view_for(lens), lens, scene.pose)
+    assert xy[:, 0].max() <= size[0] - PANEL_PX - MARGIN_PX + 0.5

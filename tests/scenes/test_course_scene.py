@@ -1,0 +1,426 @@
+"""The peloton scene's course mode through a real server: kernel agreement, uploads over the websocket (good and
+bad files), play / pause / scrub, air and model choices, the shared paceline, and crafted values."""
+
+from __future__ import annotations
+
+import math
+import threading
+import time
+
+import numpy as np
+import pytest
+import viser
+from helpers.gpx import BAD_FILES, gpx_text, hill_gpx
+from helpers.scenes import MakeScene
+from helpers.uploads import upload
+from helpers.wsclient import BrowserClient
+
+from kernels import course as course_kernel
+from kernels import cycling
+from scenes.peloton import (
+    SAMPLE_LABEL,
+    CourseMode,
+    CourseParams,
+    PelotonParams,
+    PelotonScene,
+    compute_course,
+    format_duration,
+    group_cda,
+)
+
+
+@pytest.fixture
+def scene(show_scene: MakeScene) -> PelotonScene:
+    return show_scene(PelotonScene)
+
+
+@pytest.fixture
+def mode(scene: PelotonScene) -> CourseMode:
+    scene.course_mode.enable.value = True
+    return scene.course_mode
+
+
+# ------------------------------------------------------------------------------------------------ server side
+def test_course_mode_opens_off_and_shows_the_sample_when_ticked(scene: PelotonScene) -> None:
+    mode = scene.course_mode
+    assert not mode.enabled and not mode.frame.visible and scene.course.visible
+    assert mode.route_label == SAMPLE_LABEL and mode.state is None
+    assert not mode.chart.visible  # no ride yet: no profile over flat zeros
+    mode.enable.value = True
+    assert mode.enabled and mode.frame.visible and not scene.course.visible
+    # Ridden: the chart shows, with the rider's real speed and power along the course.
+    assert mode.chart.visible
+    _, _, speed_kmh, power_w = (np.asarray(series) for series in mode.chart.data)
+    assert np.all(speed_kmh >= 0.0) and speed_kmh.max() > 5.0 and power_w.max() > 100.0
+    expected = compute_course(mode.route, CourseParams(), PelotonParams())
+    assert mode.state is not None
+    assert mode.state.ride.time_s == pytest.approx(expected.ride.time_s, rel=1e-12)
+    minutes, seconds = divmod(round(expected.ride.time_s), 60)
+    hours, minutes = divmod(minutes, 60)
+    assert f"Finish **{hours}:{minutes:02d}:{seconds:02d}**" in mode.readout.content
+    assert "published climb profile" in mode.route_info.content
+    # The chart: distance, elevation, speed, power, all finite, none NaN-only.
+    data = mode.chart.data
+    assert len(data) == 4 and all(np.all(np.isfinite(np.asarray(series))) for series in data)
+    assert float(np.max(data[0])) == pytest.approx(mode.route.total_distance_m / 1000.0)
+    np.testing.assert_allclose(np.asarray(data[3]).max(), 250.0, rtol=1e-6)
+    # Splits every km, last one at the finish.
+    assert mode.splits.content.count("\n") == 1 + 14
+    mode.enable.value = False
+    assert scene.course.visible and not mode.frame.visible
+
+
+def test_the_kernel_rides_with_the_paceline_sharing_the_work(mode: CourseMode) -> None:
+    scene = mode.scene
+    assert mode.state is not None
+    four = mode.state
+    line = scene.params
+    reduction = cycling.drag_reduction(line.n_riders, line.gap_m, line.model)
+    assert four.group_cda_m2 == pytest.approx(line.cda_m2 * (1 - reduction.mean()))
+    rider = course_kernel.Rider(
+        cda_m2=four.group_cda_m2, mass_kg=80.0, crr=0.004, drivetrain_efficiency=0.976
+    )
+    direct = course_kernel.ride(mode.route, 250.0, rider, max_speed_ms=72.0 / 3.6)
+    assert four.ride.time_s == pytest.approx(direct.time_s, rel=1e-12)
+    scene.controls["n_riders"].value = 1  # one rider alone: slower
+    assert mode.state.ride.time_s > four.ride.time_s
+    assert mode.state.group_cda_m2 == line.cda_m2
+    scene.controls["n_riders"].value = 6
+    assert mode.state.ride.time_s < four.ride.time_s
+    assert group_cda(scene.params) < four.group_cda_m2
+
+
+def test_model_and_air_choices_change_the_ride_and_the_readout_shows_both_densities(
+    mode: CourseMode,
+) -> None:
+    assert mode.state is not None
+    martin = mode.state.ride.time_s
+    mode.controls["model"].value = "Seed (aero, rolling, climbing)"
+    assert mode.params.model == "seed" and mode.state.ride.time_s < martin  # no bearings, no spokes
+    mode.controls["air"].value = "Weather (temperature, pressure or altitude, humidity)"
+    mode.controls["temperature_c"].value = 30.0
+    mode.controls["humidity_pct"].value = 80.0
+    start = float(mode.route.elevation_m[0])
+    expected = float(cycling.air_density_weather(30.0, cycling.isa_pressure_hpa(start), 0.8))
+    assert mode.state.density_weather == pytest.approx(expected, rel=1e-12)
+    assert f"weather **{expected:.3f}**" in mode.readout.content
+    assert f"seed (exponential) **{float(cycling.air_density(start)):.3f}**" in mode.readout.content
+    np.testing.assert_allclose(mode.state.ride.air_density[0], expected, rtol=1e-3)
+    # A barometer reading replaces the standard atmosphere's pressure.
+    mode.controls["pressure_from_barometer"].value = "Barometer at the start (hPa)"
+    mode.controls["pressure_hpa"].value = 1000.0
+    assert mode.state.density_weather == pytest.approx(
+        float(cycling.air_density_weather(30.0, 1000.0, 0.8)), rel=1e-12
+    )
+
+
+def test_find_the_power_for_a_time(mode: CourseMode) -> None:
+    mode.controls["target_min"].value = 50.0
+    mode.solve.value = True  # what a click does, on the server: runs on_click
+    assert mode.state is not None
+    assert mode.state.ride.time_s == pytest.approx(
+        50 * 60.0, abs=1.0
+    )  # the power is rounded to 0.1 W
+    assert mode.controls["power_w"].value == pytest.approx(mode.params.power_w)
+
+
+def test_pacing_reports_the_time_saved(mode: CourseMode) -> None:
+    mode.controls["pacing"].value = True
+    assert mode.state is not None and mode.state.pacing is not None
+    saved = mode.state.pacing.time_saved_s
+    assert f"{saved:.0f} s saved" in mode.readout.content
+    assert mode.state.ride.average_power_w == pytest.approx(
+        mode.state.constant.average_power_w, rel=1e-6
+    )
+
+
+def test_exaggeration_stretches_the_drawn_heights(mode: CourseMode) -> None:
+    before = np.asarray(mode.route_line.points)[:, :, 2].copy()
+    mode.controls["exaggeration"].value = 6.0
+    after = np.asarray(mode.route_line.points)[:, :, 2]
+    base = 0.05 + 0.02
+    np.testing.assert_allclose(after - base, 3.0 * (before - base), rtol=1e-4, atol=1e-5)
+
+
+def test_play_pause_and_scrub_move_the_riders(mode: CourseMode) -> None:
+    scene = mode.scene
+    mode.controls["playback"].value = 600.0
+    body = mode.course_riders["body"]
+    start = np.asarray(body.batched_positions)[0].copy()
+    mode._on_play()
+    time.sleep(0.6)
+    with scene._lock:
+        moved = mode.leader_distance_m()
+        assert moved > 100.0  # 600× real time for half a second at ~12 km/h
+        assert not np.allclose(np.asarray(body.batched_positions)[0], start)
+    mode._on_pause()
+    with scene._lock:
+        held = mode.leader_distance_m()
+    time.sleep(0.3)
+    assert mode.leader_distance_m() == held
+    mode.scrub.value = 10.0
+    assert mode.leader_distance_m() == pytest.approx(10_000.0, abs=1.0)
+    assert mode.state is not None
+    assert "Leader at **10.00 km**" in mode.now.content
+    # The riders follow the route: the leader is drawn where the route is at 10 km.
+    where, _ = mode._drawing.at_distance(mode.route, np.array([10_000.0]), mode.params.exaggeration)
+    np.testing.assert_allclose(np.asarray(body.batched_positions)[0], where[0], atol=1e-4)
+
+
+def test_every_bad_file_keeps_the_last_good_course(mode: CourseMode) -> None:
+    assert mode.load(hill_gpx("Good hill"), "good.gpx")
+    good = mode.route
+    for kind, (text, message) in BAD_FILES.items():
+        assert not mode.load(text.encode(), f"{kind}.gpx"), kind
+        assert mode.route is good, kind
+        assert message.split()[0] in mode.route_info.content, kind
+        assert "Still showing **Good hill**" in mode.route_info.content
+    big = b"<gpx>" + b" " * (course_kernel.MAX_FILE_BYTES + 1)
+    assert not mode.load(big, "big.gpx") and "20 MiB" in mode.route_info.content
+    many = (
+        '<gpx version="1.1"><trk><trkseg>'
+        + '<trkpt lat="45" lon="6"><ele>1</ele></trkpt>' * (course_kernel.MAX_POINTS + 1)
+        + "</trkseg></trk></gpx>"
+    ).encode()
+    assert not mode.load(many, "many.gpx") and "200000" in mode.route_info.content
+    assert mode.route is good
+    # A good file afterwards clears the message.
+    mode._on_sample()
+    assert mode.route_label == SAMPLE_LABEL and "not loaded" not in mode.route_info.content
+
+
+def test_file_text_is_escaped_in_the_readouts(mode: CourseMode) -> None:
+    name = "&lt;img src=x onerror=alert(1)&gt; [link](http://x) **b**"  # XML-escaped in the file
+    assert mode.load(hill_gpx(name), "x.gpx")
+    assert mode.route.name.startswith("<img")
+    info = mode.route_info.content
+    assert "<img" not in info and "](" not in info and "&lt;img" in info
+
+
+# ------------------------------------------------------------------------------------------------ over the websocket
+def test_upload_a_gpx_from_a_browser(server: viser.ViserServer, mode: CourseMode) -> None:
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Upload GPX")
+        upload(client, "Upload GPX", "hill.gpx", hill_gpx("Browser hill", 3000), part=20_000)
+        client.wait_for(lambda: mode.route.name == "Browser hill", what="the uploaded course")
+        assert mode.route.n_points == 3000
+        client.wait_for(
+            lambda: any(
+                "Browser hill" in str(e["props"].get("_markdown", "")) for e in client.gui.values()
+            ),
+            what="the client to be shown the new course",
+        )
+        assert mode.scrub.max == pytest.approx(mode.route.total_distance_m / 1000.0, abs=0.01)
+
+
+@pytest.mark.parametrize(
+    "kind", ["plain text", "one point", "no elevation", "nan latitude", "no track points"]
+)
+def test_a_bad_upload_from_a_browser_is_reported(
+    server: viser.ViserServer, mode: CourseMode, kind: str, caplog: pytest.LogCaptureFixture
+) -> None:
+    good = mode.route
+    text, message = BAD_FILES[kind]
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Upload GPX")
+        upload(client, "Upload GPX", f"{kind}.gpx", text.encode())
+        client.wait_for(
+            lambda: any(
+                "was not loaded" in str(e["props"].get("_markdown", ""))
+                for e in client.gui.values()
+            ),
+            what="the message",
+        )
+    assert mode.route is good
+    assert message.split()[0] in mode.route_info.content
+    assert not [r for r in caplog.records if r.levelname == "ERROR"]
+
+
+CRAFTED = [
+    ("Course power (W)", float("nan"), "power_w", 250.0),
+    ("Course power (W)", 1e9, "power_w", 2000.0),
+    ("Course power (W)", -5.0, "power_w", 20.0),
+    ("Humidity (%)", float("inf"), "humidity_pct", 50.0),
+    ("Temperature (°C)", 1e6, "temperature_c", 45.0),
+    ("Air", "vacuum", "air", "seed"),
+    ("Power model", "<b>x</b>", "model", "martin"),
+    ("Pressure from", "guess", "pressure_from_barometer", False),
+    ("Safe descending speed (km/h)", 0.0, "max_speed_kmh", 20.0),
+    ("Elevation exaggeration (×)", float("nan"), "exaggeration", 2.0),
+]
+
+
+@pytest.mark.parametrize(("label", "value", "field", "expected"), CRAFTED)
+def test_crafted_course_values_keep_a_good_state(
+    server: viser.ViserServer,
+    mode: CourseMode,
+    label: str,
+    value: object,
+    field: str,
+    expected: object,
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui(label)
+        stamp = len(client.received)
+        client.set_value(label, value)
+        client.wait_for(lambda: len(client.received) > stamp, what="the server to answer")
+        time.sleep(0.15)
+        with mode.scene._lock:
+            assert getattr(mode.params, field) == expected
+            assert mode.state is not None and math.isfinite(mode.state.ride.time_s)
+    assert not [r for r in caplog.records if r.levelname == "ERROR"], "a callback failed"
+
+
+@pytest.mark.parametrize("value", [float("nan"), 1e9, -3.0, "far"])
+def test_crafted_scrub_positions_are_clamped(
+    server: viser.ViserServer, mode: CourseMode, value: object
+) -> None:
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Position (km)")
+        client.set_value("Position (km)", 4.0)
+        client.wait_for(lambda: abs(mode.leader_distance_m() - 4000.0) < 1.0, what="scrub to 4 km")
+        client.set_value("Position (km)", value)
+        time.sleep(0.2)
+        with mode.scene._lock:
+            d = mode.leader_distance_m()
+            assert 0.0 <= d <= mode.route.total_distance_m
+            if value == 1e9:
+                assert d == pytest.approx(mode.route.total_distance_m, abs=10.0)
+            elif value == -3.0:
+                assert d == 0.0
+            else:
+                assert d == pytest.approx(4000.0, abs=1.0)
+
+
+def test_play_from_a_browser(server: viser.ViserServer, mode: CourseMode) -> None:
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Play")
+        client.wait_for_gui("Playback speed (×)")
+        client.set_value("Playback speed (×)", 600.0)
+        client.click("Play")
+        client.wait_for(lambda: mode.leader_distance_m() > 200.0, what="the riders to ride")
+        client.click("Pause")
+        client.wait_for(lambda: not mode.playing, what="pause")
+        # The browser's scrub slider follows the leader.
+        client.wait_for(
+            lambda: (
+                isinstance(client.value_of("Position (km)"), float)
+                and client.value_of("Position (km)") > 0.1
+            ),
+            what="the slider to follow",
+        )
+
+
+# ------------------------------------------------------------------------------------------------ uploads out of order
+# Kind: work that finishes out of order. Two uploads close together parse in parallel on viser's pool; the last
+# file picked must win even when its parse finishes first.
+def test_the_newest_upload_wins_when_an_older_parse_finishes_last(
+    server: viser.ViserServer, mode: CourseMode, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    real = course_kernel.load_gpx
+    older_done = threading.Event()
+
+    def slow_for_the_first(source: bytes, **kwargs: object) -> course_kernel.Course:
+        if b"Older hill" in source:
+            time.sleep(1.0)
+            try:
+                return real(source)
+            finally:
+                older_done.set()
+        return real(source)
+
+    monkeypatch.setattr(course_kernel, "load_gpx", slow_for_the_first)
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Upload GPX")
+        upload(client, "Upload GPX", "older.gpx", hill_gpx("Older hill"))
+        time.sleep(0.2)  # the older parse is under way
+        upload(client, "Upload GPX", "newer.gpx", hill_gpx("Newer hill"))
+        client.wait_for(lambda: mode.route.name == "Newer hill", what="the newer course")
+        assert older_done.wait(5.0)
+        time.sleep(0.3)  # the older parse's install, had it been allowed, has run by now
+    assert mode.route.name == "Newer hill" and mode.route_label == "newer.gpx"
+
+
+# Kind: state left over from the last course. The Position slider goes back to 0 with a new course.
+def test_a_new_course_puts_the_position_slider_back_to_the_start(mode: CourseMode) -> None:
+    mode.scrub.value = 1.04
+    assert mode.leader_distance_m() == pytest.approx(1040.0, abs=1.0)
+    assert mode.load(hill_gpx("Next hill"), "next.gpx")
+    assert mode.scrub.value == 0.0
+    assert mode.leader_distance_m() == 0.0
+    assert "Leader at **0.00 km**" in mode.now.content
+
+
+# Kind: a found value silently clipped to an input's range. Each target is solved within the input's range or
+# the message says plainly, in minutes, that it is out of it (12 min needed > 2000 W; 6000 min < 20 W).
+@pytest.mark.parametrize("target_min", [1.0, 12.0, 30.0, 50.0, 90.0, 600.0, 6000.0])
+def test_find_the_power_says_when_the_target_is_out_of_the_inputs_range(
+    mode: CourseMode, target_min: float
+) -> None:
+    mode.controls["target_min"].value = target_min
+    mode.solve.value = True
+    assert mode.state is not None
+    ride = mode.state.ride
+    content = mode.route_info.content
+    assert "out of reach" not in content and "time_s" not in content
+    if mode.controls["power_w"].value == 2000.0 and ride.time_s > target_min * 60.0 + 1.0:
+        assert f"A {target_min:g} min finish needs more than 2000 W" in content
+        assert format_duration(ride.time_s) in content
+    elif mode.controls["power_w"].value == 20.0 and ride.time_s < target_min * 60.0 - 1.0:
+        assert f"A {target_min:g} min finish needs less than 20 W" in content
+    else:
+        assert ride.time_s == pytest.approx(target_min * 60.0, rel=5e-4, abs=1.0)  # power to 0.1 W
+        assert "finish needs" not in content
+    assert (target_min <= 12.0) == ("more than 2000 W" in content)
+    assert (target_min >= 6000.0) == ("less than 20 W" in content)
+
+
+# Kind: code names and unexplained numbers in the readout.
+def test_the_readout_names_the_model_by_its_label_and_explains_coasting(mode: CourseMode) -> None:
+    assert "(Martin et al. 1998 (full))" in mode.readout.content
+    assert "martin model" not in mode.readout.content
+    mode.controls["model"].value = "Seed (aero, rolling, climbing)"
+    assert "(Seed (aero, rolling, climbing))" in mode.readout.content
+    # 2 km at −20 %: 250 W would go far past the 72 km/h cap, so the riders coast and brake.
+    down = [(45.0 + i * 1e-4, 6.0, 1000.0 - 0.2 * 11.1195 * i) for i in range(180)]
+    assert mode.load(gpx_text(down).encode(), "down.gpx")
+    assert mode.state is not None
+    average = mode.state.ride.average_power_w
+    assert average < 100.0
+    assert (
+        f"Average {average:.0f} W of the 250 W set: the riders coast where the descent would take them "
+        "over the 72 km/h safe speed"
+    ) in mode.readout.content
+    mode.scrub.value = 1.5
+    assert "(coasting at the 72 km/h descent cap)" in mode.now.content
+
+
+# Kind: bad files, through the scene: refused in a rider's words, the last good course kept.
+REVIEW_FILES = {
+    "vertical": (
+        '<?xml version="1.0"?><gpx version="1.1" creator="r"><trk><trkseg><trkpt lat="45" lon="6"><ele>100</ele>'
+        '</trkpt><trkpt lat="45.0000001" lon="6"><ele>600</ele></trkpt><trkpt lat="45.0000002" lon="6">'
+        "<ele>1100</ele></trkpt></trkseg></trk></gpx>",
+        "was not loaded: the elevation changes 4 496 602 % of the distance near 0.00 km; no road is steeper",
+    ),
+    "nan elevation": (
+        gpx_text([(45.0, 6.0, 1.0), (45.001, 6.0, float("nan"))]),
+        "was not loaded: track point 2 has elevation nan, not a number",
+    ),
+    "not gpx": (
+        "<html><body>hi</body></html>",
+        "was not loaded: the file is not GPX: no &lt;gpx&gt;",
+    ),
+}
+
+
+@pytest.mark.parametrize("kind", list(REVIEW_FILES))
+def test_bad_files_are_refused_in_a_riders_words(mode: CourseMode, kind: str) -> None:
+    good = mode.route
+    text, message = REVIEW_FILES[kind]
+    assert not mode.load(text.encode(), f"{kind}.gpx")
+    assert mode.route is good
+    assert message in mode.route_info.content
+    for word in ("elevation_m", "latitude_deg", "non-finite", "time_s", "GPX is not"):
+        assert word not in mode.route_info.content

@@ -1,0 +1,366 @@
+"""The editor's GLSL path without a browser: source checks, compiler errors with lines, the GL-sampled grid against
+numpy, ``mesh_glsl`` against analytic shapes, and the ray-march of a typed field."""
+
+from __future__ import annotations
+
+import math
+import re
+
+import numpy as np
+import pytest
+from helpers.ci import need_gl
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from kernels import sdf
+from shaders import gl_service
+from shaders import renderer as gl_renderer
+from shaders.renderer import (
+    MAX_SOURCE_CHARS,
+    Camera,
+    ShaderCompileError,
+    check_source,
+    mesh_glsl,
+)
+
+BOUNDS = np.array([[-1.0, -1.0, -1.0], [1.0, 1.0, 1.0]])
+SPHERE = "float sdf(vec3 p) {\n    return sd_sphere(p - vec3(0.1, -0.2, 0.05), 0.55);\n}\n"
+
+
+@pytest.fixture(autouse=True)
+def gl_when_marked(request: pytest.FixtureRequest) -> None:
+    if request.node.get_closest_marker("gl") is None:
+        return
+    need_gl()
+
+
+# ------------------------------------------------------------------------------------------ source checks
+@pytest.mark.parametrize(
+    ("source", "line", "words"),
+    [
+        ("float sdf(vec3 p) {\n  for (int i = 0; i < 9; i++) {}\n  return 1.0;\n}", 2, "loops"),
+        ("float sdf(vec3 p) {\n  while (true) {}\n  return 1.0;\n}", 2, "loops"),
+        ("#define X 1\nfloat sdf(vec3 p) { return 1.0; }", 1, "preprocessor"),
+        ("float sdf(vec3 p) {\n\n  return gl_FragCoord.x;\n}", 3, "gl_FragCoord"),
+        ("uniform float u;\nfloat sdf(vec3 p) { return u; }", 1, "uniform"),
+        ("float sdf(vec3 p) {\n  return 1.0; // é\n}", 2, "ASCII"),
+        ("void main() {}\nfloat sdf(vec3 p) { return 1.0; }", 1, "main"),
+        ("float sdf(vec3 p) { /* x */ return 1.0; }", None, "block comments"),
+        ("float distance_to_it(vec3 p) { return 1.0; }", None, "define float sdf"),
+        ("float sdf(vec3 p) { return 1.0; }" + " " * MAX_SOURCE_CHARS, None, "limit"),
+    ],
+)
+def test_refused_sources_say_why_and_where(source: str, line: int | None, words: str) -> None:
+    with pytest.raises(ShaderCompileError, match=words) as info:
+        check_source(source)
+    assert info.value.line == line
+
+
+def test_a_loop_word_in_a_comment_or_name_is_fine() -> None:
+    check_source("float sdf(vec3 p) {\n    float format = 1.0; // for each\n    return format;\n}")
+
+
+@given(st.text(max_size=300))
+def test_any_text_is_either_accepted_or_refused_cleanly(text: str) -> None:
+    try:
+        check_source("float sdf(vec3 p) { return 1.0; }\n" + text)
+    except ShaderCompileError as exc:
+        assert str(exc)
+
+
+# Loops in disguise: a backslash-newline splices lines for the compiler, and Mesa ends a //
+# comment at a lone carriage return, so a check line by line saw other words than the compiler.
+@pytest.mark.parametrize(
+    ("source", "words"),
+    [
+        (
+            "float sdf(vec3 p){ float s=0.0; fo\\\nr(int i=0;i<3;i++){s+=0.1;} return s; }\n",
+            "backslash",
+        ),
+        ("float sdf(vec3 p){ disc\\\nard; return 1.0; }\n", "backslash"),
+        ("unif\\\norm float u;\nfloat sdf(vec3 p){ return u; }\n", "backslash"),
+        (
+            "float sdf(vec3 p){ return 1.0; } // hi\rfloat g(){ for(int i=0;i<3;i++){} return 0.0; }\n",
+            "carriage",
+        ),
+        ("float sdf(vec3 p){ return length(p)-F; }\r#define F 1.0\r", "carriage"),
+        ("float sdf(vec3 p){ return length(p)-1.0; } // x \\\n\n", "backslash"),
+        ("float sdf(vec3 p){ return 1.0; } # define X\n", "preprocessor"),
+    ],
+)
+def test_line_splices_and_carriage_returns_are_refused(source: str, words: str) -> None:
+    with pytest.raises(ShaderCompileError, match=words):
+        check_source(source)
+
+
+_CONSTRUCTS = [
+    "for(int i=0;i<3;i++){}",
+    "while(true){}",
+    "do{}while(true);",
+    "discard;",
+    "uniform float u;",
+    "#define X 1",
+    "void main(){}",
+]
+
+
+def _compiler_view(source: str) -> str:
+    """What a GLSL compiler reads: continuations spliced, a carriage return as a line end, // comments gone."""
+    spliced = re.sub(r"\\\r?\n", "", source).replace("\r", "\n")
+    return "\n".join(line.split("//", 1)[0] for line in spliced.split("\n"))
+
+
+@given(
+    st.sampled_from(_CONSTRUCTS),
+    st.lists(st.integers(0, 40), max_size=3),
+    st.sampled_from(["\\\n", "\\\r\n", "\r", "// c\r", "// c\\\n"]),
+)
+def test_no_disguise_of_a_forbidden_construct_gets_through(
+    construct: str, cuts: list[int], disguise: str
+) -> None:
+    # The construct cut anywhere by a continuation, or hidden after a comment a carriage return ends: the
+    # compiler would see it, so the check must refuse the text.
+    text = construct
+    for cut in sorted({c % (len(construct) + 1) for c in cuts}, reverse=True):
+        text = text[:cut] + disguise + text[cut:]
+    if not cuts:
+        text = disguise + text
+    source = "float sdf(vec3 p) { return 1.0; }\n" + text + "\n"
+    with pytest.raises(ShaderCompileError):
+        check_source(source)
+
+
+@given(st.text(alphabet=st.sampled_from(list("for wdiscaueUnm#/\\\r\n\t(){};x")), max_size=80))
+def test_accepted_text_shows_the_compiler_no_forbidden_word(text: str) -> None:
+    source = "float sdf(vec3 p) { return 1.0; }\n" + text
+    try:
+        check_source(source)
+    except ShaderCompileError:
+        return
+    seen = _compiler_view(source)
+    assert "#" not in seen
+    words = set(re.findall(r"[A-Za-z_]\w*", seen))
+    assert not words & {"for", "while", "do", "discard", "uniform", "main"}
+
+
+def _chain(links: int, calls: int = 2) -> str:
+    lines = ["float f0(vec3 p){ return length(p)-1.0; }"]
+    for i in range(1, links + 1):
+        args = ", ".join(f"f{i - 1}(p*{1 + j / 100:.2f})" for j in range(calls))
+        lines.append(
+            f"float f{i}(vec3 p){{ return min(0.0, min({args}, 1.0)); }}"
+            if calls > 1
+            else f"float f{i}(vec3 p){{ return f{i - 1}(p*1.01); }}"
+        )
+    lines.append(f"float sdf(vec3 p){{ return f{links}(p); }}")
+    return "\n".join(lines) + "\n"
+
+
+def test_a_ten_link_call_chain_is_refused_for_its_inlined_size() -> None:
+    source = (
+        "float f0(vec3 p){ return length(p)-1.0; }\n"
+        + "".join(
+            f"float f{i}(vec3 p){{ return min(f{i - 1}(p*1.01), f{i - 1}(p.yzx+0.01)); }}\n"
+            for i in range(1, 11)
+        )
+        + "float sdf(vec3 p){ return f10(p); }\n"
+    )
+    assert len(source) == 679
+    with pytest.raises(ShaderCompileError, match=r"36846 tokens.*limit is 20000"):
+        check_source(source)
+
+
+@given(st.integers(1, 12), st.integers(1, 3))
+def test_inlined_size_multiplies_by_the_calls_at_each_link(links: int, calls: int) -> None:
+    sizes = gl_renderer.inlined_sizes(_chain(links, calls))
+    for i in range(1, links + 1):
+        own = sizes[f"f{i}"] - calls * sizes[f"f{i - 1}"]
+        assert own == sizes["f1"] - calls * sizes["f0"]  # every link's own tokens are the same
+    expected_ok = sizes["sdf"] <= gl_renderer.MAX_INLINED_TOKENS
+    try:
+        check_source(_chain(links, calls))
+        assert expected_ok
+    except ShaderCompileError as exc:
+        assert not expected_ok and "inlined" in str(exc)
+
+
+def test_compiler_logs_of_both_vendors_give_the_line() -> None:
+    mesa = "GLSL Compiler failed\n\nfragment_shader\n===\n0:3(16): error: syntax error, unexpected ';'\n"
+    nvidia = "0(2) : error C0000: syntax error, unexpected '}' at token \"}\"\n"
+    assert ShaderCompileError.from_compiler(mesa, "a\nb\nc").line == 3
+    assert ShaderCompileError.from_compiler(nvidia, "a\nb\nc").line == 2
+    # An error outside the person's text (in the app's own code) has no line of theirs.
+    assert ShaderCompileError.from_compiler(mesa.replace("0:3", "0:90"), "a\nb").line is None
+
+
+@pytest.mark.gl
+def test_compile_error_is_a_value_error_with_the_compilers_message_and_line() -> None:
+    bad = "float sdf(vec3 p) {\n    float r = 0.5;\n    return sd_sphere(p, r) +;\n}\n"
+    with pytest.raises(ValueError, match=r"^line 3: .*syntax error") as info:
+        mesh_glsl(bad, 32, BOUNDS)
+    assert isinstance(info.value, ShaderCompileError) and info.value.line == 3
+    with pytest.raises(ValueError, match="line 2"):
+        mesh_glsl("float sdf(vec3 p) {\n    return sd_sphere(p, 1.0, 2.0);\n}", 32, BOUNDS)
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize(
+    ("resolution", "bounds", "words"),
+    [
+        (8, BOUNDS, "resolution"),
+        (64, [[0, 0, 0], [0, 1, 1]], "bounds"),
+        (64, [[0, 0, 0], [np.nan, 1, 1]], "bounds"),
+    ],
+)
+def test_bad_resolution_or_bounds_raise(resolution: int, bounds: object, words: str) -> None:
+    with pytest.raises(ValueError, match=words):
+        mesh_glsl(SPHERE, resolution, bounds)  # type: ignore[arg-type]
+
+
+@pytest.mark.gl
+def test_nan_field_is_refused() -> None:
+    with pytest.raises(ValueError, match="NaN"):
+        mesh_glsl("float sdf(vec3 p) {\n    return sqrt(-1.0 - p.x * p.x);\n}", 32, BOUNDS)
+
+
+# ------------------------------------------------------------------------------------------ sampling and mesh
+@pytest.mark.gl
+def test_gl_sampled_grid_equals_numpy_at_every_sample() -> None:
+    source = (
+        "float sdf(vec3 p) {\n    return smooth_union(sd_cylinder(p, 0.5, 0.3), "
+        "sd_octahedron(p - vec3(0.3, 0.2, 0.1), 0.4), 0.2, BLEND_POLY);\n}\n"
+    )
+    grid = sdf.make_grid(sdf.default_scene(), 48, BOUNDS)
+    field = gl_service.run(lambda gl: gl.sample_field(source, grid))
+    axes = [grid.origin[i] + grid.spacing * np.arange(grid.shape[i]) for i in range(3)]
+    points = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+    expected = sdf.smooth_union(
+        sdf.sd_cylinder(points, 0.5, 0.3),
+        sdf.sd_octahedron(points - [0.3, 0.2, 0.1], 0.4),
+        0.2,
+    ).reshape(grid.shape)
+    assert field.shape == grid.shape
+    np.testing.assert_allclose(field, expected, atol=1e-5, rtol=0)
+
+
+@pytest.mark.gl
+def test_gl_sampled_grid_in_several_draws_is_the_same() -> None:
+    grid = sdf.make_grid(sdf.default_scene(), 200, BOUNDS)  # 200·200 rows > 8192: several draws
+    field = gl_service.run(lambda gl: gl.sample_field(SPHERE, grid))
+    k = np.arange(grid.shape[2])
+    z = grid.origin[2] + grid.spacing * k
+    column = field[grid.shape[0] // 2, grid.shape[1] // 2]
+    x = grid.origin[0] + grid.spacing * (grid.shape[0] // 2)
+    y = grid.origin[1] + grid.spacing * (grid.shape[1] // 2)
+    expected = np.sqrt((x - 0.1) ** 2 + (y + 0.2) ** 2 + (z - 0.05) ** 2) - 0.55
+    np.testing.assert_allclose(column, expected, atol=1e-5)
+
+
+@pytest.mark.gl
+def test_mesh_glsl_of_a_sphere_is_the_sphere_with_its_colour() -> None:
+    source = SPHERE + "vec3 color(vec3 p) {\n    return vec3(0.2, 0.4, 0.8);\n}\n"
+    tri = mesh_glsl(source, 64, BOUNDS)
+    radii = np.linalg.norm(tri.vertices - [0.1, -0.2, 0.05], axis=1)
+    spacing = 2.0 / 63
+    assert np.abs(radii - 0.55).max() < 0.1 * spacing
+    assert tri.is_watertight
+    assert tri.volume == pytest.approx(4 / 3 * math.pi * 0.55**3, rel=0.01)
+    visual = tri.visual
+    assert visual is not None
+    colors = np.asarray(visual.vertex_colors)[:, :3]  # pyright: ignore[reportAttributeAccessIssue]
+    assert np.all(colors == np.round(np.array([0.2, 0.4, 0.8]) * 255))
+
+
+@pytest.mark.gl
+def test_mesh_glsl_equals_the_numpy_mesher_on_the_same_field() -> None:
+    """One algorithm: the GL-sampled field goes through the kernel's marching-cubes pass."""
+    source = "float sdf(vec3 p) {\n    return sd_round_box(p, vec3(0.6, 0.4, 0.3), 0.1);\n}\n"
+    tri = mesh_glsl(source, 48, BOUNDS)
+    grid = sdf.make_grid(sdf.default_scene(), 48, BOUNDS)
+    axes = [grid.origin[i] + grid.spacing * np.arange(grid.shape[i]) for i in range(3)]
+    points = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+    field = sdf.sd_round_box(points, (0.6, 0.4, 0.3), 0.1).astype(np.float32).reshape(grid.shape)
+    vertices, faces = sdf.mesh_samples(grid, field)
+    assert len(tri.faces) == len(faces)
+    np.testing.assert_allclose(np.sort(tri.vertices, axis=0), np.sort(vertices, axis=0), atol=1e-5)
+
+
+@pytest.mark.gl
+def test_empty_field_gives_an_empty_mesh() -> None:
+    tri = mesh_glsl("float sdf(vec3 p) {\n    return 1.0;\n}\n", 32, BOUNDS)
+    assert len(tri.faces) == 0
+
+
+# Thin shells: the mesher's cell mask once kept only cells with a corner within a cell diagonal of zero, which assumes
+# |∇d| ≤ 1; a typed field need not be a distance, and K·(length(p) − 1) lost most of its faces for K = 3, 10, 100.
+WIDE = np.array([[-1.5, -1.5, -1.5], [1.5, 1.5, 1.5]])
+
+
+def scaled_sphere(k: float) -> str:
+    return f"float sdf(vec3 p) {{ return {k:.9g} * (length(p) - 1.0); }}"
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("k", [3.0, 10.0, 100.0, 1e30])
+def test_a_steep_field_meshes_watertight_with_the_spheres_area(k: float) -> None:
+    tri = mesh_glsl(scaled_sphere(k), 64, WIDE)
+    assert tri.is_watertight
+    assert tri.area == pytest.approx(4 * math.pi, rel=0.005)  # 12.57 m², not 8.05, 2.5 or 0.39
+
+
+@pytest.mark.gl
+def test_the_elongation_example_is_watertight() -> None:
+    source = next(
+        s for title, s in gl_renderer.examples().items() if title.startswith("Elongation")
+    )
+    tri = mesh_glsl(source, 64, WIDE)
+    assert tri.is_watertight and len(tri.faces) == 6500
+
+
+@pytest.mark.gl
+@settings(max_examples=25)
+@given(
+    st.floats(-6.0, 30.0),
+    st.sampled_from(
+        [
+            "length(p) - 1.0",
+            "sd_box(p - vec3(0.013, 0.021, 0.017), vec3(0.7, 0.5, 0.9))",
+            "sd_torus(p - vec3(0.011, 0.0, 0.023), 0.8, 0.3)",
+        ]
+    ),
+)
+def test_a_positive_scale_of_the_field_changes_nothing(exponent: float, body: str) -> None:
+    # Marching cubes interpolates linearly between corners, so K·sdf has sdf's mesh for every K > 0 (the shapes
+    # are moved off the grid's planes: a sample exactly on the level is a tie float rounding may break either way).
+    k = 10.0**exponent
+    reference = mesh_glsl(f"float sdf(vec3 p) {{ return {body}; }}", 40, WIDE)
+    scaled = mesh_glsl(f"float sdf(vec3 p) {{ return {k:.9g} * ({body}); }}", 40, WIDE)
+    assert scaled.is_watertight and reference.is_watertight
+    assert len(scaled.faces) == len(reference.faces)
+    assert scaled.area == pytest.approx(reference.area, rel=1e-4)
+
+
+# ------------------------------------------------------------------------------------------ ray-march
+@pytest.mark.gl
+def test_field_raymarch_depth_matches_the_analytic_sphere() -> None:
+    camera = Camera((2.0, -1.5, 1.0), (0.1, -0.2, 0.05), fov_y_rad=math.radians(40))
+    _, depth = gl_service.run(lambda gl: gl.render_field(SPHERE, BOUNDS, camera, 96, 64))
+    origins, dirs = gl_renderer.camera_rays(camera, 96, 64)
+    oc = origins - [0.1, -0.2, 0.05]
+    b = np.sum(oc * dirs, axis=1)
+    disc = b * b - (np.sum(oc * oc, axis=1) - 0.55**2)
+    t = np.where(disc >= 0, -b - np.sqrt(np.maximum(disc, 0)), np.inf)
+    forward, _, _ = camera.basis()
+    expected = (t * (dirs @ forward)).reshape(64, 96)
+    hit = np.isfinite(expected) & (disc.reshape(64, 96) > 0.01)  # away from grazing rays
+    assert hit.sum() > 500
+    np.testing.assert_allclose(depth[hit], expected[hit], atol=2e-3)
+    clear_miss = disc.reshape(64, 96) < -0.01
+    assert clear_miss.sum() > 500 and np.all(np.isinf(depth[clear_miss]))
+
+
+def test_examples_are_at_least_six_and_pass_the_checks() -> None:
+    examples = gl_renderer.examples()
+    assert len(examples) >= 6
+    for title, source in examples.items():
+        assert title and check_source(source) == source

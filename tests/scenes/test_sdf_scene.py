@@ -1,0 +1,882 @@
+"""The SDF gallery through a real ViserServer: the mesh it shows, gizmo drags over the websocket, bad input, the
+reference image and its readouts, downloads, and a clean teardown."""
+
+from __future__ import annotations
+
+import io
+import math
+import time
+
+import numpy as np
+import pytest
+import trimesh
+import viser
+from helpers.ci import need_gl
+from helpers.scenes import MakeScene
+from helpers.viser_private import gui_uuid, gui_uuids, node_names
+from helpers.waiting import wait_until
+from helpers.wsclient import BrowserClient
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from trimesh.visual.color import ColorVisuals
+
+from kernels import sdf
+from scenes.sdf_gallery import RESOLUTION_LABEL, SdfGalleryParams, SdfGalleryScene
+from shaders import gl_service
+from shaders.renderer import Camera, GLUnavailableError
+
+MESH = "/sdf/mesh"
+
+
+@pytest.fixture
+def scene(show_scene: MakeScene) -> SdfGalleryScene:
+    return show_scene(SdfGalleryScene)
+
+
+def shown_mesh(scene: SdfGalleryScene) -> trimesh.Trimesh:
+    """The mesh the browser receives: the GLB bytes of the mesh node, loaded back."""
+    loaded = trimesh.load(
+        io.BytesIO(scene.mesh_node.glb_data), file_type="glb", force="mesh", process=False
+    )
+    assert isinstance(loaded, trimesh.Trimesh)
+    return loaded
+
+
+# ------------------------------------------------------------------------------------------ server side
+def test_opening_mesh_is_the_kernels(scene: SdfGalleryScene) -> None:
+    params = SdfGalleryParams()
+    vertices, faces, colors = sdf.mesh(params.scene(), params.resolution)
+    np.testing.assert_array_equal(scene.mesh_vertices, vertices)
+    np.testing.assert_array_equal(scene.mesh_faces, faces)
+    np.testing.assert_array_equal(scene.mesh_colors, colors)
+    glb = shown_mesh(scene)
+    assert len(glb.faces) == len(faces)
+    # The viewer's GLB is in the world frame, so its box matches the mesh's (GLB stores float32).
+    np.testing.assert_allclose(glb.bounds, [vertices.min(axis=0), vertices.max(axis=0)], atol=1e-5)
+    # Smooth normals point outward (the field's gradient); colours are the kernel's, made linear for three.js.
+    reference_normals = trimesh.Trimesh(vertices, faces, process=False).vertex_normals
+    assert np.median(np.einsum("ij,ij->i", glb.vertex_normals, reference_normals)) > 0.99
+    visual = glb.visual
+    assert isinstance(visual, ColorVisuals)
+    np.testing.assert_allclose(visual.vertex_colors[:, :3], 255 * colors**2.2, atol=0.51)
+    assert scene.agreement.triangles == len(faces)
+    assert f"{len(faces):,}" in scene.readout.content
+
+
+def test_gizmo_drag_remeshes(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
+    top_before = scene.mesh_vertices[:, 2].max()
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_node(MESH)
+        glb_before = scene.mesh_node.glb_data
+        path = [(0.0, 0.0, 0.5 + 0.05 * i) for i in range(1, 9)]
+        client.drag_transform("/sdf/gizmo_1", path, period_s=0.02)
+        wait_until(
+            lambda: (
+                scene.mesh_scene is not None and scene.mesh_scene.primitives[0].center == path[-1]
+            ),
+            "the mesh of the last drag position",
+        )
+        # The sphere (radius 0.45) rose 0.4 m: the mesh's top rose with it.
+        assert scene.mesh_vertices[:, 2].max() == pytest.approx(top_before + 0.4, abs=0.02)
+        assert scene.mesh_node.glb_data != glb_before
+        client.wait_for(
+            lambda: client.nodes[MESH].get("props", {}).get("glb_data") == scene.mesh_node.glb_data,
+            what="the new mesh at the client",
+        )
+
+
+def test_a_burst_of_drags_coalesces_to_the_latest(
+    server: viser.ViserServer, scene: SdfGalleryScene
+) -> None:
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_node(MESH)
+        before = scene.mesh_serial
+        path = [
+            (0.3 * math.cos(a), 0.3 * math.sin(a), 0.5) for a in np.linspace(0, 2 * math.pi, 41)[1:]
+        ]
+        client.drag_transform("/sdf/gizmo_2", path)  # no pauses: faster than any mesher
+        target = tuple(float(v) for v in path[-1])
+        wait_until(
+            lambda: (
+                scene.mesh_scene is not None
+                and np.allclose(scene.mesh_scene.primitives[1].center, target)
+            ),
+            "the last drag position meshed",
+        )
+        expected = sdf.mesh(scene.params.scene(), scene.params.resolution)
+        np.testing.assert_array_equal(scene.mesh_vertices, expected[0])
+        assert scene.mesh_serial - before < 20  # 40 updates, far fewer meshes
+
+
+def test_gui_changes_remesh(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
+    volume_union = shown_mesh(scene).volume
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("P2 combine")
+        serial = scene.mesh_serial
+        client.set_value("P2 combine", "Subtract")
+        wait_until(lambda: scene.mesh_serial > serial, "re-mesh after subtract")
+        assert scene.mesh_scene is not None and scene.mesh_scene.primitives[1].op == "subtract"
+        assert trimesh.Trimesh(scene.mesh_vertices, scene.mesh_faces).volume < 0.8 * volume_union
+        serial = scene.mesh_serial
+        client.set_value("P4 on", False)
+        wait_until(lambda: scene.mesh_serial > serial, "re-mesh without P4")
+        assert scene.mesh_scene is not None and len(scene.mesh_scene.primitives) == 3
+        gizmo_4 = server.scene.get_handle_by_name("/sdf/gizmo_4")
+        assert gizmo_4 is not None and gizmo_4.visible is False
+        serial = scene.mesh_serial
+        client.set_value("Blend", "Smooth (exponential)")
+        client.set_value("P1 kind", "Box")
+        client.set_value("P1 colour", (10, 200, 30))
+        wait_until(
+            lambda: (
+                scene.mesh_scene is not None
+                and scene.mesh_scene.blend == "exp"
+                and scene.mesh_scene.primitives[0].kind == "box"
+                and scene.mesh_scene.primitives[0].color[1] == pytest.approx(200 / 255)
+            ),
+            "blend, kind and colour in the mesh",
+        )
+        expected = sdf.mesh(scene.params.scene(), scene.params.resolution)
+        for got, want in zip(
+            (scene.mesh_vertices, scene.mesh_faces, scene.mesh_colors), expected, strict=True
+        ):
+            np.testing.assert_array_equal(got, want)
+        client.wait_for(  # a box uses all three sizes
+            lambda: client.element("P1 size b (m)")["props"]["disabled"] is False,
+            what="size b enabled",
+        )
+
+
+def test_crafted_bad_values_keep_the_last_good_scene(
+    server: viser.ViserServer, scene: SdfGalleryScene
+) -> None:
+    good = scene.params
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Blend width k (m)")
+        client.wait_for_node("/sdf/gizmo_1")
+        client.set_value("Blend width k (m)", float("nan"))
+        client.wait_for(
+            lambda: client.value_of("Blend width k (m)") == good.k, what="k written back"
+        )
+        client.set_value("P2 kind", "Pyramid")  # not an option
+        client.wait_for(lambda: client.value_of("P2 kind") == "Box", what="kind written back")
+        client.set_value(
+            "P3 size a (m)", "big"
+        )  # viser itself refuses this one; the final check covers it
+        client.set_value("P1 colour", (300, -4, 20))
+        client.wait_for(
+            lambda: tuple(client.value_of("P1 colour")) == good.primitives[0].color,
+            what="colour back",
+        )
+        client.drag_transform("/sdf/gizmo_1", [(float("nan"), 0.0, 0.0)])
+        client.drag_transform("/sdf/gizmo_2", [(0.6, 0.0, 0.3)], wxyz=(0.0, 0.0, 0.0, 0.0))
+        client.set_value(RESOLUTION_LABEL, -5)  # out of range: clamped to the slider's minimum
+        client.wait_for(lambda: client.value_of(RESOLUTION_LABEL) == 32, what="resolution clamped")
+        wait_until(
+            lambda: scene.mesh_scene is not None and scene.params.resolution == 32,
+            "the mesh at resolution 32",
+        )
+        wait_until(
+            lambda: len(scene.mesh_vertices) == len(sdf.mesh(good.scene(), 32)[0]), "32³ mesh"
+        )
+    assert scene.params == SdfGalleryParams(resolution=32)
+    assert scene.mesh_scene == good.scene()
+    np.testing.assert_array_equal(scene.mesh_vertices, sdf.mesh(good.scene(), 32)[0])
+
+
+def test_gizmo_is_kept_inside_the_box(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
+    with BrowserClient(server.get_port()) as client:
+        client.drag_transform("/sdf/gizmo_3", [(9.0, -9.0, 0.1)])
+        wait_until(lambda: scene.params.primitives[2].position == (1.5, -1.5, 0.1), "clamped gizmo")
+    gizmo_3 = server.scene.get_handle_by_name("/sdf/gizmo_3")
+    assert gizmo_3 is not None and tuple(gizmo_3.position) == (1.5, -1.5, 0.1)
+
+
+def test_high_resolution_shows_progress_then_a_fine_mesh(
+    server: viser.ViserServer, scene: SdfGalleryScene
+) -> None:
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui(RESOLUTION_LABEL)
+        client.set_value(RESOLUTION_LABEL, 256)
+        progress_uuid = gui_uuid(scene.progress)
+        client.wait_for(
+            lambda: any(
+                m.get("type") == "GuiUpdateMessage"
+                and m.get("uuid") == progress_uuid
+                and m["updates"].get("visible") is True
+                for _, m in client.received
+            ),
+            what="progress bar shown",
+        )
+        wait_until(
+            lambda: scene.mesh_serial > 0 and len(scene.mesh_faces) > 100_000,
+            "256³ mesh",
+            timeout_s=60,
+        )
+        wait_until(lambda: scene.progress.visible is False, "progress bar hidden")
+
+
+# ------------------------------------------------------------------------------------------ reference image
+@pytest.mark.gl
+def test_reference_image_readouts_and_rerender(
+    server: viser.ViserServer, scene: SdfGalleryScene
+) -> None:
+    need_gl()
+    with BrowserClient(server.get_port()) as client:
+        client.send_camera(position=(2.3, -2.5, 1.7), look_at=(0.05, 0.0, 0.3), size=(600, 800))
+        # 320 px wide at this camera's 4:3 aspect (the client's first camera, 16:9, may get a render first).
+        wait_until(
+            lambda: (
+                scene.reference_rgb is not None
+                and scene.reference_rgb.shape == (240, 320, 3)
+                and scene.agreement.iou is not None
+            ),
+            "reference from this camera",
+            timeout_s=60,
+        )
+        first = scene.reference_rgb
+        assert first is not None
+        a = scene.agreement
+        assert (
+            a.iou is not None and a.iou > 0.97
+        )  # box edges on the silhouette are bevelled by marching cubes
+        assert a.depth_diff_voxels is not None and a.depth_diff_voxels < 0.1
+        assert a.render_ms is not None and "Silhouette IoU" in scene.readout.content
+        # Moving the camera re-renders from the new view once it rests.
+        count = scene.reference_serial
+        client.send_camera(position=(0.0, -3.5, 0.4), look_at=(0.0, 0.0, 0.3), size=(600, 800))
+        wait_until(
+            lambda: scene.reference_serial > count, "re-render after the camera moved", timeout_s=30
+        )
+        assert scene.reference_rgb is not None and not np.array_equal(scene.reference_rgb, first)
+        # A brighter ambient term brightens the object.
+        dark = scene.reference_rgb.astype(float).mean()
+        count = scene.reference_serial
+        client.set_value("Ambient k_a", 0.9)
+        wait_until(lambda: scene.reference_serial > count, "re-render after k_a", timeout_s=30)
+        assert scene.params.shading.ambient == 0.9
+        assert scene.reference_rgb.astype(float).mean() > dark + 5
+
+
+@pytest.mark.gl
+def test_live_mode_renders_while_the_camera_moves(
+    server: viser.ViserServer, scene: SdfGalleryScene
+) -> None:
+    """ "When the camera stops" waits for a still camera; "Live" renders while camera messages keep coming."""
+    need_gl()
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Re-render")
+        client.set_value("Re-render", "Live")
+        wait_until(lambda: scene.params.reference_mode == "live", "live mode")
+        count = scene.reference_serial
+        for step in range(60):  # an orbit, one camera message every 50 ms: never still for 0.25 s
+            angle = 0.05 * step
+            client.send_camera(
+                position=(3 * math.cos(angle), 3 * math.sin(angle), 1.5), look_at=(0, 0, 0.3)
+            )
+            time.sleep(0.05)
+        # A render already in flight accounts for one at most; live mode keeps rendering during the motion.
+        assert scene.reference_serial - count >= 3
+
+
+def test_downloads(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Download mesh (STL)")
+        for label, name in [
+            ("Download mesh (STL)", "sdf_mesh.stl"),
+            ("Download mesh (OBJ)", "sdf_mesh.obj"),
+        ]:
+            client.click(label)
+            client.wait_for(
+                lambda name=name: any(m.get("filename") == name for _, m in client.received),
+                what=name,
+            )
+            start = next(m for _, m in client.received if m.get("filename") == name)
+            client.wait_for(
+                lambda start=start: (
+                    sum(
+                        1
+                        for _, m in client.received
+                        if m.get("transfer_uuid") == start["transfer_uuid"]
+                    )
+                    > start["part_count"]
+                ),
+                what=f"{name} parts",
+            )
+            parts = sorted(
+                (m["part_index"], m["content"])
+                for _, m in client.received
+                if m.get("type") == "FileTransferPart"
+                and m["transfer_uuid"] == start["transfer_uuid"]
+            )
+            data = b"".join(content for _, content in parts)
+            assert len(data) == start["size_bytes"]
+            loaded = trimesh.load(
+                io.BytesIO(data), file_type=name.rsplit(".", 1)[1], force="mesh", process=False
+            )
+            assert isinstance(loaded, trimesh.Trimesh)
+            assert len(loaded.faces) == len(scene.mesh_faces)
+    name, glb = scene.export("glb")
+    assert name == "sdf_mesh.glb" and glb is not None and glb[:4] == b"glTF"
+
+
+@pytest.mark.gl
+def test_png_download_is_the_reference_image(scene: SdfGalleryScene) -> None:
+    need_gl()
+    wait_until(lambda: scene.reference_rgb is not None, "reference", timeout_s=60)
+    from PIL import Image
+
+    name, png = scene.export("png")
+    assert name == "sdf_reference.png" and png is not None
+    assert scene.reference_rgb is not None
+    np.testing.assert_array_equal(np.asarray(Image.open(io.BytesIO(png))), scene.reference_rgb)
+
+
+def test_without_gl_the_panel_says_why_and_meshing_goes_on(
+    server: viser.ViserServer, monkeypatch: pytest.MonkeyPatch
+) -> None:
+
+    def no_gl(job: object, timeout_s: float | None = None) -> None:
+        raise GLUnavailableError(
+            "No OpenGL 3.3 context on EGL (test): the mesh view works without it."
+        )
+
+    monkeypatch.setattr(gl_service, "run", no_gl)
+    scene = SdfGalleryScene(server)
+    try:
+        wait_until(lambda: scene.gl_error is not None, "the renderer to be tried")
+        wait_until(lambda: "No reference image" in scene.reference_note.content, "the reason shown")
+        assert "EGL" in scene.reference_note.content and scene.reference_rgb is None
+        with BrowserClient(server.get_port()) as client:
+            client.drag_transform("/sdf/gizmo_1", [(0.1, 0.0, 0.6)])
+            wait_until(
+                lambda: (
+                    scene.mesh_scene is not None
+                    and scene.mesh_scene.primitives[0].center == (0.1, 0.0, 0.6)
+                ),
+                "a mesh without GL",
+            )
+    finally:
+        scene.close()
+
+
+# ------------------------------------------------------------------------------------------ teardown
+def test_close_removes_everything_and_stops_the_worker(server: viser.ViserServer) -> None:
+    nodes_before, gui_before = node_names(server), gui_uuids(server)
+    scene = SdfGalleryScene(server)
+    assert MESH in node_names(server)
+    worker = scene.worker.thread
+    scene.close()
+    assert not worker.is_alive()
+    assert node_names(server) == nodes_before
+    assert gui_uuids(server) == gui_before
+
+
+def rss_mib() -> float:
+    with open("/proc/self/statm") as f:
+        return int(f.read().split()[1]) * 4096 / 2**20
+
+
+@pytest.mark.gl
+def test_fifty_builds_share_one_gl_context_and_do_not_grow_memory(
+    server: viser.ViserServer,
+) -> None:
+    """Each build once made a new EGL context on a new thread (~50 MiB each, never reclaimed)."""
+    import gc
+    import threading
+
+    need_gl()
+
+    def build_render_close() -> None:
+        scene = SdfGalleryScene(server)
+        try:
+            scene.on_camera_values(Camera((1.9, -2.1, 1.4), (0.0, 0.0, 0.3)), 4 / 3)
+            wait_until(lambda: scene.reference_serial > 0, "a reference image")
+        finally:
+            scene.close()
+
+    for _ in range(3):  # warm: the shared context, its programs, numba and skimage caches
+        build_render_close()
+    gc.collect()
+    threads_before = threading.active_count()
+    before = rss_mib()
+    for _ in range(50):
+        build_render_close()
+    gc.collect()
+    grown = rss_mib() - before
+    assert grown <= 20.0, f"RSS grew {grown:.1f} MiB over 50 builds"
+    assert threading.active_count() == threads_before
+    gl_threads = [t for t in threading.enumerate() if t.name == "gl-service"]
+    assert gl_threads == [gl_service.thread()]
+
+
+def test_blend_dropdown_says_hard_and_smooth_and_hard_ignores_k(
+    server: viser.ViserServer, scene: SdfGalleryScene
+) -> None:
+    blend = scene.scene_controls["blend"]
+    assert isinstance(blend, viser.GuiDropdownHandle)
+    assert blend.options == (
+        "Hard",
+        "Smooth (polynomial)",
+        "Smooth (exponential)",
+    )
+    assert "samples per side" in scene.scene_controls["resolution"].label
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Blend")
+        client.set_value("Blend", "Hard")
+        wait_until(
+            lambda: scene.mesh_scene is not None and scene.mesh_scene.k == 0.0, "a hard mesh"
+        )
+        assert scene.scene_controls["k"].disabled
+        meshed = scene.mesh_scene
+        assert meshed is not None
+        # The hard scene's distance is the plain minimum of the four primitives' distances.
+        p = np.array([[0.3, 0.0, 0.3], [0.2, 0.1, 0.6]])
+        expected = np.min([prim.distance(p) for prim in meshed.primitives], axis=0)
+        np.testing.assert_allclose(sdf.scene_distance(meshed, p), expected, atol=1e-12)
+
+
+def test_gizmos_draw_over_the_mesh_and_reach_out_of_it(scene: SdfGalleryScene) -> None:
+    for gizmo, slot in zip(scene.gizmos, scene.params.primitives, strict=True):
+        assert gizmo.depth_test is False
+        prim = slot.primitive()
+        # The arrow tips lie outside the primitive (positive distance): something to grab from outside.
+        tips = np.asarray(slot.position) + gizmo.scale * sdf.rotation_matrix(slot.wxyz).T
+        assert np.all(prim.distance(tips) > 0.0), slot.kind
+
+
+def test_each_gizmo_is_sized_coloured_and_named_for_its_own_primitive(
+    server: viser.ViserServer, scene: SdfGalleryScene
+) -> None:
+    # Gizmos over each other: four 0.8 m gizmos once drawn without depth test piled up over the middle. Each is now its primitive's
+    # size plus a margin, with a ball of its colour and its name.
+    from scenes.sdf_gallery import GIZMO_MARGIN_M
+
+    scales = [g.scale for g in scene.gizmos]
+    # Sphere r = 0.45 m, box half size 0.3 m, torus ring 0.6 + 0.12 m, capsule 0.35 + 0.15 m: each plus the margin.
+    reach = np.array([0.45, 0.3, 0.72, 0.5]) + GIZMO_MARGIN_M
+    assert scales == pytest.approx(reach, abs=0.011)
+    for i, (marker, label, slot) in enumerate(
+        zip(scene.gizmo_markers, scene.gizmo_labels, scene.params.primitives, strict=True)
+    ):
+        assert tuple(marker.color) == slot.color
+        assert label.text == f"P{i + 1} {slot.kind}"
+    assert len({tuple(m.color) for m in scene.gizmo_markers}) == 4
+    # The sphere's gizmo follows its radius: 0.45 m → 0.25 m.
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("P1 size a (m)")
+        client.set_value("P1 size a (m)", 0.25)
+        wait_until(
+            lambda: scene.gizmos[0].scale == pytest.approx(0.25 + GIZMO_MARGIN_M, abs=0.011),
+            "the resized gizmo",
+        )
+        client.set_value("P1 colour", (10, 200, 30))
+        wait_until(
+            lambda: tuple(scene.gizmo_markers[0].color) == (10, 200, 30), "the marker colour"
+        )
+
+
+@pytest.mark.parametrize(
+    ("label", "kind"),
+    [("Cylinder", "cylinder"), ("Octahedron", "octahedron"), ("Ellipsoid (bound)", "ellipsoid")],
+)
+def test_catalogue_primitives_from_the_dropdown_are_meshed(
+    server: viser.ViserServer, scene: SdfGalleryScene, label: str, kind: str
+) -> None:
+    from scenes.sdf_gallery import KIND_LABELS
+
+    assert {"Cylinder", "Round box", "Octahedron", "Cone", "Hexagonal prism"} <= set(KIND_LABELS)
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("P2 kind")
+        client.set_value("P2 kind", label)
+        wait_until(
+            lambda: scene.mesh_scene is not None and scene.mesh_scene.primitives[1].kind == kind,
+            f"a mesh with a {kind}",
+        )
+        meshed = scene.mesh_scene
+        assert meshed is not None
+        expected = sdf.mesh(meshed, scene.params.resolution)
+        np.testing.assert_array_equal(scene.mesh_vertices, expected[0])
+        # The mesh's vertices lie on the surface of the scene with the new kind.
+        d = sdf.scene_distance(meshed, scene.mesh_vertices)
+        assert np.abs(d).max() < 0.5 * sdf.make_grid(meshed, scene.params.resolution).spacing
+
+
+# ------------------------------------------------------------------------------------------ editor and view
+SPHERE_SOURCE = "float sdf(vec3 p) {\n    return sd_sphere(p - vec3(0.2, 0.0, 0.1), 0.6);\n}\n"
+
+
+def background_images(client: BrowserClient) -> list[dict]:
+    return [m for _, m in client.received if m.get("type") == "BackgroundImageMessage"]
+
+
+@pytest.mark.gl
+def test_typed_source_is_meshed_and_a_bad_one_keeps_the_last_good(
+    server: viser.ViserServer, scene: SdfGalleryScene
+) -> None:
+    need_gl()
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("sdf(p) in GLSL")
+        client.set_value("sdf(p) in GLSL", SPHERE_SOURCE)
+        client.click("Apply")
+        wait_until(lambda: scene.editor_serial == 1, "the source applied")
+        assert scene.params.shape_source == "editor" and scene.mesh_scene is None
+        client.wait_for(lambda: client.value_of("Shape") == "GLSL editor", what="Shape shown")
+        # The mesh is the typed sphere: every vertex 0.6 m from (0.2, 0, 0.1), within a fraction of a voxel.
+        radii = np.linalg.norm(scene.mesh_vertices - [0.2, 0.0, 0.1], axis=1)
+        assert len(radii) > 1000
+        assert np.abs(radii - 0.6).max() < 0.01
+        assert not any(g.visible for g in scene.gizmos)
+        # The downloads are the typed shape's mesh.
+        name, data = scene.export("stl")
+        assert name == "sdf_mesh.stl" and data is not None
+        exported = trimesh.load(io.BytesIO(data), file_type="stl", force="mesh")
+        assert isinstance(exported, trimesh.Trimesh)
+        assert exported.volume == pytest.approx(4 / 3 * math.pi * 0.6**3, rel=0.02)
+        # A compile error: the message names the line; the sphere stays.
+        shown = scene.mesh_vertices.copy()
+        client.set_value("sdf(p) in GLSL", "float sdf(vec3 p) {\n    return sd_sphere(p, 0.5)\n}\n")
+        client.click("Apply")
+        wait_until(lambda: scene.editor_error is not None, "the error")
+        assert scene.editor_error is not None and scene.editor_error.startswith("line 3:")
+        assert "line 3" in scene.editor_status.content
+        # A loop and an over-long source are refused before the compiler sees them.
+        for text, words in [
+            (
+                "float sdf(vec3 p) {\n    float d = 1.0;\n    for (;;) { d = 0.5; }\n    return d;\n}",
+                "line 3",
+            ),
+            ("float sdf(vec3 p) { return 1.0; }\n" + "//" * 4100, "limit"),
+            ("#extension GL_ARB_foo : enable\nfloat sdf(vec3 p) { return 1.0; }", "line 1"),
+        ]:
+            scene.editor_error = None
+            client.set_value("sdf(p) in GLSL", text)
+            client.click("Apply")
+            wait_until(lambda: scene.editor_error is not None, "a refusal")
+            assert words in str(scene.editor_error)
+        assert scene.editor_serial == 1
+        np.testing.assert_array_equal(scene.mesh_vertices, shown)
+
+
+@pytest.mark.gl
+def test_every_example_applies_and_meshes(
+    server: viser.ViserServer, scene: SdfGalleryScene
+) -> None:
+    from scenes.sdf_gallery import EXAMPLES
+
+    need_gl()
+    assert len(EXAMPLES) >= 6
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Example")
+        for n, title in enumerate(list(EXAMPLES)[1:] + list(EXAMPLES)[:1], start=1):
+            client.set_value("Example", title)
+            wait_until(lambda n=n: scene.editor_serial == n, f"example {title!r}")
+            assert scene.params.editor.source == EXAMPLES[title]
+            assert len(scene.mesh_faces) > 500, title
+            client.wait_for(
+                lambda t=title: client.value_of("sdf(p) in GLSL") == EXAMPLES[t], what="text"
+            )
+
+
+@pytest.mark.gl
+def test_raymarched_view_goes_to_the_background_with_depth(
+    server: viser.ViserServer, scene: SdfGalleryScene
+) -> None:
+    need_gl()
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("View")
+        client.send_camera(position=(2.0, -2.4, 1.6), look_at=(0.0, 0.0, 0.3), size=(400, 640))
+        client.set_value("View", "Ray-marched")
+        wait_until(lambda: scene.view_serial > 0, "a main-view frame")
+        assert scene.mesh_node.visible is False and scene.wireframe_node.visible is False
+        # Wait for the frame itself: under load the last background message seen may still be an earlier one
+        # (the clearing of the mesh view's background), not yet the ray-marched frame with its depth.
+        client.wait_for(
+            lambda: any(m["rgb_data"] and m["depth_data"] for m in background_images(client)),
+            what="a background image with depth",
+        )
+        # At rest the frame is the full width, with the viewer's aspect.
+        wait_until(
+            lambda: scene.view_rgb is not None and scene.view_rgb.shape[1] == 640, "the full frame"
+        )
+        assert scene.view_rgb is not None and scene.view_rgb.shape[:2] == (400, 640)
+        # Moving: a reduced frame first.
+        client.send_camera(position=(2.2, -2.2, 1.6), look_at=(0.0, 0.0, 0.3), size=(400, 640))
+        wait_until(
+            lambda: scene.view_rgb is not None and scene.view_rgb.shape[1] == 320, "a reduced frame"
+        )
+        client.set_value("View", "Both")
+        client.wait_for(lambda: True)
+        wait_until(lambda: scene.wireframe_node.visible, "the wireframe")
+        assert len(scene.wireframe_node.faces) == len(scene.mesh_faces)
+        client.set_value("View", "Mesh")
+        wait_until(lambda: scene.mesh_node.visible, "the mesh back")
+        client.wait_for(
+            lambda: background_images(client)[-1]["rgb_data"] is None, what="background cleared"
+        )
+
+
+def test_camera_with_zero_height_or_nan_is_ignored(
+    server: viser.ViserServer, scene: SdfGalleryScene
+) -> None:
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("View")
+        client.send_camera(size=(0, 640))
+        client.send_camera(position=(float("nan"), 0.0, 1.0))
+        client.send_camera(size=(400, 640))
+        serial = scene.mesh_serial
+        client.drag_transform("/sdf/gizmo_1", [(0.1, 0.0, 0.5)])
+        wait_until(lambda: scene.mesh_serial > serial, "the scene still answering")
+
+
+@pytest.mark.gl
+def test_with_editing_off_apply_uses_only_the_servers_examples(
+    server: viser.ViserServer, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import scenes.sdf_gallery.editor as gallery
+
+    need_gl()
+    monkeypatch.setattr(gallery, "editing_allowed", lambda: False)
+    scene = SdfGalleryScene(server)
+    try:
+        assert scene.editor.disabled and "Editing is off" in scene.editor_status.content
+        with BrowserClient(server.get_port()) as client:
+            client.wait_for_gui("Apply")
+            client.set_value(
+                "sdf(p) in GLSL", SPHERE_SOURCE
+            )  # a crafted client can still send text
+            client.click("Apply")
+            wait_until(lambda: scene.editor_serial == 1, "an apply")
+            assert scene.params.editor.source == next(iter(gallery.EXAMPLES.values()))
+    finally:
+        scene.close()
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize(
+    ("limit", "words"), [("COMPILE_LIMIT_S", "compiling took"), ("FRAME_LIMIT_S", "frame took")]
+)
+def test_compile_and_frame_time_limits_refuse_a_slow_source(
+    server: viser.ViserServer,
+    scene: SdfGalleryScene,
+    monkeypatch: pytest.MonkeyPatch,
+    limit: str,
+    words: str,
+) -> None:
+    import scenes.sdf_gallery.editor as gallery
+
+    need_gl()
+    monkeypatch.setattr(gallery, limit, 1e-9)  # every source is too slow now
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("sdf(p) in GLSL")
+        client.set_value("sdf(p) in GLSL", SPHERE_SOURCE.replace("0.6", "0.61"))
+        client.click("Apply")
+        wait_until(lambda: scene.editor_error is not None, "a refusal")
+        assert words in str(scene.editor_error) and "limit" in str(scene.editor_error)
+        assert scene.editor_serial == 0 and scene.params.shape_source == "primitives"
+
+
+def chain_source(links: int) -> str:
+    """A loop-free chain that inlines to a huge program: each function calls the one before twice, so the inlined code
+    doubles at each link (ten links: 679 characters, 76 s for Mesa to compile)."""
+    lines = ["float f0(vec3 p){ return length(p)-1.0; }"]
+    for i in range(1, links + 1):
+        lines.append(f"float f{i}(vec3 p){{ return min(f{i - 1}(p*1.01), f{i - 1}(p.yzx+0.01)); }}")
+    lines.append(f"float sdf(vec3 p){{ return f{links}(p); }}")
+    return "\n".join(lines) + "\n"
+
+
+@pytest.mark.gl
+def test_a_slow_compile_is_stopped_at_the_limit_while_the_server_keeps_serving(
+    server: viser.ViserServer, scene: SdfGalleryScene, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import scenes.sdf_gallery.editor as gallery
+
+    need_gl()
+    # Nine links pass the size bound but take Mesa several seconds: the trial process is killed at the limit.
+    monkeypatch.setattr(gallery, "COMPILE_LIMIT_S", 1.0)
+    monkeypatch.setattr(gallery, "FRAME_LIMIT_S", 0.5)
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("sdf(p) in GLSL")
+        client.set_value("sdf(p) in GLSL", chain_source(9))
+        start = time.monotonic()
+        client.click("Apply")
+        time.sleep(0.3)
+        # Meanwhile another callback answers at once: the compile is not in this process.
+        client.set_value("View", "Both")
+        wait_until(lambda: scene.wireframe_node.visible, "the view switch", timeout_s=2.0)
+        assert scene.editor_error is None
+        wait_until(lambda: scene.editor_error is not None, "the refusal", timeout_s=30.0)
+        refused_s = time.monotonic() - start
+        assert "stopped" in str(scene.editor_error) and "limit" in str(scene.editor_error)
+        assert (
+            refused_s < 20.0
+        )  # the limits plus the child's start (about 2 s here), not the 8 s compile
+        assert scene.editor_serial == 0 and scene.params.shape_source == "primitives"
+        # Ten links are refused before anything compiles, with the size and the limit.
+        scene.editor_error = None
+        client.set_value("sdf(p) in GLSL", chain_source(10))
+        start = time.monotonic()
+        client.click("Apply")
+        wait_until(lambda: scene.editor_error is not None, "the size refusal", timeout_s=5.0)
+        assert "inlined" in str(scene.editor_error) and "20000" in str(scene.editor_error)
+
+
+@pytest.mark.parametrize("extra", [1, 3 * 2**20])
+def test_an_over_long_editor_text_is_put_back_for_every_viewer(
+    server: viser.ViserServer, scene: SdfGalleryScene, extra: int
+) -> None:
+    from scenes.sdf_gallery import EDITOR_KEEP_CHARS
+
+    label = "sdf(p) in GLSL"
+    with BrowserClient(server.get_port()) as crafted, BrowserClient(server.get_port()) as other:
+        crafted.wait_for_gui(label)
+        other.wait_for_gui(label)
+        before = scene.editor.value
+        crafted.set_value(label, SPHERE_SOURCE)  # a text within the limit is kept
+        wait_until(lambda: scene.editor.value == SPHERE_SOURCE, "the kept text")
+        crafted.set_value(label, "x" * (EDITOR_KEEP_CHARS + extra))
+        # Refused at the app's message gate (text controls take at most MAX_TEXT_CHARS) or by the editor's own
+        # handler: either way the server keeps the last good text and sends it to every viewer.
+        time.sleep(0.5)
+        assert scene.editor.value == SPHERE_SOURCE != before
+        other.wait_for(lambda: other.value_of(label) == SPHERE_SOURCE, what="the text put back")
+        crafted.wait_for(lambda: crafted.value_of(label) == SPHERE_SOURCE, what="the text put back")
+    with BrowserClient(server.get_port()) as late:
+        late.wait_for_gui(label)
+        late.wait_for(lambda: late.value_of(label) == SPHERE_SOURCE, what="the kept text")
+        assert all(
+            len(str(m.get("updates", {}).get("value", ""))) < 10**5 for _, m in late.received
+        )
+
+
+def test_apply_of_a_text_over_the_source_limit_says_its_length_and_the_limit(
+    server: viser.ViserServer, scene: SdfGalleryScene
+) -> None:
+    from scenes.sdf_gallery import MAX_SOURCE_CHARS
+
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Apply")
+        text = SPHERE_SOURCE + " " * (MAX_SOURCE_CHARS + 1 - len(SPHERE_SOURCE))
+        client.set_value("sdf(p) in GLSL", text)
+        wait_until(lambda: scene.editor.value == text, "the kept text")
+        client.click("Apply")
+        wait_until(lambda: scene.editor_error is not None, "the refusal")
+        assert "8001 characters long; the limit is 8000 characters" in str(scene.editor_error)
+        assert "8001 characters long" in scene.editor_status.content
+        assert scene.editor_serial == 0
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize(
+    ("body", "side"),
+    [("return 1.0;", "outside"), ("return -2.0;", "inside"), ("return 1e30;", "outside")],
+)
+def test_a_field_without_a_surface_in_the_bounds_is_not_applied(
+    server: viser.ViserServer, scene: SdfGalleryScene, body: str, side: str
+) -> None:
+    need_gl()
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Apply")
+        client.set_value("sdf(p) in GLSL", f"float sdf(vec3 p) {{ {body} }}\n")
+        client.click("Apply")
+        wait_until(lambda: scene.editor_error is not None, "the refusal", timeout_s=30.0)
+        assert "no surface lies inside the bounds" in str(scene.editor_error)
+        assert side in str(scene.editor_error) and "±1.5 m" in str(scene.editor_error)
+        assert (
+            "0 triangles" not in scene.editor_status.content
+            and "Applied" not in scene.editor_status.content
+        )
+        assert (
+            scene.editor_serial == 0 and len(scene.mesh_faces) > 500
+        )  # the primitives' mesh stays
+
+
+_ODD = st.one_of(
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.integers(-(2**70), 2**70),
+    st.just(None),
+    st.text(max_size=3),
+    st.lists(st.floats(), max_size=4),
+)
+
+
+@given(
+    st.fixed_dictionaries(
+        {
+            "position": st.one_of(_ODD, st.tuples(*[st.floats()] * 3)),
+            "look_at": st.one_of(_ODD, st.tuples(*[st.floats()] * 3)),
+            "up_direction": st.one_of(_ODD, st.just((0.0, 0.0, 1.0))),
+            "fov": _ODD,
+            "image_width": _ODD,
+            "image_height": _ODD,
+        }
+    )
+)
+@settings(max_examples=200, suppress_health_check=[HealthCheck.function_scoped_fixture])
+def test_any_camera_message_fields_keep_the_view_sane(
+    scene: SdfGalleryScene, fields: dict[str, object]
+) -> None:
+    # Every field of a ViewerCameraMessage the scene reads, crafted: its handler never raises, and what it keeps
+    # is finite (a camera, an aspect in range and a rest frame of a sane size).
+    class Cam:
+        def __init__(self) -> None:
+            self.__dict__.update(fields)
+
+        @property
+        def aspect(self) -> float:
+            return self.image_width / self.image_height  # type: ignore[operator]
+
+    scene.on_camera(Cam())
+    assert 0.5 <= scene.viewer.aspect <= 2.5
+    assert 1 <= scene.viewer.width_px <= 2e4
+    width, height = gallery_rest_size(scene.viewer.width_px, scene.viewer.aspect, None)
+    assert width <= 1600 and 16 <= height <= 1000 and (width >= 640 or height == 1000)
+
+
+def test_a_camera_with_nan_numbers_is_ignored(scene: SdfGalleryScene) -> None:
+    from types import SimpleNamespace
+
+    before = (scene.viewer.camera, scene.viewer.aspect, scene.viewer.width_px)
+    nan = float("nan")
+    scene.on_camera(
+        SimpleNamespace(
+            position=nan,
+            look_at=(0.0, 0.0, 0.0),
+            up_direction=(0.0, 0.0, 1.0),
+            fov=1.0,
+            image_width=1600,
+            image_height=nan,
+            aspect=nan,
+        )
+    )
+    assert (scene.viewer.camera, scene.viewer.aspect, scene.viewer.width_px) == before
+
+
+def gallery_rest_size(width: int, aspect: float, s_per_pixel: float | None) -> tuple[int, int]:
+    from scenes.sdf_gallery import rest_size
+
+    return rest_size(width, aspect, s_per_pixel)
+
+
+@pytest.mark.parametrize(
+    ("viewer", "aspect", "s_per_pixel", "size"),
+    [
+        (
+            1600,
+            1.6,
+            None,
+            (1600, 1000),
+        ),  # an odd canvas: drawn at its size, not 640 stretched
+        (2400, 1.6, None, (1600, 1000)),  # capped
+        (1600, 2.5, None, (1600, 640)),
+        (1000, 0.5, None, (500, 1000)),  # a tall canvas: the height is the limit
+        (300, 1.6, None, (640, 400)),  # never below the old rest width
+        (1600, 1.6, 0.6 / (800 * 500), (800, 500)),  # the budget allows a quarter of the pixels
+        (1600, 1.6, 1.0, (640, 400)),  # a very slow field: the old rest size
+    ],
+)
+def test_rest_frame_size(
+    viewer: int, aspect: float, s_per_pixel: float | None, size: tuple[int, int]
+) -> None:
+    assert gallery_rest_size(viewer, aspect, s_per_pixel) == size

@@ -1,0 +1,226 @@
+"""The app: loopback by default, a warning for other addresses, and a switcher that leaves nothing behind."""
+
+from __future__ import annotations
+
+import inspect
+import logging
+import signal
+import socket
+import subprocess
+import sys
+import threading
+import types
+
+import pytest
+import viser
+from helpers.paths import ROOT
+from helpers.viser_private import gui_uuid, gui_uuids, node_names
+from helpers.wsclient import BrowserClient
+
+import app
+from scenes import SCENES
+from server.switcher import SceneSwitcher
+
+
+def test_defaults_bind_loopback_port_8080_and_open_peloton() -> None:
+    defaults = {name: p.default for name, p in inspect.signature(app.main).parameters.items()}
+    # No port given means 8080, or the next free one; a port given must be free.
+    assert defaults == {
+        "scene": "peloton",
+        "host": "127.0.0.1",
+        "port": None,
+        "allow_remote_glsl": False,
+        "shared": False,
+    }
+    assert app.DEFAULT_PORT == 8080
+
+
+def test_remote_host_warning_says_whether_glsl_editing_is_on() -> None:
+    off = app.exposure_warning("0.0.0.0", 9000)
+    on = app.exposure_warning("0.0.0.0", 9000, allow_remote_glsl=True)
+    assert off is not None and "GLSL editing in the SDF gallery is OFF" in off
+    assert "--allow-remote-glsl" in off
+    assert on is not None and "GLSL editing in the SDF gallery is ON" in on
+
+
+def test_port_messages_say_plainly_what_happened() -> None:
+    assert app.port_message(8080, 8080, explicit=False) is None
+    assert app.port_message(9000, 9000, explicit=True) is None
+    assert app.port_message(8080, 8081, explicit=False) == (
+        "Port 8080 is already in use; serving on port 8081 instead."
+    )
+    refusal = app.port_message(9000, 9001, explicit=True)
+    assert refusal is not None and "Port 9000 is already in use" in refusal and "--port" in refusal
+
+
+def _free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return int(probe.getsockname()[1])
+
+
+def test_ctrl_c_stops_the_app_with_one_line() -> None:
+    port = _free_port()
+    process = subprocess.Popen(
+        [sys.executable, str(ROOT / "app.py"), "--port", str(port)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+    )
+    try:
+        assert process.stdout is not None
+        started = []
+        for line in process.stdout:
+            started.append(line)
+            if "Open http" in line:
+                break
+        assert f"Open http://127.0.0.1:{port} " in started[-1], started
+        process.send_signal(signal.SIGINT)
+        rest, _ = process.communicate(timeout=60)
+    finally:
+        process.kill()
+    assert process.returncode == 0
+    assert rest == "Stopped.\n"  # no traceback, no farewell from viser or websockets
+    assert "Traceback" not in "".join(started)
+
+
+def test_a_busy_port_given_explicitly_is_refused_plainly() -> None:
+    with socket.socket() as holder:
+        holder.bind(("127.0.0.1", 0))
+        holder.listen()
+        port = int(holder.getsockname()[1])
+        result = subprocess.run(
+            [sys.executable, str(ROOT / "app.py"), "--port", str(port)],
+            capture_output=True,
+            text=True,
+            timeout=60,
+        )
+    assert result.returncode == 2
+    assert f"Port {port} is already in use" in result.stderr
+    assert "Traceback" not in result.stderr + result.stdout
+    assert "Open http" not in result.stdout  # it did not quietly serve elsewhere
+
+
+@pytest.mark.parametrize("host", ["127.0.0.1", "localhost", "::1", "127.0.0.2"])
+def test_loopback_hosts_print_no_warning(host: str) -> None:
+    assert app.exposure_warning(host, 8080) is None
+
+
+@pytest.mark.parametrize("host", ["0.0.0.0", "::", "192.168.1.20", "my-laptop.local"])
+def test_other_hosts_warn_what_they_expose(host: str) -> None:
+    warning = app.exposure_warning(host, 9000)
+    assert warning is not None
+    assert f"{host}:9000" in warning and "Anyone who can reach" in warning
+
+
+def test_cli_help_lists_scene_host_and_port() -> None:
+    result = subprocess.run(
+        [sys.executable, str(ROOT / "app.py"), "--help"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=True,
+    )
+    for flag in ("--scene", "--host", "--port", "--shared"):
+        assert flag in result.stdout
+    for key in SCENES:
+        assert key in result.stdout
+
+
+def test_cli_rejects_an_unknown_scene() -> None:
+    result = subprocess.run(
+        [sys.executable, str(ROOT / "app.py"), "--scene", "pinball"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert result.returncode != 0
+    assert "pinball" in result.stdout + result.stderr
+
+
+def test_every_scene_has_an_about_panel_with_equations_and_sources() -> None:
+    for cls in SCENES.values():
+        about = cls.about.lower()
+        assert len(about) > 300, cls.key
+        assert "assumption" in about, cls.key
+        assert "=" in about, cls.key  # at least one equation
+
+
+def test_switcher_lists_every_scene(switcher: SceneSwitcher) -> None:
+    assert tuple(switcher.dropdown.options) == tuple(cls.title for cls in SCENES.values())
+
+
+def test_switching_removes_every_node_and_gui_element_of_the_old_scene(
+    server: viser.ViserServer,
+) -> None:
+    bare_nodes = node_names(server)
+    keys = list(SCENES)
+    switcher = SceneSwitcher(server, keys[0])
+    switcher_gui = {gui_uuid(switcher.dropdown), gui_uuid(switcher.reset_button)}
+    for key in keys[1:] + keys[:1]:
+        old_nodes = node_names(server) - bare_nodes
+        old_gui = gui_uuids(server)
+        switcher.show(key, rebuild=True)
+        new_nodes = node_names(server) - bare_nodes
+        assert all(name == f"/{key}" or name.startswith(f"/{key}/") for name in new_nodes), key
+        if old_nodes != new_nodes:
+            assert not (old_nodes & new_nodes)
+        assert old_gui & gui_uuids(server) == switcher_gui
+    # Closing the last scene leaves only what the bare server had, plus the switcher's own controls.
+    switcher.scene.close()
+    assert node_names(server) == bare_nodes
+    assert gui_uuids(server) == switcher_gui
+
+
+def test_switching_from_a_browser(server: viser.ViserServer) -> None:
+    switcher = SceneSwitcher(server, "peloton")
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_node("/peloton")
+        for key, cls in SCENES.items():
+            client.set_value("Scene", cls.title)
+            client.wait_for(lambda key=key: switcher.scene.key == key, what=f"switch to {key}")
+            client.wait_for(lambda key=key: f"/{key}" in client.nodes, what=f"/{key} on the client")
+        stale = switcher.scene
+        client.click("Reset scene to defaults")
+        client.wait_for(lambda: switcher.scene is not stale, what="reset to rebuild the scene")
+        client.set_value("Scene", "Not a scene")
+        client.set_value("Scene", SCENES["peloton"].title)
+        client.wait_for(lambda: switcher.scene.key == "peloton", what="back to peloton")
+        client.wait_for(
+            lambda: (
+                not any(
+                    name.startswith("/") and name.split("/")[1] in set(SCENES) - {"peloton"}
+                    for name in client.nodes
+                )
+            ),
+            what="other scenes' nodes gone from the client",
+        )
+    switcher.close()
+
+
+def test_warm_kernels_runs_every_warm_up_on_one_daemon_thread(
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    from kernels import ball, course, fabrik
+
+    assert inspect.signature(app.warm_kernels).parameters["modules"].default == (
+        fabrik,
+        ball,
+        course,
+    )
+    calls: list[tuple[str, threading.Thread]] = []
+    failing, plain, warming = (types.ModuleType(name) for name in ("failing", "plain", "warming"))
+
+    def fail() -> None:
+        calls.append(("failing", threading.current_thread()))
+        raise RuntimeError("no compiler today")
+
+    failing.warm_up = fail  # type: ignore[attr-defined]
+    warming.warm_up = lambda: calls.append(("warming", threading.current_thread()))  # type: ignore[attr-defined]
+    with caplog.at_level(logging.INFO, logger="app"):
+        thread = app.warm_kernels((failing, plain, warming))
+        thread.join(10)
+    assert not thread.is_alive() and thread.daemon
+    # A failing warm-up is logged and the next still runs; a module without one is skipped; all on that thread.
+    assert calls == [("failing", thread), ("warming", thread)]
+    assert "warming failing failed" in caplog.text and "compiled kernels ready" in caplog.text
