@@ -20,6 +20,13 @@ chart's window before uPlot has committed the new one, and the new chart opens z
 labels' chart opened on x 0..1 of 0..80 and showed y "-4,899.999" to "-4,899.996" for data from -4,900 to 2,100.
 A pinned range (``auto: false``, a ``range`` tuple) skips that effect; a new x extent sends new scales, which
 rebuild the chart on the new range. Drag-zoom still works and a double click returns to the whole range.
+
+Counts stay whole and small values stay readable. An x whose data are all whole numbers (iterations) gets whole
+tick steps (``incrs`` 1, 2, 5, 10, …), and a single point a range of one unit from it (0..1: ticks "0" and "1")
+instead of half a unit either side (fractional ticks, and a "0.5" cut at the canvas's edge). A log axis whose data
+reach below 10⁻³ (a clamped zero, say) would be labelled "0" by uPlot's three-decimal format; it gets its decades
+as fixed ``splits`` with their own labels ("1e-6", "0.001", "1"), at most :data:`LOG_TICKS_MAX` of them, on a range
+pinned to those decades (:func:`log_ticks`).
 """
 
 from __future__ import annotations
@@ -54,6 +61,12 @@ FAINT_TICKS = "rgba(0,0,0,0.07)"
 """uPlot's default tick colour (its grid's)."""
 X_TICKS_MAX = 16
 """An x axis has at most this many ticks (50 px apart over at most 800 px)."""
+WHOLE_INCRS = tuple(float(m * 10**k) for k in range(16) for m in (1, 2, 5))
+"""Tick steps of an axis of whole numbers: 1, 2, 5, 10, 20, 50, … (uPlot takes the first that leaves its spacing)."""
+LOG_TICKS_MAX = 6
+"""A log axis with labelled decades gets at most this many (30 px apart on the smallest chart's ~180 px plot)."""
+LOG_DECIMALS_MIN = -MAX_DECIMALS
+"""The smallest decade uPlot's own labels can write ("0.001"); below it they read "0"."""
 
 
 class AddUplot(Protocol):
@@ -106,14 +119,48 @@ def widest_linear_label(lo: float, hi: float, ticks_max: int, pad: float) -> str
     return sign + format_label(top, decimals)
 
 
-def widest_log_label(lo: float, hi: float) -> str:
-    """The widest tick label uPlot can write on a base-10 log axis over positive data ``lo``..``hi``.
+def decade_label(exponent: int) -> str:
+    """The label of 10^exponent: as uPlot writes it ("0.001", "1", "1,000"), or "1e-6" where uPlot would write "0"."""
+    if exponent < LOG_DECIMALS_MIN:
+        return f"1e{exponent}"
+    return format_label(10.0**exponent, max(0, -exponent))
 
-    uPlot widens a log range to whole decades and labels powers of ten and their multiples.
+
+def widest_log_label(lo: float, hi: float) -> str:
+    """The widest tick label a base-10 log axis over positive data ``lo``..``hi`` can show.
+
+    uPlot widens a log range to whole decades and labels powers of ten and their multiples; decades below 10⁻³ are
+    labelled by :func:`log_ticks` ("1e-6").
     """
     low, high = math.floor(math.log10(lo)), math.ceil(math.log10(hi))
-    labels = [format_label(10.0**e, max(0, -e)) for e in range(low, high + 1)]
+    labels = [decade_label(e) for e in range(low, high + 1)]
     return max(labels, key=label_px)
+
+
+def log_ticks(lo: float, hi: float) -> tuple[tuple[float, ...], tuple[str, ...]] | None:
+    """Fixed decade ticks (values, labels) for a log axis over positive data ``lo``..``hi``, or None where uPlot's
+    own labels read right (no decade below 10⁻³).
+
+    Every ``step``-th decade from the one at or below ``lo`` to the first at or above ``hi``, with ``step`` the
+    least that keeps them to :data:`LOG_TICKS_MAX`; the axis's range is pinned to the first and last.
+    """
+    low, high = math.floor(math.log10(lo)), math.ceil(math.log10(hi))
+    if low >= LOG_DECIMALS_MIN:
+        return None
+    high = max(high, low + 1)
+    step = max(1, math.ceil((high - low) / (LOG_TICKS_MAX - 1)))
+    exponents = range(low, low + step * math.ceil((high - low) / step) + 1, step)
+    return tuple(10.0**e for e in exponents), tuple(decade_label(e) for e in exponents)
+
+
+def whole_numbers(values: np.ndarray) -> bool:
+    """Whether the finite values of a 1-D array are all whole numbers (and there is at least one)."""
+    finite = values[np.isfinite(values)]
+    return (
+        bool(finite.size)
+        and bool(np.all(finite == np.round(finite)))
+        and bool(np.abs(finite).max() < 2**53)
+    )
 
 
 # --------------------------------------------------------------------------------------------- fitting
@@ -135,9 +182,10 @@ def fit_x_scale(
 ) -> dict[str, viser.uplot.Scale]:
     """``scales`` with the x scale pinned to the finite extent of ``data[0]`` (see the module's note).
 
-    A flat x (one value) is widened by half a unit or 1 % of its size, whichever is more. The x scale is left as
-    given when it has a range of its own, is ordinal, has no finite value (positive, on a log scale), or would be
-    widened past the largest float. Other scales are returned as they are.
+    A flat x (one value) is widened to the next whole number when it is one (0 → 0..1, an iteration count), else
+    by half a unit or 1 % of its size, whichever is more. The x scale is left as given when it has a range of its
+    own, is ordinal, has no finite value (positive, on a log scale), or would be widened past the largest float.
+    Other scales are returned as they are.
     """
     out = {key: viser.uplot.Scale(**scale) for key, scale in scales.items()}  # type: ignore[typeddict-item]
     x_scale = out.get("x", viser.uplot.Scale())
@@ -149,15 +197,41 @@ def fit_x_scale(
     if found is None:
         return out
     lo, hi = found
-    if hi <= lo:
+    if hi <= lo and x_scale.get("distr") == 3:
+        lo, hi = lo / 2.0, lo * 2.0
+    elif hi <= lo and lo == round(lo) and abs(lo) < 2**53:
+        hi = lo + 1.0
+    elif hi <= lo:
         half = max(0.5, 0.01 * abs(lo))
-        lo, hi = (lo / 2.0, lo * 2.0) if x_scale.get("distr") == 3 else (lo - half, hi + half)
+        lo, hi = lo - half, hi + half
     if not (math.isfinite(lo) and math.isfinite(hi)):  # widened past the largest float
         return out
     x_scale = viser.uplot.Scale(**x_scale)  # type: ignore[typeddict-item]
     x_scale["auto"] = False
     x_scale["range"] = (lo, hi)
     out["x"] = x_scale
+    return out
+
+
+def fit_scales(
+    data: Sequence[np.ndarray],
+    series: Sequence[Mapping[str, Any]],
+    scales: Mapping[str, Mapping[str, Any]],
+) -> dict[str, viser.uplot.Scale]:
+    """:func:`fit_x_scale`, and each log y scale whose data reach below 10⁻³ pinned to its decade ticks'
+    range (:func:`log_ticks`), so the fixed ticks :func:`fit_layout` gives its axis span the plot."""
+    out = fit_x_scale(data, scales)
+    y_scales = _series_scales(series)
+    for key, scale in out.items():
+        if key == "x" or scale.get("distr") != 3 or "range" in scales.get(key, {}):
+            continue
+        found = _range([d for d, s in zip(data[1:], y_scales, strict=True) if s == key], True)
+        ticks = log_ticks(*found) if found is not None else None
+        if ticks is not None:
+            pinned = viser.uplot.Scale(**scale)  # type: ignore[typeddict-item]
+            pinned["auto"] = False
+            pinned["range"] = (ticks[0][0], ticks[0][-1])
+            out[key] = pinned
     return out
 
 
@@ -203,17 +277,36 @@ def fit_layout(
             else [d for d, s in zip(data[1:], y_scales, strict=True) if s == key]
         )
         found = _range(values, log)
-        if found is not None and side in (1, 3):
-            widest = (
-                widest_log_label(*found) if log else widest_linear_label(*found, Y_TICKS_MAX, 0.1)
-            )
-            need = label_px(widest) + TICK_PX + GAP_PX + MARGIN_PX
-            out["size"] = max(AXIS_SIZE_PX, SIZE_STEP_PX * math.ceil(need / SIZE_STEP_PX))
-        elif found is not None:
-            widest = (
-                widest_log_label(*found) if log else widest_linear_label(*found, X_TICKS_MAX, 0.0)
-            )
-            x_label_px = max(x_label_px, label_px(widest))
+        whole = (
+            not log
+            and bool(values)
+            and all(whole_numbers(np.asarray(v, dtype=np.float64)) for v in values)
+        )
+        if whole and "incrs" not in axis and "splits" not in axis:
+            out["incrs"] = WHOLE_INCRS
+        ticks = log_ticks(*found) if log and found is not None else None
+        if ticks is not None and "splits" not in axis and "values" not in axis:
+            out["splits"], out["values"] = ticks
+        if found is not None:
+            vertical_axis = side in (1, 3)
+            if ticks is not None and "values" not in axis:
+                widest = max(ticks[1], key=label_px)
+            elif log:
+                widest = widest_log_label(*found)
+            elif (
+                whole and not vertical_axis
+            ):  # whole ticks over the pinned range, a unit past one point
+                widest = ("-" if found[0] < 0.0 else "") + format_label(
+                    max(abs(found[0]), abs(found[1]) + 1.0), 0
+                )
+            else:
+                ticks_max, pad = (Y_TICKS_MAX, 0.1) if vertical_axis else (X_TICKS_MAX, 0.0)
+                widest = widest_linear_label(*found, ticks_max, pad)
+            if vertical_axis:
+                need = label_px(widest) + TICK_PX + GAP_PX + MARGIN_PX
+                out["size"] = max(AXIS_SIZE_PX, SIZE_STEP_PX * math.ceil(need / SIZE_STEP_PX))
+            else:
+                x_label_px = max(x_label_px, label_px(widest))
         fitted.append(out)
     vertical = bool(sides & {1, 3})
     horizontal = bool(sides & {0, 2})
@@ -228,7 +321,7 @@ def fit_layout(
 
 
 class FittedChart:
-    """A uPlot chart in the GUI whose axes and x range are refitted (:func:`fit_layout`, :func:`fit_x_scale`)
+    """A uPlot chart in the GUI whose axes and ranges are refitted (:func:`fit_layout`, :func:`fit_scales`)
     whenever its data are set."""
 
     def __init__(
@@ -248,7 +341,7 @@ class FittedChart:
         self.handle = gui.add_uplot(
             data=data,
             series=series,
-            scales=fit_x_scale(data, scales),
+            scales=fit_scales(data, series, scales),
             axes=fitted,
             padding=padding,
             **kwargs,
@@ -263,7 +356,7 @@ class FittedChart:
     @data.setter
     def data(self, data: tuple[np.ndarray, ...]) -> None:
         fitted, padding = fit_layout(data, self._series, self._scales, self._axes)
-        pinned = fit_x_scale(data, self._scales)
+        pinned = fit_scales(data, self._series, self._scales)
         if pinned != self.handle.scales:
             self.handle.scales = pinned
         if fitted != self.handle.axes:
