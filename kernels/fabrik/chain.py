@@ -72,8 +72,9 @@ _EXTRAPOLATION_MIN_RATIO = 0.5
 """Error ratio per iteration below which FABRIK iterates are left as they are."""
 _DLS_DAMPING = 0.1
 """Damping of the DLS step, times the mean link length (Buss 2004 suggests λ of the order of the link size)."""
-_POLISH_STARTS = 4
-"""Starts of the polish of a FABRIK chain under hinges that stalls or creeps: the best pose, then admissible poses."""
+_POLISH_STARTS = 5
+"""Starts of the polish of a FABRIK chain under hinges that stalls or creeps: the best pose, then two mirrored pairs
+of admissible poses."""
 _POLISH_STEPS = 50
 """Most damped-least-squares steps of the polish from each start (not ``max_iterations``: a longer run must repeat
 a shorter one's polish)."""
@@ -423,11 +424,16 @@ def _admissible_start(
 ) -> None:  # fmt: skip
     """Rebuild ``p`` from its root as the ``start``-th admissible pose: every joint at an angle inside its limit
     (:func:`~kernels.fabrik.limits._inside_limit`), the fractions taken from additive recurrences over the start
-    and the joint, kept off a range's ends (a one-sided range's end is often a fixed point)."""
+    and the joint, kept off a range's ends (a one-sided range's end is often a fixed point). Starts come in
+    mirrored pairs (fractions u and 1 − u: each joint's angle reflected within its range), so a chain and its
+    mirror image try the same poses, mirrored."""
+    pair = (start + 1) // 2
     qx, qy, qz = rest[0], rest[1], rest[2]
     for i in range(lengths.shape[0]):
-        u = 0.1 + 0.8 * ((0.5 + start * _GOLDEN[0] + i * _GOLDEN[1]) % 1.0)
-        v = (start * _GOLDEN[2] + i * _GOLDEN[1]) % 1.0
+        u = 0.1 + 0.8 * ((0.5 + pair * _GOLDEN[0] + i * _GOLDEN[1]) % 1.0)
+        if start % 2 == 0:
+            u = 1.0 - u
+        v = (pair * _GOLDEN[2] + i * _GOLDEN[1]) % 1.0
         dx, dy, dz = _inside_limit(qx, qy, qz, table, i, rest, u, v, dim)
         length = lengths[i]
         p[i + 1, 0], p[i + 1, 1], p[i + 1, 2] = (
