@@ -1,0 +1,87 @@
+"""numba's disk cache, kept in step with the source of every kernel.
+
+numba keys a compiled function's cached machine code on its own file's modification time and size only. A compiled
+function that calls one in another module (the FABRIK chain core calls the joint rules in ``fabrik/limits.py``; the
+course's ride loop calls ``cycling``'s power law) would keep running the old callee after that module changed, until
+its own file changed too. So the kernels keep one stamp beside the cache: a hash of every kernel source file. When it
+differs from the sources on disk, every cached kernel is dropped and compiles afresh on its next use (once).
+
+Where the cache lives: numba writes it in ``__pycache__`` beside each module, or under ``NUMBA_CACHE_DIR`` when that
+is set (mirroring the source path). Both are kept in step here. Where neither is writable numba falls back to a
+user-wide directory; a stale entry there is not seen here (it only arises when an installed, read-only copy of the
+package is upgraded in place without its files' times changing).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import logging
+import os
+from pathlib import Path
+
+logger = logging.getLogger(__name__)
+
+STAMP_NAME = "numba-sources.sha256"
+"""The stamp's file name, in the kernels' own ``__pycache__``."""
+
+_CACHE_SUFFIXES = (".nbi", ".nbc")
+
+
+def source_hash(root: Path) -> str:
+    """SHA-256 over the relative path and bytes of every ``.py`` file below ``root``, in sorted order."""
+    digest = hashlib.sha256()
+    for path in sorted(root.rglob("*.py")):
+        if "__pycache__" in path.parts:
+            continue
+        digest.update(path.relative_to(root).as_posix().encode())
+        digest.update(b"\0")
+        digest.update(path.read_bytes())
+        digest.update(b"\0")
+    return digest.hexdigest()
+
+
+def cache_dirs(root: Path) -> list[Path]:
+    """Every directory numba may keep a cache of ``root``'s modules in: each ``__pycache__`` below it and, with
+    ``NUMBA_CACHE_DIR`` set, the mirrored tree there."""
+    dirs = [path for path in root.rglob("__pycache__") if path.is_dir()]
+    user_dir = os.environ.get("NUMBA_CACHE_DIR")
+    if user_dir:
+        mirrored = Path(user_dir) / root.resolve().relative_to(root.resolve().anchor)
+        if mirrored.is_dir():
+            dirs.extend(path for path in [mirrored, *mirrored.rglob("*")] if path.is_dir())
+    return dirs
+
+
+def drop_stale_cache(root: Path) -> bool:
+    """Drop numba's cached kernels below ``root`` when any source changed since they were cached; True if it did.
+
+    The stamp is written to ``root/__pycache__``; where that cannot be written nothing is dropped or stamped (numba
+    then caches elsewhere or not at all, see the module docstring).
+    """
+    stamp = root / "__pycache__" / STAMP_NAME
+    current = source_hash(root)
+    try:
+        if stamp.read_text().strip() == current:
+            return False
+    except OSError:
+        pass  # no stamp yet: whatever is cached may predate it
+    dropped = 0
+    for directory in cache_dirs(root):
+        for path in directory.iterdir():
+            if path.suffix in _CACHE_SUFFIXES:
+                try:
+                    path.unlink()
+                    dropped += 1
+                except OSError:
+                    pass  # another process removed it first, or the directory is read-only
+    try:
+        stamp.parent.mkdir(exist_ok=True)
+        stamp.write_text(current + "\n")
+    except OSError:
+        return False
+    if dropped:
+        logger.info(
+            "kernel sources changed: dropped %d cached numba files; they compile again on first use",
+            dropped,
+        )
+    return dropped > 0

@@ -1,0 +1,68 @@
+"""numba's cache follows every kernel source: a change in any module drops every cached kernel, once."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from kernels import _jit_cache
+
+
+def _package(root: Path) -> tuple[Path, Path]:
+    (root / "pkg" / "__pycache__").mkdir(parents=True)
+    (root / "pkg" / "core.py").write_text("def f():\n    return 1\n")
+    (root / "pkg" / "rules.py").write_text("def g():\n    return 2\n")
+    cached = root / "pkg" / "__pycache__" / "core.f-1.py311.nbi"
+    return root / "pkg" / "rules.py", cached
+
+
+def _cache(cached: Path) -> None:
+    cached.write_bytes(b"index")
+    cached.with_suffix(".nbc").write_bytes(b"code")
+
+
+def test_a_changed_callee_module_drops_the_callers_cache(tmp_path: Path) -> None:
+    rules, cached = _package(tmp_path)
+    _jit_cache.drop_stale_cache(tmp_path)  # first stamp
+    _cache(cached)
+    assert not _jit_cache.drop_stale_cache(tmp_path)  # nothing changed: the cache stays
+    assert cached.exists()
+    rules.write_text("def g():\n    return 3\n")  # only the callee's module changes
+    assert _jit_cache.drop_stale_cache(tmp_path)
+    assert not cached.exists() and not cached.with_suffix(".nbc").exists()
+    _cache(cached)  # compiled again from the new sources
+    assert not _jit_cache.drop_stale_cache(tmp_path)
+    assert cached.exists()
+
+
+def test_without_a_stamp_whatever_is_cached_is_dropped(tmp_path: Path) -> None:
+    _, cached = _package(tmp_path)
+    _cache(cached)
+    assert _jit_cache.drop_stale_cache(tmp_path)
+    assert not cached.exists()
+    assert (
+        tmp_path / "__pycache__" / _jit_cache.STAMP_NAME
+    ).read_text().strip() == _jit_cache.source_hash(tmp_path)
+
+
+def test_a_cache_under_numba_cache_dir_is_kept_in_step(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    source = tmp_path / "src"
+    rules, _ = _package(source)
+    user = tmp_path / "user-cache"
+    mirrored = user / source.resolve().relative_to(source.resolve().anchor) / "pkg"
+    mirrored.mkdir(parents=True)
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(user))
+    _jit_cache.drop_stale_cache(source)
+    _cache(mirrored / "core.f-1.py311.nbi")
+    rules.write_text("def g():\n    return 4\n")
+    assert _jit_cache.drop_stale_cache(source)
+    assert not (mirrored / "core.f-1.py311.nbi").exists()
+
+
+def test_the_real_kernels_are_stamped_with_their_sources() -> None:
+    root = Path(_jit_cache.__file__).parent
+    stamp = root / "__pycache__" / _jit_cache.STAMP_NAME
+    assert stamp.read_text().strip() == _jit_cache.source_hash(root)
