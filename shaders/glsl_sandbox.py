@@ -217,11 +217,7 @@ def function_headers(tokens: list[Token]) -> list[FunctionHeader]:
         if depth or token.text != "(" or i < 2:
             continue
         kind, name = tokens[i - 2], tokens[i - 1]
-        if (
-            not (kind.is_name and name.is_name)
-            or kind.text in _NOT_TYPES
-            or kind.text in _QUALIFIERS
-        ):
+        if not (kind.is_name and name.is_name) or kind.text in _NOT_TYPES or kind.text in _QUALIFIERS:
             continue
         j, parens = i + 1, 1
         while j < len(tokens) and parens and tokens[j].text not in ("{", "}", ";"):
@@ -229,11 +225,7 @@ def function_headers(tokens: list[Token]) -> list[FunctionHeader]:
             j += 1
         if parens or j >= len(tokens) or tokens[j].text not in ("{", ";"):
             continue
-        out.append(
-            FunctionHeader(
-                kind.text, name, _split_parameters(tokens[i + 1 : j - 1]), tokens[j].text == "{"
-            )
-        )
+        out.append(FunctionHeader(kind.text, name, _split_parameters(tokens[i + 1 : j - 1]), tokens[j].text == "{"))
     return out
 
 
@@ -290,9 +282,7 @@ def brace_problem(tokens: list[Token], source: str) -> ShaderCompileError | None
         elif token.text == "}":
             if not opened:
                 extra = stray or token
-                return ShaderCompileError(
-                    "'}' closes no '{' (one '}' too many, or a '{' missing)", extra.line
-                )
+                return ShaderCompileError("'}' closes no '{' (one '}' too many, or a '{' missing)", extra.line)
             if first_on_line[token.line] is token:
                 indent = _indent(lines[token.line - 1])
                 same = [k for k, t in enumerate(opened) if _indent(lines[t.line - 1]) == indent]
@@ -305,18 +295,14 @@ def brace_problem(tokens: list[Token], source: str) -> ShaderCompileError | None
         return None
     if unclosed is not None:
         brace, closer = unclosed
-        return ShaderCompileError(
-            f"'{{' is never closed: a '}}' is missing before line {closer.line}", brace.line
-        )
+        return ShaderCompileError(f"'{{' is never closed: a '}}' is missing before line {closer.line}", brace.line)
     return ShaderCompileError("'{' is never closed: a '}' is missing at the end", opened[-1].line)
 
 
 # ------------------------------------------------------------------------------------------ compiler messages
 APPENDED_FIRST_LINE = 100001
 """The line number the code :func:`user_glsl` appends after a source starts at (past any source's last line)."""
-_LOG_ERROR = re.compile(
-    r"^\s*\d+[:(](\d+)\)?(?:\((\d+)\))?\s*:\s*error\s*:?\s*(?:[A-Z]\d{4}\s*:\s*)?(.+)$", re.M
-)
+_LOG_ERROR = re.compile(r"^\s*\d+[:(](\d+)\)?(?:\((\d+)\))?\s*:\s*error\s*:?\s*(?:[A-Z]\d{4}\s*:\s*)?(.+)$", re.M)
 _OPERATORS = {
     "ADD_ASSIGN": "+=",
     "SUB_ASSIGN": "-=",
@@ -356,9 +342,7 @@ _KINDS: dict[str, tuple[str, str]] = {
     "end of file": ("end", "the end of the text"),
 }
 """Mesa's (bison's) token names: which kind of token of the source each stands for, and in words."""
-_TYPE_WORDS = re.compile(
-    r"(?:[biud]?vec[234]|d?mat[234](?:x[234])?|float|double|u?int|bool|void|sampler\w*)$"
-)
+_TYPE_WORDS = re.compile(r"(?:[biud]?vec[234]|d?mat[234](?:x[234])?|float|double|u?int|bool|void|sampler\w*)$")
 _TOKEN_NAME = re.compile(r"\$end|end of file|\b(?:[A-Z][A-Z0-9]*_)*[A-Z][A-Z0-9]*(?:_[A-Z0-9]+)*\b")
 _SYNTAX = re.compile(r"^syntax error, unexpected (.+?)(?:, expecting (.+?))?(?: at token .*)?$")
 
@@ -399,9 +383,7 @@ def _plain_words(text: str) -> str:
     return _TOKEN_NAME.sub(words, text)
 
 
-def plain_compiler_message(
-    message: str, tokens: list[Token], line: int | None, column: int | None
-) -> str:
+def plain_compiler_message(message: str, tokens: list[Token], line: int | None, column: int | None) -> str:
     """A compiler's error ``message`` about ``line`` (column ``column``, if given) of the tokenized source, in words
     a person reads: a bison syntax error names the token the source has there ("missing ';' before 'float'?")
     instead of the parser's name for it (``BASIC_TYPE_TOK``), and says which line ends without the ``;`` when the
@@ -411,9 +393,7 @@ def plain_compiler_message(
     if syntax is None:
         return _plain_words(message)
     kind, words = _kind_words(syntax.group(1).strip())
-    expected = [
-        _kind_words(e.strip())[1] for e in re.split(r"\s+or\s+", syntax.group(2) or "") if e.strip()
-    ]
+    expected = [_kind_words(e.strip())[1] for e in re.split(r"\s+or\s+", syntax.group(2) or "") if e.strip()]
     wanted = " or ".join(expected)
     if line is None or kind == "end":
         last = tokens[-1].text if tokens else ""
@@ -462,10 +442,7 @@ class ShaderCompileError(ValueError):
                 last = tokens[-1]
                 return cls(plain_compiler_message(message, tokens, None, None), last.line)
             return cls(plain_compiler_message(message, tokens, None, None), None)
-        text = (
-            " ".join(log.replace("GLSL Compiler failed", "").split())
-            or "the shader did not compile"
-        )
+        text = " ".join(log.replace("GLSL Compiler failed", "").split()) or "the shader did not compile"
         return cls(_plain_words(text), None)
 
 
@@ -485,9 +462,7 @@ def check_source(source: object) -> str:
     if not isinstance(source, str):
         raise ShaderCompileError("the source must be text", None)
     if len(source) > MAX_SOURCE_CHARS:
-        raise ShaderCompileError(
-            f"the source is {len(source)} characters; the limit is {MAX_SOURCE_CHARS}", None
-        )
+        raise ShaderCompileError(f"the source is {len(source)} characters; the limit is {MAX_SOURCE_CHARS}", None)
     # Check the text the compiler will see. A backslash before a newline splices two lines into one (so
     # "fo\<newline>r" is the word for) and Mesa ends a // comment at a lone carriage return (so a loop after one is
     # code): neither has a use in sdf() text, so both are refused outright, and every line below is a line the
@@ -495,13 +470,9 @@ def check_source(source: object) -> str:
     for number, line in enumerate(source.split("\n"), start=1):
         bad = next((c for c in line if not (" " <= c <= "~" or c == "\t")), None)
         if bad == "\r":
-            raise ShaderCompileError(
-                "carriage returns are not allowed (end lines with a plain newline)", number
-            )
+            raise ShaderCompileError("carriage returns are not allowed (end lines with a plain newline)", number)
         if bad is not None:
-            raise ShaderCompileError(
-                f"character {bad!r} is not allowed (printable ASCII only)", number
-            )
+            raise ShaderCompileError(f"character {bad!r} is not allowed (printable ASCII only)", number)
         if "\\" in line:
             raise ShaderCompileError(
                 "backslashes are not allowed (a backslash at a line's end joins it to the next)",
@@ -559,9 +530,7 @@ def check_field_bounds(bounds: ArrayLike) -> NDArray[np.float64]:
     """An editor field's (2, 3) min and max corners (m) as float64, within ±1000 m, else ``ValueError``."""
     box = np.asarray(bounds, dtype=np.float64)
     if box.shape != (2, 3) or not np.all(np.isfinite(box)) or np.any(box[1] <= box[0]):
-        raise ValueError(
-            f"bounds must be finite (2, 3) min and max corners with max > min, got {box.tolist()}"
-        )
+        raise ValueError(f"bounds must be finite (2, 3) min and max corners with max > min, got {box.tolist()}")
     if np.any(np.abs(box) > 1e3):
         raise ValueError("bounds must lie within ±1000 m")
     return box

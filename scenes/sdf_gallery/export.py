@@ -51,22 +51,16 @@ def download(
     match fmt:
         case "png":
             if reference is None or reference.size == 0:
-                return Download(
-                    "sdf_reference.png", None, "The reference image has not been rendered."
-                )
+                return Download("sdf_reference.png", None, "The reference image has not been rendered.")
             return Download("sdf_reference.png", png_bytes(reference))
         case "glb" | "stl" | "obj":
             name = f"sdf_mesh.{fmt}"
             if len(faces) == 0:
-                return Download(
-                    name, None, "The shape is empty (0 triangles): there is no surface to export."
-                )
+                return Download(name, None, "The shape is empty (0 triangles): there is no surface to export.")
             return Download(name, mesh_file(fmt, vertices, faces, colors))
 
 
-def mesh_file(
-    fmt: MeshFormat, vertices: np.ndarray, faces: np.ndarray, colors: np.ndarray
-) -> bytes:
+def mesh_file(fmt: MeshFormat, vertices: np.ndarray, faces: np.ndarray, colors: np.ndarray) -> bytes:
     """The mesh as a file of format ``fmt``, with its colours where the format has them; ValueError for a mesh of
     no triangles (its files would be broken: an OBJ of bare ``v``/``f`` lines, a GLB node with no mesh)."""
     if len(faces) == 0:
@@ -93,9 +87,7 @@ def scene_normals(scene: sdf.Scene, vertices: np.ndarray) -> np.ndarray:
     return gradient / np.maximum(np.linalg.norm(gradient, axis=1, keepdims=True), 1e-12)
 
 
-def viewer_glb(
-    vertices: np.ndarray, faces: np.ndarray, colors: np.ndarray, normals: np.ndarray
-) -> bytes:
+def viewer_glb(vertices: np.ndarray, faces: np.ndarray, colors: np.ndarray, normals: np.ndarray) -> bytes:
     """A minimal GLB for the 3D view: positions, smooth normals and 8-bit vertex colours, written directly.
 
     Normals are the field's gradient (exact directions where the SDF is, no averaging of faces). Colours are made

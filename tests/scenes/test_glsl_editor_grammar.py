@@ -39,9 +39,7 @@ MESA_TOKEN_NAME = re.compile(
     r"|\b(?:IDENTIFIER|FLOATCONSTANT|INTCONSTANT|UINTCONSTANT|BOOLCONSTANT|STRUCT|IF|ELSE|RETURN)\b"
 )
 """Words of Mesa's parser (BASIC_TYPE_TOK, NEW_IDENTIFIER, FLOATCONSTANT, $end, …) that a message must not show."""
-POINTS = np.array(
-    [[0.0, 0.0, 0.0], [0.7, 0.0, 0.05], [0.3, -0.4, 0.2], [-0.9, 0.5, -0.3], [0.1, 0.65, 0.0]]
-)
+POINTS = np.array([[0.0, 0.0, 0.0], [0.7, 0.0, 0.05], [0.3, -0.4, 0.2], [-0.9, 0.5, -0.3], [0.1, 0.65, 0.0]])
 
 
 @pytest.fixture(autouse=True)
@@ -172,9 +170,7 @@ def test_a_const_in_signature_ray_marches_as_the_plain_form() -> None:
     shading = Shading(shadows=False, occlusion=False)
 
     def depth(source: str) -> np.ndarray:
-        return gl_service.run(lambda gl: gl.render_field(source, BOUNDS, camera, 64, 40, shading))[
-            1
-        ]
+        return gl_service.run(lambda gl: gl.render_field(source, BOUNDS, camera, 64, 40, shading))[1]
 
     plain, quilez = depth(PLAIN_SDF), depth(QUILEZ_STYLE[1])
     assert np.isfinite(plain).sum() > 300
@@ -206,9 +202,7 @@ def test_a_missing_semicolon_says_so_in_words() -> None:
     )
     with pytest.raises(ShaderCompileError) as info:
         gl_service.run(lambda gl: gl.compile_field(source))
-    assert str(info.value) == (
-        "line 4: syntax error, missing ';' before 'float'? (line 3 ends without one)"
-    )
+    assert str(info.value) == ("line 4: syntax error, missing ';' before 'float'? (line 3 ends without one)")
 
 
 @pytest.mark.parametrize(
@@ -251,9 +245,7 @@ def test_a_missing_semicolon_says_so_in_words() -> None:
         ),
     ],
 )
-def test_compiler_logs_read_in_words_on_the_persons_line(
-    log: str, source: str, message: str
-) -> None:
+def test_compiler_logs_read_in_words_on_the_persons_line(log: str, source: str, message: str) -> None:
     error = ShaderCompileError.from_compiler(log, source)
     assert str(error) == message
     assert not MESA_TOKEN_NAME.search(str(error))
@@ -305,9 +297,7 @@ def _assert_names_the_line(error: ShaderCompileError, line: int) -> None:
     text = str(error)
     assert re.search(rf"\bline {line}\b", text), text
     assert not MESA_TOKEN_NAME.search(text), text
-    assert (
-        error.line is not None and abs(error.line - line) <= 3
-    )  # the compiler's line, or the one after
+    assert error.line is not None and abs(error.line - line) <= 3  # the compiler's line, or the one after
 
 
 @given(programs())
@@ -316,9 +306,7 @@ def test_the_generated_programs_are_valid(program: tuple[list[str], list[int]]) 
 
 
 @given(programs(), st.integers(0, 10), st.sampled_from(sorted(BRACE_ERRORS)))
-def test_a_brace_error_names_its_line(
-    program: tuple[list[str], list[int]], choice: int, kind: str
-) -> None:
+def test_a_brace_error_names_its_line(program: tuple[list[str], list[int]], choice: int, kind: str) -> None:
     source, line = _inject(program, choice, kind)
     with pytest.raises(ShaderCompileError) as info:
         check_source(source)
@@ -329,9 +317,7 @@ def test_a_brace_error_names_its_line(
 @pytest.mark.gl
 @settings(max_examples=60, suppress_health_check=[HealthCheck.too_slow])
 @given(programs(), st.integers(0, 10), st.sampled_from(sorted(COMPILE_ERRORS)))
-def test_a_compile_error_names_its_line_in_words(
-    program: tuple[list[str], list[int]], choice: int, kind: str
-) -> None:
+def test_a_compile_error_names_its_line_in_words(program: tuple[list[str], list[int]], choice: int, kind: str) -> None:
     source, line = _inject(program, choice, kind)
     check_source(source)  # the checks pass: the compiler finds it
     with pytest.raises(ShaderCompileError) as info:

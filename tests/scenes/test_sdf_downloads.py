@@ -52,8 +52,7 @@ def press(client: BrowserClient, label: str) -> tuple[str, str, Any]:
                 parts = [
                     p
                     for _, p in client.received
-                    if p.get("type") == "FileTransferPart"
-                    and p["transfer_uuid"] == m["transfer_uuid"]
+                    if p.get("type") == "FileTransferPart" and p["transfer_uuid"] == m["transfer_uuid"]
                 ]
                 if len(parts) == m["part_count"]:
                     answer["file"] = (m, parts)
@@ -153,9 +152,7 @@ def scenes(draw: st.DrawFn) -> sdf.Scene:
 
 @settings(max_examples=30, deadline=None)
 @given(scenes(), st.sampled_from(MESH_FORMATS))
-def test_every_mesh_download_is_a_file_with_its_triangles_or_nothing(
-    scene: sdf.Scene, fmt: MeshFormat
-) -> None:
+def test_every_mesh_download_is_a_file_with_its_triangles_or_nothing(scene: sdf.Scene, fmt: MeshFormat) -> None:
     vertices, faces, colors = sdf.mesh(scene, 24)
     answer = download(fmt, vertices, faces, colors, None)
     assert answer.name == f"sdf_mesh.{fmt}"
