@@ -5,7 +5,6 @@ Under CI=true nothing is skipped: a missing Chromium or GL context fails the run
 
 from __future__ import annotations
 
-import os
 import shutil
 import tempfile
 from collections.abc import Iterator
@@ -13,7 +12,7 @@ from pathlib import Path
 
 import pytest
 import viser
-from helpers.ci import IN_CI, fresh_renderer, skip_or_fail
+from helpers.ci import CHROMIUM, CHROMIUM_ARGS, fresh_renderer, skip_or_fail
 from helpers.scenes import MakeScene, S
 from hypothesis import settings
 
@@ -24,20 +23,11 @@ from server.sessions import Sessions
 from server.switcher import SceneSwitcher
 from shaders.renderer import Renderer
 
-# CI must not be flaky: under CI=true hypothesis draws the same examples on every run (locally it explores anew).
-settings.register_profile("ci", derandomize=True, deadline=None, print_blob=True)
-if IN_CI:
-    settings.load_profile("ci")
-CHROMIUM = os.environ.get("CHROMIUM", "/usr/bin/chromium")
-CHROMIUM_ARGS = [
-    "--no-sandbox",
-    "--disable-quic",
-    "--no-first-run",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-    "--enable-unsafe-swiftshader",
-]
+# The README's test command must pass for anyone, every run: hypothesis draws the same examples in and out of CI.
+# Explore with fresh ones before calling a change done: pytest --hypothesis-profile=explore --hypothesis-seed=random
+settings.register_profile("deterministic", derandomize=True, deadline=None, print_blob=True)
+settings.register_profile("explore", derandomize=False, deadline=None, print_blob=True)
+settings.load_profile("deterministic")  # --hypothesis-profile, read after this file, overrides it
 
 
 @pytest.fixture

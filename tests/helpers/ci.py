@@ -15,6 +15,18 @@ from shaders.renderer import GLUnavailableError, Renderer
 IN_CI = os.environ.get("CI", "").lower() in ("1", "true", "yes")
 """Whether this run is CI's: then nothing may be skipped for want of a capability."""
 
+CHROMIUM = os.environ.get("CHROMIUM", "/usr/bin/chromium")
+"""Debian's Chromium, which the browser tests drive (never a browser a test tool downloads)."""
+CHROMIUM_ARGS = [
+    "--no-sandbox",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--enable-unsafe-swiftshader",
+]
+
 
 def skip_or_fail(reason: str) -> NoReturn:
     """Skip outside CI; under CI=true a missing capability is a failure, never a silent skip."""
