@@ -95,9 +95,7 @@ def warm_kernels(modules: tuple[ModuleType, ...] = (fabrik, ball, course)) -> th
     return thread
 
 
-def serve_scenes(
-    server: viser.ViserServer, scene: SceneName, *, shared: bool
-) -> SceneSwitcher | Sessions:
+def serve_scenes(server: viser.ViserServer, scene: SceneName, *, shared: bool) -> SceneSwitcher | Sessions:
     """Put the scenes on ``server``: one switcher for every tab (``shared``), or one per tab, built as it connects."""
     limit_malloc_arenas()
     install_gate(server)
@@ -170,9 +168,7 @@ def main(
     warning = exposure_warning(host, asked, allow_remote_glsl=allow_remote_glsl)
     if warning is not None:
         print(warning, flush=True)
-    if port is not None and not port_is_free(
-        host, port
-    ):  # refuse before viser prints a URL it will not serve
+    if port is not None and not port_is_free(host, port):  # refuse before viser prints a URL it will not serve
         print(port_message(port, port + 1, explicit=True), file=sys.stderr, flush=True)
         raise SystemExit(2)
     warm_kernels()

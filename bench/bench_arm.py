@@ -137,15 +137,10 @@ def paper_setup(runs: int, seed: int, baseline_runs: int) -> dict[str, float]:
             joints, t, tolerance=tolerance, max_iterations=5000, extrapolate=False
         ),
         "ccd": lambda t: fabrik.ccd(joints, t, tolerance=tolerance, max_iterations=5000),
-        "jacobian_dls": lambda t: fabrik.jacobian_dls(
-            joints, t, tolerance=tolerance, max_iterations=5000
-        ),
+        "jacobian_dls": lambda t: fabrik.jacobian_dls(joints, t, tolerance=tolerance, max_iterations=5000),
     }
     base_s = np.mean(
-        [
-            fastest(lambda t=t: baseline_solve(joints, t, tolerance, 5000))[0]
-            for t in targets[:baseline_runs]
-        ]
+        [fastest(lambda t=t: baseline_solve(joints, t, tolerance, 5000))[0] for t in targets[:baseline_runs]]
     )
     rows = {}
     for name, solver in solvers.items():
@@ -157,13 +152,9 @@ def paper_setup(runs: int, seed: int, baseline_runs: int) -> dict[str, float]:
             iterations.append(result.iterations)
             reached += result.status == "reached"
         rows[name] = (np.mean(iterations), np.mean(times) * 1e6, np.median(times) * 1e6, reached)
+    print(f"\n## Paper setup: 10 links of 1 m, 3D, {runs} reachable random targets, tolerance {tolerance} m ({load()})")
     print(
-        f"\n## Paper setup: 10 links of 1 m, 3D, {runs} reachable random targets, tolerance {tolerance} m "
-        f"({load()})"
-    )
-    print(
-        "| solver | mean iterations | mean µs/solve | median µs | reached | × baseline | paper iterations "
-        "| paper ms |"
+        "| solver | mean iterations | mean µs/solve | median µs | reached | × baseline | paper iterations | paper ms |"
     )
     print("|---|---:|---:|---:|---:|---:|---:|---:|")
     for name, (its, mean_us, median_us, reached) in rows.items():
@@ -172,9 +163,7 @@ def paper_setup(runs: int, seed: int, baseline_runs: int) -> dict[str, float]:
             f"| {name} | {its:.1f} | {mean_us:.1f} | {median_us:.1f} | {reached}/{runs} | "
             f"{base_s * 1e6 / mean_us:.0f}× | {paper_its:g} | {paper_ms:g} |"
         )
-    print(
-        f"| baseline: plain numpy FABRIK ({baseline_runs} targets) | | {base_s * 1e6:.0f} | | | 1× | | |"
-    )
+    print(f"| baseline: plain numpy FABRIK ({baseline_runs} targets) | | {base_s * 1e6:.0f} | | | 1× | | |")
     return {"paper_mean_us": rows["fabrik"][1], "paper_ratio": base_s * 1e6 / rows["fabrik"][1]}
 
 
@@ -191,9 +180,7 @@ def drag_latency(frames: int, baseline_frames: int) -> dict[str, float]:
         pose = arc_chain(12, 0.1)
         times, iterations, statuses = [], [], []
         for target in drag_targets(frames):
-            elapsed, result = fastest(
-                lambda target=target, pose=pose, extra=extra: fabrik.solve(pose, target, **extra)
-            )
+            elapsed, result = fastest(lambda target=target, pose=pose, extra=extra: fabrik.solve(pose, target, **extra))
             assert isinstance(result, fabrik.Solution)
             pose = result.joints
             times.append(elapsed)
@@ -210,9 +197,7 @@ def drag_latency(frames: int, baseline_frames: int) -> dict[str, float]:
     # The baseline follows the same drag with the same limits (it knows no obstacles).
     pose, times = arc_chain(12, 0.1), []
     for target in drag_targets(frames)[:baseline_frames]:
-        elapsed, pose = fastest(
-            lambda target=target, pose=pose: baseline_solve(pose, target, 1e-3, 50, LIMITS)
-        )
+        elapsed, pose = fastest(lambda target=target, pose=pose: baseline_solve(pose, target, 1e-3, 50, LIMITS))
         times.append(elapsed)
     us = np.array(times) * 1e6
     print(
@@ -238,8 +223,10 @@ def batch_throughput(batch: int, baseline_chains: int, seed: int) -> dict[str, f
     )
     print("|---|---:|---:|---:|---:|---:|---|---:|---:|")
     figures = {}
-    cases = {"no limits": ({}, None), "30° limits + 4 obstacles": ({"cone_half_angle_rad": LIMITS,
-                                                                 "obstacles": OBSTACLES}, LIMITS)}  # fmt: skip
+    cases = {
+        "no limits": ({}, None),
+        "30° limits + 4 obstacles": ({"cone_half_angle_rad": LIMITS, "obstacles": OBSTACLES}, LIMITS),
+    }
     for label, (kwargs, phi) in cases.items():
         best, cpu, result = math.inf, math.nan, None
         for _ in range(REPEATS):
@@ -309,29 +296,38 @@ def skeletons(frames: int) -> dict[str, float]:
     phase = np.linspace(0.0, 2 * math.pi, frames)
     # Every fingertip target moves every frame: each finger curls and opens on a cycle of its own.
     curls = [hand(target_curl_rad=0.2 + 0.4 * (1 + math.sin(t))).targets for t in phase]
-    finger_phase = [
-        hand(target_curl_rad=0.2 + 0.4 * (1 + math.cos(1.7 * t))).targets for t in phase
-    ]
+    finger_phase = [hand(target_curl_rad=0.2 + 0.4 * (1 + math.cos(1.7 * t))).targets for t in phase]
     tree = tree_30()
     cases = {
         "hand: 5 fingers × 3 hinges (+ welded palm), all 5 targets moving": (
-            list(rest.parents), rest.joints, list(rest.constraints), list(rest.effectors),
+            list(rest.parents),
+            rest.joints,
+            list(rest.constraints),
+            list(rest.effectors),
             [np.where(np.arange(5)[:, None] % 2 == 0, a, b) for a, b in zip(curls, finger_phase, strict=True)],
         ),
         "30-joint tree, 5 effectors, 60° cones, all 5 targets moving": (
-            tree[0], tree[1], tree[2], [9, 14, 19, 24, 29],
-            [tree[1][[9, 14, 19, 24, 29]] + 0.15 * np.stack(
-                [np.sin(t + np.arange(5)), np.cos(1.3 * t + np.arange(5)), np.full(5, -abs(math.sin(t)))],
-                axis=1) for t in phase],
+            tree[0],
+            tree[1],
+            tree[2],
+            [9, 14, 19, 24, 29],
+            [
+                tree[1][[9, 14, 19, 24, 29]]
+                + 0.15
+                * np.stack(
+                    [np.sin(t + np.arange(5)), np.cos(1.3 * t + np.arange(5)), np.full(5, -abs(math.sin(t)))], axis=1
+                )
+                for t in phase
+            ],
         ),
-    }  # fmt: skip
+    }
     for label, (parents, joints, constraints, effectors, targets) in cases.items():
         pose, times, iterations, statuses = joints.copy(), [], [], []
         for frame in targets:
             goal = {e: frame[k] for k, e in enumerate(effectors)}
             elapsed, result = fastest(
-                lambda pose=pose, goal=goal, parents=parents, constraints=constraints: (
-                    fabrik.solve_tree(parents, pose, goal, constraints=constraints)
+                lambda pose=pose, goal=goal, parents=parents, constraints=constraints: fabrik.solve_tree(
+                    parents, pose, goal, constraints=constraints
                 )
             )
             assert isinstance(result, fabrik.TreeSolution)
@@ -358,9 +354,7 @@ def overhead(calls: int) -> dict[str, float]:
         f"\n## Python around the core: one solve, links of 0.1 m, 3D, no limits, {calls} calls each, "
         f"interleaved ({load()})"
     )
-    print(
-        "| links | core median µs | core p95 µs | solve median µs | solve p95 µs | ratio (median) |"
-    )
+    print("| links | core median µs | core p95 µs | solve median µs | solve p95 µs | ratio (median) |")
     print("|---:|---:|---:|---:|---:|---:|")
     figures = {}
     for n in (2, 4, 8, 16):
@@ -394,9 +388,7 @@ def cold_start() -> dict[str, float]:
     with tempfile.TemporaryDirectory() as cache:
         env = {**os.environ, "NUMBA_CACHE_DIR": cache, "PYTHONPATH": str(ROOT)}
         for label in ("cold (empty cache: compile)", "warm (cache present: load)"):
-            out = subprocess.run(
-                [sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True
-            )
+            out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
             figures[label] = float(out.stdout.split()[-1])
     print(f"\n## Start-up: import kernels.fabrik + warm_up() in a fresh process ({load()})")
     print("| case | s |")
@@ -413,9 +405,7 @@ def main() -> None:
     parser.add_argument("--batch", type=int, default=10_000)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--quick", action="store_true", help="fewer solves, for a smoke run")
-    parser.add_argument(
-        "--overhead", action="store_true", help="only the Python-around-the-core table"
-    )
+    parser.add_argument("--overhead", action="store_true", help="only the Python-around-the-core table")
     args = parser.parse_args()
     if args.quick:
         args.runs, args.frames, args.batch = 20, 100, 2000
@@ -435,28 +425,65 @@ def main() -> None:
     print("| measure | goal | measured | × baseline | met |")
     print("|---|---|---:|---:|---|")
     rows = [
-        ("FABRIK, 12 links, 30° limits, 4 obstacles, drag p95", "≤ 50 µs",
-         f"{drag['drag_p95_us']:.1f} µs", f"{drag['drag_ratio']:.0f}×", drag["drag_p95_us"] <= 50),
-        ("FABRIK, paper setup, mean per solve", "≤ 10 µs", f"{paper['paper_mean_us']:.1f} µs",
-         f"{paper['paper_ratio']:.0f}×", paper["paper_mean_us"] <= 10),
-        ("solve_batch, 12 links, no limits", "≥ 1.5 M chains/s on 2 cores",
-         f"{batch['no limits']:,.0f}/s ({batch['no limits, per core']:,.0f}/s per core)", "",
-         batch["no limits"] >= 1.5e6),
-        ("solve_batch, 12 links, limits + 4 obstacles", "≥ 300 k chains/s",
-         f"{batch['30° limits + 4 obstacles']:,.0f}/s "
-         f"({batch['30° limits + 4 obstacles, per core']:,.0f}/s per core)", "",
-         batch["30° limits + 4 obstacles"] >= 3e5),
-        ("cold start: compile every core", "report it",
-         f"{start['cold (empty cache: compile)']:.1f} s", "", True),
-        ("warm start: load every core from the cache", "(part of app start ≤ 3 s)",
-         f"{start['warm (cache present: load)']:.2f} s", "", start["warm (cache present: load)"] <= 3),
-        ("issue 14: hand, 5 fingers × 3 hinges, all targets moving, p95", "≤ 100 µs",
-         f"{trees['hand']:.1f} µs", "", trees["hand"] <= 100),
-        ("issue 14: 30-joint tree, 5 effectors, p95", "≤ 1 ms",
-         f"{trees['30-joint tree']:.1f} µs", "", trees["30-joint tree"] <= 1000),
-        ("one solve over its compiled core, 2–16 links, median", "≤ 2×",
-         f"{max(around.values()):.2f}× (worst)", "", max(around.values()) <= 2.0),
-    ]  # fmt: skip
+        (
+            "FABRIK, 12 links, 30° limits, 4 obstacles, drag p95",
+            "≤ 50 µs",
+            f"{drag['drag_p95_us']:.1f} µs",
+            f"{drag['drag_ratio']:.0f}×",
+            drag["drag_p95_us"] <= 50,
+        ),
+        (
+            "FABRIK, paper setup, mean per solve",
+            "≤ 10 µs",
+            f"{paper['paper_mean_us']:.1f} µs",
+            f"{paper['paper_ratio']:.0f}×",
+            paper["paper_mean_us"] <= 10,
+        ),
+        (
+            "solve_batch, 12 links, no limits",
+            "≥ 1.5 M chains/s on 2 cores",
+            f"{batch['no limits']:,.0f}/s ({batch['no limits, per core']:,.0f}/s per core)",
+            "",
+            batch["no limits"] >= 1.5e6,
+        ),
+        (
+            "solve_batch, 12 links, limits + 4 obstacles",
+            "≥ 300 k chains/s",
+            f"{batch['30° limits + 4 obstacles']:,.0f}/s "
+            f"({batch['30° limits + 4 obstacles, per core']:,.0f}/s per core)",
+            "",
+            batch["30° limits + 4 obstacles"] >= 3e5,
+        ),
+        ("cold start: compile every core", "report it", f"{start['cold (empty cache: compile)']:.1f} s", "", True),
+        (
+            "warm start: load every core from the cache",
+            "(part of app start ≤ 3 s)",
+            f"{start['warm (cache present: load)']:.2f} s",
+            "",
+            start["warm (cache present: load)"] <= 3,
+        ),
+        (
+            "issue 14: hand, 5 fingers × 3 hinges, all targets moving, p95",
+            "≤ 100 µs",
+            f"{trees['hand']:.1f} µs",
+            "",
+            trees["hand"] <= 100,
+        ),
+        (
+            "issue 14: 30-joint tree, 5 effectors, p95",
+            "≤ 1 ms",
+            f"{trees['30-joint tree']:.1f} µs",
+            "",
+            trees["30-joint tree"] <= 1000,
+        ),
+        (
+            "one solve over its compiled core, 2–16 links, median",
+            "≤ 2×",
+            f"{max(around.values()):.2f}× (worst)",
+            "",
+            max(around.values()) <= 2.0,
+        ),
+    ]
     for measure, goal, measured, ratio, met in rows:
         print(f"| {measure} | {goal} | {measured} | {ratio} | {'met' if met else 'NOT met'} |")
 

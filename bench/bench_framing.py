@@ -60,9 +60,7 @@ def baseline_frame_points(
     depth_extent = float(np.max(np.abs(w))) if len(w) else 0.0
     size = float(np.max(np.linalg.norm(rel, axis=1))) if len(rel) else 0.0
 
-    def shift(
-        coord: NDArray[np.float64], scale: NDArray[np.float64], lo: float, hi: float
-    ) -> float:
+    def shift(coord: NDArray[np.float64], scale: NDArray[np.float64], lo: float, hi: float) -> float:
         reach = size + 1.0 + float(np.max(scale)) * (abs(lo) + abs(hi) + 1.0)
         a, b = -reach, reach
         for _ in range(60):
@@ -136,17 +134,11 @@ def main() -> None:
     )
     for name, pts, ndc in cases:
 
-        def new(
-            pts: NDArray[np.float64] = pts, ndc: tuple[float, float, float, float] = ndc
-        ) -> View:
+        def new(pts: NDArray[np.float64] = pts, ndc: tuple[float, float, float, float] = ndc) -> View:
             return frame_points(pts, direction, fov_rad=lens.fov_rad, aspect=lens.aspect, ndc=ndc)
 
-        def old(
-            pts: NDArray[np.float64] = pts, ndc: tuple[float, float, float, float] = ndc
-        ) -> View:
-            return baseline_frame_points(
-                pts, direction, fov_rad=lens.fov_rad, aspect=lens.aspect, ndc=ndc
-            )
+        def old(pts: NDArray[np.float64] = pts, ndc: tuple[float, float, float, float] = ndc) -> View:
+            return baseline_frame_points(pts, direction, fov_rad=lens.fov_rad, aspect=lens.aspect, ndc=ndc)
 
         fast, slow = per_call_ms(new, 2000), per_call_ms(old, 40)
         a, b = new(), old()

@@ -109,16 +109,12 @@ def kernel_rows() -> None:
     cases: list[tuple[str, Callable[[], NDArray[np.float64]], int]] = [
         (
             "Euler 1 ms (seed), one 30 m flight",
-            lambda: ball.simulate(
-                START, VELOCITY, SPIN, dt=1e-3, method="euler", x_stop=LINE_M
-            ).position[-1],
+            lambda: ball.simulate(START, VELOCITY, SPIN, dt=1e-3, method="euler", x_stop=LINE_M).position[-1],
             30,
         ),
         (
             "RK4 10 ms, one 30 m flight",
-            lambda: ball.simulate(
-                START, VELOCITY, SPIN, dt=1e-2, method="rk4", x_stop=LINE_M
-            ).position[-1],
+            lambda: ball.simulate(START, VELOCITY, SPIN, dt=1e-2, method="rk4", x_stop=LINE_M).position[-1],
             200,
         ),
         (
@@ -170,9 +166,7 @@ def scene_rows() -> None:
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("Spin rate (rev/s)")
         client.wait_for_node("/freekick/path")
-        for i in range(
-            120
-        ):  # constant model: the path does not move with the rate; time the server only
+        for i in range(120):  # constant model: the path does not move with the rate; time the server only
             done = len(handling)
             client.set_value("Spin rate (rev/s)", 4.0 + 0.1 * (i % 80))
             client.wait_for(lambda done=done: len(handling) > done, what="the callback")
@@ -187,9 +181,7 @@ def scene_rows() -> None:
             client.set_value("Spin rate (rev/s)", 4.0 + 0.1 * (i % 80) + 0.05)
             client.wait_for(
                 lambda before=before: (
-                    not np.array_equal(
-                        np.asarray(client.nodes["/freekick/path"]["props"]["points"]), before
-                    )
+                    not np.array_equal(np.asarray(client.nodes["/freekick/path"]["props"]["points"]), before)
                 ),
                 what="redrawn path",
             )
@@ -317,9 +309,7 @@ def numpy_batch(
     return np.stack(frames), n
 
 
-def numpy_outcomes(
-    states: NDArray[np.float64], wall: ball.Panel, goal: ball.Panel
-) -> NDArray[np.str_]:
+def numpy_outcomes(states: NDArray[np.float64], wall: ball.Panel, goal: ball.Panel) -> NDArray[np.str_]:
     """Results of :func:`numpy_batch` flights (linear interpolation at each plane: the cheap reference)."""
     result = np.full(states.shape[1], "short", dtype="<U5")
     crossings = []
@@ -340,11 +330,7 @@ def numpy_outcomes(
     result[goal_found & inside & under] = "goal"
     result[goal_found & inside & ~under] = "over"
     result[goal_found & ~inside] = "wide"
-    hit = (
-        wall_found
-        & (np.abs(wall_lateral) <= 0.5 * wall.width_m + R)
-        & (wall_point[:, 2] <= wall.height_m + R)
-    )
+    hit = wall_found & (np.abs(wall_lateral) <= 0.5 * wall.width_m + R) & (wall_point[:, 2] <= wall.height_m + R)
     result[hit] = "wall"
     return result
 
@@ -356,9 +342,13 @@ def batch_kicks(k: int = 10_000) -> tuple[NDArray[np.float64], ...]:
     elevations = np.radians(rng.uniform(5.0, 30.0, k))
     azimuths = np.radians(rng.uniform(-15.0, 15.0, k))
     velocities = np.stack(
-        [speeds * np.cos(elevations) * np.cos(azimuths), speeds * np.cos(elevations) * np.sin(azimuths),
-         speeds * np.sin(elevations)], axis=1,
-    )  # fmt: skip
+        [
+            speeds * np.cos(elevations) * np.cos(azimuths),
+            speeds * np.cos(elevations) * np.sin(azimuths),
+            speeds * np.sin(elevations),
+        ],
+        axis=1,
+    )
     spins = np.zeros((k, 3))
     spins[:, 2] = 2 * math.pi * rng.uniform(-12.0, 12.0, k)
     return np.tile([-25.0, 0.0, R], (k, 1)), velocities, spins
@@ -405,9 +395,7 @@ def app_start(cache_dir: str | None) -> tuple[float, float | None]:
         process.wait(timeout=30)
 
 
-def goal_row(
-    name: str, values: list[float], unit: float, unit_name: str, goal: float | None, note: str
-) -> None:
+def goal_row(name: str, values: list[float], unit: float, unit_name: str, goal: float | None, note: str) -> None:
     """One row: median, p95 and best (the best is what an idle machine gives; this one is shared)."""
     median, p95 = statistics.median(values) / unit, float(np.percentile(values, 95)) / unit
     best = min(values) / unit
@@ -466,15 +454,17 @@ def goal_rows() -> None:
     batch = timings(lambda: ball.simulate_batch(starts, velocities, spins, **options), 9)  # type: ignore[arg-type]
     plain = timings(lambda: numpy_batch(starts, velocities, spins, 0.5), 3)
     ratio = statistics.median(plain) / statistics.median(batch)
-    goal_row("simulate_batch, 10 000 kicks, RK4 10 ms", batch, 1e-3, "ms", 60.0,
-             f"{ratio:.1f}x plain numpy over the kicks ({statistics.median(plain) * 1e3:.0f} ms)")  # fmt: skip
-    wall, goal = ball.free_kick_panels((-25.0, 0.0), (0.0, 0.0), (1.0, 0.0))
-    fused = timings(
-        lambda: ball.simulate_outcomes(starts, velocities, spins, wall, goal, **options), 9
-    )  # type: ignore[arg-type]
     goal_row(
-        "  simulate_outcomes, same kicks (no storage)", fused, 1e-3, "ms", None, "verdicts only"
+        "simulate_batch, 10 000 kicks, RK4 10 ms",
+        batch,
+        1e-3,
+        "ms",
+        60.0,
+        f"{ratio:.1f}x plain numpy over the kicks ({statistics.median(plain) * 1e3:.0f} ms)",
     )
+    wall, goal = ball.free_kick_panels((-25.0, 0.0), (0.0, 0.0), (1.0, 0.0))
+    fused = timings(lambda: ball.simulate_outcomes(starts, velocities, spins, wall, goal, **options), 9)  # type: ignore[arg-type]
+    goal_row("  simulate_outcomes, same kicks (no storage)", fused, 1e-3, "ms", None, "verdicts only")
 
     params = FreeKickParams()
     grid = timings(lambda: outcome_map(params), 15)
@@ -484,9 +474,7 @@ def goal_rows() -> None:
     map_starts = np.tile([-22.0, 0.0, R], (speeds.size, 1))
     map_velocities = speeds.reshape(-1, 1) * direction
     map_spins = 2 * math.pi * rates.reshape(-1, 1) * np.array([0.0, 0.0, 1.0])
-    map_wall, map_goal = ball.free_kick_panels(
-        (-22.0, 0.0), (0.0, 0.0), (1.0, 0.0), wall_width_m=2.0
-    )
+    map_wall, map_goal = ball.free_kick_panels((-22.0, 0.0), (0.0, 0.0), (1.0, 0.0), wall_width_m=2.0)
 
     def plain_map() -> NDArray[np.str_]:
         states, _ = numpy_batch(map_starts, map_velocities, map_spins, 0.5)
@@ -495,16 +483,34 @@ def goal_rows() -> None:
     plain = timings(plain_map, 5)
     agree = float(np.mean(plain_map().reshape(speeds.shape) == outcome_map(params)))
     ratio = statistics.median(plain) / statistics.median(grid)
-    goal_row("outcome map 41 x 31 (scene's outcome_map)", grid, 1e-3, "ms", 20.0,
-             f"{ratio:.0f}x plain numpy ({statistics.median(plain) * 1e3:.0f} ms, {agree:.1%} same cells)")  # fmt: skip
+    goal_row(
+        "outcome map 41 x 31 (scene's outcome_map)",
+        grid,
+        1e-3,
+        "ms",
+        20.0,
+        f"{ratio:.0f}x plain numpy ({statistics.median(plain) * 1e3:.0f} ms, {agree:.1%} same cells)",
+    )
 
     warm = [app_start(None) for _ in range(3)]
-    goal_row("app start to serving, warm cache", [w[0] for w in warm], 1.0, "s", 3.0,
-             f"kernels warm after {statistics.median([w[1] or math.nan for w in warm]):.2f} s")  # fmt: skip
+    goal_row(
+        "app start to serving, warm cache",
+        [w[0] for w in warm],
+        1.0,
+        "s",
+        3.0,
+        f"kernels warm after {statistics.median([w[1] or math.nan for w in warm]):.2f} s",
+    )
     with tempfile.TemporaryDirectory() as empty:
         serving, warmed = app_start(empty)
-    goal_row("app start to serving, cold cache", [serving], 1.0, "s", None,
-             f"kernels compiled after {warmed or math.nan:.1f} s (background thread)")  # fmt: skip
+    goal_row(
+        "app start to serving, cold cache",
+        [serving],
+        1.0,
+        "s",
+        None,
+        f"kernels compiled after {warmed or math.nan:.1f} s (background thread)",
+    )
     load_after = os.getloadavg()
     print(
         f"\nCPU: {cpu}, {os.cpu_count()} logical CPUs; numba {numba.__version__}, {numba.get_num_threads()} threads "
@@ -542,17 +548,23 @@ def overhead_rows(calls: int = 20_000) -> None:
         public_s.append((end - middle) * 1e-9)
         keywords_s.append((last - end) * 1e-9)
     core = statistics.median(core_s)
-    print(
-        "| measurement                                    |     median |        p95 | unit | note"
-    )
-    print(
-        "|------------------------------------------------|-----------:|-----------:|------|-----"
-    )
+    print("| measurement                                    |     median |        p95 | unit | note")
+    print("|------------------------------------------------|-----------:|-----------:|------|-----")
     row("(a) compiled core alone, RK4 10 ms, 30 m", core_s, 1e-6, "us", f"{calls} calls")
-    row("(b) simulate(..., config)", public_s, 1e-6, "us",
-        f"{statistics.median(public_s) / core:.2f}x the core (goal <= 2x)")  # fmt: skip
-    row("(c) simulate(..., dt=..., method=...)", keywords_s, 1e-6, "us",
-        f"{statistics.median(keywords_s) / core:.2f}x the core")  # fmt: skip
+    row(
+        "(b) simulate(..., config)",
+        public_s,
+        1e-6,
+        "us",
+        f"{statistics.median(public_s) / core:.2f}x the core (goal <= 2x)",
+    )
+    row(
+        "(c) simulate(..., dt=..., method=...)",
+        keywords_s,
+        1e-6,
+        "us",
+        f"{statistics.median(keywords_s) / core:.2f}x the core",
+    )
     print(f"load average (1 min) {os.getloadavg()[0]:.2f}\n")
 
 
@@ -564,18 +576,12 @@ def main() -> None:
     overhead_rows()
     if "--goals" in sys.argv:
         return
-    print(
-        "| measurement                                    |     median |        p95 | unit | note"
-    )
-    print(
-        "|------------------------------------------------|-----------:|-----------:|------|-----"
-    )
+    print("| measurement                                    |     median |        p95 | unit | note")
+    print("|------------------------------------------------|-----------:|-----------:|------|-----")
     kernel_rows()
     scene_rows()
     cpus = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
-    print(
-        f"\nmachine: {sys.platform}, {cpus} CPUs, Python {sys.version.split()[0]}, numpy {np.__version__}"
-    )
+    print(f"\nmachine: {sys.platform}, {cpus} CPUs, Python {sys.version.split()[0]}, numpy {np.__version__}")
 
 
 if __name__ == "__main__":

@@ -26,7 +26,7 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tests"))
 
 import viser  # noqa: E402
-from wsclient import BrowserClient  # noqa: E402
+from helpers.wsclient import BrowserClient  # noqa: E402
 
 from kernels import course, cycling  # noqa: E402
 from scenes.peloton import PelotonScene  # noqa: E402
@@ -80,9 +80,7 @@ def course_rows() -> None:
     air = course.Air("weather", temperature_c=22.0, pressure_hpa=980.0, relative_humidity=0.5)
     rides = timings(lambda: course.ride(route, 250.0, rider, 4.0, 225.0, air), 30)
     target = course.ride(route, 250.0, rider, 4.0, 225.0, air).time_s
-    inverse = timings(
-        lambda: course.power_for_time(route, target * 0.95, rider, 4.0, 225.0, air), 10
-    )
+    inverse = timings(lambda: course.power_for_time(route, target * 0.95, rider, 4.0, 225.0, air), 10)
     paced = timings(lambda: course.paced_ride(route, 250.0, rider, 0.15, 4.0, 225.0, air), 5)
     row("course.ride, 100 km at 10 m (10^4 segments)", rides, 1e-3, "ms", "goal <= 50 ms")
     row("course.power_for_time, 100 km", inverse, 1e-3, "ms", "goal <= 0.5 s")
@@ -103,9 +101,7 @@ def main() -> None:
     course_rows()
     rng = np.random.default_rng(0)
     speeds = rng.uniform(0.0, 20.0, 1_000_000)
-    kernel = timings(
-        lambda: cycling.power(speeds, 0.3, 80.0, 0.004, drivetrain_efficiency=0.976), 15
-    )
+    kernel = timings(lambda: cycling.power(speeds, 0.3, 80.0, 0.004, drivetrain_efficiency=0.976), 15)
     sample = speeds[:100_000].tolist()
     loop = timings(lambda: python_loop_power(sample), 5)
     loop_per_million = [t * 10 for t in loop]

@@ -40,7 +40,7 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tests"))
 
 import viser  # noqa: E402
-from wsclient import BrowserClient  # noqa: E402
+from helpers.wsclient import BrowserClient  # noqa: E402
 
 from kernels import sdf  # noqa: E402
 from scenes.sdf_gallery import EXAMPLES, SdfGalleryScene  # noqa: E402
@@ -89,9 +89,7 @@ def bench_mesh(repeats: int) -> list[str]:
     ]
     grid = sdf.make_grid(scene, 161, bounds)
     samples = int(np.prod(grid.shape))
-    full = times_ms(
-        lambda: sdf.mesh(scene, 161, bounds, near_surface=False), max(2, repeats // 3), warmup=0
-    )
+    full = times_ms(lambda: sdf.mesh(scene, 161, bounds, near_surface=False), max(2, repeats // 3), warmup=0)
     near = times_ms(lambda: sdf.mesh(scene, 161, bounds), repeats)
     same = all(
         np.array_equal(a, b)
@@ -131,20 +129,14 @@ def _bench_reference(renderer: Renderer, repeats: int) -> list[str]:
         ("no shadows, no AO", Shading(shadows=False, occlusion=False)),
     ]:
         cpu_start = time.process_time()
-        t = times_ms(
-            lambda shading=shading: renderer.render(scene, camera, 512, 512, shading), repeats
-        )
-        cpu_ms = (
-            1e3 * (time.process_time() - cpu_start) / (repeats + 1)
-        )  # llvmpipe's threads are ours
+        t = times_ms(lambda shading=shading: renderer.render(scene, camera, 512, 512, shading), repeats)
+        cpu_ms = 1e3 * (time.process_time() - cpu_start) / (repeats + 1)  # llvmpipe's threads are ours
         rows.append(
             row(
                 f"Reference 512×512, {label} ({renderer.renderer_name})",
                 f"median {statistics.median(t):.0f} ms, p95 {p95(t):.0f} ms (CPU {cpu_ms:.0f} ms a frame)",
                 "≤ 60 ms" if label == "full shading" else "",
-                ("met" if statistics.median(t) <= 60 else "missed")
-                if label == "full shading"
-                else "",
+                ("met" if statistics.median(t) <= 60 else "missed") if label == "full shading" else "",
             )
         )
     t = times_ms(lambda: renderer.render(scene, camera, 1920, 1080), max(2, repeats // 3))
@@ -154,9 +146,7 @@ def _bench_reference(renderer: Renderer, repeats: int) -> list[str]:
             f"Reference 1920×1080, full shading ({renderer.renderer_name})",
             f"median {statistics.median(t):.0f} ms = {1e3 / statistics.median(t):.1f} frames/s",
             "≥ 100 frames/s on a GPU",
-            ("met" if 1e3 / statistics.median(t) >= 100 else "missed")
-            if gpu
-            else "no GPU lent: not measurable",
+            ("met" if 1e3 / statistics.median(t) >= 100 else "missed") if gpu else "no GPU lent: not measurable",
         )
     )
     return rows
@@ -173,9 +163,7 @@ def bench_glsl_mesh(repeats: int) -> list[str]:
         return [row("GLSL-sampled mesh", f"not measured: {exc}", "", "n/a")]
     t = times_ms(lambda: gl_renderer.mesh_glsl(BLEND_EXAMPLE, 128, EDITOR_BOUNDS), repeats)
     grid = sdf.make_grid(sdf.default_scene(), 128, EDITOR_BOUNDS)
-    sample = times_ms(
-        lambda: gl_service.run(lambda gl: gl.sample_field(BLEND_EXAMPLE, grid)), repeats
-    )
+    sample = times_ms(lambda: gl_service.run(lambda gl: gl.sample_field(BLEND_EXAMPLE, grid)), repeats)
     scene = sdf.default_scene()
     bounds = cube_bounds(scene)
     numpy = times_ms(lambda: sdf.mesh(scene, 128, bounds), repeats)
@@ -204,9 +192,7 @@ def bench_view(repeats: int) -> list[str]:
             ),
             (
                 "editor example 1",
-                lambda gl, w, h, shading: gl.render_field(
-                    BLEND_EXAMPLE, EDITOR_BOUNDS, camera, w, h, shading
-                ),
+                lambda gl, w, h, shading: gl.render_field(BLEND_EXAMPLE, EDITOR_BOUNDS, camera, w, h, shading),
             ),
         ]:
             for width, height, moving in [(320, 200, True), (640, 400, False)]:
@@ -216,9 +202,7 @@ def bench_view(repeats: int) -> list[str]:
                 def frame(march=march, width=width, height=height, shading=shading) -> None:
                     rgb, depth = gl_service.run(lambda gl: march(gl, width, height, shading))
                     depth = np.where(np.isfinite(depth), depth, 1e3).astype(np.float32)
-                    server.scene.set_background_image(
-                        rgb, format="jpeg", jpeg_quality=90, depth=depth
-                    )
+                    server.scene.set_background_image(rgb, format="jpeg", jpeg_quality=90, depth=depth)
 
                 try:
                     t = times_ms(frame, repeats * 2)
@@ -300,8 +284,7 @@ def bench_edit(edits: int) -> list[str]:
         row(
             f"Edit → new ray-march and 64³ mesh at the websocket client ({edits} new sources)",
             f"p50 {statistics.median(latencies):.0f} ms, p95 {p95(latencies):.0f} ms, "
-            f"max {max(latencies):.0f} ms"
-            + (f"; {len(failures)} refused: {failures[0]}" if failures else ""),
+            f"max {max(latencies):.0f} ms" + (f"; {len(failures)} refused: {failures[0]}" if failures else ""),
             "≤ 1 s",
             "met" if max(latencies) <= 1000 and not failures else "missed",
         )
@@ -320,9 +303,7 @@ def bench_drag(drags: int) -> list[str]:
             owner = str(client.nodes["/sdf/gizmo_1"].get("owner", "") or "")
             client.send("TransformControlsDragStartMessage", name="/sdf/gizmo_1", owner=owner)
             for i in range(drags):
-                z = 0.5 + 0.3 * np.sin(
-                    (i + 1) / 3
-                )  # never the opening 0.5: an unchanged mesh sends nothing
+                z = 0.5 + 0.3 * np.sin((i + 1) / 3)  # never the opening 0.5: an unchanged mesh sends nothing
                 count = len(client.received)
                 serial = scene.mesh_serial
                 start = time.monotonic()
@@ -351,9 +332,7 @@ def bench_drag(drags: int) -> list[str]:
                 latencies.append(1e3 * (arrival - start))
                 server_side.append(scene.agreement.mesh_ms)
                 assert scene.mesh_serial > serial
-                time.sleep(
-                    0.15
-                )  # let the reference render settle between drags, as a person pauses
+                time.sleep(0.15)  # let the reference render settle between drags, as a person pauses
             client.send("TransformControlsDragEndMessage", name="/sdf/gizmo_1", owner=owner)
     finally:
         scene.close()
@@ -372,15 +351,11 @@ def bench_drag(drags: int) -> list[str]:
 def main() -> None:
     parser = argparse.ArgumentParser(description="Benchmark the SDF gallery.")
     parser.add_argument("--quick", action="store_true", help="fewer repeats")
-    parser.add_argument(
-        "--only-issue-12", action="store_true", help="only the editor and main-view rows (5-7)"
-    )
+    parser.add_argument("--only-issue-12", action="store_true", help="only the editor and main-view rows (5-7)")
     args = parser.parse_args()
     repeats = 3 if args.quick else 9
     load = os.getloadavg()[0]
-    print(
-        f"Machine: {os.cpu_count()} cores, load average {load:.1f} at start (other work shares these cores)."
-    )
+    print(f"Machine: {os.cpu_count()} cores, load average {load:.1f} at start (other work shares these cores).")
     print("| Measure | Result | Goal | Verdict |")
     print("|---|---|---|---|")
     rows: list[Callable[[], list[str]]] = []

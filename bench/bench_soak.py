@@ -4,7 +4,7 @@
                                [--modes session shared]
 
 For each mode and scene it starts ``app.py`` in its own process (``--shared`` for the shared mode) and N fake
-browsers (``tests/wsclient.py``), each in its own process. Every browser connects and receives its scene first; then
+browsers (``tests/helpers/wsclient.py``), each in its own process. Every browser connects and receives its scene first; then
 all start together (a barrier file) and each moves its scene's main input at ``rate`` messages per second for
 exactly ``seconds``: the peloton's speed slider, the arm's target gizmo, the free kick's launch speed slider, the SDF
 gallery's second primitive's gizmo. A browser keeps only the arrival times of the scene updates it receives (kept
@@ -46,7 +46,7 @@ from typing import Any
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))
 
-from wsclient import BrowserClient  # noqa: E402
+from helpers.wsclient import BrowserClient  # noqa: E402
 
 MIB = 1024 * 1024
 GOAL_P95_MS = {"peloton": 50.0, "arm": 50.0, "freekick": 50.0, "sdf": 150.0}
@@ -60,9 +60,7 @@ QUIET_S = 3.0
 
 
 # ------------------------------------------------------------------------------------------------ one browser
-def run_client(
-    port: int, scene: str, rate: float, seconds: float, index: int, barrier: Path
-) -> dict[str, Any]:
+def run_client(port: int, scene: str, rate: float, seconds: float, index: int, barrier: Path) -> dict[str, Any]:
     """One fake browser's run; returns what the parent reports.
 
     It connects, waits for its scene, writes ``barrier.ready<index>``, waits for the parent's ``barrier`` file (the
@@ -99,9 +97,7 @@ def run_client(
         k = 0
         previous: Any = None
         while (now := time.monotonic()) - start < seconds:
-            phase = (
-                2 * math.pi * (k / (rate * 4.0) + index / 8.0)
-            )  # a 4 s cycle, each browser out of step
+            phase = 2 * math.pi * (k / (rate * 4.0) + index / 8.0)  # a 4 s cycle, each browser out of step
             if scene in SLIDERS:
                 label, lo, hi = SLIDERS[scene]
                 last = round(lo + (hi - lo) * (0.5 + 0.5 * math.sin(phase)), 1)
@@ -115,9 +111,7 @@ def run_client(
                     round(z + radius * math.sin(phase), 4),
                 )
                 client.drag_transform_step(name, last, owner)
-            if (
-                last != previous
-            ):  # a repeated value changes nothing: no update follows it, so it is not timed
+            if last != previous:  # a repeated value changes nothing: no update follows it, so it is not timed
                 sends.append(time.monotonic())
             previous = last
             k += 1
@@ -136,9 +130,7 @@ def run_client(
         result["latencies_ms"] = latencies_ms(arrivals, sends)
         result["last"] = last
         result["shown"] = (
-            client.value_of(SLIDERS[scene][0])
-            if scene in SLIDERS
-            else client.pose_of(GIZMOS[scene][0])[0]
+            client.value_of(SLIDERS[scene][0]) if scene in SLIDERS else client.pose_of(GIZMOS[scene][0])[0]
         )
         if client.closed_by_server:
             result["errors"].append("the server closed the connection")
@@ -159,8 +151,7 @@ def drain_arrivals(client: BrowserClient, scene: str, arrivals: list[float]) -> 
     arrivals.extend(
         t
         for t, message in received
-        if str(message.get("name", "")).startswith(prefix)
-        and not str(message.get("type", "")).startswith("Gui")
+        if str(message.get("name", "")).startswith(prefix) and not str(message.get("type", "")).startswith("Gui")
     )
 
 
@@ -204,9 +195,7 @@ def soak(mode: str, scene: str, clients: int, rate: float, seconds: float) -> di
     if mode == "shared":
         args.append("--shared")
     log: list[str] = []
-    app = subprocess.Popen(
-        args, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True
-    )
+    app = subprocess.Popen(args, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     assert app.stdout is not None
     for line in app.stdout:
         log.append(line)
@@ -256,11 +245,7 @@ def soak(mode: str, scene: str, clients: int, rate: float, seconds: float) -> di
             results = []
             for out in outputs:
                 text = out.read_text().strip() if out.exists() else ""
-                results.append(
-                    json.loads(text)
-                    if text
-                    else {"errors": ["no result"], "latencies_ms": [], "sent": 0}
-                )
+                results.append(json.loads(text) if text else {"errors": ["no result"], "latencies_ms": [], "sent": 0})
             # while the browsers sent: after the first minute (after the first third of a shorter run)
             running = [(t, r) for t, r in samples if 0.0 <= t <= seconds]
             slope = slope_mib_per_min(running, min(60.0, seconds / 3.0))
@@ -338,11 +323,7 @@ def check_convergence(mode: str, scene: str, port: int, results: list[dict[str, 
 def _same(a: Any, b: Any) -> bool:
     if isinstance(a, (list, tuple)) and isinstance(b, (list, tuple)):
         return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b, strict=True))
-    return (
-        isinstance(a, (int, float))
-        and isinstance(b, (int, float))
-        and abs(float(a) - float(b)) <= 1e-6
-    )
+    return isinstance(a, (int, float)) and isinstance(b, (int, float)) and abs(float(a) - float(b)) <= 1e-6
 
 
 SCENE_TITLES = {"peloton": "peloton", "arm": "arm", "freekick": "free kick", "sdf": "SDF gallery"}
@@ -388,9 +369,7 @@ def rss_every_10_s(samples: list[tuple[float, float]]) -> list[float]:
 def main() -> None:
     if len(sys.argv) > 1 and sys.argv[1] == "--client":
         port, scene, rate, seconds, index, out_path, barrier = sys.argv[2:9]
-        result = run_client(
-            int(port), scene, float(rate), float(seconds), int(index), Path(barrier)
-        )
+        result = run_client(int(port), scene, float(rate), float(seconds), int(index), Path(barrier))
         Path(out_path).write_text(json.dumps(result))
         return
     parser = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
@@ -403,9 +382,7 @@ def main() -> None:
         default=["peloton", "arm", "freekick", "sdf"],
         choices=list(GOAL_P95_MS),
     )
-    parser.add_argument(
-        "--modes", nargs="+", default=["session", "shared"], choices=["session", "shared"]
-    )
+    parser.add_argument("--modes", nargs="+", default=["session", "shared"], choices=["session", "shared"])
     args = parser.parse_args()
     started = time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())
     print(

@@ -105,9 +105,7 @@ def draft_factor(gap_m: ArrayLike) -> NDArray[np.float64]:
     return 1.0 - 0.27 * np.exp(-gap / 3.5)
 
 
-def drag_reduction(
-    n_riders: int, gap_m: float, model: DraftModel = "measured"
-) -> NDArray[np.float64]:
+def drag_reduction(n_riders: int, gap_m: float, model: DraftModel = "measured") -> NDArray[np.float64]:
     """Fractional CdA reduction of each rider in a single-file line, leader first.
 
     Args:
@@ -128,9 +126,7 @@ def drag_reduction(
         case "seed":
             reduction[1:] = 1.0 - float(draft_factor(gap))
         case "measured":
-            plateau = np.array(
-                [_MEASURED_PLATEAU[min(k, len(_MEASURED_PLATEAU)) - 1] for k in range(1, n_riders)]
-            )
+            plateau = np.array([_MEASURED_PLATEAU[min(k, len(_MEASURED_PLATEAU)) - 1] for k in range(1, n_riders)])
             reduction[1:] = plateau * np.exp(-gap / _MEASURED_FADE_M)
             reduction[0] = _LEADER_PLATEAU * np.exp(-gap / _LEADER_FADE_M)
         case _:
@@ -240,9 +236,7 @@ def power(
     v = _non_negative("speed_ms", speed_ms)
     r = _resistance(cda_m2, mass_kg, crr, grade, altitude_m, headwind_ms, drivetrain_efficiency)
 
-    aero, rolling, _, climbing = wheel_power_terms(
-        v, r.drag, r.rolling_force, r.climbing_force, r.wind, 0.0, 0.0
-    )
+    aero, rolling, _, climbing = wheel_power_terms(v, r.drag, r.rolling_force, r.climbing_force, r.wind, 0.0, 0.0)
     aero, rolling, climbing, efficiency = np.broadcast_arrays(aero, rolling, climbing, r.efficiency)
     wheel = aero + rolling + climbing
     # The drivetrain loses a share of what the rider puts in; when the wheel needs no power (a descent),
@@ -293,16 +287,12 @@ def speed_for_power(
         ValueError: an argument is not finite, out of :func:`power`'s range, or outside the domain above.
     """
     target = _non_negative("power_w", power_w)
-    values = dict(
-        cda_m2=cda_m2, mass_kg=mass_kg, crr=crr, altitude_m=altitude_m, headwind_ms=headwind_ms
-    )
+    values = dict(cda_m2=cda_m2, mass_kg=mass_kg, crr=crr, altitude_m=altitude_m, headwind_ms=headwind_ms)
     for name, (low, high) in SPEED_FOR_POWER_DOMAIN.items():
         value = power_w if name == "power_w" else values[name]
         array = target if name == "power_w" else _finite(name, value)
         if np.any((array < low) | (array > high)):
-            raise ValueError(
-                f"{name} must be in [{low:g}, {high:g}] for speed_for_power, got {value!r}"
-            )
+            raise ValueError(f"{name} must be in [{low:g}, {high:g}] for speed_for_power, got {value!r}")
     r = _resistance(cda_m2, mass_kg, crr, grade, altitude_m, headwind_ms, drivetrain_efficiency)
     # Validated above. Rolling plus climbing as m·g·cos θ·(Crr + grade), which is exactly 0 where Crr = −grade
     # (the sum of the two forces would leave rounding there, and its square root would move v_c); the ratio
@@ -381,9 +371,7 @@ def _largest_root_unguarded(
         )
         # Converged: f at the rounding level of its terms, a bracket one ulp wide, or no move left. (A test on
         # v's own rounding, eps·v·|df|, stopped several ulps short where |df| is large: a fast tailwind.)
-        moving = (
-            (np.abs(f) > noise) & (step != vi) & (hi_i - lo_i > 2.0 * eps * np.maximum(hi_i, 0.0))
-        )
+        moving = (np.abs(f) > noise) & (step != vi) & (hi_i - lo_i > 2.0 * eps * np.maximum(hi_i, 0.0))
         v[idx[moving]] = step[moving]
         idx = idx[moving]
     # The nearest float: v or one of its neighbours (within the bracket [v0, ∞)).
@@ -443,9 +431,7 @@ def _cubic_guess(
     return np.where(np.isfinite(best), best, np.nan)
 
 
-def _cubic_real_roots(
-    b: NDArray[np.float64], c: NDArray[np.float64], d: NDArray[np.float64]
-) -> NDArray[np.float64]:
+def _cubic_real_roots(b: NDArray[np.float64], c: NDArray[np.float64], d: NDArray[np.float64]) -> NDArray[np.float64]:
     """Real roots of x³ + b·x² + c·x + d = 0, batched: (N, 3), NaN where a root is complex.
 
     Cardano for one real root, the trigonometric form for three (no complex arithmetic, no loops).
@@ -576,18 +562,14 @@ def air_density_weather(
         raise ValueError(f"pressure_hpa must be in [10, 1100] hPa, got {pressure_hpa!r}")
     rh = _finite("relative_humidity", relative_humidity)
     if np.any((rh < 0.0) | (rh > 1.0)):
-        raise ValueError(
-            f"relative_humidity must be a fraction in [0, 1], got {relative_humidity!r}"
-        )
+        raise ValueError(f"relative_humidity must be a fraction in [0, 1], got {relative_humidity!r}")
     e = rh * e_s
     if np.any(e >= p):
         raise ValueError("relative_humidity: the vapour pressure would reach the total pressure")
     return 100.0 * ((p - e) / (R_DRY_AIR * t_k) + e / (R_WATER_VAPOUR * t_k))
 
 
-_EARTH_RADIUS_ISA_M = (
-    6_356_766.0  # r₀ of the geopotential conversion, U.S. Standard Atmosphere 1976
-)
+_EARTH_RADIUS_ISA_M = 6_356_766.0  # r₀ of the geopotential conversion, U.S. Standard Atmosphere 1976
 
 
 def _isa_altitude(altitude_m: ArrayLike) -> NDArray[np.float64]:

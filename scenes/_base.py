@@ -218,9 +218,7 @@ class Scene(abc.ABC, Generic[P]):
             if threading.get_ident() != self._build_thread and not self._built.wait(BUILD_WAIT_S):
                 with self._pending_lock:
                     pending = False
-                logger.warning(
-                    "%s: the scene took over %.0f s to build; input dropped", self.key, BUILD_WAIT_S
-                )
+                logger.warning("%s: the scene took over %.0f s to build; input dropped", self.key, BUILD_WAIT_S)
                 return
             with self._lock:
                 with self._pending_lock:
@@ -318,9 +316,7 @@ class Scene(abc.ABC, Generic[P]):
         """Set GUI ``handle``'s value to ``value`` (a cleaned value, shown to every browser) without running this
         scene's handler of it again (the ``on_update`` the write triggers returns at once)."""
         was = self._in_callback
-        self._in_callback = (
-            True  # the synchronous on_update this triggers must not re-run the handler
-        )
+        self._in_callback = True  # the synchronous on_update this triggers must not re-run the handler
         try:
             handle.value = value
         finally:

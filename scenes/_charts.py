@@ -156,11 +156,7 @@ def log_ticks(lo: float, hi: float) -> tuple[tuple[float, ...], tuple[str, ...]]
 def whole_numbers(values: np.ndarray) -> bool:
     """Whether the finite values of a 1-D array are all whole numbers (and there is at least one)."""
     finite = values[np.isfinite(values)]
-    return (
-        bool(finite.size)
-        and bool(np.all(finite == np.round(finite)))
-        and bool(np.abs(finite).max() < 2**53)
-    )
+    return bool(finite.size) and bool(np.all(finite == np.round(finite))) and bool(np.abs(finite).max() < 2**53)
 
 
 # --------------------------------------------------------------------------------------------- fitting
@@ -177,9 +173,7 @@ def _range(values: Sequence[np.ndarray], log: bool) -> tuple[float, float] | Non
     return float(min(v.min() for v in finite)), float(max(v.max() for v in finite))
 
 
-def fit_x_scale(
-    data: Sequence[np.ndarray], scales: Mapping[str, Mapping[str, Any]]
-) -> dict[str, viser.uplot.Scale]:
+def fit_x_scale(data: Sequence[np.ndarray], scales: Mapping[str, Mapping[str, Any]]) -> dict[str, viser.uplot.Scale]:
     """``scales`` with the x scale pinned to the finite extent of ``data[0]`` (see the module's note).
 
     A flat x (one value) is widened to the next whole number when it is one (0 → 0..1, an iteration count), else
@@ -189,9 +183,7 @@ def fit_x_scale(
     """
     out = {key: viser.uplot.Scale(**scale) for key, scale in scales.items()}  # type: ignore[typeddict-item]
     x_scale = out.get("x", viser.uplot.Scale())
-    if (
-        "range" in x_scale or x_scale.get("distr") == 2
-    ):  # the caller's own range; ordinal x (index units)
+    if "range" in x_scale or x_scale.get("distr") == 2:  # the caller's own range; ordinal x (index units)
         return out
     found = _range([np.asarray(data[0], dtype=np.float64)], x_scale.get("distr") == 3)
     if found is None:
@@ -271,17 +263,9 @@ def fit_layout(
             sides.add(side)
         key = str(axis.get("scale", "x" if k == 0 else "y"))
         log = scales.get(key, {}).get("distr") == 3
-        values = (
-            [data[0]]
-            if key == "x"
-            else [d for d, s in zip(data[1:], y_scales, strict=True) if s == key]
-        )
+        values = [data[0]] if key == "x" else [d for d, s in zip(data[1:], y_scales, strict=True) if s == key]
         found = _range(values, log)
-        whole = (
-            not log
-            and bool(values)
-            and all(whole_numbers(np.asarray(v, dtype=np.float64)) for v in values)
-        )
+        whole = not log and bool(values) and all(whole_numbers(np.asarray(v, dtype=np.float64)) for v in values)
         if whole and "incrs" not in axis and "splits" not in axis:
             out["incrs"] = WHOLE_INCRS
         ticks = log_ticks(*found) if log and found is not None else None
@@ -293,12 +277,8 @@ def fit_layout(
                 widest = max(ticks[1], key=label_px)
             elif log:
                 widest = widest_log_label(*found)
-            elif (
-                whole and not vertical_axis
-            ):  # whole ticks over the pinned range, a unit past one point
-                widest = ("-" if found[0] < 0.0 else "") + format_label(
-                    max(abs(found[0]), abs(found[1]) + 1.0), 0
-                )
+            elif whole and not vertical_axis:  # whole ticks over the pinned range, a unit past one point
+                widest = ("-" if found[0] < 0.0 else "") + format_label(max(abs(found[0]), abs(found[1]) + 1.0), 0)
             else:
                 ticks_max, pad = (Y_TICKS_MAX, 0.1) if vertical_axis else (X_TICKS_MAX, 0.0)
                 widest = widest_linear_label(*found, ticks_max, pad)

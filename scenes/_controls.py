@@ -105,9 +105,7 @@ class Control:
             case "text":
                 return ControlSpec("text", costly=self.costly)
             case "rgb":
-                return ControlSpec(
-                    "rgb", lo=0.0, hi=255.0, integer=True, length=3, costly=self.costly
-                )
+                return ControlSpec("rgb", lo=0.0, hi=255.0, integer=True, length=3, costly=self.costly)
 
     @property
     def per_element(self) -> bool:
@@ -138,13 +136,9 @@ class Control:
                 assert self.lo is not None and self.hi is not None and self.step is not None
                 return gui.add_slider(label, self.lo, self.hi, self.step, value, **common)
             case "number":
-                return gui.add_number(
-                    label, value, min=self.lo, max=self.hi, step=self.step, **common
-                )
+                return gui.add_number(label, value, min=self.lo, max=self.hi, step=self.step, **common)
             case "dropdown":
-                return gui.add_dropdown(
-                    label, self.labels, initial_value=self.to_gui(value), **common
-                )
+                return gui.add_dropdown(label, self.labels, initial_value=self.to_gui(value), **common)
             case "checkbox":
                 return gui.add_checkbox(label, value, **common)
             case "text":
@@ -223,9 +217,7 @@ def dropdown(
 ) -> dict[str, Control]:
     """A dropdown of ``options`` (the field's possible values), shown as ``labels`` (default: the options)."""
     shown = tuple(str(option) for option in options) if labels is None else tuple(labels)
-    assert len(shown) == len(options) and len(set(shown)) == len(shown), (
-        "one distinct label per option"
-    )
+    assert len(shown) == len(options) and len(set(shown)) == len(shown), "one distinct label per option"
     return _declare(
         Control(
             "dropdown",
@@ -249,9 +241,7 @@ def checkbox(
     hint: str | None = None,
 ) -> dict[str, Control]:
     """A checkbox for a ``bool`` field."""
-    return _declare(
-        Control("checkbox", label, folder=folder, costly=costly, disabled=disabled, hint=hint)
-    )
+    return _declare(Control("checkbox", label, folder=folder, costly=costly, disabled=disabled, hint=hint))
 
 
 def text(
@@ -286,9 +276,7 @@ def rgb(
     hint: str | None = None,
 ) -> dict[str, Control]:
     """A colour picker for a ``tuple[int, int, int]`` field (0–255 each)."""
-    return _declare(
-        Control("rgb", label, folder=folder, costly=costly, disabled=disabled, hint=hint)
-    )
+    return _declare(Control("rgb", label, folder=folder, costly=costly, disabled=disabled, hint=hint))
 
 
 def declared(params_type: type[Any]) -> dict[str, Control]:
@@ -337,9 +325,7 @@ class Controls(Generic[P]):
         :func:`read_controls` reads them all."""
         assert self.params_type is other.params_type, "controls of two parameter types"
         assert not self.fields.keys() & other.fields.keys(), "a field built twice"
-        return Controls(
-            self.params_type, {**self.fields, **other.fields}, {**self.folders, **other.folders}
-        )
+        return Controls(self.params_type, {**self.fields, **other.fields}, {**self.folders, **other.folders})
 
     def __iter__(self) -> Iterator[Handle]:
         """Every handle, in field order."""
@@ -426,9 +412,7 @@ def read_controls(controls: Controls[P], last_good: P, *, write_back: WriteBack 
     return dataclasses.replace(last_good, **changes)
 
 
-def _read(
-    control: Control, spec: ControlSpec, handle: Handle, last_good: Any, write_back: WriteBack
-) -> Any:
+def _read(control: Control, spec: ControlSpec, handle: Handle, last_good: Any, write_back: WriteBack) -> Any:
     raw = handle.value
     accepted, cleaned, _reason = clean_value(spec, raw)
     if not accepted:

@@ -62,9 +62,7 @@ class Lens:
     def aspect(self) -> float:
         return self.width_px / self.height_px
 
-    def usable_ndc(
-        self, *, right_px: float = 0.0, top_px: float = 0.0
-    ) -> tuple[float, float, float, float]:
+    def usable_ndc(self, *, right_px: float = 0.0, top_px: float = 0.0) -> tuple[float, float, float, float]:
         """(x0, x1, y0, y1) of the canvas left of the panel, in normalised device coordinates.
 
         ``right_px`` and ``top_px`` keep extra room free for screen-sized things anchored at the points (labels).
@@ -137,9 +135,7 @@ def frame_points(
     # Also NaN: the rectangle is empty, or too small to hold the points from `far`.
     if not distance <= far:
         if ndc != FULL_NDC:
-            return frame_points(
-                pts, direction, fov_rad=fov_rad, aspect=aspect, ndc=FULL_NDC, min_depth=min_depth
-            )
+            return frame_points(pts, direction, fov_rad=fov_rad, aspect=aspect, ndc=FULL_NDC, min_depth=min_depth)
         distance = far
     depth = distance + w
     sx = _centring_shift(u, depth * tan_x, x0, x1)
@@ -152,9 +148,7 @@ def frame_points(
     )
 
 
-def _least_distance(
-    coord: NDArray[np.float64], w: NDArray[np.float64], tan: float, lo: float, hi: float
-) -> float:
+def _least_distance(coord: NDArray[np.float64], w: NDArray[np.float64], tan: float, lo: float, hi: float) -> float:
     """Least distance D at which some shift s puts every (coord_i − s)/((D + w_i)·tan) inside [lo, hi] (m).
 
     Feasible iff coord_i − hi·k_i ≤ coord_j − lo·k_j for every pair (i, j), with k = (D + w)·tan; the pairs separate,
@@ -167,9 +161,7 @@ def _least_distance(
     return (float(np.max(scaled - hi * w)) + float(np.max(lo * w - scaled))) / (hi - lo)
 
 
-def _centring_shift(
-    coord: NDArray[np.float64], scale: NDArray[np.float64], lo: float, hi: float
-) -> float:
+def _centring_shift(coord: NDArray[np.float64], scale: NDArray[np.float64], lo: float, hi: float) -> float:
     """The shift s with the projections p_i = (coord_i − s)/scale_i (scale > 0) centred in [lo, hi]:
     max p + min p = lo + hi, exactly (to rounding).
 
@@ -213,23 +205,14 @@ def project_points(view: View, lens: Lens, points: NDArray[np.float64]) -> NDArr
     tan_y = math.tan(0.5 * lens.fov_rad)
     ndc_x = (rel @ right) / (safe * tan_y * lens.aspect)
     ndc_y = (rel @ up) / (safe * tan_y)
-    return np.stack(
-        [0.5 * (ndc_x + 1.0) * lens.width_px, 0.5 * (1.0 - ndc_y) * lens.height_px, depth], axis=1
-    )
+    return np.stack([0.5 * (ndc_x + 1.0) * lens.width_px, 0.5 * (1.0 - ndc_y) * lens.height_px, depth], axis=1)
 
 
-def box_corners(
-    lo: NDArray[np.float64] | tuple, hi: NDArray[np.float64] | tuple
-) -> NDArray[np.float64]:
+def box_corners(lo: NDArray[np.float64] | tuple, hi: NDArray[np.float64] | tuple) -> NDArray[np.float64]:
     """(8, 3) corners of the axis-aligned box [lo, hi]."""
     lo_a, hi_a = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
     return np.array(
-        [
-            [(lo_a, hi_a)[i][0], (lo_a, hi_a)[j][1], (lo_a, hi_a)[k][2]]
-            for i in (0, 1)
-            for j in (0, 1)
-            for k in (0, 1)
-        ]
+        [[(lo_a, hi_a)[i][0], (lo_a, hi_a)[j][1], (lo_a, hi_a)[k][2]] for i in (0, 1) for j in (0, 1) for k in (0, 1)]
     )
 
 

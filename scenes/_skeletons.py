@@ -80,9 +80,7 @@ class Skeleton:
     root_direction: tuple[float, float, float] = (0.0, 0.0, 1.0)
 
 
-def _chain(
-    start: NDArray[np.float64], directions: list[NDArray[np.float64]], lengths: list[float]
-) -> list:
+def _chain(start: NDArray[np.float64], directions: list[NDArray[np.float64]], lengths: list[float]) -> list:
     points, here = [], start
     for direction, length in zip(directions, lengths, strict=True):
         here = here + length * direction / np.linalg.norm(direction)
@@ -92,11 +90,7 @@ def _chain(
 
 def _turned(u: NDArray[np.float64], axis: NDArray[np.float64], angle: float) -> NDArray[np.float64]:
     """u turned by ``angle`` (rad) about the unit axis (Rodrigues)."""
-    return (
-        u * math.cos(angle)
-        + np.cross(axis, u) * math.sin(angle)
-        + axis * float(axis @ u) * (1.0 - math.cos(angle))
-    )
+    return u * math.cos(angle) + np.cross(axis, u) * math.sin(angle) + axis * float(axis @ u) * (1.0 - math.cos(angle))
 
 
 def robot_arm() -> Skeleton:
@@ -160,9 +154,7 @@ def hand(curl_rad: float = 0.15, target_curl_rad: float = 0.6) -> Skeleton:
             u = np.array([0.6, -0.3, 0.75]) if f == 0 else palm / np.linalg.norm(palm)
             u = u / np.linalg.norm(u)
             bend = curls[f] - float(curls[f] @ u) * u
-            axis = np.cross(
-                u, bend / np.linalg.norm(bend)
-            )  # turning u about it by +θ curls toward the palm
+            axis = np.cross(u, bend / np.linalg.norm(bend))  # turning u about it by +θ curls toward the palm
             metacarpal = palm / np.linalg.norm(palm)
             weld_axis = np.cross(metacarpal, np.array([0.0, -1.0, 0.0]))
             parents.append(0)
@@ -209,17 +201,22 @@ def upper_body() -> Skeleton:
     for side, colour in ((-1.0, 0), (1.0, 1)):
         start = len(points)
         parents.extend([3, start, start + 1, start + 2])
-        arm = _chain(points[3], [np.array([side, 0.0, -0.1]), np.array([side, 0.0, -0.4]),
-                                 np.array([side * 0.6, -0.2, -1.0]), np.array([side * 0.3, -0.1, -1.0])],
-                     [0.18, 0.3, 0.28, 0.1])  # fmt: skip
+        arm = _chain(
+            points[3],
+            [
+                np.array([side, 0.0, -0.1]),
+                np.array([side, 0.0, -0.4]),
+                np.array([side * 0.6, -0.2, -1.0]),
+                np.array([side * 0.3, -0.1, -1.0]),
+            ],
+            [0.18, 0.3, 0.28, 0.1],
+        )
         points.extend(arm)
         cones.extend([1.75, 1.4, 2.4, 0.8])
         chain_of.extend([5, colour, colour, colour])
     joints = np.array(points)
     effectors = (5, 9, 13)
-    targets = joints[list(effectors)] + np.array(
-        [[0.05, -0.02, -0.03], [-0.1, -0.2, 0.3], [0.15, -0.2, 0.35]]
-    )
+    targets = joints[list(effectors)] + np.array([[0.05, -0.02, -0.03], [-0.1, -0.2, 0.3], [0.15, -0.2, 0.35]])
     return Skeleton(
         name="Upper body",
         parents=tuple(parents),
@@ -263,16 +260,18 @@ def joint_usage(skeleton: Skeleton, joints: NDArray[np.float64]) -> NDArray[np.f
         if grand < 0:
             usage[j] = fabrik.limit_usage(joints[[up, j]], [constraint], skeleton.root_direction)[0]
         else:
-            usage[j] = fabrik.limit_usage(
-                joints[[grand, up, j]], [None, constraint], skeleton.root_direction
-            )[1]
+            usage[j] = fabrik.limit_usage(joints[[grand, up, j]], [None, constraint], skeleton.root_direction)[1]
     return usage
 
 
 def solve_skeleton(
-    skeleton: Skeleton, pose: NDArray[np.float64], targets: NDArray[np.float64], *, tolerance_m: float,
+    skeleton: Skeleton,
+    pose: NDArray[np.float64],
+    targets: NDArray[np.float64],
+    *,
+    tolerance_m: float,
     max_iterations: int,
-) -> SkeletonReport:  # fmt: skip
+) -> SkeletonReport:
     """One frame: every effector toward its target, from the last pose (no viser); where an effector is stuck
     ("limited" more than 10 tolerances away) also from the rest pose, keeping the closer result."""
     goal = {e: targets[k] for k, e in enumerate(skeleton.effectors)}
@@ -287,10 +286,7 @@ def solve_skeleton(
         root_direction=skeleton.root_direction,
     )
     result = solve(pose)
-    stuck = any(
-        s == "limited" and e > 10.0 * tolerance_m
-        for s, e in zip(result.status, result.error, strict=True)
-    )
+    stuck = any(s == "limited" and e > 10.0 * tolerance_m for s, e in zip(result.status, result.error, strict=True))
     if stuck:
         # A finger curled far past its target can settle at a fixed point of FABRIK's hinge passes (the forward
         # pass flips its curled links); from the rest pose it opens. Keep whichever is closer.
@@ -306,10 +302,7 @@ def hinge_axes(skeleton: Skeleton, joints: NDArray[np.float64]) -> NDArray[np.fl
     bars = []
     rest = np.asarray(skeleton.root_direction)
     for j, constraint in enumerate(skeleton.constraints):
-        if (
-            not isinstance(constraint, fabrik.Hinge)
-            or constraint.max_angle_rad == constraint.min_angle_rad
-        ):
+        if not isinstance(constraint, fabrik.Hinge) or constraint.max_angle_rad == constraint.min_angle_rad:
             continue  # a weld has no axis to show
         up = skeleton.parents[j]
         axis = np.asarray(constraint.axis, dtype=np.float64)
@@ -321,9 +314,7 @@ def hinge_axes(skeleton: Skeleton, joints: NDArray[np.float64]) -> NDArray[np.fl
             sin_a, cos_a = float(np.linalg.norm(turn)), float(rest @ previous)
             if sin_a > 1e-12:
                 axis = _turned(axis, turn / sin_a, math.atan2(sin_a, cos_a))
-        bars.append(
-            [joints[up] - AXIS_HALF_LENGTH_M * axis, joints[up] + AXIS_HALF_LENGTH_M * axis]
-        )
+        bars.append([joints[up] - AXIS_HALF_LENGTH_M * axis, joints[up] + AXIS_HALF_LENGTH_M * axis])
     return np.array(bars, dtype=np.float64).reshape(-1, 2, 3)
 
 
@@ -341,11 +332,7 @@ def clean_target(raw: object, planar: bool) -> NDArray[np.float64] | None:
         point = np.asarray(raw, dtype=np.float64)
     except (TypeError, ValueError):
         return None
-    if (
-        point.shape != (3,)
-        or not np.all(np.isfinite(point))
-        or np.any(np.abs(point) > WORLD_LIMIT_M)
-    ):
+    if point.shape != (3,) or not np.all(np.isfinite(point)) or np.any(np.abs(point) > WORLD_LIMIT_M):
         return None
     if planar:
         point = point.copy()
@@ -416,9 +403,7 @@ class SkeletonView:
                 translation_limits=(box, box, box),
                 visible=False,
             )
-            server.scene.add_icosphere(
-                f"{root}/skeleton/target_{k}/marker", radius=0.025, color=TARGET_COLOURS[k]
-            )
+            server.scene.add_icosphere(f"{root}/skeleton/target_{k}/marker", radius=0.025, color=TARGET_COLOURS[k])
             # One wrapper per gizmo, made once, so a burst of drag messages coalesces (Scene.callback).
             gizmo.on_update(self.scene.callback(functools.partial(self._apply_target, k)))
             self.gizmos.append(gizmo)
@@ -563,8 +548,7 @@ class SkeletonView:
     def _readout(self, sk: Skeleton, report: SkeletonReport) -> str:
         r = report.result
         rows = "\n".join(
-            f"| {label} | {r.error[k] * 1000.0:.2f} | {r.status[k]} |"
-            for k, label in enumerate(sk.effector_labels)
+            f"| {label} | {r.error[k] * 1000.0:.2f} | {r.status[k]} |" for k, label in enumerate(sk.effector_labels)
         )
         return (
             f"**{sk.name}**: {r.iterations} iteration{'s' if r.iterations != 1 else ''}, "

@@ -105,9 +105,7 @@ class LatestWorker:
                 return
             except Exception:
                 logger.exception("%s: the error handler failed too", self.thread.name)
-        logger.error(
-            "%s: a background job failed; the last result stays", self.thread.name, exc_info=error
-        )
+        logger.error("%s: a background job failed; the last result stays", self.thread.name, exc_info=error)
 
     def _run(self) -> None:
         while (job := self._next_job()) is not None:

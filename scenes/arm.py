@@ -66,19 +66,13 @@ class ArmParams:
     Each field is also its GUI control, declared once (:mod:`scenes._controls`), in the order and folder shown.
     """
 
-    preset: PresetLabel = field(
-        default="Chain", metadata=dropdown("Preset", PRESET_LABELS, folder="Skeleton")
-    )
+    preset: PresetLabel = field(default="Chain", metadata=dropdown("Preset", PRESET_LABELS, folder="Skeleton"))
     """What is shown: the scene's own chain, or a skeleton preset (:mod:`scenes._skeletons`) in its place."""
     n_links: int = field(default=6, metadata=slider("Links", 2, MAX_LINKS, 1, folder="Chain"))
     """Links in the chain (2–12)."""
-    link_length_m: float = field(
-        default=0.25, metadata=slider("Link length (m)", 0.05, 0.5, 0.01, folder="Chain")
-    )
+    link_length_m: float = field(default=0.25, metadata=slider("Link length (m)", 0.05, 0.5, 0.01, folder="Chain"))
     """Length of every link (m)."""
-    three_d: bool = field(
-        default=False, metadata=checkbox("3D (free target, sphere obstacles)", folder="Chain")
-    )
+    three_d: bool = field(default=False, metadata=checkbox("3D (free target, sphere obstacles)", folder="Chain"))
     """False: the chain moves in the vertical x–z plane; True: in 3D."""
     limits: bool = field(default=False, metadata=checkbox("Joint limits", folder="Joint limits"))
     """Whether joint limits (cones) apply."""
@@ -89,9 +83,7 @@ class ArmParams:
     """Cone half-angle of every joint (degrees)."""
     avoid: bool = field(default=True, metadata=checkbox("Avoid obstacles", folder="Obstacles"))
     """Whether the solver avoids the obstacles (when off they are drawn but ignored)."""
-    n_obstacles: int = field(
-        default=1, metadata=slider("Obstacles", 0, MAX_OBSTACLES, 1, folder="Obstacles")
-    )
+    n_obstacles: int = field(default=1, metadata=slider("Obstacles", 0, MAX_OBSTACLES, 1, folder="Obstacles"))
     """Obstacles shown (0–4)."""
     radii_m: tuple[float, ...] = field(
         default=(0.18, 0.15, 0.12, 0.2),
@@ -102,19 +94,13 @@ class ArmParams:
         default="FABRIK", metadata=dropdown("Solver", tuple(SOLVER_FROM_LABEL), folder="Solver")
     )
     """Iterative method."""
-    tolerance_mm: float = field(
-        default=1.0, metadata=slider("Tolerance (mm)", 0.01, 50.0, 0.01, folder="Solver")
-    )
+    tolerance_mm: float = field(default=1.0, metadata=slider("Tolerance (mm)", 0.01, 50.0, 0.01, folder="Solver"))
     """Stop when the end effector is this close to the target (mm)."""
-    max_iterations: int = field(
-        default=50, metadata=slider("Max iterations", 1, 500, 1, folder="Solver")
-    )
+    max_iterations: int = field(default=50, metadata=slider("Max iterations", 1, 500, 1, folder="Solver"))
     """Iteration cap per solve."""
 
 
-OBSTACLE_STARTS = np.array(
-    [[0.45, 0.0, 0.45], [-0.6, 0.0, 0.9], [0.3, 0.0, 1.45], [-0.4, 0.0, 0.3]]
-)
+OBSTACLE_STARTS = np.array([[0.45, 0.0, 0.45], [-0.6, 0.0, 0.9], [0.3, 0.0, 1.45], [-0.4, 0.0, 0.3]])
 """Where the obstacles open (world, m)."""
 TARGET_START = np.array([0.9, 0.0, 0.6])
 
@@ -153,18 +139,14 @@ def to_world(points: NDArray[np.float64], three_d: bool) -> NDArray[np.float64]:
     return np.stack([points[..., 0], np.zeros(points.shape[:-1]), points[..., 1]], axis=-1)
 
 
-def segment_pose(
-    start: NDArray[np.float64], end: NDArray[np.float64]
-) -> tuple[NDArray[np.float64], ...]:
+def segment_pose(start: NDArray[np.float64], end: NDArray[np.float64]) -> tuple[NDArray[np.float64], ...]:
     """wxyz (N, 4) turning +z onto each segment, and lengths (N,), for (N, 3) starts and ends."""
     offset = end - start
     length = np.linalg.norm(offset, axis=1)
     direction = offset / np.where(length > 1e-12, length, 1.0)[:, None]
     direction[length <= 1e-12] = (0.0, 0.0, 1.0)
     # Half-way quaternion from +z to d: (1 + d_z, z × d) normalised; antiparallel: 180° about x.
-    wxyz = np.stack(
-        [1.0 + direction[:, 2], -direction[:, 1], direction[:, 0], np.zeros(len(length))], axis=1
-    )
+    wxyz = np.stack([1.0 + direction[:, 2], -direction[:, 1], direction[:, 0], np.zeros(len(length))], axis=1)
     flipped = direction[:, 2] < -1.0 + 1e-9
     wxyz[flipped] = (0.0, 1.0, 0.0, 0.0)
     return wxyz / np.linalg.norm(wxyz, axis=1, keepdims=True), length
@@ -196,10 +178,7 @@ def solve_arm(
     """Solve one frame: the chosen solver from ``joints`` toward ``target``, and the two-bone ghost (no viser)."""
     three_d = params.three_d
     obstacles = (
-        [
-            (to_kernel(obstacle_centres[k], three_d), params.radii_m[k])
-            for k in range(params.n_obstacles)
-        ]
+        [(to_kernel(obstacle_centres[k], three_d), params.radii_m[k]) for k in range(params.n_obstacles)]
         if params.avoid
         else []
     )
@@ -224,9 +203,7 @@ def solve_arm(
     micros = (time.perf_counter() - began) * 1e6
 
     lengths = fabrik.link_lengths(start)
-    upper, lower = (
-        (lengths[0], lengths[1]) if len(lengths) == 2 else (lengths.sum() / 2, lengths.sum() / 2)
-    )
+    upper, lower = (lengths[0], lengths[1]) if len(lengths) == 2 else (lengths.sum() / 2, lengths.sum() / 2)
     middle = result.joints[len(lengths) // 2]
     bend = middle - result.joints[0]
     ghost = fabrik.two_bone(start[0], float(upper), float(lower), goal, bend)
@@ -248,11 +225,7 @@ def clean_point(raw: object, three_d: bool) -> NDArray[np.float64] | None:
         point = np.asarray(raw, dtype=np.float64)
     except (TypeError, ValueError):
         return None
-    if (
-        point.shape != (3,)
-        or not np.all(np.isfinite(point))
-        or np.any(np.abs(point) > WORLD_LIMIT_M)
-    ):
+    if point.shape != (3,) or not np.all(np.isfinite(point)) or np.any(np.abs(point) > WORLD_LIMIT_M):
         return None
     if not three_d:
         point = point.copy()
@@ -288,19 +261,10 @@ def framed_points(
     """
     axes = np.eye(3) if params.three_d else np.eye(3)[[0, 2]]
     depth = BASE_HALF_M  # the plate is a box in the plane too: its near face must fit
-    base = np.array(
-        [
-            [x, y, z]
-            for x in (-BASE_HALF_M, BASE_HALF_M)
-            for y in (-depth, depth)
-            for z in (-0.06, 0.0)
-        ]
-    )
+    base = np.array([[x, y, z] for x in (-BASE_HALF_M, BASE_HALF_M) for y in (-depth, depth) for z in (-0.06, 0.0)])
     shown = obstacle_centres[: params.n_obstacles]
     radii = np.asarray(params.radii_m[: params.n_obstacles], dtype=np.float64)
-    rims = (shown[:, None, :] + radii[:, None, None] * np.vstack([axes, -axes])[None]).reshape(
-        -1, 3
-    )
+    rims = (shown[:, None, :] + radii[:, None, None] * np.vstack([axes, -axes])[None]).reshape(-1, 3)
     handles = np.vstack([target[None, :], shown])
     tips = (handles[:, None, :] + GIZMO_SCALE_M * axes[None]).reshape(-1, 3)
     return np.vstack([pose, base, target[None, :], rims, tips])
@@ -390,9 +354,7 @@ is a static pose.
     def _build_gui(self) -> None:
         gui, p = self.server.gui, self.params
         with self.gui_root:
-            skeleton = build_controls(
-                gui, p, names=("preset",)
-            )  # first: the panel opens with the menu on top
+            skeleton = build_controls(gui, p, names=("preset",))  # first: the panel opens with the menu on top
             with gui.add_folder("This frame"):
                 self.readout = gui.add_markdown("")
                 self.ghost_readout = gui.add_markdown("")
@@ -542,9 +504,7 @@ is a static pose.
     # ----------------------------------------------------------------------------------------- callbacks
     def _on_target_drag(self, event: object) -> None:
         self._apply_target_cb(None)
-        if (
-            getattr(event, "phase", None) == "end"
-        ):  # not mid-drag: the view must not move under the mouse
+        if getattr(event, "phase", None) == "end":  # not mid-drag: the view must not move under the mouse
             self._reframe_cb(None)
 
     def _apply_target(self) -> None:
@@ -582,9 +542,7 @@ is a static pose.
         self.solve_and_draw()
 
     def _on_scene_click(self, event: viser.SceneClickEvent) -> None:
-        self.callback(functools.partial(self._apply_click, event.ray_origin, event.ray_direction))(
-            None
-        )
+        self.callback(functools.partial(self._apply_click, event.ray_origin, event.ray_direction))(None)
 
     def _apply_click(self, origin: object, direction: object) -> None:
         """Place the target where the click's ray meets the chain's plane (y = 0, or the target's y in 3D)."""
@@ -593,11 +551,7 @@ is a static pose.
             d = np.asarray(direction, dtype=np.float64)
         except (TypeError, ValueError):
             return
-        if (
-            o.shape != (3,)
-            or d.shape != (3,)
-            or not (np.all(np.isfinite(o)) and np.all(np.isfinite(d)))
-        ):
+        if o.shape != (3,) or d.shape != (3,) or not (np.all(np.isfinite(o)) and np.all(np.isfinite(d))):
             return
         if abs(d[1]) < 1e-9:
             return  # a ray parallel to the plane never meets it
@@ -658,9 +612,7 @@ is a static pose.
         view = self.skeletons
         if not view.active:
             return framed_points(self.params, self.pose, self.target, self.obstacle_centres)
-        arrows = (view.targets[:, None, :] + SKELETON_GIZMO_M * np.eye(3)[None, :, :]).reshape(
-            -1, 3
-        )
+        arrows = (view.targets[:, None, :] + SKELETON_GIZMO_M * np.eye(3)[None, :, :]).reshape(-1, 3)
         return np.vstack([view.pose, view.targets, arrows])
 
     def _reframe_if_outgrown(self) -> None:
@@ -714,9 +666,7 @@ is a static pose.
         link_pos = np.zeros((MAX_LINKS, 3))
         link_pos[:n] = joints[:-1]
         link_scale = np.zeros((MAX_LINKS, 3))
-        link_scale[:n] = np.stack(
-            [np.full(n, LINK_RADIUS_M), np.full(n, LINK_RADIUS_M), lengths], axis=1
-        )
+        link_scale[:n] = np.stack([np.full(n, LINK_RADIUS_M), np.full(n, LINK_RADIUS_M), lengths], axis=1)
         joint_pos = np.zeros((MAX_LINKS + 1, 3))
         joint_pos[: n + 1] = joints
         joint_scale = np.zeros((MAX_LINKS + 1, 3))

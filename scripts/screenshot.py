@@ -20,8 +20,8 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tests"))
 
-from browser import scene_page, screenshot  # noqa: E402
-from conftest import CHROMIUM, CHROMIUM_ARGS  # noqa: E402
+from helpers.browser import scene_page, screenshot  # noqa: E402
+from helpers.ci import CHROMIUM, CHROMIUM_ARGS  # noqa: E402
 
 from scenes import SCENES  # noqa: E402
 

@@ -20,16 +20,14 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tests"))
 
-from browser import open_viser  # noqa: E402
-from conftest import CHROMIUM, CHROMIUM_ARGS  # noqa: E402
+from helpers.browser import open_viser  # noqa: E402
+from helpers.ci import CHROMIUM, CHROMIUM_ARGS  # noqa: E402
 
 from scenes.peloton import PelotonScene  # noqa: E402
 from server.switcher import SceneSwitcher  # noqa: E402
 
 
-def main(
-    out: Path = ROOT / "docs" / "peloton_course.png", at_km: float = 5.5, settle_s: float = 5.0
-) -> None:
+def main(out: Path = ROOT / "docs" / "peloton_course.png", at_km: float = 5.5, settle_s: float = 5.0) -> None:
     """Screenshot the course mode.
 
     Args:
@@ -54,9 +52,12 @@ def main(
     with sync_playwright() as playwright:
         profile = tempfile.mkdtemp(prefix="chromium-shot-")
         context = playwright.chromium.launch_persistent_context(
-            profile, executable_path=CHROMIUM, headless=True, args=CHROMIUM_ARGS,
+            profile,
+            executable_path=CHROMIUM,
+            headless=True,
+            args=CHROMIUM_ARGS,
             viewport={"width": 1600, "height": 1000},
-        )  # fmt: skip
+        )
         try:
             page = context.new_page()
             open_viser(page, server.get_port(), "/peloton/course_mode/route")

@@ -88,9 +88,7 @@ class CostlyBudget(typing.Generic[Item]):
         self._tokens = min(float(self.burst), self._tokens + elapsed * self.rate_hz)
         self._refilled_at = max(now, self._refilled_at)
 
-    def offer(
-        self, key: str, item: Item, now: float, *, free: bool = False, hold: bool = False
-    ) -> tuple[bool, bool]:
+    def offer(self, key: str, item: Item, now: float, *, free: bool = False, hold: bool = False) -> tuple[bool, bool]:
         """(goes now, replaced one held back) for ``item``, the new value of control ``key``.
 
         A ``free`` input (a cheap control, a gizmo) costs no token: it goes at once unless inputs are held back,

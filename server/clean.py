@@ -65,9 +65,7 @@ def spec_from_handle(handle: object) -> ControlSpec:
         return ControlSpec("text")
     if isinstance(handle, (viser.GuiVector2Handle, viser.GuiVector3Handle)):
         return ControlSpec("vector", length=len(handle.value))
-    return ControlSpec(
-        "display"
-    )  # progress bars, uploads, button groups...: nothing a browser may set
+    return ControlSpec("display")  # progress bars, uploads, button groups...: nothing a browser may set
 
 
 # viser's handles are dataclasses compared by value, so unhashable: no WeakKeyDictionary. The specs are kept by the

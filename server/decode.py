@@ -49,10 +49,7 @@ _ALLOWED_BY_NAME = {cls.__name__: cls for cls in ALLOWED_MESSAGES}
 def camera_fields(message: messages.ViewerCameraMessage) -> tuple[dict[str, Any] | None, str]:
     """(the camera's fields, cleaned, or None; the first field that is not a camera a browser can have, or "")."""
     wxyz = unit_quaternion(message.wxyz)
-    points = {
-        name: finite_vector(getattr(message, name), 3)
-        for name in ("position", "look_at", "up_direction")
-    }
+    points = {name: finite_vector(getattr(message, name), 3) for name in ("position", "look_at", "up_direction")}
     fov, near, far = (finite_number(v) for v in (message.fov, message.near, message.far))
     sizes = {"image_height": message.image_height, "image_width": message.image_width}
     if wxyz is None:
@@ -136,9 +133,7 @@ def decode_frame(raw: object) -> messages.Message | None:
             # field itself, so these warnings would only repeat what it refuses.
             warnings.simplefilter("ignore")
             message = messages.Message.deserialize(raw)
-    except (
-        Exception
-    ) as error:  # the frame's fields do not fit the message: refused, the connection stays up
+    except Exception as error:  # the frame's fields do not fit the message: refused, the connection stays up
         refusals.refuse(f"malformed {kind}", f"{type(error).__name__}: {error}")
         return None
     if not isinstance(message, _ALLOWED_BY_NAME[kind]):

@@ -87,9 +87,7 @@ class Gate:
     # Every message reaches viser's server-scoped and its connection-scoped handlers (two tasks). The gate takes
     # the connection's dispatch for itself and runs both from one place, after cleaning.
     def _on_connect(self, connection: Any) -> None:
-        self._client_dispatch[int(connection.client_id)] = viser_compat.take_connection_dispatch(
-            connection
-        )
+        self._client_dispatch[int(connection.client_id)] = viser_compat.take_connection_dispatch(connection)
         connection.queue_message(messages.RunJavascriptMessage(source=CSS_CAMERA_JS))
 
     def _on_disconnect(self, connection: Any) -> None:
@@ -106,22 +104,14 @@ class Gate:
             return
         try:
             cleaned, after = self._clean(server, int(client_id), message)
-            if isinstance(cleaned, IN_LINE) and not self._admit(
-                server, int(client_id), cleaned, after
-            ):
+            if isinstance(cleaned, IN_LINE) and not self._admit(server, int(client_id), cleaned, after):
                 return  # held back, coalesced: delivered when the tab's budget allows
-        except (
-            Exception
-        ) as error:  # a gate bug must not take the connection down, nor let the message through
-            self.log.refuse(
-                f"unreadable {type(message).__name__}", f"{type(error).__name__}: {error}"
-            )
+        except Exception as error:  # a gate bug must not take the connection down, nor let the message through
+            self.log.refuse(f"unreadable {type(message).__name__}", f"{type(error).__name__}: {error}")
             return
         await self._deliver(client_id, cleaned, after)
 
-    async def _deliver(
-        self, client_id: Any, cleaned: Any, after: Callable[[], None] | None
-    ) -> None:
+    async def _deliver(self, client_id: Any, cleaned: Any, after: Callable[[], None] | None) -> None:
         if cleaned is not None:
             await self._server_dispatch(client_id, cleaned)
             client_dispatch = self._client_dispatch.get(int(client_id))
@@ -158,9 +148,7 @@ class Gate:
             return False
         now = time.monotonic()
         if tab is None:
-            tab = self._budgets[client_id] = TabBudget(
-                CostlyBudget(budget.COSTLY_BURST, budget.COSTLY_RATE_HZ, now)
-            )
+            tab = self._budgets[client_id] = TabBudget(CostlyBudget(budget.COSTLY_BURST, budget.COSTLY_RATE_HZ, now))
         goes, replaced = tab.budget.offer(key, (message, after, None), now)
         if goes:
             self._deliver_costly(client_id, tab, message, after)
@@ -180,9 +168,7 @@ class Gate:
         handle = self._gui_handle(server, client_id, str(message.uuid))
         return handle is not None and control_spec(handle).costly
 
-    def _deliver_costly(
-        self, client_id: int, tab: TabBudget, message: Any, after: Callable[[], None] | None
-    ) -> None:
+    def _deliver_costly(self, client_id: int, tab: TabBudget, message: Any, after: Callable[[], None] | None) -> None:
         """Deliver a costly input as a task; until its handler has finished, the tab's cheap inputs wait."""
         tab.in_flight += 1
 
@@ -193,9 +179,7 @@ class Gate:
 
         self._start(client_id, message, after).add_done_callback(finished)
 
-    def _start(
-        self, client_id: int, message: Any, after: Callable[[], None] | None
-    ) -> asyncio.Future[None]:
+    def _start(self, client_id: int, message: Any, after: Callable[[], None] | None) -> asyncio.Future[None]:
         task = asyncio.ensure_future(self._deliver(client_id, message, after))
         self._deliveries.add(task)  # asyncio keeps only a weak reference to a running task
         task.add_done_callback(self._deliveries.discard)
@@ -222,10 +206,7 @@ class Gate:
         try:
             if taken is not None and server is not None:
                 key, (message, after, label) = taken
-                if (
-                    isinstance(message, messages.GuiUpdateMessage)
-                    and self._gui_handle(server, client_id, key) is None
-                ):
+                if isinstance(message, messages.GuiUpdateMessage) and self._gui_handle(server, client_id, key) is None:
                     # The control went meanwhile: a Reset or scene switch held back before it rebuilt its scene.
                     # An edit made after it goes to the rebuilt scene's control of the same kind, label and
                     # folders (a person who clicked Reset, then moved Speed, expects Speed to stick); with none,
@@ -240,16 +221,12 @@ class Gate:
         finally:
             self._schedule(client_id, tab)
 
-    def _control_path(
-        self, server: viser.ViserServer, client_id: int, handle: Any
-    ) -> tuple[type, str]:
+    def _control_path(self, server: viser.ViserServer, client_id: int, handle: Any) -> tuple[type, str]:
         """(handle type, its label under the labels of the folders it sits in): which control it is to a person,
         the same for a control rebuilt by a Reset and different in another scene (under another scene's folder)."""
         names = [str(getattr(handle, "label", ""))]
         parent = viser_compat.parent_container_id(handle)
-        for _ in range(
-            32
-        ):  # folders nest a few deep; a cycle would be viser's bug, not a hang here
+        for _ in range(32):  # folders nest a few deep; a cycle would be viser's bug, not a hang here
             if parent == "root":
                 break
             container = viser_compat.gui_container_by_uuid(server, client_id, parent)
@@ -284,9 +261,7 @@ class Gate:
         ]
         if len(matches) != 1:
             return None, None
-        return self._clean_gui(
-            server, client_id, messages.GuiUpdateMessage(matches[0], message.updates)
-        )
+        return self._clean_gui(server, client_id, messages.GuiUpdateMessage(matches[0], message.updates))
 
     def uploads_in_flight(self) -> tuple[int, int]:
         """(uploads, bytes they announced) started and not finished, across every tab of this server."""
@@ -303,9 +278,7 @@ class Gate:
     def _client(self, server: viser.ViserServer, client_id: int) -> viser.ClientHandle | None:
         return viser_compat.connected_client(server, client_id)
 
-    def _clean(
-        self, server: viser.ViserServer, client_id: int, message: Any
-    ) -> tuple[Any, Callable[[], None] | None]:
+    def _clean(self, server: viser.ViserServer, client_id: int, message: Any) -> tuple[Any, Callable[[], None] | None]:
         if isinstance(message, messages.GuiUpdateMessage):
             return self._clean_gui(server, client_id, message)
         if isinstance(message, messages.TransformControlsUpdateMessage):
@@ -316,9 +289,7 @@ class Gate:
             # A drag ends: every viewer, the dragging one too, is sent the gizmo's pose on the server (during the
             # drag the sender is not, so its own gizmo does not fight the mouse).
             handle = self._gizmo_handle(server, client_id, str(message.name), str(message.owner))
-            return message, None if handle is None else functools.partial(
-                viser_compat.send_gizmo_pose, handle
-            )
+            return message, None if handle is None else functools.partial(viser_compat.send_gizmo_pose, handle)
         if isinstance(message, (messages.ScenePointerMessage, messages.SceneNodeClickMessage)):
             reason = click_problem(message)
             if reason:
@@ -342,9 +313,7 @@ class Gate:
     ) -> tuple[Any, Callable[[], None] | None]:
         updates = message.updates
         if not isinstance(updates, dict) or set(updates) != {"value"}:
-            fields = (
-                sorted(str(key)[:40] for key in updates) if isinstance(updates, dict) else updates
-            )
+            fields = sorted(str(key)[:40] for key in updates) if isinstance(updates, dict) else updates
             self.log.refuse("GUI update of a field other than value", f"fields {fields!r}")
             return None, None
         handle = self._gui_handle(server, client_id, str(message.uuid))
@@ -368,9 +337,7 @@ class Gate:
         handle = self._gui_handle(server, client_id, str(message.source_component_uuid))
         size, parts = message.size_bytes, message.part_count
         if not isinstance(handle, viser.GuiUploadButtonHandle):
-            self.log.refuse(
-                "upload for an unknown id", f"uuid {str(message.source_component_uuid)[:64]!r}"
-            )
+            self.log.refuse("upload for an unknown id", f"uuid {str(message.source_component_uuid)[:64]!r}")
             return None, None
         if not all(isinstance(x, int) and not isinstance(x, bool) for x in (size, parts)) or (
             not 0 <= parts <= max(1, -(-size // MIN_PART_BYTES)) or (size > 0) != (parts > 0)
@@ -382,8 +349,7 @@ class Gate:
             return None, self._tell(
                 server,
                 client_id,
-                f"The file is {size / MIB:.1f} MiB; this server takes files up to "
-                f"{MAX_UPLOAD_BYTES / MIB:.0f} MiB.",
+                f"The file is {size / MIB:.1f} MiB; this server takes files up to {MAX_UPLOAD_BYTES / MIB:.0f} MiB.",
             )
         if not all(
             isinstance(x, str) and len(x) <= MAX_NAME_CHARS
@@ -418,10 +384,7 @@ class Gate:
                 f"{MAX_UPLOAD_BYTES_IN_FLIGHT_PER_TAB / MIB:.0f} MiB at once. Wait for them to finish.",
             )
         count, total_bytes = self.uploads_in_flight()
-        if (
-            count >= MAX_UPLOADS_IN_FLIGHT_TOTAL
-            or total_bytes + size > MAX_UPLOAD_BYTES_IN_FLIGHT_TOTAL
-        ):
+        if count >= MAX_UPLOADS_IN_FLIGHT_TOTAL or total_bytes + size > MAX_UPLOAD_BYTES_IN_FLIGHT_TOTAL:
             self.log.refuse(
                 "uploads in flight across all tabs",
                 f"{count} uploads of {total_bytes} bytes under way, {size} more asked (limits "
@@ -445,9 +408,7 @@ class Gate:
         def notify() -> None:
             client = self._client(server, client_id)
             if client is not None:
-                client.add_notification(
-                    "Upload refused", body, color="red", auto_close_seconds=15.0
-                )
+                client.add_notification("Upload refused", body, color="red", auto_close_seconds=15.0)
 
         return notify
 
@@ -488,9 +449,7 @@ class Gate:
             del self._uploads[client_id][str(message.transfer_uuid)]
         return message
 
-    def _gizmo_handle(
-        self, server: viser.ViserServer, client_id: int, name: str, owner: str
-    ) -> Any:
+    def _gizmo_handle(self, server: viser.ViserServer, client_id: int, name: str, owner: str) -> Any:
         return viser_compat.gizmo_by_name(server, client_id, name, owner)
 
     def _clean_gizmo(

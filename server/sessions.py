@@ -170,9 +170,7 @@ class Session:
             return self.viser_server.get_clients()
         return {self.client.client_id: self.client}
 
-    def frame_camera(
-        self, position: tuple[float, float, float], look_at: tuple[float, float, float]
-    ) -> None:
+    def frame_camera(self, position: tuple[float, float, float], look_at: tuple[float, float, float]) -> None:
         """Point this session's cameras (and, when shared, the cameras of tabs still to come) at a scene."""
         if self.client is None:
             self.viser_server.initial_camera.position = position
@@ -253,9 +251,7 @@ class Sessions:
             with dead_writes_allowed(client):
                 switcher.close()
             if not switcher.scene.join(timeout_s=120.0):
-                logger.warning(
-                    "session of client %s: a scene thread is still running", client.client_id
-                )
+                logger.warning("session of client %s: a scene thread is still running", client.client_id)
         except Exception:
             logger.exception("closing the session of client %s failed", client.client_id)
 

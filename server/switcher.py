@@ -63,9 +63,7 @@ class SceneSwitcher:
                     order=-100.0,
                 )
             )
-            self.reset_button = mark_costly(
-                session.gui.add_button("Reset scene to defaults", order=-99.0)
-            )
+            self.reset_button = mark_costly(session.gui.add_button("Reset scene to defaults", order=-99.0))
             # Awaited by viser (coroutines), the builds running on a worker thread: the gate then knows when a
             # pick or Reset has finished, and holds that tab's later inputs until it has (server.gate).
             self.dropdown.on_update(_in_a_thread(self._on_pick))

@@ -152,9 +152,7 @@ def send_gui_value(handle: Any) -> None:
     """Send the server's value of GUI ``handle`` to every viewer of it (a button, or a removed control: nothing)."""
     state = handle._impl
     if not state.removed and not state.is_button:
-        state.gui_api._websock_interface.queue_message(
-            messages.GuiUpdateMessage(state.uuid, {"value": state.value})
-        )
+        state.gui_api._websock_interface.queue_message(messages.GuiUpdateMessage(state.uuid, {"value": state.value}))
 
 
 def send_gizmo_pose(handle: Any) -> None:

@@ -29,18 +29,14 @@ class Camera:
     """Vertical field of view (rad), in (0, π)."""
 
     def __post_init__(self) -> None:
-        eye, target, up = (
-            np.asarray(v, dtype=np.float64) for v in (self.position, self.look_at, self.up)
-        )
+        eye, target, up = (np.asarray(v, dtype=np.float64) for v in (self.position, self.look_at, self.up))
         for name, v in (("position", eye), ("look_at", target), ("up", up)):
             if v.shape != (3,) or not np.all(np.isfinite(v)):
                 raise ValueError(f"{name} must be 3 finite numbers, got {v.tolist()}")
         forward = target - eye
         if np.linalg.norm(forward) < 1e-9:
             raise ValueError("look_at must differ from position")
-        if np.linalg.norm(np.cross(forward, up)) < 1e-9 * np.linalg.norm(forward) * max(
-            np.linalg.norm(up), 1e-30
-        ):
+        if np.linalg.norm(np.cross(forward, up)) < 1e-9 * np.linalg.norm(forward) * max(np.linalg.norm(up), 1e-30):
             raise ValueError("up must not be parallel to the view axis")
         if not (math.isfinite(self.fov_y_rad) and 0.0 < self.fov_y_rad < math.pi):
             raise ValueError(f"fov_y_rad must be in (0, π), got {self.fov_y_rad}")
@@ -119,21 +115,15 @@ class Shading:
             if not (math.isfinite(value) and value > 0.0):
                 raise ValueError(f"{name} must be finite and positive, got {value}")
         if not (math.isfinite(self.normal_epsilon) and self.normal_epsilon > 0.0):
-            raise ValueError(
-                f"normal_epsilon must be finite and positive, got {self.normal_epsilon}"
-            )
+            raise ValueError(f"normal_epsilon must be finite and positive, got {self.normal_epsilon}")
         light = np.asarray(self.light_direction, dtype=np.float64)
         if light.shape != (3,) or not np.all(np.isfinite(light)) or np.linalg.norm(light) < 1e-9:
-            raise ValueError(
-                f"light_direction must be a finite non-zero 3-vector, got {light.tolist()}"
-            )
+            raise ValueError(f"light_direction must be a finite non-zero 3-vector, got {light.tolist()}")
         if not 1 <= self.max_steps <= 4096:
             raise ValueError(f"max_steps must be in 1..4096, got {self.max_steps}")
 
 
-def camera_rays(
-    camera: Camera, width: int, height: int
-) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+def camera_rays(camera: Camera, width: int, height: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """The renderer's rays in numpy: origins and unit directions, (H·W, 3) each, row-major from the top row."""
     check_image_size(width, height)
     forward, right, up = camera.basis()
@@ -150,11 +140,7 @@ def camera_rays(
 def check_image_size(width: int, height: int) -> None:
     """``ValueError`` unless ``width`` and ``height`` are integers in 1..8192 (px)."""
     for name, value in (("width", width), ("height", height)):
-        if (
-            isinstance(value, bool)
-            or not isinstance(value, (int, np.integer))
-            or not 1 <= value <= 8192
-        ):
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not 1 <= value <= 8192:
             raise ValueError(f"{name} must be an integer in 1..8192, got {value!r}")
 
 

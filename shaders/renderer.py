@@ -97,21 +97,15 @@ def _bounding_boxes(
     return centers, rotations, half + unions * scene.k / 4 + 1e-3
 
 
-def _bounds_scissor(
-    camera: Camera, scene: sdf.Scene, width: int, height: int
-) -> tuple[int, int, int, int]:
+def _bounds_scissor(camera: Camera, scene: sdf.Scene, width: int, height: int) -> tuple[int, int, int, int]:
     """(x, y, w, h) pixel rectangle (GL origin bottom left) holding the screen image of the bounding boxes.
 
     Conservative: the rectangle bounds the boxes' projected corners, widened by a pixel; if any corner lies near or
     behind the eye it is the whole image.
     """
     centers, rotations, half = _bounding_boxes(scene)
-    unit = np.array(
-        [[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=np.float64
-    )
-    corners = (
-        centers[:, None, :] + np.einsum("pij,pcj->pci", rotations, half[:, None, :] * unit[None])
-    ).reshape(-1, 3)
+    unit = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=np.float64)
+    corners = (centers[:, None, :] + np.einsum("pij,pcj->pci", rotations, half[:, None, :] * unit[None])).reshape(-1, 3)
     return screen_rectangle(camera, corners, width, height)
 
 
@@ -121,13 +115,9 @@ def _background_levels(shading: Shading) -> tuple[int, int, int]:
     return red, green, blue
 
 
-def _box_scissor(
-    camera: Camera, box: NDArray[np.float64], width: int, height: int
-) -> tuple[int, int, int, int]:
+def _box_scissor(camera: Camera, box: NDArray[np.float64], width: int, height: int) -> tuple[int, int, int, int]:
     """:func:`_bounds_scissor` for one axis-aligned box (the editor's bounds)."""
-    corners = np.array(
-        [[box[i, 0], box[j, 1], box[k, 2]] for i in (0, 1) for j in (0, 1) for k in (0, 1)]
-    )
+    corners = np.array([[box[i, 0], box[j, 1], box[k, 2]] for i in (0, 1) for j in (0, 1) for k in (0, 1)])
     return screen_rectangle(camera, corners, width, height)
 
 
@@ -136,9 +126,7 @@ def create_context() -> object:
     try:
         import moderngl
     except ImportError as exc:  # pragma: no cover - moderngl is a dependency
-        raise GLUnavailableError(
-            f"moderngl is not installed ({exc}); the reference image needs it"
-        ) from exc
+        raise GLUnavailableError(f"moderngl is not installed ({exc}); the reference image needs it") from exc
     try:
         # moderngl's stub types `backend` wrongly (as a dict); the runtime takes the backend's name.
         return moderngl.create_standalone_context(backend="egl", require=330)  # pyright: ignore[reportArgumentType]
@@ -170,9 +158,7 @@ class Renderer:
         self._fullscreen = read_source("fullscreen.vert")
         self._raymarch: dict[tuple[bool, bool, bool, bool], object] = {}
         self._raymarch_vao: dict[tuple[bool, bool, bool, bool], object] = {}
-        self._fields: collections.OrderedDict[tuple[str, str], tuple[object, object]] = (
-            collections.OrderedDict()
-        )
+        self._fields: collections.OrderedDict[tuple[str, str], tuple[object, object]] = collections.OrderedDict()
         """Compiled editor programs by (source, variant), least recently used first."""
         self.renderer_name = str(self.ctx.info.get("GL_RENDERER", "unknown"))
         self._target_size: tuple[int, int] | None = None
@@ -185,9 +171,7 @@ class Renderer:
             vertex_shader=fullscreen,
             fragment_shader=with_defines(read_source("probe.frag"), EXTRA_KINDS=1),
         )
-        self._mesh = self.ctx.program(
-            vertex_shader=read_source("mesh.vert"), fragment_shader=read_source("mesh.frag")
-        )
+        self._mesh = self.ctx.program(vertex_shader=read_source("mesh.vert"), fragment_shader=read_source("mesh.frag"))
         self._probe_vao = self.ctx.vertex_array(self._probe, [])
 
     def release(self) -> None:
@@ -359,9 +343,7 @@ class Renderer:
         fbo.scissor = (0, 0, width, height)
         return self._read(color, depth, width, height)
 
-    def _set_camera(
-        self, prog: object, camera: Camera, width: int, height: int, shading: Shading
-    ) -> None:
+    def _set_camera(self, prog: object, camera: Camera, width: int, height: int, shading: Shading) -> None:
         """The camera, marching and shading uniforms of a ray-march program."""
         self._set_shading(prog, shading)
         forward, right, up = camera.basis()
@@ -417,9 +399,9 @@ class Renderer:
             raise ValueError(f"faces must be (F, 3) indices into vertices, got {f.shape}")
         if c.shape != v.shape:
             raise ValueError(f"colors must match vertices' shape {v.shape}, got {c.shape}")
-        normals = (
-            trimesh.Trimesh(v, f, process=False).vertex_normals if len(f) else np.zeros_like(v)
-        ).astype(np.float32)
+        normals = (trimesh.Trimesh(v, f, process=False).vertex_normals if len(f) else np.zeros_like(v)).astype(
+            np.float32
+        )
         eye = np.asarray(camera.position, dtype=np.float64)
         forward, _, _ = camera.basis()
         reach = np.linalg.norm(v - eye, axis=1).max() if len(v) else 1.0
@@ -435,9 +417,7 @@ class Renderer:
         self._set(prog, "u_forward", tuple(forward))
         _, color, depth = self._targets(width, height, shading)
         if len(f):
-            interleaved = np.concatenate(
-                [v.astype(np.float32), normals, c.astype(np.float32)], axis=1
-            )
+            interleaved = np.concatenate([v.astype(np.float32), normals, c.astype(np.float32)], axis=1)
             vbo = self.ctx.buffer(np.ascontiguousarray(interleaved).tobytes())
             ibo = self.ctx.buffer(np.ascontiguousarray(f, dtype=np.int32).tobytes())
             vao = self.ctx.vertex_array(
@@ -450,9 +430,7 @@ class Renderer:
                 obj.release()
         return self._read(color, depth, width, height)
 
-    def probe(
-        self, scene: sdf.Scene, points: ArrayLike
-    ) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
+    def probe(self, scene: sdf.Scene, points: ArrayLike) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
         """Evaluate ``scene_distance`` and ``scene_color`` of ``sdf.glsl`` at points (via a float texture).
 
         Args:
@@ -515,9 +493,7 @@ class Renderer:
                 POLY_BLEND_ONLY=1,
             )
         try:
-            prog = self.ctx.program(
-                vertex_shader=self._fullscreen, fragment_shader=template + user_glsl(source)
-            )
+            prog = self.ctx.program(vertex_shader=self._fullscreen, fragment_shader=template + user_glsl(source))
         except moderngl.Error as exc:
             raise ShaderCompileError.from_compiler(str(exc), source) from None
         vao = self.ctx.vertex_array(prog, [])
@@ -554,9 +530,7 @@ class Renderer:
         self._field_program(source, "sample")
         self._field_program(source, f"march:{int(shading.shadows)}:{int(shading.occlusion)}")
 
-    def probe_field(
-        self, source: str, points: ArrayLike
-    ) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
+    def probe_field(self, source: str, points: ArrayLike) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
         """The editor's ``sdf`` and ``color`` at (N, 3) points: (N,) distances and (N, 3) colours, float32."""
         import moderngl
 
@@ -599,9 +573,7 @@ class Renderer:
         nx, ny, nz = grid.shape
         slices = max(1, min(nz, _MAX_ROWS // ny))
         distance = self.ctx.texture((nx, ny * slices), 1, dtype="f4")
-        color = self.ctx.texture(
-            (nx, ny * slices), 4, dtype="f1"
-        )  # a quarter of the points pass's bytes
+        color = self.ctx.texture((nx, ny * slices), 4, dtype="f1")  # a quarter of the points pass's bytes
         fbo = self.ctx.framebuffer(color_attachments=[distance, color])
         fbo.use()
         self._set(prog, "u_origin", tuple(float(v) for v in grid.origin))
@@ -641,9 +613,7 @@ class Renderer:
         check_source(source)
         box = check_field_bounds(bounds)
         shading = shading or Shading()
-        prog, vao = self._field_program(
-            source, f"march:{int(shading.shadows)}:{int(shading.occlusion)}"
-        )
+        prog, vao = self._field_program(source, f"march:{int(shading.shadows)}:{int(shading.occlusion)}")
         self._set(prog, "u_field_lo", tuple(float(v) for v in box[0]))
         self._set(prog, "u_field_hi", tuple(float(v) for v in box[1]))
         self._set_camera(prog, camera, width, height, shading)
@@ -699,9 +669,7 @@ def mesh_glsl(source: str, resolution: int, bounds: ArrayLike) -> trimesh.Trimes
 
     check_source(source)
     box = check_field_bounds(bounds)
-    grid = sdf.make_grid(
-        sdf.default_scene(), resolution, box
-    )  # the scene is unused when bounds are given
+    grid = sdf.make_grid(sdf.default_scene(), resolution, box)  # the scene is unused when bounds are given
 
     def job(gl: Renderer) -> trimesh.Trimesh:
         field = gl.sample_field(source, grid)

@@ -97,9 +97,7 @@ def trial(
         try:
             first = lines.get(timeout=START_LIMIT_S)
         except queue.Empty:
-            raise GLUnavailableError(
-                f"the GLSL trial process did not start within {START_LIMIT_S:.0f} s"
-            ) from None
+            raise GLUnavailableError(f"the GLSL trial process did not start within {START_LIMIT_S:.0f} s") from None
         if first.strip() != "ready":
             answer = json.loads(first) if first.strip() else {"error": "the trial process ended"}
             raise GLUnavailableError(str(answer.get("error")))
@@ -125,9 +123,7 @@ def trial(
         )
     times = TrialTimes(float(answer["compile_s"]), float(answer["frame_s"]))
     if times.compile_s > compile_limit_s:
-        raise ShaderCompileError(
-            f"compiling took {times.compile_s:.1f} s; the limit is {compile_limit_s:.0f} s", None
-        )
+        raise ShaderCompileError(f"compiling took {times.compile_s:.1f} s; the limit is {compile_limit_s:.0f} s", None)
     if times.frame_s > frame_limit_s:
         raise ShaderCompileError(
             f"one {width}-pixel-wide frame took {1e3 * times.frame_s:.0f} ms; the limit is "

@@ -130,9 +130,7 @@ def _round_down(value: float) -> float:
     return math.floor(value / scale) * scale
 
 
-def _refuse_overflow(
-    endings: NDArray[np.int64], config: NDArray[np.float64], launches: NDArray[np.float64]
-) -> None:
+def _refuse_overflow(endings: NDArray[np.int64], config: NDArray[np.float64], launches: NDArray[np.float64]) -> None:
     """Raise where a kick's step was beyond the method's stability limit (ending 4, not flown), or where a flight
     overflowed to inf or NaN (ending 3: a step too long for its drag that the limit does not bound, or absurd input).
     ``launches`` are the (K, 13) launch rows, for the limit the message names."""
@@ -282,9 +280,7 @@ def simulate_batch(
     )
 
 
-def outcome(
-    trajectory: Trajectory, wall: Panel, goal: Panel, *, radius_m: float = BALL_RADIUS_M
-) -> Outcome:
+def outcome(trajectory: Trajectory, wall: Panel, goal: Panel, *, radius_m: float = BALL_RADIUS_M) -> Outcome:
     """Judge one flight against the wall and the goal.
 
     The ball hits the wall when its centre crosses the wall's plane within a radius of the defenders' outline
@@ -304,9 +300,7 @@ def outcome(
     """
     radius = _checks.positive("radius_m", radius_m)
     if not isinstance(trajectory, Trajectory):
-        raise ValueError(
-            f"trajectory must be a Trajectory from simulate(), got {type(trajectory).__name__}"
-        )
+        raise ValueError(f"trajectory must be a Trajectory from simulate(), got {type(trajectory).__name__}")
     crossings = np.empty((2, 4))
     t, position, velocity = trajectory.t, trajectory.position, trajectory.velocity
     code = judge(t, position, velocity, len(t), panel_rows(wall, goal), radius, crossings)
@@ -320,9 +314,7 @@ def outcome(
     )
 
 
-def outcome_batch(
-    batch: BatchTrajectory, wall: Panel, goal: Panel, *, radius_m: float = BALL_RADIUS_M
-) -> BatchOutcome:
+def outcome_batch(batch: BatchTrajectory, wall: Panel, goal: Panel, *, radius_m: float = BALL_RADIUS_M) -> BatchOutcome:
     """:func:`outcome` for every kick of a batch, in parallel.
 
     Args:
@@ -336,9 +328,7 @@ def outcome_batch(
     """
     radius = _checks.positive("radius_m", radius_m)
     if not isinstance(batch, BatchTrajectory):
-        raise ValueError(
-            f"batch must be a BatchTrajectory from simulate_batch(), got {type(batch).__name__}"
-        )
+        raise ValueError(f"batch must be a BatchTrajectory from simulate_batch(), got {type(batch).__name__}")
     k = len(batch.n_samples)
     results, crossings, panels = (
         np.empty(k, dtype=np.int64),
@@ -419,15 +409,11 @@ def spin_vector(rate_rev_s: float, axis: ArrayLike) -> NDArray[np.float64]:
     scale = float(np.abs(direction).max())
     if scale == 0.0:
         raise ValueError("axis must not be zero")
-    direction = (
-        direction / scale
-    )  # largest component ±1 first: neither overflows nor underflows when squared
+    direction = direction / scale  # largest component ±1 first: neither overflows nor underflows when squared
     return 2.0 * math.pi * rate * direction / float(np.linalg.norm(direction))
 
 
-def launch_velocity(
-    speed_ms: float, elevation_rad: float, azimuth_rad: float
-) -> NDArray[np.float64]:
+def launch_velocity(speed_ms: float, elevation_rad: float, azimuth_rad: float) -> NDArray[np.float64]:
     """Velocity (3,) in m/s from speed, elevation above the ground and azimuth to the left of +x."""
     speed = _checks.non_negative("speed_ms", speed_ms)
     elevation = _checks.finite_number("elevation_rad", elevation_rad)
@@ -449,9 +435,7 @@ def warm_up() -> None:
     """
     wall, goal = free_kick_panels((0.0, 0.0), (12.0, 0.0), (1.0, 0.0))
     start, velocity, spin = (0.0, 0.0, BALL_RADIUS_M), (20.0, 0.0, 4.0), (0.0, 0.0, 30.0)
-    flight = simulate(
-        start, velocity, spin, dt=0.05, method="rk4", model="measured", knuckle_seed=0
-    )
+    flight = simulate(start, velocity, spin, dt=0.05, method="rk4", model="measured", knuckle_seed=0)
     outcome(flight, wall, goal)
     rows = np.array([start, start])
     batch = simulate_batch(rows, [velocity, velocity], [spin, spin], dt=0.05, t_max=0.2)

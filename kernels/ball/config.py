@@ -149,9 +149,7 @@ class FlightConfig:
         step = _checks.positive("dt", self.dt)
         duration = _checks.positive("t_max", self.t_max)
         if duration / step > _MAX_STEPS:
-            raise ValueError(
-                f"dt must be at least t_max/{_MAX_STEPS} = {duration / _MAX_STEPS:g} s, got {step:g}"
-            )
+            raise ValueError(f"dt must be at least t_max/{_MAX_STEPS} = {duration / _MAX_STEPS:g} s, got {step:g}")
         if self.method not in ("euler", "rk4"):
             raise ValueError(f"method must be 'euler' or 'rk4', got {self.method!r}")
         if self.model not in ("constant", "measured"):
@@ -205,9 +203,7 @@ def flight_config(config: FlightConfig | None, options: dict[str, Any]) -> Fligh
             raise ValueError(f"config must be a FlightConfig, got {type(config).__name__}")
         return config
     if config is not None:
-        raise ValueError(
-            f"pass either config or its fields as keywords, not both: {sorted(options)}"
-        )
+        raise ValueError(f"pass either config or its fields as keywords, not both: {sorted(options)}")
     try:
         key: object = tuple((name, type(value), value) for name, value in options.items())
         hash(key)
@@ -258,18 +254,12 @@ def kick_rows(
     )
     k = len(p0)
     if len(v0) != k or len(w0) != k:
-        raise ValueError(
-            f"positions, velocities and spins must have the same length, got {k}, {len(v0)}, {len(w0)}"
-        )
+        raise ValueError(f"positions, velocities and spins must have the same length, got {k}, {len(v0)}, {len(w0)}")
     if knuckle_seeds is None:
         seeds: list[int | None] = [None] * k
     else:
-        if isinstance(knuckle_seeds, (str, bytes)) or not isinstance(
-            knuckle_seeds, (Sequence, np.ndarray)
-        ):
-            raise ValueError(
-                f"knuckle_seeds must be None or a sequence of K seeds, got {knuckle_seeds!r}"
-            )
+        if isinstance(knuckle_seeds, (str, bytes)) or not isinstance(knuckle_seeds, (Sequence, np.ndarray)):
+            raise ValueError(f"knuckle_seeds must be None or a sequence of K seeds, got {knuckle_seeds!r}")
         seeds = [checked_seed("knuckle_seeds", seed) for seed in knuckle_seeds]
         if len(seeds) != k:
             raise ValueError(f"knuckle_seeds must have {k} entries, got {len(seeds)}")

@@ -69,10 +69,7 @@ def _hermite(p0, v0, p1, v1, h, s):
     else:
         value = p0 + (p1 - p0) * (3 * s2 - 2 * s3) + h * ((s3 - 2 * s2 + s) * v0 + (s3 - s2) * v1)
     slope = (
-        (6 * s2 - 6 * s) * p0
-        + (3 * s2 - 4 * s + 1) * h * v0
-        + (6 * s - 6 * s2) * p1
-        + (3 * s2 - 2 * s) * h * v1
+        (6 * s2 - 6 * s) * p0 + (3 * s2 - 4 * s + 1) * h * v0 + (6 * s - 6 * s2) * p1 + (3 * s2 - 2 * s) * h * v1
     ) / h
     return value, slope
 
@@ -189,12 +186,8 @@ def _fly(launch, kick, config, t_out, state_out):
         hit_stop = x < x_stop <= x1 or (n == 0 and x == x_stop and x1 > x)
         if hit_ground or hit_stop:
             # End on whichever of the ground and the stop plane the cubic through this step reaches first.
-            f_ground = (
-                crossing_fraction(z - ground, vz, z1 - ground, vz1, h) if hit_ground else np.inf
-            )
-            f_stop = (
-                crossing_fraction(x_stop - x, -vx, x_stop - x1, -vx1, h) if hit_stop else np.inf
-            )
+            f_ground = crossing_fraction(z - ground, vz, z1 - ground, vz1, h) if hit_ground else np.inf
+            f_stop = crossing_fraction(x_stop - x, -vx, x_stop - x1, -vx1, h) if hit_stop else np.inf
             ending = 0 if f_ground <= f_stop else 1
             f = min(f_ground, f_stop)
             ex, evx = _hermite(x, vx, x1, vx1, h, f)
@@ -227,9 +220,7 @@ def simulate_one(launch, config, t_out, state_out, forces_out):
     fill_kick(launch, config, kick)
     n, ending = _fly(launch, kick, config, t_out, state_out)
     sample_forces(t_out[:n], state_out[:n], kick, config, forces_out[:n])
-    if not np.isfinite(
-        forces_out[:n]
-    ).all():  # a finite flight with an infinite force: a 1e-300 kg ball
+    if not np.isfinite(forces_out[:n]).all():  # a finite flight with an infinite force: a 1e-300 kg ball
         ending = 3
     return n, ending
 
@@ -325,9 +316,7 @@ def judge(t, position, velocity, n, panels, radius, crossings):
 def judge_batch(t, position, velocity, n_samples, panels, radius, results, crossings):
     """:func:`judge` for every flight of a (K, T) batch, in parallel."""
     for k in prange(len(n_samples)):
-        results[k] = judge(
-            t[k], position[k], velocity[k], n_samples[k], panels, radius, crossings[k]
-        )
+        results[k] = judge(t[k], position[k], velocity[k], n_samples[k], panels, radius, crossings[k])
 
 
 @compiled(parallel=True)

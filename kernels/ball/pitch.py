@@ -67,14 +67,10 @@ def free_kick_panels(
     aim = centre - ball
     distance = float(np.hypot(*aim))
     if distance <= WALL_DISTANCE_M:
-        raise ValueError(
-            f"ball_xy must be more than {WALL_DISTANCE_M} m from the goal, got {distance:.2f} m"
-        )
+        raise ValueError(f"ball_xy must be more than {WALL_DISTANCE_M} m from the goal, got {distance:.2f} m")
     aim /= distance
     left = np.array([-aim[1], aim[0]])
-    wall_foot = (
-        ball + WALL_DISTANCE_M * aim + _checks.finite_number("wall_offset_m", wall_offset_m) * left
-    )
+    wall_foot = ball + WALL_DISTANCE_M * aim + _checks.finite_number("wall_offset_m", wall_offset_m) * left
     wall = Panel(
         (float(wall_foot[0]), float(wall_foot[1])),
         (float(aim[0]), float(aim[1])),

@@ -40,9 +40,7 @@ SAMPLE_ROUTE = Path(__file__).parent.with_name("routes") / "alpe_dhuez.gpx"
 _GPX_ROOT = re.compile(r"<(?:([A-Za-z_][\w.-]*):)?gpx[\s>/]")
 
 
-def load_gpx(
-    source: str | os.PathLike[str] | bytes, *, name: str | None = None, smoothing_m: float = 50.0
-) -> Course:
+def load_gpx(source: str | os.PathLike[str] | bytes, *, name: str | None = None, smoothing_m: float = 50.0) -> Course:
     """Read a GPX file's track and route points into a :class:`Course`.
 
     Args:
@@ -156,9 +154,12 @@ _XML_ENCODING = re.compile(rb"""^<\?xml[^>]*?encoding\s*=\s*["']([A-Za-z0-9._-]+
 def _decode(data: bytes, label: str) -> str:
     """The file's text: by its byte-order mark, else its XML declaration's encoding, else UTF-8 (XML 1.0 §4.3.3)."""
     for bom, codec in (
-        (codecs.BOM_UTF32_LE, "utf-32"), (codecs.BOM_UTF32_BE, "utf-32"), (codecs.BOM_UTF8, "utf-8-sig"),
-        (codecs.BOM_UTF16_LE, "utf-16"), (codecs.BOM_UTF16_BE, "utf-16"),
-    ):  # fmt: skip
+        (codecs.BOM_UTF32_LE, "utf-32"),
+        (codecs.BOM_UTF32_BE, "utf-32"),
+        (codecs.BOM_UTF8, "utf-8-sig"),
+        (codecs.BOM_UTF16_LE, "utf-16"),
+        (codecs.BOM_UTF16_BE, "utf-16"),
+    ):
         if data.startswith(bom):
             encoding = codec
             break
@@ -174,9 +175,7 @@ def _decode(data: bytes, label: str) -> str:
     except (UnicodeDecodeError, ValueError) as error:
         raise ValueError(f"{label} is not GPX: it is not text in {encoding.upper()}") from error
     # The text is decoded now: the declaration's encoding must not be applied a second time by the XML parser.
-    return re.sub(
-        r"""^(\ufeff?<\?xml[^>]*?)\s+encoding\s*=\s*["'][^"']*["']""", r"\1", text, count=1
-    )
+    return re.sub(r"""^(\ufeff?<\?xml[^>]*?)\s+encoding\s*=\s*["'][^"']*["']""", r"\1", text, count=1)
 
 
 def _check_values(
@@ -188,8 +187,10 @@ def _check_values(
 ) -> None:
     """Refuse a point that is not on the map, in words a rider reads (point numbers from 1, as in the file)."""
     for values, what, limit, unit in (
-        (lat, "latitude", 90.0, "°"), (lon, "longitude", 180.0, "°"), (ele, "elevation", 10_000.0, " m"),
-    ):  # fmt: skip
+        (lat, "latitude", 90.0, "°"),
+        (lon, "longitude", 180.0, "°"),
+        (ele, "elevation", 10_000.0, " m"),
+    ):
         bad = ~np.isfinite(values)
         if np.any(bad):
             first = int(np.argmax(bad))
@@ -201,8 +202,7 @@ def _check_values(
         if np.any(out):
             first = int(np.argmax(out))
             raise ValueError(
-                f"{label}: {kind} point {first + 1} has {what} {values[first]:g}{unit}, outside "
-                f"±{_spaced(limit)}{unit}"
+                f"{label}: {kind} point {first + 1} has {what} {values[first]:g}{unit}, outside ±{_spaced(limit)}{unit}"
             )
 
 
@@ -238,9 +238,7 @@ def _pieces(gpx: gpxpy.gpx.GPX, text: str) -> list[_Piece]:
         ]
         for i, track in enumerate(gpx.tracks)
     ]
-    routes = [
-        [_Piece("route", f"route {i + 1}", route.points)] for i, route in enumerate(gpx.routes)
-    ]
+    routes = [[_Piece("route", f"route {i + 1}", route.points)] for i, route in enumerate(gpx.routes)]
     order = _PIECE_TAG.findall(_NOT_MARKUP.sub("", text))
     if order.count("trk") == len(tracks) and order.count("rte") == len(routes):
         queues = {"trk": iter(tracks), "rte": iter(routes)}
@@ -266,10 +264,7 @@ def _check_gaps(label: str, pieces: Sequence[_Piece]) -> None:
 def _great_circle_m(lat1: float, lon1: float, lat2: float, lon2: float) -> float:
     """Haversine distance (m) between two points (°)."""
     p1, p2 = math.radians(lat1), math.radians(lat2)
-    a = (
-        math.sin((p2 - p1) / 2) ** 2
-        + math.cos(p1) * math.cos(p2) * math.sin(math.radians(lon2 - lon1) / 2) ** 2
-    )
+    a = math.sin((p2 - p1) / 2) ** 2 + math.cos(p1) * math.cos(p2) * math.sin(math.radians(lon2 - lon1) / 2) ** 2
     return 2.0 * EARTH_RADIUS_M * math.asin(math.sqrt(min(max(a, 0.0), 1.0)))
 
 

@@ -102,14 +102,8 @@ class Air:
             case "seed":
                 return cycling.air_density(h)
             case "weather":
-                temperature = self.temperature_c - cycling.ISA_LAPSE_RATE_K_PER_M * (
-                    h - self.altitude_m
-                )
-                pressure = (
-                    self.pressure_hpa
-                    * cycling.isa_pressure_hpa(h)
-                    / cycling.isa_pressure_hpa(self.altitude_m)
-                )
+                temperature = self.temperature_c - cycling.ISA_LAPSE_RATE_K_PER_M * (h - self.altitude_m)
+                pressure = self.pressure_hpa * cycling.isa_pressure_hpa(h) / cycling.isa_pressure_hpa(self.altitude_m)
                 return cycling.air_density_weather(
                     np.clip(temperature, -60.0, 60.0),
                     np.clip(pressure, 10.0, 1100.0),
@@ -183,9 +177,7 @@ _REFINE_UP_TO = 64
 @numba.njit(cache=True)
 def _wheel_power(v, drag, rolling, climbing, wind, b0, b1):  # pragma: no cover - compiled
     """P_wheel(v) (W): the sum of :func:`kernels.cycling.wheel_power_terms`, the one power law, compiled."""
-    aero, roll, bearings, climb = cycling.wheel_power_terms_compiled(
-        v, drag, rolling, climbing, wind, b0, b1
-    )
+    aero, roll, bearings, climb = cycling.wheel_power_terms_compiled(v, drag, rolling, climbing, wind, b0, b1)
     return aero + roll + bearings + climb
 
 
@@ -203,9 +195,7 @@ def _step(v0, length, drag, rolling, climbing, wind, power_in, mass, b0, b1):  #
         return lo
     # Newton from v̄ = v0 (the answer for a short step), inside a bracket [lo, hi] that bisection falls back on.
     x = v0 if v0 > lo else 1.0
-    q_x = 2.0 * mass * (x - v0) * x * x + length * (
-        _wheel_power(x, drag, rolling, climbing, wind, b0, b1) - power_in
-    )
+    q_x = 2.0 * mass * (x - v0) * x * x + length * (_wheel_power(x, drag, rolling, climbing, wind, b0, b1) - power_in)
     if q_x > 0.0:
         hi = x
     else:
@@ -221,9 +211,7 @@ def _step(v0, length, drag, rolling, climbing, wind, power_in, mass, b0, b1):  #
             hi *= 2.0
     for _ in range(100):
         air = x + wind
-        q = 2.0 * mass * (x - v0) * x * x + length * (
-            _wheel_power(x, drag, rolling, climbing, wind, b0, b1) - power_in
-        )
+        q = 2.0 * mass * (x - v0) * x * x + length * (_wheel_power(x, drag, rolling, climbing, wind, b0, b1) - power_in)
         if q <= 0.0:
             lo = x
         else:
@@ -290,11 +278,7 @@ def _ride_core(
                     ok = False
                     break
                 v1 = 2.0 * vb - v
-                if (
-                    not graded
-                    and n_sub < _REFINE_UP_TO
-                    and abs(v1 - v) > _REFINE_RATIO * max(v, v1)
-                ):
+                if not graded and n_sub < _REFINE_UP_TO and abs(v1 - v) > _REFINE_RATIO * max(v, v1):
                     ok = False  # an abrupt change of speed (a wall, a crest): finer steps, for accuracy
                     break
                 rider_in = p_in
@@ -355,9 +339,7 @@ class _Segments:
     b1: float
 
 
-def _segments(
-    course: Course, rider: Rider, wind_ms: float, wind_from_deg: float, air: Air
-) -> _Segments:
+def _segments(course: Course, rider: Rider, wind_ms: float, wind_from_deg: float, air: Air) -> _Segments:
     if not isinstance(course, Course):
         raise ValueError(f"course must be a Course, got {type(course).__name__}")
     if not isinstance(rider, Rider):
@@ -390,30 +372,38 @@ def _segment_power(power_w: ArrayLike, n_segments: int) -> NDArray[np.float64]:
     try:
         power = np.asarray(power_w, dtype=np.float64)
     except (TypeError, ValueError) as error:
-        raise ValueError(
-            f"power_w must be a number or an array of numbers, got {power_w!r}"
-        ) from error
+        raise ValueError(f"power_w must be a number or an array of numbers, got {power_w!r}") from error
     if power.ndim == 0:
         power = np.full(n_segments, float(power))
     if power.shape != (n_segments,):
-        raise ValueError(
-            f"power_w must be a number or shape ({n_segments},), got shape {power.shape}"
-        )
+        raise ValueError(f"power_w must be a number or shape ({n_segments},), got shape {power.shape}")
     if not np.all(np.isfinite(power)) or np.any(power <= 0.0):
         raise ValueError("power_w must be finite and > 0 (W)")
     return np.ascontiguousarray(power)
 
 
-def _ride(
-    course: Course, power: NDArray[np.float64], s: _Segments, max_speed: float, start: float
-) -> Ride:
+def _ride(course: Course, power: NDArray[np.float64], s: _Segments, max_speed: float, start: float) -> Ride:
     n = course.n_points
     speed, elapsed = np.empty(n), np.empty(n)
     power_out, energy = np.empty(n - 1), np.zeros(6)
     failed = _ride_core(
-        s.length, s.drag, s.rolling, s.climbing, s.wind, power, s.efficiency, s.mass, s.b0, s.b1,
-        max_speed, start, speed, elapsed, power_out, energy,
-    )  # fmt: skip
+        s.length,
+        s.drag,
+        s.rolling,
+        s.climbing,
+        s.wind,
+        power,
+        s.efficiency,
+        s.mass,
+        s.b0,
+        s.b1,
+        max_speed,
+        start,
+        speed,
+        elapsed,
+        power_out,
+        energy,
+    )
     if failed:
         raise ValueError(f"the rider cannot cross segment {failed - 1} at this power")
     work = float(energy[_E_WORK])
@@ -541,15 +531,11 @@ def power_for_time(
             nxt = x - f / slope
             if nxt > math.log(hi_p):
                 if x >= math.log(hi_p) or time_at(hi_p) > target + tol:
-                    raise ValueError(
-                        f"time_s {target:.1f} s is out of reach: it needs more than {hi_p:.0f} W"
-                    )
+                    raise ValueError(f"time_s {target:.1f} s is out of reach: it needs more than {hi_p:.0f} W")
                 nxt = math.log(hi_p)
             elif nxt < math.log(lo_p):
                 if x <= math.log(lo_p) or time_at(lo_p) < target - tol:
-                    raise ValueError(
-                        f"time_s {target:.1f} s is out of reach: even {lo_p:.0f} W rides it faster"
-                    )
+                    raise ValueError(f"time_s {target:.1f} s is out of reach: even {lo_p:.0f} W rides it faster")
                 nxt = math.log(lo_p)
         x_prev, f_prev = x, f
         x = nxt

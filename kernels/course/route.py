@@ -137,9 +137,7 @@ def total_ascent(
     return _hysteresis_ascent(profile, threshold)
 
 
-def _despike(
-    distance: NDArray[np.float64], z: NDArray[np.float64], half: int = 2
-) -> NDArray[np.float64]:
+def _despike(distance: NDArray[np.float64], z: NDArray[np.float64], half: int = 2) -> NDArray[np.float64]:
     """z with each spike replaced by the median of the 2·half + 1 points about it (ends mirrored).
 
     A point is a spike when it is farther from that median than :data:`ASCENT_SPIKE_GRADE` times the distance to
@@ -149,12 +147,8 @@ def _despike(
     n = z.shape[0]
     if n < 2 * half + 1:
         return z
-    windows = np.lib.stride_tricks.sliding_window_view(
-        np.pad(z, half, mode="reflect"), 2 * half + 1
-    )
-    reach_ends = np.lib.stride_tricks.sliding_window_view(
-        np.pad(distance, half, mode="edge"), 2 * half + 1
-    )
+    windows = np.lib.stride_tricks.sliding_window_view(np.pad(z, half, mode="reflect"), 2 * half + 1)
+    reach_ends = np.lib.stride_tricks.sliding_window_view(np.pad(distance, half, mode="edge"), 2 * half + 1)
     median = np.median(windows, axis=1)
     reach = np.maximum(distance - reach_ends[:, 0], reach_ends[:, -1] - distance)
     return np.where(np.abs(z - median) > ASCENT_SPIKE_GRADE * reach, median, z)
@@ -197,9 +191,7 @@ def _hysteresis_ascent(z: NDArray[np.float64], threshold: float) -> float:
     return float(total)
 
 
-def _smooth(
-    distance: NDArray[np.float64], z: NDArray[np.float64], window_m: float
-) -> NDArray[np.float64]:
+def _smooth(distance: NDArray[np.float64], z: NDArray[np.float64], window_m: float) -> NDArray[np.float64]:
     """Moving average of the piecewise-linear profile z(s) over [s − h, s + h] ∩ route, h = window/2."""
     if window_m <= 0.0 or distance.shape[0] < 3:
         return z.copy()
@@ -220,9 +212,7 @@ def _smooth(
     return (integral_at(hi) - integral_at(lo)) / (hi - lo)
 
 
-def _checked_points(
-    name: str, arrays: dict[str, ArrayLike], n_min: int = 2
-) -> dict[str, NDArray[np.float64]]:
+def _checked_points(name: str, arrays: dict[str, ArrayLike], n_min: int = 2) -> dict[str, NDArray[np.float64]]:
     """(N,) arrays of one length, finite, n_min ≤ N ≤ MAX_POINTS; else ValueError.
 
     Kept here rather than in :mod:`kernels._checks`: a route's messages say how many points are bad and where the
@@ -390,9 +380,7 @@ def course_from_xy(
     return _finish(name, east, north, run, heading, p["elevation_m"], smoothing_m)
 
 
-def steepest_grade(
-    distance_m: ArrayLike, elevation_m: ArrayLike, window_m: float
-) -> tuple[float, int]:
+def steepest_grade(distance_m: ArrayLike, elevation_m: ArrayLike, window_m: float) -> tuple[float, int]:
     """Largest |rise| / run over the stretches from each point to the first point at least ``window_m`` further on
     (the whole route when it is shorter). A cliff anywhere lies inside one such stretch, so no moving average can
     hide it. Returns the grade and the stretch's first point. (N,) inputs, distance strictly increasing (m)."""

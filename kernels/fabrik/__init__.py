@@ -144,5 +144,11 @@ def warm_up() -> None:
             )
     hinge = Hinge((0.0, 1.0, 0.0), -1.0, 1.0)
     solve(chain, [0.8, 0.0, 1.2], constraints=[hinge, Cone(1.0)], max_iterations=3)
-    solve_tree([-1, 0, 1, 1], np.vstack([chain, [[-0.3, 0.0, 1.9]]]), {2: [0.8, 0.0, 1.2], 3: [-0.8, 0.0, 1.2]},
-               constraints=[None, hinge, Cone(1.0), hinge], obstacles=obstacles, max_iterations=3)  # fmt: skip
+    solve_tree(
+        [-1, 0, 1, 1],
+        np.vstack([chain, [[-0.3, 0.0, 1.9]]]),
+        {2: [0.8, 0.0, 1.2], 3: [-0.8, 0.0, 1.2]},
+        constraints=[None, hinge, Cone(1.0), hinge],
+        obstacles=obstacles,
+        max_iterations=3,
+    )

@@ -137,9 +137,18 @@ def solve(
             obstacles that are not (centre, radius) pairs, max_iterations outside [1, 100 000], or constraints of
             the wrong count or kind (a hinge axis off ±z in 2D).
     """
-    return _solve_single("fabrik", joints, target, tolerance, max_iterations,
-                         cone_half_angle_rad, obstacles, root_direction, extrapolate,
-                         constraints)  # fmt: skip
+    return _solve_single(
+        "fabrik",
+        joints,
+        target,
+        tolerance,
+        max_iterations,
+        cone_half_angle_rad,
+        obstacles,
+        root_direction,
+        extrapolate,
+        constraints,
+    )
 
 
 def solve_batch(
@@ -179,13 +188,12 @@ def solve_batch(
     batch, count, dim = chains.shape
     points = bounded_array("targets", targets, _LARGEST)
     if points.shape != (batch, dim):
-        raise ValueError(
-            f"targets must have shape ({batch}, {dim}) to match joints, got {points.shape}"
-        )
+        raise ValueError(f"targets must have shape ({batch}, {dim}) to match joints, got {points.shape}")
     if not isinstance(solver, str) or solver not in _SOLVER_IDS:
         raise ValueError(f"solver must be one of 'fabrik', 'ccd', 'jacobian_dls', got {solver!r}")
-    setup = _Setup.build(dim, tolerance, max_iterations, cone_half_angle_rad, obstacles,
-                         root_direction, _SOLVER_IDS[solver], extrapolate)  # fmt: skip
+    setup = _Setup.build(
+        dim, tolerance, max_iterations, cone_half_angle_rad, obstacles, root_direction, _SOLVER_IDS[solver], extrapolate
+    )
     setup = setup.constrained(constraints, count - 1, dim, cone_half_angle_rad)
     p = np.zeros((batch, count, 3))
     p[:, :, :dim] = chains
@@ -197,8 +205,21 @@ def solve_batch(
     status = np.empty(batch, dtype=np.int64)
     error = np.empty(batch)
     scale, params, centres, radii = _to_unit_scale(p, goal, setup)
-    args = (p, goal, params, setup.flags, setup.root_direction, centres, radii,
-            out_p, history, iterations, status, error, setup.table)  # fmt: skip
+    args = (
+        p,
+        goal,
+        params,
+        setup.flags,
+        setup.root_direction,
+        centres,
+        radii,
+        out_p,
+        history,
+        iterations,
+        status,
+        error,
+        setup.table,
+    )
     if batch == 1:
         _solve_rows(0, 1, *args)
     else:
@@ -233,9 +254,18 @@ def ccd(
 
     Arguments, result and errors are those of :func:`solve`.
     """
-    return _solve_single("ccd", joints, target, tolerance, max_iterations,
-                         cone_half_angle_rad, obstacles, root_direction, False,
-                         constraints)  # fmt: skip
+    return _solve_single(
+        "ccd",
+        joints,
+        target,
+        tolerance,
+        max_iterations,
+        cone_half_angle_rad,
+        obstacles,
+        root_direction,
+        False,
+        constraints,
+    )
 
 
 def jacobian_dls(
@@ -253,9 +283,18 @@ def jacobian_dls(
 
     Arguments, result and errors are those of :func:`solve`.
     """
-    return _solve_single("jacobian_dls", joints, target, tolerance, max_iterations,
-                         cone_half_angle_rad, obstacles, root_direction, False,
-                         constraints)  # fmt: skip
+    return _solve_single(
+        "jacobian_dls",
+        joints,
+        target,
+        tolerance,
+        max_iterations,
+        cone_half_angle_rad,
+        obstacles,
+        root_direction,
+        False,
+        constraints,
+    )
 
 
 def limit_usage(
@@ -496,22 +535,16 @@ class _Setup:
     table: NDArray[np.float64] = dataclasses.field(default_factory=lambda: _FREE_TABLE)
     """(T, 13) joint limits, one row per segment (T = n) or one row for all (T = 1); see :func:`_limit_table`."""
 
-    def constrained(
-        self, constraints: Sequence[Constraint] | None, n: int, dim: int, cone: float | None
-    ) -> _Setup:
+    def constrained(self, constraints: Sequence[Constraint] | None, n: int, dim: int, cone: float | None) -> _Setup:
         """These options with per-segment ``constraints`` (checked) in place of the uniform cone."""
         if constraints is None:
             return self
         if cone is not None:
-            raise ValueError(
-                "constraints and cone_half_angle_rad are alternatives: give one of them, not both"
-            )
+            raise ValueError("constraints and cone_half_angle_rad are alternatives: give one of them, not both")
         table = _limit_table(constraints, n, dim, "constraints", segment_offset=0)
         has_limits, holding = _limit_flags(table)
         cones = table[table[:, 0] == _KIND_CONE, 1]
-        cos_phi = (
-            float(cones.max()) if cones.size else -1.0
-        )  # the tightest cone bounds the unbending arc
+        cos_phi = float(cones.max()) if cones.size else -1.0  # the tightest cone bounds the unbending arc
         params = self.params.copy()
         params[1], params[2] = cos_phi, math.sqrt(max(0.0, 1.0 - cos_phi * cos_phi))
         flags = self.flags.copy()
@@ -530,23 +563,15 @@ class _Setup:
         extrapolate: bool,
     ) -> _Setup:
         try:
-            options = _options(
-                dim, tolerance, max_iterations, cone_half_angle_rad, solver, extrapolate
-            )
-        except (
-            TypeError
-        ):  # an unhashable argument: check it without the cache (and raise ValueError)
-            options = _options.__wrapped__(
-                dim, tolerance, max_iterations, cone_half_angle_rad, solver, extrapolate
-            )
+            options = _options(dim, tolerance, max_iterations, cone_half_angle_rad, solver, extrapolate)
+        except TypeError:  # an unhashable argument: check it without the cache (and raise ValueError)
+            options = _options.__wrapped__(dim, tolerance, max_iterations, cone_half_angle_rad, solver, extrapolate)
         # an array or an iterator: its items are the obstacles
         if not isinstance(obstacles, (list, tuple)):
             try:
                 obstacles = list(obstacles)
             except TypeError as error:
-                raise ValueError(
-                    f"obstacles must be a sequence of (centre, radius), got {obstacles!r}"
-                ) from error
+                raise ValueError(f"obstacles must be a sequence of (centre, radius), got {obstacles!r}") from error
         if root_direction is None and not obstacles:
             return options
         count = len(obstacles)
@@ -555,15 +580,11 @@ class _Setup:
             try:
                 centre, radius = obstacle
             except (TypeError, ValueError) as error:
-                raise ValueError(
-                    f"obstacles[{k}] must be (centre, radius), got {obstacle!r}"
-                ) from error
+                raise ValueError(f"obstacles[{k}] must be (centre, radius), got {obstacle!r}") from error
             centres[k, :dim] = _check_vector(f"obstacles[{k}] centre", centre, dim)
             radii[k] = finite_number(f"obstacles[{k}] radius", radius)
             if not 0.0 < radii[k] <= _LARGEST:
-                raise ValueError(
-                    f"obstacles[{k}] radius must be a finite number in (0, {_LARGEST:g}], got {radius!r}"
-                )
+                raise ValueError(f"obstacles[{k}] radius must be a finite number in (0, {_LARGEST:g}], got {radius!r}")
         rest = options.root_direction
         if root_direction is not None:
             rest = np.zeros(3)
@@ -588,9 +609,7 @@ def _options(
     if isinstance(max_iterations, bool) or not isinstance(max_iterations, (int, np.integer)):
         raise ValueError(f"max_iterations must be an integer, got {max_iterations!r}")
     if not 1 <= max_iterations <= _MAX_ITERATIONS_CAP:
-        raise ValueError(
-            f"max_iterations must be in [1, {_MAX_ITERATIONS_CAP}], got {max_iterations}"
-        )
+        raise ValueError(f"max_iterations must be in [1, {_MAX_ITERATIONS_CAP}], got {max_iterations}")
     cos_phi, sin_phi, has_limits = -1.0, 0.0, 0
     if cone_half_angle_rad is not None:
         phi = finite_number("cone_half_angle_rad", cone_half_angle_rad)
@@ -653,8 +672,17 @@ def compiled_single_solve(
     chain = _check_joints("joints", joints, batched=False)
     point = _check_vector("target", target, chain.shape[1])
     setup = _Setup.build(chain.shape[1], 1e-3, 50, None, (), None, _SOLVER_IDS["fabrik"], True)
-    args = (np.ascontiguousarray(chain), np.ascontiguousarray(point), _LARGEST, setup.params,
-            setup.flags, setup.root_direction, setup.centres, setup.radii, setup.table)  # fmt: skip
+    args = (
+        np.ascontiguousarray(chain),
+        np.ascontiguousarray(point),
+        _LARGEST,
+        setup.params,
+        setup.flags,
+        setup.root_direction,
+        setup.centres,
+        setup.radii,
+        setup.table,
+    )
     return _solve_one, args
 
 
@@ -676,20 +704,33 @@ def _solve_single(
     numbers (finite, magnitude ≤ 1e300); anything else, or a refused number, goes through the checks of
     :mod:`kernels._checks` first, which name the argument in their error."""
     chain = joints
-    if not (type(chain) is np.ndarray and chain.dtype == np.float64 and chain.ndim == 2
-            and chain.shape[1] in (2, 3) and chain.shape[0] >= 2):  # fmt: skip
+    if not (
+        type(chain) is np.ndarray
+        and chain.dtype == np.float64
+        and chain.ndim == 2
+        and chain.shape[1] in (2, 3)
+        and chain.shape[0] >= 2
+    ):
         chain = _check_joints("joints", joints, batched=False)
     count, dim = chain.shape
     point = target
     if not (type(point) is np.ndarray and point.dtype == np.float64 and point.shape == (dim,)):
         point = _check_vector("target", target, dim)
-    setup = _Setup.build(dim, tolerance, max_iterations, cone_half_angle_rad, obstacles,
-                         root_direction, _SOLVER_IDS[solver], extrapolate)  # fmt: skip
+    setup = _Setup.build(
+        dim, tolerance, max_iterations, cone_half_angle_rad, obstacles, root_direction, _SOLVER_IDS[solver], extrapolate
+    )
     setup = setup.constrained(constraints, count - 1, dim, cone_half_angle_rad)
     code, out, history, used, status, error = _solve_one(
-        np.ascontiguousarray(chain), np.ascontiguousarray(point), _LARGEST, setup.params,
-        setup.flags, setup.root_direction, setup.centres, setup.radii, setup.table,
-    )  # fmt: skip
+        np.ascontiguousarray(chain),
+        np.ascontiguousarray(point),
+        _LARGEST,
+        setup.params,
+        setup.flags,
+        setup.root_direction,
+        setup.centres,
+        setup.radii,
+        setup.table,
+    )
     if code == _BAD_JOINTS:
         _check_joints("joints", joints, batched=False)  # raises, naming it
     if code == _BAD_TARGET:
@@ -697,7 +738,5 @@ def _solve_single(
     # The frozen dataclass's __init__ sets each field through object.__setattr__ (~0.8 µs, a third of the Python
     # around a small chain's core); filling the instance's dict makes the same object in a quarter of that.
     solution = object.__new__(Solution)
-    solution.__dict__.update(
-        joints=out, iterations=used, error=error, status=STATUSES[status], error_history=history
-    )
+    solution.__dict__.update(joints=out, iterations=used, error=error, status=STATUSES[status], error_history=history)
     return solution

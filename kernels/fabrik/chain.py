@@ -47,9 +47,7 @@ Status = Literal["reached", "unreachable", "max_iterations", "blocked", "limited
 * ``"infeasible"``: no pose the solver saw (neither the start nor any iterate) keeps every limit and clears every
   obstacle; the last iterate is returned, and it is not admissible.
 """
-STATUSES: tuple[Status, ...] = (
-    "reached", "unreachable", "max_iterations", "blocked", "limited", "infeasible"
-)  # fmt: skip
+STATUSES: tuple[Status, ...] = ("reached", "unreachable", "max_iterations", "blocked", "limited", "infeasible")
 _REACHED, _UNREACHABLE, _MAX_ITERATIONS, _BLOCKED, _LIMITED, _INFEASIBLE = range(6)
 
 Solver = Literal["fabrik", "ccd", "jacobian_dls"]
@@ -88,24 +86,28 @@ evenly and deterministically: the same starts in every call, every thread."""
 
 @numba.njit(cache=True, error_model="numpy")
 def _forward_pass(
-    p: NDArray[np.float64], target: NDArray[np.float64], lengths: NDArray[np.float64],
-    tiny: float, rest: NDArray[np.float64], limits: tuple[bool, NDArray[np.float64]],
-    centres: NDArray[np.float64], radii: NDArray[np.float64], live: NDArray[np.bool_],
-    has_zero: bool, dim: int,
-) -> None:  # fmt: skip
+    p: NDArray[np.float64],
+    target: NDArray[np.float64],
+    lengths: NDArray[np.float64],
+    tiny: float,
+    rest: NDArray[np.float64],
+    limits: tuple[bool, NDArray[np.float64]],
+    centres: NDArray[np.float64],
+    radii: NDArray[np.float64],
+    live: NDArray[np.bool_],
+    has_zero: bool,
+    dim: int,
+) -> None:
     """End on the target, each joint back toward its old place at its link's length (the root is left)."""
     has_limits, table = limits
     n = lengths.shape[0]
     p[n, 0], p[n, 1], p[n, 2] = target[0], target[1], target[2]
-    qx, qy, qz, _ = _unit(p[0, 0] - p[n, 0], p[0, 1] - p[n, 1], p[0, 2] - p[n, 2],
-                          -rest[0], -rest[1], -rest[2], tiny)  # fmt: skip
+    qx, qy, qz, _ = _unit(p[0, 0] - p[n, 0], p[0, 1] - p[n, 1], p[0, 2] - p[n, 2], -rest[0], -rest[1], -rest[2], tiny)
     x, y, z = p[n, 0], p[n, 1], p[n, 2]  # the anchor, carried in registers from joint to joint
     for i in range(n - 1, 0, -1):
         dx, dy, dz, _ = _unit(p[i, 0] - x, p[i, 1] - y, p[i, 2] - z, qx, qy, qz, tiny)
         if radii.shape[0] > 0:
-            dx, dy, dz, _ = _deflect(
-                x, y, z, dx, dy, dz, lengths[i], centres, radii, live, tiny, dim
-            )
+            dx, dy, dz, _ = _deflect(x, y, z, dx, dy, dz, lengths[i], centres, radii, live, tiny, dim)
         if has_limits:
             dx, dy, dz = _forward_limits(p, i, n, dx, dy, dz, qx, qy, qz, table, rest, tiny, dim)
         length = lengths[i]
@@ -117,10 +119,17 @@ def _forward_pass(
 
 @numba.njit(cache=True, error_model="numpy")
 def _backward_pass(
-    p: NDArray[np.float64], lengths: NDArray[np.float64], tiny: float,
-    rest: NDArray[np.float64], limits: tuple[bool, NDArray[np.float64]], centres: NDArray[np.float64],
-    radii: NDArray[np.float64], live: NDArray[np.bool_], has_zero: bool, dim: int,
-) -> None:  # fmt: skip
+    p: NDArray[np.float64],
+    lengths: NDArray[np.float64],
+    tiny: float,
+    rest: NDArray[np.float64],
+    limits: tuple[bool, NDArray[np.float64]],
+    centres: NDArray[np.float64],
+    radii: NDArray[np.float64],
+    live: NDArray[np.bool_],
+    has_zero: bool,
+    dim: int,
+) -> None:
     """Root back on its place, each joint outward toward its current place; limits and obstacles enforced."""
     has_limits, table = limits
     qx, qy, qz = rest[0], rest[1], rest[2]
@@ -130,8 +139,7 @@ def _backward_pass(
         if has_limits:
             dx, dy, dz = _constrain(dx, dy, dz, qx, qy, qz, table, i - 1, rest, tiny, dim)
         if radii.shape[0] > 0:
-            dx, dy, dz, turned = _deflect(x, y, z, dx, dy, dz, lengths[i - 1], centres, radii, live,
-                                          tiny, dim)  # fmt: skip
+            dx, dy, dz, turned = _deflect(x, y, z, dx, dy, dz, lengths[i - 1], centres, radii, live, tiny, dim)
             if turned and has_limits:
                 dx, dy, dz = _constrain(dx, dy, dz, qx, qy, qz, table, i - 1, rest, tiny, dim)
         length = lengths[i - 1]
@@ -143,18 +151,19 @@ def _backward_pass(
 
 @numba.njit(cache=True, error_model="numpy")
 def _ccd_sweep(
-    p: NDArray[np.float64], target: NDArray[np.float64], tiny: float, rest: NDArray[np.float64],
+    p: NDArray[np.float64],
+    target: NDArray[np.float64],
+    tiny: float,
+    rest: NDArray[np.float64],
     dim: int,
-) -> None:  # fmt: skip
+) -> None:
     """One CCD sweep (Wang & Chen 1991): each joint, end to root, turns what lies beyond it about
     ``to_end × to_target`` (Rodrigues' formula) so that the end points at the target."""
     n = p.shape[0] - 1
     for i in range(n - 1, -1, -1):
         ox, oy, oz = p[i, 0], p[i, 1], p[i, 2]
-        ex, ey, ez, end_norm = _unit(p[n, 0] - ox, p[n, 1] - oy, p[n, 2] - oz,
-                                     rest[0], rest[1], rest[2], tiny)  # fmt: skip
-        tx, ty, tz, target_norm = _unit(target[0] - ox, target[1] - oy, target[2] - oz,
-                                        ex, ey, ez, tiny)  # fmt: skip
+        ex, ey, ez, end_norm = _unit(p[n, 0] - ox, p[n, 1] - oy, p[n, 2] - oz, rest[0], rest[1], rest[2], tiny)
+        tx, ty, tz, target_norm = _unit(target[0] - ox, target[1] - oy, target[2] - oz, ex, ey, ez, tiny)
         if not (end_norm > tiny and target_norm > tiny):
             continue
         cos_a = min(max(ex * tx + ey * ty + ez * tz, -1.0), 1.0)
@@ -175,9 +184,12 @@ def _ccd_sweep(
 
 @numba.njit(cache=True, error_model="numpy")
 def _dls_step(
-    p: NDArray[np.float64], target: NDArray[np.float64], lengths: NDArray[np.float64],
-    tiny: float, turns: NDArray[np.float64],
-) -> None:  # fmt: skip
+    p: NDArray[np.float64],
+    target: NDArray[np.float64],
+    lengths: NDArray[np.float64],
+    tiny: float,
+    turns: NDArray[np.float64],
+) -> None:
     """One damped-least-squares step on joint angles (Wampler 1986; Buss 2004): ``Δθ = Jᵀ(JJᵀ + λ²I)⁻¹e``.
 
     Ball joints: ``J_i = −[l_i]×`` with ``l_i = p_n − p_i``, so ``JJᵀ = Σ |l_i|²I − l_i l_iᵀ`` and
@@ -241,9 +253,7 @@ def _dls_step(
             )
             for r in range(3):
                 for q in range(3):
-                    product[r, q] = (
-                        turn[r, 0] * step[0, q] + turn[r, 1] * step[1, q] + turn[r, 2] * step[2, q]
-                    )
+                    product[r, q] = turn[r, 0] * step[0, q] + turn[r, 1] * step[1, q] + turn[r, 2] * step[2, q]
             turn[:, :] = product
         p[i + 1, 0] = p[i, 0] + turn[0, 0] * sx + turn[0, 1] * sy + turn[0, 2] * sz
         p[i + 1, 1] = p[i, 1] + turn[1, 0] * sx + turn[1, 1] * sy + turn[1, 2] * sz
@@ -251,14 +261,11 @@ def _dls_step(
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _cone_ok(
-    p: NDArray[np.float64], tiny: float, rest: NDArray[np.float64], table: NDArray[np.float64]
-) -> bool:
+def _cone_ok(p: NDArray[np.float64], tiny: float, rest: NDArray[np.float64], table: NDArray[np.float64]) -> bool:
     """Whether every segment keeps its joint's cone or hinge (zero-length segments have none and are skipped)."""
     qx, qy, qz = rest[0], rest[1], rest[2]
     for i in range(p.shape[0] - 1):
-        dx, dy, dz, norm = _unit(p[i + 1, 0] - p[i, 0], p[i + 1, 1] - p[i, 1],
-                                 p[i + 1, 2] - p[i, 2], qx, qy, qz, tiny)  # fmt: skip
+        dx, dy, dz, norm = _unit(p[i + 1, 0] - p[i, 0], p[i + 1, 1] - p[i, 1], p[i + 1, 2] - p[i, 2], qx, qy, qz, tiny)
         if norm <= tiny:
             continue
         if not _joint_ok(dx, dy, dz, qx, qy, qz, table, i, rest, tiny):
@@ -269,9 +276,12 @@ def _cone_ok(
 
 @numba.njit(cache=True, error_model="numpy")
 def _colliding(
-    p: NDArray[np.float64], centres: NDArray[np.float64], radii: NDArray[np.float64],
-    live: NDArray[np.bool_], inflate: float,
-) -> bool:  # fmt: skip
+    p: NDArray[np.float64],
+    centres: NDArray[np.float64],
+    radii: NDArray[np.float64],
+    live: NDArray[np.bool_],
+    inflate: float,
+) -> bool:
     """Whether any segment passes within ``inflate`` × radius of a live obstacle's centre."""
     for i in range(p.shape[0] - 1):
         if _segment_cuts(p, i, i + 1, centres, radii, live, inflate):
@@ -281,10 +291,15 @@ def _colliding(
 
 @numba.njit(cache=True, error_model="numpy")
 def _admissible(
-    p: NDArray[np.float64], tiny: float, rest: NDArray[np.float64], has_limits: bool,
-    table: NDArray[np.float64], centres: NDArray[np.float64], radii: NDArray[np.float64],
+    p: NDArray[np.float64],
+    tiny: float,
+    rest: NDArray[np.float64],
+    has_limits: bool,
+    table: NDArray[np.float64],
+    centres: NDArray[np.float64],
+    radii: NDArray[np.float64],
     live: NDArray[np.bool_],
-) -> bool:  # fmt: skip
+) -> bool:
     """Whether the pose keeps every joint limit and cuts no live obstacle."""
     if has_limits and not _cone_ok(p, tiny, rest, table):
         return False
@@ -310,9 +325,14 @@ def _end_error(p: NDArray[np.float64], target: NDArray[np.float64]) -> float:
 
 @numba.njit(cache=True, error_model="numpy")
 def _place_on_line(
-    pose: NDArray[np.float64], root: NDArray[np.float64], lengths: NDArray[np.float64],
-    ux: float, uy: float, uz: float, fold: bool,
-) -> None:  # fmt: skip
+    pose: NDArray[np.float64],
+    root: NDArray[np.float64],
+    lengths: NDArray[np.float64],
+    ux: float,
+    uy: float,
+    uz: float,
+    fold: bool,
+) -> None:
     """The chain along the unit direction u from the root: straight, or (``fold``) with its longest link toward u
     and the others folded back, so the end rests on the inner boundary of the reach."""
     longest = np.argmax(lengths)
@@ -329,10 +349,15 @@ def _place_on_line(
 
 @numba.njit(cache=True, error_model="numpy")
 def _unbend(
-    p: NDArray[np.float64], target: NDArray[np.float64], lengths: NDArray[np.float64],
-    tiny: float, rest: NDArray[np.float64], limits: tuple[bool, NDArray[np.float64]], cos_phi: float,
+    p: NDArray[np.float64],
+    target: NDArray[np.float64],
+    lengths: NDArray[np.float64],
+    tiny: float,
+    rest: NDArray[np.float64],
+    limits: tuple[bool, NDArray[np.float64]],
+    cos_phi: float,
     dim: int,
-) -> None:  # fmt: skip
+) -> None:
     """Bend a straight chain whose target lies on its own line into a gentle arc centred on that line, so the
     passes can bend it (every interior joint leaves the line; an arc starting along it would leave p_1 on it).
 
@@ -368,9 +393,7 @@ def _unbend(
     # The arc turns by each joint's bend; centred, its first and last segments straddle the line.
     turn, bent = 0.0, False
     for i in range(1, n):
-        bend = (
-            step if not has_limits else _bend_within(table, i, ax, ay, az, nx, ny, nz, rest, step)
-        )
+        bend = step if not has_limits else _bend_within(table, i, ax, ay, az, nx, ny, nz, rest, step)
         bent = bent or bend != 0.0
         turn += bend
     if not bent:
@@ -378,11 +401,7 @@ def _unbend(
     angle = -0.5 * turn
     for i in range(n):
         if i > 0:
-            angle += (
-                step
-                if not has_limits
-                else _bend_within(table, i, ax, ay, az, nx, ny, nz, rest, step)
-            )
+            angle += step if not has_limits else _bend_within(table, i, ax, ay, az, nx, ny, nz, rest, step)
         c, s = math.cos(angle) * lengths[i], math.sin(angle) * lengths[i]
         p[i + 1, 0] = p[i, 0] + c * ax + s * sx
         p[i + 1, 1] = p[i, 1] + c * ay + s * sy
@@ -391,9 +410,12 @@ def _unbend(
 
 @numba.njit(cache=True, error_model="numpy")
 def _extrapolate(
-    p: NDArray[np.float64], previous: NDArray[np.float64], error: float, previous_error: float,
+    p: NDArray[np.float64],
+    previous: NDArray[np.float64],
+    error: float,
+    previous_error: float,
     allowed: bool,
-) -> bool:  # fmt: skip
+) -> bool:
     """Move the joints on along their last step, in place, by the rest of a geometric series; ``previous`` (the
     pose before the last step) becomes the pose before this move.
 
@@ -419,9 +441,15 @@ def _extrapolate(
 
 @numba.njit(cache=True, error_model="numpy")
 def _admissible_start(
-    p: NDArray[np.float64], lengths: NDArray[np.float64], tiny: float, rest: NDArray[np.float64],
-    table: NDArray[np.float64], has_zero: bool, start: int, dim: int,
-) -> None:  # fmt: skip
+    p: NDArray[np.float64],
+    lengths: NDArray[np.float64],
+    tiny: float,
+    rest: NDArray[np.float64],
+    table: NDArray[np.float64],
+    has_zero: bool,
+    start: int,
+    dim: int,
+) -> None:
     """Rebuild ``p`` from its root as the ``start``-th admissible pose: every joint at an angle inside its limit
     (:func:`~kernels.fabrik.limits._inside_limit`), the fractions taken from additive recurrences over the start
     and the joint, kept off a range's ends (a one-sided range's end is often a fixed point). Starts come in
@@ -447,12 +475,23 @@ def _admissible_start(
 
 @numba.njit(cache=True, error_model="numpy")
 def _polish(
-    p: NDArray[np.float64], best: NDArray[np.float64], best_error: float,
-    target: NDArray[np.float64], tolerance: float, budget: int, lengths: NDArray[np.float64],
-    tiny: float, rest: NDArray[np.float64], limits: tuple[bool, NDArray[np.float64]],
-    centres: NDArray[np.float64], radii: NDArray[np.float64], live: NDArray[np.bool_],
-    has_zero: bool, dim: int, turns: NDArray[np.float64],
-) -> float:  # fmt: skip
+    p: NDArray[np.float64],
+    best: NDArray[np.float64],
+    best_error: float,
+    target: NDArray[np.float64],
+    tolerance: float,
+    budget: int,
+    lengths: NDArray[np.float64],
+    tiny: float,
+    rest: NDArray[np.float64],
+    limits: tuple[bool, NDArray[np.float64]],
+    centres: NDArray[np.float64],
+    radii: NDArray[np.float64],
+    live: NDArray[np.bool_],
+    has_zero: bool,
+    dim: int,
+    turns: NDArray[np.float64],
+) -> float:
     """Damped least squares (:func:`_dls_step`, each iterate projected by the constrained backward pass) from the
     best pose, then from admissible poses (:func:`_admissible_start`), once FABRIK under hinges stalls or creeps
     short of a reachable target. FABRIK's fixed points under one-sided or narrow hinge ranges are many (a joint resting at a
@@ -471,9 +510,7 @@ def _polish(
             _admissible_start(p, lengths, tiny, rest, table, has_zero, start, dim)
             _backward_pass(p, lengths, tiny, rest, limits, centres, radii, live, has_zero, dim)
             error = _end_error(p, target)
-            if error < best_error and _admissible(
-                p, tiny, rest, has_limits, table, centres, radii, live
-            ):
+            if error < best_error and _admissible(p, tiny, rest, has_limits, table, centres, radii, live):
                 _copy(p, best)
                 best_error = error
                 if error <= tolerance:
@@ -483,9 +520,7 @@ def _polish(
             _dls_step(p, target, lengths, tiny, turns)
             _backward_pass(p, lengths, tiny, rest, limits, centres, radii, live, has_zero, dim)
             error = _end_error(p, target)
-            if error < best_error and _admissible(
-                p, tiny, rest, has_limits, table, centres, radii, live
-            ):
+            if error < best_error and _admissible(p, tiny, rest, has_limits, table, centres, radii, live):
                 _copy(p, best)
                 best_error = error
                 if error <= tolerance:
@@ -499,12 +534,22 @@ def _polish(
 
 @numba.njit(cache=True, error_model="numpy")
 def _solve_chain(
-    p: NDArray[np.float64], target: NDArray[np.float64], params: NDArray[np.float64],
-    flags: NDArray[np.int64], rest: NDArray[np.float64], centres: NDArray[np.float64],
-    radii: NDArray[np.float64], lengths: NDArray[np.float64], live: NDArray[np.bool_],
-    best: NDArray[np.float64], previous: NDArray[np.float64], before: NDArray[np.float64],
-    out_p: NDArray[np.float64], history: NDArray[np.float64], table: NDArray[np.float64],
-) -> tuple[int, int, float]:  # fmt: skip
+    p: NDArray[np.float64],
+    target: NDArray[np.float64],
+    params: NDArray[np.float64],
+    flags: NDArray[np.int64],
+    rest: NDArray[np.float64],
+    centres: NDArray[np.float64],
+    radii: NDArray[np.float64],
+    lengths: NDArray[np.float64],
+    live: NDArray[np.bool_],
+    best: NDArray[np.float64],
+    previous: NDArray[np.float64],
+    before: NDArray[np.float64],
+    out_p: NDArray[np.float64],
+    history: NDArray[np.float64],
+    table: NDArray[np.float64],
+) -> tuple[int, int, float]:
     """Solve one chain, starting from ``p`` (n + 1, 3), which it works on in place.
 
     Writes the returned pose to ``out_p`` and the iterates' errors to ``history`` (max_iterations + 1,), which it
@@ -583,15 +628,11 @@ def _solve_chain(
     for iteration in range(1, max_iterations + 1):
         count = iteration
         last_error = history[iteration - 1]
-        if (
-            extrapolate and iteration >= restart + 2
-        ):  # from the third iteration on, and while trusted
+        if extrapolate and iteration >= restart + 2:  # from the third iteration on, and while trusted
             allowed = iteration >= restart + 3 and trusted
             moved = _extrapolate(p, previous, last_error, history[iteration - 2], allowed)
         if solver == _FABRIK:
-            _forward_pass(
-                p, target, lengths, tiny, rest, limits, centres, radii, live, has_zero, dim
-            )
+            _forward_pass(p, target, lengths, tiny, rest, limits, centres, radii, live, has_zero, dim)
         elif solver == _CCD:
             _ccd_sweep(p, target, tiny, rest, dim)
         else:
@@ -611,9 +652,7 @@ def _solve_chain(
             reached = error <= tolerance
         if best_error < mark_error - progress:
             mark_iteration, mark_error = iteration, best_error
-        stalled = stall_applies and (
-            abs(last_error - error) < stall or iteration - mark_iteration >= _PATIENCE
-        )
+        stalled = stall_applies and (abs(last_error - error) < stall or iteration - mark_iteration >= _PATIENCE)
         if stalled and not reached and retry:
             # A stall under limits is a fixed point of this start, not proof that the limits keep the target
             # away: go on once from the straight pose toward the target, clamped into the cones (another basin).
@@ -626,16 +665,12 @@ def _solve_chain(
             )
             ux, uy, uz, _ = _unit(ox, oy, oz, rest[0], rest[1], rest[2], tiny)
             _place_on_line(p, best[0], lengths, ux, uy, uz, False)
-            _unbend(
-                p, target, lengths, tiny, rest, limits, cos_phi, dim
-            )  # a straight chain never bends
+            _unbend(p, target, lengths, tiny, rest, limits, cos_phi, dim)  # a straight chain never bends
             _backward_pass(p, lengths, tiny, rest, limits, centres, radii, live, has_zero, dim)
             # The restart pose is a candidate too: where the limits leave the chain nearly rigid, the passes from
             # it may move away from the best pose it already is.
             error = _end_error(p, target)
-            if error < best_error and _admissible(
-                p, tiny, rest, has_limits, table, centres, radii, live
-            ):
+            if error < best_error and _admissible(p, tiny, rest, has_limits, table, centres, radii, live):
                 _copy(p, best)
                 best_error = error
                 reached = error <= tolerance
@@ -649,17 +684,31 @@ def _solve_chain(
             if (stalled and not retry) or creeping:
                 # Decided by the iterates alone, which a longer run repeats: more iterations are never worse.
                 polish = False
-                best_error = _polish(out_p, best, best_error, target, tolerance, _POLISH_STEPS, lengths, tiny,
-                                     rest, limits, centres, radii, live, has_zero, dim, before)  # fmt: skip
+                best_error = _polish(
+                    out_p,
+                    best,
+                    best_error,
+                    target,
+                    tolerance,
+                    _POLISH_STEPS,
+                    lengths,
+                    tiny,
+                    rest,
+                    limits,
+                    centres,
+                    radii,
+                    live,
+                    has_zero,
+                    dim,
+                    before,
+                )
                 if best_error <= tolerance:
                     reached = True
                     _copy(best, p)
         if reached or stalled:
             break
 
-    if (
-        reached or best_error == np.inf
-    ):  # reached: this iterate is the best; none admissible: the last
+    if reached or best_error == np.inf:  # reached: this iterate is the best; none admissible: the last
         _copy(p, out_p)
     else:
         _copy(best, out_p)
@@ -673,10 +722,9 @@ def _solve_chain(
         return count, _UNREACHABLE, final_error
     if any_live:
         for k in range(radii.shape[0]):
-            inside = (
-                (centres[k, 0] - target[0]) ** 2 + (centres[k, 1] - target[1]) ** 2
-                + (centres[k, 2] - target[2]) ** 2 < radii[k] * radii[k]
-            )  # fmt: skip
+            inside = (centres[k, 0] - target[0]) ** 2 + (centres[k, 1] - target[1]) ** 2 + (
+                centres[k, 2] - target[2]
+            ) ** 2 < radii[k] * radii[k]
             if live[k] and inside:
                 return count, _BLOCKED, final_error
         if _colliding(out_p, centres, radii, live, 1.0 + _TOUCH):
@@ -686,12 +734,22 @@ def _solve_chain(
 
 @numba.njit(cache=True, error_model="numpy")
 def _solve_rows(
-    lo: int, hi: int, p: NDArray[np.float64], target: NDArray[np.float64],
-    params: NDArray[np.float64], flags: NDArray[np.int64], rest: NDArray[np.float64],
-    centres: NDArray[np.float64], radii: NDArray[np.float64], out_p: NDArray[np.float64],
-    history: NDArray[np.float64], iterations: NDArray[np.int64], status: NDArray[np.int64],
-    error: NDArray[np.float64], table: NDArray[np.float64],
-) -> None:  # fmt: skip
+    lo: int,
+    hi: int,
+    p: NDArray[np.float64],
+    target: NDArray[np.float64],
+    params: NDArray[np.float64],
+    flags: NDArray[np.int64],
+    rest: NDArray[np.float64],
+    centres: NDArray[np.float64],
+    radii: NDArray[np.float64],
+    out_p: NDArray[np.float64],
+    history: NDArray[np.float64],
+    iterations: NDArray[np.int64],
+    status: NDArray[np.int64],
+    error: NDArray[np.float64],
+    table: NDArray[np.float64],
+) -> None:
     """Solve rows ``lo`` to ``hi`` of a batch (p (B, n + 1, 3), target (B, 3)) with one set of scratch arrays."""
     count = p.shape[1]
     lengths = np.empty(count - 1)
@@ -699,24 +757,61 @@ def _solve_rows(
     best, previous, before = np.empty((count, 3)), np.empty((count, 3)), np.empty((count, 3))
     for b in range(lo, hi):
         iterations[b], status[b], error[b] = _solve_chain(
-            p[b], target[b], params, flags, rest, centres, radii, lengths, live, best, previous,
-            before, out_p[b], history[b], table,
-        )  # fmt: skip
+            p[b],
+            target[b],
+            params,
+            flags,
+            rest,
+            centres,
+            radii,
+            lengths,
+            live,
+            best,
+            previous,
+            before,
+            out_p[b],
+            history[b],
+            table,
+        )
 
 
 @numba.njit(cache=True, error_model="numpy", parallel=True)
 def _solve_parallel(
-    chunks: int, p: NDArray[np.float64], target: NDArray[np.float64],
-    params: NDArray[np.float64], flags: NDArray[np.int64], rest: NDArray[np.float64],
-    centres: NDArray[np.float64], radii: NDArray[np.float64], out_p: NDArray[np.float64],
-    history: NDArray[np.float64], iterations: NDArray[np.int64], status: NDArray[np.int64],
-    error: NDArray[np.float64], table: NDArray[np.float64],
-) -> None:  # fmt: skip
+    chunks: int,
+    p: NDArray[np.float64],
+    target: NDArray[np.float64],
+    params: NDArray[np.float64],
+    flags: NDArray[np.int64],
+    rest: NDArray[np.float64],
+    centres: NDArray[np.float64],
+    radii: NDArray[np.float64],
+    out_p: NDArray[np.float64],
+    history: NDArray[np.float64],
+    iterations: NDArray[np.int64],
+    status: NDArray[np.int64],
+    error: NDArray[np.float64],
+    table: NDArray[np.float64],
+) -> None:
     """:func:`_solve_rows` over a whole batch, in ``chunks`` contiguous chunks spread over numba's threads."""
     batch = p.shape[0]
     for c in numba.prange(chunks):
-        _solve_rows(c * batch // chunks, (c + 1) * batch // chunks, p, target, params, flags, rest,
-                    centres, radii, out_p, history, iterations, status, error, table)  # fmt: skip
+        _solve_rows(
+            c * batch // chunks,
+            (c + 1) * batch // chunks,
+            p,
+            target,
+            params,
+            flags,
+            rest,
+            centres,
+            radii,
+            out_p,
+            history,
+            iterations,
+            status,
+            error,
+            table,
+        )
 
 
 _UNSCALED = 2.0**-16, 2.0**16
@@ -736,10 +831,16 @@ def _within(values: NDArray[np.float64], bound: float) -> bool:
 
 @numba.njit(cache=True, error_model="numpy")
 def _solve_one(
-    joints: NDArray[np.float64], target: NDArray[np.float64], bound: float,
-    params: NDArray[np.float64], flags: NDArray[np.int64], rest: NDArray[np.float64],
-    centres: NDArray[np.float64], radii: NDArray[np.float64], table: NDArray[np.float64],
-) -> tuple[int, NDArray[np.float64], NDArray[np.float64], int, int, float]:  # fmt: skip
+    joints: NDArray[np.float64],
+    target: NDArray[np.float64],
+    bound: float,
+    params: NDArray[np.float64],
+    flags: NDArray[np.int64],
+    rest: NDArray[np.float64],
+    centres: NDArray[np.float64],
+    radii: NDArray[np.float64],
+    table: NDArray[np.float64],
+) -> tuple[int, NDArray[np.float64], NDArray[np.float64], int, int, float]:
     """One chain from shape-checked ``joints`` (n + 1, d) and ``target`` (d,), d = 2 or 3 (m): the whole single
     solve in one compiled call, so a small chain spends little time outside the core.
 
@@ -775,8 +876,9 @@ def _solve_one(
     lengths = np.empty(count - 1)
     live = np.empty(radii.shape[0], dtype=np.bool_)
     best, previous, before = np.empty((count, 3)), np.empty((count, 3)), np.empty((count, 3))
-    iterations, status, error = _solve_chain(p, goal, params, flags, rest, centres, radii, lengths,
-                                             live, best, previous, before, out_p, history, table)  # fmt: skip
+    iterations, status, error = _solve_chain(
+        p, goal, params, flags, rest, centres, radii, lengths, live, best, previous, before, out_p, history, table
+    )
     if scale != 1.0:
         out_p *= scale
         history *= scale

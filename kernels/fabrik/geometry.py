@@ -90,15 +90,22 @@ def _wrap(angle: float) -> float:
 
 @numba.njit(cache=True, error_model="numpy")
 def _turn_clear(
-    ax: float, ay: float, az: float, vx: float, vy: float, vz: float, length: float,
-    centre: NDArray[np.float64], radius: float, tiny: float, dim: int,
-) -> tuple[float, float, float]:  # fmt: skip
+    ax: float,
+    ay: float,
+    az: float,
+    vx: float,
+    vy: float,
+    vz: float,
+    length: float,
+    centre: NDArray[np.float64],
+    radius: float,
+    tiny: float,
+    dim: int,
+) -> tuple[float, float, float]:
     """The direction nearest v whose segment of ``length`` from anchor ``a`` just clears one obstacle: tangent to
     it if the segment is long enough to reach the tangent point, else with its far end on the surface."""
     clear = radius * (1.0 + _CLEARANCE)
-    cx, cy, cz, distance = _unit(
-        centre[0] - ax, centre[1] - ay, centre[2] - az, -vx, -vy, -vz, tiny
-    )
+    cx, cy, cz, distance = _unit(centre[0] - ax, centre[1] - ay, centre[2] - az, -vx, -vy, -vz, tiny)
     if distance <= radius:  # an anchor inside: leave straight away from the centre
         return -cx, -cy, -cz
     if length * length >= distance * distance - clear * clear:
@@ -121,10 +128,19 @@ def _turn_clear(
 
 @numba.njit(cache=True, error_model="numpy")
 def _deflect(
-    ax: float, ay: float, az: float, vx: float, vy: float, vz: float, length: float,
-    centres: NDArray[np.float64], radii: NDArray[np.float64], live: NDArray[np.bool_], tiny: float,
+    ax: float,
+    ay: float,
+    az: float,
+    vx: float,
+    vy: float,
+    vz: float,
+    length: float,
+    centres: NDArray[np.float64],
+    radii: NDArray[np.float64],
+    live: NDArray[np.bool_],
+    tiny: float,
     dim: int,
-) -> tuple[float, float, float, bool]:  # fmt: skip
+) -> tuple[float, float, float, bool]:
     """Turn the segment ``a + t·v, t ∈ [0, length]`` by the least angle until no live obstacle cuts it; returns
     the new unit direction and whether it was turned."""
     turned = False
@@ -142,8 +158,7 @@ def _deflect(
             t = min(max(along, 0.0), length)
             if rel2 - 2.0 * t * along + t * t < radii[k] * radii[k]:
                 hit = True
-                vx, vy, vz = _turn_clear(ax, ay, az, vx, vy, vz, length, centres[k], radii[k],
-                                         tiny, dim)  # fmt: skip
+                vx, vy, vz = _turn_clear(ax, ay, az, vx, vy, vz, length, centres[k], radii[k], tiny, dim)
         if not hit:
             return vx, vy, vz, turned
         turned = True
@@ -152,9 +167,14 @@ def _deflect(
 
 @numba.njit(cache=True, error_model="numpy")
 def _segment_cuts(
-    p: NDArray[np.float64], a: int, b: int, centres: NDArray[np.float64],
-    radii: NDArray[np.float64], live: NDArray[np.bool_], inflate: float,
-) -> bool:  # fmt: skip
+    p: NDArray[np.float64],
+    a: int,
+    b: int,
+    centres: NDArray[np.float64],
+    radii: NDArray[np.float64],
+    live: NDArray[np.bool_],
+    inflate: float,
+) -> bool:
     """Whether the segment from joint ``a`` to joint ``b`` of ``p`` (J, 3) passes within ``inflate`` × radius of a
     live obstacle's centre. A zero-length segment is its one point (the closest-point parameter is not divided by
     its zero squared length). The chain and the tree both test their poses with it."""

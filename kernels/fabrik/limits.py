@@ -92,21 +92,15 @@ class Hinge:
         if not -math.pi <= low <= math.pi:
             raise ValueError(f"min_angle_rad must be in [−π, π], got {self.min_angle_rad!r}")
         if not low <= high <= math.pi:
-            raise ValueError(
-                f"max_angle_rad must be in [min_angle_rad, π] = [{low}, π], got {self.max_angle_rad!r}"
-            )
+            raise ValueError(f"max_angle_rad must be in [min_angle_rad, π] = [{low}, π], got {self.max_angle_rad!r}")
         reference = None
         if self.reference_axis is not None:
             raw = bounded_array("reference_axis", self.reference_axis, _LARGEST)
             if raw.shape != (3,):
-                raise ValueError(
-                    f"reference_axis must be a (3,) vector, got {self.reference_axis!r}"
-                )
+                raise ValueError(f"reference_axis must be a (3,) vector, got {self.reference_axis!r}")
             off = raw - float(raw @ axis) * axis
             if not float(np.linalg.norm(off)) > 1e-9 * max(float(np.linalg.norm(raw)), _TINY):
-                raise ValueError(
-                    f"reference_axis must not be parallel to axis, got {self.reference_axis!r}"
-                )
+                raise ValueError(f"reference_axis must not be parallel to axis, got {self.reference_axis!r}")
             reference = tuple(float(v) for v in off / float(np.linalg.norm(off)))
         match self.frame:
             case "global" | "local":
@@ -142,9 +136,7 @@ def _limit_table(
     if isinstance(constraints, (str, bytes)) or not isinstance(constraints, Sequence):
         raise ValueError(f"{name} must be a sequence of Cone, Hinge or None, got {constraints!r}")
     if len(constraints) != count:
-        raise ValueError(
-            f"{name} must have one entry per segment ({count}), got {len(constraints)}"
-        )
+        raise ValueError(f"{name} must have one entry per segment ({count}), got {len(constraints)}")
     table = np.zeros((count, _TABLE_WIDTH))
     for i, item in enumerate(constraints):
         if i < segment_offset and item is not None:
@@ -158,9 +150,7 @@ def _limit_table(
             case Hinge():
                 axis = np.asarray(item.axis)
                 if dim == 2 and abs(axis[2]) < 1.0 - 1e-12:
-                    raise ValueError(
-                        f"{name}[{i}].axis must be ±z for a 2D chain, got {item.axis!r}"
-                    )
+                    raise ValueError(f"{name}[{i}].axis must be ±z for a 2D chain, got {item.axis!r}")
                 table[i, 0] = _KIND_HINGE
                 table[i, 3:6] = axis
                 if item.reference_axis is not None:
@@ -175,9 +165,16 @@ def _limit_table(
 
 @numba.njit(cache=True, error_model="numpy")
 def _clamp_cone(
-    vx: float, vy: float, vz: float, ax: float, ay: float, az: float, cos_phi: float,
-    sin_phi: float, dim: int,
-) -> tuple[float, float, float]:  # fmt: skip
+    vx: float,
+    vy: float,
+    vz: float,
+    ax: float,
+    ay: float,
+    az: float,
+    cos_phi: float,
+    sin_phi: float,
+    dim: int,
+) -> tuple[float, float, float]:
     """The unit direction v turned, by the least angle, into the cone of half-angle φ around the unit ``a``."""
     cos_v = vx * ax + vy * ay + vz * az
     if not cos_v < cos_phi:
@@ -202,9 +199,13 @@ def _row(table: NDArray[np.float64], i: int) -> int:
 
 @numba.njit(cache=True, error_model="numpy")
 def _hinge_axes(
-    table: NDArray[np.float64], row: int, qx: float, qy: float, qz: float,
+    table: NDArray[np.float64],
+    row: int,
+    qx: float,
+    qy: float,
+    qz: float,
     rest: NDArray[np.float64],
-) -> tuple[float, float, float, float, float, float]:  # fmt: skip
+) -> tuple[float, float, float, float, float, float]:
     """The hinge's world axis a and unit reference r ⊥ a, for a previous-segment direction q (unit)."""
     ax, ay, az = table[row, 3], table[row, 4], table[row, 5]
     rx, ry, rz = table[row, 6], table[row, 7], table[row, 8]
@@ -222,9 +223,18 @@ def _hinge_axes(
 
 @numba.njit(cache=True, error_model="numpy")
 def _hinge_angle(
-    vx: float, vy: float, vz: float, ax: float, ay: float, az: float, rx: float, ry: float,
-    rz: float, low: float, high: float,
-) -> float:  # fmt: skip
+    vx: float,
+    vy: float,
+    vz: float,
+    ax: float,
+    ay: float,
+    az: float,
+    rx: float,
+    ry: float,
+    rz: float,
+    low: float,
+    high: float,
+) -> float:
     """Signed angle of v about a from r (rad), as the representative in [low − 2π, high + 2π] nearest the range."""
     bx, by, bz = ay * rz - az * ry, az * rx - ax * rz, ax * ry - ay * rx
     theta = math.atan2(vx * bx + vy * by + vz * bz, vx * rx + vy * ry + vz * rz)
@@ -237,9 +247,16 @@ def _hinge_angle(
 
 @numba.njit(cache=True, error_model="numpy")
 def _clamp_hinge(
-    vx: float, vy: float, vz: float, qx: float, qy: float, qz: float,
-    table: NDArray[np.float64], row: int, rest: NDArray[np.float64],
-) -> tuple[float, float, float]:  # fmt: skip
+    vx: float,
+    vy: float,
+    vz: float,
+    qx: float,
+    qy: float,
+    qz: float,
+    table: NDArray[np.float64],
+    row: int,
+    rest: NDArray[np.float64],
+) -> tuple[float, float, float]:
     """The unit direction v brought onto the hinge: projected onto its plane (the nearest direction there), then,
     outside the range, onto the nearer end around the circle."""
     ax, ay, az, rx, ry, rz = _hinge_axes(table, row, qx, qy, qz, rest)
@@ -257,9 +274,18 @@ def _clamp_hinge(
 
 @numba.njit(cache=True, error_model="numpy")
 def _constrain(
-    vx: float, vy: float, vz: float, qx: float, qy: float, qz: float,
-    table: NDArray[np.float64], i: int, rest: NDArray[np.float64], tiny: float, dim: int,
-) -> tuple[float, float, float]:  # fmt: skip
+    vx: float,
+    vy: float,
+    vz: float,
+    qx: float,
+    qy: float,
+    qz: float,
+    table: NDArray[np.float64],
+    i: int,
+    rest: NDArray[np.float64],
+    tiny: float,
+    dim: int,
+) -> tuple[float, float, float]:
     """Segment i's unit direction v brought inside its joint's limit, q (unit) the previous segment's direction."""
     row = _row(table, i)
     kind = table[row, 0]
@@ -272,9 +298,17 @@ def _constrain(
 
 @numba.njit(cache=True, error_model="numpy")
 def _hold_by_next(
-    dx: float, dy: float, dz: float, qx: float, qy: float, qz: float,
-    table: NDArray[np.float64], row: int, rest: NDArray[np.float64], dim: int,
-) -> tuple[float, float, float]:  # fmt: skip
+    dx: float,
+    dy: float,
+    dz: float,
+    qx: float,
+    qy: float,
+    qz: float,
+    table: NDArray[np.float64],
+    row: int,
+    rest: NDArray[np.float64],
+    dim: int,
+) -> tuple[float, float, float]:
     """A forward pass's rule for the joint ``row`` beyond a segment: the segment's reversed unit direction d is
     held by the next segment's (reversed, unit q) through that joint.
 
@@ -294,9 +328,16 @@ def _hold_by_next(
 
 @numba.njit(cache=True, error_model="numpy")
 def _into_hinge_plane(
-    dx: float, dy: float, dz: float, sx: float, sy: float, sz: float,
-    table: NDArray[np.float64], row: int, rest: NDArray[np.float64],
-) -> tuple[float, float, float]:  # fmt: skip
+    dx: float,
+    dy: float,
+    dz: float,
+    sx: float,
+    sy: float,
+    sz: float,
+    table: NDArray[np.float64],
+    row: int,
+    rest: NDArray[np.float64],
+) -> tuple[float, float, float]:
     """A forward pass's rule for a segment's own joint ``row``: a hinge keeps the segment's reversed unit direction
     d in its plane, the plane taken from the previous segment's unit direction s as it stands (caliko's forward
     pass; the range waits for the backward pass). Other joints leave d. Chain and tree share it."""
@@ -310,18 +351,29 @@ def _into_hinge_plane(
 
 @numba.njit(cache=True, error_model="numpy")
 def _forward_limits(
-    p: NDArray[np.float64], i: int, n: int, dx: float, dy: float, dz: float, qx: float,
-    qy: float, qz: float, table: NDArray[np.float64], rest: NDArray[np.float64], tiny: float,
+    p: NDArray[np.float64],
+    i: int,
+    n: int,
+    dx: float,
+    dy: float,
+    dz: float,
+    qx: float,
+    qy: float,
+    qz: float,
+    table: NDArray[np.float64],
+    rest: NDArray[np.float64],
+    tiny: float,
     dim: int,
-) -> tuple[float, float, float]:  # fmt: skip
+) -> tuple[float, float, float]:
     """The chain's forward-pass limits on segment i, whose reversed unit direction is d (q: segment i + 1's,
     reversed): held by the joint to segment i + 1, then kept in its own hinge's plane."""
     if i < n - 1:
         dx, dy, dz = _hold_by_next(dx, dy, dz, qx, qy, qz, table, _row(table, i + 1), rest, dim)
     row = _row(table, i)
     if table[row, 0] == _KIND_HINGE:
-        sx, sy, sz, _ = _unit(p[i, 0] - p[i - 1, 0], p[i, 1] - p[i - 1, 1], p[i, 2] - p[i - 1, 2],
-                              rest[0], rest[1], rest[2], tiny)  # fmt: skip
+        sx, sy, sz, _ = _unit(
+            p[i, 0] - p[i - 1, 0], p[i, 1] - p[i - 1, 1], p[i, 2] - p[i - 1, 2], rest[0], rest[1], rest[2], tiny
+        )
         dx, dy, dz = _into_hinge_plane(dx, dy, dz, sx, sy, sz, table, row, rest)
     return dx, dy, dz
 
@@ -348,9 +400,17 @@ def _limit_flags(table: NDArray[np.float64]) -> tuple[bool, bool]:
 
 @numba.njit(cache=True, error_model="numpy")
 def _joint_ok(
-    dx: float, dy: float, dz: float, qx: float, qy: float, qz: float,
-    table: NDArray[np.float64], i: int, rest: NDArray[np.float64], tiny: float,
-) -> bool:  # fmt: skip
+    dx: float,
+    dy: float,
+    dz: float,
+    qx: float,
+    qy: float,
+    qz: float,
+    table: NDArray[np.float64],
+    i: int,
+    rest: NDArray[np.float64],
+    tiny: float,
+) -> bool:
     """Whether segment i's unit direction d keeps its joint's limit, q the previous segment's unit direction."""
     row = _row(table, i)
     kind = table[row, 0]
@@ -375,8 +435,7 @@ def _usage(
     share = np.zeros(n)
     qx, qy, qz = rest[0], rest[1], rest[2]
     for i in range(n):
-        dx, dy, dz, norm = _unit(p[i + 1, 0] - p[i, 0], p[i + 1, 1] - p[i, 1],
-                                 p[i + 1, 2] - p[i, 2], qx, qy, qz, tiny)  # fmt: skip
+        dx, dy, dz, norm = _unit(p[i + 1, 0] - p[i, 0], p[i + 1, 1] - p[i, 1], p[i + 1, 2] - p[i, 2], qx, qy, qz, tiny)
         if norm <= tiny:
             continue
         row = _row(table, i)
@@ -398,9 +457,16 @@ def _usage(
 
 @numba.njit(cache=True, error_model="numpy")
 def _inside_limit(
-    qx: float, qy: float, qz: float, table: NDArray[np.float64], i: int,
-    rest: NDArray[np.float64], u: float, v: float, dim: int,
-) -> tuple[float, float, float]:  # fmt: skip
+    qx: float,
+    qy: float,
+    qz: float,
+    table: NDArray[np.float64],
+    i: int,
+    rest: NDArray[np.float64],
+    u: float,
+    v: float,
+    dim: int,
+) -> tuple[float, float, float]:
     """A unit direction for segment i that keeps its joint's limit, q (unit) the previous segment's direction, picked
     by two numbers u, v in [0, 1): a hinge's angle at the fraction u of its range; a cone's (or a free joint's,
     the cone of π) angle from q at ``(2u − 1) φ`` in the plane, or at ``u φ`` with azimuth ``2π v`` in 3D.
@@ -441,9 +507,17 @@ def _holding_hinge(table: NDArray[np.float64]) -> bool:
 
 @numba.njit(cache=True, error_model="numpy")
 def _bend_within(
-    table: NDArray[np.float64], i: int, qx: float, qy: float, qz: float, nx: float, ny: float,
-    nz: float, rest: NDArray[np.float64], step: float,
-) -> float:  # fmt: skip
+    table: NDArray[np.float64],
+    i: int,
+    qx: float,
+    qy: float,
+    qz: float,
+    nx: float,
+    ny: float,
+    nz: float,
+    rest: NDArray[np.float64],
+    step: float,
+) -> float:
     """The signed bend (rad, right-handed about the unit normal n) that segment i takes from the straight
     continuation q (unit) of the segment before it when a straight chain is bent into an arc: ``step`` toward the
     centre of a hinge's range about ±n, at most half way to that side's end (0 for a zero range, the feasible side

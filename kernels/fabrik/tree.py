@@ -136,9 +136,7 @@ def solve_tree(
     points = _check_joints("joints", joints, batched=False)
     count, dim = points.shape
     if not isinstance(targets, Mapping) or not targets:
-        raise ValueError(
-            f"targets must be a non-empty mapping joint index → target, got {targets!r}"
-        )
+        raise ValueError(f"targets must be a non-empty mapping joint index → target, got {targets!r}")
     # Keys and parents are checked for type and shape before the cache: 2.0 and True hash as 2 and 1, and a
     # flattened (1, J) array as its (J,) row, so the cache would otherwise answer for input it must refuse.
     for key in targets:
@@ -157,17 +155,25 @@ def solve_tree(
     goal = np.zeros((count, 3))
     for key in effector_ids.tolist():
         goal[key, :dim] = _check_vector(f"targets[{key}]", targets[key], dim)
-    setup = _Setup.build(dim, tolerance, max_iterations, None, obstacles, root_direction,
-                         _FABRIK, False)  # fmt: skip
+    setup = _Setup.build(dim, tolerance, max_iterations, None, obstacles, root_direction, _FABRIK, False)
     root = int(order[0])
     table = _tree_table(constraints, count, dim, root)
     tol = float(setup.params[0])
 
     if is_chain:  # one chain: solve's result
         chain_constraints = None if constraints is None else [constraints[j] for j in order[1:]]
-        single = _solve_single("fabrik", points[order], goal[effector_ids[0], :dim], tol,
-                               setup.max_iterations, None, obstacles, root_direction, True,
-                               chain_constraints)  # fmt: skip
+        single = _solve_single(
+            "fabrik",
+            points[order],
+            goal[effector_ids[0], :dim],
+            tol,
+            setup.max_iterations,
+            None,
+            obstacles,
+            root_direction,
+            True,
+            chain_constraints,
+        )
         out = np.empty_like(points)
         out[order] = single.joints
         return TreeSolution(
@@ -193,9 +199,24 @@ def solve_tree(
         goal /= scale
         tol, centres, radii = tol / scale, centres / scale, radii / scale
     iterations = _solve_tree_core(
-        p, parent, order, active, goal, has_goal, effector_ids, table, setup.root_direction,
-        centres, radii, tol, setup.max_iterations, dim, history, codes, final,
-    )  # fmt: skip
+        p,
+        parent,
+        order,
+        active,
+        goal,
+        has_goal,
+        effector_ids,
+        table,
+        setup.root_direction,
+        centres,
+        radii,
+        tol,
+        setup.max_iterations,
+        dim,
+        history,
+        codes,
+        final,
+    )
     if scale != 1.0:
         p *= scale
         history *= scale
@@ -213,26 +234,16 @@ def solve_tree(
 @functools.lru_cache(maxsize=64)
 def _tree_topology(
     parents: object, count: int, keys: tuple[object, ...]
-) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.bool_], NDArray[np.bool_],
-           NDArray[np.int64], bool]:  # fmt: skip
+) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.bool_], NDArray[np.bool_], NDArray[np.int64], bool]:
     """Checked tree structure: breadth-first order, parents, the joints that take part in the forward stage (a
     target beyond them), the targeted joints, the effectors (ascending) and whether the tree is one chain. Cached:
     a dragged skeleton asks for the same every frame (the arrays are never written to)."""
     try:
         raw = np.asarray(parents)
     except (TypeError, ValueError) as error:
-        raise ValueError(
-            f"parents must be a ({count},) array of integers, got {parents!r}"
-        ) from error
-    if (
-        raw.shape != (count,)
-        or raw.dtype.kind not in "iu"
-        or np.any(raw < -1)
-        or np.any(raw >= count)
-    ):
-        raise ValueError(
-            f"parents must be ({count},) integers in [−1, {count - 1}], got {parents!r}"
-        )
+        raise ValueError(f"parents must be a ({count},) array of integers, got {parents!r}") from error
+    if raw.shape != (count,) or raw.dtype.kind not in "iu" or np.any(raw < -1) or np.any(raw >= count):
+        raise ValueError(f"parents must be ({count},) integers in [−1, {count - 1}], got {parents!r}")
     parent = raw.astype(np.int64)
     roots = np.flatnonzero(parent == -1)
     if roots.size != 1:
@@ -245,22 +256,16 @@ def _tree_topology(
     for j in order:  # breadth first: every joint after its parent
         order.extend(children[j])
     if len(order) != count:
-        raise ValueError(
-            "parents must form one tree: some joints are on a cycle, not under the root"
-        )
+        raise ValueError("parents must form one tree: some joints are on a cycle, not under the root")
     has_goal = np.zeros(count, dtype=np.bool_)
     for key in keys:
         if isinstance(key, bool) or not isinstance(key, (int, np.integer)) or not 0 <= key < count:
             raise ValueError(f"targets keys must be joint indices in [0, {count - 1}], got {key!r}")
         if children[key]:
-            raise ValueError(
-                f"targets[{key}] is on a joint with children: targets go on end effectors"
-            )
+            raise ValueError(f"targets[{key}] is on a joint with children: targets go on end effectors")
         has_goal[key] = True
     active = has_goal.copy()
-    for j in reversed(
-        order
-    ):  # a joint takes part in the forward stage when a target lies beyond it
+    for j in reversed(order):  # a joint takes part in the forward stage when a target lies beyond it
         if active[j] and parent[j] >= 0:
             active[parent[j]] = True
     effectors = np.flatnonzero(has_goal).astype(np.int64)
@@ -268,9 +273,7 @@ def _tree_topology(
     return np.array(order, dtype=np.int64), parent, active, has_goal, effectors, is_chain
 
 
-def _tree_table(
-    constraints: Sequence[Constraint] | None, count: int, dim: int, root: int
-) -> NDArray[np.float64]:
+def _tree_table(constraints: Sequence[Constraint] | None, count: int, dim: int, root: int) -> NDArray[np.float64]:
     """The checked limit table of a tree (one row per joint), cached on hashable constraints."""
     if constraints is None:
         return np.zeros((count, _TABLE_WIDTH))
@@ -281,27 +284,32 @@ def _tree_table(
 
 
 @functools.lru_cache(maxsize=64)
-def _tree_table_cached(
-    constraints: Sequence[Constraint], count: int, dim: int, root: int
-) -> NDArray[np.float64]:
-    if (
-        isinstance(constraints, Sequence)
-        and len(constraints) == count
-        and constraints[root] is not None
-    ):
+def _tree_table_cached(constraints: Sequence[Constraint], count: int, dim: int, root: int) -> NDArray[np.float64]:
+    if isinstance(constraints, Sequence) and len(constraints) == count and constraints[root] is not None:
         raise ValueError(f"constraints[{root}] must be None: the root has no segment")
     return _limit_table(constraints, count, dim, "constraints", segment_offset=0)
 
 
 @numba.njit(cache=True, error_model="numpy")
 def _solve_tree_core(
-    p: NDArray[np.float64], parents: NDArray[np.int64], order: NDArray[np.int64],
-    active: NDArray[np.bool_], goal: NDArray[np.float64], has_goal: NDArray[np.bool_],
-    effectors: NDArray[np.int64], table: NDArray[np.float64], rest: NDArray[np.float64],
-    centres: NDArray[np.float64], radii: NDArray[np.float64], tolerance: float,
-    max_iterations: int, dim: int, history: NDArray[np.float64], codes: NDArray[np.int64],
+    p: NDArray[np.float64],
+    parents: NDArray[np.int64],
+    order: NDArray[np.int64],
+    active: NDArray[np.bool_],
+    goal: NDArray[np.float64],
+    has_goal: NDArray[np.bool_],
+    effectors: NDArray[np.int64],
+    table: NDArray[np.float64],
+    rest: NDArray[np.float64],
+    centres: NDArray[np.float64],
+    radii: NDArray[np.float64],
+    tolerance: float,
+    max_iterations: int,
+    dim: int,
+    history: NDArray[np.float64],
+    codes: NDArray[np.int64],
     final: NDArray[np.float64],
-) -> int:  # fmt: skip
+) -> int:
     """Multi-end-effector FABRIK on ``p`` (J, 3), in place; ``order`` is breadth first from the root.
 
     Leaves the returned pose in ``p``: the last iterate where it keeps every limit and clears every live obstacle,
@@ -356,15 +364,20 @@ def _solve_tree_core(
     best = p.copy()
     best_worst = np.inf
     bx, by, bz = p[root, 0], p[root, 1], p[root, 2]
-    directions = np.zeros(
-        (count, 3)
-    )  # each joint's segment direction (its parent's where it has none)
+    directions = np.zeros((count, 3))  # each joint's segment direction (its parent's where it has none)
     directions[root, 0], directions[root, 1], directions[root, 2] = rest[0], rest[1], rest[2]
     for k in range(1, count):
         j = int(order[k])
         up = int(parents[j])
-        ux, uy, uz, _ = _unit(p[j, 0] - p[up, 0], p[j, 1] - p[up, 1], p[j, 2] - p[up, 2],
-                              directions[up, 0], directions[up, 1], directions[up, 2], tiny)  # fmt: skip
+        ux, uy, uz, _ = _unit(
+            p[j, 0] - p[up, 0],
+            p[j, 1] - p[up, 1],
+            p[j, 2] - p[up, 2],
+            directions[up, 0],
+            directions[up, 1],
+            directions[up, 2],
+            tiny,
+        )
         directions[j, 0], directions[j, 1], directions[j, 2] = ux, uy, uz
     sums = np.zeros((count, 3))
     counts = np.zeros(count, dtype=np.int64)
@@ -380,8 +393,9 @@ def _solve_tree_core(
         best_worst = worst
         if worst <= tolerance:  # the start is returned as reached only where it keeps every limit
             final[:] = history[0]
-            _tree_statuses(p, parents, goal, effectors, lengths, centres, radii, live, tolerance,
-                           tiny, final, False, False, codes)  # fmt: skip
+            _tree_statuses(
+                p, parents, goal, effectors, lengths, centres, radii, live, tolerance, tiny, final, False, False, codes
+            )
             return 0
     stall = _STALL * tolerance + tiny
     iterations, stalled, retry = 0, False, True
@@ -400,20 +414,19 @@ def _solve_tree_core(
                 x, y, z = sums[j, 0] / counts[j], sums[j, 1] / counts[j], sums[j, 2] / counts[j]
             p[j, 0], p[j, 1], p[j, 2] = x, y, z
             up = int(parents[j])
-            dx, dy, dz, _ = _unit(p[up, 0] - x, p[up, 1] - y, p[up, 2] - z,
-                                  -directions[j, 0], -directions[j, 1], -directions[j, 2], tiny)  # fmt: skip
+            dx, dy, dz, _ = _unit(
+                p[up, 0] - x, p[up, 1] - y, p[up, 2] - z, -directions[j, 0], -directions[j, 1], -directions[j, 2], tiny
+            )
             c = only_child[j]
-            if (
-                c >= 0 and not has_goal[j]
-            ):  # the joint to its one child holds this segment (as in a chain)
+            if c >= 0 and not has_goal[j]:  # the joint to its one child holds this segment (as in a chain)
                 qx, qy, qz, _ = _unit(x - p[c, 0], y - p[c, 1], z - p[c, 2], dx, dy, dz, tiny)
                 dx, dy, dz = _hold_by_next(dx, dy, dz, qx, qy, qz, table, c, rest, dim)
             # keep the segment in its hinge's plane (caliko's forward pass)
-            dx, dy, dz = _into_hinge_plane(dx, dy, dz, directions[up, 0], directions[up, 1],
-                                           directions[up, 2], table, j, rest)  # fmt: skip
+            dx, dy, dz = _into_hinge_plane(
+                dx, dy, dz, directions[up, 0], directions[up, 1], directions[up, 2], table, j, rest
+            )
             if radii.shape[0] > 0:
-                dx, dy, dz, _ = _deflect(x, y, z, dx, dy, dz, lengths[j], centres, radii, live, tiny,
-                                         dim)  # fmt: skip
+                dx, dy, dz, _ = _deflect(x, y, z, dx, dy, dz, lengths[j], centres, radii, live, tiny, dim)
             sums[up, 0] += x + lengths[j] * dx
             sums[up, 1] += y + lengths[j] * dy
             sums[up, 2] += z + lengths[j] * dz
@@ -429,8 +442,7 @@ def _solve_tree_core(
             if has_limits:
                 dx, dy, dz = _constrain(dx, dy, dz, qx, qy, qz, table, j, rest, tiny, dim)
             if radii.shape[0] > 0:
-                dx, dy, dz, turned = _deflect(ax, ay, az, dx, dy, dz, lengths[j], centres, radii,
-                                              live, tiny, dim)  # fmt: skip
+                dx, dy, dz, turned = _deflect(ax, ay, az, dx, dy, dz, lengths[j], centres, radii, live, tiny, dim)
                 if turned and has_limits:
                     dx, dy, dz = _constrain(dx, dy, dz, qx, qy, qz, table, j, rest, tiny, dim)
             length = lengths[j]
@@ -467,26 +479,36 @@ def _solve_tree_core(
     feasible = best_worst < np.inf
     if feasible and (
         not retry  # restarted: never worse than the best before or after
-        or not _tree_admissible(
-            p, parents, order, table, rest, tiny, has_limits, centres, radii, live
-        )
+        or not _tree_admissible(p, parents, order, table, rest, tiny, has_limits, centres, radii, live)
     ):
         p[:, :] = best  # never an inadmissible last iterate where an admissible one was seen
     for e in range(effectors.shape[0]):
         k = int(effectors[e])
         x, y, z = p[k, 0] - goal[k, 0], p[k, 1] - goal[k, 1], p[k, 2] - goal[k, 2]
         final[e] = math.sqrt(x * x + y * y + z * z)
-    _tree_statuses(p, parents, goal, effectors, lengths, centres, radii, live, tolerance, tiny,
-                   final, stalled, holding or any_live, codes)  # fmt: skip
+    _tree_statuses(
+        p,
+        parents,
+        goal,
+        effectors,
+        lengths,
+        centres,
+        radii,
+        live,
+        tolerance,
+        tiny,
+        final,
+        stalled,
+        holding or any_live,
+        codes,
+    )
     if not feasible:
         codes[:] = _INFEASIBLE
     return iterations
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _tree_extent(
-    p: NDArray[np.float64], goal: NDArray[np.float64], effectors: NDArray[np.int64], root: int
-) -> float:
+def _tree_extent(p: NDArray[np.float64], goal: NDArray[np.float64], effectors: NDArray[np.int64], root: int) -> float:
     """The largest coordinate offset from the root of a joint or a target (m)."""
     extent = 0.0
     for j in range(p.shape[0]):
@@ -500,9 +522,13 @@ def _tree_extent(
 
 @numba.njit(cache=True, error_model="numpy")
 def _tree_turn_aside(
-    p: NDArray[np.float64], parents: NDArray[np.int64], order: NDArray[np.int64],
-    lengths: NDArray[np.float64], tiny: float, dim: int,
-) -> None:  # fmt: skip
+    p: NDArray[np.float64],
+    parents: NDArray[np.int64],
+    order: NDArray[np.int64],
+    lengths: NDArray[np.float64],
+    tiny: float,
+    dim: int,
+) -> None:
     """Turn every segment of the pose ``p`` (in place, root fixed, lengths kept) by 1 to 2 rad about an axis
     across it, the angles and axes spread by the golden ratio over the breadth-first order (deterministic, and
     different for mirror-image branches)."""
@@ -511,8 +537,9 @@ def _tree_turn_aside(
     for k in range(1, p.shape[0]):
         j = int(order[k])
         up = int(parents[j])
-        dx, dy, dz, _ = _unit(old[j, 0] - old[up, 0], old[j, 1] - old[up, 1], old[j, 2] - old[up, 2],
-                              0.0, 0.0, 1.0, tiny)  # fmt: skip
+        dx, dy, dz, _ = _unit(
+            old[j, 0] - old[up, 0], old[j, 1] - old[up, 1], old[j, 2] - old[up, 2], 0.0, 0.0, 1.0, tiny
+        )
         spread = (k * golden) % 1.0
         angle = 1.0 + spread
         if dim == 2:
@@ -520,9 +547,7 @@ def _tree_turn_aside(
             angle = angle if k % 2 else -angle
         else:
             px, py, pz = _perpendicular(dx, dy, dz, 3)
-            ax, ay, az = _rotate(
-                px, py, pz, dx, dy, dz, 2.0 * math.pi * ((k * golden * golden) % 1.0)
-            )
+            ax, ay, az = _rotate(px, py, pz, dx, dy, dz, 2.0 * math.pi * ((k * golden * golden) % 1.0))
         dx, dy, dz = _rotate(dx, dy, dz, ax, ay, az, angle)
         p[j, 0] = p[up, 0] + lengths[j] * dx
         p[j, 1] = p[up, 1] + lengths[j] * dy
@@ -531,10 +556,17 @@ def _tree_turn_aside(
 
 @numba.njit(cache=True, error_model="numpy")
 def _tree_admissible(
-    p: NDArray[np.float64], parents: NDArray[np.int64], order: NDArray[np.int64],
-    table: NDArray[np.float64], rest: NDArray[np.float64], tiny: float, has_limits: bool,
-    centres: NDArray[np.float64], radii: NDArray[np.float64], live: NDArray[np.bool_],
-) -> bool:  # fmt: skip
+    p: NDArray[np.float64],
+    parents: NDArray[np.int64],
+    order: NDArray[np.int64],
+    table: NDArray[np.float64],
+    rest: NDArray[np.float64],
+    tiny: float,
+    has_limits: bool,
+    centres: NDArray[np.float64],
+    radii: NDArray[np.float64],
+    live: NDArray[np.bool_],
+) -> bool:
     """Whether the tree's pose keeps every joint limit (each segment against its parent's, the root's against
     ``rest``; zero-length segments have none and pass their parent's on) and cuts no live obstacle."""
     if not has_limits and radii.shape[0] == 0:
@@ -547,8 +579,7 @@ def _tree_admissible(
         j = int(order[k])
         up = int(parents[j])
         qx, qy, qz = directions[up, 0], directions[up, 1], directions[up, 2]
-        dx, dy, dz, norm = _unit(p[j, 0] - p[up, 0], p[j, 1] - p[up, 1], p[j, 2] - p[up, 2],
-                                 qx, qy, qz, tiny)  # fmt: skip
+        dx, dy, dz, norm = _unit(p[j, 0] - p[up, 0], p[j, 1] - p[up, 1], p[j, 2] - p[up, 2], qx, qy, qz, tiny)
         if norm <= tiny:
             directions[j, 0], directions[j, 1], directions[j, 2] = qx, qy, qz
             continue
@@ -562,20 +593,28 @@ def _tree_admissible(
 
 @numba.njit(cache=True, error_model="numpy")
 def _tree_statuses(
-    p: NDArray[np.float64], parents: NDArray[np.int64], goal: NDArray[np.float64],
-    effectors: NDArray[np.int64], lengths: NDArray[np.float64], centres: NDArray[np.float64],
-    radii: NDArray[np.float64], live: NDArray[np.bool_], tolerance: float, tiny: float,
-    error: NDArray[np.float64], stalled: bool, held: bool, codes: NDArray[np.int64],
-) -> None:  # fmt: skip
+    p: NDArray[np.float64],
+    parents: NDArray[np.int64],
+    goal: NDArray[np.float64],
+    effectors: NDArray[np.int64],
+    lengths: NDArray[np.float64],
+    centres: NDArray[np.float64],
+    radii: NDArray[np.float64],
+    live: NDArray[np.bool_],
+    tolerance: float,
+    tiny: float,
+    error: NDArray[np.float64],
+    stalled: bool,
+    held: bool,
+    codes: NDArray[np.int64],
+) -> None:
     """Each effector's status code (see :func:`_solve_tree_core`); ``held``: limits or live obstacles can hold the
     tree at a fixed point (else a stall is another effector's target out of reach: "unreachable")."""
     touching = False
     if radii.shape[0] > 0:
         for j in range(p.shape[0]):
             up = int(parents[j])
-            touching = touching or (
-                up >= 0 and _segment_cuts(p, up, j, centres, radii, live, 1.0 + _TOUCH)
-            )
+            touching = touching or (up >= 0 and _segment_cuts(p, up, j, centres, radii, live, 1.0 + _TOUCH))
     root = 0
     while parents[root] >= 0:
         root = int(parents[root])
@@ -607,9 +646,12 @@ def _tree_statuses(
 
 @numba.njit(cache=True, error_model="numpy")
 def _tree_errors(
-    p: NDArray[np.float64], goal: NDArray[np.float64], effectors: NDArray[np.int64],
-    history: NDArray[np.float64], row: int,
-) -> float:  # fmt: skip
+    p: NDArray[np.float64],
+    goal: NDArray[np.float64],
+    effectors: NDArray[np.int64],
+    history: NDArray[np.float64],
+    row: int,
+) -> float:
     """Write each effector's distance to its target into ``history[row]``; return the largest."""
     worst = 0.0
     for e in range(effectors.shape[0]):

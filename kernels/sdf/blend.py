@@ -54,9 +54,7 @@ def _distances(a: ArrayLike, b: ArrayLike) -> tuple[FloatArray, FloatArray]:
     return a_arr, b_arr
 
 
-def _smin_poly_weighted(
-    a: AnyFloatArray, b: AnyFloatArray, k: float
-) -> tuple[AnyFloatArray, AnyFloatArray]:
+def _smin_poly_weighted(a: AnyFloatArray, b: AnyFloatArray, k: float) -> tuple[AnyFloatArray, AnyFloatArray]:
     """Polynomial smooth min and the weight of ``b`` in it (``1 − h``), in the inputs' float dtype.
 
     Finite for every finite k ≥ 0 and finite distances, and never NaN for infinite ones: a width below
@@ -77,9 +75,7 @@ def _smin_poly_weighted(
     return d, 1.0 - h
 
 
-def _smin_exp_weighted(
-    a: AnyFloatArray, b: AnyFloatArray, k: float
-) -> tuple[AnyFloatArray, AnyFloatArray]:
+def _smin_exp_weighted(a: AnyFloatArray, b: AnyFloatArray, k: float) -> tuple[AnyFloatArray, AnyFloatArray]:
     """Exponential smooth min (``k`` = sharpness) and the weight of ``b``: exp(−kb)/(exp(−ka) + exp(−kb)).
 
     Finite for every sharpness in (0, ∞] and finite distances, in the inputs' float dtype, and never NaN for
@@ -96,9 +92,7 @@ def _smin_exp_weighted(
         gap = np.where(a == b, dtype.type(0.0), np.abs(a - b))
         e = np.exp(-sharpness * gap)  # in [0, 1]; −∞·0 (NaN) only at gap 0, set below
         e = np.where(gap == 0.0, dtype.type(1.0), e)
-        d = (
-            np.minimum(a, b) - np.log1p(e) / sharpness
-        )  # log1p(e) ≤ ln 2: → 0 as the sharpness grows
+        d = np.minimum(a, b) - np.log1p(e) / sharpness  # log1p(e) ≤ ln 2: → 0 as the sharpness grows
     w_b = np.where(a > b, 1.0, e) / (1.0 + e)
     return d, w_b
 
@@ -115,9 +109,7 @@ def smin_poly(a: ArrayLike, b: ArrayLike, k: float) -> FloatArray:
         Blended distances (m), the broadcast shape.
     """
     a_arr, b_arr = _distances(a, b)
-    return np.asarray(
-        _smin_poly_weighted(a_arr, b_arr, _checks.non_negative("k", k))[0], dtype=np.float64
-    )
+    return np.asarray(_smin_poly_weighted(a_arr, b_arr, _checks.non_negative("k", k))[0], dtype=np.float64)
 
 
 def smin_exp(a: ArrayLike, b: ArrayLike, k: float) -> FloatArray:
@@ -132,9 +124,7 @@ def smin_exp(a: ArrayLike, b: ArrayLike, k: float) -> FloatArray:
         Blended distances (m), ≤ min(a, b) − 0 and ≥ min(a, b) − ln 2 / k.
     """
     a_arr, b_arr = _distances(a, b)
-    return np.asarray(
-        _smin_exp_weighted(a_arr, b_arr, _checks.positive("k", k))[0], dtype=np.float64
-    )
+    return np.asarray(_smin_exp_weighted(a_arr, b_arr, _checks.positive("k", k))[0], dtype=np.float64)
 
 
 def op_union(a: ArrayLike, b: ArrayLike) -> FloatArray:

@@ -58,9 +58,7 @@ def make_grid(scene: Scene, resolution: int, bounds: ArrayLike | None = None) ->
     if isinstance(resolution, bool) or not isinstance(resolution, (int, np.integer)):
         raise ValueError(f"resolution must be an integer, got {resolution!r}")
     if not MIN_RESOLUTION <= int(resolution) <= MAX_RESOLUTION:
-        raise ValueError(
-            f"resolution must be in {MIN_RESOLUTION}..{MAX_RESOLUTION}, got {resolution}"
-        )
+        raise ValueError(f"resolution must be in {MIN_RESOLUTION}..{MAX_RESOLUTION}, got {resolution}")
     if bounds is None:
         box = scene_bounds(scene)
     else:
@@ -88,9 +86,7 @@ def sample_full(scene: Scene, grid: Grid) -> NDArray[np.float32]:
     """The field at every grid sample, (nx, ny, nz) float32: the plain baseline the coarse-to-fine pass matches."""
     axes = [grid.origin[i] + grid.spacing * np.arange(grid.shape[i]) for i in range(3)]
     xs, ys, zs = np.meshgrid(*axes, indexing="ij")
-    return _field_at(scene, np.stack([xs.ravel(), ys.ravel(), zs.ravel()], axis=1)).reshape(
-        grid.shape
-    )
+    return _field_at(scene, np.stack([xs.ravel(), ys.ravel(), zs.ravel()], axis=1)).reshape(grid.shape)
 
 
 def _field_at(scene: Scene, points: NDArray[np.floating]) -> NDArray[np.float32]:
@@ -120,9 +116,7 @@ class NearSurfaceField:
     """Points evaluated, block centres included."""
 
 
-def sample_near_surface(
-    scene: Scene, grid: Grid, progress: Callable[[float], None] | None = None
-) -> NearSurfaceField:
+def sample_near_surface(scene: Scene, grid: Grid, progress: Callable[[float], None] | None = None) -> NearSurfaceField:
     """The field, evaluated exactly where marching cubes reads it and sign-filled elsewhere.
 
     Args:
@@ -160,10 +154,7 @@ def sample_near_surface(
         if progress is not None:
             progress(0.2 + 0.6 * (1 - child / top))
         ratio = size // child
-        offsets = (
-            np.stack(np.meshgrid(*[np.arange(ratio)] * 3, indexing="ij"), axis=-1).reshape(-1, 3)
-            * child
-        )
+        offsets = np.stack(np.meshgrid(*[np.arange(ratio)] * 3, indexing="ij"), axis=-1).reshape(-1, 3) * child
         corners = (corners[:, None, :] + offsets[None, :, :]).reshape(-1, 3)
         d = _field_at(scene, block_centers(corners, child))
         evaluated += len(d)
@@ -309,9 +300,7 @@ def _touches_solid(scene: Scene, grid: Grid, samples: NDArray[np.bool_]) -> NDAr
     return out
 
 
-def mesh_trimesh(
-    vertices: FloatArray, faces: NDArray[np.int64], colors: FloatArray
-) -> trimesh.Trimesh:
+def mesh_trimesh(vertices: FloatArray, faces: NDArray[np.int64], colors: FloatArray) -> trimesh.Trimesh:
     """The output of :func:`mesh` as a ``trimesh.Trimesh`` with 8-bit vertex colours (for export)."""
     rgba = np.concatenate([np.clip(colors, 0.0, 1.0), np.ones((len(colors), 1))], axis=1)
     return trimesh.Trimesh(

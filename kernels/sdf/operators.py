@@ -80,9 +80,7 @@ def op_twist(p: ArrayLike, rate: float) -> FloatArray:
     if not math.isfinite(k):
         raise ValueError(f"rate must be finite, got {rate!r}")
     c, s = np.cos(k * pts[:, 1]), np.sin(k * pts[:, 1])
-    return np.stack(
-        [c * pts[:, 0] - s * pts[:, 2], pts[:, 1], s * pts[:, 0] + c * pts[:, 2]], axis=1
-    )
+    return np.stack([c * pts[:, 0] - s * pts[:, 2], pts[:, 1], s * pts[:, 0] + c * pts[:, 2]], axis=1)
 
 
 def op_bend(p: ArrayLike, rate: float) -> FloatArray:
@@ -102,9 +100,7 @@ def op_bend(p: ArrayLike, rate: float) -> FloatArray:
     if not math.isfinite(k):
         raise ValueError(f"rate must be finite, got {rate!r}")
     c, s = np.cos(k * pts[:, 0]), np.sin(k * pts[:, 0])
-    return np.stack(
-        [c * pts[:, 0] - s * pts[:, 1], s * pts[:, 0] + c * pts[:, 1], pts[:, 2]], axis=1
-    )
+    return np.stack([c * pts[:, 0] - s * pts[:, 1], s * pts[:, 0] + c * pts[:, 1], pts[:, 2]], axis=1)
 
 
 def op_repeat_finite(p: ArrayLike, spacing: ArrayLike, limit: ArrayLike) -> FloatArray:

@@ -106,9 +106,7 @@ class Primitive:
 
     def distance(self, points: FloatArray) -> FloatArray:
         """(N,) distance of (N, 3) world points."""
-        return self.distance_xyz(points[:, 0], points[:, 1], points[:, 2]).astype(
-            np.float64, copy=False
-        )
+        return self.distance_xyz(points[:, 0], points[:, 1], points[:, 2]).astype(np.float64, copy=False)
 
     @functools.cached_property
     def _turned(self) -> FloatArray | None:
@@ -163,22 +161,14 @@ class Scene:
         object.__setattr__(self, "primitives", prims)
         k = _checks.non_negative("k", self.k)
         if k > MAX_BLEND_WIDTH:
-            raise ValueError(
-                f"k must be at most MAX_BLEND_WIDTH = {MAX_BLEND_WIDTH:g} m, got {self.k!r}"
-            )
+            raise ValueError(f"k must be at most MAX_BLEND_WIDTH = {MAX_BLEND_WIDTH:g} m, got {self.k!r}")
         object.__setattr__(self, "k", k)
 
 
-def _fold(
-    scene: Scene, points: FloatArray, with_color: bool
-) -> tuple[FloatArray, FloatArray | None]:
-    x, y, z = (
-        np.ascontiguousarray(points[:, i]) for i in range(3)
-    )  # strided columns are several times slower
+def _fold(scene: Scene, points: FloatArray, with_color: bool) -> tuple[FloatArray, FloatArray | None]:
+    x, y, z = (np.ascontiguousarray(points[:, i]) for i in range(3))  # strided columns are several times slower
     d, color = fold_xyz(scene, x, y, z, with_color)
-    return d.astype(np.float64, copy=False), None if color is None else color.astype(
-        np.float64, copy=False
-    )
+    return d.astype(np.float64, copy=False), None if color is None else color.astype(np.float64, copy=False)
 
 
 def fold_xyz(
@@ -351,9 +341,7 @@ def default_scene() -> Scene:
         primitives=(
             Primitive("sphere", (0.0, 0.0, 0.5), (0.45,), color=(0.90, 0.35, 0.30)),
             Primitive("box", (0.6, 0.0, 0.3), (0.3, 0.3, 0.3), color=(0.30, 0.60, 0.90)),
-            Primitive(
-                "torus", (0.0, 0.0, 0.1), (0.6, 0.12), rotation=flat, color=(0.95, 0.80, 0.30)
-            ),
+            Primitive("torus", (0.0, 0.0, 0.1), (0.6, 0.12), rotation=flat, color=(0.95, 0.80, 0.30)),
             Primitive("capsule", (-0.5, 0.2, 0.5), (0.35, 0.15), color=(0.40, 0.80, 0.45)),
         ),
         k=0.25,

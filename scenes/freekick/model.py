@@ -90,50 +90,36 @@ class FreeKickParams:
         metadata=slider("Spot angle (°, + = left)", -45.0, 45.0, 1.0, folder="Ball spot"),
     )
     """Where the spot is, seen from the goal: angle off the pitch's centre line, + toward the kicker's left (°)."""
-    speed_ms: float = field(
-        default=25.0, metadata=slider("Launch speed (m/s)", 5.0, 40.0, 0.5, folder="Strike")
-    )
+    speed_ms: float = field(default=25.0, metadata=slider("Launch speed (m/s)", 5.0, 40.0, 0.5, folder="Strike"))
     """Launch speed (m/s)."""
-    elevation_deg: float = field(
-        default=17.0, metadata=slider("Elevation (°)", -5.0, 50.0, 0.5, folder="Strike")
-    )
+    elevation_deg: float = field(default=17.0, metadata=slider("Elevation (°)", -5.0, 50.0, 0.5, folder="Strike"))
     """Launch angle above the ground (°)."""
     azimuth_deg: float = field(
         default=-9.0, metadata=slider("Azimuth (°, + = left)", -30.0, 30.0, 0.5, folder="Strike")
     )
     """Launch direction relative to the line from ball to goal centre, + to the left (°)."""
-    spin_rev_s: float = field(
-        default=8.0, metadata=slider("Spin rate (rev/s)", 0.0, 15.0, 0.1, folder="Strike")
-    )
+    spin_rev_s: float = field(default=8.0, metadata=slider("Spin rate (rev/s)", 0.0, 15.0, 0.1, folder="Strike"))
     """Spin rate (rev/s)."""
     spin_axis: SpinAxis = field(
         default="left",
-        metadata=dropdown(
-            "Spin axis", tuple(SPIN_AXIS_LABELS), tuple(SPIN_AXIS_LABELS.values()), folder="Strike"
-        ),
+        metadata=dropdown("Spin axis", tuple(SPIN_AXIS_LABELS), tuple(SPIN_AXIS_LABELS.values()), folder="Strike"),
     )
     """Spin axis: sidespin either way, topspin, backspin, or custom."""
     axis_tilt_deg: float = field(
         default=0.0,
-        metadata=slider(
-            "Axis tilt from vertical (°)", -180.0, 180.0, 1.0, folder="Strike", disabled=True
-        ),
+        metadata=slider("Axis tilt from vertical (°)", -180.0, 180.0, 1.0, folder="Strike", disabled=True),
     )
     """Custom axis: tilt from vertical toward the kicker's left (°); 0 is sidespin left, 90 topspin. Its control is
     greyed out unless the spin axis is custom."""
     axis_turn_deg: float = field(
         default=0.0,
-        metadata=slider(
-            "Axis turn toward the kick (°)", -90.0, 90.0, 1.0, folder="Strike", disabled=True
-        ),
+        metadata=slider("Axis turn toward the kick (°)", -90.0, 90.0, 1.0, folder="Strike", disabled=True),
     )
     """Custom axis: turn of the tilted part toward the kick direction (°); 90 with tilt 90 is rifle spin. Greyed out
     unless the spin axis is custom."""
     model: ball.Model = field(
         default="measured",
-        metadata=dropdown(
-            "Model", tuple(MODEL_LABELS), tuple(MODEL_LABELS.values()), folder="Physics"
-        ),
+        metadata=dropdown("Model", tuple(MODEL_LABELS), tuple(MODEL_LABELS.values()), folder="Physics"),
     )
     """Coefficient model: the measured one, under which the spin rate changes the flight; the seed's constant one
     curls every spinning kick alike."""
@@ -149,9 +135,7 @@ class FreeKickParams:
     """Integrator and its step."""
     knuckle: bool = field(default=False, metadata=checkbox("Knuckleball", folder="Physics"))
     """Unsteady knuckleball side force (only acts with near-zero spin)."""
-    knuckle_seed: int = field(
-        default=1, metadata=number("Knuckle seed", 0, 9999, 1, folder="Physics", disabled=True)
-    )
+    knuckle_seed: int = field(default=1, metadata=number("Knuckle seed", 0, 9999, 1, folder="Physics", disabled=True))
     """Seed of the knuckleball's side force: the same seed, the same flight. Greyed out without the knuckleball."""
     wall_jumps: bool = field(default=False, metadata=checkbox("Wall jumps", folder="Physics"))
     """Whether the wall jumps (its top rises by 0.35 m)."""
@@ -180,9 +164,7 @@ PRESETS: tuple[Preset, ...] = (
     Preset("Curler round the wall", FreeKickParams()),
     Preset(
         "Dipping topspin",
-        FreeKickParams(
-            speed_ms=28.0, elevation_deg=21.0, azimuth_deg=0.0, spin_rev_s=8.0, spin_axis="top"
-        ),
+        FreeKickParams(speed_ms=28.0, elevation_deg=21.0, azimuth_deg=0.0, spin_rev_s=8.0, spin_axis="top"),
     ),
     Preset(
         "Knuckleball",
@@ -257,9 +239,7 @@ def spin_axis(p: FreeKickParams) -> NDArray[np.float64]:
             return -left
         case "custom":
             tilt, turn = math.radians(p.axis_tilt_deg), math.radians(p.axis_turn_deg)
-            return math.cos(tilt) * up + math.sin(tilt) * (
-                math.cos(turn) * left + math.sin(turn) * forward
-            )
+            return math.cos(tilt) * up + math.sin(tilt) * (math.cos(turn) * left + math.sin(turn) * forward)
 
 
 def spin_vector(p: FreeKickParams, scale: float = 1.0) -> NDArray[np.float64]:
@@ -318,9 +298,7 @@ class KickState:
     goal: ball.Panel
 
 
-def _fly(
-    p: FreeKickParams, spin_scale: float, *, knuckle: bool, band: bool = False
-) -> ball.Trajectory:
+def _fly(p: FreeKickParams, spin_scale: float, *, knuckle: bool, band: bool = False) -> ball.Trajectory:
     """One flight; ``band`` flights (only drawn, never measured) use RK4 at 20 ms, well under a millimetre off."""
     return ball.simulate(
         ball_spot(p),
@@ -386,9 +364,7 @@ def _ghost_kick(p: FreeKickParams) -> tuple[ball.Trajectory, ball.Outcome]:
     return ghost, ball.outcome(ghost, wall, goal)
 
 
-def sample_rows(
-    times: NDArray[np.float64], t: NDArray[np.float64], values: NDArray[np.float64]
-) -> NDArray[np.float64]:
+def sample_rows(times: NDArray[np.float64], t: NDArray[np.float64], values: NDArray[np.float64]) -> NDArray[np.float64]:
     """(M, C) ``values`` (N, C), given at the increasing sample times ``t`` (N,), interpolated linearly at ``times``
     (M,), clamped to ``[t[0], t[-1]]``: ``np.interp`` on every column at once. One ``np.interp`` finds each time's
     fractional row (``np.interp`` clamps, and is compiled); the columns are then blended in one step (a redraw

@@ -46,9 +46,7 @@ def goal_frame_mesh() -> trimesh.Trimesh:
         _cylinder(np.array([r, side * (half + r), 0.0]), np.array([r, side * (half + r), h + r]), r)
         for side in (-1.0, 1.0)
     ]
-    parts.append(
-        _cylinder(np.array([r, -(half + 2 * r), h + r]), np.array([r, half + 2 * r, h + r]), r)
-    )
+    parts.append(_cylinder(np.array([r, -(half + 2 * r), h + r]), np.array([r, half + 2 * r, h + r]), r))
     mesh = trimesh.util.concatenate(parts)
     assert isinstance(mesh, trimesh.Trimesh)
     return mesh
@@ -128,9 +126,7 @@ def arrow_segments(
     direction = vectors / np.where(length > 1e-9, length, 1.0)
     side = np.cross(direction, np.array([0.0, 0.0, 1.0]))
     side_norm = np.linalg.norm(side, axis=1, keepdims=True)
-    side = np.where(
-        side_norm > 1e-6, side / np.where(side_norm > 1e-6, side_norm, 1.0), [0.0, 1.0, 0.0]
-    )
+    side = np.where(side_norm > 1e-6, side / np.where(side_norm > 1e-6, side_norm, 1.0), [0.0, 1.0, 0.0])
     barb = np.minimum(head, 0.4 * length)
     left = tips - barb * direction + 0.5 * barb * side
     right = tips - barb * direction - 0.5 * barb * side
@@ -148,9 +144,7 @@ def polyline_segments(points: NDArray[np.float64]) -> NDArray[np.float32]:
     return np.stack([points[:-1], points[1:]], axis=1).astype(np.float32)
 
 
-def axis_angle_wxyz(
-    axis: NDArray[np.float64], angle_rad: float
-) -> tuple[float, float, float, float]:
+def axis_angle_wxyz(axis: NDArray[np.float64], angle_rad: float) -> tuple[float, float, float, float]:
     """The wxyz quaternion turning ``angle_rad`` about (3,) ``axis`` (any length; zero gives no turn)."""
     norm = float(np.linalg.norm(axis))
     if norm == 0.0:

@@ -159,9 +159,7 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
                     series=(
                         viser.uplot.Series(label="t (s)"),
                         *(
-                            viser.uplot.Series(
-                                label=f"{name.title()} (N)", stroke=_css(colour), width=2
-                            )
+                            viser.uplot.Series(label=f"{name.title()} (N)", stroke=_css(colour), width=2)
                             for name, colour in CHART_COLOURS.items()
                         ),
                     ),
@@ -199,9 +197,7 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
         self.kick_button.on_click(self.callback(self._on_kick))
         self.view_controls.on_update(self.callback(self._on_view))
         for preset, button in zip(PRESETS, self.preset_buttons, strict=True):
-            button.on_click(
-                self.callback(lambda preset=preset: self.apply(preset.params.shown_as(self.params)))
-            )
+            button.on_click(self.callback(lambda preset=preset: self.apply(preset.params.shown_as(self.params))))
 
     # ----------------------------------------------------------------------------------------- world
     def _build_world(self) -> None:
@@ -209,16 +205,10 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
         grass = trimesh.creation.box(extents=(50.0, 70.0, 0.02))
         grass.apply_translation((-22.0, 0.0, -0.011))
         scene.add_mesh_simple(f"{root}/grass", grass.vertices, grass.faces, color=(70, 140, 60))
-        scene.add_line_segments(
-            f"{root}/markings", pitch_markings(), colors=(245, 245, 245), thickness=0.12
-        )
+        scene.add_line_segments(f"{root}/markings", pitch_markings(), colors=(245, 245, 245), thickness=0.12)
         frame = goal_frame_mesh()
-        scene.add_mesh_simple(
-            f"{root}/goal_frame", frame.vertices, frame.faces, color=(250, 250, 250)
-        )
-        scene.add_line_segments(
-            f"{root}/net", net_segments(), colors=(225, 225, 225), thickness=0.02
-        )
+        scene.add_mesh_simple(f"{root}/goal_frame", frame.vertices, frame.faces, color=(250, 250, 250))
+        scene.add_line_segments(f"{root}/net", net_segments(), colors=(225, 225, 225), thickness=0.02)
         half, h = 0.5 * ball.GOAL_WIDTH_M, ball.GOAL_HEIGHT_M
         # A nearly invisible pane across the goal mouth: clicking it aims a kick there.
         self.goal_mouth = scene.add_mesh_simple(
@@ -251,29 +241,19 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
             lod="off",
         )
 
-        self.ball_frame = scene.add_frame(
-            f"{root}/ball", show_axes=False, position=tuple(ball_spot(self.params))
-        )
+        self.ball_frame = scene.add_frame(f"{root}/ball", show_axes=False, position=tuple(ball_spot(self.params)))
         sphere = trimesh.creation.icosphere(subdivisions=3, radius=ball.BALL_RADIUS_M)
-        scene.add_mesh_simple(
-            f"{self.ball_frame.name}/sphere", sphere.vertices, sphere.faces, color=(250, 250, 250)
-        )
+        scene.add_mesh_simple(f"{self.ball_frame.name}/sphere", sphere.vertices, sphere.faces, color=(250, 250, 250))
         # A dark band round the ball's equator makes its spin visible.
         band = trimesh.creation.torus(
             major_radius=ball.BALL_RADIUS_M, minor_radius=0.018, major_sections=32, minor_sections=6
         )
         band.apply_transform(trimesh.transformations.rotation_matrix(math.pi / 2, [1, 0, 0]))
-        scene.add_mesh_simple(
-            f"{self.ball_frame.name}/band", band.vertices, band.faces, color=(20, 20, 20)
-        )
+        scene.add_mesh_simple(f"{self.ball_frame.name}/band", band.vertices, band.faces, color=(20, 20, 20))
 
         empty_path = np.zeros((PATH_POINTS - 1, 2, 3), np.float32)
-        self.path = scene.add_line_segments(
-            f"{root}/path", empty_path, colors=PATH_COLOUR, thickness=0.09
-        )
-        self.ghost = scene.add_line_segments(
-            f"{root}/ghost", empty_path, colors=GHOST_COLOUR, thickness=0.04
-        )
+        self.path = scene.add_line_segments(f"{root}/path", empty_path, colors=PATH_COLOUR, thickness=0.09)
+        self.ghost = scene.add_line_segments(f"{root}/ghost", empty_path, colors=GHOST_COLOUR, thickness=0.04)
         self.band = scene.add_mesh_simple(
             f"{root}/band",
             np.zeros((2 * PATH_POINTS, 3), np.float32),
@@ -286,9 +266,7 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
         )
         empty_arrows = np.zeros((3 * ARROW_POINTS, 2, 3), np.float32)
         self.arrows = {
-            name: scene.add_line_segments(
-                f"{root}/force_{name}", empty_arrows, colors=colour, thickness=0.07
-            )
+            name: scene.add_line_segments(f"{root}/force_{name}", empty_arrows, colors=colour, thickness=0.07)
             for name, colour in FORCE_COLOURS.items()
         }
 
@@ -303,9 +281,7 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
         self._set_params(self.read_params())
 
     def _set_params(self, params: FreeKickParams) -> None:
-        state = compute_kick(
-            params
-        )  # raises (and keeps the last state) if the kernels refuse the input
+        state = compute_kick(params)  # raises (and keeps the last state) if the kernels refuse the input
         moved = (params.distance_m, params.angle_deg) != (
             self.params.distance_m,
             self.params.angle_deg,
@@ -350,11 +326,7 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
             d = np.asarray(ray_direction, dtype=np.float64)
         except (TypeError, ValueError):
             return  # not a ray: a crafted message
-        if (
-            o.shape != (3,)
-            or d.shape != (3,)
-            or not (np.all(np.isfinite(o)) and np.all(np.isfinite(d)))
-        ):
+        if o.shape != (3,) or d.shape != (3,) or not (np.all(np.isfinite(o)) and np.all(np.isfinite(d))):
             return
         if abs(d[0]) < 1e-9:
             return
@@ -383,18 +355,12 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
                 if self.closed or version != self._aim_version:
                     return
                 if found is None:
-                    self.aim_message = (
-                        "No kick at this speed reaches that point over the wall; try another speed."
-                    )
+                    self.aim_message = "No kick at this speed reaches that point over the wall; try another speed."
                     self.aim_status.content = self.aim_message
                     return
                 self.apply(found.shown_as(self.params))  # as shown now, not when the click came
                 point = self.state.outcome.goal_point
-                reached = (
-                    ""
-                    if point is None
-                    else f" It crosses at y = {point[1]:+.2f} m, z = {point[2]:.2f} m."
-                )
+                reached = "" if point is None else f" It crosses at y = {point[1]:+.2f} m, z = {point[2]:.2f} m."
                 self.aim_message = (
                     f"Found: elevation {found.elevation_deg:.1f}°, azimuth {found.azimuth_deg:+.1f}°, "
                     f"{spin_words(found)}.{reached}"
@@ -473,9 +439,7 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
         flight = state.flight
         times = np.linspace(0.0, float(flight.t[-1]), ARROW_POINTS + 2)[1:-1]
         names = list(FORCE_COLOURS)
-        at = sample_rows(
-            times, flight.t, np.hstack([flight.position, *(getattr(flight, n) for n in names)])
-        )
+        at = sample_rows(times, flight.t, np.hstack([flight.position, *(getattr(flight, n) for n in names)]))
         origins, forces = at[:, :3], at[:, 3:].reshape(ARROW_POINTS, len(names), 3)
         # Every force's arrows in one call: (3 parts, force, arrow, 2, 3), each force's (3K, 2, 3) a slice.
         arrows = arrow_segments(
@@ -505,9 +469,7 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
             set_if_changed(
                 self.wall_nodes,
                 "batched_wxyzs",
-                np.tile(
-                    [math.cos(heading / 2), 0.0, 0.0, math.sin(heading / 2)], (DEFENDERS, 1)
-                ).astype(np.float32),
+                np.tile([math.cos(heading / 2), 0.0, 0.0, math.sin(heading / 2)], (DEFENDERS, 1)).astype(np.float32),
             )
             set_if_changed(self.ball_frame, "position", tuple(ball_spot(p)))
             set_if_changed(self.ball_frame, "wxyz", (1.0, 0.0, 0.0, 0.0))
@@ -533,9 +495,7 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
             "wide": "Wide of the post",
             "short": "Lands short of the goal",
         }[o.result]
-        wall_height = (
-            "never reaches the wall" if o.wall_point is None else f"{o.wall_point[2]:.2f} m"
-        )
+        wall_height = "never reaches the wall" if o.wall_point is None else f"{o.wall_point[2]:.2f} m"
         lines = [
             f"**{verdict}**",
             "",

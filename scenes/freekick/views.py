@@ -66,9 +66,7 @@ def view_direction(
             return forward + 0.12 * down
         case "side":  # from the kicker's right: the ball flies left to right across the screen
             return left + 0.15 * down
-        case (
-            "goal"
-        ):  # the goalkeeper's: from in front of the goal line, back at the ball and the wall
+        case "goal":  # the goalkeeper's: from in front of the goal line, back at the ball and the wall
             return -forward + look_aside * left + look_down * down
         case "above":
             return 0.35 * forward + down
@@ -84,13 +82,7 @@ def view_points(p: FreeKickParams, state: KickState, view: ViewName) -> NDArray[
     wall = state.wall
     _normal, along = wall_axes(wall)
     centre, width = np.array(wall.centre_xy), 0.5 * DEFENDERS * DEFENDER_WIDTH_M
-    wall_pts = np.array(
-        [
-            [*(centre + side * width * along), z]
-            for side in (-1.0, 1.0)
-            for z in (0.0, wall.height_m)
-        ]
-    )
+    wall_pts = np.array([[*(centre + side * width * along), z] for side in (-1.0, 1.0) for z in (0.0, wall.height_m)])
     path, ghost = resample(state.flight, 24), resample(state.ghost, 24)
     spot = ball_spot(p)
     sphere = spot + ball.BALL_RADIUS_M * np.vstack([np.eye(3), -np.eye(3)])
@@ -112,9 +104,7 @@ def wall_hides(state: KickState, eye: NDArray[np.float64], target: NDArray[np.fl
         return False
     hit = eye + (a / (a - b)) * (target - eye)
     half = 0.5 * DEFENDERS * DEFENDER_WIDTH_M + ball.BALL_RADIUS_M
-    return (
-        abs(float((hit - centre) @ along)) <= half and hit[2] <= wall.height_m + ball.BALL_RADIUS_M
-    )
+    return abs(float((hit - centre) @ along)) <= half and hit[2] <= wall.height_m + ball.BALL_RADIUS_M
 
 
 def frame_view(p: FreeKickParams, state: KickState, view: ViewName, lens: Lens) -> View:

@@ -52,13 +52,31 @@ if TYPE_CHECKING:
 logger = logging.getLogger(__name__)
 
 RIDE_INPUTS = (
-    "power_w", "model", "air", "temperature_c", "pressure_from_barometer", "pressure_hpa",
-    "humidity_pct", "wind_ms", "wind_from_deg", "max_speed_kmh", "pacing", "pacing_gain_pct",
-)  # fmt: skip
+    "power_w",
+    "model",
+    "air",
+    "temperature_c",
+    "pressure_from_barometer",
+    "pressure_hpa",
+    "humidity_pct",
+    "wind_ms",
+    "wind_from_deg",
+    "max_speed_kmh",
+    "pacing",
+    "pacing_gain_pct",
+)
 """The course inputs that change the ride (the rest change only the view or the solver's target)."""
 LINE_INPUTS = (
-    "cda_m2", "mass_kg", "crr", "drivetrain_pct", "drafting", "n_riders", "gap_m", "model", "position",
-)  # fmt: skip
+    "cda_m2",
+    "mass_kg",
+    "crr",
+    "drivetrain_pct",
+    "drafting",
+    "n_riders",
+    "gap_m",
+    "model",
+    "position",
+)
 """The line's inputs that change the ride on the course (the paceline options apply there too)."""
 
 
@@ -102,9 +120,7 @@ class CourseMode:
             self.play = gui.add_button("Play")
             self.pause = gui.add_button("Pause")
             # Hand-built, not a parameter: playback moves it, and its range is the loaded route's length.
-            self.scrub = gui.add_slider(
-                "Position (km)", min=0.0, max=self._total_km(), step=0.01, initial_value=0.0
-            )
+            self.scrub = gui.add_slider("Position (km)", min=0.0, max=self._total_km(), step=0.01, initial_value=0.0)
             self.now = gui.add_markdown("")
             self.readout = gui.add_markdown("")
             self.chart = FittedChart(
@@ -112,15 +128,9 @@ class CourseMode:
                 data=self._chart_data(),
                 series=(
                     viser.uplot.Series(label="Distance (km)"),
-                    viser.uplot.Series(
-                        label="Elevation (m)", stroke="rgb(120,90,60)", width=2, scale="m"
-                    ),
-                    viser.uplot.Series(
-                        label="Speed (km/h)", stroke="rgb(30,110,220)", width=1.5, scale="kmh"
-                    ),
-                    viser.uplot.Series(
-                        label="Power (W)", stroke="rgb(220,40,40)", width=1.5, scale="W"
-                    ),
+                    viser.uplot.Series(label="Elevation (m)", stroke="rgb(120,90,60)", width=2, scale="m"),
+                    viser.uplot.Series(label="Speed (km/h)", stroke="rgb(30,110,220)", width=1.5, scale="kmh"),
+                    viser.uplot.Series(label="Power (W)", stroke="rgb(220,40,40)", width=1.5, scale="W"),
                 ),
                 scales={
                     "x": viser.uplot.Scale(time=False, auto=True),
@@ -131,9 +141,7 @@ class CourseMode:
                 axes=(
                     viser.uplot.Axis(scale="x", label="km"),
                     viser.uplot.Axis(scale="m", label="m", side=3),
-                    viser.uplot.Axis(
-                        scale="kmh", label="km/h", side=1, grid=viser.uplot.Axis_Grid(show=False)
-                    ),
+                    viser.uplot.Axis(scale="kmh", label="km/h", side=1, grid=viser.uplot.Axis_Grid(show=False)),
                 ),
                 legend=viser.uplot.Legend(show=True),
                 title="Elevation, speed and power along the course",
@@ -146,11 +154,7 @@ class CourseMode:
             rest = build_controls(
                 gui,
                 p,
-                [
-                    name
-                    for name in declared(CourseParams)
-                    if name not in {*head.fields, *power.fields}
-                ],
+                [name for name in declared(CourseParams) if name not in {*head.fields, *power.fields}],
                 collapsed=(MORE_FOLDER,),
                 folders_open=power.folders,
             )
@@ -190,9 +194,7 @@ class CourseMode:
     # ----------------------------------------------------------------------------------------- world
     def _build_world(self) -> None:
         scene = self.server.scene
-        self.frame = scene.add_frame(
-            f"{self.scene.root.name}/course_mode", show_axes=False, visible=False
-        )
+        self.frame = scene.add_frame(f"{self.scene.root.name}/course_mode", show_axes=False, visible=False)
         index = drawn_indices(self.route.n_points, MAX_DRAWN_POINTS)
         points = self._drawing.points(self.route, index, self.params.exaggeration)
         vertices, faces = terrain_strip(points, TERRAIN_HALF_WIDTH_M)
@@ -208,12 +210,8 @@ class CourseMode:
             side="double",
         )
         segments, colours = self._route_segments(index, points)
-        self.route_line = scene.add_line_segments(
-            f"{self.frame.name}/route", segments, colors=colours, thickness=0.08
-        )
-        self.course_riders = add_riders(
-            scene, f"{self.frame.name}/riders", self.scene.params.position, 0.0
-        )
+        self.route_line = scene.add_line_segments(f"{self.frame.name}/route", segments, colors=colours, thickness=0.08)
+        self.course_riders = add_riders(scene, f"{self.frame.name}/riders", self.scene.params.position, 0.0)
         self._drawn_position = self.scene.params.position
         self.leader_marker = scene.add_icosphere(
             f"{self.frame.name}/leader_marker",
@@ -221,16 +219,10 @@ class CourseMode:
             color=(255, 60, 60),
             position=(0.0, 0.0, 1.0),
         )
-        self.start_label = scene.add_label(
-            f"{self.frame.name}/start", text="Start", position=tuple(points[0])
-        )
-        self.finish_label = scene.add_label(
-            f"{self.frame.name}/finish", text="Finish", position=tuple(points[-1])
-        )
+        self.start_label = scene.add_label(f"{self.frame.name}/start", text="Start", position=tuple(points[0]))
+        self.finish_label = scene.add_label(f"{self.frame.name}/finish", text="Finish", position=tuple(points[-1]))
 
-    def _route_segments(
-        self, index: np.ndarray, points: np.ndarray
-    ) -> tuple[np.ndarray, np.ndarray]:
+    def _route_segments(self, index: np.ndarray, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         segments = np.stack([points[:-1], points[1:]], axis=1) + [0.0, 0.0, 0.02]
         rise = np.diff(self.route.elevation_m[index])
         run = np.maximum(np.diff(self.route.distance_m[index]), 1e-9)
@@ -250,9 +242,7 @@ class CourseMode:
         self.scene.wake_loops()
 
     def _on_input(self) -> None:
-        if (
-            not self.enabled
-        ):  # the line's sliders move often: ride the course only while it is shown
+        if not self.enabled:  # the line's sliders move often: ride the course only while it is shown
             self.state = None
             return
         self.recompute()
@@ -328,8 +318,7 @@ class CourseMode:
         if route is None or state is None:
             reason = str(error).removeprefix("the file: ")  # the file is named already
             self.message = (
-                f"**{_escape(label)}** was not loaded: {_escape(reason)}. "
-                f"Still showing **{_escape(self.route.name)}**."
+                f"**{_escape(label)}** was not loaded: {_escape(reason)}. Still showing **{_escape(self.route.name)}**."
             )
             self.redraw()
             return False
@@ -379,9 +368,15 @@ class CourseMode:
         else:
             try:
                 power = course_kernel.power_for_time(
-                    self.route, target_s, rider, params.wind_ms, params.wind_from_deg, air,
-                    max_speed_ms=cap, tolerance_s=0.05,
-                )  # fmt: skip
+                    self.route,
+                    target_s,
+                    rider,
+                    params.wind_ms,
+                    params.wind_from_deg,
+                    air,
+                    max_speed_ms=cap,
+                    tolerance_s=0.05,
+                )
             except ValueError as error:
                 self.message = f"Could not find the power for {wanted}: {_escape(str(error))}"
                 self.redraw()
@@ -499,9 +494,7 @@ class CourseMode:
         n = self.scene.params.n_riders
         positions = np.zeros((MAX_RIDERS, 3))
         wxyz = np.tile([1.0, 0.0, 0.0, 0.0], (MAX_RIDERS, 1))
-        where, yaw = self._drawing.at_distance(
-            self.route, self.rider_distances_m(), self.params.exaggeration
-        )
+        where, yaw = self._drawing.at_distance(self.route, self.rider_distances_m(), self.params.exaggeration)
         positions[:n] = where
         wxyz[:n] = np.stack([np.cos(yaw / 2), np.zeros(n), np.zeros(n), np.sin(yaw / 2)], axis=1)
         visible = (np.arange(MAX_RIDERS) < n).astype(np.float64)
@@ -519,9 +512,7 @@ class CourseMode:
         index = drawn_indices(route.n_points, MAX_CHART_POINTS)
         km = route.distance_m[index] / 1000.0
         elevation = route.elevation_m[index]
-        if (
-            self.state is None
-        ):  # before the first ride: the profile, and zeros (never a NaN-only series)
+        if self.state is None:  # before the first ride: the profile, and zeros (never a NaN-only series)
             zeros = np.zeros_like(km)
             return km, elevation, zeros, zeros
         ride = self.state.ride
@@ -575,9 +566,7 @@ class CourseMode:
             f"weather **{state.density_weather:.3f}** kg/m³; riding in the {which} air"
         )
         if ride.brakes_j > 0.0:
-            text += (
-                f"  \nBraking to hold {p.max_speed_kmh:.0f} km/h took {ride.brakes_j / 1000:.0f} kJ"
-            )
+            text += f"  \nBraking to hold {p.max_speed_kmh:.0f} km/h took {ride.brakes_j / 1000:.0f} kJ"
         return text
 
     def _splits_markdown(self) -> str:
@@ -588,9 +577,7 @@ class CourseMode:
         marks, times = ride.splits(every)
         rows = ["| km | elapsed | split | km/h |", "|---:|---:|---:|---:|"]
         previous_mark, previous_time = 0.0, 0.0
-        shown = np.unique(
-            np.linspace(0, marks.shape[0] - 1, min(marks.shape[0], 20)).round().astype(int)
-        )
+        shown = np.unique(np.linspace(0, marks.shape[0] - 1, min(marks.shape[0], 20)).round().astype(int))
         for i in range(marks.shape[0]):
             split = times[i] - previous_time
             speed = 3.6 * (marks[i] - previous_mark) / split if split > 0 else 0.0
@@ -628,6 +615,11 @@ class CourseMode:
 def _escape(text: str) -> str:
     """Text from a file, shown in markdown: no HTML, no markdown links or images."""
     return (
-        text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
-        .replace("[", "&#91;").replace("]", "&#93;").replace("*", "&#42;").replace("|", "&#124;")
-    )  # fmt: skip
+        text.replace("&", "&amp;")
+        .replace("<", "&lt;")
+        .replace(">", "&gt;")
+        .replace("[", "&#91;")
+        .replace("]", "&#93;")
+        .replace("*", "&#42;")
+        .replace("|", "&#124;")
+    )

@@ -22,9 +22,7 @@ from kernels import cycling
 from scenes._controls import checkbox, dropdown, number, slider
 from scenes.peloton.model import PelotonParams, group_cda
 
-CourseAirLabel = Literal[
-    "Seed (exponential)", "Weather (temperature, pressure or altitude, humidity)"
-]
+CourseAirLabel = Literal["Seed (exponential)", "Weather (temperature, pressure or altitude, humidity)"]
 AIR_FROM_LABEL: dict[str, course_kernel.AirKind] = {
     "Seed (exponential)": "seed",
     "Weather (temperature, pressure or altitude, humidity)": "weather",
@@ -69,9 +67,7 @@ class CourseParams:
         metadata=number("Course power (W)", *COURSE_POWER_RANGE_W, 5.0, folder=POWER_FOLDER),
     )
     """Constant pedal power of each rider (W)."""
-    target_min: float = field(
-        default=60.0, metadata=number("Target time (min)", 1.0, 6000.0, 1.0, folder=POWER_FOLDER)
-    )
+    target_min: float = field(default=60.0, metadata=number("Target time (min)", 1.0, 6000.0, 1.0, folder=POWER_FOLDER))
     """Finish time that 'Find the power for this time' aims at (min)."""
     model: course_kernel.Model = field(
         default="martin",
@@ -85,9 +81,7 @@ class CourseParams:
     """Power model: Martin et al. 1998's full terms or the seed's three."""
     air: course_kernel.AirKind = field(
         default="seed",
-        metadata=dropdown(
-            "Air", tuple(AIR_FROM_LABEL.values()), tuple(AIR_FROM_LABEL), folder=POWER_FOLDER
-        ),
+        metadata=dropdown("Air", tuple(AIR_FROM_LABEL.values()), tuple(AIR_FROM_LABEL), folder=POWER_FOLDER),
     )
     """Air along the route: the seed's exponential atmosphere or a weather reading."""
     temperature_c: float = field(
@@ -104,13 +98,9 @@ class CourseParams:
         metadata=number("Pressure at the start (hPa)", 500.0, 1100.0, 0.5, folder=POWER_FOLDER),
     )
     """Station pressure at the start (hPa), when read from a barometer."""
-    humidity_pct: float = field(
-        default=50.0, metadata=slider("Humidity (%)", 0.0, 100.0, 1.0, folder=POWER_FOLDER)
-    )
+    humidity_pct: float = field(default=50.0, metadata=slider("Humidity (%)", 0.0, 100.0, 1.0, folder=POWER_FOLDER))
     """Relative humidity (%), weather air."""
-    wind_ms: float = field(
-        default=0.0, metadata=slider("Wind (m/s)", 0.0, 20.0, 0.5, folder=MORE_FOLDER)
-    )
+    wind_ms: float = field(default=0.0, metadata=slider("Wind (m/s)", 0.0, 20.0, 0.5, folder=MORE_FOLDER))
     """Wind speed (m/s)."""
     wind_from_deg: float = field(
         default=0.0,
@@ -124,18 +114,14 @@ class CourseParams:
     """Safe descending speed (km/h): riders brake to hold it."""
     pacing: bool = field(default=False, metadata=checkbox("Pace by grade", folder=MORE_FOLDER))
     """Vary power with the grade (Swain 1997) at the same average."""
-    pacing_gain_pct: float = field(
-        default=15.0, metadata=slider("Pacing gain (%)", 0.0, 50.0, 1.0, folder=MORE_FOLDER)
-    )
+    pacing_gain_pct: float = field(default=15.0, metadata=slider("Pacing gain (%)", 0.0, 50.0, 1.0, folder=MORE_FOLDER))
     """How much more power on steep climbs, and less on descents (%)."""
     exaggeration: float = field(
         default=2.0,
         metadata=slider("Elevation exaggeration (×)", 1.0, 10.0, 0.5, folder=MORE_FOLDER),
     )
     """Vertical exaggeration of the drawn terrain."""
-    playback: float = field(
-        default=60.0, metadata=slider("Playback speed (×)", 1.0, 600.0, 1.0, folder=MORE_FOLDER)
-    )
+    playback: float = field(default=60.0, metadata=slider("Playback speed (×)", 1.0, 600.0, 1.0, folder=MORE_FOLDER))
     """Playback speed (× real time)."""
 
 
@@ -166,9 +152,7 @@ def course_air(route: course_kernel.Course, p: CourseParams) -> course_kernel.Ai
         if p.pressure_from_barometer
         else float(cycling.isa_pressure_hpa(np.clip(start, -1000.0, 20_000.0)))
     )
-    return course_kernel.Air(
-        p.air, p.temperature_c, pressure, p.humidity_pct / 100.0, altitude_m=start
-    )
+    return course_kernel.Air(p.air, p.temperature_c, pressure, p.humidity_pct / 100.0, altitude_m=start)
 
 
 def course_rider(line: PelotonParams, p: CourseParams, cda_m2: float) -> course_kernel.Rider:
@@ -182,9 +166,7 @@ def course_rider(line: PelotonParams, p: CourseParams, cda_m2: float) -> course_
     )
 
 
-def compute_course(
-    route: course_kernel.Course, p: CourseParams, line: PelotonParams
-) -> CourseState:
+def compute_course(route: course_kernel.Course, p: CourseParams, line: PelotonParams) -> CourseState:
     """Ride ``route`` for one parameter set (no viser: testable on its own)."""
     air = course_air(route, p)
     weather = dataclasses.replace(air, kind="weather")
@@ -254,17 +236,11 @@ class CourseDrawing:
         east, north = route.east_m, route.north_m
         extent = max(float(np.ptp(east)), float(np.ptp(north)), 1.0)
         centre = np.array([0.5 * (east.min() + east.max()), 0.5 * (north.min() + north.max())])
-        return CourseDrawing(
-            scale=COURSE_BOX_M / extent, offset=centre, base_m=float(route.elevation_m.min())
-        )
+        return CourseDrawing(scale=COURSE_BOX_M / extent, offset=centre, base_m=float(route.elevation_m.min()))
 
-    def points(
-        self, route: course_kernel.Course, index: np.ndarray, exaggeration: float
-    ) -> np.ndarray:
+    def points(self, route: course_kernel.Course, index: np.ndarray, exaggeration: float) -> np.ndarray:
         """(k, 3) scene positions of route points ``index``."""
-        xy = (
-            np.stack([route.east_m[index], route.north_m[index]], axis=1) - self.offset
-        ) * self.scale
+        xy = (np.stack([route.east_m[index], route.north_m[index]], axis=1) - self.offset) * self.scale
         z = (route.elevation_m[index] - self.base_m) * self.scale * exaggeration + 0.05
         return np.concatenate([xy + COURSE_CENTRE, z[:, None]], axis=1)
 
@@ -276,9 +252,7 @@ class CourseDrawing:
         east = np.interp(d, route.distance_m, route.east_m)
         north = np.interp(d, route.distance_m, route.north_m)
         z = np.interp(d, route.distance_m, route.elevation_m)
-        segment = np.clip(
-            np.searchsorted(route.distance_m, d, side="right") - 1, 0, route.n_points - 2
-        )
+        segment = np.clip(np.searchsorted(route.distance_m, d, side="right") - 1, 0, route.n_points - 2)
         yaw = math.pi / 2 - route.heading_rad[segment]
         xy = (np.stack([east, north], axis=1) - self.offset) * self.scale + COURSE_CENTRE
         zz = (z - self.base_m) * self.scale * exaggeration + 0.05
@@ -304,10 +278,14 @@ def terrain_strip(points: np.ndarray, half_width: float) -> tuple[np.ndarray, np
     a = np.arange(k - 1)
     b = a + 1
     L, R, C, F = 0, k, 2 * k, 3 * k  # block offsets: left edge, right edge, centre, its foot
-    faces = np.concatenate([
-        np.stack([L + a, R + a, R + b], axis=1), np.stack([L + a, R + b, L + b], axis=1),  # strip
-        np.stack([F + a, C + a, C + b], axis=1), np.stack([F + a, C + b, F + b], axis=1),  # curtain
-    ])  # fmt: skip
+    faces = np.concatenate(
+        [
+            np.stack([L + a, R + a, R + b], axis=1),
+            np.stack([L + a, R + b, L + b], axis=1),  # strip
+            np.stack([F + a, C + a, C + b], axis=1),
+            np.stack([F + a, C + b, F + b], axis=1),  # curtain
+        ]
+    )
     return vertices.astype(np.float32), faces.astype(np.uint32)
 
 
@@ -325,9 +303,5 @@ def grade_colours(grade: np.ndarray) -> np.ndarray:
     up = np.clip(g, 0.0, 1.0)[:, None]
     down = np.clip(-g, 0.0, 1.0)[:, None]
     flat = np.array([90.0, 200.0, 90.0])
-    colour = (
-        flat
-        + up * (np.array([230.0, 40.0, 30.0]) - flat)
-        + down * (np.array([40.0, 110.0, 230.0]) - flat)
-    )
+    colour = flat + up * (np.array([230.0, 40.0, 30.0]) - flat) + down * (np.array([40.0, 110.0, 230.0]) - flat)
     return colour.astype(np.uint8)

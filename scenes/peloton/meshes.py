@@ -48,9 +48,7 @@ def two_bone_knee(hip: np.ndarray, foot: np.ndarray, thigh: float, shin: float) 
     along = (thigh**2 - shin**2 + d**2) / (2 * d)
     height = math.sqrt(max(thigh**2 - along**2, 0.0))
     u = d_vec / np.linalg.norm(d_vec)
-    forward = np.array(
-        [u[2], 0.0, -u[0]]
-    )  # u rotated by −90° about y: in front of the hip–foot line
+    forward = np.array([u[2], 0.0, -u[0]])  # u rotated by −90° about y: in front of the hip–foot line
     if forward[0] < 0:
         forward = -forward
     return hip + along * u + height * forward
@@ -110,9 +108,7 @@ def rider_meshes(position: Position) -> dict[str, trimesh.Trimesh]:
         h_side = hip + [0.0, side * 0.1, 0.0]
         knee = two_bone_knee(h_side, foot, 0.46, 0.46)
         body_parts += [rod(h_side, knee, 0.065), rod(knee, foot, 0.05)]
-    head_centre = shoulder + 0.17 * np.array(
-        [math.cos(theta * 0.5), 0.0, math.sin(theta * 0.5) + 0.6]
-    )
+    head_centre = shoulder + 0.17 * np.array([math.cos(theta * 0.5), 0.0, math.sin(theta * 0.5) + 0.6])
     head = trimesh.creation.icosphere(subdivisions=2, radius=0.12)
     head.apply_translation(head_centre)
     bike, body = trimesh.util.concatenate(bike_parts), trimesh.util.concatenate(body_parts)

@@ -69,24 +69,16 @@ class PelotonParams:
     Each field is also its GUI control, declared once (:mod:`scenes._controls`), in the order and folder shown.
     """
 
-    speed_kmh: float = field(
-        default=40.0, metadata=slider("Speed (km/h)", 0.0, 80.0, 0.5, folder="Rider")
-    )
+    speed_kmh: float = field(default=40.0, metadata=slider("Speed (km/h)", 0.0, 80.0, 0.5, folder="Rider"))
     """Ground speed of the line (km/h)."""
     position: Position = field(
         default="drops",
-        metadata=dropdown(
-            "Position", tuple(POSITIONS), tuple(p.label for p in POSITIONS.values()), folder="Rider"
-        ),
+        metadata=dropdown("Position", tuple(POSITIONS), tuple(p.label for p in POSITIONS.values()), folder="Rider"),
     )
     """Riding position: sets the drawing and, when chosen, the CdA."""
-    cda_m2: float = field(
-        default=0.32, metadata=slider("CdA (m²)", 0.10, 0.80, 0.005, folder="Rider")
-    )
+    cda_m2: float = field(default=0.32, metadata=slider("CdA (m²)", 0.10, 0.80, 0.005, folder="Rider"))
     """Drag area of one rider riding alone (m²)."""
-    mass_kg: float = field(
-        default=80.0, metadata=slider("Mass, rider + bike (kg)", 30.0, 150.0, 0.5, folder="Rider")
-    )
+    mass_kg: float = field(default=80.0, metadata=slider("Mass, rider + bike (kg)", 30.0, 150.0, 0.5, folder="Rider"))
     """Rider plus bike (kg)."""
     crr: float = field(default=0.0040, metadata=slider("Crr", 0.0, 0.02, 0.0005, folder="Rider"))
     """Rolling-resistance coefficient (the "Tyres / surface" presets above it set it)."""
@@ -94,13 +86,9 @@ class PelotonParams:
         default=97.6, metadata=slider("Drivetrain efficiency (%)", 80.0, 100.0, 0.1, folder="Rider")
     )
     """Drivetrain efficiency (%), Martin et al. 1998."""
-    grade_pct: float = field(
-        default=0.0, metadata=slider("Grade (%)", -15.0, 20.0, 0.5, folder="Course")
-    )
+    grade_pct: float = field(default=0.0, metadata=slider("Grade (%)", -15.0, 20.0, 0.5, folder="Course"))
     """Road grade (%), rise over run."""
-    altitude_m: float = field(
-        default=0.0, metadata=slider("Altitude (m)", 0.0, 4000.0, 50.0, folder="Course")
-    )
+    altitude_m: float = field(default=0.0, metadata=slider("Altitude (m)", 0.0, 4000.0, 50.0, folder="Course"))
     """Altitude (m): sets air density."""
     headwind_ms: float = field(
         default=0.0,
@@ -111,9 +99,7 @@ class PelotonParams:
     """Whether riders behind the leader draft."""
     n_riders: int = field(default=4, metadata=slider("Riders", 1, MAX_RIDERS, 1, folder="Drafting"))
     """Riders in the line."""
-    gap_m: float = field(
-        default=0.5, metadata=slider("Gap (m)", 0.0, MAX_GAP_M, 0.1, folder="Drafting")
-    )
+    gap_m: float = field(default=0.5, metadata=slider("Gap (m)", 0.0, MAX_GAP_M, 0.1, folder="Drafting"))
     """Wheel-to-wheel gap between riders (m)."""
     model: cycling.DraftModel = field(
         default="measured",
@@ -127,9 +113,7 @@ class PelotonParams:
     """Drafting model: the seed's formula or the position-dependent fit to measurements."""
     rotate: bool = field(default=False, metadata=checkbox("Rotate the lead", folder="Drafting"))
     """Whether the lead rotates: every turn the leader swings off and drops to the back."""
-    turn_s: float = field(
-        default=6.0, metadata=slider("Turn at the front (s)", 2.0, 30.0, 1.0, folder="Drafting")
-    )
+    turn_s: float = field(default=6.0, metadata=slider("Turn at the front (s)", 2.0, 30.0, 1.0, folder="Drafting"))
     """Seconds each rider leads when the lead rotates."""
     target_power_w: float = field(
         default=250.0, metadata=number("Power (W)", 0.0, 2500.0, 5.0, folder="Speed at a power")
@@ -198,9 +182,7 @@ def solo_curves(key: SoloKey) -> tuple[np.ndarray, ...]:
     """(speeds in km/h, aero, rolling, climbing, total) of one rider from 0 to 80 km/h, for the chart."""
     cda, mass, crr, grade_pct, altitude, wind, drivetrain_pct = key
     speeds_kmh = np.linspace(0.0, 80.0, 161)
-    solo = cycling.power(
-        speeds_kmh / 3.6, cda, mass, crr, grade_pct / 100.0, altitude, wind, drivetrain_pct / 100.0
-    )
+    solo = cycling.power(speeds_kmh / 3.6, cda, mass, crr, grade_pct / 100.0, altitude, wind, drivetrain_pct / 100.0)
     curves = (speeds_kmh, solo.aero, solo.rolling, solo.climbing, solo.total)
     for curve in curves:
         curve.setflags(write=False)  # shared between calls
@@ -212,7 +194,5 @@ def solo_speed(key: SoloKey, power_w: float) -> float:
     """Speed (m/s) at which one rider alone holds ``power_w`` (W)."""
     cda, mass, crr, grade_pct, altitude, wind, drivetrain_pct = key
     return float(
-        cycling.speed_for_power(
-            power_w, cda, mass, crr, grade_pct / 100.0, altitude, wind, drivetrain_pct / 100.0
-        )
+        cycling.speed_for_power(power_w, cda, mass, crr, grade_pct / 100.0, altitude, wind, drivetrain_pct / 100.0)
     )

@@ -31,9 +31,7 @@ def course_to_world(points: np.ndarray, grade_pct: float) -> np.ndarray:
     theta = math.atan(grade_pct / 100.0)
     c, s = math.cos(theta), math.sin(theta)
     pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
-    return np.stack(
-        [c * pts[:, 0] - s * pts[:, 2], pts[:, 1], s * pts[:, 0] + c * pts[:, 2]], axis=1
-    )
+    return np.stack([c * pts[:, 0] - s * pts[:, 2], pts[:, 1], s * pts[:, 0] + c * pts[:, 2]], axis=1)
 
 
 def label_lifts_px(anchors_px: np.ndarray, label_px: tuple[float, float] = LABEL_PX) -> np.ndarray:

@@ -182,32 +182,19 @@ time-averaged power is the mean over positions, far below the leader's.
         length, middle = end - start, 0.5 * (start + end)
         grass = trimesh.creation.box(extents=(length + 30.0, 60.0, 0.02))
         grass.apply_translation((middle, 0.0, -0.03))
-        scene.add_mesh_simple(
-            f"{self.course.name}/grass", grass.vertices, grass.faces, color=(120, 165, 95)
-        )
+        scene.add_mesh_simple(f"{self.course.name}/grass", grass.vertices, grass.faces, color=(120, 165, 95))
         road = trimesh.creation.box(extents=(length, 3.0, 0.02))
         road.apply_translation((middle, 0.0, -0.01))
-        self.road = scene.add_mesh_simple(
-            f"{self.course.name}/road", road.vertices, road.faces, color=(70, 72, 78)
-        )
-        dashes = np.array(
-            [
-                [[x, 0.0, 0.002], [x + 1.5, 0.0, 0.002]]
-                for x in np.arange(start + 1.0, end - 1.0, 3.0)
-            ]
-        )
-        scene.add_line_segments(
-            f"{self.course.name}/centre_line", dashes, colors=(240, 240, 240), thickness=0.08
-        )
+        self.road = scene.add_mesh_simple(f"{self.course.name}/road", road.vertices, road.faces, color=(70, 72, 78))
+        dashes = np.array([[[x, 0.0, 0.002], [x + 1.5, 0.0, 0.002]] for x in np.arange(start + 1.0, end - 1.0, 3.0)])
+        scene.add_line_segments(f"{self.course.name}/centre_line", dashes, colors=(240, 240, 240), thickness=0.08)
         for side in (-1.5, 1.5):
             edge = np.array([[[start, side, 0.003], [end, side, 0.003]]])
             scene.add_line_segments(
                 f"{self.course.name}/edge_{side:+.0f}", edge, colors=(250, 250, 250), thickness=0.06
             )
 
-        self.riders_nodes = add_riders(
-            scene, f"{self.course.name}/riders", self.params.position, 1.0
-        )
+        self.riders_nodes = add_riders(scene, f"{self.course.name}/riders", self.params.position, 1.0)
         identity = np.tile([1.0, 0.0, 0.0, 0.0], (MAX_RIDERS, 1))
         zeros = np.zeros((MAX_RIDERS, 3))
         self._drawn_position = self.params.position
@@ -254,12 +241,8 @@ time-averaged power is the mean over positions, far below the leader's.
         self.apply_inputs()
 
     def _on_rotate(self) -> None:
-        rotation = (
-            self.read_params()
-        )  # only the rotation is taken: the line's power stays as computed
-        self.params = dataclasses.replace(
-            self.params, rotate=rotation.rotate, turn_s=rotation.turn_s
-        )
+        rotation = self.read_params()  # only the rotation is taken: the line's power stays as computed
+        self.params = dataclasses.replace(self.params, rotate=rotation.rotate, turn_s=rotation.turn_s)
         self._rotation_time_s = 0.0
         self._energy_j[:] = 0.0
         self._ridden_s = 0.0
@@ -298,12 +281,7 @@ time-averaged power is the mean over positions, far below the leader's.
         x_hi = front + (3.0 + min(abs(p.headwind_ms), 15.0) * 0.25 if p.headwind_ms != 0 else 0.0)
         lo, hi = np.array([back, -1.1, 0.0]), np.array([x_hi, 1.1, max(top, 2.2)])
         corners = np.array(
-            [
-                [(lo, hi)[i][0], (lo, hi)[j][1], (lo, hi)[k][2]]
-                for i in (0, 1)
-                for j in (0, 1)
-                for k in (0, 1)
-            ]
+            [[(lo, hi)[i][0], (lo, hi)[j][1], (lo, hi)[k][2]] for i in (0, 1) for j in (0, 1) for k in (0, 1)]
         )
         return course_to_world(corners, p.grade_pct)
 
@@ -338,9 +316,7 @@ time-averaged power is the mean over positions, far below the leader's.
             # above its anchor, in the room the rectangle leaves. Framing the anchors shrinks the line, which may
             # stack the labels differently: repeat until the lifted anchors fit.
             for _ in range(MAX_RIDERS + 2):
-                view = frame_points(
-                    framed, VIEW_DIRECTION, fov_rad=lens.fov_rad, aspect=lens.aspect, ndc=ndc
-                )
+                view = frame_points(framed, VIEW_DIRECTION, fov_rad=lens.fov_rad, aspect=lens.aspect, ndc=ndc)
                 lifts_px = label_lifts_px(project_px(anchors, view, lens))
                 lifts_m = lift_to_metres(anchors, lifts_px, up_world, view, lens)
                 lifted = anchors + lifts_m[:, None] * up_world
@@ -437,9 +413,7 @@ time-averaged power is the mean over positions, far below the leader's.
 
         with self.server.atomic():
             theta = math.atan(p.grade_pct / 100.0)
-            set_if_changed(
-                self.course, "wxyz", (math.cos(-theta / 2), 0.0, math.sin(-theta / 2), 0.0)
-            )
+            set_if_changed(self.course, "wxyz", (math.cos(-theta / 2), 0.0, math.sin(-theta / 2), 0.0))
             if p.position != self._drawn_position:
                 show_position(self.riders_nodes, p.position)
                 self._drawn_position = p.position
@@ -452,9 +426,7 @@ time-averaged power is the mean over positions, far below the leader's.
                 watts = np.zeros(MAX_RIDERS)
                 watts[:n] = np.maximum(np.asarray(getattr(state.power, component))[slots], 0.0)
                 height = watts * BAR_METRES_PER_WATT
-                bar_pos = positions + np.stack(
-                    [np.zeros(MAX_RIDERS), np.zeros(MAX_RIDERS), 1.75 + base], axis=1
-                )
+                bar_pos = positions + np.stack([np.zeros(MAX_RIDERS), np.zeros(MAX_RIDERS), 1.75 + base], axis=1)
                 self.bars[component].batched_positions = bar_pos.astype(np.float32)
                 self.bars[component].batched_scales = np.stack(
                     [0.35 * visible, 0.35 * visible, np.maximum(height, 1e-4) * visible], axis=1
@@ -467,9 +439,7 @@ time-averaged power is the mean over positions, far below the leader's.
                 if i < n:
                     watts = float(total[slots[i]])
                     solo = float(state.solo.total)
-                    share = (
-                        f"{100.0 * watts / solo:.0f} % of solo" if solo > 0 else "solo needs 0 W"
-                    )
+                    share = f"{100.0 * watts / solo:.0f} % of solo" if solo > 0 else "solo needs 0 W"
                     text = f"{watts:.0f} W · {share}"
                     if label.text != text:
                         label.text = text
@@ -551,9 +521,7 @@ time-averaged power is the mean over positions, far below the leader's.
             text = f"Here the leader needs {lead:.0f} W: gravity does the work and nobody needs shelter."
         if self.params.rotate and self._ridden_s > 0:
             averages = self._energy_j[:n] / self._ridden_s
-            text += "  \nTime-averaged so far: " + ", ".join(
-                f"R{i + 1} {a:.0f} W" for i, a in enumerate(averages)
-            )
+            text += "  \nTime-averaged so far: " + ", ".join(f"R{i + 1} {a:.0f} W" for i, a in enumerate(averages))
         return text
 
     def _speed_markdown(self) -> str:

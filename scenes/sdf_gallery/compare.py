@@ -44,9 +44,7 @@ def compare(marched: np.ndarray, rasterised: np.ndarray) -> tuple[float | None, 
     iou = float((a & b).sum()) / union
     both = a & b
     inner = np.zeros_like(both)
-    inner[1:-1, 1:-1] = (
-        both[1:-1, 1:-1] & both[:-2, 1:-1] & both[2:, 1:-1] & both[1:-1, :-2] & both[1:-1, 2:]
-    )
+    inner[1:-1, 1:-1] = both[1:-1, 1:-1] & both[:-2, 1:-1] & both[2:, 1:-1] & both[1:-1, :-2] & both[1:-1, 2:]
     if not inner.any():
         return iou, None
     return iou, float(np.mean(np.abs(marched[inner].astype(np.float64) - rasterised[inner])))

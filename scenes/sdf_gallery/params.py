@@ -198,16 +198,12 @@ class SdfGalleryParams:
 
     view_mode: ViewMode = field(
         default="mesh",
-        metadata=dropdown(
-            "View", tuple(VIEW_LABELS.values()), tuple(VIEW_LABELS), folder="Shape and view"
-        ),
+        metadata=dropdown("View", tuple(VIEW_LABELS.values()), tuple(VIEW_LABELS), folder="Shape and view"),
     )
     """The main 3D view: the mesh, the GLSL ray-march (background image with depth), or both (mesh as wireframe)."""
     shape_source: ShapeSource = field(
         default="primitives",
-        metadata=dropdown(
-            "Shape", tuple(SOURCE_LABELS.values()), tuple(SOURCE_LABELS), folder="Shape and view"
-        ),
+        metadata=dropdown("Shape", tuple(SOURCE_LABELS.values()), tuple(SOURCE_LABELS), folder="Shape and view"),
     )
     """Show the primitives' scene or the editor's field."""
     example: str = field(
@@ -227,14 +223,10 @@ class SdfGalleryParams:
     """Half the side of the cube the editor's field is meshed and ray-marched in, for the next mesh (m)."""
     blend: BlendChoice = field(
         default="poly",
-        metadata=dropdown(
-            "Blend", tuple(BLEND_LABELS.values()), tuple(BLEND_LABELS), folder="Blend and mesh"
-        ),
+        metadata=dropdown("Blend", tuple(BLEND_LABELS.values()), tuple(BLEND_LABELS), folder="Blend and mesh"),
     )
     """Hard booleans (k is not used), or the polynomial or exponential smooth minimum of width k."""
-    k: float = field(
-        default=0.25, metadata=slider("Blend width k (m)", 0.0, 1.0, 0.01, folder="Blend and mesh")
-    )
+    k: float = field(default=0.25, metadata=slider("Blend width k (m)", 0.0, 1.0, 0.01, folder="Blend and mesh"))
     """Blend width (m); 0 is a hard boolean."""
     resolution: int = field(
         default=64,
@@ -378,9 +370,7 @@ def viewer_size(camera: Any) -> tuple[int, int] | None:
         width, height = float(camera.image_width), float(camera.image_height)
     except (TypeError, ValueError, AttributeError, OverflowError):
         return None
-    if not (
-        math.isfinite(width) and math.isfinite(height) and 1 <= width <= 2e4 and 1 <= height <= 2e4
-    ):
+    if not (math.isfinite(width) and math.isfinite(height) and 1 <= width <= 2e4 and 1 <= height <= 2e4):
         return None
     return round(width), round(height)
 
@@ -416,9 +406,7 @@ def gizmo_reach(slot: PrimitiveParams) -> float:
 
 
 @functools.lru_cache(maxsize=256)
-def _reach(
-    kind: sdf.PrimitiveKind, size: tuple[float, ...], wxyz: tuple[float, float, float, float]
-) -> float:
+def _reach(kind: sdf.PrimitiveKind, size: tuple[float, ...], wxyz: tuple[float, float, float, float]) -> float:
     try:
         prim = sdf.Primitive(kind, (0.0, 0.0, 0.0), size, rotation=wxyz)
     except ValueError:

@@ -206,13 +206,9 @@ IoU is lowest when a box edge is on the silhouette.
                 self.view_note = gui.add_markdown("")
             self.example_controls = build_controls(gui, p, ("example",), collapsed=("GLSL editor",))
             folders = self.example_controls.folders
-            self.editor = build_controls(gui, p, ("editor_text",), folders_open=folders)[
-                "editor_text"
-            ]
+            self.editor = build_controls(gui, p, ("editor_text",), folders_open=folders)["editor_text"]
             self.editor.disabled = not allowed
-            self.half_size_controls = build_controls(
-                gui, p, ("editor_half_size",), folders_open=folders
-            )
+            self.half_size_controls = build_controls(gui, p, ("editor_half_size",), folders_open=folders)
             with folders["GLSL editor"]:
                 self.apply = mark_costly(gui.add_button("Apply"))  # compiles GLSL, remeshes
                 self.editor_status = gui.add_markdown(EDITOR_HELP if allowed else EDITING_OFF)
@@ -221,16 +217,12 @@ IoU is lowest when a box edge is on the silhouette.
                 self.progress = gui.add_progress_bar(0.0, visible=False)
                 self.readout = gui.add_markdown("")
             with gui.add_folder(REFERENCE_FOLDER) as reference_folder:
-                self.reference = gui.add_image(
-                    np.full((120, 160, 3), 235, np.uint8), label="Reference", format="png"
-                )
+                self.reference = gui.add_image(np.full((120, 160, 3), 235, np.uint8), label="Reference", format="png")
                 self.reference_note = gui.add_markdown("")
             self.shading_controls = build_controls(
                 gui, p, SHADING_FIELDS, folders_open={REFERENCE_FOLDER: reference_folder}
             )
-            self.slot_controls = [
-                build_slot_controls(gui, i, slot) for i, slot in enumerate(p.primitives)
-            ]
+            self.slot_controls = [build_slot_controls(gui, i, slot) for i, slot in enumerate(p.primitives)]
             gui.add_markdown(SIZE_MEANING)
             with gui.add_folder("Downloads", expand_by_default=False):
                 self.downloads: dict[DownloadFormat, viser.GuiButtonHandle] = {
@@ -255,12 +247,8 @@ IoU is lowest when a box edge is on the silhouette.
     def _build_world(self) -> None:
         scene = self.server.scene
         vertices, faces, colors = sdf.mesh(self.params.scene(), self.params.resolution)
-        self.mesh_node = scene.add_mesh_trimesh(
-            f"{self.root.name}/mesh", sdf.mesh_trimesh(vertices, faces, colors)
-        )
-        self.mesh_node.glb_data = viewer_glb(
-            vertices, faces, colors, scene_normals(self.params.scene(), vertices)
-        )
+        self.mesh_node = scene.add_mesh_trimesh(f"{self.root.name}/mesh", sdf.mesh_trimesh(vertices, faces, colors))
+        self.mesh_node.glb_data = viewer_glb(vertices, faces, colors, scene_normals(self.params.scene(), vertices))
         self.wireframe_node = scene.add_mesh_simple(
             f"{self.root.name}/wireframe",
             vertices.astype(np.float32),
@@ -286,9 +274,7 @@ IoU is lowest when a box edge is on the silhouette.
         """The current scene controls' and gizmos' values, cleaned: anything unusable keeps the last good value."""
         last = self.params
         slots = []
-        for i, (controls, gizmo, old) in enumerate(
-            zip(self.slot_controls, self.gizmos, last.primitives, strict=True)
-        ):
+        for i, (controls, gizmo, old) in enumerate(zip(self.slot_controls, self.gizmos, last.primitives, strict=True)):
             slot = _controls.read_controls(controls, old, write_back=self.write_back)
             slots.append(
                 dataclasses.replace(
@@ -422,9 +408,7 @@ IoU is lowest when a box edge is on the silhouette.
         self.editor_error = message
         with self._lock:
             if not self.closed:
-                self.editor_status.content = (
-                    f"**Not applied.** {message}\n\nThe last good shape stays on screen."
-                )
+                self.editor_status.content = f"**Not applied.** {message}\n\nThe last good shape stays on screen."
 
     def _show_view_mode(self) -> None:
         mode = self.params.view_mode
@@ -445,9 +429,7 @@ IoU is lowest when a box edge is on the silhouette.
     def _sync_enabled_inputs(self) -> None:
         """Show gizmos of enabled primitives, sized and named for them; grey out sizes the kind does not use."""
         self.scene_controls["k"].disabled = self.params.blend == "hard"
-        for controls, gizmo, slot in zip(
-            self.slot_controls, self.gizmos, self.params.primitives, strict=True
-        ):
+        for controls, gizmo, slot in zip(self.slot_controls, self.gizmos, self.params.primitives, strict=True):
             gizmo.visible = slot.enabled and self.params.shape_source == "primitives"
             for j, handle in enumerate(controls.each("size")):
                 handle.disabled = j >= SIZES_USED[slot.kind] or not slot.enabled
@@ -563,8 +545,7 @@ IoU is lowest when a box edge is on the silhouette.
                 not self._reference_due
                 or self.mesh_shape is None
                 or self._wanted_scene is not None
-                or self._refine
-                is not None  # the reference compares against the full mesh, not a preview
+                or self._refine is not None  # the reference compares against the full mesh, not a preview
             ):
                 return False
             if self.params.reference_mode == "live":
@@ -615,7 +596,9 @@ IoU is lowest when a box edge is on the silhouette.
             source_control = self.view_controls.fields["shape_source"].control
             self.write_back(self.view_controls["shape_source"], source_control.to_gui("editor"))
             self._sync_enabled_inputs()
-            self.editor_status.content = f"**Applied** in {total_ms:.0f} ms (compile, a test frame and a {resolution}³ mesh)."
+            self.editor_status.content = (
+                f"**Applied** in {total_ms:.0f} ms (compile, a test frame and a {resolution}³ mesh)."
+            )
         with self._state:
             self._reference_due = True
             self._view_key = None
@@ -677,9 +660,7 @@ IoU is lowest when a box edge is on the silhouette.
                     bounds = None if isinstance(shape, sdf.Scene) else shape.bounds
                     self._mesh_voxel = sdf.make_grid(grid_scene, resolution, bounds).spacing
                     self.mesh_serial += 1
-                    self.agreement = dataclasses.replace(
-                        self.agreement, triangles=len(faces), mesh_ms=mesh_ms
-                    )
+                    self.agreement = dataclasses.replace(self.agreement, triangles=len(faces), mesh_ms=mesh_ms)
                     self.readout.content = readout_markdown(self.agreement)
             self.server.flush()
 
@@ -687,9 +668,7 @@ IoU is lowest when a box edge is on the silhouette.
         with self._state:
             self._reference_due = False
             camera, aspect = self._camera_or_default(), self.viewer.aspect
-        with (
-            self._lock
-        ):  # one consistent mesh: the worker replaces all four together under this lock
+        with self._lock:  # one consistent mesh: the worker replaces all four together under this lock
             params = self.params
             scene, vertices, faces, colors = (
                 self.mesh_shape,
@@ -706,9 +685,7 @@ IoU is lowest when a box edge is on the silhouette.
             start = time.perf_counter()
             rgb, depth = march(renderer, scene, camera, width, height, params.shading)
             render_ms = 1e3 * (time.perf_counter() - start)
-            _, mesh_depth = renderer.render_mesh(
-                vertices, faces, colors, camera, width, height, params.shading
-            )
+            _, mesh_depth = renderer.render_mesh(vertices, faces, colors, camera, width, height, params.shading)
             return rgb, depth, mesh_depth, render_ms, renderer.renderer_name
 
         rgb, depth, mesh_depth, render_ms, renderer_name = gl_service.run(job)
@@ -799,9 +776,7 @@ IoU is lowest when a box edge is on the silhouette.
     def download(self, fmt: DownloadFormat) -> Download:
         """The file of a download button (the current mesh as glb, stl or obj, the reference image as png), or why
         there is none (an empty mesh, no reference yet)."""
-        with (
-            self._lock
-        ):  # a consistent snapshot: the worker replaces these together under this lock
+        with self._lock:  # a consistent snapshot: the worker replaces these together under this lock
             reference, vertices, faces, colors = (
                 self.reference_rgb,
                 self.mesh_vertices,

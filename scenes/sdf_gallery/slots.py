@@ -104,9 +104,7 @@ def update_gizmo_looks(
         label.text = text
 
 
-def read_wxyz(
-    gizmo: Any, last_good: tuple[float, float, float, float]
-) -> tuple[float, float, float, float]:
+def read_wxyz(gizmo: Any, last_good: tuple[float, float, float, float]) -> tuple[float, float, float, float]:
     """A gizmo's orientation, normalised; ``last_good`` (put back on the gizmo) if it is not a usable quaternion."""
     try:
         q = np.asarray(gizmo.wxyz, dtype=np.float64).reshape(4)

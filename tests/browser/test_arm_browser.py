@@ -55,9 +55,7 @@ def _chain_points(scene: ArmScene) -> np.ndarray:
         p = scene.params
         shown_obstacles = scene.obstacle_centres[: p.n_obstacles]
         radii = np.asarray(p.radii_m[: p.n_obstacles])[:, None]
-        return np.vstack(
-            [scene.pose, scene.target[None, :], shown_obstacles - radii, shown_obstacles + radii]
-        )
+        return np.vstack([scene.pose, scene.target[None, :], shown_obstacles - radii, shown_obstacles + radii])
 
 
 def test_the_chain_is_in_view_clear_of_the_panel(shown: ScenePage) -> None:
@@ -104,9 +102,7 @@ def test_three_d_shows_the_floor_grid_from_an_angle(shown: ScenePage) -> None:
     image = screenshot(shown.page)
     checkbox = control_row(shown.page, "3D (free target, sphere obstacles)").locator("input").first
     checkbox.click()
-    wait_until(
-        lambda: scene.params.three_d and scene.framing.frames > frames, "3D mode and its camera"
-    )
+    wait_until(lambda: scene.params.three_d and scene.framing.frames > frames, "3D mode and its camera")
     settle(shown)
     after = screenshot(shown.page)
     # The camera left the front-on view: it looks across x as well as along y, and from above.
@@ -116,17 +112,13 @@ def test_three_d_shows_the_floor_grid_from_an_angle(shown: ScenePage) -> None:
             " window.__viserMutable.camera.getWorldDirection(v); return v.toArray(); }"
         )
     )
-    assert abs(direction[0]) > 0.25 and direction[1] < -0.25, (
-        direction
-    )  # three.js is y-up: −y is down
+    assert abs(direction[0]) > 0.25 and direction[1] < -0.25, direction  # three.js is y-up: −y is down
     # The floor grid is drawn, and much of the picture changed.
     grid = changed_mask(after, with_nodes_hidden(shown.page, ["/arm/floor"]))
     assert grid.sum() > 5_000, grid.sum()
     assert changed_mask(image, after).mean() > 0.02
     xy = assert_in_view(shown, "/arm", _chain_points(scene), "chain in 3D")
-    assert_seen(
-        shown, after, MAIN[:2], xy, "chain in 3D", max_outside=0.6
-    )  # its shadow on the floor
+    assert_seen(shown, after, MAIN[:2], xy, "chain in 3D", max_outside=0.6)  # its shadow on the floor
     assert error_text(shown.page) == []
     checkbox.click()
     wait_until(lambda: not scene.params.three_d, "back to the plane")
@@ -154,9 +146,7 @@ def test_drag_the_target_gizmo_with_the_mouse(server: viser.ViserServer, browser
     assert start[0] > origin[0] + 5  # the arrow points right on screen from this camera
     page.mouse.move(*start)
     page.mouse.down()
-    for step in range(
-        1, 11
-    ):  # about 0.15 m to the left: clear of the obstacle, so the chain reaches it
+    for step in range(1, 11):  # about 0.15 m to the left: clear of the obstacle, so the chain reaches it
         page.mouse.move(start[0] - 6 * step, start[1], steps=2)
         time.sleep(0.02)
     page.mouse.up()
@@ -204,9 +194,7 @@ def test_drag_the_target_gizmo_with_the_mouse(server: viser.ViserServer, browser
 
     deadline = time.monotonic() + 10.0
     shown = drawn_end()
-    while time.monotonic() < deadline and (
-        shown is None or np.linalg.norm(np.array(shown) - end) > 1e-3
-    ):
+    while time.monotonic() < deadline and (shown is None or np.linalg.norm(np.array(shown) - end) > 1e-3):
         time.sleep(0.1)
         shown = drawn_end()
     assert shown is not None
@@ -254,9 +242,7 @@ def _assert_chain_fills_the_view(shown: ScenePage, what: str) -> None:
     left, _, _, _ = panel_rect(shown.page)
     width, height = np.ptp(chain, axis=0)
     fill = max(width / left, height / shown.viewport[1])
-    assert fill >= FILL, (
-        f"{what}: the chain spans {width:.0f}×{height:.0f} px, {fill:.2f} of the free view"
-    )
+    assert fill >= FILL, f"{what}: the chain spans {width:.0f}×{height:.0f} px, {fill:.2f} of the free view"
 
 
 def test_the_chain_fills_the_view_in_the_plane_and_in_3d(shown: ScenePage) -> None:

@@ -31,9 +31,7 @@ args => {
 """World position of instance ``i`` of a batched mesh, as the page's three.js scene holds it."""
 
 
-def test_drag_a_fingertip_target_with_the_mouse(
-    server: viser.ViserServer, browser_page: Any
-) -> None:
+def test_drag_a_fingertip_target_with_the_mouse(server: viser.ViserServer, browser_page: Any) -> None:
     switcher = SceneSwitcher(server, "arm")
     scene = switcher.scene
     assert isinstance(scene, ArmScene)
@@ -88,9 +86,7 @@ def test_drag_a_fingertip_target_with_the_mouse(
     # The page draws the new pose: the fingertip's instance in three.js sits where the server solved it.
     deadline = time.monotonic() + 10.0
     shown = page.evaluate(INSTANCE, {"name": "/arm/skeleton/joints", "i": effector})
-    while time.monotonic() < deadline and (
-        shown is None or np.linalg.norm(np.array(shown) - tip) > 1e-3
-    ):
+    while time.monotonic() < deadline and (shown is None or np.linalg.norm(np.array(shown) - tip) > 1e-3):
         time.sleep(0.1)
         shown = page.evaluate(INSTANCE, {"name": "/arm/skeleton/joints", "i": effector})
     assert shown is not None

@@ -28,9 +28,7 @@ VIEWPORT = (1280, 720)
 
 def _canvas(page: Any) -> tuple[int, int]:
     """(device px width, CSS px width) of viser's canvas."""
-    width, css = page.evaluate(
-        "() => [window.__viserMutable.canvas.width, window.__viserMutable.canvas.clientWidth]"
-    )
+    width, css = page.evaluate("() => [window.__viserMutable.canvas.width, window.__viserMutable.canvas.clientWidth]")
     return int(width), int(css)
 
 
@@ -56,9 +54,7 @@ def test_the_camera_reports_css_pixels_and_the_line_is_framed_clear_of_the_panel
         settle(shown)
         device, css = _canvas(page)
         assert css == VIEWPORT[0]
-        assert (
-            device >= 0.7 * ratio * css
-        )  # the screen really is HiDPI (viser may draw at 0.75 of it)
+        assert device >= 0.7 * ratio * css  # the screen really is HiDPI (viser may draw at 0.75 of it)
         camera = shown.client_camera
         assert (camera.image_width, camera.image_height) == VIEWPORT
         with scene._lock:

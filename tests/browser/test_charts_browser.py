@@ -74,9 +74,7 @@ class Probe:
             axes=(
                 viser.uplot.Axis(scale="x", label="x"),
                 viser.uplot.Axis(scale="a", label="a", side=3),
-                viser.uplot.Axis(
-                    scale="b", label="b", side=1, grid=viser.uplot.Axis_Grid(show=False)
-                ),
+                viser.uplot.Axis(scale="b", label="b", side=1, grid=viser.uplot.Axis_Grid(show=False)),
             ),
             title=TWO_AXES,
             aspect=1.4,
@@ -121,9 +119,7 @@ def test_the_wide_labels_that_were_cut(probe: Probe) -> None:
     probe.show(probe.two, TWO_AXES, (x, elevation, elevation / 90.0, elevation / 5.0))
 
 
-@settings(
-    max_examples=12, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
-)
+@settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(
     magnitude=st.floats(-2.5, 5.5),
     low=st.floats(-1.0, 1.0),
@@ -140,9 +136,7 @@ def test_labels_stay_inside_for_any_range(
     probe.show(probe.two, TWO_AXES, (x, y, right, y))
 
 
-@settings(
-    max_examples=8, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
-)
+@settings(max_examples=8, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(low=st.floats(-6.0, 2.0), decades=st.floats(0.3, 7.0))
 def test_log_labels_stay_inside_for_any_decades(probe: Probe, low: float, decades: float) -> None:
     x = np.arange(40, dtype=np.float64)

@@ -33,9 +33,7 @@ def png(image: np.ndarray) -> bytes:
     return buffer.getvalue()
 
 
-def test_upload_a_gpx_and_play_it(
-    server: viser.ViserServer, browser_page: Any, tmp_path: Path
-) -> None:
+def test_upload_a_gpx_and_play_it(server: viser.ViserServer, browser_page: Any, tmp_path: Path) -> None:
     switcher = SceneSwitcher(server, "peloton")
     scene = switcher.scene
     assert isinstance(scene, PelotonScene)
@@ -62,9 +60,7 @@ def test_upload_a_gpx_and_play_it(
     # Fast forward, set on the server (its on_update and cleaning run).
     mode.controls["playback"].value = 300.0
     page.get_by_role("button", name="Play").first.click()
-    wait_until(
-        lambda: mode.leader_distance_m() > start + 500.0, "the riders to ride", timeout_s=20.0
-    )
+    wait_until(lambda: mode.leader_distance_m() > start + 500.0, "the riders to ride", timeout_s=20.0)
     page.get_by_role("button", name="Pause").first.click()
     wait_until(lambda: not mode.playing, "pause", timeout_s=10.0)
     time.sleep(0.5)
@@ -88,9 +84,7 @@ def test_upload_a_gpx_and_play_it(
 
 
 @pytest.mark.parametrize("viewport", [(1600, 1000), (1280, 720)], ids=["1600x1000", "1280x720"])
-def test_the_course_chart_tick_labels_stay_inside_its_canvas(
-    chromium_browser: Any, viewport: tuple[int, int]
-) -> None:
+def test_the_course_chart_tick_labels_stay_inside_its_canvas(chromium_browser: Any, viewport: tuple[int, int]) -> None:
     from helpers.browser import (
         assert_chart_shows_its_data,
         assert_tick_labels_inside,
@@ -105,9 +99,7 @@ def test_the_course_chart_tick_labels_stay_inside_its_canvas(
         assert isinstance(scene, PelotonScene)
         mode = scene.course_mode
         shown.page.get_by_text("Ride a course", exact=True).first.click()
-        wait_until(
-            lambda: mode.enabled and mode.state is not None, "course mode on", timeout_s=15.0
-        )
+        wait_until(lambda: mode.enabled and mode.state is not None, "course mode on", timeout_s=15.0)
         # The sample climb tops out at 1815 m: the "2,000" tick sits at the plot's top (its label was cut).
         with scene._lock:
             data = mode.chart.data

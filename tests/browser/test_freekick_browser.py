@@ -132,9 +132,7 @@ def test_ten_percent_more_spin_moves_the_path_on_the_screen(shown: ScenePage) ->
         spin = scene.params.spin_rev_s
     was = project(shown.page, "/freekick", before)[:, :2]
     set_number(shown.page, "Spin rate (rev/s)", round(1.1 * spin, 1))
-    wait_until(
-        lambda: scene.params.spin_rev_s == round(1.1 * spin, 1), "the new spin to reach the scene"
-    )
+    wait_until(lambda: scene.params.spin_rev_s == round(1.1 * spin, 1), "the new spin to reach the scene")
     settle(shown)
     with scene._lock:
         after = resample(scene.state.flight, 40)
@@ -147,12 +145,9 @@ def test_ten_percent_more_spin_moves_the_path_on_the_screen(shown: ScenePage) ->
     image = screenshot(shown.page)
     samples = now[20:-2:2]
     drawn = [
-        colour_pixels(image[int(y) - 4 : int(y) + 5, int(x) - 4 : int(x) + 5], PATH_COLOUR, 70) > 0
-        for x, y in samples
+        colour_pixels(image[int(y) - 4 : int(y) + 5, int(x) - 4 : int(x) + 5], PATH_COLOUR, 70) > 0 for x, y in samples
     ]
-    assert np.mean(drawn) > 0.7, (
-        f"the path shows at only {sum(drawn)} of {len(drawn)} places"
-    )  # arrows cross it
+    assert np.mean(drawn) > 0.7, f"the path shows at only {sum(drawn)} of {len(drawn)} places"  # arrows cross it
     assert error_text(shown.page) == []
 
 
@@ -167,9 +162,7 @@ def test_every_camera_view_keeps_the_kick_in_view(shown: ScenePage) -> None:
         frames = scene.framing.frames
         scene.controls["view"].value = VIEW_LABELS[view]  # type: ignore[index]
         wait_until(
-            lambda view=view, frames=frames: (
-                scene.params.view == view and scene.framing.frames > frames
-            ),
+            lambda view=view, frames=frames: scene.params.view == view and scene.framing.frames > frames,
             f"the {view} view",
         )
         settle(shown)
@@ -214,9 +207,7 @@ def test_every_camera_view_keeps_the_kick_in_view(shown: ScenePage) -> None:
         assert not over_ball.any(), f"the goal is drawn over the ball at {x, y}"
 
 
-def test_pressing_kick_flies_the_ball_in_the_page(
-    server: viser.ViserServer, browser_page: Any
-) -> None:
+def test_pressing_kick_flies_the_ball_in_the_page(server: viser.ViserServer, browser_page: Any) -> None:
     switcher = SceneSwitcher(server, "freekick")
     try:
         scene = switcher.scene
@@ -225,9 +216,7 @@ def test_pressing_kick_flies_the_ball_in_the_page(
         open_viser(page, server.get_port(), BALL)
         close_notifications(page)
         spot_x = float(ball_spot(scene.params)[0])
-        page.wait_for_function(
-            f"() => Math.abs({NODE}.position.x - ({spot_x})) < 1e-3", timeout=20_000
-        )
+        page.wait_for_function(f"() => Math.abs({NODE}.position.x - ({spot_x})) < 1e-3", timeout=20_000)
 
         # Record what the page draws, every animation frame, from before the click on.
         page.evaluate(

@@ -92,9 +92,7 @@ def _look_at_the_line(shown: ScenePage) -> None:
             )
     for x, y in corners:
         box = image[max(int(y) - 40, 0) : int(y) + 10, int(x) - 10 : int(x + reach_x)]
-        assert np.count_nonzero(box.max(axis=-1) < 120) > 10, (
-            f"no label text near ({x:.0f}, {y:.0f})"
-        )
+        assert np.count_nonzero(box.max(axis=-1) < 120) > 10, f"no label text near ({x:.0f}, {y:.0f})"
 
 
 def test_the_line_is_in_view_clear_of_the_panel(shown: ScenePage) -> None:
@@ -114,9 +112,7 @@ def test_eight_riders_far_apart_stay_in_view(shown: ScenePage) -> None:
     scene = shown.scene
     set_number(shown.page, "Riders", 8)
     set_number(shown.page, "Gap (m)", 6)
-    wait_until(
-        lambda: scene.params.n_riders == 8 and scene.params.gap_m == 6.0, "8 riders, 6 m apart"
-    )
+    wait_until(lambda: scene.params.n_riders == 8 and scene.params.gap_m == 6.0, "8 riders, 6 m apart")
     settle(shown)
     _look_at_the_line(shown)
     assert error_text(shown.page) == []
@@ -126,9 +122,7 @@ def test_more_speed_lifts_the_now_line_and_the_bars(shown: ScenePage) -> None:
     scene = shown.scene
 
     def red_row() -> float:
-        rows = np.nonzero(
-            np.linalg.norm(chart_image(shown.page, CHART).astype(float) - NOW_RED, axis=-1) < 40
-        )[0]
+        rows = np.nonzero(np.linalg.norm(chart_image(shown.page, CHART).astype(float) - NOW_RED, axis=-1) < 40)[0]
         assert len(rows) > 20
         return float(np.median(rows))
 

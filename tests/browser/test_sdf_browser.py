@@ -63,9 +63,7 @@ READ_IMAGE = """
 """
 
 
-def test_browser_shows_the_mesh_and_the_reference_image(
-    server: viser.ViserServer, browser_page: Any
-) -> None:
+def test_browser_shows_the_mesh_and_the_reference_image(server: viser.ViserServer, browser_page: Any) -> None:
     need_gl()
     switcher = SceneSwitcher(server, "sdf")
     scene = switcher.scene
@@ -99,12 +97,8 @@ def test_browser_shows_the_mesh_and_the_reference_image(
         while time.monotonic() < deadline:
             expected = scene.reference_rgb
             height, width = expected.shape[:2]
-            handle = page.wait_for_function(
-                f"({READ_IMAGE})([{width}, {height}])", timeout=30_000, polling=200
-            )
-            shown = np.asarray(handle.json_value(), dtype=np.uint8).reshape(height, width, 4)[
-                ..., :3
-            ]
+            handle = page.wait_for_function(f"({READ_IMAGE})([{width}, {height}])", timeout=30_000, polling=200)
+            shown = np.asarray(handle.json_value(), dtype=np.uint8).reshape(height, width, 4)[..., :3]
             if np.array_equal(shown, scene.reference_rgb):
                 break
             time.sleep(0.2)
@@ -144,9 +138,7 @@ def wait_for_green(page: Any, pixels: int = 5000, timeout_s: float = 30.0) -> np
     return mask
 
 
-def test_typed_shape_is_meshed_and_ray_marched_in_the_main_view(
-    server: viser.ViserServer, browser_page: Any
-) -> None:
+def test_typed_shape_is_meshed_and_ray_marched_in_the_main_view(server: viser.ViserServer, browser_page: Any) -> None:
     from kernels import sdf
 
     need_gl()
@@ -157,18 +149,14 @@ def test_typed_shape_is_meshed_and_ray_marched_in_the_main_view(
     try:
         page.set_viewport_size({"width": 1600, "height": 1000})
         open_viser(page, server.get_port(), "/sdf/mesh")
-        page.locator(
-            'text="GLSL editor" >> visible=true'
-        ).first.click()  # the folder, not the About text
+        page.locator('text="GLSL editor" >> visible=true').first.click()  # the folder, not the About text
         editor = page.locator("textarea").filter(has_text="sdf(vec3 p)").first
         editor.fill(OCTAHEDRON)
         page.get_by_role("button", name="Apply").click()
         deadline = time.monotonic() + 60
         while scene.editor_serial == 0 and time.monotonic() < deadline:
             time.sleep(0.05)
-        assert (
-            scene.editor_serial == 1 and scene.params.editor.source == OCTAHEDRON.strip("\n") + "\n"
-        )
+        assert scene.editor_serial == 1 and scene.params.editor.source == OCTAHEDRON.strip("\n") + "\n"
         # Meshed: every vertex on the octahedron the person typed.
         d = sdf.sd_octahedron(scene.mesh_vertices - [0.0, 0.0, 0.4], 0.7)
         assert len(d) > 500 and np.abs(d).max() < 0.02
@@ -179,14 +167,10 @@ def test_typed_shape_is_meshed_and_ray_marched_in_the_main_view(
         # Ray-marched: the same green shape, now from the shader, with the mesh hidden.
         page.locator("input[value='Mesh']").first.click()
         page.get_by_role("option", name="Ray-marched").click()
-        page.wait_for_function(
-            "() => !window.__viserMutable.nodeRefFromName['/sdf/mesh'].visible", timeout=30_000
-        )
+        page.wait_for_function("() => !window.__viserMutable.nodeRefFromName['/sdf/mesh'].visible", timeout=30_000)
         deadline = time.monotonic() + 60
         # The frame at rest: the canvas's width (at least 640 px; a moving frame is 320).
-        while time.monotonic() < deadline and not (
-            scene.view_rgb is not None and scene.view_rgb.shape[1] >= 640
-        ):
+        while time.monotonic() < deadline and not (scene.view_rgb is not None and scene.view_rgb.shape[1] >= 640):
             time.sleep(0.05)
         assert scene.view_rgb is not None and scene.view_rgb.shape[1] >= 640
         marched_green = wait_for_green(page)

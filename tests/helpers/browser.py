@@ -171,9 +171,7 @@ def colour_pixels(image: NDArray[np.uint8], rgb: Sequence[int], tolerance: float
     return int(np.count_nonzero(distance <= tolerance))
 
 
-def changed_mask(
-    a: NDArray[np.uint8], b: NDArray[np.uint8], threshold: int = 24
-) -> NDArray[np.bool_]:
+def changed_mask(a: NDArray[np.uint8], b: NDArray[np.uint8], threshold: int = 24) -> NDArray[np.bool_]:
     """(H, W) pixels whose colour differs by more than ``threshold`` in some channel."""
     return np.abs(a.astype(np.int16) - b.astype(np.int16)).max(axis=-1) > threshold
 
@@ -203,9 +201,7 @@ def with_nodes_hidden(page: Any, names: Iterable[str]) -> NDArray[np.uint8]:
     image = screenshot(page)
     page.evaluate(HIDE, {"names": names, "hide": False})
     wait_frames(page, 3)
-    assert drawn_width(page) == width, (
-        "the drawing resolution changed: open the page with open_viser"
-    )
+    assert drawn_width(page) == width, "the drawing resolution changed: open the page with open_viser"
     return image
 
 
@@ -266,9 +262,7 @@ def scene_page(context: Any, key: str, viewport: tuple[int, int]) -> Iterator[Sc
     server = app.make_server("127.0.0.1", 0, verbose=False)
     switcher = SceneSwitcher(server, key)
     page = context.new_page()
-    page.set_default_timeout(
-        90_000
-    )  # software WebGL on two busy cores: a screenshot can take many seconds
+    page.set_default_timeout(90_000)  # software WebGL on two busy cores: a screenshot can take many seconds
     try:
         page.set_viewport_size({"width": viewport[0], "height": viewport[1]})
         open_viser(page, server.get_port(), f"/{key}")
@@ -296,9 +290,7 @@ def settle(shown: ScenePage, timeout_s: float = 30.0) -> None:
     client_ids = list(shown.server.get_clients())
     deadline = time.monotonic() + timeout_s
     last, still = None, 0
-    while (
-        time.monotonic() < deadline and still < 3
-    ):  # the same pose over three drawn frames, not one glance
+    while time.monotonic() < deadline and still < 3:  # the same pose over three drawn frames, not one glance
         now = shown.page.evaluate(
             "() => [...window.__viserMutable.camera.position.toArray(),"
             " ...window.__viserMutable.camera.quaternion.toArray()]"
@@ -312,9 +304,7 @@ def settle(shown: ScenePage, timeout_s: float = 30.0) -> None:
     wait_frames(shown.page, 3)
 
 
-def assert_in_view(
-    shown: ScenePage, frame: str, points: NDArray[np.float64], what: str
-) -> NDArray[np.float64]:
+def assert_in_view(shown: ScenePage, frame: str, points: NDArray[np.float64], what: str) -> NDArray[np.float64]:
     """Assert that ``points`` (in node ``frame``'s coordinates) project inside the page and left of the panel.
 
     Returns their (N, 2) CSS positions.
@@ -387,19 +377,13 @@ def assert_seen(
     x1, y1 = np.ceil(xy.max(axis=0)).astype(int) + 4
     inside = covered[max(y0, 0) : max(y1, 0), max(x0, 0) : max(x1, 0)].sum()
     area = max((x1 - x0) * (y1 - y0), 1)
-    assert inside > 200 and inside > 0.005 * area, (
-        f"{what}: only {inside} px of its {area} px box show it"
-    )
+    assert inside > 200 and inside > 0.005 * area, f"{what}: only {inside} px of its {area} px box show it"
     outside = covered.sum() - inside
-    assert outside <= max_outside * covered.sum(), (
-        f"{what}: {outside} of {covered.sum()} px drawn outside its box"
-    )
+    assert outside <= max_outside * covered.sum(), f"{what}: {outside} of {covered.sum()} px drawn outside its box"
     return covered
 
 
-def assert_chart_draws(
-    page: Any, title: str, colours: dict[str, Sequence[int]], min_px: int = 25
-) -> None:
+def assert_chart_draws(page: Any, title: str, colours: dict[str, Sequence[int]], min_px: int = 25) -> None:
     """Assert that the plot area of chart ``title`` shows every series' colour (at least ``min_px`` pixels)."""
     image = chart_image(page, title)
     counts = {name: colour_pixels(image, rgb) for name, rgb in colours.items()}
@@ -529,21 +513,16 @@ def assert_tick_labels_inside(page: Any, title: str, border_px: int = 2) -> None
         f"{box['text']!r} (axis {box['axis']}: x {box['left']:.1f}..{box['right']:.1f}, "
         f"y {box['top']:.1f}..{box['bottom']:.1f})"
         for box in layout["boxes"]
-        if min(box["left"], box["top"]) < inside
-        or box["right"] > width - inside
-        or box["bottom"] > height - inside
+        if min(box["left"], box["top"]) < inside or box["right"] > width - inside or box["bottom"] > height - inside
     ]
     assert layout["boxes"], f"chart {title!r}: no tick labels drawn"
     assert not any(box["rotated"] for box in layout["boxes"]), "rotated tick labels: not measured"
-    assert not outside, (
-        f"chart {title!r} ({width}×{height} canvas px): labels cut at the edge: {outside}"
-    )
+    assert not outside, f"chart {title!r} ({width}×{height} canvas px): labels cut at the edge: {outside}"
     image = chart_canvas_image(page, title)
     ring = np.ones(image.shape[:2], dtype=bool)
     ring[border_px:-border_px, border_px:-border_px] = False
     touching = {
-        colour: colour_pixels(image[ring], _css_rgb(colour), tolerance=30.0)
-        for colour in set(layout["stroke"])
+        colour: colour_pixels(image[ring], _css_rgb(colour), tolerance=30.0) for colour in set(layout["stroke"])
     }
     assert not any(touching.values()), (
         f"chart {title!r}: axis-text pixels on the canvas's outer {border_px} px: {touching}"

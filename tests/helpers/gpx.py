@@ -25,9 +25,7 @@ def line_points(n: int, step_deg: float = 1e-4) -> list[tuple[float, float, floa
 
 
 def hill_gpx(name: str = "Test hill", n: int = 300) -> bytes:
-    points = [
-        (45.0 + i * 1e-4, 6.0 + i * 5e-5, 200.0 + 40.0 * math.sin(i / 40.0)) for i in range(n)
-    ]
+    points = [(45.0 + i * 1e-4, 6.0 + i * 5e-5, 200.0 + 40.0 * math.sin(i / 40.0)) for i in range(n)]
     return gpx_text(points).replace("<name>t</name>", f"<name>{name}</name>").encode()
 
 
@@ -43,8 +41,11 @@ BAD_FILES = {
     "no elevation": (gpx_text([(45.0 + i * 1e-4, 6.0, None) for i in range(5)]), "no elevation"),
     "some elevation missing": (gpx_text([(45.0, 6.0, 1.0), (45.001, 6.0, None), (45.002, 6.0, 3.0)]), "1 of 3"),
     "nan latitude": (gpx_text([(45.0, 6.0, 1.0), (float("nan"), 6.0, 2.0)]), "point 2 has latitude nan, not a number"),
-    "inf elevation": (gpx_text([(45.0, 6.0, 1.0), (45.001, 6.0, float("inf"))]), "point 2 has elevation inf, not a number"),
+    "inf elevation": (
+        gpx_text([(45.0, 6.0, 1.0), (45.001, 6.0, float("inf"))]),
+        "point 2 has elevation inf, not a number",
+    ),
     "latitude out of range": (gpx_text([(45.0, 6.0, 1.0), (95.0, 6.0, 2.0)]), "latitude"),
     "bad number": (gpx_text([(45.0, 6.0, 1.0)]).replace('lat="45.0"', 'lat="abc"'), "not a valid GPX"),
     "elevation absurd": (gpx_text([(45.0, 6.0, 1.0), (45.001, 6.0, 1e7)]), "elevation"),
-}  # fmt: skip
+}

@@ -51,6 +51,4 @@ def pinhole_ndc(
     rel = points - position
     depth = rel @ d
     tan_y = math.tan(fov_rad / 2)
-    return np.stack(
-        [(rel @ right) / (depth * tan_y * aspect), (rel @ up) / (depth * tan_y), depth], axis=1
-    )
+    return np.stack([(rel @ right) / (depth * tan_y * aspect), (rel @ up) / (depth * tan_y), depth], axis=1)

@@ -8,9 +8,7 @@ from typing import Any
 from helpers.wsclient import BrowserClient
 
 
-def upload(
-    client: BrowserClient, label: str, filename: str, data: bytes, part: int = 64_000
-) -> None:
+def upload(client: BrowserClient, label: str, filename: str, data: bytes, part: int = 64_000) -> None:
     """What the browser sends when a person picks a file for the upload button ``label``."""
     source = client.uuid_of(label)
     transfer = str(uuid.uuid4())
@@ -46,7 +44,5 @@ def send_part(client: BrowserClient, transfer: str, index: int, content: Any) ->
 
 def notices(client: BrowserClient) -> list[dict[str, Any]]:
     return [
-        message["props"]
-        for _at, message in list(client.received)
-        if message.get("type") == "NotificationShowMessage"
+        message["props"] for _at, message in list(client.received) if message.get("type") == "NotificationShowMessage"
     ]

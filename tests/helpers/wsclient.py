@@ -35,9 +35,7 @@ def decode_frame(frame: bytes) -> list[dict[str, Any]]:
     """Decode one server → client websocket frame into its list of message dicts (arrays as numpy)."""
     inner_size = int.from_bytes(frame[0:8], "little")
     compressed_size = int.from_bytes(frame[8:16], "little")
-    inner = zstandard.ZstdDecompressor().decompress(
-        frame[16 : 16 + compressed_size], max_output_size=inner_size
-    )
+    inner = zstandard.ZstdDecompressor().decompress(frame[16 : 16 + compressed_size], max_output_size=inner_size)
     payload = msgspec.msgpack.decode(inner)
     buffers: list[bytes] = []
     offset = 16 + compressed_size
@@ -152,9 +150,7 @@ class BrowserClient:
             self.nodes[message["name"]] = dict(message)
 
     # ------------------------------------------------------------------------------------------ waiting
-    def wait_for(
-        self, predicate: Callable[[], bool], timeout: float = 10.0, what: str = "condition"
-    ) -> None:
+    def wait_for(self, predicate: Callable[[], bool], timeout: float = 10.0, what: str = "condition") -> None:
         """Block until ``predicate()`` is true (checked whenever messages arrive); AssertionError on timeout."""
         deadline = time.monotonic() + timeout
         with self._lock:
@@ -286,9 +282,7 @@ class BrowserClient:
         owner = str(self.wait_for_node(name).get("owner", "") or "")
         self.send("TransformControlsDragStartMessage", name=name, owner=owner)
         for position in positions:
-            with (
-                self._lock
-            ):  # the browser shows the gizmo where the mouse put it, as the real one does
+            with self._lock:  # the browser shows the gizmo where the mouse put it, as the real one does
                 self.nodes[name]["position"] = position
                 self.nodes[name]["wxyz"] = wxyz
             self.send(
@@ -313,13 +307,9 @@ class BrowserClient:
         with self._lock:
             self.nodes[name]["position"] = position
             self.nodes[name]["wxyz"] = wxyz
-        self.send(
-            "TransformControlsUpdateMessage", name=name, wxyz=wxyz, position=position, owner=owner
-        )
+        self.send("TransformControlsUpdateMessage", name=name, wxyz=wxyz, position=position, owner=owner)
 
-    def click_scene(
-        self, ray_origin: tuple[float, float, float], ray_direction: tuple[float, float, float]
-    ) -> None:
+    def click_scene(self, ray_origin: tuple[float, float, float], ray_direction: tuple[float, float, float]) -> None:
         """A click in the 3D view along the given world ray."""
         self.send(
             "ScenePointerMessage",

@@ -123,9 +123,7 @@ def test_no_air_gives_the_exact_parabola_and_the_seed_euler_its_known_offset() -
 
 def test_drag_alone_decays_speed_exponentially_with_distance() -> None:
     v0 = 30.0
-    flight = ball.simulate(
-        START, (v0, 0.0, 0.0), (0, 0, 0), dt=2e-3, method="rk4", gravity=0.0, t_max=3.0
-    )
+    flight = ball.simulate(START, (v0, 0.0, 0.0), (0, 0, 0), dt=2e-3, method="rk4", gravity=0.0, t_max=3.0)
     k = RHO * AREA * 0.25 / (2 * M)
     distance = flight.position[:, 0]
     speed = np.linalg.norm(flight.velocity, axis=1)
@@ -159,9 +157,7 @@ def test_constant_lift_and_drag_without_gravity_fly_a_circle() -> None:
     model=st.sampled_from(["constant", "measured"]),
 )
 @settings(max_examples=25, deadline=None)
-def test_zero_spin_never_curls(
-    speed: float, elevation: float, azimuth: float, model: ball.Model
-) -> None:
+def test_zero_spin_never_curls(speed: float, elevation: float, azimuth: float, model: ball.Model) -> None:
     v0 = kick(speed, elevation, azimuth)
     flight = ball.simulate(START, v0, (0, 0, 0), dt=1e-2, method="rk4", model=model)
     across = np.array([-math.sin(math.radians(azimuth)), math.cos(math.radians(azimuth)), 0.0])
@@ -170,9 +166,7 @@ def test_zero_spin_never_curls(
 
 
 # ------------------------------------------------------------------------------------------------ directions and sizes
-def flight_at(
-    x_line: float, velocity: NDArray[np.float64], spin: NDArray[np.float64], **kw: object
-):
+def flight_at(x_line: float, velocity: NDArray[np.float64], spin: NDArray[np.float64], **kw: object):
     return ball.simulate(START, velocity, spin, dt=1e-2, method="rk4", x_stop=x_line, **kw)  # type: ignore[arg-type]
 
 
@@ -188,9 +182,7 @@ def test_sidespin_about_plus_z_curls_left_topspin_dips_backspin_floats() -> None
 
 
 @pytest.mark.parametrize(("speed", "rev_s"), [(25.0, 8.0), (30.0, 10.0), (27.0, 9.0)])
-def test_seed_claim_of_3_to_5_m_sideways_over_25_m_holds_with_the_corrected_force(
-    speed: float, rev_s: float
-) -> None:
+def test_seed_claim_of_3_to_5_m_sideways_over_25_m_holds_with_the_corrected_force(speed: float, rev_s: float) -> None:
     v0 = kick(speed, 16.0)
     curl = flight_at(25.0, v0, ball.spin_vector(rev_s, (0, 0, 1)))
     assert curl.ended == "x_stop"
@@ -202,19 +194,13 @@ def test_measured_coefficients_match_goff_and_carre_and_the_lift_slope() -> None
     v0 = np.array([speed, 0.0, 0.0])
     dynamic = 0.5 * RHO * AREA * speed**2
     still = ball.simulate(START, v0, np.zeros(3), model="measured", t_max=0.01)
-    assert np.linalg.norm(still.drag[0]) / dynamic == pytest.approx(
-        0.155, abs=2e-4
-    )  # supercritical, no spin
+    assert np.linalg.norm(still.drag[0]) / dynamic == pytest.approx(0.155, abs=2e-4)  # supercritical, no spin
     slow = ball.simulate(START, (8.0, 0.0, 0.0), np.zeros(3), model="measured", t_max=0.01)
-    assert np.linalg.norm(slow.drag[0]) / (0.5 * RHO * AREA * 64) == pytest.approx(
-        0.49, abs=0.01
-    )  # subcritical
+    assert np.linalg.norm(slow.drag[0]) / (0.5 * RHO * AREA * 64) == pytest.approx(0.49, abs=0.01)  # subcritical
     spin = ball.spin_vector(8.0, (0, 0, 1))
     s_param = R * 2 * math.pi * 8.0 / speed
     spinning = ball.simulate(START, v0, spin, model="measured", t_max=0.01)
-    assert np.linalg.norm(spinning.drag[0]) / dynamic == pytest.approx(
-        0.4127 * s_param**0.3056, rel=1e-9
-    )
+    assert np.linalg.norm(spinning.drag[0]) / dynamic == pytest.approx(0.4127 * s_param**0.3056, rel=1e-9)
     assert np.linalg.norm(spinning.magnus[0]) / dynamic == pytest.approx(0.9 * s_param, rel=1e-9)
 
 
@@ -229,13 +215,7 @@ def test_a_tenth_more_spin_changes_the_flight_only_in_the_measured_model() -> No
 def test_forces_are_sampled_with_the_flight() -> None:
     flight = ball.simulate(START, kick(25.0, 15.0), ball.spin_vector(8.0, (0, 0, 1)), dt=1e-3)
     n = len(flight.t)
-    assert (
-        flight.position.shape
-        == flight.drag.shape
-        == flight.magnus.shape
-        == flight.gravity.shape
-        == (n, 3)
-    )
+    assert flight.position.shape == flight.drag.shape == flight.magnus.shape == flight.gravity.shape == (n, 3)
     np.testing.assert_allclose(np.diff(flight.t[:-1]), 1e-3, rtol=1e-9)
     assert 0.0 < flight.t[-1] - flight.t[-2] <= 1e-3
     assert flight.ended == "ground" and flight.position[-1, 2] == 0.0
@@ -250,9 +230,7 @@ def test_forces_are_sampled_with_the_flight() -> None:
 # ------------------------------------------------------------------------------------------------ outcomes
 def judge(speed: float, elevation: float, azimuth: float, rev_s: float = 0.0) -> ball.Outcome:
     spin = ball.spin_vector(rev_s, (0, 0, 1))
-    flight = ball.simulate(
-        START, kick(speed, elevation, azimuth), spin, dt=1e-2, method="rk4", ground_m=R
-    )
+    flight = ball.simulate(START, kick(speed, elevation, azimuth), spin, dt=1e-2, method="rk4", ground_m=R)
     return ball.outcome(flight, WALL, GOAL)
 
 
@@ -264,18 +242,12 @@ def test_outcomes_of_hand_made_kicks() -> None:
     assert over.result == "over" and over.goal_point is not None and over.goal_point[2] > 2.44
     wide = judge(25.0, 17.0, 12.0)
     assert wide.result == "wide" and wide.goal_point is not None and abs(wide.goal_point[1]) > 3.66
-    curler = judge(
-        25.0, 17.0, -9.0, rev_s=8.0
-    )  # round the wall's right end, curled back inside the near post
+    curler = judge(25.0, 17.0, -9.0, rev_s=8.0)  # round the wall's right end, curled back inside the near post
     assert curler.result == "goal"
     assert curler.wall_point is not None and curler.goal_point is not None
     assert curler.wall_point[2] > 1.8 + R or abs(curler.wall_point[1]) > 1.0 + R
     assert abs(curler.goal_point[1]) < 3.66 - R and curler.goal_point[2] < 2.44 - R
-    assert (
-        curler.goal_time is not None
-        and curler.wall_time is not None
-        and curler.goal_time > curler.wall_time
-    )
+    assert curler.goal_time is not None and curler.wall_time is not None and curler.goal_time > curler.wall_time
     short = judge(12.0, 20.0, 0.0)
     assert short.result == "short" and short.goal_point is None
 
@@ -284,12 +256,8 @@ def test_wall_clearance_counts_the_ball_radius_and_the_jump() -> None:
     wall_point = judge(25.0, 16.0, 0.0).wall_point
     assert wall_point is not None
     clearance = wall_point[2] - R  # underside of the ball above the ground at the wall
-    low_wall, _ = ball.free_kick_panels(
-        (0.0, 0.0), (25.0, 0.0), (1.0, 0.0), wall_height_m=clearance - 0.01
-    )
-    high_wall, _ = ball.free_kick_panels(
-        (0.0, 0.0), (25.0, 0.0), (1.0, 0.0), wall_height_m=clearance + 0.01
-    )
+    low_wall, _ = ball.free_kick_panels((0.0, 0.0), (25.0, 0.0), (1.0, 0.0), wall_height_m=clearance - 0.01)
+    high_wall, _ = ball.free_kick_panels((0.0, 0.0), (25.0, 0.0), (1.0, 0.0), wall_height_m=clearance + 0.01)
     flight = ball.simulate(START, kick(25.0, 16.0), np.zeros(3), dt=1e-2, method="rk4", ground_m=R)
     assert ball.outcome(flight, low_wall, GOAL).result != "wall"
     assert ball.outcome(flight, high_wall, GOAL).result == "wall"
@@ -335,9 +303,7 @@ def test_knuckle_force_needs_near_zero_spin() -> None:
     ],
 )
 def test_batch_equals_single_runs(method: ball.Method, dt: float, model: ball.Model) -> None:
-    velocities = np.array(
-        [kick(25, 16, -9), kick(30, 30, 0), kick(12, 20, 0), kick(25, 12, 0), kick(20, 8, 2)]
-    )
+    velocities = np.array([kick(25, 16, -9), kick(30, 30, 0), kick(12, 20, 0), kick(25, 12, 0), kick(20, 8, 2)])
     spins = np.array(
         [
             ball.spin_vector(8, (0, 0, 1)),
@@ -436,9 +402,7 @@ def reference_acceleration(
     v: NDArray[np.float64], t: float, spin: NDArray[np.float64], model: str, knuckle: tuple | None
 ) -> NDArray[np.float64]:
     speed = float(np.linalg.norm(v))
-    scale = float(
-        np.abs(spin).max()
-    )  # |ω| and ω̂ without under- or overflow: ω̂ is a unit vector for any ω ≠ 0
+    scale = float(np.abs(spin).max())  # |ω| and ω̂ without under- or overflow: ω̂ is a unit vector for any ω ≠ 0
     rate = scale * float(np.linalg.norm(spin / scale)) if scale > 0 else 0.0
     axis = spin / scale / (rate / scale) if rate > 0 else np.zeros(3)
     if model == "constant":
@@ -470,9 +434,7 @@ def reference_knuckle(v0: NDArray[np.float64], spin: NDArray[np.float64], seed: 
     return weight, 2 * math.pi * speed / 15.0, theta, phi1, phi2, n1, np.cross(along, n1)
 
 
-def reference_flight(
-    p0, v0, spin, *, dt, method, model, t_max, seed=None, ground=0.0, x_stop=math.inf
-):
+def reference_flight(p0, v0, spin, *, dt, method, model, t_max, seed=None, ground=0.0, x_stop=math.inf):
     """(t, states (N, 6)) of the steps before the flight ends, and the (old, new, h) states of the last step.
 
     Every step is dt but the last, which ends on t_max.
@@ -525,12 +487,8 @@ def hermite_root(d0: float, dd0: float, d1: float, dd1: float, h: float) -> floa
     # h00 = 2s³ − 3s² + 1, h10 = s³ − 2s² + s, h01 = −2s³ + 3s², h11 = s³ − s².
     a, b = h * dd0, h * dd1
     coefficients = [2 * d0 + a - 2 * d1 + b, -3 * d0 - 2 * a + 3 * d1 - b, a, d0]
-    roots = [
-        r.real for r in np.roots(coefficients) if abs(r.imag) < 1e-9 and -1e-9 <= r.real <= 1 + 1e-9
-    ]
-    if (
-        d0 == 0.0 and dd0 > 0.0
-    ):  # (a rise far below 1e-12 of the step lands "at once": either root will do)
+    roots = [r.real for r in np.roots(coefficients) if abs(r.imag) < 1e-9 and -1e-9 <= r.real <= 1 + 1e-9]
+    if d0 == 0.0 and dd0 > 0.0:  # (a rise far below 1e-12 of the step lands "at once": either root will do)
         roots = [r for r in roots if r > 1e-12] or roots
     return min(roots)
 
@@ -570,13 +528,29 @@ def test_every_sample_matches_a_plain_reference_of_the_equations(
         dt /= 8
     seed, model = kick_settings_["seed"], kick_settings_["model"]
     flight = ball.simulate(
-        START, velocity, spin, dt=dt, method=method, model=model, t_max=2.5,  # type: ignore[arg-type]
-        x_stop=x_stop, ground_m=R, knuckle_seed=seed,
-    )  # fmt: skip
+        START,
+        velocity,
+        spin,
+        dt=dt,
+        method=method,
+        model=model,
+        t_max=2.5,  # type: ignore[arg-type]
+        x_stop=x_stop,
+        ground_m=R,
+        knuckle_seed=seed,
+    )
     t, states, last = reference_flight(
-        START, velocity, spin, dt=dt, method=method, model=model, t_max=2.5, seed=seed, ground=R,
+        START,
+        velocity,
+        spin,
+        dt=dt,
+        method=method,
+        model=model,
+        t_max=2.5,
+        seed=seed,
+        ground=R,
         x_stop=math.inf if x_stop is None else x_stop,
-    )  # fmt: skip
+    )
     n = len(t)
     assert len(flight.t) == n + (last is not None)
     np.testing.assert_allclose(flight.t[:n], t, rtol=1e-12, atol=1e-15)
@@ -597,22 +571,16 @@ def test_every_sample_matches_a_plain_reference_of_the_equations(
     assert flight.t[-1] == pytest.approx(t[-1] + s * h, abs=1e-9)
     expected = hermite(old[:3], old[3:], new[:3], new[3:], h, s)
     np.testing.assert_allclose(flight.position[-1], expected, atol=1e-8)
-    assert flight.position[-1, 2 if ended == "ground" else 0] == (
-        R if ended == "ground" else x_stop
-    )
+    assert flight.position[-1, 2 if ended == "ground" else 0] == (R if ended == "ground" else x_stop)
     # Forces along the flight are the reference's accelerations times the mass.
     knuckle = reference_knuckle(velocity, spin, seed)
     total = flight.drag + flight.magnus + flight.gravity + flight.knuckle
     for i in (0, n // 2, len(flight.t) - 1):
-        expected_force = M * reference_acceleration(
-            flight.velocity[i], flight.t[i], spin, model, knuckle
-        )
+        expected_force = M * reference_acceleration(flight.velocity[i], flight.t[i], spin, model, knuckle)
         np.testing.assert_allclose(total[i], expected_force, rtol=1e-9, atol=1e-12)
 
 
-def reference_outcome(
-    flight: ball.Trajectory, wall: ball.Panel, goal: ball.Panel, radius: float = R
-):
+def reference_outcome(flight: ball.Trajectory, wall: ball.Panel, goal: ball.Panel, radius: float = R):
     """(result, wall point, goal point, margin): the docstring's rules on the first crossing of each plane."""
     points = []
     for panel in (wall, goal):
@@ -644,10 +612,7 @@ def reference_outcome(
             abs(abs(wall_lateral) - (wall.width_m / 2 + radius)),
             abs(wall_point[2] - (wall.height_m + radius)),
         ]
-        if (
-            abs(wall_lateral) <= wall.width_m / 2 + radius
-            and wall_point[2] <= wall.height_m + radius
-        ):
+        if abs(wall_lateral) <= wall.width_m / 2 + radius and wall_point[2] <= wall.height_m + radius:
             return "wall", wall_point, goal_point, min(margins)
     if goal_point is None:
         return "short", wall_point, goal_point, min(margins)
@@ -666,9 +631,7 @@ def reference_outcome(
     )
 
 
-@given(
-    kick_settings_=kick_settings, wall_height=st.floats(1.0, 2.4), wall_offset=st.floats(-2.0, 2.0)
-)
+@given(kick_settings_=kick_settings, wall_height=st.floats(1.0, 2.4), wall_offset=st.floats(-2.0, 2.0))
 @settings(max_examples=40, deadline=None)
 def test_outcome_matches_the_rules_applied_by_a_plain_reference(
     kick_settings_: dict, wall_height: float, wall_offset: float
@@ -678,9 +641,17 @@ def test_outcome_matches_the_rules_applied_by_a_plain_reference(
         (0.0, 0.0), (22.0, 0.0), (1.0, 0.0), wall_height_m=wall_height, wall_offset_m=wall_offset
     )
     flight = ball.simulate(
-        START, velocity, spin, dt=1e-2, method="rk4", model=kick_settings_["model"], t_max=4.0,
-        x_stop=23.0, ground_m=R, knuckle_seed=kick_settings_["seed"],
-    )  # fmt: skip
+        START,
+        velocity,
+        spin,
+        dt=1e-2,
+        method="rk4",
+        model=kick_settings_["model"],
+        t_max=4.0,
+        x_stop=23.0,
+        ground_m=R,
+        knuckle_seed=kick_settings_["seed"],
+    )
     result, wall_point, goal_point, margin = reference_outcome(flight, wall, goal)
     judged = ball.outcome(flight, wall, goal)
     if margin > 1e-9:  # a crossing within rounding of an edge may fall either way
@@ -699,8 +670,12 @@ def straight_flight(y: float, z: float) -> ball.Trajectory:
         t=np.array([0.0, 1.0]),
         position=np.array([[-1.0, y, z], [1.0, y, z]]),
         velocity=np.array([[2.0, 0.0, 0.0], [2.0, 0.0, 0.0]]),
-        drag=zeros, magnus=zeros, gravity=zeros, knuckle=zeros, ended="x_stop",
-    )  # fmt: skip
+        drag=zeros,
+        magnus=zeros,
+        gravity=zeros,
+        knuckle=zeros,
+        ended="x_stop",
+    )
 
 
 def test_values_exactly_on_the_post_and_bar_thresholds() -> None:
@@ -713,9 +688,7 @@ def test_values_exactly_on_the_post_and_bar_thresholds() -> None:
     assert ball.outcome(straight_flight(0.0, math.nextafter(bar, 9.0)), wall, goal).result == "over"
     assert ball.outcome(straight_flight(post, 1.0), wall, goal).result == "goal"
     assert ball.outcome(straight_flight(-post, 1.0), wall, goal).result == "goal"
-    assert (
-        ball.outcome(straight_flight(math.nextafter(post, 9.0), 1.0), wall, goal).result == "wide"
-    )
+    assert ball.outcome(straight_flight(math.nextafter(post, 9.0), 1.0), wall, goal).result == "wide"
 
 
 def test_a_sample_exactly_on_the_plane_is_the_crossing() -> None:
@@ -724,9 +697,12 @@ def test_a_sample_exactly_on_the_plane_is_the_crossing() -> None:
         t=np.array([0.0, 0.5, 1.0]),
         position=np.array([[-1.0, 0.3, 1.0], [0.0, 0.3, 1.0], [1.0, 0.3, 1.0]]),
         velocity=np.tile([2.0, 0.0, 0.0], (3, 1)),
-        drag=np.zeros((3, 3)), magnus=np.zeros((3, 3)), gravity=np.zeros((3, 3)), knuckle=np.zeros((3, 3)),
+        drag=np.zeros((3, 3)),
+        magnus=np.zeros((3, 3)),
+        gravity=np.zeros((3, 3)),
+        knuckle=np.zeros((3, 3)),
         ended="x_stop",
-    )  # fmt: skip
+    )
     judged = ball.outcome(flight, wall, goal)
     assert judged.goal_time == 0.5 and judged.goal_point is not None
     assert judged.goal_point.tolist() == [0.0, 0.3, 1.0]
@@ -737,9 +713,7 @@ def test_a_sample_exactly_on_the_plane_is_the_crossing() -> None:
     method=st.sampled_from(["euler", "rk4"]),
 )
 @settings(max_examples=15, deadline=None)
-def test_simulate_outcomes_equals_outcome_batch_of_simulate_batch(
-    kicks: list[dict], method: str
-) -> None:
+def test_simulate_outcomes_equals_outcome_batch_of_simulate_batch(kicks: list[dict], method: str) -> None:
     pairs = [kick_of(k) for k in kicks]
     velocities = np.array([p[0] for p in pairs]).reshape(-1, 3)
     spins = np.array([p[1] for p in pairs]).reshape(-1, 3)
@@ -755,16 +729,12 @@ def test_simulate_outcomes_equals_outcome_batch_of_simulate_batch(
     batch = ball.simulate_batch(positions, velocities, spins, knuckle_seeds=seeds, **options)  # type: ignore[arg-type]
     assert batch.t.shape == (len(pairs), max([1, *batch.n_samples.tolist()]))
     judged = ball.outcome_batch(batch, WALL, GOAL)
-    fused = ball.simulate_outcomes(
-        positions, velocities, spins, WALL, GOAL, knuckle_seeds=seeds, **options
-    )  # type: ignore[arg-type]
+    fused = ball.simulate_outcomes(positions, velocities, spins, WALL, GOAL, knuckle_seeds=seeds, **options)  # type: ignore[arg-type]
     np.testing.assert_array_equal(fused.result, judged.result)
     np.testing.assert_array_equal(fused.wall_point, judged.wall_point)
     np.testing.assert_array_equal(fused.goal_point, judged.goal_point)
     for i, k in enumerate(kicks):  # and each is the single kick's verdict
-        single = ball.simulate(
-            positions[i], velocities[i], spins[i], knuckle_seed=k["seed"], **options
-        )  # type: ignore[arg-type]
+        single = ball.simulate(positions[i], velocities[i], spins[i], knuckle_seed=k["seed"], **options)  # type: ignore[arg-type]
         assert fused.result[i] == ball.outcome(single, WALL, GOAL).result
 
 
@@ -782,15 +752,15 @@ def test_a_batch_too_large_to_reserve_counts_first_and_stores_the_same(
     # Padded with each flight's end, up to the longest flight.
     k = int(np.argmin(reserved.n_samples))
     assert reserved.t.shape[1] == reserved.n_samples.max() > reserved.n_samples[k]
-    np.testing.assert_array_equal(reserved.position[k, reserved.n_samples[k] :], reserved.position[k, -1:].repeat(
-        reserved.t.shape[1] - reserved.n_samples[k], axis=0))  # fmt: skip
+    np.testing.assert_array_equal(
+        reserved.position[k, reserved.n_samples[k] :],
+        reserved.position[k, -1:].repeat(reserved.t.shape[1] - reserved.n_samples[k], axis=0),
+    )
 
 
 def test_threads_judging_at_once_get_the_results_of_one_at_a_time() -> None:
     rng = np.random.default_rng(3)
-    velocities = np.array(
-        [kick(s, e, a) for s, e, a in rng.uniform([15, 5, -15], [35, 30, 15], (300, 3))]
-    )
+    velocities = np.array([kick(s, e, a) for s, e, a in rng.uniform([15, 5, -15], [35, 30, 15], (300, 3))])
     spins = np.zeros((300, 3))
     spins[:, 2] = rng.uniform(-60, 60, 300)
     positions = np.tile(START, (300, 1))
@@ -799,9 +769,7 @@ def test_threads_judging_at_once_get_the_results_of_one_at_a_time() -> None:
     with ThreadPoolExecutor(4) as pool:
         runs = list(
             pool.map(
-                lambda _: ball.simulate_outcomes(
-                    positions, velocities, spins, WALL, GOAL, **options
-                ),
+                lambda _: ball.simulate_outcomes(positions, velocities, spins, WALL, GOAL, **options),
                 range(8),
             )
         )  # type: ignore[arg-type]
@@ -824,9 +792,7 @@ def test_a_ball_dropped_from_rest_falls_straight_down_in_every_mode() -> None:
                 knuckle_seed=seed,
             )  # type: ignore[arg-type]
             assert flight.ended == "ground"
-            np.testing.assert_array_equal(
-                flight.position[:, :2], np.tile([1.0, 2.0], (len(flight.t), 1))
-            )
+            np.testing.assert_array_equal(flight.position[:, :2], np.tile([1.0, 2.0], (len(flight.t), 1)))
             # Drag slows the fall a little: it lands later than in a vacuum.
             assert math.sqrt(2 * 3.0 / G) < flight.t[-1] < math.sqrt(2 * 3.0 / G) + 0.02
 
@@ -873,9 +839,7 @@ def test_huge_parameters_give_a_finite_flight_or_an_error_naming_dt(
     except ValueError as error:
         assert "dt" in str(error) and "overshoots the drag" in str(error)
         with pytest.raises(ValueError, match="dt"):
-            ball.simulate_batch(
-                [START, START], [velocity, (1.0, 0.0, 1.0)], [spin, spin], **arguments
-            )  # type: ignore[arg-type]
+            ball.simulate_batch([START, START], [velocity, (1.0, 0.0, 1.0)], [spin, spin], **arguments)  # type: ignore[arg-type]
         with pytest.raises(ValueError, match="dt"):
             ball.simulate_outcomes([START], [velocity], [spin], WALL, GOAL, **arguments)  # type: ignore[arg-type]
         return
@@ -889,26 +853,19 @@ def test_the_overflow_that_used_to_be_silent() -> None:
     # A thousand times sea-level air and no gravity: a 10 ms Euler step at 30 m/s overshoots the drag, so the
     # velocity flips and grows each step until it is inf, then NaN. This came back as a NaN trajectory.
     with pytest.raises(ValueError, match=r"dt = 0\.01 s is too long"):
-        ball.simulate(
-            START, (30.0, 0.0, 0.0), np.zeros(3), dt=1e-2, air_density=1225.0, gravity=0.0
-        )
+        ball.simulate(START, (30.0, 0.0, 0.0), np.zeros(3), dt=1e-2, air_density=1225.0, gravity=0.0)
     # A 1e-300 kg ball: one 0.5 s Euler step flings it 2e294 m sideways, finite but absurd (hypothesis found it).
     with pytest.raises(ValueError, match=r"dt = 0\.5 s is too long"):
         ball.simulate_batch([START], [(0.5, 0.0, 0.5)], [(0.0, 0.0, 50.0)], dt=0.5, mass_kg=1e-300)
     # The same guard leaves stiff but stable flights alone: RK4 at 10 ms in ten times sea-level air.
-    thick = ball.simulate(
-        START, kick(30.0, 15.0), np.zeros(3), dt=1e-2, method="rk4", air_density=12.25
-    )
+    thick = ball.simulate(START, kick(30.0, 15.0), np.zeros(3), dt=1e-2, method="rk4", air_density=12.25)
     assert thick.ended == "ground" and 0.0 < thick.position[-1, 0] < 15.0
 
 
 def test_a_huge_spin_still_curls() -> None:
     # |ω|² overflowed to inf for a 1e200 rad/s spin, so ω̂ = ω/|ω| was 0 and the constant model did not curl.
     huge = flight_at(20.0, kick(25.0, 15.0), np.array([0.0, 0.0, 1e200]))
-    assert (
-        huge.position[-1, 1]
-        == flight_at(20.0, kick(25.0, 15.0), np.array([0.0, 0.0, 1.0])).position[-1, 1]
-    )
+    assert huge.position[-1, 1] == flight_at(20.0, kick(25.0, 15.0), np.array([0.0, 0.0, 1.0])).position[-1, 1]
     assert huge.position[-1, 1] > 2.0
 
 
@@ -977,9 +934,7 @@ def test_without_a_writable_cache_directory_the_cores_compile_uncached(
     assert jit.compiled(parallel=True)(core)() == 7
     assert calls == [{"cache": True, "parallel": True}, {"parallel": True}]
     assert jit.UNCACHED == ["core"]
-    monkeypatch.setattr(
-        jit, "njit", lambda **options: (_ for _ in ()).throw(RuntimeError("other failure"))
-    )
+    monkeypatch.setattr(jit, "njit", lambda **options: (_ for _ in ()).throw(RuntimeError("other failure")))
     with pytest.raises(RuntimeError, match="other failure"):
         jit.compiled()(core)
 
@@ -993,15 +948,11 @@ def vacuum_landing_time(z0: float, vz: float, ground: float) -> float:
 def test_a_ball_that_peaks_and_lands_within_one_step_lands_there_not_at_the_launch() -> None:
     # Kind: a root finder started from a linear guess stalled at s = 0 when the ball rose at the step's start,
     # so the landing was put back at the launch point (t = 0, "ground", no error).
-    flight = ball.simulate(
-        (0, 0, 0.2), (1, 0, 1), (0, 0, 0), ground_m=0.11, air_density=0, method="rk4", dt=0.5
-    )
+    flight = ball.simulate((0, 0, 0.2), (1, 0, 1), (0, 0, 0), ground_m=0.11, air_density=0, method="rk4", dt=0.5)
     assert flight.ended == "ground"
     assert flight.t[-1] == pytest.approx(0.27146477587624, rel=1e-12)
     np.testing.assert_allclose(flight.position[-1], [0.27146477587624, 0.0, 0.11], rtol=1e-12)
-    low = ball.simulate(
-        (0, 0, 0.12), (1, 0, 0.3), (0, 0, 0), ground_m=0.11, air_density=0, method="rk4", dt=0.5
-    )
+    low = ball.simulate((0, 0, 0.12), (1, 0, 0.3), (0, 0, 0), ground_m=0.11, air_density=0, method="rk4", dt=0.5)
     assert low.t[-1] == pytest.approx(0.08511484556613763, rel=1e-12)
     # The default 25 m/s kick at 17° in air, with one step longer than the flight: lands ~27 m out, not at x = 0.
     fine = ball.simulate(START, kick(25.0, 17.0), np.zeros(3), ground_m=R, method="rk4", dt=1e-3)
@@ -1084,29 +1035,19 @@ def test_a_wall_and_goal_crossing_inside_one_long_step_is_found() -> None:
     wall, goal = ball.free_kick_panels((-12.0, 0.0), (12.0, 0.0), (1.0, 0.0), wall_width_m=0.5)
     wall = dataclasses.replace(wall, centre_xy=(-10.0, 50.0))
     for dt in (0.05, 0.8, 3.0):
-        flight = ball.simulate(
-            (-12.0, 0.0, R), (20.0, 0.0, 9.0), (0, 0, 0), air_density=0.0, method="rk4", dt=dt
-        )
+        flight = ball.simulate((-12.0, 0.0, R), (20.0, 0.0, 9.0), (0, 0, 0), air_density=0.0, method="rk4", dt=dt)
         judged = ball.outcome(flight, wall, goal)
         t = 24.0 / 20.0
         assert judged.goal_time == pytest.approx(t, rel=1e-12)
         assert judged.goal_point is not None
-        np.testing.assert_allclose(
-            judged.goal_point, [12.0, 0.0, R + 9.0 * t - 0.5 * G * t * t], atol=1e-12
-        )
+        np.testing.assert_allclose(judged.goal_point, [12.0, 0.0, R + 9.0 * t - 0.5 * G * t * t], atol=1e-12)
 
 
-def line_flight(
-    start: tuple[float, float, float], velocity: tuple[float, float, float], n: int, dt: float
-):
+def line_flight(start: tuple[float, float, float], velocity: tuple[float, float, float], n: int, dt: float):
     t = np.arange(n, dtype=np.float64) * dt
-    position = np.asarray(start, dtype=np.float64) + t[:, None] * np.asarray(
-        velocity, dtype=np.float64
-    )
+    position = np.asarray(start, dtype=np.float64) + t[:, None] * np.asarray(velocity, dtype=np.float64)
     zero = np.zeros((n, 3))
-    return ball.Trajectory(
-        t, position, np.tile(velocity, (n, 1)).astype(float), zero, zero, zero, zero, "ground"
-    )
+    return ball.Trajectory(t, position, np.tile(velocity, (n, 1)).astype(float), zero, zero, zero, zero, "ground")
 
 
 @given(offset=st.floats(0.0, 0.3), dt=st.floats(0.01, 0.5), sign=st.sampled_from([-1.0, 1.0]))
@@ -1121,9 +1062,7 @@ def test_a_ball_exactly_on_an_edge_gets_one_verdict_however_it_is_sampled(
     post, bar = 0.5 * GOAL_WIDTH_M - R, GOAL_HEIGHT_M - R
     n = int((offset + dt) / dt) + 3  # the samples reach past the plane
     for y, z in ((sign * post, 1.0), (0.0, bar), (sign * post, bar)):
-        judged = ball.outcome(
-            line_flight((-offset - dt, y, z), (1.0, 0.0, 0.0), n, dt), far_wall, goal
-        )
+        judged = ball.outcome(line_flight((-offset - dt, y, z), (1.0, 0.0, 0.0), n, dt), far_wall, goal)
         assert judged.result == "goal" and judged.goal_point is not None
         assert judged.goal_point[1:].tolist() == [y, z]
     wall = ball.Panel((-10.0, 0.0), (1.0, 0.0), 2.0, 1.8)
@@ -1141,10 +1080,7 @@ def test_a_start_exactly_on_a_plane_crosses_it_at_once() -> None:
     into_net = ball.outcome(line_flight((0.0, 0.0, 1.0), (1.0, 0.0, 0.0), 5, 0.1), far_wall, goal)
     assert into_net.result == "goal" and into_net.goal_time == 0.0
     wall = ball.Panel((-10.0, 0.0), (1.0, 0.0), 2.0, 1.8)
-    assert (
-        ball.outcome(line_flight((-10.0, 0.0, 1.0), (1.0, 0.0, 0.0), 20, 0.1), wall, goal).result
-        == "wall"
-    )
+    assert ball.outcome(line_flight((-10.0, 0.0, 1.0), (1.0, 0.0, 0.0), 20, 0.1), wall, goal).result == "wall"
     # Leaving the plane backwards is no crossing.
     out = ball.outcome(line_flight((0.0, 0.0, 1.0), (-1.0, 0.0, 0.0), 5, 0.1), far_wall, goal)
     assert out.result == "short" and out.goal_time is None
@@ -1178,24 +1114,16 @@ def test_the_last_sample_is_exactly_t_max_for_any_step(dt: float, t_max: float) 
     )
     assert flight.ended == "t_max" and flight.t[-1] == t_max
     assert np.all(np.diff(flight.t) > 0.0) and np.all(np.diff(flight.t) <= dt * (1 + 1e-9))
-    np.testing.assert_allclose(
-        flight.position[-1], [3.0 * t_max, 0.0, 1e6 - 0.5 * G * t_max**2], rtol=1e-12
-    )
+    np.testing.assert_allclose(flight.position[-1], [3.0 * t_max, 0.0, 1e6 - 0.5 * G * t_max**2], rtol=1e-12)
 
 
 def test_t_max_cases_the_reviewer_found() -> None:
     high = ((0.0, 0.0, 100.0), (1.0, 0.0, 0.0), (0, 0, 0))
-    assert ball.simulate(*high, t_max=1.0, dt=0.3).t.tolist() == pytest.approx(
-        [0.0, 0.3, 0.6, 0.9, 1.0]
-    )
+    assert ball.simulate(*high, t_max=1.0, dt=0.3).t.tolist() == pytest.approx([0.0, 0.3, 0.6, 0.9, 1.0])
     # A step longer than the whole flight lands on the parabola, not 10 s later or never.
     lob = ball.simulate(*high, t_max=5.0, dt=10.0, air_density=0.0, method="rk4")
-    assert lob.ended == "ground" and lob.t[-1] == pytest.approx(
-        math.sqrt(2.0 * 100.0 / G), rel=1e-12
-    )
-    far = ball.simulate(
-        (0.0, 0.0, 1e4), (1.0, 0.0, 0.0), (0, 0, 0), t_max=5.0, dt=1e10, air_density=0.0
-    )
+    assert lob.ended == "ground" and lob.t[-1] == pytest.approx(math.sqrt(2.0 * 100.0 / G), rel=1e-12)
+    far = ball.simulate((0.0, 0.0, 1e4), (1.0, 0.0, 0.0), (0, 0, 0), t_max=5.0, dt=1e10, air_density=0.0)
     assert far.t.tolist() == [0.0, 5.0] and far.ended == "t_max"
 
 
@@ -1218,14 +1146,9 @@ def test_more_bad_input_raises_naming_the_argument() -> None:
     with pytest.raises(ValueError, match="spin is too fast for the measured model"):
         ball.simulate(START, kick(25, 15), (0.0, 0.0, 1e200), model="measured")
     with pytest.raises(ValueError, match=r"spins\[0\] is too fast"):
-        ball.simulate_outcomes(
-            [START], [kick(25, 15)], [(0.0, 0.0, 1e200)], WALL, GOAL, model="measured"
-        )
+        ball.simulate_outcomes([START], [kick(25, 15)], [(0.0, 0.0, 1e200)], WALL, GOAL, model="measured")
     # The bound is far beyond any kick: 100 rev/s at 5 m/s (S ≈ 14) still flies.
-    assert (
-        ball.simulate(START, kick(5, 15), ball.spin_vector(100, (0, 0, 1)), model="measured").ended
-        == "ground"
-    )
+    assert ball.simulate(START, kick(5, 15), ball.spin_vector(100, (0, 0, 1)), model="measured").ended == "ground"
 
 
 @given(
@@ -1233,28 +1156,20 @@ def test_more_bad_input_raises_naming_the_argument() -> None:
     axis=st.sampled_from([(1, 1, 0), (1, 0, 0), (0, -3, 4), (1, 1, 1)]),
 )
 @settings(max_examples=60, deadline=None)
-def test_spin_vector_normalises_any_scale_of_axis(
-    exponent: int, axis: tuple[int, int, int]
-) -> None:
+def test_spin_vector_normalises_any_scale_of_axis(exponent: int, axis: tuple[int, int, int]) -> None:
     # Kind: the axis's squares overflowed (1e300) or underflowed (3e-200) before the division.
     direction = np.array(axis, dtype=float)
     expected = 2.0 * math.pi * direction / np.linalg.norm(direction)
-    np.testing.assert_allclose(
-        ball.spin_vector(1.0, direction * 10.0**exponent), expected, rtol=1e-15
-    )
+    np.testing.assert_allclose(ball.spin_vector(1.0, direction * 10.0**exponent), expected, rtol=1e-15)
 
 
 def test_spin_vector_cases_the_reviewer_found() -> None:
-    np.testing.assert_allclose(
-        ball.spin_vector(1, (1e300, 1e300, 0)), 2 * math.pi / math.sqrt(2) * np.array([1, 1, 0])
-    )
+    np.testing.assert_allclose(ball.spin_vector(1, (1e300, 1e300, 0)), 2 * math.pi / math.sqrt(2) * np.array([1, 1, 0]))
     np.testing.assert_allclose(ball.spin_vector(1, (3e-200, 0, 0)), [2 * math.pi, 0.0, 0.0])
 
 
 def test_a_flight_config_is_checked_once_and_flies_as_its_keywords() -> None:
-    config = ball.FlightConfig(
-        dt=1e-2, method="rk4", model="measured", t_max=3.0, x_stop=20.0, ground_m=R
-    )
+    config = ball.FlightConfig(dt=1e-2, method="rk4", model="measured", t_max=3.0, x_stop=20.0, ground_m=R)
     velocity, spin = (25.0, 1.0, 6.0), (0.0, 0.0, 40.0)
     by_config = ball.simulate(START, velocity, spin, config)
     by_keywords = ball.simulate(

@@ -44,9 +44,7 @@ def _reference_landing(density: float, velocity: np.ndarray, height: float) -> t
     ground.terminal = True  # type: ignore[attr-defined]
     ground.direction = -1  # type: ignore[attr-defined]
     start = np.array([0.0, 0.0, height, *velocity])
-    solution = solve_ivp(
-        rate, (0.0, 10.0), start, method="DOP853", rtol=1e-10, atol=1e-12, events=ground
-    )
+    solution = solve_ivp(rate, (0.0, 10.0), start, method="DOP853", rtol=1e-10, atol=1e-12, events=ground)
     return float(solution.y_events[0][0][0]), float(solution.t_events[0][0])
 
 
@@ -57,13 +55,9 @@ def _limit_named(error: ValueError) -> float:
     return float(found.group(1))
 
 
-def _refusal(
-    density: float, velocity: np.ndarray, height: float, dt: float, method: ball.Method
-) -> ValueError:
+def _refusal(density: float, velocity: np.ndarray, height: float, dt: float, method: ball.Method) -> ValueError:
     with pytest.raises(ValueError, match=r"^dt = ") as caught:
-        ball.simulate(
-            (0.0, 0.0, height), velocity, (0.0, 0.0, 0.0), air_density=density, dt=dt, method=method
-        )
+        ball.simulate((0.0, 0.0, height), velocity, (0.0, 0.0, 0.0), air_density=density, dt=dt, method=method)
     return caught.value
 
 
@@ -83,9 +77,7 @@ def test_the_reported_long_euler_steps_are_refused_with_their_limit(
     assert _limit_named(error) == pytest.approx(expected, rel=1e-2)
     assert _limit_named(error) <= expected
     # Just under the limit the flight is drawn, and lands ahead of the kick, as DOP853's does.
-    flight = ball.simulate(
-        (0.0, 0.0, 1.0), v0, (0.0, 0.0, 0.0), air_density=density, dt=0.99 * expected
-    )
+    flight = ball.simulate((0.0, 0.0, 1.0), v0, (0.0, 0.0, 0.0), air_density=density, dt=0.99 * expected)
     x_ref, _ = _reference_landing(density, v0, 1.0)
     assert x_ref > 0.0 and flight.position[-1, 0] > 0.0
 
@@ -126,9 +118,7 @@ def test_a_flight_is_refused_naming_dt_or_lands_ahead_as_the_reference_does(
     start = (0.0, 0.0, height)
     k = _drag_factor(density)
     try:
-        flight = ball.simulate(
-            start, v0, (0.0, 0.0, 0.0), air_density=density, dt=dt, method=method, t_max=10.0
-        )
+        flight = ball.simulate(start, v0, (0.0, 0.0, 0.0), air_density=density, dt=dt, method=method, t_max=10.0)
     except ValueError as error:
         limit = _limit_named(error)
         assert str(error).startswith(f"dt = {dt:g} s is too long for this drag") and limit < dt
@@ -162,8 +152,26 @@ def test_the_free_kick_scene_never_meets_the_limit(model: ball.Model, knuckle: i
                 for elevation in (-5.0, 50.0):
                     v0 = ball.launch_velocity(speed, math.radians(elevation), 0.0)
                     w0 = ball.spin_vector(spin_rev_s * 1.1, (0.0, 0.0, 1.0))
-                    ball.simulate((0.0, 0.0, ball.BALL_RADIUS_M), v0, w0, method=method, dt=dt, model=model,
-                                  t_max=4.0, ground_m=ball.BALL_RADIUS_M, knuckle_seed=knuckle)  # fmt: skip
+                    ball.simulate(
+                        (0.0, 0.0, ball.BALL_RADIUS_M),
+                        v0,
+                        w0,
+                        method=method,
+                        dt=dt,
+                        model=model,
+                        t_max=4.0,
+                        ground_m=ball.BALL_RADIUS_M,
+                        knuckle_seed=knuckle,
+                    )
                     # A margin of ten: even ten times the step would be accepted.
-                    ball.simulate((0.0, 0.0, ball.BALL_RADIUS_M), v0, w0, method=method, dt=10.0 * dt, model=model,
-                                  t_max=4.0, ground_m=ball.BALL_RADIUS_M, knuckle_seed=knuckle)  # fmt: skip
+                    ball.simulate(
+                        (0.0, 0.0, ball.BALL_RADIUS_M),
+                        v0,
+                        w0,
+                        method=method,
+                        dt=10.0 * dt,
+                        model=model,
+                        t_max=4.0,
+                        ground_m=ball.BALL_RADIUS_M,
+                        knuckle_seed=knuckle,
+                    )

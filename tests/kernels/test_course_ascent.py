@@ -25,9 +25,7 @@ METRE_DEG = 180.0 / (math.pi * course.EARTH_RADIUS_M)
 Shape = Literal["flat", "one hill", "several hills", "long climb"]
 
 
-def profile(
-    shape: Shape, s: np.ndarray, heights: list[float], grade: float
-) -> tuple[np.ndarray, float]:
+def profile(shape: Shape, s: np.ndarray, heights: list[float], grade: float) -> tuple[np.ndarray, float]:
     """(elevation above 300 m at distances s, its true total ascent), from closed forms.
 
     Hills are raised cosines h·(1 + cos(2π(s − c)/w))/2 on their own stretch of road, each rising exactly h once;
@@ -42,9 +40,7 @@ def profile(
             hills = heights[:1] if shape == "one hill" else heights
             slot = float(s[-1]) / len(hills)
             for k, h in enumerate(hills):
-                w = min(
-                    0.9 * slot, max(600.0, math.pi * h / 0.12)
-                )  # steepest π·h/w: 12 %, or 15 % where short
+                w = min(0.9 * slot, max(600.0, math.pi * h / 0.12))  # steepest π·h/w: 12 %, or 15 % where short
                 h = min(h, 0.15 * w / math.pi)
                 hills[k] = h
                 centre = slot * (k + 0.5)
@@ -62,13 +58,9 @@ def noisy(z: np.ndarray, sigma: float, spike_rate: float, seed: int) -> np.ndarr
     return z + rng.normal(0.0, sigma, z.shape) + np.where(spikes, size, 0.0)
 
 
-def along_a_meridian(
-    s: np.ndarray, elevation: np.ndarray, smoothing_m: float = 50.0
-) -> course.Course:
+def along_a_meridian(s: np.ndarray, elevation: np.ndarray, smoothing_m: float = 50.0) -> course.Course:
     """A course due north from 45° N 6° E (what load_gpx builds after parsing)."""
-    return course.course_from_points(
-        45.0 + s * METRE_DEG, np.full_like(s, 6.0), elevation, smoothing_m=smoothing_m
-    )
+    return course.course_from_points(45.0 + s * METRE_DEG, np.full_like(s, 6.0), elevation, smoothing_m=smoothing_m)
 
 
 @settings(max_examples=EXAMPLES, deadline=None)
@@ -138,9 +130,7 @@ def test_flat_ten_kilometres_with_gps_noise_climbs_nothing() -> None:
     elevation = noisy(np.full_like(s, 300.0), 1.5, 0.0, seed=2024)
     c = course.load_gpx(gpx(s, elevation))
     summed = float(np.sum(np.maximum(np.diff(c.elevation_m), 0.0)))
-    print(
-        f"flat 10 km, σ 1.5 m: every rise of the smoothed profile {summed:.1f} m, climbing_m {c.climbing_m:.1f} m"
-    )
+    print(f"flat 10 km, σ 1.5 m: every rise of the smoothed profile {summed:.1f} m, climbing_m {c.climbing_m:.1f} m")
     assert summed > 50.0  # the noise the old sum counted
     assert c.climbing_m <= 5.0
 
@@ -148,9 +138,7 @@ def test_flat_ten_kilometres_with_gps_noise_climbs_nothing() -> None:
 def test_one_fifty_metre_hill_reads_fifty_metres() -> None:
     """The public case: the same road with one 50 m hill (a raised cosine 2 km long, 7.9 % at its steepest)."""
     s = np.arange(0.0, 10_000.0 + 2.5, 5.0)
-    clean = 300.0 + np.where(
-        np.abs(s - 5000.0) < 1000.0, 25.0 * (1.0 + np.cos(np.pi * (s - 5000.0) / 1000.0)), 0.0
-    )
+    clean = 300.0 + np.where(np.abs(s - 5000.0) < 1000.0, 25.0 * (1.0 + np.cos(np.pi * (s - 5000.0) / 1000.0)), 0.0)
     c = course.load_gpx(gpx(s, noisy(clean, 1.5, 0.0, seed=2025)))
     summed = float(np.sum(np.maximum(np.diff(c.elevation_m), 0.0)))
     print(f"one 50 m hill, σ 1.5 m: every rise {summed:.1f} m, climbing_m {c.climbing_m:.1f} m")
@@ -177,9 +165,7 @@ def test_the_ride_is_unchanged_by_noise_in_its_net_climbing_work() -> None:
         (([1.0, 0.0], [0.0, 1.0]), "distance_m must be non-decreasing"),
     ],
 )
-def test_bad_profiles_are_refused_naming_the_argument(
-    arguments: tuple[list[float], list[float]], name: str
-) -> None:
+def test_bad_profiles_are_refused_naming_the_argument(arguments: tuple[list[float], list[float]], name: str) -> None:
     with pytest.raises(ValueError, match=name):
         course.total_ascent(*arguments)
     with pytest.raises(ValueError, match="threshold_m"):

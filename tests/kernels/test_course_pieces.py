@@ -29,17 +29,12 @@ def haversine_m(a: Point, b: Point) -> float:
     """Great-circle distance (m) on the IUGG mean sphere, written out here."""
     (lat1, lon1), (lat2, lon2) = a, b
     p1, p2 = math.radians(lat1), math.radians(lat2)
-    h = (
-        math.sin((p2 - p1) / 2) ** 2
-        + math.cos(p1) * math.cos(p2) * math.sin(math.radians(lon2 - lon1) / 2) ** 2
-    )
+    h = math.sin((p2 - p1) / 2) ** 2 + math.cos(p1) * math.cos(p2) * math.sin(math.radians(lon2 - lon1) / 2) ** 2
     return 2.0 * 6_371_008.8 * math.asin(math.sqrt(min(1.0, h)))
 
 
 def rows(piece: Piece, tag: str) -> str:
-    return "".join(
-        f'<{tag} lat="{lat!r}" lon="{lon!r}"><ele>100</ele></{tag}>' for lat, lon in piece
-    )
+    return "".join(f'<{tag} lat="{lat!r}" lon="{lon!r}"><ele>100</ele></{tag}>' for lat, lon in piece)
 
 
 def arrange(pieces: Sequence[Piece], layout: Sequence[str]) -> str:
@@ -54,9 +49,7 @@ def arrange(pieces: Sequence[Piece], layout: Sequence[str]) -> str:
             if open_track:
                 parts.append("</trk>")
                 open_track = False
-            parts.append(
-                "<!-- <trk> <rte> -->" if how == "note" else "<trk><name>empty</name></trk>"
-            )
+            parts.append("<!-- <trk> <rte> -->" if how == "note" else "<trk><name>empty</name></trk>")
             continue
         piece = next(pieces_left)
         if how == "rte" or (how == "trk" and open_track):
@@ -115,9 +108,7 @@ LAYOUTS = ("tracks", "segments", "routes", "mixed")
     pieces=piece_sets(),
     mix=st.lists(st.sampled_from(["trk", "seg", "rte", "note", "empty"]), max_size=40),
 )
-def test_every_arrangement_of_the_pieces_gets_the_same_verdict(
-    pieces: list[Piece], mix: list[str]
-) -> None:
+def test_every_arrangement_of_the_pieces_gets_the_same_verdict(pieces: list[Piece], mix: list[str]) -> None:
     """Tracks, segments of one track, routes, or a random mix: the same course when the pieces follow on, the same
     refusal (which pieces, how far apart) when two consecutive ones are more than 2 km apart."""
     kept, used = [], 0
@@ -147,9 +138,7 @@ def test_every_arrangement_of_the_pieces_gets_the_same_verdict(
             course.load_gpx(text)
         message = str(refused.value)
         k, gap = verdict
-        found = re.search(
-            rf"segment {k} starts ([\d ]+\.\d) km from where segment {k - 1} ends", message
-        )
+        found = re.search(rf"segment {k} starts ([\d ]+\.\d) km from where segment {k - 1} ends", message)
         assert found is not None, (layout, message)
         assert float(found.group(1).replace(" ", "")) == pytest.approx(gap / 1000.0, abs=0.051), (
             layout,
@@ -171,17 +160,13 @@ def test_routes_in_france_and_sydney_are_refused_not_joined() -> None:
     """The public case: no track, one route at 45° N 6° E and one at 33.8° S 151.2° E (loaded as 16 807 km)."""
     gap_km = haversine_m((45.002, 6.0), (-33.8, 151.2)) / 1000.0
     print(f"routes 45N 6E and 33.8S 151.2E: {gap_km:.1f} km apart")
-    with pytest.raises(
-        ValueError, match=r"segment 2 starts [\d ]+\.\d km from where segment 1 ends"
-    ) as refused:
+    with pytest.raises(ValueError, match=r"segment 2 starts [\d ]+\.\d km from where segment 1 ends") as refused:
         course.load_gpx(two_routes((-33.8, 151.2)))
     message = str(refused.value)
     print(message)
     assert "segment 1 is route 1, segment 2 is route 2" in message
     number = re.search(r"starts ([\d ]+\.\d) km", message)
-    assert number is not None and float(number.group(1).replace(" ", "")) == pytest.approx(
-        gap_km, abs=0.051
-    )
+    assert number is not None and float(number.group(1).replace(" ", "")) == pytest.approx(gap_km, abs=0.051)
 
 
 def test_near_routes_and_a_track_after_a_route_are_joined_in_file_order() -> None:

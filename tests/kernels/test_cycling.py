@@ -92,9 +92,7 @@ def test_doubling_speed_costs_eight_times_the_aero_power() -> None:
 def test_wind_uses_air_speed_squared_with_its_sign() -> None:
     head = cycling.power(10.0, 0.3, 80.0, 0.0, headwind_ms=5.0)
     assert float(head.aero) == pytest.approx(0.5 * RHO * 0.3 * 15.0**2 * 10.0)
-    tail = cycling.power(
-        5.0, 0.3, 80.0, 0.0, headwind_ms=-10.0
-    )  # wind faster than the rider pushes
+    tail = cycling.power(5.0, 0.3, 80.0, 0.0, headwind_ms=-10.0)  # wind faster than the rider pushes
     assert float(tail.aero) == pytest.approx(-0.5 * RHO * 0.3 * 5.0**2 * 5.0)
 
 
@@ -117,9 +115,7 @@ def test_power_broadcasts_over_arrays() -> None:
     grades = np.array([0.0, 0.05, -0.05])[None, :]
     p = cycling.power(speeds, 0.3, 80.0, 0.004, grade=grades)
     assert p.total.shape == (5, 3)
-    assert float(p.climbing[2, 1]) == pytest.approx(
-        80 * G * math.sin(math.atan(0.05)) * float(speeds[2, 0])
-    )
+    assert float(p.climbing[2, 1]) == pytest.approx(80 * G * math.sin(math.atan(0.05)) * float(speeds[2, 0]))
 
 
 @given(
@@ -168,9 +164,7 @@ def test_speed_for_power_round_trips_to_1e_6(
     wind: float,
     efficiency: float,
 ) -> None:
-    args = dict(
-        grade=grade, altitude_m=altitude, headwind_ms=wind, drivetrain_efficiency=efficiency
-    )
+    args = dict(grade=grade, altitude_m=altitude, headwind_ms=wind, drivetrain_efficiency=efficiency)
     v = float(cycling.speed_for_power(power_w, cda, mass, crr, **args))
     assert v >= 0.0
     if v == 0.0:  # only possible when even standing still needs no power: P(0) = 0 = target
@@ -208,16 +202,12 @@ def test_descent_coasting_speed_is_terminal_velocity() -> None:
 def test_strong_tailwind_takes_the_largest_root() -> None:
     # 12 m/s tailwind, 50 W: the rider is pushed to near the wind speed and beyond it.
     v = float(cycling.speed_for_power(50.0, 0.4, 80.0, 0.004, headwind_ms=-12.0))
-    assert float(cycling.power(v, 0.4, 80.0, 0.004, headwind_ms=-12.0).total) == pytest.approx(
-        50.0, rel=1e-6
-    )
+    assert float(cycling.power(v, 0.4, 80.0, 0.004, headwind_ms=-12.0).total) == pytest.approx(50.0, rel=1e-6)
     assert v > 12.0
 
 
 def test_speed_for_power_broadcasts() -> None:
-    v = cycling.speed_for_power(
-        np.array([100.0, 200.0, 400.0]), 0.3, 80.0, 0.004, grade=np.array([[0.0], [0.05]])
-    )
+    v = cycling.speed_for_power(np.array([100.0, 200.0, 400.0]), 0.3, 80.0, 0.004, grade=np.array([[0.0], [0.05]]))
     assert v.shape == (2, 3)
     assert np.all(np.diff(v, axis=1) > 0)
     assert np.all(v[1] < v[0])

@@ -27,13 +27,9 @@ CRC_SATURATION_HPA = [(0.0, 6.1129), (10.0, 12.282), (20.0, 23.393), (30.0, 42.4
 
 
 @pytest.mark.parametrize(("altitude", "pressure", "density"), US_STANDARD_ATMOSPHERE_1976)
-def test_standard_atmosphere_matches_the_1976_tables(
-    altitude: float, pressure: float, density: float
-) -> None:
+def test_standard_atmosphere_matches_the_1976_tables(altitude: float, pressure: float, density: float) -> None:
     assert float(cycling.isa_pressure_hpa(altitude)) == pytest.approx(pressure, rel=1e-4)
-    rho = cycling.air_density_weather(
-        cycling.isa_temperature_c(altitude), cycling.isa_pressure_hpa(altitude)
-    )
+    rho = cycling.air_density_weather(cycling.isa_temperature_c(altitude), cycling.isa_pressure_hpa(altitude))
     assert float(rho) == pytest.approx(density, rel=2e-4)
 
 
@@ -47,17 +43,13 @@ def test_isa_temperature_at_the_tropopause_and_above() -> None:
 def test_the_issue_figures_at_2500_m() -> None:
     """The issue: the seed's exponential gives 0.913 kg/m³ at 2 500 m where the standard atmosphere gives 0.957."""
     assert float(cycling.air_density(2500.0)) == pytest.approx(0.913, abs=5e-4)
-    isa = cycling.air_density_weather(
-        cycling.isa_temperature_c(2500.0), cycling.isa_pressure_hpa(2500.0)
-    )
+    isa = cycling.air_density_weather(cycling.isa_temperature_c(2500.0), cycling.isa_pressure_hpa(2500.0))
     assert float(isa) == pytest.approx(0.957, abs=5e-4)
 
 
 @pytest.mark.parametrize(("temperature", "pressure"), CRC_SATURATION_HPA)
 def test_saturation_pressure_against_the_crc_table(temperature: float, pressure: float) -> None:
-    assert float(cycling.saturation_vapour_pressure_hpa(temperature)) == pytest.approx(
-        pressure, rel=1e-3
-    )
+    assert float(cycling.saturation_vapour_pressure_hpa(temperature)) == pytest.approx(pressure, rel=1e-3)
 
 
 def mole_fraction_density(t_c: float, p_hpa: float, rh: float) -> float:
@@ -80,9 +72,7 @@ def mole_fraction_density(t_c: float, p_hpa: float, rh: float) -> float:
         (40.0, 950.0, 0.9),
     ],
 )
-def test_moist_air_density_against_the_mole_fraction_form(
-    t_c: float, p_hpa: float, rh: float
-) -> None:
+def test_moist_air_density_against_the_mole_fraction_form(t_c: float, p_hpa: float, rh: float) -> None:
     assert float(cycling.air_density_weather(t_c, p_hpa, rh)) == pytest.approx(
         mole_fraction_density(t_c, p_hpa, rh), rel=3e-4
     )
@@ -93,9 +83,7 @@ def test_humid_air_is_lighter_by_the_expected_amount() -> None:
     dry = float(cycling.air_density_weather(30.0, 1013.25, 0.0))
     wet = float(cycling.air_density_weather(30.0, 1013.25, 1.0))
     e = float(cycling.saturation_vapour_pressure_hpa(30.0))
-    assert 1.0 - wet / dry == pytest.approx(
-        e / 1013.25 * (1.0 - cycling.R_DRY_AIR / cycling.R_WATER_VAPOUR)
-    )
+    assert 1.0 - wet / dry == pytest.approx(e / 1013.25 * (1.0 - cycling.R_DRY_AIR / cycling.R_WATER_VAPOUR))
     assert 0.014 < 1.0 - wet / dry < 0.017
 
 
@@ -150,9 +138,21 @@ def test_range_edges_are_accepted_and_beyond_them_rejected() -> None:
 
 # ------------------------------------------------------------------------------------------------ Martin et al. 1998
 def paper_power(
-    v_g: float, cda: float, m_t: float, mu: float, g_r: float, w: float, rho: float,
-    e_c: float, f_w: float, inertia: float, r: float, v_i: float, v_f: float, dt: float,
-) -> dict[str, float]:  # fmt: skip
+    v_g: float,
+    cda: float,
+    m_t: float,
+    mu: float,
+    g_r: float,
+    w: float,
+    rho: float,
+    e_c: float,
+    f_w: float,
+    inertia: float,
+    r: float,
+    v_i: float,
+    v_f: float,
+    dt: float,
+) -> dict[str, float]:
     """Martin et al. (1998), eqs. 2–9 written from the paper, air speed from ahead (V_A = V_G + w ≥ 0)."""
     v_a = v_g + w
     p_at = 0.5 * rho * (cda + f_w) * v_a**2 * v_g
@@ -161,8 +161,7 @@ def paper_power(
     p_pe = v_g * m_t * 9.81 * math.sin(math.atan(g_r))
     p_ke = 0.5 * (m_t + inertia / r**2) * (v_f**2 - v_i**2) / dt
     net = p_at + p_rr + p_wb + p_pe + p_ke
-    return {"aero": p_at, "rolling": p_rr, "bearings": p_wb, "climbing": p_pe, "kinetic": p_ke,
-            "total": net / e_c}  # fmt: skip
+    return {"aero": p_at, "rolling": p_rr, "bearings": p_wb, "climbing": p_pe, "kinetic": p_ke, "total": net / e_c}
 
 
 @given(
@@ -179,8 +178,7 @@ def test_martin_power_matches_the_paper_term_by_term(
     v: float, cda: float, m: float, crr: float, grade: float, w: float, rho: float, a: float
 ) -> None:
     dt = 0.5  # the paper's finite-difference kinetic term over [t − dt/2, t + dt/2] at constant acceleration
-    ref = paper_power(v, cda, m, crr, grade, w, rho, 0.976, 0.0044, 0.14, 0.311,
-                      v - a * dt / 2, v + a * dt / 2, dt)  # fmt: skip
+    ref = paper_power(v, cda, m, crr, grade, w, rho, 0.976, 0.0044, 0.14, 0.311, v - a * dt / 2, v + a * dt / 2, dt)
     got = cycling.martin_power(v, cda, m, crr, grade, w, rho, acceleration_ms2=a)
     for term in ("aero", "rolling", "bearings", "climbing", "kinetic"):
         assert float(getattr(got, term)) == pytest.approx(ref[term], rel=1e-9, abs=1e-9), term
@@ -201,9 +199,7 @@ def test_martin_paper_defaults_and_a_hand_number() -> None:
     assert float(p.bearings) == pytest.approx(1.78, abs=1e-9)
     assert float(p.total) == pytest.approx((186.445 + 31.392 + 1.78) / 0.976, abs=2e-3)
     # The seed model is Martin's without spokes, bearings and drivetrain: set those off and they agree.
-    bare = cycling.martin_power(
-        10.0, 0.30, 80.0, 0.004, drivetrain_efficiency=1.0, spoke_drag_m2=0.0
-    )
+    bare = cycling.martin_power(10.0, 0.30, 80.0, 0.004, drivetrain_efficiency=1.0, spoke_drag_m2=0.0)
     seed = cycling.power(10.0, 0.30, 80.0, 0.004)
     assert float(bare.total) - float(bare.bearings) == pytest.approx(float(seed.total), rel=1e-12)
 
@@ -214,9 +210,7 @@ def test_martin_tailwind_faster_than_the_rider_pushes() -> None:
 
 
 def test_martin_broadcasts_and_rejects_bad_arguments() -> None:
-    p = cycling.martin_power(
-        np.linspace(0, 20, 5), 0.3, 80.0, 0.004, grade=np.array([[0.0], [0.1]])
-    )
+    p = cycling.martin_power(np.linspace(0, 20, 5), 0.3, 80.0, 0.004, grade=np.array([[0.0], [0.1]]))
     assert p.total.shape == (2, 5) and p.kinetic.shape == (2, 5)
     for kwargs, name in [
         ({"speed_ms": -1.0}, "speed_ms"),

@@ -46,9 +46,7 @@ def largest_root_reference(power_w: float, **args: float) -> float:
         lo = float(speeds[i])
         # An exact zero on the grid: it is the largest root unless another lies inside the next cell.
         return (
-            lo
-            if f(lo + 1e-12) > 0.0 or i + 1 == len(speeds)
-            else bracketed_root(f, lo + 1e-12, float(speeds[i + 1]))
+            lo if f(lo + 1e-12) > 0.0 or i + 1 == len(speeds) else bracketed_root(f, lo + 1e-12, float(speeds[i + 1]))
         )
     return bracketed_root(f, float(speeds[i]), float(speeds[i + 1]))
 
@@ -85,27 +83,21 @@ def courses(draw: st.DrawFn) -> dict[str, float]:
         crr=crr,
         grade=grade,
         altitude_m=draw(st.sampled_from([0.0, 2000.0])),
-        headwind_ms=draw(
-            st.one_of(st.sampled_from([0.0, -1.0, -2.0, -13.5, -15.0]), st.floats(-15.0, 15.0))
-        ),
+        headwind_ms=draw(st.one_of(st.sampled_from([0.0, -1.0, -2.0, -13.5, -15.0]), st.floats(-15.0, 15.0))),
         drivetrain_efficiency=draw(st.sampled_from([1.0, 0.976, 0.8])),
     )
 
 
 @given(power_w=powers, course=courses())
 @settings(max_examples=300, deadline=None)
-def test_speed_for_power_is_the_largest_root_everywhere(
-    power_w: float, course: dict[str, float]
-) -> None:
+def test_speed_for_power_is_the_largest_root_everywhere(power_w: float, course: dict[str, float]) -> None:
     v = float(cycling.speed_for_power(power_w, **course))
     assert_is_the_largest_root(v, power_w, **course)
 
 
 @given(course=courses(), fraction=st.sampled_from([0.5, 1e-3, 1e-9]))
 @settings(max_examples=150, deadline=None)
-def test_speed_for_power_is_continuous_as_power_goes_to_zero(
-    course: dict[str, float], fraction: float
-) -> None:
+def test_speed_for_power_is_continuous_as_power_goes_to_zero(course: dict[str, float], fraction: float) -> None:
     """ε-δ: for δ > 0 every power below power(v(0) + δ) gives a speed within δ above v(0), and never below it."""
     v_zero = float(cycling.speed_for_power(0.0, **course))
     for delta in (1e-2, 1e-4, 1e-6):
@@ -123,9 +115,7 @@ def test_vectorised_call_equals_one_value_at_a_time() -> None:
     p = rng.choice([0.0, 1e-9, 50.0, 300.0], 400)
     batch = cycling.speed_for_power(p, 0.32, 80.0, crr, grade=grade, headwind_ms=wind)
     single = [
-        float(
-            cycling.speed_for_power(p[i], 0.32, 80.0, crr[i], grade=grade[i], headwind_ms=wind[i])
-        )
+        float(cycling.speed_for_power(p[i], 0.32, 80.0, crr[i], grade=grade[i], headwind_ms=wind[i]))
         for i in range(400)
     ]
     np.testing.assert_array_equal(batch, single)
@@ -149,9 +139,7 @@ def test_no_rolling_on_the_flat_carries_the_rider_at_the_tailwind_speed(tailwind
 def test_standing_still_needs_no_power_without_a_push() -> None:
     assert float(cycling.speed_for_power(0.0, 0.32, 80.0, 0.004)) == 0.0
     assert float(cycling.speed_for_power(0.0, 0.32, 80.0, 0.0)) == 0.0
-    assert (
-        float(cycling.speed_for_power(0.0, 0.32, 80.0, 0.004, headwind_ms=-1.0)) == 0.0
-    )  # rolling holds
+    assert float(cycling.speed_for_power(0.0, 0.32, 80.0, 0.004, headwind_ms=-1.0)) == 0.0  # rolling holds
     # Flat, no rolling, no wind: P = a·v³, so v = ∛(P/a) for the smallest powers too.
     a = 0.5 * 1.225 * 0.32
     for p in (1e-300, 1e-9, 1.0):
@@ -180,14 +168,10 @@ def assert_solves_to_the_nearest_float(v: float, **args: float) -> None:
     target = args.pop("power_w")
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        parts = cycling.power(
-            np.array([max(np.nextafter(v, -1.0), 0.0), v, np.nextafter(v, np.inf)]), **args
-        )
+        parts = cycling.power(np.array([max(np.nextafter(v, -1.0), 0.0), v, np.nextafter(v, np.inf)]), **args)
     miss = np.abs(parts.total - target)
     scale = np.abs(parts.aero[1]) + np.abs(parts.rolling[1]) + np.abs(parts.climbing[1])
-    per_ulp = 0.5 * abs(
-        parts.total[2] - parts.total[0]
-    )  # where one ulp of v moves P by more than 1e-9 W
+    per_ulp = 0.5 * abs(parts.total[2] - parts.total[0])  # where one ulp of v moves P by more than 1e-9 W
     assert miss[1] <= max(1e-9 * target, 1e-9, 1e-13 * scale, 2.0 * per_ulp), (
         v,
         parts.total[1],
@@ -208,8 +192,7 @@ def edge(name: str) -> st.SearchStrategy[float]:
     cda_m2=edge("cda_m2"),
     mass_kg=edge("mass_kg") | st.sampled_from([5e-324, 1e-300, 80.0]),
     crr=edge("crr"),
-    grade=st.floats(allow_nan=False, allow_infinity=False)
-    | st.sampled_from([-1.7e308, 1.7e308, -1e10, 0.0]),
+    grade=st.floats(allow_nan=False, allow_infinity=False) | st.sampled_from([-1.7e308, 1.7e308, -1e10, 0.0]),
     altitude_m=edge("altitude_m"),
     headwind_ms=edge("headwind_ms") | st.sampled_from([-300.0, -1000.0, 1000.0]),
     drivetrain_efficiency=st.sampled_from([1.0, 0.9, 0.01]),
@@ -226,9 +209,7 @@ def test_speed_for_power_is_finite_and_exact_over_its_whole_domain(**args: float
     beyond=st.floats(1e-9, 1.0) | st.sampled_from([1e3, 1e150, 1e300]),
 )
 @settings(max_examples=200, deadline=None)
-def test_speed_for_power_rejects_values_outside_its_domain_by_name(
-    name: str, side: float, beyond: float
-) -> None:
+def test_speed_for_power_rejects_values_outside_its_domain_by_name(name: str, side: float, beyond: float) -> None:
     low, high = DOMAIN[name]
     end = high if side > 0.0 else low
     value = end + side * max(beyond * max(abs(end), 1.0), 1e-300)
@@ -318,17 +299,13 @@ def test_peloton_readout_at_zero_watts_on_a_cancelling_grade(server: viser.Viser
                 client.set_value(label, value)
             client.wait_for(
                 lambda: (
-                    (scene.params.crr, scene.params.grade_pct, scene.params.headwind_ms)
-                    == (0.005, -0.5, -2.0)
+                    (scene.params.crr, scene.params.grade_pct, scene.params.headwind_ms) == (0.005, -0.5, -2.0)
                     and scene.params.target_power_w == 0.0
                 ),
                 what="the server to apply the course",
             )
             client.wait_for(
-                lambda: any(
-                    "holds **7.2 km/h**" in str(e["props"].get("_markdown", ""))
-                    for e in client.gui.values()
-                ),
+                lambda: any("holds **7.2 km/h**" in str(e["props"].get("_markdown", "")) for e in client.gui.values()),
                 what="the client to receive 7.2 km/h",
             )
             assert "**0.0 km/h**" not in scene.speed_out.content

@@ -19,9 +19,7 @@ from kernels import sdf
 # Widths from zero through float64 and float32 subnormals to ordinary ones.
 TINY_WIDTHS = [0.0, 5e-324, 1e-320, 1e-310, 2.2e-308, 1e-300, 1e-45, 1e-40, 1.2e-38, 1e-30, 1e-12]
 widths = st.one_of(st.sampled_from(TINY_WIDTHS), st.floats(0.0, 1e-3), st.floats(0.0, 1.0))
-distances = st.one_of(
-    st.sampled_from([0.0, -0.0, 1e-30, -1e-30, 0.25, -0.25]), st.floats(-3.0, 3.0)
-)
+distances = st.one_of(st.sampled_from([0.0, -0.0, 1e-30, -1e-30, 0.25, -0.25]), st.floats(-3.0, 3.0))
 
 HARD = {
     "union": np.minimum,
@@ -35,9 +33,7 @@ SMOOTH = {
 }
 
 
-def assert_near_hard(
-    got: np.ndarray, hard: np.ndarray, k: float, a: np.ndarray, b: np.ndarray
-) -> None:
+def assert_near_hard(got: np.ndarray, hard: np.ndarray, k: float, a: np.ndarray, b: np.ndarray) -> None:
     assert np.all(np.isfinite(got)), got
     rounding = 4 * np.finfo(got.dtype).eps * np.maximum(np.abs(a), np.abs(b))
     assert np.all(np.abs(got.astype(np.float64) - hard) <= k / 4 * (1 + 1e-6) + rounding)
@@ -199,9 +195,7 @@ def test_blends_of_infinite_and_huge_distances_are_never_nan(
     got64 = np.asarray(got, dtype=np.float64)
     assert not np.any(np.isnan(got64))
     infinite = ~np.isfinite(hard)
-    np.testing.assert_array_equal(
-        got64[infinite], hard[infinite]
-    )  # inf blended with anything is the hard answer
+    np.testing.assert_array_equal(got64[infinite], hard[infinite])  # inf blended with anything is the hard answer
     big = float(np.finfo(dtype).max)
     # Finite where the hard answer is, unless the true blend itself (within k/4 of it) lies beyond the dtype.
     with np.errstate(over="ignore", invalid="ignore"):
@@ -226,9 +220,7 @@ def test_an_infinite_distance_blends_to_the_other_one() -> None:
 
 @pytest.mark.parametrize("op", sdf.BOOLEAN_OPS)
 @pytest.mark.parametrize("blend", sdf.BLEND_FORMS)
-def test_a_far_point_has_an_infinite_distance_and_a_colour(
-    op: sdf.BooleanOp, blend: sdf.BlendForm
-) -> None:
+def test_a_far_point_has_an_infinite_distance_and_a_colour(op: sdf.BooleanOp, blend: sdf.BlendForm) -> None:
     # Once: NaN for every op and form at [[1e200, 0, 0]] (both primitives' lengths overflow to inf).
     scene = sdf.Scene(
         (
@@ -259,9 +251,7 @@ def test_smin_exp_with_a_subnormal_sharpness_is_finite_without_warnings() -> Non
             warnings.simplefilter("error")
             got = sdf.smin_exp(a, b, sharpness)
         with np.errstate(over="ignore"):
-            low = (
-                np.minimum(a, b) - np.log(2.0) / sharpness
-            )  # −inf: the bound says nothing at such sharpness
+            low = np.minimum(a, b) - np.log(2.0) / sharpness  # −inf: the bound says nothing at such sharpness
         assert np.all(np.isfinite(got)) and np.all((low <= got) & (got <= np.minimum(a, b)))
 
 

@@ -47,10 +47,7 @@ def euler_characteristic(inside: np.ndarray) -> int:
         present = None
         for offset in itertools.product(*[(0,) if s else (0, 1) for s in spans]):
             part = cubes[
-                tuple(
-                    slice(0, n) if s else slice(o, n - 1 + o)
-                    for s, o, n in zip(spans, offset, m, strict=True)
-                )
+                tuple(slice(0, n) if s else slice(o, n - 1 + o) for s, o, n in zip(spans, offset, m, strict=True))
             ]
             present = part if present is None else present | part
         assert present is not None
@@ -88,16 +85,11 @@ def inside_cells(scene: sdf.Scene, resolution: int, subdivide: int = 1) -> np.nd
 @st.composite
 def on_grid_box_pairs(draw: st.DrawFn, smooth: bool) -> tuple[sdf.Scene, int, dict[str, float]]:
     """Two boxes whose faces lie on grid planes, two voxels apart or coincident (every slab ≥ 2 voxels)."""
-    resolution = draw(
-        st.sampled_from(ON_GRID_RESOLUTIONS if not smooth else ON_GRID_RESOLUTIONS[:2])
-    )
+    resolution = draw(st.sampled_from(ON_GRID_RESOLUTIONS if not smooth else ON_GRID_RESOLUTIONS[:2]))
     top = (resolution - 1) // 2 - 1  # even indices 2..resolution − 3
     boxes = []
     for _ in range(2):
-        ends = [
-            sorted(draw(st.lists(st.integers(1, top), min_size=2, max_size=2, unique=True)))
-            for _ in range(3)
-        ]
+        ends = [sorted(draw(st.lists(st.integers(1, top), min_size=2, max_size=2, unique=True))) for _ in range(3)]
         boxes.append((tuple(2 * e[0] for e in ends), tuple(2 * e[1] for e in ends)))
     op = draw(st.sampled_from(sdf.BOOLEAN_OPS))
     (lo_a, hi_a), (lo_b, hi_b) = boxes
@@ -198,14 +190,10 @@ def l_shape() -> sdf.Scene:
 
 @pytest.mark.parametrize("resolution", [17, 33, 65])
 @pytest.mark.parametrize("near_surface", [True, False], ids=["coarse-to-fine", "full-grid"])
-def test_box_minus_box_on_grid_planes_is_a_closed_l_shape(
-    resolution: int, near_surface: bool
-) -> None:
+def test_box_minus_box_on_grid_planes_is_a_closed_l_shape(resolution: int, near_surface: bool) -> None:
     # Once: not watertight, Euler number 25 / 217 / 1177, volume 0.9115 at 17. Right: Euler 2, volume 0.875.
     grid = sdf.make_grid(l_shape(), resolution, BOUNDS)
-    assert (
-        np.count_nonzero(sdf.sample_full(l_shape(), grid) == 0.0) > 100
-    )  # the faces do lie on samples
+    assert np.count_nonzero(sdf.sample_full(l_shape(), grid) == 0.0) > 100  # the faces do lie on samples
     tri = assert_closed_solid(l_shape(), resolution, chi=1, near_surface=near_surface)
     assert tri is not None
     h = spacing(resolution)
@@ -291,9 +279,7 @@ def test_a_slab_one_voxel_thick_is_meshed() -> None:
         assert tri is not None
         # Convex edges on samples are exact; the faces sit at most 2δ = 2e-3 voxel outside.
         assert 0.125 - 1e-9 <= tri.volume <= 0.125 + 2 * sdf.ISO_NUDGE_VOXELS * 0.125 * tri.area
-        np.testing.assert_allclose(
-            tri.bounds, [[-0.5, -0.5, 0.0], [0.5, 0.5, 0.125]], atol=1e-3 * 0.125 * 2
-        )
+        np.testing.assert_allclose(tri.bounds, [[-0.5, -0.5, 0.0], [0.5, 0.5, 0.125]], atol=1e-3 * 0.125 * 2)
 
 
 @pytest.mark.parametrize("resolution", [16, 17, 33])

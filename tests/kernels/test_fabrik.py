@@ -25,9 +25,7 @@ BAD_SOLVER: Any = "newton"
 
 
 # ------------------------------------------------------------------------------------------------ helpers
-def random_chain(
-    rng: np.random.Generator, n: int, d: int, *, bend: float = 0.6
-) -> NDArray[np.float64]:
+def random_chain(rng: np.random.Generator, n: int, d: int, *, bend: float = 0.6) -> NDArray[np.float64]:
     """A chain of n links, lengths 0.2–1.5 m, each turning by up to ``bend`` rad from the last, rooted at a random place."""
     lengths = rng.uniform(0.2, 1.5, n)
     direction = np.zeros(d)
@@ -62,17 +60,13 @@ chains = st.tuples(st.integers(1, 12), st.sampled_from([2, 3]), st.integers(0, 2
 # ------------------------------------------------------------------------------------------------ properties
 @PROPERTY
 @given(chains, st.floats(0.0, 1.0), st.booleans(), st.booleans())
-def test_lengths_preserved_and_finite(
-    chain: tuple[int, int, int], where: float, limits: bool, obstacle: bool
-) -> None:
+def test_lengths_preserved_and_finite(chain: tuple[int, int, int], where: float, limits: bool, obstacle: bool) -> None:
     n, d, seed = chain
     rng = np.random.default_rng(seed)
     joints = random_chain(rng, n, d)
     total = fabrik.link_lengths(joints).sum()
     target = joints[0] + random_direction(rng, d) * where * 1.3 * total
-    obstacles = (
-        [(joints[0] + random_direction(rng, d) * 0.5 * total, 0.1 * total)] if obstacle else []
-    )
+    obstacles = [(joints[0] + random_direction(rng, d) * 0.5 * total, 0.1 * total)] if obstacle else []
     obstacles = [o for o in obstacles if np.linalg.norm(o[0] - joints[0]) > o[1]]
     result = fabrik.solve(
         joints,
@@ -83,18 +77,14 @@ def test_lengths_preserved_and_finite(
     )
     assert np.all(np.isfinite(result.joints))
     assert np.all(np.isfinite(result.error_history))
-    np.testing.assert_allclose(
-        fabrik.link_lengths(result.joints), fabrik.link_lengths(joints), rtol=1e-9
-    )
+    np.testing.assert_allclose(fabrik.link_lengths(result.joints), fabrik.link_lengths(joints), rtol=1e-9)
     np.testing.assert_array_equal(result.joints[0], joints[0])
     assert result.error == pytest.approx(np.linalg.norm(result.joints[-1] - target), abs=1e-12)
 
 
 @PROPERTY
 @given(chains, st.floats(0.0, 1.0), st.sampled_from(["fabrik", "ccd", "jacobian_dls"]))
-def test_reachable_targets_are_reached(
-    chain: tuple[int, int, int], where: float, solver: fabrik.Solver
-) -> None:
+def test_reachable_targets_are_reached(chain: tuple[int, int, int], where: float, solver: fabrik.Solver) -> None:
     n, d, seed = chain
     n = max(n, 2)  # one link reaches only its own circle
     rng = np.random.default_rng(seed)
@@ -104,9 +94,7 @@ def test_reachable_targets_are_reached(
     radius = inner + (0.05 + 0.9 * where) * (outer - inner)
     target = joints[0] + random_direction(rng, d) * radius
     tolerance = 1e-3 * outer
-    result = fabrik.solve_batch(
-        joints[None], target[None], tolerance=tolerance, max_iterations=3000, solver=solver
-    )[0]
+    result = fabrik.solve_batch(joints[None], target[None], tolerance=tolerance, max_iterations=3000, solver=solver)[0]
     assert result.status == "reached"
     assert result.error < tolerance
     assert np.linalg.norm(result.joints[-1] - target) < tolerance
@@ -114,9 +102,7 @@ def test_reachable_targets_are_reached(
 
 @PROPERTY
 @given(chains, st.floats(1.001, 5.0))
-def test_targets_beyond_reach_give_a_straight_chain_at_once(
-    chain: tuple[int, int, int], factor: float
-) -> None:
+def test_targets_beyond_reach_give_a_straight_chain_at_once(chain: tuple[int, int, int], factor: float) -> None:
     n, d, seed = chain
     rng = np.random.default_rng(seed)
     joints = random_chain(rng, n, d)
@@ -164,9 +150,7 @@ def test_cone_limits_never_violated(chain: tuple[int, int, int], where: float, p
         )[0]
         angles = fabrik.joint_angles(result.joints, root_direction)
         assert np.all(angles <= phi + 1e-6), (solver, angles.max(), phi)
-        np.testing.assert_allclose(
-            fabrik.link_lengths(result.joints), fabrik.link_lengths(joints), rtol=1e-9
-        )
+        np.testing.assert_allclose(fabrik.link_lengths(result.joints), fabrik.link_lengths(joints), rtol=1e-9)
 
 
 @PROPERTY
@@ -186,9 +170,7 @@ def test_no_segment_passes_through_an_obstacle(
         if segment_clearance(joints, centre) > radius and len(obstacles) < count:
             obstacles.append((centre, radius))
     phi = 0.8 if limits else None
-    result = fabrik.solve(
-        joints, target, obstacles=obstacles, cone_half_angle_rad=phi, max_iterations=100
-    )
+    result = fabrik.solve(joints, target, obstacles=obstacles, cone_half_angle_rad=phi, max_iterations=100)
     for centre, radius in obstacles:
         assert segment_clearance(result.joints, centre) >= radius * (1.0 - 1e-9), result.status
     if limits:
@@ -223,9 +205,7 @@ def test_single_solve_gives_the_batch_paths_bits_while_dragging_past_obstacles()
     """``solve`` runs its own one-chain driver; every field must equal a batch of one, bit for bit, on every status."""
     rng = np.random.default_rng(7)
     angles = 0.15 * np.arange(12)
-    joints = np.vstack(
-        [np.zeros(3), np.cumsum(0.1 * np.stack([np.sin(angles), 0 * angles, np.cos(angles)], 1), 0)]
-    )
+    joints = np.vstack([np.zeros(3), np.cumsum(0.1 * np.stack([np.sin(angles), 0 * angles, np.cos(angles)], 1), 0)])
     obstacles = [
         (np.array([0.35, 0.0, 0.55]), 0.08),
         (np.array([-0.3, 0.1, 0.6]), 0.1),
@@ -307,14 +287,10 @@ def test_degenerate_inputs_never_give_nan(d: int) -> None:
     for joints, target in cases:
         for phi in (None, 0.5):
             for solver in ("fabrik", "ccd", "jacobian_dls"):
-                result = fabrik.solve_batch(
-                    joints[None], target[None], cone_half_angle_rad=phi, solver=solver
-                )[0]
+                result = fabrik.solve_batch(joints[None], target[None], cone_half_angle_rad=phi, solver=solver)[0]
                 assert np.all(np.isfinite(result.joints)), (joints, target, phi, solver)
                 assert np.isfinite(result.error)
-                np.testing.assert_allclose(
-                    fabrik.link_lengths(result.joints), fabrik.link_lengths(joints), atol=1e-12
-                )
+                np.testing.assert_allclose(fabrik.link_lengths(result.joints), fabrik.link_lengths(joints), atol=1e-12)
     # A target on the root of an equal two-link chain is reachable: the chain folds onto itself.
     result = fabrik.solve(np.array([[0.0, 0.0], [0.0, 1.0], [1.0, 1.0]]), np.zeros(2))
     assert result.status == "reached"
@@ -376,9 +352,7 @@ def test_dragged_target_near_the_cone_limits_is_followed_in_few_iterations() -> 
     steps = link * np.stack([np.sin(angles), np.zeros(n), np.cos(angles)], axis=1)
     pose = np.vstack([np.zeros(3), np.cumsum(steps, axis=0)])
     worst = 0
-    for k in range(
-        260
-    ):  # the first half of the figure-eight, through the frames where the limits bind
+    for k in range(260):  # the first half of the figure-eight, through the frames where the limits bind
         s = 2.0 * math.pi * k / 500
         target = np.array([0.45 * math.sin(s), 0.25 * math.sin(2 * s), 0.75 + 0.2 * math.cos(s)])
         result = fabrik.solve(pose, target, cone_half_angle_rad=phi)
@@ -401,9 +375,7 @@ def test_plain_fabrik_is_still_available_and_slower_near_the_limits() -> None:
         pose, total = start, 0
         for k in range(0, 260, 4):
             s = 2.0 * math.pi * k / 500
-            target = np.array(
-                [0.45 * math.sin(s), 0.25 * math.sin(2 * s), 0.75 + 0.2 * math.cos(s)]
-            )
+            target = np.array([0.45 * math.sin(s), 0.25 * math.sin(2 * s), 0.75 + 0.2 * math.cos(s)])
             result = fabrik.solve(pose, target, cone_half_angle_rad=phi, extrapolate=extrapolate)
             assert np.all(fabrik.joint_angles(result.joints) <= phi + 1e-6)
             np.testing.assert_allclose(fabrik.link_lengths(result.joints), link, rtol=1e-9)
@@ -432,19 +404,13 @@ def test_targets_the_limits_put_out_of_reach_settle_limited_before_the_cap(d: in
 # ------------------------------------------------------------------------------------------------ two-bone
 def test_two_bone_matches_the_law_of_cosines() -> None:
     joints = fabrik.two_bone([0.0, 0.0], 1.0, 1.0, [math.sqrt(2.0), 0.0], [0.0, 1.0])
-    np.testing.assert_allclose(
-        joints, [[0, 0], [math.sqrt(0.5), math.sqrt(0.5)], [math.sqrt(2.0), 0]], atol=1e-12
-    )
+    np.testing.assert_allclose(joints, [[0, 0], [math.sqrt(0.5), math.sqrt(0.5)], [math.sqrt(2.0), 0]], atol=1e-12)
     # 3-4-5 triangle: the elbow angle at the root is acos(3/5) off the root–target line.
     joints = fabrik.two_bone([0.0, 0.0, 0.0], 3.0, 4.0, [5.0, 0.0, 0.0], [0.0, 0.0, -1.0])
     np.testing.assert_allclose(joints[1], [3.0 * 0.6, 0.0, -3.0 * 0.8], atol=1e-12)
     # Out of reach: straight toward the target; inside the hole: folded.
-    np.testing.assert_allclose(
-        fabrik.two_bone([0, 0], 1.0, 2.0, [10.0, 0.0], [0, 1])[2], [3.0, 0.0], atol=1e-12
-    )
-    np.testing.assert_allclose(
-        fabrik.two_bone([0, 0], 1.0, 2.0, [0.5, 0.0], [0, 1])[2], [1.0, 0.0], atol=1e-12
-    )
+    np.testing.assert_allclose(fabrik.two_bone([0, 0], 1.0, 2.0, [10.0, 0.0], [0, 1])[2], [3.0, 0.0], atol=1e-12)
+    np.testing.assert_allclose(fabrik.two_bone([0, 0], 1.0, 2.0, [0.5, 0.0], [0, 1])[2], [1.0, 0.0], atol=1e-12)
 
 
 @PROPERTY
@@ -510,9 +476,7 @@ def test_invalid_input_names_the_argument(call: object, name: str) -> None:
 SOLVERS: tuple[fabrik.Solver, ...] = ("fabrik", "ccd", "jacobian_dls")
 
 
-def reachable_target(
-    rng: np.random.Generator, joints: NDArray[np.float64], where: float
-) -> NDArray[np.float64]:
+def reachable_target(rng: np.random.Generator, joints: NDArray[np.float64], where: float) -> NDArray[np.float64]:
     """A target inside the reach annulus, ``where`` ∈ [0, 1] of the way out, clear of both edges."""
     inner, outer = fabrik.reach_limits(fabrik.link_lengths(joints))
     radius = inner + (0.05 + 0.9 * where) * (outer - inner)
@@ -559,9 +523,7 @@ def test_ccd_and_dls_iterates_are_the_published_methods(
     rng = np.random.default_rng(seed)
     joints = random_chain(rng, n, d, bend=1.0)
     target = reachable_target(rng, joints, where)
-    result = fabrik.solve_batch(
-        joints[None], target[None], tolerance=0.0, max_iterations=cap, solver=solver
-    )[0]
+    result = fabrik.solve_batch(joints[None], target[None], tolerance=0.0, max_iterations=cap, solver=solver)[0]
     reference = ik_reference.ccd if solver == "ccd" else ik_reference.dls
     poses = reference(joints, target, result.iterations)
     scale = fabrik.link_lengths(joints).sum()
@@ -582,9 +544,12 @@ def test_paper_setup_reaches_in_fewer_iterations_than_table_1() -> None:
     counts = []
     for plain in (False, True):
         batch = fabrik.solve_batch(
-            np.repeat(joints[None], 40, axis=0), targets, tolerance=0.01, max_iterations=1000,
+            np.repeat(joints[None], 40, axis=0),
+            targets,
+            tolerance=0.01,
+            max_iterations=1000,
             extrapolate=not plain,
-        )  # fmt: skip
+        )
         assert np.all(batch.status == "reached")
         counts.append(batch.iterations.mean())
     assert counts[1] <= 15.5
@@ -593,9 +558,7 @@ def test_paper_setup_reaches_in_fewer_iterations_than_table_1() -> None:
 
 @PROPERTY
 @given(st.integers(1, 12), st.sampled_from([2, 3]), st.integers(0, 2**32 - 1), st.booleans())
-def test_every_solver_gives_a_batch_the_bits_of_single_solves(
-    n: int, d: int, seed: int, limits: bool
-) -> None:
+def test_every_solver_gives_a_batch_the_bits_of_single_solves(n: int, d: int, seed: int, limits: bool) -> None:
     rng = np.random.default_rng(seed)
     joints = np.stack([random_chain(rng, n, d) for _ in range(5)])
     joints -= joints[:, :1]
@@ -686,10 +649,16 @@ def test_the_returned_pose_is_the_best_admissible_pose_seen(
     previous = math.inf
     for cap in CAPS:
         result = fabrik.solve_batch(
-            joints[None], target[None], tolerance=1e-3 * outer, max_iterations=cap,
-            cone_half_angle_rad=phi, obstacles=obstacles, root_direction=root_direction,
-            solver=solver, extrapolate=extrapolate,
-        )[0]  # fmt: skip
+            joints[None],
+            target[None],
+            tolerance=1e-3 * outer,
+            max_iterations=cap,
+            cone_half_angle_rad=phi,
+            obstacles=obstacles,
+            root_direction=root_direction,
+            solver=solver,
+            extrapolate=extrapolate,
+        )[0]
         # More iterations never give a worse admissible pose: each run repeats the shorter one's iterates first.
         # (Only where no admissible pose was ever seen is the last iterate returned, whatever its error.)
         if admissible(result.joints, phi, root_direction, obstacles):
@@ -739,9 +708,13 @@ def test_ccd_with_limits_and_obstacles_is_not_unreachable(solver: fabrik.Solver)
     obstacles = [(OBSTACLE_STARTS[k][[0, 2]], radii[k]) for k in range(4)]
     for target in ([0.8, 0.6], [0.0, 1.0], [1.0, 0.0]):
         result = fabrik.solve_batch(
-            joints[None], np.array([target]), cone_half_angle_rad=math.radians(28.0),
-            obstacles=obstacles, root_direction=[0.0, 1.0], solver=solver,
-        )[0]  # fmt: skip
+            joints[None],
+            np.array([target]),
+            cone_half_angle_rad=math.radians(28.0),
+            obstacles=obstacles,
+            root_direction=[0.0, 1.0],
+            solver=solver,
+        )[0]
         assert result.status in ("reached", "limited", "blocked", "max_iterations"), target
         assert result.error <= np.linalg.norm(joints[-1] - target)
 
@@ -785,16 +758,15 @@ def test_targets_within_tolerance_of_full_reach_are_reached(
     side -= (side @ direction) * direction
     tilt = 0.0 if phi is None else 0.99 * phi * rng.uniform()
     root_direction = math.cos(tilt) * direction + math.sin(tilt) * side / np.linalg.norm(side)
-    obstacles = [
-        (c, r)
-        for c, r in random_obstacles(rng, joints, count)
-        if segment_clearance(straight, c) > r
-    ]
+    obstacles = [(c, r) for c, r in random_obstacles(rng, joints, count) if segment_clearance(straight, c) > r]
     assert admissible(straight, phi, root_direction, obstacles)
     kwargs: dict[str, Any] = {
-        "tolerance": tolerance, "max_iterations": cap, "cone_half_angle_rad": phi,
-        "obstacles": obstacles, "root_direction": root_direction,
-    }  # fmt: skip
+        "tolerance": tolerance,
+        "max_iterations": cap,
+        "cone_half_angle_rad": phi,
+        "obstacles": obstacles,
+        "root_direction": root_direction,
+    }
     if batched:
         result = fabrik.solve_batch(joints[None], target[None], **kwargs)[0]
     else:
@@ -806,12 +778,8 @@ def test_targets_within_tolerance_of_full_reach_are_reached(
 
 
 @pytest.mark.parametrize("d", [2, 3])
-@pytest.mark.parametrize(
-    ("degrees", "short_of_reach"), [(90.0, 0.5e-3), (135.0, 0.9e-3), (90.0, 0.0), (180.0, 0.0)]
-)
-def test_full_reach_targets_of_the_default_arm_are_reached(
-    d: int, degrees: float, short_of_reach: float
-) -> None:
+@pytest.mark.parametrize(("degrees", "short_of_reach"), [(90.0, 0.5e-3), (135.0, 0.9e-3), (90.0, 0.0), (180.0, 0.0)])
+def test_full_reach_targets_of_the_default_arm_are_reached(d: int, degrees: float, short_of_reach: float) -> None:
     """The cases that showed it: 6 links of 0.25 m straight up, tolerance 1 mm, the target at ΣL − 0.5 mm at 90° to
     the chain, ΣL − 0.9 mm at 135°, or exactly ΣL: "max_iterations" at 1.57, 5.07 and 7.94 mm before. The straight
     pose toward the target is within tolerance: reached, its error exactly the shortfall."""
@@ -843,9 +811,7 @@ def test_warm_up_compiles_every_core_with_a_cache() -> None:
         for name, value in vars(module).items()
         if isinstance(value, CPUDispatcher)
     }
-    assert {"_solve_rows", "_solve_parallel", "_forward_pass", "_ccd_sweep", "_dls_step"} <= set(
-        cores
-    )
+    assert {"_solve_rows", "_solve_parallel", "_forward_pass", "_ccd_sweep", "_dls_step"} <= set(cores)
     for name, core in cores.items():
         cache = core._cache  # pyright: ignore[reportAttributeAccessIssue]
         assert type(cache).__name__ == "FunctionCache", name  # cache=True on every core
@@ -878,11 +844,15 @@ def test_compile_cache_falls_back_to_a_user_directory_when_the_package_is_read_o
     environment.pop("NUMBA_CACHE_DIR", None)
     runs = [
         subprocess.run(
-            [sys.executable, "-c", script], env=environment, capture_output=True, text=True,
-            timeout=120, check=True,
+            [sys.executable, "-c", script],
+            env=environment,
+            capture_output=True,
+            text=True,
+            timeout=120,
+            check=True,
         ).stdout.split()
         for _ in range(2)
-    ]  # fmt: skip
+    ]
     assert runs[0][1].startswith(str(tmp_path / "user-cache" / "numba"))
     assert any(path.suffix == ".nbc" for path in (tmp_path / "user-cache").rglob("*"))
     assert (runs[0][0], runs[1][0]) == ("0", "1")  # compiled once, then loaded from the user cache
@@ -926,17 +896,13 @@ def test_targets_within_tolerance_of_the_inner_radius_are_reached(
     rest = lengths.sum() - lengths[longest]
     # Stretch the longest link along its own direction so that it beats the rest by the factor ``dominance``.
     scaled = joints.copy()
-    scaled[longest + 1 :] += (joints[longest + 1] - joints[longest]) * (
-        dominance * rest / lengths[longest] - 1.0
-    )
+    scaled[longest + 1 :] += (joints[longest + 1] - joints[longest]) * (dominance * rest / lengths[longest] - 1.0)
     joints, lengths = scaled, fabrik.link_lengths(scaled)
     inner, outer = fabrik.reach_limits(lengths)
     assert inner > 0.0
     tolerance = relative_tolerance * inner
     direction = random_direction(rng, d)
-    rounding = 1e-12 * (
-        outer + np.abs(joints[0]).max()
-    )  # the target stops that far inside the band
+    rounding = 1e-12 * (outer + np.abs(joints[0]).max())  # the target stops that far inside the band
     target = joints[0] + direction * (inner + fraction * max(tolerance - rounding, 0.0))
     obstacles = [
         (c, r)
@@ -1006,13 +972,21 @@ def test_solves_at_any_power_of_two_scale_are_the_unit_solve_scaled(
     s = math.ldexp(1.0, exponent)
     common: dict[str, Any] = {"cone_half_angle_rad": phi, "root_direction": root_direction * s}
     unit = fabrik.solve_batch(
-        joints[None], target[None], tolerance=relative_tolerance * outer, solver=solver,
-        obstacles=obstacles, **common,
-    )[0]  # fmt: skip
+        joints[None],
+        target[None],
+        tolerance=relative_tolerance * outer,
+        solver=solver,
+        obstacles=obstacles,
+        **common,
+    )[0]
     scaled = fabrik.solve_batch(
-        joints[None] * s, target[None] * s, tolerance=relative_tolerance * outer * s,
-        solver=solver, obstacles=[(c * s, r * s) for c, r in obstacles], **common,
-    )[0]  # fmt: skip
+        joints[None] * s,
+        target[None] * s,
+        tolerance=relative_tolerance * outer * s,
+        solver=solver,
+        obstacles=[(c * s, r * s) for c, r in obstacles],
+        **common,
+    )[0]
     assert (scaled.status, scaled.iterations) == (unit.status, unit.iterations)
     np.testing.assert_array_equal(scaled.joints, unit.joints * s)
     assert scaled.error == unit.error * s
@@ -1020,9 +994,7 @@ def test_solves_at_any_power_of_two_scale_are_the_unit_solve_scaled(
         (unit, relative_tolerance * outer),
         (scaled, relative_tolerance * outer * s),
     ):
-        assert (result.status == "reached") == (
-            result.error <= tolerance and result.status != "infeasible"
-        )
+        assert (result.status == "reached") == (result.error <= tolerance and result.status != "infeasible")
 
 
 @pytest.mark.parametrize("scale", [1e-300, 1e-160, 1e-20, 1e154, 4e299])
@@ -1032,9 +1004,7 @@ def test_huge_and_tiny_chains_are_solved(scale: float, solver: fabrik.Solver) ->
     overflowed (NaN joints, inf error); at 1e-20 and below "reached" came with errors 1000× the tolerance. Right:
     reached, error ≤ s·1e-3, finite joints with the links' lengths."""
     joints = scale * np.array([[0.0, 0.0], [0.0, 1.0], [0.0, 2.0]])
-    result = fabrik.solve_batch(
-        joints[None], scale * np.array([[1.0, 1.0]]), tolerance=scale * 1e-3, solver=solver
-    )[0]
+    result = fabrik.solve_batch(joints[None], scale * np.array([[1.0, 1.0]]), tolerance=scale * 1e-3, solver=solver)[0]
     assert result.status == "reached"
     assert result.error <= scale * 1e-3
     assert np.isfinite(result.joints).all()
@@ -1057,9 +1027,7 @@ def test_reached_has_no_slack_beyond_the_tolerance() -> None:
 def test_root_direction_of_any_length_keeps_the_cone(length: float) -> None:
     """F4: root_direction (0, 1e300) normalised to (0, 0) (its squared norm overflowed) and silently removed the
     root cone. Any non-zero length gives the same direction: the first link stays within 0.1 rad of +y."""
-    result = fabrik.solve(
-        [[0.0, 0.0], [0.0, 1.0]], [1.0, 0.0], cone_half_angle_rad=0.1, root_direction=[0.0, length]
-    )
+    result = fabrik.solve([[0.0, 0.0], [0.0, 1.0]], [1.0, 0.0], cone_half_angle_rad=0.1, root_direction=[0.0, length])
     assert result.status == "limited"
     np.testing.assert_allclose(result.joints[1], [math.sin(0.1), math.cos(0.1)], rtol=1e-12)
 
@@ -1068,15 +1036,11 @@ def test_huge_two_bone_points_at_its_target() -> None:
     """F4's two-bone input: links of 1e300 from the origin to (1e300, 1e300), bending toward +y, pointed away
     from the target (L² overflowed). Right: elbow (0, 1e300), end on the target."""
     pose = fabrik.two_bone([0.0, 0.0], 1e300, 1e300, [1e300, 1e300], [0.0, 1.0])
-    np.testing.assert_allclose(
-        pose, [[0.0, 0.0], [0.0, 1e300], [1e300, 1e300]], rtol=1e-12, atol=0.0
-    )
+    np.testing.assert_allclose(pose, [[0.0, 0.0], [0.0, 1e300], [1e300, 1e300]], rtol=1e-12, atol=0.0)
 
 
 @PROPERTY
-@given(
-    st.integers(-900, 900), st.integers(0, 2**32 - 1), st.floats(0.0, 1.2), st.sampled_from([2, 3])
-)
+@given(st.integers(-900, 900), st.integers(0, 2**32 - 1), st.floats(0.0, 1.2), st.sampled_from([2, 3]))
 def test_two_bone_at_any_power_of_two_scale_is_the_unit_solve_scaled(
     exponent: int, seed: int, where: float, d: int
 ) -> None:
@@ -1087,9 +1051,7 @@ def test_two_bone_at_any_power_of_two_scale_is_the_unit_solve_scaled(
     bend = random_direction(rng, d)
     s = math.ldexp(1.0, exponent)
     unit = fabrik.two_bone(root, upper, lower, target, bend)
-    np.testing.assert_array_equal(
-        fabrik.two_bone(root * s, upper * s, lower * s, target * s, bend * s), unit * s
-    )
+    np.testing.assert_array_equal(fabrik.two_bone(root * s, upper * s, lower * s, target * s, bend * s), unit * s)
 
 
 @PROPERTY
@@ -1108,15 +1070,11 @@ def test_a_start_on_the_target_is_reached_at_tolerance_zero(
     root_direction = (joints[1] - joints[0]) / np.linalg.norm(joints[1] - joints[0])
     if phi is not None and not admissible(joints, phi, root_direction, []):
         phi = None
-    kwargs: dict[str, Any] = {
-        "tolerance": 0.0, "cone_half_angle_rad": phi, "root_direction": root_direction
-    }  # fmt: skip
+    kwargs: dict[str, Any] = {"tolerance": 0.0, "cone_half_angle_rad": phi, "root_direction": root_direction}
     if batched:
         result = fabrik.solve_batch(joints[None], joints[-1:], solver=solver, **kwargs)[0]
     else:
-        call = {"fabrik": fabrik.solve, "ccd": fabrik.ccd, "jacobian_dls": fabrik.jacobian_dls}[
-            solver
-        ]
+        call = {"fabrik": fabrik.solve, "ccd": fabrik.ccd, "jacobian_dls": fabrik.jacobian_dls}[solver]
         result = call(joints, joints[-1], **kwargs)
     assert (result.status, result.iterations, result.error) == ("reached", 0, 0.0)
     np.testing.assert_array_equal(result.joints, joints)
@@ -1126,9 +1084,7 @@ def test_a_start_on_the_target_is_reached_at_tolerance_zero(
 def test_start_on_the_target_with_tolerance_zero(solver: fabrik.Solver) -> None:
     """F5's input: chain (0, 0), (0, 1), (1, 1), target (1, 1), tolerance 0."""
     joints = np.array([[0.0, 0.0], [0.0, 1.0], [1.0, 1.0]])
-    result = fabrik.solve_batch(joints[None], np.array([[1.0, 1.0]]), tolerance=0.0, solver=solver)[
-        0
-    ]
+    result = fabrik.solve_batch(joints[None], np.array([[1.0, 1.0]]), tolerance=0.0, solver=solver)[0]
     assert (result.status, result.iterations, result.error) == ("reached", 0, 0.0)
 
 
@@ -1160,9 +1116,14 @@ def test_only_infeasible_solves_return_a_pose_that_breaks_a_constraint(
     root_direction = random_direction(rng, d)
     obstacles = random_obstacles(rng, joints, count)
     result = fabrik.solve_batch(
-        joints[None], target[None], tolerance=1e-2 * outer, cone_half_angle_rad=phi,
-        obstacles=obstacles, root_direction=root_direction, solver=solver,
-    )[0]  # fmt: skip
+        joints[None],
+        target[None],
+        tolerance=1e-2 * outer,
+        cone_half_angle_rad=phi,
+        obstacles=obstacles,
+        root_direction=root_direction,
+        solver=solver,
+    )[0]
     if result.status != "infeasible":
         assert admissible(result.joints, phi, root_direction, obstacles), result.status
     if admissible(joints, phi, root_direction, obstacles):
@@ -1172,21 +1133,32 @@ def test_only_infeasible_solves_return_a_pose_that_breaks_a_constraint(
 def test_a_dls_pose_through_an_obstacle_is_infeasible() -> None:
     """The case that showed it: DLS returned a pose cutting an obstacle by 0.025 m with status
     "blocked" and error < tolerance. The start cuts one too, and no iterate clears them all: "infeasible"."""
-    joints = np.array([
-        [0.0, 0.0], [0.6891671438919661, 0.5236051652449843], [0.2882144032837863, 0.024944821000129125],
-        [0.15713216682656647, 0.21905153446984119], [-0.38456598998267744, 0.667941055707956],
-        [-1.0444604674055584, 1.0667592091512175], [-1.1148908635415238, 1.1659096698694158],
-        [-1.4713856155887348, 1.3694575772849973], [-1.607000108026135, 1.703482813456145],
-    ])  # fmt: skip
+    joints = np.array(
+        [
+            [0.0, 0.0],
+            [0.6891671438919661, 0.5236051652449843],
+            [0.2882144032837863, 0.024944821000129125],
+            [0.15713216682656647, 0.21905153446984119],
+            [-0.38456598998267744, 0.667941055707956],
+            [-1.0444604674055584, 1.0667592091512175],
+            [-1.1148908635415238, 1.1659096698694158],
+            [-1.4713856155887348, 1.3694575772849973],
+            [-1.607000108026135, 1.703482813456145],
+        ]
+    )
     obstacles = [
-        (np.array([-3.731, 2.542]), 1.51), (np.array([2.075, -0.036]), 1.418),
+        (np.array([-3.731, 2.542]), 1.51),
+        (np.array([2.075, -0.036]), 1.418),
         (np.array([-4.075, 1.363]), 1.308),
-    ]  # fmt: skip
+    ]
     phi = 2.270989480013398
     result = fabrik.jacobian_dls(
-        joints, [-0.000632119904869785, 6.225565368868713e-07], tolerance=0.01,
-        cone_half_angle_rad=phi, obstacles=obstacles,
-    )  # fmt: skip
+        joints,
+        [-0.000632119904869785, 6.225565368868713e-07],
+        tolerance=0.01,
+        cone_half_angle_rad=phi,
+        obstacles=obstacles,
+    )
     assert not admissible(joints, phi, np.array([0.0, 1.0]), obstacles)
     assert not admissible(result.joints, phi, np.array([0.0, 1.0]), obstacles)
     assert result.status == "infeasible"
@@ -1276,9 +1248,7 @@ def test_targets_an_admissible_pose_reaches_are_seldom_limited() -> None:
         ([0.6049, 0.8281, 0.436], [-0.2333, 1.8494], 0.154),
     ],
 )
-def test_stalled_limited_chains_restart(
-    lengths: list[float], target: list[float], before: float
-) -> None:
+def test_stalled_limited_chains_restart(lengths: list[float], target: list[float], before: float) -> None:
     """F7's inputs (p9.py), φ = 0.3 rad, from straight up: "limited" at 0.708 m and 0.154 m, while an admissible
     pose (every joint within 0.24 rad) ends on the target. After the restart the error is below 2 % of that."""
     joints = np.zeros((len(lengths) + 1, 2))

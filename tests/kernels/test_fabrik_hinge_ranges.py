@@ -73,9 +73,7 @@ def keeps_ranges(joints: NDArray[np.float64], ranges: list[tuple[float, float]])
     headings = np.unwrap(np.arctan2(segments[:, 1], segments[:, 0]))
     relative = np.diff(np.concatenate([[math.pi / 2], headings]))
     relative = (relative + math.pi) % (2 * math.pi) - math.pi
-    return all(
-        low - 1e-7 <= a <= high + 1e-7 for a, (low, high) in zip(relative, ranges, strict=True)
-    )
+    return all(low - 1e-7 <= a <= high + 1e-7 for a, (low, high) in zip(relative, ranges, strict=True))
 
 
 # ------------------------------------------------------------------------------ one-sided ranges: both hands
@@ -114,8 +112,10 @@ def miss_rate(rng: np.random.Generator, count: int, hand: int, arm: bool) -> flo
 @pytest.mark.parametrize("arm", [True, False], ids=["2x1m-arm", "2-6-links"])
 def test_at_most_two_percent_of_reachable_targets_are_missed_by_either_hand(arm: bool) -> None:
     rates = {hand: miss_rate(np.random.default_rng(7), 400, hand, arm) for hand in (1, -1)}
-    print(f"missed ({'2 x 1 m arm' if arm else '2-6 links'}, 400 reachable targets): right {rates[1]:.1%}, "
-          f"mirror {rates[-1]:.1%}")  # fmt: skip
+    print(
+        f"missed ({'2 x 1 m arm' if arm else '2-6 links'}, 400 reachable targets): right {rates[1]:.1%}, "
+        f"mirror {rates[-1]:.1%}"
+    )
     assert rates[1] <= MISS_GOAL and rates[-1] <= MISS_GOAL, rates
     assert abs(rates[1] - rates[-1]) <= 0.01, rates
 
@@ -146,9 +146,7 @@ ROD_2D = np.array([[0.0, 0.0], [0.0, 1.0], [0.0, 2.0], [0.0, 3.0]])
 ROD_3D = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, 2.0], [0.0, 0.0, 3.0]])
 
 
-@pytest.mark.parametrize(
-    ("target", "expected"), [((1.0, 2.5), 0.307), ((-2.0, -2.0), 0.172), ((2.0, 0.5), 0.938)]
-)
+@pytest.mark.parametrize(("target", "expected"), [((1.0, 2.5), 0.307), ((-2.0, -2.0), 0.172), ((2.0, 0.5), 0.938)])
 @pytest.mark.parametrize("kind", ["hinge", "cone"])
 def test_a_rod_of_zero_range_hinges_ends_at_its_optimum(
     target: tuple[float, float], expected: float, kind: str
@@ -188,9 +186,7 @@ def test_a_rod_of_one_degree_hinges_ends_at_its_optimum(target: tuple[float, flo
 
 @pytest.mark.parametrize("target", [(1.0, 0.5, 2.5), (-2.0, 1.0, -2.0), (2.0, -1.0, 0.5)])
 @pytest.mark.parametrize("flex_deg", [0.0, 1.0])
-def test_a_3d_rod_of_local_hinges_ends_at_its_optimum(
-    target: tuple[float, float, float], flex_deg: float
-) -> None:
+def test_a_3d_rod_of_local_hinges_ends_at_its_optimum(target: tuple[float, float, float], flex_deg: float) -> None:
     """The same rod in 3D along +z, its hinges about x in the frame of the previous segment."""
     point = np.array(target)
     flex = math.radians(flex_deg)

@@ -99,19 +99,12 @@ def test_a_hinge_is_never_violated_from_any_start(
     joints = random_chain(rng, n, 3)  # a random start: it breaks the hinges
     hinges = random_hinges(rng, n, frame)
     rest = np.array([0.0, 0.0, 1.0])
-    if (
-        frame == "local"
-    ):  # the shortest turn is undefined for antiparallel segments: not a start we draw
-        hinges = [fabrik.Hinge(h.axis, h.min_angle_rad, h.max_angle_rad, h.reference_axis, "local")
-                  for h in hinges]  # fmt: skip
+    if frame == "local":  # the shortest turn is undefined for antiparallel segments: not a start we draw
+        hinges = [fabrik.Hinge(h.axis, h.min_angle_rad, h.max_angle_rad, h.reference_axis, "local") for h in hinges]
     total = float(fabrik.link_lengths(joints).sum())
     target = joints[0] + rng.normal(size=3) / math.sqrt(3) * where * total
-    result = fabrik.solve_batch(
-        joints[None], target[None], constraints=hinges, solver=solver, max_iterations=100
-    )[0]
-    np.testing.assert_allclose(
-        fabrik.link_lengths(result.joints), fabrik.link_lengths(joints), rtol=1e-9
-    )
+    result = fabrik.solve_batch(joints[None], target[None], constraints=hinges, solver=solver, max_iterations=100)[0]
+    np.testing.assert_allclose(fabrik.link_lengths(result.joints), fabrik.link_lengths(joints), rtol=1e-9)
     if result.iterations == 0:
         return  # the start already reached and kept every hinge (checked by the kernel)
     try:
@@ -124,15 +117,11 @@ def test_a_hinge_is_never_violated_from_any_start(
 
 @PROPERTY
 @given(st.integers(1, 10), SEEDS, st.floats(-2.0, 2.0))
-def test_a_planar_chain_of_global_z_hinges_stays_in_its_plane(
-    n: int, seed: int, height: float
-) -> None:
+def test_a_planar_chain_of_global_z_hinges_stays_in_its_plane(n: int, seed: int, height: float) -> None:
     rng = np.random.default_rng(seed)
     planar = random_chain(rng, n, 2)
     joints = np.column_stack([planar, np.full(n + 1, height)])  # in the plane z = height
-    hinges = [
-        fabrik.Hinge((0, 0, 1), -rng.uniform(0.2, 3.0), rng.uniform(0.2, 3.0)) for _ in range(n)
-    ]
+    hinges = [fabrik.Hinge((0, 0, 1), -rng.uniform(0.2, 3.0), rng.uniform(0.2, 3.0)) for _ in range(n)]
     target = rng.uniform(-4.0, 4.0, 3)  # anywhere, also off the plane
     result = fabrik.solve(joints, target, constraints=hinges, root_direction=(1.0, 0.0, 0.0))
     np.testing.assert_allclose(result.joints[:, 2], height, atol=1e-12)
@@ -165,21 +154,18 @@ def test_hinge_range_limits_hold_in_the_plane(n: int, seed: int, where: float) -
 
 @PROPERTY
 @given(st.integers(2, 10), SEEDS, st.floats(0.0, 1.0), st.booleans())
-def test_free_hinges_reach_every_reachable_target_in_their_plane(
-    n: int, seed: int, where: float, local: bool
-) -> None:
+def test_free_hinges_reach_every_reachable_target_in_their_plane(n: int, seed: int, where: float, local: bool) -> None:
     rng = np.random.default_rng(seed)
     joints = np.column_stack([random_chain(rng, n, 2), np.zeros(n + 1)])
     inner, outer = fabrik.reach_limits(fabrik.link_lengths(joints))
-    radius = inner + (0.05 + 0.9 * where) * (
-        outer - inner
-    )  # clear of the annulus edges (see test_fabrik)
+    radius = inner + (0.05 + 0.9 * where) * (outer - inner)  # clear of the annulus edges (see test_fabrik)
     angle = rng.uniform(0, 2 * math.pi)
     target = joints[0] + radius * np.array([math.cos(angle), math.sin(angle), 0.0])
     hinges = [fabrik.Hinge((0, 0, 1), frame="local" if local else "global")] * n
     tolerance = 1e-3 * outer
-    result = fabrik.solve(joints, target, constraints=hinges, tolerance=tolerance,
-                          max_iterations=3000, root_direction=(0.0, 1.0, 0.0))  # fmt: skip
+    result = fabrik.solve(
+        joints, target, constraints=hinges, tolerance=tolerance, max_iterations=3000, root_direction=(0.0, 1.0, 0.0)
+    )
     assert result.status == "reached"
     assert np.linalg.norm(result.joints[-1] - target) < tolerance
 
@@ -217,9 +203,7 @@ def test_a_straight_hinge_range_of_zero_fixes_the_segment() -> None:
 
 
 # ------------------------------------------------------------------------------------------------ plain tree reference
-def tree_reference(
-    parents: list[int], joints: Array, targets: dict[int, Array], iterations: int
-) -> list[Array]:
+def tree_reference(parents: list[int], joints: Array, targets: dict[int, Array], iterations: int) -> list[Array]:
     """Poses after each iteration of multi-end-effector FABRIK (Aristidou & Lasenby 2011, §4.2), plainly.
 
     Forward: each effector on its target, each joint pulled toward its parent (λ = d / |p_parent − p_j|); a joint
@@ -265,9 +249,7 @@ def random_tree(rng: np.random.Generator, count: int, d: int) -> tuple[list[int]
     parents = [-1] + [int(rng.integers(0, j)) for j in range(1, count)]
     joints = np.zeros((count, d))
     for j in range(1, count):
-        joints[j] = joints[parents[j]] + rng.uniform(0.3, 1.0) * (
-            np.eye(d)[-1] + 0.8 * rng.normal(size=d)
-        )
+        joints[j] = joints[parents[j]] + rng.uniform(0.3, 1.0) * (np.eye(d)[-1] + 0.8 * rng.normal(size=d))
     return parents, joints
 
 
@@ -296,9 +278,7 @@ def test_tree_iterates_are_the_papers_algorithm(count: int, seed: int, d: int, k
 
 @PROPERTY
 @given(st.integers(2, 10), SEEDS, st.sampled_from([2, 3]), st.booleans())
-def test_a_tree_that_is_one_chain_gives_solves_result(
-    n: int, seed: int, d: int, hinged: bool
-) -> None:
+def test_a_tree_that_is_one_chain_gives_solves_result(n: int, seed: int, d: int, hinged: bool) -> None:
     rng = np.random.default_rng(seed)
     chain = random_chain(rng, n, d)
     target = chain[0] + rng.normal(size=d)
@@ -313,11 +293,8 @@ def test_a_tree_that_is_one_chain_gives_solves_result(
     parents = [-1 if order[s] == 0 else int(where[order[s] - 1]) for s in range(n + 1)]
     stored_constraints = None
     if constraints is not None:
-        stored_constraints = [
-            None if order[s] == 0 else constraints[order[s] - 1] for s in range(n + 1)
-        ]
-    result = fabrik.solve_tree(parents, chain[order], {int(where[n]): target},
-                               constraints=stored_constraints)  # fmt: skip
+        stored_constraints = [None if order[s] == 0 else constraints[order[s] - 1] for s in range(n + 1)]
+    result = fabrik.solve_tree(parents, chain[order], {int(where[n]): target}, constraints=stored_constraints)
     assert np.array_equal(result.joints[where], expected.joints)
     assert result.status == (expected.status,)
     assert result.iterations == expected.iterations
@@ -336,9 +313,7 @@ def pose_tree(rng: np.random.Generator, parents: list[int], joints: Array) -> Ar
 
 @PROPERTY
 @given(st.integers(2, 5), st.integers(1, 4), SEEDS, st.sampled_from([2, 3]))
-def test_reachable_effectors_on_separate_branches_reach(
-    branches: int, links: int, seed: int, d: int
-) -> None:
+def test_reachable_effectors_on_separate_branches_reach(branches: int, links: int, seed: int, d: int) -> None:
     """Branches that meet only at the root do not conflict: every effector reaches a target its branch can reach."""
     rng = np.random.default_rng(seed)
     parents = [-1]
@@ -357,8 +332,10 @@ def test_reachable_effectors_on_separate_branches_reach(
     if links == 1:
         assert all(s in ("reached", "unreachable", "limited") for s in result.status)
         return  # one link only reaches its own circle
-    inner = [fabrik.reach_limits(fabrik.link_lengths(start[[0, *range(1 + b * links, 1 + (b + 1) * links)]]))
-             for b in range(branches)]  # fmt: skip
+    inner = [
+        fabrik.reach_limits(fabrik.link_lengths(start[[0, *range(1 + b * links, 1 + (b + 1) * links)]]))
+        for b in range(branches)
+    ]
     for e, key in enumerate(result.effectors):
         b = (int(key) - 1) // links
         radius = float(np.linalg.norm(targets[int(key)]))
@@ -371,10 +348,17 @@ def test_reachable_effectors_on_separate_branches_reach(
 def y_tree() -> tuple[list[int], Array]:
     """Root, a trunk of two links to a sub-base, and two arms of two links each, mirror-symmetric in x."""
     parents = [-1, 0, 1, 2, 3, 2, 5]
-    joints = np.array([
-        [0.0, 0.0], [0.0, 0.5], [0.0, 1.0],
-        [-0.4, 1.3], [-0.8, 1.6], [0.4, 1.3], [0.8, 1.6],
-    ])  # fmt: skip
+    joints = np.array(
+        [
+            [0.0, 0.0],
+            [0.0, 0.5],
+            [0.0, 1.0],
+            [-0.4, 1.3],
+            [-0.8, 1.6],
+            [0.4, 1.3],
+            [0.8, 1.6],
+        ]
+    )
     return parents, joints
 
 
@@ -396,9 +380,7 @@ def test_conflicting_targets_settle_at_the_centroid_compromise(spread: float) ->
 
 @PROPERTY
 @given(SEEDS, st.floats(0.5, 3.0))
-def test_conflicting_targets_settle_at_a_fixed_point_of_the_centroid_rule(
-    seed: int, spread: float
-) -> None:
+def test_conflicting_targets_settle_at_a_fixed_point_of_the_centroid_rule(seed: int, spread: float) -> None:
     rng = np.random.default_rng(seed)
     parents, joints = y_tree()
     targets = {4: rng.normal(size=2) * spread, 6: rng.normal(size=2) * spread}
@@ -500,23 +482,26 @@ def test_invalid_input_names_the_argument(call: object, name: str) -> None:
 
 # ------------------------------------------------------------------------------------------------ review faults
 Y3_PARENTS = [-1, 0, 1, 2, 3, 2, 5]
-Y3 = np.array([
-    [0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, 2.0],
-    [-0.5, 0.0, 2.8], [-1.0, 0.0, 3.6], [0.5, 0.0, 2.8], [1.0, 0.0, 3.6],
-])  # fmt: skip
+Y3 = np.array(
+    [
+        [0.0, 0.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [0.0, 0.0, 2.0],
+        [-0.5, 0.0, 2.8],
+        [-1.0, 0.0, 3.6],
+        [0.5, 0.0, 2.8],
+        [1.0, 0.0, 3.6],
+    ]
+)
 
 
-def tree_hinge_violation(
-    parents: list[int], joints: Array, hinges: dict[int, fabrik.Hinge]
-) -> tuple[float, float]:
+def tree_hinge_violation(parents: list[int], joints: Array, hinges: dict[int, fabrik.Hinge]) -> tuple[float, float]:
     """(largest |segment · axis|, largest angle outside its range in rad) over a 3D tree's global hinges without a
     reference axis (each measured from its parent's segment, the root's children from +z), in plain numpy."""
     off_plane, off_range = 0.0, 0.0
     for j, hinge in hinges.items():
         up = parents[j]
-        previous = (
-            np.array([0.0, 0.0, 1.0]) if parents[up] < 0 else joints[up] - joints[parents[up]]
-        )
+        previous = np.array([0.0, 0.0, 1.0]) if parents[up] < 0 else joints[up] - joints[parents[up]]
         u = (joints[j] - joints[up]) / np.linalg.norm(joints[j] - joints[up])
         axis = np.asarray(hinge.axis)
         reference = previous - (previous @ axis) * axis
@@ -558,9 +543,7 @@ def test_every_returned_pose_keeps_every_hinge_whatever_the_start(count: int, se
     result = fabrik.solve_tree(parents, joints, targets, constraints=constraints)
     off_plane, off_range = tree_hinge_violation(parents, result.joints, hinges)
     assert off_plane < 1e-9 and off_range < 1e-9
-    if (
-        max(tree_hinge_violation(parents, joints, hinges)) > 1e-6
-    ):  # a start that breaks one is iterated on
+    if max(tree_hinge_violation(parents, joints, hinges)) > 1e-6:  # a start that breaks one is iterated on
         assert result.iterations > 0
     for status, error in zip(result.status, result.error, strict=True):
         assert status != "reached" or error <= 1e-3
@@ -593,8 +576,7 @@ def test_huge_and_tiny_trees_solve_as_the_unit_tree(size: float) -> None:
     stalled as "limited"). With the tolerance scaled too, every scale gives the unit tree's result scaled."""
     targets = {4: np.array([-1.5, 0.0, 3.0]), 6: np.array([1.5, 0.0, 3.0])}
     unit = fabrik.solve_tree(Y3_PARENTS, Y3, targets, tolerance=1e-3)
-    scaled = fabrik.solve_tree(Y3_PARENTS, Y3 * size, {k: v * size for k, v in targets.items()},
-                               tolerance=1e-3 * size)  # fmt: skip
+    scaled = fabrik.solve_tree(Y3_PARENTS, Y3 * size, {k: v * size for k, v in targets.items()}, tolerance=1e-3 * size)
     assert np.isfinite(scaled.joints).all()
     assert scaled.status == unit.status == ("reached", "reached")
     assert scaled.iterations == unit.iterations
@@ -616,9 +598,14 @@ def test_a_tree_scaled_by_a_power_of_two_gives_the_result_scaled(
     obstacles = [(joints[0] + np.eye(d)[0] * 2.0, 0.5)]
     s = math.ldexp(1.0, k)
     base = fabrik.solve_tree(parents, joints, targets, constraints=constraints, obstacles=obstacles)
-    scaled = fabrik.solve_tree(parents, joints * s, {e: t * s for e, t in targets.items()},
-                               tolerance=1e-3 * s, constraints=constraints,
-                               obstacles=[(c * s, r * s) for c, r in obstacles])  # fmt: skip
+    scaled = fabrik.solve_tree(
+        parents,
+        joints * s,
+        {e: t * s for e, t in targets.items()},
+        tolerance=1e-3 * s,
+        constraints=constraints,
+        obstacles=[(c * s, r * s) for c, r in obstacles],
+    )
     assert scaled.status == base.status
     assert scaled.iterations == base.iterations
     np.testing.assert_array_equal(scaled.joints, base.joints * s)
@@ -649,9 +636,7 @@ def test_a_free_tree_is_never_limited(count: int, seed: int, d: int, spread: flo
     ("key", "alias", "parents"),
     [(2, 2.0, [-1, 0, 1]), (1, True, [-1, 0]), (2, np.float64(2.0), [-1, 0, 1])],
 )
-def test_keys_that_hash_as_a_cached_index_are_still_refused(
-    key: int, alias: Any, parents: list[int]
-) -> None:
+def test_keys_that_hash_as_a_cached_index_are_still_refused(key: int, alias: Any, parents: list[int]) -> None:
     """Kind: validation behind a cache. 2.0 and True hash as 2 and 1, so after a call with the integer key the
     topology cache accepted them."""
     joints = np.eye(len(parents), 3)
@@ -692,8 +677,7 @@ def test_chain_and_one_branch_tree_judge_a_pose_alike(seed: int, n: int, limited
     order = np.arange(n + 1, dtype=np.int64)
     tree_table = np.vstack([np.zeros((1, table.shape[1])), table])
     as_chain = chain._admissible(p, tiny, rest, limited, table, centres, radii, live)
-    as_tree = tree._tree_admissible(p, parents, order, tree_table, rest, tiny, limited, centres,
-                                    radii, live)  # fmt: skip
+    as_tree = tree._tree_admissible(p, parents, order, tree_table, rest, tiny, limited, centres, radii, live)
     assert as_chain == as_tree
     for i in range(n):  # the one segment test, zero-length segments included, never NaN
         cut = geometry._segment_cuts(p, i, i + 1, centres, radii, live, 1.0)
@@ -714,5 +698,4 @@ def test_a_zero_length_segment_inside_a_sphere_cuts_it_for_chain_and_tree() -> N
     rest = np.array([0.0, 0.0, 1.0])
     parents, order = np.array([-1, 0, 1]), np.array([0, 1, 2])
     assert not chain._admissible(p, 1e-12, rest, False, table, centres, radii, live)
-    assert not tree._tree_admissible(p, parents, order, np.zeros((3, 13)), rest, 1e-12, False,
-                                     centres, radii, live)  # fmt: skip
+    assert not tree._tree_admissible(p, parents, order, np.zeros((3, 13)), rest, 1e-12, False, centres, radii, live)

@@ -41,14 +41,10 @@ def test_without_a_stamp_whatever_is_cached_is_dropped(tmp_path: Path) -> None:
     _cache(cached)
     assert _jit_cache.drop_stale_cache(tmp_path)
     assert not cached.exists()
-    assert (
-        tmp_path / "__pycache__" / _jit_cache.STAMP_NAME
-    ).read_text().strip() == _jit_cache.source_hash(tmp_path)
+    assert (tmp_path / "__pycache__" / _jit_cache.STAMP_NAME).read_text().strip() == _jit_cache.source_hash(tmp_path)
 
 
-def test_a_cache_under_numba_cache_dir_is_kept_in_step(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
+def test_a_cache_under_numba_cache_dir_is_kept_in_step(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     source = tmp_path / "src"
     rules, _ = _package(source)
     user = tmp_path / "user-cache"

@@ -18,9 +18,7 @@ point = st.tuples(finite, finite, finite)
 positive = st.floats(0.05, 2.0)
 
 
-def quat_about(
-    axis: tuple[float, float, float], angle_rad: float
-) -> tuple[float, float, float, float]:
+def quat_about(axis: tuple[float, float, float], angle_rad: float) -> tuple[float, float, float, float]:
     a = np.asarray(axis, dtype=float) / np.linalg.norm(axis)
     s = math.sin(angle_rad / 2)
     return (math.cos(angle_rad / 2), a[0] * s, a[1] * s, a[2] * s)
@@ -47,9 +45,7 @@ def test_sphere_exact(p: tuple[float, float, float], expected: float) -> None:
     ],
 )
 def test_box_exact(p: tuple[float, float, float], expected: float) -> None:
-    assert sdf.sd_box(np.array([p], float), (1.0, 2.0, 3.0))[0] == pytest.approx(
-        expected, abs=1e-12
-    )
+    assert sdf.sd_box(np.array([p], float), (1.0, 2.0, 3.0))[0] == pytest.approx(expected, abs=1e-12)
 
 
 @pytest.mark.parametrize(
@@ -77,9 +73,7 @@ def test_capsule_exact(p: tuple[float, float, float], expected: float) -> None:
 
 @SETTINGS
 @given(p=point, b=st.tuples(positive, positive, positive))
-def test_box_matches_clamp_construction(
-    p: tuple[float, float, float], b: tuple[float, float, float]
-) -> None:
+def test_box_matches_clamp_construction(p: tuple[float, float, float], b: tuple[float, float, float]) -> None:
     """Outside: distance to the nearest box point (a clamp); inside: minus the distance to the nearest face."""
     q, half = np.array(p), np.array(b)
     nearest = np.clip(q, -half, half)
@@ -90,9 +84,7 @@ def test_box_matches_clamp_construction(
 
 @SETTINGS
 @given(p=point, major=st.floats(0.5, 2.0), minor=st.floats(0.05, 0.45))
-def test_torus_matches_distance_to_ring(
-    p: tuple[float, float, float], major: float, minor: float
-) -> None:
+def test_torus_matches_distance_to_ring(p: tuple[float, float, float], major: float, minor: float) -> None:
     """Distance to the ring circle (sampled finely in the xz plane) minus the tube radius."""
     angles = np.linspace(0, 2 * np.pi, 20001)
     ring = np.stack([major * np.cos(angles), np.zeros_like(angles), major * np.sin(angles)], axis=1)
@@ -107,9 +99,7 @@ def test_capsule_matches_distance_to_segment(p, a, b, r) -> None:
     segment = np.array(a) + s * (np.array(b) - np.array(a))
     expected = float(np.min(np.linalg.norm(segment - np.array(p), axis=1))) - r
     seg_len = float(np.linalg.norm(np.subtract(b, a)))
-    assert sdf.sd_capsule(np.array([p]), a, b, r)[0] == pytest.approx(
-        expected, abs=1e-4 * seg_len + 1e-12
-    )
+    assert sdf.sd_capsule(np.array([p]), a, b, r)[0] == pytest.approx(expected, abs=1e-4 * seg_len + 1e-12)
 
 
 # ------------------------------------------------------------------------------------------ blends
@@ -144,9 +134,7 @@ def test_smin_tends_to_min_as_blend_narrows(k: float) -> None:
     b = a[::-1].copy()
     assert np.max(np.abs(sdf.smin_poly(a, b, k) - np.minimum(a, b))) <= k / 4 + 1e-15
     sharp = 1.0 / k  # exp's k is a sharpness: the blend narrows as it grows
-    assert (
-        np.max(np.abs(sdf.smin_exp(a, b, sharp) - np.minimum(a, b))) <= math.log(2) / sharp + 1e-15
-    )
+    assert np.max(np.abs(sdf.smin_exp(a, b, sharp) - np.minimum(a, b))) <= math.log(2) / sharp + 1e-15
     assert sdf.smin_poly(0.3, 0.7, 0.0) == 0.3
 
 
@@ -172,9 +160,7 @@ def test_hard_booleans() -> None:
     k=st.floats(0.01, 1.0),
     blend=st.sampled_from(sdf.BLEND_FORMS),
 )
-def test_smooth_booleans_bound_the_hard_ones(
-    a: float, b: float, k: float, blend: sdf.BlendForm
-) -> None:
+def test_smooth_booleans_bound_the_hard_ones(a: float, b: float, k: float, blend: sdf.BlendForm) -> None:
     # Both forms dip by at most k/4 (exp with sharpness 4·ln2/k: ln2/sharpness = k/4).
     dip = k / 4 + 1e-12
     union = float(sdf.smooth_union(a, b, k, blend))
@@ -200,12 +186,8 @@ def test_primitive_moves_and_rotates_rigidly() -> None:
 def test_capsule_and_torus_axes_are_local_y() -> None:
     capsule = sdf.Scene((sdf.Primitive("capsule", (0, 0, 0), (1.0, 0.25)),))
     torus = sdf.Scene((sdf.Primitive("torus", (0, 0, 0), (1.0, 0.25)),))
-    np.testing.assert_allclose(
-        sdf.scene_distance(capsule, [[0, 1.25, 0], [1.25, 0, 0]]), [0.0, 1.0], atol=1e-12
-    )
-    np.testing.assert_allclose(
-        sdf.scene_distance(torus, [[0, 0, 1.0], [0, 1.0, 0]]), [-0.25, math.sqrt(2) - 0.25]
-    )
+    np.testing.assert_allclose(sdf.scene_distance(capsule, [[0, 1.25, 0], [1.25, 0, 0]]), [0.0, 1.0], atol=1e-12)
+    np.testing.assert_allclose(sdf.scene_distance(torus, [[0, 0, 1.0], [0, 1.0, 0]]), [-0.25, math.sqrt(2) - 0.25])
 
 
 def test_scene_folds_ops_in_order() -> None:
@@ -261,9 +243,7 @@ def random_scenes(draw: st.DrawFn) -> sdf.Scene:
         rotation = (draw(st.floats(0.1, 1)), *(draw(st.floats(-1, 1)) for _ in range(3)))
         op = draw(st.sampled_from(sdf.BOOLEAN_OPS))
         prims.append(sdf.Primitive(kind, center, size, rotation, op=op))  # type: ignore[arg-type]
-    return sdf.Scene(
-        tuple(prims), k=draw(st.floats(0.0, 0.5)), blend=draw(st.sampled_from(sdf.BLEND_FORMS))
-    )
+    return sdf.Scene(tuple(prims), k=draw(st.floats(0.0, 0.5)), blend=draw(st.sampled_from(sdf.BLEND_FORMS)))
 
 
 @SETTINGS
@@ -417,9 +397,7 @@ def test_ray_spheres_interval() -> None:
     origins = np.array([[0.0, 0, 0], [5.0, 0, 0], [0.0, 0, 5], [0.0, 0, 20]])
     directions = np.array([[0.0, 0, 1], [0.0, 0, 1], [0.0, 0, 1], [0.0, 0, 1]])
     t_enter, t_exit = sdf.ray_spheres_interval(origins, directions, centers, radii)
-    np.testing.assert_allclose(
-        t_enter[[0, 2]], [4.0, 0.0]
-    )  # first entry; a ray born inside starts at 0
+    np.testing.assert_allclose(t_enter[[0, 2]], [4.0, 0.0])  # first entry; a ray born inside starts at 0
     np.testing.assert_allclose(t_exit[[0, 2]], [12.0, 7.0])  # last exit
     assert t_exit[1] < t_enter[1] and t_exit[3] < t_enter[3]  # beside them; past them
 

@@ -88,10 +88,7 @@ POINT_MAPS: list[tuple[str, Callable[[np.ndarray], np.ndarray], str]] = [
 
 
 def probe(sdf_body: str, color_body: str = "vec3(0.0)") -> tuple[np.ndarray, np.ndarray]:
-    source = (
-        f"float sdf(vec3 p) {{\n    return {sdf_body};\n}}\n"
-        f"vec3 color(vec3 p) {{\n    return {color_body};\n}}\n"
-    )
+    source = f"float sdf(vec3 p) {{\n    return {sdf_body};\n}}\nvec3 color(vec3 p) {{\n    return {color_body};\n}}\n"
     try:
         d, c = gl_service.run(lambda gl: gl.probe_field(source, POINTS))
     except GLUnavailableError as exc:
@@ -115,27 +112,21 @@ def test_every_new_function_is_in_both_languages_with_its_source_and_exactness()
 
 @pytest.mark.gl
 @pytest.mark.parametrize(("name", "numpy_fn", "glsl"), DISTANCES, ids=[c[0] for c in DISTANCES])
-def test_distance_glsl_matches_numpy(
-    name: str, numpy_fn: Callable[[np.ndarray], np.ndarray], glsl: str
-) -> None:
+def test_distance_glsl_matches_numpy(name: str, numpy_fn: Callable[[np.ndarray], np.ndarray], glsl: str) -> None:
     d_gl, _ = probe(glsl)
     np.testing.assert_allclose(d_gl, numpy_fn(POINTS), atol=1e-5, rtol=0, err_msg=name)
 
 
 @pytest.mark.gl
 @pytest.mark.parametrize(("name", "numpy_fn", "glsl"), POINT_MAPS, ids=[c[0] for c in POINT_MAPS])
-def test_point_map_glsl_matches_numpy(
-    name: str, numpy_fn: Callable[[np.ndarray], np.ndarray], glsl: str
-) -> None:
+def test_point_map_glsl_matches_numpy(name: str, numpy_fn: Callable[[np.ndarray], np.ndarray], glsl: str) -> None:
     _, mapped = probe("0.0", glsl)
     np.testing.assert_allclose(mapped, numpy_fn(POINTS), atol=1e-5, rtol=0, err_msg=name)
 
 
 # ------------------------------------------------------------------------------------------ exact distances
 S3 = math.sqrt(3.0)
-ANALYTIC: list[
-    tuple[str, Callable[[np.ndarray], np.ndarray], list[tuple[tuple[float, ...], float]]]
-] = [
+ANALYTIC: list[tuple[str, Callable[[np.ndarray], np.ndarray], list[tuple[tuple[float, ...], float]]]] = [
     (
         "cylinder h=0.6 r=0.4",
         lambda p: sdf.sd_cylinder(p, 0.6, 0.4),
@@ -229,12 +220,7 @@ def test_exact_primitives_are_eikonal_and_point_at_their_surface(
     norm = np.linalg.norm(g, axis=1)
     # Away from the medial axis and the shape's edges (where the field has a kink) the gradient is a unit vector
     # and one step of −d along it reaches the surface: the property that defines an exact distance.
-    smooth = (
-        np.abs(gradient(lambda q: np.linalg.norm(gradient(fn, q, 1e-6), axis=1), POINTS, 1e-3)).max(
-            axis=1
-        )
-        < 1e3
-    )
+    smooth = np.abs(gradient(lambda q: np.linalg.norm(gradient(fn, q, 1e-6), axis=1), POINTS, 1e-3)).max(axis=1) < 1e3
     assert smooth.mean() > 0.8, name
     np.testing.assert_allclose(norm[smooth], 1.0, atol=1e-4, err_msg=name)
     foot = POINTS[smooth] - d[smooth, None] * g[smooth] / norm[smooth, None]
@@ -244,23 +230,16 @@ def test_exact_primitives_are_eikonal_and_point_at_their_surface(
 def test_ellipsoid_is_a_bound_zero_on_its_surface_and_exact_for_a_sphere() -> None:
     radii = np.array([0.9, 0.5, 0.3])
     theta, phi = RNG.uniform(0, np.pi, 500), RNG.uniform(0, 2 * np.pi, 500)
-    on = (
-        np.stack([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), np.cos(theta)], axis=1)
-        * radii
-    )
+    on = np.stack([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), np.cos(theta)], axis=1) * radii
     np.testing.assert_allclose(sdf.sd_ellipsoid(on, radii), 0.0, atol=1e-12)
     inside = np.einsum("ij,j->ij", POINTS, 1 / radii)
     inside_mask = np.linalg.norm(inside, axis=1) < 1
     assert np.all((sdf.sd_ellipsoid(POINTS, radii) < 0) == inside_mask)
-    np.testing.assert_allclose(
-        sdf.sd_ellipsoid(POINTS, (0.7, 0.7, 0.7)), sdf.sd_sphere(POINTS, 0.7), atol=1e-12
-    )
+    np.testing.assert_allclose(sdf.sd_ellipsoid(POINTS, (0.7, 0.7, 0.7)), sdf.sd_sphere(POINTS, 0.7), atol=1e-12)
     assert sdf.sd_ellipsoid(np.zeros((1, 3)), radii)[0] == -0.3
     # Not exact: off the axes the estimate differs from the distance to a dense sampling of the surface.
     t, f = np.meshgrid(np.linspace(0, np.pi, 800), np.linspace(0, 2 * np.pi, 1600))
-    dense = np.stack([np.sin(t) * np.cos(f), np.sin(t) * np.sin(f), np.cos(t)], axis=-1).reshape(
-        -1, 3
-    )
+    dense = np.stack([np.sin(t) * np.cos(f), np.sin(t) * np.sin(f), np.cos(t)], axis=-1).reshape(-1, 3)
     query = np.array([[0.8, 0.6, 0.3]])
     true = np.linalg.norm(dense * radii - query, axis=1).min()
     assert abs(sdf.sd_ellipsoid(query, radii)[0] - true) > 1e-2
@@ -269,9 +248,7 @@ def test_ellipsoid_is_a_bound_zero_on_its_surface_and_exact_for_a_sphere() -> No
 # ------------------------------------------------------------------------------------------ operators
 def test_op_round_of_a_box_is_the_round_box_grown() -> None:
     b, r = np.array([0.5, 0.4, 0.3]), 0.1
-    np.testing.assert_allclose(
-        sdf.op_round(sdf.sd_box(POINTS, b), r), sdf.sd_round_box(POINTS, b + r, r), atol=1e-12
-    )
+    np.testing.assert_allclose(sdf.op_round(sdf.sd_box(POINTS, b), r), sdf.sd_round_box(POINTS, b + r, r), atol=1e-12)
 
 
 def test_op_onion_is_a_shell() -> None:
@@ -289,9 +266,7 @@ def test_elongated_sphere_is_a_capsule() -> None:
 
 def test_elongated_box_is_the_longer_box() -> None:
     q, extra = sdf.op_elongate(POINTS, (0.2, 0.0, 0.1))
-    np.testing.assert_allclose(
-        sdf.sd_box(q, (0.3, 0.3, 0.3)) + extra, sdf.sd_box(POINTS, (0.5, 0.3, 0.4)), atol=1e-12
-    )
+    np.testing.assert_allclose(sdf.sd_box(q, (0.3, 0.3, 0.3)) + extra, sdf.sd_box(POINTS, (0.5, 0.3, 0.4)), atol=1e-12)
 
 
 def rotation_about(axis: int, angle: np.ndarray) -> np.ndarray:
@@ -311,9 +286,7 @@ def test_twist_rotates_each_slice_about_y_by_rate_times_height() -> None:
     expected = np.einsum("nij,nj->ni", rotation_about(1, -rate * POINTS[:, 1]), POINTS)
     np.testing.assert_allclose(mapped, expected, atol=1e-12)
     np.testing.assert_allclose(mapped[:, 1], POINTS[:, 1])
-    np.testing.assert_allclose(
-        np.hypot(mapped[:, 0], mapped[:, 2]), np.hypot(POINTS[:, 0], POINTS[:, 2])
-    )
+    np.testing.assert_allclose(np.hypot(mapped[:, 0], mapped[:, 2]), np.hypot(POINTS[:, 0], POINTS[:, 2]))
 
 
 def test_bend_rotates_about_z_by_rate_times_x() -> None:
@@ -325,12 +298,7 @@ def test_bend_rotates_about_z_by_rate_times_x() -> None:
 def test_finite_repetition_of_a_sphere_is_the_union_of_its_copies() -> None:
     spacing, limit, r = np.array([0.5, 0.7, 0.3]), np.array([2, 1, 0]), 0.12
     repeated = sdf.sd_sphere(sdf.op_repeat_finite(POINTS, spacing, limit), r)
-    copies = [
-        spacing * np.array([i, j, k])
-        for i in range(-2, 3)
-        for j in range(-1, 2)
-        for k in range(0, 1)
-    ]
+    copies = [spacing * np.array([i, j, k]) for i in range(-2, 3) for j in range(-1, 2) for k in range(0, 1)]
     union = np.min([sdf.sd_sphere(POINTS - c, r) for c in copies], axis=0)
     np.testing.assert_allclose(repeated, union, atol=1e-12)
 
@@ -358,9 +326,7 @@ def test_mirror_symmetry_is_the_shape_and_its_reflection() -> None:
     y=st.floats(-3, 3),
     z=st.floats(-3, 3),
 )
-def test_cylinder_against_its_closed_form_everywhere(
-    h: float, r: float, x: float, y: float, z: float
-) -> None:
+def test_cylinder_against_its_closed_form_everywhere(h: float, r: float, x: float, y: float, z: float) -> None:
     rho, height = math.hypot(x, z), abs(y)
     if rho <= r and height <= h:
         expected = -min(r - rho, h - height)
@@ -395,9 +361,7 @@ def test_bad_arguments_raise_naming_the_argument(call: Callable[[], object], arg
 
 
 def test_lipschitz_ellipsoid_bound_never_exceeds_the_distance_and_quilez_estimate_can() -> None:
-    radii = np.array(
-        [0.5, 0.5, 0.125]
-    )  # the flat one hypothesis found grows faster than 1/m under Quilez's
+    radii = np.array([0.5, 0.5, 0.125])  # the flat one hypothesis found grows faster than 1/m under Quilez's
     a, b = POINTS[:1500], POINTS[1500:]
     slope = lambda f: np.abs(f(a) - f(b)) / np.linalg.norm(a - b, axis=1)  # noqa: E731
     assert slope(lambda q: sdf.sd_ellipsoid_lipschitz(q, radii)).max() <= 1.0 + 1e-12

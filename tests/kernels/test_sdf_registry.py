@@ -121,9 +121,7 @@ def test_a_registered_kind_is_evaluated_and_meshed(octahedron_bound: sdf.Primiti
     prim = sdf.Primitive(kind, (0.2, -0.1, 0.3), (0.5,))
     rng = np.random.default_rng(7)
     points = rng.uniform(-1.0, 1.0, (500, 3))
-    np.testing.assert_allclose(
-        prim.distance(points), sd_octahedron_bound(points - prim.center, 0.5), atol=1e-12
-    )
+    np.testing.assert_allclose(prim.distance(points), sd_octahedron_bound(points - prim.center, 0.5), atol=1e-12)
     vertices, faces, _ = sdf.mesh(sdf.Scene((prim,)), 48)
     assert len(faces) > 1000
     voxel = sdf.make_grid(sdf.Scene((prim,)), 48).spacing

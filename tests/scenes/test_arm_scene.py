@@ -94,9 +94,7 @@ def test_more_links_and_joint_limits(scene: ArmScene) -> None:
     colours = np.asarray(scene.joint_nodes.batched_colors)[: MAX_LINKS + 1]
     at_limit = angles > math.radians(29.9)
     assert at_limit.sum() >= 3
-    assert np.all(colours[:-1][at_limit][:, 0] >= 220) and np.all(
-        colours[:-1][at_limit][:, 1] <= 60
-    )
+    assert np.all(colours[:-1][at_limit][:, 0] >= 220) and np.all(colours[:-1][at_limit][:, 1] <= 60)
     relaxed = angles < math.radians(5.0)
     assert np.all(colours[:-1][relaxed][:, 1] >= 190)  # green
     np.testing.assert_array_equal(colours[-1], (205, 210, 220))
@@ -164,9 +162,7 @@ def client_joints(client: BrowserClient) -> np.ndarray | None:
     return client.visible_instances("/arm/joints")
 
 
-def test_dragging_the_target_gizmo_moves_the_chain_end_onto_it(
-    server: viser.ViserServer, scene: ArmScene
-) -> None:
+def test_dragging_the_target_gizmo_moves_the_chain_end_onto_it(server: viser.ViserServer, scene: ArmScene) -> None:
     with BrowserClient(server.get_port()) as client:
         client.wait_for_node("/arm/target")
         path = [(0.9 - 0.05 * i, 0.0, 0.6 + 0.04 * i) for i in range(1, 13)]
@@ -185,14 +181,10 @@ def test_dragging_the_target_gizmo_moves_the_chain_end_onto_it(
         client.wait_for(browser_shows_end_on_target, what="the browser to receive the new pose")
 
 
-def test_an_off_plane_drag_is_put_back_in_the_plane(
-    server: viser.ViserServer, scene: ArmScene
-) -> None:
+def test_an_off_plane_drag_is_put_back_in_the_plane(server: viser.ViserServer, scene: ArmScene) -> None:
     with BrowserClient(server.get_port()) as client:
         client.wait_for_node("/arm/target")
-        client.drag_transform(
-            "/arm/target", [(0.7, 0.4, 0.9)]
-        )  # y = 0.4: a crafted client, out of the plane
+        client.drag_transform("/arm/target", [(0.7, 0.4, 0.9)])  # y = 0.4: a crafted client, out of the plane
         client.wait_for(lambda: scene.gizmo_events >= 3, what="the drag handled")
         with scene._lock:
             np.testing.assert_array_equal(scene.target, (0.7, 0.0, 0.9))
@@ -266,9 +258,7 @@ def test_crafted_obstacle_message_and_slider_values_keep_a_good_state(
             assert report is not None and report.result.status == "reached"
 
 
-def test_clicking_in_the_plane_places_the_target(
-    server: viser.ViserServer, scene: ArmScene
-) -> None:
+def test_clicking_in_the_plane_places_the_target(server: viser.ViserServer, scene: ArmScene) -> None:
     with BrowserClient(server.get_port()) as client:
         client.wait_for_node("/arm/target")
         # A ray from the camera side (−y) through (−0.5, 0, 1.0).

@@ -19,9 +19,7 @@ def scene(show_scene: MakeScene) -> ArmScene:
 
 
 def link_lengths(skeleton: _skeletons.Skeleton, joints: np.ndarray) -> np.ndarray:
-    return np.array(
-        [np.linalg.norm(joints[j] - joints[up]) for j, up in enumerate(skeleton.parents) if up >= 0]
-    )
+    return np.array([np.linalg.norm(joints[j] - joints[up]) for j, up in enumerate(skeleton.parents) if up >= 0])
 
 
 # ------------------------------------------------------------------------------------------------ pure
@@ -30,9 +28,7 @@ def test_presets_open_in_a_pose_that_keeps_their_limits_and_lengths(
     label: _skeletons.PresetLabel,
 ) -> None:
     skeleton = _skeletons.PRESETS[label]()
-    report = _skeletons.solve_skeleton(
-        skeleton, skeleton.joints, skeleton.targets, tolerance_m=1e-3, max_iterations=50
-    )
+    report = _skeletons.solve_skeleton(skeleton, skeleton.joints, skeleton.targets, tolerance_m=1e-3, max_iterations=50)
     np.testing.assert_allclose(
         link_lengths(skeleton, report.result.joints),
         link_lengths(skeleton, skeleton.joints),
@@ -48,17 +44,13 @@ def test_presets_open_in_a_pose_that_keeps_their_limits_and_lengths(
     if label in ("Robot arm", "Hand"):  # targets the skeleton can reach without conflict
         assert all(s == "reached" for s in report.result.status)
     if label == "Robot arm":
-        assert np.all(
-            report.result.joints[:, 1] == 0.0
-        )  # the hinges about y keep it in the x–z plane
+        assert np.all(report.result.joints[:, 1] == 0.0)  # the hinges about y keep it in the x–z plane
 
 
 def test_clean_target_refuses_what_is_not_three_finite_numbers_in_the_box() -> None:
     for bad in ([np.nan, 0, 0], [0, 0], "abc", [0, 0, 1e9], [[0, 0, 0]], None):
         assert _skeletons.clean_target(bad, planar=False) is None
-    np.testing.assert_array_equal(
-        _skeletons.clean_target([0.1, 0.5, 0.2], planar=True), [0.1, 0.0, 0.2]
-    )
+    np.testing.assert_array_equal(_skeletons.clean_target([0.1, 0.5, 0.2], planar=True), [0.1, 0.0, 0.2])
 
 
 # ------------------------------------------------------------------------------------------------ websocket
@@ -75,14 +67,10 @@ def test_choosing_the_hand_and_dragging_a_fingertip_target_curls_the_finger(
         client.wait_for_gui("Preset")
         client.set_value("Preset", "Hand")
         client.wait_for(lambda: view.preset == "Hand" and view.solves >= 1, what="the hand shown")
-        assert (
-            not scene.link_nodes.visible and not scene.target_gizmo.visible
-        )  # the chain is hidden
+        assert not scene.link_nodes.visible and not scene.target_gizmo.visible  # the chain is hidden
         index = 1
         start = view.targets[index].copy()
-        goal = _skeletons.hand(target_curl_rad=1.0).targets[
-            index
-        ]  # the index finger curled further
+        goal = _skeletons.hand(target_curl_rad=1.0).targets[index]  # the index finger curled further
         points = [start + (goal - start) * t for t in np.linspace(0.1, 1.0, 8)]
         path = [(float(x), float(y), float(z)) for x, y, z in points]
         client.wait_for_node(f"/arm/skeleton/target_{index}")
@@ -109,9 +97,7 @@ def test_choosing_the_hand_and_dragging_a_fingertip_target_curls_the_finger(
         )
 
 
-@pytest.mark.parametrize(
-    "bad", [(float("nan"), 0.0, 0.5), (1e12, 0.0, 0.5), (0.3, float("-inf"), 0.5)]
-)
+@pytest.mark.parametrize("bad", [(float("nan"), 0.0, 0.5), (1e12, 0.0, 0.5), (0.3, float("-inf"), 0.5)])
 def test_crafted_skeleton_gizmo_and_preset_messages_keep_the_last_good_state(
     server: viser.ViserServer, scene: ArmScene, bad: tuple[float, float, float]
 ) -> None:
@@ -119,9 +105,7 @@ def test_crafted_skeleton_gizmo_and_preset_messages_keep_the_last_good_state(
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("Preset")
         client.set_value("Preset", "Upper body")
-        client.wait_for(
-            lambda: view.preset == "Upper body" and view.solves >= 1, what="the body shown"
-        )
+        client.wait_for(lambda: view.preset == "Upper body" and view.solves >= 1, what="the body shown")
         pose, targets, solves = view.pose.copy(), view.targets.copy(), view.solves
         client.drag_transform("/arm/skeleton/target_0", [bad])
         client.wait_for(lambda: view.gizmo_events >= 3, what="the crafted drag handled")

@@ -34,9 +34,7 @@ def _x_axis(data: tuple[np.ndarray, ...], scales: dict[str, viser.uplot.Scale]) 
     return axes[0]
 
 
-def _whole_ticks(
-    lo: float, hi: float, incrs: tuple[float, ...], px: float, space: float = 50.0
-) -> list[float]:
+def _whole_ticks(lo: float, hi: float, incrs: tuple[float, ...], px: float, space: float = 50.0) -> list[float]:
     """uPlot's linear splits: the first increment at least ``space`` px apart, multiples of it in [lo, hi]."""
     incr = next(i for i in incrs if i * px / (hi - lo) >= space)
     first = math.ceil(lo / incr) * incr

@@ -185,9 +185,7 @@ class SlowBuild(Scene):
         handler = self.callback(lambda: self.seen.append(self.node is not None))
         caller = threading.Thread(target=handler)  # a browser's message, on viser's thread pool
         caller.start()
-        caller.join(
-            timeout=0.3
-        )  # long enough for an unguarded handler to run on the half-built scene
+        caller.join(timeout=0.3)  # long enough for an unguarded handler to run on the half-built scene
         self.caller = caller
         self.node = server.scene.add_frame(f"{self.root.name}/node")
 
@@ -222,10 +220,7 @@ def test_flooding_a_slider_ends_on_the_last_value_for_every_viewer(
             client.wait_for(lambda c=client: c.value_of(SPEED) == 27.5, what="the slider at 27.5")
             client.wait_for(
                 lambda c=client: np.allclose(
-                    c.nodes["/freekick/path"]
-                    .get("props", {})
-                    .get("points", np.zeros(0))
-                    .reshape(-1),
+                    c.nodes["/freekick/path"].get("props", {}).get("points", np.zeros(0)).reshape(-1),
                     expected.reshape(-1),
                     rtol=1e-6,
                 ),
@@ -248,16 +243,11 @@ def test_sdf_preview_while_dragging_ends_on_the_full_mesh_and_reference(
     with BrowserClient(server.get_port()) as client:
         client.wait_for_node("/sdf/mesh")
         previews, references = scene.preview_serial, scene.reference_serial
-        path = [
-            (0.3 * math.cos(a), 0.3 * math.sin(a), 0.5) for a in np.linspace(0, 2 * math.pi, 61)[1:]
-        ]
+        path = [(0.3 * math.cos(a), 0.3 * math.sin(a), 0.5) for a in np.linspace(0, 2 * math.pi, 61)[1:]]
         client.drag_transform("/sdf/gizmo_2", path)  # no pauses: a burst
         target = tuple(float(v) for v in path[-1])
         wait_until(
-            lambda: (
-                scene.mesh_scene is not None
-                and np.allclose(scene.mesh_scene.primitives[1].center, target)
-            ),
+            lambda: scene.mesh_scene is not None and np.allclose(scene.mesh_scene.primitives[1].center, target),
             "the full mesh of the last position",
         )
         assert scene.preview_serial > previews  # the drag was shown with cheap previews
@@ -271,18 +261,12 @@ def test_sdf_preview_while_dragging_ends_on_the_full_mesh_and_reference(
         client.set_value("View", "Mesh")
         wait_until(lambda: scene.mesh_node.visible, "the mesh back")
         client.wait_for(
-            lambda: (
-                client.nodes["/sdf/mesh"].get("props", {}).get("glb_data")
-                == scene.mesh_node.glb_data
-            ),
+            lambda: client.nodes["/sdf/mesh"].get("props", {}).get("glb_data") == scene.mesh_node.glb_data,
             what="the full mesh at the viewer",
         )
         if has_gl:
             wait_until(
-                lambda: (
-                    scene.reference_serial > references
-                    and scene.reference_mesh_serial == scene.mesh_serial
-                ),
+                lambda: scene.reference_serial > references and scene.reference_mesh_serial == scene.mesh_serial,
                 "the reference against the full mesh after the drag",
             )
             assert scene.reference_rgb is not None
@@ -323,9 +307,7 @@ def test_a_drag_burst_on_an_arm_gizmo_coalesces_and_ends_on_its_last_pose(
                 lambda: np.allclose(np.asarray(handle.position), path[-1]),
                 "the last message to reach the server",
             )
-            time.sleep(
-                0.2
-            )  # let viser's pool start the queued calls (each returns or waits on the lock)
+            time.sleep(0.2)  # let viser's pool start the queued calls (each returns or waits on the lock)
         wait_until(lambda: sum(runs) >= len(path), "every message handled")
         with scene._lock:
             shown = scene.target if gizmo == "/arm/target" else scene.obstacle_centres[0]

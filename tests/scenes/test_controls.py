@@ -48,9 +48,7 @@ class Demo:
     """A dropdown whose field holds the option and whose GUI shows its label."""
     drafting: bool = field(default=True, metadata=checkbox("Drafting", folder="B"))
     """A checkbox."""
-    radii_m: tuple[float, ...] = field(
-        default=(0.1, 0.2, 0.3), metadata=slider("Ball {n} radius (m)", 0.05, 0.5, 0.01)
-    )
+    radii_m: tuple[float, ...] = field(default=(0.1, 0.2, 0.3), metadata=slider("Ball {n} radius (m)", 0.05, 0.5, 0.01))
     """A tuple: one slider per element."""
     colour: tuple[int, int, int] = field(default=(10, 20, 30), metadata=rgb("Colour"))
     """An RGB colour: one control for the tuple."""
@@ -127,9 +125,7 @@ def test_the_builder_makes_each_declared_control(demo: Controls[Demo]) -> None:
 def test_the_gate_gets_each_spec_from_its_declaration(demo: Controls[Demo]) -> None:
     assert control_spec(demo["speed_kmh"]) == ControlSpec("number", lo=0.0, hi=80.0)
     assert control_spec(demo["riders"]) == ControlSpec("number", lo=1.0, hi=16.0, integer=True)
-    assert control_spec(demo["mode"]) == ControlSpec(
-        "choice", options=("Fast (approximate)", "Exact")
-    )
+    assert control_spec(demo["mode"]) == ControlSpec("choice", options=("Fast (approximate)", "Exact"))
     assert control_spec(demo["drafting"]) == ControlSpec("bool")
     assert control_spec(demo["colour"]).kind == "rgb"
     assert control_spec(demo["source"]).kind == "text"
@@ -210,8 +206,7 @@ def test_the_reader_clamps_numbers_to_the_declared_range_and_writes_them_back(
 def test_the_reader_refuses_unusable_values_and_keeps_the_last_good_one(
     demo: Controls[Demo], name: str, bad: object
 ) -> None:
-    last = Demo(speed_kmh=12.5, riders=5, power_w=100.0, mode="fast", drafting=False,
-                colour=(4, 5, 6), source="torus")  # fmt: skip
+    last = Demo(speed_kmh=12.5, riders=5, power_w=100.0, mode="fast", drafting=False, colour=(4, 5, 6), source="torus")
     for field_name in ("speed_kmh", "riders", "power_w", "drafting", "colour", "source"):
         demo[field_name].value = getattr(last, field_name)
     demo["mode"].value = "Fast (approximate)"
@@ -278,9 +273,7 @@ def test_some_fields_can_be_built_where_the_caller_is(server: viser.ViserServer)
     store_value(some["power_w"], -5.0)
     params = read_controls(some, Demo(speed_kmh=3.0))
     assert (params.power_w, params.speed_kmh) == (0.0, 3.0)  # fields not built keep their value
-    assert (
-        list(declared(Demo)) == [*Demo.__dataclass_fields__][:-1]
-    )  # every field but the undeclared note
+    assert list(declared(Demo)) == [*Demo.__dataclass_fields__][:-1]  # every field but the undeclared note
     rest = build_controls(server.gui, Demo(), ("speed_kmh", "riders"))
     both = some | rest
     assert list(both.fields) == ["power_w", "source", "speed_kmh", "riders"]

@@ -77,9 +77,7 @@ def test_the_kernel_rides_with_the_paceline_sharing_the_work(mode: CourseMode) -
     line = scene.params
     reduction = cycling.drag_reduction(line.n_riders, line.gap_m, line.model)
     assert four.group_cda_m2 == pytest.approx(line.cda_m2 * (1 - reduction.mean()))
-    rider = course_kernel.Rider(
-        cda_m2=four.group_cda_m2, mass_kg=80.0, crr=0.004, drivetrain_efficiency=0.976
-    )
+    rider = course_kernel.Rider(cda_m2=four.group_cda_m2, mass_kg=80.0, crr=0.004, drivetrain_efficiency=0.976)
     direct = course_kernel.ride(mode.route, 250.0, rider, max_speed_ms=72.0 / 3.6)
     assert four.ride.time_s == pytest.approx(direct.time_s, rel=1e-12)
     scene.controls["n_riders"].value = 1  # one rider alone: slower
@@ -109,18 +107,14 @@ def test_model_and_air_choices_change_the_ride_and_the_readout_shows_both_densit
     # A barometer reading replaces the standard atmosphere's pressure.
     mode.controls["pressure_from_barometer"].value = "Barometer at the start (hPa)"
     mode.controls["pressure_hpa"].value = 1000.0
-    assert mode.state.density_weather == pytest.approx(
-        float(cycling.air_density_weather(30.0, 1000.0, 0.8)), rel=1e-12
-    )
+    assert mode.state.density_weather == pytest.approx(float(cycling.air_density_weather(30.0, 1000.0, 0.8)), rel=1e-12)
 
 
 def test_find_the_power_for_a_time(mode: CourseMode) -> None:
     mode.controls["target_min"].value = 50.0
     mode.solve.value = True  # what a click does, on the server: runs on_click
     assert mode.state is not None
-    assert mode.state.ride.time_s == pytest.approx(
-        50 * 60.0, abs=1.0
-    )  # the power is rounded to 0.1 W
+    assert mode.state.ride.time_s == pytest.approx(50 * 60.0, abs=1.0)  # the power is rounded to 0.1 W
     assert mode.controls["power_w"].value == pytest.approx(mode.params.power_w)
 
 
@@ -129,9 +123,7 @@ def test_pacing_reports_the_time_saved(mode: CourseMode) -> None:
     assert mode.state is not None and mode.state.pacing is not None
     saved = mode.state.pacing.time_saved_s
     assert f"{saved:.0f} s saved" in mode.readout.content
-    assert mode.state.ride.average_power_w == pytest.approx(
-        mode.state.constant.average_power_w, rel=1e-6
-    )
+    assert mode.state.ride.average_power_w == pytest.approx(mode.state.constant.average_power_w, rel=1e-6)
 
 
 def test_exaggeration_stretches_the_drawn_heights(mode: CourseMode) -> None:
@@ -205,17 +197,13 @@ def test_upload_a_gpx_from_a_browser(server: viser.ViserServer, mode: CourseMode
         client.wait_for(lambda: mode.route.name == "Browser hill", what="the uploaded course")
         assert mode.route.n_points == 3000
         client.wait_for(
-            lambda: any(
-                "Browser hill" in str(e["props"].get("_markdown", "")) for e in client.gui.values()
-            ),
+            lambda: any("Browser hill" in str(e["props"].get("_markdown", "")) for e in client.gui.values()),
             what="the client to be shown the new course",
         )
         assert mode.scrub.max == pytest.approx(mode.route.total_distance_m / 1000.0, abs=0.01)
 
 
-@pytest.mark.parametrize(
-    "kind", ["plain text", "one point", "no elevation", "nan latitude", "no track points"]
-)
+@pytest.mark.parametrize("kind", ["plain text", "one point", "no elevation", "nan latitude", "no track points"])
 def test_a_bad_upload_from_a_browser_is_reported(
     server: viser.ViserServer, mode: CourseMode, kind: str, caplog: pytest.LogCaptureFixture
 ) -> None:
@@ -225,10 +213,7 @@ def test_a_bad_upload_from_a_browser_is_reported(
         client.wait_for_gui("Upload GPX")
         upload(client, "Upload GPX", f"{kind}.gpx", text.encode())
         client.wait_for(
-            lambda: any(
-                "was not loaded" in str(e["props"].get("_markdown", ""))
-                for e in client.gui.values()
-            ),
+            lambda: any("was not loaded" in str(e["props"].get("_markdown", "")) for e in client.gui.values()),
             what="the message",
         )
     assert mode.route is good
@@ -273,9 +258,7 @@ def test_crafted_course_values_keep_a_good_state(
 
 
 @pytest.mark.parametrize("value", [float("nan"), 1e9, -3.0, "far"])
-def test_crafted_scrub_positions_are_clamped(
-    server: viser.ViserServer, mode: CourseMode, value: object
-) -> None:
+def test_crafted_scrub_positions_are_clamped(server: viser.ViserServer, mode: CourseMode, value: object) -> None:
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("Position (km)")
         client.set_value("Position (km)", 4.0)
@@ -304,10 +287,7 @@ def test_play_from_a_browser(server: viser.ViserServer, mode: CourseMode) -> Non
         client.wait_for(lambda: not mode.playing, what="pause")
         # The browser's scrub slider follows the leader.
         client.wait_for(
-            lambda: (
-                isinstance(client.value_of("Position (km)"), float)
-                and client.value_of("Position (km)") > 0.1
-            ),
+            lambda: isinstance(client.value_of("Position (km)"), float) and client.value_of("Position (km)") > 0.1,
             what="the slider to follow",
         )
 
@@ -355,9 +335,7 @@ def test_a_new_course_puts_the_position_slider_back_to_the_start(mode: CourseMod
 # Kind: a found value silently clipped to an input's range. Each target is solved within the input's range or
 # the message says plainly, in minutes, that it is out of it (12 min needed > 2000 W; 6000 min < 20 W).
 @pytest.mark.parametrize("target_min", [1.0, 12.0, 30.0, 50.0, 90.0, 600.0, 6000.0])
-def test_find_the_power_says_when_the_target_is_out_of_the_inputs_range(
-    mode: CourseMode, target_min: float
-) -> None:
+def test_find_the_power_says_when_the_target_is_out_of_the_inputs_range(mode: CourseMode, target_min: float) -> None:
     mode.controls["target_min"].value = target_min
     mode.solve.value = True
     assert mode.state is not None

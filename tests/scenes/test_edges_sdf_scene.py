@@ -17,9 +17,7 @@ from scenes.sdf_gallery import SdfGalleryScene
 from server.switcher import SceneSwitcher
 
 
-@pytest.mark.parametrize(
-    ("k", "blend"), [(1e-40, "Exponential"), (1e-310, "Polynomial"), (1e-310, "Exponential")]
-)
+@pytest.mark.parametrize(("k", "blend"), [(1e-40, "Exponential"), (1e-310, "Polynomial"), (1e-310, "Exponential")])
 def test_a_tiny_blend_width_from_a_browser_still_shows_the_shape(
     server: viser.ViserServer, switcher: SceneSwitcher, k: float, blend: str
 ) -> None:
@@ -39,9 +37,7 @@ def test_a_tiny_blend_width_from_a_browser_still_shows_the_shape(
                 scene.mesh_scene is not None
                 and scene.mesh_scene.k == k
                 and scene.mesh_scene.primitives[1]
-                == dataclasses.replace(
-                    scene.mesh_scene.primitives[0], color=scene.mesh_scene.primitives[1].color
-                )
+                == dataclasses.replace(scene.mesh_scene.primitives[0], color=scene.mesh_scene.primitives[1].color)
             ),
             "the re-mesh of the tied pair at the tiny width",
         )
@@ -49,8 +45,6 @@ def test_a_tiny_blend_width_from_a_browser_still_shows_the_shape(
         hard = sdf.mesh(sdf.Scene(scene.mesh_scene.primitives, k=0.0), scene.params.resolution)
         assert len(hard[1]) > 1000
         assert abs(len(scene.mesh_faces) - len(hard[1])) <= 0.02 * len(hard[1]) + 16
-        shown = trimesh.load(
-            io.BytesIO(scene.mesh_node.glb_data), file_type="glb", force="mesh", process=False
-        )
+        shown = trimesh.load(io.BytesIO(scene.mesh_node.glb_data), file_type="glb", force="mesh", process=False)
         assert isinstance(shown, trimesh.Trimesh) and len(shown.faces) == len(scene.mesh_faces)
         assert np.all(np.isfinite(shown.vertices))

@@ -14,9 +14,7 @@ from hypothesis import strategies as st
 from scenes._framing import NEAR_M, ClientFraming, Lens, View, box_corners, frame_points
 
 
-def _project(
-    points: np.ndarray, position: np.ndarray, look_at: np.ndarray, fov: float, aspect: float
-) -> np.ndarray:
+def _project(points: np.ndarray, position: np.ndarray, look_at: np.ndarray, fov: float, aspect: float) -> np.ndarray:
     """(N, 3) NDC x, y and depth (m) through an independent pinhole camera."""
     return pinhole_ndc(points, position, look_at, fov, aspect)
 
@@ -38,9 +36,7 @@ def _assert_tight_or_held_back(
 ) -> None:
     """Tight: some point reaches an edge of the rectangle, unless the least depth holds the camera back (its nearest
     point is as near as allowed: a cloud along the view direction, or one a few centimetres across)."""
-    spread = max(
-        np.ptp(projected[:, 0]) / (ndc[1] - ndc[0]), np.ptp(projected[:, 1]) / (ndc[3] - ndc[2])
-    )
+    spread = max(np.ptp(projected[:, 0]) / (ndc[1] - ndc[0]), np.ptp(projected[:, 1]) / (ndc[3] - ndc[2]))
     held_back = projected[:, 2].min() <= least_depth * (1.0 + 1e-6) + 1e-6
     assert held_back or spread > 0.97, (spread, projected[:, 2].min())
 
@@ -64,12 +60,8 @@ def test_every_point_projects_inside_the_rectangle(
     cloud = np.array(points)
     direction = _direction(azimuth, pitch)
     ndc = (-0.8, 0.4, -0.7, 0.9)
-    view = frame_points(
-        cloud, direction, fov_rad=math.radians(fov_deg), aspect=aspect, ndc=ndc, min_depth=min_depth
-    )
-    projected = _project(
-        cloud, np.array(view.position), np.array(view.look_at), math.radians(fov_deg), aspect
-    )
+    view = frame_points(cloud, direction, fov_rad=math.radians(fov_deg), aspect=aspect, ndc=ndc, min_depth=min_depth)
+    projected = _project(cloud, np.array(view.position), np.array(view.look_at), math.radians(fov_deg), aspect)
     least_depth = max(min_depth, NEAR_M)
     assert np.all(projected[:, 2] >= least_depth - 1e-6)
     eps = 1e-6
@@ -83,12 +75,8 @@ def test_a_cloud_along_the_view_direction_stays_beyond_the_near_plane() -> None:
     # Found by the property above: the camera was put 1 mm in front of the near point (viser clips at 10 mm).
     cloud = np.array([(0.0, 0.0, 0.0), (2.0, 0.0, 3.0)])
     direction = (math.cos(3.0) * math.cos(-1.0), math.sin(3.0) * math.cos(-1.0), math.sin(-1.0))
-    view = frame_points(
-        cloud, direction, fov_rad=math.radians(20.0), aspect=1.0, ndc=(-0.8, 0.4, -0.7, 0.9)
-    )
-    projected = _project(
-        cloud, np.array(view.position), np.array(view.look_at), math.radians(20.0), 1.0
-    )
+    view = frame_points(cloud, direction, fov_rad=math.radians(20.0), aspect=1.0, ndc=(-0.8, 0.4, -0.7, 0.9))
+    projected = _project(cloud, np.array(view.position), np.array(view.look_at), math.radians(20.0), 1.0)
     assert projected[:, 2].min() == pytest.approx(NEAR_M, rel=1e-3)
 
 
@@ -96,19 +84,12 @@ def test_a_box_seen_side_on_is_centred_in_the_free_part_of_the_window() -> None:
     # A 10 m × 1 m × 2 m box, seen along +y: its centre lands mid-way across the canvas left of the panel.
     lo, hi = np.array([-5.0, -0.5, 0.0]), np.array([5.0, 0.5, 2.0])
     corners = np.array(
-        [
-            [(lo, hi)[i][0], (lo, hi)[j][1], (lo, hi)[k][2]]
-            for i in (0, 1)
-            for j in (0, 1)
-            for k in (0, 1)
-        ]
+        [[(lo, hi)[i][0], (lo, hi)[j][1], (lo, hi)[k][2]] for i in (0, 1) for j in (0, 1) for k in (0, 1)]
     )
     lens = Lens(math.radians(50.0), 1600, 1000)
     ndc = lens.usable_ndc()
     view = frame_points(corners, (0.0, 1.0, 0.0), fov_rad=lens.fov_rad, aspect=lens.aspect, ndc=ndc)
-    projected = _project(
-        corners, np.array(view.position), np.array(view.look_at), lens.fov_rad, lens.aspect
-    )
+    projected = _project(corners, np.array(view.position), np.array(view.look_at), lens.fov_rad, lens.aspect)
     centre_x = 0.5 * (projected[:, 0].min() + projected[:, 0].max())
     assert centre_x == pytest.approx(0.5 * (ndc[0] + ndc[1]), abs=1e-6)
     assert ndc[1] < 1.0 - 2 * 384 / 1600  # the free part ends left of the 384 px panel
@@ -168,14 +149,10 @@ def test_eight_riders_six_metres_apart_in_a_1150_px_window_are_framed_near() -> 
     lens = Lens(math.radians(75.0), 1150, 720)
     ndc = lens.usable_ndc(right_px=190.0, top_px=30.0)
     assert ndc[1] < 0.0
-    view = frame_points(
-        corners, (-1.2, 7.5, -1.8), fov_rad=lens.fov_rad, aspect=lens.aspect, ndc=ndc
-    )
+    view = frame_points(corners, (-1.2, 7.5, -1.8), fov_rad=lens.fov_rad, aspect=lens.aspect, ndc=ndc)
     distance = float(np.linalg.norm(np.subtract(view.position, view.look_at)))
     assert 20.0 < distance < 80.0, distance
-    projected = _project(
-        corners, np.array(view.position), np.array(view.look_at), lens.fov_rad, lens.aspect
-    )
+    projected = _project(corners, np.array(view.position), np.array(view.look_at), lens.fov_rad, lens.aspect)
     assert projected[:, 0].min() >= ndc[0] - 1e-6 and projected[:, 0].max() <= ndc[1] + 1e-6
 
 
@@ -300,17 +277,10 @@ def _reference_view(
         kx, ky = depth * tan_y * aspect, depth * tan_y
         sx, sy = centred(u, kx, rect[0], rect[1]), centred(v, ky, rect[2], rect[3])
         px, py = (u - sx) / kx, (v - sy) / ky
-        inside = (
-            px.min() >= rect[0]
-            and px.max() <= rect[1]
-            and py.min() >= rect[2]
-            and py.max() <= rect[3]
-        )
+        inside = px.min() >= rect[0] and px.max() <= rect[1] and py.min() >= rect[2] and py.max() <= rect[3]
         return bool(inside), sx, sy
 
-    empty = not (
-        ndc[1] > ndc[0] and ndc[3] > ndc[2]
-    )  # the docstring's rule (a lone point fits a line by luck)
+    empty = not (ndc[1] > ndc[0] and ndc[3] > ndc[2])  # the docstring's rule (a lone point fits a line by luck)
     for rect in [(-0.9, 0.9, -0.9, 0.9)] if empty else [ndc, (-0.9, 0.9, -0.9, 0.9)]:
         near = float(np.abs(w).max()) + NEAR_M
         far = float(np.abs(w).max()) + least + 1000.0 * (size + 1.0)

@@ -57,9 +57,7 @@ def scene(show_scene: MakeScene) -> FreeKickScene:
 
 @settings(max_examples=200, deadline=None)
 @given(
-    steps=st.lists(
-        st.floats(1e-9, 10.0, allow_nan=False, allow_infinity=False), min_size=0, max_size=30
-    ),
+    steps=st.lists(st.floats(1e-9, 10.0, allow_nan=False, allow_infinity=False), min_size=0, max_size=30),
     start=st.floats(-5.0, 5.0),
     columns=st.integers(1, 6),
     queries=st.lists(st.floats(-20.0, 320.0, allow_nan=False), min_size=0, max_size=20),
@@ -83,9 +81,7 @@ def test_sample_rows_at_a_node_and_beyond_the_ends() -> None:
     t = np.array([0.0, 0.5, 2.0])
     values = np.array([[0.0, 10.0], [1.0, 20.0], [4.0, -10.0]])
     got = sample_rows(np.array([-1.0, 0.5, 1.25, 2.0, 9.0]), t, values)
-    np.testing.assert_array_equal(
-        got, [[0.0, 10.0], [1.0, 20.0], [2.5, 5.0], [4.0, -10.0], [4.0, -10.0]]
-    )
+    np.testing.assert_array_equal(got, [[0.0, 10.0], [1.0, 20.0], [2.5, 5.0], [4.0, -10.0], [4.0, -10.0]])
 
 
 def drawn_path(scene: FreeKickScene) -> np.ndarray:
@@ -116,18 +112,14 @@ def test_opening_state_is_the_kernels_curler(scene: FreeKickScene) -> None:
     np.testing.assert_allclose(gravity, 0.43 * 9.81)
     # Gravity arrows point down, 0.3 m per newton.
     arrows = np.asarray(scene.arrows["gravity"].points)[:ARROW_POINTS]
-    np.testing.assert_allclose(
-        arrows[:, 1] - arrows[:, 0], [[0, 0, -0.3 * 0.43 * 9.81]] * ARROW_POINTS, atol=1e-5
-    )
+    np.testing.assert_allclose(arrows[:, 1] - arrows[:, 0], [[0, 0, -0.3 * 0.43 * 9.81]] * ARROW_POINTS, atol=1e-5)
 
 
 def test_spin_changes_path_band_and_outcome_with_the_measured_model(scene: FreeKickScene) -> None:
     assert scene.params.model == "measured"  # the scene opens on the model under which spin matters
     scene.controls["model"].value = "Constant C_D = C_L = 0.25 (seed)"
     band = np.asarray(scene.band.vertices)
-    assert np.allclose(
-        band[0::2], band[1::2], atol=1e-5
-    )  # constant model: ±10 % spin flies the same path
+    assert np.allclose(band[0::2], band[1::2], atol=1e-5)  # constant model: ±10 % spin flies the same path
     scene.controls["model"].value = "Measured C_D(Re, S), C_L(S)"
     scene.controls["azimuth_deg"].value = -12.0
     assert scene.params.model == "measured" and scene.state.outcome.result == "goal"
@@ -161,9 +153,7 @@ def _kernel_flight(
     ("integrator", "method", "dt"),
     [("RK4, 10 ms", "rk4", 1e-2), ("Euler, 1 ms (seed)", "euler", 1e-3)],
 )
-@pytest.mark.parametrize(
-    "model_label", ["Constant C_D = C_L = 0.25 (seed)", "Measured C_D(Re, S), C_L(S)"]
-)
+@pytest.mark.parametrize("model_label", ["Constant C_D = C_L = 0.25 (seed)", "Measured C_D(Re, S), C_L(S)"])
 def test_drawn_path_ghost_and_band_are_the_kernels_flights(
     scene: FreeKickScene, integrator: str, method: ball.Method, dt: float, model_label: str
 ) -> None:
@@ -230,9 +220,7 @@ def test_kick_flies_the_ball_spinning_along_its_path(scene: FreeKickScene) -> No
         assert np.linalg.norm(mid - spot) > 10.0
         # Rotated about the spin axis (+z, sidespin) by 2π·8 rev/s·0.5 s.
         angle = 2 * math.pi * 8.0 * 0.5
-        np.testing.assert_allclose(
-            wxyz, [math.cos(angle / 2), 0, 0, math.sin(angle / 2)], atol=1e-9
-        )
+        np.testing.assert_allclose(wxyz, [math.cos(angle / 2), 0, 0, math.sin(angle / 2)], atol=1e-9)
         for _ in range(40):
             scene._animate(0.1)
         assert scene.kick_time_s is None  # landed, rested, and went back to the spot
@@ -296,9 +284,7 @@ def test_a_burst_of_slider_changes_computes_one_outcome_map_for_the_last(
 ) -> None:
     runs = scene.map_runs
     for spin in np.linspace(5.0, 9.0, 12):
-        scene.controls["spin_rev_s"].value = float(
-            spin
-        )  # each redraws at once; the map waits for the burst to end
+        scene.controls["spin_rev_s"].value = float(spin)  # each redraws at once; the map waits for the burst to end
     assert scene.wait_idle()
     # Twelve changes, one map (a few at most if this machine stalls for a quarter second mid-burst).
     assert runs < scene.map_runs <= runs + 3
@@ -320,9 +306,7 @@ def test_scene_close_leaves_only_the_switcher(server: viser.ViserServer) -> None
 
 # ------------------------------------------------------------------------------------------------ over the websocket
 def _markdown_shown(client: BrowserClient, text: str) -> bool:
-    return any(
-        text in str(element["props"].get("_markdown", "")) for element in client.gui.values()
-    )
+    return any(text in str(element["props"].get("_markdown", "")) for element in client.gui.values())
 
 
 def test_spin_slider_from_a_browser_changes_the_path_and_the_outcome(
@@ -340,13 +324,9 @@ def test_spin_slider_from_a_browser_changes_the_path_and_the_outcome(
         path_node = client.wait_for_node("/freekick/path")
         before = np.array(path_node["props"]["points"]).copy()
         client.set_value("Spin rate (rev/s)", 2.0)
+        client.wait_for(lambda: _markdown_shown(client, "**Wide of the post**"), what="the new outcome shown")
         client.wait_for(
-            lambda: _markdown_shown(client, "**Wide of the post**"), what="the new outcome shown"
-        )
-        client.wait_for(
-            lambda: (
-                not np.allclose(np.array(client.nodes["/freekick/path"]["props"]["points"]), before)
-            ),
+            lambda: not np.allclose(np.array(client.nodes["/freekick/path"]["props"]["points"]), before),
             what="the new path sent",
         )
         sent = np.array(client.nodes["/freekick/path"]["props"]["points"]).reshape(-1, 2, 3)
@@ -381,18 +361,12 @@ def test_crafted_values_keep_the_last_good_state(
         client.wait_for_gui(label)
         client.set_value(label, value)
         # The cleaned value is echoed to every browser; the scene holds it.
-        client.wait_for(
-            lambda: _echoed(client.value_of(label), expected), what="the cleaned value echoed"
-        )
-        client.wait_for(
-            lambda: getattr(scene.params, field) == expected, what="the scene to hold the value"
-        )
+        client.wait_for(lambda: _echoed(client.value_of(label), expected), what="the cleaned value echoed")
+        client.wait_for(lambda: getattr(scene.params, field) == expected, what="the scene to hold the value")
         with scene._lock:
             assert np.all(np.isfinite(scene.state.flight.position))
             assert np.all(np.isfinite(np.asarray(scene.path.points)))
-            if (
-                getattr(FreeKickParams(), field) == expected
-            ):  # refused outright: the flight is the one before
+            if getattr(FreeKickParams(), field) == expected:  # refused outright: the flight is the one before
                 np.testing.assert_array_equal(scene.state.flight.position, good.flight.position)
 
 
@@ -400,9 +374,7 @@ def _echoed(shown: object, expected: object) -> bool:
     if isinstance(expected, str):
         return isinstance(shown, str) and shown not in ("sideways-ish", "magic", "leapfrog")
     assert isinstance(expected, (int, float))
-    return (
-        isinstance(shown, (int, float)) and math.isfinite(shown) and float(shown) == float(expected)
-    )
+    return isinstance(shown, (int, float)) and math.isfinite(shown) and float(shown) == float(expected)
 
 
 def test_wrong_types_and_crafted_clicks_leave_the_scene_serving(
@@ -412,9 +384,7 @@ def test_wrong_types_and_crafted_clicks_leave_the_scene_serving(
         client.wait_for_gui("Spin rate (rev/s)")
         client.set_value("Spin rate (rev/s)", "fast")
         client.set_value("Knuckleball", "yes please")
-        client.set_value(
-            "Knuckle seed", float("nan")
-        )  # viser's own int cast refuses it before the scene
+        client.set_value("Knuckle seed", float("nan"))  # viser's own int cast refuses it before the scene
         client.send(
             "SceneNodeClickMessage",
             name="/freekick/goal_mouth",
@@ -434,9 +404,7 @@ def test_wrong_types_and_crafted_clicks_leave_the_scene_serving(
             screen_pos=(0.5, 0.5),
             modifier=None,
         )
-        client.wait_for(
-            lambda: scene.last_target == (1.5, 1.2), what="the click to reach the scene"
-        )
+        client.wait_for(lambda: scene.last_target == (1.5, 1.2), what="the click to reach the scene")
         assert scene.wait_idle()
         client.wait_for(lambda: _markdown_shown(client, "Found:"), what="the aim result shown")
         point = scene.state.outcome.goal_point
@@ -444,15 +412,11 @@ def test_wrong_types_and_crafted_clicks_leave_the_scene_serving(
         assert np.linalg.norm(point[1:] - [1.5, 1.2]) < 0.05
         assert scene.params.knuckle is False and scene.params.knuckle_seed == 1
         client.set_value("Launch speed (m/s)", 27.0)
-        client.wait_for(
-            lambda: scene.params.speed_ms == 27.0, what="a good value after the bad ones"
-        )
+        client.wait_for(lambda: scene.params.speed_ms == 27.0, what="a good value after the bad ones")
 
 
 # ------------------------------------------------------------------------------------------------ aiming (review 2)
-def test_aiming_returns_none_for_a_point_no_kick_reaches_and_a_kick_within_the_tolerance_otherwise() -> (
-    None
-):
+def test_aiming_returns_none_for_a_point_no_kick_reaches_and_a_kick_within_the_tolerance_otherwise() -> None:
     # Kind: no miss tolerance, so a kick crossing 1.28 m from the click came back as "Found".
     p = FreeKickParams()
     assert aim_at(p, (0.0, 0.2)) is None  # under the wall's shadow at 25 m/s
@@ -567,9 +531,7 @@ def _assert_framed(p: FreeKickParams, view: ViewName, lens: Lens) -> View:
 @pytest.mark.parametrize("lens", LENSES, ids=lambda lens: f"{lens.width_px}x{lens.height_px}")
 @pytest.mark.parametrize("view", list(VIEW_LABELS))
 @pytest.mark.parametrize("preset", PRESETS, ids=lambda preset: preset.label)
-def test_every_view_frames_every_preset_left_of_the_panel(
-    preset: Preset, view: ViewName, lens: Lens
-) -> None:
+def test_every_view_frames_every_preset_left_of_the_panel(preset: Preset, view: ViewName, lens: Lens) -> None:
     _assert_framed(preset.params, view, lens)
 
 
@@ -583,15 +545,11 @@ def test_every_view_frames_every_preset_left_of_the_panel(
 def test_every_view_frames_every_ball_spot_left_of_the_panel(
     distance: float, angle: float, view: ViewName, wide: bool
 ) -> None:
-    _assert_framed(
-        FreeKickParams(distance_m=distance, angle_deg=angle), view, LENSES[0 if wide else 1]
-    )
+    _assert_framed(FreeKickParams(distance_m=distance, angle_deg=angle), view, LENSES[0 if wide else 1])
 
 
 @pytest.mark.parametrize(("distance", "angle"), [(12.0, 45.0), (12.0, -45.0), (13.0, 45.0)])
-def test_the_goalkeepers_view_stands_in_front_of_the_line_for_a_close_wide_spot(
-    distance: float, angle: float
-) -> None:
+def test_the_goalkeepers_view_stands_in_front_of_the_line_for_a_close_wide_spot(distance: float, angle: float) -> None:
     """Close in and wide, the wall stands 3 m from the goal: framed flat, the camera ended up inside the net."""
     for lens in LENSES:
         _assert_framed(FreeKickParams(distance_m=distance, angle_deg=angle), "goal", lens)
@@ -605,9 +563,7 @@ def test_the_opening_view_shows_the_curl_across_the_screen_and_a_large_goal(lens
     # The path and its no-spin ghost stand apart on the screen over the whole second half of the flight...
     gap_new, gap_old = _path_ghost_gap(state, new, lens), _path_ghost_gap(state, old, lens)
     assert np.mean(gap_new >= OPENING_GAP_PX) >= 0.9, np.round(gap_new)
-    assert np.mean(gap_old >= OPENING_GAP_PX) < 0.5, np.round(
-        gap_old
-    )  # the old view drew them on top of each other
+    assert np.mean(gap_old >= OPENING_GAP_PX) < 0.5, np.round(gap_old)  # the old view drew them on top of each other
     # ...and the goal is not a stamp in the distance.
     assert _goal_width_share(new, lens) >= OPENING_GOAL_SHARE > _goal_width_share(old, lens)
     # Seen from behind the kicker: the camera is farther from the goal than the ball, and above it.
@@ -621,18 +577,12 @@ def test_project_points_agrees_with_frame_points() -> None:
     points = rng.uniform(-5.0, 5.0, (30, 3))
     lens = LENSES[0]
     ndc = lens.usable_ndc()
-    framed = frame_points(
-        points, (1.0, 0.3, -0.4), fov_rad=lens.fov_rad, aspect=lens.aspect, ndc=ndc
-    )
+    framed = frame_points(points, (1.0, 0.3, -0.4), fov_rad=lens.fov_rad, aspect=lens.aspect, ndc=ndc)
     xy = project_points(framed, lens, points)
     x_ndc = 2.0 * xy[:, 0] / lens.width_px - 1.0
     y_ndc = 1.0 - 2.0 * xy[:, 1] / lens.height_px
     assert x_ndc.min() >= ndc[0] - 1e-6 and x_ndc.max() <= ndc[1] + 1e-6
     assert y_ndc.min() >= ndc[2] - 1e-6 and y_ndc.max() <= ndc[3] + 1e-6
-    touches_x = math.isclose(x_ndc.min(), ndc[0], abs_tol=1e-3) and math.isclose(
-        x_ndc.max(), ndc[1], abs_tol=1e-3
-    )
-    touches_y = math.isclose(y_ndc.min(), ndc[2], abs_tol=1e-3) and math.isclose(
-        y_ndc.max(), ndc[3], abs_tol=1e-3
-    )
+    touches_x = math.isclose(x_ndc.min(), ndc[0], abs_tol=1e-3) and math.isclose(x_ndc.max(), ndc[1], abs_tol=1e-3)
+    touches_y = math.isclose(y_ndc.min(), ndc[2], abs_tol=1e-3) and math.isclose(y_ndc.max(), ndc[3], abs_tol=1e-3)
     assert touches_x or touches_y

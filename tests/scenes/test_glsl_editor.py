@@ -115,9 +115,7 @@ def _compiler_view(source: str) -> str:
     st.lists(st.integers(0, 40), max_size=3),
     st.sampled_from(["\\\n", "\\\r\n", "\r", "// c\r", "// c\\\n"]),
 )
-def test_no_disguise_of_a_forbidden_construct_gets_through(
-    construct: str, cuts: list[int], disguise: str
-) -> None:
+def test_no_disguise_of_a_forbidden_construct_gets_through(construct: str, cuts: list[int], disguise: str) -> None:
     # The construct cut anywhere by a continuation, or hidden after a comment a carriage return ends: the
     # compiler would see it, so the check must refuse the text.
     text = construct
@@ -160,8 +158,7 @@ def test_a_ten_link_call_chain_is_refused_for_its_inlined_size() -> None:
     source = (
         "float f0(vec3 p){ return length(p)-1.0; }\n"
         + "".join(
-            f"float f{i}(vec3 p){{ return min(f{i - 1}(p*1.01), f{i - 1}(p.yzx+0.01)); }}\n"
-            for i in range(1, 11)
+            f"float f{i}(vec3 p){{ return min(f{i - 1}(p*1.01), f{i - 1}(p.yzx+0.01)); }}\n" for i in range(1, 11)
         )
         + "float sdf(vec3 p){ return f10(p); }\n"
     )
@@ -310,9 +307,7 @@ def test_a_steep_field_meshes_watertight_with_the_spheres_area(k: float) -> None
 
 @pytest.mark.gl
 def test_the_elongation_example_is_watertight() -> None:
-    source = next(
-        s for title, s in gl_renderer.examples().items() if title.startswith("Elongation")
-    )
+    source = next(s for title, s in gl_renderer.examples().items() if title.startswith("Elongation"))
     tri = mesh_glsl(source, 64, WIDE)
     assert tri.is_watertight and len(tri.faces) == 6500
 

@@ -44,14 +44,18 @@ def bar_heights(scene: PelotonScene, component: str) -> np.ndarray:
 def test_opening_state_matches_the_kernel(scene: PelotonScene) -> None:
     p = PelotonParams()
     expected = cycling.paceline(
-        p.n_riders, p.gap_m, p.speed_kmh / 3.6, p.cda_m2, p.mass_kg, p.crr,
-        drivetrain_efficiency=p.drivetrain_pct / 100, model="measured",
-    )  # fmt: skip
+        p.n_riders,
+        p.gap_m,
+        p.speed_kmh / 3.6,
+        p.cda_m2,
+        p.mass_kg,
+        p.crr,
+        drivetrain_efficiency=p.drivetrain_pct / 100,
+        model="measured",
+    )
     np.testing.assert_allclose(scene.state.power.total, expected.total, rtol=1e-12)
     # Bars: aero height is watts × scale for each shown rider; hidden riders are scaled to zero.
-    np.testing.assert_allclose(
-        bar_heights(scene, "aero")[:4], expected.aero * BAR_METRES_PER_WATT, rtol=1e-5
-    )
+    np.testing.assert_allclose(bar_heights(scene, "aero")[:4], expected.aero * BAR_METRES_PER_WATT, rtol=1e-5)
     scales = scene.riders_nodes["body"].batched_scales
     assert scales is not None
     assert np.all(np.asarray(scales)[4:] == 0.0) and np.all(np.asarray(scales)[:4] == 1.0)
@@ -66,15 +70,11 @@ def test_changing_values_updates_every_output(scene: PelotonScene) -> None:
     assert scene.params.speed_kmh == 50.0 and scene.params.n_riders == 6
     line = compute_line(scene.params)
     np.testing.assert_allclose(scene.state.power.total, line.power.total)
-    assert np.all(
-        bar_heights(scene, "climbing")[:6] > 0.1
-    )  # 6 % at 50 km/h: hundreds of watts of climbing
+    assert np.all(bar_heights(scene, "climbing")[:6] > 0.1)  # 6 % at 50 km/h: hundreds of watts of climbing
     assert scene.labels[5].visible and not scene.labels[6].visible
     assert scene.table.content.count("\n") == 1 + 6  # header, rule, six riders
     chart = scene.chart.data
-    assert chart[0][-1] == 80.0 and np.nanmax(chart[5]) == pytest.approx(
-        float(scene.state.solo.total)
-    )
+    assert chart[0][-1] == 80.0 and np.nanmax(chart[5]) == pytest.approx(float(scene.state.solo.total))
     # The grade tilts the road: rotation about −y by atan(6 %).
     w, _, y, _ = scene.course.wxyz
     assert 2 * math.atan2(-y, w) == pytest.approx(math.atan(0.06), rel=1e-6)
@@ -117,9 +117,7 @@ def test_position_preset_sets_cda_and_redraws_the_rider(scene: PelotonScene) -> 
 def test_crr_preset_sets_crr(scene: PelotonScene) -> None:
     scene.crr_preset.value = "Mountain bike, knobbly (0.0120)"
     assert scene.params.crr == pytest.approx(0.012)
-    assert float(scene.state.power.rolling[0]) == pytest.approx(
-        0.012 * 80 * 9.81 * 40 / 3.6, rel=1e-6
-    )
+    assert float(scene.state.power.rolling[0]) == pytest.approx(0.012 * 80 * 9.81 * 40 / 3.6, rel=1e-6)
 
 
 def test_speed_at_a_power_readout(scene: PelotonScene) -> None:
@@ -173,10 +171,7 @@ def test_slider_from_a_browser_runs_the_callback_and_updates_the_client(
         expected = compute_line(scene.params).power.total
         client.wait_for(lambda: scene.table.content != old_table, what="table redraw")
         client.wait_for(
-            lambda: any(
-                f"**{expected[0]:.0f}**" in str(e["props"].get("_markdown", ""))
-                for e in client.gui.values()
-            ),
+            lambda: any(f"**{expected[0]:.0f}**" in str(e["props"].get("_markdown", "")) for e in client.gui.values()),
             what="the client to receive the new table",
         )
 
@@ -234,9 +229,7 @@ def _shown_matches(shown: object, expected: object) -> bool:
     if isinstance(expected, str) or isinstance(shown, str):
         return isinstance(shown, str) and shown in CLEAN_OPTIONS
     assert isinstance(expected, (int, float))
-    return (
-        isinstance(shown, (int, float)) and math.isfinite(shown) and float(shown) == float(expected)
-    )
+    return isinstance(shown, (int, float)) and math.isfinite(shown) and float(shown) == float(expected)
 
 
 def test_wrong_types_and_unknown_messages_leave_the_server_serving(
@@ -248,13 +241,9 @@ def test_wrong_types_and_unknown_messages_leave_the_server_serving(
         client.set_value("Speed (km/h)", [1, 2, 3])
         client.set_value("Drafting", "yes please")
         client.send("GuiUpdateMessage", uuid="no-such-uuid", updates={"value": 1.0})
-        client.send(
-            "TransformControlsUpdateMessage", name="/nothing", wxyz=(1, 0, 0, 0), position=(0, 0, 0)
-        )
+        client.send("TransformControlsUpdateMessage", name="/nothing", wxyz=(1, 0, 0, 0), position=(0, 0, 0))
         client.set_value("Speed (km/h)", 33.0)
-        client.wait_for(
-            lambda: scene.params.speed_kmh == 33.0, what="a good value after the bad ones"
-        )
+        client.wait_for(lambda: scene.params.speed_kmh == 33.0, what="a good value after the bad ones")
         assert scene.params.drafting is True
     # A new browser can still connect and drive the scene.
     with BrowserClient(server.get_port()) as second:
@@ -266,9 +255,7 @@ def test_wrong_types_and_unknown_messages_leave_the_server_serving(
 
 
 # ------------------------------------------------------------------------------------------------ labels
-def _screen_px(
-    points: np.ndarray, position: np.ndarray, look_at: np.ndarray, lens: Lens
-) -> np.ndarray:
+def _screen_px(points: np.ndarray, position: np.ndarray, look_at: np.ndarray, lens: Lens) -> np.ndarray:
     """(N, 2) px (y down) of world points: a pinhole camera with z up, written out apart from the scene's."""
     x, y, depth = pinhole_ndc(points, position, look_at, lens.fov_rad, lens.aspect).T
     assert np.all(depth > 0.0)
@@ -281,13 +268,9 @@ def label_boxes_px(scene: PelotonScene, lens: Lens) -> np.ndarray:
     n, theta = scene.params.n_riders, math.atan(scene.params.grade_pct / 100.0)
     local = np.array([scene.labels[i].position for i in range(n)], dtype=np.float64)
     c, s = math.cos(theta), math.sin(theta)  # the course frame turns by −θ about y
-    world = np.stack(
-        [c * local[:, 0] - s * local[:, 2], local[:, 1], s * local[:, 0] + c * local[:, 2]], 1
-    )
+    world = np.stack([c * local[:, 0] - s * local[:, 2], local[:, 1], s * local[:, 0] + c * local[:, 2]], 1)
     xy = _screen_px(world, np.array(view.position), np.array(view.look_at), lens)
-    return np.concatenate(
-        [xy[:, :1], xy[:, 1:] - LABEL_PX[1], xy[:, :1] + LABEL_PX[0], xy[:, 1:]], 1
-    )
+    return np.concatenate([xy[:, :1], xy[:, 1:] - LABEL_PX[1], xy[:, :1] + LABEL_PX[0], xy[:, 1:]], 1)
 
 
 def assert_labels_apart_and_in_view(boxes: np.ndarray, lens: Lens) -> None:
@@ -296,12 +279,7 @@ def assert_labels_apart_and_in_view(boxes: np.ndarray, lens: Lens) -> None:
     assert right.max() <= lens.width_px - PANEL_PX + 1e-6 and bottom.max() <= lens.height_px, boxes
     for i in range(len(boxes)):
         for j in range(i + 1, len(boxes)):
-            apart = (
-                right[i] <= left[j]
-                or right[j] <= left[i]
-                or bottom[i] <= top[j]
-                or bottom[j] <= top[i]
-            )
+            apart = right[i] <= left[j] or right[j] <= left[i] or bottom[i] <= top[j] or bottom[j] <= top[i]
             assert apart, f"labels {i} and {j} overlap: {boxes[i]} and {boxes[j]}"
 
 
@@ -338,15 +316,11 @@ def test_labels_never_overlap_and_stay_in_view_clear_of_the_panel(
 
 
 @pytest.mark.parametrize("viewport", [(1280, 720), (1000, 800)])
-def test_a_steep_fast_long_line_keeps_its_last_label_in_view(
-    scene: PelotonScene, viewport: tuple[int, int]
-) -> None:
+def test_a_steep_fast_long_line_keeps_its_last_label_in_view(scene: PelotonScene, viewport: tuple[int, int]) -> None:
     # The failing input (a fresh review): 8 riders 15 m apart at 80 km/h up 20 %: the labels, lifted along the
     # tilted road's up, leaned out of the framed box, and the last one started left of the window.
     c = scene.controls
-    c["n_riders"].value, c["gap_m"].value, c["speed_kmh"].value, c["grade_pct"].value = (
-        8, 15.0, 80.0, 20.0
-    )  # fmt: skip
+    c["n_riders"].value, c["gap_m"].value, c["speed_kmh"].value, c["grade_pct"].value = (8, 15.0, 80.0, 20.0)
     lens = Lens(math.radians(75.0), *viewport)
     assert_labels_apart_and_in_view(label_boxes_px(scene, lens), lens)
 

@@ -32,9 +32,7 @@ class Probe(Scene):
         """What the loop's step reports: False puts the loop to sleep until wake_loops()."""
         self.gizmo_events = 0
         with self.gui_root:
-            self.slider = server.gui.add_slider(
-                "Value", min=0.0, max=10.0, step=0.1, initial_value=1.0
-            )
+            self.slider = server.gui.add_slider("Value", min=0.0, max=10.0, step=0.1, initial_value=1.0)
             self.choice = server.gui.add_dropdown("Choice", options=("a", "b"), initial_value="a")
             self.boom = server.gui.add_button("Boom")
         self.gizmo = server.scene.add_transform_controls(f"{self.root.name}/gizmo", scale=0.5)
@@ -131,9 +129,7 @@ def test_gizmo_positions_from_a_browser_are_cleaned(server: viser.ViserServer) -
         seen = probe.gizmo_events
         client.drag_transform("/probe/gizmo", [(float("nan"), 0.0, 0.0)])
         # start, update and end each run the callback: wait until all three were handled
-        client.wait_for(
-            lambda: probe.gizmo_events >= seen + 3, what="the crafted drag to be handled"
-        )
+        client.wait_for(lambda: probe.gizmo_events >= seen + 3, what="the crafted drag to be handled")
         with probe._lock:
             assert probe.point == (1.0, 2.0, 3.0)
             assert tuple(probe.gizmo.position) == (1.0, 2.0, 3.0)
@@ -160,9 +156,7 @@ def test_close_stops_the_loop_and_removes_everything(server: viser.ViserServer) 
 @pytest.mark.parametrize("key", list(SCENES))
 def test_a_closed_scene_is_released(server: viser.ViserServer, key: str) -> None:
     """Nothing the server keeps (callbacks, camera listeners) may hold a closed scene alive."""
-    with BrowserClient(
-        server.get_port()
-    ) as client:  # a connected browser, so per-client callbacks exist
+    with BrowserClient(server.get_port()) as client:  # a connected browser, so per-client callbacks exist
         client.wait_for(lambda: len(server.get_clients()) == 1, what="the client to register")
         refs = []
         for _ in range(2):

@@ -35,9 +35,7 @@ def scene(show_scene: MakeScene) -> SdfGalleryScene:
 
 def shown_mesh(scene: SdfGalleryScene) -> trimesh.Trimesh:
     """The mesh the browser receives: the GLB bytes of the mesh node, loaded back."""
-    loaded = trimesh.load(
-        io.BytesIO(scene.mesh_node.glb_data), file_type="glb", force="mesh", process=False
-    )
+    loaded = trimesh.load(io.BytesIO(scene.mesh_node.glb_data), file_type="glb", force="mesh", process=False)
     assert isinstance(loaded, trimesh.Trimesh)
     return loaded
 
@@ -71,9 +69,7 @@ def test_gizmo_drag_remeshes(server: viser.ViserServer, scene: SdfGalleryScene) 
         path = [(0.0, 0.0, 0.5 + 0.05 * i) for i in range(1, 9)]
         client.drag_transform("/sdf/gizmo_1", path, period_s=0.02)
         wait_until(
-            lambda: (
-                scene.mesh_scene is not None and scene.mesh_scene.primitives[0].center == path[-1]
-            ),
+            lambda: scene.mesh_scene is not None and scene.mesh_scene.primitives[0].center == path[-1],
             "the mesh of the last drag position",
         )
         # The sphere (radius 0.45) rose 0.4 m: the mesh's top rose with it.
@@ -85,22 +81,15 @@ def test_gizmo_drag_remeshes(server: viser.ViserServer, scene: SdfGalleryScene) 
         )
 
 
-def test_a_burst_of_drags_coalesces_to_the_latest(
-    server: viser.ViserServer, scene: SdfGalleryScene
-) -> None:
+def test_a_burst_of_drags_coalesces_to_the_latest(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
     with BrowserClient(server.get_port()) as client:
         client.wait_for_node(MESH)
         before = scene.mesh_serial
-        path = [
-            (0.3 * math.cos(a), 0.3 * math.sin(a), 0.5) for a in np.linspace(0, 2 * math.pi, 41)[1:]
-        ]
+        path = [(0.3 * math.cos(a), 0.3 * math.sin(a), 0.5) for a in np.linspace(0, 2 * math.pi, 41)[1:]]
         client.drag_transform("/sdf/gizmo_2", path)  # no pauses: faster than any mesher
         target = tuple(float(v) for v in path[-1])
         wait_until(
-            lambda: (
-                scene.mesh_scene is not None
-                and np.allclose(scene.mesh_scene.primitives[1].center, target)
-            ),
+            lambda: scene.mesh_scene is not None and np.allclose(scene.mesh_scene.primitives[1].center, target),
             "the last drag position meshed",
         )
         expected = sdf.mesh(scene.params.scene(), scene.params.resolution)
@@ -137,9 +126,7 @@ def test_gui_changes_remesh(server: viser.ViserServer, scene: SdfGalleryScene) -
             "blend, kind and colour in the mesh",
         )
         expected = sdf.mesh(scene.params.scene(), scene.params.resolution)
-        for got, want in zip(
-            (scene.mesh_vertices, scene.mesh_faces, scene.mesh_colors), expected, strict=True
-        ):
+        for got, want in zip((scene.mesh_vertices, scene.mesh_faces, scene.mesh_colors), expected, strict=True):
             np.testing.assert_array_equal(got, want)
         client.wait_for(  # a box uses all three sizes
             lambda: client.element("P1 size b (m)")["props"]["disabled"] is False,
@@ -147,22 +134,16 @@ def test_gui_changes_remesh(server: viser.ViserServer, scene: SdfGalleryScene) -
         )
 
 
-def test_crafted_bad_values_keep_the_last_good_scene(
-    server: viser.ViserServer, scene: SdfGalleryScene
-) -> None:
+def test_crafted_bad_values_keep_the_last_good_scene(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
     good = scene.params
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("Blend width k (m)")
         client.wait_for_node("/sdf/gizmo_1")
         client.set_value("Blend width k (m)", float("nan"))
-        client.wait_for(
-            lambda: client.value_of("Blend width k (m)") == good.k, what="k written back"
-        )
+        client.wait_for(lambda: client.value_of("Blend width k (m)") == good.k, what="k written back")
         client.set_value("P2 kind", "Pyramid")  # not an option
         client.wait_for(lambda: client.value_of("P2 kind") == "Box", what="kind written back")
-        client.set_value(
-            "P3 size a (m)", "big"
-        )  # viser itself refuses this one; the final check covers it
+        client.set_value("P3 size a (m)", "big")  # viser itself refuses this one; the final check covers it
         client.set_value("P1 colour", (300, -4, 20))
         client.wait_for(
             lambda: tuple(client.value_of("P1 colour")) == good.primitives[0].color,
@@ -176,9 +157,7 @@ def test_crafted_bad_values_keep_the_last_good_scene(
             lambda: scene.mesh_scene is not None and scene.params.resolution == 32,
             "the mesh at resolution 32",
         )
-        wait_until(
-            lambda: len(scene.mesh_vertices) == len(sdf.mesh(good.scene(), 32)[0]), "32³ mesh"
-        )
+        wait_until(lambda: len(scene.mesh_vertices) == len(sdf.mesh(good.scene(), 32)[0]), "32³ mesh")
     assert scene.params == SdfGalleryParams(resolution=32)
     assert scene.mesh_scene == good.scene()
     np.testing.assert_array_equal(scene.mesh_vertices, sdf.mesh(good.scene(), 32)[0])
@@ -192,9 +171,7 @@ def test_gizmo_is_kept_inside_the_box(server: viser.ViserServer, scene: SdfGalle
     assert gizmo_3 is not None and tuple(gizmo_3.position) == (1.5, -1.5, 0.1)
 
 
-def test_high_resolution_shows_progress_then_a_fine_mesh(
-    server: viser.ViserServer, scene: SdfGalleryScene
-) -> None:
+def test_high_resolution_shows_progress_then_a_fine_mesh(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui(RESOLUTION_LABEL)
         client.set_value(RESOLUTION_LABEL, 256)
@@ -218,9 +195,7 @@ def test_high_resolution_shows_progress_then_a_fine_mesh(
 
 # ------------------------------------------------------------------------------------------ reference image
 @pytest.mark.gl
-def test_reference_image_readouts_and_rerender(
-    server: viser.ViserServer, scene: SdfGalleryScene
-) -> None:
+def test_reference_image_readouts_and_rerender(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
     need_gl()
     with BrowserClient(server.get_port()) as client:
         client.send_camera(position=(2.3, -2.5, 1.7), look_at=(0.05, 0.0, 0.3), size=(600, 800))
@@ -237,17 +212,13 @@ def test_reference_image_readouts_and_rerender(
         first = scene.reference_rgb
         assert first is not None
         a = scene.agreement
-        assert (
-            a.iou is not None and a.iou > 0.97
-        )  # box edges on the silhouette are bevelled by marching cubes
+        assert a.iou is not None and a.iou > 0.97  # box edges on the silhouette are bevelled by marching cubes
         assert a.depth_diff_voxels is not None and a.depth_diff_voxels < 0.1
         assert a.render_ms is not None and "Silhouette IoU" in scene.readout.content
         # Moving the camera re-renders from the new view once it rests.
         count = scene.reference_serial
         client.send_camera(position=(0.0, -3.5, 0.4), look_at=(0.0, 0.0, 0.3), size=(600, 800))
-        wait_until(
-            lambda: scene.reference_serial > count, "re-render after the camera moved", timeout_s=30
-        )
+        wait_until(lambda: scene.reference_serial > count, "re-render after the camera moved", timeout_s=30)
         assert scene.reference_rgb is not None and not np.array_equal(scene.reference_rgb, first)
         # A brighter ambient term brightens the object.
         dark = scene.reference_rgb.astype(float).mean()
@@ -259,9 +230,7 @@ def test_reference_image_readouts_and_rerender(
 
 
 @pytest.mark.gl
-def test_live_mode_renders_while_the_camera_moves(
-    server: viser.ViserServer, scene: SdfGalleryScene
-) -> None:
+def test_live_mode_renders_while_the_camera_moves(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
     """ "When the camera stops" waits for a still camera; "Live" renders while camera messages keep coming."""
     need_gl()
     with BrowserClient(server.get_port()) as client:
@@ -271,9 +240,7 @@ def test_live_mode_renders_while_the_camera_moves(
         count = scene.reference_serial
         for step in range(60):  # an orbit, one camera message every 50 ms: never still for 0.25 s
             angle = 0.05 * step
-            client.send_camera(
-                position=(3 * math.cos(angle), 3 * math.sin(angle), 1.5), look_at=(0, 0, 0.3)
-            )
+            client.send_camera(position=(3 * math.cos(angle), 3 * math.sin(angle), 1.5), look_at=(0, 0, 0.3))
             time.sleep(0.05)
         # A render already in flight accounts for one at most; live mode keeps rendering during the motion.
         assert scene.reference_serial - count >= 3
@@ -294,11 +261,7 @@ def test_downloads(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
             start = next(m for _, m in client.received if m.get("filename") == name)
             client.wait_for(
                 lambda start=start: (
-                    sum(
-                        1
-                        for _, m in client.received
-                        if m.get("transfer_uuid") == start["transfer_uuid"]
-                    )
+                    sum(1 for _, m in client.received if m.get("transfer_uuid") == start["transfer_uuid"])
                     > start["part_count"]
                 ),
                 what=f"{name} parts",
@@ -306,14 +269,11 @@ def test_downloads(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
             parts = sorted(
                 (m["part_index"], m["content"])
                 for _, m in client.received
-                if m.get("type") == "FileTransferPart"
-                and m["transfer_uuid"] == start["transfer_uuid"]
+                if m.get("type") == "FileTransferPart" and m["transfer_uuid"] == start["transfer_uuid"]
             )
             data = b"".join(content for _, content in parts)
             assert len(data) == start["size_bytes"]
-            loaded = trimesh.load(
-                io.BytesIO(data), file_type=name.rsplit(".", 1)[1], force="mesh", process=False
-            )
+            loaded = trimesh.load(io.BytesIO(data), file_type=name.rsplit(".", 1)[1], force="mesh", process=False)
             assert isinstance(loaded, trimesh.Trimesh)
             assert len(loaded.faces) == len(scene.mesh_faces)
     name, glb = scene.export("glb")
@@ -337,9 +297,7 @@ def test_without_gl_the_panel_says_why_and_meshing_goes_on(
 ) -> None:
 
     def no_gl(job: object, timeout_s: float | None = None) -> None:
-        raise GLUnavailableError(
-            "No OpenGL 3.3 context on EGL (test): the mesh view works without it."
-        )
+        raise GLUnavailableError("No OpenGL 3.3 context on EGL (test): the mesh view works without it.")
 
     monkeypatch.setattr(gl_service, "run", no_gl)
     scene = SdfGalleryScene(server)
@@ -350,10 +308,7 @@ def test_without_gl_the_panel_says_why_and_meshing_goes_on(
         with BrowserClient(server.get_port()) as client:
             client.drag_transform("/sdf/gizmo_1", [(0.1, 0.0, 0.6)])
             wait_until(
-                lambda: (
-                    scene.mesh_scene is not None
-                    and scene.mesh_scene.primitives[0].center == (0.1, 0.0, 0.6)
-                ),
+                lambda: scene.mesh_scene is not None and scene.mesh_scene.primitives[0].center == (0.1, 0.0, 0.6),
                 "a mesh without GL",
             )
     finally:
@@ -424,9 +379,7 @@ def test_blend_dropdown_says_hard_and_smooth_and_hard_ignores_k(
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("Blend")
         client.set_value("Blend", "Hard")
-        wait_until(
-            lambda: scene.mesh_scene is not None and scene.mesh_scene.k == 0.0, "a hard mesh"
-        )
+        wait_until(lambda: scene.mesh_scene is not None and scene.mesh_scene.k == 0.0, "a hard mesh")
         assert scene.scene_controls["k"].disabled
         meshed = scene.mesh_scene
         assert meshed is not None
@@ -471,9 +424,7 @@ def test_each_gizmo_is_sized_coloured_and_named_for_its_own_primitive(
             "the resized gizmo",
         )
         client.set_value("P1 colour", (10, 200, 30))
-        wait_until(
-            lambda: tuple(scene.gizmo_markers[0].color) == (10, 200, 30), "the marker colour"
-        )
+        wait_until(lambda: tuple(scene.gizmo_markers[0].color) == (10, 200, 30), "the marker colour")
 
 
 @pytest.mark.parametrize(
@@ -559,9 +510,7 @@ def test_typed_source_is_meshed_and_a_bad_one_keeps_the_last_good(
 
 
 @pytest.mark.gl
-def test_every_example_applies_and_meshes(
-    server: viser.ViserServer, scene: SdfGalleryScene
-) -> None:
+def test_every_example_applies_and_meshes(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
     from scenes.sdf_gallery import EXAMPLES
 
     need_gl()
@@ -573,15 +522,11 @@ def test_every_example_applies_and_meshes(
             wait_until(lambda n=n: scene.editor_serial == n, f"example {title!r}")
             assert scene.params.editor.source == EXAMPLES[title]
             assert len(scene.mesh_faces) > 500, title
-            client.wait_for(
-                lambda t=title: client.value_of("sdf(p) in GLSL") == EXAMPLES[t], what="text"
-            )
+            client.wait_for(lambda t=title: client.value_of("sdf(p) in GLSL") == EXAMPLES[t], what="text")
 
 
 @pytest.mark.gl
-def test_raymarched_view_goes_to_the_background_with_depth(
-    server: viser.ViserServer, scene: SdfGalleryScene
-) -> None:
+def test_raymarched_view_goes_to_the_background_with_depth(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
     need_gl()
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("View")
@@ -596,29 +541,21 @@ def test_raymarched_view_goes_to_the_background_with_depth(
             what="a background image with depth",
         )
         # At rest the frame is the full width, with the viewer's aspect.
-        wait_until(
-            lambda: scene.view_rgb is not None and scene.view_rgb.shape[1] == 640, "the full frame"
-        )
+        wait_until(lambda: scene.view_rgb is not None and scene.view_rgb.shape[1] == 640, "the full frame")
         assert scene.view_rgb is not None and scene.view_rgb.shape[:2] == (400, 640)
         # Moving: a reduced frame first.
         client.send_camera(position=(2.2, -2.2, 1.6), look_at=(0.0, 0.0, 0.3), size=(400, 640))
-        wait_until(
-            lambda: scene.view_rgb is not None and scene.view_rgb.shape[1] == 320, "a reduced frame"
-        )
+        wait_until(lambda: scene.view_rgb is not None and scene.view_rgb.shape[1] == 320, "a reduced frame")
         client.set_value("View", "Both")
         client.wait_for(lambda: True)
         wait_until(lambda: scene.wireframe_node.visible, "the wireframe")
         assert len(scene.wireframe_node.faces) == len(scene.mesh_faces)
         client.set_value("View", "Mesh")
         wait_until(lambda: scene.mesh_node.visible, "the mesh back")
-        client.wait_for(
-            lambda: background_images(client)[-1]["rgb_data"] is None, what="background cleared"
-        )
+        client.wait_for(lambda: background_images(client)[-1]["rgb_data"] is None, what="background cleared")
 
 
-def test_camera_with_zero_height_or_nan_is_ignored(
-    server: viser.ViserServer, scene: SdfGalleryScene
-) -> None:
+def test_camera_with_zero_height_or_nan_is_ignored(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("View")
         client.send_camera(size=(0, 640))
@@ -642,9 +579,7 @@ def test_with_editing_off_apply_uses_only_the_servers_examples(
         assert scene.editor.disabled and "Editing is off" in scene.editor_status.content
         with BrowserClient(server.get_port()) as client:
             client.wait_for_gui("Apply")
-            client.set_value(
-                "sdf(p) in GLSL", SPHERE_SOURCE
-            )  # a crafted client can still send text
+            client.set_value("sdf(p) in GLSL", SPHERE_SOURCE)  # a crafted client can still send text
             client.click("Apply")
             wait_until(lambda: scene.editor_serial == 1, "an apply")
             assert scene.params.editor.source == next(iter(gallery.EXAMPLES.values()))
@@ -653,9 +588,7 @@ def test_with_editing_off_apply_uses_only_the_servers_examples(
 
 
 @pytest.mark.gl
-@pytest.mark.parametrize(
-    ("limit", "words"), [("COMPILE_LIMIT_S", "compiling took"), ("FRAME_LIMIT_S", "frame took")]
-)
+@pytest.mark.parametrize(("limit", "words"), [("COMPILE_LIMIT_S", "compiling took"), ("FRAME_LIMIT_S", "frame took")])
 def test_compile_and_frame_time_limits_refuse_a_slow_source(
     server: viser.ViserServer,
     scene: SdfGalleryScene,
@@ -709,9 +642,7 @@ def test_a_slow_compile_is_stopped_at_the_limit_while_the_server_keeps_serving(
         wait_until(lambda: scene.editor_error is not None, "the refusal", timeout_s=30.0)
         refused_s = time.monotonic() - start
         assert "stopped" in str(scene.editor_error) and "limit" in str(scene.editor_error)
-        assert (
-            refused_s < 20.0
-        )  # the limits plus the child's start (about 2 s here), not the 8 s compile
+        assert refused_s < 20.0  # the limits plus the child's start (about 2 s here), not the 8 s compile
         assert scene.editor_serial == 0 and scene.params.shape_source == "primitives"
         # Ten links are refused before anything compiles, with the size and the limit.
         scene.editor_error = None
@@ -745,9 +676,7 @@ def test_an_over_long_editor_text_is_put_back_for_every_viewer(
     with BrowserClient(server.get_port()) as late:
         late.wait_for_gui(label)
         late.wait_for(lambda: late.value_of(label) == SPHERE_SOURCE, what="the kept text")
-        assert all(
-            len(str(m.get("updates", {}).get("value", ""))) < 10**5 for _, m in late.received
-        )
+        assert all(len(str(m.get("updates", {}).get("value", ""))) < 10**5 for _, m in late.received)
 
 
 def test_apply_of_a_text_over_the_source_limit_says_its_length_and_the_limit(
@@ -783,13 +712,8 @@ def test_a_field_without_a_surface_in_the_bounds_is_not_applied(
         wait_until(lambda: scene.editor_error is not None, "the refusal", timeout_s=30.0)
         assert "no surface lies inside the bounds" in str(scene.editor_error)
         assert side in str(scene.editor_error) and "±1.5 m" in str(scene.editor_error)
-        assert (
-            "0 triangles" not in scene.editor_status.content
-            and "Applied" not in scene.editor_status.content
-        )
-        assert (
-            scene.editor_serial == 0 and len(scene.mesh_faces) > 500
-        )  # the primitives' mesh stays
+        assert "0 triangles" not in scene.editor_status.content and "Applied" not in scene.editor_status.content
+        assert scene.editor_serial == 0 and len(scene.mesh_faces) > 500  # the primitives' mesh stays
 
 
 _ODD = st.one_of(
@@ -814,9 +738,7 @@ _ODD = st.one_of(
     )
 )
 @settings(max_examples=200, suppress_health_check=[HealthCheck.function_scoped_fixture])
-def test_any_camera_message_fields_keep_the_view_sane(
-    scene: SdfGalleryScene, fields: dict[str, object]
-) -> None:
+def test_any_camera_message_fields_keep_the_view_sane(scene: SdfGalleryScene, fields: dict[str, object]) -> None:
     # Every field of a ViewerCameraMessage the scene reads, crafted: its handler never raises, and what it keeps
     # is finite (a camera, an aspect in range and a rest frame of a sane size).
     class Cam:
@@ -876,7 +798,5 @@ def gallery_rest_size(width: int, aspect: float, s_per_pixel: float | None) -> t
         (1600, 1.6, 1.0, (640, 400)),  # a very slow field: the old rest size
     ],
 )
-def test_rest_frame_size(
-    viewer: int, aspect: float, s_per_pixel: float | None, size: tuple[int, int]
-) -> None:
+def test_rest_frame_size(viewer: int, aspect: float, s_per_pixel: float | None, size: tuple[int, int]) -> None:
     assert gallery_rest_size(viewer, aspect, s_per_pixel) == size

@@ -21,9 +21,7 @@ def worker():
 def test_a_burst_runs_the_first_and_the_newest_only(worker: LatestWorker) -> None:
     gate = threading.Event()
     ran: list[int] = []
-    worker.submit(
-        lambda: (gate.wait(5.0), ran.append(0))
-    )  # holds the thread while the burst arrives
+    worker.submit(lambda: (gate.wait(5.0), ran.append(0)))  # holds the thread while the burst arrives
     time.sleep(0.05)
     for i in range(1, 101):
         worker.submit(lambda i=i: ran.append(i))

@@ -189,8 +189,7 @@ def test_switching_from_a_browser(server: viser.ViserServer) -> None:
         client.wait_for(
             lambda: (
                 not any(
-                    name.startswith("/") and name.split("/")[1] in set(SCENES) - {"peloton"}
-                    for name in client.nodes
+                    name.startswith("/") and name.split("/")[1] in set(SCENES) - {"peloton"} for name in client.nodes
                 )
             ),
             what="other scenes' nodes gone from the client",

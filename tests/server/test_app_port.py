@@ -38,15 +38,11 @@ def test_a_busy_port_given_with_port_is_refused_without_a_url() -> None:
         )
     assert run.returncode == 2
     assert f"Port {busy} is already in use" in run.stderr
-    assert (
-        "http://" not in run.stdout + run.stderr
-    )  # viser's banner would name a port it never serves
+    assert "http://" not in run.stdout + run.stderr  # viser's banner would name a port it never serves
 
 
 def test_help_names_the_port_default_in_words() -> None:
-    run = subprocess.run(
-        [sys.executable, "app.py", "--help"], cwd=ROOT, capture_output=True, text=True, timeout=120
-    )
+    run = subprocess.run([sys.executable, "app.py", "--help"], cwd=ROOT, capture_output=True, text=True, timeout=120)
     assert run.returncode == 0
     text = " ".join(run.stdout.split())
     assert "--port INT" in text and "{None}" not in text

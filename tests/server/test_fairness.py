@@ -116,9 +116,7 @@ def first_gui_delay(server: viser.ViserServer, sessions: Sessions) -> float:
 def builds_of(client: BrowserClient, root: str) -> list[float]:
     """When ``client`` was sent each new build of the scene whose root frame is ``root``."""
     return [
-        at
-        for at, message in client.received
-        if message.get("type") == "FrameMessage" and message.get("name") == root
+        at for at, message in client.received if message.get("type") == "FrameMessage" and message.get("name") == root
     ]
 
 
@@ -150,9 +148,7 @@ def test_a_reset_flood_does_not_delay_another_tab_and_ends_in_a_reset_scene(
         assert switcher is not None
         reset = flooder.wait_for_gui("Reset scene to defaults")
         flooder.set_value("Scene", SCENES[key].title)
-        flooder.wait_for(
-            lambda: switcher.scene.key == key, timeout=30.0, what=f"the session shows {key}"
-        )
+        flooder.wait_for(lambda: switcher.scene.key == key, timeout=30.0, what=f"the session shows {key}")
         flooder.wait_for_gui(label)
         flooder.set_value(label, value)
         flooder.wait_for(
@@ -171,10 +167,7 @@ def test_a_reset_flood_does_not_delay_another_tab_and_ends_in_a_reset_scene(
             time.sleep(0.5)  # the flood is under way
             delay = first_gui_delay(server, sessions)
         flood_s = flood.last_sent_at - started
-        print(
-            f"{key} Reset flood: {flood.sent} clicks in {flood_s:.1f} s; another tab's first GUI in "
-            f"{delay:.2f} s"
-        )
+        print(f"{key} Reset flood: {flood.sent} clicks in {flood_s:.1f} s; another tab's first GUI in {delay:.2f} s")
         assert flood.sent > 0.5 * FLOOD_HZ
         assert delay <= FIRST_GUI_BOUND_S, f"the second tab's first GUI took {delay:.2f} s"
 
@@ -407,9 +400,7 @@ def test_an_edit_after_a_held_back_reset_waits_for_it() -> None:
 
 def test_a_burst_of_resets_is_one_held_back_reset() -> None:
     budget: CostlyBudget[str] = CostlyBudget(3, 1.0, now=0.0)
-    assert [budget.offer("reset", f"click {i}", 0.0)[0] for i in range(200)] == [True] * 3 + [
-        False
-    ] * 197
+    assert [budget.offer("reset", f"click {i}", 0.0)[0] for i in range(200)] == [True] * 3 + [False] * 197
     assert budget.held == 1 and budget.wait_s(0.0) == pytest.approx(1.0)
     assert budget.take(0.5) is None
     assert budget.take(1.0) == ("reset", "click 199")
@@ -479,9 +470,7 @@ def test_uploads_beyond_the_server_wide_count_are_refused_with_a_notice_and_the_
             for i, (client, _scene) in enumerate(tabs):  # 5 tabs × 2 uploads: 10 > the cap of 8
                 transfers.append([start_upload(client, len(data[i]), 1) for _ in range(2)])
                 if i < 4:
-                    client.wait_for(
-                        lambda i=i: gate.uploads_in_flight()[0] == 2 * (i + 1), what="in flight"
-                    )
+                    client.wait_for(lambda i=i: gate.uploads_in_flight()[0] == 2 * (i + 1), what="in flight")
             assert MAX_UPLOADS_IN_FLIGHT_TOTAL == 8
             note = refusal_notice(tabs[4][0])
             assert "other uploads" in note["body"] and "8 files" in note["body"]
@@ -499,9 +488,7 @@ def test_uploads_beyond_the_server_wide_count_are_refused_with_a_notice_and_the_
             assert tabs[4][1].course_mode.route.name != "Tab 4"
             # Once the others are done, the refused tab's upload goes through.
             upload(tabs[4][0], "Upload GPX", "again.gpx", data[4])
-            tabs[4][0].wait_for(
-                lambda: tabs[4][1].course_mode.route.name == "Tab 4", what="the retry"
-            )
+            tabs[4][0].wait_for(lambda: tabs[4][1].course_mode.route.name == "Tab 4", what="the retry")
         assert "refused uploads in flight across all tabs" in caplog.text
     finally:
         for client, _scene in tabs:

@@ -131,9 +131,7 @@ def shows_server_values(client: BrowserClient, server: viser.ViserServer) -> boo
     values = server_values(server)
     with client._lock:
         shown = {uuid: element["value"] for uuid, element in client.gui.items()}
-    return all(
-        same_value(shown.get(uuid), value) for uuid, value in values.items() if uuid in shown
-    )
+    return all(same_value(shown.get(uuid), value) for uuid, value in values.items() if uuid in shown)
 
 
 def shows_server_poses(client: BrowserClient, server: viser.ViserServer) -> bool:
@@ -142,10 +140,7 @@ def shows_server_poses(client: BrowserClient, server: viser.ViserServer) -> bool
             position, wxyz = client.pose_of(name)
         except (KeyError, TypeError, ValueError):
             return False
-        if not (
-            np.allclose(position, gizmo.position, atol=1e-9)
-            and np.allclose(wxyz, gizmo.wxyz, atol=1e-9)
-        ):
+        if not (np.allclose(position, gizmo.position, atol=1e-9) and np.allclose(wxyz, gizmo.wxyz, atol=1e-9)):
             return False
     return True
 
@@ -224,9 +219,7 @@ def hostile_barrage(attacker: BrowserClient, server: viser.ViserServer) -> int:
         kind = element["type"]
         if kind in INPUT_TYPES:
             for value in bad_values_for(kind):
-                with (
-                    attacker._lock
-                ):  # the browser shows its own (crafted) edit, as the real one does
+                with attacker._lock:  # the browser shows its own (crafted) edit, as the real one does
                     attacker.gui[uuid]["value"] = value
                 attacker.send("GuiUpdateMessage", uuid=uuid, updates={"value": value})
                 sent += 1
@@ -289,16 +282,11 @@ def hostile_barrage(attacker: BrowserClient, server: viser.ViserServer) -> int:
 
 
 def scene_poses(server: viser.ViserServer) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    return {
-        name: (np.array(gizmo.position), np.array(gizmo.wxyz))
-        for name, gizmo in gizmos(server.scene).items()
-    }
+    return {name: (np.array(gizmo.position), np.array(gizmo.wxyz)) for name, gizmo in gizmos(server.scene).items()}
 
 
 @contextlib.contextmanager
-def two_viewers(
-    server: viser.ViserServer, key: str
-) -> Iterator[tuple[SceneSwitcher, BrowserClient, BrowserClient]]:
+def two_viewers(server: viser.ViserServer, key: str) -> Iterator[tuple[SceneSwitcher, BrowserClient, BrowserClient]]:
     """Scene ``key`` on ``server`` and two browsers showing it, both registered and past the scene's first
     callbacks: the first sends, the second watches. The scene closes after the browsers."""
     switcher = SceneSwitcher(server, key)
@@ -338,10 +326,7 @@ def test_every_hostile_message_leaves_every_viewer_on_the_last_good_state(
             if e["type"] in INPUT_TYPES or e["type"] == "GuiButtonMessage"
         }
         # Every tab's camera, the attacker's too: its crafted cameras (a zero height) must not be applied.
-        cameras_before = {
-            cid: (c.camera.image_width, c.camera.image_height)
-            for cid, c in server.get_clients().items()
-        }
+        cameras_before = {cid: (c.camera.image_width, c.camera.image_height) for cid, c in server.get_clients().items()}
         caplog.clear()
 
         sent = hostile_barrage(attacker, server)
@@ -375,8 +360,7 @@ def test_every_hostile_message_leaves_every_viewer_on_the_last_good_state(
         for uuid, props in observer_props.items():
             assert observer.gui[uuid]["props"] == props, uuid
         assert {
-            cid: (c.camera.image_width, c.camera.image_height)
-            for cid, c in server.get_clients().items()
+            cid: (c.camera.image_width, c.camera.image_height) for cid, c in server.get_clients().items()
         } == cameras_before
 
         # One line per kind of refusal, and no tracebacks anywhere.
@@ -391,9 +375,7 @@ def test_every_hostile_message_leaves_every_viewer_on_the_last_good_state(
         # A new browser connects and drives the scene.
         with BrowserClient(server.get_port()) as late:
             late.wait_for_gui(label)
-            late.wait_for(
-                lambda: same_value(late.value_of(label), good), what="the late tab's value"
-            )
+            late.wait_for(lambda: same_value(late.value_of(label), good), what="the late tab's value")
 
 
 def dataclass_replace(params: Any, field: str, value: Any) -> Any:
@@ -403,9 +385,7 @@ def dataclass_replace(params: Any, field: str, value: Any) -> Any:
 
 
 @pytest.mark.parametrize("key", list(SCENES))
-def test_huge_numbers_clamp_to_the_range_the_scene_declared(
-    server: viser.ViserServer, key: str
-) -> None:
+def test_huge_numbers_clamp_to_the_range_the_scene_declared(server: viser.ViserServer, key: str) -> None:
     """±1e308 are finite: every number control ends on the bound of its declared range, in every viewer."""
     with two_viewers(server, key) as (switcher, attacker, observer):
         handles = gui_inputs(server.gui)
@@ -470,9 +450,7 @@ def test_each_refusal_logs_one_line_and_a_flood_stays_one_line(
         lines = refused_lines(caplog)
         assert len(lines) == 1 and refused_kind(lines[0]) == kind
         assert lines[0].exc_info is None
-        refusals.interval_s = (
-            0.0  # once the window has passed, the next line counts what it held back
-        )
+        refusals.interval_s = 0.0  # once the window has passed, the next line counts what it held back
         try:
             client.send("GuiUpdateMessage", uuid=uuid, updates=updates)
             client.wait_for(lambda: len(refused_lines(caplog)) == 2, what="the next window's line")
@@ -481,9 +459,7 @@ def test_each_refusal_logs_one_line_and_a_flood_stays_one_line(
         assert "200 more of this kind" in refused_lines(caplog)[1].getMessage()
 
 
-def test_crafted_props_cannot_lift_a_slider_limit(
-    server: viser.ViserServer, switcher: SceneSwitcher
-) -> None:
+def test_crafted_props_cannot_lift_a_slider_limit(server: viser.ViserServer, switcher: SceneSwitcher) -> None:
     """The issue's case: ``{"props": {}}`` then "Riders" 40 broke the peloton until Reset."""
     with BrowserClient(server.get_port()) as client:
         uuid = client.wait_for_gui("Riders")
@@ -496,17 +472,13 @@ def test_crafted_props_cannot_lift_a_slider_limit(
         )
 
 
-def test_a_string_false_does_not_tick_a_checkbox(
-    server: viser.ViserServer, switcher: SceneSwitcher
-) -> None:
+def test_a_string_false_does_not_tick_a_checkbox(server: viser.ViserServer, switcher: SceneSwitcher) -> None:
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("Drafting")
         client.set_value("Drafting", False)
         client.wait_for(lambda: switcher.scene.params.drafting is False, what="unticked")  # type: ignore[attr-defined]
         client.set_value("Drafting", "false")  # bool("false") is True: viser alone would tick it
-        client.wait_for(
-            lambda: client.value_of("Drafting") is False, what="the server's False echoed"
-        )
+        client.wait_for(lambda: client.value_of("Drafting") is False, what="the server's False echoed")
         assert switcher.scene.params.drafting is False  # type: ignore[attr-defined]
 
 
@@ -527,9 +499,7 @@ def test_a_zero_height_camera_never_reaches_the_sdf_camera_handler(
     assert any("camera" in refused_kind(r) for r in refused_lines(caplog))
 
 
-def test_two_viewers_moving_one_slider_ms_apart_end_equal(
-    server: viser.ViserServer, switcher: SceneSwitcher
-) -> None:
+def test_two_viewers_moving_one_slider_ms_apart_end_equal(server: viser.ViserServer, switcher: SceneSwitcher) -> None:
     """Two tabs move one slider 2-12 ms apart, 32 times: both end on the server's value every time.
 
     Without the write-back, a tab that only shows what the server said never hears of its own edit: viser sends
@@ -598,9 +568,7 @@ JSONISH = st.recursive(
     | st.integers(min_value=-(2**63), max_value=2**63)
     | st.floats(allow_nan=True, allow_infinity=True)
     | st.text(max_size=8),
-    lambda children: (
-        st.lists(children, max_size=5) | st.dictionaries(st.text(max_size=4), children, max_size=3)
-    ),
+    lambda children: st.lists(children, max_size=5) | st.dictionaries(st.text(max_size=4), children, max_size=3),
     max_leaves=8,
 )
 
@@ -614,9 +582,7 @@ def test_a_number_control_accepts_only_finite_numbers_inside_its_range(
     accepted, cleaned, reason = clean_value(spec, value)
     is_number = isinstance(value, (int, float)) and not isinstance(value, bool)
     holds_an_integer = math.ceil(lo) <= math.floor(hi)
-    assert accepted == (
-        is_number and math.isfinite(float(value)) and (holds_an_integer or not integer)
-    )
+    assert accepted == (is_number and math.isfinite(float(value)) and (holds_an_integer or not integer))
     if accepted:
         assert isinstance(cleaned, int if integer else float) and not isinstance(cleaned, bool)
         assert lo <= cleaned <= hi
@@ -644,9 +610,7 @@ def test_a_dropdown_accepts_only_its_own_options(value: Any, options: list[str])
         assert cleaned == value
 
 
-FLOATS = st.floats(allow_nan=True, allow_infinity=True) | st.sampled_from(
-    [0.0, -0.0, 5e-324, 1e308, -1e308]
-)
+FLOATS = st.floats(allow_nan=True, allow_infinity=True) | st.sampled_from([0.0, -0.0, 5e-324, 1e308, -1e308])
 
 
 @given(q=st.lists(FLOATS, min_size=0, max_size=6) | JSONISH)
@@ -655,9 +619,7 @@ def test_an_orientation_is_four_finite_numbers_normalised_or_refused(q: Any) -> 
     four_finite = (
         isinstance(q, (list, tuple))
         and len(q) == 4
-        and all(
-            isinstance(c, (int, float)) and not isinstance(c, bool) and math.isfinite(c) for c in q
-        )
+        and all(isinstance(c, (int, float)) and not isinstance(c, bool) and math.isfinite(c) for c in q)
     )
     if unit is None:
         assert not four_finite or math.hypot(*q) <= 1e-12 or not math.isfinite(math.hypot(*q))
@@ -666,16 +628,11 @@ def test_an_orientation_is_four_finite_numbers_normalised_or_refused(q: Any) -> 
         assert math.isclose(math.hypot(*unit), 1.0, rel_tol=1e-12)
         # the same direction as the input
         norm = math.hypot(*q)
-        assert all(
-            math.isclose(u, c / norm, rel_tol=1e-9, abs_tol=1e-12)
-            for u, c in zip(unit, q, strict=True)
-        )
+        assert all(math.isclose(u, c / norm, rel_tol=1e-9, abs_tol=1e-12) for u, c in zip(unit, q, strict=True))
 
 
 @pytest.mark.parametrize("key", ["arm", "sdf"])  # the scenes with gizmos
-def test_a_valid_but_not_unit_orientation_reaches_every_viewer_normalised(
-    server: viser.ViserServer, key: str
-) -> None:
+def test_a_valid_but_not_unit_orientation_reaches_every_viewer_normalised(server: viser.ViserServer, key: str) -> None:
     """(2, 0, 0, 0) and the like are valid rotations, so they are not refused, but no viewer may be left holding
     them un-normalised: the sender's own copy included, every viewer ends on the server's unit quaternion."""
     with two_viewers(server, key) as (_switcher, sender, observer):
@@ -700,9 +657,7 @@ def test_orientations_on_the_issue_list() -> None:
     assert unit_quaternion((0.0, 0.0, 0.0, 0.0)) is None
     assert unit_quaternion((NAN, 0.0, 0.0, 0.0)) is None
     assert unit_quaternion((1.0, 0.0, 0.0)) is None
-    assert unit_quaternion((1e308, 1e308, 0.0, 0.0)) == pytest.approx(
-        (0.5**0.5, 0.5**0.5, 0.0, 0.0)
-    )
+    assert unit_quaternion((1e308, 1e308, 0.0, 0.0)) == pytest.approx((0.5**0.5, 0.5**0.5, 0.0, 0.0))
 
 
 class _TabView:
@@ -752,9 +707,7 @@ def test_every_hostile_message_leaves_each_tab_on_its_last_good_state(
             # Another tab's controls are unknown to this one: edits aimed at them reach nothing.
             for uuid, element in list(other.gui.items()):
                 if element["type"] in INPUT_TYPES:
-                    attacker.send(
-                        "GuiUpdateMessage", uuid=uuid, updates={"value": element["value"]}
-                    )
+                    attacker.send("GuiUpdateMessage", uuid=uuid, updates={"value": element["value"]})
                     attacker.send("GuiUpdateMessage", uuid=uuid, updates={"value": 1e308})
                     sent += 2
             assert sent > 100
@@ -817,9 +770,7 @@ def test_every_hostile_message_leaves_each_tab_on_its_last_good_state(
         ({"image_width": 10**12}, "image_width"),
     ],
 )
-def test_a_camera_out_of_bounds_is_refused_naming_its_field(
-    change: dict[str, Any], field: str
-) -> None:
+def test_a_camera_out_of_bounds_is_refused_naming_its_field(change: dict[str, Any], field: str) -> None:
     """The refusal's log line names the field that was wrong (a fresh user found it quoting the valid image size
     for a camera refused for its position), and a finite camera 1e308 m out is refused: every distance the
     scenes take from it overflowed (numpy's RuntimeWarning in the log)."""

@@ -128,9 +128,7 @@ def test_uploads_in_flight_are_bounded_per_browser(
         )
 
 
-def test_a_file_over_the_size_limit_is_refused_with_a_notice(
-    server: viser.ViserServer, mode: CourseMode
-) -> None:
+def test_a_file_over_the_size_limit_is_refused_with_a_notice(server: viser.ViserServer, mode: CourseMode) -> None:
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("Upload GPX")
         start(client, part_count=25, size_bytes=MAX_UPLOAD_BYTES + 1)
@@ -185,9 +183,7 @@ def test_a_transfer_id_in_flight_cannot_be_taken_by_another_tab(
         a.wait_for(lambda: mode.route.name == "Mine", what="a's own course, whole")
 
 
-def test_one_tab_holds_at_most_its_share_of_the_upload_budget(
-    server: viser.ViserServer, mode: CourseMode
-) -> None:
+def test_one_tab_holds_at_most_its_share_of_the_upload_budget(server: viser.ViserServer, mode: CourseMode) -> None:
     big = MAX_UPLOAD_BYTES_IN_FLIGHT_PER_TAB // 2 + 1
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("Upload GPX")

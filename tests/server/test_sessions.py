@@ -38,9 +38,7 @@ from server.switcher import SceneSwitcher
 MIB = 1024 * 1024
 
 
-def test_each_tab_switches_and_resets_only_its_own_scene(
-    server: viser.ViserServer, sessions: Sessions
-) -> None:
+def test_each_tab_switches_and_resets_only_its_own_scene(server: viser.ViserServer, sessions: Sessions) -> None:
     a, mine = connect_tab(server, sessions)
     b, theirs = connect_tab(server, sessions)
     with a, b:
@@ -88,9 +86,7 @@ def test_the_gate_guards_a_tabs_own_controls_and_gizmos(
         a.drag_transform("/arm/target", [(float("nan"), 0.0, 0.5)], wxyz=(0.0, 0.0, 0.0, 0.0))
         a.set_value("Max iterations", 77)
         a.wait_for(lambda: scene.params.max_iterations == 77, what="the honest edit")  # type: ignore[attr-defined]
-        a.wait_for(
-            lambda: a.value_of("Links") == MAX_LINKS, what="Links clamped to its declared max"
-        )
+        a.wait_for(lambda: a.value_of("Links") == MAX_LINKS, what="Links clamped to its declared max")
         assert scene.params.n_links == MAX_LINKS  # type: ignore[attr-defined]
         assert "Links" in a.labels()
         handle = gizmos(mine.server.scene)["/arm/target"]
@@ -99,11 +95,7 @@ def test_the_gate_guards_a_tabs_own_controls_and_gizmos(
             what="the tab shown its gizmo's last good pose",
         )
         assert all(math.isfinite(v) for v in handle.position)
-        kinds = {
-            str(r.args[0])
-            for r in caplog.records
-            if r.name == "server.refusals" and isinstance(r.args, tuple)
-        }
+        kinds = {str(r.args[0]) for r in caplog.records if r.name == "server.refusals" and isinstance(r.args, tuple)}
         assert "GUI update of a field other than value" in kinds
         assert any("gizmo position" in kind for kind in kinds)
         assert any("gizmo orientation" in kind for kind in kinds)
@@ -115,9 +107,7 @@ def test_a_closed_tab_frees_its_session(server: viser.ViserServer, sessions: Ses
         client, switcher = connect_tab(server, sessions)
         with client:
             client.set_value("Scene", SCENES[key].title)
-            client.wait_for(
-                lambda switcher=switcher, key=key: switcher.scene.key == key, timeout=60
-            )
+            client.wait_for(lambda switcher=switcher, key=key: switcher.scene.key == key, timeout=60)
             refs += [
                 weakref.ref(switcher),
                 weakref.ref(switcher.scene),
@@ -196,9 +186,7 @@ def test_a_pick_or_reset_handled_after_its_tab_closed_builds_nothing(
     picked = switcher.dropdown
     switcher.close()
     assert switcher.scene.closed
-    store_value(
-        picked, SCENES["peloton"].title
-    )  # what viser stores before it runs the queued callback
+    store_value(picked, SCENES["peloton"].title)  # what viser stores before it runs the queued callback
     if action == "pick":
         switcher._on_pick(None)  # pyright: ignore[reportPrivateUsage]
     else:
@@ -217,9 +205,7 @@ def test_shared_mode_is_one_scene_for_every_tab(server: viser.ViserServer) -> No
             a.set_value("Scene", SCENES["freekick"].title)
             b.wait_for(lambda: "/freekick" in b.nodes, what="B sees A's switch")
             b.wait_for(lambda: b.value_of("Scene") == SCENES["freekick"].title, what="B's dropdown")
-            b.wait_for(
-                lambda: switcher.scene.key == "freekick", what="the one scene is the free kick"
-            )
+            b.wait_for(lambda: switcher.scene.key == "freekick", what="the one scene is the free kick")
     finally:
         switcher.close()
 
@@ -400,9 +386,7 @@ def test_tab_churn_leaves_rss_flat_and_sends_nothing_to_closed_tabs() -> None:
             churn(30)
             end, threads_after = settled_rss(app), thread_count(app.process.pid)
             per_tab_kib = (end - start) / 30 / 1024
-            measured.append(
-                f"{per_tab_kib:.0f} KiB a tab, threads {threads_before} -> {threads_after}"
-            )
+            measured.append(f"{per_tab_kib:.0f} KiB a tab, threads {threads_before} -> {threads_after}")
             if threads_after <= threads_before:
                 break
         print(f"tab churn: {start / MIB:.1f} -> {end / MIB:.1f} MiB over 30 tabs; {measured}")
@@ -432,9 +416,7 @@ def _trim_heap() -> None:
         "sdf",
     ],
 )
-def test_fifty_builds_and_closes_grow_rss_at_most_20_mib(
-    server: viser.ViserServer, key: str
-) -> None:
+def test_fifty_builds_and_closes_grow_rss_at_most_20_mib(server: viser.ViserServer, key: str) -> None:
     """Each build runs until the scene is fully up (the SDF gallery: its first reference image) before it closes."""
 
     def build_and_close() -> None:
@@ -451,9 +433,7 @@ def test_fifty_builds_and_closes_grow_rss_at_most_20_mib(
     start = rss_bytes()
     for build in range(50):
         build_and_close()
-        if (
-            build % 5 == 4
-        ):  # a leak of whole megabytes per build shows early: stop before it eats the machine
+        if build % 5 == 4:  # a leak of whole megabytes per build shows early: stop before it eats the machine
             grown_mib = (rss_bytes() - start) / MIB
             assert grown_mib <= 100.0, f"{key}: {grown_mib:.0f} MiB after {build + 1} builds"
     _trim_heap()
@@ -495,19 +475,13 @@ def test_each_tab_s_sdf_reference_is_rendered_from_that_tab_s_camera(
                 s = shape(scene)
                 return s is not None and abs(s[0] / s[1] - height_over_width) < 0.02
 
-            a.wait_for(
-                lambda: aspect_is(scene_a, 600 / 800), timeout=120, what="A's landscape reference"
-            )
-            b.wait_for(
-                lambda: aspect_is(scene_b, 800 / 600), timeout=120, what="B's portrait reference"
-            )
+            a.wait_for(lambda: aspect_is(scene_a, 600 / 800), timeout=120, what="A's landscape reference")
+            b.wait_for(lambda: aspect_is(scene_b, 800 / 600), timeout=120, what="B's portrait reference")
             first_b = scene_b.reference_rgb
             serial_a = scene_a.reference_serial
             serial_b = scene_b.reference_serial
             b.send_camera(position=(0.0, -3.5, 0.4), look_at=(0.0, 0.0, 0.3), size=(800, 600))
-            b.wait_for(
-                lambda: scene_b.reference_serial > serial_b, timeout=60, what="B re-rendered"
-            )
+            b.wait_for(lambda: scene_b.reference_serial > serial_b, timeout=60, what="B re-rendered")
             assert scene_b.reference_rgb is not None and first_b is not None
             assert not np.array_equal(scene_b.reference_rgb, first_b)
             time.sleep(0.5)  # A's camera did not move: nothing re-renders A's reference

@@ -90,9 +90,7 @@ def test_the_patch_is_in_use_and_writes_cast() -> None:
     assert installed_property_cast() is cast_value_recursive
     server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
     try:
-        cloud = server.scene.add_point_cloud(
-            "/cloud", points=np.zeros((2, 3)), colors=np.zeros((2, 3), dtype=np.uint8)
-        )
+        cloud = server.scene.add_point_cloud("/cloud", points=np.zeros((2, 3)), colors=np.zeros((2, 3), dtype=np.uint8))
         cloud.points = np.ones((2, 3), dtype=np.float64)  # type: ignore[assignment]  # cast to the float16 it holds
         cloud.colors = np.array([[0.0, 0.5, 1.0], [1.0, 1.0, 1.0]])  # floats in [0, 1] to uint8
         assert cloud.points.dtype == np.float16 and np.array_equal(cloud.points, np.ones((2, 3)))

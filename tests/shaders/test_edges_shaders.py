@@ -76,9 +76,7 @@ def test_glsl_blends_are_finite_and_near_the_hard_operation_for_every_width(
 
 @pytest.mark.gl
 @pytest.mark.parametrize(("k", "blend"), [(1e-40, "exp"), (1e-310, "poly"), (1e-310, "exp")])
-def test_glsl_two_spheres_at_a_tiny_width_match_k_zero(
-    gl: Renderer, k: float, blend: sdf.BlendForm
-) -> None:
+def test_glsl_two_spheres_at_a_tiny_width_match_k_zero(gl: Renderer, k: float, blend: sdf.BlendForm) -> None:
     scene = scene_of(("union",), k, blend)
     distance, _ = gl.probe(scene, [[0.0, 0.0, 0.0], [0.0, 0.3, 0.0], [1.0, 0.0, 0.0]])
     assert np.all(np.isfinite(distance))
@@ -126,27 +124,19 @@ def glsl_blends(gl: Renderer, inputs: np.ndarray) -> tuple[np.ndarray, np.ndarra
     ),
 )
 @settings(max_examples=30, deadline=None)
-def test_glsl_blend_functions_are_finite_and_near_the_hard_ones(
-    gl: Renderer, k: float, a: list[float]
-) -> None:
+def test_glsl_blend_functions_are_finite_and_near_the_hard_ones(gl: Renderer, k: float, a: list[float]) -> None:
     a_arr = np.asarray(a, np.float32)
     # b equal to a (the tie), a float32 ulp away, and well apart; sharpness 4 ln 2 / k as float32 (inf when it
     # overflows), as a scene of width k would use.
-    b_arr = np.concatenate(
-        [a_arr, np.nextafter(a_arr, np.float32(np.inf)), a_arr + np.float32(0.3)]
-    )
+    b_arr = np.concatenate([a_arr, np.nextafter(a_arr, np.float32(np.inf)), a_arr + np.float32(0.3)])
     a_all = np.tile(a_arr, 3)
     with np.errstate(divide="ignore", over="ignore"):
         sharpness = np.float32(sdf.EXP_SHARPNESS_PER_WIDTH) / np.float32(k)
-    inputs = np.stack(
-        [a_all, b_arr, np.full_like(a_all, k), np.full_like(a_all, sharpness)], axis=1
-    )
+    inputs = np.stack([a_all, b_arr, np.full_like(a_all, k), np.full_like(a_all, sharpness)], axis=1)
     poly, expo = glsl_blends(gl, inputs)
     assert np.all(np.isfinite(poly)) and np.all(np.isfinite(expo))
     x, y = a_all.astype(np.float64), b_arr.astype(np.float64)
-    hard = np.stack(
-        [np.minimum(x, y), np.minimum(x, y), np.maximum(x, -y), np.maximum(x, y)], axis=1
-    )
+    hard = np.stack([np.minimum(x, y), np.minimum(x, y), np.maximum(x, -y), np.maximum(x, y)], axis=1)
     slack = k / 4 * (1 + 1e-6) + 4e-7 * np.maximum(np.abs(x), np.abs(y))[:, None] + 1e-30
     assert np.all(np.abs(poly - hard) <= slack)
     assert np.all(np.abs(expo - hard) <= slack)
@@ -155,9 +145,7 @@ def test_glsl_blend_functions_are_finite_and_near_the_hard_ones(
 @pytest.mark.gl
 @pytest.mark.parametrize("k", [0.0, 1e-310, 1e-40, 1.1e-38, 1.2e-38, 1e-30, 0.25])
 @pytest.mark.parametrize("blend", sdf.BLEND_FORMS)
-def test_glsl_and_numpy_colour_a_tie_alike_at_every_width(
-    gl: Renderer, k: float, blend: sdf.BlendForm
-) -> None:
+def test_glsl_and_numpy_colour_a_tie_alike_at_every_width(gl: Renderer, k: float, blend: sdf.BlendForm) -> None:
     """Two coincident spheres tie everywhere: the mesh (numpy) and the reference (GLSL) must colour them alike.
 
     Below MIN_BLEND_WIDTH both take the first primitive's colour, as k = 0 does; above it both mix half and half.
@@ -191,22 +179,16 @@ FLOAT32_MAX = float(np.finfo(np.float32).max)
     ),
 )
 @settings(max_examples=30, deadline=None)
-def test_glsl_blends_of_infinite_and_huge_distances_are_never_nan(
-    gl: Renderer, k: float, values: list[float]
-) -> None:
+def test_glsl_blends_of_infinite_and_huge_distances_are_never_nan(gl: Renderer, k: float, values: list[float]) -> None:
     v = np.asarray(values, np.float32)
     a_all, b_all = np.repeat(v, len(v)), np.tile(v, len(v))  # every pair, ties included
     with np.errstate(divide="ignore", over="ignore", under="ignore"):
         sharpness = np.float32(sdf.EXP_SHARPNESS_PER_WIDTH) / np.float32(k)
-    inputs = np.stack(
-        [a_all, b_all, np.full_like(a_all, k), np.full_like(a_all, sharpness)], axis=1
-    )
+    inputs = np.stack([a_all, b_all, np.full_like(a_all, k), np.full_like(a_all, sharpness)], axis=1)
     poly, expo = glsl_blends(gl, inputs)
     assert not np.any(np.isnan(poly)) and not np.any(np.isnan(expo))
     x, y = a_all.astype(np.float64), b_all.astype(np.float64)
-    hard = np.stack(
-        [np.minimum(x, y), np.minimum(x, y), np.maximum(x, -y), np.maximum(x, y)], axis=1
-    )
+    hard = np.stack([np.minimum(x, y), np.minimum(x, y), np.maximum(x, -y), np.maximum(x, y)], axis=1)
     infinite = ~np.isfinite(hard)
     for got in (poly, expo):
         got64 = got.astype(np.float64)

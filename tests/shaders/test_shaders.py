@@ -38,16 +38,10 @@ def smooth_scene(blend: sdf.BlendForm = "poly") -> sdf.Scene:
 def every_op_scene() -> sdf.Scene:
     return sdf.Scene(
         (
-            sdf.Primitive(
-                "box", (0.1, 0, 0), (0.6, 0.5, 0.4), rotation=(0.8, 0.1, 0.5, 0.2), color=(1, 0, 0)
-            ),
+            sdf.Primitive("box", (0.1, 0, 0), (0.6, 0.5, 0.4), rotation=(0.8, 0.1, 0.5, 0.2), color=(1, 0, 0)),
             sdf.Primitive("sphere", (0.5, 0.2, 0.1), (0.4,), op="subtract", color=(0, 1, 0)),
-            sdf.Primitive(
-                "torus", (0, 0, 0), (0.5, 0.2), rotation=FLAT, op="intersect", color=(0, 0, 1)
-            ),
-            sdf.Primitive(
-                "capsule", (-0.4, 0, 0.3), (0.4, 0.15), rotation=(0.7, 0.7, 0, 0), color=(1, 1, 0)
-            ),
+            sdf.Primitive("torus", (0, 0, 0), (0.5, 0.2), rotation=FLAT, op="intersect", color=(0, 0, 1)),
+            sdf.Primitive("capsule", (-0.4, 0, 0.3), (0.4, 0.15), rotation=(0.7, 0.7, 0, 0), color=(1, 1, 0)),
         ),
         k=0.2,
         blend="exp",
@@ -69,9 +63,7 @@ def view_depth(camera: Camera, t: np.ndarray, directions: np.ndarray) -> np.ndar
 # ------------------------------------------------------------------------------------------ GLSL == numpy
 def test_glsl_mirrors_the_kernel_name_for_name() -> None:
     source = (gl_renderer.SHADER_DIR / "sdf.glsl").read_text()
-    glsl_functions = set(
-        re.findall(r"^(?:float|vec2|vec3|vec4) (\w+)\(", source, flags=re.MULTILINE)
-    )
+    glsl_functions = set(re.findall(r"^(?:float|vec2|vec3|vec4) (\w+)\(", source, flags=re.MULTILINE))
     public = {
         "sd_sphere",
         "sd_box",
@@ -101,9 +93,7 @@ def test_glsl_mirrors_the_kernel_name_for_name() -> None:
         every_op_scene(),
         sdf.Scene(every_op_scene().primitives, k=0.0),
         *(
-            sdf.Scene(
-                (sdf.Primitive(kind, (0.1, -0.2, 0.3), size, rotation=(0.6, 0.3, -0.5, 0.4)),)
-            )
+            sdf.Scene((sdf.Primitive(kind, (0.1, -0.2, 0.3), size, rotation=(0.6, 0.3, -0.5, 0.4)),))
             for kind, size in [
                 ("sphere", (0.7,)),
                 ("box", (0.3, 0.5, 0.7)),
@@ -215,9 +205,7 @@ def test_off_screen_and_distant_scenes(gl: Renderer, camera: Camera) -> None:
     scene = sdf.default_scene()
     rgb, depth = gl.render(scene, camera, 48, 32, NO_SHADOWS)
     origins, directions = gl_renderer.camera_rays(camera, 48, 32)
-    expected = view_depth(camera, sdf.sphere_trace(scene, origins, directions), directions).reshape(
-        32, 48
-    )
+    expected = view_depth(camera, sdf.sphere_trace(scene, origins, directions), directions).reshape(32, 48)
     np.testing.assert_array_equal(np.isfinite(depth), np.isfinite(expected))
     background = np.round(np.array(NO_SHADOWS.background) * 255)
     assert np.all(rgb[~np.isfinite(depth)] == background)
@@ -250,9 +238,7 @@ def sphere_scene(color: tuple[float, float, float] = (0.8, 0.5, 0.2)) -> sdf.Sce
 @pytest.mark.gl
 def test_phong_terms_match_the_analytic_sphere(gl: Renderer) -> None:
     camera = Camera((0, -4, 1), (0, 0, 0), fov_y_rad=math.radians(45))
-    shading = Shading(
-        ambient=0.15, diffuse=0.6, specular=0.4, shininess=20.0, shadows=False, occlusion=False
-    )
+    shading = Shading(ambient=0.15, diffuse=0.6, specular=0.4, shininess=20.0, shadows=False, occlusion=False)
     albedo = np.array([0.8, 0.5, 0.2])
     rgb, depth = gl.render(sphere_scene(tuple(albedo)), camera, 96, 96, shading)
     origins, directions = gl_renderer.camera_rays(camera, 96, 96)
@@ -265,9 +251,7 @@ def test_phong_terms_match_the_analytic_sphere(gl: Renderer) -> None:
     light = np.array(shading.light_direction) / np.linalg.norm(shading.light_direction)
     n_dot_l = np.maximum(n @ light, 0.0)
     r = 2 * (n @ light)[:, None] * n - light
-    spec = np.where(
-        n_dot_l > 0, np.maximum(np.einsum("ij,ij->i", r, -directions), 0.0) ** 20.0, 0.0
-    )
+    spec = np.where(n_dot_l > 0, np.maximum(np.einsum("ij,ij->i", r, -directions), 0.0) ** 20.0, 0.0)
     expected = 0.15 * albedo + 0.6 * albedo * n_dot_l[:, None] + 0.4 * spec[:, None]
     expected = np.clip(expected, 0, 1).reshape(96, 96, 3)
     got = rgb.astype(float) / 255
@@ -288,9 +272,7 @@ def test_soft_shadow_darkens_what_the_light_cannot_see(gl: Renderer) -> None:
         k=0.0,
     )
     camera = Camera((0, -3, 3), (0, 0, 0), fov_y_rad=math.radians(45))
-    base = Shading(
-        ambient=0.2, diffuse=0.8, specular=0.0, light_direction=(0, 0, 1), occlusion=False
-    )
+    base = Shading(ambient=0.2, diffuse=0.8, specular=0.0, light_direction=(0, 0, 1), occlusion=False)
     lit, _ = gl.render(scene, camera, 96, 96, dataclass_replace(base, shadows=False))
     shadowed, depth = gl.render(scene, camera, 96, 96, base)
     origins, directions = gl_renderer.camera_rays(camera, 96, 96)
@@ -331,9 +313,7 @@ def test_ambient_occlusion_darkens_creases_only(gl: Renderer) -> None:
     forward, _, _ = camera.basis()
     points = origins + (depth.ravel() / (directions @ forward))[:, None] * directions
     radial = np.hypot(points[:, 0], points[:, 1]).reshape(96, 96)
-    near_contact = (
-        np.isfinite(depth) & (np.abs(points[:, 2].reshape(96, 96) - 0.1) < 0.01) & (radial < 0.25)
-    )
+    near_contact = np.isfinite(depth) & (np.abs(points[:, 2].reshape(96, 96) - 0.1) < 0.01) & (radial < 0.25)
     assert near_contact.sum() > 5
     assert (occluded[near_contact].astype(int) - plain[near_contact].astype(int)).mean() < -40
 
@@ -364,9 +344,7 @@ def test_missing_gl_context_says_why(monkeypatch: pytest.MonkeyPatch) -> None:
         raise RuntimeError("eglInitialize failed")
 
     monkeypatch.setattr(moderngl, "create_standalone_context", refuse)
-    with pytest.raises(
-        GLUnavailableError, match=r"EGL.*eglInitialize failed.*mesh view works without it"
-    ):
+    with pytest.raises(GLUnavailableError, match=r"EGL.*eglInitialize failed.*mesh view works without it"):
         Renderer()
 
 
