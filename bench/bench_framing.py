@@ -28,8 +28,8 @@ from scenes._framing import (  # noqa: E402
     FULL_NDC,
     NEAR_M,
     Lens,
+    Sight,
     View,
-    _basis,  # pyright: ignore[reportPrivateUsage]
     box_corners,
     frame_points,
 )
@@ -44,21 +44,13 @@ def baseline_frame_points(
     ndc: tuple[float, float, float, float] = FULL_NDC,
     min_depth: float = 0.0,
 ) -> View:
-    """``scenes._framing.frame_points`` as it was before the closed form (commit 3b41d9e), unchanged."""
+    """``scenes._framing.frame_points`` as it was before the closed form (commit 3b41d9e), on the same
+    :class:`~scenes._framing.Sight` of the points."""
     pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
-    if not (math.isfinite(fov_rad) and 0.01 < fov_rad < 3.0):
-        fov_rad = math.radians(50.0)
-    if not (math.isfinite(aspect) and aspect > 0.05):
-        aspect = 1.6
     x0, x1, y0, y1 = ndc
-    d, right, up = _basis(np.asarray(direction, dtype=np.float64))
-    centre = 0.5 * (pts.min(axis=0) + pts.max(axis=0))
-    rel = pts - centre
-    u, v, w = rel @ right, rel @ up, rel @ d
-    tan_y = math.tan(0.5 * fov_rad)
-    tan_x = aspect * tan_y
-    depth_extent = float(np.max(np.abs(w))) if len(w) else 0.0
-    size = float(np.max(np.linalg.norm(rel, axis=1))) if len(rel) else 0.0
+    sight = Sight.of(pts, direction, fov_rad=fov_rad, aspect=aspect)
+    u, v, w, tan_x, tan_y = sight.u, sight.v, sight.w, sight.tan_x, sight.tan_y
+    depth_extent, size = sight.depth_extent, sight.size
 
     def shift(coord: NDArray[np.float64], scale: NDArray[np.float64], lo: float, hi: float) -> float:
         reach = size + 1.0 + float(np.max(scale)) * (abs(lo) + abs(hi) + 1.0)
@@ -98,12 +90,7 @@ def baseline_frame_points(
             return baseline_frame_points(
                 pts, direction, fov_rad=fov_rad, aspect=aspect, ndc=FULL_NDC, min_depth=min_depth
             )
-    look_at = centre + sx * right + sy * up
-    position = look_at - far * d
-    return View(
-        position=(float(position[0]), float(position[1]), float(position[2])),
-        look_at=(float(look_at[0]), float(look_at[1]), float(look_at[2])),
-    )
+    return sight.view(far, sx, sy)
 
 
 def per_call_ms(func: Callable[[], View], repeat: int) -> list[float]:

@@ -33,7 +33,7 @@ import contextlib
 import dataclasses
 import itertools
 from collections.abc import Callable, Collection, Iterator, Mapping, Sequence
-from typing import TYPE_CHECKING, Any, Generic, Literal, TypeAlias, TypeVar
+from typing import TYPE_CHECKING, Any, Generic, Literal, TypeAlias, TypedDict, TypeVar
 
 import viser
 
@@ -41,6 +41,7 @@ from server.clean import ControlSpec, clean_value, record_spec
 
 if TYPE_CHECKING:
     from _typeshed import DataclassInstance
+    from typing_extensions import Unpack
 
     from server.sessions import GuiFacade
 
@@ -147,35 +148,22 @@ class Control:
                 return gui.add_rgb(label, value, **common)
 
 
+class Placement(TypedDict, total=False):
+    """What a control of any kind may also be given: see the fields of the same names on :class:`Control`."""
+
+    folder: str | None
+    costly: bool
+    disabled: bool
+    hint: str | None
+
+
 def _declare(control: Control) -> dict[str, Control]:
     return {METADATA_KEY: control}
 
 
-def slider(
-    label: str,
-    lo: float,
-    hi: float,
-    step: float,
-    *,
-    folder: str | None = None,
-    costly: bool = False,
-    disabled: bool = False,
-    hint: str | None = None,
-) -> dict[str, Control]:
+def slider(label: str, lo: float, hi: float, step: float, **placement: Unpack[Placement]) -> dict[str, Control]:
     """A slider over [lo, hi] in steps of ``step``; an integer one when the field's default is an ``int``."""
-    return _declare(
-        Control(
-            "slider",
-            label,
-            lo,
-            hi,
-            step,
-            folder=folder,
-            costly=costly,
-            disabled=disabled,
-            hint=hint,
-        )
-    )
+    return _declare(Control("slider", label, lo, hi, step, **placement))
 
 
 def number(
@@ -183,100 +171,34 @@ def number(
     lo: float | None = None,
     hi: float | None = None,
     step: float | None = None,
-    *,
-    folder: str | None = None,
-    costly: bool = False,
-    disabled: bool = False,
-    hint: str | None = None,
+    **placement: Unpack[Placement],
 ) -> dict[str, Control]:
     """A number box, clamped to [lo, hi] where given."""
-    return _declare(
-        Control(
-            "number",
-            label,
-            lo,
-            hi,
-            step,
-            folder=folder,
-            costly=costly,
-            disabled=disabled,
-            hint=hint,
-        )
-    )
+    return _declare(Control("number", label, lo, hi, step, **placement))
 
 
 def dropdown(
-    label: str,
-    options: Sequence[Any],
-    labels: Sequence[str] | None = None,
-    *,
-    folder: str | None = None,
-    costly: bool = False,
-    disabled: bool = False,
-    hint: str | None = None,
+    label: str, options: Sequence[Any], labels: Sequence[str] | None = None, **placement: Unpack[Placement]
 ) -> dict[str, Control]:
     """A dropdown of ``options`` (the field's possible values), shown as ``labels`` (default: the options)."""
     shown = tuple(str(option) for option in options) if labels is None else tuple(labels)
     assert len(shown) == len(options) and len(set(shown)) == len(shown), "one distinct label per option"
-    return _declare(
-        Control(
-            "dropdown",
-            label,
-            options=tuple(options),
-            labels=shown,
-            folder=folder,
-            costly=costly,
-            disabled=disabled,
-            hint=hint,
-        )
-    )
+    return _declare(Control("dropdown", label, options=tuple(options), labels=shown, **placement))
 
 
-def checkbox(
-    label: str,
-    *,
-    folder: str | None = None,
-    costly: bool = False,
-    disabled: bool = False,
-    hint: str | None = None,
-) -> dict[str, Control]:
+def checkbox(label: str, **placement: Unpack[Placement]) -> dict[str, Control]:
     """A checkbox for a ``bool`` field."""
-    return _declare(Control("checkbox", label, folder=folder, costly=costly, disabled=disabled, hint=hint))
+    return _declare(Control("checkbox", label, **placement))
 
 
-def text(
-    label: str,
-    *,
-    multiline: bool = False,
-    folder: str | None = None,
-    costly: bool = False,
-    disabled: bool = False,
-    hint: str | None = None,
-) -> dict[str, Control]:
+def text(label: str, *, multiline: bool = False, **placement: Unpack[Placement]) -> dict[str, Control]:
     """A text box for a ``str`` field (the gate refuses text over :data:`server.clean.MAX_TEXT_CHARS`)."""
-    return _declare(
-        Control(
-            "text",
-            label,
-            multiline=multiline,
-            folder=folder,
-            costly=costly,
-            disabled=disabled,
-            hint=hint,
-        )
-    )
+    return _declare(Control("text", label, multiline=multiline, **placement))
 
 
-def rgb(
-    label: str,
-    *,
-    folder: str | None = None,
-    costly: bool = False,
-    disabled: bool = False,
-    hint: str | None = None,
-) -> dict[str, Control]:
+def rgb(label: str, **placement: Unpack[Placement]) -> dict[str, Control]:
     """A colour picker for a ``tuple[int, int, int]`` field (0–255 each)."""
-    return _declare(Control("rgb", label, folder=folder, costly=costly, disabled=disabled, hint=hint))
+    return _declare(Control("rgb", label, **placement))
 
 
 def declared(params_type: type[Any]) -> dict[str, Control]:

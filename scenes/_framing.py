@@ -79,6 +79,71 @@ class Lens:
         )
 
 
+@dataclasses.dataclass(frozen=True)
+class Sight:
+    """Points as a camera looking along a direction sees them, about the centre of their bounding box: where
+    framing starts, whatever way it then finds the distance and the centring shifts."""
+
+    centre: NDArray[np.float64]
+    """(3,) centre of the points' bounding box (m)."""
+    forward: NDArray[np.float64]
+    """(3,) unit view direction."""
+    right: NDArray[np.float64]
+    """(3,) unit right of the view (horizontal)."""
+    up: NDArray[np.float64]
+    """(3,) unit up of the view."""
+    u: NDArray[np.float64]
+    """(N,) each point's offset from the centre along :attr:`right` (m)."""
+    v: NDArray[np.float64]
+    """(N,) along :attr:`up` (m)."""
+    w: NDArray[np.float64]
+    """(N,) along :attr:`forward` (m)."""
+    tan_x: float
+    """Tangent of half the horizontal field of view."""
+    tan_y: float
+    """Tangent of half the vertical field of view."""
+    depth_extent: float
+    """Largest |w| (m)."""
+    size: float
+    """Largest distance of a point from the centre (m)."""
+
+    @staticmethod
+    def of(pts: NDArray[np.float64], direction: tuple[float, float, float], *, fov_rad: float, aspect: float) -> Sight:
+        """The sight of (N ≥ 1, 3) points along ``direction``; an unusable ``fov_rad`` is 50°, an ``aspect`` 1.6."""
+        if not (math.isfinite(fov_rad) and 0.01 < fov_rad < 3.0):
+            fov_rad = math.radians(50.0)
+        if not (math.isfinite(aspect) and aspect > 0.05):
+            aspect = 1.6
+        forward, right, up = _basis(np.asarray(direction, dtype=np.float64))
+        centre = 0.5 * (pts.min(axis=0) + pts.max(axis=0))
+        rel = pts - centre
+        w = rel @ forward
+        tan_y = math.tan(0.5 * fov_rad)
+        return Sight(
+            centre,
+            forward,
+            right,
+            up,
+            u=rel @ right,
+            v=rel @ up,
+            w=w,
+            tan_x=aspect * tan_y,
+            tan_y=tan_y,
+            depth_extent=float(np.max(np.abs(w))),
+            size=float(np.max(np.linalg.norm(rel, axis=1))),
+        )
+
+    def view(self, distance: float, sx: float, sy: float) -> View:
+        """The camera ``distance`` (m) behind the centre shifted by ``sx`` right and ``sy`` up (m), looking along
+        :attr:`forward`; it orbits the shifted centre."""
+        look_at = self.centre + sx * self.right + sy * self.up
+        position = look_at - distance * self.forward
+        return View(
+            position=(float(position[0]), float(position[1]), float(position[2])),
+            look_at=(float(look_at[0]), float(look_at[1]), float(look_at[2])),
+        )
+
+
 def frame_points(
     points: NDArray[np.float64],
     direction: tuple[float, float, float],
@@ -105,19 +170,10 @@ def frame_points(
         in ``ndc`` rather than in the middle of the canvas.
     """
     pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
-    if not (math.isfinite(fov_rad) and 0.01 < fov_rad < 3.0):
-        fov_rad = math.radians(50.0)
-    if not (math.isfinite(aspect) and aspect > 0.05):
-        aspect = 1.6
     x0, x1, y0, y1 = ndc
-    d, right, up = _basis(np.asarray(direction, dtype=np.float64))
-    centre = 0.5 * (pts.min(axis=0) + pts.max(axis=0))
-    rel = pts - centre
-    u, v, w = rel @ right, rel @ up, rel @ d
-    tan_y = math.tan(0.5 * fov_rad)
-    tan_x = aspect * tan_y
-    depth_extent = float(np.max(np.abs(w)))
-    size = float(np.max(np.linalg.norm(rel, axis=1)))
+    sight = Sight.of(pts, direction, fov_rad=fov_rad, aspect=aspect)
+    u, v, w, tan_x, tan_y = sight.u, sight.v, sight.w, sight.tan_x, sight.tan_y
+    depth_extent, size = sight.depth_extent, sight.size
     least_depth = max(min_depth, NEAR_M) if math.isfinite(min_depth) else NEAR_M
     # The camera at distance D behind the centre sees point i at depth D + w_i and, shifted by s across the view, at
     # ndc (u_i − s)/((D + w_i)·tan_x) on x (likewise on y). Some s puts every point inside [lo, hi] iff
@@ -140,12 +196,7 @@ def frame_points(
     depth = distance + w
     sx = _centring_shift(u, depth * tan_x, x0, x1)
     sy = _centring_shift(v, depth * tan_y, y0, y1)
-    look_at = centre + sx * right + sy * up
-    position = look_at - distance * d
-    return View(
-        position=(float(position[0]), float(position[1]), float(position[2])),
-        look_at=(float(look_at[0]), float(look_at[1]), float(look_at[2])),
-    )
+    return sight.view(distance, sx, sy)
 
 
 def _least_distance(coord: NDArray[np.float64], w: NDArray[np.float64], tan: float, lo: float, hi: float) -> float:

@@ -121,6 +121,14 @@ def _box_scissor(camera: Camera, box: NDArray[np.float64], width: int, height: i
     return screen_rectangle(camera, corners, width, height)
 
 
+def _probe_points(points: ArrayLike) -> NDArray[np.float32]:
+    """Points to probe as (N, 3) float32, or ValueError unless they are finite and N ≥ 1."""
+    pts = np.asarray(points, dtype=np.float32)
+    if pts.ndim != 2 or pts.shape[1] != 3 or not np.all(np.isfinite(pts)) or len(pts) == 0:
+        raise ValueError(f"points must be finite (N, 3) with N ≥ 1, got {pts.shape}")
+    return pts
+
+
 def create_context() -> object:
     """A standalone OpenGL 3.3+ context on EGL, or :class:`GLUnavailableError` saying why not."""
     try:
@@ -440,11 +448,17 @@ class Renderer:
         Returns:
             (N,) distances (m) and (N, 3) colours, float32, computed by the GLSL.
         """
+        pts = _probe_points(points)
+        self._set_scene(self._probe, scene)
+        return self._draw_probe(self._probe, self._probe_vao, pts)
+
+    def _draw_probe(
+        self, prog: object, vao: object, pts: NDArray[np.float32]
+    ) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
+        """Draw a probing program (its scene or source already set) once per point, read from a float texture:
+        (N,) distances and (N, 3) colours, float32."""
         import moderngl
 
-        pts = np.asarray(points, dtype=np.float32)
-        if pts.ndim != 2 or pts.shape[1] != 3 or not np.all(np.isfinite(pts)) or len(pts) == 0:
-            raise ValueError(f"points must be finite (N, 3) with N ≥ 1, got {pts.shape}")
         n = len(pts)
         width = min(n, _PROBE_WIDTH)
         height = -(-n // width)
@@ -455,11 +469,10 @@ class Renderer:
         distance = self.ctx.texture((width, height), 1, dtype="f4")
         color = self.ctx.texture((width, height), 4, dtype="f4")
         fbo = self.ctx.framebuffer(color_attachments=[distance, color])
-        self._set_scene(self._probe, scene)
         source.use(location=0)
-        self._set(self._probe, "u_points", 0)
+        self._set(prog, "u_points", 0)
         fbo.use()
-        self._probe_vao.render(moderngl.TRIANGLES, vertices=3)
+        vao.render(moderngl.TRIANGLES, vertices=3)  # pyright: ignore[reportAttributeAccessIssue]
         d = np.frombuffer(distance.read(), np.float32)[:n].copy()
         rgb = np.frombuffer(color.read(), np.float32).reshape(-1, 4)[:n, :3].copy()
         for obj in (fbo, source, distance, color):
@@ -532,33 +545,11 @@ class Renderer:
 
     def probe_field(self, source: str, points: ArrayLike) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
         """The editor's ``sdf`` and ``color`` at (N, 3) points: (N,) distances and (N, 3) colours, float32."""
-        import moderngl
-
         check_source(source)
-        pts = np.asarray(points, dtype=np.float32)
-        if pts.ndim != 2 or pts.shape[1] != 3 or not np.all(np.isfinite(pts)) or len(pts) == 0:
-            raise ValueError(f"points must be finite (N, 3) with N ≥ 1, got {pts.shape}")
+        pts = _probe_points(points)
         prog, vao = self._field_program(source, "sample")
         self._set(prog, "u_sample_points", 1)
-        n = len(pts)
-        width = min(n, _PROBE_WIDTH)
-        height = -(-n // width)
-        padded = np.zeros((width * height, 3), np.float32)
-        padded[:n] = pts
-        texture = self.ctx.texture((width, height), 3, padded.tobytes(), dtype="f4")
-        texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
-        distance = self.ctx.texture((width, height), 1, dtype="f4")
-        color = self.ctx.texture((width, height), 4, dtype="f4")
-        fbo = self.ctx.framebuffer(color_attachments=[distance, color])
-        texture.use(location=0)
-        self._set(prog, "u_points", 0)
-        fbo.use()
-        vao.render(moderngl.TRIANGLES, vertices=3)  # pyright: ignore[reportAttributeAccessIssue]
-        d = np.frombuffer(distance.read(), np.float32)[:n].copy()
-        rgb = np.frombuffer(color.read(), np.float32).reshape(-1, 4)[:n, :3].copy()
-        for obj in (fbo, texture, distance, color):
-            obj.release()
-        return d, rgb
+        return self._draw_probe(prog, vao, pts)
 
     def sample_field(self, source: str, grid: sdf.Grid) -> NDArray[np.float32]:
         """The editor's ``sdf`` at every sample of ``grid``: (nx, ny, nz) float32 (m), sampled in GLSL.
