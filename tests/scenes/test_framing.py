@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import contextlib
 import math
+from typing import NamedTuple
 
 import numpy as np
 import pytest
@@ -31,6 +32,75 @@ def _direction(azimuth: float, pitch: float) -> tuple[float, float, float]:
     )
 
 
+def _rectangle(x0: float, width: float, y0: float, height: float) -> tuple[float, float, float, float]:
+    """NDC rectangle (x0, x1, y0, y1) from a corner and a size, its far edges kept inside the view."""
+    return (x0, min(x0 + width, 0.99), y0, min(y0 + height, 0.99))
+
+
+def _clouds(min_size: int, max_size: int) -> st.SearchStrategy[np.ndarray]:
+    """(N, 3) point clouds (m) of ``min_size`` to ``max_size`` points."""
+    return st.lists(st.tuples(coordinate, coordinate, coordinate), min_size=min_size, max_size=max_size).map(np.array)
+
+
+def _directions(max_pitch: float) -> st.SearchStrategy[tuple[float, float, float]]:
+    """Unit view directions at any azimuth, pitched at most ``max_pitch`` (rad) above or below the horizontal."""
+    return st.builds(_direction, st.floats(-math.pi, math.pi), st.floats(-max_pitch, max_pitch))
+
+
+def _rectangles(side: st.SearchStrategy[float]) -> st.SearchStrategy[tuple[float, float, float, float]]:
+    """NDC rectangles with a corner anywhere in the view and sides drawn from ``side``."""
+    corner = st.floats(-0.99, 0.9)
+    return st.builds(_rectangle, corner, side, corner, side)
+
+
+MIN_DEPTHS = st.sampled_from([0.0, 3.0])
+"""No least depth, and one that holds the camera back."""
+
+
+class Shot(NamedTuple):
+    """One call of frame_points: a cloud seen along a direction through a lens into a rectangle."""
+
+    cloud: np.ndarray
+    """(N, 3) points to frame (m)."""
+    direction: tuple[float, float, float]
+    """Unit view direction."""
+    fov: float
+    """Vertical field of view (rad)."""
+    aspect: float
+    """Width over height of the window."""
+    ndc: tuple[float, float, float, float]
+    """Rectangle (x0, x1, y0, y1) the points must land in."""
+    min_depth: float
+    """Least depth of any point in front of the camera (m)."""
+
+    def view(self) -> View:
+        return frame_points(
+            self.cloud, self.direction, fov_rad=self.fov, aspect=self.aspect, ndc=self.ndc, min_depth=self.min_depth
+        )
+
+    def project(self, view: View) -> np.ndarray:
+        """(N, 3) NDC x, y and depth of the cloud through ``view``, by the independent pinhole camera."""
+        return _project(self.cloud, np.array(view.position), np.array(view.look_at), self.fov, self.aspect)
+
+
+def _shots(
+    clouds: st.SearchStrategy[np.ndarray],
+    max_pitch: float,
+    rectangles: st.SearchStrategy[tuple[float, float, float, float]],
+    min_depths: st.SearchStrategy[float] = MIN_DEPTHS,
+) -> st.SearchStrategy[Shot]:
+    """Shots of the given clouds into the given rectangles, any lens of 20–90° and aspect 0.5–3."""
+    fovs = st.floats(20.0, 90.0).map(math.radians)
+    return st.builds(Shot, clouds, _directions(max_pitch), fovs, st.floats(0.5, 3.0), rectangles, min_depths)
+
+
+def _assert_inside(projected: np.ndarray, ndc: tuple[float, float, float, float]) -> None:
+    """Every projected point's NDC x and y lie inside the rectangle ``ndc``, to rounding."""
+    eps = 1e-6
+    assert projected[:, 0].min() >= ndc[0] - eps and projected[:, 0].max() <= ndc[1] + eps
+    assert projected[:, 1].min() >= ndc[2] - eps and projected[:, 1].max() <= ndc[3] + eps
+
+
 def _assert_tight_or_held_back(
     projected: np.ndarray, ndc: tuple[float, float, float, float], least_depth: float
 ) -> None:
@@ -41,34 +111,14 @@ def _assert_tight_or_held_back(
     assert held_back or spread > 0.97, (spread, projected[:, 2].min())
 
 
-@given(
-    points=st.lists(st.tuples(coordinate, coordinate, coordinate), min_size=1, max_size=12),
-    azimuth=st.floats(-math.pi, math.pi),
-    pitch=st.floats(-1.2, 1.2),
-    fov_deg=st.floats(20.0, 90.0),
-    aspect=st.floats(0.5, 3.0),
-    min_depth=st.sampled_from([0.0, 3.0]),
-)
-def test_every_point_projects_inside_the_rectangle(
-    points: list[tuple[float, float, float]],
-    azimuth: float,
-    pitch: float,
-    fov_deg: float,
-    aspect: float,
-    min_depth: float,
-) -> None:
-    cloud = np.array(points)
-    direction = _direction(azimuth, pitch)
-    ndc = (-0.8, 0.4, -0.7, 0.9)
-    view = frame_points(cloud, direction, fov_rad=math.radians(fov_deg), aspect=aspect, ndc=ndc, min_depth=min_depth)
-    projected = _project(cloud, np.array(view.position), np.array(view.look_at), math.radians(fov_deg), aspect)
-    least_depth = max(min_depth, NEAR_M)
+@given(_shots(_clouds(1, 12), 1.2, st.just((-0.8, 0.4, -0.7, 0.9))))
+def test_every_point_projects_inside_the_rectangle(shot: Shot) -> None:
+    projected = shot.project(shot.view())
+    least_depth = max(shot.min_depth, NEAR_M)
     assert np.all(projected[:, 2] >= least_depth - 1e-6)
-    eps = 1e-6
-    assert projected[:, 0].min() >= ndc[0] - eps and projected[:, 0].max() <= ndc[1] + eps
-    assert projected[:, 1].min() >= ndc[2] - eps and projected[:, 1].max() <= ndc[3] + eps
-    if np.ptp(cloud, axis=0).max() > 1e-3:
-        _assert_tight_or_held_back(projected, ndc, least_depth)
+    _assert_inside(projected, shot.ndc)
+    if np.ptp(shot.cloud, axis=0).max() > 1e-3:
+        _assert_tight_or_held_back(projected, shot.ndc, least_depth)
 
 
 def test_a_cloud_along_the_view_direction_stays_beyond_the_near_plane() -> None:
@@ -101,43 +151,16 @@ def test_a_narrow_window_uses_the_whole_width_and_bad_lenses_fall_back() -> None
     assert all(math.isfinite(c) for c in (*view.position, *view.look_at))
 
 
-@given(
-    points=st.lists(st.tuples(coordinate, coordinate, coordinate), min_size=2, max_size=12),
-    azimuth=st.floats(-math.pi, math.pi),
-    pitch=st.floats(-1.0, 1.0),
-    fov_deg=st.floats(20.0, 90.0),
-    aspect=st.floats(0.5, 3.0),
-    x0=st.floats(-0.99, 0.9),
-    width=st.floats(0.05, 1.0),
-    y0=st.floats(-0.99, 0.9),
-    height=st.floats(0.05, 1.0),
-)
-def test_a_rectangle_off_the_view_axis_is_filled_too(
-    points: list[tuple[float, float, float]],
-    azimuth: float,
-    pitch: float,
-    fov_deg: float,
-    aspect: float,
-    x0: float,
-    width: float,
-    y0: float,
-    height: float,
-) -> None:
+@given(_shots(_clouds(2, 12), 1.0, _rectangles(st.floats(0.05, 1.0)), min_depths=st.just(0.0)))
+def test_a_rectangle_off_the_view_axis_is_filled_too(shot: Shot) -> None:
     # The fault's family: any rectangle, also one that misses the centre of the view (the part of a narrow window
     # left of the panel and the labels' room lies wholly left of it). Every point lands inside, and tightly.
-    ndc = (x0, min(x0 + width, 0.99), y0, min(y0 + height, 0.99))
-    cloud = np.array(points)
-    if np.ptp(cloud, axis=0).max() < 1e-2:
+    if np.ptp(shot.cloud, axis=0).max() < 1e-2:
         return
-    direction = _direction(azimuth, pitch)
-    fov = math.radians(fov_deg)
-    view = frame_points(cloud, direction, fov_rad=fov, aspect=aspect, ndc=ndc)
-    projected = _project(cloud, np.array(view.position), np.array(view.look_at), fov, aspect)
-    eps = 1e-6
+    projected = shot.project(shot.view())
     assert np.all(projected[:, 2] > 0.0)
-    assert projected[:, 0].min() >= ndc[0] - eps and projected[:, 0].max() <= ndc[1] + eps
-    assert projected[:, 1].min() >= ndc[2] - eps and projected[:, 1].max() <= ndc[3] + eps
-    _assert_tight_or_held_back(projected, ndc, NEAR_M)
+    _assert_inside(projected, shot.ndc)
+    _assert_tight_or_held_back(projected, shot.ndc, NEAR_M)
 
 
 def test_eight_riders_six_metres_apart_in_a_1150_px_window_are_framed_near() -> None:
@@ -239,18 +262,12 @@ def test_without_an_opening_view_a_move_after_the_confirmation_is_the_persons() 
     assert framing.frames == 1 and tab.position == opening
 
 
-def _reference_view(
-    cloud: np.ndarray,
-    direction: tuple[float, float, float],
-    fov: float,
-    aspect: float,
-    ndc: tuple[float, float, float, float],
-    min_depth: float,
-) -> tuple[np.ndarray, np.ndarray]:
+def _reference_view(shot: Shot) -> tuple[np.ndarray, np.ndarray]:
     """(position, look_at) by brute force, as frame_points once searched: bisect the distance between the depth
     extent and 1000× the cloud's size, at each one bisecting each shift across the view until the points' ndc are
     centred in the rectangle and checking they fit; an empty (x1 ≤ x0 or y1 ≤ y0) or unreachable rectangle falls back
     to the whole view."""
+    cloud, direction, fov, aspect, ndc, min_depth = shot
     d = np.asarray(direction) / np.linalg.norm(direction)
     right = np.cross(d, [0.0, 0.0, 1.0])
     right /= np.linalg.norm(right)
@@ -299,46 +316,23 @@ def _reference_view(
 # A rectangle's side is empty (≤ 0) or at least 0.01: a narrower one is below what the brute force resolves (with one
 # point it takes a 1e-210 wide rectangle for empty, as the bisection's shift never lands the point inside).
 _side = st.one_of(st.floats(-0.3, 0.0), st.floats(0.01, 1.0))
-_LINE = [tuple(c) for c in box_corners((-54.75, -1.1, 0.0), (0.85, 1.1, 4.26)).tolist()]
+_LINE = box_corners((-54.75, -1.1, 0.0), (0.85, 1.1, 4.26))
 
 
-@given(
-    points=st.lists(st.tuples(coordinate, coordinate, coordinate), min_size=1, max_size=16),
-    azimuth=st.floats(-math.pi, math.pi),
-    pitch=st.floats(-1.2, 1.2),
-    fov_deg=st.floats(20.0, 90.0),
-    aspect=st.floats(0.5, 3.0),
-    x0=st.floats(-0.99, 0.9),
-    width=_side,
-    y0=st.floats(-0.99, 0.9),
-    height=_side,
-    min_depth=st.sampled_from([0.0, 3.0]),
-)
+@given(_shots(_clouds(1, 16), 1.2, _rectangles(_side)))
 @settings(deadline=None)  # the brute force takes ~40 ms an example
-@example(_LINE, 1.73, -0.23, 75.0, 1150 / 720, -0.917, 0.832, -0.867, 1.65, 0.0)
-@example(_LINE, 0.4, 0.3, 50.0, 1.6, -0.8, 1.6, -0.8, 1.6, 3.0)
-@example(_LINE, 0.4, 0.3, 50.0, 1.6, 0.3, -0.2, -0.5, 1.0, 0.0)
-def test_frame_points_agrees_with_a_brute_force_search(
-    points: list[tuple[float, float, float]],
-    azimuth: float,
-    pitch: float,
-    fov_deg: float,
-    aspect: float,
-    x0: float,
-    width: float,
-    y0: float,
-    height: float,
-    min_depth: float,
-) -> None:
+@example(
+    Shot(_LINE, _direction(1.73, -0.23), math.radians(75.0), 1150 / 720, _rectangle(-0.917, 0.832, -0.867, 1.65), 0.0)
+)
+@example(Shot(_LINE, _direction(0.4, 0.3), math.radians(50.0), 1.6, _rectangle(-0.8, 1.6, -0.8, 1.6), 3.0))
+@example(Shot(_LINE, _direction(0.4, 0.3), math.radians(50.0), 1.6, _rectangle(0.3, -0.2, -0.5, 1.0), 0.0))
+def test_frame_points_agrees_with_a_brute_force_search(shot: Shot) -> None:
     # The fault's kind: a closed-form search that differs from the nested bisections it replaced, for any cloud,
     # direction, lens or rectangle (off the view axis, or empty: x1 ≤ x0 or y1 ≤ y0). The nearest distance and the
     # centring shift are both unique, so the views agree to rounding.
-    cloud = np.array(points)
-    direction = _direction(azimuth, pitch)
-    fov = math.radians(fov_deg)
-    ndc = (x0, min(x0 + width, 0.99), y0, min(y0 + height, 0.99))
-    view = frame_points(cloud, direction, fov_rad=fov, aspect=aspect, ndc=ndc, min_depth=min_depth)
-    position, look_at = _reference_view(cloud, direction, fov, aspect, ndc, min_depth)
+    view = shot.view()
+    position, look_at = _reference_view(shot)
+    cloud = shot.cloud
     scale = 1.0 + float(np.linalg.norm(position - look_at)) + float(np.ptp(cloud, axis=0).max())
     assert np.abs(np.subtract(view.position, position)).max() <= 1e-9 * scale, (view, position)
     assert np.abs(np.subtract(view.look_at, look_at)).max() <= 1e-9 * scale, (view, look_at)
