@@ -246,6 +246,15 @@ class BrowserClient:
             self.gui[uuid]["value"] = value
         self.send("GuiUpdateMessage", uuid=uuid, updates={"value": value})
 
+    def set_value_answered(self, label: str, value: Any, settle_s: float = 0.15) -> None:
+        """Wait for the control labelled ``label``, send ``value`` to it, wait for the server's answer, then
+        ``settle_s`` more for the callback (it runs on viser's thread pool) to finish."""
+        self.wait_for_gui(label)
+        stamp = len(self.received)
+        self.set_value(label, value)
+        self.wait_for(lambda: len(self.received) > stamp, what="the server to answer")
+        time.sleep(settle_s)
+
     def click(self, label: str) -> None:
         """What a browser sends when a person clicks the button labelled ``label``."""
         self.send("GuiUpdateMessage", uuid=self.uuid_of(label), updates={"value": True})

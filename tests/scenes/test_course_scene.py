@@ -246,11 +246,7 @@ def test_crafted_course_values_keep_a_good_state(
     caplog: pytest.LogCaptureFixture,
 ) -> None:
     with BrowserClient(server.get_port()) as client:
-        client.wait_for_gui(label)
-        stamp = len(client.received)
-        client.set_value(label, value)
-        client.wait_for(lambda: len(client.received) > stamp, what="the server to answer")
-        time.sleep(0.15)
+        client.set_value_answered(label, value)
         with mode.scene._lock:
             assert getattr(mode.params, field) == expected
             assert mode.state is not None and math.isfinite(mode.state.ride.time_s)

@@ -205,11 +205,7 @@ def test_crafted_values_keep_a_good_state(
     caplog: pytest.LogCaptureFixture,
 ) -> None:
     with BrowserClient(server.get_port()) as client:
-        client.wait_for_gui(label)
-        stamp = len(client.received)
-        client.set_value(label, value)
-        client.wait_for(lambda: len(client.received) > stamp, what="the server to answer")
-        time.sleep(0.1)  # let the thread-pool callback finish
+        client.set_value_answered(label, value)
         with scene._lock:
             assert getattr(scene.params, field) == expected
             assert np.all(np.isfinite(scene.state.power.total))
