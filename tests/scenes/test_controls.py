@@ -5,13 +5,14 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import time
+from collections.abc import Callable
 from dataclasses import field
 from typing import Any, Literal
 
 import pytest
 import viser
 from helpers.viser_private import store_value
+from helpers.waiting import wait_until
 from helpers.wsclient import BrowserClient
 
 from scenes._controls import (
@@ -58,16 +59,22 @@ class Demo:
     """A field without a declaration: no control, and the reader keeps its value."""
 
 
-def written(handles: list[Any]) -> list[tuple[Any, Any]]:
-    """A write-back that records what it wrote, then writes it."""
-    log: list[tuple[Any, Any]] = []
+def _set_value(handle: Any, value: Any) -> None:
+    handle.value = value
+
+
+def read_logged(
+    controls: Controls[Demo], last: Demo, store: Callable[[Any, Any], None] = _set_value
+) -> tuple[Demo, list[tuple[str, Any]]]:
+    """``read_controls`` with a write-back that records (label, value) for each value it writes back, then has
+    ``store`` write it; the parameters read and that log."""
+    log: list[tuple[str, Any]] = []
 
     def write(handle: Any, value: Any) -> None:
         log.append((handle.label, value))
-        handle.value = value
+        store(handle, value)
 
-    handles.append(write)
-    return log
+    return read_controls(controls, last, write_back=write), log
 
 
 @pytest.fixture
@@ -75,29 +82,31 @@ def demo(server: viser.ViserServer) -> Controls[Demo]:
     return build_controls(server.gui, Demo())
 
 
+@pytest.mark.parametrize(
+    ("name", "kind", "label", "lo", "hi", "step", "value"),
+    [
+        ("speed_kmh", viser.GuiSliderHandle, "Speed (km/h)", 0, 80, 0.5, 40.0),
+        ("riders", viser.GuiSliderHandle, "Riders", 1, 16, 1, 8),
+        ("power_w", viser.GuiNumberHandle, "Power (W)", 0.0, 2500.0, 5.0, 250.0),
+    ],
+)
+def test_the_builder_makes_each_declared_number(
+    demo: Controls[Demo],
+    name: str,
+    kind: type[viser.GuiSliderHandle] | type[viser.GuiNumberHandle],
+    label: str,
+    lo: float,
+    hi: float,
+    step: float,
+    value: float,
+) -> None:
+    handle = demo[name]
+    assert isinstance(handle, kind)
+    assert (handle.label, handle.min, handle.max, handle.step, handle.value) == (label, lo, hi, step, value)
+    assert type(handle.value) is type(value)
+
+
 def test_the_builder_makes_each_declared_control(demo: Controls[Demo]) -> None:
-    speed = demo["speed_kmh"]
-    assert isinstance(speed, viser.GuiSliderHandle)
-    assert (speed.label, speed.min, speed.max, speed.step, speed.value) == (
-        "Speed (km/h)",
-        0,
-        80,
-        0.5,
-        40.0,
-    )
-    riders = demo["riders"]
-    assert isinstance(riders, viser.GuiSliderHandle)
-    assert (riders.min, riders.max, riders.step, riders.value) == (1, 16, 1, 8)
-    assert isinstance(riders.value, int)
-    power = demo["power_w"]
-    assert isinstance(power, viser.GuiNumberHandle)
-    assert (power.label, power.min, power.max, power.step, power.value) == (
-        "Power (W)",
-        0.0,
-        2500.0,
-        5.0,
-        250.0,
-    )
     mode = demo["mode"]
     assert isinstance(mode, viser.GuiDropdownHandle)
     assert tuple(mode.options) == ("Fast (approximate)", "Exact") and mode.value == "Exact"
@@ -144,9 +153,7 @@ def test_the_reader_returns_the_values_shown(demo: Controls[Demo]) -> None:
     demo.each("radii_m")[1].value = 0.45
     demo["colour"].value = (1, 2, 3)
     demo["source"].value = "box"
-    writes: list[Any] = []
-    log = written(writes)
-    params = read_controls(demo, Demo(note="kept"), write_back=writes[0])
+    params, log = read_logged(demo, Demo(note="kept"))
     assert params == Demo(
         speed_kmh=55.5,
         riders=3,
@@ -168,9 +175,7 @@ def test_the_reader_clamps_numbers_to_the_declared_range_and_writes_them_back(
     store_value(demo["riders"], -40)
     store_value(demo["power_w"], 9999.0)
     store_value(demo.each("radii_m")[2], 0.0)
-    writes: list[Any] = []
-    log = written(writes)
-    params = read_controls(demo, Demo(), write_back=writes[0])
+    params, log = read_logged(demo, Demo())
     assert (params.speed_kmh, params.riders, params.power_w) == (80.0, 1, 2500.0)
     assert params.radii_m == (0.1, 0.2, 0.05)
     assert demo["speed_kmh"].value == 80.0 and demo["riders"].value == 1
@@ -211,15 +216,9 @@ def test_the_reader_refuses_unusable_values_and_keeps_the_last_good_one(
         demo[field_name].value = getattr(last, field_name)
     demo["mode"].value = "Fast (approximate)"
     store_value(demo[name], bad)
-    log: list[tuple[str, object]] = []
-
-    def write(handle: Any, value: object) -> None:
-        # viser casts a value set on a handle to the type of the one it holds: a wrong type can only be stored by
-        # a browser the gate let through (it does not), so here the write-back goes where the browser's went.
-        log.append((handle.label, value))
-        store_value(handle, value)
-
-    params = read_controls(demo, last, write_back=write)
+    # viser casts a value set on a handle to the type of the one it holds: a wrong type can only be stored by a
+    # browser the gate let through (it does not), so here the write-back goes where the browser's went.
+    params, log = read_logged(demo, last, store=store_value)
     assert params == last
     shown = "Fast (approximate)" if name == "mode" else getattr(last, name)
     assert demo[name].value == shown
@@ -236,9 +235,7 @@ def test_the_reader_keeps_the_last_good_element_of_a_tuple(demo: Controls[Demo])
 def test_a_float_slider_may_hold_an_int(demo: Controls[Demo]) -> None:
     """viser keeps a browser's 40 as an int: the same number, nothing written back, a float in the params."""
     store_value(demo["speed_kmh"], 40)
-    writes: list[Any] = []
-    log = written(writes)
-    params = read_controls(demo, Demo(), write_back=writes[0])
+    params, log = read_logged(demo, Demo())
     assert params.speed_kmh == 40.0 and isinstance(params.speed_kmh, float) and log == []
 
 
@@ -302,13 +299,12 @@ def test_a_browser_value_is_cleaned_once_by_the_declared_spec(server: viser.Vise
         client.set_value("Speed (km/h)", math.nan)
         client.set_value("Mode", "Turbo")
         client.set_value("Power (W)", 3000.0)
-        deadline = time.monotonic() + 10.0
-        while demo["riders"].value != 16 or demo["power_w"].value != 2500.0:
-            assert time.monotonic() < deadline, "the gate's clamped values did not arrive"
-            time.sleep(0.02)
-    writes: list[Any] = []
-    log = written(writes)
-    params = read_controls(demo, Demo(), write_back=writes[0])
+        wait_until(
+            lambda: demo["riders"].value == 16 and demo["power_w"].value == 2500.0,
+            "the gate's clamped values",
+            timeout_s=10.0,
+        )
+    params, log = read_logged(demo, Demo())
     assert (params.riders, params.power_w, params.speed_kmh, params.mode) == (
         16,
         2500.0,
