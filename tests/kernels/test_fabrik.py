@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
 import os
@@ -611,64 +612,86 @@ def random_obstacles(
     return found
 
 
+@dataclasses.dataclass(frozen=True)
+class Problem:
+    """A random limited problem: a chain, a target, a root direction, obstacles near the chain and a cone limit."""
+
+    joints: NDArray[np.float64]
+    """(n + 1, d) start pose (m)."""
+    target: NDArray[np.float64]
+    """(d,) target of the end joint (m)."""
+    root_direction: NDArray[np.float64]
+    """(d,) axis of the first joint's cone."""
+    obstacles: list[tuple[NDArray[np.float64], float]]
+    """Circles or spheres (centre, radius) in m."""
+    phi: float | None
+    """Cone half-angle of every joint (rad), or None for no limit."""
+
+    @property
+    def outer(self) -> float:
+        """The chain's total length (m)."""
+        return float(fabrik.link_lengths(self.joints).sum())
+
+    def admissible(self, joints: NDArray[np.float64]) -> bool:
+        return admissible(joints, self.phi, self.root_direction, self.obstacles)
+
+    def solve(self, **kwargs: Any) -> fabrik.Solution:
+        """``fabrik.solve_batch`` of this one problem under its limits and obstacles."""
+        return fabrik.solve_batch(
+            self.joints[None],
+            self.target[None],
+            cone_half_angle_rad=self.phi,
+            obstacles=self.obstacles,
+            root_direction=self.root_direction,
+            **kwargs,
+        )[0]
+
+
+def _problem(chain: tuple[int, int, int], where: float, phi: float | None, count: int, bend: float) -> Problem:
+    """A chain of ``n`` links in ``d`` dimensions drawn from ``seed``, its target ``where`` × its length from the
+    root, and up to ``count`` obstacles."""
+    n, d, seed = chain
+    rng = np.random.default_rng(seed)
+    joints = random_chain(rng, n, d, bend=bend)
+    target = joints[0] + random_direction(rng, d) * where * fabrik.link_lengths(joints).sum()
+    root_direction = random_direction(rng, d)
+    return Problem(joints, target, root_direction, random_obstacles(rng, joints, count), phi)
+
+
+def problems(counts: st.SearchStrategy[int], bends: st.SearchStrategy[float]) -> st.SearchStrategy[Problem]:
+    """Limited problems over the whole family: any chain, a target from the root to 1.3× the reach, no limit or
+    any cone, ``counts`` obstacles, chains as bent as ``bends``."""
+    return st.builds(_problem, chains, st.floats(0.0, 1.3), st.one_of(st.none(), st.floats(0.05, 3.1)), counts, bends)
+
+
 CAPS = (1, 2, 3, 5, 8, 13, 21, 34)
 
 
 @PROPERTY
-@given(
-    chains,
-    st.floats(0.0, 1.3),
-    st.one_of(st.none(), st.floats(0.05, 3.1)),
-    st.integers(0, 4),
-    st.sampled_from(SOLVERS),
-    st.booleans(),
-    st.floats(0.1, 2.0),
-)
+@given(problems(st.integers(0, 4), st.floats(0.1, 2.0)), st.sampled_from(SOLVERS), st.booleans())
 def test_the_returned_pose_is_the_best_admissible_pose_seen(
-    chain: tuple[int, int, int],
-    where: float,
-    phi: float | None,
-    count: int,
-    solver: fabrik.Solver,
-    extrapolate: bool,
-    bend: float,
+    problem: Problem, solver: fabrik.Solver, extrapolate: bool
 ) -> None:
     """Limited chains keep their best pose, over the whole family: never worse than an admissible start, never worse than an admissible
     iterate, admissible whenever an admissible pose was seen, and status words that say what happened."""
-    n, d, seed = chain
-    rng = np.random.default_rng(seed)
-    joints = random_chain(rng, n, d, bend=bend)
-    lengths = fabrik.link_lengths(joints)
-    inner, outer = fabrik.reach_limits(lengths)
-    target = joints[0] + random_direction(rng, d) * where * outer
-    root_direction = random_direction(rng, d)
-    obstacles = random_obstacles(rng, joints, count)
-    start_ok = admissible(joints, phi, root_direction, obstacles)
+    joints, target, phi, obstacles = problem.joints, problem.target, problem.phi, problem.obstacles
+    inner, outer = fabrik.reach_limits(fabrik.link_lengths(joints))
+    start_ok = problem.admissible(joints)
     start_error = float(np.linalg.norm(joints[-1] - target))
     distance = float(np.linalg.norm(target - joints[0]))
     previous = math.inf
     for cap in CAPS:
-        result = fabrik.solve_batch(
-            joints[None],
-            target[None],
-            tolerance=1e-3 * outer,
-            max_iterations=cap,
-            cone_half_angle_rad=phi,
-            obstacles=obstacles,
-            root_direction=root_direction,
-            solver=solver,
-            extrapolate=extrapolate,
-        )[0]
+        result = problem.solve(tolerance=1e-3 * outer, max_iterations=cap, solver=solver, extrapolate=extrapolate)
         # More iterations never give a worse admissible pose: each run repeats the shorter one's iterates first.
         # (Only where no admissible pose was ever seen is the last iterate returned, whatever its error.)
-        if admissible(result.joints, phi, root_direction, obstacles):
+        if problem.admissible(result.joints):
             assert result.error <= previous + 1e-12 * outer
             previous = result.error
         else:
             assert previous == math.inf, "an admissible pose was seen with fewer iterations"
         if start_ok:
             assert result.error <= start_error + 1e-12 * outer
-            assert admissible(result.joints, phi, root_direction, obstacles), result.status
+            assert problem.admissible(result.joints), result.status
         if not obstacles and result.iterations > 0:  # limits alone: every iterate is admissible
             assert result.error <= result.error_history[1:].min() + 1e-12 * outer
         if result.status == "reached":
@@ -941,52 +964,30 @@ def test_inner_radius_targets_are_reached_at_once(d: int, x: float, right_error:
 
 @PROPERTY
 @given(
-    chains,
+    problems(st.integers(0, 3), st.just(0.6)),
     st.integers(-900, 900),
-    st.floats(0.0, 1.3),
-    st.one_of(st.none(), st.floats(0.05, 3.1)),
-    st.integers(0, 3),
     st.sampled_from(SOLVERS),
     st.sampled_from([0.0, 1e-6, 1e-3, 0.1]),
 )
 def test_solves_at_any_power_of_two_scale_are_the_unit_solve_scaled(
-    chain: tuple[int, int, int],
-    exponent: int,
-    where: float,
-    phi: float | None,
-    count: int,
-    solver: fabrik.Solver,
-    relative_tolerance: float,
+    problem: Problem, exponent: int, solver: fabrik.Solver, relative_tolerance: float
 ) -> None:
     """Scale (overflowing squares at 1e154–1e300, absolute slack floors on tiny chains), over the
     whole family: a problem multiplied by 2^k, k ∈ [−900, 900] (chains from 1e-271 m to 1e271 m), is solved as the
     unit problem multiplied by 2^k, bit for bit (same status, iterations, joints × 2^k, error × 2^k); the core has
     no absolute length anywhere. Every "reached" has error ≤ tolerance, exactly."""
-    n, d, seed = chain
-    rng = np.random.default_rng(seed)
-    joints = random_chain(rng, n, d)
-    outer = fabrik.link_lengths(joints).sum()
-    target = joints[0] + random_direction(rng, d) * where * outer
-    root_direction = random_direction(rng, d)
-    obstacles = random_obstacles(rng, joints, count)
+    outer = problem.outer
     s = math.ldexp(1.0, exponent)
-    common: dict[str, Any] = {"cone_half_angle_rad": phi, "root_direction": root_direction * s}
-    unit = fabrik.solve_batch(
-        joints[None],
-        target[None],
-        tolerance=relative_tolerance * outer,
-        solver=solver,
-        obstacles=obstacles,
-        **common,
-    )[0]
-    scaled = fabrik.solve_batch(
-        joints[None] * s,
-        target[None] * s,
-        tolerance=relative_tolerance * outer * s,
-        solver=solver,
-        obstacles=[(c * s, r * s) for c, r in obstacles],
-        **common,
-    )[0]
+    # Both get the root direction × 2^k: a direction's length does not matter, and so the two differ in scale only.
+    unit_problem = dataclasses.replace(problem, root_direction=problem.root_direction * s)
+    scaled_problem = dataclasses.replace(
+        unit_problem,
+        joints=problem.joints * s,
+        target=problem.target * s,
+        obstacles=[(c * s, r * s) for c, r in problem.obstacles],
+    )
+    unit = unit_problem.solve(tolerance=relative_tolerance * outer, solver=solver)
+    scaled = scaled_problem.solve(tolerance=relative_tolerance * outer * s, solver=solver)
     assert (scaled.status, scaled.iterations) == (unit.status, unit.iterations)
     np.testing.assert_array_equal(scaled.joints, unit.joints * s)
     assert scaled.error == unit.error * s
@@ -1089,44 +1090,15 @@ def test_start_on_the_target_with_tolerance_zero(solver: fabrik.Solver) -> None:
 
 
 @PROPERTY
-@given(
-    chains,
-    st.floats(0.0, 1.3),
-    st.one_of(st.none(), st.floats(0.05, 3.1)),
-    st.integers(1, 6),
-    st.sampled_from(SOLVERS),
-    st.floats(0.1, 2.0),
-)
-def test_only_infeasible_solves_return_a_pose_that_breaks_a_constraint(
-    chain: tuple[int, int, int],
-    where: float,
-    phi: float | None,
-    count: int,
-    solver: fabrik.Solver,
-    bend: float,
-) -> None:
+@given(problems(st.integers(1, 6), st.floats(0.1, 2.0)), st.sampled_from(SOLVERS))
+def test_only_infeasible_solves_return_a_pose_that_breaks_a_constraint(problem: Problem, solver: fabrik.Solver) -> None:
     """Feasible poses only, over the whole family: a returned pose that cuts an obstacle or breaks a limit comes
     only with status "infeasible" (no admissible pose was ever seen), never "blocked" or "reached"; an admissible
     start is never "infeasible". Starts here are random, often through the obstacles."""
-    n, d, seed = chain
-    rng = np.random.default_rng(seed)
-    joints = random_chain(rng, n, d, bend=bend)
-    outer = fabrik.link_lengths(joints).sum()
-    target = joints[0] + random_direction(rng, d) * where * outer
-    root_direction = random_direction(rng, d)
-    obstacles = random_obstacles(rng, joints, count)
-    result = fabrik.solve_batch(
-        joints[None],
-        target[None],
-        tolerance=1e-2 * outer,
-        cone_half_angle_rad=phi,
-        obstacles=obstacles,
-        root_direction=root_direction,
-        solver=solver,
-    )[0]
+    result = problem.solve(tolerance=1e-2 * problem.outer, solver=solver)
     if result.status != "infeasible":
-        assert admissible(result.joints, phi, root_direction, obstacles), result.status
-    if admissible(joints, phi, root_direction, obstacles):
+        assert problem.admissible(result.joints), result.status
+    if problem.admissible(problem.joints):
         assert result.status != "infeasible"
 
 
