@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 import pytest
+from helpers import riders
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -121,9 +122,9 @@ def test_power_broadcasts_over_arrays() -> None:
 @given(
     v=st.floats(0.1, 30.0),
     dv=st.floats(0.01, 5.0),
-    cda=st.floats(0.1, 0.8),
-    mass=st.floats(40.0, 150.0),
-    crr=st.floats(0.0, 0.02),
+    cda=riders.cda_m2,
+    mass=riders.mass_kg,
+    crr=riders.crr,
     grade=st.floats(0.0, 0.2),
     wind=st.floats(0.0, 15.0),
 )
@@ -145,9 +146,9 @@ def test_speed_for_power_known_flat_case() -> None:
 
 @given(
     power_w=st.floats(0.0, 1500.0),
-    cda=st.floats(0.1, 0.8),
-    mass=st.floats(40.0, 150.0),
-    crr=st.floats(0.0, 0.02),
+    cda=riders.cda_m2,
+    mass=riders.mass_kg,
+    crr=riders.crr,
     grade=st.floats(-0.15, 0.2),
     altitude=st.floats(0.0, 4000.0),
     wind=st.floats(-15.0, 15.0),
@@ -178,7 +179,7 @@ def test_speed_for_power_round_trips_to_1e_6(
 
 @given(
     v=st.floats(0.5, 25.0),
-    cda=st.floats(0.1, 0.8),
+    cda=riders.cda_m2,
     grade=st.floats(0.0, 0.2),
     wind=st.floats(0.0, 10.0),
 )

@@ -7,6 +7,7 @@ import math
 
 import numpy as np
 import pytest
+from helpers import riders
 from hypothesis import given
 from hypothesis import strategies as st
 
@@ -166,8 +167,8 @@ def paper_power(
 
 @given(
     v=st.floats(0.0, 25.0),
-    cda=st.floats(0.1, 0.8),
-    m=st.floats(40.0, 150.0),
+    cda=riders.cda_m2,
+    m=riders.mass_kg,
     crr=st.floats(0.0, 0.015),
     grade=st.floats(-0.05, 0.25),
     w=st.floats(0.0, 15.0),

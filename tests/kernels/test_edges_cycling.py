@@ -10,6 +10,7 @@ from collections.abc import Callable
 import numpy as np
 import pytest
 import viser
+from helpers import riders
 from helpers.wsclient import BrowserClient
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -78,8 +79,8 @@ def courses(draw: st.DrawFn) -> dict[str, float]:
         )
     )
     return dict(
-        cda_m2=draw(st.floats(0.1, 0.8)),
-        mass_kg=draw(st.floats(40.0, 150.0)),
+        cda_m2=draw(riders.cda_m2),
+        mass_kg=draw(riders.mass_kg),
         crr=crr,
         grade=grade,
         altitude_m=draw(st.sampled_from([0.0, 2000.0])),
