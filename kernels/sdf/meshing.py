@@ -24,7 +24,7 @@ from collections.abc import Callable
 import numpy as np
 import trimesh
 from numpy.typing import ArrayLike, NDArray
-from skimage.measure import marching_cubes
+from skimage.measure import label, marching_cubes
 
 from kernels.sdf.primitives import FloatArray
 from kernels.sdf.scene import Primitive, Scene, fold_xyz, scene_bounds, scene_color
@@ -245,7 +245,7 @@ def _polygonise(
         lined[[0, -1], :, :] = False
         lined[:, [0, -1], :] = False
         lined[:, :, [0, -1]] = False
-        inward = (field < 0.0) | _touches_solid(scene, grid, lined)
+        inward = (field < 0.0) | _holds_volume(_touches_solid(scene, grid, lined), field < 0.0)
         nudged = np.where(inward, -delta, delta)
         # A level sample left outside next to one moved inside: the edge between them runs along a face that only
         # the inside one bounds (a cut flush with another face), so the surface belongs at the inside sample, not
@@ -264,6 +264,37 @@ def _polygonise(
     verts = verts.astype(np.float64) + np.asarray(grid.origin)
     # scikit-image's default winding faces a field that is negative inside outward (tests check the volume's sign).
     return verts, faces.astype(np.int64), scene_color(scene, verts)
+
+
+def _holds_volume(level_in: NDArray[np.bool_], inside: NDArray[np.bool_]) -> NDArray[np.bool_]:
+    """The ``level_in`` samples (level samples bound for the inside) whose group, 6-connected through them and the
+    ``inside`` samples, holds a sample strictly inside or a whole grid cell (all eight corners in it).
+
+    A group that holds neither is a line or a point where the field only touches zero (a smooth blend's crease running
+    along a grid line): the solid has no volume there at this grid, and marching cubes would close those samples into
+    a separate shell of no thickness, a second component that a finer grid does not have. A feature one voxel thick
+    with both faces on grid planes still holds whole cells, and a face of a larger solid touches its inside samples.
+    """
+    if not level_in.any():
+        return level_in
+    lo = np.maximum(np.argwhere(level_in).min(axis=0) - 1, 0)
+    hi = np.argwhere(level_in).max(axis=0) + 2
+    box = tuple(slice(a, b) for a, b in zip(lo, hi, strict=True))
+    candidates, solid = level_in[box], inside[box]
+    members = candidates | solid
+    labels: NDArray[np.intp] = np.asarray(label(members, connectivity=1), dtype=np.intp)
+    count = int(labels.max())
+    keep = np.zeros(count + 1, dtype=bool)
+    keep[labels[solid]] = True
+    nx, ny, nz = (n - 1 for n in members.shape)
+    whole = np.ones((nx, ny, nz), dtype=bool)
+    for dx, dy, dz in itertools.product((0, 1), repeat=3):
+        whole &= members[dx : dx + nx, dy : dy + ny, dz : dz + nz]
+    keep[labels[:-1, :-1, :-1][whole]] = True
+    keep[0] = False
+    out = np.zeros_like(level_in)
+    out[box] = candidates & keep[labels]
+    return out
 
 
 def _beside(samples: NDArray[np.bool_]) -> NDArray[np.bool_]:
