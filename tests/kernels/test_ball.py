@@ -8,6 +8,7 @@ import subprocess
 import sys
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -527,29 +528,10 @@ def test_every_sample_matches_a_plain_reference_of_the_equations(
     if method == "euler":
         dt /= 8
     seed, model = kick_settings_["seed"], kick_settings_["model"]
-    flight = ball.simulate(
-        START,
-        velocity,
-        spin,
-        dt=dt,
-        method=method,
-        model=model,
-        t_max=2.5,  # type: ignore[arg-type]
-        x_stop=x_stop,
-        ground_m=R,
-        knuckle_seed=seed,
-    )
+    both: dict[str, Any] = {"dt": dt, "method": method, "model": model, "t_max": 2.5}
+    flight = ball.simulate(START, velocity, spin, x_stop=x_stop, ground_m=R, knuckle_seed=seed, **both)
     t, states, last = reference_flight(
-        START,
-        velocity,
-        spin,
-        dt=dt,
-        method=method,
-        model=model,
-        t_max=2.5,
-        seed=seed,
-        ground=R,
-        x_stop=math.inf if x_stop is None else x_stop,
+        START, velocity, spin, seed=seed, ground=R, x_stop=math.inf if x_stop is None else x_stop, **both
     )
     n = len(t)
     assert len(flight.t) == n + (last is not None)
