@@ -26,6 +26,7 @@ __all__ = [
     "points",
     "positive",
     "positive_array",
+    "positive_vector",
     "vector",
 ]
 
@@ -105,6 +106,14 @@ def vector(name: str, value: ArrayLike, size: int) -> NDArray[np.float64]:
     array = finite_array(name, value)
     if array.shape != (size,):
         raise ValueError(f"{name} must have shape ({size},), got {array.shape}")
+    return array
+
+
+def positive_vector(name: str, value: ArrayLike, size: int) -> NDArray[np.float64]:
+    """:func:`vector` with every element > 0 (sizes, semi-axes, spacings), else ``ValueError`` naming it."""
+    array = vector(name, value, size)
+    if np.any(array <= 0.0):
+        raise ValueError(f"{name} must be > 0, got {array.tolist()}")
     return array
 
 

@@ -49,13 +49,9 @@ class Rider:
 
     def __post_init__(self) -> None:
         for key in ("cda_m2", "mass_kg", "wheel_radius_m"):
-            value = getattr(self, key)
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0.0):
-                raise ValueError(f"{key} must be a finite number > 0, got {value!r}")
+            _checks.positive(key, getattr(self, key))
         for key in ("crr", "spoke_drag_m2", "wheel_inertia_kgm2"):
-            value = getattr(self, key)
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0.0):
-                raise ValueError(f"{key} must be a finite number >= 0, got {value!r}")
+            _checks.non_negative(key, getattr(self, key))
         eta = self.drivetrain_efficiency
         if not (isinstance(eta, (int, float)) and 0.0 < eta <= 1.0):
             raise ValueError(f"drivetrain_efficiency must be in (0, 1], got {eta!r}")
@@ -158,8 +154,7 @@ class Ride:
 
     def splits(self, every_m: float = 1000.0) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """(marks, elapsed): the elapsed time (s) at every ``every_m`` metres and at the finish."""
-        if not (math.isfinite(every_m) and every_m > 0.0):
-            raise ValueError(f"every_m must be finite and > 0, got {every_m!r}")
+        _checks.positive("every_m", every_m)
         total = float(self.distance_m[-1])
         marks = np.arange(every_m, total, every_m)
         if marks.shape[0] > 10_000:

@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-import math
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -253,8 +252,7 @@ def _finish(
     elevation: NDArray[np.float64],
     smoothing_m: float,
 ) -> Course:
-    if not (math.isfinite(smoothing_m) and smoothing_m >= 0.0):
-        raise ValueError(f"smoothing_m must be finite and >= 0, got {smoothing_m!r}")
+    _checks.non_negative("smoothing_m", smoothing_m)
     if np.any(np.abs(elevation) > 10_000.0):
         raise ValueError(f"{name}: elevation outside ±10 000 m")
     # Points at one place (a paused GPS logs many) carry no distance: keep the first of each run.

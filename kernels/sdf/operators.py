@@ -9,8 +9,6 @@ Source: I. Quilez, "distance functions" (iquilezles.org/articles/distfunctions, 
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -76,9 +74,7 @@ def op_twist(p: ArrayLike, rate: float) -> FloatArray:
         (N, 3) points: (c·x − s·z, y, s·x + c·z) with c, s = cos, sin(rate·y).
     """
     pts = _checks.points("p", p)
-    k = float(rate)
-    if not math.isfinite(k):
-        raise ValueError(f"rate must be finite, got {rate!r}")
+    k = _checks.finite_number("rate", rate)
     c, s = np.cos(k * pts[:, 1]), np.sin(k * pts[:, 1])
     return np.stack([c * pts[:, 0] - s * pts[:, 2], pts[:, 1], s * pts[:, 0] + c * pts[:, 2]], axis=1)
 
@@ -96,9 +92,7 @@ def op_bend(p: ArrayLike, rate: float) -> FloatArray:
         (N, 3) points: (c·x − s·y, s·x + c·y, z) with c, s = cos, sin(rate·x).
     """
     pts = _checks.points("p", p)
-    k = float(rate)
-    if not math.isfinite(k):
-        raise ValueError(f"rate must be finite, got {rate!r}")
+    k = _checks.finite_number("rate", rate)
     c, s = np.cos(k * pts[:, 0]), np.sin(k * pts[:, 0])
     return np.stack([c * pts[:, 0] - s * pts[:, 1], s * pts[:, 0] + c * pts[:, 1], pts[:, 2]], axis=1)
 
@@ -119,9 +113,7 @@ def op_repeat_finite(p: ArrayLike, spacing: ArrayLike, limit: ArrayLike) -> Floa
         (N, 3) points in the nearest copy's frame.
     """
     pts = _checks.points("p", p)
-    c = _checks.vector("spacing", spacing, 3)
-    if np.any(c <= 0.0):
-        raise ValueError(f"spacing must be positive, got {c.tolist()}")
+    c = _checks.positive_vector("spacing", spacing, 3)
     lim = _checks.vector("limit", limit, 3)
     if np.any(lim < 0.0) or np.any(lim != np.round(lim)):
         raise ValueError(f"limit must be whole numbers ≥ 0, got {lim.tolist()}")

@@ -78,9 +78,7 @@ def sd_box(p: ArrayLike, half_size: ArrayLike) -> FloatArray:
         (N,) signed distances (m).
     """
     pts = _checks.points("p", p)
-    b = _checks.vector("half_size", half_size, 3)
-    if np.any(b <= 0.0):
-        raise ValueError(f"half_size must be positive, got {b.tolist()}")
+    b = _checks.positive_vector("half_size", half_size, 3)
     q = np.abs(pts) - b
     outside = np.linalg.norm(np.maximum(q, 0.0), axis=1)
     inside = np.minimum(q.max(axis=1), 0.0)
@@ -163,9 +161,7 @@ def sd_round_box(p: ArrayLike, half_size: ArrayLike, radius: float) -> FloatArra
         (N,) signed distances (m).
     """
     pts = _checks.points("p", p)
-    b = _checks.vector("half_size", half_size, 3)
-    if np.any(b <= 0.0):
-        raise ValueError(f"half_size must be positive, got {b.tolist()}")
+    b = _checks.positive_vector("half_size", half_size, 3)
     r = _checks.non_negative("radius", radius)
     if r > b.min():
         raise ValueError(f"radius must be at most min(half_size) = {b.min()}, got {radius!r}")
@@ -265,9 +261,7 @@ def sd_ellipsoid(p: ArrayLike, radii: ArrayLike) -> FloatArray:
         (N,) signed distance estimates (m).
     """
     pts = _checks.points("p", p)
-    r = _checks.vector("radii", radii, 3)
-    if np.any(r <= 0.0):
-        raise ValueError(f"radii must be positive, got {r.tolist()}")
+    r = _checks.positive_vector("radii", radii, 3)
     k0 = np.linalg.norm(pts / r, axis=1)
     k1 = np.linalg.norm(pts / (r * r), axis=1)
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -292,9 +286,7 @@ def sd_ellipsoid_lipschitz(p: ArrayLike, radii: ArrayLike) -> FloatArray:
         (N,) signed distance bounds (m).
     """
     pts = _checks.points("p", p)
-    r = _checks.vector("radii", radii, 3)
-    if np.any(r <= 0.0):
-        raise ValueError(f"radii must be positive, got {r.tolist()}")
+    r = _checks.positive_vector("radii", radii, 3)
     return (np.linalg.norm(pts / r, axis=1) - 1.0) * r.min()
 
 
@@ -314,9 +306,7 @@ def sd_plane(p: ArrayLike, normal: ArrayLike, offset: float) -> FloatArray:
     length = float(np.linalg.norm(n))
     if length < 1e-12:
         raise ValueError("normal must be non-zero")
-    off = float(offset)
-    if not math.isfinite(off):
-        raise ValueError(f"offset must be finite, got {offset!r}")
+    off = _checks.finite_number("offset", offset)
     return pts @ (n / length) + off
 
 
