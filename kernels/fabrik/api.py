@@ -225,7 +225,7 @@ def solve_batch(
     else:
         # numba's workqueue threading layer (where OpenMP and TBB are missing) is not thread-safe
         with _PARALLEL_LOCK:
-            _solve_parallel(min(batch, _CHUNKS), *args)
+            _solve_parallel(min(batch, _CHUNKS), args)
     if scale != 1.0:
         out_p *= scale
         history *= scale

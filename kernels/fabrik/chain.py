@@ -9,7 +9,7 @@ perpendicular and the rotations differ. See :mod:`kernels.fabrik` for the model,
 from __future__ import annotations
 
 import math
-from typing import Literal
+from typing import Any, Literal
 
 import numba
 import numpy as np
@@ -776,42 +776,12 @@ def _solve_rows(
 
 
 @numba.njit(cache=True, error_model="numpy", parallel=True)
-def _solve_parallel(
-    chunks: int,
-    p: NDArray[np.float64],
-    target: NDArray[np.float64],
-    params: NDArray[np.float64],
-    flags: NDArray[np.int64],
-    rest: NDArray[np.float64],
-    centres: NDArray[np.float64],
-    radii: NDArray[np.float64],
-    out_p: NDArray[np.float64],
-    history: NDArray[np.float64],
-    iterations: NDArray[np.int64],
-    status: NDArray[np.int64],
-    error: NDArray[np.float64],
-    table: NDArray[np.float64],
-) -> None:
-    """:func:`_solve_rows` over a whole batch, in ``chunks`` contiguous chunks spread over numba's threads."""
-    batch = p.shape[0]
+def _solve_parallel(chunks: int, rows: tuple[Any, ...]) -> None:
+    """:func:`_solve_rows` over a whole batch, in ``chunks`` contiguous chunks spread over numba's threads;
+    ``rows`` holds its arguments after ``lo`` and ``hi`` (``p`` (B, n + 1, 3) first)."""
+    batch = rows[0].shape[0]
     for c in numba.prange(chunks):
-        _solve_rows(
-            c * batch // chunks,
-            (c + 1) * batch // chunks,
-            p,
-            target,
-            params,
-            flags,
-            rest,
-            centres,
-            radii,
-            out_p,
-            history,
-            iterations,
-            status,
-            error,
-            table,
-        )
+        _solve_rows(c * batch // chunks, (c + 1) * batch // chunks, *rows)
 
 
 _UNSCALED = 2.0**-16, 2.0**16
