@@ -310,12 +310,17 @@ class FittedChart:
         data: tuple[np.ndarray, ...],
         series: tuple[viser.uplot.Series, ...],
         *,
-        scales: dict[str, viser.uplot.Scale],
+        scales: dict[str, viser.uplot.Scale] | None = None,
         axes: tuple[viser.uplot.Axis, ...] | None = None,
         **kwargs: Any,
     ) -> None:
-        """Add the chart to ``gui``; the other keyword arguments go to ``add_uplot`` as they are (not padding)."""
+        """Add the chart to ``gui``; the other keyword arguments go to ``add_uplot`` as they are (not padding).
+
+        ``scales`` defaults to a plain number line on x (not uPlot's default of time) and y, both fitted to the data.
+        """
         assert "padding" not in kwargs, "the padding is fitted"
+        if scales is None:
+            scales = {"x": viser.uplot.Scale(time=False, auto=True), "y": viser.uplot.Scale(auto=True)}
         self._series, self._scales, self._axes = series, scales, axes
         fitted, padding = fit_layout(data, series, scales, axes)
         self.handle = gui.add_uplot(

@@ -22,6 +22,7 @@ import trimesh
 from numpy.typing import NDArray
 
 from kernels import fabrik
+from scenes._instances import add_instances
 
 if TYPE_CHECKING:
     import viser
@@ -33,7 +34,8 @@ PRESET_LABELS: tuple[PresetLabel, ...] = ("Chain", "Robot arm", "Hand", "Upper b
 MAX_JOINTS = 24
 MAX_EFFECTORS = 5
 WORLD_LIMIT_M = 4.0
-"""Targets stay inside this box (±m on each axis), as the chain's do."""
+"""Targets and obstacles, the chain's and the skeletons', stay inside this box (±m on each axis); anything a browser
+sends beyond it is refused."""
 LINK_RADIUS_M = 0.016
 JOINT_RADIUS_M = 0.026
 GIZMO_SCALE_M = 0.12
@@ -326,8 +328,8 @@ def usage_colours(usage: NDArray[np.float64], free: NDArray[np.bool_]) -> NDArra
 
 
 def clean_target(raw: object, planar: bool) -> NDArray[np.float64] | None:
-    """A browser-sent gizmo position as a world point: three finite numbers inside the world box (y put back to 0
-    for a planar preset), else None."""
+    """A browser-sent position as a world point: three finite numbers inside the world box (y put back to 0 in the
+    plane: a crafted client may send any y), else None."""
     try:
         point = np.asarray(raw, dtype=np.float64)
     except (TypeError, ValueError):
@@ -337,6 +339,23 @@ def clean_target(raw: object, planar: bool) -> NDArray[np.float64] | None:
     if planar:
         point = point.copy()
         point[1] = 0.0
+    return point
+
+
+def moved_gizmo(
+    gizmo: viser.TransformControlsHandle, last: NDArray[np.float64], planar: bool, *, upright: bool = False
+) -> NDArray[np.float64] | None:
+    """Where a dragged gizmo now puts its point, cleaned by :func:`clean_target` and drawn there (a crafted y off
+    the plane is put back); None for a position that cannot be used, with the gizmo put back on ``last`` (and
+    upright when ``upright``): the last good point and pose stay."""
+    point = clean_target(gizmo.position, planar)
+    if point is None:
+        gizmo.position = last
+        if upright:
+            gizmo.wxyz = (1.0, 0.0, 0.0, 0.0)
+        return None
+    if not np.array_equal(point, np.asarray(gizmo.position, dtype=np.float64)):
+        gizmo.position = point
     return point
 
 
@@ -363,27 +382,20 @@ class SkeletonView:
         cylinder = trimesh.creation.cylinder(radius=1.0, height=1.0, sections=12)
         cylinder.apply_translation((0.0, 0.0, 0.5))
         sphere = trimesh.creation.icosphere(subdivisions=2, radius=1.0)
-        identity = np.tile([1.0, 0.0, 0.0, 0.0], (MAX_JOINTS, 1))
-        self.link_nodes = server.scene.add_batched_meshes_simple(
+        self.link_nodes = add_instances(
+            server.scene,
             f"{root}/skeleton/links",
-            vertices=cylinder.vertices.astype(np.float32),
-            faces=cylinder.faces.astype(np.uint32),
-            batched_wxyzs=identity,
-            batched_positions=np.zeros((MAX_JOINTS, 3)),
-            batched_scales=np.zeros((MAX_JOINTS, 3)),
-            batched_colors=np.tile(CHAIN_COLOURS[0], (MAX_JOINTS, 1)),
-            lod="off",
+            cylinder,
+            MAX_JOINTS,
+            np.tile(CHAIN_COLOURS[0], (MAX_JOINTS, 1)),
             visible=False,
         )
-        self.joint_nodes = server.scene.add_batched_meshes_simple(
+        self.joint_nodes = add_instances(
+            server.scene,
             f"{root}/skeleton/joints",
-            vertices=sphere.vertices.astype(np.float32),
-            faces=sphere.faces.astype(np.uint32),
-            batched_wxyzs=identity,
-            batched_positions=np.zeros((MAX_JOINTS, 3)),
-            batched_scales=np.zeros((MAX_JOINTS, 3)),
-            batched_colors=np.tile(np.array(FREE_COLOUR, np.uint8), (MAX_JOINTS, 1)),
-            lod="off",
+            sphere,
+            MAX_JOINTS,
+            np.tile(np.array(FREE_COLOUR, np.uint8), (MAX_JOINTS, 1)),
             visible=False,
         )
         self.axes = server.scene.add_line_segments(
@@ -466,15 +478,8 @@ class SkeletonView:
         sk = self.skeleton
         if sk is None or k >= len(sk.effectors):
             return
-        gizmo = self.gizmos[k]
-        point = clean_target(gizmo.position, sk.planar)
-        if point is None:  # NaN, huge, wrong shape: keep the last good target and pose
-            gizmo.position = self.targets[k]
-            gizmo.wxyz = (1.0, 0.0, 0.0, 0.0)
-            return
-        if not np.array_equal(point, np.asarray(gizmo.position, dtype=np.float64)):
-            gizmo.position = point
-        if np.array_equal(point, self.targets[k]):
+        point = moved_gizmo(self.gizmos[k], self.targets[k], sk.planar, upright=True)
+        if point is None or np.array_equal(point, self.targets[k]):
             return
         self.targets[k] = point
         self.solve_and_draw()

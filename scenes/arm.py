@@ -30,13 +30,12 @@ from scenes._base import Scene
 from scenes._charts import FittedChart
 from scenes._controls import build_controls, checkbox, dropdown, slider
 from scenes._framing import ClientFraming, Lens, View, frame_points
+from scenes._instances import add_instances
 from scenes._skeletons import GIZMO_SCALE_M as SKELETON_GIZMO_M
-from scenes._skeletons import PRESET_LABELS, PresetLabel, SkeletonView
+from scenes._skeletons import PRESET_LABELS, WORLD_LIMIT_M, PresetLabel, SkeletonView, clean_target, moved_gizmo
 
 MAX_LINKS = 12
 MAX_OBSTACLES = 4
-WORLD_LIMIT_M = 4.0
-"""Targets and obstacles stay inside this box (±m on each axis); anything a browser sends beyond it is refused."""
 LINK_RADIUS_M = 0.018
 JOINT_RADIUS_M = 0.03
 
@@ -216,23 +215,6 @@ def solve_arm(
     )
 
 
-def clean_point(raw: object, three_d: bool) -> NDArray[np.float64] | None:
-    """A browser-sent position as a world point, or None when it is not three finite numbers inside the world box.
-
-    In the plane, y is put back to 0 (a crafted client may send any y).
-    """
-    try:
-        point = np.asarray(raw, dtype=np.float64)
-    except (TypeError, ValueError):
-        return None
-    if point.shape != (3,) or not np.all(np.isfinite(point)) or np.any(np.abs(point) > WORLD_LIMIT_M):
-        return None
-    if not three_d:
-        point = point.copy()
-        point[1] = 0.0
-    return point
-
-
 # --------------------------------------------------------------------------------------------- geometry
 GIZMO_SCALE_M = 0.3
 """Length of the target's and obstacles' gizmo arrows (m): the person must see them to grab them."""
@@ -387,60 +369,30 @@ is a static pose.
         base = trimesh.creation.box(extents=(0.16, 0.16, 0.06))
         base.apply_translation((0.0, 0.0, -0.03))
         scene.add_mesh_simple(f"{root}/base", base.vertices, base.faces, color=(90, 95, 105))
-        self.grid = scene.add_grid(
-            f"{root}/plane",
-            width=4.0,
-            height=4.0,
-            plane="xz",
-            cell_size=0.25,
-            section_size=1.0,
-            plane_color=(235, 240, 250),
-            plane_opacity=0.25,
-        )
-        self.floor = scene.add_grid(
-            f"{root}/floor",
-            width=4.0,
-            height=4.0,
-            plane="xy",
-            cell_size=0.25,
-            section_size=1.0,
-            plane_color=(235, 240, 250),
-            plane_opacity=0.5,
-            visible=self.params.three_d,
-        )
+
+        def grid(name: str, plane: Literal["xz", "xy"], opacity: float, visible: bool) -> viser.GridHandle:
+            """A 4 m square grid of 0.25 m cells, in 1 m sections."""
+            return scene.add_grid(
+                f"{root}/{name}",
+                width=4.0,
+                height=4.0,
+                plane=plane,
+                cell_size=0.25,
+                section_size=1.0,
+                plane_color=(235, 240, 250),
+                plane_opacity=opacity,
+                visible=visible,
+            )
+
+        self.grid = grid("plane", "xz", 0.25, visible=True)
+        self.floor = grid("floor", "xy", 0.5, visible=self.params.three_d)
         cylinder, sphere = _unit_cylinder(), trimesh.creation.icosphere(subdivisions=2, radius=1.0)
-        identity = np.tile([1.0, 0.0, 0.0, 0.0], (MAX_LINKS, 1))
-        self.link_nodes = scene.add_batched_meshes_simple(
-            f"{root}/links",
-            vertices=cylinder.vertices.astype(np.float32),
-            faces=cylinder.faces.astype(np.uint32),
-            batched_wxyzs=identity,
-            batched_positions=np.zeros((MAX_LINKS, 3)),
-            batched_scales=np.zeros((MAX_LINKS, 3)),
-            batched_colors=(70, 110, 200),
-            lod="off",
+        self.link_nodes = add_instances(scene, f"{root}/links", cylinder, MAX_LINKS, (70, 110, 200))
+        self.joint_nodes = add_instances(
+            scene, f"{root}/joints", sphere, MAX_LINKS + 1, np.tile(np.array(REST_COLOUR, np.uint8), (MAX_LINKS + 1, 1))
         )
-        self.joint_nodes = scene.add_batched_meshes_simple(
-            f"{root}/joints",
-            vertices=sphere.vertices.astype(np.float32),
-            faces=sphere.faces.astype(np.uint32),
-            batched_wxyzs=np.tile([1.0, 0.0, 0.0, 0.0], (MAX_LINKS + 1, 1)),
-            batched_positions=np.zeros((MAX_LINKS + 1, 3)),
-            batched_scales=np.zeros((MAX_LINKS + 1, 3)),
-            batched_colors=np.tile(np.array(REST_COLOUR, np.uint8), (MAX_LINKS + 1, 1)),
-            lod="off",
-        )
-        self.ghost_links = scene.add_batched_meshes_simple(
-            f"{root}/ghost_links",
-            vertices=cylinder.vertices.astype(np.float32),
-            faces=cylinder.faces.astype(np.uint32),
-            batched_wxyzs=identity[:2],
-            batched_positions=np.zeros((2, 3)),
-            batched_scales=np.zeros((2, 3)),
-            batched_colors=GHOST_COLOUR,
-            opacity=0.35,
-            lod="off",
-            cast_shadow=False,
+        self.ghost_links = add_instances(
+            scene, f"{root}/ghost_links", cylinder, 2, GHOST_COLOUR, opacity=0.35, cast_shadow=False
         )
         self.ghost_elbow = scene.add_icosphere(
             f"{root}/ghost_elbow", radius=JOINT_RADIUS_M * 0.9, color=GHOST_COLOUR, opacity=0.45
@@ -509,16 +461,9 @@ is a static pose.
 
     def _apply_target(self) -> None:
         self.gizmo_events += self.messages_in_call
-        point = clean_point(self.target_gizmo.position, self.params.three_d)
-        if point is None:  # NaN, huge, wrong shape: keep the last good target and pose
-            self.target_gizmo.position = self.target
-            self.target_gizmo.wxyz = (1.0, 0.0, 0.0, 0.0)
-            return
-        if not np.array_equal(point, np.asarray(self.target_gizmo.position, dtype=np.float64)):
-            # A crafted y off the plane: draw the gizmo where the chain solves.
-            self.target_gizmo.position = point
-        if np.array_equal(point, self.target) and self.report is not None:
-            return  # a burst of updates: an earlier one already solved for this position
+        point = moved_gizmo(self.target_gizmo, self.target, not self.params.three_d, upright=True)
+        if point is None or (np.array_equal(point, self.target) and self.report is not None):
+            return  # unusable, or a burst of updates: an earlier one already solved for this position
         self.target = point
         self.solve_and_draw()
 
@@ -529,14 +474,8 @@ is a static pose.
 
     def _apply_obstacle(self, k: int) -> None:
         self.gizmo_events += self.messages_in_call
-        gizmo = self.obstacle_gizmos[k]
-        point = clean_point(gizmo.position, self.params.three_d)
-        if point is None:
-            gizmo.position = self.obstacle_centres[k]
-            return
-        if not np.array_equal(point, np.asarray(gizmo.position, dtype=np.float64)):
-            gizmo.position = point
-        if np.array_equal(point, self.obstacle_centres[k]):
+        point = moved_gizmo(self.obstacle_gizmos[k], self.obstacle_centres[k], not self.params.three_d)
+        if point is None or np.array_equal(point, self.obstacle_centres[k]):
             return
         self.obstacle_centres[k] = point
         self.solve_and_draw()
@@ -559,7 +498,7 @@ is a static pose.
         t = (plane_y - o[1]) / d[1]
         if t <= 0.0:
             return
-        point = clean_point(o + t * d, self.params.three_d)
+        point = clean_target(o + t * d, planar=not self.params.three_d)
         if point is None:
             return
         self.target = point

@@ -24,6 +24,7 @@ from scenes._base import Scene, set_if_changed
 from scenes._charts import FittedChart
 from scenes._controls import build_controls, declared
 from scenes._framing import ClientFraming, Lens, View
+from scenes._instances import add_instances
 from scenes._worker import LatestWorker
 from scenes.freekick.model import (
     DEFENDER_WIDTH_M,
@@ -163,10 +164,6 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
                             for name, colour in CHART_COLOURS.items()
                         ),
                     ),
-                    scales={
-                        "x": viser.uplot.Scale(time=False, auto=True),
-                        "y": viser.uplot.Scale(auto=True),
-                    },
                     legend=viser.uplot.Legend(show=True),
                     title="Force magnitudes along the flight",
                     aspect=1.6,
@@ -231,14 +228,13 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
         )
 
         defender = defender_mesh()
-        self.wall_nodes = scene.add_batched_meshes_simple(
+        self.wall_nodes = add_instances(
+            scene,
             f"{root}/wall",
-            vertices=defender.vertices.astype(np.float32),
-            faces=defender.faces.astype(np.uint32),
-            batched_wxyzs=np.tile([1.0, 0.0, 0.0, 0.0], (DEFENDERS, 1)),
-            batched_positions=np.zeros((DEFENDERS, 3)),
-            batched_colors=np.tile(np.array([30, 60, 170], np.uint8), (DEFENDERS, 1)),
-            lod="off",
+            defender,
+            DEFENDERS,
+            np.tile(np.array([30, 60, 170], np.uint8), (DEFENDERS, 1)),
+            scale=None,
         )
 
         self.ball_frame = scene.add_frame(f"{root}/ball", show_axes=False, position=tuple(ball_spot(self.params)))

@@ -13,6 +13,7 @@ import numpy as np
 import trimesh
 import viser
 
+from scenes._instances import add_instances
 from scenes.peloton.model import MAX_RIDERS, POSITIONS, Position
 
 JERSEYS = np.array(
@@ -123,16 +124,7 @@ def add_riders(
     origin and scaled by ``scale`` (0 hides them until they are placed)."""
     nodes: dict[str, viser.BatchedMeshHandle] = {}
     for part, mesh in rider_meshes(position).items():
-        nodes[part] = scene.add_batched_meshes_simple(
-            f"{prefix}_{part}",
-            vertices=mesh.vertices.astype(np.float32),
-            faces=mesh.faces.astype(np.uint32),
-            batched_wxyzs=np.tile([1.0, 0.0, 0.0, 0.0], (MAX_RIDERS, 1)),
-            batched_positions=np.zeros((MAX_RIDERS, 3)),
-            batched_scales=np.full((MAX_RIDERS, 3), scale),
-            batched_colors=RIDER_COLOURS[part],
-            lod="off",
-        )
+        nodes[part] = add_instances(scene, f"{prefix}_{part}", mesh, MAX_RIDERS, RIDER_COLOURS[part], scale=scale)
     return nodes
 
 

@@ -22,6 +22,7 @@ from scenes._base import Scene, set_if_changed
 from scenes._charts import FittedChart
 from scenes._controls import Controls, build_controls, declared
 from scenes._framing import ClientFraming, Lens, View, frame_points
+from scenes._instances import add_instances
 from scenes.peloton.course import CourseMode
 from scenes.peloton.meshes import add_riders, show_position
 from scenes.peloton.model import (
@@ -151,10 +152,6 @@ time-averaged power is the mean over positions, far below the leader's.
                             points=viser.uplot.Series_Points(show=False),
                         ),
                     ),
-                    scales={
-                        "x": viser.uplot.Scale(time=False, auto=True),
-                        "y": viser.uplot.Scale(auto=True),
-                    },
                     legend=viser.uplot.Legend(show=True),
                     title="Solo power vs speed (cube law)",
                     aspect=1.4,
@@ -195,23 +192,18 @@ time-averaged power is the mean over positions, far below the leader's.
             )
 
         self.riders_nodes = add_riders(scene, f"{self.course.name}/riders", self.params.position, 1.0)
-        identity = np.tile([1.0, 0.0, 0.0, 0.0], (MAX_RIDERS, 1))
-        zeros = np.zeros((MAX_RIDERS, 3))
         self._drawn_position = self.params.position
 
         unit_box = trimesh.creation.box(extents=(1.0, 1.0, 1.0))
         unit_box.apply_translation((0.0, 0.0, 0.5))  # grows upward from its base
         self.bars: dict[str, viser.BatchedMeshHandle] = {}
         for component, colour in COMPONENT_COLOURS.items():
-            self.bars[component] = scene.add_batched_meshes_simple(
+            self.bars[component] = add_instances(
+                scene,
                 f"{self.course.name}/bars_{component}",
-                vertices=unit_box.vertices.astype(np.float32),
-                faces=unit_box.faces.astype(np.uint32),
-                batched_wxyzs=identity,
-                batched_positions=zeros,
-                batched_scales=np.zeros((MAX_RIDERS, 3)),
-                batched_colors=np.tile(np.array(colour, np.uint8), (MAX_RIDERS, 1)),
-                lod="off",
+                unit_box,
+                MAX_RIDERS,
+                np.tile(np.array(colour, np.uint8), (MAX_RIDERS, 1)),
                 cast_shadow=False,
             )
         self.labels = [
