@@ -328,7 +328,6 @@ class Renderer:
             RGB (H, W, 3) uint8 (row 0 at the top) and depth along the view axis (H, W) float32 in metres, inf
             where a ray misses.
         """
-        import moderngl
 
         check_image_size(width, height)
         shading = shading or Shading()
@@ -341,11 +340,26 @@ class Renderer:
         )
         prog, vao = self._raymarch_program(variant)
         self._set_scene(prog, scene)
+        return self._march(prog, vao, camera, width, height, shading, _bounds_scissor(camera, scene, width, height))
+
+    def _march(
+        self,
+        prog: object,
+        vao: object,
+        camera: Camera,
+        width: int,
+        height: int,
+        shading: Shading,
+        scissor: tuple[int, int, int, int],
+    ) -> tuple[NDArray[np.uint8], NDArray[np.float32]]:
+        """Draw a ray-march program (its scene or field already set) into fresh targets and read them back; only
+        the pixels in ``scissor`` run the shader (llvmpipe pays for every pixel)."""
+        import moderngl
+
         self._set_camera(prog, camera, width, height, shading)
         fbo, color, depth = self._targets(width, height, shading)
         assert isinstance(fbo, moderngl.Framebuffer)
-        # Only pixels whose rays can meet a bounding box run the shader (llvmpipe pays for every pixel).
-        fbo.scissor = _bounds_scissor(camera, scene, width, height)
+        fbo.scissor = scissor
         self.ctx.disable(moderngl.DEPTH_TEST)
         vao.render(moderngl.TRIANGLES, vertices=3)  # pyright: ignore[reportAttributeAccessIssue]
         fbo.scissor = (0, 0, width, height)
@@ -598,7 +612,6 @@ class Renderer:
         Returns:
             RGB (H, W, 3) uint8 and depth along the view axis (H, W) float32 (m), inf where a ray misses.
         """
-        import moderngl
 
         check_image_size(width, height)
         check_source(source)
@@ -607,14 +620,7 @@ class Renderer:
         prog, vao = self._field_program(source, f"march:{int(shading.shadows)}:{int(shading.occlusion)}")
         self._set(prog, "u_field_lo", tuple(float(v) for v in box[0]))
         self._set(prog, "u_field_hi", tuple(float(v) for v in box[1]))
-        self._set_camera(prog, camera, width, height, shading)
-        fbo, color, depth = self._targets(width, height, shading)
-        assert isinstance(fbo, moderngl.Framebuffer)
-        fbo.scissor = _box_scissor(camera, box, width, height)
-        self.ctx.disable(moderngl.DEPTH_TEST)
-        vao.render(moderngl.TRIANGLES, vertices=3)  # pyright: ignore[reportAttributeAccessIssue]
-        fbo.scissor = (0, 0, width, height)
-        return self._read(color, depth, width, height)
+        return self._march(prog, vao, camera, width, height, shading, _box_scissor(camera, box, width, height))
 
 
 _local = threading.local()
