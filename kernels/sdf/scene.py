@@ -78,12 +78,10 @@ class Primitive:
         if self.op not in BOOLEAN_OPS:
             raise ValueError(f"op must be one of {BOOLEAN_OPS}, got {self.op!r}")
         center = _checks.vector("center", self.center, 3)
-        size = np.asarray(self.size, dtype=np.float64)
+        size = _checks.positive_array("size", self.size)
         count = primitive_spec(self.kind).size_count
         if size.shape != (count,):
             raise ValueError(f"size of a {self.kind} must have {count} values, got {size.shape}")
-        if not np.all(np.isfinite(size)) or np.any(size <= 0.0):
-            raise ValueError(f"size must be finite and positive, got {size.tolist()}")
         rotation = rotation_matrix(self.rotation)  # raises for a bad quaternion
         del rotation
         q = np.asarray(self.rotation, dtype=np.float64)
