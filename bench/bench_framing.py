@@ -14,8 +14,6 @@ from __future__ import annotations
 import math
 import statistics
 import sys
-import time
-from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -24,6 +22,7 @@ from numpy.typing import NDArray
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from bench._timing import p95, timings  # noqa: E402
 from scenes._framing import (  # noqa: E402
     FULL_NDC,
     NEAR_M,
@@ -36,21 +35,13 @@ from scenes._framing import (  # noqa: E402
 
 
 def baseline_frame_points(
-    points: NDArray[np.float64],
-    direction: tuple[float, float, float],
-    *,
-    fov_rad: float,
-    aspect: float,
-    ndc: tuple[float, float, float, float] = FULL_NDC,
-    min_depth: float = 0.0,
+    sight: Sight, ndc: tuple[float, float, float, float] = FULL_NDC, min_depth: float = 0.0
 ) -> View:
-    """``scenes._framing.frame_points`` as it was before the closed form (commit 3b41d9e), on the same
+    """``scenes._framing.frame_points`` as it was before the closed form (commit 3b41d9e), from the same
     :class:`~scenes._framing.Sight` of the points."""
-    pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
     x0, x1, y0, y1 = ndc
-    sight = Sight.of(pts, direction, fov_rad=fov_rad, aspect=aspect)
-    u, v, w, tan_x, tan_y = sight.u, sight.v, sight.w, sight.tan_x, sight.tan_y
-    depth_extent, size = sight.depth_extent, sight.size
+    u, v, w = sight.offsets
+    tan_x, tan_y, depth_extent, size = sight.tan_x, sight.tan_y, sight.depth_extent, sight.size
 
     def shift(coord: NDArray[np.float64], scale: NDArray[np.float64], lo: float, hi: float) -> float:
         reach = size + 1.0 + float(np.max(scale)) * (abs(lo) + abs(hi) + 1.0)
@@ -87,24 +78,8 @@ def baseline_frame_points(
     ok, sx, sy = fits(far)
     if not ok:
         if ndc != FULL_NDC:
-            return baseline_frame_points(
-                pts, direction, fov_rad=fov_rad, aspect=aspect, ndc=FULL_NDC, min_depth=min_depth
-            )
+            return baseline_frame_points(sight, FULL_NDC, min_depth)
     return sight.view(far, sx, sy)
-
-
-def per_call_ms(func: Callable[[], View], repeat: int) -> list[float]:
-    func()  # warm
-    out = []
-    for _ in range(repeat):
-        start = time.perf_counter()
-        func()
-        out.append(1e3 * (time.perf_counter() - start))
-    return out
-
-
-def p95(values: list[float]) -> float:
-    return float(np.percentile(values, 95))
 
 
 def main() -> None:
@@ -125,9 +100,9 @@ def main() -> None:
             return frame_points(pts, direction, fov_rad=lens.fov_rad, aspect=lens.aspect, ndc=ndc)
 
         def old(pts: NDArray[np.float64] = pts, ndc: tuple[float, float, float, float] = ndc) -> View:
-            return baseline_frame_points(pts, direction, fov_rad=lens.fov_rad, aspect=lens.aspect, ndc=ndc)
+            return baseline_frame_points(Sight.of(pts, direction, fov_rad=lens.fov_rad, aspect=lens.aspect), ndc)
 
-        fast, slow = per_call_ms(new, 2000), per_call_ms(old, 40)
+        fast, slow = timings(new, 2000, warmup=1, scale=1e3), timings(old, 40, warmup=1, scale=1e3)
         a, b = new(), old()
         diff = max(
             float(np.abs(np.subtract(a.position, b.position)).max()),

@@ -82,30 +82,24 @@ class Lens:
 @dataclasses.dataclass(frozen=True)
 class Sight:
     """Points as a camera looking along a direction sees them, about the centre of their bounding box: where
-    framing starts, whatever way it then finds the distance and the centring shifts."""
+    framing starts, whatever way it then finds the distance and the centring shifts.
+
+    Attributes:
+        centre: (3,) centre of the points' bounding box (m).
+        basis: (3,) unit vectors (forward, right, up): the view direction, its horizontal right and its up.
+        offsets: (N,) arrays (u, v, w), each point's offset from the centre along right, up and forward (m).
+        tan_x, tan_y: tangents of half the horizontal and half the vertical field of view.
+        depth_extent: largest |w| (m).
+        size: largest distance of a point from the centre (m).
+    """
 
     centre: NDArray[np.float64]
-    """(3,) centre of the points' bounding box (m)."""
-    forward: NDArray[np.float64]
-    """(3,) unit view direction."""
-    right: NDArray[np.float64]
-    """(3,) unit right of the view (horizontal)."""
-    up: NDArray[np.float64]
-    """(3,) unit up of the view."""
-    u: NDArray[np.float64]
-    """(N,) each point's offset from the centre along :attr:`right` (m)."""
-    v: NDArray[np.float64]
-    """(N,) along :attr:`up` (m)."""
-    w: NDArray[np.float64]
-    """(N,) along :attr:`forward` (m)."""
+    basis: tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]
+    offsets: tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]
     tan_x: float
-    """Tangent of half the horizontal field of view."""
     tan_y: float
-    """Tangent of half the vertical field of view."""
     depth_extent: float
-    """Largest |w| (m)."""
     size: float
-    """Largest distance of a point from the centre (m)."""
 
     @staticmethod
     def of(pts: NDArray[np.float64], direction: tuple[float, float, float], *, fov_rad: float, aspect: float) -> Sight:
@@ -121,12 +115,8 @@ class Sight:
         tan_y = math.tan(0.5 * fov_rad)
         return Sight(
             centre,
-            forward,
-            right,
-            up,
-            u=rel @ right,
-            v=rel @ up,
-            w=w,
+            (forward, right, up),
+            (rel @ right, rel @ up, w),
             tan_x=aspect * tan_y,
             tan_y=tan_y,
             depth_extent=float(np.max(np.abs(w))),
@@ -135,9 +125,10 @@ class Sight:
 
     def view(self, distance: float, sx: float, sy: float) -> View:
         """The camera ``distance`` (m) behind the centre shifted by ``sx`` right and ``sy`` up (m), looking along
-        :attr:`forward`; it orbits the shifted centre."""
-        look_at = self.centre + sx * self.right + sy * self.up
-        position = look_at - distance * self.forward
+        the view direction; it orbits the shifted centre."""
+        forward, right, up = self.basis
+        look_at = self.centre + sx * right + sy * up
+        position = look_at - distance * forward
         return View(
             position=(float(position[0]), float(position[1]), float(position[2])),
             look_at=(float(look_at[0]), float(look_at[1]), float(look_at[2])),
@@ -172,8 +163,8 @@ def frame_points(
     pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
     x0, x1, y0, y1 = ndc
     sight = Sight.of(pts, direction, fov_rad=fov_rad, aspect=aspect)
-    u, v, w, tan_x, tan_y = sight.u, sight.v, sight.w, sight.tan_x, sight.tan_y
-    depth_extent, size = sight.depth_extent, sight.size
+    u, v, w = sight.offsets
+    tan_x, tan_y, depth_extent, size = sight.tan_x, sight.tan_y, sight.depth_extent, sight.size
     least_depth = max(min_depth, NEAR_M) if math.isfinite(min_depth) else NEAR_M
     # The camera at distance D behind the centre sees point i at depth D + w_i and, shifted by s across the view, at
     # ndc (u_i − s)/((D + w_i)·tan_x) on x (likewise on y). Some s puts every point inside [lo, hi] iff
