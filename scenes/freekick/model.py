@@ -39,10 +39,10 @@ SPIN_AXIS_LABELS: dict[SpinAxis, str] = {
 }
 MODEL_LABELS: dict[ball.Model, str] = {
     "measured": "Measured C_D(Re, S), C_L(S)",
-    "constant": "Constant C_D = C_L = 0.25 (seed)",
+    "constant": "Constant C_D = C_L = 0.25 (textbook)",
 }
 Integrator = Literal["rk4", "euler"]
-INTEGRATOR_LABELS: dict[Integrator, str] = {"rk4": "RK4, 10 ms", "euler": "Euler, 1 ms (seed)"}
+INTEGRATOR_LABELS: dict[Integrator, str] = {"rk4": "RK4, 10 ms", "euler": "Euler, 1 ms (textbook)"}
 INTEGRATOR_STEP_S: dict[Integrator, float] = {"rk4": 1e-2, "euler": 1e-3}
 BAND_STEP_S = 2e-2
 """Step of the ±10 % spin band's flights (RK4): they are drawn, not measured, and must not slow a redraw."""
@@ -121,7 +121,7 @@ class FreeKickParams:
         default="measured",
         metadata=dropdown("Model", tuple(MODEL_LABELS), tuple(MODEL_LABELS.values()), folder="Physics"),
     )
-    """Coefficient model: the measured one, under which the spin rate changes the flight; the seed's constant one
+    """Coefficient model: the measured one, under which the spin rate changes the flight; the original brief's constant one
     curls every spinning kick alike."""
     integrator: Integrator = field(
         default="rk4",
@@ -135,8 +135,10 @@ class FreeKickParams:
     """Integrator and its step."""
     knuckle: bool = field(default=False, metadata=checkbox("Knuckleball", folder="Physics"))
     """Unsteady knuckleball side force (only acts with near-zero spin)."""
-    knuckle_seed: int = field(default=1, metadata=number("Knuckle seed", 0, 9999, 1, folder="Physics", disabled=True))
-    """Seed of the knuckleball's side force: the same seed, the same flight. Greyed out without the knuckleball."""
+    knuckle_seed: int = field(
+        default=1, metadata=number("Knuckle random draw", 0, 9999, 1, folder="Physics", disabled=True)
+    )
+    """Random draw of the knuckleball's side force: the same number, the same flight. Greyed out without the knuckleball."""
     wall_jumps: bool = field(default=False, metadata=checkbox("Wall jumps", folder="Physics"))
     """Whether the wall jumps (its top rises by 0.35 m)."""
     show_forces: bool = field(default=True, metadata=checkbox("Force arrows", folder="Physics"))

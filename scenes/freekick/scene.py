@@ -94,16 +94,16 @@ outcome map colours each launch speed × spin rate by result: goal (green), wall
 short (grey); the white cross is the current kick.
 
 **Equations** (A = πr², ω̂ = ω/|ω|): F_drag = −½ρA·C_D·|v|·v, F_Magnus = ½ρA·C_L·|v|·(ω̂ × v), F_g = −m·g·ẑ;
-m = 0.43 kg, r = 0.11 m, ρ = 1.225 kg/m³. The seed's Magnus formula (C_L·ρπr²·|v×ω|/|ω|) is not a force; this form
+m = 0.43 kg, r = 0.11 m, ρ = 1.225 kg/m³. The original brief's Magnus formula (C_L·ρπr²·|v×ω|/|ω|) is not a force; this form
 keeps its direction and gives its 3–5 m of curl over 25 m.
 
 **Models.** *Constant*: C_D = C_L = 0.25; the curl radius is then 2m/(ρA·C_L) ≈ 74 m whatever the spin rate, so the
 spin rate changes nothing but the direction. *Measured*: C_L = 0.9·S (S = r|ω|/|v|, up to S = 0.3; Asai et al.
 2007), C_D from Goff & Carré 2010 (drag crisis near Re 2–3·10⁵, 0.4127·S^0.3056 when spinning): 10 % more spin
 visibly moves the ball. *Knuckleball*: with almost no spin, an unsteady side force zig-zags the ball by about a
-diameter per ~15 m (Cohen, Texier, Quéré & Clanet 2012; Texier et al. 2016), drawn from a seed.
+diameter per ~15 m (Cohen, Texier, Quéré & Clanet 2012; Texier et al. 2016), drawn from a random draw number (the same number, the same flight).
 
-**Integrators.** RK4 at 10 ms is within a micrometre of a DOP853 reference over 30 m; the seed's Euler at 1 ms is
+**Integrators.** RK4 at 10 ms is within a micrometre of a DOP853 reference over 30 m; the original brief's Euler at 1 ms is
 off by about 1.4 cm, not "within a centimetre".
 
 **Assumptions.** Constant spin, still air, no bounce: the flight ends when the ball touches the turf; posts, bar and

@@ -560,9 +560,9 @@ class CourseMode:
                 f"  \nPacing by grade (±{p.pacing_gain_pct:.0f} %): {format_duration(state.constant.time_s)} at constant "
                 f"power → {format_duration(ride.time_s)}, **{saved:.0f} s {'saved' if saved >= 0 else 'lost'}** at the same average power"
             )
-        which = "weather" if p.air == "weather" else "seed"
+        which = "weather" if p.air == "weather" else "exponential-atmosphere"
         text += (
-            f"  \nAir at the start ({state.route.elevation_m[0]:.0f} m): seed (exponential) **{state.density_seed:.3f}** kg/m³, "
+            f"  \nAir at the start ({state.route.elevation_m[0]:.0f} m): exponential atmosphere **{state.density_seed:.3f}** kg/m³, "
             f"weather **{state.density_weather:.3f}** kg/m³; riding in the {which} air"
         )
         if ride.brakes_j > 0.0:

@@ -22,16 +22,16 @@ from kernels import cycling
 from scenes._controls import checkbox, dropdown, number, slider
 from scenes.peloton.model import PelotonParams, group_cda
 
-CourseAirLabel = Literal["Seed (exponential)", "Weather (temperature, pressure or altitude, humidity)"]
+CourseAirLabel = Literal["Exponential atmosphere (textbook)", "Weather (temperature, pressure or altitude, humidity)"]
 AIR_FROM_LABEL: dict[str, course_kernel.AirKind] = {
-    "Seed (exponential)": "seed",
+    "Exponential atmosphere (textbook)": "seed",
     "Weather (temperature, pressure or altitude, humidity)": "weather",
 }
 PRESSURE_SOURCES = ("Standard atmosphere at the route's altitude", "Barometer at the start (hPa)")
 """What the "Pressure from" dropdown shows for :attr:`CourseParams.pressure_from_barometer` False and True."""
 POWER_MODEL_FROM_LABEL: dict[str, course_kernel.Model] = {
     "Martin et al. 1998 (full)": "martin",
-    "Seed (aero, rolling, climbing)": "seed",
+    "Textbook (aero, rolling, climbing)": "seed",
 }
 COURSE_POWER_RANGE_W = (20.0, 2000.0)
 """What the Course power input takes (W); 'Find the power for this time' says when a target needs more or less."""
@@ -78,12 +78,12 @@ class CourseParams:
             folder=POWER_FOLDER,
         ),
     )
-    """Power model: Martin et al. 1998's full terms or the seed's three."""
+    """Power model: Martin et al. 1998's full terms or the textbook three."""
     air: course_kernel.AirKind = field(
         default="seed",
         metadata=dropdown("Air", tuple(AIR_FROM_LABEL.values()), tuple(AIR_FROM_LABEL), folder=POWER_FOLDER),
     )
-    """Air along the route: the seed's exponential atmosphere or a weather reading."""
+    """Air along the route: the textbook exponential atmosphere or a weather reading."""
     temperature_c: float = field(
         default=15.0, metadata=slider("Temperature (°C)", -20.0, 45.0, 0.5, folder=POWER_FOLDER)
     )
@@ -139,7 +139,7 @@ class CourseState:
     group_cda_m2: float
     """CdA the group rides at when riders share the front equally (m²)."""
     density_seed: float
-    """The seed's density at the start (kg/m³)."""
+    """The exponential atmosphere's density at the start (kg/m³)."""
     density_weather: float
     """The weather reading's density at the start (kg/m³)."""
 

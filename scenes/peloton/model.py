@@ -32,7 +32,7 @@ Position = Literal["upright", "hoods", "drops", "tt", "hour"]
 class RidingPosition:
     label: str
     cda_m2: float
-    """Typical drag area for the position (seed's table; hour record from Bigham 2022)."""
+    """Typical drag area for the position (the original brief's table; hour record from Bigham 2022)."""
     torso_deg: float
     """Torso angle above horizontal, for the drawing."""
     hands: tuple[float, float, float]
@@ -55,9 +55,9 @@ CRR_PRESETS: dict[str, float] = {
     "Gravel tyre (0.0080)": 0.0080,
     "Mountain bike, knobbly (0.0120)": 0.0120,
 }
-DraftModelLabel = Literal["Seed formula", "Measured (by position)"]
+DraftModelLabel = Literal["Textbook formula (exponential fade)", "Measured (by position)"]
 MODEL_FROM_LABEL: dict[str, cycling.DraftModel] = {
-    "Seed formula": "seed",
+    "Textbook formula (exponential fade)": "seed",
     "Measured (by position)": "measured",
 }
 
@@ -110,7 +110,7 @@ class PelotonParams:
             folder="Drafting",
         ),
     )
-    """Drafting model: the seed's formula or the position-dependent fit to measurements."""
+    """Drafting model: the textbook formula or the position-dependent fit to measurements."""
     rotate: bool = field(default=False, metadata=checkbox("Rotate the lead", folder="Drafting"))
     """Whether the lead rotates: every turn the leader swings off and drops to the back."""
     turn_s: float = field(default=6.0, metadata=slider("Turn at the front (s)", 2.0, 30.0, 1.0, folder="Drafting"))

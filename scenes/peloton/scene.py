@@ -81,13 +81,13 @@ rolling resistance and climbing; riders behind draft. The bars above the riders 
 P_aero = ½ρ·CdA·(v+w)|v+w|·v, P_roll = Crr·m·g·cos θ·v, P_climb = m·g·sin θ·v,
 P = (P_aero + P_roll + P_climb)/η, ρ = 1.225·exp(−h/8500).
 
-**Drafting.** *Seed formula*: CdA·(1 − 0.27·exp(−gap/3.5)) for every follower (27 % at 0 m, 6.5 % at 5 m; the
-seed's prose overstates it). *Measured*: position-dependent, fitted to team-pursuit measurements (Barry et al. 2015;
+**Drafting.** *Textbook formula*: CdA·(1 − 0.27·exp(−gap/3.5)) for every follower (27 % at 0 m, 6.5 % at 5 m; the
+original brief's prose overstates it). *Measured*: position-dependent, fitted to team-pursuit measurements (Barry et al. 2015;
 Fitton et al. 2018; Broker, Kyle & Burke 1999), fading with gap as Swiss Side's CFD does; the leader gains ~3 %
 from the rider behind (Blocken et al. 2013).
 
 **Assumptions.** Steady speed, no bearing or wheel-rotation losses, CdA independent of yaw; the exponential
-atmosphere is the seed's (ISA gives ρ about 4 % higher at 2000 m).
+atmosphere is the textbook one (ISA gives ρ about 4 % higher at 2000 m).
 
 **Rotate the lead** animates a paceline: every turn the leader swings off and drops to the back, so each rider's
 time-averaged power is the mean over positions, far below the leader's.

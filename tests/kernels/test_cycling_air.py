@@ -42,7 +42,7 @@ def test_isa_temperature_at_the_tropopause_and_above() -> None:
 
 
 def test_the_issue_figures_at_2500_m() -> None:
-    """The issue: the seed's exponential gives 0.913 kg/m³ at 2 500 m where the standard atmosphere gives 0.957."""
+    """The textbook exponential gives 0.913 kg/m³ at 2 500 m where the standard atmosphere gives 0.957."""
     assert float(cycling.air_density(2500.0)) == pytest.approx(0.913, abs=5e-4)
     isa = cycling.air_density_weather(cycling.isa_temperature_c(2500.0), cycling.isa_pressure_hpa(2500.0))
     assert float(isa) == pytest.approx(0.957, abs=5e-4)

@@ -93,7 +93,7 @@ def test_model_and_air_choices_change_the_ride_and_the_readout_shows_both_densit
 ) -> None:
     assert mode.state is not None
     martin = mode.state.ride.time_s
-    mode.controls["model"].value = "Seed (aero, rolling, climbing)"
+    mode.controls["model"].value = "Textbook (aero, rolling, climbing)"
     assert mode.params.model == "seed" and mode.state.ride.time_s < martin  # no bearings, no spokes
     mode.controls["air"].value = "Weather (temperature, pressure or altitude, humidity)"
     mode.controls["temperature_c"].value = 30.0
@@ -102,7 +102,7 @@ def test_model_and_air_choices_change_the_ride_and_the_readout_shows_both_densit
     expected = float(cycling.air_density_weather(30.0, cycling.isa_pressure_hpa(start), 0.8))
     assert mode.state.density_weather == pytest.approx(expected, rel=1e-12)
     assert f"weather **{expected:.3f}**" in mode.readout.content
-    assert f"seed (exponential) **{float(cycling.air_density(start)):.3f}**" in mode.readout.content
+    assert f"exponential atmosphere **{float(cycling.air_density(start)):.3f}**" in mode.readout.content
     np.testing.assert_allclose(mode.state.ride.air_density[0], expected, rtol=1e-3)
     # A barometer reading replaces the standard atmosphere's pressure.
     mode.controls["pressure_from_barometer"].value = "Barometer at the start (hPa)"
@@ -354,8 +354,8 @@ def test_find_the_power_says_when_the_target_is_out_of_the_inputs_range(mode: Co
 def test_the_readout_names_the_model_by_its_label_and_explains_coasting(mode: CourseMode) -> None:
     assert "(Martin et al. 1998 (full))" in mode.readout.content
     assert "martin model" not in mode.readout.content
-    mode.controls["model"].value = "Seed (aero, rolling, climbing)"
-    assert "(Seed (aero, rolling, climbing))" in mode.readout.content
+    mode.controls["model"].value = "Textbook (aero, rolling, climbing)"
+    assert "(Textbook (aero, rolling, climbing))" in mode.readout.content
     # 2 km at −20 %: 250 W would go far past the 72 km/h cap, so the riders coast and brake.
     down = [(45.0 + i * 1e-4, 6.0, 1000.0 - 0.2 * 11.1195 * i) for i in range(180)]
     assert mode.load(gpx_text(down).encode(), "down.gpx")

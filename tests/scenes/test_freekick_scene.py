@@ -117,7 +117,7 @@ def test_opening_state_is_the_kernels_curler(scene: FreeKickScene) -> None:
 
 def test_spin_changes_path_band_and_outcome_with_the_measured_model(scene: FreeKickScene) -> None:
     assert scene.params.model == "measured"  # the scene opens on the model under which spin matters
-    scene.controls["model"].value = "Constant C_D = C_L = 0.25 (seed)"
+    scene.controls["model"].value = "Constant C_D = C_L = 0.25 (textbook)"
     band = np.asarray(scene.band.vertices)
     assert np.allclose(band[0::2], band[1::2], atol=1e-5)  # constant model: ±10 % spin flies the same path
     scene.controls["model"].value = "Measured C_D(Re, S), C_L(S)"
@@ -151,9 +151,9 @@ def _kernel_flight(
 
 @pytest.mark.parametrize(
     ("integrator", "method", "dt"),
-    [("RK4, 10 ms", "rk4", 1e-2), ("Euler, 1 ms (seed)", "euler", 1e-3)],
+    [("RK4, 10 ms", "rk4", 1e-2), ("Euler, 1 ms (textbook)", "euler", 1e-3)],
 )
-@pytest.mark.parametrize("model_label", ["Constant C_D = C_L = 0.25 (seed)", "Measured C_D(Re, S), C_L(S)"])
+@pytest.mark.parametrize("model_label", ["Constant C_D = C_L = 0.25 (textbook)", "Measured C_D(Re, S), C_L(S)"])
 def test_drawn_path_ghost_and_band_are_the_kernels_flights(
     scene: FreeKickScene, integrator: str, method: ball.Method, dt: float, model_label: str
 ) -> None:
@@ -254,7 +254,7 @@ def test_a_click_ray_through_the_goal_mouth_aims_there(scene: FreeKickScene) -> 
 
 
 def test_outcome_map_matches_single_runs(scene: FreeKickScene) -> None:
-    scene.controls["model"].value = "Constant C_D = C_L = 0.25 (seed)"
+    scene.controls["model"].value = "Constant C_D = C_L = 0.25 (textbook)"
     assert scene.wait_idle()
     results = scene.map_results
     assert results is not None and results.shape == (len(MAP_SPINS_REV_S), len(MAP_SPEEDS_MS))
@@ -343,7 +343,7 @@ CRAFTED = [
     ("Spin axis", "sideways-ish", "spin_axis", "left"),
     ("Model", "magic", "model", "measured"),
     ("Integrator", "leapfrog", "integrator", "rk4"),
-    ("Knuckle seed", -7, "knuckle_seed", 0),
+    ("Knuckle random draw", -7, "knuckle_seed", 0),
 ]
 
 
@@ -384,7 +384,7 @@ def test_wrong_types_and_crafted_clicks_leave_the_scene_serving(
         client.wait_for_gui("Spin rate (rev/s)")
         client.set_value("Spin rate (rev/s)", "fast")
         client.set_value("Knuckleball", "yes please")
-        client.set_value("Knuckle seed", float("nan"))  # viser's own int cast refuses it before the scene
+        client.set_value("Knuckle random draw", float("nan"))  # viser's own int cast refuses it before the scene
         client.send(
             "SceneNodeClickMessage",
             name="/freekick/goal_mouth",
