@@ -560,10 +560,10 @@ class CourseMode:
                 f"  \nPacing by grade (±{p.pacing_gain_pct:.0f} %): {format_duration(state.constant.time_s)} at constant "
                 f"power → {format_duration(ride.time_s)}, **{saved:.0f} s {'saved' if saved >= 0 else 'lost'}** at the same average power"
             )
-        which = "weather" if p.air == "weather" else "exponential-atmosphere"
+        which = "the weather's air" if p.air == "weather" else "the exponential atmosphere"
         text += (
             f"  \nAir at the start ({state.route.elevation_m[0]:.0f} m): exponential atmosphere **{state.density_seed:.3f}** kg/m³, "
-            f"weather **{state.density_weather:.3f}** kg/m³; riding in the {which} air"
+            f"weather **{state.density_weather:.3f}** kg/m³; riding in {which}"
         )
         if ride.brakes_j > 0.0:
             text += f"  \nBraking to hold {p.max_speed_kmh:.0f} km/h took {ride.brakes_j / 1000:.0f} kJ"
