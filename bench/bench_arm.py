@@ -167,6 +167,18 @@ def paper_setup(runs: int, seed: int, baseline_runs: int) -> dict[str, float]:
     return {"paper_mean_us": rows["fabrik"][1], "paper_ratio": base_s * 1e6 / rows["fabrik"][1]}
 
 
+def drag_row(label: str, times: list[float], iterations: list[int], statuses: list[str]) -> float:
+    """Print one drag's table row (times in s) and return its p95 (µs)."""
+    us = np.array(times) * 1e6
+    names, counts = np.unique(statuses, return_counts=True)
+    mix = ", ".join(f"{name} {count}" for name, count in zip(names, counts, strict=True))
+    print(
+        f"| {label} | {np.median(us):.1f} | {np.percentile(us, 95):.1f} | {us.max():.1f} | "
+        f"{np.mean(iterations):.1f} | {np.percentile(iterations, 95):.0f} | {mix} |"
+    )
+    return float(np.percentile(us, 95))
+
+
 def drag_latency(frames: int, baseline_frames: int) -> dict[str, float]:
     kwargs = {"cone_half_angle_rad": LIMITS, "obstacles": OBSTACLES}
     print(
@@ -186,14 +198,7 @@ def drag_latency(frames: int, baseline_frames: int) -> dict[str, float]:
             times.append(elapsed)
             iterations.append(result.iterations)
             statuses.append(result.status)
-        us = np.array(times) * 1e6
-        names, counts = np.unique(statuses, return_counts=True)
-        mix = ", ".join(f"{name} {count}" for name, count in zip(names, counts, strict=True))
-        print(
-            f"| {label} | {np.median(us):.1f} | {np.percentile(us, 95):.1f} | {us.max():.1f} | "
-            f"{np.mean(iterations):.1f} | {np.percentile(iterations, 95):.0f} | {mix} |"
-        )
-        figures.setdefault("drag_p95_us", float(np.percentile(us, 95)))
+        figures.setdefault("drag_p95_us", drag_row(label, times, iterations, statuses))
     # The baseline follows the same drag with the same limits (it knows no obstacles).
     pose, times = arc_chain(12, 0.1), []
     for target in drag_targets(frames)[:baseline_frames]:
@@ -335,14 +340,7 @@ def skeletons(frames: int) -> dict[str, float]:
             times.append(elapsed)
             iterations.append(result.iterations)
             statuses.extend(result.status)
-        us = np.array(times) * 1e6
-        names, counts = np.unique(statuses, return_counts=True)
-        mix = ", ".join(f"{name} {count}" for name, count in zip(names, counts, strict=True))
-        print(
-            f"| {label} | {np.median(us):.1f} | {np.percentile(us, 95):.1f} | {us.max():.1f} | "
-            f"{np.mean(iterations):.1f} | {np.percentile(iterations, 95):.0f} | {mix} |"
-        )
-        figures[label.split(":")[0].split(",")[0]] = float(np.percentile(us, 95))
+        figures[label.split(":")[0].split(",")[0]] = drag_row(label, times, iterations, statuses)
     return figures
 
 

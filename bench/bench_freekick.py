@@ -46,6 +46,7 @@ sys.path.insert(0, str(ROOT))
 import numba  # noqa: E402
 import viser  # noqa: E402
 
+from bench._timing import row, time_handling, timings  # noqa: E402
 from kernels import ball  # noqa: E402
 from kernels.ball.config import N_STEPS  # noqa: E402
 from kernels.ball.core import simulate_one  # noqa: E402
@@ -61,20 +62,6 @@ SPIN = ball.spin_vector(9.0, (0.0, 0.0, 1.0))
 LINE_M = 30.0
 MAP_SPEEDS = np.linspace(15.0, 35.0, 41)
 MAP_SPINS = np.linspace(0.0, 15.0, 31)
-
-
-def timings(func: Callable[[], object], repeat: int) -> list[float]:
-    out = []
-    for _ in range(repeat):
-        start = time.perf_counter()
-        func()
-        out.append(time.perf_counter() - start)
-    return out
-
-
-def row(name: str, values: list[float], unit: float, unit_name: str, note: str = "") -> None:
-    median, p95 = statistics.median(values) / unit, float(np.percentile(values, 95)) / unit
-    print(f"| {name:<46} | {median:>10.3f} | {p95:>10.3f} | {unit_name:<4} | {note}")
 
 
 def scipy_flight(method: str, rtol: float, atol: float) -> NDArray[np.float64]:
@@ -151,17 +138,7 @@ def scene_rows() -> None:
     scene = switcher.scene
     assert isinstance(scene, FreeKickScene)
     scene.wait_idle()
-    handling: list[float] = []
-    inner = scene.apply_inputs
-
-    def timed_on_input() -> None:
-        start = time.perf_counter()
-        inner()
-        handling.append(time.perf_counter() - start)
-
-    for slider in (scene.controls["spin_rev_s"], scene.controls["speed_ms"]):
-        slider.remove_update_callback()
-        slider.on_update(scene.callback(timed_on_input))
+    handling = time_handling(scene, ("spin_rev_s", "speed_ms"))
 
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("Spin rate (rev/s)")
@@ -188,7 +165,7 @@ def scene_rows() -> None:
             round_trips.append(time.perf_counter() - start)
             time.sleep(0.02)
         measured = handling[len(constant) :]
-        scene.controls["integrator"].value = "Euler, 1 ms (seed)"
+        scene.controls["integrator"].value = "Euler, 1 ms (textbook)"
         scene.wait_idle()
         for i in range(120):
             done = len(handling)
@@ -256,6 +233,18 @@ def numpy_acceleration(v: NDArray[np.float64], axis: NDArray[np.float64]) -> NDA
     return a
 
 
+def numpy_rk4_step(
+    p: NDArray[np.float64], v: NDArray[np.float64], axis: NDArray[np.float64], dt: float
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """One classical RK4 step of positions and velocities (..., 3) over ``dt`` (s), plain numpy."""
+    k1 = numpy_acceleration(v, axis)
+    k2 = numpy_acceleration(v + 0.5 * dt * k1, axis)
+    k3 = numpy_acceleration(v + 0.5 * dt * k2, axis)
+    k4 = numpy_acceleration(v + dt * k3, axis)
+    p_next = p + dt / 6 * (v + 2 * (v + 0.5 * dt * k1) + 2 * (v + 0.5 * dt * k2) + (v + dt * k3))
+    return p_next, v + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+
+
 def numpy_flight(method: str, dt: float, x_stop: float) -> NDArray[np.float64]:
     """The curler in plain numpy, one 3-vector step at a time, until it passes x_stop or lands: (N, 6) states."""
     axis = SPIN / np.linalg.norm(SPIN)
@@ -266,12 +255,7 @@ def numpy_flight(method: str, dt: float, x_stop: float) -> NDArray[np.float64]:
             v = v + dt * numpy_acceleration(v, axis)
             p = p + dt * v
         else:
-            k1 = numpy_acceleration(v, axis)
-            k2 = numpy_acceleration(v + 0.5 * dt * k1, axis)
-            k3 = numpy_acceleration(v + 0.5 * dt * k2, axis)
-            k4 = numpy_acceleration(v + dt * k3, axis)
-            p = p + dt / 6 * (v + 2 * (v + 0.5 * dt * k1) + 2 * (v + 0.5 * dt * k2) + (v + dt * k3))
-            v = v + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+            p, v = numpy_rk4_step(p, v, axis, dt)
         states.append(np.concatenate((p, v)))
         if p[2] <= 0.0 or p[0] >= x_stop:
             break
@@ -293,12 +277,7 @@ def numpy_batch(
     n = np.ones(len(p), dtype=np.int64)
     frames = [np.concatenate((p, v), axis=1)]
     for _ in range(400):
-        k1 = numpy_acceleration(v, axis)
-        k2 = numpy_acceleration(v + 0.5 * dt * k1, axis)
-        k3 = numpy_acceleration(v + 0.5 * dt * k2, axis)
-        k4 = numpy_acceleration(v + dt * k3, axis)
-        p_new = p + dt / 6 * (v + 2 * (v + 0.5 * dt * k1) + 2 * (v + 0.5 * dt * k2) + (v + dt * k3))
-        v_new = v + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+        p_new, v_new = numpy_rk4_step(p, v, axis, dt)
         p = np.where(flying[:, None], p_new, p)
         v = np.where(flying[:, None], v_new, v)
         n += flying

@@ -16,7 +16,6 @@ import os
 import statistics
 import sys
 import time
-from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -28,22 +27,11 @@ sys.path.insert(0, str(ROOT / "tests"))
 import viser  # noqa: E402
 from helpers.wsclient import BrowserClient  # noqa: E402
 
+from bench._timing import row as timing_row  # noqa: E402
+from bench._timing import time_handling, timings  # noqa: E402
 from kernels import course, cycling  # noqa: E402
 from scenes.peloton import PelotonScene  # noqa: E402
 from server.switcher import SceneSwitcher  # noqa: E402
-
-
-def timings(func: Callable[[], object], repeat: int) -> list[float]:
-    out = []
-    for _ in range(repeat):
-        start = time.perf_counter()
-        func()
-        out.append(time.perf_counter() - start)
-    return out
-
-
-def p95(values: list[float]) -> float:
-    return float(np.percentile(values, 95))
 
 
 def python_loop_power(speeds: list[float]) -> list[float]:
@@ -56,9 +44,7 @@ def python_loop_power(speeds: list[float]) -> list[float]:
 
 
 def row(name: str, values: list[float], unit: float, unit_name: str, note: str = "") -> None:
-    print(
-        f"| {name:<44} | {statistics.median(values) / unit:>10.3f} | {p95(values) / unit:>10.3f} | {unit_name:<4} | {note}"
-    )
+    timing_row(name, values, unit, unit_name, note, width=44)
 
 
 def hundred_km() -> course.Course:
@@ -135,17 +121,7 @@ def main() -> None:
     switcher = SceneSwitcher(server, "peloton")
     scene = switcher.scene
     assert isinstance(scene, PelotonScene)
-    handling: list[float] = []
-    inner = scene.apply_inputs
-
-    def timed_on_input() -> None:
-        start = time.perf_counter()
-        inner()
-        handling.append(time.perf_counter() - start)
-
-    speed = scene.controls["speed_kmh"]
-    speed.remove_update_callback()
-    speed.on_update(scene.callback(timed_on_input))
+    handling = time_handling(scene, ("speed_kmh",))
 
     round_trips: list[float] = []
     with BrowserClient(server.get_port()) as client:

@@ -42,6 +42,7 @@ sys.path.insert(0, str(ROOT / "tests"))
 import viser  # noqa: E402
 from helpers.wsclient import BrowserClient  # noqa: E402
 
+from bench._timing import p95, timings  # noqa: E402
 from kernels import sdf  # noqa: E402
 from scenes.sdf_gallery import EXAMPLES, SdfGalleryScene  # noqa: E402
 from shaders import gl_service  # noqa: E402
@@ -50,18 +51,7 @@ from shaders.renderer import Camera, GLUnavailableError, Renderer, Shading  # no
 
 
 def times_ms(call: Callable[[], object], repeats: int, warmup: int = 1) -> list[float]:
-    for _ in range(warmup):
-        call()
-    out = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        call()
-        out.append(1e3 * (time.perf_counter() - start))
-    return out
-
-
-def p95(values: list[float]) -> float:
-    return float(np.percentile(values, 95))
+    return timings(call, repeats, warmup=warmup, scale=1e3)
 
 
 def cube_bounds(scene: sdf.Scene) -> np.ndarray:
