@@ -25,7 +25,7 @@ from helpers.browser import (
     error_text,
     open_viser,
     project,
-    save_docs_screenshot,
+    save_scene_screenshot,
     scene_page,
     screen_of,
     screenshot,
@@ -74,7 +74,7 @@ def test_the_chain_is_in_view_clear_of_the_panel(shown: ScenePage) -> None:
     ys, xs = np.nonzero(gizmo & ~disc)
     beyond = np.hypot(xs - centre[0], ys - centre[1]) > rim_px + 3
     assert beyond.sum() > 30, f"gizmo hidden in its obstacle ({beyond.sum()} px outside the rim)"
-    save_docs_screenshot(shown, "arm")
+    save_scene_screenshot(shown, "arm")
 
 
 def test_the_error_plot_draws_and_its_top_label_fits(shown: ScenePage) -> None:

@@ -27,7 +27,7 @@ from helpers.browser import (
     open_viser,
     panel_rect,
     project,
-    save_docs_screenshot,
+    save_scene_screenshot,
     scene_page,
     screenshot,
     set_number,
@@ -114,7 +114,7 @@ def test_the_kick_fills_the_view_clear_of_the_panel(shown: ScenePage) -> None:
     ghost_xy = project(shown.page, "/freekick", ghost)[:, :2]
     gap = polyline_gap(path_xy, ghost_xy)
     assert np.mean(gap >= OPENING_GAP_PX) >= 0.9, np.round(gap)
-    save_docs_screenshot(shown, "freekick")
+    save_scene_screenshot(shown, "freekick")
 
 
 def test_the_force_chart_draws_every_series(shown: ScenePage) -> None:

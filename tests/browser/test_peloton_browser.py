@@ -25,7 +25,7 @@ from helpers.browser import (
     error_text,
     open_viser,
     panel_rect,
-    save_docs_screenshot,
+    save_scene_screenshot,
     scene_page,
     screenshot,
     set_number,
@@ -97,7 +97,7 @@ def _look_at_the_line(shown: ScenePage) -> None:
 
 def test_the_line_is_in_view_clear_of_the_panel(shown: ScenePage) -> None:
     _look_at_the_line(shown)
-    save_docs_screenshot(shown, "peloton")
+    save_scene_screenshot(shown, "peloton")
 
 
 def test_the_chart_draws_every_curve(shown: ScenePage) -> None:

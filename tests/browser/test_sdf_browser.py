@@ -18,7 +18,7 @@ from helpers.browser import (
     error_text,
     node_box_corners,
     open_viser,
-    save_docs_screenshot,
+    save_scene_screenshot,
     scene_page,
     screenshot,
 )
@@ -46,7 +46,7 @@ def test_the_mesh_is_in_view_clear_of_the_panel(shown: ScenePage) -> None:
     xy = assert_in_view(shown, MESH, corners, "the mesh's bounding box")
     assert_seen(shown, image, [MESH], xy, "the mesh")
     assert error_text(shown.page) == []
-    save_docs_screenshot(shown, "sdf")
+    save_scene_screenshot(shown, "sdf")
 
 
 READ_IMAGE = """

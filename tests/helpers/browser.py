@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from helpers.paths import DOCS
+from helpers.paths import SCREENSHOTS
 from helpers.waiting import wait_until
 
 VIEWPORTS: tuple[tuple[int, int], ...] = ((1600, 1000), (1280, 720))
@@ -391,11 +391,12 @@ def assert_chart_draws(page: Any, title: str, colours: dict[str, Sequence[int]],
     assert not missing, f"chart {title!r}: series not drawn {missing} (all: {counts})"
 
 
-def save_docs_screenshot(shown: ScenePage, key: str) -> None:
-    """At 1600×1000, write the README's screenshot of scene ``key`` to docs/ from this very page."""
+def save_scene_screenshot(shown: ScenePage, key: str) -> None:
+    """At 1600×1000, save the picture of scene ``key`` from this very page to :data:`helpers.paths.SCREENSHOTS`."""
     if shown.viewport != (1600, 1000):
         return
-    screenshot(shown.page, path=str(DOCS / f"{key}.png"))
+    SCREENSHOTS.mkdir(parents=True, exist_ok=True)
+    screenshot(shown.page, path=str(SCREENSHOTS / f"{key}.png"))
 
 
 # ------------------------------------------------------------------------------------- chart tick labels
