@@ -336,7 +336,8 @@ is a static pose.
     def _build_gui(self) -> None:
         gui, p = self.server.gui, self.params
         with self.gui_root:
-            skeleton = build_controls(gui, p, names=("preset",))  # first: the panel opens with the menu on top
+            skeleton = build_controls(gui, p, names=("preset",))
+            skeleton.folders["Skeleton"].order = -1  # above About: the panel opens with the preset menu on top
             with gui.add_folder("This frame"):
                 self.readout = gui.add_markdown("")
                 self.ghost_readout = gui.add_markdown("")

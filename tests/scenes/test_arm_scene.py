@@ -326,3 +326,17 @@ def test_moving_the_target_out_of_the_framed_box_frames_again(scene: ArmScene) -
         scene.solve_and_draw()
         scene._reframe_if_outgrown()
         assert calls == [1]
+
+
+def test_the_panel_opens_with_the_skeleton_menu_above_about(server: viser.ViserServer, scene: ArmScene) -> None:
+    """The preset menu is a declared control like any other, and its folder still comes first in the scene's panel."""
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Preset")
+        folders = {
+            element["props"].get("label"): element
+            for element in list(client.gui.values())
+            if element["type"] == "GuiFolderMessage"
+        }
+        skeleton, about = folders["Skeleton"], folders["About"]
+        assert skeleton["container_uuid"] == about["container_uuid"]
+        assert skeleton["props"]["order"] < about["props"]["order"]
