@@ -14,15 +14,15 @@ import time
 from pathlib import Path
 
 import tyro
-import viser
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tests"))
 
-from helpers.browser import open_viser  # noqa: E402
+from helpers.browser import close_notifications, open_viser  # noqa: E402
 from helpers.ci import CHROMIUM, CHROMIUM_ARGS  # noqa: E402
 
+from app import make_server  # noqa: E402
 from scenes.peloton import PelotonScene  # noqa: E402
 from server.switcher import SceneSwitcher  # noqa: E402
 
@@ -38,7 +38,7 @@ def main(out: Path = ROOT / "docs" / "peloton_course.png", at_km: float = 5.5, s
     from playwright.sync_api import Error as PlaywrightError
     from playwright.sync_api import sync_playwright
 
-    server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
+    server = make_server("127.0.0.1", 0, verbose=False)  # the app's own panel title and width
     server.gui.configure_theme(control_width="large")  # as app.py serves it
     switcher = SceneSwitcher(server, "peloton")
     scene = switcher.scene
@@ -61,6 +61,7 @@ def main(out: Path = ROOT / "docs" / "peloton_course.png", at_km: float = 5.5, s
         try:
             page = context.new_page()
             open_viser(page, server.get_port(), "/peloton/course_mode/route")
+            close_notifications(page)
             time.sleep(settle_s)
             close_buttons = page.locator(".mantine-Notification-closeButton")
             for i in range(close_buttons.count()):
