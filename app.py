@@ -168,6 +168,9 @@ def main(
     warning = exposure_warning(host, asked, allow_remote_glsl=allow_remote_glsl)
     if warning is not None:
         print(warning, flush=True)
+    if port is not None and not 1 <= port <= 65535:
+        print(f"--port must be a TCP port from 1 to 65535, got {port}.", file=sys.stderr, flush=True)
+        raise SystemExit(2)
     if port is not None and not port_is_free(host, port):  # refuse before viser prints a URL it will not serve
         print(port_message(port, port + 1, explicit=True), file=sys.stderr, flush=True)
         raise SystemExit(2)

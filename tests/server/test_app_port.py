@@ -47,3 +47,13 @@ def test_help_names_the_port_default_in_words() -> None:
     text = " ".join(run.stdout.split())
     assert "--port INT" in text and "{None}" not in text
     assert "default: 8080, or the next free port" in text.replace("│ ", "").replace(" │", "")
+
+
+def test_a_port_outside_the_tcp_range_is_refused_in_words() -> None:
+    for port in ("0", "-1", "99999"):
+        run = subprocess.run(
+            [sys.executable, "app.py", "--port", port], cwd=ROOT, capture_output=True, text=True, timeout=120
+        )
+        assert run.returncode == 2, port
+        assert "--port must be a TCP port from 1 to 65535" in run.stderr and "Traceback" not in run.stderr
+        assert "http://" not in run.stdout + run.stderr
