@@ -1,4 +1,4 @@
-"""Benchmark of the arm scene's solvers against issue 11's goals, with a plain numpy FABRIK as the baseline.
+"""Benchmark of the arm scene's solvers against the scene's speed goals, with a plain numpy FABRIK as the baseline.
 
 Run ``.venv/bin/python bench/bench_arm.py`` (``--quick`` for a shorter run). It prints the machine (CPU, cores,
 numba's threads and threading layer, the load average before and after), then:
@@ -287,7 +287,7 @@ def tree_30() -> tuple[list[int], Array, list[fabrik.Constraint]]:
 
 
 def skeletons(frames: int) -> dict[str, float]:
-    """Issue 14: the arm scene's hand preset with every fingertip target moving, and a 30-joint tree."""
+    """The arm scene's hand preset with every fingertip target moving, and a 30-joint tree."""
     print(
         f"\n## Skeletons (solve_tree), tolerance 1 mm, max 50 iterations, {frames} frames, each warm-started "
         f"from the last pose ({load()})"
@@ -419,7 +419,7 @@ def main() -> None:
     around = overhead(2000 if args.quick else 20_000)
     start = cold_start()
     threads = numba.get_num_threads()
-    print(f"\n## Goals (issue 11; {threads} threads; {load()})")
+    print(f"\n## Goals ({threads} threads; {load()})")
     print("| measure | goal | measured | × baseline | met |")
     print("|---|---|---:|---:|---|")
     rows = [
@@ -461,14 +461,14 @@ def main() -> None:
             start["warm (cache present: load)"] <= 3,
         ),
         (
-            "issue 14: hand, 5 fingers × 3 hinges, all targets moving, p95",
+            "hand, 5 fingers × 3 hinges, all targets moving, p95",
             "≤ 100 µs",
             f"{trees['hand']:.1f} µs",
             "",
             trees["hand"] <= 100,
         ),
         (
-            "issue 14: 30-joint tree, 5 effectors, p95",
+            "30-joint tree, 5 effectors, p95",
             "≤ 1 ms",
             f"{trees['30-joint tree']:.1f} µs",
             "",

@@ -6,7 +6,7 @@
 
 Prints:
 
-* the goal table of issue 11: one 30 m curler (28 m/s, 19°, 9 rev/s sidespin, constant coefficients) at RK4 10 ms
+* the goal table: one 30 m curler (28 m/s, 19°, 9 rev/s sidespin, constant coefficients) at RK4 10 ms
   and at the seed's Euler 1 ms; ``simulate_batch`` on 10 000 kicks (RK4 10 ms); the 41 × 31 outcome map; the app's
   start to serving its page with numba's cache warm and cold (a fresh ``NUMBA_CACHE_DIR``), and when its background
   warm-up finished. Each kernel row has a ratio against a plain numpy implementation of the same equations run in
@@ -394,7 +394,7 @@ def goal_rows() -> None:
     cpu = models[0] if models else cpu
     ball.warm_up()
     print(
-        "| goal (issue 11)                              |    median |       p95 |      best | unit | goal        "
+        "| goal                                         |    median |       p95 |      best | unit | goal        "
         "| verdict | note"
     )
     print(

@@ -2,7 +2,7 @@
 
     python bench/bench_sdf.py [--quick]
 
-Prints one table. Rows and goals (issue 5):
+Prints one table. Rows and goals:
 
 1. Mesh the four-primitive smooth default scene at 128³ samples (coarse-to-fine + marching cubes + merge):
    median and p95, goal ≤ 100 ms.
@@ -13,7 +13,7 @@ Prints one table. Rows and goals (issue 5):
 4. A gizmo drag through the websocket test client → the new 64³ mesh arriving back at the client: p50, p95,
    goal p95 ≤ 50 ms.
 
-Issue 12 (the editor and the ray-marched main view):
+The editor and the ray-marched main view:
 
 5. An editor source's field sampled in GLSL at 128³ plus marching cubes (``mesh_glsl``): goal ≤ 150 ms on
    llvmpipe; the kernel's numpy mesher on the default scene at 128³ is the same-process baseline.
@@ -341,7 +341,7 @@ def bench_drag(drags: int) -> list[str]:
 def main() -> None:
     parser = argparse.ArgumentParser(description="Benchmark the SDF gallery.")
     parser.add_argument("--quick", action="store_true", help="fewer repeats")
-    parser.add_argument("--only-issue-12", action="store_true", help="only the editor and main-view rows (5-7)")
+    parser.add_argument("--only-editor-and-view", action="store_true", help="only the editor and main-view rows (5-7)")
     args = parser.parse_args()
     repeats = 3 if args.quick else 9
     load = os.getloadavg()[0]
@@ -349,7 +349,7 @@ def main() -> None:
     print("| Measure | Result | Goal | Verdict |")
     print("|---|---|---|---|")
     rows: list[Callable[[], list[str]]] = []
-    if not args.only_issue_12:
+    if not args.only_editor_and_view:
         rows += [
             lambda: bench_mesh(repeats),
             lambda: bench_reference(repeats),

@@ -492,7 +492,7 @@ def paceline(
 
 
 # --------------------------------------------------------------------------------------------- weather air
-# Real air, for the course mode (issue 13): the ideal gas law for moist air, and the standard atmosphere.
+# Real air, for the course mode: the ideal gas law for moist air, and the standard atmosphere.
 R_DRY_AIR = 287.058
 """Specific gas constant of dry air (J/(kg·K)), R / 0.0289652 kg/mol (U.S. Standard Atmosphere 1976)."""
 R_WATER_VAPOUR = 461.495

@@ -467,7 +467,7 @@ def test_any_course_balances_its_books_and_more_power_is_faster(
     assert faster.time_s <= r.time_s * (1 + 1e-9)
 
 
-# ------------------------------------------------------------------------------------------------ review of issue 13
+# ------------------------------------------------------------------------------------------------ edge cases of a ride
 # Kind: a profile steeper than any road. The reviewer's vertical.gpx (three points 1 cm apart rising 1000 m) loaded
 # as flat because the 50 m smoothing averaged the cliff away; wall.gpx (300 %) was ridden at 1 km/h.
 def test_a_vertical_profile_is_refused_before_smoothing_hides_it() -> None:

@@ -1,4 +1,4 @@
-"""Issue 8, item 1: ``cycling.speed_for_power`` at its edges (P = 0, tangencies, tiny powers), against a reference
+"""``cycling.speed_for_power`` at its edges (P = 0, tangencies, tiny powers), against a reference
 written here: a dense scan of ``cycling.power`` for the last sign change, refined by scipy's brentq."""
 
 from __future__ import annotations
@@ -122,9 +122,9 @@ def test_vectorised_call_equals_one_value_at_a_time() -> None:
     np.testing.assert_array_equal(batch, single)
 
 
-# ------------------------------------------------------------------------------------------------ the issue's inputs
+# ------------------------------------------------------------------------------------------------ public inputs
 def test_rolling_cancelling_the_grade_carries_the_rider_at_the_tailwind_speed() -> None:
-    # Issue 8: returned 0.0 m/s, while 1e-9 W returned 2.00005 m/s.
+    # Once: returned 0.0 m/s, while 1e-9 W returned 2.00005 m/s.
     v = float(cycling.speed_for_power(0.0, 0.32, 80.0, 0.005, grade=-0.005, headwind_ms=-2.0))
     assert v == 2.0
     near = float(cycling.speed_for_power(1e-9, 0.32, 80.0, 0.005, grade=-0.005, headwind_ms=-2.0))
@@ -149,7 +149,7 @@ def test_standing_still_needs_no_power_without_a_push() -> None:
 
 
 # ------------------------------------------------------------------------ the domain: overflow, underflow, last ulps
-# The kind (review of issue 8): finite accepted inputs whose intermediates (P/a, |c|/a, w², m·g·(Crr + grade),
+# The kind: finite accepted inputs whose intermediates (P/a, |c|/a, w², m·g·(Crr + grade),
 # ρ(h)) overflow or underflow, giving inf or a wrong finite speed, and a stopping rule that quit several ulps short
 # where dP/dv is large. Family: every argument at and beyond the ends of SPEED_FOR_POWER_DOMAIN, any finite grade.
 DOMAIN = cycling.SPEED_FOR_POWER_DOMAIN

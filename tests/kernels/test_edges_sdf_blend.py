@@ -129,7 +129,7 @@ def test_a_tiny_width_meshes_like_the_hard_scene(pair: tuple[sdf.Scene, sdf.Scen
     assert np.all(np.isfinite(colors))
 
 
-# ------------------------------------------------------------------------------------------------ the inputs
+# ------------------------------------------------------------------------------------------------ public inputs
 def two_spheres(k: float, blend: sdf.BlendForm) -> sdf.Scene:
     return sdf.Scene(
         (

@@ -42,7 +42,7 @@ from server.sessions import Sessions
 from server.switcher import SceneSwitcher
 
 FIRST_GUI_BOUND_S = 2.0
-"""The most another tab may wait for its first GUI while one tab floods (the issue's bound)."""
+"""The most another tab may wait for its first GUI while one tab floods (the goal's bound)."""
 FLOOD_HZ = 200.0
 
 

@@ -460,7 +460,7 @@ def test_each_refusal_logs_one_line_and_a_flood_stays_one_line(
 
 
 def test_crafted_props_cannot_lift_a_slider_limit(server: viser.ViserServer, switcher: SceneSwitcher) -> None:
-    """The issue's case: ``{"props": {}}`` then "Riders" 40 broke the peloton until Reset."""
+    """The reported case: ``{"props": {}}`` then "Riders" 40 broke the peloton until Reset."""
     with BrowserClient(server.get_port()) as client:
         uuid = client.wait_for_gui("Riders")
         client.send("GuiUpdateMessage", uuid=uuid, updates={"props": {}})

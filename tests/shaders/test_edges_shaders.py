@@ -34,7 +34,7 @@ def probe_points(scene: sdf.Scene) -> np.ndarray:
 
 
 def scene_of(ops: tuple[sdf.BooleanOp, ...], k: float, blend: sdf.BlendForm) -> sdf.Scene:
-    """Spheres of radius 0.5 at (±0.5, 0, 0) (the issue's pair), then more primitives combined by ``ops``."""
+    """Spheres of radius 0.5 at (±0.5, 0, 0) (the reported pair), then more primitives combined by ``ops``."""
     more = [
         sdf.Primitive("box", (0.0, 0.0, 0.3), (0.4, 0.3, 0.3)),
         sdf.Primitive("torus", (0.0, 0.0, 0.0), (0.5, 0.15)),
