@@ -58,6 +58,14 @@ def start(client: BrowserClient, **override: Any) -> str:
     return str(fields["transfer_uuid"])
 
 
+def acked(client: BrowserClient, transfer: str) -> bool:
+    """Whether ``client`` has been sent a part ack for ``transfer`` (viser sends every tab each upload's acks)."""
+    return any(
+        message.get("type") == "FileTransferPartAck" and message.get("transfer_uuid") == transfer
+        for _at, message in list(client.received)
+    )
+
+
 CRAFTED_STARTS: list[dict[str, Any]] = [
     {"source_component_uuid": "no-such-control"},
     {"size_bytes": MAX_UPLOAD_BYTES + 1},
@@ -159,11 +167,6 @@ def test_an_upload_of_tiny_parts_is_refused(
         assert install_gate(server).uploads_in_flight() == (0, 0)
 
 
-@pytest.mark.xfail(
-    strict=False,
-    reason="open fault: after the course scene's tests in the same process, a's completed upload is sometimes never "
-    "installed (lost, not slow: a 90 s wait fails too); the refusal half of this test holds",
-)
 def test_a_transfer_id_in_flight_cannot_be_taken_by_another_tab(
     server: viser.ViserServer, mode: CourseMode, caplog: pytest.LogCaptureFixture
 ) -> None:
@@ -180,6 +183,9 @@ def test_a_transfer_id_in_flight_cannot_be_taken_by_another_tab(
         b.wait_for_gui("Upload GPX")
         transfer = start(a, part_count=2, size_bytes=len(data), filename="mine.gpx")
         send_part(a, transfer, 0, data[:half])
+        # b learns the id from the part's ack, as a real second tab would. Waiting for it also orders the two
+        # sockets: without it, b's start could reach the server first and rightly own the id, refusing a's.
+        b.wait_for(lambda: acked(b, transfer), what="the ack of a's first part")
         start(b, part_count=2, size_bytes=len(data), filename="theirs.gpx", transfer_uuid=transfer)
         client_b_part = hill_gpx("Theirs", 300)
         send_part(b, transfer, 1, client_b_part[half:])  # refused: b has no upload under that id
