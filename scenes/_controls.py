@@ -9,7 +9,8 @@ gate's own :func:`~server.clean.clean_value` (one clamp, in one place): a number
 unusable (NaN, ±inf, a wrong type, an unknown option) keeps the last good value, and a cleaned value that differs
 from the control's is written back so every browser shows what the scene uses.
 
-Kinds: :func:`slider`, :func:`number`, :func:`dropdown` (the field holds the option, the GUI shows its label),
+Kinds: :func:`slider`, :func:`number`, :func:`dropdown` (the field holds the option, the GUI shows its label;
+:func:`dropdown_from_labels` takes them from a label → option table),
 :func:`checkbox`, :func:`text` and :func:`rgb`. A number is an integer when the field's default is an ``int``. A
 field whose default is a tuple of scalars gets one control per element, its label formatted with ``n`` (1, 2, ...).
 A declaration's ``folder`` puts the control in a folder of that name, opened around consecutive fields that name it
@@ -184,6 +185,13 @@ def dropdown(
     shown = tuple(str(option) for option in options) if labels is None else tuple(labels)
     assert len(shown) == len(options) and len(set(shown)) == len(shown), "one distinct label per option"
     return _declare(Control("dropdown", label, options=tuple(options), labels=shown, **placement))
+
+
+def dropdown_from_labels(
+    label: str, option_from_label: Mapping[str, Any], **placement: Unpack[Placement]
+) -> dict[str, Control]:
+    """A dropdown of ``option_from_label``'s values, each shown as its key (a scene's ``X_FROM_LABEL`` table)."""
+    return dropdown(label, tuple(option_from_label.values()), tuple(option_from_label), **placement)
 
 
 def checkbox(label: str, **placement: Unpack[Placement]) -> dict[str, Control]:

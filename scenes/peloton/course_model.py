@@ -19,7 +19,7 @@ import trimesh
 
 from kernels import course as course_kernel
 from kernels import cycling
-from scenes._controls import checkbox, dropdown, number, slider
+from scenes._controls import checkbox, dropdown, dropdown_from_labels, number, slider
 from scenes.peloton.model import PelotonParams, group_cda
 
 CourseAirLabel = Literal["Exponential atmosphere (textbook)", "Weather (temperature, pressure or altitude, humidity)"]
@@ -71,17 +71,12 @@ class CourseParams:
     """Finish time that 'Find the power for this time' aims at (min)."""
     model: course_kernel.Model = field(
         default="martin",
-        metadata=dropdown(
-            "Power model",
-            tuple(POWER_MODEL_FROM_LABEL.values()),
-            tuple(POWER_MODEL_FROM_LABEL),
-            folder=POWER_FOLDER,
-        ),
+        metadata=dropdown_from_labels("Power model", POWER_MODEL_FROM_LABEL, folder=POWER_FOLDER),
     )
     """Power model: Martin et al. 1998's full terms or the textbook three."""
     air: course_kernel.AirKind = field(
         default="seed",
-        metadata=dropdown("Air", tuple(AIR_FROM_LABEL.values()), tuple(AIR_FROM_LABEL), folder=POWER_FOLDER),
+        metadata=dropdown_from_labels("Air", AIR_FROM_LABEL, folder=POWER_FOLDER),
     )
     """Air along the route: the textbook exponential atmosphere or a weather reading."""
     temperature_c: float = field(

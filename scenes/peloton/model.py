@@ -17,7 +17,7 @@ from typing import Literal
 import numpy as np
 
 from kernels import cycling
-from scenes._controls import checkbox, dropdown, number, slider
+from scenes._controls import checkbox, dropdown, dropdown_from_labels, number, slider
 
 MAX_RIDERS = 8
 BIKE_LENGTH_M = 1.70
@@ -103,12 +103,7 @@ class PelotonParams:
     """Wheel-to-wheel gap between riders (m)."""
     model: cycling.DraftModel = field(
         default="measured",
-        metadata=dropdown(
-            "Draft model",
-            tuple(MODEL_FROM_LABEL.values()),
-            tuple(MODEL_FROM_LABEL),
-            folder="Drafting",
-        ),
+        metadata=dropdown_from_labels("Draft model", MODEL_FROM_LABEL, folder="Drafting"),
     )
     """Drafting model: the textbook formula or the position-dependent fit to measurements."""
     rotate: bool = field(default=False, metadata=checkbox("Rotate the lead", folder="Drafting"))

@@ -17,7 +17,7 @@ from typing import Any, Literal
 import numpy as np
 
 from kernels import sdf
-from scenes._controls import checkbox, dropdown, rgb, slider, text
+from scenes._controls import checkbox, dropdown, dropdown_from_labels, rgb, slider, text
 from scenes.sdf_gallery.editor import EDITOR_HALF_SIZE_M, EXAMPLES, EditorField
 from shaders.renderer import Camera, Shading
 
@@ -122,22 +122,10 @@ class PrimitiveParams:
     enabled: bool = field(metadata=checkbox("P{slot} on", folder="Primitive {slot}"))
     """Whether it is part of the scene (the first always is)."""
     kind: sdf.PrimitiveKind = field(
-        metadata=dropdown(
-            "P{slot} kind",
-            tuple(KIND_LABELS.values()),
-            tuple(KIND_LABELS),
-            folder="Primitive {slot}",
-        )
+        metadata=dropdown_from_labels("P{slot} kind", KIND_LABELS, folder="Primitive {slot}")
     )
     """One of the kernel's kinds (sphere, box, torus, capsule and the catalogue's six)."""
-    op: sdf.BooleanOp = field(
-        metadata=dropdown(
-            "P{slot} combine",
-            tuple(OP_LABELS.values()),
-            tuple(OP_LABELS),
-            folder="Primitive {slot}",
-        )
-    )
+    op: sdf.BooleanOp = field(metadata=dropdown_from_labels("P{slot} combine", OP_LABELS, folder="Primitive {slot}"))
     """How it combines with the primitives before it."""
     size: tuple[float, float, float] = field(
         metadata=slider("P{slot} size {axis} (m)", *SIZE_RANGE_M, 0.01, folder="Primitive {slot}")
@@ -198,12 +186,12 @@ class SdfGalleryParams:
 
     view_mode: ViewMode = field(
         default="mesh",
-        metadata=dropdown("View", tuple(VIEW_LABELS.values()), tuple(VIEW_LABELS), folder="Shape and view"),
+        metadata=dropdown_from_labels("View", VIEW_LABELS, folder="Shape and view"),
     )
     """The main 3D view: the mesh, the GLSL ray-march (background image with depth), or both (mesh as wireframe)."""
     shape_source: ShapeSource = field(
         default="primitives",
-        metadata=dropdown("Shape", tuple(SOURCE_LABELS.values()), tuple(SOURCE_LABELS), folder="Shape and view"),
+        metadata=dropdown_from_labels("Shape", SOURCE_LABELS, folder="Shape and view"),
     )
     """Show the primitives' scene or the editor's field."""
     example: str = field(
@@ -223,7 +211,7 @@ class SdfGalleryParams:
     """Half the side of the cube the editor's field is meshed and ray-marched in, for the next mesh (m)."""
     blend: BlendChoice = field(
         default="poly",
-        metadata=dropdown("Blend", tuple(BLEND_LABELS.values()), tuple(BLEND_LABELS), folder="Blend and mesh"),
+        metadata=dropdown_from_labels("Blend", BLEND_LABELS, folder="Blend and mesh"),
     )
     """Hard booleans (k is not used), or the polynomial or exponential smooth minimum of width k."""
     k: float = field(default=0.25, metadata=slider("Blend width k (m)", 0.0, 1.0, 0.01, folder="Blend and mesh"))
@@ -235,12 +223,7 @@ class SdfGalleryParams:
     """Marching-cubes samples along the longest side of the bounds (32–256); a change remeshes (up to seconds)."""
     reference_mode: ReferenceMode = field(
         default="stopped",
-        metadata=dropdown(
-            "Re-render",
-            tuple(MODE_LABELS.values()),
-            tuple(MODE_LABELS),
-            folder=REFERENCE_FOLDER,
-        ),
+        metadata=dropdown_from_labels("Re-render", MODE_LABELS, folder=REFERENCE_FOLDER),
     )
     """Render the reference when the camera stops, or live while it moves."""
     reference_width: int = field(
