@@ -515,6 +515,11 @@ def _fallback_axis(bend: NDArray[np.float64], dim: int) -> NDArray[np.float64]:
     return _perpendicular_numpy(bend / norm)
 
 
+_F64 = NDArray[np.float64]
+_SingleArgs = tuple[_F64, _F64, float, _F64, NDArray[np.int64], _F64, _F64, _F64, _F64]
+"""The arguments of :func:`~kernels.fabrik.chain._solve_one`, in order: see :meth:`_Setup.single_args`."""
+
+
 @dataclasses.dataclass(frozen=True)
 class _Setup:
     """Checked options shared by every chain, packed as the compiled core takes them."""
@@ -534,6 +539,21 @@ class _Setup:
     """(K,) obstacle radii (m)."""
     table: NDArray[np.float64] = dataclasses.field(default_factory=lambda: _FREE_TABLE)
     """(T, 13) joint limits, one row per segment (T = n) or one row for all (T = 1); see :func:`_limit_table`."""
+
+    def single_args(self, chain: ArrayLike, point: ArrayLike) -> _SingleArgs:
+        """The arguments of :func:`~kernels.fabrik.chain._solve_one` for one shape-checked chain (n + 1, d) and
+        target (d,): what :func:`_solve_single` calls it with, and what :func:`compiled_single_solve` times."""
+        return (
+            np.ascontiguousarray(chain),
+            np.ascontiguousarray(point),
+            _LARGEST,
+            self.params,
+            self.flags,
+            self.root_direction,
+            self.centres,
+            self.radii,
+            self.table,
+        )
 
     def constrained(self, constraints: Sequence[Constraint] | None, n: int, dim: int, cone: float | None) -> _Setup:
         """These options with per-segment ``constraints`` (checked) in place of the uniform cone."""
@@ -672,18 +692,7 @@ def compiled_single_solve(
     chain = _check_joints("joints", joints, batched=False)
     point = _check_vector("target", target, chain.shape[1])
     setup = _Setup.build(chain.shape[1], 1e-3, 50, None, (), None, _SOLVER_IDS["fabrik"], True)
-    args = (
-        np.ascontiguousarray(chain),
-        np.ascontiguousarray(point),
-        _LARGEST,
-        setup.params,
-        setup.flags,
-        setup.root_direction,
-        setup.centres,
-        setup.radii,
-        setup.table,
-    )
-    return _solve_one, args
+    return _solve_one, setup.single_args(chain, point)
 
 
 def _solve_single(
@@ -720,17 +729,7 @@ def _solve_single(
         dim, tolerance, max_iterations, cone_half_angle_rad, obstacles, root_direction, _SOLVER_IDS[solver], extrapolate
     )
     setup = setup.constrained(constraints, count - 1, dim, cone_half_angle_rad)
-    code, out, history, used, status, error = _solve_one(
-        np.ascontiguousarray(chain),
-        np.ascontiguousarray(point),
-        _LARGEST,
-        setup.params,
-        setup.flags,
-        setup.root_direction,
-        setup.centres,
-        setup.radii,
-        setup.table,
-    )
+    code, out, history, used, status, error = _solve_one(*setup.single_args(chain, point))
     if code == _BAD_JOINTS:
         _check_joints("joints", joints, batched=False)  # raises, naming it
     if code == _BAD_TARGET:
