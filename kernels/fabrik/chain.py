@@ -508,24 +508,20 @@ def _polish(
             _copy(best, p)
         else:
             _admissible_start(p, lengths, tiny, rest, table, has_zero, start, dim)
-            _backward_pass(p, lengths, tiny, rest, limits, centres, radii, live, has_zero, dim)
+        # Iteration 0 is the start itself (projected, unless it is the best pose), then the steps from it.
+        mark_iteration, mark_error = 0, 0.0
+        for iteration in range(budget + 1):
+            if iteration > 0:
+                _dls_step(p, target, lengths, tiny, turns)
+            if iteration > 0 or start > 0:
+                _backward_pass(p, lengths, tiny, rest, limits, centres, radii, live, has_zero, dim)
             error = _end_error(p, target)
             if error < best_error and _admissible(p, tiny, rest, has_limits, table, centres, radii, live):
                 _copy(p, best)
                 best_error = error
                 if error <= tolerance:
                     return best_error
-        mark_iteration, mark_error = 0, _end_error(p, target)
-        for iteration in range(1, budget + 1):
-            _dls_step(p, target, lengths, tiny, turns)
-            _backward_pass(p, lengths, tiny, rest, limits, centres, radii, live, has_zero, dim)
-            error = _end_error(p, target)
-            if error < best_error and _admissible(p, tiny, rest, has_limits, table, centres, radii, live):
-                _copy(p, best)
-                best_error = error
-                if error <= tolerance:
-                    return best_error
-            if error < mark_error - progress:
+            if iteration == 0 or error < mark_error - progress:
                 mark_iteration, mark_error = iteration, error
             elif iteration - mark_iteration >= _PATIENCE:
                 break
