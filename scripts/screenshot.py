@@ -9,9 +9,7 @@ python scripts/screenshot.py --scenes arm    # just one
 
 from __future__ import annotations
 
-import shutil
 import sys
-import tempfile
 from pathlib import Path
 
 import tyro
@@ -21,7 +19,7 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tests"))
 
 from helpers.browser import scene_page, screenshot  # noqa: E402
-from helpers.ci import CHROMIUM, CHROMIUM_ARGS  # noqa: E402
+from helpers.ci import chromium_context  # noqa: E402
 
 from scenes import SCENES  # noqa: E402
 
@@ -33,24 +31,14 @@ def main(scenes: tuple[str, ...] = (), out_dir: Path = ROOT / "docs") -> None:
         scenes: scene keys; empty means all.
         out_dir: where the PNGs go.
     """
-    from playwright.sync_api import sync_playwright
-
     keys = list(scenes) or list(SCENES)
     out_dir.mkdir(parents=True, exist_ok=True)
-    with sync_playwright() as playwright:
-        profile = tempfile.mkdtemp(prefix="chromium-shot-")
-        context = playwright.chromium.launch_persistent_context(
-            profile, executable_path=CHROMIUM, headless=True, args=CHROMIUM_ARGS
-        )
-        try:
-            for key in keys:
-                with scene_page(context, key, (1600, 1000)) as shown:
-                    path = out_dir / f"{key}.png"
-                    screenshot(shown.page, path=str(path))
-                    print(f"saved {path}")
-        finally:
-            context.close()
-            shutil.rmtree(profile, ignore_errors=True)
+    with chromium_context() as context:
+        for key in keys:
+            with scene_page(context, key, (1600, 1000)) as shown:
+                path = out_dir / f"{key}.png"
+                screenshot(shown.page, path=str(path))
+                print(f"saved {path}")
 
 
 if __name__ == "__main__":

@@ -7,9 +7,7 @@ The sample route, four riders sharing the front, weather air, played to about 40
 
 from __future__ import annotations
 
-import shutil
 import sys
-import tempfile
 import time
 from pathlib import Path
 
@@ -20,7 +18,7 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tests"))
 
 from helpers.browser import close_notifications, open_viser  # noqa: E402
-from helpers.ci import CHROMIUM, CHROMIUM_ARGS  # noqa: E402
+from helpers.ci import chromium_context  # noqa: E402
 
 from app import make_server  # noqa: E402
 from scenes.peloton import PelotonScene  # noqa: E402
@@ -36,7 +34,6 @@ def main(out: Path = ROOT / "docs" / "peloton_course.png", at_km: float = 5.5, s
         settle_s: seconds to let the page render.
     """
     from playwright.sync_api import Error as PlaywrightError
-    from playwright.sync_api import sync_playwright
 
     server = make_server("127.0.0.1", 0, verbose=False)  # the app's own panel title and width
     server.gui.configure_theme(control_width="large")  # as app.py serves it
@@ -49,40 +46,28 @@ def main(out: Path = ROOT / "docs" / "peloton_course.png", at_km: float = 5.5, s
     mode.controls["temperature_c"].value = 24.0
     mode.controls["humidity_pct"].value = 60.0
     mode.scrub.value = at_km
-    with sync_playwright() as playwright:
-        profile = tempfile.mkdtemp(prefix="chromium-shot-")
-        context = playwright.chromium.launch_persistent_context(
-            profile,
-            executable_path=CHROMIUM,
-            headless=True,
-            args=CHROMIUM_ARGS,
-            viewport={"width": 1600, "height": 1000},
-        )
-        try:
-            page = context.new_page()
-            open_viser(page, server.get_port(), "/peloton/course_mode/route")
-            close_notifications(page)
-            time.sleep(settle_s)
-            close_buttons = page.locator(".mantine-Notification-closeButton")
-            for i in range(close_buttons.count()):
-                try:
-                    close_buttons.nth(i).click(timeout=2000, force=True)
-                except PlaywrightError:
-                    pass  # already gone
-            # Fold the line's own folders so the course mode's readouts and chart are in view.
-            for folder in ("Rider", "Course", "Drafting", "Results", "Speed at a power"):
-                try:
-                    page.get_by_text(folder, exact=True).first.click(timeout=20_000)
-                except PlaywrightError:
-                    print(f"could not fold {folder!r}; the picture shows it open")
-            chart = page.locator(".uplot", has_text="Elevation, speed and power along the course")
-            chart.first.scroll_into_view_if_needed(timeout=10_000)
-            time.sleep(1.0)
-            page.screenshot(path=str(out))
-            print(f"saved {out}")
-        finally:
-            context.close()
-            shutil.rmtree(profile, ignore_errors=True)
+    with chromium_context((1600, 1000)) as context:
+        page = context.new_page()
+        open_viser(page, server.get_port(), "/peloton/course_mode/route")
+        close_notifications(page)
+        time.sleep(settle_s)
+        close_buttons = page.locator(".mantine-Notification-closeButton")
+        for i in range(close_buttons.count()):
+            try:
+                close_buttons.nth(i).click(timeout=2000, force=True)
+            except PlaywrightError:
+                pass  # already gone
+        # Fold the line's own folders so the course mode's readouts and chart are in view.
+        for folder in ("Rider", "Course", "Drafting", "Results", "Speed at a power"):
+            try:
+                page.get_by_text(folder, exact=True).first.click(timeout=20_000)
+            except PlaywrightError:
+                print(f"could not fold {folder!r}; the picture shows it open")
+        chart = page.locator(".uplot", has_text="Elevation, speed and power along the course")
+        chart.first.scroll_into_view_if_needed(timeout=10_000)
+        time.sleep(1.0)
+        page.screenshot(path=str(out))
+        print(f"saved {out}")
     switcher.close()
     server.stop()
 

@@ -5,14 +5,14 @@ Under CI=true nothing is skipped: a missing Chromium or GL context fails the run
 
 from __future__ import annotations
 
+import contextlib
 import shutil
-import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 import viser
-from helpers.ci import CHROMIUM, CHROMIUM_ARGS, fresh_renderer, skip_or_fail
+from helpers.ci import CHROMIUM, chromium_context, fresh_renderer, skip_or_fail
 from helpers.scenes import MakeScene, S
 from hypothesis import settings
 
@@ -44,22 +44,16 @@ def server() -> Iterator[viser.ViserServer]:
 @pytest.fixture
 def switcher(server: viser.ViserServer) -> Iterator[SceneSwitcher]:
     """The app's scene switcher on ``server``'s shared session (what every tab sees), showing the first scene."""
-    app = SceneSwitcher(server, "peloton")
-    try:
+    with contextlib.closing(SceneSwitcher(server, "peloton")) as app:
         yield app
-    finally:
-        app.close()
 
 
 @pytest.fixture
 def sessions(server: viser.ViserServer) -> Iterator[Sessions]:
     """The app's per-tab sessions on ``server`` (each tab its own scene), opening on the peloton."""
-    manager = serve_scenes(server, "peloton", shared=False)
-    assert isinstance(manager, Sessions)
-    try:
+    with contextlib.closing(serve_scenes(server, "peloton", shared=False)) as manager:
+        assert isinstance(manager, Sessions)
         yield manager
-    finally:
-        manager.close()
 
 
 @pytest.fixture
@@ -104,22 +98,8 @@ def chromium_browser() -> Iterator[object]:
     """Debian's Chromium driven by playwright (never playwright's own downloaded browser)."""
     if shutil.which(CHROMIUM) is None and not Path(CHROMIUM).exists():
         skip_or_fail(f"Chromium not found at {CHROMIUM}: apt-get install chromium")
-    from playwright.sync_api import sync_playwright
-
-    with sync_playwright() as playwright:
-        user_data = tempfile.mkdtemp(prefix="chromium-profile-")
-        context = playwright.chromium.launch_persistent_context(
-            user_data,
-            executable_path=CHROMIUM,
-            headless=True,
-            args=CHROMIUM_ARGS,
-            viewport={"width": 1280, "height": 800},
-        )
-        try:
-            yield context
-        finally:
-            context.close()
-            shutil.rmtree(user_data, ignore_errors=True)
+    with chromium_context((1280, 800)) as context:
+        yield context
 
 
 @pytest.fixture

@@ -4,13 +4,18 @@ from __future__ import annotations
 
 import contextlib
 import os
+import shutil
+import tempfile
 from collections.abc import Iterator
-from typing import NoReturn
+from typing import TYPE_CHECKING, Any, NoReturn
 
 import pytest
 
 from shaders import gl_service
 from shaders.renderer import GLUnavailableError, Renderer
+
+if TYPE_CHECKING:
+    from playwright.sync_api import ViewportSize
 
 IN_CI = os.environ.get("CI", "").lower() in ("1", "true", "yes")
 """Whether this run is CI's: then nothing may be skipped for want of a capability."""
@@ -26,6 +31,25 @@ CHROMIUM_ARGS = [
     "--disable-sync",
     "--enable-unsafe-swiftshader",
 ]
+
+
+@contextlib.contextmanager
+def chromium_context(viewport: tuple[int, int] | None = None) -> Iterator[Any]:
+    """A playwright browser context of Debian's Chromium (never playwright's own downloaded browser), in a profile
+    folder of its own that is removed afterwards; ``viewport`` (CSS px) is its pages' default size."""
+    from playwright.sync_api import sync_playwright
+
+    size: ViewportSize | None = None if viewport is None else {"width": viewport[0], "height": viewport[1]}
+    with sync_playwright() as playwright:
+        profile = tempfile.mkdtemp(prefix="chromium-profile-")
+        context = playwright.chromium.launch_persistent_context(
+            profile, executable_path=CHROMIUM, headless=True, args=CHROMIUM_ARGS, viewport=size
+        )
+        try:
+            yield context
+        finally:
+            context.close()
+            shutil.rmtree(profile, ignore_errors=True)
 
 
 def skip_or_fail(reason: str) -> NoReturn:
