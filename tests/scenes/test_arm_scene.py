@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 import viser
-from helpers.scenes import MakeScene
+from helpers.scenes import scene_fixture
 from helpers.wsclient import BrowserClient
 
 from kernels import fabrik
@@ -21,10 +21,7 @@ from scenes.arm import (
     solve_arm,
 )
 
-
-@pytest.fixture
-def scene(show_scene: MakeScene) -> ArmScene:
-    return show_scene(ArmScene)
+scene = scene_fixture(ArmScene)
 
 
 def drawn_joints(scene: ArmScene) -> np.ndarray:

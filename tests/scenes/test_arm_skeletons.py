@@ -5,17 +5,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import viser
-from helpers.scenes import MakeScene
+from helpers.scenes import scene_fixture
 from helpers.wsclient import BrowserClient
 
 from kernels import fabrik
 from scenes import _skeletons
 from scenes.arm import ArmScene
 
-
-@pytest.fixture
-def scene(show_scene: MakeScene) -> ArmScene:
-    return show_scene(ArmScene)
+scene = scene_fixture(ArmScene)
 
 
 def link_lengths(skeleton: _skeletons.Skeleton, joints: np.ndarray) -> np.ndarray:

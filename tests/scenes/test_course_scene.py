@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 import viser
 from helpers.gpx import BAD_FILES, gpx_text, hill_gpx
-from helpers.scenes import MakeScene
+from helpers.scenes import scene_fixture
 from helpers.uploads import upload
 from helpers.wsclient import BrowserClient
 
@@ -28,10 +28,7 @@ from scenes.peloton import (
     group_cda,
 )
 
-
-@pytest.fixture
-def scene(show_scene: MakeScene) -> PelotonScene:
-    return show_scene(PelotonScene)
+scene = scene_fixture(PelotonScene)
 
 
 @pytest.fixture

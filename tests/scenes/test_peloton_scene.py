@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 import viser
 from helpers.browser import VIEWPORTS
-from helpers.scenes import MakeScene
+from helpers.scenes import scene_fixture
 from helpers.screen_geometry import pinhole_ndc
 from helpers.wsclient import BrowserClient
 from hypothesis import HealthCheck, given, settings
@@ -28,10 +28,7 @@ from scenes.peloton import (
 )
 from server.switcher import SceneSwitcher
 
-
-@pytest.fixture
-def scene(show_scene: MakeScene) -> PelotonScene:
-    return show_scene(PelotonScene)
+scene = scene_fixture(PelotonScene)
 
 
 def bar_heights(scene: PelotonScene, component: str) -> np.ndarray:

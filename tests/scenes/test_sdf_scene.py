@@ -12,7 +12,7 @@ import pytest
 import trimesh
 import viser
 from helpers.ci import need_gl
-from helpers.scenes import MakeScene
+from helpers.scenes import scene_fixture
 from helpers.viser_private import gui_uuid, gui_uuids, node_names
 from helpers.waiting import wait_until
 from helpers.wsclient import BrowserClient
@@ -28,9 +28,7 @@ from shaders.renderer import Camera, GLUnavailableError
 MESH = "/sdf/mesh"
 
 
-@pytest.fixture
-def scene(show_scene: MakeScene) -> SdfGalleryScene:
-    return show_scene(SdfGalleryScene)
+scene = scene_fixture(SdfGalleryScene)
 
 
 def shown_mesh(scene: SdfGalleryScene) -> trimesh.Trimesh:
