@@ -1,18 +1,14 @@
 """A real browser looks at the arm: chain, target and obstacle in view and clear of the panel, the obstacle's gizmo
 outside its disc, the error plot drawn with its top label whole, no error text, at 1600×1000 and 1280×720; the 3D
-toggle shows the floor grid from an angle; a mouse drag on the target's gizmo makes the chain follow on screen."""
+toggle shows the floor grid from an angle. (The mouse drags are in ``test_interactions_browser.py``.)"""
 
 from __future__ import annotations
 
-import time
-from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
 import pytest
-import viser
 from helpers.browser import (
-    VIEWPORTS,
     NumberChange,
     ScenePage,
     assert_chart_draws,
@@ -20,23 +16,18 @@ from helpers.browser import (
     assert_in_view,
     assert_seen,
     changed_mask,
-    close_notifications,
     control_row,
     error_text,
-    open_viser,
     project,
     save_scene_screenshot,
-    scene_page,
-    screen_of,
+    scene_page_fixture,
     screenshot,
     settle,
-    wait_frames,
     with_nodes_hidden,
 )
 from helpers.waiting import wait_until
 
 from scenes.arm import ArmScene
-from server.switcher import SceneSwitcher
 
 pytestmark = pytest.mark.browser
 
@@ -44,10 +35,7 @@ MAIN = ["/arm/links", "/arm/joints", "/arm/target", "/arm/obstacle_0"]
 CHART = "Error after each iteration (log scale)"
 
 
-@pytest.fixture(scope="module", params=VIEWPORTS, ids=lambda v: f"{v[0]}x{v[1]}")
-def shown(request: pytest.FixtureRequest, chromium_browser: Any) -> Iterator[ScenePage]:
-    with scene_page(chromium_browser, "arm", request.param) as page:
-        yield page
+shown = scene_page_fixture("arm")
 
 
 def _chain_points(scene: ArmScene) -> np.ndarray:
@@ -123,90 +111,6 @@ def test_three_d_shows_the_floor_grid_from_an_angle(shown: ScenePage) -> None:
     checkbox.click()
     wait_until(lambda: not scene.params.three_d, "back to the plane")
     settle(shown)
-
-
-def test_drag_the_target_gizmo_with_the_mouse(server: viser.ViserServer, browser_page: Any) -> None:
-    switcher = SceneSwitcher(server, "arm")
-    scene = switcher.scene
-    assert isinstance(scene, ArmScene)
-    page = browser_page
-    open_viser(page, server.get_port(), "/arm/target")
-    close_notifications(page)
-    # The drag aims at the gizmo on the screen: the camera must be framed and still first, or it moves under the
-    # mouse (CI: the drag missed the gizmo while the framing was still arriving).
-    size = page.viewport_size
-    settle(ScenePage(server, switcher, page, (size["width"], size["height"])))
-    target_before = scene.target.copy()
-    end_before = scene.pose[-1].copy()
-    image_before = screenshot(page)
-
-    # Grab the gizmo's x arrow (local +x, out along the shaft) and pull it to the left on screen.
-    start = screen_of(page, "/arm/target", (0.2, 0.0, 0.0))
-    origin = screen_of(page, "/arm/target", (0.0, 0.0, 0.0))
-    assert start[0] > origin[0] + 5  # the arrow points right on screen from this camera
-    page.mouse.move(*start)
-    page.mouse.down()
-    for step in range(1, 11):  # about 0.15 m to the left: clear of the obstacle, so the chain reaches it
-        page.mouse.move(start[0] - 6 * step, start[1], steps=2)
-        time.sleep(0.02)
-    page.mouse.up()
-
-    # Wait until the drag's messages have all been handled: the target has moved and then held still.
-    deadline = time.monotonic() + 15.0
-    last, still_since = target_before.copy(), time.monotonic()
-    while time.monotonic() < deadline:
-        with scene._lock:
-            now = scene.target.copy()
-        if not np.array_equal(now, last):
-            last, still_since = now, time.monotonic()
-        elif now[0] < target_before[0] - 0.05 and time.monotonic() - still_since > 0.5:
-            break
-        time.sleep(0.05)
-    with scene._lock:
-        target = scene.target.copy()
-        end = scene.pose[-1].copy()
-        report = scene.report
-    # The target moved left (−x) along the arrow only; the plane keeps y = 0 and the drag kept z.
-    assert target[0] < target_before[0] - 0.05
-    assert target[1] == 0.0
-    assert abs(target[2] - target_before[2]) < 1e-6
-    # The chain followed: its end is on the new target, far from where it was.
-    assert report is not None and report.result.status == "reached"
-    assert np.linalg.norm(end - target) < 1e-3
-    assert np.linalg.norm(end - end_before) > 0.05
-    # The page draws the new pose: the end joint's instance in three.js sits on the new target.
-    n = scene.params.n_links
-
-    def drawn_end() -> list[float] | None:
-        return page.evaluate(
-            """n => {
-              let mesh = null;
-              window.__viserMutable.nodeRefFromName['/arm/joints'].traverse(o => {
-                if (o.isInstancedMesh && mesh === null) mesh = o;
-              });
-              if (mesh === null || mesh.count <= n) return null;
-              const matrix = new mesh.matrix.constructor();
-              mesh.getMatrixAt(n, matrix);
-              return [matrix.elements[12], matrix.elements[13], matrix.elements[14]];
-            }""",
-            n,
-        )
-
-    deadline = time.monotonic() + 10.0
-    shown = drawn_end()
-    while time.monotonic() < deadline and (shown is None or np.linalg.norm(np.array(shown) - end) > 1e-3):
-        time.sleep(0.1)
-        shown = drawn_end()
-    assert shown is not None
-    np.testing.assert_allclose(shown, end, atol=1e-3)
-    # A person sees the chain's end move: the picture changed around the new end's place on the screen.
-    wait_frames(page, 3)
-    x, y = screen_of(page, "/arm", tuple(end))
-    was_x, _ = screen_of(page, "/arm", tuple(end_before))
-    assert was_x - x > 15  # dragged left on the screen
-    changed = changed_mask(image_before, screenshot(page))
-    assert changed[int(y) - 15 : int(y) + 15, int(x) - 15 : int(x) + 15].sum() > 40
-    switcher.close()
 
 
 def test_the_error_plot_tick_labels_stay_inside_its_canvas(shown: ScenePage) -> None:

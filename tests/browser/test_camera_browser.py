@@ -15,11 +15,10 @@ from typing import Any
 import numpy as np
 import pytest
 import viser
-from helpers.browser import ScenePage, assert_in_view, close_notifications, open_viser, settle
+from helpers.browser import assert_in_view, close_notifications, served_scene, settle
 from helpers.waiting import wait_until
 
 from scenes.peloton import PelotonScene
-from server.switcher import SceneSwitcher
 
 pytestmark = pytest.mark.browser
 
@@ -42,15 +41,13 @@ def test_the_camera_reports_css_pixels_and_the_line_is_framed_clear_of_the_panel
         "Emulation.setDeviceMetricsOverride",
         {"width": VIEWPORT[0], "height": VIEWPORT[1], "deviceScaleFactor": ratio, "mobile": False},
     )
-    switcher = SceneSwitcher(server, "peloton")
-    try:
-        scene = switcher.scene
+    with served_scene(server, page, "peloton", viewport=VIEWPORT) as shown:
+        scene = shown.scene
         assert isinstance(scene, PelotonScene)
         # The longest line: the last rider is the first to go under the panel.
         scene.controls["n_riders"].value = 8
-        open_viser(page, server.get_port(), "/peloton")
+        shown.open("/peloton")
         close_notifications(page)
-        shown = ScenePage(server, switcher, page, VIEWPORT)
         settle(shown)
         device, css = _canvas(page)
         assert css == VIEWPORT[0]
@@ -80,5 +77,3 @@ def test_the_camera_reports_css_pixels_and_the_line_is_framed_clear_of_the_panel
         wait_until(lambda: scene.framing.frames > frames, "the reset tab to be framed again")
         settle(shown)
         np.testing.assert_allclose(camera.position, position, atol=1e-3)
-    finally:
-        switcher.close()

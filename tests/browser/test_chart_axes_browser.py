@@ -3,14 +3,11 @@ iteration ticks, no label cut at the canvas's edge, at 1280×720."""
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-from typing import Any
-
 import pytest
 from helpers.browser import (
     ScenePage,
     assert_tick_labels_inside,
-    scene_page,
+    scene_page_fixture,
     set_number,
     tick_label_boxes,
     wait_chart_data,
@@ -24,10 +21,7 @@ pytestmark = pytest.mark.browser
 CHART = "Error after each iteration (log scale)"
 
 
-@pytest.fixture(scope="module")
-def shown(chromium_browser: Any) -> Iterator[ScenePage]:
-    with scene_page(chromium_browser, "arm", (1280, 720)) as page:
-        yield page
+shown = scene_page_fixture("arm", [(1280, 720)])
 
 
 def test_zero_iterations_show_whole_ticks_and_no_cut_label(shown: ScenePage) -> None:

@@ -1,19 +1,16 @@
 """A real browser looks at the free kick: ball, wall, goal and path in view and clear of the panel, the force chart
 drawn, no error text, at 1600×1000 and 1280×720; in the opening view the path stands apart from its no-spin ghost and
 10 % more spin moves it on the screen; every camera view keeps the kick in view with the goal a real size, and the
-goalkeeper's view stands in front of the goal line with no net over the ball; a mouse click on "Kick" flies the ball
-in the page."""
+goalkeeper's view stands in front of the goal line with no net over the ball. (The click on "Kick" is in
+``test_interactions_browser.py``.)"""
 
 from __future__ import annotations
 
-from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
 import pytest
-import viser
 from helpers.browser import (
-    VIEWPORTS,
     NumberChange,
     ScenePage,
     assert_chart_draws,
@@ -21,14 +18,12 @@ from helpers.browser import (
     assert_in_view,
     assert_seen,
     changed_mask,
-    close_notifications,
     colour_pixels,
     error_text,
-    open_viser,
     panel_rect,
     project,
     save_scene_screenshot,
-    scene_page,
+    scene_page_fixture,
     screenshot,
     set_number,
     settle,
@@ -50,7 +45,6 @@ from scenes.freekick import (
     resample,
     view_points,
 )
-from server.switcher import SceneSwitcher
 
 pytestmark = pytest.mark.browser
 
@@ -75,10 +69,7 @@ SPIN_SHIFT_SHARE = 0.006
 the opening view (the old view: 8.2 px at 1600 and 5.8 px at 1280 wide, under it)."""
 
 
-@pytest.fixture(scope="module", params=VIEWPORTS, ids=lambda v: f"{v[0]}x{v[1]}")
-def shown(request: pytest.FixtureRequest, chromium_browser: Any) -> Iterator[ScenePage]:
-    with scene_page(chromium_browser, "freekick", request.param) as page:
-        yield page
+shown = scene_page_fixture("freekick")
 
 
 def _look_at_the_kick(shown: ScenePage) -> None:
@@ -205,41 +196,6 @@ def test_every_camera_view_keeps_the_kick_in_view(shown: ScenePage) -> None:
         goal = ["/freekick/net", "/freekick/goal_frame"]
         over_ball = changed_mask(plain, with_nodes_hidden(shown.page, [*overlays, *goal])) & ball
         assert not over_ball.any(), f"the goal is drawn over the ball at {x, y}"
-
-
-def test_pressing_kick_flies_the_ball_in_the_page(server: viser.ViserServer, browser_page: Any) -> None:
-    switcher = SceneSwitcher(server, "freekick")
-    try:
-        scene = switcher.scene
-        assert isinstance(scene, FreeKickScene)
-        page = browser_page
-        open_viser(page, server.get_port(), BALL)
-        close_notifications(page)
-        spot_x = float(ball_spot(scene.params)[0])
-        page.wait_for_function(f"() => Math.abs({NODE}.position.x - ({spot_x})) < 1e-3", timeout=20_000)
-
-        # Record what the page draws, every animation frame, from before the click on.
-        page.evaluate(
-            f"""() => {{
-                window.__kick = {{ maxX: -1e9, minW: 1.0 }};
-                const sample = () => {{
-                    const node = {NODE};
-                    window.__kick.maxX = Math.max(window.__kick.maxX, node.position.x);
-                    window.__kick.minW = Math.min(window.__kick.minW, Math.abs(node.quaternion.w));
-                    requestAnimationFrame(sample);
-                }};
-                sample();
-            }}"""
-        )
-        page.get_by_role("button", name="Kick", exact=True).click()
-
-        # The three.js ball left its spot and travelled toward the goal (x = 0), several metres on...
-        page.wait_for_function(f"() => window.__kick.maxX > {spot_x + 5.0}", timeout=20_000)
-        assert spot_x + 5.0 < float(page.evaluate("() => window.__kick.maxX")) <= 2.0 + 1e-6
-        # ...spinning: its orientation left the identity during the flight.
-        page.wait_for_function("() => window.__kick.minW < 0.999", timeout=20_000)
-    finally:
-        switcher.close()
 
 
 def test_the_force_chart_tick_labels_stay_inside_its_canvas(shown: ScenePage) -> None:

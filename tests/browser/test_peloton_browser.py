@@ -1,42 +1,33 @@
 """A real browser looks at the peloton: the line in view and clear of the panel, the chart's curves drawn, no error
-text, at 1600×1000 and 1280×720; a typed rider count and speed change the picture where they should; a mouse drag
-on the speed slider changes the power."""
+text, at 1600×1000 and 1280×720; a typed rider count and speed change the picture where they should. (The mouse
+drag on the speed slider is in ``test_interactions_browser.py``.)"""
 
 from __future__ import annotations
 
-import io
-import time
-from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
 import pytest
-import viser
 from helpers.browser import (
-    VIEWPORTS,
     NumberChange,
     ScenePage,
     assert_chart_draws,
     assert_chart_fits_after,
     assert_in_view,
     assert_seen,
-    canvas_is_not_blank,
     chart_image,
     error_text,
-    open_viser,
     panel_rect,
     save_scene_screenshot,
-    scene_page,
+    scene_page_fixture,
     screenshot,
     set_number,
     settle,
     with_labels_hidden,
 )
 from helpers.waiting import wait_until
-from PIL import Image
 
 from scenes.peloton import COMPONENT_COLOURS, LABEL_PX, PelotonScene
-from server.switcher import SceneSwitcher
 
 pytestmark = pytest.mark.browser
 
@@ -53,10 +44,7 @@ CHART_COLOURS = {
 }
 
 
-@pytest.fixture(scope="module", params=VIEWPORTS, ids=lambda v: f"{v[0]}x{v[1]}")
-def shown(request: pytest.FixtureRequest, chromium_browser: Any) -> Iterator[ScenePage]:
-    with scene_page(chromium_browser, "peloton", request.param) as page:
-        yield page
+shown = scene_page_fixture("peloton")
 
 
 def _look_at_the_line(shown: ScenePage) -> None:
@@ -141,61 +129,6 @@ def test_more_speed_lifts_the_now_line_and_the_bars(shown: ScenePage) -> None:
         assert scene.line_points()[:, 2].max() > top_before
     _look_at_the_line(shown)
     assert_chart_draws(shown.page, CHART, CHART_COLOURS)
-
-
-def test_drag_speed_slider_with_the_mouse(server: viser.ViserServer, browser_page: Any) -> None:
-    switcher = SceneSwitcher(server, "peloton")
-    scene = switcher.scene
-    assert isinstance(scene, PelotonScene)
-    page = browser_page
-    open_viser(page, server.get_port(), "/peloton/course/riders_body")
-
-    # The canvas shows the scene, not a blank page.
-    clients = list(server.get_clients().values())
-    assert len(clients) == 1
-    render = clients[0].get_render(height=360, width=640, transport_format="png")
-    buffer = io.BytesIO()
-    Image.fromarray(render).save(buffer, format="PNG")
-    assert canvas_is_not_blank(buffer.getvalue())
-
-    before_speed = scene.params.speed_kmh
-    before_power = float(scene.state.power.total[0])
-    label = page.get_by_text("Speed (km/h)", exact=True).first
-    row = label.locator("xpath=ancestor::*[.//*[@role='slider']][1]")
-    thumb = row.locator("[role='slider']").first
-    box = thumb.bounding_box()
-    assert box is not None
-    x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
-    page.mouse.move(x, y)
-    page.mouse.down()
-    for step in range(1, 11):
-        page.mouse.move(x + 4 * step, y)
-    page.mouse.up()
-
-    # Wait until the drag's messages have all been handled: the speed has moved and then held still.
-    end = time.monotonic() + 15.0
-    last, still_since = before_speed, time.monotonic()
-    while time.monotonic() < end:
-        with scene._lock:
-            speed = scene.params.speed_kmh
-        if speed != last:
-            last, still_since = speed, time.monotonic()
-        elif speed != before_speed and time.monotonic() - still_since > 0.5:
-            break
-        time.sleep(0.05)
-    with scene._lock:
-        final_speed = scene.params.speed_kmh
-        final_power = float(scene.state.power.total[0])
-    assert final_speed > before_speed
-    assert final_power > before_power
-    # The page shows the server's new value in the slider's number box.
-    page.wait_for_function(
-        "v => [...document.querySelectorAll('[role=slider]')].some(e => Number(e.getAttribute('aria-valuenow')) === v)",
-        arg=final_speed,
-        timeout=10_000,
-        polling=100,
-    )
-    switcher.close()
 
 
 def test_the_chart_tick_labels_stay_inside_its_canvas(shown: ScenePage) -> None:

@@ -11,8 +11,8 @@ import dataclasses
 import io
 import re
 import time
-from collections.abc import Iterable, Iterator, Sequence
-from typing import Any
+from collections.abc import Callable, Iterable, Iterator, Sequence
+from typing import Any, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -20,6 +20,7 @@ from numpy.typing import NDArray
 from helpers.paths import SCREENSHOTS
 from helpers.waiting import wait_until
 
+T = TypeVar("T")
 VIEWPORTS: tuple[tuple[int, int], ...] = ((1600, 1000), (1280, 720))
 """The windows every scene is looked at in (CSS px)."""
 ERROR_TEXT = re.compile(r"\bNaN\b|\bnan\b|Traceback|Exception|undefined|\binf\b|Infinity|\[object")
@@ -251,6 +252,49 @@ class ScenePage:
         clients = list(self.server.get_clients().values())
         assert len(clients) == 1, clients
         return clients[0].camera
+
+    def open(self, node: str) -> None:
+        """Open the page on this server and wait for scene node ``node`` (:func:`open_viser`)."""
+        open_viser(self.page, self.server.get_port(), node)
+
+
+def scene_page_fixture(key: str, viewports: Sequence[tuple[int, int]] = VIEWPORTS, *, gl: bool = False) -> Any:
+    """A module-scoped fixture (assign it to ``shown``): scene ``key`` served and shown in one settled page per
+    viewport (:func:`scene_page`), shared by the module's tests at that viewport. ``gl``: the scene needs the
+    process's GL context (made first, or the test skipped or failed)."""
+    import pytest
+
+    @pytest.fixture(scope="module", params=list(viewports), ids=lambda v: f"{v[0]}x{v[1]}")
+    def shown(request: pytest.FixtureRequest, chromium_browser: Any) -> Iterator[ScenePage]:
+        if gl:
+            from helpers.ci import need_gl
+
+            need_gl()
+        with scene_page(chromium_browser, key, request.param) as page:
+            yield page
+
+    return shown
+
+
+@contextlib.contextmanager
+def served_scene(
+    server: Any, page: Any, key: str, node: str | None = None, viewport: tuple[int, int] | None = None
+) -> Iterator[ScenePage]:
+    """Scene ``key`` shown on ``server`` by the app's switcher (closed afterwards) for ``page``, whose CSS size is
+    ``viewport`` (default: the page's own); the page is opened on scene node ``node`` when given (else call
+    :meth:`ScenePage.open` when ready)."""
+    from server.switcher import SceneSwitcher
+
+    switcher = SceneSwitcher(server, key)
+    try:
+        if viewport is None:
+            viewport = (page.viewport_size["width"], page.viewport_size["height"])
+        shown = ScenePage(server, switcher, page, viewport)
+        if node is not None:
+            shown.open(node)
+        yield shown
+    finally:
+        switcher.close()
 
 
 @contextlib.contextmanager
@@ -597,6 +641,70 @@ def screen_of(page: Any, name: str, local: tuple[float, float, float]) -> tuple[
     """CSS position of a point in scene node ``name``'s own frame."""
     x, y, _ = project(page, name, [local])[0]
     return float(x), float(y)
+
+
+def drag(
+    page: Any,
+    start: tuple[float, float],
+    step: tuple[float, float],
+    moves: int,
+    *,
+    steps: int = 2,
+    pause_s: float = 0.02,
+) -> None:
+    """Press the mouse at ``start`` (CSS px), move it ``moves`` times by ``step`` (each move in ``steps`` mouse
+    events, ``pause_s`` apart, as a hand moves) and release it."""
+    page.mouse.move(*start)
+    page.mouse.down()
+    for k in range(1, moves + 1):
+        page.mouse.move(start[0] + step[0] * k, start[1] + step[1] * k, steps=steps)
+        if pause_s:
+            time.sleep(pause_s)
+    page.mouse.up()
+
+
+def wait_moved_and_still(read: Callable[[], T], moved: Callable[[T], bool], timeout_s: float = 15.0) -> T:
+    """Poll ``read()`` until its value has ``moved`` and then held still for half a second: every message of a drag
+    has been handled. Returns the value then, or after ``timeout_s`` (the caller asserts what it must be)."""
+    deadline = time.monotonic() + timeout_s
+    last, still_since = read(), time.monotonic()
+    while time.monotonic() < deadline:
+        now = read()
+        if not np.array_equal(np.asarray(now), np.asarray(last)):
+            last, still_since = now, time.monotonic()
+        elif moved(now) and time.monotonic() - still_since > 0.5:
+            break
+        time.sleep(0.05)
+    return read()
+
+
+INSTANCE = """
+args => {
+  let mesh = null;
+  window.__viserMutable.nodeRefFromName[args.name].traverse(o => {
+    if (o.isInstancedMesh && mesh === null) mesh = o;
+  });
+  if (mesh === null || mesh.count <= args.i) return null;
+  const matrix = new mesh.matrix.constructor();
+  mesh.getMatrixAt(args.i, matrix);
+  return [matrix.elements[12], matrix.elements[13], matrix.elements[14]];
+}
+"""
+"""Position of instance ``i`` of a batched mesh, as the page's three.js scene holds it."""
+
+
+def assert_instance_drawn_at(
+    page: Any, name: str, i: int, expected: NDArray[np.float64], atol: float = 1e-3, timeout_s: float = 10.0
+) -> None:
+    """Assert that the page comes to draw instance ``i`` of batched mesh node ``name`` at ``expected`` (the pose the
+    server solved), within ``timeout_s``."""
+    deadline = time.monotonic() + timeout_s
+    drawn = page.evaluate(INSTANCE, {"name": name, "i": i})
+    while time.monotonic() < deadline and (drawn is None or np.linalg.norm(np.array(drawn) - expected) > atol):
+        time.sleep(0.1)
+        drawn = page.evaluate(INSTANCE, {"name": name, "i": i})
+    assert drawn is not None
+    np.testing.assert_allclose(drawn, expected, atol=atol)
 
 
 @dataclasses.dataclass(frozen=True)
