@@ -18,6 +18,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from kernels import _checks
+from kernels.ball import core
 from kernels.ball.config import (
     BALL_RADIUS_M,
     DT,
@@ -34,20 +35,18 @@ from kernels.ball.config import (
     kick_rows,
     launch_rows,
 )
-from kernels.ball.core import (
-    ENDINGS,
-    RESULTS,
-    Ending,
-    Result,
-    fly_and_judge,
-    fly_batch,
-    judge,
-    judge_batch,
-    pad,
-    simulate_one,
-    stable_step,
-)
+from kernels.ball.core import ENDINGS, RESULTS, Ending, Result
 from kernels.ball.pitch import Panel, free_kick_panels, panel_rows
+from kernels.warming import Entry
+
+# The compiled cores called from here: plain Python while the app's first start compiles them (kernels.warming).
+fly_and_judge = Entry(core.fly_and_judge)
+fly_batch = Entry(core.fly_batch)
+judge = Entry(core.judge)
+judge_batch = Entry(core.judge_batch)
+pad = Entry(core.pad)
+simulate_one = Entry(core.simulate_one)
+stable_step = Entry(core.stable_step)
 
 RESERVE_BYTES = 2**31
 """Largest time-major reservation :func:`simulate_batch` makes before it counts the samples first (bytes)."""

@@ -20,6 +20,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from kernels import _checks, cycling
 from kernels.course.route import Course, course_from_xy
+from kernels.warming import Entry
 
 Model = Literal["seed", "martin"]
 AirKind = Literal["seed", "weather"]
@@ -381,7 +382,7 @@ def _ride(course: Course, power: NDArray[np.float64], s: _Segments, max_speed: f
     n = course.n_points
     speed, elapsed = np.empty(n), np.empty(n)
     power_out, energy = np.empty(n - 1), np.zeros(6)
-    failed = _ride_core(
+    failed = _ride_core_entry(
         s.length,
         s.drag,
         s.rolling,
@@ -601,6 +602,10 @@ def paced_ride(
         if abs(ratio - 1.0) < 1e-9:
             break
     return Pacing(constant=constant, paced=paced, time_saved_s=constant.time_s - paced.time_s)
+
+
+# The compiled ride loop as _ride calls it: plain Python while the app's first start compiles it (kernels.warming).
+_ride_core_entry = Entry(_ride_core)
 
 
 def warm_up() -> None:

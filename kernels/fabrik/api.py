@@ -25,24 +25,33 @@ from kernels.fabrik.chain import (
     STATUSES,
     Solver,
     Status,
-    _solve_one,
-    _solve_parallel,
-    _solve_rows,
 )
+from kernels.fabrik.chain import _solve_one as _compiled_solve_one
+from kernels.fabrik.chain import _solve_parallel as _compiled_solve_parallel
+from kernels.fabrik.chain import _solve_rows as _compiled_solve_rows
 from kernels.fabrik.geometry import (
     _LARGEST,
     _TINY,
-    _perpendicular,
 )
+from kernels.fabrik.geometry import _perpendicular as _compiled_perpendicular
 from kernels.fabrik.limits import (
     _FREE_TABLE,
     _KIND_CONE,
     _TABLE_WIDTH,
     Constraint,
-    _limit_flags,
     _limit_table,
-    _usage,
 )
+from kernels.fabrik.limits import _limit_flags as _compiled_limit_flags
+from kernels.fabrik.limits import _usage as _compiled_usage
+from kernels.warming import Entry
+
+# The compiled cores Python calls here: plain Python while the app's first start compiles them (kernels.warming).
+_solve_one = Entry(_compiled_solve_one)
+_solve_rows = Entry(_compiled_solve_rows)
+_solve_parallel = Entry(_compiled_solve_parallel)
+_perpendicular = Entry(_compiled_perpendicular)
+_limit_flags = Entry(_compiled_limit_flags)
+_usage = Entry(_compiled_usage)
 
 Obstacle = tuple[ArrayLike, float]
 """``(centre (d,) m, radius m)``: a circle in 2D, a sphere in 3D."""
@@ -692,7 +701,7 @@ def compiled_single_solve(
     chain = _check_joints("joints", joints, batched=False)
     point = _check_vector("target", target, chain.shape[1])
     setup = _Setup.build(chain.shape[1], 1e-3, 50, None, (), None, _SOLVER_IDS["fabrik"], True)
-    return _solve_one, setup.single_args(chain, point)
+    return _compiled_solve_one, setup.single_args(chain, point)
 
 
 def _solve_single(

@@ -55,6 +55,7 @@ from kernels.fabrik.limits import (
     _limit_flags,
     _limit_table,
 )
+from kernels.warming import Entry
 
 
 @dataclasses.dataclass(frozen=True)
@@ -191,14 +192,14 @@ def solve_tree(
     codes = np.empty(len(effector_ids), dtype=np.int64)
     final = np.empty(len(effector_ids))
     # As solve: divided by a power of 2 near the extent (exact), so squared norms neither overflow nor underflow
-    extent = _tree_extent(p, goal, effector_ids, root)
+    extent = _tree_extent_entry(p, goal, effector_ids, root)
     scale, centres, radii = 1.0, setup.centres, setup.radii
     if extent != 0.0 and not _UNSCALED[0] <= extent <= _UNSCALED[1]:
         scale = math.ldexp(1.0, math.frexp(extent)[1])
         p /= scale
         goal /= scale
         tol, centres, radii = tol / scale, centres / scale, radii / scale
-    iterations = _solve_tree_core(
+    iterations = _solve_tree_core_entry(
         p,
         parent,
         order,
@@ -660,3 +661,9 @@ def _tree_errors(
         history[row, e] = math.sqrt(x * x + y * y + z * z)
         worst = max(worst, history[row, e])
     return worst
+
+
+# The compiled cores solve_tree calls from Python: plain Python while the app's first start compiles them
+# (kernels.warming); compiled code calls the dispatchers above directly.
+_solve_tree_core_entry = Entry(_solve_tree_core)
+_tree_extent_entry = Entry(_tree_extent)

@@ -1,0 +1,284 @@
+"""The first start: kernels compile in the background while the same functions run as plain Python.
+
+A cold numba cache makes the first call of each compiled kernel wait for its compile (several seconds per module on
+a small machine). :func:`start` compiles every kernel module in child processes (which write numba's disk cache, in
+parallel over the machine's cores) and then loads the cache here. Until a module's kernels are loaded, each compiled
+entry point (an :class:`Entry`, wrapped around the numba dispatcher that Python code calls) runs its *plain-Python
+twin*: the very same function, ``dispatcher.py_func``, with every compiled function it calls swapped for that
+function's own twin. No second copy of any algorithm exists; the twin is slower (pure Python loops) but gives the
+same numbers, which is good enough for the first frames.
+
+Outside :func:`start` (tests, scripts, library use) nothing changes: an :class:`Entry` calls its dispatcher, which
+compiles on first use as numba always does.
+
+    >>> from kernels import warming
+    >>> warming.start()            # in the app, before serving pages
+    >>> warming.progress()         # Progress(done=('course',), pending=('fabrik', 'ball'), elapsed_s=4.2)
+"""
+
+from __future__ import annotations
+
+import atexit
+import dataclasses
+import importlib
+import logging
+import os
+import subprocess
+import sys
+import threading
+import time
+import types
+from collections.abc import Callable, Sequence
+from typing import Any, Generic, ParamSpec, TypeVar
+
+from numba.core.dispatcher import Dispatcher
+
+logger = logging.getLogger(__name__)
+
+MODULES: tuple[str, ...] = ("kernels.fabrik", "kernels.ball", "kernels.course")
+"""The kernel packages with compiled code, each with a ``warm_up()`` that compiles every core it has."""
+
+LABELS: dict[str, str] = {
+    "kernels.fabrik": "inverse kinematics",
+    "kernels.ball": "ball flight",
+    "kernels.course": "course ride",
+}
+"""What each package computes, in the words the status line uses."""
+
+P = ParamSpec("P")
+R = TypeVar("R")
+
+
+@dataclasses.dataclass(frozen=True)
+class Progress:
+    """Where the background compile stands: packages loaded, packages still compiling, seconds since :func:`start`."""
+
+    done: tuple[str, ...]
+    pending: tuple[str, ...]
+    elapsed_s: float
+
+    @property
+    def finished(self) -> bool:
+        return not self.pending
+
+
+class _State:
+    """The process-wide state of the background compile (one per process; :func:`start` is idempotent)."""
+
+    def __init__(self) -> None:
+        self.lock = threading.Lock()
+        self.started_at: float | None = None
+        self.pending: set[str] = set()
+        self.done: list[str] = []
+        self.listeners: list[Callable[[Progress], None]] = []
+
+
+_STATE = _State()
+_TWINS: dict[Any, Callable[..., Any]] = {}
+_TWINS_LOCK = threading.RLock()
+
+
+def _module_twin(module: types.ModuleType) -> types.SimpleNamespace:
+    """A namespace with ``module``'s attributes, its compiled functions swapped for their twins (for code that calls
+    ``cycling.wheel_power_terms_compiled(...)`` through the module)."""
+    key = ("module", module.__name__)
+    if key in _TWINS:
+        return _TWINS[key]  # type: ignore[return-value]
+    namespace = types.SimpleNamespace()
+    _TWINS[key] = namespace  # type: ignore[assignment]
+    for name, value in vars(module).items():
+        setattr(namespace, name, _make_twin(value) if isinstance(value, Dispatcher) else value)
+    return namespace
+
+
+def python_twin(dispatcher: Any) -> Callable[..., Any]:
+    """The plain-Python twin of a numba dispatcher: its ``py_func`` (the same code object) run with globals in
+    which every compiled function it calls is that function's twin, recursively. Calling it never compiles.
+
+    Raises:
+        TypeError: ``dispatcher`` is not a numba dispatcher.
+    """
+    if not isinstance(dispatcher, Dispatcher):
+        raise TypeError(f"dispatcher must be a numba dispatcher, got {type(dispatcher).__name__}")
+    with _TWINS_LOCK:
+        return _make_twin(dispatcher)
+
+
+def _make_twin(dispatcher: Any) -> Callable[..., Any]:
+    twin = _TWINS.get(dispatcher)
+    if twin is not None:
+        return twin
+    source = dispatcher.py_func
+    namespace: dict[str, Any] = dict(source.__globals__)
+    twin = types.FunctionType(source.__code__, namespace, source.__name__, source.__defaults__, source.__closure__)
+    twin.__kwdefaults__ = source.__kwdefaults__
+    twin.__doc__ = source.__doc__
+    _TWINS[dispatcher] = twin  # before the callees: recursion and cycles find it
+    for name, value in namespace.items():
+        if isinstance(value, Dispatcher):
+            namespace[name] = _make_twin(value)
+        elif isinstance(value, types.ModuleType) and value.__name__.startswith("kernels."):
+            namespace[name] = _module_twin(value)
+    return twin
+
+
+class Entry(Generic[P, R]):
+    """A compiled kernel as Python code calls it: the dispatcher, or, while :func:`start`'s compile of its package
+    is under way and the dispatcher holds no compiled code yet, the dispatcher's plain-Python twin.
+
+    Wrap only functions that Python calls (compiled code calls the dispatcher itself: ``entry.compiled``).
+    """
+
+    def __init__(self, compiled: Callable[P, R]) -> None:
+        if not isinstance(compiled, Dispatcher):
+            raise TypeError(f"compiled must be a numba dispatcher, got {type(compiled).__name__}")
+        self.compiled = compiled
+        self.package = compiled.py_func.__module__.rsplit(".", 1)[0] if "." in compiled.py_func.__module__ else ""
+        self.__doc__ = compiled.__doc__
+        self.__name__ = compiled.__name__
+
+    def __call__(self, *args: P.args, **kwargs: P.kwargs) -> R:
+        if _STATE.pending and not self.compiled.signatures and _package_of(self.compiled) in _STATE.pending:
+            try:
+                return python_twin(self.compiled)(*args, **kwargs)
+            except Exception:  # a twin that cannot run this input: wait for the compiled code instead
+                logger.debug("plain-Python %s failed; waiting for its compiled code", self.__name__, exc_info=True)
+        return self.compiled(*args, **kwargs)
+
+
+def _package_of(dispatcher: Any) -> str:
+    module = dispatcher.py_func.__module__
+    for package in MODULES:
+        if module == package or module.startswith(package + "."):
+            return package
+    return "kernels.cycling" if module == "kernels.cycling" else module
+
+
+def is_pending(package: str) -> bool:
+    """Whether ``package`` (e.g. ``"kernels.ball"``) is still compiling in the background (False without
+    :func:`start`)."""
+    return package in _STATE.pending
+
+
+def progress() -> Progress:
+    """Where the background compile stands (both tuples empty when :func:`start` was never called)."""
+    with _STATE.lock:
+        elapsed = 0.0 if _STATE.started_at is None else time.perf_counter() - _STATE.started_at
+        return Progress(tuple(_STATE.done), tuple(sorted(_STATE.pending)), elapsed)
+
+
+def on_progress(listener: Callable[[Progress], None]) -> None:
+    """Call ``listener(progress())`` each time a package finishes (from a background thread; it must not raise)."""
+    with _STATE.lock:
+        _STATE.listeners.append(listener)
+
+
+def remove_listener(listener: Callable[[Progress], None]) -> None:
+    """Stop calling ``listener`` (no error when it was not registered)."""
+    with _STATE.lock:
+        if listener in _STATE.listeners:
+            _STATE.listeners.remove(listener)
+
+
+def describe(progress: Progress) -> str:
+    """The status line for ``progress``: what is compiling, how far it is, and what that means for the scenes."""
+    total = len(progress.done) + len(progress.pending)
+    pending = ", ".join(LABELS.get(name, name) for name in progress.pending)
+    return (
+        f"First start: compiling the {pending} kernels ({len(progress.done)} of {total} ready). Until then they "
+        "run as plain Python, so a scene may answer slowly."
+    )
+
+
+def start(modules: Sequence[str] = MODULES, *, processes: bool = True) -> threading.Thread | None:
+    """Compile ``modules``' kernels in the background; until each is ready its entries run as plain Python.
+
+    With ``processes`` each package compiles in a child process of its own (numba's compile holds this process's
+    GIL for most of its time; children use the other cores and write the disk cache), then loads here from the
+    cache; without, or where a child fails, it compiles on a thread here. Returns the thread that waits for them
+    (None when already started).
+    """
+    with _STATE.lock:
+        if _STATE.started_at is not None:
+            return None
+        _STATE.started_at = time.perf_counter()
+        _STATE.pending = set(modules)
+        _STATE.done = []
+    thread = threading.Thread(
+        target=_compile_all, args=(tuple(modules), processes), name="kernels-warming", daemon=True
+    )
+    thread.start()
+    return thread
+
+
+def _compile_all(modules: tuple[str, ...], processes: bool) -> None:
+    """Compile every package at once (a child process each), and load each here as soon as its child is done."""
+    waiters = [
+        threading.Thread(target=_compile_one, args=(name, processes), name=f"kernels-warming-{name}", daemon=True)
+        for name in modules
+    ]
+    for waiter in waiters:
+        waiter.start()
+    for waiter in waiters:
+        waiter.join()
+    with _STATE.lock:
+        started = _STATE.started_at or 0.0
+    logger.info("compiled kernels ready in %.1f s", time.perf_counter() - started)
+
+
+def _compile_one(name: str, processes: bool) -> None:
+    child = _spawn(name) if processes else None
+    if child is not None:
+        _, errors = child.communicate()
+        if child.returncode != 0:  # it failed: the load below compiles here instead, and the log says why
+            logger.warning("the compile process for %s failed: %s", name, errors.decode(errors="replace")[-2000:])
+    try:
+        importlib.import_module(name).warm_up()  # loads what the child cached, or compiles here
+    except Exception:  # the kernel then compiles on first use instead; say why
+        logger.exception("compiling %s failed", name)
+    _finish(name)
+
+
+_CHILDREN: list[subprocess.Popen[bytes]] = []
+"""Compile processes started here; any still running when this process exits is stopped with it."""
+
+
+def _spawn(name: str) -> subprocess.Popen[bytes] | None:
+    command = [sys.executable, "-c", f"import {name} as m; m.warm_up()"]
+    try:
+        child = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, env=os.environ.copy())
+    except OSError:
+        logger.warning("could not start a compile process for %s; compiling here", name)
+        return None
+    if not _CHILDREN:
+        atexit.register(_stop_children)
+    _CHILDREN.append(child)
+    return child
+
+
+def _stop_children() -> None:
+    for child in _CHILDREN:
+        if child.poll() is None:
+            child.kill()
+
+
+def _finish(name: str) -> None:
+    with _STATE.lock:
+        _STATE.pending.discard(name)
+        _STATE.done.append(name)
+        listeners = list(_STATE.listeners)
+    snapshot = progress()
+    for listener in listeners:
+        try:
+            listener(snapshot)
+        except Exception:
+            logger.exception("a compile-progress listener failed")
+
+
+def _reset_for_tests() -> None:
+    """Forget :func:`start` (tests only): entries call their dispatchers again."""
+    with _STATE.lock:
+        _STATE.started_at = None
+        _STATE.pending = set()
+        _STATE.done = []
+        _STATE.listeners = []

@@ -1,0 +1,190 @@
+"""The first start's plain-Python twins: every compiled core Python calls is an Entry, each twin gives the compiled
+numbers, and the background compile reports its progress and then hands every call to the compiled code."""
+
+from __future__ import annotations
+
+import importlib
+import pkgutil
+import sys
+import types
+from collections.abc import Callable, Iterator
+from typing import Any
+
+import numpy as np
+import pytest
+from numba.core.dispatcher import Dispatcher
+
+import kernels
+from kernels import ball, course, fabrik, warming
+from kernels.ball.core import RESULTS
+from kernels.fabrik import Cone, Hinge
+
+
+@pytest.fixture
+def fresh_warming() -> Iterator[None]:
+    warming._reset_for_tests()
+    yield
+    warming._reset_for_tests()
+
+
+def _code_objects(code: types.CodeType) -> Iterator[types.CodeType]:
+    yield code
+    for constant in code.co_consts:
+        if isinstance(constant, types.CodeType):
+            yield from _code_objects(constant)
+
+
+def _python_functions(module: types.ModuleType) -> Iterator[types.FunctionType]:
+    for value in vars(module).values():
+        members = vars(value).values() if isinstance(value, type) else (value,)
+        for member in members:
+            function = getattr(member, "__func__", member)
+            if isinstance(function, types.FunctionType) and function.__module__ == module.__name__:
+                yield function
+
+
+def test_python_code_in_the_kernels_calls_compiled_cores_only_through_entries() -> None:
+    # A bare dispatcher called from Python would compile in the serving process during the first start (seconds
+    # holding its GIL) instead of running its twin. compiled_single_solve hands the raw core to a benchmark on purpose.
+    bare = []
+    for info in pkgutil.walk_packages(kernels.__path__, "kernels."):
+        module = importlib.import_module(info.name)
+        for function in _python_functions(module):
+            for code in _code_objects(function.__code__):
+                for name in code.co_names:
+                    if isinstance(function.__globals__.get(name), Dispatcher):
+                        bare.append(f"{module.__name__}.{function.__qualname__} calls {name}")
+    assert bare == ["kernels.fabrik.api.compiled_single_solve calls _compiled_solve_one"]
+
+
+def _chain() -> np.ndarray:
+    return np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.3, 0.0, 1.9], [0.6, 0.0, 2.5]])
+
+
+def _wall_goal() -> tuple[Any, Any]:
+    return ball.free_kick_panels((0.0, 0.0), (20.0, 0.0), (1.0, 0.0))
+
+
+def _kicks() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    rows = np.tile((0.0, 0.0, ball.BALL_RADIUS_M), (6, 1))
+    velocities = np.tile((25.0, -3.0, 6.0), (6, 1)) + np.linspace(0.0, 2.0, 6)[:, None]
+    spins = np.tile((0.0, 5.0, 50.0), (6, 1))
+    return rows, velocities, spins
+
+
+def _outcome_numbers(outcome: Any) -> np.ndarray:
+    """An outcome's verdicts (as codes) and its wall and goal crossing points, NaN where it crossed none."""
+    codes = np.atleast_1d(np.vectorize(RESULTS.index)(np.asarray(outcome.result)))
+    points = [
+        np.full(3, np.nan) if point is None else np.asarray(point) for point in (outcome.wall_point, outcome.goal_point)
+    ]
+    return np.nan_to_num(np.concatenate([codes.astype(float), *(point.ravel() for point in points)]), nan=-1.0)
+
+
+CASES: dict[str, Callable[[], Any]] = {
+    "fabrik.solve with limits and an obstacle": lambda: (
+        fabrik.solve(
+            _chain(),
+            [0.8, 0.3, 1.2],
+            constraints=[Hinge((0.0, 1.0, 0.0), -1.0, 1.0), Cone(1.0), Cone(1.0)],
+            obstacles=[((1.0, 0.0, 1.0), 0.2)],
+        ).joints
+    ),
+    "fabrik.solve_batch (parallel driver)": lambda: (
+        fabrik.solve_batch(
+            np.repeat(_chain()[None], 3, axis=0), np.array([[0.8, 0.0, 1.2], [0.5, 0.5, 1.5], [0.0, 0.9, 1.0]])
+        ).joints
+    ),
+    "fabrik.ccd": lambda: fabrik.ccd(_chain(), [0.8, 0.3, 1.2]).joints,
+    "fabrik.jacobian_dls": lambda: fabrik.jacobian_dls(_chain(), [0.8, 0.3, 1.2]).joints,
+    "fabrik.solve_tree": lambda: (
+        fabrik.solve_tree(
+            [-1, 0, 1, 1],
+            np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.3, 0.0, 1.9], [-0.3, 0.0, 1.9]]),
+            {2: [0.8, 0.0, 1.2], 3: [-0.8, 0.0, 1.2]},
+        ).joints
+    ),
+    "ball.simulate RK4, measured model, knuckle": lambda: (
+        ball.simulate(
+            (0.0, 0.0, 0.11),
+            (25.0, -3.0, 6.0),
+            (0.0, 0.0, 3.0),
+            dt=0.002,
+            method="rk4",
+            model="measured",
+            knuckle_seed=3,
+        ).position
+    ),
+    "ball.outcome": lambda: _outcome_numbers(
+        ball.outcome(ball.simulate((0.0, 0.0, 0.11), (25.0, -3.0, 6.0), (0.0, 0.0, 50.0), dt=0.002), *_wall_goal())
+    ),
+    "ball.simulate_batch": lambda: np.nan_to_num(ball.simulate_batch(*_kicks(), dt=0.002).position, nan=-1.0),
+    "ball.simulate_outcomes": lambda: _outcome_numbers(ball.simulate_outcomes(*_kicks(), *_wall_goal(), dt=0.002)),
+    "course.ride": lambda: np.array(
+        [
+            course.ride(
+                course.course_from_xy(
+                    np.linspace(0.0, 3000.0, 60), np.zeros(60), 40.0 * np.sin(np.linspace(0.0, 3.0, 60))
+                ),
+                250.0,
+            ).time_s
+        ]
+    ),
+}
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_the_plain_python_twin_gives_the_compiled_numbers(case: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    compiled = np.asarray(CASES[case](), dtype=float)
+    monkeypatch.setattr(warming.Entry, "__call__", lambda self, *a, **k: warming.python_twin(self.compiled)(*a, **k))
+    twin = np.asarray(CASES[case](), dtype=float)
+    assert twin.shape == compiled.shape
+    np.testing.assert_allclose(twin, compiled, rtol=1e-9, atol=1e-12)
+
+
+def test_a_twin_calls_no_compiled_code() -> None:
+    from kernels.fabrik.chain import _solve_chain
+
+    twin = warming.python_twin(_solve_chain)
+    assert twin.__code__ is _solve_chain.py_func.__code__  # the same source, not a copy
+    compiled_globals = [name for name, value in twin.__globals__.items() if isinstance(value, Dispatcher)]
+    assert compiled_globals == []
+    with pytest.raises(TypeError, match="dispatcher"):
+        warming.python_twin(len)
+
+
+def test_entries_run_twins_only_while_their_package_is_pending(fresh_warming: None) -> None:
+    from kernels.fabrik import api
+
+    ran: list[str] = []
+    real_twin = warming.python_twin
+
+    def spy(dispatcher: Any) -> Any:
+        ran.append(dispatcher.__name__)
+        return real_twin(dispatcher)
+
+    entry = warming.Entry(api._solve_one.compiled)
+    warming._STATE.pending = {"kernels.ball"}  # another package compiling: fabrik's entry uses its compiled code
+    original = warming.python_twin
+    try:
+        warming.python_twin = spy  # type: ignore[assignment]
+        fabrik.solve(_chain(), [0.8, 0.3, 1.2])
+        assert ran == []
+        assert entry.package == "kernels.fabrik"
+    finally:
+        warming.python_twin = original  # type: ignore[assignment]
+
+
+def test_start_reports_progress_and_then_hands_calls_to_compiled_code(fresh_warming: None) -> None:
+    seen: list[warming.Progress] = []
+    warming.on_progress(seen.append)
+    thread = warming.start(("kernels.course",), processes=False)
+    assert thread is not None
+    assert warming.start(("kernels.course",)) is None  # once per process
+    thread.join(120)
+    assert not thread.is_alive()
+    assert [progress.done for progress in seen] == [("kernels.course",)]
+    assert seen[-1].finished and warming.progress().finished
+    assert "course ride" in warming.describe(warming.Progress(done=(), pending=("kernels.course",), elapsed_s=1.0))
+    ride_module = sys.modules["kernels.course.ride"]
+    assert ride_module._ride_core_entry.compiled.signatures  # compiled (or loaded) by start
