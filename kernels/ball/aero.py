@@ -53,7 +53,7 @@ N_KICK = 14
 
 
 # --------------------------------------------------------------------------------------------- force law
-@compiled(inline="always")
+@compiled()
 def _norm(v):
     """|v| of a (3,) vector without overflow or underflow in the squares (a spin of 1e200 rad/s still has an axis)."""
     scale = max(abs(v[0]), abs(v[1]), abs(v[2]))
@@ -136,7 +136,7 @@ def max_stable_step(launch, kick, config):
     return (beta / (2.0 * rate) if rate > 0.0 else math.inf), fastest
 
 
-@compiled(inline="always")
+@compiled()
 def _factors(speed, kick, config):
     """(−½ρA·C_D·|v|/m, ½ρA·C_L·|v|/m) at this speed: drag and lift per unit velocity and mass (1/s)."""
     q = config[Q]
@@ -151,7 +151,7 @@ def _factors(speed, kick, config):
     return -q * drag * speed, q * lift * speed
 
 
-@compiled(inline="always")
+@compiled()
 def _knuckle(speed, t, kick):
     """Knuckle side force per unit mass (m/s², 3 values); zero when the kick has none."""
     gain = kick[GAIN]
@@ -167,7 +167,7 @@ def _knuckle(speed, t, kick):
     )
 
 
-@compiled(inline="always")
+@compiled()
 def acceleration(vx, vy, vz, t, kick, config):
     """Total acceleration (m/s²): drag, Magnus (ω̂ × v), knuckle and gravity."""
     speed = math.sqrt(vx * vx + vy * vy + vz * vz)

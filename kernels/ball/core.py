@@ -28,7 +28,7 @@ RESULTS: tuple[Result, ...] = ("goal", "wall", "over", "wide", "short")
 
 
 # --------------------------------------------------------------------------------------------- flight
-@compiled(inline="always")
+@compiled()
 def _step(x, y, z, vx, vy, vz, t, dt, kick, config):
     """One step of length ``dt`` of the configured method: (x, y, z, vx, vy, vz) after it."""
     if config[RK4] == 0.0:  # the seed's Euler: velocity first, then position with the new velocity
@@ -54,7 +54,7 @@ def _step(x, y, z, vx, vy, vz, t, dt, kick, config):
     )
 
 
-@compiled(inline="always")
+@compiled()
 def _hermite(p0, v0, p1, v1, h, s):
     """Cubic Hermite value and derivative (per unit time) at fraction ``s`` of a step of length ``h``.
 
@@ -74,13 +74,13 @@ def _hermite(p0, v0, p1, v1, h, s):
     return value, slope
 
 
-@compiled(inline="always")
+@compiled()
 def _cubic_value(d0, dd0, d1, dd1, h, s):
     value, _ = _hermite(d0, dd0, d1, dd1, h, s)
     return value
 
 
-@compiled(inline="always")
+@compiled()
 def crossing_fraction(d0, dd0, d1, dd1, h):
     """First fraction s ∈ [0, 1] of a step where the cubic Hermite through (d0, dd0) and (d1, dd1) reaches zero.
 
