@@ -17,15 +17,12 @@ import ipaddress
 import logging
 import socket
 import sys
-import threading
-import time
-from types import ModuleType
 from typing import Annotated
 
 import tyro
 import viser
 
-from kernels import ball, course, fabrik
+from kernels import warming
 from scenes import SceneName
 from scenes.sdf_gallery import COMPILE_LIMIT_S, FRAME_LIMIT_S, MAX_SOURCE_CHARS, set_editing_allowed
 from server.gate import install_gate
@@ -69,30 +66,6 @@ def exposure_warning(host: str, port: int, *, allow_remote_glsl: bool = False) -
         "address can open the page, move every slider and drag every gizmo, with no password; the server runs "
         f"their inputs on this machine. Use --host 127.0.0.1 (the default) unless that is what you want. {glsl}"
     )
-
-
-def warm_kernels(modules: tuple[ModuleType, ...] = (fabrik, ball, course)) -> threading.Thread:
-    """Run each module's ``warm_up()`` (where it has one) on one daemon thread, started here.
-
-    The compiled kernels then load from numba's cache (or compile, the first time) while the page is served, so
-    neither the first page nor the first drag waits for a compile.
-    """
-
-    def run() -> None:
-        start = time.perf_counter()
-        for module in modules:
-            warm_up = getattr(module, "warm_up", None)
-            if warm_up is None:
-                continue
-            try:
-                warm_up()
-            except Exception:  # the kernel then compiles on first use instead; say why
-                logger.exception("warming %s failed", module.__name__)
-        logger.info("compiled kernels ready in %.2f s", time.perf_counter() - start)
-
-    thread = threading.Thread(target=run, name="warm-kernels", daemon=True)
-    thread.start()
-    return thread
 
 
 def serve_scenes(server: viser.ViserServer, scene: SceneName, *, shared: bool) -> SceneSwitcher | Sessions:
@@ -174,7 +147,7 @@ def main(
     if port is not None and not port_is_free(host, port):  # refuse before viser prints a URL it will not serve
         print(port_message(port, port + 1, explicit=True), file=sys.stderr, flush=True)
         raise SystemExit(2)
-    warm_kernels()
+    warming.start()  # every scene draws at once; kernels run as plain Python until compiled
     server = None
     try:
         server = make_server(host, asked)

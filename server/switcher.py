@@ -16,6 +16,7 @@ import viser
 
 from scenes import SCENES, Scene
 from server.clean import mark_costly
+from server.compile_status import CompileStatus
 from server.sessions import Session
 
 logger = logging.getLogger(__name__)
@@ -64,6 +65,7 @@ class SceneSwitcher:
                 )
             )
             self.reset_button = mark_costly(session.gui.add_button("Reset scene to defaults", order=-99.0))
+            self.compile_status = CompileStatus(session.gui, order=-98.0)
             # Awaited by viser (coroutines), the builds running on a worker thread: the gate then knows when a
             # pick or Reset has finished, and holds that tab's later inputs until it has (server.gate).
             self.dropdown.on_update(_in_a_thread(self._on_pick))
@@ -113,3 +115,4 @@ class SceneSwitcher:
             self.scene.close()
             self.dropdown.remove()
             self.reset_button.remove()
+            self.compile_status.close()

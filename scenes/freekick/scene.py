@@ -19,7 +19,7 @@ import viser
 import viser.uplot
 from numpy.typing import NDArray
 
-from kernels import ball
+from kernels import ball, warming
 from scenes._base import Scene, set_if_changed
 from scenes._charts import FittedChart
 from scenes._controls import build_controls, declared
@@ -73,6 +73,10 @@ from scenes.freekick.views import frame_view
 
 CHART_COLOURS = {**FORCE_COLOURS, "knuckle": KNUCKLE_COLOUR}
 """The force chart's series after time, by the flight's force field: its arrows' colours and the knuckle's."""
+
+
+BALL_KERNELS = "kernels.ball"
+"""The package whose compile the outcome map waits for on a first start (see :mod:`kernels.warming`)."""
 
 
 def _css(rgb: tuple[int, int, int]) -> str:
@@ -134,8 +138,16 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
         self.redraw()
         self.framing = ClientFraming(self._view_for, opening=self.camera_position)
         self.watch_cameras(self.framing.on_camera)
+        # On a first start the map (1,271 kicks) waits for the compiled flight; plain Python would take ~10 s.
+        warming.on_progress(self._on_kernels_compiled)
         self.request_outcome_map()
         self.start_loop(self._animate, 1.0 / 30.0)
+
+    def _on_kernels_compiled(self, progress: warming.Progress) -> None:
+        if BALL_KERNELS in progress.done:
+            warming.remove_listener(self._on_kernels_compiled)
+            if not self.closed:
+                self.request_outcome_map()
 
     # ----------------------------------------------------------------------------------------- GUI
     def _build_gui(self) -> None:
@@ -373,6 +385,11 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
         version, params = self._map_version, self.params
 
         def job() -> None:
+            if warming.is_pending(BALL_KERNELS):  # requested again once they are compiled
+                with self._lock:
+                    if not self.closed:
+                        self.map_status.content = "The outcome map is drawn once the ball-flight kernels have compiled."
+                return
             self.map_runs += 1
             results = outcome_map(params)
             with self._lock:
@@ -416,6 +433,7 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
     def close(self) -> None:
         """Drop any waiting search and stop the workers, then remove the scene (a search in flight finishes, and
         finds the scene closed)."""
+        warming.remove_listener(self._on_kernels_compiled)
         for worker in (self._aim_worker, self._map_worker):
             worker.close(timeout_s=0.0)  # the base's close joins their threads
         super().close()

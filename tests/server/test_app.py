@@ -2,14 +2,12 @@
 
 from __future__ import annotations
 
+import contextlib
 import inspect
-import logging
 import signal
 import socket
 import subprocess
 import sys
-import threading
-import types
 
 import pytest
 import viser
@@ -197,29 +195,25 @@ def test_switching_from_a_browser(server: viser.ViserServer) -> None:
     switcher.close()
 
 
-def test_warm_kernels_runs_every_warm_up_on_one_daemon_thread(
-    caplog: pytest.LogCaptureFixture,
-) -> None:
-    from kernels import ball, course, fabrik
+def test_the_first_start_says_what_compiles_until_every_kernel_is_ready(server: viser.ViserServer) -> None:
+    # The app starts kernels.warming before serving; a tab opened while it compiles says so under the scene picker,
+    # counts each package as it lands, and the line goes once all are ready.
+    from kernels import warming
 
-    assert inspect.signature(app.warm_kernels).parameters["modules"].default == (
-        fabrik,
-        ball,
-        course,
-    )
-    calls: list[tuple[str, threading.Thread]] = []
-    failing, plain, warming = (types.ModuleType(name) for name in ("failing", "plain", "warming"))
-
-    def fail() -> None:
-        calls.append(("failing", threading.current_thread()))
-        raise RuntimeError("no compiler today")
-
-    failing.warm_up = fail  # type: ignore[attr-defined]
-    warming.warm_up = lambda: calls.append(("warming", threading.current_thread()))  # type: ignore[attr-defined]
-    with caplog.at_level(logging.INFO, logger="app"):
-        thread = app.warm_kernels((failing, plain, warming))
-        thread.join(10)
-    assert not thread.is_alive() and thread.daemon
-    # A failing warm-up is logged and the next still runs; a module without one is skipped; all on that thread.
-    assert calls == [("failing", thread), ("warming", thread)]
-    assert "warming failing failed" in caplog.text and "compiled kernels ready" in caplog.text
+    warming._reset_for_tests()
+    warming._STATE.started_at = 0.0
+    warming._STATE.pending = {"kernels.fabrik", "kernels.ball"}
+    try:
+        with contextlib.closing(SceneSwitcher(server, "arm")) as switcher:
+            status = switcher.compile_status
+            assert status.shown
+            assert status.text.startswith("First start: compiling the ball flight, inverse kinematics kernels (0 of 2")
+            warming._finish("kernels.ball")
+            assert status.shown and "inverse kinematics kernels (1 of 2 ready)" in status.text
+            assert "ball flight" not in status.text
+            warming._finish("kernels.fabrik")
+            assert not status.shown
+        with contextlib.closing(SceneSwitcher(server, "arm")) as later:  # a tab opened after: no line at all
+            assert not later.compile_status.shown
+    finally:
+        warming._reset_for_tests()
