@@ -476,13 +476,13 @@ time-averaged power is the mean over positions, far below the leader's.
         p, solo = self.params, self.state.solo
         rho = float(cycling.air_density(p.altitude_m))
         wheel = float(solo.aero + solo.rolling + solo.climbing)
-        aero_share = 100.0 * float(solo.aero) / wheel if wheel > 0 else float("nan")
         thinner = 100 * (1 - rho / cycling.RHO_SEA_LEVEL)
         where = "sea level" if abs(thinner) < 0.05 else f"{thinner:.1f} % thinner than at sea level"
-        return (
-            f"Air density **{rho:.3f} kg/m³** ({where})  \n"
-            f"Solo rider: **{float(solo.total):.0f} W**, aero share of wheel power **{aero_share:.1f} %**"
-        )
+        if wheel > 0:
+            share = f"aero share of wheel power **{100.0 * float(solo.aero) / wheel:.1f} %**"
+        else:  # standing still, or a descent that pays for the air: no share of nothing
+            share = "no power needed at the wheel"
+        return f"Air density **{rho:.3f} kg/m³** ({where})  \nSolo rider: **{float(solo.total):.0f} W**, {share}"
 
     def _table_markdown(self) -> str:
         state = self.state
@@ -504,7 +504,9 @@ time-averaged power is the mean over positions, far below the leader's.
             return ""
         mean = float(np.mean(self.state.power.total))
         lead = float(self.state.power.total[0])
-        if lead > 0:
+        if not self.params.drafting:
+            text = f"Drafting is off: every rider rides in clean air at the leader's {lead:.0f} W, so rotating saves nothing."
+        elif lead > 0:
             text = (
                 f"Rotating evenly, each rider averages **{mean:.0f} W** against the leader's {lead:.0f} W "
                 f"({100 * (1 - mean / lead):.0f} % less): the reason teams rotate."

@@ -362,3 +362,27 @@ def test_the_lead_starts_rotating_when_riders_join_with_rotate_on(scene: Peloton
         time.sleep(0.02)
     with scene._lock:
         assert scene._rotation_time_s > 0.1, "the rotation did not start when riders joined"
+
+
+@pytest.mark.parametrize(
+    ("speed", "grade", "wheel_power"), [(0.0, 0.0, False), (40.0, -15.0, False), (40.0, 0.0, True)]
+)
+def test_the_aero_share_is_a_number_only_where_the_wheel_needs_power(
+    scene: PelotonScene, speed: float, grade: float, wheel_power: bool
+) -> None:
+    # Standing still or coasting down a steep descent the wheel needs no power: no "nan %" share of nothing.
+    scene.controls["speed_kmh"].value = speed
+    scene.controls["grade_pct"].value = grade
+    text = scene.density.content
+    assert "nan" not in text.lower()
+    assert ("aero share of wheel power" in text) is wheel_power
+    assert ("no power needed at the wheel" in text) is not wheel_power
+
+
+def test_with_drafting_off_the_rotation_line_says_rotating_saves_nothing(scene: PelotonScene) -> None:
+    scene.controls["drafting"].value = False
+    text = scene.rotation.content
+    assert text.startswith("Drafting is off") and "saves nothing" in text
+    assert "teams rotate" not in text and "0 % less" not in text
+    scene.controls["drafting"].value = True
+    assert "the reason teams rotate" in scene.rotation.content
