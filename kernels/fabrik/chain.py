@@ -172,7 +172,7 @@ def _ccd_sweep(
         # (In the plane the axis is ±z; end and target antiparallel turn about z, or in 3D any perpendicular.)
         kx, ky, kz, _ = _unit(kx, ky, kz, 0.0, 0.0, 1.0, 1e-12)
         if sin_a <= 1e-12 and dim == 3:
-            kx, ky, kz = _perpendicular(ex, ey, ez, 3)
+            kx, ky, kz = _perpendicular(ex, ey, ez, dim)
         for j in range(i + 1, n + 1):
             # Rodrigues: v cos a + (k × v) sin a + k (k·v)(1 − cos a)
             vx, vy, vz = p[j, 0] - ox, p[j, 1] - oy, p[j, 2] - oz
@@ -254,7 +254,7 @@ def _dls_step(
             for r in range(3):
                 for q in range(3):
                     product[r, q] = turn[r, 0] * step[0, q] + turn[r, 1] * step[1, q] + turn[r, 2] * step[2, q]
-            turn[:, :] = product
+            turn, product = product, turn  # no array copy: numba compiles its shape checks for seconds
         p[i + 1, 0] = p[i, 0] + turn[0, 0] * sx + turn[0, 1] * sy + turn[0, 2] * sz
         p[i + 1, 1] = p[i, 1] + turn[1, 0] * sx + turn[1, 1] * sy + turn[1, 2] * sz
         p[i + 1, 2] = p[i, 2] + turn[2, 0] * sx + turn[2, 1] * sy + turn[2, 2] * sz
@@ -560,7 +560,7 @@ def _solve_chain(
     n = p.shape[0] - 1
     history[:] = np.nan
 
-    total, has_zero = 0.0, False
+    total = 0.0
     for i in range(n):
         dx, dy, dz = p[i + 1, 0] - p[i, 0], p[i + 1, 1] - p[i, 1], p[i + 1, 2] - p[i, 2]
         lengths[i] = math.sqrt(dx * dx + dy * dy + dz * dz)
@@ -569,8 +569,7 @@ def _solve_chain(
     distance = math.sqrt(ox * ox + oy * oy + oz * oz)
     # relative only: the core gives the same bits at any power-of-2 scale
     tiny = _TINY * max(total, distance)
-    for i in range(n):
-        has_zero = has_zero or lengths[i] <= tiny
+    has_zero = np.min(lengths) <= tiny  # a bool, never the literal False (which compiled every pass twice)
     inner = max(0.0, 2.0 * np.max(lengths) - total)
     beyond = distance > total + tiny
     fold = distance < inner - tiny
@@ -686,7 +685,7 @@ def _solve_chain(
                     best_error,
                     target,
                     tolerance,
-                    _POLISH_STEPS,
+                    int(_POLISH_STEPS),  # an int, not the literal 50: one compiled _polish
                     lengths,
                     tiny,
                     rest,

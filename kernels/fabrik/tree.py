@@ -35,6 +35,7 @@ from kernels.fabrik.chain import (
     _UNREACHABLE,
     STATUSES,
     Status,
+    _copy,
 )
 from kernels.fabrik.geometry import (
     _TINY,
@@ -393,7 +394,8 @@ def _solve_tree_core(
     if _tree_admissible(p, parents, order, table, rest, tiny, has_limits, centres, radii, live):
         best_worst = worst
         if worst <= tolerance:  # the start is returned as reached only where it keeps every limit
-            final[:] = history[0]
+            for e in range(final.shape[0]):
+                final[e] = history[0, e]
             _tree_statuses(
                 p, parents, goal, effectors, lengths, centres, radii, live, tolerance, tiny, final, False, False, codes
             )
@@ -461,7 +463,7 @@ def _solve_tree_core(
             p, parents, order, table, rest, tiny, has_limits, centres, radii, live
         )
         if admissible and worst < best_worst:
-            best[:, :] = p
+            _copy(p, best)  # a loop: an array copy compiles numba's shape checks for seconds
             best_worst = worst
         if admissible and worst <= tolerance:
             break
@@ -482,7 +484,7 @@ def _solve_tree_core(
         not retry  # restarted: never worse than the best before or after
         or not _tree_admissible(p, parents, order, table, rest, tiny, has_limits, centres, radii, live)
     ):
-        p[:, :] = best  # never an inadmissible last iterate where an admissible one was seen
+        _copy(best, p)  # never an inadmissible last iterate where an admissible one was seen
     for e in range(effectors.shape[0]):
         k = int(effectors[e])
         x, y, z = p[k, 0] - goal[k, 0], p[k, 1] - goal[k, 1], p[k, 2] - goal[k, 2]
