@@ -35,6 +35,14 @@ def run_child(warming_on: bool) -> None:
     from scenes import SCENES
     from server.switcher import SceneSwitcher
 
+    if warming_on:
+        warming.on_progress(
+            lambda progress: print(
+                f"| {warming.LABELS[progress.done[-1]]} kernels compiled and loaded (from start) | "
+                f"{time.perf_counter() - started:.2f} |",
+                flush=True,
+            )
+        )
     thread = warming.start() if warming_on else None
     print(f"| imports{' + start' if warming_on else ''} | {time.perf_counter() - started:.2f} |", flush=True)
     server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
