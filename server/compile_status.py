@@ -8,6 +8,7 @@ import threading
 import viser
 
 from kernels import warming
+from server.sessions import GuiFacade
 
 logger = logging.getLogger(__name__)
 
@@ -18,7 +19,7 @@ class CompileStatus:
     Shows nothing when nothing compiles (a warm cache, or the kernels used without :func:`kernels.warming.start`).
     """
 
-    def __init__(self, gui: viser.GuiApi, *, order: float) -> None:
+    def __init__(self, gui: viser.GuiApi | GuiFacade, *, order: float) -> None:
         self._lock = threading.Lock()
         self._handle: viser.GuiMarkdownHandle | None = None
         warming.on_progress(self._update)  # first, so a finish between here and the check below is not missed

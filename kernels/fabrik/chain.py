@@ -569,7 +569,7 @@ def _solve_chain(
     distance = math.sqrt(ox * ox + oy * oy + oz * oz)
     # relative only: the core gives the same bits at any power-of-2 scale
     tiny = _TINY * max(total, distance)
-    has_zero = np.min(lengths) <= tiny  # a bool, never the literal False (which compiled every pass twice)
+    has_zero = bool(np.min(lengths) <= tiny)  # a bool, never the literal False (which compiled every pass twice)
     inner = max(0.0, 2.0 * np.max(lengths) - total)
     beyond = distance > total + tiny
     fold = distance < inner - tiny
