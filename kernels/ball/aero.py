@@ -137,17 +137,41 @@ def max_stable_step(launch, kick, config):
 
 
 @compiled()
-def _factors(speed, kick, config):
-    """(−½ρA·C_D·|v|/m, ½ρA·C_L·|v|/m) at this speed: drag and lift per unit velocity and mass (1/s)."""
-    q = config[Q]
-    if config[MEASURED] == 0.0:
-        return -q * config[C_D] * speed, q * config[C_L] * speed
-    spin_parameter = config[RADIUS] * kick[RATE] / max(speed, 1e-9)
+def drag_lift(speed, rate, measured, constant_drag, constant_lift, radius, re_per_speed):
+    """(C_D, C_L) of a ball at ``speed`` (m/s, ≥ 0) spinning at ``rate`` = |ω| (rad/s, ≥ 0): ``constant_drag`` and
+    ``constant_lift`` when ``measured`` is 0, else the measured fits C_D(Re, S) of Goff & Carré 2010 (Eur. J. Phys. 31)
+    and C_L(S) of Asai et al. 2007 (Sports Eng. 10), with S = ``radius``·|ω|/max(|v|, 10⁻⁹ m/s) and
+    Re = ``re_per_speed``·|v| (ρ·2r/μ). The flight's force law and the public :func:`kernels.ball.coefficients` both
+    call this one function. Plain scalars, not the settings vector: an array argument costs the flight's every force
+    evaluation a reference-count increment and decrement."""
+    if measured == 0.0:
+        return constant_drag, constant_lift
+    spin_parameter = radius * rate / max(speed, 1e-9)
     lift = 0.9 * min(spin_parameter, 0.3)  # Asai et al. 2007
-    arg = min((config[RE_PER_SPEED] * speed - _RE_CRISIS) / _RE_WIDTH, 50.0)
+    arg = min((re_per_speed * speed - _RE_CRISIS) / _RE_WIDTH, 50.0)
     still = 0.155 + 0.346 / (1.0 + math.exp(arg))  # Goff & Carré 2010
     spinning = 0.4127 * max(spin_parameter, 0.05) ** 0.3056
     drag = still + min(spin_parameter / 0.05, 1.0) * (spinning - still)
+    return drag, lift
+
+
+@compiled()
+def drag_lift_table(speeds, rates, config, drag, lift):
+    """:func:`drag_lift` at each of the (N,) ``speeds`` and ``rates`` under the (14,) settings' model, into the (N,)
+    ``drag`` and ``lift``."""
+    measured, c_d, c_l = config[MEASURED], config[C_D], config[C_L]
+    radius, re_per_speed = config[RADIUS], config[RE_PER_SPEED]
+    for i in range(len(speeds)):
+        drag[i], lift[i] = drag_lift(speeds[i], rates[i], measured, c_d, c_l, radius, re_per_speed)
+
+
+@compiled()
+def _factors(speed, kick, config):
+    """(−½ρA·C_D·|v|/m, ½ρA·C_L·|v|/m) at this speed: drag and lift per unit velocity and mass (1/s)."""
+    q = config[Q]
+    drag, lift = drag_lift(
+        speed, kick[RATE], config[MEASURED], config[C_D], config[C_L], config[RADIUS], config[RE_PER_SPEED]
+    )
     return -q * drag * speed, q * lift * speed
 
 
