@@ -72,7 +72,17 @@ overflows), also raises ``ValueError`` naming ``dt`` rather than returning an ab
 Modules: :mod:`~kernels.ball.config` (constants, :class:`FlightConfig`, input checks), :mod:`~kernels.ball.pitch` (goal
 and wall panels), :mod:`~kernels.ball.aero` (the compiled force law), :mod:`~kernels.ball.core` (the compiled flight,
 crossings and verdict), :mod:`~kernels.ball.api` (:func:`simulate`, the batch functions and their results),
-:mod:`~kernels.ball.jit` (numba with or without its disk cache). Everything public is importable from here.
+:mod:`~kernels.ball.contact` (the compiled bounce), :mod:`~kernels.ball.laws` (:func:`coefficients` and
+:func:`bounce`), :mod:`~kernels.ball.jit` (numba with or without its disk cache). Everything public is importable
+from here.
+
+Laws on their own: :func:`coefficients` gives the (C_D, C_L) above at any speed and spin rate, from the same compiled
+function the flight's force law calls. :func:`bounce` gives a ball's velocity and spin after it strikes a surface,
+by Cross's grip–slip impulse model (Cross 2002, Am. J. Phys. 70:1093; Mencke et al. 2020, Am. J. Phys. 88:934):
+normal impulse −(1 + e_n)·m·(v·n); the contact point's tangential velocity u_t reversed to −e_t·u_t while the ball
+grips, or a Coulomb friction impulse μ·J_n against it when that would need more; defaults e_n 0.6, μ 0.6, e_t 0.1
+and I = ⅔·m·r² (a 2 m drop rebounds 0.72 m, inside FIFA Quality Pro's 0.60–0.85 m for turf). The flight does not
+call it yet.
 """
 
 from __future__ import annotations
@@ -105,6 +115,7 @@ from kernels.ball.config import (
     Model,
 )
 from kernels.ball.core import Ending, Result
+from kernels.ball.laws import bounce, coefficients
 from kernels.ball.pitch import GOAL_HEIGHT_M, GOAL_WIDTH_M, WALL_DISTANCE_M, Panel, free_kick_panels
 
 __all__ = [
@@ -129,6 +140,8 @@ __all__ = [
     "Panel",
     "Result",
     "Trajectory",
+    "bounce",
+    "coefficients",
     "free_kick_panels",
     "launch_velocity",
     "outcome",

@@ -36,6 +36,7 @@ from kernels.ball.config import (
     launch_rows,
 )
 from kernels.ball.core import ENDINGS, RESULTS, Ending, Result
+from kernels.ball.laws import bounce, coefficients
 from kernels.ball.pitch import Panel, free_kick_panels, panel_rows
 from kernels.warming import Entry
 
@@ -427,7 +428,8 @@ def launch_velocity(speed_ms: float, elevation_rad: float, azimuth_rad: float) -
 
 
 def warm_up() -> None:
-    """Compile, or load from the cache, every compiled core, on tiny inputs (both models, both methods, a knuckle).
+    """Compile, or load from the cache, every compiled core, on tiny inputs (both models, both methods, a knuckle,
+    the coefficients and a bounce).
 
     Call once at start-up, off the thread that serves users: the first kick then runs at full speed. A cold compile
     takes several seconds; a warm cache loads in well under one.
@@ -440,3 +442,5 @@ def warm_up() -> None:
     batch = simulate_batch(rows, [velocity, velocity], [spin, spin], dt=0.05, t_max=0.2)
     outcome_batch(batch, wall, goal)
     simulate_outcomes(rows, [velocity, velocity], [spin, spin], wall, goal, dt=0.05, x_stop=13.0)
+    coefficients(20.0, 30.0)
+    bounce(velocity, spin)
