@@ -438,6 +438,10 @@ def warm_up() -> None:
     start, velocity, spin = (0.0, 0.0, BALL_RADIUS_M), (20.0, 0.0, 4.0), (0.0, 0.0, 30.0)
     flight = simulate(start, velocity, spin, dt=0.05, method="rk4", model="measured", knuckle_seed=0)
     outcome(flight, wall, goal)
+    frozen = [a.view() for a in (flight.t, flight.position, flight.velocity)]  # same layouts, read-only views
+    for array in frozen:
+        array.setflags(write=False)  # callers that keep flights read-only (the scene does) get their own variant
+    outcome(dataclasses.replace(flight, t=frozen[0], position=frozen[1], velocity=frozen[2]), wall, goal)
     rows = np.array([start, start])
     batch = simulate_batch(rows, [velocity, velocity], [spin, spin], dt=0.05, t_max=0.2)
     outcome_batch(batch, wall, goal)

@@ -152,3 +152,4 @@ def warm_up() -> None:
         obstacles=obstacles,
         max_iterations=3,
     )
+    limit_usage(chain, [hinge, Cone(1.0)])  # the skeleton presets' readouts

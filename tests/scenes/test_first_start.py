@@ -78,3 +78,47 @@ def test_the_outcome_map_waits_for_the_compiled_flight_then_draws(compiling: Non
         assert scene.map_status.content.startswith("Of 1271 kicks:")
     finally:
         scene.close()
+
+
+WARMED_SCENES_SCRIPT = """
+import numba, sys, viser
+from kernels import warming
+from scenes import SCENES
+from scenes._skeletons import PRESET_LABELS
+for name in warming.MODULES:
+    __import__(name, fromlist=["warm_up"]).warm_up()
+def compiled():
+    return {
+        (module, name, str(signature))
+        for module, value in list(sys.modules.items()) if module.startswith("kernels.")
+        for name, dispatcher in vars(value).items() if isinstance(dispatcher, numba.core.dispatcher.Dispatcher)
+        for signature in dispatcher.signatures
+    }
+before = compiled()
+server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
+for key, kind in SCENES.items():
+    scene = kind(server)
+    if key == "arm":
+        for label in PRESET_LABELS:
+            scene.controls["preset"].value = label
+    getattr(scene, "wait_idle", lambda timeout_s: True)(120.0)
+    scene.close()
+server.stop()
+print("NEW", sorted(compiled() - before))
+"""
+
+
+def test_once_warmed_up_no_scene_compiles_anything() -> None:
+    # What the app's background compile loads must cover every call the scenes make (each scene, each arm preset),
+    # or a scene would stall on a compile after the status line has gone. A fresh process: this one's dispatchers
+    # already hold whatever earlier tests compiled.
+    import subprocess
+    import sys
+
+    from helpers.paths import ROOT
+
+    run = subprocess.run(
+        [sys.executable, "-c", WARMED_SCENES_SCRIPT], cwd=ROOT, capture_output=True, text=True, timeout=600
+    )
+    assert run.returncode == 0, run.stderr[-3000:]
+    assert run.stdout.strip().splitlines()[-1] == "NEW []"
