@@ -248,6 +248,11 @@ class AppProcess:
         # Keep reading, so a chatty app never blocks on a full pipe, and a test can look at its log.
         threading.Thread(target=self._read_output, daemon=True).start()
 
+    def wait_compiled(self, timeout_s: float = 300.0) -> None:
+        """Wait until the app has loaded every compiled kernel (its first start compiles them in the background, and
+        loading them grows its memory: measure after that)."""
+        wait_until(lambda: "compiled kernels ready" in self.log, "the app's kernels compiled and loaded", timeout_s)
+
     def _read_output(self) -> None:
         assert self.process.stdout is not None
         for line in self.process.stdout:
@@ -341,6 +346,7 @@ def test_sixteen_sessions_fit_the_budget_and_are_given_back(scene: str, budget_m
     try:
         # First use loads what every session shares (kernels, caches, shaders, the SDF gallery's one GL
         # context): the warm tab runs until its scene is fully up, or "start" would leave the context out.
+        app.wait_compiled()  # before the warm tab, which then loads the compiled code its scene calls
         warm = open_tabs(app, 1, scene)
         for tab in warm:
             tab.close()
@@ -377,6 +383,7 @@ def test_tab_churn_leaves_rss_flat_and_sends_nothing_to_closed_tabs() -> None:
     try:
         # viser's callback pool grows toward its 32 threads as builds overlap, each thread adding its stack pages
         # (~0.4 MiB): measure over a run of tabs in which the pool no longer grew.
+        app.wait_compiled()
         churn(30)
         measured: list[str] = []
         start = end = threads_before = threads_after = 0
