@@ -21,6 +21,7 @@ from __future__ import annotations
 import atexit
 import dataclasses
 import importlib
+import importlib.util
 import logging
 import os
 import subprocess
@@ -29,9 +30,12 @@ import threading
 import time
 import types
 from collections.abc import Callable, Sequence
+from pathlib import Path
 from typing import Any, Generic, ParamSpec, TypeVar
 
 from numba.core.dispatcher import Dispatcher
+
+from kernels._jit_cache import cache_dirs
 
 logger = logging.getLogger(__name__)
 
@@ -227,7 +231,7 @@ def _compile_all(modules: tuple[str, ...], processes: bool) -> None:
 
 
 def _compile_one(name: str, processes: bool) -> None:
-    child = _spawn(name) if processes else None
+    child = _spawn(name) if processes and not has_cache(name) else None  # a warm cache loads here in ~1 s
     if child is not None:
         _, errors = child.communicate()
         if child.returncode != 0:  # it failed: the load below compiles here instead, and the log says why
@@ -241,6 +245,24 @@ def _compile_one(name: str, processes: bool) -> None:
 
 _CHILDREN: list[subprocess.Popen[bytes]] = []
 """Compile processes started here; any still running when this process exits is stopped with it."""
+
+
+def has_cache(package: str) -> bool:
+    """Whether numba's disk cache holds compiled code of ``package`` (beside it, or under ``NUMBA_CACHE_DIR``); the
+    cache is dropped whole when any kernel source changes (:mod:`kernels._jit_cache`), so any index means a warm one."""
+    spec = importlib.util.find_spec(package)
+    if spec is None or spec.origin is None:
+        return False
+    override = os.environ.get("NUMBA_CACHE_DIR")  # when set, numba reads only there
+    for directory in cache_dirs(Path(spec.origin).parent):
+        if override and not directory.is_relative_to(override):
+            continue
+        try:
+            if any(path.suffix == ".nbi" for path in directory.iterdir()):
+                return True
+        except OSError:
+            continue
+    return False
 
 
 def _spawn(name: str) -> subprocess.Popen[bytes] | None:

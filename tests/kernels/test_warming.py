@@ -188,3 +188,18 @@ def test_start_reports_progress_and_then_hands_calls_to_compiled_code(fresh_warm
     assert "course ride" in warming.describe(warming.Progress(done=(), pending=("kernels.course",), elapsed_s=1.0))
     ride_module = sys.modules["kernels.course.ride"]
     assert ride_module._ride_core_entry.compiled.signatures  # compiled (or loaded) by start
+
+
+def test_a_package_with_a_cache_index_loads_in_process_one_without_compiles_in_a_child(
+    tmp_path: Any, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from pathlib import Path
+
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))  # numba then reads its cache only there
+    assert not any(warming.has_cache(name) for name in warming.MODULES)
+    course_dir = Path(kernels.__file__).parent.resolve() / "course"
+    mirrored = tmp_path / course_dir.relative_to(course_dir.anchor)
+    mirrored.mkdir(parents=True)
+    (mirrored / "ride._ride_core-1.py311.nbi").write_bytes(b"")
+    assert warming.has_cache("kernels.course")
+    assert not warming.has_cache("kernels.fabrik") and not warming.has_cache("kernels.ball")
