@@ -7,9 +7,10 @@ its own file changed too. So the kernels keep one stamp beside the cache: a hash
 differs from the sources on disk, every cached kernel is dropped and compiles afresh on its next use (once).
 
 Where the cache lives: numba writes it in ``__pycache__`` beside each module, or under ``NUMBA_CACHE_DIR`` when that
-is set (mirroring the source path). Both are kept in step here. Where neither is writable numba falls back to a
-user-wide directory; a stale entry there is not seen here (it only arises when an installed, read-only copy of the
-package is upgraded in place without its files' times changing).
+is set, or, where the package's own directory is read-only, in numba's user-wide directory (``~/.cache/numba``); the
+last two hold one directory per source directory, named by numba from its path. All are kept in step here, except
+where the stamp itself cannot be written (a read-only install: then nothing is dropped, see
+:func:`drop_stale_cache`).
 """
 
 from __future__ import annotations
@@ -18,6 +19,9 @@ import hashlib
 import logging
 import os
 from pathlib import Path
+
+from numba.core.caching import UserProvidedCacheLocator
+from numba.misc.appdirs import AppDirs
 
 logger = logging.getLogger(__name__)
 
@@ -41,14 +45,19 @@ def source_hash(root: Path) -> str:
 
 
 def cache_dirs(root: Path) -> list[Path]:
-    """Every directory numba may keep a cache of ``root``'s modules in: each ``__pycache__`` below it and, with
-    ``NUMBA_CACHE_DIR`` set, the mirrored tree there."""
+    """Every directory numba may keep a cache of ``root``'s modules in: each ``__pycache__`` below it and, for each
+    source directory below it, numba's directory for it under ``NUMBA_CACHE_DIR`` (when set) and under numba's
+    user-wide cache (``~/.cache/numba``). numba names those ``<directory name>_<SHA-1 of its absolute path>``
+    (``UserProvidedCacheLocator.get_suitable_cache_subpath``, numba 0.68)."""
     dirs = [path for path in root.rglob("__pycache__") if path.is_dir()]
-    user_dir = os.environ.get("NUMBA_CACHE_DIR")
-    if user_dir:
-        mirrored = Path(user_dir) / root.resolve().relative_to(root.resolve().anchor)
-        if mirrored.is_dir():
-            dirs.extend(path for path in [mirrored, *mirrored.rglob("*")] if path.is_dir())
+    sources = sorted({path.parent for path in root.rglob("*.py") if "__pycache__" not in path.parts})
+    bases = [Path(user_dir)] if (user_dir := os.environ.get("NUMBA_CACHE_DIR")) else []
+    bases.append(Path(AppDirs(appname="numba", appauthor=False).user_cache_dir))
+    for base in bases:
+        for source in sources:
+            path = base / UserProvidedCacheLocator.get_suitable_cache_subpath(str(source / "module.py"))
+            if path.is_dir():
+                dirs.append(path)
     return dirs
 
 

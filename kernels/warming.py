@@ -202,23 +202,27 @@ def start(modules: Sequence[str] = MODULES, *, processes: bool = True) -> thread
     cache; without, or where a child fails, it compiles on a thread here. Returns the thread that waits for them
     (None when already started).
     """
+    cold = tuple(name for name in modules if not has_cache(name))
     with _STATE.lock:
         if _STATE.started_at is not None:
             return None
         _STATE.started_at = time.perf_counter()
-        _STATE.pending = set(modules)
+        _STATE.pending = set(cold)  # a package with a warm cache just loads (about a second): no twins, no status
         _STATE.done = []
     thread = threading.Thread(
-        target=_compile_all, args=(tuple(modules), processes), name="kernels-warming", daemon=True
+        target=_compile_all, args=(tuple(modules), set(cold), processes), name="kernels-warming", daemon=True
     )
     thread.start()
     return thread
 
 
-def _compile_all(modules: tuple[str, ...], processes: bool) -> None:
-    """Compile every package at once (a child process each), and load each here as soon as its child is done."""
+def _compile_all(modules: tuple[str, ...], cold: set[str], processes: bool) -> None:
+    """Compile every cold package at once (a child process each) and load each here as soon as its child is done;
+    load the warm ones from the cache meanwhile."""
     waiters = [
-        threading.Thread(target=_compile_one, args=(name, processes), name=f"kernels-warming-{name}", daemon=True)
+        threading.Thread(
+            target=_compile_one, args=(name, processes and name in cold), name=f"kernels-warming-{name}", daemon=True
+        )
         for name in modules
     ]
     for waiter in waiters:
@@ -230,8 +234,8 @@ def _compile_all(modules: tuple[str, ...], processes: bool) -> None:
     logger.info("compiled kernels ready in %.1f s", time.perf_counter() - started)
 
 
-def _compile_one(name: str, processes: bool) -> None:
-    child = _spawn(name) if processes and not has_cache(name) else None  # a warm cache loads here in ~1 s
+def _compile_one(name: str, in_a_child: bool) -> None:
+    child = _spawn(name) if in_a_child else None
     if child is not None:
         _, errors = child.communicate()
         if child.returncode != 0:  # it failed: the load below compiles here instead, and the log says why

@@ -175,7 +175,10 @@ def test_entries_run_twins_only_while_their_package_is_pending(fresh_warming: No
         warming.python_twin = original  # type: ignore[assignment]
 
 
-def test_start_reports_progress_and_then_hands_calls_to_compiled_code(fresh_warming: None) -> None:
+def test_start_reports_progress_and_then_hands_calls_to_compiled_code(
+    fresh_warming: None, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(warming, "has_cache", lambda package: False)  # as on a first start
     seen: list[warming.Progress] = []
     warming.on_progress(seen.append)
     thread = warming.start(("kernels.course",), processes=False)
@@ -193,13 +196,27 @@ def test_start_reports_progress_and_then_hands_calls_to_compiled_code(fresh_warm
 def test_a_package_with_a_cache_index_loads_in_process_one_without_compiles_in_a_child(
     tmp_path: Any, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    from pathlib import Path
+    import os
+    import subprocess
 
-    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))  # numba then reads its cache only there
+    # numba itself writes the course's cache under an empty NUMBA_CACHE_DIR (read when numba is imported: a child)
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
     assert not any(warming.has_cache(name) for name in warming.MODULES)
-    course_dir = Path(kernels.__file__).parent.resolve() / "course"
-    mirrored = tmp_path / course_dir.relative_to(course_dir.anchor)
-    mirrored.mkdir(parents=True)
-    (mirrored / "ride._ride_core-1.py311.nbi").write_bytes(b"")
+    warm = "import kernels.course as m; m.warm_up()"
+    subprocess.run([sys.executable, "-c", warm], env=env, check=True, timeout=300)
     assert warming.has_cache("kernels.course")
     assert not warming.has_cache("kernels.fabrik") and not warming.has_cache("kernels.ball")
+
+
+def test_a_package_with_a_warm_cache_is_never_pending(fresh_warming: None, monkeypatch: pytest.MonkeyPatch) -> None:
+    # A later start loads the cache in about a second: no plain-Python twins and no "First start" line for it.
+    monkeypatch.setattr(warming, "has_cache", lambda package: package == "kernels.course")
+    monkeypatch.setattr(warming, "_spawn", lambda name: None)  # compile the cold one here, not in a child
+    seen: list[warming.Progress] = []
+    warming.on_progress(seen.append)
+    thread = warming.start(("kernels.course", "kernels.ball"))
+    assert thread is not None
+    assert not warming.is_pending("kernels.course")
+    thread.join(300)
+    assert sorted(seen[-1].done) == ["kernels.ball", "kernels.course"] and seen[-1].finished
