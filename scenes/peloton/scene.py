@@ -67,6 +67,13 @@ LAST = ("target_power_w",)
 
 
 # --------------------------------------------------------------------------------------------- scene
+
+
+def _watts(value: float) -> str:
+    """Whole watts, never "-0"."""
+    return f"{round(float(value))}"  # an int: round(-0.4) is 0, not -0.0
+
+
 class PelotonScene(Scene[PelotonParams]):
     key = "peloton"
     title = "Peloton: cycling power"
@@ -482,7 +489,11 @@ time-averaged power is the mean over positions, far below the leader's.
             share = f"aero share of wheel power **{100.0 * float(solo.aero) / wheel:.1f} %**"
         else:  # standing still, or a descent that pays for the air: no share of nothing
             share = "no power needed at the wheel"
-        return f"Air density **{rho:.3f} kg/m³** ({where})  \nSolo rider: **{float(solo.total):.0f} W**, {share}"
+        total = float(solo.total)
+        rider = (
+            f"**{_watts(total)} W**" if total > -0.5 else f"coasting (it would brake {-total:.0f} W to hold this speed)"
+        )
+        return f"Air density **{rho:.3f} kg/m³** ({where})  \nSolo rider: {rider}, {share}"
 
     def _table_markdown(self) -> str:
         state = self.state
@@ -493,8 +504,8 @@ time-averaged power is the mean over positions, far below the leader's.
         ]
         for i in range(self.params.n_riders):
             rows.append(
-                f"| {i + 1} | {state.cda_m2[i]:.3f} | {state.power.aero[i]:.0f} / {state.power.rolling[i]:.0f} / "
-                f"{state.power.climbing[i]:.0f} | **{state.power.total[i]:.0f}** | {100 * state.saving[i]:.1f} % |"
+                f"| {i + 1} | {state.cda_m2[i]:.3f} | {_watts(state.power.aero[i])} / {_watts(state.power.rolling[i])} / "
+                f"{_watts(state.power.climbing[i])} | **{_watts(state.power.total[i])}** | {100 * state.saving[i]:.1f} % |"
             )
         return "\n".join(rows)
 
@@ -504,15 +515,15 @@ time-averaged power is the mean over positions, far below the leader's.
             return ""
         mean = float(np.mean(self.state.power.total))
         lead = float(self.state.power.total[0])
-        if not self.params.drafting:
+        if lead <= 0:
+            text = "Downhill at this speed gravity does the work: nobody needs to pedal, so nobody needs shelter."
+        elif not self.params.drafting:
             text = f"Drafting is off: every rider rides in clean air at the leader's {lead:.0f} W, so rotating saves nothing."
-        elif lead > 0:
+        else:
             text = (
                 f"Rotating evenly, each rider averages **{mean:.0f} W** against the leader's {lead:.0f} W "
                 f"({100 * (1 - mean / lead):.0f} % less): the reason teams rotate."
             )
-        else:
-            text = f"Here the leader needs {lead:.0f} W: gravity does the work and nobody needs shelter."
         if self.params.rotate and self._ridden_s > 0:
             averages = self._energy_j[:n] / self._ridden_s
             text += "  \nTime-averaged so far: " + ", ".join(f"R{i + 1} {a:.0f} W" for i, a in enumerate(averages))

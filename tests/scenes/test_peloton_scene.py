@@ -386,3 +386,17 @@ def test_with_drafting_off_the_rotation_line_says_rotating_saves_nothing(scene: 
     assert "teams rotate" not in text and "0 % less" not in text
     scene.controls["drafting"].value = True
     assert "the reason teams rotate" in scene.rotation.content
+
+
+def test_downhill_readouts_say_coasting_not_negative_watts(scene: PelotonScene) -> None:
+    scene.controls["grade_pct"].value = -15.0
+    scene.controls["speed_kmh"].value = 25.0
+    assert float(scene.state.solo.total) < 0  # the descent would pay more than the air takes
+    assert "Solo rider: coasting (it would brake" in scene.density.content
+    assert scene.rotation.content.startswith("Downhill at this speed gravity does the work")
+    scene.controls["drafting"].value = False  # the same sentence: nobody pedals
+    assert scene.rotation.content.startswith("Downhill")
+    scene.controls["speed_kmh"].value = 0.0
+    rows = scene.table.content.splitlines()[2:]
+    assert rows and all("-0 " not in row and "/ -0" not in row for row in rows)
+    assert "Solo rider: **0 W**, no power needed at the wheel" in scene.density.content  # standing still
