@@ -21,7 +21,7 @@ import numpy as np
 import trimesh
 from numpy.typing import NDArray
 
-from kernels import fabrik
+from kernels import fabrik, warming
 from scenes._instances import add_instances
 
 if TYPE_CHECKING:
@@ -248,6 +248,12 @@ class SkeletonReport:
     """Wall time of the kernel call (µs)."""
     usage: NDArray[np.float64]
     """(J,) share of its limit each joint's segment uses, in [0, 1] (0 for the root and free joints)."""
+
+
+def plain_python_note() -> str:
+    """Said after a solve time while the app's first start still compiles the FABRIK kernels (kernels.warming): the
+    solve ran as plain Python, so its time is not the compiled solver's."""
+    return " (plain Python: the first start is still compiling)" if warming.is_pending("kernels.fabrik") else ""
 
 
 def joint_usage(skeleton: Skeleton, joints: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -557,5 +563,5 @@ class SkeletonView:
         )
         return (
             f"**{sk.name}**: {r.iterations} iteration{'s' if r.iterations != 1 else ''}, "
-            f"solve **{report.micros:,.0f} µs**\n\n| Effector | Error (mm) | Status |\n|---|---|---|\n{rows}"
+            f"solve **{report.micros:,.0f} µs**{plain_python_note()}\n\n| Effector | Error (mm) | Status |\n|---|---|---|\n{rows}"
         )

@@ -32,7 +32,15 @@ from scenes._controls import build_controls, checkbox, dropdown, slider
 from scenes._framing import ClientFraming, Lens, View, frame_points
 from scenes._instances import add_instances
 from scenes._skeletons import GIZMO_SCALE_M as SKELETON_GIZMO_M
-from scenes._skeletons import PRESET_LABELS, WORLD_LIMIT_M, PresetLabel, SkeletonView, clean_target, moved_gizmo
+from scenes._skeletons import (
+    PRESET_LABELS,
+    WORLD_LIMIT_M,
+    PresetLabel,
+    SkeletonView,
+    clean_target,
+    moved_gizmo,
+    plain_python_note,
+)
 
 MAX_LINKS = 12
 MAX_OBSTACLES = 4
@@ -648,7 +656,7 @@ is a static pose.
         text = (
             f"**{p.solver}**: {r.iterations} iteration{'s' if r.iterations != 1 else ''}, "
             f"error **{r.error * 1000.0:.3f} mm**, status **{r.status}**  \n"
-            f"Solve time **{report.micros:,.0f} µs**"
+            f"Solve time **{report.micros:,.0f} µs**{plain_python_note()}"
         )
         covering = [
             k + 1

@@ -122,3 +122,19 @@ def test_once_warmed_up_no_scene_compiles_anything() -> None:
     )
     assert run.returncode == 0, run.stderr[-3000:]
     assert run.stdout.strip().splitlines()[-1] == "NEW []"
+
+
+def test_the_arm_says_a_solve_time_is_plain_python_while_its_kernels_compile(
+    compiling: None, server: viser.ViserServer
+) -> None:
+    from scenes.arm import ArmScene
+
+    scene = ArmScene(server)
+    try:
+        assert "Solve time" in scene.readout.content
+        assert scene.readout.content.endswith("(plain Python: the first start is still compiling)")
+        warming._finish("kernels.fabrik")
+        scene.controls["n_links"].value = scene.params.n_links + 1  # the next solve is the compiled one's
+        assert "Solve time" in scene.readout.content and "plain Python" not in scene.readout.content
+    finally:
+        scene.close()
