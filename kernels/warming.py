@@ -137,12 +137,13 @@ class Entry(Generic[P, R]):
         if not isinstance(compiled, Dispatcher):
             raise TypeError(f"compiled must be a numba dispatcher, got {type(compiled).__name__}")
         self.compiled = compiled
-        self.package = compiled.py_func.__module__.rsplit(".", 1)[0] if "." in compiled.py_func.__module__ else ""
+        self.package = _package_of(compiled.py_func.__module__)
+        """The package of :data:`MODULES` whose background compile this entry waits for (found once, here)."""
         self.__doc__ = compiled.__doc__
         self.__name__ = compiled.__name__
 
     def __call__(self, *args: P.args, **kwargs: P.kwargs) -> R:
-        if _STATE.pending and not self.compiled.signatures and _package_of(self.compiled) in _STATE.pending:
+        if _STATE.pending and not self.compiled.signatures and self.package in _STATE.pending:
             try:
                 return python_twin(self.compiled)(*args, **kwargs)
             except Exception:  # a twin that cannot run this input: wait for the compiled code instead
@@ -150,12 +151,9 @@ class Entry(Generic[P, R]):
         return self.compiled(*args, **kwargs)
 
 
-def _package_of(dispatcher: Any) -> str:
-    module = dispatcher.py_func.__module__
-    for package in MODULES:
-        if module == package or module.startswith(package + "."):
-            return package
-    return "kernels.cycling" if module == "kernels.cycling" else module
+def _package_of(module: str) -> str:
+    """The package of :data:`MODULES` that holds ``module``, else ``module`` itself."""
+    return next((package for package in MODULES if module == package or module.startswith(package + ".")), module)
 
 
 def is_pending(package: str) -> bool:
