@@ -19,6 +19,7 @@ from scenes.peloton.course_model import (
 )
 from scenes.peloton.model import (
     MAX_GAP_M,
+    MAX_GROUP,
     MAX_RIDERS,
     POSITIONS,
     LineState,
@@ -34,6 +35,7 @@ __all__ = [
     "COMPONENT_COLOURS",
     "LABEL_PX",
     "MAX_GAP_M",
+    "MAX_GROUP",
     "MAX_RIDERS",
     "POSITIONS",
     "SAMPLE_LABEL",

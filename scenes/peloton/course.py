@@ -46,6 +46,9 @@ from scenes.peloton.course_model import (
 from scenes.peloton.meshes import add_riders, show_position
 from scenes.peloton.model import BIKE_LENGTH_M, MAX_RIDERS, Position, group_cda
 
+FORMATION_WORDS = {"single": "in single file", "double": "two abreast", "bunch": "in a bunch", "echelon": "in echelon"}
+"""How the course readout names each formation."""
+
 if TYPE_CHECKING:
     from scenes.peloton.scene import PelotonScene
 
@@ -72,6 +75,7 @@ LINE_INPUTS = (
     "crr",
     "drivetrain_pct",
     "drafting",
+    "formation",
     "n_riders",
     "gap_m",
     "model",
@@ -445,8 +449,9 @@ class CourseMode:
         return self.leader_distance_m() / 1000.0
 
     def rider_distances_m(self) -> np.ndarray:
-        """(n_riders,) distance along the route of each drawn rider, leader first (spaced as drawn)."""
-        n, gap = self.scene.params.n_riders, self.scene.params.gap_m
+        """(n,) distance along the route of each drawn rider, leader first (spaced as drawn): the first
+        :data:`MAX_RIDERS` of the group (the course's scale draws a bunch as the line at its head)."""
+        n, gap = min(self.scene.params.n_riders, MAX_RIDERS), self.scene.params.gap_m
         spacing_m = (BIKE_LENGTH_M + gap) * COURSE_MARKER_SCALE / self._drawing.scale
         return self.leader_distance_m() - np.arange(n) * spacing_m
 
@@ -491,7 +496,7 @@ class CourseMode:
         self._drawn_exaggeration = self.params.exaggeration
 
     def _draw_riders(self) -> None:
-        n = self.scene.params.n_riders
+        n = min(self.scene.params.n_riders, MAX_RIDERS)
         positions = np.zeros((MAX_RIDERS, 3))
         wxyz = np.tile([1.0, 0.0, 0.0, 0.0], (MAX_RIDERS, 1))
         where, yaw = self._drawing.at_distance(self.route, self.rider_distances_m(), self.params.exaggeration)
@@ -551,7 +556,8 @@ class CourseMode:
             )
         if state.group_cda_m2 != line.cda_m2:
             text += (
-                f"  \n{line.n_riders} riders sharing the front (mean CdA {state.group_cda_m2:.3f} m²): "
+                f"  \n{line.n_riders} riders {FORMATION_WORDS[line.formation]} sharing the work, each at the "
+                f"formation's mean drag (CdA {state.group_cda_m2:.3f} m²): "
                 f"alone the same power takes {format_duration(state.solo.time_s)}"
             )
         if state.pacing is not None:

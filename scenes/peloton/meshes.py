@@ -117,14 +117,20 @@ def rider_meshes(position: Position) -> dict[str, trimesh.Trimesh]:
     return {"bike": bike, "body": body, "head": head}
 
 
+def rider_colours(part: str, count: int) -> np.ndarray:
+    """(count, 3) uint8 colours of one part for ``count`` riders: :data:`RIDER_COLOURS`, the jerseys repeating."""
+    return np.resize(RIDER_COLOURS[part], (count, 3)).astype(np.uint8)
+
+
 def add_riders(
-    scene: viser.SceneApi, prefix: str, position: Position, scale: float
+    scene: viser.SceneApi, prefix: str, position: Position, scale: float, count: int = MAX_RIDERS
 ) -> dict[str, viser.BatchedMeshHandle]:
-    """One batched mesh per part (``<prefix>_bike``, ``_body``, ``_head``), an instance per rider slot, all at the
-    origin and scaled by ``scale`` (0 hides them until they are placed)."""
+    """One batched mesh per part (``<prefix>_bike``, ``_body``, ``_head``), ``count`` instances (one per rider
+    slot), all at the origin and scaled by ``scale`` (0 hides them until they are placed). Three nodes whatever the
+    count: 121 riders cost the browser three draw calls, as 8 do."""
     nodes: dict[str, viser.BatchedMeshHandle] = {}
     for part, mesh in rider_meshes(position).items():
-        nodes[part] = add_instances(scene, f"{prefix}_{part}", mesh, MAX_RIDERS, RIDER_COLOURS[part], scale=scale)
+        nodes[part] = add_instances(scene, f"{prefix}_{part}", mesh, count, rider_colours(part, count), scale=scale)
     return nodes
 
 

@@ -20,6 +20,12 @@ from kernels import cycling
 from scenes._controls import checkbox, dropdown, dropdown_from_labels, number, slider
 
 MAX_RIDERS = 8
+"""Riders of a single file drawn with their own power bars and labels (more, or another formation, are coloured by
+power instead)."""
+MAX_GROUP = 121
+"""Most riders the scene shows: Blocken et al. 2018's peloton."""
+LATERAL_M = 0.6
+"""Distance between the centres of riders side by side in a formation (m)."""
 BIKE_LENGTH_M = 1.70
 """Wheel-to-wheel length of one bike; the gap is measured from the front wheel to the wheel ahead."""
 MAX_GAP_M = 15.0
@@ -54,6 +60,12 @@ CRR_PRESETS: dict[str, float] = {
     "Training tyre (0.0060)": 0.0060,
     "Gravel tyre (0.0080)": 0.0080,
     "Mountain bike, knobbly (0.0120)": 0.0120,
+}
+FORMATION_FROM_LABEL: dict[str, cycling.FormationShape] = {
+    "Single file": "single",
+    "Two abreast": "double",
+    "Bunch (peloton)": "bunch",
+    "Echelon": "echelon",
 }
 DraftModelLabel = Literal["Textbook formula (exponential fade)", "Measured (by position)"]
 MODEL_FROM_LABEL: dict[str, cycling.DraftModel] = {
@@ -97,8 +109,12 @@ class PelotonParams:
     """Wind against the riders (m/s); negative is a tailwind."""
     drafting: bool = field(default=True, metadata=checkbox("Drafting", folder="Drafting"))
     """Whether riders behind the leader draft."""
-    n_riders: int = field(default=4, metadata=slider("Riders", 1, MAX_RIDERS, 1, folder="Drafting"))
-    """Riders in the line."""
+    formation: cycling.FormationShape = field(
+        default="single", metadata=dropdown_from_labels("Formation", FORMATION_FROM_LABEL, folder="Drafting")
+    )
+    """How the riders ride together: single file, two abreast, a bunch or an echelon."""
+    n_riders: int = field(default=4, metadata=slider("Riders", 1, MAX_GROUP, 1, folder="Drafting"))
+    """Riders in the group."""
     gap_m: float = field(default=0.5, metadata=slider("Gap (m)", 0.0, MAX_GAP_M, 0.1, folder="Drafting"))
     """Wheel-to-wheel gap between riders (m)."""
     model: cycling.DraftModel = field(
@@ -124,6 +140,8 @@ class LineState:
     cda_m2: np.ndarray
     power: cycling.Power
     solo: cycling.Power
+    positions: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros((0, 2)))
+    """(n, 2) where each rider rides (m): x forward, y to the left, leader first."""
 
     @property
     def saving(self) -> np.ndarray:
@@ -146,19 +164,38 @@ def compute_line(p: PelotonParams) -> LineState:
         drivetrain_efficiency=p.drivetrain_pct / 100.0,
     )
     speed = p.speed_kmh / 3.6
-    reduction = cycling.drag_reduction(n, p.gap_m, p.model) if p.drafting else np.zeros(n)
+    positions = formation_positions(p)
+    reduction = drag_reductions(p) if p.drafting else np.zeros(n)
     cda = p.cda_m2 * (1.0 - reduction)
     power = cycling.power(np.full(n, speed), cda, **common)
     solo = cycling.power(speed, p.cda_m2, **common)
-    return LineState(reduction=reduction, cda_m2=cda, power=power, solo=solo)
+    return LineState(reduction=reduction, cda_m2=cda, power=power, solo=solo, positions=positions)
+
+
+def formation_positions(p: PelotonParams) -> np.ndarray:
+    """(n_riders, 2) positions of the riders in the chosen formation (m), leader first."""
+    return cycling.formation(p.n_riders, p.formation, gap_m=p.gap_m, lateral_m=LATERAL_M)
+
+
+def drag_reductions(p: PelotonParams) -> np.ndarray:
+    """(n_riders,) drag reduction of each rider, leader first: the line model in single file (as it always was),
+    the formation wake model (:func:`kernels.cycling.formation_drag`) otherwise."""
+    if p.formation == "single":
+        return cycling.drag_reduction(p.n_riders, p.gap_m, p.model)
+    return 1.0 - cycling.formation_drag(formation_positions(p), p.model)
+
+
+def is_line_view(p: PelotonParams) -> bool:
+    """Whether the scene draws the labelled line (single file of at most :data:`MAX_RIDERS`) rather than a group
+    coloured by power."""
+    return p.formation == "single" and p.n_riders <= MAX_RIDERS
 
 
 def group_cda(line: PelotonParams) -> float:
-    """CdA of a rider in a line that rotates evenly: the mean over the positions (the riders share the work)."""
+    """CdA of a rider in a group that shares the work evenly: the mean over the formation's positions."""
     if not line.drafting or line.n_riders < 2:
         return line.cda_m2
-    reduction = cycling.drag_reduction(line.n_riders, line.gap_m, line.model)
-    return float(line.cda_m2 * (1.0 - np.mean(reduction)))
+    return float(line.cda_m2 * (1.0 - np.mean(drag_reductions(line))))
 
 
 # The solo rider's curve and speed-at-power depend on neither the speed nor the line: moving the speed slider (the

@@ -24,16 +24,18 @@ from scenes._controls import Controls, build_controls, declared
 from scenes._framing import ClientFraming, Lens, View, frame_points
 from scenes._instances import add_instances
 from scenes.peloton.course import CourseMode
-from scenes.peloton.meshes import add_riders, show_position
+from scenes.peloton.meshes import add_riders, rider_colours, show_position
 from scenes.peloton.model import (
     BIKE_LENGTH_M,
     CRR_PRESETS,
     MAX_GAP_M,
+    MAX_GROUP,
     MAX_RIDERS,
     POSITIONS,
     PelotonParams,
     Position,
     compute_line,
+    is_line_view,
     solo_curves,
     solo_key,
     solo_speed,
@@ -47,13 +49,19 @@ from scenes.peloton.projection import (
     slot_offsets,
 )
 
-ROAD_X_M = (-(MAX_RIDERS - 1) * (BIKE_LENGTH_M + MAX_GAP_M) - 15.0, 15.0)
-"""(start, end) x of the drawn road (m): the longest line (8 riders, the largest gap) rides on it, with 15 m spare
-at each end."""
+ROAD_X_M = (-(MAX_GROUP - 1) * (BIKE_LENGTH_M + MAX_GAP_M) - 15.0, 15.0)
+"""(start, end) x of the drawn road (m): the longest group (121 riders in single file at the largest gap) rides on
+it, with 15 m spare at each end."""
+ROAD_HALF_WIDTH_M = 3.0
+"""Half the road's width (m): a bunch eight abreast fits on it."""
 BAR_METRES_PER_WATT = 1.0 / 400.0
 """Height of the stacked power bars above the riders."""
 VIEW_DIRECTION = (-1.2, 7.5, -1.8)
 """The camera looks at the line from its left side, a little ahead of it and above."""
+GROUP_VIEW_DIRECTION = (-2.0, 4.0, -3.2)
+"""A group (a bunch, two abreast, an echelon, a long line) is seen from higher up, so the rows behind show."""
+POWER_COLOURS = np.array([(40, 90, 220), (40, 180, 200), (90, 190, 80), (245, 200, 40), (225, 50, 40)], np.float64)
+"""Rider colours by power, low to high: blue, teal, green, yellow, red."""
 LABEL_STAGGER_M = 0.4
 """Every other rider's label sits this much higher (m) until a camera is framed and the labels laid out for it."""
 BAR_HEADROOM = 1.3
@@ -64,6 +72,38 @@ ROTATION = ("rotate", "turn_s")
 """The paceline's rotation controls: they restart the rotation and leave the line's power as it is."""
 LAST = ("target_power_w",)
 """The controls built after the Results folder (in their own folder, with the speed-at-a-power readout)."""
+
+
+# --------------------------------------------------------------------------------------------- colours by power
+def power_range(watts: np.ndarray) -> tuple[float, float]:
+    """(low, high) ends of the colour scale (W): the group's least and most power, at least 10 W apart."""
+    low, high = float(np.min(watts)), float(np.max(watts))
+    middle = 0.5 * (low + high)
+    half = max(0.5 * (high - low), 5.0)
+    return middle - half, middle + half
+
+
+def power_colours(watts: np.ndarray, low: float, high: float) -> np.ndarray:
+    """(N, 3) uint8 colours of ``watts`` on :data:`POWER_COLOURS` from ``low`` to ``high`` W."""
+    t = np.clip((np.asarray(watts, np.float64) - low) / (high - low), 0.0, 1.0) * (len(POWER_COLOURS) - 1)
+    stops = np.arange(len(POWER_COLOURS), dtype=np.float64)
+    channels = [np.interp(t, stops, POWER_COLOURS[:, c]) for c in range(3)]
+    return np.round(np.stack(channels, axis=1)).astype(np.uint8)
+
+
+def legend_bar(width: int = 240, height: int = 14) -> np.ndarray:
+    """(height, width, 3) uint8 image of the colour scale, low power at the left."""
+    row = power_colours(np.linspace(0.0, 1.0, width), 0.0, 1.0)
+    return np.ascontiguousarray(np.broadcast_to(row, (height, width, 3)))
+
+
+LEGEND_NAMES = ("blue", "teal", "green", "yellow", "red")
+
+
+def legend_markdown(low: float, high: float) -> str:
+    """The watts at the colour scale's five stops, under its bar."""
+    stops = " · ".join(f"{name} {_watts(t)}" for name, t in zip(LEGEND_NAMES, np.linspace(low, high, 5), strict=True))
+    return f"**Rider colour = power (W):** {stops}"
 
 
 # --------------------------------------------------------------------------------------------- scene
@@ -140,6 +180,8 @@ time-averaged power is the mean over positions, far below the leader's.
             )
             with gui.add_folder("Results"):
                 self.density = gui.add_markdown("")
+                self.legend_bar = gui.add_image(legend_bar(), format="png", visible=False)
+                self.legend = gui.add_markdown("", visible=False)
                 self.table = gui.add_markdown("")
                 self.rotation = gui.add_markdown("")
                 self.chart = FittedChart(
@@ -187,18 +229,18 @@ time-averaged power is the mean over positions, far below the leader's.
         grass = trimesh.creation.box(extents=(length + 30.0, 60.0, 0.02))
         grass.apply_translation((middle, 0.0, -0.03))
         scene.add_mesh_simple(f"{self.course.name}/grass", grass.vertices, grass.faces, color=(120, 165, 95))
-        road = trimesh.creation.box(extents=(length, 3.0, 0.02))
+        road = trimesh.creation.box(extents=(length, 2.0 * ROAD_HALF_WIDTH_M, 0.02))
         road.apply_translation((middle, 0.0, -0.01))
         self.road = scene.add_mesh_simple(f"{self.course.name}/road", road.vertices, road.faces, color=(70, 72, 78))
         dashes = np.array([[[x, 0.0, 0.002], [x + 1.5, 0.0, 0.002]] for x in np.arange(start + 1.0, end - 1.0, 3.0)])
         scene.add_line_segments(f"{self.course.name}/centre_line", dashes, colors=(240, 240, 240), thickness=0.08)
-        for side in (-1.5, 1.5):
+        for side in (-ROAD_HALF_WIDTH_M, ROAD_HALF_WIDTH_M):
             edge = np.array([[[start, side, 0.003], [end, side, 0.003]]])
             scene.add_line_segments(
                 f"{self.course.name}/edge_{side:+.0f}", edge, colors=(250, 250, 250), thickness=0.06
             )
 
-        self.riders_nodes = add_riders(scene, f"{self.course.name}/riders", self.params.position, 1.0)
+        self.riders_nodes = add_riders(scene, f"{self.course.name}/riders", self.params.position, 0.0, MAX_GROUP)
         self._drawn_position = self.params.position
 
         unit_box = trimesh.creation.box(extents=(1.0, 1.0, 1.0))
@@ -263,15 +305,28 @@ time-averaged power is the mean over positions, far below the leader's.
             raise
         self._update_framing()
         # An input can start the rotation (Riders raised from 1 while Rotate is on): wake the loop.
-        if self.params.rotate and self.params.n_riders > 1:
+        if self._rotating():
             self.wake_loops()
 
     # ----------------------------------------------------------------------------------------- camera
+    def _rotating(self) -> bool:
+        """Whether the lead rotates now: asked for, with a line of two or more drawn with its bars."""
+        return self.params.rotate and self.params.n_riders > 1 and is_line_view(self.params)
+
     def line_points(self, bar_headroom: float = 1.0) -> np.ndarray:
         """(N, 3) world points the view must hold: every rider (also swinging off), bar tops (``bar_headroom`` times
-        as tall as now) and the wind arrow."""
+        as tall as now) and the wind arrow; for a group, every rider and the wind arrow."""
         p = self.params
         n = p.n_riders
+        if not is_line_view(p):
+            xy = self.state.positions
+            x_hi = 0.5 * BIKE_LENGTH_M + (3.0 + min(abs(p.headwind_ms), 15.0) * 0.25 if p.headwind_ms != 0 else 0.0)
+            lo = np.array([xy[:, 0].min() - 0.5 * BIKE_LENGTH_M, xy[:, 1].min() - 0.5, 0.0])
+            hi = np.array([x_hi, xy[:, 1].max() + 0.5, 2.0])
+            corners = np.array(
+                [[(lo, hi)[i][0], (lo, hi)[j][1], (lo, hi)[k][2]] for i in (0, 1) for j in (0, 1) for k in (0, 1)]
+            )
+            return course_to_world(corners, p.grade_pct)
         front, back = (
             0.5 * BIKE_LENGTH_M,
             float(slot_offsets(n, p.gap_m)[n - 1]) - 0.5 * BIKE_LENGTH_M,
@@ -292,8 +347,11 @@ time-averaged power is the mean over positions, far below the leader's.
         return np.sum(parts, axis=0)[: self.params.n_riders] * BAR_METRES_PER_WATT
 
     def label_anchors(self) -> np.ndarray:
-        """(n_riders, 3) world points where each slot's label sits before it is lifted: just above its bar."""
+        """(n_riders, 3) world points where each slot's label sits before it is lifted: just above its bar (none for
+        a group, which has no labels)."""
         p, n = self.params, self.params.n_riders
+        if not is_line_view(p):
+            return np.zeros((0, 3))
         x = slot_offsets(n, p.gap_m)[:n]
         local = np.stack([x, np.zeros(n), 1.95 + self._bar_heights_m()], 1)
         return course_to_world(local, p.grade_pct)
@@ -315,7 +373,8 @@ time-averaged power is the mean over positions, far below the leader's.
             # above its anchor, in the room the rectangle leaves. Framing the anchors shrinks the line, which may
             # stack the labels differently: repeat until the lifted anchors fit.
             for _ in range(MAX_RIDERS + 2):
-                view = frame_points(framed, VIEW_DIRECTION, fov_rad=lens.fov_rad, aspect=lens.aspect, ndc=ndc)
+                direction = VIEW_DIRECTION if is_line_view(self.params) else GROUP_VIEW_DIRECTION
+                view = frame_points(framed, direction, fov_rad=lens.fov_rad, aspect=lens.aspect, ndc=ndc)
                 lifts_px = label_lifts_px(project_px(anchors, view, lens))
                 lifts_m = lift_to_metres(anchors, lifts_px, up_world, view, lens)
                 lifted = anchors + lifts_m[:, None] * up_world
@@ -351,7 +410,7 @@ time-averaged power is the mean over positions, far below the leader's.
 
     def _framing_key(self) -> tuple[object, ...]:
         p = self.params
-        return (p.n_riders, p.gap_m, p.grade_pct, p.headwind_ms != 0.0)
+        return (p.n_riders, p.formation, p.gap_m, p.grade_pct, p.headwind_ms != 0.0)
 
     def read_params(self) -> PelotonParams:
         """The current GUI values, cleaned: anything non-finite, out of range or unknown keeps the last good value."""
@@ -371,7 +430,7 @@ time-averaged power is the mean over positions, far below the leader's.
         n, p = self.params.n_riders, self.params
         slots = slot_offsets(n, p.gap_m)
         x, y = slots.copy(), np.zeros(MAX_RIDERS)
-        if not (p.rotate and n > 1):
+        if not self._rotating():
             return x, y
         turn = p.turn_s
         k, phase = divmod(self._rotation_time_s / turn, 1.0)
@@ -391,7 +450,7 @@ time-averaged power is the mean over positions, far below the leader's.
     def current_slots(self) -> np.ndarray:
         """(n_riders,) slot index each rider holds (0 = leader); the identity unless the lead rotates."""
         n = self.params.n_riders
-        if not (self.params.rotate and n > 1):
+        if not self._rotating():
             return np.arange(n)
         k = int(self._rotation_time_s // self.params.turn_s)
         return (np.arange(n) - k) % n
@@ -402,6 +461,9 @@ time-averaged power is the mean over positions, far below the leader's.
         One atomic update; the animation redraws without readouts, which do not change as riders move.
         """
         p, state = self.params, self.state
+        if not is_line_view(p):
+            self._redraw_group(readouts=readouts)
+            return
         n = p.n_riders
         slots = self.current_slots()
         total = np.asarray(state.power.total)
@@ -409,6 +471,10 @@ time-averaged power is the mean over positions, far below the leader's.
         positions = np.stack([x, y, np.zeros(MAX_RIDERS)], axis=1)
         visible = (np.arange(MAX_RIDERS) < n).astype(np.float64)
         scales = np.repeat(visible[:, None], 3, axis=1)
+        group_positions = np.zeros((MAX_GROUP, 3), np.float32)
+        group_positions[:MAX_RIDERS] = positions
+        group_scales = np.zeros((MAX_GROUP, 3), np.float32)
+        group_scales[:MAX_RIDERS] = scales
 
         with self.server.atomic():
             theta = math.atan(p.grade_pct / 100.0)
@@ -416,9 +482,7 @@ time-averaged power is the mean over positions, far below the leader's.
             if p.position != self._drawn_position:
                 show_position(self.riders_nodes, p.position)
                 self._drawn_position = p.position
-            for node in self.riders_nodes.values():
-                set_if_changed(node, "batched_positions", positions.astype(np.float32))
-                set_if_changed(node, "batched_scales", scales.astype(np.float32))
+            self._show_riders(group_positions, group_scales, rider_colours("body", MAX_GROUP))
 
             base = np.zeros(MAX_RIDERS)
             for component in ("aero", "rolling", "climbing"):
@@ -453,6 +517,8 @@ time-averaged power is the mean over positions, far below the leader's.
             rotation = self._rotation_markdown()
             if self.rotation.content != rotation:
                 self.rotation.content = rotation
+            set_if_changed(self.legend, "visible", False)
+            set_if_changed(self.legend_bar, "visible", False)
             if readouts:
                 self._draw_wind()
                 self.density.content = self._density_markdown()
@@ -460,6 +526,82 @@ time-averaged power is the mean over positions, far below the leader's.
                 self.chart.data = self._chart_data()
                 self.speed_out.content = self._speed_markdown()
         self.server.flush()
+
+    def _show_riders(self, positions: np.ndarray, scales: np.ndarray, bodies: np.ndarray) -> None:
+        """Place the (MAX_GROUP,) rider instances and colour their bodies (only what changed goes out)."""
+        for node in self.riders_nodes.values():
+            set_if_changed(node, "batched_positions", positions.astype(np.float32))
+            set_if_changed(node, "batched_scales", scales.astype(np.float32))
+        set_if_changed(self.riders_nodes["body"], "batched_colors", bodies)
+
+    def _redraw_group(self, *, readouts: bool) -> None:
+        """Draw a group: every rider where the formation puts it, its jersey coloured by its power (the legend in
+        the panel says the watts), no bars or labels; the readouts, with ``readouts``."""
+        p, state = self.params, self.state
+        n = p.n_riders
+        positions = np.zeros((MAX_GROUP, 3), np.float32)
+        positions[:n, :2] = state.positions
+        scales = np.zeros((MAX_GROUP, 3), np.float32)
+        scales[:n] = 1.0
+        total = np.asarray(state.power.total)
+        low, high = power_range(total)
+        bodies = rider_colours("body", MAX_GROUP)
+        bodies[:n] = power_colours(total, low, high)
+        with self.server.atomic():
+            theta = math.atan(p.grade_pct / 100.0)
+            set_if_changed(self.course, "wxyz", (math.cos(-theta / 2), 0.0, math.sin(-theta / 2), 0.0))
+            if p.position != self._drawn_position:
+                show_position(self.riders_nodes, p.position)
+                self._drawn_position = p.position
+            self._show_riders(positions, scales, bodies)
+            for bar in self.bars.values():
+                set_if_changed(bar, "batched_scales", np.zeros((MAX_RIDERS, 3), np.float32))
+            for label in self.labels:
+                if label.visible:
+                    label.visible = False
+            legend = legend_markdown(low, high)
+            if self.legend.content != legend:
+                self.legend.content = legend
+            set_if_changed(self.legend, "visible", True)
+            set_if_changed(self.legend_bar, "visible", True)
+            rotation = self._rotation_markdown()
+            if self.rotation.content != rotation:
+                self.rotation.content = rotation
+            if readouts:
+                self._draw_wind()
+                self.density.content = self._density_markdown()
+                self.table.content = self._group_table_markdown()
+                self.chart.data = self._chart_data()
+                self.speed_out.content = self._speed_markdown()
+        self.server.flush()
+
+    def _group_table_markdown(self) -> str:
+        """Drag and power by row of the formation (riders level with each other share a row), front to back; long
+        groups show their first and last rows."""
+        state, p = self.state, self.params
+        x = np.round(state.positions[:, 0], 6)
+        rows = [np.flatnonzero(x == value) for value in sorted(set(x.tolist()), reverse=True)]
+        total, drag = np.asarray(state.power.total), 1.0 - state.reduction
+        lines = [
+            f"{p.n_riders} riders · mean drag **{100 * float(np.mean(drag)):.0f} %** of a lone rider's · mean power "
+            f"**{_watts(float(np.mean(total)))} W** (a lone rider {_watts(float(state.solo.total))} W)",
+            "",
+            "| Row | Riders | Drag (% of alone) | Power (W) |",
+            "|---|---|---|---|",
+        ]
+        shown = rows if len(rows) <= 14 else [*rows[:10], None, *rows[-3:]]
+        for index, members in enumerate(shown):
+            if members is None:
+                lines.append("| … | | | |")
+                continue
+            number = index + 1 if index < 10 or len(rows) <= 14 else len(rows) - (len(shown) - index) + 1
+            d, w = 100 * drag[members], total[members]
+            drag_text = f"{d.min():.0f}" if round(d.min()) == round(d.max()) else f"{d.min():.0f}–{d.max():.0f}"
+            low, high = _watts(float(w.min())), _watts(float(w.max()))
+            lines.append(
+                f"| {number} | {len(members)} | {drag_text} | {f'**{low}**' if low == high else f'**{low}**–**{high}**'} |"
+            )
+        return "\n".join(lines)
 
     def _draw_wind(self) -> None:
         w = self.params.headwind_ms
@@ -542,7 +684,7 @@ time-averaged power is the mean over positions, far below the leader's.
     # ----------------------------------------------------------------------------------------- animation
     def _animate(self, dt: float) -> bool:
         """One frame of the rotating lead; False (the loop sleeps) when the lead does not rotate."""
-        if not (self.params.rotate and self.params.n_riders > 1):
+        if not self._rotating():
             return False
         dt = min(dt, 0.2)
         slots = self.current_slots()

@@ -21,6 +21,7 @@ from scenes.peloton import (
     BAR_METRES_PER_WATT,
     LABEL_PX,
     MAX_GAP_M,
+    MAX_GROUP,
     MAX_RIDERS,
     PelotonParams,
     PelotonScene,
@@ -179,7 +180,7 @@ CRAFTED = [
     ("Speed (km/h)", float("inf"), "speed_kmh", 40.0),
     ("Speed (km/h)", 1e12, "speed_kmh", 80.0),  # clamped to the slider's max
     ("Speed (km/h)", -50.0, "speed_kmh", 0.0),  # clamped to min
-    ("Riders", 100, "n_riders", MAX_RIDERS),
+    ("Riders", 1000, "n_riders", MAX_GROUP),
     ("Riders", 2.6, "n_riders", 2),  # viser casts to the slider's int type first
     ("Gap (m)", float("nan"), "gap_m", 0.5),
     ("CdA (m²)", 0.0, "cda_m2", 0.10),
@@ -400,3 +401,46 @@ def test_downhill_readouts_say_coasting_not_negative_watts(scene: PelotonScene) 
     rows = scene.table.content.splitlines()[2:]
     assert rows and all("-0 " not in row and "/ -0" not in row for row in rows)
     assert "Solo rider: **0 W**, no power needed at the wheel" in scene.density.content  # standing still
+
+
+# ------------------------------------------------------------------------------------------------ formations
+def test_a_121_rider_bunch_draws_every_rider_coloured_by_its_power(scene: PelotonScene) -> None:
+    from scenes.peloton.scene import POWER_COLOURS, power_colours, power_range
+
+    c = scene.controls
+    c["formation"].value, c["n_riders"].value, c["gap_m"].value = "Bunch (peloton)", 121, 0.3
+    p = scene.params
+    assert (p.formation, p.n_riders) == ("bunch", 121)
+    positions = cycling.formation(121, "bunch", gap_m=0.3, lateral_m=0.6)
+    drag = cycling.formation_drag(positions)
+    expected = cycling.power(p.speed_kmh / 3.6, p.cda_m2 * drag, p.mass_kg, p.crr, drivetrain_efficiency=0.976)
+    np.testing.assert_allclose(scene.state.power.total, expected.total, rtol=1e-12)
+    # Every rider placed where the formation puts it, three nodes however many riders.
+    body = scene.riders_nodes["body"]
+    placed = np.asarray(body.batched_positions)[:121, :2]
+    np.testing.assert_allclose(placed, positions, atol=1e-5)
+    assert np.all(np.asarray(body.batched_scales)[:121] == 1.0)
+    # The leader works hardest and is red; the middle of the bunch is blue; the legend says the watts.
+    colours = np.asarray(body.batched_colors)[:121]
+    np.testing.assert_array_equal(colours[0], POWER_COLOURS[-1].astype(np.uint8))
+    low, high = power_range(expected.total)
+    np.testing.assert_array_equal(colours, power_colours(expected.total, low, high))
+    assert tuple(colours[int(np.argmin(expected.total))]) == tuple(POWER_COLOURS[0].astype(np.uint8))
+    assert scene.legend.visible and scene.legend_bar.visible
+    assert f"red {float(expected.total.max()):.0f}" in scene.legend.content
+    # No bars or labels for a bunch; the table gives the leader's watts and the mean drag.
+    assert not any(label.visible for label in scene.labels)
+    assert f"**{float(expected.total[0]):.0f}**" in scene.table.content
+    assert f"mean drag **{100 * float(np.mean(drag)):.0f} %**" in scene.table.content
+
+
+def test_back_to_single_file_of_eight_is_the_labelled_line_again(scene: PelotonScene) -> None:
+    c = scene.controls
+    c["formation"].value, c["n_riders"].value = "Echelon", 30
+    assert not scene.labels[0].visible and scene.legend.visible
+    c["formation"].value, c["n_riders"].value = "Single file", 8
+    assert all(label.visible for label in scene.labels) and not scene.legend.visible
+    expected = compute_line(scene.params)
+    np.testing.assert_array_equal(scene.state.reduction, cycling.drag_reduction(8, scene.params.gap_m))
+    assert scene.labels[0].text.startswith(f"{expected.power.total[0]:.0f} W")
+    assert np.all(np.asarray(scene.riders_nodes["body"].batched_scales)[8:] == 0.0)
