@@ -56,8 +56,8 @@ def test_a_pair_in_line_gives_the_leader_blocken_2013_gain_and_the_follower_the_
 
 
 def test_a_follower_loses_its_shelter_as_it_moves_out_of_line() -> None:
-    # Wind-tunnel pairs (Barry et al. 2014; the FEDSM 2017 echelon study): the in-line position shelters most, and
-    # the benefit falls away as the follower moves sideways; beside the leader (no overlap) it is gone.
+    # A 2017 wind-tunnel study of drafting offsets (ASME FEDSM 2017): no sideways offset gives the lowest drag; the
+    # benefit falls away as the follower moves sideways, and beside the leader (no overlap) it is gone.
     offsets = np.linspace(0.0, 2.0, 21)
     follower = [cycling.formation_drag(np.array([[0.0, 0.0], [-2.0, dy]]))[1] for dy in offsets]
     assert np.all(np.diff(follower) > 0.0)

@@ -395,3 +395,25 @@ def test_bad_files_are_refused_in_a_riders_words(mode: CourseMode, kind: str) ->
     assert message in mode.route_info.content
     for word in ("elevation_m", "latitude_deg", "non-finite", "time_s", "GPX is not"):
         assert word not in mode.route_info.content
+
+
+def test_a_bunch_rides_the_course_at_its_formations_mean_drag(mode: CourseMode) -> None:
+    scene = mode.scene
+    assert mode.state is not None
+    line_of_four = mode.state.ride.time_s
+    scene.controls["formation"].value = "Bunch (peloton)"
+    scene.controls["n_riders"].value = 121
+    scene.controls["gap_m"].value = 0.3
+    assert mode.state is not None
+    positions = cycling.formation(121, "bunch", gap_m=0.3, lateral_m=0.6)
+    mean_drag = float(np.mean(cycling.formation_drag(positions)))
+    assert 0.10 < mean_drag < 0.25  # most of a 121-rider bunch rides at 5-10 % of a lone rider's drag
+    assert mode.state.group_cda_m2 == pytest.approx(scene.params.cda_m2 * mean_drag, rel=1e-12)
+    rider = course_kernel.Rider(cda_m2=mode.state.group_cda_m2, mass_kg=80.0, crr=0.004, drivetrain_efficiency=0.976)
+    direct = course_kernel.ride(mode.route, 250.0, rider, max_speed_ms=72.0 / 3.6)
+    assert mode.state.ride.time_s == pytest.approx(direct.time_s, rel=1e-12)
+    assert mode.state.ride.time_s < line_of_four  # sharing a bunch's shelter is faster than a line of four
+    assert "121 riders in a bunch" in mode.readout.content
+    # The course draws the head of the group (its scale has no room for 121): eight riders, none beyond.
+    scales = np.asarray(mode.course_riders["body"].batched_scales)
+    assert scales.shape[0] == 8
