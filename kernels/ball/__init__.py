@@ -19,15 +19,19 @@ C_L = 0.25). Two coefficient models:
   and Re = ρ·|v|·2r/μ (μ = 1.81·10⁻⁵ Pa·s):
 
       C_L(S) = 0.9·min(S, 0.3)
-          Lift grows roughly as 0.8–1.0·S up to S ≈ 0.3 in wind-tunnel measurements (Asai et al. 2007, Sports Eng.
-          10; Carré, Goff et al. 2005–2010). Beyond S = 0.3 data are sparse; the value is held at 0.27.
+          A linear law capped at S = 0.3 (0.27 beyond). It lies below the measurements: 0.16 at S = 0.18 and 0.20 at
+          S = 0.22, where Asai et al. 2007 (Sports Eng. 10:101, wind tunnel) measured 0.21 and 0.24 (0.29 at
+          S = 0.34), and Bray & Kerwin 2003 (J. Sports Sci. 21:75) fitted 0.23–0.29 to real free kicks. A saturating
+          C_L = 0.32·(1 − e^(−S/0.17)) follows Asai within 0.015; it is not adopted here, so flights stay as they
+          were, and the curl is therefore somewhat understated.
       C_D(Re, S) = C_D0(Re) + min(S/0.05, 1)·(C_Ds(max(S, 0.05)) − C_D0(Re))
       C_D0(Re)   = 0.155 + 0.346 / (1 + exp((Re − 1.815·10⁵) / 1.949·10⁴))
       C_Ds(S)    = 0.4127·S^0.3056
-          Goff & Carré 2010 (Eur. J. Phys. 31): the non-spinning fit 0.155 + 0.346/(1 + exp((v − 12.19)/1.309)),
-          re-expressed in Re for a 0.22 m ball in air of 1.225 kg/m³, puts the drag crisis at Re 2.2–3.3·10⁵ as Hong
-          & Asai 2013 measured; the spinning fit (S > 0.05) is theirs too. Between S = 0 and 0.05 the two are blended
-          linearly so C_D is continuous.
+          Goff & Carré 2010 (Eur. J. Phys. 31): the non-spinning fit 0.155 + 0.346/(1 + exp((v − 12.19)/1.309)) to
+          the Teamgeist, re-expressed in Re for a 0.22 m ball in air of 1.225 kg/m³, is centred at Re = 1.815·10⁵
+          (12.2 m/s); the centre is :attr:`FlightConfig.drag_crisis_re` (other balls cross elsewhere:
+          :data:`DRAG_CRISIS_RE_BY_BALL`). The spinning fit (S > 0.05) is theirs too. Between S = 0 and 0.05 the two
+          are blended linearly so C_D is continuous.
 
 Knuckleball (``knuckle_seed`` set): a ball kicked with almost no spin at 24–30 m/s sheds an unsteady wake and
 zig-zags by about one ball diameter, one zig-zag per ~15 m of flight (Cohen, Darbois Texier, Quéré & Clanet, APS DFD
@@ -41,8 +45,9 @@ kick at 12° over 25 m is 0.18 m for seeds 0–29 and 0.21 m for seeds 0–199 (
 one ball diameter" (0.22 m) those papers report.
 
 Assumptions: spin is constant in flight (spin decay over a 1–2 s free kick is a few percent); still air; the ball is
-rigid and stops at the first touch of the ground (no bounce or roll); a ball that touches the wall or the frame does
-not rebound. Integrators: ``"euler"`` is the seed's fixed-step method (v += a·dt, then x += v·dt; first order),
+rigid. Without a pitch the flight stops at the first touch of the ground and a ball that touches the wall or the
+frame does not rebound; with a :class:`Pitch` (``simulate(..., pitch=...)``) it bounces, rolls and strikes the posts,
+bar, wall and keeper (:mod:`kernels.ball.play`). Integrators: ``"euler"`` is the seed's fixed-step method (v += a·dt, then x += v·dt; first order),
 ``"rk4"`` the classical fourth-order Runge–Kutta. The last sample of a flight is placed on the ground (or on the
 ``x_stop`` plane) by cubic Hermite interpolation of the last step, which keeps RK4's accuracy: the first root of
 that cubic in the step, bracketed between its turning points (a ball may rise, peak and land within one long step).
@@ -81,15 +86,25 @@ function the flight's force law calls. :func:`bounce` gives a ball's velocity an
 by Cross's grip–slip impulse model (Cross 2002, Am. J. Phys. 70:1093; Mencke et al. 2020, Am. J. Phys. 88:934):
 normal impulse −(1 + e_n)·m·(v·n); the contact point's tangential velocity u_t reversed to −e_t·u_t while the ball
 grips, or a Coulomb friction impulse μ·J_n against it when that would need more; defaults e_n 0.6, μ 0.6, e_t 0.1
-and I = ⅔·m·r² (a 2 m drop rebounds 0.72 m, inside FIFA Quality Pro's 0.60–0.85 m for turf). The flight does not
-call it yet.
+and I = ⅔·m·r² (a 2 m drop rebounds 0.72 m, inside FIFA Quality Pro's 0.60–0.85 m for turf). The flight on a
+pitch calls the same compiled impact at every contact.
+
+On a pitch (:mod:`kernels.ball.play`, :class:`Pitch`, :class:`Keeper`): the ball bounces on the turf (e_n 0.6,
+μ 0.6 dry / 0.25 wet, e_t 0.1), rolls once a bounce leaves it under 0.5 m/s upward (rolling resistance 0.8 m/s² plus
+the air's drag: FIFA's ball-roll band, 4–10 m from 3.2 m/s), strikes posts and bar (capsules of radius 0.06 m,
+e_n 0.75, μ 0.3: assumed from FIFA's drop onto steel, see :data:`FRAME`), the wall's players (capsules, e_n 0.4,
+a guess) and the keeper (saved on touch), and stops in the net. Odds of a real strike with a player's scatter:
+:mod:`kernels.ball.odds`.
 """
 
 from __future__ import annotations
 
 from kernels.ball.api import (
+    EVENT_KINDS,
     BatchOutcome,
     BatchTrajectory,
+    Event,
+    KeeperDive,
     Outcome,
     Trajectory,
     launch_velocity,
@@ -106,6 +121,8 @@ from kernels.ball.config import (
     AIR_VISCOSITY,
     BALL_MASS_KG,
     BALL_RADIUS_M,
+    DRAG_CRISIS_RE,
+    DRAG_CRISIS_RE_BY_BALL,
     KNUCKLE_COEFFICIENT,
     KNUCKLE_SPIN_LIMIT,
     KNUCKLE_WAVELENGTH_M,
@@ -116,29 +133,54 @@ from kernels.ball.config import (
 )
 from kernels.ball.core import Ending, Result
 from kernels.ball.laws import bounce, coefficients
-from kernels.ball.pitch import GOAL_HEIGHT_M, GOAL_WIDTH_M, WALL_DISTANCE_M, Panel, free_kick_panels
+from kernels.ball.pitch import (
+    BODY,
+    DRY_TURF,
+    FRAME,
+    GOAL_HEIGHT_M,
+    GOAL_WIDTH_M,
+    WALL_DISTANCE_M,
+    WET_TURF,
+    Keeper,
+    Panel,
+    Pitch,
+    Surface,
+    free_kick_panels,
+)
 
 __all__ = [
     "AIR_DENSITY",
     "AIR_VISCOSITY",
     "BALL_MASS_KG",
     "BALL_RADIUS_M",
+    "BODY",
+    "DRAG_CRISIS_RE",
+    "DRAG_CRISIS_RE_BY_BALL",
+    "DRY_TURF",
+    "EVENT_KINDS",
+    "FRAME",
     "GOAL_HEIGHT_M",
     "GOAL_WIDTH_M",
     "KNUCKLE_COEFFICIENT",
     "KNUCKLE_SPIN_LIMIT",
     "KNUCKLE_WAVELENGTH_M",
     "WALL_DISTANCE_M",
+    "WET_TURF",
     "BatchOutcome",
     "BatchTrajectory",
     "Ending",
+    "Event",
     "FlightConfig",
     "G",
+    "Keeper",
+    "KeeperDive",
     "Method",
     "Model",
     "Outcome",
     "Panel",
+    "Pitch",
     "Result",
+    "Surface",
     "Trajectory",
     "bounce",
     "coefficients",

@@ -3,8 +3,9 @@ and gravity.
 
 Scalar cores on the (14,) settings vector of :class:`kernels.ball.config.FlightConfig` and each kick's (14,)
 constants (slots :data:`AXIS` … :data:`N2`: ω̂, |ω|, knuckle gain, rate, phases, directions). Accelerations are per
-unit mass (m/s²), forces in N. Coefficients: constant C_D and C_L, or the measured fits C_L(S) of Asai et al. 2007
-(Sports Eng. 10) and C_D(Re, S) of Goff & Carré 2010 (Eur. J. Phys. 31); knuckle force after Cohen et al. 2012 and
+unit mass (m/s²), forces in N. Coefficients: constant C_D and C_L, or the measured model: C_L(S) = 0.9·min(S, 0.3)
+(below Asai et al. 2007's wind-tunnel values, Sports Eng. 10) and C_D(Re, S) of Goff & Carré 2010 (Eur. J. Phys. 31),
+its drag crisis centred at the configured Reynolds number (1.815·10⁵, their Teamgeist fit); knuckle force after Cohen et al. 2012 and
 Texier et al. 2016 (New J. Phys. 18). The model, its assumptions and its sources in full: :mod:`kernels.ball`.
 """
 
@@ -23,6 +24,7 @@ from kernels.ball.config import (
     MASS,
     MEASURED,
     RADIUS,
+    RE_CRISIS,
     RE_PER_SPEED,
     RK4,
     T_MAX,
@@ -30,8 +32,8 @@ from kernels.ball.config import (
 )
 from kernels.ball.jit import compiled
 
-# Goff & Carré 2010 no-spin drag fit, in Reynolds number (see :mod:`kernels.ball`).
-_RE_CRISIS = 1.815e5
+# Width of the Goff & Carré 2010 no-spin drag fit's crisis, in Reynolds number (its centre is a setting: see
+# :data:`kernels.ball.config.DRAG_CRISIS_RE`).
 _RE_WIDTH = 1.949e4
 
 # Bounds of the measured fits below (Goff & Carré 2010, Asai et al. 2007): C_D0 lies in (0.155, 0.501), the spinning
@@ -137,18 +139,18 @@ def max_stable_step(launch, kick, config):
 
 
 @compiled()
-def drag_lift(speed, rate, measured, constant_drag, constant_lift, radius, re_per_speed):
+def drag_lift(speed, rate, measured, constant_drag, constant_lift, radius, re_per_speed, re_crisis):
     """(C_D, C_L) of a ball at ``speed`` (m/s, ≥ 0) spinning at ``rate`` = |ω| (rad/s, ≥ 0): ``constant_drag`` and
-    ``constant_lift`` when ``measured`` is 0, else the measured fits C_D(Re, S) of Goff & Carré 2010 (Eur. J. Phys. 31)
-    and C_L(S) of Asai et al. 2007 (Sports Eng. 10), with S = ``radius``·|ω|/max(|v|, 10⁻⁹ m/s) and
-    Re = ``re_per_speed``·|v| (ρ·2r/μ). The flight's force law and the public :func:`kernels.ball.coefficients` both
+    ``constant_lift`` when ``measured`` is 0, else the measured fits C_D(Re, S) of Goff & Carré 2010 (Eur. J. Phys. 31),
+    its drag crisis centred at Re = ``re_crisis``, and C_L(S) = 0.9·min(S, 0.3), with S = ``radius``·|ω|/max(|v|,
+    10⁻⁹ m/s) and Re = ``re_per_speed``·|v| (ρ·2r/μ). The flight's force law and the public :func:`kernels.ball.coefficients` both
     call this one function. Plain scalars, not the settings vector: an array argument costs the flight's every force
     evaluation a reference-count increment and decrement."""
     if measured == 0.0:
         return constant_drag, constant_lift
     spin_parameter = radius * rate / max(speed, 1e-9)
-    lift = 0.9 * min(spin_parameter, 0.3)  # Asai et al. 2007
-    arg = min((re_per_speed * speed - _RE_CRISIS) / _RE_WIDTH, 50.0)
+    lift = 0.9 * min(spin_parameter, 0.3)  # below Asai et al. 2007's wind-tunnel values: see kernels.ball
+    arg = min((re_per_speed * speed - re_crisis) / _RE_WIDTH, 50.0)
     still = 0.155 + 0.346 / (1.0 + math.exp(arg))  # Goff & Carré 2010
     spinning = 0.4127 * max(spin_parameter, 0.05) ** 0.3056
     drag = still + min(spin_parameter / 0.05, 1.0) * (spinning - still)
@@ -160,9 +162,9 @@ def drag_lift_table(speeds, rates, config, drag, lift):
     """:func:`drag_lift` at each of the (N,) ``speeds`` and ``rates`` under the (14,) settings' model, into the (N,)
     ``drag`` and ``lift``."""
     measured, c_d, c_l = config[MEASURED], config[C_D], config[C_L]
-    radius, re_per_speed = config[RADIUS], config[RE_PER_SPEED]
+    radius, re_per_speed, re_crisis = config[RADIUS], config[RE_PER_SPEED], config[RE_CRISIS]
     for i in range(len(speeds)):
-        drag[i], lift[i] = drag_lift(speeds[i], rates[i], measured, c_d, c_l, radius, re_per_speed)
+        drag[i], lift[i] = drag_lift(speeds[i], rates[i], measured, c_d, c_l, radius, re_per_speed, re_crisis)
 
 
 @compiled()
@@ -170,7 +172,14 @@ def _factors(speed, kick, config):
     """(−½ρA·C_D·|v|/m, ½ρA·C_L·|v|/m) at this speed: drag and lift per unit velocity and mass (1/s)."""
     q = config[Q]
     drag, lift = drag_lift(
-        speed, kick[RATE], config[MEASURED], config[C_D], config[C_L], config[RADIUS], config[RE_PER_SPEED]
+        speed,
+        kick[RATE],
+        config[MEASURED],
+        config[C_D],
+        config[C_L],
+        config[RADIUS],
+        config[RE_PER_SPEED],
+        config[RE_CRISIS],
     )
     return -q * drag * speed, q * lift * speed
 

@@ -18,13 +18,14 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from kernels import _checks
-from kernels.ball import core
+from kernels.ball import core, play
 from kernels.ball.config import (
     BALL_RADIUS_M,
     DT,
     GROUND,
     MEASURED,
     N_STEPS,
+    RADIUS,
     RK4,
     FlightConfig,
     check_launches,
@@ -37,7 +38,7 @@ from kernels.ball.config import (
 )
 from kernels.ball.core import ENDINGS, RESULTS, Ending, Result
 from kernels.ball.laws import bounce, coefficients
-from kernels.ball.pitch import Panel, free_kick_panels, panel_rows
+from kernels.ball.pitch import Keeper, Panel, Pitch, free_kick_panels, panel_rows, pitch_vector
 from kernels.warming import Entry
 
 # The compiled cores called from here: plain Python while the app's first start compiles them (kernels.warming).
@@ -48,12 +49,46 @@ judge_batch = Entry(core.judge_batch)
 pad = Entry(core.pad)
 simulate_one = Entry(core.simulate_one)
 stable_step = Entry(core.stable_step)
+play_one = Entry(play.play_one)
+play_batch = Entry(play.play_batch)
+
+EVENT_KINDS: tuple[str, ...] = ("ground", "post", "bar", "wall", "keeper", "net")
+"""Kinds of :class:`Event`, in the compiled flight's code order."""
 
 RESERVE_BYTES = 2**31
 """Largest time-major reservation :func:`simulate_batch` makes before it counts the samples first (bytes)."""
 # numba's workqueue threading layer (the fallback where neither TBB nor OpenMP is present) must not launch two
 # parallel kernels at once; the scene's workers and the app's warm-up may call from different threads.
 _PARALLEL = threading.Lock()
+
+
+@dataclasses.dataclass(frozen=True)
+class Event:
+    """A contact on the pitch."""
+
+    t: float
+    """Time since the kick (s)."""
+    kind: str
+    """``"ground"``, ``"post"``, ``"bar"``, ``"wall"`` (a player), ``"keeper"`` or ``"net"``."""
+    position: tuple[float, float, float]
+    """Ball centre at the contact (m)."""
+
+
+@dataclasses.dataclass(frozen=True)
+class KeeperDive:
+    """When the keeper set off and where he went (a flight on a pitch with a keeper)."""
+
+    t: float
+    """Start of the dive (s since the kick)."""
+    target: tuple[float, float, float]
+    """Where he read the ball would cross the goal line (m)."""
+
+
+def _events(rows: NDArray[np.float64], count: int) -> tuple[Event, ...]:
+    return tuple(
+        Event(float(row[0]), EVENT_KINDS[int(row[1])], (float(row[2]), float(row[3]), float(row[4])))
+        for row in rows[:count]
+    )
 
 
 @dataclasses.dataclass(frozen=True)
@@ -75,7 +110,16 @@ class Trajectory:
     knuckle: NDArray[np.float64]
     """(N, 3) knuckleball side force (N); zero unless ``knuckle_seed`` was set and the spin is near zero."""
     ended: Ending
-    """Why the flight stopped: it touched the ground, passed ``x_stop``, or reached ``t_max``."""
+    """Why the flight stopped: it touched the ground (no pitch), passed ``x_stop``, or reached ``t_max``; on a
+    pitch also ``"stopped"`` (at rest on the turf), ``"net"``, ``"out"`` (left the pitch) or ``"saved"``."""
+    events: tuple[Event, ...] = ()
+    """On a pitch: the contacts in order (ground, post, bar, wall, keeper, net); empty without one."""
+    spin: NDArray[np.float64] | None = None
+    """On a pitch: (N, 3) the angular velocity at each sample (rad/s), changed by each contact; None without one."""
+    result: Result | None = None
+    """On a pitch: the verdict (as :class:`Outcome`'s, with ``"post"``, ``"bar"`` and ``"saved"``); None without."""
+    keeper_dive: KeeperDive | None = None
+    """On a pitch with a keeper: his dive, or None if he never set off."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -91,7 +135,12 @@ class BatchTrajectory:
     n_samples: NDArray[np.int64]
     """(K,) samples that belong to each flight; the last is its interpolated end."""
     ended: NDArray[np.str_]
-    """(K,) ``"ground"``, ``"x_stop"`` or ``"t_max"``."""
+    """(K,) ``"ground"``, ``"x_stop"`` or ``"t_max"`` (on a pitch also ``"stopped"``, ``"net"``, ``"out"``,
+    ``"saved"``)."""
+    events: tuple[tuple[Event, ...], ...] | None = None
+    """On a pitch: each kick's contacts in order; None without one."""
+    result: NDArray[np.str_] | None = None
+    """On a pitch: (K,) each kick's verdict; None without one."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -120,6 +169,10 @@ class BatchOutcome:
     """(K, 3) crossing of the wall's plane (m)."""
     goal_point: NDArray[np.float64]
     """(K, 3) crossing of the goal's plane (m)."""
+
+    def counts(self) -> dict[str, int]:
+        """How many kicks ended each way: every one of the eight results, zeros included."""
+        return {name: int(np.count_nonzero(self.result == name)) for name in RESULTS}
 
 
 def _round_down(value: float) -> float:
@@ -162,6 +215,7 @@ def simulate(
     config: FlightConfig | None = None,
     *,
     knuckle_seed: int | None = None,
+    pitch: Pitch | None = None,
     **options: Any,
 ) -> Trajectory:
     """Integrate one kick until the ball's centre reaches ``ground_m``, passes ``x_stop``, or ``t_max`` runs out.
@@ -173,12 +227,16 @@ def simulate(
         config: the ball, air, integrator and end of the flight (:class:`FlightConfig`, validated once); default
             ``FlightConfig()``.
         knuckle_seed: turn on the knuckleball side force (near-zero spin only), drawn from this seed.
+        pitch: a :class:`Pitch`: the flight goes on after it lands (bounces, rolls, strikes the posts, the bar, the
+            wall's players and the keeper) until it stops, enters the net, leaves the pitch, is saved, passes
+            ``x_stop`` or reaches ``t_max``; its contacts are ``events`` and its verdict ``result`` (see
+            :mod:`kernels.ball.play`). None (the default): it ends where it first touches the ground.
         **options: instead of ``config``, any of :class:`FlightConfig`'s fields as keywords (``dt=1e-2,
             method="rk4"``); the config built from them is cached, so repeating the same options costs no
             validation.
 
     Returns:
-        :class:`Trajectory`, sampled every ``dt`` plus the interpolated end.
+        :class:`Trajectory`, sampled every ``dt`` plus the interpolated end (on a pitch, plus each contact).
 
     Raises:
         ValueError: naming the argument, for non-finite, boolean or wrongly shaped input, an invalid
@@ -204,6 +262,8 @@ def simulate(
         launch = np.array(p0 + v0 + w0 + _NO_KNUCKLE)
         if settings[MEASURED] or p0[2] < settings[GROUND]:
             check_launches(launch[None], settings, batch=False)
+    if pitch is not None:
+        return _simulate_on_pitch(launch, settings, pitch)
     rows = int(settings[N_STEPS]) + 1
     t, state, forces = np.empty(rows), np.empty((rows, 6)), np.empty((rows, 12))
     n, ending = simulate_one(launch, settings, t, state, forces)
@@ -218,7 +278,45 @@ def simulate(
         magnus=forces[:, 3:6],
         gravity=forces[:, 6:9],
         knuckle=forces[:, 9:12],
-        ended=ENDINGS[ending],
+        ended=_ending(ending),
+    )
+
+
+def _ending(code: int) -> Ending:
+    name = ENDINGS[code]
+    assert name not in ("diverged", "refused")
+    return name  # type: ignore[return-value]
+
+
+def _keeper_dive(info: NDArray[np.float64]) -> KeeperDive | None:
+    if math.isnan(info[play.I_DIVE]):
+        return None
+    target = info[play.I_TARGET : play.I_TARGET + 3]
+    return KeeperDive(float(info[play.I_DIVE]), (float(target[0]), float(target[1]), float(target[2])))
+
+
+def _simulate_on_pitch(launch: NDArray[np.float64], settings: NDArray[np.float64], pitch: Pitch) -> Trajectory:
+    vector = pitch_vector(pitch, launch[:2], float(settings[GROUND]), float(settings[RADIUS]))
+    rows = int(settings[N_STEPS]) + 1 + play.EXTRA_ROWS
+    t, state, spin, forces = np.empty(rows), np.empty((rows, 6)), np.empty((rows, 3)), np.empty((rows, 12))
+    events, info = np.empty((play.MAX_EVENTS, 5)), np.empty(play.N_INFO)
+    n, ending = play_one(launch, settings, vector, t, state, spin, forces, events, info)
+    if ending in (3, 4):
+        _refuse_overflow(np.array([ending]), settings, launch[None])
+    state, forces = state[:n], forces[:n]
+    return Trajectory(
+        t=t[:n],
+        position=state[:, :3],
+        velocity=state[:, 3:],
+        drag=forces[:, 0:3],
+        magnus=forces[:, 3:6],
+        gravity=forces[:, 6:9],
+        knuckle=forces[:, 9:12],
+        ended=_ending(ending),
+        events=_events(events, int(info[play.I_EVENTS])),
+        spin=spin[:n],
+        result=RESULTS[int(info[play.I_RESULT])],
+        keeper_dive=_keeper_dive(info),
     )
 
 
@@ -233,6 +331,7 @@ def simulate_batch(
     config: FlightConfig | None = None,
     *,
     knuckle_seeds: Sequence[int | None] | None = None,
+    pitch: Pitch | None = None,
     **options: Any,
 ) -> BatchTrajectory:
     """Integrate K kicks, in parallel over the kicks; each flight is :func:`simulate`'s, bit for bit.
@@ -246,6 +345,9 @@ def simulate_batch(
         velocities: (K, 3) launch velocities (m/s).
         spins: (K, 3) angular velocities (rad/s).
         knuckle_seeds: None, or K seeds (each None or an int) as :func:`simulate`'s ``knuckle_seed``.
+        pitch: as for :func:`simulate`, shared by every kick (a keeper without a position is placed for the first
+            kick's spot); each flight is then :func:`simulate`'s on that pitch, and ``events`` and ``result`` are
+            filled.
         config, options: as for :func:`simulate`, shared by every kick.
 
     Returns:
@@ -254,6 +356,8 @@ def simulate_batch(
     settings = flight_config(config, options).settings
     launches = kick_rows(positions, velocities, spins, knuckle_seeds)
     check_launches(launches, settings, batch=True)
+    if pitch is not None:
+        return _batch_on_pitch(launches, settings, pitch)
     k = len(launches)
     rows = int(settings[N_STEPS]) + 1
     n_samples, endings = np.ones(k, dtype=np.int64), np.full(k, 2, dtype=np.int64)
@@ -277,6 +381,42 @@ def simulate_batch(
         velocity=state[:, :, 3:],
         n_samples=n_samples,
         ended=np.array(ENDINGS, dtype="<U6")[endings],
+    )
+
+
+def _play_batch(
+    launches: NDArray[np.float64], settings: NDArray[np.float64], pitch: Pitch, keep: bool
+) -> tuple[Any, ...]:
+    """Every kick on the pitch, in parallel: (t, state, spin, events, info, n_samples, endings); flights kept only
+    when ``keep`` (else zero-length rows)."""
+    k = len(launches)
+    spot = launches[0, :2] if k else np.zeros(2)
+    vector = pitch_vector(pitch, spot, float(settings[GROUND]), float(settings[RADIUS]))
+    rows = int(settings[N_STEPS]) + 1 + play.EXTRA_ROWS if keep else 0
+    t, state, spin = np.empty((k, rows)), np.empty((k, rows, 6)), np.empty((k, rows, 3))
+    events, info = np.empty((k, play.MAX_EVENTS, 5)), np.empty((k, play.N_INFO))
+    n_samples, endings = np.ones(k, dtype=np.int64), np.full(k, 2, dtype=np.int64)
+    with _PARALLEL:
+        play_batch(launches, settings, vector, t, state, spin, events, info, n_samples, endings)
+    _refuse_overflow(endings, settings, launches)
+    return t, state, spin, events, info, n_samples, endings
+
+
+def _batch_on_pitch(launches: NDArray[np.float64], settings: NDArray[np.float64], pitch: Pitch) -> BatchTrajectory:
+    t, state, _, events, info, n_samples, endings = _play_batch(launches, settings, pitch, keep=True)
+    width = int(n_samples.max()) if len(n_samples) else 1
+    t, state = t[:, :width], state[:, :width]
+    for k, n in enumerate(n_samples):  # pad each flight with its last sample
+        t[k, n:] = t[k, n - 1]
+        state[k, n:] = state[k, n - 1]
+    return BatchTrajectory(
+        t=t,
+        position=state[:, :, :3],
+        velocity=state[:, :, 3:],
+        n_samples=n_samples,
+        ended=np.array(ENDINGS, dtype="<U8")[endings],
+        events=tuple(_events(events[k], int(info[k, play.I_EVENTS])) for k in range(len(n_samples))),
+        result=np.array(RESULTS, dtype="<U5")[info[:, play.I_RESULT].astype(np.int64)],
     )
 
 
@@ -361,11 +501,12 @@ def simulate_outcomes(
     positions: ArrayLike,
     velocities: ArrayLike,
     spins: ArrayLike,
-    wall: Panel,
-    goal: Panel,
+    wall: Panel | None = None,
+    goal: Panel | None = None,
     config: FlightConfig | None = None,
     *,
     knuckle_seeds: Sequence[int | None] | None = None,
+    pitch: Pitch | None = None,
     **options: Any,
 ) -> BatchOutcome:
     """``outcome_batch(simulate_batch(...), wall, goal)`` without keeping the flights: the same verdicts and crossings.
@@ -375,8 +516,12 @@ def simulate_outcomes(
 
     Args:
         positions, velocities, spins, knuckle_seeds: the K kicks, as for :func:`simulate_batch`.
-        wall: the wall.
-        goal: the goal mouth.
+        wall: the wall, or None for none (its crossings are then NaN).
+        goal: the goal mouth (without a pitch, required).
+        pitch: a :class:`Pitch` (then ``wall`` and ``goal`` are its own, and must be None or the same): each kick
+            plays on to its end as :func:`simulate`'s does on it, and is judged by what it did (results gain
+            ``"post"``, ``"bar"`` and ``"saved"``; a ball in off the post is a ``"goal"``); the wall's point is
+            where it crossed the wall's plane.
         config, options: as for :func:`simulate`, shared by every kick; its ``radius_m`` also sizes the ball
             for the verdict.
 
@@ -386,11 +531,29 @@ def simulate_outcomes(
     settings = flight_config(config, options).settings
     launches = kick_rows(positions, velocities, spins, knuckle_seeds)
     check_launches(launches, settings, batch=True)
+    if pitch is not None:
+        if not isinstance(pitch, Pitch):
+            raise ValueError(f"pitch must be a Pitch, got {type(pitch).__name__}")
+        if (wall is not None and wall != pitch.wall) or (goal is not None and goal != pitch.goal):
+            raise ValueError("with a pitch, wall and goal are the pitch's own: pass None (or the same panels)")
+        *_, info, _, _ = _play_batch(launches, settings, pitch, keep=False)
+        return BatchOutcome(
+            result=np.array(RESULTS, dtype="<U5")[info[:, play.I_RESULT].astype(np.int64)],
+            wall_point=info[:, play.I_WALL + 1 : play.I_WALL + 4].copy(),
+            goal_point=info[:, play.I_GOAL + 1 : play.I_GOAL + 4].copy(),
+        )
+    if goal is None:
+        raise ValueError("goal must be a Panel (or pass a pitch)")
+    no_wall = wall is None
+    if wall is None:  # a wall nobody can hit: below the turf
+        wall = Panel(goal.centre_xy, goal.normal_xy, 1e-9, -1e300)
     k, panels = len(launches), panel_rows(wall, goal)
     results, crossings, endings = np.empty(k, np.int64), np.empty((k, 2, 4)), np.empty(k, np.int64)
     with _PARALLEL:
         fly_and_judge(launches, settings, panels, results, crossings, endings)
     _refuse_overflow(endings, settings, launches)
+    if no_wall:
+        crossings[:, 0, :] = np.nan
     return _batch_outcome(results, crossings)
 
 
@@ -448,3 +611,7 @@ def warm_up() -> None:
     simulate_outcomes(rows, [velocity, velocity], [spin, spin], wall, goal, dt=0.05, x_stop=13.0)
     coefficients(20.0, 30.0)
     bounce(velocity, spin)
+    pitch = Pitch(goal, wall, Keeper())
+    simulate(start, velocity, spin, dt=0.05, method="rk4", model="measured", knuckle_seed=0, pitch=pitch)
+    simulate_batch(rows, [velocity, velocity], [spin, spin], dt=0.05, t_max=0.2, pitch=pitch)
+    simulate_outcomes(rows, [velocity, velocity], [spin, spin], dt=0.05, pitch=pitch)

@@ -1,7 +1,7 @@
 """The ball, the air and the integrator: constants, :class:`FlightConfig`, and the checks on every kick's input.
 
-SI units (m, s, kg, rad/s). :class:`FlightConfig` is validated once and carries the compiled cores' (14,) settings
-vector, whose slots are :data:`Q` … :data:`T_MAX`; :func:`launch_rows` turns K validated kicks into the cores'
+SI units (m, s, kg, rad/s). :class:`FlightConfig` is validated once and carries the compiled cores' (15,) settings
+vector, whose slots are :data:`Q` … :data:`RE_CRISIS`; :func:`launch_rows` turns K validated kicks into the cores'
 (K, 13) launch rows (position, velocity, spin, knuckle angles and flag). Every check raises ``ValueError`` naming the
 argument. The constants' sources are in :mod:`kernels.ball`'s docstring.
 """
@@ -34,6 +34,14 @@ KNUCKLE_WAVELENGTH_M = 15.0
 """Flight distance of one zig-zag (Cohen et al. 2012)."""
 KNUCKLE_SPIN_LIMIT = 0.05
 """Launch spin parameter S₀ at and above which the knuckle force is off."""
+DRAG_CRISIS_RE = 1.815e5
+"""Centre of the measured model's drag crisis (Reynolds number): Goff & Carré 2010's no-spin fit to the Teamgeist
+(0.155 + 0.346/(1 + exp((v − 12.19 m/s)/1.309 m/s)), in Re for a 0.22 m ball in air of 1.225 kg/m³)."""
+DRAG_CRISIS_RE_BY_BALL = {"Teamgeist": 1.815e5}
+"""Documented centres of the drag crisis per ball, for :attr:`FlightConfig.drag_crisis_re`. Only the Teamgeist's
+(Goff & Carré 2010) is a fitted centre; wind-tunnel studies place other balls' crises elsewhere (32-panel balls
+nearer 2.2–3.0·10⁵ in a compilation we have not checked against the papers; the Brazuca's critical speed below the
+Jabulani's, Goff, Asai & Hong 2014), so set the centre from the ball's own measurement."""
 
 Method = Literal["euler", "rk4"]
 Model = Literal["constant", "measured"]
@@ -42,7 +50,7 @@ _MAX_STEPS = 1_000_000
 
 # The compiled cores read their settings from one float64 vector; these are its slots.
 Q, GRAVITY, RADIUS, RE_PER_SPEED, C_D, C_L, MASS, DT, GROUND, X_STOP = range(10)
-N_STEPS, RK4, MEASURED, T_MAX = 10, 11, 12, 13
+N_STEPS, RK4, MEASURED, T_MAX, RE_CRISIS = 10, 11, 12, 13, 14
 
 _SPIN_PARAMETER_LIMIT = 1e3
 """Largest spin parameter S = r·|ω|/|v| the measured model accepts at launch; its fits stop at S ≈ 0.3 (held
@@ -142,8 +150,11 @@ class FlightConfig:
     ground_m: float = 0.0
     """Height of the ball's centre at which it touches the ground (m); the radius for a ball whose underside
     meets the turf at z = 0."""
+    drag_crisis_re: float = DRAG_CRISIS_RE
+    """Centre of the measured model's drag crisis (Reynolds number, > 0): 1.815·10⁵ for the Teamgeist that Goff &
+    Carré 2010 measured (the default); see :data:`DRAG_CRISIS_RE_BY_BALL`."""
     settings: NDArray[np.float64] = dataclasses.field(init=False, repr=False, compare=False)
-    """(14,) the compiled cores' settings vector (slots ``Q`` … ``T_MAX``), read-only; derived, not an argument."""
+    """(15,) the compiled cores' settings vector (slots ``Q`` … ``RE_CRISIS``), read-only; derived, not an argument."""
 
     def __post_init__(self) -> None:
         step = _checks.positive("dt", self.dt)
@@ -162,8 +173,9 @@ class FlightConfig:
         g = _checks.finite_number("gravity", self.gravity)
         stop = math.inf if self.x_stop is None else _checks.finite_number("x_stop", self.x_stop)
         ground = _checks.finite_number("ground_m", self.ground_m)
+        crisis = _checks.positive("drag_crisis_re", self.drag_crisis_re)
         # In slot order: Q (½ρA/m, 1/m), GRAVITY, RADIUS, RE_PER_SPEED, C_D, C_L, MASS, DT, GROUND,
-        # X_STOP, N_STEPS, RK4, MEASURED, T_MAX.
+        # X_STOP, N_STEPS, RK4, MEASURED, T_MAX, RE_CRISIS.
         settings = np.array(
             [
                 0.5 * density * math.pi * radius**2 / mass,
@@ -180,6 +192,7 @@ class FlightConfig:
                 self.method == "rk4",
                 self.model == "measured",
                 duration,
+                crisis,
             ]
         )
         settings.setflags(write=False)

@@ -19,12 +19,13 @@ from kernels.ball.aero import N_KICK, acceleration, fill_kick, max_stable_step, 
 from kernels.ball.config import DT, GRAVITY, GROUND, N_STEPS, RADIUS, RK4, T_MAX, X_STOP
 from kernels.ball.jit import compiled
 
-Ending = Literal["ground", "x_stop", "t_max"]
-Result = Literal["goal", "wall", "over", "wide", "short"]
+Ending = Literal["ground", "x_stop", "t_max", "stopped", "net", "out", "saved"]
+Result = Literal["goal", "wall", "over", "wide", "short", "post", "bar", "saved"]
 
-# Codes of the compiled flight's ending (3, diverged, raises) and of its verdict.
-ENDINGS: tuple[Ending, ...] = ("ground", "x_stop", "t_max")
-RESULTS: tuple[Result, ...] = ("goal", "wall", "over", "wide", "short")
+# Codes of the compiled flight's ending (3 diverged and 4 refused raise; 5–8 only on a pitch, kernels.ball.play)
+# and of its verdict (5–7 only on a pitch).
+ENDINGS: tuple[str, ...] = ("ground", "x_stop", "t_max", "diverged", "refused", "stopped", "net", "out", "saved")
+RESULTS: tuple[Result, ...] = ("goal", "wall", "over", "wide", "short", "post", "bar", "saved")
 
 
 # --------------------------------------------------------------------------------------------- flight

@@ -3,8 +3,8 @@
 :func:`coefficients` returns the C_D and C_L the flight uses, from the same compiled function its force law calls
 (:func:`kernels.ball.aero.drag_lift`); :func:`bounce` applies Cross's grip–slip impulse model
 (:mod:`kernels.ball.contact`). Both check their arguments once (``ValueError`` naming the argument) and hand trusted
-arrays to their compiled cores. The flight does not call :func:`bounce` yet: it stops at the first touch of the
-ground. Frame, units and the flight's model: :mod:`kernels.ball`.
+arrays to their compiled cores. The flight on a pitch applies the same compiled impact at each contact
+(:mod:`kernels.ball.play`). Frame, units and the flight's model: :mod:`kernels.ball`.
 """
 
 from __future__ import annotations
@@ -53,13 +53,14 @@ def coefficients(
     ``"constant"``: the configured C_D and C_L (0.25 and 0.25 by default). ``"measured"``: with S = r·|ω|/|v| the
     spin parameter and Re = ρ·|v|·2r/μ,
 
-        C_L(S)     = 0.9·min(S, 0.3)                                   (Asai et al. 2007, Sports Eng. 10)
+        C_L(S)     = 0.9·min(S, 0.3)        (below Asai et al. 2007's wind-tunnel 0.21 at S = 0.18: see kernels.ball)
         C_D(Re, S) = C_D0(Re) + min(S/0.05, 1)·(C_Ds(max(S, 0.05)) − C_D0(Re))
-        C_D0(Re)   = 0.155 + 0.346 / (1 + exp((Re − 1.815·10⁵) / 1.949·10⁴))   (Goff & Carré 2010, Eur. J. Phys. 31)
+        C_D0(Re)   = 0.155 + 0.346 / (1 + exp((Re − Re_c) / 1.949·10⁴))   (Goff & Carré 2010, Eur. J. Phys. 31)
         C_Ds(S)    = 0.4127·S^0.3056                                   (Goff & Carré 2010)
 
-    so a spinless ball's drag falls through the drag crisis (0.501 well below, 0.328 at 12.19 m/s, 0.155 well
-    above, for the default ball and air) and a spinning one's grows with S. Computed by the very compiled function
+    with Re_c the crisis centre (``drag_crisis_re``, 1.815·10⁵ for the Teamgeist they measured), so a spinless
+    ball's drag falls through the drag crisis (0.501 well below, 0.328 at 12.19 m/s, 0.155 well above, for the
+    default ball and air) and a spinning one's grows with S. Computed by the very compiled function
     the flight's force law calls (:func:`kernels.ball.aero.drag_lift`); details and sources in :mod:`kernels.ball`.
 
     Args:
@@ -67,7 +68,8 @@ def coefficients(
         spin_rads: its spin rate |ω| (rad/s, ≥ 0): a number or an array, broadcast against ``speed_ms``.
         model: ``"measured"`` or ``"constant"``.
         **options: any of :class:`FlightConfig`'s fields but ``model``, as for :func:`simulate`; those that matter
-            here are ``radius_m`` and ``air_density`` (the measured model's S and Re) and ``drag_coefficient`` and
+            here are ``radius_m``, ``air_density`` and ``drag_crisis_re`` (the measured model's S, Re and crisis
+            centre) and ``drag_coefficient`` and
             ``lift_coefficient`` (the constant model's values).
 
     Returns:
@@ -145,7 +147,7 @@ def bounce(
     A ball not moving into the surface (v·n ≥ 0) is returned unchanged. Kinetic energy (translational and
     rotational) never rises, and the angular momentum about the contact point is conserved. The defaults are a
     size-5 ball on dry turf: e_n = 0.6 (a 2 m drop rebounds 0.72 m, inside FIFA Quality Pro's 0.60–0.85 m), μ = 0.6,
-    e_t = 0.1 (see :mod:`kernels.ball.contact`). The flight does not call this yet.
+    e_t = 0.1 (see :mod:`kernels.ball.contact`). The flight on a pitch applies the same compiled impact.
 
     Args:
         velocity: (3,) or (K, 3) velocity at impact (m/s).

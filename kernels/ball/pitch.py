@@ -13,6 +13,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from kernels import _checks
+from kernels.ball import play
 from kernels.ball.config import checked_vector
 
 GOAL_WIDTH_M = 7.32
@@ -101,3 +102,188 @@ def panel_rows(wall: Panel, goal: Panel) -> NDArray[np.float64]:
         row[4] = _checks.positive(f"{name}.width_m", panel.width_m)
         row[5] = _checks.finite_number(f"{name}.height_m", panel.height_m)
     return rows
+
+
+# --------------------------------------------------------------------------------------------- the pitch
+@dataclasses.dataclass(frozen=True)
+class Surface:
+    """How the ball meets a surface: Cross's grip–slip impulse coefficients (see :func:`kernels.ball.bounce`) and,
+    for turf, its rolling resistance."""
+
+    restitution: float = 0.6
+    """e_n, normal coefficient of restitution (0–1)."""
+    friction: float = 0.6
+    """μ, sliding friction (≥ 0)."""
+    tangential_restitution: float = 0.1
+    """e_t, the share of the contact point's tangential velocity returned reversed on grip (0–1)."""
+    rolling_deceleration_ms2: float = 0.8
+    """Rolling resistance (m/s², ≥ 0); the air's drag adds to it."""
+
+
+DRY_TURF = Surface()
+"""Dry turf: e_n 0.6 (a 2 m drop rebounds 0.72 m, inside FIFA Quality Pro's 0.60–0.85 m), μ 0.6, e_t 0.1 (Cross
+2002's grip–slip values for a ball that grips), rolling resistance 0.8 m/s² (FIFA's ball-roll band: a ball leaving
+the ramp at ~3.2 m/s rolls 4–10 m)."""
+WET_TURF = Surface(friction=0.25)
+"""Wet turf: as dry but μ 0.25 (0.2–0.3 wet): the ball skids on."""
+FRAME = Surface(restitution=0.75, friction=0.3, tangential_restitution=0.1, rolling_deceleration_ms2=0.0)
+"""Posts and bar (aluminium): e_n 0.75, μ 0.3. Assumed from FIFA's drop test onto steel (2 m → 1.35–1.55 m, e 0.82–
+0.88 at 6.3 m/s), lowered because e falls at shot speeds; μ 0.3 is a guess for a ball sliding on painted metal."""
+BODY = Surface(restitution=0.4, friction=0.5, tangential_restitution=0.0, rolling_deceleration_ms2=0.0)
+"""The wall's players: e_n 0.4, μ 0.5, e_t 0: a guess (a body is soft and absorbs much of the impact); no
+published value was found."""
+
+
+@dataclasses.dataclass(frozen=True)
+class Keeper:
+    """A goalkeeper: a stick of radius ``body_radius_m`` from feet to fingertips through the centre of mass.
+
+    He stands (upright, fingertips at ``com_height_m + hand_reach_m``) on the bisector of the angle the two posts
+    make at the ball, ``depth_m`` off his line (shifted ``shift_m`` to his left, looking out), until a reaction time
+    after the ball passes the wall (after the kick without a wall). Then he reads where the ball, flying straight on
+    under gravity, will cross the goal line (within the goal) and dives: his centre of mass accelerates uniformly
+    for ``push_off_s`` to ``dive_speed_ms``, then keeps it, along the straight line that puts his fingertips there,
+    while the stick turns from upright to point at it over ``turn_s``. A ball that touches him is saved.
+
+    Numbers: dive speed 3.9 m/s, the horizontal centre-of-mass speed at take-off of elite keepers diving to balls
+    from a ball cannon (Ibrahim et al. 2019, J. Sports Sci. 37:313: 2.7 + 1.2 m/s from the two legs); reaction
+    0.25 s (simple visual reaction is 0.2–0.3 s); push-off 0.3 s and turn 0.3 s are estimates of the dive's
+    duration to take-off, body sizes a 1.90 m keeper's. Spratford et al. 2009 (J. Sports Sci.) was not available
+    to check against.
+    """
+
+    position_xy: tuple[float, float] | None = None
+    """Where he stands (m); None places him by the angle, from the ball's spot (the first kick's for a batch)."""
+    depth_m: float = 1.0
+    """Off the goal line toward the ball, along the bisector (m), when placed by the angle."""
+    shift_m: float = 0.0
+    """Sideways shift from the bisector (m, + to the left looking from the goal toward the ball), when placed."""
+    reaction_s: float = 0.25
+    """From the ball passing the wall (or the kick) to the start of the dive (s)."""
+    push_off_s: float = 0.3
+    """Time to reach the dive speed (s, > 0)."""
+    dive_speed_ms: float = 3.9
+    """Centre-of-mass speed in the dive (m/s)."""
+    turn_s: float = 0.3
+    """Time for the body to turn from upright to point at the ball (s, > 0)."""
+    com_height_m: float = 1.0
+    """Centre of mass above the turf, standing (m)."""
+    hand_reach_m: float = 1.3
+    """Centre of mass to fingertips, arms stretched (m)."""
+    foot_reach_m: float = 1.0
+    """Centre of mass to the soles (m)."""
+    body_radius_m: float = 0.15
+    """Half the body's thickness (m)."""
+
+    def placed(self, ball_xy: ArrayLike, goal: Panel) -> tuple[float, float]:
+        """Where he stands for a ball at ``ball_xy``: ``position_xy``, or on the bisector of the posts' angle."""
+        if self.position_xy is not None:
+            spot = checked_vector("keeper.position_xy", self.position_xy, 2)
+            return float(spot[0]), float(spot[1])
+        ball = checked_vector("ball_xy", ball_xy, 2)
+        centre = checked_vector("goal.centre_xy", goal.centre_xy, 2)
+        normal = checked_vector("goal.normal_xy", goal.normal_xy, 2)
+        normal = normal / float(np.hypot(*normal))
+        along = np.array([-normal[1], normal[0]])
+        # The bisector of the angle at the ball runs from the ball through the point that splits the goal line in
+        # the ratio of the ball's distances to the posts; the keeper stands on it, depth_m out from the line.
+        d_right = float(np.hypot(*(ball - (centre - 0.5 * goal.width_m * along))))
+        d_left = float(np.hypot(*(ball - (centre + 0.5 * goal.width_m * along))))
+        split = centre + (-0.5 + d_right / (d_right + d_left)) * goal.width_m * along
+        towards_ball = ball - split
+        length = float(np.hypot(*towards_ball))
+        unit = towards_ball / length if length > 0 else -normal
+        left = np.array([-unit[1], unit[0]])
+        spot = split + _checks.finite_number("keeper.depth_m", self.depth_m) * unit
+        spot = spot - _checks.finite_number("keeper.shift_m", self.shift_m) * left
+        return float(spot[0]), float(spot[1])
+
+
+@dataclasses.dataclass(frozen=True)
+class Pitch:
+    """The goal (its posts, bar and net), the wall and the keeper, for a flight that goes on after it lands.
+
+    Heights stand on the turf, at ``ground_m − radius_m`` of the flight's config (z = 0 for a ball whose centre
+    touches at its radius, as the scene flies it). Posts and bar are cylinders (capsules) of ``post_radius_m`` (Law 1:
+    at most 12 cm wide), the posts centred on the goal line ``goal.width_m`` apart at their inside edges, the bar's
+    underside ``goal.height_m`` up; the net a box ``net_depth_m`` deep behind the line that stops the ball. The
+    wall's players stand side by side as upright capsules of radius ``wall.width_m/(2·players)``, their heads at
+    ``wall.height_m`` (give a jumping wall's height for a jump). A ball wholly over the goal line off the goal, or over
+    a touchline (``pitch_width_m`` wide, centred on the goal), leaves the pitch.
+    """
+
+    goal: Panel
+    wall: Panel | None = None
+    keeper: Keeper | None = None
+    post_radius_m: float = 0.06
+    surface: Surface = DRY_TURF
+    frame: Surface = FRAME
+    body: Surface = BODY
+    net_depth_m: float = 2.0
+    wall_players: int | None = None
+    """Players in the wall; None: one per 0.5 m of its width."""
+    pitch_width_m: float = 68.0
+    roll_speed_ms: float = 0.5
+    """A ground bounce leaving less than this upward (a hop under 1.3 cm) starts the roll (m/s)."""
+
+
+def _surface_slots(name: str, surface: Surface, radius: float) -> list[float]:
+    e_n, e_t = surface.restitution, surface.tangential_restitution
+    for label, value in (("restitution", e_n), ("tangential_restitution", e_t)):
+        number = _checks.finite_number(f"{name}.{label}", value)
+        if not 0.0 <= number <= 1.0:
+            raise ValueError(f"{name}.{label} must be in [0, 1], got {value!r}")
+    mu = _checks.non_negative(f"{name}.friction", surface.friction)
+    _checks.non_negative(f"{name}.rolling_deceleration_ms2", surface.rolling_deceleration_ms2)
+    return [float(e_n), float(e_t), mu, radius, 2.0 / 3.0]
+
+
+def pitch_vector(pitch: Pitch, ball_xy: ArrayLike, ground_m: float, radius_m: float) -> NDArray[np.float64]:
+    """The compiled flight's (N_PITCH,) pitch vector (slots in :mod:`kernels.ball.play`), checked (``ValueError``
+    naming the field). ``ball_xy`` places a keeper without a position."""
+    if not isinstance(pitch, Pitch):
+        raise ValueError(f"pitch must be a Pitch, got {type(pitch).__name__}")
+    vector = np.zeros(play.N_PITCH)
+    goal_row = panel_rows(pitch.wall or pitch.goal, pitch.goal)[1]
+    vector[play.GX : play.GH + 1] = goal_row
+    vector[play.POST_R] = _checks.positive("pitch.post_radius_m", pitch.post_radius_m)
+    vector[play.NET_DEPTH] = _checks.positive("pitch.net_depth_m", pitch.net_depth_m)
+    vector[play.TURF] = ground_m - radius_m
+    vector[play.HALF_WIDTH] = 0.5 * _checks.positive("pitch.pitch_width_m", pitch.pitch_width_m)
+    vector[play.ROLL_DECEL] = _checks.non_negative(
+        "pitch.surface.rolling_deceleration_ms2", pitch.surface.rolling_deceleration_ms2
+    )
+    vector[play.ROLL_SPEED] = _checks.non_negative("pitch.roll_speed_ms", pitch.roll_speed_ms)
+    for slot, name, surface in (
+        (play.TURF_SURFACE, "pitch.surface", pitch.surface),
+        (play.FRAME_SURFACE, "pitch.frame", pitch.frame),
+        (play.BODY_SURFACE, "pitch.body", pitch.body),
+    ):
+        vector[slot : slot + 5] = _surface_slots(name, surface, radius_m)
+    if pitch.wall is not None:
+        wall_row = panel_rows(pitch.wall, pitch.goal)[0]
+        players = pitch.wall_players
+        if players is None:
+            players = max(1, round(wall_row[4] / 0.5))
+        if isinstance(players, bool) or not isinstance(players, (int, np.integer)) or not 1 <= players <= 16:
+            raise ValueError(f"pitch.wall_players must be None or an integer in [1, 16], got {players!r}")
+        vector[play.WALL_ON] = 1.0
+        vector[play.WX : play.WH + 1] = wall_row
+        vector[play.N_PLAYERS] = players
+        vector[play.PLAYER_R] = wall_row[4] / (2.0 * players)
+    keeper = pitch.keeper
+    if keeper is not None:
+        if not isinstance(keeper, Keeper):
+            raise ValueError(f"pitch.keeper must be a Keeper, got {type(keeper).__name__}")
+        kx, ky = keeper.placed(ball_xy, pitch.goal)
+        vector[play.KEEPER_ON] = 1.0
+        vector[play.KX], vector[play.KY] = kx, ky
+        vector[play.K_RADIUS] = _checks.positive("keeper.body_radius_m", keeper.body_radius_m)
+        vector[play.K_COM] = _checks.positive("keeper.com_height_m", keeper.com_height_m)
+        vector[play.K_HANDS] = _checks.positive("keeper.hand_reach_m", keeper.hand_reach_m)
+        vector[play.K_FEET] = _checks.positive("keeper.foot_reach_m", keeper.foot_reach_m)
+        vector[play.K_REACT] = _checks.non_negative("keeper.reaction_s", keeper.reaction_s)
+        vector[play.K_PUSH] = _checks.positive("keeper.push_off_s", keeper.push_off_s)
+        vector[play.K_SPEED] = _checks.non_negative("keeper.dive_speed_ms", keeper.dive_speed_ms)
+        vector[play.K_TURN] = _checks.positive("keeper.turn_s", keeper.turn_s)
+    return vector

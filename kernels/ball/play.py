@@ -1,0 +1,577 @@
+"""The flight on a pitch, compiled: it bounces, rolls, strikes the posts, the bar, the wall's players and the keeper,
+and ends in the net, at rest, off the pitch, in the keeper's hands or at ``t_max``.
+
+One compiled loop, :func:`play`, steps the same force law and RK4/Euler step as the free flight
+(:func:`kernels.ball.core._step`) between contacts; each contact is the first one found inside a step (the ground by
+the cubic Hermite root of :func:`~kernels.ball.core.crossing_fraction`, a capsule by bisection on the Hermite
+interpolant after a swept test of the step's chord) and applies :func:`kernels.ball.contact.impact`, Cross's
+grip–slip impulse (Cross 2002), with the surface's coefficients. The step then restarts from the contact, so samples
+are every ``dt`` between contacts, plus one at each contact. Spin is constant between contacts and changed by each.
+
+Pitch geometry is one (:data:`N_PITCH`,) vector (slots below) built by :func:`kernels.ball.pitch.pitch_vector`:
+the goal (posts: vertical capsules of radius r_p on the goal line at ±(w/2 + r_p); bar: a horizontal capsule with
+its underside at h), the net (a box 2 m deep behind the line: reaching it stops the ball), the wall's players
+(vertical capsules side by side, their tops at the wall's height) and the keeper (a capsule from feet to fingertips
+that stands, then, a reaction time after the ball passes the wall, moves toward where it reads the ball will cross
+the line). Rolling: once a ground bounce leaves less than :data:`ROLL_SPEED` upward, the ball rolls, held on the
+turf, slowed by a constant rolling resistance and the air's drag, until it stops. Sources and numbers:
+:mod:`kernels.ball.pitch`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import prange
+
+from kernels.ball.aero import AXIS, GAIN, N_KICK, RATE, drag_lift, fill_kick, max_stable_step, sample_forces
+from kernels.ball.config import (
+    C_D,
+    C_L,
+    DT,
+    GRAVITY,
+    GROUND,
+    MEASURED,
+    N_STEPS,
+    RADIUS,
+    RE_CRISIS,
+    RE_PER_SPEED,
+    T_MAX,
+    X_STOP,
+    Q,
+)
+from kernels.ball.contact import N_SURFACE, impact
+from kernels.ball.core import _hermite, _step, crossing_fraction
+from kernels.ball.jit import compiled
+
+# Slots of the pitch vector.
+GX, GY, GNX, GNY, GW, GH, POST_R, NET_DEPTH, TURF, HALF_WIDTH, ROLL_DECEL, ROLL_SPEED = range(12)
+TURF_SURFACE, FRAME_SURFACE, BODY_SURFACE = 12, 17, 22  # each N_SURFACE (5) slots: e_n, e_t, μ, R, α
+WALL_ON, WX, WY, WNX, WNY, WW, WH, N_PLAYERS, PLAYER_R = range(27, 36)
+KEEPER_ON, KX, KY, K_RADIUS, K_COM, K_HANDS, K_FEET, K_REACT, K_PUSH, K_SPEED, K_TURN = range(36, 47)
+N_PITCH = 48
+
+MAX_EVENTS = 64
+"""Contacts recorded per flight; a flight that would have more ends at the last (it is long at rest by then)."""
+MAX_CAPSULES = 20
+EXTRA_ROWS = 2 * MAX_EVENTS + 2
+"""Samples a flight on a pitch may add to ``n_steps + 1``: one at each contact and one partial step after it."""
+
+# Event kinds, ending codes and result codes (their names: kernels.ball.api).
+GROUND_HIT, POST, BAR, WALL, KEEPER, NET = range(6)
+ENDED_X_STOP, ENDED_T_MAX, DIVERGED, REFUSED, STOPPED, IN_NET, OUT, SAVED = 1, 2, 3, 4, 5, 6, 7, 8
+GOAL, WALL_RESULT, OVER, WIDE, SHORT, POST_RESULT, BAR_RESULT, SAVED_RESULT = range(8)
+
+# Slots of a flight's (N_INFO,) summary.
+I_RESULT, I_WALL, I_GOAL, I_EVENTS, I_DIVE, I_TARGET, I_FIRST = 0, 1, 5, 9, 10, 11, 14
+N_INFO = 16
+
+
+# --------------------------------------------------------------------------------------------- geometry
+@compiled()
+def _segment_closest(px, py, pz, dx, dy, dz, qx, qy, qz, ex, ey, ez):
+    """Closest points of segments P(s) = p + s·d and Q(u) = q + u·e, s, u ∈ [0, 1]: (s, u, squared distance).
+
+    Ericson, Real-Time Collision Detection (2005), §5.1.9.
+    """
+    rx, ry, rz = px - qx, py - qy, pz - qz
+    a = dx * dx + dy * dy + dz * dz
+    e2 = ex * ex + ey * ey + ez * ez
+    f = ex * rx + ey * ry + ez * rz
+    if a <= 1e-30 and e2 <= 1e-30:
+        return 0.0, 0.0, rx * rx + ry * ry + rz * rz
+    if a <= 1e-30:
+        s, u = 0.0, min(max(f / e2, 0.0), 1.0)
+    else:
+        c = dx * rx + dy * ry + dz * rz
+        if e2 <= 1e-30:
+            u, s = 0.0, min(max(-c / a, 0.0), 1.0)
+        else:
+            b = dx * ex + dy * ey + dz * ez
+            denom = a * e2 - b * b
+            s = min(max((b * f - c * e2) / denom, 0.0), 1.0) if denom > 1e-30 else 0.0
+            u = (b * s + f) / e2
+            if u < 0.0:
+                u, s = 0.0, min(max(-c / a, 0.0), 1.0)
+            elif u > 1.0:
+                u, s = 1.0, min(max((b - c) / a, 0.0), 1.0)
+    wx = px + s * dx - qx - u * ex
+    wy = py + s * dy - qy - u * ey
+    wz = pz + s * dz - qz - u * ez
+    return s, u, wx * wx + wy * wy + wz * wz
+
+
+@compiled()
+def _to_axis(x, y, z, cap):
+    """Distance from a point to a capsule's axis segment (``cap``: ax, ay, az, bx, by, bz, …) and the unit vector
+    from the axis to the point."""
+    ex, ey, ez = cap[3] - cap[0], cap[4] - cap[1], cap[5] - cap[2]
+    length2 = ex * ex + ey * ey + ez * ez
+    u = 0.0
+    if length2 > 0.0:
+        u = min(max(((x - cap[0]) * ex + (y - cap[1]) * ey + (z - cap[2]) * ez) / length2, 0.0), 1.0)
+    wx, wy, wz = x - cap[0] - u * ex, y - cap[1] - u * ey, z - cap[2] - u * ez
+    distance = math.sqrt(wx * wx + wy * wy + wz * wz)
+    if distance == 0.0:
+        return 0.0, 0.0, 0.0, 1.0
+    return distance, wx / distance, wy / distance, wz / distance
+
+
+@compiled()
+def _capsule_fraction(x, y, z, vx, vy, vz, x1, y1, z1, vx1, vy1, vz1, h, cap, radius):
+    """First fraction of the step at which the ball (radius ``radius``) touches the capsule ``cap`` while moving
+    into it, or 2.0 for none: a swept test of the chord, then bisection on the cubic Hermite path."""
+    reach = radius + cap[6]
+    _, _, d2 = _segment_closest(
+        x, y, z, x1 - x, y1 - y, z1 - z, cap[0], cap[1], cap[2], cap[3] - cap[0], cap[4] - cap[1], cap[5] - cap[2]
+    )
+    if d2 > (reach + 1e-3) ** 2:
+        return 2.0
+    distance, nx, ny, nz = _to_axis(x, y, z, cap)
+    if distance <= reach:  # touching at the start: a contact only if moving into it
+        return 0.0 if vx * nx + vy * ny + vz * nz < 0.0 else 2.0
+    # The chord's closest approach brackets the first touch (distance to a convex body is convex along a line).
+    s_hi, _, _ = _segment_closest(
+        x, y, z, x1 - x, y1 - y, z1 - z, cap[0], cap[1], cap[2], cap[3] - cap[0], cap[4] - cap[1], cap[5] - cap[2]
+    )
+    lo, hi = 0.0, max(s_hi, 1e-12)
+    px, _ = _hermite(x, vx, x1, vx1, h, hi)
+    py, _ = _hermite(y, vy, y1, vy1, h, hi)
+    pz, _ = _hermite(z, vz, z1, vz1, h, hi)
+    distance, _, _, _ = _to_axis(px, py, pz, cap)
+    if distance > reach:
+        return 2.0
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        px, _ = _hermite(x, vx, x1, vx1, h, mid)
+        py, _ = _hermite(y, vy, y1, vy1, h, mid)
+        pz, _ = _hermite(z, vz, z1, vz1, h, mid)
+        distance, _, _, _ = _to_axis(px, py, pz, cap)
+        if distance > reach:
+            lo = mid
+        else:
+            hi = mid
+        if hi - lo < 1e-13:
+            break
+    return lo
+
+
+@compiled()
+def _keeper_capsule(pitch, dive_t, target, t, cap):
+    """The keeper's capsule at time ``t`` into ``cap`` (8,): a stick from feet to fingertips through the centre of
+    mass. Standing, it is upright; from ``dive_t`` the centre of mass accelerates uniformly for the push-off time to
+    the dive speed, then keeps it, along the straight line to the point that puts the fingertips on ``target``,
+    stopping there; the stick turns from upright to point at the target over the turn time."""
+    turf = pitch[TURF]
+    mx, my, mz = pitch[KX], pitch[KY], turf + pitch[K_COM]
+    ux, uy, uz = 0.0, 0.0, 1.0
+    if t > dive_t:
+        tau = t - dive_t
+        push, speed = pitch[K_PUSH], pitch[K_SPEED]
+        travel = 0.5 * speed * tau * tau / push if tau < push else 0.5 * speed * push + speed * (tau - push)
+        gx, gy, gz = target[0] - mx, target[1] - my, target[2] - mz
+        span = math.sqrt(gx * gx + gy * gy + gz * gz)
+        if span > 1e-9:
+            gx, gy, gz = gx / span, gy / span, gz / span
+            move = min(travel, max(span - pitch[K_HANDS], 0.0))
+            mx, my, mz = mx + gx * move, my + gy * move, mz + gz * move
+            turn = min(tau / pitch[K_TURN], 1.0)
+            ux, uy, uz = turn * gx, turn * gy, (1.0 - turn) + turn * gz
+            length = math.sqrt(ux * ux + uy * uy + uz * uz)
+            if length > 1e-9:
+                ux, uy, uz = ux / length, uy / length, uz / length
+            else:
+                ux, uy, uz = gx, gy, gz
+    feet, hands, r = pitch[K_FEET], pitch[K_HANDS], pitch[K_RADIUS]
+    cap[0], cap[1], cap[2] = mx - ux * (feet - r), my - uy * (feet - r), max(mz - uz * (feet - r), turf + r)
+    cap[3], cap[4], cap[5] = mx + ux * (hands - r), my + uy * (hands - r), max(mz + uz * (hands - r), turf + r)
+    cap[6], cap[7] = r, KEEPER
+
+
+@compiled()
+def _fixed_capsules(pitch, caps):
+    """Posts, bar and the wall's players as rows of ``caps`` (ax, ay, az, bx, by, bz, radius, kind); their count."""
+    gx, gy, nx, ny = pitch[GX], pitch[GY], pitch[GNX], pitch[GNY]
+    ax, ay = -ny, nx  # along the goal line, to the left looking into the net
+    rp, turf = pitch[POST_R], pitch[TURF]
+    half = 0.5 * pitch[GW] + rp
+    top = turf + pitch[GH] + rp
+    for i, side in enumerate((-1.0, 1.0)):
+        caps[i, 0], caps[i, 1], caps[i, 2] = gx + side * half * ax, gy + side * half * ay, turf
+        caps[i, 3], caps[i, 4], caps[i, 5] = caps[i, 0], caps[i, 1], top
+        caps[i, 6], caps[i, 7] = rp, POST
+    caps[2, 0], caps[2, 1], caps[2, 2] = gx - half * ax, gy - half * ay, top
+    caps[2, 3], caps[2, 4], caps[2, 5] = gx + half * ax, gy + half * ay, top
+    caps[2, 6], caps[2, 7] = rp, BAR
+    count = 3
+    if pitch[WALL_ON] != 0.0:
+        players, r = int(pitch[N_PLAYERS]), pitch[PLAYER_R]
+        wx, wy = -pitch[WNY], pitch[WNX]
+        for j in range(players):
+            offset = (j - 0.5 * (players - 1)) * 2.0 * r
+            cx, cy = pitch[WX] + offset * wx, pitch[WY] + offset * wy
+            caps[count, 0], caps[count, 1], caps[count, 2] = cx, cy, turf + r
+            caps[count, 3], caps[count, 4] = cx, cy
+            caps[count, 5] = max(turf + pitch[WH] - r, turf + r)
+            caps[count, 6], caps[count, 7] = r, WALL
+            count += 1
+    return count
+
+
+# --------------------------------------------------------------------------------------------- the flight
+@compiled()
+def _roll_acceleration(vx, vy, kick, config, decel):
+    """Horizontal acceleration of a rolling ball: rolling resistance ``decel`` and the air's drag (spin rate |v|/R)."""
+    speed = math.sqrt(vx * vx + vy * vy)
+    if speed == 0.0:
+        return 0.0, 0.0
+    c_d, _ = drag_lift(
+        speed,
+        speed / config[RADIUS],
+        config[MEASURED],
+        config[C_D],
+        config[C_L],
+        config[RADIUS],
+        config[RE_PER_SPEED],
+        config[RE_CRISIS],
+    )
+    k = decel / speed + config[Q] * c_d * speed
+    return -k * vx, -k * vy
+
+
+@compiled()
+def _set_spin(kick, wx, wy, wz):
+    rate = math.sqrt(wx * wx + wy * wy + wz * wz)
+    kick[RATE] = rate
+    if rate > 0.0:
+        kick[AXIS], kick[AXIS + 1], kick[AXIS + 2] = wx / rate, wy / rate, wz / rate
+    else:
+        kick[AXIS], kick[AXIS + 1], kick[AXIS + 2] = 0.0, 0.0, 0.0
+
+
+@compiled()
+def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
+    """Fly one kick on the pitch. Writes samples (time, position and velocity, spin) to ``t_out`` (T,), ``state_out``
+    (T, 6) and ``spin_out`` (T, 3), T ≥ n_steps + 1 + :data:`EXTRA_ROWS` (T = 0: count only); contacts (time, kind,
+    x, y, z) to ``events`` (:data:`MAX_EVENTS`, 5); the verdict, the wall's and goal's plane crossings (time, x, y,
+    z; NaN where none), the contact count, the keeper's dive start and target and the first contact's time to
+    ``info`` (:data:`N_INFO`,). ``kick`` (from :func:`fill_kick`) is changed: spin after each contact, no knuckle
+    force after the first. Returns (samples written, ending code)."""
+    store = len(t_out) > 0
+    info[:] = np.nan
+    info[I_EVENTS] = 0.0
+    dt, ground, x_stop, g, t_max = config[DT], config[GROUND], config[X_STOP], config[GRAVITY], config[T_MAX]
+    radius = config[RADIUS]
+    x, y, z, vx, vy, vz = launch[0], launch[1], launch[2], launch[3], launch[4], launch[5]
+    wx, wy, wz = launch[6], launch[7], launch[8]
+    energy_limit = vx * vx + vy * vy + vz * vz + 2.0 * g * z
+    energy_limit += 3.0 * (vx * vx + vy * vy + vz * vz + 2.0 * abs(g) * (abs(z) + 1.0)) + 100.0
+    if store:
+        t_out[0] = 0.0
+        state_out[0, 0], state_out[0, 1], state_out[0, 2] = x, y, z
+        state_out[0, 3], state_out[0, 4], state_out[0, 5] = vx, vy, vz
+        spin_out[0, 0], spin_out[0, 1], spin_out[0, 2] = wx, wy, wz
+    refused = dt > max_stable_step(launch, kick, config)[0]
+    if refused:
+        info[I_RESULT] = SHORT
+        return 1, REFUSED
+    caps = np.empty((MAX_CAPSULES, 8))
+    n_fixed = _fixed_capsules(pitch, caps)
+    keeper = pitch[KEEPER_ON] != 0.0
+    n_caps = n_fixed + 1 if keeper else n_fixed
+    target = np.zeros(3)
+    dive_t = math.inf
+    seen_t = math.inf if pitch[WALL_ON] != 0.0 else 0.0
+    v_in, w_in, normal, v_new, w_new = np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3)
+    turf_surface = pitch[TURF_SURFACE : TURF_SURFACE + N_SURFACE]
+    frame_surface = pitch[FRAME_SURFACE : FRAME_SURFACE + N_SURFACE]
+    body_surface = pitch[BODY_SURFACE : BODY_SURFACE + N_SURFACE]
+    gx, gy, gnx, gny = pitch[GX], pitch[GY], pitch[GNX], pitch[GNY]
+    half_goal, rp, turf = 0.5 * pitch[GW], pitch[POST_R], pitch[TURF]
+    n_events, first_frame, touched_wall, touched_keeper, scored, inside = 0, -1, False, False, False, False
+    rolling = False
+    t, n, ending = 0.0, 1, ENDED_T_MAX
+    max_rows = len(t_out)
+    for _ in range(int(config[N_STEPS]) + EXTRA_ROWS):
+        h = min(dt, t_max - t)
+        if h <= 1e-12 * max(dt, 1.0):
+            break
+        # The keeper reads the ball a reaction time after it passes the wall (or after the kick).
+        if keeper and dive_t == math.inf and t >= seen_t + pitch[K_REACT]:
+            dive_t = t
+            depth = (x - gx) * gnx + (y - gy) * gny
+            approach = vx * gnx + vy * gny
+            lead = -depth / approach if approach > 1e-9 and depth < 0.0 else 0.0
+            lead = min(lead, 3.0)
+            lateral = -(x + vx * lead - gx) * gny + (y + vy * lead - gy) * gnx
+            lateral = min(max(lateral, -half_goal), half_goal)
+            height = min(max(z + vz * lead - 0.5 * g * lead * lead, turf + radius), turf + pitch[GH])
+            target[0], target[1], target[2] = gx - lateral * gny, gy + lateral * gnx, height
+            info[I_DIVE] = dive_t
+            info[I_TARGET], info[I_TARGET + 1], info[I_TARGET + 2] = target[0], target[1], target[2]
+        # One step: RK4/Euler in flight; rolling, the same step on the horizontal velocity, or the exact stop.
+        stop_here = False
+        if rolling:
+            speed = math.sqrt(vx * vx + vy * vy)
+            if speed == 0.0:
+                ending = STOPPED
+                break
+            ax0, ay0 = _roll_acceleration(vx, vy, kick, config, pitch[ROLL_DECEL])
+            decel = math.sqrt(ax0 * ax0 + ay0 * ay0)
+            if speed <= decel * h:  # it stops inside this step (the deceleration is nearly constant over it)
+                h = speed / decel
+                x1, y1, z1 = x + 0.5 * vx * h, y + 0.5 * vy * h, z
+                vx1, vy1, vz1 = 0.0, 0.0, 0.0
+                stop_here = True
+            else:
+                half = 0.5 * h
+                a2x, a2y = _roll_acceleration(vx + half * ax0, vy + half * ay0, kick, config, pitch[ROLL_DECEL])
+                a3x, a3y = _roll_acceleration(vx + half * a2x, vy + half * a2y, kick, config, pitch[ROLL_DECEL])
+                a4x, a4y = _roll_acceleration(vx + h * a3x, vy + h * a3y, kick, config, pitch[ROLL_DECEL])
+                x1 = x + h / 6.0 * (vx + 2.0 * (vx + half * ax0) + 2.0 * (vx + half * a2x) + vx + h * a3x)
+                y1 = y + h / 6.0 * (vy + 2.0 * (vy + half * ay0) + 2.0 * (vy + half * a2y) + vy + h * a3y)
+                z1, vz1 = z, 0.0
+                vx1 = vx + h / 6.0 * (ax0 + 2.0 * (a2x + a3x) + a4x)
+                vy1 = vy + h / 6.0 * (ay0 + 2.0 * (a2y + a3y) + a4y)
+                if vx1 * vx + vy1 * vy <= 0.0:  # reversed: stop where the speed reached zero
+                    vx1, vy1 = 0.0, 0.0
+                    stop_here = True
+        else:
+            x1, y1, z1, vx1, vy1, vz1 = _step(x, y, z, vx, vy, vz, t, h, kick, config)
+        if vx1 * vx1 + vy1 * vy1 + vz1 * vz1 + 2.0 * g * z1 > energy_limit or not math.isfinite(
+            x1 + y1 + z1 + vx1 + vy1 + vz1
+        ):
+            ending = DIVERGED
+            break
+        if keeper:
+            _keeper_capsule(pitch, dive_t, target, t + 0.5 * h, caps[n_fixed])
+        # The first contact in the step.
+        best, kind, which = 2.0, -1, -1
+        if not rolling and z1 <= ground:
+            best, kind = crossing_fraction(z - ground, vz, z1 - ground, vz1, h), GROUND_HIT
+        if x < x_stop <= x1 or (t == 0.0 and x == x_stop and x1 > x):
+            f = crossing_fraction(x_stop - x, -vx, x_stop - x1, -vx1, h)
+            if f < best:
+                best, kind = f, -2
+        for c in range(n_caps):
+            f = _capsule_fraction(x, y, z, vx, vy, vz, x1, y1, z1, vx1, vy1, vz1, h, caps[c], radius)
+            if f < best:
+                best, kind, which = f, int(caps[c, 7]), c
+        depth0 = (x - gx) * gnx + (y - gy) * gny
+        depth1 = (x1 - gx) * gnx + (y1 - gy) * gny
+        rate0, rate1 = vx * gnx + vy * gny, vx1 * gnx + vy1 * gny
+        if not inside and depth0 < 0.0 <= depth1:
+            f = crossing_fraction(-depth0, -rate0, -depth1, -rate1, h)
+            if f <= best:
+                cx, _ = _hermite(x, vx, x1, vx1, h, f)
+                cy, _ = _hermite(y, vy, y1, vy1, h, f)
+                cz, _ = _hermite(z, vz, z1, vz1, h, f)
+                if math.isnan(info[I_GOAL]):
+                    info[I_GOAL], info[I_GOAL + 1], info[I_GOAL + 2], info[I_GOAL + 3] = t + f * h, cx, cy, cz
+                lateral = -(cx - gx) * gny + (cy - gy) * gnx
+                if abs(lateral) <= half_goal + rp and cz <= turf + pitch[GH] + rp:
+                    inside = True
+                else:
+                    best, kind = f, -3  # over the goal line outside the goal: it leaves the pitch
+        elif inside and depth0 >= 0.0 > depth1:
+            inside = False  # back out through the mouth
+        if inside:
+            # Wholly over the line (Law 10: a goal), then the net: back, sides and roof stop it.
+            line = rp + radius
+            if not scored and depth1 >= line:
+                scored = True
+            limit = pitch[NET_DEPTH] - radius
+            if depth1 >= limit:
+                f = crossing_fraction(limit - depth0, -rate0, limit - depth1, -rate1, h)
+                if f < best:
+                    best, kind = f, NET
+            lat0 = -(x - gx) * gny + (y - gy) * gnx
+            lat1 = -(x1 - gx) * gny + (y1 - gy) * gnx
+            side = half_goal + rp - radius
+            if depth1 > rp and abs(lat1) >= side and abs(lat0) < side:
+                sign = 1.0 if lat1 > 0.0 else -1.0
+                f = crossing_fraction(
+                    side - sign * lat0,
+                    -sign * (-vx * gny + vy * gnx),
+                    side - sign * lat1,
+                    -sign * (-vx1 * gny + vy1 * gnx),
+                    h,
+                )
+                if f < best:
+                    best, kind = f, NET
+            roof = turf + pitch[GH] + 2.0 * rp - radius
+            if depth1 > rp and z1 >= roof > z:
+                f = crossing_fraction(roof - z, -vz, roof - z1, -vz1, h)
+                if f < best:
+                    best, kind = f, NET
+        # The wall's plane (the keeper's first clear sight of the ball).
+        if pitch[WALL_ON] != 0.0 and math.isnan(info[I_WALL]):
+            d0 = (x - pitch[WX]) * pitch[WNX] + (y - pitch[WY]) * pitch[WNY]
+            d1 = (x1 - pitch[WX]) * pitch[WNX] + (y1 - pitch[WY]) * pitch[WNY]
+            if d0 < 0.0 <= d1:
+                f = crossing_fraction(
+                    -d0, -(vx * pitch[WNX] + vy * pitch[WNY]), -d1, -(vx1 * pitch[WNX] + vy1 * pitch[WNY]), h
+                )
+                if f <= best:
+                    cx, _ = _hermite(x, vx, x1, vx1, h, f)
+                    cy, _ = _hermite(y, vy, y1, vy1, h, f)
+                    cz, _ = _hermite(z, vz, z1, vz1, h, f)
+                    info[I_WALL], info[I_WALL + 1], info[I_WALL + 2], info[I_WALL + 3] = t + f * h, cx, cy, cz
+                    seen_t = t + f * h
+        lat_end = -(x1 - gx) * gny + (y1 - gy) * gnx
+        if kind == -1 and abs(lat_end) > pitch[HALF_WIDTH]:
+            best, kind = 1.0, -3  # over a touchline
+        if kind == -1:
+            x, y, z, vx, vy, vz = x1, y1, z1, vx1, vy1, vz1
+            t = t + h
+            if store and n < max_rows:
+                t_out[n] = t
+                state_out[n, 0], state_out[n, 1], state_out[n, 2] = x, y, z
+                state_out[n, 3], state_out[n, 4], state_out[n, 5] = vx, vy, vz
+                spin_out[n, 0], spin_out[n, 1], spin_out[n, 2] = wx, wy, wz
+            n += 1
+            if stop_here:
+                ending = STOPPED
+                break
+            continue
+        # Move to the contact.
+        f = best
+        if stop_here:  # the stop's path is uniform deceleration, not a cubic with these end slopes
+            ex, ey, ez = x + vx * h * (f - 0.5 * f * f), y + vy * h * (f - 0.5 * f * f), z
+            evx, evy, evz = vx * (1.0 - f), vy * (1.0 - f), 0.0
+        else:
+            ex, evx = _hermite(x, vx, x1, vx1, h, f)
+            ey, evy = _hermite(y, vy, y1, vy1, h, f)
+            ez, evz = _hermite(z, vz, z1, vz1, h, f)
+        if rolling:
+            ez, evz = ground, 0.0
+        t = t + f * h
+        x, y, z, vx, vy, vz = ex, ey, ez, evx, evy, evz
+        done = False
+        if kind == GROUND_HIT or kind == POST or kind == BAR or kind == WALL:
+            if kind == GROUND_HIT:
+                z = ground
+                normal[0], normal[1], normal[2] = 0.0, 0.0, 1.0
+                surface = turf_surface
+            else:
+                _, nx, ny, nz = _to_axis(x, y, z, caps[which])
+                if rolling:
+                    nz = 0.0
+                    length = math.sqrt(nx * nx + ny * ny)
+                    if length > 0.0:
+                        nx, ny = nx / length, ny / length
+                    else:
+                        speed = max(math.sqrt(vx * vx + vy * vy), 1e-300)
+                        nx, ny = -vx / speed, -vy / speed
+                normal[0], normal[1], normal[2] = nx, ny, nz
+                surface = frame_surface if kind != WALL else body_surface
+            v_in[0], v_in[1], v_in[2] = vx, vy, vz
+            w_in[0], w_in[1], w_in[2] = wx, wy, wz
+            impact(v_in, w_in, normal, surface, v_new, w_new)
+            vx, vy, vz = v_new[0], v_new[1], v_new[2]
+            wx, wy, wz = w_new[0], w_new[1], w_new[2]
+            if kind == GROUND_HIT and vz < pitch[ROLL_SPEED]:
+                rolling = True
+            if rolling:
+                # Onto the turf, rolling without slipping: a gripping tangential impulse that stops the contact
+                # point (Cross's grip with e_t = 0; it conserves the angular momentum about the contact point and
+                # never adds energy), then ω = (ẑ × v)/R; spin about the vertical is lost to the turf.
+                vz = 0.0
+                alpha = turf_surface[4]
+                share = alpha / (1.0 + alpha)
+                ux, uy = vx - radius * wy, vy + radius * wx
+                vx, vy = vx - share * ux, vy - share * uy
+                wx, wy, wz = -vy / radius, vx / radius, 0.0
+            if kind == WALL:
+                touched_wall = True
+            elif kind != GROUND_HIT and first_frame < 0:
+                first_frame = kind
+        elif kind == KEEPER:
+            touched_keeper, ending, done = True, SAVED, True
+        elif kind == NET:
+            vx, vy, vz, ending, done = 0.0, 0.0, 0.0, IN_NET, True
+        elif kind == -2:
+            ending, done = ENDED_X_STOP, True
+        else:  # kind == -3
+            ending, done = OUT, True
+        if kind >= 0:
+            if n_events < MAX_EVENTS:
+                events[n_events, 0], events[n_events, 1] = t, kind
+                events[n_events, 2], events[n_events, 3], events[n_events, 4] = x, y, z
+            n_events += 1
+            if n_events == 1:
+                info[I_FIRST] = t
+            kick[GAIN] = 0.0  # the knuckle's unsteady wake is a launch effect; any contact ends it
+            _set_spin(kick, wx, wy, wz)
+        if store and n < max_rows:
+            t_out[n] = t
+            state_out[n, 0], state_out[n, 1], state_out[n, 2] = x, y, z
+            state_out[n, 3], state_out[n, 4], state_out[n, 5] = vx, vy, vz
+            spin_out[n, 0], spin_out[n, 1], spin_out[n, 2] = wx, wy, wz
+        n += 1
+        if stop_here and kind < 0:
+            ending, done = (STOPPED if not done else ending), True
+        if done or n_events >= MAX_EVENTS:
+            break
+        if rolling and vx == 0.0 and vy == 0.0:
+            ending = STOPPED
+            break
+    # Whole ball over the line between the posts and under the bar, at any time (off the post, the bar, the wall
+    # or the keeper too), is a goal; then the keeper, the wall, the frame, and where it crossed the line.
+    if scored:
+        result = GOAL
+    elif touched_keeper:
+        result = SAVED_RESULT
+    elif touched_wall:
+        result = WALL_RESULT
+    elif first_frame == POST:
+        result = POST_RESULT
+    elif first_frame == BAR:
+        result = BAR_RESULT
+    elif not math.isnan(info[I_GOAL]):
+        lateral = -(info[I_GOAL + 1] - gx) * gny + (info[I_GOAL + 2] - gy) * gnx
+        if abs(lateral) > half_goal - radius:
+            result = WIDE
+        elif info[I_GOAL + 3] > turf + pitch[GH] - radius:
+            result = OVER
+        else:
+            result = SHORT
+    else:
+        result = SHORT
+    info[I_RESULT] = result
+    info[I_EVENTS] = min(n_events, MAX_EVENTS)
+    return min(n, max_rows) if store else n, ending
+
+
+@compiled()
+def play_one(launch, config, pitch, t_out, state_out, spin_out, forces_out, events, info):
+    """:func:`simulate` on a pitch, compiled: the kick's constants, its flight, and the forces at each sample (the
+    spin of the sample; no Magnus force while rolling; the knuckle force only before the first contact)."""
+    kick = np.empty(N_KICK)
+    fill_kick(launch, config, kick)
+    gain = kick[GAIN]
+    n, ending = play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info)
+    first = info[I_FIRST] if not math.isnan(info[I_FIRST]) else math.inf
+    for i in range(n):
+        _set_spin(kick, spin_out[i, 0], spin_out[i, 1], spin_out[i, 2])
+        kick[GAIN] = gain if t_out[i] < first else 0.0
+        sample_forces(t_out[i : i + 1], state_out[i : i + 1], kick, config, forces_out[i : i + 1])
+        if state_out[i, 2] == config[GROUND] and state_out[i, 5] == 0.0 and t_out[i] >= first:
+            forces_out[i, 3], forces_out[i, 4], forces_out[i, 5] = 0.0, 0.0, 0.0  # rolling: no lift off the turf
+    if not np.isfinite(forces_out[:n]).all():
+        ending = DIVERGED
+    return n, ending
+
+
+@compiled(parallel=True)
+def play_batch(launches, config, pitch, t_out, state_out, spin_out, events, info, n_samples, endings):
+    """:func:`play` for each kick, in parallel: kick k's samples into row k of ``t_out`` (K, T), ``state_out``
+    (K, T, 6), ``spin_out`` (K, T, 3) (T = 0: verdicts only), its contacts into ``events`` (K, MAX_EVENTS, 5) and its
+    summary into ``info`` (K, N_INFO)."""
+    for k in prange(len(launches)):
+        kick = np.empty(N_KICK)
+        fill_kick(launches[k], config, kick)
+        n_samples[k], endings[k] = play(
+            launches[k], kick, config, pitch, t_out[k], state_out[k], spin_out[k], events[k], info[k]
+        )
