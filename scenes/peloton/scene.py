@@ -68,6 +68,8 @@ BAR_HEADROOM = 1.3
 """Bars that outgrow the framed view are framed again this many times as tall: power goes with the cube of speed, so
 a drag from 30 to 50 km/h re-frames about 7 times instead of 20."""
 COMPONENT_COLOURS = {"aero": (60, 130, 240), "rolling": (245, 160, 40), "climbing": (60, 190, 90)}
+ROTATION_WIDTH = {"single": 1, "double": 2}
+"""Riders who lead together in each formation that rotates (the others do not take turns in order)."""
 ROTATION = ("rotate", "turn_s")
 """The paceline's rotation controls: they restart the rotation and leave the line's power as it is."""
 LAST = ("target_power_w",)
@@ -146,7 +148,7 @@ time-averaged power is the mean over positions, far below the leader's.
         self.state = compute_line(self.params)
         self._drawn_position: Position | None = None
         self._rotation_time_s = 0.0
-        self._energy_j = np.zeros(MAX_RIDERS)
+        self._energy_j = np.zeros(MAX_GROUP)
         self._ridden_s = 0.0
         self._label_lift_m = LABEL_STAGGER_M * (np.arange(MAX_RIDERS) % 2)
         """How far each slot's label sits above its bar (m): laid out for the camera framed last."""
@@ -309,9 +311,15 @@ time-averaged power is the mean over positions, far below the leader's.
             self.wake_loops()
 
     # ----------------------------------------------------------------------------------------- camera
+    def _rotation_width(self) -> int:
+        """Riders who lead together and drop back together: 1 in single file, 2 two abreast, 0 where riders do not
+        take turns in order (a bunch, an echelon)."""
+        return ROTATION_WIDTH.get(self.params.formation, 0)
+
     def _rotating(self) -> bool:
-        """Whether the lead rotates now: asked for, with a line of two or more drawn with its bars."""
-        return self.params.rotate and self.params.n_riders > 1 and is_line_view(self.params)
+        """Whether the lead rotates now: asked for, in a paceline with more riders than lead at once."""
+        width = self._rotation_width()
+        return self.params.rotate and width > 0 and self.params.n_riders > width
 
     def line_points(self, bar_headroom: float = 1.0) -> np.ndarray:
         """(N, 3) world points the view must hold: every rider (also swinging off), bar tops (``bar_headroom`` times
@@ -453,7 +461,26 @@ time-averaged power is the mean over positions, far below the leader's.
         if not self._rotating():
             return np.arange(n)
         k = int(self._rotation_time_s // self.params.turn_s)
-        return (np.arange(n) - k) % n
+        return (np.arange(n) - k * self._rotation_width()) % n
+
+    def group_positions(self) -> np.ndarray:
+        """(n_riders, 2) where each rider of a group rides now (m): its formation slot or, while the lead rotates,
+        between slots: in the last quarter of a turn the front riders swing out and drift to the back while the
+        others move up a row."""
+        slots_xy = self.state.positions
+        if not self._rotating():
+            return slots_xy
+        n, width = self.params.n_riders, self._rotation_width()
+        slots = self.current_slots()
+        phase = (self._rotation_time_s / self.params.turn_s) % 1.0
+        u = max(0.0, (phase - 0.75) / 0.25)
+        ease = 0.5 - 0.5 * math.cos(math.pi * u)
+        target = (slots - width) % n
+        xy = slots_xy[slots] + ease * (slots_xy[target] - slots_xy[slots])
+        leading = slots < width
+        outward = np.where(slots_xy[slots, 1] < 0.0, -1.0, 1.0)
+        xy[:, 1] += leading * outward * 0.9 * math.sin(math.pi * ease)
+        return xy
 
     def redraw(self, *, readouts: bool = True) -> None:
         """Push the current state to the riders, bars and labels and, with ``readouts``, to the GUI outputs.
@@ -540,13 +567,13 @@ time-averaged power is the mean over positions, far below the leader's.
         p, state = self.params, self.state
         n = p.n_riders
         positions = np.zeros((MAX_GROUP, 3), np.float32)
-        positions[:n, :2] = state.positions
+        positions[:n, :2] = self.group_positions()
         scales = np.zeros((MAX_GROUP, 3), np.float32)
         scales[:n] = 1.0
         total = np.asarray(state.power.total)
         low, high = power_range(total)
         bodies = rider_colours("body", MAX_GROUP)
-        bodies[:n] = power_colours(total, low, high)
+        bodies[:n] = power_colours(total[self.current_slots()], low, high)
         with self.server.atomic():
             theta = math.atan(p.grade_pct / 100.0)
             set_if_changed(self.course, "wxyz", (math.cos(-theta / 2), 0.0, math.sin(-theta / 2), 0.0))
@@ -657,6 +684,11 @@ time-averaged power is the mean over positions, far below the leader's.
             return ""
         mean = float(np.mean(self.state.power.total))
         lead = float(self.state.power.total[0])
+        if self._rotation_width() == 0:
+            return (
+                f"In a {'bunch' if self.params.formation == 'bunch' else 'echelon'} riders do not take turns in order: "
+                f"the mean over its places is **{_watts(mean)} W** against the leader's {_watts(lead)} W."
+            )
         if lead <= 0:
             text = "Downhill at this speed gravity does the work: nobody needs to pedal, so nobody needs shelter."
         elif not self.params.drafting:
@@ -668,7 +700,10 @@ time-averaged power is the mean over positions, far below the leader's.
             )
         if self.params.rotate and self._ridden_s > 0:
             averages = self._energy_j[:n] / self._ridden_s
-            text += "  \nTime-averaged so far: " + ", ".join(f"R{i + 1} {a:.0f} W" for i, a in enumerate(averages))
+            if n <= MAX_RIDERS:
+                text += "  \nTime-averaged so far: " + ", ".join(f"R{i + 1} {a:.0f} W" for i, a in enumerate(averages))
+            else:
+                text += f"  \nTime-averaged so far: {averages.min():.0f}–{averages.max():.0f} W across the {n} riders"
         return text
 
     def _speed_markdown(self) -> str:

@@ -444,3 +444,37 @@ def test_back_to_single_file_of_eight_is_the_labelled_line_again(scene: PelotonS
     np.testing.assert_array_equal(scene.state.reduction, cycling.drag_reduction(8, scene.params.gap_m))
     assert scene.labels[0].text.startswith(f"{expected.power.total[0]:.0f} W")
     assert np.all(np.asarray(scene.riders_nodes["body"].batched_scales)[8:] == 0.0)
+
+
+def test_a_two_abreast_paceline_rotates_by_pairs_and_evens_out_the_power(scene: PelotonScene) -> None:
+    c = scene.controls
+    c["formation"].value, c["n_riders"].value, c["gap_m"].value = "Two abreast", 6, 0.3
+    c["turn_s"].value = 2.0
+    c["rotate"].value = True
+    slots_xy = cycling.formation(6, "double", gap_m=0.3, lateral_m=0.6)
+    totals = np.asarray(scene.state.power.total)
+    with scene._lock:  # step the animation by hand, the scene's own loop held off
+        scene._energy_j[:] = 0.0
+        scene._ridden_s = 0.0
+        scene._rotation_time_s = 0.0
+        for _ in range(20):  # one turn: the front pair has dropped to the back, the others moved up a row
+            scene._animate(0.1)
+        np.testing.assert_array_equal(scene.current_slots(), [4, 5, 0, 1, 2, 3])
+        np.testing.assert_allclose(scene.group_positions(), slots_xy[[4, 5, 0, 1, 2, 3]], atol=1e-9)
+        drawn = np.asarray(scene.riders_nodes["body"].batched_positions)[:6, :2]
+        np.testing.assert_allclose(drawn, slots_xy[[4, 5, 0, 1, 2, 3]], atol=1e-5)
+        for _ in range(40):  # two more turns: every pair has led once
+            scene._animate(0.1)
+        averages = scene.rider_average_power()
+    # Each rider spent a third of the time in each row: the mean over the places (up to the 0.1 s steps).
+    np.testing.assert_allclose(averages, np.mean(totals), rtol=0.02)
+    assert "Time-averaged so far" in scene.rotation.content
+
+
+def test_a_bunch_does_not_rotate_and_says_so(scene: PelotonScene) -> None:
+    c = scene.controls
+    c["formation"].value, c["n_riders"].value = "Bunch (peloton)", 60
+    c["rotate"].value = True
+    with scene._lock:
+        assert not scene._animate(0.1)
+    assert "do not take turns in order" in scene.rotation.content
