@@ -69,7 +69,7 @@ Model and method:
   the same result.
 * Speed: each solver is one implementation compiled by numba (``@njit(cache=True)``) on the scalars of one chain;
   :func:`solve` calls it for one chain, :func:`solve_batch` for every chain, in parallel over the batch
-  (``prange``; ``numba.set_num_threads`` sets the threads). 2D chains run as 3D ones in the plane ``z = 0``. The
+  (the core runs without the GIL on a pool of threads; ``numba.set_num_threads`` sets how many). 2D chains run as 3D ones in the plane ``z = 0``. The
   first call compiles (seconds) or loads the machine code from numba's cache (``__pycache__`` beside this file, or
   numba's user-wide cache directory where that is read-only); :func:`warm_up` does it ahead of time.
 
@@ -133,15 +133,14 @@ def warm_up() -> None:
     chain = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.3, 0.0, 1.9]])
     obstacles = [(np.array([1.0, 0.0, 1.0]), 0.2)]
     for solver in ("fabrik", "ccd", "jacobian_dls"):
-        for batch in (1, 2):  # the serial driver (one chain) and the parallel one
-            solve_batch(
-                np.repeat(chain[None], batch, axis=0),
-                np.repeat([[0.8, 0.0, 1.2]], batch, axis=0),
-                cone_half_angle_rad=1.0,
-                obstacles=obstacles,
-                max_iterations=3,
-                solver=solver,
-            )
+        solve_batch(
+            np.repeat(chain[None], 2, axis=0),
+            np.repeat([[0.8, 0.0, 1.2]], 2, axis=0),
+            cone_half_angle_rad=1.0,
+            obstacles=obstacles,
+            max_iterations=3,
+            solver=solver,
+        )
     hinge = Hinge((0.0, 1.0, 0.0), -1.0, 1.0)
     solve(chain, [0.8, 0.0, 1.2], constraints=[hinge, Cone(1.0)], max_iterations=3)
     solve_tree(

@@ -7,12 +7,14 @@ Shapes: one chain is (n + 1, d) joints and a (d,) target, d = 2 or 3, metres; a 
 
 from __future__ import annotations
 
+import concurrent.futures
 import dataclasses
 import functools
 import math
-import threading
 from collections.abc import Callable, Sequence
+from typing import Any
 
+import numba
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -27,7 +29,6 @@ from kernels.fabrik.chain import (
     Status,
 )
 from kernels.fabrik.chain import _solve_one as _compiled_solve_one
-from kernels.fabrik.chain import _solve_parallel as _compiled_solve_parallel
 from kernels.fabrik.chain import _solve_rows as _compiled_solve_rows
 from kernels.fabrik.geometry import (
     _LARGEST,
@@ -48,7 +49,6 @@ from kernels.warming import Entry
 # The compiled cores Python calls here: plain Python while the app's first start compiles them (kernels.warming).
 _solve_one = Entry(_compiled_solve_one)
 _solve_rows = Entry(_compiled_solve_rows)
-_solve_parallel = Entry(_compiled_solve_parallel)
 _perpendicular = Entry(_compiled_perpendicular)
 _limit_flags = Entry(_compiled_limit_flags)
 _usage = Entry(_compiled_usage)
@@ -59,9 +59,32 @@ Obstacle = tuple[ArrayLike, float]
 _MAX_ITERATIONS_CAP = 100_000
 """Largest ``max_iterations`` accepted (each chain keeps an error history of that length)."""
 
-_CHUNKS = 256
-"""Most chunks a parallel batch is cut into: enough to balance chains that need 1 and 50 iterations."""
-_PARALLEL_LOCK = threading.Lock()
+_CHUNKS_PER_THREAD = 16
+"""Chunks per thread a batch is cut into: enough to balance chains that need 1 and 50 iterations."""
+
+
+@functools.cache
+def _batch_threads() -> concurrent.futures.ThreadPoolExecutor:
+    """The process's threads for batches (made on first use, as many as numba may use). ``_solve_rows`` runs without
+    the GIL, so plain threads share a batch; ``numba.set_num_threads`` sets how many a call uses, as it would for a
+    ``prange`` loop, and no ``parallel=True`` core has to compile on the first start."""
+    most = numba.config.NUMBA_NUM_THREADS  # pyright: ignore[reportAttributeAccessIssue]  (set at import, not typed)
+    return concurrent.futures.ThreadPoolExecutor(most, thread_name_prefix="fabrik-batch")
+
+
+def _solve_batch_rows(args: tuple[Any, ...]) -> None:
+    """:func:`~kernels.fabrik.chain._solve_rows` over every row of a batch (``args[0]`` the (B, n + 1, 3) joints), cut
+    into contiguous chunks run on ``numba.get_num_threads()`` threads."""
+    batch = len(args[0])
+    threads = min(numba.get_num_threads(), batch)
+    if threads <= 1:
+        _solve_rows(0, batch, *args)
+        return
+    chunks = min(batch, threads * _CHUNKS_PER_THREAD)
+    bounds = [c * batch // chunks for c in range(chunks + 1)]
+    done = _batch_threads().map(lambda c: _solve_rows(bounds[c], bounds[c + 1], *args), range(chunks))
+    for _ in done:  # re-raises a chunk's error here
+        pass
 
 
 @dataclasses.dataclass(frozen=True)
@@ -229,12 +252,7 @@ def solve_batch(
         error,
         setup.table,
     )
-    if batch == 1:
-        _solve_rows(0, 1, *args)
-    else:
-        # numba's workqueue threading layer (where OpenMP and TBB are missing) is not thread-safe
-        with _PARALLEL_LOCK:
-            _solve_parallel(min(batch, _CHUNKS), args)
+    _solve_batch_rows(args)
     if scale != 1.0:
         out_p *= scale
         history *= scale

@@ -1,15 +1,15 @@
 """The compiled chain core: FABRIK (Aristidou & Lasenby 2011), CCD (Wang & Chen 1991) and damped least squares
 (Wampler 1986; Buss 2004) on the scalars of one chain of ``n + 1`` joints ``p`` (n + 1, 3), metres.
 
-Every solver lives once, here; ``_solve_rows`` runs it over some rows of a batch, ``solve`` calls it for one row,
-``_solve_parallel`` splits a batch into chunks across threads. A 2D chain has z = 0 and ``dim = 2`` where the
+Every solver lives once, here; ``_solve_rows`` runs it over some rows of a batch (without the GIL, so the batch
+driver in :mod:`~kernels.fabrik.api` runs chunks of a batch on several threads), ``_solve_one`` for one chain. A 2D chain has z = 0 and ``dim = 2`` where the
 perpendicular and the rotations differ. See :mod:`kernels.fabrik` for the model, the statuses and the stopping rules.
 """
 
 from __future__ import annotations
 
 import math
-from typing import Any, Literal
+from typing import Literal
 
 import numba
 import numpy as np
@@ -727,7 +727,7 @@ def _solve_chain(
     return count, _LIMITED if stalled else _MAX_ITERATIONS, final_error
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, error_model="numpy", nogil=True)
 def _solve_rows(
     lo: int,
     hi: int,
@@ -768,15 +768,6 @@ def _solve_rows(
             history[b],
             table,
         )
-
-
-@numba.njit(cache=True, error_model="numpy", parallel=True)
-def _solve_parallel(chunks: int, rows: tuple[Any, ...]) -> None:
-    """:func:`_solve_rows` over a whole batch, in ``chunks`` contiguous chunks spread over numba's threads;
-    ``rows`` holds its arguments after ``lo`` and ``hi`` (``p`` (B, n + 1, 3) first)."""
-    batch = rows[0].shape[0]
-    for c in numba.prange(chunks):
-        _solve_rows(c * batch // chunks, (c + 1) * batch // chunks, *rows)
 
 
 _UNSCALED = 2.0**-16, 2.0**16

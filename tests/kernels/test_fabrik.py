@@ -834,12 +834,12 @@ def test_warm_up_compiles_every_core_with_a_cache() -> None:
         for name, value in vars(module).items()
         if isinstance(value, CPUDispatcher)
     }
-    assert {"_solve_rows", "_solve_parallel", "_forward_pass", "_ccd_sweep", "_dls_step"} <= set(cores)
+    assert {"_solve_rows", "_solve_one", "_forward_pass", "_ccd_sweep", "_dls_step"} <= set(cores)
     for name, core in cores.items():
         cache = core._cache  # pyright: ignore[reportAttributeAccessIssue]
         assert type(cache).__name__ == "FunctionCache", name  # cache=True on every core
     # The two entry points are compiled (or loaded); the cores they call are linked into them.
-    assert chain._solve_rows.signatures and chain._solve_parallel.signatures
+    assert chain._solve_rows.signatures and chain._solve_one.signatures
 
 
 def test_compile_cache_falls_back_to_a_user_directory_when_the_package_is_read_only(
