@@ -133,6 +133,7 @@ from kernels.ball.config import (
 )
 from kernels.ball.core import Ending, Result
 from kernels.ball.laws import bounce, coefficients
+from kernels.ball.odds import Odds, StrikeSpread, odds_map, strike_odds
 from kernels.ball.pitch import (
     BODY,
     DRY_TURF,
@@ -176,21 +177,25 @@ __all__ = [
     "KeeperDive",
     "Method",
     "Model",
+    "Odds",
     "Outcome",
     "Panel",
     "Pitch",
     "Result",
+    "StrikeSpread",
     "Surface",
     "Trajectory",
     "bounce",
     "coefficients",
     "free_kick_panels",
     "launch_velocity",
+    "odds_map",
     "outcome",
     "outcome_batch",
     "simulate",
     "simulate_batch",
     "simulate_outcomes",
     "spin_vector",
+    "strike_odds",
     "warm_up",
 ]

@@ -335,3 +335,32 @@ def test_drag_crisis_centre_is_a_setting() -> None:
 def test_a_bad_pitch_raises_naming_the_field(pitch, name) -> None:
     with pytest.raises(ValueError, match=name):
         ball.simulate((-22.0, 0.0, R), (20.0, 0.0, 3.0), (0.0, 0.0, 0.0), ground_m=R, pitch=pitch)
+
+
+def test_the_plain_python_twin_of_the_pitch_flight_gives_the_compiled_numbers(monkeypatch: pytest.MonkeyPatch) -> None:
+    # While the app's first start compiles the package, its entries run their plain-Python twins: same numbers.
+    from kernels import warming
+
+    pitch = ball.Pitch(GOAL, WALL, ball.Keeper())
+    velocities = np.array(
+        [
+            ball.launch_velocity(s, math.radians(e), math.radians(-5.0))
+            for s, e in ((26.0, 17.0), (30.0, 12.0), (15.0, 8.0))
+        ]
+    )
+    spins = np.tile(ball.spin_vector(9.0, (0.0, 0.0, 1.0)), (3, 1))
+    starts = np.tile([-22.0, 0.0, R], (3, 1))
+    options = {"dt": 1e-2, "method": "rk4", "model": "measured", "ground_m": R, "t_max": 4.0, "pitch": pitch}
+
+    def run() -> tuple[np.ndarray, np.ndarray, list[str]]:
+        one = ball.simulate(starts[0], velocities[0], spins[0], **options)
+        batch = ball.simulate_batch(starts, velocities, spins, **options)
+        judged = ball.simulate_outcomes(starts, velocities, spins, **options)
+        return one.position, batch.position, [*judged.result, str(one.result), *[e.kind for e in one.events]]
+
+    compiled = run()
+    monkeypatch.setattr(warming.Entry, "__call__", lambda self, *a, **k: warming.python_twin(self.compiled)(*a, **k))
+    twin = run()
+    np.testing.assert_allclose(twin[0], compiled[0], rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(twin[1], compiled[1], rtol=1e-9, atol=1e-12)
+    assert twin[2] == compiled[2]
