@@ -80,6 +80,10 @@ class Skeleton:
     planar: bool
     """True: targets slide in the x–z plane only."""
     root_direction: tuple[float, float, float] = (0.0, 0.0, 1.0)
+    tolerance_mm: float = 1.0
+    """The preset's own solver setting: an effector within this distance of its target is "reached" (mm)."""
+    max_iterations: int = 50
+    """The preset's own solver setting: iterations per solve at most."""
 
 
 def _chain(start: NDArray[np.float64], directions: list[NDArray[np.float64]], lengths: list[float]) -> list:
@@ -191,34 +195,51 @@ def hand(curl_rad: float = 0.15, target_curl_rad: float = 0.6) -> Skeleton:
     )
 
 
+UPPER_BODY_REST_ARM = ((1.0, 0.0, -0.1), (1.0, 0.0, -0.4), (0.6, -0.2, -1.0), (0.3, -0.1, -1.0))
+"""Directions of an arm's clavicle, upper arm, forearm and hand at rest (x toward the arm's side, y to the back)."""
+UPPER_BODY_REACH = (
+    ((-0.15, -0.1), ((1.0, 0.0, -0.05), (1.0, -0.8, -0.2), (0.3, -1.0, 0.6), (0.2, -1.0, 0.6))),
+    ((1.0, 0.0, -0.1), (1.0, -0.3, -0.6), (0.4, -0.8, 0.2), (0.2, -1.0, 0.3)),
+)
+"""The pose the opening targets come from: ((neck lean x, y), right arm directions), left arm directions; the head
+nods forward and to the right, the right hand reaches forward to chest height, the left hand forward to the belly."""
+
+
+def _upper_body_joints(
+    neck: tuple[float, float],
+    arms: tuple[tuple[tuple[float, float, float], ...], tuple[tuple[float, float, float], ...]],
+) -> NDArray[np.float64]:
+    """(14, 3) joints of the upper body: a straight spine up from the pelvis, the neck and head leaning by ``neck``
+    (x, y per unit height), and the two arms' segments along ``arms`` (right, left; x mirrored for the left)."""
+    pelvis = np.array([0.0, 0.0, 0.2])
+    head = np.array([neck[0], neck[1], 1.0])
+    points = [pelvis, *_chain(pelvis, [np.array([0.0, 0.0, 1.0])] * 3 + [head] * 2, [0.2, 0.2, 0.2, 0.1, 0.2])]
+    chest = points[3]
+    for side, directions in zip((-1.0, 1.0), arms, strict=True):
+        mirrored = [np.array([side * x, y, z]) for x, y, z in directions]
+        points.extend(_chain(chest, mirrored, [0.18, 0.3, 0.28, 0.1]))
+    return np.array(points)
+
+
 def upper_body() -> Skeleton:
     """A humanoid upper body of ball joints: pelvis root, a three-link spine, neck and head, and two arms
     (clavicle, upper arm, forearm, hand) from the chest, the chest a sub-base of three branches. Cones: spine 20°,
-    neck 29°, head 34°, clavicle 100° and shoulder 80° from the previous link, elbow 137°, wrist 46°."""
-    pelvis = np.array([0.0, 0.0, 0.2])
+    neck 29°, head 34°, clavicle 100° and shoulder 80° from the previous link, elbow 137°, wrist 46°.
+
+    The opening targets are the head's and the hands' places in another pose of the same body that keeps every
+    limit (:data:`UPPER_BODY_REACH`): reachable together, so the body opens with every effector on its target."""
     parents = [-1, 0, 1, 2, 3, 4]
-    points = [pelvis, *_chain(pelvis, [np.array([0.0, 0.0, 1.0])] * 5, [0.2, 0.2, 0.2, 0.1, 0.2])]
     cones = [None, 0.35, 0.35, 0.35, 0.5, 0.6]
     chain_of = [5, 5, 5, 5, 2, 2]
-    for side, colour in ((-1.0, 0), (1.0, 1)):
-        start = len(points)
+    for colour in (0, 1):
+        start = len(parents)
         parents.extend([3, start, start + 1, start + 2])
-        arm = _chain(
-            points[3],
-            [
-                np.array([side, 0.0, -0.1]),
-                np.array([side, 0.0, -0.4]),
-                np.array([side * 0.6, -0.2, -1.0]),
-                np.array([side * 0.3, -0.1, -1.0]),
-            ],
-            [0.18, 0.3, 0.28, 0.1],
-        )
-        points.extend(arm)
         cones.extend([1.75, 1.4, 2.4, 0.8])
         chain_of.extend([5, colour, colour, colour])
-    joints = np.array(points)
+    joints = _upper_body_joints((0.0, 0.0), (UPPER_BODY_REST_ARM, UPPER_BODY_REST_ARM))
+    (neck, right), left = UPPER_BODY_REACH
     effectors = (5, 9, 13)
-    targets = joints[list(effectors)] + np.array([[0.05, -0.02, -0.03], [-0.1, -0.2, 0.3], [0.15, -0.2, 0.35]])
+    targets = _upper_body_joints(neck, (right, left))[list(effectors)]
     return Skeleton(
         name="Upper body",
         parents=tuple(parents),
@@ -229,6 +250,7 @@ def upper_body() -> Skeleton:
         effector_labels=("Head", "Right hand", "Left hand"),
         targets=targets,
         planar=False,
+        max_iterations=100,  # three effectors pulling on one spine converge more slowly than one chain
     )
 
 
@@ -436,6 +458,7 @@ class SkeletonView:
         """Switch to a preset (its rest pose and opening targets), or back to the chain; the camera frames it."""
         self.preset = label
         self.skeleton = None if label == "Chain" else PRESETS[label]()
+        self.scene.show_chain_panel(self.skeleton is None)
         with self.scene.server.atomic():
             self._show_chain(self.skeleton is None)
             for node in (self.link_nodes, self.joint_nodes, self.axes):
@@ -495,13 +518,12 @@ class SkeletonView:
         sk = self.skeleton
         if sk is None:
             return
-        p = self.scene.params
         report = solve_skeleton(
             sk,
             self.pose,
             self.targets,
-            tolerance_m=p.tolerance_mm / 1000.0,
-            max_iterations=p.max_iterations,
+            tolerance_m=sk.tolerance_mm / 1000.0,
+            max_iterations=sk.max_iterations,
         )
         self.pose = report.result.joints
         self.report = report
@@ -563,5 +585,7 @@ class SkeletonView:
         )
         return (
             f"**{sk.name}**: {r.iterations} iteration{'s' if r.iterations != 1 else ''}, "
-            f"solve **{report.micros:,.0f} µs**{plain_python_note()}\n\n| Effector | Error (mm) | Status |\n|---|---|---|\n{rows}"
+            f"solve **{report.micros:,.0f} µs**{plain_python_note()}  \n"
+            f"Multi-end-effector FABRIK, tolerance {sk.tolerance_mm:g} mm, at most {sk.max_iterations} iterations."
+            f"\n\n| Effector | Error (mm) | Status |\n|---|---|---|\n{rows}"
         )

@@ -118,13 +118,18 @@ class SolveReport:
 
     result: fabrik.Solution
     micros: float
-    """Wall time of the kernel call (µs)."""
+    """Wall time of the kernel calls that made the pose (µs): the solve, and the other starts where it fell short."""
     ghost: NDArray[np.float64]
     """(3, 3) world root, elbow and end of the analytic two-bone ghost (m)."""
     ghost_error_m: float
     """Distance of the ghost's end from the target (m)."""
     ghost_gap_m: float
     """Distance from the ghost's elbow to the chain's middle joint (m); for two links, FABRIK's elbow."""
+    best_history: tuple[NDArray[np.float64], NDArray[np.float64]] = (np.zeros(1), np.zeros(1))
+    """(iterations (K,), error (K,) m): the error of the pose the solver would return after that many iterations,
+    the best admissible one it has seen (:func:`admissible_history`); the last is ``result.error``."""
+    start: str = "last pose"
+    """Where the returned pose's solve started: "last pose", or the other start that came closer."""
 
 
 def rest_pose(n_links: int, link_length_m: float) -> NDArray[np.float64]:
@@ -176,51 +181,211 @@ def _root_direction(three_d: bool) -> NDArray[np.float64]:
     return np.array([0.0, 0.0, 1.0]) if three_d else np.array([0.0, 1.0])
 
 
-def solve_arm(
-    params: ArmParams,
-    joints: NDArray[np.float64],
-    target: NDArray[np.float64],
-    obstacle_centres: NDArray[np.float64],
-) -> SolveReport:
-    """Solve one frame: the chosen solver from ``joints`` toward ``target``, and the two-bone ghost (no viser)."""
+def _solve_kwargs(params: ArmParams, obstacle_centres: NDArray[np.float64]) -> dict[str, Any]:
     three_d = params.three_d
     obstacles = (
         [(to_kernel(obstacle_centres[k], three_d), params.radii_m[k]) for k in range(params.n_obstacles)]
         if params.avoid
         else []
     )
-    kwargs: dict[str, Any] = {
+    return {
         "tolerance": params.tolerance_mm / 1000.0,
         "max_iterations": params.max_iterations,
         "cone_half_angle_rad": math.radians(params.half_angle_deg) if params.limits else None,
         "obstacles": obstacles,
         "root_direction": _root_direction(three_d),
     }
-    start = to_kernel(joints, three_d)
+
+
+def _run(
+    method: fabrik.Solver, start: NDArray[np.float64], goal: NDArray[np.float64], **kwargs: Any
+) -> fabrik.Solution:
+    match method:
+        case "fabrik":
+            return fabrik.solve(start, goal, **kwargs)
+        case "ccd":
+            return fabrik.ccd(start, goal, **kwargs)
+        case "jacobian_dls":
+            return fabrik.jacobian_dls(start, goal, **kwargs)
+
+
+ARC_STARTS = 9
+"""Other starts tried when a constrained solve falls short: this many arcs, each link turned by the same angle from
+the last, from the cone's −half-angle to +half-angle (or ±60° without limits), in the vertical plane of the target."""
+
+
+def arc_starts(params: ArmParams, target: NDArray[np.float64]) -> list[NDArray[np.float64]]:
+    """(ARC_STARTS,) world poses (n + 1, 3) that keep every joint limit: arcs of constant bend up from the root,
+    in the vertical plane through the target (the x–z plane when planar)."""
+    bend = math.radians(params.half_angle_deg) if params.limits else math.radians(60.0)
+    across = np.array([target[0], target[1] if params.three_d else 0.0])
+    across = across / np.linalg.norm(across) if np.linalg.norm(across) > 1e-9 else np.array([1.0, 0.0])
+    poses = []
+    for turn in np.linspace(-bend, bend, ARC_STARTS):
+        angles = turn * np.arange(1, params.n_links + 1)
+        steps = np.stack([np.sin(angles) * across[0], np.sin(angles) * across[1], np.cos(angles)], axis=1)
+        poses.append(np.vstack([np.zeros(3), np.cumsum(params.link_length_m * steps, axis=0)]))
+    return poses
+
+
+def constrained(params: ArmParams) -> bool:
+    """Whether some iterate or start may break a joint limit or cut an obstacle (so not every pose is admissible)."""
+    return params.limits or (params.avoid and params.n_obstacles > 0)
+
+
+HISTORY_POINTS = 24
+"""Most iteration counts :func:`admissible_history` replays (evenly spread, the last always included)."""
+
+
+def admissible_history(
+    params: ArmParams,
+    start: NDArray[np.float64],
+    target: NDArray[np.float64],
+    obstacle_centres: NDArray[np.float64],
+    result: fabrik.Solution,
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """What the solver would return after k iterations, for k up to ``result.iterations``: (k (K,), error (K,) m).
+
+    The solvers return the best admissible pose they have seen (every limit kept, every obstacle cleared), not the
+    last iterate, and stop from what the iterates did alone, so a run capped at k iterations repeats the first k
+    iterations of the full run and returns the best admissible pose among them: its error is the k-th point. Without
+    limits or obstacles every iterate is admissible and the points are the running minimum of the error history.
+    Counts where no admissible pose had been seen yet (status "infeasible") are left out."""
+    history = result.error_history
+    if result.iterations == 0:
+        return np.zeros(1), np.array([result.error])
+    if not constrained(params):
+        counts = np.arange(1, len(history))
+        return counts.astype(np.float64), np.minimum.accumulate(history)[1:]
+    counts = np.unique(np.round(np.linspace(1, result.iterations, min(result.iterations, HISTORY_POINTS))))
+    counts = counts.astype(np.int64)
+    kwargs = _solve_kwargs(params, obstacle_centres)
+    method = SOLVER_FROM_LABEL[params.solver]
+    kept_k, kept_e = [], []
+    for k in counts[:-1]:
+        kwargs["max_iterations"] = int(k)
+        capped = _run(method, to_kernel(start, params.three_d), to_kernel(target, params.three_d), **kwargs)
+        if capped.status != "infeasible":
+            kept_k.append(float(k))
+            kept_e.append(capped.error)
+    if result.status != "infeasible":
+        kept_k.append(float(result.iterations))
+        kept_e.append(result.error)
+    return np.array(kept_k), np.array(kept_e)
+
+
+def solve_arm(
+    params: ArmParams,
+    joints: NDArray[np.float64],
+    target: NDArray[np.float64],
+    obstacle_centres: NDArray[np.float64],
+    *,
+    history: bool = True,
+) -> SolveReport:
+    """Solve one frame: the chosen solver from ``joints`` toward ``target``, and the two-bone ghost (no viser).
+
+    Where limits or obstacles apply and the solve falls short of the tolerance, it is run again from the rest-like
+    arcs of :func:`arc_starts`, and the closest admissible pose of all is kept (the last pose's unless another is
+    closer by more than the tolerance): a fixed point reached from one start is not proof that no closer pose exists.
+    ``history``: also replay the returned solve for :attr:`SolveReport.best_history`."""
+    three_d = params.three_d
+    kwargs = _solve_kwargs(params, obstacle_centres)
     goal = to_kernel(target, three_d)
     method = SOLVER_FROM_LABEL[params.solver]
     began = time.perf_counter()
-    match method:
-        case "fabrik":
-            result = fabrik.solve(start, goal, **kwargs)
-        case "ccd":
-            result = fabrik.ccd(start, goal, **kwargs)
-        case "jacobian_dls":
-            result = fabrik.jacobian_dls(start, goal, **kwargs)
+    result = _run(method, to_kernel(joints, three_d), goal, **kwargs)
+    start, start_name = joints, "last pose"
+    tolerance = params.tolerance_mm / 1000.0
+    if result.status != "reached" and constrained(params):
+        for k, pose in enumerate(arc_starts(params, target)):
+            other = _run(method, to_kernel(pose, three_d), goal, **kwargs)
+            if other.status != "infeasible" and other.error < result.error - tolerance:
+                result, start, start_name = other, pose, f"arc {k + 1} of {ARC_STARTS}"
     micros = (time.perf_counter() - began) * 1e6
+    best = admissible_history(params, start, target, obstacle_centres, result) if history else (np.zeros(1), np.zeros(1))
 
-    lengths = fabrik.link_lengths(start)
+    kernel_start = to_kernel(joints, three_d)
+    lengths = fabrik.link_lengths(kernel_start)
     upper, lower = (lengths[0], lengths[1]) if len(lengths) == 2 else (lengths.sum() / 2, lengths.sum() / 2)
     middle = result.joints[len(lengths) // 2]
     bend = middle - result.joints[0]
-    ghost = fabrik.two_bone(start[0], float(upper), float(lower), goal, bend)
+    ghost = fabrik.two_bone(kernel_start[0], float(upper), float(lower), goal, bend)
     return SolveReport(
         result=dataclasses.replace(result, joints=to_world(result.joints, three_d)),
         micros=micros,
         ghost=to_world(ghost, three_d),
         ghost_error_m=float(np.linalg.norm(ghost[2] - goal)),
         ghost_gap_m=float(np.linalg.norm(ghost[1] - middle)),
+        best_history=best,
+        start=start_name,
     )
+
+
+def segment_clearance(joints: NDArray[np.float64], centre: NDArray[np.float64]) -> float:
+    """Least distance (m) from ``centre`` (3,) to the chain's segments (joints (n + 1, 3))."""
+    a, b = joints[:-1], joints[1:]
+    seg = b - a
+    t = np.clip(np.einsum("ij,ij->i", centre - a, seg) / np.maximum(np.einsum("ij,ij->i", seg, seg), 1e-300), 0, 1)
+    return float(np.min(np.linalg.norm(a + t[:, None] * seg - centre, axis=1)))
+
+
+def _listed(words: list[str]) -> str:
+    return words[0] if len(words) == 1 else ", ".join(words[:-1]) + " and " + words[-1]
+
+
+def why_short(
+    params: ArmParams,
+    report: SolveReport,
+    target: NDArray[np.float64],
+    obstacle_centres: NDArray[np.float64],
+) -> str:
+    """In words, why the returned pose's end is not on the target ("" when it is, within the tolerance): the reach,
+    the obstacle the chain rests against or the target is in, the joints held at their limit, the iteration cap."""
+    r = report.result
+    if r.status == "reached":
+        return ""
+    joints = r.joints
+    reach = params.n_links * params.link_length_m
+    distance = float(np.linalg.norm(target - joints[0]))
+    reasons: list[str] = []
+    if distance > reach:
+        reasons.append(f"the target is {distance:.2f} m from the base, beyond the chain's reach of {reach:.2f} m")
+    avoided = range(params.n_obstacles) if params.avoid else range(0)
+    covering = [k for k in avoided if np.linalg.norm(obstacle_centres[k] - joints[0]) <= params.radii_m[k]]
+    inside = [
+        k + 1 for k in avoided if k not in covering and np.linalg.norm(target - obstacle_centres[k]) < params.radii_m[k]
+    ]
+    if inside:
+        reasons.append(f"the target is inside obstacle {_listed([str(k) for k in inside])}")
+    touching = [
+        k + 1
+        for k in avoided
+        if k not in covering and segment_clearance(joints, obstacle_centres[k]) <= params.radii_m[k] * (1 + 1e-3) + 1e-4
+    ]
+    if touching and not inside:
+        which = _listed([str(k) for k in touching])
+        reasons.append(f"obstacle {which} is in the way (the chain rests against it)")
+    if params.limits:
+        angles = fabrik.joint_angles(to_kernel(joints, params.three_d), _root_direction(params.three_d))
+        held = np.flatnonzero(angles >= math.radians(params.half_angle_deg) - math.radians(0.5))
+        if len(held):
+            names = ["the base" if j == 0 else f"joint {j + 1}" for j in held]
+            verb = "is" if len(held) == 1 else "are"
+            reasons.append(f"{_listed(names)} {verb} at the {params.half_angle_deg:g}° joint limit")
+        elif r.status == "limited":
+            used = float(np.max(angles)) / max(math.radians(params.half_angle_deg), 1e-12)
+            reasons.append(
+                f"under the {params.half_angle_deg:g}° joint limits the solver found no closer pose "
+                f"(its joints bend up to {min(used, 1.0):.0%} of the limit)"
+            )
+    if r.status == "max_iterations":
+        reasons.append(f"it was still closing in after {r.iterations} iterations (raise Max iterations)")
+    if r.status == "infeasible":
+        reasons.append("no pose it saw kept every limit and cleared every obstacle")
+    if not reasons:
+        reasons.append("the iterations stalled there")
+    text = "; ".join(reasons)
+    return f"Short by **{r.error * 1000.0:.1f} mm**: {text[0].upper()}{text[1:]}."
 
 
 # --------------------------------------------------------------------------------------------- geometry
@@ -283,7 +448,9 @@ class ArmScene(Scene[ArmParams]):
     about = """
 **What it shows.** A chain of 2–12 rigid links whose root is fixed. Drag the red target's gizmo (or click in the
 plane) and the chain's end follows it. The readout gives the iterations this frame took, the final error, the
-status and the time per solve; the plot shows the error after each iteration (log scale). Joints turn from green
+status and the time per solve, and, when the end is short of the target, why (the reach, the obstacle in the way,
+the joints held at their limit); the plot shows, after each iteration, the error of the pose the solver would return
+then: the best one it has seen that keeps every limit and clears every obstacle (log scale). Joints turn from green
 to red as they approach their limit. The translucent blue ghost is the analytic two-bone solution (with two links
 the same problem; with more, two bones of the same total reach).
 
@@ -294,7 +461,8 @@ outwards. Repeat until |pₙ − target| < tolerance. No angles, no matrices.
 **Limits.** Each segment stays within a cone of the chosen half-angle around the previous one (the first around
 the vertical), clamped inside each pass. **Obstacles** (circles in the plane, spheres in 3D): a segment that would
 cut one is turned about its anchor by the least angle until it just clears it. The solver returns the best pose
-it saw that keeps every limit and clears every obstacle. **Status**: "reached" (within the tolerance);
+it saw that keeps every limit and clears every obstacle; when that falls short, the scene also solves from a
+few gently bent arcs that keep the limits, and keeps whichever pose comes closest. **Status**: "reached" (within the tolerance);
 "unreachable" (the target lies outside the reach annulus max(0, 2·max L − ΣL) ≤ |target − root| ≤ ΣL; the chain
 stretches straight toward it at once); "blocked" (within reach, but the chain rests against an obstacle short of it, or the
 target is inside one); "limited" (within reach, but the iterates stalled at a fixed point under the joint limits
@@ -346,7 +514,8 @@ is a static pose.
         with self.gui_root:
             skeleton = build_controls(gui, p, names=("preset",))
             skeleton.folders["Skeleton"].order = -1  # above About: the panel opens with the preset menu on top
-            with gui.add_folder("This frame"):
+            self.frame_folder = gui.add_folder("This frame")
+            with self.frame_folder:
                 self.readout = gui.add_markdown("")
                 self.ghost_readout = gui.add_markdown("")
                 self.plot = FittedChart(
@@ -354,7 +523,7 @@ is a static pose.
                     data=(np.zeros(1), np.ones(1)),
                     series=(
                         viser.uplot.Series(label="Iteration"),
-                        viser.uplot.Series(label="Error (mm)", stroke="rgb(230,50,50)", width=2),
+                        viser.uplot.Series(label="Best pose's error (mm)", stroke="rgb(230,50,50)", width=2),
                     ),
                     scales={
                         "x": viser.uplot.Scale(time=False, auto=True),
@@ -515,6 +684,17 @@ is a static pose.
         self.solve_and_draw()
         self._reframe_if_outgrown()
 
+    CHAIN_FOLDERS = ("Chain", "Joint limits", "Obstacles", "Solver")
+    """The folders of controls that act on the scene's own chain (hidden while a skeleton preset is shown)."""
+
+    def show_chain_panel(self, visible: bool) -> None:
+        """Show or hide the chain's own readouts ("This frame": its status, ghost and error chart) and controls
+        (:data:`CHAIN_FOLDERS`): a skeleton preset shows its own readout in the Skeleton folder instead."""
+        with self.server.atomic():
+            self.frame_folder.visible = visible
+            for label in self.CHAIN_FOLDERS:
+                self.controls.folders[label].visible = visible
+
     def _on_reset_pose(self) -> None:
         self.pose = rest_pose(self.params.n_links, self.params.link_length_m)
         self.solve_and_draw()
@@ -644,11 +824,8 @@ is a static pose.
                 self.obstacle_spheres[k].scale = p.radii_m[k]
             self.readout.content = self._readout_markdown(report)
             self.ghost_readout.content = self._ghost_markdown(report)
-            history = report.result.error_history
-            self.plot.data = (
-                np.arange(len(history), dtype=np.float64),
-                np.maximum(history * 1000.0, 1e-6),
-            )
+            counts, errors = report.best_history
+            self.plot.data = (counts.astype(np.float64), np.maximum(errors * 1000.0, 1e-6))
         self.server.flush()
 
     def _readout_markdown(self, report: SolveReport) -> str:
@@ -658,6 +835,11 @@ is a static pose.
             f"error **{r.error * 1000.0:.3f} mm**, status **{r.status}**  \n"
             f"Solve time **{report.micros:,.0f} µs**{plain_python_note()}"
         )
+        if report.start != "last pose":
+            text += f"  \nThe last pose led to a worse fixed point: this pose was solved from {report.start}."
+        short = why_short(p, report, self.target, self.obstacle_centres)
+        if short:
+            text += f"  \n{short}"
         covering = [
             k + 1
             for k in range(p.n_obstacles)

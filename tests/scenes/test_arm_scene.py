@@ -60,8 +60,9 @@ def test_opening_state_reaches_the_target_around_the_obstacle(scene: ArmScene) -
     assert report.ghost_error_m < 1e-9
     assert "status **reached**" in scene.readout.content
     assert f"{report.result.iterations} iteration" in scene.readout.content
-    history = np.asarray(scene.plot.data[1])
-    assert len(history) == report.result.iterations + 1
+    counts, history = (np.asarray(d) for d in scene.plot.data)
+    np.testing.assert_array_equal(counts, np.arange(1, report.result.iterations + 1))
+    assert history[-1] == pytest.approx(report.result.error * 1000.0)  # the chart ends on the readout's error
     assert history[-1] < 1.0  # mm, below the tolerance
 
 
@@ -337,3 +338,122 @@ def test_the_panel_opens_with_the_skeleton_menu_above_about(server: viser.ViserS
         skeleton, about = folders["Skeleton"], folders["About"]
         assert skeleton["container_uuid"] == about["container_uuid"]
         assert skeleton["props"]["order"] < about["props"]["order"]
+
+
+# ------------------------------------------------------------------------------------------------ short of the target
+def best_admissible_by_sampling(
+    params: ArmParams, target: np.ndarray, centres: np.ndarray, count: int = 200_000
+) -> float:
+    """An independent reference: the closest end (m) of ``count`` random planar poses that keep every cone limit and
+    clear every obstacle (each link turned by a uniform angle within ±half-angle from the last, the base from up)."""
+    rng = np.random.default_rng(7)
+    phi = math.radians(params.half_angle_deg)
+    angles = np.cumsum(rng.uniform(-phi, phi, (count, params.n_links)), axis=1)
+    steps = params.link_length_m * np.stack([np.sin(angles), np.cos(angles)], axis=-1)
+    joints = np.concatenate([np.zeros((count, 1, 2)), np.cumsum(steps, axis=1)], axis=1)
+    admissible = np.ones(count, dtype=bool)
+    for k in range(params.n_obstacles):
+        centre = centres[k, [0, 2]]
+        a, seg = joints[:, :-1], np.diff(joints, axis=1)
+        t = np.clip(((centre - a) * seg).sum(-1) / (seg * seg).sum(-1), 0.0, 1.0)
+        admissible &= np.linalg.norm(a + t[..., None] * seg - centre, axis=-1).min(axis=1) >= params.radii_m[k]
+    errors = np.linalg.norm(joints[:, -1] - target[[0, 2]], axis=1)
+    return float(errors[admissible].min())
+
+
+def readout_error_mm(text: str) -> float:
+    return float(text.split("error **")[1].split(" mm")[0])
+
+
+def test_joint_limits_switched_on_over_a_reached_target_keep_the_closest_admissible_pose(
+    server: viser.ViserServer, scene: ArmScene
+) -> None:
+    """The chain reaches (0.1, 0.98) round the obstacle; ticking 45° limits once swung it away to end "blocked"
+    216 mm short, though random admissible poses come within 13 mm. Now it ends at least as close as they do, and the
+    chart ends on the readout's error, never rising (it plots the pose the solver would return: the best so far)."""
+    goal = (0.1, 0.0, 0.98)
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_node("/arm/target")
+        client.drag_transform("/arm/target", [goal])
+        client.wait_for(lambda: bool(np.linalg.norm(scene.pose[-1] - goal) < 1e-3), what="the target reached")
+        client.wait_for_gui("Joint limits")
+        client.set_value("Joint limits", True)
+        client.wait_for(lambda: scene.params.limits, what="limits on")
+        with scene._lock:
+            params, target, centres = scene.params, scene.target.copy(), scene.obstacle_centres.copy()
+            report, text = scene.report, scene.readout.content
+            counts, chart = (np.asarray(d, dtype=np.float64) for d in scene.plot.data)
+        assert report is not None
+        reference = best_admissible_by_sampling(params, target, centres)
+        assert reference < 0.05  # an admissible pose 13 mm off exists
+        error_mm = readout_error_mm(text)
+        assert error_mm <= reference * 1000.0 + 1.0, (error_mm, reference, text)
+        angles = fabrik.joint_angles(scene.pose[:, [0, 2]], [0.0, 1.0])
+        assert np.all(angles <= math.radians(45.0) + 1e-6)
+        assert clearance(scene.pose, centres[0]) >= params.radii_m[0] - 1e-9
+        assert chart[-1] == pytest.approx(error_mm, abs=5e-4)  # the readout rounds to 0.001 mm
+        assert np.all(np.diff(chart) <= 1e-9), chart
+        assert np.all(np.diff(counts) > 0)
+
+
+def test_the_chart_plots_the_best_admissible_pose_not_the_iterates(scene: ArmScene) -> None:
+    """20° cones over the reached default pose: the iterates wander (their error ends near 520 mm) while the pose
+    returned is the best admissible one; the chart shows that pose's error after each iteration, ending on it."""
+    scene.controls["half_angle_deg"].value = 20.0
+    scene.controls["limits"].value = True
+    report = scene.report
+    assert report is not None and report.result.status != "reached"
+    counts, chart = (np.asarray(d, dtype=np.float64) for d in scene.plot.data)
+    assert chart[-1] == pytest.approx(report.result.error * 1000.0)
+    assert readout_error_mm(scene.readout.content) == pytest.approx(chart[-1], abs=5e-4)
+    assert np.all(np.diff(chart) <= 1e-9)
+    # Each point is what a run capped at that many iterations returns, from the same start.
+    from scenes.arm import _run, _solve_kwargs, arc_starts, to_kernel
+
+    starts = {
+        "last pose": None,
+        **{f"arc {k + 1} of 9": pose for k, pose in enumerate(arc_starts(scene.params, scene.target))},
+    }
+    start = starts[report.start]
+    if start is not None:
+        for k, value in zip(counts[:3], chart[:3], strict=True):
+            kwargs = _solve_kwargs(scene.params, scene.obstacle_centres) | {"max_iterations": int(k)}
+            capped = _run("fabrik", to_kernel(start, False), to_kernel(scene.target, False), **kwargs)
+            assert capped.error * 1000.0 == pytest.approx(value)
+
+
+@pytest.mark.parametrize(
+    ("setup", "words"),
+    [
+        ({"target": (1.6, 0.0, 0.6)}, "beyond the chain's reach of 1.50 m"),
+        ({"target": (0.45, 0.0, 0.5)}, "the target is inside obstacle 1"),
+        ({"target": (0.0, 0.0, 1.4), "obstacle": (0.0, 0.0, 0.75), "radius": 0.6}, "obstacle 1 is in the way"),
+        ({"limits": 5.0, "n_obstacles": 0}, "at the 5° joint limit"),
+    ],
+)
+def test_a_short_pose_says_in_words_why(scene: ArmScene, setup: dict, words: str) -> None:
+    if "n_obstacles" in setup:
+        scene.controls["n_obstacles"].value = setup["n_obstacles"]
+    if "radius" in setup:
+        scene.controls.each("radii_m")[0].value = setup["radius"]
+    if "obstacle" in setup:
+        scene.obstacle_gizmos[0].position = setup["obstacle"]
+        scene._apply_obstacle(0)
+    if "limits" in setup:
+        scene.controls["half_angle_deg"].value = setup["limits"]
+        scene.controls["limits"].value = True
+    if "target" in setup:
+        scene.target_gizmo.position = setup["target"]
+        scene._apply_target()
+    report = scene.report
+    assert report is not None and report.result.status != "reached"
+    text = scene.readout.content
+    assert f"Short by **{report.result.error * 1000.0:.1f} mm**" in text, text
+    assert words in text.lower(), text
+    # Reached again: no excuse is left on the readout.
+    scene.controls["limits"].value = False
+    scene.controls["n_obstacles"].value = 0
+    scene.target_gizmo.position = (0.5, 0.0, 0.9)
+    scene._apply_target()
+    assert scene.report is not None and scene.report.result.status == "reached"
+    assert "Short by" not in scene.readout.content

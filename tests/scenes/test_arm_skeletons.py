@@ -140,3 +140,110 @@ def test_the_camera_frames_the_shown_skeleton(
     scene.skeletons.show("Chain")
     xy = project_points(scene._view_for(lens), lens, scene.pose)
     assert xy[:, 0].max() <= size[0] - PANEL_PX - MARGIN_PX + 0.5
+
+
+# ------------------------------------------------------------------------------------------------ what the panel shows
+def shown_elements(client: BrowserClient) -> list[dict]:
+    """The GUI elements this browser draws: visible themselves and inside visible folders all the way up."""
+    with client._lock:
+        gui = dict(client.gui)
+
+    def shown(uuid: str | None) -> bool:
+        while uuid is not None and uuid in gui:
+            element = gui[uuid]
+            if element["props"].get("visible") is False:
+                return False
+            uuid = element.get("container_uuid")
+        return True
+
+    return [element for uuid, element in gui.items() if shown(uuid)]
+
+
+def shown_labels(client: BrowserClient) -> set[str]:
+    return {str(e["props"].get("label")) for e in shown_elements(client) if e["props"].get("label") is not None}
+
+
+def shown_texts(client: BrowserClient) -> str:
+    """Every markdown text this browser draws, and the titles of the charts it draws."""
+    parts = []
+    for e in shown_elements(client):
+        if e["type"] == "GuiMarkdownMessage":
+            parts.append(str(e["props"].get("_markdown", e["props"].get("content", ""))))
+        elif e["type"] == "GuiUplotMessage":
+            parts.append(f"[chart {e['props'].get('title')}]")
+    return "\n".join(parts)
+
+
+CHAIN_ONLY = {
+    "Links",
+    "Link length (m)",
+    "Joint limits",
+    "Cone half-angle (°)",
+    "Avoid obstacles",
+    "Obstacles",
+    "Solver",
+    "Tolerance (mm)",
+    "Max iterations",
+    "Straighten the chain",
+    "This frame",
+}
+"""Labels of the chain's own controls and folders (every one acts on the chain alone)."""
+
+
+@pytest.mark.parametrize("label", ["Robot arm", "Hand", "Upper body"])
+def test_a_preset_shows_its_own_readouts_and_controls_only(
+    server: viser.ViserServer, scene: ArmScene, label: _skeletons.PresetLabel
+) -> None:
+    view = scene.skeletons
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Preset")
+        client.wait_for(lambda: "status **reached**" in shown_texts(client), what="the chain's readout")
+        assert CHAIN_ONLY <= shown_labels(client)  # the chain's panel, as it opens
+        assert "[chart Error after each iteration (log scale)]" in shown_texts(client)
+        client.set_value("Preset", label)
+        client.wait_for(
+            lambda: view.preset == label and f"**{label}**" in shown_texts(client), what=f"{label} and its readout"
+        )
+        client.wait_for(lambda: not (CHAIN_ONLY & shown_labels(client)), what="the chain's controls hidden")
+        texts = shown_texts(client)
+        # No word of the hidden chain: no "FABRIK: n iterations, error … status …", no ghost, no chain chart.
+        assert "status **" not in texts and "Two-bone ghost" not in texts and "[chart" not in texts, texts
+        assert "| Effector | Error (mm) | Status |" in texts
+        assert {"Preset", "Skeleton"} <= shown_labels(client)
+        client.set_value("Preset", "Chain")
+        client.wait_for(lambda: CHAIN_ONLY <= shown_labels(client), what="the chain's controls back")
+        client.wait_for(lambda: "status **" in shown_texts(client), what="the chain's readout back")
+        assert "| Effector |" not in shown_texts(client)
+
+
+@pytest.mark.parametrize("label", ["Robot arm", "Hand", "Upper body"])
+def test_every_preset_opens_solved_by_its_own_solver_settings(
+    server: viser.ViserServer, scene: ArmScene, label: _skeletons.PresetLabel
+) -> None:
+    """A fresh page, the chain's solver turned to a 1-iteration, 50 mm setting first: the preset opens with every
+    effector "reached" within its own tolerance, and says which settings it solved with."""
+    view = scene.skeletons
+    skeleton = _skeletons.PRESETS[label]()
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Preset")
+        client.set_value("Max iterations", 1)
+        client.set_value("Tolerance (mm)", 50.0)
+        client.wait_for(lambda: scene.params.max_iterations == 1, what="the chain's cap at 1")
+        client.set_value("Preset", label)
+        client.wait_for(lambda: f"**{label}**" in shown_texts(client), what=f"{label}'s readout")
+        texts = shown_texts(client)
+        rows = [line.split("|")[1:4] for line in texts.splitlines() if line.startswith("| ") and "Effector" not in line]
+        assert [name.strip() for name, _, _ in rows] == list(skeleton.effector_labels)
+        for name, error_mm, status in rows:
+            assert status.strip() == "reached", texts
+            assert float(error_mm) <= skeleton.tolerance_mm, (name, texts)
+        assert f"tolerance {skeleton.tolerance_mm:g} mm, at most {skeleton.max_iterations} iterations" in texts
+        iterations = int(texts.split(f"**{label}**: ")[1].split(" iteration")[0])
+        assert 1 <= iterations < skeleton.max_iterations or (iterations == 0 and label != "Upper body")
+        # The opening targets are reachable: the pose on them keeps every limit and every link's length.
+        with scene._lock:
+            pose = view.pose.copy()
+        assert np.all(_skeletons.joint_usage(skeleton, pose) <= 1.0 + 1e-9)
+        np.testing.assert_allclose(link_lengths(skeleton, pose), link_lengths(skeleton, skeleton.joints), rtol=1e-9)
+        for k, effector in enumerate(skeleton.effectors):
+            assert np.linalg.norm(pose[effector] - skeleton.targets[k]) <= skeleton.tolerance_mm / 1000.0
