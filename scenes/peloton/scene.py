@@ -41,6 +41,7 @@ from scenes.peloton.model import (
     solo_speed,
 )
 from scenes.peloton.projection import (
+    LABEL_PAD_PX,
     LABEL_PX,
     course_to_world,
     label_lifts_px,
@@ -152,6 +153,9 @@ time-averaged power is the mean over positions, far below the leader's.
         self._ridden_s = 0.0
         self._label_lift_m = LABEL_STAGGER_M * (np.arange(MAX_RIDERS) % 2)
         """How far each slot's label sits above its bar (m): laid out for the camera framed last."""
+        self._lane_lift_m = np.full(MAX_RIDERS, 2.0 * LABEL_STAGGER_M)
+        """How far above its bar (m), at each slot, the label of a leader dropping back rides: above every other
+        label, so it crosses none of them (laid out with the others)."""
         self._build_gui()
         self._build_world()
         self.redraw()
@@ -266,6 +270,15 @@ time-averaged power is the mean over positions, far below the leader's.
             )
             for i in range(MAX_RIDERS)
         ]
+        # A thin line from each bar's top up to its label: a label lifted clear of its neighbours still shows whose
+        # it is.
+        self.label_leaders = scene.add_line_segments(
+            f"{self.course.name}/label_leaders",
+            np.zeros((MAX_RIDERS, 2, 3)),
+            colors=(90, 90, 95),
+            thickness=1.5,
+            thickness_units="screen",
+        )
         self.wind_arrow = scene.add_line_segments(
             f"{self.root.name}/wind", np.zeros((3, 2, 3)), colors=(120, 200, 255), thickness=0.05
         )
@@ -386,6 +399,10 @@ time-averaged power is the mean over positions, far below the leader's.
                 lifts_px = label_lifts_px(project_px(anchors, view, lens))
                 lifts_m = lift_to_metres(anchors, lifts_px, up_world, view, lens)
                 lifted = anchors + lifts_m[:, None] * up_world
+                lane_px = np.full(len(anchors), lifts_px.max(initial=0.0) + LABEL_PX[1] + LABEL_PAD_PX)
+                lane_m = lift_to_metres(anchors, lane_px, up_world, view, lens)
+                if self._rotating():  # the lane a dropping leader's label rides in must be in view too
+                    lifted = np.vstack([lifted, anchors + lane_m[:, None] * up_world])
                 px = project_px(lifted, view, lens)
                 if (
                     px[:, 0].min(initial=x0) >= x0 - 0.5
@@ -398,6 +415,8 @@ time-averaged power is the mean over positions, far below the leader's.
             assert view is not None
             self._label_lift_m = np.zeros(MAX_RIDERS)
             self._label_lift_m[: len(lifts_m)] = lifts_m
+            self._lane_lift_m = np.zeros(MAX_RIDERS)
+            self._lane_lift_m[: len(lane_m)] = lane_m
             self.redraw(readouts=False)
             return view
 
@@ -522,6 +541,12 @@ time-averaged power is the mean over positions, far below the leader's.
                     [0.35 * visible, 0.35 * visible, np.maximum(height, 1e-4) * visible], axis=1
                 ).astype(np.float32)
                 base = base + height
+            lifts = self._label_lifts(x, slots)
+            leaders = np.zeros((MAX_RIDERS, 2, 3))
+            leaders[:n, 0] = np.stack([x[:n], y[:n], 1.75 + base[:n]], axis=1)
+            leaders[:n, 1] = np.stack([x[:n], y[:n], 1.95 + base[:n] + lifts], axis=1)
+            set_if_changed(self.label_leaders, "points", leaders.astype(np.float32))
+            set_if_changed(self.label_leaders, "visible", True)
             for i, label in enumerate(self.labels):
                 # Only write what changed: every property write is a message to every browser.
                 if label.visible != (i < n):
@@ -538,7 +563,7 @@ time-averaged power is the mean over positions, far below the leader's.
                     set_if_changed(
                         label,
                         "position",
-                        (x[i], y[i], 1.95 + base[i] + self._label_lift_m[slots[i]]),
+                        (x[i], y[i], 1.95 + base[i] + lifts[i]),
                     )
 
             rotation = self._rotation_markdown()
@@ -553,6 +578,22 @@ time-averaged power is the mean over positions, far below the leader's.
                 self.chart.data = self._chart_data()
                 self.speed_out.content = self._speed_markdown()
         self.server.flush()
+
+    def _label_lifts(self, x: np.ndarray, slots: np.ndarray) -> np.ndarray:
+        """(n_riders,) how far above its bar each rider's label sits (m): its slot's lift from the layout; a leader
+        dropping back steps up into the lane above every label as it swings off and rides there, so its label
+        crosses no other (it steps, from one frame to the next, rather than sliding through the others)."""
+        n = self.params.n_riders
+        lifts = self._label_lift_m[slots].copy()
+        if not self._rotating():
+            return lifts
+        xs = slot_offsets(n, self.params.gap_m)[:n]
+        for i in np.flatnonzero(slots == 0):
+            drift = (xs[0] - x[i]) / max(xs[0] - xs[n - 1], 1e-9)
+            if drift <= 0.0:
+                continue
+            lifts[i] = max(float(np.interp(x[i], xs[::-1], self._lane_lift_m[:n][::-1])), lifts[i])
+        return lifts
 
     def _show_riders(self, positions: np.ndarray, scales: np.ndarray, bodies: np.ndarray) -> None:
         """Place the (MAX_GROUP,) rider instances and colour their bodies (only what changed goes out)."""
@@ -586,6 +627,7 @@ time-averaged power is the mean over positions, far below the leader's.
             for label in self.labels:
                 if label.visible:
                     label.visible = False
+            set_if_changed(self.label_leaders, "visible", False)
             legend = legend_markdown(low, high)
             if self.legend.content != legend:
                 self.legend.content = legend
