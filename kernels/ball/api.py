@@ -9,6 +9,7 @@ in m, m/s and N), :class:`BatchTrajectory` ((K, T) and (K, T, 3)), :class:`Outco
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import threading
 from collections.abc import Sequence
@@ -295,8 +296,27 @@ def _keeper_dive(info: NDArray[np.float64]) -> KeeperDive | None:
     return KeeperDive(float(info[play.I_DIVE]), (float(target[0]), float(target[1]), float(target[2])))
 
 
+@functools.lru_cache(maxsize=64)
+def _cached_pitch_vector(pitch: Pitch, spot: tuple[float, float], ground: float, radius: float) -> NDArray[np.float64]:
+    vector = pitch_vector(pitch, spot, ground, radius)
+    vector.setflags(write=False)
+    return vector
+
+
+def _pitch_vector(pitch: Pitch, spot: NDArray[np.float64], ground: float, radius: float) -> NDArray[np.float64]:
+    """:func:`pitch_vector`, cached for a pitch flown again from the same spot (the checks cost more than a kick)."""
+    if not isinstance(pitch, Pitch):
+        raise ValueError(f"pitch must be a Pitch, got {type(pitch).__name__}")
+    try:
+        return _cached_pitch_vector(pitch, (float(spot[0]), float(spot[1])), ground, radius)
+    except TypeError:  # a field that cannot be hashed (an array where a tuple belongs): checked uncached
+        vector = pitch_vector(pitch, spot, ground, radius)
+        vector.setflags(write=False)  # the one array type the compiled flight is built for
+        return vector
+
+
 def _simulate_on_pitch(launch: NDArray[np.float64], settings: NDArray[np.float64], pitch: Pitch) -> Trajectory:
-    vector = pitch_vector(pitch, launch[:2], float(settings[GROUND]), float(settings[RADIUS]))
+    vector = _pitch_vector(pitch, launch[:2], float(settings[GROUND]), float(settings[RADIUS]))
     rows = int(settings[N_STEPS]) + 1 + play.EXTRA_ROWS
     t, state, spin, forces = np.empty(rows), np.empty((rows, 6)), np.empty((rows, 3)), np.empty((rows, 12))
     events, info = np.empty((play.MAX_EVENTS, 5)), np.empty(play.N_INFO)
@@ -391,7 +411,7 @@ def _play_batch(
     when ``keep`` (else zero-length rows)."""
     k = len(launches)
     spot = launches[0, :2] if k else np.zeros(2)
-    vector = pitch_vector(pitch, spot, float(settings[GROUND]), float(settings[RADIUS]))
+    vector = _pitch_vector(pitch, spot, float(settings[GROUND]), float(settings[RADIUS]))
     rows = int(settings[N_STEPS]) + 1 + play.EXTRA_ROWS if keep else 0
     t, state, spin = np.empty((k, rows)), np.empty((k, rows, 6)), np.empty((k, rows, 3))
     events, info = np.empty((k, play.MAX_EVENTS, 5)), np.empty((k, play.N_INFO))

@@ -123,6 +123,14 @@ def _capsule_fraction(x, y, z, vx, vy, vz, x1, y1, z1, vx1, vy1, vz1, h, cap, ra
     """First fraction of the step at which the ball (radius ``radius``) touches the capsule ``cap`` while moving
     into it, or 2.0 for none: a swept test of the chord, then bisection on the cubic Hermite path."""
     reach = radius + cap[6]
+    # Broad phase: the step's chord and the capsule's axis, each boxed, must come within reach (most steps do not).
+    margin = reach + 1e-3
+    if max(x, x1) < min(cap[0], cap[3]) - margin or min(x, x1) > max(cap[0], cap[3]) + margin:
+        return 2.0
+    if max(y, y1) < min(cap[1], cap[4]) - margin or min(y, y1) > max(cap[1], cap[4]) + margin:
+        return 2.0
+    if max(z, z1) < min(cap[2], cap[5]) - margin or min(z, z1) > max(cap[2], cap[5]) + margin:
+        return 2.0
     _, _, d2 = _segment_closest(
         x, y, z, x1 - x, y1 - y, z1 - z, cap[0], cap[1], cap[2], cap[3] - cap[0], cap[4] - cap[1], cap[5] - cap[2]
     )

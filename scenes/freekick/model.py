@@ -29,6 +29,10 @@ DEFENDER_HEIGHT_M = 1.8
 DEFENDERS = 4
 DEFENDER_WIDTH_M = 0.5
 
+KNUCKLE_SPIN_REV_S = 0.0
+"""Spin the Knuckleball checkbox sets when it is ticked: a knuckleball is struck with almost none, and any real spin
+(a launch spin parameter of 0.05, about 2 rev/s at 25 m/s) steadies the wake that makes it wobble."""
+
 SpinAxis = Literal["left", "right", "top", "back", "custom"]
 SPIN_AXIS_LABELS: dict[SpinAxis, str] = {
     "left": "Sidespin, curls left",
@@ -135,9 +139,7 @@ class FreeKickParams:
     """Integrator and its step."""
     knuckle: bool = field(default=False, metadata=checkbox("Knuckleball", folder="Physics"))
     """Unsteady knuckleball side force (only acts with near-zero spin)."""
-    knuckle_seed: int = field(
-        default=1, metadata=number("Knuckle random draw", 0, 9999, 1, folder="Physics", disabled=True)
-    )
+    knuckle_seed: int = field(default=1, metadata=number("Random draw", 0, 9999, 1, folder="Physics", disabled=True))
     """Random draw of the knuckleball's side force: the same number, the same flight. Greyed out without the knuckleball."""
     wall_jumps: bool = field(default=False, metadata=checkbox("Wall jumps", folder="Physics"))
     """Whether the wall jumps (its top rises by 0.35 m)."""
@@ -271,6 +273,27 @@ def panels(p: FreeKickParams) -> tuple[ball.Panel, ball.Panel]:
         wall_height_m=height,
         wall_offset_m=offset,
     )
+
+
+def knuckle_ticked(before: FreeKickParams, after: FreeKickParams) -> FreeKickParams:
+    """``after``, with the spin set to :data:`KNUCKLE_SPIN_REV_S` if the knuckleball has just been switched on with
+    spin enough to steady it: ticking the box gives a knuckleball, not a curler with a dead checkbox."""
+    if after.knuckle and not before.knuckle and after.spin_rev_s != KNUCKLE_SPIN_REV_S:
+        return dataclasses.replace(after, spin_rev_s=KNUCKLE_SPIN_REV_S)
+    return after
+
+
+def knuckle_wobble_m(state: KickState) -> float | None:
+    """Largest sideways distance (m) of the kick from its spinless ghost over the ghost's flight, where the kick
+    carries a knuckle force; None without one."""
+    flight, ghost = state.flight, state.ghost
+    if not np.any(flight.knuckle):
+        return None
+    times = ghost.t[ghost.t <= flight.t[-1]]
+    if len(times) < 2:
+        return None
+    kick = np.column_stack([np.interp(times, flight.t, flight.position[:, i]) for i in range(3)])
+    return float(np.abs(np.linalg.norm((kick - ghost.position[: len(times)])[:, 1:], axis=1)).max())
 
 
 def wall_axes(wall: ball.Panel) -> tuple[NDArray[np.float64], NDArray[np.float64]]:

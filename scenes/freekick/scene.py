@@ -42,6 +42,8 @@ from scenes.freekick.model import (
     ball_spot,
     compute_kick,
     deflection_m,
+    knuckle_ticked,
+    knuckle_wobble_m,
     outcome_map,
     outcome_map_image,
     position_at,
@@ -285,8 +287,21 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
         return self.read_controls(self.controls)
 
     def apply_inputs(self) -> None:
-        """Read the controls and show the kick they set (what a change of any control but the view runs)."""
-        self._set_params(self.read_params())
+        """Read the controls and show the kick they set (what a change of any control but the view runs). Ticking
+        Knuckleball sets the spin near zero, and the slider shows it."""
+        params = self.read_params()
+        knuckled = knuckle_ticked(self.params, params)
+        if knuckled is not params:
+            self.knuckle_note = (
+                f"Knuckleball: spin set to {knuckled.spin_rev_s:g} rev/s (a knuckleball is struck with almost none; "
+                "spin steadies the wake that makes it wobble)."
+            )
+            handle = self.controls["spin_rev_s"]
+            if handle.value != knuckled.spin_rev_s:
+                handle.value = knuckled.spin_rev_s
+        elif not params.knuckle:
+            self.knuckle_note = ""
+        self._set_params(knuckled)
 
     def _set_params(self, params: FreeKickParams) -> None:
         state = compute_kick(params)  # raises (and keeps the last state) if the kernels refuse the input
@@ -527,6 +542,14 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
         deflection = deflection_m(state)
         if deflection is not None:
             lines.append(f"Sideways against the no-spin kick: **{deflection:+.2f} m** (+ = left)")
+        wobble = knuckle_wobble_m(state)
+        if wobble is not None:
+            lines.append(f"Knuckle wobble: up to **{wobble:.2f} m** off the spinless path (dashed)")
+        elif p.knuckle:
+            lines.append("Knuckleball: no wobble at this spin (any real spin steadies the wake)")
+        note = getattr(self, "knuckle_note", "")
+        if note:
+            lines.append(note)
         s_param = ball.BALL_RADIUS_M * 2 * math.pi * p.spin_rev_s / max(p.speed_ms, 1e-9)
         lines.append(f"Spin parameter S = r·ω/v = {s_param:.3f}")
         return "  \n".join(lines)
