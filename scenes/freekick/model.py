@@ -48,6 +48,8 @@ MODEL_LABELS: dict[ball.Model, str] = {
 Integrator = Literal["rk4", "euler"]
 INTEGRATOR_LABELS: dict[Integrator, str] = {"rk4": "RK4, 10 ms", "euler": "Euler, 1 ms (textbook)"}
 INTEGRATOR_STEP_S: dict[Integrator, float] = {"rk4": 1e-2, "euler": 1e-3}
+PLAY_T_MAX_S = 6.0
+"""How long the kick is played on after it lands (s)."""
 BAND_STEP_S = 2e-2
 """Step of the ±10 % spin band's flights (RK4): they are drawn, not measured, and must not slow a redraw."""
 
@@ -275,6 +277,42 @@ def panels(p: FreeKickParams) -> tuple[ball.Panel, ball.Panel]:
     )
 
 
+def play_words(played: ball.Trajectory | None) -> str:
+    """What the kick did once it touched something, in words: "hits the left post at 1.8 m, goes in"."""
+    if played is None or not played.events:
+        return ""
+    phrases: list[str] = []
+    bounces = 0
+    for event in played.events:
+        _, y, z = event.position
+        if event.kind == "ground":
+            bounces += 1
+            continue
+        if bounces:
+            phrases.append("bounces" if bounces == 1 else f"bounces {bounces}×")
+            bounces = 0
+        side = "left" if y > 0 else "right"
+        if event.kind == "post":
+            phrases.append(f"hits the {side} post at {z:.1f} m")
+        elif event.kind == "bar":
+            phrases.append(f"hits the bar {abs(y):.1f} m {side} of centre")
+        elif event.kind == "wall":
+            phrases.append(f"hits a defender at {z:.1f} m")
+    ending = {
+        "net": "ends in the net",
+        "out": "goes out of play",
+        "stopped": f"rolls to a stop {max(-played.position[-1, 0], 0.0):.1f} m out",
+        "saved": "is saved",
+    }.get(played.ended, f"still rolling after {PLAY_T_MAX_S:g} s")
+    if bounces:
+        phrases.append("bounces" if bounces == 1 else f"bounces {bounces}×")
+    if played.result == "goal" and played.ended != "net":
+        ending = "goes in"
+    phrases.append(ending)
+    text = ", ".join(phrases)
+    return text[0].upper() + text[1:]
+
+
 def knuckle_ticked(before: FreeKickParams, after: FreeKickParams) -> FreeKickParams:
     """``after``, with the spin set to :data:`KNUCKLE_SPIN_REV_S` if the knuckleball has just been switched on with
     spin enough to steady it: ticking the box gives a knuckleball, not a curler with a dead checkbox."""
@@ -321,6 +359,9 @@ class KickState:
     """What the no-spin kick did."""
     wall: ball.Panel
     goal: ball.Panel
+    played: ball.Trajectory | None = None
+    """The same kick played on after it first touches anything: it bounces, rolls, strikes the posts, the bar and
+    the wall's players, and stops in the net (the kernel's flight on a pitch, without a keeper)."""
 
 
 def _fly(p: FreeKickParams, spin_scale: float, *, knuckle: bool, band: bool = False) -> ball.Trajectory:
@@ -348,6 +389,18 @@ def compute_kick(p: FreeKickParams) -> KickState:
     wall, goal = panels(p)
     flight = _fly(p, 1.0, knuckle=True)
     ghost, ghost_outcome = _ghost_kick(_without_spin(p))
+    played = ball.simulate(
+        ball_spot(p),
+        launch_velocity(p),
+        spin_vector(p),
+        dt=INTEGRATOR_STEP_S[p.integrator],
+        method=p.integrator,
+        model=p.model,
+        t_max=PLAY_T_MAX_S,
+        ground_m=ball.BALL_RADIUS_M,
+        knuckle_seed=p.knuckle_seed if p.knuckle else None,
+        pitch=ball.Pitch(goal, wall),
+    )
     return KickState(
         flight=flight,
         ghost=ghost,
@@ -357,6 +410,7 @@ def compute_kick(p: FreeKickParams) -> KickState:
         ghost_outcome=ghost_outcome,
         wall=wall,
         goal=goal,
+        played=played,
     )
 
 
@@ -405,6 +459,14 @@ def sample_rows(times: NDArray[np.float64], t: NDArray[np.float64], values: NDAr
 def resample(flight: ball.Trajectory, n: int = PATH_POINTS) -> NDArray[np.float64]:
     """(n, 3) positions at n evenly spaced times over the flight."""
     return sample_rows(np.linspace(0.0, float(flight.t[-1]), n), flight.t, flight.position)
+
+
+def after_contact(played: ball.Trajectory | None, n: int = PATH_POINTS) -> NDArray[np.float64] | None:
+    """(n, 3) the played-on flight from its first contact to its end, at n evenly spaced times; None if it touched
+    nothing (or ended at the touch)."""
+    if played is None or not played.events or played.events[0].t >= float(played.t[-1]):
+        return None
+    return sample_rows(np.linspace(played.events[0].t, float(played.t[-1]), n), played.t, played.position)
 
 
 def position_at(flight: ball.Trajectory, t: float) -> NDArray[np.float64]:

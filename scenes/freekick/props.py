@@ -25,6 +25,8 @@ KNUCKLE_COLOUR = (240, 150, 20)
 PATH_COLOUR = (255, 140, 0)
 """The kick as set: a thick orange line."""
 GHOST_COLOUR = (40, 40, 40)
+AFTER_COLOUR = (255, 215, 150)
+"""The kick played on after its first contact (pale orange, beside the kick's own orange)."""
 """The no-spin ghost: thin, dark and dashed, so it never reads as the kick itself."""
 
 

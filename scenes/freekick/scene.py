@@ -38,6 +38,7 @@ from scenes.freekick.model import (
     PRESETS,
     RESULT_COLOURS,
     FreeKickParams,
+    after_contact,
     aim_at,
     ball_spot,
     compute_kick,
@@ -46,6 +47,7 @@ from scenes.freekick.model import (
     knuckle_wobble_m,
     outcome_map,
     outcome_map_image,
+    play_words,
     position_at,
     resample,
     sample_rows,
@@ -55,6 +57,7 @@ from scenes.freekick.model import (
     wall_axes,
 )
 from scenes.freekick.props import (
+    AFTER_COLOUR,
     ARROW_POINTS,
     FORCE_COLOURS,
     GHOST_COLOUR,
@@ -264,6 +267,8 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
         empty_path = np.zeros((PATH_POINTS - 1, 2, 3), np.float32)
         self.path = scene.add_line_segments(f"{root}/path", empty_path, colors=PATH_COLOUR, thickness=0.09)
         self.ghost = scene.add_line_segments(f"{root}/ghost", empty_path, colors=GHOST_COLOUR, thickness=0.04)
+        self.after = scene.add_line_segments(f"{root}/after", empty_path, colors=AFTER_COLOUR, thickness=0.06)
+        """The kick played on after its first contact: bounces, rolls, rebounds off the frame or a defender."""
         self.band = scene.add_mesh_simple(
             f"{root}/band",
             np.zeros((2 * PATH_POINTS, 3), np.float32),
@@ -485,6 +490,10 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
         with self.server.atomic():
             self.path.points = polyline_segments(path)
             self.ghost.points = dashed(polyline_segments(resample(state.ghost)))
+            after = after_contact(state.played)
+            if after is not None:
+                self.after.points = polyline_segments(after).astype(np.float32)
+            set_if_changed(self.after, "visible", after is not None)
             self.band.vertices = strip.astype(np.float32)
             for k, name in enumerate(names):
                 self.arrows[name].points = arrows[:, k].reshape(-1, 2, 3).astype(np.float32)
@@ -542,6 +551,9 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
         deflection = deflection_m(state)
         if deflection is not None:
             lines.append(f"Sideways against the no-spin kick: **{deflection:+.2f} m** (+ = left)")
+        words = play_words(state.played)
+        if words:
+            lines.append(f"Played on: **{words}** (pale line)")
         wobble = knuckle_wobble_m(state)
         if wobble is not None:
             lines.append(f"Knuckle wobble: up to **{wobble:.2f} m** off the spinless path (dashed)")

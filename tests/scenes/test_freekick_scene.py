@@ -205,6 +205,28 @@ def test_a_jumping_wall_blocks_the_curler(scene: FreeKickScene) -> None:
     assert scene.state.outcome.result == "wall" and "Blocked by the wall" in scene.result.content
 
 
+def test_a_blocked_kick_is_played_on_off_the_defender_and_the_scene_says_so(scene: FreeKickScene) -> None:
+    # 14° is too flat for the wall: the kernel's flight on a pitch strikes a defender's body, rebounds and bounces
+    # on; the pale line draws it from the contact on, and the readout says what happened in words.
+    scene.controls["elevation_deg"].value = 14.0
+    played = scene.state.played
+    assert played is not None and played.result == "wall"
+    hit = played.events[0]
+    assert hit.kind == "wall"
+    assert hit.position[0] == pytest.approx(-22.0 + 9.15, abs=0.5)  # at the wall, 9.15 m out
+    assert played.velocity[-1, 0] <= 0.0 or played.ended != "net"  # it does not go on into the goal
+    assert scene.after.visible
+    drawn = np.asarray(scene.after.points).reshape(-1, 3)
+    np.testing.assert_allclose(drawn[0], hit.position, atol=1e-5)  # the pale line starts at the contact
+    assert f"Hits a defender at {hit.position[2]:.1f} m" in scene.result.content
+    assert "bounces" in scene.result.content
+    # The opening curler goes straight into the net: nothing to play on, no pale line.
+    scene.controls["elevation_deg"].value = 17.0
+    assert scene.state.played is not None and [e.kind for e in scene.state.played.events] == ["net"]
+    assert not scene.after.visible
+    assert "Played on: **Ends in the net**" in scene.result.content
+
+
 def test_kick_flies_the_ball_spinning_along_its_path(scene: FreeKickScene) -> None:
     spot = np.array(scene.ball_frame.position)
     scene.kick_button.value = True
