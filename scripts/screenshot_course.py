@@ -51,12 +51,6 @@ def main(out: Path = ROOT / "docs" / "peloton_course.png", at_km: float = 5.5, s
         open_viser(page, server.get_port(), "/peloton/course_mode/route")
         close_notifications(page)
         time.sleep(settle_s)
-        close_buttons = page.locator(".mantine-Notification-closeButton")
-        for i in range(close_buttons.count()):
-            try:
-                close_buttons.nth(i).click(timeout=2000, force=True)
-            except PlaywrightError:
-                pass  # already gone
         # Fold the line's own folders so the course mode's readouts and chart are in view.
         for folder in ("Rider", "Course", "Drafting", "Results", "Speed at a power"):
             try:

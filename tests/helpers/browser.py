@@ -82,13 +82,38 @@ def drawn_width(page: Any) -> int:
     return int(page.evaluate("() => window.__viserMutable.canvas.width"))
 
 
-def close_notifications(page: Any) -> None:
-    """Hide the toasts, as a person would close them: the software-WebGL notice covers the top left corner.
+SOFTWARE_WEBGL = """
+() => {
+  const gl = document.createElement("canvas").getContext("webgl2") || document.createElement("canvas").getContext("webgl");
+  const info = gl && gl.getExtension("WEBGL_debug_renderer_info");
+  const renderer = (info ? gl.getParameter(info.UNMASKED_RENDERER_WEBGL) : "").toLowerCase();
+  return ["swiftshader", "llvmpipe", "softpipe", "software"].some(name => renderer.includes(name));
+}
+"""
+"""Whether viser's client will show its "Software WebGL rendering detected" notice (its own test, BrowserWarning)."""
 
-    (Clicking each close button waits on Mantine's exit animation, seconds per toast under software rendering.)
+TOAST = ".mantine-Notification-root"
+"""A notification (toast) of viser's client."""
+
+
+def close_notifications(page: Any, timeout_ms: int = 90_000) -> list[str]:
+    """Close viser's toasts as a person would, and return their titles.
+
+    Without a GPU, viser's client shows "Software WebGL rendering detected" over the top-left corner of the scene
+    (296 × 171 CSS px at 14 px from the corner) soon after the page opens, until it is closed. This waits for that
+    notice where the page renders in software, then clicks the close button of every toast and waits until each
+    has gone (Mantine's exit animation takes seconds while software WebGL keeps the page busy).
     """
-    page.add_style_tag(content=".mantine-Notifications-root { display: none !important; }")
+    if page.evaluate(SOFTWARE_WEBGL):
+        page.locator(TOAST, has_text="Software WebGL rendering detected").wait_for(timeout=timeout_ms)
+    toasts = page.locator(TOAST)
+    titles = [toasts.nth(i).inner_text().split("\n")[0] for i in range(toasts.count())]
+    close = page.locator(f"{TOAST} .mantine-Notification-closeButton")
+    for i in reversed(range(close.count())):
+        close.nth(i).click(no_wait_after=True, timeout=timeout_ms)
+    page.wait_for_function(f"() => !document.querySelector({TOAST!r})", timeout=timeout_ms)
     wait_frames(page, 2)
+    return titles
 
 
 def wait_frames(page: Any, frames: int = 3) -> None:
