@@ -405,25 +405,51 @@ def simulate_batch(
 
 
 def _play_batch(
-    launches: NDArray[np.float64], settings: NDArray[np.float64], pitch: Pitch, keep: bool
+    launches: NDArray[np.float64],
+    settings: NDArray[np.float64],
+    pitches: NDArray[np.float64],
+    which: NDArray[np.int64],
+    keep: bool,
 ) -> tuple[Any, ...]:
-    """Every kick on the pitch, in parallel: (t, state, spin, events, info, n_samples, endings); flights kept only
-    when ``keep`` (else zero-length rows)."""
+    """Every kick on its pitch (``pitches[which[k]]``, read-only (P, N_PITCH) rows), in parallel: (t, state, spin,
+    events, info, n_samples, endings); flights kept only when ``keep`` (else zero-length rows, and each flight ends
+    once its verdict cannot change)."""
     k = len(launches)
-    spot = launches[0, :2] if k else np.zeros(2)
-    vector = _pitch_vector(pitch, spot, float(settings[GROUND]), float(settings[RADIUS]))
     rows = int(settings[N_STEPS]) + 1 + play.EXTRA_ROWS if keep else 0
     t, state, spin = np.empty((k, rows)), np.empty((k, rows, 6)), np.empty((k, rows, 3))
     events, info = np.empty((k, play.MAX_EVENTS, 5)), np.empty((k, play.N_INFO))
     n_samples, endings = np.ones(k, dtype=np.int64), np.full(k, 2, dtype=np.int64)
     with _PARALLEL:
-        play_batch(launches, settings, vector, t, state, spin, events, info, n_samples, endings)
+        play_batch(launches, settings, pitches, which, t, state, spin, events, info, n_samples, endings)
     _refuse_overflow(endings, settings, launches)
     return t, state, spin, events, info, n_samples, endings
 
 
+def _one_pitch(
+    launches: NDArray[np.float64], settings: NDArray[np.float64], pitch: Pitch
+) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+    """(1, N_PITCH) read-only rows of ``pitch`` (a keeper placed for the first kick's spot) and every kick's index."""
+    spot = launches[0, :2] if len(launches) else np.zeros(2)
+    vector = _pitch_vector(pitch, spot, float(settings[GROUND]), float(settings[RADIUS]))
+    return vector[None], np.zeros(len(launches), dtype=np.int64)
+
+
+def pitch_outcomes(
+    launches: NDArray[np.float64], settings: NDArray[np.float64], pitches: NDArray[np.float64], which: NDArray[np.int64]
+) -> NDArray[np.int64]:
+    """Result codes (:data:`RESULTS` order) of K checked launch rows (``kick_rows``) each on its own pitch row
+    (``pitch_vector`` rows stacked, ``which[k]`` the row of kick k), in one parallel call: what a map over many spots
+    wants. Trusts its arguments (the callers in this package check them)."""
+    stacked = np.array(pitches, dtype=np.float64, order="C")
+    stacked.setflags(write=False)
+    *_, info, _, _ = _play_batch(launches, settings, stacked, np.asarray(which, dtype=np.int64), keep=False)
+    return info[:, play.I_RESULT].astype(np.int64)
+
+
 def _batch_on_pitch(launches: NDArray[np.float64], settings: NDArray[np.float64], pitch: Pitch) -> BatchTrajectory:
-    t, state, _, events, info, n_samples, endings = _play_batch(launches, settings, pitch, keep=True)
+    t, state, _, events, info, n_samples, endings = _play_batch(
+        launches, settings, *_one_pitch(launches, settings, pitch), keep=True
+    )
     width = int(n_samples.max()) if len(n_samples) else 1
     t, state = t[:, :width], state[:, :width]
     for k, n in enumerate(n_samples):  # pad each flight with its last sample
@@ -556,7 +582,7 @@ def simulate_outcomes(
             raise ValueError(f"pitch must be a Pitch, got {type(pitch).__name__}")
         if (wall is not None and wall != pitch.wall) or (goal is not None and goal != pitch.goal):
             raise ValueError("with a pitch, wall and goal are the pitch's own: pass None (or the same panels)")
-        *_, info, _, _ = _play_batch(launches, settings, pitch, keep=False)
+        *_, info, _, _ = _play_batch(launches, settings, *_one_pitch(launches, settings, pitch), keep=False)
         return BatchOutcome(
             result=np.array(RESULTS, dtype="<U5")[info[:, play.I_RESULT].astype(np.int64)],
             wall_point=info[:, play.I_WALL + 1 : play.I_WALL + 4].copy(),
@@ -633,5 +659,12 @@ def warm_up() -> None:
     bounce(velocity, spin)
     pitch = Pitch(goal, wall, Keeper())
     simulate(start, velocity, spin, dt=0.05, method="rk4", model="measured", knuckle_seed=0, pitch=pitch)
+    many = np.stack([pitch_vector(pitch, (0.0, 0.0), 0.0, BALL_RADIUS_M)] * 2)
+    pitch_outcomes(
+        kick_rows(rows, [velocity, velocity], [spin, spin], None),
+        flight_config(None, {}).settings,
+        many,
+        np.array([0, 1]),
+    )
     simulate_batch(rows, [velocity, velocity], [spin, spin], dt=0.05, t_max=0.2, pitch=pitch)
     simulate_outcomes(rows, [velocity, velocity], [spin, spin], dt=0.05, pitch=pitch)

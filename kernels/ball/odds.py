@@ -10,6 +10,7 @@ numpy's ``default_rng(draw)``: the same draw number, the same strikes. No compil
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import math
 from collections.abc import Callable
 from typing import Any
@@ -18,10 +19,11 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from kernels import _checks
-from kernels.ball.api import simulate_outcomes
-from kernels.ball.config import BALL_RADIUS_M, checked_seed, checked_vector
+from kernels.ball import play
+from kernels.ball.api import pitch_outcomes, simulate_outcomes
+from kernels.ball.config import GROUND, RADIUS, check_launches, checked_seed, checked_vector, flight_config
 from kernels.ball.core import RESULTS
-from kernels.ball.pitch import Keeper, Pitch, Surface, free_kick_panels
+from kernels.ball.pitch import Keeper, Pitch, Surface, free_kick_panels, pitch_vector
 
 
 @dataclasses.dataclass(frozen=True)
@@ -164,45 +166,52 @@ def odds_map(
     n: int = 64,
     draw: int = 0,
     progress: Callable[[float], object] | None = None,
+    chunks: int = 8,
     **options: Any,
 ) -> dict[str, NDArray[np.float64]]:
     """Each result's probability at every spot of a grid around a goal at the origin (the goal line x = 0, the
     pitch toward −x): for D distances and A angles (+ to the left, seen from the goal), (D, A) arrays per result.
 
     The strike at each spot is the same kick turned to that spot: ``aim_rad`` is its azimuth from the line to the
-    goal's centre (+ left), spin in the ball's frame (x toward the goal's centre). The wall (if any) stands 9.15 m
-    out, square to that line; the keeper is placed by the angle. ``progress`` is called with the share done.
+    goal's centre (+ left), spin in the ball's frame (x toward the goal's centre); every spot gets the same n
+    strikes' scatter (one draw). The wall (if any) stands 9.15 m out, square to that line; the keeper is placed by
+    the angle. All spots' strikes fly in ``chunks`` parallel calls (each spot on its own pitch); ``progress`` is
+    called with the share done after each.
     """
     distances = _checks.finite_array("distances_m", distances_m).reshape(-1)
     angles = _checks.finite_array("angles_rad", angles_rad).reshape(-1)
     spin = checked_vector("spin_rads", spin_rads, 3)
-    ground = options.get("ground_m", BALL_RADIUS_M)
-    options = {**options, "ground_m": ground}
-    maps = {name: np.zeros((len(distances), len(angles))) for name in RESULTS}
-    total, done = len(distances) * len(angles), 0
-    for i, distance in enumerate(distances):
-        for j, angle in enumerate(angles):
-            spot = np.array([-distance * math.cos(angle), distance * math.sin(angle)])
-            heading = math.atan2(-spot[1], -spot[0])  # toward the goal's centre
-            c, s = math.cos(heading), math.sin(heading)
-            turned = np.array([c * spin[0] - s * spin[1], s * spin[0] + c * spin[1], spin[2]])
-            wall_panel, goal = free_kick_panels(spot, (0.0, 0.0), (1.0, 0.0), wall_height_m=wall_height_m)
-            pitch = Pitch(goal, wall_panel if wall else None, keeper, surface=surface or Pitch(goal).surface)
-            odds = strike_odds(
-                (spot[0], spot[1], ground),
-                speed_ms,
-                elevation_rad,
-                heading + aim_rad,
-                turned,
-                pitch,
-                spread=spread,
-                n=n,
-                draw=draw,
-                **options,
-            )
-            for name in RESULTS:
-                maps[name][i, j] = odds.probability(name)
-            done += 1
-            if progress is not None:
-                progress(done / total)
-    return maps
+    if isinstance(chunks, bool) or not isinstance(chunks, (int, np.integer)) or chunks < 1:
+        raise ValueError(f"chunks must be an integer >= 1, got {chunks!r}")
+    settings = flight_config(None, options).settings
+    ground, radius = float(settings[GROUND]), float(settings[RADIUS])
+    # One scatter, drawn along +x, turned to each spot.
+    velocities, spins = draw_strikes(speed_ms, elevation_rad, aim_rad, spin, spread or StrikeSpread(), n, draw)
+    spots = np.array(
+        [[-d * math.cos(a), d * math.sin(a)] for d in distances for a in angles], dtype=np.float64
+    ).reshape(-1, 2)
+    vectors = np.empty((len(spots), play.N_PITCH))
+    launches = np.zeros((len(spots) * len(velocities), 13))
+    for s, spot in enumerate(spots):
+        heading = math.atan2(-spot[1], -spot[0])  # toward the goal's centre
+        c, si = math.cos(heading), math.sin(heading)
+        turn = np.array([[c, -si, 0.0], [si, c, 0.0], [0.0, 0.0, 1.0]])
+        wall_panel, goal = free_kick_panels(spot, (0.0, 0.0), (1.0, 0.0), wall_height_m=wall_height_m)
+        pitch = Pitch(goal, wall_panel if wall else None, keeper, surface=surface or Pitch(goal).surface)
+        vectors[s] = pitch_vector(pitch, spot, ground, radius)
+        rows = launches[s * len(velocities) : (s + 1) * len(velocities)]
+        rows[:, 0:2], rows[:, 2] = spot, ground
+        rows[:, 3:6], rows[:, 6:9] = velocities @ turn.T, spins @ turn.T
+    check_launches(launches, settings, batch=True)
+    which = np.repeat(np.arange(len(spots)), len(velocities))
+    codes = np.empty(len(launches), dtype=np.int64)
+    bounds = np.linspace(0, len(spots), min(chunks, max(len(spots), 1)) + 1).astype(int)
+    for lo, hi in itertools.pairwise(bounds.tolist()):
+        a, b = lo * len(velocities), hi * len(velocities)
+        codes[a:b] = pitch_outcomes(launches[a:b], settings, vectors[lo:hi], which[a:b] - lo)
+        if progress is not None:
+            progress(hi / len(spots))
+    per_spot = codes.reshape(len(spots), len(velocities))
+    return {
+        name: (per_spot == code).mean(axis=1).reshape(len(distances), len(angles)) for code, name in enumerate(RESULTS)
+    }

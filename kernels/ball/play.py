@@ -299,6 +299,7 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
     half_goal, rp, turf = 0.5 * pitch[GW], pitch[POST_R], pitch[TURF]
     n_events, first_frame, touched_wall, touched_keeper, scored, inside = 0, -1, False, False, False, False
     rolling = False
+    crossed = 2.0  # fraction of this step at which the whole ball is over the goal line (2: not in this step)
     t, n, ending = 0.0, 1, ENDED_T_MAX
     max_rows = len(t_out)
     for _ in range(int(config[N_STEPS]) + EXTRA_ROWS):
@@ -388,7 +389,7 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
             # Wholly over the line (Law 10: a goal), then the net: back, sides and roof stop it.
             line = rp + radius
             if not scored and depth1 >= line:
-                scored = True
+                crossed = 0.0 if depth0 >= line else crossing_fraction(line - depth0, -rate0, line - depth1, -rate1, h)
             limit = pitch[NET_DEPTH] - radius
             if depth1 >= limit:
                 f = crossing_fraction(limit - depth0, -rate0, limit - depth1, -rate1, h)
@@ -427,6 +428,9 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
                     cz, _ = _hermite(z, vz, z1, vz1, h, f)
                     info[I_WALL], info[I_WALL + 1], info[I_WALL + 2], info[I_WALL + 3] = t + f * h, cx, cy, cz
                     seen_t = t + f * h
+        if crossed <= min(best, 1.0):  # wholly over the line before any contact in this step
+            scored = True
+        crossed = 2.0
         lat_end = -(x1 - gx) * gny + (y1 - gy) * gnx
         if kind == -1 and abs(lat_end) > pitch[HALF_WIDTH]:
             best, kind = 1.0, -3  # over a touchline
@@ -442,6 +446,8 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
             if stop_here:
                 ending = STOPPED
                 break
+            if not store and (scored or (rolling and not inside and vx * gnx + vy * gny <= 0.0)):
+                break  # a verdict only: a goal stays a goal, and a straight roll away from the goal never comes back
             continue
         # Move to the contact.
         f = best
@@ -525,6 +531,8 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
         if rolling and vx == 0.0 and vy == 0.0:
             ending = STOPPED
             break
+        if not store and (scored or (rolling and not inside and vx * gnx + vy * gny <= 0.0)):
+            break
     # Whole ball over the line between the posts and under the bar, at any time (off the post, the bar, the wall
     # or the keeper too), is a goal; then the keeper, the wall, the frame, and where it crossed the line.
     if scored:
@@ -573,13 +581,14 @@ def play_one(launch, config, pitch, t_out, state_out, spin_out, forces_out, even
 
 
 @compiled(parallel=True)
-def play_batch(launches, config, pitch, t_out, state_out, spin_out, events, info, n_samples, endings):
-    """:func:`play` for each kick, in parallel: kick k's samples into row k of ``t_out`` (K, T), ``state_out``
-    (K, T, 6), ``spin_out`` (K, T, 3) (T = 0: verdicts only), its contacts into ``events`` (K, MAX_EVENTS, 5) and its
+def play_batch(launches, config, pitches, which, t_out, state_out, spin_out, events, info, n_samples, endings):
+    """:func:`play` for each kick, in parallel, kick k on pitch ``pitches[which[k]]`` ((P, N_PITCH) and (K,)): its
+    samples into row k of ``t_out`` (K, T), ``state_out`` (K, T, 6), ``spin_out`` (K, T, 3) (T = 0: verdicts only,
+    and each flight ends once its verdict cannot change), its contacts into ``events`` (K, MAX_EVENTS, 5) and its
     summary into ``info`` (K, N_INFO)."""
     for k in prange(len(launches)):
         kick = np.empty(N_KICK)
         fill_kick(launches[k], config, kick)
         n_samples[k], endings[k] = play(
-            launches[k], kick, config, pitch, t_out[k], state_out[k], spin_out[k], events[k], info[k]
+            launches[k], kick, config, pitches[which[k]], t_out[k], state_out[k], spin_out[k], events[k], info[k]
         )

@@ -73,6 +73,13 @@ def test_the_odds_map_reports_progress_and_its_shares_sum_to_one() -> None:
     total = sum(maps.values())
     np.testing.assert_allclose(total, 1.0)
     assert maps["goal"].shape == (2, 3)
+    # The map's spot straight in front (angle 0) strikes the same n kicks as strike_odds from there: same shares.
+    wall, goal = ball.free_kick_panels((-25.0, 0.0), (0.0, 0.0), (1.0, 0.0))
+    alone = odds.strike_odds(
+        (-25.0, 0.0, R), 26.0, math.radians(17.0), 0.0, SPIN, ball.Pitch(goal, wall, ball.Keeper()), n=16, **OPTIONS
+    )
+    for name in alone.counts:
+        assert maps[name][1, 1] == pytest.approx(alone.probability(name)), name
 
 
 @pytest.mark.parametrize(
