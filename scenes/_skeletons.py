@@ -39,7 +39,12 @@ sends beyond it is refused."""
 LINK_RADIUS_M = 0.016
 JOINT_RADIUS_M = 0.026
 GIZMO_SCALE_M = 0.12
-"""Length of a target gizmo's arrows (m); the camera frames their tips."""
+"""Longest arrows a target gizmo has (m); a skeleton's are shorter where its targets lie close together
+(:func:`gizmo_scale`). The camera frames their tips."""
+END_RADIUS_M = 0.75 * JOINT_RADIUS_M
+"""Radius of the ball at each chain's free end (m)."""
+MARKER_RADIUS_M = 0.6 * JOINT_RADIUS_M
+"""Radius of the coloured ball at each target (m): smaller than an end's, so an effector on its target shows."""
 AXIS_HALF_LENGTH_M = 0.05
 CHAIN_COLOURS = np.array(
     [
@@ -254,6 +259,17 @@ def upper_body() -> Skeleton:
     )
 
 
+def gizmo_scale(skeleton: Skeleton) -> float:
+    """Arrow length of the skeleton's target gizmos (m): 40 % of the least distance between two of its opening
+    targets, at most :data:`GIZMO_SCALE_M`, so neighbouring gizmos (a hand's fingertips) do not overlap."""
+    targets = skeleton.targets
+    if len(targets) < 2:
+        return GIZMO_SCALE_M
+    gaps = np.linalg.norm(targets[:, None, :] - targets[None, :, :], axis=-1)
+    least = float(np.min(gaps[np.triu_indices(len(targets), 1)]))
+    return float(min(GIZMO_SCALE_M, 0.4 * least))
+
+
 PRESETS: dict[PresetLabel, Callable[[], Skeleton]] = {
     "Robot arm": robot_arm,
     "Hand": hand,
@@ -399,6 +415,8 @@ class SkeletonView:
         self.pose = np.zeros((0, 3))
         self.targets = np.zeros((0, 3))
         self.report: SkeletonReport | None = None
+        self.gizmo_scale = GIZMO_SCALE_M
+        """Arrow length of the shown skeleton's target gizmos (m; :func:`gizmo_scale`)."""
         self.solves = 0
         """Skeleton solves so far (tests wait on it)."""
         self.gizmo_events = 0
@@ -440,10 +458,13 @@ class SkeletonView:
                 f"{root}/skeleton/target_{k}",
                 scale=GIZMO_SCALE_M,
                 disable_rotations=True,
+                disable_sliders=True,  # arrows only: five gizmos' plane handles hid the fingers they move
                 translation_limits=(box, box, box),
                 visible=False,
             )
-            server.scene.add_icosphere(f"{root}/skeleton/target_{k}/marker", radius=0.025, color=TARGET_COLOURS[k])
+            server.scene.add_icosphere(
+                f"{root}/skeleton/target_{k}/marker", radius=MARKER_RADIUS_M, color=TARGET_COLOURS[k]
+            )
             # One wrapper per gizmo, made once, so a burst of drag messages coalesces (Scene.callback).
             gizmo.on_update(self.scene.callback(functools.partial(self._apply_target, k)))
             self.gizmos.append(gizmo)
@@ -475,6 +496,7 @@ class SkeletonView:
         sk = self.skeleton
         self.pose = sk.joints.copy()
         self.targets = sk.targets.copy()
+        self.gizmo_scale = gizmo_scale(sk)
         axes = (True, False, True) if sk.planar else (True, True, True)
         with self.scene.server.atomic():
             for k, gizmo in enumerate(self.gizmos):
@@ -482,13 +504,14 @@ class SkeletonView:
                 gizmo.visible = shown
                 if shown:
                     gizmo.active_axes = axes
+                    gizmo.scale = self.gizmo_scale
                     gizmo.position = self.targets[k]
         self.solve_and_draw()
         self.scene.framing.reframe()
 
     def _show_chain(self, visible: bool) -> None:
         s = self.scene
-        for node in (s.link_nodes, s.joint_nodes, s.ghost_links, s.ghost_elbow, s.target_gizmo):
+        for node in (s.link_nodes, s.joint_nodes, s.ghost_links, s.ghost_elbow, s.target_gizmo, s.base_node):
             node.visible = visible
         for k in range(len(s.obstacle_gizmos)):
             shown = visible and k < s.params.n_obstacles
@@ -563,6 +586,11 @@ class SkeletonView:
             limited[up] = limited[up] and free[j]
         joint_colour = np.tile(np.array(FREE_COLOUR, np.uint8), (MAX_JOINTS, 1))
         joint_colour[:count] = usage_colours(nearness, limited)
+        # An end (fingertip, hand, head) has no limit to show: a smaller ball in its chain's colour, so it reads as
+        # the tip of that chain rather than as a white blob over it.
+        ends = [j for j in range(count) if j not in sk.parents and sk.parents[j] >= 0]
+        joint_scale[ends] = END_RADIUS_M
+        joint_colour[ends] = CHAIN_COLOURS[[sk.chain_of[j] for j in ends]]
         bars = hinge_axes(sk, joints)
         with self.scene.server.atomic():
             self.link_nodes.batched_wxyzs = link_wxyz.astype(np.float32)

@@ -31,7 +31,7 @@ from scenes._charts import FittedChart
 from scenes._controls import build_controls, checkbox, dropdown, slider
 from scenes._framing import ClientFraming, Lens, View, frame_points
 from scenes._instances import add_instances
-from scenes._skeletons import GIZMO_SCALE_M as SKELETON_GIZMO_M
+from scenes._skeletons import JOINT_RADIUS_M as SKELETON_JOINT_M
 from scenes._skeletons import (
     PRESET_LABELS,
     WORLD_LIMIT_M,
@@ -60,8 +60,9 @@ OBSTACLE_COLOUR = (235, 120, 60)
 TARGET_COLOUR = (230, 40, 60)
 PLANE_VIEW = (0.0, 1.0, -0.12)
 """Planar mode looks at the x–z plane from −y, a little from above."""
-SPACE_VIEW = (-0.55, 1.0, -0.6)
-"""3D mode looks from the front left and above, so depth reads at once without orbiting."""
+SPACE_VIEW = (0.55, 1.0, -0.6)
+"""3D mode looks from the front left (−x, −y) and above, so depth reads at once without orbiting; the chain bends
+away from the camera (toward +x), so the obstacles and the target lie beyond the base, not in front of it."""
 LIMIT_RAMP = np.array([(60, 200, 90), (250, 200, 40), (230, 50, 50)], dtype=np.float64)
 """Joint colour at 0 %, 50 % and 100 % of its limit."""
 
@@ -302,7 +303,9 @@ def solve_arm(
             if other.status != "infeasible" and other.error < result.error - tolerance:
                 result, start, start_name = other, pose, f"arc {k + 1} of {ARC_STARTS}"
     micros = (time.perf_counter() - began) * 1e6
-    best = admissible_history(params, start, target, obstacle_centres, result) if history else (np.zeros(1), np.zeros(1))
+    best = (
+        admissible_history(params, start, target, obstacle_centres, result) if history else (np.zeros(1), np.zeros(1))
+    )
 
     kernel_start = to_kernel(joints, three_d)
     lengths = fabrik.link_lengths(kernel_start)
@@ -393,8 +396,22 @@ GIZMO_SCALE_M = 0.3
 """Length of the target's and obstacles' gizmo arrows (m): the person must see them to grab them."""
 BASE_HALF_M = 0.08
 """Half the width of the base plate the chain stands on (m)."""
+FRAME_ROOM = 0.04
+"""Share of the free view's width and height kept empty on each side of what is framed: room for the arrowheads,
+the joints' and links' thickness and the shading at the edges."""
+PLANE_DEPTH, SPACE_DEPTH = 0.5, 0.5
+"""The nearest framed point stays at least this many times the framed box's largest side in front of the camera
+(in the plane, in 3D): closer, the wide lens makes what is near (an obstacle, a target gizmo, a fingertip) look
+several times larger than what is far (the base)."""
 FRAME_SLACK = 0.15
 """A framed view is kept until what it must show leaves the framed box grown by this fraction of its size."""
+
+
+def box_points() -> NDArray[np.float64]:
+    """(8, 3) corners of the base plate the chain stands on (m)."""
+    return np.array(
+        [[x, y, z] for x in (-BASE_HALF_M, BASE_HALF_M) for y in (-BASE_HALF_M, BASE_HALF_M) for z in (-0.06, 0.0)]
+    )
 
 
 def framed_points(
@@ -415,14 +432,22 @@ def framed_points(
         obstacle_centres: (MAX_OBSTACLES, 3) obstacle centres (m); the first ``params.n_obstacles`` are shown.
     """
     axes = np.eye(3) if params.three_d else np.eye(3)[[0, 2]]
-    depth = BASE_HALF_M  # the plate is a box in the plane too: its near face must fit
-    base = np.array([[x, y, z] for x in (-BASE_HALF_M, BASE_HALF_M) for y in (-depth, depth) for z in (-0.06, 0.0)])
+    base = box_points()  # the plate is a box in the plane too: its near face must fit
     shown = obstacle_centres[: params.n_obstacles]
     radii = np.asarray(params.radii_m[: params.n_obstacles], dtype=np.float64)
     rims = (shown[:, None, :] + radii[:, None, None] * np.vstack([axes, -axes])[None]).reshape(-1, 3)
+    if params.three_d:  # a sphere seen from the side and above: its bounding cube
+        rims = np.vstack([rims, *(padded(shown[k : k + 1], float(radii[k])) for k in range(len(shown)))])
     handles = np.vstack([target[None, :], shown])
     tips = (handles[:, None, :] + GIZMO_SCALE_M * axes[None]).reshape(-1, 3)
-    return np.vstack([pose, base, target[None, :], rims, tips])
+    return np.vstack([pose, padded(pose, JOINT_RADIUS_M), base, target[None, :], rims, tips])
+
+
+def padded(points: NDArray[np.float64], radius: float) -> NDArray[np.float64]:
+    """(8·N, 3) the corners of the cube of half-side ``radius`` (m) around each of ``points`` (N, 3): what a sphere
+    of that radius about each point needs framed, from any side."""
+    corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=np.float64)
+    return (points[:, None, :] + radius * corners[None]).reshape(-1, 3)
 
 
 def _unit_cylinder() -> trimesh.Trimesh:
@@ -546,7 +571,7 @@ is a static pose.
         scene, root = self.server.scene, self.root.name
         base = trimesh.creation.box(extents=(0.16, 0.16, 0.06))
         base.apply_translation((0.0, 0.0, -0.03))
-        scene.add_mesh_simple(f"{root}/base", base.vertices, base.faces, color=(90, 95, 105))
+        self.base_node = scene.add_mesh_simple(f"{root}/base", base.vertices, base.faces, color=(90, 95, 105))
 
         def grid(name: str, plane: Literal["xz", "xy"], opacity: float, visible: bool) -> viser.GridHandle:
             """A 4 m square grid of 0.25 m cells, in 1 m sections."""
@@ -726,12 +751,19 @@ is a static pose.
         points = self._points_to_frame()
         lo, hi = points.min(axis=0), points.max(axis=0)
         self._framed_box = (lo, hi)
+        sk = self.skeletons.skeleton
+        planar = not p.three_d if sk is None else True  # a skeleton is seen from the front, as it opens
+        deep = p.three_d if sk is None else not sk.planar  # whether what is framed reaches toward the camera
+        extent = float(np.max(hi - lo))
+        x0, x1, y0, y1 = lens.usable_ndc()
+        room_x, room_y = FRAME_ROOM * (x1 - x0), FRAME_ROOM * (y1 - y0)
         return frame_points(
             points,
-            SPACE_VIEW if p.three_d else PLANE_VIEW,
+            PLANE_VIEW if planar else SPACE_VIEW,
             fov_rad=lens.fov_rad,
             aspect=lens.aspect,
-            ndc=lens.usable_ndc(),
+            ndc=(x0 + room_x, x1 - room_x, y0 + room_y, y1 - room_y),
+            min_depth=(SPACE_DEPTH if deep else PLANE_DEPTH) * extent,
         )
 
     def _points_to_frame(self) -> NDArray[np.float64]:
@@ -739,9 +771,11 @@ is a static pose.
         preset is shown instead, its joints, its targets and their gizmo arrows."""
         view = self.skeletons
         if not view.active:
-            return framed_points(self.params, self.pose, self.target, self.obstacle_centres)
-        arrows = (view.targets[:, None, :] + SKELETON_GIZMO_M * np.eye(3)[None, :, :]).reshape(-1, 3)
-        return np.vstack([view.pose, view.targets, arrows])
+            points = framed_points(self.params, self.pose, self.target, self.obstacle_centres)
+            ghost = self.report.ghost if self.report is not None else np.zeros((0, 3))
+            return np.vstack([points, padded(ghost, JOINT_RADIUS_M)])
+        arrows = (view.targets[:, None, :] + view.gizmo_scale * np.eye(3)[None, :, :]).reshape(-1, 3)
+        return np.vstack([padded(view.pose, SKELETON_JOINT_M), padded(view.targets, SKELETON_JOINT_M), arrows])
 
     def _reframe_if_outgrown(self) -> None:
         """Frame again when the chain, target or obstacles left the framed box (grown by :data:`FRAME_SLACK`)."""

@@ -194,6 +194,9 @@ class SdfGalleryParams:
         metadata=dropdown_from_labels("Shape", SOURCE_LABELS, folder="Shape and view"),
     )
     """Show the primitives' scene or the editor's field."""
+    rings: bool = field(default=False, metadata=checkbox("Rotation rings on the gizmos", folder="Shape and view"))
+    """Whether the gizmos show their rotation rings (turn a primitive); off, only the arrows (move it) clutter the
+    shape."""
     example: str = field(
         default=next(iter(EXAMPLES)),
         metadata=dropdown("Example", tuple(EXAMPLES), folder="GLSL editor"),

@@ -33,6 +33,7 @@ from kernels import sdf
 from scenes import _controls
 from scenes._base import TURNS, Scene, mark_costly
 from scenes._controls import build_controls
+from scenes._framing import ClientFraming, Lens, View, box_corners, frame_points
 from scenes._worker import LatestWorker
 from scenes.sdf_gallery import editor
 from scenes.sdf_gallery.compare import Agreement, compare, readout_markdown
@@ -49,6 +50,7 @@ from scenes.sdf_gallery.params import (
     BOX_HI,
     BOX_LO,
     CAMERA_REST_S,
+    GIZMO_MARKER_RADIUS_M,
     MOVING_WIDTH_PX,
     PREVIEW_RESOLUTION,
     REFERENCE_FOLDER,
@@ -60,6 +62,7 @@ from scenes.sdf_gallery.params import (
     Shape,
     Viewer,
     camera_from_viser,
+    gizmo_reach,
     moving_shading,
     rest_size,
     viewer_size,
@@ -89,6 +92,16 @@ VIEW_NOTES = {
     "surface.",
 }
 """What the note under the View dropdown says for each view."""
+
+
+EDITOR_LINES = 18
+"""Lines of GLSL the editor shows at once."""
+EDITOR_STYLE = (
+    f"<style>.mantine-Textarea-input {{ min-height: calc({EDITOR_LINES} * 1.55em) !important;"
+    " font-family: ui-monospace, monospace; white-space: pre; }</style>"
+)
+"""Drawn inside the GLSL editor's folder (and only while the gallery is shown): the editor as a code box of
+EDITOR_LINES lines (viser's own text box grows from 2 to at most 6)."""
 
 
 class SdfGalleryScene(Scene[SdfGalleryParams]):
@@ -181,7 +194,38 @@ IoU is lowest when a box edge is on the silhouette.
         """Runs :meth:`step`: the meshing and ray-marching, off the callback threads."""
         self._threads.append(self.worker.thread)
         self.watch_cameras(self.on_camera)
+        self.framing = ClientFraming(self._view_for, opening=self.camera_position)
+        """Frames each tab's camera on the shape and its gizmos when it opens (and when its window is resized)."""
+        self.watch_cameras(self.framing.on_camera)
         self._wake()
+
+    def _view_for(self, lens: Lens) -> View:
+        """The opening view's direction, as close as the shape, its gizmos' arrows, rings and labels allow, in the
+        canvas left of the panel (:func:`scenes._framing.frame_points`)."""
+        return frame_points(
+            self.framed_points(),
+            (
+                self.camera_look_at[0] - self.camera_position[0],
+                self.camera_look_at[1] - self.camera_position[1],
+                self.camera_look_at[2] - self.camera_position[2],
+            ),
+            fov_rad=lens.fov_rad,
+            aspect=lens.aspect,
+            ndc=lens.usable_ndc(),
+        )
+
+    def framed_points(self) -> np.ndarray:
+        """(N, 3) world points (m) the camera frames: the shown mesh's bounding box and, with the primitives shown,
+        each enabled gizmo's reach (arrows and rings) and its label above it."""
+        vertices = self.mesh_vertices if len(self.mesh_vertices) else self._opening_vertices
+        points = [box_corners(vertices.min(axis=0), vertices.max(axis=0))] if len(vertices) else []
+        if self.params.shape_source == "primitives":
+            for slot in self.params.primitives:
+                if slot.enabled:
+                    reach = gizmo_reach(slot) + 2.5 * GIZMO_MARKER_RADIUS_M  # the label sits beyond the arrow
+                    centre = np.asarray(slot.position, dtype=np.float64)
+                    points.append(centre + reach * np.vstack([np.eye(3), -np.eye(3)]))
+        return np.vstack(points) if points else np.zeros((1, 3))
 
     def close(self) -> None:
         """Stop the worker and wait for it (a reference render in flight finishes first), then remove everything."""
@@ -201,7 +245,7 @@ IoU is lowest when a box edge is on the silhouette.
         p = self.params
         allowed = editor.editing_allowed()
         with self.gui_root:
-            self.view_controls = build_controls(gui, p, ("view_mode", "shape_source"))
+            self.view_controls = build_controls(gui, p, ("view_mode", "shape_source", "rings"))
             with self.view_controls.folders["Shape and view"]:
                 self.view_note = gui.add_markdown("")
             self.example_controls = build_controls(gui, p, ("example",), collapsed=("GLSL editor",))
@@ -210,6 +254,9 @@ IoU is lowest when a box edge is on the silhouette.
             self.editor.disabled = not allowed
             self.half_size_controls = build_controls(gui, p, ("editor_half_size",), folders_open=folders)
             with folders["GLSL editor"]:
+                # viser draws a multi-line text box 2–6 lines tall; a GLSL function wants a screenful (sdf.md).
+                api: Any = getattr(gui, "api", gui)  # the session's facade records inputs only; html is not one
+                api.add_html(EDITOR_STYLE)
                 self.apply = mark_costly(gui.add_button("Apply"))  # compiles GLSL, remeshes
                 self.editor_status = gui.add_markdown(EDITOR_HELP if allowed else EDITING_OFF)
             self.scene_controls = build_controls(gui, p, SCENE_FIELDS)
@@ -247,6 +294,7 @@ IoU is lowest when a box edge is on the silhouette.
     def _build_world(self) -> None:
         scene = self.server.scene
         vertices, faces, colors = sdf.mesh(self.params.scene(), self.params.resolution)
+        self._opening_vertices = vertices
         self.mesh_node = scene.add_mesh_trimesh(f"{self.root.name}/mesh", sdf.mesh_trimesh(vertices, faces, colors))
         self.mesh_node.glb_data = viewer_glb(vertices, faces, colors, scene_normals(self.params.scene(), vertices))
         self.wireframe_node = scene.add_mesh_simple(
@@ -263,7 +311,9 @@ IoU is lowest when a box edge is on the silhouette.
         self.gizmo_markers: list[viser.IcosphereHandle] = []
         self.gizmo_labels: list[viser.LabelHandle] = []
         for i, slot in enumerate(self.params.primitives):
-            gizmo, marker, label = add_slot_gizmo(scene, f"{self.root.name}/gizmo_{i + 1}", i, slot)
+            gizmo, marker, label = add_slot_gizmo(
+                scene, f"{self.root.name}/gizmo_{i + 1}", i, slot, rings=self.params.rings
+            )
             gizmo.on_update(self._on_scene)
             self.gizmos.append(gizmo)
             self.gizmo_markers.append(marker)
@@ -301,6 +351,10 @@ IoU is lowest when a box edge is on the silhouette.
         before = self.params
         self.params = self.read_controls(self.view_controls)
         self._show_view_mode()
+        if self.params.rings != before.rings:
+            with self.server.atomic():
+                for gizmo in self.gizmos:
+                    gizmo.disable_rotations = not self.params.rings
         if self.params.shape_source != before.shape_source:
             self._sync_enabled_inputs()
             self._request_mesh()
@@ -429,6 +483,8 @@ IoU is lowest when a box edge is on the silhouette.
     def _sync_enabled_inputs(self) -> None:
         """Show gizmos of enabled primitives, sized and named for them; grey out sizes the kind does not use."""
         self.scene_controls["k"].disabled = self.params.blend == "hard"
+        for name in ("blend", "k"):  # they act on the primitives only: hidden while a GLSL field is shown
+            self.scene_controls[name].visible = self.params.shape_source == "primitives"
         for controls, gizmo, slot in zip(self.slot_controls, self.gizmos, self.params.primitives, strict=True):
             gizmo.visible = slot.enabled and self.params.shape_source == "primitives"
             for j, handle in enumerate(controls.each("size")):

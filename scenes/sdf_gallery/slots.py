@@ -52,16 +52,18 @@ def build_slot_controls(gui: Any, index: int, slot: PrimitiveParams) -> Controls
 
 
 def add_slot_gizmo(
-    scene: Any, name: str, index: int, slot: PrimitiveParams
+    scene: Any, name: str, index: int, slot: PrimitiveParams, *, rings: bool = False
 ) -> tuple[viser.TransformControlsHandle, viser.IcosphereHandle, viser.LabelHandle]:
-    """Add the gizmo of slot ``index`` (from 0) at node ``name``, with its marker ball and label."""
+    """Add the gizmo of slot ``index`` (from 0) at node ``name``, with its marker ball and label; its rotation rings
+    only when ``rings``."""
     reach = gizmo_reach(slot)
     marker_at, label_at = gizmo_tips(reach)
     gizmo = scene.add_transform_controls(
         name,
         scale=reach,
         line_width=2.0,
-        disable_sliders=True,  # the plane handles of four gizmos cluttered the middle; arrows and rings stay
+        disable_sliders=True,  # the plane handles of four gizmos cluttered the middle
+        disable_rotations=not rings,  # so did twelve rotation rings: shown on request ("Rotation rings on the gizmos")
         # Drawn over the mesh: a gizmo sits at its primitive's centre, inside the surface. Each is sized to its own
         # primitive (its arrows just poke out of it), so the four do not pile up in the middle.
         depth_test=False,

@@ -247,3 +247,83 @@ def test_every_preset_opens_solved_by_its_own_solver_settings(
         np.testing.assert_allclose(link_lengths(skeleton, pose), link_lengths(skeleton, skeleton.joints), rtol=1e-9)
         for k, effector in enumerate(skeleton.effectors):
             assert np.linalg.norm(pose[effector] - skeleton.targets[k]) <= skeleton.tolerance_mm / 1000.0
+
+
+# ------------------------------------------------------------------------------------------------ framing
+def _free_rect(size: tuple[int, int]) -> tuple[float, float, float, float]:
+    from scenes._framing import MARGIN_PX, PANEL_PX
+
+    return MARGIN_PX, size[0] - PANEL_PX - MARGIN_PX, MARGIN_PX, size[1] - MARGIN_PX
+
+
+def _sphere_extremes(centres: np.ndarray, radius: float) -> np.ndarray:
+    """The 8 cube corners around each sphere: a sphere's silhouette lies inside their projection's box."""
+    corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=np.float64)
+    return (centres[:, None, :] + radius * corners[None]).reshape(-1, 3)
+
+
+@pytest.mark.parametrize("size", [(1600, 1000), (1280, 720)])
+@pytest.mark.parametrize("what", ["3D chain", "Robot arm", "Hand", "Upper body"])
+def test_each_view_frames_everything_it_shows_with_room_and_no_close_up(
+    scene: ArmScene, what: str, size: tuple[int, int]
+) -> None:
+    """The 3D toggle and each preset frame every joint (as a sphere), the base, the ghost, each obstacle sphere and
+    each gizmo's arrow tips inside the free view with room at the edges (the 3D view cut the chain at the left and
+    top, Robot arm's top joint and Hand's wrist were cut), from far enough that nothing near the camera looms: the
+    nearest framed point is at least 0.4 times as far as the farthest (a sphere's drawn size varies at most
+    2.5-fold with its depth; framed as close as it could be, 3.4-fold in 3D, and the obstacle sphere hid the base)."""
+    import math
+
+    from scenes import arm
+    from scenes._framing import Lens, project_points
+
+    if what == "3D chain":
+        scene.controls["three_d"].value = True
+        with scene._lock:
+            report = scene.report
+            assert report is not None
+            p = scene.params
+            axes = np.eye(3)
+            tips = np.vstack(
+                [h + arm.GIZMO_SCALE_M * axes for h in [scene.target, *scene.obstacle_centres[: p.n_obstacles]]]
+            )
+            shown = np.vstack(
+                [
+                    _sphere_extremes(scene.pose, arm.JOINT_RADIUS_M),
+                    _sphere_extremes(report.ghost, arm.JOINT_RADIUS_M),
+                    *(_sphere_extremes(scene.obstacle_centres[k : k + 1], p.radii_m[k]) for k in range(p.n_obstacles)),
+                    tips,
+                    arm.box_points(),
+                ]
+            )
+    else:
+        scene.skeletons.show(what)  # type: ignore[arg-type]
+        view = scene.skeletons
+        arrows = np.vstack([t + view.gizmo_scale * np.eye(3) for t in view.targets])
+        shown = np.vstack([_sphere_extremes(view.pose, _skeletons.JOINT_RADIUS_M), arrows])
+    lens = Lens(math.radians(75.0), *size)
+    xy = project_points(scene._view_for(lens), lens, shown)
+    left, right, top, bottom = _free_rect(size)
+    room_x, room_y = 0.03 * (right - left), 0.03 * (bottom - top)
+    assert xy[:, 0].min() >= left + room_x and xy[:, 0].max() <= right - room_x, (what, xy[:, 0].min(), xy[:, 0].max())
+    assert xy[:, 1].min() >= top + room_y and xy[:, 1].max() <= bottom - room_y, (what, xy[:, 1].min(), xy[:, 1].max())
+    depth = xy[:, 2]
+    assert depth.min() >= 0.4 * depth.max(), (what, depth.min(), depth.max())
+    # Still a view of the thing, not of empty space: it spans at least half the free width or height.
+    fill = max(np.ptp(xy[:, 0]) / (right - left), np.ptp(xy[:, 1]) / (bottom - top))
+    assert fill >= 0.5, (what, fill)
+
+
+def test_hand_gizmos_are_scaled_to_the_fingers_and_leave_the_fingertips_seen(scene: ArmScene) -> None:
+    """Each fingertip's gizmo reaches less than half-way to the next fingertip's (they overlapped at 0.12 m), and a
+    target's ball is smaller than the fingertip joint on it, so a reached fingertip shows round its target."""
+    scene.skeletons.show("Hand")
+    view = scene.skeletons
+    targets = view.targets
+    gaps = np.linalg.norm(targets[:, None] - targets[None], axis=-1)[np.triu_indices(len(targets), 1)]
+    assert view.gizmo_scale < 0.5 * gaps.min()
+    assert all(g.scale == pytest.approx(view.gizmo_scale) for g in view.gizmos[: len(targets)])
+    assert _skeletons.MARKER_RADIUS_M < _skeletons.JOINT_RADIUS_M
+    # The robot arm's single target keeps the full-size arrows.
+    scene.skeletons.show("Robot arm")
+    assert scene.skeletons.gizmo_scale == _skeletons.GIZMO_SCALE_M

@@ -798,3 +798,77 @@ def gallery_rest_size(width: int, aspect: float, s_per_pixel: float | None) -> t
 )
 def test_rest_frame_size(viewer: int, aspect: float, s_per_pixel: float | None, size: tuple[int, int]) -> None:
     assert gallery_rest_size(viewer, aspect, s_per_pixel) == size
+
+
+# ------------------------------------------------------------------------------------------------ what a person sees
+def _shown(client: BrowserClient, label: str) -> bool:
+    """Whether this browser draws the control labelled ``label``: it and every folder above it visible."""
+    with client._lock:
+        gui = dict(client.gui)
+        uuid = next(u for u, e in gui.items() if e["props"].get("label") == label and e["type"] != "GuiFolderMessage")
+        while uuid in gui:
+            if gui[uuid]["props"].get("visible") is False:
+                return False
+            uuid = gui[uuid].get("container_uuid")
+    return True
+
+
+def test_blend_and_k_hide_while_a_glsl_field_is_shown(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
+    """Blend and its width act on the primitives only: with the GLSL editor's field shown they are not drawn; the
+    mesh resolution (used by both) stays."""
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Blend")
+        assert _shown(client, "Blend") and _shown(client, "Blend width k (m)")
+        client.set_value("Shape", "GLSL editor")
+        client.wait_for(lambda: not _shown(client, "Blend"), what="Blend hidden")
+        assert not _shown(client, "Blend width k (m)")
+        assert _shown(client, RESOLUTION_LABEL)
+        client.set_value("Shape", "Primitives (panels below)")
+        client.wait_for(lambda: _shown(client, "Blend") and _shown(client, "Blend width k (m)"), what="Blend back")
+
+
+def test_rotation_rings_show_only_when_asked(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
+    """Four gizmos' twelve rotation rings covered the shape: the gizmos open with their arrows only, and the rings
+    come with "Rotation rings on the gizmos" (what the browser is told, not just the handle)."""
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_node("/sdf/gizmo_1")
+
+        def rings_off() -> list[bool]:
+            with client._lock:
+                return [
+                    bool(client.nodes[f"/sdf/gizmo_{k}"]["props"]["disable_rotations"])
+                    for k in range(1, 5)
+                    if f"/sdf/gizmo_{k}" in client.nodes
+                ]
+
+        assert rings_off() == [True] * 4
+        client.wait_for_gui("Rotation rings on the gizmos")
+        client.set_value("Rotation rings on the gizmos", True)
+        client.wait_for(lambda: rings_off() == [False] * 4, what="the rings drawn")
+
+
+@pytest.mark.parametrize("size", [(1600, 1000), (1280, 720)])
+def test_the_opening_view_frames_the_shape_large_with_its_gizmos(scene: SdfGalleryScene, size: tuple[int, int]) -> None:
+    """The shape spans at least 55 % of the view left of the panel (it spanned 25–30 %, off to one side), and every
+    gizmo's arrows, rings and label stay inside that view."""
+    from scenes._framing import MARGIN_PX, PANEL_PX, Lens, box_corners, project_points
+    from scenes.sdf_gallery.params import GIZMO_MARKER_RADIUS_M, gizmo_reach
+
+    lens = Lens(math.radians(75.0), *size)
+    view = scene._view_for(lens)
+    with scene._lock:
+        vertices = scene.mesh_vertices if len(scene.mesh_vertices) else scene._opening_vertices
+        shape = project_points(view, lens, box_corners(vertices.min(axis=0), vertices.max(axis=0)))
+        gizmos = np.vstack(
+            [
+                np.asarray(slot.position)
+                + (gizmo_reach(slot) + 2.5 * GIZMO_MARKER_RADIUS_M) * np.vstack([np.eye(3), -np.eye(3)])
+                for slot in scene.params.primitives
+                if slot.enabled
+            ]
+        )
+    left, right, top, bottom = MARGIN_PX, size[0] - PANEL_PX - MARGIN_PX, MARGIN_PX, size[1] - MARGIN_PX
+    assert np.ptp(shape[:, 0]) >= 0.55 * (right - left) or np.ptp(shape[:, 1]) >= 0.55 * (bottom - top)
+    xy = project_points(view, lens, gizmos)
+    assert xy[:, 0].min() >= left - 0.5 and xy[:, 0].max() <= right + 0.5
+    assert xy[:, 1].min() >= top - 0.5 and xy[:, 1].max() <= bottom + 0.5
