@@ -277,6 +277,49 @@ def panels(p: FreeKickParams) -> tuple[ball.Panel, ball.Panel]:
     )
 
 
+STRIKES = 200
+"""Strikes of the current kick played out for its odds (a player's scatter, :class:`kernels.ball.StrikeSpread`)."""
+
+
+def strike_chances(p: FreeKickParams, n: int = STRIKES) -> ball.Odds:
+    """The current kick struck ``n`` times with a skilled player's scatter (:class:`kernels.ball.StrikeSpread`'s
+    defaults), each played on over the scene's pitch (wall, posts, bar, net; no keeper), without the knuckle force."""
+    wall, goal = panels(p)
+    return ball.strike_odds(
+        ball_spot(p),
+        p.speed_ms,
+        math.radians(p.elevation_deg),
+        aim_heading_rad(p),
+        spin_vector(p),
+        ball.Pitch(goal, wall),
+        n=n,
+        dt=INTEGRATOR_STEP_S[p.integrator],
+        method=p.integrator,
+        model=p.model,
+        t_max=PLAY_T_MAX_S,
+        ground_m=ball.BALL_RADIUS_M,
+    )
+
+
+ODDS_WORDS = {
+    "goal": "goal",
+    "wall": "wall",
+    "over": "over",
+    "wide": "wide",
+    "post": "post",
+    "bar": "bar",
+    "saved": "saved",
+    "short": "short",
+}
+
+
+def chances_words(odds: ball.Odds) -> str:
+    """ "Struck 200 times with a player's scatter: goal 62 %, wall 9 %, …" (results that happened, largest first)."""
+    shares = sorted(((odds.probability(name), name) for name in odds.counts if odds.counts[name]), reverse=True)
+    listed = ", ".join(f"{ODDS_WORDS[name]} {100 * share:.0f} %" for share, name in shares)
+    return f"Struck {odds.n} times with a player's scatter (no keeper): **{listed}**"
+
+
 def play_words(played: ball.Trajectory | None) -> str:
     """What the kick did once it touched something, in words: "hits the left post at 1.8 m, goes in"."""
     if played is None or not played.events:

@@ -41,6 +41,7 @@ from scenes.freekick.model import (
     after_contact,
     aim_at,
     ball_spot,
+    chances_words,
     compute_kick,
     deflection_m,
     knuckle_ticked,
@@ -54,6 +55,7 @@ from scenes.freekick.model import (
     spin_axis,
     spin_vector,
     spin_words,
+    strike_chances,
     wall_axes,
 )
 from scenes.freekick.props import (
@@ -132,6 +134,10 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
         """How many outcome maps have been computed (a burst of changes computes one)."""
         self.map_params: FreeKickParams | None = None
         """The settings the shown outcome map was computed for."""
+        self.chances: ball.Odds | None = None
+        """The odds shown for the map's settings: the kick struck many times with a player's scatter."""
+        self.knuckle_note = ""
+        """Says so when ticking Knuckleball has just set the spin near zero."""
         self.last_target: tuple[float, float] | None = None
         self.aim_message = ""
         self._map_worker = LatestWorker("freekick-map")
@@ -206,6 +212,8 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
                     format="png",
                 )
                 self.map_status = gui.add_markdown("Computing…")
+                self.odds_status = gui.add_markdown("")
+                """The current kick's odds over many strikes, computed with the map."""
 
         self.kick_controls.on_update(self.callback(self.apply_inputs))
         self.kick_button.on_click(self.callback(self._on_kick))
@@ -412,6 +420,7 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
                 return
             self.map_runs += 1
             results = outcome_map(params)
+            chances = strike_chances(params)
             with self._lock:
                 if self.closed or version != self._map_version:
                     return
@@ -434,6 +443,8 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
                         "measured model to see the spin rate matter."
                     )
                 self.map_status.content = summary
+                self.chances = chances
+                self.odds_status.content = chances_words(chances)
 
         self._map_worker.submit(job, delay_s=MAP_QUIET_S)
 
@@ -559,9 +570,8 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
             lines.append(f"Knuckle wobble: up to **{wobble:.2f} m** off the spinless path (dashed)")
         elif p.knuckle:
             lines.append("Knuckleball: no wobble at this spin (any real spin steadies the wake)")
-        note = getattr(self, "knuckle_note", "")
-        if note:
-            lines.append(note)
+        if self.knuckle_note:
+            lines.append(self.knuckle_note)
         s_param = ball.BALL_RADIUS_M * 2 * math.pi * p.spin_rev_s / max(p.speed_ms, 1e-9)
         lines.append(f"Spin parameter S = r·ω/v = {s_param:.3f}")
         return "  \n".join(lines)

@@ -46,7 +46,7 @@ from scenes.freekick import (
     view_points,
     wall_hides,
 )
-from scenes.freekick.model import knuckle_wobble_m
+from scenes.freekick.model import knuckle_wobble_m, strike_chances
 
 
 @pytest.fixture
@@ -274,6 +274,19 @@ def test_a_click_ray_through_the_goal_mouth_aims_there(scene: FreeKickScene) -> 
     scene.aim_from_ray("not a ray", None)
     assert scene.wait_idle()
     assert scene.params == before and scene.last_target == pytest.approx((-2.0, 2.0))
+
+
+def test_the_current_strikes_odds_are_shown_with_the_map(scene: FreeKickScene) -> None:
+    # The opening curler struck 200 times with a player's scatter: the shares shown are the kernel's for the
+    # same strikes, and most of them go in (it is a goal struck as set).
+    assert scene.wait_idle(120.0)
+    chances = scene.chances
+    assert chances is not None and chances.n == 200
+    expected = strike_chances(scene.params)
+    assert chances.counts == expected.counts
+    assert chances.probability("goal") > 0.4
+    goal_share = f"goal {100 * chances.probability('goal'):.0f} %"
+    assert goal_share in scene.odds_status.content and "Struck 200 times" in scene.odds_status.content
 
 
 def test_outcome_map_matches_single_runs(scene: FreeKickScene) -> None:
