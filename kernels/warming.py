@@ -236,17 +236,23 @@ def _compile_one(name: str, in_a_child: bool) -> None:
     child = _spawn(name) if in_a_child else None
     if child is not None:
         _, errors = child.communicate()
+        if _EXITING.is_set():  # the app is exiting and stopped the child: nothing to load, nothing to say
+            return
         if child.returncode != 0:  # it failed: the load below compiles here instead, and the log says why
             logger.warning("the compile process for %s failed: %s", name, errors.decode(errors="replace")[-2000:])
     try:
         importlib.import_module(name).warm_up()  # loads what the child cached, or compiles here
-    except Exception:  # the kernel then compiles on first use instead; say why
-        logger.exception("compiling %s failed", name)
+    except Exception:  # the kernel then compiles on first use instead; say why (unless the app is exiting)
+        if not _EXITING.is_set():
+            logger.exception("compiling %s failed", name)
+        return
     _finish(name)
 
 
 _CHILDREN: list[subprocess.Popen[bytes]] = []
 """Compile processes started here; any still running when this process exits is stopped with it."""
+_EXITING = threading.Event()
+"""Set when this process exits: a compile cut short then is neither loaded nor reported."""
 
 
 def has_cache(package: str) -> bool:
@@ -281,6 +287,7 @@ def _spawn(name: str) -> subprocess.Popen[bytes] | None:
 
 
 def _stop_children() -> None:
+    _EXITING.set()
     for child in _CHILDREN:
         if child.poll() is None:
             child.kill()
@@ -301,6 +308,7 @@ def _finish(name: str) -> None:
 
 def _reset_for_tests() -> None:
     """Forget :func:`start` (tests only): entries call their dispatchers again."""
+    _EXITING.clear()
     with _STATE.lock:
         _STATE.started_at = None
         _STATE.pending = set()

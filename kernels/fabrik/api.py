@@ -7,10 +7,10 @@ Shapes: one chain is (n + 1, d) joints and a (d,) target, d = 2 or 3, metres; a 
 
 from __future__ import annotations
 
-import concurrent.futures
 import dataclasses
 import functools
 import math
+import threading
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -63,18 +63,12 @@ _CHUNKS_PER_THREAD = 16
 """Chunks per thread a batch is cut into: enough to balance chains that need 1 and 50 iterations."""
 
 
-@functools.cache
-def _batch_threads() -> concurrent.futures.ThreadPoolExecutor:
-    """The process's threads for batches (made on first use, as many as numba may use). ``_solve_rows`` runs without
-    the GIL, so plain threads share a batch; ``numba.set_num_threads`` sets how many a call uses, as it would for a
-    ``prange`` loop, and no ``parallel=True`` core has to compile on the first start."""
-    most = numba.config.NUMBA_NUM_THREADS  # pyright: ignore[reportAttributeAccessIssue]  (set at import, not typed)
-    return concurrent.futures.ThreadPoolExecutor(most, thread_name_prefix="fabrik-batch")
-
-
 def _solve_batch_rows(args: tuple[Any, ...]) -> None:
     """:func:`~kernels.fabrik.chain._solve_rows` over every row of a batch (``args[0]`` the (B, n + 1, 3) joints), cut
-    into contiguous chunks run on ``numba.get_num_threads()`` threads."""
+    into contiguous chunks that ``numba.get_num_threads()`` threads (this one and helpers started for the call) take
+    in turn. ``_solve_rows`` runs without the GIL, so plain threads share the batch as a ``prange`` loop would, and
+    no ``parallel=True`` core has to compile on the first start. Threads of the call's own, not a pool: a batch
+    solved while the interpreter shuts down (an ``atexit`` hook) still runs, on this thread if no other can start."""
     batch = len(args[0])
     threads = min(numba.get_num_threads(), batch)
     if threads <= 1:
@@ -82,9 +76,29 @@ def _solve_batch_rows(args: tuple[Any, ...]) -> None:
         return
     chunks = min(batch, threads * _CHUNKS_PER_THREAD)
     bounds = [c * batch // chunks for c in range(chunks + 1)]
-    done = _batch_threads().map(lambda c: _solve_rows(bounds[c], bounds[c + 1], *args), range(chunks))
-    for _ in done:  # re-raises a chunk's error here
-        pass
+    order = iter(range(chunks))  # shared: next() on it is one atomic step under the GIL
+    errors: list[BaseException] = []
+
+    def take_chunks() -> None:
+        try:
+            for c in order:
+                _solve_rows(bounds[c], bounds[c + 1], *args)
+        except BaseException as exc:  # re-raised in the calling thread below
+            errors.append(exc)
+
+    helpers: list[threading.Thread] = []
+    for _ in range(threads - 1):
+        helper = threading.Thread(target=take_chunks, name="fabrik-batch", daemon=True)
+        try:
+            helper.start()
+        except RuntimeError:  # no new threads while the interpreter shuts down: this one takes the rest
+            break
+        helpers.append(helper)
+    take_chunks()
+    for helper in helpers:
+        helper.join()
+    if errors:
+        raise errors[0]
 
 
 @dataclasses.dataclass(frozen=True)

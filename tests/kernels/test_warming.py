@@ -220,3 +220,37 @@ def test_a_package_with_a_warm_cache_is_never_pending(fresh_warming: None, monke
     assert not warming.is_pending("kernels.course")
     thread.join(300)
     assert sorted(seen[-1].done) == ["kernels.ball", "kernels.course"] and seen[-1].finished
+
+
+def test_exiting_while_a_package_compiles_stops_its_child_and_says_nothing(
+    fresh_warming: None, monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
+) -> None:
+    # Ctrl+C during a first start: the app exits, its compile children are stopped, and the thread that waited on
+    # one must neither compile the package here (at interpreter shutdown) nor log a traceback about it.
+    import subprocess
+    import threading
+
+    loads: list[str] = []
+    monkeypatch.setattr(warming, "_CHILDREN", [])
+    package = types.ModuleType("slow_kernels")
+    package.warm_up = lambda: loads.append("slow_kernels")  # pyright: ignore[reportAttributeAccessIssue]
+    monkeypatch.setitem(sys.modules, "slow_kernels", package)
+
+    def slow_child(name: str) -> subprocess.Popen[bytes]:
+        child = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"], stderr=subprocess.PIPE)
+        warming._CHILDREN.append(child)
+        return child
+
+    monkeypatch.setattr(warming, "_spawn", slow_child)
+    waiter = threading.Thread(target=warming._compile_one, args=("slow_kernels", True))
+    with caplog.at_level("DEBUG", logger="kernels.warming"):
+        waiter.start()
+        while not warming._CHILDREN:
+            waiter.join(0.01)
+        warming._stop_children()
+        waiter.join(30)
+    assert not waiter.is_alive()
+    assert warming._CHILDREN[0].returncode is not None  # the child was stopped
+    assert loads == []  # nothing compiled or loaded here while exiting
+    assert caplog.records == []
+    assert "slow_kernels" not in warming.progress().done

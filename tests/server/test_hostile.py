@@ -26,6 +26,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from scenes import SCENES, Scene
+from scenes.peloton import MAX_GROUP
 from server.clean import (
     ControlSpec,
     clean_value,
@@ -464,11 +465,12 @@ def test_crafted_props_cannot_lift_a_slider_limit(server: viser.ViserServer, swi
     with BrowserClient(server.get_port()) as client:
         uuid = client.wait_for_gui("Riders")
         client.send("GuiUpdateMessage", uuid=uuid, updates={"props": {}})
-        client.set_value("Riders", 40)
-        # The gate clamps the value (the page shows 8 at once); the scene's coalesced callback applies it after.
+        top = MAX_GROUP  # the slider's declared max (121 riders: a bunch)
+        client.set_value("Riders", 4 * top)
+        # The gate clamps the value (the page shows the max at once); the scene's coalesced callback applies it after.
         client.wait_for(
-            lambda: client.value_of("Riders") == 8 and switcher.scene.params.n_riders == 8,  # type: ignore[attr-defined]
-            what="Riders clamped to its max, 8, on the page and in the scene",
+            lambda: client.value_of("Riders") == top and switcher.scene.params.n_riders == top,  # type: ignore[attr-defined]
+            what=f"Riders clamped to its max, {top}, on the page and in the scene",
         )
 
 
