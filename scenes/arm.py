@@ -399,10 +399,11 @@ BASE_HALF_M = 0.08
 FRAME_ROOM = 0.04
 """Share of the free view's width and height kept empty on each side of what is framed: room for the arrowheads,
 the joints' and links' thickness and the shading at the edges."""
-PLANE_DEPTH, SPACE_DEPTH = 0.5, 0.5
+PLANE_DEPTH, SPACE_DEPTH, SKELETON_DEPTH = 0.5, 0.5, 0.8
 """The nearest framed point stays at least this many times the framed box's largest side in front of the camera
-(in the plane, in 3D): closer, the wide lens makes what is near (an obstacle, a target gizmo, a fingertip) look
-several times larger than what is far (the base)."""
+(the chain in the plane, in 3D, a skeleton reaching toward the camera): closer, the wide lens makes what is near (an
+obstacle, a target gizmo, a fingertip curled toward the camera) look several times larger than what is far (the base,
+the knuckles)."""
 FRAME_SLACK = 0.15
 """A framed view is kept until what it must show leaves the framed box grown by this fraction of its size."""
 
@@ -763,7 +764,7 @@ is a static pose.
             fov_rad=lens.fov_rad,
             aspect=lens.aspect,
             ndc=(x0 + room_x, x1 - room_x, y0 + room_y, y1 - room_y),
-            min_depth=(SPACE_DEPTH if deep else PLANE_DEPTH) * extent,
+            min_depth=(PLANE_DEPTH if not deep else SPACE_DEPTH if sk is None else SKELETON_DEPTH) * extent,
         )
 
     def _points_to_frame(self) -> NDArray[np.float64]:

@@ -172,3 +172,64 @@ def test_the_chain_fills_the_view_in_the_plane_and_in_3d(shown: ScenePage) -> No
     set_number(shown.page, "Links", 6)
     wait_until(lambda: scene.params.n_links == 6, "6 links again")
     settle(shown)
+
+
+def _sphere_corners(centres: np.ndarray, radius: float) -> np.ndarray:
+    corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=np.float64)
+    return (centres[:, None, :] + radius * corners[None]).reshape(-1, 3)
+
+
+def test_the_3d_view_and_each_preset_show_everything_whole(shown: ScenePage) -> None:
+    """In the browser, at both sizes: the 3D toggle, and each preset, show every joint whole (as a sphere), the
+    ghost, the obstacle sphere and the gizmo tips inside the page and clear of the panel, and the preset's fingers,
+    hands and head as drawn pixels; the same 15 s later, and the chain comes back framed."""
+    import time
+
+    from scenes import _skeletons
+    from scenes.arm import GIZMO_SCALE_M, JOINT_RADIUS_M
+
+    scene = shown.scene
+    assert isinstance(scene, ArmScene)
+    checkbox = control_row(shown.page, "3D (free target, sphere obstacles)").locator("input").first
+    frames = scene.framing.frames
+    checkbox.click()
+    wait_until(lambda: scene.params.three_d and scene.framing.frames > frames, "3D and its camera")
+    settle(shown)
+    for wait_s in (0.0, 15.0):
+        time.sleep(wait_s)
+        with scene._lock:
+            report, p = scene.report, scene.params
+            assert report is not None
+            points = np.vstack(
+                [
+                    _sphere_corners(scene.pose, JOINT_RADIUS_M),
+                    report.ghost,
+                    _sphere_corners(scene.obstacle_centres[:1], p.radii_m[0]),
+                    scene.target + GIZMO_SCALE_M * np.eye(3),
+                ]
+            )
+        assert_in_view(shown, "/arm", points, f"3D chain after {wait_s:.0f} s")
+    screenshot(shown.page, path=f"/tmp/arm_3d_after_{shown.viewport[0]}.png")
+    checkbox.click()
+    wait_until(lambda: not scene.params.three_d, "back to the plane")
+    settle(shown)
+    for label in ("Robot arm", "Hand", "Upper body"):
+        frames = scene.framing.frames
+        scene.controls["preset"].value = label  # as the menu sends it (the pixels are what this test is about)
+        assert scene.skeletons.preset == label and scene.framing.frames > frames  # the callback ran and framed it
+        settle(shown)
+        image = screenshot(shown.page, path=f"/tmp/arm_{label.replace(' ', '_')}_after_{shown.viewport[0]}.png")
+        view = scene.skeletons
+        with scene._lock:
+            points = np.vstack(
+                [
+                    _sphere_corners(view.pose, _skeletons.JOINT_RADIUS_M),
+                    (view.targets[:, None, :] + view.gizmo_scale * np.eye(3)[None]).reshape(-1, 3),
+                ]
+            )
+        xy = assert_in_view(shown, "/arm", points, label)
+        assert_seen(shown, image, ["/arm/skeleton/links", "/arm/skeleton/joints"], xy, label)
+    scene.controls["preset"].value = "Chain"
+    wait_until(lambda: not scene.skeletons.active, "the chain back")
+    settle(shown)
+    _assert_chain_fills_the_view(shown, "the chain again")

@@ -323,7 +323,17 @@ def test_hand_gizmos_are_scaled_to_the_fingers_and_leave_the_fingertips_seen(sce
     gaps = np.linalg.norm(targets[:, None] - targets[None], axis=-1)[np.triu_indices(len(targets), 1)]
     assert view.gizmo_scale < 0.5 * gaps.min()
     assert all(g.scale == pytest.approx(view.gizmo_scale) for g in view.gizmos[: len(targets)])
-    assert _skeletons.MARKER_RADIUS_M < _skeletons.JOINT_RADIUS_M
+    # The fingertips are drawn as smaller balls in their finger's colour (they were white blobs as big as a joint),
+    # and each target's ball is smaller still, so a reached fingertip shows round its target.
+    skeleton = view.skeleton
+    assert skeleton is not None
+    scales = np.asarray(view.joint_nodes.batched_scales)[:, 0]
+    colours = np.asarray(view.joint_nodes.batched_colors)
+    for k, tip in enumerate(skeleton.effectors):
+        assert scales[tip] == pytest.approx(_skeletons.END_RADIUS_M) and scales[tip] < _skeletons.JOINT_RADIUS_M
+        np.testing.assert_array_equal(colours[tip], _skeletons.CHAIN_COLOURS[skeleton.chain_of[tip]])
+        assert tuple(colours[tip]) != _skeletons.FREE_COLOUR, k
+    assert _skeletons.MARKER_RADIUS_M < _skeletons.END_RADIUS_M
     # The robot arm's single target keeps the full-size arrows.
     scene.skeletons.show("Robot arm")
     assert scene.skeletons.gizmo_scale == _skeletons.GIZMO_SCALE_M
