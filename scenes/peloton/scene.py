@@ -119,7 +119,8 @@ class PelotonScene(Scene[PelotonParams]):
     camera_position = (-2.0, -7.5, 2.8)
     camera_look_at = (-3.2, 0.0, 1.0)
     about = """
-**What it shows.** Riders in a line at one speed. Each rider's power is split into pushing air (aero), tyre
+**What it shows.** Riders at one speed: a line of up to eight with power bars, or a formation of up to 121 (two
+abreast, a bunch, an echelon) with each rider coloured by power. Each rider's power is split into pushing air (aero), tyre
 rolling resistance and climbing; riders behind draft. The bars above the riders stack aero (blue), rolling
 (orange) and climbing (green); the label gives watts and the share of the solo rider's power.
 
@@ -721,7 +722,7 @@ time-averaged power is the mean over positions, far below the leader's.
         lead = float(self.state.power.total[0])
         if self._rotation_width() == 0:
             return (
-                f"In a {'bunch' if self.params.formation == 'bunch' else 'echelon'} riders do not take turns in order: "
+                f"In {'a bunch' if self.params.formation == 'bunch' else 'an echelon'} riders do not take turns in order: "
                 f"the mean over its places is **{_watts(mean)} W** against the leader's {_watts(lead)} W."
             )
         if lead <= 0:

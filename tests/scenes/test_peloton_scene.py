@@ -535,3 +535,17 @@ def test_bars_stand_nearly_upright_in_the_framed_view(
     top = _screen_px(base + [0.0, 0.0, 1.0], np.array(view.position), np.array(view.look_at), lens)
     lean_deg = np.degrees(np.arctan2(top[:, 0] - bottom[:, 0], bottom[:, 1] - top[:, 1]))
     assert np.abs(lean_deg).max() <= 6.0, lean_deg
+
+
+@pytest.mark.parametrize(
+    ("label", "words"), [("Bunch (peloton)", "In a bunch riders"), ("Echelon", "In an echelon riders")]
+)
+def test_a_formation_that_does_not_rotate_is_named_in_plain_english(
+    scene: PelotonScene, label: str, words: str
+) -> None:
+    c = scene.controls
+    c["formation"].value, c["n_riders"].value = label, 20
+    c["rotate"].value = True
+    with scene._lock:
+        assert not scene._animate(0.1)
+    assert words in scene.rotation.content
