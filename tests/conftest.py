@@ -30,6 +30,7 @@ settings.register_profile("explore", derandomize=False, deadline=None, print_blo
 settings.load_profile("deterministic")  # --hypothesis-profile, read after this file, overrides it
 
 
+@pytest.hookimpl(tryfirst=True)  # before xdist reads the groups
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     """Under pytest-xdist (``-n auto`` in pyproject): every browser test runs on one worker, one after another, since
     each page keeps a core busy drawing software WebGL; every other file runs whole on one worker (its module

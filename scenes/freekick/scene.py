@@ -537,16 +537,26 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
     def readout_markdown(self) -> str:
         state, p = self.state, self.params
         o = state.outcome
-        verdict = {
+        verdicts = {
             "goal": "GOAL",
             "wall": "Blocked by the wall",
             "over": "Over the bar",
             "wide": "Wide of the post",
             "short": "Lands short of the goal",
-        }[o.result]
+            "post": "Hits the post",
+            "bar": "Hits the bar",
+            "saved": "Saved",
+        }
+        # The verdict is the pitch's (posts, bar, defenders, turf) wherever the kick is played on; the free flight's
+        # crossing of the goal plane is said beside it when it differs (a ball 0.1 m wide of the post's inside edge
+        # still strikes the post).
+        played = state.played
+        result = played.result if played is not None and played.result in verdicts else o.result
         wall_height = "never reaches the wall" if o.wall_point is None else f"{o.wall_point[2]:.2f} m"
-        lines = [
-            f"**{verdict}**",
+        lines = [f"**{verdicts[result]}**"]
+        if result != o.result:
+            lines.append(f"In free flight through the goal plane: {verdicts[o.result]}")
+        lines += [
             "",
             f"Height at the wall: **{wall_height}** (wall top {state.wall.height_m:.2f} m)",
         ]

@@ -116,8 +116,11 @@ def test_drag_a_fingertip_target_with_the_mouse(server: viser.ViserServer, brows
             tip_before = view.pose[effector].copy()
         picture_before = page.screenshot()
 
-        # Grab the gizmo's z arrow (local +z, along the shaft) and pull it down on screen.
-        start = screen_of(page, name, (0.0, 0.0, 0.08))
+        # Grab the gizmo's z arrow (local +z, along the shaft; the arrows are scaled to the gaps between the
+        # fingertips) and pull it down on screen.
+        with scene._lock:
+            arrow = view.gizmo_scale
+        start = screen_of(page, name, (0.0, 0.0, 0.6 * arrow))
         origin = screen_of(page, name, (0.0, 0.0, 0.0))
         assert start[1] < origin[1] - 5  # the arrow points up on screen from this camera
         drag(page, start, (0.0, 3.0), 15)

@@ -17,6 +17,7 @@ from helpers.browser import (
     assert_seen,
     chart_image,
     error_text,
+    line_mask,
     panel_rect,
     save_scene_screenshot,
     scene_page_fixture,
@@ -110,7 +111,7 @@ def test_more_speed_lifts_the_now_line_and_the_bars(shown: ScenePage) -> None:
     scene = shown.scene
 
     def red_row() -> float:
-        rows = np.nonzero(np.linalg.norm(chart_image(shown.page, CHART).astype(float) - NOW_RED, axis=-1) < 40)[0]
+        rows = np.nonzero(line_mask(chart_image(shown.page, CHART), NOW_RED))[0]
         assert len(rows) > 20
         return float(np.median(rows))
 

@@ -197,6 +197,18 @@ def colour_pixels(image: NDArray[np.uint8], rgb: Sequence[int], tolerance: float
     return int(np.count_nonzero(distance <= tolerance))
 
 
+def line_mask(image: NDArray[np.uint8], rgb: Sequence[int], strength: float = 0.5) -> NDArray[np.bool_]:
+    """(H, W) pixels that show a line of colour ``rgb`` drawn over white: the colour itself or, where a thin line
+    falls between pixel rows, its blend with the white background holding at least ``strength`` of it (a 1.5 px
+    dashed line across two rows is (231, 100, 100) for (220, 30, 30), not the colour itself)."""
+    white = np.full(3, 255.0)
+    towards = np.asarray(rgb, np.float64) - white
+    offset = image.astype(np.float64) - white
+    share = offset @ towards / max(float(towards @ towards), 1e-9)
+    residual = np.linalg.norm(offset - share[..., None] * towards, axis=-1)
+    return (share >= strength) & (residual <= 30.0)
+
+
 def changed_mask(a: NDArray[np.uint8], b: NDArray[np.uint8], threshold: int = 24) -> NDArray[np.bool_]:
     """(H, W) pixels whose colour differs by more than ``threshold`` in some channel."""
     return np.abs(a.astype(np.int16) - b.astype(np.int16)).max(axis=-1) > threshold
@@ -455,7 +467,7 @@ def assert_seen(
 def assert_chart_draws(page: Any, title: str, colours: dict[str, Sequence[int]], min_px: int = 25) -> None:
     """Assert that the plot area of chart ``title`` shows every series' colour (at least ``min_px`` pixels)."""
     image = chart_image(page, title)
-    counts = {name: colour_pixels(image, rgb) for name, rgb in colours.items()}
+    counts = {name: int(np.count_nonzero(line_mask(image, rgb))) for name, rgb in colours.items()}
     missing = {name: n for name, n in counts.items() if n < min_px}
     assert not missing, f"chart {title!r}: series not drawn {missing} (all: {counts})"
 

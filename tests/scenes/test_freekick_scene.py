@@ -643,3 +643,26 @@ def test_project_points_agrees_with_frame_points() -> None:
     touches_x = math.isclose(x_ndc.min(), ndc[0], abs_tol=1e-3) and math.isclose(x_ndc.max(), ndc[1], abs_tol=1e-3)
     touches_y = math.isclose(y_ndc.min(), ndc[2], abs_tol=1e-3) and math.isclose(y_ndc.max(), ndc[3], abs_tol=1e-3)
     assert touches_x or touches_y
+
+
+def test_the_verdict_is_what_the_pitch_makes_of_the_kick_and_never_contradicts_played_on(scene: FreeKickScene) -> None:
+    # Reported: Knuckleball on the default kick read "Wide of the post" over "Played on: Hits the right post":
+    # the free flight crossed the goal plane 0.11 m outside the post's inside edge, where the ball (0.11 m) still
+    # strikes the post (0.06 m). The headline is the pitch's result; the free flight's is said beside it.
+    scene.controls["knuckle"].value = True
+    played = scene.state.played
+    assert played is not None and played.result == "post"
+    headline, second = (line.strip() for line in scene.result.content.splitlines()[:2])
+    assert headline == "**Hits the post**"
+    assert second == "In free flight through the goal plane: Wide of the post"
+    assert "Hits the right post" in scene.result.content or "hits the right post" in scene.result.content
+    seen: set[str] = set()
+    for azimuth in np.linspace(-16.0, 4.0, 11):  # across the goal mouth and past both posts
+        scene.controls["azimuth_deg"].value = float(azimuth)
+        played, outcome = scene.state.played, scene.state.outcome
+        result = played.result if played is not None and played.result is not None else outcome.result
+        seen.add(result)
+        headline = scene.result.content.splitlines()[0].strip()
+        words = {"goal": "GOAL", "wide": "Wide of the post", "post": "Hits the post", "bar": "Hits the bar"}
+        assert headline == f"**{words.get(result, headline.strip('*'))}**", (azimuth, result, headline)
+    assert {"goal", "wide"} <= seen
