@@ -30,16 +30,6 @@ settings.register_profile("explore", derandomize=False, deadline=None, print_blo
 settings.load_profile("deterministic")  # --hypothesis-profile, read after this file, overrides it
 
 
-@pytest.hookimpl(tryfirst=True)  # before xdist reads the groups
-def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
-    """Under pytest-xdist (``-n auto`` in pyproject): every browser test runs on one worker, one after another, since
-    each page keeps a core busy drawing software WebGL; every other file runs whole on one worker (its module
-    fixtures made once) while the other worker takes the next file."""
-    for item in items:
-        browser = item.get_closest_marker("browser") or "chromium_browser" in getattr(item, "fixturenames", ())
-        item.add_marker(pytest.mark.xdist_group("browser" if browser else item.path.stem))
-
-
 @pytest.fixture
 def server() -> Iterator[viser.ViserServer]:
     """A real ViserServer on a free loopback port, behind the app's message gate (as app.py puts it)."""
