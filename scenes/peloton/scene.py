@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Callable
 
 import numpy as np
 import trimesh
@@ -519,11 +520,7 @@ time-averaged power is the mean over positions, far below the leader's.
         group_scales[:MAX_RIDERS] = scales
 
         with self.server.atomic():
-            theta = math.atan(p.grade_pct / 100.0)
-            set_if_changed(self.course, "wxyz", (math.cos(-theta / 2), 0.0, math.sin(-theta / 2), 0.0))
-            if p.position != self._drawn_position:
-                show_position(self.riders_nodes, p.position)
-                self._drawn_position = p.position
+            self._tilt_and_pose()
             self._show_riders(group_positions, group_scales, rider_colours("body", MAX_GROUP))
 
             base = np.zeros(MAX_RIDERS)
@@ -562,17 +559,31 @@ time-averaged power is the mean over positions, far below the leader's.
                         (x[i], y[i], 1.95 + base[i] + lifts[i]),
                     )
 
-            rotation = self._rotation_markdown()
-            if self.rotation.content != rotation:
-                self.rotation.content = rotation
             set_if_changed(self.legend, "visible", False)
-            if readouts:
-                self._draw_wind()
-                self.density.content = self._density_markdown()
-                self.table.content = self._table_markdown()
-                self.chart.data = self._chart_data()
-                self.speed_out.content = self._speed_markdown()
+            self._show_panel(self._table_markdown, readouts=readouts)
         self.server.flush()
+
+    def _tilt_and_pose(self) -> None:
+        """Tilt the road to the grade and, when the riding position changed, pose every rider for it."""
+        p = self.params
+        theta = math.atan(p.grade_pct / 100.0)
+        set_if_changed(self.course, "wxyz", (math.cos(-theta / 2), 0.0, math.sin(-theta / 2), 0.0))
+        if p.position != self._drawn_position:
+            show_position(self.riders_nodes, p.position)
+            self._drawn_position = p.position
+
+    def _show_panel(self, table: Callable[[], str], *, readouts: bool) -> None:
+        """Write the lead rotation's words and, with ``readouts``, the wind, the density, ``table()``, the chart and
+        the speed: the readouts a line and a group share."""
+        rotation = self._rotation_markdown()
+        if self.rotation.content != rotation:
+            self.rotation.content = rotation
+        if readouts:
+            self._draw_wind()
+            self.density.content = self._density_markdown()
+            self.table.content = table()
+            self.chart.data = self._chart_data()
+            self.speed_out.content = self._speed_markdown()
 
     def _label_lifts(self, x: np.ndarray, slots: np.ndarray) -> np.ndarray:
         """(n_riders,) how far above its bar each rider's label sits (m): its slot's lift from the layout; a leader
@@ -611,11 +622,7 @@ time-averaged power is the mean over positions, far below the leader's.
         bodies = rider_colours("body", MAX_GROUP)
         bodies[:n] = power_colours(total[self.current_slots()], low, high)
         with self.server.atomic():
-            theta = math.atan(p.grade_pct / 100.0)
-            set_if_changed(self.course, "wxyz", (math.cos(-theta / 2), 0.0, math.sin(-theta / 2), 0.0))
-            if p.position != self._drawn_position:
-                show_position(self.riders_nodes, p.position)
-                self._drawn_position = p.position
+            self._tilt_and_pose()
             self._show_riders(positions, scales, bodies)
             for bar in self.bars.values():
                 set_if_changed(bar, "batched_scales", np.zeros((MAX_RIDERS, 3), np.float32))
@@ -627,15 +634,7 @@ time-averaged power is the mean over positions, far below the leader's.
             if self.legend.content != legend:
                 self.legend.content = legend
             set_if_changed(self.legend, "visible", True)
-            rotation = self._rotation_markdown()
-            if self.rotation.content != rotation:
-                self.rotation.content = rotation
-            if readouts:
-                self._draw_wind()
-                self.density.content = self._density_markdown()
-                self.table.content = self._group_table_markdown()
-                self.chart.data = self._chart_data()
-                self.speed_out.content = self._speed_markdown()
+            self._show_panel(self._group_table_markdown, readouts=readouts)
         self.server.flush()
 
     def _group_table_markdown(self) -> str:
