@@ -167,13 +167,15 @@ def drag_lift_table(speeds, rates, config, drag, lift):
         drag[i], lift[i] = drag_lift(speeds[i], rates[i], measured, c_d, c_l, radius, re_per_speed, re_crisis)
 
 
-@compiled()
-def _factors(speed, kick, config):
-    """(−½ρA·C_D·|v|/m, ½ρA·C_L·|v|/m) at this speed: drag and lift per unit velocity and mass (1/s)."""
-    q = config[Q]
-    drag, lift = drag_lift(
+@compiled(inline="always")
+def configured_drag_lift(speed, rate, config):
+    """:func:`drag_lift` under the (14,) settings' model: the force law's and the rolling ball's coefficients.
+
+    Inlined into its callers, so reading the settings here costs what reading them there did.
+    """
+    return drag_lift(
         speed,
-        kick[RATE],
+        rate,
         config[MEASURED],
         config[C_D],
         config[C_L],
@@ -181,6 +183,13 @@ def _factors(speed, kick, config):
         config[RE_PER_SPEED],
         config[RE_CRISIS],
     )
+
+
+@compiled()
+def _factors(speed, kick, config):
+    """(−½ρA·C_D·|v|/m, ½ρA·C_L·|v|/m) at this speed: drag and lift per unit velocity and mass (1/s)."""
+    q = config[Q]
+    drag, lift = configured_drag_lift(speed, kick[RATE], config)
     return -q * drag * speed, q * lift * speed
 
 

@@ -147,6 +147,26 @@ def crossing_fraction(d0, dd0, d1, dd1, h):
     return s
 
 
+@compiled(inline="always")
+def _energy_limit(vx, vy, vz, z, g):
+    """Bound on |v|² + 2gz past which a flight launched at (vx, vy, vz) from height ``z`` has diverged (m²/s²).
+
+    Drag dissipates and Magnus does no work, so |v|² + 2gz never grows but for the knuckle force's small push; a
+    step that overshoots the drag makes it grow without bound. The stability limit refuses such a step before the
+    flight; this guard stays for what it does not bound (Euler with much lift and little drag).
+    """
+    speed2 = vx * vx + vy * vy + vz * vz
+    return (speed2 + 2.0 * g * z) + (3.0 * (speed2 + 2.0 * abs(g) * (abs(z) + 1.0)) + 100.0)
+
+
+@compiled(inline="always")
+def _write_sample(t_out, state_out, n, t, x, y, z, vx, vy, vz):
+    """Sample ``n``: its time into ``t_out`` (T,), its position then velocity into ``state_out`` (T, 6)."""
+    t_out[n] = t
+    state_out[n, 0], state_out[n, 1], state_out[n, 2] = x, y, z
+    state_out[n, 3], state_out[n, 4], state_out[n, 5] = vx, vy, vz
+
+
 @compiled()
 def _fly(launch, kick, config, t_out, state_out):
     """Step one kick (its (13,) launch row and (14,) constants) until it lands, passes ``x_stop`` or runs out of time.
@@ -163,16 +183,10 @@ def _fly(launch, kick, config, t_out, state_out):
     refused = dt > max_stable_step(launch, kick, config)[0]
     n_steps = int(config[N_STEPS])
     x, y, z, vx, vy, vz = launch[0], launch[1], launch[2], launch[3], launch[4], launch[5]
-    # Drag dissipates and Magnus does no work, so |v|² + 2gz never grows but for the knuckle force's small push;
-    # a step that overshoots the drag makes it grow without bound. The stability limit refuses such a step before
-    # the flight; this guard stays for what it does not bound (Euler with much lift and little drag).
     g = config[GRAVITY]
-    energy_limit = vx * vx + vy * vy + vz * vz + 2.0 * g * z
-    energy_limit += 3.0 * (vx * vx + vy * vy + vz * vz + 2.0 * abs(g) * (abs(z) + 1.0)) + 100.0
+    energy_limit = _energy_limit(vx, vy, vz, z, g)
     if store:
-        t_out[0] = 0.0
-        state_out[0, 0], state_out[0, 1], state_out[0, 2] = x, y, z
-        state_out[0, 3], state_out[0, 4], state_out[0, 5] = vx, vy, vz
+        _write_sample(t_out, state_out, 0, 0.0, x, y, z, vx, vy, vz)
     if refused:
         return 1, 4
     t_max = config[T_MAX]
@@ -201,15 +215,11 @@ def _fly(launch, kick, config, t_out, state_out):
             if not math.isfinite(ex + ey + ez + evx + evy + evz):  # inf or NaN (or ~1e308)
                 ending = 3
             if store:
-                t_out[n + 1] = n * dt + f * h
-                state_out[n + 1, 0], state_out[n + 1, 1], state_out[n + 1, 2] = ex, ey, ez
-                state_out[n + 1, 3], state_out[n + 1, 4], state_out[n + 1, 5] = evx, evy, evz
+                _write_sample(t_out, state_out, n + 1, n * dt + f * h, ex, ey, ez, evx, evy, evz)
             return n + 2, ending
         x, y, z, vx, vy, vz = x1, y1, z1, vx1, vy1, vz1
         if store:
-            t_out[n + 1] = (n + 1) * dt if n < n_steps - 1 else t_max
-            state_out[n + 1, 0], state_out[n + 1, 1], state_out[n + 1, 2] = x, y, z
-            state_out[n + 1, 3], state_out[n + 1, 4], state_out[n + 1, 5] = vx, vy, vz
+            _write_sample(t_out, state_out, n + 1, (n + 1) * dt if n < n_steps - 1 else t_max, x, y, z, vx, vy, vz)
     # A state that overflowed stays inf or NaN to the end (NaN fails the ground test, so it runs to t_max).
     return n_steps + 1, 2 if math.isfinite(x + y + z + vx + vy + vz) else 3
 

@@ -25,24 +25,19 @@ import math
 import numpy as np
 from numba import prange
 
-from kernels.ball.aero import AXIS, GAIN, N_KICK, RATE, drag_lift, fill_kick, max_stable_step, sample_forces
+from kernels.ball.aero import AXIS, GAIN, N_KICK, RATE, configured_drag_lift, fill_kick, max_stable_step, sample_forces
 from kernels.ball.config import (
-    C_D,
-    C_L,
     DT,
     GRAVITY,
     GROUND,
-    MEASURED,
     N_STEPS,
     RADIUS,
-    RE_CRISIS,
-    RE_PER_SPEED,
     T_MAX,
     X_STOP,
     Q,
 )
 from kernels.ball.contact import N_SURFACE, impact
-from kernels.ball.core import _hermite, _step, crossing_fraction
+from kernels.ball.core import _energy_limit, _hermite, _step, _write_sample, crossing_fraction
 from kernels.ball.jit import compiled
 
 # Slots of the pitch vector.
@@ -234,16 +229,7 @@ def _roll_acceleration(vx, vy, kick, config, decel):
     speed = math.sqrt(vx * vx + vy * vy)
     if speed == 0.0:
         return 0.0, 0.0
-    c_d, _ = drag_lift(
-        speed,
-        speed / config[RADIUS],
-        config[MEASURED],
-        config[C_D],
-        config[C_L],
-        config[RADIUS],
-        config[RE_PER_SPEED],
-        config[RE_CRISIS],
-    )
+    c_d, _ = configured_drag_lift(speed, speed / config[RADIUS], config)
     k = decel / speed + config[Q] * c_d * speed
     return -k * vx, -k * vy
 
@@ -256,6 +242,13 @@ def _set_spin(kick, wx, wy, wz):
         kick[AXIS], kick[AXIS + 1], kick[AXIS + 2] = wx / rate, wy / rate, wz / rate
     else:
         kick[AXIS], kick[AXIS + 1], kick[AXIS + 2] = 0.0, 0.0, 0.0
+
+
+@compiled(inline="always")
+def _write_spin_sample(t_out, state_out, spin_out, n, t, x, y, z, vx, vy, vz, wx, wy, wz):
+    """The free flight's sample ``n`` (:func:`~kernels.ball.core._write_sample`) and its spin into ``spin_out``."""
+    _write_sample(t_out, state_out, n, t, x, y, z, vx, vy, vz)
+    spin_out[n, 0], spin_out[n, 1], spin_out[n, 2] = wx, wy, wz
 
 
 @compiled()
@@ -273,13 +266,9 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
     radius = config[RADIUS]
     x, y, z, vx, vy, vz = launch[0], launch[1], launch[2], launch[3], launch[4], launch[5]
     wx, wy, wz = launch[6], launch[7], launch[8]
-    energy_limit = vx * vx + vy * vy + vz * vz + 2.0 * g * z
-    energy_limit += 3.0 * (vx * vx + vy * vy + vz * vz + 2.0 * abs(g) * (abs(z) + 1.0)) + 100.0
+    energy_limit = _energy_limit(vx, vy, vz, z, g)
     if store:
-        t_out[0] = 0.0
-        state_out[0, 0], state_out[0, 1], state_out[0, 2] = x, y, z
-        state_out[0, 3], state_out[0, 4], state_out[0, 5] = vx, vy, vz
-        spin_out[0, 0], spin_out[0, 1], spin_out[0, 2] = wx, wy, wz
+        _write_spin_sample(t_out, state_out, spin_out, 0, 0.0, x, y, z, vx, vy, vz, wx, wy, wz)
     refused = dt > max_stable_step(launch, kick, config)[0]
     if refused:
         info[I_RESULT] = SHORT
@@ -438,10 +427,7 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
             x, y, z, vx, vy, vz = x1, y1, z1, vx1, vy1, vz1
             t = t + h
             if store and n < max_rows:
-                t_out[n] = t
-                state_out[n, 0], state_out[n, 1], state_out[n, 2] = x, y, z
-                state_out[n, 3], state_out[n, 4], state_out[n, 5] = vx, vy, vz
-                spin_out[n, 0], spin_out[n, 1], spin_out[n, 2] = wx, wy, wz
+                _write_spin_sample(t_out, state_out, spin_out, n, t, x, y, z, vx, vy, vz, wx, wy, wz)
             n += 1
             if stop_here:
                 ending = STOPPED
@@ -519,10 +505,7 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
             kick[GAIN] = 0.0  # the knuckle's unsteady wake is a launch effect; any contact ends it
             _set_spin(kick, wx, wy, wz)
         if store and n < max_rows:
-            t_out[n] = t
-            state_out[n, 0], state_out[n, 1], state_out[n, 2] = x, y, z
-            state_out[n, 3], state_out[n, 4], state_out[n, 5] = vx, vy, vz
-            spin_out[n, 0], spin_out[n, 1], spin_out[n, 2] = wx, wy, wz
+            _write_spin_sample(t_out, state_out, spin_out, n, t, x, y, z, vx, vy, vz, wx, wy, wz)
         n += 1
         if stop_here and kind < 0:
             ending, done = (STOPPED if not done else ending), True
