@@ -40,7 +40,7 @@ peloton (J. Wind Eng. Ind. Aerodyn. 179:319). Plain numpy over the (N, N) offset
 from __future__ import annotations
 
 import dataclasses
-from typing import Literal
+from typing import Any, Literal, NamedTuple
 
 import numba
 import numpy as np
@@ -308,8 +308,7 @@ def speed_for_power(
         r.drag, np.asarray(mass_kg, dtype=np.float64) * G * road, r.wind, target * r.efficiency
     )
     shape = broadcast[0].shape
-    a, c, w, p = (np.array(x, dtype=np.float64).ravel() for x in broadcast)
-    return _largest_root(a, c, w, p).reshape(shape)
+    return _largest_root(_PowerBalance(*(np.array(x, dtype=np.float64).ravel() for x in broadcast))).reshape(shape)
 
 
 SPEED_FOR_POWER_DOMAIN: dict[str, tuple[float, float]] = {
@@ -324,10 +323,25 @@ SPEED_FOR_POWER_DOMAIN: dict[str, tuple[float, float]] = {
 …) still apply. Within them no intermediate of the solver overflows or underflows to a wrong answer."""
 
 
-def _largest_root(
-    a: NDArray[np.float64], c: NDArray[np.float64], w: NDArray[np.float64], p: NDArray[np.float64]
-) -> NDArray[np.float64]:
-    """Largest v ≥ 0 with a·v·(v + w)|v + w| + c·v = p, all (N,), a > 0, p ≥ 0 (see :func:`speed_for_power`).
+class _PowerBalance(NamedTuple):
+    """The wheel-power balance a·v·(v + w)|v + w| + c·v = p that :func:`speed_for_power` solves for v, per point."""
+
+    a: NDArray[np.float64]
+    """½ρ·CdA (kg/m), > 0."""
+    c: NDArray[np.float64]
+    """Rolling plus climbing, m·g·cos θ·(Crr + grade) (N)."""
+    w: NDArray[np.float64]
+    """Headwind (m/s)."""
+    p: NDArray[np.float64]
+    """Power at the wheel (W), ≥ 0."""
+
+    def at(self, index: Any) -> _PowerBalance:
+        """The balance at ``index`` of every coefficient (a subset, or a new axis to broadcast against)."""
+        return _PowerBalance(self.a[index], self.c[index], self.w[index], self.p[index])
+
+
+def _largest_root(balance: _PowerBalance) -> NDArray[np.float64]:
+    """Largest v ≥ 0 of the ``balance``, all (N,), a > 0, p ≥ 0 (see :func:`speed_for_power`).
 
     Each step takes Newton's point when it stays in the bracket, else the bracket's secant point (Newton
     overshoots on the concave part of a tailwind branch, and the root may sit at the bracket's low end), else its
@@ -335,18 +349,17 @@ def _largest_root(
     the bracket is one ulp wide, then keeps whichever of v and its two float neighbours gives the smallest |f|.
     """
     with np.errstate(all="ignore"):
-        return _largest_root_unguarded(a, c, w, p)
+        return _largest_root_unguarded(balance)
 
 
-def _largest_root_unguarded(
-    a: NDArray[np.float64], c: NDArray[np.float64], w: NDArray[np.float64], p: NDArray[np.float64]
-) -> NDArray[np.float64]:
+def _largest_root_unguarded(balance: _PowerBalance) -> NDArray[np.float64]:
+    a, c, w, p = balance
     balance_air = np.sign(-c) * np.sqrt(np.abs(c) / a)  # air speed at which drag balances c: g = 0
     v0 = np.maximum(balance_air - w, 0.0)
     lo, f_lo = v0.copy(), -p  # P(v0) = 0
     hi = v0 + 2.0 * np.abs(balance_air) + np.cbrt(p / a)  # P(hi) ≥ p: see the docstring's bracket
-    f_hi = np.maximum(_residual(hi, a, c, w, p)[0], 0.0)
-    v = np.clip(_cubic_guess(a, c, w, p, v0), lo, hi)
+    f_hi = np.maximum(_residual(hi, balance)[0], 0.0)
+    v = np.clip(_cubic_guess(balance, v0), lo, hi)
     v = np.where(np.isfinite(v), v, 0.5 * (lo + hi))
     active = p > 0.0  # P = 0: v0 is the answer
     v = np.where(active, v, v0)
@@ -356,8 +369,8 @@ def _largest_root_unguarded(
         if idx.size == 0:
             break
         # Work on the unconverged points only: most converge in three or four steps.
-        vi, ai, ci, wi, pi = v[idx], a[idx], c[idx], w[idx], p[idx]
-        f, g, g_slope, noise = _residual(vi, ai, ci, wi, pi)
+        vi, balance_i = v[idx], balance.at(idx)
+        f, g, g_slope, noise = _residual(vi, balance_i)
         below, above = f < 0.0, f > 0.0
         lo_i = np.where(below, vi, lo[idx])
         f_lo_i = np.where(below, f, f_lo[idx])
@@ -367,7 +380,7 @@ def _largest_root_unguarded(
         df = g + vi * g_slope
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             # v − f/df rearranged: on the bracket g ≥ 0, so no term cancels and a root near 0 keeps its digits.
-            newton = (pi + vi * vi * g_slope) / df
+            newton = (balance_i.p + vi * vi * g_slope) / df
             secant = lo_i - f_lo_i * (hi_i - lo_i) / (f_hi_i - f_lo_i)
         step = np.where(
             (newton >= lo_i) & (newton <= hi_i),
@@ -385,20 +398,14 @@ def _largest_root_unguarded(
         vs = v[solved]
         candidates = np.stack([vs, np.nextafter(vs, -np.inf), np.nextafter(vs, np.inf)], axis=1)
         candidates = np.maximum(candidates, v0[solved, None])
-        args = (a[solved, None], c[solved, None], w[solved, None], p[solved, None])
-        f_all = np.abs(_residual(candidates, *args)[0])
+        f_all = np.abs(_residual(candidates, balance.at((solved, None)))[0])
         v[solved] = candidates[np.arange(solved.size), np.argmin(f_all, axis=1)]
     return v
 
 
-def _residual(
-    v: NDArray[np.float64],
-    a: NDArray[np.float64],
-    c: NDArray[np.float64],
-    w: NDArray[np.float64],
-    p: NDArray[np.float64],
-) -> tuple[NDArray[np.float64], ...]:
+def _residual(v: NDArray[np.float64], balance: _PowerBalance) -> tuple[NDArray[np.float64], ...]:
     """f = v·g(v) − p, g, dg/dv, and the rounding level of f's terms."""
+    a, c, w, p = balance
     u = v + w
     drag = a * u * np.abs(u)
     g = drag + c
@@ -410,19 +417,14 @@ _MAX_POLISH_STEPS = 200
 """Bound on the safeguarded Newton steps; bisection alone halves a bracket to one ulp in about 60."""
 
 
-def _cubic_guess(
-    a: NDArray[np.float64],
-    c: NDArray[np.float64],
-    w: NDArray[np.float64],
-    p: NDArray[np.float64],
-    v0: NDArray[np.float64],
-) -> NDArray[np.float64]:
+def _cubic_guess(balance: _PowerBalance, v0: NDArray[np.float64]) -> NDArray[np.float64]:
     """Closed-form root of the cubic on the branch that holds the root: the first guess for the polish.
 
     Branch s = +1 (v ≥ −w, air from ahead): a·v³ + 2aw·v² + (aw² + c)·v − p = 0; branch s = −1 (v < −w, a
     tailwind faster than the rider) has every coefficient but c negated. The root lies on branch −1 when v₀ < −w
     and P(−w) = −c·w ≥ p.
     """
+    a, c, w, p = balance
     sign = np.where((v0 < -w) & (-c * w >= p), -1.0, 1.0)
     lead = sign * a
     roots = _cubic_real_roots(2.0 * w, (lead * w * w + c) / lead, -p / lead)
