@@ -22,11 +22,10 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tests"))
 
 import viser  # noqa: E402
-from helpers.wsclient import BrowserClient  # noqa: E402
 
 from bench._timing import row as timing_row  # noqa: E402
 from bench._timing import time_handling, timings  # noqa: E402
-from bench.bench_peloton import machine  # noqa: E402
+from bench.bench_peloton import machine, speed_round_trips  # noqa: E402
 from kernels import cycling  # noqa: E402
 from scenes.peloton import PelotonScene  # noqa: E402
 from server.switcher import SceneSwitcher  # noqa: E402
@@ -64,23 +63,7 @@ def server_rows() -> None:
     server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
     switcher, scene = bunch_scene(server)
     handling = time_handling(scene, ("speed_kmh",))
-    round_trips: list[float] = []
-    with BrowserClient(server.get_port()) as client:
-        client.wait_for_gui("Speed (km/h)")
-        time.sleep(0.5)
-        for i in range(120):
-            speed = 20.0 + (i % 50)
-            expected = leader_watts(speed)
-            start = time.perf_counter()
-            client.set_value("Speed (km/h)", speed)
-            client.wait_for(
-                lambda expected=expected: any(
-                    expected in str(e["props"].get("_markdown", "")) for e in client.gui.values()
-                ),
-                what="redrawn table",
-            )
-            round_trips.append(time.perf_counter() - start)
-            time.sleep(0.02)
+    round_trips = speed_round_trips(server, leader_watts)
     switcher.close()
     server.stop()
     row("121 riders: slider -> callback -> redraw (server)", handling, 1e-3, "ms", "goal p95 <= 16 ms")
