@@ -326,22 +326,19 @@ _OPERATORS = {
     "LEFT_OP": "<<",
     "RIGHT_OP": ">>",
 }
-_KINDS: dict[str, tuple[str, str]] = {
-    "BASIC_TYPE_TOK": ("type", "a type name"),
-    "TYPE_IDENTIFIER": ("name", "a type name"),
-    "TYPE_NAME": ("name", "a type name"),
-    "NEW_IDENTIFIER": ("name", "a name"),
-    "IDENTIFIER": ("name", "a name"),
-    "FIELD_SELECTION": ("name", "a field name"),
-    "FLOATCONSTANT": ("number", "a number"),
-    "DOUBLECONSTANT": ("number", "a number"),
-    "INTCONSTANT": ("number", "a whole number"),
-    "UINTCONSTANT": ("number", "a whole number"),
-    "BOOLCONSTANT": ("name", "true or false"),
-    "$end": ("end", "the end of the text"),
-    "end of file": ("end", "the end of the text"),
+_KIND_NAMES: dict[tuple[str, str], tuple[str, ...]] = {
+    ("type", "a type name"): ("BASIC_TYPE_TOK",),
+    ("name", "a type name"): ("TYPE_IDENTIFIER", "TYPE_NAME"),
+    ("name", "a name"): ("NEW_IDENTIFIER", "IDENTIFIER"),
+    ("name", "a field name"): ("FIELD_SELECTION",),
+    ("number", "a number"): ("FLOATCONSTANT", "DOUBLECONSTANT"),
+    ("number", "a whole number"): ("INTCONSTANT", "UINTCONSTANT"),
+    ("name", "true or false"): ("BOOLCONSTANT",),
+    ("end", "the end of the text"): ("$end", "end of file"),
 }
-"""Mesa's (bison's) token names: which kind of token of the source each stands for, and in words."""
+"""Mesa's (bison's) token names by what they stand for: the kind of token of the source, and in words."""
+_KINDS: dict[str, tuple[str, str]] = {name: kind for kind, names in _KIND_NAMES.items() for name in names}
+"""Each token name's (kind, words), from :data:`_KIND_NAMES`."""
 _TYPE_WORDS = re.compile(r"(?:[biud]?vec[234]|d?mat[234](?:x[234])?|float|double|u?int|bool|void|sampler\w*)$")
 _TOKEN_NAME = re.compile(r"\$end|end of file|\b(?:[A-Z][A-Z0-9]*_)*[A-Z][A-Z0-9]*(?:_[A-Z0-9]+)*\b")
 _SYNTAX = re.compile(r"^syntax error, unexpected (.+?)(?:, expecting (.+?))?(?: at token .*)?$")
