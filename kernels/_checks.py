@@ -12,7 +12,7 @@ under a microsecond per argument here.
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -21,6 +21,8 @@ __all__ = [
     "bounded_array",
     "finite_array",
     "finite_number",
+    "instance",
+    "integer",
     "non_negative",
     "non_negative_array",
     "points",
@@ -31,6 +33,7 @@ __all__ = [
 ]
 
 _REAL_SCALARS = (float, int, np.floating, np.integer)
+T = TypeVar("T")
 
 
 def finite_number(name: str, value: object) -> float:
@@ -45,6 +48,25 @@ def finite_number(name: str, value: object) -> float:
         if math.isfinite(number):
             return number
     raise ValueError(f"{name} must be a finite number, got {value!r}")
+
+
+def integer(name: str, value: object, minimum: int | None = None) -> int:
+    """``value`` as an int when it is a Python or numpy integer (not bool), ≥ ``minimum`` if given, else
+    ``ValueError`` naming it."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or (minimum is not None and value < minimum):
+        at_least = "" if minimum is None else f" >= {minimum}"
+        raise ValueError(f"{name} must be an integer{at_least}, got {value!r}")
+    return int(value)
+
+
+def instance(name: str, value: object, kind: type[T], what: str = "") -> T:
+    """``value`` when it is a ``kind``, else ``ValueError`` naming it and the type it got.
+
+    ``what`` says what was wanted where "a <kind's name>" does not ("an Air", "a Trajectory from simulate()").
+    """
+    if not isinstance(value, kind):
+        raise ValueError(f"{name} must be {what or 'a ' + kind.__name__}, got {type(value).__name__}")
+    return value
 
 
 def positive(name: str, value: object) -> float:

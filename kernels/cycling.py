@@ -121,8 +121,7 @@ def drag_reduction(n_riders: int, gap_m: float, model: DraftModel = "measured") 
     Returns:
         (n_riders,) reductions in [0, 1); effective CdA is ``cda·(1 − reduction)``.
     """
-    if isinstance(n_riders, bool) or not isinstance(n_riders, (int, np.integer)) or n_riders < 1:
-        raise ValueError(f"n_riders must be an integer >= 1, got {n_riders!r}")
+    _checks.integer("n_riders", n_riders, 1)
     gap = float(_non_negative("gap_m", gap_m))
     reduction = np.zeros(int(n_riders))
     if n_riders == 1:
@@ -783,8 +782,7 @@ def formation(
     Raises:
         ValueError: an argument is out of range; the message names it.
     """
-    if isinstance(n_riders, bool) or not isinstance(n_riders, (int, np.integer)):
-        raise ValueError(f"n_riders must be an integer, got {n_riders!r}")
+    _checks.integer("n_riders", n_riders)
     if not 1 <= n_riders <= MAX_FORMATION_RIDERS:
         raise ValueError(f"n_riders must be in [1, {MAX_FORMATION_RIDERS}], got {n_riders!r}")
     gap = _checks.non_negative("gap_m", gap_m)

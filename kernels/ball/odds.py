@@ -78,9 +78,7 @@ def draw_strikes(
     normal angle in a uniformly drawn direction. The first strike is always the kick itself.
     """
     spread = spread.checked()
-    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
-        raise ValueError(f"n must be an integer >= 1, got {n!r}")
-    count = int(n)
+    count = _checks.integer("n", n, 1)
     rng = np.random.default_rng(checked_seed("draw", draw))
     normal = rng.standard_normal((count, 5))
     normal[0] = 0.0
@@ -181,8 +179,7 @@ def odds_map(
     distances = _checks.finite_array("distances_m", distances_m).reshape(-1)
     angles = _checks.finite_array("angles_rad", angles_rad).reshape(-1)
     spin = checked_vector("spin_rads", spin_rads, 3)
-    if isinstance(chunks, bool) or not isinstance(chunks, (int, np.integer)) or chunks < 1:
-        raise ValueError(f"chunks must be an integer >= 1, got {chunks!r}")
+    _checks.integer("chunks", chunks, 1)
     settings = flight_config(None, options).settings
     ground, radius = float(settings[GROUND]), float(settings[RADIUS])
     # One scatter, drawn along +x, turned to each spot.

@@ -241,8 +241,7 @@ def _surface_slots(name: str, surface: Surface, radius: float) -> list[float]:
 def pitch_vector(pitch: Pitch, ball_xy: ArrayLike, ground_m: float, radius_m: float) -> NDArray[np.float64]:
     """The compiled flight's (N_PITCH,) pitch vector (slots in :mod:`kernels.ball.play`), checked (``ValueError``
     naming the field). ``ball_xy`` places a keeper without a position."""
-    if not isinstance(pitch, Pitch):
-        raise ValueError(f"pitch must be a Pitch, got {type(pitch).__name__}")
+    _checks.instance("pitch", pitch, Pitch)
     vector = np.zeros(play.N_PITCH)
     goal_row = panel_rows(pitch.wall or pitch.goal, pitch.goal)[1]
     vector[play.GX : play.GH + 1] = goal_row
@@ -273,8 +272,7 @@ def pitch_vector(pitch: Pitch, ball_xy: ArrayLike, ground_m: float, radius_m: fl
         vector[play.PLAYER_R] = wall_row[4] / (2.0 * players)
     keeper = pitch.keeper
     if keeper is not None:
-        if not isinstance(keeper, Keeper):
-            raise ValueError(f"pitch.keeper must be a Keeper, got {type(keeper).__name__}")
+        _checks.instance("pitch.keeper", keeper, Keeper)
         kx, ky = keeper.placed(ball_xy, pitch.goal)
         vector[play.KEEPER_ON] = 1.0
         vector[play.KX], vector[play.KY] = kx, ky

@@ -336,12 +336,9 @@ class _Segments:
 
 
 def _segments(course: Course, rider: Rider, wind_ms: float, wind_from_deg: float, air: Air) -> _Segments:
-    if not isinstance(course, Course):
-        raise ValueError(f"course must be a Course, got {type(course).__name__}")
-    if not isinstance(rider, Rider):
-        raise ValueError(f"rider must be a Rider, got {type(rider).__name__}")
-    if not isinstance(air, Air):
-        raise ValueError(f"air must be an Air, got {type(air).__name__}")
+    _checks.instance("course", course, Course)
+    _checks.instance("rider", rider, Rider)
+    _checks.instance("air", air, Air, "an Air")
     wind = _checks.finite_number("wind_ms", wind_ms)
     wind_from = math.radians(_checks.finite_number("wind_from_deg", wind_from_deg))
     rolling, climbing = cycling.road_forces(rider.mass_kg, rider.crr, course.grade)

@@ -26,6 +26,7 @@ import trimesh
 from numpy.typing import ArrayLike, NDArray
 from skimage.measure import label, marching_cubes
 
+from kernels import _checks
 from kernels.sdf.primitives import FloatArray
 from kernels.sdf.scene import Primitive, Scene, fold_xyz, scene_bounds, scene_color
 
@@ -55,8 +56,7 @@ def make_grid(scene: Scene, resolution: int, bounds: ArrayLike | None = None) ->
         resolution: samples along the longest side, 16..512.
         bounds: optional (2, 3) min and max corners (m).
     """
-    if isinstance(resolution, bool) or not isinstance(resolution, (int, np.integer)):
-        raise ValueError(f"resolution must be an integer, got {resolution!r}")
+    _checks.integer("resolution", resolution)
     if not MIN_RESOLUTION <= int(resolution) <= MAX_RESOLUTION:
         raise ValueError(f"resolution must be in {MIN_RESOLUTION}..{MAX_RESOLUTION}, got {resolution}")
     if bounds is None:
