@@ -270,6 +270,14 @@ def simulate(
     n, ending = simulate_one(launch, settings, t, state, forces)
     if ending >= 3:
         _refuse_overflow(np.array([ending]), settings, launch[None])
+    return _trajectory(t, state, forces, n, ending)
+
+
+def _trajectory(
+    t: NDArray[np.float64], state: NDArray[np.float64], forces: NDArray[np.float64], n: int, ending: int
+) -> Trajectory:
+    """The first ``n`` samples of a flight's buffers: times (T,), states (T, 6) and forces (T, 12: drag, Magnus,
+    gravity, knuckle), ended by ``ending``'s code."""
     state, forces = state[:n], forces[:n]
     return Trajectory(
         t=t[:n],
@@ -305,8 +313,7 @@ def _cached_pitch_vector(pitch: Pitch, spot: tuple[float, float], ground: float,
 
 def _pitch_vector(pitch: Pitch, spot: NDArray[np.float64], ground: float, radius: float) -> NDArray[np.float64]:
     """:func:`pitch_vector`, cached for a pitch flown again from the same spot (the checks cost more than a kick)."""
-    if not isinstance(pitch, Pitch):
-        raise ValueError(f"pitch must be a Pitch, got {type(pitch).__name__}")
+    _checks.instance("pitch", pitch, Pitch)
     try:
         return _cached_pitch_vector(pitch, (float(spot[0]), float(spot[1])), ground, radius)
     except TypeError:  # a field that cannot be hashed (an array where a tuple belongs): checked uncached
@@ -323,16 +330,8 @@ def _simulate_on_pitch(launch: NDArray[np.float64], settings: NDArray[np.float64
     n, ending = play_one(launch, settings, vector, t, state, spin, forces, events, info)
     if ending in (3, 4):
         _refuse_overflow(np.array([ending]), settings, launch[None])
-    state, forces = state[:n], forces[:n]
-    return Trajectory(
-        t=t[:n],
-        position=state[:, :3],
-        velocity=state[:, 3:],
-        drag=forces[:, 0:3],
-        magnus=forces[:, 3:6],
-        gravity=forces[:, 6:9],
-        knuckle=forces[:, 9:12],
-        ended=_ending(ending),
+    return dataclasses.replace(
+        _trajectory(t, state, forces, n, ending),
         events=_events(events, int(info[play.I_EVENTS])),
         spin=spin[:n],
         result=RESULTS[int(info[play.I_RESULT])],
@@ -373,9 +372,7 @@ def simulate_batch(
     Returns:
         :class:`BatchTrajectory`.
     """
-    settings = flight_config(config, options).settings
-    launches = kick_rows(positions, velocities, spins, knuckle_seeds)
-    check_launches(launches, settings, batch=True)
+    settings, launches = _checked_batch(positions, velocities, spins, knuckle_seeds, config, options)
     if pitch is not None:
         return _batch_on_pitch(launches, settings, pitch)
     k = len(launches)
@@ -402,6 +399,21 @@ def simulate_batch(
         n_samples=n_samples,
         ended=np.array(ENDINGS, dtype="<U6")[endings],
     )
+
+
+def _checked_batch(
+    positions: ArrayLike,
+    velocities: ArrayLike,
+    spins: ArrayLike,
+    knuckle_seeds: Sequence[int | None] | None,
+    config: FlightConfig | None,
+    options: dict[str, Any],
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """A batch's (14,) settings and its (K, 13) launch rows, checked (``ValueError`` naming the argument)."""
+    settings = flight_config(config, options).settings
+    launches = kick_rows(positions, velocities, spins, knuckle_seeds)
+    check_launches(launches, settings, batch=True)
+    return settings, launches
 
 
 def _play_batch(
@@ -485,8 +497,7 @@ def outcome(trajectory: Trajectory, wall: Panel, goal: Panel, *, radius_m: float
         :class:`Outcome`.
     """
     radius = _checks.positive("radius_m", radius_m)
-    if not isinstance(trajectory, Trajectory):
-        raise ValueError(f"trajectory must be a Trajectory from simulate(), got {type(trajectory).__name__}")
+    _checks.instance("trajectory", trajectory, Trajectory, "a Trajectory from simulate()")
     crossings = np.empty((2, 4))
     t, position, velocity = trajectory.t, trajectory.position, trajectory.velocity
     code = judge(t, position, velocity, len(t), panel_rows(wall, goal), radius, crossings)
@@ -513,8 +524,7 @@ def outcome_batch(batch: BatchTrajectory, wall: Panel, goal: Panel, *, radius_m:
         :class:`BatchOutcome`.
     """
     radius = _checks.positive("radius_m", radius_m)
-    if not isinstance(batch, BatchTrajectory):
-        raise ValueError(f"batch must be a BatchTrajectory from simulate_batch(), got {type(batch).__name__}")
+    _checks.instance("batch", batch, BatchTrajectory, "a BatchTrajectory from simulate_batch()")
     k = len(batch.n_samples)
     results, crossings, panels = (
         np.empty(k, dtype=np.int64),
@@ -574,12 +584,9 @@ def simulate_outcomes(
     Returns:
         :class:`BatchOutcome`.
     """
-    settings = flight_config(config, options).settings
-    launches = kick_rows(positions, velocities, spins, knuckle_seeds)
-    check_launches(launches, settings, batch=True)
+    settings, launches = _checked_batch(positions, velocities, spins, knuckle_seeds, config, options)
     if pitch is not None:
-        if not isinstance(pitch, Pitch):
-            raise ValueError(f"pitch must be a Pitch, got {type(pitch).__name__}")
+        _checks.instance("pitch", pitch, Pitch)
         if (wall is not None and wall != pitch.wall) or (goal is not None and goal != pitch.goal):
             raise ValueError("with a pitch, wall and goal are the pitch's own: pass None (or the same panels)")
         *_, info, _, _ = _play_batch(launches, settings, *_one_pitch(launches, settings, pitch), keep=False)
