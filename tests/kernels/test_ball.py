@@ -4,14 +4,13 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import subprocess
-import sys
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
+from helpers.processes import python_stdout
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from numpy.typing import NDArray
@@ -882,15 +881,7 @@ print(before, sum(len(core.signatures) for core in cores))
 def test_after_warm_up_nothing_compiles() -> None:
     # In a fresh process (loading numba's cache, or compiling once): every use of the public API afterwards runs
     # code warm_up() already compiled, so the app's first page and first drag never wait for a compile.
-    result = subprocess.run(
-        [sys.executable, "-c", WARM_CHECK],
-        cwd=ROOT,
-        capture_output=True,
-        text=True,
-        timeout=600,
-        check=True,
-    )
-    before, after = map(int, result.stdout.split())
+    before, after = map(int, python_stdout(WARM_CHECK, timeout_s=600, cwd=ROOT).split())
     assert before > 0 and after == before
 
 

@@ -6,14 +6,13 @@ import dataclasses
 import itertools
 import math
 import os
-import subprocess
-import sys
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
 from helpers import ik_reference
+from helpers.processes import python_stdout
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from numpy.typing import NDArray
@@ -865,17 +864,7 @@ def test_compile_cache_falls_back_to_a_user_directory_when_the_package_is_read_o
         "XDG_CACHE_HOME": str(tmp_path / "user-cache"),
     }
     environment.pop("NUMBA_CACHE_DIR", None)
-    runs = [
-        subprocess.run(
-            [sys.executable, "-c", script],
-            env=environment,
-            capture_output=True,
-            text=True,
-            timeout=120,
-            check=True,
-        ).stdout.split()
-        for _ in range(2)
-    ]
+    runs = [python_stdout(script, timeout_s=120, env=environment).split() for _ in range(2)]
     assert runs[0][1].startswith(str(tmp_path / "user-cache" / "numba"))
     assert any(path.suffix == ".nbc" for path in (tmp_path / "user-cache").rglob("*"))
     assert (runs[0][0], runs[1][0]) == ("0", "1")  # compiled once, then loaded from the user cache
