@@ -56,14 +56,20 @@ def client_joints(client: BrowserClient) -> np.ndarray | None:
     return client.visible_instances("/arm/skeleton/joints")
 
 
+def choose_preset(client: BrowserClient, scene: ArmScene, label: _skeletons.PresetLabel) -> None:
+    """Pick skeleton preset ``label`` from the browser and wait until the scene has shown and solved it."""
+    view = scene.skeletons
+    client.wait_for_gui("Preset")
+    client.set_value("Preset", label)
+    client.wait_for(lambda: view.preset == label and view.solves >= 1, what=f"{label} shown")
+
+
 def test_choosing_the_hand_and_dragging_a_fingertip_target_curls_the_finger(
     server: viser.ViserServer, scene: ArmScene
 ) -> None:
     view = scene.skeletons
     with BrowserClient(server.get_port()) as client:
-        client.wait_for_gui("Preset")
-        client.set_value("Preset", "Hand")
-        client.wait_for(lambda: view.preset == "Hand" and view.solves >= 1, what="the hand shown")
+        choose_preset(client, scene, "Hand")
         assert not scene.link_nodes.visible and not scene.target_gizmo.visible  # the chain is hidden
         index = 1
         start = view.targets[index].copy()
@@ -100,9 +106,7 @@ def test_crafted_skeleton_gizmo_and_preset_messages_keep_the_last_good_state(
 ) -> None:
     view = scene.skeletons
     with BrowserClient(server.get_port()) as client:
-        client.wait_for_gui("Preset")
-        client.set_value("Preset", "Upper body")
-        client.wait_for(lambda: view.preset == "Upper body" and view.solves >= 1, what="the body shown")
+        choose_preset(client, scene, "Upper body")
         pose, targets, solves = view.pose.copy(), view.targets.copy(), view.solves
         client.drag_transform("/arm/skeleton/target_0", [bad])
         client.wait_for(lambda: view.gizmo_events >= 3, what="the crafted drag handled")

@@ -346,13 +346,16 @@ def assert_within_the_budget(times: list[float]) -> None:
             assert j - i + 1 <= COSTLY_BURST + (times[j] - start) * COSTLY_RATE_HZ + 1e-9
 
 
-@given(
-    st.lists(
-        st.tuples(st.floats(0.0, 0.6), st.sampled_from("abc"), st.integers(0, 9)),
+def arrivals_of(controls: str) -> st.SearchStrategy[list[tuple[float, str, int]]]:
+    """1 to 80 arrivals (gap s, control, value) of the one-letter ``controls``, as ``replay`` takes them."""
+    return st.lists(
+        st.tuples(st.floats(0.0, 0.6), st.sampled_from(controls), st.integers(0, 9)),
         min_size=1,
         max_size=80,
     )
-)
+
+
+@given(arrivals_of("abc"))
 def test_the_budget_bounds_work_and_delivers_each_controls_last_value(
     arrivals: list[tuple[float, str, int]],
 ) -> None:
@@ -365,13 +368,7 @@ def test_the_budget_bounds_work_and_delivers_each_controls_last_value(
     assert_within_the_budget([t for t, _key, _value in delivered])
 
 
-@given(
-    st.lists(
-        st.tuples(st.floats(0.0, 0.6), st.sampled_from("abcxy"), st.integers(0, 9)),
-        min_size=1,
-        max_size=80,
-    )
-)
+@given(arrivals_of("abcxy"))
 def test_an_input_after_a_held_back_one_is_applied_after_it(
     arrivals: list[tuple[float, str, int]],
 ) -> None:
