@@ -769,21 +769,22 @@ def assert_chart_fits_after(
     """
     scene = shown.scene
     assert_tick_labels_inside(shown.page, title)
-    for change in changes:
-        set_number(shown.page, change.label, change.value)
-    wait_until(
-        lambda: all(getattr(scene.params, c.field) == c.value for c in changes),
-        f"{[c.field for c in changes]} set",
-    )
+    _type_numbers(shown, [(c.label, c.field, c.value) for c in changes], "set")
     with scene._lock:
         data = chart_data(scene)
     check(data)
     wait_chart_data(shown.page, title, data)
     assert_chart_shows_its_data(shown.page, title, data)
     assert_tick_labels_inside(shown.page, title)
-    for change in changes:
-        set_number(shown.page, change.label, change.restore)
+    _type_numbers(shown, [(c.label, c.field, c.restore) for c in changes], "back")
+
+
+def _type_numbers(shown: ScenePage, typed: Sequence[tuple[str, str, float]], what: str) -> None:
+    """Type each ``(label, field, value)`` into its number control, then wait until the scene's parameters hold them
+    all (``what`` names the wait: "set", "back")."""
+    for label, _field, value in typed:
+        set_number(shown.page, label, value)
     wait_until(
-        lambda: all(getattr(scene.params, c.field) == c.restore for c in changes),
-        f"{[c.field for c in changes]} back",
+        lambda: all(getattr(shown.scene.params, field) == value for _label, field, value in typed),
+        f"{[field for _label, field, _value in typed]} {what}",
     )

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 import viser
 from helpers.ci import need_gl
-from helpers.scenes import MakeScene
+from helpers.scenes import scene_fixture
 from helpers.waiting import wait_until
 from helpers.wsclient import BrowserClient
 from hypothesis import HealthCheck, given, settings
@@ -326,11 +326,13 @@ def test_a_compile_error_names_its_line_in_words(program: tuple[list[str], list[
 
 
 # ------------------------------------------------------------------------------------------ through the scene
+scene = scene_fixture(SdfGalleryScene)
+
+
 @pytest.mark.gl
 def test_the_editor_applies_a_const_in_source_and_names_an_unclosed_brace(
-    server: viser.ViserServer, show_scene: MakeScene
+    server: viser.ViserServer, scene: SdfGalleryScene
 ) -> None:
-    scene = show_scene(SdfGalleryScene)
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("sdf(p) in GLSL")
         client.set_value("sdf(p) in GLSL", QUILEZ_STYLE[1])

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 import trimesh
 import viser
-from helpers.scenes import MakeScene
+from helpers.scenes import MakeScene, scene_fixture
 from helpers.waiting import wait_until
 from helpers.wsclient import BrowserClient
 from hypothesis import given, settings
@@ -75,10 +75,12 @@ def triangles_in(data: bytes, fmt: str) -> int:
 
 
 # ------------------------------------------------------------------------------------------ through the scene
+scene = scene_fixture(SdfGalleryScene)
+
+
 def test_an_empty_shape_downloads_nothing_and_says_so_for_every_mesh_format(
-    server: viser.ViserServer, show_scene: MakeScene
+    server: viser.ViserServer, scene: SdfGalleryScene
 ) -> None:
-    scene = show_scene(SdfGalleryScene)
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("P4 combine")
         for slot in (2, 3, 4):
@@ -101,9 +103,8 @@ def test_an_empty_shape_downloads_nothing_and_says_so_for_every_mesh_format(
 
 
 def test_a_shape_downloads_as_files_that_parse_back_with_its_triangles(
-    server: viser.ViserServer, show_scene: MakeScene
+    server: viser.ViserServer, scene: SdfGalleryScene
 ) -> None:
-    scene = show_scene(SdfGalleryScene)
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("Download mesh (GLB)")
         triangles = len(scene.mesh_faces)
