@@ -59,24 +59,25 @@ def test_a_2_m_drop_rebounds_inside_fifa_quality_pros_band_and_settles_to_a_stop
     assert 0.60 <= rebound < 0.72
 
 
+def first_bounce(
+    speed_ms: float, elevation_rad: float, spin_rad_s: tuple[float, float, float], t_max: float
+) -> tuple[ball.Trajectory, int]:
+    """A ball launched along +x from the turf at the origin, over the bare pitch in a vacuum (dt 1 ms): its flight,
+    and the index of the sample at its first event, which is asserted to be a bounce on the ground."""
+    velocity = (speed_ms * math.cos(elevation_rad), 0.0, speed_ms * math.sin(elevation_rad))
+    flight = ball.simulate((0.0, 0.0, R), velocity, spin_rad_s, dt=1e-3, t_max=t_max, pitch=BARE, **VACUUM)
+    first = flight.events[0]
+    assert first.kind == "ground"
+    return flight, int(np.flatnonzero(flight.t == first.t)[0])
+
+
 def test_fifas_oblique_test_in_flight_leaves_at_45_to_60_percent_of_its_speed() -> None:
     # Launched from the turf at 13.9 m/s and 25° in a vacuum, the ball lands at the same speed and angle: FIFA's
     # angle-behaviour test (13.9 m/s at 25°, no spin; 45–60 % kept). By hand (Cross 2002, e_n 0.6, e_t 0.1, μ 0.6):
     # it grips and leaves at 56.74 % of its speed.
     angle = math.radians(25.0)
-    flight = ball.simulate(
-        (0.0, 0.0, R),
-        (13.9 * math.cos(angle), 0.0, 13.9 * math.sin(angle)),
-        (0.0, 0.0, 0.0),
-        dt=1e-3,
-        t_max=4.0,
-        pitch=BARE,
-        **VACUUM,
-    )
-    first = flight.events[0]
-    assert first.kind == "ground"
-    assert first.t == pytest.approx(2 * 13.9 * math.sin(angle) / G, rel=1e-9)
-    i = int(np.flatnonzero(flight.t == first.t)[0])
+    flight, i = first_bounce(13.9, angle, (0.0, 0.0, 0.0), t_max=4.0)
+    assert flight.events[0].t == pytest.approx(2 * 13.9 * math.sin(angle) / G, rel=1e-9)
     ratio = float(np.linalg.norm(flight.velocity[i])) / 13.9
     assert 0.45 <= ratio <= 0.60
     assert ratio == pytest.approx(0.5674, abs=2e-4)
@@ -194,19 +195,7 @@ def test_energy_never_rises_over_random_impacts(speed, elevation, azimuth, spin,
 def test_angular_momentum_about_the_contact_point_is_kept_when_the_ball_grips() -> None:
     # A ball with topspin lands and grips; about the contact point only the weight has a moment, and the impact
     # is instantaneous, so I·ω + m·(R·n) × v is the same just before and just after (Cross 2002).
-    angle = math.radians(30.0)
-    flight = ball.simulate(
-        (0.0, 0.0, R),
-        (8.0 * math.cos(angle), 0.0, 8.0 * math.sin(angle)),
-        (0.0, 20.0, 0.0),
-        dt=1e-3,
-        t_max=3.0,
-        pitch=BARE,
-        **VACUUM,
-    )
-    hit = flight.events[0]
-    assert hit.kind == "ground"
-    i = int(np.flatnonzero(flight.t == hit.t)[0])
+    flight, i = first_bounce(8.0, math.radians(30.0), (0.0, 20.0, 0.0), t_max=3.0)
     before_v = flight.velocity[i - 1] - np.array([0.0, 0.0, G]) * (flight.t[i] - flight.t[i - 1])
     assert flight.spin is not None
     before_w, after_w, after_v = flight.spin[i - 1], flight.spin[i], flight.velocity[i]
