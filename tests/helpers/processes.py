@@ -16,12 +16,7 @@ def python_stdout(
     Raises ``subprocess.CalledProcessError`` when the script fails, and ``subprocess.TimeoutExpired`` after
     ``timeout_s`` seconds.
     """
+    command = [sys.executable, "-c", script]
     return subprocess.run(
-        [sys.executable, "-c", script],
-        cwd=cwd,
-        env=env,
-        capture_output=True,
-        text=True,
-        timeout=timeout_s,
-        check=True,
+        command, cwd=cwd, env=env, capture_output=True, text=True, timeout=timeout_s, check=True
     ).stdout

@@ -109,24 +109,30 @@ def test_a_roll_at_3_2_m_s_stops_in_4_to_10_m() -> None:
     assert skid.position[-1, 0] == pytest.approx(0.36 * 6.4, rel=1e-9)
 
 
-def test_a_post_hit_at_25_m_s_5_cm_off_centre_bounces_as_the_contact_geometry_says() -> None:
-    # No gravity, no air: the ball flies straight along +x at 25 m/s, 1 m up, its centre 5 cm to the left of the
-    # left post's axis (posts at y = ±(3.66 + 0.06) m on the goal line x = 0). It touches when the centres are
-    # R + r_p = 0.17 m apart: at x = −√(0.17² − 0.05²), the normal from the post's axis to the ball's centre.
-    post_y = 3.66 + 0.06
-    start_x = -5.0
-    flight = ball.simulate(
-        (start_x, post_y + 0.05, 1.0),
+def straight_at_the_goal_line(x: float, y: float, t_max: float) -> ball.Trajectory:
+    """A ball without spin flying straight along +x at 25 m/s from (x, y) 1 m up, with neither gravity nor air,
+    over the bare pitch (dt 1 ms, rk4)."""
+    return ball.simulate(
+        (x, y, 1.0),
         (25.0, 0.0, 0.0),
         (0.0, 0.0, 0.0),
         dt=1e-3,
-        t_max=1.0,
+        t_max=t_max,
         gravity=0.0,
         air_density=0.0,
         method="rk4",
         ground_m=R,
         pitch=BARE,
     )
+
+
+def test_a_post_hit_at_25_m_s_5_cm_off_centre_bounces_as_the_contact_geometry_says() -> None:
+    # No gravity, no air: the ball flies straight along +x at 25 m/s, 1 m up, its centre 5 cm to the left of the
+    # left post's axis (posts at y = ±(3.66 + 0.06) m on the goal line x = 0). It touches when the centres are
+    # R + r_p = 0.17 m apart: at x = −√(0.17² − 0.05²), the normal from the post's axis to the ball's centre.
+    post_y = 3.66 + 0.06
+    start_x = -5.0
+    flight = straight_at_the_goal_line(start_x, post_y + 0.05, t_max=1.0)
     hit = flight.events[0]
     assert hit.kind == "post"
     contact_x = -math.sqrt(0.17**2 - 0.05**2)
@@ -150,18 +156,7 @@ def test_a_post_hit_at_25_m_s_5_cm_off_centre_bounces_as_the_contact_geometry_sa
 def test_in_off_the_post_is_a_goal_and_the_net_stops_it() -> None:
     # 16.5 cm inside the post's axis line (touching at 17 cm): the ball glances the inside of the post and goes in.
     post_y = 3.66 + 0.06
-    flight = ball.simulate(
-        (-5.0, post_y - 0.165, 1.0),
-        (25.0, 0.0, 0.0),
-        (0.0, 0.0, 0.0),
-        dt=1e-3,
-        t_max=2.0,
-        gravity=0.0,
-        air_density=0.0,
-        method="rk4",
-        ground_m=R,
-        pitch=BARE,
-    )
+    flight = straight_at_the_goal_line(-5.0, post_y - 0.165, t_max=2.0)
     kinds = [e.kind for e in flight.events]
     assert kinds[0] == "post" and kinds[-1] == "net"
     assert flight.result == "goal"

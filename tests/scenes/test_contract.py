@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from typing import Any
+from typing import Any, NamedTuple
 
 import pytest
 import viser
@@ -51,23 +51,37 @@ def in_range_value(control: Control, current: float) -> float:
     raise AssertionError(f"no in-range value other than {current} for {control.label!r}")
 
 
-@pytest.mark.parametrize("kind", KINDS, ids=IDS)
+class Bare(NamedTuple):
+    """What the server holds before the scene is built."""
+
+    nodes: set[str]
+    """The scene node names."""
+    gui: set[str]
+    """The GUI elements' ids."""
+
+
+@pytest.fixture
+def bare(server: viser.ViserServer) -> Bare:
+    """The server's nodes and GUI elements before the test's scene is built."""
+    return Bare(node_names(server), gui_uuids(server))
+
+
+@pytest.fixture(params=KINDS, ids=IDS)
+def scene(request: pytest.FixtureRequest, scene_on: MakeScene, bare: Bare) -> Scene:
+    """Each scene of :data:`scenes.SCENES` in turn, built on the test's server once ``bare`` has been read."""
+    return scene_on(request.param)
+
+
 def test_a_scene_builds_its_controls_and_its_nodes_under_its_root(
-    server: viser.ViserServer, scene_on: MakeScene, kind: type[Scene]
+    server: viser.ViserServer, scene: Scene, bare: Bare
 ) -> None:
-    bare_nodes, bare_gui = node_names(server), gui_uuids(server)
-    scene = scene_on(kind)
-    made = node_names(server) - bare_nodes
+    made = node_names(server) - bare.nodes
     assert made and all(name.startswith(scene.root.name) for name in made)
     assert len({name for name in made if name.startswith(f"{scene.root.name}/")}) > 10
-    assert len(gui_uuids(server) - bare_gui) > len(declared(type(scene.params)))
+    assert len(gui_uuids(server) - bare.gui) > len(declared(type(scene.params)))
 
 
-@pytest.mark.parametrize("kind", KINDS, ids=IDS)
-def test_a_declared_control_moved_in_range_changes_the_params(
-    server: viser.ViserServer, scene_on: MakeScene, kind: type[Scene]
-) -> None:
-    scene = scene_on(kind)
+def test_a_declared_control_moved_in_range_changes_the_params(server: viser.ViserServer, scene: Scene) -> None:
     name, control = first_number_field(scene)
     before = scene.params
     value = in_range_value(control, getattr(before, name))
@@ -81,11 +95,9 @@ def test_a_declared_control_moved_in_range_changes_the_params(
     assert scene.params == dataclasses.replace(before, **{name: getattr(scene.params, name)})
 
 
-@pytest.mark.parametrize("kind", KINDS, ids=IDS)
 def test_hostile_values_are_refused_or_clamped_and_the_last_good_params_kept(
-    server: viser.ViserServer, scene_on: MakeScene, kind: type[Scene]
+    server: viser.ViserServer, scene: Scene
 ) -> None:
-    scene = scene_on(kind)
     name, control = first_number_field(scene)
     assert control.lo is not None and control.hi is not None
     good = scene.params
@@ -118,14 +130,11 @@ def test_hostile_values_are_refused_or_clamped_and_the_last_good_params_kept(
             assert scene.params == dataclasses.replace(good, **{name: clamped})
 
 
-@pytest.mark.parametrize("kind", KINDS, ids=IDS)
 def test_close_removes_every_node_and_gui_element_the_scene_made(
-    server: viser.ViserServer, scene_on: MakeScene, kind: type[Scene]
+    server: viser.ViserServer, scene: Scene, bare: Bare
 ) -> None:
-    bare_nodes, bare_gui = node_names(server), gui_uuids(server)
-    scene = scene_on(kind)
-    assert node_names(server) != bare_nodes and gui_uuids(server) != bare_gui
+    assert node_names(server) != bare.nodes and gui_uuids(server) != bare.gui
     scene.close()
     assert scene.join(10.0), "the scene's threads outlived close()"
-    assert node_names(server) == bare_nodes
-    assert gui_uuids(server) == bare_gui
+    assert node_names(server) == bare.nodes
+    assert gui_uuids(server) == bare.gui

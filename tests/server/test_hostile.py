@@ -213,6 +213,22 @@ def bad_cameras() -> list[dict[str, Any]]:
     return [{**good, **change} for change in changes]
 
 
+def assert_an_honest_edit_lands_after(
+    sent: int, attacker: BrowserClient, scene: Scene, label: str, field: str, good: object
+) -> None:
+    """After a barrage of ``sent`` hostile messages (more than 100), the attacker's honest edit of ``label`` to
+    ``good`` reaches the scene's ``field``, and the server keeps serving the attacker too: its connection is still
+    up and answered."""
+    assert sent > 100
+    attacker.set_value(label, good)
+    attacker.wait_for(
+        lambda: getattr(scene.params, field) == good,  # type: ignore[attr-defined]
+        timeout=60,
+        what=f"the honest {label} edit after {sent} hostile messages",
+    )
+    assert not attacker.closed_by_server
+
+
 def hostile_barrage(attacker: BrowserClient, server: viser.ViserServer) -> int:
     """Send every hostile message this suite knows at every control and gizmo; returns how many were sent."""
     sent = 0
@@ -331,16 +347,7 @@ def test_every_hostile_message_leaves_every_viewer_on_the_last_good_state(
         caplog.clear()
 
         sent = hostile_barrage(attacker, server)
-        assert sent > 100
-        attacker.set_value(label, good)
-        attacker.wait_for(
-            lambda: getattr(scene.params, field) == good,  # type: ignore[attr-defined]
-            timeout=60,
-            what=f"the honest {label} edit after {sent} hostile messages",
-        )
-
-        # The server keeps serving the attacker too: its connection is still up and answered.
-        assert not attacker.closed_by_server
+        assert_an_honest_edit_lands_after(sent, attacker, scene, label, field, good)
         # The scene is the one it was, with only the honest edit applied.
         assert switcher.scene is scene
         with scene._lock:
@@ -712,14 +719,7 @@ def test_every_hostile_message_leaves_each_tab_on_its_last_good_state(
                     attacker.send("GuiUpdateMessage", uuid=uuid, updates={"value": element["value"]})
                     attacker.send("GuiUpdateMessage", uuid=uuid, updates={"value": 1e308})
                     sent += 2
-            assert sent > 100
-            attacker.set_value(label, good)
-            attacker.wait_for(
-                lambda: getattr(scene.params, field) == good,  # type: ignore[attr-defined]
-                timeout=60,
-                what=f"the honest {label} edit after {sent} hostile messages",
-            )
-            assert not attacker.closed_by_server
+            assert_an_honest_edit_lands_after(sent, attacker, scene, label, field, good)
             assert mine.scene is scene and theirs.scene is their_scene
             with scene._lock:
                 assert scene.params == dataclass_replace(params_before, field, good)  # type: ignore[attr-defined]
