@@ -16,6 +16,7 @@ binaryBufferLengths}) [padding to 8] [raw buffers, each 8-aligned]``; numpy arra
 
 from __future__ import annotations
 
+import math
 import threading
 import time
 from collections.abc import Callable, Iterable
@@ -328,6 +329,12 @@ class BrowserClient:
             screen_pos=((0.5, 0.5),),
             modifier=None,
         )
+
+
+def shows_number(shown: object, expected: object) -> bool:
+    """Whether a control's value as a browser shows it is the finite number ``expected`` (an int or a float)."""
+    assert isinstance(expected, (int, float))
+    return isinstance(shown, (int, float)) and math.isfinite(shown) and float(shown) == float(expected)
 
 
 def connect_tab(server: Any, sessions: Any) -> tuple[BrowserClient, Any]:
