@@ -33,6 +33,17 @@ SMOOTH = {
 }
 
 
+def smooth_in_its_dtype(op: sdf.BooleanOp, x: np.ndarray, y: np.ndarray, k: float, blend: sdf.BlendForm) -> np.ndarray:
+    """The smooth ``op`` of ``x`` and ``y`` as the code runs it for their dtype: the float64 functions, or the mesher's
+    float32 path, whose result is asserted to stay float32 and whose weights to lie in [0, 1]."""
+    if x.dtype == np.float64:
+        return SMOOTH[op](x, y, k, blend)
+    got, weight = sdf.combine_weighted(x, y, op, k, blend)
+    assert got.dtype == np.float32 and np.all(np.isfinite(weight))
+    assert np.all((weight >= 0.0) & (weight <= 1.0))
+    return got
+
+
 def assert_near_hard(got: np.ndarray, hard: np.ndarray, k: float, a: np.ndarray, b: np.ndarray) -> None:
     assert np.all(np.isfinite(got)), got
     rounding = 4 * np.finfo(got.dtype).eps * np.maximum(np.abs(a), np.abs(b))
@@ -63,12 +74,7 @@ def test_every_blend_is_finite_and_near_the_hard_operation_for_every_width(
     for x, y in ((a_arr, b_arr), (b_arr, a_arr), (a_arr, -b_arr)):
         x_t, y_t = x.astype(dtype), y.astype(dtype)
         with np.errstate(divide="raise"):  # nothing is ever divided by a width or sharpness of 0
-            if dtype is np.float64:
-                got = SMOOTH[op](x_t, y_t, k, blend)
-            else:  # the mesher's float32 path
-                got, weight = sdf.combine_weighted(x_t, y_t, op, k, blend)
-                assert got.dtype == np.float32 and np.all(np.isfinite(weight))
-                assert np.all((weight >= 0.0) & (weight <= 1.0))
+            got = smooth_in_its_dtype(op, x_t, y_t, k, blend)
         hard = HARD[op](x_t.astype(np.float64), y_t.astype(np.float64))
         assert_near_hard(np.asarray(got), hard, k, x_t, y_t)
 
@@ -186,11 +192,7 @@ def test_blends_of_infinite_and_huge_distances_are_never_nan(
         x, y = np.asarray(a[:n]).astype(dtype), np.asarray(b[:n]).astype(dtype)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        if dtype is np.float64:
-            got = SMOOTH[op](x, y, k, blend)
-        else:
-            got, weight = sdf.combine_weighted(x, y, op, k, blend)
-            assert np.all((weight >= 0.0) & (weight <= 1.0))
+        got = smooth_in_its_dtype(op, x, y, k, blend)
     hard = HARD[op](x.astype(np.float64), y.astype(np.float64))
     got64 = np.asarray(got, dtype=np.float64)
     assert not np.any(np.isnan(got64))
