@@ -433,6 +433,19 @@ def _echoed(shown: object, expected: object) -> bool:
     return shows_number(shown, expected)
 
 
+def _click_the_goal_mouth(client: BrowserClient, ray_origin: tuple[float, float, float]) -> None:
+    """Send a click on the goal mouth along +x from ``ray_origin`` (m), as viser's client reports one."""
+    client.send(
+        "SceneNodeClickMessage",
+        name="/freekick/goal_mouth",
+        instance_index=None,
+        ray_origin=ray_origin,
+        ray_direction=(1.0, 0.0, 0.0),
+        screen_pos=(0.5, 0.5),
+        modifier=None,
+    )
+
+
 def test_wrong_types_and_crafted_clicks_leave_the_scene_serving(
     server: viser.ViserServer, scene: FreeKickScene
 ) -> None:
@@ -441,25 +454,9 @@ def test_wrong_types_and_crafted_clicks_leave_the_scene_serving(
         client.set_value("Spin rate (rev/s)", "fast")
         client.set_value("Knuckleball", "yes please")
         client.set_value("Random draw", float("nan"))  # viser's own int cast refuses it before the scene
-        client.send(
-            "SceneNodeClickMessage",
-            name="/freekick/goal_mouth",
-            instance_index=None,
-            ray_origin=(math.nan, 0.0, 1.0),
-            ray_direction=(1.0, 0.0, 0.0),
-            screen_pos=(0.5, 0.5),
-            modifier=None,
-        )
+        _click_the_goal_mouth(client, ray_origin=(math.nan, 0.0, 1.0))
         # A real click through the mouth: the scene aims a kick at (y, z) = (1.5, 1.2).
-        client.send(
-            "SceneNodeClickMessage",
-            name="/freekick/goal_mouth",
-            instance_index=None,
-            ray_origin=(-20.0, 1.5, 1.2),
-            ray_direction=(1.0, 0.0, 0.0),
-            screen_pos=(0.5, 0.5),
-            modifier=None,
-        )
+        _click_the_goal_mouth(client, ray_origin=(-20.0, 1.5, 1.2))
         client.wait_for(lambda: scene.last_target == (1.5, 1.2), what="the click to reach the scene")
         assert scene.wait_idle()
         client.wait_for(lambda: _markdown_shown(client, "Found:"), what="the aim result shown")
