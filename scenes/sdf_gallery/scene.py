@@ -483,10 +483,12 @@ IoU is lowest when a box edge is on the silhouette.
     def _sync_enabled_inputs(self) -> None:
         """Show gizmos of enabled primitives, sized and named for them; grey out sizes the kind does not use."""
         self.scene_controls["k"].disabled = self.params.blend == "hard"
+        primitives = self.params.shape_source == "primitives"
         for name in ("blend", "k"):  # they act on the primitives only: hidden while a GLSL field is shown
-            self.scene_controls[name].visible = self.params.shape_source == "primitives"
+            self.scene_controls[name].visible = primitives
+        self.view_controls["rings"].visible = primitives  # so do the gizmos the rings sit on
         for controls, gizmo, slot in zip(self.slot_controls, self.gizmos, self.params.primitives, strict=True):
-            gizmo.visible = slot.enabled and self.params.shape_source == "primitives"
+            gizmo.visible = slot.enabled and primitives
             for j, handle in enumerate(controls.each("size")):
                 handle.disabled = j >= SIZES_USED[slot.kind] or not slot.enabled
         # Each gizmo's size, marker colour and label follow its primitive's kind, size and colour.

@@ -813,18 +813,22 @@ def _shown(client: BrowserClient, label: str) -> bool:
     return True
 
 
-def test_blend_and_k_hide_while_a_glsl_field_is_shown(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
-    """Blend and its width act on the primitives only: with the GLSL editor's field shown they are not drawn; the
-    mesh resolution (used by both) stays."""
+PRIMITIVES_ONLY = ("Blend", "Blend width k (m)", "Rotation rings on the gizmos")
+"""Controls that act on the primitives (or their gizmos) only."""
+
+
+def test_primitive_controls_hide_while_a_glsl_field_is_shown(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
+    """Blend, its width and the gizmos' rotation rings act on the primitives only: with the GLSL editor's field shown
+    they are not drawn; the mesh resolution (used by both) stays."""
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("Blend")
-        assert _shown(client, "Blend") and _shown(client, "Blend width k (m)")
+        assert all(_shown(client, label) for label in PRIMITIVES_ONLY)
         client.set_value("Shape", "GLSL editor")
         client.wait_for(lambda: not _shown(client, "Blend"), what="Blend hidden")
-        assert not _shown(client, "Blend width k (m)")
+        assert [_shown(client, label) for label in PRIMITIVES_ONLY] == [False] * 3
         assert _shown(client, RESOLUTION_LABEL)
         client.set_value("Shape", "Primitives (panels below)")
-        client.wait_for(lambda: _shown(client, "Blend") and _shown(client, "Blend width k (m)"), what="Blend back")
+        client.wait_for(lambda: all(_shown(client, label) for label in PRIMITIVES_ONLY), what="Blend and rings back")
 
 
 def test_rotation_rings_show_only_when_asked(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
