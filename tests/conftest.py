@@ -13,6 +13,7 @@ from pathlib import Path
 import pytest
 import viser
 from helpers.ci import CHROMIUM, chromium_context, fresh_renderer, skip_or_fail
+from helpers.properties import EXPLORE_EXAMPLES
 from helpers.scenes import MakeScene, S
 from hypothesis import settings
 
@@ -26,7 +27,7 @@ from shaders.renderer import Renderer
 # The README's test command must pass for anyone, every run: hypothesis draws the same examples in and out of CI.
 # Explore with fresh ones before calling a change done: pytest --hypothesis-profile=explore --hypothesis-seed=random
 settings.register_profile("deterministic", derandomize=True, deadline=None, print_blob=True)
-settings.register_profile("explore", derandomize=False, deadline=None, print_blob=True)
+settings.register_profile("explore", derandomize=False, deadline=None, print_blob=True, max_examples=EXPLORE_EXAMPLES)
 settings.load_profile("deterministic")  # --hypothesis-profile, read after this file, overrides it
 
 

@@ -18,6 +18,7 @@ from helpers.browser import (
     open_viser,
     wait_chart_data,
 )
+from helpers.properties import examples
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -119,7 +120,7 @@ def test_the_wide_labels_that_were_cut(probe: Probe) -> None:
     probe.show(probe.two, TWO_AXES, (x, elevation, elevation / 90.0, elevation / 5.0))
 
 
-@settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(max_examples=examples(12), deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(
     magnitude=st.floats(-2.5, 5.5),
     low=st.floats(-1.0, 1.0),
@@ -136,7 +137,7 @@ def test_labels_stay_inside_for_any_range(
     probe.show(probe.two, TWO_AXES, (x, y, right, y))
 
 
-@settings(max_examples=8, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(max_examples=examples(8), deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(low=st.floats(-6.0, 2.0), decades=st.floats(0.3, 7.0))
 def test_log_labels_stay_inside_for_any_decades(probe: Probe, low: float, decades: float) -> None:
     x = np.arange(40, dtype=np.float64)

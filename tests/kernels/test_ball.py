@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 import pytest
 from helpers.processes import python_stdout
+from helpers.properties import examples
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from numpy.typing import NDArray
@@ -156,7 +157,7 @@ def test_constant_lift_and_drag_without_gravity_fly_a_circle() -> None:
     azimuth=st.floats(-40.0, 40.0),
     model=st.sampled_from(["constant", "measured"]),
 )
-@settings(max_examples=25, deadline=None)
+@settings(max_examples=examples(25), deadline=None)
 def test_zero_spin_never_curls(speed: float, elevation: float, azimuth: float, model: ball.Model) -> None:
     v0 = kick(speed, elevation, azimuth)
     flight = ball.simulate(START, v0, (0, 0, 0), dt=1e-2, method="rk4", model=model)
@@ -519,7 +520,7 @@ def kick_of(settings_: dict) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     dt=st.floats(2e-3, 4e-2),
     x_stop=st.one_of(st.none(), st.floats(5.0, 30.0)),
 )
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=examples(40), deadline=None)
 def test_every_sample_matches_a_plain_reference_of_the_equations(
     kick_settings_: dict, method: str, dt: float, x_stop: float | None
 ) -> None:
@@ -613,7 +614,7 @@ def reference_outcome(flight: ball.Trajectory, wall: ball.Panel, goal: ball.Pane
 
 
 @given(kick_settings_=kick_settings, wall_height=st.floats(1.0, 2.4), wall_offset=st.floats(-2.0, 2.0))
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=examples(40), deadline=None)
 def test_outcome_matches_the_rules_applied_by_a_plain_reference(
     kick_settings_: dict, wall_height: float, wall_offset: float
 ) -> None:
@@ -693,7 +694,7 @@ def test_a_sample_exactly_on_the_plane_is_the_crossing() -> None:
     kicks=st.lists(kick_settings, min_size=0, max_size=6),
     method=st.sampled_from(["euler", "rk4"]),
 )
-@settings(max_examples=15, deadline=None)
+@settings(max_examples=examples(15), deadline=None)
 def test_simulate_outcomes_equals_outcome_batch_of_simulate_batch(kicks: list[dict], method: str) -> None:
     pairs = [kick_of(k) for k in kicks]
     velocities = np.array([p[0] for p in pairs]).reshape(-1, 3)
@@ -782,7 +783,7 @@ def test_a_ball_dropped_from_rest_falls_straight_down_in_every_mode() -> None:
     exponent=st.integers(-300, 300),
     axis=st.tuples(st.floats(-1, 1), st.floats(-1, 1), st.floats(0.1, 1)),
 )
-@settings(max_examples=30, deadline=None)
+@settings(max_examples=examples(30), deadline=None)
 def test_the_constant_model_curls_by_the_spin_axis_for_any_rate(exponent: int, axis: tuple) -> None:
     # Constant C_L: the Magnus force is ½ρA·C_L·|v|·(ω̂ × v), whatever |ω|, from 1e-300 to 1e300 rad/s.
     direction = np.array(axis) / np.linalg.norm(axis)
@@ -802,7 +803,7 @@ def test_the_constant_model_curls_by_the_spin_axis_for_any_rate(exponent: int, a
     speed=st.floats(0.0, 1e200),
     method=st.sampled_from(["euler", "rk4"]),
 )
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=examples(60), deadline=None)
 def test_huge_parameters_give_a_finite_flight_or_an_error_naming_dt(
     air_density: float, mass: float, dt: float, speed: float, method: str
 ) -> None:
@@ -943,7 +944,7 @@ def test_a_ball_that_peaks_and_lands_within_one_step_lands_there_not_at_the_laun
     dt=st.floats(1e-3, 5.0),
     ground=st.floats(-1.0, 1.0),
 )
-@settings(max_examples=80, deadline=None)
+@settings(max_examples=examples(80), deadline=None)
 def test_a_kick_in_a_vacuum_lands_on_the_parabola_for_any_step(
     z0: float, vx: float, vz: float, dt: float, ground: float
 ) -> None:
@@ -977,7 +978,7 @@ def test_a_kick_in_a_vacuum_lands_on_the_parabola_for_any_step(
     dd1=st.floats(-1e3, 1e3),
     h=st.floats(1e-6, 10.0),
 )
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=examples(300), deadline=None)
 def test_the_crossing_is_the_first_root_of_the_step_cubic(
     d0: float, d1: float, dd0: float, dd1: float, h: float
 ) -> None:
@@ -1024,7 +1025,7 @@ def line_flight(start: tuple[float, float, float], velocity: tuple[float, float,
 
 
 @given(offset=st.floats(0.0, 0.3), dt=st.floats(0.01, 0.5), sign=st.sampled_from([-1.0, 1.0]))
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=examples(60), deadline=None)
 def test_a_ball_exactly_on_an_edge_gets_one_verdict_however_it_is_sampled(
     offset: float, dt: float, sign: float
 ) -> None:
@@ -1071,7 +1072,7 @@ def test_a_start_below_the_ground_is_refused_naming_the_position() -> None:
 
 
 @given(dt=st.floats(1e-3, 1e12), t_max=st.floats(1e-3, 10.0))
-@settings(max_examples=80, deadline=None)
+@settings(max_examples=examples(80), deadline=None)
 def test_the_last_sample_is_exactly_t_max_for_any_step(dt: float, t_max: float) -> None:
     # Kind: whole steps overshot t_max (t_max = 1, dt = 0.3 ended at 1.2) or, with dt ≫ t_max, took none.
     if t_max / dt > 1e5:
@@ -1128,7 +1129,7 @@ def test_more_bad_input_raises_naming_the_argument() -> None:
     exponent=st.integers(-300, 300),
     axis=st.sampled_from([(1, 1, 0), (1, 0, 0), (0, -3, 4), (1, 1, 1)]),
 )
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=examples(60), deadline=None)
 def test_spin_vector_normalises_any_scale_of_axis(exponent: int, axis: tuple[int, int, int]) -> None:
     # Kind: the axis's squares overflowed (1e300) or underflowed (3e-200) before the division.
     direction = np.array(axis, dtype=float)

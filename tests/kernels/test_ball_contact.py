@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers.properties import examples
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from numpy.typing import NDArray
@@ -242,7 +243,7 @@ spins = st.tuples(*[st.floats(-400.0, 400.0)] * 3)
 normals = st.tuples(*[st.floats(-1.0, 1.0)] * 3).filter(lambda n: math.hypot(*n) > 0.05)
 
 
-@settings(max_examples=2000)
+@settings(max_examples=examples(2000))
 @given(
     v=vectors,
     w=spins,

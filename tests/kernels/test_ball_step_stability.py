@@ -13,6 +13,7 @@ import re
 
 import numpy as np
 import pytest
+from helpers.properties import examples
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.integrate import solve_ivp
@@ -110,7 +111,7 @@ def test_batches_refuse_the_same_kick_the_single_call_refuses() -> None:
     dt=st.floats(math.log(1e-4), math.log(0.1)).map(math.exp),
     method=st.sampled_from(("euler", "rk4")),
 )
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=examples(60), deadline=None)
 def test_a_flight_is_refused_naming_dt_or_lands_ahead_as_the_reference_does(
     density: float, speed: float, elevation: float, height: float, dt: float, method: ball.Method
 ) -> None:

@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from helpers.gpx import BAD_FILES, gpx_text, line_points
+from helpers.properties import examples
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from scipy.integrate import solve_ivp
@@ -217,7 +218,7 @@ def test_martin_terms_cost_time_against_the_seed_model() -> None:
 
 
 # ------------------------------------------------------------------------------------------------ inverse, pacing
-@settings(max_examples=20, deadline=None)
+@settings(max_examples=examples(20), deadline=None)
 @given(
     power=st.floats(40.0, 900.0),
     wind=st.floats(-8.0, 8.0),
@@ -409,7 +410,7 @@ def test_more_than_200_000_points_is_refused() -> None:
         )
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=examples(40), deadline=None)
 @given(st.binary(max_size=400))
 def test_arbitrary_bytes_never_escape_as_anything_but_value_error(data: bytes) -> None:
     for source in (data, b"<gpx>" + data):
@@ -419,7 +420,7 @@ def test_arbitrary_bytes_never_escape_as_anything_but_value_error(data: bytes) -
             pass
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=examples(40), deadline=None)
 @given(
     grades=st.lists(st.floats(-0.2, 0.2), min_size=2, max_size=40),
     step=st.floats(1.0, 400.0),
@@ -479,7 +480,7 @@ def test_a_vertical_profile_is_refused_before_smoothing_hides_it() -> None:
         course.load_gpx(gpx_text(wall))
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=examples(40), deadline=None)
 @given(
     grade=st.floats(0.0, 3.0),
     spacing=st.sampled_from([0.01, 1.0, 11.12, 100.0]),
@@ -600,7 +601,7 @@ def test_bad_file_messages_name_no_kernel_arguments(kind: str) -> None:
 
 
 # Kind: the drawing projection keeps every route's true shape (north_pole.gpx drew a 3.5 km "U").
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=examples(40), deadline=None)
 @given(
     lat=st.floats(-90.0, 90.0),
     lon=st.floats(-180.0, 180.0),

@@ -15,6 +15,7 @@ from typing import Literal
 
 import numpy as np
 import pytest
+from helpers.properties import examples
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -63,7 +64,7 @@ def along_a_meridian(s: np.ndarray, elevation: np.ndarray, smoothing_m: float = 
     return course.course_from_points(45.0 + s * METRE_DEG, np.full_like(s, 6.0), elevation, smoothing_m=smoothing_m)
 
 
-@settings(max_examples=EXAMPLES, deadline=None)
+@settings(max_examples=examples(EXAMPLES), deadline=None)
 @given(
     shape=st.sampled_from(["flat", "one hill", "several hills", "long climb"]),
     length_m=st.floats(3_000.0, 12_000.0),
@@ -93,7 +94,7 @@ def test_ascent_of_a_noisy_profile_is_within_ten_percent_or_five_metres(
     assert abs(c.climbing_m - true) <= max(0.1 * true, 5.0), (c.climbing_m, true)
 
 
-@settings(max_examples=EXAMPLES, deadline=None)
+@settings(max_examples=examples(EXAMPLES), deadline=None)
 @given(
     shape=st.sampled_from(["one hill", "several hills", "long climb"]),
     spacing_m=st.floats(1.0, 200.0),

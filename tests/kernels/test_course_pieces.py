@@ -15,6 +15,7 @@ import re
 from collections.abc import Sequence
 
 import pytest
+from helpers.properties import examples
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
@@ -103,7 +104,7 @@ def piece_sets(draw: st.DrawFn) -> list[Piece]:
 LAYOUTS = ("tracks", "segments", "routes", "mixed")
 
 
-@settings(max_examples=EXAMPLES, deadline=None)
+@settings(max_examples=examples(EXAMPLES), deadline=None)
 @given(
     pieces=piece_sets(),
     mix=st.lists(st.sampled_from(["trk", "seg", "rte", "note", "empty"]), max_size=40),

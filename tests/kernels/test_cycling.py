@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pytest
 from helpers import riders
+from helpers.properties import examples
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -53,7 +54,7 @@ def test_measured_model_fades_with_gap_like_swiss_side_cfd() -> None:
 
 
 @given(n=st.integers(2, 12), gap=st.floats(0.0, 20.0))
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=examples(60), deadline=None)
 def test_measured_model_is_monotone_in_position_and_gap(n: int, gap: float) -> None:
     reduction = cycling.drag_reduction(n, gap, "measured")
     assert np.all(np.diff(reduction[1:]) >= 0.0)  # further back saves at least as much
@@ -128,7 +129,7 @@ def test_power_broadcasts_over_arrays() -> None:
     grade=st.floats(0.0, 0.2),
     wind=st.floats(0.0, 15.0),
 )
-@settings(max_examples=100, deadline=None)
+@settings(max_examples=examples(100), deadline=None)
 def test_power_rises_with_speed(
     v: float, dv: float, cda: float, mass: float, crr: float, grade: float, wind: float
 ) -> None:
@@ -154,7 +155,7 @@ def test_speed_for_power_known_flat_case() -> None:
     wind=st.floats(-15.0, 15.0),
     efficiency=st.floats(0.8, 1.0),
 )
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 def test_speed_for_power_round_trips_to_1e_6(
     power_w: float,
     cda: float,
@@ -183,7 +184,7 @@ def test_speed_for_power_round_trips_to_1e_6(
     grade=st.floats(0.0, 0.2),
     wind=st.floats(0.0, 10.0),
 )
-@settings(max_examples=100, deadline=None)
+@settings(max_examples=examples(100), deadline=None)
 def test_speed_from_power_from_speed_is_identity_where_power_is_monotone(
     v: float, cda: float, grade: float, wind: float
 ) -> None:

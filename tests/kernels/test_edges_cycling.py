@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 import viser
 from helpers import riders
+from helpers.properties import examples
 from helpers.wsclient import BrowserClient
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -90,14 +91,14 @@ def courses(draw: st.DrawFn) -> dict[str, float]:
 
 
 @given(power_w=powers, course=courses())
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=examples(300), deadline=None)
 def test_speed_for_power_is_the_largest_root_everywhere(power_w: float, course: dict[str, float]) -> None:
     v = float(cycling.speed_for_power(power_w, **course))
     assert_is_the_largest_root(v, power_w, **course)
 
 
 @given(course=courses(), fraction=st.sampled_from([0.5, 1e-3, 1e-9]))
-@settings(max_examples=150, deadline=None)
+@settings(max_examples=examples(150), deadline=None)
 def test_speed_for_power_is_continuous_as_power_goes_to_zero(course: dict[str, float], fraction: float) -> None:
     """ε-δ: for δ > 0 every power below power(v(0) + δ) gives a speed within δ above v(0), and never below it."""
     v_zero = float(cycling.speed_for_power(0.0, **course))
@@ -198,7 +199,7 @@ def edge(name: str) -> st.SearchStrategy[float]:
     headwind_ms=edge("headwind_ms") | st.sampled_from([-300.0, -1000.0, 1000.0]),
     drivetrain_efficiency=st.sampled_from([1.0, 0.9, 0.01]),
 )
-@settings(max_examples=400, deadline=None)
+@settings(max_examples=examples(400), deadline=None)
 def test_speed_for_power_is_finite_and_exact_over_its_whole_domain(**args: float) -> None:
     v = solve_without_warnings(**args)
     assert_solves_to_the_nearest_float(v, **args)
@@ -209,7 +210,7 @@ def test_speed_for_power_is_finite_and_exact_over_its_whole_domain(**args: float
     side=st.sampled_from([-1.0, 1.0]),
     beyond=st.floats(1e-9, 1.0) | st.sampled_from([1e3, 1e150, 1e300]),
 )
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 def test_speed_for_power_rejects_values_outside_its_domain_by_name(name: str, side: float, beyond: float) -> None:
     low, high = DOMAIN[name]
     end = high if side > 0.0 else low

@@ -11,6 +11,7 @@ import warnings
 
 import numpy as np
 import pytest
+from helpers.properties import examples
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -58,7 +59,7 @@ def assert_near_hard(got: np.ndarray, hard: np.ndarray, k: float, a: np.ndarray,
     blend=st.sampled_from(sdf.BLEND_FORMS),
     dtype=st.sampled_from([np.float32, np.float64]),
 )
-@settings(max_examples=400, deadline=None)
+@settings(max_examples=examples(400), deadline=None)
 def test_every_blend_is_finite_and_near_the_hard_operation_for_every_width(
     a: list[float],
     b_offset: list[float],
@@ -80,7 +81,7 @@ def test_every_blend_is_finite_and_near_the_hard_operation_for_every_width(
 
 
 @given(k=st.sampled_from(TINY_WIDTHS[1:]), blend=st.sampled_from(sdf.BLEND_FORMS))
-@settings(max_examples=30, deadline=None)
+@settings(max_examples=examples(30), deadline=None)
 def test_smin_forms_tend_to_min_at_ties(k: float, blend: sdf.BlendForm) -> None:
     a = np.array([0.0, 1.0, -2.0, 1e-300])
     if blend == "poly":
@@ -119,7 +120,7 @@ def scenes_with_tiny_width(draw: st.DrawFn) -> tuple[sdf.Scene, sdf.Scene]:
 
 
 @given(pair=scenes_with_tiny_width())
-@settings(max_examples=25, deadline=None)
+@settings(max_examples=examples(25), deadline=None)
 def test_a_tiny_width_meshes_like_the_hard_scene(pair: tuple[sdf.Scene, sdf.Scene]) -> None:
     tiny, hard = pair
     bounds = sdf.scene_bounds(hard)
@@ -178,7 +179,7 @@ extreme_widths = st.one_of(
     blend=st.sampled_from(sdf.BLEND_FORMS),
     dtype=st.sampled_from([np.float32, np.float64]),
 )
-@settings(max_examples=400, deadline=None)
+@settings(max_examples=examples(400), deadline=None)
 def test_blends_of_infinite_and_huge_distances_are_never_nan(
     a: list[float],
     b: list[float],

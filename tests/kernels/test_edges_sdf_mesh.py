@@ -13,6 +13,7 @@ import itertools
 import numpy as np
 import pytest
 import trimesh
+from helpers.properties import examples
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
@@ -127,7 +128,7 @@ def assert_closed_solid(
 
 
 @given(case=on_grid_box_pairs(smooth=False))
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=examples(60), deadline=None)
 def test_hard_csg_of_boxes_on_grid_planes_meshes_closed(
     case: tuple[sdf.Scene, int, dict[str, float]],
 ) -> None:
@@ -146,7 +147,7 @@ def test_hard_csg_of_boxes_on_grid_planes_meshes_closed(
 
 
 @given(case=on_grid_box_pairs(smooth=True))
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=examples(40), deadline=None)
 def test_smooth_csg_of_boxes_on_grid_planes_meshes_closed(
     case: tuple[sdf.Scene, int, dict[str, float]],
 ) -> None:
@@ -169,7 +170,7 @@ def test_smooth_csg_of_boxes_on_grid_planes_meshes_closed(
 
 
 @given(case=st.one_of(on_grid_box_pairs(smooth=False), on_grid_box_pairs(smooth=True)))
-@settings(max_examples=25, deadline=None)
+@settings(max_examples=examples(25), deadline=None)
 def test_coarse_to_fine_still_equals_the_full_grid_with_samples_on_the_level(
     case: tuple[sdf.Scene, int, dict[str, float]],
 ) -> None:
@@ -280,7 +281,7 @@ def one_voxel_features(draw: st.DrawFn) -> tuple[sdf.Scene, int, float]:
 
 
 @given(case=one_voxel_features())
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=examples(60), deadline=None)
 def test_a_feature_one_voxel_thick_on_grid_planes_meshes_closed(
     case: tuple[sdf.Scene, int, float],
 ) -> None:

@@ -13,13 +13,14 @@ import numpy as np
 import pytest
 from helpers import ik_reference
 from helpers.processes import python_stdout
+from helpers.properties import examples
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from numpy.typing import NDArray
 
 from kernels import fabrik
 
-PROPERTY = settings(max_examples=60, deadline=None)
+PROPERTY = settings(max_examples=examples(60), deadline=None)
 BAD_SOLVER: Any = "newton"
 """A solver name a caller could send that is not a :data:`fabrik.Solver`."""
 

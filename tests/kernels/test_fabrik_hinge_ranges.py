@@ -13,13 +13,14 @@ import os
 
 import numpy as np
 import pytest
+from helpers.properties import examples
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from numpy.typing import NDArray
 
 from kernels import fabrik
 
-PROPERTY = settings(max_examples=int(os.environ.get("EXPLORE_EXAMPLES", 60)), deadline=None)
+PROPERTY = settings(max_examples=examples(int)(os.environ.get("EXPLORE_EXAMPLES", 60)), deadline=None)
 Z = (0.0, 0.0, 1.0)
 TOLERANCE = 1e-3
 SHOULDER = (-math.pi / 2, math.pi / 2)

@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from helpers import riders
+from helpers.properties import examples
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -33,7 +34,7 @@ def _interior(positions: np.ndarray) -> np.ndarray:
 
 # ------------------------------------------------------------------------------------------------ (a) single file
 @given(n=st.integers(1, 40), gap=st.floats(0.0, 15.0), model=st.sampled_from(["measured", "seed"]))
-@settings(max_examples=80)
+@settings(max_examples=examples(80))
 def test_single_file_is_the_line_model(n: int, gap: float, model: cycling.DraftModel) -> None:
     drag = cycling.formation_drag(cycling.formation(n, "single", gap_m=gap), model)
     expected = 1.0 - cycling.drag_reduction(n, gap, model)
@@ -110,7 +111,7 @@ layouts = st.lists(st.tuples(st.floats(-40.0, 0.0), st.floats(-4.0, 4.0)), min_s
 @given(
     layout=layouts, back=st.floats(0.0, 20.0), side=st.floats(-4.0, 4.0), model=st.sampled_from(["measured", "seed"])
 )
-@settings(max_examples=150)
+@settings(max_examples=examples(150))
 def test_a_rider_joining_behind_never_raises_anyones_drag(
     layout: np.ndarray, back: float, side: float, model: cycling.DraftModel
 ) -> None:
@@ -121,14 +122,14 @@ def test_a_rider_joining_behind_never_raises_anyones_drag(
 
 
 @given(layout=layouts, model=st.sampled_from(["measured", "seed"]))
-@settings(max_examples=150)
+@settings(max_examples=examples(150))
 def test_the_mirror_image_across_the_road_gives_the_same_drags(layout: np.ndarray, model: cycling.DraftModel) -> None:
     mirrored = layout * np.array([1.0, -1.0])
     np.testing.assert_array_equal(cycling.formation_drag(mirrored, model), cycling.formation_drag(layout, model))
 
 
 @given(layout=layouts, seed=st.integers(0, 2**32 - 1))
-@settings(max_examples=60)
+@settings(max_examples=examples(60))
 def test_drags_follow_the_riders_not_their_order(layout: np.ndarray, seed: int) -> None:
     order = np.random.default_rng(seed).permutation(len(layout))
     drag = cycling.formation_drag(layout)
@@ -152,7 +153,7 @@ def test_echelon_steps_back_and_to_the_right() -> None:
 
 
 @given(speed=st.floats(0.0, 20.0), cda=riders.cda_m2, mass=riders.mass_kg, crr=riders.crr)
-@settings(max_examples=30)
+@settings(max_examples=examples(30))
 def test_formation_power_is_the_power_law_at_each_riders_drag(
     speed: float, cda: float, mass: float, crr: float
 ) -> None:

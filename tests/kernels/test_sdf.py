@@ -7,12 +7,13 @@ import math
 import numpy as np
 import pytest
 import trimesh
+from helpers.properties import examples
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from kernels import sdf
 
-SETTINGS = settings(max_examples=40, deadline=None)
+SETTINGS = settings(max_examples=examples(40), deadline=None)
 finite = st.floats(-3.0, 3.0, allow_nan=False)
 point = st.tuples(finite, finite, finite)
 positive = st.floats(0.05, 2.0)
@@ -341,7 +342,7 @@ def test_samples_exactly_on_the_surface_are_merged() -> None:
     assert tri.is_watertight and tri.volume > 0
 
 
-@settings(max_examples=12, deadline=None)
+@settings(max_examples=examples(12), deadline=None)
 @given(scene=random_scenes())
 def test_near_surface_sampling_gives_the_full_grid_mesh(scene: sdf.Scene) -> None:
     """Coarse-to-fine output equals plain full-grid evaluation plus marching cubes, exactly."""

@@ -7,6 +7,7 @@ import math
 
 import numpy as np
 import viser.uplot
+from helpers.properties import examples
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -73,7 +74,7 @@ whole_x = st.lists(st.integers(-1000, 10**6), min_size=1, max_size=40).map(
 
 
 @given(x=whole_x)
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 def test_whole_number_x_gets_whole_ticks_and_at_least_a_unit_of_range(x: np.ndarray) -> None:
     data = (x, np.ones_like(x))
     axis = _x_axis(data, LINEAR_SCALES)
@@ -96,7 +97,7 @@ def test_whole_number_x_gets_whole_ticks_and_at_least_a_unit_of_range(x: np.ndar
         lambda v: any(value != round(value) for value in v)
     )
 )
-@settings(max_examples=100, deadline=None)
+@settings(max_examples=examples(100), deadline=None)
 def test_fractional_x_keeps_uplot_s_own_ticks(x: list[float]) -> None:
     data = (np.array(sorted(x)), np.ones(len(x)))
     assert "incrs" not in _x_axis(data, LINEAR_SCALES)
@@ -110,7 +111,7 @@ def test_fractional_x_keeps_uplot_s_own_ticks(x: list[float]) -> None:
     ),
     floor_exponent=st.integers(-12, -1),
 )
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=examples(300), deadline=None)
 def test_a_log_axis_never_labels_a_tick_zero(values: list[float], floor_exponent: int) -> None:
     """Zeros clamped to a floor (as the arm does), huge and tiny values: every label is its decade's value."""
     y = np.maximum(np.array(values), 10.0**floor_exponent)

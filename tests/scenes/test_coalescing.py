@@ -17,6 +17,7 @@ from collections.abc import Callable
 import numpy as np
 import pytest
 import viser
+from helpers.properties import examples
 from helpers.waiting import wait_until
 from helpers.wsclient import BrowserClient
 from hypothesis import given, settings
@@ -70,7 +71,7 @@ def flood(held: Held, values: list[float], queued: int = 1) -> list[threading.Th
     return threads
 
 
-@settings(max_examples=20, deadline=None)
+@settings(max_examples=examples(20), deadline=None)
 @given(values=st.lists(st.floats(0.0, 10.0, allow_nan=False), min_size=1, max_size=60))
 def test_a_flood_coalesces_to_one_call_that_reads_the_last_value(values: list[float]) -> None:
     server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
@@ -107,7 +108,7 @@ def test_200_values_coalesce_to_the_last() -> None:
         server.stop()
 
 
-@settings(max_examples=10, deadline=None)
+@settings(max_examples=examples(10), deadline=None)
 @given(values=st.lists(st.floats(0.0, 10.0, allow_nan=False), min_size=1, max_size=40))
 def test_two_scenes_take_turns_and_a_burst_that_waits_merges(values: list[float]) -> None:
     """While one tab's callback runs, another tab's scene does not run its own (one turn per process), and the burst

@@ -9,6 +9,7 @@ import math
 import numpy as np
 import pytest
 import viser
+from helpers.properties import examples
 from helpers.scenes import MakeScene
 from helpers.screen_geometry import GOAL_CORNERS, polyline_gap
 from helpers.wsclient import BrowserClient, shows_number
@@ -56,7 +57,7 @@ def scene(show_scene: MakeScene) -> FreeKickScene:
     return shown
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(
     steps=st.lists(st.floats(1e-9, 10.0, allow_nan=False, allow_infinity=False), min_size=0, max_size=30),
     start=st.floats(-5.0, 5.0),
@@ -588,7 +589,7 @@ def test_every_view_frames_every_preset_left_of_the_panel(preset: Preset, view: 
     _assert_framed(preset.params, view, lens)
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=examples(40), deadline=None)
 @given(
     distance=st.floats(12.0, 40.0),
     angle=st.floats(-45.0, 45.0),

@@ -9,6 +9,7 @@ import re
 import numpy as np
 import pytest
 from helpers.ci import need_gl
+from helpers.properties import examples
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -313,7 +314,7 @@ def test_the_elongation_example_is_watertight() -> None:
 
 
 @pytest.mark.gl
-@settings(max_examples=25)
+@settings(max_examples=examples(25))
 @given(
     st.floats(-6.0, 30.0),
     st.sampled_from(

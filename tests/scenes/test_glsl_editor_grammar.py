@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 import viser
 from helpers.ci import need_gl
+from helpers.properties import examples
 from helpers.scenes import scene_fixture
 from helpers.waiting import wait_until
 from helpers.wsclient import BrowserClient
@@ -132,7 +133,7 @@ def test_every_legal_spelling_of_the_definitions_is_accepted(definition: tuple[s
 
 
 @pytest.mark.gl
-@settings(max_examples=12, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=examples(12), suppress_health_check=[HealthCheck.too_slow])
 @given(definitions())
 def test_every_legal_spelling_samples_as_the_plain_form(definition: tuple[str, bool]) -> None:
     source, has_color = definition
@@ -315,7 +316,7 @@ def test_a_brace_error_names_its_line(program: tuple[list[str], list[int]], choi
 
 
 @pytest.mark.gl
-@settings(max_examples=60, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=examples(60), suppress_health_check=[HealthCheck.too_slow])
 @given(programs(), st.integers(0, 10), st.sampled_from(sorted(COMPILE_ERRORS)))
 def test_a_compile_error_names_its_line_in_words(program: tuple[list[str], list[int]], choice: int, kind: str) -> None:
     source, line = _inject(program, choice, kind)

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 import viser
 from helpers.browser import VIEWPORTS
+from helpers.properties import examples
 from helpers.scenes import scene_fixture
 from helpers.screen_geometry import pinhole_ndc
 from helpers.wsclient import BrowserClient, shows_number
@@ -277,7 +278,7 @@ def assert_labels_apart_and_in_view(boxes: np.ndarray, lens: Lens) -> None:
 
 
 # One scene serves every input: each sets all four controls it varies (building a server per input is slow).
-@settings(max_examples=40, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(max_examples=examples(40), suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(
     n=st.integers(2, MAX_RIDERS),
     gap_tenths=st.integers(0, 150),
@@ -327,7 +328,7 @@ def test_eight_riders_six_metres_apart_at_1280x720_have_labels_apart(scene: Pelo
     assert np.ptp(boxes[:, 1]) >= LABEL_PX[1]  # they had to stack
 
 
-@settings(max_examples=30, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(max_examples=examples(30), suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(n=st.integers(1, MAX_RIDERS), gap_tenths=st.integers(0, round(10 * MAX_GAP_M)))
 def test_every_rider_rides_on_the_drawn_road(scene: PelotonScene, n: int, gap_tenths: int) -> None:
     """The kind: scenery sized for the opening state. The road was 60 m long, so from 8 riders ~4 m apart the last

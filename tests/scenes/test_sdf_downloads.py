@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 import trimesh
 import viser
+from helpers.properties import examples
 from helpers.scenes import MakeScene, scene_fixture
 from helpers.waiting import wait_until
 from helpers.wsclient import BrowserClient
@@ -151,7 +152,7 @@ def scenes(draw: st.DrawFn) -> sdf.Scene:
     return sdf.Scene(tuple(primitives), k=draw(st.sampled_from([0.0, 0.1])))
 
 
-@settings(max_examples=30, deadline=None)
+@settings(max_examples=examples(30), deadline=None)
 @given(scenes(), st.sampled_from(MESH_FORMATS))
 def test_every_mesh_download_is_a_file_with_its_triangles_or_nothing(scene: sdf.Scene, fmt: MeshFormat) -> None:
     vertices, faces, colors = sdf.mesh(scene, 24)

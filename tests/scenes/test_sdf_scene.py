@@ -12,6 +12,7 @@ import pytest
 import trimesh
 import viser
 from helpers.ci import need_gl
+from helpers.properties import examples
 from helpers.scenes import scene_fixture
 from helpers.viser_private import gui_uuid, gui_uuids, node_names
 from helpers.waiting import wait_until
@@ -735,7 +736,7 @@ _ODD = st.one_of(
         }
     )
 )
-@settings(max_examples=200, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(max_examples=examples(200), suppress_health_check=[HealthCheck.function_scoped_fixture])
 def test_any_camera_message_fields_keep_the_view_sane(scene: SdfGalleryScene, fields: dict[str, object]) -> None:
     # Every field of a ViewerCameraMessage the scene reads, crafted: its handler never raises, and what it keeps
     # is finite (a camera, an aspect in range and a rest frame of a sane size).

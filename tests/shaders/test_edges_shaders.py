@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from helpers.paths import GLSL
+from helpers.properties import examples
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -59,7 +60,7 @@ def dataclass_with_op(primitive: sdf.Primitive, op: sdf.BooleanOp) -> sdf.Primit
     ops=st.lists(st.sampled_from(sdf.BOOLEAN_OPS), min_size=1, max_size=3).map(tuple),
     blend=st.sampled_from(sdf.BLEND_FORMS),
 )
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=examples(40), deadline=None)
 def test_glsl_blends_are_finite_and_near_the_hard_operation_for_every_width(
     gl: Renderer, k: float, ops: tuple[sdf.BooleanOp, ...], blend: sdf.BlendForm
 ) -> None:
@@ -123,7 +124,7 @@ def glsl_blends(gl: Renderer, inputs: np.ndarray) -> tuple[np.ndarray, np.ndarra
         max_size=8,
     ),
 )
-@settings(max_examples=30, deadline=None)
+@settings(max_examples=examples(30), deadline=None)
 def test_glsl_blend_functions_are_finite_and_near_the_hard_ones(gl: Renderer, k: float, a: list[float]) -> None:
     a_arr = np.asarray(a, np.float32)
     # b equal to a (the tie), a float32 ulp away, and well apart; sharpness 4 ln 2 / k as float32 (inf when it
@@ -178,7 +179,7 @@ FLOAT32_MAX = float(np.finfo(np.float32).max)
         max_size=8,
     ),
 )
-@settings(max_examples=30, deadline=None)
+@settings(max_examples=examples(30), deadline=None)
 def test_glsl_blends_of_infinite_and_huge_distances_are_never_nan(gl: Renderer, k: float, values: list[float]) -> None:
     v = np.asarray(values, np.float32)
     a_all, b_all = np.repeat(v, len(v)), np.tile(v, len(v))  # every pair, ties included
