@@ -18,7 +18,10 @@ from numpy.typing import NDArray
 from kernels.fabrik.geometry import (
     _TINY,
     _TOUCH,
+    Obstacles,
     _deflect,
+    _inside_live,
+    _mark_live,
     _perpendicular,
     _segment_cuts,
     _unit,
@@ -92,9 +95,7 @@ def _forward_pass(
     tiny: float,
     rest: NDArray[np.float64],
     limits: tuple[bool, NDArray[np.float64]],
-    centres: NDArray[np.float64],
-    radii: NDArray[np.float64],
-    live: NDArray[np.bool_],
+    obstacles: Obstacles,
     has_zero: bool,
     dim: int,
 ) -> None:
@@ -106,8 +107,8 @@ def _forward_pass(
     x, y, z = p[n, 0], p[n, 1], p[n, 2]  # the anchor, carried in registers from joint to joint
     for i in range(n - 1, 0, -1):
         dx, dy, dz, _ = _unit(p[i, 0] - x, p[i, 1] - y, p[i, 2] - z, qx, qy, qz, tiny)
-        if radii.shape[0] > 0:
-            dx, dy, dz, _ = _deflect(x, y, z, dx, dy, dz, lengths[i], centres, radii, live, tiny, dim)
+        if obstacles[1].shape[0] > 0:  # any obstacle at all
+            dx, dy, dz, _ = _deflect(x, y, z, dx, dy, dz, lengths[i], obstacles, tiny, dim)
         if has_limits:
             dx, dy, dz = _forward_limits(p, i, n, dx, dy, dz, qx, qy, qz, table, rest, tiny, dim)
         length = lengths[i]
@@ -124,9 +125,7 @@ def _backward_pass(
     tiny: float,
     rest: NDArray[np.float64],
     limits: tuple[bool, NDArray[np.float64]],
-    centres: NDArray[np.float64],
-    radii: NDArray[np.float64],
-    live: NDArray[np.bool_],
+    obstacles: Obstacles,
     has_zero: bool,
     dim: int,
 ) -> None:
@@ -138,8 +137,8 @@ def _backward_pass(
         dx, dy, dz, _ = _unit(p[i, 0] - x, p[i, 1] - y, p[i, 2] - z, qx, qy, qz, tiny)
         if has_limits:
             dx, dy, dz = _constrain(dx, dy, dz, qx, qy, qz, table, i - 1, rest, tiny, dim)
-        if radii.shape[0] > 0:
-            dx, dy, dz, turned = _deflect(x, y, z, dx, dy, dz, lengths[i - 1], centres, radii, live, tiny, dim)
+        if obstacles[1].shape[0] > 0:  # any obstacle at all
+            dx, dy, dz, turned = _deflect(x, y, z, dx, dy, dz, lengths[i - 1], obstacles, tiny, dim)
             if turned and has_limits:
                 dx, dy, dz = _constrain(dx, dy, dz, qx, qy, qz, table, i - 1, rest, tiny, dim)
         length = lengths[i - 1]
@@ -275,16 +274,10 @@ def _cone_ok(p: NDArray[np.float64], tiny: float, rest: NDArray[np.float64], tab
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _colliding(
-    p: NDArray[np.float64],
-    centres: NDArray[np.float64],
-    radii: NDArray[np.float64],
-    live: NDArray[np.bool_],
-    inflate: float,
-) -> bool:
+def _colliding(p: NDArray[np.float64], obstacles: Obstacles, inflate: float) -> bool:
     """Whether any segment passes within ``inflate`` × radius of a live obstacle's centre."""
     for i in range(p.shape[0] - 1):
-        if _segment_cuts(p, i, i + 1, centres, radii, live, inflate):
+        if _segment_cuts(p, i, i + 1, obstacles, inflate):
             return True
     return False
 
@@ -296,14 +289,12 @@ def _admissible(
     rest: NDArray[np.float64],
     has_limits: bool,
     table: NDArray[np.float64],
-    centres: NDArray[np.float64],
-    radii: NDArray[np.float64],
-    live: NDArray[np.bool_],
+    obstacles: Obstacles,
 ) -> bool:
     """Whether the pose keeps every joint limit and cuts no live obstacle."""
     if has_limits and not _cone_ok(p, tiny, rest, table):
         return False
-    return not _colliding(p, centres, radii, live, 1.0)
+    return not _colliding(p, obstacles, 1.0)
 
 
 @numba.njit(cache=True, error_model="numpy")
@@ -485,9 +476,7 @@ def _polish(
     tiny: float,
     rest: NDArray[np.float64],
     limits: tuple[bool, NDArray[np.float64]],
-    centres: NDArray[np.float64],
-    radii: NDArray[np.float64],
-    live: NDArray[np.bool_],
+    obstacles: Obstacles,
     has_zero: bool,
     dim: int,
     turns: NDArray[np.float64],
@@ -514,9 +503,9 @@ def _polish(
             if iteration > 0:
                 _dls_step(p, target, lengths, tiny, turns)
             if iteration > 0 or start > 0:
-                _backward_pass(p, lengths, tiny, rest, limits, centres, radii, live, has_zero, dim)
+                _backward_pass(p, lengths, tiny, rest, limits, obstacles, has_zero, dim)
             error = _end_error(p, target)
-            if error < best_error and _admissible(p, tiny, rest, has_limits, table, centres, radii, live):
+            if error < best_error and _admissible(p, tiny, rest, has_limits, table, obstacles):
                 _copy(p, best)
                 best_error = error
                 if error <= tolerance:
@@ -577,19 +566,15 @@ def _solve_chain(
     # Within tolerance of the inner radius the folded pose is as good a candidate as the straight one at full reach.
     near_inner = inner > 0.0 and distance <= inner + tolerance + tiny
     fold = fold or (near_inner and distance - inner < total - distance)
-    any_live = False
-    for k in range(radii.shape[0]):
-        live[k] = (centres[k, 0] - p[0, 0]) ** 2 + (centres[k, 1] - p[0, 1]) ** 2 + (
-            centres[k, 2] - p[0, 2]
-        ) ** 2 > radii[k] * radii[k]
-        any_live = any_live or live[k]
+    any_live = _mark_live(centres, radii, live, p[0, 0], p[0, 1], p[0, 2])
+    obstacles = (centres, radii, live)
     constrained = (has_limits and flags[5] != 0) or any_live
 
     error = _end_error(p, target)
     history[0] = error
     _copy(p, best)
     best_error = np.inf
-    if _admissible(p, tiny, rest, has_limits, table, centres, radii, live):
+    if _admissible(p, tiny, rest, has_limits, table, obstacles):
         best_error = error
         if error <= tolerance:
             _copy(p, out_p)
@@ -601,7 +586,7 @@ def _solve_chain(
         _place_on_line(before, p[0], lengths, ux, uy, uz, fold)
         candidate = _end_error(before, target)
         # "reached" means error ≤ tolerance, with no slack: a candidate short of it by rounding iterates on.
-        if _admissible(before, tiny, rest, has_limits, table, centres, radii, live):
+        if _admissible(before, tiny, rest, has_limits, table, obstacles):
             if candidate <= tolerance or out_of_reach:
                 _copy(before, out_p)
                 history[1] = candidate
@@ -627,19 +612,19 @@ def _solve_chain(
             allowed = iteration >= restart + 3 and trusted
             moved = _extrapolate(p, previous, last_error, history[iteration - 2], allowed)
         if solver == _FABRIK:
-            _forward_pass(p, target, lengths, tiny, rest, limits, centres, radii, live, has_zero, dim)
+            _forward_pass(p, target, lengths, tiny, rest, limits, obstacles, has_zero, dim)
         elif solver == _CCD:
             _ccd_sweep(p, target, tiny, rest, dim)
         else:
             _dls_step(p, target, lengths, tiny, before)
-        _backward_pass(p, lengths, tiny, rest, limits, centres, radii, live, has_zero, dim)
+        _backward_pass(p, lengths, tiny, rest, limits, obstacles, has_zero, dim)
         error = _end_error(p, target)
         history[iteration] = error
         # A chain whose extrapolation made its error grow (a target the limits keep away, r → 1) is left to plain
         # FABRIK from then on, which settles at its fixed point.
         trusted = trusted and not (moved and error > last_error)
         if (error < best_error or error <= tolerance) and (
-            not constrained or _admissible(p, tiny, rest, has_limits, table, centres, radii, live)
+            not constrained or _admissible(p, tiny, rest, has_limits, table, obstacles)
         ):
             if error < best_error:
                 _copy(p, best)
@@ -661,11 +646,11 @@ def _solve_chain(
             ux, uy, uz, _ = _unit(ox, oy, oz, rest[0], rest[1], rest[2], tiny)
             _place_on_line(p, best[0], lengths, ux, uy, uz, False)
             _unbend(p, target, lengths, tiny, rest, limits, cos_phi, dim)  # a straight chain never bends
-            _backward_pass(p, lengths, tiny, rest, limits, centres, radii, live, has_zero, dim)
+            _backward_pass(p, lengths, tiny, rest, limits, obstacles, has_zero, dim)
             # The restart pose is a candidate too: where the limits leave the chain nearly rigid, the passes from
             # it may move away from the best pose it already is.
             error = _end_error(p, target)
-            if error < best_error and _admissible(p, tiny, rest, has_limits, table, centres, radii, live):
+            if error < best_error and _admissible(p, tiny, rest, has_limits, table, obstacles):
                 _copy(p, best)
                 best_error = error
                 reached = error <= tolerance
@@ -690,9 +675,7 @@ def _solve_chain(
                     tiny,
                     rest,
                     limits,
-                    centres,
-                    radii,
-                    live,
+                    obstacles,
                     has_zero,
                     dim,
                     before,
@@ -715,15 +698,10 @@ def _solve_chain(
         return count, _INFEASIBLE, final_error
     if out_of_reach:
         return count, _UNREACHABLE, final_error
-    if any_live:
-        for k in range(radii.shape[0]):
-            inside = (centres[k, 0] - target[0]) ** 2 + (centres[k, 1] - target[1]) ** 2 + (
-                centres[k, 2] - target[2]
-            ) ** 2 < radii[k] * radii[k]
-            if live[k] and inside:
-                return count, _BLOCKED, final_error
-        if _colliding(out_p, centres, radii, live, 1.0 + _TOUCH):
-            return count, _BLOCKED, final_error
+    if any_live and (
+        _inside_live(obstacles, target[0], target[1], target[2]) or _colliding(out_p, obstacles, 1.0 + _TOUCH)
+    ):
+        return count, _BLOCKED, final_error
     return count, _LIMITED if stalled else _MAX_ITERATIONS, final_error
 
 

@@ -1,7 +1,8 @@
 """Compiled vector primitives shared by the chain and tree solvers: unit vectors, rotations, and the obstacle rule.
 
 Vectors are passed as scalars ``(x, y, z)`` in metres (a 2D problem has z = 0 and ``dim = 2``); obstacles are
-``centres`` (K, 3) m and ``radii`` (K,) m, circles in 2D and spheres in 3D. A segment is ``a + t·v``,
+``centres`` (K, 3) m and ``radii`` (K,) m, circles in 2D and spheres in 3D; the passes take them as one
+:data:`Obstacles` tuple with ``live`` (K,), those the root stands outside of. A segment is ``a + t·v``,
 ``t ∈ [0, length]``. Whenever a pass would place a segment through an obstacle, it is turned about its anchor by the
 least angle until it only touches it (tangent, or its far end on the surface).
 """
@@ -23,6 +24,10 @@ _CLEARANCE = 1e-6
 """Segments are turned to clear an obstacle by this fraction of its radius, so rounding never leaves them inside."""
 _TOUCH = 1e-3
 """A pose within this fraction of an obstacle's radius of it rests against it ("blocked")."""
+
+Obstacles = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.bool_]]
+"""``(centres, radii, live)``: centres (K, 3) m, radii (K,) m, and which of them count (K,): an obstacle the root
+stands inside of is ignored."""
 
 
 @numba.njit(cache=True, error_model="numpy")
@@ -135,14 +140,13 @@ def _deflect(
     vy: float,
     vz: float,
     length: float,
-    centres: NDArray[np.float64],
-    radii: NDArray[np.float64],
-    live: NDArray[np.bool_],
+    obstacles: Obstacles,
     tiny: float,
     dim: int,
 ) -> tuple[float, float, float, bool]:
     """Turn the segment ``a + t·v, t ∈ [0, length]`` by the least angle until no live obstacle cuts it; returns
     the new unit direction and whether it was turned."""
+    centres, radii, live = obstacles
     turned = False
     for _ in range(3):  # turning around one obstacle can push into another: a few rounds settle it
         hit = False
@@ -166,18 +170,11 @@ def _deflect(
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _segment_cuts(
-    p: NDArray[np.float64],
-    a: int,
-    b: int,
-    centres: NDArray[np.float64],
-    radii: NDArray[np.float64],
-    live: NDArray[np.bool_],
-    inflate: float,
-) -> bool:
+def _segment_cuts(p: NDArray[np.float64], a: int, b: int, obstacles: Obstacles, inflate: float) -> bool:
     """Whether the segment from joint ``a`` to joint ``b`` of ``p`` (J, 3) passes within ``inflate`` × radius of a
     live obstacle's centre. A zero-length segment is its one point (the closest-point parameter is not divided by
     its zero squared length). The chain and the tree both test their poses with it."""
+    centres, radii, live = obstacles
     x, y, z = p[a, 0], p[a, 1], p[a, 2]
     sx, sy, sz = p[b, 0] - x, p[b, 1] - y, p[b, 2] - z
     seg2 = sx * sx + sy * sy + sz * sz
@@ -192,5 +189,30 @@ def _segment_cuts(
         t = min(max((rx * sx + ry * sy + rz * sz) / (seg2 if seg2 > 0.0 else 1.0), 0.0), 1.0)
         gx, gy, gz = rx - t * sx, ry - t * sy, rz - t * sz
         if gx * gx + gy * gy + gz * gz < grown * grown:
+            return True
+    return False
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _mark_live(
+    centres: NDArray[np.float64], radii: NDArray[np.float64], live: NDArray[np.bool_], x: float, y: float, z: float
+) -> bool:
+    """Mark in ``live`` (K,) each obstacle the root ``(x, y, z)`` stands outside of (one it stands inside could never
+    be cleared, so it is ignored); whether any is live."""
+    any_live = False
+    for k in range(radii.shape[0]):
+        rx, ry, rz = centres[k, 0] - x, centres[k, 1] - y, centres[k, 2] - z
+        live[k] = rx * rx + ry * ry + rz * rz > radii[k] * radii[k]
+        any_live = any_live or live[k]
+    return any_live
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _inside_live(obstacles: Obstacles, x: float, y: float, z: float) -> bool:
+    """Whether the point ``(x, y, z)`` (a target) lies inside a live obstacle."""
+    centres, radii, live = obstacles
+    for k in range(radii.shape[0]):
+        rx, ry, rz = centres[k, 0] - x, centres[k, 1] - y, centres[k, 2] - z
+        if live[k] and rx * rx + ry * ry + rz * rz < radii[k] * radii[k]:
             return True
     return False

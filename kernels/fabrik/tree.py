@@ -40,7 +40,10 @@ from kernels.fabrik.chain import (
 from kernels.fabrik.geometry import (
     _TINY,
     _TOUCH,
+    Obstacles,
     _deflect,
+    _inside_live,
+    _mark_live,
     _perpendicular,
     _rotate,
     _segment_cuts,
@@ -342,12 +345,8 @@ def _solve_tree_core(
     # relative only (as solve): the core gives the same bits at any power-of-2 scale
     tiny = _TINY * max(total, distance)
     live = np.empty(radii.shape[0], dtype=np.bool_)
-    any_live = False
-    for k in range(radii.shape[0]):
-        live[k] = (centres[k, 0] - p[root, 0]) ** 2 + (centres[k, 1] - p[root, 1]) ** 2 + (
-            centres[k, 2] - p[root, 2]
-        ) ** 2 > radii[k] * radii[k]
-        any_live = any_live or live[k]
+    any_live = _mark_live(centres, radii, live, p[root, 0], p[root, 1], p[root, 2])
+    obstacles = (centres, radii, live)
     # As solve, the fixed-point rule stops a tree only where limits or obstacles can hold it, or where some
     # effector's target is out of its path's reach; a free tree within reach iterates on to the cap.
     out_of_reach = False
@@ -391,14 +390,12 @@ def _solve_tree_core(
             counts[up] += 1
 
     worst = _tree_errors(p, goal, effectors, history, 0)
-    if _tree_admissible(p, parents, order, table, rest, tiny, has_limits, centres, radii, live):
+    if _tree_admissible(p, parents, order, table, rest, tiny, has_limits, obstacles):
         best_worst = worst
         if worst <= tolerance:  # the start is returned as reached only where it keeps every limit
             for e in range(final.shape[0]):
                 final[e] = history[0, e]
-            _tree_statuses(
-                p, parents, goal, effectors, lengths, centres, radii, live, tolerance, tiny, final, False, False, codes
-            )
+            _tree_statuses(p, parents, goal, effectors, lengths, obstacles, tolerance, tiny, final, False, False, codes)
             return 0
     stall = _STALL * tolerance + tiny
     iterations, stalled, retry = 0, False, True
@@ -429,7 +426,7 @@ def _solve_tree_core(
                 dx, dy, dz, directions[up, 0], directions[up, 1], directions[up, 2], table, j, rest
             )
             if radii.shape[0] > 0:
-                dx, dy, dz, _ = _deflect(x, y, z, dx, dy, dz, lengths[j], centres, radii, live, tiny, dim)
+                dx, dy, dz, _ = _deflect(x, y, z, dx, dy, dz, lengths[j], obstacles, tiny, dim)
             sums[up, 0] += x + lengths[j] * dx
             sums[up, 1] += y + lengths[j] * dy
             sums[up, 2] += z + lengths[j] * dz
@@ -445,7 +442,7 @@ def _solve_tree_core(
             if has_limits:
                 dx, dy, dz = _constrain(dx, dy, dz, qx, qy, qz, table, j, rest, tiny, dim)
             if radii.shape[0] > 0:
-                dx, dy, dz, turned = _deflect(ax, ay, az, dx, dy, dz, lengths[j], centres, radii, live, tiny, dim)
+                dx, dy, dz, turned = _deflect(ax, ay, az, dx, dy, dz, lengths[j], obstacles, tiny, dim)
                 if turned and has_limits:
                     dx, dy, dz = _constrain(dx, dy, dz, qx, qy, qz, table, j, rest, tiny, dim)
             length = lengths[j]
@@ -460,7 +457,7 @@ def _solve_tree_core(
         # restart the best is returned). The backward stage keeps every limit on every iterate.
         track = any_live or not retry
         admissible = (worst <= tolerance or (track and worst < best_worst)) and _tree_admissible(
-            p, parents, order, table, rest, tiny, has_limits, centres, radii, live
+            p, parents, order, table, rest, tiny, has_limits, obstacles
         )
         if admissible and worst < best_worst:
             _copy(p, best)  # a loop: an array copy compiles numba's shape checks for seconds
@@ -482,7 +479,7 @@ def _solve_tree_core(
     feasible = best_worst < np.inf
     if feasible and (
         not retry  # restarted: never worse than the best before or after
-        or not _tree_admissible(p, parents, order, table, rest, tiny, has_limits, centres, radii, live)
+        or not _tree_admissible(p, parents, order, table, rest, tiny, has_limits, obstacles)
     ):
         _copy(best, p)  # never an inadmissible last iterate where an admissible one was seen
     for e in range(effectors.shape[0]):
@@ -495,9 +492,7 @@ def _solve_tree_core(
         goal,
         effectors,
         lengths,
-        centres,
-        radii,
-        live,
+        obstacles,
         tolerance,
         tiny,
         final,
@@ -566,13 +561,11 @@ def _tree_admissible(
     rest: NDArray[np.float64],
     tiny: float,
     has_limits: bool,
-    centres: NDArray[np.float64],
-    radii: NDArray[np.float64],
-    live: NDArray[np.bool_],
+    obstacles: Obstacles,
 ) -> bool:
     """Whether the tree's pose keeps every joint limit (each segment against its parent's, the root's against
     ``rest``; zero-length segments have none and pass their parent's on) and cuts no live obstacle."""
-    if not has_limits and radii.shape[0] == 0:
+    if not has_limits and obstacles[1].shape[0] == 0:  # no limits and no obstacle at all
         return True
     count = p.shape[0]
     directions = np.empty((count, 3))
@@ -589,7 +582,7 @@ def _tree_admissible(
         if has_limits and not _joint_ok(dx, dy, dz, qx, qy, qz, table, j, rest, tiny):
             return False
         directions[j, 0], directions[j, 1], directions[j, 2] = dx, dy, dz
-        if _segment_cuts(p, up, j, centres, radii, live, 1.0):
+        if _segment_cuts(p, up, j, obstacles, 1.0):
             return False
     return True
 
@@ -601,9 +594,7 @@ def _tree_statuses(
     goal: NDArray[np.float64],
     effectors: NDArray[np.int64],
     lengths: NDArray[np.float64],
-    centres: NDArray[np.float64],
-    radii: NDArray[np.float64],
-    live: NDArray[np.bool_],
+    obstacles: Obstacles,
     tolerance: float,
     tiny: float,
     error: NDArray[np.float64],
@@ -614,10 +605,10 @@ def _tree_statuses(
     """Each effector's status code (see :func:`_solve_tree_core`); ``held``: limits or live obstacles can hold the
     tree at a fixed point (else a stall is another effector's target out of reach: "unreachable")."""
     touching = False
-    if radii.shape[0] > 0:
+    if obstacles[1].shape[0] > 0:  # any obstacle at all
         for j in range(p.shape[0]):
             up = int(parents[j])
-            touching = touching or (up >= 0 and _segment_cuts(p, up, j, centres, radii, live, 1.0 + _TOUCH))
+            touching = touching or (up >= 0 and _segment_cuts(p, up, j, obstacles, 1.0 + _TOUCH))
     root = 0
     while parents[root] >= 0:
         root = int(parents[root])
@@ -631,12 +622,7 @@ def _tree_statuses(
         inner = max(0.0, 2.0 * longest - reach)
         dx, dy, dz = goal[key, 0] - p[root, 0], goal[key, 1] - p[root, 1], goal[key, 2] - p[root, 2]
         distance = math.sqrt(dx * dx + dy * dy + dz * dz)
-        inside = False
-        for k in range(radii.shape[0]):
-            ox = centres[k, 0] - goal[key, 0]
-            oy = centres[k, 1] - goal[key, 1]
-            oz = centres[k, 2] - goal[key, 2]
-            inside = inside or (live[k] and ox * ox + oy * oy + oz * oz < radii[k] * radii[k])
+        inside = _inside_live(obstacles, goal[key, 0], goal[key, 1], goal[key, 2])
         if error[e] <= tolerance:
             codes[e] = _REACHED
         elif distance > reach + tiny or distance < inner - tiny:
