@@ -59,11 +59,11 @@ launched below it is refused. The measured model refuses a launch spin parameter
 
 Implementation: every numeric core (force law, Euler and RK4 steps, the Hermite end of a flight, plane crossings and
 the verdict) is written once, on scalars, and compiled by numba (``@njit(cache=True)``). One kick and a batch run the
-same compiled flight; a batch runs its kicks in parallel (``prange``, :func:`numba.get_num_threads` threads). The
-Python functions around them only validate (``ValueError`` naming the argument) and package arrays. Compiled code is cached
-in ``__pycache__`` beside each module, or, where that is read-only (an installed package), in numba's user-wide cache
-(``~/.cache/numba``; ``NUMBA_CACHE_DIR`` overrides both; with neither writable, no disk cache). :func:`warm_up`
-compiles (or loads) every core.
+same compiled flight; a batch runs its kicks in parallel (ranges of kicks on :func:`numba.get_num_threads` threads,
+the compiled loop without the GIL). The Python functions around them only validate (``ValueError`` naming the
+argument) and package arrays. Compiled code is cached in ``__pycache__`` beside each module, or, where that is
+read-only (an installed package), in numba's user-wide cache (``~/.cache/numba``; ``NUMBA_CACHE_DIR`` overrides
+both; with neither writable, no disk cache). :func:`warm_up` compiles (or loads) every core.
 
 Step limit: a kick whose ``dt`` is beyond the method's stability limit for its drag is refused before it flies, with a
 ``ValueError`` naming ``dt`` and the limit (:func:`kernels.ball.aero.max_stable_step`). Drag alone on a ball at speed

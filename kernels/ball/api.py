@@ -11,7 +11,6 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
-import threading
 from collections.abc import Sequence
 from typing import Any
 
@@ -19,6 +18,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from kernels import _checks
+from kernels._rows import run_rows
 from kernels.ball import core, play
 from kernels.ball.config import (
     BALL_RADIUS_M,
@@ -43,24 +43,21 @@ from kernels.ball.pitch import Keeper, Panel, Pitch, free_kick_panels, panel_row
 from kernels.warming import Entry
 
 # The compiled cores called from here: plain Python while the app's first start compiles them (kernels.warming).
-fly_and_judge = Entry(core.fly_and_judge)
-fly_batch = Entry(core.fly_batch)
+fly_and_judge_rows = Entry(core.fly_and_judge_rows)
+fly_rows = Entry(core.fly_rows)
 judge = Entry(core.judge)
-judge_batch = Entry(core.judge_batch)
+judge_rows = Entry(core.judge_rows)
 pad = Entry(core.pad)
 simulate_one = Entry(core.simulate_one)
 stable_step = Entry(core.stable_step)
 play_one = Entry(play.play_one)
-play_batch = Entry(play.play_batch)
+play_rows = Entry(play.play_rows)
 
 EVENT_KINDS: tuple[str, ...] = ("ground", "post", "bar", "wall", "keeper", "net")
 """Kinds of :class:`Event`, in the compiled flight's code order."""
 
 RESERVE_BYTES = 2**31
 """Largest time-major reservation :func:`simulate_batch` makes before it counts the samples first (bytes)."""
-# numba's workqueue threading layer (the fallback where neither TBB nor OpenMP is present) must not launch two
-# parallel kernels at once; the scene's workers and the app's warm-up may call from different threads.
-_PARALLEL = threading.Lock()
 
 
 @dataclasses.dataclass(frozen=True)
@@ -378,18 +375,17 @@ def simulate_batch(
     k = len(launches)
     rows = int(settings[N_STEPS]) + 1
     n_samples, endings = np.ones(k, dtype=np.int64), np.full(k, 2, dtype=np.int64)
-    with _PARALLEL:
-        # Time-major (T, K) storage with room for the longest flight t_max allows: rows past this batch's longest
-        # flight are never touched, so they never become memory. Where even that reservation is too large, count
-        # the samples first.
-        if rows * k * 56 > RESERVE_BYTES:
-            fly_batch(launches, settings, np.empty((0, k)), np.empty((0, k, 6)), n_samples, endings)
-            rows = int(n_samples.max())
-        t, state = np.empty((rows, k)), np.empty((rows, k, 6))
-        fly_batch(launches, settings, t, state, n_samples, endings)
-        width = int(n_samples.max()) if k else 1
-        t, state = t[:width], state[:width]
-        pad(t, state, n_samples)
+    # Time-major (T, K) storage with room for the longest flight t_max allows: rows past this batch's longest
+    # flight are never touched, so they never become memory. Where even that reservation is too large, count
+    # the samples first.
+    if rows * k * 56 > RESERVE_BYTES:
+        run_rows(fly_rows, k, launches, settings, np.empty((0, k)), np.empty((0, k, 6)), n_samples, endings)
+        rows = int(n_samples.max())
+    t, state = np.empty((rows, k)), np.empty((rows, k, 6))
+    run_rows(fly_rows, k, launches, settings, t, state, n_samples, endings)
+    width = int(n_samples.max()) if k else 1
+    t, state = t[:width], state[:width]
+    pad(t, state, n_samples)
     _refuse_overflow(endings, settings, launches)
     state = state.transpose(1, 0, 2)  # (K, T, 6) view, no copy
     return BatchTrajectory(
@@ -431,8 +427,7 @@ def _play_batch(
     t, state, spin = np.empty((k, rows)), np.empty((k, rows, 6)), np.empty((k, rows, 3))
     events, info = np.empty((k, play.MAX_EVENTS, 5)), np.empty((k, play.N_INFO))
     n_samples, endings = np.ones(k, dtype=np.int64), np.full(k, 2, dtype=np.int64)
-    with _PARALLEL:
-        play_batch(launches, settings, pitches, which, t, state, spin, events, info, n_samples, endings)
+    run_rows(play_rows, k, launches, settings, pitches, which, t, state, spin, events, info, n_samples, endings)
     _refuse_overflow(endings, settings, launches)
     return t, state, spin, events, info, n_samples, endings
 
@@ -500,6 +495,12 @@ def outcome(trajectory: Trajectory, wall: Panel, goal: Panel, *, radius_m: float
     _checks.instance("trajectory", trajectory, Trajectory, "a Trajectory from simulate()")
     crossings = np.empty((2, 4))
     t, position, velocity = trajectory.t, trajectory.position, trajectory.velocity
+    if not (t.flags.writeable and position.flags.writeable and velocity.flags.writeable):
+        # A read-only flight (the scene keeps its flights so) is judged from a writable copy laid out as simulate()'s:
+        # one compiled judge for both, not a second variant to compile on the first start.
+        state = np.empty((len(t), 6))
+        state[:, :3], state[:, 3:] = position, velocity
+        t, position, velocity = np.array(t), state[:, :3], state[:, 3:]
     code = judge(t, position, velocity, len(t), panel_rows(wall, goal), radius, crossings)
     wall_ok, goal_ok = not math.isnan(crossings[0, 0]), not math.isnan(crossings[1, 0])
     return Outcome(
@@ -531,17 +532,9 @@ def outcome_batch(batch: BatchTrajectory, wall: Panel, goal: Panel, *, radius_m:
         np.empty((k, 2, 4)),
         panel_rows(wall, goal),
     )
-    with _PARALLEL:
-        judge_batch(
-            batch.t,
-            batch.position,
-            batch.velocity,
-            batch.n_samples,
-            panels,
-            radius,
-            results,
-            crossings,
-        )
+    run_rows(
+        judge_rows, k, batch.t, batch.position, batch.velocity, batch.n_samples, panels, radius, results, crossings
+    )
     return _batch_outcome(results, crossings)
 
 
@@ -602,8 +595,7 @@ def simulate_outcomes(
         wall = Panel(goal.centre_xy, goal.normal_xy, 1e-9, -1e300)
     k, panels = len(launches), panel_rows(wall, goal)
     results, crossings, endings = np.empty(k, np.int64), np.empty((k, 2, 4)), np.empty(k, np.int64)
-    with _PARALLEL:
-        fly_and_judge(launches, settings, panels, results, crossings, endings)
+    run_rows(fly_and_judge_rows, k, launches, settings, panels, results, crossings, endings)
     _refuse_overflow(endings, settings, launches)
     if no_wall:
         crossings[:, 0, :] = np.nan

@@ -1,7 +1,7 @@
 """The compiled flight and its verdict: Euler or RK4 steps, the Hermite end of a flight, plane crossings, the judge.
 
 A flight writes its samples' times (T,) and states (T, 6: position then velocity, m and m/s) into buffers the caller
-gives; a batch runs its K kicks in parallel (``prange``) into (T, K) and (T, K, 6) time-major buffers. Each flight
+gives; a batch runs its K kicks, a range of them per thread, into (T, K) and (T, K, 6) time-major buffers. Each flight
 ends with a code in :data:`ENDINGS` order (3: diverged; 4: not flown, its step beyond the method's stability limit),
 each verdict with one in :data:`RESULTS` order. Crossings are the first root of the cubic Hermite interpolant of the
 step (:func:`crossing_fraction`). Method and assumptions: :mod:`kernels.ball`.
@@ -13,7 +13,6 @@ import math
 from typing import Literal
 
 import numpy as np
-from numba import prange
 
 from kernels.ball.aero import N_KICK, acceleration, fill_kick, max_stable_step, sample_forces
 from kernels.ball.config import DT, GRAVITY, GROUND, N_STEPS, RADIUS, RK4, T_MAX, X_STOP
@@ -244,26 +243,28 @@ def stable_step(launch, config):
     return max_stable_step(launch, kick, config)
 
 
-@compiled(parallel=True)
-def fly_batch(launches, config, t_out, state_out, n_samples, endings):
-    """Every kick's flight into column k of ``t_out`` (T, K) and ``state_out`` (T, K, 6), in parallel.
+@compiled(nogil=True)
+def fly_rows(start, stop, launches, config, t_out, state_out, n_samples, endings):
+    """Kicks ``start`` to ``stop`` of a batch, each flight into column k of ``t_out`` (T, K) and ``state_out``
+    (T, K, 6); without the GIL, so threads share a batch (:func:`kernels._rows.run_rows`).
 
     T must hold each flight (n_steps + 1 always does); with T = 0 it only counts the samples.
     """
-    for k in prange(len(launches)):
-        kick = np.empty(N_KICK)
+    kick = np.empty(N_KICK)
+    for k in range(start, stop):
         fill_kick(launches[k], config, kick)
         n_samples[k], endings[k] = _fly(launches[k], kick, config, t_out[:, k], state_out[:, k])
 
 
-@compiled(parallel=True)
+@compiled(nogil=True)
 def pad(t, state, n_samples):
     """Repeat each flight's last sample to the end of ``t`` (T, K) and ``state`` (T, K, 6)."""
-    for k in prange(len(n_samples)):
+    for k in range(len(n_samples)):
         last = n_samples[k] - 1
         for i in range(last + 1, t.shape[0]):
             t[i, k] = t[last, k]
-            state[i, k, :] = state[last, k, :]
+            for c in range(6):
+                state[i, k, c] = state[last, k, c]
 
 
 # --------------------------------------------------------------------------------------------- outcome
@@ -323,19 +324,20 @@ def judge(t, position, velocity, n, panels, radius, crossings):
     return 0 if crossings[1, 3] <= goal[5] - radius else 2
 
 
-@compiled(parallel=True)
-def judge_batch(t, position, velocity, n_samples, panels, radius, results, crossings):
-    """:func:`judge` for every flight of a (K, T) batch, in parallel."""
-    for k in prange(len(n_samples)):
+@compiled(nogil=True)
+def judge_rows(start, stop, t, position, velocity, n_samples, panels, radius, results, crossings):
+    """:func:`judge` for flights ``start`` to ``stop`` of a (K, T) batch, without the GIL (threads share a batch)."""
+    for k in range(start, stop):
         results[k] = judge(t[k], position[k], velocity[k], n_samples[k], panels, radius, crossings[k])
 
 
-@compiled(parallel=True)
-def fly_and_judge(launches, config, panels, results, crossings, endings):
-    """Fly each kick into its own scratch buffer and judge it at once (ball radius from ``config``): nothing kept."""
+@compiled(nogil=True)
+def fly_and_judge_rows(start, stop, launches, config, panels, results, crossings, endings):
+    """Fly kicks ``start`` to ``stop`` each into a scratch buffer and judge it at once (ball radius from ``config``):
+    nothing kept. Without the GIL (threads share a batch)."""
     rows = int(config[N_STEPS]) + 1
-    for k in prange(len(launches)):
-        kick, t, state = np.empty(N_KICK), np.empty(rows), np.empty((rows, 6))
+    kick, t, state = np.empty(N_KICK), np.empty(rows), np.empty((rows, 6))
+    for k in range(start, stop):
         fill_kick(launches[k], config, kick)
         n, endings[k] = _fly(launches[k], kick, config, t, state)
         results[k] = judge(t, state[:, :3], state[:, 3:], n, panels, config[RADIUS], crossings[k])

@@ -195,6 +195,7 @@ def bounce(
     surface = np.empty(contact.N_SURFACE)
     surface[contact.RESTITUTION], surface[contact.TANGENTIAL_RESTITUTION] = e_n, e_t
     surface[contact.FRICTION], surface[contact.RADIUS], surface[contact.INERTIA_FACTOR] = mu, radius, alpha
+    surface.setflags(write=False)  # typed as the pitch's read-only surfaces: one compiled impact for both
     impacts(velocities, spins, unit, surface, v_out, w_out)
     if not (np.isfinite(v_out).all() and np.isfinite(w_out).all()):
         raise ValueError(

@@ -23,7 +23,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import prange
 
 from kernels.ball.aero import AXIS, GAIN, N_KICK, RATE, configured_drag_lift, fill_kick, max_stable_step, sample_forces
 from kernels.ball.config import (
@@ -563,14 +562,17 @@ def play_one(launch, config, pitch, t_out, state_out, spin_out, forces_out, even
     return n, ending
 
 
-@compiled(parallel=True)
-def play_batch(launches, config, pitches, which, t_out, state_out, spin_out, events, info, n_samples, endings):
-    """:func:`play` for each kick, in parallel, kick k on pitch ``pitches[which[k]]`` ((P, N_PITCH) and (K,)): its
-    samples into row k of ``t_out`` (K, T), ``state_out`` (K, T, 6), ``spin_out`` (K, T, 3) (T = 0: verdicts only,
-    and each flight ends once its verdict cannot change), its contacts into ``events`` (K, MAX_EVENTS, 5) and its
-    summary into ``info`` (K, N_INFO)."""
-    for k in prange(len(launches)):
-        kick = np.empty(N_KICK)
+@compiled(nogil=True)
+def play_rows(
+    start, stop, launches, config, pitches, which, t_out, state_out, spin_out, events, info, n_samples, endings
+):
+    """:func:`play` for kicks ``start`` to ``stop``, without the GIL (threads share a batch:
+    :func:`kernels._rows.run_rows`), kick k on pitch ``pitches[which[k]]`` ((P, N_PITCH) and (K,)): its samples into
+    row k of ``t_out`` (K, T), ``state_out`` (K, T, 6), ``spin_out`` (K, T, 3) (T = 0: verdicts only, and each flight
+    ends once its verdict cannot change), its contacts into ``events`` (K, MAX_EVENTS, 5) and its summary into
+    ``info`` (K, N_INFO)."""
+    kick = np.empty(N_KICK)
+    for k in range(start, stop):
         fill_kick(launches[k], config, kick)
         n_samples[k], endings[k] = play(
             launches[k], kick, config, pitches[which[k]], t_out[k], state_out[k], spin_out[k], events[k], info[k]
