@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import itertools
 import math
-import os
 import re
 from collections.abc import Sequence
 
@@ -21,7 +20,7 @@ from hypothesis import strategies as st
 
 from kernels import course
 
-EXAMPLES = int(os.environ.get("EXPLORE_EXAMPLES", 150))
+EXAMPLES = 150
 Point = tuple[float, float]
 Piece = list[Point]
 
