@@ -10,15 +10,14 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
-import threading
 from collections.abc import Callable, Sequence
 from typing import Any
 
-import numba
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from kernels._checks import bounded_array, finite_number
+from kernels._rows import run_rows
 from kernels.fabrik.chain import (
     _BAD_JOINTS,
     _BAD_TARGET,
@@ -59,46 +58,12 @@ Obstacle = tuple[ArrayLike, float]
 _MAX_ITERATIONS_CAP = 100_000
 """Largest ``max_iterations`` accepted (each chain keeps an error history of that length)."""
 
-_CHUNKS_PER_THREAD = 16
-"""Chunks per thread a batch is cut into: enough to balance chains that need 1 and 50 iterations."""
-
 
 def _solve_batch_rows(args: tuple[Any, ...]) -> None:
-    """:func:`~kernels.fabrik.chain._solve_rows` over every row of a batch (``args[0]`` the (B, n + 1, 3) joints), cut
-    into contiguous chunks that ``numba.get_num_threads()`` threads (this one and helpers started for the call) take
-    in turn. ``_solve_rows`` runs without the GIL, so plain threads share the batch as a ``prange`` loop would, and
-    no ``parallel=True`` core has to compile on the first start. Threads of the call's own, not a pool: a batch
-    solved while the interpreter shuts down (an ``atexit`` hook) still runs, on this thread if no other can start."""
-    batch = len(args[0])
-    threads = min(numba.get_num_threads(), batch)
-    if threads <= 1:
-        _solve_rows(0, batch, *args)
-        return
-    chunks = min(batch, threads * _CHUNKS_PER_THREAD)
-    bounds = [c * batch // chunks for c in range(chunks + 1)]
-    order = iter(range(chunks))  # shared: next() on it is one atomic step under the GIL
-    errors: list[BaseException] = []
-
-    def take_chunks() -> None:
-        try:
-            for c in order:
-                _solve_rows(bounds[c], bounds[c + 1], *args)
-        except BaseException as exc:  # re-raised in the calling thread below
-            errors.append(exc)
-
-    helpers: list[threading.Thread] = []
-    for _ in range(threads - 1):
-        helper = threading.Thread(target=take_chunks, name="fabrik-batch", daemon=True)
-        try:
-            helper.start()
-        except RuntimeError:  # no new threads while the interpreter shuts down: this one takes the rest
-            break
-        helpers.append(helper)
-    take_chunks()
-    for helper in helpers:
-        helper.join()
-    if errors:
-        raise errors[0]
+    """:func:`~kernels.fabrik.chain._solve_rows` over every row of a batch (``args[0]`` the (B, n + 1, 3) joints),
+    shared among threads by :func:`kernels._rows.run_rows`: ``_solve_rows`` runs without the GIL, so no
+    ``parallel=True`` core has to compile on the first start."""
+    run_rows(_solve_rows, len(args[0]), *args)
 
 
 @dataclasses.dataclass(frozen=True)
