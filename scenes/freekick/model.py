@@ -11,6 +11,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
+from collections.abc import Callable
 from dataclasses import field
 from typing import Literal
 
@@ -145,6 +146,8 @@ class FreeKickParams:
     """Random draw of the knuckleball's side force: the same number, the same flight. Greyed out without the knuckleball."""
     wall_jumps: bool = field(default=False, metadata=checkbox("Wall jumps", folder="Physics"))
     """Whether the wall jumps (its top rises by 0.35 m)."""
+    keeper: bool = field(default=True, metadata=checkbox("Goalkeeper", folder="Physics"))
+    """Whether a goalkeeper (:data:`KEEPER`) stands in goal, reads the kick and dives for it."""
     show_forces: bool = field(default=True, metadata=checkbox("Force arrows", folder="Physics"))
     """Whether the force arrows are drawn along the path (how the kick is shown, not what it is)."""
     view: ViewName = field(
@@ -167,7 +170,19 @@ class Preset:
 
 
 PRESETS: tuple[Preset, ...] = (
-    Preset("Curler round the wall", FreeKickParams()),
+    Preset("Curler round the wall, saved", FreeKickParams()),
+    Preset(
+        "Top corner past the keeper",
+        FreeKickParams(speed_ms=28.0, elevation_deg=16.0, azimuth_deg=-14.0, spin_rev_s=8.0),
+    ),
+    Preset(
+        "Low curler: bounces, saved",
+        FreeKickParams(speed_ms=25.0, elevation_deg=12.0, azimuth_deg=-10.0, spin_rev_s=8.0),
+    ),
+    Preset(
+        "Driven, off the post",
+        FreeKickParams(speed_ms=28.0, elevation_deg=12.0, azimuth_deg=-10.0, spin_rev_s=0.0),
+    ),
     Preset(
         "Dipping topspin",
         FreeKickParams(speed_ms=28.0, elevation_deg=21.0, azimuth_deg=0.0, spin_rev_s=8.0, spin_axis="top"),
@@ -277,21 +292,175 @@ def panels(p: FreeKickParams) -> tuple[ball.Panel, ball.Panel]:
     )
 
 
+KEEPER = ball.Keeper()
+"""The scene's goalkeeper: the kernel's defaults (a 1.90 m keeper 1 m off his line on the bisector of the posts'
+angle, reacting 0.25 s after the ball passes the wall, diving at 3.9 m/s)."""
+
+
+def pitch(p: FreeKickParams) -> ball.Pitch:
+    """The pitch the kick is played on: the goal (posts, bar, net), the wall's players and the keeper if ``p`` has
+    one."""
+    wall, goal = panels(p)
+    return ball.Pitch(goal, wall, KEEPER if p.keeper else None)
+
+
+@dataclasses.dataclass(frozen=True)
+class KeeperPose:
+    """The keeper as the kernel moves him: a stick from the soles to the fingertips through his centre of mass."""
+
+    com: NDArray[np.float64]
+    """(T, 3) centre of mass (m)."""
+    up: NDArray[np.float64]
+    """(T, 3) unit direction from the soles toward the fingertips."""
+
+    def ends(self, keeper: ball.Keeper = KEEPER) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """(T, 3) soles and (T, 3) fingertips (m): the stick's ends, as the kernel's capsule before its rounding."""
+        return self.com - keeper.foot_reach_m * self.up, self.com + keeper.hand_reach_m * self.up
+
+
+def keeper_pose(
+    keeper_xy: tuple[float, float],
+    dive: ball.KeeperDive | None,
+    times: NDArray[np.float64],
+    keeper: ball.Keeper = KEEPER,
+) -> KeeperPose:
+    """Where the keeper is at each of ``times`` (s since the kick), as :func:`kernels.ball.simulate` moves him.
+
+    Upright on ``keeper_xy`` until the dive starts (``dive.t``); then his centre of mass accelerates uniformly over
+    ``push_off_s`` to ``dive_speed_ms`` and keeps that speed along the straight line toward ``dive.target``, stopping
+    where his fingertips reach it, while his body turns from upright to point at it over ``turn_s`` (the kernel's
+    keeper model, :class:`kernels.ball.Keeper`; dive speed from Ibrahim et al. 2019). The turf is at z = 0.
+    """
+    t = np.asarray(times, dtype=np.float64).reshape(-1)
+    com = np.tile([keeper_xy[0], keeper_xy[1], keeper.com_height_m], (len(t), 1))
+    up = np.tile([0.0, 0.0, 1.0], (len(t), 1))
+    if dive is None:
+        return KeeperPose(com, up)
+    tau = np.maximum(t - dive.t, 0.0)
+    push, speed = keeper.push_off_s, keeper.dive_speed_ms
+    travel = np.where(tau < push, 0.5 * speed * tau**2 / push, 0.5 * speed * push + speed * (tau - push))
+    to_target = np.asarray(dive.target, dtype=np.float64) - com[0]
+    span = float(np.linalg.norm(to_target))
+    if span <= 1e-9:
+        return KeeperPose(com, up)
+    g = to_target / span
+    move = np.minimum(travel, max(span - keeper.hand_reach_m, 0.0))
+    com = com + move[:, None] * g
+    turn = np.minimum(tau / keeper.turn_s, 1.0)[:, None]
+    up = (1.0 - turn) * up + turn * g
+    up /= np.linalg.norm(up, axis=1, keepdims=True)
+    return KeeperPose(com, up)
+
+
+def keeper_gap_m(pose: KeeperPose, points: NDArray[np.float64], keeper: ball.Keeper = KEEPER) -> NDArray[np.float64]:
+    """(T,) distance (m) from each ball centre of (T, 3) ``points`` to the keeper's body at the same instant, less
+    the ball's radius and half the body's thickness: ≤ 0 where the ball touches him."""
+    r = keeper.body_radius_m
+    soles = pose.com - (keeper.foot_reach_m - r) * pose.up  # the kernel's capsule: its segment and radius
+    tips = pose.com + (keeper.hand_reach_m - r) * pose.up
+    axis = tips - soles
+    s = np.clip(np.einsum("ij,ij->i", points - soles, axis) / np.einsum("ij,ij->i", axis, axis), 0.0, 1.0)
+    nearest = soles + s[:, None] * axis
+    return np.linalg.norm(points - nearest, axis=1) - keeper.body_radius_m - ball.BALL_RADIUS_M
+
+
+KEEPER_STEP_S = 2e-3
+"""Time step (s) at which the keeper's reach is searched for the readout's "reached it … early"."""
+
+
+def save_margin_s(state: KickState) -> float | None:
+    """How much earlier (s) the keeper's body could have touched the ball where he met it than it arrived there;
+    None unless he saved it. The kernel's keeper (:func:`keeper_pose`) searched every :data:`KEEPER_STEP_S`."""
+    played, spot = state.played, state.keeper_xy
+    if played is None or spot is None or played.keeper_dive is None:
+        return None
+    saved = next((event for event in played.events if event.kind == "keeper"), None)
+    if saved is None:
+        return None
+    times = np.arange(played.keeper_dive.t, saved.t + KEEPER_STEP_S, KEEPER_STEP_S)
+    point = np.tile(saved.position, (len(times), 1))
+    reach = keeper_gap_m(keeper_pose(spot, played.keeper_dive, times), point) <= 1e-3
+    first = float(times[int(np.argmax(reach))]) if reach.any() else saved.t
+    return max(saved.t - first, 0.0)
+
+
+def keeper_words(state: KickState) -> str:
+    """What the keeper did, in words: "dives right 0.67 s after the kick, reaches it 0.26 s early", "... the ball
+    beats him by 0.42 m" or "never dives". Empty without a keeper."""
+    played, spot = state.played, state.keeper_xy
+    if played is None or spot is None:
+        return ""
+    dive = played.keeper_dive
+    if dive is None:
+        return "never dives (the ball never gets past the wall)"
+    across = dive.target[1] - spot[1]  # + toward the kicker's left, as every readout says it
+    way = "up" if abs(across) < 0.3 else ("left" if across > 0 else "right")
+    dived = f"dives {way} {dive.t:.2f} s after the kick"
+    margin = save_margin_s(state)
+    if margin is not None:
+        return f"{dived}, reaches it {margin:.2f} s early"
+    # The ball got past: how close his body came to it over the flight.
+    gap = keeper_gap_m(keeper_pose(spot, dive, played.t), played.position)
+    nearest = max(float(gap.min()), 0.0)
+    if played.result == "goal":
+        return f"{dived}; the ball beats him by {nearest:.2f} m"
+    return f"{dived}; gets within {nearest:.2f} m of the ball"
+
+
+def keeper_show_time(state: KickState) -> float:
+    """The instant (s) the still picture shows the keeper at: when he touches the ball, else when the ball reaches
+    the goal line (or the flight's end, if it never does)."""
+    played = state.played
+    if played is None:
+        return 0.0
+    saved = next((event.t for event in played.events if event.kind == "keeper"), None)
+    if saved is not None:
+        return saved
+    over = np.flatnonzero(played.position[:, 0] >= 0.0)
+    return float(played.t[over[0]] if len(over) else played.t[-1])
+
+
+LIMBS = ("left leg", "right leg", "body", "left arm", "right arm", "head")
+"""The keeper figure's parts, each drawn as one rod from a start to an end point."""
+LIMB_RADII_M = np.array([0.08, 0.08, 0.16, 0.06, 0.06, 0.11])
+"""Each part's half-thickness (m): the body a little thicker than the kernel's stick (0.15 m)."""
+
+
+def keeper_limbs(pose: KeeperPose, facing_xy: NDArray[np.float64], keeper: ball.Keeper = KEEPER) -> NDArray[np.float64]:
+    """(T, 6, 2, 3) start and end of each of :data:`LIMBS` (m) for a simple articulated figure on the kernel's
+    stick: legs from the hips to the soles (feet apart), the body from the hips to the shoulders, arms from the
+    shoulders to the fingertips (hands apart, up the stick as the kernel's reach has them) and the head. ``facing_xy``
+    is the (2,) direction he faces (toward the ball); the figure spreads its limbs across it."""
+    soles, tips = pose.ends(keeper)
+    up, com = pose.up, pose.com
+    facing = np.array([facing_xy[0], facing_xy[1], 0.0])
+    side = np.cross(facing, up)  # across the body, in the plane he dives in
+    norm = np.linalg.norm(side, axis=1, keepdims=True)
+    side = np.where(norm > 1e-6, side / np.maximum(norm, 1e-9), np.array([0.0, 1.0, 0.0]))
+    hips = com - 0.05 * up
+    shoulders = com + 0.5 * up
+    head = com + 0.72 * up
+    legs = [(hips + k * 0.1 * side, soles + k * 0.18 * side) for k in (1.0, -1.0)]
+    arms = [(shoulders + k * 0.2 * side, tips + k * 0.15 * side - 0.05 * up) for k in (1.0, -1.0)]
+    parts = [*legs, (hips, shoulders), *arms, (head - 0.06 * up, head + 0.06 * up)]
+    return np.stack([np.stack(part, axis=1) for part in parts], axis=1)
+
+
 STRIKES = 200
 """Strikes of the current kick played out for its odds (a player's scatter, :class:`kernels.ball.StrikeSpread`)."""
 
 
 def strike_chances(p: FreeKickParams, n: int = STRIKES) -> ball.Odds:
     """The current kick struck ``n`` times with a skilled player's scatter (:class:`kernels.ball.StrikeSpread`'s
-    defaults), each played on over the scene's pitch (wall, posts, bar, net; no keeper), without the knuckle force."""
-    wall, goal = panels(p)
+    defaults), each played on over the scene's pitch (wall, posts, bar, net and the keeper if there is one), without
+    the knuckle force."""
     return ball.strike_odds(
         ball_spot(p),
         p.speed_ms,
         math.radians(p.elevation_deg),
         aim_heading_rad(p),
         spin_vector(p),
-        ball.Pitch(goal, wall),
+        pitch(p),
         n=n,
         dt=INTEGRATOR_STEP_S[p.integrator],
         method=p.integrator,
@@ -299,6 +468,92 @@ def strike_chances(p: FreeKickParams, n: int = STRIKES) -> ball.Odds:
         t_max=PLAY_T_MAX_S,
         ground_m=ball.BALL_RADIUS_M,
     )
+
+
+ODDS_MAP_DISTANCES_M = np.linspace(16.0, 36.0, 21)
+"""The odds map's rows: distance from the spot to the goal's centre (m), every metre."""
+ODDS_MAP_ANGLES_DEG = np.linspace(-40.0, 40.0, 17)
+"""The odds map's columns: the spot's angle off the centre line (°, + to the kicker's left), every 5°."""
+ODDS_MAP_STRIKES = 32
+"""Strikes per spot of the odds map (21 × 17 spots × 32 = 11,424 kicks played out)."""
+ODDS_MAP_T_MAX_S = 4.0
+"""How long each of the map's kicks is played out (s): every verdict is in well before."""
+
+
+def odds_map_settings(p: FreeKickParams) -> FreeKickParams:
+    """What the odds map of ``p`` depends on: ``p`` without its spot and its display settings (the map is the same
+    strike from every spot)."""
+    plain = FreeKickParams()
+    return dataclasses.replace(
+        p, distance_m=plain.distance_m, angle_deg=plain.angle_deg, show_forces=plain.show_forces, view=plain.view
+    )
+
+
+def spot_odds_map(p: FreeKickParams, progress: Callable[[float], object] | None = None) -> NDArray[np.float64]:
+    """(D, A) the chance of a goal from each spot of :data:`ODDS_MAP_DISTANCES_M` × :data:`ODDS_MAP_ANGLES_DEG` for
+    the current strike (its speed, elevation, azimuth and spin, turned to face the goal from each spot), struck
+    :data:`ODDS_MAP_STRIKES` times with a skilled player's scatter over a 4-man wall square to the line to the goal
+    (jumping if ``p``'s does) and the keeper if ``p`` has one (:func:`kernels.ball.odds_map`, no knuckle force).
+    ``progress`` is called with the share done (0–1) as the spots' batches finish."""
+    straight = dataclasses.replace(p, angle_deg=0.0)  # from the centre line the world's axes are the ball's
+    chances = ball.odds_map(
+        ODDS_MAP_DISTANCES_M,
+        np.radians(ODDS_MAP_ANGLES_DEG),
+        p.speed_ms,
+        math.radians(p.elevation_deg),
+        math.radians(p.azimuth_deg),
+        spin_vector(straight),
+        keeper=KEEPER if p.keeper else None,
+        wall_height_m=DEFENDER_HEIGHT_M + (JUMP_M if p.wall_jumps else 0.0),
+        n=ODDS_MAP_STRIKES,
+        progress=progress,
+        chunks=17,
+        dt=INTEGRATOR_STEP_S["rk4"],
+        method="rk4",
+        model=p.model,
+        t_max=ODDS_MAP_T_MAX_S,
+        ground_m=ball.BALL_RADIUS_M,
+    )
+    return chances["goal"]
+
+
+HEAT_STOPS = np.array([[0.0, 20, 20, 110], [0.35, 170, 20, 150], [0.7, 240, 80, 20], [1.0, 255, 240, 40]])
+"""The heat map's colour ramp: (share, R, G, B) stops from no goals (dark purple) through red to every strike a
+goal (pale yellow); every stop stands out from the grass."""
+
+
+def heat_colours(chance: NDArray[np.float64]) -> NDArray[np.uint8]:
+    """(..., 3) RGB of each chance (0–1) on :data:`HEAT_STOPS`."""
+    c = np.clip(np.asarray(chance, dtype=np.float64), 0.0, 1.0)
+    rgb = [np.interp(c, HEAT_STOPS[:, 0], HEAT_STOPS[:, k]) for k in (1, 2, 3)]
+    return np.stack(rgb, axis=-1).round().astype(np.uint8)
+
+
+def heat_cells(p: FreeKickParams | None = None) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """The odds map's cells on the turf, row-major as :func:`spot_odds_map`'s (D, A): (D·A, 3) centres (m, just
+    above the grass), (D·A,) headings (rad, from +x: the line from the spot to the goal) and (D·A, 2) sizes (m,
+    along and across that line: a metre by the arc of 5°)."""
+    d, a = np.meshgrid(ODDS_MAP_DISTANCES_M, np.radians(ODDS_MAP_ANGLES_DEG), indexing="ij")
+    d, a = d.ravel(), a.ravel()
+    centres = np.column_stack([-d * np.cos(a), d * np.sin(a), np.full(d.size, 0.012)])
+    headings = np.arctan2(-centres[:, 1], -centres[:, 0])
+    step_d = float(ODDS_MAP_DISTANCES_M[1] - ODDS_MAP_DISTANCES_M[0])
+    step_a = math.radians(float(ODDS_MAP_ANGLES_DEG[1] - ODDS_MAP_ANGLES_DEG[0]))
+    sizes = np.column_stack([np.full(d.size, 0.96 * step_d), 0.96 * d * step_a])
+    return centres, headings, sizes
+
+
+def odds_map_words(chance: NDArray[np.float64], p: FreeKickParams) -> str:
+    """The map in words: the best spot and its chance, and the chance from the spot nearest the ball's."""
+    best = np.unravel_index(int(np.argmax(chance)), chance.shape)
+    d, a = ODDS_MAP_DISTANCES_M[best[0]], ODDS_MAP_ANGLES_DEG[best[1]]
+    side = "on the centre line" if a == 0 else f"{abs(a):g}° {'left' if a > 0 else 'right'}"
+    text = f"Best spot: **{d:g} m, {side}: goal {100 * chance[best]:.0f} %**"
+    i = int(np.argmin(np.abs(ODDS_MAP_DISTANCES_M - p.distance_m)))
+    j = int(np.argmin(np.abs(ODDS_MAP_ANGLES_DEG - p.angle_deg)))
+    if abs(ODDS_MAP_DISTANCES_M[i] - p.distance_m) <= 0.5 and abs(ODDS_MAP_ANGLES_DEG[j] - p.angle_deg) <= 2.5:
+        text += f"; from this spot: **{100 * chance[i, j]:.0f} %**"
+    return text
 
 
 ODDS_WORDS = {
@@ -317,7 +572,7 @@ def chances_words(odds: ball.Odds) -> str:
     """ "Struck 200 times with a player's scatter: goal 62 %, wall 9 %, …" (results that happened, largest first)."""
     shares = sorted(((odds.probability(name), name) for name in odds.counts if odds.counts[name]), reverse=True)
     listed = ", ".join(f"{ODDS_WORDS[name]} {100 * share:.0f} %" for share, name in shares)
-    return f"Struck {odds.n} times with a player's scatter (no keeper): **{listed}**"
+    return f"Struck {odds.n} times with a player's scatter: **{listed}**"
 
 
 def play_words(played: ball.Trajectory | None) -> str:
@@ -345,7 +600,7 @@ def play_words(played: ball.Trajectory | None) -> str:
         "net": "ends in the net",
         "out": "goes out of play",
         "stopped": f"rolls to a stop {max(-played.position[-1, 0], 0.0):.1f} m out",
-        "saved": "is saved",
+        "saved": "into the keeper's hands",
     }.get(played.ended, f"still rolling after {PLAY_T_MAX_S:g} s")
     if bounces:
         phrases.append("bounces" if bounces == 1 else f"bounces {bounces}×")
@@ -377,6 +632,73 @@ def knuckle_wobble_m(state: KickState) -> float | None:
     return float(np.abs(np.linalg.norm((kick - ghost.position[: len(times)])[:, 1:], axis=1)).max())
 
 
+WOBBLE_SCALE = 10.0
+"""How much the knuckleball's drawn wobble magnifies its difference from the spinless path: a ball's width over
+25 m is too little to see from the stands, ten times it is not."""
+
+
+def _knuckle_difference(state: KickState, n: int) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
+    """(n, 3) the spinless ghost and (n, 3) the kick's difference from it (m), at n times over both flights; None
+    without a knuckle force."""
+    flight, ghost = state.flight, state.ghost
+    if not np.any(flight.knuckle):
+        return None
+    end = min(float(flight.t[-1]), float(ghost.t[-1]))
+    times = np.linspace(0.0, end, n)
+    base = sample_rows(times, ghost.t, ghost.position)
+    return base, sample_rows(times, flight.t, flight.position) - base
+
+
+def wobble_path(state: KickState, n: int = PATH_POINTS) -> NDArray[np.float64] | None:
+    """(n, 3) the knuckleball's path drawn with its difference from the spinless path magnified
+    :data:`WOBBLE_SCALE` times; None without a knuckle force."""
+    found = _knuckle_difference(state, n)
+    return None if found is None else found[0] + WOBBLE_SCALE * found[1]
+
+
+def knuckle_swerves(p: FreeKickParams, state: KickState) -> list[tuple[float, float]]:
+    """Where the knuckleball swerves furthest each way: for each stretch of flight on one side of the spinless path
+    (by at least 2 cm), its furthest point as (distance from the spot along the ground (m), sideways offset (m, + to
+    the kicker's left)), in flight order. Empty without a knuckle force."""
+    found = _knuckle_difference(state, 400)
+    if found is None:
+        return []
+    base, diff = found
+    heading = aim_heading_rad(p)
+    sideways = diff @ np.array([-math.sin(heading), math.cos(heading), 0.0])
+    spot = ball_spot(p)
+    along = np.hypot(base[:, 0] - spot[0], base[:, 1] - spot[1])
+    side = np.where(np.abs(sideways) >= 0.02, np.sign(sideways), 0.0)
+    swerves: list[tuple[float, float]] = []
+    start = None
+    for i in range(len(side) + 1):
+        if i < len(side) and side[i] != 0.0 and (start is None or side[i] == side[start]):
+            start = i if start is None else start
+            continue
+        if start is not None:
+            far = start + int(np.argmax(np.abs(sideways[start:i])))
+            swerves.append((float(along[far]), float(sideways[far])))
+            start = i if i < len(side) and side[i] != 0.0 else None
+    return swerves
+
+
+def wobble_words(p: FreeKickParams, state: KickState) -> str:
+    """The knuckleball's swerves in words: "swerves 0.12 m left at 8 m, then 0.33 m right at 21 m; 0.10 m lower at
+    most"; empty without a knuckle force."""
+    found = _knuckle_difference(state, 400)
+    if found is None:
+        return ""
+    said = [
+        f"{abs(side):.2f} m {'left' if side > 0 else 'right'} at {at:.0f} m" for at, side in knuckle_swerves(p, state)
+    ]
+    words = "swerves " + ", then ".join(said) if said else "keeps within 2 cm sideways"
+    rise = found[1][:, 2]
+    far = int(np.argmax(np.abs(rise)))
+    if abs(rise[far]) >= 0.02:
+        words += f"; {abs(rise[far]):.2f} m {'higher' if rise[far] > 0 else 'lower'} at most"
+    return words
+
+
 def wall_axes(wall: ball.Panel) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """(2,) unit normal of the wall (toward the goal) and (2,) unit direction along it, + to the kicker's left."""
     normal = np.array(wall.normal_xy) / np.hypot(*wall.normal_xy)
@@ -404,7 +726,9 @@ class KickState:
     goal: ball.Panel
     played: ball.Trajectory | None = None
     """The same kick played on after it first touches anything: it bounces, rolls, strikes the posts, the bar and
-    the wall's players, and stops in the net (the kernel's flight on a pitch, without a keeper)."""
+    the wall's players and the keeper, and stops in the net or his hands (the kernel's flight on a pitch)."""
+    keeper_xy: tuple[float, float] | None = None
+    """Where the keeper stands (m), None without one."""
 
 
 def _fly(p: FreeKickParams, spin_scale: float, *, knuckle: bool, band: bool = False) -> ball.Trajectory:
@@ -442,7 +766,7 @@ def compute_kick(p: FreeKickParams) -> KickState:
         t_max=PLAY_T_MAX_S,
         ground_m=ball.BALL_RADIUS_M,
         knuckle_seed=p.knuckle_seed if p.knuckle else None,
-        pitch=ball.Pitch(goal, wall),
+        pitch=pitch(p),
     )
     return KickState(
         flight=flight,
@@ -454,6 +778,7 @@ def compute_kick(p: FreeKickParams) -> KickState:
         wall=wall,
         goal=goal,
         played=played,
+        keeper_xy=KEEPER.placed(ball_spot(p)[:2], goal) if p.keeper else None,
     )
 
 
@@ -468,6 +793,7 @@ def _without_spin(p: FreeKickParams) -> FreeKickParams:
         axis_turn_deg=plain.axis_turn_deg,
         knuckle=False,
         knuckle_seed=plain.knuckle_seed,
+        keeper=plain.keeper,
         show_forces=plain.show_forces,
         view=plain.view,
     )

@@ -10,6 +10,7 @@ settings to be still for a moment so dragging a slider redraws at full speed.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 
@@ -30,6 +31,8 @@ from scenes.freekick.model import (
     DEFENDER_WIDTH_M,
     DEFENDERS,
     JUMP_M,
+    LIMB_RADII_M,
+    LIMBS,
     MAP_CELL_PX,
     MAP_QUIET_S,
     MAP_SPEEDS_MS,
@@ -37,6 +40,7 @@ from scenes.freekick.model import (
     PATH_POINTS,
     PRESETS,
     RESULT_COLOURS,
+    WOBBLE_SCALE,
     FreeKickParams,
     after_contact,
     aim_at,
@@ -44,19 +48,31 @@ from scenes.freekick.model import (
     chances_words,
     compute_kick,
     deflection_m,
+    heat_cells,
+    heat_colours,
+    keeper_limbs,
+    keeper_pose,
+    keeper_show_time,
+    keeper_words,
     knuckle_ticked,
     knuckle_wobble_m,
+    odds_map_settings,
+    odds_map_words,
     outcome_map,
     outcome_map_image,
     play_words,
     position_at,
     resample,
     sample_rows,
+    save_margin_s,
     spin_axis,
     spin_vector,
     spin_words,
+    spot_odds_map,
     strike_chances,
     wall_axes,
+    wobble_path,
+    wobble_words,
 )
 from scenes.freekick.props import (
     AFTER_COLOUR,
@@ -84,6 +100,35 @@ CHART_COLOURS = {**FORCE_COLOURS, "knuckle": KNUCKLE_COLOUR}
 
 BALL_KERNELS = "kernels.ball"
 """The package whose compile the outcome map waits for on a first start (see :mod:`kernels.warming`)."""
+
+
+KEEPER_COLOURS = np.array(
+    [[25, 25, 25], [25, 25, 25], [250, 205, 0], [250, 205, 0], [250, 205, 0], [235, 190, 150]], np.uint8
+)
+"""The keeper's limbs (:data:`~scenes.freekick.model.LIMBS`): dark shorts and socks, a bright yellow shirt that
+stands out from both teams and the grass, and his head."""
+REPLAY_MAX_S = 4.0
+"""The Kick button's replay stops this long after the kick (s), even if the ball rolls on."""
+
+
+def _z_to(directions: NDArray[np.float64]) -> NDArray[np.float64]:
+    """(N, 4) wxyz quaternions turning +z onto each of (N, 3) unit ``directions`` (half-way vector; −z turns about x)."""
+    z = np.array([0.0, 0.0, 1.0])
+    w = 1.0 + directions @ z
+    xyz = np.cross(z, directions)
+    q = np.column_stack([w, xyz])
+    flipped = w < 1e-9
+    q[flipped] = [0.0, 1.0, 0.0, 0.0]
+    return q / np.linalg.norm(q, axis=1, keepdims=True)
+
+
+def heat_legend_image(width: int = 240, height: int = 18) -> NDArray[np.uint8]:
+    """The odds map's colour bar: no goals at the left to every strike a goal at the right, ticks every 25 %."""
+    bar = np.repeat(heat_colours(np.linspace(0.0, 1.0, width))[None], height, axis=0)
+    for share in (0.0, 0.25, 0.5, 0.75, 1.0):
+        x = min(round(share * (width - 1)), width - 1)
+        bar[height - 5 :, max(x - 1, 0) : x + 1] = 255
+    return bar
 
 
 def _css(rgb: tuple[int, int, int]) -> str:
@@ -140,10 +185,16 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
         """Says so when ticking Knuckleball has just set the spin near zero."""
         self.last_target: tuple[float, float] | None = None
         self.aim_message = ""
+        self._odds_version = 0
+        self.odds_map: NDArray[np.float64] | None = None
+        """The goal chance over the pitch's spots (:func:`~scenes.freekick.model.spot_odds_map`), once asked for."""
+        self.odds_map_params: FreeKickParams | None = None
+        """The strike (:func:`~scenes.freekick.model.odds_map_settings`) the shown odds map is for."""
         self._map_worker = LatestWorker("freekick-map")
         self._aim_worker = LatestWorker("freekick-aim")
+        self._odds_worker = LatestWorker("freekick-odds-map")
         # The scene's join() waits for a search in flight, as for its animation loop.
-        self._threads += [self._map_worker.thread, self._aim_worker.thread]
+        self._threads += [self._map_worker.thread, self._aim_worker.thread, self._odds_worker.thread]
         self._build_gui()
         self._build_world()
         self.redraw()
@@ -214,9 +265,19 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
                 self.map_status = gui.add_markdown("Computing…")
                 self.odds_status = gui.add_markdown("")
                 """The current kick's odds over many strikes, computed with the map."""
+            with gui.add_folder("Goal chance over the pitch"):
+                self.heat_button = gui.add_button("Map the goal chance from every spot")
+                self.heat_progress = gui.add_progress_bar(0.0, visible=False, animated=True)
+                self.heat_status = gui.add_markdown(
+                    "This strike from 357 spots, 16–36 m out and 40° either side, 32 strikes each with a player's "
+                    "scatter: the goal chance drawn on the grass."
+                )
+                self.heat_legend = gui.add_image(heat_legend_image(), label="Goal 0 → 100 %", format="png")
+                self.heat_legend.visible = False
 
         self.kick_controls.on_update(self.callback(self.apply_inputs))
         self.kick_button.on_click(self.callback(self._on_kick))
+        self.heat_button.on_click(self.callback(self.request_odds_map))
         self.view_controls.on_update(self.callback(self._on_view))
         for preset, button in zip(PRESETS, self.preset_buttons, strict=True):
             button.on_click(self.callback(lambda preset=preset: self.apply(preset.params.shown_as(self.params))))
@@ -252,6 +313,28 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
             visible=False,
         )
 
+        # The goal chance over the pitch: one flat tile per spot, coloured once a map is computed.
+        centres, headings, sizes = heat_cells()
+        tile = trimesh.creation.box(extents=(1.0, 1.0, 0.004))
+        self.heat_nodes = add_instances(
+            scene,
+            f"{root}/odds_map",
+            tile,
+            len(centres),
+            np.tile(heat_colours(np.zeros(1)), (len(centres), 1)),
+            scale=None,
+            cast_shadow=False,
+            visible=False,
+        )
+        half = 0.5 * np.hypot(sizes[:, 0], sizes[:, 1])[:, None]
+        self._heat_corners = np.vstack([centres + half * [1.0, 1.0, 0.0], centres - half * [1.0, 1.0, 0.0]])
+        """Points round every tile of the odds map: what the view from above keeps in frame while it shows."""
+        self.heat_nodes.batched_positions = centres.astype(np.float32)
+        self.heat_nodes.batched_wxyzs = np.column_stack(
+            [np.cos(headings / 2), np.zeros((len(headings), 2)), np.sin(headings / 2)]
+        ).astype(np.float32)
+        self.heat_nodes.batched_scales = np.column_stack([sizes, np.ones(len(sizes))]).astype(np.float32)
+
         defender = defender_mesh()
         self.wall_nodes = add_instances(
             scene,
@@ -260,6 +343,14 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
             DEFENDERS,
             np.tile(np.array([30, 60, 170], np.uint8), (DEFENDERS, 1)),
             scale=None,
+        )
+
+        # The keeper: one rod per limb (a unit cylinder stretched and turned), and a head.
+        rod = trimesh.creation.cylinder(radius=1.0, height=1.0, sections=10)
+        rod.apply_translation((0.0, 0.0, 0.5))
+        self.keeper_nodes = add_instances(scene, f"{root}/keeper", rod, len(LIMBS), KEEPER_COLOURS, scale=None)
+        self.keeper_head = scene.add_icosphere(
+            f"{root}/keeper_head", radius=LIMB_RADII_M[-1], color=(235, 190, 150), subdivisions=2
         )
 
         self.ball_frame = scene.add_frame(f"{root}/ball", show_axes=False, position=tuple(ball_spot(self.params)))
@@ -276,6 +367,10 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
         self.path = scene.add_line_segments(f"{root}/path", empty_path, colors=PATH_COLOUR, thickness=0.09)
         self.ghost = scene.add_line_segments(f"{root}/ghost", empty_path, colors=GHOST_COLOUR, thickness=0.04)
         self.after = scene.add_line_segments(f"{root}/after", empty_path, colors=AFTER_COLOUR, thickness=0.06)
+        self.wobble = scene.add_line_segments(
+            f"{root}/wobble", empty_path, colors=KNUCKLE_COLOUR, thickness=0.05, visible=False
+        )
+        """The knuckleball's difference from the spinless path, magnified (hidden without a knuckle force)."""
         """The kick played on after its first contact: bounces, rolls, rebounds off the frame or a defender."""
         self.band = scene.add_mesh_simple(
             f"{root}/band",
@@ -326,6 +421,7 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
         self.kick_time_s = None
         self.redraw()
         self.request_outcome_map()
+        self._show_odds_map()
         if moved:  # the ball is on another spot: every view moves with it
             self.framing.reframe()
 
@@ -335,7 +431,8 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
         self.framing.reframe()
 
     def _view_for(self, lens: Lens) -> View:
-        return frame_view(self.params, self.state, self.params.view, lens)
+        shown = self.heat_nodes.visible
+        return frame_view(self.params, self.state, self.params.view, lens, self._heat_corners if shown else None)
 
     def apply(self, params: FreeKickParams) -> None:
         """Show ``params``: write every GUI control (without re-running callbacks) and redraw once."""
@@ -448,12 +545,59 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
 
         self._map_worker.submit(job, delay_s=MAP_QUIET_S)
 
+    # ----------------------------------------------------------------------------------------- odds over the pitch
+    def request_odds_map(self) -> None:
+        """Queue the goal chance of the current strike from every spot of the map (the button); a progress bar
+        follows it, and a newer request drops this one's result."""
+        self._odds_version += 1
+        version, params = self._odds_version, self.params
+        with self.server.atomic():
+            self.heat_progress.value = 0.0
+            self.heat_progress.visible = True
+            self.heat_status.content = "Striking the kick from every spot…"
+
+        def progress(share: float) -> None:
+            with self._lock:
+                if not self.closed and version == self._odds_version:
+                    self.heat_progress.value = round(100.0 * share, 1)
+
+        def job() -> None:
+            chance = spot_odds_map(params, progress)
+            with self._lock:
+                if self.closed or version != self._odds_version:
+                    return
+                self.odds_map, self.odds_map_params = chance, odds_map_settings(params)
+                self.heat_nodes.batched_colors = heat_colours(chance.ravel())
+                self.heat_progress.visible = False
+                self._show_odds_map()
+                if self.params.view != "above":  # a map of the pitch reads best from above
+                    self.apply(dataclasses.replace(self.params, view="above"))
+                else:
+                    self.framing.reframe()
+
+        self._odds_worker.submit(job)
+
+    def _show_odds_map(self) -> None:
+        """Show the odds map if it is for the current strike (from any spot), else hide it and say why."""
+        current = self.odds_map is not None and self.odds_map_params == odds_map_settings(self.params)
+        with self.server.atomic():
+            set_if_changed(self.heat_nodes, "visible", current)
+            set_if_changed(self.heat_legend, "visible", current)
+            if current and self.odds_map is not None:
+                self.heat_status.content = (
+                    f"{odds_map_words(self.odds_map, self.params)}  \nEach tile: this strike from there, 32 times "
+                    "with a player's scatter, the wall square to the goal. Shown from above (pick another View to "
+                    "see the kick)."
+                )
+            elif self.odds_map is not None and self._odds_worker.idle():
+                self.heat_status.content = "The strike has changed: map it again to see its goal chance."
+
     def wait_idle(self, timeout_s: float = 30.0) -> bool:
         """Sleep until no search is queued or running (True), or ``timeout_s`` has passed (False); for tests and
         benchmarks. An aim's result queues a new outcome map, so the aim worker is waited for first, and both again
         should a search have been queued meanwhile."""
         deadline = time.monotonic() + timeout_s
-        workers = (self._aim_worker, self._map_worker)
+        workers = (self._aim_worker, self._map_worker, self._odds_worker)
         while True:
             for worker in workers:
                 if not worker.wait_idle(max(0.0, deadline - time.monotonic())):
@@ -465,7 +609,7 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
         """Drop any waiting search and stop the workers, then remove the scene (a search in flight finishes, and
         finds the scene closed)."""
         warming.remove_listener(self._on_kernels_compiled)
-        for worker in (self._aim_worker, self._map_worker):
+        for worker in (self._aim_worker, self._map_worker, self._odds_worker):
             worker.close(timeout_s=0.0)  # the base's close joins their threads
         super().close()
 
@@ -505,6 +649,10 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
             if after is not None:
                 self.after.points = polyline_segments(after).astype(np.float32)
             set_if_changed(self.after, "visible", after is not None)
+            wobble = wobble_path(state)
+            if wobble is not None:
+                self.wobble.points = polyline_segments(wobble)
+            set_if_changed(self.wobble, "visible", wobble is not None)
             self.band.vertices = strip.astype(np.float32)
             for k, name in enumerate(names):
                 self.arrows[name].points = arrows[:, k].reshape(-1, 2, 3).astype(np.float32)
@@ -520,6 +668,7 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
                 "batched_wxyzs",
                 np.tile([math.cos(heading / 2), 0.0, 0.0, math.sin(heading / 2)], (DEFENDERS, 1)).astype(np.float32),
             )
+            self._draw_keeper(keeper_show_time(state))
             set_if_changed(self.ball_frame, "position", tuple(ball_spot(p)))
             set_if_changed(self.ball_frame, "wxyz", (1.0, 0.0, 0.0, 0.0))
             for name, disabled in (
@@ -553,6 +702,9 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
         played = state.played
         result = played.result if played is not None and played.result in verdicts else o.result
         wall_height = "never reaches the wall" if o.wall_point is None else f"{o.wall_point[2]:.2f} m"
+        margin = save_margin_s(state)
+        if result == "saved" and margin is not None:
+            verdicts["saved"] = f"Saved: the keeper reached it {margin:.2f} s early"
         lines = [f"**{verdicts[result]}**"]
         if result != o.result:
             lines.append(f"In free flight through the goal plane: {verdicts[o.result]}")
@@ -575,9 +727,15 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
         words = play_words(state.played)
         if words:
             lines.append(f"Played on: **{words}** (pale line)")
+        keeper = keeper_words(state)
+        if keeper:
+            lines.append(f"Keeper (drawn as the ball arrives): **{keeper}**")
         wobble = knuckle_wobble_m(state)
         if wobble is not None:
-            lines.append(f"Knuckle wobble: up to **{wobble:.2f} m** off the spinless path (dashed)")
+            lines.append(
+                f"Knuckle wobble: up to **{wobble:.2f} m** off the spinless path (dashed): "
+                f"**{wobble_words(p, state)}**; the thin orange line draws it {WOBBLE_SCALE:g}× larger"
+            )
         elif p.knuckle:
             lines.append("Knuckleball: no wobble at this spin (any real spin steadies the wake)")
         if self.knuckle_note:
@@ -586,21 +744,50 @@ wall do not deflect it. A goal needs the whole ball inside the posts and under t
         lines.append(f"Spin parameter S = r·ω/v = {s_param:.3f}")
         return "  \n".join(lines)
 
+    def _draw_keeper(self, t: float) -> None:
+        """Put the keeper figure where the kernel's keeper is ``t`` s after the kick (hidden without one)."""
+        state = self.state
+        shown = state.keeper_xy is not None and state.played is not None
+        set_if_changed(self.keeper_nodes, "visible", shown)
+        set_if_changed(self.keeper_head, "visible", shown)
+        if state.keeper_xy is None or state.played is None:
+            return
+        pose = keeper_pose(state.keeper_xy, state.played.keeper_dive, np.array([t]))
+        facing = ball_spot(self.params)[:2] - np.array(state.keeper_xy)
+        limbs = keeper_limbs(pose, facing / max(float(np.linalg.norm(facing)), 1e-9))[0]
+        starts, ends = limbs[:, 0], limbs[:, 1]
+        lengths = np.linalg.norm(ends - starts, axis=1)
+        directions = (ends - starts) / np.maximum(lengths, 1e-9)[:, None]
+        self.keeper_nodes.batched_positions = starts.astype(np.float32)
+        self.keeper_nodes.batched_wxyzs = _z_to(directions).astype(np.float32)
+        scales = np.column_stack([LIMB_RADII_M, LIMB_RADII_M, lengths])
+        scales[-1] = 0.0  # the head is its own sphere
+        self.keeper_nodes.batched_scales = scales.astype(np.float32)
+        self.keeper_head.position = 0.5 * (starts[-1] + ends[-1])
+
+    def replay_flight(self) -> ball.Trajectory:
+        """What the Kick button flies: the kick played on (bounces, posts, the keeper), else its free flight."""
+        return self.state.played if self.state.played is not None else self.state.flight
+
     # ----------------------------------------------------------------------------------------- animation
     def _animate(self, dt: float) -> bool:
         """One frame of the kick's replay; False (the loop sleeps) when no kick is playing."""
         if self.kick_time_s is None:
             return False
-        flight = self.state.flight
+        flight = self.replay_flight()
+        end = min(float(flight.t[-1]), REPLAY_MAX_S)
         self.kick_time_s += min(dt, 0.1)
-        t = min(self.kick_time_s, float(flight.t[-1]))
+        t = min(self.kick_time_s, end)
         angle = float(np.linalg.norm(spin_vector(self.params))) * t
         with self.server.atomic():
             self.ball_frame.position = tuple(position_at(flight, t))
             self.ball_frame.wxyz = axis_angle_wxyz(spin_axis(self.params), angle)
+            self._draw_keeper(t)
         self.server.flush()
-        if self.kick_time_s >= float(flight.t[-1]) + 1.5:
+        if self.kick_time_s >= end + 1.5:
             self.kick_time_s = None  # rest a moment where it landed, then go back to the spot
-            self.ball_frame.position = tuple(ball_spot(self.params))
-            self.ball_frame.wxyz = (1.0, 0.0, 0.0, 0.0)
+            with self.server.atomic():
+                self.ball_frame.position = tuple(ball_spot(self.params))
+                self.ball_frame.wxyz = (1.0, 0.0, 0.0, 0.0)
+                self._draw_keeper(keeper_show_time(self.state))
         return True

@@ -72,10 +72,13 @@ def view_direction(
             return 0.35 * forward + down
 
 
-def view_points(p: FreeKickParams, state: KickState, view: ViewName) -> NDArray[np.float64]:
+def view_points(
+    p: FreeKickParams, state: KickState, view: ViewName, also: NDArray[np.float64] | None = None
+) -> NDArray[np.float64]:
     """(N, 3) what ``view`` keeps in frame (m): the ball on its spot (its whole sphere), the path and the no-spin
     ghost, the wall and the goal with its net; the goalkeeper's view (``"goal"``) stands in front of the goal, so it
-    keeps neither the goal nor the last :data:`KEEPER_SEES_FROM_M` of the flights.
+    keeps neither the goal nor the last :data:`KEEPER_SEES_FROM_M` of the flights. ``also``: (M, 3) more points the
+    view from above keeps in frame (the odds map's tiles, when it is shown).
     """
     half, h = 0.5 * ball.GOAL_WIDTH_M, ball.GOAL_HEIGHT_M
     goal = np.array([[x, y, z] for x in (0.0, 2.0) for y in (-half, half) for z in (0.0, h)])
@@ -90,6 +93,8 @@ def view_points(p: FreeKickParams, state: KickState, view: ViewName) -> NDArray[
         flights = np.vstack([path, ghost])
         far_out = flights[flights[:, 0] <= -KEEPER_SEES_FROM_M]
         return np.vstack([wall_pts, far_out, sphere])
+    if view == "above" and also is not None:
+        return np.vstack([goal, wall_pts, path, ghost, sphere, also])
     return np.vstack([goal, wall_pts, path, ghost, sphere])
 
 
@@ -107,14 +112,17 @@ def wall_hides(state: KickState, eye: NDArray[np.float64], target: NDArray[np.fl
     return abs(float((hit - centre) @ along)) <= half and hit[2] <= wall.height_m + ball.BALL_RADIUS_M
 
 
-def frame_view(p: FreeKickParams, state: KickState, view: ViewName, lens: Lens) -> View:
-    """The camera pose of ``view`` for one browser's ``lens``: :func:`view_points` in frame, left of the panel.
+def frame_view(
+    p: FreeKickParams, state: KickState, view: ViewName, lens: Lens, also: NDArray[np.float64] | None = None
+) -> View:
+    """The camera pose of ``view`` for one browser's ``lens``: :func:`view_points` (with ``also``) in frame, left of
+    the panel.
 
     The goalkeeper's view tries tilts (:data:`KEEPER_LOOK_DOWN`, flattest first) and turns
     (:data:`KEEPER_LOOK_ASIDE`) until its camera stands at least :data:`KEEPER_FRONT_M` in front of the goal line
     and sees the ball past or over the wall; failing that, the last pose in front of the line, else the last tried.
     """
-    points = view_points(p, state, view)
+    points = view_points(p, state, view, also)
     if view == "goal":
         tries = [(down, aside) for down in KEEPER_LOOK_DOWN for aside in KEEPER_LOOK_ASIDE]
     else:
