@@ -66,6 +66,7 @@ class GuiFacade:
         self.add_upload_button = _recording(api.add_upload_button)
         self.add_folder = api.add_folder
         self.add_markdown = api.add_markdown
+        self.add_html = api.add_html
         self.add_image = api.add_image
         self.add_progress_bar = api.add_progress_bar
         self.add_uplot = api.add_uplot

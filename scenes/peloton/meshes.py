@@ -7,6 +7,7 @@ riders the same way, and :func:`show_position` re-meshes them when the riding po
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -115,6 +116,14 @@ def rider_meshes(position: Position) -> dict[str, trimesh.Trimesh]:
     bike, body = trimesh.util.concatenate(bike_parts), trimesh.util.concatenate(body_parts)
     assert isinstance(bike, trimesh.Trimesh) and isinstance(body, trimesh.Trimesh)
     return {"bike": bike, "body": body, "head": head}
+
+
+@functools.cache
+def rider_head_m(position: Position) -> tuple[float, float]:
+    """(ahead, up): where the top of a rider's head is in ``position``, ahead of the bike's middle and above the
+    road (m)."""
+    head = rider_meshes(position)["head"].vertices
+    return float(0.5 * (head[:, 0].min() + head[:, 0].max())), float(head[:, 2].max())
 
 
 def rider_colours(part: str, count: int) -> np.ndarray:

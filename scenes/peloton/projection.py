@@ -34,27 +34,52 @@ def course_to_world(points: np.ndarray, grade_pct: float) -> np.ndarray:
     return np.stack([c * pts[:, 0] - s * pts[:, 2], pts[:, 1], s * pts[:, 0] + c * pts[:, 2]], axis=1)
 
 
-def label_lifts_px(anchors_px: np.ndarray, label_px: tuple[float, float] = LABEL_PX) -> np.ndarray:
+def label_lifts_px(
+    anchors_px: np.ndarray,
+    label_px: tuple[float, float] = LABEL_PX,
+    *,
+    text_px: float | None = None,
+    stem_px: float = 0.0,
+) -> np.ndarray:
     """(N,) how far (px, upward) to lift each label so no two overlap, leader first: each takes the lowest free place.
+
+    Each label hangs on a leader line, straight down from its anchor to its rider ``stem_px`` below the unlifted
+    anchor; with ``text_px`` no label's text (that wide, right of its anchor) crosses another label's line either.
 
     Args:
         anchors_px: (N, 2) screen x, y (px, y down) of each label's anchor; its box spans ``label_px`` right of and
             above it.
         label_px: (width, height) of a label's box (px).
+        text_px: width of a label's text (px), at most ``label_px[0]``; None: lines are not looked at.
+        stem_px: length (px) of a leader line below its unlifted anchor.
     """
     width, height = label_px[0] + LABEL_PAD_PX, label_px[1] + LABEL_PAD_PX
-    lifts = np.zeros(len(anchors_px))
-    for i, (x, y) in enumerate(np.asarray(anchors_px, dtype=np.float64)):
+    text = None if text_px is None else min(text_px, label_px[0]) + LABEL_PAD_PX
+    anchors = np.asarray(anchors_px, dtype=np.float64)
+    lifts = np.zeros(len(anchors))
+    for i, (x, y) in enumerate(anchors):
         # Label j, placed, forbids lifts in (low, high): where the two boxes would share rows.
         blocked = [
             (y - yj + lifts[j] - height, y - yj + lifts[j] + height)
-            for j, (xj, yj) in enumerate(anchors_px[:i])
+            for j, (xj, yj) in enumerate(anchors[:i])
             if abs(x - xj) < width
         ]
-        for lift in sorted({0.0, *(high for _, high in blocked)}):
+        if text is not None:
+            for j, (xj, yj) in enumerate(anchors[:i]):
+                if (
+                    x - LABEL_PAD_PX < xj < x + text
+                ):  # this label's text would cross j's line (yj - lift_j to yj + stem)
+                    blocked.append((y - yj - stem_px - height, y - yj + lifts[j] + LABEL_PAD_PX))
+                if xj - LABEL_PAD_PX < x < xj + text:  # this label's line would rise through j's text
+                    top = y - yj + lifts[j]  # this lift puts the label level with j's
+                    if y + stem_px > yj - lifts[j] - height:
+                        blocked.append((top - LABEL_PAD_PX, np.inf))
+        for lift in sorted({0.0, *(high for _, high in blocked if np.isfinite(high))}):
             if lift >= 0.0 and not any(low < lift < high for low, high in blocked):
                 lifts[i] = lift
                 break
+        else:  # no free place: above every other label
+            lifts[i] = max((high for _, high in blocked if np.isfinite(high)), default=0.0)
     return lifts
 
 

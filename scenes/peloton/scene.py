@@ -25,7 +25,7 @@ from scenes._controls import Controls, build_controls, declared
 from scenes._framing import ClientFraming, Lens, View, frame_points
 from scenes._instances import add_instances
 from scenes.peloton.course import CourseMode
-from scenes.peloton.meshes import add_riders, rider_colours, show_position
+from scenes.peloton.meshes import add_riders, rider_colours, rider_head_m, show_position
 from scenes.peloton.model import (
     BIKE_LENGTH_M,
     CRR_PRESETS,
@@ -62,8 +62,33 @@ VIEW_DIRECTION = (-1.2, 7.5, -0.6)
 """The camera looks at the line from its left side, a little ahead of it and a little above: looking down steeply,
 a wide-angle view leaned the bars at the window's edge by 15° (vertical lines converge); at 4.5° down they stand
 within 6° of upright."""
-GROUP_VIEW_DIRECTION = (-2.0, 4.0, -3.2)
-"""A group (a bunch, two abreast, an echelon, a long line) is seen from higher up, so the rows behind show."""
+
+
+def _looking(azimuth_deg: float, down_deg: float) -> tuple[float, float, float]:
+    """A unit view direction ``azimuth_deg`` round from the road's forward axis (x) towards its left (y), looking
+    ``down_deg`` below the horizon."""
+    a, e = math.radians(azimuth_deg), math.radians(down_deg)
+    return (math.cos(e) * math.cos(a), math.cos(e) * math.sin(a), -math.sin(e))
+
+
+GROUP_VIEW_DIRECTIONS: dict[str, tuple[float, float, float]] = {
+    "single": _looking(140.0, 40.0),
+    "double": _looking(140.0, 40.0),
+    "bunch": _looking(140.0, 40.0),
+    "echelon": _looking(160.0, 40.0),
+}
+"""A group (a long line, two abreast, a bunch, an echelon) is seen from ahead, on its right, 40° down, so the rows
+behind show: of the directions tried round the group (every 20°, 20–55° down, the browser's 75° field of view),
+these draw its smallest riders (the tenth percentile) largest once framed: a 20-rider echelon at 1280×720 about
+47 px instead of 27 from the side, a bunch of 121 30 px instead of 23."""
+GROUP_LABELS = 4
+"""Riders of a group labelled in the picture with their power and drag: the leader, the hardest-working rider
+behind it, the one who works least and the last."""
+GROUP_STEM_M = 0.35
+"""A group label's anchor sits this far above the top of its rider's head (m), on a line down to the head."""
+TEXT_PX_PER_CHAR = 6.4
+"""Width (px) a label's text takes per character (DejaVu Sans at the labels' size: 20 characters measured 115 px),
+with room to spare: a label's text must not cross another label's line."""
 POWER_COLOURS = np.array([(40, 90, 220), (40, 180, 200), (90, 190, 80), (245, 200, 40), (225, 50, 40)], np.float64)
 """Rider colours by power, low to high: blue, teal, green, yellow, red."""
 LABEL_STAGGER_M = 0.4
@@ -100,10 +125,18 @@ def power_colours(watts: np.ndarray, low: float, high: float) -> np.ndarray:
 LEGEND_NAMES = ("blue", "teal", "green", "yellow", "red")
 
 
-def legend_markdown(low: float, high: float) -> str:
-    """The watts at the colour scale's five stops, under its bar."""
-    stops = " · ".join(f"{name} {_watts(t)}" for name, t in zip(LEGEND_NAMES, np.linspace(low, high, 5), strict=True))
-    return f"**Rider colour = power (W):** {stops}"
+def legend_html(low: float, high: float, summary: str) -> str:
+    """The colour scale as five swatches, each over its name and watts, then ``summary`` (plain text)."""
+    stops = "".join(
+        f'<div style="flex:1;text-align:center"><div style="height:14px;border-radius:2px;'
+        f'background:rgb({r:.0f},{g:.0f},{b:.0f})"></div>{name} {_watts(t)}</div>'
+        for name, t, (r, g, b) in zip(LEGEND_NAMES, np.linspace(low, high, 5), POWER_COLOURS, strict=True)
+    )
+    return (
+        '<div style="font-size:13px;line-height:1.35;padding:2px 0 6px">'
+        "<b>Rider colour = power (W)</b>"
+        f'<div style="display:flex;gap:3px;margin:3px 0">{stops}</div>{summary}</div>'
+    )
 
 
 # --------------------------------------------------------------------------------------------- scene
@@ -168,6 +201,8 @@ time-averaged power is the mean over positions, far below the leader's.
     def _build_gui(self) -> None:
         gui, p = self.server.gui, self.params
         with self.gui_root:
+            # A group's colour key, at the top of the panel: seen at once, without scrolling, in a small window.
+            self.legend = gui.add_html("", visible=False)
             rider = build_controls(gui, p, ("speed_kmh", "position", "cda_m2", "mass_kg"))
             with rider.folders["Rider"]:
                 # Hand-built, not a parameter: a preset that sets the Crr slider, which holds the value used.
@@ -184,7 +219,6 @@ time-averaged power is the mean over positions, far below the leader's.
             )
             with gui.add_folder("Results"):
                 self.density = gui.add_markdown("")
-                self.legend = gui.add_markdown("", visible=False)
                 self.table = gui.add_markdown("")
                 self.rotation = gui.add_markdown("")
                 self.chart = FittedChart(
@@ -337,14 +371,14 @@ time-averaged power is the mean over positions, far below the leader's.
         p = self.params
         n = p.n_riders
         if not is_line_view(p):
-            xy = self.state.positions
-            x_hi = 0.5 * BIKE_LENGTH_M + (3.0 + min(abs(p.headwind_ms), 15.0) * 0.25 if p.headwind_ms != 0 else 0.0)
-            lo = np.array([xy[:, 0].min() - 0.5 * BIKE_LENGTH_M, xy[:, 1].min() - 0.5, 0.0])
-            hi = np.array([x_hi, xy[:, 1].max() + 0.5, 2.0])
-            corners = np.array(
-                [[(lo, hi)[i][0], (lo, hi)[j][1], (lo, hi)[k][2]] for i in (0, 1) for j in (0, 1) for k in (0, 1)]
-            )
-            return course_to_world(corners, p.grade_pct)
+            x, y = self.state.positions.T
+            top = np.full(n, rider_head_m(p.position)[1])
+            half, zero = 0.5 * BIKE_LENGTH_M, np.zeros(n)
+            ends = [(x + half, y, zero), (x - half, y, zero), (x, y + 0.3, zero), (x, y - 0.3, zero), (x, y, top)]
+            local = np.vstack([np.stack(end, axis=1) for end in ends])
+            if p.headwind_ms != 0:  # the wind arrow, ahead of the leader
+                local = np.vstack([local, [[x.max() + half + 3.0 + min(abs(p.headwind_ms), 15.0) * 0.25, 0.0, 1.2]]])
+            return course_to_world(local, p.grade_pct)
         front, back = (
             0.5 * BIKE_LENGTH_M,
             float(slot_offsets(n, p.gap_m)[n - 1]) - 0.5 * BIKE_LENGTH_M,
@@ -365,14 +399,42 @@ time-averaged power is the mean over positions, far below the leader's.
         return np.sum(parts, axis=0)[: self.params.n_riders] * BAR_METRES_PER_WATT
 
     def label_anchors(self) -> np.ndarray:
-        """(n_riders, 3) world points where each slot's label sits before it is lifted: just above its bar (none for
-        a group, which has no labels)."""
+        """(labels, 3) world points where each label sits before it is lifted: just above its bar in a line, above
+        its rider's head (:data:`GROUP_STEM_M`) for the riders of a group that are labelled
+        (:meth:`marked_slots`)."""
         p, n = self.params, self.params.n_riders
         if not is_line_view(p):
-            return np.zeros((0, 3))
+            ahead, top = rider_head_m(p.position)
+            xy = self.state.positions[self.marked_slots()] + [ahead, 0.0]
+            return course_to_world(np.column_stack([xy, np.full(len(xy), top + GROUP_STEM_M)]), p.grade_pct)
         x = slot_offsets(n, p.gap_m)[:n]
         local = np.stack([x, np.zeros(n), 1.95 + self._bar_heights_m()], 1)
         return course_to_world(local, p.grade_pct)
+
+    def marked_slots(self) -> np.ndarray:
+        """Slots of a group labelled in the picture, front first, none twice: the leader, the hardest-working rider
+        behind it, the one who works least and the last (:data:`GROUP_LABELS`)."""
+        n, total = self.params.n_riders, np.asarray(self.state.power.total)
+        if n == 1:
+            return np.zeros(1, np.int64)
+        picks = [0, 1 + int(np.argmax(total[1:])), int(np.argmin(total)), n - 1]
+        # One label per reading: riders that would say the same (a pair at the front, the last rider when it is
+        # the one who works least) are labelled once.
+        said = {self.label_text(slot): slot for slot in reversed(picks)}
+        unique = list(dict.fromkeys(slot for slot in picks if said[self.label_text(slot)] == slot))[:GROUP_LABELS]
+        x = self.state.positions[unique, 0]
+        return np.asarray(unique, np.int64)[np.argsort(-x, kind="stable")]
+
+    def label_text(self, slot: int) -> str:
+        """What the label of the rider in ``slot`` says: its watts and its share of the solo rider's power in a
+        line; its watts and its drag (% of the same rider alone) in a group."""
+        state = self.state
+        watts = float(state.power.total[slot])
+        if not is_line_view(self.params):
+            return f"{_watts(watts)} W · drag {100.0 * (1.0 - float(state.reduction[slot])):.0f} %"
+        solo = float(state.solo.total)
+        share = f"{100.0 * watts / solo:.0f} % of solo" if solo > 0 else "solo needs 0 W"
+        return f"{watts:.0f} W · {share}"
 
     def _view_for(self, lens: Lens) -> View:
         """The view of the line for ``lens``, with room above it for the labels, which it lays out for that lens."""
@@ -390,13 +452,21 @@ time-averaged power is the mean over positions, far below the leader's.
             # 20 % grade the last label started left of the window); the box of each label lies right of and
             # above its anchor, in the room the rectangle leaves. Framing the anchors shrinks the line, which may
             # stack the labels differently: repeat until the lifted anchors fit.
+            line_view = is_line_view(self.params)
+            slots = range(self.params.n_riders) if line_view else self.marked_slots()
+            text_px = TEXT_PX_PER_CHAR * max(len(self.label_text(int(slot))) for slot in slots)
+            stem_m = 0.2 if line_view else GROUP_STEM_M  # from the bar's top or the head up to the anchor
             for _ in range(MAX_RIDERS + 2):
-                direction = VIEW_DIRECTION if is_line_view(self.params) else GROUP_VIEW_DIRECTION
+                direction = VIEW_DIRECTION if line_view else GROUP_VIEW_DIRECTIONS[self.params.formation]
                 view = frame_points(framed, direction, fov_rad=lens.fov_rad, aspect=lens.aspect, ndc=ndc)
-                lifts_px = label_lifts_px(project_px(anchors, view, lens))
+                anchors_px = project_px(anchors, view, lens)
+                stem_px = float(np.max(project_px(anchors - stem_m * up_world, view, lens)[:, 1] - anchors_px[:, 1]))
+                lifts_px = label_lifts_px(anchors_px, text_px=text_px, stem_px=stem_px)
                 lifts_m = lift_to_metres(anchors, lifts_px, up_world, view, lens)
                 lifted = anchors + lifts_m[:, None] * up_world
-                lane_px = np.full(len(anchors), lifts_px.max(initial=0.0) + LABEL_PX[1] + LABEL_PAD_PX)
+                # The lane: a label lifted to it sits, wherever along the line, above the top of every label.
+                lane_y = np.min(anchors_px[:, 1] - lifts_px, initial=np.inf) - LABEL_PX[1] - LABEL_PAD_PX
+                lane_px = np.maximum(anchors_px[:, 1] - lane_y, 0.0)
                 lane_m = lift_to_metres(anchors, lane_px, up_world, view, lens)
                 if self._rotating():  # the lane a dropping leader's label rides in must be in view too
                     lifted = np.vstack([lifted, anchors + lane_m[:, None] * up_world])
@@ -509,7 +579,6 @@ time-averaged power is the mean over positions, far below the leader's.
             return
         n = p.n_riders
         slots = self.current_slots()
-        total = np.asarray(state.power.total)
         x, y = self._slot_of_rider()
         positions = np.stack([x, y, np.zeros(MAX_RIDERS)], axis=1)
         visible = (np.arange(MAX_RIDERS) < n).astype(np.float64)
@@ -545,10 +614,7 @@ time-averaged power is the mean over positions, far below the leader's.
                 if label.visible != (i < n):
                     label.visible = i < n
                 if i < n:
-                    watts = float(total[slots[i]])
-                    solo = float(state.solo.total)
-                    share = f"{100.0 * watts / solo:.0f} % of solo" if solo > 0 else "solo needs 0 W"
-                    text = f"{watts:.0f} W · {share}"
+                    text = self.label_text(int(slots[i]))
                     if label.text != text:
                         label.text = text
                     # Neighbours' labels alternate in height so close riders' labels never overlap.
@@ -626,16 +692,41 @@ time-averaged power is the mean over positions, far below the leader's.
             self._show_riders(positions, scales, bodies)
             for bar in self.bars.values():
                 set_if_changed(bar, "batched_scales", np.zeros((MAX_RIDERS, 3), np.float32))
-            for label in self.labels:
-                if label.visible:
-                    label.visible = False
-            set_if_changed(self.label_leaders, "visible", False)
-            legend = legend_markdown(low, high)
+            self._label_group(positions)
+            drag = 1.0 - state.reduction
+            summary = (
+                f"{n} riders: mean drag {100 * float(np.mean(drag)):.0f} % of a lone rider's, mean power "
+                f"{_watts(float(np.mean(total)))} W (alone {_watts(float(state.solo.total))} W)"
+            )
+            legend = legend_html(low, high, summary)
             if self.legend.content != legend:
                 self.legend.content = legend
             set_if_changed(self.legend, "visible", True)
             self._show_panel(self._group_table_markdown, readouts=readouts)
         self.server.flush()
+
+    def _label_group(self, positions: np.ndarray) -> None:
+        """Label the marked riders of a group (:meth:`marked_slots`) where they ride now (``positions``: (MAX_GROUP,
+        3) of every rider, m), each on a line down to its head; hide the other labels."""
+        marked = self.marked_slots()
+        rider_in = np.argsort(self.current_slots())  # which rider rides in each slot
+        ahead, head = rider_head_m(self.params.position)
+        leaders = np.zeros((MAX_RIDERS, 2, 3))
+        for i, label in enumerate(self.labels):
+            shown = i < len(marked)
+            if label.visible != shown:
+                label.visible = shown
+            if not shown:
+                continue
+            x, y = float(positions[rider_in[marked[i]], 0]) + ahead, float(positions[rider_in[marked[i]], 1])
+            top = head + GROUP_STEM_M + float(self._label_lift_m[i])
+            leaders[i] = [(x, y, head + 0.05), (x, y, top)]
+            text = self.label_text(int(marked[i]))
+            if label.text != text:
+                label.text = text
+            set_if_changed(label, "position", (x, y, top))
+        set_if_changed(self.label_leaders, "points", leaders.astype(np.float32))
+        set_if_changed(self.label_leaders, "visible", True)
 
     def _group_table_markdown(self) -> str:
         """Drag and power by row of the formation (riders level with each other share a row), front to back; long
