@@ -149,6 +149,13 @@ in real time. Click a point in the goal mouth to have the scene find a kick that
 outcome map colours each launch speed × spin rate by result: goal (green), wall (red), over (orange), wide (yellow),
 short (grey); the white cross is the current kick.
 
+**On the pitch.** The same kick played on (pale line): it bounces, rolls, strikes the posts, bar and the wall's
+players, and the goalkeeper (yellow shirt) stands on the bisector of the posts' angle, reads the ball 0.25 s after
+it passes the wall and dives at 3.9 m/s (Ibrahim et al. 2019) to where he reads it will cross; a touch is a save.
+He is drawn as the ball arrives; **Kick** plays his dive. **Goal chance over the pitch** strikes this kick 32 times
+from each of 357 spots and colours each spot by its goal chance. *Knuckleball*: the thin orange line draws the
+kick's difference from the spinless path ten times larger.
+
 **Equations** (A = πr², ω̂ = ω/|ω|): F_drag = −½ρA·C_D·|v|·v, F_Magnus = ½ρA·C_L·|v|·(ω̂ × v), F_g = −m·g·ẑ;
 m = 0.43 kg, r = 0.11 m, ρ = 1.225 kg/m³. The original brief's Magnus formula (C_L·ρπr²·|v×ω|/|ω|) is not a force; this form
 keeps its direction and gives its 3–5 m of curl over 25 m.
@@ -162,8 +169,10 @@ diameter per ~15 m (Cohen, Texier, Quéré & Clanet 2012; Texier et al. 2016), d
 **Integrators.** RK4 at 10 ms is within a micrometre of a DOP853 reference over 30 m; the original brief's Euler at 1 ms is
 off by about 1.4 cm, not "within a centimetre".
 
-**Assumptions.** Constant spin, still air, no bounce: the flight ends when the ball touches the turf; posts, bar and
-wall do not deflect it. A goal needs the whole ball inside the posts and under the bar.
+**Assumptions.** Constant spin between contacts, still air. The orange flight ends at the turf or two metres past
+the goal line; the played-on flight and its verdict are the pitch's. A goal needs the whole ball over the line
+between the posts and under the bar. The keeper reads the ball once and never again, so a ball that bounces in front
+of him beats him more often than it would a real keeper.
 """
 
     def __init__(self, server: viser.ViserServer) -> None:

@@ -15,9 +15,8 @@ from helpers.screen_geometry import GOAL_CORNERS, polyline_gap
 from helpers.wsclient import BrowserClient, shows_number
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from numpy.typing import NDArray
-
 from kernels import ball
+from numpy.typing import NDArray
 from scenes._framing import MARGIN_PX, PANEL_PX, Lens, View, frame_points, project_points
 from scenes.freekick import (
     AIM_TOLERANCE_M,
@@ -47,7 +46,7 @@ from scenes.freekick import (
     view_points,
     wall_hides,
 )
-from scenes.freekick.model import knuckle_wobble_m, strike_chances
+from scenes.freekick.model import keeper_pose, knuckle_wobble_m, spot_odds_map, strike_chances
 
 
 @pytest.fixture
@@ -103,7 +102,10 @@ def test_opening_state_is_the_kernels_curler(scene: FreeKickScene) -> None:
     heading = math.atan2(expected.ghost.velocity[0, 1], expected.ghost.velocity[0, 0])
     across = np.array([-math.sin(heading), math.cos(heading), 0.0])
     np.testing.assert_allclose((ghost[:, 0] - expected.ghost.position[0]) @ across, 0.0, atol=1e-4)
-    assert "**GOAL**" in scene.result.content
+    # Played on the pitch, the keeper gets to it: the headline is his save, the free flight's goal said beside it.
+    assert expected.played is not None and expected.played.result == scene.state.played.result == "saved"  # type: ignore[union-attr]
+    assert scene.result.content.startswith("**Saved: the keeper reached it ")
+    assert "In free flight through the goal plane: GOAL" in scene.result.content
     assert f"{expected.outcome.wall_point[2]:.2f} m" in scene.result.content  # type: ignore[index]
     assert "+3.09 m" in scene.result.content  # sideways against the no-spin kick, curled left
     # Force chart: |drag|, |Magnus|, |gravity| against time, straight from the kernel.
@@ -183,20 +185,6 @@ def test_drawn_path_ghost_and_band_are_the_kernels_flights(
             np.testing.assert_array_equal(edge, resample(expected).astype(np.float32))
 
 
-def test_presets_score_and_set_every_control(scene: FreeKickScene) -> None:
-    for preset, button in zip(PRESETS, scene.preset_buttons, strict=True):
-        button.value = True  # what a click does, server side
-        scene.wait_idle()
-        assert scene.params == preset.params, preset.label
-        assert scene.state.outcome.result == "goal", preset.label
-        assert scene.controls["spin_rev_s"].value == preset.params.spin_rev_s
-        if preset.params.knuckle:  # the knuckle force acts, not just the label
-            assert preset.params.spin_rev_s == 0.0
-            assert np.abs(scene.state.flight.knuckle).max() > 0.1
-            assert np.all(scene.state.ghost.knuckle == 0.0)
-    assert any(preset.params.knuckle for preset in PRESETS)
-
-
 def test_a_jumping_wall_blocks_the_curler(scene: FreeKickScene) -> None:
     scene.controls["wall_jumps"].value = True
     assert scene.state.wall.height_m == pytest.approx(1.8 + JUMP_M)
@@ -221,7 +209,8 @@ def test_a_blocked_kick_is_played_on_off_the_defender_and_the_scene_says_so(scen
     np.testing.assert_allclose(drawn[0], hit.position, atol=1e-5)  # the pale line starts at the contact
     assert f"Hits a defender at {hit.position[2]:.1f} m" in scene.result.content
     assert "bounces" in scene.result.content
-    # The opening curler goes straight into the net: nothing to play on, no pale line.
+    # Without the keeper the opening curler goes straight into the net: nothing to play on, no pale line.
+    scene.controls["keeper"].value = False
     scene.controls["elevation_deg"].value = 17.0
     assert scene.state.played is not None and [e.kind for e in scene.state.played.events] == ["net"]
     assert not scene.after.visible
@@ -238,7 +227,8 @@ def test_kick_flies_the_ball_spinning_along_its_path(scene: FreeKickScene) -> No
             scene._animate(0.1)
         mid = np.array(scene.ball_frame.position)
         wxyz = np.array(scene.ball_frame.wxyz)
-        flight = scene.state.flight
+        flight = scene.state.played  # the kick played on: it bounces, hits the frame, is saved
+        assert flight is not None and flight.events[0].t > 0.5
         expected = [np.interp(0.5, flight.t, flight.position[:, k]) for k in range(3)]
         np.testing.assert_allclose(mid, expected, atol=1e-9)
         assert np.linalg.norm(mid - spot) > 10.0
@@ -279,15 +269,21 @@ def test_a_click_ray_through_the_goal_mouth_aims_there(scene: FreeKickScene) -> 
 
 def test_the_current_strikes_odds_are_shown_with_the_map(scene: FreeKickScene) -> None:
     # The opening curler struck 200 times with a player's scatter: the shares shown are the kernel's for the
-    # same strikes, and most of them go in (it is a goal struck as set).
+    # same strikes. The keeper saves it as struck, and most of its scatter too; without him most go in.
     assert scene.wait_idle(120.0)
     chances = scene.chances
     assert chances is not None and chances.n == 200
     expected = strike_chances(scene.params)
     assert chances.counts == expected.counts
-    assert chances.probability("goal") > 0.4
-    goal_share = f"goal {100 * chances.probability('goal'):.0f} %"
-    assert goal_share in scene.odds_status.content and "Struck 200 times" in scene.odds_status.content
+    assert chances.probability("saved") > 0.4 and chances.probability("goal") > 0.2
+    for name in ("saved", "goal"):
+        assert f"{name} {100 * chances.probability(name):.0f} %" in scene.odds_status.content
+    assert "Struck 200 times" in scene.odds_status.content
+    scene.controls["keeper"].value = False
+    assert scene.wait_idle(120.0)
+    chances = scene.chances
+    assert chances is not None and chances.counts["saved"] == 0 and chances.probability("goal") > 0.4
+    assert f"goal {100 * chances.probability('goal'):.0f} %" in scene.odds_status.content
 
 
 def test_outcome_map_matches_single_runs(scene: FreeKickScene) -> None:
@@ -372,10 +368,11 @@ def test_spin_slider_from_a_browser_changes_the_path_and_the_outcome(
 ) -> None:
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("Spin rate (rev/s)")
+        client.set_value("Goalkeeper", False)  # the free kick against the wall and the frame alone
         client.set_value("Model", "Measured C_D(Re, S), C_L(S)")
         client.set_value("Azimuth (°, + = left)", -12.0)
         client.wait_for(
-            lambda: scene.params.azimuth_deg == -12.0 and scene.params.model == "measured",
+            lambda: scene.params.azimuth_deg == -12.0 and scene.params.model == "measured" and not scene.params.keeper,
             what="setup",
         )
         client.wait_for(lambda: _markdown_shown(client, "**GOAL**"), what="a goal shown")
@@ -646,6 +643,7 @@ def test_the_verdict_is_what_the_pitch_makes_of_the_kick_and_never_contradicts_p
     # Reported: Knuckleball on the default kick read "Wide of the post" over "Played on: Hits the right post":
     # the free flight crossed the goal plane 0.11 m outside the post's inside edge, where the ball (0.11 m) still
     # strikes the post (0.06 m). The headline is the pitch's result; the free flight's is said beside it.
+    scene.controls["keeper"].value = False  # the frame's verdicts alone
     scene.controls["knuckle"].value = True
     played = scene.state.played
     assert played is not None and played.result == "post"
@@ -663,3 +661,191 @@ def test_the_verdict_is_what_the_pitch_makes_of_the_kick_and_never_contradicts_p
         words = {"goal": "GOAL", "wide": "Wide of the post", "post": "Hits the post", "bar": "Hits the bar"}
         assert headline == f"**{words.get(result, headline.strip('*'))}**", (azimuth, result, headline)
     assert {"goal", "wide"} <= seen
+
+
+# ------------------------------------------------------------------------------------------------ the keeper
+PRESET_OUTCOMES = {
+    # label: (the pitch's verdict, the contacts in order, words the readout says)
+    "Curler round the wall, saved": ("saved", ["keeper"], "**Saved: the keeper reached it 0.26 s early**"),
+    "Top corner past the keeper": ("goal", ["net"], "the ball beats him by 0.96 m"),
+    "Low curler: bounces, saved": ("saved", ["ground", "keeper"], "Played on: **Bounces, into the keeper's hands**"),
+    "Driven, off the post": ("post", ["post"], "Played on: **Hits the right post at 1.2 m, goes out of play**"),
+    "Dipping topspin": ("saved", ["keeper"], "**Saved: the keeper reached it"),
+    "Knuckleball": ("saved", ["keeper"], "swerves 0.34 m right at 29 m"),
+    "Long-range swerve": ("goal", ["net"], "the ball beats him by 0.52 m"),
+}
+"""What each preset shows, as the kernel plays it on the scene's pitch (wall, posts, net and the keeper)."""
+
+
+def test_each_preset_shows_what_its_label_says(scene: FreeKickScene) -> None:
+    assert [preset.label for preset in PRESETS] == list(PRESET_OUTCOMES)
+    for preset, button in zip(PRESETS, scene.preset_buttons, strict=True):
+        button.value = True  # what a click does, server side
+        assert scene.wait_idle()
+        verdict, contacts, words = PRESET_OUTCOMES[preset.label]
+        played = scene.state.played
+        assert scene.params == preset.params, preset.label
+        assert played is not None and played.result == verdict, (preset.label, played and played.result)
+        assert [event.kind for event in played.events] == contacts, preset.label
+        assert words in scene.result.content, (preset.label, scene.result.content)
+        assert scene.keeper_nodes.visible and scene.keeper_head.visible
+        if preset.params.knuckle:  # the knuckle force acts, not just the label
+            assert preset.params.spin_rev_s == 0.0
+            assert np.abs(scene.state.flight.knuckle).max() > 0.1
+            assert np.all(scene.state.ghost.knuckle == 0.0)
+    assert any(preset.params.knuckle for preset in PRESETS)
+
+
+def _stick(com: NDArray[np.float64], up: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The kernel's keeper capsule's segment (its ends pulled in by the body's radius) for a pose."""
+    keeper = ball.Keeper()
+    r = keeper.body_radius_m
+    return com - (keeper.foot_reach_m - r) * up, com + (keeper.hand_reach_m - r) * up
+
+
+def _distance_to_segment(p: NDArray[np.float64], a: NDArray[np.float64], b: NDArray[np.float64]) -> float:
+    s = float(np.clip((p - a) @ (b - a) / ((b - a) @ (b - a)), 0.0, 1.0))
+    return float(np.linalg.norm(p - (a + s * (b - a))))
+
+
+def test_the_drawn_keeper_is_where_the_kernel_keeper_meets_the_ball(scene: FreeKickScene) -> None:
+    # The kernel ends the opening curler in the keeper's hands: its own contact event says when and where. The
+    # scene's keeper (drawn from the kernel's model) touches the ball there and then, and nowhere before.
+    played = scene.state.played
+    assert played is not None and played.result == "saved" and played.keeper_dive is not None
+    touch = played.events[-1]
+    assert touch.kind == "keeper"
+    keeper = ball.Keeper()
+    spot = keeper.placed(ball_spot(scene.params)[:2], scene.state.goal)
+    assert scene.state.keeper_xy == pytest.approx(spot)
+    times = played.t[played.t < touch.t]
+    pose = keeper_pose(spot, played.keeper_dive, np.append(times, touch.t))
+    reach = keeper.body_radius_m + ball.BALL_RADIUS_M
+    gaps = [
+        _distance_to_segment(point, *_stick(com, up)) - reach
+        for point, com, up in zip(
+            np.vstack([played.position[: len(times)], touch.position]), pose.com, pose.up, strict=True
+        )
+    ]
+    assert abs(gaps[-1]) < 2e-3  # touching at the kernel's contact (its step samples him mid-step)
+    assert min(gaps[:-1]) > -2e-3  # and not through him before
+    # Before the dive he stands upright on his spot, fingertips 2.3 m up.
+    standing = keeper_pose(spot, played.keeper_dive, np.array([0.0, played.keeper_dive.t]))
+    np.testing.assert_allclose(standing.com, [[*spot, 1.0]] * 2)
+    np.testing.assert_allclose(standing.up, [[0, 0, 1]] * 2)
+    # The still picture shows him at the touch: his limbs' rods are drawn from that pose (hips to soles for the
+    # legs, shoulders to fingertips for the arms).
+    starts = np.asarray(scene.keeper_nodes.batched_positions)
+    scales = np.asarray(scene.keeper_nodes.batched_scales)
+    at_touch = keeper_pose(spot, played.keeper_dive, np.array([touch.t]))
+    soles, tips = at_touch.ends()
+    hips = at_touch.com[0] - 0.05 * at_touch.up[0]
+    np.testing.assert_allclose(starts[2], hips, atol=1e-5)  # the body starts at the hips
+    assert scales[2, 2] == pytest.approx(0.55, abs=1e-5)  # hips to shoulders
+    legs_end = starts[:2] + scales[:2, 2:3] * _rod_direction(scene)[:2]
+    np.testing.assert_allclose(legs_end.mean(axis=0), soles[0], atol=1e-5)
+    arms_end = starts[3:5] + scales[3:5, 2:3] * _rod_direction(scene)[3:5]
+    np.testing.assert_allclose(arms_end.mean(axis=0), tips[0] - 0.05 * at_touch.up[0], atol=1e-5)
+    # The readout's margin: the earliest instant his body could touch a ball waiting at the touch point.
+    early = np.arange(played.keeper_dive.t, touch.t, 1e-3)
+    poses = keeper_pose(spot, played.keeper_dive, early)
+    could = [
+        _distance_to_segment(np.asarray(touch.position), *_stick(com, up)) <= reach
+        for com, up in zip(poses.com, poses.up, strict=True)
+    ]
+    first = early[int(np.argmax(could))]
+    assert f"reached it {touch.t - first:.2f} s early" in scene.result.content
+
+
+def _rod_direction(scene: FreeKickScene) -> NDArray[np.float64]:
+    """(N, 3) where each drawn rod points: +z turned by its quaternion."""
+    wxyz = np.asarray(scene.keeper_nodes.batched_wxyzs, dtype=np.float64)
+    w, x, y, z = wxyz.T
+    return np.column_stack([2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y)])
+
+
+def test_the_keeper_dives_during_the_kick_and_goes_without_a_keeper(scene: FreeKickScene) -> None:
+    scene.kick_button.value = True
+    with scene._lock:
+        scene.kick_time_s = 0.0
+        scene._animate(0.05)
+        body = _rod_direction(scene)[2]
+        assert body == pytest.approx([0.0, 0.0, 1.0], abs=1e-6)  # upright before he reads the kick
+        for _ in range(10):
+            scene._animate(0.1)
+        played = scene.state.played
+        assert played is not None and played.keeper_dive is not None
+        leaning = _rod_direction(scene)[2]
+        assert leaning[2] < 0.9 and leaning[1] < -0.3  # diving to the right (−y), where the ball goes
+    scene.controls["keeper"].value = False
+    assert not scene.keeper_nodes.visible and not scene.keeper_head.visible
+    played = scene.state.played
+    assert played is not None and played.result == "goal" and played.keeper_dive is None
+    assert "**GOAL**" in scene.result.content and "Keeper" not in scene.result.content
+
+
+# ------------------------------------------------------------------------------------------------ goal chance map
+def test_the_goal_chance_map_is_one_click_away_and_is_the_kernels(scene: FreeKickScene) -> None:
+    assert not scene.heat_nodes.visible and not scene.heat_progress.visible
+    scene.heat_button.value = True  # the click
+    assert scene.heat_progress.visible  # the bar shows while the spots are struck
+    assert scene.wait_idle(300.0)
+    assert not scene.heat_progress.visible
+    assert scene.heat_nodes.visible and scene.heat_legend.visible
+    assert scene.params.view == "above"  # a map of the pitch, seen from above
+    chance = scene.odds_map
+    assert chance is not None and chance.shape == (21, 17)
+    # The kernel's map for the same strike: 25 m/s at 17°, 9° right of the goal's centre, 8 rev/s of sidespin
+    # about +z, 32 strikes per spot, the keeper in goal, RK4 at 10 ms under the measured model.
+    expected = ball.odds_map(
+        np.linspace(16.0, 36.0, 21),
+        np.radians(np.linspace(-40.0, 40.0, 17)),
+        25.0,
+        math.radians(17.0),
+        math.radians(-9.0),
+        (0.0, 0.0, 2 * math.pi * 8.0),
+        keeper=ball.Keeper(),
+        n=32,
+        dt=1e-2,
+        method="rk4",
+        model="measured",
+        t_max=4.0,
+        ground_m=ball.BALL_RADIUS_M,
+    )["goal"]
+    np.testing.assert_array_equal(chance, expected)
+    # Each tile's colour is its chance on the ramp: the best spot brightest, and the readout names it.
+    colours = np.asarray(scene.heat_nodes.batched_colors).reshape(21, 17, 3).astype(int)
+    best, worst = np.unravel_index(np.argmax(chance), chance.shape), np.unravel_index(np.argmin(chance), chance.shape)
+    assert colours[best].sum() > colours[worst].sum() + 200
+    assert f"goal {100 * chance.max():.0f} %" in scene.heat_status.content
+    # Moving the ball keeps the map (the same strike from every spot); a new strike hides it and says so.
+    scene.controls["distance_m"].value = 25.0
+    assert scene.heat_nodes.visible
+    scene.controls["spin_rev_s"].value = 5.0
+    assert not scene.heat_nodes.visible and "map it again" in scene.heat_status.content
+
+
+def test_the_odds_map_reports_its_progress_to_the_end() -> None:
+    shares: list[float] = []
+    spot_odds_map(FreeKickParams(speed_ms=20.0, keeper=False), shares.append)
+    assert len(shares) >= 10 and shares == sorted(shares) and shares[-1] == 1.0
+
+
+# ------------------------------------------------------------------------------------------------ knuckleball
+def test_the_knuckleball_wobble_is_drawn_ten_times_larger_and_said_in_words(scene: FreeKickScene) -> None:
+    assert not scene.wobble.visible  # a curler has no knuckle force
+    knuckler = next(preset for preset in PRESETS if preset.params.knuckle)
+    scene.apply(knuckler.params)
+    state = scene.state
+    assert scene.wobble.visible
+    # The thin line is the spinless path plus ten times the kick's difference from it, at the same instants.
+    drawn = np.asarray(scene.wobble.points)
+    end = min(float(state.flight.t[-1]), float(state.ghost.t[-1]))
+    times = np.linspace(0.0, end, PATH_POINTS)
+    kick = np.column_stack([np.interp(times, state.flight.t, state.flight.position[:, k]) for k in range(3)])
+    ghost = np.column_stack([np.interp(times, state.ghost.t, state.ghost.position[:, k]) for k in range(3)])
+    np.testing.assert_allclose(drawn[:, 0], (ghost + 10.0 * (kick - ghost))[:-1], atol=1e-4)
+    # A ball's width and a half of wobble at the end becomes metres on the screen.
+    sideways = np.abs(drawn[:, 1, 1] - ghost[1:, 1])
+    assert 2.5 < sideways.max() < 6.0
+    assert "swerves 0.34 m right at 29 m" in scene.result.content and "10× larger" in scene.result.content
