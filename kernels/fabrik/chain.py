@@ -16,6 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from kernels.fabrik.geometry import (
+    _OFF,
     _TINY,
     _TOUCH,
     Obstacles,
@@ -644,7 +645,7 @@ def _solve_chain(
                 iteration,
             )
             ux, uy, uz, _ = _unit(ox, oy, oz, rest[0], rest[1], rest[2], tiny)
-            _place_on_line(p, best[0], lengths, ux, uy, uz, False)
+            _place_on_line(p, best[0], lengths, ux, uy, uz, bool(_OFF))
             _unbend(p, target, lengths, tiny, rest, limits, cos_phi, dim)  # a straight chain never bends
             _backward_pass(p, lengths, tiny, rest, limits, obstacles, has_zero, dim)
             # The restart pose is a candidate too: where the limits leave the chain nearly rigid, the passes from
@@ -786,7 +787,7 @@ def _solve_one(
     count, dim = joints.shape[0], joints.shape[1]
     if not _within(joints, bound):
         return _BAD_JOINTS, np.empty((0, dim)), np.empty(0), 0, 0, 0.0
-    if not _within(target, bound):
+    if not _within(target.reshape((1, dim)), bound):  # as a 2D array, like the joints: one compiled _within
         return _BAD_TARGET, np.empty((0, dim)), np.empty(0), 0, 0, 0.0
     p = np.zeros((count, 3))
     goal = np.zeros(3)

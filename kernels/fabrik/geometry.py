@@ -30,6 +30,11 @@ Obstacles = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.bool_]]
 stands inside of is ignored."""
 
 
+_DIM_3D, _ROW_0, _OFF = 3, 0, False
+"""Passed by compiled callers as ``int(_DIM_3D)``, ``int(_ROW_0)``, ``bool(_OFF)``: numba types a bare ``3``, ``0`` or
+``False`` as a literal and compiles the callee once more for it; an int or bool argument shares the one variant."""
+
+
 @numba.njit(cache=True, error_model="numpy")
 def _unit(
     x: float, y: float, z: float, fx: float, fy: float, fz: float, tiny: float
@@ -64,7 +69,7 @@ def _turn_shortest(
     cx, cy, cz = s[1] * tz - s[2] * ty, s[2] * tx - s[0] * tz, s[0] * ty - s[1] * tx
     dot = s[0] * tx + s[1] * ty + s[2] * tz
     if dot < -1.0 + 1e-12:
-        kx, ky, kz = _perpendicular(s[0], s[1], s[2], 3)
+        kx, ky, kz = _perpendicular(s[0], s[1], s[2], int(_DIM_3D))
         along = 2.0 * (kx * vx + ky * vy + kz * vz)
         return along * kx - vx, along * ky - vy, along * kz - vz
     wx, wy, wz = cy * vz - cz * vy, cz * vx - cx * vz, cx * vy - cy * vx

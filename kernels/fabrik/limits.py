@@ -19,6 +19,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from kernels._checks import bounded_array, finite_number
 from kernels.fabrik.geometry import (
+    _DIM_3D,
     _LARGEST,
     _TINY,
     _perpendicular,
@@ -216,7 +217,7 @@ def _hinge_axes(
     if table[row, 12] == 0.0:
         rx, ry, rz = qx, qy, qz
     along = rx * ax + ry * ay + rz * az
-    px, py, pz = _perpendicular(ax, ay, az, 3)
+    px, py, pz = _perpendicular(ax, ay, az, int(_DIM_3D))
     rx, ry, rz, _ = _unit(rx - along * ax, ry - along * ay, rz - along * az, px, py, pz, 1e-9)
     return ax, ay, az, rx, ry, rz
 

@@ -38,6 +38,9 @@ from kernels.fabrik.chain import (
     _copy,
 )
 from kernels.fabrik.geometry import (
+    _DIM_3D,
+    _OFF,
+    _ROW_0,
     _TINY,
     _TOUCH,
     Obstacles,
@@ -389,13 +392,14 @@ def _solve_tree_core(
             only_child[up] = j if counts[up] == 0 else -1
             counts[up] += 1
 
-    worst = _tree_errors(p, goal, effectors, history, 0)
+    worst = _tree_errors(p, goal, effectors, history, int(_ROW_0))
     if _tree_admissible(p, parents, order, table, rest, tiny, has_limits, obstacles):
         best_worst = worst
         if worst <= tolerance:  # the start is returned as reached only where it keeps every limit
             for e in range(final.shape[0]):
                 final[e] = history[0, e]
-            _tree_statuses(p, parents, goal, effectors, lengths, obstacles, tolerance, tiny, final, False, False, codes)
+            no = bool(_OFF)
+            _tree_statuses(p, parents, goal, effectors, lengths, obstacles, tolerance, tiny, final, no, no, codes)
             return 0
     stall = _STALL * tolerance + tiny
     iterations, stalled, retry = 0, False, True
@@ -544,7 +548,7 @@ def _tree_turn_aside(
             ax, ay, az = 0.0, 0.0, 1.0
             angle = angle if k % 2 else -angle
         else:
-            px, py, pz = _perpendicular(dx, dy, dz, 3)
+            px, py, pz = _perpendicular(dx, dy, dz, int(_DIM_3D))
             ax, ay, az = _rotate(px, py, pz, dx, dy, dz, 2.0 * math.pi * ((k * golden * golden) % 1.0))
         dx, dy, dz = _rotate(dx, dy, dz, ax, ay, az, angle)
         p[j, 0] = p[up, 0] + lengths[j] * dx
