@@ -15,8 +15,9 @@ from helpers.screen_geometry import GOAL_CORNERS, polyline_gap
 from helpers.wsclient import BrowserClient, shows_number
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from kernels import ball
 from numpy.typing import NDArray
+
+from kernels import ball
 from scenes._framing import MARGIN_PX, PANEL_PX, Lens, View, frame_points, project_points
 from scenes.freekick import (
     AIM_TOLERANCE_M,
