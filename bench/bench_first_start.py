@@ -2,6 +2,7 @@
 long until every kernel is compiled.
 
     python bench/bench_first_start.py            # both runs below, each in a fresh process with an empty cache
+    python bench/bench_first_start.py --only warming
 
 Two runs, each in a fresh process with its own empty ``NUMBA_CACHE_DIR``:
 - *warming*, as the app starts: :func:`kernels.warming.start` compiles in child processes while the scenes' kernels
@@ -9,13 +10,15 @@ Two runs, each in a fresh process with its own empty ``NUMBA_CACHE_DIR``:
   frame is computed (its workers idle), and the time until every kernel is compiled and loaded is printed.
 - *baseline*, the same scenes with no background compile: each first call compiles where it stands.
 
-Prints a table per run (seconds). The browser's own draw adds a fraction of a second on top (see docs/performance.md).
+Prints a table per run (seconds); the warming run adds the CPU seconds its compile processes used (user + system,
+summed over them: on a busy machine the wall time stretches, this much less). The browser's own draw adds a fraction of a second on top (see docs/performance.md).
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import resource
 import subprocess
 import sys
 import tempfile
@@ -59,6 +62,8 @@ def run_child(warming_on: bool) -> None:
         if thread is not None:
             thread.join()
             print(f"| every kernel compiled and loaded (from start) | {time.perf_counter() - started:.2f} |")
+            children = resource.getrusage(resource.RUSAGE_CHILDREN)
+            print(f"| CPU time of the compile processes, together | {children.ru_utime + children.ru_stime:.2f} |")
     finally:
         server.stop()
 
@@ -66,12 +71,13 @@ def run_child(warming_on: bool) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--child", choices=("warming", "baseline"), help=argparse.SUPPRESS)
+    parser.add_argument("--only", choices=("warming", "baseline"), help="run only this one of the two runs")
     args = parser.parse_args()
     if args.child is not None:
         run_child(args.child == "warming")
         return
     print(f"# First start on an empty numba cache ({os.cpu_count()} cores, {time.strftime('%Y-%m-%d %H:%M')})")
-    for mode in ("warming", "baseline"):
+    for mode in (args.only,) if args.only else ("warming", "baseline"):
         with tempfile.TemporaryDirectory(prefix="numba-cold-") as cache:
             print(f"\n## {mode}\n| step | s |\n|---|---:|", flush=True)
             env = dict(os.environ, NUMBA_CACHE_DIR=cache, PYTHONPATH=str(ROOT))
