@@ -27,6 +27,7 @@ from helpers.browser import (
     screenshot,
     set_number,
     settle,
+    visible_text,
     with_nodes_hidden,
 )
 from helpers.screen_geometry import GOAL_CORNERS, polyline_gap
@@ -37,6 +38,7 @@ from scenes.freekick import (
     FORCE_COLOURS,
     KNUCKLE_COLOUR,
     PATH_COLOUR,
+    PRESETS,
     VIEW_LABELS,
     FreeKickScene,
     ViewName,
@@ -45,6 +47,7 @@ from scenes.freekick import (
     resample,
     view_points,
 )
+from scenes.freekick.model import heat_cells
 
 pytestmark = pytest.mark.browser
 
@@ -215,3 +218,63 @@ def test_the_force_chart_tick_labels_stay_inside_its_canvas(shown: ScenePage) ->
         lambda scene: scene.chart.data,
         over_ten_newtons,
     )
+
+
+KEEPER = ["/freekick/keeper", "/freekick/keeper_head"]
+SHOWN_PRESETS = (
+    "Low curler: bounces, saved",
+    "Driven, off the post",
+    "Top corner past the keeper",
+    "Curler round the wall, saved",  # the defaults last: the page is left as it opened
+)
+"""Presets whose picture is looked at: a bounce and a save, a post, a goal past the keeper, the opening save."""
+
+
+def _keeper_points(scene: FreeKickScene) -> np.ndarray:
+    """(N, 3) both ends of every drawn limb of the keeper (m)."""
+    starts = np.asarray(scene.keeper_nodes.batched_positions, dtype=np.float64)
+    scales = np.asarray(scene.keeper_nodes.batched_scales, dtype=np.float64)
+    w, x, y, z = np.asarray(scene.keeper_nodes.batched_wxyzs, dtype=np.float64).T
+    axis = np.column_stack([2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y)])
+    return np.vstack([starts, starts + scales[:, 2:3] * axis, np.asarray(scene.keeper_head.position)[None]])
+
+
+def test_each_preset_shows_the_keeper_in_view_and_says_what_happened(shown: ScenePage) -> None:
+    scene = shown.scene
+    assert isinstance(scene, FreeKickScene)
+    words = {
+        "Low curler: bounces, saved": "Bounces, into the keeper's hands",
+        "Driven, off the post": "Hits the right post at 1.2 m",
+        "Top corner past the keeper": "the ball beats him by",
+        "Curler round the wall, saved": "Saved: the keeper reached it",
+    }
+    for label in SHOWN_PRESETS:
+        preset = next(preset for preset in PRESETS if preset.label == label)
+        shown.page.get_by_role("button", name=label, exact=True).click()
+        wait_until(lambda preset=preset: scene.params == preset.params.shown_as(scene.params), f"the {label} preset")
+        settle(shown)
+        assert words[label] in visible_text(shown.page), label
+        image = screenshot(shown.page)
+        with scene._lock:
+            points = _keeper_points(scene)
+        xy = assert_in_view(shown, "/freekick", points, f"the keeper ({label})")
+        assert_seen(shown, image, KEEPER, xy, f"the keeper ({label})", max_outside=0.4)  # his shadow falls aside
+    assert error_text(shown.page) == []
+
+
+def test_the_goal_chance_map_is_drawn_on_the_grass_from_above(shown: ScenePage) -> None:
+    scene = shown.scene
+    assert isinstance(scene, FreeKickScene)
+    assert not scene.heat_nodes.visible
+    shown.page.get_by_role("button", name="Map the goal chance from every spot").click()
+    wait_until(lambda: scene.heat_nodes.visible and scene.params.view == "above", "the map", 300.0)
+    settle(shown)
+    image = screenshot(shown.page)
+    centres, _, _ = heat_cells()
+    xy = assert_in_view(shown, "/freekick", centres, "the goal-chance map")
+    covered = assert_seen(shown, image, ["/freekick/odds_map"], xy, "the goal-chance map", max_outside=0.1)
+    # The map is a large picture, not a strip: it covers a tenth of the free canvas or more.
+    assert covered.sum() > 0.1 * panel_rect(shown.page)[0] * shown.viewport[1]
+    text = visible_text(shown.page)
+    assert "Best spot:" in text and "Goal 0 → 100 %" in text
+    assert error_text(shown.page) == []
