@@ -2,7 +2,7 @@
 
 python scripts/screenshot_course.py
 
-The sample route, four riders sharing the front, weather air, played to about 40 % of the way.
+The sample route, a bunch of 30 riders sharing the work, weather air, about 40 % of the way up the climb.
 """
 
 from __future__ import annotations
@@ -41,8 +41,10 @@ def main(out: Path = ROOT / "docs" / "peloton_course.png", at_km: float = 5.5, s
     scene = switcher.scene
     assert isinstance(scene, PelotonScene)
     mode = scene.course_mode
+    scene.controls["formation"].value = "Bunch (peloton)"
+    scene.controls["n_riders"].value = 30
     mode.enable.value = True
-    mode.controls["air"].value = "Weather (temperature, pressure or altitude, humidity)"
+    mode.controls["air"].value = "Weather reading"
     mode.controls["temperature_c"].value = 24.0
     mode.controls["humidity_pct"].value = 60.0
     mode.scrub.value = at_km
@@ -57,7 +59,7 @@ def main(out: Path = ROOT / "docs" / "peloton_course.png", at_km: float = 5.5, s
                 page.get_by_text(folder, exact=True).first.click(timeout=20_000)
             except PlaywrightError:
                 print(f"could not fold {folder!r}; the picture shows it open")
-        chart = page.locator(".uplot", has_text="Elevation, speed and power along the course")
+        chart = page.locator(".uplot", has_text="Elevation, speed and power")
         chart.first.scroll_into_view_if_needed(timeout=10_000)
         time.sleep(1.0)
         page.screenshot(path=str(out))

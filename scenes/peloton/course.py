@@ -19,33 +19,34 @@ from kernels import course as course_kernel
 from scenes._base import record_spec
 from scenes._charts import FittedChart
 from scenes._controls import build_controls, declared, read_controls
+from scenes._framing import Lens, View, box_corners, frame_points
 from scenes.peloton.course_model import (
-    COURSE_MARKER_SCALE,
     COURSE_POWER_RANGE_W,
+    GROUP_VIEW_DIRECTION,
+    LINE_VIEW_DIRECTION,
     MAX_CHART_POINTS,
-    MAX_DRAWN_POINTS,
     MODE_FOLDER,
     MODEL_LABEL,
     MORE_FOLDER,
     POWER_FOLDER,
+    ROAD_AHEAD_M,
     SAMPLE_LABEL,
-    TERRAIN_HALF_WIDTH_M,
-    CourseDrawing,
     CourseParams,
     CourseState,
+    RoadLayout,
     compute_course,
     course_air,
     course_rider,
     drawn_indices,
     format_duration,
-    grade_colours,
-    ground_under,
+    lay_out_road,
     split_every_m,
-    terrain_strip,
 )
 from scenes.peloton.meshes import add_riders, show_position
-from scenes.peloton.model import BIKE_LENGTH_M, MAX_RIDERS, Position, group_cda
+from scenes.peloton.model import BIKE_LENGTH_M, MAX_GROUP, Position, group_cda, is_line_view
 
+CHART_TITLE = "Elevation, speed and power"
+"""The course chart's title (short: the panel is narrow)."""
 FORMATION_WORDS = {"single": "in single file", "double": "two abreast", "bunch": "in a bunch", "echelon": "in echelon"}
 """How the course readout names each formation."""
 
@@ -104,7 +105,6 @@ class CourseMode:
         self.message = ""
         self._since_readout = 0.0
         self._drawn_position: Position | None = None
-        self._drawing = CourseDrawing.of(self.route)
         self._upload_lock = threading.Lock()
         self._upload_seq = 0
         """Number of the newest upload: parses run in parallel on viser's pool, and only the newest installs."""
@@ -140,15 +140,16 @@ class CourseMode:
                     "x": viser.uplot.Scale(time=False, auto=True),
                     "m": viser.uplot.Scale(auto=True),
                     "kmh": viser.uplot.Scale(auto=True),
-                    "W": viser.uplot.Scale(auto=True),  # no axis of its own: the legend gives watts
+                    "W": viser.uplot.Scale(auto=True),
                 },
                 axes=(
                     viser.uplot.Axis(scale="x", label="km"),
-                    viser.uplot.Axis(scale="m", label="m", side=3),
-                    viser.uplot.Axis(scale="kmh", label="km/h", side=1, grid=viser.uplot.Axis_Grid(show=False)),
+                    viser.uplot.Axis(scale="m", label="m", side=3, size=44, labelSize=14),
+                    _right_axis("kmh", "km/h", 30, "rgb(30,110,220)"),
+                    _right_axis("W", "W", 46, "rgb(220,40,40)"),
                 ),
                 legend=viser.uplot.Legend(show=True),
-                title="Elevation, speed and power along the course",
+                title=CHART_TITLE,
                 aspect=1.4,
                 visible=False,  # until the first ride: a profile over flat zeros reads as a rider not pedalling
             )
@@ -199,39 +200,51 @@ class CourseMode:
     def _build_world(self) -> None:
         scene = self.server.scene
         self.frame = scene.add_frame(f"{self.scene.root.name}/course_mode", show_axes=False, visible=False)
-        index = drawn_indices(self.route.n_points, MAX_DRAWN_POINTS)
-        points = self._drawing.points(self.route, index, self.params.exaggeration)
-        vertices, faces = terrain_strip(points, TERRAIN_HALF_WIDTH_M)
-        ground_vertices, ground_faces = ground_under(points)
-        self.ground = scene.add_mesh_simple(
-            f"{self.frame.name}/ground", ground_vertices, ground_faces, color=(205, 210, 195)
+        layout = self.layout()
+        name = self.frame.name
+        self.verge = scene.add_mesh_simple(f"{name}/verge", *layout.verge, color=(120, 165, 95))
+        self.road = scene.add_mesh_simple(f"{name}/route", *layout.road, color=(70, 72, 78))  # the route's road
+        self.road_edges = scene.add_line_segments(
+            f"{name}/road_edges", layout.edges, colors=(250, 250, 250), thickness=0.06
         )
-        self.terrain = scene.add_mesh_simple(
-            f"{self.frame.name}/terrain",
-            vertices,
-            faces,
-            color=(150, 175, 110),
-            side="double",
+        self.centre_line = scene.add_line_segments(
+            f"{name}/centre_line", layout.dashes, colors=(240, 240, 240), thickness=0.08
         )
-        segments, colours = self._route_segments(index, points)
-        self.route_line = scene.add_line_segments(f"{self.frame.name}/route", segments, colors=colours, thickness=0.08)
-        self.course_riders = add_riders(scene, f"{self.frame.name}/riders", self.scene.params.position, 0.0)
+        self.course_riders = add_riders(scene, f"{name}/riders", self.scene.params.position, 0.0, MAX_GROUP)
         self._drawn_position = self.scene.params.position
-        self.leader_marker = scene.add_icosphere(
-            f"{self.frame.name}/leader_marker",
-            radius=0.12,
-            color=(255, 60, 60),
-            position=(0.0, 0.0, 1.0),
-        )
-        self.start_label = scene.add_label(f"{self.frame.name}/start", text="Start", position=tuple(points[0]))
-        self.finish_label = scene.add_label(f"{self.frame.name}/finish", text="Finish", position=tuple(points[-1]))
+        self.mark_lines = {
+            mark: scene.add_line_segments(
+                f"{name}/{mark.lower()}_line", np.zeros((1, 2, 3)), colors=(250, 250, 250), thickness=0.25
+            )
+            for mark in layout.marks
+        }
+        self.mark_labels = {
+            mark: scene.add_label(f"{name}/{mark.lower()}", text=mark, position=(0.0, 0.0, 0.0))
+            for mark in layout.marks
+        }
+        self._draw_layout(layout)
 
-    def _route_segments(self, index: np.ndarray, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        segments = np.stack([points[:-1], points[1:]], axis=1) + [0.0, 0.0, 0.02]
-        rise = np.diff(self.route.elevation_m[index])
-        run = np.maximum(np.diff(self.route.distance_m[index]), 1e-9)
-        colours = grade_colours(rise / run)
-        return segments.astype(np.float32), np.repeat(colours[:, None, :], 2, axis=1)
+    def formation_xy(self) -> np.ndarray:
+        """(n, 2) the group's formation (m ahead of the leader, m to its left), leader first, as the line lays it
+        out."""
+        return np.asarray(self.scene.state.positions, dtype=np.float64)[: self.scene.params.n_riders]
+
+    def layout(self) -> RoadLayout:
+        """The road near the group and the group on it, where the leader is now."""
+        return lay_out_road(self.route, self.leader_distance_m(), self.formation_xy(), self.params.exaggeration)
+
+    def view_for(self, lens: Lens) -> View:
+        """The camera for ``lens`` that shows the whole group on its road left of the panel, as large as it fits:
+        every rider, head to wheels, and a little road ahead of the leader."""
+        with self.scene._lock:
+            positions = self.layout().riders[0]
+            direction = LINE_VIEW_DIRECTION if is_line_view(self.scene.params) else GROUP_VIEW_DIRECTION
+        half = 0.5 * BIKE_LENGTH_M + 0.2
+        lo = positions.min(axis=0) - [half, 0.7, 0.0]
+        hi = positions.max(axis=0) + [half + min(3.0, ROAD_AHEAD_M), 0.7, 1.9]
+        return frame_points(
+            box_corners(lo, hi), direction, fov_rad=lens.fov_rad, aspect=lens.aspect, ndc=lens.usable_ndc()
+        )
 
     # ----------------------------------------------------------------------------------------- inputs
     def read_params(self) -> CourseParams:
@@ -239,10 +252,13 @@ class CourseMode:
         return read_controls(self.controls, self.params, write_back=self.scene.write_back)
 
     def _on_enable(self) -> None:
+        was = self.enabled
         self.params = read_controls(self.head, self.params, write_back=self.scene.write_back)
         if self.enabled and self.state is None:
             self.recompute()
         self.redraw()
+        if self.enabled != was:
+            self.scene.framing.reframe()  # the course's group on its road, or the line again
         self.scene.wake_loops()
 
     def _on_input(self) -> None:
@@ -265,9 +281,12 @@ class CourseMode:
         except ValueError as error:
             self.message = f"Could not ride this course: {error}"
             return
+        # The riders stay where they are on the course (the Position slider's place), not at the same time of a
+        # ride that is now faster or slower: else the readout and the slider part (5.57 km against 5.5).
+        at_m = self.leader_distance_m() if self.state is not None else self._scrub_m()
         self.params, self.state = params, state
         self.message = ""
-        self.play_time_s = min(self.play_time_s, state.ride.time_s)
+        self.play_time_s = float(np.interp(at_m, state.ride.distance_m, state.ride.elapsed_s))
         if self.enabled and self.playing:  # a ride that had none to play now has one
             self.scene.wake_loops()
 
@@ -331,12 +350,11 @@ class CourseMode:
         self.message = ""
         self.play_time_s = 0.0
         self.playing = False
-        self._drawing = CourseDrawing.of(route)
         self.scrub.max = self._total_km()
         # The gate clamps a browser's scrub to the new course's length, not the first one's.
         record_spec(self.scrub)
         self.scene.write_back(self.scrub, 0.0)  # the riders are back at the start
-        self.redraw(geometry=True)
+        self.redraw()
         return True
 
     def _on_solve(self) -> None:
@@ -402,8 +420,21 @@ class CourseMode:
 
     def _on_pause(self) -> None:
         self.playing = False
-        self.scene.write_back(self.scrub, round(self._leader_km(), 2))  # where the riders stopped
+        self._show_at_km(round(self._leader_km(), 2))  # where the riders stopped, to the slider's step
         self.redraw(readouts=False)
+
+    def _show_at_km(self, km: float) -> None:
+        """Put the Position slider and the riders at ``km`` together (the readout then says the same place)."""
+        self.scene.write_back(self.scrub, km)
+        if self.state is not None:
+            ride = self.state.ride
+            self.play_time_s = float(np.interp(km * 1000.0, ride.distance_m, ride.elapsed_s))
+
+    def _scrub_m(self) -> float:
+        """Where the Position slider puts the riders (m), cleaned."""
+        raw = self.scrub.value
+        ok = isinstance(raw, (int, float)) and not isinstance(raw, bool) and math.isfinite(raw)
+        return 1000.0 * float(np.clip(raw if ok else 0.0, 0.0, self._total_km()))
 
     def _on_scrub(self) -> None:
         if self.state is None:
@@ -448,27 +479,19 @@ class CourseMode:
     def _leader_km(self) -> float:
         return self.leader_distance_m() / 1000.0
 
-    def rider_distances_m(self) -> np.ndarray:
-        """(n,) distance along the route of each drawn rider, leader first (spaced as drawn): the first
-        :data:`MAX_RIDERS` of the group (the course's scale draws a bunch as the line at its head)."""
-        n, gap = min(self.scene.params.n_riders, MAX_RIDERS), self.scene.params.gap_m
-        spacing_m = (BIKE_LENGTH_M + gap) * COURSE_MARKER_SCALE / self._drawing.scale
-        return self.leader_distance_m() - np.arange(n) * spacing_m
-
-    def redraw(self, *, geometry: bool = False, readouts: bool = True, now: bool = True) -> None:
-        """Show or hide the mode and push its state: riders always, geometry and readouts when asked."""
+    def redraw(self, *, readouts: bool = True, now: bool = True) -> None:
+        """Show or hide the mode and push its state: the road and riders always, the readouts when asked."""
         s = self.scene
         with self.server.atomic():
             s.course.visible = not self.enabled
             if self.enabled:
                 s.wind_arrow.visible = False
             self.frame.visible = self.enabled
-            if geometry or self._drawn_exaggeration != self.params.exaggeration:
-                self._draw_geometry()
             if s.params.position != self._drawn_position:
                 show_position(self.course_riders, s.params.position)
                 self._drawn_position = s.params.position
-            self._draw_riders()
+            if self.enabled:
+                self._draw_layout(self.layout())
             if now:
                 self.now.content = self._now_markdown()
             if readouts:
@@ -479,38 +502,32 @@ class CourseMode:
                 self.chart.visible = self.state is not None
         self.server.flush()
 
-    _drawn_exaggeration: float = 2.0
-
-    def _draw_geometry(self) -> None:
-        index = drawn_indices(self.route.n_points, MAX_DRAWN_POINTS)
-        points = self._drawing.points(self.route, index, self.params.exaggeration)
-        vertices, faces = terrain_strip(points, TERRAIN_HALF_WIDTH_M)
-        self.terrain.vertices = vertices
-        self.terrain.faces = faces
-        self.ground.vertices, self.ground.faces = ground_under(points)
-        segments, colours = self._route_segments(index, points)
-        self.route_line.points = segments
-        self.route_line.colors = colours
-        self.start_label.position = tuple(points[0])
-        self.finish_label.position = tuple(points[-1])
-        self._drawn_exaggeration = self.params.exaggeration
-
-    def _draw_riders(self) -> None:
-        n = min(self.scene.params.n_riders, MAX_RIDERS)
-        positions = np.zeros((MAX_RIDERS, 3))
-        wxyz = np.tile([1.0, 0.0, 0.0, 0.0], (MAX_RIDERS, 1))
-        where, yaw = self._drawing.at_distance(self.route, self.rider_distances_m(), self.params.exaggeration)
-        positions[:n] = where
-        wxyz[:n] = np.stack([np.cos(yaw / 2), np.zeros(n), np.zeros(n), np.sin(yaw / 2)], axis=1)
-        visible = (np.arange(MAX_RIDERS) < n).astype(np.float64)
-        # Riders behind the start wait there (hidden until the line has rolled out).
-        visible[:n] *= self.rider_distances_m() >= 0.0
-        scales = np.repeat(visible[:, None], 3, axis=1) * COURSE_MARKER_SCALE
+    def _draw_layout(self, layout: RoadLayout) -> None:
+        """Push a layout to the road's and riders' nodes (faces only when the road's length changed)."""
+        for node, (vertices, faces) in ((self.road, layout.road), (self.verge, layout.verge)):
+            if node.faces.shape != faces.shape:
+                node.faces = faces
+            node.vertices = vertices
+        self.road_edges.points = layout.edges
+        self.centre_line.points = layout.dashes
+        for mark, ends in layout.marks.items():
+            line, label = self.mark_lines[mark], self.mark_labels[mark]
+            line.visible = label.visible = ends is not None
+            if ends is not None:
+                line.points = ends[None].astype(np.float32)
+                label.position = ends[0] + np.array([0.0, 0.0, 2.2])
+        positions, wxyz = layout.riders
+        n = positions.shape[0]
+        all_positions = np.zeros((MAX_GROUP, 3), np.float32)
+        all_positions[:n] = positions
+        all_wxyz = np.tile(np.array([1.0, 0.0, 0.0, 0.0], np.float32), (MAX_GROUP, 1))
+        all_wxyz[:n] = wxyz
+        scales = np.zeros((MAX_GROUP, 3), np.float32)
+        scales[:n] = 1.0
         for node in self.course_riders.values():
-            node.batched_positions = positions.astype(np.float32)
-            node.batched_wxyzs = wxyz.astype(np.float32)
-            node.batched_scales = scales.astype(np.float32)
-        self.leader_marker.position = tuple(where[0] + [0.0, 0.0, 0.5])
+            node.batched_positions = all_positions
+            node.batched_wxyzs = all_wxyz
+            node.batched_scales = scales
 
     def _chart_data(self) -> tuple[np.ndarray, ...]:
         route = self.route
@@ -616,6 +633,19 @@ class CourseMode:
             f"Leader at **{d / 1000:.2f} km**, {format_duration(self.play_time_s)}: "
             f"{3.6 * speed:.1f} km/h, {power:.0f} W{coasting}, {elevation:.0f} m"
         )
+
+
+def _right_axis(scale: str, label: str, size: float, colour: str) -> viser.uplot.Axis:
+    """An axis of the course chart on its right, in its series' colour, without grid lines (the left axis has them)."""
+    return viser.uplot.Axis(
+        scale=scale,
+        label=label,
+        side=1,
+        size=size,
+        labelSize=14,
+        grid=viser.uplot.Axis_Grid(show=False),
+        stroke=colour,
+    )
 
 
 def _escape(text: str) -> str:

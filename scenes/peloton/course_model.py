@@ -2,9 +2,9 @@
 
 :class:`CourseParams` is what the user sets in the mode (each field declares its GUI control, :mod:`scenes._controls`);
 :func:`compute_course` rides a route for it and the line's :class:`~scenes.peloton.model.PelotonParams` into a
-:class:`CourseState` through :mod:`kernels.course` (Martin et al. 1998). :class:`CourseDrawing`,
-:func:`terrain_strip`, :func:`ground_under` and :func:`grade_colours` map the route into the box the line's camera
-already frames: map metres scaled, elevation exaggerated, (N, 3) scene points. No viser handles: all testable alone.
+:class:`CourseState` through :mod:`kernels.course` (Martin et al. 1998). :class:`ChaseFrame`, :func:`road_strip`
+and :func:`riders_on_road` lay the road near the group and the group on it at life size, in a frame that rides along
+with the group (heights exaggerated on request). No viser handles: all testable alone.
 """
 
 from __future__ import annotations
@@ -15,19 +15,18 @@ from dataclasses import field
 from typing import Literal
 
 import numpy as np
-import trimesh
 
 from kernels import course as course_kernel
 from kernels import cycling
 from scenes._controls import checkbox, dropdown, dropdown_from_labels, number, slider
 from scenes.peloton.model import PelotonParams, group_cda
 
-CourseAirLabel = Literal["Exponential atmosphere (textbook)", "Weather (temperature, pressure or altitude, humidity)"]
+CourseAirLabel = Literal["Textbook atmosphere", "Weather reading"]
 AIR_FROM_LABEL: dict[str, course_kernel.AirKind] = {
-    "Exponential atmosphere (textbook)": "seed",
-    "Weather (temperature, pressure or altitude, humidity)": "weather",
+    "Textbook atmosphere": "seed",
+    "Weather reading": "weather",
 }
-PRESSURE_SOURCES = ("Standard atmosphere at the route's altitude", "Barometer at the start (hPa)")
+PRESSURE_SOURCES = ("Standard atmosphere", "Barometer")
 """What the "Pressure from" dropdown shows for :attr:`CourseParams.pressure_from_barometer` False and True."""
 POWER_MODEL_FROM_LABEL: dict[str, course_kernel.Model] = {
     "Martin et al. 1998 (full)": "martin",
@@ -37,14 +36,20 @@ COURSE_POWER_RANGE_W = (20.0, 2000.0)
 """What the Course power input takes (W); 'Find the power for this time' says when a target needs more or less."""
 MODEL_LABEL = {model: label for label, model in POWER_MODEL_FROM_LABEL.items()}
 SAMPLE_LABEL = "Alpe d'Huez (sample, from the published profile)"
-COURSE_BOX_M = 6.0
-"""The drawn course fits a square of this size (scene metres) where the line's camera looks."""
-COURSE_CENTRE = np.array([-3.2, 0.0])
-TERRAIN_HALF_WIDTH_M = 0.15
-"""Half width of the drawn terrain strip (scene m)."""
-COURSE_MARKER_SCALE = 0.25
-"""Riders on the course are drawn at this fraction of life size (a marker, not to the map's scale)."""
-MAX_DRAWN_POINTS = 2000
+ROAD_HALF_WIDTH_M = 3.0
+"""Half the drawn road's width (m) at least: wider where the formation is wider."""
+VERGE_HALF_WIDTH_M = 16.0
+"""Half the width of the grass either side of the road (m)."""
+ROAD_AHEAD_M = 30.0
+"""Road drawn ahead of the leader (m)."""
+ROAD_BEHIND_M = 20.0
+"""Road drawn behind the last rider (m)."""
+ROAD_STEP_M = 1.0
+"""Spacing of the drawn road's cross-sections (m): a bend of the route turns smoothly over a few of them."""
+LINE_VIEW_DIRECTION = (1.2, 7.5, -1.6)
+"""Where the camera looks at a line of riders on the course: from the line's right side, a little behind and above."""
+GROUP_VIEW_DIRECTION = (3.0, 2.6, -2.4)
+"""Where the camera looks at a group on the course: from behind its right side and above, so every row shows."""
 MAX_CHART_POINTS = 1000
 
 MODE_FOLDER = "Course mode (GPX route)"
@@ -80,7 +85,7 @@ class CourseParams:
     )
     """Air along the route: the textbook exponential atmosphere or a weather reading."""
     temperature_c: float = field(
-        default=15.0, metadata=slider("Temperature (°C)", -20.0, 45.0, 0.5, folder=POWER_FOLDER)
+        default=15.0, metadata=slider("Temp (°C)", -20.0, 45.0, 0.5, folder=POWER_FOLDER)
     )
     """Air temperature at the start (°C), weather air."""
     pressure_from_barometer: bool = field(
@@ -112,10 +117,10 @@ class CourseParams:
     pacing_gain_pct: float = field(default=15.0, metadata=slider("Pacing gain (%)", 0.0, 50.0, 1.0, folder=MORE_FOLDER))
     """How much more power on steep climbs, and less on descents (%)."""
     exaggeration: float = field(
-        default=2.0,
-        metadata=slider("Elevation exaggeration (×)", 1.0, 10.0, 0.5, folder=MORE_FOLDER),
+        default=1.0,
+        metadata=slider("Steepness drawn (×)", 1.0, 5.0, 0.5, folder=MORE_FOLDER),
     )
-    """Vertical exaggeration of the drawn terrain."""
+    """Vertical exaggeration of the drawn road (the ride itself is on the real grades)."""
     playback: float = field(default=60.0, metadata=slider("Playback speed (×)", 1.0, 600.0, 1.0, folder=MORE_FOLDER))
     """Playback speed (× real time)."""
 
@@ -215,88 +220,166 @@ def drawn_indices(n_points: int, limit: int) -> np.ndarray:
     return np.unique(np.linspace(0, n_points - 1, min(n_points, limit)).round().astype(np.int64))
 
 
-@dataclasses.dataclass(frozen=True)
-class CourseDrawing:
-    """The route mapped into the scene: map (east, north) scaled into the framed box, elevation exaggerated."""
+def route_points(route: course_kernel.Course, distance_m: np.ndarray) -> np.ndarray:
+    """(k, 3) map points (east, north, elevation; m) at distances along the route (m). Before the start and past the
+    finish the road runs on straight and level, along the first and last segment (riders wait there)."""
+    d = np.asarray(distance_m, dtype=np.float64)
+    total = float(route.total_distance_m)
+    inside = np.clip(d, 0.0, total)
+    east = np.interp(inside, route.distance_m, route.east_m)
+    north = np.interp(inside, route.distance_m, route.north_m)
+    elevation = np.interp(inside, route.distance_m, route.elevation_m)
+    for end, beyond in ((0, np.minimum(d, 0.0)), (-1, np.maximum(d - total, 0.0))):
+        a, b = (0, 1) if end == 0 else (-2, -1)
+        step = np.array([route.east_m[b] - route.east_m[a], route.north_m[b] - route.north_m[a]])
+        step = step / max(float(np.hypot(*step)), 1e-9)
+        east = east + beyond * step[0]
+        north = north + beyond * step[1]
+    return np.stack([east, north, elevation], axis=1)
 
-    scale: float
-    """Scene metres per map metre."""
-    offset: np.ndarray
-    """(2,) map point drawn at COURSE_CENTRE (m)."""
-    base_m: float
-    """Elevation drawn at z = 0 (m): the route's lowest point."""
+
+@dataclasses.dataclass(frozen=True)
+class ChaseFrame:
+    """The scene frame the riders are drawn in, at life size: its origin is the middle of the group on the route,
+    its x axis points from the group's last rider to its leader (level), z is up, with heights exaggerated by
+    ``exaggeration`` about the origin. The road and riders are laid out in it every frame, so a camera framed on the
+    group keeps seeing it as it rides."""
+
+    origin: np.ndarray
+    """(3,) map point (east, north, elevation; m) drawn at the scene origin."""
+    heading_rad: float
+    """Direction of the scene's x axis on the map (rad, counter-clockwise from east)."""
+    exaggeration: float
 
     @staticmethod
-    def of(route: course_kernel.Course) -> CourseDrawing:
-        east, north = route.east_m, route.north_m
-        extent = max(float(np.ptp(east)), float(np.ptp(north)), 1.0)
-        centre = np.array([0.5 * (east.min() + east.max()), 0.5 * (north.min() + north.max())])
-        return CourseDrawing(scale=COURSE_BOX_M / extent, offset=centre, base_m=float(route.elevation_m.min()))
+    def around(route: course_kernel.Course, leader_m: float, length_m: float, exaggeration: float) -> ChaseFrame:
+        """The frame around a group whose leader is at ``leader_m`` and whose last rider is ``length_m`` behind."""
+        half = 0.5 * max(length_m, 4.0)
+        tail, middle, head = route_points(route, np.array([leader_m - 2 * half, leader_m - half, leader_m]))
+        heading = math.atan2(head[1] - tail[1], head[0] - tail[0])
+        return ChaseFrame(origin=middle, heading_rad=heading, exaggeration=exaggeration)
 
-    def points(self, route: course_kernel.Course, index: np.ndarray, exaggeration: float) -> np.ndarray:
-        """(k, 3) scene positions of route points ``index``."""
-        xy = (np.stack([route.east_m[index], route.north_m[index]], axis=1) - self.offset) * self.scale
-        z = (route.elevation_m[index] - self.base_m) * self.scale * exaggeration + 0.05
-        return np.concatenate([xy + COURSE_CENTRE, z[:, None]], axis=1)
+    def local(self, points: np.ndarray) -> np.ndarray:
+        """(k, 3) scene points of (k, 3) map points."""
+        c, s = math.cos(self.heading_rad), math.sin(self.heading_rad)
+        d = points - self.origin
+        return np.stack([c * d[:, 0] + s * d[:, 1], -s * d[:, 0] + c * d[:, 1], self.exaggeration * d[:, 2]], axis=1)
 
-    def at_distance(
-        self, route: course_kernel.Course, distance_m: np.ndarray, exaggeration: float
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """(k, 3) scene positions and (k,) yaw angles (rad, from +x) at distances along the route."""
-        d = np.clip(distance_m, 0.0, route.total_distance_m)
-        east = np.interp(d, route.distance_m, route.east_m)
-        north = np.interp(d, route.distance_m, route.north_m)
-        z = np.interp(d, route.distance_m, route.elevation_m)
-        segment = np.clip(np.searchsorted(route.distance_m, d, side="right") - 1, 0, route.n_points - 2)
-        yaw = math.pi / 2 - route.heading_rad[segment]
-        xy = (np.stack([east, north], axis=1) - self.offset) * self.scale + COURSE_CENTRE
-        zz = (z - self.base_m) * self.scale * exaggeration + 0.05
-        return np.concatenate([xy, zz[:, None]], axis=1), yaw
+    def along(self, route: course_kernel.Course, distance_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(k, 3) scene points of the road's centre at distances along the route and (k, 3) unit tangents there."""
+        d = np.asarray(distance_m, dtype=np.float64)
+        centre = self.local(route_points(route, d))
+        tangent = self.local(route_points(route, d + 0.5)) - self.local(route_points(route, d - 0.5))
+        norm = np.linalg.norm(tangent, axis=1, keepdims=True)
+        return centre, tangent / np.where(norm > 1e-12, norm, 1.0)
 
 
-def terrain_strip(points: np.ndarray, half_width: float) -> tuple[np.ndarray, np.ndarray]:
-    """A road-side strip along the route and a curtain under it down to z = 0: (4k, 3) vertices and faces.
-
-    The strip is the terrain the road crosses; the curtain shows the height above the valley floor.
-    """
-    k = points.shape[0]
-    direction = np.gradient(points[:, :2], axis=0)
-    norm = np.linalg.norm(direction, axis=1, keepdims=True)
-    direction = direction / np.where(norm > 1e-12, norm, 1.0)
-    side = np.stack([-direction[:, 1], direction[:, 0]], axis=1) * half_width
-    top = points[:, 2:3] - 0.03
-    left = np.concatenate([points[:, :2] + side, top], axis=1)
-    right = np.concatenate([points[:, :2] - side, top], axis=1)
-    centre = np.concatenate([points[:, :2], top - 0.01], axis=1)
-    foot = centre * [1.0, 1.0, 0.0]
-    vertices = np.concatenate([left, right, centre, foot])
+def road_strip(
+    frame: ChaseFrame, route: course_kernel.Course, distance_m: np.ndarray, half_width: float, lift: float = 0.0
+) -> tuple[np.ndarray, np.ndarray]:
+    """A flat strip ``half_width`` (m) either side of the road's centre at the (k,) distances ``distance_m``,
+    ``lift`` (m) above it: (2k, 3) scene vertices (left edge, then right edge) and (2(k−1), 3) faces."""
+    centre, tangent = frame.along(route, distance_m)
+    left = np.stack([-tangent[:, 1], tangent[:, 0], np.zeros(len(centre))], axis=1)
+    left /= np.maximum(np.linalg.norm(left, axis=1, keepdims=True), 1e-12)
+    lifted = centre + [0.0, 0.0, lift]
+    vertices = np.concatenate([lifted + half_width * left, lifted - half_width * left])
+    k = centre.shape[0]
     a = np.arange(k - 1)
-    b = a + 1
-    L, R, C, F = 0, k, 2 * k, 3 * k  # block offsets: left edge, right edge, centre, its foot
-    faces = np.concatenate(
-        [
-            np.stack([L + a, R + a, R + b], axis=1),
-            np.stack([L + a, R + b, L + b], axis=1),  # strip
-            np.stack([F + a, C + a, C + b], axis=1),
-            np.stack([F + a, C + b, F + b], axis=1),  # curtain
-        ]
-    )
+    faces = np.concatenate([np.stack([a, k + a, k + a + 1], axis=1), np.stack([a, k + a + 1, a + 1], axis=1)])
     return vertices.astype(np.float32), faces.astype(np.uint32)
 
 
-def ground_under(points: np.ndarray, margin: float = 0.6) -> tuple[np.ndarray, np.ndarray]:
-    """A thin slab under the route's bounding rectangle plus ``margin`` (scene m): vertices and faces."""
-    lo, hi = points[:, :2].min(axis=0) - margin, points[:, :2].max(axis=0) + margin
-    slab = trimesh.creation.box(extents=(*(hi - lo), 0.02))
-    slab.apply_translation((*((lo + hi) / 2), -0.011))
-    return slab.vertices.astype(np.float32), slab.faces.astype(np.uint32)
+def riders_on_road(
+    frame: ChaseFrame, route: course_kernel.Course, leader_m: float, formation_xy: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Where each rider of a formation rides on the road: (n, 3) scene positions and (n, 4) wxyz orientations.
+
+    ``formation_xy`` is (n, 2): metres ahead of the leader (≤ 0 behind) and to its left, as
+    :func:`kernels.cycling.formation` lays them out on a straight road; on the route each rider keeps its distance
+    behind the leader along the road and its offset across it, turned to the road's heading and pitched to its
+    drawn grade."""
+    xy = np.asarray(formation_xy, dtype=np.float64).reshape(-1, 2)
+    centre, tangent = frame.along(route, leader_m + xy[:, 0])
+    yaw = np.arctan2(tangent[:, 1], tangent[:, 0])
+    pitch = np.arctan2(tangent[:, 2], np.hypot(tangent[:, 0], tangent[:, 1]))
+    left = np.stack([-np.sin(yaw), np.cos(yaw), np.zeros(len(yaw))], axis=1)
+    positions = centre + xy[:, 1:2] * left
+    # Yaw about z, then the nose up by the grade (a turn about the rider's left axis, −pitch by the right hand).
+    cy, sy = np.cos(yaw / 2), np.sin(yaw / 2)
+    cp, sp = np.cos(-pitch / 2), np.sin(-pitch / 2)
+    wxyz = np.stack([cy * cp, -sy * sp, cy * sp, sy * cp], axis=1)
+    return positions, wxyz
 
 
-def grade_colours(grade: np.ndarray) -> np.ndarray:
-    """(k, 3) uint8: descents blue, flat white-green, climbs yellow to red at 12 %."""
-    g = np.clip(grade / 0.12, -1.0, 1.0)
-    up = np.clip(g, 0.0, 1.0)[:, None]
-    down = np.clip(-g, 0.0, 1.0)[:, None]
-    flat = np.array([90.0, 200.0, 90.0])
-    colour = flat + up * (np.array([230.0, 40.0, 30.0]) - flat) + down * (np.array([40.0, 110.0, 230.0]) - flat)
-    return colour.astype(np.uint8)
+def dash_distances(d_from: float, d_to: float, every_m: float = 3.0, count: int | None = None) -> np.ndarray:
+    """(m, 2) start and end (m along the route) of the centre line's dashes between ``d_from`` and ``d_to``: 1.5 m
+    dashes every ``every_m``, fixed to the road so they pass as the riders move; padded to ``count`` rows with empty
+    dashes (the drawn node keeps its size)."""
+    first = math.ceil(d_from / every_m) * every_m
+    starts = np.arange(first, d_to - 0.5 * every_m, every_m)
+    dashes = np.stack([starts, starts + 0.5 * every_m], axis=1)
+    if count is not None:
+        empty = np.full((max(count - len(dashes), 0), 2), d_from)  # zero-length: drawn as nothing
+        dashes = np.concatenate([dashes[:count], empty])
+    return dashes
+
+
+@dataclasses.dataclass(frozen=True)
+class RoadLayout:
+    """The road near the group and the group on it, in the scene frame of :class:`ChaseFrame` (m)."""
+
+    frame: ChaseFrame
+    window_m: tuple[float, float]
+    """(from, to): the stretch of the route drawn (m along it; before 0 and past the finish the road runs on)."""
+    half_width_m: float
+    road: tuple[np.ndarray, np.ndarray]
+    """Vertices and faces of the road."""
+    verge: tuple[np.ndarray, np.ndarray]
+    """Vertices and faces of the grass either side, a little below the road."""
+    edges: np.ndarray
+    """(2(k−1), 2, 3) segments of the road's two white edge lines."""
+    dashes: np.ndarray
+    """(m, 2, 3) segments of the centre line's dashes."""
+    riders: tuple[np.ndarray, np.ndarray]
+    """(n, 3) positions and (n, 4) wxyz of the riders, leader first."""
+    marks: dict[str, np.ndarray | None]
+    """"Start" and "Finish": (2, 3) ends of the line across the road there, or None when it is not in the window."""
+
+
+def lay_out_road(
+    route: course_kernel.Course, leader_m: float, formation_xy: np.ndarray, exaggeration: float
+) -> RoadLayout:
+    """Lay the group out on the road at ``leader_m`` along the route, and the road around it (see
+    :class:`RoadLayout`). ``formation_xy`` is (n, 2) as :func:`riders_on_road` takes it."""
+    xy = np.asarray(formation_xy, dtype=np.float64).reshape(-1, 2)
+    length = float(-xy[:, 0].min()) if len(xy) else 0.0
+    frame = ChaseFrame.around(route, leader_m, length, exaggeration)
+    half_width = max(ROAD_HALF_WIDTH_M, float(np.abs(xy[:, 1]).max(initial=0.0)) + 0.9)
+    d_from, d_to = leader_m - length - ROAD_BEHIND_M, leader_m + ROAD_AHEAD_M
+    k = round((d_to - d_from) / ROAD_STEP_M) + 1
+    distance = np.linspace(d_from, d_to, k)
+    road = road_strip(frame, route, distance, half_width, 0.0)
+    verge = road_strip(frame, route, distance, VERGE_HALF_WIDTH_M, -0.03)
+    inset = road_strip(frame, route, distance, half_width - 0.15, 0.004)[0]
+    edges = np.concatenate([np.stack([side[:-1], side[1:]], axis=1) for side in (inset[:k], inset[k:])])
+    dash_m = dash_distances(d_from, d_to, count=int((d_to - d_from) / 3.0) + 1)
+    dashes = frame.along(route, dash_m.ravel())[0].reshape(-1, 2, 3) + [0.0, 0.0, 0.004]
+    marks: dict[str, np.ndarray | None] = {}
+    for name, at in (("Start", 0.0), ("Finish", float(route.total_distance_m))):
+        if d_from <= at <= d_to:
+            across, _ = road_strip(frame, route, np.array([at, at + 0.01]), half_width, 0.006)
+            marks[name] = np.stack([across[0], across[2]])
+        else:
+            marks[name] = None
+    return RoadLayout(
+        frame=frame,
+        window_m=(d_from, d_to),
+        half_width_m=half_width,
+        road=road,
+        verge=verge,
+        edges=edges.astype(np.float32),
+        dashes=dashes.astype(np.float32),
+        riders=riders_on_road(frame, route, leader_m, xy),
+        marks=marks,
+    )

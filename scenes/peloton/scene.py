@@ -437,7 +437,11 @@ time-averaged power is the mean over positions, far below the leader's.
         return f"{watts:.0f} W · {share}"
 
     def _view_for(self, lens: Lens) -> View:
-        """The view of the line for ``lens``, with room above it for the labels, which it lays out for that lens."""
+        """The view of the line for ``lens``, with room above it for the labels, which it lays out for that lens (or,
+        in course mode, the course's view of its group: :meth:`CourseMode.view_for`)."""
+        course_mode = getattr(self, "course_mode", None)  # built last
+        if course_mode is not None and course_mode.enabled:
+            return course_mode.view_for(lens)
         with self._lock:
             anchors = self.label_anchors()
             up_world = course_to_world(np.array([[0.0, 0.0, 1.0]]), self.params.grade_pct)[0]

@@ -234,7 +234,7 @@ def test_upload_a_gpx_and_play_it(server: viser.ViserServer, browser_page: Any, 
         assert changed.mean() > 0.0005, f"only {changed.mean():.5f} of the pixels changed"
 
         # The profile chart shows the elevation line (brown) and the power line (red) in its canvas.
-        chart = page.locator(".uplot", has_text="Elevation, speed and power along the course").first
+        chart = page.locator(".uplot", has_text="Elevation, speed and power").first
         chart.scroll_into_view_if_needed(timeout=10_000)
         shot = np.asarray(Image.open(io.BytesIO(chart.screenshot())).convert("RGB")).astype(int)
 

@@ -27,6 +27,7 @@ from scenes.peloton import (
     format_duration,
     group_cda,
 )
+from scenes.peloton.course_model import lay_out_road, route_points
 
 scene = scene_fixture(PelotonScene)
 
@@ -92,7 +93,7 @@ def test_model_and_air_choices_change_the_ride_and_the_readout_shows_both_densit
     martin = mode.state.ride.time_s
     mode.controls["model"].value = "Textbook (aero, rolling, climbing)"
     assert mode.params.model == "seed" and mode.state.ride.time_s < martin  # no bearings, no spokes
-    mode.controls["air"].value = "Weather (temperature, pressure or altitude, humidity)"
+    mode.controls["air"].value = "Weather reading"
     mode.controls["temperature_c"].value = 30.0
     mode.controls["humidity_pct"].value = 80.0
     start = float(mode.route.elevation_m[0])
@@ -102,7 +103,7 @@ def test_model_and_air_choices_change_the_ride_and_the_readout_shows_both_densit
     assert f"exponential atmosphere **{float(cycling.air_density(start)):.3f}**" in mode.readout.content
     np.testing.assert_allclose(mode.state.ride.air_density[0], expected, rtol=1e-3)
     # A barometer reading replaces the standard atmosphere's pressure.
-    mode.controls["pressure_from_barometer"].value = "Barometer at the start (hPa)"
+    mode.controls["pressure_from_barometer"].value = "Barometer"
     mode.controls["pressure_hpa"].value = 1000.0
     assert mode.state.density_weather == pytest.approx(float(cycling.air_density_weather(30.0, 1000.0, 0.8)), rel=1e-12)
 
@@ -124,11 +125,12 @@ def test_pacing_reports_the_time_saved(mode: CourseMode) -> None:
 
 
 def test_exaggeration_stretches_the_drawn_heights(mode: CourseMode) -> None:
-    before = np.asarray(mode.route_line.points)[:, :, 2].copy()
-    mode.controls["exaggeration"].value = 6.0
-    after = np.asarray(mode.route_line.points)[:, :, 2]
-    base = 0.05 + 0.02
-    np.testing.assert_allclose(after - base, 3.0 * (before - base), rtol=1e-4, atol=1e-5)
+    mode.scrub.value = 5.0  # on the climb
+    before = np.asarray(mode.road.vertices)[:, 2].copy()
+    assert np.ptp(before) > 2.0  # the road climbs under the group: ~8 % over ~50 m drawn
+    mode.controls["exaggeration"].value = 3.0
+    after = np.asarray(mode.road.vertices)[:, 2]
+    np.testing.assert_allclose(after, 3.0 * before, rtol=1e-4, atol=1e-4)  # heights from the group's middle
 
 
 def test_play_pause_and_scrub_move_the_riders(mode: CourseMode) -> None:
@@ -151,9 +153,13 @@ def test_play_pause_and_scrub_move_the_riders(mode: CourseMode) -> None:
     assert mode.leader_distance_m() == pytest.approx(10_000.0, abs=1.0)
     assert mode.state is not None
     assert "Leader at **10.00 km**" in mode.now.content
-    # The riders follow the route: the leader is drawn where the route is at 10 km.
-    where, _ = mode._drawing.at_distance(mode.route, np.array([10_000.0]), mode.params.exaggeration)
+    # The riders follow the route: the leader is drawn where the route is at 10 km, in the frame riding with them.
+    frame = mode.layout().frame
+    where = frame.local(route_points(mode.route, np.array([10_000.0])))
     np.testing.assert_allclose(np.asarray(body.batched_positions)[0], where[0], atol=1e-4)
+    # The next rider, as far behind the leader along the road as the line lays it out.
+    behind = frame.local(route_points(mode.route, np.array([10_000.0 + scene.state.positions[1, 0]])))
+    np.testing.assert_allclose(np.asarray(body.batched_positions)[1], behind[0], atol=1e-4)
 
 
 def test_every_bad_file_keeps_the_last_good_course(mode: CourseMode) -> None:
@@ -223,12 +229,12 @@ CRAFTED = [
     ("Course power (W)", 1e9, "power_w", 2000.0),
     ("Course power (W)", -5.0, "power_w", 20.0),
     ("Humidity (%)", float("inf"), "humidity_pct", 50.0),
-    ("Temperature (°C)", 1e6, "temperature_c", 45.0),
+    ("Temp (°C)", 1e6, "temperature_c", 45.0),
     ("Air", "vacuum", "air", "seed"),
     ("Power model", "<b>x</b>", "model", "martin"),
     ("Pressure from", "guess", "pressure_from_barometer", False),
     ("Safe descending speed (km/h)", 0.0, "max_speed_kmh", 20.0),
-    ("Elevation exaggeration (×)", float("nan"), "exaggeration", 2.0),
+    ("Steepness drawn (×)", float("nan"), "exaggeration", 1.0),
 ]
 
 
@@ -397,6 +403,56 @@ def test_bad_files_are_refused_in_a_riders_words(mode: CourseMode, kind: str) ->
         assert word not in mode.route_info.content
 
 
+def test_the_riders_keep_their_place_when_the_ride_changes(mode: CourseMode) -> None:
+    """The Position slider and the leader's readout say the same place after a change that makes the ride faster or
+    slower, and after the mode is hidden, the formation changed and the mode shown again (a reviewer saw 5.57 km
+    beside a slider at 5.5: the riders had kept the time of the old ride, not their place)."""
+    scene = mode.scene
+    mode.scrub.value = 5.5
+    assert mode.leader_distance_m() == pytest.approx(5500.0, abs=1e-6)
+    mode.controls["power_w"].value = 400.0  # a faster ride: the same time is further up the road
+    assert mode.leader_distance_m() == pytest.approx(5500.0, abs=1e-6)
+    assert "Leader at **5.50 km**" in mode.now.content and mode.scrub.value == 5.5
+    mode.enable.value = False
+    scene.controls["formation"].value = "Bunch (peloton)"
+    scene.controls["n_riders"].value = 30
+    mode.enable.value = True
+    assert mode.leader_distance_m() == pytest.approx(5500.0, abs=1e-6)
+    assert "Leader at **5.50 km**" in mode.now.content and mode.scrub.value == 5.5
+    # Pause snaps the riders to the slider's step, so the two agree to the last digit shown.
+    mode.controls["playback"].value = 600.0
+    mode._on_play()
+    time.sleep(0.4)
+    mode._on_pause()
+    assert mode.leader_distance_m() == pytest.approx(1000.0 * float(mode.scrub.value), abs=1e-6)
+    assert f"Leader at **{float(mode.scrub.value):.2f} km**" in mode.now.content
+
+
+def test_the_road_and_riders_lie_where_the_route_runs() -> None:
+    """The drawn frame: the leader at the route's point, the road's centre under it, each rider on the road's
+    surface, nose along the road and pitched by the drawn grade (a turn of +x by the rider's wxyz)."""
+    route = course_kernel.load_gpx(course_kernel.SAMPLE_ROUTE)
+    xy = cycling.formation(30, "bunch", gap_m=0.5, lateral_m=0.6)
+    layout = lay_out_road(route, 6000.0, xy, 2.0)
+    positions, wxyz = layout.riders
+    centre, tangent = layout.frame.along(route, 6000.0 + xy[:, 0])
+    # Across the road by each rider's lateral offset, level with its centre line.
+    offset = positions - centre
+    np.testing.assert_allclose(np.abs(offset[:, 2]), 0.0, atol=1e-9)
+    np.testing.assert_allclose(np.linalg.norm(offset[:, :2], axis=1), np.abs(xy[:, 1]), atol=1e-9)
+    # Each rider's nose (+x turned by its quaternion) points along the road, its grade included.
+    w, x, y, z = wxyz.T
+    nose = np.stack([1 - 2 * (y * y + z * z), 2 * (x * y + w * z), 2 * (x * z - w * y)], axis=1)
+    np.testing.assert_allclose(nose, tangent, atol=1e-9)
+    assert np.all(tangent[:, 2] > 0.05)  # 8 % up, drawn 2x: 16 %
+    # The road runs under the whole group and 30 m ahead of the leader; the window says so.
+    d_from, d_to = layout.window_m
+    assert d_from <= 6000.0 + xy[:, 0].min() - 10.0 and d_to == pytest.approx(6030.0)
+    assert layout.marks == {"Start": None, "Finish": None}
+    at_start = lay_out_road(route, 0.0, xy, 1.0)
+    assert at_start.marks["Start"] is not None and at_start.marks["Finish"] is None
+
+
 def test_a_bunch_rides_the_course_at_its_formations_mean_drag(mode: CourseMode) -> None:
     scene = mode.scene
     assert mode.state is not None
@@ -414,6 +470,16 @@ def test_a_bunch_rides_the_course_at_its_formations_mean_drag(mode: CourseMode) 
     assert mode.state.ride.time_s == pytest.approx(direct.time_s, rel=1e-12)
     assert mode.state.ride.time_s < line_of_four  # sharing a bunch's shelter is faster than a line of four
     assert "121 riders in a bunch" in mode.readout.content
-    # The course draws the head of the group (its scale has no room for 121): eight riders, none beyond.
+    # The course draws the whole group as it rides: 121 rider instances at life size, each where its formation
+    # puts it (on this straight start, metres behind the leader along the road and across it), on the road.
     scales = np.asarray(mode.course_riders["body"].batched_scales)
-    assert scales.shape[0] == 8
+    assert np.all(scales[:121] == 1.0) and np.all(scales[121:] == 0.0)
+    drawn = np.asarray(mode.course_riders["body"].batched_positions)[:121].astype(np.float64)
+    relative = drawn - drawn[0]
+    heading = np.arctan2(relative[-1, 1], relative[-1, 0]) - np.arctan2(positions[-1, 1], positions[-1, 0])
+    c, s = np.cos(heading), np.sin(heading)
+    turned = np.stack([c * positions[:, 0] - s * positions[:, 1], s * positions[:, 0] + c * positions[:, 1]], 1)
+    np.testing.assert_allclose(relative[:, :2], turned, atol=0.05)  # the formation, turned to the road
+    layout = mode.layout()
+    assert layout.half_width_m >= 2.1 + 0.5  # the road holds the bunch's width
+    assert len({tuple(np.round(p, 3)) for p in drawn}) == 121
