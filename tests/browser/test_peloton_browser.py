@@ -16,19 +16,26 @@ from helpers.browser import (
     assert_in_view,
     assert_seen,
     chart_image,
+    colour_pixels,
+    control_row,
     error_text,
     line_mask,
     panel_rect,
+    project,
     save_scene_screenshot,
     scene_page_fixture,
     screenshot,
     set_number,
     settle,
+    visible_text,
     with_labels_hidden,
 )
 from helpers.waiting import wait_until
 
 from scenes.peloton import COMPONENT_COLOURS, LABEL_PX, PelotonScene
+from scenes.peloton.meshes import rider_head_m
+from scenes.peloton.model import FORMATION_FROM_LABEL
+from scenes.peloton.scene import POWER_COLOURS
 
 pytestmark = pytest.mark.browser
 
@@ -82,6 +89,15 @@ def _look_at_the_line(shown: ScenePage) -> None:
     for x, y in corners:
         box = image[max(int(y) - 40, 0) : int(y) + 10, int(x) - 10 : int(x + reach_x)]
         assert np.count_nonzero(box.max(axis=-1) < 120) > 10, f"no label text near ({x:.0f}, {y:.0f})"
+    # No label's text (about 5.75 px a character, measured) sits on another rider's leader line.
+    with scene._lock:
+        lines = np.asarray(scene.label_leaders.points)[:n]
+        texts = [scene.labels[i].text for i in range(n)]
+    feet = project(shown.page, "/peloton/course", lines[:, 0])[:, :2]
+    for i, (x, y) in enumerate(corners):
+        for j in range(n):
+            if j != i and x < corners[j, 0] < x + 5.75 * len(texts[i]):
+                assert feet[j, 1] <= y - reach_y or corners[j, 1] >= y, f"label {i} crosses rider {j}'s line"
 
 
 def test_the_line_is_in_view_clear_of_the_panel(shown: ScenePage) -> None:
@@ -149,3 +165,102 @@ def test_the_chart_tick_labels_stay_inside_its_canvas(shown: ScenePage) -> None:
         lambda scene: scene.chart.data,
         over_ten_kilowatts,
     )
+
+
+def choose(page: Any, label: str, option: str) -> None:
+    """Pick ``option`` in the dropdown labelled ``label``, as a person would: open it, click the option."""
+    control_row(page, label).locator("input").first.click()
+    page.get_by_role("option", name=option).click()
+
+
+def show_group(shown: ScenePage, formation: str, riders: int, gap_m: float = 0.5) -> None:
+    """Set Formation, Riders and Gap through the page and wait until the scene has them and the page has settled
+    (an earlier test of the module may have left the riders 6 m apart)."""
+    scene = shown.scene
+    choose(shown.page, "Formation", formation)
+    set_number(shown.page, "Riders", riders)
+    set_number(shown.page, "Gap (m)", gap_m)
+    wait_until(
+        lambda: (
+            (scene.params.n_riders, scene.params.formation, scene.params.gap_m)
+            == (riders, FORMATION_FROM_LABEL[formation], gap_m)
+        ),
+        f"{riders} riders, {formation}, {gap_m} m apart",
+    )
+    settle(shown)
+
+
+def rider_heights_px(shown: ScenePage) -> np.ndarray:
+    """(n,) on-screen height (CSS px) of each rider of the group, road to the top of its head, through the page's
+    own camera."""
+    scene = shown.scene
+    with scene._lock:
+        xy = np.asarray(scene.riders_nodes["body"].batched_positions)[: scene.params.n_riders, :2]
+        top = rider_head_m(scene.params.position)[1]
+    feet = project(shown.page, "/peloton/course", np.column_stack([xy, np.zeros(len(xy))]))
+    heads = project(shown.page, "/peloton/course", np.column_stack([xy, np.full(len(xy), top)]))
+    return np.linalg.norm(heads[:, :2] - feet[:, :2], axis=1)
+
+
+def test_a_bunch_of_121_shows_each_riders_power_in_colour_and_in_numbers(shown: ScenePage) -> None:
+    scene, page = shown.scene, shown.page
+    try:
+        show_group(shown, "Bunch (peloton)", 121)
+        image = screenshot(page)
+        with scene._lock:
+            points = scene.line_points()
+            total = np.asarray(scene.state.power.total)
+            marked = [(label.text, np.asarray(label.position)) for label in scene.labels if label.visible]
+        # The whole bunch in view and clear of the panel, every rider tall enough to make out.
+        xy = assert_in_view(shown, "/peloton", points, "the bunch of 121")
+        heights = rider_heights_px(shown)
+        assert np.percentile(heights, 10) >= (28 if shown.viewport == (1280, 720) else 40), np.percentile(heights, 10)
+        covered = assert_seen(shown, with_labels_hidden(page), RIDERS, xy, "121 riders", without_labels=True)
+        # Coloured by power: the riders' pixels show several of the legend's colours, the leader's red and the
+        # sheltered riders' blue among them (a jersey's shade changes its brightness, not its hue).
+        riders = image[covered].astype(np.float64)
+        chroma = riders / np.maximum(riders.max(axis=1, keepdims=True), 1.0)
+        saturated = riders.max(axis=1) - riders.min(axis=1) > 60
+        stops = POWER_COLOURS / POWER_COLOURS.max(axis=1, keepdims=True)
+        nearest = np.argmin(np.linalg.norm(chroma[:, None, :] - stops[None], axis=2), axis=1)
+        counts = np.bincount(nearest[saturated], minlength=len(POWER_COLOURS))
+        assert np.count_nonzero(counts >= 30) >= 3, counts
+        assert counts[0] >= 30 and counts[-1] >= 30, counts
+        # The legend at the top of the panel, seen without scrolling: its swatches in those colours, the watts
+        # under them from the least to the most any rider needs.
+        legend = page.get_by_text("Rider colour = power (W)", exact=True)
+        box = legend.bounding_box()
+        assert box is not None and box["y"] >= 0 and box["y"] + box["height"] <= shown.viewport[1] - 80, box
+        panel = screenshot(page)
+        for rgb in POWER_COLOURS:
+            assert colour_pixels(panel, rgb, tolerance=6.0) > 300, rgb  # a swatch, not just a few riders' pixels
+        text = visible_text(page)
+        assert f"blue {round(float(total.min()))}" in text and f"red {round(float(total.max()))}" in text
+        # Numbers in the picture: a few riders labelled with their watts and drag, the leader's among them, each
+        # label in view clear of the panel with dark text where it is drawn.
+        assert 2 <= len(marked) <= 4 and marked[0][0].startswith(f"{round(float(total[0]))} W · drag ")
+        anchors = assert_in_view(shown, "/peloton/course", np.array([p for _, p in marked]), "the labels")
+        left, _, _, _ = panel_rect(page)
+        assert anchors[:, 0].max() + LABEL_PX[0] <= left and anchors[:, 1].min() - LABEL_PX[1] >= 0, anchors
+        for x, y in anchors:
+            box_px = image[max(int(y) - 40, 0) : int(y) + 10, int(x) - 10 : int(x + LABEL_PX[0])]
+            assert np.count_nonzero(box_px.max(axis=-1) < 120) > 10, f"no label text near ({x:.0f}, {y:.0f})"
+        assert error_text(page) == []
+        save_scene_screenshot(shown, "peloton_bunch")
+    finally:
+        scene.controls["formation"].value, scene.controls["n_riders"].value = "Single file", 4
+
+
+def test_an_echelon_of_20_is_drawn_large_enough_to_see(shown: ScenePage) -> None:
+    # The failing look (a review): 20 riders in echelon were tiny at 1280×720 (about 26 px long).
+    scene = shown.scene
+    try:
+        show_group(shown, "Echelon", 20)
+        with scene._lock:
+            points = scene.line_points()
+        assert_in_view(shown, "/peloton", points, "the echelon of 20")
+        heights = rider_heights_px(shown)
+        assert np.percentile(heights, 10) >= (40 if shown.viewport == (1280, 720) else 55), heights
+        assert error_text(shown.page) == []
+    finally:
+        scene.controls["formation"].value, scene.controls["n_riders"].value = "Single file", 4
