@@ -93,9 +93,13 @@ def ccd(joints: Array, target: Array, iterations: int) -> list[Array]:
                 turn = np.array([[c, -s], [s, c]])
             else:
                 axis = np.cross(to_end, to_target)
-                cos_a = to_end @ to_target / (np.linalg.norm(to_end) * np.linalg.norm(to_target))
-                angle = math.acos(min(1.0, max(-1.0, float(cos_a))))
-                turn = Rotation.from_rotvec(axis / np.linalg.norm(axis) * angle).as_matrix()
+                # atan2(|a × b|, a · b): exact to rounding at every angle (acos of the cosine loses half the digits
+                # near 0, 2e-8 rad, which is what a converging sweep turns by).
+                sine = float(np.linalg.norm(axis))
+                if sine == 0.0:  # the end effector already on the ray to the target: nothing to turn
+                    continue
+                angle = math.atan2(sine, float(to_end @ to_target))
+                turn = Rotation.from_rotvec(axis / sine * angle).as_matrix()
             p[i + 1 :] = p[i] + (p[i + 1 :] - p[i]) @ turn.T
         poses.append(p.copy())
     return poses
