@@ -84,9 +84,7 @@ class CourseParams:
         metadata=dropdown_from_labels("Air", AIR_FROM_LABEL, folder=POWER_FOLDER),
     )
     """Air along the route: the textbook exponential atmosphere or a weather reading."""
-    temperature_c: float = field(
-        default=15.0, metadata=slider("Temp (°C)", -20.0, 45.0, 0.5, folder=POWER_FOLDER)
-    )
+    temperature_c: float = field(default=15.0, metadata=slider("Temp (°C)", -20.0, 45.0, 0.5, folder=POWER_FOLDER))
     """Air temperature at the start (°C), weather air."""
     pressure_from_barometer: bool = field(
         default=False,
