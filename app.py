@@ -15,6 +15,8 @@ import contextlib
 import io
 import ipaddress
 import logging
+import select
+import signal
 import socket
 import sys
 from typing import Annotated
@@ -164,11 +166,34 @@ def main(
             f"Open http://{shown_host}:{server.get_port()} in a browser (Ctrl+C to stop).",
             flush=True,
         )
-        server.sleep_forever()
+        sleep_until_a_signal()
     except KeyboardInterrupt:
         if server is not None:
             _stop_quietly(server)
         print("Stopped.", flush=True)
+
+
+def sleep_until_a_signal() -> None:
+    """Sleep until Ctrl+C, whichever thread the system hands the signal to.
+
+    ``ViserServer.sleep_forever`` sleeps an hour at a time: when the system delivers SIGINT to one of the server's
+    threads rather than the main one, the main thread sleeps on and the app does not stop. Here the main thread waits
+    on Python's signal wake-up socket, which the interpreter writes to on any signal from any thread; the pending
+    ``KeyboardInterrupt`` is then raised here.
+    """
+    reader, writer = socket.socketpair()
+    reader.setblocking(False)
+    writer.setblocking(False)
+    previous = signal.set_wakeup_fd(writer.fileno())
+    try:
+        while True:
+            select.select([reader], [], [])
+            with contextlib.suppress(BlockingIOError):
+                reader.recv(64)
+    finally:
+        signal.set_wakeup_fd(previous)
+        reader.close()
+        writer.close()
 
 
 def _stop_quietly(server: viser.ViserServer) -> None:
