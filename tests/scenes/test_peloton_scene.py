@@ -17,7 +17,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from kernels import cycling
-from scenes._framing import PANEL_PX, Lens
+from scenes._framing import PANEL_PX, Lens, View
 from scenes.peloton import (
     BAR_METRES_PER_WATT,
     LABEL_PX,
@@ -539,15 +539,21 @@ def test_each_label_has_a_line_down_to_its_bar(scene: PelotonScene) -> None:
         assert np.min(np.linalg.norm(heads - label[:2], axis=1)) < 1e-4  # a rider's head right under it
 
 
+def _framed(scene: PelotonScene, viewport: tuple[int, int], **values: object) -> tuple[Lens, View]:
+    """Set the named controls, then the 75° lens at ``viewport`` and the scene's camera view framed for it."""
+    for name, value in values.items():
+        scene.controls[name].value = value
+    lens = Lens(math.radians(75.0), *viewport)
+    return lens, scene._view_for(lens)
+
+
 @pytest.mark.parametrize("viewport", VIEWPORTS)
 @pytest.mark.parametrize(("n", "gap"), [(4, 0.5), (8, 0.5), (8, 6.0), (8, 15.0)])
 def test_bars_stand_nearly_upright_in_the_framed_view(
     scene: PelotonScene, viewport: tuple[int, int], n: int, gap: float
 ) -> None:
     # The failing look (a review): bars leaned strongly in the wide-angle view, up to 15-17° at the window's edge.
-    scene.controls["n_riders"].value, scene.controls["gap_m"].value = n, gap
-    lens = Lens(math.radians(75.0), *viewport)
-    view = scene._view_for(lens)
+    lens, view = _framed(scene, viewport, n_riders=n, gap_m=gap)
     base = np.asarray(scene.bars["aero"].batched_positions)[:n].astype(np.float64)
     bottom = _screen_px(base, np.array(view.position), np.array(view.look_at), lens)
     top = _screen_px(base + [0.0, 0.0, 1.0], np.array(view.position), np.array(view.look_at), lens)
@@ -575,9 +581,7 @@ def test_no_label_text_crosses_another_riders_leader_line(
     scene: PelotonScene, viewport: tuple[int, int], n: int, gap: float
 ) -> None:
     # The failing look (a review): with eight riders in single file, a label's "solo" sat on the next rider's line.
-    scene.controls["n_riders"].value, scene.controls["gap_m"].value = n, gap
-    lens = Lens(math.radians(75.0), *viewport)
-    view = scene._view_for(lens)
+    lens, view = _framed(scene, viewport, n_riders=n, gap_m=gap)
     lines = np.asarray(scene.label_leaders.points)[:n]
     theta = math.atan(scene.params.grade_pct / 100.0)
     c, s = math.cos(theta), math.sin(theta)
@@ -607,9 +611,7 @@ def test_a_group_is_framed_with_riders_a_person_can_see(
     scene: PelotonScene, viewport: tuple[int, int], shape: str, n: int
 ) -> None:
     # The failing look (a review): an echelon of 20 at 1280×720 drew riders about 27 px tall.
-    scene.controls["formation"].value, scene.controls["n_riders"].value = shape, n
-    lens = Lens(math.radians(75.0), *viewport)
-    view = scene._view_for(lens)
+    lens, view = _framed(scene, viewport, formation=shape, n_riders=n)
     xy = np.asarray(scene.riders_nodes["body"].batched_positions)[:n, :2]
     top = rider_head_m(scene.params.position)[1]
 
