@@ -19,7 +19,8 @@ from helpers.waiting import wait_until
 from helpers.wsclient import BrowserClient
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from trimesh.visual.color import ColorVisuals
+from trimesh.visual.material import PBRMaterial
+from trimesh.visual.texture import TextureVisuals
 
 from kernels import sdf
 from scenes.sdf_gallery import RESOLUTION_LABEL, SdfGalleryParams, SdfGalleryScene
@@ -33,10 +34,13 @@ scene = scene_fixture(SdfGalleryScene)
 
 
 def shown_mesh(scene: SdfGalleryScene) -> trimesh.Trimesh:
-    """The mesh the browser receives: the GLB bytes of the mesh node, loaded back."""
-    loaded = trimesh.load(io.BytesIO(scene.mesh_node.glb_data), file_type="glb", force="mesh", process=False)
-    assert isinstance(loaded, trimesh.Trimesh)
-    return loaded
+    """The mesh the browser receives: the GLB bytes of the mesh node, loaded back (its one geometry, with its
+    material and vertex colours)."""
+    loaded = trimesh.load(io.BytesIO(scene.mesh_node.glb_data), file_type="glb", process=False)
+    assert isinstance(loaded, trimesh.Scene) and len(loaded.geometry) == 1
+    (mesh,) = loaded.geometry.values()
+    assert isinstance(mesh, trimesh.Trimesh)
+    return mesh
 
 
 # ------------------------------------------------------------------------------------------ server side
@@ -50,12 +54,17 @@ def test_opening_mesh_is_the_kernels(scene: SdfGalleryScene) -> None:
     assert len(glb.faces) == len(faces)
     # The viewer's GLB is in the world frame, so its box matches the mesh's (GLB stores float32).
     np.testing.assert_allclose(glb.bounds, [vertices.min(axis=0), vertices.max(axis=0)], atol=1e-5)
-    # Smooth normals point outward (the field's gradient); colours are the kernel's, made linear for three.js.
+    # Smooth normals point outward (the field's gradient); colours are the kernel's, made linear for three.js (the
+    # sRGB curve, IEC 61966-2-1).
     reference_normals = trimesh.Trimesh(vertices, faces, process=False).vertex_normals
     assert np.median(np.einsum("ij,ij->i", glb.vertex_normals, reference_normals)) > 0.99
     visual = glb.visual
-    assert isinstance(visual, ColorVisuals)
-    np.testing.assert_allclose(visual.vertex_colors[:, :3], 255 * colors**2.2, atol=0.51)
+    assert isinstance(visual, TextureVisuals)
+    linear = np.where(colors <= 0.04045, colors / 12.92, ((colors + 0.055) / 1.055) ** 2.4)
+    np.testing.assert_allclose(visual.vertex_attributes["color"][:, :3], 255 * linear, atol=0.51)
+    # Matte: glTF's default material is fully metallic, which shades black without an environment map to reflect.
+    assert isinstance(visual.material, PBRMaterial)
+    assert visual.material.metallicFactor == 0.0
     assert scene.agreement.triangles == len(faces)
     assert f"{len(faces):,}" in scene.readout.content
 
@@ -836,8 +845,6 @@ def test_rotation_rings_show_only_when_asked(server: viser.ViserServer, scene: S
     """Four gizmos' twelve rotation rings covered the shape: the gizmos open with their arrows only, and the rings
     come with "Rotation rings on the gizmos" (what the browser is told, not just the handle)."""
     with BrowserClient(server.get_port()) as client:
-        client.wait_for_node("/sdf/gizmo_1")
-
         def rings_off() -> list[bool]:
             with client._lock:
                 return [
@@ -846,6 +853,8 @@ def test_rotation_rings_show_only_when_asked(server: viser.ViserServer, scene: S
                     if f"/sdf/gizmo_{k}" in client.nodes
                 ]
 
+        # The four gizmos may arrive in more than one websocket frame: wait for the fourth before judging them.
+        client.wait_for(lambda: len(rings_off()) == 4, what="the four gizmos")
         assert rings_off() == [True] * 4
         client.wait_for_gui("Rotation rings on the gizmos")
         client.set_value("Rotation rings on the gizmos", True)
