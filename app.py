@@ -26,6 +26,7 @@ import viser
 
 from kernels import warming
 from scenes import SceneName
+from scenes._look import configure_lighting
 from scenes.sdf_gallery import COMPILE_LIMIT_S, FRAME_LIMIT_S, MAX_SOURCE_CHARS, set_editing_allowed
 from server.gate import install_gate
 from server.memory import limit_malloc_arenas
@@ -107,12 +108,14 @@ def port_is_free(host: str, port: int) -> bool:
 
 
 def make_server(host: str, port: int, *, verbose: bool = True) -> viser.ViserServer:
-    """The viser server as the app serves it: its label on the panel and the wide control panel.
+    """The viser server as the app serves it: its label on the panel, the wide control panel and the lighting that a
+    browser without a GPU can keep up with (:mod:`scenes._look`).
 
     The browser tests build theirs with this too, so what they look at (and the README screenshots) is the app's.
     """
     server = viser.ViserServer(host=host, port=port, label=APP_LABEL, verbose=verbose)
     server.gui.configure_theme(control_width="large")
+    configure_lighting(server.scene)
     return server
 
 

@@ -22,7 +22,7 @@ import trimesh
 from numpy.typing import NDArray
 
 from kernels import fabrik, warming
-from scenes._instances import add_instances
+from scenes._instances import add_instances, park_hidden
 
 if TYPE_CHECKING:
     import viser
@@ -594,10 +594,10 @@ class SkeletonView:
         bars = hinge_axes(sk, joints)
         with self.scene.server.atomic():
             self.link_nodes.batched_wxyzs = link_wxyz.astype(np.float32)
-            self.link_nodes.batched_positions = link_pos.astype(np.float32)
+            self.link_nodes.batched_positions = park_hidden(link_pos, link_scale)
             self.link_nodes.batched_scales = link_scale.astype(np.float32)
             self.link_nodes.batched_colors = link_colour
-            self.joint_nodes.batched_positions = joint_pos.astype(np.float32)
+            self.joint_nodes.batched_positions = park_hidden(joint_pos, joint_scale)
             self.joint_nodes.batched_scales = joint_scale.astype(np.float32)
             self.joint_nodes.batched_colors = joint_colour
             if len(bars):

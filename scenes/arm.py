@@ -30,7 +30,7 @@ from scenes._base import Scene
 from scenes._charts import FittedChart
 from scenes._controls import build_controls, checkbox, dropdown, slider
 from scenes._framing import ClientFraming, Lens, View, frame_points
-from scenes._instances import add_instances
+from scenes._instances import add_instances, park_hidden
 from scenes._skeletons import JOINT_RADIUS_M as SKELETON_JOINT_M
 from scenes._skeletons import (
     PRESET_LABELS,
@@ -574,22 +574,23 @@ is a static pose.
         base.apply_translation((0.0, 0.0, -0.03))
         self.base_node = scene.add_mesh_simple(f"{root}/base", base.vertices, base.faces, color=(90, 95, 105))
 
-        def grid(name: str, plane: Literal["xz", "xy"], opacity: float, visible: bool) -> viser.GridHandle:
-            """A 4 m square grid of 0.25 m cells, in 1 m sections."""
-            return scene.add_grid(
-                f"{root}/{name}",
-                width=4.0,
-                height=4.0,
-                plane=plane,
-                cell_size=0.25,
-                section_size=1.0,
-                plane_color=(235, 240, 250),
-                plane_opacity=opacity,
-                visible=visible,
+        def grid(name: str, plane: Literal["xz", "xy"], visible: bool) -> viser.LineSegmentsHandle:
+            """A 4 m square grid of 0.25 m cells, darker every 1 m, as thin lines: viser's own grid shades every pixel
+            of its plane, which took a software-WebGL view from 45 to 8 frames/s (docs/performance.md)."""
+            ticks = np.linspace(-2.0, 2.0, 17)
+            ends = np.stack([np.stack([ticks, np.full(17, -2.0)], 1), np.stack([ticks, np.full(17, 2.0)], 1)], 1)
+            uv = np.concatenate([ends, ends[:, :, ::-1]])  # (34, 2, 2): lines along v, then along u
+            points = np.zeros((len(uv), 2, 3), np.float32)
+            points[..., 0] = uv[..., 0]
+            points[..., 2 if plane == "xz" else 1] = uv[..., 1]
+            section = np.isclose(np.tile(ticks, 2) % 1.0, 0.0)
+            colours = np.where(section[:, None, None], 150, 205).repeat(2, 1).repeat(3, 2).astype(np.uint8)
+            return scene.add_line_segments(
+                f"{root}/{name}", points, colours, thickness=1.0, thickness_units="screen", visible=visible
             )
 
-        self.grid = grid("plane", "xz", 0.25, visible=True)
-        self.floor = grid("floor", "xy", 0.5, visible=self.params.three_d)
+        self.grid = grid("plane", "xz", visible=True)
+        self.floor = grid("floor", "xy", visible=self.params.three_d)
         cylinder, sphere = _unit_cylinder(), trimesh.creation.icosphere(subdivisions=2, radius=1.0)
         self.link_nodes = add_instances(scene, f"{root}/links", cylinder, MAX_LINKS, (70, 110, 200))
         self.joint_nodes = add_instances(
@@ -841,9 +842,9 @@ is a static pose.
 
         with self.server.atomic():
             self.link_nodes.batched_wxyzs = link_wxyz.astype(np.float32)
-            self.link_nodes.batched_positions = link_pos.astype(np.float32)
+            self.link_nodes.batched_positions = park_hidden(link_pos, link_scale)
             self.link_nodes.batched_scales = link_scale.astype(np.float32)
-            self.joint_nodes.batched_positions = joint_pos.astype(np.float32)
+            self.joint_nodes.batched_positions = park_hidden(joint_pos, joint_scale)
             self.joint_nodes.batched_scales = joint_scale.astype(np.float32)
             self.joint_nodes.batched_colors = joint_colour
             self.ghost_links.batched_wxyzs = ghost_wxyz.astype(np.float32)

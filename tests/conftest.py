@@ -19,6 +19,7 @@ from hypothesis import settings
 
 from app import serve_scenes
 from scenes._base import Scene
+from scenes._look import configure_lighting
 from server.gate import install_gate
 from server.sessions import Sessions
 from server.switcher import SceneSwitcher
@@ -33,8 +34,9 @@ settings.load_profile("deterministic")  # --hypothesis-profile, read after this 
 
 @pytest.fixture
 def server() -> Iterator[viser.ViserServer]:
-    """A real ViserServer on a free loopback port, behind the app's message gate (as app.py puts it)."""
+    """A real ViserServer on a free loopback port, lit and behind the app's message gate (as app.py puts it)."""
     srv = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
+    configure_lighting(srv.scene)
     install_gate(srv)
     try:
         yield srv

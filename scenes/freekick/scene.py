@@ -26,6 +26,7 @@ from scenes._charts import FittedChart
 from scenes._controls import build_controls, declared
 from scenes._framing import ClientFraming, Lens, View
 from scenes._instances import add_instances
+from scenes._look import add_ground
 from scenes._worker import LatestWorker
 from scenes.freekick.model import (
     DEFENDER_WIDTH_M,
@@ -94,6 +95,8 @@ from scenes.freekick.props import (
 )
 from scenes.freekick.views import frame_view
 
+GRASS_COLOUR = (115, 190, 104)
+"""The pitch's grass (8-bit sRGB, drawn unlit: after viser's tone mapping it shows as the lit grass did)."""
 CHART_COLOURS = {**FORCE_COLOURS, "knuckle": KNUCKLE_COLOUR}
 """The force chart's series after time, by the flight's force field: its arrows' colours and the knuckle's."""
 
@@ -296,7 +299,7 @@ of him beats him more often than it would a real keeper.
         scene, root = self.server.scene, self.root.name
         grass = trimesh.creation.box(extents=(50.0, 70.0, 0.02))
         grass.apply_translation((-22.0, 0.0, -0.011))
-        scene.add_mesh_simple(f"{root}/grass", grass.vertices, grass.faces, color=(70, 140, 60))
+        add_ground(scene, f"{root}/grass", grass.vertices, grass.faces, GRASS_COLOUR)
         scene.add_line_segments(f"{root}/markings", pitch_markings(), colors=(245, 245, 245), thickness=0.12)
         frame = goal_frame_mesh()
         scene.add_mesh_simple(f"{root}/goal_frame", frame.vertices, frame.faces, color=(250, 250, 250))

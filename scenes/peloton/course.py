@@ -20,6 +20,8 @@ from scenes._base import record_spec
 from scenes._charts import FittedChart
 from scenes._controls import build_controls, declared, read_controls
 from scenes._framing import Lens, View, box_corners, frame_points
+from scenes._instances import park_hidden
+from scenes._look import add_ground, mesh_glb
 from scenes.peloton.course_model import (
     COURSE_POWER_RANGE_W,
     GROUP_VIEW_DIRECTION,
@@ -42,7 +44,7 @@ from scenes.peloton.course_model import (
     lay_out_road,
     split_every_m,
 )
-from scenes.peloton.meshes import add_riders, show_position
+from scenes.peloton.meshes import GRASS_COLOUR, ROAD_COLOUR, Detail, add_riders, rider_detail, show_position
 from scenes.peloton.model import BIKE_LENGTH_M, MAX_GROUP, Position, group_cda, is_line_view
 
 CHART_TITLE = "Elevation, speed and power"
@@ -104,7 +106,8 @@ class CourseMode:
         self.play_time_s = 0.0
         self.message = ""
         self._since_readout = 0.0
-        self._drawn_position: Position | None = None
+        self._drawn_riders: tuple[Position, Detail] | None = None
+        """The riding position and mesh detail the riders were last meshed for."""
         self._upload_lock = threading.Lock()
         self._upload_seq = 0
         """Number of the newest upload: parses run in parallel on viser's pool, and only the newest installs."""
@@ -202,8 +205,8 @@ class CourseMode:
         self.frame = scene.add_frame(f"{self.scene.root.name}/course_mode", show_axes=False, visible=False)
         layout = self.layout()
         name = self.frame.name
-        self.verge = scene.add_mesh_simple(f"{name}/verge", *layout.verge, color=(120, 165, 95))
-        self.road = scene.add_mesh_simple(f"{name}/route", *layout.road, color=(70, 72, 78))  # the route's road
+        self.verge = add_ground(scene, f"{name}/verge", *layout.verge, GRASS_COLOUR)
+        self.road = add_ground(scene, f"{name}/route", *layout.road, ROAD_COLOUR)  # the route's road
         self.road_edges = scene.add_line_segments(
             f"{name}/road_edges", layout.edges, colors=(250, 250, 250), thickness=0.06
         )
@@ -211,7 +214,7 @@ class CourseMode:
             f"{name}/centre_line", layout.dashes, colors=(240, 240, 240), thickness=0.08
         )
         self.course_riders = add_riders(scene, f"{name}/riders", self.scene.params.position, 0.0, MAX_GROUP)
-        self._drawn_position = self.scene.params.position
+        self._drawn_riders = (self.scene.params.position, "full")
         self.mark_lines = {
             mark: scene.add_line_segments(
                 f"{name}/{mark.lower()}_line", np.zeros((1, 2, 3)), colors=(250, 250, 250), thickness=0.25
@@ -487,9 +490,10 @@ class CourseMode:
             if self.enabled:
                 s.wind_arrow.visible = False
             self.frame.visible = self.enabled
-            if s.params.position != self._drawn_position:
-                show_position(self.course_riders, s.params.position)
-                self._drawn_position = s.params.position
+            riders = (s.params.position, rider_detail(s.params.n_riders))
+            if riders != self._drawn_riders:
+                show_position(self.course_riders, *riders)
+                self._drawn_riders = riders
             if self.enabled:
                 self._draw_layout(self.layout())
             if now:
@@ -503,11 +507,12 @@ class CourseMode:
         self.server.flush()
 
     def _draw_layout(self, layout: RoadLayout) -> None:
-        """Push a layout to the road's and riders' nodes (faces only when the road's length changed)."""
-        for node, (vertices, faces) in ((self.road, layout.road), (self.verge, layout.verge)):
-            if node.faces.shape != faces.shape:
-                node.faces = faces
-            node.vertices = vertices
+        """Push a layout to the road's and riders' nodes."""
+        for node, (vertices, faces), colour in (
+            (self.road, layout.road, ROAD_COLOUR),
+            (self.verge, layout.verge, GRASS_COLOUR),
+        ):
+            node.glb_data = mesh_glb(vertices, faces, color=colour, unlit=True)
         self.road_edges.points = layout.edges
         self.centre_line.points = layout.dashes
         for mark, ends in layout.marks.items():
@@ -524,6 +529,7 @@ class CourseMode:
         all_wxyz[:n] = wxyz
         scales = np.zeros((MAX_GROUP, 3), np.float32)
         scales[:n] = 1.0
+        all_positions = park_hidden(all_positions, scales)
         for node in self.course_riders.values():
             node.batched_positions = all_positions
             node.batched_wxyzs = all_wxyz

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import functools
 import math
+from typing import Literal
 
 import numpy as np
 import trimesh
@@ -17,6 +18,10 @@ import viser
 from scenes._instances import add_instances
 from scenes.peloton.model import MAX_RIDERS, POSITIONS, Position
 
+GRASS_COLOUR = (168, 205, 150)
+"""The verge's grass (8-bit sRGB, drawn unlit: after viser's tone mapping it shows as the lit grass did)."""
+ROAD_COLOUR = (110, 112, 127)
+"""The road's asphalt (8-bit sRGB, drawn unlit, as :data:`GRASS_COLOUR`)."""
 JERSEYS = np.array(
     [
         (220, 40, 40),
@@ -38,9 +43,30 @@ RIDER_COLOURS = {
 """(MAX_RIDERS, 3) uint8 colour of each part, per rider slot: bikes dark, bodies in team jerseys, heads pale."""
 
 
-def rod(a: np.ndarray, b: np.ndarray, radius: float) -> trimesh.Trimesh:
-    """An eight-sided cylinder of ``radius`` from (3,) point ``a`` to ``b`` (m)."""
-    return trimesh.creation.cylinder(radius=radius, segment=np.array([a, b]), sections=8)
+Detail = Literal["full", "light"]
+"""How finely a rider is meshed: ``"full"`` (1 504 triangles) for a line of a few riders seen close, ``"light"``
+(about a third of them) for a group, where a rider is a few dozen pixels tall: in Chromium's software WebGL a bunch
+of 121 riders drew 4.3 → 7.1 frames/s at 1280×720 with the light mesh (docs/performance.md)."""
+
+LIGHT_ABOVE = 8
+"""Riders are meshed ``"light"`` when more than this many ride."""
+
+SECTIONS: dict[Detail, dict[str, int]] = {
+    "full": {"rod": 8, "wheel_major": 24, "wheel_minor": 6, "capsule": 8, "head": 2},
+    "light": {"rod": 4, "wheel_major": 12, "wheel_minor": 3, "capsule": 5, "head": 1},
+}
+"""Per detail: sides of a rod, segments round a wheel and round its tyre, rings of the torso, subdivisions of the
+head's icosphere."""
+
+
+def rider_detail(n_riders: int) -> Detail:
+    """The mesh detail for a group of ``n_riders``."""
+    return "light" if n_riders > LIGHT_ABOVE else "full"
+
+
+def rod(a: np.ndarray, b: np.ndarray, radius: float, sections: int = 8) -> trimesh.Trimesh:
+    """A cylinder of ``sections`` sides and ``radius`` from (3,) point ``a`` to ``b`` (m)."""
+    return trimesh.creation.cylinder(radius=radius, segment=np.array([a, b]), sections=sections)
 
 
 def two_bone_knee(hip: np.ndarray, foot: np.ndarray, thigh: float, shin: float) -> np.ndarray:
@@ -56,9 +82,12 @@ def two_bone_knee(hip: np.ndarray, foot: np.ndarray, thigh: float, shin: float) 
     return hip + along * u + height * forward
 
 
-def rider_meshes(position: Position) -> dict[str, trimesh.Trimesh]:
-    """Low-poly bike, body and head for one rider, in the bike frame (x forward, z up, ground at z = 0)."""
-    pose = POSITIONS[position]
+@functools.cache
+def rider_meshes(position: Position, detail: Detail = "full") -> dict[str, trimesh.Trimesh]:
+    """Low-poly bike, body and head for one rider, in the bike frame (x forward, z up, ground at z = 0), meshed at
+    ``detail`` (:data:`SECTIONS`). The meshes are cached and shared: copy before changing one."""
+    pose, n = POSITIONS[position], SECTIONS[detail]
+    rod_n = functools.partial(rod, sections=n["rod"])
     wheel_r = 0.34
     rear, front = np.array([-0.51, 0.0, wheel_r]), np.array([0.51, 0.0, wheel_r])
     bb = np.array([-0.04, 0.0, 0.27])
@@ -69,7 +98,10 @@ def rider_meshes(position: Position) -> dict[str, trimesh.Trimesh]:
     bike_parts = []
     for centre in (rear, front):
         wheel = trimesh.creation.torus(
-            major_radius=wheel_r - 0.015, minor_radius=0.018, major_sections=24, minor_sections=6
+            major_radius=wheel_r - 0.015,
+            minor_radius=0.018,
+            major_sections=n["wheel_major"],
+            minor_sections=n["wheel_minor"],
         )
         wheel.apply_transform(trimesh.transformations.rotation_matrix(math.pi / 2, [1, 0, 0]))
         wheel.apply_translation(centre)
@@ -82,15 +114,15 @@ def rider_meshes(position: Position) -> dict[str, trimesh.Trimesh]:
         (seat, head_top),
         (head_top, front),
     ):
-        bike_parts.append(rod(a, b, 0.016))
-    bike_parts.append(rod(head_top, bars, 0.014))
-    bike_parts.append(rod(bars + [0, -0.2, 0], bars + [0, 0.2, 0], 0.012))
-    bike_parts.append(rod(seat + [-0.08, 0, 0.03], seat + [0.08, 0, 0.03], 0.03))
+        bike_parts.append(rod_n(a, b, 0.016))
+    bike_parts.append(rod_n(head_top, bars, 0.014))
+    bike_parts.append(rod_n(bars + [0, -0.2, 0], bars + [0, 0.2, 0], 0.012))
+    bike_parts.append(rod_n(seat + [-0.08, 0, 0.03], seat + [0.08, 0, 0.03], 0.03))
 
     theta = math.radians(pose.torso_deg)
     hip = seat + np.array([0.0, 0.0, 0.08])
     shoulder = hip + 0.58 * np.array([math.cos(theta), 0.0, math.sin(theta)])
-    torso = trimesh.creation.capsule(height=0.58, radius=0.12, count=[8, 8])
+    torso = trimesh.creation.capsule(height=0.58, radius=0.12, count=[n["capsule"], n["capsule"]])
     torso.apply_transform(
         trimesh.geometry.align_vectors([0, 0, 1], shoulder - hip)  # capsule axis along the torso
     )
@@ -102,16 +134,16 @@ def rider_meshes(position: Position) -> dict[str, trimesh.Trimesh]:
         h = hands * [1.0, side, 1.0]
         if position in ("tt", "hour"):  # elbows on the pads: upper arm down, forearm forward
             elbow = np.array([s[0] + 0.05, side * 0.09, hands[2] - 0.02])
-            body_parts += [rod(s, elbow, 0.045), rod(elbow, h, 0.04)]
+            body_parts += [rod_n(s, elbow, 0.045), rod_n(elbow, h, 0.04)]
         else:
-            body_parts.append(rod(s, h, 0.045))
+            body_parts.append(rod_n(s, h, 0.045))
         crank = np.array([side * 0.17 * 0.7, 0.0, -side * 0.17 * 0.7])
         foot = bb + crank + [0.0, side * 0.12, 0.0]
         h_side = hip + [0.0, side * 0.1, 0.0]
         knee = two_bone_knee(h_side, foot, 0.46, 0.46)
-        body_parts += [rod(h_side, knee, 0.065), rod(knee, foot, 0.05)]
+        body_parts += [rod_n(h_side, knee, 0.065), rod_n(knee, foot, 0.05)]
     head_centre = shoulder + 0.17 * np.array([math.cos(theta * 0.5), 0.0, math.sin(theta * 0.5) + 0.6])
-    head = trimesh.creation.icosphere(subdivisions=2, radius=0.12)
+    head = trimesh.creation.icosphere(subdivisions=n["head"], radius=0.12)
     head.apply_translation(head_centre)
     bike, body = trimesh.util.concatenate(bike_parts), trimesh.util.concatenate(body_parts)
     assert isinstance(bike, trimesh.Trimesh) and isinstance(body, trimesh.Trimesh)
@@ -132,19 +164,24 @@ def rider_colours(part: str, count: int) -> np.ndarray:
 
 
 def add_riders(
-    scene: viser.SceneApi, prefix: str, position: Position, scale: float, count: int = MAX_RIDERS
+    scene: viser.SceneApi,
+    prefix: str,
+    position: Position,
+    scale: float,
+    count: int = MAX_RIDERS,
+    detail: Detail = "full",
 ) -> dict[str, viser.BatchedMeshHandle]:
     """One batched mesh per part (``<prefix>_bike``, ``_body``, ``_head``), ``count`` instances (one per rider
     slot), all at the origin and scaled by ``scale`` (0 hides them until they are placed). Three nodes whatever the
     count: 121 riders cost the browser three draw calls, as 8 do."""
     nodes: dict[str, viser.BatchedMeshHandle] = {}
-    for part, mesh in rider_meshes(position).items():
+    for part, mesh in rider_meshes(position, detail).items():
         nodes[part] = add_instances(scene, f"{prefix}_{part}", mesh, count, rider_colours(part, count), scale=scale)
     return nodes
 
 
-def show_position(nodes: dict[str, viser.BatchedMeshHandle], position: Position) -> None:
-    """Re-mesh the riders of :func:`add_riders` for another riding position."""
-    for part, mesh in rider_meshes(position).items():
+def show_position(nodes: dict[str, viser.BatchedMeshHandle], position: Position, detail: Detail = "full") -> None:
+    """Re-mesh the riders of :func:`add_riders` for another riding position or detail."""
+    for part, mesh in rider_meshes(position, detail).items():
         nodes[part].vertices = mesh.vertices.astype(np.float32)
         nodes[part].faces = mesh.faces.astype(np.uint32)

@@ -23,9 +23,19 @@ from scenes._base import Scene, set_if_changed
 from scenes._charts import FittedChart
 from scenes._controls import Controls, build_controls, declared
 from scenes._framing import ClientFraming, Lens, View, frame_points
-from scenes._instances import add_instances
+from scenes._instances import add_instances, park_hidden
+from scenes._look import add_ground
 from scenes.peloton.course import CourseMode
-from scenes.peloton.meshes import add_riders, rider_colours, rider_head_m, show_position
+from scenes.peloton.meshes import (
+    GRASS_COLOUR,
+    ROAD_COLOUR,
+    Detail,
+    add_riders,
+    rider_colours,
+    rider_detail,
+    rider_head_m,
+    show_position,
+)
 from scenes.peloton.model import (
     BIKE_LENGTH_M,
     CRR_PRESETS,
@@ -178,7 +188,8 @@ time-averaged power is the mean over positions, far below the leader's.
         super().__init__(server)
         self.params = PelotonParams()
         self.state = compute_line(self.params)
-        self._drawn_position: Position | None = None
+        self._drawn_riders: tuple[Position, Detail] | None = None
+        """The riding position and mesh detail the riders were last meshed for."""
         self._rotation_time_s = 0.0
         self._energy_j = np.zeros(MAX_GROUP)
         self._ridden_s = 0.0
@@ -265,10 +276,10 @@ time-averaged power is the mean over positions, far below the leader's.
         length, middle = end - start, 0.5 * (start + end)
         grass = trimesh.creation.box(extents=(length + 30.0, 60.0, 0.02))
         grass.apply_translation((middle, 0.0, -0.03))
-        scene.add_mesh_simple(f"{self.course.name}/grass", grass.vertices, grass.faces, color=(120, 165, 95))
+        add_ground(scene, f"{self.course.name}/grass", grass.vertices, grass.faces, GRASS_COLOUR)
         road = trimesh.creation.box(extents=(length, 2.0 * ROAD_HALF_WIDTH_M, 0.02))
         road.apply_translation((middle, 0.0, -0.01))
-        self.road = scene.add_mesh_simple(f"{self.course.name}/road", road.vertices, road.faces, color=(70, 72, 78))
+        self.road = add_ground(scene, f"{self.course.name}/road", road.vertices, road.faces, ROAD_COLOUR)
         dashes = np.array([[[x, 0.0, 0.002], [x + 1.5, 0.0, 0.002]] for x in np.arange(start + 1.0, end - 1.0, 3.0)])
         scene.add_line_segments(f"{self.course.name}/centre_line", dashes, colors=(240, 240, 240), thickness=0.08)
         for side in (-ROAD_HALF_WIDTH_M, ROAD_HALF_WIDTH_M):
@@ -278,7 +289,7 @@ time-averaged power is the mean over positions, far below the leader's.
             )
 
         self.riders_nodes = add_riders(scene, f"{self.course.name}/riders", self.params.position, 0.0, MAX_GROUP)
-        self._drawn_position = self.params.position
+        self._drawn_riders = (self.params.position, "full")
 
         unit_box = trimesh.creation.box(extents=(1.0, 1.0, 1.0))
         unit_box.apply_translation((0.0, 0.0, 0.5))  # grows upward from its base
@@ -634,13 +645,15 @@ time-averaged power is the mean over positions, far below the leader's.
         self.server.flush()
 
     def _tilt_and_pose(self) -> None:
-        """Tilt the road to the grade and, when the riding position changed, pose every rider for it."""
+        """Tilt the road to the grade and, when the riding position or the group's mesh detail changed, re-mesh every
+        rider for it."""
         p = self.params
         theta = math.atan(p.grade_pct / 100.0)
         set_if_changed(self.course, "wxyz", (math.cos(-theta / 2), 0.0, math.sin(-theta / 2), 0.0))
-        if p.position != self._drawn_position:
-            show_position(self.riders_nodes, p.position)
-            self._drawn_position = p.position
+        riders = (p.position, rider_detail(p.n_riders))
+        if riders != self._drawn_riders:
+            show_position(self.riders_nodes, *riders)
+            self._drawn_riders = riders
 
     def _show_panel(self, table: Callable[[], str], *, readouts: bool) -> None:
         """Write the lead rotation's words and, with ``readouts``, the wind, the density, ``table()``, the chart and
@@ -673,8 +686,9 @@ time-averaged power is the mean over positions, far below the leader's.
 
     def _show_riders(self, positions: np.ndarray, scales: np.ndarray, bodies: np.ndarray) -> None:
         """Place the (MAX_GROUP,) rider instances and colour their bodies (only what changed goes out)."""
+        positions = park_hidden(positions, scales)
         for node in self.riders_nodes.values():
-            set_if_changed(node, "batched_positions", positions.astype(np.float32))
+            set_if_changed(node, "batched_positions", positions)
             set_if_changed(node, "batched_scales", scales.astype(np.float32))
         set_if_changed(self.riders_nodes["body"], "batched_colors", bodies)
 

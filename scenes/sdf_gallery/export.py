@@ -9,14 +9,13 @@ from __future__ import annotations
 
 import dataclasses
 import io
-import json
-import struct
 from typing import Literal
 
 import numpy as np
 from PIL import Image
 
 from kernels import sdf
+from scenes._look import mesh_glb
 
 MeshFormat = Literal["glb", "stl", "obj"]
 """The mesh's download formats."""
@@ -88,73 +87,6 @@ def scene_normals(scene: sdf.Scene, vertices: np.ndarray) -> np.ndarray:
 
 
 def viewer_glb(vertices: np.ndarray, faces: np.ndarray, colors: np.ndarray, normals: np.ndarray) -> bytes:
-    """A minimal GLB for the 3D view: positions, smooth normals and 8-bit vertex colours, written directly.
-
-    Normals are the field's gradient (exact directions where the SDF is, no averaging of faces). Colours are made
-    linear: three.js treats vertex colours as linear light, so sRGB-like values would look washed out. (trimesh's
-    exporter gives the same file for downloads but costs several times as long, and this runs on every drag.)
-    """
-    v = np.asarray(vertices, dtype=np.float32)
-    normals = np.asarray(normals, dtype=np.float32).reshape(-1, 3)
-    rgba = np.empty((len(v), 4), np.uint8)
-    rgba[:, :3] = np.round(255 * np.clip(colors, 0.0, 1.0) ** 2.2)
-    rgba[:, 3] = 255
-    indices = np.ascontiguousarray(faces, dtype=np.uint32).ravel()
-    blobs = [indices.tobytes(), v.tobytes(), normals.tobytes(), rgba.tobytes()]
-    views, offset = [], 0
-    for blob, target in zip(blobs, (34963, 34962, 34962, 34962), strict=True):
-        views.append({"buffer": 0, "byteOffset": offset, "byteLength": len(blob), "target": target})
-        offset += len(blob)  # every blob's length is a multiple of 4
-    lo = v.min(axis=0).tolist() if len(v) else [0.0] * 3
-    hi = v.max(axis=0).tolist() if len(v) else [0.0] * 3
-    gltf = {
-        "asset": {"version": "2.0"},
-        "scene": 0,
-        "scenes": [{"nodes": [0]}],
-        "nodes": [{"mesh": 0}],
-        "meshes": [
-            {
-                "primitives": [
-                    {
-                        "attributes": {"POSITION": 1, "NORMAL": 2, "COLOR_0": 3},
-                        "indices": 0,
-                        "mode": 4,
-                    }
-                ]
-            }
-        ],
-        "buffers": [{"byteLength": offset}],
-        "bufferViews": views,
-        "accessors": [
-            {"bufferView": 0, "componentType": 5125, "count": len(indices), "type": "SCALAR"},
-            {
-                "bufferView": 1,
-                "componentType": 5126,
-                "count": len(v),
-                "type": "VEC3",
-                "min": lo,
-                "max": hi,
-            },
-            {"bufferView": 2, "componentType": 5126, "count": len(v), "type": "VEC3"},
-            {
-                "bufferView": 3,
-                "componentType": 5121,
-                "normalized": True,
-                "count": len(v),
-                "type": "VEC4",
-            },
-        ],
-    }
-    text = json.dumps(gltf, separators=(",", ":")).encode()
-    text += b" " * (-len(text) % 4)
-    body = b"".join(blobs)
-    total = 12 + 8 + len(text) + 8 + len(body)
-    return b"".join(
-        [
-            struct.pack("<4sII", b"glTF", 2, total),
-            struct.pack("<I4s", len(text), b"JSON"),
-            text,
-            struct.pack("<I4s", len(body), b"BIN\x00"),
-            body,
-        ]
-    )
+    """The GLB the 3D view gets: positions, the field's gradient as normals (exact directions where the SDF is, no
+    averaging of faces) and the vertex colours, with the project's matte material (:func:`scenes._look.mesh_glb`)."""
+    return mesh_glb(vertices, faces, normals=normals, vertex_colors=colors)

@@ -3,9 +3,12 @@ and the ``scene`` fixture a scene's test module declares in one line."""
 
 from __future__ import annotations
 
+import io
 from typing import Any, Protocol, TypeVar
 
+import numpy as np
 import pytest
+import trimesh
 
 from scenes._base import Scene
 
@@ -27,3 +30,10 @@ def scene_fixture(kind: type[Scene]) -> Any:
         return show_scene(kind)
 
     return scene
+
+
+def glb_vertices(glb_data: bytes) -> np.ndarray:
+    """(V, 3) vertex positions of a one-mesh GLB as a scene sends it (read by trimesh, not by our writer)."""
+    loaded = trimesh.load(io.BytesIO(glb_data), file_type="glb", force="mesh", process=False)
+    assert isinstance(loaded, trimesh.Trimesh)
+    return np.asarray(loaded.vertices)

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 import viser
 from helpers.gpx import BAD_FILES, gpx_text, hill_gpx
-from helpers.scenes import scene_fixture
+from helpers.scenes import glb_vertices, scene_fixture
 from helpers.uploads import upload
 from helpers.wsclient import BrowserClient
 
@@ -126,10 +126,10 @@ def test_pacing_reports_the_time_saved(mode: CourseMode) -> None:
 
 def test_exaggeration_stretches_the_drawn_heights(mode: CourseMode) -> None:
     mode.scrub.value = 5.0  # on the climb
-    before = np.asarray(mode.road.vertices)[:, 2].copy()
+    before = glb_vertices(mode.road.glb_data)[:, 2].copy()
     assert np.ptp(before) > 2.0  # the road climbs under the group: ~8 % over ~50 m drawn
     mode.controls["exaggeration"].value = 3.0
-    after = np.asarray(mode.road.vertices)[:, 2]
+    after = glb_vertices(mode.road.glb_data)[:, 2]
     np.testing.assert_allclose(after, 3.0 * before, rtol=1e-4, atol=1e-4)  # heights from the group's middle
 
 

@@ -10,7 +10,7 @@ import pytest
 import viser
 from helpers.browser import VIEWPORTS
 from helpers.properties import examples
-from helpers.scenes import scene_fixture
+from helpers.scenes import glb_vertices, scene_fixture
 from helpers.screen_geometry import pinhole_ndc
 from helpers.wsclient import BrowserClient, shows_number
 from hypothesis import HealthCheck, given, settings
@@ -335,7 +335,7 @@ def test_every_rider_rides_on_the_drawn_road(scene: PelotonScene, n: int, gap_te
     """The kind: scenery sized for the opening state. The road was 60 m long, so from 8 riders ~4 m apart the last
     rode on the grass, and at the 15 m gap the rear riders floated past the ground's edge."""
     scene.controls["n_riders"].value, scene.controls["gap_m"].value = n, gap_tenths / 10
-    road_x = np.asarray(scene.road.vertices)[:, 0]
+    road_x = glb_vertices(scene.road.glb_data)[:, 0]
     with scene._lock:
         x = np.asarray(scene.line_points())[:, 0]
     assert road_x.min() <= x.min() - 1.0 and x.max() + 1.0 <= road_x.max(), (x.min(), road_x.min())
@@ -344,7 +344,7 @@ def test_every_rider_rides_on_the_drawn_road(scene: PelotonScene, n: int, gap_te
 def test_eight_riders_at_the_largest_gap_ride_on_the_road(scene: PelotonScene) -> None:
     scene.controls["n_riders"].value, scene.controls["gap_m"].value = 8, MAX_GAP_M
     tail = 7 * (1.70 + 15.0)  # the last rider's slot, 116.9 m behind the leader
-    assert np.asarray(scene.road.vertices)[:, 0].min() <= -tail - 1.0
+    assert glb_vertices(scene.road.glb_data)[:, 0].min() <= -tail - 1.0
 
 
 def test_the_lead_starts_rotating_when_riders_join_with_rotate_on(scene: PelotonScene) -> None:
