@@ -45,15 +45,15 @@ RIDER_COLOURS = {
 
 Detail = Literal["full", "light"]
 """How finely a rider is meshed: ``"full"`` (1 504 triangles) for a line of a few riders seen close, ``"light"``
-(about a third of them) for a group, where a rider is a few dozen pixels tall: in Chromium's software WebGL a bunch
-of 121 riders drew 4.3 → 7.1 frames/s at 1280×720 with the light mesh (docs/performance.md)."""
+(412) for a group, where a rider is a few dozen pixels tall: in Chromium's software WebGL a bunch of 121 riders drew
+4.3 → 10.0 frames/s at 1280×720 with the light mesh (docs/performance.md)."""
 
 LIGHT_ABOVE = 8
 """Riders are meshed ``"light"`` when more than this many ride."""
 
 SECTIONS: dict[Detail, dict[str, int]] = {
     "full": {"rod": 8, "wheel_major": 24, "wheel_minor": 6, "capsule": 8, "head": 2},
-    "light": {"rod": 4, "wheel_major": 12, "wheel_minor": 3, "capsule": 5, "head": 1},
+    "light": {"rod": 3, "wheel_major": 10, "wheel_minor": 3, "capsule": 4, "head": 1},
 }
 """Per detail: sides of a rod, segments round a wheel and round its tyre, rings of the torso, subdivisions of the
 head's icosphere."""

@@ -122,14 +122,16 @@ def test_the_peloton_sends_its_hidden_riders_out_of_every_view(server: viser.Vis
         assert np.all(np.abs(positions[:3, 2]) < 1.0)  # the three shown ride on the road
 
 
-def test_a_light_rider_is_the_same_figure_in_a_third_of_the_triangles() -> None:
+def test_a_light_rider_is_the_same_figure_in_under_a_third_of_the_triangles() -> None:
     for position in POSITIONS:
         full, light = rider_meshes(position, "full"), rider_meshes(position, "light")
         full_triangles = sum(len(m.faces) for m in full.values())
         light_triangles = sum(len(m.faces) for m in light.values())
-        assert light_triangles < 0.4 * full_triangles, (position, light_triangles, full_triangles)
-        for part in full:  # each part spans the same box within 2 cm: the same size and pose
-            np.testing.assert_allclose(light[part].bounds, full[part].bounds, atol=0.02, err_msg=f"{position} {part}")
+        assert light_triangles < full_triangles / 3, (position, light_triangles, full_triangles)
+        # Each part spans the same box within 3 cm (a 3-sided rod's flat side lies at half its radius, 2.3 cm in from
+        # a 4.5 cm arm): the same size and pose.
+        for part in full:
+            np.testing.assert_allclose(light[part].bounds, full[part].bounds, atol=0.03, err_msg=f"{position} {part}")
 
 
 def test_a_group_rides_light_and_a_line_rides_full(scene: PelotonScene) -> None:
