@@ -180,8 +180,9 @@ def _first_example() -> EditorField:
 class SdfGalleryParams:
     """Everything the gallery shows is a function of these; defaults are the opening state.
 
-    The controls go in four folders, in this order: "Shape and view", "GLSL editor" (collapsed), "Blend and mesh"
-    and "Reference (GLSL ray-march)"; the primitive slots' folders follow (:class:`PrimitiveParams`).
+    The controls go in four folders, in this order: "Shape and view", "GLSL editor" (shown with Shape = GLSL
+    editor), "Blend and mesh" and "Reference (GLSL ray-march)"; the primitive slots' folders follow
+    (:class:`PrimitiveParams`, shown with Shape = primitives).
     """
 
     view_mode: ViewMode = field(

@@ -248,7 +248,8 @@ IoU is lowest when a box edge is on the silhouette.
             self.view_controls = build_controls(gui, p, ("view_mode", "shape_source", "rings"))
             with self.view_controls.folders["Shape and view"]:
                 self.view_note = gui.add_markdown("")
-            self.example_controls = build_controls(gui, p, ("example",), collapsed=("GLSL editor",))
+            # Shown only with Shape = GLSL editor, and open when it shows (viser opens a folder only as it is made).
+            self.example_controls = build_controls(gui, p, ("example",))
             folders = self.example_controls.folders
             self.editor = build_controls(gui, p, ("editor_text",), folders_open=folders)["editor_text"]
             self.editor.disabled = not allowed
@@ -270,7 +271,7 @@ IoU is lowest when a box edge is on the silhouette.
                 gui, p, SHADING_FIELDS, folders_open={REFERENCE_FOLDER: reference_folder}
             )
             self.slot_controls = [build_slot_controls(gui, i, slot) for i, slot in enumerate(p.primitives)]
-            gui.add_markdown(SIZE_MEANING)
+            self.size_note = gui.add_markdown(SIZE_MEANING)
             with gui.add_folder("Downloads", expand_by_default=False):
                 self.downloads: dict[DownloadFormat, viser.GuiButtonHandle] = {
                     "glb": gui.add_button("Download mesh (GLB)"),
@@ -484,9 +485,14 @@ IoU is lowest when a box edge is on the silhouette.
         """Show gizmos of enabled primitives, sized and named for them; grey out sizes the kind does not use."""
         self.scene_controls["k"].disabled = self.params.blend == "hard"
         primitives = self.params.shape_source == "primitives"
-        for name in ("blend", "k"):  # they act on the primitives only: hidden while a GLSL field is shown
+        # Each shape source shows its own controls only: the primitives' panels, blend and gizmo rings, or the editor.
+        for name in ("blend", "k"):
             self.scene_controls[name].visible = primitives
         self.view_controls["rings"].visible = primitives  # so do the gizmos the rings sit on
+        for folder in (folder for controls in self.slot_controls for folder in controls.folders.values()):
+            folder.visible = primitives
+        self.size_note.visible = primitives
+        self.example_controls.folders["GLSL editor"].visible = not primitives
         for controls, gizmo, slot in zip(self.slot_controls, self.gizmos, self.params.primitives, strict=True):
             gizmo.visible = slot.enabled and primitives
             for j, handle in enumerate(controls.each("size")):

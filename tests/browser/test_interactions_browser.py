@@ -24,6 +24,7 @@ from helpers.browser import (
     canvas_is_not_blank,
     changed_mask,
     close_notifications,
+    control_row,
     drag,
     screen_of,
     screenshot,
@@ -372,8 +373,13 @@ def test_typed_shape_is_meshed_and_ray_marched_in_the_main_view(server: viser.Vi
     with served_scene(server, browser_page, "sdf", MESH) as served:
         scene, page = served.scene, served.page
         assert isinstance(scene, SdfGalleryScene)
-        page.locator('text="GLSL editor" >> visible=true').first.click()  # the folder, not the About text
+        # Shape → GLSL editor, as a person picks it: the editor's folder appears, open.
+        control_row(page, "Shape").locator("input").first.click()
+        page.get_by_role("option", name="GLSL editor").click()
         editor = page.locator("textarea").filter(has_text="sdf(vec3 p)").first
+        # The folder shows open, its code box a screenful tall (at least 15 of its lines), not viser's 2–6 lines.
+        lines = editor.evaluate("e => e.getBoundingClientRect().height / parseFloat(getComputedStyle(e).lineHeight)")
+        assert editor.is_visible() and lines >= 15, lines
         editor.fill(OCTAHEDRON)
         page.get_by_role("button", name="Apply").click()
         deadline = time.monotonic() + 60

@@ -823,28 +823,38 @@ def _shown(client: BrowserClient, label: str) -> bool:
     return True
 
 
-PRIMITIVES_ONLY = ("Blend", "Blend width k (m)", "Rotation rings on the gizmos")
-"""Controls that act on the primitives (or their gizmos) only."""
+PRIMITIVES_ONLY = ("Blend", "Blend width k (m)", "Rotation rings on the gizmos", "P1 kind", "P4 colour")
+"""Controls that act on the primitives (or their gizmos) only: hidden with Shape = GLSL editor."""
+EDITOR_ONLY = ("Example", "sdf(p) in GLSL", "Apply")
+"""Controls of the GLSL editor: shown with Shape = GLSL editor only."""
 
 
 def test_primitive_controls_hide_while_a_glsl_field_is_shown(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
-    """Blend, its width and the gizmos' rotation rings act on the primitives only: with the GLSL editor's field shown
-    they are not drawn; the mesh resolution (used by both) stays."""
+    """Each shape source shows its own controls: Blend, its width, the gizmos' rotation rings and the primitives'
+    panels act on the primitives only, and are not drawn while the GLSL editor's field is shown, which shows the
+    editor's folder instead (a person who picked GLSL editor saw a collapsed folder among panels that did nothing);
+    the mesh resolution (used by both) stays."""
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("Blend")
         assert all(_shown(client, label) for label in PRIMITIVES_ONLY)
+        assert not any(_shown(client, label) for label in EDITOR_ONLY)
         client.set_value("Shape", "GLSL editor")
         client.wait_for(lambda: not _shown(client, "Blend"), what="Blend hidden")
-        assert [_shown(client, label) for label in PRIMITIVES_ONLY] == [False] * 3
+        assert [_shown(client, label) for label in PRIMITIVES_ONLY] == [False] * len(PRIMITIVES_ONLY)
+        assert all(_shown(client, label) for label in EDITOR_ONLY)
+        # viser opens a folder only as it is made: the editor's is made open, so it shows open when it appears.
+        assert client.element("GLSL editor")["props"]["expand_by_default"]
         assert _shown(client, RESOLUTION_LABEL)
         client.set_value("Shape", "Primitives (panels below)")
         client.wait_for(lambda: all(_shown(client, label) for label in PRIMITIVES_ONLY), what="Blend and rings back")
+        assert not any(_shown(client, label) for label in EDITOR_ONLY)
 
 
 def test_rotation_rings_show_only_when_asked(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
     """Four gizmos' twelve rotation rings covered the shape: the gizmos open with their arrows only, and the rings
     come with "Rotation rings on the gizmos" (what the browser is told, not just the handle)."""
     with BrowserClient(server.get_port()) as client:
+
         def rings_off() -> list[bool]:
             with client._lock:
                 return [
