@@ -738,6 +738,9 @@ BIKE_LENGTH_M = 1.70
 """Wheel-to-wheel length of one bike (m): a gap is measured from a front wheel to the rear wheel ahead."""
 BUNCH_WIDTH = 8
 """Riders abreast where a bunch stops widening (Blocken et al. 2018's peloton widens row by row behind its leader)."""
+ECHELON_WIDTH = BUNCH_WIDTH
+"""Riders in one echelon: it reaches across a road as wide as a bunch's widest row, and the riders who find no place
+in it ride in the next echelon behind, as the groups of a race split by a crosswind do."""
 
 # Wake-model constants of formation_drag ("measured"), fitted to Blocken et al. 2018's 121-rider map (see
 # docs/peloton.md for the fit and its residuals). The single-file part reuses the line model's constants above.
@@ -766,8 +769,9 @@ def formation(
     * ``"bunch"``: a peloton after Blocken et al. 2018 (J. Wind Eng. Ind. Aerodyn. 179:319): one leader, then rows
       one rider wider each until :data:`BUNCH_WIDTH` abreast, then rows of 8 and 7 alternately; every row is centred
       on the road, so neighbouring rows are staggered by half a rider. Rows are one bike plus ``gap_m`` apart.
-    * ``"echelon"``: a diagonal line, each rider half a bike plus ``gap_m`` behind the one ahead and ``lateral_m`` to
-      its right.
+    * ``"echelon"``: diagonal lines of up to :data:`ECHELON_WIDTH` riders, each rider half a bike plus ``gap_m``
+      behind the one ahead and ``lateral_m`` to its right; a full echelon spans the road, so the next rider starts
+      the next echelon at the leader's side, one bike plus ``gap_m`` behind the last rider of the one ahead.
 
     Args:
         n_riders: riders (1 to :data:`MAX_FORMATION_RIDERS`).
@@ -802,7 +806,11 @@ def formation(
                 np.float64
             )
         case "echelon":
-            return np.stack([-k * (0.5 * BIKE_LENGTH_M + gap), -k * lateral], axis=1).astype(np.float64)
+            # Rider k rides in echelon k // ECHELON_WIDTH, place k % ECHELON_WIDTH: a half-bike step back along it,
+            # one whole bike back from the end of one echelon to the start of the next.
+            row, place = np.divmod(k, ECHELON_WIDTH)
+            x = -(k - row) * (0.5 * BIKE_LENGTH_M + gap) - row * step
+            return np.stack([x, -place * lateral], axis=1).astype(np.float64)
         case "bunch":
             xs: list[float] = []
             ys: list[float] = []

@@ -3,6 +3,8 @@ its two properties (a rider joining behind never raises anyone's drag; the mirro
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 from helpers import riders
@@ -150,6 +152,37 @@ def test_every_shape_lays_out_n_distinct_riders_leader_first(shape: cycling.Form
 def test_echelon_steps_back_and_to_the_right() -> None:
     positions = cycling.formation(5, "echelon", gap_m=0.2, lateral_m=0.5)
     np.testing.assert_allclose(np.diff(positions, axis=0), np.tile([-(0.85 + 0.2), -0.5], (4, 1)))
+
+
+def test_a_long_echelon_wraps_into_echelons_one_behind_another_each_across_the_road() -> None:
+    # The failing look (a review): an echelon of 121 ran 72 m to the right, off the road and across the grass.
+    gap, lateral, width = 0.3, 0.6, cycling.ECHELON_WIDTH
+    positions = cycling.formation(121, "echelon", gap_m=gap, lateral_m=lateral)
+    k = np.arange(121)
+    # Each echelon spans the same width as the bunch's widest row, starting again at the leader's side.
+    np.testing.assert_allclose(positions[:, 1], -(k % width) * lateral)
+    widest_bunch_row = np.ptp(cycling.formation(121, "bunch", lateral_m=lateral)[:, 1])
+    assert np.ptp(positions[:, 1]) == pytest.approx(widest_bunch_row)
+    # Along an echelon half a bike plus the gap back; from its last rider to the next echelon's first, one bike
+    # plus the gap: every rider rides behind all those before it.
+    steps = -np.diff(positions[:, 0])
+    starts = k[1:] % width == 0
+    np.testing.assert_allclose(steps[~starts], 0.5 * cycling.BIKE_LENGTH_M + gap)
+    np.testing.assert_allclose(steps[starts], cycling.BIKE_LENGTH_M + gap)
+    assert starts.sum() == 15  # 121 riders: fifteen full echelons of eight and one rider starting the sixteenth
+
+
+@pytest.mark.parametrize("shape", cycling.FORMATION_SHAPES)
+def test_a_formation_of_n_plus_one_is_the_formation_of_n_and_one_rider_behind(shape: cycling.FormationShape) -> None:
+    # So the wake model's "a rider joining behind never raises anyone's drag" holds from one count to the next.
+    big = cycling.formation(121, shape, gap_m=0.4, lateral_m=0.6)
+    for n in range(1, 121):
+        np.testing.assert_array_equal(cycling.formation(n, shape, gap_m=0.4, lateral_m=0.6), big[:n])
+    if shape == "echelon":
+        assert np.all(np.diff(big[:, 0]) < 0.0)
+        drags = [cycling.formation_drag(big[:n]) for n in range(1, 122)]
+        for before, after in itertools.pairwise(drags):
+            assert np.all(after[:-1] <= before + 1e-12)
 
 
 @given(speed=st.floats(0.0, 20.0), cda=riders.cda_m2, mass=riders.mass_kg, crr=riders.crr)
