@@ -172,9 +172,17 @@ def compute_line(p: PelotonParams) -> LineState:
     return LineState(reduction=reduction, cda_m2=cda, power=power, solo=solo, positions=positions)
 
 
-def formation_positions(p: PelotonParams) -> np.ndarray:
-    """(n_riders, 2) positions of the riders in the chosen formation (m), leader first."""
+def _formation(p: PelotonParams) -> np.ndarray:
     return cycling.formation(p.n_riders, p.formation, gap_m=p.gap_m, lateral_m=LATERAL_M)
+
+
+def formation_positions(p: PelotonParams) -> np.ndarray:
+    """(n_riders, 2) positions of the riders in the chosen formation on the road (m), leader first: the formation
+    moved across the road so that its outermost riders are as far left of the road's axis as right of it (an
+    echelon starts at the left edge and steps across to the right one). Moving a whole group changes no rider's
+    drag: the wake model sees only the riders' offsets from each other."""
+    xy = _formation(p)
+    return xy - [0.0, 0.5 * float(xy[:, 1].min() + xy[:, 1].max())]
 
 
 def drag_reductions(p: PelotonParams) -> np.ndarray:
@@ -182,7 +190,7 @@ def drag_reductions(p: PelotonParams) -> np.ndarray:
     the formation wake model (:func:`kernels.cycling.formation_drag`) otherwise."""
     if p.formation == "single":
         return cycling.drag_reduction(p.n_riders, p.gap_m, p.model)
-    return 1.0 - cycling.formation_drag(formation_positions(p), p.model)
+    return 1.0 - cycling.formation_drag(_formation(p), p.model)
 
 
 def is_line_view(p: PelotonParams) -> bool:

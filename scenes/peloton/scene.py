@@ -54,11 +54,13 @@ from scenes.peloton.model import (
 from scenes.peloton.projection import (
     LABEL_PAD_PX,
     LABEL_PX,
+    beside_notice,
     course_to_world,
     label_lifts_px,
     lift_to_metres,
     project_px,
     slot_offsets,
+    under_notice,
 )
 
 ROAD_X_M = (-(MAX_GROUP - 1) * (BIKE_LENGTH_M + MAX_GAP_M) - 15.0, 15.0)
@@ -82,15 +84,12 @@ def _looking(azimuth_deg: float, down_deg: float) -> tuple[float, float, float]:
 
 
 GROUP_VIEW_DIRECTIONS: dict[str, tuple[float, float, float]] = {
-    "single": _looking(140.0, 40.0),
-    "double": _looking(140.0, 40.0),
-    "bunch": _looking(140.0, 40.0),
-    "echelon": _looking(160.0, 40.0),
+    shape: _looking(160.0, 40.0) for shape in ("single", "double", "bunch", "echelon")
 }
-"""A group (a long line, two abreast, a bunch, an echelon) is seen from ahead, on its right, 40° down, so the rows
-behind show: of the directions tried round the group (every 20°, 20–55° down, the browser's 75° field of view),
-these draw its smallest riders (the tenth percentile) largest once framed: a 20-rider echelon at 1280×720 about
-47 px instead of 27 from the side, a bunch of 121 30 px instead of 23."""
+"""A group (a long line, two abreast, a bunch, echelons) is seen from ahead, on its right, 40° down, so the rows
+behind show: of the directions tried round the group (every 20°, 30–60° down, the browser's 75° field of view), this
+draws its smallest riders (the tenth percentile) largest once framed clear of the panel and of the software-WebGL
+notice: a bunch of 121 at 1280×720 25 px tall (36 px at 1600×1000), 20 riders in echelons 33 px (53 px)."""
 GROUP_LABELS = 4
 """Riders of a group labelled in the picture with their power and drag: the leader, the hardest-working rider
 behind it, the one who works least and the last."""
@@ -150,6 +149,16 @@ def legend_html(low: float, high: float, summary: str) -> str:
 
 
 # --------------------------------------------------------------------------------------------- scene
+@dataclasses.dataclass(frozen=True)
+class _Framing:
+    """A view framed with its labels laid out: each label's lift and lane lift (m), whether anything framed lies
+    under the software-WebGL notice, and the camera's distance from what it orbits (m: nearer draws larger)."""
+
+    view: View
+    lifts_m: np.ndarray
+    lane_m: np.ndarray
+    under_notice: bool
+    distance_m: float
 
 
 def _watts(value: float) -> str:
@@ -378,15 +387,22 @@ time-averaged power is the mean over positions, far below the leader's.
 
     def line_points(self, bar_headroom: float = 1.0) -> np.ndarray:
         """(N, 3) world points the view must hold: every rider (also swinging off), bar tops (``bar_headroom`` times
-        as tall as now) and the wind arrow; for a group, every rider and the wind arrow."""
+        as tall as now) and the wind arrow; for a group, the corners of every rider's box and the wind arrow."""
         p = self.params
         n = p.n_riders
         if not is_line_view(p):
             x, y = self.state.positions.T
-            top = np.full(n, rider_head_m(p.position)[1])
-            half, zero = 0.5 * BIKE_LENGTH_M, np.zeros(n)
-            ends = [(x + half, y, zero), (x - half, y, zero), (x, y + 0.3, zero), (x, y - 0.3, zero), (x, y, top)]
-            local = np.vstack([np.stack(end, axis=1) for end in ends])
+            top, half = rider_head_m(p.position)[1], 0.5 * BIKE_LENGTH_M
+            # Every corner of each rider's box, wheels to head: a close camera (a few riders) sees a box's top
+            # corners well outside the points of a cross through it.
+            local = np.vstack(
+                [
+                    np.stack([x + sx * half, y + sy * 0.3, np.full(n, z)], axis=1)
+                    for sx in (-1, 1)
+                    for sy in (-1, 1)
+                    for z in (0.0, top)
+                ]
+            )
             if p.headwind_ms != 0:  # the wind arrow, ahead of the leader
                 local = np.vstack([local, [[x.max() + half + 3.0 + min(abs(p.headwind_ms), 15.0) * 0.25, 0.0, 1.2]]])
             return course_to_world(local, p.grade_pct)
@@ -449,58 +465,73 @@ time-averaged power is the mean over positions, far below the leader's.
 
     def _view_for(self, lens: Lens) -> View:
         """The view of the line for ``lens``, with room above it for the labels, which it lays out for that lens (or,
-        in course mode, the course's view of its group: :meth:`CourseMode.view_for`)."""
+        in course mode, the course's view of its group: :meth:`CourseMode.view_for`).
+
+        Nothing goes under viser's software-WebGL notice at the top left (:data:`NOTICE_PX`): where the view of the
+        whole rectangle left of the panel would put something there, the larger of the views below the notice and
+        right of it is taken."""
         course_mode = getattr(self, "course_mode", None)  # built last
         if course_mode is not None and course_mode.enabled:
             return course_mode.view_for(lens)
         with self._lock:
-            anchors = self.label_anchors()
-            up_world = course_to_world(np.array([[0.0, 0.0, 1.0]]), self.params.grade_pct)[0]
             ndc = lens.usable_ndc(right_px=LABEL_PX[0], top_px=LABEL_PX[1])
-            x0, x1 = (ndc[0] + 1.0) / 2.0 * lens.width_px, (ndc[1] + 1.0) / 2.0 * lens.width_px
-            y_top, y_bottom = (
-                (1.0 - ndc[3]) / 2.0 * lens.height_px,
-                (1.0 - ndc[2]) / 2.0 * lens.height_px,
-            )
-            framed, view, lifts_m = self._framed_points, None, np.zeros(len(anchors))
-            # Frame the line with the lifted label anchors, which lean with the road's tilt (a fresh review: up a
-            # 20 % grade the last label started left of the window); the box of each label lies right of and
-            # above its anchor, in the room the rectangle leaves. Framing the anchors shrinks the line, which may
-            # stack the labels differently: repeat until the lifted anchors fit.
-            line_view = is_line_view(self.params)
-            slots = range(self.params.n_riders) if line_view else self.marked_slots()
-            text_px = TEXT_PX_PER_CHAR * max(len(self.label_text(int(slot))) for slot in slots)
-            stem_m = 0.2 if line_view else GROUP_STEM_M  # from the bar's top or the head up to the anchor
-            for _ in range(MAX_RIDERS + 2):
-                direction = VIEW_DIRECTION if line_view else GROUP_VIEW_DIRECTIONS[self.params.formation]
-                view = frame_points(framed, direction, fov_rad=lens.fov_rad, aspect=lens.aspect, ndc=ndc)
-                anchors_px = project_px(anchors, view, lens)
-                stem_px = float(np.max(project_px(anchors - stem_m * up_world, view, lens)[:, 1] - anchors_px[:, 1]))
-                lifts_px = label_lifts_px(anchors_px, text_px=text_px, stem_px=stem_px)
-                lifts_m = lift_to_metres(anchors, lifts_px, up_world, view, lens)
-                lifted = anchors + lifts_m[:, None] * up_world
-                # The lane: a label lifted to it sits, wherever along the line, above the top of every label.
-                lane_y = np.min(anchors_px[:, 1] - lifts_px, initial=np.inf) - LABEL_PX[1] - LABEL_PAD_PX
-                lane_px = np.maximum(anchors_px[:, 1] - lane_y, 0.0)
-                lane_m = lift_to_metres(anchors, lane_px, up_world, view, lens)
-                if self._rotating():  # the lane a dropping leader's label rides in must be in view too
-                    lifted = np.vstack([lifted, anchors + lane_m[:, None] * up_world])
-                px = project_px(lifted, view, lens)
-                if (
-                    px[:, 0].min(initial=x0) >= x0 - 0.5
-                    and px[:, 0].max(initial=x1) <= x1 + 0.5
-                    and px[:, 1].min(initial=y_top) >= y_top - 0.5
-                    and px[:, 1].max(initial=y_bottom) <= y_bottom + 0.5
-                ):
-                    break
-                framed = np.vstack([framed, lifted])
-            assert view is not None
+            framing = self._frame_with_labels(lens, ndc)
+            if framing.under_notice:
+                candidates = [self._frame_with_labels(lens, part) for part in beside_notice(lens, ndc)]
+                clear = [c for c in candidates if not c.under_notice] or candidates
+                framing = min(clear, key=lambda c: c.distance_m)
             self._label_lift_m = np.zeros(MAX_RIDERS)
-            self._label_lift_m[: len(lifts_m)] = lifts_m
+            self._label_lift_m[: len(framing.lifts_m)] = framing.lifts_m
             self._lane_lift_m = np.zeros(MAX_RIDERS)
-            self._lane_lift_m[: len(lane_m)] = lane_m
+            self._lane_lift_m[: len(framing.lane_m)] = framing.lane_m
             self.redraw(readouts=False)
-            return view
+            return framing.view
+
+    def _frame_with_labels(self, lens: Lens, ndc: tuple[float, float, float, float]) -> _Framing:
+        """Frame what :meth:`line_points` holds inside ``ndc`` with the labels laid out for it (call under the
+        lock)."""
+        anchors = self.label_anchors()
+        up_world = course_to_world(np.array([[0.0, 0.0, 1.0]]), self.params.grade_pct)[0]
+        x0, x1 = (ndc[0] + 1.0) / 2.0 * lens.width_px, (ndc[1] + 1.0) / 2.0 * lens.width_px
+        y_top, y_bottom = (1.0 - ndc[3]) / 2.0 * lens.height_px, (1.0 - ndc[2]) / 2.0 * lens.height_px
+        framed, view = self._framed_points, None
+        lifts_m = lane_m = np.zeros(len(anchors))
+        lifted = anchors
+        # Frame the line with the lifted label anchors, which lean with the road's tilt (a fresh review: up a 20 %
+        # grade the last label started left of the window); the box of each label lies right of and above its
+        # anchor, in the room the rectangle leaves. Framing the anchors shrinks the line, which may stack the labels
+        # differently: repeat until the lifted anchors fit.
+        line_view = is_line_view(self.params)
+        slots = range(self.params.n_riders) if line_view else self.marked_slots()
+        text_px = TEXT_PX_PER_CHAR * max(len(self.label_text(int(slot))) for slot in slots)
+        stem_m = 0.2 if line_view else GROUP_STEM_M  # from the bar's top or the head up to the anchor
+        direction = VIEW_DIRECTION if line_view else GROUP_VIEW_DIRECTIONS[self.params.formation]
+        for _ in range(MAX_RIDERS + 2):
+            view = frame_points(framed, direction, fov_rad=lens.fov_rad, aspect=lens.aspect, ndc=ndc)
+            anchors_px = project_px(anchors, view, lens)
+            stem_px = float(np.max(project_px(anchors - stem_m * up_world, view, lens)[:, 1] - anchors_px[:, 1]))
+            lifts_px = label_lifts_px(anchors_px, text_px=text_px, stem_px=stem_px)
+            lifts_m = lift_to_metres(anchors, lifts_px, up_world, view, lens)
+            lifted = anchors + lifts_m[:, None] * up_world
+            # The lane: a label lifted to it sits, wherever along the line, above the top of every label.
+            lane_y = np.min(anchors_px[:, 1] - lifts_px, initial=np.inf) - LABEL_PX[1] - LABEL_PAD_PX
+            lane_px = np.maximum(anchors_px[:, 1] - lane_y, 0.0)
+            lane_m = lift_to_metres(anchors, lane_px, up_world, view, lens)
+            if self._rotating():  # the lane a dropping leader's label rides in must be in view too
+                lifted = np.vstack([lifted, anchors + lane_m[:, None] * up_world])
+            px = project_px(lifted, view, lens)
+            if (
+                px[:, 0].min(initial=x0) >= x0 - 0.5
+                and px[:, 0].max(initial=x1) <= x1 + 0.5
+                and px[:, 1].min(initial=y_top) >= y_top - 0.5
+                and px[:, 1].max(initial=y_bottom) <= y_bottom + 0.5
+            ):
+                break
+            framed = np.vstack([framed, lifted])
+        assert view is not None
+        hidden = under_notice(project_px(framed, view, lens), project_px(lifted, view, lens))
+        distance = math.dist(view.position, view.look_at)
+        return _Framing(view, lifts_m, lane_m, under_notice=hidden, distance_m=distance)
 
     def _update_framing(self) -> None:
         """Frame every browser again when the line changes length or tilt, or its bars outgrow the view.
