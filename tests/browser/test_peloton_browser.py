@@ -4,6 +4,8 @@ drag on the speed slider is in ``test_interactions_browser.py``.)"""
 
 from __future__ import annotations
 
+import contextlib
+from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
@@ -286,36 +288,46 @@ def test_an_echelon_of_20_is_drawn_large_enough_to_see(shown: ScenePage) -> None
         scene.controls["formation"].value, scene.controls["n_riders"].value = "Single file", 4
 
 
+@contextlib.contextmanager
+def notice_left_open(shown: ScenePage) -> Iterator[tuple[float, float] | None]:
+    """Wait for viser's software-WebGL notice and leave it open; give its bottom right corner (CSS px), or None where
+    the page draws on a GPU and shows none."""
+    hold_resolution(shown.page)
+    if not shown.page.evaluate(SOFTWARE_WEBGL):
+        yield None
+        return
+    toast = shown.page.locator(TOAST, has_text="Software WebGL rendering detected")
+    toast.wait_for(timeout=90_000)
+    box = toast.bounding_box()
+    assert box is not None
+    yield box["x"] + box["width"], box["y"] + box["height"]
+    assert shown.page.locator(TOAST).count() == 1  # still open: what was looked at was under it
+
+
 @pytest.mark.parametrize("viewport", VIEWPORTS, ids=lambda v: f"{v[0]}x{v[1]}")
 def test_a_group_of_121_is_framed_clear_of_the_software_webgl_notice(
     server: viser.ViserServer, browser_page: Any, viewport: tuple[int, int]
 ) -> None:
     # The failing look (a review): at 1280×720 the back rows of a 121-rider bunch lay under viser's notice, and an
     # echelon of 121 ran off the road. Here the notice stays open, as it does until a person closes it.
-    page = browser_page
-    page.set_viewport_size({"width": viewport[0], "height": viewport[1]})
-    with served_scene(server, page, "peloton", "/peloton", viewport=viewport) as shown:
-        hold_resolution(page)
-        notice: tuple[float, float] | None = None
-        if page.evaluate(SOFTWARE_WEBGL):
-            toast = page.locator(TOAST, has_text="Software WebGL rendering detected")
-            toast.wait_for(timeout=90_000)
-            box = toast.bounding_box()
-            assert box is not None
-            notice = (box["x"] + box["width"], box["y"] + box["height"])
+    browser_page.set_viewport_size({"width": viewport[0], "height": viewport[1]})
+    with (
+        served_scene(server, browser_page, "peloton", "/peloton", viewport=viewport) as shown,
+        notice_left_open(shown) as notice,
+    ):
+        page = shown.page
+        if notice is not None:
             assert notice[0] <= NOTICE_PX[0] and notice[1] <= NOTICE_PX[1], notice  # the room the scene keeps free
         scene = shown.scene
         assert isinstance(scene, PelotonScene)
         for formation in ("Bunch (peloton)", "Echelon"):
             scene.controls["formation"].value, scene.controls["n_riders"].value = formation, 121
             settle(shown)
-            if notice is not None:
-                assert page.locator(TOAST).count() == 1  # still open
             with scene._lock:
                 n = scene.params.n_riders
                 xy = np.asarray(scene.riders_nodes["body"].batched_positions, dtype=np.float64)[:n, :2]
                 top = rider_head_m(scene.params.position)[1]
-                road = node_box_corners(page, "/peloton/course/road")
+            road = node_box_corners(page, "/peloton/course/road")
             corners = np.vstack(
                 [
                     np.column_stack([xy + [sx * 0.85, sy * 0.3], np.full(n, z)])
