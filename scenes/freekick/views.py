@@ -10,10 +10,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from kernels import ball
-from scenes._framing import Lens, View, frame_points
+from scenes._framing import Lens, View, box_corners, frame_points, project_points
 from scenes.freekick.model import (
     DEFENDER_WIDTH_M,
     DEFENDERS,
+    KEEPER,
     FreeKickParams,
     KickState,
     ViewName,
@@ -21,6 +22,7 @@ from scenes.freekick.model import (
     resample,
     wall_axes,
 )
+from scenes.peloton.projection import NOTICE_PX, beside_notice
 
 VIEW_MIN_DEPTH_M: dict[ViewName, float] = {
     "broadcast": 3.0,
@@ -38,6 +40,8 @@ KEEPER_LOOK_DOWN = (0.25, 0.5, 0.8, 1.2, 2.0, 3.0)
 KEEPER_LOOK_ASIDE = (0.3, -0.3, 0.0)
 """Sideways turns (per unit of horizontal look, + toward the kicker's left) it tries at each tilt: a keeper steps
 to one side to see the ball past the wall."""
+KEEPER_BOX_M = 0.5
+"""Half the width of the box (m) kept in frame around where the keeper stands: his body and arms."""
 KEEPER_FRONT_M = 0.3
 """How far in front of the goal line (x < 0) the goalkeeper's camera stands at least (m)."""
 
@@ -76,12 +80,21 @@ def view_points(
     p: FreeKickParams, state: KickState, view: ViewName, also: NDArray[np.float64] | None = None
 ) -> NDArray[np.float64]:
     """(N, 3) what ``view`` keeps in frame (m): the ball on its spot (its whole sphere), the path and the no-spin
-    ghost, the wall and the goal with its net; the goalkeeper's view (``"goal"``) stands in front of the goal, so it
+    ghost, the wall, the goal with its net and the keeper standing in it (his box to his raised hands); the goalkeeper's view (``"goal"``) stands in front of the goal, so it
     keeps neither the goal nor the last :data:`KEEPER_SEES_FROM_M` of the flights. ``also``: (M, 3) more points the
     view from above keeps in frame (the odds map's tiles, when it is shown).
     """
     half, h = 0.5 * ball.GOAL_WIDTH_M, ball.GOAL_HEIGHT_M
     goal = np.array([[x, y, z] for x in (0.0, 2.0) for y in (-half, half) for z in (0.0, h)])
+    if state.keeper_xy is not None:
+        kx, ky = state.keeper_xy
+        top = KEEPER.com_height_m + KEEPER.hand_reach_m
+        goal = np.vstack(
+            [
+                goal,
+                box_corners((kx - KEEPER_BOX_M, ky - KEEPER_BOX_M, 0.0), (kx + KEEPER_BOX_M, ky + KEEPER_BOX_M, top)),
+            ]
+        )
     wall = state.wall
     _normal, along = wall_axes(wall)
     centre, width = np.array(wall.centre_xy), 0.5 * DEFENDERS * DEFENDER_WIDTH_M
@@ -116,7 +129,7 @@ def frame_view(
     p: FreeKickParams, state: KickState, view: ViewName, lens: Lens, also: NDArray[np.float64] | None = None
 ) -> View:
     """The camera pose of ``view`` for one browser's ``lens``: :func:`view_points` (with ``also``) in frame, left of
-    the panel.
+    the panel and clear of viser's software-WebGL notice at the top left (:func:`frame_clear_of_notice`).
 
     The goalkeeper's view tries tilts (:data:`KEEPER_LOOK_DOWN`, flattest first) and turns
     (:data:`KEEPER_LOOK_ASIDE`) until its camera stands at least :data:`KEEPER_FRONT_M` in front of the goal line
@@ -131,14 +144,7 @@ def frame_view(
     framed, in_front = None, None
     for down, aside in tries:
         d = view_direction(p, view, down, aside)
-        framed = frame_points(
-            points,
-            (float(d[0]), float(d[1]), float(d[2])),
-            fov_rad=lens.fov_rad,
-            aspect=lens.aspect,
-            ndc=lens.usable_ndc(),
-            min_depth=VIEW_MIN_DEPTH_M[view],
-        )
+        framed = frame_clear_of_notice(points, (float(d[0]), float(d[1]), float(d[2])), lens, VIEW_MIN_DEPTH_M[view])
         if view != "goal":
             return framed
         if framed.position[0] <= -KEEPER_FRONT_M:
@@ -147,3 +153,31 @@ def frame_view(
                 return framed
     assert framed is not None
     return in_front if in_front is not None else framed
+
+
+def under_notice(view: View, lens: Lens, points: NDArray[np.float64]) -> bool:
+    """Whether any of the (N, 3) ``points`` (m) lands under viser's software-WebGL notice (:data:`NOTICE_PX`, the
+    canvas's top left corner) seen from ``view`` through ``lens``."""
+    px = project_points(view, lens, points)
+    return bool(np.any((px[:, 0] < NOTICE_PX[0]) & (px[:, 1] < NOTICE_PX[1])))
+
+
+def frame_clear_of_notice(
+    points: NDArray[np.float64], direction: tuple[float, float, float], lens: Lens, min_depth: float
+) -> View:
+    """The camera looking along ``direction`` that shows every one of (N, 3) ``points`` (m) left of the panel, at
+    least ``min_depth`` (m) in front of it, and none under viser's software-WebGL notice: a browser without a GPU
+    shows it over the top left of the scene until a person closes it. Where the framing of the whole free rectangle
+    puts a point there, the nearer (larger) of the framings below the notice and right of it that keeps every point
+    clear (:func:`scenes.peloton.projection.beside_notice`); if neither does, the nearer of the two."""
+
+    def frame(ndc: tuple[float, float, float, float]) -> View:
+        return frame_points(points, direction, fov_rad=lens.fov_rad, aspect=lens.aspect, ndc=ndc, min_depth=min_depth)
+
+    ndc = lens.usable_ndc()
+    framed = frame(ndc)
+    if not under_notice(framed, lens, points):
+        return framed
+    candidates = [frame(part) for part in beside_notice(lens, ndc)]
+    clear = [c for c in candidates if not under_notice(c, lens, points)] or candidates
+    return min(clear, key=lambda v: float(np.linalg.norm(np.subtract(v.position, v.look_at))))
