@@ -11,6 +11,8 @@ from typing import Any
 import numpy as np
 import pytest
 from helpers.browser import (
+    SOFTWARE_WEBGL,
+    TOAST,
     NumberChange,
     ScenePage,
     assert_chart_draws,
@@ -25,6 +27,7 @@ from helpers.browser import (
     save_scene_screenshot,
     scene_page_fixture,
     screenshot,
+    served_scene,
     set_number,
     settle,
     visible_text,
@@ -67,9 +70,10 @@ earlier tests left, and 0.06 for a ball 40 m out."""
 OPENING_GAP_PX = 25.0
 """Least on-screen distance of the path from its no-spin ghost over the flight's second half, opening view (the old
 one drew them 1–10 px apart)."""
-SPIN_SHIFT_SHARE = 0.006
+SPIN_SHIFT_SHARE = 0.005
 """10 % more spin moves the crossing of the goal line by at least this share of the window width on the screen in
-the opening view (the old view: 8.2 px at 1600 and 5.8 px at 1280 wide, under it)."""
+the opening view (the old view: 8.2 px at 1600 and 5.8 px at 1280 wide; framed clear of the software-WebGL notice
+the view at 1280×720 is smaller: 6.6 px)."""
 
 
 shown = scene_page_fixture("freekick")
@@ -100,7 +104,7 @@ def test_the_kick_fills_the_view_clear_of_the_panel(shown: ScenePage) -> None:
         path, ghost = resample(scene.state.flight, 40), resample(scene.state.ghost, 40)
     xy = project(shown.page, "/freekick", points)[:, :2]
     width = panel_rect(shown.page)[0]
-    assert np.ptp(xy[:, 0]) > 0.6 * width, np.ptp(xy[:, 0])
+    assert np.ptp(xy[:, 0]) > 0.55 * width, np.ptp(xy[:, 0])  # 0.60 at 1280×720, framed below the WebGL notice
     # ...with the goal a real size...
     assert _goal_share(shown) >= OPENING_GOAL_SHARE, _goal_share(shown)
     # ...and the curl across the screen: the path stands apart from the no-spin ghost over the second half.
@@ -278,3 +282,54 @@ def test_the_goal_chance_map_is_drawn_on_the_grass_from_above(shown: ScenePage) 
     text = visible_text(shown.page)
     assert "Best spot:" in text and "Goal 0 → 100 %" in text
     assert error_text(shown.page) == []
+
+
+@pytest.mark.parametrize("viewport", [(1600, 1000), (1280, 720)], ids=lambda v: f"{v[0]}x{v[1]}")
+def test_the_goal_frame_and_keeper_show_clear_of_the_notice_and_the_panel(
+    server: Any, browser_page: Any, viewport: tuple[int, int]
+) -> None:
+    # A review at 1280×720 saw only the goal's top left corner, under viser's software-WebGL notice, and no keeper
+    # while the readout said "Saved"; with the ball 30 m out at 40° the goal and keeper left the frame. Here the
+    # notice stays open, as it does until a person closes it, and the pixels the goal's white frame and the keeper
+    # make (the difference when they are hidden) are counted where a person can see them, left of the panel.
+    browser_page.set_viewport_size({"width": viewport[0], "height": viewport[1]})
+    with served_scene(server, browser_page, "freekick", "/freekick/goal_frame", viewport=viewport) as shown:
+        page = shown.page
+        notice = (0.0, 0.0)
+        if page.evaluate(SOFTWARE_WEBGL):
+            toast = page.locator(TOAST, has_text="Software WebGL rendering detected")
+            toast.wait_for(timeout=90_000)
+            box = toast.bounding_box()
+            assert box is not None
+            notice = (box["x"] + box["width"], box["y"] + box["height"])
+        scene = shown.scene
+        assert isinstance(scene, FreeKickScene)
+        panel_left = panel_rect(page)[0]
+        for distance, angle in ((22.0, 0.0), (30.0, 40.0), (40.0, -45.0)):
+            scene.controls["distance_m"].value, scene.controls["angle_deg"].value = distance, angle
+            settle(shown)
+            shown_px = screenshot(page, path=f"/tmp/freekick_notice_{distance:.0f}_{angle:.0f}_{viewport[0]}.png")
+            # The goal's corners and the standing keeper's box through the page's own camera: in the page, left of
+            # the panel and none behind the notice (the notice hides what is under it, so pixels alone cannot tell).
+            with scene._lock:
+                keeper = scene.state.keeper_xy
+            assert keeper is not None
+            standing = [
+                [keeper[0] + sx, keeper[1] + sy, z] for sx in (-0.4, 0.4) for sy in (-0.4, 0.4) for z in (0, 2.3)
+            ]
+            seen_xy = assert_in_view(shown, "/freekick", np.vstack([GOAL_CORNERS, standing]), "goal and keeper")
+            hidden = (seen_xy[:, 0] < notice[0]) & (seen_xy[:, 1] < notice[1])
+            assert not hidden.any(), ((distance, angle, viewport), seen_xy[hidden])
+            # Least pixels each draws: the goal's frame covers 133 px at its smallest (40 m out at −45°, 1280×720).
+            for names, least in ((["/freekick/goal_frame"], 100), (["/freekick/keeper", "/freekick/keeper_head"], 20)):
+                seen = changed_mask(shown_px, with_nodes_hidden(page, names))
+                seen[:, int(panel_left) :] = False  # the panel's text can redraw meanwhile; it covers the canvas
+                ys, xs = np.nonzero(seen)
+                where = (names[0], distance, angle, viewport)
+                assert len(xs) >= least, where  # drawn large enough to see
+                under = (xs < notice[0]) & (ys < notice[1])
+                assert not under.any(), (where, int(under.sum()))  # none of it under the notice
+            if notice != (0.0, 0.0):
+                assert page.locator(TOAST).count() == 1  # still open: what was looked at was under it
+            assert error_text(page) == []
+        scene.controls["distance_m"].value, scene.controls["angle_deg"].value = 22.0, 0.0
