@@ -76,6 +76,10 @@ class AddUplot(Protocol):
 
 
 # --------------------------------------------------------------------------------------------- label widths
+TINY = 1e-300
+"""Least magnitude the label arithmetic works with: far below the 3 decimals a label shows, far above the subnormals."""
+
+
 def label_px(text: str) -> float:
     """Width in CSS px of tick label ``text`` in uPlot's 12 px axis font (an upper bound)."""
     return sum(DIGIT_PX if c.isdigit() else CHAR_PX.get(c, DIGIT_PX) for c in text)
@@ -111,10 +115,12 @@ def widest_linear_label(lo: float, hi: float, ticks_max: int, pad: float) -> str
     extent = max(abs(lo), abs(hi)) + pad * span
     if extent <= 0.0:
         return "0"
+    # Below TINY a power of ten underflows to 0 (subnormal data): such values print as "0.000" whatever they are.
+    extent = max(extent, TINY)
     lead = 10.0 ** math.floor(math.log10(extent))
     # The extent rounded up at its leading digit.
     top = math.ceil(extent / lead * (1.0 - 1e-12)) * lead
-    decimals = _decimals_of_step(span / ticks_max)
+    decimals = _decimals_of_step(max(span / ticks_max, TINY))
     sign = "-" if lo < 0.0 else ""
     return sign + format_label(top, decimals)
 

@@ -169,12 +169,10 @@ def frame_points(
     # The camera at distance D behind the centre sees point i at depth D + w_i and, shifted by s across the view, at
     # ndc (u_i − s)/((D + w_i)·tan_x) on x (likewise on y). Some s puts every point inside [lo, hi] iff
     # max_i(u_i − hi·k_i) ≤ min_j(u_j − lo·k_j) with k = (D + w)·tan_x, which is linear in D: the least distance is
-    # closed-form (_least_distance). The nearest distance is never under the one the depths allow, nor (as the
-    # bracket of the former bisection) under depth_extent + NEAR_M; it is never over `far`, beyond which the
-    # rectangle counts as unable to hold the points.
+    # closed-form (_least_distance). The nearest distance is never under the one the depths allow (which keeps every
+    # k positive); it is never over `far`, beyond which the rectangle counts as unable to hold the points.
     far = depth_extent + least_depth + 1000.0 * (size + 1.0)
     distance = max(
-        depth_extent + NEAR_M,
         least_depth - float(np.min(w)),
         _least_distance(u, w, tan_x, x0, x1),
         _least_distance(v, w, tan_y, y0, y1),

@@ -11,6 +11,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
+import sys
 from collections.abc import Sequence
 from typing import Any
 
@@ -178,6 +179,8 @@ def _round_down(value: float) -> float:
     if not 0.0 < value < math.inf:
         return value
     scale = 10.0 ** (math.floor(math.log10(value)) - 2)
+    if scale < sys.float_info.min:  # a subnormal scale: rounding there is coarser than three digits
+        return value
     return math.floor(value / scale) * scale
 
 

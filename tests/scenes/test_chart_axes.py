@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 import viser.uplot
 from helpers.properties import examples
 from hypothesis import given, settings
@@ -20,6 +21,7 @@ from scenes._charts import (
     label_px,
     log_ticks,
     whole_numbers,
+    widest_linear_label,
 )
 
 SERIES = (viser.uplot.Series(label="Iteration"), viser.uplot.Series(label="Error (mm)"))
@@ -101,6 +103,18 @@ def test_whole_number_x_gets_whole_ticks_and_at_least_a_unit_of_range(x: np.ndar
 def test_fractional_x_keeps_uplot_s_own_ticks(x: list[float]) -> None:
     data = (np.array(sorted(x)), np.ones(len(x)))
     assert "incrs" not in _x_axis(data, LINEAR_SCALES)
+
+
+@pytest.mark.parametrize(
+    ("x", "widest"),
+    [([5e-324], "0.000"), ([-5e-324, 5e-324], "-0.000"), ([0.0, 1e-310], "0.000"), ([1e-320, 2e-320, 0.5], "0.50")],
+)
+def test_subnormal_x_gets_a_label_width_and_uplot_s_own_ticks(x: list[float], widest: str) -> None:
+    # Found with fresh examples: a lone x of 5e-324 was divided by a power of ten that underflowed to zero. Values
+    # that small print as uPlot's 3-decimal zero.
+    data = (np.array(x), np.ones(len(x)))
+    assert "incrs" not in _x_axis(data, LINEAR_SCALES)
+    assert widest_linear_label(min(x), max(x), 16, 0.0) == widest
 
 
 @given(

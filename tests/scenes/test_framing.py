@@ -130,6 +130,19 @@ def test_a_cloud_along_the_view_direction_stays_beyond_the_near_plane() -> None:
     assert projected[:, 2].min() == pytest.approx(NEAR_M, rel=1e-3)
 
 
+def test_a_cloud_deep_behind_its_centre_is_framed_tight_not_held_back_by_its_far_side() -> None:
+    # Found by the property above with fresh examples: the camera was kept at least the cloud's largest depth offset
+    # (its far side's) behind the centre, so a cloud whose far side lies deeper than its near side filled only 93 % of
+    # the rectangle while its nearest point stood 0.23 m away, not at the 0.05 m that holds a camera back.
+    cloud = np.array([(0.0, 0.0, 0.0), (0.0, 2.0, 0.0), (1.0, 0.0, 0.0)])
+    ndc, fov = (-0.8, 0.4, -0.7, 0.9), math.radians(31.0)
+    view = frame_points(cloud, _direction(-1.75, 0.0), fov_rad=fov, aspect=3.0, ndc=ndc)
+    projected = _project(cloud, np.array(view.position), np.array(view.look_at), fov, 3.0)
+    _assert_inside(projected, ndc)
+    assert np.ptp(projected[:, 0]) / (ndc[1] - ndc[0]) == pytest.approx(1.0, abs=1e-9)
+    assert projected[:, 2].min() > NEAR_M
+
+
 def test_a_box_seen_side_on_is_centred_in_the_free_part_of_the_window() -> None:
     # A 10 m × 1 m × 2 m box, seen along +y: its centre lands mid-way across the canvas left of the panel.
     lo, hi = np.array([-5.0, -0.5, 0.0]), np.array([5.0, 0.5, 2.0])
