@@ -256,6 +256,56 @@ def box_corners(lo: NDArray[np.float64] | tuple, hi: NDArray[np.float64] | tuple
     )
 
 
+NOTICE_PX = (318.0, 193.0)
+"""Room (px, width and height from the canvas's top left corner) of viser's "Software WebGL rendering detected"
+notice: 296 × 171 px, 14 px from the corner, with 8 px to spare. A browser drawing without a GPU shows it over the
+scene until a person closes it, so nothing framed goes under it."""
+
+
+def in_notice(points_px: NDArray[np.float64]) -> NDArray[np.bool_]:
+    """(N,) whether each canvas point of (N, ≥2) ``points_px`` (x, y in px from the top left) lies under
+    :data:`NOTICE_PX`."""
+    px = np.asarray(points_px, dtype=np.float64).reshape(len(points_px), -1)
+    return (px[:, 0] < NOTICE_PX[0]) & (px[:, 1] < NOTICE_PX[1])
+
+
+def beside_notice(
+    lens: Lens, ndc: tuple[float, float, float, float], *, room_above_px: float = 0.0
+) -> list[tuple[float, float, float, float]]:
+    """The two parts of the rectangle ``ndc`` (x0, x1, y0, y1, normalised device coordinates of ``lens``) clear of
+    :data:`NOTICE_PX`: below the notice (leaving ``room_above_px`` under it, e.g. for labels drawn above their
+    anchors) and right of it."""
+    x0, x1, y0, y1 = ndc
+    # One pixel past the notice's edges, so a point framed onto a part's edge stays clear of it after rounding.
+    below = 1.0 - 2.0 * (NOTICE_PX[1] + 1.0 + room_above_px) / max(lens.height_px, 1)
+    right = -1.0 + 2.0 * (NOTICE_PX[0] + 1.0) / max(lens.width_px, 1)
+    return [(x0, x1, y0, min(y1, below)), (max(x0, right), x1, y0, y1)]
+
+
+def frame_clear_of_notice(
+    points: NDArray[np.float64], direction: tuple[float, float, float], lens: Lens, *, min_depth: float = 0.0
+) -> View:
+    """The camera looking along ``direction`` that shows every one of (N, 3) ``points`` (m) left of the panel, at
+    least ``min_depth`` (m) in front of it, and none under viser's software-WebGL notice (:data:`NOTICE_PX`).
+
+    Where the framing of the whole free rectangle puts a point under the notice, the nearer (larger) of the framings
+    below it and right of it (:func:`beside_notice`) that keeps every point clear; if neither does, the nearer."""
+
+    def frame(ndc: tuple[float, float, float, float]) -> View:
+        return frame_points(points, direction, fov_rad=lens.fov_rad, aspect=lens.aspect, ndc=ndc, min_depth=min_depth)
+
+    def hidden(view: View) -> bool:
+        return bool(in_notice(project_points(view, lens, points)).any())
+
+    ndc = lens.usable_ndc()
+    framed = frame(ndc)
+    if not hidden(framed):
+        return framed
+    candidates = [frame(part) for part in beside_notice(lens, ndc)]
+    clear = [c for c in candidates if not hidden(c)] or candidates
+    return min(clear, key=lambda v: math.dist(v.position, v.look_at))
+
+
 class ClientFraming:
     """Frames each browser's camera once, by its own image size, and all of them again on :meth:`reframe`.
 

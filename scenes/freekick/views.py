@@ -10,7 +10,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from kernels import ball
-from scenes._framing import Lens, View, box_corners, frame_points, project_points
+from scenes._framing import Lens, View, box_corners, frame_clear_of_notice
 from scenes.freekick.model import (
     DEFENDER_WIDTH_M,
     DEFENDERS,
@@ -22,7 +22,6 @@ from scenes.freekick.model import (
     resample,
     wall_axes,
 )
-from scenes.peloton.projection import NOTICE_PX, beside_notice
 
 VIEW_MIN_DEPTH_M: dict[ViewName, float] = {
     "broadcast": 3.0,
@@ -144,7 +143,9 @@ def frame_view(
     framed, in_front = None, None
     for down, aside in tries:
         d = view_direction(p, view, down, aside)
-        framed = frame_clear_of_notice(points, (float(d[0]), float(d[1]), float(d[2])), lens, VIEW_MIN_DEPTH_M[view])
+        framed = frame_clear_of_notice(
+            points, (float(d[0]), float(d[1]), float(d[2])), lens, min_depth=VIEW_MIN_DEPTH_M[view]
+        )
         if view != "goal":
             return framed
         if framed.position[0] <= -KEEPER_FRONT_M:
@@ -153,31 +154,3 @@ def frame_view(
                 return framed
     assert framed is not None
     return in_front if in_front is not None else framed
-
-
-def under_notice(view: View, lens: Lens, points: NDArray[np.float64]) -> bool:
-    """Whether any of the (N, 3) ``points`` (m) lands under viser's software-WebGL notice (:data:`NOTICE_PX`, the
-    canvas's top left corner) seen from ``view`` through ``lens``."""
-    px = project_points(view, lens, points)
-    return bool(np.any((px[:, 0] < NOTICE_PX[0]) & (px[:, 1] < NOTICE_PX[1])))
-
-
-def frame_clear_of_notice(
-    points: NDArray[np.float64], direction: tuple[float, float, float], lens: Lens, min_depth: float
-) -> View:
-    """The camera looking along ``direction`` that shows every one of (N, 3) ``points`` (m) left of the panel, at
-    least ``min_depth`` (m) in front of it, and none under viser's software-WebGL notice: a browser without a GPU
-    shows it over the top left of the scene until a person closes it. Where the framing of the whole free rectangle
-    puts a point there, the nearer (larger) of the framings below the notice and right of it that keeps every point
-    clear (:func:`scenes.peloton.projection.beside_notice`); if neither does, the nearer of the two."""
-
-    def frame(ndc: tuple[float, float, float, float]) -> View:
-        return frame_points(points, direction, fov_rad=lens.fov_rad, aspect=lens.aspect, ndc=ndc, min_depth=min_depth)
-
-    ndc = lens.usable_ndc()
-    framed = frame(ndc)
-    if not under_notice(framed, lens, points):
-        return framed
-    candidates = [frame(part) for part in beside_notice(lens, ndc)]
-    clear = [c for c in candidates if not under_notice(c, lens, points)] or candidates
-    return min(clear, key=lambda v: float(np.linalg.norm(np.subtract(v.position, v.look_at))))

@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 
-from scenes._framing import Lens, View
+from scenes._framing import Lens, View, in_notice
 from scenes.peloton.model import BIKE_LENGTH_M, MAX_RIDERS
 
 LABEL_PX = (190.0, 30.0)
@@ -24,28 +24,13 @@ def slot_offsets(n_riders: int, gap_m: float) -> np.ndarray:
 
 LABEL_PAD_PX = 4.0
 """Clear space kept between two riders' labels (px)."""
-NOTICE_PX = (318.0, 193.0)
-"""Room (px, width and height from the canvas's top left corner) of viser's "Software WebGL rendering detected"
-notice: 296 × 171 px, 14 px from the corner, with 8 px to spare. A browser drawing without a GPU shows it over the
-scene until a person closes it, so nothing framed goes under it."""
-
-
-def beside_notice(lens: Lens, ndc: tuple[float, float, float, float]) -> list[tuple[float, float, float, float]]:
-    """The parts of the rectangle ``ndc`` (x0, x1, y0, y1, normalised device coordinates of ``lens``) clear of
-    :data:`NOTICE_PX`: below the notice, with room above for a label, and right of it."""
-    x0, x1, y0, y1 = ndc
-    below = 1.0 - 2.0 * (NOTICE_PX[1] + LABEL_PX[1]) / max(lens.height_px, 1)
-    right = -1.0 + 2.0 * NOTICE_PX[0] / max(lens.width_px, 1)
-    return [(x0, x1, y0, min(y1, below)), (max(x0, right), x1, y0, y1)]
 
 
 def under_notice(points_px: np.ndarray, anchors_px: np.ndarray) -> bool:
     """Whether any of the (N, 2) ``points_px`` or any label drawn right of and above its (M, 2) anchor
     (:data:`LABEL_PX`) would lie under :data:`NOTICE_PX`."""
-    width, height = NOTICE_PX
-    points = (points_px[:, 0] < width) & (points_px[:, 1] < height)
-    labels = (anchors_px[:, 0] < width) & (anchors_px[:, 1] - LABEL_PX[1] < height)
-    return bool(points.any() or labels.any())
+    label_bottoms = np.asarray(anchors_px, dtype=np.float64) - (0.0, LABEL_PX[1])
+    return bool(in_notice(points_px).any() or in_notice(label_bottoms).any())
 
 
 def course_to_world(points: np.ndarray, grade_pct: float) -> np.ndarray:

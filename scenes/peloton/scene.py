@@ -22,7 +22,7 @@ from kernels import cycling
 from scenes._base import Scene, set_if_changed
 from scenes._charts import FittedChart
 from scenes._controls import Controls, build_controls, declared
-from scenes._framing import ClientFraming, Lens, View, frame_points
+from scenes._framing import ClientFraming, Lens, View, beside_notice, frame_points
 from scenes._instances import add_instances, park_hidden
 from scenes._look import add_ground
 from scenes.peloton.course import CourseMode
@@ -54,7 +54,6 @@ from scenes.peloton.model import (
 from scenes.peloton.projection import (
     LABEL_PAD_PX,
     LABEL_PX,
-    beside_notice,
     course_to_world,
     label_lifts_px,
     lift_to_metres,
@@ -477,7 +476,9 @@ time-averaged power is the mean over positions, far below the leader's.
             ndc = lens.usable_ndc(right_px=LABEL_PX[0], top_px=LABEL_PX[1])
             framing = self._frame_with_labels(lens, ndc)
             if framing.under_notice:
-                candidates = [self._frame_with_labels(lens, part) for part in beside_notice(lens, ndc)]
+                candidates = [
+                    self._frame_with_labels(lens, part) for part in beside_notice(lens, ndc, room_above_px=LABEL_PX[1])
+                ]
                 clear = [c for c in candidates if not c.under_notice] or candidates
                 framing = min(clear, key=lambda c: c.distance_m)
             self._label_lift_m = np.zeros(MAX_RIDERS)

@@ -41,10 +41,10 @@ from helpers.browser import (
 )
 from helpers.waiting import wait_until
 
+from scenes._framing import NOTICE_PX
 from scenes.peloton import COMPONENT_COLOURS, LABEL_PX, PelotonScene
 from scenes.peloton.meshes import rider_head_m
 from scenes.peloton.model import FORMATION_FROM_LABEL
-from scenes.peloton.projection import NOTICE_PX
 from scenes.peloton.scene import POWER_COLOURS
 
 pytestmark = pytest.mark.browser

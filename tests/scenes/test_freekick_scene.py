@@ -18,7 +18,7 @@ from hypothesis import strategies as st
 from numpy.typing import NDArray
 
 from kernels import ball
-from scenes._framing import MARGIN_PX, PANEL_PX, Lens, View, frame_points, project_points
+from scenes._framing import MARGIN_PX, NOTICE_PX, PANEL_PX, Lens, View, frame_points, project_points
 from scenes.freekick import (
     AIM_TOLERANCE_M,
     ARROW_POINTS,
@@ -48,7 +48,6 @@ from scenes.freekick import (
     wall_hides,
 )
 from scenes.freekick.model import keeper_pose, knuckle_wobble_m, spot_odds_map, strike_chances
-from scenes.peloton.projection import NOTICE_PX
 
 
 @pytest.fixture

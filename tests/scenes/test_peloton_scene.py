@@ -17,7 +17,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from kernels import cycling
-from scenes._framing import MARGIN_PX, PANEL_PX, Lens, View
+from scenes._framing import MARGIN_PX, NOTICE_PX, PANEL_PX, Lens, View
 from scenes.peloton import (
     BAR_METRES_PER_WATT,
     LABEL_PX,
@@ -30,7 +30,6 @@ from scenes.peloton import (
 )
 from scenes.peloton.meshes import rider_head_m
 from scenes.peloton.model import FORMATION_FROM_LABEL, formation_positions
-from scenes.peloton.projection import NOTICE_PX
 from server.switcher import SceneSwitcher
 
 scene = scene_fixture(PelotonScene)
