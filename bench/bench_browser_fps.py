@@ -11,7 +11,7 @@ drawing width (viser's client lowers its resolution while frames are slow; "held
 the browser tests do). The WebGL renderer string says whether it was software (SwiftShader) or a GPU.
 
 The cases are the scenes as they open, plus ``peloton-bunch``: the peloton with Formation set to a bunch and Riders
-to 121 through the page, as a person sets them. Each case runs ``repeats`` times (a fresh page each time) and a
+to 121 through the page, as a person sets them, and ``sdf-both``: the SDF gallery's View set to Both. Each case runs ``repeats`` times (a fresh page each time) and a
 last table gives the median frames per second of its runs: on a machine shared with other work one run can be
 unlucky.
 """
@@ -66,9 +66,19 @@ def bunch_of_121(shown: ScenePage) -> None:
     settle(shown)
 
 
+def sdf_both(shown: ScenePage) -> None:
+    """Set the SDF gallery's View to Both (the ray-march with the mesh's wireframe) through its dropdown."""
+    page = shown.page
+    control_row(page, "View").locator("input").first.click()
+    page.get_by_role("option", name="Both", exact=True).click()
+    wait_until(lambda: shown.scene.view_edges > 0, "the ray-march with the wireframe")
+    settle(shown)
+
+
 CASES: dict[str, tuple[str, Callable[[ScenePage], None] | None]] = {
     **{key: (key, None) for key in SCENES},
     "peloton-bunch": ("peloton", bunch_of_121),
+    "sdf-both": ("sdf", sdf_both),
 }
 """Each case: the scene it opens and what is set on its page before the camera is dragged."""
 

@@ -1,14 +1,17 @@
 """How the gallery's mesh and its ray-march agree: the :class:`Agreement` readout and the comparison behind it.
 
 :func:`compare` takes two depth images of one camera, (H, W) float (m, +inf where a ray misses): the sphere-traced
-field and the rasterised mesh. :func:`readout_markdown` is the table the "Blend and mesh" folder shows.
+field and the rasterised mesh. :func:`readout_markdown` is the table the "Blend and mesh" folder shows. :class:`Wire`
+is the mesh's edges the "both" view draws over the ray-march, where a person sees the two agree.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import functools
 
 import numpy as np
+import trimesh
 
 
 @dataclasses.dataclass(frozen=True)
@@ -60,3 +63,25 @@ def readout_markdown(a: Agreement) -> str:
         f"| Time to render | {render} |\n| Silhouette IoU (mesh vs ray-march) | {iou} |\n"
         f"| Mean depth difference | {depth} |"
     )
+
+
+class Wire:
+    """A mesh's edges for the wireframe of the "both" view, found once per mesh and only if that view draws it."""
+
+    def __init__(self, vertices: np.ndarray, faces: np.ndarray, *, serial: int) -> None:
+        self.vertices, self.faces, self.serial = vertices, faces, serial
+
+    @functools.cached_property
+    def edges(self) -> np.ndarray:
+        """(E, 2) vertex indices of the mesh's edges, each once."""
+        if len(self.faces) == 0:
+            return np.zeros((0, 2), np.int64)
+        return trimesh.Trimesh(self.vertices, self.faces, process=False).edges_unique
+
+    @functools.cached_property
+    def tolerance_m(self) -> float:
+        """How far behind the marched surface an edge still shows (m): its mean length, which bounds the sag of a
+        chord under a curved surface."""
+        if len(self.edges) == 0:
+            return 0.0
+        return float(np.linalg.norm(self.vertices[self.edges[:, 0]] - self.vertices[self.edges[:, 1]], axis=1).mean())

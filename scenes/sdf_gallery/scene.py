@@ -36,7 +36,7 @@ from scenes._controls import build_controls
 from scenes._framing import ClientFraming, Lens, View, box_corners, frame_points
 from scenes._worker import LatestWorker
 from scenes.sdf_gallery import editor
-from scenes.sdf_gallery.compare import Agreement, compare, readout_markdown
+from scenes.sdf_gallery.compare import Agreement, Wire, compare, readout_markdown
 from scenes.sdf_gallery.editor import EDITING_OFF, EDITOR_HELP, EXAMPLES, EditorField
 from scenes.sdf_gallery.export import (
     NOTHING_TO_DOWNLOAD,
@@ -298,16 +298,10 @@ IoU is lowest when a box edge is on the silhouette.
         self._opening_vertices = vertices
         self.mesh_node = scene.add_mesh_trimesh(f"{self.root.name}/mesh", sdf.mesh_trimesh(vertices, faces, colors))
         self.mesh_node.glb_data = viewer_glb(vertices, faces, colors, scene_normals(self.params.scene(), vertices))
-        self.wireframe_node = scene.add_mesh_simple(
-            f"{self.root.name}/wireframe",
-            vertices.astype(np.float32),
-            faces.astype(np.uint32),
-            color=(40, 40, 40),
-            wireframe=True,
-            visible=False,
-        )
-        self._wire: tuple[np.ndarray, np.ndarray] | None = None
-        """The latest mesh's (vertices, faces) for the wireframe, drawn only while it shows."""
+        self._wire = Wire(vertices, faces, serial=0)
+        """The latest mesh (preview or full), drawn as a wireframe over the ray-march in the "both" view."""
+        self.view_edges = 0
+        """Mesh edges drawn over the last main-view frame (0 unless the view is "both")."""
         self.gizmos: list[viser.TransformControlsHandle] = []
         self.gizmo_markers: list[viser.IcosphereHandle] = []
         self.gizmo_labels: list[viser.LabelHandle] = []
@@ -469,17 +463,9 @@ IoU is lowest when a box edge is on the silhouette.
         mode = self.params.view_mode
         with self.server.atomic():
             self.mesh_node.visible = mode == "mesh"
-            if mode == "both":
-                self._draw_wire()
-            self.wireframe_node.visible = mode == "both"
             if mode == "mesh":
                 self.server.scene.set_background_image(None)
             self.view_note.content = VIEW_NOTES[mode]
-
-    def _draw_wire(self) -> None:
-        """Put the latest mesh (preview or full) on the wireframe node."""
-        if self._wire is not None:
-            self.wireframe_node.vertices, self.wireframe_node.faces = self._wire
 
     def _sync_enabled_inputs(self) -> None:
         """Show gizmos of enabled primitives, sized and named for them; grey out sizes the kind does not use."""
@@ -707,11 +693,9 @@ IoU is lowest when a box edge is on the silhouette.
                 return
             with self.server.atomic():
                 self.mesh_node.glb_data = glb
-                # The wireframe shows only in the "Both" view: a hidden one is not sent (40 % of a preview's bytes
-                # to every viewer), it is drawn from the latest mesh when it is shown.
-                self._wire = (vertices.astype(np.float32), faces.astype(np.uint32))
-                if self.wireframe_node.visible:
-                    self._draw_wire()
+                # The "both" view draws this mesh's edges into its ray-marched frame (never sent as lines: a
+                # software-WebGL browser drew ~10⁴ of them at 4-6 frames/s).
+                self._wire = Wire(vertices, faces, serial=self._wire.serial + 1)
                 self.progress.visible = False
                 self.shown_resolution = resolution
                 if preview:
@@ -789,7 +773,9 @@ IoU is lowest when a box edge is on the silhouette.
                 self._view_moving = False
                 return
         aspect, viewer_width = viewer.aspect, viewer.width_px
-        key = (shape, camera, aspect, viewer_width, moving, params.shading, params.view_mode)
+        with self._lock:
+            wire = self._wire if params.view_mode == "both" else None
+        key = (shape, camera, aspect, viewer_width, moving, params.shading, params.view_mode, wire and wire.serial)
         self._view_moving = moving
         if key == self._view_key:
             return
@@ -801,7 +787,14 @@ IoU is lowest when a box edge is on the silhouette.
             width, height = rest_size(viewer_width, aspect, self._rest_s_per_pixel or guess)
         shading = moving_shading(params.shading) if moving else params.shading
         start = time.perf_counter()
-        rgb, depth = gl_service.run(lambda gl: march(gl, shape, camera, width, height, shading))
+
+        def job(gl: Renderer) -> tuple[np.ndarray, np.ndarray]:
+            rgb, depth = march(gl, shape, camera, width, height, shading)
+            if wire is not None and len(wire.edges):
+                rgb = gl.draw_edges(wire.vertices, wire.edges, camera, width, height, tolerance_m=wire.tolerance_m)
+            return rgb, depth
+
+        rgb, depth = gl_service.run(job)
         view_ms = 1e3 * (time.perf_counter() - start)
         if moving:
             self._moving_s_per_pixel = view_ms / 1e3 / (width * height)
@@ -814,6 +807,7 @@ IoU is lowest when a box edge is on the silhouette.
                 return
             self.server.scene.set_background_image(rgb, format="jpeg", jpeg_quality=90, depth=depth)
             self.view_rgb, self.view_ms = rgb, view_ms
+            self.view_edges = 0 if wire is None else len(wire.edges)
             self.view_serial += 1
             self._view_key = key
             self.server.flush()

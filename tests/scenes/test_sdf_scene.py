@@ -541,7 +541,7 @@ def test_raymarched_view_goes_to_the_background_with_depth(server: viser.ViserSe
         client.send_camera(position=(2.0, -2.4, 1.6), look_at=(0.0, 0.0, 0.3), size=(400, 640))
         client.set_value("View", "Ray-marched")
         wait_until(lambda: scene.view_serial > 0, "a main-view frame")
-        assert scene.mesh_node.visible is False and scene.wireframe_node.visible is False
+        assert scene.mesh_node.visible is False and scene.view_edges == 0
         # Wait for the frame itself: under load the last background message seen may still be an earlier one
         # (the clearing of the mesh view's background), not yet the ray-marched frame with its depth.
         client.wait_for(
@@ -554,10 +554,21 @@ def test_raymarched_view_goes_to_the_background_with_depth(server: viser.ViserSe
         # Moving: a reduced frame first.
         client.send_camera(position=(2.2, -2.2, 1.6), look_at=(0.0, 0.0, 0.3), size=(400, 640))
         wait_until(lambda: scene.view_rgb is not None and scene.view_rgb.shape[1] == 320, "a reduced frame")
+        marched = scene.view_rgb
         client.set_value("View", "Both")
-        client.wait_for(lambda: True)
-        wait_until(lambda: scene.wireframe_node.visible, "the wireframe")
-        assert len(scene.wireframe_node.faces) == len(scene.mesh_faces)
+        # The mesh's edges, each once, are drawn into the ray-marched frame (the browser gets one picture, not
+        # ~10⁴ lines): dark lines over the shape, and the frame is the march elsewhere.
+        edges = trimesh.Trimesh(scene.mesh_vertices, scene.mesh_faces, process=False).edges_unique
+        wait_until(lambda: scene.view_edges == len(edges) and scene.view_rgb.shape[1] == 640, "the wireframe at rest")
+        assert scene.mesh_node.visible is False
+        assert background_images(client)[-1]["depth_data"] is not None
+        rest = scene.view_rgb
+        client.set_value("View", "Ray-marched")
+        wait_until(lambda: scene.view_edges == 0 and scene.view_rgb.shape[1] == 640, "the march at rest")
+        lines = np.abs(rest.astype(np.int16) - scene.view_rgb).max(axis=2) > 24
+        dark = rest.max(axis=2) < 90
+        assert 0.01 < lines.mean() < 0.5 and (lines & dark).sum() > 0.8 * lines.sum()
+        assert marched is not None
         client.set_value("View", "Mesh")
         wait_until(lambda: scene.mesh_node.visible, "the mesh back")
         client.wait_for(lambda: background_images(client)[-1]["rgb_data"] is None, what="background cleared")
@@ -645,7 +656,7 @@ def test_a_slow_compile_is_stopped_at_the_limit_while_the_server_keeps_serving(
         time.sleep(0.3)
         # Meanwhile another callback answers at once: the compile is not in this process.
         client.set_value("View", "Both")
-        wait_until(lambda: scene.wireframe_node.visible, "the view switch", timeout_s=2.0)
+        wait_until(lambda: scene.params.view_mode == "both", "the view switch", timeout_s=2.0)
         assert scene.editor_error is None
         wait_until(lambda: scene.editor_error is not None, "the refusal", timeout_s=30.0)
         refused_s = time.monotonic() - start

@@ -11,6 +11,7 @@ import re
 
 import numpy as np
 import pytest
+import trimesh
 from scipy import ndimage
 
 from kernels import sdf
@@ -228,6 +229,56 @@ def test_mesh_agrees_with_raymarch(gl: Renderer, camera: Camera) -> None:
     assert inner.sum() > 5000
     difference = np.abs(np.subtract(marched[inner], rasterised[inner], dtype=np.float64))
     assert difference.mean() <= 0.1 * voxel
+
+
+@pytest.mark.gl
+def test_edges_drawn_over_the_march_show_in_front_and_hide_behind_its_surface(gl: Renderer) -> None:
+    # A box meshed coarsely, seen from above a corner: each edge's midpoint is classified by an independent pinhole
+    # projection against the march's own depth at its pixel.
+    scene = sdf.Scene((sdf.Primitive("box", (0.0, 0.0, 0.0), (0.5, 0.4, 0.3), color=(0.9, 0.8, 0.2)),))
+    camera = Camera((1.8, -2.2, 1.6), (0.0, 0.0, 0.0), fov_y_rad=math.radians(45))
+    width, height = 320, 240
+    vertices, faces, _ = sdf.mesh(scene, 16)
+    edges = trimesh.Trimesh(vertices, faces, process=False).edges_unique
+    tolerance = 0.02
+    marched, depth = gl.render(scene, camera, width, height, NO_SHADOWS)
+    drawn = gl.draw_edges(vertices, edges, camera, width, height, tolerance_m=tolerance, color=(255, 0, 255))
+    forward, right, up = camera.basis()
+    tan = math.tan(camera.fov_y_rad / 2)
+
+    def project(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Pixel column, row and depth along the view axis (m) of world points, by the pinhole camera."""
+        rel = points - np.asarray(camera.position)
+        z = rel @ forward
+        col = np.floor(((rel @ right) / (z * tan * width / height) + 1.0) / 2.0 * width).astype(int)
+        row = np.floor((1.0 - (rel @ up) / (z * tan)) / 2.0 * height).astype(int)
+        return col, row, z
+
+    col, row, z = project(0.5 * (vertices[edges[:, 0]] + vertices[edges[:, 1]]))
+    surface = depth[row, col]
+    magenta = (drawn[..., 0] > 200) & (drawn[..., 1] < 60) & (drawn[..., 2] > 200)
+    near_line = ndimage.binary_dilation(magenta, iterations=1)
+    front = z <= surface + 0.5 * tolerance
+    behind = z > surface + 0.1  # the far faces: a box's depth is 0.6-1.0 m through
+    assert front.sum() > 100 and behind.sum() > 100
+    assert near_line[row[front], col[front]].mean() > 0.95, "edges on the seen faces are not drawn"
+    # Off the lines the picture is the march's, pixel for pixel.
+    np.testing.assert_array_equal(drawn[~near_line], marched[~near_line])
+    # The far faces' edges alone, away from the outline (whose edges a person does see), leave no pixel drawn.
+    inside = ndimage.binary_erosion(np.isfinite(depth), iterations=3)
+    ends = [project(vertices[edges[:, k]]) for k in (0, 1)]
+    hidden = behind & inside[row, col] & inside[ends[0][1], ends[0][0]] & inside[ends[1][1], ends[1][0]]
+    assert hidden.sum() > 50
+    gl.render(scene, camera, width, height, NO_SHADOWS)
+    far_only = gl.draw_edges(vertices, edges[hidden], camera, width, height, tolerance_m=tolerance, color=(255, 0, 255))
+    np.testing.assert_array_equal(far_only, marched)
+    # A march of another size must come first; malformed edges are refused by name.
+    with pytest.raises(ValueError, match="draw_edges needs a march of 100x100"):
+        gl.draw_edges(vertices, edges, camera, 100, 100, tolerance_m=tolerance)
+    with pytest.raises(ValueError, match="edges"):
+        gl.draw_edges(vertices, edges + len(vertices), camera, width, height, tolerance_m=tolerance)
+    with pytest.raises(ValueError, match="tolerance_m"):
+        gl.draw_edges(vertices, edges, camera, width, height, tolerance_m=math.nan)
 
 
 # ------------------------------------------------------------------------------------------ shading
