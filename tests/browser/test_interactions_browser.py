@@ -26,6 +26,7 @@ from helpers.browser import (
     close_notifications,
     control_row,
     drag,
+    panel_rect,
     screen_of,
     screenshot,
     served_scene,
@@ -406,4 +407,27 @@ def test_typed_shape_is_meshed_and_ray_marched_in_the_main_view(server: viser.Vi
         assert marched_green.sum() > 5000
         overlap = (mesh_green & marched_green).sum() / (mesh_green | marched_green).sum()
         assert overlap > 0.8, f"mesh and ray-march silhouettes overlap {overlap:.2f}"
-        page.screenshot(path="/tmp/sdf_browser_raymarched.png")
+        marched_rgb = screenshot(page)
+
+        # Both: the mesh's edges as dark lines over the ray-marched shape, and nowhere off it.
+        page.locator("input[value='Ray-marched']").first.click()
+        page.get_by_role("option", name="Both", exact=True).click()
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline and not (
+            scene.view_edges > 0 and scene.view_rgb is not None and scene.view_rgb.shape[1] >= 640
+        ):
+            time.sleep(0.05)
+        assert scene.view_edges > 0 and scene.view_rgb is not None and scene.view_rgb.shape[1] >= 640
+        wait_frames(page, 3)
+        from scipy import ndimage
+
+        both_rgb = screenshot(page)
+        # Line pixels: changed from the ray-marched picture of the same camera, and darker.
+        lines = changed_mask(marched_rgb, both_rgb) & (both_rgb.sum(axis=2) < marched_rgb.sum(axis=2))
+        shape = ndimage.binary_dilation(marched_green, iterations=4)
+        inside = ndimage.binary_erosion(marched_green, iterations=4)
+        assert 0.03 < lines[inside].mean() < 0.6, lines[inside].mean()  # a wireframe, not a blot or nothing
+        # Off the shape (the sky around it, left of the panel) no line is drawn.
+        free = np.zeros_like(shape)
+        free[:, : int(panel_rect(page)[0]) - 10] = True
+        assert lines[free & ~shape].mean() < 0.002
