@@ -182,8 +182,12 @@ def sleep_until_a_signal() -> None:
     ``ViserServer.sleep_forever`` sleeps an hour at a time: when the system delivers SIGINT to one of the server's
     threads rather than the main one, the main thread sleeps on and the app does not stop. Here the main thread waits
     on Python's signal wake-up socket, which the interpreter writes to on any signal from any thread; the pending
-    ``KeyboardInterrupt`` is then raised here.
+    ``KeyboardInterrupt`` is then raised here. Where SIGINT was ignored (a background job), it is restored.
     """
+    # A shell starts a background job (`python app.py &` in a script) with SIGINT ignored, and Python then leaves it
+    # ignored: Ctrl+C would not stop the app.
+    if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
     reader, writer = socket.socketpair()
     reader.setblocking(False)
     writer.setblocking(False)

@@ -58,13 +58,21 @@ def _free_port() -> int:
         return int(probe.getsockname()[1])
 
 
-def test_ctrl_c_stops_the_app_with_one_line() -> None:
+def _ignore_sigint() -> None:
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+@pytest.mark.parametrize("started", ["in a terminal", "as a background job"])
+def test_ctrl_c_stops_the_app_with_one_line(started: str) -> None:
+    # A shell that starts a command in the background (`python app.py &` in a script) starts it with SIGINT ignored;
+    # Ctrl+C must stop the app whichever way it was started.
     port = _free_port()
     process = subprocess.Popen(
         [sys.executable, str(ROOT / "app.py"), "--port", str(port)],
         stdout=subprocess.PIPE,
         stderr=subprocess.STDOUT,
         text=True,
+        preexec_fn=_ignore_sigint if started == "as a background job" else None,
     )
     try:
         assert process.stdout is not None
