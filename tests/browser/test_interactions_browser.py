@@ -38,6 +38,7 @@ from helpers.ci import need_gl
 from helpers.gpx import hill_gpx
 from helpers.waiting import wait_until
 from PIL import Image
+from scipy import ndimage
 
 from scenes._skeletons import hand
 from scenes.arm import ArmScene
@@ -419,13 +420,11 @@ def test_typed_shape_is_meshed_and_ray_marched_in_the_main_view(server: viser.Vi
             time.sleep(0.05)
         assert scene.view_edges > 0 and scene.view_rgb is not None and scene.view_rgb.shape[1] >= 640
         wait_frames(page, 3)
-        from scipy import ndimage
-
         both_rgb = screenshot(page)
         # Line pixels: changed from the ray-marched picture of the same camera, and darker.
         lines = changed_mask(marched_rgb, both_rgb) & (both_rgb.sum(axis=2) < marched_rgb.sum(axis=2))
-        shape = ndimage.binary_dilation(marched_green, iterations=4)
-        inside = ndimage.binary_erosion(marched_green, iterations=4)
+        shape = np.asarray(ndimage.binary_dilation(marched_green, iterations=4), dtype=bool)
+        inside = np.asarray(ndimage.binary_erosion(marched_green, iterations=4), dtype=bool)
         assert 0.03 < lines[inside].mean() < 0.6, lines[inside].mean()  # a wireframe, not a blot or nothing
         # Off the shape (the sky around it, left of the panel) no line is drawn.
         free = np.zeros_like(shape)

@@ -161,6 +161,6 @@ def test_a_registered_kind_is_ray_marched_to_the_kernels_surface(gl_with_extra: 
     _, rasterised = gl_with_extra.render_mesh(vertices, faces, colors, CAMERA, 128, 128)
     a, b = np.isfinite(marched), np.isfinite(rasterised)
     assert (a & b).sum() / (a | b).sum() >= 0.98
-    inner = ndimage.binary_erosion(a & b, iterations=1)
+    inner = np.asarray(ndimage.binary_erosion(a & b, iterations=1), dtype=bool)
     difference = np.abs(np.subtract(marched[inner], rasterised[inner], dtype=np.float64))
     assert difference.mean() <= 0.2 * voxel

@@ -62,8 +62,8 @@ def _ignore_sigint() -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
-@pytest.mark.parametrize("started", ["in a terminal", "as a background job"])
-def test_ctrl_c_stops_the_app_with_one_line(started: str) -> None:
+@pytest.mark.parametrize("how", ["in a terminal", "as a background job"])
+def test_ctrl_c_stops_the_app_with_one_line(how: str) -> None:
     # A shell that starts a command in the background (`python app.py &` in a script) starts it with SIGINT ignored;
     # Ctrl+C must stop the app whichever way it was started.
     port = _free_port()
@@ -72,7 +72,7 @@ def test_ctrl_c_stops_the_app_with_one_line(started: str) -> None:
         stdout=subprocess.PIPE,
         stderr=subprocess.STDOUT,
         text=True,
-        preexec_fn=_ignore_sigint if started == "as a background job" else None,
+        preexec_fn=_ignore_sigint if how == "as a background job" else None,
     )
     try:
         assert process.stdout is not None

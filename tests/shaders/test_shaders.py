@@ -225,7 +225,7 @@ def test_mesh_agrees_with_raymarch(gl: Renderer, camera: Camera) -> None:
     a, b = np.isfinite(marched), np.isfinite(rasterised)
     iou = (a & b).sum() / (a | b).sum()
     assert iou >= 0.99
-    inner = ndimage.binary_erosion(a & b, iterations=1)
+    inner = np.asarray(ndimage.binary_erosion(a & b, iterations=1), dtype=bool)
     assert inner.sum() > 5000
     difference = np.abs(np.subtract(marched[inner], rasterised[inner], dtype=np.float64))
     assert difference.mean() <= 0.1 * voxel
@@ -257,7 +257,7 @@ def test_edges_drawn_over_the_march_show_in_front_and_hide_behind_its_surface(gl
     col, row, z = project(0.5 * (vertices[edges[:, 0]] + vertices[edges[:, 1]]))
     surface = depth[row, col]
     magenta = (drawn[..., 0] > 200) & (drawn[..., 1] < 60) & (drawn[..., 2] > 200)
-    near_line = ndimage.binary_dilation(magenta, iterations=1)
+    near_line = np.asarray(ndimage.binary_dilation(magenta, iterations=1), dtype=bool)
     front = z <= surface + 0.5 * tolerance
     behind = z > surface + 0.1  # the far faces: a box's depth is 0.6-1.0 m through
     assert front.sum() > 100 and behind.sum() > 100
@@ -265,7 +265,7 @@ def test_edges_drawn_over_the_march_show_in_front_and_hide_behind_its_surface(gl
     # Off the lines the picture is the march's, pixel for pixel.
     np.testing.assert_array_equal(drawn[~near_line], marched[~near_line])
     # The far faces' edges alone, away from the outline (whose edges a person does see), leave no pixel drawn.
-    inside = ndimage.binary_erosion(np.isfinite(depth), iterations=3)
+    inside = np.asarray(ndimage.binary_erosion(np.isfinite(depth), iterations=3), dtype=bool)
     ends = [project(vertices[edges[:, k]]) for k in (0, 1)]
     hidden = behind & inside[row, col] & inside[ends[0][1], ends[0][0]] & inside[ends[1][1], ends[1][0]]
     assert hidden.sum() > 50
@@ -306,7 +306,7 @@ def test_phong_terms_match_the_analytic_sphere(gl: Renderer) -> None:
     expected = 0.15 * albedo + 0.6 * albedo * n_dot_l[:, None] + 0.4 * spec[:, None]
     expected = np.clip(expected, 0, 1).reshape(96, 96, 3)
     got = rgb.astype(float) / 255
-    inner = ndimage.binary_erosion(hit.reshape(96, 96), iterations=2)
+    inner = np.asarray(ndimage.binary_erosion(hit.reshape(96, 96), iterations=2), dtype=bool)
     assert inner.sum() > 2000
     assert np.abs(got[inner] - expected[inner]).max() < 4 / 255
     assert np.all(rgb[~hit.reshape(96, 96)] == np.round(np.array(shading.background) * 255))
@@ -349,7 +349,7 @@ def test_ambient_occlusion_darkens_creases_only(gl: Renderer) -> None:
     with_ao = dataclass_replace(ambient_only, occlusion=True)
     convex_plain, _ = gl.render(sphere_scene(), camera, 64, 64, ambient_only)
     convex_ao, hit_depth = gl.render(sphere_scene(), camera, 64, 64, with_ao)
-    inner = ndimage.binary_erosion(np.isfinite(hit_depth), iterations=2)
+    inner = np.asarray(ndimage.binary_erosion(np.isfinite(hit_depth), iterations=2), dtype=bool)
     assert np.abs(convex_ao[inner].astype(int) - convex_plain[inner].astype(int)).max() <= 1
     crease = sdf.Scene(
         (
