@@ -43,9 +43,10 @@ from scenes.freekick.props import (
 )
 from scenes.freekick.scene import FreeKickScene
 from scenes.freekick.views import (
-    KEEPER_FRONT_M,
     VIEW_MIN_DEPTH_M,
+    VIEW_TILTS,
     frame_view,
+    goal_hides,
     view_points,
     wall_hides,
 )
@@ -58,7 +59,6 @@ __all__ = [
     "ARROW_POINTS",
     "FORCE_COLOURS",
     "JUMP_M",
-    "KEEPER_FRONT_M",
     "KNUCKLE_COLOUR",
     "MAP_QUIET_S",
     "MAP_SPEEDS_MS",
@@ -69,6 +69,7 @@ __all__ = [
     "RESULT_COLOURS",
     "VIEW_LABELS",
     "VIEW_MIN_DEPTH_M",
+    "VIEW_TILTS",
     "FreeKickParams",
     "FreeKickScene",
     "KickState",
@@ -78,6 +79,7 @@ __all__ = [
     "ball_spot",
     "compute_kick",
     "frame_view",
+    "goal_hides",
     "outcome_map",
     "polyline_segments",
     "resample",

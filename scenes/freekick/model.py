@@ -392,7 +392,7 @@ def keeper_words(state: KickState) -> str:
         return ""
     dive = played.keeper_dive
     if dive is None:
-        return "never dives (the ball never gets past the wall)"
+        return _why_no_dive(state, played)
     across = dive.target[1] - spot[1]  # + toward the kicker's left, as every readout says it
     way = "up" if abs(across) < 0.3 else ("left" if across > 0 else "right")
     dived = f"dives {way} {dive.t:.2f} s after the kick"
@@ -405,6 +405,38 @@ def keeper_words(state: KickState) -> str:
     if played.result == "goal":
         return f"{dived}; the ball beats him by {nearest:.2f} m"
     return f"{dived}; gets within {nearest:.2f} m of the ball"
+
+
+def wall_passed_s(state: KickState, played: ball.Trajectory) -> float | None:
+    """When (s) the played-on ball first crosses the wall's plane toward the goal (the keeper's first clear sight
+    of it), None if it never does."""
+    normal, _along = wall_axes(state.wall)
+    side = (played.position[:, :2] - np.array(state.wall.centre_xy)) @ normal
+    past = np.flatnonzero((side[:-1] < 0.0) & (side[1:] >= 0.0))
+    if not len(past):
+        return None
+    i = int(past[0])
+    f = -side[i] / (side[i + 1] - side[i])
+    return float(played.t[i] + f * (played.t[i + 1] - played.t[i]))
+
+
+def _why_no_dive(state: KickState, played: ball.Trajectory) -> str:
+    """Why the keeper never set off, as what happened to the ball says: it never got past the wall (only when it hit
+    the wall), it never reached it, or the play was over before his reaction time was up."""
+    passed = wall_passed_s(state, played)
+    if passed is None:
+        if any(event.kind == "wall" for event in played.events):
+            return "never dives (the ball never gets past the wall)"
+        return "never dives (the ball never reaches the wall)"
+    over = float(played.t[-1]) - passed
+    what = {
+        "goal": "it is in the goal",
+        "post": "it hits the post",
+        "bar": "it hits the bar",
+        "wide": "it is past the post",
+        "over": "it is over the bar",
+    }.get(str(played.result), "the play is over")
+    return f"never dives: {what} {max(over, 0.0):.2f} s after it passes the wall, before he reacts ({KEEPER.reaction_s:.2f} s)"
 
 
 def keeper_show_time(state: KickState) -> float:

@@ -95,6 +95,10 @@ from scenes.freekick.props import (
 )
 from scenes.freekick.views import frame_view
 
+GRASS_HALF_M = 2500.0
+"""Half the side (m) of the grass square round the goal: past viser's far clipping plane (1000 m along the view
+axis, up to 2.2 km at the canvas's corners for the client's 75° field of view) from any camera the views put within
+100 m of the goal, so no view shows where it ends."""
 GRASS_COLOUR = (115, 190, 104)
 """The pitch's grass (8-bit sRGB, drawn unlit: after viser's tone mapping it shows as the lit grass did)."""
 CHART_COLOURS = {**FORCE_COLOURS, "knuckle": KNUCKLE_COLOUR}
@@ -297,8 +301,8 @@ of him beats him more often than it would a real keeper.
     # ----------------------------------------------------------------------------------------- world
     def _build_world(self) -> None:
         scene, root = self.server.scene, self.root.name
-        grass = trimesh.creation.box(extents=(50.0, 70.0, 0.02))
-        grass.apply_translation((-22.0, 0.0, -0.011))
+        grass = trimesh.creation.box(extents=(2.0 * GRASS_HALF_M, 2.0 * GRASS_HALF_M, 0.02))
+        grass.apply_translation((0.0, 0.0, -0.011))
         add_ground(scene, f"{root}/grass", grass.vertices, grass.faces, GRASS_COLOUR)
         scene.add_line_segments(f"{root}/markings", pitch_markings(), colors=(245, 245, 245), thickness=0.12)
         frame = goal_frame_mesh()

@@ -1,7 +1,7 @@
 """A real browser looks at the free kick: ball, wall, goal and path in view and clear of the panel, the force chart
 drawn, no error text, at 1600×1000 and 1280×720; in the opening view the path stands apart from its no-spin ghost and
 10 % more spin moves it on the screen; every camera view keeps the kick in view with the goal a real size, and the
-goalkeeper's view stands in front of the goal line with no net over the ball. (The click on "Kick" is in
+goalkeeper's view looks over his shoulder with no net over the ball. (The click on "Kick" is in
 ``test_interactions_browser.py``.)"""
 
 from __future__ import annotations
@@ -183,9 +183,12 @@ def test_every_camera_view_keeps_the_kick_in_view(shown: ScenePage) -> None:
             seen = float(np.ptp(project(shown.page, "/freekick", GOAL_CORNERS)[:, 0]))
             assert seen == pytest.approx(expected, rel=GOAL_SHARE_AGREES), view
             continue
-        # The goalkeeper's view: the camera stands on the pitch in front of the goal line (x < 0)...
+        # The goalkeeper's view: the camera stands behind the keeper, above his raised hands (over his shoulder)...
         eye = np.asarray(shown.client_camera.position)
-        assert eye[0] < -0.25, eye
+        with scene._lock:
+            keeper_xy = scene.state.keeper_xy
+        assert keeper_xy is not None
+        assert np.hypot(*(eye[:2] - spot[:2])) > np.hypot(*(np.asarray(keeper_xy) - spot[:2])) and eye[2] > 2.3, eye
         # ...the ball is seen, and no net or post is drawn over it. From 20-odd metres the ball is a few pixels
         # across and its own path and force arrows start on it, so both pictures leave those out: the ball's pixels
         # are what hiding it changes, and none of them may change when the goal is hidden too.
