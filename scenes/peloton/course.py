@@ -16,10 +16,10 @@ import viser
 import viser.uplot
 
 from kernels import course as course_kernel
-from scenes._base import record_spec
+from scenes._base import record_spec, set_if_changed
 from scenes._charts import FittedChart
 from scenes._controls import build_controls, declared, read_controls
-from scenes._framing import Lens, View, box_corners, frame_points
+from scenes._framing import Lens, View, frame_clear_of_notice
 from scenes._instances import park_hidden
 from scenes._look import add_ground, mesh_glb
 from scenes.peloton.course_model import (
@@ -31,7 +31,6 @@ from scenes.peloton.course_model import (
     MODEL_LABEL,
     MORE_FOLDER,
     POWER_FOLDER,
-    ROAD_AHEAD_M,
     SAMPLE_LABEL,
     CourseParams,
     CourseState,
@@ -42,13 +41,33 @@ from scenes.peloton.course_model import (
     drawn_indices,
     format_duration,
     lay_out_road,
+    place_powers,
+    rider_boxes,
     split_every_m,
 )
-from scenes.peloton.meshes import GRASS_COLOUR, ROAD_COLOUR, Detail, add_riders, rider_detail, show_position
+from scenes.peloton.legend import formation_table, legend_html, power_colours, power_range
+from scenes.peloton.meshes import (
+    GRASS_COLOUR,
+    ROAD_COLOUR,
+    Detail,
+    add_riders,
+    rider_detail,
+    rider_head_m,
+    show_position,
+)
 from scenes.peloton.model import BIKE_LENGTH_M, MAX_GROUP, Position, group_cda, is_line_view
 
 CHART_TITLE = "Elevation, speed and power"
 """The course chart's title (short: the panel is narrow)."""
+FRAMED_LENGTH_M = 45.0
+"""The camera frames at most this much of the group, from its leader back (m): a longer line (121 riders in single
+file run 270 m) framed whole draws its riders a few pixels tall, so the front of it is framed and the panel says so."""
+ROAD_SHOWN_M = {True: (3.0, 0.0), False: (10.0, 4.0)}
+"""Road the camera frames ahead of the leader and behind the last framed rider (m), the road's full width, for a line
+seen from its side (True) and a group seen from behind (False): a small group is seen on its road, not from a metre
+away (two abreast of 8 stood 37 % of the window tall)."""
+RIDER_HALF_M = (0.5 * BIKE_LENGTH_M, 0.3)
+"""Half a rider's box (m): along the bike and across the handlebars."""
 FORMATION_WORDS = {"single": "in single file", "double": "two abreast", "bunch": "in a bunch", "echelon": "in echelon"}
 """How the course readout names each formation."""
 
@@ -237,17 +256,37 @@ class CourseMode:
         return lay_out_road(self.route, self.leader_distance_m(), self.formation_xy(), self.params.exaggeration)
 
     def view_for(self, lens: Lens) -> View:
-        """The camera for ``lens`` that shows the whole group on its road left of the panel, as large as it fits:
-        every rider, head to wheels, and a little road ahead of the leader."""
+        """The camera for ``lens`` that shows the group on its road left of the panel and clear of viser's
+        software-WebGL notice, as large as it fits: every framed rider's box, wheels to head, and the road's width
+        from a little behind the last framed rider to a little ahead of the leader (:data:`ROAD_SHOWN_M`). A group
+        longer than :data:`FRAMED_LENGTH_M` has its front framed (:meth:`framed_riders`)."""
         with self.scene._lock:
-            positions = self.layout().riders[0]
+            points = self.framed_points()
             direction = LINE_VIEW_DIRECTION if is_line_view(self.scene.params) else GROUP_VIEW_DIRECTION
-        half = 0.5 * BIKE_LENGTH_M + 0.2
-        lo = positions.min(axis=0) - [half, 0.7, 0.0]
-        hi = positions.max(axis=0) + [half + min(3.0, ROAD_AHEAD_M), 0.7, 1.9]
-        return frame_points(
-            box_corners(lo, hi), direction, fov_rad=lens.fov_rad, aspect=lens.aspect, ndc=lens.usable_ndc()
-        )
+        return frame_clear_of_notice(points, direction, lens)
+
+    def framed_riders(self) -> int:
+        """How many riders, from the leader back, the camera frames: those within :data:`FRAMED_LENGTH_M` of it."""
+        xy = self.formation_xy()
+        return max(int(np.count_nonzero(xy[:, 0] >= -FRAMED_LENGTH_M)), 1)
+
+    def framed_points(self) -> np.ndarray:
+        """(k, 3) scene points the camera frames: each framed rider's box corners (turned and pitched as drawn) and
+        the road's edges where :data:`ROAD_SHOWN_M` says."""
+        layout = self.layout()
+        n = self.framed_riders()
+        positions, wxyz = layout.riders
+        boxes = rider_boxes(positions[:n], wxyz[:n], rider_head_m(self.scene.params.position)[1], RIDER_HALF_M)
+        xy = self.formation_xy()[:n]
+        leader = self.leader_distance_m()
+        ahead, behind = ROAD_SHOWN_M[is_line_view(self.scene.params)]
+        d_from, d_to = layout.window_m
+        vertices = layout.road[0].astype(np.float64)
+        k = vertices.shape[0] // 2
+        distance = np.linspace(d_from, d_to, k)
+        near = (distance >= leader + float(xy[:, 0].min()) - behind) & (distance <= leader + ahead)
+        road = np.vstack([vertices[:k][near], vertices[k:][near]])
+        return np.vstack([boxes, road])
 
     # ----------------------------------------------------------------------------------------- inputs
     def read_params(self) -> CourseParams:
@@ -260,6 +299,8 @@ class CourseMode:
         if self.enabled and self.state is None:
             self.recompute()
         self.redraw()
+        if not self.enabled:
+            self.scene.redraw()  # the flat road's legend, table and readouts again
         if self.enabled != was:
             self.scene.framing.reframe()  # the course's group on its road, or the line again
         self.scene.wake_loops()
@@ -425,6 +466,7 @@ class CourseMode:
         self.playing = False
         self._show_at_km(round(self._leader_km(), 2))  # where the riders stopped, to the slider's step
         self.redraw(readouts=False)
+        self.scene.framing.reframe()  # framed for the road where they stopped
 
     def _show_at_km(self, km: float) -> None:
         """Put the Position slider and the riders at ``km`` together (the readout then says the same place)."""
@@ -450,6 +492,8 @@ class CourseMode:
         ride = self.state.ride
         self.play_time_s = float(np.interp(km * 1000.0, ride.distance_m, ride.elapsed_s))
         self.redraw(readouts=False)
+        # The group keeps its place in the picture as the road under it bends and steepens.
+        self.scene.framing.reframe()
 
     # ----------------------------------------------------------------------------------------- animation
     def _animate(self, dt: float) -> bool:
@@ -496,6 +540,8 @@ class CourseMode:
                 self._drawn_riders = riders
             if self.enabled:
                 self._draw_layout(self.layout())
+                if now or readouts:
+                    self._show_places(readouts=readouts)
             if now:
                 self.now.content = self._now_markdown()
             if readouts:
@@ -505,6 +551,60 @@ class CourseMode:
                 self.chart.data = self._chart_data()
                 self.chart.visible = self.state is not None
         self.server.flush()
+
+    def place_watts(self) -> tuple[np.ndarray, np.ndarray]:
+        """(n,) each place's power where the leader is now and (n,) its mean over the ride (W), leader first
+        (:func:`~scenes.peloton.course_model.place_powers`); zeros before the first ride."""
+        n = self.scene.params.n_riders
+        if self.state is None or self.state.drag.shape[0] != n:
+            return np.zeros(n), np.zeros(n)
+        return place_powers(self.state, self.leader_distance_m())
+
+    def _show_places(self, *, readouts: bool) -> None:
+        """Colour each rider by its place's power where the group is now, with the key in watts at the top of the
+        panel; with ``readouts``, the Results table of the course's places and the words on how the group shares the
+        work."""
+        s, state = self.scene, self.state
+        if state is None:
+            return
+        n = s.params.n_riders
+        here, mean = self.place_watts()
+        low, high = power_range(here)
+        bodies = np.asarray(self.course_riders["body"].batched_colors).copy()
+        bodies[:n] = power_colours(here, low, high)
+        set_if_changed(self.course_riders["body"], "batched_colors", bodies)
+        drag = state.drag
+        summary = (
+            f"Power of each place where the group is now ({self._leader_km():.2f} km): {n} riders, mean drag "
+            f"{100 * float(np.mean(drag)):.0f} % of a lone rider's"
+        )
+        set_if_changed(s.legend, "content", legend_html(low, high, summary, "Rider colour = power here (W)"))
+        set_if_changed(s.legend, "visible", True)
+        table = formation_table(
+            s.state.positions,
+            drag,
+            {"Here (W)": here, "Ride mean (W)": mean},
+            f"Each place of the formation at **{self._leader_km():.2f} km** and over the whole ride",
+        )
+        set_if_changed(s.table, "content", table)
+        if not readouts:
+            return
+        framed = self.framed_riders()
+        shown = (
+            ""
+            if framed >= n
+            else (
+                f"  \nThe camera frames the front {FRAMED_LENGTH_M:.0f} m of the group (its first {framed} riders); the "
+                f"line runs {-float(self.formation_xy()[:, 0].min()):.0f} m back: zoom out to see the rest."
+            )
+        )
+        s.density.content = (
+            f"**On the course.** The group rides at the mean drag of its formation, "
+            f"**{100 * float(np.mean(drag)):.0f} %** of a lone rider's (CdA {state.group_cda_m2:.3f} m²), as riders "
+            f"who take turns at every place share it; each averages the course power over the ride.{shown}"
+        )
+        s.rotation.content = ""
+        s.chart.visible = False  # the flat road's solo curve: the course's own chart is in its folder
 
     def _draw_layout(self, layout: RoadLayout) -> None:
         """Push a layout to the road's and riders' nodes."""

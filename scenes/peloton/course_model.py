@@ -19,7 +19,7 @@ import numpy as np
 from kernels import course as course_kernel
 from kernels import cycling
 from scenes._controls import checkbox, dropdown, dropdown_from_labels, number, slider
-from scenes.peloton.model import PelotonParams, group_cda
+from scenes.peloton.model import PelotonParams, drag_reductions, group_cda
 
 CourseAirLabel = Literal["Textbook atmosphere", "Weather reading"]
 AIR_FROM_LABEL: dict[str, course_kernel.AirKind] = {
@@ -49,7 +49,8 @@ ROAD_STEP_M = 1.0
 LINE_VIEW_DIRECTION = (1.2, 7.5, -1.6)
 """Where the camera looks at a line of riders on the course: from the line's right side, a little behind and above."""
 GROUP_VIEW_DIRECTION = (3.0, 2.6, -2.4)
-"""Where the camera looks at a group on the course: from behind its right side and above, so every row shows."""
+"""Where the camera looks at a group on the course: from behind its right side and above, so every row shows (from
+ahead, as on the flat road, the road framed ahead of the leader pushed the group to the far end of the picture)."""
 MAX_CHART_POINTS = 1000
 
 MODE_FOLDER = "Course mode (GPX route)"
@@ -135,7 +136,14 @@ class CourseState:
     """One rider alone at the same power (no shelter)."""
     pacing: course_kernel.Pacing | None
     group_cda_m2: float
-    """CdA the group rides at when riders share the front equally (m²)."""
+    """CdA the group rides at when riders share the front equally (m²): the rider's CdA times the mean of
+    :attr:`drag`."""
+    drag: np.ndarray
+    """(n,) drag of each place in the formation as a fraction of the same rider alone, leader first."""
+    rider_cda_m2: float
+    """The rider's CdA alone (m²)."""
+    efficiency: float
+    """Drivetrain efficiency (0, 1]."""
     density_seed: float
     """The exponential atmosphere's density at the start (kg/m³)."""
     density_weather: float
@@ -174,6 +182,7 @@ def compute_course(route: course_kernel.Course, p: CourseParams, line: PelotonPa
         return course_rider(line, p, cda)
 
     cda = group_cda(line)
+    drag = 1.0 - drag_reductions(line) if line.drafting and line.n_riders >= 2 else np.ones(line.n_riders)
     wind, wind_from, cap = p.wind_ms, p.wind_from_deg, p.max_speed_kmh / 3.6
 
     def ride_at(cda_m2: float) -> course_kernel.Ride:
@@ -195,9 +204,43 @@ def compute_course(route: course_kernel.Course, p: CourseParams, line: PelotonPa
         solo=solo,
         pacing=pacing,
         group_cda_m2=cda,
+        drag=drag,
+        rider_cda_m2=line.cda_m2,
+        efficiency=line.drivetrain_pct / 100.0,
         density_seed=float(cycling.air_density(start)),
         density_weather=float(weather.density(start)),
     )
+
+
+def aero_watts_per_m2(ride: course_kernel.Ride, efficiency: float) -> np.ndarray:
+    """(N − 1,) pedal power (W) each m² of drag area costs on each segment of ``ride``: ½·ρ·(v + w)·|v + w|·v / η at
+    the segment's mean speed v (its length over its time), headwind w and air density ρ (Martin et al. 1998's aero
+    term; the spoke drag F_w is the same for every rider, so it drops out of a difference between riders)."""
+    seconds = np.diff(ride.elapsed_s)
+    metres = np.diff(ride.distance_m)
+    v = np.divide(metres, seconds, out=np.zeros_like(metres), where=seconds > 0.0)
+    air = v + ride.headwind_ms
+    return 0.5 * ride.air_density * air * np.abs(air) * v / efficiency
+
+
+def place_powers(state: CourseState, at_m: float) -> tuple[np.ndarray, np.ndarray]:
+    """Each place's pedal power in the formation (W), leader first: (n,) where the leader is ``at_m`` (m along the
+    route) and (n,) its mean over the ride (by time).
+
+    The group rides at the mean drag of its places, at the group's power P (the ride's); a place with drag area
+    CdA_i needs P + (CdA_i − CdA_group)·a, with a the aero power per m² there (:func:`aero_watts_per_m2`), so the
+    places' mean is P. Riders who share the work in turn each average P over the ride. A place that would need less
+    than nothing (a sheltered rider on a descent where the group coasts) shows 0 W: it brakes or sits up.
+    """
+    ride = state.ride
+    per_m2 = aero_watts_per_m2(ride, state.efficiency)
+    extra = state.rider_cda_m2 * np.asarray(state.drag) - state.group_cda_m2  # (n,) m²
+    segment = int(np.clip(np.searchsorted(ride.distance_m, at_m, side="right") - 1, 0, per_m2.shape[0] - 1))
+    here = float(ride.power_w[segment]) + extra * float(per_m2[segment])
+    seconds = np.diff(ride.elapsed_s)
+    mean_per_m2 = float(np.sum(per_m2 * seconds) / max(float(np.sum(seconds)), 1e-9))
+    mean = ride.average_power_w + extra * mean_per_m2
+    return np.maximum(here, 0.0), np.maximum(mean, 0.0)
 
 
 def format_duration(seconds: float) -> str:
@@ -308,6 +351,24 @@ def riders_on_road(
     cp, sp = np.cos(-pitch / 2), np.sin(-pitch / 2)
     wxyz = np.stack([cy * cp, -sy * sp, cy * sp, sy * cp], axis=1)
     return positions, wxyz
+
+
+def rider_boxes(positions: np.ndarray, wxyz: np.ndarray, top_m: float, half_m: tuple[float, float]) -> np.ndarray:
+    """(8n, 3) corners of each rider's box as drawn: ``half_m`` (m, along the bike and across it) either side of its
+    (n, 3) position, from the road to ``top_m`` above it, turned by its (n, 4) wxyz orientation."""
+    w, x, y, z = np.asarray(wxyz, np.float64).T
+    # The rotation matrix of a unit quaternion (columns: where the rider's x, y and z axes point).
+    axes = np.stack(
+        [
+            np.stack([1 - 2 * (y * y + z * z), 2 * (x * y + w * z), 2 * (x * z - w * y)], axis=1),
+            np.stack([2 * (x * y - w * z), 1 - 2 * (x * x + z * z), 2 * (y * z + w * x)], axis=1),
+            np.stack([2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y)], axis=1),
+        ],
+        axis=1,
+    )  # (n, 3 axes, 3)
+    corners = np.array([(sx * half_m[0], sy * half_m[1], h) for sx in (-1, 1) for sy in (-1, 1) for h in (0.0, top_m)])
+    pos = np.asarray(positions, np.float64)
+    return (pos[:, None, :] + np.einsum("ck,nkd->ncd", corners, axes)).reshape(-1, 3)
 
 
 def dash_distances(d_from: float, d_to: float, every_m: float = 3.0, count: int | None = None) -> np.ndarray:

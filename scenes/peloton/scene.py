@@ -26,6 +26,13 @@ from scenes._framing import ClientFraming, Lens, View, beside_notice, frame_poin
 from scenes._instances import add_instances, park_hidden
 from scenes._look import add_ground
 from scenes.peloton.course import CourseMode
+from scenes.peloton.legend import (
+    formation_table,
+    legend_html,
+    power_colours,
+    power_range,
+)
+from scenes.peloton.legend import watts_text as _watts
 from scenes.peloton.meshes import (
     GRASS_COLOUR,
     ROAD_COLOUR,
@@ -97,8 +104,6 @@ GROUP_STEM_M = 0.35
 TEXT_PX_PER_CHAR = 6.4
 """Width (px) a label's text takes per character (DejaVu Sans at the labels' size: 20 characters measured 115 px),
 with room to spare: a label's text must not cross another label's line."""
-POWER_COLOURS = np.array([(40, 90, 220), (40, 180, 200), (90, 190, 80), (245, 200, 40), (225, 50, 40)], np.float64)
-"""Rider colours by power, low to high: blue, teal, green, yellow, red."""
 LABEL_STAGGER_M = 0.4
 """Every other rider's label sits this much higher (m) until a camera is framed and the labels laid out for it."""
 BAR_HEADROOM = 1.3
@@ -113,40 +118,6 @@ LAST = ("target_power_w",)
 """The controls built after the Results folder (in their own folder, with the speed-at-a-power readout)."""
 
 
-# --------------------------------------------------------------------------------------------- colours by power
-def power_range(watts: np.ndarray) -> tuple[float, float]:
-    """(low, high) ends of the colour scale (W): the group's least and most power, at least 10 W apart."""
-    low, high = float(np.min(watts)), float(np.max(watts))
-    middle = 0.5 * (low + high)
-    half = max(0.5 * (high - low), 5.0)
-    return middle - half, middle + half
-
-
-def power_colours(watts: np.ndarray, low: float, high: float) -> np.ndarray:
-    """(N, 3) uint8 colours of ``watts`` on :data:`POWER_COLOURS` from ``low`` to ``high`` W."""
-    t = np.clip((np.asarray(watts, np.float64) - low) / (high - low), 0.0, 1.0) * (len(POWER_COLOURS) - 1)
-    stops = np.arange(len(POWER_COLOURS), dtype=np.float64)
-    channels = [np.interp(t, stops, POWER_COLOURS[:, c]) for c in range(3)]
-    return np.round(np.stack(channels, axis=1)).astype(np.uint8)
-
-
-LEGEND_NAMES = ("blue", "teal", "green", "yellow", "red")
-
-
-def legend_html(low: float, high: float, summary: str) -> str:
-    """The colour scale as five swatches, each over its name and watts, then ``summary`` (plain text)."""
-    stops = "".join(
-        f'<div style="flex:1;text-align:center"><div style="height:14px;border-radius:2px;'
-        f'background:rgb({r:.0f},{g:.0f},{b:.0f})"></div>{name} {_watts(t)}</div>'
-        for name, t, (r, g, b) in zip(LEGEND_NAMES, np.linspace(low, high, 5), POWER_COLOURS, strict=True)
-    )
-    return (
-        '<div style="font-size:13px;line-height:1.35;padding:2px 0 6px">'
-        "<b>Rider colour = power (W)</b>"
-        f'<div style="display:flex;gap:3px;margin:3px 0">{stops}</div>{summary}</div>'
-    )
-
-
 # --------------------------------------------------------------------------------------------- scene
 @dataclasses.dataclass(frozen=True)
 class _Framing:
@@ -158,11 +129,6 @@ class _Framing:
     lane_m: np.ndarray
     under_notice: bool
     distance_m: float
-
-
-def _watts(value: float) -> str:
-    """Whole watts, never "-0"."""
-    return f"{round(float(value))}"  # an int: round(-0.4) is 0, not -0.0
 
 
 class PelotonScene(Scene[PelotonParams]):
@@ -621,6 +587,9 @@ time-averaged power is the mean over positions, far below the leader's.
         One atomic update; the animation redraws without readouts, which do not change as riders move.
         """
         p, state = self.params, self.state
+        course_mode = getattr(self, "course_mode", None)  # built last
+        if course_mode is not None and course_mode.enabled:
+            return  # the flat road is hidden and the panel's legend and table are the course's (CourseMode.redraw)
         if not is_line_view(p):
             self._redraw_group(readouts=readouts)
             return
@@ -698,6 +667,7 @@ time-averaged power is the mean over positions, far below the leader's.
             self.density.content = self._density_markdown()
             self.table.content = table()
             self.chart.data = self._chart_data()
+            set_if_changed(self.chart, "visible", True)  # hidden in course mode, which has its own chart
             self.speed_out.content = self._speed_markdown()
 
     def _label_lifts(self, x: np.ndarray, slots: np.ndarray) -> np.ndarray:
@@ -782,29 +752,12 @@ time-averaged power is the mean over positions, far below the leader's.
         """Drag and power by row of the formation (riders level with each other share a row), front to back; long
         groups show their first and last rows."""
         state, p = self.state, self.params
-        x = np.round(state.positions[:, 0], 6)
-        rows = [np.flatnonzero(x == value) for value in sorted(set(x.tolist()), reverse=True)]
         total, drag = np.asarray(state.power.total), 1.0 - state.reduction
-        lines = [
+        summary = (
             f"{p.n_riders} riders · mean drag **{100 * float(np.mean(drag)):.0f} %** of a lone rider's · mean power "
-            f"**{_watts(float(np.mean(total)))} W** (a lone rider {_watts(float(state.solo.total))} W)",
-            "",
-            "| Row | Riders | Drag (% of alone) | Power (W) |",
-            "|---|---|---|---|",
-        ]
-        shown = rows if len(rows) <= 14 else [*rows[:10], None, *rows[-3:]]
-        for index, members in enumerate(shown):
-            if members is None:
-                lines.append("| … | | | |")
-                continue
-            number = index + 1 if index < 10 or len(rows) <= 14 else len(rows) - (len(shown) - index) + 1
-            d, w = 100 * drag[members], total[members]
-            drag_text = f"{d.min():.0f}" if round(d.min()) == round(d.max()) else f"{d.min():.0f}–{d.max():.0f}"
-            low, high = _watts(float(w.min())), _watts(float(w.max()))
-            lines.append(
-                f"| {number} | {len(members)} | {drag_text} | {f'**{low}**' if low == high else f'**{low}**–**{high}**'} |"
-            )
-        return "\n".join(lines)
+            f"**{_watts(float(np.mean(total)))} W** (a lone rider {_watts(float(state.solo.total))} W)"
+        )
+        return formation_table(state.positions, drag, {"Power (W)": total}, summary)
 
     def _draw_wind(self) -> None:
         w = self.params.headwind_ms

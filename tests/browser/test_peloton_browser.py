@@ -39,13 +39,14 @@ from helpers.browser import (
     visible_text,
     with_labels_hidden,
 )
+from helpers.gpx import gpx_text
 from helpers.waiting import wait_until
 
 from scenes._framing import NOTICE_PX
 from scenes.peloton import COMPONENT_COLOURS, LABEL_PX, PelotonScene
+from scenes.peloton.legend import POWER_COLOURS
 from scenes.peloton.meshes import rider_head_m
 from scenes.peloton.model import FORMATION_FROM_LABEL
-from scenes.peloton.scene import POWER_COLOURS
 
 pytestmark = pytest.mark.browser
 
@@ -237,12 +238,7 @@ def test_a_bunch_of_121_shows_each_riders_power_in_colour_and_in_numbers(shown: 
         covered = assert_seen(shown, with_labels_hidden(page), RIDERS, xy, "121 riders", without_labels=True)
         # Coloured by power: the riders' pixels show several of the legend's colours, the leader's red and the
         # sheltered riders' blue among them (a jersey's shade changes its brightness, not its hue).
-        riders = image[covered].astype(np.float64)
-        chroma = riders / np.maximum(riders.max(axis=1, keepdims=True), 1.0)
-        saturated = riders.max(axis=1) - riders.min(axis=1) > 60
-        stops = POWER_COLOURS / POWER_COLOURS.max(axis=1, keepdims=True)
-        nearest = np.argmin(np.linalg.norm(chroma[:, None, :] - stops[None], axis=2), axis=1)
-        counts = np.bincount(nearest[saturated], minlength=len(POWER_COLOURS))
+        counts = power_colour_counts(image, covered)
         assert np.count_nonzero(counts >= 30) >= 3, counts
         assert counts[0] >= 30 and counts[-1] >= 30, counts
         # The legend at the top of the panel, seen without scrolling: its swatches in those colours, the watts
@@ -304,17 +300,38 @@ def notice_left_open(shown: ScenePage) -> Iterator[tuple[float, float] | None]:
     assert shown.page.locator(TOAST).count() == 1  # still open: what was looked at was under it
 
 
+@contextlib.contextmanager
+def peloton_with_notice(
+    server: viser.ViserServer, browser_page: Any, viewport: tuple[int, int]
+) -> Iterator[tuple[ScenePage, tuple[float, float] | None]]:
+    """The peloton at ``viewport`` with viser's software-WebGL notice left open (:func:`notice_left_open`): the page
+    and the notice's bottom right corner (None where the page draws on a GPU)."""
+    browser_page.set_viewport_size({"width": viewport[0], "height": viewport[1]})
+    with (
+        served_scene(server, browser_page, "peloton", "/peloton", viewport=viewport) as shown,
+        notice_left_open(shown) as notice,
+    ):
+        yield shown, notice
+
+
+def power_colour_counts(image: np.ndarray, covered: np.ndarray) -> np.ndarray:
+    """(5,) how many of the saturated pixels of ``image`` under ``covered`` lie nearest each of
+    :data:`POWER_COLOURS` in hue (a jersey's shade changes its brightness, not its hue)."""
+    riders = image[covered].astype(np.float64)
+    chroma = riders / np.maximum(riders.max(axis=1, keepdims=True), 1.0)
+    saturated = riders.max(axis=1) - riders.min(axis=1) > 60
+    stops = POWER_COLOURS / POWER_COLOURS.max(axis=1, keepdims=True)
+    nearest = np.argmin(np.linalg.norm(chroma[:, None, :] - stops[None], axis=2), axis=1)
+    return np.bincount(nearest[saturated], minlength=len(POWER_COLOURS))
+
+
 @pytest.mark.parametrize("viewport", VIEWPORTS, ids=lambda v: f"{v[0]}x{v[1]}")
 def test_a_group_of_121_is_framed_clear_of_the_software_webgl_notice(
     server: viser.ViserServer, browser_page: Any, viewport: tuple[int, int]
 ) -> None:
     # The failing look (a review): at 1280×720 the back rows of a 121-rider bunch lay under viser's notice, and an
     # echelon of 121 ran off the road. Here the notice stays open, as it does until a person closes it.
-    browser_page.set_viewport_size({"width": viewport[0], "height": viewport[1]})
-    with (
-        served_scene(server, browser_page, "peloton", "/peloton", viewport=viewport) as shown,
-        notice_left_open(shown) as notice,
-    ):
+    with peloton_with_notice(server, browser_page, viewport) as (shown, notice):
         page = shown.page
         if notice is not None:
             assert notice[0] <= NOTICE_PX[0] and notice[1] <= NOTICE_PX[1], notice  # the room the scene keeps free
@@ -345,3 +362,75 @@ def test_a_group_of_121_is_framed_clear_of_the_software_webgl_notice(
                 assert not under.any(), f"{formation}: {under.sum()} rider corners under the notice"
             screenshot(page, path=f"/tmp/peloton_{formation.split()[0].lower()}_121_{viewport[0]}x{viewport[1]}.png")
             assert error_text(page) == []
+
+
+COURSE_RIDERS = [f"/peloton/course_mode/riders_{part}" for part in ("body", "bike", "head")]
+LEGEND_LINES = """(title) => {
+    const heading = [...document.querySelectorAll('b')].find((b) => b.textContent === title);
+    const stops = heading.nextElementSibling.children;
+    return [...stops].map((stop) => {
+        const range = document.createRange();
+        range.selectNodeContents(stop.lastChild);
+        return new Set([...range.getClientRects()].map((r) => Math.round(r.top))).size;
+    });
+}"""
+"""Lines the watts under each of a legend's swatches take (the legend titled by the argument)."""
+
+
+@pytest.mark.parametrize("viewport", VIEWPORTS, ids=lambda v: f"{v[0]}x{v[1]}")
+def test_course_mode_colours_a_bunch_by_power_with_its_legend_clear_of_the_notice(
+    server: viser.ViserServer, browser_page: Any, viewport: tuple[int, int]
+) -> None:
+    # The failing look (a review): on the course a bunch kept its team jerseys, the panel its flat-road table and
+    # no legend; the legend's watts wrapped under their names. The notice stays open, as a person first sees it.
+    with peloton_with_notice(server, browser_page, viewport) as (shown, notice):
+        page, scene = shown.page, shown.scene
+        assert isinstance(scene, PelotonScene)
+        mode = scene.course_mode
+        mode.enable.value = True
+        # A flat road at 40-odd km/h, where shelter matters (on a climb the places differ by a few watts).
+        flat = [(45.0 + i * 1e-4, 6.0, 20.0) for i in range(400)]
+        assert mode.load(gpx_text(flat).encode(), "flat.gpx")
+        for formation, n in (("Bunch (peloton)", 121), ("Bunch (peloton)", 40), ("Single file", 8)):
+            scene.controls["formation"].value, scene.controls["n_riders"].value = formation, n
+            mode.scrub.value = 2.0
+            settle(shown)
+            with scene._lock:
+                framed = mode.framed_riders()
+                positions, wxyz = mode.layout().riders
+                here, _ = mode.place_watts()
+                top = rider_head_m(scene.params.position)[1]
+            w, x, y, z = wxyz[:framed].T
+            nose = np.stack([1 - 2 * (y * y + z * z), 2 * (x * y + w * z), 2 * (x * z - w * y)], axis=1)
+            left = np.stack([-nose[:, 1], nose[:, 0], np.zeros(framed)], axis=1)
+            left /= np.linalg.norm(left, axis=1, keepdims=True)
+            corners = np.vstack(
+                [
+                    positions[:framed] + sx * 0.85 * nose + sy * 0.3 * left + [0.0, 0.0, h]
+                    for sx in (-1, 1)
+                    for sy in (-1, 1)
+                    for h in (0.0, top)
+                ]
+            )
+            # Every rider's box in view left of the panel and, where the page shows the notice, none under it.
+            seen = assert_in_view(shown, "/peloton/course_mode", corners, f"{formation} of {n} on the course")
+            if notice is not None:
+                under = (seen[:, 0] < notice[0]) & (seen[:, 1] < notice[1])
+                assert not under.any(), f"{formation} of {n}: {under.sum()} rider corners under the notice"
+            image = with_labels_hidden(page)
+            screenshot(page, path=f"/tmp/peloton_course_{formation.split()[0].lower()}{n}_{viewport[0]}.png")
+            covered = assert_seen(shown, image, COURSE_RIDERS, seen, f"{n} riders", without_labels=True)
+            # Coloured by power: several of the legend's colours, the sheltered riders' blue among them, and the red
+            # of the leader, who works hardest (small: it rides at the far end, seen from behind).
+            counts = power_colour_counts(image, covered)
+            assert np.count_nonzero(counts >= 30) >= 3 and counts[0] >= 30 and counts[-1] >= 5, counts
+            # The legend at the top of the panel, each swatch's watts on one line, from the least to the most.
+            title = "Rider colour = power here (W)"
+            legend = page.get_by_text(title, exact=True)
+            legend.evaluate(SCROLL_PANEL_TO_TOP)
+            assert page.evaluate(LEGEND_LINES, title) == [1] * 5
+            text = visible_text(page)
+            assert f"{round(float(here.min()))} W" in text and f"{round(float(here.max()))} W" in text
+            assert "Ride mean (W)" in text and "rides at the mean drag of its formation" in text
+            assert error_text(page) == []
+        mode.enable.value = False

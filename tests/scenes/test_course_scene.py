@@ -10,13 +10,16 @@ import time
 import numpy as np
 import pytest
 import viser
+from helpers.browser import VIEWPORTS
 from helpers.gpx import BAD_FILES, gpx_text, hill_gpx
 from helpers.scenes import glb_vertices, scene_fixture
+from helpers.screen_geometry import pinhole_ndc
 from helpers.uploads import upload
 from helpers.wsclient import BrowserClient
 
 from kernels import course as course_kernel
 from kernels import cycling
+from scenes._framing import MARGIN_PX, NOTICE_PX, PANEL_PX, Lens
 from scenes.peloton import (
     SAMPLE_LABEL,
     CourseMode,
@@ -28,6 +31,8 @@ from scenes.peloton import (
     group_cda,
 )
 from scenes.peloton.course_model import lay_out_road, route_points
+from scenes.peloton.meshes import rider_head_m
+from scenes.peloton.model import FORMATION_FROM_LABEL as FORMATION
 
 scene = scene_fixture(PelotonScene)
 
@@ -483,3 +488,148 @@ def test_a_bunch_rides_the_course_at_its_formations_mean_drag(mode: CourseMode) 
     layout = mode.layout()
     assert layout.half_width_m >= 2.1 + 0.5  # the road holds the bunch's width
     assert len({tuple(np.round(p, 3)) for p in drawn}) == 121
+
+
+# ------------------------------------------------------------------------------------------------ places' power
+def _place_watts_reference(mode: CourseMode, at_m: float) -> tuple[np.ndarray, np.ndarray]:
+    """Each place's power where the leader is ``at_m`` and over the ride, written out: the group's power plus the
+    aero power ½·ρ·(v + w)·|v + w|·v/η of the place's drag area above (or below) the group's."""
+    state, line = mode.state, mode.scene.params
+    assert state is not None
+    ride = state.ride
+    positions = cycling.formation(line.n_riders, line.formation, gap_m=line.gap_m, lateral_m=0.6)
+    drag = (
+        1.0 - cycling.drag_reduction(line.n_riders, line.gap_m, line.model)
+        if line.formation == "single"
+        else cycling.formation_drag(positions, line.model)
+    )
+    cda = line.cda_m2 * drag
+    group = float(np.mean(cda))
+    eta = line.drivetrain_pct / 100.0
+    dt = np.diff(ride.elapsed_s)
+    v = np.diff(ride.distance_m) / dt
+    air = v + ride.headwind_ms
+    per_m2 = 0.5 * ride.air_density * air * np.abs(air) * v / eta
+    j = int(np.searchsorted(ride.distance_m, at_m, side="right")) - 1
+    here = ride.power_w[j] + (cda - group) * per_m2[j]
+    mean = ride.work_j / ride.time_s + (cda - group) * float(np.sum(per_m2 * dt) / np.sum(dt))
+    return here, mean
+
+
+@pytest.mark.parametrize(("shape", "n"), [("Bunch (peloton)", 40), ("Bunch (peloton)", 121), ("Single file", 8)])
+def test_course_mode_colours_each_rider_by_its_places_power_with_a_legend_and_the_courses_table(
+    mode: CourseMode, shape: str, n: int
+) -> None:
+    # The failing look (a review): on the course a bunch kept the flat road's jerseys and Results table, and showed
+    # no power legend.
+    from scenes.peloton.legend import power_colours, power_range
+
+    scene = mode.scene
+    scene.controls["formation"].value, scene.controls["n_riders"].value = shape, n
+    mode.scrub.value = 6.0  # on the climb
+    here, mean = _place_watts_reference(mode, mode.leader_distance_m())
+    assert mode.leader_distance_m() == pytest.approx(6000.0, abs=1.0)
+    assert mode.state is not None
+    ride_power_here = float(mode.state.ride.power_w[np.searchsorted(mode.state.ride.distance_m, 6000.0) - 1])
+    # The places average the group's power (it rides at their mean drag); the leader works hardest.
+    assert float(np.mean(here)) == pytest.approx(ride_power_here, rel=1e-9)
+    assert float(np.mean(mean)) == pytest.approx(mode.state.ride.average_power_w, rel=1e-9)
+    assert int(np.argmax(here)) == 0 and here[0] > ride_power_here + 1.0
+    got_here, got_mean = mode.place_watts()
+    np.testing.assert_allclose(got_here, here, rtol=1e-9)
+    np.testing.assert_allclose(got_mean, mean, rtol=1e-9)
+    # Each rider's jersey in its place's colour, on the legend's scale, which says the watts.
+    bodies = np.asarray(mode.course_riders["body"].batched_colors)[:n]
+    low, high = power_range(here)
+    np.testing.assert_array_equal(bodies, power_colours(here, low, high))
+    legend = scene.legend.content
+    assert scene.legend.visible and "power here (W)" in legend
+    assert f"{round(low)} W</div>" in legend and f"{round(high)} W</div>" in legend
+    # The Results table is the course's: each place's drag, its power here and over the ride.
+    table = scene.table.content
+    assert "| Here (W) | Ride mean (W) |" in table and "CdA (m²)" not in table
+    assert f"**{round(float(here[0]))}**" in table.splitlines()[4]
+    # The panel says the group rides at its formation's mean drag.
+    assert "rides at the mean drag of its formation" in scene.density.content
+    assert f"CdA {mode.state.group_cda_m2:.3f} m²" in scene.density.content
+    assert not scene.chart.visible
+    # Back on the flat road: its own table, legend and chart again.
+    mode.enable.value = False
+    assert "CdA (m²)" in scene.table.content or "Power (W)" in scene.table.content
+    assert not scene.legend.visible or "power here" not in scene.legend.content
+    assert scene.chart.visible and scene.legend.visible == (shape != "Single file")
+
+
+def test_the_places_colours_follow_the_riders_along_the_course(mode: CourseMode) -> None:
+    scene = mode.scene
+    scene.controls["formation"].value, scene.controls["n_riders"].value = "Bunch (peloton)", 40
+    mode.scrub.value = 0.5
+    first = np.asarray(mode.course_riders["body"].batched_colors)[:40].copy()
+    legend = scene.legend.content
+    mode.scrub.value = 12.0
+    assert scene.legend.content != legend and "12.00 km" in scene.legend.content
+    here, _ = _place_watts_reference(mode, mode.leader_distance_m())
+    from scenes.peloton.legend import power_colours, power_range
+
+    np.testing.assert_array_equal(
+        np.asarray(mode.course_riders["body"].batched_colors)[:40], power_colours(here, *power_range(here))
+    )
+    assert first.shape == (40, 3)
+
+
+# ------------------------------------------------------------------------------------------------ camera
+def _course_rider_boxes(mode: CourseMode, n: int) -> np.ndarray:
+    """(n, 8, 3) corners of each drawn course rider's box (1.70 m by 0.6 m, road to the top of its head), turned
+    by its drawn quaternion, from the rider handles."""
+    positions = np.asarray(mode.course_riders["body"].batched_positions, dtype=np.float64)[:n]
+    w, x, y, z = np.asarray(mode.course_riders["body"].batched_wxyzs, dtype=np.float64)[:n].T
+    top = rider_head_m(mode.scene.params.position)[1]
+    local = np.array([(sx * 0.85, sy * 0.3, h) for sx in (-1, 1) for sy in (-1, 1) for h in (0.0, top)])
+    # v' = v + 2w(q × v) + 2 q × (q × v), q = (x, y, z): the quaternion's turn written out.
+    q = np.stack([x, y, z], axis=1)[:, None, :]
+    v = np.broadcast_to(local, (n, 8, 3))
+    t = 2.0 * np.cross(q, v)
+    return positions[:, None, :] + v + w[:, None, None] * t + np.cross(q, t)
+
+
+@pytest.mark.parametrize("viewport", VIEWPORTS)
+@pytest.mark.parametrize(
+    ("shape", "n"),
+    [("Single file", 8), ("Two abreast", 8), ("Bunch (peloton)", 40), ("Bunch (peloton)", 121), ("Single file", 121)],
+)
+def test_the_course_camera_frames_the_group_left_of_the_panel_and_clear_of_the_notice(
+    mode: CourseMode, viewport: tuple[int, int], shape: str, n: int
+) -> None:
+    # The failing look (a review): the course's camera put riders under viser's software-WebGL notice, drew a single
+    # file of 121 as dots and two abreast of 8 from a metre away.
+    scene = mode.scene
+    scene.controls["formation"].value, scene.controls["n_riders"].value = shape, n
+    mode.scrub.value = 3.0
+    lens = Lens(math.radians(75.0), *viewport)
+    view = scene._view_for(lens)
+    boxes = _course_rider_boxes(mode, n)
+    framed = mode.framed_riders()
+    behind = -cycling.formation(n, "single" if shape == "Single file" else FORMATION[shape], gap_m=0.5, lateral_m=0.6)
+    # Every rider within 45 m of the leader is framed: all of every group here but the single file of 121.
+    assert framed == int(np.count_nonzero(behind[:, 0] <= 45.0)) and (framed == n) == (
+        n != 121 or shape != "Single file"
+    )
+    x, y, depth = pinhole_ndc(
+        boxes[:framed].reshape(-1, 3), np.array(view.position), np.array(view.look_at), lens.fov_rad, lens.aspect
+    ).T
+    assert np.all(depth > 0.0)
+    px = np.stack([(x + 1) / 2 * lens.width_px, (1 - y) / 2 * lens.height_px], axis=1)
+    width, height = viewport
+    assert px.min() >= 0.5 * MARGIN_PX and px[:, 1].max() <= height - 0.5 * MARGIN_PX, (px.min(0), px.max(0))
+    assert px[:, 0].max() <= width - PANEL_PX, px.max(0)
+    under = (px[:, 0] < NOTICE_PX[0]) & (px[:, 1] < NOTICE_PX[1])
+    assert not under.any(), f"{shape} of {n}: {under.sum()} rider corners under the notice"
+    # Riders a person can make out (before, a single file of 121 drew them 4-6 px tall), and none so close that it
+    # stands over 30 % of the window tall (before, two abreast of 8: 34-37 %).
+    tall = np.ptp(px.reshape(framed, 8, 2)[:, :, 1], axis=1)
+    least = {(1600, 1000): 30.0, (1280, 720): 21.0}[viewport]
+    assert np.percentile(tall, 10) >= least and tall.max() <= 0.3 * height, (np.percentile(tall, 10), tall.max())
+    if framed < n:
+        assert f"front 45 m of the group (its first {framed} riders)" in scene.density.content
+    else:
+        assert "front 45 m" not in scene.density.content

@@ -490,7 +490,7 @@ def test_downhill_readouts_say_coasting_not_negative_watts(scene: PelotonScene) 
 
 # ------------------------------------------------------------------------------------------------ formations
 def test_a_121_rider_bunch_draws_every_rider_coloured_by_its_power(scene: PelotonScene) -> None:
-    from scenes.peloton.scene import POWER_COLOURS, power_colours, power_range
+    from scenes.peloton.legend import POWER_COLOURS, power_colours, power_range
 
     c = scene.controls
     c["formation"].value, c["n_riders"].value, c["gap_m"].value = "Bunch (peloton)", 121, 0.3
@@ -512,7 +512,8 @@ def test_a_121_rider_bunch_draws_every_rider_coloured_by_its_power(scene: Peloto
     np.testing.assert_array_equal(colours, power_colours(expected.total, low, high))
     assert tuple(colours[int(np.argmin(expected.total))]) == tuple(POWER_COLOURS[0].astype(np.uint8))
     assert scene.legend.visible
-    assert f"red {float(expected.total.max()):.0f}" in scene.legend.content
+    # The red swatch's watts, on one line under it (its name is its tooltip).
+    assert f"{float(expected.total.max()):.0f} W</div>" in scene.legend.content.split('title="red"')[1]
     # No bars; a few riders labelled in the picture with their watts and drag, the leader first and the rider who
     # works least among them; the table gives the leader's watts and the mean drag.
     assert np.all(bar_heights(scene, "aero") == 0.0)
