@@ -252,8 +252,10 @@ def test_a_bunch_of_121_shows_each_riders_power_in_colour_and_in_numbers(shown: 
         panel = screenshot(page)
         for rgb in POWER_COLOURS:
             assert colour_pixels(panel, rgb, tolerance=6.0) > 300, rgb  # a swatch, not just a few riders' pixels
+        # Each swatch's watts on one line (at 1600×1000 "yellow 253 W" wrapped under its swatch).
+        assert page.evaluate(LEGEND_LINES, "Rider colour = power (W)") == [1] * 5
         text = visible_text(page)
-        assert f"blue {round(float(total.min()))}" in text and f"red {round(float(total.max()))}" in text
+        assert f"{round(float(total.min()))} W" in text and f"{round(float(total.max()))} W" in text
         # Numbers in the picture: a few riders labelled with their watts and drag, the leader's among them, each
         # label in view clear of the panel with dark text where it is drawn.
         assert 2 <= len(marked) <= 4 and marked[0][0].startswith(f"{round(float(total[0]))} W · drag ")
