@@ -36,7 +36,7 @@ from helpers.browser import (
 from helpers.screen_geometry import GOAL_CORNERS, polyline_gap
 from helpers.waiting import wait_until
 
-from scenes._framing import Lens, project_points
+from scenes._framing import NOTICE_PX, Lens, project_points
 from scenes.freekick import (
     FORCE_COLOURS,
     KNUCKLE_COLOUR,
@@ -206,6 +206,13 @@ def test_every_camera_view_keeps_the_kick_in_view(shown: ScenePage) -> None:
         goal = ["/freekick/net", "/freekick/goal_frame"]
         over_ball = changed_mask(plain, with_nodes_hidden(shown.page, [*overlays, *goal])) & ball
         assert not over_ball.any(), f"the goal is drawn over the ball at {x, y}"
+        # ...and the keeper is drawn, left of the panel and clear of the software-WebGL notice (the old view stood
+        # inside him or showed none of him).
+        keeper = changed_mask(plain, with_nodes_hidden(shown.page, [*overlays, *KEEPER]))
+        assert keeper.sum() >= 40, keeper.sum()
+        rows, cols = np.nonzero(keeper)
+        assert cols.max() < panel_rect(shown.page)[0], cols.max()
+        assert not ((cols < NOTICE_PX[0]) & (rows < NOTICE_PX[1])).any(), "the keeper under the notice"
 
 
 def test_the_force_chart_tick_labels_stay_inside_its_canvas(shown: ScenePage) -> None:
