@@ -24,6 +24,7 @@ from scenes._instances import park_hidden
 from scenes._look import add_ground, mesh_glb
 from scenes.peloton.course_model import (
     COURSE_POWER_RANGE_W,
+    FRAMED_LENGTH_M,
     GROUP_VIEW_DIRECTION,
     LINE_VIEW_DIRECTION,
     MAX_CHART_POINTS,
@@ -59,9 +60,6 @@ from scenes.peloton.model import BIKE_LENGTH_M, MAX_GROUP, Position, group_cda, 
 
 CHART_TITLE = "Elevation, speed and power"
 """The course chart's title (short: the panel is narrow)."""
-FRAMED_LENGTH_M = 45.0
-"""The camera frames at most this much of the group, from its leader back (m): a longer line (121 riders in single
-file run 270 m) framed whole draws its riders a few pixels tall, so the front of it is framed and the panel says so."""
 ROAD_SHOWN_M = {True: (3.0, 0.0), False: (10.0, 4.0)}
 """Road the camera frames ahead of the leader and behind the last framed rider (m), the road's full width, for a line
 seen from its side (True) and a group seen from behind (False): a small group is seen on its road, not from a metre
@@ -583,8 +581,9 @@ class CourseMode:
         table = formation_table(
             s.state.positions,
             drag,
-            {"Here (W)": here, "Ride mean (W)": mean},
-            f"Each place of the formation at **{self._leader_km():.2f} km** and over the whole ride",
+            {"Here": here, "Ride mean": mean},
+            f"Each place's drag (% of a lone rider's) and power (W) at **{self._leader_km():.2f} km** and over the "
+            "whole ride",
         )
         set_if_changed(s.table, "content", table)
         if not readouts:

@@ -51,6 +51,10 @@ LINE_VIEW_DIRECTION = (1.2, 7.5, -1.6)
 GROUP_VIEW_DIRECTION = (3.0, 2.6, -2.4)
 """Where the camera looks at a group on the course: from behind its right side and above, so every row shows (from
 ahead, as on the flat road, the road framed ahead of the leader pushed the group to the far end of the picture)."""
+FRAMED_LENGTH_M = 45.0
+"""The camera frames at most this much of the group, from its leader back (m): a longer line (121 riders in single
+file run over 260 m) framed whole draws its riders a few pixels tall, so the front of it is framed and the panel says
+so. The scene's frame turns with the road under that front (:func:`lay_out_road`)."""
 MAX_CHART_POINTS = 1000
 
 MODE_FOLDER = "Course mode (GPX route)"
@@ -413,7 +417,9 @@ def lay_out_road(
     :class:`RoadLayout`). ``formation_xy`` is (n, 2) as :func:`riders_on_road` takes it."""
     xy = np.asarray(formation_xy, dtype=np.float64).reshape(-1, 2)
     length = float(-xy[:, 0].min()) if len(xy) else 0.0
-    frame = ChaseFrame.around(route, leader_m, length, exaggeration)
+    # The frame follows the road under the group's framed front: the camera looks along it, not along the chord
+    # from a long line's leader to its last rider, which a hairpin turns across the road at the front.
+    frame = ChaseFrame.around(route, leader_m, min(length, FRAMED_LENGTH_M), exaggeration)
     half_width = max(ROAD_HALF_WIDTH_M, float(np.abs(xy[:, 1]).max(initial=0.0)) + 0.9)
     d_from, d_to = leader_m - length - ROAD_BEHIND_M, leader_m + ROAD_AHEAD_M
     k = round((d_to - d_from) / ROAD_STEP_M) + 1

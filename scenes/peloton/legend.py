@@ -52,7 +52,7 @@ def legend_html(low: float, high: float, summary: str, title: str = "Rider colou
 
 def formation_table(positions: np.ndarray, drag: np.ndarray, columns: dict[str, np.ndarray], summary: str) -> str:
     """``summary``, then a markdown table of a formation by row (riders level with each other share a row), front to
-    back: each row's number, its riders, their drag (% of the same rider alone) and, per ``columns`` (header → (n,)
+    back: each row's number, its riders, their drag (%, of the same rider alone) and, per ``columns`` (header → (n,)
     watts), their watts (a range where they differ); a formation of more than :data:`TABLE_ROWS` rows shows its
     first ten and last three.
 
@@ -67,7 +67,7 @@ def formation_table(positions: np.ndarray, drag: np.ndarray, columns: dict[str, 
     lines = [
         summary,
         "",
-        "| Row | Riders | Drag (% of alone) | " + " | ".join(columns) + " |",
+        "| Row | Riders | Drag (%) | " + " | ".join(columns) + " |",
         "|---|---|---|" + "---|" * len(columns),
     ]
     shown = rows if len(rows) <= TABLE_ROWS else [*rows[:10], None, *rows[-3:]]
@@ -82,6 +82,6 @@ def formation_table(positions: np.ndarray, drag: np.ndarray, columns: dict[str, 
         for values in columns.values():
             w = np.asarray(values)[members]
             low, high = watts_text(float(w.min())), watts_text(float(w.max()))
-            cells.append(f"**{low}**" if low == high else f"**{low}**–**{high}**")
+            cells.append(f"**{low}**" if low == high else f"**{low}–{high}**")
         lines.append(f"| {number} | {len(members)} | {drag_text} | " + " | ".join(cells) + " |")
     return "\n".join(lines)

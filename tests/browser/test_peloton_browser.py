@@ -433,6 +433,6 @@ def test_course_mode_colours_a_bunch_by_power_with_its_legend_clear_of_the_notic
             assert page.evaluate(LEGEND_LINES, title) == [1] * 5
             text = visible_text(page)
             assert f"{round(float(here.min()))} W" in text and f"{round(float(here.max()))} W" in text
-            assert "Ride mean (W)" in text and "rides at the mean drag of its formation" in text
+            assert "Ride mean" in text and "rides at the mean drag of its formation" in text
             assert error_text(page) == []
         mode.enable.value = False

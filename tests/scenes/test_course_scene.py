@@ -547,7 +547,7 @@ def test_course_mode_colours_each_rider_by_its_places_power_with_a_legend_and_th
     assert f"{round(low)} W</div>" in legend and f"{round(high)} W</div>" in legend
     # The Results table is the course's: each place's drag, its power here and over the ride.
     table = scene.table.content
-    assert "| Here (W) | Ride mean (W) |" in table and "CdA (m²)" not in table
+    assert "| Drag (%) | Here | Ride mean |" in table and "CdA (m²)" not in table
     assert f"**{round(float(here[0]))}**" in table.splitlines()[4]
     # The panel says the group rides at its formation's mean drag.
     assert "rides at the mean drag of its formation" in scene.density.content
@@ -592,19 +592,20 @@ def _course_rider_boxes(mode: CourseMode, n: int) -> np.ndarray:
     return positions[:, None, :] + v + w[:, None, None] * t + np.cross(q, t)
 
 
+@pytest.mark.parametrize("km", [3.0, 9.0])  # a straight, a hairpin
 @pytest.mark.parametrize("viewport", VIEWPORTS)
 @pytest.mark.parametrize(
     ("shape", "n"),
     [("Single file", 8), ("Two abreast", 8), ("Bunch (peloton)", 40), ("Bunch (peloton)", 121), ("Single file", 121)],
 )
 def test_the_course_camera_frames_the_group_left_of_the_panel_and_clear_of_the_notice(
-    mode: CourseMode, viewport: tuple[int, int], shape: str, n: int
+    mode: CourseMode, viewport: tuple[int, int], shape: str, n: int, km: float
 ) -> None:
     # The failing look (a review): the course's camera put riders under viser's software-WebGL notice, drew a single
     # file of 121 as dots and two abreast of 8 from a metre away.
     scene = mode.scene
     scene.controls["formation"].value, scene.controls["n_riders"].value = shape, n
-    mode.scrub.value = 3.0
+    mode.scrub.value = km
     lens = Lens(math.radians(75.0), *viewport)
     view = scene._view_for(lens)
     boxes = _course_rider_boxes(mode, n)
