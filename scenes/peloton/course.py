@@ -563,9 +563,9 @@ class CourseMode:
         panel; with ``readouts``, the Results table of the course's places and the words on how the group shares the
         work."""
         s, state = self.scene, self.state
-        if state is None:
-            return
         n = s.params.n_riders
+        if state is None or state.drag.shape[0] != n:  # no ride yet, or the last good one is of another group
+            return
         here, mean = self.place_watts()
         low, high = power_range(here)
         bodies = np.asarray(self.course_riders["body"].batched_colors).copy()
