@@ -122,11 +122,8 @@ def goal_hides(eye: NDArray[np.float64], target: NDArray[np.float64], clear_m: f
     the box from the goal line to the back of the net, up to ``clear_m`` over the crossbar) on its way."""
     half = 0.5 * ball.GOAL_WIDTH_M + 0.12
     top = ball.GOAL_HEIGHT_M + 0.12 + clear_m
-    for s in np.linspace(0.0, 1.0, 65):
-        x, y, z = eye + s * (target - eye)
-        if -0.12 <= x <= 2.0 and abs(y) <= half and z <= top:
-            return True
-    return False
+    x, y, z = (eye + np.linspace(0.0, 1.0, 65)[:, None] * (target - eye)).T
+    return bool(np.any((x >= -0.12) & (x <= 2.0) & (np.abs(y) <= half) & (z <= top)))
 
 
 def keeper_head(state: KickState) -> NDArray[np.float64] | None:
@@ -136,7 +133,7 @@ def keeper_head(state: KickState) -> NDArray[np.float64] | None:
     return np.array([*state.keeper_xy, KEEPER.com_height_m + KEEPER.hand_reach_m])
 
 
-def tilt_chosen(p: FreeKickParams, state: KickState, view: ViewName, lens: Lens, framed: View) -> bool:
+def tilt_chosen(p: FreeKickParams, state: KickState, view: ViewName, framed: View) -> bool:
     """Whether the goalkeeper's ``framed`` pose sees the ball over the goal and past the wall, and the keeper's
     raised hands over the goal (always true for the other views)."""
     if view != "goal":
@@ -175,7 +172,7 @@ def frame_view(
             points, (float(d[0]), float(d[1]), float(d[2])), lens, min_depth=VIEW_MIN_DEPTH_M[view]
         )
         if view == "goal":
-            if tilt_chosen(p, state, view, lens, framed):
+            if tilt_chosen(p, state, view, framed):
                 return framed
             continue
         width = goal_width_px(framed, lens)
