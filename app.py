@@ -139,6 +139,7 @@ def main(
         shared: one scene for every browser tab (a switch or Reset in one tab changes it for all); by default each
             tab has its own scene.
     """
+    let_ctrl_c_stop_the_app()
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s %(levelname)s %(message)s")
     logging.getLogger("websockets").setLevel(logging.WARNING)  # not a line per start and stop
     asked = DEFAULT_PORT if port is None else port
@@ -176,18 +177,26 @@ def main(
         print("Stopped.", flush=True)
 
 
+def let_ctrl_c_stop_the_app() -> None:
+    """Restore Python's Ctrl+C where it was ignored.
+
+    A shell starts a background job (`python app.py &` in a script) with SIGINT ignored, and Python then leaves it
+    ignored: Ctrl+C would not stop the app. :func:`main` calls this before it prints the address, so a Ctrl+C sent as
+    soon as the address shows is not lost.
+    """
+    if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+
+
 def sleep_until_a_signal() -> None:
     """Sleep until Ctrl+C, whichever thread the system hands the signal to.
 
     ``ViserServer.sleep_forever`` sleeps an hour at a time: when the system delivers SIGINT to one of the server's
     threads rather than the main one, the main thread sleeps on and the app does not stop. Here the main thread waits
     on Python's signal wake-up socket, which the interpreter writes to on any signal from any thread; the pending
-    ``KeyboardInterrupt`` is then raised here. Where SIGINT was ignored (a background job), it is restored.
+    ``KeyboardInterrupt`` is then raised here.
     """
-    # A shell starts a background job (`python app.py &` in a script) with SIGINT ignored, and Python then leaves it
-    # ignored: Ctrl+C would not stop the app.
-    if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
-        signal.signal(signal.SIGINT, signal.default_int_handler)
+    let_ctrl_c_stop_the_app()
     reader, writer = socket.socketpair()
     reader.setblocking(False)
     writer.setblocking(False)
