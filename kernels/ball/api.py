@@ -40,7 +40,7 @@ from kernels.ball.config import (
 )
 from kernels.ball.core import ENDINGS, RESULTS, Ending, Result
 from kernels.ball.laws import bounce, coefficients
-from kernels.ball.pitch import Keeper, Panel, Pitch, free_kick_panels, panel_rows, pitch_vector
+from kernels.ball.pitch import Keeper, Panel, Pitch, free_kick_panels, keeper_slots, panel_rows, pitch_vector
 from kernels.warming import Entry
 
 # The compiled cores called from here: plain Python while the app's first start compiles them (kernels.warming).
@@ -302,6 +302,50 @@ def _keeper_dive(info: NDArray[np.float64]) -> KeeperDive | None:
         return None
     target = info[play.I_TARGET : play.I_TARGET + 3]
     return KeeperDive(float(info[play.I_DIVE]), (float(target[0]), float(target[1]), float(target[2])))
+
+
+@dataclasses.dataclass(frozen=True)
+class KeeperPath:
+    """The keeper at given times as a flight on a pitch moves him (:class:`Keeper`): a stick of radius
+    ``keeper.body_radius_m`` from his soles to his fingertips through his centre of mass."""
+
+    t: NDArray[np.float64]
+    """(T,) times since the kick (s)."""
+    com: NDArray[np.float64]
+    """(T, 3) centre of mass (m)."""
+    up: NDArray[np.float64]
+    """(T, 3) unit direction from the soles toward the fingertips."""
+    capsule: NDArray[np.float64]
+    """(T, 2, 3) the segment the ball is tested against (m): the stick's ends pulled in by the body's radius and kept
+    a radius above the turf; a ball whose centre comes within its radius plus the body's of it touches him."""
+
+
+def keeper_path(
+    keeper: Keeper,
+    position_xy: ArrayLike,
+    dive: KeeperDive | None,
+    times: ArrayLike,
+    *,
+    turf_m: float = 0.0,
+) -> KeeperPath:
+    """Where ``keeper``, standing at ``position_xy`` (m) on turf at height ``turf_m``, is at each of ``times`` (s since
+    the kick), after ``dive`` (a flight's :attr:`Trajectory.keeper_dive`; None: he stands). The flight's own compiled
+    keeper, so a picture drawn from it is the body the ball met. ``ValueError`` naming a non-finite argument."""
+    _checks.instance("keeper", keeper, Keeper)
+    spot = checked_vector("position_xy", position_xy, 2)
+    t = np.ascontiguousarray(_checks.finite_array("times", times).reshape(-1))
+    vector = np.zeros(play.N_PITCH)
+    vector[play.TURF] = _checks.finite_number("turf_m", turf_m)
+    keeper_slots(vector, keeper, (float(spot[0]), float(spot[1])))
+    if dive is None:
+        dive_t, target = math.inf, np.zeros(3)
+    else:
+        _checks.instance("dive", dive, KeeperDive)
+        dive_t = _checks.finite_number("dive.t", dive.t)
+        target = checked_vector("dive.target", dive.target, 3)
+    out = np.empty((len(t), 12))
+    play.keeper_path(vector, dive_t, target, t, out)
+    return KeeperPath(t, out[:, 0:3], out[:, 3:6], out[:, 6:12].reshape(-1, 2, 3))
 
 
 @functools.lru_cache(maxsize=64)
@@ -670,3 +714,4 @@ def warm_up() -> None:
     )
     simulate_batch(rows, [velocity, velocity], [spin, spin], dt=0.05, t_max=0.2, pitch=pitch)
     simulate_outcomes(rows, [velocity, velocity], [spin, spin], dt=0.05, pitch=pitch)
+    keeper_path(Keeper(), (11.0, 0.0), KeeperDive(0.2, (12.0, 2.0, 1.5)), np.array([0.0, 0.5]))

@@ -273,15 +273,21 @@ def pitch_vector(pitch: Pitch, ball_xy: ArrayLike, ground_m: float, radius_m: fl
     keeper = pitch.keeper
     if keeper is not None:
         _checks.instance("pitch.keeper", keeper, Keeper)
-        kx, ky = keeper.placed(ball_xy, pitch.goal)
-        vector[play.KEEPER_ON] = 1.0
-        vector[play.KX], vector[play.KY] = kx, ky
-        vector[play.K_RADIUS] = _checks.positive("keeper.body_radius_m", keeper.body_radius_m)
-        vector[play.K_COM] = _checks.positive("keeper.com_height_m", keeper.com_height_m)
-        vector[play.K_HANDS] = _checks.positive("keeper.hand_reach_m", keeper.hand_reach_m)
-        vector[play.K_FEET] = _checks.positive("keeper.foot_reach_m", keeper.foot_reach_m)
-        vector[play.K_REACT] = _checks.non_negative("keeper.reaction_s", keeper.reaction_s)
-        vector[play.K_PUSH] = _checks.positive("keeper.push_off_s", keeper.push_off_s)
-        vector[play.K_SPEED] = _checks.non_negative("keeper.dive_speed_ms", keeper.dive_speed_ms)
-        vector[play.K_TURN] = _checks.positive("keeper.turn_s", keeper.turn_s)
+        keeper_slots(vector, keeper, keeper.placed(ball_xy, pitch.goal))
     return vector
+
+
+def keeper_slots(vector: NDArray[np.float64], keeper: Keeper, position_xy: tuple[float, float]) -> None:
+    """Write ``keeper``, standing at ``position_xy``, into a pitch vector's keeper slots, checked (``ValueError``
+    naming the field)."""
+    kx, ky = position_xy
+    vector[play.KEEPER_ON] = 1.0
+    vector[play.KX], vector[play.KY] = kx, ky
+    vector[play.K_RADIUS] = _checks.positive("keeper.body_radius_m", keeper.body_radius_m)
+    vector[play.K_COM] = _checks.positive("keeper.com_height_m", keeper.com_height_m)
+    vector[play.K_HANDS] = _checks.positive("keeper.hand_reach_m", keeper.hand_reach_m)
+    vector[play.K_FEET] = _checks.positive("keeper.foot_reach_m", keeper.foot_reach_m)
+    vector[play.K_REACT] = _checks.non_negative("keeper.reaction_s", keeper.reaction_s)
+    vector[play.K_PUSH] = _checks.positive("keeper.push_off_s", keeper.push_off_s)
+    vector[play.K_SPEED] = _checks.non_negative("keeper.dive_speed_ms", keeper.dive_speed_ms)
+    vector[play.K_TURN] = _checks.positive("keeper.turn_s", keeper.turn_s)

@@ -160,13 +160,13 @@ def _capsule_fraction(x, y, z, vx, vy, vz, x1, y1, z1, vx1, vy1, vz1, h, cap, ra
 
 
 @compiled()
-def _keeper_capsule(pitch, dive_t, target, t, cap):
-    """The keeper's capsule at time ``t`` into ``cap`` (8,): a stick from feet to fingertips through the centre of
-    mass. Standing, it is upright; from ``dive_t`` the centre of mass accelerates uniformly for the push-off time to
-    the dive speed, then keeps it, along the straight line to the point that puts the fingertips on ``target``,
-    stopping there; the stick turns from upright to point at the target over the turn time."""
-    turf = pitch[TURF]
-    mx, my, mz = pitch[KX], pitch[KY], turf + pitch[K_COM]
+def _keeper_pose(pitch, dive_t, target, t):
+    """The keeper at time ``t``: his centre of mass and the unit vector from it toward his fingertips, as
+    (mx, my, mz, ux, uy, uz). Standing, he is upright; from ``dive_t`` the centre of mass accelerates uniformly for
+    the push-off time to the dive speed, then keeps it, along the straight line to the point that puts the
+    fingertips on ``target``, stopping there; the body turns from upright to point at the target over the turn
+    time."""
+    mx, my, mz = pitch[KX], pitch[KY], pitch[TURF] + pitch[K_COM]
     ux, uy, uz = 0.0, 0.0, 1.0
     if t > dive_t:
         tau = t - dive_t
@@ -185,10 +185,29 @@ def _keeper_capsule(pitch, dive_t, target, t, cap):
                 ux, uy, uz = ux / length, uy / length, uz / length
             else:
                 ux, uy, uz = gx, gy, gz
-    feet, hands, r = pitch[K_FEET], pitch[K_HANDS], pitch[K_RADIUS]
+    return mx, my, mz, ux, uy, uz
+
+
+@compiled()
+def _keeper_capsule(pitch, dive_t, target, t, cap):
+    """The keeper's capsule at time ``t`` into ``cap`` (8,): a stick from feet to fingertips through the centre of
+    mass (:func:`_keeper_pose`), its ends pulled in by the body's radius and kept above the turf."""
+    mx, my, mz, ux, uy, uz = _keeper_pose(pitch, dive_t, target, t)
+    turf, feet, hands, r = pitch[TURF], pitch[K_FEET], pitch[K_HANDS], pitch[K_RADIUS]
     cap[0], cap[1], cap[2] = mx - ux * (feet - r), my - uy * (feet - r), max(mz - uz * (feet - r), turf + r)
     cap[3], cap[4], cap[5] = mx + ux * (hands - r), my + uy * (hands - r), max(mz + uz * (hands - r), turf + r)
     cap[6], cap[7] = r, KEEPER
+
+
+@compiled()
+def keeper_path(pitch, dive_t, target, times, out):
+    """The keeper at each of ``times`` (T,) into ``out`` (T, 12): centre of mass (3), the unit vector toward the
+    fingertips (3), and the ends of the capsule the ball is tested against (feet end 3, fingertip end 3)."""
+    cap = np.empty(8)
+    for i in range(times.shape[0]):
+        out[i, 0], out[i, 1], out[i, 2], out[i, 3], out[i, 4], out[i, 5] = _keeper_pose(pitch, dive_t, target, times[i])
+        _keeper_capsule(pitch, dive_t, target, times[i], cap)
+        out[i, 6:12] = cap[:6]
 
 
 @compiled()

@@ -304,60 +304,13 @@ def pitch(p: FreeKickParams) -> ball.Pitch:
     return ball.Pitch(goal, wall, KEEPER if p.keeper else None)
 
 
-@dataclasses.dataclass(frozen=True)
-class KeeperPose:
-    """The keeper as the kernel moves him: a stick from the soles to the fingertips through his centre of mass."""
-
-    com: NDArray[np.float64]
-    """(T, 3) centre of mass (m)."""
-    up: NDArray[np.float64]
-    """(T, 3) unit direction from the soles toward the fingertips."""
-
-    def ends(self, keeper: ball.Keeper = KEEPER) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """(T, 3) soles and (T, 3) fingertips (m): the stick's ends, as the kernel's capsule before its rounding."""
-        return self.com - keeper.foot_reach_m * self.up, self.com + keeper.hand_reach_m * self.up
-
-
-def keeper_pose(
-    keeper_xy: tuple[float, float],
-    dive: ball.KeeperDive | None,
-    times: NDArray[np.float64],
-    keeper: ball.Keeper = KEEPER,
-) -> KeeperPose:
-    """Where the keeper is at each of ``times`` (s since the kick), as :func:`kernels.ball.simulate` moves him.
-
-    Upright on ``keeper_xy`` until the dive starts (``dive.t``); then his centre of mass accelerates uniformly over
-    ``push_off_s`` to ``dive_speed_ms`` and keeps that speed along the straight line toward ``dive.target``, stopping
-    where his fingertips reach it, while his body turns from upright to point at it over ``turn_s`` (the kernel's
-    keeper model, :class:`kernels.ball.Keeper`; dive speed from Ibrahim et al. 2019). The turf is at z = 0.
-    """
-    t = np.asarray(times, dtype=np.float64).reshape(-1)
-    com = np.tile([keeper_xy[0], keeper_xy[1], keeper.com_height_m], (len(t), 1))
-    up = np.tile([0.0, 0.0, 1.0], (len(t), 1))
-    if dive is None:
-        return KeeperPose(com, up)
-    tau = np.maximum(t - dive.t, 0.0)
-    push, speed = keeper.push_off_s, keeper.dive_speed_ms
-    travel = np.where(tau < push, 0.5 * speed * tau**2 / push, 0.5 * speed * push + speed * (tau - push))
-    to_target = np.asarray(dive.target, dtype=np.float64) - com[0]
-    span = float(np.linalg.norm(to_target))
-    if span <= 1e-9:
-        return KeeperPose(com, up)
-    g = to_target / span
-    move = np.minimum(travel, max(span - keeper.hand_reach_m, 0.0))
-    com = com + move[:, None] * g
-    turn = np.minimum(tau / keeper.turn_s, 1.0)[:, None]
-    up = (1.0 - turn) * up + turn * g
-    up /= np.linalg.norm(up, axis=1, keepdims=True)
-    return KeeperPose(com, up)
-
-
-def keeper_gap_m(pose: KeeperPose, points: NDArray[np.float64], keeper: ball.Keeper = KEEPER) -> NDArray[np.float64]:
-    """(T,) distance (m) from each ball centre of (T, 3) ``points`` to the keeper's body at the same instant, less
-    the ball's radius and half the body's thickness: ≤ 0 where the ball touches him."""
-    r = keeper.body_radius_m
-    soles = pose.com - (keeper.foot_reach_m - r) * pose.up  # the kernel's capsule: its segment and radius
-    tips = pose.com + (keeper.hand_reach_m - r) * pose.up
+def keeper_gap_m(
+    pose: ball.KeeperPath, points: NDArray[np.float64], keeper: ball.Keeper = KEEPER
+) -> NDArray[np.float64]:
+    """(T,) distance (m) from each ball centre of (T, 3) ``points`` to the keeper's body at the same instant
+    (the kernel's capsule, :attr:`kernels.ball.KeeperPath.capsule`), less the ball's radius and half the body's
+    thickness: ≤ 0 where the ball touches him."""
+    soles, tips = pose.capsule[:, 0], pose.capsule[:, 1]
     axis = tips - soles
     s = np.clip(np.einsum("ij,ij->i", points - soles, axis) / np.einsum("ij,ij->i", axis, axis), 0.0, 1.0)
     nearest = soles + s[:, None] * axis
@@ -370,7 +323,8 @@ KEEPER_STEP_S = 2e-3
 
 def save_margin_s(state: KickState) -> float | None:
     """How much earlier (s) the keeper's body could have touched the ball where he met it than it arrived there;
-    None unless he saved it. The kernel's keeper (:func:`keeper_pose`) searched every :data:`KEEPER_STEP_S`."""
+    None unless he saved it. The kernel's keeper (:func:`kernels.ball.keeper_path`) searched every
+    :data:`KEEPER_STEP_S`."""
     played, spot = state.played, state.keeper_xy
     if played is None or spot is None or played.keeper_dive is None:
         return None
@@ -379,7 +333,7 @@ def save_margin_s(state: KickState) -> float | None:
         return None
     times = np.arange(played.keeper_dive.t, saved.t + KEEPER_STEP_S, KEEPER_STEP_S)
     point = np.tile(saved.position, (len(times), 1))
-    reach = keeper_gap_m(keeper_pose(spot, played.keeper_dive, times), point) <= 1e-3
+    reach = keeper_gap_m(ball.keeper_path(KEEPER, spot, played.keeper_dive, times), point) <= 1e-3
     first = float(times[int(np.argmax(reach))]) if reach.any() else saved.t
     return max(saved.t - first, 0.0)
 
@@ -400,7 +354,7 @@ def keeper_words(state: KickState) -> str:
     if margin is not None:
         return f"{dived}, reaches it {margin:.2f} s early"
     # The ball got past: how close his body came to it over the flight.
-    gap = keeper_gap_m(keeper_pose(spot, dive, played.t), played.position)
+    gap = keeper_gap_m(ball.keeper_path(KEEPER, spot, dive, played.t), played.position)
     nearest = max(float(gap.min()), 0.0)
     if played.result == "goal":
         return f"{dived}; the ball beats him by {nearest:.2f} m"
@@ -458,13 +412,13 @@ LIMB_RADII_M = np.array([0.08, 0.08, 0.16, 0.06, 0.06, 0.11])
 """Each part's half-thickness (m): the body a little thicker than the kernel's stick (0.15 m)."""
 
 
-def keeper_limbs(pose: KeeperPose, facing_xy: NDArray[np.float64], keeper: ball.Keeper = KEEPER) -> NDArray[np.float64]:
+def keeper_limbs(pose: ball.KeeperPath, facing_xy: NDArray[np.float64], keeper: ball.Keeper = KEEPER) -> NDArray[np.float64]:
     """(T, 6, 2, 3) start and end of each of :data:`LIMBS` (m) for a simple articulated figure on the kernel's
     stick: legs from the hips to the soles (feet apart), the body from the hips to the shoulders, arms from the
     shoulders to the fingertips (hands apart, up the stick as the kernel's reach has them) and the head. ``facing_xy``
     is the (2,) direction he faces (toward the ball); the figure spreads its limbs across it."""
-    soles, tips = pose.ends(keeper)
     up, com = pose.up, pose.com
+    soles, tips = com - keeper.foot_reach_m * up, com + keeper.hand_reach_m * up
     facing = np.array([facing_xy[0], facing_xy[1], 0.0])
     side = np.cross(facing, up)  # across the body, in the plane he dives in
     norm = np.linalg.norm(side, axis=1, keepdims=True)

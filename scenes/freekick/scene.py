@@ -32,6 +32,7 @@ from scenes.freekick.model import (
     DEFENDER_WIDTH_M,
     DEFENDERS,
     JUMP_M,
+    KEEPER,
     LIMB_RADII_M,
     LIMBS,
     MAP_CELL_PX,
@@ -52,7 +53,6 @@ from scenes.freekick.model import (
     heat_cells,
     heat_colours,
     keeper_limbs,
-    keeper_pose,
     keeper_show_time,
     keeper_words,
     knuckle_ticked,
@@ -768,7 +768,7 @@ of him beats him more often than it would a real keeper.
         set_if_changed(self.keeper_head, "visible", shown)
         if state.keeper_xy is None or state.played is None:
             return
-        pose = keeper_pose(state.keeper_xy, state.played.keeper_dive, np.array([t]))
+        pose = ball.keeper_path(KEEPER, state.keeper_xy, state.played.keeper_dive, np.array([t]))
         facing = ball_spot(self.params)[:2] - np.array(state.keeper_xy)
         limbs = keeper_limbs(pose, facing / max(float(np.linalg.norm(facing)), 1e-9))[0]
         starts, ends = limbs[:, 0], limbs[:, 1]

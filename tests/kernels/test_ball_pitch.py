@@ -5,6 +5,7 @@ outcomes, and two published flights (Mencke et al. 2020, Bray & Kerwin 2003) as 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 import pytest
@@ -204,11 +205,9 @@ def test_angular_momentum_about_the_contact_point_is_kept_when_the_ball_grips() 
     np.testing.assert_allclose(l_after, l_before, rtol=1e-9, atol=1e-12)
 
 
-def test_a_soft_shot_at_the_keeper_is_saved_and_a_fast_one_into_the_top_corner_is_not() -> None:
-    keeper = ball.Keeper()
-    pitch = ball.Pitch(GOAL, None, keeper)
-    spot = (-20.0, 0.0, R)
-    soft = ball.simulate(
+def _soft_shot_at_the_keeper(spot: tuple[float, float, float], pitch: ball.Pitch) -> ball.Trajectory:
+    """14 m/s, 8° up, straight at the goal's centre from ``spot``: the keeper has time to get to it."""
+    return ball.simulate(
         spot,
         ball.launch_velocity(14.0, math.radians(8.0), 0.0),
         (0.0, 0.0, 0.0),
@@ -219,6 +218,13 @@ def test_a_soft_shot_at_the_keeper_is_saved_and_a_fast_one_into_the_top_corner_i
         ground_m=R,
         pitch=pitch,
     )
+
+
+def test_a_soft_shot_at_the_keeper_is_saved_and_a_fast_one_into_the_top_corner_is_not() -> None:
+    keeper = ball.Keeper()
+    pitch = ball.Pitch(GOAL, None, keeper)
+    spot = (-20.0, 0.0, R)
+    soft = _soft_shot_at_the_keeper(spot, pitch)
     assert soft.result == "saved" and soft.ended == "saved"
     assert soft.events[-1].kind == "keeper"
     # 32 m/s at the top left corner (aim 3.2 m left, 2.1 m up at the line).
@@ -230,6 +236,62 @@ def test_a_soft_shot_at_the_keeper_is_saved_and_a_fast_one_into_the_top_corner_i
     )
     assert fast.result == "goal", (fast.result, fast.events)
     assert fast.keeper_dive is not None and fast.keeper_dive.target[1] > 2.0  # he went the right way, too late
+
+
+def test_the_keeper_path_is_the_body_the_flight_met() -> None:
+    """``keeper_path`` is the flight's own compiled keeper: at the saved contact its capsule is one ball radius plus
+    one body radius from the ball's centre, and before the dive he stands upright on his spot."""
+    keeper = ball.Keeper()
+    pitch = ball.Pitch(GOAL, None, keeper)
+    spot = (-20.0, 0.0, R)
+    soft = _soft_shot_at_the_keeper(spot, pitch)
+    touch, dive = soft.events[-1], soft.keeper_dive
+    assert touch.kind == "keeper" and dive is not None
+    stand = keeper.placed(spot[:2], GOAL)
+    path = ball.keeper_path(keeper, stand, dive, [0.0, dive.t, touch.t])
+    a, b = path.capsule[2]
+    along = float(np.clip(np.dot(np.subtract(touch.position, a), b - a) / np.dot(b - a, b - a), 0.0, 1.0))
+    gap = float(np.linalg.norm(np.subtract(touch.position, a + along * (b - a))))
+    assert gap == pytest.approx(keeper.body_radius_m + R, abs=3e-3)  # the flight holds him still over a 10 ms step
+    np.testing.assert_allclose(path.com[:2], [[*stand, keeper.com_height_m]] * 2)
+    np.testing.assert_allclose(path.up[:2], [[0.0, 0.0, 1.0]] * 2)
+    # Standing, the capsule runs from a body radius above the soles to a body radius short of the fingertips.
+    r = keeper.body_radius_m
+    np.testing.assert_allclose(path.capsule[0, 0], [*stand, keeper.com_height_m - keeper.foot_reach_m + r])
+    np.testing.assert_allclose(path.capsule[0, 1], [*stand, keeper.com_height_m + keeper.hand_reach_m - r])
+
+
+def test_the_keeper_dives_at_his_push_off_and_dive_speed_toward_the_target() -> None:
+    # Uniform acceleration over the push-off to the dive speed, then that speed, along the line to the target,
+    # stopping where his fingertips reach it; turned to point at it after the turn time.
+    keeper = ball.Keeper()
+    target = (0.0, 3.0, 2.0)
+    dive = ball.KeeperDive(0.5, target)
+    taus = np.array([0.1, 0.3, 0.6, 5.0])
+    path = ball.keeper_path(keeper, (0.0, 0.0), dive, dive.t + taus)
+    start = np.array([0.0, 0.0, keeper.com_height_m])
+    line = np.subtract(target, start)
+    span = float(np.linalg.norm(line))
+    v, push = keeper.dive_speed_ms, keeper.push_off_s
+    travel = [0.5 * v * 0.1**2 / push, 0.5 * v * push, 0.5 * v * push + 0.3 * v, span - keeper.hand_reach_m]
+    np.testing.assert_allclose(np.linalg.norm(path.com - start, axis=1), travel, rtol=1e-12)
+    np.testing.assert_allclose(path.up[2:], [line / span] * 2, atol=1e-12)
+    np.testing.assert_allclose(np.linalg.norm(path.up, axis=1), 1.0)
+
+
+@pytest.mark.parametrize(
+    ("argument", "call"),
+    [
+        ("times", lambda: ball.keeper_path(ball.Keeper(), (0.0, 0.0), None, [0.0, math.nan])),
+        ("position_xy", lambda: ball.keeper_path(ball.Keeper(), (0.0, math.inf), None, [0.0])),
+        ("dive.target", lambda: ball.keeper_path(ball.Keeper(), (0.0, 0.0), ball.KeeperDive(0.1, (1.0, 2.0)), [0.0])),  # type: ignore[arg-type]
+        ("keeper.turn_s", lambda: ball.keeper_path(ball.Keeper(turn_s=0.0), (0.0, 0.0), None, [0.0])),
+        ("turf_m", lambda: ball.keeper_path(ball.Keeper(), (0.0, 0.0), None, [0.0], turf_m=math.nan)),
+    ],
+)
+def test_the_keeper_path_refuses_bad_input_naming_it(argument: str, call: Callable[[], object]) -> None:
+    with pytest.raises(ValueError, match=argument.replace(".", r"\.")):
+        call()
 
 
 def test_outcomes_on_a_pitch_count_post_bar_and_saved_and_match_single_flights() -> None:

@@ -47,7 +47,7 @@ from scenes.freekick import (
     view_points,
     wall_hides,
 )
-from scenes.freekick.model import keeper_pose, keeper_words, knuckle_wobble_m, spot_odds_map, strike_chances
+from scenes.freekick.model import keeper_words, knuckle_wobble_m, spot_odds_map, strike_chances
 from scenes.freekick.scene import GRASS_HALF_M
 
 
@@ -838,7 +838,7 @@ def test_the_drawn_keeper_is_where_the_kernel_keeper_meets_the_ball(scene: FreeK
     spot = keeper.placed(ball_spot(scene.params)[:2], scene.state.goal)
     assert scene.state.keeper_xy == pytest.approx(spot)
     times = played.t[played.t < touch.t]
-    pose = keeper_pose(spot, played.keeper_dive, np.append(times, touch.t))
+    pose = ball.keeper_path(keeper, spot, played.keeper_dive, np.append(times, touch.t))
     reach = keeper.body_radius_m + ball.BALL_RADIUS_M
     gaps = [
         _distance_to_segment(point, *_stick(com, up)) - reach
@@ -849,25 +849,26 @@ def test_the_drawn_keeper_is_where_the_kernel_keeper_meets_the_ball(scene: FreeK
     assert abs(gaps[-1]) < 2e-3  # touching at the kernel's contact (its step samples him mid-step)
     assert min(gaps[:-1]) > -2e-3  # and not through him before
     # Before the dive he stands upright on his spot, fingertips 2.3 m up.
-    standing = keeper_pose(spot, played.keeper_dive, np.array([0.0, played.keeper_dive.t]))
+    standing = ball.keeper_path(keeper, spot, played.keeper_dive, np.array([0.0, played.keeper_dive.t]))
     np.testing.assert_allclose(standing.com, [[*spot, 1.0]] * 2)
     np.testing.assert_allclose(standing.up, [[0, 0, 1]] * 2)
     # The still picture shows him at the touch: his limbs' rods are drawn from that pose (hips to soles for the
     # legs, shoulders to fingertips for the arms).
     starts = np.asarray(scene.keeper_nodes.batched_positions)
     scales = np.asarray(scene.keeper_nodes.batched_scales)
-    at_touch = keeper_pose(spot, played.keeper_dive, np.array([touch.t]))
-    soles, tips = at_touch.ends()
+    at_touch = ball.keeper_path(keeper, spot, played.keeper_dive, np.array([touch.t]))
+    soles = at_touch.com[0] - keeper.foot_reach_m * at_touch.up[0]
+    tips = at_touch.com[0] + keeper.hand_reach_m * at_touch.up[0]
     hips = at_touch.com[0] - 0.05 * at_touch.up[0]
     np.testing.assert_allclose(starts[2], hips, atol=1e-5)  # the body starts at the hips
     assert scales[2, 2] == pytest.approx(0.55, abs=1e-5)  # hips to shoulders
     legs_end = starts[:2] + scales[:2, 2:3] * _rod_direction(scene)[:2]
-    np.testing.assert_allclose(legs_end.mean(axis=0), soles[0], atol=1e-5)
+    np.testing.assert_allclose(legs_end.mean(axis=0), soles, atol=1e-5)
     arms_end = starts[3:5] + scales[3:5, 2:3] * _rod_direction(scene)[3:5]
-    np.testing.assert_allclose(arms_end.mean(axis=0), tips[0] - 0.05 * at_touch.up[0], atol=1e-5)
+    np.testing.assert_allclose(arms_end.mean(axis=0), tips - 0.05 * at_touch.up[0], atol=1e-5)
     # The readout's margin: the earliest instant his body could touch a ball waiting at the touch point.
     early = np.arange(played.keeper_dive.t, touch.t, 1e-3)
-    poses = keeper_pose(spot, played.keeper_dive, early)
+    poses = ball.keeper_path(keeper, spot, played.keeper_dive, early)
     could = [
         _distance_to_segment(np.asarray(touch.position), *_stick(com, up)) <= reach
         for com, up in zip(poses.com, poses.up, strict=True)
