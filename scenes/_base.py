@@ -111,6 +111,12 @@ class Scene(abc.ABC, Generic[P]):
             session.gui.add_markdown(self.about)
         session.frame_camera(self.camera_position, self.camera_look_at)
 
+    @property
+    def state_lock(self) -> threading.RLock:
+        """The lock every callback of the scene holds while it reads or changes the scene's state: a helper that
+        reads that state from another thread (a camera framing asked by a new tab) holds it too."""
+        return self._lock
+
     # ----------------------------------------------------------------------------------------- lifecycle
     def close(self) -> None:
         """Stop the scene's threads and remove every node and GUI element it created."""

@@ -258,7 +258,7 @@ class CourseMode:
         software-WebGL notice, as large as it fits: every framed rider's box, wheels to head, and the road's width
         from a little behind the last framed rider to a little ahead of the leader (:data:`ROAD_SHOWN_M`). A group
         longer than :data:`FRAMED_LENGTH_M` has its front framed (:meth:`framed_riders`)."""
-        with self.scene._lock:
+        with self.scene.state_lock:
             points = self.framed_points()
             direction = LINE_VIEW_DIRECTION if is_line_view(self.scene.params) else GROUP_VIEW_DIRECTION
         return frame_clear_of_notice(points, direction, lens)
