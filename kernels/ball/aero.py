@@ -41,6 +41,8 @@ _RE_WIDTH = 1.949e4
 _MEASURED_DRAG_MIN = 0.155
 _MEASURED_STILL_DRAG_MAX = 0.501
 _MEASURED_LIFT_MAX = 0.27
+_SPINNING_AT_BLEND = 0.4127 * 0.05**0.3056
+"""The spinning C_D at S = 0.05, where the blend from the still fit reaches it (a constant: no power per call)."""
 
 EULER_STABILITY = 2.0
 """Forward Euler's stability interval on the negative real axis, |1 + z| ≤ 1 for z ∈ [−2, 0]."""
@@ -150,11 +152,11 @@ def drag_lift(speed, rate, measured, constant_drag, constant_lift, radius, re_pe
         return constant_drag, constant_lift
     spin_parameter = radius * rate / max(speed, 1e-9)
     lift = 0.9 * min(spin_parameter, 0.3)  # below Asai et al. 2007's wind-tunnel values: see kernels.ball
+    if spin_parameter >= 0.05:  # the spinning fit alone (the blend's weight is 1): no exponential to evaluate
+        return 0.4127 * spin_parameter**0.3056, lift  # Goff & Carré 2010
     arg = min((re_per_speed * speed - re_crisis) / _RE_WIDTH, 50.0)
     still = 0.155 + 0.346 / (1.0 + math.exp(arg))  # Goff & Carré 2010
-    spinning = 0.4127 * max(spin_parameter, 0.05) ** 0.3056
-    drag = still + min(spin_parameter / 0.05, 1.0) * (spinning - still)
-    return drag, lift
+    return still + (spin_parameter / 0.05) * (_SPINNING_AT_BLEND - still), lift
 
 
 @compiled()

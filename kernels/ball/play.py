@@ -240,6 +240,47 @@ def _fixed_capsules(pitch, caps):
     return count
 
 
+@compiled()
+def _group_boxes(caps, n_fixed, reach, boxes):
+    """Boxes (lo x y z, hi x y z) around the goal frame's capsules (rows 0–2) and the wall's (rows 3 to
+    ``n_fixed``) into ``boxes`` (2, 6), grown by ``reach``: a step whose chord box misses a group's box cannot touch
+    any capsule of it, so its capsules are not tested one by one. An empty group's box is empty (lo > hi)."""
+    boxes[:, 0:3] = math.inf
+    boxes[:, 3:6] = -math.inf
+    for c in range(n_fixed):
+        g = 0 if c < 3 else 1
+        grow = reach + caps[c, 6]
+        for k in range(3):
+            boxes[g, k] = min(boxes[g, k], min(caps[c, k], caps[c, k + 3]) - grow)
+            boxes[g, k + 3] = max(boxes[g, k + 3], max(caps[c, k], caps[c, k + 3]) + grow)
+
+
+@compiled()
+def _chord_meets(x, y, z, x1, y1, z1, boxes, g):
+    """Whether the box of the step's chord meets group ``g``'s box of :func:`_group_boxes`."""
+    return not (
+        max(x, x1) < boxes[g, 0]
+        or min(x, x1) > boxes[g, 3]
+        or max(y, y1) < boxes[g, 1]
+        or min(y, y1) > boxes[g, 4]
+        or max(z, z1) < boxes[g, 2]
+        or min(z, z1) > boxes[g, 5]
+    )
+
+
+@compiled()
+def _keeper_box(pitch, dive_t, target, reach, boxes):
+    """A box around every place the keeper's capsule can be from now on into ``boxes[2]``, grown by ``reach``: the
+    segment his centre of mass moves along (:func:`_keeper_pose`), grown by his longer reach (the stick may point
+    anywhere) and his body's radius."""
+    x0, y0, z0, _, _, _ = _keeper_pose(pitch, dive_t, target, -1.0)  # standing: the dive starts at t ≥ 0
+    late = dive_t + 1e9 if dive_t < math.inf else -1.0  # long after the dive: where he stops
+    x1, y1, z1, _, _, _ = _keeper_pose(pitch, dive_t, target, late)
+    grow = reach + pitch[K_RADIUS] + max(pitch[K_HANDS], pitch[K_FEET])
+    boxes[2, 0], boxes[2, 1], boxes[2, 2] = min(x0, x1) - grow, min(y0, y1) - grow, min(z0, z1) - grow
+    boxes[2, 3], boxes[2, 4], boxes[2, 5] = max(x0, x1) + grow, max(y0, y1) + grow, max(z0, z1) + grow
+
+
 # --------------------------------------------------------------------------------------------- the flight
 @compiled()
 def _roll_acceleration(vx, vy, kick, config, decel):
@@ -295,8 +336,12 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
     n_fixed = _fixed_capsules(pitch, caps)
     keeper = pitch[KEEPER_ON] != 0.0
     n_caps = n_fixed + 1 if keeper else n_fixed
+    boxes = np.empty((3, 6))
+    _group_boxes(caps, n_fixed, radius + 1e-3, boxes)  # the capsule test's own broad-phase margin
     target = np.zeros(3)
     dive_t = math.inf
+    if keeper:
+        _keeper_box(pitch, dive_t, target, radius + 1e-3, boxes)  # standing until he dives
     seen_t = math.inf if pitch[WALL_ON] != 0.0 else 0.0
     v_in, w_in, normal, v_new, w_new = np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3)
     turf_surface = pitch[TURF_SURFACE : TURF_SURFACE + N_SURFACE]
@@ -326,6 +371,7 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
             target[0], target[1], target[2] = gx - lateral * gny, gy + lateral * gnx, height
             info[I_DIVE] = dive_t
             info[I_TARGET], info[I_TARGET + 1], info[I_TARGET + 2] = target[0], target[1], target[2]
+            _keeper_box(pitch, dive_t, target, radius + 1e-3, boxes)
         # One step: RK4/Euler in flight; rolling, the same step on the horizontal velocity, or the exact stop.
         stop_here = False
         if rolling:
@@ -360,7 +406,8 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
         ):
             ending = DIVERGED
             break
-        if keeper:
+        near_keeper = keeper and _chord_meets(x, y, z, x1, y1, z1, boxes, 2)
+        if near_keeper:
             _keeper_capsule(pitch, dive_t, target, t + 0.5 * h, caps[n_fixed])
         # The first contact in the step.
         best, kind, which = 2.0, -1, -1
@@ -370,7 +417,11 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
             f = crossing_fraction(x_stop - x, -vx, x_stop - x1, -vx1, h)
             if f < best:
                 best, kind = f, -2
+        near_frame = _chord_meets(x, y, z, x1, y1, z1, boxes, 0)
+        near_wall = _chord_meets(x, y, z, x1, y1, z1, boxes, 1)
         for c in range(n_caps):
+            if (c < 3 and not near_frame) or (3 <= c < n_fixed and not near_wall) or (c == n_fixed and not near_keeper):
+                continue
             f = _capsule_fraction(x, y, z, vx, vy, vz, x1, y1, z1, vx1, vy1, vz1, h, caps[c], radius)
             if f < best:
                 best, kind, which = f, int(caps[c, 7]), c

@@ -13,6 +13,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from kernels import ball
+from kernels.ball import play
+from kernels.ball.pitch import keeper_slots, pitch_vector
 
 R, G, ALPHA = 0.11, 9.81, 2.0 / 3.0
 VACUUM = {"air_density": 0.0, "method": "rk4", "ground_m": R}
@@ -410,3 +412,53 @@ def test_the_plain_python_twin_of_the_pitch_flight_gives_the_compiled_numbers(mo
     np.testing.assert_allclose(twin[0], compiled[0], rtol=1e-9, atol=1e-12)
     np.testing.assert_allclose(twin[1], compiled[1], rtol=1e-9, atol=1e-12)
     assert twin[2] == compiled[2]
+
+
+@given(
+    spot=st.tuples(st.floats(-3.0, 3.0), st.floats(-3.0, 3.0)),
+    target=st.tuples(st.floats(-6.0, 6.0), st.floats(-6.0, 6.0), st.floats(0.0, 3.0)),
+    dive_t=st.floats(0.0, 2.0),
+    speed=st.floats(0.0, 10.0),
+    hands=st.floats(0.2, 2.0),
+    feet=st.floats(0.2, 2.0),
+)
+def test_the_keepers_box_holds_his_body_at_every_instant(
+    spot: tuple[float, float],
+    target: tuple[float, float, float],
+    dive_t: float,
+    speed: float,
+    hands: float,
+    feet: float,
+) -> None:
+    # The flight skips the keeper's capsule test for a step whose chord misses this box: the box must hold every
+    # place his body can be, grown by the ball's reach, or a save would be missed.
+    keeper = ball.Keeper(dive_speed_ms=speed, hand_reach_m=hands, foot_reach_m=feet)
+    vector = np.zeros(play.N_PITCH)
+    keeper_slots(vector, keeper, spot)
+    reach = R + 1e-3
+    boxes = np.empty((3, 6))
+    times = np.concatenate([np.linspace(0.0, dive_t + 3.0, 200), [dive_t + 1e6]])
+    for dive in (None, ball.KeeperDive(dive_t, target)):
+        play._keeper_box(vector, math.inf if dive is None else dive.t, np.array(target), reach, boxes)
+        ends = ball.keeper_path(keeper, spot, dive, times).capsule.reshape(-1, 3)
+        lo, hi = boxes[2, :3] + reach + keeper.body_radius_m, boxes[2, 3:] - reach - keeper.body_radius_m
+        assert np.all(ends >= lo - 1e-9) and np.all(ends <= hi + 1e-9)
+
+
+def test_the_goal_frame_and_wall_boxes_hold_each_of_their_capsules() -> None:
+    wall, goal = ball.free_kick_panels((-25.0, 4.0), (0.0, 0.0), (1.0, 0.0))
+    pitch = ball.Pitch(goal, wall, wall_players=5)
+    vector = pitch_vector(pitch, (-25.0, 4.0), R, R)
+    caps = np.empty((play.MAX_CAPSULES, 8))
+    n_fixed = play._fixed_capsules(vector, caps)
+    assert n_fixed == 8
+    boxes = np.empty((3, 6))
+    reach = R + 1e-3
+    play._group_boxes(caps, n_fixed, reach, boxes)
+    for c in range(n_fixed):
+        box = boxes[0 if c < 3 else 1]
+        grow = reach + caps[c, 6]
+        for end in (caps[c, 0:3], caps[c, 3:6]):
+            assert np.all(end - grow >= box[:3] - 1e-12) and np.all(end + grow <= box[3:] + 1e-12)
+    # Each group's box is no bigger than its capsules: the goal's spans the posts, the wall's its players.
+    assert boxes[0, 4] - boxes[0, 1] == pytest.approx(ball.GOAL_WIDTH_M + 4 * 0.06 + 2 * reach)
