@@ -46,7 +46,7 @@ from scenes.peloton.course_model import (
     rider_boxes,
     split_every_m,
 )
-from scenes.peloton.legend import formation_table, legend_html, power_colours, power_range
+from scenes.peloton.legend import formation_table, legend_html, power_colours, power_range, riders_text
 from scenes.peloton.meshes import (
     GRASS_COLOUR,
     ROAD_COLOUR,
@@ -64,6 +64,10 @@ ROAD_SHOWN_M = {True: (3.0, 0.0), False: (10.0, 4.0)}
 """Road the camera frames ahead of the leader and behind the last framed rider (m), the road's full width, for a line
 seen from its side (True) and a group seen from behind (False): a small group is seen on its road, not from a metre
 away (two abreast of 8 stood 37 % of the window tall)."""
+BACKDROP_HALF_M = 2000.0
+"""Half the side of the flat grass under course mode's road window (m): to the horizon at every camera distance."""
+BACKDROP_DROP_M = 1.0
+"""How far under the lowest point of the drawn verge the flat grass lies (m)."""
 RIDER_HALF_M = (0.5 * BIKE_LENGTH_M, 0.3)
 """Half a rider's box (m): along the bike and across the handlebars."""
 FORMATION_WORDS = {"single": "in single file", "double": "two abreast", "bunch": "in a bunch", "echelon": "in echelon"}
@@ -222,6 +226,16 @@ class CourseMode:
         self.frame = scene.add_frame(f"{self.scene.root.name}/course_mode", show_axes=False, visible=False)
         layout = self.layout()
         name = self.frame.name
+        # Grass to the horizon under the whole drawn window (the verge follows the road; beyond it the view showed
+        # the sky through the inside of a hairpin): lower than every drawn point, so it never covers the road.
+        half = BACKDROP_HALF_M
+        self.backdrop = add_ground(
+            scene,
+            f"{name}/backdrop",
+            np.array([[-half, -half, 0.0], [half, -half, 0.0], [half, half, 0.0], [-half, half, 0.0]]),
+            np.array([[0, 1, 2], [0, 2, 3]]),
+            GRASS_COLOUR,
+        )
         self.verge = add_ground(scene, f"{name}/verge", *layout.verge, GRASS_COLOUR)
         self.road = add_ground(scene, f"{name}/route", *layout.road, ROAD_COLOUR)  # the route's road
         self.road_edges = scene.add_line_segments(
@@ -573,10 +587,10 @@ class CourseMode:
         set_if_changed(self.course_riders["body"], "batched_colors", bodies)
         drag = state.drag
         summary = (
-            f"Power of each place where the group is now ({self._leader_km():.2f} km): {n} riders, mean drag "
+            f"Power of each place where the group is now ({self._leader_km():.2f} km): {riders_text(n)}, mean drag "
             f"{100 * float(np.mean(drag)):.0f} % of a lone rider's"
         )
-        set_if_changed(s.legend, "content", legend_html(low, high, summary, "Rider colour = power here (W)"))
+        set_if_changed(s.legend, "content", legend_html(here, summary, "Rider colour = power here (W)"))
         set_if_changed(s.legend, "visible", True)
         table = formation_table(
             s.state.positions,
@@ -599,8 +613,10 @@ class CourseMode:
         )
         s.density.content = (
             f"**On the course.** The group rides at the mean drag of its formation, "
-            f"**{100 * float(np.mean(drag)):.0f} %** of a lone rider's (CdA {state.group_cda_m2:.3f} m²), as riders "
-            f"who take turns at every place share it; each averages the course power over the ride.{shown}"
+            f"**{100 * float(np.mean(drag)):.0f} %** of a lone rider's (CdA {state.group_cda_m2:.3f} m²): the speed at "
+            f"which its places' powers average the course power. Each rider's colour is its place's power; a rider "
+            f"who moves through the places over a long ride (a rotating line, or the slow churn of a bunch) averages "
+            f"the course power.{shown}"
         )
         s.rotation.content = ""
         s.chart.visible = False  # the flat road's solo curve: the course's own chart is in its folder
@@ -612,6 +628,7 @@ class CourseMode:
             (self.verge, layout.verge, GRASS_COLOUR),
         ):
             node.glb_data = mesh_glb(vertices, faces, color=colour, unlit=True)
+        self.backdrop.position = (0.0, 0.0, float(layout.verge[0][:, 2].min()) - BACKDROP_DROP_M)
         self.road_edges.points = layout.edges
         self.centre_line.points = layout.dashes
         for mark, ends in layout.marks.items():
@@ -678,8 +695,8 @@ class CourseMode:
             )
         if state.group_cda_m2 != line.cda_m2:
             text += (
-                f"  \n{line.n_riders} riders {FORMATION_WORDS[line.formation]} sharing the work, each at the "
-                f"formation's mean drag (CdA {state.group_cda_m2:.3f} m²): "
+                f"  \n{riders_text(line.n_riders)} {FORMATION_WORDS[line.formation]} at the formation's mean drag "
+                f"(CdA {state.group_cda_m2:.3f} m²): "
                 f"alone the same power takes {format_duration(state.solo.time_s)}"
             )
         if state.pacing is not None:

@@ -40,6 +40,9 @@ ROAD_HALF_WIDTH_M = 3.0
 """Half the drawn road's width (m) at least: wider where the formation is wider."""
 VERGE_HALF_WIDTH_M = 16.0
 """Half the width of the grass either side of the road (m)."""
+VERGE_DROP_M = 0.5
+"""How far under the road the verge lies (m). A strip's quads twist in a bend on a climb (its inner edge climbs faster
+than its outer); a verge just under the road rose through it there in stripes."""
 ROAD_AHEAD_M = 30.0
 """Road drawn ahead of the leader (m)."""
 ROAD_BEHIND_M = 20.0
@@ -283,6 +286,27 @@ def route_points(route: course_kernel.Course, distance_m: np.ndarray) -> np.ndar
     return np.stack([east, north, elevation], axis=1)
 
 
+CORNER_ROUNDING_M = 6.0
+"""σ (m) of the Gaussian along the route that rounds its corners where the road is drawn: a GPX track is a
+polyline, and at its corners a road several metres wide, and a bunch across it, would fold over itself."""
+_ROUNDING_OFFSETS = np.linspace(-2.0, 2.0, 41) * CORNER_ROUNDING_M  # 0.6 m apart: finer than any GPX track
+_ROUNDING_WEIGHTS = np.exp(-0.5 * (_ROUNDING_OFFSETS / CORNER_ROUNDING_M) ** 2)
+_ROUNDING_WEIGHTS /= _ROUNDING_WEIGHTS.sum()
+
+
+INSIDE_REACH = 0.8
+"""How far a drawn strip (road, verge) reaches into the inside of a bend, as a fraction of the bend's radius."""
+
+
+def drawn_route_points(route: course_kernel.Course, distance_m: np.ndarray) -> np.ndarray:
+    """(k, 3) :func:`route_points` at distances along the route (m), averaged with Gaussian weights over
+    ±2·:data:`CORNER_ROUNDING_M` of road: the road as drawn, its corners rounded into bends (and its grade changes
+    eased); the road and the riders on it are both laid out on it."""
+    d = np.asarray(distance_m, dtype=np.float64).reshape(-1)
+    points = route_points(route, (d[:, None] + _ROUNDING_OFFSETS[None, :]).ravel())
+    return np.einsum("kmc,m->kc", points.reshape(len(d), len(_ROUNDING_OFFSETS), 3), _ROUNDING_WEIGHTS)
+
+
 @dataclasses.dataclass(frozen=True)
 class ChaseFrame:
     """The scene frame the riders are drawn in, at life size: its origin is the middle of the group on the route,
@@ -311,10 +335,11 @@ class ChaseFrame:
         return np.stack([c * d[:, 0] + s * d[:, 1], -s * d[:, 0] + c * d[:, 1], self.exaggeration * d[:, 2]], axis=1)
 
     def along(self, route: course_kernel.Course, distance_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(k, 3) scene points of the road's centre at distances along the route and (k, 3) unit tangents there."""
+        """(k, 3) scene points of the road's centre at distances along the route and (k, 3) unit tangents there,
+        the route's corners rounded (:func:`drawn_route_points`)."""
         d = np.asarray(distance_m, dtype=np.float64)
-        centre = self.local(route_points(route, d))
-        tangent = self.local(route_points(route, d + 0.5)) - self.local(route_points(route, d - 0.5))
+        centre = self.local(drawn_route_points(route, d))
+        tangent = self.local(drawn_route_points(route, d + 0.5)) - self.local(drawn_route_points(route, d - 0.5))
         norm = np.linalg.norm(tangent, axis=1, keepdims=True)
         return centre, tangent / np.where(norm > 1e-12, norm, 1.0)
 
@@ -323,12 +348,29 @@ def road_strip(
     frame: ChaseFrame, route: course_kernel.Course, distance_m: np.ndarray, half_width: float, lift: float = 0.0
 ) -> tuple[np.ndarray, np.ndarray]:
     """A flat strip ``half_width`` (m) either side of the road's centre at the (k,) distances ``distance_m``,
-    ``lift`` (m) above it: (2k, 3) scene vertices (left edge, then right edge) and (2(k−1), 3) faces."""
-    centre, tangent = frame.along(route, distance_m)
+    ``lift`` (m) above it: (2k, 3) scene vertices (left edge, then right edge) and (2(k−1), 3) faces.
+
+    On the inside of a bend the strip reaches at most :data:`INSIDE_REACH` of the bend's radius: wider, its inner
+    edge would pass the bend's centre, fold back over itself and, on a climb, lie over the road further on."""
+    d = np.asarray(distance_m, dtype=np.float64)
+    centre, tangent = frame.along(route, d)
     left = np.stack([-tangent[:, 1], tangent[:, 0], np.zeros(len(centre))], axis=1)
     left /= np.maximum(np.linalg.norm(left, axis=1, keepdims=True), 1e-12)
+    heading = np.unwrap(np.arctan2(tangent[:, 1], tangent[:, 0]))
+    # Curvature dθ/ds (1/m, + turning left), each side's sharpest within a half-width along the road (the inner
+    # edge of a strip that narrows into a bend folds over where the bend is sharpest, not only where it is).
+    turning = np.zeros(len(d))
+    if len(d) > 2 and np.all(np.diff(d) > 0):
+        turning = np.gradient(heading, d)
+        reach = math.ceil(half_width / float(np.median(np.diff(d))))
+        windows = np.lib.stride_tricks.sliding_window_view(np.pad(turning, reach, mode="edge"), 2 * reach + 1)
+        left_turn, right_turn = np.maximum(windows.max(axis=1), 0.0), np.maximum(-windows.min(axis=1), 0.0)
+    else:
+        left_turn = right_turn = np.zeros(len(d))
+    left_width = np.minimum(half_width, INSIDE_REACH / np.maximum(left_turn, 1e-9))[:, None]
+    right_width = np.minimum(half_width, INSIDE_REACH / np.maximum(right_turn, 1e-9))[:, None]
     lifted = centre + [0.0, 0.0, lift]
-    vertices = np.concatenate([lifted + half_width * left, lifted - half_width * left])
+    vertices = np.concatenate([lifted + left_width * left, lifted - right_width * left])
     k = centre.shape[0]
     a = np.arange(k - 1)
     faces = np.concatenate([np.stack([a, k + a, k + a + 1], axis=1), np.stack([a, k + a + 1, a + 1], axis=1)])
@@ -425,7 +467,7 @@ def lay_out_road(
     k = round((d_to - d_from) / ROAD_STEP_M) + 1
     distance = np.linspace(d_from, d_to, k)
     road = road_strip(frame, route, distance, half_width, 0.0)
-    verge = road_strip(frame, route, distance, VERGE_HALF_WIDTH_M, -0.03)
+    verge = road_strip(frame, route, distance, VERGE_HALF_WIDTH_M, -VERGE_DROP_M)
     inset = road_strip(frame, route, distance, half_width - 0.15, 0.004)[0]
     edges = np.concatenate([np.stack([side[:-1], side[1:]], axis=1) for side in (inset[:k], inset[k:])])
     dash_m = dash_distances(d_from, d_to, count=int((d_to - d_from) / 3.0) + 1)

@@ -34,19 +34,36 @@ def power_colours(watts: np.ndarray, low: float, high: float) -> np.ndarray:
     return np.round(np.stack(channels, axis=1)).astype(np.uint8)
 
 
-def legend_html(low: float, high: float, summary: str, title: str = "Rider colour = power (W)") -> str:
-    """The colour scale as five swatches, each over its watts on one line (its colour's name in a tooltip), under
-    ``title``, then ``summary`` (plain text)."""
-    stops = "".join(
-        f'<div title="{name}" style="flex:1;min-width:0;text-align:center;white-space:nowrap">'
-        f'<div style="height:14px;border-radius:2px;background:rgb({r:.0f},{g:.0f},{b:.0f})"></div>'
-        f"{watts_text(t)} W</div>"
-        for name, t, (r, g, b) in zip(LEGEND_NAMES, np.linspace(low, high, 5), POWER_COLOURS, strict=True)
-    )
+def riders_text(n: int) -> str:
+    """"1 rider", "8 riders"."""
+    return f"{n} rider" if n == 1 else f"{n} riders"
+
+
+def legend_html(watts: np.ndarray, summary: str, title: str = "Rider colour = power (W)") -> str:
+    """The colour scale of ``watts`` (:func:`power_range`) as five swatches, each over its watts on one line (its
+    colour's name in a tooltip), under ``title``, then ``summary`` (plain text). Where every rider rides at the same
+    power (a group of one), one swatch with that power: no scale to read."""
+    values = np.asarray(watts, np.float64).reshape(-1)
+    low, high = power_range(values)
+    if float(values.max() - values.min()) < 0.5:
+        (r, g, b), = power_colours(values[:1], low, high).astype(np.float64)
+        every = " (every rider)" if len(values) > 1 else ""
+        swatches = (
+            '<div style="flex:1;min-width:0;white-space:nowrap">'
+            f'<div style="height:14px;border-radius:2px;background:rgb({r:.0f},{g:.0f},{b:.0f})"></div>'
+            f"{watts_text(values[0])} W{every}</div>"
+        )
+    else:
+        swatches = "".join(
+            f'<div title="{name}" style="flex:1;min-width:0;text-align:center;white-space:nowrap">'
+            f'<div style="height:14px;border-radius:2px;background:rgb({r:.0f},{g:.0f},{b:.0f})"></div>'
+            f"{watts_text(t)} W</div>"
+            for name, t, (r, g, b) in zip(LEGEND_NAMES, np.linspace(low, high, 5), POWER_COLOURS, strict=True)
+        )
     return (
         '<div style="font-size:13px;line-height:1.35;padding:2px 0 6px">'
         f"<b>{title}</b>"
-        f'<div style="display:flex;gap:3px;margin:3px 0">{stops}</div>{summary}</div>'
+        f'<div style="display:flex;gap:3px;margin:3px 0">{swatches}</div>{summary}</div>'
     )
 
 

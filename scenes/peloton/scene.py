@@ -31,6 +31,7 @@ from scenes.peloton.legend import (
     legend_html,
     power_colours,
     power_range,
+    riders_text,
 )
 from scenes.peloton.legend import watts_text as _watts
 from scenes.peloton.meshes import (
@@ -715,10 +716,10 @@ time-averaged power is the mean over positions, far below the leader's.
             self._label_group(positions)
             drag = 1.0 - state.reduction
             summary = (
-                f"{n} riders: mean drag {100 * float(np.mean(drag)):.0f} % of a lone rider's, mean power "
+                f"{riders_text(n)}: mean drag {100 * float(np.mean(drag)):.0f} % of a lone rider's, mean power "
                 f"{_watts(float(np.mean(total)))} W (alone {_watts(float(state.solo.total))} W)"
             )
-            legend = legend_html(low, high, summary)
+            legend = legend_html(total, summary)
             if self.legend.content != legend:
                 self.legend.content = legend
             set_if_changed(self.legend, "visible", True)
@@ -754,7 +755,7 @@ time-averaged power is the mean over positions, far below the leader's.
         state, p = self.state, self.params
         total, drag = np.asarray(state.power.total), 1.0 - state.reduction
         summary = (
-            f"{p.n_riders} riders · mean drag **{100 * float(np.mean(drag)):.0f} %** of a lone rider's · mean power "
+            f"{riders_text(p.n_riders)} · mean drag **{100 * float(np.mean(drag)):.0f} %** of a lone rider's · mean power "
             f"**{_watts(float(np.mean(total)))} W** (a lone rider {_watts(float(state.solo.total))} W)"
         )
         return formation_table(state.positions, drag, {"Power (W)": total}, summary)

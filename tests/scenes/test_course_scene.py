@@ -458,6 +458,48 @@ def test_the_road_and_riders_lie_where_the_route_runs() -> None:
     assert at_start.marks["Start"] is not None and at_start.marks["Finish"] is None
 
 
+def _surface_heights(vertices: np.ndarray, faces: np.ndarray, points_xy: np.ndarray) -> np.ndarray:
+    """(P,) the highest height of the triangle mesh straight above or below each (P, 2) point; −inf where no
+    triangle covers it (barycentric test in plan, either winding)."""
+    a, b, c = (vertices[faces[:, k]].astype(np.float64) for k in range(3))
+    p = points_xy[:, None, :]
+    v0, v1, v2 = (b - a)[None, :, :2], (c - a)[None, :, :2], p - a[None, :, :2]
+    d00, d01, d11 = (v0 * v0).sum(-1), (v0 * v1).sum(-1), (v1 * v1).sum(-1)
+    d20, d21 = (v2 * v0).sum(-1), (v2 * v1).sum(-1)
+    denom = d00 * d11 - d01 * d01
+    ok = np.abs(denom) > 1e-12
+    safe = np.where(ok, denom, 1.0)
+    v, w = (d11 * d20 - d01 * d21) / safe, (d00 * d21 - d01 * d20) / safe
+    inside = ok & (v >= -1e-9) & (w >= -1e-9) & (v + w <= 1 + 1e-9)
+    z = a[None, :, 2] + v * (b - a)[None, :, 2] + w * (c - a)[None, :, 2]
+    return np.where(inside, z, -np.inf).max(axis=1)
+
+
+@pytest.mark.parametrize("shape", ["bunch", "echelon", "double"])
+@pytest.mark.parametrize("exaggeration", [1.0, 5.0])
+def test_every_rider_stands_on_the_drawn_road_with_no_grass_over_it(
+    shape: cycling.FormationShape, exaggeration: float
+) -> None:
+    """At every 100 m of the sample climb, 121 riders: the road strip never folds over itself (its faces all face
+    up), every rider stands on it (a road face under each, at the rider's height), and no grass lies over the road
+    where a rider stands. The route is a polyline: at its corners the road folded and the back rows of a bunch stood
+    on the grass beside it; a verge just under the road rose through it in stripes where the road bends and climbs."""
+    route = course_kernel.load_gpx(course_kernel.SAMPLE_ROUTE)
+    xy = cycling.formation(121, shape, gap_m=0.5, lateral_m=0.6)
+    for leader_m in np.arange(200.0, float(route.total_distance_m), 100.0):
+        layout = lay_out_road(route, float(leader_m), xy, exaggeration)
+        road_v, road_f = layout.road
+        a, b, c = (road_v[road_f[:, k]].astype(np.float64) for k in range(3))
+        assert np.all(np.cross(b - a, c - a)[:, 2] > 0.0), f"the road folds at {leader_m:.0f} m"
+        riders = layout.riders[0]
+        on_road = _surface_heights(road_v, road_f, riders[:, :2])
+        # A road face under every rider (none: it stood on the grass), at its height to within 0.2 m, less than a
+        # wheel's radius (the strip's faces are planar, so on a steeply drawn climb they cut a bend's chord).
+        assert np.all(np.abs(on_road - riders[:, 2]) < 0.2), f"a rider off the road at {leader_m:.0f} m"
+        grass = _surface_heights(*layout.verge, riders[:, :2])
+        assert np.all(grass < on_road), f"grass over the road at {leader_m:.0f} m"
+
+
 def test_a_bunch_rides_the_course_at_its_formations_mean_drag(mode: CourseMode) -> None:
     scene = mode.scene
     assert mode.state is not None
@@ -475,6 +517,11 @@ def test_a_bunch_rides_the_course_at_its_formations_mean_drag(mode: CourseMode) 
     assert mode.state.ride.time_s == pytest.approx(direct.time_s, rel=1e-12)
     assert mode.state.ride.time_s < line_of_four  # sharing a bunch's shelter is faster than a line of four
     assert "121 riders in a bunch" in mode.readout.content
+    # One account of how a bunch shares the work, on the flat road and on the course: riders in a bunch do not take
+    # turns in order (the flat road says so), so the course does not say they take turns at every place.
+    for words in (mode.readout.content, scene.density.content):
+        assert "take turns" not in words and "sharing the work" not in words
+    assert "the speed at which its places' powers average the course power" in scene.density.content
     # The course draws the whole group as it rides: 121 rider instances at life size, each where its formation
     # puts it (on this straight start, metres behind the leader along the road and across it), on the road.
     scales = np.asarray(mode.course_riders["body"].batched_scales)

@@ -489,6 +489,20 @@ def test_downhill_readouts_say_coasting_not_negative_watts(scene: PelotonScene) 
 
 
 # ------------------------------------------------------------------------------------------------ formations
+@pytest.mark.parametrize("formation", ["Two abreast", "Bunch (peloton)", "Echelon"])
+def test_a_group_of_one_reads_as_one_rider_with_one_power(scene: PelotonScene, formation: str) -> None:
+    # A lone rider in a group formation: "1 rider" (not "1 riders"), and the key shows its one power, not a scale
+    # of five made-up watts (306-316 W for a rider at 311 W).
+    c = scene.controls
+    c["formation"].value, c["n_riders"].value = formation, 1
+    watts = float(np.asarray(scene.state.power.total)[0])
+    legend = scene.legend.content
+    assert "1 rider:" in legend and "1 riders" not in legend
+    assert legend.count("height:14px") == 1
+    assert f">{watts:.0f} W</div>" in legend
+    assert "1 rider ·" in scene.table.content
+
+
 def test_a_121_rider_bunch_draws_every_rider_coloured_by_its_power(scene: PelotonScene) -> None:
     from scenes.peloton.legend import POWER_COLOURS, power_colours, power_range
 
