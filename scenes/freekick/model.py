@@ -412,7 +412,9 @@ LIMB_RADII_M = np.array([0.08, 0.08, 0.16, 0.06, 0.06, 0.11])
 """Each part's half-thickness (m): the body a little thicker than the kernel's stick (0.15 m)."""
 
 
-def keeper_limbs(pose: ball.KeeperPath, facing_xy: NDArray[np.float64], keeper: ball.Keeper = KEEPER) -> NDArray[np.float64]:
+def keeper_limbs(
+    pose: ball.KeeperPath, facing_xy: NDArray[np.float64], keeper: ball.Keeper = KEEPER
+) -> NDArray[np.float64]:
     """(T, 6, 2, 3) start and end of each of :data:`LIMBS` (m) for a simple articulated figure on the kernel's
     stick: legs from the hips to the soles (feet apart), the body from the hips to the shoulders, arms from the
     shoulders to the fingertips (hands apart, up the stick as the kernel's reach has them) and the head. ``facing_xy``

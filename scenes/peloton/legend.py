@@ -35,7 +35,7 @@ def power_colours(watts: np.ndarray, low: float, high: float) -> np.ndarray:
 
 
 def riders_text(n: int) -> str:
-    """"1 rider", "8 riders"."""
+    """ "1 rider", "8 riders"."""
     return f"{n} rider" if n == 1 else f"{n} riders"
 
 
@@ -46,7 +46,7 @@ def legend_html(watts: np.ndarray, summary: str, title: str = "Rider colour = po
     values = np.asarray(watts, np.float64).reshape(-1)
     low, high = power_range(values)
     if float(values.max() - values.min()) < 0.5:
-        (r, g, b), = power_colours(values[:1], low, high).astype(np.float64)
+        ((r, g, b),) = power_colours(values[:1], low, high).astype(np.float64)
         every = " (every rider)" if len(values) > 1 else ""
         swatches = (
             '<div style="flex:1;min-width:0;white-space:nowrap">'
