@@ -189,7 +189,7 @@ def compute_course(route: course_kernel.Course, p: CourseParams, line: PelotonPa
         return course_rider(line, p, cda)
 
     cda = group_cda(line)
-    drag = 1.0 - drag_reductions(line) if line.drafting and line.n_riders >= 2 else np.ones(line.n_riders)
+    drag = 1.0 - drag_reductions(line, yaw_rad=0.0) if line.drafting and line.n_riders >= 2 else np.ones(line.n_riders)
     wind, wind_from, cap = p.wind_ms, p.wind_from_deg, p.max_speed_kmh / 3.6
 
     def ride_at(cda_m2: float) -> course_kernel.Ride:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import math
 from dataclasses import field
 from typing import Literal
 
@@ -107,6 +108,13 @@ class PelotonParams:
         metadata=slider("Headwind (m/s, − = tailwind)", -15.0, 15.0, 0.5, folder="Course"),
     )
     """Wind against the riders (m/s); negative is a tailwind."""
+    crosswind_ms: float = field(
+        default=0.0,
+        metadata=slider("Crosswind (m/s, + from the left)", -15.0, 15.0, 0.5, folder="Course"),
+    )
+    """Wind across the road (m/s, + blowing from the riders' left): it turns the wakes downwind
+    (:func:`formation_yaw`), so a line loses its shelter and an echelon forms on the downwind side. The power's air
+    speed is the wind along the road (the headwind)."""
     drafting: bool = field(default=True, metadata=checkbox("Drafting", folder="Drafting"))
     """Whether riders behind the leader draft."""
     formation: cycling.FormationShape = field(
@@ -172,8 +180,27 @@ def compute_line(p: PelotonParams) -> LineState:
     return LineState(reduction=reduction, cda_m2=cda, power=power, solo=solo, positions=positions)
 
 
+MAX_YAW_RAD = math.radians(85.0)
+"""Largest apparent-wind yaw the wakes are turned by (rad): a tailwind as fast as the riders has no wake to ride in
+that the model knows; past 85° it is held there."""
+
+
+def formation_yaw(p: PelotonParams) -> float:
+    """Yaw of the apparent wind the group rides in (rad, + from the left): :func:`kernels.cycling.apparent_yaw` of the
+    speed, headwind and crosswind, held within ±:data:`MAX_YAW_RAD`; 0 without a crosswind."""
+    if p.crosswind_ms == 0.0:
+        return 0.0
+    yaw = cycling.apparent_yaw(p.speed_kmh / 3.6, p.headwind_ms, p.crosswind_ms)
+    return float(np.clip(yaw, -MAX_YAW_RAD, MAX_YAW_RAD))
+
+
 def _formation(p: PelotonParams) -> np.ndarray:
-    return cycling.formation(p.n_riders, p.formation, gap_m=p.gap_m, lateral_m=LATERAL_M)
+    """The formation as the kernel lays it out; an echelon on the downwind side (it steps to the right behind its
+    leader, into a wind from the left; mirrored for a wind from the right)."""
+    xy = cycling.formation(p.n_riders, p.formation, gap_m=p.gap_m, lateral_m=LATERAL_M)
+    if p.formation == "echelon" and p.crosswind_ms < 0.0:
+        xy = xy * np.array([1.0, -1.0])
+    return xy
 
 
 def formation_positions(p: PelotonParams) -> np.ndarray:
@@ -185,12 +212,14 @@ def formation_positions(p: PelotonParams) -> np.ndarray:
     return xy - [0.0, 0.5 * float(xy[:, 1].min() + xy[:, 1].max())]
 
 
-def drag_reductions(p: PelotonParams) -> np.ndarray:
-    """(n_riders,) drag reduction of each rider, leader first: the line model in single file (as it always was),
-    the formation wake model (:func:`kernels.cycling.formation_drag`) otherwise."""
-    if p.formation == "single":
+def drag_reductions(p: PelotonParams, yaw_rad: float | None = None) -> np.ndarray:
+    """(n_riders,) drag reduction of each rider, leader first: the line model in single file in still air (as it
+    always was), the formation wake model (:func:`kernels.cycling.formation_drag`) otherwise, its wakes turned by
+    ``yaw_rad`` (rad; None: the flat road's own, :func:`formation_yaw`)."""
+    yaw = formation_yaw(p) if yaw_rad is None else yaw_rad
+    if p.formation == "single" and yaw == 0.0:
         return cycling.drag_reduction(p.n_riders, p.gap_m, p.model)
-    return 1.0 - cycling.formation_drag(_formation(p), p.model)
+    return 1.0 - cycling.formation_drag(_formation(p), p.model, yaw_rad=yaw)
 
 
 def is_line_view(p: PelotonParams) -> bool:
@@ -200,10 +229,11 @@ def is_line_view(p: PelotonParams) -> bool:
 
 
 def group_cda(line: PelotonParams) -> float:
-    """CdA of a rider in a group that shares the work evenly: the mean over the formation's positions."""
+    """CdA of a rider in a group that shares the work evenly: the mean over the formation's positions, in still air
+    (course mode's wind is the route's own)."""
     if not line.drafting or line.n_riders < 2:
         return line.cda_m2
-    return float(line.cda_m2 * (1.0 - np.mean(drag_reductions(line))))
+    return float(line.cda_m2 * (1.0 - np.mean(drag_reductions(line, yaw_rad=0.0))))
 
 
 # The solo rider's curve and speed-at-power depend on neither the speed nor the line: moving the speed slider (the

@@ -132,6 +132,12 @@ class _Framing:
     distance_m: float
 
 
+def _arrow_length(p: PelotonParams) -> float:
+    """Length of the wind arrow (m): 0.25 m per m/s of ground wind (head and cross), at most 15 m/s's; 0 in still
+    air."""
+    return min(math.hypot(p.headwind_ms, p.crosswind_ms), 15.0) * 0.25
+
+
 class PelotonScene(Scene[PelotonParams]):
     key = "peloton"
     title = "Peloton: cycling power"
@@ -150,7 +156,9 @@ P = (P_aero + P_roll + P_climb)/η, ρ = 1.225·exp(−h/8500).
 **Drafting.** *Textbook formula*: CdA·(1 − 0.27·exp(−gap/3.5)) for every follower (27 % at 0 m, 6.5 % at 5 m; the
 original brief's prose overstates it). *Measured*: position-dependent, fitted to team-pursuit measurements (Barry et al. 2015;
 Fitton et al. 2018; Broker, Kyle & Burke 1999), fading with gap as Swiss Side's CFD does; the leader gains ~3 %
-from the rider behind (Blocken et al. 2013).
+from the rider behind (Blocken et al. 2013). *Crosswind*: the wakes trail along the apparent wind, at yaw
+ψ = atan(crosswind/(v + w)), so a line loses its shelter and an echelon angled downwind keeps it (checked against a
+2022 CFD study of five riders in a crosswind); the power's air speed is the wind along the road.
 
 **Assumptions.** Steady speed, no bearing or wheel-rotation losses, CdA independent of yaw; the exponential
 atmosphere is the textbook one (ISA gives ρ about 4 % higher at 2000 m).
@@ -369,15 +377,15 @@ time-averaged power is the mean over positions, far below the leader's.
                     for z in (0.0, top)
                 ]
             )
-            if p.headwind_ms != 0:  # the wind arrow, ahead of the leader
-                local = np.vstack([local, [[x.max() + half + 3.0 + min(abs(p.headwind_ms), 15.0) * 0.25, 0.0, 1.2]]])
+            if _arrow_length(p) > 0:  # the wind arrow, ahead of the leader
+                local = np.vstack([local, [[x.max() + half + 3.0 + _arrow_length(p), 0.0, 1.2]]])
             return course_to_world(local, p.grade_pct)
         front, back = (
             0.5 * BIKE_LENGTH_M,
             float(slot_offsets(n, p.gap_m)[n - 1]) - 0.5 * BIKE_LENGTH_M,
         )
         top = 1.95 + LABEL_STAGGER_M + bar_headroom * float(np.max(self._bar_heights_m()))
-        x_hi = front + (3.0 + min(abs(p.headwind_ms), 15.0) * 0.25 if p.headwind_ms != 0 else 0.0)
+        x_hi = front + (3.0 + _arrow_length(p) if _arrow_length(p) > 0 else 0.0)
         lo, hi = np.array([back, -1.1, 0.0]), np.array([x_hi, 1.1, max(top, 2.2)])
         corners = np.array(
             [[(lo, hi)[i][0], (lo, hi)[j][1], (lo, hi)[k][2]] for i in (0, 1) for j in (0, 1) for k in (0, 1)]
@@ -518,7 +526,7 @@ time-averaged power is the mean over positions, far below the leader's.
 
     def _framing_key(self) -> tuple[object, ...]:
         p = self.params
-        return (p.n_riders, p.formation, p.gap_m, p.grade_pct, p.headwind_ms != 0.0)
+        return (p.n_riders, p.formation, p.gap_m, p.grade_pct, _arrow_length(p) > 0, p.crosswind_ms < 0.0)
 
     def read_params(self) -> PelotonParams:
         """The current GUI values, cleaned: anything non-finite, out of range or unknown keeps the last good value."""
@@ -761,22 +769,20 @@ time-averaged power is the mean over positions, far below the leader's.
         return formation_table(state.positions, drag, {"Power (W)": total}, summary)
 
     def _draw_wind(self) -> None:
-        w = self.params.headwind_ms
-        length = min(abs(w), 15.0) * 0.25
-        if length < 1e-6:
+        """The ground wind as an arrow ahead of the leader, blowing the way it blows (against the riders for a
+        headwind, across from the left for a crosswind from the left), 0.25 m per m/s up to 15 m/s."""
+        p = self.params
+        length = _arrow_length(p)
+        if length == 0.0:
             self.wind_arrow.visible = False
             return
         self.wind_arrow.visible = True
-        tip_x = 3.0 if w > 0 else 3.0 + length
-        tail_x = tip_x + length if w > 0 else tip_x - length
-        direction = -1.0 if w > 0 else 1.0
-        tip = np.array([tip_x, 0.0, 1.2])
-        head = [tip - [direction * 0.3, 0.0, -0.2], tip - [direction * 0.3, 0.0, 0.2]]
-        set_if_changed(
-            self.wind_arrow,
-            "points",
-            np.array([[[tail_x, 0.0, 1.2], tip], [head[0], tip], [head[1], tip]]),
-        )
+        blowing = np.array([-p.headwind_ms, -p.crosswind_ms, 0.0])
+        u = blowing / float(np.linalg.norm(blowing))
+        centre = np.array([3.0 + 0.5 * length, 0.0, 1.2])
+        tail, tip = centre - 0.5 * length * u, centre + 0.5 * length * u
+        head = [tip - 0.3 * u + [0.0, 0.0, 0.2], tip - 0.3 * u - [0.0, 0.0, 0.2]]
+        set_if_changed(self.wind_arrow, "points", np.array([[tail, tip], [head[0], tip], [head[1], tip]]))
 
     def _density_markdown(self) -> str:
         p, solo = self.params, self.state.solo

@@ -489,6 +489,31 @@ def test_downhill_readouts_say_coasting_not_negative_watts(scene: PelotonScene) 
 
 
 # ------------------------------------------------------------------------------------------------ formations
+def test_a_crosswind_takes_a_lines_shelter_and_the_echelon_forms_downwind(scene: PelotonScene) -> None:
+    c = scene.controls
+    c["speed_kmh"].value, c["n_riders"].value, c["gap_m"].value = 40.0, 4, 0.5
+    still = scene.state.reduction.copy()
+    c["crosswind_ms"].value = 8.0  # from the left
+    yaw = math.atan2(8.0, 40.0 / 3.6)
+    line = cycling.formation(4, "single", gap_m=0.5)
+    np.testing.assert_allclose(scene.state.reduction, 1.0 - cycling.formation_drag(line, yaw_rad=yaw), rtol=1e-12)
+    assert np.all(scene.state.reduction[1:] < still[1:] - 0.15)  # the followers ride beside the wake
+    # The wind arrow blows across the road from the left (toward −y) and against nothing along it.
+    tail, tip = np.asarray(scene.wind_arrow.points)[0]
+    assert scene.wind_arrow.visible and tip[1] < tail[1] and tip[0] == pytest.approx(tail[0])
+    # From the right, an echelon steps back to the left (downwind) and shelters its riders better than the line.
+    c["crosswind_ms"].value = -8.0
+    line_reduction = scene.state.reduction.copy()
+    c["formation"].value = "Echelon"
+    positions = scene.state.positions
+    assert np.all(np.diff(positions[:, 1]) > 0)  # each rider further left than the one ahead
+    expected = 1.0 - cycling.formation_drag(
+        cycling.formation(4, "echelon", gap_m=0.5, lateral_m=0.6) * [1.0, -1.0], yaw_rad=-yaw
+    )
+    np.testing.assert_allclose(scene.state.reduction, expected, rtol=1e-12)
+    assert np.all(scene.state.reduction[1:] > line_reduction[1:] + 0.1)
+
+
 @pytest.mark.parametrize("formation", ["Two abreast", "Bunch (peloton)", "Echelon"])
 def test_a_group_of_one_reads_as_one_rider_with_one_power(scene: PelotonScene, formation: str) -> None:
     # A lone rider in a group formation: "1 rider" (not "1 riders"), and the key shows its one power, not a scale
