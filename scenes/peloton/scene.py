@@ -26,6 +26,7 @@ from scenes._framing import ClientFraming, Lens, View, beside_notice, frame_poin
 from scenes._instances import add_instances, park_hidden
 from scenes._look import add_ground
 from scenes.peloton.course import CourseMode
+from scenes.peloton.course_model import FRAMED_LENGTH_M
 from scenes.peloton.legend import (
     formation_table,
     legend_html,
@@ -366,6 +367,8 @@ time-averaged power is the mean over positions, far below the leader's.
         n = p.n_riders
         if not is_line_view(p):
             x, y = self.state.positions.T
+            framed = x >= x.max() - FRAMED_LENGTH_M  # a long line's front, at a readable size
+            x, y, n = x[framed], y[framed], int(np.count_nonzero(framed))
             top, half = rider_head_m(p.position)[1], 0.5 * BIKE_LENGTH_M
             # Every corner of each rider's box, wheels to head: a close camera (a few riders) sees a box's top
             # corners well outside the points of a cross through it.
@@ -414,17 +417,23 @@ time-averaged power is the mean over positions, far below the leader's.
 
     def marked_slots(self) -> np.ndarray:
         """Slots of a group labelled in the picture, front first, none twice: the leader, the hardest-working rider
-        behind it, the one who works least and the last (:data:`GROUP_LABELS`)."""
+        behind it, the one who works least and the last (:data:`GROUP_LABELS`), of the riders the camera frames (the
+        front :data:`FRAMED_LENGTH_M` of a long group)."""
         n, total = self.params.n_riders, np.asarray(self.state.power.total)
         if n == 1:
             return np.zeros(1, np.int64)
-        picks = [0, 1 + int(np.argmax(total[1:])), int(np.argmin(total)), n - 1]
+        x = self.state.positions[:, 0]
+        framed = np.flatnonzero(x >= x.max() - FRAMED_LENGTH_M)
+        behind = framed[framed > 0]
+        if len(behind) == 0:
+            return np.zeros(1, np.int64)
+        last = int(framed[-1])  # slots run front to back: the last rider, or the last one framed
+        picks = [0, int(behind[np.argmax(total[behind])]), int(framed[np.argmin(total[framed])]), last]
         # One label per reading: riders that would say the same (a pair at the front, the last rider when it is
         # the one who works least) are labelled once.
         said = {self.label_text(slot): slot for slot in reversed(picks)}
         unique = list(dict.fromkeys(slot for slot in picks if said[self.label_text(slot)] == slot))[:GROUP_LABELS]
-        x = self.state.positions[unique, 0]
-        return np.asarray(unique, np.int64)[np.argsort(-x, kind="stable")]
+        return np.asarray(unique, np.int64)[np.argsort(-x[unique], kind="stable")]
 
     def label_text(self, slot: int) -> str:
         """What the label of the rider in ``slot`` says: its watts and its share of the solo rider's power in a
@@ -766,6 +775,13 @@ time-averaged power is the mean over positions, far below the leader's.
             f"{riders_text(p.n_riders)} · mean drag **{100 * float(np.mean(drag)):.0f} %** of a lone rider's · mean power "
             f"**{_watts(float(np.mean(total)))} W** (a lone rider {_watts(float(state.solo.total))} W)"
         )
+        x = np.asarray(state.positions)[:, 0]
+        framed = int(np.count_nonzero(x >= x.max() - FRAMED_LENGTH_M))
+        if framed < p.n_riders:
+            summary += (
+                f"  \nThe camera frames the front {FRAMED_LENGTH_M:.0f} m of the group (its first {framed} riders); "
+                f"it runs {float(x.max() - x.min()):.0f} m back: zoom out to see the rest."
+            )
         return formation_table(state.positions, drag, {"Power (W)": total}, summary)
 
     def _draw_wind(self) -> None:

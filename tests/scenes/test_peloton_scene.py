@@ -28,6 +28,7 @@ from scenes.peloton import (
     PelotonScene,
     compute_line,
 )
+from scenes.peloton.course_model import FRAMED_LENGTH_M
 from scenes.peloton.meshes import rider_head_m
 from scenes.peloton.model import FORMATION_FROM_LABEL, formation_positions
 from server.switcher import SceneSwitcher
@@ -384,10 +385,12 @@ def test_every_drawn_rider_rides_on_the_drawn_road(
     assert np.all(xy - RIDER_HALF_M >= lo) and np.all(xy + RIDER_HALF_M <= hi), (shape, n, xy.min(0), xy.max(0))
 
 
-def _rider_box_points(scene: PelotonScene) -> np.ndarray:
-    """(8n, 3) world corners of each drawn rider's box, road to the top of its head."""
-    n = scene.params.n_riders
-    xy = np.asarray(scene.riders_nodes["body"].batched_positions, dtype=np.float64)[:n, :2]
+def _rider_box_points(scene: PelotonScene, front_m: float = math.inf) -> np.ndarray:
+    """(8n, 3) world corners of each drawn rider's box, road to the top of its head: every rider's, or only those
+    within ``front_m`` of the leader."""
+    xy = np.asarray(scene.riders_nodes["body"].batched_positions, dtype=np.float64)[: scene.params.n_riders, :2]
+    xy = xy[xy[:, 0] >= xy[:, 0].max() - front_m]
+    n = len(xy)
     top = rider_head_m(scene.params.position)[1]
     corners = [
         np.column_stack([xy + [sx * RIDER_HALF_M[0], sy * RIDER_HALF_M[1]], np.full(n, z)])
@@ -409,10 +412,17 @@ def test_every_rider_is_framed_left_of_the_panel_and_clear_of_the_notice(
 ) -> None:
     """Every rider, wheels to head, through the camera the scene sends for this window: inside the window's margins,
     left of the panel, and not under viser's software-WebGL notice at the top left (a review: a bunch of 121 at
-    1280×720 had its back rows under it), nor any label."""
+    1280×720 had its back rows under it), nor any label. A group longer than 45 m has its front 45 m framed (121 in
+    single file framed whole stood 4-6 px tall), and the Results say so."""
     lens, view = _framed(scene, viewport, formation=shape, n_riders=n)
     with scene._lock:
-        points = _rider_box_points(scene)
+        points = _rider_box_points(scene, front_m=FRAMED_LENGTH_M)
+        length = float(np.ptp(scene.state.positions[:, 0]))
+        framed = int(np.count_nonzero(scene.state.positions[:, 0] >= -FRAMED_LENGTH_M))
+    if length > FRAMED_LENGTH_M:
+        assert f"The camera frames the front 45 m of the group (its first {framed} riders)" in scene.table.content
+    else:
+        assert framed == n and "The camera frames the front" not in scene.table.content
     px = _screen_px(points, np.array(view.position), np.array(view.look_at), lens)
     width, height = viewport
     # Framing keeps MARGIN_PX free round the points it frames, which stand for a rider less fully than its box.
