@@ -133,6 +133,9 @@ class _Framing:
     distance_m: float
 
 
+MIN_FRAMED_ROAD_M = (10.0, 4.0)
+"""Least road (m, along and across) a group's camera frames round the group: a few riders are seen on their road."""
+
 def _arrow_length(p: PelotonParams) -> float:
     """Length of the wind arrow (m): 0.25 m per m/s of ground wind (head and cross), at most 15 m/s's; 0 in still
     air."""
@@ -382,6 +385,12 @@ time-averaged power is the mean over positions, far below the leader's.
             )
             if _arrow_length(p) > 0:  # the wind arrow, ahead of the leader
                 local = np.vstack([local, [[x.max() + half + 3.0 + _arrow_length(p), 0.0, 1.2]]])
+            # At least a patch of road round a small group: a lone rider framed by its own box filled half the
+            # window, its label far above it.
+            length, width = MIN_FRAMED_ROAD_M
+            front = x.max() + half
+            patch = [[front - length * i, width * (j - 0.5), 0.0] for i in (0, 1) for j in (0, 1)]
+            local = np.vstack([local, patch])
             return course_to_world(local, p.grade_pct)
         front, back = (
             0.5 * BIKE_LENGTH_M,

@@ -740,6 +740,22 @@ def test_no_label_text_crosses_another_riders_leader_line(
 
 
 @pytest.mark.parametrize("viewport", VIEWPORTS)
+@pytest.mark.parametrize("shape", ["Two abreast", "Bunch (peloton)", "Echelon"])
+def test_a_lone_rider_is_seen_on_its_road_not_filling_the_window(
+    scene: PelotonScene, viewport: tuple[int, int], shape: str
+) -> None:
+    # The failing look (a review): one rider in a group formation, framed by its own box, stood half the window tall
+    # with its label on a long line far above it.
+    lens, view = _framed(scene, viewport, formation=shape, n_riders=1)
+    x, y = np.asarray(scene.riders_nodes["body"].batched_positions, dtype=np.float64)[0, :2]
+    top = rider_head_m(scene.params.position)[1]
+    feet, head = _screen_px(np.array([[x, y, 0.0], [x, y, top]]), np.array(view.position), np.array(view.look_at), lens)
+    tall = float(np.linalg.norm(head - feet))
+    assert 0.1 * lens.height_px <= tall <= 0.3 * lens.height_px, f"{tall:.0f} px of {lens.height_px}"
+    assert_labels_apart_and_in_view(label_boxes_px(scene, lens), lens)
+
+
+@pytest.mark.parametrize("viewport", VIEWPORTS)
 @pytest.mark.parametrize(("shape", "n"), [("Echelon", 20), ("Bunch (peloton)", 121), ("Two abreast", 40)])
 def test_a_group_is_framed_with_riders_a_person_can_see(
     scene: PelotonScene, viewport: tuple[int, int], shape: str, n: int
