@@ -133,6 +133,7 @@ class CourseMode:
         self._upload_seq = 0
         """Number of the newest upload: parses run in parallel on viser's pool, and only the newest installs."""
         self._build_gui()
+        self._show_air_inputs(self.params)
         self._build_world()
         scene.start_loop(self._animate, 1.0 / 30.0)
 
@@ -317,7 +318,17 @@ class CourseMode:
             self.scene.framing.reframe()  # the course's group on its road, or the line again
         self.scene.wake_loops()
 
+    def _show_air_inputs(self, p: CourseParams) -> None:
+        """Show only the air inputs that the chosen air uses: a weather reading's temperature, pressure source and
+        humidity, and the pressure itself only when it is read from a barometer (the textbook atmosphere uses
+        none of them; the standard atmosphere gives the pressure)."""
+        weather = p.air == "weather"
+        for name in ("temperature_c", "pressure_from_barometer", "humidity_pct"):
+            set_if_changed(self.controls[name], "visible", weather)
+        set_if_changed(self.controls["pressure_hpa"], "visible", weather and p.pressure_from_barometer)
+
     def _on_input(self) -> None:
+        self._show_air_inputs(self.read_params())
         if not self.enabled:  # the line's sliders move often: ride the course only while it is shown
             self.state = None
             return
@@ -705,11 +716,18 @@ class CourseMode:
                 f"  \nPacing by grade (±{p.pacing_gain_pct:.0f} %): {format_duration(state.constant.time_s)} at constant "
                 f"power → {format_duration(ride.time_s)}, **{saved:.0f} s {'saved' if saved >= 0 else 'lost'}** at the same average power"
             )
-        which = "the weather's air" if p.air == "weather" else "the exponential atmosphere"
-        text += (
-            f"  \nAir at the start ({state.route.elevation_m[0]:.0f} m): exponential atmosphere **{state.density_seed:.3f}** kg/m³, "
-            f"weather **{state.density_weather:.3f}** kg/m³; riding in {which}"
-        )
+        start = f"  \nAir at the start ({state.route.elevation_m[0]:.0f} m): "
+        if p.air == "weather":
+            source = (
+                f"{p.pressure_hpa:g} hPa read" if p.pressure_from_barometer else "the standard atmosphere's pressure"
+            )
+            text += (
+                f"{start}the weather reading, **{state.density_weather:.3f}** kg/m³ ({p.temperature_c:g} °C, "
+                f"{source}, {p.humidity_pct:g} % humidity); the textbook atmosphere would give "
+                f"{state.density_seed:.3f} kg/m³"
+            )
+        else:
+            text += f"{start}the textbook atmosphere (exponential), **{state.density_seed:.3f}** kg/m³"
         if ride.brakes_j > 0.0:
             text += f"  \nBraking to hold {p.max_speed_kmh:.0f} km/h took {ride.brakes_j / 1000:.0f} kJ"
         return text

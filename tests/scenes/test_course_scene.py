@@ -98,19 +98,30 @@ def test_model_and_air_choices_change_the_ride_and_the_readout_shows_both_densit
     martin = mode.state.ride.time_s
     mode.controls["model"].value = "Textbook (aero, rolling, climbing)"
     assert mode.params.model == "seed" and mode.state.ride.time_s < martin  # no bearings, no spokes
+    # The textbook atmosphere uses no reading: its inputs are hidden, and the readout names it as the menu does.
+    air_inputs = ("temperature_c", "pressure_from_barometer", "pressure_hpa", "humidity_pct")
+    assert not any(mode.controls[name].visible for name in air_inputs)
+    start = float(mode.route.elevation_m[0])
+    textbook = float(cycling.air_density(start))
+    assert f"the textbook atmosphere (exponential), **{textbook:.3f}** kg/m³" in mode.readout.content
     mode.controls["air"].value = "Weather reading"
+    # A reading's temperature, pressure source and humidity show; the pressure box only for a barometer.
+    assert [mode.controls[name].visible for name in air_inputs] == [True, True, False, True]
     mode.controls["temperature_c"].value = 30.0
     mode.controls["humidity_pct"].value = 80.0
-    start = float(mode.route.elevation_m[0])
     expected = float(cycling.air_density_weather(30.0, cycling.isa_pressure_hpa(start), 0.8))
     assert mode.state.density_weather == pytest.approx(expected, rel=1e-12)
-    assert f"weather **{expected:.3f}**" in mode.readout.content
-    assert f"exponential atmosphere **{float(cycling.air_density(start)):.3f}**" in mode.readout.content
+    assert f"the weather reading, **{expected:.3f}** kg/m³ (30 °C, the standard atmosphere's pressure" in (
+        mode.readout.content
+    )
+    assert f"the textbook atmosphere would give {textbook:.3f} kg/m³" in mode.readout.content
     np.testing.assert_allclose(mode.state.ride.air_density[0], expected, rtol=1e-3)
     # A barometer reading replaces the standard atmosphere's pressure.
     mode.controls["pressure_from_barometer"].value = "Barometer"
+    assert mode.controls["pressure_hpa"].visible
     mode.controls["pressure_hpa"].value = 1000.0
     assert mode.state.density_weather == pytest.approx(float(cycling.air_density_weather(30.0, 1000.0, 0.8)), rel=1e-12)
+    assert "1000 hPa read" in mode.readout.content
 
 
 def test_find_the_power_for_a_time(mode: CourseMode) -> None:
