@@ -136,6 +136,7 @@ class _Framing:
 MIN_FRAMED_ROAD_M = (10.0, 4.0)
 """Least road (m, along and across) a group's camera frames round the group: a few riders are seen on their road."""
 
+
 def _arrow_length(p: PelotonParams) -> float:
     """Length of the wind arrow (m): 0.25 m per m/s of ground wind (head and cross), at most 15 m/s's; 0 in still
     air."""

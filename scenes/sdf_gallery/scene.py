@@ -98,10 +98,14 @@ EDITOR_LINES = 18
 """Lines of GLSL the editor shows at once."""
 EDITOR_STYLE = (
     f"<style>.mantine-Textarea-input {{ min-height: calc({EDITOR_LINES} * 1.55em) !important;"
-    " font-family: ui-monospace, monospace; white-space: pre; }</style>"
+    " font-family: ui-monospace, monospace; white-space: pre-wrap; overflow-wrap: anywhere; }"
+    " .mantine-Flex-root:has(.mantine-Textarea-input) { flex-direction: column; align-items: stretch; }"
+    " .mantine-Flex-root:has(.mantine-Textarea-input) > div { width: 100% !important; }</style>"
 )
 """Drawn inside the GLSL editor's folder (and only while the gallery is shown): the editor as a code box of
-EDITOR_LINES lines (viser's own text box grows from 2 to at most 6)."""
+EDITOR_LINES lines (viser's own text box grows from 2 to at most 6), the panel's full width under its label (viser
+gives every control's label a column of its own: the box was 236 px wide, 34 characters), long lines wrapped rather
+than cut off."""
 
 
 class SdfGalleryScene(Scene[SdfGalleryParams]):

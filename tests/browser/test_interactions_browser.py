@@ -382,6 +382,13 @@ def test_typed_shape_is_meshed_and_ray_marched_in_the_main_view(server: viser.Vi
         # The folder shows open, its code box a screenful tall (at least 15 of its lines), not viser's 2–6 lines.
         lines = editor.evaluate("e => e.getBoundingClientRect().height / parseFloat(getComputedStyle(e).lineHeight)")
         assert editor.is_visible() and lines >= 15, lines
+        # The panel's full width under its label, every line wrapped inside it (none cut off at the box's edge).
+        box = editor.bounding_box()
+        panel = page.locator(".mantine-Textarea-root").first.evaluate(
+            "e => e.closest('.mantine-Paper-root, [class*=Folder]').getBoundingClientRect().width"
+        )
+        assert box is not None and box["width"] >= 0.85 * panel, (box, panel)
+        assert editor.evaluate("e => e.scrollWidth <= e.clientWidth + 1")
         editor.fill(OCTAHEDRON)
         page.get_by_role("button", name="Apply").click()
         deadline = time.monotonic() + 60
