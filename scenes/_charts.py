@@ -241,7 +241,8 @@ def fit_layout(
 ) -> tuple[tuple[viser.uplot.Axis, ...], tuple[int, int, int, int]]:
     """Axes and padding (top, right, bottom, left; CSS px) that keep every tick label of this chart in its canvas.
 
-    Each vertical axis gets a width for its widest label (at least uPlot's 50 px); a side with no axis is padded
+    Each vertical axis gets a width for its widest label (at least its own ``size``, else uPlot's 50 px); a side with
+    no axis is padded
     for half a label: above and below the plot for the y labels at its top and bottom ticks, left and right for
     the x labels at its ends.
 
@@ -290,7 +291,8 @@ def fit_layout(
                 widest = widest_linear_label(*found, ticks_max, pad)
             if vertical_axis:
                 need = label_px(widest) + TICK_PX + GAP_PX + MARGIN_PX
-                out["size"] = max(AXIS_SIZE_PX, SIZE_STEP_PX * math.ceil(need / SIZE_STEP_PX))
+                least = float(axis.get("size", AXIS_SIZE_PX))  # an axis's own size is its least width
+                out["size"] = max(least, SIZE_STEP_PX * math.ceil(need / SIZE_STEP_PX))
             else:
                 x_label_px = max(x_label_px, label_px(widest))
         fitted.append(out)

@@ -167,11 +167,13 @@ class CourseMode:
                     "kmh": viser.uplot.Scale(auto=True),
                     "W": viser.uplot.Scale(auto=True),
                 },
+                # Three y axes share a panel-wide chart: each axis is coloured as its series and the units are in
+                # the legend's names, so no axis spends width on a unit label (with them the plot was 104 px wide).
                 axes=(
-                    viser.uplot.Axis(scale="x", label="km"),
-                    viser.uplot.Axis(scale="m", label="m", side=3, size=44, labelSize=14),
-                    _right_axis("kmh", "km/h", 30, "rgb(30,110,220)"),
-                    _right_axis("W", "W", 46, "rgb(220,40,40)"),
+                    viser.uplot.Axis(scale="x", label="km", labelSize=16),
+                    viser.uplot.Axis(scale="m", side=3, size=28, labelSize=0, stroke="rgb(120,90,60)"),
+                    _right_axis("kmh", 28, "rgb(30,110,220)"),
+                    _right_axis("W", 28, "rgb(220,40,40)"),
                 ),
                 legend=viser.uplot.Legend(show=True),
                 title=CHART_TITLE,
@@ -671,7 +673,8 @@ class CourseMode:
             zeros = np.zeros_like(km)
             return km, elevation, zeros, zeros
         ride = self.state.ride
-        return km, elevation, 3.6 * ride.speed_ms[index], ride.power_w[index]
+        # Whole watts: the power axis then ticks whole numbers, and its labels take no room for decimals.
+        return km, elevation, 3.6 * ride.speed_ms[index], np.round(ride.power_w[index])
 
     def _route_markdown(self) -> str:
         r = self.route
@@ -775,16 +778,11 @@ class CourseMode:
         )
 
 
-def _right_axis(scale: str, label: str, size: float, colour: str) -> viser.uplot.Axis:
-    """An axis of the course chart on its right, in its series' colour, without grid lines (the left axis has them)."""
+def _right_axis(scale: str, size: float, colour: str) -> viser.uplot.Axis:
+    """An axis of the course chart on its right, in its series' colour, without grid lines (the left axis has them)
+    and without a unit label (the legend names the unit)."""
     return viser.uplot.Axis(
-        scale=scale,
-        label=label,
-        side=1,
-        size=size,
-        labelSize=14,
-        grid=viser.uplot.Axis_Grid(show=False),
-        stroke=colour,
+        scale=scale, side=1, size=size, labelSize=0, grid=viser.uplot.Axis_Grid(show=False), stroke=colour
     )
 
 

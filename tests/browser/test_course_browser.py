@@ -47,6 +47,9 @@ def test_the_course_chart_tick_labels_stay_inside_its_canvas(shown: ScenePage) -
     wait_chart_data(shown.page, title, data)
     assert_chart_shows_its_data(shown.page, title, data)
     assert_tick_labels_inside(shown.page, title)
+    # Three y axes leave the route room: the plot at least half the chart's width (it was 104 px of 324).
+    plot, whole = shown.page.evaluate(PLOT_AND_CHART_WIDTH, title)
+    assert plot >= 0.5 * whole, (plot, whole)
     # More power: the speed axis on the right reaches higher.
     before = float(np.max(data[2]))
     set_number(shown.page, "Course power (W)", 2000)
@@ -58,6 +61,14 @@ def test_the_course_chart_tick_labels_stay_inside_its_canvas(shown: ScenePage) -
     assert_chart_shows_its_data(shown.page, title, data)
     assert_tick_labels_inside(shown.page, title)
 
+
+PLOT_AND_CHART_WIDTH = """
+title => {
+  const chart = [...document.querySelectorAll('.uplot')].find(u => u.querySelector('.u-title')?.textContent === title);
+  return [chart.querySelector('.u-over').getBoundingClientRect().width, chart.getBoundingClientRect().width];
+}
+"""
+"""The width (px) of a uPlot chart's plot area and of the whole chart, by its title."""
 
 RIDER_HEIGHT_M = 1.45
 """Height of a drawn rider in the drops, wheels to helmet (m, :func:`scenes.peloton.meshes.rider_meshes`)."""
