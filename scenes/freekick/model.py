@@ -608,16 +608,12 @@ def knuckle_ticked(before: FreeKickParams, after: FreeKickParams) -> FreeKickPar
 
 
 def knuckle_wobble_m(state: KickState) -> float | None:
-    """Largest sideways distance (m) of the kick from its spinless ghost over the ghost's flight, where the kick
-    carries a knuckle force; None without one."""
-    flight, ghost = state.flight, state.ghost
-    if not np.any(flight.knuckle):
+    """Largest distance (m) of the kick from its spinless ghost across the line of flight (sideways and up or down),
+    up to the played ball's first contact, where the kick carries a knuckle force; None without one."""
+    found = _knuckle_difference(state, 400)
+    if found is None:
         return None
-    times = ghost.t[ghost.t <= flight.t[-1]]
-    if len(times) < 2:
-        return None
-    kick = np.column_stack([np.interp(times, flight.t, flight.position[:, i]) for i in range(3)])
-    return float(np.abs(np.linalg.norm((kick - ghost.position[: len(times)])[:, 1:], axis=1)).max())
+    return float(np.linalg.norm(found[1][:, 1:], axis=1).max())
 
 
 WOBBLE_SCALE = 10.0
@@ -626,12 +622,16 @@ WOBBLE_SCALE = 10.0
 
 
 def _knuckle_difference(state: KickState, n: int) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
-    """(n, 3) the spinless ghost and (n, 3) the kick's difference from it (m), at n times over both flights; None
-    without a knuckle force."""
+    """(n, 3) the spinless ghost and (n, 3) the kick's difference from it (m), at n times over both flights, up to
+    the played ball's first contact (the knuckle force ends there, and past it the ball goes where the contact sends
+    it, not where the free flight would); None without a knuckle force."""
     flight, ghost = state.flight, state.ghost
     if not np.any(flight.knuckle):
         return None
     end = min(float(flight.t[-1]), float(ghost.t[-1]))
+    played = state.played
+    if played is not None and played.events:
+        end = min(end, played.events[0].t)
     times = np.linspace(0.0, end, n)
     base = sample_rows(times, ghost.t, ghost.position)
     return base, sample_rows(times, flight.t, flight.position) - base

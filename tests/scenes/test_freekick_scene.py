@@ -500,6 +500,22 @@ def test_an_aimed_kick_without_spin_says_no_spin() -> None:
     )
 
 
+def test_the_drawn_wobble_ends_where_the_played_ball_first_touches_something(scene: FreeKickScene) -> None:
+    # A review: the thin line that draws the knuckleball's wobble ten times larger ran on past the post the ball hit,
+    # far right of the goal and off the pitch, where the free flight would have gone.
+    from scenes.freekick.model import WOBBLE_SCALE, sample_rows, wobble_path
+
+    scene.controls["knuckle"].value = True
+    state = scene.state
+    assert state.played is not None and state.played.events
+    touch = state.played.events[0].t
+    path = wobble_path(state)
+    assert path is not None
+    ghost = sample_rows(np.array([touch]), state.ghost.t, state.ghost.position)[0]
+    kick = sample_rows(np.array([touch]), state.flight.t, state.flight.position)[0]
+    np.testing.assert_allclose(path[-1], ghost + WOBBLE_SCALE * (kick - ghost), atol=1e-9)
+
+
 def test_the_outcome_map_flies_the_knuckleball_when_it_is_on() -> None:
     knuckler = next(preset.params for preset in PRESETS if preset.params.knuckle)
     on, off = outcome_map(knuckler), outcome_map(dataclasses.replace(knuckler, knuckle=False))
@@ -790,7 +806,7 @@ PRESET_OUTCOMES = {
     "Low curler: bounces, saved": ("saved", ["ground", "keeper"], "Played on: **Bounces, into the keeper's hands**"),
     "Driven, off the post": ("post", ["post"], "Played on: **Hits the right post at 1.2 m, goes out of play**"),
     "Dipping topspin": ("saved", ["keeper"], "**Saved: the keeper reached it"),
-    "Knuckleball": ("saved", ["keeper"], "swerves 0.34 m right at 29 m"),
+    "Knuckleball": ("saved", ["keeper"], "swerves 0.32 m right at 27 m"),
     "Long-range swerve": ("goal", ["net"], "the ball beats him by 0.52 m"),
 }
 """What each preset shows, as the kernel plays it on the scene's pitch (wall, posts, net and the keeper)."""
@@ -958,9 +974,12 @@ def test_the_knuckleball_wobble_is_drawn_ten_times_larger_and_said_in_words(scen
     scene.apply(knuckler.params)
     state = scene.state
     assert scene.wobble.visible
-    # The thin line is the spinless path plus ten times the kick's difference from it, at the same instants.
+    # The thin line is the spinless path plus ten times the kick's difference from it, at the same instants, up to
+    # the played ball's first contact.
     drawn = np.asarray(scene.wobble.points)
     end = min(float(state.flight.t[-1]), float(state.ghost.t[-1]))
+    if state.played is not None and state.played.events:
+        end = min(end, state.played.events[0].t)
     times = np.linspace(0.0, end, PATH_POINTS)
     kick = np.column_stack([np.interp(times, state.flight.t, state.flight.position[:, k]) for k in range(3)])
     ghost = np.column_stack([np.interp(times, state.ghost.t, state.ghost.position[:, k]) for k in range(3)])
@@ -968,7 +987,7 @@ def test_the_knuckleball_wobble_is_drawn_ten_times_larger_and_said_in_words(scen
     # A ball's width and a half of wobble at the end becomes metres on the screen.
     sideways = np.abs(drawn[:, 1, 1] - ghost[1:, 1])
     assert 2.5 < sideways.max() < 6.0
-    assert "swerves 0.34 m right at 29 m" in scene.result.content and "10× larger" in scene.result.content
+    assert "swerves 0.32 m right at 27 m" in scene.result.content and "10× larger" in scene.result.content
 
 
 @pytest.mark.parametrize("distance", [12.0, 16.0, 22.0, 30.0])
