@@ -328,6 +328,18 @@ def power_colour_counts(image: np.ndarray, covered: np.ndarray) -> np.ndarray:
     return np.bincount(nearest[saturated], minlength=len(POWER_COLOURS))
 
 
+def _in_view_clear_of_notice(
+    shown: ScenePage, frame: str, corners: np.ndarray, what: str, notice: tuple[float, float] | None
+) -> np.ndarray:
+    """``corners`` (k, 3) of ``frame`` in view left of the panel (:func:`assert_in_view`) and, where the page shows
+    the software-WebGL notice (its bottom-right corner ``notice``, px), none under it; their screen points."""
+    seen = assert_in_view(shown, frame, corners, what)
+    if notice is not None:
+        under = (seen[:, 0] < notice[0]) & (seen[:, 1] < notice[1])
+        assert not under.any(), f"{what}: {under.sum()} rider corners under the notice"
+    return seen
+
+
 @pytest.mark.parametrize("viewport", VIEWPORTS, ids=lambda v: f"{v[0]}x{v[1]}")
 def test_a_group_of_121_is_framed_clear_of_the_software_webgl_notice(
     server: viser.ViserServer, browser_page: Any, viewport: tuple[int, int]
@@ -361,10 +373,7 @@ def test_a_group_of_121_is_framed_clear_of_the_software_webgl_notice(
                 ]
             )
             # In view left of the panel and, where the page shows the notice, none under it.
-            seen = assert_in_view(shown, "/peloton/course", corners, f"{formation} of 121")
-            if notice is not None:
-                under = (seen[:, 0] < notice[0]) & (seen[:, 1] < notice[1])
-                assert not under.any(), f"{formation}: {under.sum()} rider corners under the notice"
+            _in_view_clear_of_notice(shown, "/peloton/course", corners, f"{formation} of 121", notice)
             screenshot(page, path=f"/tmp/peloton_{formation.split()[0].lower()}_121_{viewport[0]}x{viewport[1]}.png")
             assert error_text(page) == []
 
@@ -418,10 +427,9 @@ def test_course_mode_colours_a_bunch_by_power_with_its_legend_clear_of_the_notic
                 ]
             )
             # Every rider's box in view left of the panel and, where the page shows the notice, none under it.
-            seen = assert_in_view(shown, "/peloton/course_mode", corners, f"{formation} of {n} on the course")
-            if notice is not None:
-                under = (seen[:, 0] < notice[0]) & (seen[:, 1] < notice[1])
-                assert not under.any(), f"{formation} of {n}: {under.sum()} rider corners under the notice"
+            seen = _in_view_clear_of_notice(
+                shown, "/peloton/course_mode", corners, f"{formation} of {n} on the course", notice
+            )
             image = with_labels_hidden(page)
             screenshot(page, path=f"/tmp/peloton_course_{formation.split()[0].lower()}{n}_{viewport[0]}.png")
             covered = assert_seen(shown, image, COURSE_RIDERS, seen, f"{n} riders", without_labels=True)
