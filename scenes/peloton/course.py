@@ -106,6 +106,11 @@ LINE_INPUTS = (
     "position",
 )
 """The line's inputs that change the ride on the course (the paceline options apply there too)."""
+FLAT_ROAD_ONLY = ("speed_kmh", "rotate", "turn_s")
+"""The flat road's inputs that the course does not use, hidden while it is ridden."""
+FLAT_ROAD_FOLDERS = ("Course", "Speed at a power")
+"""The flat road's folders that the course does not use (grade, altitude, head- and crosswind; the speed at a
+power), hidden while it is ridden."""
 
 
 class CourseMode:
@@ -308,9 +313,21 @@ class CourseMode:
         """The course inputs, cleaned: anything non-finite, out of range or unknown keeps the last good value."""
         return read_controls(self.controls, self.params, write_back=self.scene.write_back)
 
+    def _show_flat_road_inputs(self) -> None:
+        """Hide the flat road's inputs that the course does not use while the course is ridden (its speed, grade,
+        altitude, head- and crosswind, the rotation and the speed at a power: the course rides at a power, on its
+        own grades and in its own air), and show them again on the flat road."""
+        flat = not self.enabled
+        controls = self.scene.controls
+        for name in FLAT_ROAD_ONLY:
+            set_if_changed(controls[name], "visible", flat)
+        for folder in FLAT_ROAD_FOLDERS:
+            set_if_changed(controls.folders[folder], "visible", flat)
+
     def _on_enable(self) -> None:
         was = self.enabled
         self.params = read_controls(self.head, self.params, write_back=self.scene.write_back)
+        self._show_flat_road_inputs()
         if self.enabled and self.state is None:
             self.recompute()
         self.redraw()

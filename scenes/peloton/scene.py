@@ -855,6 +855,11 @@ time-averaged power is the mean over positions, far below the leader's.
             text = "Downhill at this speed gravity does the work: nobody needs to pedal, so nobody needs shelter."
         elif not self.params.drafting:
             text = f"Drafting is off: every rider rides in clean air at the leader's {lead:.0f} W, so rotating saves nothing."
+        elif mean >= 0.995 * lead:
+            text = (
+                f"Nobody rides in shelter here (the wind takes the wakes to the side of the line): every rider works "
+                f"about as hard as the leader, {lead:.0f} W, so rotating saves nothing."
+            )
         else:
             text = (
                 f"Rotating evenly, each rider averages **{mean:.0f} W** against the leader's {lead:.0f} W "

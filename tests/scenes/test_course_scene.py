@@ -44,6 +44,21 @@ def mode(scene: PelotonScene) -> CourseMode:
 
 
 # ------------------------------------------------------------------------------------------------ server side
+def test_the_flat_roads_inputs_the_course_does_not_use_hide_while_it_is_ridden(scene: PelotonScene) -> None:
+    # A review: Crosswind moved nothing on the course (the picture the same to the pixel) and stayed up; so did the
+    # flat road's speed, grade, altitude and headwind. The course rides at a power, on its grades, in its own air.
+    c = scene.controls
+    flat_only = [c["speed_kmh"], c["rotate"], c["turn_s"], c.folders["Course"], c.folders["Speed at a power"]]
+    assert all(handle.visible for handle in flat_only)
+    scene.course_mode.enable.value = True
+    assert not any(handle.visible for handle in flat_only)
+    time_before = scene.course_mode.state.ride.time_s if scene.course_mode.state else None
+    c["crosswind_ms"].value = 12.0  # a crafted message to the hidden control changes nothing on the course
+    assert scene.course_mode.state is not None and scene.course_mode.state.ride.time_s == time_before
+    scene.course_mode.enable.value = False
+    assert all(handle.visible for handle in flat_only)
+
+
 def test_course_mode_opens_off_and_shows_the_sample_when_ticked(scene: PelotonScene) -> None:
     mode = scene.course_mode
     assert not mode.enabled and not mode.frame.visible and scene.course.visible

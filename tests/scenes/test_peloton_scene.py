@@ -508,6 +508,12 @@ def test_a_crosswind_takes_a_lines_shelter_and_the_echelon_forms_downwind(scene:
     line = cycling.formation(4, "single", gap_m=0.5)
     np.testing.assert_allclose(scene.state.reduction, 1.0 - cycling.formation_drag(line, yaw_rad=yaw), rtol=1e-12)
     assert np.all(scene.state.reduction[1:] < still[1:] - 0.15)  # the followers ride beside the wake
+    c["crosswind_ms"].value = 12.0  # hard enough that no follower keeps any shelter
+    assert np.all(scene.state.reduction[1:] < 0.005)
+    assert (
+        "rotating saves nothing" in scene.rotation.content and "the reason teams rotate" not in scene.rotation.content
+    )
+    c["crosswind_ms"].value = 8.0
     # The wind arrow blows across the road from the left (toward −y) and against nothing along it.
     tail, tip = np.asarray(scene.wind_arrow.points)[0]
     assert scene.wind_arrow.visible and tip[1] < tail[1] and tip[0] == pytest.approx(tail[0])
