@@ -24,7 +24,6 @@ from scenes._instances import park_hidden
 from scenes._look import add_ground, mesh_glb
 from scenes.peloton.course_model import (
     COURSE_POWER_RANGE_W,
-    FRAMED_LENGTH_M,
     GROUP_VIEW_DIRECTION,
     LINE_VIEW_DIRECTION,
     MAX_CHART_POINTS,
@@ -41,6 +40,8 @@ from scenes.peloton.course_model import (
     course_rider,
     drawn_indices,
     format_duration,
+    framed_front,
+    framed_words,
     lay_out_road,
     place_powers,
     rider_boxes,
@@ -288,7 +289,7 @@ class CourseMode:
     def framed_riders(self) -> int:
         """How many riders, from the leader back, the camera frames: those within :data:`FRAMED_LENGTH_M` of it."""
         xy = self.formation_xy()
-        return max(int(np.count_nonzero(xy[:, 0] >= -FRAMED_LENGTH_M)), 1)
+        return int(np.count_nonzero(framed_front(xy)))
 
     def framed_points(self) -> np.ndarray:
         """(k, 3) scene points the camera frames: each framed rider's box corners (turned and pitched as drawn) and
@@ -632,15 +633,7 @@ class CourseMode:
         set_if_changed(s.table, "content", table)
         if not readouts:
             return
-        framed = self.framed_riders()
-        shown = (
-            ""
-            if framed >= n
-            else (
-                f"  \nThe camera frames the front {FRAMED_LENGTH_M:.0f} m of the group (its first {framed} riders); the "
-                f"line runs {-float(self.formation_xy()[:, 0].min()):.0f} m back: zoom out to see the rest."
-            )
-        )
+        shown = framed_words(self.formation_xy())
         s.density.content = (
             f"**On the course.** The group rides at the mean drag of its formation, "
             f"**{100 * float(np.mean(drag)):.0f} %** of a lone rider's (CdA {state.group_cda_m2:.3f} m²): the speed at "

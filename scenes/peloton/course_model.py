@@ -58,6 +58,28 @@ FRAMED_LENGTH_M = 45.0
 """The camera frames at most this much of the group, from its leader back (m): a longer line (121 riders in single
 file run over 260 m) framed whole draws its riders a few pixels tall, so the front of it is framed and the panel says
 so. The scene's frame turns with the road under that front (:func:`lay_out_road`)."""
+
+
+def framed_front(xy: np.ndarray) -> np.ndarray:
+    """(n,) whether each rider of an (n, 2) formation (m ahead, m left; leader first) is within
+    :data:`FRAMED_LENGTH_M` of its front: the riders a camera frames."""
+    x = np.asarray(xy, dtype=np.float64)[:, 0]
+    return x >= x.max() - FRAMED_LENGTH_M
+
+
+def framed_words(xy: np.ndarray) -> str:
+    """What the panel says of a group longer than :data:`FRAMED_LENGTH_M` (a line break and a sentence: how many of
+    its riders are framed, how far it runs back); empty for a group framed whole."""
+    framed = int(np.count_nonzero(framed_front(xy)))
+    if framed >= len(xy):
+        return ""
+    x = np.asarray(xy, dtype=np.float64)[:, 0]
+    return (
+        f"  \nThe camera frames the front {FRAMED_LENGTH_M:.0f} m of the group (its first {framed} riders); it runs "
+        f"{float(x.max() - x.min()):.0f} m back: zoom out to see the rest."
+    )
+
+
 MAX_CHART_POINTS = 1000
 
 MODE_FOLDER = "Course mode (GPX route)"
@@ -353,13 +375,19 @@ def road_strip(
     On the inside of a bend the strip reaches at most :data:`INSIDE_REACH` of the bend's radius: wider, its inner
     edge would pass the bend's centre, fold back over itself and, on a climb, lie over the road further on."""
     d = np.asarray(distance_m, dtype=np.float64)
-    centre, tangent = frame.along(route, d)
+    return strip_along(d, *frame.along(route, d), half_width, lift)
+
+
+def strip_along(
+    d: np.ndarray, centre: np.ndarray, tangent: np.ndarray, half_width: float, lift: float = 0.0
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`road_strip` on a centre line already laid out: (k,) distances (m), (k, 3) centre points and (k, 3) unit
+    tangents (:meth:`ChaseFrame.along`), so strips of several widths share one layout of the road."""
     left = np.stack([-tangent[:, 1], tangent[:, 0], np.zeros(len(centre))], axis=1)
     left /= np.maximum(np.linalg.norm(left, axis=1, keepdims=True), 1e-12)
     heading = np.unwrap(np.arctan2(tangent[:, 1], tangent[:, 0]))
     # Curvature dθ/ds (1/m, + turning left), each side's sharpest within a half-width along the road (the inner
     # edge of a strip that narrows into a bend folds over where the bend is sharpest, not only where it is).
-    turning = np.zeros(len(d))
     if len(d) > 2 and np.all(np.diff(d) > 0):
         turning = np.gradient(heading, d)
         reach = math.ceil(half_width / float(np.median(np.diff(d))))
@@ -466,9 +494,10 @@ def lay_out_road(
     d_from, d_to = leader_m - length - ROAD_BEHIND_M, leader_m + ROAD_AHEAD_M
     k = round((d_to - d_from) / ROAD_STEP_M) + 1
     distance = np.linspace(d_from, d_to, k)
-    road = road_strip(frame, route, distance, half_width, 0.0)
-    verge = road_strip(frame, route, distance, VERGE_HALF_WIDTH_M, -VERGE_DROP_M)
-    inset = road_strip(frame, route, distance, half_width - 0.15, 0.004)[0]
+    line = frame.along(route, distance)  # laid out once for the road, its verge and its edge lines
+    road = strip_along(distance, *line, half_width, 0.0)
+    verge = strip_along(distance, *line, VERGE_HALF_WIDTH_M, -VERGE_DROP_M)
+    inset = strip_along(distance, *line, half_width - 0.15, 0.004)[0]
     edges = np.concatenate([np.stack([side[:-1], side[1:]], axis=1) for side in (inset[:k], inset[k:])])
     dash_m = dash_distances(d_from, d_to, count=int((d_to - d_from) / 3.0) + 1)
     dashes = frame.along(route, dash_m.ravel())[0].reshape(-1, 2, 3) + [0.0, 0.0, 0.004]

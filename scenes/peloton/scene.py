@@ -26,7 +26,7 @@ from scenes._framing import ClientFraming, Lens, View, beside_notice, frame_poin
 from scenes._instances import add_instances, park_hidden
 from scenes._look import add_ground
 from scenes.peloton.course import CourseMode
-from scenes.peloton.course_model import FRAMED_LENGTH_M
+from scenes.peloton.course_model import framed_front, framed_words
 from scenes.peloton.legend import (
     formation_table,
     legend_html,
@@ -371,7 +371,7 @@ time-averaged power is the mean over positions, far below the leader's.
         n = p.n_riders
         if not is_line_view(p):
             x, y = self.state.positions.T
-            framed = x >= x.max() - FRAMED_LENGTH_M  # a long line's front, at a readable size
+            framed = framed_front(self.state.positions)  # a long line's front, at a readable size
             x, y, n = x[framed], y[framed], int(np.count_nonzero(framed))
             top, half = rider_head_m(p.position)[1], 0.5 * BIKE_LENGTH_M
             # Every corner of each rider's box, wheels to head: a close camera (a few riders) sees a box's top
@@ -433,7 +433,7 @@ time-averaged power is the mean over positions, far below the leader's.
         if n == 1:
             return np.zeros(1, np.int64)
         x = self.state.positions[:, 0]
-        framed = np.flatnonzero(x >= x.max() - FRAMED_LENGTH_M)
+        framed = np.flatnonzero(framed_front(self.state.positions))
         behind = framed[framed > 0]
         if len(behind) == 0:
             return np.zeros(1, np.int64)
@@ -785,13 +785,7 @@ time-averaged power is the mean over positions, far below the leader's.
             f"{riders_text(p.n_riders)} · mean drag **{100 * float(np.mean(drag)):.0f} %** of a lone rider's · mean power "
             f"**{_watts(float(np.mean(total)))} W** (a lone rider {_watts(float(state.solo.total))} W)"
         )
-        x = np.asarray(state.positions)[:, 0]
-        framed = int(np.count_nonzero(x >= x.max() - FRAMED_LENGTH_M))
-        if framed < p.n_riders:
-            summary += (
-                f"  \nThe camera frames the front {FRAMED_LENGTH_M:.0f} m of the group (its first {framed} riders); "
-                f"it runs {float(x.max() - x.min()):.0f} m back: zoom out to see the rest."
-            )
+        summary += framed_words(state.positions)
         return formation_table(state.positions, drag, {"Power (W)": total}, summary)
 
     def _draw_wind(self) -> None:
