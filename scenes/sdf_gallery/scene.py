@@ -168,6 +168,10 @@ IoU is lowest when a box edge is on the silhouette.
         self.reference_mesh_serial = 0
         """The ``mesh_serial`` of the full mesh the shown reference was compared against."""
         self.reference_rgb: np.ndarray | None = None
+        self.reference_params: SdfGalleryParams | None = None
+        self.reference_camera: Camera | None = None
+        """The parameters and camera the shown reference image was rendered with (a render in flight when an input
+        or the camera changes finishes with those it started with)."""
         self.agreement = Agreement(0, 0.0, None, None, None)
         self.gl_error: str | None = None
         self.viewer = Viewer()
@@ -748,6 +752,7 @@ IoU is lowest when a box edge is on the silhouette.
             with self.server.atomic():
                 self.reference.image = rgb
                 self.reference_rgb = rgb
+                self.reference_params, self.reference_camera = params, camera
                 self.reference_serial += 1
                 self.reference_mesh_serial = mesh_serial
                 self.agreement = dataclasses.replace(

@@ -226,13 +226,30 @@ def test_reference_image_readouts_and_rerender(server: viser.ViserServer, scene:
         # Moving the camera re-renders from the new view once it rests.
         count = scene.reference_serial
         client.send_camera(position=(0.0, -3.5, 0.4), look_at=(0.0, 0.0, 0.3), size=(600, 800))
-        wait_until(lambda: scene.reference_serial > count, "re-render after the camera moved", timeout_s=30)
+        wait_until(
+            lambda: (
+                scene.reference_serial > count
+                and scene.reference_camera is not None
+                and np.allclose(scene.reference_camera.position, (0.0, -3.5, 0.4))
+            ),
+            "re-render after the camera moved",
+            timeout_s=30,
+        )
         assert scene.reference_rgb is not None and not np.array_equal(scene.reference_rgb, first)
         # A brighter ambient term brightens the object.
         dark = scene.reference_rgb.astype(float).mean()
         count = scene.reference_serial
         client.set_value("Ambient k_a", 0.9)
-        wait_until(lambda: scene.reference_serial > count, "re-render after k_a", timeout_s=30)
+        # A render already in flight may finish first, with the old k_a: wait for the one rendered with the new.
+        wait_until(
+            lambda: (
+                scene.reference_serial > count
+                and scene.reference_params is not None
+                and scene.reference_params.shading.ambient == 0.9
+            ),
+            "re-render after k_a",
+            timeout_s=30,
+        )
         assert scene.params.shading.ambient == 0.9
         assert scene.reference_rgb.astype(float).mean() > dark + 5
 
