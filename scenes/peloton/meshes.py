@@ -43,30 +43,48 @@ RIDER_COLOURS = {
 """(MAX_RIDERS, 3) uint8 colour of each part, per rider slot: bikes dark, bodies in team jerseys, heads pale."""
 
 
-Detail = Literal["full", "light"]
+Detail = Literal["full", "light", "crowd"]
 """How finely a rider is meshed: ``"full"`` (1 504 triangles) for a line of a few riders seen close, ``"light"``
-(412) for a group, where a rider is a few dozen pixels tall: in Chromium's software WebGL a bunch of 121 riders drew
-4.3 → 10.0 frames/s at 1280×720 with the light mesh (docs/performance.md)."""
+(412) for a group, where a rider is a few dozen pixels tall, ``"crowd"`` (186: open rods, flat wheels) for a bunch,
+where most riders are a few pixels tall. Chromium's software WebGL spends its frame on the riders' triangles: a bunch
+of 121 drew 4.3 → 10.0 frames/s at 1280×720 with the light mesh and more with the crowd mesh
+(docs/performance.md)."""
 
 LIGHT_ABOVE = 8
 """Riders are meshed ``"light"`` when more than this many ride."""
+CROWD_ABOVE = 40
+"""Riders are meshed ``"crowd"`` when more than this many ride."""
 
 SECTIONS: dict[Detail, dict[str, int]] = {
-    "full": {"rod": 8, "wheel_major": 24, "wheel_minor": 6, "capsule": 8, "head": 2},
-    "light": {"rod": 3, "wheel_major": 10, "wheel_minor": 3, "capsule": 4, "head": 1},
+    "full": {"rod": 8, "wheel_major": 24, "wheel_minor": 6, "capsule": 8, "head": 2, "caps": 1},
+    "light": {"rod": 3, "wheel_major": 10, "wheel_minor": 3, "capsule": 4, "head": 1, "caps": 1},
+    "crowd": {"rod": 3, "wheel_major": 8, "wheel_minor": 2, "capsule": 0, "head": 0, "caps": 0},
 }
-"""Per detail: sides of a rod, segments round a wheel and round its tyre, rings of the torso, subdivisions of the
-head's icosphere."""
+"""Per detail: sides of a rod, segments round a wheel and round its tyre (2: a flat ring in the wheel's plane), rings
+of the torso's capsule (0: the torso is a 6-sided open rod), subdivisions of the head's icosphere, and whether rods have
+end caps (an open rod's ends do not show a few pixels tall)."""
 
 
 def rider_detail(n_riders: int) -> Detail:
     """The mesh detail for a group of ``n_riders``."""
-    return "light" if n_riders > LIGHT_ABOVE else "full"
+    return "crowd" if n_riders > CROWD_ABOVE else "light" if n_riders > LIGHT_ABOVE else "full"
 
 
-def rod(a: np.ndarray, b: np.ndarray, radius: float, sections: int = 8) -> trimesh.Trimesh:
-    """A cylinder of ``sections`` sides and ``radius`` from (3,) point ``a`` to ``b`` (m)."""
-    return trimesh.creation.cylinder(radius=radius, segment=np.array([a, b]), sections=sections)
+def rod(a: np.ndarray, b: np.ndarray, radius: float, sections: int = 8, caps: bool = True) -> trimesh.Trimesh:
+    """A cylinder of ``sections`` sides and ``radius`` from (3,) point ``a`` to ``b`` (m); without ``caps`` only its
+    sides (2·``sections`` triangles)."""
+    if caps:
+        return trimesh.creation.cylinder(radius=radius, segment=np.array([a, b]), sections=sections)
+    axis = (b - a) / np.linalg.norm(b - a)
+    side = np.cross(axis, [0.0, 0.0, 1.0] if abs(axis[2]) < 0.9 else [1.0, 0.0, 0.0])
+    side /= np.linalg.norm(side)
+    up = np.cross(axis, side)
+    angles = 2.0 * math.pi * np.arange(sections) / sections
+    ring = radius * (np.cos(angles)[:, None] * side + np.sin(angles)[:, None] * up)
+    k = np.arange(sections)
+    nxt = (k + 1) % sections
+    faces = np.concatenate([np.stack([k, nxt, k + sections], 1), np.stack([nxt, nxt + sections, k + sections], 1)])
+    return trimesh.Trimesh(np.concatenate([a + ring, b + ring]), faces, process=False)
 
 
 def two_bone_knee(hip: np.ndarray, foot: np.ndarray, thigh: float, shin: float) -> np.ndarray:
@@ -87,7 +105,7 @@ def rider_meshes(position: Position, detail: Detail = "full") -> dict[str, trime
     """Low-poly bike, body and head for one rider, in the bike frame (x forward, z up, ground at z = 0), meshed at
     ``detail`` (:data:`SECTIONS`). The meshes are cached and shared: copy before changing one."""
     pose, n = POSITIONS[position], SECTIONS[detail]
-    rod_n = functools.partial(rod, sections=n["rod"])
+    rod_n = functools.partial(rod, sections=n["rod"], caps=bool(n["caps"]))
     wheel_r = 0.34
     rear, front = np.array([-0.51, 0.0, wheel_r]), np.array([0.51, 0.0, wheel_r])
     bb = np.array([-0.04, 0.0, 0.27])
@@ -103,6 +121,8 @@ def rider_meshes(position: Position, detail: Detail = "full") -> dict[str, trime
             major_sections=n["wheel_major"],
             minor_sections=n["wheel_minor"],
         )
+        if n["wheel_minor"] == 2:  # a flat ring: its two faces must not share vertices, or their normals cancel
+            wheel.unmerge_vertices()
         wheel.apply_transform(trimesh.transformations.rotation_matrix(math.pi / 2, [1, 0, 0]))
         wheel.apply_translation(centre)
         bike_parts.append(wheel)
@@ -122,11 +142,15 @@ def rider_meshes(position: Position, detail: Detail = "full") -> dict[str, trime
     theta = math.radians(pose.torso_deg)
     hip = seat + np.array([0.0, 0.0, 0.08])
     shoulder = hip + 0.58 * np.array([math.cos(theta), 0.0, math.sin(theta)])
-    torso = trimesh.creation.capsule(height=0.58, radius=0.12, count=[n["capsule"], n["capsule"]])
-    torso.apply_transform(
-        trimesh.geometry.align_vectors([0, 0, 1], shoulder - hip)  # capsule axis along the torso
-    )
-    torso.apply_translation((hip + shoulder) / 2)
+    if n["capsule"]:
+        torso = trimesh.creation.capsule(height=0.58, radius=0.12, count=[n["capsule"], n["capsule"]])
+        torso.apply_transform(
+            trimesh.geometry.align_vectors([0, 0, 1], shoulder - hip)  # capsule axis along the torso
+        )
+        torso.apply_translation((hip + shoulder) / 2)
+    else:  # a 6-sided rod a little past the hips and shoulders, where the capsule's round ends reach
+        along = (shoulder - hip) / np.linalg.norm(shoulder - hip)
+        torso = rod(hip - 0.09 * along, shoulder + 0.09 * along, 0.12, 6, caps=False)
     body_parts = [torso]
     hands = np.array(pose.hands)
     for side in (-1.0, 1.0):

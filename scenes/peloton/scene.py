@@ -262,9 +262,15 @@ time-averaged power is the mean over positions, far below the leader's.
         self.course = scene.add_frame(f"{self.root.name}/course", show_axes=False)
         start, end = ROAD_X_M
         length, middle = end - start, 0.5 * (start + end)
-        grass = trimesh.creation.box(extents=(length + 30.0, 60.0, 0.02))
-        grass.apply_translation((middle, 0.0, -0.03))
-        add_ground(scene, f"{self.course.name}/grass", grass.vertices, grass.faces, GRASS_COLOUR)
+        # Grass either side of the road, not under it: in software WebGL every pixel drawn twice costs a frame.
+        verges = []
+        for side in (-1.0, 1.0):
+            verge = trimesh.creation.box(extents=(length + 30.0, 30.0 - ROAD_HALF_WIDTH_M, 0.02))
+            verge.apply_translation((middle, side * 0.5 * (30.0 + ROAD_HALF_WIDTH_M), -0.03))
+            verges.append(verge)
+        grass = trimesh.util.concatenate(verges)
+        assert isinstance(grass, trimesh.Trimesh)
+        self.grass = add_ground(scene, f"{self.course.name}/grass", grass.vertices, grass.faces, GRASS_COLOUR)
         road = trimesh.creation.box(extents=(length, 2.0 * ROAD_HALF_WIDTH_M, 0.02))
         road.apply_translation((middle, 0.0, -0.01))
         self.road = add_ground(scene, f"{self.course.name}/road", road.vertices, road.faces, ROAD_COLOUR)

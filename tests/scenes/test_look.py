@@ -1,6 +1,7 @@
 """What the browser is sent to draw cheaply (scenes/_look.py, scenes/_instances.py, the peloton's rider detail): the
 lights without shadow maps or environment map, matte and unlit GLBs, hidden instances parked out of view, a light
-rider mesh for a group. The frames per second these buy are measured by bench/bench_browser_fps.py."""
+rider mesh for a group and a crowd mesh for a bunch, grass that is not drawn under the road. The frames per second
+these buy are measured by bench/bench_browser_fps.py."""
 
 from __future__ import annotations
 
@@ -19,9 +20,9 @@ from trimesh.visual.material import PBRMaterial
 import app
 from scenes._instances import PARKED_AT_M, park_hidden
 from scenes._look import mesh_glb
-from scenes.peloton.meshes import LIGHT_ABOVE, rider_detail, rider_meshes
+from scenes.peloton.meshes import CROWD_ABOVE, LIGHT_ABOVE, rider_detail, rider_meshes, rod
 from scenes.peloton.model import MAX_GROUP, POSITIONS
-from scenes.peloton.scene import PelotonScene
+from scenes.peloton.scene import ROAD_HALF_WIDTH_M, PelotonScene
 
 scene = scene_fixture(PelotonScene)
 
@@ -122,21 +123,58 @@ def test_the_peloton_sends_its_hidden_riders_out_of_every_view(server: viser.Vis
         assert np.all(np.abs(positions[:3, 2]) < 1.0)  # the three shown ride on the road
 
 
-def test_a_light_rider_is_the_same_figure_in_under_a_third_of_the_triangles() -> None:
+@pytest.mark.parametrize(("detail", "coarser", "share"), [("light", "full", 1 / 3), ("crowd", "light", 1 / 2)])
+def test_a_lighter_rider_is_the_same_figure_in_a_fraction_of_the_triangles(detail: str, coarser: str, share: float):
     for position in POSITIONS:
-        full, light = rider_meshes(position, "full"), rider_meshes(position, "light")
-        full_triangles = sum(len(m.faces) for m in full.values())
+        fine, light = rider_meshes(position, coarser), rider_meshes(position, detail)
+        fine_triangles = sum(len(m.faces) for m in fine.values())
         light_triangles = sum(len(m.faces) for m in light.values())
-        assert light_triangles < full_triangles / 3, (position, light_triangles, full_triangles)
+        assert light_triangles < fine_triangles * share, (position, light_triangles, fine_triangles)
         # Each part spans the same box within 3 cm (a 3-sided rod's flat side lies at half its radius, 2.3 cm in from
         # a 4.5 cm arm): the same size and pose.
-        for part in full:
-            np.testing.assert_allclose(light[part].bounds, full[part].bounds, atol=0.03, err_msg=f"{position} {part}")
+        for part in fine:
+            np.testing.assert_allclose(light[part].bounds, fine[part].bounds, atol=0.03, err_msg=f"{position} {part}")
+
+
+@pytest.mark.parametrize("detail", ["full", "light", "crowd"])
+def test_every_rider_face_faces_out_and_every_vertex_has_a_normal(detail: str) -> None:
+    """The browser shades by vertex normals averaged over faces: a flat ring whose two sides shared vertices would
+    average to zero (black), and a face wound inwards is culled from the side it should show."""
+    for position in POSITIONS:
+        for part, mesh in rider_meshes(position, detail).items():
+            normals = mesh.vertex_normals
+            np.testing.assert_allclose(np.linalg.norm(normals, axis=1), 1.0, atol=1e-6, err_msg=f"{position} {part}")
+            if part == "bike":
+                continue  # a wheel's flat ring has no inside to face away from (the open rods are tested below)
+            for piece in mesh.split(only_watertight=False):  # torso, arms, legs, head: each a convex solid
+                outward = piece.triangles_center - piece.vertices.mean(axis=0)
+                facing = np.einsum("ij,ij->i", piece.face_normals, outward)
+                assert np.all(facing > 0), (position, part, detail)
+
+
+def test_an_open_rod_is_a_prism_wound_outwards() -> None:
+    a, b = np.array([0.1, 0.2, 0.3]), np.array([0.4, -0.1, 0.9])
+    prism = rod(a, b, 0.05, 3, caps=False)
+    assert len(prism.faces) == 6
+    axis = (b - a) / np.linalg.norm(b - a)
+    radial = prism.triangles_center - a - np.outer((prism.triangles_center - a) @ axis, axis)
+    assert np.all(np.einsum("ij,ij->i", prism.face_normals, radial) > 0)
+    capped = rod(a, b, 0.05, 3)
+    assert capped.is_watertight and len(capped.faces) > len(prism.faces)
+
+
+def test_the_grass_lies_beside_the_road_not_under_it(scene: PelotonScene) -> None:
+    """Every pixel of road drawn over grass is shaded twice; in software WebGL the ground is a third of a frame."""
+    grass = read_glb(scene.grass.glb_data)
+    inside = np.abs(grass.triangles_center[:, 1]) < ROAD_HALF_WIDTH_M - 1e-6
+    assert not inside.any()
+    assert grass.bounds[0, 1] <= -25.0 and grass.bounds[1, 1] >= 25.0  # and it still reaches the horizon either side
 
 
 def test_a_group_rides_light_and_a_line_rides_full(scene: PelotonScene) -> None:
     assert rider_detail(LIGHT_ABOVE) == "full" and rider_detail(LIGHT_ABOVE + 1) == "light"
-    for count, detail in ((MAX_GROUP, "light"), (4, "full")):
+    assert rider_detail(CROWD_ABOVE) == "light" and rider_detail(CROWD_ABOVE + 1) == "crowd"
+    for count, detail in ((MAX_GROUP, "crowd"), (20, "light"), (4, "full")):
         scene.controls["n_riders"].value = count
         meshes = rider_meshes(scene.params.position, detail)
         for part, node in scene.riders_nodes.items():
