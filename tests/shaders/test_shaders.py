@@ -85,47 +85,40 @@ def test_glsl_mirrors_the_kernel_name_for_name() -> None:
     assert all(callable(getattr(sdf, name)) for name in public)
 
 
+ALONE_SIZES: dict[sdf.PrimitiveKind, tuple[float, ...]] = {
+    "sphere": (0.7,),
+    "box": (0.3, 0.5, 0.7),
+    "torus": (0.6, 0.2),
+    "capsule": (0.5, 0.3),
+    "cylinder": (0.5, 0.3),
+    "round_box": (0.3, 0.5, 0.7),
+    "octahedron": (0.7,),
+    "cone": (0.5, 0.9),
+    "hex_prism": (0.4, 0.6),
+    "ellipsoid": (0.3, 0.5, 0.7),
+}
+"""Sizes of each built-in kind for a scene of that one primitive, tilted and off the origin."""
+
+
+def test_every_built_in_kind_is_probed_alone() -> None:
+    assert tuple(ALONE_SIZES) == sdf.BUILT_IN_KINDS
+
+
 @pytest.mark.gl
 @pytest.mark.parametrize(
     "scene",
     [
-        sdf.default_scene(),
-        smooth_scene("exp"),
-        every_op_scene(),
-        sdf.Scene(every_op_scene().primitives, k=0.0),
+        pytest.param(sdf.default_scene(), id="default"),
+        pytest.param(smooth_scene("exp"), id="smooth-exp"),
+        pytest.param(every_op_scene(), id="every-op"),
+        pytest.param(sdf.Scene(every_op_scene().primitives, k=0.0), id="hard"),
         *(
-            sdf.Scene((sdf.Primitive(kind, (0.1, -0.2, 0.3), size, rotation=(0.6, 0.3, -0.5, 0.4)),))
-            for kind, size in [
-                ("sphere", (0.7,)),
-                ("box", (0.3, 0.5, 0.7)),
-                ("torus", (0.6, 0.2)),
-                ("capsule", (0.5, 0.3)),
-                ("cylinder", (0.5, 0.3)),
-                ("round_box", (0.3, 0.5, 0.7)),
-                ("octahedron", (0.7,)),
-                ("cone", (0.5, 0.9)),
-                ("hex_prism", (0.4, 0.6)),
-                ("ellipsoid", (0.3, 0.5, 0.7)),
-            ]
+            pytest.param(
+                sdf.Scene((sdf.Primitive(kind, (0.1, -0.2, 0.3), size, rotation=(0.6, 0.3, -0.5, 0.4)),)), id=kind
+            )
+            for kind, size in ALONE_SIZES.items()
         ),
-        "catalogue",
-    ],
-    ids=[
-        "default",
-        "smooth-exp",
-        "every-op",
-        "hard",
-        "sphere",
-        "box",
-        "torus",
-        "capsule",
-        "cylinder",
-        "round_box",
-        "octahedron",
-        "cone",
-        "hex_prism",
-        "ellipsoid",
-        "catalogue",
+        pytest.param("catalogue", id="catalogue"),
     ],
 )
 def test_glsl_scene_distance_and_color_match_numpy(gl: Renderer, scene: sdf.Scene | str) -> None:
