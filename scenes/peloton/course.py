@@ -575,7 +575,7 @@ class CourseMode:
         with self.server.atomic():
             s.course.visible = not self.enabled
             if self.enabled:
-                s.wind_arrow.visible = False
+                s.wind_arrow.visible = s.wind_label.visible = False
             self.frame.visible = self.enabled
             riders = (s.params.position, rider_detail(s.params.n_riders))
             if riders != self._drawn_riders:

@@ -18,6 +18,19 @@ def watts_text(value: float) -> str:
     return f"{round(float(value))}"  # an int: round(-0.4) is 0, not -0.0
 
 
+def coasting_words(brake_w: np.ndarray) -> str:
+    """A sentence for riders who coast (``brake_w``: (n,) watts each brakes off to hold the speed, 0 for those who
+    pedal), or "" when every rider pedals."""
+    braking = np.asarray(brake_w, np.float64)
+    braking = braking[braking >= 0.5]
+    if braking.size == 0:
+        return ""
+    low, high = watts_text(float(braking.min())), watts_text(float(braking.max()))
+    amount = f"{low} W" if low == high else f"{low}–{high} W"
+    who = "The rider coasts" if len(np.asarray(brake_w)) == 1 else f"{riders_text(braking.size)} coast"
+    return f"{who} at 0 W: the slope gives more than the speed needs, so to hold it they brake off {amount}."
+
+
 def power_range(watts: np.ndarray) -> tuple[float, float]:
     """(low, high) ends of the colour scale (W): the group's least and most power, at least 10 W apart."""
     low, high = float(np.min(watts)), float(np.max(watts))

@@ -152,12 +152,28 @@ class LineState:
     """(n, 2) where each rider rides (m): x forward, y to the left, leader first."""
 
     @property
+    def pedal_w(self) -> np.ndarray:
+        """(n,) what each rider pedals (W): the power the speed needs, or 0 where it needs less than nothing (down a
+        slope the rider coasts and brakes off the rest, :attr:`brake_w`), as in course mode."""
+        return np.maximum(np.asarray(self.power.total, np.float64), 0.0)
+
+    @property
+    def brake_w(self) -> np.ndarray:
+        """(n,) what each rider brakes off to hold the speed (W): the power the speed needs below 0, as positive."""
+        return np.maximum(-np.asarray(self.power.total, np.float64), 0.0)
+
+    @property
+    def solo_pedal_w(self) -> float:
+        """What the same rider alone pedals (W), 0 where it coasts."""
+        return max(float(self.solo.total), 0.0)
+
+    @property
     def saving(self) -> np.ndarray:
-        """(n,) fraction of the solo rider's power each rider saves; zero when riding alone costs nothing."""
-        solo = float(self.solo.total)
+        """(n,) fraction of the solo rider's pedalling each rider saves; zero when riding alone costs nothing."""
+        solo = self.solo_pedal_w
         if solo <= 0.0:
-            return np.zeros_like(self.power.total)
-        return 1.0 - self.power.total / solo
+            return np.zeros_like(self.pedal_w)
+        return 1.0 - self.pedal_w / solo
 
 
 def compute_line(p: PelotonParams) -> LineState:
@@ -192,6 +208,29 @@ def formation_yaw(p: PelotonParams) -> float:
         return 0.0
     yaw = cycling.apparent_yaw(p.speed_kmh / 3.6, p.headwind_ms, p.crosswind_ms)
     return float(np.clip(yaw, -MAX_YAW_RAD, MAX_YAW_RAD))
+
+
+def wind_words(p: PelotonParams) -> str:
+    """The ground wind in a few words, for the label at the wind arrow ("headwind 5 m/s", "crosswind 8 m/s from the
+    left", "wind 9.4 m/s (5 head, 8 from left)"); "" in still air. The arrow alone is foreshortened where the view
+    looks across the road, as the side view of a line does."""
+    head, cross = p.headwind_ms, p.crosswind_ms
+    side = "left" if cross > 0 else "right"
+    if cross == 0.0:
+        return "" if head == 0.0 else f"{'headwind' if head > 0 else 'tailwind'} {abs(head):.3g} m/s"
+    if head == 0.0:
+        return f"crosswind {abs(cross):.3g} m/s from the {side}"
+    along = f"{abs(head):.3g} {'head' if head > 0 else 'tail'}"
+    return f"wind {math.hypot(head, cross):.2g} m/s ({along}, {abs(cross):.3g} from {side})"
+
+
+def yaw_words(p: PelotonParams) -> str:
+    """Where the air meets the riders, for the panel ("the air meets the riders 36° off their line, from the
+    left"); "" without a crosswind, where it meets them head on (or from behind, in a tailwind faster than they)."""
+    if p.crosswind_ms == 0.0:
+        return ""
+    yaw = math.degrees(cycling.apparent_yaw(p.speed_kmh / 3.6, p.headwind_ms, p.crosswind_ms))
+    return f"the air meets the riders {abs(yaw):.0f}° off their line, from the {'left' if yaw > 0 else 'right'}"
 
 
 def _formation(p: PelotonParams) -> np.ndarray:

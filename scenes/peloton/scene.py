@@ -28,6 +28,7 @@ from scenes._look import add_ground
 from scenes.peloton.course import CourseMode
 from scenes.peloton.course_model import framed_front, framed_words
 from scenes.peloton.legend import (
+    coasting_words,
     formation_table,
     legend_html,
     power_colours,
@@ -59,6 +60,8 @@ from scenes.peloton.model import (
     solo_curves,
     solo_key,
     solo_speed,
+    wind_words,
+    yaw_words,
 )
 from scenes.peloton.projection import (
     LABEL_PAD_PX,
@@ -318,6 +321,9 @@ time-averaged power is the mean over positions, far below the leader's.
         self.wind_arrow = scene.add_line_segments(
             f"{self.root.name}/wind", np.zeros((3, 2, 3)), colors=(120, 200, 255), thickness=0.05
         )
+        self.wind_label = scene.add_label(
+            f"{self.root.name}/wind_words", text="", position=(3.0, 0.0, 1.6), font_screen_scale=0.9, visible=False
+        )
 
     # ----------------------------------------------------------------------------------------- callbacks
     def _on_position(self) -> None:
@@ -435,7 +441,7 @@ time-averaged power is the mean over positions, far below the leader's.
         """Slots of a group labelled in the picture, front first, none twice: the leader, the hardest-working rider
         behind it, the one who works least and the last (:data:`GROUP_LABELS`), of the riders the camera frames (the
         front :data:`FRAMED_LENGTH_M` of a long group)."""
-        n, total = self.params.n_riders, np.asarray(self.state.power.total)
+        n, total = self.params.n_riders, self.state.pedal_w
         if n == 1:
             return np.zeros(1, np.int64)
         x = self.state.positions[:, 0]
@@ -455,12 +461,12 @@ time-averaged power is the mean over positions, far below the leader's.
         """What the label of the rider in ``slot`` says: its watts and its share of the solo rider's power in a
         line; its watts and its drag (% of the same rider alone) in a group."""
         state = self.state
-        watts = float(state.power.total[slot])
+        watts = float(state.pedal_w[slot])
         if not is_line_view(self.params):
             return f"{_watts(watts)} W · drag {100.0 * (1.0 - float(state.reduction[slot])):.0f} %"
-        solo = float(state.solo.total)
-        share = f"{100.0 * watts / solo:.0f} % of solo" if solo > 0 else "solo needs 0 W"
-        return f"{watts:.0f} W · {share}"
+        solo = state.solo_pedal_w
+        share = f"{100.0 * watts / solo:.0f} % of solo" if solo > 0 else "coasting"
+        return f"{_watts(watts)} W · {share}"
 
     def _view_for(self, lens: Lens) -> View:
         """The view of the line for ``lens``, with room above it for the labels, which it lays out for that lens (or,
@@ -737,7 +743,7 @@ time-averaged power is the mean over positions, far below the leader's.
         positions[:n, :2] = self.group_positions()
         scales = np.zeros((MAX_GROUP, 3), np.float32)
         scales[:n] = 1.0
-        total = np.asarray(state.power.total)
+        total = state.pedal_w
         low, high = power_range(total)
         bodies = rider_colours("body", MAX_GROUP)
         bodies[:n] = power_colours(total[self.current_slots()], low, high)
@@ -750,7 +756,7 @@ time-averaged power is the mean over positions, far below the leader's.
             drag = 1.0 - state.reduction
             summary = (
                 f"{riders_text(n)}: mean drag {100 * float(np.mean(drag)):.0f} % of a lone rider's, mean power "
-                f"{_watts(float(np.mean(total)))} W (alone {_watts(float(state.solo.total))} W)"
+                f"{_watts(float(np.mean(total)))} W (alone {_watts(state.solo_pedal_w)} W)"
             )
             legend = legend_html(total, summary)
             if self.legend.content != legend:
@@ -786,11 +792,13 @@ time-averaged power is the mean over positions, far below the leader's.
         """Drag and power by row of the formation (riders level with each other share a row), front to back; long
         groups show their first and last rows."""
         state, p = self.state, self.params
-        total, drag = np.asarray(state.power.total), 1.0 - state.reduction
+        total, drag = state.pedal_w, 1.0 - state.reduction
         summary = (
             f"{riders_text(p.n_riders)} · mean drag **{100 * float(np.mean(drag)):.0f} %** of a lone rider's · mean power "
-            f"**{_watts(float(np.mean(total)))} W** (a lone rider {_watts(float(state.solo.total))} W)"
+            f"**{_watts(float(np.mean(total)))} W** (a lone rider {_watts(state.solo_pedal_w)} W)"
         )
+        if coasting := coasting_words(state.brake_w):
+            summary += "  \n" + coasting
         summary += framed_words(state.positions)
         return formation_table(state.positions, drag, {"Power (W)": total}, summary)
 
@@ -800,15 +808,20 @@ time-averaged power is the mean over positions, far below the leader's.
         p = self.params
         length = _arrow_length(p)
         if length == 0.0:
-            self.wind_arrow.visible = False
+            self.wind_arrow.visible = self.wind_label.visible = False
             return
-        self.wind_arrow.visible = True
+        self.wind_arrow.visible = self.wind_label.visible = True
         blowing = np.array([-p.headwind_ms, -p.crosswind_ms, 0.0])
         u = blowing / float(np.linalg.norm(blowing))
         centre = np.array([3.0 + 0.5 * length, 0.0, 1.2])
         tail, tip = centre - 0.5 * length * u, centre + 0.5 * length * u
         head = [tip - 0.3 * u + [0.0, 0.0, 0.2], tip - 0.3 * u - [0.0, 0.0, 0.2]]
         set_if_changed(self.wind_arrow, "points", np.array([[tail, tip], [head[0], tip], [head[1], tip]]))
+        words = wind_words(p)
+        if self.wind_label.text != words:
+            self.wind_label.text = words
+        # The words start above the arrow's end nearest the leader and read on over it, toward the panel.
+        set_if_changed(self.wind_label, "position", (3.0, 0.0, 1.2 + 0.5))
 
     def _density_markdown(self) -> str:
         p, solo = self.params, self.state.solo
@@ -824,7 +837,10 @@ time-averaged power is the mean over positions, far below the leader's.
         rider = (
             f"**{_watts(total)} W**" if total > -0.5 else f"coasting (it would brake {-total:.0f} W to hold this speed)"
         )
-        return f"Air density **{rho:.3f} kg/m³** ({where})  \nSolo rider: {rider}, {share}"
+        text = f"Air density **{rho:.3f} kg/m³** ({where})  \nSolo rider: {rider}, {share}"
+        if yaw := yaw_words(p):
+            text += f"  \n{wind_words(p).capitalize()}: {yaw}."
+        return text
 
     def _table_markdown(self) -> str:
         state = self.state
@@ -836,16 +852,17 @@ time-averaged power is the mean over positions, far below the leader's.
         for i in range(self.params.n_riders):
             rows.append(
                 f"| {i + 1} | {state.cda_m2[i]:.3f} | {_watts(state.power.aero[i])} / {_watts(state.power.rolling[i])} / "
-                f"{_watts(state.power.climbing[i])} | **{_watts(state.power.total[i])}** | {100 * state.saving[i]:.1f} % |"
+                f"{_watts(state.power.climbing[i])} | **{_watts(state.pedal_w[i])}** | {100 * state.saving[i]:.1f} % |"
             )
-        return "\n".join(rows)
+        coasting = coasting_words(state.brake_w)
+        return "\n".join(rows) + (f"\n\n{coasting}" if coasting else "")
 
     def _rotation_markdown(self) -> str:
         n = self.params.n_riders
         if n < 2:
             return ""
-        mean = float(np.mean(self.state.power.total))
-        lead = float(self.state.power.total[0])
+        mean = float(np.mean(self.state.pedal_w))
+        lead = float(self.state.pedal_w[0])
         if self._rotation_width() == 0:
             return (
                 f"In {'a bunch' if self.params.formation == 'bunch' else 'an echelon'} riders do not take turns in order: "
@@ -890,7 +907,7 @@ time-averaged power is the mean over positions, far below the leader's.
             return False
         dt = min(dt, 0.2)
         slots = self.current_slots()
-        self._energy_j[: self.params.n_riders] += np.asarray(self.state.power.total)[slots] * dt
+        self._energy_j[: self.params.n_riders] += self.state.pedal_w[slots] * dt
         self._ridden_s += dt
         self._rotation_time_s += dt
         self.redraw(readouts=False)

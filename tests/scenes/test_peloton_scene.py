@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 import time
 
 import numpy as np
@@ -31,6 +32,7 @@ from scenes.peloton import (
 from scenes.peloton.course_model import FRAMED_LENGTH_M
 from scenes.peloton.meshes import rider_head_m
 from scenes.peloton.model import FORMATION_FROM_LABEL, formation_positions
+from scenes.peloton.scene import TEXT_PX_PER_CHAR
 from server.switcher import SceneSwitcher
 
 scene = scene_fixture(PelotonScene)
@@ -498,7 +500,66 @@ def test_downhill_readouts_say_coasting_not_negative_watts(scene: PelotonScene) 
     assert "Solo rider: **0 W**, no power needed at the wheel" in scene.density.content  # standing still
 
 
+@pytest.mark.parametrize(("formation", "n"), [("Single file", 4), ("Bunch (peloton)", 121), ("Echelon", 20)])
+@pytest.mark.parametrize("grade", [-15.0, -8.0, -3.0, 0.0, 6.0])
+def test_no_rider_pedals_negative_watts_and_a_coasting_rider_says_what_it_brakes(
+    scene: PelotonScene, formation: str, n: int, grade: float
+) -> None:
+    """Down a slope at a set speed a sheltered rider would need less than nothing: it coasts and brakes, and every
+    readout (labels, table, summary, colour scale) says 0 W and the braking, as course mode does."""
+    c = scene.controls
+    c["formation"].value, c["n_riders"].value, c["grade_pct"].value = formation, n, grade
+    need = np.asarray(scene.state.power.total)  # what the speed needs of each rider (W), the kernel's
+    assert len(need) == n
+    # Every watt figure the panel and the labels show is a whole, non-negative number.
+    shown = scene.table.content + scene.legend.content + " ".join(scene.label_text(i) for i in range(n))
+    assert not re.search(r"(?<![\w/])-\d+ W|\*\*-\d", shown), shown
+    braking = -need[need <= -0.5]
+    words = re.search(r"coasts? at 0 W: .* brake off (\d+)(?:–(\d+))? W", scene.table.content)
+    if braking.size == 0:
+        assert words is None
+        assert "coast" not in scene.table.content
+    else:
+        assert words is not None, scene.table.content
+        low, high = int(words[1]), int(words[2] or words[1])
+        assert (low, high) == (round(float(braking.min())), round(float(braking.max())))
+    for i in range(n):
+        expected = max(round(float(need[i])), 0)
+        assert scene.label_text(i).startswith(f"{expected} W"), (i, scene.label_text(i), need[i])
+
+
 # ------------------------------------------------------------------------------------------------ formations
+@pytest.mark.parametrize("viewport", [*VIEWPORTS, (1000, 800)])
+@pytest.mark.parametrize(("n", "gap"), [(1, 0.5), (4, 0.5), (8, 15.0)])
+@pytest.mark.parametrize(
+    ("head", "cross", "words"),
+    [
+        (0.0, 8.0, "crosswind 8 m/s from the left"),
+        (5.0, -8.0, "wind 9.4 m/s (5 head, 8 from right)"),
+        (-3.0, 0.0, "tailwind 3 m/s"),
+        (15.0, 15.0, "wind 21 m/s (15 head, 15 from left)"),
+    ],
+)
+def test_the_wind_arrow_says_the_wind_in_words_in_view_clear_of_the_panel(
+    scene: PelotonScene, viewport: tuple[int, int], n: int, gap: float, head: float, cross: float, words: str
+) -> None:
+    """Seen from the side, as a line is, an arrow across the road points at the camera and shows as a stub: the
+    label says the wind, and the framed view keeps it left of the panel."""
+    c = scene.controls
+    c["n_riders"].value, c["gap_m"].value, c["headwind_ms"].value, c["crosswind_ms"].value = n, gap, head, cross
+    assert scene.wind_label.visible and scene.wind_label.text == words
+    lens = Lens(math.radians(75.0), *viewport)
+    view = scene._view_for(lens)
+    anchor = np.array([scene.wind_label.position], dtype=np.float64)
+    ((x, y),) = _screen_px(anchor, np.array(view.position), np.array(view.look_at), lens)
+    assert 0.0 <= x and x + len(words) * TEXT_PX_PER_CHAR <= lens.width_px - PANEL_PX, (x, words)
+    assert LABEL_PX[1] <= y <= lens.height_px
+    if cross:
+        assert "the air meets the riders" in scene.density.content
+    c["headwind_ms"].value = c["crosswind_ms"].value = 0.0
+    assert not scene.wind_label.visible and "the air meets" not in scene.density.content
+
+
 def test_a_crosswind_takes_a_lines_shelter_and_the_echelon_forms_downwind(scene: PelotonScene) -> None:
     c = scene.controls
     c["speed_kmh"].value, c["n_riders"].value, c["gap_m"].value = 40.0, 4, 0.5
