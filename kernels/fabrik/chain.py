@@ -120,6 +120,40 @@ def _forward_pass(
 
 
 @numba.njit(cache=True, error_model="numpy")
+def _backward_step(
+    x: float,
+    y: float,
+    z: float,
+    px: float,
+    py: float,
+    pz: float,
+    qx: float,
+    qy: float,
+    qz: float,
+    length: float,
+    row: int,
+    rest: NDArray[np.float64],
+    limits: tuple[bool, NDArray[np.float64]],
+    obstacles: Obstacles,
+    tiny: float,
+    dim: int,
+) -> tuple[float, float, float]:
+    """Backward reaching's rule for one segment, shared by chains and trees: the unit direction from its placed
+    anchor (x, y, z) toward its joint's current place (px, py, pz), clamped into the limit of table row ``row``
+    about the previous segment's direction q, turned clear of live obstacles at ``length``, and clamped again where
+    that turned it."""
+    has_limits, table = limits
+    dx, dy, dz, _ = _unit(px - x, py - y, pz - z, qx, qy, qz, tiny)
+    if has_limits:
+        dx, dy, dz = _constrain(dx, dy, dz, qx, qy, qz, table, row, rest, tiny, dim)
+    if obstacles[1].shape[0] > 0:  # any obstacle at all
+        dx, dy, dz, turned = _deflect(x, y, z, dx, dy, dz, length, obstacles, tiny, dim)
+        if turned and has_limits:
+            dx, dy, dz = _constrain(dx, dy, dz, qx, qy, qz, table, row, rest, tiny, dim)
+    return dx, dy, dz
+
+
+@numba.njit(cache=True, error_model="numpy")
 def _backward_pass(
     p: NDArray[np.float64],
     lengths: NDArray[np.float64],
@@ -131,18 +165,13 @@ def _backward_pass(
     dim: int,
 ) -> None:
     """Root back on its place, each joint outward toward its current place; limits and obstacles enforced."""
-    has_limits, table = limits
     qx, qy, qz = rest[0], rest[1], rest[2]
     x, y, z = p[0, 0], p[0, 1], p[0, 2]  # the anchor, carried in registers from joint to joint
     for i in range(1, lengths.shape[0] + 1):
-        dx, dy, dz, _ = _unit(p[i, 0] - x, p[i, 1] - y, p[i, 2] - z, qx, qy, qz, tiny)
-        if has_limits:
-            dx, dy, dz = _constrain(dx, dy, dz, qx, qy, qz, table, i - 1, rest, tiny, dim)
-        if obstacles[1].shape[0] > 0:  # any obstacle at all
-            dx, dy, dz, turned = _deflect(x, y, z, dx, dy, dz, lengths[i - 1], obstacles, tiny, dim)
-            if turned and has_limits:
-                dx, dy, dz = _constrain(dx, dy, dz, qx, qy, qz, table, i - 1, rest, tiny, dim)
         length = lengths[i - 1]
+        dx, dy, dz = _backward_step(
+            x, y, z, p[i, 0], p[i, 1], p[i, 2], qx, qy, qz, length, i - 1, rest, limits, obstacles, tiny, dim
+        )
         x, y, z = x + length * dx, y + length * dy, z + length * dz
         p[i, 0], p[i, 1], p[i, 2] = x, y, z
         if not has_zero or length > tiny:

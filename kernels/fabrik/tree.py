@@ -35,6 +35,7 @@ from kernels.fabrik.chain import (
     _UNREACHABLE,
     STATUSES,
     Status,
+    _backward_step,
     _copy,
 )
 from kernels.fabrik.geometry import (
@@ -55,7 +56,6 @@ from kernels.fabrik.geometry import (
 from kernels.fabrik.limits import (
     _TABLE_WIDTH,
     Constraint,
-    _constrain,
     _hold_by_next,
     _into_hinge_plane,
     _joint_ok,
@@ -332,6 +332,7 @@ def _solve_tree_core(
     root = int(order[0])
     history[:, :] = np.nan
     has_limits, holding = _limit_flags(table)
+    limits = (has_limits, table)
     lengths = np.zeros(count)
     total = 0.0
     for j in range(count):
@@ -354,16 +355,7 @@ def _solve_tree_core(
     # effector's target is out of its path's reach; a free tree within reach iterates on to the cap.
     out_of_reach = False
     for e in range(effectors.shape[0]):
-        key = int(effectors[e])
-        reach, longest, j = 0.0, 0.0, key
-        while parents[j] >= 0:
-            reach += lengths[j]
-            longest = max(longest, lengths[j])
-            j = int(parents[j])
-        inner = max(0.0, 2.0 * longest - reach)  # the path's annulus, as solve's
-        dx, dy, dz = goal[key, 0] - p[root, 0], goal[key, 1] - p[root, 1], goal[key, 2] - p[root, 2]
-        distance = math.sqrt(dx * dx + dy * dy + dz * dz)
-        out_of_reach = out_of_reach or distance > reach + tiny or distance < inner - tiny
+        out_of_reach = out_of_reach or _out_of_reach(p, parents, lengths, goal, int(effectors[e]), root, tiny)
     stall_applies = holding or any_live or out_of_reach
     best = p.copy()
     best_worst = np.inf
@@ -442,14 +434,10 @@ def _solve_tree_core(
             up = int(parents[j])
             qx, qy, qz = directions[up, 0], directions[up, 1], directions[up, 2]
             ax, ay, az = p[up, 0], p[up, 1], p[up, 2]
-            dx, dy, dz, _ = _unit(p[j, 0] - ax, p[j, 1] - ay, p[j, 2] - az, qx, qy, qz, tiny)
-            if has_limits:
-                dx, dy, dz = _constrain(dx, dy, dz, qx, qy, qz, table, j, rest, tiny, dim)
-            if radii.shape[0] > 0:
-                dx, dy, dz, turned = _deflect(ax, ay, az, dx, dy, dz, lengths[j], obstacles, tiny, dim)
-                if turned and has_limits:
-                    dx, dy, dz = _constrain(dx, dy, dz, qx, qy, qz, table, j, rest, tiny, dim)
             length = lengths[j]
+            dx, dy, dz = _backward_step(
+                ax, ay, az, p[j, 0], p[j, 1], p[j, 2], qx, qy, qz, length, j, rest, limits, obstacles, tiny, dim
+            )
             p[j, 0], p[j, 1], p[j, 2] = ax + length * dx, ay + length * dy, az + length * dz
             if length > tiny:
                 directions[j, 0], directions[j, 1], directions[j, 2] = dx, dy, dz
@@ -592,6 +580,29 @@ def _tree_admissible(
 
 
 @numba.njit(cache=True, error_model="numpy")
+def _out_of_reach(
+    p: NDArray[np.float64],
+    parents: NDArray[np.int64],
+    lengths: NDArray[np.float64],
+    goal: NDArray[np.float64],
+    key: int,
+    root: int,
+    tiny: float,
+) -> bool:
+    """Whether effector ``key``'s target lies outside the annulus its path from the root reaches (as solve's: the
+    path's length outside, twice its longest link less that length inside)."""
+    reach, longest, j = 0.0, 0.0, key
+    while parents[j] >= 0:
+        reach += lengths[j]
+        longest = max(longest, lengths[j])
+        j = int(parents[j])
+    inner = max(0.0, 2.0 * longest - reach)
+    dx, dy, dz = goal[key, 0] - p[root, 0], goal[key, 1] - p[root, 1], goal[key, 2] - p[root, 2]
+    distance = math.sqrt(dx * dx + dy * dy + dz * dz)
+    return distance > reach + tiny or distance < inner - tiny
+
+
+@numba.njit(cache=True, error_model="numpy")
 def _tree_statuses(
     p: NDArray[np.float64],
     parents: NDArray[np.int64],
@@ -618,18 +629,10 @@ def _tree_statuses(
         root = int(parents[root])
     for e in range(effectors.shape[0]):
         key = int(effectors[e])
-        reach, longest, j = 0.0, 0.0, key
-        while parents[j] >= 0:
-            reach += lengths[j]
-            longest = max(longest, lengths[j])
-            j = int(parents[j])
-        inner = max(0.0, 2.0 * longest - reach)
-        dx, dy, dz = goal[key, 0] - p[root, 0], goal[key, 1] - p[root, 1], goal[key, 2] - p[root, 2]
-        distance = math.sqrt(dx * dx + dy * dy + dz * dz)
         inside = _inside_live(obstacles, goal[key, 0], goal[key, 1], goal[key, 2])
         if error[e] <= tolerance:
             codes[e] = _REACHED
-        elif distance > reach + tiny or distance < inner - tiny:
+        elif _out_of_reach(p, parents, lengths, goal, key, root, tiny):
             codes[e] = _UNREACHABLE
         elif inside or touching:
             codes[e] = _BLOCKED
