@@ -13,6 +13,7 @@ import itertools
 import numpy as np
 import pytest
 import trimesh
+from helpers.meshing import assert_near_surface_meshes_like_the_full_grid
 from helpers.properties import examples
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
@@ -175,10 +176,7 @@ def test_coarse_to_fine_still_equals_the_full_grid_with_samples_on_the_level(
     case: tuple[sdf.Scene, int, dict[str, float]],
 ) -> None:
     scene, resolution, _ = case
-    near = sdf.mesh(scene, resolution, BOUNDS)
-    full = sdf.mesh(scene, resolution, BOUNDS, near_surface=False)
-    for a, b in zip(near, full, strict=True):
-        np.testing.assert_array_equal(a, b)
+    assert_near_surface_meshes_like_the_full_grid(scene, resolution, BOUNDS)
 
 
 # ------------------------------------------------------------------------------------------------ public inputs
@@ -291,10 +289,7 @@ def test_a_feature_one_voxel_thick_on_grid_planes_meshes_closed(
     # A box's edges are convex and lie on samples: exact, up to the 2δ nudge of its faces.
     nudge = 2.0 * sdf.ISO_NUDGE_VOXELS * spacing(resolution) * tri.area
     assert exact - 1e-9 <= tri.volume <= exact + nudge + 1e-9
-    near = sdf.mesh(scene, resolution, BOUNDS)
-    full = sdf.mesh(scene, resolution, BOUNDS, near_surface=False)
-    for a, b in zip(near, full, strict=True):
-        np.testing.assert_array_equal(a, b)
+    assert_near_surface_meshes_like_the_full_grid(scene, resolution, BOUNDS)
 
 
 def test_zero_volume_sets_stay_empty() -> None:

@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pytest
 import trimesh
+from helpers.meshing import assert_near_surface_meshes_like_the_full_grid
 from helpers.properties import examples
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -346,10 +347,7 @@ def test_samples_exactly_on_the_surface_are_merged() -> None:
 @given(scene=random_scenes())
 def test_near_surface_sampling_gives_the_full_grid_mesh(scene: sdf.Scene) -> None:
     """Coarse-to-fine output equals plain full-grid evaluation plus marching cubes, exactly."""
-    near = sdf.mesh(scene, 40)
-    full = sdf.mesh(scene, 40, near_surface=False)
-    for a, b in zip(near, full, strict=True):
-        np.testing.assert_array_equal(a, b)
+    assert_near_surface_meshes_like_the_full_grid(scene, 40)
     grid = sdf.make_grid(scene, 40)
     near_field = sdf.sample_near_surface(scene, grid)
     full_field = sdf.sample_full(scene, grid)
