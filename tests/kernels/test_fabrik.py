@@ -744,6 +744,15 @@ def test_ccd_with_limits_and_obstacles_is_not_unreachable(solver: fabrik.Solver)
 
 
 # ------------------------------------------------------------------------------------------------ targets at full reach
+def solve_alone_or_as_a_batch(
+    joints: NDArray[np.float64], target: NDArray[np.float64], batched: bool, **kwargs: Any
+) -> fabrik.Solution:
+    """``fabrik.solve`` of one chain, or (``batched``) the one row of ``solve_batch`` on a batch of that chain alone."""
+    if batched:
+        return fabrik.solve_batch(joints[None], target[None], **kwargs)[0]
+    return fabrik.solve(joints, target, **kwargs)
+
+
 @PROPERTY
 @given(
     chains,
@@ -791,10 +800,7 @@ def test_targets_within_tolerance_of_full_reach_are_reached(
         "obstacles": obstacles,
         "root_direction": root_direction,
     }
-    if batched:
-        result = fabrik.solve_batch(joints[None], target[None], **kwargs)[0]
-    else:
-        result = fabrik.solve(joints, target, **kwargs)
+    result = solve_alone_or_as_a_batch(joints, target, batched, **kwargs)
     assert result.status == "reached"
     assert 0 <= result.iterations <= cap
     assert result.error <= tolerance
@@ -924,10 +930,7 @@ def test_targets_within_tolerance_of_the_inner_radius_are_reached(
         if segment_clearance(folded_pose(joints[0], lengths, direction), c) > r
     ]
     kwargs: dict[str, Any] = {"tolerance": tolerance, "obstacles": obstacles}
-    if batched:
-        result = fabrik.solve_batch(joints[None], target[None], **kwargs)[0]
-    else:
-        result = fabrik.solve(joints, target, **kwargs)
+    result = solve_alone_or_as_a_batch(joints, target, batched, **kwargs)
     assert result.status == "reached"
     assert result.error <= tolerance
     assert admissible(result.joints, None, direction, obstacles)
