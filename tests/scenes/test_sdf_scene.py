@@ -215,7 +215,7 @@ def test_reference_image_readouts_and_rerender(server: viser.ViserServer, scene:
                 and scene.agreement.iou is not None
             ),
             "reference from this camera",
-            timeout_s=60,
+            timeout_s=90,
         )
         first = scene.reference_rgb
         assert first is not None
@@ -233,7 +233,7 @@ def test_reference_image_readouts_and_rerender(server: viser.ViserServer, scene:
                 and np.allclose(scene.reference_camera.position, (0.0, -3.5, 0.4))
             ),
             "re-render after the camera moved",
-            timeout_s=30,
+            timeout_s=90,  # a software GL render on a machine busy with the rest of the suite
         )
         assert scene.reference_rgb is not None and not np.array_equal(scene.reference_rgb, first)
         # A brighter ambient term brightens the object.
@@ -248,7 +248,7 @@ def test_reference_image_readouts_and_rerender(server: viser.ViserServer, scene:
                 and scene.reference_params.shading.ambient == 0.9
             ),
             "re-render after k_a",
-            timeout_s=30,
+            timeout_s=90,  # a software GL render on a machine busy with the rest of the suite
         )
         assert scene.params.shading.ambient == 0.9
         assert scene.reference_rgb.astype(float).mean() > dark + 5
