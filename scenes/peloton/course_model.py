@@ -257,15 +257,20 @@ def place_powers(state: CourseState, at_m: float) -> tuple[np.ndarray, np.ndarra
     route) and (n,) its mean over the ride (by time).
 
     The group rides at the mean drag of its places, at the group's power P (the ride's); a place with drag area
-    CdA_i needs P + (CdA_i − CdA_group)·a, with a the aero power per m² there (:func:`aero_watts_per_m2`), so the
-    places' mean is P. Riders who share the work in turn each average P over the ride. A place that would need less
-    than nothing (a sheltered rider on a descent where the group coasts) shows 0 W: it brakes or sits up.
+    CdA_i needs P + (CdA_i − CdA_group)·a, with a the aero power per m² (½·ρ·(v + w)·|v + w|·v / η): here at the
+    speed v at ``at_m`` (0 at a standing start, where every place needs P), over the ride at each segment's mean
+    speed (:func:`aero_watts_per_m2`), so the places' mean is P. Riders who share the work in turn each average P
+    over the ride. A place that would need less than nothing (a sheltered rider on a descent where the group coasts)
+    shows 0 W: it brakes or sits up.
     """
     ride = state.ride
     per_m2 = aero_watts_per_m2(ride, state.efficiency)
     extra = state.rider_cda_m2 * np.asarray(state.drag) - state.group_cda_m2  # (n,) m²
     segment = int(np.clip(np.searchsorted(ride.distance_m, at_m, side="right") - 1, 0, per_m2.shape[0] - 1))
-    here = float(ride.power_w[segment]) + extra * float(per_m2[segment])
+    v = float(np.interp(at_m, ride.distance_m, ride.speed_ms))
+    air = v + float(ride.headwind_ms[segment])
+    per_m2_here = 0.5 * float(ride.air_density[segment]) * air * abs(air) * v / state.efficiency
+    here = float(ride.power_w[segment]) + extra * per_m2_here
     seconds = np.diff(ride.elapsed_s)
     mean_per_m2 = float(np.sum(per_m2 * seconds) / max(float(np.sum(seconds)), 1e-9))
     mean = ride.average_power_w + extra * mean_per_m2

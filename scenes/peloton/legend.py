@@ -28,7 +28,10 @@ def coasting_words(brake_w: np.ndarray) -> str:
     low, high = watts_text(float(braking.min())), watts_text(float(braking.max()))
     amount = f"{low} W" if low == high else f"{low}–{high} W"
     who = "The rider coasts" if len(np.asarray(brake_w)) == 1 else f"{riders_text(braking.size)} coast"
-    return f"{who} at 0 W: the slope gives more than the speed needs, so to hold it they brake off {amount}."
+    return (
+        f"{who} at 0 W: the slope or the tailwind gives more than holding this speed takes, so to hold it they brake "
+        f"off {amount}."
+    )
 
 
 def power_range(watts: np.ndarray) -> tuple[float, float]:

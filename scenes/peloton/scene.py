@@ -465,7 +465,8 @@ time-averaged power is the mean over positions, far below the leader's.
         if not is_line_view(self.params):
             return f"{_watts(watts)} W · drag {100.0 * (1.0 - float(state.reduction[slot])):.0f} %"
         solo = state.solo_pedal_w
-        share = f"{100.0 * watts / solo:.0f} % of solo" if solo > 0 else "coasting"
+        coasting = solo <= 0.0 or float(state.brake_w[slot]) >= 0.5
+        share = "coasting" if coasting else f"{100.0 * watts / solo:.0f} % of solo"
         return f"{_watts(watts)} W · {share}"
 
     def _view_for(self, lens: Lens) -> View:
@@ -826,12 +827,15 @@ time-averaged power is the mean over positions, far below the leader's.
     def _density_markdown(self) -> str:
         p, solo = self.params, self.state.solo
         rho = float(cycling.air_density(p.altitude_m))
-        wheel = float(solo.aero + solo.rolling + solo.climbing)
+        # What the rider's power is spent on: the air (when the air drags), the tyres and the climb (uphill). Down a
+        # slope, or pushed by a tailwind, part of it is paid by gravity or the wind, not spent.
+        aero, rolling, climbing = float(solo.aero), float(solo.rolling), float(solo.climbing)
+        spent = max(aero, 0.0) + rolling + max(climbing, 0.0)
         thinner = 100 * (1 - rho / cycling.RHO_SEA_LEVEL)
         where = "sea level" if abs(thinner) < 0.05 else f"{thinner:.1f} % thinner than at sea level"
-        if wheel > 0:
-            share = f"aero share of wheel power **{100.0 * float(solo.aero) / wheel:.1f} %**"
-        else:  # standing still, or a descent that pays for the air: no share of nothing
+        if spent > 0 and aero + rolling + climbing > 0:
+            share = f"the air takes **{100.0 * max(aero, 0.0) / spent:.1f} %** of the power spent"
+        else:  # standing still, or a descent or tailwind that pays for it all: no share of nothing
             share = "no power needed at the wheel"
         total = float(solo.total)
         rider = (
@@ -855,6 +859,8 @@ time-averaged power is the mean over positions, far below the leader's.
                 f"{_watts(state.power.climbing[i])} | **{_watts(state.pedal_w[i])}** | {100 * state.saving[i]:.1f} % |"
             )
         coasting = coasting_words(state.brake_w)
+        if coasting:  # the bars stand for what is spent, which the rider's 0 W is not
+            coasting += " The bars show what the air and the tyres take, which gravity or the wind pays."
         return "\n".join(rows) + (f"\n\n{coasting}" if coasting else "")
 
     def _rotation_markdown(self) -> str:
@@ -869,7 +875,8 @@ time-averaged power is the mean over positions, far below the leader's.
                 f"the mean over its places is **{_watts(mean)} W** against the leader's {_watts(lead)} W."
             )
         if lead <= 0:
-            text = "Downhill at this speed gravity does the work: nobody needs to pedal, so nobody needs shelter."
+            what = "gravity does" if self.params.grade_pct < 0 else "the tailwind does"
+            text = f"At this speed {what} the work: nobody needs to pedal, so nobody needs shelter."
         elif not self.params.drafting:
             text = f"Drafting is off: every rider rides in clean air at the leader's {lead:.0f} W, so rotating saves nothing."
         elif mean >= 0.995 * lead:

@@ -566,7 +566,8 @@ def test_a_bunch_rides_the_course_at_its_formations_mean_drag(mode: CourseMode) 
 # ------------------------------------------------------------------------------------------------ places' power
 def _place_watts_reference(mode: CourseMode, at_m: float) -> tuple[np.ndarray, np.ndarray]:
     """Each place's power where the leader is ``at_m`` and over the ride, written out: the group's power plus the
-    aero power ½·ρ·(v + w)·|v + w|·v/η of the place's drag area above (or below) the group's."""
+    aero power ½·ρ·(v + w)·|v + w|·v/η of the place's drag area above (or below) the group's, at the speed at
+    ``at_m`` (interpolated between the route's points) and, over the ride, at each segment's mean speed."""
     state, line = mode.state, mode.scene.params
     assert state is not None
     ride = state.ride
@@ -584,9 +585,24 @@ def _place_watts_reference(mode: CourseMode, at_m: float) -> tuple[np.ndarray, n
     air = v + ride.headwind_ms
     per_m2 = 0.5 * ride.air_density * air * np.abs(air) * v / eta
     j = int(np.searchsorted(ride.distance_m, at_m, side="right")) - 1
-    here = ride.power_w[j] + (cda - group) * per_m2[j]
+    v_here = np.interp(at_m, ride.distance_m, ride.speed_ms)
+    air_here = v_here + ride.headwind_ms[j]
+    here = ride.power_w[j] + (cda - group) * 0.5 * ride.air_density[j] * air_here * abs(air_here) * v_here / eta
     mean = ride.work_j / ride.time_s + (cda - group) * float(np.sum(per_m2 * dt) / np.sum(dt))
     return here, mean
+
+
+def test_at_a_standing_start_every_place_needs_the_groups_power(mode: CourseMode) -> None:
+    # The failing input (a review): at 0.00 km and 0.0 km/h a bunch of 121's places read 247–257 W, the aero term of
+    # the first segment's mean speed; standing still, no place has any air to push.
+    scene = mode.scene
+    scene.controls["formation"].value, scene.controls["n_riders"].value = "Bunch (peloton)", 121
+    mode.scrub.value = 0.0
+    assert mode.state is not None and mode.state.ride.speed_ms[0] == 0.0
+    here, _ = mode.place_watts()
+    np.testing.assert_allclose(here, float(mode.state.ride.power_w[0]), rtol=1e-12)
+    reference, _ = _place_watts_reference(mode, mode.leader_distance_m())
+    np.testing.assert_allclose(here, reference, rtol=1e-9)
 
 
 @pytest.mark.parametrize(("shape", "n"), [("Bunch (peloton)", 40), ("Bunch (peloton)", 121), ("Single file", 8)])

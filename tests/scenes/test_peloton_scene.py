@@ -473,8 +473,59 @@ def test_the_aero_share_is_a_number_only_where_the_wheel_needs_power(
     scene.controls["grade_pct"].value = grade
     text = scene.density.content
     assert "nan" not in text.lower()
-    assert ("aero share of wheel power" in text) is wheel_power
+    assert ("of the power spent" in text) is wheel_power
     assert ("no power needed at the wheel" in text) is not wheel_power
+
+
+@pytest.mark.parametrize(
+    ("speed", "grade", "headwind"),
+    [(40.0, -3.0, 0.0), (40.0, 0.0, 0.0), (20.0, 8.0, 0.0), (20.0, 0.0, -4.0), (40.0, -1.0, -3.0), (15.0, 0.0, -5.0)],
+)
+def test_the_airs_share_of_the_power_spent_is_a_share(
+    scene: PelotonScene, speed: float, grade: float, headwind: float
+) -> None:
+    # The failing input (a review): down 3 % the readout said "aero share of wheel power 636.5 %", the air's 300 W
+    # over a wheel power that gravity had cut to 47 W. The share is of what is spent: air (when it drags), tyres,
+    # climbing (uphill), each from the kernel's own terms.
+    c = scene.controls
+    c["speed_kmh"].value, c["grade_pct"].value, c["headwind_ms"].value = speed, grade, headwind
+    solo = scene.state.solo
+    aero, rolling, climbing = float(solo.aero), float(solo.rolling), float(solo.climbing)
+    words = re.search(r"the air takes \*\*([\d.]+) %\*\* of the power spent", scene.density.content)
+    if aero + rolling + climbing <= 0:
+        assert words is None and "no power needed at the wheel" in scene.density.content
+        return
+    assert words is not None, scene.density.content
+    expected = 100.0 * max(aero, 0.0) / (max(aero, 0.0) + rolling + max(climbing, 0.0))
+    assert float(words[1]) == pytest.approx(expected, abs=0.05)
+    assert 0.0 <= float(words[1]) <= 100.0
+
+
+def test_a_rider_that_coasts_is_labelled_coasting_whatever_the_solo_rider_does(scene: PelotonScene) -> None:
+    # The failing input (a review): down 3 % with 8 riders the solo rider still pedals 43 W, and the sheltered riders
+    # who coast were labelled "0 W · 0 % of solo", where down 8 % they read "0 W · coasting".
+    c = scene.controls
+    c["n_riders"].value, c["grade_pct"].value = 8, -3.0
+    assert scene.state.solo_pedal_w > 0
+    for slot in range(8):
+        text = scene.label_text(slot)
+        if float(scene.state.brake_w[slot]) >= 0.5:
+            assert text == "0 W · coasting"
+        else:
+            assert text.endswith("% of solo") and not text.startswith("0 W")
+
+
+def test_a_tailwind_that_pushes_the_riders_is_not_called_a_slope(scene: PelotonScene) -> None:
+    # The failing input (a review): flat road, 15 m/s tailwind, 20 km/h: "the slope gives more than the speed needs"
+    # and "Downhill at this speed gravity does the work".
+    c = scene.controls
+    c["headwind_ms"].value, c["crosswind_ms"].value, c["speed_kmh"].value = -15.0, 8.0, 20.0
+    assert float(scene.state.solo.total) < 0
+    assert "Downhill" not in scene.rotation.content and "gravity" not in scene.rotation.content
+    assert scene.rotation.content.startswith("At this speed the tailwind does the work")
+    assert "the slope or the tailwind gives more" in scene.table.content
+    c["headwind_ms"].value, c["grade_pct"].value = 0.0, -15.0
+    assert scene.rotation.content.startswith("At this speed gravity does the work")
 
 
 def test_with_drafting_off_the_rotation_line_says_rotating_saves_nothing(scene: PelotonScene) -> None:
@@ -491,9 +542,9 @@ def test_downhill_readouts_say_coasting_not_negative_watts(scene: PelotonScene) 
     scene.controls["speed_kmh"].value = 25.0
     assert float(scene.state.solo.total) < 0  # the descent would pay more than the air takes
     assert "Solo rider: coasting (it would brake" in scene.density.content
-    assert scene.rotation.content.startswith("Downhill at this speed gravity does the work")
+    assert scene.rotation.content.startswith("At this speed gravity does the work")
     scene.controls["drafting"].value = False  # the same sentence: nobody pedals
-    assert scene.rotation.content.startswith("Downhill")
+    assert scene.rotation.content.startswith("At this speed gravity")
     scene.controls["speed_kmh"].value = 0.0
     rows = scene.table.content.splitlines()[2:]
     assert rows and all("-0 " not in row and "/ -0" not in row for row in rows)
