@@ -782,9 +782,14 @@ class CourseMode:
         coasting = ""
         if self.state.pacing is None and power < 0.99 * self.params.power_w:
             coasting = f" (coasting at the {self.params.max_speed_kmh:.0f} km/h descent cap)"
+        if self.scene.params.n_riders > 1:  # the group's power; the leader's place needs more (the table's row 1)
+            lead = float(self.place_watts()[0][0])
+            watts = f"the group's {power:.0f} W{coasting} (the leader's place {lead:.0f} W)"
+        else:
+            watts = f"{power:.0f} W{coasting}"
         return (
             f"Leader at **{d / 1000:.2f} km**, {format_duration(self.play_time_s)}: "
-            f"{3.6 * speed:.1f} km/h, {power:.0f} W{coasting}, {elevation:.0f} m"
+            f"{3.6 * speed:.1f} km/h, {watts}, {elevation:.0f} m"
         )
 
 

@@ -18,27 +18,31 @@ def watts_text(value: float) -> str:
     return f"{round(float(value))}"  # an int: round(-0.4) is 0, not -0.0
 
 
-def coasting_words(brake_w: np.ndarray) -> str:
+def coasting_words(brake_w: np.ndarray, cause: str) -> str:
     """A sentence for riders who coast (``brake_w``: (n,) watts each brakes off to hold the speed, 0 for those who
-    pedal), or "" when every rider pedals."""
+    pedal; ``cause``: what pushes them, "the slope", "the tailwind" or both), or "" when no rider coasts."""
     braking = np.asarray(brake_w, np.float64)
     braking = braking[braking >= 0.5]
     if braking.size == 0:
         return ""
     low, high = watts_text(float(braking.min())), watts_text(float(braking.max()))
     amount = f"{low} W" if low == high else f"{low}–{high} W"
-    who = "The rider coasts" if len(np.asarray(brake_w)) == 1 else f"{riders_text(braking.size)} coast"
-    return (
-        f"{who} at 0 W: the slope or the tailwind gives more than holding this speed takes, so to hold it they brake "
-        f"off {amount}."
-    )
+    if len(np.asarray(brake_w)) == 1:
+        who, verb, they = "The rider", "coasts", "it brakes"
+    else:
+        one = braking.size == 1
+        who, verb, they = riders_text(braking.size), "coasts" if one else "coast", "it brakes" if one else "they brake"
+    return f"{who} {verb} at 0 W: {cause} gives more than this speed takes, and {they} off {amount} to hold it."
 
 
 def power_range(watts: np.ndarray) -> tuple[float, float]:
-    """(low, high) ends of the colour scale (W): the group's least and most power, at least 10 W apart."""
+    """(low, high) ends of the colour scale (W): the group's least and most power, at least 10 W apart, and never
+    below 0 W where no rider is below it (a scale of pedal power that read "-4 W")."""
     low, high = float(np.min(watts)), float(np.max(watts))
     middle = 0.5 * (low + high)
     half = max(0.5 * (high - low), 5.0)
+    if low >= 0.0 and middle - half < 0.0:
+        return 0.0, 2.0 * half
     return middle - half, middle + half
 
 

@@ -457,17 +457,28 @@ time-averaged power is the mean over positions, far below the leader's.
         unique = list(dict.fromkeys(slot for slot in picks if said[self.label_text(slot)] == slot))[:GROUP_LABELS]
         return np.asarray(unique, np.int64)[np.argsort(-x[unique], kind="stable")]
 
+    def push_cause(self, slope: str = "the slope") -> str:
+        """What pushes the riders along when they need less than nothing: ``slope`` (the slope, or gravity), "the
+        tailwind" or both."""
+        p = self.params
+        causes = [what for what, yes in ((slope, p.grade_pct < 0), ("the tailwind", p.headwind_ms < 0)) if yes]
+        return " and ".join(causes) or slope
+
     def label_text(self, slot: int) -> str:
         """What the label of the rider in ``slot`` says: its watts and its share of the solo rider's power in a
         line; its watts and its drag (% of the same rider alone) in a group."""
         state = self.state
         watts = float(state.pedal_w[slot])
+        coasting = float(state.brake_w[slot]) >= 0.5
+        power = f"{_watts(watts)} W coasting" if coasting else f"{_watts(watts)} W"
         if not is_line_view(self.params):
-            return f"{_watts(watts)} W · drag {100.0 * (1.0 - float(state.reduction[slot])):.0f} %"
+            return f"{power} · drag {100.0 * (1.0 - float(state.reduction[slot])):.0f} %"
         solo = state.solo_pedal_w
-        coasting = solo <= 0.0 or float(state.brake_w[slot]) >= 0.5
-        share = "coasting" if coasting else f"{100.0 * watts / solo:.0f} % of solo"
-        return f"{_watts(watts)} W · {share}"
+        if coasting:
+            return "0 W · coasting"
+        if self.params.speed_kmh == 0.0:
+            return "0 W · standing still"
+        return f"{power} · solo coasts" if solo <= 0.0 else f"{power} · {100.0 * watts / solo:.0f} % of solo"
 
     def _view_for(self, lens: Lens) -> View:
         """The view of the line for ``lens``, with room above it for the labels, which it lays out for that lens (or,
@@ -798,7 +809,7 @@ time-averaged power is the mean over positions, far below the leader's.
             f"{riders_text(p.n_riders)} · mean drag **{100 * float(np.mean(drag)):.0f} %** of a lone rider's · mean power "
             f"**{_watts(float(np.mean(total)))} W** (a lone rider {_watts(state.solo_pedal_w)} W)"
         )
-        if coasting := coasting_words(state.brake_w):
+        if coasting := coasting_words(state.brake_w, self.push_cause()):
             summary += "  \n" + coasting
         summary += framed_words(state.positions)
         return formation_table(state.positions, drag, {"Power (W)": total}, summary)
@@ -858,9 +869,9 @@ time-averaged power is the mean over positions, far below the leader's.
                 f"| {i + 1} | {state.cda_m2[i]:.3f} | {_watts(state.power.aero[i])} / {_watts(state.power.rolling[i])} / "
                 f"{_watts(state.power.climbing[i])} | **{_watts(state.pedal_w[i])}** | {100 * state.saving[i]:.1f} % |"
             )
-        coasting = coasting_words(state.brake_w)
+        coasting = coasting_words(state.brake_w, self.push_cause())
         if coasting:  # the bars stand for what is spent, which the rider's 0 W is not
-            coasting += " The bars show what the air and the tyres take, which gravity or the wind pays."
+            coasting += f" The bars show what the air and the tyres take, which {self.push_cause('gravity')} pays."
         return "\n".join(rows) + (f"\n\n{coasting}" if coasting else "")
 
     def _rotation_markdown(self) -> str:
@@ -874,9 +885,17 @@ time-averaged power is the mean over positions, far below the leader's.
                 f"In {'a bunch' if self.params.formation == 'bunch' else 'an echelon'} riders do not take turns in order: "
                 f"the mean over its places is **{_watts(mean)} W** against the leader's {_watts(lead)} W."
             )
-        if lead <= 0:
-            what = "gravity does" if self.params.grade_pct < 0 else "the tailwind does"
-            text = f"At this speed {what} the work: nobody needs to pedal, so nobody needs shelter."
+        hardest = float(np.max(self.state.pedal_w))
+        if self.params.speed_kmh == 0.0:
+            text = "Standing still, nobody pedals and nobody needs shelter."
+        elif hardest < 0.5:
+            text = f"At this speed {self.push_cause('gravity')} does the work: nobody needs to pedal, so nobody needs shelter."
+        elif hardest >= lead + 0.5:  # a tailwind faster than the riders: shelter takes its push away too
+            leader = "The leader coasts" if lead < 0.5 else f"The leader pedals {lead:.0f} W"
+            text = (
+                f"{leader}: the tailwind pushes it along. The riders behind it are sheltered from that push too and "
+                f"pedal up to {hardest:.0f} W, so the lead is the easy turn here."
+            )
         elif not self.params.drafting:
             text = f"Drafting is off: every rider rides in clean air at the leader's {lead:.0f} W, so rotating saves nothing."
         elif mean >= 0.995 * lead:

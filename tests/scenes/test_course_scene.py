@@ -592,6 +592,25 @@ def _place_watts_reference(mode: CourseMode, at_m: float) -> tuple[np.ndarray, n
     return here, mean
 
 
+@pytest.mark.parametrize(("shape", "n"), [("Bunch (peloton)", 121), ("Single file", 8), ("Single file", 1)])
+def test_the_leader_readout_gives_the_groups_power_and_the_leaders_place(mode: CourseMode, shape: str, n: int) -> None:
+    # The failing input (a review): at 13.15 km "Leader at 13.15 km … 250 W" while the table's row 1 said 277 W:
+    # the 250 W was the group's.
+    scene = mode.scene
+    scene.controls["formation"].value, scene.controls["n_riders"].value = shape, n
+    mode.scrub.value = 13.15
+    assert mode.state is not None
+    ride = mode.state.ride
+    group = float(ride.power_w[int(np.searchsorted(ride.distance_m, mode.leader_distance_m(), side="right")) - 1])
+    here, _ = _place_watts_reference(mode, mode.leader_distance_m())
+    text = mode.now.content
+    if n == 1:
+        assert f", {group:.0f} W" in text and "place" not in text
+    else:
+        assert f"the group's {group:.0f} W" in text and f"the leader's place {float(here[0]):.0f} W" in text
+        assert f"**{round(float(here[0]))}**" in scene.table.content.splitlines()[4]
+
+
 def test_at_a_standing_start_every_place_needs_the_groups_power(mode: CourseMode) -> None:
     # The failing input (a review): at 0.00 km and 0.0 km/h a bunch of 121's places read 247–257 W, the aero term of
     # the first segment's mean speed; standing still, no place has any air to push.

@@ -30,6 +30,7 @@ from scenes.peloton import (
     compute_line,
 )
 from scenes.peloton.course_model import FRAMED_LENGTH_M
+from scenes.peloton.legend import legend_html, power_range
 from scenes.peloton.meshes import rider_head_m
 from scenes.peloton.model import FORMATION_FROM_LABEL, formation_positions
 from scenes.peloton.scene import TEXT_PX_PER_CHAR
@@ -521,20 +522,49 @@ def test_a_tailwind_that_pushes_the_riders_is_not_called_a_slope(scene: PelotonS
     c = scene.controls
     c["headwind_ms"].value, c["crosswind_ms"].value, c["speed_kmh"].value = -15.0, 8.0, 20.0
     assert float(scene.state.solo.total) < 0
-    assert "Downhill" not in scene.rotation.content and "gravity" not in scene.rotation.content
-    assert scene.rotation.content.startswith("At this speed the tailwind does the work")
-    assert "the slope or the tailwind gives more" in scene.table.content
-    c["headwind_ms"].value, c["grade_pct"].value = 0.0, -15.0
+    assert "slope" not in scene.rotation.content and "gravity" not in scene.rotation.content
+    assert "the tailwind gives more than this speed takes" in scene.table.content
+    assert "slope" not in scene.table.content and "gravity" not in scene.table.content
+    c["headwind_ms"].value, c["crosswind_ms"].value, c["grade_pct"].value = 0.0, 0.0, -15.0
     assert scene.rotation.content.startswith("At this speed gravity does the work")
+    assert "the slope gives more" in scene.table.content and "tailwind" not in scene.table.content
 
 
-def test_with_drafting_off_the_rotation_line_says_rotating_saves_nothing(scene: PelotonScene) -> None:
-    scene.controls["drafting"].value = False
-    text = scene.rotation.content
-    assert text.startswith("Drafting is off") and "saves nothing" in text
-    assert "teams rotate" not in text and "0 % less" not in text
-    scene.controls["drafting"].value = True
-    assert "the reason teams rotate" in scene.rotation.content
+def test_riders_sheltered_from_a_tailwinds_push_pedal_and_are_not_called_coasting(scene: PelotonScene) -> None:
+    # The failing input (a second review): 4 riders, 20 km/h, 10 m/s tailwind: the leader coasts, the riders behind
+    # get less of the push and pedal 4–6 W, but every label said "coasting", the summary "1 rider coast" and the
+    # rotation "nobody needs to pedal".
+    c = scene.controls
+    c["speed_kmh"].value, c["headwind_ms"].value = 20.0, -10.0
+    need = np.asarray(scene.state.power.total)
+    assert need[0] <= -0.5 and np.all(need[1:] >= 0.5)  # the kernel's: the leader is pushed, the others pedal
+    assert scene.label_text(0) == "0 W · coasting"
+    for i in range(1, 4):
+        assert scene.label_text(i) == f"{round(float(need[i]))} W · solo coasts"
+    assert "1 rider coasts at 0 W" in scene.table.content and "it brakes off" in scene.table.content
+    assert scene.rotation.content.startswith("The leader coasts: the tailwind pushes it along")
+    assert f"pedal up to {float(np.max(need)):.0f} W" in scene.rotation.content
+
+
+def test_riders_standing_still_are_not_coasting_and_no_wind_does_the_work(scene: PelotonScene) -> None:
+    # The failing input (a second review): speed 0 in a 10 m/s headwind read "At this speed the tailwind does the
+    # work" and every rider "coasting".
+    c = scene.controls
+    c["speed_kmh"].value, c["headwind_ms"].value = 0.0, 10.0
+    assert all(scene.label_text(i) == "0 W · standing still" for i in range(4))
+    assert scene.rotation.content.startswith("Standing still") and "tailwind" not in scene.rotation.content
+    assert "coast" not in scene.table.content
+
+
+def test_a_legend_of_small_powers_never_reads_below_zero() -> None:
+    # The failing input (a second review): a bunch of 20 at 20 km/h in a 15 m/s tailwind pedals 0–2 W, and the
+    # legend's 10 W minimum span read "-4 W, -1 W, 1 W, 4 W, 6 W".
+    for watts in (np.array([0.0, 0.5, 2.0]), np.array([0.0, 0.0]), np.array([3.0, 4.0]), np.array([0.0, 9.0])):
+        low, high = power_range(watts)
+        assert low >= 0.0 and high - low >= 10.0 - 1e-12 and low <= watts.min() and high >= watts.max()
+        assert not re.search(r">-\d", legend_html(watts, ""))
+    low, high = power_range(np.array([250.0, 251.0]))  # away from zero the span stays centred
+    assert (low, high) == pytest.approx((245.5, 255.5))
 
 
 def test_downhill_readouts_say_coasting_not_negative_watts(scene: PelotonScene) -> None:
@@ -552,31 +582,53 @@ def test_downhill_readouts_say_coasting_not_negative_watts(scene: PelotonScene) 
 
 
 @pytest.mark.parametrize(("formation", "n"), [("Single file", 4), ("Bunch (peloton)", 121), ("Echelon", 20)])
-@pytest.mark.parametrize("grade", [-15.0, -8.0, -3.0, 0.0, 6.0])
-def test_no_rider_pedals_negative_watts_and_a_coasting_rider_says_what_it_brakes(
-    scene: PelotonScene, formation: str, n: int, grade: float
+@pytest.mark.parametrize(
+    ("grade", "headwind", "speed"),
+    [
+        (-15.0, 0.0, 40.0),
+        (-8.0, 0.0, 40.0),
+        (-3.0, 0.0, 40.0),
+        (0.0, 0.0, 40.0),
+        (6.0, 0.0, 40.0),
+        (0.0, -15.0, 20.0),
+        (0.0, -10.0, 20.0),
+        (0.0, -15.0, 40.0),
+        (-3.0, -5.0, 30.0),
+        (0.0, 10.0, 0.0),
+    ],
+)
+def test_no_rider_pedals_negative_watts_and_a_coasting_rider_says_what_it_brakes_and_why(
+    scene: PelotonScene, formation: str, n: int, grade: float, headwind: float, speed: float
 ) -> None:
-    """Down a slope at a set speed a sheltered rider would need less than nothing: it coasts and brakes, and every
-    readout (labels, table, summary, colour scale) says 0 W and the braking, as course mode does."""
+    """Down a slope, or pushed by a tailwind, at a set speed a rider may need less than nothing: it coasts and brakes,
+    and every readout (labels, table, summary, colour scale) says 0 W, the braking and its cause, as course mode
+    does; a rider that still pedals (sheltered from a tailwind's push) is not called coasting."""
     c = scene.controls
-    c["formation"].value, c["n_riders"].value, c["grade_pct"].value = formation, n, grade
+    c["formation"].value, c["n_riders"].value = formation, n
+    c["grade_pct"].value, c["headwind_ms"].value, c["speed_kmh"].value = grade, headwind, speed
     need = np.asarray(scene.state.power.total)  # what the speed needs of each rider (W), the kernel's
     assert len(need) == n
+    labels = [scene.label_text(i) for i in range(n)]
     # Every watt figure the panel and the labels show is a whole, non-negative number.
-    shown = scene.table.content + scene.legend.content + " ".join(scene.label_text(i) for i in range(n))
+    shown = scene.table.content + scene.legend.content + " ".join(labels)
     assert not re.search(r"(?<![\w/])-\d+ W|\*\*-\d", shown), shown
     braking = -need[need <= -0.5]
-    words = re.search(r"coasts? at 0 W: .* brake off (\d+)(?:–(\d+))? W", scene.table.content)
+    words = re.search(r"coasts? at 0 W: (.*) gives more .* brakes? off (\d+)(?:–(\d+))? W", scene.table.content)
     if braking.size == 0:
         assert words is None
         assert "coast" not in scene.table.content
     else:
         assert words is not None, scene.table.content
-        low, high = int(words[1]), int(words[2] or words[1])
+        low, high = int(words[2]), int(words[3] or words[2])
         assert (low, high) == (round(float(braking.min())), round(float(braking.max())))
+        assert ("the slope" in words[1]) == (grade < 0) and ("the tailwind" in words[1]) == (headwind < 0)
     for i in range(n):
         expected = max(round(float(need[i])), 0)
-        assert scene.label_text(i).startswith(f"{expected} W"), (i, scene.label_text(i), need[i])
+        assert labels[i].startswith(f"{expected} W"), (i, labels[i], need[i])
+        assert ("coasting" in labels[i]) == (need[i] <= -0.5), (i, labels[i], need[i])
+    rotation = scene.rotation.content
+    assert grade < 0 or ("slope" not in rotation and "gravity" not in rotation), rotation
+    assert headwind < 0 or "tailwind" not in rotation, rotation
 
 
 # ------------------------------------------------------------------------------------------------ formations
