@@ -18,9 +18,10 @@ def watts_text(value: float) -> str:
     return f"{round(float(value))}"  # an int: round(-0.4) is 0, not -0.0
 
 
-def coasting_words(brake_w: np.ndarray, cause: str) -> str:
+def coasting_words(brake_w: np.ndarray, cause: str, plural: bool = False) -> str:
     """A sentence for riders who coast (``brake_w``: (n,) watts each brakes off to hold the speed, 0 for those who
-    pedal; ``cause``: what pushes them, "the slope", "the tailwind" or both), or "" when no rider coasts."""
+    pedal; ``cause``: what pushes them, "the slope", "the tailwind" or both, ``plural`` for both), or "" when no rider
+    coasts."""
     braking = np.asarray(brake_w, np.float64)
     braking = braking[braking >= 0.5]
     if braking.size == 0:
@@ -32,7 +33,8 @@ def coasting_words(brake_w: np.ndarray, cause: str) -> str:
     else:
         one = braking.size == 1
         who, verb, they = riders_text(braking.size), "coasts" if one else "coast", "it brakes" if one else "they brake"
-    return f"{who} {verb} at 0 W: {cause} gives more than this speed takes, and {they} off {amount} to hold it."
+    give = "give" if plural else "gives"
+    return f"{who} {verb} at 0 W: {cause} {give} more than this speed takes, and {they} off {amount} to hold it."
 
 
 def power_range(watts: np.ndarray) -> tuple[float, float]:

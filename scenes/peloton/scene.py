@@ -457,12 +457,15 @@ time-averaged power is the mean over positions, far below the leader's.
         unique = list(dict.fromkeys(slot for slot in picks if said[self.label_text(slot)] == slot))[:GROUP_LABELS]
         return np.asarray(unique, np.int64)[np.argsort(-x[unique], kind="stable")]
 
-    def push_cause(self, slope: str = "the slope") -> str:
-        """What pushes the riders along when they need less than nothing: ``slope`` (the slope, or gravity), "the
-        tailwind" or both."""
-        p = self.params
-        causes = [what for what, yes in ((slope, p.grade_pct < 0), ("the tailwind", p.headwind_ms < 0)) if yes]
-        return " and ".join(causes) or slope
+    def push_cause(self, slope: str = "the slope") -> tuple[str, bool]:
+        """(what, plural): what gives the riders power when they need less than nothing, from the solo rider's own
+        terms: ``slope`` (the slope, or gravity) where its climbing term is negative, "the tailwind" where its air term
+        is (a tailwind faster than the rider), or both (plural: the verb agrees)."""
+        solo = self.state.solo
+        causes = [
+            what for what, yes in ((slope, float(solo.climbing) < 0.0), ("the tailwind", float(solo.aero) < 0.0)) if yes
+        ]
+        return " and ".join(causes) or slope, len(causes) > 1
 
     def label_text(self, slot: int) -> str:
         """What the label of the rider in ``slot`` says: its watts and its share of the solo rider's power in a
@@ -478,7 +481,11 @@ time-averaged power is the mean over positions, far below the leader's.
             return "0 W · coasting"
         if self.params.speed_kmh == 0.0:
             return "0 W · standing still"
-        return f"{power} · solo coasts" if solo <= 0.0 else f"{power} · {100.0 * watts / solo:.0f} % of solo"
+        if solo <= 0.0:
+            return f"{power} · solo coasts"
+        if watts > solo + 0.5:  # sheltered from a tailwind's push: more than alone, no share to give
+            return f"{power} · solo {_watts(solo)} W"
+        return f"{power} · {100.0 * watts / solo:.0f} % of solo"
 
     def _view_for(self, lens: Lens) -> View:
         """The view of the line for ``lens``, with room above it for the labels, which it lays out for that lens (or,
@@ -809,7 +816,7 @@ time-averaged power is the mean over positions, far below the leader's.
             f"{riders_text(p.n_riders)} · mean drag **{100 * float(np.mean(drag)):.0f} %** of a lone rider's · mean power "
             f"**{_watts(float(np.mean(total)))} W** (a lone rider {_watts(state.solo_pedal_w)} W)"
         )
-        if coasting := coasting_words(state.brake_w, self.push_cause()):
+        if coasting := coasting_words(state.brake_w, *self.push_cause()):
             summary += "  \n" + coasting
         summary += framed_words(state.positions)
         return formation_table(state.positions, drag, {"Power (W)": total}, summary)
@@ -867,12 +874,23 @@ time-averaged power is the mean over positions, far below the leader's.
         for i in range(self.params.n_riders):
             rows.append(
                 f"| {i + 1} | {state.cda_m2[i]:.3f} | {_watts(state.power.aero[i])} / {_watts(state.power.rolling[i])} / "
-                f"{_watts(state.power.climbing[i])} | **{_watts(state.pedal_w[i])}** | {100 * state.saving[i]:.1f} % |"
+                f"{_watts(state.power.climbing[i])} | **{_watts(state.pedal_w[i])}** | {self._saving_text(i)} |"
             )
-        coasting = coasting_words(state.brake_w, self.push_cause())
+        coasting = coasting_words(state.brake_w, *self.push_cause())
         if coasting:  # the bars stand for what is spent, which the rider's 0 W is not
-            coasting += f" The bars show what the air and the tyres take, which {self.push_cause('gravity')} pays."
+            payer, both = self.push_cause("gravity")
+            taken = "the tyres take" if float(state.solo.aero) < 0.0 else "the air and the tyres take"
+            coasting += f" The bars show what {taken}, which {payer} {'pay' if both else 'pays'}."
         return "\n".join(rows) + (f"\n\n{coasting}" if coasting else "")
+
+    def _saving_text(self, slot: int) -> str:
+        """The Saving cell of a rider: its saving against the solo rider (%), or what it pedals more (a rider
+        sheltered from a tailwind's push needs more than alone)."""
+        state = self.state
+        extra = float(state.pedal_w[slot]) - state.solo_pedal_w
+        if state.solo_pedal_w > 0.0 and extra > 0.5:
+            return f"none ({extra:.0f} W more)"
+        return f"{100 * float(state.saving[slot]):.1f} %"
 
     def _rotation_markdown(self) -> str:
         n = self.params.n_riders
@@ -889,8 +907,12 @@ time-averaged power is the mean over positions, far below the leader's.
         if self.params.speed_kmh == 0.0:
             text = "Standing still, nobody pedals and nobody needs shelter."
         elif hardest < 0.5:
-            text = f"At this speed {self.push_cause('gravity')} does the work: nobody needs to pedal, so nobody needs shelter."
-        elif hardest >= lead + 0.5:  # a tailwind faster than the riders: shelter takes its push away too
+            payer, both = self.push_cause("gravity")
+            text = (
+                f"At this speed {payer} {'do' if both else 'does'} the work: nobody needs to pedal, so nobody needs "
+                "shelter."
+            )
+        elif hardest >= lead + 0.5 and float(self.state.solo.aero) < 0.0:  # a tailwind faster than the riders
             leader = "The leader coasts" if lead < 0.5 else f"The leader pedals {lead:.0f} W"
             text = (
                 f"{leader}: the tailwind pushes it along. The riders behind it are sheltered from that push too and "
@@ -900,8 +922,8 @@ time-averaged power is the mean over positions, far below the leader's.
             text = f"Drafting is off: every rider rides in clean air at the leader's {lead:.0f} W, so rotating saves nothing."
         elif mean >= 0.995 * lead:
             text = (
-                f"Nobody rides in shelter here (the wind takes the wakes to the side of the line): every rider works "
-                f"about as hard as the leader, {lead:.0f} W, so rotating saves nothing."
+                f"Nobody gains from shelter here{self._no_shelter_reason()}: every rider works about as hard as the "
+                f"leader, {lead:.0f} W, or harder, so rotating saves nothing."
             )
         else:
             text = (
@@ -915,6 +937,19 @@ time-averaged power is the mean over positions, far below the leader's.
             else:
                 text += f"  \nTime-averaged so far: {averages.min():.0f}–{averages.max():.0f} W across the {n} riders"
         return text
+
+    def _no_shelter_reason(self) -> str:
+        """Why no rider saves power behind another, in parentheses (a crosswind, riders side by side, little air to
+        push through), or "" when none of these says it."""
+        p, solo = self.params, self.state.solo
+        spent = max(float(solo.aero), 0.0) + float(solo.rolling) + max(float(solo.climbing), 0.0)
+        if p.crosswind_ms != 0.0:
+            return " (the crosswind takes the wakes to the side of the line)"
+        if p.formation == "double" and p.n_riders == 2:
+            return " (the two ride side by side: nobody rides behind)"
+        if spent <= 0.0 or max(float(solo.aero), 0.0) < 0.05 * spent:
+            return " (there is little air drag to shelter from at this air speed)"
+        return ""
 
     def _speed_markdown(self) -> str:
         p = self.params

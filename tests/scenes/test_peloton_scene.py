@@ -546,6 +546,76 @@ def test_riders_sheltered_from_a_tailwinds_push_pedal_and_are_not_called_coastin
     assert f"pedal up to {float(np.max(need)):.0f} W" in scene.rotation.content
 
 
+# The failing inputs of a third review: (formation, riders, speed km/h, grade %, headwind, crosswind), what the
+# rotation sentence must say and what no readout may say.
+THIRD_REVIEW = [
+    ("Two abreast", 4, 40.0, 0.0, 0.0, 8.0, "Rotating evenly", "tailwind"),
+    ("Two abreast", 2, 80.0, 0.0, 10.0, -10.0, "the crosswind takes the wakes", "tailwind"),
+    ("Two abreast", 2, 40.0, 0.0, 0.0, 0.0, "side by side", "wind"),
+    ("Single file", 4, 5.0, 20.0, 0.0, 0.0, "little air drag", "wind"),
+    ("Single file", 2, 20.0, 0.0, -5.0, 0.0, "", "crosswind"),
+    ("Single file", 2, 40.0, -3.0, -5.0, 8.0, "", "tailwind"),
+    ("Single file", 4, 20.0, -8.0, -15.0, 0.0, "gravity and the tailwind do the work", "does the work"),
+]
+
+
+@pytest.mark.parametrize(("formation", "n", "speed", "grade", "head", "cross", "says", "never"), THIRD_REVIEW)
+def test_the_rotation_sentence_gives_the_cause_the_inputs_have(
+    scene: PelotonScene,
+    formation: str,
+    n: int,
+    speed: float,
+    grade: float,
+    head: float,
+    cross: float,
+    says: str,
+    never: str,
+) -> None:
+    # A third review: "the tailwind pushes it along" with no tailwind (two abreast in a crosswind), "the wind takes
+    # the wakes to the side" with no wind (two side by side; 5 km/h up 20 %), "gravity and the tailwind does".
+    c = scene.controls
+    c["formation"].value, c["n_riders"].value = formation, n
+    c["speed_kmh"].value, c["grade_pct"].value, c["headwind_ms"].value, c["crosswind_ms"].value = (
+        speed,
+        grade,
+        head,
+        cross,
+    )
+    rotation = scene.rotation.content
+    assert says in rotation, rotation
+    assert never not in rotation, rotation
+    if "tailwind" in never:  # no readout credits a tailwind that only lowers the drag, or none at all
+        assert "tailwind" not in scene.table.content
+    for wrong in (
+        "gravity and the tailwind does",
+        "the tailwind gives more",
+        "and the tailwind gives",
+        "tailwind pays",
+    ):
+        if " and " in rotation + scene.table.content:
+            assert wrong not in rotation + scene.table.content
+
+
+def test_riders_a_tailwind_pushes_less_than_the_solo_rider_say_what_alone_would_pedal(scene: PelotonScene) -> None:
+    # A third review: 8 riders in a 15 m/s tailwind at 40 km/h read "18 W · 904 % of solo" and saved "−804.4 %":
+    # sheltered, they get less of the push than a rider alone and pedal more.
+    c = scene.controls
+    c["n_riders"].value, c["headwind_ms"].value = 8, -15.0
+    solo = scene.state.solo_pedal_w
+    assert solo > 0
+    for i in range(8):
+        text = scene.label_text(i)
+        watts = float(scene.state.pedal_w[i])
+        if watts > solo + 0.5:
+            assert text == f"{round(watts)} W · solo {round(solo)} W", text
+        else:
+            share = re.search(r"(\d+) % of solo", text)
+            assert share is not None and int(share[1]) <= 100, text
+    table = scene.table.content
+    assert not re.search(r"-\d+(\.\d)? %", table), table
+    assert "W more)" in table
+
+
 def test_riders_standing_still_are_not_coasting_and_no_wind_does_the_work(scene: PelotonScene) -> None:
     # The failing input (a second review): speed 0 in a 10 m/s headwind read "At this speed the tailwind does the
     # work" and every rider "coasting".
@@ -621,14 +691,23 @@ def test_no_rider_pedals_negative_watts_and_a_coasting_rider_says_what_it_brakes
         assert words is not None, scene.table.content
         low, high = int(words[2]), int(words[3] or words[2])
         assert (low, high) == (round(float(braking.min())), round(float(braking.max())))
-        assert ("the slope" in words[1]) == (grade < 0) and ("the tailwind" in words[1]) == (headwind < 0)
+        # The cause is what gives the solo rider power (the kernel's terms): the slope where climbing is negative,
+        # the tailwind where the air term is (a tailwind faster than the rider; a slower one only lowers the drag).
+        solo = scene.state.solo
+        assert ("the slope" in words[1]) == (float(solo.climbing) < 0) and ("the tailwind" in words[1]) == (
+            float(solo.aero) < 0
+        ), (words[1], solo)
+        assert ("give more" in words[0]) == (" and " in words[1])
     for i in range(n):
         expected = max(round(float(need[i])), 0)
         assert labels[i].startswith(f"{expected} W"), (i, labels[i], need[i])
         assert ("coasting" in labels[i]) == (need[i] <= -0.5), (i, labels[i], need[i])
     rotation = scene.rotation.content
-    assert grade < 0 or ("slope" not in rotation and "gravity" not in rotation), rotation
-    assert headwind < 0 or "tailwind" not in rotation, rotation
+    solo = scene.state.solo
+    assert float(solo.climbing) < 0 or ("slope" not in rotation and "gravity" not in rotation), rotation
+    assert float(solo.aero) < 0 or "tailwind" not in rotation, rotation
+    assert c["crosswind_ms"].value != 0 or "crosswind" not in rotation, rotation
+    assert " and the tailwind does " not in rotation and " and the tailwind pays" not in scene.table.content
 
 
 # ------------------------------------------------------------------------------------------------ formations
