@@ -483,7 +483,7 @@ time-averaged power is the mean over positions, far below the leader's.
             return "0 W · standing still"
         if solo <= 0.0:
             return f"{power} · solo coasts"
-        if watts > solo + 0.5:  # sheltered from a tailwind's push: more than alone, no share to give
+        if round(100.0 * watts / solo) > 100:  # sheltered from a tailwind's push: more than alone, no share to give
             return f"{power} · solo {_watts(solo)} W"
         return f"{power} · {100.0 * watts / solo:.0f} % of solo"
 
@@ -879,8 +879,18 @@ time-averaged power is the mean over positions, far below the leader's.
         coasting = coasting_words(state.brake_w, *self.push_cause())
         if coasting:  # the bars stand for what is spent, which the rider's 0 W is not
             payer, both = self.push_cause("gravity")
-            taken = "the tyres take" if float(state.solo.aero) < 0.0 else "the air and the tyres take"
-            coasting += f" The bars show what {taken}, which {payer} {'pay' if both else 'pays'}."
+            solo = state.solo
+            parts = [
+                what
+                for what, yes in (
+                    ("the air", float(solo.aero) > 0.0),
+                    ("the tyres", True),
+                    ("the climb", float(solo.climbing) > 0.0),
+                )
+                if yes
+            ]
+            taken = " and ".join([", ".join(parts[:-1]), parts[-1]] if len(parts) > 1 else parts)
+            coasting += f" The bars show what {taken} take, which {payer} {'pay' if both else 'pays'}."
         return "\n".join(rows) + (f"\n\n{coasting}" if coasting else "")
 
     def _saving_text(self, slot: int) -> str:
@@ -888,9 +898,10 @@ time-averaged power is the mean over positions, far below the leader's.
         sheltered from a tailwind's push needs more than alone)."""
         state = self.state
         extra = float(state.pedal_w[slot]) - state.solo_pedal_w
-        if state.solo_pedal_w > 0.0 and extra > 0.5:
-            return f"none ({extra:.0f} W more)"
-        return f"{100 * float(state.saving[slot]):.1f} %"
+        saving = 100.0 * float(state.saving[slot])
+        if state.solo_pedal_w > 0.0 and round(saving, 1) < 0.0:
+            return f"none ({extra:.1f} W more)" if extra < 1.0 else f"none ({extra:.0f} W more)"
+        return f"{max(saving, 0.0):.1f} %"  # never "-0.0 %"
 
     def _rotation_markdown(self) -> str:
         n = self.params.n_riders
@@ -918,6 +929,8 @@ time-averaged power is the mean over positions, far below the leader's.
                 f"{leader}: the tailwind pushes it along. The riders behind it are sheltered from that push too and "
                 f"pedal up to {hardest:.0f} W, so the lead is the easy turn here."
             )
+        elif self.params.n_riders <= self._rotation_width():
+            text = f"The two ride side by side at the front: there is nobody to rotate with; each pedals about {mean:.0f} W."
         elif not self.params.drafting:
             text = f"Drafting is off: every rider rides in clean air at the leader's {lead:.0f} W, so rotating saves nothing."
         elif mean >= 0.995 * lead:
@@ -926,9 +939,11 @@ time-averaged power is the mean over positions, far below the leader's.
                 f"leader, {lead:.0f} W, or harder, so rotating saves nothing."
             )
         else:
+            less = 100 * (1 - mean / lead)
+            why = "the reason teams rotate" if less >= 5.0 else "little to gain from rotating here"
             text = (
                 f"Rotating evenly, each rider averages **{mean:.0f} W** against the leader's {lead:.0f} W "
-                f"({100 * (1 - mean / lead):.0f} % less): the reason teams rotate."
+                f"({less:.0f} % less): {why}."
             )
         if self.params.rotate and self._ridden_s > 0:
             averages = self._energy_j[:n] / self._ridden_s
@@ -939,16 +954,20 @@ time-averaged power is the mean over positions, far below the leader's.
         return text
 
     def _no_shelter_reason(self) -> str:
-        """Why no rider saves power behind another, in parentheses (a crosswind, riders side by side, little air to
-        push through), or "" when none of these says it."""
+        """Why no rider saves power behind another, in parentheses, the first that holds: no air drag or little of it
+        (a tailwind as fast as the riders, a slow climb), two riders side by side, a crosswind that takes the wakes
+        aside; "" when none of these says it."""
         p, solo = self.params, self.state.solo
-        spent = max(float(solo.aero), 0.0) + float(solo.rolling) + max(float(solo.climbing), 0.0)
-        if p.crosswind_ms != 0.0:
-            return " (the crosswind takes the wakes to the side of the line)"
+        aero = float(solo.aero)
+        spent = max(aero, 0.0) + float(solo.rolling) + max(float(solo.climbing), 0.0)
+        if aero <= 0.0:
+            return " (the tailwind is as fast as the riders or faster: there is no air drag to shelter from)"
+        if aero < 0.05 * spent:
+            return " (there is little air drag to shelter from at this air speed)"
         if p.formation == "double" and p.n_riders == 2:
             return " (the two ride side by side: nobody rides behind)"
-        if spent <= 0.0 or max(float(solo.aero), 0.0) < 0.05 * spent:
-            return " (there is little air drag to shelter from at this air speed)"
+        if p.crosswind_ms != 0.0:
+            return " (the crosswind takes the wakes to the side of the group)"
         return ""
 
     def _speed_markdown(self) -> str:

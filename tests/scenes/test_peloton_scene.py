@@ -550,7 +550,13 @@ def test_riders_sheltered_from_a_tailwinds_push_pedal_and_are_not_called_coastin
 # rotation sentence must say and what no readout may say.
 THIRD_REVIEW = [
     ("Two abreast", 4, 40.0, 0.0, 0.0, 8.0, "Rotating evenly", "tailwind"),
-    ("Two abreast", 2, 80.0, 0.0, 10.0, -10.0, "the crosswind takes the wakes", "tailwind"),
+    ("Two abreast", 2, 80.0, 0.0, 10.0, -10.0, "side by side at the front", "tailwind"),
+    # ... and of a fourth (a sweep of every input): the crosswind blamed where the air or the pair was the reason, a
+    # pair that never rotates told it rotates.
+    ("Single file", 2, 40.0, 0.0, -15.0, -10.0, "tailwind", "crosswind"),
+    ("Two abreast", 2, 40.0, -3.0, 0.0, -10.0, "side by side", "crosswind"),
+    ("Two abreast", 2, 5.0, 20.0, -15.0, -10.0, "side by side at the front", "Rotating evenly"),
+    ("Single file", 4, 20.0, 8.0, 0.0, 0.0, "little to gain from rotating here", "the reason teams rotate"),
     ("Two abreast", 2, 40.0, 0.0, 0.0, 0.0, "side by side", "wind"),
     ("Single file", 4, 5.0, 20.0, 0.0, 0.0, "little air drag", "wind"),
     ("Single file", 2, 20.0, 0.0, -5.0, 0.0, "", "crosswind"),
@@ -614,6 +620,39 @@ def test_riders_a_tailwind_pushes_less_than_the_solo_rider_say_what_alone_would_
     table = scene.table.content
     assert not re.search(r"-\d+(\.\d)? %", table), table
     assert "W more)" in table
+
+
+@pytest.mark.parametrize(
+    ("n", "speed", "grade", "head", "cross"),
+    [(2, 5.0, 0.0, -5.0, 0.0), (2, 5.0, 8.0, -5.0, 0.0), (2, 40.0, 0.0, -15.0, -10.0), (8, 40.0, 0.0, -15.0, 0.0)],
+)
+def test_no_share_of_solo_above_100_and_no_saving_below_0(
+    scene: PelotonScene, n: int, speed: float, grade: float, head: float, cross: float
+) -> None:
+    # A fourth review: a leader pedalling 1.0 W against the solo rider's 0.92 W read "1 W · 109 % of solo" and saved
+    # "-9.4 %"; elsewhere "-0.0 %".
+    c = scene.controls
+    c["n_riders"].value = n
+    c["speed_kmh"].value, c["grade_pct"].value, c["headwind_ms"].value, c["crosswind_ms"].value = (
+        speed,
+        grade,
+        head,
+        cross,
+    )
+    for i in range(n):
+        share = re.search(r"(\d+) % of solo", scene.label_text(i))
+        assert share is None or int(share[1]) <= 100, scene.label_text(i)
+    assert not re.search(r"\| -\d+(\.\d)? % \|", scene.table.content), scene.table.content
+
+
+def test_the_bars_sentence_names_every_bar_it_stacks(scene: PelotonScene) -> None:
+    # A fourth review: up 1 % in a 15 m/s tailwind at 5 km/h the riders coast and the bars stack the tyres and the
+    # climb, but the sentence said "what the tyres take".
+    c = scene.controls
+    c["n_riders"].value, c["speed_kmh"].value, c["grade_pct"].value, c["headwind_ms"].value = 2, 5.0, 1.0, -15.0
+    solo = scene.state.solo
+    assert float(solo.aero) < 0 < float(solo.climbing) and float(scene.state.brake_w.max()) >= 0.5
+    assert "The bars show what the tyres and the climb take, which the tailwind pays." in scene.table.content
 
 
 def test_riders_standing_still_are_not_coasting_and_no_wind_does_the_work(scene: PelotonScene) -> None:
