@@ -483,7 +483,9 @@ time-averaged power is the mean over positions, far below the leader's.
             return "0 W · standing still"
         if solo <= 0.0:
             return f"{power} · solo coasts"
-        if round(100.0 * watts / solo) > 100:  # sheltered from a tailwind's push: more than alone, no share to give
+        if (
+            round(100.0 * float(state.saving[slot]), 1) < 0.0
+        ):  # more than alone (a tailwind's push lost): as Saving says
             return f"{power} · solo {_watts(solo)} W"
         return f"{power} · {100.0 * watts / solo:.0f} % of solo"
 

@@ -624,7 +624,13 @@ def test_riders_a_tailwind_pushes_less_than_the_solo_rider_say_what_alone_would_
 
 @pytest.mark.parametrize(
     ("n", "speed", "grade", "head", "cross"),
-    [(2, 5.0, 0.0, -5.0, 0.0), (2, 5.0, 8.0, -5.0, 0.0), (2, 40.0, 0.0, -15.0, -10.0), (8, 40.0, 0.0, -15.0, 0.0)],
+    [
+        (2, 5.0, 0.0, -5.0, 0.0),
+        (2, 5.0, 8.0, -5.0, 0.0),
+        (2, 40.0, 0.0, -15.0, -10.0),
+        (8, 40.0, 0.0, -15.0, 0.0),
+        (2, 40.0, 8.0, -15.0, 0.0),  # "715 W · 100 % of solo" beside "none (0.7 W more)"
+    ],
 )
 def test_no_share_of_solo_above_100_and_no_saving_below_0(
     scene: PelotonScene, n: int, speed: float, grade: float, head: float, cross: float
@@ -639,9 +645,12 @@ def test_no_share_of_solo_above_100_and_no_saving_below_0(
         head,
         cross,
     )
+    rows = scene.table.content.splitlines()[2 : 2 + n]
     for i in range(n):
         share = re.search(r"(\d+) % of solo", scene.label_text(i))
         assert share is None or int(share[1]) <= 100, scene.label_text(i)
+        # The label and the Saving cell agree: a rider that pedals more than alone says so in both.
+        assert ("W more)" in rows[i]) == (" · solo " in scene.label_text(i)), (rows[i], scene.label_text(i))
     assert not re.search(r"\| -\d+(\.\d)? % \|", scene.table.content), scene.table.content
 
 
