@@ -15,6 +15,7 @@ from dataclasses import field
 from typing import Literal
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from kernels import course as course_kernel
 from kernels import cycling
@@ -241,15 +242,21 @@ def compute_course(route: course_kernel.Course, p: CourseParams, line: PelotonPa
     )
 
 
+def _per_m2(speed_ms: ArrayLike, headwind_ms: ArrayLike, density: ArrayLike, efficiency: float) -> np.ndarray:
+    """Pedal power (W) each m² of drag area costs: ½·ρ·(v + w)·|v + w|·v / η (Martin et al. 1998's aero term; the
+    spoke drag F_w is the same for every rider, so it drops out of a difference between riders)."""
+    v = np.asarray(speed_ms, np.float64)
+    air = v + np.asarray(headwind_ms, np.float64)
+    return 0.5 * np.asarray(density, np.float64) * air * np.abs(air) * v / efficiency
+
+
 def aero_watts_per_m2(ride: course_kernel.Ride, efficiency: float) -> np.ndarray:
-    """(N − 1,) pedal power (W) each m² of drag area costs on each segment of ``ride``: ½·ρ·(v + w)·|v + w|·v / η at
-    the segment's mean speed v (its length over its time), headwind w and air density ρ (Martin et al. 1998's aero
-    term; the spoke drag F_w is the same for every rider, so it drops out of a difference between riders)."""
+    """(N − 1,) pedal power (W) each m² of drag area costs on each segment of ``ride`` (:func:`_per_m2`) at the
+    segment's mean speed v (its length over its time), headwind w and air density ρ."""
     seconds = np.diff(ride.elapsed_s)
     metres = np.diff(ride.distance_m)
     v = np.divide(metres, seconds, out=np.zeros_like(metres), where=seconds > 0.0)
-    air = v + ride.headwind_ms
-    return 0.5 * ride.air_density * air * np.abs(air) * v / efficiency
+    return _per_m2(v, ride.headwind_ms, ride.air_density, efficiency)
 
 
 def place_powers(state: CourseState, at_m: float) -> tuple[np.ndarray, np.ndarray]:
@@ -267,10 +274,9 @@ def place_powers(state: CourseState, at_m: float) -> tuple[np.ndarray, np.ndarra
     per_m2 = aero_watts_per_m2(ride, state.efficiency)
     extra = state.rider_cda_m2 * np.asarray(state.drag) - state.group_cda_m2  # (n,) m²
     segment = int(np.clip(np.searchsorted(ride.distance_m, at_m, side="right") - 1, 0, per_m2.shape[0] - 1))
-    v = float(np.interp(at_m, ride.distance_m, ride.speed_ms))
-    air = v + float(ride.headwind_ms[segment])
-    per_m2_here = 0.5 * float(ride.air_density[segment]) * air * abs(air) * v / state.efficiency
-    here = float(ride.power_w[segment]) + extra * per_m2_here
+    v = np.interp(at_m, ride.distance_m, ride.speed_ms)
+    here_per_m2 = float(_per_m2(v, ride.headwind_ms[segment], ride.air_density[segment], state.efficiency))
+    here = float(ride.power_w[segment]) + extra * here_per_m2
     seconds = np.diff(ride.elapsed_s)
     mean_per_m2 = float(np.sum(per_m2 * seconds) / max(float(np.sum(seconds)), 1e-9))
     mean = ride.average_power_w + extra * mean_per_m2

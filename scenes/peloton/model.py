@@ -151,13 +151,13 @@ class LineState:
     positions: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros((0, 2)))
     """(n, 2) where each rider rides (m): x forward, y to the left, leader first."""
 
-    @property
+    @functools.cached_property
     def pedal_w(self) -> np.ndarray:
         """(n,) what each rider pedals (W): the power the speed needs, or 0 where it needs less than nothing (down a
         slope the rider coasts and brakes off the rest, :attr:`brake_w`), as in course mode."""
         return np.maximum(np.asarray(self.power.total, np.float64), 0.0)
 
-    @property
+    @functools.cached_property
     def brake_w(self) -> np.ndarray:
         """(n,) what each rider brakes off to hold the speed (W): the power the speed needs below 0, as positive."""
         return np.maximum(-np.asarray(self.power.total, np.float64), 0.0)
@@ -167,13 +167,26 @@ class LineState:
         """What the same rider alone pedals (W), 0 where it coasts."""
         return max(float(self.solo.total), 0.0)
 
-    @property
+    @functools.cached_property
     def saving(self) -> np.ndarray:
         """(n,) fraction of the solo rider's pedalling each rider saves; zero when riding alone costs nothing."""
         solo = self.solo_pedal_w
         if solo <= 0.0:
             return np.zeros_like(self.pedal_w)
         return 1.0 - self.pedal_w / solo
+
+    @functools.cached_property
+    def pedals_more(self) -> np.ndarray:
+        """(n,) bool: the riders who pedal more than alone (to 0.1 % of the solo rider's power), as a rider sheltered
+        from a tailwind's push does; their saving is none."""
+        return (self.solo_pedal_w > 0.0) & (np.round(100.0 * self.saving, 1) < 0.0)
+
+    @property
+    def solo_spent_w(self) -> float:
+        """What the solo rider's power is spent on (W): the air where it drags, the tyres, the climb uphill. Down a
+        slope or in a tailwind faster than the rider, gravity or the wind pays part of it."""
+        solo = self.solo
+        return max(float(solo.aero), 0.0) + float(solo.rolling) + max(float(solo.climbing), 0.0)
 
 
 def compute_line(p: PelotonParams) -> LineState:

@@ -483,9 +483,7 @@ time-averaged power is the mean over positions, far below the leader's.
             return "0 W · standing still"
         if solo <= 0.0:
             return f"{power} · solo coasts"
-        if (
-            round(100.0 * float(state.saving[slot]), 1) < 0.0
-        ):  # more than alone (a tailwind's push lost): as Saving says
+        if state.pedals_more[slot]:  # a tailwind's push lost to shelter: what alone would pedal, as Saving says
             return f"{power} · solo {_watts(solo)} W"
         return f"{power} · {100.0 * watts / solo:.0f} % of solo"
 
@@ -847,10 +845,8 @@ time-averaged power is the mean over positions, far below the leader's.
     def _density_markdown(self) -> str:
         p, solo = self.params, self.state.solo
         rho = float(cycling.air_density(p.altitude_m))
-        # What the rider's power is spent on: the air (when the air drags), the tyres and the climb (uphill). Down a
-        # slope, or pushed by a tailwind, part of it is paid by gravity or the wind, not spent.
         aero, rolling, climbing = float(solo.aero), float(solo.rolling), float(solo.climbing)
-        spent = max(aero, 0.0) + rolling + max(climbing, 0.0)
+        spent = self.state.solo_spent_w
         thinner = 100 * (1 - rho / cycling.RHO_SEA_LEVEL)
         where = "sea level" if abs(thinner) < 0.05 else f"{thinner:.1f} % thinner than at sea level"
         if spent > 0 and aero + rolling + climbing > 0:
@@ -899,11 +895,10 @@ time-averaged power is the mean over positions, far below the leader's.
         """The Saving cell of a rider: its saving against the solo rider (%), or what it pedals more (a rider
         sheltered from a tailwind's push needs more than alone)."""
         state = self.state
-        extra = float(state.pedal_w[slot]) - state.solo_pedal_w
-        saving = 100.0 * float(state.saving[slot])
-        if state.solo_pedal_w > 0.0 and round(saving, 1) < 0.0:
+        if state.pedals_more[slot]:
+            extra = float(state.pedal_w[slot]) - state.solo_pedal_w
             return f"none ({extra:.1f} W more)" if extra < 1.0 else f"none ({extra:.0f} W more)"
-        return f"{max(saving, 0.0):.1f} %"  # never "-0.0 %"
+        return f"{max(100.0 * float(state.saving[slot]), 0.0):.1f} %"  # never "-0.0 %"
 
     def _rotation_markdown(self) -> str:
         n = self.params.n_riders
@@ -957,18 +952,14 @@ time-averaged power is the mean over positions, far below the leader's.
 
     def _no_shelter_reason(self) -> str:
         """Why no rider saves power behind another, in parentheses, the first that holds: no air drag or little of it
-        (a tailwind as fast as the riders, a slow climb), two riders side by side, a crosswind that takes the wakes
-        aside; "" when none of these says it."""
-        p, solo = self.params, self.state.solo
-        aero = float(solo.aero)
-        spent = max(aero, 0.0) + float(solo.rolling) + max(float(solo.climbing), 0.0)
+        (a tailwind as fast as the riders, a slow climb), a crosswind that takes the wakes aside; "" when none of
+        these says it (a pair side by side is told so before it is asked)."""
+        aero = float(self.state.solo.aero)
         if aero <= 0.0:
             return " (the tailwind is as fast as the riders or faster: there is no air drag to shelter from)"
-        if aero < 0.05 * spent:
+        if aero < 0.05 * self.state.solo_spent_w:
             return " (there is little air drag to shelter from at this air speed)"
-        if p.formation == "double" and p.n_riders == 2:
-            return " (the two ride side by side: nobody rides behind)"
-        if p.crosswind_ms != 0.0:
+        if self.params.crosswind_ms != 0.0:
             return " (the crosswind takes the wakes to the side of the group)"
         return ""
 
