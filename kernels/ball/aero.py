@@ -12,6 +12,7 @@ Texier et al. 2016 (New J. Phys. 18). The model, its assumptions and its sources
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 from kernels.ball.config import (
     C_D,
@@ -141,22 +142,44 @@ def max_stable_step(launch, kick, config):
 
 
 @compiled()
-def drag_lift(speed, rate, measured, constant_drag, constant_lift, radius, re_per_speed, re_crisis):
-    """(C_D, C_L) of a ball at ``speed`` (m/s, ≥ 0) spinning at ``rate`` = |ω| (rad/s, ≥ 0): ``constant_drag`` and
-    ``constant_lift`` when ``measured`` is 0, else the measured fits C_D(Re, S) of Goff & Carré 2010 (Eur. J. Phys. 31),
-    its drag crisis centred at Re = ``re_crisis``, and C_L(S) = 0.9·min(S, 0.3), with S = ``radius``·|ω|/max(|v|,
-    10⁻⁹ m/s) and Re = ``re_per_speed``·|v| (ρ·2r/μ). The flight's force law and the public :func:`kernels.ball.coefficients` both
-    call this one function. Plain scalars, not the settings vector: an array argument costs the flight's every force
-    evaluation a reference-count increment and decrement."""
+def drag_lift_speeds(speed2, rate, measured, constant_drag, constant_lift, radius, re_per_speed, re_crisis):
+    """(C_D·|v|, C_L·|v|) in m/s of a ball with squared speed ``speed2`` = |v|² (m²/s², ≥ 0) spinning at ``rate`` =
+    |ω| (rad/s, ≥ 0): ``constant_drag`` and ``constant_lift`` times |v| when ``measured`` is 0, else the measured fits
+    C_D(Re, S) of Goff & Carré 2010 (Eur. J. Phys. 31), its drag crisis centred at Re = ``re_crisis``, and
+    C_L(S) = 0.9·min(S, 0.3), with S = ``radius``·|ω|/|v| and Re = ``re_per_speed``·|v| (ρ·2r/μ).
+
+    The one implementation of the law: the flight's force law, the rolling ball and the public
+    :func:`kernels.ball.coefficients` (through :func:`drag_lift`) all call it. It is written for the force law, whose
+    four evaluations an RK4 step makes one after another: with the spinning fit (S ≥ 0.05) C_D·|v| =
+    0.4127·(r|ω|)^0.3056·(|v|²)^0.3472, one logarithm and one exponential of |v|² with no square root or division
+    before them, and C_L·|v| = 0.9·min(r|ω|, 0.3·|v|). Plain scalars, not the settings vector: an array argument
+    costs every evaluation a reference-count increment and decrement.
+    """
+    speed = math.sqrt(speed2)
     if measured == 0.0:
-        return constant_drag, constant_lift
-    spin_parameter = radius * rate / max(speed, 1e-9)
-    lift = 0.9 * min(spin_parameter, 0.3)  # below Asai et al. 2007's wind-tunnel values: see kernels.ball
-    if spin_parameter >= 0.05:  # the spinning fit alone (the blend's weight is 1): no exponential to evaluate
-        return 0.4127 * spin_parameter**0.3056, lift  # Goff & Carré 2010
+        return constant_drag * speed, constant_lift * speed
+    if speed2 == 0.0:
+        return 0.0, 0.0  # at rest, no force: the logarithms below need |v| > 0
+    spin_speed = radius * rate  # r|ω| (m/s): S·|v|
+    lift = 0.9 * min(spin_speed, 0.3 * speed)  # below Asai et al. 2007's wind-tunnel values: see kernels.ball
+    if spin_speed * spin_speed >= 0.0025 * speed2:  # S ≥ 0.05: the spinning fit alone (the blend's weight is 1)
+        # 0.4127·S^0.3056·|v| (Goff & Carré 2010) as one exponential (here r|ω| > 0).
+        return 0.4127 * math.exp(0.3056 * math.log(spin_speed) + 0.3472 * math.log(speed2)), lift
     arg = min((re_per_speed * speed - re_crisis) / _RE_WIDTH, 50.0)
     still = 0.155 + 0.346 / (1.0 + math.exp(arg))  # Goff & Carré 2010
-    return still + (spin_parameter / 0.05) * (_SPINNING_AT_BLEND - still), lift
+    # The blend C_D0 + (S/0.05)·(C_Ds(0.05) − C_D0), times |v|: (S/0.05)·|v| = r|ω|/0.05.
+    return still * speed + (spin_speed / 0.05) * (_SPINNING_AT_BLEND - still), lift
+
+
+@compiled()
+def drag_lift(speed, rate, measured, constant_drag, constant_lift, radius, re_per_speed, re_crisis):
+    """(C_D, C_L) of a ball at ``speed`` (m/s, ≥ 0) spinning at ``rate`` = |ω| (rad/s, ≥ 0): :func:`drag_lift_speeds`
+    divided by the speed, taken as at least 10⁻⁹ m/s (so a ball at rest has the spin parameter of one at 10⁻⁹ m/s)."""
+    speed = max(speed, 1e-9)
+    drag, lift = drag_lift_speeds(
+        speed * speed, rate, measured, constant_drag, constant_lift, radius, re_per_speed, re_crisis
+    )
+    return drag / speed, lift / speed
 
 
 @compiled()
@@ -170,13 +193,13 @@ def drag_lift_table(speeds, rates, config, drag, lift):
 
 
 @compiled(inline="always")
-def configured_drag_lift(speed, rate, config):
-    """:func:`drag_lift` under the (14,) settings' model: the force law's and the rolling ball's coefficients.
+def configured_drag_lift_speeds(speed2, rate, config):
+    """:func:`drag_lift_speeds` under the (14,) settings' model: the rolling ball's coefficients.
 
     Inlined into its callers, so reading the settings here costs what reading them there did.
     """
-    return drag_lift(
-        speed,
+    return drag_lift_speeds(
+        speed2,
         rate,
         config[MEASURED],
         config[C_D],
@@ -187,41 +210,112 @@ def configured_drag_lift(speed, rate, config):
     )
 
 
-@compiled()
-def _factors(speed, kick, config):
-    """(−½ρA·C_D·|v|/m, ½ρA·C_L·|v|/m) at this speed: drag and lift per unit velocity and mass (1/s)."""
-    q = config[Q]
-    drag, lift = configured_drag_lift(speed, kick[RATE], config)
-    return -q * drag * speed, q * lift * speed
+class ForceLaw(NamedTuple):
+    """One kick's force law as plain numbers (:func:`force_law`), handed to each force evaluation by value.
+
+    An array handed to a compiled function costs each call an atomic reference-count increment and decrement; in
+    the four evaluations of an RK4 step, one after another, those took about a fifth of the step.
+    """
+
+    q: float
+    """½ρA/m (1/m): force per unit mass per unit C·|v|²."""
+    gravity: float
+    """g (m/s², acting along −z)."""
+    measured: float
+    """1.0 for the measured coefficients, 0.0 for the constant ones."""
+    drag: float
+    """The constant model's C_D."""
+    lift: float
+    """The constant model's C_L."""
+    radius: float
+    """Ball radius (m)."""
+    re_per_speed: float
+    """Reynolds number per m/s of speed (ρ·2r/μ)."""
+    re_crisis: float
+    """The measured C_D's drag-crisis centre (Reynolds number)."""
+    axis_x: float
+    """Unit spin axis ω̂ (0 without spin)."""
+    axis_y: float
+    axis_z: float
+    rate: float
+    """|ω| (rad/s)."""
+    gain: float
+    """Knuckle gain ½ρA·C_K·w/m (1/m); 0 without the knuckle force."""
+    omega: float
+    """Knuckle force's angular rate Ω (rad/s)."""
+    phase_1: float
+    """Phases of its two components (rad)."""
+    phase_2: float
+    n1_x: float
+    """cos θ·n₁: the first component's direction."""
+    n1_y: float
+    n1_z: float
+    n2_x: float
+    """sin θ·n₂: the second component's direction."""
+    n2_y: float
+    n2_z: float
 
 
 @compiled()
-def _knuckle(speed, t, kick):
-    """Knuckle side force per unit mass (m/s², 3 values); zero when the kick has none."""
-    gain = kick[GAIN]
-    if gain == 0.0:
-        return 0.0, 0.0, 0.0
-    kk = gain * speed * speed
-    s1 = kk * math.sin(kick[OMEGA] * t + kick[PHASE])
-    s2 = kk * math.sin(kick[OMEGA] * t + kick[PHASE + 1])
-    return (
-        s1 * kick[N1] + s2 * kick[N2],
-        s1 * kick[N1 + 1] + s2 * kick[N2 + 1],
-        s1 * kick[N1 + 2] + s2 * kick[N2 + 2],
+def force_law(kick, config):
+    """The :class:`ForceLaw` of one kick's (14,) constants under the (14,) settings."""
+    return ForceLaw(
+        config[Q],
+        config[GRAVITY],
+        config[MEASURED],
+        config[C_D],
+        config[C_L],
+        config[RADIUS],
+        config[RE_PER_SPEED],
+        config[RE_CRISIS],
+        kick[AXIS],
+        kick[AXIS + 1],
+        kick[AXIS + 2],
+        kick[RATE],
+        kick[GAIN],
+        kick[OMEGA],
+        kick[PHASE],
+        kick[PHASE + 1],
+        kick[N1],
+        kick[N1 + 1],
+        kick[N1 + 2],
+        kick[N2],
+        kick[N2 + 1],
+        kick[N2 + 2],
     )
 
 
 @compiled()
-def acceleration(vx, vy, vz, t, kick, config):
-    """Total acceleration (m/s²): drag, Magnus (ω̂ × v), knuckle and gravity."""
-    speed = math.sqrt(vx * vx + vy * vy + vz * vz)
-    kd, kl = _factors(speed, kick, config)
-    wx, wy, wz = kick[AXIS], kick[AXIS + 1], kick[AXIS + 2]
-    sx, sy, sz = _knuckle(speed, t, kick)
+def _factors(speed2, law):
+    """(−½ρA·C_D·|v|/m, ½ρA·C_L·|v|/m) at squared speed ``speed2``: drag and lift per unit velocity and mass (1/s)."""
+    drag, lift = drag_lift_speeds(
+        speed2, law.rate, law.measured, law.drag, law.lift, law.radius, law.re_per_speed, law.re_crisis
+    )
+    return -law.q * drag, law.q * lift
+
+
+@compiled()
+def _knuckle(speed2, t, law):
+    """Knuckle side force per unit mass (m/s², 3 values) at squared speed ``speed2``; zero when the kick has none."""
+    if law.gain == 0.0:
+        return 0.0, 0.0, 0.0
+    kk = law.gain * speed2
+    s1 = kk * math.sin(law.omega * t + law.phase_1)
+    s2 = kk * math.sin(law.omega * t + law.phase_2)
+    return s1 * law.n1_x + s2 * law.n2_x, s1 * law.n1_y + s2 * law.n2_y, s1 * law.n1_z + s2 * law.n2_z
+
+
+@compiled(inline="always")
+def acceleration(vx, vy, vz, t, law):
+    """Total acceleration (m/s²) under the kick's :class:`ForceLaw`: drag, Magnus (ω̂ × v), knuckle and gravity."""
+    speed2 = vx * vx + vy * vy + vz * vz
+    kd, kl = _factors(speed2, law)
+    wx, wy, wz = law.axis_x, law.axis_y, law.axis_z
+    sx, sy, sz = _knuckle(speed2, t, law)
     return (
         kd * vx + kl * (wy * vz - wz * vy) + sx,
         kd * vy + kl * (wz * vx - wx * vz) + sy,
-        kd * vz + kl * (wx * vy - wy * vx) + sz - config[GRAVITY],
+        kd * vz + kl * (wx * vy - wy * vx) + sz - law.gravity,
     )
 
 
@@ -229,15 +323,16 @@ def acceleration(vx, vy, vz, t, kick, config):
 def sample_forces(t, state, kick, config, forces):
     """Drag, Magnus, gravity and knuckle forces (N) at each sample: ``forces`` (N, 12) from ``state`` (N, 6)."""
     m = config[MASS]
-    wx, wy, wz = kick[AXIS], kick[AXIS + 1], kick[AXIS + 2]
+    law = force_law(kick, config)
+    wx, wy, wz = law.axis_x, law.axis_y, law.axis_z
     for i in range(len(t)):
         vx, vy, vz = state[i, 3], state[i, 4], state[i, 5]
-        speed = math.sqrt(vx * vx + vy * vy + vz * vz)
-        kd, kl = _factors(speed, kick, config)
-        sx, sy, sz = _knuckle(speed, t[i], kick)
+        speed2 = vx * vx + vy * vy + vz * vz
+        kd, kl = _factors(speed2, law)
+        sx, sy, sz = _knuckle(speed2, t[i], law)
         forces[i, 0], forces[i, 1], forces[i, 2] = m * kd * vx, m * kd * vy, m * kd * vz
         forces[i, 3] = m * kl * (wy * vz - wz * vy)
         forces[i, 4] = m * kl * (wz * vx - wx * vz)
         forces[i, 5] = m * kl * (wx * vy - wy * vx)
-        forces[i, 6], forces[i, 7], forces[i, 8] = 0.0, 0.0, -m * config[GRAVITY]
+        forces[i, 6], forces[i, 7], forces[i, 8] = 0.0, 0.0, -m * law.gravity
         forces[i, 9], forces[i, 10], forces[i, 11] = m * sx, m * sy, m * sz

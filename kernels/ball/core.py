@@ -14,7 +14,7 @@ from typing import Literal
 
 import numpy as np
 
-from kernels.ball.aero import N_KICK, acceleration, fill_kick, max_stable_step, sample_forces
+from kernels.ball.aero import N_KICK, acceleration, fill_kick, force_law, max_stable_step, sample_forces
 from kernels.ball.config import DT, GRAVITY, GROUND, N_STEPS, RADIUS, RK4, T_MAX, X_STOP
 from kernels.ball.jit import compiled
 
@@ -28,22 +28,23 @@ RESULTS: tuple[Result, ...] = ("goal", "wall", "over", "wide", "short", "post", 
 
 
 # --------------------------------------------------------------------------------------------- flight
-@compiled()
-def _step(x, y, z, vx, vy, vz, t, dt, kick, config):
-    """One step of length ``dt`` of the configured method: (x, y, z, vx, vy, vz) after it."""
-    if config[RK4] == 0.0:  # the seed's Euler: velocity first, then position with the new velocity
-        ax, ay, az = acceleration(vx, vy, vz, t, kick, config)
+@compiled(inline="always")
+def _step(x, y, z, vx, vy, vz, t, dt, law, rk4):
+    """One step of length ``dt``, RK4 if ``rk4`` else Euler, under the kick's force law: (x, y, z, vx, vy, vz)
+    after it."""
+    if not rk4:  # the textbook Euler: velocity first, then position with the new velocity
+        ax, ay, az = acceleration(vx, vy, vz, t, law)
         vx1, vy1, vz1 = vx + ax * dt, vy + ay * dt, vz + az * dt
         return x + vx1 * dt, y + vy1 * dt, z + vz1 * dt, vx1, vy1, vz1
     half, sixth = 0.5 * dt, dt / 6.0
     # The acceleration does not depend on position, so each stage's position slope is its velocity.
-    a1x, a1y, a1z = acceleration(vx, vy, vz, t, kick, config)
+    a1x, a1y, a1z = acceleration(vx, vy, vz, t, law)
     v2x, v2y, v2z = vx + half * a1x, vy + half * a1y, vz + half * a1z
-    a2x, a2y, a2z = acceleration(v2x, v2y, v2z, t + half, kick, config)
+    a2x, a2y, a2z = acceleration(v2x, v2y, v2z, t + half, law)
     v3x, v3y, v3z = vx + half * a2x, vy + half * a2y, vz + half * a2z
-    a3x, a3y, a3z = acceleration(v3x, v3y, v3z, t + half, kick, config)
+    a3x, a3y, a3z = acceleration(v3x, v3y, v3z, t + half, law)
     v4x, v4y, v4z = vx + dt * a3x, vy + dt * a3y, vz + dt * a3z
-    a4x, a4y, a4z = acceleration(v4x, v4y, v4z, t + dt, kick, config)
+    a4x, a4y, a4z = acceleration(v4x, v4y, v4z, t + dt, law)
     return (
         x + sixth * (vx + 2.0 * (v2x + v3x) + v4x),
         y + sixth * (vy + 2.0 * (v2y + v3y) + v4y),
@@ -189,10 +190,11 @@ def _fly(launch, kick, config, t_out, state_out):
     if refused:
         return 1, 4
     t_max = config[T_MAX]
+    law, rk4 = force_law(kick, config), config[RK4] != 0.0
     for n in range(n_steps):
         # Every step is dt but the last, which ends exactly on t_max.
         h = dt if n < n_steps - 1 else t_max - (n_steps - 1) * dt
-        x1, y1, z1, vx1, vy1, vz1 = _step(x, y, z, vx, vy, vz, n * dt, h, kick, config)
+        x1, y1, z1, vx1, vy1, vz1 = _step(x, y, z, vx, vy, vz, n * dt, h, law, rk4)
         if vx1 * vx1 + vy1 * vy1 + vz1 * vz1 + 2.0 * g * z1 > energy_limit:
             return n + 1, 3
         # The stop plane is closed on the start side: a kick launched on it, moving on, stops at t = 0.

@@ -24,13 +24,24 @@ import math
 
 import numpy as np
 
-from kernels.ball.aero import AXIS, GAIN, N_KICK, RATE, configured_drag_lift, fill_kick, max_stable_step, sample_forces
+from kernels.ball.aero import (
+    AXIS,
+    GAIN,
+    N_KICK,
+    RATE,
+    configured_drag_lift_speeds,
+    fill_kick,
+    force_law,
+    max_stable_step,
+    sample_forces,
+)
 from kernels.ball.config import (
     DT,
     GRAVITY,
     GROUND,
     N_STEPS,
     RADIUS,
+    RK4,
     T_MAX,
     X_STOP,
     Q,
@@ -131,8 +142,11 @@ def _capsule_fraction(x, y, z, vx, vy, vz, x1, y1, z1, vx1, vy1, vz1, h, cap, ra
     if d2 > (reach + 1e-3) ** 2:
         return 2.0
     distance, nx, ny, nz = _to_axis(x, y, z, cap)
-    if distance <= reach:  # touching at the start: a contact only if moving into it
-        return 0.0 if vx * nx + vy * ny + vz * nz < 0.0 else 2.0
+    # Touching at the start (to rounding: the last contact leaves a ball at reach ± 1 ulp): a contact only if moving
+    # into the body faster than 1 nm/s (a ball it left sliding along the body moves along it to rounding). Without
+    # the tolerances such a ball met the body again at once, contact after contact with no change.
+    if distance <= reach * (1.0 + 1e-12):
+        return 0.0 if vx * nx + vy * ny + vz * nz < -1e-9 else 2.0
     # The chord's closest approach brackets the first touch (distance to a convex body is convex along a line).
     s_hi, _, _ = _segment_closest(
         x, y, z, x1 - x, y1 - y, z1 - z, cap[0], cap[1], cap[2], cap[3] - cap[0], cap[4] - cap[1], cap[5] - cap[2]
@@ -256,15 +270,21 @@ def _group_boxes(caps, n_fixed, reach, boxes):
 
 
 @compiled()
-def _chord_meets(x, y, z, x1, y1, z1, boxes, g):
-    """Whether the box of the step's chord meets group ``g``'s box of :func:`_group_boxes`."""
+def _box(boxes, g):
+    """Row ``g`` of ``boxes`` as a tuple (lo x y z, hi x y z): what the step tests, read with no array reference."""
+    return boxes[g, 0], boxes[g, 1], boxes[g, 2], boxes[g, 3], boxes[g, 4], boxes[g, 5]
+
+
+@compiled()
+def _chord_meets(x, y, z, x1, y1, z1, box):
+    """Whether the box of the step's chord meets ``box`` (:func:`_box`)."""
     return not (
-        max(x, x1) < boxes[g, 0]
-        or min(x, x1) > boxes[g, 3]
-        or max(y, y1) < boxes[g, 1]
-        or min(y, y1) > boxes[g, 4]
-        or max(z, z1) < boxes[g, 2]
-        or min(z, z1) > boxes[g, 5]
+        max(x, x1) < box[0]
+        or min(x, x1) > box[3]
+        or max(y, y1) < box[1]
+        or min(y, y1) > box[4]
+        or max(z, z1) < box[2]
+        or min(z, z1) > box[5]
     )
 
 
@@ -281,15 +301,35 @@ def _keeper_box(pitch, dive_t, target, reach, boxes):
     boxes[2, 3], boxes[2, 4], boxes[2, 5] = max(x0, x1) + grow, max(y0, y1) + grow, max(z0, z1) + grow
 
 
+@compiled()
+def _rolls_clear(x, y, z, vx, vy, pitch, boxes):
+    """Whether a ball rolling from (x, y, z) at (vx, vy) can no longer change its verdict: it rolls away from the
+    goal and its roll misses the wall's and the keeper's boxes (``boxes`` rows 1 and 2, :func:`_group_boxes`,
+    :func:`_keeper_box`; the goal frame lies behind it). A roll runs straight, since every force on a rolling ball
+    acts against its velocity, and stops within |v|²/(2·d), d the rolling deceleration (the air's drag only
+    shortens it)."""
+    if vx * pitch[GNX] + vy * pitch[GNY] > 0.0:
+        return False
+    decel = pitch[ROLL_DECEL]
+    if decel <= 0.0:
+        return False
+    reach = math.sqrt(vx * vx + vy * vy) / (2.0 * decel)  # the stop is at (x, y) + (vx, vy)·reach
+    x1, y1 = x + vx * reach, y + vy * reach
+    return not (
+        _chord_meets(x, y, z, x1, y1, z, _box(boxes, 1))
+        or (pitch[KEEPER_ON] != 0.0 and _chord_meets(x, y, z, x1, y1, z, _box(boxes, 2)))
+    )
+
+
 # --------------------------------------------------------------------------------------------- the flight
 @compiled()
 def _roll_acceleration(vx, vy, kick, config, decel):
     """Horizontal acceleration of a rolling ball: rolling resistance ``decel`` and the air's drag (spin rate |v|/R)."""
-    speed = math.sqrt(vx * vx + vy * vy)
-    if speed == 0.0:
+    speed2 = vx * vx + vy * vy
+    if speed2 == 0.0:
         return 0.0, 0.0
-    c_d, _ = configured_drag_lift(speed, speed / config[RADIUS], config)
-    k = decel / speed + config[Q] * c_d * speed
+    drag, _ = configured_drag_lift_speeds(speed2, math.sqrt(speed2) / config[RADIUS], config)  # C_D·|v|
+    k = decel / math.sqrt(speed2) + config[Q] * drag
     return -k * vx, -k * vy
 
 
@@ -342,6 +382,7 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
     dive_t = math.inf
     if keeper:
         _keeper_box(pitch, dive_t, target, radius + 1e-3, boxes)  # standing until he dives
+    frame_box, wall_box, keeper_box = _box(boxes, 0), _box(boxes, 1), _box(boxes, 2)
     seen_t = math.inf if pitch[WALL_ON] != 0.0 else 0.0
     v_in, w_in, normal, v_new, w_new = np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3)
     turf_surface = pitch[TURF_SURFACE : TURF_SURFACE + N_SURFACE]
@@ -351,6 +392,7 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
     half_goal, rp, turf = 0.5 * pitch[GW], pitch[POST_R], pitch[TURF]
     n_events, first_frame, touched_wall, touched_keeper, scored, inside = 0, -1, False, False, False, False
     rolling = False
+    law, rk4 = force_law(kick, config), config[RK4] != 0.0
     crossed = 2.0  # fraction of this step at which the whole ball is over the goal line (2: not in this step)
     t, n, ending = 0.0, 1, ENDED_T_MAX
     max_rows = len(t_out)
@@ -372,6 +414,7 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
             info[I_DIVE] = dive_t
             info[I_TARGET], info[I_TARGET + 1], info[I_TARGET + 2] = target[0], target[1], target[2]
             _keeper_box(pitch, dive_t, target, radius + 1e-3, boxes)
+            keeper_box = _box(boxes, 2)
         # One step: RK4/Euler in flight; rolling, the same step on the horizontal velocity, or the exact stop.
         stop_here = False
         if rolling:
@@ -400,13 +443,13 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
                     vx1, vy1 = 0.0, 0.0
                     stop_here = True
         else:
-            x1, y1, z1, vx1, vy1, vz1 = _step(x, y, z, vx, vy, vz, t, h, kick, config)
+            x1, y1, z1, vx1, vy1, vz1 = _step(x, y, z, vx, vy, vz, t, h, law, rk4)
         if vx1 * vx1 + vy1 * vy1 + vz1 * vz1 + 2.0 * g * z1 > energy_limit or not math.isfinite(
             x1 + y1 + z1 + vx1 + vy1 + vz1
         ):
             ending = DIVERGED
             break
-        near_keeper = keeper and _chord_meets(x, y, z, x1, y1, z1, boxes, 2)
+        near_keeper = keeper and _chord_meets(x, y, z, x1, y1, z1, keeper_box)
         if near_keeper:
             _keeper_capsule(pitch, dive_t, target, t + 0.5 * h, caps[n_fixed])
         # The first contact in the step.
@@ -417,8 +460,8 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
             f = crossing_fraction(x_stop - x, -vx, x_stop - x1, -vx1, h)
             if f < best:
                 best, kind = f, -2
-        near_frame = _chord_meets(x, y, z, x1, y1, z1, boxes, 0)
-        near_wall = _chord_meets(x, y, z, x1, y1, z1, boxes, 1)
+        near_frame = _chord_meets(x, y, z, x1, y1, z1, frame_box)
+        near_wall = _chord_meets(x, y, z, x1, y1, z1, wall_box)
         for c in range(n_caps):
             if (c < 3 and not near_frame) or (3 <= c < n_fixed and not near_wall) or (c == n_fixed and not near_keeper):
                 continue
@@ -501,8 +544,8 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
             if stop_here:
                 ending = STOPPED
                 break
-            if not store and (scored or (rolling and not inside and vx * gnx + vy * gny <= 0.0)):
-                break  # a verdict only: a goal stays a goal, and a straight roll away from the goal never comes back
+            if not store and (scored or (rolling and not inside and _rolls_clear(x, y, z, vx, vy, pitch, boxes))):
+                break  # a verdict only: a goal stays a goal, and a roll away from the goal and clear of every body
             continue
         # Move to the contact.
         f = best
@@ -551,6 +594,12 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
                 share = alpha / (1.0 + alpha)
                 ux, uy = vx - radius * wy, vy + radius * wx
                 vx, vy = vx - share * ux, vy - share * uy
+                into = vx * normal[0] + vy * normal[1]
+                if kind != GROUND_HIT and into < 0.0:
+                    # The turf's grip can leave a ball that rolled into a post or a player still rolling into it
+                    # (its spin outweighs the rebound); the body stops that part and the ball rolls on along it,
+                    # or rests against it. Without this it struck the body again at once, contact after contact.
+                    vx, vy = vx - into * normal[0], vy - into * normal[1]
                 wx, wy, wz = -vy / radius, vx / radius, 0.0
             if kind == WALL:
                 touched_wall = True
@@ -573,6 +622,7 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
                 info[I_FIRST] = t
             kick[GAIN] = 0.0  # the knuckle's unsteady wake is a launch effect; any contact ends it
             _set_spin(kick, wx, wy, wz)
+            law = force_law(kick, config)
         if store and n < max_rows:
             _write_spin_sample(t_out, state_out, spin_out, n, t, x, y, z, vx, vy, vz, wx, wy, wz)
         n += 1
@@ -583,7 +633,7 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
         if rolling and vx == 0.0 and vy == 0.0:
             ending = STOPPED
             break
-        if not store and (scored or (rolling and not inside and vx * gnx + vy * gny <= 0.0)):
+        if not store and (scored or (rolling and not inside and _rolls_clear(x, y, z, vx, vy, pitch, boxes))):
             break
     # Whole ball over the line between the posts and under the bar, at any time (off the post, the bar, the wall
     # or the keeper too), is a goal; then the keeper, the wall, the frame, and where it crossed the line.
@@ -621,10 +671,23 @@ def play_one(launch, config, pitch, t_out, state_out, spin_out, forces_out, even
     gain = kick[GAIN]
     n, ending = play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info)
     first = info[I_FIRST] if not math.isnan(info[I_FIRST]) else math.inf
-    for i in range(n):
+    i = 0
+    while i < n:  # one call of the force law per run of samples with one spin, on one side of the first contact
+        before = t_out[i] < first
+        j = i + 1
+        while (
+            j < n
+            and (t_out[j] < first) == before
+            and spin_out[j, 0] == spin_out[i, 0]
+            and spin_out[j, 1] == spin_out[i, 1]
+            and spin_out[j, 2] == spin_out[i, 2]
+        ):
+            j += 1
         _set_spin(kick, spin_out[i, 0], spin_out[i, 1], spin_out[i, 2])
-        kick[GAIN] = gain if t_out[i] < first else 0.0
-        sample_forces(t_out[i : i + 1], state_out[i : i + 1], kick, config, forces_out[i : i + 1])
+        kick[GAIN] = gain if before else 0.0
+        sample_forces(t_out[i:j], state_out[i:j], kick, config, forces_out[i:j])
+        i = j
+    for i in range(n):
         if state_out[i, 2] == config[GROUND] and state_out[i, 5] == 0.0 and t_out[i] >= first:
             forces_out[i, 3], forces_out[i, 4], forces_out[i, 5] = 0.0, 0.0, 0.0  # rolling: no lift off the turf
     if not np.isfinite(forces_out[:n]).all():

@@ -319,6 +319,51 @@ def test_outcomes_on_a_pitch_count_post_bar_and_saved_and_match_single_flights()
     assert batch.events is not None and len(batch.events) == 5
 
 
+def test_a_ball_rolled_into_the_wall_stops_against_it_and_its_verdict_is_the_wall() -> None:
+    # Rolled back at the wall from 6 m before the goal, it meets two players at once. It rested against them,
+    # struck them 64 times at one instant and "ended at t_max" at 2.18 s; the verdict alone said "short", its roll
+    # being away from the goal.
+    pitch = ball.Pitch(GOAL, WALL, ball.Keeper())
+    options = {"dt": 1e-2, "method": "rk4", "model": "measured", "ground_m": R, "t_max": 6.0}
+    start, velocity, spin = (-6.0, 0.0, R), (-7.0, 0.0, 0.0), (0.0, 0.0, 0.0)
+    flight = ball.simulate(start, velocity, spin, pitch=pitch, **options)
+    assert flight.result == "wall"
+    assert flight.ended == "stopped"
+    assert [e.kind for e in flight.events][:2] == ["ground", "wall"]
+    assert len(flight.events) <= 4
+    np.testing.assert_array_equal(flight.velocity[-1], 0.0)
+    assert list(ball.simulate_outcomes([start], [velocity], [spin], pitch=pitch, **options).result) == ["wall"]
+
+
+def test_rolls_and_low_kicks_about_the_wall_get_the_flights_verdict_and_end_honestly() -> None:
+    # The family of the case above: 3000 rolls and low kicks from between the wall and the goal, every way, spun
+    # or not. The verdict alone (which ends a flight once it cannot change) is the whole flight's; a flight ends
+    # at t_max only at t_max, never stuck on a body with its contacts used up.
+    rng = np.random.default_rng(1)
+    k = 3000
+    starts = np.column_stack([rng.uniform(-12.0, -1.0, k), rng.uniform(-4.0, 4.0, k), np.full(k, R)])
+    azimuth, speed = rng.uniform(-math.pi, math.pi, k), rng.uniform(0.5, 14.0, k)
+    elevation = rng.uniform(0.0, 0.5, k) * (rng.random(k) < 0.5)
+    velocities = np.column_stack(
+        [
+            speed * np.cos(elevation) * np.cos(azimuth),
+            speed * np.cos(elevation) * np.sin(azimuth),
+            speed * np.sin(elevation),
+        ]
+    )
+    spins = rng.normal(0.0, 20.0, (k, 3)) * (rng.random((k, 1)) < 0.5)
+    pitch = ball.Pitch(GOAL, WALL, ball.Keeper())
+    options = {"dt": 1e-2, "method": "rk4", "model": "measured", "ground_m": R, "t_max": 6.0}
+    judged = ball.simulate_outcomes(starts, velocities, spins, pitch=pitch, **options)
+    flights = ball.simulate_batch(starts, velocities, spins, pitch=pitch, **options)
+    assert flights.result is not None and flights.events is not None
+    assert list(judged.result) == list(flights.result)
+    assert int((flights.result == "wall").sum()) > 100  # the family reaches the wall
+    last = flights.t[np.arange(k), flights.n_samples - 1]
+    assert np.all(last[flights.ended == "t_max"] == pytest.approx(6.0))
+    assert max(len(events) for events in flights.events) < play.MAX_EVENTS
+
+
 def test_without_a_wall_outcomes_still_judge_the_goal() -> None:
     velocity = ball.launch_velocity(25.0, math.radians(14.0), 0.0)
     judged = ball.simulate_outcomes(
