@@ -53,6 +53,7 @@ simulate_one = Entry(core.simulate_one)
 stable_step = Entry(core.stable_step)
 play_one = Entry(play.play_one)
 play_rows = Entry(play.play_rows)
+keeper_path_core = Entry(play.keeper_path)
 
 EVENT_KINDS: tuple[str, ...] = ("ground", "post", "bar", "wall", "keeper", "net")
 """Kinds of :class:`Event`, in the compiled flight's code order."""
@@ -343,8 +344,9 @@ def keeper_path(
         _checks.instance("dive", dive, KeeperDive)
         dive_t = _checks.finite_number("dive.t", dive.t)
         target = checked_vector("dive.target", dive.target, 3)
+    vector.setflags(write=False)  # read-only, as the flight hands it on: one compiled keeper for both
     out = np.empty((len(t), 12))
-    play.keeper_path(vector, dive_t, target, t, out)
+    keeper_path_core(vector, dive_t, target, t, out)
     return KeeperPath(t, out[:, 0:3], out[:, 3:6], out[:, 6:12].reshape(-1, 2, 3))
 
 
@@ -541,14 +543,14 @@ def outcome(trajectory: Trajectory, wall: Panel, goal: Panel, *, radius_m: float
     radius = _checks.positive("radius_m", radius_m)
     _checks.instance("trajectory", trajectory, Trajectory, "a Trajectory from simulate()")
     crossings = np.empty((2, 4))
-    t, position, velocity = trajectory.t, trajectory.position, trajectory.velocity
-    if not (t.flags.writeable and position.flags.writeable and velocity.flags.writeable):
-        # A read-only flight (the scene keeps its flights so) is judged from a writable copy laid out as simulate()'s:
-        # one compiled judge for both, not a second variant to compile on the first start.
-        state = np.empty((len(t), 6))
-        state[:, :3], state[:, 3:] = position, velocity
-        t, position, velocity = np.array(t), state[:, :3], state[:, 3:]
-    code = judge(t, position, velocity, len(t), panel_rows(wall, goal), radius, crossings)
+    # Judged from a writable copy laid out as a batch's row (times strided, positions and velocities slices of one
+    # state array), whatever the flight's own layout or flags (the scene keeps its flights read-only): the package
+    # then compiles one judge for single flights and batches, not a variant per layout on the first start.
+    n = len(trajectory.t)
+    columns = np.empty((n, 7))
+    columns[:, 0], columns[:, 1:4], columns[:, 4:7] = trajectory.t, trajectory.position, trajectory.velocity
+    t, position, velocity = columns[:, 0], columns[:, 1:4], columns[:, 4:7]
+    code = judge(t, position, velocity, n, panel_rows(wall, goal), radius, crossings)
     wall_ok, goal_ok = not math.isnan(crossings[0, 0]), not math.isnan(crossings[1, 0])
     return Outcome(
         result=RESULTS[code],

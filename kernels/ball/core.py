@@ -230,7 +230,8 @@ def simulate_one(launch, config, t_out, state_out, forces_out):
     """:func:`simulate`'s compiled part: the kick's constants, its flight and the forces along it."""
     kick = np.empty(N_KICK)
     fill_kick(launch, config, kick)
-    n, ending = _fly(launch, kick, config, t_out, state_out)
+    # Strided views ([::1] types as any layout), as fly_rows hands it a batch's columns: one compiled _fly.
+    n, ending = _fly(launch, kick, config, t_out[::1], state_out[::1])
     sample_forces(t_out[:n], state_out[:n], kick, config, forces_out[:n])
     if not np.isfinite(forces_out[:n]).all():  # a finite flight with an infinite force: a 1e-300 kg ball
         ending = 3
@@ -341,5 +342,5 @@ def fly_and_judge_rows(start, stop, launches, config, panels, results, crossings
     kick, t, state = np.empty(N_KICK), np.empty(rows), np.empty((rows, 6))
     for k in range(start, stop):
         fill_kick(launches[k], config, kick)
-        n, endings[k] = _fly(launches[k], kick, config, t, state)
-        results[k] = judge(t, state[:, :3], state[:, 3:], n, panels, config[RADIUS], crossings[k])
+        n, endings[k] = _fly(launches[k], kick, config, t[::1], state[::1])  # any layout: as simulate_one
+        results[k] = judge(t[::1], state[:, :3], state[:, 3:], n, panels, config[RADIUS], crossings[k])

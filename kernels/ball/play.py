@@ -221,7 +221,8 @@ def keeper_path(pitch, dive_t, target, times, out):
     for i in range(times.shape[0]):
         out[i, 0], out[i, 1], out[i, 2], out[i, 3], out[i, 4], out[i, 5] = _keeper_pose(pitch, dive_t, target, times[i])
         _keeper_capsule(pitch, dive_t, target, times[i], cap)
-        out[i, 6:12] = cap[:6]
+        for c in range(6):  # element by element: a slice assignment compiles numba's shape-mismatch message
+            out[i, 6 + c] = cap[c]
 
 
 @compiled()

@@ -3,6 +3,7 @@ numbers, and the background compile reports its progress and then hands every ca
 
 from __future__ import annotations
 
+import dis
 import importlib
 import pkgutil
 import sys
@@ -14,7 +15,6 @@ import numpy as np
 import pytest
 from numba.core.dispatcher import Dispatcher
 
-import kernels
 from kernels import ball, course, fabrik, warming
 from kernels.ball.core import RESULTS
 from kernels.fabrik import Cone, Hinge
@@ -43,17 +43,38 @@ def _python_functions(module: types.ModuleType) -> Iterator[types.FunctionType]:
                 yield function
 
 
+def _modules(package: str) -> Iterator[pkgutil.ModuleInfo]:
+    return pkgutil.walk_packages(importlib.import_module(package).__path__, f"{package}.")
+
+
+def _called_names(code: types.CodeType, namespace: dict[str, Any]) -> Iterator[str]:
+    """Names of the dispatchers ``code`` reaches: a global that is one, or one read as a module's attribute
+    (``play.keeper_path``)."""
+    module: types.ModuleType | None = None
+    for instruction in dis.get_instructions(code):
+        if instruction.opname in ("LOAD_ATTR", "LOAD_METHOD") and module is not None:
+            if isinstance(getattr(module, instruction.argval, None), Dispatcher):
+                yield f"{module.__name__.rsplit('.', 1)[-1]}.{instruction.argval}"
+        module = None
+        if instruction.opname == "LOAD_GLOBAL":
+            value = namespace.get(instruction.argval)
+            if isinstance(value, Dispatcher):
+                yield instruction.argval
+            elif isinstance(value, types.ModuleType):
+                module = value
+
+
 def test_python_code_in_the_kernels_calls_compiled_cores_only_through_entries() -> None:
-    # A bare dispatcher called from Python would compile in the serving process during the first start (seconds
+    # A bare dispatcher called from Python (the scenes' too) would compile in the serving process during the first start (seconds
     # holding its GIL) instead of running its twin. compiled_single_solve hands the raw core to a benchmark on purpose.
     bare = []
-    for info in pkgutil.walk_packages(kernels.__path__, "kernels."):
+    infos = [info for package in ("kernels", "scenes", "server", "shaders") for info in _modules(package)]
+    for info in infos:
         module = importlib.import_module(info.name)
         for function in _python_functions(module):
             for code in _code_objects(function.__code__):
-                for name in code.co_names:
-                    if isinstance(function.__globals__.get(name), Dispatcher):
-                        bare.append(f"{module.__name__}.{function.__qualname__} calls {name}")
+                for name in _called_names(code, function.__globals__):
+                    bare.append(f"{module.__name__}.{function.__qualname__} calls {name}")
     assert bare == ["kernels.fabrik.api.compiled_single_solve calls _compiled_solve_one"]
 
 
