@@ -192,24 +192,6 @@ def drag_lift_table(speeds, rates, config, drag, lift):
         drag[i], lift[i] = drag_lift(speeds[i], rates[i], measured, c_d, c_l, radius, re_per_speed, re_crisis)
 
 
-@compiled(inline="always")
-def configured_drag_lift_speeds(speed2, rate, config):
-    """:func:`drag_lift_speeds` under the (14,) settings' model: the rolling ball's coefficients.
-
-    Inlined into its callers, so reading the settings here costs what reading them there did.
-    """
-    return drag_lift_speeds(
-        speed2,
-        rate,
-        config[MEASURED],
-        config[C_D],
-        config[C_L],
-        config[RADIUS],
-        config[RE_PER_SPEED],
-        config[RE_CRISIS],
-    )
-
-
 class ForceLaw(NamedTuple):
     """One kick's force law as plain numbers (:func:`force_law`), handed to each force evaluation by value.
 

@@ -29,7 +29,7 @@ from kernels.ball.aero import (
     GAIN,
     N_KICK,
     RATE,
-    configured_drag_lift_speeds,
+    drag_lift_speeds,
     fill_kick,
     force_law,
     max_stable_step,
@@ -44,7 +44,6 @@ from kernels.ball.config import (
     RK4,
     T_MAX,
     X_STOP,
-    Q,
 )
 from kernels.ball.contact import N_SURFACE, impact
 from kernels.ball.core import _energy_limit, _hermite, _step, _write_sample, crossing_fraction
@@ -324,13 +323,17 @@ def _rolls_clear(x, y, z, vx, vy, pitch, boxes):
 
 # --------------------------------------------------------------------------------------------- the flight
 @compiled()
-def _roll_acceleration(vx, vy, kick, config, decel):
-    """Horizontal acceleration of a rolling ball: rolling resistance ``decel`` and the air's drag (spin rate |v|/R)."""
+def _roll_acceleration(vx, vy, law, decel):
+    """Horizontal acceleration of a rolling ball: rolling resistance ``decel`` and the air's drag (spin rate |v|/R)
+    under the kick's :class:`~kernels.ball.aero.ForceLaw`."""
     speed2 = vx * vx + vy * vy
     if speed2 == 0.0:
         return 0.0, 0.0
-    drag, _ = configured_drag_lift_speeds(speed2, math.sqrt(speed2) / config[RADIUS], config)  # C_D·|v|
-    k = decel / math.sqrt(speed2) + config[Q] * drag
+    speed = math.sqrt(speed2)
+    drag, _ = drag_lift_speeds(
+        speed2, speed / law.radius, law.measured, law.drag, law.lift, law.radius, law.re_per_speed, law.re_crisis
+    )  # C_D·|v|
+    k = decel / speed + law.q * drag
     return -k * vx, -k * vy
 
 
@@ -423,7 +426,7 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
             if speed == 0.0:
                 ending = STOPPED
                 break
-            ax0, ay0 = _roll_acceleration(vx, vy, kick, config, pitch[ROLL_DECEL])
+            ax0, ay0 = _roll_acceleration(vx, vy, law, pitch[ROLL_DECEL])
             decel = math.sqrt(ax0 * ax0 + ay0 * ay0)
             if speed <= decel * h:  # it stops inside this step (the deceleration is nearly constant over it)
                 h = speed / decel
@@ -432,9 +435,9 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
                 stop_here = True
             else:
                 half = 0.5 * h
-                a2x, a2y = _roll_acceleration(vx + half * ax0, vy + half * ay0, kick, config, pitch[ROLL_DECEL])
-                a3x, a3y = _roll_acceleration(vx + half * a2x, vy + half * a2y, kick, config, pitch[ROLL_DECEL])
-                a4x, a4y = _roll_acceleration(vx + h * a3x, vy + h * a3y, kick, config, pitch[ROLL_DECEL])
+                a2x, a2y = _roll_acceleration(vx + half * ax0, vy + half * ay0, law, pitch[ROLL_DECEL])
+                a3x, a3y = _roll_acceleration(vx + half * a2x, vy + half * a2y, law, pitch[ROLL_DECEL])
+                a4x, a4y = _roll_acceleration(vx + h * a3x, vy + h * a3y, law, pitch[ROLL_DECEL])
                 x1 = x + h / 6.0 * (vx + 2.0 * (vx + half * ax0) + 2.0 * (vx + half * a2x) + vx + h * a3x)
                 y1 = y + h / 6.0 * (vy + 2.0 * (vy + half * ay0) + 2.0 * (vy + half * a2y) + vy + h * a3y)
                 z1, vz1 = z, 0.0
