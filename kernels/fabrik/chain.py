@@ -256,7 +256,8 @@ def _dls_step(
             lx * yy - ly * yx,
         )
     # Turn every segment by the joints up to it and re-chain from the root.
-    turn, step, product = np.eye(3), np.empty((3, 3)), np.empty((3, 3))
+    turn, step, product = np.zeros((3, 3)), np.empty((3, 3)), np.empty((3, 3))
+    turn[0, 0] = turn[1, 1] = turn[2, 2] = 1.0  # the identity (np.eye compiles an overload of its own)
     ox, oy, oz = p[0, 0], p[0, 1], p[0, 2]
     for i in range(n):
         sx, sy, sz = p[i + 1, 0] - ox, p[i + 1, 1] - oy, p[i + 1, 2] - oz
@@ -356,7 +357,10 @@ def _place_on_line(
 ) -> None:
     """The chain along the unit direction u from the root: straight, or (``fold``) with its longest link toward u
     and the others folded back, so the end rests on the inner boundary of the reach."""
-    longest = np.argmax(lengths)
+    longest = 0  # the first longest link (np.argmax compiles an overload of its own)
+    for i in range(1, lengths.shape[0]):
+        if lengths[i] > lengths[longest]:
+            longest = i
     reach = 0.0
     pose[0, 0], pose[0, 1], pose[0, 2] = root[0], root[1], root[2]
     for i in range(lengths.shape[0]):
@@ -588,8 +592,11 @@ def _solve_chain(
     distance = math.sqrt(ox * ox + oy * oy + oz * oz)
     # relative only: the core gives the same bits at any power-of-2 scale
     tiny = _TINY * max(total, distance)
-    has_zero = bool(np.min(lengths) <= tiny)  # a bool, never the literal False (which compiled every pass twice)
-    inner = max(0.0, 2.0 * np.max(lengths) - total)
+    shortest, longest = lengths[0], lengths[0]  # a loop: np.min and np.max compile overloads of their own
+    for i in range(1, lengths.shape[0]):
+        shortest, longest = min(shortest, lengths[i]), max(longest, lengths[i])
+    has_zero = bool(shortest <= tiny)  # a bool, never the literal False (which compiled every pass twice)
+    inner = max(0.0, 2.0 * longest - total)
     beyond = distance > total + tiny
     fold = distance < inner - tiny
     out_of_reach = beyond or fold

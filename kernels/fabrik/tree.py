@@ -377,7 +377,9 @@ def _solve_tree_core(
         directions[j, 0], directions[j, 1], directions[j, 2] = ux, uy, uz
     sums = np.zeros((count, 3))
     counts = np.zeros(count, dtype=np.int64)
-    only_child = np.full(count, -1, dtype=np.int64)  # the one active child, where a joint has one
+    only_child = np.empty(count, dtype=np.int64)  # the one active child, where a joint has one (-1: none yet)
+    for j in range(count):
+        only_child[j] = -1
     for j in range(count):
         up = int(parents[j])
         if up >= 0 and active[j]:
