@@ -302,13 +302,15 @@ def _keeper_box(pitch, dive_t, target, reach, boxes):
 
 
 @compiled()
-def _rolls_clear(x, y, z, vx, vy, pitch, boxes):
+def _rolls_clear(x, y, z, vx, vy, pitch, boxes, dived):
     """Whether a ball rolling from (x, y, z) at (vx, vy) can no longer change its verdict: it rolls away from the
-    goal and its roll misses the wall's and the keeper's boxes (``boxes`` rows 1 and 2, :func:`_group_boxes`,
-    :func:`_keeper_box`; the goal frame lies behind it). A roll runs straight, since every force on a rolling ball
+    goal (or along its line) and its roll misses the goal frame's, the wall's and the keeper's boxes (``boxes``,
+    :func:`_group_boxes`, :func:`_keeper_box`). Before the keeper has ``dived`` nothing is clear: his box holds only
+    where he stands, not where his dive will take him. A roll runs straight, since every force on a rolling ball
     acts against its velocity, and stops within |v|²/(2·d), d the rolling deceleration (the air's drag only
     shortens it)."""
-    if vx * pitch[GNX] + vy * pitch[GNY] > 0.0:
+    keeper = pitch[KEEPER_ON] != 0.0
+    if vx * pitch[GNX] + vy * pitch[GNY] > 0.0 or (keeper and not dived):
         return False
     decel = pitch[ROLL_DECEL]
     if decel <= 0.0:
@@ -316,8 +318,9 @@ def _rolls_clear(x, y, z, vx, vy, pitch, boxes):
     reach = math.sqrt(vx * vx + vy * vy) / (2.0 * decel)  # the stop is at (x, y) + (vx, vy)·reach
     x1, y1 = x + vx * reach, y + vy * reach
     return not (
-        _chord_meets(x, y, z, x1, y1, z, _box(boxes, 1))
-        or (pitch[KEEPER_ON] != 0.0 and _chord_meets(x, y, z, x1, y1, z, _box(boxes, 2)))
+        _chord_meets(x, y, z, x1, y1, z, _box(boxes, 0))
+        or _chord_meets(x, y, z, x1, y1, z, _box(boxes, 1))
+        or (keeper and _chord_meets(x, y, z, x1, y1, z, _box(boxes, 2)))
     )
 
 
@@ -369,7 +372,10 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
     radius = config[RADIUS]
     x, y, z, vx, vy, vz = launch[0], launch[1], launch[2], launch[3], launch[4], launch[5]
     wx, wy, wz = launch[6], launch[7], launch[8]
-    energy_limit = _energy_limit(vx, vy, vz, z, g)
+    # The spin's energy counts too (α·R²·|ω|² per unit mass, doubled as |v|² is), with the same margin: a bounce can
+    # turn it into speed, and a ball rolled with heavy backspin leaves the turf faster than it came.
+    spin_energy = pitch[TURF_SURFACE + 4] * radius * radius * (wx * wx + wy * wy + wz * wz)
+    energy_limit = _energy_limit(vx, vy, vz, z, g) + 4.0 * spin_energy
     if store:
         _write_spin_sample(t_out, state_out, spin_out, 0, 0.0, x, y, z, vx, vy, vz, wx, wy, wz)
     refused = dt > max_stable_step(launch, kick, config)[0]
@@ -548,7 +554,9 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
             if stop_here:
                 ending = STOPPED
                 break
-            if not store and (scored or (rolling and not inside and _rolls_clear(x, y, z, vx, vy, pitch, boxes))):
+            if not store and (
+                scored or (rolling and not inside and _rolls_clear(x, y, z, vx, vy, pitch, boxes, dive_t < math.inf))
+            ):
                 break  # a verdict only: a goal stays a goal, and a roll away from the goal and clear of every body
             continue
         # Move to the contact.
@@ -637,7 +645,9 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
         if rolling and vx == 0.0 and vy == 0.0:
             ending = STOPPED
             break
-        if not store and (scored or (rolling and not inside and _rolls_clear(x, y, z, vx, vy, pitch, boxes))):
+        if not store and (
+            scored or (rolling and not inside and _rolls_clear(x, y, z, vx, vy, pitch, boxes, dive_t < math.inf))
+        ):
             break
     # Whole ball over the line between the posts and under the bar, at any time (off the post, the bar, the wall
     # or the keeper too), is a goal; then the keeper, the wall, the frame, and where it crossed the line.
