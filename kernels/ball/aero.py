@@ -176,6 +176,8 @@ def drag_lift(speed, rate, measured, constant_drag, constant_lift, radius, re_pe
     """(C_D, C_L) of a ball at ``speed`` (m/s, ≥ 0) spinning at ``rate`` = |ω| (rad/s, ≥ 0): :func:`drag_lift_speeds`
     divided by the speed, taken as at least 10⁻⁹ m/s (so a ball at rest has the spin parameter of one at 10⁻⁹ m/s)."""
     speed = max(speed, 1e-9)
+    if speed > 1e150:  # |v|² would overflow: so far past the drag crisis the coefficients depend on S alone
+        rate, speed = rate * (1e150 / speed), 1e150
     drag, lift = drag_lift_speeds(
         speed * speed, rate, measured, constant_drag, constant_lift, radius, re_per_speed, re_crisis
     )

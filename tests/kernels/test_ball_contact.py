@@ -99,6 +99,19 @@ def test_spinning_coefficients_follow_the_published_fits() -> None:
     assert c_l[-1] == pytest.approx(0.27)
 
 
+@pytest.mark.parametrize("speed", [1e150, 1.35e154, 1e200, 1e300, 1e306])
+def test_coefficients_hold_at_any_speed(speed: float) -> None:
+    # The law is computed from |v|², which overflows past 1.34e154 m/s: C_D read inf there. So far past the drag
+    # crisis the measured coefficients depend on S alone (C_D0 = 0.155), and the constant ones on nothing.
+    s = np.array([0.0, 0.01, 0.05, 0.2, 0.3, 5.0])
+    c_d, c_l = ball.coefficients(speed, s * (speed / R))
+    np.testing.assert_allclose(c_l, 0.9 * np.minimum(s, 0.3), rtol=1e-12)  # Asai et al. 2007
+    still = 0.155 + 0.346 / (1.0 + math.exp(50.0))  # Goff & Carré 2010, its exponent's argument capped at 50
+    blend = still + s / 0.05 * (0.4127 * 0.05**0.3056 - still)
+    np.testing.assert_allclose(c_d, np.where(s >= 0.05, 0.4127 * np.maximum(s, 1e-300) ** 0.3056, blend), rtol=1e-12)
+    assert ball.coefficients(speed, 1.0, "constant") == (0.25, 0.25)
+
+
 def test_the_constant_model_gives_its_constants_whatever_the_speed_and_spin() -> None:
     speed, rate = np.array([0.0, 5.0, 12.19, 40.0])[:, None], np.array([0.0, 10.0, 300.0])
     c_d, c_l = ball.coefficients(speed, rate, "constant")
