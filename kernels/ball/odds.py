@@ -77,7 +77,7 @@ def draw_strikes(
     Speed, elevation and azimuth get normal scatter; the spin rate too (clipped at 0), and its axis is tilted by a
     normal angle in a uniformly drawn direction. The first strike is always the kick itself.
     """
-    spread = spread.checked()
+    spread = _checks.instance("spread", spread, StrikeSpread).checked()
     count = _checks.integer("n", n, 1)
     rng = np.random.default_rng(checked_seed("draw", draw))
     normal = rng.standard_normal((count, 5))
@@ -113,6 +113,13 @@ def draw_strikes(
     return velocities, spins
 
 
+def _spread(spread: object) -> StrikeSpread:
+    """``spread``, or the default scatter for None; ``ValueError`` for anything else."""
+    if spread is None:
+        return StrikeSpread()
+    return _checks.instance("spread", spread, StrikeSpread)
+
+
 def strike_odds(
     position: ArrayLike,
     speed_ms: float,
@@ -142,7 +149,8 @@ def strike_odds(
         :class:`Odds`.
     """
     start = checked_vector("position", position, 3)
-    velocities, spins = draw_strikes(speed_ms, elevation_rad, azimuth_rad, spin_rads, spread or StrikeSpread(), n, draw)
+    _checks.instance("pitch", pitch, Pitch)
+    velocities, spins = draw_strikes(speed_ms, elevation_rad, azimuth_rad, spin_rads, _spread(spread), n, draw)
     starts = np.broadcast_to(start, velocities.shape)
     judged = simulate_outcomes(starts, velocities, spins, pitch=pitch, **options)
     return Odds(judged.counts(), len(velocities))
@@ -176,14 +184,23 @@ def odds_map(
     the angle. All spots' strikes fly in ``chunks`` parallel calls (each spot on its own pitch); ``progress`` is
     called with the share done after each.
     """
-    distances = _checks.finite_array("distances_m", distances_m).reshape(-1)
-    angles = _checks.finite_array("angles_rad", angles_rad).reshape(-1)
+    distances = _checks.finite_array("distances_m", distances_m)
+    angles = _checks.finite_array("angles_rad", angles_rad)
+    for name, array in (("distances_m", distances), ("angles_rad", angles)):
+        if array.ndim != 1 or len(array) == 0:
+            raise ValueError(f"{name} must be a non-empty 1-D array, got shape {array.shape}")
     spin = checked_vector("spin_rads", spin_rads, 3)
     _checks.integer("chunks", chunks, 1)
+    if not isinstance(wall, bool):
+        raise ValueError(f"wall must be True or False, got {wall!r}")
+    if keeper is not None:
+        _checks.instance("keeper", keeper, Keeper)
+    if surface is not None:
+        _checks.instance("surface", surface, Surface)
     settings = flight_config(None, options).settings
     ground, radius = float(settings[GROUND]), float(settings[RADIUS])
     # One scatter, drawn along +x, turned to each spot.
-    velocities, spins = draw_strikes(speed_ms, elevation_rad, aim_rad, spin, spread or StrikeSpread(), n, draw)
+    velocities, spins = draw_strikes(speed_ms, elevation_rad, aim_rad, spin, _spread(spread), n, draw)
     spots = np.array(
         [[-d * math.cos(a), d * math.sin(a)] for d in distances for a in angles], dtype=np.float64
     ).reshape(-1, 2)

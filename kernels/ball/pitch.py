@@ -89,19 +89,23 @@ def free_kick_panels(
 
 def panel_rows(wall: Panel, goal: Panel) -> NDArray[np.float64]:
     """The wall and the goal as the compiled cores' (2, 6) rows: centre x, y, unit normal x, y, width, height."""
-    rows = np.empty((2, 6))
-    for row, (name, panel) in zip(rows, (("wall", wall), ("goal", goal)), strict=True):
-        normal = checked_vector(f"{name}.normal_xy", panel.normal_xy, 2)
-        length = float(np.hypot(*normal))
-        if length == 0.0:
-            raise ValueError(f"{name}.normal_xy must not be zero")
-        row[0:2], row[2:4] = (
-            checked_vector(f"{name}.centre_xy", panel.centre_xy, 2),
-            normal / length,
-        )
-        row[4] = _checks.positive(f"{name}.width_m", panel.width_m)
-        row[5] = _checks.finite_number(f"{name}.height_m", panel.height_m)
-    return rows
+    return np.array([panel_row("wall", wall), panel_row("goal", goal)])
+
+
+def panel_row(name: str, panel: Panel, *, standing: bool = False) -> NDArray[np.float64]:
+    """One panel as a compiled core's (6,) row: centre x, y, unit normal x, y, width, height; ``standing`` asks for a
+    height above the turf (> 0). ``ValueError`` naming ``name`` and the field."""
+    _checks.instance(name, panel, Panel)
+    normal = checked_vector(f"{name}.normal_xy", panel.normal_xy, 2)
+    length = float(np.hypot(*normal))
+    if length == 0.0:
+        raise ValueError(f"{name}.normal_xy must not be zero")
+    row = np.empty(6)
+    row[0:2], row[2:4] = checked_vector(f"{name}.centre_xy", panel.centre_xy, 2), normal / length
+    row[4] = _checks.positive(f"{name}.width_m", panel.width_m)
+    check = _checks.positive if standing else _checks.finite_number
+    row[5] = check(f"{name}.height_m", panel.height_m)
+    return row
 
 
 # --------------------------------------------------------------------------------------------- the pitch
@@ -242,11 +246,17 @@ def pitch_vector(pitch: Pitch, ball_xy: ArrayLike, ground_m: float, radius_m: fl
     """The compiled flight's (N_PITCH,) pitch vector (slots in :mod:`kernels.ball.play`), checked (``ValueError``
     naming the field). ``ball_xy`` places a keeper without a position."""
     _checks.instance("pitch", pitch, Pitch)
+    for name in ("surface", "frame", "body"):
+        _checks.instance(f"pitch.{name}", getattr(pitch, name), Surface)
     vector = np.zeros(play.N_PITCH)
-    goal_row = panel_rows(pitch.wall or pitch.goal, pitch.goal)[1]
-    vector[play.GX : play.GH + 1] = goal_row
-    vector[play.POST_R] = _checks.positive("pitch.post_radius_m", pitch.post_radius_m)
+    vector[play.GX : play.GH + 1] = panel_row("pitch.goal", pitch.goal, standing=True)
+    post_radius = vector[play.POST_R] = _checks.positive("pitch.post_radius_m", pitch.post_radius_m)
     vector[play.NET_DEPTH] = _checks.positive("pitch.net_depth_m", pitch.net_depth_m)
+    if vector[play.NET_DEPTH] <= 2.0 * radius_m + post_radius:  # room for the whole ball over the line (a goal)
+        raise ValueError(
+            f"pitch.net_depth_m must be more than the ball's diameter and the post's radius "
+            f"({2.0 * radius_m + post_radius:g} m), got {pitch.net_depth_m!r}"
+        )
     vector[play.TURF] = ground_m - radius_m
     vector[play.HALF_WIDTH] = 0.5 * _checks.positive("pitch.pitch_width_m", pitch.pitch_width_m)
     vector[play.ROLL_DECEL] = _checks.non_negative(
@@ -260,7 +270,7 @@ def pitch_vector(pitch: Pitch, ball_xy: ArrayLike, ground_m: float, radius_m: fl
     ):
         vector[slot : slot + 5] = _surface_slots(name, surface, radius_m)
     if pitch.wall is not None:
-        wall_row = panel_rows(pitch.wall, pitch.goal)[0]
+        wall_row = panel_row("pitch.wall", pitch.wall, standing=True)
         players = pitch.wall_players
         if players is None:
             players = max(1, round(wall_row[4] / 0.5))
@@ -283,11 +293,20 @@ def keeper_slots(vector: NDArray[np.float64], keeper: Keeper, position_xy: tuple
     kx, ky = position_xy
     vector[play.KEEPER_ON] = 1.0
     vector[play.KX], vector[play.KY] = kx, ky
-    vector[play.K_RADIUS] = _checks.positive("keeper.body_radius_m", keeper.body_radius_m)
-    vector[play.K_COM] = _checks.positive("keeper.com_height_m", keeper.com_height_m)
-    vector[play.K_HANDS] = _checks.positive("keeper.hand_reach_m", keeper.hand_reach_m)
-    vector[play.K_FEET] = _checks.positive("keeper.foot_reach_m", keeper.foot_reach_m)
-    vector[play.K_REACT] = _checks.non_negative("keeper.reaction_s", keeper.reaction_s)
-    vector[play.K_PUSH] = _checks.positive("keeper.push_off_s", keeper.push_off_s)
-    vector[play.K_SPEED] = _checks.non_negative("keeper.dive_speed_ms", keeper.dive_speed_ms)
-    vector[play.K_TURN] = _checks.positive("keeper.turn_s", keeper.turn_s)
+    # Bounded by a human's size and speed, several times over (a keeper 10³⁰⁰ m tall overflowed his own box).
+    vector[play.K_RADIUS] = _within("keeper.body_radius_m", keeper.body_radius_m, 1.0)
+    vector[play.K_COM] = _within("keeper.com_height_m", keeper.com_height_m, 5.0)
+    vector[play.K_HANDS] = _within("keeper.hand_reach_m", keeper.hand_reach_m, 5.0)
+    vector[play.K_FEET] = _within("keeper.foot_reach_m", keeper.foot_reach_m, 5.0)
+    vector[play.K_REACT] = _within("keeper.reaction_s", keeper.reaction_s, 10.0, zero=True)
+    vector[play.K_PUSH] = _within("keeper.push_off_s", keeper.push_off_s, 10.0)
+    vector[play.K_SPEED] = _within("keeper.dive_speed_ms", keeper.dive_speed_ms, 20.0, zero=True)
+    vector[play.K_TURN] = _within("keeper.turn_s", keeper.turn_s, 10.0)
+
+
+def _within(name: str, value: object, most: float, *, zero: bool = False) -> float:
+    """A number in (0, ``most``] (``zero``: [0, ``most``]), else ``ValueError`` naming it."""
+    number = _checks.non_negative(name, value) if zero else _checks.positive(name, value)
+    if number > most:
+        raise ValueError(f"{name} must be at most {most:g}, got {value!r}")
+    return number

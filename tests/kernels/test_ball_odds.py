@@ -84,9 +84,36 @@ def test_the_odds_map_reports_progress_and_its_shares_sum_to_one() -> None:
 
 @pytest.mark.parametrize(
     ("kwargs", "name"),
-    [({"n": 0}, "n"), ({"draw": -1}, "draw"), ({"spread": odds.StrikeSpread(speed_ms=-1.0)}, "speed_ms")],
+    [
+        ({"n": 0}, "n"),
+        ({"draw": -1}, "draw"),
+        ({"spread": odds.StrikeSpread(speed_ms=-1.0)}, "speed_ms"),
+        ({"spread": "s"}, "spread must be a StrikeSpread"),
+    ],
 )
 def test_bad_odds_input_raises_naming_it(kwargs, name) -> None:
     wall, goal = ball.free_kick_panels((-22.0, 0.0), (0.0, 0.0), (1.0, 0.0))
     with pytest.raises(ValueError, match=name):
         odds.strike_odds((-22.0, 0.0, R), 25.0, 0.3, 0.0, SPIN, ball.Pitch(goal, wall), **kwargs, **OPTIONS)
+
+
+def test_strike_odds_wants_a_pitch() -> None:
+    with pytest.raises(ValueError, match="pitch must be a Pitch"):
+        odds.strike_odds((-22.0, 0.0, R), 25.0, 0.3, 0.0, SPIN, None, **OPTIONS)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "name"),
+    [
+        ({"wall": "yes"}, "wall must be True or False"),
+        ({"keeper": "keeper"}, "keeper must be a Keeper"),
+        ({"surface": 1.0}, "surface must be a Surface"),
+        ({"distances_m": [[20.0, 21.0]]}, "distances_m must be a non-empty 1-D array"),
+        ({"angles_rad": []}, "angles_rad must be a non-empty 1-D array"),
+        ({"spread": "s"}, "spread must be a StrikeSpread"),
+    ],
+)
+def test_bad_odds_map_input_raises_naming_it(kwargs, name) -> None:
+    arguments = {"distances_m": [20.0], "angles_rad": [0.0], **kwargs}
+    with pytest.raises(ValueError, match=name):
+        odds.odds_map(speed_ms=25.0, elevation_rad=0.3, aim_rad=0.0, spin_rads=SPIN, n=2, **arguments, **OPTIONS)

@@ -405,9 +405,8 @@ def test_a_roll_with_heavy_spin_flies_on_a_pitch_as_without_one(spin: float) -> 
     # The divergence guard counted the launch's speed and height, not its spin: a 5 m/s roll spun at 500 rad/s
     # (S = 11, inside the measured model's range) sped up at its first bounce and was refused as diverging.
     start, velocity, spinning = (-15.0, 0.0, R), (5.0, 0.0, 0.0), (0.0, spin, 0.0)
-    options = {"dt": 1e-3, "ground_m": R}
-    ball.simulate(start, velocity, spinning, **options)  # flies without a pitch
-    flight = ball.simulate(start, velocity, spinning, pitch=ball.Pitch(GOAL, WALL), **options)
+    ball.simulate(start, velocity, spinning, dt=1e-3, ground_m=R)  # flies without a pitch
+    flight = ball.simulate(start, velocity, spinning, dt=1e-3, ground_m=R, pitch=ball.Pitch(GOAL, WALL))
     assert flight.ended in ("stopped", "t_max")
     assert flight.events[0].kind == "ground"
     assert np.all(np.diff(energy(flight)) <= 1e-9 * energy(flight)[0])
@@ -472,6 +471,18 @@ def test_drag_crisis_centre_is_a_setting() -> None:
         (ball.Pitch(GOAL, WALL, wall_players=0), "wall_players"),
         (ball.Pitch(GOAL, keeper=ball.Keeper(push_off_s=0.0)), "push_off_s"),
         ("pitch", "pitch must be a Pitch"),
+        # Each field of the wrong type, the goal named as the goal, sizes a pitch cannot have.
+        (ball.Pitch(None), r"pitch\.goal must be a Panel"),  # type: ignore[arg-type]
+        (ball.Pitch(GOAL, "wall"), r"pitch\.wall must be a Panel"),  # type: ignore[arg-type]
+        (ball.Pitch(GOAL, surface="turf"), r"pitch\.surface must be a Surface"),  # type: ignore[arg-type]
+        (ball.Pitch(GOAL, frame=None), r"pitch\.frame must be a Surface"),  # type: ignore[arg-type]
+        (ball.Pitch(ball.Panel((math.nan, 0.0), (1.0, 0.0), 7.32, 2.44)), r"pitch\.goal\.centre_xy"),
+        (ball.Pitch(ball.Panel((0.0, 0.0), (1.0, 0.0), 0.0, 2.44)), r"pitch\.goal\.width_m"),
+        (ball.Pitch(ball.Panel((0.0, 0.0), (1.0, 0.0), 7.32, -1.0)), r"pitch\.goal\.height_m"),
+        (ball.Pitch(GOAL, ball.Panel(WALL.centre_xy, WALL.normal_xy, 2.0, -5.0)), r"pitch\.wall\.height_m"),
+        (ball.Pitch(GOAL, net_depth_m=0.05), "net_depth_m"),
+        (ball.Pitch(GOAL, keeper=ball.Keeper(hand_reach_m=1e300)), "hand_reach_m"),
+        (ball.Pitch(GOAL, keeper=ball.Keeper(dive_speed_ms=1e6)), "dive_speed_ms"),
     ],
 )
 def test_a_bad_pitch_raises_naming_the_field(pitch, name) -> None:
