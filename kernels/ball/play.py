@@ -402,6 +402,7 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
     half_goal, rp, turf = 0.5 * pitch[GW], pitch[POST_R], pitch[TURF]
     n_events, first_frame, touched_wall, touched_keeper, scored, inside = 0, -1, False, False, False, False
     rolling = False
+    chatter, supported_t = 0, -math.inf  # contacts in quick succession on bodies below the ball, the last one's time
     law, rk4 = force_law(kick, config), config[RK4] != 0.0
     crossed = 2.0  # fraction of this step at which the whole ball is over the goal line (2: not in this step)
     t, n, ending = 0.0, 1, ENDED_T_MAX
@@ -613,6 +614,16 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
                     # or rests against it. Without this it struck the body again at once, contact after contact.
                     vx, vy = vx - into * normal[0], vy - into * normal[1]
                 wx, wy, wz = -vy / radius, vx / radius, 0.0
+            elif kind != GROUND_HIT and normal[2] >= 0.5:  # on a body below it: a head, the bar, a post's top
+                chatter = chatter + 1 if t - supported_t < 0.01 else 0
+                supported_t = t
+                if vx * vx + vy * vy + vz * vz < pitch[ROLL_SPEED] ** 2 or chatter >= 2:
+                    # Settled there: it leaves slower than a ground bounce that starts the roll (slow overall: a
+                    # fast ball grazing the bar leaves with a weak rebound too), or it is caught between two heads,
+                    # struck three times inside 10 ms. Each bounce would come sooner than the last, without end.
+                    # The ball rests there.
+                    vx, vy, vz, wx, wy, wz = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+                    ending, done = STOPPED, True
             if kind == WALL:
                 touched_wall = True
             elif kind != GROUND_HIT and first_frame < 0:

@@ -379,6 +379,53 @@ def test_rolls_and_low_kicks_get_the_flights_verdict_and_end_honestly(
 
 
 @pytest.mark.parametrize(
+    ("start", "velocity", "spin", "options", "result"),
+    [
+        # A lob onto the wall's heads: it chattered on them, 64 contacts, and "ended at t_max" at 3.4 s.
+        ((-22.0, 0.389, 0.0), (4.232, 0.219, 10.58), (3.989, -1.382, -0.246), {"dt": 0.01}, "wall"),
+        ((-12.85, 0.0, 3.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), {}, "wall"),  # dropped between two heads
+        ((-12.85, 0.25, 3.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), {}, "wall"),  # onto a head
+        ((0.0, 0.0, 5.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), {}, "bar"),  # onto the bar
+        ((-12.85, 0.0, 3.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), {"dt": 0.01, "method": "rk4"}, "wall"),
+    ],
+)
+def test_a_ball_that_settles_on_a_head_or_the_bar_rests_there(start, velocity, spin, options, result) -> None:
+    # Each bounce on a body below the ball came sooner than the last, without end, until the contacts ran out.
+    flight = ball.simulate(start, velocity, spin, pitch=ball.Pitch(GOAL, WALL), **{"ground_m": 0.0, **options})
+    assert flight.result == result
+    assert flight.ended == "stopped"
+    assert len(flight.events) < 16
+    np.testing.assert_array_equal(flight.velocity[-1], 0.0)
+    assert flight.position[-1, 2] > 1.5  # up on the body, not fallen through it
+
+
+@pytest.mark.parametrize("method", ["euler", "rk4"])
+def test_balls_dropped_onto_the_wall_and_the_frame_end_honestly(method: str) -> None:
+    # The family: 2000 balls dropped or lobbed gently onto the wall's heads, the bar and the posts' tops, spun or not.
+    rng = np.random.default_rng(2)
+    k = 2000
+    on_wall = rng.random(k) < 0.5
+    starts = np.column_stack(
+        [
+            np.where(on_wall, -12.85 + rng.uniform(-0.3, 0.3, k), rng.uniform(-0.3, 0.3, k)),
+            np.where(on_wall, rng.uniform(-1.2, 1.2, k), rng.uniform(-4.0, 4.0, k)),
+            rng.uniform(2.6, 5.0, k),
+        ]
+    )
+    velocities = rng.normal(0.0, 1.0, (k, 3))
+    spins = rng.normal(0.0, 10.0, (k, 3)) * (rng.random((k, 1)) < 0.5)
+    options = {"dt": 1e-3 if method == "euler" else 1e-2, "method": method, "ground_m": R, "t_max": 6.0}
+    flights = ball.simulate_batch(starts, velocities, spins, pitch=ball.Pitch(GOAL, WALL), **options)
+    assert flights.result is not None and flights.events is not None
+    assert int((flights.result == "wall").sum()) > 200 and int((flights.result == "bar").sum()) > 50
+    last = flights.t[np.arange(k), flights.n_samples - 1]
+    assert np.all(last[flights.ended == "t_max"] == pytest.approx(6.0))
+    assert max(len(events) for events in flights.events) < play.MAX_EVENTS
+    judged = ball.simulate_outcomes(starts, velocities, spins, pitch=ball.Pitch(GOAL, WALL), **options)
+    assert list(judged.result) == list(flights.result)
+
+
+@pytest.mark.parametrize(
     ("start", "velocity", "pitch", "result"),
     [
         # Rolling away from the goal, or along its line, into a post: judged "short", the roll being away.
