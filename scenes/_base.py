@@ -39,7 +39,7 @@ from server.clean import ControlSpec as ControlSpec
 from server.clean import clean_value, control_spec
 from server.clean import mark_costly as mark_costly
 from server.clean import record_spec as record_spec
-from server.sessions import Session
+from server.sessions import CameraReport, Session
 from server.turns import TURNS as TURNS
 
 logger = logging.getLogger(__name__)
@@ -149,7 +149,7 @@ class Scene(abc.ABC, Generic[P]):
         self.server.cameras.add(listener)
         self._camera_listeners.append(listener)
         for client in self.server.get_clients().values():
-            listener(client.camera)
+            listener(CameraReport(client.camera))  # type: ignore[arg-type]  # reads as the handle does
 
     def start_loop(self, step: Callable[[float], bool], period_s: float) -> None:
         """Run ``step(dt)`` every ``period_s`` on a daemon thread until :meth:`close`; it sleeps, never spins.

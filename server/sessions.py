@@ -21,6 +21,7 @@ from collections.abc import Callable
 from contextlib import AbstractContextManager
 from typing import TYPE_CHECKING, ParamSpec, TypeVar
 
+import numpy as np
 import viser
 
 from server.clean import record_spec
@@ -74,11 +75,64 @@ class GuiFacade:
         self.configure_theme = api.configure_theme
 
 
+class CameraReport:
+    """One camera message as it came in: the values viser's camera handle held then, read once (any that cannot be
+    read are read from the handle on use, and raise there as they would have). Writes (``position``, ``look_at``,
+    ``up_direction``, ...) go to the live handle, and so to the tab.
+
+    viser hands a camera callback the live handle on a thread pool, and a later message, or another listener's
+    write to the handle (the framing's), may have replaced its values by the time a listener reads them: the SDF
+    gallery once rendered its reference from a framing it wrote itself instead of the view the tab reported.
+    """
+
+    handle: viser.CameraHandle
+    """The live handle (writes go to it)."""
+
+    _FIELDS = (
+        "wxyz",
+        "position",
+        "look_at",
+        "up_direction",
+        "fov",
+        "aspect",
+        "near",
+        "far",
+        "image_width",
+        "image_height",
+    )
+
+    def __init__(self, handle: viser.CameraHandle) -> None:
+        values: dict[str, object] = {}
+        for name in self._FIELDS:
+            try:
+                value = getattr(handle, name)
+            except Exception:  # a handle with no report yet asserts, a crafted one may hold anything: read on use
+                continue
+            values[name] = value.copy() if isinstance(value, np.ndarray) else value
+        object.__setattr__(self, "handle", handle)
+        object.__setattr__(self, "_values", values)
+
+    @property
+    def client(self) -> viser.ClientHandle:
+        return self.handle.client
+
+    def __getattr__(self, name: str) -> object:  # only names not set on the report itself
+        values = object.__getattribute__(self, "_values")
+        if name in values:
+            return values[name]
+        return getattr(object.__getattribute__(self, "handle"), name)
+
+    def __setattr__(self, name: str, value: object) -> None:
+        setattr(self.handle, name, value)
+
+
 class CameraHub:
     """One set of viser camera callbacks per server (or per client), forwarding to whichever scenes listen now.
 
     viser 1.1.1 cannot remove an ``on_client_connect`` or camera callback, so a scene that registered its own would
-    stay reachable (and keep being called) after it closed; scenes subscribe here instead.
+    stay reachable (and keep being called) after it closed; scenes subscribe here instead. Each message reaches the
+    listeners as a :class:`CameraReport` of its own values, messages in the order they came, one at a time; a
+    listener that raises is logged and the others still hear of it.
     """
 
     def __init__(self, server: viser.ViserServer | None, client: viser.ClientHandle | None) -> None:
@@ -92,14 +146,25 @@ class CameraHub:
             server.on_client_connect(self._attach)
 
     def _attach(self, client: viser.ClientHandle) -> None:
-        client.camera.on_update(self._dispatch)
-        self._dispatch(client.camera)
+        # A tab's first camera message connects it and then reaches this callback too; a tab already connected is
+        # read by each listener as it subscribes (scenes._base.Scene.watch_cameras).
+        client.camera.on_update(self._on_message)
 
-    def _dispatch(self, camera: viser.CameraHandle) -> None:
+    async def _on_message(self, camera: viser.CameraHandle) -> None:
+        # A coroutine callback: viser awaits it on its event loop as it takes the message, so the report holds this
+        # message's values and the listeners hear of messages one at a time, in order (a plain callback would run
+        # on viser's thread pool, in any order, reading whatever the handle holds by then). The listeners are
+        # quick: they record the camera and hand any work to their scene's worker.
+        self._dispatch(CameraReport(camera))
+
+    def _dispatch(self, report: CameraReport) -> None:
         with self._lock:
             listeners = list(self._listeners)
         for listener in listeners:
-            listener(camera)
+            try:
+                listener(report)  # type: ignore[arg-type]  # a CameraReport reads as the handle does
+            except Exception:
+                logger.exception("a camera listener failed; the others still hear of the camera")
 
     def add(self, listener: Callable[[viser.CameraHandle], None]) -> None:
         with self._lock:
