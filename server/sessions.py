@@ -14,6 +14,7 @@ stays reachable from viser.
 
 from __future__ import annotations
 
+import asyncio
 import logging
 import threading
 import weakref
@@ -87,6 +88,8 @@ class CameraReport:
 
     handle: viser.CameraHandle
     """The live handle (writes go to it)."""
+    tab: object
+    """Which tab reported it (its client id)."""
 
     _FIELDS = (
         "wxyz",
@@ -109,7 +112,12 @@ class CameraReport:
             except Exception:  # a handle with no report yet asserts, a crafted one may hold anything: read on use
                 continue
             values[name] = value.copy() if isinstance(value, np.ndarray) else value
+        try:
+            tab: object = int(handle.client.client_id)
+        except Exception:  # a handle without a client: one of its own
+            tab = id(handle)
         object.__setattr__(self, "handle", handle)
+        object.__setattr__(self, "tab", tab)
         object.__setattr__(self, "_values", values)
 
     @property
@@ -131,13 +139,15 @@ class CameraHub:
 
     viser 1.1.1 cannot remove an ``on_client_connect`` or camera callback, so a scene that registered its own would
     stay reachable (and keep being called) after it closed; scenes subscribe here instead. Each message reaches the
-    listeners as a :class:`CameraReport` of its own values, messages in the order they came, one at a time; a
-    listener that raises is logged and the others still hear of it.
+    listeners as a :class:`CameraReport` of its own values, in the order they came, one at a time, off the event loop
+    (a tab's burst coalesced to its newest report); a listener that raises is logged and the others still hear of it.
     """
 
     def __init__(self, server: viser.ViserServer | None, client: viser.ClientHandle | None) -> None:
         self._listeners: list[Callable[[viser.CameraHandle], None]] = []
         self._lock = threading.Lock()
+        self._pending: dict[object, CameraReport] = {}  # the newest report of each tab not yet heard, oldest first
+        self._draining = False
         if client is not None:
             self._attach(client)
         elif server is not None:
@@ -152,19 +162,31 @@ class CameraHub:
 
     async def _on_message(self, camera: viser.CameraHandle) -> None:
         # A coroutine callback: viser awaits it on its event loop as it takes the message, so the report holds this
-        # message's values and the listeners hear of messages one at a time, in order (a plain callback would run
-        # on viser's thread pool, in any order, reading whatever the handle holds by then). The listeners are
-        # quick: they record the camera and hand any work to their scene's worker.
-        self._dispatch(CameraReport(camera))
-
-    def _dispatch(self, report: CameraReport) -> None:
+        # message's values (a plain callback runs later on viser's thread pool and reads whatever the handle holds
+        # by then). The listeners run off the loop, on one thread at a time, in order, each tab's burst coalesced
+        # to its newest report: a framing (which may redraw a scene under its lock) never holds up the server.
+        report = CameraReport(camera)
         with self._lock:
-            listeners = list(self._listeners)
-        for listener in listeners:
-            try:
-                listener(report)  # type: ignore[arg-type]  # a CameraReport reads as the handle does
-            except Exception:
-                logger.exception("a camera listener failed; the others still hear of the camera")
+            self._pending.pop(report.tab, None)
+            self._pending[report.tab] = report
+            if self._draining:
+                return  # the thread draining the reports takes it
+            self._draining = True
+        asyncio.get_running_loop().run_in_executor(None, self._drain)
+
+    def _drain(self) -> None:
+        while True:
+            with self._lock:
+                if not self._pending:
+                    self._draining = False
+                    return
+                report = self._pending.pop(next(iter(self._pending)))
+                listeners = list(self._listeners)
+            for listener in listeners:
+                try:
+                    listener(report)  # type: ignore[arg-type]  # a CameraReport reads as the handle does
+                except Exception:
+                    logger.exception("a camera listener failed; the others still hear of the camera")
 
     def add(self, listener: Callable[[viser.CameraHandle], None]) -> None:
         with self._lock:

@@ -3,6 +3,7 @@ the camera by one listener (the framing's) or a later message never changes what
 
 from __future__ import annotations
 
+import asyncio
 import threading
 from typing import Any
 
@@ -36,13 +37,21 @@ def test_a_listener_reads_the_reported_camera_even_after_another_wrote_to_it(ser
     assert (9.0, 9.0, 9.0) not in seen
 
 
-def test_reports_arrive_one_at_a_time_in_the_order_sent(server: viser.ViserServer) -> None:
+def test_reports_arrive_one_at_a_time_in_order_off_the_event_loop(server: viser.ViserServer) -> None:
+    # A tab's burst may be coalesced to its newest report, but what arrives comes in the order it was sent, one
+    # report at a time, and never on the server's event loop (a framing there held up every tab during a resize).
     seen: list[float] = []
     inside = threading.Semaphore(1)
     overlaps: list[bool] = []
+    on_loop: list[bool] = []
 
     def records(camera: Any) -> None:
         overlaps.append(not inside.acquire(blocking=False))
+        try:
+            asyncio.get_running_loop()
+            on_loop.append(True)
+        except RuntimeError:
+            on_loop.append(False)
         try:
             seen.append(float(np.asarray(camera.position)[0]))
         finally:
@@ -55,8 +64,8 @@ def test_reports_arrive_one_at_a_time_in_the_order_sent(server: viser.ViserServe
             client.send_camera(position=(x, -3.0, 1.0))
         wait_until(lambda: seen[-1:] == [sent[-1]], "the last camera")
     reported = [x for x in seen if x in sent]
-    assert reported == sent
-    assert not any(overlaps)
+    assert reported == sorted(set(reported))  # in order, none twice
+    assert not any(overlaps) and not any(on_loop)
 
 
 def test_a_failing_listener_does_not_keep_the_camera_from_the_others(server: viser.ViserServer) -> None:
