@@ -113,13 +113,6 @@ def draw_strikes(
     return velocities, spins
 
 
-def _spread(spread: object) -> StrikeSpread:
-    """``spread``, or the default scatter for None; ``ValueError`` for anything else."""
-    if spread is None:
-        return StrikeSpread()
-    return _checks.instance("spread", spread, StrikeSpread)
-
-
 def strike_odds(
     position: ArrayLike,
     speed_ms: float,
@@ -150,7 +143,9 @@ def strike_odds(
     """
     start = checked_vector("position", position, 3)
     _checks.instance("pitch", pitch, Pitch)
-    velocities, spins = draw_strikes(speed_ms, elevation_rad, azimuth_rad, spin_rads, _spread(spread), n, draw)
+    velocities, spins = draw_strikes(
+        speed_ms, elevation_rad, azimuth_rad, spin_rads, StrikeSpread() if spread is None else spread, n, draw
+    )
     starts = np.broadcast_to(start, velocities.shape)
     judged = simulate_outcomes(starts, velocities, spins, pitch=pitch, **options)
     return Odds(judged.counts(), len(velocities))
@@ -200,7 +195,9 @@ def odds_map(
     settings = flight_config(None, options).settings
     ground, radius = float(settings[GROUND]), float(settings[RADIUS])
     # One scatter, drawn along +x, turned to each spot.
-    velocities, spins = draw_strikes(speed_ms, elevation_rad, aim_rad, spin, _spread(spread), n, draw)
+    velocities, spins = draw_strikes(
+        speed_ms, elevation_rad, aim_rad, spin, StrikeSpread() if spread is None else spread, n, draw
+    )
     spots = np.array(
         [[-d * math.cos(a), d * math.sin(a)] for d in distances for a in angles], dtype=np.float64
     ).reshape(-1, 2)
