@@ -400,7 +400,7 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
     body_surface = pitch[BODY_SURFACE : BODY_SURFACE + N_SURFACE]
     gx, gy, gnx, gny = pitch[GX], pitch[GY], pitch[GNX], pitch[GNY]
     half_goal, rp, turf = 0.5 * pitch[GW], pitch[POST_R], pitch[TURF]
-    n_events, first_frame, touched_wall, touched_keeper, scored, inside = 0, -1, False, False, False, False
+    n_events, first_body, touched_keeper, scored, inside = 0, -1, False, False, False
     rolling = False
     chatter, supported_t = 0, -math.inf  # contacts in quick succession on bodies below the ball, the last one's time
     law, rk4 = force_law(kick, config), config[RK4] != 0.0
@@ -624,10 +624,8 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
                     # The ball rests there.
                     vx, vy, vz, wx, wy, wz = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
                     ending, done = STOPPED, True
-            if kind == WALL:
-                touched_wall = True
-            elif kind != GROUND_HIT and first_frame < 0:
-                first_frame = kind
+            if kind != GROUND_HIT and first_body < 0:
+                first_body = kind  # the wall's players, a post or the bar: the first of them decides the verdict
         elif kind == KEEPER:
             touched_keeper, ending, done = True, SAVED, True
         elif kind == NET:
@@ -661,16 +659,18 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
         ):
             break
     # Whole ball over the line between the posts and under the bar, at any time (off the post, the bar, the wall
-    # or the keeper too), is a goal; then the keeper, the wall, the frame, and where it crossed the line.
+    # or the keeper too), is a goal; then the keeper; then the first of the wall and the frame it struck (a ball off
+    # the bar that bounces back into the wall's backs hit the bar: the wall did not block it); then where it crossed
+    # the line.
     if scored:
         result = GOAL
     elif touched_keeper:
         result = SAVED_RESULT
-    elif touched_wall:
+    elif first_body == WALL:
         result = WALL_RESULT
-    elif first_frame == POST:
+    elif first_body == POST:
         result = POST_RESULT
-    elif first_frame == BAR:
+    elif first_body == BAR:
         result = BAR_RESULT
     elif not math.isnan(info[I_GOAL]):
         lateral = -(info[I_GOAL + 1] - gx) * gny + (info[I_GOAL + 2] - gy) * gnx
