@@ -186,8 +186,9 @@ def _round_down(value: float) -> float:
 
 
 def _refuse_overflow(endings: NDArray[np.int64], config: NDArray[np.float64], launches: NDArray[np.float64]) -> None:
-    """Raise where a kick's step was beyond the method's stability limit (ending 4, not flown), or where a flight
-    overflowed to inf or NaN (ending 3: a step too long for its drag that the limit does not bound, or absurd input).
+    """Raise where a kick's step was beyond the method's stability limit (ending 4, not flown), where its ball
+    started inside a body of the pitch (ending 9, not flown), or where a flight overflowed to inf or NaN (ending 3: a
+    step too long for its drag that the limit does not bound, or absurd input).
     ``launches`` are the (K, 13) launch rows, for the limit the message names."""
     refused = np.flatnonzero(endings == 4)
     if refused.size:
@@ -200,6 +201,13 @@ def _refuse_overflow(endings: NDArray[np.int64], config: NDArray[np.float64], la
             f"{method}, the method's stability limit with the drag at {fastest:.3g} m/s (the fastest this ball "
             "can fly; see kernels.ball): a longer step overshoots the drag, reversing or amplifying the velocity; "
             "use a smaller dt, or a smaller air_density or a larger mass_kg"
+        )
+    inside = np.flatnonzero(endings == 9)
+    if inside.size:
+        which = "the ball" if len(endings) == 1 else f"the ball of kicks {inside[:5].tolist()}"
+        raise ValueError(
+            f"position: {which} starts inside a post, the bar, a player of the wall or the keeper (at "
+            f"{launches[int(inside[0]), :3].tolist()} m); it would leave the body with no contact: start it outside"
         )
     bad = np.flatnonzero(endings == 3)
     if bad.size:
@@ -374,7 +382,7 @@ def _simulate_on_pitch(launch: NDArray[np.float64], settings: NDArray[np.float64
     t, state, spin, forces = np.empty(rows), np.empty((rows, 6)), np.empty((rows, 3)), np.empty((rows, 12))
     events, info = np.empty((play.MAX_EVENTS, 5)), np.empty(play.N_INFO)
     n, ending = play_one(launch, settings, vector, t, state, spin, forces, events, info)
-    if ending in (3, 4):
+    if ending in (3, 4, 9):
         _refuse_overflow(np.array([ending]), settings, launch[None])
     return dataclasses.replace(
         _trajectory(t, state, forces, n, ending),

@@ -2,8 +2,8 @@
 
 A flight writes its samples' times (T,) and states (T, 6: position then velocity, m and m/s) into buffers the caller
 gives; a batch runs its K kicks, a range of them per thread, into (T, K) and (T, K, 6) time-major buffers. Each flight
-ends with a code in :data:`ENDINGS` order (3: diverged; 4: not flown, its step beyond the method's stability limit),
-each verdict with one in :data:`RESULTS` order. Crossings are the first root of the cubic Hermite interpolant of the
+ends with a code in :data:`ENDINGS` order (3: diverged; 4: not flown, its step beyond the method's stability limit;
+9: not flown, the ball starts inside a body of the pitch), each verdict with one in :data:`RESULTS` order. Crossings are the first root of the cubic Hermite interpolant of the
 step (:func:`crossing_fraction`). Method and assumptions: :mod:`kernels.ball`.
 """
 
@@ -21,9 +21,20 @@ from kernels.ball.jit import compiled
 Ending = Literal["ground", "x_stop", "t_max", "stopped", "net", "out", "saved"]
 Result = Literal["goal", "wall", "over", "wide", "short", "post", "bar", "saved"]
 
-# Codes of the compiled flight's ending (3 diverged and 4 refused raise; 5–8 only on a pitch, kernels.ball.play)
-# and of its verdict (5–7 only on a pitch).
-ENDINGS: tuple[str, ...] = ("ground", "x_stop", "t_max", "diverged", "refused", "stopped", "net", "out", "saved")
+# Codes of the compiled flight's ending (3 diverged, 4 refused and 9 started inside a body raise; 5–9 only on a
+# pitch, kernels.ball.play) and of its verdict (5–7 only on a pitch).
+ENDINGS: tuple[str, ...] = (
+    "ground",
+    "x_stop",
+    "t_max",
+    "diverged",
+    "refused",
+    "stopped",
+    "net",
+    "out",
+    "saved",
+    "inside",
+)
 RESULTS: tuple[Result, ...] = ("goal", "wall", "over", "wide", "short", "post", "bar", "saved")
 
 

@@ -64,7 +64,7 @@ EXTRA_ROWS = 2 * MAX_EVENTS + 2
 
 # Event kinds, ending codes and result codes (their names: kernels.ball.api).
 GROUND_HIT, POST, BAR, WALL, KEEPER, NET = range(6)
-ENDED_X_STOP, ENDED_T_MAX, DIVERGED, REFUSED, STOPPED, IN_NET, OUT, SAVED = 1, 2, 3, 4, 5, 6, 7, 8
+ENDED_X_STOP, ENDED_T_MAX, DIVERGED, REFUSED, STOPPED, IN_NET, OUT, SAVED, INSIDE = 1, 2, 3, 4, 5, 6, 7, 8, 9
 GOAL, WALL_RESULT, OVER, WIDE, SHORT, POST_RESULT, BAR_RESULT, SAVED_RESULT = range(8)
 
 # Slots of a flight's (N_INFO,) summary.
@@ -393,6 +393,12 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
     if keeper:
         _keeper_box(pitch, dive_t, target, radius + 1e-3, boxes)  # standing until he dives
     frame_box, wall_box, keeper_box = _box(boxes, 0), _box(boxes, 1), _box(boxes, 2)
+    if keeper:
+        _keeper_capsule(pitch, dive_t, target, 0.0, caps[n_fixed])
+    for c in range(n_caps):  # a ball that starts inside a body would leave it with no contact: not flown
+        if _to_axis(x, y, z, caps[c])[0] < (caps[c, 6] + radius) * (1.0 - 1e-9):
+            info[I_RESULT] = SHORT
+            return 1, INSIDE
     seen_t = math.inf if pitch[WALL_ON] != 0.0 else 0.0
     v_in, w_in, normal, v_new, w_new = np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3)
     turf_surface = pitch[TURF_SURFACE : TURF_SURFACE + N_SURFACE]

@@ -4,6 +4,7 @@ outcomes, and two published flights (Mencke et al. 2020, Bray & Kerwin 2003) as 
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable
 
@@ -28,6 +29,23 @@ def energy(flight: ball.Trajectory, g: float = G) -> np.ndarray:
     v2 = (flight.velocity**2).sum(axis=1)
     w2 = (flight.spin**2).sum(axis=1)
     return 0.5 * v2 + 0.5 * ALPHA * R**2 * w2 + g * flight.position[:, 2]
+
+
+def outside_bodies(starts: np.ndarray, pitch: ball.Pitch) -> np.ndarray:
+    """(K,) mask of the starts a batch on ``pitch`` accepts: not inside a post, the bar, the wall or the keeper (who
+    stands where the batch's first kick places him)."""
+    keeper = pitch.keeper
+    if keeper is not None and keeper.position_xy is None:
+        placed = dataclasses.replace(keeper, position_xy=keeper.placed(starts[0, :2], pitch.goal))
+        pitch = dataclasses.replace(pitch, keeper=placed)
+    keep = np.ones(len(starts), dtype=bool)
+    for i, start in enumerate(starts):
+        try:
+            ball.simulate(start, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), pitch=pitch, dt=1e-2, t_max=1e-2, ground_m=R)
+        except ValueError as error:
+            assert str(error).startswith("position: the ball starts inside"), error
+            keep[i] = False
+    return keep
 
 
 def test_a_2_m_drop_rebounds_inside_fifa_quality_pros_band_and_settles_to_a_stop() -> None:
@@ -356,9 +374,42 @@ def test_the_first_body_a_ball_strikes_decides_its_verdict_unless_it_scores_or_i
             if flight.result not in ("goal", "saved") and first is not None:
                 assert flight.result == first, (velocity.tolist(), spin_k.tolist(), [e.kind for e in flight.events])
             if first is not None:
-                seen[(first, flight.result)] = seen.get((first, flight.result), 0) + 1
-    # The family holds every kind of first body, and bodies struck after it that do not decide.
+                seen[(first, str(flight.result))] = seen.get((first, str(flight.result)), 0) + 1
+    # The family reaches both: balls whose first body is the wall, and the bar.
     assert {("wall", "wall"), ("bar", "bar")} <= set(seen)
+
+
+@pytest.mark.parametrize(
+    ("body", "start"),
+    [
+        ("the left post", (0.0, 3.72, 1.0)),
+        ("the bar", (0.0, 1.0, 2.5 + R)),
+        ("a player of the wall", (-22.0 + 9.15, 0.1, 1.0)),
+        ("the keeper, standing", (-1.0, 0.0, 1.0)),
+    ],
+)
+def test_a_ball_that_starts_inside_a_body_is_refused_naming_the_position(body: str, start: tuple[float, ...]) -> None:
+    # It was flown: it left the body with no contact, through the post or the keeper.
+    pitch = ball.Pitch(GOAL, WALL, ball.Keeper())
+    options = {"dt": 1e-2, "method": "rk4", "model": "measured", "ground_m": R, "t_max": 4.0}
+    with pytest.raises(ValueError, match=r"^position: the ball starts inside"):
+        ball.simulate(start, (-5.0, 0.0, 2.0), (0.0, 0.0, 0.0), pitch=pitch, **options)
+    starts = [(-22.0, 0.0, R), start]
+    with pytest.raises(ValueError, match=r"^position: the ball of kicks \[1\] starts inside"):
+        ball.simulate_outcomes(starts, [(20.0, 0.0, 5.0)] * 2, [(0.0, 0.0, 0.0)] * 2, pitch=pitch, **options)
+    with pytest.raises(ValueError, match=r"^position: the ball of kicks \[1\] starts inside"):
+        ball.simulate_batch(starts, [(20.0, 0.0, 5.0)] * 2, [(0.0, 0.0, 0.0)] * 2, pitch=pitch, **options)
+
+
+def test_a_ball_that_starts_touching_a_post_flies_and_strikes_it_moving_in() -> None:
+    pitch = ball.Pitch(GOAL, WALL, ball.Keeper())
+    options = {"dt": 1e-2, "method": "rk4", "model": "measured", "ground_m": R, "t_max": 4.0}
+    touching = (0.0, 3.72 + 0.06 + R, 1.0)  # the post's surface: outside it, just
+    away = ball.simulate(touching, (0.0, 5.0, 0.0), (0.0, 0.0, 0.0), pitch=pitch, **options)
+    assert "post" not in [e.kind for e in away.events]
+    into = ball.simulate(touching, (0.0, -5.0, 0.0), (0.0, 0.0, 0.0), pitch=pitch, **options)
+    assert into.events[0].kind == "post"
+    assert into.events[0].t == 0.0
 
 
 def test_a_ball_rolled_into_the_wall_stops_against_it_and_its_verdict_is_the_wall() -> None:
@@ -408,6 +459,8 @@ def test_rolls_and_low_kicks_get_the_flights_verdict_and_end_honestly(
         ]
     )
     spins = rng.normal(0.0, 20.0, (k, 3)) * (rng.random((k, 1)) < 0.5)
+    keep = outside_bodies(starts, pitch)  # a start inside a post or the keeper is refused (tested above)
+    starts, velocities, spins, k = starts[keep], velocities[keep], spins[keep], int(keep.sum())
     options = {"dt": 1e-2, "method": "rk4", "model": "measured", "ground_m": R, "t_max": 6.0}
     judged = ball.simulate_outcomes(starts, velocities, spins, pitch=pitch, **options)
     flights = ball.simulate_batch(starts, velocities, spins, pitch=pitch, **options)
@@ -456,6 +509,8 @@ def test_balls_dropped_onto_the_wall_and_the_frame_end_honestly(method: str) -> 
     )
     velocities = rng.normal(0.0, 1.0, (k, 3))
     spins = rng.normal(0.0, 10.0, (k, 3)) * (rng.random((k, 1)) < 0.5)
+    keep = outside_bodies(starts, ball.Pitch(GOAL, WALL))  # a start inside the bar or a head is refused
+    starts, velocities, spins, k = starts[keep], velocities[keep], spins[keep], int(keep.sum())
     options = {"dt": 1e-3 if method == "euler" else 1e-2, "method": method, "ground_m": R, "t_max": 6.0}
     flights = ball.simulate_batch(starts, velocities, spins, pitch=ball.Pitch(GOAL, WALL), **options)
     assert flights.result is not None and flights.events is not None
