@@ -635,7 +635,11 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
         elif kind == KEEPER:
             touched_keeper, ending, done = True, SAVED, True
         elif kind == NET:
+            # The net lies behind the line and the ball came in through the mouth: what it stops drops inside the
+            # goal. A ball angled into the side netting met it with its centre 0.06 m past the line, before the
+            # whole ball was over (0.17 m), and stopped there, "short" or "post".
             vx, vy, vz, ending, done = 0.0, 0.0, 0.0, IN_NET, True
+            scored = True
         elif kind == -2:
             ending, done = ENDED_X_STOP, True
         else:  # kind == -3

@@ -412,6 +412,34 @@ def test_a_ball_that_starts_touching_a_post_flies_and_strikes_it_moving_in() -> 
     assert into.events[0].t == 0.0
 
 
+@pytest.mark.parametrize(
+    ("spot", "velocity", "surface", "contacts"),
+    [
+        # Angled into the side netting from 34.6 m: "short".
+        ((-28.713225829330998, -19.268327013847895), (23.616045812836926, 18.712347127014713, 7.9772595870634095),
+         ball.DRY_TURF, ["net"]),
+        # In off the post, then the side netting: "post".
+        ((-16.735104480165543, -5.859780408205981), (21.841244090695362, 12.362290900304643, 5.0607637549849045),
+         ball.WET_TURF, ["post", "ground", "net"]),
+    ],
+)  # fmt: skip
+def test_a_ball_the_side_netting_stops_is_a_goal(spot, velocity, surface, contacts) -> None:
+    # The side netting met the ball with its centre 0.06 m past the line, before the whole ball was over it (0.17 m),
+    # and stopped it there: it never scored. What the net stops drops inside the goal.
+    wall, goal = ball.free_kick_panels(spot, (0.0, 0.0), (1.0, 0.0))
+    pitch = ball.Pitch(goal, wall, ball.Keeper(), surface=surface)
+    options = {"dt": 1e-2, "method": "rk4", "model": "measured", "ground_m": R, "t_max": 4.0}
+    start = (*spot, R)
+    flight = ball.simulate(start, velocity, (0.0, 0.0, 0.0), pitch=pitch, **options)
+    assert [e.kind for e in flight.events] == contacts
+    assert flight.ended == "net"
+    assert 0.06 < flight.events[-1].position[0] < 0.17  # between the side netting and the whole ball over the line
+    assert flight.result == "goal"
+    assert list(ball.simulate_outcomes([start], [velocity], [(0.0, 0.0, 0.0)], pitch=pitch, **options).result) == [
+        "goal"
+    ]
+
+
 def test_a_ball_rolled_into_the_wall_stops_against_it_and_its_verdict_is_the_wall() -> None:
     # Rolled back at the wall from 6 m before the goal, it meets two players at once. It rested against them,
     # struck them 64 times at one instant and "ended at t_max" at 2.18 s; the verdict alone said "short", its roll
