@@ -3,8 +3,9 @@
 A flight writes its samples' times (T,) and states (T, 6: position then velocity, m and m/s) into buffers the caller
 gives; a batch runs its K kicks, a range of them per thread, into (T, K) and (T, K, 6) time-major buffers. Each flight
 ends with a code in :data:`ENDINGS` order (3: diverged; 4: not flown, its step beyond the method's stability limit;
-9: not flown, the ball starts inside a body of the pitch), each verdict with one in :data:`RESULTS` order. Crossings are the first root of the cubic Hermite interpolant of the
-step (:func:`crossing_fraction`). Method and assumptions: :mod:`kernels.ball`.
+9: not flown, the ball starts inside a body of the pitch), each verdict with one in :data:`RESULTS` order. Crossings
+are the first root of the cubic Hermite interpolant of the step (:func:`crossing_fraction`). Method and assumptions:
+:mod:`kernels.ball`.
 """
 
 from __future__ import annotations
