@@ -111,7 +111,9 @@ class Trajectory:
     """(N, 3) knuckleball side force (N); zero unless ``knuckle_seed`` was set and the spin is near zero."""
     ended: Ending
     """Why the flight stopped: it touched the ground (no pitch), passed ``x_stop``, or reached ``t_max``; on a
-    pitch also ``"stopped"`` (at rest on the turf), ``"net"``, ``"out"`` (left the pitch) or ``"saved"``."""
+    pitch also ``"stopped"`` (at rest on the turf), ``"net"``, ``"out"`` (left the pitch), ``"saved"`` or
+    ``"contacts"`` (its 64th contact, :data:`kernels.ball.play.MAX_EVENTS`: a surface that returns nearly all the
+    ball's energy)."""
     events: tuple[Event, ...] = ()
     """On a pitch: the contacts in order (ground, post, bar, wall, keeper, net); empty without one."""
     spin: NDArray[np.float64] | None = None
@@ -136,7 +138,7 @@ class BatchTrajectory:
     """(K,) samples that belong to each flight; the last is its interpolated end."""
     ended: NDArray[np.str_]
     """(K,) ``"ground"``, ``"x_stop"`` or ``"t_max"`` (on a pitch also ``"stopped"``, ``"net"``, ``"out"``,
-    ``"saved"``)."""
+    ``"saved"``, ``"contacts"``)."""
     events: tuple[tuple[Event, ...], ...] | None = None
     """On a pitch: each kick's contacts in order; None without one."""
     result: NDArray[np.str_] | None = None

@@ -19,10 +19,10 @@ from kernels.ball.aero import N_KICK, acceleration, fill_kick, force_law, max_st
 from kernels.ball.config import DT, GRAVITY, GROUND, N_STEPS, RADIUS, RK4, T_MAX, X_STOP
 from kernels.ball.jit import compiled
 
-Ending = Literal["ground", "x_stop", "t_max", "stopped", "net", "out", "saved"]
+Ending = Literal["ground", "x_stop", "t_max", "stopped", "net", "out", "saved", "contacts"]
 Result = Literal["goal", "wall", "over", "wide", "short", "post", "bar", "saved"]
 
-# Codes of the compiled flight's ending (3 diverged, 4 refused and 9 started inside a body raise; 5–9 only on a
+# Codes of the compiled flight's ending (3 diverged, 4 refused and 9 started inside a body raise; 5–10 only on a
 # pitch, kernels.ball.play) and of its verdict (5–7 only on a pitch).
 ENDINGS: tuple[str, ...] = (
     "ground",
@@ -35,6 +35,7 @@ ENDINGS: tuple[str, ...] = (
     "out",
     "saved",
     "inside",
+    "contacts",
 )
 RESULTS: tuple[Result, ...] = ("goal", "wall", "over", "wide", "short", "post", "bar", "saved")
 

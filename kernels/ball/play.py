@@ -57,14 +57,15 @@ KEEPER_ON, KX, KY, K_RADIUS, K_COM, K_HANDS, K_FEET, K_REACT, K_PUSH, K_SPEED, K
 N_PITCH = 48
 
 MAX_EVENTS = 64
-"""Contacts recorded per flight; a flight that would have more ends at the last (it is long at rest by then)."""
+"""Contacts recorded per flight; a flight ends at its 64th, with the ending ``"contacts"`` (only a surface that
+returns nearly all the ball's energy, restitution ≳ 0.97, bounces that often in a flight)."""
 MAX_CAPSULES = 20
 EXTRA_ROWS = 2 * MAX_EVENTS + 2
 """Samples a flight on a pitch may add to ``n_steps + 1``: one at each contact and one partial step after it."""
 
 # Event kinds, ending codes and result codes (their names: kernels.ball.api).
 GROUND_HIT, POST, BAR, WALL, KEEPER, NET = range(6)
-ENDED_X_STOP, ENDED_T_MAX, DIVERGED, REFUSED, STOPPED, IN_NET, OUT, SAVED, INSIDE = 1, 2, 3, 4, 5, 6, 7, 8, 9
+ENDED_X_STOP, ENDED_T_MAX, DIVERGED, REFUSED, STOPPED, IN_NET, OUT, SAVED, INSIDE, CONTACTS = range(1, 11)
 GOAL, WALL_RESULT, OVER, WIDE, SHORT, POST_RESULT, BAR_RESULT, SAVED_RESULT = range(8)
 
 # Slots of a flight's (N_INFO,) summary.
@@ -659,7 +660,10 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
         n += 1
         if stop_here and kind < 0:
             ending, done = (STOPPED if not done else ending), True
-        if done or n_events >= MAX_EVENTS:
+        if done:
+            break
+        if n_events >= MAX_EVENTS:
+            ending = CONTACTS
             break
         if rolling and vx == 0.0 and vy == 0.0:
             ending = STOPPED

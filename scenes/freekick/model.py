@@ -589,6 +589,7 @@ def play_words(played: ball.Trajectory | None) -> str:
         "out": "goes out of play",
         "stopped": f"rolls to a stop {max(-played.position[-1, 0], 0.0):.1f} m out",
         "saved": "into the keeper's hands",
+        "contacts": f"still bouncing after {len(played.events)} contacts",
     }.get(played.ended, f"still rolling after {PLAY_T_MAX_S:g} s")
     if bounces:
         phrases.append("bounces" if bounces == 1 else f"bounces {bounces}×")

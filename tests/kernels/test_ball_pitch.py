@@ -523,6 +523,33 @@ def test_a_ball_that_settles_on_a_head_or_the_bar_rests_there(start, velocity, s
 
 
 @pytest.mark.parametrize("method", ["euler", "rk4"])
+@pytest.mark.parametrize("restitution", [1.0, 0.99, 0.97, 0.9])
+def test_a_flight_that_runs_out_of_contacts_says_so(method: str, restitution: float) -> None:
+    # A ball on a near-perfectly elastic turf, dropped 5 cm and rolling at 0.5 m/s, hops about 0.2 s at a time: its
+    # 64th contact came long before t_max, and it ended there reported as "t_max". A less elastic turf lets it
+    # settle into a roll first (frictionless, in a vacuum: it is still rolling at t_max).
+    surface = ball.Surface(restitution=restitution, friction=0.0, rolling_deceleration_ms2=0.0)
+    pitch = ball.Pitch(GOAL, surface=surface)
+    start, velocity, spin = (-30.0, 0.0, R + 0.05), (0.5, 0.0, 0.0), (0.0, 0.5 / R, 0.0)
+    options = {"dt": 1e-3 if method == "euler" else 1e-2, "method": method, "ground_m": R, "t_max": 30.0}
+    options.update(air_density=0.0)
+    flight = ball.simulate(start, velocity, spin, pitch=pitch, **options)
+    assert all(event.kind == "ground" for event in flight.events)
+    if restitution == 1.0:
+        assert flight.ended == "contacts"
+    if flight.ended == "contacts":
+        assert len(flight.events) == play.MAX_EVENTS
+        assert flight.t[-1] == pytest.approx(flight.events[-1].t) and flight.t[-1] < 15.0
+    else:
+        assert len(flight.events) < play.MAX_EVENTS
+        assert flight.ended == "t_max" and flight.t[-1] == 30.0
+    batch = ball.simulate_batch([start], [velocity], [spin], pitch=pitch, **options)
+    assert batch.ended[0] == flight.ended and batch.n_samples[0] == len(flight.t)
+    judged = ball.simulate_outcomes([start], [velocity], [spin], pitch=pitch, **options)
+    assert judged.result[0] == flight.result == "short"
+
+
+@pytest.mark.parametrize("method", ["euler", "rk4"])
 def test_balls_dropped_onto_the_wall_and_the_frame_end_honestly(method: str) -> None:
     # The family: 2000 balls dropped or lobbed gently onto the wall's heads, the bar and the posts' tops, spun or not.
     rng = np.random.default_rng(2)
