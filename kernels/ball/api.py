@@ -637,6 +637,9 @@ def simulate_outcomes(
         :class:`BatchOutcome`.
     """
     settings, launches = _checked_batch(positions, velocities, spins, knuckle_seeds, config, options)
+    for name, panel in (("wall", wall), ("goal", goal)):
+        if panel is not None:
+            _checks.instance(name, panel, Panel)
     if pitch is not None:
         _checks.instance("pitch", pitch, Pitch)
         if (wall is not None and wall != pitch.wall) or (goal is not None and goal != pitch.goal):

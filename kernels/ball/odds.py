@@ -23,7 +23,12 @@ from kernels.ball import play
 from kernels.ball.api import pitch_outcomes, simulate_outcomes
 from kernels.ball.config import GROUND, RADIUS, check_launches, checked_seed, checked_vector, flight_config
 from kernels.ball.core import RESULTS
-from kernels.ball.pitch import Keeper, Pitch, Surface, free_kick_panels, pitch_vector
+from kernels.ball.pitch import WALL_DISTANCE_M, Keeper, Pitch, Surface, free_kick_panels, pitch_vector
+
+MAX_STRIKES = 1_000_000
+"""Most strikes one call flies (:func:`odds_map`: spots × ``n``): a million take about 17 s on 2 cores."""
+MAX_DISTANCE_M = 120.0
+"""The farthest spot of :func:`odds_map`: the longest pitch Law 1 allows."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -77,8 +82,16 @@ def draw_strikes(
     Speed, elevation and azimuth get normal scatter; the spin rate too (clipped at 0), and its axis is tilted by a
     normal angle in a uniformly drawn direction. The first strike is always the kick itself.
     """
+    speed_ms = _checks.non_negative("speed_ms", speed_ms)
+    elevation_rad = _checks.finite_number("elevation_rad", elevation_rad)
+    azimuth_rad = _checks.finite_number("azimuth_rad", azimuth_rad)
+    spin = checked_vector("spin_rads", spin_rads, 3)
+    scale = float(np.abs(spin).max())
+    rate = scale * float(np.linalg.norm(spin / scale)) if scale > 0.0 else 0.0  # |ω| without overflowing its square
+    if not math.isfinite(rate):
+        raise ValueError(f"spin_rads must have a finite magnitude, got {spin_rads!r}")
     spread = _checks.instance("spread", spread, StrikeSpread).checked()
-    count = _checks.integer("n", n, 1)
+    count = _strike_count("n", n, 1)
     rng = np.random.default_rng(checked_seed("draw", draw))
     normal = rng.standard_normal((count, 5))
     normal[0] = 0.0
@@ -88,10 +101,8 @@ def draw_strikes(
     velocities = speed[:, None] * np.stack(
         (np.cos(elevation) * np.cos(azimuth), np.cos(elevation) * np.sin(azimuth), np.sin(elevation)), axis=1
     )
-    spin = checked_vector("spin_rads", spin_rads, 3)
-    rate = float(np.linalg.norm(spin))
     rates = np.maximum(rate + 2.0 * math.pi * spread.spin_rate_rev_s * normal[:, 3], 0.0)
-    axis = spin / rate if rate > 0.0 else np.array([0.0, 0.0, 1.0])
+    axis = spin / scale / (rate / scale) if rate > 0.0 else np.array([0.0, 0.0, 1.0])
     # Tilt the axis by a normal angle about a random direction perpendicular to it (Rodrigues' rotation).
     helper = np.array([1.0, 0.0, 0.0]) if abs(axis[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
     e1 = np.cross(axis, helper)
@@ -184,8 +195,18 @@ def odds_map(
     for name, array in (("distances_m", distances), ("angles_rad", angles)):
         if array.ndim != 1 or len(array) == 0:
             raise ValueError(f"{name} must be a non-empty 1-D array, got shape {array.shape}")
-    spin = checked_vector("spin_rads", spin_rads, 3)
+    if not ((distances > WALL_DISTANCE_M) & (distances <= MAX_DISTANCE_M)).all():
+        raise ValueError(
+            f"distances_m must be in ({WALL_DISTANCE_M}, {MAX_DISTANCE_M:g}] m (beyond the wall's distance, on a "
+            f"pitch), got {distances_m!r}"
+        )
+    if not (np.abs(angles) < 0.5 * math.pi).all():
+        raise ValueError(f"angles_rad must be in (−π/2, π/2) (in front of the goal line), got {angles_rad!r}")
+    _checks.finite_number("aim_rad", aim_rad)
+    _strike_count("n", n * len(distances) * len(angles), len(distances) * len(angles), "n × spots")
     _checks.integer("chunks", chunks, 1)
+    if progress is not None and not callable(progress):
+        raise ValueError(f"progress must be None or a function of the share done, got {progress!r}")
     if not isinstance(wall, bool):
         raise ValueError(f"wall must be True or False, got {wall!r}")
     if keeper is not None:
@@ -196,7 +217,7 @@ def odds_map(
     ground, radius = float(settings[GROUND]), float(settings[RADIUS])
     # One scatter, drawn along +x, turned to each spot.
     velocities, spins = draw_strikes(
-        speed_ms, elevation_rad, aim_rad, spin, StrikeSpread() if spread is None else spread, n, draw
+        speed_ms, elevation_rad, aim_rad, spin_rads, StrikeSpread() if spread is None else spread, n, draw
     )
     spots = np.array(
         [[-d * math.cos(a), d * math.sin(a)] for d in distances for a in angles], dtype=np.float64
@@ -226,3 +247,12 @@ def odds_map(
     return {
         name: (per_spot == code).mean(axis=1).reshape(len(distances), len(angles)) for code, name in enumerate(RESULTS)
     }
+
+
+def _strike_count(name: str, value: object, minimum: int, what: str = "") -> int:
+    """An integer in [``minimum``, :data:`MAX_STRIKES`], else ``ValueError`` naming it (``what``: the product it
+    is part of)."""
+    count = _checks.integer(name, value, minimum)
+    if count > MAX_STRIKES:
+        raise ValueError(f"{what or name} must be at most {MAX_STRIKES:,} strikes in one call, got {count:,}")
+    return count

@@ -185,9 +185,8 @@ class Keeper:
             spot = checked_vector("keeper.position_xy", self.position_xy, 2)
             return float(spot[0]), float(spot[1])
         ball = checked_vector("ball_xy", ball_xy, 2)
-        centre = checked_vector("goal.centre_xy", goal.centre_xy, 2)
-        normal = checked_vector("goal.normal_xy", goal.normal_xy, 2)
-        normal = normal / float(np.hypot(*normal))
+        row = panel_row("goal", goal, standing=True)
+        centre, normal = row[0:2], row[2:4]
         along = np.array([-normal[1], normal[0]])
         # The bisector of the angle at the ball runs from the ball through the point that splits the goal line in
         # the ratio of the ball's distances to the posts; the keeper stands on it, depth_m out from the line.
@@ -274,6 +273,11 @@ def pitch_vector(pitch: Pitch, ball_xy: ArrayLike, ground_m: float, radius_m: fl
         players = pitch.wall_players
         if players is None:
             players = max(1, round(wall_row[4] / 0.5))
+            if players > 16:
+                raise ValueError(
+                    f"pitch.wall.width_m is {wall_row[4]:g} m, {players} players at 0.5 m each; a wall has at most "
+                    f"16 (8 m): give pitch.wall_players, or a narrower wall"
+                )
         if isinstance(players, bool) or not isinstance(players, (int, np.integer)) or not 1 <= players <= 16:
             raise ValueError(f"pitch.wall_players must be None or an integer in [1, 16], got {players!r}")
         vector[play.WALL_ON] = 1.0

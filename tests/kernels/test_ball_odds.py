@@ -117,3 +117,91 @@ def test_bad_odds_map_input_raises_naming_it(kwargs, name) -> None:
     arguments = {"distances_m": [20.0], "angles_rad": [0.0], **kwargs}
     with pytest.raises(ValueError, match=name):
         odds.odds_map(speed_ms=25.0, elevation_rad=0.3, aim_rad=0.0, spin_rads=SPIN, n=2, **arguments, **OPTIONS)
+
+
+# The intended kick's numbers, each bad in every way a caller can get one wrong. They reached numpy unchecked: a
+# string or None raised numpy's TypeError, inf and NaN gave NaN velocities, a negative speed was flown backwards.
+BAD_NUMBERS = ["25", None, math.inf, -math.inf, math.nan, True, 1j, [25.0], np.array([25.0, 1.0])]
+
+
+def _kick_arguments(function: str) -> tuple[dict[str, object], dict[str, object]]:
+    """The kick's scalar arguments by name, and the rest of a valid call, for one of the three odds functions."""
+    kick: dict[str, object] = {"speed_ms": 25.0, "elevation_rad": 0.3}
+    if function == "odds_map":
+        kick["aim_rad"] = 0.0
+        rest = {"distances_m": [20.0], "angles_rad": [0.0], "spin_rads": SPIN, "n": 2, **OPTIONS}
+    else:
+        kick["azimuth_rad"] = 0.0
+        rest = {"spin_rads": SPIN, "n": 2}
+        if function == "strike_odds":
+            wall, goal = ball.free_kick_panels((-22.0, 0.0), (0.0, 0.0), (1.0, 0.0))
+            rest.update(position=(-22.0, 0.0, R), pitch=ball.Pitch(goal, wall), **OPTIONS)
+        else:
+            rest["spread"] = odds.StrikeSpread()
+    return kick, rest
+
+
+@pytest.mark.parametrize("function", ["draw_strikes", "strike_odds", "odds_map"])
+@pytest.mark.parametrize("argument", ["speed_ms", "elevation_rad", "direction"])
+@pytest.mark.parametrize("bad", [*BAD_NUMBERS, -5.0], ids=repr)
+def test_a_bad_kick_number_raises_naming_it(function: str, argument: str, bad: object) -> None:
+    kick, rest = _kick_arguments(function)
+    if argument == "direction":
+        argument = "aim_rad" if function == "odds_map" else "azimuth_rad"
+    if type(bad) is float and bad == -5.0 and argument != "speed_ms":
+        getattr(odds, function)(**{**kick, argument: bad}, **rest)  # a negative angle is an angle
+        return
+    with pytest.raises(ValueError, match=f"^{argument} must be"):
+        getattr(odds, function)(**{**kick, argument: bad}, **rest)
+
+
+def test_a_huge_spin_keeps_its_axis_and_one_too_large_to_measure_is_refused() -> None:
+    # |ω|² of 1e200 rad/s overflowed to inf, and the axis came out NaN.
+    still = odds.StrikeSpread(0.0, 0.0, 0.0, 0.0, 0.0)
+    _, spins = odds.draw_strikes(25.0, 0.3, 0.0, (0.0, 3e200, 4e200), still, 3)
+    np.testing.assert_allclose(spins, [[0.0, 3e200, 4e200]] * 3, rtol=1e-15)
+    _, spins = odds.draw_strikes(25.0, 0.3, 0.0, (0.0, 3e-200, 4e-200), still, 3)
+    np.testing.assert_allclose(spins, [[0.0, 3e-200, 4e-200]] * 3, rtol=1e-15)
+    with pytest.raises(ValueError, match="spin_rads must have a finite magnitude"):
+        odds.draw_strikes(25.0, 0.3, 0.0, (1.5e308, 1.5e308, 1.5e308), still, 3)  # |ω| = 2.6e308
+
+
+def test_strike_counts_are_capped_before_anything_is_allocated() -> None:
+    # n = 10¹² asked numpy for 36 TiB and raised MemoryError.
+    velocities, _ = odds.draw_strikes(25.0, 0.3, 0.0, SPIN, odds.StrikeSpread(), odds.MAX_STRIKES)
+    assert velocities.shape == (odds.MAX_STRIKES, 3)
+    for n in (odds.MAX_STRIKES + 1, 10**12):
+        with pytest.raises(ValueError, match=r"^n must be at most 1,000,000 strikes"):
+            odds.draw_strikes(25.0, 0.3, 0.0, SPIN, odds.StrikeSpread(), n)
+    with pytest.raises(ValueError, match=r"^n × spots must be at most 1,000,000 strikes in one call, got 1,000,020"):
+        odds.odds_map([20.0, 25.0], [0.0, 0.1], 25.0, 0.3, 0.0, SPIN, n=250_005, **OPTIONS)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "name"),
+    [
+        # A spot too close was blamed on "ball_xy", an argument odds_map does not have.
+        ({"distances_m": [5.0]}, "distances_m must be in"),
+        ({"distances_m": [9.15]}, "distances_m must be in"),
+        ({"distances_m": [20.0, -20.0]}, "distances_m must be in"),
+        ({"distances_m": [120.5]}, "distances_m must be in"),
+        # 10³⁰⁰ m out: "the ball starts inside a post".
+        ({"distances_m": [1e300]}, "distances_m must be in"),
+        # Behind the goal line: every strike "short", a map of nothing.
+        ({"angles_rad": [3.0]}, "angles_rad must be in"),
+        ({"angles_rad": [0.0, -math.pi / 2]}, "angles_rad must be in"),
+        # progress=1 raised TypeError once the first chunk was flown.
+        ({"progress": 1}, "progress must be None or a function"),
+        ({"progress": "bar"}, "progress must be None or a function"),
+    ],
+)
+def test_a_bad_odds_map_grid_or_progress_raises_naming_it(kwargs, name) -> None:
+    arguments = {"distances_m": [20.0], "angles_rad": [0.0], **kwargs}
+    with pytest.raises(ValueError, match=f"^{name}"):
+        odds.odds_map(speed_ms=25.0, elevation_rad=0.3, aim_rad=0.0, spin_rads=SPIN, n=2, **arguments, **OPTIONS)
+
+
+def test_the_odds_maps_edges_are_accepted() -> None:
+    edges = odds.odds_map([9.2, 120.0], [-1.5, 1.5], 25.0, 0.3, 0.0, SPIN, n=2, progress=lambda share: None, **OPTIONS)
+    assert edges["goal"].shape == (2, 2)
+    np.testing.assert_allclose(sum(edges.values()), 1.0)

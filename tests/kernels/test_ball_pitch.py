@@ -7,6 +7,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 import pytest
@@ -682,11 +683,53 @@ def test_drag_crisis_centre_is_a_setting() -> None:
         (ball.Pitch(GOAL, net_depth_m=0.05), "net_depth_m"),
         (ball.Pitch(GOAL, keeper=ball.Keeper(hand_reach_m=1e300)), "hand_reach_m"),
         (ball.Pitch(GOAL, keeper=ball.Keeper(dive_speed_ms=1e6)), "dive_speed_ms"),
+        # A 20 m wall counted one player a 0.5 m: refused as "wall_players ... got 40", a field left at None.
+        (ball.Pitch(GOAL, ball.Panel(WALL.centre_xy, WALL.normal_xy, 20.0, 1.8)), r"pitch\.wall\.width_m is 20 m"),
     ],
 )
 def test_a_bad_pitch_raises_naming_the_field(pitch, name) -> None:
     with pytest.raises(ValueError, match=name):
         ball.simulate((-22.0, 0.0, R), (20.0, 0.0, 3.0), (0.0, 0.0, 0.0), ground_m=R, pitch=pitch)
+
+
+def test_a_wall_of_sixteen_players_counted_from_its_width_is_accepted() -> None:
+    wide = ball.Pitch(GOAL, ball.Panel(WALL.centre_xy, WALL.normal_xy, 8.0, 1.8))
+    assert pitch_vector(wide, (-22.0, 0.0), R, R)[play.N_PLAYERS] == 16
+
+
+@pytest.mark.parametrize(
+    ("goal", "name"),
+    [
+        ("goal", "goal must be a Panel, got str"),
+        (ball.Panel((0.0, 0.0), (0.0, 0.0), 7.32, 2.44), r"goal\.normal_xy must not be zero"),
+        (ball.Panel((0.0, 0.0), (1.0, 0.0), 0.0, 2.44), r"goal\.width_m must be > 0"),
+        (ball.Panel((math.nan, 0.0), (1.0, 0.0), 7.32, 2.44), r"goal\.centre_xy"),
+        (ball.Panel((0.0, 0.0), (1.0, 0.0), "wide", 2.44), r"goal\.width_m"),  # type: ignore[arg-type]
+    ],
+)
+def test_a_keeper_placed_in_a_bad_goal_raises_naming_the_field(goal, name) -> None:
+    # The goal was read unchecked: a string raised AttributeError, a zero normal placed him at NaN, width 0 passed.
+    with pytest.raises(ValueError, match=name):
+        ball.Keeper().placed((-20.0, 0.0), goal)
+
+
+def test_a_keeper_stands_on_the_bisector_of_the_posts_angle_for_a_goal_of_any_normal_length() -> None:
+    # The normal's length never mattered; the goal's row normalises it. Straight out in front, 1 m off his line.
+    for normal in ((1.0, 0.0), (5.0, 0.0), (1e-3, 0.0)):
+        spot = ball.Keeper().placed((-20.0, 0.0), ball.Panel((0.0, 0.0), normal, 7.32, 2.44))
+        assert spot == pytest.approx((-ball.Keeper().depth_m, 0.0), abs=1e-12)
+
+
+@pytest.mark.parametrize("panel", [np.zeros(3), "wall", 1.0, (0.0, 0.0)])
+@pytest.mark.parametrize("field", ["wall", "goal"])
+def test_outcomes_refuse_a_wall_or_goal_that_is_not_a_panel(panel, field) -> None:
+    # With a pitch, an array for the wall got numpy's "truth value of an array is ambiguous".
+    start, velocity = np.array([[-22.0, 0.0, R]]), np.array([[25.0, 0.0, 6.0]])
+    for pitch in (ball.Pitch(GOAL, WALL), None):
+        given: dict[str, Any] = {"wall": WALL, "goal": GOAL} if pitch is None else {}
+        given[field] = panel
+        with pytest.raises(ValueError, match=f"{field} must be a Panel"):
+            ball.simulate_outcomes(start, velocity, np.zeros((1, 3)), pitch=pitch, ground_m=R, **given)
 
 
 def test_the_plain_python_twin_of_the_pitch_flight_gives_the_compiled_numbers(monkeypatch: pytest.MonkeyPatch) -> None:
