@@ -16,6 +16,7 @@ describes; the tests compare the compiled solvers' iterates against these.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 from numpy.typing import NDArray
@@ -141,3 +142,28 @@ def dls(joints: Array, target: Array, iterations: int) -> list[Array]:
         p[1:] = p[0] + np.cumsum(segments, axis=0)
         poses.append(p.copy())
     return poses
+
+
+def end_errors(poses: list[Array], target: Array) -> Array:
+    """(K,) the end effector's distance to ``target`` in each pose (m)."""
+    return np.array([float(np.linalg.norm(pose[-1] - target)) for pose in poses])
+
+
+def rounding_reach(
+    reference: Callable[[Array, Array], list[Array]], joints: Array, target: Array, scale: float
+) -> Array:
+    """(K,) how far the reference's own end-effector errors move, iteration by iteration, when the target moves by
+    10⁻¹⁵·``scale`` (about one rounding) in three fixed random directions: the largest move of each.
+
+    An iteration can amplify rounding (FABRIK with cones, or CCD, on some chains: tenfold and more per
+    iteration), and then two correct implementations that round differently part after a few iterations. This
+    measures that amplification on the reference itself, so a comparison can allow it and no more.
+    """
+    base = end_errors(reference(joints, target), target)
+    rng = np.random.default_rng(0)
+    reach = np.zeros_like(base)
+    for _ in range(3):
+        direction = rng.normal(size=target.shape)
+        moved = target + direction / np.linalg.norm(direction) * 1e-15 * scale
+        reach = np.maximum(reach, np.abs(end_errors(reference(joints, moved), moved) - base))
+    return reach

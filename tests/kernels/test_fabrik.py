@@ -486,6 +486,7 @@ def reachable_target(rng: np.random.Generator, joints: NDArray[np.float64], wher
 
 @PROPERTY
 @given(chains, st.floats(0.0, 1.0), st.sampled_from([None, 0.4, 1.2]), st.integers(1, 20))
+@example(chain=(9, 2, 9), where=0.46875, phi=0.4, cap=6)  # rounding grows ~40× an iteration: 2.6e-8 m apart at 6
 def test_fabrik_iterates_are_the_papers_algorithm(
     chain: tuple[int, int, int], where: float, phi: float | None, cap: int
 ) -> None:
@@ -504,14 +505,22 @@ def test_fabrik_iterates_are_the_papers_algorithm(
         cone_half_angle_rad=phi,
         extrapolate=False,
     )
-    poses = ik_reference.fabrik(joints, target, result.iterations, phi)
+
+    def reference(start: NDArray[np.float64], goal: NDArray[np.float64]) -> list[NDArray[np.float64]]:
+        return ik_reference.fabrik(start, goal, result.iterations, phi)
+
+    poses = reference(joints, target)
     scale = fabrik.link_lengths(joints).sum()
-    errors = [float(np.linalg.norm(pose[-1] - target)) for pose in poses]
-    np.testing.assert_allclose(result.error_history[1:], errors, rtol=0, atol=1e-9 * scale)
+    # Some chains amplify rounding from iteration to iteration (a 2D chain of 9 links with 0.4 rad cones, tenfold
+    # and more each time): there the two part as the reference parts from itself under a rounding's nudge.
+    reach = ik_reference.rounding_reach(reference, joints, target, scale)
+    errors = ik_reference.end_errors(poses, target)
+    assert np.all(np.abs(result.error_history[1:] - errors) <= 1e-9 * scale + 100.0 * reach)
     if phi is None:  # every iterate is admissible: the best of them, or the start, comes back
-        candidates = [joints, *poses]
-        best = candidates[int(np.argmin(result.error_history))]
-        np.testing.assert_allclose(result.joints, best, rtol=0, atol=1e-9 * scale)
+        assert result.error == min(result.error_history)
+        best = int(np.argmin(result.error_history))
+        if best == 0 or reach[best - 1] < 1e-12 * scale:  # where rounding has not taken it elsewhere
+            np.testing.assert_allclose(result.joints, [joints, *poses][best], rtol=0, atol=1e-9 * scale)
 
 
 @PROPERTY
@@ -527,13 +536,20 @@ def test_ccd_and_dls_iterates_are_the_published_methods(
     target = reachable_target(rng, joints, where)
     result = fabrik.solve_batch(joints[None], target[None], tolerance=0.0, max_iterations=cap, solver=solver)[0]
     reference = ik_reference.ccd if solver == "ccd" else ik_reference.dls
-    poses = reference(joints, target, result.iterations)
+
+    def run(start: NDArray[np.float64], goal: NDArray[np.float64]) -> list[NDArray[np.float64]]:
+        return reference(start, goal, result.iterations)
+
+    poses = run(joints, target)
     scale = fabrik.link_lengths(joints).sum()
-    errors = [float(np.linalg.norm(pose[-1] - target)) for pose in poses]
-    np.testing.assert_allclose(result.error_history[1:], errors, rtol=0, atol=1e-8 * scale)
-    best = [joints, *poses][int(np.argmin(result.error_history))]
-    # Joints can drift along the redundant directions by rounding that CCD amplifies; the end does not.
-    np.testing.assert_allclose(result.joints, best, rtol=0, atol=1e-6 * scale)
+    reach = ik_reference.rounding_reach(run, joints, target, scale)  # as for FABRIK's iterates above
+    errors = ik_reference.end_errors(poses, target)
+    assert np.all(np.abs(result.error_history[1:] - errors) <= 1e-8 * scale + 100.0 * reach)
+    assert result.error == min(result.error_history)
+    best = int(np.argmin(result.error_history))
+    if best == 0 or reach[best - 1] < 1e-12 * scale:
+        # Joints can drift along the redundant directions by rounding that CCD amplifies; the end does not.
+        np.testing.assert_allclose(result.joints, [joints, *poses][best], rtol=0, atol=1e-6 * scale)
 
 
 def test_paper_setup_reaches_in_fewer_iterations_than_table_1() -> None:
