@@ -87,8 +87,8 @@ _non_negative = _checks.non_negative_array
 
 def _efficiency(value: ArrayLike) -> NDArray[np.float64]:
     array = _finite("drivetrain_efficiency", value)
-    if np.any((array <= 0.0) | (array > 1.0)):
-        raise ValueError(f"drivetrain_efficiency must be in (0, 1], got {value!r}")
+    if np.any((array < 1e-3) | (array > 1.0)):  # a thousandth: far below any drivetrain, and no overflow
+        raise ValueError(f"drivetrain_efficiency must be in [0.001, 1], got {value!r}")
     return array
 
 
@@ -233,12 +233,22 @@ def power(
         grade: rise over run (0.05 = 5 %).
         altitude_m: altitude (m), sets air density.
         headwind_ms: wind against the rider (m/s); negative for a tailwind.
-        drivetrain_efficiency: fraction of pedal power reaching the wheel, in (0, 1].
+        drivetrain_efficiency: fraction of pedal power reaching the wheel, in [0.001, 1].
 
     Returns:
         :class:`Power` with the broadcast shape of the inputs.
     """
     v = _non_negative("speed_ms", speed_ms)
+    _check_domain(
+        "power",
+        MODEL_DOMAIN,
+        speed_ms=speed_ms,
+        cda_m2=cda_m2,
+        mass_kg=mass_kg,
+        crr=crr,
+        altitude_m=altitude_m,
+        headwind_ms=headwind_ms,
+    )
     r = _resistance(cda_m2, mass_kg, crr, grade, altitude_m, headwind_ms, drivetrain_efficiency)
 
     aero, rolling, _, climbing = wheel_power_terms(v, r.drag, r.rolling_force, r.climbing_force, r.wind, 0.0, 0.0)
@@ -292,12 +302,16 @@ def speed_for_power(
         ValueError: an argument is not finite, out of :func:`power`'s range, or outside the domain above.
     """
     target = _non_negative("power_w", power_w)
-    values = dict(cda_m2=cda_m2, mass_kg=mass_kg, crr=crr, altitude_m=altitude_m, headwind_ms=headwind_ms)
-    for name, (low, high) in SPEED_FOR_POWER_DOMAIN.items():
-        value = power_w if name == "power_w" else values[name]
-        array = target if name == "power_w" else _finite(name, value)
-        if np.any((array < low) | (array > high)):
-            raise ValueError(f"{name} must be in [{low:g}, {high:g}] for speed_for_power, got {value!r}")
+    _check_domain(
+        "speed_for_power",
+        SPEED_FOR_POWER_DOMAIN,
+        power_w=power_w,
+        cda_m2=cda_m2,
+        mass_kg=mass_kg,
+        crr=crr,
+        altitude_m=altitude_m,
+        headwind_ms=headwind_ms,
+    )
     r = _resistance(cda_m2, mass_kg, crr, grade, altitude_m, headwind_ms, drivetrain_efficiency)
     # Validated above. Rolling plus climbing as m·g·cos θ·(Crr + grade), which is exactly 0 where Crr = −grade
     # (the sum of the two forces would leave rounding there, and its square root would move v_c); the ratio
@@ -311,16 +325,44 @@ def speed_for_power(
     return _largest_root(_PowerBalance(*(np.array(x, dtype=np.float64).ravel() for x in broadcast))).reshape(shape)
 
 
-SPEED_FOR_POWER_DOMAIN: dict[str, tuple[float, float]] = {
-    "power_w": (0.0, 1e6),
+MODEL_DOMAIN: dict[str, tuple[float, float]] = {
+    "speed_ms": (0.0, 1e8),
     "cda_m2": (1e-6, 1e4),
     "mass_kg": (0.0, 1e6),
     "crr": (0.0, 1.0),
     "altitude_m": (-500.0, 30_000.0),
     "headwind_ms": (-1000.0, 1000.0),
 }
+"""Closed ranges (SI units) on which :func:`power` (and :func:`paceline`, :func:`formation_power`,
+:func:`martin_power`) is defined: far beyond any rider (the speed reaches every speed :func:`speed_for_power`
+returns), and where the model still means something (no air above ~30 km). Outside them a huge but finite input
+gave inf or NaN watts; now ``ValueError`` naming it."""
+
+MARTIN_DOMAIN: dict[str, tuple[float, float]] = {
+    **{name: bounds for name, bounds in MODEL_DOMAIN.items() if name != "altitude_m"},
+    "air_density": (0.0, 100.0),
+    "spoke_drag_m2": (0.0, 1e4),
+    "wheel_inertia_kgm2": (0.0, 1e6),
+    "wheel_radius_m": (1e-3, 100.0),
+    "acceleration_ms2": (-1e4, 1e4),
+}
+"""As :data:`MODEL_DOMAIN`, for :func:`martin_power`'s own inputs (the air given as a density, up to 100 kg/m³)."""
+
+SPEED_FOR_POWER_DOMAIN: dict[str, tuple[float, float]] = {
+    "power_w": (0.0, 1e6),
+    **{name: bounds for name, bounds in MODEL_DOMAIN.items() if name != "speed_ms"},
+}
 """Closed ranges (SI units) on which :func:`speed_for_power` is defined; ``power``'s own checks (CdA, mass > 0,
 …) still apply. Within them no intermediate of the solver overflows or underflows to a wrong answer."""
+
+
+def _check_domain(function: str, domain: dict[str, tuple[float, float]], **values: ArrayLike) -> None:
+    """``ValueError`` naming the first of ``values`` that is not finite or lies outside its ``domain`` range."""
+    for name, value in values.items():
+        low, high = domain[name]
+        array = _finite(name, value)
+        if np.any((array < low) | (array > high)):
+            raise ValueError(f"{name} must be in [{low:g}, {high:g}] for {function}, got {value!r}")
 
 
 class _PowerBalance(NamedTuple):
@@ -686,7 +728,7 @@ def martin_power(
         grade: rise over run G_R (0.05 = 5 %).
         headwind_ms: wind against the rider (m/s); negative for a tailwind.
         air_density: ρ (kg/m³, > 0); :func:`air_density_weather` gives it from a weather reading.
-        drivetrain_efficiency: E_c in (0, 1].
+        drivetrain_efficiency: E_c in [0.001, 1].
         spoke_drag_m2: F_w, drag area of the rotating spokes (m², ≥ 0).
         wheel_inertia_kgm2: I, moment of inertia of both wheels together (kg·m², ≥ 0).
         wheel_radius_m: r, outer radius of the tyre (m, > 0).
@@ -699,6 +741,20 @@ def martin_power(
         ValueError: an argument is not finite or out of its range; the message names it.
     """
     v = _non_negative("speed_ms", speed_ms)
+    _check_domain(
+        "martin_power",
+        MARTIN_DOMAIN,
+        speed_ms=speed_ms,
+        cda_m2=cda_m2,
+        mass_kg=mass_kg,
+        crr=crr,
+        headwind_ms=headwind_ms,
+        air_density=air_density,
+        spoke_drag_m2=spoke_drag_m2,
+        wheel_inertia_kgm2=wheel_inertia_kgm2,
+        wheel_radius_m=wheel_radius_m,
+        acceleration_ms2=acceleration_ms2,
+    )
     mass = _positive("mass_kg", mass_kg)
     slope = _finite("grade", grade)
     rho = _positive("air_density", air_density)

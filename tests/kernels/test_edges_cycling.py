@@ -3,9 +3,11 @@ written here: a dense scan of ``cycling.power`` for the last sign change, refine
 
 from __future__ import annotations
 
+import itertools
 import math
 import warnings
 from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 import pytest
@@ -259,14 +261,15 @@ def test_a_vertical_descent_falls_at_terminal_velocity(grade: float) -> None:
     assert v == pytest.approx(root, rel=1e-12)
 
 
-def test_a_subnormal_efficiency_is_the_zero_power_speed() -> None:
-    # P·η underflows to (almost) nothing: the rider coasts (power() itself overflows dividing by such an η).
-    for grade, expected in (
-        (0.0, 0.0),
-        (-0.02, float(cycling.speed_for_power(0.0, 0.32, 80.0, 0.005, -0.02))),
-    ):
-        v = solve_without_warnings(**dict(BASE, grade=grade, drivetrain_efficiency=5e-324))
-        assert v == pytest.approx(expected, rel=1e-15, abs=1e-300)
+def test_an_efficiency_below_a_thousandth_is_refused_and_a_thousandth_solves() -> None:
+    # A subnormal η: P·η underflowed to nothing in the inverse, and power() overflowed dividing by it.
+    for efficiency in (5e-324, 1e-300, 9.99e-4, 0.0):
+        with pytest.raises(ValueError, match=r"^drivetrain_efficiency must be in \[0.001, 1\]"):
+            cycling.speed_for_power(**dict(BASE, drivetrain_efficiency=efficiency))
+        with pytest.raises(ValueError, match=r"^drivetrain_efficiency must be in \[0.001, 1\]"):
+            cycling.power(**POWER_BASE, drivetrain_efficiency=efficiency)
+    args = dict(BASE, drivetrain_efficiency=1e-3)
+    assert_solves_to_the_nearest_float(solve_without_warnings(**args), **args)
 
 
 def test_a_fast_tailwind_lands_on_the_nearest_float() -> None:
@@ -313,3 +316,55 @@ def test_peloton_readout_at_zero_watts_on_a_cancelling_grade(server: viser.Viser
             assert "**0.0 km/h**" not in scene.speed_out.content
     finally:
         switcher.close()
+
+
+# ------------------------------------------------------------------------ power and martin_power over their domains
+# The kind: a huge but finite input to the forward model (mass 1e308, speed or wind 1e300, altitude −1e6 m, CdA
+# 1e200) gave NaN or inf watts, or 10⁵³ W, with only numpy's RuntimeWarning. Family: every corner of each domain,
+# any finite grade, gives finite watts without a warning; every argument past either end is refused by name.
+POWER_BASE = dict(speed_ms=10.0, cda_m2=0.3, mass_kg=80.0, crr=0.004)
+FORWARD = [(cycling.power, cycling.MODEL_DOMAIN), (cycling.martin_power, cycling.MARTIN_DOMAIN)]
+
+
+@pytest.mark.parametrize(
+    ("argument", "value"),
+    [
+        ("mass_kg", 1e308),
+        ("speed_ms", 1e300),
+        ("headwind_ms", 1e300),
+        ("altitude_m", -1e6),
+        ("cda_m2", 1e200),
+        ("drivetrain_efficiency", 5e-324),
+    ],
+)
+def test_power_refuses_the_huge_inputs_that_gave_nan_or_inf(argument: str, value: float) -> None:
+    with pytest.raises(ValueError, match=f"^{argument} must be in"):
+        cycling.power(**{**POWER_BASE, argument: value})
+
+
+@pytest.mark.parametrize(("function", "domain"), FORWARD, ids=["power", "martin_power"])
+@pytest.mark.parametrize("grade", [0.0, 0.3, -1.7e308, 1.7e308])
+def test_power_is_finite_at_every_corner_of_its_domain(function: Callable[..., Any], domain: dict, grade: float):
+    names = sorted(domain)
+    for corner in itertools.product(*[domain[name] for name in names]):
+        args = dict(zip(names, corner, strict=True))
+        for name in ("mass_kg", "air_density", "wheel_radius_m", "cda_m2"):  # > 0 where the range starts at 0
+            if args.get(name) == 0.0:
+                args[name] = 5e-324
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            total = function(grade=grade, drivetrain_efficiency=1e-3, **args).total
+        assert np.isfinite(total).all(), args
+
+
+@pytest.mark.parametrize(("function", "domain"), FORWARD, ids=["power", "martin_power"])
+@pytest.mark.parametrize("side", [-1.0, 1.0])
+@pytest.mark.parametrize("beyond", [1e-6, 1.0, 1e150, 1e300])
+def test_power_refuses_every_argument_past_its_domain_by_name(
+    function: Callable[..., Any], domain: dict, side: float, beyond: float
+) -> None:
+    for name, (low, high) in domain.items():
+        edge_value = high if side > 0 else low
+        value = edge_value + side * max(abs(edge_value), 1.0) * beyond
+        with pytest.raises(ValueError, match=f"^{name} must be"):
+            function(**{**POWER_BASE, name: value})
