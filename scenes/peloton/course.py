@@ -132,6 +132,9 @@ class CourseMode:
         self.playing = False
         self.play_time_s = 0.0
         self.message = ""
+        self.solve_note: tuple[float, float, str] | None = None
+        """(target min, power W, what it says) of the last 'Find the power' whose target lay outside the power
+        input's range: the readout says it while that target and that power are still set."""
         self._since_readout = 0.0
         self._drawn_riders: tuple[Position, Detail] | None = None
         """The riding position and mesh detail the riders were last meshed for."""
@@ -491,11 +494,12 @@ class CourseMode:
                 self.redraw()
                 return
             note = ""
-        self.scene.write_back(self.controls["power_w"], float(np.clip(round(power, 1), low, high)))
+        power = float(np.clip(round(power, 1), low, high))
+        # Kept with its target and power, not as the passing message: the browser's echo of the power just set
+        # recomputes the ride, which clears the message, and the note vanished before anyone read it.
+        self.solve_note = (params.target_min, power, note) if note else None
+        self.scene.write_back(self.controls["power_w"], power)
         self._on_input()
-        if note and not self.message:
-            self.message = note
-            self.redraw()
 
     def _on_play(self) -> None:
         if self.state is None:
@@ -712,10 +716,12 @@ class CourseMode:
             f"Finish **{format_duration(ride.time_s)}**, average **{3.6 * ride.average_speed_ms:.1f} km/h** "
             f"at **{ride.average_power_w:.0f} W** ({MODEL_LABEL[p.model]})"
         )
+        if self.solve_note is not None and self.solve_note[:2] == (p.target_min, p.power_w):
+            text += f"  \n⚠️ {self.solve_note[2]}"
         if ride.average_power_w < 0.99 * p.power_w and state.pacing is None:
             text += (
                 f"  \nAverage {ride.average_power_w:.0f} W of the {p.power_w:.0f} W set: the riders coast "
-                f"where the descent would take them over the {p.max_speed_kmh:.0f} km/h safe speed"
+                f"where {p.power_w:.0f} W would take them over the {p.max_speed_kmh:.0f} km/h safe speed"
             )
         if state.group_cda_m2 != line.cda_m2:
             text += (
@@ -781,7 +787,7 @@ class CourseMode:
         elevation = float(np.interp(d, self.route.distance_m, self.route.elevation_m))
         coasting = ""
         if self.state.pacing is None and power < 0.99 * self.params.power_w:
-            coasting = f" (coasting at the {self.params.max_speed_kmh:.0f} km/h descent cap)"
+            coasting = f" (coasting at the {self.params.max_speed_kmh:.0f} km/h safe speed)"
         if self.scene.params.n_riders > 1:  # the group's power; the leader's place needs more (the table's row 1)
             lead = float(self.place_watts()[0][0])
             watts = f"the group's {power:.0f} W{coasting} (the leader's place {lead:.0f} W)"
