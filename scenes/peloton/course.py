@@ -192,6 +192,8 @@ class CourseMode:
             power = build_controls(gui, p, ("power_w", "target_min"))
             with power.folders[POWER_FOLDER]:  # between the target and the model
                 self.solve = gui.add_button("Find the power for this time")
+                self.solve_info = gui.add_markdown("", visible=False)
+                """Under the button, where the eye is after a click: why the power found is an input's end."""
             rest = build_controls(
                 gui,
                 p,
@@ -490,13 +492,14 @@ class CourseMode:
                     tolerance_s=0.05,
                 )
             except ValueError as error:
-                self.message = f"Could not find the power for {wanted}: {_escape(str(error))}"
+                reason = f"Could not find the power for {wanted}: {_escape(str(error))}"
+                self.solve_note = (params.target_min, params.power_w, reason)
                 self.redraw()
                 return
             note = ""
         power = float(np.clip(round(power, 1), low, high))
-        # Kept with its target and power, not as the passing message: the browser's echo of the power just set
-        # recomputes the ride, which clears the message, and the note vanished before anyone read it.
+        # Shown under the button while this target and this power are set (it stood at the top of the folder,
+        # scrolled out of view by the time the button is reached).
         self.solve_note = (params.target_min, power, note) if note else None
         self.scene.write_back(self.controls["power_w"], power)
         self._on_input()
@@ -594,6 +597,9 @@ class CourseMode:
             if readouts:
                 self.route_info.content = self._route_markdown()
                 self.readout.content = self._readout_markdown()
+                note = self._solve_note_markdown()
+                set_if_changed(self.solve_info, "content", note)
+                set_if_changed(self.solve_info, "visible", bool(note))
                 self.splits.content = self._splits_markdown()
                 self.chart.data = self._chart_data()
                 self.chart.visible = self.state is not None
@@ -706,6 +712,11 @@ class CourseMode:
             text += f"  \n⚠️ {self.message}"
         return text
 
+    def _solve_note_markdown(self) -> str:
+        """The last 'Find the power' note while its target and its power are still set, else ""."""
+        note, p = self.solve_note, self.params
+        return f"⚠️ {note[2]}" if note is not None and note[:2] == (p.target_min, p.power_w) else ""
+
     def _readout_markdown(self) -> str:
         state = self.state
         if state is None:
@@ -716,8 +727,6 @@ class CourseMode:
             f"Finish **{format_duration(ride.time_s)}**, average **{3.6 * ride.average_speed_ms:.1f} km/h** "
             f"at **{ride.average_power_w:.0f} W** ({MODEL_LABEL[p.model]})"
         )
-        if self.solve_note is not None and self.solve_note[:2] == (p.target_min, p.power_w):
-            text += f"  \n⚠️ {self.solve_note[2]}"
         if ride.average_power_w < 0.99 * p.power_w and state.pacing is None:
             text += (
                 f"  \nAverage {ride.average_power_w:.0f} W of the {p.power_w:.0f} W set: the riders coast "

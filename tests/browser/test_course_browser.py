@@ -155,3 +155,30 @@ def test_the_course_panel_labels_read_whole(shown: ScenePage) -> None:
     for label in ("Pressure from", "Air"):
         fits = shown.page.evaluate(VALUE_FITS, label)
         assert fits and all(ok for _, ok in fits), (label, fits)
+
+
+def test_find_the_power_says_in_view_when_the_target_is_out_of_reach(shown: ScenePage) -> None:
+    """A 1 min target at the sample climb needs more than the power input's 2000 W: after a click of 'Find the
+    power for this time' the page says so where the eye is (the note stood at the top of the course's folder,
+    scrolled out of view by the time the button is reached)."""
+    scene = shown.scene
+    assert isinstance(scene, PelotonScene)
+    mode = scene.course_mode
+    with scene._lock:
+        if not mode.enabled:
+            mode.enable.value = True
+    wait_until(lambda: mode.enabled and mode.state is not None, "course mode on", timeout_s=15.0)
+    set_number(shown.page, "Target time (min)", 1)
+    wait_until(lambda: mode.params.target_min == 1.0, "the target time", timeout_s=15.0)
+    button = shown.page.get_by_role("button", name="Find the power for this time")
+    button.scroll_into_view_if_needed()
+    button.click()
+    wait_until(lambda: mode.params.power_w == 2000.0, "the power found", timeout_s=15.0)
+    settle(shown)
+    note = shown.page.get_by_text("A 1 min finish needs more than 2000 W", exact=False)
+    wait_until(lambda: note.count() > 0, "the out-of-reach note on the page", timeout_s=10.0)
+    # Where the eye is after the click: in the panel's view as it stands, not scrolled to.
+    box, viewport = note.first.bounding_box(), shown.page.viewport_size
+    assert box is not None and viewport is not None
+    _, top, _, bottom = panel_rect(shown.page)
+    assert top <= box["y"] and box["y"] + box["height"] <= min(bottom, viewport["height"]), (box, (top, bottom))
