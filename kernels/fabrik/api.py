@@ -21,6 +21,8 @@ from kernels._rows import run_rows
 from kernels.fabrik.chain import (
     _BAD_JOINTS,
     _BAD_TARGET,
+    _FAR_TARGET,
+    _FARTHEST,
     _SOLVER_IDS,
     _UNSCALED,
     STATUSES,
@@ -215,6 +217,7 @@ def solve_batch(
     iterations = np.empty(batch, dtype=np.int64)
     status = np.empty(batch, dtype=np.int64)
     error = np.empty(batch)
+    check_reach_span(chains, points, "targets")
     scale, params, centres, radii = _to_unit_scale(p, goal, setup)
     args = (
         p,
@@ -662,6 +665,42 @@ def _options(
     )
 
 
+def check_reach_span(joints: NDArray[np.float64], targets: NDArray[np.float64], name: str) -> None:
+    """``ValueError`` naming ``name`` (and the row, for a batch) when a target lies more than :data:`_FARTHEST` times
+    its chain's length from the root, or when one batch holds chains whose sizes differ by more than that.
+
+    ``joints`` (B, n + 1, d) and ``targets`` (B, d), finite and checked. Each chain is solved in units of a power of
+    2 near the batch's size (see :func:`_to_unit_scale`); outside these spans its links fall below that scale's
+    rounding and the solve is no longer the algorithm's (FABRIK collapsed a 0.5 m chain to its root for a target
+    1e200 m away, and that row's scale made the other rows of its batch report "reached" where they were not).
+    """
+    root = joints[:, :1, :]
+    size = np.maximum(np.abs(joints - root).max(axis=(1, 2)), np.abs(targets - root[:, 0]).max(axis=1))
+    total = _norms(np.diff(joints, axis=1)).sum(axis=1)
+    reach = _norms(targets - root[:, 0])
+    far = np.flatnonzero((total > 0.0) & (reach / _FARTHEST > total))
+    if far.size:
+        k = far[0]
+        row = "" if name == "target" else f"[{k}]"
+        raise ValueError(
+            f"{name}{row} is {reach[k]:.3g} m from the root, more than {_FARTHEST:g} times the chain's length "
+            f"({total[k]:.3g} m): too far to solve; a target nearer on the same line gives the same pose"
+        )
+    sized = size[size > 0.0]
+    if sized.size and sized.max() / _FARTHEST > sized.min():
+        small, large = int(np.flatnonzero(size == sized.min())[0]), int(np.flatnonzero(size == sized.max())[0])
+        raise ValueError(
+            f"joints[{small}] and its target span {size[small]:.3g} m and joints[{large}] {size[large]:.3g} m: "
+            f"chains more than {_FARTHEST:g} times apart in size cannot share a batch; solve them in separate calls"
+        )
+
+
+def _norms(vectors: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Euclidean norms over the last axis (2 or 3 components), by ``hypot``: no square overflows or underflows."""
+    result = np.hypot(vectors[..., 0], vectors[..., 1])
+    return np.hypot(result, vectors[..., 2]) if vectors.shape[-1] == 3 else result
+
+
 def _to_unit_scale(
     p: NDArray[np.float64], goal: NDArray[np.float64], setup: _Setup
 ) -> tuple[float, NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
@@ -740,6 +779,8 @@ def _solve_single(
         _check_joints("joints", joints, batched=False)  # raises, naming it
     if code == _BAD_TARGET:
         _check_vector("target", target, dim)
+    if code == _FAR_TARGET:
+        check_reach_span(chain[None], point[None], "target")  # raises, naming it
     # The frozen dataclass's __init__ sets each field through object.__setattr__ (~0.8 µs, a third of the Python
     # around a small chain's core); filling the instance's dict makes the same object in a quarter of that.
     solution = object.__new__(Solution)

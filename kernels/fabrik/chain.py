@@ -787,8 +787,12 @@ def _solve_rows(
 
 _UNSCALED = 2.0**-16, 2.0**16
 """Extents (m) solved as they are; outside, a problem is divided by a power of 2 near its extent first."""
-_BAD_JOINTS, _BAD_TARGET = 1, 2
+_BAD_JOINTS, _BAD_TARGET, _FAR_TARGET = 1, 2, 3
 """What :func:`_solve_one` found wrong with its input (0: nothing); the caller raises the error that names it."""
+_FARTHEST = 1e12
+"""Most times its chain's length (ΣL > 0) that a target may lie from the root. Beyond it the links are smaller
+than the rounding of the problem's scale: FABRIK collapsed a chain to its root (a target 1e200 m from a 0.5 m
+chain), CCD and DLS stopped turning it, and in a batch one such row rescaled every other row."""
 
 
 @numba.njit(cache=True, error_model="numpy")
@@ -798,6 +802,25 @@ def _within(values: NDArray[np.float64], bound: float) -> bool:
         if not abs(value) <= bound:
             return False
     return True
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _norm_of_difference(
+    joints: NDArray[np.float64], i: int, j: int, target: NDArray[np.float64], dim: int, to_target: bool
+) -> float:
+    """|joints[i] − joints[j]|, or |target − joints[j]| if ``to_target``, scaled by its largest component first so
+    that no square overflows or underflows (a 0.25 m link beside a target 1e200 m away)."""
+    largest = 0.0
+    for c in range(dim):
+        a = target[c] if to_target else joints[i, c]
+        largest = max(largest, abs(a - joints[j, c]))
+    if largest == 0.0:
+        return 0.0
+    sum_sq = 0.0
+    for c in range(dim):
+        a = target[c] if to_target else joints[i, c]
+        sum_sq += ((a - joints[j, c]) / largest) ** 2
+    return largest * math.sqrt(sum_sq)
 
 
 @numba.njit(cache=True, error_model="numpy")
@@ -834,6 +857,13 @@ def _solve_one(
             extent = max(extent, abs(joints[i, c] - joints[0, c]))
         goal[c] = target[c]
         extent = max(extent, abs(target[c] - joints[0, c]))
+    if extent > 0.0:  # the target within _FARTHEST chain lengths
+        total = 0.0
+        for i in range(1, count):
+            total += _norm_of_difference(joints, i, i - 1, target, dim, False)
+        reach = _norm_of_difference(joints, 0, 0, target, dim, True)
+        if total > 0.0 and reach / _FARTHEST > total:
+            return _FAR_TARGET, np.empty((0, dim)), np.empty(0), 0, 0, 0.0
     scale = 1.0
     if extent != 0.0 and not _UNSCALED[0] <= extent <= _UNSCALED[1]:
         scale = math.ldexp(1.0, math.frexp(extent)[1])  # ≥ extent, exact; division by it is exact

@@ -21,12 +21,14 @@ from kernels.fabrik.api import (
     Obstacle,
     _check_joints,
     _check_vector,
+    _norms,
     _Setup,
     _solve_single,
 )
 from kernels.fabrik.chain import (
     _BLOCKED,
     _FABRIK,
+    _FARTHEST,
     _INFEASIBLE,
     _LIMITED,
     _MAX_ITERATIONS,
@@ -193,6 +195,17 @@ def solve_tree(
             error_history=single.error_history[:, None].copy(),
         )
 
+    # Each target within _FARTHEST times the whole tree's length of the root, as solve's target of its chain.
+    children = np.flatnonzero(parent >= 0)
+    total = float(_norms(points[children] - points[parent[children]]).sum())
+    reach = _norms(goal[effector_ids, :dim] - points[root])
+    far = np.flatnonzero(reach / _FARTHEST > total) if total > 0.0 else np.empty(0, dtype=np.int64)
+    if far.size:
+        key = int(effector_ids[far[0]])
+        raise ValueError(
+            f"targets[{key}] is {reach[far[0]]:.3g} m from the root, more than {_FARTHEST:g} times the tree's length "
+            f"({total:.3g} m): too far to solve"
+        )
     p = np.zeros((count, 3))
     p[:, :dim] = points
     history = np.empty((setup.max_iterations + 1, len(effector_ids)))

@@ -1238,3 +1238,59 @@ def test_stalled_limited_chains_restart(lengths: list[float], target: list[float
     result = fabrik.solve(joints, target, cone_half_angle_rad=0.3)
     assert result.error < 0.03 * before
     assert admissible(result.joints, 0.3, np.array([0.0, 1.0]), [])
+
+
+# ------------------------------------------------------------------------------------- targets beyond the chain's scale
+# The kind: a target so far from a chain (or chains so different in size in one batch) that its links fall below
+# the rounding of the problem's scale. FABRIK collapsed a 0.5 m chain to its root for a target 1e200 m away, CCD and
+# DLS stopped turning toward a target 1e13 m away, and a batch row with such a target rescaled the other rows, one
+# of which then reported "reached" 0.36 m from its target. Family: every entry point and solver, targets 10^k chain
+# lengths out, k up to 300; batches mixing chains of sizes 10^k apart.
+BENT = np.array([[0.0, 0.0, 0.0], [0.0, 0.25, 0.0], [0.0, 0.5, 0.0]])
+
+
+@pytest.mark.parametrize("solver", SOLVERS)
+@pytest.mark.parametrize("exponent", [0, 3, 6, 9, 11.99, 12.01, 13, 20, 100, 200, 300])
+def test_a_target_more_than_1e12_chain_lengths_away_is_refused_and_nearer_ones_solve(
+    solver: fabrik.Solver, exponent: float
+) -> None:
+    distance = 0.5 * 10.0**exponent
+    target = np.array([distance, 0.0, 0.0])
+    if exponent > 12:
+        for call in (
+            lambda: fabrik.solve_batch(BENT[None], target[None], solver=solver),
+            lambda: getattr(fabrik, "solve" if solver == "fabrik" else solver)(BENT, target),
+        ):
+            with pytest.raises(ValueError, match=r"^targets?(\[0\])? is .* more than 1e\+12 times the chain's length"):
+                call()
+        return
+    result = fabrik.solve_batch(BENT[None], target[None], solver=solver, max_iterations=200)[0]
+    np.testing.assert_allclose(fabrik.link_lengths(result.joints), [0.25, 0.25], rtol=1e-9)
+    assert result.status == ("reached" if exponent == 0 else "unreachable") or solver != "fabrik"
+    if solver == "fabrik" and exponent > 0:  # straightened toward the target, as Algorithm 1 does
+        np.testing.assert_allclose(result.joints, [[0, 0, 0], [0.25, 0, 0], [0.5, 0, 0]], atol=1e-12)
+
+
+def test_the_reviewers_far_targets_are_refused_by_every_entry_point() -> None:
+    chain = [[0.0, 0.0, 0.0], [0.25, 0.0, 0.0], [0.5, 0.0, 0.0]]
+    for far in (1e200, 1e300):
+        with pytest.raises(ValueError, match=r"^target is"):
+            fabrik.solve(chain, [far, 0.0, 0.0])
+    tree = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.3, 0.0, 1.9], [-0.3, 0.0, 1.9]])
+    with pytest.raises(ValueError, match=r"^targets\[2\] is 1e\+200 m from the root"):
+        fabrik.solve_tree([-1, 0, 1, 1], tree, {2: [1e200, 0.0, 0.0], 3: [-0.8, 0.0, 1.2]})
+
+
+@pytest.mark.parametrize("exponent", [-300, -200, -13, 13, 200])
+def test_a_batch_of_chains_too_different_in_size_is_refused_and_close_sizes_solve_as_alone(exponent: int) -> None:
+    # The row beside a 1e200 m problem reported "reached" with its end 0.36 m from its target.
+    other = BENT * 10.0**exponent
+    targets = np.array([[0.3, 0.3, 0.0], [0.3 * 10.0**exponent, 0.3 * 10.0**exponent, 0.0]])
+    with pytest.raises(ValueError, match="cannot share a batch"):
+        fabrik.solve_batch(np.stack([BENT, other]), targets)
+    near = 10.0 ** np.sign(exponent) * 1e11  # within the span: each row as it solves alone
+    mixed = fabrik.solve_batch(np.stack([BENT, BENT * near]), np.array([[0.3, 0.3, 0.0], [0.3 * near, 0.3 * near, 0]]))
+    for row, (joints, target) in enumerate(((BENT, [0.3, 0.3, 0.0]), (BENT * near, [0.3 * near, 0.3 * near, 0.0]))):
+        alone = fabrik.solve_batch(joints[None], np.array([target]))[0]
+        assert mixed.status[row] == alone.status
+        assert mixed.error[row] == pytest.approx(alone.error, rel=1e-9, abs=1e-9 * np.abs(joints).max())
