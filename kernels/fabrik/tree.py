@@ -114,7 +114,7 @@ def solve_tree(
     ``max_iterations``, or when no effector's error changes by more than 0.1 % of the tolerance in an iteration
     where limits or obstacles can hold the tree or a target is out of reach (as :func:`solve`); a free tree within
     reach that stalls so goes on once from every segment turned aside (a mirror-symmetric start stays symmetric
-    under the centroid rule), then to the cap. "Reached" is error ≤ tolerance on a pose that keeps every limit (a
+    under the centroid rule; a tree already on its targets to rounding is not turned), then to the cap. "Reached" is error ≤ tolerance on a pose that keeps every limit (a
     start that breaks one is iterated on); the returned pose is the last iterate, or the best admissible one where
     the last is not. Huge or tiny trees are divided by a power of 2 first (as :func:`solve`): a tree scaled by 2^k
     gives the same result scaled.
@@ -478,9 +478,11 @@ def _solve_tree_core(
             if stall_applies:
                 stalled = True
                 break
-            if retry and iteration < max_iterations:
+            if retry and iteration < max_iterations and worst > tiny:
                 # A free tree within reach at a fixed point of the centroid rule (a mirror-symmetric start keeps
                 # it symmetric): go on once from every segment turned aside, another basin; then on to the cap.
+                # Not a tree already on its targets to rounding (tolerance 0 asks for more than rounding gives):
+                # turned aside, it left them by 1.7 m.
                 retry = False
                 _tree_turn_aside(p, parents, order, lengths, tiny, dim)
     feasible = best_worst < np.inf

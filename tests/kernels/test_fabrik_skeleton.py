@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 import pytest
 from helpers.properties import examples
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from numpy.typing import NDArray
 
@@ -260,6 +260,7 @@ def leaves(parents: list[int]) -> list[int]:
 
 @PROPERTY
 @given(st.integers(4, 14), SEEDS, st.sampled_from([2, 3]), st.integers(1, 6))
+@example(count=6, seed=74720, d=3, k=6)  # on its target to 4e-16 m at 5: turned aside as a stall, 1.7 m off at 6
 def test_tree_iterates_are_the_papers_algorithm(count: int, seed: int, d: int, k: int) -> None:
     rng = np.random.default_rng(seed)
     parents, joints = random_tree(rng, count, d)
