@@ -46,12 +46,22 @@ above it 0.5/k and the exp sharpness 4·ln 2/k stay finite in float32."""
 
 
 def _distances(a: ArrayLike, b: ArrayLike) -> tuple[FloatArray, FloatArray]:
-    a_arr, b_arr = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
-    if np.any(np.isnan(a_arr)):
-        raise ValueError("a must not be NaN")
-    if np.any(np.isnan(b_arr)):
-        raise ValueError("b must not be NaN")
-    return a_arr, b_arr
+    return _distance_array("a", a), _distance_array("b", b)
+
+
+def _distance_array(name: str, value: ArrayLike) -> FloatArray:
+    """Distances (m) as float64, ±inf allowed; NaN, bool, complex and text refused with ``ValueError`` naming
+    ``name`` (numpy turned True into 1 m, dropped an imaginary part, or raised its own TypeError)."""
+    try:
+        array = np.asarray(value)
+        if array.dtype.kind not in "fiu":
+            raise TypeError(array.dtype)
+        array = np.asarray(array, dtype=np.float64)
+    except (TypeError, ValueError, OverflowError) as error:
+        raise ValueError(f"{name} must be real distances (m), got {value!r}") from error
+    if np.any(np.isnan(array)):
+        raise ValueError(f"{name} must not be NaN")
+    return array
 
 
 def _smin_poly_weighted(a: AnyFloatArray, b: AnyFloatArray, k: float) -> tuple[AnyFloatArray, AnyFloatArray]:

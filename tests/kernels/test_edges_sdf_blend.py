@@ -306,3 +306,38 @@ def test_bounds_beyond_float32_reach_are_refused_by_name() -> None:
     for size in (2e18, 2e19, 1e30):
         with pytest.raises(ValueError, match="bounds"):
             sdf.mesh(scene, 16, [[-size] * 3, [size] * 3])
+
+
+# The kind: distances that are not real numbers. A complex distance raised float()'s TypeError, or (in an array)
+# lost its imaginary part with only numpy's warning; True was blended as 1 m. Family: every public blend and boolean,
+# each bad value as a and as b.
+BLENDS = {
+    "smin_poly": lambda a, b: sdf.smin_poly(a, b, 0.1),
+    "smin_exp": lambda a, b: sdf.smin_exp(a, b, 10.0),
+    "op_union": sdf.op_union,
+    "op_subtract": sdf.op_subtract,
+    "op_intersect": sdf.op_intersect,
+    "smooth_union": lambda a, b: sdf.smooth_union(a, b, 0.1),
+    "smooth_subtract": lambda a, b: sdf.smooth_subtract(a, b, 0.1, "exp"),
+    "smooth_intersect": lambda a, b: sdf.smooth_intersect(a, b, 0.1),
+}
+
+
+@pytest.mark.parametrize("name", sorted(BLENDS))
+@pytest.mark.parametrize(
+    "bad", [1 + 1j, np.array([1 + 1j, 0.5]), True, np.array([True]), "0.5", None, [0.5, "a"]], ids=repr
+)
+@pytest.mark.parametrize("side", ["a", "b"])
+def test_a_distance_that_is_not_a_real_number_is_refused_by_name(name: str, bad: object, side: str) -> None:
+    a, b = (bad, 0.5) if side == "a" else (0.5, bad)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(ValueError, match=f"^{side} must be real distances"):
+            BLENDS[name](a, b)
+
+
+@pytest.mark.parametrize("name", sorted(BLENDS))
+def test_real_distances_of_every_kind_still_blend(name: str) -> None:
+    for a in (0.3, np.float32(0.3), np.int64(1), [0.3, -np.inf], np.array([[0.3], [np.inf]], dtype=np.float32)):
+        result = BLENDS[name](a, 0.5)
+        assert not np.isnan(result).any()
