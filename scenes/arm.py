@@ -130,7 +130,7 @@ class SolveReport:
     """(iterations (K,), error (K,) m): the error of the pose the solver would return after that many iterations,
     the best admissible one it has seen (:func:`admissible_history`); the last is ``result.error``."""
     start: str = "last pose"
-    """Where the returned pose's solve started: "last pose", or the other start that came closer."""
+    """Where the returned pose's solve started: "last pose", or the gently bent start that came closer."""
 
 
 def rest_pose(n_links: int, link_length_m: float) -> NDArray[np.float64]:
@@ -301,7 +301,7 @@ def solve_arm(
         for k, pose in enumerate(arc_starts(params, target)):
             other = _run(method, to_kernel(pose, three_d), goal, **kwargs)
             if other.status != "infeasible" and other.error < result.error - tolerance:
-                result, start, start_name = other, pose, f"arc {k + 1} of {ARC_STARTS}"
+                result, start, start_name = other, pose, f"gently bent start {k + 1} of {ARC_STARTS}"
     micros = (time.perf_counter() - began) * 1e6
     best = (
         admissible_history(params, start, target, obstacle_centres, result) if history else (np.zeros(1), np.zeros(1))
@@ -872,7 +872,10 @@ is a static pose.
             f"Solve time **{report.micros:,.0f} µs**{plain_python_note()}"
         )
         if report.start != "last pose":
-            text += f"  \nThe last pose led to a worse fixed point: this pose was solved from {report.start}."
+            text += (
+                f"  \nFrom the last pose the joint limits held the arm farther from the target, so this pose was "
+                f"solved again from a {report.start} (other starts are tried when the solve falls short)."
+            )
         short = why_short(p, report, self.target, self.obstacle_centres)
         if short:
             text += f"  \n{short}"

@@ -412,10 +412,13 @@ def test_the_chart_plots_the_best_admissible_pose_not_the_iterates(scene: ArmSce
 
     starts = {
         "last pose": None,
-        **{f"arc {k + 1} of 9": pose for k, pose in enumerate(arc_starts(scene.params, scene.target))},
+        **{f"gently bent start {k + 1} of 9": pose for k, pose in enumerate(arc_starts(scene.params, scene.target))},
     }
     start = starts[report.start]
+    # Said in words a user has: it read "a worse fixed point ... solved from arc 8 of 9".
+    assert "fixed point" not in scene.readout.content and "arc " not in scene.readout.content
     if start is not None:
+        assert f"solved again from a {report.start}" in scene.readout.content
         for k, value in zip(counts[:3], chart[:3], strict=True):
             kwargs = _solve_kwargs(scene.params, scene.obstacle_centres) | {"max_iterations": int(k)}
             capped = _run("fabrik", to_kernel(start, False), to_kernel(scene.target, False), **kwargs)
@@ -457,3 +460,16 @@ def test_a_short_pose_says_in_words_why(scene: ArmScene, setup: dict, words: str
     scene._apply_target()
     assert scene.report is not None and scene.report.result.status == "reached"
     assert "Short by" not in scene.readout.content
+
+
+def test_a_solve_from_another_start_is_told_in_a_users_words(scene: ArmScene) -> None:
+    # Two links of 0.5 m: the last pose falls short under the limits and a bent start comes closer. The readout said
+    # "The last pose led to a worse fixed point: this pose was solved from arc 8 of 9".
+    scene.controls["n_links"].value = 2
+    scene.controls["link_length_m"].value = 0.5
+    report = scene.report
+    assert report is not None and report.start == "gently bent start 8 of 9"
+    text = scene.readout.content
+    assert "the joint limits held the arm farther from the target" in text
+    assert "solved again from a gently bent start 8 of 9" in text
+    assert "fixed point" not in text and "arc " not in text
