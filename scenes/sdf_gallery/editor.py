@@ -28,6 +28,8 @@ EDITOR_HALF_SIZE_M = 1.5
 """The editor's field is meshed and ray-marched inside the cube [−h, h]³ (m) by default."""
 EXAMPLES = gl_renderer.examples()
 """The editor's examples, by title."""
+OWN_CODE = "Your own code"
+"""What the Example menu shows once the editor's text is no example's: picking an example again then puts it back."""
 EXAMPLE_SOURCES = frozenset(EXAMPLES.values())
 EDITOR_KEEP_CHARS = 2 * MAX_SOURCE_CHARS
 """Longest text the editor keeps (characters): room to paste a little too much and trim it; beyond, the previous

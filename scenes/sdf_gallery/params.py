@@ -18,7 +18,7 @@ import numpy as np
 
 from kernels import sdf
 from scenes._controls import checkbox, dropdown, dropdown_from_labels, rgb, slider, text
-from scenes.sdf_gallery.editor import EDITOR_HALF_SIZE_M, EXAMPLES, EditorField
+from scenes.sdf_gallery.editor import EDITOR_HALF_SIZE_M, EXAMPLES, OWN_CODE, EditorField
 from shaders.renderer import Camera, Shading
 
 BOX_M = 1.5
@@ -200,9 +200,10 @@ class SdfGalleryParams:
     shape."""
     example: str = field(
         default=next(iter(EXAMPLES)),
-        metadata=dropdown("Example", tuple(EXAMPLES), folder="GLSL editor"),
+        metadata=dropdown("Example", (*EXAMPLES, OWN_CODE), folder="GLSL editor"),
     )
-    """The title of the example last picked (picking one puts its source in the editor and applies it)."""
+    """The title of the example last picked (picking one puts its source in the editor and applies it), or
+    :data:`OWN_CODE` once the editor's text is no example's."""
     editor_text: str = field(
         default=next(iter(EXAMPLES.values())),
         metadata=text("sdf(p) in GLSL", multiline=True, folder="GLSL editor"),

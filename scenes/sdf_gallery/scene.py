@@ -37,7 +37,7 @@ from scenes._framing import ClientFraming, Lens, View, box_corners, frame_points
 from scenes._worker import LatestWorker
 from scenes.sdf_gallery import editor
 from scenes.sdf_gallery.compare import Agreement, Wire, compare, readout_markdown
-from scenes.sdf_gallery.editor import EDITING_OFF, EDITOR_HELP, EXAMPLES, EditorField
+from scenes.sdf_gallery.editor import EDITING_OFF, EDITOR_HELP, EXAMPLES, OWN_CODE, EditorField
 from scenes.sdf_gallery.export import (
     NOTHING_TO_DOWNLOAD,
     Download,
@@ -370,8 +370,10 @@ IoU is lowest when a box edge is on the silhouette.
         self._apply_example()
 
     def _apply_example(self) -> None:
-        """Put the chosen example's source in the editor and apply it."""
-        source = EXAMPLES[self.params.example]
+        """Put the chosen example's source in the editor and apply it (the editor's own code stays as it is)."""
+        source = EXAMPLES.get(self.params.example)
+        if source is None:  # OWN_CODE: nothing to put in
+            return
         self.write_back(self.editor, source)
         self.params = dataclasses.replace(self.params, editor_text=source)
         self._request_source(source)
@@ -384,6 +386,9 @@ IoU is lowest when a box edge is on the silhouette.
         problem = editor.kept_text_problem(text)
         if problem is None:
             self.params = dataclasses.replace(self.params, editor_text=text)
+            if text != EXAMPLES.get(self.params.example, text):  # no longer the example: the menu says so
+                self.write_back(self.example_controls["example"], OWN_CODE)
+                self.params = dataclasses.replace(self.params, example=OWN_CODE)
             return
         self.write_back(self.editor, self.params.editor_text)
         if problem:

@@ -551,6 +551,31 @@ def test_every_example_applies_and_meshes(server: viser.ViserServer, scene: SdfG
 
 
 @pytest.mark.gl
+def test_typed_code_shows_as_your_own_and_the_same_example_can_be_picked_again(
+    server: viser.ViserServer, scene: SdfGalleryScene
+) -> None:
+    # After typing, the menu still showed the example, and picking it again was no change: nothing came back.
+    from scenes.sdf_gallery import EXAMPLES
+    from scenes.sdf_gallery.editor import OWN_CODE
+
+    need_gl()
+    first = next(iter(EXAMPLES))
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Example")
+        assert client.value_of("Example") == first
+        client.set_value("sdf(p) in GLSL", SPHERE_SOURCE)
+        client.wait_for(lambda: client.value_of("Example") == OWN_CODE, what="the menu saying 'Your own code'")
+        assert scene.params.example == OWN_CODE
+        client.set_value("Example", OWN_CODE)  # picking it changes nothing: the typed code stays
+        client.set_value("Example", first)
+        client.wait_for(lambda: client.value_of("sdf(p) in GLSL") == EXAMPLES[first], what="the example back")
+        assert client.value_of("Example") == first
+        client.set_value("sdf(p) in GLSL", EXAMPLES[first])  # the example's own text: still that example
+        time.sleep(0.3)
+        assert client.value_of("Example") == first
+
+
+@pytest.mark.gl
 def test_raymarched_view_goes_to_the_background_with_depth(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
     need_gl()
     with BrowserClient(server.get_port()) as client:
