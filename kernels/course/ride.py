@@ -38,7 +38,7 @@ class Rider:
     crr: float = 0.004
     """Rolling-resistance coefficient (≥ 0)."""
     drivetrain_efficiency: float = 0.976
-    """Fraction of pedal power reaching the wheel, (0, 1]; Martin et al. 1998's 0.976."""
+    """Fraction of pedal power reaching the wheel, [0.001, 1]; Martin et al. 1998's 0.976."""
     model: Model = "martin"
     """``"seed"``: aero, rolling, climbing; ``"martin"``: Martin et al. 1998's terms."""
     spoke_drag_m2: float = 0.0044
@@ -53,9 +53,15 @@ class Rider:
             _checks.positive(key, getattr(self, key))
         for key in ("crr", "spoke_drag_m2", "wheel_inertia_kgm2"):
             _checks.non_negative(key, getattr(self, key))
+        # The forward model's ranges (cycling.MARTIN_DOMAIN): a mass of 1e308 kg overflowed the ride, and a tyre
+        # radius of 1e-300 m raised ZeroDivisionError.
+        for key in ("cda_m2", "mass_kg", "crr", "spoke_drag_m2", "wheel_inertia_kgm2", "wheel_radius_m"):
+            low, high = cycling.MARTIN_DOMAIN[key]
+            if not low <= getattr(self, key) <= high:
+                raise ValueError(f"{key} must be in [{low:g}, {high:g}], got {getattr(self, key)!r}")
         eta = self.drivetrain_efficiency
-        if not (isinstance(eta, (int, float)) and 0.0 < eta <= 1.0):
-            raise ValueError(f"drivetrain_efficiency must be in (0, 1], got {eta!r}")
+        if not (isinstance(eta, (int, float)) and not isinstance(eta, bool) and 1e-3 <= eta <= 1.0):
+            raise ValueError(f"drivetrain_efficiency must be in [0.001, 1], got {eta!r}")
         if self.model not in ("seed", "martin"):
             raise ValueError(f"model must be 'seed' or 'martin', got {self.model!r}")
 

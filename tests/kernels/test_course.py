@@ -4,6 +4,7 @@ loop, power_for_time against ride, pacing, the sample route, and every kind of b
 from __future__ import annotations
 
 import math
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -291,8 +292,17 @@ def test_bad_ride_arguments_name_themselves() -> None:
         ({"crr": -0.1}, "crr"),
         ({"drivetrain_efficiency": 0.0}, "drivetrain_efficiency"),
         ({"model": "magic"}, "model"),
+        # Huge or tiny but finite: the ride overflowed (1e308 kg) or raised ZeroDivisionError (a 1e-300 m tyre).
+        ({"mass_kg": 1e308}, "mass_kg"),
+        ({"wheel_radius_m": 1e-300}, "wheel_radius_m"),
+        ({"wheel_inertia_kgm2": 1e300}, "wheel_inertia_kgm2"),
+        ({"cda_m2": 1e300}, "cda_m2"),
+        ({"crr": 1e300}, "crr"),
+        ({"spoke_drag_m2": 1e300}, "spoke_drag_m2"),
+        ({"drivetrain_efficiency": 5e-324}, "drivetrain_efficiency"),
+        ({"drivetrain_efficiency": True}, "drivetrain_efficiency"),
     ]:
-        with pytest.raises(ValueError, match=name):
+        with pytest.raises(ValueError, match=f"^{name} must"):
             Rider(**kwargs)  # type: ignore[arg-type]
     with pytest.raises(ValueError, match="relative_humidity"):
         Air("weather", relative_humidity=2.0)
@@ -630,3 +640,16 @@ def test_the_route_over_the_north_pole_is_drawn_straight() -> None:
     assert c.total_distance_m == pytest.approx(200 * 11.1195, rel=1e-3)
     assert float(np.ptp(c.north_m) + np.ptp(c.east_m)) == pytest.approx(c.total_distance_m, rel=1e-3)
     assert min(float(np.ptp(c.north_m)), float(np.ptp(c.east_m))) < 0.01  # a line, not a "U"
+
+
+@pytest.mark.parametrize("model", ["martin", "seed"])
+@pytest.mark.parametrize("key", ["cda_m2", "mass_kg", "crr", "spoke_drag_m2", "wheel_inertia_kgm2", "wheel_radius_m"])
+def test_a_rider_at_either_end_of_every_range_rides_the_sample_climb_in_finite_time(model: str, key: str) -> None:
+    # The family of the refusals above: inside the ranges no ride overflows, warns or divides by zero.
+    c = course.load_gpx(course.SAMPLE_ROUTE)
+    for value in cycling.MARTIN_DOMAIN[key]:
+        rider = Rider(**{key: value if value > 0.0 or key != "mass_kg" else 5e-324}, model=model)  # type: ignore[arg-type]
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            ride = course.ride(c, 250.0, rider)
+        assert math.isfinite(ride.time_s) and ride.time_s > 0.0
