@@ -24,6 +24,7 @@ from kernels.fabrik.chain import (
     _FAR_TARGET,
     _FARTHEST,
     _SOLVER_IDS,
+    _SPAN,
     _UNSCALED,
     STATUSES,
     Solver,
@@ -667,31 +668,44 @@ def _options(
 
 def check_reach_span(joints: NDArray[np.float64], targets: NDArray[np.float64], name: str) -> None:
     """``ValueError`` naming ``name`` (and the row, for a batch) when a target lies more than :data:`_FARTHEST` times
-    its chain's length from the root, or when one batch holds chains whose sizes differ by more than that.
+    its chain's length from the root, or the chain lies more than that from the origin; or, for a batch, when its
+    chains (targets included) differ in size by more than :data:`_SPAN`.
 
-    ``joints`` (B, n + 1, d) and ``targets`` (B, d), finite and checked. Each chain is solved in units of a power of
-    2 near the batch's size (see :func:`_to_unit_scale`); outside these spans its links fall below that scale's
-    rounding and the solve is no longer the algorithm's (FABRIK collapsed a 0.5 m chain to its root for a target
-    1e200 m away, and that row's scale made the other rows of its batch report "reached" where they were not).
+    ``joints`` (B, n + 1, d) and ``targets`` (B, d), finite and checked. Outside these spans the links fall below
+    the rounding of the problem's scale and the solve is no longer the algorithm's: FABRIK collapsed a 0.5 m chain to
+    its root for a target 1e200 m away; a chain 1e15 m from the origin had its links changed 8 % by the rounding of
+    its coordinates; and a batch is solved in units of one power of 2 near its largest chain (see
+    :func:`_to_unit_scale`), so a row 1e200 times smaller lost its links (DLS already at 1e60).
     """
     root = joints[:, :1, :]
     size = np.maximum(np.abs(joints - root).max(axis=(1, 2)), np.abs(targets - root[:, 0]).max(axis=1))
     total = _norms(np.diff(joints, axis=1)).sum(axis=1)
     reach = _norms(targets - root[:, 0])
-    far = np.flatnonzero((total > 0.0) & (reach / _FARTHEST > total))
-    if far.size:
-        k = far[0]
-        row = "" if name == "target" else f"[{k}]"
+    origin = np.maximum(np.abs(joints).max(axis=(1, 2)), np.abs(targets).max(axis=1))
+    single = name == "target"
+    for measure, what in ((reach, "target"), (origin, "origin")):
+        far = np.flatnonzero((total > 0.0) & (measure / _FARTHEST > total))
+        if not far.size:
+            continue
+        k = int(far[0])
+        if what == "target":
+            raise ValueError(
+                f"{name}{'' if single else f'[{k}]'} is {reach[k]:.3g} m from the root, more than {_FARTHEST:g} "
+                f"times the chain's length ({total[k]:.3g} m): too far to solve; a target nearer on the same line "
+                f"gives the same pose"
+            )
         raise ValueError(
-            f"{name}{row} is {reach[k]:.3g} m from the root, more than {_FARTHEST:g} times the chain's length "
-            f"({total[k]:.3g} m): too far to solve; a target nearer on the same line gives the same pose"
+            f"joints{'' if single else f'[{k}]'} and the target lie {origin[k]:.3g} m from the origin, more than "
+            f"{_FARTHEST:g} times the chain's length ({total[k]:.3g} m): the rounding of the coordinates alone "
+            f"changes its links; solve it with the origin nearer"
         )
     sized = size[size > 0.0]
-    if sized.size and sized.max() / _FARTHEST > sized.min():
+    if sized.size and sized.max() / _SPAN > sized.min():
         small, large = int(np.flatnonzero(size == sized.min())[0]), int(np.flatnonzero(size == sized.max())[0])
         raise ValueError(
-            f"joints[{small}] and its target span {size[small]:.3g} m and joints[{large}] {size[large]:.3g} m: "
-            f"chains more than {_FARTHEST:g} times apart in size cannot share a batch; solve them in separate calls"
+            f"row {small} (joints and target within {size[small]:.3g} m of its root) and row {large} (within "
+            f"{size[large]:.3g} m) differ in size by more than {_SPAN:g} times: they cannot share a batch; solve "
+            f"them in separate calls"
         )
 
 
@@ -781,6 +795,20 @@ def _solve_single(
         _check_vector("target", target, dim)
     if code == _FAR_TARGET:
         check_reach_span(chain[None], point[None], "target")  # raises, naming it
+        # The compiled estimate and this check round differently in the last ulps at the limit: solve it as a batch
+        # of one, which this check passed (never the empty arrays of a refused call).
+        return solve_batch(
+            chain[None],
+            point[None],
+            tolerance=tolerance,
+            max_iterations=max_iterations,
+            cone_half_angle_rad=cone_half_angle_rad,
+            obstacles=obstacles,
+            root_direction=root_direction,
+            constraints=constraints,
+            solver=solver,
+            extrapolate=extrapolate,
+        )[0]
     # The frozen dataclass's __init__ sets each field through object.__setattr__ (~0.8 µs, a third of the Python
     # around a small chain's core); filling the instance's dict makes the same object in a quarter of that.
     solution = object.__new__(Solution)

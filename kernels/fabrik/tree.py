@@ -206,6 +206,12 @@ def solve_tree(
             f"targets[{key}] is {reach[far[0]]:.3g} m from the root, more than {_FARTHEST:g} times the tree's length "
             f"({total:.3g} m): too far to solve"
         )
+    origin = max(float(np.abs(points).max()), float(np.abs(goal[effector_ids, :dim]).max()))
+    if total > 0.0 and origin / _FARTHEST > total:
+        raise ValueError(
+            f"joints and targets lie {origin:.3g} m from the origin, more than {_FARTHEST:g} times the tree's length "
+            f"({total:.3g} m): the rounding of the coordinates alone changes its links; solve it with the origin nearer"
+        )
     p = np.zeros((count, 3))
     p[:, :dim] = points
     history = np.empty((setup.max_iterations + 1, len(effector_ids)))
