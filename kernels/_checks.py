@@ -40,7 +40,7 @@ def finite_number(name: str, value: object) -> float:
     """``value`` as a float when it is a finite real scalar (Python or numpy; not bool), else ``ValueError``."""
     if type(value) is float and math.isfinite(value):  # the common case, first
         return value
-    if isinstance(value, _REAL_SCALARS) and not isinstance(value, (bool, np.bool_)):
+    if isinstance(value, _REAL_SCALARS) and not isinstance(value, (bool, np.bool_, np.timedelta64)):
         try:
             number = float(value)
         except OverflowError:  # an int beyond float64
@@ -53,7 +53,11 @@ def finite_number(name: str, value: object) -> float:
 def integer(name: str, value: object, minimum: int | None = None) -> int:
     """``value`` as an int when it is a Python or numpy integer (not bool), ≥ ``minimum`` if given, else
     ``ValueError`` naming it."""
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or (minimum is not None and value < minimum):
+    if (
+        isinstance(value, (bool, np.timedelta64))  # numpy's timedelta is an integer type
+        or not isinstance(value, (int, np.integer))
+        or (minimum is not None and value < minimum)
+    ):
         at_least = "" if minimum is None else f" >= {minimum}"
         raise ValueError(f"{name} must be an integer{at_least}, got {value!r}")
     return int(value)

@@ -203,6 +203,7 @@ def odds_map(
     if not (np.abs(angles) < 0.5 * math.pi).all():
         raise ValueError(f"angles_rad must be in (−π/2, π/2) (in front of the goal line), got {angles_rad!r}")
     _checks.finite_number("aim_rad", aim_rad)
+    _checks.integer("n", n, 1)
     _strike_count("n", n * len(distances) * len(angles), len(distances) * len(angles), "n × spots")
     _checks.integer("chunks", chunks, 1)
     if progress is not None and not callable(progress):

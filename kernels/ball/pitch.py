@@ -22,6 +22,8 @@ GOAL_HEIGHT_M = 2.44
 """Ground to the underside of the crossbar."""
 WALL_DISTANCE_M = 9.15
 """FIFA distance of the defensive wall from the ball."""
+MAX_PANEL_M = 1000.0
+"""Largest width or height of a wall or goal (m): several times the longest pitch (120 m)."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -75,8 +77,8 @@ def free_kick_panels(
     wall = Panel(
         (float(wall_foot[0]), float(wall_foot[1])),
         (float(aim[0]), float(aim[1])),
-        _checks.positive("wall_width_m", wall_width_m),
-        _checks.positive("wall_height_m", wall_height_m),
+        _panel_size("wall_width_m", wall_width_m),
+        _panel_size("wall_height_m", wall_height_m),
     )
     goal = Panel(
         (float(centre[0]), float(centre[1])),
@@ -85,6 +87,14 @@ def free_kick_panels(
         GOAL_HEIGHT_M,
     )
     return wall, goal
+
+
+def _panel_size(name: str, value: object) -> float:
+    """A size in (0, :data:`MAX_PANEL_M`] m, else ``ValueError`` naming it."""
+    size = _checks.positive(name, value)
+    if size > MAX_PANEL_M:
+        raise ValueError(f"{name} must be at most {MAX_PANEL_M:g} m, got {value!r}")
+    return size
 
 
 def panel_rows(wall: Panel, goal: Panel) -> NDArray[np.float64]:
@@ -105,6 +115,10 @@ def panel_row(name: str, panel: Panel, *, standing: bool = False) -> NDArray[np.
     row[4] = _checks.positive(f"{name}.width_m", panel.width_m)
     check = _checks.positive if standing else _checks.finite_number
     row[5] = check(f"{name}.height_m", panel.height_m)
+    # Bounded by a pitch's size, many times over: a wall 1e300 m high let a shot through (its top overflowed).
+    for slot, field in ((4, "width_m"), (5, "height_m")):
+        if row[slot] > MAX_PANEL_M:
+            raise ValueError(f"{name}.{field} must be at most {MAX_PANEL_M:g} m, got {getattr(panel, field)!r}")
     return row
 
 
@@ -184,7 +198,7 @@ class Keeper:
         if self.position_xy is not None:
             spot = checked_vector("keeper.position_xy", self.position_xy, 2)
             return float(spot[0]), float(spot[1])
-        ball = checked_vector("ball_xy", ball_xy, 2)
+        ball = _checks.bounded_array("ball_xy", checked_vector("ball_xy", ball_xy, 2), 1e300)  # no hypot overflows
         row = panel_row("goal", goal, standing=True)
         centre, normal = row[0:2], row[2:4]
         along = np.array([-normal[1], normal[0]])

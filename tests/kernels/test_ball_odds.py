@@ -205,3 +205,40 @@ def test_the_odds_maps_edges_are_accepted() -> None:
     edges = odds.odds_map([9.2, 120.0], [-1.5, 1.5], 25.0, 0.3, 0.0, SPIN, n=2, progress=lambda share: None, **OPTIONS)
     assert edges["goal"].shape == (2, 2)
     np.testing.assert_allclose(sum(edges.values()), 1.0)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "name"),
+    [
+        ({"n": None}, r"^n must be an integer"),  # TypeError multiplying None
+        ({"n": 2.0}, r"^n must be an integer"),
+        ({"wall_height_m": 1e300}, r"^wall_height_m must be at most 1000 m"),  # the wall let the shot through
+        ({"wall_height_m": 1000.5}, r"^wall_height_m must be at most 1000 m"),
+    ],
+)
+def test_a_second_reviews_odds_map_inputs_are_refused_by_name(kwargs, name) -> None:
+    arguments = {"distances_m": [20.0], "angles_rad": [0.2], "n": 2, **kwargs}
+    with pytest.raises(ValueError, match=name):
+        odds.odds_map(speed_ms=25.0, elevation_rad=0.2, aim_rad=0.0, spin_rads=(0.0, 0.0, 0.0), **arguments, **OPTIONS)
+
+
+def test_a_tall_wall_blocks_a_low_shot_up_to_the_largest_height_accepted() -> None:
+    for height in (1.8, 10.0, 1000.0):
+        shares = odds.odds_map([20.0], [0.2], 25.0, 0.2, 0.0, (0.0, 0.0, 0.0), wall_height_m=height, n=2, **OPTIONS)
+        assert shares["wall"][0, 0] == 1.0, height
+
+
+def test_a_keeper_placed_for_a_ball_beyond_1e300_m_is_refused_not_nan() -> None:
+    _, goal = ball.free_kick_panels((-20.0, 0.0), (0.0, 0.0), (1.0, 0.0))
+    with pytest.raises(ValueError, match=r"^ball_xy must be of magnitude"):
+        ball.Keeper().placed((1.7e308, 1.7e308), goal)
+    x, y = ball.Keeper().placed((-1e300, 0.0), goal)
+    assert math.isfinite(x) and math.isfinite(y)
+    with pytest.raises(ValueError, match=r"^pitch\.goal\.height_m must be at most 1000 m"):
+        ball.simulate(
+            (-20.0, 0.0, R),
+            (25.0, 0.0, 3.0),
+            (0.0, 0.0, 0.0),
+            ground_m=R,
+            pitch=ball.Pitch(ball.Panel((0, 0), (1, 0), 7.32, 1e300)),
+        )

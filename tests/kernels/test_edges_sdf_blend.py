@@ -341,3 +341,10 @@ def test_real_distances_of_every_kind_still_blend(name: str) -> None:
     for a in (0.3, np.float32(0.3), np.int64(1), [0.3, -np.inf], np.array([[0.3], [np.inf]], dtype=np.float32)):
         result = BLENDS[name](a, 0.5)
         assert not np.isnan(result).any()
+
+
+@pytest.mark.parametrize("name", ["smin_poly", "smin_exp", "smooth_union", "smooth_subtract", "smooth_intersect"])
+def test_a_timedelta_width_is_refused_by_name(name: str) -> None:
+    # numpy's timedelta64 is an integer type: accepted as a number, then float() raised TypeError.
+    with pytest.raises(ValueError, match=r"^k must be a finite number"):
+        getattr(sdf, name)(0.3, 0.5, np.timedelta64(1, "s"))
