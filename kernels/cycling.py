@@ -123,7 +123,11 @@ def drag_reduction(n_riders: int, gap_m: float, model: DraftModel = "measured") 
         (n_riders,) reductions in [0, 1); effective CdA is ``cda·(1 − reduction)``.
     """
     _checks.integer("n_riders", n_riders, 1)
-    gap = float(_non_negative("gap_m", gap_m))
+    if n_riders > MAX_FORMATION_RIDERS:  # 10¹² riders asked numpy for 7 TiB
+        raise ValueError(f"n_riders must be at most {MAX_FORMATION_RIDERS}, got {n_riders!r}")
+    gap = _checks.non_negative("gap_m", gap_m)  # one gap: an array raised numpy's TypeError
+    if model not in ("seed", "measured"):  # checked for one rider too
+        raise ValueError(f"model must be 'seed' or 'measured', got {model!r}")
     reduction = np.zeros(int(n_riders))
     if n_riders == 1:
         return reduction
@@ -238,7 +242,6 @@ def power(
     Returns:
         :class:`Power` with the broadcast shape of the inputs.
     """
-    v = _non_negative("speed_ms", speed_ms)
     _check_domain(
         "power",
         MODEL_DOMAIN,
@@ -249,6 +252,22 @@ def power(
         altitude_m=altitude_m,
         headwind_ms=headwind_ms,
     )
+    return _power(speed_ms, cda_m2, mass_kg, crr, grade, altitude_m, headwind_ms, drivetrain_efficiency)
+
+
+def _power(
+    speed_ms: ArrayLike,
+    cda_m2: ArrayLike,
+    mass_kg: ArrayLike,
+    crr: ArrayLike,
+    grade: ArrayLike,
+    altitude_m: ArrayLike,
+    headwind_ms: ArrayLike,
+    drivetrain_efficiency: ArrayLike,
+) -> Power:
+    """:func:`power` once its callers have checked the ranges (a group's CdA times its drag share may lie below
+    the range a rider's CdA is checked against)."""
+    v = _non_negative("speed_ms", speed_ms)
     r = _resistance(cda_m2, mass_kg, crr, grade, altitude_m, headwind_ms, drivetrain_efficiency)
 
     aero, rolling, _, climbing = wheel_power_terms(v, r.drag, r.rolling_force, r.climbing_force, r.wind, 0.0, 0.0)
@@ -527,16 +546,18 @@ def paceline(
     Returns:
         :class:`Power` whose fields have shape (n_riders,).
     """
+    speed = _checks.non_negative("speed_ms", speed_ms)  # one speed for the line
+    _check_group(cda_m2, mass_kg, crr, altitude_m, headwind_ms, speed, "paceline")
     effective_cda = _positive("cda_m2", cda_m2) * (1.0 - drag_reduction(n_riders, gap_m, model))
-    return power(
-        np.full(int(n_riders), float(_non_negative("speed_ms", speed_ms))),
+    return _power(
+        np.full(int(n_riders), speed),
         effective_cda,
         mass_kg,
         crr,
-        grade=grade,
-        altitude_m=altitude_m,
-        headwind_ms=headwind_ms,
-        drivetrain_efficiency=drivetrain_efficiency,
+        grade,
+        altitude_m,
+        headwind_ms,
+        drivetrain_efficiency,
     )
 
 
@@ -1016,14 +1037,39 @@ def formation_power(
     Returns:
         :class:`Power` whose fields have shape (N,), in the order of ``positions_xy``.
     """
+    speed = _checks.non_negative("speed_ms", speed_ms)  # the group's one speed
+    _check_group(cda_m2, mass_kg, crr, altitude_m, headwind_ms, speed, "formation_power")
     drag = formation_drag(positions_xy, model)
-    return power(
-        np.full(drag.shape, float(_non_negative("speed_ms", speed_ms))),
+    return _power(
+        np.full(drag.shape, speed),
         _positive("cda_m2", cda_m2) * drag,
         mass_kg,
         crr,
-        grade=grade,
+        grade,
+        altitude_m,
+        headwind_ms,
+        drivetrain_efficiency,
+    )
+
+
+def _check_group(
+    cda_m2: ArrayLike,
+    mass_kg: ArrayLike,
+    crr: ArrayLike,
+    altitude_m: ArrayLike,
+    headwind_ms: ArrayLike,
+    speed: float,
+    function: str,
+) -> None:
+    """:data:`MODEL_DOMAIN` for one rider's inputs to a group's power (the rider's CdA, before drafting shrinks it:
+    a CdA at the range's floor drafted below it and was refused, quoting values the caller never passed)."""
+    _check_domain(
+        function,
+        MODEL_DOMAIN,
+        speed_ms=speed,
+        cda_m2=cda_m2,
+        mass_kg=mass_kg,
+        crr=crr,
         altitude_m=altitude_m,
         headwind_ms=headwind_ms,
-        drivetrain_efficiency=drivetrain_efficiency,
     )

@@ -369,7 +369,10 @@ def _segments(course: Course, rider: Rider, wind_ms: float, wind_from_deg: float
 def _segment_power(power_w: ArrayLike, n_segments: int) -> NDArray[np.float64]:
     # Special to a ride: one number for the whole course or one per segment, so not a kernels._checks shape.
     try:
-        power = np.asarray(power_w, dtype=np.float64)
+        power = np.asarray(power_w)
+        if power.dtype.kind not in "fiu":  # True rode as 1 W, "250" as 250 W, a complex power lost its imaginary part
+            raise TypeError(power.dtype)
+        power = np.asarray(power, dtype=np.float64)
     except (TypeError, ValueError) as error:
         raise ValueError(f"power_w must be a number or an array of numbers, got {power_w!r}") from error
     if power.ndim == 0:
@@ -530,11 +533,11 @@ def power_for_time(
             nxt = x - f / slope
             if nxt > math.log(hi_p):
                 if x >= math.log(hi_p) or time_at(hi_p) > target + tol:
-                    raise ValueError(f"time_s {target:.1f} s is out of reach: it needs more than {hi_p:.0f} W")
+                    raise ValueError(f"time_s {target:.6g} s is out of reach: it needs more than {hi_p:.0f} W")
                 nxt = math.log(hi_p)
             elif nxt < math.log(lo_p):
                 if x <= math.log(lo_p) or time_at(lo_p) < target - tol:
-                    raise ValueError(f"time_s {target:.1f} s is out of reach: even {lo_p:.0f} W rides it faster")
+                    raise ValueError(f"time_s {target:.6g} s is out of reach: even {lo_p:.0f} W rides it faster")
                 nxt = math.log(lo_p)
         x_prev, f_prev = x, f
         x = nxt

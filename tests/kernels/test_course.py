@@ -4,6 +4,7 @@ loop, power_for_time against ride, pacing, the sample route, and every kind of b
 from __future__ import annotations
 
 import math
+import re
 import warnings
 from pathlib import Path
 
@@ -653,3 +654,21 @@ def test_a_rider_at_either_end_of_every_range_rides_the_sample_climb_in_finite_t
             warnings.simplefilter("error")
             ride = course.ride(c, 250.0, rider)
         assert math.isfinite(ride.time_s) and ride.time_s > 0.0
+
+
+@pytest.mark.parametrize("power", [True, np.array([True]), "250", np.array([1 + 0j]), None, [250.0, "a"]], ids=repr)
+def test_a_ride_refuses_a_power_that_is_not_a_real_number(power: object) -> None:
+    # True rode as 1 W (903,564 s), "250" as 250 W, and a complex power lost its imaginary part with a warning.
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(ValueError, match=r"^power_w must be a number or an array of numbers"):
+            course.ride(course.load_gpx(course.SAMPLE_ROUTE), power)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize(
+    ("time_s", "shown"), [(1e300, "time_s 1e+300 s"), (1e-300, "time_s 1e-300 s"), (60.0, "time_s 60 s")]
+)
+def test_an_out_of_reach_time_is_quoted_as_given(time_s: float, shown: str) -> None:
+    # ":.1f" printed 1e300 as 301 digits and 1e-300 as "0.0 s".
+    with pytest.raises(ValueError, match=f"^{re.escape(shown)} is out of reach"):
+        course.power_for_time(course.load_gpx(course.SAMPLE_ROUTE), time_s)

@@ -368,3 +368,36 @@ def test_power_refuses_every_argument_past_its_domain_by_name(
         value = edge_value + side * max(abs(edge_value), 1.0) * beyond
         with pytest.raises(ValueError, match=f"^{name} must be"):
             function(**{**POWER_BASE, name: value})
+
+
+@pytest.mark.parametrize(
+    ("call", "message"),
+    [
+        # One speed or gap for the group: an array raised numpy's "only 0-dimensional arrays" TypeError.
+        (lambda: cycling.paceline(3, 1.0, [10.0, 11.0], 0.3, 80.0, 0.004), "^speed_ms must be a finite number"),  # type: ignore[arg-type]
+        (lambda: cycling.formation_power([[0, 0], [-2, 0]], [10.0, 11.0], 0.3, 80, 0.004), "^speed_ms must be"),  # type: ignore[arg-type]
+        (lambda: cycling.paceline(2, [1.0, 2.0], 10.0, 0.3, 80.0, 0.004), "^gap_m must be a finite number"),  # type: ignore[arg-type]
+        # 10¹² riders asked for 7 TiB.
+        (lambda: cycling.paceline(10**12, 1.0, 10.0, 0.3, 80.0, 0.004), "^n_riders must be at most 200"),
+        (lambda: cycling.drag_reduction(201, 1.0), "^n_riders must be at most 200"),
+        # The model was checked only from two riders up.
+        (lambda: cycling.paceline(1, 1.0, 10.0, 0.3, 80.0, 0.004, model=None), "^model must be"),  # type: ignore[arg-type]
+        (lambda: cycling.drag_reduction(1, 1.0, model="bogus"), "^model must be"),  # type: ignore[arg-type]
+    ],
+)
+def test_a_groups_bad_input_is_refused_by_name(call: Callable[[], object], message: str) -> None:
+    with pytest.raises(ValueError, match=message):
+        call()
+
+
+def test_a_group_at_the_cda_floor_is_accepted_though_drafting_takes_it_below() -> None:
+    # CdA 1e-6 m² (the range's floor), drafted to 5e-7: refused as "cda_m2 ... got array([9.7e-07, 6.0e-07, ...])".
+    line = cycling.paceline(3, 0.0, 10.0, 1e-6, 80.0, 0.004, model="measured")
+    alone = cycling.power(10.0, 1e-6, 80.0, 0.004)
+    assert np.all(line.total < alone.total) and np.all(np.isfinite(line.total))
+    # 2,000 riders packed tight: the drag share falls to 7e-13 of the leader's; the power is rolling alone, finite.
+    x = -0.01 * np.arange(2000)
+    y = np.where(np.arange(2000) % 2, 0.41, -0.41)
+    group = cycling.formation_power(np.column_stack([x, y]), 10.0, 0.3, 80.0, 0.004)
+    rolling = float(cycling.power(10.0, 0.3, 80.0, 0.004).rolling)
+    assert np.all(group.total >= rolling) and np.all(np.isfinite(group.total))
