@@ -115,7 +115,7 @@ def drag_reduction(n_riders: int, gap_m: float, model: DraftModel = "measured") 
     """Fractional CdA reduction of each rider in a single-file line, leader first.
 
     Args:
-        n_riders: riders in the line (≥ 1).
+        n_riders: riders in the line (1 to :data:`MAX_FORMATION_RIDERS`, 200).
         gap_m: wheel-to-wheel gap between consecutive riders (m, ≥ 0).
         model: ``"seed"`` or ``"measured"`` (see the module docstring).
 
@@ -538,7 +538,7 @@ def paceline(
     """Power of each rider in a single-file line at one speed, leader first.
 
     Args:
-        n_riders: riders in the line (≥ 1).
+        n_riders: riders in the line (1 to :data:`MAX_FORMATION_RIDERS`, 200).
         gap_m: wheel-to-wheel gap (m, ≥ 0).
         model: ``"seed"`` or ``"measured"`` drafting (see the module docstring).
         Other arguments as for :func:`power`, for one rider.
