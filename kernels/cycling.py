@@ -242,16 +242,7 @@ def power(
     Returns:
         :class:`Power` with the broadcast shape of the inputs.
     """
-    _check_domain(
-        "power",
-        MODEL_DOMAIN,
-        speed_ms=speed_ms,
-        cda_m2=cda_m2,
-        mass_kg=mass_kg,
-        crr=crr,
-        altitude_m=altitude_m,
-        headwind_ms=headwind_ms,
-    )
+    _check_model_domain(cda_m2, mass_kg, crr, altitude_m, headwind_ms, speed_ms, "power")
     return _power(speed_ms, cda_m2, mass_kg, crr, grade, altitude_m, headwind_ms, drivetrain_efficiency)
 
 
@@ -547,7 +538,7 @@ def paceline(
         :class:`Power` whose fields have shape (n_riders,).
     """
     speed = _checks.non_negative("speed_ms", speed_ms)  # one speed for the line
-    _check_group(cda_m2, mass_kg, crr, altitude_m, headwind_ms, speed, "paceline")
+    _check_model_domain(cda_m2, mass_kg, crr, altitude_m, headwind_ms, speed, "paceline")
     effective_cda = _positive("cda_m2", cda_m2) * (1.0 - drag_reduction(n_riders, gap_m, model))
     return _power(
         np.full(int(n_riders), speed),
@@ -1038,7 +1029,7 @@ def formation_power(
         :class:`Power` whose fields have shape (N,), in the order of ``positions_xy``.
     """
     speed = _checks.non_negative("speed_ms", speed_ms)  # the group's one speed
-    _check_group(cda_m2, mass_kg, crr, altitude_m, headwind_ms, speed, "formation_power")
+    _check_model_domain(cda_m2, mass_kg, crr, altitude_m, headwind_ms, speed, "formation_power")
     drag = formation_drag(positions_xy, model)
     return _power(
         np.full(drag.shape, speed),
@@ -1052,21 +1043,21 @@ def formation_power(
     )
 
 
-def _check_group(
+def _check_model_domain(
     cda_m2: ArrayLike,
     mass_kg: ArrayLike,
     crr: ArrayLike,
     altitude_m: ArrayLike,
     headwind_ms: ArrayLike,
-    speed: float,
+    speed_ms: ArrayLike,
     function: str,
 ) -> None:
-    """:data:`MODEL_DOMAIN` for one rider's inputs to a group's power (the rider's CdA, before drafting shrinks it:
-    a CdA at the range's floor drafted below it and was refused, quoting values the caller never passed)."""
+    """:data:`MODEL_DOMAIN` for one rider's inputs (for a group, the rider's CdA before drafting shrinks it: a CdA
+    at the range's floor drafted below it and was refused, quoting values the caller never passed)."""
     _check_domain(
         function,
         MODEL_DOMAIN,
-        speed_ms=speed,
+        speed_ms=speed_ms,
         cda_m2=cda_m2,
         mass_kg=mass_kg,
         crr=crr,

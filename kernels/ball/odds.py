@@ -102,7 +102,7 @@ def draw_strikes(
         (np.cos(elevation) * np.cos(azimuth), np.cos(elevation) * np.sin(azimuth), np.sin(elevation)), axis=1
     )
     rates = np.maximum(rate + 2.0 * math.pi * spread.spin_rate_rev_s * normal[:, 3], 0.0)
-    axis = spin / scale / (rate / scale) if rate > 0.0 else np.array([0.0, 0.0, 1.0])
+    axis = spin / rate if rate > 0.0 else np.array([0.0, 0.0, 1.0])
     # Tilt the axis by a normal angle about a random direction perpendicular to it (Rodrigues' rotation).
     helper = np.array([1.0, 0.0, 0.0]) if abs(axis[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
     e1 = np.cross(axis, helper)

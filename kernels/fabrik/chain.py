@@ -854,23 +854,20 @@ def _solve_one(
         return _BAD_TARGET, np.empty((0, dim)), np.empty(0), 0, 0, 0.0
     p = np.zeros((count, 3))
     goal = np.zeros(3)
-    extent = 0.0
+    extent, origin = 0.0, 0.0
     for c in range(dim):
         for i in range(count):
             p[i, c] = joints[i, c]
             extent = max(extent, abs(joints[i, c] - joints[0, c]))
+            origin = max(origin, abs(joints[i, c]))
         goal[c] = target[c]
         extent = max(extent, abs(target[c] - joints[0, c]))
-    if extent > 0.0:  # the target within _FARTHEST chain lengths
+        origin = max(origin, abs(target[c]))
+    if extent > 0.0:  # the target within _FARTHEST chain lengths, the chain within them of the origin
         total = 0.0
         for i in range(1, count):
             total += _norm_of_difference(joints, i, i - 1, target, dim, False)
         reach = _norm_of_difference(joints, 0, 0, target, dim, True)
-        origin = 0.0
-        for c in range(dim):
-            origin = max(origin, abs(target[c]))
-            for i in range(count):
-                origin = max(origin, abs(joints[i, c]))
         if total > 0.0 and (reach / _FARTHEST > total or origin / _FARTHEST > total):
             return _FAR_TARGET, np.empty((0, dim)), np.empty(0), 0, 0, 0.0
     scale = 1.0

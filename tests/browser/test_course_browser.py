@@ -26,7 +26,7 @@ from helpers.browser import (
 from helpers.waiting import wait_until
 
 from scenes.peloton import PelotonScene
-from scenes.peloton.course import CHART_TITLE
+from scenes.peloton.course import CHART_TITLE, CourseMode
 
 pytestmark = pytest.mark.browser
 
@@ -104,13 +104,10 @@ def test_the_course_frames_every_rider_of_the_group_large_on_its_road(
     course drew riders 10-20 px tall before), its farthest rows still ≥ 14 px; the road under them shows."""
     scene = shown.scene
     assert isinstance(scene, PelotonScene)
-    mode = scene.course_mode
     with scene._lock:
         scene.controls["formation"].value = formation
         scene.controls["n_riders"].value = riders
-        if not mode.enabled:
-            mode.enable.value = True
-    wait_until(lambda: mode.enabled and mode.state is not None, "course mode on", timeout_s=15.0)
+    mode = course_on(shown)
     settle(shown)
     with scene._lock:
         feet = np.asarray(mode.course_riders["body"].batched_positions, np.float64)
@@ -161,13 +158,7 @@ def test_find_the_power_says_in_view_when_the_target_is_out_of_reach(shown: Scen
     """A 1 min target at the sample climb needs more than the power input's 2000 W: after a click of 'Find the
     power for this time' the page says so where the eye is (the note stood at the top of the course's folder,
     scrolled out of view by the time the button is reached)."""
-    scene = shown.scene
-    assert isinstance(scene, PelotonScene)
-    mode = scene.course_mode
-    with scene._lock:
-        if not mode.enabled:
-            mode.enable.value = True
-    wait_until(lambda: mode.enabled and mode.state is not None, "course mode on", timeout_s=15.0)
+    mode = course_on(shown)
     set_number(shown.page, "Target time (min)", 1)
     wait_until(lambda: mode.params.target_min == 1.0, "the target time", timeout_s=15.0)
     button = shown.page.get_by_role("button", name="Find the power for this time")
@@ -182,3 +173,15 @@ def test_find_the_power_says_in_view_when_the_target_is_out_of_reach(shown: Scen
     assert box is not None and viewport is not None
     _, top, _, bottom = panel_rect(shown.page)
     assert top <= box["y"] and box["y"] + box["height"] <= min(bottom, viewport["height"]), (box, (top, bottom))
+
+
+def course_on(shown: ScenePage) -> CourseMode:
+    """Tick the peloton's course mode (if it is not on already) and wait for its first ride."""
+    scene = shown.scene
+    assert isinstance(scene, PelotonScene)
+    mode = scene.course_mode
+    with scene._lock:
+        if not mode.enabled:
+            mode.enable.value = True
+    wait_until(lambda: mode.enabled and mode.state is not None, "course mode on", timeout_s=15.0)
+    return mode
