@@ -171,7 +171,7 @@ class Ride:
 
 
 _E_WORK, _E_AERO, _E_ROLL, _E_BEAR, _E_CLIMB, _E_BRAKE = range(6)
-_REFINE_RATIO = 0.5
+_REFINE_RATIO = 0.1
 """A step that changes the speed by more than this fraction is redone in halves (up to _REFINE_UP_TO)."""
 _REFINE_UP_TO = 64
 

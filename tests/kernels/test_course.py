@@ -137,8 +137,11 @@ def test_per_point_power_is_the_cycling_law(rider: Rider) -> None:
     eta = rider.drivetrain_efficiency
     law = (eta * r.power_w[:-1] - kinetic) / eta
     assert np.all(r.brakes_j == 0.0)
+    # A segment whose speed changes by more than a tenth is ridden in finer steps (the grade's turn at 1.5 km).
+    one_step = np.abs(np.diff(r.speed_ms)) <= 0.1 * np.maximum(r.speed_ms[1:], r.speed_ms[:-1])
+    assert one_step.sum() >= one_step.size - 2
     reference = martin_1998_pedal_power(mean, r.air_density, c.grade, r.headwind_ms, rider)
-    np.testing.assert_allclose(law, reference, rtol=1e-9)
+    np.testing.assert_allclose(law[one_step], reference[one_step], rtol=1e-9)
     altitude = 0.5 * (c.elevation_m[1:] + c.elevation_m[:-1])
     if rider.model == "seed":
         kernel = cycling.power(
@@ -148,7 +151,7 @@ def test_per_point_power_is_the_cycling_law(rider: Rider) -> None:
         kernel = cycling.martin_power(
             mean, rider.cda_m2, rider.mass_kg, rider.crr, c.grade, r.headwind_ms, r.air_density, eta
         ).total
-    np.testing.assert_allclose(law, kernel, rtol=1e-9)
+    np.testing.assert_allclose(law[one_step], kernel[one_step], rtol=1e-9)
 
 
 # ------------------------------------------------------------------------------------------------ energy
@@ -250,7 +253,8 @@ def descent_time_by_ode(c: course.Course, rider: Rider, power: float, v0: float,
 # Kind: the cap reached within a step. The whole step was ridden at the mean of its entry speed and the cap, as if
 # the cap were reached only at its end, so more power could ride slower (2.5 % on a 349 m step of a −16 % descent:
 # at 1350 W the step refined, at 1300 W it did not). The step now reaches the cap where the model's equation says,
-# then holds it.
+# then holds it. The same kind without the cap: a step refined only where the speed changed by half let 925 W
+# climb 2.5 % faster than 930 W (refined where it changes by a tenth, the property test below compares 2 % more).
 @pytest.mark.parametrize("rider", [SEED, MARTIN], ids=["seed", "martin"])
 def test_a_step_that_reaches_the_cap_holds_it_from_where_it_is_reached(rider: Rider) -> None:
     run = np.array([0.0, 350.0])
@@ -260,13 +264,26 @@ def test_a_step_that_reaches_the_cap_holds_it_from_where_it_is_reached(rider: Ri
         r = course.ride(c, power, rider, max_speed_ms=26.45, start_speed_ms=16.7)
         assert r.speed_ms[-1] == 26.45
         reference = descent_time_by_ode(c, rider, power, 16.7, 26.45)
-        assert r.time_s == pytest.approx(reference, rel=0.015)  # one trapezoid step; 0.12-0.15 before
+        assert r.time_s == pytest.approx(reference, rel=1e-3)  # 0.11-0.15 before
         times.append(r.time_s)
     assert np.all(np.diff(times) < 0.0)
     # Cut into 35 steps, the same ride converges on the reference.
     fine = course.course_from_xy(np.zeros(36), np.linspace(0.0, 350.0, 36), -0.16 * np.linspace(0.0, 350.0, 36))
     r = course.ride(fine, 1350.0, rider, max_speed_ms=26.45, start_speed_ms=16.7)
     assert r.time_s == pytest.approx(descent_time_by_ode(fine, rider, 1350.0, 16.7, 26.45), rel=3e-4)
+
+
+def test_more_power_climbs_faster_where_the_step_is_refined() -> None:
+    """A 108 m step up 15.6 % from 18 m/s, into a 15 m/s wind, then 108 m of flat: time falls with every 5 W."""
+    heading = np.array([0.0, 1.5])
+    east = np.concatenate(([0.0], np.cumsum(108.0 * np.sin(heading))))
+    north = np.concatenate(([0.0], np.cumsum(108.0 * np.cos(heading))))
+    c = course.course_from_xy(east, north, np.array([0.0, 0.15625 * 108.0, 0.15625 * 108.0]))
+    times = [
+        course.ride(c, power, SEED, 15.0, 56.0, max_speed_ms=18.0, start_speed_ms=18.0).time_s
+        for power in np.arange(900.0, 1001.0, 5.0)
+    ]
+    assert np.all(np.diff(times) < 0.0)  # 925 W rode 0.48 s faster than 930 W
 
 
 def test_energy_books_balance_from_rest() -> None:
