@@ -345,6 +345,9 @@ def _ride_core(
 
 
 _MIN_POWER_W, _MAX_POWER_W = 1.0, 5000.0
+_MAX_SPEED_MS = cycling.MODEL_DOMAIN["speed_ms"][1]
+_MAX_WIND_MS = cycling.MODEL_DOMAIN["headwind_ms"][1]
+"""A ride's safe speed and wind stay within the power law's range (:data:`kernels.cycling.MODEL_DOMAIN`)."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -368,6 +371,10 @@ def _segments(course: Course, rider: Rider, wind_ms: float, wind_from_deg: float
     _checks.instance("rider", rider, Rider)
     _checks.instance("air", air, Air, "an Air")
     wind = _checks.finite_number("wind_ms", wind_ms)
+    if abs(wind) > _MAX_WIND_MS:
+        raise ValueError(
+            f"wind_ms must be in [-{_MAX_WIND_MS:g}, {_MAX_WIND_MS:g}] m/s (the model's range), got {wind_ms!r}"
+        )
     wind_from = math.radians(_checks.finite_number("wind_from_deg", wind_from_deg))
     rolling, climbing = cycling.road_forces(rider.mass_kg, rider.crr, course.grade)
     mid_elevation = 0.5 * (course.elevation_m[1:] + course.elevation_m[:-1])
@@ -452,6 +459,10 @@ def _ride(course: Course, power: NDArray[np.float64], s: _Segments, max_speed: f
 
 def _speeds(max_speed_ms: float, start_speed_ms: float) -> tuple[float, float]:
     cap = _checks.positive("max_speed_ms", max_speed_ms)
+    if cap > _MAX_SPEED_MS:
+        raise ValueError(
+            f"max_speed_ms must be at most {_MAX_SPEED_MS:g} m/s (the model's range), got {max_speed_ms!r}"
+        )
     start = _checks.finite_number("start_speed_ms", start_speed_ms)
     if start < 0.0 or start > cap:
         raise ValueError(f"start_speed_ms must be in [0, max_speed_ms], got {start_speed_ms!r}")
@@ -474,10 +485,10 @@ def ride(
         course: the route.
         power_w: pedal power (W, > 0): one number, or (N − 1,) one per segment.
         rider: rider, bike and model.
-        wind_ms: wind speed (m/s; negative reverses it).
+        wind_ms: wind speed (m/s, at most 1000 either way; negative reverses it).
         wind_from_deg: where the wind blows from, clockwise from north (°): 0 is a north wind.
         air: air density along the route.
-        max_speed_ms: safe descending speed (m/s, > 0; 20 m/s = 72 km/h); the rider brakes to hold it.
+        max_speed_ms: safe descending speed (m/s, in (0, 10⁸]; 20 m/s = 72 km/h); the rider brakes to hold it.
         start_speed_ms: speed at the start (m/s, 0 = from rest).
 
     Returns:

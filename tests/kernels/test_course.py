@@ -740,6 +740,29 @@ def test_a_rider_at_either_end_of_every_range_rides_the_sample_climb_in_finite_t
         assert math.isfinite(ride.time_s) and ride.time_s > 0.0
 
 
+@pytest.mark.parametrize(
+    ("key", "inside", "outside"),
+    [("wind_ms", (-1000.0, 1000.0), (-1000.5, 1e6)), ("max_speed_ms", (1e-3, 1e8), (1.0001e8, 1e300))],
+)
+def test_a_ride_keeps_its_wind_and_safe_speed_in_the_model_range(
+    key: str, inside: tuple[float, float], outside: tuple[float, float]
+) -> None:
+    # A safe speed of 1e300 m/s from a start of 1e300 m/s ended at 1.9e100 m/s; a 10^6 m/s wind was ridden.
+    c = course.load_gpx(course.SAMPLE_ROUTE)
+    for value in inside:  # inside: a finite ride, or a segment the rider cannot cross, never an overflow
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            try:
+                r = course.ride(c, 250.0, **{key: value})  # type: ignore[arg-type]
+            except ValueError as error:
+                assert str(error).startswith("the rider cannot cross segment")
+            else:
+                assert math.isfinite(r.time_s) and r.time_s > 0.0
+    for value in outside:
+        with pytest.raises(ValueError, match=f"^{key} must be"):
+            course.ride(c, 250.0, **{key: value})  # type: ignore[arg-type]
+
+
 @pytest.mark.parametrize("power", [True, np.array([True]), "250", np.array([1 + 0j]), None, [250.0, "a"]], ids=repr)
 def test_a_ride_refuses_a_power_that_is_not_a_real_number(power: object) -> None:
     # True rode as 1 W (903,564 s), "250" as 250 W, and a complex power lost its imaginary part with a warning.
