@@ -1,5 +1,5 @@
 """Typing for the scene fixtures of ``tests/conftest.py`` (a callable that makes or shows a scene of a given class),
-and the ``scene`` fixture a scene's test module declares in one line."""
+the ``scene`` fixture a scene's test module declares in one line, and readers of the GLB meshes scenes send."""
 
 from __future__ import annotations
 
@@ -30,6 +30,16 @@ def scene_fixture(kind: type[Scene]) -> Any:
         return show_scene(kind)
 
     return scene
+
+
+def read_glb(glb_data: bytes) -> trimesh.Trimesh:
+    """The one mesh of a GLB as a scene sends it, read by trimesh (not by our writer) with its material and vertex
+    colours."""
+    loaded = trimesh.load(io.BytesIO(glb_data), file_type="glb", process=False)
+    assert isinstance(loaded, trimesh.Scene) and len(loaded.geometry) == 1
+    (mesh,) = loaded.geometry.values()
+    assert isinstance(mesh, trimesh.Trimesh)
+    return mesh
 
 
 def glb_vertices(glb_data: bytes) -> np.ndarray:

@@ -13,7 +13,7 @@ import trimesh
 import viser
 from helpers.ci import need_gl
 from helpers.properties import examples
-from helpers.scenes import scene_fixture
+from helpers.scenes import read_glb, scene_fixture
 from helpers.viser_private import gui_uuid, gui_uuids, node_names
 from helpers.waiting import wait_until
 from helpers.wsclient import BrowserClient
@@ -36,11 +36,7 @@ scene = scene_fixture(SdfGalleryScene)
 def shown_mesh(scene: SdfGalleryScene) -> trimesh.Trimesh:
     """The mesh the browser receives: the GLB bytes of the mesh node, loaded back (its one geometry, with its
     material and vertex colours)."""
-    loaded = trimesh.load(io.BytesIO(scene.mesh_node.glb_data), file_type="glb", process=False)
-    assert isinstance(loaded, trimesh.Scene) and len(loaded.geometry) == 1
-    (mesh,) = loaded.geometry.values()
-    assert isinstance(mesh, trimesh.Trimesh)
-    return mesh
+    return read_glb(scene.mesh_node.glb_data)
 
 
 # ------------------------------------------------------------------------------------------ server side
