@@ -94,13 +94,6 @@ SENTINELS = {  # an honest edit per scene, to know the hostile messages before i
 }
 
 
-@pytest.fixture(autouse=True)
-def _fresh_refusal_log() -> Iterator[None]:
-    refusals.reset()
-    yield
-    refusals.reset()
-
-
 def refused_lines(caplog: pytest.LogCaptureFixture) -> list[logging.LogRecord]:
     return [r for r in caplog.records if r.name == "server.refusals"]
 
