@@ -12,7 +12,6 @@ import re
 import numpy as np
 import pytest
 import viser
-from helpers.ci import need_gl
 from helpers.properties import examples
 from helpers.scenes import scene_fixture
 from helpers.waiting import wait_until
@@ -41,12 +40,6 @@ MESA_TOKEN_NAME = re.compile(
 )
 """Words of Mesa's parser (BASIC_TYPE_TOK, NEW_IDENTIFIER, FLOATCONSTANT, $end, …) that a message must not show."""
 POINTS = np.array([[0.0, 0.0, 0.0], [0.7, 0.0, 0.05], [0.3, -0.4, 0.2], [-0.9, 0.5, -0.3], [0.1, 0.65, 0.0]])
-
-
-@pytest.fixture(autouse=True)
-def gl_when_marked(request: pytest.FixtureRequest) -> None:
-    if request.node.get_closest_marker("gl") is not None:
-        need_gl()
 
 
 def probe(source: str) -> tuple[np.ndarray, np.ndarray]:

@@ -11,7 +11,6 @@ import numpy as np
 import pytest
 import trimesh
 import viser
-from helpers.ci import need_gl
 from helpers.properties import examples
 from helpers.scenes import read_glb, scene_fixture
 from helpers.viser_private import gui_uuid, gui_uuids, node_names
@@ -200,7 +199,6 @@ def test_high_resolution_shows_progress_then_a_fine_mesh(server: viser.ViserServ
 # ------------------------------------------------------------------------------------------ reference image
 @pytest.mark.gl
 def test_reference_image_readouts_and_rerender(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
-    need_gl()
     with BrowserClient(server.get_port()) as client:
         client.send_camera(position=(2.3, -2.5, 1.7), look_at=(0.05, 0.0, 0.3), size=(600, 800))
         # 320 px wide at this camera's 4:3 aspect (the client's first camera, 16:9, may get a render first).
@@ -253,7 +251,6 @@ def test_reference_image_readouts_and_rerender(server: viser.ViserServer, scene:
 @pytest.mark.gl
 def test_live_mode_renders_while_the_camera_moves(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
     """ "When the camera stops" waits for a still camera; "Live" renders while camera messages keep coming."""
-    need_gl()
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("Re-render")
         client.set_value("Re-render", "Live")
@@ -303,7 +300,6 @@ def test_downloads(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
 
 @pytest.mark.gl
 def test_png_download_is_the_reference_image(scene: SdfGalleryScene) -> None:
-    need_gl()
     wait_until(lambda: scene.reference_rgb is not None, "reference", timeout_s=60)
     from PIL import Image
 
@@ -360,8 +356,6 @@ def test_fifty_builds_share_one_gl_context_and_do_not_grow_memory(
     """Each build once made a new EGL context on a new thread (~50 MiB each, never reclaimed)."""
     import gc
     import threading
-
-    need_gl()
 
     def build_render_close() -> None:
         scene = SdfGalleryScene(server)
@@ -486,7 +480,6 @@ def background_images(client: BrowserClient) -> list[dict]:
 def test_typed_source_is_meshed_and_a_bad_one_keeps_the_last_good(
     server: viser.ViserServer, scene: SdfGalleryScene
 ) -> None:
-    need_gl()
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("sdf(p) in GLSL")
         client.set_value("sdf(p) in GLSL", SPHERE_SOURCE)
@@ -534,7 +527,6 @@ def test_typed_source_is_meshed_and_a_bad_one_keeps_the_last_good(
 def test_every_example_applies_and_meshes(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
     from scenes.sdf_gallery import EXAMPLES
 
-    need_gl()
     assert len(EXAMPLES) >= 6
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("Example")
@@ -554,7 +546,6 @@ def test_typed_code_shows_as_your_own_and_the_same_example_can_be_picked_again(
     from scenes.sdf_gallery import EXAMPLES
     from scenes.sdf_gallery.editor import OWN_CODE
 
-    need_gl()
     first = next(iter(EXAMPLES))
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("Example")
@@ -573,7 +564,6 @@ def test_typed_code_shows_as_your_own_and_the_same_example_can_be_picked_again(
 
 @pytest.mark.gl
 def test_raymarched_view_goes_to_the_background_with_depth(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
-    need_gl()
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("View")
         client.send_camera(position=(2.0, -2.4, 1.6), look_at=(0.0, 0.0, 0.3), size=(400, 640))
@@ -632,7 +622,6 @@ def test_with_editing_off_apply_uses_only_the_servers_examples(
 ) -> None:
     import scenes.sdf_gallery.editor as gallery
 
-    need_gl()
     monkeypatch.setattr(gallery, "editing_allowed", lambda: False)
     scene = SdfGalleryScene(server)
     try:
@@ -658,7 +647,6 @@ def test_compile_and_frame_time_limits_refuse_a_slow_source(
 ) -> None:
     import scenes.sdf_gallery.editor as gallery
 
-    need_gl()
     monkeypatch.setattr(gallery, limit, 1e-9)  # every source is too slow now
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("sdf(p) in GLSL")
@@ -685,7 +673,6 @@ def test_a_slow_compile_is_stopped_at_the_limit_while_the_server_keeps_serving(
 ) -> None:
     import scenes.sdf_gallery.editor as gallery
 
-    need_gl()
     # Nine links pass the size bound but take Mesa several seconds: the trial process is killed at the limit.
     monkeypatch.setattr(gallery, "COMPILE_LIMIT_S", 1.0)
     monkeypatch.setattr(gallery, "FRAME_LIMIT_S", 0.5)
@@ -764,7 +751,6 @@ def test_apply_of_a_text_over_the_source_limit_says_its_length_and_the_limit(
 def test_a_field_without_a_surface_in_the_bounds_is_not_applied(
     server: viser.ViserServer, scene: SdfGalleryScene, body: str, side: str
 ) -> None:
-    need_gl()
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("Apply")
         client.set_value("sdf(p) in GLSL", f"float sdf(vec3 p) {{ {body} }}\n")
