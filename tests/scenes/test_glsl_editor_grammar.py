@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 import viser
 from helpers.properties import examples
-from helpers.scenes import scene_fixture
+from helpers.scenes import apply_glsl, scene_fixture
 from helpers.waiting import wait_until
 from helpers.wsclient import BrowserClient
 from hypothesis import HealthCheck, given, settings
@@ -328,13 +328,10 @@ def test_the_editor_applies_a_const_in_source_and_names_an_unclosed_brace(
     server: viser.ViserServer, scene: SdfGalleryScene
 ) -> None:
     with BrowserClient(server.get_port()) as client:
-        client.wait_for_gui("sdf(p) in GLSL")
-        client.set_value("sdf(p) in GLSL", QUILEZ_STYLE[1])
-        client.click("Apply")
+        apply_glsl(client, QUILEZ_STYLE[1])
         wait_until(lambda: scene.editor_serial == 1, "the source applied", timeout_s=60)
         assert scene.editor_error is None and len(scene.mesh_faces) > 1000
-        client.set_value("sdf(p) in GLSL", "float sdf(in vec3 p) {\n    return length(p) - 0.5;\n")
-        client.click("Apply")
+        apply_glsl(client, "float sdf(in vec3 p) {\n    return length(p) - 0.5;\n")
         wait_until(lambda: scene.editor_error is not None, "the error", timeout_s=60)
         assert scene.editor_error is not None
         assert scene.editor_error.startswith("line 1: '{' is never closed")

@@ -12,7 +12,7 @@ import pytest
 import trimesh
 import viser
 from helpers.properties import examples
-from helpers.scenes import read_glb, scene_fixture
+from helpers.scenes import apply_glsl, read_glb, scene_fixture
 from helpers.viser_private import gui_uuid, gui_uuids, node_names
 from helpers.waiting import wait_until
 from helpers.wsclient import BrowserClient
@@ -481,9 +481,7 @@ def test_typed_source_is_meshed_and_a_bad_one_keeps_the_last_good(
     server: viser.ViserServer, scene: SdfGalleryScene
 ) -> None:
     with BrowserClient(server.get_port()) as client:
-        client.wait_for_gui("sdf(p) in GLSL")
-        client.set_value("sdf(p) in GLSL", SPHERE_SOURCE)
-        client.click("Apply")
+        apply_glsl(client, SPHERE_SOURCE)
         wait_until(lambda: scene.editor_serial == 1, "the source applied")
         assert scene.params.shape_source == "editor" and scene.mesh_scene is None
         client.wait_for(lambda: client.value_of("Shape") == "GLSL editor", what="Shape shown")
@@ -500,8 +498,7 @@ def test_typed_source_is_meshed_and_a_bad_one_keeps_the_last_good(
         assert exported.volume == pytest.approx(4 / 3 * math.pi * 0.6**3, rel=0.02)
         # A compile error: the message names the line; the sphere stays.
         shown = scene.mesh_vertices.copy()
-        client.set_value("sdf(p) in GLSL", "float sdf(vec3 p) {\n    return sd_sphere(p, 0.5)\n}\n")
-        client.click("Apply")
+        apply_glsl(client, "float sdf(vec3 p) {\n    return sd_sphere(p, 0.5)\n}\n")
         wait_until(lambda: scene.editor_error is not None, "the error")
         assert scene.editor_error is not None and scene.editor_error.startswith("line 3:")
         assert "line 3" in scene.editor_status.content
@@ -515,8 +512,7 @@ def test_typed_source_is_meshed_and_a_bad_one_keeps_the_last_good(
             ("#extension GL_ARB_foo : enable\nfloat sdf(vec3 p) { return 1.0; }", "line 1"),
         ]:
             scene.editor_error = None
-            client.set_value("sdf(p) in GLSL", text)
-            client.click("Apply")
+            apply_glsl(client, text)
             wait_until(lambda: scene.editor_error is not None, "a refusal")
             assert words in str(scene.editor_error)
         assert scene.editor_serial == 1
@@ -628,8 +624,7 @@ def test_with_editing_off_apply_uses_only_the_servers_examples(
         assert scene.editor.disabled and "Editing is off" in scene.editor_status.content
         with BrowserClient(server.get_port()) as client:
             client.wait_for_gui("Apply")
-            client.set_value("sdf(p) in GLSL", SPHERE_SOURCE)  # a crafted client can still send text
-            client.click("Apply")
+            apply_glsl(client, SPHERE_SOURCE)  # a crafted client can still send text
             wait_until(lambda: scene.editor_serial == 1, "an apply")
             assert scene.params.editor.source == next(iter(gallery.EXAMPLES.values()))
     finally:
@@ -649,9 +644,7 @@ def test_compile_and_frame_time_limits_refuse_a_slow_source(
 
     monkeypatch.setattr(gallery, limit, 1e-9)  # every source is too slow now
     with BrowserClient(server.get_port()) as client:
-        client.wait_for_gui("sdf(p) in GLSL")
-        client.set_value("sdf(p) in GLSL", SPHERE_SOURCE.replace("0.6", "0.61"))
-        client.click("Apply")
+        apply_glsl(client, SPHERE_SOURCE.replace("0.6", "0.61"))
         wait_until(lambda: scene.editor_error is not None, "a refusal")
         assert words in str(scene.editor_error) and "limit" in str(scene.editor_error)
         assert scene.editor_serial == 0 and scene.params.shape_source == "primitives"
@@ -753,8 +746,7 @@ def test_a_field_without_a_surface_in_the_bounds_is_not_applied(
 ) -> None:
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("Apply")
-        client.set_value("sdf(p) in GLSL", f"float sdf(vec3 p) {{ {body} }}\n")
-        client.click("Apply")
+        apply_glsl(client, f"float sdf(vec3 p) {{ {body} }}\n")
         wait_until(lambda: scene.editor_error is not None, "the refusal", timeout_s=30.0)
         assert "no surface lies inside the bounds" in str(scene.editor_error)
         assert side in str(scene.editor_error) and "±1.5 m" in str(scene.editor_error)
