@@ -38,7 +38,6 @@ from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.integrate import solve_ivp
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
@@ -52,11 +51,9 @@ from kernels.ball.config import N_STEPS  # noqa: E402
 from kernels.ball.core import simulate_one  # noqa: E402
 from scenes.freekick import MAP_QUIET_S, FreeKickParams, FreeKickScene, outcome_map  # noqa: E402
 from server.switcher import SceneSwitcher  # noqa: E402
+from tests.helpers.ball_reference import START, G, Q, R, reference_at_x  # noqa: E402
 from tests.helpers.wsclient import BrowserClient  # noqa: E402
 
-M, R, RHO, G = 0.43, 0.11, 1.225, 9.81
-Q = 0.5 * RHO * math.pi * R**2 / M
-START = np.array([0.0, 0.0, R])
 VELOCITY = ball.launch_velocity(28.0, math.radians(19.0), math.radians(-8.0))
 SPIN = ball.spin_vector(9.0, (0.0, 0.0, 1.0))
 LINE_M = 30.0
@@ -65,30 +62,8 @@ MAP_SPINS = np.linspace(0.0, 15.0, 31)
 
 
 def scipy_flight(method: str, rtol: float, atol: float) -> NDArray[np.float64]:
-    """Ball centre at x = 30 m by scipy's ``solve_ivp`` (constant coefficients, written out independently)."""
-    axis = SPIN / np.linalg.norm(SPIN)
-
-    def rhs(_t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
-        v = y[3:]
-        speed = math.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
-        a = -Q * 0.25 * speed * v + Q * 0.25 * speed * np.cross(axis, v)
-        a[2] -= G
-        return np.concatenate((v, a))
-
-    def crossing(_t: float, y: NDArray[np.float64]) -> float:
-        return float(y[0] - LINE_M)
-
-    crossing.terminal = True  # type: ignore[attr-defined]
-    solution = solve_ivp(
-        rhs,
-        (0.0, 5.0),
-        np.concatenate((START, VELOCITY)),
-        method=method,
-        rtol=rtol,
-        atol=atol,
-        events=crossing,
-    )
-    return solution.y_events[0][0][:3]
+    """Ball centre at x = 30 m by scipy's ``solve_ivp`` (constant coefficients, the tests' independent reference)."""
+    return reference_at_x(VELOCITY, SPIN, LINE_M, method=method, rtol=rtol, atol=atol)
 
 
 def kernel_rows() -> None:

@@ -41,6 +41,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Callable
 from typing import Any, Literal, NamedTuple
 
 import numba
@@ -537,12 +538,41 @@ def paceline(
     Returns:
         :class:`Power` whose fields have shape (n_riders,).
     """
-    speed = _checks.non_negative("speed_ms", speed_ms)  # one speed for the line
-    _check_model_domain(cda_m2, mass_kg, crr, altitude_m, headwind_ms, speed, "paceline")
-    effective_cda = _positive("cda_m2", cda_m2) * (1.0 - drag_reduction(n_riders, gap_m, model))
+    return _group_power(
+        "paceline",
+        lambda: 1.0 - drag_reduction(n_riders, gap_m, model),
+        speed_ms,
+        cda_m2,
+        mass_kg,
+        crr,
+        grade,
+        altitude_m,
+        headwind_ms,
+        drivetrain_efficiency,
+    )
+
+
+def _group_power(
+    function: str,
+    drag_fraction: Callable[[], NDArray[np.float64]],
+    speed_ms: float,
+    cda_m2: float,
+    mass_kg: float,
+    crr: float,
+    grade: float,
+    altitude_m: float,
+    headwind_ms: float,
+    drivetrain_efficiency: float,
+) -> Power:
+    """:func:`power` of each rider of a group at its one speed, each rider's CdA times its ``drag_fraction()``
+    ((N,) fractions of a lone rider's drag), which is called once the rider's own inputs are checked against
+    :data:`MODEL_DOMAIN` (``function`` names the caller in the message)."""
+    speed = _checks.non_negative("speed_ms", speed_ms)  # the group's one speed
+    _check_model_domain(cda_m2, mass_kg, crr, altitude_m, headwind_ms, speed, function)
+    drag = drag_fraction()
     return _power(
-        np.full(int(n_riders), speed),
-        effective_cda,
+        np.full(drag.shape, speed),
+        _positive("cda_m2", cda_m2) * drag,
         mass_kg,
         crr,
         grade,
@@ -1028,12 +1058,11 @@ def formation_power(
     Returns:
         :class:`Power` whose fields have shape (N,), in the order of ``positions_xy``.
     """
-    speed = _checks.non_negative("speed_ms", speed_ms)  # the group's one speed
-    _check_model_domain(cda_m2, mass_kg, crr, altitude_m, headwind_ms, speed, "formation_power")
-    drag = formation_drag(positions_xy, model)
-    return _power(
-        np.full(drag.shape, speed),
-        _positive("cda_m2", cda_m2) * drag,
+    return _group_power(
+        "formation_power",
+        lambda: formation_drag(positions_xy, model),
+        speed_ms,
+        cda_m2,
         mass_kg,
         crr,
         grade,

@@ -179,6 +179,14 @@ def _range(values: Sequence[np.ndarray], log: bool) -> tuple[float, float] | Non
     return float(min(v.min() for v in finite)), float(max(v.max() for v in finite))
 
 
+def _pinned(scale: Mapping[str, Any], lo: float, hi: float) -> viser.uplot.Scale:
+    """A copy of ``scale`` fixed to [lo, hi] (uPlot's ``auto`` off, so it does not rescale to the data)."""
+    pinned = viser.uplot.Scale(**scale)  # type: ignore[typeddict-item]
+    pinned["auto"] = False
+    pinned["range"] = (lo, hi)
+    return pinned
+
+
 def fit_x_scale(data: Sequence[np.ndarray], scales: Mapping[str, Mapping[str, Any]]) -> dict[str, viser.uplot.Scale]:
     """``scales`` with the x scale pinned to the finite extent of ``data[0]`` (see the module's note).
 
@@ -204,10 +212,7 @@ def fit_x_scale(data: Sequence[np.ndarray], scales: Mapping[str, Mapping[str, An
         lo, hi = lo - half, hi + half
     if not (math.isfinite(lo) and math.isfinite(hi)):  # widened past the largest float
         return out
-    x_scale = viser.uplot.Scale(**x_scale)  # type: ignore[typeddict-item]
-    x_scale["auto"] = False
-    x_scale["range"] = (lo, hi)
-    out["x"] = x_scale
+    out["x"] = _pinned(x_scale, lo, hi)
     return out
 
 
@@ -226,10 +231,7 @@ def fit_scales(
         found = _range([d for d, s in zip(data[1:], y_scales, strict=True) if s == key], True)
         ticks = log_ticks(*found) if found is not None else None
         if ticks is not None:
-            pinned = viser.uplot.Scale(**scale)  # type: ignore[typeddict-item]
-            pinned["auto"] = False
-            pinned["range"] = (ticks[0][0], ticks[0][-1])
-            out[key] = pinned
+            out[key] = _pinned(scale, ticks[0][0], ticks[0][-1])
     return out
 
 

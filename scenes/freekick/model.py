@@ -13,7 +13,7 @@ import functools
 import math
 from collections.abc import Callable
 from dataclasses import field
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -304,6 +304,19 @@ def pitch(p: FreeKickParams) -> ball.Pitch:
     return ball.Pitch(goal, wall, KEEPER if p.keeper else None)
 
 
+def play_options(p: FreeKickParams) -> dict[str, Any]:
+    """How a kick is played on :func:`pitch`, the kick shown and the strikes of its odds alike: ``p``'s integrator
+    and model for :data:`PLAY_T_MAX_S`, the ball's centre a radius above the turf (:class:`kernels.ball.FlightConfig`
+    fields)."""
+    return {
+        "dt": INTEGRATOR_STEP_S[p.integrator],
+        "method": p.integrator,
+        "model": p.model,
+        "t_max": PLAY_T_MAX_S,
+        "ground_m": ball.BALL_RADIUS_M,
+    }
+
+
 def keeper_gap_m(
     pose: ball.KeeperPath, points: NDArray[np.float64], keeper: ball.Keeper = KEEPER
 ) -> NDArray[np.float64]:
@@ -450,11 +463,7 @@ def strike_chances(p: FreeKickParams, n: int = STRIKES) -> ball.Odds:
         spin_vector(p),
         pitch(p),
         n=n,
-        dt=INTEGRATOR_STEP_S[p.integrator],
-        method=p.integrator,
-        model=p.model,
-        t_max=PLAY_T_MAX_S,
-        ground_m=ball.BALL_RADIUS_M,
+        **play_options(p),
     )
 
 
@@ -749,13 +758,9 @@ def compute_kick(p: FreeKickParams) -> KickState:
         ball_spot(p),
         launch_velocity(p),
         spin_vector(p),
-        dt=INTEGRATOR_STEP_S[p.integrator],
-        method=p.integrator,
-        model=p.model,
-        t_max=PLAY_T_MAX_S,
-        ground_m=ball.BALL_RADIUS_M,
         knuckle_seed=p.knuckle_seed if p.knuckle else None,
         pitch=pitch(p),
+        **play_options(p),
     )
     return KickState(
         flight=flight,

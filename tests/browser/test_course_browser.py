@@ -136,12 +136,8 @@ def test_the_course_frames_every_rider_of_the_group_large_on_its_road(
 def test_the_course_panel_labels_read_whole(shown: ScenePage) -> None:
     """No label of the course's air controls breaks inside a word ("Temperatur / e"), and the "Pressure from" and
     "Air" values show whole in their boxes."""
-    scene = shown.scene
-    assert isinstance(scene, PelotonScene)
-    mode = scene.course_mode
-    with scene._lock:
-        if not mode.enabled:
-            mode.enable.value = True
+    mode = course_on(shown)
+    with shown.scene._lock:
         mode.controls["air"].value = "Weather reading"
     wait_until(lambda: mode.params.air == "weather", "weather air", timeout_s=15.0)
     control_row(shown.page, "Pressure from").scroll_into_view_if_needed()

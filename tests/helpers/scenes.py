@@ -1,5 +1,6 @@
 """Typing for the scene fixtures of ``tests/conftest.py`` (a callable that makes or shows a scene of a given class),
-and the ``scene`` fixture a scene's test module declares in one line."""
+the ``scene`` fixture a scene's test module declares in one line, readers of the GLB meshes scenes send, and
+what a person does in the SDF gallery's GLSL editor."""
 
 from __future__ import annotations
 
@@ -10,6 +11,7 @@ import numpy as np
 import pytest
 import trimesh
 
+from helpers.wsclient import BrowserClient
 from scenes._base import Scene
 
 S = TypeVar("S", bound=Scene)
@@ -32,8 +34,29 @@ def scene_fixture(kind: type[Scene]) -> Any:
     return scene
 
 
+def read_glb(glb_data: bytes) -> trimesh.Trimesh:
+    """The one mesh of a GLB as a scene sends it, read by trimesh (not by our writer) with its material and vertex
+    colours."""
+    loaded = trimesh.load(io.BytesIO(glb_data), file_type="glb", process=False)
+    assert isinstance(loaded, trimesh.Scene) and len(loaded.geometry) == 1
+    (mesh,) = loaded.geometry.values()
+    assert isinstance(mesh, trimesh.Trimesh)
+    return mesh
+
+
 def glb_vertices(glb_data: bytes) -> np.ndarray:
     """(V, 3) vertex positions of a one-mesh GLB as a scene sends it (read by trimesh, not by our writer)."""
     loaded = trimesh.load(io.BytesIO(glb_data), file_type="glb", force="mesh", process=False)
     assert isinstance(loaded, trimesh.Trimesh)
     return np.asarray(loaded.vertices)
+
+
+GLSL_EDITOR = "sdf(p) in GLSL"
+"""The label of the SDF gallery's GLSL editor."""
+
+
+def apply_glsl(client: BrowserClient, source: str) -> None:
+    """What a person does in the SDF gallery's GLSL editor: wait for it, type ``source`` and click Apply."""
+    client.wait_for_gui(GLSL_EDITOR)
+    client.set_value(GLSL_EDITOR, source)
+    client.click("Apply")

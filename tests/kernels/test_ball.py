@@ -10,21 +10,17 @@ from typing import Any
 
 import numpy as np
 import pytest
+from helpers.ball_reference import AREA, RHO, START, G, M, Q, R, reference_at_x
 from helpers.processes import python_stdout
 from helpers.properties import examples
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from numpy.typing import NDArray
-from scipy.integrate import solve_ivp
 
 from kernels import ball
 from kernels.ball import api, jit
 from kernels.ball.core import crossing_fraction
 
-M, R, RHO, G = 0.43, 0.11, 1.225, 9.81
-AREA = math.pi * R**2
-Q = 0.5 * RHO * AREA / M  # ½ρA/m (1/m)
-START = np.array([0.0, 0.0, R])  # ball on the turf
 WALL, GOAL = ball.free_kick_panels((0.0, 0.0), (25.0, 0.0), (1.0, 0.0))
 GOAL_WIDTH_M, GOAL_HEIGHT_M = 7.32, 2.44  # FIFA, inside the posts and under the bar
 ROOT = Path(__file__).resolve().parents[1]
@@ -32,49 +28,6 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def kick(speed: float, elevation_deg: float, azimuth_deg: float = 0.0) -> NDArray[np.float64]:
     return ball.launch_velocity(speed, math.radians(elevation_deg), math.radians(azimuth_deg))
-
-
-# ------------------------------------------------------------------------------------------------ reference solver
-def reference_at_x(
-    velocity: NDArray[np.float64],
-    spin: NDArray[np.float64],
-    x_line: float,
-    model: str = "constant",
-) -> NDArray[np.float64]:
-    """Ball centre where it crosses x = x_line, by scipy's DOP853 at tight tolerances (written independently here)."""
-    rate = float(np.linalg.norm(spin))
-    axis = spin / rate if rate > 0 else np.zeros(3)
-
-    def rhs(_t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
-        v = y[3:]
-        speed = float(np.linalg.norm(v))
-        if model == "constant":
-            c_d, c_l = 0.25, 0.25
-        else:  # Goff & Carré 2010 and a lift slope of 0.9 (see kernels.ball's docstring)
-            s_param = R * rate / speed
-            c_l = 0.9 * min(s_param, 0.3)
-            re = RHO * speed * 2 * R / 1.81e-5
-            still = 0.155 + 0.346 / (1 + math.exp((re - 1.815e5) / 1.949e4))
-            spinning = 0.4127 * max(s_param, 0.05) ** 0.3056
-            c_d = still + min(s_param / 0.05, 1.0) * (spinning - still)
-        a = -Q * c_d * speed * v + Q * c_l * speed * np.cross(axis, v) + np.array([0.0, 0.0, -G])
-        return np.concatenate((v, a))
-
-    def crossing(_t: float, y: NDArray[np.float64]) -> float:
-        return float(y[0] - x_line)
-
-    crossing.terminal = True  # type: ignore[attr-defined]
-    solution = solve_ivp(
-        rhs,
-        (0.0, 5.0),
-        np.concatenate((START, velocity)),
-        method="DOP853",
-        rtol=1e-12,
-        atol=1e-12,
-        events=crossing,
-    )
-    assert solution.status == 1, "the reference flight must reach the line"
-    return solution.y_events[0][0][:3]
 
 
 CURLER = (kick(28.0, 19.0, -8.0), ball.spin_vector(9.0, (0.0, 0.0, 1.0)))  # a 30 m curler, S ≈ 0.22

@@ -8,7 +8,6 @@ import re
 
 import numpy as np
 import pytest
-from helpers.ci import need_gl
 from helpers.properties import examples
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -26,13 +25,6 @@ from shaders.renderer import (
 
 BOUNDS = np.array([[-1.0, -1.0, -1.0], [1.0, 1.0, 1.0]])
 SPHERE = "float sdf(vec3 p) {\n    return sd_sphere(p - vec3(0.1, -0.2, 0.05), 0.55);\n}\n"
-
-
-@pytest.fixture(autouse=True)
-def gl_when_marked(request: pytest.FixtureRequest) -> None:
-    if request.node.get_closest_marker("gl") is None:
-        return
-    need_gl()
 
 
 # ------------------------------------------------------------------------------------------ source checks

@@ -12,9 +12,8 @@ import re
 import numpy as np
 import pytest
 import viser
-from helpers.ci import need_gl
 from helpers.properties import examples
-from helpers.scenes import scene_fixture
+from helpers.scenes import apply_glsl, scene_fixture
 from helpers.waiting import wait_until
 from helpers.wsclient import BrowserClient
 from hypothesis import HealthCheck, given, settings
@@ -41,12 +40,6 @@ MESA_TOKEN_NAME = re.compile(
 )
 """Words of Mesa's parser (BASIC_TYPE_TOK, NEW_IDENTIFIER, FLOATCONSTANT, $end, …) that a message must not show."""
 POINTS = np.array([[0.0, 0.0, 0.0], [0.7, 0.0, 0.05], [0.3, -0.4, 0.2], [-0.9, 0.5, -0.3], [0.1, 0.65, 0.0]])
-
-
-@pytest.fixture(autouse=True)
-def gl_when_marked(request: pytest.FixtureRequest) -> None:
-    if request.node.get_closest_marker("gl") is not None:
-        need_gl()
 
 
 def probe(source: str) -> tuple[np.ndarray, np.ndarray]:
@@ -335,13 +328,10 @@ def test_the_editor_applies_a_const_in_source_and_names_an_unclosed_brace(
     server: viser.ViserServer, scene: SdfGalleryScene
 ) -> None:
     with BrowserClient(server.get_port()) as client:
-        client.wait_for_gui("sdf(p) in GLSL")
-        client.set_value("sdf(p) in GLSL", QUILEZ_STYLE[1])
-        client.click("Apply")
+        apply_glsl(client, QUILEZ_STYLE[1])
         wait_until(lambda: scene.editor_serial == 1, "the source applied", timeout_s=60)
         assert scene.editor_error is None and len(scene.mesh_faces) > 1000
-        client.set_value("sdf(p) in GLSL", "float sdf(in vec3 p) {\n    return length(p) - 0.5;\n")
-        client.click("Apply")
+        apply_glsl(client, "float sdf(in vec3 p) {\n    return length(p) - 0.5;\n")
         wait_until(lambda: scene.editor_error is not None, "the error", timeout_s=60)
         assert scene.editor_error is not None
         assert scene.editor_error.startswith("line 1: '{' is never closed")

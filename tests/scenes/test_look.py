@@ -5,7 +5,6 @@ these buy are measured by bench/bench_browser_fps.py."""
 
 from __future__ import annotations
 
-import io
 import json
 import struct
 
@@ -13,7 +12,7 @@ import numpy as np
 import pytest
 import trimesh
 import viser
-from helpers.scenes import scene_fixture
+from helpers.scenes import read_glb, scene_fixture
 from helpers.wsclient import BrowserClient
 from trimesh.visual.material import PBRMaterial
 
@@ -25,15 +24,6 @@ from scenes.peloton.model import MAX_GROUP, POSITIONS
 from scenes.peloton.scene import ROAD_HALF_WIDTH_M, PelotonScene
 
 scene = scene_fixture(PelotonScene)
-
-
-def read_glb(glb: bytes) -> trimesh.Trimesh:
-    """The one mesh of a GLB, read by trimesh (with its material)."""
-    loaded = trimesh.load(io.BytesIO(glb), file_type="glb", process=False)
-    assert isinstance(loaded, trimesh.Scene) and len(loaded.geometry) == 1
-    (mesh,) = loaded.geometry.values()
-    assert isinstance(mesh, trimesh.Trimesh)
-    return mesh
 
 
 def glb_json(glb: bytes) -> dict:

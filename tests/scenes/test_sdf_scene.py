@@ -11,9 +11,8 @@ import numpy as np
 import pytest
 import trimesh
 import viser
-from helpers.ci import need_gl
 from helpers.properties import examples
-from helpers.scenes import scene_fixture
+from helpers.scenes import apply_glsl, read_glb, scene_fixture
 from helpers.viser_private import gui_uuid, gui_uuids, node_names
 from helpers.waiting import wait_until
 from helpers.wsclient import BrowserClient
@@ -36,11 +35,7 @@ scene = scene_fixture(SdfGalleryScene)
 def shown_mesh(scene: SdfGalleryScene) -> trimesh.Trimesh:
     """The mesh the browser receives: the GLB bytes of the mesh node, loaded back (its one geometry, with its
     material and vertex colours)."""
-    loaded = trimesh.load(io.BytesIO(scene.mesh_node.glb_data), file_type="glb", process=False)
-    assert isinstance(loaded, trimesh.Scene) and len(loaded.geometry) == 1
-    (mesh,) = loaded.geometry.values()
-    assert isinstance(mesh, trimesh.Trimesh)
-    return mesh
+    return read_glb(scene.mesh_node.glb_data)
 
 
 # ------------------------------------------------------------------------------------------ server side
@@ -204,7 +199,6 @@ def test_high_resolution_shows_progress_then_a_fine_mesh(server: viser.ViserServ
 # ------------------------------------------------------------------------------------------ reference image
 @pytest.mark.gl
 def test_reference_image_readouts_and_rerender(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
-    need_gl()
     with BrowserClient(server.get_port()) as client:
         client.send_camera(position=(2.3, -2.5, 1.7), look_at=(0.05, 0.0, 0.3), size=(600, 800))
         # 320 px wide at this camera's 4:3 aspect (the client's first camera, 16:9, may get a render first).
@@ -257,7 +251,6 @@ def test_reference_image_readouts_and_rerender(server: viser.ViserServer, scene:
 @pytest.mark.gl
 def test_live_mode_renders_while_the_camera_moves(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
     """ "When the camera stops" waits for a still camera; "Live" renders while camera messages keep coming."""
-    need_gl()
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("Re-render")
         client.set_value("Re-render", "Live")
@@ -307,7 +300,6 @@ def test_downloads(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
 
 @pytest.mark.gl
 def test_png_download_is_the_reference_image(scene: SdfGalleryScene) -> None:
-    need_gl()
     wait_until(lambda: scene.reference_rgb is not None, "reference", timeout_s=60)
     from PIL import Image
 
@@ -364,8 +356,6 @@ def test_fifty_builds_share_one_gl_context_and_do_not_grow_memory(
     """Each build once made a new EGL context on a new thread (~50 MiB each, never reclaimed)."""
     import gc
     import threading
-
-    need_gl()
 
     def build_render_close() -> None:
         scene = SdfGalleryScene(server)
@@ -490,11 +480,8 @@ def background_images(client: BrowserClient) -> list[dict]:
 def test_typed_source_is_meshed_and_a_bad_one_keeps_the_last_good(
     server: viser.ViserServer, scene: SdfGalleryScene
 ) -> None:
-    need_gl()
     with BrowserClient(server.get_port()) as client:
-        client.wait_for_gui("sdf(p) in GLSL")
-        client.set_value("sdf(p) in GLSL", SPHERE_SOURCE)
-        client.click("Apply")
+        apply_glsl(client, SPHERE_SOURCE)
         wait_until(lambda: scene.editor_serial == 1, "the source applied")
         assert scene.params.shape_source == "editor" and scene.mesh_scene is None
         client.wait_for(lambda: client.value_of("Shape") == "GLSL editor", what="Shape shown")
@@ -511,8 +498,7 @@ def test_typed_source_is_meshed_and_a_bad_one_keeps_the_last_good(
         assert exported.volume == pytest.approx(4 / 3 * math.pi * 0.6**3, rel=0.02)
         # A compile error: the message names the line; the sphere stays.
         shown = scene.mesh_vertices.copy()
-        client.set_value("sdf(p) in GLSL", "float sdf(vec3 p) {\n    return sd_sphere(p, 0.5)\n}\n")
-        client.click("Apply")
+        apply_glsl(client, "float sdf(vec3 p) {\n    return sd_sphere(p, 0.5)\n}\n")
         wait_until(lambda: scene.editor_error is not None, "the error")
         assert scene.editor_error is not None and scene.editor_error.startswith("line 3:")
         assert "line 3" in scene.editor_status.content
@@ -526,8 +512,7 @@ def test_typed_source_is_meshed_and_a_bad_one_keeps_the_last_good(
             ("#extension GL_ARB_foo : enable\nfloat sdf(vec3 p) { return 1.0; }", "line 1"),
         ]:
             scene.editor_error = None
-            client.set_value("sdf(p) in GLSL", text)
-            client.click("Apply")
+            apply_glsl(client, text)
             wait_until(lambda: scene.editor_error is not None, "a refusal")
             assert words in str(scene.editor_error)
         assert scene.editor_serial == 1
@@ -538,7 +523,6 @@ def test_typed_source_is_meshed_and_a_bad_one_keeps_the_last_good(
 def test_every_example_applies_and_meshes(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
     from scenes.sdf_gallery import EXAMPLES
 
-    need_gl()
     assert len(EXAMPLES) >= 6
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("Example")
@@ -558,7 +542,6 @@ def test_typed_code_shows_as_your_own_and_the_same_example_can_be_picked_again(
     from scenes.sdf_gallery import EXAMPLES
     from scenes.sdf_gallery.editor import OWN_CODE
 
-    need_gl()
     first = next(iter(EXAMPLES))
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("Example")
@@ -577,7 +560,6 @@ def test_typed_code_shows_as_your_own_and_the_same_example_can_be_picked_again(
 
 @pytest.mark.gl
 def test_raymarched_view_goes_to_the_background_with_depth(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
-    need_gl()
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("View")
         client.send_camera(position=(2.0, -2.4, 1.6), look_at=(0.0, 0.0, 0.3), size=(400, 640))
@@ -636,15 +618,13 @@ def test_with_editing_off_apply_uses_only_the_servers_examples(
 ) -> None:
     import scenes.sdf_gallery.editor as gallery
 
-    need_gl()
     monkeypatch.setattr(gallery, "editing_allowed", lambda: False)
     scene = SdfGalleryScene(server)
     try:
         assert scene.editor.disabled and "Editing is off" in scene.editor_status.content
         with BrowserClient(server.get_port()) as client:
             client.wait_for_gui("Apply")
-            client.set_value("sdf(p) in GLSL", SPHERE_SOURCE)  # a crafted client can still send text
-            client.click("Apply")
+            apply_glsl(client, SPHERE_SOURCE)  # a crafted client can still send text
             wait_until(lambda: scene.editor_serial == 1, "an apply")
             assert scene.params.editor.source == next(iter(gallery.EXAMPLES.values()))
     finally:
@@ -662,12 +642,9 @@ def test_compile_and_frame_time_limits_refuse_a_slow_source(
 ) -> None:
     import scenes.sdf_gallery.editor as gallery
 
-    need_gl()
     monkeypatch.setattr(gallery, limit, 1e-9)  # every source is too slow now
     with BrowserClient(server.get_port()) as client:
-        client.wait_for_gui("sdf(p) in GLSL")
-        client.set_value("sdf(p) in GLSL", SPHERE_SOURCE.replace("0.6", "0.61"))
-        client.click("Apply")
+        apply_glsl(client, SPHERE_SOURCE.replace("0.6", "0.61"))
         wait_until(lambda: scene.editor_error is not None, "a refusal")
         assert words in str(scene.editor_error) and "limit" in str(scene.editor_error)
         assert scene.editor_serial == 0 and scene.params.shape_source == "primitives"
@@ -689,7 +666,6 @@ def test_a_slow_compile_is_stopped_at_the_limit_while_the_server_keeps_serving(
 ) -> None:
     import scenes.sdf_gallery.editor as gallery
 
-    need_gl()
     # Nine links pass the size bound but take Mesa several seconds: the trial process is killed at the limit.
     monkeypatch.setattr(gallery, "COMPILE_LIMIT_S", 1.0)
     monkeypatch.setattr(gallery, "FRAME_LIMIT_S", 0.5)
@@ -768,11 +744,9 @@ def test_apply_of_a_text_over_the_source_limit_says_its_length_and_the_limit(
 def test_a_field_without_a_surface_in_the_bounds_is_not_applied(
     server: viser.ViserServer, scene: SdfGalleryScene, body: str, side: str
 ) -> None:
-    need_gl()
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("Apply")
-        client.set_value("sdf(p) in GLSL", f"float sdf(vec3 p) {{ {body} }}\n")
-        client.click("Apply")
+        apply_glsl(client, f"float sdf(vec3 p) {{ {body} }}\n")
         wait_until(lambda: scene.editor_error is not None, "the refusal", timeout_s=30.0)
         assert "no surface lies inside the bounds" in str(scene.editor_error)
         assert side in str(scene.editor_error) and "±1.5 m" in str(scene.editor_error)

@@ -14,7 +14,7 @@ import logging
 import threading
 import time
 import uuid
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from typing import Any
 
 import pytest
@@ -37,20 +37,12 @@ from server.budget import (
     CostlyBudget,
 )
 from server.gate import install_gate
-from server.refusals import refusals
 from server.sessions import Sessions
 from server.switcher import SceneSwitcher
 
 FIRST_GUI_BOUND_S = 2.0
 """The most another tab may wait for its first GUI while one tab floods (the goal's bound)."""
 FLOOD_HZ = 200.0
-
-
-@pytest.fixture(autouse=True)
-def _fresh_refusal_log() -> Iterator[None]:
-    refusals.reset()
-    yield
-    refusals.reset()
 
 
 def own_session(server: viser.ViserServer, sessions: Sessions, known: set[int]) -> int:

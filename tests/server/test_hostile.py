@@ -94,13 +94,6 @@ SENTINELS = {  # an honest edit per scene, to know the hostile messages before i
 }
 
 
-@pytest.fixture(autouse=True)
-def _fresh_refusal_log() -> Iterator[None]:
-    refusals.reset()
-    yield
-    refusals.reset()
-
-
 def refused_lines(caplog: pytest.LogCaptureFixture) -> list[logging.LogRecord]:
     return [r for r in caplog.records if r.name == "server.refusals"]
 
@@ -302,6 +295,33 @@ def scene_poses(server: viser.ViserServer) -> dict[str, tuple[np.ndarray, np.nda
     return {name: (np.array(gizmo.position), np.array(gizmo.wxyz)) for name, gizmo in gizmos(server.scene).items()}
 
 
+def assert_untouched_but(
+    sentinel: str,
+    server: viser.ViserServer,
+    values_before: dict[str, Any],
+    poses_before: dict[str, tuple[np.ndarray, np.ndarray]],
+) -> None:
+    """Every input on ``server`` but ``sentinel`` (the honest edit's) holds its value from before the barrage
+    (:func:`server_values`), and every gizmo its pose (:func:`scene_poses`)."""
+    values_after = server_values(server)
+    for uuid, value in values_before.items():
+        if uuid != sentinel:
+            assert same_value(values_after[uuid], value), (uuid, value, values_after[uuid])
+    for name, (position, wxyz) in scene_poses(server).items():
+        np.testing.assert_array_equal(position, poses_before[name][0], err_msg=name)
+        np.testing.assert_allclose(wxyz, poses_before[name][1], atol=1e-12, err_msg=name)
+
+
+def assert_each_refusal_logged_once(caplog: pytest.LogCaptureFixture, capfd: pytest.CaptureFixture[str]) -> list[str]:
+    """One refusal line per kind, and no error or traceback logged or printed; returns the kinds logged."""
+    kinds = [refused_kind(r) for r in refused_lines(caplog)]
+    assert len(kinds) == len(set(kinds)), kinds
+    assert not [r for r in caplog.records if r.exc_info or r.levelno >= logging.ERROR]
+    out, err = capfd.readouterr()
+    assert "Traceback" not in out + err
+    return kinds
+
+
 @contextlib.contextmanager
 def two_viewers(server: viser.ViserServer, key: str) -> Iterator[tuple[SceneSwitcher, BrowserClient, BrowserClient]]:
     """Scene ``key`` on ``server`` and two browsers showing it, both registered and past the scene's first
@@ -352,15 +372,8 @@ def test_every_hostile_message_leaves_every_viewer_on_the_last_good_state(
         assert switcher.scene is scene
         with scene._lock:
             assert scene.params == dataclass_replace(params_before, field, good)  # type: ignore[attr-defined]
-        sentinel = attacker.uuid_of(label)
-        values_after = server_values(server)
-        for uuid, value in values_before.items():
-            if uuid != sentinel:
-                assert same_value(values_after[uuid], value), (uuid, value, values_after[uuid])
+        assert_untouched_but(attacker.uuid_of(label), server, values_before, poses_before)
         assert {u: control_state(h) for u, h in gui_inputs(server.gui).items()} == controls_before
-        for name, (position, wxyz) in scene_poses(server).items():
-            np.testing.assert_array_equal(position, poses_before[name][0], err_msg=name)
-            np.testing.assert_allclose(wxyz, poses_before[name][1], atol=1e-12, err_msg=name)
         # Every viewer shows the server's values and poses; the observer saw no crafted props.
         for viewer in (attacker, observer):
             viewer.wait_for(lambda v=viewer: shows_server_values(v, server), what="values converge")
@@ -372,13 +385,8 @@ def test_every_hostile_message_leaves_every_viewer_on_the_last_good_state(
         } == cameras_before
 
         # One line per kind of refusal, and no tracebacks anywhere.
-        lines = refused_lines(caplog)
-        kinds = [refused_kind(r) for r in lines]
-        assert len(kinds) == len(set(kinds)), kinds
+        kinds = assert_each_refusal_logged_once(caplog, capfd)
         assert len(kinds) >= 10, kinds
-        assert not [r for r in caplog.records if r.exc_info or r.levelno >= logging.ERROR]
-        out, err = capfd.readouterr()
-        assert "Traceback" not in out + err
 
         # A new browser connects and drives the scene.
         with BrowserClient(server.get_port()) as late:
@@ -725,14 +733,7 @@ def test_every_hostile_message_leaves_each_tab_on_its_last_good_state(
                 assert scene.params == dataclass_replace(params_before, field, good)  # type: ignore[attr-defined]
             with their_scene._lock:
                 assert their_scene.params == their_params  # type: ignore[attr-defined]
-            sentinel = attacker.uuid_of(label)
-            values_after = server_values(view)  # type: ignore[arg-type]
-            for uuid, value in values_before.items():
-                if uuid != sentinel:
-                    assert same_value(values_after[uuid], value), (uuid, value, values_after[uuid])
-            for name, (position, wxyz) in scene_poses(view).items():  # type: ignore[arg-type]
-                np.testing.assert_array_equal(position, poses_before[name][0], err_msg=name)
-                np.testing.assert_allclose(wxyz, poses_before[name][1], atol=1e-12, err_msg=name)
+            assert_untouched_but(attacker.uuid_of(label), view, values_before, poses_before)  # type: ignore[arg-type]
             attacker.wait_for(
                 lambda: shows_server_values(attacker, view),  # type: ignore[arg-type]
                 what="the attacker's values converge",
@@ -746,12 +747,7 @@ def test_every_hostile_message_leaves_each_tab_on_its_last_good_state(
                 lambda: shows_server_values(other, theirs_view),  # type: ignore[arg-type]
                 what="the other tab still shows its own scene's values",
             )
-            lines = refused_lines(caplog)
-            kinds = [refused_kind(r) for r in lines]
-            assert len(kinds) == len(set(kinds)), kinds
-            assert not [r for r in caplog.records if r.exc_info or r.levelno >= logging.ERROR]
-            out, err = capfd.readouterr()
-            assert "Traceback" not in out + err
+            assert_each_refusal_logged_once(caplog, capfd)
     finally:
         sessions.close()
 

@@ -10,7 +10,6 @@ from __future__ import annotations
 import dataclasses
 import logging
 import typing
-from collections.abc import Iterator
 from typing import Any
 
 import pytest
@@ -25,13 +24,6 @@ from server.switcher import SceneSwitcher
 from server.viser_compat import messages
 
 WRONG_VALUES: list[Any] = [{"a": 1}, [[1, 2], [3]], None, "text", 1e308, -7, True, b"\x00"]
-
-
-@pytest.fixture(autouse=True)
-def _fresh_refusal_log() -> Iterator[None]:
-    refusals.reset()
-    yield
-    refusals.reset()
 
 
 def honest_fields(cls: type) -> dict[str, Any]:

@@ -26,13 +26,7 @@ from server.budget import (
     MIN_PART_BYTES,
 )
 from server.gate import install_gate
-from server.refusals import refusals
 from server.switcher import SceneSwitcher
-
-
-@pytest.fixture(autouse=True)
-def fresh_refusal_log() -> None:
-    refusals.reset()  # one line per kind per 10 s: each test starts with none logged
 
 
 @pytest.fixture
