@@ -9,6 +9,10 @@ Prints median and p95 (and the machine, numba's thread count and the load averag
 * 10 000 scattered strikes of that kick judged on the pitch (``simulate_outcomes(..., pitch=...)``, RK4 10 ms,
   wall and keeper), in parallel over the kicks;
 * the odds map, 41 distances × 31 angles × 64 strikes (``kernels.ball.odds.odds_map``).
+
+The two batches are also timed on one thread in CPU time (``time.thread_time``): on a machine shared with other
+work their wall-clock times swing with its load, the CPU time of one thread far less, so a before/after pair taken
+under load compares in it.
 """
 
 from __future__ import annotations
@@ -49,6 +53,23 @@ def timings(call: Callable[[], object], repeats: int) -> tuple[float, float]:
         start = time.perf_counter()
         call()
         times.append(time.perf_counter() - start)
+    times.sort()
+    return statistics.median(times), times[min(len(times) - 1, int(0.95 * len(times)))]
+
+
+def cpu_timings(call: Callable[[], object], repeats: int) -> tuple[float, float]:
+    """(median, p95) CPU seconds of ``repeats`` calls on this thread alone (numba's thread count set to 1 for
+    them): the work itself, which other jobs on a shared machine slow far less than the wall clock."""
+    threads = numba.get_num_threads()
+    numba.set_num_threads(1)
+    try:
+        times = []
+        for _ in range(repeats):
+            start = time.thread_time()
+            call()
+            times.append(time.thread_time() - start)
+    finally:
+        numba.set_num_threads(threads)
     times.sort()
     return statistics.median(times), times[min(len(times) - 1, int(0.95 * len(times)))]
 
@@ -105,6 +126,8 @@ def main() -> None:
     counts = ball.simulate_outcomes(starts, velocities, spins, config=config, pitch=pitch).counts()
     print(f"| 10 000 strikes' outcomes with collisions and a keeper | {median * 1e3:.1f} ms | p95 {p95 * 1e3:.1f} ms |")
     print(f"  their results: {counts}")
+    median, p95 = cpu_timings(lambda: ball.simulate_outcomes(starts, velocities, spins, config=config, pitch=pitch), 7)
+    print(f"| the same, one thread, CPU time | {median * 1e3:.1f} ms | p95 {p95 * 1e3:.1f} ms |")
 
     distances = np.linspace(16.0, 36.0, 41)
     angles = np.radians(np.linspace(-40.0, 40.0, 31))
@@ -115,6 +138,13 @@ def main() -> None:
         3,
     )
     print(f"| odds map 41 × 31 spots × 64 strikes | {median:.2f} s | p95 {p95:.2f} s |")
+    median, p95 = cpu_timings(
+        lambda: odds.odds_map(
+            distances, angles, 26.0, math.radians(17.0), math.radians(-6.0), SPIN, keeper=ball.Keeper(), n=64, **OPTIONS
+        ),
+        3,
+    )
+    print(f"| the same, one thread, CPU time | {median:.2f} s | p95 {p95:.2f} s |")
 
 
 if __name__ == "__main__":

@@ -148,23 +148,41 @@ def drag_lift_speeds(speed2, rate, measured, constant_drag, constant_lift, radiu
     C_D(Re, S) of Goff & Carré 2010 (Eur. J. Phys. 31), its drag crisis centred at Re = ``re_crisis``, and
     C_L(S) = 0.9·min(S, 0.3), with S = ``radius``·|ω|/|v| and Re = ``re_per_speed``·|v| (ρ·2r/μ).
 
-    The one implementation of the law: the flight's force law, the rolling ball and the public
-    :func:`kernels.ball.coefficients` (through :func:`drag_lift`) all call it. It is written for the force law, whose
-    four evaluations an RK4 step makes one after another: with the spinning fit (S ≥ 0.05) C_D·|v| =
-    0.4127·(r|ω|)^0.3056·(|v|²)^0.3472, one logarithm and one exponential of |v|² with no square root or division
-    before them, and C_L·|v| = 0.9·min(r|ω|, 0.3·|v|). Plain scalars, not the settings vector: an array argument
-    costs every evaluation a reference-count increment and decrement.
+    The one implementation of the law: the flight's force law (through :func:`_drag_lift_spin`, with the spin's
+    logarithm taken once per :class:`ForceLaw`), the rolling ball and the public :func:`kernels.ball.coefficients`
+    (through :func:`drag_lift`) all come here.
+    """
+    spin_speed = radius * rate  # r|ω| (m/s): S·|v|
+    return _drag_lift_spin(
+        speed2, spin_speed, _spin_term(spin_speed), measured, constant_drag, constant_lift, re_per_speed, re_crisis
+    )
+
+
+@compiled()
+def _spin_term(spin_speed):
+    """0.3056·ln(r|ω|), the spinning C_D fit's spin factor as a logarithm (−∞ without spin, where it is unused)."""
+    return 0.3056 * math.log(spin_speed) if spin_speed > 0.0 else -math.inf
+
+
+@compiled()
+def _drag_lift_spin(speed2, spin_speed, spin_term, measured, constant_drag, constant_lift, re_per_speed, re_crisis):
+    """:func:`drag_lift_speeds` given r|ω| = ``spin_speed`` (m/s) and ``spin_term`` = :func:`_spin_term` of it.
+
+    Written for the force law, whose four evaluations an RK4 step makes one after another: with the spinning fit
+    (S ≥ 0.05) C_D·|v| = 0.4127·(r|ω|)^0.3056·(|v|²)^0.3472 = 0.4127·exp(``spin_term`` + 0.3472·ln |v|²), one
+    logarithm and one exponential of |v|² with no square root or division before them (the spin's logarithm is the
+    kick's, taken once), and C_L·|v| = 0.9·min(r|ω|, 0.3·|v|). Plain scalars, not the settings vector: an array
+    argument costs every evaluation a reference-count increment and decrement.
     """
     speed = math.sqrt(speed2)
     if measured == 0.0:
         return constant_drag * speed, constant_lift * speed
     if speed2 == 0.0:
         return 0.0, 0.0  # at rest, no force: the logarithms below need |v| > 0
-    spin_speed = radius * rate  # r|ω| (m/s): S·|v|
     lift = 0.9 * min(spin_speed, 0.3 * speed)  # below Asai et al. 2007's wind-tunnel values: see kernels.ball
     if spin_speed * spin_speed >= 0.0025 * speed2:  # S ≥ 0.05: the spinning fit alone (the blend's weight is 1)
         # 0.4127·S^0.3056·|v| (Goff & Carré 2010) as one exponential (here r|ω| > 0).
-        return 0.4127 * math.exp(0.3056 * math.log(spin_speed) + 0.3472 * math.log(speed2)), lift
+        return 0.4127 * math.exp(spin_term + 0.3472 * math.log(speed2)), lift
     arg = min((re_per_speed * speed - re_crisis) / _RE_WIDTH, 50.0)
     still = 0.155 + 0.346 / (1.0 + math.exp(arg))  # Goff & Carré 2010
     # The blend C_D0 + (S/0.05)·(C_Ds(0.05) − C_D0), times |v|: (S/0.05)·|v| = r|ω|/0.05.
@@ -238,6 +256,10 @@ class ForceLaw(NamedTuple):
     """sin θ·n₂: the second component's direction."""
     n2_y: float
     n2_z: float
+    spin_speed: float
+    """r|ω| (m/s)."""
+    spin_term: float
+    """0.3056·ln(r|ω|), the measured C_D's spin factor as a logarithm (:func:`_spin_term`)."""
 
 
 @compiled()
@@ -266,14 +288,16 @@ def force_law(kick, config):
         kick[N2],
         kick[N2 + 1],
         kick[N2 + 2],
+        config[RADIUS] * kick[RATE],
+        _spin_term(config[RADIUS] * kick[RATE]),
     )
 
 
 @compiled()
 def _factors(speed2, law):
     """(−½ρA·C_D·|v|/m, ½ρA·C_L·|v|/m) at squared speed ``speed2``: drag and lift per unit velocity and mass (1/s)."""
-    drag, lift = drag_lift_speeds(
-        speed2, law.rate, law.measured, law.drag, law.lift, law.radius, law.re_per_speed, law.re_crisis
+    drag, lift = _drag_lift_spin(
+        speed2, law.spin_speed, law.spin_term, law.measured, law.drag, law.lift, law.re_per_speed, law.re_crisis
     )
     return -law.q * drag, law.q * lift
 

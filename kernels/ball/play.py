@@ -325,6 +325,66 @@ def _rolls_clear(x, y, z, vx, vy, pitch, boxes, dived):
     )
 
 
+@compiled()
+def _reach_boxes(pitch, reach, boxes):
+    """Boxes around every place a ball that has struck the wall, a post or the bar could still change its verdict,
+    grown by ``reach``: the goal mouth (a goal: the ball's centre crosses the goal line there, within a post's
+    radius of the posts and the bar) into ``boxes[3]``, and every place the keeper's capsule can ever be (he stands,
+    then dives to a point of the mouth: his centre of mass keeps to the box around where he stands and the mouth's
+    corners, grown by his longer reach and his body's radius) into ``boxes[4]``; ``boxes[4]`` is empty (lo > hi)
+    without a keeper."""
+    gx, gy, ax, ay = pitch[GX], pitch[GY], -pitch[GNY], pitch[GNX]
+    half, turf = 0.5 * pitch[GW] + pitch[POST_R], pitch[TURF]
+    boxes[3, 0], boxes[3, 3] = gx - abs(ax) * half - reach, gx + abs(ax) * half + reach
+    boxes[3, 1], boxes[3, 4] = gy - abs(ay) * half - reach, gy + abs(ay) * half + reach
+    boxes[3, 2], boxes[3, 5] = turf - reach, turf + pitch[GH] + pitch[POST_R] + reach
+    boxes[4, 0:3] = math.inf
+    boxes[4, 3:6] = -math.inf
+    if pitch[KEEPER_ON] == 0.0:
+        return
+    # Where he stands, and the corners of the dive targets' rectangle (play: lateral within the goal's half width,
+    # height from the ball's radius above the turf to the bar's underside; the ball's radius is reach's larger part).
+    grow = reach + pitch[K_RADIUS] + max(pitch[K_HANDS], pitch[K_FEET])
+    lo_x, lo_y, lo_z = pitch[KX], pitch[KY], turf + pitch[K_COM]
+    hi_x, hi_y, hi_z = lo_x, lo_y, lo_z
+    for side in (-1.0, 1.0):
+        cx, cy = gx + side * 0.5 * pitch[GW] * ax, gy + side * 0.5 * pitch[GW] * ay
+        lo_x, hi_x, lo_y, hi_y = min(lo_x, cx), max(hi_x, cx), min(lo_y, cy), max(hi_y, cy)
+    lo_z, hi_z = min(lo_z, turf), max(hi_z, turf + pitch[GH])
+    boxes[4, 0], boxes[4, 1], boxes[4, 2] = lo_x - grow, lo_y - grow, lo_z - grow
+    boxes[4, 3], boxes[4, 4], boxes[4, 5] = hi_x + grow, hi_y + grow, hi_z + grow
+
+
+@compiled()
+def _box_distance2(x, y, z, box):
+    """Squared distance from (x, y, z) to ``box`` (:func:`_box`); 0 inside it, +inf for an empty box."""
+    if box[0] > box[3]:
+        return math.inf
+    dx = max(box[0] - x, x - box[3], 0.0)
+    dy = max(box[1] - y, y - box[4], 0.0)
+    dz = max(box[2] - z, z - box[5], 0.0)
+    return dx * dx + dy * dy + dz * dz
+
+
+@compiled()
+def _out_of_reach(x, y, z, vx, vy, vz, wx, wy, wz, t_left, g, ground, spin_inertia, mouth_box, keeper_box):
+    """Whether a ball that has struck something (the knuckle force ended) can no longer reach the goal mouth nor the
+    keeper (``mouth_box``, ``keeper_box``: :func:`_reach_boxes`, or the dived keeper's :func:`_keeper_box`) in the
+    ``t_left`` seconds left: then nothing can change the verdict of a ball whose first body decided it.
+
+    Its energy per unit mass, doubled, E = |v|² + 2g·(z − ground) + α·R²·|ω|² (``spin_inertia`` = α·R²), never
+    grows: the drag only takes energy, the Magnus force is square to the velocity and does no work, gravity only
+    trades height for speed, spin is constant in flight, every impact (Cross's model with 0 ≤ e_n, e_t ≤ 1) and the
+    start of a roll take energy (:mod:`kernels.ball.contact`), and a roll slows. So |v| ≤ √E from now on, and the
+    ball's path, each step's chord box included, keeps within √E·``t_left`` of here; 2 % of E and 0.01 m²/s² are
+    added for the integration's and the contact roots' rounding. The bound holds whatever the spin and however the
+    ball bounces off the turf, the wall or the frame.
+    """
+    energy = vx * vx + vy * vy + vz * vz + 2.0 * g * (z - ground) + spin_inertia * (wx * wx + wy * wy + wz * wz)
+    reach2 = (1.02 * energy + 0.01) * t_left * t_left
+    return _box_distance2(x, y, z, mouth_box) > reach2 and _box_distance2(x, y, z, keeper_box) > reach2
+
+
 # --------------------------------------------------------------------------------------------- the flight
 @compiled()
 def _roll_acceleration(vx, vy, law, decel):
@@ -387,13 +447,22 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
     n_fixed = _fixed_capsules(pitch, caps)
     keeper = pitch[KEEPER_ON] != 0.0
     n_caps = n_fixed + 1 if keeper else n_fixed
-    boxes = np.empty((3, 6))
+    boxes = np.empty((5, 6))
     _group_boxes(caps, n_fixed, radius + 1e-3, boxes)  # the capsule test's own broad-phase margin
     target = np.zeros(3)
     dive_t = math.inf
     if keeper:
         _keeper_box(pitch, dive_t, target, radius + 1e-3, boxes)  # standing until he dives
     frame_box, wall_box, keeper_box = _box(boxes, 0), _box(boxes, 1), _box(boxes, 2)
+    _reach_boxes(pitch, radius + 1e-3, boxes)
+    mouth_box, keeper_reach = _box(boxes, 3), _box(boxes, 4)
+    # The energy bound of _out_of_reach counts the spin with the ball's α and R, the same in every surface's slots
+    # (pitch_vector writes the ball's); where they differ, it is not used.
+    spin_inertia = pitch[TURF_SURFACE + 4] * pitch[TURF_SURFACE + 3] ** 2
+    bounded = True
+    for slot in (FRAME_SURFACE, BODY_SURFACE):
+        if pitch[slot + 4] * pitch[slot + 3] ** 2 != spin_inertia:
+            bounded = False
     if keeper:
         _keeper_capsule(pitch, dive_t, target, 0.0, caps[n_fixed])
     for c in range(n_caps):  # a ball that starts inside a body would leave it with no contact: not flown
@@ -563,7 +632,30 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
                 ending = STOPPED
                 break
             if not store and (
-                scored or (rolling and not inside and _rolls_clear(x, y, z, vx, vy, pitch, boxes, dive_t < math.inf))
+                scored
+                or (rolling and not inside and _rolls_clear(x, y, z, vx, vy, pitch, boxes, dive_t < math.inf))
+                or (
+                    bounded
+                    and first_body >= 0
+                    and not inside
+                    and _out_of_reach(
+                        x,
+                        y,
+                        z,
+                        vx,
+                        vy,
+                        vz,
+                        wx,
+                        wy,
+                        wz,
+                        t_max - t,
+                        g,
+                        ground,
+                        spin_inertia,
+                        mouth_box,
+                        keeper_box if dive_t < math.inf else keeper_reach,
+                    )
+                )
             ):
                 break  # a verdict only: a goal stays a goal, and a roll away from the goal and clear of every body
             continue
@@ -669,7 +761,30 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
             ending = STOPPED
             break
         if not store and (
-            scored or (rolling and not inside and _rolls_clear(x, y, z, vx, vy, pitch, boxes, dive_t < math.inf))
+            scored
+            or (rolling and not inside and _rolls_clear(x, y, z, vx, vy, pitch, boxes, dive_t < math.inf))
+            or (
+                bounded
+                and first_body >= 0
+                and not inside
+                and _out_of_reach(
+                    x,
+                    y,
+                    z,
+                    vx,
+                    vy,
+                    vz,
+                    wx,
+                    wy,
+                    wz,
+                    t_max - t,
+                    g,
+                    ground,
+                    spin_inertia,
+                    mouth_box,
+                    keeper_box if dive_t < math.inf else keeper_reach,
+                )
+            )
         ):
             break
     # Whole ball over the line between the posts and under the bar, at any time (off the post, the bar, the wall

@@ -9,6 +9,7 @@ import pytest
 
 from kernels import ball
 from kernels.ball import odds
+from kernels.ball.pitch import pitch_vector
 
 R = ball.BALL_RADIUS_M
 OPTIONS = {"dt": 1e-2, "method": "rk4", "model": "measured", "ground_m": R, "t_max": 4.0}
@@ -242,3 +243,26 @@ def test_a_keeper_placed_for_a_ball_beyond_1e300_m_is_refused_not_nan() -> None:
             ground_m=R,
             pitch=ball.Pitch(ball.Panel((0, 0), (1, 0), 7.32, 1e300)),
         )
+
+
+@pytest.mark.parametrize(
+    ("keeper", "wall", "surface"),
+    [
+        (ball.Keeper(), True, None),
+        (ball.Keeper(depth_m=2.5, shift_m=-0.7), False, ball.WET_TURF),
+        (ball.Keeper(position_xy=(-1.0, 0.5)), True, None),
+        (None, True, ball.WET_TURF),
+        (None, False, None),
+    ],
+)
+def test_the_odds_maps_pitches_are_each_spots_own_pitch_bit_for_bit(keeper, wall, surface) -> None:
+    # The map builds its spots' pitch vectors all at once: each must be the one pitch_vector gives the spot's own
+    # free kick (its wall 9.15 m out toward the goal, the keeper placed for it), to the last bit.
+    distances = np.array([9.2, 16.0, 22.5, 36.0, 119.0])
+    angles = np.radians([-89.0, -40.0, -7.3, 0.0, 12.0, 40.0, 89.0])
+    spots = np.array([[-d * math.cos(a), d * math.sin(a)] for d in distances for a in angles])
+    vectors = odds.spot_vectors(spots, keeper, wall, 1.9, surface, R, R)
+    for spot, vector in zip(spots, vectors, strict=True):
+        wall_panel, goal = ball.free_kick_panels(spot, (0.0, 0.0), (1.0, 0.0), wall_height_m=1.9)
+        pitch = ball.Pitch(goal, wall_panel if wall else None, keeper, surface=surface or ball.Pitch(goal).surface)
+        np.testing.assert_array_equal(vector, pitch_vector(pitch, spot, R, R))
