@@ -47,9 +47,25 @@ class StrikeSpread:
     spin_axis_deg: float = 8.0
 
     def checked(self) -> StrikeSpread:
+        """This spread, each deviation a number in [0, :data:`SPREAD_LIMITS`]; ``ValueError`` naming one that is not."""
         for field in dataclasses.fields(self):
-            _checks.non_negative(f"spread.{field.name}", getattr(self, field.name))
+            name = f"spread.{field.name}"
+            value = _checks.non_negative(name, getattr(self, field.name))
+            if value > SPREAD_LIMITS[field.name]:
+                raise ValueError(f"{name} must be at most {SPREAD_LIMITS[field.name]:g}, got {value!r}")
         return self
+
+
+SPREAD_LIMITS = {
+    "speed_ms": 50.0,
+    "direction_deg": 180.0,
+    "elevation_deg": 90.0,
+    "spin_rate_rev_s": 50.0,
+    "spin_axis_deg": 180.0,
+}
+"""The largest deviation of each :class:`StrikeSpread` field: a half turn of direction or axis, a right angle of
+elevation (wider draws only wrap round), and a speed or spin rate beyond any foot (the hardest strikes reach about
+35 m/s and 15 rev/s). A spin spread of 1e300 rev/s was played."""
 
 
 @dataclasses.dataclass(frozen=True)

@@ -89,6 +89,11 @@ def test_the_odds_map_reports_progress_and_its_shares_sum_to_one() -> None:
         ({"n": 0}, "n"),
         ({"draw": -1}, "draw"),
         ({"spread": odds.StrikeSpread(speed_ms=-1.0)}, "speed_ms"),
+        ({"spread": odds.StrikeSpread(spin_rate_rev_s=1e300)}, "spread.spin_rate_rev_s must be at most 50"),
+        ({"spread": odds.StrikeSpread(direction_deg=180.5)}, "spread.direction_deg must be at most 180"),
+        ({"spread": odds.StrikeSpread(elevation_deg=math.inf)}, "spread.elevation_deg"),
+        ({"spread": odds.StrikeSpread(spin_axis_deg=181.0)}, "spread.spin_axis_deg must be at most 180"),
+        ({"spread": odds.StrikeSpread(speed_ms=50.01)}, "spread.speed_ms must be at most 50"),
         ({"spread": "s"}, "spread must be a StrikeSpread"),
     ],
 )
@@ -96,6 +101,16 @@ def test_bad_odds_input_raises_naming_it(kwargs, name) -> None:
     wall, goal = ball.free_kick_panels((-22.0, 0.0), (0.0, 0.0), (1.0, 0.0))
     with pytest.raises(ValueError, match=name):
         odds.strike_odds((-22.0, 0.0, R), 25.0, 0.3, 0.0, SPIN, ball.Pitch(goal, wall), **kwargs, **OPTIONS)
+
+
+@pytest.mark.parametrize("name", sorted(odds.SPREAD_LIMITS))
+def test_a_spread_at_its_limit_still_gives_odds(name: str) -> None:
+    wall, goal = ball.free_kick_panels((-22.0, 0.0), (0.0, 0.0), (1.0, 0.0))
+    spread = odds.StrikeSpread(**{name: odds.SPREAD_LIMITS[name]})  # type: ignore[arg-type]
+    result = odds.strike_odds(
+        (-22.0, 0.0, R), 25.0, 0.3, 0.0, SPIN, ball.Pitch(goal, wall), spread=spread, n=32, **OPTIONS
+    )
+    assert sum(result.counts.values()) == result.n == 32
 
 
 def test_strike_odds_wants_a_pitch() -> None:
