@@ -543,6 +543,7 @@ def _polish(
 def _solve_chain(
     p: NDArray[np.float64],
     target: NDArray[np.float64],
+    tolerance: float,
     params: NDArray[np.float64],
     flags: NDArray[np.int64],
     rest: NDArray[np.float64],
@@ -563,7 +564,7 @@ def _solve_chain(
     leaves NaN past the last iteration; ``lengths`` (n,), ``live`` (K,), ``best``, ``previous`` and ``before``
     (n + 1, 3) are scratch. Returns (iterations, status, error of the returned pose).
     """
-    tolerance, cos_phi = params[0], params[1]
+    cos_phi = params[1]  # the tolerance comes on its own, in the units the chain is solved in
     max_iterations, dim, solver = flags[0], flags[1], flags[2]
     extrapolate = flags[3] != 0 and solver == _FABRIK
     has_limits = flags[4] != 0
@@ -749,6 +750,7 @@ def _solve_rows(
         iterations[b], status[b], error[b] = _solve_chain(
             p[b],
             target[b],
+            params[0],
             params,
             flags,
             rest,
@@ -828,15 +830,11 @@ def _solve_one(
         return _BAD_JOINTS, np.empty((0, dim)), np.empty(0), 0, 0, 0.0
     if not _within(target.reshape((1, dim)), bound):  # as a 2D array, like the joints: one compiled _within
         return _BAD_TARGET, np.empty((0, dim)), np.empty(0), 0, 0, 0.0
-    p = np.zeros((count, 3))
-    goal = np.zeros(3)
     extent, origin = 0.0, 0.0
     for c in range(dim):
         for i in range(count):
-            p[i, c] = joints[i, c]
             extent = max(extent, abs(joints[i, c] - joints[0, c]))
             origin = max(origin, abs(joints[i, c]))
-        goal[c] = target[c]
         extent = max(extent, abs(target[c] - joints[0, c]))
         origin = max(origin, abs(target[c]))
     if extent > 0.0:  # the target within _FARTHEST chain lengths, the chain within them of the origin
@@ -849,21 +847,47 @@ def _solve_one(
     scale = 1.0
     if extent != 0.0 and not _UNSCALED[0] <= extent <= _UNSCALED[1]:
         scale = math.ldexp(1.0, math.frexp(extent)[1])  # ≥ extent, exact; division by it is exact
-        p /= scale
-        goal /= scale
-        params = params.copy()
-        params[0] = params[0] / scale
-        centres, radii = centres / scale, radii / scale
+        scaled_centres, scaled_radii = np.empty((radii.shape[0], 3)), np.empty(radii.shape[0])
+        for k in range(radii.shape[0]):
+            scaled_radii[k] = radii[k] / scale
+            for c in range(3):
+                scaled_centres[k, c] = centres[k, c] / scale
+        centres, radii = scaled_centres, scaled_radii
+    # Padded to 3D and divided by the scale (by 1.0: the same bits) in loops: array arithmetic compiles a ufunc
+    # loop for each expression.
+    p, goal = np.zeros((count, 3)), np.zeros(3)
+    for c in range(dim):
+        for i in range(count):
+            p[i, c] = joints[i, c] / scale
+        goal[c] = target[c] / scale
     history = np.empty(flags[0] + 1)
     out_p = np.empty((count, 3))
     lengths = np.empty(count - 1)
     live = np.empty(radii.shape[0], dtype=np.bool_)
     best, previous, before = np.empty((count, 3)), np.empty((count, 3)), np.empty((count, 3))
     iterations, status, error = _solve_chain(
-        p, goal, params, flags, rest, centres, radii, lengths, live, best, previous, before, out_p, history, table
+        p,
+        goal,
+        params[0] / scale,
+        params,
+        flags,
+        rest,
+        centres,
+        radii,
+        lengths,
+        live,
+        best,
+        previous,
+        before,
+        out_p,
+        history,
+        table,
     )
-    if scale != 1.0:
-        out_p *= scale
-        history *= scale
-        error *= scale
-    return 0, out_p[:, :dim].copy(), history[: iterations + 1], iterations, status, error
+    out = np.empty((count, dim))
+    for i in range(count):
+        for c in range(dim):
+            out[i, c] = out_p[i, c] * scale
+    history = history[: iterations + 1]
+    for k in range(iterations + 1):
+        history[k] *= scale
+    return 0, out, history, iterations, status, error * scale
