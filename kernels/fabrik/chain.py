@@ -305,20 +305,6 @@ def _dls_step(p: NDArray[np.float64], target: NDArray[np.float64], ctx: Context,
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _cone_ok(p: NDArray[np.float64], tiny: float, rest: NDArray[np.float64], table: NDArray[np.float64]) -> bool:
-    """Whether every segment keeps its joint's cone or hinge (zero-length segments have none and are skipped)."""
-    qx, qy, qz = rest[0], rest[1], rest[2]
-    for i in range(p.shape[0] - 1):
-        dx, dy, dz, norm = _unit(p[i + 1, 0] - p[i, 0], p[i + 1, 1] - p[i, 1], p[i + 1, 2] - p[i, 2], qx, qy, qz, tiny)
-        if norm <= tiny:
-            continue
-        if not _joint_ok(dx, dy, dz, qx, qy, qz, table, i, rest, tiny):
-            return False
-        qx, qy, qz = dx, dy, dz
-    return True
-
-
-@numba.njit(cache=True, error_model="numpy")
 def _colliding(p: NDArray[np.float64], obstacles: Obstacles, inflate: float) -> bool:
     """Whether any segment passes within ``inflate`` × radius of a live obstacle's centre."""
     for i in range(p.shape[0] - 1):
@@ -329,9 +315,20 @@ def _colliding(p: NDArray[np.float64], obstacles: Obstacles, inflate: float) -> 
 
 @numba.njit(cache=True, error_model="numpy")
 def _admissible(p: NDArray[np.float64], ctx: Context) -> bool:
-    """Whether the pose keeps every joint limit and cuts no live obstacle."""
-    if ctx.has_limits and not _cone_ok(p, ctx.tiny, ctx.rest, ctx.table):
-        return False
+    """Whether the pose keeps every joint's cone or hinge (zero-length segments have none and are skipped) and cuts
+    no live obstacle."""
+    if ctx.has_limits:
+        tiny, rest, table = ctx.tiny, ctx.rest, ctx.table
+        qx, qy, qz = rest[0], rest[1], rest[2]
+        for i in range(p.shape[0] - 1):
+            dx, dy, dz, norm = _unit(
+                p[i + 1, 0] - p[i, 0], p[i + 1, 1] - p[i, 1], p[i + 1, 2] - p[i, 2], qx, qy, qz, tiny
+            )
+            if norm <= tiny:
+                continue
+            if not _joint_ok(dx, dy, dz, qx, qy, qz, table, i, rest, tiny):
+                return False
+            qx, qy, qz = dx, dy, dz
     return not _colliding(p, ctx.obstacles, 1.0)
 
 
@@ -569,7 +566,8 @@ def _solve_chain(
     extrapolate = flags[3] != 0 and solver == _FABRIK
     has_limits = flags[4] != 0
     n = p.shape[0] - 1
-    history[:] = np.nan
+    for k in range(history.shape[0]):  # a loop: a slice assignment compiles an overload of its own
+        history[k] = np.nan
 
     total = 0.0
     for i in range(n):
