@@ -9,7 +9,7 @@ perpendicular and the rotations differ. See :mod:`kernels.fabrik` for the model,
 from __future__ import annotations
 
 import math
-from typing import Literal, NamedTuple
+from typing import Literal
 
 import numba
 import numpy as np
@@ -88,38 +88,20 @@ _GOLDEN = 0.6180339887498949, 0.7548776662466927, 0.5698402909980532
 evenly and deterministically: the same starts in every call, every thread."""
 
 
-class Context(NamedTuple):
-    """What the passes of one solve read and never write, travelling as one argument: a chain's (built by
-    :func:`_solve_chain`) or a tree's (by :func:`~kernels.fabrik.tree._solve_tree_core`). numba passes a named tuple
-    of arrays and scalars as one value, and every pass compiles once for both."""
-
-    lengths: NDArray[np.float64]
-    """(n,) a chain's link lengths, link i from joint i to i + 1; or (J,) a tree's, joint j's link to its parent
-    (0 for the root) (m)."""
-    tiny: float
-    """Length below which a vector has no direction (m): :data:`~kernels.fabrik.geometry._TINY` times the scale."""
-    rest: NDArray[np.float64]
-    """(3,) the unit root direction, the "previous segment" of the root's segments."""
-    has_limits: bool
-    """Whether ``table`` holds any limit."""
-    table: NDArray[np.float64]
-    """(rows, 13) the limit table (:mod:`kernels.fabrik.limits`): one row per segment, or one for all."""
-    obstacles: Obstacles
-    """``(centres, radii, live)``, see :data:`~kernels.fabrik.geometry.Obstacles`."""
-    has_zero: bool
-    """Whether some link is no longer than ``tiny`` (a zero-length link passes its direction on)."""
-    dim: int
-    """2 (the plane z = 0) or 3."""
-
-
 @numba.njit(cache=True, error_model="numpy")
 def _forward_pass(
     p: NDArray[np.float64],
     target: NDArray[np.float64],
-    ctx: Context,
+    lengths: NDArray[np.float64],
+    tiny: float,
+    rest: NDArray[np.float64],
+    limits: tuple[bool, NDArray[np.float64]],
+    obstacles: Obstacles,
+    has_zero: bool,
+    dim: int,
 ) -> None:
     """End on the target, each joint back toward its old place at its link's length (the root is left)."""
-    lengths, tiny, rest, obstacles, dim = ctx.lengths, ctx.tiny, ctx.rest, ctx.obstacles, ctx.dim
+    has_limits, table = limits
     n = lengths.shape[0]
     p[n, 0], p[n, 1], p[n, 2] = target[0], target[1], target[2]
     qx, qy, qz, _ = _unit(p[0, 0] - p[n, 0], p[0, 1] - p[n, 1], p[0, 2] - p[n, 2], -rest[0], -rest[1], -rest[2], tiny)
@@ -128,12 +110,12 @@ def _forward_pass(
         dx, dy, dz, _ = _unit(p[i, 0] - x, p[i, 1] - y, p[i, 2] - z, qx, qy, qz, tiny)
         if obstacles[1].shape[0] > 0:  # any obstacle at all
             dx, dy, dz, _ = _deflect(x, y, z, dx, dy, dz, lengths[i], obstacles, tiny, dim)
-        if ctx.has_limits:
-            dx, dy, dz = _forward_limits(p, i, n, dx, dy, dz, qx, qy, qz, ctx.table, rest, tiny, dim)
+        if has_limits:
+            dx, dy, dz = _forward_limits(p, i, n, dx, dy, dz, qx, qy, qz, table, rest, tiny, dim)
         length = lengths[i]
         x, y, z = x + length * dx, y + length * dy, z + length * dz
         p[i, 0], p[i, 1], p[i, 2] = x, y, z
-        if not ctx.has_zero or length > tiny:
+        if not has_zero or length > tiny:
             qx, qy, qz = dx, dy, dz
 
 
@@ -150,20 +132,17 @@ def _backward_step(
     qz: float,
     length: float,
     row: int,
-    ctx: Context,
+    rest: NDArray[np.float64],
+    limits: tuple[bool, NDArray[np.float64]],
+    obstacles: Obstacles,
+    tiny: float,
+    dim: int,
 ) -> tuple[float, float, float]:
     """Backward reaching's rule for one segment, shared by chains and trees: the unit direction from its placed
     anchor (x, y, z) toward its joint's current place (px, py, pz), clamped into the limit of table row ``row``
     about the previous segment's direction q, turned clear of live obstacles at ``length``, and clamped again where
     that turned it."""
-    has_limits, table, rest, obstacles, tiny, dim = (
-        ctx.has_limits,
-        ctx.table,
-        ctx.rest,
-        ctx.obstacles,
-        ctx.tiny,
-        ctx.dim,
-    )
+    has_limits, table = limits
     dx, dy, dz, _ = _unit(px - x, py - y, pz - z, qx, qy, qz, tiny)
     if has_limits:
         dx, dy, dz = _constrain(dx, dy, dz, qx, qy, qz, table, row, rest, tiny, dim)
@@ -175,25 +154,40 @@ def _backward_step(
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _backward_pass(p: NDArray[np.float64], ctx: Context) -> None:
+def _backward_pass(
+    p: NDArray[np.float64],
+    lengths: NDArray[np.float64],
+    tiny: float,
+    rest: NDArray[np.float64],
+    limits: tuple[bool, NDArray[np.float64]],
+    obstacles: Obstacles,
+    has_zero: bool,
+    dim: int,
+) -> None:
     """Root back on its place, each joint outward toward its current place; limits and obstacles enforced."""
-    lengths, tiny = ctx.lengths, ctx.tiny
-    qx, qy, qz = ctx.rest[0], ctx.rest[1], ctx.rest[2]
+    qx, qy, qz = rest[0], rest[1], rest[2]
     x, y, z = p[0, 0], p[0, 1], p[0, 2]  # the anchor, carried in registers from joint to joint
     for i in range(1, lengths.shape[0] + 1):
         length = lengths[i - 1]
-        dx, dy, dz = _backward_step(x, y, z, p[i, 0], p[i, 1], p[i, 2], qx, qy, qz, length, i - 1, ctx)
+        dx, dy, dz = _backward_step(
+            x, y, z, p[i, 0], p[i, 1], p[i, 2], qx, qy, qz, length, i - 1, rest, limits, obstacles, tiny, dim
+        )
         x, y, z = x + length * dx, y + length * dy, z + length * dz
         p[i, 0], p[i, 1], p[i, 2] = x, y, z
-        if not ctx.has_zero or length > tiny:
+        if not has_zero or length > tiny:
             qx, qy, qz = dx, dy, dz
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _ccd_sweep(p: NDArray[np.float64], target: NDArray[np.float64], ctx: Context) -> None:
+def _ccd_sweep(
+    p: NDArray[np.float64],
+    target: NDArray[np.float64],
+    tiny: float,
+    rest: NDArray[np.float64],
+    dim: int,
+) -> None:
     """One CCD sweep (Wang & Chen 1991): each joint, end to root, turns what lies beyond it about
     ``to_end × to_target`` (Rodrigues' formula) so that the end points at the target."""
-    tiny, rest, dim = ctx.tiny, ctx.rest, ctx.dim
     n = p.shape[0] - 1
     for i in range(n - 1, -1, -1):
         ox, oy, oz = p[i, 0], p[i, 1], p[i, 2]
@@ -218,7 +212,13 @@ def _ccd_sweep(p: NDArray[np.float64], target: NDArray[np.float64], ctx: Context
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _dls_step(p: NDArray[np.float64], target: NDArray[np.float64], ctx: Context, turns: NDArray[np.float64]) -> None:
+def _dls_step(
+    p: NDArray[np.float64],
+    target: NDArray[np.float64],
+    lengths: NDArray[np.float64],
+    tiny: float,
+    turns: NDArray[np.float64],
+) -> None:
     """One damped-least-squares step on joint angles (Wampler 1986; Buss 2004): ``Δθ = Jᵀ(JJᵀ + λ²I)⁻¹e``.
 
     Ball joints: ``J_i = −[l_i]×`` with ``l_i = p_n − p_i``, so ``JJᵀ = Σ |l_i|²I − l_i l_iᵀ`` and
@@ -227,7 +227,6 @@ def _dls_step(p: NDArray[np.float64], target: NDArray[np.float64], ctx: Context,
     ``λ = 0.1 × mean link length`` (Buss 2004). Segment j turns by ``R(Δθ_0) … R(Δθ_j)``, the rotations of the
     joints' rotation vectors (in the plane: by their summed angle). ``turns`` is (n + 1, 3) scratch.
     """
-    lengths, tiny = ctx.lengths, ctx.tiny
     n = lengths.shape[0]
     endx, endy, endz = p[n, 0], p[n, 1], p[n, 2]
     total = 0.0  # a loop: np.sum compiles an overload of its own (and adds in this order too)
@@ -314,11 +313,17 @@ def _colliding(p: NDArray[np.float64], obstacles: Obstacles, inflate: float) -> 
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _admissible(p: NDArray[np.float64], ctx: Context) -> bool:
+def _admissible(
+    p: NDArray[np.float64],
+    tiny: float,
+    rest: NDArray[np.float64],
+    has_limits: bool,
+    table: NDArray[np.float64],
+    obstacles: Obstacles,
+) -> bool:
     """Whether the pose keeps every joint's cone or hinge (zero-length segments have none and are skipped) and cuts
     no live obstacle."""
-    if ctx.has_limits:
-        tiny, rest, table = ctx.tiny, ctx.rest, ctx.table
+    if has_limits:
         qx, qy, qz = rest[0], rest[1], rest[2]
         for i in range(p.shape[0] - 1):
             dx, dy, dz, norm = _unit(
@@ -329,7 +334,7 @@ def _admissible(p: NDArray[np.float64], ctx: Context) -> bool:
             if not _joint_ok(dx, dy, dz, qx, qy, qz, table, i, rest, tiny):
                 return False
             qx, qy, qz = dx, dy, dz
-    return not _colliding(p, ctx.obstacles, 1.0)
+    return not _colliding(p, obstacles, 1.0)
 
 
 @numba.njit(cache=True, error_model="numpy")
@@ -380,8 +385,12 @@ def _place_on_line(
 def _unbend(
     p: NDArray[np.float64],
     target: NDArray[np.float64],
-    ctx: Context,
+    lengths: NDArray[np.float64],
+    tiny: float,
+    rest: NDArray[np.float64],
+    limits: tuple[bool, NDArray[np.float64]],
     cos_phi: float,
+    dim: int,
 ) -> None:
     """Bend a straight chain whose target lies on its own line into a gentle arc centred on that line, so the
     passes can bend it (every interior joint leaves the line; an arc starting along it would leave p_1 on it).
@@ -389,7 +398,7 @@ def _unbend(
     Each joint bends by the same step, at most half the tightest cone, and a hinge about the arc's normal toward
     the inside of its range (:func:`~kernels.fabrik.limits._bend_within`): a bend past a one-sided range's end,
     or any bend of a zero range, would be clamped straight again, leaving the chain rotated off its line."""
-    lengths, tiny, rest, has_limits, table, dim = ctx.lengths, ctx.tiny, ctx.rest, ctx.has_limits, ctx.table, ctx.dim
+    has_limits, table = limits
     n = p.shape[0] - 1
     ax, ay, az = rest[0], rest[1], rest[2]
     for i in range(n):  # the axis: the first segment with a direction
@@ -465,13 +474,21 @@ def _extrapolate(
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _admissible_start(p: NDArray[np.float64], ctx: Context, start: int) -> None:
+def _admissible_start(
+    p: NDArray[np.float64],
+    lengths: NDArray[np.float64],
+    tiny: float,
+    rest: NDArray[np.float64],
+    table: NDArray[np.float64],
+    has_zero: bool,
+    start: int,
+    dim: int,
+) -> None:
     """Rebuild ``p`` from its root as the ``start``-th admissible pose: every joint at an angle inside its limit
     (:func:`~kernels.fabrik.limits._inside_limit`), the fractions taken from additive recurrences over the start
     and the joint, kept off a range's ends (a one-sided range's end is often a fixed point). Starts come in
     mirrored pairs (fractions u and 1 − u: each joint's angle reflected within its range), so a chain and its
     mirror image try the same poses, mirrored."""
-    lengths, tiny, rest, table, dim = ctx.lengths, ctx.tiny, ctx.rest, ctx.table, ctx.dim
     pair = (start + 1) // 2
     qx, qy, qz = rest[0], rest[1], rest[2]
     for i in range(lengths.shape[0]):
@@ -486,7 +503,7 @@ def _admissible_start(p: NDArray[np.float64], ctx: Context, start: int) -> None:
             p[i, 1] + length * dy,
             p[i, 2] + length * dz,
         )
-        if not ctx.has_zero or length > tiny:
+        if not has_zero or length > tiny:
             qx, qy, qz = dx, dy, dz
 
 
@@ -498,7 +515,13 @@ def _polish(
     target: NDArray[np.float64],
     tolerance: float,
     budget: int,
-    ctx: Context,
+    lengths: NDArray[np.float64],
+    tiny: float,
+    rest: NDArray[np.float64],
+    limits: tuple[bool, NDArray[np.float64]],
+    obstacles: Obstacles,
+    has_zero: bool,
+    dim: int,
     turns: NDArray[np.float64],
 ) -> float:
     """Damped least squares (:func:`_dls_step`, each iterate projected by the constrained backward pass) from the
@@ -510,21 +533,22 @@ def _polish(
     improved by :data:`_PROGRESS` of the tolerance in :data:`_PATIENCE` steps; the first iterate within the
     tolerance ends it. Updates ``best`` (n + 1, 3) in place and returns its error; ``p`` and ``turns`` (n + 1, 3)
     are scratch."""
-    progress = _PROGRESS * tolerance + ctx.tiny
+    has_limits, table = limits
+    progress = _PROGRESS * tolerance + tiny
     for start in range(_POLISH_STARTS):
         if start == 0:
             _copy(best, p)
         else:
-            _admissible_start(p, ctx, start)
+            _admissible_start(p, lengths, tiny, rest, table, has_zero, start, dim)
         # Iteration 0 is the start itself (projected, unless it is the best pose), then the steps from it.
         mark_iteration, mark_error = 0, 0.0
         for iteration in range(budget + 1):
             if iteration > 0:
-                _dls_step(p, target, ctx, turns)
+                _dls_step(p, target, lengths, tiny, turns)
             if iteration > 0 or start > 0:
-                _backward_pass(p, ctx)
+                _backward_pass(p, lengths, tiny, rest, limits, obstacles, has_zero, dim)
             error = _end_error(p, target)
-            if error < best_error and _admissible(p, ctx):
+            if error < best_error and _admissible(p, tiny, rest, has_limits, table, obstacles):
                 _copy(p, best)
                 best_error = error
                 if error <= tolerance:
@@ -565,6 +589,7 @@ def _solve_chain(
     max_iterations, dim, solver = flags[0], flags[1], flags[2]
     extrapolate = flags[3] != 0 and solver == _FABRIK
     has_limits = flags[4] != 0
+    limits = (has_limits, table)
     n = p.shape[0] - 1
     for k in range(history.shape[0]):  # a loop: a slice assignment compiles an overload of its own
         history[k] = np.nan
@@ -591,14 +616,13 @@ def _solve_chain(
     fold = fold or (near_inner and distance - inner < total - distance)
     any_live = _mark_live(centres, radii, live, p[0, 0], p[0, 1], p[0, 2])
     obstacles = (centres, radii, live)
-    ctx = Context(lengths, tiny, rest, has_limits, table, obstacles, has_zero, dim)
     constrained = (has_limits and flags[5] != 0) or any_live
 
     error = _end_error(p, target)
     history[0] = error
     _copy(p, best)
     best_error = np.inf
-    if _admissible(p, ctx):
+    if _admissible(p, tiny, rest, has_limits, table, obstacles):
         best_error = error
         if error <= tolerance:
             _copy(p, out_p)
@@ -610,13 +634,13 @@ def _solve_chain(
         _place_on_line(before, p[0], lengths, ux, uy, uz, fold)
         candidate = _end_error(before, target)
         # "reached" means error ≤ tolerance, with no slack: a candidate short of it by rounding iterates on.
-        if _admissible(before, ctx):
+        if _admissible(before, tiny, rest, has_limits, table, obstacles):
             if candidate <= tolerance or out_of_reach:
                 _copy(before, out_p)
                 history[1] = candidate
                 return 1, _REACHED if candidate <= tolerance else _UNREACHABLE, candidate
 
-    _unbend(p, target, ctx, cos_phi)
+    _unbend(p, target, lengths, tiny, rest, limits, cos_phi, dim)
     # The extrapolation's first call moves by 0 × (p − previous): never 0 × uninitialised memory (NaN).
     _copy(p, previous)
     stall = _STALL * tolerance + tiny
@@ -636,18 +660,20 @@ def _solve_chain(
             allowed = iteration >= restart + 3 and trusted
             moved = _extrapolate(p, previous, last_error, history[iteration - 2], allowed)
         if solver == _FABRIK:
-            _forward_pass(p, target, ctx)
+            _forward_pass(p, target, lengths, tiny, rest, limits, obstacles, has_zero, dim)
         elif solver == _CCD:
-            _ccd_sweep(p, target, ctx)
+            _ccd_sweep(p, target, tiny, rest, dim)
         else:
-            _dls_step(p, target, ctx, before)
-        _backward_pass(p, ctx)
+            _dls_step(p, target, lengths, tiny, before)
+        _backward_pass(p, lengths, tiny, rest, limits, obstacles, has_zero, dim)
         error = _end_error(p, target)
         history[iteration] = error
         # A chain whose extrapolation made its error grow (a target the limits keep away, r → 1) is left to plain
         # FABRIK from then on, which settles at its fixed point.
         trusted = trusted and not (moved and error > last_error)
-        if (error < best_error or error <= tolerance) and (not constrained or _admissible(p, ctx)):
+        if (error < best_error or error <= tolerance) and (
+            not constrained or _admissible(p, tiny, rest, has_limits, table, obstacles)
+        ):
             if error < best_error:
                 _copy(p, best)
                 best_error = error
@@ -667,12 +693,12 @@ def _solve_chain(
             )
             ux, uy, uz, _ = _unit(ox, oy, oz, rest[0], rest[1], rest[2], tiny)
             _place_on_line(p, best[0], lengths, ux, uy, uz, bool(_OFF))
-            _unbend(p, target, ctx, cos_phi)  # a straight chain never bends
-            _backward_pass(p, ctx)
+            _unbend(p, target, lengths, tiny, rest, limits, cos_phi, dim)  # a straight chain never bends
+            _backward_pass(p, lengths, tiny, rest, limits, obstacles, has_zero, dim)
             # The restart pose is a candidate too: where the limits leave the chain nearly rigid, the passes from
             # it may move away from the best pose it already is.
             error = _end_error(p, target)
-            if error < best_error and _admissible(p, ctx):
+            if error < best_error and _admissible(p, tiny, rest, has_limits, table, obstacles):
                 _copy(p, best)
                 best_error = error
                 reached = error <= tolerance
@@ -693,7 +719,13 @@ def _solve_chain(
                     target,
                     tolerance,
                     int(_POLISH_STEPS),  # an int, not the literal 50: one compiled _polish
-                    ctx,
+                    lengths,
+                    tiny,
+                    rest,
+                    limits,
+                    obstacles,
+                    has_zero,
+                    dim,
                     before,
                 )
                 if best_error <= tolerance:

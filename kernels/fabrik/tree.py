@@ -36,7 +36,6 @@ from kernels.fabrik.chain import (
     _STALL,
     _UNREACHABLE,
     STATUSES,
-    Context,
     Status,
     _backward_step,
     _copy,
@@ -47,6 +46,7 @@ from kernels.fabrik.geometry import (
     _ROW_0,
     _TINY,
     _TOUCH,
+    Obstacles,
     _deflect,
     _inside_live,
     _mark_live,
@@ -354,6 +354,7 @@ def _solve_tree_core(
         for e in range(history.shape[1]):
             history[row, e] = np.nan
     has_limits, holding = _limit_flags(table)
+    limits = (has_limits, table)
     lengths = np.zeros(count)
     total = 0.0
     for j in range(count):
@@ -372,13 +373,11 @@ def _solve_tree_core(
     live = np.empty(radii.shape[0], dtype=np.bool_)
     any_live = _mark_live(centres, radii, live, p[root, 0], p[root, 1], p[root, 2])
     obstacles = (centres, radii, live)
-    # (has_zero is for the chain's passes; the tree's test each link's length)
-    ctx = Context(lengths, tiny, rest, has_limits, table, obstacles, True, dim)
     # As solve, the fixed-point rule stops a tree only where limits or obstacles can hold it, or where some
     # effector's target is out of its path's reach; a free tree within reach iterates on to the cap.
     out_of_reach = False
     for e in range(effectors.shape[0]):
-        out_of_reach = out_of_reach or _out_of_reach(p, parents, goal, int(effectors[e]), root, ctx)
+        out_of_reach = out_of_reach or _out_of_reach(p, parents, lengths, goal, int(effectors[e]), root, tiny)
     stall_applies = holding or any_live or out_of_reach
     best = np.empty((count, 3))
     _copy(p, best)
@@ -411,13 +410,13 @@ def _solve_tree_core(
             counts[up] += 1
 
     worst = _tree_errors(p, goal, effectors, history, int(_ROW_0))
-    if _tree_admissible(p, parents, order, ctx):
+    if _tree_admissible(p, parents, order, table, rest, tiny, has_limits, obstacles):
         best_worst = worst
         if worst <= tolerance:  # the start is returned as reached only where it keeps every limit
             for e in range(final.shape[0]):
                 final[e] = history[0, e]
             no = bool(_OFF)
-            _tree_statuses(p, parents, goal, effectors, ctx, tolerance, final, no, no, codes)
+            _tree_statuses(p, parents, goal, effectors, lengths, obstacles, tolerance, tiny, final, no, no, codes)
             return 0
     stall = _STALL * tolerance + tiny
     iterations, stalled, retry = 0, False, True
@@ -461,7 +460,9 @@ def _solve_tree_core(
             qx, qy, qz = directions[up, 0], directions[up, 1], directions[up, 2]
             ax, ay, az = p[up, 0], p[up, 1], p[up, 2]
             length = lengths[j]
-            dx, dy, dz = _backward_step(ax, ay, az, p[j, 0], p[j, 1], p[j, 2], qx, qy, qz, length, j, ctx)
+            dx, dy, dz = _backward_step(
+                ax, ay, az, p[j, 0], p[j, 1], p[j, 2], qx, qy, qz, length, j, rest, limits, obstacles, tiny, dim
+            )
             p[j, 0], p[j, 1], p[j, 2] = ax + length * dx, ay + length * dy, az + length * dz
             if length > tiny:
                 directions[j, 0], directions[j, 1], directions[j, 2] = dx, dy, dz
@@ -472,7 +473,9 @@ def _solve_tree_core(
         # where the last iterate may not be the one returned (live obstacles can leave it cutting one; after a
         # restart the best is returned). The backward stage keeps every limit on every iterate.
         track = any_live or not retry
-        admissible = (worst <= tolerance or (track and worst < best_worst)) and _tree_admissible(p, parents, order, ctx)
+        admissible = (worst <= tolerance or (track and worst < best_worst)) and _tree_admissible(
+            p, parents, order, table, rest, tiny, has_limits, obstacles
+        )
         if admissible and worst < best_worst:
             _copy(p, best)  # a loop: an array copy compiles numba's shape checks for seconds
             best_worst = worst
@@ -491,11 +494,11 @@ def _solve_tree_core(
                 # Not a tree already on its targets to rounding (tolerance 0 asks for more than rounding gives):
                 # turned aside, it left them by 1.7 m.
                 retry = False
-                _tree_turn_aside(p, parents, order, ctx)
+                _tree_turn_aside(p, parents, order, lengths, tiny, dim)
     feasible = best_worst < np.inf
     if feasible and (
         not retry  # restarted: never worse than the best before or after
-        or not _tree_admissible(p, parents, order, ctx)
+        or not _tree_admissible(p, parents, order, table, rest, tiny, has_limits, obstacles)
     ):
         _copy(best, p)  # never an inadmissible last iterate where an admissible one was seen
     for e in range(effectors.shape[0]):
@@ -507,8 +510,10 @@ def _solve_tree_core(
         parents,
         goal,
         effectors,
-        ctx,
+        lengths,
+        obstacles,
         tolerance,
+        tiny,
         final,
         stalled,
         holding or any_live,
@@ -522,12 +527,16 @@ def _solve_tree_core(
 
 @numba.njit(cache=True, error_model="numpy")
 def _tree_turn_aside(
-    p: NDArray[np.float64], parents: NDArray[np.int64], order: NDArray[np.int64], ctx: Context
+    p: NDArray[np.float64],
+    parents: NDArray[np.int64],
+    order: NDArray[np.int64],
+    lengths: NDArray[np.float64],
+    tiny: float,
+    dim: int,
 ) -> None:
     """Turn every segment of the pose ``p`` (in place, root fixed, lengths kept) by 1 to 2 rad about an axis
     across it, the angles and axes spread by the golden ratio over the breadth-first order (deterministic, and
     different for mirror-image branches)."""
-    lengths, tiny, dim = ctx.lengths, ctx.tiny, ctx.dim
     old = np.empty((p.shape[0], 3))
     _copy(p, old)
     golden = 0.6180339887498949
@@ -553,11 +562,17 @@ def _tree_turn_aside(
 
 @numba.njit(cache=True, error_model="numpy")
 def _tree_admissible(
-    p: NDArray[np.float64], parents: NDArray[np.int64], order: NDArray[np.int64], ctx: Context
+    p: NDArray[np.float64],
+    parents: NDArray[np.int64],
+    order: NDArray[np.int64],
+    table: NDArray[np.float64],
+    rest: NDArray[np.float64],
+    tiny: float,
+    has_limits: bool,
+    obstacles: Obstacles,
 ) -> bool:
     """Whether the tree's pose keeps every joint limit (each segment against its parent's, the root's against
     ``rest``; zero-length segments have none and pass their parent's on) and cuts no live obstacle."""
-    tiny, rest, has_limits, table, obstacles = ctx.tiny, ctx.rest, ctx.has_limits, ctx.table, ctx.obstacles
     if not has_limits and obstacles[1].shape[0] == 0:  # no limits and no obstacle at all
         return True
     count = p.shape[0]
@@ -582,11 +597,16 @@ def _tree_admissible(
 
 @numba.njit(cache=True, error_model="numpy")
 def _out_of_reach(
-    p: NDArray[np.float64], parents: NDArray[np.int64], goal: NDArray[np.float64], key: int, root: int, ctx: Context
+    p: NDArray[np.float64],
+    parents: NDArray[np.int64],
+    lengths: NDArray[np.float64],
+    goal: NDArray[np.float64],
+    key: int,
+    root: int,
+    tiny: float,
 ) -> bool:
     """Whether effector ``key``'s target lies outside the annulus its path from the root reaches (as solve's: the
     path's length outside, twice its longest link less that length inside)."""
-    lengths = ctx.lengths
     reach, longest, j = 0.0, 0.0, key
     while parents[j] >= 0:
         reach += lengths[j]
@@ -595,7 +615,7 @@ def _out_of_reach(
     inner = max(0.0, 2.0 * longest - reach)
     dx, dy, dz = goal[key, 0] - p[root, 0], goal[key, 1] - p[root, 1], goal[key, 2] - p[root, 2]
     distance = math.sqrt(dx * dx + dy * dy + dz * dz)
-    return distance > reach + ctx.tiny or distance < inner - ctx.tiny
+    return distance > reach + tiny or distance < inner - tiny
 
 
 @numba.njit(cache=True, error_model="numpy")
@@ -604,8 +624,10 @@ def _tree_statuses(
     parents: NDArray[np.int64],
     goal: NDArray[np.float64],
     effectors: NDArray[np.int64],
-    ctx: Context,
+    lengths: NDArray[np.float64],
+    obstacles: Obstacles,
     tolerance: float,
+    tiny: float,
     error: NDArray[np.float64],
     stalled: bool,
     held: bool,
@@ -613,7 +635,6 @@ def _tree_statuses(
 ) -> None:
     """Each effector's status code (see :func:`_solve_tree_core`); ``held``: limits or live obstacles can hold the
     tree at a fixed point (else a stall is another effector's target out of reach: "unreachable")."""
-    obstacles = ctx.obstacles
     touching = False
     if obstacles[1].shape[0] > 0:  # any obstacle at all
         for j in range(p.shape[0]):
@@ -627,7 +648,7 @@ def _tree_statuses(
         inside = _inside_live(obstacles, goal[key, 0], goal[key, 1], goal[key, 2])
         if error[e] <= tolerance:
             codes[e] = _REACHED
-        elif _out_of_reach(p, parents, goal, key, root, ctx):
+        elif _out_of_reach(p, parents, lengths, goal, key, root, tiny):
             codes[e] = _UNREACHABLE
         elif inside or touching:
             codes[e] = _BLOCKED
