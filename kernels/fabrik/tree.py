@@ -218,8 +218,7 @@ def solve_tree(
     codes = np.empty(len(effector_ids), dtype=np.int64)
     final = np.empty(len(effector_ids))
     # As solve: divided by a power of 2 near the extent (exact), so squared norms neither overflow nor underflow
-    # (the largest coordinate offset of a joint or a target from the root)
-    extent = max(float(np.abs(p - p[root]).max()), float(np.abs(goal[effector_ids] - p[root]).max()))
+    extent = _tree_extent_entry(p, goal, effector_ids, root)
     scale, centres, radii = 1.0, setup.centres, setup.radii
     if extent != 0.0 and not _UNSCALED[0] <= extent <= _UNSCALED[1]:
         scale = math.ldexp(1.0, math.frexp(extent)[1])
@@ -526,6 +525,19 @@ def _solve_tree_core(
 
 
 @numba.njit(cache=True, error_model="numpy")
+def _tree_extent(p: NDArray[np.float64], goal: NDArray[np.float64], effectors: NDArray[np.int64], root: int) -> float:
+    """The largest coordinate offset from the root of a joint or a target (m)."""
+    extent = 0.0
+    for j in range(p.shape[0]):
+        for c in range(3):
+            extent = max(extent, abs(p[j, c] - p[root, c]))
+    for e in range(effectors.shape[0]):
+        for c in range(3):
+            extent = max(extent, abs(goal[int(effectors[e]), c] - p[root, c]))
+    return extent
+
+
+@numba.njit(cache=True, error_model="numpy")
 def _tree_turn_aside(
     p: NDArray[np.float64],
     parents: NDArray[np.int64],
@@ -677,3 +689,4 @@ def _tree_errors(
 # The compiled cores solve_tree calls from Python: plain Python while the app's first start compiles them
 # (kernels.warming); compiled code calls the dispatchers above directly.
 _solve_tree_core_entry = Entry(_solve_tree_core)
+_tree_extent_entry = Entry(_tree_extent)
