@@ -895,23 +895,9 @@ def _solve_one(
     lengths = np.empty(count - 1)
     live = np.empty(radii.shape[0], dtype=np.bool_)
     best, previous, before = np.empty((count, 3)), np.empty((count, 3)), np.empty((count, 3))
+    tol = params[0] / scale
     iterations, status, error = _solve_chain(
-        p,
-        goal,
-        params[0] / scale,
-        params,
-        flags,
-        rest,
-        centres,
-        radii,
-        lengths,
-        live,
-        best,
-        previous,
-        before,
-        out_p,
-        history,
-        table,
+        p, goal, tol, params, flags, rest, centres, radii, lengths, live, best, previous, before, out_p, history, table
     )
     out = np.empty((count, dim))
     for i in range(count):
