@@ -229,7 +229,10 @@ def _dls_step(
     """
     n = lengths.shape[0]
     endx, endy, endz = p[n, 0], p[n, 1], p[n, 2]
-    cap = max(np.sum(lengths) / n, tiny)
+    total = 0.0  # a loop: np.sum compiles an overload of its own (and adds in this order too)
+    for i in range(n):
+        total += lengths[i]
+    cap = max(total / n, tiny)
     ex, ey, ez = target[0] - endx, target[1] - endy, target[2] - endz
     shrink = min(1.0, cap / max(math.sqrt(ex * ex + ey * ey + ez * ez), tiny))
     ex, ey, ez = ex * shrink, ey * shrink, ez * shrink
@@ -255,53 +258,49 @@ def _dls_step(
             lz * yx - lx * yz,
             lx * yy - ly * yx,
         )
-    # Turn every segment by the joints up to it and re-chain from the root.
-    turn, step, product = np.zeros((3, 3)), np.empty((3, 3)), np.empty((3, 3))
-    turn[0, 0] = turn[1, 1] = turn[2, 2] = 1.0  # the identity (np.eye compiles an overload of its own)
+    # Turn every segment by the joints up to it and re-chain from the root: ``turn`` (t00 … t22, row by row) is
+    # the product of the joints' rotations so far, on scalars (3 × 3 arrays compiled for seconds more).
+    t00, t01, t02, t10, t11, t12, t20, t21, t22 = 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0
     ox, oy, oz = p[0, 0], p[0, 1], p[0, 2]
     for i in range(n):
         sx, sy, sz = p[i + 1, 0] - ox, p[i + 1, 1] - oy, p[i + 1, 2] - oz
         ox, oy, oz = p[i + 1, 0], p[i + 1, 1], p[i + 1, 2]
-        theta = math.sqrt(turns[i, 0] ** 2 + turns[i, 1] ** 2 + turns[i, 2] ** 2)
+        wx, wy, wz = turns[i, 0], turns[i, 1], turns[i, 2]
+        theta = math.sqrt(wx**2 + wy**2 + wz**2)
         if theta > 1e-15:
-            kx, ky, kz = turns[i, 0] / theta, turns[i, 1] / theta, turns[i, 2] / theta
+            kx, ky, kz = wx / theta, wy / theta, wz / theta
             s, c = math.sin(theta), math.cos(theta)
-            # Rodrigues: R = cos θ I + sin θ [k]× + (1 − cos θ) k kᵀ
-            for r in range(3):
-                for q in range(3):
-                    step[r, q] = (1.0 - c) * turns[i, r] * turns[i, q] / (theta * theta)
-                step[r, r] += c
-            step[0, 1], step[0, 2], step[1, 2] = (
-                step[0, 1] - s * kz,
-                step[0, 2] + s * ky,
-                step[1, 2] - s * kx,
+            # Rodrigues: R = cos θ I + sin θ [k]× + (1 − cos θ) k kᵀ, with k kᵀ as w wᵀ / θ²
+            theta2, versine = theta * theta, 1.0 - c
+            r00, r11, r22 = (
+                versine * wx * wx / theta2 + c,
+                versine * wy * wy / theta2 + c,
+                versine * wz * wz / theta2 + c,
             )
-            step[1, 0], step[2, 0], step[2, 1] = (
-                step[1, 0] + s * kz,
-                step[2, 0] - s * ky,
-                step[2, 1] + s * kx,
+            r01, r02, r12 = (
+                versine * wx * wy / theta2 - s * kz,
+                versine * wx * wz / theta2 + s * ky,
+                versine * wy * wz / theta2 - s * kx,
             )
-            for r in range(3):
-                for q in range(3):
-                    product[r, q] = turn[r, 0] * step[0, q] + turn[r, 1] * step[1, q] + turn[r, 2] * step[2, q]
-            turn, product = product, turn  # no array copy: numba compiles its shape checks for seconds
-        p[i + 1, 0] = p[i, 0] + turn[0, 0] * sx + turn[0, 1] * sy + turn[0, 2] * sz
-        p[i + 1, 1] = p[i, 1] + turn[1, 0] * sx + turn[1, 1] * sy + turn[1, 2] * sz
-        p[i + 1, 2] = p[i, 2] + turn[2, 0] * sx + turn[2, 1] * sy + turn[2, 2] * sz
-
-
-@numba.njit(cache=True, error_model="numpy")
-def _cone_ok(p: NDArray[np.float64], tiny: float, rest: NDArray[np.float64], table: NDArray[np.float64]) -> bool:
-    """Whether every segment keeps its joint's cone or hinge (zero-length segments have none and are skipped)."""
-    qx, qy, qz = rest[0], rest[1], rest[2]
-    for i in range(p.shape[0] - 1):
-        dx, dy, dz, norm = _unit(p[i + 1, 0] - p[i, 0], p[i + 1, 1] - p[i, 1], p[i + 1, 2] - p[i, 2], qx, qy, qz, tiny)
-        if norm <= tiny:
-            continue
-        if not _joint_ok(dx, dy, dz, qx, qy, qz, table, i, rest, tiny):
-            return False
-        qx, qy, qz = dx, dy, dz
-    return True
+            r10, r20, r21 = (
+                versine * wy * wx / theta2 + s * kz,
+                versine * wz * wx / theta2 - s * ky,
+                versine * wz * wy / theta2 + s * kx,
+            )
+            t00, t01, t02, t10, t11, t12, t20, t21, t22 = (
+                t00 * r00 + t01 * r10 + t02 * r20,
+                t00 * r01 + t01 * r11 + t02 * r21,
+                t00 * r02 + t01 * r12 + t02 * r22,
+                t10 * r00 + t11 * r10 + t12 * r20,
+                t10 * r01 + t11 * r11 + t12 * r21,
+                t10 * r02 + t11 * r12 + t12 * r22,
+                t20 * r00 + t21 * r10 + t22 * r20,
+                t20 * r01 + t21 * r11 + t22 * r21,
+                t20 * r02 + t21 * r12 + t22 * r22,
+            )
+        p[i + 1, 0] = p[i, 0] + t00 * sx + t01 * sy + t02 * sz
+        p[i + 1, 1] = p[i, 1] + t10 * sx + t11 * sy + t12 * sz
+        p[i + 1, 2] = p[i, 2] + t20 * sx + t21 * sy + t22 * sz
 
 
 @numba.njit(cache=True, error_model="numpy")
@@ -322,9 +321,19 @@ def _admissible(
     table: NDArray[np.float64],
     obstacles: Obstacles,
 ) -> bool:
-    """Whether the pose keeps every joint limit and cuts no live obstacle."""
-    if has_limits and not _cone_ok(p, tiny, rest, table):
-        return False
+    """Whether the pose keeps every joint's cone or hinge (zero-length segments have none and are skipped) and cuts
+    no live obstacle."""
+    if has_limits:
+        qx, qy, qz = rest[0], rest[1], rest[2]
+        for i in range(p.shape[0] - 1):
+            dx, dy, dz, norm = _unit(
+                p[i + 1, 0] - p[i, 0], p[i + 1, 1] - p[i, 1], p[i + 1, 2] - p[i, 2], qx, qy, qz, tiny
+            )
+            if norm <= tiny:
+                continue
+            if not _joint_ok(dx, dy, dz, qx, qy, qz, table, i, rest, tiny):
+                return False
+            qx, qy, qz = dx, dy, dz
     return not _colliding(p, obstacles, 1.0)
 
 
@@ -555,6 +564,7 @@ def _polish(
 def _solve_chain(
     p: NDArray[np.float64],
     target: NDArray[np.float64],
+    tolerance: float,
     params: NDArray[np.float64],
     flags: NDArray[np.int64],
     rest: NDArray[np.float64],
@@ -575,13 +585,14 @@ def _solve_chain(
     leaves NaN past the last iteration; ``lengths`` (n,), ``live`` (K,), ``best``, ``previous`` and ``before``
     (n + 1, 3) are scratch. Returns (iterations, status, error of the returned pose).
     """
-    tolerance, cos_phi = params[0], params[1]
+    cos_phi = params[1]  # the tolerance comes on its own, in the units the chain is solved in
     max_iterations, dim, solver = flags[0], flags[1], flags[2]
     extrapolate = flags[3] != 0 and solver == _FABRIK
     has_limits = flags[4] != 0
     limits = (has_limits, table)
     n = p.shape[0] - 1
-    history[:] = np.nan
+    for k in range(history.shape[0]):  # a loop: a slice assignment compiles an overload of its own
+        history[k] = np.nan
 
     total = 0.0
     for i in range(n):
@@ -769,6 +780,7 @@ def _solve_rows(
         iterations[b], status[b], error[b] = _solve_chain(
             p[b],
             target[b],
+            params[0],
             params,
             flags,
             rest,
@@ -809,21 +821,17 @@ def _within(values: NDArray[np.float64], bound: float) -> bool:
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _norm_of_difference(
-    joints: NDArray[np.float64], i: int, j: int, target: NDArray[np.float64], dim: int, to_target: bool
-) -> float:
-    """|joints[i] − joints[j]|, or |target − joints[j]| if ``to_target``, scaled by its largest component first so
-    that no square overflows or underflows (a 0.25 m link beside a target 1e200 m away)."""
+def _norm_of_difference(a: NDArray[np.float64], b: NDArray[np.float64], dim: int) -> float:
+    """|a − b| over the first ``dim`` components, scaled by its largest component first so that no square
+    overflows or underflows (a 0.25 m link beside a target 1e200 m away)."""
     largest = 0.0
     for c in range(dim):
-        a = target[c] if to_target else joints[i, c]
-        largest = max(largest, abs(a - joints[j, c]))
+        largest = max(largest, abs(a[c] - b[c]))
     if largest == 0.0:
         return 0.0
     sum_sq = 0.0
     for c in range(dim):
-        a = target[c] if to_target else joints[i, c]
-        sum_sq += ((a - joints[j, c]) / largest) ** 2
+        sum_sq += ((a[c] - b[c]) / largest) ** 2
     return largest * math.sqrt(sum_sq)
 
 
@@ -852,42 +860,50 @@ def _solve_one(
         return _BAD_JOINTS, np.empty((0, dim)), np.empty(0), 0, 0, 0.0
     if not _within(target.reshape((1, dim)), bound):  # as a 2D array, like the joints: one compiled _within
         return _BAD_TARGET, np.empty((0, dim)), np.empty(0), 0, 0, 0.0
-    p = np.zeros((count, 3))
-    goal = np.zeros(3)
     extent, origin = 0.0, 0.0
     for c in range(dim):
         for i in range(count):
-            p[i, c] = joints[i, c]
             extent = max(extent, abs(joints[i, c] - joints[0, c]))
             origin = max(origin, abs(joints[i, c]))
-        goal[c] = target[c]
         extent = max(extent, abs(target[c] - joints[0, c]))
         origin = max(origin, abs(target[c]))
     if extent > 0.0:  # the target within _FARTHEST chain lengths, the chain within them of the origin
         total = 0.0
         for i in range(1, count):
-            total += _norm_of_difference(joints, i, i - 1, target, dim, False)
-        reach = _norm_of_difference(joints, 0, 0, target, dim, True)
+            total += _norm_of_difference(joints[i], joints[i - 1], dim)
+        reach = _norm_of_difference(target, joints[0], dim)  # one signature: rows and the target are (d,)
         if total > 0.0 and (reach / _FARTHEST > total or origin / _FARTHEST > total):
             return _FAR_TARGET, np.empty((0, dim)), np.empty(0), 0, 0, 0.0
     scale = 1.0
     if extent != 0.0 and not _UNSCALED[0] <= extent <= _UNSCALED[1]:
         scale = math.ldexp(1.0, math.frexp(extent)[1])  # ≥ extent, exact; division by it is exact
-        p /= scale
-        goal /= scale
-        params = params.copy()
-        params[0] = params[0] / scale
-        centres, radii = centres / scale, radii / scale
+        scaled_centres, scaled_radii = np.empty((radii.shape[0], 3)), np.empty(radii.shape[0])
+        for k in range(radii.shape[0]):
+            scaled_radii[k] = radii[k] / scale
+            for c in range(3):
+                scaled_centres[k, c] = centres[k, c] / scale
+        centres, radii = scaled_centres, scaled_radii
+    # Padded to 3D and divided by the scale (by 1.0: the same bits) in loops: array arithmetic compiles a ufunc
+    # loop for each expression.
+    p, goal = np.zeros((count, 3)), np.zeros(3)
+    for c in range(dim):
+        for i in range(count):
+            p[i, c] = joints[i, c] / scale
+        goal[c] = target[c] / scale
     history = np.empty(flags[0] + 1)
     out_p = np.empty((count, 3))
     lengths = np.empty(count - 1)
     live = np.empty(radii.shape[0], dtype=np.bool_)
     best, previous, before = np.empty((count, 3)), np.empty((count, 3)), np.empty((count, 3))
+    tol = params[0] / scale
     iterations, status, error = _solve_chain(
-        p, goal, params, flags, rest, centres, radii, lengths, live, best, previous, before, out_p, history, table
+        p, goal, tol, params, flags, rest, centres, radii, lengths, live, best, previous, before, out_p, history, table
     )
-    if scale != 1.0:
-        out_p *= scale
-        history *= scale
-        error *= scale
-    return 0, out_p[:, :dim].copy(), history[: iterations + 1], iterations, status, error
+    out = np.empty((count, dim))
+    for i in range(count):
+        for c in range(dim):
+            out[i, c] = out_p[i, c] * scale
+    history = history[: iterations + 1]
+    for k in range(iterations + 1):
+        history[k] *= scale
+    return 0, out, history, iterations, status, error * scale

@@ -534,7 +534,7 @@ def _bend_within(
     low, high = low - straight, high - straight
     # About another axis, the backward pass turns the bend into the hinge's plane: keep it that small.
     if abs(along) < 1.0 - 1e-9:
-        return min(step, max(0.5 * high, -0.5 * low, 0.0))
+        return min(step, max(max(0.5 * high, -0.5 * low), 0.0))  # max of two: one compiled max
     if along < 0.0:
         low, high = -high, -low
     if low + high >= 0.0:

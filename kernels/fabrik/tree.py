@@ -349,7 +349,9 @@ def _solve_tree_core(
     a tree scaled by a power of 2 gives the same bits scaled."""
     count = p.shape[0]
     root = int(order[0])
-    history[:, :] = np.nan
+    for row in range(history.shape[0]):  # loops, here and below: slice assignments compile overloads of their own
+        for e in range(history.shape[1]):
+            history[row, e] = np.nan
     has_limits, holding = _limit_flags(table)
     limits = (has_limits, table)
     lengths = np.zeros(count)
@@ -376,7 +378,8 @@ def _solve_tree_core(
     for e in range(effectors.shape[0]):
         out_of_reach = out_of_reach or _out_of_reach(p, parents, lengths, goal, int(effectors[e]), root, tiny)
     stall_applies = holding or any_live or out_of_reach
-    best = p.copy()
+    best = np.empty((count, 3))
+    _copy(p, best)
     best_worst = np.inf
     bx, by, bz = p[root, 0], p[root, 1], p[root, 2]
     directions = np.zeros((count, 3))  # each joint's segment direction (its parent's where it has none)
@@ -395,10 +398,10 @@ def _solve_tree_core(
         )
         directions[j, 0], directions[j, 1], directions[j, 2] = ux, uy, uz
     sums = np.zeros((count, 3))
-    counts = np.zeros(count, dtype=np.int64)
+    counts = np.empty(count, dtype=np.int64)
     only_child = np.empty(count, dtype=np.int64)  # the one active child, where a joint has one (-1: none yet)
     for j in range(count):
-        only_child[j] = -1
+        counts[j], only_child[j] = 0, -1
     for j in range(count):
         up = int(parents[j])
         if up >= 0 and active[j]:
@@ -419,8 +422,8 @@ def _solve_tree_core(
     for iteration in range(1, max_iterations + 1):
         iterations = iteration
         # forward stage: effectors on their targets, sub-bases at the centroid of their branches' proposals
-        sums[:, :] = 0.0
-        counts[:] = 0
+        for j in range(count):
+            sums[j, 0], sums[j, 1], sums[j, 2], counts[j] = 0.0, 0.0, 0.0, 0
         for k in range(count - 1, 0, -1):
             j = int(order[k])
             if not active[j]:
@@ -516,7 +519,8 @@ def _solve_tree_core(
         codes,
     )
     if not feasible:
-        codes[:] = _INFEASIBLE
+        for e in range(codes.shape[0]):
+            codes[e] = _INFEASIBLE
     return iterations
 
 
@@ -545,7 +549,8 @@ def _tree_turn_aside(
     """Turn every segment of the pose ``p`` (in place, root fixed, lengths kept) by 1 to 2 rad about an axis
     across it, the angles and axes spread by the golden ratio over the breadth-first order (deterministic, and
     different for mirror-image branches)."""
-    old = p.copy()
+    old = np.empty((p.shape[0], 3))
+    _copy(p, old)
     golden = 0.6180339887498949
     for k in range(1, p.shape[0]):
         j = int(order[k])
