@@ -241,18 +241,32 @@ class BrowserClient:
             return self.gui[uuid]
 
     def set_value(self, label: str, value: Any) -> None:
-        """What a browser sends when a person moves the slider (or edits the input) labelled ``label``."""
+        """What a browser sends when a person moves the slider (or edits the input) labelled ``label``.
+
+        A dropdown takes only one of its options, as in a browser: a label that is not one (the server refuses it
+        and keeps its value) raises ``AssertionError`` here, so a test cannot silently test the default instead.
+        A crafted value goes through :meth:`send_value`."""
+        uuid = self.uuid_of(label)
+        with self._lock:
+            options = self.gui[uuid]["props"].get("options")
+        if options is not None and value not in options:
+            raise AssertionError(f"{value!r} is not one of {label!r}'s options {list(options)}")
+        self.send_value(label, value)
+
+    def send_value(self, label: str, value: Any) -> None:
+        """What a crafted client sends as the value of the control labelled ``label``: anything, unchecked."""
         uuid = self.uuid_of(label)
         with self._lock:  # the browser shows its own edit at once, as the real one does
             self.gui[uuid]["value"] = value
         self.send("GuiUpdateMessage", uuid=uuid, updates={"value": value})
 
     def set_value_answered(self, label: str, value: Any, settle_s: float = 0.15) -> None:
-        """Wait for the control labelled ``label``, send ``value`` to it, wait for the server's answer, then
-        ``settle_s`` more for the callback (it runs on viser's thread pool) to finish."""
+        """Wait for the control labelled ``label``, send ``value`` to it (crafted: anything, as :meth:`send_value`),
+        wait for the server's answer, then ``settle_s`` more for the callback (it runs on viser's thread pool) to
+        finish."""
         self.wait_for_gui(label)
         stamp = len(self.received)
-        self.set_value(label, value)
+        self.send_value(label, value)
         self.wait_for(lambda: len(self.received) > stamp, what="the server to answer")
         time.sleep(settle_s)
 

@@ -238,7 +238,7 @@ def test_crafted_obstacle_message_and_slider_values_keep_a_good_state(
             ("Cone half-angle (°)", float("inf")),
             ("Joint limits", "yes"),
         ):
-            client.set_value(label, value)
+            client.send_value(label, value)
         # Every callback re-reads every control, so once this last, honest edit shows, the crafted ones are cleaned.
         client.set_value("Max iterations", 77)
         client.wait_for(lambda: scene.params.max_iterations == 77, what="the sentinel edit applied")

@@ -110,7 +110,7 @@ def test_crafted_skeleton_gizmo_and_preset_messages_keep_the_last_good_state(
         pose, targets, solves = view.pose.copy(), view.targets.copy(), view.solves
         client.drag_transform("/arm/skeleton/target_0", [bad])
         client.wait_for(lambda: view.gizmo_events >= 3, what="the crafted drag handled")
-        client.set_value("Preset", "Octopus")
+        client.send_value("Preset", "Octopus")
         client.set_value("Max iterations", 60)  # an honest sentinel edit after the crafted ones
         client.wait_for(lambda: scene.params.max_iterations == 60, what="the sentinel edit")
         with scene._lock:

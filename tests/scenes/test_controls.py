@@ -297,7 +297,7 @@ def test_a_browser_value_is_cleaned_once_by_the_declared_spec(server: viser.Vise
         client.wait_for_gui("Riders")
         client.set_value("Riders", 99)
         client.set_value("Speed (km/h)", math.nan)
-        client.set_value("Mode", "Turbo")
+        client.send_value("Mode", "Turbo")
         client.set_value("Power (W)", 3000.0)
         wait_until(
             lambda: demo["riders"].value == 16 and demo["power_w"].value == 2500.0,

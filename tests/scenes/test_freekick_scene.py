@@ -416,7 +416,7 @@ def test_crafted_values_keep_the_last_good_state(
     good = scene.state
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui(label)
-        client.set_value(label, value)
+        client.send_value(label, value)
         # The cleaned value is echoed to every browser; the scene holds it.
         client.wait_for(lambda: _echoed(client.value_of(label), expected), what="the cleaned value echoed")
         client.wait_for(lambda: getattr(scene.params, field) == expected, what="the scene to hold the value")

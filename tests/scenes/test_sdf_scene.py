@@ -144,7 +144,7 @@ def test_crafted_bad_values_keep_the_last_good_scene(server: viser.ViserServer, 
         client.wait_for_node("/sdf/gizmo_1")
         client.set_value("Blend width k (m)", float("nan"))
         client.wait_for(lambda: client.value_of("Blend width k (m)") == good.k, what="k written back")
-        client.set_value("P2 kind", "Pyramid")  # not an option
+        client.send_value("P2 kind", "Pyramid")  # not an option
         client.wait_for(lambda: client.value_of("P2 kind") == "Box", what="kind written back")
         client.set_value("P3 size a (m)", "big")  # viser itself refuses this one; the final check covers it
         client.set_value("P1 colour", (300, -4, 20))

@@ -235,7 +235,7 @@ def test_switching_from_a_browser(server: viser.ViserServer) -> None:
         stale = switcher.scene
         client.click("Reset scene to defaults")
         client.wait_for(lambda: switcher.scene is not stale, what="reset to rebuild the scene")
-        client.set_value("Scene", "Not a scene")
+        client.send_value("Scene", "Not a scene")
         client.set_value("Scene", SCENES["peloton"].title)
         client.wait_for(lambda: switcher.scene.key == "peloton", what="back to peloton")
         client.wait_for(
