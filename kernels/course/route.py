@@ -221,7 +221,10 @@ def _checked_points(name: str, arrays: dict[str, ArrayLike], n_min: int = 2) -> 
     shape = None
     for key, value in arrays.items():
         try:
-            array = np.asarray(value, dtype=np.float64)
+            array = np.asarray(value)
+            if array.dtype.kind not in "fiu":  # True was a metre and "10" ten of them
+                raise TypeError(array.dtype)
+            array = np.asarray(array, dtype=np.float64)
         except (TypeError, ValueError) as error:
             raise ValueError(f"{key} must be an array of numbers") from error
         if array.ndim != 1:

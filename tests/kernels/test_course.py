@@ -763,6 +763,16 @@ def test_a_ride_keeps_its_wind_and_safe_speed_in_the_model_range(
             course.ride(c, 250.0, **{key: value})  # type: ignore[arg-type]
 
 
+@pytest.mark.parametrize("bad", [[True, False], ["0", "10"], [0.0, 1 + 0j], [0.0, None]], ids=repr)
+def test_a_course_from_xy_refuses_coordinates_that_are_not_real_numbers(bad: list[object]) -> None:
+    # [True, False] built a 1 m course and ["0", "10"] a 10 m one, where a ride refuses both kinds.
+    for key in ("east_m", "north_m", "elevation_m"):
+        xyz: dict[str, object] = {"east_m": [0.0, 10.0], "north_m": [0.0, 0.0], "elevation_m": [0.0, 0.0]}
+        xyz[key] = bad
+        with pytest.raises(ValueError, match=f"^{key} must be an array of numbers"):
+            course.course_from_xy(**xyz)  # type: ignore[arg-type]
+
+
 @pytest.mark.parametrize("power", [True, np.array([True]), "250", np.array([1 + 0j]), None, [250.0, "a"]], ids=repr)
 def test_a_ride_refuses_a_power_that_is_not_a_real_number(power: object) -> None:
     # True rode as 1 W (903,564 s), "250" as 250 W, and a complex power lost its imaginary part with a warning.
