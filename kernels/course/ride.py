@@ -283,8 +283,8 @@ def _ride_core(
                 if not graded and n_sub < _REFINE_UP_TO and abs(v1 - v) > _REFINE_RATIO * max(v, v1):
                     ok = False  # an abrupt change of speed (a wall, a crest): finer steps, for accuracy
                     break
-                reach = sub  # ridden at mean speed vb, the rider's power reach_in
-                reach_in = p_in
+                reach, reach_in = sub, p_in  # ridden at mean speed vb, the rider's power reach_in
+                hold, hold_in = 0.0, 0.0  # then at the cap, the rider's power hold_in
                 if v1 > v_cap:
                     # The cap is reached within the step: at full power up to it, then held (the rider eases off, the
                     # brakes take the rest). The reach distance solves the step's own equation with v̄ = (v + cap)/2.
@@ -295,35 +295,25 @@ def _ride_core(
                     need = _wheel_power(v_cap, drag[i], rolling[i], climbing[i], wind[i], b0, b1)
                     if surplus > 0.0 and need <= p_in:
                         reach = min(2.0 * mass * (vb - v) * vb * vb / surplus, sub)
-                        hold = sub - reach
-                        if hold > 0.0:
-                            rider_in = max(need, 0.0)
-                            dt = hold / v_cap
-                            brake += (rider_in - need) * dt
-                            p_aero, p_roll, p_bear, _ = cycling.wheel_power_terms_compiled(
-                                v_cap, drag[i], rolling[i], climbing[i], wind[i], b0, b1
-                            )
-                            dt_total += dt
-                            work += rider_in / efficiency * dt
-                            aero += p_aero * dt
-                            roll += p_roll * dt
-                            bear += p_bear * dt
+                        hold, hold_in = sub - reach, max(need, 0.0)
+                        brake += (hold_in - need) * (hold / v_cap)
                     else:
                         # The cap is above what this power can hold: the step's overshoot is the trapezoid's, not the
                         # rider's. The step arrives at the cap, the rider easing to what that takes (at most p_in).
                         need = (2.0 * mass * (vb - v) * vb * vb + sub * (p_in - surplus)) / sub
                         reach_in = min(max(need, 0.0), p_in)
                         brake += (reach_in - need) * sub / vb
-                if reach > 0.0:
-                    dt = reach / vb
-                    p_aero, p_roll, p_bear, _ = cycling.wheel_power_terms_compiled(
-                        vb, drag[i], rolling[i], climbing[i], wind[i], b0, b1
-                    )
-                    dt_total += dt
-                    work += reach_in / efficiency * dt
-                    aero += p_aero * dt
-                    roll += p_roll * dt
-                    bear += p_bear * dt
+                for distance, speed_here, rider_in in ((hold, v_cap, hold_in), (reach, vb, reach_in)):
+                    if distance > 0.0:
+                        dt = distance / speed_here
+                        p_aero, p_roll, p_bear, _ = cycling.wheel_power_terms_compiled(
+                            speed_here, drag[i], rolling[i], climbing[i], wind[i], b0, b1
+                        )
+                        dt_total += dt
+                        work += rider_in / efficiency * dt
+                        aero += p_aero * dt
+                        roll += p_roll * dt
+                        bear += p_bear * dt
                 v = max(v1, 0.0)
             if ok:
                 break
