@@ -484,6 +484,35 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
     t, n, ending = 0.0, 1, ENDED_T_MAX
     max_rows = len(t_out)
     for _ in range(int(config[N_STEPS]) + EXTRA_ROWS):
+        # A verdict only: a goal stays a goal; a roll away from the goal and clear of every body, or a ball whose
+        # first body decided it and whose energy cannot carry it back to the mouth or the keeper, ends here.
+        if not store and (
+            scored
+            or (rolling and not inside and _rolls_clear(x, y, z, vx, vy, pitch, boxes, dive_t < math.inf))
+            or (
+                bounded
+                and first_body >= 0
+                and not inside
+                and _out_of_reach(
+                    x,
+                    y,
+                    z,
+                    vx,
+                    vy,
+                    vz,
+                    wx,
+                    wy,
+                    wz,
+                    t_max - t,
+                    g,
+                    ground,
+                    spin_inertia,
+                    mouth_box,
+                    keeper_box if dive_t < math.inf else keeper_reach,
+                )
+            )
+        ):
+            break
         h = min(dt, t_max - t)
         if h <= 1e-12 * max(dt, 1.0):
             break
@@ -631,33 +660,6 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
             if stop_here:
                 ending = STOPPED
                 break
-            if not store and (
-                scored
-                or (rolling and not inside and _rolls_clear(x, y, z, vx, vy, pitch, boxes, dive_t < math.inf))
-                or (
-                    bounded
-                    and first_body >= 0
-                    and not inside
-                    and _out_of_reach(
-                        x,
-                        y,
-                        z,
-                        vx,
-                        vy,
-                        vz,
-                        wx,
-                        wy,
-                        wz,
-                        t_max - t,
-                        g,
-                        ground,
-                        spin_inertia,
-                        mouth_box,
-                        keeper_box if dive_t < math.inf else keeper_reach,
-                    )
-                )
-            ):
-                break  # a verdict only: a goal stays a goal, and a roll away from the goal and clear of every body
             continue
         # Move to the contact.
         f = best
@@ -759,33 +761,6 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
             break
         if rolling and vx == 0.0 and vy == 0.0:
             ending = STOPPED
-            break
-        if not store and (
-            scored
-            or (rolling and not inside and _rolls_clear(x, y, z, vx, vy, pitch, boxes, dive_t < math.inf))
-            or (
-                bounded
-                and first_body >= 0
-                and not inside
-                and _out_of_reach(
-                    x,
-                    y,
-                    z,
-                    vx,
-                    vy,
-                    vz,
-                    wx,
-                    wy,
-                    wz,
-                    t_max - t,
-                    g,
-                    ground,
-                    spin_inertia,
-                    mouth_box,
-                    keeper_box if dive_t < math.inf else keeper_reach,
-                )
-            )
-        ):
             break
     # Whole ball over the line between the posts and under the bar, at any time (off the post, the bar, the wall
     # or the keeper too), is a goal; then the keeper; then the first of the wall and the frame it struck (a ball off
