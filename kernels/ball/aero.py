@@ -153,9 +153,19 @@ def drag_lift_speeds(speed2, rate, measured, constant_drag, constant_lift, radiu
     (through :func:`drag_lift`) all come here.
     """
     spin_speed = radius * rate  # r|ω| (m/s): S·|v|
-    return _drag_lift_spin(
-        speed2, spin_speed, _spin_term(spin_speed), measured, constant_drag, constant_lift, re_per_speed, re_crisis
+    drag, lift, _ = _drag_lift_spin(
+        speed2,
+        spin_speed,
+        _spin_term(spin_speed),
+        measured,
+        constant_drag,
+        constant_lift,
+        re_per_speed,
+        re_crisis,
+        0.0,
+        0.0,
     )
+    return drag, lift
 
 
 @compiled()
@@ -164,29 +174,89 @@ def _spin_term(spin_speed):
     return 0.3056 * math.log(spin_speed) if spin_speed > 0.0 else -math.inf
 
 
-@compiled()
-def _drag_lift_spin(speed2, spin_speed, spin_term, measured, constant_drag, constant_lift, re_per_speed, re_crisis):
-    """:func:`drag_lift_speeds` given r|ω| = ``spin_speed`` (m/s) and ``spin_term`` = :func:`_spin_term` of it.
+_SPINNING_POWER = 0.3472
+"""The spinning C_D fit's C_D·|v| = 0.4127·(r|ω|)^0.3056·(|v|²)^0.3472 grows as this power of the squared speed."""
+_NEAR = 1.0 / 32.0
+"""How far (relative) a squared speed may lie from a reference for :func:`_spinning_drag_near`'s series."""
 
-    Written for the force law, whose four evaluations an RK4 step makes one after another: with the spinning fit
-    (S ≥ 0.05) C_D·|v| = 0.4127·(r|ω|)^0.3056·(|v|²)^0.3472 = 0.4127·exp(``spin_term`` + 0.3472·ln |v|²), one
-    logarithm and one exponential of |v|² with no square root or division before them (the spin's logarithm is the
-    kick's, taken once), and C_L·|v| = 0.9·min(r|ω|, 0.3·|v|). Plain scalars, not the settings vector: an array
-    argument costs every evaluation a reference-count increment and decrement.
+
+def _binomial_series(power: float, terms: int) -> tuple[float, ...]:
+    """The coefficients C(power, k), k = 1 … ``terms``, of (1 + r)^power = 1 + Σ C(power, k)·r^k."""
+    coefficients, c = [], 1.0
+    for k in range(1, terms + 1):
+        c *= (power - k + 1) / k
+        coefficients.append(c)
+    return tuple(coefficients)
+
+
+# (1 + r)^0.3472 to 9 terms: for |r| ≤ 1/32 the first term left out, |C(0.3472, 10)|·r¹⁰ ≤ 0.012·2⁻⁵⁰, is below
+# 2⁻⁵³ (half an ulp), so the series is as exact as the exponential it stands for.
+_S1, _S2, _S3, _S4, _S5, _S6, _S7, _S8, _S9 = _binomial_series(_SPINNING_POWER, 9)
+
+
+@compiled()
+def _spinning_drag_near(speed2, inverse_reference2, reference_drag):
+    """The spinning fit's C_D·|v| (m/s) at squared speed ``speed2`` from its value ``reference_drag`` at a squared
+    speed 1/``inverse_reference2``, where |speed2·inverse_reference2 − 1| ≤ 1/32: reference_drag·(1 + r)^0.3472 by
+    its binomial series (no exponential, no logarithm; in Estrin's order, whose few dependent steps an RK4 stage
+    waits on less than nine in a row). NaN where the speed lies farther out (the caller then takes the exponential).
     """
-    speed = math.sqrt(speed2)
+    r = speed2 * inverse_reference2 - 1.0
+    if not abs(r) <= _NEAR:
+        return math.nan
+    r2 = r * r
+    r4 = r2 * r2
+    low = (1.0 + _S1 * r) + r2 * (_S2 + _S3 * r)
+    high = (_S4 + _S5 * r) + r2 * (_S6 + _S7 * r)
+    return reference_drag * ((low + r4 * high) + (r4 * r4) * (_S8 + _S9 * r))
+
+
+@compiled()
+def _drag_lift_spin(
+    speed2,
+    spin_speed,
+    spin_term,
+    measured,
+    constant_drag,
+    constant_lift,
+    re_per_speed,
+    re_crisis,
+    inverse_reference2,
+    reference_drag,
+):
+    """:func:`drag_lift_speeds` given r|ω| = ``spin_speed`` (m/s) and ``spin_term`` = :func:`_spin_term` of it, and
+    a nearby state's 1/|v|² (s²/m²) and spinning-fit C_D·|v| (m/s; 0 where that state was not under the spinning
+    fit, or for none): (C_D·|v|, C_L·|v|, this state's spinning-fit C_D·|v| or 0).
+
+    Written for the force law, whose four evaluations an RK4 step makes one after another, each waiting on the
+    last: with the spinning fit (S ≥ 0.05) C_D·|v| = 0.4127·(r|ω|)^0.3056·(|v|²)^0.3472
+    = 0.4127·exp(``spin_term`` + 0.3472·ln |v|²), one logarithm and one exponential of |v|² with no square root or
+    division before them (the spin's logarithm is the kick's, taken once); where ``reference_drag`` > 0 and |v|²
+    lies within 1/32 of the reference's, the same value from the reference by :func:`_spinning_drag_near` (a step's
+    later stages from its first). C_L·|v| = 0.9·min(r|ω|, 0.3·|v|), the square root taken only at S > 0.3. Plain
+    scalars, not the settings vector: an array argument costs every evaluation a reference-count increment and
+    decrement.
+    """
     if measured == 0.0:
-        return constant_drag * speed, constant_lift * speed
+        speed = math.sqrt(speed2)
+        return constant_drag * speed, constant_lift * speed, 0.0
     if speed2 == 0.0:
-        return 0.0, 0.0  # at rest, no force: the logarithms below need |v| > 0
-    lift = 0.9 * min(spin_speed, 0.3 * speed)  # below Asai et al. 2007's wind-tunnel values: see kernels.ball
+        return 0.0, 0.0, 0.0  # at rest, no force: the logarithms below need |v| > 0
+    # Below Asai et al. 2007's wind-tunnel values: see kernels.ball.
+    lift = 0.9 * spin_speed if spin_speed * spin_speed <= 0.09 * speed2 else 0.27 * math.sqrt(speed2)
     if spin_speed * spin_speed >= 0.0025 * speed2:  # S ≥ 0.05: the spinning fit alone (the blend's weight is 1)
-        # 0.4127·S^0.3056·|v| (Goff & Carré 2010) as one exponential (here r|ω| > 0).
-        return 0.4127 * math.exp(spin_term + 0.3472 * math.log(speed2)), lift
+        drag = math.nan
+        if reference_drag > 0.0:
+            drag = _spinning_drag_near(speed2, inverse_reference2, reference_drag)
+        if math.isnan(drag):
+            # 0.4127·S^0.3056·|v| (Goff & Carré 2010) as one exponential (here r|ω| > 0).
+            drag = 0.4127 * math.exp(spin_term + _SPINNING_POWER * math.log(speed2))
+        return drag, lift, drag
+    speed = math.sqrt(speed2)
     arg = min((re_per_speed * speed - re_crisis) / _RE_WIDTH, 50.0)
     still = 0.155 + 0.346 / (1.0 + math.exp(arg))  # Goff & Carré 2010
     # The blend C_D0 + (S/0.05)·(C_Ds(0.05) − C_D0), times |v|: (S/0.05)·|v| = r|ω|/0.05.
-    return still * speed + (spin_speed / 0.05) * (_SPINNING_AT_BLEND - still), lift
+    return still * speed + (spin_speed / 0.05) * (_SPINNING_AT_BLEND - still), lift, 0.0
 
 
 @compiled()
@@ -294,12 +364,23 @@ def force_law(kick, config):
 
 
 @compiled()
-def _factors(speed2, law):
-    """(−½ρA·C_D·|v|/m, ½ρA·C_L·|v|/m) at squared speed ``speed2``: drag and lift per unit velocity and mass (1/s)."""
-    drag, lift = _drag_lift_spin(
-        speed2, law.spin_speed, law.spin_term, law.measured, law.drag, law.lift, law.re_per_speed, law.re_crisis
+def _factors(speed2, law, inverse_reference2, reference_drag):
+    """(−½ρA·C_D·|v|/m, ½ρA·C_L·|v|/m) at squared speed ``speed2``: drag and lift per unit velocity and mass (1/s);
+    then the spinning fit's C_D·|v| (0 where not that fit), a reference for a nearby evaluation with 1/``speed2``
+    (see :func:`_drag_lift_spin`; pass 0.0, 0.0 for none)."""
+    drag, lift, spinning = _drag_lift_spin(
+        speed2,
+        law.spin_speed,
+        law.spin_term,
+        law.measured,
+        law.drag,
+        law.lift,
+        law.re_per_speed,
+        law.re_crisis,
+        inverse_reference2,
+        reference_drag,
     )
-    return -law.q * drag, law.q * lift
+    return -law.q * drag, law.q * lift, spinning
 
 
 @compiled()
@@ -314,16 +395,21 @@ def _knuckle(speed2, t, law):
 
 
 @compiled(inline="always")
-def acceleration(vx, vy, vz, t, law):
-    """Total acceleration (m/s²) under the kick's :class:`ForceLaw`: drag, Magnus (ω̂ × v), knuckle and gravity."""
+def acceleration(vx, vy, vz, t, law, inverse_reference2, reference_drag):
+    """Total acceleration (m/s²) under the kick's :class:`ForceLaw`: drag, Magnus (ω̂ × v), knuckle and gravity;
+    then |v|² (m²/s²) and the spinning fit's C_D·|v| (m/s, 0 where not that fit), the reference that a later
+    evaluation near this one may pass back as 1/|v|² and C_D·|v| (0.0, 0.0 for none: see
+    :func:`_drag_lift_spin`)."""
     speed2 = vx * vx + vy * vy + vz * vz
-    kd, kl = _factors(speed2, law)
+    kd, kl, spinning = _factors(speed2, law, inverse_reference2, reference_drag)
     wx, wy, wz = law.axis_x, law.axis_y, law.axis_z
     sx, sy, sz = _knuckle(speed2, t, law)
     return (
         kd * vx + kl * (wy * vz - wz * vy) + sx,
         kd * vy + kl * (wz * vx - wx * vz) + sy,
         kd * vz + kl * (wx * vy - wy * vx) + sz - law.gravity,
+        speed2,
+        spinning,
     )
 
 
@@ -336,7 +422,7 @@ def sample_forces(t, state, kick, config, forces):
     for i in range(len(t)):
         vx, vy, vz = state[i, 3], state[i, 4], state[i, 5]
         speed2 = vx * vx + vy * vy + vz * vz
-        kd, kl = _factors(speed2, law)
+        kd, kl, _ = _factors(speed2, law, 0.0, 0.0)
         sx, sy, sz = _knuckle(speed2, t[i], law)
         forces[i, 0], forces[i, 1], forces[i, 2] = m * kd * vx, m * kd * vy, m * kd * vz
         forces[i, 3] = m * kl * (wy * vz - wz * vy)

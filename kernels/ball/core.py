@@ -46,18 +46,20 @@ def _step(x, y, z, vx, vy, vz, t, dt, law, rk4):
     """One step of length ``dt``, RK4 if ``rk4`` else Euler, under the kick's force law: (x, y, z, vx, vy, vz)
     after it."""
     if not rk4:  # the textbook Euler: velocity first, then position with the new velocity
-        ax, ay, az = acceleration(vx, vy, vz, t, law)
+        ax, ay, az, _, _ = acceleration(vx, vy, vz, t, law, 0.0, 0.0)
         vx1, vy1, vz1 = vx + ax * dt, vy + ay * dt, vz + az * dt
         return x + vx1 * dt, y + vy1 * dt, z + vz1 * dt, vx1, vy1, vz1
     half, sixth = 0.5 * dt, dt / 6.0
-    # The acceleration does not depend on position, so each stage's position slope is its velocity.
-    a1x, a1y, a1z = acceleration(vx, vy, vz, t, law)
+    # The acceleration does not depend on position, so each stage's position slope is its velocity. The later
+    # stages take the drag from the first's where their speed is near it (the same value, without exp and log).
+    a1x, a1y, a1z, speed2, drag = acceleration(vx, vy, vz, t, law, 0.0, 0.0)
+    inverse2 = 1.0 / speed2 if drag > 0.0 else 0.0
     v2x, v2y, v2z = vx + half * a1x, vy + half * a1y, vz + half * a1z
-    a2x, a2y, a2z = acceleration(v2x, v2y, v2z, t + half, law)
+    a2x, a2y, a2z, _, _ = acceleration(v2x, v2y, v2z, t + half, law, inverse2, drag)
     v3x, v3y, v3z = vx + half * a2x, vy + half * a2y, vz + half * a2z
-    a3x, a3y, a3z = acceleration(v3x, v3y, v3z, t + half, law)
+    a3x, a3y, a3z, _, _ = acceleration(v3x, v3y, v3z, t + half, law, inverse2, drag)
     v4x, v4y, v4z = vx + dt * a3x, vy + dt * a3y, vz + dt * a3z
-    a4x, a4y, a4z = acceleration(v4x, v4y, v4z, t + dt, law)
+    a4x, a4y, a4z, _, _ = acceleration(v4x, v4y, v4z, t + dt, law, inverse2, drag)
     return (
         x + sixth * (vx + 2.0 * (v2x + v3x) + v4x),
         y + sixth * (vy + 2.0 * (v2y + v3y) + v4y),
