@@ -44,11 +44,11 @@ import math
 from collections.abc import Callable
 from typing import Any, Literal, NamedTuple
 
-import numba
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from kernels import _checks
+from kernels._jit import compiled
 
 G = 9.81
 """Gravitational acceleration (m/s²)."""
@@ -167,7 +167,7 @@ def wheel_power_terms(v, drag, rolling_force, climbing_force, wind, b0, b1):
     return drag * air * abs(air) * v, rolling_force * v, b0 * v + b1 * v * v, climbing_force * v
 
 
-wheel_power_terms_compiled = numba.njit(cache=True, inline="always")(wheel_power_terms)
+wheel_power_terms_compiled = compiled(inline="always")(wheel_power_terms)
 """The very same :func:`wheel_power_terms`, compiled by numba for scalar calls from compiled loops."""
 
 

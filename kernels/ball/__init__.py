@@ -78,7 +78,7 @@ Modules: :mod:`~kernels.ball.config` (constants, :class:`FlightConfig`, input ch
 and wall panels), :mod:`~kernels.ball.aero` (the compiled force law), :mod:`~kernels.ball.core` (the compiled flight,
 crossings and verdict), :mod:`~kernels.ball.api` (:func:`simulate`, the batch functions and their results),
 :mod:`~kernels.ball.contact` (the compiled bounce), :mod:`~kernels.ball.laws` (:func:`coefficients` and
-:func:`bounce`), :mod:`~kernels.ball.jit` (numba with or without its disk cache). Everything public is importable
+:func:`bounce`), :mod:`kernels._jit` (numba with or without its disk cache). Everything public is importable
 from here.
 
 Laws on their own: :func:`coefficients` gives the (C_D, C_L) above at any speed and spin rate, from the same compiled

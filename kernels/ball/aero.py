@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 from typing import NamedTuple
 
+from kernels._jit import compiled
 from kernels.ball.config import (
     C_D,
     C_L,
@@ -31,7 +32,6 @@ from kernels.ball.config import (
     T_MAX,
     Q,
 )
-from kernels.ball.jit import compiled
 
 # Width of the Goff & Carré 2010 no-spin drag fit's crisis, in Reynolds number (its centre is a setting: see
 # :data:`kernels.ball.config.DRAG_CRISIS_RE`).

@@ -17,7 +17,7 @@ A ball that is not moving into the surface (v·n ≥ 0) leaves unchanged. Kineti
 I·ω + m·(R·n) × v, is conserved by every impact.
 
 Scalar cores on (3,) rows and a (5,) surface vector (e_n, e_t, μ, R, α in the slots :data:`RESTITUTION` …
-:data:`INERTIA_FACTOR`), compiled by numba like the flight (:mod:`kernels.ball.jit`); :func:`impacts` runs a batch
+:data:`INERTIA_FACTOR`), compiled by numba like the flight (:mod:`kernels._jit`); :func:`impacts` runs a batch
 through the single :func:`impact`. The public, checked function is :func:`kernels.ball.bounce`.
 """
 
@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import math
 
-from kernels.ball.jit import compiled
+from kernels._jit import compiled
 
 # The surface and ball of an impact are one (5,) vector; these are its slots.
 RESTITUTION, TANGENTIAL_RESTITUTION, FRICTION, RADIUS, INERTIA_FACTOR = range(5)

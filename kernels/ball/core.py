@@ -15,9 +15,9 @@ from typing import Literal
 
 import numpy as np
 
+from kernels._jit import compiled
 from kernels.ball.aero import N_KICK, acceleration, fill_kick, force_law, max_stable_step, sample_forces
 from kernels.ball.config import DT, GRAVITY, GROUND, N_STEPS, RADIUS, RK4, T_MAX, X_STOP
-from kernels.ball.jit import compiled
 
 Ending = Literal["ground", "x_stop", "t_max", "stopped", "net", "out", "saved", "contacts"]
 Result = Literal["goal", "wall", "over", "wide", "short", "post", "bar", "saved"]

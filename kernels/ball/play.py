@@ -24,6 +24,7 @@ import math
 
 import numpy as np
 
+from kernels._jit import compiled
 from kernels.ball.aero import (
     AXIS,
     GAIN,
@@ -47,7 +48,6 @@ from kernels.ball.config import (
 )
 from kernels.ball.contact import N_SURFACE, impact
 from kernels.ball.core import _energy_limit, _hermite, _step, _write_sample, crossing_fraction
-from kernels.ball.jit import compiled
 
 # Slots of the pitch vector.
 GX, GY, GNX, GNY, GW, GH, POST_R, NET_DEPTH, TURF, HALF_WIDTH, ROLL_DECEL, ROLL_SPEED = range(12)

@@ -14,11 +14,11 @@ import dataclasses
 import math
 from typing import Literal
 
-import numba
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from kernels import _checks, cycling
+from kernels._jit import compiled
 from kernels.course.route import Course, course_from_xy
 from kernels.warming import Entry
 
@@ -176,14 +176,14 @@ _REFINE_RATIO = 0.1
 _REFINE_UP_TO = 64
 
 
-@numba.njit(cache=True)
+@compiled()
 def _wheel_power(v, drag, rolling, climbing, wind, b0, b1):  # pragma: no cover - compiled
     """P_wheel(v) (W): the sum of :func:`kernels.cycling.wheel_power_terms`, the one power law, compiled."""
     aero, roll, bearings, climb = cycling.wheel_power_terms_compiled(v, drag, rolling, climbing, wind, b0, b1)
     return aero + roll + bearings + climb
 
 
-@numba.njit(cache=True)
+@compiled()
 def _step(v0, length, drag, rolling, climbing, wind, power_in, mass, b0, b1):  # pragma: no cover
     """Mean speed v̄ ≥ v0/2 solving 2M(v̄ − v0)v̄² + L·(P_wheel(v̄) − P_in) = 0; −1 when none exists."""
     force = rolling + climbing
@@ -231,7 +231,7 @@ def _step(v0, length, drag, rolling, climbing, wind, power_in, mass, b0, b1):  #
     return x
 
 
-@numba.njit(cache=True)
+@compiled()
 def _ride_core(
     length,
     drag,

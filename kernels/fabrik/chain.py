@@ -11,10 +11,10 @@ from __future__ import annotations
 import math
 from typing import Literal
 
-import numba
 import numpy as np
 from numpy.typing import NDArray
 
+from kernels._jit import compiled
 from kernels.fabrik.geometry import (
     _OFF,
     _TINY,
@@ -88,7 +88,7 @@ _GOLDEN = 0.6180339887498949, 0.7548776662466927, 0.5698402909980532
 evenly and deterministically: the same starts in every call, every thread."""
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _forward_pass(
     p: NDArray[np.float64],
     target: NDArray[np.float64],
@@ -119,7 +119,7 @@ def _forward_pass(
             qx, qy, qz = dx, dy, dz
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _backward_step(
     x: float,
     y: float,
@@ -153,7 +153,7 @@ def _backward_step(
     return dx, dy, dz
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _backward_pass(
     p: NDArray[np.float64],
     lengths: NDArray[np.float64],
@@ -178,7 +178,7 @@ def _backward_pass(
             qx, qy, qz = dx, dy, dz
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _ccd_sweep(
     p: NDArray[np.float64],
     target: NDArray[np.float64],
@@ -211,7 +211,7 @@ def _ccd_sweep(
             p[j, 2] = oz + vz * cos_a + (kx * vy - ky * vx) * sin_a + kz * dot
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _dls_step(
     p: NDArray[np.float64],
     target: NDArray[np.float64],
@@ -303,7 +303,7 @@ def _dls_step(
         p[i + 1, 2] = p[i, 2] + t20 * sx + t21 * sy + t22 * sz
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _colliding(p: NDArray[np.float64], obstacles: Obstacles, inflate: float) -> bool:
     """Whether any segment passes within ``inflate`` × radius of a live obstacle's centre."""
     for i in range(p.shape[0] - 1):
@@ -312,7 +312,7 @@ def _colliding(p: NDArray[np.float64], obstacles: Obstacles, inflate: float) -> 
     return False
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _admissible(
     p: NDArray[np.float64],
     tiny: float,
@@ -337,7 +337,7 @@ def _admissible(
     return not _colliding(p, obstacles, 1.0)
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _copy(source: NDArray[np.float64], destination: NDArray[np.float64]) -> None:
     for i in range(source.shape[0]):
         destination[i, 0], destination[i, 1], destination[i, 2] = (
@@ -347,14 +347,14 @@ def _copy(source: NDArray[np.float64], destination: NDArray[np.float64]) -> None
         )
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _end_error(p: NDArray[np.float64], target: NDArray[np.float64]) -> float:
     n = p.shape[0] - 1
     x, y, z = p[n, 0] - target[0], p[n, 1] - target[1], p[n, 2] - target[2]
     return math.sqrt(x * x + y * y + z * z)
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _place_on_line(
     pose: NDArray[np.float64],
     root: NDArray[np.float64],
@@ -381,7 +381,7 @@ def _place_on_line(
         )
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _unbend(
     p: NDArray[np.float64],
     target: NDArray[np.float64],
@@ -442,7 +442,7 @@ def _unbend(
         p[i + 1, 2] = p[i, 2] + c * az + s * sz
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _extrapolate(
     p: NDArray[np.float64],
     previous: NDArray[np.float64],
@@ -473,7 +473,7 @@ def _extrapolate(
     return True
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _admissible_start(
     p: NDArray[np.float64],
     lengths: NDArray[np.float64],
@@ -507,7 +507,7 @@ def _admissible_start(
             qx, qy, qz = dx, dy, dz
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _polish(
     p: NDArray[np.float64],
     best: NDArray[np.float64],
@@ -560,7 +560,7 @@ def _polish(
     return best_error
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _solve_chain(
     p: NDArray[np.float64],
     target: NDArray[np.float64],
@@ -753,7 +753,7 @@ def _solve_chain(
     return count, _LIMITED if stalled else _MAX_ITERATIONS, final_error
 
 
-@numba.njit(cache=True, error_model="numpy", nogil=True)
+@compiled(error_model="numpy", nogil=True)
 def _solve_rows(
     lo: int,
     hi: int,
@@ -811,7 +811,7 @@ _SPAN = 1e40
 a power of 2 near its largest, and DLS lost a chain 1e60 times smaller (its 3 × 3 determinant underflows)."""
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _within(values: NDArray[np.float64], bound: float) -> bool:
     """Whether every value is finite and of magnitude ≤ ``bound`` (NaN fails)."""
     for value in values.flat:
@@ -820,7 +820,7 @@ def _within(values: NDArray[np.float64], bound: float) -> bool:
     return True
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _norm_of_difference(a: NDArray[np.float64], b: NDArray[np.float64], dim: int) -> float:
     """|a − b| over the first ``dim`` components, scaled by its largest component first so that no square
     overflows or underflows (a 0.25 m link beside a target 1e200 m away)."""
@@ -835,7 +835,7 @@ def _norm_of_difference(a: NDArray[np.float64], b: NDArray[np.float64], dim: int
     return largest * math.sqrt(sum_sq)
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _solve_one(
     joints: NDArray[np.float64],
     target: NDArray[np.float64],

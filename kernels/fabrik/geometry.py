@@ -11,9 +11,10 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 from numpy.typing import NDArray
+
+from kernels._jit import compiled
 
 _TINY = 1e-12
 """Relative length below which a vector has no direction, and the rounding slack of the reach tests (times the
@@ -35,7 +36,7 @@ _DIM_3D, _ROW_0, _OFF = 3, 0, False
 ``False`` as a literal and compiles the callee once more for it; an int or bool argument shares the one variant."""
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _unit(
     x: float, y: float, z: float, fx: float, fy: float, fz: float, tiny: float
 ) -> tuple[float, float, float, float]:
@@ -47,7 +48,7 @@ def _unit(
     return fx, fy, fz, norm
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _perpendicular(x: float, y: float, z: float, dim: int) -> tuple[float, float, float]:
     """A fixed unit vector perpendicular to the unit vector (x, y, z): in the plane for d = 2."""
     if dim == 2:
@@ -59,7 +60,7 @@ def _perpendicular(x: float, y: float, z: float, dim: int) -> tuple[float, float
     return cx / norm, cy / norm, cz / norm
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _turn_shortest(
     vx: float, vy: float, vz: float, s: NDArray[np.float64], tx: float, ty: float, tz: float
 ) -> tuple[float, float, float]:
@@ -78,7 +79,7 @@ def _turn_shortest(
     return vx + wx + k * ux, vy + wy + k * uy, vz + wz + k * uz
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _rotate(
     vx: float, vy: float, vz: float, ax: float, ay: float, az: float, angle: float
 ) -> tuple[float, float, float]:
@@ -92,13 +93,13 @@ def _rotate(
     )
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _wrap(angle: float) -> float:
     """``angle`` (rad) brought into [−π, π)."""
     return (angle + math.pi) % (2.0 * math.pi) - math.pi
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _turn_clear(
     ax: float,
     ay: float,
@@ -136,7 +137,7 @@ def _turn_clear(
     return tx / norm, ty / norm, tz / norm
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _deflect(
     ax: float,
     ay: float,
@@ -174,7 +175,7 @@ def _deflect(
     return vx, vy, vz, turned
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _segment_cuts(p: NDArray[np.float64], a: int, b: int, obstacles: Obstacles, inflate: float) -> bool:
     """Whether the segment from joint ``a`` to joint ``b`` of ``p`` (J, 3) passes within ``inflate`` × radius of a
     live obstacle's centre. A zero-length segment is its one point (the closest-point parameter is not divided by
@@ -198,7 +199,7 @@ def _segment_cuts(p: NDArray[np.float64], a: int, b: int, obstacles: Obstacles, 
     return False
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _mark_live(
     centres: NDArray[np.float64], radii: NDArray[np.float64], live: NDArray[np.bool_], x: float, y: float, z: float
 ) -> bool:
@@ -212,7 +213,7 @@ def _mark_live(
     return any_live
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _inside_live(obstacles: Obstacles, x: float, y: float, z: float) -> bool:
     """Whether the point ``(x, y, z)`` (a target) lies inside a live obstacle."""
     centres, radii, live = obstacles

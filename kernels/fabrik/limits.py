@@ -13,11 +13,11 @@ import math
 from collections.abc import Sequence
 from typing import Literal
 
-import numba
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from kernels._checks import bounded_array, finite_number
+from kernels._jit import compiled
 from kernels.fabrik.geometry import (
     _DIM_3D,
     _LARGEST,
@@ -164,7 +164,7 @@ def _limit_table(
     return table
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _clamp_cone(
     vx: float,
     vy: float,
@@ -193,12 +193,12 @@ def _clamp_cone(
     return cx / norm, cy / norm, cz / norm
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _row(table: NDArray[np.float64], i: int) -> int:
     return i if table.shape[0] > 1 else 0
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _hinge_axes(
     table: NDArray[np.float64],
     row: int,
@@ -222,7 +222,7 @@ def _hinge_axes(
     return ax, ay, az, rx, ry, rz
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _hinge_angle(
     vx: float,
     vy: float,
@@ -246,7 +246,7 @@ def _hinge_angle(
     return theta
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _clamp_hinge(
     vx: float,
     vy: float,
@@ -273,7 +273,7 @@ def _clamp_hinge(
     return c * rx + s * bx, c * ry + s * by, c * rz + s * bz
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _constrain(
     vx: float,
     vy: float,
@@ -297,7 +297,7 @@ def _constrain(
     return vx, vy, vz
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _hold_by_next(
     dx: float,
     dy: float,
@@ -327,7 +327,7 @@ def _hold_by_next(
     return dx, dy, dz
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _into_hinge_plane(
     dx: float,
     dy: float,
@@ -350,7 +350,7 @@ def _into_hinge_plane(
     return dx, dy, dz
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _forward_limits(
     p: NDArray[np.float64],
     i: int,
@@ -379,7 +379,7 @@ def _forward_limits(
     return dx, dy, dz
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _holds(table: NDArray[np.float64], row: int) -> bool:
     """Whether joint ``row`` can hold a chain at a fixed point: a cone, or a hinge with less than the full turn
     (a free hinge only keeps its segment in its plane, where it moves as freely as without it)."""
@@ -389,7 +389,7 @@ def _holds(table: NDArray[np.float64], row: int) -> bool:
     return not (kind == _KIND_HINGE and table[row, 10] - table[row, 9] >= 2.0 * math.pi)
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _limit_flags(table: NDArray[np.float64]) -> tuple[bool, bool]:
     """(any limit at all, any limit that can hold a chain or tree at a fixed point; see :func:`_holds`)."""
     has_limits, holding = False, False
@@ -399,7 +399,7 @@ def _limit_flags(table: NDArray[np.float64]) -> tuple[bool, bool]:
     return has_limits, holding
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _joint_ok(
     dx: float,
     dy: float,
@@ -427,7 +427,7 @@ def _joint_ok(
     return True
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _usage(
     p: NDArray[np.float64], table: NDArray[np.float64], rest: NDArray[np.float64], tiny: float
 ) -> NDArray[np.float64]:
@@ -456,7 +456,7 @@ def _usage(
     return share
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _inside_limit(
     qx: float,
     qy: float,
@@ -497,7 +497,7 @@ def _inside_limit(
     return dx / norm, dy / norm, dz / norm
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _holding_hinge(table: NDArray[np.float64]) -> bool:
     """Whether some joint is a hinge with less than the full turn (see :func:`_holds`)."""
     for row in range(table.shape[0]):
@@ -506,7 +506,7 @@ def _holding_hinge(table: NDArray[np.float64]) -> bool:
     return False
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _bend_within(
     table: NDArray[np.float64],
     i: int,

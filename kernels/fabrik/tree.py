@@ -12,10 +12,10 @@ import functools
 import math
 from collections.abc import Mapping, Sequence
 
-import numba
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from kernels._jit import compiled
 from kernels.fabrik.api import (
     _UNSCALED,
     Obstacle,
@@ -317,7 +317,7 @@ def _tree_table_cached(constraints: Sequence[Constraint], count: int, dim: int, 
     return _limit_table(constraints, count, dim, "constraints", segment_offset=0)
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _solve_tree_core(
     p: NDArray[np.float64],
     parents: NDArray[np.int64],
@@ -524,7 +524,7 @@ def _solve_tree_core(
     return iterations
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _tree_extent(p: NDArray[np.float64], goal: NDArray[np.float64], effectors: NDArray[np.int64], root: int) -> float:
     """The largest coordinate offset from the root of a joint or a target (m)."""
     extent = 0.0
@@ -537,7 +537,7 @@ def _tree_extent(p: NDArray[np.float64], goal: NDArray[np.float64], effectors: N
     return extent
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _tree_turn_aside(
     p: NDArray[np.float64],
     parents: NDArray[np.int64],
@@ -572,7 +572,7 @@ def _tree_turn_aside(
         p[j, 2] = p[up, 2] + lengths[j] * dz
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _tree_admissible(
     p: NDArray[np.float64],
     parents: NDArray[np.int64],
@@ -607,7 +607,7 @@ def _tree_admissible(
     return True
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _out_of_reach(
     p: NDArray[np.float64],
     parents: NDArray[np.int64],
@@ -630,7 +630,7 @@ def _out_of_reach(
     return distance > reach + tiny or distance < inner - tiny
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _tree_statuses(
     p: NDArray[np.float64],
     parents: NDArray[np.int64],
@@ -668,7 +668,7 @@ def _tree_statuses(
             codes[e] = (_LIMITED if held else _UNREACHABLE) if stalled else _MAX_ITERATIONS
 
 
-@numba.njit(cache=True, error_model="numpy")
+@compiled(error_model="numpy")
 def _tree_errors(
     p: NDArray[np.float64],
     goal: NDArray[np.float64],

@@ -19,7 +19,7 @@ from hypothesis import strategies as st
 from numpy.typing import NDArray
 
 from kernels import ball
-from kernels.ball import aero, api, jit
+from kernels.ball import aero, api
 from kernels.ball.core import crossing_fraction
 
 WALL, GOAL = ball.free_kick_panels((0.0, 0.0), (25.0, 0.0), (1.0, 0.0))
@@ -864,33 +864,6 @@ def test_after_warm_up_nothing_compiles() -> None:
     # code warm_up() already compiled, so the app's first page and first drag never wait for a compile.
     before, after = map(int, python_stdout(WARM_CHECK, timeout_s=600, cwd=ROOT).split())
     assert before > 0 and after == before
-
-
-def test_without_a_writable_cache_directory_the_cores_compile_uncached(
-    monkeypatch: pytest.MonkeyPatch,
-) -> None:
-    # numba refuses cache=True when neither the package's __pycache__ nor ~/.cache/numba is writable (checked by
-    # hand as user nobody with a read-only HOME): the module must still import, just compiling at every start.
-    calls: list[dict[str, object]] = []
-
-    def refusing_njit(**options: object):
-        calls.append(options)
-        if options.get("cache"):
-            raise RuntimeError("cannot cache function 'f': no locator available for file 'ball.py'")
-        return lambda function: function
-
-    monkeypatch.setattr(jit, "njit", refusing_njit)
-    monkeypatch.setattr(jit, "UNCACHED", [])
-
-    def core() -> int:
-        return 7
-
-    assert jit.compiled(parallel=True)(core)() == 7
-    assert calls == [{"cache": True, "parallel": True}, {"parallel": True}]
-    assert jit.UNCACHED == ["core"]
-    monkeypatch.setattr(jit, "njit", lambda **options: (_ for _ in ()).throw(RuntimeError("other failure")))
-    with pytest.raises(RuntimeError, match="other failure"):
-        jit.compiled()(core)
 
 
 # ------------------------------------------------------------------------------------------------ review 2

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import pytest
 
+from kernels import _jit as jit
 from kernels import _jit_cache
 
 
@@ -73,3 +74,52 @@ def test_the_real_kernels_are_stamped_with_their_sources() -> None:
     root = Path(_jit_cache.__file__).parent
     stamp = root / "__pycache__" / _jit_cache.STAMP_NAME
     assert stamp.read_text().strip() == _jit_cache.source_hash(root)
+
+
+def test_without_a_writable_cache_directory_the_kernels_compile_uncached(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # numba refuses cache=True when neither the package's __pycache__ nor ~/.cache/numba is writable (checked by
+    # hand as user nobody with a read-only HOME): the module must still import, just compiling at every start.
+    calls: list[dict[str, object]] = []
+
+    def refusing_njit(**options: object):
+        calls.append(options)
+        if options.get("cache"):
+            raise RuntimeError("cannot cache function 'f': no locator available for file 'chain.py'")
+        return lambda function: function
+
+    monkeypatch.setattr(jit, "njit", refusing_njit)
+    monkeypatch.setattr(jit, "UNCACHED", [])
+
+    def core() -> int:
+        return 7
+
+    assert jit.compiled(parallel=True)(core)() == 7
+    assert calls == [
+        {"cache": True, "no_cfunc_wrapper": True, "parallel": True},
+        {"no_cfunc_wrapper": True, "parallel": True},
+    ]
+    assert jit.UNCACHED == ["core"]
+    monkeypatch.setattr(jit, "njit", lambda **options: (_ for _ in ()).throw(RuntimeError("other failure")))
+    with pytest.raises(RuntimeError, match="other failure"):
+        jit.compiled()(core)
+
+
+def test_every_compiled_kernel_is_made_one_way() -> None:
+    # One decorator compiles every kernel, so each has the disk cache's fallback and no C wrapper it never uses.
+    import importlib
+    import pkgutil
+
+    from numba.core.registry import CPUDispatcher
+
+    import kernels
+
+    dispatchers = {}
+    for info in pkgutil.walk_packages(kernels.__path__, "kernels."):
+        for value in vars(importlib.import_module(info.name)).values():
+            if isinstance(value, CPUDispatcher):
+                dispatchers[f"{value.py_func.__module__}.{value.py_func.__qualname__}"] = value
+    assert len(dispatchers) > 100
+    made_otherwise = [name for name, d in dispatchers.items() if not d.targetoptions.get("no_cfunc_wrapper")]
+    assert made_otherwise == []
