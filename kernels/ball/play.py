@@ -270,9 +270,10 @@ def _group_boxes(caps, n_fixed, reach, boxes):
             boxes[g, k + 3] = max(boxes[g, k + 3], max(caps[c, k], caps[c, k + 3]) + grow)
 
 
-@compiled()
+@compiled(inline="always")
 def _box(boxes, g):
-    """Row ``g`` of ``boxes`` as a tuple (lo x y z, hi x y z): what the step tests, read with no array reference."""
+    """Row ``g`` of ``boxes`` as a tuple (lo x y z, hi x y z): what the step tests, read with no array reference.
+    (Inlined: called with constant rows, it would otherwise compile once for each.)"""
     return boxes[g, 0], boxes[g, 1], boxes[g, 2], boxes[g, 3], boxes[g, 4], boxes[g, 5]
 
 
