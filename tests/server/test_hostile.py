@@ -20,6 +20,7 @@ import msgspec
 import numpy as np
 import pytest
 import viser
+from helpers.scenes import StubScene
 from helpers.viser_private import control_state, gizmos, gui_inputs
 from helpers.wsclient import BrowserClient, connect_tab
 from hypothesis import given
@@ -563,10 +564,8 @@ def test_a_partial_callback_that_raises_is_logged_by_its_function_name(
 ) -> None:
     """The arm's obstacle gizmos use functools.partial, which has no __name__: the error path itself raised."""
 
-    class Partial(Scene):
+    class Partial(StubScene):
         key = "partial"
-        title = "Partial"
-        about = "A test scene."
 
     scene = Partial(server)
 
