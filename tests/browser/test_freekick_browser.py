@@ -15,14 +15,15 @@ from helpers.browser import (
     TOAST,
     NumberChange,
     ScenePage,
-    assert_chart_draws,
     assert_chart_fits_after,
     assert_in_view,
     assert_seen,
     changed_mask,
+    chart_and_text_tests,
     colour_pixels,
     error_text,
     panel_rect,
+    peaks_over,
     project,
     save_scene_screenshot,
     scene_page_fixture,
@@ -115,12 +116,7 @@ def test_the_kick_fills_the_view_clear_of_the_panel(shown: ScenePage) -> None:
     save_scene_screenshot(shown, "freekick")
 
 
-def test_the_force_chart_draws_every_series(shown: ScenePage) -> None:
-    assert_chart_draws(shown.page, CHART, CHART_COLOURS)
-
-
-def test_no_error_text_on_the_page(shown: ScenePage) -> None:
-    assert error_text(shown.page) == []
+test_the_chart_draws_every_series, test_no_error_text_on_the_page = chart_and_text_tests(CHART, CHART_COLOURS)
 
 
 def test_ten_percent_more_spin_moves_the_path_on_the_screen(shown: ScenePage) -> None:
@@ -215,23 +211,16 @@ def test_every_camera_view_keeps_the_kick_in_view(shown: ScenePage) -> None:
         assert not ((cols < NOTICE_PX[0]) & (rows < NOTICE_PX[1])).any(), "the keeper under the notice"
 
 
+HARDEST_KICK = [
+    NumberChange("Launch speed (m/s)", "speed_ms", 40.0, 25.0),
+    NumberChange("Spin rate (rev/s)", "spin_rev_s", 15.0, 8.0),
+]
+"""The hardest, most spun kick: the force axis grows from a few newtons to over ten."""
+
+
 def test_the_force_chart_tick_labels_stay_inside_its_canvas(shown: ScenePage) -> None:
     assert isinstance(shown.scene, FreeKickScene)
-
-    def over_ten_newtons(data: Any) -> None:
-        assert max(float(np.max(series)) for series in data[1:]) > 10.0
-
-    # The hardest, most spun kick: the force axis grows from a few newtons to over ten.
-    assert_chart_fits_after(
-        shown,
-        CHART,
-        [
-            NumberChange("Launch speed (m/s)", "speed_ms", 40.0, 25.0),
-            NumberChange("Spin rate (rev/s)", "spin_rev_s", 15.0, 8.0),
-        ],
-        lambda scene: scene.chart.data,
-        over_ten_newtons,
-    )
+    assert_chart_fits_after(shown, CHART, HARDEST_KICK, lambda scene: scene.chart.data, peaks_over(10.0))
 
 
 KEEPER = ["/freekick/keeper", "/freekick/keeper_head"]

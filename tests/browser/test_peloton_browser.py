@@ -21,6 +21,7 @@ from helpers.browser import (
     assert_chart_fits_after,
     assert_in_view,
     assert_seen,
+    chart_and_text_tests,
     chart_image,
     colour_pixels,
     control_row,
@@ -29,6 +30,7 @@ from helpers.browser import (
     line_mask,
     node_box_corners,
     panel_rect,
+    peaks_over,
     project,
     save_scene_screenshot,
     scene_page_fixture,
@@ -117,12 +119,7 @@ def test_the_line_is_in_view_clear_of_the_panel(shown: ScenePage) -> None:
     save_scene_screenshot(shown, "peloton")
 
 
-def test_the_chart_draws_every_curve(shown: ScenePage) -> None:
-    assert_chart_draws(shown.page, CHART, CHART_COLOURS)
-
-
-def test_no_error_text_on_the_page(shown: ScenePage) -> None:
-    assert error_text(shown.page) == []
+test_the_chart_draws_every_series, test_no_error_text_on_the_page = chart_and_text_tests(CHART, CHART_COLOURS)
 
 
 def test_eight_riders_far_apart_stay_in_view(shown: ScenePage) -> None:
@@ -160,23 +157,16 @@ def test_more_speed_lifts_the_now_line_and_the_bars(shown: ScenePage) -> None:
     assert_chart_draws(shown.page, CHART, CHART_COLOURS)
 
 
+BIG_RIDER_INTO_A_GALE = [
+    NumberChange("CdA (m²)", "cda_m2", 0.8, 0.32),
+    NumberChange("Headwind (m/s, − = tailwind)", "headwind_ms", 15.0, 0.0),
+]
+"""A bigger rider into a gale: the power axis reaches "20,000" W (it ran 7 px off the canvas's left edge)."""
+
+
 def test_the_chart_tick_labels_stay_inside_its_canvas(shown: ScenePage) -> None:
     assert isinstance(shown.scene, PelotonScene)
-
-    def over_ten_kilowatts(data: Any) -> None:
-        assert max(float(np.max(series)) for series in data[1:]) > 10_000.0
-
-    # A bigger rider into a gale: the power axis reaches "20,000" W (it ran 7 px off the canvas's left edge).
-    assert_chart_fits_after(
-        shown,
-        CHART,
-        [
-            NumberChange("CdA (m²)", "cda_m2", 0.8, 0.32),
-            NumberChange("Headwind (m/s, − = tailwind)", "headwind_ms", 15.0, 0.0),
-        ],
-        lambda scene: scene.chart.data,
-        over_ten_kilowatts,
-    )
+    assert_chart_fits_after(shown, CHART, BIG_RIDER_INTO_A_GALE, lambda scene: scene.chart.data, peaks_over(10_000.0))
 
 
 def choose(page: Any, label: str, option: str) -> None:

@@ -295,6 +295,19 @@ class ScenePage:
         open_viser(self.page, self.server.get_port(), node)
 
 
+def chart_and_text_tests(chart: str, colours: dict[str, Sequence[int]]) -> tuple[Any, Any]:
+    """Two tests for a module with a ``shown`` fixture (assign them to ``test_…`` names): chart ``chart`` draws every
+    series in its ``colours`` (:func:`assert_chart_draws`), and the page shows no error text (:func:`error_text`)."""
+
+    def test_the_chart_draws_every_series(shown: ScenePage) -> None:
+        assert_chart_draws(shown.page, chart, colours)
+
+    def test_no_error_text_on_the_page(shown: ScenePage) -> None:
+        assert error_text(shown.page) == []
+
+    return test_the_chart_draws_every_series, test_no_error_text_on_the_page
+
+
 def scene_page_fixture(key: str, viewports: Sequence[tuple[int, int]] = VIEWPORTS, *, gl: bool = False) -> Any:
     """A module-scoped fixture (assign it to ``shown``): scene ``key`` served and shown in one settled page per
     viewport (:func:`scene_page`), shared by the module's tests at that viewport. ``gl``: the scene needs the
@@ -777,6 +790,16 @@ def assert_chart_fits_after(
     assert_chart_shows_its_data(shown.page, title, data)
     assert_tick_labels_inside(shown.page, title)
     _type_numbers(shown, [(c.label, c.field, c.restore) for c in changes], "back")
+
+
+def peaks_over(limit: float) -> Callable[[Any], None]:
+    """A ``check`` for :func:`assert_chart_fits_after`: some series of the chart's data (after its x values) rises
+    over ``limit``."""
+
+    def check(data: Any) -> None:
+        assert max(float(np.max(series)) for series in data[1:]) > limit
+
+    return check
 
 
 def _type_numbers(shown: ScenePage, typed: Sequence[tuple[str, str, float]], what: str) -> None:

@@ -23,6 +23,13 @@ class MakeScene(Protocol):
     def __call__(self, kind: type[S]) -> S: ...
 
 
+class StubScene(Scene):
+    """A scene made for a test: a subclass names its ``key``; no person reads its title or its about."""
+
+    title = "Test"
+    about = "A test scene."
+
+
 def scene_fixture(kind: type[Scene]) -> Any:
     """A fixture (assign it to ``scene``): a scene of class ``kind`` shown on the test's switcher, through
     ``tests/conftest.py``'s ``show_scene`` (checked to be of that class, closed with the switcher)."""

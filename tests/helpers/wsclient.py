@@ -16,10 +16,12 @@ binaryBufferLengths}) [padding to 8] [raw buffers, each 8-aligned]``; numpy arra
 
 from __future__ import annotations
 
+import contextlib
+import dataclasses
 import math
 import threading
 import time
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
 from typing import Any
 
 import msgspec
@@ -349,6 +351,30 @@ def shows_number(shown: object, expected: object) -> bool:
     """Whether a control's value as a browser shows it is the finite number ``expected`` (an int or a float)."""
     assert isinstance(expected, (int, float))
     return isinstance(shown, (int, float)) and math.isfinite(shown) and float(shown) == float(expected)
+
+
+@dataclasses.dataclass(frozen=True)
+class Crafted:
+    """A crafted value sent to the control labelled ``label``, the parameter ``field`` it sets, and what that field
+    must hold after (the value cleaned)."""
+
+    label: str
+    value: object
+    field: str
+    expected: object
+
+    def __str__(self) -> str:
+        return f"{self.label}-{self.value}-{self.field}-{self.expected}"
+
+
+@contextlib.contextmanager
+def crafted_sent(port: int, crafted: Crafted, caplog: Any) -> Iterator[BrowserClient]:
+    """A browser on ``port`` that has sent ``crafted``'s value and had the server answer; on leaving, asserts that
+    no callback logged an error (``caplog``: pytest's log capture)."""
+    with BrowserClient(port) as client:
+        client.set_value_answered(crafted.label, crafted.value)
+        yield client
+    assert not [r for r in caplog.records if r.levelname == "ERROR"], "a callback failed"
 
 
 def connect_tab(server: Any, sessions: Any) -> tuple[BrowserClient, Any]:

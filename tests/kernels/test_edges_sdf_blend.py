@@ -7,6 +7,7 @@ scene's is.
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
 
 import numpy as np
@@ -51,27 +52,48 @@ def assert_near_hard(got: np.ndarray, hard: np.ndarray, k: float, a: np.ndarray,
     assert np.all(np.abs(got.astype(np.float64) - hard) <= k / 4 * (1 + 1e-6) + rounding)
 
 
-@given(
-    a=st.lists(distances, min_size=1, max_size=20),
-    b_offset=st.lists(st.sampled_from([0.0, 1e-40, -1e-40, 1e-7, 0.3]), min_size=1, max_size=20),
-    k=widths,
-    op=st.sampled_from(sdf.BOOLEAN_OPS),
-    blend=st.sampled_from(sdf.BLEND_FORMS),
-    dtype=st.sampled_from([np.float32, np.float64]),
-)
+@dataclasses.dataclass(frozen=True)
+class Blend:
+    """One call of a blend: two equal-length float64 arrays, a width, the boolean, the form and the dtype run in."""
+
+    a: np.ndarray
+    b: np.ndarray
+    k: float
+    op: sdf.BooleanOp
+    blend: sdf.BlendForm
+    dtype: type
+
+
+@st.composite
+def blends(
+    draw: st.DrawFn, a: st.SearchStrategy[float], b: st.SearchStrategy[float], k: st.SearchStrategy[float], size: int
+) -> Blend:
+    """A :class:`Blend` of up to ``size`` values drawn from ``a`` and ``b``, a width from ``k``, and any op, form and
+    dtype."""
+    a_list = draw(st.lists(a, min_size=1, max_size=size))
+    b_list = draw(st.lists(b, min_size=1, max_size=size))
+    n = min(len(a_list), len(b_list))
+    return Blend(
+        np.asarray(a_list[:n], dtype=np.float64),
+        np.asarray(b_list[:n], dtype=np.float64),
+        draw(k),
+        draw(st.sampled_from(sdf.BOOLEAN_OPS)),
+        draw(st.sampled_from(sdf.BLEND_FORMS)),
+        draw(st.sampled_from([np.float32, np.float64])),
+    )
+
+
+offsets = st.sampled_from([0.0, 1e-40, -1e-40, 1e-7, 0.3])
+"""b − a in the test below."""
+
+
+@given(case=blends(distances, offsets, widths, 20))
 @settings(max_examples=examples(400), deadline=None)
-def test_every_blend_is_finite_and_near_the_hard_operation_for_every_width(
-    a: list[float],
-    b_offset: list[float],
-    k: float,
-    op: sdf.BooleanOp,
-    blend: sdf.BlendForm,
-    dtype: type,
-) -> None:
-    n = min(len(a), len(b_offset))
+def test_every_blend_is_finite_and_near_the_hard_operation_for_every_width(case: Blend) -> None:
+    op, k, blend, dtype = case.op, case.k, case.blend, case.dtype
     # b near a (equal, one subnormal apart, a few ulps, far): the ties where 0/0 and inf·0 used to appear.
-    a_arr = np.asarray(a[:n], dtype=np.float64)
-    b_arr = a_arr + np.asarray(b_offset[:n])
+    a_arr = case.a
+    b_arr = a_arr + case.b
     for x, y in ((a_arr, b_arr), (b_arr, a_arr), (a_arr, -b_arr)):
         x_t, y_t = x.astype(dtype), y.astype(dtype)
         with np.errstate(divide="raise"):  # nothing is ever divided by a width or sharpness of 0
@@ -171,26 +193,12 @@ extreme_widths = st.one_of(
 )
 
 
-@given(
-    a=st.lists(extreme_distances, min_size=1, max_size=12),
-    b=st.lists(extreme_distances, min_size=1, max_size=12),
-    k=extreme_widths,
-    op=st.sampled_from(sdf.BOOLEAN_OPS),
-    blend=st.sampled_from(sdf.BLEND_FORMS),
-    dtype=st.sampled_from([np.float32, np.float64]),
-)
+@given(case=blends(extreme_distances, extreme_distances, extreme_widths, 12))
 @settings(max_examples=examples(400), deadline=None)
-def test_blends_of_infinite_and_huge_distances_are_never_nan(
-    a: list[float],
-    b: list[float],
-    k: float,
-    op: sdf.BooleanOp,
-    blend: sdf.BlendForm,
-    dtype: type,
-) -> None:
-    n = min(len(a), len(b))
+def test_blends_of_infinite_and_huge_distances_are_never_nan(case: Blend) -> None:
+    op, k, blend, dtype = case.op, case.k, case.blend, case.dtype
     with np.errstate(over="ignore"):
-        x, y = np.asarray(a[:n]).astype(dtype), np.asarray(b[:n]).astype(dtype)
+        x, y = case.a.astype(dtype), case.b.astype(dtype)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         got = smooth_in_its_dtype(op, x, y, k, blend)

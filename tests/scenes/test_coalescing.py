@@ -19,13 +19,13 @@ import pytest
 import trimesh
 import viser
 from helpers.properties import examples
+from helpers.scenes import StubScene
 from helpers.waiting import wait_until
 from helpers.wsclient import BrowserClient
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from kernels import sdf
-from scenes._base import Scene
 from scenes.arm import ArmScene
 from scenes.freekick import FreeKickParams, FreeKickScene, _segments, compute_kick, resample
 from scenes.sdf_gallery import PREVIEW_RESOLUTION, SdfGalleryScene
@@ -37,12 +37,10 @@ from shaders.renderer import GLUnavailableError
 SPEED = "Launch speed (m/s)"
 
 
-class Held(Scene):
+class Held(StubScene):
     """A scene whose handler blocks on its first call until released, and records the value each call reads."""
 
     key = "held"
-    title = "Held"
-    about = "A test scene."
 
     def __init__(self, server: viser.ViserServer) -> None:
         super().__init__(server)
@@ -173,12 +171,10 @@ def test_turns_go_in_the_order_asked_are_reentrant_and_survive_an_exception() ->
     assert done.wait(5.0), "the turn stayed held after an exception"
 
 
-class SlowBuild(Scene):
+class SlowBuild(StubScene):
     """A scene whose control exists, and is moved by a browser, before its 3D node does."""
 
     key = "slowbuild"
-    title = "Slow build"
-    about = "A test scene."
 
     def __init__(self, server: viser.ViserServer) -> None:
         super().__init__(server)

@@ -9,17 +9,16 @@ import weakref
 
 import pytest
 import viser
+from helpers.scenes import StubScene
 from helpers.viser_private import gui_uuids, node_names
 from helpers.wsclient import BrowserClient
 
 from scenes import SCENES
-from scenes._base import Scene
 from server.sessions import camera_hub
 
 
-class Probe(Scene):
+class Probe(StubScene):
     key = "probe"
-    title = "Probe"
     about = "A test scene. Assumptions: none. Equation: x = x."
 
     def __init__(self, server: viser.ViserServer) -> None:

@@ -20,6 +20,7 @@ import msgspec
 import numpy as np
 import pytest
 import viser
+from helpers.scenes import StubScene
 from helpers.viser_private import control_state, gizmos, gui_inputs
 from helpers.wsclient import BrowserClient, connect_tab
 from hypothesis import given
@@ -322,6 +323,12 @@ def assert_each_refusal_logged_once(caplog: pytest.LogCaptureFixture, capfd: pyt
     return kinds
 
 
+@pytest.fixture(params=list(SCENES))
+def key(request: pytest.FixtureRequest) -> str:
+    """Each scene's key in turn (a test may name fewer with its own ``parametrize``)."""
+    return request.param
+
+
 @contextlib.contextmanager
 def two_viewers(server: viser.ViserServer, key: str) -> Iterator[tuple[SceneSwitcher, BrowserClient, BrowserClient]]:
     """Scene ``key`` on ``server`` and two browsers showing it, both registered and past the scene's first
@@ -342,7 +349,6 @@ def two_viewers(server: viser.ViserServer, key: str) -> Iterator[tuple[SceneSwit
         switcher.close()
 
 
-@pytest.mark.parametrize("key", list(SCENES))
 def test_every_hostile_message_leaves_every_viewer_on_the_last_good_state(
     server: viser.ViserServer,
     key: str,
@@ -400,7 +406,6 @@ def dataclass_replace(params: Any, field: str, value: Any) -> Any:
     return dataclasses.replace(params, **{field: value})
 
 
-@pytest.mark.parametrize("key", list(SCENES))
 def test_huge_numbers_clamp_to_the_range_the_scene_declared(server: viser.ViserServer, key: str) -> None:
     """±1e308 are finite: every number control ends on the bound of its declared range, in every viewer."""
     with two_viewers(server, key) as (switcher, attacker, observer):
@@ -559,10 +564,8 @@ def test_a_partial_callback_that_raises_is_logged_by_its_function_name(
 ) -> None:
     """The arm's obstacle gizmos use functools.partial, which has no __name__: the error path itself raised."""
 
-    class Partial(Scene):
+    class Partial(StubScene):
         key = "partial"
-        title = "Partial"
-        about = "A test scene."
 
     scene = Partial(server)
 
@@ -686,7 +689,6 @@ class _TabView:
         self.scene = session.scene
 
 
-@pytest.mark.parametrize("key", list(SCENES))
 def test_every_hostile_message_leaves_each_tab_on_its_last_good_state(
     server: viser.ViserServer,
     key: str,
