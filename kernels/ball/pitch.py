@@ -152,6 +152,12 @@ BODY = Surface(restitution=0.4, friction=0.5, tangential_restitution=0.0, rollin
 published value was found."""
 
 
+PENALTY_AREA_DEPTH_M = 16.5
+"""How far the penalty area reaches out from the goal line (m; Law 1: 16.5 m, 18 yd)."""
+PENALTY_AREA_HALF_WIDTH_M = 20.16
+"""Half the penalty area's width, from the goal's centre (m; Law 1: 16.5 m beyond each post, 7.32 m apart)."""
+
+
 @dataclasses.dataclass(frozen=True)
 class Keeper:
     """A goalkeeper: a stick of radius ``body_radius_m`` from feet to fingertips through the centre of mass.
@@ -171,11 +177,15 @@ class Keeper:
     """
 
     position_xy: tuple[float, float] | None = None
-    """Where he stands (m); None places him by the angle, from the ball's spot (the first kick's for a batch)."""
+    """Where he stands (m), in his penalty area (:data:`PENALTY_AREA_DEPTH_M` off the goal line, at most
+    :data:`PENALTY_AREA_HALF_WIDTH_M` either side of the goal's centre); None places him by the angle, from the
+    ball's spot (the first kick's for a batch)."""
     depth_m: float = 1.0
-    """Off the goal line toward the ball, along the bisector (m), when placed by the angle."""
+    """Off the goal line toward the ball, along the bisector (m, 0 to :data:`PENALTY_AREA_DEPTH_M`), when placed by
+    the angle."""
     shift_m: float = 0.0
-    """Sideways shift from the bisector (m, + to the left looking from the goal toward the ball), when placed."""
+    """Sideways shift from the bisector (m, + to the left looking from the goal toward the ball; at most
+    :data:`PENALTY_AREA_HALF_WIDTH_M` either way), when placed."""
     reaction_s: float = 0.25
     """From the ball passing the wall (or the kick) to the start of the dive (s)."""
     push_off_s: float = 0.3
@@ -194,14 +204,31 @@ class Keeper:
     """Half the body's thickness (m)."""
 
     def placed(self, ball_xy: ArrayLike, goal: Panel) -> tuple[float, float]:
-        """Where he stands for a ball at ``ball_xy``: ``position_xy``, or on the bisector of the posts' angle."""
-        if self.position_xy is not None:
-            spot = checked_vector("keeper.position_xy", self.position_xy, 2)
-            return float(spot[0]), float(spot[1])
-        ball = _checks.bounded_array("ball_xy", checked_vector("ball_xy", ball_xy, 2), 1e300)  # no hypot overflows
+        """Where he stands for a ball at ``ball_xy``: ``position_xy``, or on the bisector of the posts' angle.
+
+        Raises ``ValueError`` naming the field where he would stand outside his penalty area: behind his goal line
+        (in the net, where a touch would save a ball already in), or so far out that he plays no part.
+        """
         row = panel_row("goal", goal, standing=True)
         centre, normal = row[0:2], row[2:4]
         along = np.array([-normal[1], normal[0]])
+        if self.position_xy is not None:
+            spot = checked_vector("keeper.position_xy", self.position_xy, 2)
+            out, across = float(-(spot - centre) @ normal), float((spot - centre) @ along)
+            if not (0.0 <= out <= PENALTY_AREA_DEPTH_M and abs(across) <= PENALTY_AREA_HALF_WIDTH_M):
+                raise ValueError(
+                    f"keeper.position_xy must be in his penalty area: 0 to {PENALTY_AREA_DEPTH_M:g} m out from the "
+                    f"goal line and within {PENALTY_AREA_HALF_WIDTH_M:g} m of the goal's centre across it; "
+                    f"{tuple(self.position_xy)!r} is {out:.3g} m out and {across:.3g} m across"
+                )
+            return float(spot[0]), float(spot[1])
+        depth = _checks.finite_number("keeper.depth_m", self.depth_m)
+        if not 0.0 <= depth <= PENALTY_AREA_DEPTH_M:
+            raise ValueError(f"keeper.depth_m must be in [0, {PENALTY_AREA_DEPTH_M:g}] m, got {self.depth_m!r}")
+        shift = _checks.finite_number("keeper.shift_m", self.shift_m)
+        if abs(shift) > PENALTY_AREA_HALF_WIDTH_M:
+            raise ValueError(f"keeper.shift_m must be within ±{PENALTY_AREA_HALF_WIDTH_M:g} m, got {self.shift_m!r}")
+        ball = _checks.bounded_array("ball_xy", checked_vector("ball_xy", ball_xy, 2), 1e300)  # no hypot overflows
         # The bisector of the angle at the ball runs from the ball through the point that splits the goal line in
         # the ratio of the ball's distances to the posts; the keeper stands on it, depth_m out from the line.
         d_right = float(np.hypot(*(ball - (centre - 0.5 * goal.width_m * along))))
@@ -211,8 +238,7 @@ class Keeper:
         length = float(np.hypot(*towards_ball))
         unit = towards_ball / length if length > 0 else -normal
         left = np.array([-unit[1], unit[0]])
-        spot = split + _checks.finite_number("keeper.depth_m", self.depth_m) * unit
-        spot = spot - _checks.finite_number("keeper.shift_m", self.shift_m) * left
+        spot = split + depth * unit - shift * left
         return float(spot[0]), float(spot[1])
 
 
@@ -272,6 +298,12 @@ def pitch_vector(pitch: Pitch, ball_xy: ArrayLike, ground_m: float, radius_m: fl
         )
     vector[play.TURF] = ground_m - radius_m
     vector[play.HALF_WIDTH] = 0.5 * _checks.positive("pitch.pitch_width_m", pitch.pitch_width_m)
+    least = vector[play.GW] + 4.0 * post_radius  # the goal and both posts stand on the pitch
+    if vector[play.HALF_WIDTH] * 2.0 <= least:
+        raise ValueError(
+            f"pitch.pitch_width_m must be more than the goal's width and its posts ({least:g} m), "
+            f"got {pitch.pitch_width_m!r}"
+        )
     vector[play.ROLL_DECEL] = _checks.non_negative(
         "pitch.surface.rolling_deceleration_ms2", pitch.surface.rolling_deceleration_ms2
     )
