@@ -60,6 +60,10 @@ EVENT_KINDS: tuple[str, ...] = ("ground", "post", "bar", "wall", "keeper", "net"
 
 RESERVE_BYTES = 2**31
 """Largest time-major reservation :func:`simulate_batch` makes before it counts the samples first (bytes)."""
+MAX_KICKS = 1_000_000
+"""Most kicks one batch call flies (:func:`simulate_batch`, :func:`simulate_outcomes`), as many as the odds' strikes."""
+MAX_BATCH_BYTES = 2**32
+"""Most memory a batch's trajectories may take (bytes): :func:`simulate_batch` refuses more, naming ``positions``."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -440,6 +444,7 @@ def simulate_batch(
     if rows * k * 56 > RESERVE_BYTES:
         run_rows(fly_rows, k, launches, settings, np.empty((0, k)), np.empty((0, k, 6)), n_samples, endings)
         rows = int(n_samples.max())
+        _refuse_too_large(k, rows)
     t, state = np.empty((rows, k)), np.empty((rows, k, 6))
     run_rows(fly_rows, k, launches, settings, t, state, n_samples, endings)
     width = int(n_samples.max()) if k else 1
@@ -456,6 +461,18 @@ def simulate_batch(
     )
 
 
+def _refuse_too_large(k: int, rows: int, per_sample: int = 56) -> None:
+    """``ValueError`` where K flights of ``rows`` samples each, ``per_sample`` bytes a sample (t, position and
+    velocity: 7 float64), would take more than :data:`MAX_BATCH_BYTES`."""
+    size = k * rows * per_sample
+    if size > MAX_BATCH_BYTES:
+        raise ValueError(
+            f"positions: {k:,} flights of up to {rows:,} samples would take {size / 2**30:.1f} GiB, more than "
+            f"{MAX_BATCH_BYTES / 2**30:g} GiB: give fewer kicks, a coarser dt, an x_stop or a shorter t_max, or "
+            f"use simulate_outcomes() where only the verdicts matter"
+        )
+
+
 def _checked_batch(
     positions: ArrayLike,
     velocities: ArrayLike,
@@ -467,6 +484,8 @@ def _checked_batch(
     """A batch's (14,) settings and its (K, 13) launch rows, checked (``ValueError`` naming the argument)."""
     settings = flight_config(config, options).settings
     launches = kick_rows(positions, velocities, spins, knuckle_seeds)
+    if len(launches) > MAX_KICKS:
+        raise ValueError(f"positions must hold at most {MAX_KICKS:,} kicks in one call, got {len(launches):,}")
     check_launches(launches, settings, batch=True)
     return settings, launches
 
@@ -513,6 +532,7 @@ def pitch_outcomes(
 
 
 def _batch_on_pitch(launches: NDArray[np.float64], settings: NDArray[np.float64], pitch: Pitch) -> BatchTrajectory:
+    _refuse_too_large(len(launches), int(settings[N_STEPS]) + 1 + play.EXTRA_ROWS, per_sample=80)  # + the spin
     t, state, _, events, info, n_samples, endings = _play_batch(
         launches, settings, *_one_pitch(launches, settings, pitch), keep=True
     )
@@ -552,6 +572,11 @@ def outcome(trajectory: Trajectory, wall: Panel, goal: Panel, *, radius_m: float
     """
     radius = _checks.positive("radius_m", radius_m)
     _checks.instance("trajectory", trajectory, Trajectory, "a Trajectory from simulate()")
+    if trajectory.result is not None:
+        raise ValueError(
+            "trajectory was played on a pitch: its verdict, with the posts, the bar, the wall's players and the "
+            f"keeper, is trajectory.result ({trajectory.result!r}); outcome() judges a free flight"
+        )
     crossings = np.empty((2, 4))
     # Judged from a writable copy laid out as a batch's row (times strided, positions and velocities slices of one
     # state array), whatever the flight's own layout or flags (the scene keeps its flights read-only): the package
@@ -585,6 +610,11 @@ def outcome_batch(batch: BatchTrajectory, wall: Panel, goal: Panel, *, radius_m:
     """
     radius = _checks.positive("radius_m", radius_m)
     _checks.instance("batch", batch, BatchTrajectory, "a BatchTrajectory from simulate_batch()")
+    if batch.result is not None:
+        raise ValueError(
+            "batch was played on a pitch: its verdicts, with the posts, the bar, the wall's players and the keeper, "
+            "are batch.result; outcome_batch() judges free flights"
+        )
     k = len(batch.n_samples)
     results, crossings, panels = (
         np.empty(k, dtype=np.int64),

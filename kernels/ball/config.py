@@ -294,7 +294,8 @@ def check_launches(launches: NDArray[np.float64], config: NDArray[np.float64], b
     if low.size:
         which = f"positions[{low[0]}]" if batch else "position"
         raise ValueError(
-            f"{which} starts below the ground: z = {launches[low[0], 2]:g} m < ground_m = {config[GROUND]:g} m"
+            f"{which} starts below the ground: z = {float(launches[low[0], 2])!r} m < ground_m = "
+            f"{float(config[GROUND])!r} m"
         )
     if config[MEASURED]:
         speeds = np.maximum(_safe_norms(launches[:, 3:6]), 1.0)

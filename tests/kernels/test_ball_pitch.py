@@ -15,7 +15,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from kernels import ball
-from kernels.ball import odds, play
+from kernels.ball import api, odds, play
 from kernels.ball.pitch import keeper_slots, pitch_vector
 
 R, G, ALPHA = 0.11, 9.81, 2.0 / 3.0
@@ -683,6 +683,17 @@ def test_drag_crisis_centre_is_a_setting() -> None:
         (ball.Pitch(GOAL, net_depth_m=0.05), "net_depth_m"),
         (ball.Pitch(GOAL, keeper=ball.Keeper(hand_reach_m=1e300)), "hand_reach_m"),
         (ball.Pitch(GOAL, keeper=ball.Keeper(dive_speed_ms=1e6)), "dive_speed_ms"),
+        # A keeper out of his penalty area played as no keeper (a dive still reported), or, standing in the net,
+        # saved balls already over the line; 30 m out was blamed on the kick's position.
+        (ball.Pitch(GOAL, keeper=ball.Keeper(depth_m=-5.0)), r"keeper\.depth_m"),
+        (ball.Pitch(GOAL, keeper=ball.Keeper(depth_m=1e300)), r"keeper\.depth_m"),
+        (ball.Pitch(GOAL, keeper=ball.Keeper(depth_m=30.0)), r"keeper\.depth_m"),
+        (ball.Pitch(GOAL, keeper=ball.Keeper(shift_m=-25.0)), r"keeper\.shift_m"),
+        (ball.Pitch(GOAL, keeper=ball.Keeper(position_xy=(500.0, 0.0))), r"keeper\.position_xy"),
+        (ball.Pitch(GOAL, keeper=ball.Keeper(position_xy=(1.0, 0.0))), r"keeper\.position_xy"),
+        # A pitch narrower than the goal ended every kick "out" with no event.
+        (ball.Pitch(GOAL, pitch_width_m=1.0), r"pitch\.pitch_width_m"),
+        (ball.Pitch(GOAL, pitch_width_m=7.32 + 4 * 0.06), r"pitch\.pitch_width_m"),
         # A 20 m wall counted one player a 0.5 m: refused as "wall_players ... got 40", a field left at None.
         (ball.Pitch(GOAL, ball.Panel(WALL.centre_xy, WALL.normal_xy, 20.0, 1.8)), r"pitch\.wall\.width_m is 20 m"),
     ],
@@ -690,6 +701,84 @@ def test_drag_crisis_centre_is_a_setting() -> None:
 def test_a_bad_pitch_raises_naming_the_field(pitch, name) -> None:
     with pytest.raises(ValueError, match=name):
         ball.simulate((-22.0, 0.0, R), (20.0, 0.0, 3.0), (0.0, 0.0, 0.0), ground_m=R, pitch=pitch)
+
+
+@pytest.mark.parametrize("turn_deg", [0.0, 37.0, 180.0])
+def test_the_keeper_stands_anywhere_in_his_penalty_area_and_nowhere_else(turn_deg: float) -> None:
+    # The area reaches 16.5 m out from the goal line and 20.16 m either side of the goal's centre, in the goal's
+    # own frame whichever way it faces; its edges are in, a millimetre past them is out.
+    a = math.radians(turn_deg)
+    normal = np.array([math.cos(a), math.sin(a)])  # into the goal
+    across = np.array([-normal[1], normal[0]])
+    centre = np.array([3.0, -2.0])
+    goal = ball.Panel(tuple(centre), tuple(normal), 7.32, 2.44)
+    spot = centre - 22.0 * normal
+    for out, side, inside in (
+        (0.0, 0.0, True),
+        (16.5, 20.16, True),
+        (16.5, -20.16, True),
+        (-0.001, 0.0, False),
+        (16.501, 0.0, False),
+        (8.0, 20.161, False),
+        (8.0, -20.161, False),
+    ):
+        where = tuple(centre - out * normal + side * across)
+        keeper = ball.Keeper(position_xy=where)
+        if inside:
+            assert keeper.placed(spot, goal) == pytest.approx(where, abs=1e-12)
+        else:
+            with pytest.raises(ValueError, match=r"keeper\.position_xy must be in his penalty area"):
+                keeper.placed(spot, goal)
+    for depth, shift, inside in ((0.0, 0.0, True), (16.5, 20.16, True), (-1e-9, 0.0, False), (16.5, -20.17, False)):
+        keeper = ball.Keeper(depth_m=depth, shift_m=shift)
+        if inside:
+            keeper.placed(spot, goal)
+        else:
+            with pytest.raises(ValueError, match=r"keeper\.(depth|shift)_m"):
+                keeper.placed(spot, goal)
+
+
+def test_a_flight_played_on_a_pitch_is_not_judged_again_as_a_free_flight() -> None:
+    # outcome() judges a free flight by where it crosses the planes; a saved ball never crosses the goal's, so it
+    # read "short" where the pitch flight's own verdict was "saved".
+    pitch = ball.Pitch(GOAL, None, ball.Keeper())
+    played = ball.simulate((-22.0, 0.0, R), (18.0, 0.0, 2.5), (0.0, 0.0, 0.0), ground_m=R, pitch=pitch)
+    assert played.result == "saved"
+    with pytest.raises(ValueError, match=r"trajectory\.result \('saved'\)"):
+        ball.outcome(played, WALL, GOAL)
+    batch = ball.simulate_batch([(-22.0, 0.0, R)], [(18.0, 0.0, 2.5)], [(0.0, 0.0, 0.0)], ground_m=R, pitch=pitch)
+    with pytest.raises(ValueError, match=r"batch\.result"):
+        ball.outcome_batch(batch, WALL, GOAL)
+
+
+def test_a_batch_too_large_for_memory_or_too_many_kicks_is_refused_naming_positions(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # A million kicks took 8 GB and 44 s; three million would have exhausted the machine.
+    kicks = ([(-22.0, 0.0, R)] * 4, [(20.0, 0.0, 3.0)] * 4, [(0.0, 0.0, 0.0)] * 4)
+    rows = int(4.0 / 0.01) + 1
+    monkeypatch.setattr(api, "MAX_BATCH_BYTES", 4 * rows * 56 - 1)
+    monkeypatch.setattr(api, "RESERVE_BYTES", 0)  # counts the samples first, as a batch over 2 GiB does
+    shortest = ball.simulate_batch(*kicks, dt=0.01, t_max=4.0, x_stop=-10.0)  # short flights fit
+    assert shortest.t.shape[0] == 4
+    with pytest.raises(ValueError, match=r"positions: 4 flights of up to \d+ samples would take"):
+        ball.simulate_batch(*kicks, dt=0.001, t_max=4.0)
+    pitch_rows = int(4.0 / 0.01) + 1 + play.EXTRA_ROWS
+    monkeypatch.setattr(api, "MAX_BATCH_BYTES", 4 * pitch_rows * 80 - 1)
+    with pytest.raises(ValueError, match=r"positions: 4 flights"):
+        ball.simulate_batch(*kicks, dt=0.01, t_max=4.0, ground_m=R, pitch=ball.Pitch(GOAL))
+    monkeypatch.setattr(api, "MAX_BATCH_BYTES", 4 * pitch_rows * 80)
+    assert len(ball.simulate_batch(*kicks, dt=0.01, t_max=4.0, ground_m=R, pitch=ball.Pitch(GOAL)).result) == 4
+    monkeypatch.setattr(api, "MAX_KICKS", 3)
+    for call in (ball.simulate_batch, ball.simulate_outcomes):
+        with pytest.raises(ValueError, match="positions must hold at most 3 kicks in one call, got 4"):
+            call(*kicks)
+
+
+def test_a_float32_start_a_rounding_below_the_ground_says_by_how_much() -> None:
+    # float32(0.11) is 0.1099999994 m: refused as "z = 0.11 m < ground_m = 0.11 m", which reads as a contradiction.
+    with pytest.raises(ValueError, match=r"z = 0\.10999999940395355 m < ground_m = 0\.11 m"):
+        ball.simulate(np.array([-22.0, 0.0, 0.11], dtype=np.float32), (20.0, 0.0, 3.0), (0.0, 0.0, 0.0), ground_m=0.11)
 
 
 def test_a_wall_of_sixteen_players_counted_from_its_width_is_accepted() -> None:
