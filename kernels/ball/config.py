@@ -160,7 +160,7 @@ class FlightConfig:
         step = _checks.positive("dt", self.dt)
         duration = _checks.positive("t_max", self.t_max)
         if duration / step > _MAX_STEPS:
-            raise ValueError(f"dt must be at least t_max/{_MAX_STEPS} = {duration / _MAX_STEPS:g} s, got {step:g}")
+            raise ValueError(f"dt must be at least t_max/{_MAX_STEPS} = {duration / _MAX_STEPS:g} s, got {step!r}")
         if self.method not in ("euler", "rk4"):
             raise ValueError(f"method must be 'euler' or 'rk4', got {self.method!r}")
         if self.model not in ("constant", "measured"):
