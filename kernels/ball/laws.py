@@ -60,7 +60,10 @@ def coefficients(
 
     with Re_c the crisis centre (``drag_crisis_re``, 1.815·10⁵ for the Teamgeist they measured), so a spinless
     ball's drag falls through the drag crisis (0.501 well below, 0.328 at 12.19 m/s, 0.155 well above, for the
-    default ball and air) and a spinning one's grows with S. Computed by the very compiled function
+    default ball and air) and a spinning one's grows with S. The fits were measured up to S ≈ 0.3–0.5; beyond, C_Ds
+    is their extrapolation, which grows without bound as the speed falls at a fixed spin (S → ∞; a speed below
+    10⁻⁹ m/s counts as 10⁻⁹ m/s), so ``coefficients(0, 50)`` gives C_D ≈ 391: the drag force, ∝ C_D·|v|², still
+    goes to zero with the speed. Computed by the very compiled function
     the flight's force law calls (:func:`kernels.ball.aero.drag_lift`); details and sources in :mod:`kernels.ball`.
 
     Args:
