@@ -592,8 +592,19 @@ def heat_cells(p: FreeKickParams | None = None) -> tuple[NDArray[np.float64], ND
     return centres, headings, sizes
 
 
+ODDS_MAP_CAVEAT = (
+    "The keeper reads each ball once, as if it flew straight on, so from far out, where it dips and curls more "
+    "after he reads it, the map scores higher than a real keeper would let it."
+)
+"""Said under the map with a keeper in goal: far-out spots (30–36 m) score more than near ones (docs/freekick.md)."""
+
+
 def odds_map_words(chance: NDArray[np.float64], p: FreeKickParams) -> str:
-    """The map in words: the best spot and its chance, and the chance from the spot nearest the ball's."""
+    """The map in words: the best spot and its chance, the chance from the spot nearest the ball's and, with a keeper,
+    :data:`ODDS_MAP_CAVEAT`; or that no spot scores."""
+    if not np.any(chance > 0.0):
+        return "**No spot on the map scores with this strike.**"
+    caveat = f"  \n{ODDS_MAP_CAVEAT}" if p.keeper else ""
     best = np.unravel_index(int(np.argmax(chance)), chance.shape)
     d, a = ODDS_MAP_DISTANCES_M[best[0]], ODDS_MAP_ANGLES_DEG[best[1]]
     side = "on the centre line" if a == 0 else f"{abs(a):g}° {'left' if a > 0 else 'right'}"
@@ -602,7 +613,7 @@ def odds_map_words(chance: NDArray[np.float64], p: FreeKickParams) -> str:
     j = int(np.argmin(np.abs(ODDS_MAP_ANGLES_DEG - p.angle_deg)))
     if abs(ODDS_MAP_DISTANCES_M[i] - p.distance_m) <= 0.5 and abs(ODDS_MAP_ANGLES_DEG[j] - p.angle_deg) <= 2.5:
         text += f"; from this spot: **{100 * chance[i, j]:.0f} %**"
-    return text
+    return text + caveat
 
 
 ODDS_WORDS = {

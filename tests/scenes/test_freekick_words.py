@@ -5,12 +5,20 @@ from __future__ import annotations
 
 import dataclasses
 
+import numpy as np
 import pytest
 from helpers.scenes import MakeScene
 
 from kernels import ball
 from scenes.freekick import FreeKickParams, FreeKickScene
-from scenes.freekick.model import compute_kick, keeper_words
+from scenes.freekick.model import (
+    ODDS_MAP_ANGLES_DEG,
+    ODDS_MAP_CAVEAT,
+    ODDS_MAP_DISTANCES_M,
+    compute_kick,
+    keeper_words,
+    odds_map_words,
+)
 
 
 @pytest.fixture
@@ -106,3 +114,25 @@ def test_keeper_words_never_give_a_far_distance() -> None:
                 if part in words:
                     metres = float(words.split(part)[1].split(" m")[0])
                     assert metres <= 2.0, (distance, azimuth, words)
+
+
+# ------------------------------------------------------------------------------------------------ goal chance map
+def test_a_map_where_no_spot_scores_names_no_best_spot(scene: FreeKickScene) -> None:
+    # Reported: with every tile 0 % the map still named "Best spot: 16 m, 40° right: goal 0 %".
+    scene.apply(dataclasses.replace(FreeKickParams(), speed_ms=5.0))  # short of the goal from every spot
+    scene.heat_button.value = True  # the click
+    assert scene.wait_idle(300.0)
+    assert scene.odds_map is not None and not scene.odds_map.any()
+    status = scene.heat_status.content
+    assert "No spot on the map scores" in status and "Best spot" not in status
+
+
+def test_the_map_says_where_its_keeper_flatters_far_spots() -> None:
+    # The keeper reads the ball once, as if it flew straight on, so 30–36 m out scores more than 20 m out: the
+    # words beside the best spot say so wherever a keeper is in goal.
+    chance = np.zeros((len(ODDS_MAP_DISTANCES_M), len(ODDS_MAP_ANGLES_DEG)))
+    chance[-2, 8] = 0.9  # the best spot 35 m out
+    with_keeper = odds_map_words(chance, FreeKickParams())
+    assert with_keeper.startswith("Best spot: **35 m, on the centre line: goal 90 %**")
+    assert ODDS_MAP_CAVEAT in with_keeper and "straight on" in ODDS_MAP_CAVEAT
+    assert ODDS_MAP_CAVEAT not in odds_map_words(chance, FreeKickParams(keeper=False))
