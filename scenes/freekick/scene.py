@@ -96,7 +96,7 @@ from scenes.freekick.props import (
     polyline_segments,
     strip_faces,
 )
-from scenes.freekick.views import frame_view
+from scenes.freekick.views import frame_view, view_points
 
 GRASS_HALF_M = 2500.0
 """Half the side (m) of the grass square round the goal: past viser's far clipping plane (1000 m along the view
@@ -443,6 +443,8 @@ of him beats him more often than it would a real keeper.
         self._show_odds_map()
         if moved:  # the ball is on another spot: every view moves with it
             self.framing.reframe()
+        else:  # a higher or wider flight (or its no-spin path) than the view was framed for: frame it again
+            self.framing.keep_in_view(self._framed_points())
 
     # ----------------------------------------------------------------------------------------- camera
     def _on_view(self) -> None:
@@ -452,6 +454,11 @@ of him beats him more often than it would a real keeper.
     def _view_for(self, lens: Lens) -> View:
         shown = self.heat_nodes.visible
         return frame_view(self.params, self.state, self.params.view, lens, self._heat_corners if shown else None)
+
+    def _framed_points(self) -> NDArray[np.float64]:
+        """(N, 3) what the current view keeps in frame (m): :func:`~scenes.freekick.views.view_points`."""
+        shown = self.heat_nodes.visible
+        return view_points(self.params, self.state, self.params.view, self._heat_corners if shown else None)
 
     def apply(self, params: FreeKickParams) -> None:
         """Show ``params``: write every GUI control (without re-running callbacks) and redraw once."""
