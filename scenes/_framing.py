@@ -282,6 +282,19 @@ def beside_notice(
     return [(x0, x1, y0, min(y1, below)), (max(x0, right), x1, y0, y1)]
 
 
+def shows(view: View, lens: Lens, points: NDArray[np.float64], *, slack_px: float = 1.0) -> bool:
+    """Whether a camera at ``view`` shows every one of (N, 3) ``points`` (m) where framing puts them: in front of it,
+    inside the canvas left of the panel (:meth:`Lens.usable_ndc`, give or take ``slack_px``) and none under
+    :data:`NOTICE_PX`."""
+    xy = project_points(view, lens, points)
+    width, height = max(lens.width_px, 1), max(lens.height_px, 1)
+    x0, x1, y0, y1 = lens.usable_ndc()
+    x_ndc, y_ndc = 2.0 * xy[:, 0] / width - 1.0, 1.0 - 2.0 * xy[:, 1] / height
+    sx, sy = 2.0 * slack_px / width, 2.0 * slack_px / height
+    inside = (x_ndc >= x0 - sx) & (x_ndc <= x1 + sx) & (y_ndc >= y0 - sy) & (y_ndc <= y1 + sy)
+    return bool(np.all(inside & (xy[:, 2] >= NEAR_M)) and not in_notice(xy).any())
+
+
 def frame_clear_of_notice(
     points: NDArray[np.float64], direction: tuple[float, float, float], lens: Lens, *, min_depth: float = 0.0
 ) -> View:
@@ -385,6 +398,22 @@ class ClientFraming:
             cameras = list(self._cameras.values())
         for camera in cameras:
             self._frame(camera)
+
+    def keep_in_view(self, points: NDArray[np.float64]) -> None:
+        """Frame again every camera that no longer shows all of (N, 3) ``points`` (m) where framing would put them
+        (:func:`shows`): what the scene shows has grown out of the view, as when a kick flies higher. A camera that
+        still shows them keeps its pose, a person's own included."""
+        with self._lock:
+            cameras = list(self._cameras.values())
+        for camera in cameras:
+            try:
+                lens = Lens(float(camera.fov), int(camera.image_width), int(camera.image_height))
+                (px, py, pz), (lx, ly, lz) = (float(v) for v in camera.position), (float(v) for v in camera.look_at)
+                view = View((px, py, pz), (lx, ly, lz))
+            except (AttributeError, TypeError, ValueError, AssertionError):
+                continue
+            if lens.width_px <= 0 or lens.height_px <= 0 or not shows(view, lens, points):
+                self._frame(camera)
 
     def _frame(self, camera: Any) -> None:
         try:

@@ -351,26 +351,43 @@ def save_margin_s(state: KickState) -> float | None:
     return max(saved.t - first, 0.0)
 
 
+KEEPER_NEAR_M = 2.0
+"""Farthest (m) the keeper's body may stay from a ball that got past him for the readout to say how near he came:
+from farther away the number says nothing about the save."""
+
+
+def dive_words(dive: ball.KeeperDive, spot: tuple[float, float]) -> str:
+    """Which way the keeper standing at ``spot`` (m) goes, in football words: "jumps" (straight up, for a ball
+    read at him), else "dives to his right (your left)" or "dives to his left (your right)": he faces the kicker, so
+    his right is the kicker's left, the side every other readout calls left."""
+    across = dive.target[1] - spot[1]  # + toward the kicker's left
+    if abs(across) < 0.3:
+        return "jumps"
+    return "dives to his right (your left)" if across > 0 else "dives to his left (your right)"
+
+
 def keeper_words(state: KickState) -> str:
-    """What the keeper did, in words: "dives right 0.67 s after the kick, reaches it 0.26 s early", "... the ball
-    beats him by 0.42 m" or "never dives". Empty without a keeper."""
+    """What the keeper did, in words: "dives to his left (your right) 0.67 s after the kick, reaches it 0.26 s
+    early", "... the ball beats him by 0.42 m" or "never dives"; how near he came only when it was within
+    :data:`KEEPER_NEAR_M`. Empty without a keeper."""
     played, spot = state.played, state.keeper_xy
     if played is None or spot is None:
         return ""
     dive = played.keeper_dive
     if dive is None:
         return _why_no_dive(state, played)
-    across = dive.target[1] - spot[1]  # + toward the kicker's left, as every readout says it
-    way = "up" if abs(across) < 0.3 else ("left" if across > 0 else "right")
-    dived = f"dives {way} {dive.t:.2f} s after the kick"
+    dived = f"{dive_words(dive, spot)} {dive.t:.2f} s after the kick"
     margin = save_margin_s(state)
     if margin is not None:
         return f"{dived}, reaches it {margin:.2f} s early"
     # The ball got past: how close his body came to it over the flight.
     gap = keeper_gap_m(ball.keeper_path(KEEPER, spot, dive, played.t), played.position)
     nearest = max(float(gap.min()), 0.0)
-    if played.result == "goal":
-        return f"{dived}; the ball beats him by {nearest:.2f} m"
+    beaten = "; the ball beats him" if played.result == "goal" else ""
+    if nearest > KEEPER_NEAR_M:
+        return f"{dived}{beaten}"
+    if beaten:
+        return f"{dived}{beaten} by {nearest:.2f} m"
     return f"{dived}; gets within {nearest:.2f} m of the ball"
 
 
@@ -404,6 +421,41 @@ def _why_no_dive(state: KickState, played: ball.Trajectory) -> str:
         "over": "it is over the bar",
     }.get(str(played.result), "the play is over")
     return f"never dives: {what} {max(over, 0.0):.2f} s after it passes the wall, before he reacts ({KEEPER.reaction_s:.2f} s)"
+
+
+VERDICT_WORDS: dict[str, str] = {
+    "goal": "GOAL",
+    "wall": "Blocked by the wall",
+    "over": "Over the bar",
+    "wide": "Wide of the post",
+    "short": "Lands short of the goal",
+    "post": "Hits the post",
+    "bar": "Hits the bar",
+    "saved": "Saved",
+}
+"""The readout's headline for each of the kernel's verdicts."""
+
+
+def verdict_words(result: str, crossing: NDArray[np.float64] | None) -> str:
+    """The headline for the kernel's ``result``; ``crossing`` is the (3,) ball centre (m) where it crossed the goal
+    line, or None. The kernel calls every ball outside the posts wide, however high: one that was also above the
+    bar (where, between the posts, it would be over) reads "Wide and over the bar"."""
+    if result == "wide" and crossing is not None and crossing[2] > ball.GOAL_HEIGHT_M - ball.BALL_RADIUS_M:
+        return "Wide and over the bar"
+    return VERDICT_WORDS[result]
+
+
+def goal_line_reached(state: KickState) -> bool:
+    """Whether the ball as played on reaches the goal line where its free flight (:attr:`KickState.outcome`)
+    crosses it: the free flight crosses the goal's plane and the played ball touched nothing but the goal's frame
+    before then (up to its first contact the played flight is the free one). A ball the wall or the keeper stopped,
+    or that bounced first, never got to that crossing."""
+    crossed = state.outcome.goal_time
+    if crossed is None:
+        return False
+    if state.played is None:
+        return True
+    return all(event.t >= crossed or event.kind in ("post", "bar") for event in state.played.events)
 
 
 def keeper_show_time(state: KickState) -> float:
@@ -540,8 +592,19 @@ def heat_cells(p: FreeKickParams | None = None) -> tuple[NDArray[np.float64], ND
     return centres, headings, sizes
 
 
+ODDS_MAP_CAVEAT = (
+    "The keeper reads each ball once, as if it flew straight on, so from far out, where it dips and curls more "
+    "after he reads it, the map scores higher than a real keeper would let it."
+)
+"""Said under the map with a keeper in goal: far-out spots (30–36 m) score more than near ones (docs/freekick.md)."""
+
+
 def odds_map_words(chance: NDArray[np.float64], p: FreeKickParams) -> str:
-    """The map in words: the best spot and its chance, and the chance from the spot nearest the ball's."""
+    """The map in words: the best spot and its chance, the chance from the spot nearest the ball's and, with a keeper,
+    :data:`ODDS_MAP_CAVEAT`; or that no spot scores."""
+    if not np.any(chance > 0.0):
+        return "**No spot on the map scores with this strike.**"
+    caveat = f"  \n{ODDS_MAP_CAVEAT}" if p.keeper else ""
     best = np.unravel_index(int(np.argmax(chance)), chance.shape)
     d, a = ODDS_MAP_DISTANCES_M[best[0]], ODDS_MAP_ANGLES_DEG[best[1]]
     side = "on the centre line" if a == 0 else f"{abs(a):g}° {'left' if a > 0 else 'right'}"
@@ -550,7 +613,7 @@ def odds_map_words(chance: NDArray[np.float64], p: FreeKickParams) -> str:
     j = int(np.argmin(np.abs(ODDS_MAP_ANGLES_DEG - p.angle_deg)))
     if abs(ODDS_MAP_DISTANCES_M[i] - p.distance_m) <= 0.5 and abs(ODDS_MAP_ANGLES_DEG[j] - p.angle_deg) <= 2.5:
         text += f"; from this spot: **{100 * chance[i, j]:.0f} %**"
-    return text
+    return text + caveat
 
 
 ODDS_WORDS = {

@@ -42,6 +42,7 @@ from scenes.freekick.model import (
     PATH_POINTS,
     PRESETS,
     RESULT_COLOURS,
+    VERDICT_WORDS,
     WOBBLE_SCALE,
     FreeKickParams,
     after_contact,
@@ -50,6 +51,7 @@ from scenes.freekick.model import (
     chances_words,
     compute_kick,
     deflection_m,
+    goal_line_reached,
     heat_cells,
     heat_colours,
     keeper_limbs,
@@ -71,6 +73,7 @@ from scenes.freekick.model import (
     spin_words,
     spot_odds_map,
     strike_chances,
+    verdict_words,
     wall_axes,
     wobble_path,
     wobble_words,
@@ -93,7 +96,7 @@ from scenes.freekick.props import (
     polyline_segments,
     strip_faces,
 )
-from scenes.freekick.views import frame_view
+from scenes.freekick.views import frame_view, view_points
 
 GRASS_HALF_M = 2500.0
 """Half the side (m) of the grass square round the goal: past viser's far clipping plane (1000 m along the view
@@ -440,6 +443,8 @@ of him beats him more often than it would a real keeper.
         self._show_odds_map()
         if moved:  # the ball is on another spot: every view moves with it
             self.framing.reframe()
+        else:  # a higher or wider flight (or its no-spin path) than the view was framed for: frame it again
+            self.framing.keep_in_view(self._framed_points())
 
     # ----------------------------------------------------------------------------------------- camera
     def _on_view(self) -> None:
@@ -449,6 +454,11 @@ of him beats him more often than it would a real keeper.
     def _view_for(self, lens: Lens) -> View:
         shown = self.heat_nodes.visible
         return frame_view(self.params, self.state, self.params.view, lens, self._heat_corners if shown else None)
+
+    def _framed_points(self) -> NDArray[np.float64]:
+        """(N, 3) what the current view keeps in frame (m): :func:`~scenes.freekick.views.view_points`."""
+        shown = self.heat_nodes.visible
+        return view_points(self.params, self.state, self.params.view, self._heat_corners if shown else None)
 
     def apply(self, params: FreeKickParams) -> None:
         """Show ``params``: write every GUI control (without re-running callbacks) and redraw once."""
@@ -702,38 +712,31 @@ of him beats him more often than it would a real keeper.
     def readout_markdown(self) -> str:
         state, p = self.state, self.params
         o = state.outcome
-        verdicts = {
-            "goal": "GOAL",
-            "wall": "Blocked by the wall",
-            "over": "Over the bar",
-            "wide": "Wide of the post",
-            "short": "Lands short of the goal",
-            "post": "Hits the post",
-            "bar": "Hits the bar",
-            "saved": "Saved",
-        }
         # The verdict is the pitch's (posts, bar, defenders, turf) wherever the kick is played on; the free flight's
         # crossing of the goal plane is said beside it when it differs (a ball 0.1 m wide of the post's inside edge
         # still strikes the post).
         played = state.played
-        result = played.result if played is not None and played.result in verdicts else o.result
+        result = played.result if played is not None and played.result in VERDICT_WORDS else o.result
+        reached = goal_line_reached(state)  # then the played ball crossed where the free flight does
         wall_height = "never reaches the wall" if o.wall_point is None else f"{o.wall_point[2]:.2f} m"
         margin = save_margin_s(state)
         if result == "saved" and margin is not None:
-            verdicts["saved"] = f"Saved: the keeper reached it {margin:.2f} s early"
-        lines = [f"**{verdicts[result]}**"]
+            headline = f"Saved: the keeper reached it {margin:.2f} s early"
+        else:
+            headline = verdict_words(result, o.goal_point if reached else None)
+        lines = [f"**{headline}**"]
         if result != o.result:
-            lines.append(f"In free flight through the goal plane: {verdicts[o.result]}")
+            lines.append(f"In free flight through the goal plane: {verdict_words(o.result, o.goal_point)}")
         lines += [
             "",
             f"Height at the wall: **{wall_height}** (wall top {state.wall.height_m:.2f} m)",
         ]
-        if o.goal_point is not None and o.goal_time is not None:
+        if reached and o.goal_point is not None and o.goal_time is not None:
             lines.append(
                 f"At the goal line: **y = {o.goal_point[1]:+.2f} m, z = {o.goal_point[2]:.2f} m** after "
                 f"**{o.goal_time:.2f} s**"
             )
-        else:
+        elif o.goal_point is None:
             lines.append(
                 f"Lands after **{float(state.flight.t[-1]):.2f} s**, {-state.flight.position[-1, 0]:.1f} m short"
             )

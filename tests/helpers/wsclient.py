@@ -386,4 +386,8 @@ def connect_tab(server: Any, sessions: Any) -> tuple[BrowserClient, Any]:
     client.wait_for(lambda: sessions.switcher(client_id) is not None, what="its session built")
     switcher = sessions.switcher(client_id)
     assert switcher is not None
+    # Built on the server is not yet shown in the tab: its controls are still on their way. Wait until the tab has
+    # them, as a person cannot pick a scene before the dropdown shows.
+    client.wait_for_gui(switcher.dropdown.label)
+    client.wait_for_gui(switcher.reset_button.label)
     return client, switcher

@@ -1,0 +1,138 @@
+"""The free-kick scene's words: the readout's verdict, goal-line crossing and keeper, and the goal-chance map's
+summary, for kicks a review found misdescribed."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+from helpers.scenes import MakeScene
+
+from kernels import ball
+from scenes.freekick import FreeKickParams, FreeKickScene
+from scenes.freekick.model import (
+    ODDS_MAP_ANGLES_DEG,
+    ODDS_MAP_CAVEAT,
+    ODDS_MAP_DISTANCES_M,
+    compute_kick,
+    keeper_words,
+    odds_map_words,
+)
+
+
+@pytest.fixture
+def scene(show_scene: MakeScene) -> FreeKickScene:
+    shown = show_scene(FreeKickScene)
+    assert shown.wait_idle()
+    return shown
+
+
+def _show(scene: FreeKickScene, **changes: object) -> str:
+    """The readout once the scene shows the default kick with ``changes``."""
+    scene.apply(dataclasses.replace(FreeKickParams(), **changes))  # type: ignore[arg-type]
+    return scene.result.content
+
+
+def _keeper_line(readout: str) -> str:
+    return next(line for line in readout.splitlines() if line.startswith("Keeper"))
+
+
+def test_the_keeper_says_whose_right_he_dives_to(scene: FreeKickScene) -> None:
+    # Reported: "Keeper dives right" for a ball that crossed 4.64 m to the left. He faces the kicker: he dived to
+    # the kicker's right, his own left, reading the ball as if it flew on straight; the words now say whose side.
+    readout = _show(scene, distance_m=40.0, speed_ms=40.0, elevation_deg=50.0)
+    crossing = scene.state.outcome.goal_point
+    dive = scene.state.played.keeper_dive if scene.state.played is not None else None
+    assert crossing is not None and crossing[1] > 4.0 and dive is not None and dive.target[1] < 0.0
+    assert "dives to his left (your right)" in _keeper_line(readout)
+    # The other way round: he goes to his right, the kicker's left.
+    assert "dives to his right (your left)" in _keeper_line(_show(scene, azimuth_deg=-2.0))
+
+
+def test_a_keeper_who_goes_straight_up_jumps(scene: FreeKickScene) -> None:
+    # Reported: a keeper going up for a ball read at him "dives up".
+    line = _keeper_line(_show(scene, azimuth_deg=-7.0))
+    assert "jumps 0.67 s after the kick" in line and "dives" not in line
+
+
+def test_how_near_the_keeper_came_is_said_only_when_he_came_near(scene: FreeKickScene) -> None:
+    # Reported: "gets within 24.04 m of the ball": a distance that large says nothing.
+    far = _keeper_line(_show(scene, distance_m=40.0, speed_ms=40.0, elevation_deg=50.0))
+    assert " m of the ball" not in far and "beats him by" not in far
+    assert "gets within" not in _keeper_line(_show(scene, speed_ms=25.0, wall_jumps=True))
+    near = _keeper_line(_show(scene, azimuth_deg=-12.0, elevation_deg=20.0))  # off the bar, past his hands
+    assert "gets within 0.20 m of the ball" in near
+    assert "the ball beats him by 0.07 m" in _keeper_line(_show(scene, azimuth_deg=-14.0))
+
+
+@pytest.mark.parametrize(
+    "changes",
+    [{"speed_ms": 25.0, "wall_jumps": True}, {"speed_ms": 26.0, "elevation_deg": 13.0}],
+    ids=["jumping wall", "standing wall"],
+)
+def test_a_ball_blocked_by_the_wall_has_no_goal_line_crossing(scene: FreeKickScene, changes: dict) -> None:
+    # Reported: with the ball blocked by the wall the readout said "At the goal line: y = −0.39 m, z = 1.59 m", the
+    # free flight's crossing, for a ball that never got there.
+    readout = _show(scene, **changes)
+    played = scene.state.played
+    assert played is not None and played.result == "wall", changes
+    assert scene.state.outcome.goal_point is not None  # the free flight, through the wall, crosses the line
+    assert readout.startswith("**Blocked by the wall**")
+    assert "At the goal line" not in readout
+
+
+def test_a_ball_that_reaches_the_goal_line_says_where(scene: FreeKickScene) -> None:
+    readout = _show(scene, azimuth_deg=-20.0)
+    crossing = scene.state.outcome.goal_point
+    assert crossing is not None
+    assert f"At the goal line: **y = {crossing[1]:+.2f} m, z = {crossing[2]:.2f} m**" in readout
+
+
+def test_a_ball_wide_and_far_over_the_bar_reads_so(scene: FreeKickScene) -> None:
+    # Reported: "Wide of the post" for a ball crossing the goal line 26.75 m up. The kernel's verdict stays "wide"
+    # (outside the posts it never says over); the headline says it was over the bar's height too.
+    readout = _show(scene, distance_m=40.0, speed_ms=40.0, elevation_deg=50.0)
+    played, crossing = scene.state.played, scene.state.outcome.goal_point
+    assert played is not None and played.result == "wide" and crossing is not None
+    assert crossing[2] > 20.0
+    assert readout.splitlines()[0].strip() == "**Wide and over the bar**"
+    # A ball wide at a keeper's height is wide of the post.
+    readout = _show(scene, azimuth_deg=-20.0)
+    crossing = scene.state.outcome.goal_point
+    assert crossing is not None and crossing[2] < ball.GOAL_HEIGHT_M
+    assert readout.splitlines()[0].strip() == "**Wide of the post**"
+
+
+def test_keeper_words_never_give_a_far_distance() -> None:
+    """Over spots and strikes, the words give how near he came only within a couple of metres."""
+    for distance in (16.0, 25.0, 35.0):
+        for azimuth in (-20.0, -9.0, 5.0, 15.0):
+            p = FreeKickParams(distance_m=distance, azimuth_deg=azimuth)
+            words = keeper_words(compute_kick(p))
+            for part in ("gets within ", "beats him by "):
+                if part in words:
+                    metres = float(words.split(part)[1].split(" m")[0])
+                    assert metres <= 2.0, (distance, azimuth, words)
+
+
+# ------------------------------------------------------------------------------------------------ goal chance map
+def test_a_map_where_no_spot_scores_names_no_best_spot(scene: FreeKickScene) -> None:
+    # Reported: with every tile 0 % the map still named "Best spot: 16 m, 40° right: goal 0 %".
+    scene.apply(dataclasses.replace(FreeKickParams(), speed_ms=5.0))  # short of the goal from every spot
+    scene.heat_button.value = True  # the click
+    assert scene.wait_idle(300.0)
+    assert scene.odds_map is not None and not scene.odds_map.any()
+    status = scene.heat_status.content
+    assert "No spot on the map scores" in status and "Best spot" not in status
+
+
+def test_the_map_says_where_its_keeper_flatters_far_spots() -> None:
+    # The keeper reads the ball once, as if it flew straight on, so 30–36 m out scores more than 20 m out: the
+    # words beside the best spot say so wherever a keeper is in goal.
+    chance = np.zeros((len(ODDS_MAP_DISTANCES_M), len(ODDS_MAP_ANGLES_DEG)))
+    chance[-2, 8] = 0.9  # the best spot 35 m out
+    with_keeper = odds_map_words(chance, FreeKickParams())
+    assert with_keeper.startswith("Best spot: **35 m, on the centre line: goal 90 %**")
+    assert ODDS_MAP_CAVEAT in with_keeper and "straight on" in ODDS_MAP_CAVEAT
+    assert ODDS_MAP_CAVEAT not in odds_map_words(chance, FreeKickParams(keeper=False))
