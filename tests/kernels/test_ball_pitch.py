@@ -768,7 +768,8 @@ def test_a_batch_too_large_for_memory_or_too_many_kicks_is_refused_naming_positi
     with pytest.raises(ValueError, match=r"positions: 4 flights"):
         ball.simulate_batch(*kicks, dt=0.01, t_max=4.0, ground_m=R, pitch=ball.Pitch(GOAL))
     monkeypatch.setattr(api, "MAX_BATCH_BYTES", 4 * pitch_rows * 80)
-    assert len(ball.simulate_batch(*kicks, dt=0.01, t_max=4.0, ground_m=R, pitch=ball.Pitch(GOAL)).result) == 4
+    played = ball.simulate_batch(*kicks, dt=0.01, t_max=4.0, ground_m=R, pitch=ball.Pitch(GOAL))
+    assert played.result is not None and len(played.result) == 4
     monkeypatch.setattr(api, "MAX_KICKS", 3)
     for call in (ball.simulate_batch, ball.simulate_outcomes):
         with pytest.raises(ValueError, match="positions must hold at most 3 kicks in one call, got 4"):
