@@ -371,9 +371,33 @@ def _cached_pitch_vector(pitch: Pitch, spot: tuple[float, float], ground: float,
     return vector
 
 
+def _plain(value: object) -> bool:
+    """Whether every number in ``value`` (a pitch: dataclasses and tuples of numbers) is a plain ``float`` or
+    ``int``. Only then may a cache keyed on equality stand in for the checks: ``True == 1.0`` and
+    ``Decimal(1) == 1.0``, with equal hashes, where the checks refuse a bool or a Decimal."""
+    stack = [value]
+    while stack:
+        item = stack.pop()
+        kind = type(item)
+        if kind is float or kind is int or item is None:
+            continue
+        if kind is tuple:
+            stack.extend(item)  # type: ignore[arg-type]
+        elif hasattr(item, "__dataclass_fields__"):
+            stack.extend(vars(item).values())
+        else:
+            return False
+    return True
+
+
 def _pitch_vector(pitch: Pitch, spot: NDArray[np.float64], ground: float, radius: float) -> NDArray[np.float64]:
-    """:func:`pitch_vector`, cached for a pitch flown again from the same spot (the checks cost more than a kick)."""
+    """:func:`pitch_vector`, cached for a pitch flown again from the same spot (the checks cost more than a kick),
+    where its numbers are plain (:func:`_plain`)."""
     _checks.instance("pitch", pitch, Pitch)
+    if not _plain(pitch):
+        vector = pitch_vector(pitch, spot, ground, radius)
+        vector.setflags(write=False)
+        return vector
     try:
         return _cached_pitch_vector(pitch, (float(spot[0]), float(spot[1])), ground, radius)
     except TypeError:  # a field that cannot be hashed (an array where a tuple belongs): checked uncached
@@ -384,6 +408,7 @@ def _pitch_vector(pitch: Pitch, spot: NDArray[np.float64], ground: float, radius
 
 def _simulate_on_pitch(launch: NDArray[np.float64], settings: NDArray[np.float64], pitch: Pitch) -> Trajectory:
     vector = _pitch_vector(pitch, launch[:2], float(settings[GROUND]), float(settings[RADIUS]))
+    _refuse_off_pitch(launch[None], vector[None], _FIRST)
     rows = int(settings[N_STEPS]) + 1 + play.EXTRA_ROWS
     t, state, spin, forces = np.empty(rows), np.empty((rows, 6)), np.empty((rows, 3)), np.empty((rows, 12))
     events, info = np.empty((play.MAX_EVENTS, 5)), np.empty(play.N_INFO)
@@ -461,6 +486,30 @@ def simulate_batch(
     )
 
 
+_FIRST = np.zeros(1, dtype=np.int64)
+MAX_PITCH_LENGTH_M = 120.0
+"""How far from the goal line a kick on a pitch may start (m; Law 1: a touchline is 90–120 m long)."""
+
+
+def _refuse_off_pitch(launches: NDArray[np.float64], pitches: NDArray[np.float64], which: NDArray[np.int64]) -> None:
+    """``ValueError`` naming the first kick that starts off its pitch: behind the goal line (it would fly in through
+    the back of the net), more than :data:`MAX_PITCH_LENGTH_M` in front of it, or beyond a touchline."""
+    rows = pitches[which]
+    dx, dy = launches[:, 0] - rows[:, play.GX], launches[:, 1] - rows[:, play.GY]
+    depth = dx * rows[:, play.GNX] + dy * rows[:, play.GNY]  # + behind the goal line
+    across = -dx * rows[:, play.GNY] + dy * rows[:, play.GNX]
+    off = np.flatnonzero((depth > 0.0) | (depth < -MAX_PITCH_LENGTH_M) | (np.abs(across) > rows[:, play.HALF_WIDTH]))
+    if off.size:
+        k = int(off[0])
+        which_kick = f"positions[{k}]" if len(launches) > 1 else "position"
+        raise ValueError(
+            f"{which_kick} must be on the pitch, in front of the goal line (at most {MAX_PITCH_LENGTH_M:g} m) and "
+            f"between the touchlines; {launches[k, :3].tolist()} m is {abs(depth[k]):.4g} m "
+            f"{'behind' if depth[k] > 0.0 else 'in front of'} the line and {across[k]:.4g} m across (the touchlines "
+            f"are ±{rows[k, play.HALF_WIDTH]:g} m)"
+        )
+
+
 def _refuse_too_large(k: int, rows: int, per_sample: int = 56) -> None:
     """``ValueError`` where K flights of ``rows`` samples each, ``per_sample`` bytes a sample (t, position and
     velocity: 7 float64), would take more than :data:`MAX_BATCH_BYTES`."""
@@ -501,6 +550,7 @@ def _play_batch(
     events, info, n_samples, endings); flights kept only when ``keep`` (else zero-length rows, and each flight ends
     once its verdict cannot change)."""
     k = len(launches)
+    _refuse_off_pitch(launches, pitches, which)
     rows = int(settings[N_STEPS]) + 1 + play.EXTRA_ROWS if keep else 0
     t, state, spin = np.empty((k, rows)), np.empty((k, rows, 6)), np.empty((k, rows, 3))
     events, info = np.empty((k, play.MAX_EVENTS, 5)), np.empty((k, play.N_INFO))

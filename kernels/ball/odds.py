@@ -23,7 +23,15 @@ from kernels.ball import play
 from kernels.ball.api import pitch_outcomes, simulate_outcomes
 from kernels.ball.config import GROUND, RADIUS, check_launches, checked_seed, checked_vector, flight_config
 from kernels.ball.core import RESULTS
-from kernels.ball.pitch import WALL_DISTANCE_M, Keeper, Pitch, Surface, free_kick_panels, pitch_vector
+from kernels.ball.pitch import (
+    PITCH_WIDTH_M,
+    WALL_DISTANCE_M,
+    Keeper,
+    Pitch,
+    Surface,
+    free_kick_panels,
+    pitch_vector,
+)
 
 MAX_STRIKES = 1_000_000
 """Most strikes one call flies (:func:`odds_map`: spots × ``n``): a million take about 17 s on 2 cores."""
@@ -218,6 +226,14 @@ def odds_map(
         )
     if not (np.abs(angles) < 0.5 * math.pi).all():
         raise ValueError(f"angles_rad must be in (−π/2, π/2) (in front of the goal line), got {angles_rad!r}")
+    half_width = 0.5 * PITCH_WIDTH_M
+    across = np.abs(np.outer(distances, np.sin(angles)))
+    if (across > half_width).any():
+        i, j = np.unravel_index(int(np.argmax(across)), across.shape)
+        raise ValueError(
+            f"distances_m and angles_rad must put every spot on the pitch: {distances[i]:g} m at {angles[j]:g} rad is "
+            f"{across[i, j]:.4g} m from the goal's centre line, beyond the touchline at {half_width:g} m"
+        )
     _checks.finite_number("aim_rad", aim_rad)
     _checks.integer("n", n, 1)
     _strike_count("n", n * len(distances) * len(angles), len(distances) * len(angles), "n × spots")

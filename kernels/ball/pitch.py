@@ -43,7 +43,7 @@ class Panel:
 def free_kick_panels(
     ball_xy: ArrayLike,
     goal_centre_xy: ArrayLike = (0.0, 0.0),
-    goal_normal_xy: ArrayLike = (-1.0, 0.0),
+    goal_normal_xy: ArrayLike | None = None,
     *,
     wall_width_m: float = 2.0,
     wall_height_m: float = 1.8,
@@ -54,7 +54,9 @@ def free_kick_panels(
     Args:
         ball_xy: (2,) ball position on the ground (m).
         goal_centre_xy: (2,) centre of the goal line (m).
-        goal_normal_xy: (2,) direction from the pitch into the net.
+        goal_normal_xy: (2,) direction from the pitch into the net; None: along x, away from the ball (the goal
+            line across the x axis, as the scene lays the pitch out). It must point away from the ball: a goal
+            facing the kick the wrong way round is refused.
         wall_width_m: wall width (m), about 0.5 m a defender.
         wall_height_m: height of the defenders' heads (m), more when they jump.
         wall_offset_m: shift of the wall's centre to the left of the ball-to-goal line (m).
@@ -64,9 +66,16 @@ def free_kick_panels(
     """
     ball = checked_vector("ball_xy", ball_xy, 2)
     centre = checked_vector("goal_centre_xy", goal_centre_xy, 2)
+    if goal_normal_xy is None:
+        goal_normal_xy = (1.0 if centre[0] >= ball[0] else -1.0, 0.0)
     normal = checked_vector("goal_normal_xy", goal_normal_xy, 2)
     if not normal.any():
         raise ValueError("goal_normal_xy must not be zero")
+    if float((centre - ball) @ normal) <= 0.0:
+        raise ValueError(
+            f"goal_normal_xy points from the pitch into the net, away from the ball; {tuple(normal.tolist())!r} "
+            f"points from the goal at {tuple(centre.tolist())!r} toward the ball at {tuple(ball.tolist())!r}"
+        )
     aim = centre - ball
     distance = float(np.hypot(*aim))
     if distance <= WALL_DISTANCE_M:
@@ -152,6 +161,8 @@ BODY = Surface(restitution=0.4, friction=0.5, tangential_restitution=0.0, rollin
 published value was found."""
 
 
+PITCH_WIDTH_M = 68.0
+"""A pitch's width between the touchlines (m; 68 m for international matches, Law 1: 64–75 m)."""
 PENALTY_AREA_DEPTH_M = 16.5
 """How far the penalty area reaches out from the goal line (m; Law 1: 16.5 m, 18 yd)."""
 PENALTY_AREA_HALF_WIDTH_M = 20.16
@@ -265,7 +276,7 @@ class Pitch:
     net_depth_m: float = 2.0
     wall_players: int | None = None
     """Players in the wall; None: one per 0.5 m of its width."""
-    pitch_width_m: float = 68.0
+    pitch_width_m: float = PITCH_WIDTH_M
     roll_speed_ms: float = 0.5
     """A ground bounce leaving less than this upward (a hop under 1.3 cm) starts the roll (m/s)."""
 

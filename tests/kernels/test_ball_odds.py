@@ -218,9 +218,15 @@ def test_a_bad_odds_map_grid_or_progress_raises_naming_it(kwargs, name) -> None:
 
 
 def test_the_odds_maps_edges_are_accepted() -> None:
-    edges = odds.odds_map([9.2, 120.0], [-1.5, 1.5], 25.0, 0.3, 0.0, SPIN, n=2, progress=lambda share: None, **OPTIONS)
-    assert edges["goal"].shape == (2, 2)
-    np.testing.assert_allclose(sum(edges.values()), 1.0)
+    # The farthest spot straight out, and the widest angle as far out as the touchline (34 m from the centre line)
+    # allows; a spot beyond the touchline is refused (120 m at 1.5 rad had been played 120 m off the pitch).
+    for distances, angles in (([9.2, 120.0], [0.0]), ([9.2, 34.0 / math.sin(1.5)], [-1.5, 1.5])):
+        edges = odds.odds_map(distances, angles, 25.0, 0.3, 0.0, SPIN, n=2, progress=lambda share: None, **OPTIONS)
+        assert edges["goal"].shape == (2, len(angles))
+        np.testing.assert_allclose(sum(edges.values()), 1.0)
+    for distances, angles in (([120.0], [1.5]), ([34.01 / math.sin(0.5)], [-0.5])):
+        with pytest.raises(ValueError, match=r"distances_m and angles_rad must put every spot on the pitch"):
+            odds.odds_map(distances, angles, 25.0, 0.3, 0.0, SPIN, n=2, **OPTIONS)
 
 
 @pytest.mark.parametrize(

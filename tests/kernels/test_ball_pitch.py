@@ -7,6 +7,8 @@ from __future__ import annotations
 import dataclasses
 import math
 from collections.abc import Callable
+from decimal import Decimal
+from fractions import Fraction
 from typing import Any
 
 import numpy as np
@@ -558,7 +560,8 @@ def test_balls_dropped_onto_the_wall_and_the_frame_end_honestly(method: str) -> 
     on_wall = rng.random(k) < 0.5
     starts = np.column_stack(
         [
-            np.where(on_wall, -12.85 + rng.uniform(-0.3, 0.3, k), rng.uniform(-0.3, 0.3, k)),
+            # (onto the frame from the pitch's side of the goal line: a kick starts on the pitch)
+            np.where(on_wall, -12.85 + rng.uniform(-0.3, 0.3, k), rng.uniform(-0.3, 0.0, k)),
             np.where(on_wall, rng.uniform(-1.2, 1.2, k), rng.uniform(-4.0, 4.0, k)),
             rng.uniform(2.6, 5.0, k),
         ]
@@ -736,6 +739,65 @@ def test_the_keeper_stands_anywhere_in_his_penalty_area_and_nowhere_else(turn_de
         else:
             with pytest.raises(ValueError, match=r"keeper\.(depth|shift)_m"):
                 keeper.placed(spot, goal)
+
+
+def test_the_default_goal_faces_away_from_the_ball_and_a_goal_facing_it_is_refused() -> None:
+    # The default normal was (−1, 0) for a ball at x < 0: the kick flew through the goal from behind, "short".
+    for spot, into_the_net in (((-22.0, 0.0), (1.0, 0.0)), ((22.0, 5.0), (-1.0, 0.0))):
+        wall, goal = ball.free_kick_panels(spot)
+        assert goal.normal_xy == into_the_net
+        assert wall.normal_xy[0] == pytest.approx(into_the_net[0], abs=0.3)
+    wall, goal = ball.free_kick_panels((-22.0, 0.0))
+    flight = ball.simulate((-22.0, 0.0, R), (25.0, 0.0, 4.0), (0.0, 0.0, 0.0), ground_m=R, pitch=ball.Pitch(goal))
+    assert flight.result == "goal"
+    for spot, normal in (((-22.0, 0.0), (-1.0, 0.0)), ((-22.0, 0.0), (0.0, 1.0)), ((22.0, 0.0), (1.0, 0.0))):
+        with pytest.raises(ValueError, match=r"goal_normal_xy points from the pitch into the net, away from the ball"):
+            ball.free_kick_panels(spot, (0.0, 0.0), normal)
+
+
+@pytest.mark.parametrize(
+    ("start", "on_the_pitch"),
+    [
+        ((-22.0, 0.0, R), True),
+        ((0.0, 0.0, 2 * R), True),  # on the goal line
+        ((-120.0, 0.0, R), True),
+        ((-30.0, 34.0, R), True),  # on a touchline
+        ((-30.0, -34.0, R), True),
+        ((10.0, 0.0, R), False),  # behind the goal: it flew in through the back of the net and out up the pitch
+        ((0.001, 5.0, R), False),
+        ((-120.001, 0.0, R), False),
+        ((-22.0, 100.0, R), False),  # beyond a touchline: "out" after 1 ms
+        ((-22.0, -34.001, R), False),
+        ((1e300, 0.0, R), False),  # ran for 5 s and came back "short"
+        ((-1e300, 0.0, R), False),
+    ],
+)
+def test_a_kick_on_a_pitch_starts_on_it(start, on_the_pitch) -> None:
+    pitch = ball.Pitch(GOAL)
+    velocity = (-5.0 if start[0] > 0 else 20.0, 0.0, 3.0)
+    calls = (
+        lambda: ball.simulate(start, velocity, (0.0, 0.0, 0.0), ground_m=R, pitch=pitch),
+        lambda: ball.simulate_batch(
+            [(-22.0, 0.0, R), start], [velocity] * 2, [(0.0, 0.0, 0.0)] * 2, ground_m=R, pitch=pitch
+        ),
+        lambda: ball.simulate_outcomes([start], [velocity], [(0.0, 0.0, 0.0)], ground_m=R, pitch=pitch),
+    )
+    for name, call in zip(("position", r"positions\[1\]", "position"), calls, strict=True):
+        if on_the_pitch:
+            call()
+        else:
+            with pytest.raises(ValueError, match=name + r" must be on the pitch, in front of the goal line"):
+                call()
+
+
+@pytest.mark.parametrize("odd", [True, np.True_, Decimal(1), Fraction(1)])
+def test_a_pitch_equal_to_a_checked_one_is_still_checked(odd) -> None:
+    # Pitches are cached by equality, and True == Decimal(1) == 1.0 with one hash: a keeper 1 m out was flown, then
+    # Keeper(depth_m=True) was taken from the cache where the checks refuse it.
+    kick = ((-22.0, 0.0, R), (25.0, 0.0, 3.0), (0.0, 0.0, 0.0))
+    ball.simulate(*kick, ground_m=R, pitch=ball.Pitch(GOAL, WALL, ball.Keeper(depth_m=1.0)))
+    with pytest.raises(ValueError, match=r"keeper\.depth_m must be a finite number"):
+        ball.simulate(*kick, ground_m=R, pitch=ball.Pitch(GOAL, WALL, ball.Keeper(depth_m=odd)))
 
 
 def test_a_flight_played_on_a_pitch_is_not_judged_again_as_a_free_flight() -> None:
