@@ -408,7 +408,7 @@ def _pitch_vector(pitch: Pitch, spot: NDArray[np.float64], ground: float, radius
 
 def _simulate_on_pitch(launch: NDArray[np.float64], settings: NDArray[np.float64], pitch: Pitch) -> Trajectory:
     vector = _pitch_vector(pitch, launch[:2], float(settings[GROUND]), float(settings[RADIUS]))
-    _refuse_off_pitch(launch[None], vector[None], _FIRST)
+    _refuse_off_pitch(launch[None], vector[None], _FIRST, settings)
     rows = int(settings[N_STEPS]) + 1 + play.EXTRA_ROWS
     t, state, spin, forces = np.empty(rows), np.empty((rows, 6)), np.empty((rows, 3)), np.empty((rows, 12))
     events, info = np.empty((play.MAX_EVENTS, 5)), np.empty(play.N_INFO)
@@ -491,9 +491,22 @@ MAX_PITCH_LENGTH_M = 120.0
 """How far from the goal line a kick on a pitch may start (m; Law 1: a touchline is 90–120 m long)."""
 
 
-def _refuse_off_pitch(launches: NDArray[np.float64], pitches: NDArray[np.float64], which: NDArray[np.int64]) -> None:
-    """``ValueError`` naming the first kick that starts off its pitch: behind the goal line (it would fly in through
-    the back of the net), more than :data:`MAX_PITCH_LENGTH_M` in front of it, or beyond a touchline."""
+MAX_PITCH_DT_S = 0.05
+"""The longest step a flight on a pitch takes (s): contacts are found once a step, with the keeper where he is at its
+middle, so a coarser step can decide the verdict (the default kick, a goal at dt ≤ 0.1 s, was saved at 0.3 s)."""
+
+
+def _refuse_off_pitch(
+    launches: NDArray[np.float64], pitches: NDArray[np.float64], which: NDArray[np.int64], settings: NDArray[np.float64]
+) -> None:
+    """``ValueError`` naming ``dt`` where it is over :data:`MAX_PITCH_DT_S`, or the first kick that starts off its
+    pitch: behind the goal line (it would fly in through the back of the net), more than
+    :data:`MAX_PITCH_LENGTH_M` in front of it, or beyond a touchline."""
+    if settings[DT] > MAX_PITCH_DT_S:
+        raise ValueError(
+            f"dt must be at most {MAX_PITCH_DT_S:g} s on a pitch (contacts are found once a step), got "
+            f"{float(settings[DT])!r}"
+        )
     rows = pitches[which]
     dx, dy = launches[:, 0] - rows[:, play.GX], launches[:, 1] - rows[:, play.GY]
     depth = dx * rows[:, play.GNX] + dy * rows[:, play.GNY]  # + behind the goal line
@@ -550,7 +563,7 @@ def _play_batch(
     events, info, n_samples, endings); flights kept only when ``keep`` (else zero-length rows, and each flight ends
     once its verdict cannot change)."""
     k = len(launches)
-    _refuse_off_pitch(launches, pitches, which)
+    _refuse_off_pitch(launches, pitches, which, settings)
     rows = int(settings[N_STEPS]) + 1 + play.EXTRA_ROWS if keep else 0
     t, state, spin = np.empty((k, rows)), np.empty((k, rows, 6)), np.empty((k, rows, 3))
     events, info = np.empty((k, play.MAX_EVENTS, 5)), np.empty((k, play.N_INFO))

@@ -49,6 +49,8 @@ Model = Literal["constant", "measured"]
 _MAX_STEPS = 1_000_000
 
 # The compiled cores read their settings from one float64 vector; these are its slots.
+MAX_BALL_RADIUS_M = 1.0
+"""The largest ball a flight takes (m; a football's radius is 0.11 m): a 1e9 m ball was refused as a shallow net."""
 Q, GRAVITY, RADIUS, RE_PER_SPEED, C_D, C_L, MASS, DT, GROUND, X_STOP = range(10)
 N_STEPS, RK4, MEASURED, T_MAX, RE_CRISIS = 10, 11, 12, 13, 14
 
@@ -169,6 +171,8 @@ class FlightConfig:
         c_l = _checks.non_negative("lift_coefficient", self.lift_coefficient)
         mass = _checks.positive("mass_kg", self.mass_kg)
         radius = _checks.positive("radius_m", self.radius_m)
+        if radius > MAX_BALL_RADIUS_M:
+            raise ValueError(f"radius_m must be at most {MAX_BALL_RADIUS_M:g} m (a ball), got {self.radius_m!r}")
         density = _checks.non_negative("air_density", self.air_density)
         g = _checks.finite_number("gravity", self.gravity)
         stop = math.inf if self.x_stop is None else _checks.finite_number("x_stop", self.x_stop)

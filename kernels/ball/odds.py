@@ -35,6 +35,8 @@ from kernels.ball.pitch import (
 
 MAX_STRIKES = 1_000_000
 """Most strikes one call flies (:func:`odds_map`: spots × ``n``): a million take about 17 s on 2 cores."""
+MAX_STRIKE_SPEED_MS = 100.0
+"""The fastest strike the odds take (m/s; the fastest recorded shots are about 60 m/s): 1e9 m/s was blamed on dt."""
 MAX_DISTANCE_M = 120.0
 """The farthest spot of :func:`odds_map`: the longest pitch Law 1 allows."""
 
@@ -107,6 +109,8 @@ def draw_strikes(
     normal angle in a uniformly drawn direction. The first strike is always the kick itself.
     """
     speed_ms = _checks.non_negative("speed_ms", speed_ms)
+    if speed_ms > MAX_STRIKE_SPEED_MS:
+        raise ValueError(f"speed_ms must be at most {MAX_STRIKE_SPEED_MS:g} m/s (a strike), got {speed_ms!r}")
     elevation_rad = _checks.finite_number("elevation_rad", elevation_rad)
     azimuth_rad = _checks.finite_number("azimuth_rad", azimuth_rad)
     spin = checked_vector("spin_rads", spin_rads, 3)

@@ -161,6 +161,9 @@ BODY = Surface(restitution=0.4, friction=0.5, tangential_restitution=0.0, rollin
 published value was found."""
 
 
+MAX_POST_RADIUS_M = 0.5
+"""The thickest post or bar a pitch takes (m, radius; Law 1 allows at most 0.06): a 5 m post was refused as a net too
+shallow for it."""
 PITCH_WIDTH_M = 68.0
 """A pitch's width between the touchlines (m; 68 m for international matches, Law 1: 64–75 m)."""
 PENALTY_AREA_DEPTH_M = 16.5
@@ -300,7 +303,7 @@ def pitch_vector(pitch: Pitch, ball_xy: ArrayLike, ground_m: float, radius_m: fl
         _checks.instance(f"pitch.{name}", getattr(pitch, name), Surface)
     vector = np.zeros(play.N_PITCH)
     vector[play.GX : play.GH + 1] = panel_row("pitch.goal", pitch.goal, standing=True)
-    post_radius = vector[play.POST_R] = _checks.positive("pitch.post_radius_m", pitch.post_radius_m)
+    post_radius = vector[play.POST_R] = _within("pitch.post_radius_m", pitch.post_radius_m, MAX_POST_RADIUS_M)
     vector[play.NET_DEPTH] = _checks.positive("pitch.net_depth_m", pitch.net_depth_m)
     if vector[play.NET_DEPTH] <= 2.0 * radius_m + post_radius:  # room for the whole ball over the line (a goal)
         raise ValueError(

@@ -669,6 +669,7 @@ def test_drag_crisis_centre_is_a_setting() -> None:
     ("pitch", "name"),
     [
         (ball.Pitch(GOAL, post_radius_m=0.0), "post_radius_m"),
+        (ball.Pitch(GOAL, post_radius_m=5.0), r"pitch\.post_radius_m must be at most 0\.5"),  # blamed net_depth_m
         (ball.Pitch(GOAL, surface=ball.Surface(restitution=1.5)), "restitution"),
         (ball.Pitch(GOAL, surface=ball.Surface(friction=-1.0)), "friction"),
         (ball.Pitch(GOAL, WALL, wall_players=0), "wall_players"),
@@ -798,6 +799,40 @@ def test_a_pitch_equal_to_a_checked_one_is_still_checked(odd) -> None:
     ball.simulate(*kick, ground_m=R, pitch=ball.Pitch(GOAL, WALL, ball.Keeper(depth_m=1.0)))
     with pytest.raises(ValueError, match=r"keeper\.depth_m must be a finite number"):
         ball.simulate(*kick, ground_m=R, pitch=ball.Pitch(GOAL, WALL, ball.Keeper(depth_m=odd)))
+
+
+def test_a_huge_ball_or_strike_is_refused_by_its_own_name() -> None:
+    # A 1e9 m ball was refused as "pitch.net_depth_m must be more than ...", a 1e9 m/s strike as a too long dt.
+    kick = ((-22.0, 0.0, R), (25.0, 0.0, 3.0), (0.0, 0.0, 0.0))
+    with pytest.raises(ValueError, match=r"^radius_m must be at most 1 m"):
+        ball.simulate(*kick, radius_m=1e9, pitch=ball.Pitch(GOAL))
+    big = ((-22.0, 0.0, 1.0), *kick[1:])
+    assert ball.simulate(
+        *big, radius_m=1.0, ground_m=1.0, pitch=ball.Pitch(GOAL, net_depth_m=3.0)
+    ).result  # the largest
+    with pytest.raises(ValueError, match=r"^speed_ms must be at most 100 m/s"):
+        odds.strike_odds((-22.0, 0.0, R), 1e9, 0.3, 0.0, (0.0, 0.0, 0.0), ball.Pitch(GOAL), n=2, ground_m=R)
+    fastest = odds.strike_odds((-22.0, 0.0, R), 100.0, 0.1, 0.0, (0.0, 0.0, 0.0), ball.Pitch(GOAL), n=2, ground_m=R)
+    assert fastest.n == 2 and sum(fastest.counts.values()) == 2
+
+
+def test_a_step_too_coarse_to_find_the_contacts_is_refused_on_a_pitch() -> None:
+    # A kick that was a goal at every dt up to 0.1 s was "saved" at 0.3, 0.5 and 1 s: the keeper is met once a
+    # step, where he is at its middle. Up to 0.05 s this kick's verdict stands; beyond, dt is refused on a pitch.
+    kick = ((-22.0, 0.0, R), ball.launch_velocity(25.0, math.radians(17.0), math.radians(-9.0)))
+    spin = ball.spin_vector(8.0, (0.0, 0.0, 1.0))
+    pitch = ball.Pitch(GOAL, WALL, ball.Keeper())
+    options = {"method": "rk4", "model": "measured", "ground_m": R}
+    verdicts = {dt: ball.simulate(*kick, spin, dt=dt, pitch=pitch, **options).result for dt in (0.001, 0.01, 0.05)}
+    assert len(set(verdicts.values())) == 1, verdicts
+    for call in (
+        lambda: ball.simulate(*kick, spin, dt=0.3, pitch=pitch, **options),
+        lambda: ball.simulate_batch([kick[0]], [kick[1]], [spin], dt=0.051, pitch=pitch, **options),
+        lambda: ball.simulate_outcomes([kick[0]], [kick[1]], [spin], dt=1.0, pitch=pitch, **options),
+    ):
+        with pytest.raises(ValueError, match=r"^dt must be at most 0\.05 s on a pitch"):
+            call()
+    assert ball.simulate(*kick, spin, dt=0.3, **options).ended == "ground"  # without a pitch it is the user's
 
 
 def test_a_flight_played_on_a_pitch_is_not_judged_again_as_a_free_flight() -> None:
