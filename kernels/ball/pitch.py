@@ -179,7 +179,9 @@ class Keeper:
     He stands (upright, fingertips at ``com_height_m + hand_reach_m``) on the bisector of the angle the two posts
     make at the ball, ``depth_m`` off his line (shifted ``shift_m`` to his left, looking out), until a reaction time
     after the ball passes the wall (after the kick without a wall). Then he reads where the ball, flying straight on
-    under gravity, will cross the goal line (within the goal) and dives: his centre of mass accelerates uniformly
+    under gravity, will cross the goal line, again each step until that is within 1.5 s and within his hands' reach
+    of the goal (a slow roll, a ball going away or far wide or over draws no dive), and dives for that point
+    (brought within the goal): his centre of mass accelerates uniformly
     for ``push_off_s`` to ``dive_speed_ms``, then keeps it, along the straight line that puts his fingertips there,
     while the stick turns from upright to point at it over ``turn_s``. A ball that touches him is saved.
 

@@ -67,6 +67,9 @@ EXTRA_ROWS = 2 * MAX_EVENTS + 2
 GROUND_HIT, POST, BAR, WALL, KEEPER, NET = range(6)
 ENDED_X_STOP, ENDED_T_MAX, DIVERGED, REFUSED, STOPPED, IN_NET, OUT, SAVED, INSIDE, CONTACTS = range(1, 11)
 GOAL, WALL_RESULT, OVER, WIDE, SHORT, POST_RESULT, BAR_RESULT, SAVED_RESULT = range(8)
+DIVE_HORIZON_S = 1.5
+"""The keeper dives only for a ball that his read puts on his line within this time (s), within his hands' reach of
+the goal; until then he stands and reads it again each step (a slow roll or a ball far over the bar draws no dive)."""
 
 # Slots of a flight's (N_INFO,) summary.
 I_RESULT, I_WALL, I_GOAL, I_EVENTS, I_DIVE, I_TARGET, I_FIRST = 0, 1, 5, 9, 10, 11, 14
@@ -517,21 +520,27 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
         h = min(dt, t_max - t)
         if h <= 1e-12 * max(dt, 1.0):
             break
-        # The keeper reads the ball a reaction time after it passes the wall (or after the kick).
+        # The keeper reads the ball a reaction time after it passes the wall (or after the kick), and again each
+        # step until it will reach his line within DIVE_HORIZON_S, within his hands' reach of the goal: then he dives.
         if keeper and dive_t == math.inf and t >= seen_t + pitch[K_REACT]:
-            dive_t = t
             depth = (x - gx) * gnx + (y - gy) * gny
             approach = vx * gnx + vy * gny
-            lead = -depth / approach if approach > 1e-9 and depth < 0.0 else 0.0
-            lead = min(lead, 3.0)
-            lateral = -(x + vx * lead - gx) * gny + (y + vy * lead - gy) * gnx
-            lateral = min(max(lateral, -half_goal), half_goal)
-            height = min(max(z + vz * lead - 0.5 * g * lead * lead, turf + radius), turf + pitch[GH])
-            target[0], target[1], target[2] = gx - lateral * gny, gy + lateral * gnx, height
-            info[I_DIVE] = dive_t
-            info[I_TARGET], info[I_TARGET + 1], info[I_TARGET + 2] = target[0], target[1], target[2]
-            _keeper_box(pitch, dive_t, target, radius + 1e-3, boxes)
-            keeper_box = _box(boxes, 2)
+            lead = -depth / approach if approach > 1e-9 and depth < 0.0 else math.inf
+            lateral = -(x + vx * lead - gx) * gny + (y + vy * lead - gy) * gnx if lead <= DIVE_HORIZON_S else 0.0
+            height = z + vz * lead - 0.5 * g * lead * lead if lead <= DIVE_HORIZON_S else 0.0
+            if (
+                lead <= DIVE_HORIZON_S
+                and abs(lateral) <= half_goal + pitch[K_HANDS]
+                and height <= turf + pitch[GH] + pitch[K_HANDS]
+            ):
+                dive_t = t
+                lateral = min(max(lateral, -half_goal), half_goal)
+                height = min(max(height, turf + radius), turf + pitch[GH])
+                target[0], target[1], target[2] = gx - lateral * gny, gy + lateral * gnx, height
+                info[I_DIVE] = dive_t
+                info[I_TARGET], info[I_TARGET + 1], info[I_TARGET + 2] = target[0], target[1], target[2]
+                _keeper_box(pitch, dive_t, target, radius + 1e-3, boxes)
+                keeper_box = _box(boxes, 2)
         # One step: RK4/Euler in flight; rolling, the same step on the horizontal velocity, or the exact stop.
         stop_here = False
         if rolling:

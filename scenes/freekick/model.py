@@ -394,8 +394,13 @@ def keeper_words(state: KickState) -> str:
 def wall_passed_s(state: KickState, played: ball.Trajectory) -> float | None:
     """When (s) the played-on ball first crosses the wall's plane toward the goal (the keeper's first clear sight
     of it), None if it never does."""
-    normal, _along = wall_axes(state.wall)
-    side = (played.position[:, :2] - np.array(state.wall.centre_xy)) @ normal
+    return _plane_crossed_s(state.wall, played)
+
+
+def _plane_crossed_s(panel: ball.Panel, played: ball.Trajectory) -> float | None:
+    """When (s) the played-on ball's centre first crosses ``panel``'s plane along its normal, None if never."""
+    normal, _along = wall_axes(panel)
+    side = (played.position[:, :2] - np.array(panel.centre_xy)) @ normal
     past = np.flatnonzero((side[:-1] < 0.0) & (side[1:] >= 0.0))
     if not len(past):
         return None
@@ -406,13 +411,17 @@ def wall_passed_s(state: KickState, played: ball.Trajectory) -> float | None:
 
 def _why_no_dive(state: KickState, played: ball.Trajectory) -> str:
     """Why the keeper never set off, as what happened to the ball says: it never got past the wall (only when it hit
-    the wall), it never reached it, or the play was over before his reaction time was up."""
+    the wall), it never reached it, the play was over before his reaction time was up, or the ball never came at his
+    goal (he dives only for a ball on his line within 1.5 s, within his reach of the goal)."""
     passed = wall_passed_s(state, played)
     if passed is None:
         if any(event.kind == "wall" for event in played.events):
             return "never dives (the ball never gets past the wall)"
         return "never dives (the ball never reaches the wall)"
-    over = float(played.t[-1]) - passed
+    # Over for him when it crosses his line, strikes the frame, or stops, whichever is first.
+    ends = [float(played.t[-1]), *(event.t for event in played.events if event.kind in ("post", "bar"))]
+    line = _plane_crossed_s(state.goal, played)
+    over = min(ends if line is None else [*ends, line]) - passed
     what = {
         "goal": "it is in the goal",
         "post": "it hits the post",
@@ -420,7 +429,13 @@ def _why_no_dive(state: KickState, played: ball.Trajectory) -> str:
         "wide": "it is past the post",
         "over": "it is over the bar",
     }.get(str(played.result), "the play is over")
-    return f"never dives: {what} {max(over, 0.0):.2f} s after it passes the wall, before he reacts ({KEEPER.reaction_s:.2f} s)"
+    step = float(played.t[1] - played.t[0]) if len(played.t) > 1 else 0.0  # he reads at a step's start
+    if over < KEEPER.reaction_s + step:
+        return (
+            f"never dives: {what} {max(over, 0.0):.2f} s after it passes the wall, before he reacts "
+            f"({KEEPER.reaction_s:.2f} s)"
+        )
+    return "never dives: the ball never comes at his goal"
 
 
 VERDICT_WORDS: dict[str, str] = {
@@ -593,8 +608,8 @@ def heat_cells(p: FreeKickParams | None = None) -> tuple[NDArray[np.float64], ND
 
 
 ODDS_MAP_CAVEAT = (
-    "The keeper reads each ball once, as if it flew straight on, so from far out, where it dips and curls more "
-    "after he reads it, the map scores higher than a real keeper would let it."
+    "The keeper dives on his first read of each ball, as if it flew straight on, so from far out, where it dips "
+    "and curls more after he reads it, the map scores higher than a real keeper would let it."
 )
 """Said under the map with a keeper in goal: far-out spots (30–36 m) score more than near ones (docs/freekick.md)."""
 

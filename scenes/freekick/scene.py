@@ -181,8 +181,8 @@ off by about 1.4 cm, not "within a centimetre".
 
 **Assumptions.** Constant spin between contacts, still air. The orange flight ends at the turf or two metres past
 the goal line; the played-on flight and its verdict are the pitch's. A goal needs the whole ball over the line
-between the posts and under the bar. The keeper reads the ball once and never again, so a ball that bounces in front
-of him beats him more often than it would a real keeper.
+between the posts and under the bar. The keeper dives on his first read of a ball that comes at his goal and never
+reads it again, so a ball that bounces in front of him beats him more often than it would a real keeper.
 """
 
     def __init__(self, server: viser.ViserServer) -> None:

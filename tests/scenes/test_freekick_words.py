@@ -39,12 +39,17 @@ def _keeper_line(readout: str) -> str:
 
 
 def test_the_keeper_says_whose_right_he_dives_to(scene: FreeKickScene) -> None:
-    # Reported: "Keeper dives right" for a ball that crossed 4.64 m to the left. He faces the kicker: he dived to
-    # the kicker's right, his own left, reading the ball as if it flew on straight; the words now say whose side.
+    # Reported: "Keeper dives right" for a ball that crossed 4.64 m to the left, 26.75 m up. He faces the kicker:
+    # he dived to the kicker's right, his own left, reading the ball as if it flew on straight; the words now say
+    # whose side. He no longer dives at all for a ball that never comes at his goal, as that one.
     readout = _show(scene, distance_m=40.0, speed_ms=40.0, elevation_deg=50.0)
     crossing = scene.state.outcome.goal_point
+    assert crossing is not None and crossing[1] > 4.0 and crossing[2] > 20.0
+    assert scene.state.played is not None and scene.state.played.keeper_dive is None
+    assert "never dives: the ball never comes at his goal" in _keeper_line(readout)
+    readout = _show(scene, azimuth_deg=-14.0)  # struck to the kicker's right, in off his fingertips
     dive = scene.state.played.keeper_dive if scene.state.played is not None else None
-    assert crossing is not None and crossing[1] > 4.0 and dive is not None and dive.target[1] < 0.0
+    assert dive is not None and dive.target[1] < 0.0
     assert "dives to his left (your right)" in _keeper_line(readout)
     # The other way round: he goes to his right, the kicker's left.
     assert "dives to his right (your left)" in _keeper_line(_show(scene, azimuth_deg=-2.0))
@@ -128,8 +133,8 @@ def test_a_map_where_no_spot_scores_names_no_best_spot(scene: FreeKickScene) -> 
 
 
 def test_the_map_says_where_its_keeper_flatters_far_spots() -> None:
-    # The keeper reads the ball once, as if it flew straight on, so 30–36 m out scores more than 20 m out: the
-    # words beside the best spot say so wherever a keeper is in goal.
+    # The keeper dives on his first read of the ball, as if it flew straight on, so 30–36 m out scores more than
+    # 20 m out: the words beside the best spot say so wherever a keeper is in goal.
     chance = np.zeros((len(ODDS_MAP_DISTANCES_M), len(ODDS_MAP_ANGLES_DEG)))
     chance[-2, 8] = 0.9  # the best spot 35 m out
     with_keeper = odds_map_words(chance, FreeKickParams())
