@@ -384,7 +384,7 @@ def keeper_words(state: KickState) -> str:
     gap = keeper_gap_m(ball.keeper_path(KEEPER, spot, dive, played.t), played.position)
     nearest = max(float(gap.min()), 0.0)
     beaten = "; the ball beats him" if played.result == "goal" else ""
-    if nearest > KEEPER_NEAR_M:
+    if round(nearest, 2) >= KEEPER_NEAR_M:  # as shown: "within 2.00 m" is not near
         return f"{dived}{beaten}"
     if beaten:
         return f"{dived}{beaten} by {nearest:.2f} m"

@@ -15,6 +15,7 @@ from scenes.freekick.model import (
     ODDS_MAP_ANGLES_DEG,
     ODDS_MAP_CAVEAT,
     ODDS_MAP_DISTANCES_M,
+    PRESETS,
     compute_kick,
     keeper_words,
     odds_map_words,
@@ -69,6 +70,10 @@ def test_how_near_the_keeper_came_is_said_only_when_he_came_near(scene: FreeKick
     near = _keeper_line(_show(scene, azimuth_deg=-12.0, elevation_deg=20.0))  # off the bar, past his hands
     assert "gets within 0.20 m of the ball" in near
     assert "the ball beats him by 0.07 m" in _keeper_line(_show(scene, azimuth_deg=-14.0))
+    # Reported: the "Driven, off the post" preset said "gets within 2.00 m", 1.996 m rounded onto the cut-off.
+    for preset in PRESETS:
+        line = _keeper_line(_show(scene, **dataclasses.asdict(preset.params)))
+        assert "within 2.00 m" not in line and "by 2.00 m" not in line, (preset.label, line)
 
 
 @pytest.mark.parametrize(
