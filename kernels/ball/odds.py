@@ -24,6 +24,8 @@ from kernels.ball.api import pitch_outcomes, simulate_outcomes
 from kernels.ball.config import GROUND, RADIUS, check_launches, checked_seed, checked_vector, flight_config
 from kernels.ball.core import RESULTS
 from kernels.ball.pitch import (
+    PENALTY_AREA_DEPTH_M,
+    PENALTY_AREA_HALF_WIDTH_M,
     PITCH_WIDTH_M,
     WALL_DISTANCE_M,
     Keeper,
@@ -333,6 +335,14 @@ def spot_vectors(
         depth, shift = float(keeper.depth_m), float(keeper.shift_m)
         vectors[:, play.KX] = split_x + depth * unit_x - shift * -unit_y
         vectors[:, play.KY] = split_y + depth * unit_y - shift * unit_x
+        # Every spot's keeper in his penalty area, as Keeper.placed holds him (refused there, by name, otherwise).
+        out = -(vectors[:, play.KX] * normal[0] + vectors[:, play.KY] * normal[1])
+        across = vectors[:, play.KX] * along[0] + vectors[:, play.KY] * along[1]
+        outside = np.flatnonzero(
+            (out < 0.0) | (out > PENALTY_AREA_DEPTH_M) | (np.abs(across) > PENALTY_AREA_HALF_WIDTH_M)
+        )
+        if outside.size:
+            keeper.placed(spots[int(outside[0])], goal)  # raises, naming depth_m and shift_m
     return vectors
 
 

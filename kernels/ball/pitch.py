@@ -230,13 +230,7 @@ class Keeper:
         along = np.array([-normal[1], normal[0]])
         if self.position_xy is not None:
             spot = checked_vector("keeper.position_xy", self.position_xy, 2)
-            out, across = float(-(spot - centre) @ normal), float((spot - centre) @ along)
-            if not (0.0 <= out <= PENALTY_AREA_DEPTH_M and abs(across) <= PENALTY_AREA_HALF_WIDTH_M):
-                raise ValueError(
-                    f"keeper.position_xy must be in his penalty area: 0 to {PENALTY_AREA_DEPTH_M:g} m out from the "
-                    f"goal line and within {PENALTY_AREA_HALF_WIDTH_M:g} m of the goal's centre across it; "
-                    f"{tuple(self.position_xy)!r} is {out:.3g} m out and {across:.3g} m across"
-                )
+            _refuse_outside_area("keeper.position_xy", spot, centre, normal)
             return float(spot[0]), float(spot[1])
         depth = _checks.finite_number("keeper.depth_m", self.depth_m)
         if not 0.0 <= depth <= PENALTY_AREA_DEPTH_M:
@@ -255,7 +249,25 @@ class Keeper:
         unit = towards_ball / length if length > 0 else -normal
         left = np.array([-unit[1], unit[0]])
         spot = split + depth * unit - shift * left
+        # A shift across a wide angle's bisector can still take him behind his line (2 m from a spot 20 m wide of
+        # the goal put him 1.7 m into the net) or out of the area's side.
+        _refuse_outside_area("keeper.depth_m and keeper.shift_m", spot, centre, normal)
         return float(spot[0]), float(spot[1])
+
+
+def _refuse_outside_area(
+    name: str, spot: NDArray[np.float64], centre: NDArray[np.float64], normal: NDArray[np.float64]
+) -> None:
+    """``ValueError`` naming ``name`` where ``spot`` (the keeper's place, (2,) m) lies outside the penalty area of the
+    goal at ``centre`` whose unit ``normal`` points into the net."""
+    out = float(-(spot - centre) @ normal)
+    across = float((spot - centre) @ np.array([-normal[1], normal[0]]))
+    if not (0.0 <= out <= PENALTY_AREA_DEPTH_M and abs(across) <= PENALTY_AREA_HALF_WIDTH_M):
+        raise ValueError(
+            f"{name} must put the keeper in his penalty area: 0 to {PENALTY_AREA_DEPTH_M:g} m out from the goal line "
+            f"and within {PENALTY_AREA_HALF_WIDTH_M:g} m of the goal's centre across it; he would stand at "
+            f"{tuple(round(float(v), 6) for v in spot)!r} m, {out:.3g} m out and {across:.3g} m across"
+        )
 
 
 @dataclasses.dataclass(frozen=True)

@@ -733,7 +733,7 @@ def test_the_keeper_stands_anywhere_in_his_penalty_area_and_nowhere_else(turn_de
         if inside:
             assert keeper.placed(spot, goal) == pytest.approx(where, abs=1e-12)
         else:
-            with pytest.raises(ValueError, match=r"keeper\.position_xy must be in his penalty area"):
+            with pytest.raises(ValueError, match=r"keeper\.position_xy must put the keeper in his penalty area"):
                 keeper.placed(spot, goal)
     for depth, shift, inside in ((0.0, 0.0, True), (16.5, 20.16, True), (-1e-9, 0.0, False), (16.5, -20.17, False)):
         keeper = ball.Keeper(depth_m=depth, shift_m=shift)
@@ -835,6 +835,39 @@ def test_a_step_too_coarse_to_find_the_contacts_is_refused_on_a_pitch() -> None:
         with pytest.raises(ValueError, match=r"^dt must be at most 0\.05 s on a pitch"):
             call()
     assert ball.simulate(*kick, spin, dt=0.3, **options).ended == "ground"  # without a pitch it is the user's
+
+
+def test_a_keeper_placed_by_the_angle_lands_in_his_penalty_area_or_is_refused() -> None:
+    # Depth and shift were checked, not where they put him: a 2 m shift from a spot 20 m wide of the goal put him
+    # 1.7 m into the net, and he still "saved". Over spots all round the goal and depths and shifts up to the
+    # area's, he stands in his penalty area, or the placement is refused naming both fields.
+    for keeper, spot in (
+        (ball.Keeper(shift_m=2.0), (-5.0, 20.0)),
+        (ball.Keeper(shift_m=3.0), (-1.0, 30.0)),
+        (ball.Keeper(depth_m=16.5, shift_m=20.16), (-1.0, 33.0)),
+    ):
+        with pytest.raises(ValueError, match=r"keeper\.depth_m and keeper\.shift_m must put the keeper in his"):
+            keeper.placed(spot, GOAL)
+    placed = refused = 0
+    for distance in (9.5, 16.0, 30.0, 60.0, 119.0):
+        for angle in np.radians(np.linspace(-85.0, 85.0, 9)):
+            spot = (-distance * math.cos(angle), distance * math.sin(angle))
+            if abs(spot[1]) > 34.0:
+                continue
+            for depth in (0.0, 1.0, 8.0, 16.5):
+                for shift in (-20.16, -3.0, 0.0, 2.0, 20.16):
+                    try:
+                        x, y = ball.Keeper(depth_m=depth, shift_m=shift).placed(spot, GOAL)
+                    except ValueError as error:
+                        assert "keeper.depth_m and keeper.shift_m must put the keeper" in str(error)
+                        refused += 1
+                        continue
+                    assert 0.0 <= -x <= 16.5 + 1e-9 and abs(y) <= 20.16 + 1e-9, (spot, depth, shift, x, y)
+                    placed += 1
+    assert placed > 300 and refused > 20, (placed, refused)
+    # The odds map places a keeper at every spot at once: the same refusal, by the same names.
+    with pytest.raises(ValueError, match=r"keeper\.depth_m and keeper\.shift_m must put the keeper in his"):
+        odds.odds_map([12.0, 30.0], [0.0, 1.4], 25.0, 0.3, 0.0, (0.0, 0.0, 0.0), keeper=ball.Keeper(shift_m=3.0), n=2)
 
 
 def test_a_flight_played_on_a_pitch_is_not_judged_again_as_a_free_flight() -> None:
