@@ -49,7 +49,7 @@ MODEL_LABELS: dict[ball.Model, str] = {
 Integrator = Literal["rk4", "euler"]
 INTEGRATOR_LABELS: dict[Integrator, str] = {"rk4": "RK4, 10 ms", "euler": "Euler, 1 ms (textbook)"}
 INTEGRATOR_STEP_S: dict[Integrator, float] = {"rk4": 1e-2, "euler": 1e-3}
-PLAY_T_MAX_S = 6.0
+PLAY_T_MAX_S = 10.0
 """How long the kick is played on after it lands (s)."""
 BAND_STEP_S = 2e-2
 """Step of the ±10 % spin band's flights (RK4): they are drawn, not measured, and must not slow a redraw."""
