@@ -432,7 +432,7 @@ def _why_no_dive(state: KickState, played: ball.Trajectory) -> str:
     step = float(played.t[1] - played.t[0]) if len(played.t) > 1 else 0.0  # he reads at a step's start
     if over < KEEPER.reaction_s + step:
         return (
-            f"never dives: {what} {max(over, 0.0):.2f} s after it passes the wall, before he reacts "
+            f"never dives: {what} {max(over, 0.0):.2f} s after it passes the wall, within his reaction time "
             f"({KEEPER.reaction_s:.2f} s)"
         )
     return "never dives: the ball never comes at his goal"

@@ -1014,7 +1014,7 @@ def test_the_keepers_words_agree_with_what_happened_to_the_ball(distance: float,
             assert "wall" in kinds and not crossed, where
         if played.keeper_dive is None:
             assert words.startswith("never dives"), where
-            if crossed and "before he reacts" in words:
+            if crossed and "within his reaction time" in words:
                 seconds = float(words.split(" s after")[0].split()[-1])
                 assert seconds < ball.Keeper().reaction_s + 0.02, where
             elif crossed:  # he had time, and the ball never came at his goal: it cannot have gone in or been saved
