@@ -325,7 +325,7 @@ def pitch_vector(pitch: Pitch, ball_xy: ArrayLike, ground_m: float, radius_m: fl
             f"({2.0 * radius_m + post_radius:g} m), got {pitch.net_depth_m!r}"
         )
     vector[play.TURF] = ground_m - radius_m
-    vector[play.HALF_WIDTH] = 0.5 * _checks.positive("pitch.pitch_width_m", pitch.pitch_width_m)
+    vector[play.HALF_WIDTH] = 0.5 * _within("pitch.pitch_width_m", pitch.pitch_width_m, MAX_PANEL_M)
     least = vector[play.GW] + 4.0 * post_radius  # the goal and both posts stand on the pitch
     if vector[play.HALF_WIDTH] * 2.0 <= least:
         raise ValueError(

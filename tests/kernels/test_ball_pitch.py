@@ -700,6 +700,7 @@ def test_drag_crisis_centre_is_a_setting() -> None:
         # A pitch narrower than the goal ended every kick "out" with no event.
         (ball.Pitch(GOAL, pitch_width_m=1.0), r"pitch\.pitch_width_m"),
         (ball.Pitch(GOAL, pitch_width_m=7.32 + 4 * 0.06), r"pitch\.pitch_width_m"),
+        (ball.Pitch(GOAL, pitch_width_m=1e9), r"pitch\.pitch_width_m must be at most 1000"),  # was accepted
         # A 20 m wall counted one player a 0.5 m: refused as "wall_players ... got 40", a field left at None.
         (ball.Pitch(GOAL, ball.Panel(WALL.centre_xy, WALL.normal_xy, 20.0, 1.8)), r"pitch\.wall\.width_m is 20 m"),
     ],
