@@ -10,7 +10,6 @@ import numpy as np
 import pytest
 import viser
 from helpers.properties import examples
-from helpers.scenes import MakeScene
 from helpers.screen_geometry import GOAL_CORNERS, polyline_gap
 from helpers.wsclient import BrowserClient, shows_number
 from hypothesis import given, settings
@@ -51,13 +50,6 @@ from scenes.freekick.model import keeper_words, knuckle_wobble_m, spot_odds_map,
 from scenes.freekick.scene import GRASS_HALF_M
 
 
-@pytest.fixture
-def scene(show_scene: MakeScene) -> FreeKickScene:
-    shown = show_scene(FreeKickScene)
-    assert shown.wait_idle()
-    return shown
-
-
 @settings(max_examples=examples(200), deadline=None)
 @given(
     steps=st.lists(st.floats(1e-9, 10.0, allow_nan=False, allow_infinity=False), min_size=0, max_size=30),
@@ -87,17 +79,17 @@ def test_sample_rows_at_a_node_and_beyond_the_ends() -> None:
     np.testing.assert_array_equal(got, [[0.0, 10.0], [1.0, 20.0], [2.5, 5.0], [4.0, -10.0], [4.0, -10.0]])
 
 
-def drawn_path(scene: FreeKickScene) -> np.ndarray:
-    segments = np.asarray(scene.path.points)
+def drawn_path(freekick: FreeKickScene) -> np.ndarray:
+    segments = np.asarray(freekick.path.points)
     return np.concatenate([segments[:, 0], segments[-1:, 1]])
 
 
 # ------------------------------------------------------------------------------------------------ server side
-def test_opening_state_is_the_kernels_curler(scene: FreeKickScene) -> None:
+def test_opening_state_is_the_kernels_curler(freekick: FreeKickScene) -> None:
     expected = compute_kick(FreeKickParams())
-    assert scene.state.outcome.result == expected.outcome.result == "goal"
-    np.testing.assert_allclose(drawn_path(scene), resample(expected.flight), atol=1e-5)
-    ghost = np.asarray(scene.ghost.points)
+    assert freekick.state.outcome.result == expected.outcome.result == "goal"
+    np.testing.assert_allclose(drawn_path(freekick), resample(expected.flight), atol=1e-5)
+    ghost = np.asarray(freekick.ghost.points)
     np.testing.assert_allclose(ghost[-1, 1], expected.ghost.position[-1], atol=1e-5)
     assert ghost.shape == (PATH_POINTS - 1, 2, 3)
     # The ghost flies straight (no spin): every point on the vertical plane of its launch.
@@ -105,37 +97,37 @@ def test_opening_state_is_the_kernels_curler(scene: FreeKickScene) -> None:
     across = np.array([-math.sin(heading), math.cos(heading), 0.0])
     np.testing.assert_allclose((ghost[:, 0] - expected.ghost.position[0]) @ across, 0.0, atol=1e-4)
     # Played on the pitch, the keeper gets to it: the headline is his save, the free flight's goal said beside it.
-    assert expected.played is not None and expected.played.result == scene.state.played.result == "saved"  # type: ignore[union-attr]
-    assert scene.result.content.startswith("**Saved: the keeper reached it ")
-    assert "In free flight through the goal plane: GOAL" in scene.result.content
-    assert f"{expected.outcome.wall_point[2]:.2f} m" in scene.result.content  # type: ignore[index]
-    assert "+3.09 m" in scene.result.content  # sideways against the no-spin kick, curled left
+    assert expected.played is not None and expected.played.result == freekick.state.played.result == "saved"  # type: ignore[union-attr]
+    assert freekick.result.content.startswith("**Saved: the keeper reached it ")
+    assert "In free flight through the goal plane: GOAL" in freekick.result.content
+    assert f"{expected.outcome.wall_point[2]:.2f} m" in freekick.result.content  # type: ignore[index]
+    assert "+3.09 m" in freekick.result.content  # sideways against the no-spin kick, curled left
     # Force chart: |drag|, |Magnus|, |gravity| against time, straight from the kernel.
-    t, drag, magnus, gravity, _ = scene.chart.data
+    t, drag, magnus, gravity, _ = freekick.chart.data
     np.testing.assert_allclose(t, expected.flight.t)
     np.testing.assert_allclose(drag, np.linalg.norm(expected.flight.drag, axis=1))
     np.testing.assert_allclose(magnus, np.linalg.norm(expected.flight.magnus, axis=1))
     np.testing.assert_allclose(gravity, 0.43 * 9.81)
     # Gravity arrows point down, 0.3 m per newton.
-    arrows = np.asarray(scene.arrows["gravity"].points)[:ARROW_POINTS]
+    arrows = np.asarray(freekick.arrows["gravity"].points)[:ARROW_POINTS]
     np.testing.assert_allclose(arrows[:, 1] - arrows[:, 0], [[0, 0, -0.3 * 0.43 * 9.81]] * ARROW_POINTS, atol=1e-5)
 
 
-def test_spin_changes_path_band_and_outcome_with_the_measured_model(scene: FreeKickScene) -> None:
-    assert scene.params.model == "measured"  # the scene opens on the model under which spin matters
-    scene.controls["model"].value = "Constant C_D = C_L = 0.25 (textbook)"
-    band = np.asarray(scene.band.vertices)
+def test_spin_changes_path_band_and_outcome_with_the_measured_model(freekick: FreeKickScene) -> None:
+    assert freekick.params.model == "measured"  # the scene opens on the model under which spin matters
+    freekick.controls["model"].value = "Constant C_D = C_L = 0.25 (textbook)"
+    band = np.asarray(freekick.band.vertices)
     assert np.allclose(band[0::2], band[1::2], atol=1e-5)  # constant model: ±10 % spin flies the same path
-    scene.controls["model"].value = "Measured C_D(Re, S), C_L(S)"
-    scene.controls["azimuth_deg"].value = -12.0
-    assert scene.params.model == "measured" and scene.state.outcome.result == "goal"
-    band = np.asarray(scene.band.vertices)
+    freekick.controls["model"].value = "Measured C_D(Re, S), C_L(S)"
+    freekick.controls["azimuth_deg"].value = -12.0
+    assert freekick.params.model == "measured" and freekick.state.outcome.result == "goal"
+    band = np.asarray(freekick.band.vertices)
     width_at_goal = np.linalg.norm(band[-2] - band[-1])
     assert width_at_goal > 0.4  # a tenth more or less spin moves the ball tens of centimetres
-    before = drawn_path(scene)
-    scene.controls["spin_rev_s"].value = 2.0
-    assert scene.state.outcome.result == "wide" and "Wide of the post" in scene.result.content
-    assert np.abs(drawn_path(scene) - before).max() > 1.0
+    before = drawn_path(freekick)
+    freekick.controls["spin_rev_s"].value = 2.0
+    assert freekick.state.outcome.result == "wide" and "Wide of the post" in freekick.result.content
+    assert np.abs(drawn_path(freekick) - before).max() > 1.0
 
 
 def _kernel_flight(
@@ -161,75 +153,75 @@ def _kernel_flight(
 )
 @pytest.mark.parametrize("model_label", ["Constant C_D = C_L = 0.25 (textbook)", "Measured C_D(Re, S), C_L(S)"])
 def test_drawn_path_ghost_and_band_are_the_kernels_flights(
-    scene: FreeKickScene, integrator: str, method: ball.Method, dt: float, model_label: str
+    freekick: FreeKickScene, integrator: str, method: ball.Method, dt: float, model_label: str
 ) -> None:
     model: ball.Model = "measured" if model_label.startswith("Measured") else "constant"
-    scene.controls["integrator"].value = integrator
-    scene.controls["model"].value = model_label
+    freekick.controls["integrator"].value = integrator
+    freekick.controls["model"].value = model_label
     # A spin change keeps the no-spin ghost; a speed change flies it again. Both must draw the kernel's flights.
     for speed, spin in ((25.0, 6.5), (25.0, 9.5), (27.0, 9.5)):
-        scene.controls["speed_ms"].value = speed
-        scene.controls["spin_rev_s"].value = spin
-        assert (scene.params.speed_ms, scene.params.spin_rev_s) == (speed, spin)
+        freekick.controls["speed_ms"].value = speed
+        freekick.controls["spin_rev_s"].value = spin
+        assert (freekick.params.speed_ms, freekick.params.spin_rev_s) == (speed, spin)
         flight = _kernel_flight(speed, spin, method, dt, model)
-        np.testing.assert_array_equal(scene.state.flight.position, flight.position)
-        np.testing.assert_array_equal(drawn_path(scene), resample(flight).astype(np.float32))
+        np.testing.assert_array_equal(freekick.state.flight.position, flight.position)
+        np.testing.assert_array_equal(drawn_path(freekick), resample(flight).astype(np.float32))
         ghost = _kernel_flight(speed, 0.0, method, dt, model)
-        np.testing.assert_array_equal(scene.state.ghost.position, ghost.position)
-        drawn_ghost = np.asarray(scene.ghost.points)
+        np.testing.assert_array_equal(freekick.state.ghost.position, ghost.position)
+        drawn_ghost = np.asarray(freekick.ghost.points)
         np.testing.assert_array_equal(
             np.concatenate([drawn_ghost[:, 0], drawn_ghost[-1:, 1]]),
             resample(ghost).astype(np.float32),
         )
-        band = np.asarray(scene.band.vertices)  # the ±10 % edges fly RK4 at 20 ms
+        band = np.asarray(freekick.band.vertices)  # the ±10 % edges fly RK4 at 20 ms
         for edge, scale in ((band[0::2], 0.9), (band[1::2], 1.1)):
             expected = _kernel_flight(speed, scale * spin, "rk4", 2e-2, model)
             np.testing.assert_array_equal(edge, resample(expected).astype(np.float32))
 
 
-def test_a_jumping_wall_blocks_the_curler(scene: FreeKickScene) -> None:
-    scene.controls["wall_jumps"].value = True
-    assert scene.state.wall.height_m == pytest.approx(1.8 + JUMP_M)
-    positions = np.asarray(scene.wall_nodes.batched_positions)
+def test_a_jumping_wall_blocks_the_curler(freekick: FreeKickScene) -> None:
+    freekick.controls["wall_jumps"].value = True
+    assert freekick.state.wall.height_m == pytest.approx(1.8 + JUMP_M)
+    positions = np.asarray(freekick.wall_nodes.batched_positions)
     np.testing.assert_allclose(positions[:, 2], JUMP_M)
     np.testing.assert_allclose(positions[:, 0], -22.0 + 9.15, atol=1e-5)
-    assert scene.state.outcome.result == "wall" and "Blocked by the wall" in scene.result.content
+    assert freekick.state.outcome.result == "wall" and "Blocked by the wall" in freekick.result.content
 
 
-def test_a_blocked_kick_is_played_on_off_the_defender_and_the_scene_says_so(scene: FreeKickScene) -> None:
+def test_a_blocked_kick_is_played_on_off_the_defender_and_the_scene_says_so(freekick: FreeKickScene) -> None:
     # 14° is too flat for the wall: the kernel's flight on a pitch strikes a defender's body, rebounds and bounces
     # on; the pale line draws it from the contact on, and the readout says what happened in words.
-    scene.controls["elevation_deg"].value = 14.0
-    played = scene.state.played
+    freekick.controls["elevation_deg"].value = 14.0
+    played = freekick.state.played
     assert played is not None and played.result == "wall"
     hit = played.events[0]
     assert hit.kind == "wall"
     assert hit.position[0] == pytest.approx(-22.0 + 9.15, abs=0.5)  # at the wall, 9.15 m out
     assert played.velocity[-1, 0] <= 0.0 or played.ended != "net"  # it does not go on into the goal
-    assert scene.after.visible
-    drawn = np.asarray(scene.after.points).reshape(-1, 3)
+    assert freekick.after.visible
+    drawn = np.asarray(freekick.after.points).reshape(-1, 3)
     np.testing.assert_allclose(drawn[0], hit.position, atol=1e-5)  # the pale line starts at the contact
-    assert f"Hits a defender at {hit.position[2]:.1f} m" in scene.result.content
-    assert "bounces" in scene.result.content
+    assert f"Hits a defender at {hit.position[2]:.1f} m" in freekick.result.content
+    assert "bounces" in freekick.result.content
     # Without the keeper the opening curler goes straight into the net: nothing to play on, no pale line.
-    scene.controls["keeper"].value = False
-    scene.controls["elevation_deg"].value = 17.0
-    assert scene.state.played is not None and [e.kind for e in scene.state.played.events] == ["net"]
-    assert not scene.after.visible
-    assert "Played on: **Ends in the net**" in scene.result.content
+    freekick.controls["keeper"].value = False
+    freekick.controls["elevation_deg"].value = 17.0
+    assert freekick.state.played is not None and [e.kind for e in freekick.state.played.events] == ["net"]
+    assert not freekick.after.visible
+    assert "Played on: **Ends in the net**" in freekick.result.content
 
 
-def test_kick_flies_the_ball_spinning_along_its_path(scene: FreeKickScene) -> None:
-    spot = np.array(scene.ball_frame.position)
-    scene.kick_button.value = True
-    with scene._lock:  # step the animation deterministically, with the scene's own loop held off
-        assert scene.kick_time_s is not None
-        scene.kick_time_s = 0.0
+def test_kick_flies_the_ball_spinning_along_its_path(freekick: FreeKickScene) -> None:
+    spot = np.array(freekick.ball_frame.position)
+    freekick.kick_button.value = True
+    with freekick._lock:  # step the animation deterministically, with the scene's own loop held off
+        assert freekick.kick_time_s is not None
+        freekick.kick_time_s = 0.0
         for _ in range(5):
-            scene._animate(0.1)
-        mid = np.array(scene.ball_frame.position)
-        wxyz = np.array(scene.ball_frame.wxyz)
-        flight = scene.state.played  # the kick played on: it bounces, hits the frame, is saved
+            freekick._animate(0.1)
+        mid = np.array(freekick.ball_frame.position)
+        wxyz = np.array(freekick.ball_frame.wxyz)
+        flight = freekick.state.played  # the kick played on: it bounces, hits the frame, is saved
         assert flight is not None and flight.events[0].t > 0.5
         expected = [np.interp(0.5, flight.t, flight.position[:, k]) for k in range(3)]
         np.testing.assert_allclose(mid, expected, atol=1e-9)
@@ -238,105 +230,105 @@ def test_kick_flies_the_ball_spinning_along_its_path(scene: FreeKickScene) -> No
         angle = 2 * math.pi * 8.0 * 0.5
         np.testing.assert_allclose(wxyz, [math.cos(angle / 2), 0, 0, math.sin(angle / 2)], atol=1e-9)
         for _ in range(40):
-            scene._animate(0.1)
-        assert scene.kick_time_s is None  # landed, rested, and went back to the spot
-        np.testing.assert_allclose(scene.ball_frame.position, spot)
+            freekick._animate(0.1)
+        assert freekick.kick_time_s is None  # landed, rested, and went back to the spot
+        np.testing.assert_allclose(freekick.ball_frame.position, spot)
 
 
 def test_aiming_at_a_point_of_the_goal_mouth_finds_a_kick_over_the_wall(
-    scene: FreeKickScene,
+    freekick: FreeKickScene,
 ) -> None:
-    scene.aim_at_point(-2.6, 1.9)
-    assert scene.wait_idle()
-    point = scene.state.outcome.goal_point
-    assert scene.state.outcome.result == "goal" and point is not None
+    freekick.aim_at_point(-2.6, 1.9)
+    assert freekick.wait_idle()
+    point = freekick.state.outcome.goal_point
+    assert freekick.state.outcome.result == "goal" and point is not None
     assert np.linalg.norm(point[1:] - [-2.6, 1.9]) < 0.05
-    assert scene.controls["speed_ms"].value == 25.0  # the speed is kept
-    assert scene.controls["elevation_deg"].value == pytest.approx(scene.params.elevation_deg)
-    assert "Found" in scene.aim_status.content
-    np.testing.assert_allclose(scene.target_marker.position, (0.0, -2.6, 1.9))
+    assert freekick.controls["speed_ms"].value == 25.0  # the speed is kept
+    assert freekick.controls["elevation_deg"].value == pytest.approx(freekick.params.elevation_deg)
+    assert "Found" in freekick.aim_status.content
+    np.testing.assert_allclose(freekick.target_marker.position, (0.0, -2.6, 1.9))
 
 
-def test_a_click_ray_through_the_goal_mouth_aims_there(scene: FreeKickScene) -> None:
-    scene.aim_from_ray((-20.0, -1.0, 1.0), (20.0, -1.0, 1.0))  # hits x = 0 at y = −2, z = 2
-    assert scene.wait_idle()
-    assert scene.last_target == pytest.approx((-2.0, 2.0))
-    before = scene.params
-    scene.aim_from_ray((-20.0, 0.0, 1.0), (20.0, 10.0, 0.0))  # misses the mouth: nothing happens
-    scene.aim_from_ray((math.nan, 0.0, 1.0), (1.0, 0.0, 0.0))
-    scene.aim_from_ray("not a ray", None)
-    assert scene.wait_idle()
-    assert scene.params == before and scene.last_target == pytest.approx((-2.0, 2.0))
+def test_a_click_ray_through_the_goal_mouth_aims_there(freekick: FreeKickScene) -> None:
+    freekick.aim_from_ray((-20.0, -1.0, 1.0), (20.0, -1.0, 1.0))  # hits x = 0 at y = −2, z = 2
+    assert freekick.wait_idle()
+    assert freekick.last_target == pytest.approx((-2.0, 2.0))
+    before = freekick.params
+    freekick.aim_from_ray((-20.0, 0.0, 1.0), (20.0, 10.0, 0.0))  # misses the mouth: nothing happens
+    freekick.aim_from_ray((math.nan, 0.0, 1.0), (1.0, 0.0, 0.0))
+    freekick.aim_from_ray("not a ray", None)
+    assert freekick.wait_idle()
+    assert freekick.params == before and freekick.last_target == pytest.approx((-2.0, 2.0))
 
 
-def test_the_current_strikes_odds_are_shown_with_the_map(scene: FreeKickScene) -> None:
+def test_the_current_strikes_odds_are_shown_with_the_map(freekick: FreeKickScene) -> None:
     # The opening curler struck 200 times with a player's scatter: the shares shown are the kernel's for the
     # same strikes. The keeper saves it as struck, and most of its scatter too; without him most go in.
-    assert scene.wait_idle(120.0)
-    chances = scene.chances
+    assert freekick.wait_idle(120.0)
+    chances = freekick.chances
     assert chances is not None and chances.n == 200
-    expected = strike_chances(scene.params)
+    expected = strike_chances(freekick.params)
     assert chances.counts == expected.counts
     assert chances.probability("saved") > 0.4 and chances.probability("goal") > 0.2
     for name in ("saved", "goal"):
-        assert f"{name} {100 * chances.probability(name):.0f} %" in scene.odds_status.content
-    assert "Struck 200 times" in scene.odds_status.content
-    scene.controls["keeper"].value = False
-    assert scene.wait_idle(120.0)
-    chances = scene.chances
+        assert f"{name} {100 * chances.probability(name):.0f} %" in freekick.odds_status.content
+    assert "Struck 200 times" in freekick.odds_status.content
+    freekick.controls["keeper"].value = False
+    assert freekick.wait_idle(120.0)
+    chances = freekick.chances
     assert chances is not None and chances.counts["saved"] == 0 and chances.probability("goal") > 0.4
-    assert f"goal {100 * chances.probability('goal'):.0f} %" in scene.odds_status.content
+    assert f"goal {100 * chances.probability('goal'):.0f} %" in freekick.odds_status.content
 
 
-def test_outcome_map_matches_single_runs(scene: FreeKickScene) -> None:
-    scene.controls["model"].value = "Constant C_D = C_L = 0.25 (textbook)"
-    assert scene.wait_idle()
-    results = scene.map_results
+def test_outcome_map_matches_single_runs(freekick: FreeKickScene) -> None:
+    freekick.controls["model"].value = "Constant C_D = C_L = 0.25 (textbook)"
+    assert freekick.wait_idle()
+    results = freekick.map_results
     assert results is not None and results.shape == (len(MAP_SPINS_REV_S), len(MAP_SPEEDS_MS))
     assert {"goal", "wall", "over"} <= set(results.ravel().tolist())
     # Constant coefficients: every spinning row is the same; the readout says why.
     assert all(np.array_equal(results[1], results[row]) for row in range(2, len(MAP_SPINS_REV_S)))
-    assert "rows repeat" in scene.map_status.content
-    wall, goal = scene.state.wall, scene.state.goal
+    assert "rows repeat" in freekick.map_status.content
+    wall, goal = freekick.state.wall, freekick.state.goal
     for row, col in ((0, 0), (16, 20), (30, 40), (10, 25)):
         params = dataclasses.replace(
-            scene.params, speed_ms=float(MAP_SPEEDS_MS[col]), spin_rev_s=float(MAP_SPINS_REV_S[row])
+            freekick.params, speed_ms=float(MAP_SPEEDS_MS[col]), spin_rev_s=float(MAP_SPINS_REV_S[row])
         )
         expected = ball.outcome(compute_kick(params).flight, wall, goal).result
         assert results[row, col] == expected, (row, col)
-    image = np.asarray(scene.map_image.image)
+    image = np.asarray(freekick.map_image.image)
     rows = results.shape[0]
     cell = image.shape[0] // rows
     colour = image[(rows - 1 - 10) * cell + 1, 25 * cell + 1]
     assert tuple(colour) == RESULT_COLOURS[str(results[10, 25])]
-    scene.controls["wall_jumps"].value = True  # the map follows the settings
-    assert scene.wait_idle()
-    assert np.sum(scene.map_results == "wall") > np.sum(results == "wall")  # type: ignore[operator]
+    freekick.controls["wall_jumps"].value = True  # the map follows the settings
+    assert freekick.wait_idle()
+    assert np.sum(freekick.map_results == "wall") > np.sum(results == "wall")  # type: ignore[operator]
 
 
 def test_a_burst_of_slider_changes_computes_one_outcome_map_for_the_last(
-    scene: FreeKickScene,
+    freekick: FreeKickScene,
 ) -> None:
-    runs = scene.map_runs
+    runs = freekick.map_runs
     for spin in np.linspace(5.0, 9.0, 12):
-        scene.controls["spin_rev_s"].value = float(spin)  # each redraws at once; the map waits for the burst to end
-    assert scene.wait_idle()
+        freekick.controls["spin_rev_s"].value = float(spin)  # each redraws at once; the map waits for the burst to end
+    assert freekick.wait_idle()
     # Twelve changes, one map (a few at most if this machine stalls for a quarter second mid-burst).
-    assert runs < scene.map_runs <= runs + 3
-    assert scene.map_params == scene.params and scene.params.spin_rev_s == 9.0
+    assert runs < freekick.map_runs <= runs + 3
+    assert freekick.map_params == freekick.params and freekick.params.spin_rev_s == 9.0
 
 
 def test_scene_close_leaves_only_the_switcher(server: viser.ViserServer) -> None:
     from helpers.viser_private import gui_uuids, node_names
 
     bare_nodes, bare_gui = node_names(server), gui_uuids(server)
-    scene = FreeKickScene(server)
-    assert scene.wait_idle()
+    freekick = FreeKickScene(server)
+    assert freekick.wait_idle()
     assert len(node_names(server)) > len(bare_nodes) + 10
-    scene.close()
+    freekick.close()
     assert node_names(server) == bare_nodes
     assert gui_uuids(server) == bare_gui
-    assert not any(thread.is_alive() for thread in scene._threads)
+    assert not any(thread.is_alive() for thread in freekick._threads)
 
 
 # ------------------------------------------------------------------------------------------------ over the websocket
@@ -345,28 +337,28 @@ def _markdown_shown(client: BrowserClient, text: str) -> bool:
 
 
 def test_ticking_knuckleball_in_a_browser_sets_the_spin_near_zero_and_the_wobble_shows(
-    server: viser.ViserServer, scene: FreeKickScene
+    server: viser.ViserServer, freekick: FreeKickScene
 ) -> None:
     # At the default 8 rev/s the knuckle force is off (any real spin steadies the wake): ticking the box must give a
     # knuckleball, saying so, with the slider showing the new spin and the wobble given in the readout.
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("Knuckleball")
-        assert scene.params.spin_rev_s == 8.0 and not scene.params.knuckle
+        assert freekick.params.spin_rev_s == 8.0 and not freekick.params.knuckle
         client.set_value("Knuckleball", True)
-        client.wait_for(lambda: scene.params.knuckle and scene.params.spin_rev_s == 0.0, what="spin set to zero")
+        client.wait_for(lambda: freekick.params.knuckle and freekick.params.spin_rev_s == 0.0, what="spin set to zero")
         client.wait_for(lambda: _markdown_shown(client, "spin set to 0 rev/s"), what="the change said in words")
         client.wait_for(lambda: client.value_of("Spin rate (rev/s)") == 0.0, what="the slider showing 0")
         client.wait_for(lambda: _markdown_shown(client, "Knuckle wobble: up to"), what="the wobble in the readout")
-        with scene._lock:
-            assert np.abs(scene.state.flight.knuckle).max() > 0.1  # the side force acts
-            wobble = knuckle_wobble_m(scene.state)
+        with freekick._lock:
+            assert np.abs(freekick.state.flight.knuckle).max() > 0.1  # the side force acts
+            wobble = knuckle_wobble_m(freekick.state)
         # Cohen et al. 2012, Texier et al. 2016: about one ball diameter (0.22 m) at a striker's speed.
         assert wobble is not None and 0.05 < wobble < 0.6
         client.wait_for_gui("Random draw")
 
 
 def test_spin_slider_from_a_browser_changes_the_path_and_the_outcome(
-    server: viser.ViserServer, scene: FreeKickScene
+    server: viser.ViserServer, freekick: FreeKickScene
 ) -> None:
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("Spin rate (rev/s)")
@@ -374,7 +366,11 @@ def test_spin_slider_from_a_browser_changes_the_path_and_the_outcome(
         client.set_value("Model", "Measured C_D(Re, S), C_L(S)")
         client.set_value("Azimuth (°, + = left)", -12.0)
         client.wait_for(
-            lambda: scene.params.azimuth_deg == -12.0 and scene.params.model == "measured" and not scene.params.keeper,
+            lambda: (
+                freekick.params.azimuth_deg == -12.0
+                and freekick.params.model == "measured"
+                and not freekick.params.keeper
+            ),
             what="setup",
         )
         client.wait_for(lambda: _markdown_shown(client, "**GOAL**"), what="a goal shown")
@@ -387,7 +383,7 @@ def test_spin_slider_from_a_browser_changes_the_path_and_the_outcome(
             what="the new path sent",
         )
         sent = np.array(client.nodes["/freekick/path"]["props"]["points"]).reshape(-1, 2, 3)
-        np.testing.assert_allclose(sent, np.asarray(scene.path.points), atol=1e-6)
+        np.testing.assert_allclose(sent, np.asarray(freekick.path.points), atol=1e-6)
 
 
 CRAFTED = [
@@ -407,24 +403,24 @@ CRAFTED = [
 @pytest.mark.parametrize(("label", "value", "field", "expected"), CRAFTED)
 def test_crafted_values_keep_the_last_good_state(
     server: viser.ViserServer,
-    scene: FreeKickScene,
+    freekick: FreeKickScene,
     label: str,
     value: object,
     field: str,
     expected: object,
 ) -> None:
-    good = scene.state
+    good = freekick.state
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui(label)
         client.send_value(label, value)
         # The cleaned value is echoed to every browser; the scene holds it.
         client.wait_for(lambda: _echoed(client.value_of(label), expected), what="the cleaned value echoed")
-        client.wait_for(lambda: getattr(scene.params, field) == expected, what="the scene to hold the value")
-        with scene._lock:
-            assert np.all(np.isfinite(scene.state.flight.position))
-            assert np.all(np.isfinite(np.asarray(scene.path.points)))
+        client.wait_for(lambda: getattr(freekick.params, field) == expected, what="the scene to hold the value")
+        with freekick._lock:
+            assert np.all(np.isfinite(freekick.state.flight.position))
+            assert np.all(np.isfinite(np.asarray(freekick.path.points)))
             if getattr(FreeKickParams(), field) == expected:  # refused outright: the flight is the one before
-                np.testing.assert_array_equal(scene.state.flight.position, good.flight.position)
+                np.testing.assert_array_equal(freekick.state.flight.position, good.flight.position)
 
 
 def _echoed(shown: object, expected: object) -> bool:
@@ -447,7 +443,7 @@ def _click_the_goal_mouth(client: BrowserClient, ray_origin: tuple[float, float,
 
 
 def test_wrong_types_and_crafted_clicks_leave_the_scene_serving(
-    server: viser.ViserServer, scene: FreeKickScene
+    server: viser.ViserServer, freekick: FreeKickScene
 ) -> None:
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("Spin rate (rev/s)")
@@ -457,15 +453,15 @@ def test_wrong_types_and_crafted_clicks_leave_the_scene_serving(
         _click_the_goal_mouth(client, ray_origin=(math.nan, 0.0, 1.0))
         # A real click through the mouth: the scene aims a kick at (y, z) = (1.5, 1.2).
         _click_the_goal_mouth(client, ray_origin=(-20.0, 1.5, 1.2))
-        client.wait_for(lambda: scene.last_target == (1.5, 1.2), what="the click to reach the scene")
-        assert scene.wait_idle()
+        client.wait_for(lambda: freekick.last_target == (1.5, 1.2), what="the click to reach the scene")
+        assert freekick.wait_idle()
         client.wait_for(lambda: _markdown_shown(client, "Found:"), what="the aim result shown")
-        point = scene.state.outcome.goal_point
-        assert scene.state.outcome.result == "goal" and point is not None
+        point = freekick.state.outcome.goal_point
+        assert freekick.state.outcome.result == "goal" and point is not None
         assert np.linalg.norm(point[1:] - [1.5, 1.2]) < 0.05
-        assert scene.params.knuckle is False and scene.params.knuckle_seed == 1
+        assert freekick.params.knuckle is False and freekick.params.knuckle_seed == 1
         client.set_value("Launch speed (m/s)", 27.0)
-        client.wait_for(lambda: scene.params.speed_ms == 27.0, what="a good value after the bad ones")
+        client.wait_for(lambda: freekick.params.speed_ms == 27.0, what="a good value after the bad ones")
 
 
 # ------------------------------------------------------------------------------------------------ aiming (review 2)
@@ -500,13 +496,13 @@ def test_an_aimed_kick_without_spin_says_no_spin() -> None:
     )
 
 
-def test_the_drawn_wobble_ends_where_the_played_ball_first_touches_something(scene: FreeKickScene) -> None:
+def test_the_drawn_wobble_ends_where_the_played_ball_first_touches_something(freekick: FreeKickScene) -> None:
     # A review: the thin line that draws the knuckleball's wobble ten times larger ran on past the post the ball hit,
     # far right of the goal and off the pitch, where the free flight would have gone.
     from scenes.freekick.model import WOBBLE_SCALE, sample_rows, wobble_path
 
-    scene.controls["knuckle"].value = True
-    state = scene.state
+    freekick.controls["knuckle"].value = True
+    state = freekick.state
     assert state.played is not None and state.played.events
     touch = state.played.events[0].t
     path = wobble_path(state)
@@ -774,25 +770,27 @@ def test_project_points_agrees_with_frame_points() -> None:
     assert touches_x or touches_y
 
 
-def test_the_verdict_is_what_the_pitch_makes_of_the_kick_and_never_contradicts_played_on(scene: FreeKickScene) -> None:
+def test_the_verdict_is_what_the_pitch_makes_of_the_kick_and_never_contradicts_played_on(
+    freekick: FreeKickScene,
+) -> None:
     # Reported: Knuckleball on the default kick read "Wide of the post" over "Played on: Hits the right post":
     # the free flight crossed the goal plane 0.11 m outside the post's inside edge, where the ball (0.11 m) still
     # strikes the post (0.06 m). The headline is the pitch's result; the free flight's is said beside it.
-    scene.controls["keeper"].value = False  # the frame's verdicts alone
-    scene.controls["knuckle"].value = True
-    played = scene.state.played
+    freekick.controls["keeper"].value = False  # the frame's verdicts alone
+    freekick.controls["knuckle"].value = True
+    played = freekick.state.played
     assert played is not None and played.result == "post"
-    headline, second = (line.strip() for line in scene.result.content.splitlines()[:2])
+    headline, second = (line.strip() for line in freekick.result.content.splitlines()[:2])
     assert headline == "**Hits the post**"
     assert second == "In free flight through the goal plane: Wide of the post"
-    assert "Hits the right post" in scene.result.content or "hits the right post" in scene.result.content
+    assert "Hits the right post" in freekick.result.content or "hits the right post" in freekick.result.content
     seen: set[str] = set()
     for azimuth in np.linspace(-16.0, 4.0, 11):  # across the goal mouth and past both posts
-        scene.controls["azimuth_deg"].value = float(azimuth)
-        played, outcome = scene.state.played, scene.state.outcome
+        freekick.controls["azimuth_deg"].value = float(azimuth)
+        played, outcome = freekick.state.played, freekick.state.outcome
         result = played.result if played is not None and played.result is not None else outcome.result
         seen.add(result)
-        headline = scene.result.content.splitlines()[0].strip()
+        headline = freekick.result.content.splitlines()[0].strip()
         words = {"goal": "GOAL", "wide": "Wide of the post", "post": "Hits the post", "bar": "Hits the bar"}
         assert headline == f"**{words.get(result, headline.strip('*'))}**", (azimuth, result, headline)
     assert {"goal", "wide"} <= seen
@@ -812,22 +810,22 @@ PRESET_OUTCOMES = {
 """What each preset shows, as the kernel plays it on the scene's pitch (wall, posts, net and the keeper)."""
 
 
-def test_each_preset_shows_what_its_label_says(scene: FreeKickScene) -> None:
+def test_each_preset_shows_what_its_label_says(freekick: FreeKickScene) -> None:
     assert [preset.label for preset in PRESETS] == list(PRESET_OUTCOMES)
-    for preset, button in zip(PRESETS, scene.preset_buttons, strict=True):
+    for preset, button in zip(PRESETS, freekick.preset_buttons, strict=True):
         button.value = True  # what a click does, server side
-        assert scene.wait_idle()
+        assert freekick.wait_idle()
         verdict, contacts, words = PRESET_OUTCOMES[preset.label]
-        played = scene.state.played
-        assert scene.params == preset.params, preset.label
+        played = freekick.state.played
+        assert freekick.params == preset.params, preset.label
         assert played is not None and played.result == verdict, (preset.label, played and played.result)
         assert [event.kind for event in played.events] == contacts, preset.label
-        assert words in scene.result.content, (preset.label, scene.result.content)
-        assert scene.keeper_nodes.visible and scene.keeper_head.visible
+        assert words in freekick.result.content, (preset.label, freekick.result.content)
+        assert freekick.keeper_nodes.visible and freekick.keeper_head.visible
         if preset.params.knuckle:  # the knuckle force acts, not just the label
             assert preset.params.spin_rev_s == 0.0
-            assert np.abs(scene.state.flight.knuckle).max() > 0.1
-            assert np.all(scene.state.ghost.knuckle == 0.0)
+            assert np.abs(freekick.state.flight.knuckle).max() > 0.1
+            assert np.all(freekick.state.ghost.knuckle == 0.0)
     assert any(preset.params.knuckle for preset in PRESETS)
 
 
@@ -843,16 +841,16 @@ def _distance_to_segment(p: NDArray[np.float64], a: NDArray[np.float64], b: NDAr
     return float(np.linalg.norm(p - (a + s * (b - a))))
 
 
-def test_the_drawn_keeper_is_where_the_kernel_keeper_meets_the_ball(scene: FreeKickScene) -> None:
+def test_the_drawn_keeper_is_where_the_kernel_keeper_meets_the_ball(freekick: FreeKickScene) -> None:
     # The kernel ends the opening curler in the keeper's hands: its own contact event says when and where. The
     # scene's keeper (drawn from the kernel's model) touches the ball there and then, and nowhere before.
-    played = scene.state.played
+    played = freekick.state.played
     assert played is not None and played.result == "saved" and played.keeper_dive is not None
     touch = played.events[-1]
     assert touch.kind == "keeper"
     keeper = ball.Keeper()
-    spot = keeper.placed(ball_spot(scene.params)[:2], scene.state.goal)
-    assert scene.state.keeper_xy == pytest.approx(spot)
+    spot = keeper.placed(ball_spot(freekick.params)[:2], freekick.state.goal)
+    assert freekick.state.keeper_xy == pytest.approx(spot)
     times = played.t[played.t < touch.t]
     pose = ball.keeper_path(keeper, spot, played.keeper_dive, np.append(times, touch.t))
     reach = keeper.body_radius_m + ball.BALL_RADIUS_M
@@ -870,17 +868,17 @@ def test_the_drawn_keeper_is_where_the_kernel_keeper_meets_the_ball(scene: FreeK
     np.testing.assert_allclose(standing.up, [[0, 0, 1]] * 2)
     # The still picture shows him at the touch: his limbs' rods are drawn from that pose (hips to soles for the
     # legs, shoulders to fingertips for the arms).
-    starts = np.asarray(scene.keeper_nodes.batched_positions)
-    scales = np.asarray(scene.keeper_nodes.batched_scales)
+    starts = np.asarray(freekick.keeper_nodes.batched_positions)
+    scales = np.asarray(freekick.keeper_nodes.batched_scales)
     at_touch = ball.keeper_path(keeper, spot, played.keeper_dive, np.array([touch.t]))
     soles = at_touch.com[0] - keeper.foot_reach_m * at_touch.up[0]
     tips = at_touch.com[0] + keeper.hand_reach_m * at_touch.up[0]
     hips = at_touch.com[0] - 0.05 * at_touch.up[0]
     np.testing.assert_allclose(starts[2], hips, atol=1e-5)  # the body starts at the hips
     assert scales[2, 2] == pytest.approx(0.55, abs=1e-5)  # hips to shoulders
-    legs_end = starts[:2] + scales[:2, 2:3] * _rod_direction(scene)[:2]
+    legs_end = starts[:2] + scales[:2, 2:3] * _rod_direction(freekick)[:2]
     np.testing.assert_allclose(legs_end.mean(axis=0), soles, atol=1e-5)
-    arms_end = starts[3:5] + scales[3:5, 2:3] * _rod_direction(scene)[3:5]
+    arms_end = starts[3:5] + scales[3:5, 2:3] * _rod_direction(freekick)[3:5]
     np.testing.assert_allclose(arms_end.mean(axis=0), tips - 0.05 * at_touch.up[0], atol=1e-5)
     # The readout's margin: the earliest instant his body could touch a ball waiting at the touch point.
     early = np.arange(played.keeper_dive.t, touch.t, 1e-3)
@@ -890,46 +888,46 @@ def test_the_drawn_keeper_is_where_the_kernel_keeper_meets_the_ball(scene: FreeK
         for com, up in zip(poses.com, poses.up, strict=True)
     ]
     first = early[int(np.argmax(could))]
-    assert f"reached it {touch.t - first:.2f} s early" in scene.result.content
+    assert f"reached it {touch.t - first:.2f} s early" in freekick.result.content
 
 
-def _rod_direction(scene: FreeKickScene) -> NDArray[np.float64]:
+def _rod_direction(freekick: FreeKickScene) -> NDArray[np.float64]:
     """(N, 3) where each drawn rod points: +z turned by its quaternion."""
-    wxyz = np.asarray(scene.keeper_nodes.batched_wxyzs, dtype=np.float64)
+    wxyz = np.asarray(freekick.keeper_nodes.batched_wxyzs, dtype=np.float64)
     w, x, y, z = wxyz.T
     return np.column_stack([2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y)])
 
 
-def test_the_keeper_dives_during_the_kick_and_goes_without_a_keeper(scene: FreeKickScene) -> None:
-    scene.kick_button.value = True
-    with scene._lock:
-        scene.kick_time_s = 0.0
-        scene._animate(0.05)
-        body = _rod_direction(scene)[2]
+def test_the_keeper_dives_during_the_kick_and_goes_without_a_keeper(freekick: FreeKickScene) -> None:
+    freekick.kick_button.value = True
+    with freekick._lock:
+        freekick.kick_time_s = 0.0
+        freekick._animate(0.05)
+        body = _rod_direction(freekick)[2]
         assert body == pytest.approx([0.0, 0.0, 1.0], abs=1e-6)  # upright before he reads the kick
         for _ in range(10):
-            scene._animate(0.1)
-        played = scene.state.played
+            freekick._animate(0.1)
+        played = freekick.state.played
         assert played is not None and played.keeper_dive is not None
-        leaning = _rod_direction(scene)[2]
+        leaning = _rod_direction(freekick)[2]
         assert leaning[2] < 0.9 and leaning[1] < -0.3  # diving to the right (−y), where the ball goes
-    scene.controls["keeper"].value = False
-    assert not scene.keeper_nodes.visible and not scene.keeper_head.visible
-    played = scene.state.played
+    freekick.controls["keeper"].value = False
+    assert not freekick.keeper_nodes.visible and not freekick.keeper_head.visible
+    played = freekick.state.played
     assert played is not None and played.result == "goal" and played.keeper_dive is None
-    assert "**GOAL**" in scene.result.content and "Keeper" not in scene.result.content
+    assert "**GOAL**" in freekick.result.content and "Keeper" not in freekick.result.content
 
 
 # ------------------------------------------------------------------------------------------------ goal chance map
-def test_the_goal_chance_map_is_one_click_away_and_is_the_kernels(scene: FreeKickScene) -> None:
-    assert not scene.heat_nodes.visible and not scene.heat_progress.visible
-    scene.heat_button.value = True  # the click
-    assert scene.heat_progress.visible  # the bar shows while the spots are struck
-    assert scene.wait_idle(300.0)
-    assert not scene.heat_progress.visible
-    assert scene.heat_nodes.visible and scene.heat_legend.visible
-    assert scene.params.view == "above"  # a map of the pitch, seen from above
-    chance = scene.odds_map
+def test_the_goal_chance_map_is_one_click_away_and_is_the_kernels(freekick: FreeKickScene) -> None:
+    assert not freekick.heat_nodes.visible and not freekick.heat_progress.visible
+    freekick.heat_button.value = True  # the click
+    assert freekick.heat_progress.visible  # the bar shows while the spots are struck
+    assert freekick.wait_idle(300.0)
+    assert not freekick.heat_progress.visible
+    assert freekick.heat_nodes.visible and freekick.heat_legend.visible
+    assert freekick.params.view == "above"  # a map of the pitch, seen from above
+    chance = freekick.odds_map
     assert chance is not None and chance.shape == (21, 17)
     # The kernel's map for the same strike: 25 m/s at 17°, 9° right of the goal's centre, 8 rev/s of sidespin
     # about +z, 32 strikes per spot, the keeper in goal, RK4 at 10 ms under the measured model.
@@ -950,15 +948,15 @@ def test_the_goal_chance_map_is_one_click_away_and_is_the_kernels(scene: FreeKic
     )["goal"]
     np.testing.assert_array_equal(chance, expected)
     # Each tile's colour is its chance on the ramp: the best spot brightest, and the readout names it.
-    colours = np.asarray(scene.heat_nodes.batched_colors).reshape(21, 17, 3).astype(int)
+    colours = np.asarray(freekick.heat_nodes.batched_colors).reshape(21, 17, 3).astype(int)
     best, worst = np.unravel_index(np.argmax(chance), chance.shape), np.unravel_index(np.argmin(chance), chance.shape)
     assert colours[best].sum() > colours[worst].sum() + 200
-    assert f"goal {100 * chance.max():.0f} %" in scene.heat_status.content
+    assert f"goal {100 * chance.max():.0f} %" in freekick.heat_status.content
     # Moving the ball keeps the map (the same strike from every spot); a new strike hides it and says so.
-    scene.controls["distance_m"].value = 25.0
-    assert scene.heat_nodes.visible
-    scene.controls["spin_rev_s"].value = 5.0
-    assert not scene.heat_nodes.visible and "map it again" in scene.heat_status.content
+    freekick.controls["distance_m"].value = 25.0
+    assert freekick.heat_nodes.visible
+    freekick.controls["spin_rev_s"].value = 5.0
+    assert not freekick.heat_nodes.visible and "map it again" in freekick.heat_status.content
 
 
 def test_the_odds_map_reports_its_progress_to_the_end() -> None:
@@ -968,15 +966,15 @@ def test_the_odds_map_reports_its_progress_to_the_end() -> None:
 
 
 # ------------------------------------------------------------------------------------------------ knuckleball
-def test_the_knuckleball_wobble_is_drawn_ten_times_larger_and_said_in_words(scene: FreeKickScene) -> None:
-    assert not scene.wobble.visible  # a curler has no knuckle force
+def test_the_knuckleball_wobble_is_drawn_ten_times_larger_and_said_in_words(freekick: FreeKickScene) -> None:
+    assert not freekick.wobble.visible  # a curler has no knuckle force
     knuckler = next(preset for preset in PRESETS if preset.params.knuckle)
-    scene.apply(knuckler.params)
-    state = scene.state
-    assert scene.wobble.visible
+    freekick.apply(knuckler.params)
+    state = freekick.state
+    assert freekick.wobble.visible
     # The thin line is the spinless path plus ten times the kick's difference from it, at the same instants, up to
     # the played ball's first contact.
-    drawn = np.asarray(scene.wobble.points)
+    drawn = np.asarray(freekick.wobble.points)
     end = min(float(state.flight.t[-1]), float(state.ghost.t[-1]))
     if state.played is not None and state.played.events:
         end = min(end, state.played.events[0].t)
@@ -987,7 +985,7 @@ def test_the_knuckleball_wobble_is_drawn_ten_times_larger_and_said_in_words(scen
     # A ball's width and a half of wobble at the end becomes metres on the screen.
     sideways = np.abs(drawn[:, 1, 1] - ghost[1:, 1])
     assert 2.5 < sideways.max() < 6.0
-    assert "swerves 0.32 m right at 27 m" in scene.result.content and "10× larger" in scene.result.content
+    assert "swerves 0.32 m right at 27 m" in freekick.result.content and "10× larger" in freekick.result.content
 
 
 @pytest.mark.parametrize("distance", [12.0, 16.0, 22.0, 30.0])

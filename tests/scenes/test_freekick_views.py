@@ -8,7 +8,6 @@ import math
 
 import numpy as np
 import pytest
-from helpers.scenes import MakeScene
 
 from scenes._framing import NOTICE_PX, PANEL_PX, Lens, View, project_points
 from scenes.freekick import VIEW_LABELS, FreeKickScene, ViewName, ball_spot, resample
@@ -42,22 +41,15 @@ class _Tab:
         return contextlib.nullcontext()
 
 
-@pytest.fixture
-def scene(show_scene: MakeScene) -> FreeKickScene:
-    shown = show_scene(FreeKickScene)
-    assert shown.wait_idle()
-    return shown
-
-
-def _off_the_picture(scene: FreeKickScene, tab: _Tab, lens: Lens) -> list[str]:
+def _off_the_picture(freekick: FreeKickScene, tab: _Tab, lens: Lens) -> list[str]:
     """Which of the drawn flight, its no-spin path and the ball have a sample outside the free canvas (left of the
     panel, clear of the software-WebGL notice) of the camera the tab shows."""
     view = View(tab.position, tab.look_at)
-    state, off = scene.state, []
+    state, off = freekick.state, []
     for name, points in (
         ("flight", resample(state.flight)),
         ("no-spin path", resample(state.ghost)),
-        ("ball", ball_spot(scene.params)[None]),
+        ("ball", ball_spot(freekick.params)[None]),
     ):
         xy = project_points(view, lens, points)
         inside = (
@@ -77,26 +69,26 @@ def _off_the_picture(scene: FreeKickScene, tab: _Tab, lens: Lens) -> list[str]:
 @pytest.mark.parametrize("view", list(VIEW_LABELS))
 @pytest.mark.parametrize("kick", list(GROWN_KICKS))
 def test_every_view_keeps_a_grown_flight_and_its_no_spin_path_in_the_picture(
-    scene: FreeKickScene, kick: str, view: ViewName, lens: Lens
+    freekick: FreeKickScene, kick: str, view: ViewName, lens: Lens
 ) -> None:
     tab = _Tab(lens)
-    scene.framing.on_camera(tab)  # the tab opens and is framed
-    scene.controls["view"].value = VIEW_LABELS[view]
-    assert scene.params.view == view and not _off_the_picture(scene, tab, lens)
+    freekick.framing.on_camera(tab)  # the tab opens and is framed
+    freekick.controls["view"].value = VIEW_LABELS[view]
+    assert freekick.params.view == view and not _off_the_picture(freekick, tab, lens)
     for name, value in GROWN_KICKS[kick]:
-        scene.controls[name].value = value
-        assert getattr(scene.params, name) == value
-        assert not _off_the_picture(scene, tab, lens), (kick, view, name, value)
+        freekick.controls[name].value = value
+        assert getattr(freekick.params, name) == value
+        assert not _off_the_picture(freekick, tab, lens), (kick, view, name, value)
 
 
-def test_a_kick_that_still_fits_leaves_the_persons_view_alone(scene: FreeKickScene) -> None:
+def test_a_kick_that_still_fits_leaves_the_persons_view_alone(freekick: FreeKickScene) -> None:
     """Only a flight that leaves the picture moves the camera: a person's orbit survives a small change."""
     lens = LENSES[0]
     tab = _Tab(lens)
-    scene.framing.on_camera(tab)
-    scene.framing.on_camera(tab)  # the framed view reported back: from now on moves are the person's
+    freekick.framing.on_camera(tab)
+    freekick.framing.on_camera(tab)  # the framed view reported back: from now on moves are the person's
     eye, centre = np.asarray(tab.position), np.asarray(tab.look_at)
     tab.position = tuple(centre + 1.3 * (eye - centre))  # the person zooms out a little
-    orbited, frames = tab.position, scene.framing.frames
-    scene.controls["spin_rev_s"].value = 8.5
-    assert scene.framing.frames == frames and tab.position == orbited
+    orbited, frames = tab.position, freekick.framing.frames
+    freekick.controls["spin_rev_s"].value = 8.5
+    assert freekick.framing.frames == frames and tab.position == orbited

@@ -7,7 +7,6 @@ import dataclasses
 
 import numpy as np
 import pytest
-from helpers.scenes import MakeScene
 
 from kernels import ball
 from scenes.freekick import FreeKickParams, FreeKickScene
@@ -22,57 +21,50 @@ from scenes.freekick.model import (
 )
 
 
-@pytest.fixture
-def scene(show_scene: MakeScene) -> FreeKickScene:
-    shown = show_scene(FreeKickScene)
-    assert shown.wait_idle()
-    return shown
-
-
-def _show(scene: FreeKickScene, **changes: object) -> str:
+def _show(freekick: FreeKickScene, **changes: object) -> str:
     """The readout once the scene shows the default kick with ``changes``."""
-    scene.apply(dataclasses.replace(FreeKickParams(), **changes))  # type: ignore[arg-type]
-    return scene.result.content
+    freekick.apply(dataclasses.replace(FreeKickParams(), **changes))  # type: ignore[arg-type]
+    return freekick.result.content
 
 
 def _keeper_line(readout: str) -> str:
     return next(line for line in readout.splitlines() if line.startswith("Keeper"))
 
 
-def test_the_keeper_says_whose_right_he_dives_to(scene: FreeKickScene) -> None:
+def test_the_keeper_says_whose_right_he_dives_to(freekick: FreeKickScene) -> None:
     # Reported: "Keeper dives right" for a ball that crossed 4.64 m to the left, 26.75 m up. He faces the kicker:
     # he dived to the kicker's right, his own left, reading the ball as if it flew on straight; the words now say
     # whose side. He no longer dives at all for a ball that never comes at his goal, as that one.
-    readout = _show(scene, distance_m=40.0, speed_ms=40.0, elevation_deg=50.0)
-    crossing = scene.state.outcome.goal_point
+    readout = _show(freekick, distance_m=40.0, speed_ms=40.0, elevation_deg=50.0)
+    crossing = freekick.state.outcome.goal_point
     assert crossing is not None and crossing[1] > 4.0 and crossing[2] > 20.0
-    assert scene.state.played is not None and scene.state.played.keeper_dive is None
+    assert freekick.state.played is not None and freekick.state.played.keeper_dive is None
     assert "never dives: the ball never comes at his goal" in _keeper_line(readout)
-    readout = _show(scene, azimuth_deg=-14.0)  # struck to the kicker's right, in off his fingertips
-    dive = scene.state.played.keeper_dive if scene.state.played is not None else None
+    readout = _show(freekick, azimuth_deg=-14.0)  # struck to the kicker's right, in off his fingertips
+    dive = freekick.state.played.keeper_dive if freekick.state.played is not None else None
     assert dive is not None and dive.target[1] < 0.0
     assert "dives to his left (your right)" in _keeper_line(readout)
     # The other way round: he goes to his right, the kicker's left.
-    assert "dives to his right (your left)" in _keeper_line(_show(scene, azimuth_deg=-2.0))
+    assert "dives to his right (your left)" in _keeper_line(_show(freekick, azimuth_deg=-2.0))
 
 
-def test_a_keeper_who_goes_straight_up_jumps(scene: FreeKickScene) -> None:
+def test_a_keeper_who_goes_straight_up_jumps(freekick: FreeKickScene) -> None:
     # Reported: a keeper going up for a ball read at him "dives up".
-    line = _keeper_line(_show(scene, azimuth_deg=-7.0))
+    line = _keeper_line(_show(freekick, azimuth_deg=-7.0))
     assert "jumps 0.67 s after the kick" in line and "dives" not in line
 
 
-def test_how_near_the_keeper_came_is_said_only_when_he_came_near(scene: FreeKickScene) -> None:
+def test_how_near_the_keeper_came_is_said_only_when_he_came_near(freekick: FreeKickScene) -> None:
     # Reported: "gets within 24.04 m of the ball": a distance that large says nothing.
-    far = _keeper_line(_show(scene, distance_m=40.0, speed_ms=40.0, elevation_deg=50.0))
+    far = _keeper_line(_show(freekick, distance_m=40.0, speed_ms=40.0, elevation_deg=50.0))
     assert " m of the ball" not in far and "beats him by" not in far
-    assert "gets within" not in _keeper_line(_show(scene, speed_ms=25.0, wall_jumps=True))
-    near = _keeper_line(_show(scene, azimuth_deg=-12.0, elevation_deg=20.0))  # off the bar, past his hands
+    assert "gets within" not in _keeper_line(_show(freekick, speed_ms=25.0, wall_jumps=True))
+    near = _keeper_line(_show(freekick, azimuth_deg=-12.0, elevation_deg=20.0))  # off the bar, past his hands
     assert "gets within 0.20 m of the ball" in near
-    assert "the ball beats him by 0.07 m" in _keeper_line(_show(scene, azimuth_deg=-14.0))
+    assert "the ball beats him by 0.07 m" in _keeper_line(_show(freekick, azimuth_deg=-14.0))
     # Reported: the "Driven, off the post" preset said "gets within 2.00 m", 1.996 m rounded onto the cut-off.
     for preset in PRESETS:
-        line = _keeper_line(_show(scene, **dataclasses.asdict(preset.params)))
+        line = _keeper_line(_show(freekick, **dataclasses.asdict(preset.params)))
         assert "within 2.00 m" not in line and "by 2.00 m" not in line, (preset.label, line)
 
 
@@ -81,35 +73,35 @@ def test_how_near_the_keeper_came_is_said_only_when_he_came_near(scene: FreeKick
     [{"speed_ms": 25.0, "wall_jumps": True}, {"speed_ms": 26.0, "elevation_deg": 13.0}],
     ids=["jumping wall", "standing wall"],
 )
-def test_a_ball_blocked_by_the_wall_has_no_goal_line_crossing(scene: FreeKickScene, changes: dict) -> None:
+def test_a_ball_blocked_by_the_wall_has_no_goal_line_crossing(freekick: FreeKickScene, changes: dict) -> None:
     # Reported: with the ball blocked by the wall the readout said "At the goal line: y = −0.39 m, z = 1.59 m", the
     # free flight's crossing, for a ball that never got there.
-    readout = _show(scene, **changes)
-    played = scene.state.played
+    readout = _show(freekick, **changes)
+    played = freekick.state.played
     assert played is not None and played.result == "wall", changes
-    assert scene.state.outcome.goal_point is not None  # the free flight, through the wall, crosses the line
+    assert freekick.state.outcome.goal_point is not None  # the free flight, through the wall, crosses the line
     assert readout.startswith("**Blocked by the wall**")
     assert "At the goal line" not in readout
 
 
-def test_a_ball_that_reaches_the_goal_line_says_where(scene: FreeKickScene) -> None:
-    readout = _show(scene, azimuth_deg=-20.0)
-    crossing = scene.state.outcome.goal_point
+def test_a_ball_that_reaches_the_goal_line_says_where(freekick: FreeKickScene) -> None:
+    readout = _show(freekick, azimuth_deg=-20.0)
+    crossing = freekick.state.outcome.goal_point
     assert crossing is not None
     assert f"At the goal line: **y = {crossing[1]:+.2f} m, z = {crossing[2]:.2f} m**" in readout
 
 
-def test_a_ball_wide_and_far_over_the_bar_reads_so(scene: FreeKickScene) -> None:
+def test_a_ball_wide_and_far_over_the_bar_reads_so(freekick: FreeKickScene) -> None:
     # Reported: "Wide of the post" for a ball crossing the goal line 26.75 m up. The kernel's verdict stays "wide"
     # (outside the posts it never says over); the headline says it was over the bar's height too.
-    readout = _show(scene, distance_m=40.0, speed_ms=40.0, elevation_deg=50.0)
-    played, crossing = scene.state.played, scene.state.outcome.goal_point
+    readout = _show(freekick, distance_m=40.0, speed_ms=40.0, elevation_deg=50.0)
+    played, crossing = freekick.state.played, freekick.state.outcome.goal_point
     assert played is not None and played.result == "wide" and crossing is not None
     assert crossing[2] > 20.0
     assert readout.splitlines()[0].strip() == "**Wide and over the bar**"
     # A ball wide at a keeper's height is wide of the post.
-    readout = _show(scene, azimuth_deg=-20.0)
-    crossing = scene.state.outcome.goal_point
+    readout = _show(freekick, azimuth_deg=-20.0)
+    crossing = freekick.state.outcome.goal_point
     assert crossing is not None and crossing[2] < ball.GOAL_HEIGHT_M
     assert readout.splitlines()[0].strip() == "**Wide of the post**"
 
@@ -127,13 +119,13 @@ def test_keeper_words_never_give_a_far_distance() -> None:
 
 
 # ------------------------------------------------------------------------------------------------ goal chance map
-def test_a_map_where_no_spot_scores_names_no_best_spot(scene: FreeKickScene) -> None:
+def test_a_map_where_no_spot_scores_names_no_best_spot(freekick: FreeKickScene) -> None:
     # Reported: with every tile 0 % the map still named "Best spot: 16 m, 40° right: goal 0 %".
-    scene.apply(dataclasses.replace(FreeKickParams(), speed_ms=5.0))  # short of the goal from every spot
-    scene.heat_button.value = True  # the click
-    assert scene.wait_idle(300.0)
-    assert scene.odds_map is not None and not scene.odds_map.any()
-    status = scene.heat_status.content
+    freekick.apply(dataclasses.replace(FreeKickParams(), speed_ms=5.0))  # short of the goal from every spot
+    freekick.heat_button.value = True  # the click
+    assert freekick.wait_idle(300.0)
+    assert freekick.odds_map is not None and not freekick.odds_map.any()
+    status = freekick.heat_status.content
     assert "No spot on the map scores" in status and "Best spot" not in status
 
 
