@@ -408,7 +408,7 @@ def _pitch_vector(pitch: Pitch, spot: NDArray[np.float64], ground: float, radius
 
 def _simulate_on_pitch(launch: NDArray[np.float64], settings: NDArray[np.float64], pitch: Pitch) -> Trajectory:
     vector = _pitch_vector(pitch, launch[:2], float(settings[GROUND]), float(settings[RADIUS]))
-    _refuse_off_pitch(launch[None], vector[None], _FIRST, settings)
+    _refuse_unplayable(launch[None], vector[None], _FIRST, settings)
     rows = int(settings[N_STEPS]) + 1 + play.EXTRA_ROWS
     t, state, spin, forces = np.empty(rows), np.empty((rows, 6)), np.empty((rows, 3)), np.empty((rows, 12))
     events, info = np.empty((play.MAX_EVENTS, 5)), np.empty(play.N_INFO)
@@ -496,7 +496,7 @@ MAX_PITCH_DT_S = 0.05
 middle, so a coarser step can decide the verdict (the default kick, a goal at dt ≤ 0.1 s, was saved at 0.3 s)."""
 
 
-def _refuse_off_pitch(
+def _refuse_unplayable(
     launches: NDArray[np.float64], pitches: NDArray[np.float64], which: NDArray[np.int64], settings: NDArray[np.float64]
 ) -> None:
     """``ValueError`` naming ``dt`` where it is over :data:`MAX_PITCH_DT_S`, or the first kick that starts off its
@@ -563,7 +563,7 @@ def _play_batch(
     events, info, n_samples, endings); flights kept only when ``keep`` (else zero-length rows, and each flight ends
     once its verdict cannot change)."""
     k = len(launches)
-    _refuse_off_pitch(launches, pitches, which, settings)
+    _refuse_unplayable(launches, pitches, which, settings)
     rows = int(settings[N_STEPS]) + 1 + play.EXTRA_ROWS if keep else 0
     t, state, spin = np.empty((k, rows)), np.empty((k, rows, 6)), np.empty((k, rows, 3))
     events, info = np.empty((k, play.MAX_EVENTS, 5)), np.empty((k, play.N_INFO))
