@@ -95,15 +95,17 @@ def main() -> None:
     vector.setflags(write=False)  # as the public functions pass it
     rows = int(settings[N_STEPS]) + 1 + play.EXTRA_ROWS
     buffers = (
-        np.empty(rows),
-        np.empty((rows, 6)),
-        np.empty((rows, 3)),
-        np.empty((rows, 12)),
-        np.empty((play.MAX_EVENTS, 5)),
-        np.empty(play.N_INFO),
+        np.empty((1, rows)),
+        np.empty((1, rows, 6)),
+        np.empty((1, rows, 3)),
+        np.empty((1, rows, 12)),
+        np.empty((1, play.MAX_EVENTS, 5)),
+        np.empty((1, play.N_INFO)),
+        np.empty(1, dtype=np.int64),
+        np.empty(1, dtype=np.int64),
     )
-    core = play.play_one
-    median, p95 = timings(lambda: core(launch, settings, vector, *buffers), 2000)
+    core, first = play.play_rows, np.zeros(1, dtype=np.int64)
+    median, p95 = timings(lambda: core(0, 1, launch[None], settings, vector[None], first, *buffers), 2000)
     print(f"| one RK4 kick with collisions, compiled core | {median * 1e6:.1f} µs | p95 {p95 * 1e6:.1f} µs |")
     free_rows = int(settings[N_STEPS]) + 1
     free = (np.empty(free_rows), np.empty((free_rows, 6)), np.empty((free_rows, 12)))

@@ -51,7 +51,6 @@ judge_rows = Entry(core.judge_rows)
 pad = Entry(core.pad)
 simulate_one = Entry(core.simulate_one)
 stable_step = Entry(core.stable_step)
-play_one = Entry(play.play_one)
 play_rows = Entry(play.play_rows)
 keeper_path_core = Entry(play.keeper_path)
 
@@ -410,9 +409,14 @@ def _simulate_on_pitch(launch: NDArray[np.float64], settings: NDArray[np.float64
     vector = _pitch_vector(pitch, launch[:2], float(settings[GROUND]), float(settings[RADIUS]))
     _refuse_unplayable(launch[None], vector[None], _FIRST, settings)
     rows = int(settings[N_STEPS]) + 1 + play.EXTRA_ROWS
-    t, state, spin, forces = np.empty(rows), np.empty((rows, 6)), np.empty((rows, 3)), np.empty((rows, 12))
-    events, info = np.empty((play.MAX_EVENTS, 5)), np.empty(play.N_INFO)
-    n, ending = play_one(launch, settings, vector, t, state, spin, forces, events, info)
+    # A batch of one: the long compiled flight on a pitch has one entry, compiled once, not one for each use.
+    t, (state, spin, forces) = np.empty((1, rows)), (np.empty((1, rows, width)) for width in (6, 3, 12))
+    events, info = np.empty((1, play.MAX_EVENTS, 5)), np.empty((1, play.N_INFO))
+    n_samples, endings = np.empty(1, dtype=np.int64), np.empty(1, dtype=np.int64)
+    kick = (launch[None], settings, vector[None], _FIRST, t, state, spin, forces, events, info, n_samples, endings)
+    play_rows(0, 1, *kick)
+    n, ending, t, state, spin, forces = int(n_samples[0]), int(endings[0]), t[0], state[0], spin[0], forces[0]
+    events, info = events[0], info[0]
     if ending in (3, 4, 9):
         _refuse_overflow(np.array([ending]), settings, launch[None])
     return dataclasses.replace(
@@ -568,7 +572,8 @@ def _play_batch(
     t, state, spin = np.empty((k, rows)), np.empty((k, rows, 6)), np.empty((k, rows, 3))
     events, info = np.empty((k, play.MAX_EVENTS, 5)), np.empty((k, play.N_INFO))
     n_samples, endings = np.ones(k, dtype=np.int64), np.full(k, 2, dtype=np.int64)
-    run_rows(play_rows, k, launches, settings, pitches, which, t, state, spin, events, info, n_samples, endings)
+    forces = np.empty((k, 0, 12))  # a batch keeps no forces
+    run_rows(play_rows, k, launches, settings, pitches, which, t, state, spin, forces, events, info, n_samples, endings)
     _refuse_overflow(endings, settings, launches)
     return t, state, spin, events, info, n_samples, endings
 

@@ -802,14 +802,10 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
 
 
 @compiled()
-def play_one(launch, config, pitch, t_out, state_out, spin_out, forces_out, events, info):
-    """:func:`simulate` on a pitch, compiled: the kick's constants, its flight, and the forces at each sample (the
-    spin of the sample; no Magnus force while rolling; the knuckle force only before the first contact)."""
-    kick = np.empty(N_KICK)
-    fill_kick(launch, config, kick)
-    gain = kick[GAIN]
-    n, ending = play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info)
-    first = info[I_FIRST] if not math.isnan(info[I_FIRST]) else math.inf
+def _forces_along(t_out, state_out, spin_out, n, first, kick, gain, config, forces_out):
+    """The forces at each of a played flight's ``n`` samples, into ``forces_out`` (T, 12): each sample's spin, no
+    Magnus force while rolling, the knuckle force (``gain``) only before the ``first`` contact (s). Returns whether
+    every force is finite."""
     i = 0
     while i < n:  # one call of the force law per run of samples with one spin, on one side of the first contact
         before = t_out[i] < first
@@ -829,23 +825,43 @@ def play_one(launch, config, pitch, t_out, state_out, spin_out, forces_out, even
     for i in range(n):
         if state_out[i, 2] == config[GROUND] and state_out[i, 5] == 0.0 and t_out[i] >= first:
             forces_out[i, 3], forces_out[i, 4], forces_out[i, 5] = 0.0, 0.0, 0.0  # rolling: no lift off the turf
-    if not np.isfinite(forces_out[:n]).all():
-        ending = DIVERGED
-    return n, ending
+    return np.isfinite(forces_out[:n]).all()
 
 
 @compiled(nogil=True)
 def play_rows(
-    start, stop, launches, config, pitches, which, t_out, state_out, spin_out, events, info, n_samples, endings
+    start,
+    stop,
+    launches,
+    config,
+    pitches,
+    which,
+    t_out,
+    state_out,
+    spin_out,
+    forces_out,
+    events,
+    info,
+    n_samples,
+    endings,
 ):
     """:func:`play` for kicks ``start`` to ``stop``, without the GIL (threads share a batch:
     :func:`kernels._rows.run_rows`), kick k on pitch ``pitches[which[k]]`` ((P, N_PITCH) and (K,)): its samples into
     row k of ``t_out`` (K, T), ``state_out`` (K, T, 6), ``spin_out`` (K, T, 3) (T = 0: verdicts only, and each flight
-    ends once its verdict cannot change), its contacts into ``events`` (K, MAX_EVENTS, 5) and its summary into
-    ``info`` (K, N_INFO)."""
+    ends once its verdict cannot change) and the forces at them into ``forces_out`` (K, T, 12) (where it has T rows;
+    a batch passes (K, 0, 12): no forces), its contacts into ``events`` (K, MAX_EVENTS, 5) and its summary into
+    ``info`` (K, N_INFO). One compiled entry serves a single kick (K = 1) and a batch, so the long flight on a pitch
+    is compiled into one entry, not two."""
     kick = np.empty(N_KICK)
+    with_forces = forces_out.shape[1] > 0
     for k in range(start, stop):
         fill_kick(launches[k], config, kick)
-        n_samples[k], endings[k] = play(
+        gain = kick[GAIN]  # play() drops the knuckle force at the first contact
+        n, ending = play(
             launches[k], kick, config, pitches[which[k]], t_out[k], state_out[k], spin_out[k], events[k], info[k]
         )
+        if with_forces:
+            first = info[k, I_FIRST] if not math.isnan(info[k, I_FIRST]) else math.inf
+            if not _forces_along(t_out[k], state_out[k], spin_out[k], n, first, kick, gain, config, forces_out[k]):
+                ending = DIVERGED
+        n_samples[k], endings[k] = n, ending
