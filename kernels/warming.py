@@ -26,6 +26,7 @@ import logging
 import os
 import subprocess
 import sys
+import tempfile
 import threading
 import time
 import types
@@ -41,6 +42,12 @@ logger = logging.getLogger(__name__)
 
 MODULES: tuple[str, ...] = ("kernels.fabrik", "kernels.ball", "kernels.course")
 """The kernel packages with compiled code, each with a ``warm_up()`` that compiles every core it has."""
+
+PROCESSES: tuple[tuple[str, ...], ...] = (("kernels.fabrik",), ("kernels.course", "kernels.ball"))
+"""Which cold packages compile in one child process, in order: the two large ones (about 13 CPU-s each on a 2-core
+machine) apart, the small course package (about 1 s) first in the ball's, so that no third child pays Python's,
+numba's and LLVM's start (about 0.7 CPU-s, which on two cores the large ones would wait for). A package in none of
+them compiles in a child of its own."""
 
 LABELS: dict[str, str] = {
     "kernels.fabrik": "inverse kinematics",
@@ -143,7 +150,12 @@ class Entry(Generic[P, R]):
         self.__name__ = compiled.__name__
 
     def __call__(self, *args: P.args, **kwargs: P.kwargs) -> R:
-        if _STATE.pending and not self.compiled.signatures and self.package in _STATE.pending:
+        if (
+            _STATE.pending
+            and not self.compiled.signatures
+            and self.package in _STATE.pending
+            and not getattr(_LOADING, "here", False)
+        ):
             try:
                 return python_twin(self.compiled)(*args, **kwargs)
             except Exception:  # a twin that cannot run this input: wait for the compiled code instead
@@ -195,9 +207,10 @@ def describe(progress: Progress) -> str:
 def start(modules: Sequence[str] = MODULES, *, processes: bool = True) -> threading.Thread | None:
     """Compile ``modules``' kernels in the background; until each is ready its entries run as plain Python.
 
-    With ``processes`` each package compiles in a child process of its own (numba's compile holds this process's
-    GIL for most of its time; children use the other cores and write the disk cache), then loads here from the
-    cache; without, or where a child fails, it compiles on a thread here. Returns the thread that waits for them
+    With ``processes`` the packages compile in the child processes of :data:`PROCESSES` (numba's compile holds
+    this process's GIL for most of its time; children use the other cores and write the disk cache), and each loads
+    here from the cache as soon as its child is done with it; without, or where a child fails, it compiles on a
+    thread here. Returns the thread that waits for them
     (None when already started).
     """
     cold = tuple(name for name in modules if not has_cache(name))
@@ -215,14 +228,19 @@ def start(modules: Sequence[str] = MODULES, *, processes: bool = True) -> thread
 
 
 def _compile_all(modules: tuple[str, ...], cold: set[str], processes: bool) -> None:
-    """Compile every cold package at once (a child process each) and load each here as soon as its child is done;
-    load the warm ones from the cache meanwhile."""
+    """Compile every cold package at once (in the child processes of :data:`PROCESSES`) and load each here as soon
+    as its child reports it done; load the warm ones from the cache meanwhile."""
+    groups: list[tuple[str, ...]] = []
+    if processes:
+        ours = [tuple(name for name in group if name in cold) for group in PROCESSES]
+        groups = [group for group in ours if group] + [
+            (name,) for name in modules if name in cold and not any(name in group for group in PROCESSES)
+        ]
+    here = [name for name in modules if not any(name in group for group in groups)]
     waiters = [
-        threading.Thread(
-            target=_compile_one, args=(name, processes and name in cold), name=f"kernels-warming-{name}", daemon=True
-        )
-        for name in modules
-    ]
+        threading.Thread(target=_compile_group, args=(group,), name=f"kernels-warming-{group[0]}", daemon=True)
+        for group in groups
+    ] + [threading.Thread(target=_load, args=(name,), name=f"kernels-warming-{name}", daemon=True) for name in here]
     for waiter in waiters:
         waiter.start()
     for waiter in waiters:
@@ -232,25 +250,50 @@ def _compile_all(modules: tuple[str, ...], cold: set[str], processes: bool) -> N
     logger.info("compiled kernels ready in %.1f s", time.perf_counter() - started)
 
 
-def _compile_one(name: str, in_a_child: bool) -> None:
-    child = _spawn(name) if in_a_child else None
+def _compile_group(names: tuple[str, ...]) -> None:
+    """Compile ``names`` in one child process, in order, loading each here as soon as the child says it is done;
+    whatever the child did not finish (it failed, or could not start) compiles here instead."""
+    child = _spawn(names)
+    left = list(names)
     if child is not None:
-        _, errors = child.communicate()
+        assert child.stdout is not None
+        for line in child.stdout:  # the child prints each package's name once its cache is written
+            name = line.decode(errors="replace").strip()
+            if name in left and not _EXITING.is_set():
+                left.remove(name)
+                _load(name)
+        child.wait()
+        errors = _tail(child)
         if _EXITING.is_set():  # the app is exiting and stopped the child: nothing to load, nothing to say
             return
-        if child.returncode != 0:  # it failed: the load below compiles here instead, and the log says why
-            logger.warning("the compile process for %s failed: %s", name, errors.decode(errors="replace")[-2000:])
+        if child.returncode != 0:  # it failed: the loads below compile here instead, and the log says why
+            logger.warning("the compile process for %s failed: %s", ", ".join(left), errors)
+    for name in left:
+        _load(name)
+
+
+def _load(name: str) -> None:
+    """Load ``name``'s compiled code from the cache (or compile it here, where the cache lacks it)."""
+    _LOADING.here = True  # this thread's entries call their dispatchers while the package is still pending
     try:
-        importlib.import_module(name).warm_up()  # loads what the child cached, or compiles here
+        importlib.import_module(name).warm_up()
     except Exception:  # the kernel then compiles on first use instead; say why (unless the app is exiting)
         if not _EXITING.is_set():
             logger.exception("compiling %s failed", name)
         return
+    finally:
+        _LOADING.here = False
     _finish(name)
+
+
+_LOADING = threading.local()
+"""``here`` is True on a thread that is loading (or compiling) a package: its entries run compiled code, not twins."""
 
 
 _CHILDREN: list[subprocess.Popen[bytes]] = []
 """Compile processes started here; any still running when this process exits is stopped with it."""
+_ERRORS: dict[int, Any] = {}
+"""Each compile process's stderr file, by its pid."""
 _EXITING = threading.Event()
 """Set when this process exits: a compile cut short then is neither loaded nor reported."""
 
@@ -273,17 +316,38 @@ def has_cache(package: str) -> bool:
     return False
 
 
-def _spawn(name: str) -> subprocess.Popen[bytes] | None:
-    command = [sys.executable, "-c", f"import {name} as m; m.warm_up()"]
-    try:
-        child = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, env=os.environ.copy())
+_CHILD = (
+    "import importlib, sys\n"
+    "for name in sys.argv[1:]:\n"
+    "    importlib.import_module(name).warm_up()\n"
+    "    print(name, flush=True)\n"
+)
+"""What a compile process runs: each package's ``warm_up()`` (which writes numba's cache), its name printed after."""
+
+
+def _spawn(names: tuple[str, ...]) -> subprocess.Popen[bytes] | None:
+    command = [sys.executable, "-c", _CHILD, *names]
+    try:  # stderr to a file: a pipe the waiter does not read while it reads stdout could fill and stall the child
+        errors = tempfile.TemporaryFile()
+        child = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=errors, env=os.environ.copy())
     except OSError:
-        logger.warning("could not start a compile process for %s; compiling here", name)
+        logger.warning("could not start a compile process for %s; compiling here", ", ".join(names))
         return None
+    _ERRORS[child.pid] = errors
     if not _CHILDREN:
         atexit.register(_stop_children)
     _CHILDREN.append(child)
     return child
+
+
+def _tail(child: subprocess.Popen[bytes]) -> str:
+    """The end of what ``child`` wrote to stderr (where :func:`_spawn` kept it)."""
+    errors = _ERRORS.pop(child.pid, None)
+    if errors is None:
+        return ""
+    with errors:
+        errors.seek(0)
+        return errors.read().decode(errors="replace")[-2000:]
 
 
 def _stop_children() -> None:

@@ -200,6 +200,11 @@ def test_start_reports_progress_and_then_hands_calls_to_compiled_code(
     fresh_warming: None, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     monkeypatch.setattr(warming, "has_cache", lambda package: False)  # as on a first start
+    twins: list[str] = []
+    real_twin = warming.python_twin
+    monkeypatch.setattr(
+        warming, "python_twin", lambda dispatcher: twins.append(dispatcher.__name__) or real_twin(dispatcher)
+    )
     seen: list[warming.Progress] = []
     warming.on_progress(seen.append)
     thread = warming.start(("kernels.course",), processes=False)
@@ -212,6 +217,7 @@ def test_start_reports_progress_and_then_hands_calls_to_compiled_code(
     assert "course ride" in warming.describe(warming.Progress(done=(), pending=("kernels.course",), elapsed_s=1.0))
     ride_module = sys.modules["kernels.course.ride"]
     assert ride_module._ride_core_entry.compiled.signatures  # compiled (or loaded) by start
+    assert twins == []  # the load ran the compiled code (it had run the twins, compiling nothing, while pending)
 
 
 def test_a_package_with_a_cache_index_loads_in_process_one_without_compiles_in_a_child(
@@ -257,13 +263,14 @@ def test_exiting_while_a_package_compiles_stops_its_child_and_says_nothing(
     package.warm_up = lambda: loads.append("slow_kernels")  # pyright: ignore[reportAttributeAccessIssue]
     monkeypatch.setitem(sys.modules, "slow_kernels", package)
 
-    def slow_child(name: str) -> subprocess.Popen[bytes]:
-        child = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"], stderr=subprocess.PIPE)
+    def slow_child(names: tuple[str, ...]) -> subprocess.Popen[bytes]:
+        command = [sys.executable, "-c", "import time; time.sleep(60)"]
+        child = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
         warming._CHILDREN.append(child)
         return child
 
     monkeypatch.setattr(warming, "_spawn", slow_child)
-    waiter = threading.Thread(target=warming._compile_one, args=("slow_kernels", True))
+    waiter = threading.Thread(target=warming._compile_group, args=(("slow_kernels",),))
     with caplog.at_level("DEBUG", logger="kernels.warming"):
         waiter.start()
         while not warming._CHILDREN:
@@ -275,3 +282,47 @@ def test_exiting_while_a_package_compiles_stops_its_child_and_says_nothing(
     assert loads == []  # nothing compiled or loaded here while exiting
     assert caplog.records == []
     assert "slow_kernels" not in warming.progress().done
+
+
+def test_a_shared_compile_process_hands_over_each_package_as_soon_as_it_is_done(
+    fresh_warming: None, tmp_path: Any, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # Two packages in one child: the first loads here while the child still compiles the second (which, in the
+    # child, waits on a FIFO that the test opens only once it has seen the first done).
+    import os
+    import threading
+
+    fifo = tmp_path / "go"
+    os.mkfifo(fifo)
+    (tmp_path / "quick_kernels.py").write_text("def warm_up():\n    pass\n")
+    in_the_child = f"os.getpid() != {os.getpid()}"  # not when this process loads it after the child
+    child_waits = f"import os\n\ndef warm_up():\n    if {in_the_child}:\n        open({str(fifo)!r}).read()\n"
+    (tmp_path / "waiting_kernels.py").write_text(child_waits)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.setenv("PYTHONPATH", os.pathsep.join([str(tmp_path), os.environ.get("PYTHONPATH", "")]))
+    monkeypatch.setattr(warming, "PROCESSES", (("quick_kernels", "waiting_kernels"),))
+    monkeypatch.setattr(warming, "has_cache", lambda package: False)
+    first_done = threading.Event()
+    seen: list[warming.Progress] = []
+
+    def listener(progress: warming.Progress) -> None:
+        seen.append(progress)
+        first_done.set()
+
+    warming.on_progress(listener)
+    thread = warming.start(("quick_kernels", "waiting_kernels"))
+    assert thread is not None
+    assert first_done.wait(60)
+    assert seen[0].done == ("quick_kernels",) and seen[0].pending == ("waiting_kernels",)
+    with open(fifo, "w") as go:  # now let the child finish the second package
+        go.write("go")
+    thread.join(60)
+    assert not thread.is_alive()
+    assert [progress.done for progress in seen] == [("quick_kernels",), ("quick_kernels", "waiting_kernels")]
+    assert len(warming._CHILDREN) >= 1 and warming._CHILDREN[-1].returncode == 0  # both compiled in one child
+
+
+def test_the_small_course_package_shares_the_ball_s_compile_process() -> None:
+    # A third child would cost Python's, numba's and LLVM's start on a machine where two children fill the cores.
+    assert warming.PROCESSES == (("kernels.fabrik",), ("kernels.course", "kernels.ball"))
+    assert sorted(name for group in warming.PROCESSES for name in group) == sorted(warming.MODULES)
