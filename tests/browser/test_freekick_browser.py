@@ -15,11 +15,11 @@ from helpers.browser import (
     TOAST,
     NumberChange,
     ScenePage,
-    assert_chart_fits_after,
     assert_in_view,
     assert_seen,
     changed_mask,
     chart_and_text_tests,
+    chart_fits_test,
     colour_pixels,
     error_text,
     panel_rect,
@@ -219,9 +219,9 @@ HARDEST_KICK = [
 """The hardest, most spun kick: the force axis grows from a few newtons to over ten."""
 
 
-def test_the_force_chart_tick_labels_stay_inside_its_canvas(shown: ScenePage) -> None:
-    assert isinstance(shown.scene, FreeKickScene)
-    assert_chart_fits_after(shown, CHART, HARDEST_KICK, lambda scene: scene.chart.data, peaks_over(10.0))
+test_the_force_chart_tick_labels_stay_inside_its_canvas = chart_fits_test(
+    FreeKickScene, CHART, HARDEST_KICK, lambda scene: scene.chart.data, peaks_over(10.0)
+)
 
 
 KEEPER = ["/freekick/keeper", "/freekick/keeper_head"]

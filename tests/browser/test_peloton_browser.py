@@ -18,10 +18,10 @@ from helpers.browser import (
     NumberChange,
     ScenePage,
     assert_chart_draws,
-    assert_chart_fits_after,
     assert_in_view,
     assert_seen,
     chart_and_text_tests,
+    chart_fits_test,
     chart_image,
     colour_pixels,
     control_row,
@@ -164,9 +164,9 @@ BIG_RIDER_INTO_A_GALE = [
 """A bigger rider into a gale: the power axis reaches "20,000" W (it ran 7 px off the canvas's left edge)."""
 
 
-def test_the_chart_tick_labels_stay_inside_its_canvas(shown: ScenePage) -> None:
-    assert isinstance(shown.scene, PelotonScene)
-    assert_chart_fits_after(shown, CHART, BIG_RIDER_INTO_A_GALE, lambda scene: scene.chart.data, peaks_over(10_000.0))
+test_the_chart_tick_labels_stay_inside_its_canvas = chart_fits_test(
+    PelotonScene, CHART, BIG_RIDER_INTO_A_GALE, lambda scene: scene.chart.data, peaks_over(10_000.0)
+)
 
 
 def choose(page: Any, label: str, option: str) -> None:

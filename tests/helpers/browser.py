@@ -792,6 +792,20 @@ def assert_chart_fits_after(
     _type_numbers(shown, [(c.label, c.field, c.restore) for c in changes], "back")
 
 
+def chart_fits_test(
+    kind: type, title: str, changes: Sequence[NumberChange], chart_data: Any, check: Callable[[Any], None]
+) -> Any:
+    """A test for a module with a ``shown`` fixture (assign it to a ``test_…`` name): the page shows a scene of class
+    ``kind``, and chart ``title``'s tick labels stay inside its canvas before and after the ``changes``
+    (:func:`assert_chart_fits_after`, with its ``chart_data`` and ``check``)."""
+
+    def test_the_chart_tick_labels_stay_inside_its_canvas(shown: ScenePage) -> None:
+        assert isinstance(shown.scene, kind)
+        assert_chart_fits_after(shown, title, changes, chart_data, check)
+
+    return test_the_chart_tick_labels_stay_inside_its_canvas
+
+
 def peaks_over(limit: float) -> Callable[[Any], None]:
     """A ``check`` for :func:`assert_chart_fits_after`: some series of the chart's data (after its x values) rises
     over ``limit``."""
