@@ -12,10 +12,10 @@ from helpers.browser import (
     NumberChange,
     ScenePage,
     assert_chart_draws,
-    assert_chart_fits_after,
     assert_in_view,
     assert_seen,
     changed_mask,
+    chart_fits_test,
     control_row,
     error_text,
     project,
@@ -113,20 +113,18 @@ def test_three_d_shows_the_floor_grid_from_an_angle(shown: ScenePage) -> None:
     settle(shown)
 
 
-def test_the_error_plot_tick_labels_stay_inside_its_canvas(shown: ScenePage) -> None:
-    assert isinstance(shown.scene, ArmScene)
+def _reaches_hundredths(data: Any) -> None:
+    assert float(np.min(data[1])) < 0.1
 
-    def reaches_hundredths(data: Any) -> None:
-        assert float(np.min(data[1])) < 0.1
 
-    # A tighter tolerance: the log axis runs down to hundredths of a millimetre ("0.01", wider than "1").
-    assert_chart_fits_after(
-        shown,
-        CHART,
-        [NumberChange("Tolerance (mm)", "tolerance_mm", 0.01, 1.0)],
-        lambda scene: scene.plot.data,
-        reaches_hundredths,
-    )
+# A tighter tolerance: the log axis runs down to hundredths of a millimetre ("0.01", wider than "1").
+test_the_error_plot_tick_labels_stay_inside_its_canvas = chart_fits_test(
+    ArmScene,
+    CHART,
+    [NumberChange("Tolerance (mm)", "tolerance_mm", 0.01, 1.0)],
+    lambda scene: scene.plot.data,
+    _reaches_hundredths,
+)
 
 
 FILL = 0.5

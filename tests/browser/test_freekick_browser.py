@@ -11,24 +11,25 @@ from typing import Any
 import numpy as np
 import pytest
 from helpers.browser import (
-    SOFTWARE_WEBGL,
     TOAST,
     NumberChange,
     ScenePage,
-    assert_chart_fits_after,
     assert_in_view,
+    assert_in_view_clear_of_notice,
     assert_seen,
     changed_mask,
     chart_and_text_tests,
+    chart_fits_test,
     colour_pixels,
     error_text,
+    notice_left_open,
     panel_rect,
     peaks_over,
     project,
     save_scene_screenshot,
     scene_page_fixture,
     screenshot,
-    served_scene,
+    served_scene_at,
     set_number,
     settle,
     visible_text,
@@ -219,9 +220,9 @@ HARDEST_KICK = [
 """The hardest, most spun kick: the force axis grows from a few newtons to over ten."""
 
 
-def test_the_force_chart_tick_labels_stay_inside_its_canvas(shown: ScenePage) -> None:
-    assert isinstance(shown.scene, FreeKickScene)
-    assert_chart_fits_after(shown, CHART, HARDEST_KICK, lambda scene: scene.chart.data, peaks_over(10.0))
+test_the_force_chart_tick_labels_stay_inside_its_canvas = chart_fits_test(
+    FreeKickScene, CHART, HARDEST_KICK, lambda scene: scene.chart.data, peaks_over(10.0)
+)
 
 
 KEEPER = ["/freekick/keeper", "/freekick/keeper_head"]
@@ -333,16 +334,12 @@ def test_the_goal_frame_and_keeper_show_clear_of_the_notice_and_the_panel(
     # while the readout said "Saved"; with the ball 30 m out at 40° the goal and keeper left the frame. Here the
     # notice stays open, as it does until a person closes it, and the pixels the goal's white frame and the keeper
     # make (the difference when they are hidden) are counted where a person can see them, left of the panel.
-    browser_page.set_viewport_size({"width": viewport[0], "height": viewport[1]})
-    with served_scene(server, browser_page, "freekick", "/freekick/goal_frame", viewport=viewport) as shown:
+    with (
+        served_scene_at(server, browser_page, "freekick", "/freekick/goal_frame", viewport) as shown,
+        notice_left_open(shown) as corner,
+    ):
         page = shown.page
-        notice = (0.0, 0.0)
-        if page.evaluate(SOFTWARE_WEBGL):
-            toast = page.locator(TOAST, has_text="Software WebGL rendering detected")
-            toast.wait_for(timeout=90_000)
-            box = toast.bounding_box()
-            assert box is not None
-            notice = (box["x"] + box["width"], box["y"] + box["height"])
+        notice = (0.0, 0.0) if corner is None else corner
         scene = shown.scene
         assert isinstance(scene, FreeKickScene)
         panel_left = panel_rect(page)[0]
@@ -358,9 +355,9 @@ def test_the_goal_frame_and_keeper_show_clear_of_the_notice_and_the_panel(
             standing = [
                 [keeper[0] + sx, keeper[1] + sy, z] for sx in (-0.4, 0.4) for sy in (-0.4, 0.4) for z in (0, 2.3)
             ]
-            seen_xy = assert_in_view(shown, "/freekick", np.vstack([GOAL_CORNERS, standing]), "goal and keeper")
-            hidden = (seen_xy[:, 0] < notice[0]) & (seen_xy[:, 1] < notice[1])
-            assert not hidden.any(), ((distance, angle, viewport), seen_xy[hidden])
+            assert_in_view_clear_of_notice(
+                shown, "/freekick", np.vstack([GOAL_CORNERS, standing]), f"goal and keeper {distance, angle}", corner
+            )
             # Least pixels each draws: the goal's frame covers 133 px at its smallest (40 m out at −45°, 1280×720).
             for names, least in ((["/freekick/goal_frame"], 100), (["/freekick/keeper", "/freekick/keeper_head"], 20)):
                 seen = changed_mask(shown_px, with_nodes_hidden(page, names))
@@ -370,7 +367,7 @@ def test_the_goal_frame_and_keeper_show_clear_of_the_notice_and_the_panel(
                 assert len(xs) >= least, where  # drawn large enough to see
                 under = (xs < notice[0]) & (ys < notice[1])
                 assert not under.any(), (where, int(under.sum()))  # none of it under the notice
-            if notice != (0.0, 0.0):
+            if corner is not None:
                 assert page.locator(TOAST).count() == 1  # still open: what was looked at was under it
             assert error_text(page) == []
         scene.controls["distance_m"].value, scene.controls["angle_deg"].value = 22.0, 0.0

@@ -14,7 +14,15 @@ from typing import Any
 import numpy as np
 import pytest
 import viser
-from helpers.browser import SOFTWARE_WEBGL, TOAST, VIEWPORTS, close_notifications, screenshot, served_scene, wait_frames
+from helpers.browser import (
+    SOFTWARE_WEBGL,
+    TOAST,
+    VIEWPORTS,
+    close_notifications,
+    screenshot,
+    served_scene_at,
+    wait_frames,
+)
 
 pytestmark = pytest.mark.browser
 
@@ -24,8 +32,7 @@ def test_the_software_webgl_notice_shows_over_the_scene_and_its_close_button_unc
     server: viser.ViserServer, browser_page: Any, viewport: tuple[int, int]
 ) -> None:
     page = browser_page
-    page.set_viewport_size({"width": viewport[0], "height": viewport[1]})
-    with served_scene(server, page, "freekick", "/freekick/ball", viewport=viewport):
+    with served_scene_at(server, page, "freekick", "/freekick/ball", viewport):
         if not page.evaluate(SOFTWARE_WEBGL):  # a GPU: viser shows no notice, and none covers the scene
             wait_frames(page, 10)
             assert close_notifications(page) == []

@@ -12,30 +12,29 @@ import numpy as np
 import pytest
 import viser
 from helpers.browser import (
-    SOFTWARE_WEBGL,
-    TOAST,
     VIEWPORTS,
     NumberChange,
     ScenePage,
     assert_chart_draws,
-    assert_chart_fits_after,
     assert_in_view,
+    assert_in_view_clear_of_notice,
     assert_seen,
     chart_and_text_tests,
+    chart_fits_test,
     chart_image,
     colour_pixels,
     control_row,
     error_text,
-    hold_resolution,
     line_mask,
     node_box_corners,
+    notice_left_open,
     panel_rect,
     peaks_over,
     project,
     save_scene_screenshot,
     scene_page_fixture,
     screenshot,
-    served_scene,
+    served_scene_at,
     set_number,
     settle,
     visible_text,
@@ -164,9 +163,9 @@ BIG_RIDER_INTO_A_GALE = [
 """A bigger rider into a gale: the power axis reaches "20,000" W (it ran 7 px off the canvas's left edge)."""
 
 
-def test_the_chart_tick_labels_stay_inside_its_canvas(shown: ScenePage) -> None:
-    assert isinstance(shown.scene, PelotonScene)
-    assert_chart_fits_after(shown, CHART, BIG_RIDER_INTO_A_GALE, lambda scene: scene.chart.data, peaks_over(10_000.0))
+test_the_chart_tick_labels_stay_inside_its_canvas = chart_fits_test(
+    PelotonScene, CHART, BIG_RIDER_INTO_A_GALE, lambda scene: scene.chart.data, peaks_over(10_000.0)
+)
 
 
 def choose(page: Any, label: str, option: str) -> None:
@@ -278,30 +277,13 @@ def test_an_echelon_of_20_is_drawn_large_enough_to_see(shown: ScenePage) -> None
 
 
 @contextlib.contextmanager
-def notice_left_open(shown: ScenePage) -> Iterator[tuple[float, float] | None]:
-    """Wait for viser's software-WebGL notice and leave it open; give its bottom right corner (CSS px), or None where
-    the page draws on a GPU and shows none."""
-    hold_resolution(shown.page)
-    if not shown.page.evaluate(SOFTWARE_WEBGL):
-        yield None
-        return
-    toast = shown.page.locator(TOAST, has_text="Software WebGL rendering detected")
-    toast.wait_for(timeout=90_000)
-    box = toast.bounding_box()
-    assert box is not None
-    yield box["x"] + box["width"], box["y"] + box["height"]
-    assert shown.page.locator(TOAST).count() == 1  # still open: what was looked at was under it
-
-
-@contextlib.contextmanager
 def peloton_with_notice(
     server: viser.ViserServer, browser_page: Any, viewport: tuple[int, int]
 ) -> Iterator[tuple[ScenePage, tuple[float, float] | None]]:
     """The peloton at ``viewport`` with viser's software-WebGL notice left open (:func:`notice_left_open`): the page
     and the notice's bottom right corner (None where the page draws on a GPU)."""
-    browser_page.set_viewport_size({"width": viewport[0], "height": viewport[1]})
     with (
-        served_scene(server, browser_page, "peloton", "/peloton", viewport=viewport) as shown,
+        served_scene_at(server, browser_page, "peloton", "/peloton", viewport) as shown,
         notice_left_open(shown) as notice,
     ):
         yield shown, notice
@@ -316,18 +298,6 @@ def power_colour_counts(image: np.ndarray, covered: np.ndarray) -> np.ndarray:
     stops = POWER_COLOURS / POWER_COLOURS.max(axis=1, keepdims=True)
     nearest = np.argmin(np.linalg.norm(chroma[:, None, :] - stops[None], axis=2), axis=1)
     return np.bincount(nearest[saturated], minlength=len(POWER_COLOURS))
-
-
-def _in_view_clear_of_notice(
-    shown: ScenePage, frame: str, corners: np.ndarray, what: str, notice: tuple[float, float] | None
-) -> np.ndarray:
-    """``corners`` (k, 3) of ``frame`` in view left of the panel (:func:`assert_in_view`) and, where the page shows
-    the software-WebGL notice (its bottom-right corner ``notice``, px), none under it; their screen points."""
-    seen = assert_in_view(shown, frame, corners, what)
-    if notice is not None:
-        under = (seen[:, 0] < notice[0]) & (seen[:, 1] < notice[1])
-        assert not under.any(), f"{what}: {under.sum()} rider corners under the notice"
-    return seen
 
 
 @pytest.mark.parametrize("viewport", VIEWPORTS, ids=lambda v: f"{v[0]}x{v[1]}")
@@ -363,7 +333,7 @@ def test_a_group_of_121_is_framed_clear_of_the_software_webgl_notice(
                 ]
             )
             # In view left of the panel and, where the page shows the notice, none under it.
-            _in_view_clear_of_notice(shown, "/peloton/course", corners, f"{formation} of 121", notice)
+            assert_in_view_clear_of_notice(shown, "/peloton/course", corners, f"{formation} of 121", notice)
             screenshot(page, path=f"/tmp/peloton_{formation.split()[0].lower()}_121_{viewport[0]}x{viewport[1]}.png")
             assert error_text(page) == []
 
@@ -417,7 +387,7 @@ def test_course_mode_colours_a_bunch_by_power_with_its_legend_clear_of_the_notic
                 ]
             )
             # Every rider's box in view left of the panel and, where the page shows the notice, none under it.
-            seen = _in_view_clear_of_notice(
+            seen = assert_in_view_clear_of_notice(
                 shown, "/peloton/course_mode", corners, f"{formation} of {n} on the course", notice
             )
             image = with_labels_hidden(page)

@@ -348,6 +348,31 @@ def served_scene(
 
 
 @contextlib.contextmanager
+def served_scene_at(server: Any, page: Any, key: str, node: str, viewport: tuple[int, int]) -> Iterator[ScenePage]:
+    """:func:`served_scene` on ``page`` set to ``viewport`` (CSS px) first, opened on scene node ``node``."""
+    page.set_viewport_size({"width": viewport[0], "height": viewport[1]})
+    with served_scene(server, page, key, node, viewport=viewport) as shown:
+        yield shown
+
+
+@contextlib.contextmanager
+def notice_left_open(shown: ScenePage) -> Iterator[tuple[float, float] | None]:
+    """Wait for viser's software-WebGL notice and leave it open; give its bottom right corner (CSS px), or None where
+    the page draws on a GPU and shows none. On leaving, the notice must still be open: what was looked at was
+    under it."""
+    hold_resolution(shown.page)
+    if not shown.page.evaluate(SOFTWARE_WEBGL):
+        yield None
+        return
+    toast = shown.page.locator(TOAST, has_text="Software WebGL rendering detected")
+    toast.wait_for(timeout=90_000)
+    box = toast.bounding_box()
+    assert box is not None
+    yield box["x"] + box["width"], box["y"] + box["height"]
+    assert shown.page.locator(TOAST).count() == 1  # still open: what was looked at was under it
+
+
+@contextlib.contextmanager
 def scene_page(context: Any, key: str, viewport: tuple[int, int]) -> Iterator[ScenePage]:
     """Serve scene ``key``, open it in a new page of ``viewport`` (CSS px), and wait until it has settled."""
     import app
@@ -413,6 +438,19 @@ def assert_in_view(shown: ScenePage, frame: str, points: NDArray[np.float64], wh
     under_panel = (xy[:, 0] >= left) & (xy[:, 1] >= top) & (xy[:, 1] <= bottom)
     assert not under_panel.any(), f"{what}: {under_panel.sum()} points under the control panel"
     return xy
+
+
+def assert_in_view_clear_of_notice(
+    shown: ScenePage, frame: str, points: NDArray[np.float64], what: str, notice: tuple[float, float] | None
+) -> NDArray[np.float64]:
+    """``points`` (k, 3) of ``frame`` in view left of the panel (:func:`assert_in_view`) and, where the page shows
+    the software-WebGL notice (its bottom-right corner ``notice``, CSS px; see :func:`notice_left_open`), none under
+    it; their (k, 2) screen points (CSS px)."""
+    seen = assert_in_view(shown, frame, points, what)
+    if notice is not None:
+        under = (seen[:, 0] < notice[0]) & (seen[:, 1] < notice[1])
+        assert not under.any(), f"{what}: {under.sum()} points under the notice, at {seen[under].tolist()}"
+    return seen
 
 
 def node_box_corners(page: Any, name: str) -> NDArray[np.float64]:
@@ -790,6 +828,20 @@ def assert_chart_fits_after(
     assert_chart_shows_its_data(shown.page, title, data)
     assert_tick_labels_inside(shown.page, title)
     _type_numbers(shown, [(c.label, c.field, c.restore) for c in changes], "back")
+
+
+def chart_fits_test(
+    kind: type, title: str, changes: Sequence[NumberChange], chart_data: Any, check: Callable[[Any], None]
+) -> Any:
+    """A test for a module with a ``shown`` fixture (assign it to a ``test_…`` name): the page shows a scene of class
+    ``kind``, and chart ``title``'s tick labels stay inside its canvas before and after the ``changes``
+    (:func:`assert_chart_fits_after`, with its ``chart_data`` and ``check``)."""
+
+    def test_the_chart_tick_labels_stay_inside_its_canvas(shown: ScenePage) -> None:
+        assert isinstance(shown.scene, kind)
+        assert_chart_fits_after(shown, title, changes, chart_data, check)
+
+    return test_the_chart_tick_labels_stay_inside_its_canvas
 
 
 def peaks_over(limit: float) -> Callable[[Any], None]:
