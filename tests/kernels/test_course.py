@@ -273,6 +273,80 @@ def test_a_step_that_reaches_the_cap_holds_it_from_where_it_is_reached(rider: Ri
     assert r.time_s == pytest.approx(descent_time_by_ode(fine, rider, 1350.0, 16.7, 26.45), rel=3e-4)
 
 
+def ride_by_ode(length: float, grade: float, rider: Rider, power: float, v0: float) -> tuple[float, float]:
+    """(speed at the end (m/s), time (s)) of one straight, windless segment of ``length`` (m, along the slope)
+    rising from sea level, in the air at its mid height (as the model takes it), from scipy's DOP853 in distance
+    (M·v²·dv/ds = ηP − P_wheel(v)), independent of the kernel. From rest (v0 < 1e-3 m/s) the first millimetre is
+    the analytic start v³ = v0³ + 3ηP·s/M (resistances negligible there)."""
+    m, eta = rider.effective_mass_kg, rider.drivetrain_efficiency
+    theta, still = np.array([math.atan(grade)]), np.zeros(1)
+    rho = np.array([cycling.air_density(0.5 * length * math.sin(theta[0]))])
+
+    def rhs(_s: float, y: NDArray[np.float64]) -> list[float]:
+        wheel = float(np.sum(wheel_power(np.array([y[0]]), rider, rho, still, theta)))
+        return [(eta * power - wheel) / (m * y[0] ** 2), 1.0 / y[0]]
+
+    s0, t0 = 0.0, 0.0
+    if v0 < 1e-3:
+        s0 = 1e-3
+        v_start = (v0**3 + 3.0 * eta * power * s0 / m) ** (1.0 / 3.0)
+        t0 = 1.5 * s0 / v_start  # ∫ ds / (k·s^(1/3)) from 0: 1.5·s/v(s) (v0 = 0; less than 1 µs off for v0 < 1e-3)
+        v0 = v_start
+    sol = solve_ivp(rhs, (s0, length), [v0, t0], method="DOP853", rtol=1e-12, atol=1e-12)
+    return float(sol.y[0, -1]), float(sol.y[1, -1])
+
+
+# Kind: one step much longer than the distance the speed takes to settle (about 130 m on the flat at 200 W). The
+# midpoint step's gain dv₁/dv₀ falls to −1 there: the speed rang about the steady one, never settling (a kilometre
+# from 9.5 m/s ended at 9.3135 m/s, the steady 9.3828; ten kilometres from 9.9 ended 0.27 m/s fast). Such a step is
+# now halved until its gain is at least 1/3. The same family from nearly rest: uniform sub-steps from 1e-6 or
+# 0.5 m/s rode a flat kilometre 0.36 or 0.24 s slower than the ODE (from exactly 0 it was right: graded sub-steps).
+@pytest.mark.parametrize(
+    ("length", "grade", "power", "v0"),
+    [
+        (1000.0, 0.0, 200.0, 9.5),  # ended 0.069 m/s slow, 0.10 s early
+        (10_000.0, 0.0, 250.0, 9.9),  # ended 0.27 m/s fast
+        (100_000.0, 0.0, 250.0, 5.0),
+        (2000.0, 0.06, 300.0, 12.0),  # slowing on a climb
+        (2000.0, -0.05, 150.0, 5.0),  # speeding down a descent
+        (1000.0, 0.0, 200.0, 1e-6),  # 0.36 s slow
+        (1000.0, 0.0, 200.0, 0.5),  # 0.24 s slow
+        (1000.0, 0.0, 400.0, 3.0),  # 0.030 s slow
+        (1000.0, 0.0, 200.0, 0.0),
+    ],
+)
+@pytest.mark.parametrize("rider", [SEED, MARTIN], ids=["seed", "martin"])
+def test_one_long_segment_settles_as_the_ode_does(
+    length: float, grade: float, power: float, v0: float, rider: Rider
+) -> None:
+    c = course.course_from_xy([0.0, length], [0.0, 0.0], [0.0, grade * length])
+    r = course.ride(c, power, rider, max_speed_ms=100.0, start_speed_ms=v0)
+    speed, time = ride_by_ode(float(c.length_m[0]), grade, rider, power, v0)
+    assert r.speed_ms[-1] == pytest.approx(speed, rel=2e-5)
+    # Steps that change the speed by up to a tenth (the climb's and the descent's) are second-order: 1e-4 of the time.
+    assert r.time_s == pytest.approx(time, rel=2e-4)
+
+
+@settings(max_examples=examples(40), deadline=None)
+@given(
+    length=st.floats(50.0, 50_000.0),
+    grade=st.floats(-0.08, 0.12),
+    power=st.floats(50.0, 1000.0),
+    start=st.floats(0.0, 1.0),
+    model=st.sampled_from(["seed", "martin"]),
+)
+def test_any_single_segment_ends_at_the_ode_s_speed_and_time(
+    length: float, grade: float, power: float, start: float, model: str
+) -> None:
+    rider = SEED if model == "seed" else MARTIN
+    v0 = 20.0 * start**3  # as often near rest as near racing speed
+    c = course.course_from_xy([0.0, length], [0.0, 0.0], [0.0, grade * length])
+    r = course.ride(c, power, rider, max_speed_ms=100.0, start_speed_ms=v0)
+    speed, time = ride_by_ode(float(c.length_m[0]), grade, rider, power, v0)
+    assert r.speed_ms[-1] == pytest.approx(speed, rel=1e-3)
+    assert r.time_s == pytest.approx(time, rel=1e-4, abs=5e-3)
+
+
 def test_more_power_climbs_faster_where_the_step_is_refined() -> None:
     """A 108 m step up 15.6 % from 18 m/s, into a 15 m/s wind, then 108 m of flat: time falls with every 5 W."""
     heading = np.array([0.0, 1.5])
