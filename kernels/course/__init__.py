@@ -21,7 +21,11 @@ integrated per segment with an implicit midpoint step on the segment's mean spee
 ½·M·(v₁² − v₀²) = L·(η·P − P_wheel(v̄))/v̄, time L/v̄. The step is stable at any length (a rider starting from rest
 or entering a 20 % wall at speed needs no tiny steps), and the energy books balance exactly: the work of the pedals
 equals the kinetic energy gained plus aero, rolling, bearing and climbing work plus what the brakes take, which the
-tests check over a closed loop. A segment that cannot be crossed in one step is split in halves until it can.
+tests check over a closed loop. A segment that cannot be crossed in one step is split in halves until it can, and
+so is one that changes the speed by more than a tenth, or is much longer than the speed takes to settle (there the
+midpoint step's gain dv₁/dv₀ = (1 − λh/2)/(1 + λh/2), λ the relaxation rate per metre, falls toward −1 and the speed
+would ring about the steady one: a step whose gain misses the true e^(−λh) by more than 0.1 % of the speed is
+halved). From rest, or nearly, the sub-steps are cubically graded (v³ grows as 3ηP·s/M).
 The rider starts from rest (or ``start_speed_ms``) and brakes to hold ``max_speed_ms`` on descents, easing off the
 pedals as needed. The wind blows from ``wind_from_deg`` (meteorological convention); each segment feels its
 headwind component w = wind·cos(from − heading); the crosswind is ignored (yaw-free CdA).

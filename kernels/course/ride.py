@@ -174,13 +174,12 @@ _E_WORK, _E_AERO, _E_ROLL, _E_BEAR, _E_CLIMB, _E_BRAKE = range(6)
 _REFINE_RATIO = 0.1
 """A step that changes the speed by more than this fraction is redone in halves (up to _REFINE_UP_TO)."""
 _REFINE_UP_TO = 64
-_SETTLE_GAIN = 1.0 / 3.0
-"""Least gain dv₁/dv₀ a step may have where it changes the speed: near a steady speed the midpoint step's gain is
-(1 − λh/2)/(1 + λh/2) for relaxation rate λ (1/m) and step h, which falls to −1 (the speed rings about the steady one,
-never settling) on a step much longer than 1/λ, where the true gain is e^(−λh). At 1/3 (λh = 1) the two differ by
-0.035: such a step is redone in halves."""
-_SETTLE_RATIO = 1e-4
-"""A step that changes the speed by less than this fraction is steady: its gain does not matter."""
+_SETTLE_TOLERANCE = 1e-3
+"""Largest error a step's gain may put on its end speed, as a fraction of the speed. Near a steady speed the midpoint
+step's gain dv₁/dv₀ is A = (1 − x/2)/(1 + x/2), x = λh for relaxation rate λ (1/m) and step h, where the true gain is
+e^(−x): on a step much longer than 1/λ, A falls to −1 and the speed rings about the steady one, never settling. The
+step moves the speed by (A − 1)·d for a distance d from the steady speed, so it misses by |A − e^(−x)|·|v₁ − v₀|/|1 − A|;
+a step that misses by more is redone in halves."""
 _SETTLE_UP_TO = 4096
 """At most this many sub-steps to settle a segment (a 100 km segment, relaxing over about 130 m, takes about 800)."""
 _GRADED_BELOW = 0.01
@@ -300,14 +299,22 @@ def _ride_core(
                 if not graded and n_sub < _REFINE_UP_TO and abs(v1 - v) > _REFINE_RATIO * max(v, v1):
                     ok = False  # an abrupt change of speed (a wall, a crest): finer steps, for accuracy
                     break
-                if (
-                    n_sub < _SETTLE_UP_TO
-                    and abs(v1 - v) > _SETTLE_RATIO * max(v, v1)
-                    and 4.0 * mass * vb * vb
-                    < (1.0 + _SETTLE_GAIN) * _slope(vb, v, sub, drag[i], rolling[i], climbing[i], wind[i], mass, b0, b1)
-                ):
-                    ok = False  # a step longer than the speed takes to settle rings about the steady speed: halves
-                    break
+                if n_sub < _SETTLE_UP_TO and abs(v1 - v) > _SETTLE_TOLERANCE * max(v, v1):
+                    gain = (
+                        4.0
+                        * mass
+                        * vb
+                        * vb
+                        / _slope(vb, v, sub, drag[i], rolling[i], climbing[i], wind[i], mass, b0, b1)
+                    )
+                    gain -= 1.0  # dv₁/dv₀ = 2·dv̄/dv₀ − 1, dv̄/dv₀ = 2Mv̄²/(the step equation's slope)
+                    if gain <= -1.0 or (
+                        gain != 1.0
+                        and abs(gain - math.exp(-2.0 * (1.0 - gain) / (1.0 + gain))) * abs(v1 - v)
+                        > _SETTLE_TOLERANCE * max(v, v1) * abs(1.0 - gain)
+                    ):
+                        ok = False  # a step longer than the speed takes to settle rings about the steady speed
+                        break
                 reach, reach_in = sub, p_in  # ridden at mean speed vb, the rider's power reach_in
                 hold, hold_in = 0.0, 0.0  # then at the cap, the rider's power hold_in
                 if v1 > v_cap:
