@@ -406,7 +406,7 @@ def _pitch_vector(pitch: Pitch, spot: NDArray[np.float64], ground: float, radius
 
 
 def _simulate_on_pitch(launch: NDArray[np.float64], settings: NDArray[np.float64], pitch: Pitch) -> Trajectory:
-    vector = _pitch_vector(pitch, launch[:2], float(settings[GROUND]), float(settings[RADIUS]))
+    vector = _placed_pitch(launch[None], settings, pitch)
     _refuse_unplayable(launch[None], vector[None], _FIRST, settings)
     rows = int(settings[N_STEPS]) + 1 + play.EXTRA_ROWS
     # A batch of one: the long compiled flight on a pitch has one entry, compiled once, not one for each use.
@@ -519,11 +519,11 @@ def _refuse_unplayable(
     if off.size:
         k = int(off[0])
         which_kick = f"positions[{k}]" if len(launches) > 1 else "position"
+        where = f"{abs(depth[k]):.4g} m {'behind' if depth[k] > 0.0 else 'in front of'}"
         raise ValueError(
             f"{which_kick} must be on the pitch, in front of the goal line (at most {MAX_PITCH_LENGTH_M:g} m) and "
-            f"between the touchlines; {launches[k, :3].tolist()} m is {abs(depth[k]):.4g} m "
-            f"{'behind' if depth[k] > 0.0 else 'in front of'} the line and {across[k]:.4g} m across (the touchlines "
-            f"are ±{rows[k, play.HALF_WIDTH]:g} m)"
+            f"between the touchlines; {launches[k, :3].tolist()} m is {where} the line and {across[k]:.4g} m across "
+            f"(the touchlines are ±{rows[k, play.HALF_WIDTH]:g} m)"
         )
 
 
@@ -582,9 +582,18 @@ def _one_pitch(
     launches: NDArray[np.float64], settings: NDArray[np.float64], pitch: Pitch
 ) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
     """(1, N_PITCH) read-only rows of ``pitch`` (a keeper placed for the first kick's spot) and every kick's index."""
+    return _placed_pitch(launches, settings, pitch)[None], np.zeros(len(launches), dtype=np.int64)
+
+
+def _placed_pitch(launches: NDArray[np.float64], settings: NDArray[np.float64], pitch: Pitch) -> NDArray[np.float64]:
+    """``pitch``'s vector with its keeper placed from the first kick's spot; a spot off the pitch (behind the goal,
+    where the keeper's placement would be refused first, naming his fields) is refused naming the kick's position."""
+    ground, radius = float(settings[GROUND]), float(settings[RADIUS])
     spot = launches[0, :2] if len(launches) else np.zeros(2)
-    vector = _pitch_vector(pitch, spot, float(settings[GROUND]), float(settings[RADIUS]))
-    return vector[None], np.zeros(len(launches), dtype=np.int64)
+    if isinstance(pitch, Pitch) and pitch.keeper is not None and pitch.keeper.position_xy is None and len(launches):
+        bare = _pitch_vector(dataclasses.replace(pitch, keeper=None), spot, ground, radius)
+        _refuse_unplayable(launches, bare[None], np.zeros(len(launches), dtype=np.int64), settings)
+    return _pitch_vector(pitch, spot, ground, radius)
 
 
 def pitch_outcomes(

@@ -597,7 +597,7 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
         depth0 = (x - gx) * gnx + (y - gy) * gny
         depth1 = (x1 - gx) * gnx + (y1 - gy) * gny
         rate0, rate1 = vx * gnx + vy * gny, vx1 * gnx + vy1 * gny
-        if not inside and depth0 < 0.0 <= depth1:
+        if not inside and depth0 <= 0.0 < depth1:  # from on the line too (a kick from it flew through the net unseen)
             f = crossing_fraction(-depth0, -rate0, -depth1, -rate1, h)
             if f <= best:
                 cx, _ = _hermite(x, vx, x1, vx1, h, f)

@@ -24,6 +24,9 @@ R, G, ALPHA = 0.11, 9.81, 2.0 / 3.0
 VACUUM = {"air_density": 0.0, "method": "rk4", "ground_m": R}
 WALL, GOAL = ball.free_kick_panels((-22.0, 0.0), (0.0, 0.0), (1.0, 0.0))
 BARE = ball.Pitch(GOAL)
+OPEN = ball.Pitch(ball.free_kick_panels((-22.0, 0.0), (100.0, 0.0), (1.0, 0.0))[1])
+"""A bare pitch whose goal line is 100 m up +x: turf tests launched from the origin along +x meet no goal (from
+BARE's goal line they rolled into its goal, unseen until a kick from the line was seen crossing it)."""
 
 
 def energy(flight: ball.Trajectory, g: float = G) -> np.ndarray:
@@ -89,7 +92,7 @@ def first_bounce(
     """A ball launched along +x from the turf at the origin, over the bare pitch in a vacuum (dt 1 ms): its flight,
     and the index of the sample at its first event, which is asserted to be a bounce on the ground."""
     velocity = (speed_ms * math.cos(elevation_rad), 0.0, speed_ms * math.sin(elevation_rad))
-    flight = ball.simulate((0.0, 0.0, R), velocity, spin_rad_s, dt=1e-3, t_max=t_max, pitch=BARE, **VACUUM)
+    flight = ball.simulate((0.0, 0.0, R), velocity, spin_rad_s, dt=1e-3, t_max=t_max, pitch=OPEN, **VACUUM)
     first = flight.events[0]
     assert first.kind == "ground"
     return flight, int(np.flatnonzero(flight.t == first.t)[0])
@@ -111,7 +114,7 @@ def test_a_roll_at_3_2_m_s_stops_in_4_to_10_m() -> None:
     # FIFA's ball-roll test band: 4–10 m from ~3.2 m/s. In a vacuum the roll is the turf's 0.8 m/s² alone:
     # v²/(2a) = 6.4 m in v/a = 4 s exactly; with the air's drag it stops a little sooner, still inside the band.
     rolling = (0.0, 3.2 / R, 0.0)  # ω = (ẑ × v)/R: rolling without slipping from the start
-    flight = ball.simulate((0.0, 5.0, R), (3.2, 0.0, 0.0), rolling, dt=1e-2, t_max=20.0, pitch=BARE, **VACUUM)
+    flight = ball.simulate((0.0, 5.0, R), (3.2, 0.0, 0.0), rolling, dt=1e-2, t_max=20.0, pitch=OPEN, **VACUUM)
     assert flight.ended == "stopped"
     assert flight.position[-1, 0] == pytest.approx(6.4, rel=1e-9)
     assert flight.t[-1] == pytest.approx(4.0, rel=1e-9)
@@ -121,7 +124,7 @@ def test_a_roll_at_3_2_m_s_stops_in_4_to_10_m() -> None:
         rolling,
         dt=1e-2,
         t_max=20.0,
-        pitch=BARE,
+        pitch=OPEN,
         method="rk4",
         model="measured",
         ground_m=R,
@@ -129,7 +132,7 @@ def test_a_roll_at_3_2_m_s_stops_in_4_to_10_m() -> None:
     assert 4.0 <= air.position[-1, 0] < 6.4
     # A ball set skidding without spin grips and rolls on at v/(1 + α) = 3/5 of its speed (Cross 2002): 0.36 of
     # the distance.
-    skid = ball.simulate((0.0, 5.0, R), (3.2, 0.0, 0.0), (0.0, 0.0, 0.0), dt=1e-2, t_max=20.0, pitch=BARE, **VACUUM)
+    skid = ball.simulate((0.0, 5.0, R), (3.2, 0.0, 0.0), (0.0, 0.0, 0.0), dt=1e-2, t_max=20.0, pitch=OPEN, **VACUUM)
     assert skid.position[-1, 0] == pytest.approx(0.36 * 6.4, rel=1e-9)
 
 
@@ -792,6 +795,31 @@ def test_a_kick_on_a_pitch_starts_on_it(start, on_the_pitch) -> None:
         else:
             with pytest.raises(ValueError, match=name + r" must be on the pitch, in front of the goal line"):
                 call()
+
+
+@pytest.mark.parametrize("x", [0.0, -1e-12, -0.05])
+def test_a_kick_from_on_the_goal_line_into_the_goal_is_a_goal(x: float) -> None:
+    # From exactly on the line the flight never crossed it (the crossing wanted a start in front of it): the ball
+    # flew through the net unseen and on 55 m behind the goal, "short" at t_max.
+    flight = ball.simulate((x, 0.0, R), (25.0, -3.0, 5.0), (0.0, 0.0, 40.0), ground_m=R, pitch=ball.Pitch(GOAL))
+    assert (flight.result, flight.ended) == ("goal", "net")
+    assert flight.position[-1, 0] <= 2.0  # stopped by the net, 2 m deep
+
+
+@pytest.mark.parametrize("x", [1.0, 0.5])
+def test_a_kick_behind_the_goal_is_refused_naming_it_not_the_keeper_placed_from_it(x: float) -> None:
+    # With a keeper placed from the spot, his placement behind his line was refused first, naming keeper.depth_m and
+    # keeper.shift_m, though the kick was what was wrong.
+    pitch = ball.Pitch(GOAL, keeper=ball.Keeper())
+    start, velocity, spin = (x, 0.0, R), (-5.0, 0.0, 0.0), (0.0, 0.0, 0.0)
+    calls = (
+        lambda: ball.simulate(start, velocity, spin, ground_m=R, pitch=pitch),
+        lambda: ball.simulate_batch([start], [velocity], [spin], ground_m=R, pitch=pitch),
+        lambda: ball.simulate_outcomes([start], [velocity], [spin], ground_m=R, pitch=pitch),
+    )
+    for call in calls:
+        with pytest.raises(ValueError, match=r"^position must be on the pitch, in front of the goal line"):
+            call()
 
 
 @pytest.mark.parametrize("odd", [True, np.True_, Decimal(1), Fraction(1)])
