@@ -317,12 +317,15 @@ def has_cache(package: str) -> bool:
 
 
 _CHILD = (
-    "import importlib, sys\n"
+    "import importlib, signal, sys\n"
+    "signal.signal(signal.SIGINT, signal.SIG_IGN)\n"  # Ctrl+C stops the app, which stops this (not a traceback)
     "for name in sys.argv[1:]:\n"
     "    importlib.import_module(name).warm_up()\n"
     "    print(name, flush=True)\n"
 )
-"""What a compile process runs: each package's ``warm_up()`` (which writes numba's cache), its name printed after."""
+"""What a compile process runs: each package's ``warm_up()`` (which writes numba's cache), its name printed after.
+It ignores SIGINT: Ctrl+C in the app's terminal reaches the whole process group, and a child that died of it first
+was reported as a failed compile, with numba's traceback, before the app's exit stopped it."""
 
 
 def _spawn(names: tuple[str, ...]) -> subprocess.Popen[bytes] | None:

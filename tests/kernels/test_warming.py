@@ -326,3 +326,29 @@ def test_the_small_course_package_shares_the_ball_s_compile_process() -> None:
     # A third child would cost Python's, numba's and LLVM's start on a machine where two children fill the cores.
     assert warming.PROCESSES == (("kernels.fabrik",), ("kernels.course", "kernels.ball"))
     assert sorted(name for group in warming.PROCESSES for name in group) == sorted(warming.MODULES)
+
+
+def test_a_compile_process_outlives_ctrl_c_until_the_app_stops_it(
+    fresh_warming: None, tmp_path: Any, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # Ctrl+C reaches the whole process group: a child that died of it first was reported as a failed compile, with
+    # numba's KeyboardInterrupt traceback, before the app's exit stopped it.
+    import os
+    import signal
+    import subprocess
+
+    fifo = tmp_path / "go"
+    os.mkfifo(fifo)
+    (tmp_path / "stalled_kernels.py").write_text(f"def warm_up():\n    open({str(fifo)!r}).read()\n")
+    monkeypatch.setenv("PYTHONPATH", os.pathsep.join([str(tmp_path), os.environ.get("PYTHONPATH", "")]))
+    monkeypatch.setattr(warming, "_CHILDREN", [])
+    child = warming._spawn(("stalled_kernels",))
+    assert child is not None
+    with open(fifo, "w") as go:  # opens once the child is waiting in warm_up (past its signal set-up)
+        child.send_signal(signal.SIGINT)
+        with pytest.raises(subprocess.TimeoutExpired):
+            child.wait(timeout=1.0)  # still compiling
+        go.write("go")
+    assert child.wait(timeout=30) == 0
+    assert child.stdout is not None and child.stdout.read().decode().split() == ["stalled_kernels"]
+    assert warming._tail(child) == ""
