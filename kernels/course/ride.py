@@ -458,7 +458,9 @@ def _ride(course: Course, power: NDArray[np.float64], s: _Segments, max_speed: f
         energy,
     )
     if failed:
-        raise ValueError(f"the rider cannot cross segment {failed - 1} at this power")
+        raise ValueError(
+            f"power_w is too low: at this power the rider cannot cross segment {failed - 1} (its grade and headwind)"
+        )
     work = float(energy[_E_WORK])
     return Ride(
         time_s=float(elapsed[-1]),

@@ -472,6 +472,12 @@ def test_bad_ride_arguments_name_themselves() -> None:
         Air("vacuum")  # type: ignore[arg-type]
 
 
+def test_a_power_too_low_to_cross_a_segment_is_named() -> None:
+    # It read "the rider cannot cross segment 0 at this power", naming no argument.
+    with pytest.raises(ValueError, match=r"^power_w is too low: at this power the rider cannot cross segment 0 "):
+        course.ride(straight(100.0), 1e-300, SEED)
+
+
 def test_a_very_low_power_on_a_wall_still_finishes() -> None:
     """A 25 % wall at 30 W and a fast entry: segments split until they can be crossed, and the books balance."""
     s = np.arange(0.0, 300.0 + 5, 50.0)
@@ -833,7 +839,7 @@ def test_a_ride_keeps_its_wind_and_safe_speed_in_the_model_range(
             try:
                 r = course.ride(c, 250.0, **{key: value})  # type: ignore[arg-type]
             except ValueError as error:
-                assert str(error).startswith("the rider cannot cross segment")
+                assert str(error).startswith("power_w is too low: at this power the rider cannot cross segment")
             else:
                 assert math.isfinite(r.time_s) and r.time_s > 0.0
     for value in outside:
