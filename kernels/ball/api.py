@@ -590,10 +590,13 @@ def _placed_pitch(launches: NDArray[np.float64], settings: NDArray[np.float64], 
     where the keeper's placement would be refused first, naming his fields) is refused naming the kick's position."""
     ground, radius = float(settings[GROUND]), float(settings[RADIUS])
     spot = launches[0, :2] if len(launches) else np.zeros(2)
-    if isinstance(pitch, Pitch) and pitch.keeper is not None and pitch.keeper.position_xy is None and len(launches):
-        bare = _pitch_vector(dataclasses.replace(pitch, keeper=None), spot, ground, radius)
-        _refuse_unplayable(launches, bare[None], np.zeros(len(launches), dtype=np.int64), settings)
-    return _pitch_vector(pitch, spot, ground, radius)
+    try:
+        return _pitch_vector(pitch, spot, ground, radius)
+    except ValueError:  # the keeper's placement, or another field: is it the kick's spot that is wrong?
+        if isinstance(pitch, Pitch) and pitch.keeper is not None and pitch.keeper.position_xy is None and len(launches):
+            bare = _pitch_vector(dataclasses.replace(pitch, keeper=None), spot, ground, radius)
+            _refuse_unplayable(launches, bare[None], np.zeros(len(launches), dtype=np.int64), settings)
+        raise
 
 
 def pitch_outcomes(
