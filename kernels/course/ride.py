@@ -204,6 +204,17 @@ def _slope(x, v0, length, drag, rolling, climbing, wind, mass, b0, b1):  # pragm
 
 
 @compiled()
+def _settle_miss(gain):  # pragma: no cover - compiled
+    """|A − e^(−x)|/|1 − A| for a step's gain A = dv₁/dv₀ = (1 − x/2)/(1 + x/2): what the step misses the true
+    settling by, per unit of its move |v₁ − v₀| (:data:`_SETTLE_TOLERANCE`); infinite where A ≤ −1."""
+    if gain <= -1.0:
+        return math.inf
+    if gain == 1.0:
+        return 0.0
+    return abs(gain - math.exp(-2.0 * (1.0 - gain) / (1.0 + gain))) / abs(1.0 - gain)
+
+
+@compiled()
 def _step(v0, length, drag, rolling, climbing, wind, power_in, mass, b0, b1):  # pragma: no cover
     """Mean speed v̄ ≥ v0/2 solving 2M(v̄ − v0)v̄² + L·(P_wheel(v̄) − P_in) = 0; −1 when none exists."""
     lo = 0.5 * v0
@@ -300,19 +311,8 @@ def _ride_core(
                     ok = False  # an abrupt change of speed (a wall, a crest): finer steps, for accuracy
                     break
                 if n_sub < _SETTLE_UP_TO and abs(v1 - v) > _SETTLE_TOLERANCE * max(v, v1):
-                    gain = (
-                        4.0
-                        * mass
-                        * vb
-                        * vb
-                        / _slope(vb, v, sub, drag[i], rolling[i], climbing[i], wind[i], mass, b0, b1)
-                    )
-                    gain -= 1.0  # dv₁/dv₀ = 2·dv̄/dv₀ − 1, dv̄/dv₀ = 2Mv̄²/(the step equation's slope)
-                    if gain <= -1.0 or (
-                        gain != 1.0
-                        and abs(gain - math.exp(-2.0 * (1.0 - gain) / (1.0 + gain))) * abs(v1 - v)
-                        > _SETTLE_TOLERANCE * max(v, v1) * abs(1.0 - gain)
-                    ):
+                    slope = _slope(vb, v, sub, drag[i], rolling[i], climbing[i], wind[i], mass, b0, b1)
+                    if _settle_miss(4.0 * mass * vb * vb / slope - 1.0) * abs(v1 - v) > _SETTLE_TOLERANCE * max(v, v1):
                         ok = False  # a step longer than the speed takes to settle rings about the steady speed
                         break
                 reach, reach_in = sub, p_in  # ridden at mean speed vb, the rider's power reach_in
