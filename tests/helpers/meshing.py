@@ -7,6 +7,11 @@ from numpy.typing import ArrayLike
 
 from kernels import sdf
 
+CUBE_BOUNDS = np.array([[-1.0, -1.0, -1.0], [1.0, 1.0, 1.0]])
+"""(2, 3) min and max corners (m) of the cube [−1, 1]³ that the meshing and GLSL-editor tests sample; read-only,
+since every test module shares it."""
+CUBE_BOUNDS.setflags(write=False)
+
 
 def assert_near_surface_meshes_like_the_full_grid(
     scene: sdf.Scene, resolution: int, bounds: ArrayLike | None = None

@@ -13,14 +13,13 @@ import itertools
 import numpy as np
 import pytest
 import trimesh
-from helpers.meshing import assert_near_surface_meshes_like_the_full_grid
+from helpers.meshing import CUBE_BOUNDS, assert_near_surface_meshes_like_the_full_grid
 from helpers.properties import examples
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from kernels import sdf
 
-BOUNDS = np.array([[-1.0, -1.0, -1.0], [1.0, 1.0, 1.0]])
 # Resolutions whose grid planes (−1 + i·2/(r − 1)) land on the boxes' faces.
 ON_GRID_RESOLUTIONS = (17, 33, 65)
 
@@ -129,7 +128,7 @@ def on_grid_box_pairs(draw: st.DrawFn, smooth: bool) -> BoxPair:
 def assert_closed_solid(
     scene: sdf.Scene, resolution: int, chi: int, near_surface: bool = True
 ) -> trimesh.Trimesh | None:
-    vertices, faces, _ = sdf.mesh(scene, resolution, BOUNDS, near_surface=near_surface)
+    vertices, faces, _ = sdf.mesh(scene, resolution, CUBE_BOUNDS, near_surface=near_surface)
     if chi == 0 and len(faces) == 0:
         return None  # nothing inside (an intersection of boxes that only touch)
     tri = trimesh.Trimesh(vertices, faces, process=False)
@@ -180,7 +179,7 @@ def test_smooth_csg_of_boxes_on_grid_planes_meshes_closed(case: BoxPair) -> None
 @given(case=st.one_of(on_grid_box_pairs(smooth=False), on_grid_box_pairs(smooth=True)))
 @settings(max_examples=examples(25), deadline=None)
 def test_coarse_to_fine_still_equals_the_full_grid_with_samples_on_the_level(case: BoxPair) -> None:
-    assert_near_surface_meshes_like_the_full_grid(case.scene, case.resolution, BOUNDS)
+    assert_near_surface_meshes_like_the_full_grid(case.scene, case.resolution, CUBE_BOUNDS)
 
 
 # ------------------------------------------------------------------------------------------------ public inputs
@@ -198,7 +197,7 @@ def l_shape() -> sdf.Scene:
 @pytest.mark.parametrize("near_surface", [True, False], ids=["coarse-to-fine", "full-grid"])
 def test_box_minus_box_on_grid_planes_is_a_closed_l_shape(resolution: int, near_surface: bool) -> None:
     # Once: not watertight, Euler number 25 / 217 / 1177, volume 0.9115 at 17. Right: Euler 2, volume 0.875.
-    grid = sdf.make_grid(l_shape(), resolution, BOUNDS)
+    grid = sdf.make_grid(l_shape(), resolution, CUBE_BOUNDS)
     assert np.count_nonzero(sdf.sample_full(l_shape(), grid) == 0.0) > 100  # the faces do lie on samples
     tri = assert_closed_solid(l_shape(), resolution, chi=1, near_surface=near_surface)
     assert tri is not None
@@ -293,7 +292,7 @@ def test_a_feature_one_voxel_thick_on_grid_planes_meshes_closed(
     # A box's edges are convex and lie on samples: exact, up to the 2δ nudge of its faces.
     nudge = 2.0 * sdf.ISO_NUDGE_VOXELS * spacing(resolution) * tri.area
     assert exact - 1e-9 <= tri.volume <= exact + nudge + 1e-9
-    assert_near_surface_meshes_like_the_full_grid(scene, resolution, BOUNDS)
+    assert_near_surface_meshes_like_the_full_grid(scene, resolution, CUBE_BOUNDS)
 
 
 def test_zero_volume_sets_stay_empty() -> None:
@@ -304,7 +303,7 @@ def test_zero_volume_sets_stay_empty() -> None:
         dataclasses.replace(a, op="subtract"),
         sdf.Primitive("box", (1.0, 0.0, 0.0), (0.5, 0.5, 0.5), op="intersect"),
     ):
-        _, faces, _ = sdf.mesh(sdf.Scene((a, second), k=0.0), 17, BOUNDS)
+        _, faces, _ = sdf.mesh(sdf.Scene((a, second), k=0.0), 17, CUBE_BOUNDS)
         assert len(faces) == 0
 
 

@@ -8,6 +8,7 @@ import re
 
 import numpy as np
 import pytest
+from helpers.meshing import CUBE_BOUNDS
 from helpers.properties import examples
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -23,7 +24,6 @@ from shaders.renderer import (
     mesh_glsl,
 )
 
-BOUNDS = np.array([[-1.0, -1.0, -1.0], [1.0, 1.0, 1.0]])
 SPHERE = "float sdf(vec3 p) {\n    return sd_sphere(p - vec3(0.1, -0.2, 0.05), 0.55);\n}\n"
 
 
@@ -187,17 +187,17 @@ def test_compiler_logs_of_both_vendors_give_the_line() -> None:
 def test_compile_error_is_a_value_error_with_the_compilers_message_and_line() -> None:
     bad = "float sdf(vec3 p) {\n    float r = 0.5;\n    return sd_sphere(p, r) +;\n}\n"
     with pytest.raises(ValueError, match=r"^line 3: .*syntax error") as info:
-        mesh_glsl(bad, 32, BOUNDS)
+        mesh_glsl(bad, 32, CUBE_BOUNDS)
     assert isinstance(info.value, ShaderCompileError) and info.value.line == 3
     with pytest.raises(ValueError, match="line 2"):
-        mesh_glsl("float sdf(vec3 p) {\n    return sd_sphere(p, 1.0, 2.0);\n}", 32, BOUNDS)
+        mesh_glsl("float sdf(vec3 p) {\n    return sd_sphere(p, 1.0, 2.0);\n}", 32, CUBE_BOUNDS)
 
 
 @pytest.mark.gl
 @pytest.mark.parametrize(
     ("resolution", "bounds", "words"),
     [
-        (8, BOUNDS, "resolution"),
+        (8, CUBE_BOUNDS, "resolution"),
         (64, [[0, 0, 0], [0, 1, 1]], "bounds"),
         (64, [[0, 0, 0], [np.nan, 1, 1]], "bounds"),
     ],
@@ -210,7 +210,7 @@ def test_bad_resolution_or_bounds_raise(resolution: int, bounds: object, words: 
 @pytest.mark.gl
 def test_nan_field_is_refused() -> None:
     with pytest.raises(ValueError, match="NaN"):
-        mesh_glsl("float sdf(vec3 p) {\n    return sqrt(-1.0 - p.x * p.x);\n}", 32, BOUNDS)
+        mesh_glsl("float sdf(vec3 p) {\n    return sqrt(-1.0 - p.x * p.x);\n}", 32, CUBE_BOUNDS)
 
 
 # ------------------------------------------------------------------------------------------ sampling and mesh
@@ -220,7 +220,7 @@ def test_gl_sampled_grid_equals_numpy_at_every_sample() -> None:
         "float sdf(vec3 p) {\n    return smooth_union(sd_cylinder(p, 0.5, 0.3), "
         "sd_octahedron(p - vec3(0.3, 0.2, 0.1), 0.4), 0.2, BLEND_POLY);\n}\n"
     )
-    grid = sdf.make_grid(sdf.default_scene(), 48, BOUNDS)
+    grid = sdf.make_grid(sdf.default_scene(), 48, CUBE_BOUNDS)
     field = gl_service.run(lambda gl: gl.sample_field(source, grid))
     axes = [grid.origin[i] + grid.spacing * np.arange(grid.shape[i]) for i in range(3)]
     points = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
@@ -235,7 +235,7 @@ def test_gl_sampled_grid_equals_numpy_at_every_sample() -> None:
 
 @pytest.mark.gl
 def test_gl_sampled_grid_in_several_draws_is_the_same() -> None:
-    grid = sdf.make_grid(sdf.default_scene(), 200, BOUNDS)  # 200·200 rows > 8192: several draws
+    grid = sdf.make_grid(sdf.default_scene(), 200, CUBE_BOUNDS)  # 200·200 rows > 8192: several draws
     field = gl_service.run(lambda gl: gl.sample_field(SPHERE, grid))
     k = np.arange(grid.shape[2])
     z = grid.origin[2] + grid.spacing * k
@@ -249,7 +249,7 @@ def test_gl_sampled_grid_in_several_draws_is_the_same() -> None:
 @pytest.mark.gl
 def test_mesh_glsl_of_a_sphere_is_the_sphere_with_its_colour() -> None:
     source = SPHERE + "vec3 color(vec3 p) {\n    return vec3(0.2, 0.4, 0.8);\n}\n"
-    tri = mesh_glsl(source, 64, BOUNDS)
+    tri = mesh_glsl(source, 64, CUBE_BOUNDS)
     radii = np.linalg.norm(tri.vertices - [0.1, -0.2, 0.05], axis=1)
     spacing = 2.0 / 63
     assert np.abs(radii - 0.55).max() < 0.1 * spacing
@@ -265,8 +265,8 @@ def test_mesh_glsl_of_a_sphere_is_the_sphere_with_its_colour() -> None:
 def test_mesh_glsl_equals_the_numpy_mesher_on_the_same_field() -> None:
     """One algorithm: the GL-sampled field goes through the kernel's marching-cubes pass."""
     source = "float sdf(vec3 p) {\n    return sd_round_box(p, vec3(0.6, 0.4, 0.3), 0.1);\n}\n"
-    tri = mesh_glsl(source, 48, BOUNDS)
-    grid = sdf.make_grid(sdf.default_scene(), 48, BOUNDS)
+    tri = mesh_glsl(source, 48, CUBE_BOUNDS)
+    grid = sdf.make_grid(sdf.default_scene(), 48, CUBE_BOUNDS)
     axes = [grid.origin[i] + grid.spacing * np.arange(grid.shape[i]) for i in range(3)]
     points = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
     field = sdf.sd_round_box(points, (0.6, 0.4, 0.3), 0.1).astype(np.float32).reshape(grid.shape)
@@ -277,7 +277,7 @@ def test_mesh_glsl_equals_the_numpy_mesher_on_the_same_field() -> None:
 
 @pytest.mark.gl
 def test_empty_field_gives_an_empty_mesh() -> None:
-    tri = mesh_glsl("float sdf(vec3 p) {\n    return 1.0;\n}\n", 32, BOUNDS)
+    tri = mesh_glsl("float sdf(vec3 p) {\n    return 1.0;\n}\n", 32, CUBE_BOUNDS)
     assert len(tri.faces) == 0
 
 
@@ -332,7 +332,7 @@ def test_a_positive_scale_of_the_field_changes_nothing(exponent: float, body: st
 @pytest.mark.gl
 def test_field_raymarch_depth_matches_the_analytic_sphere() -> None:
     camera = Camera((2.0, -1.5, 1.0), (0.1, -0.2, 0.05), fov_y_rad=math.radians(40))
-    _, depth = gl_service.run(lambda gl: gl.render_field(SPHERE, BOUNDS, camera, 96, 64))
+    _, depth = gl_service.run(lambda gl: gl.render_field(SPHERE, CUBE_BOUNDS, camera, 96, 64))
     origins, dirs = gl_renderer.camera_rays(camera, 96, 64)
     oc = origins - [0.1, -0.2, 0.05]
     b = np.sum(oc * dirs, axis=1)

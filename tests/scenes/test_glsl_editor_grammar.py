@@ -12,6 +12,7 @@ import re
 import numpy as np
 import pytest
 import viser
+from helpers.meshing import CUBE_BOUNDS
 from helpers.properties import examples
 from helpers.scenes import apply_glsl, scene_fixture
 from helpers.waiting import wait_until
@@ -31,7 +32,6 @@ from shaders.glsl_sandbox import (
 )
 from shaders.renderer import Camera, Shading, mesh_glsl
 
-BOUNDS = np.array([[-1.0, -1.0, -1.0], [1.0, 1.0, 1.0]])
 PLAIN_SDF = "float sdf(vec3 p) {\n    return sd_torus(p - vec3(0.1, 0.0, 0.05), 0.6, 0.2);\n}\n"
 PLAIN_COLOR = "vec3 color(vec3 p) {\n    return vec3(0.2, 0.5, 0.8) + 0.1 * p;\n}\n"
 MESA_TOKEN_NAME = re.compile(
@@ -152,8 +152,8 @@ def test_quilez_and_shadertoy_style_signatures_pass_the_checks(source: str) -> N
 @pytest.mark.gl
 @pytest.mark.parametrize("source", QUILEZ_STYLE)
 def test_quilez_and_shadertoy_style_signatures_mesh_as_the_plain_form(source: str) -> None:
-    plain = mesh_glsl(PLAIN_SDF, 48, BOUNDS)
-    tri = mesh_glsl(source, 48, BOUNDS)
+    plain = mesh_glsl(PLAIN_SDF, 48, CUBE_BOUNDS)
+    tri = mesh_glsl(source, 48, CUBE_BOUNDS)
     assert len(tri.faces) == len(plain.faces) > 1000
     np.testing.assert_allclose(tri.vertices, plain.vertices, atol=1e-6)
 
@@ -164,7 +164,7 @@ def test_a_const_in_signature_ray_marches_as_the_plain_form() -> None:
     shading = Shading(shadows=False, occlusion=False)
 
     def depth(source: str) -> np.ndarray:
-        return gl_service.run(lambda gl: gl.render_field(source, BOUNDS, camera, 64, 40, shading))[1]
+        return gl_service.run(lambda gl: gl.render_field(source, CUBE_BOUNDS, camera, 64, 40, shading))[1]
 
     plain, quilez = depth(PLAIN_SDF), depth(QUILEZ_STYLE[1])
     assert np.isfinite(plain).sum() > 300
