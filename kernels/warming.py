@@ -36,6 +36,7 @@ from typing import Any, Generic, ParamSpec, TypeVar
 
 from numba.core.dispatcher import Dispatcher
 
+from kernels._jit import CompiledOnly
 from kernels._jit_cache import cache_dirs
 
 logger = logging.getLogger(__name__)
@@ -141,8 +142,11 @@ class Entry(Generic[P, R]):
     """
 
     def __init__(self, compiled: Callable[P, R]) -> None:
-        if not isinstance(compiled, Dispatcher):
-            raise TypeError(f"compiled must be a numba dispatcher, got {type(compiled).__name__}")
+        if not isinstance(compiled, Dispatcher) or isinstance(compiled, CompiledOnly):
+            raise TypeError(
+                "compiled must be a numba dispatcher Python may call (compiled(from_python=True)), "
+                f"got {type(compiled).__name__}"
+            )
         self.compiled = compiled
         self.package = _package_of(compiled.py_func.__module__)
         """The package of :data:`MODULES` whose background compile this entry waits for (found once, here)."""

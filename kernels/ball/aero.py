@@ -272,7 +272,7 @@ def drag_lift(speed, rate, measured, constant_drag, constant_lift, radius, re_pe
     return drag / speed, lift / speed
 
 
-@compiled()
+@compiled(from_python=True)
 def drag_lift_table(speeds, rates, config, drag, lift):
     """:func:`drag_lift` at each of the (N,) ``speeds`` and ``rates`` under the (14,) settings' model, into the (N,)
     ``drag`` and ``lift``."""

@@ -68,7 +68,7 @@ def impact(velocity, spin, normal, surface, v_out, w_out):
     return True
 
 
-@compiled()
+@compiled(from_python=True)
 def impacts(velocities, spins, normal, surface, v_out, w_out):
     """:func:`impact` on each of the (K, 3) ``velocities`` and ``spins``, into the (K, 3) ``v_out`` and ``w_out``."""
     for k in range(len(velocities)):

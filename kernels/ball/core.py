@@ -240,7 +240,7 @@ def _fly(launch, kick, config, t_out, state_out):
     return n_steps + 1, 2 if math.isfinite(x + y + z + vx + vy + vz) else 3
 
 
-@compiled()
+@compiled(from_python=True)
 def simulate_one(launch, config, t_out, state_out, forces_out):
     """:func:`simulate`'s compiled part: the kick's constants, its flight and the forces along it."""
     kick = np.empty(N_KICK)
@@ -253,7 +253,7 @@ def simulate_one(launch, config, t_out, state_out, forces_out):
     return n, ending
 
 
-@compiled()
+@compiled(from_python=True)
 def stable_step(launch, config):
     """(longest stable dt (s), fastest speed bound (m/s)) of one kick's (13,) launch row: what ending 4 compared."""
     kick = np.empty(N_KICK)
@@ -261,7 +261,7 @@ def stable_step(launch, config):
     return max_stable_step(launch, kick, config)
 
 
-@compiled(nogil=True)
+@compiled(from_python=True, nogil=True)
 def fly_rows(start, stop, launches, config, t_out, state_out, n_samples, endings):
     """Kicks ``start`` to ``stop`` of a batch, each flight into column k of ``t_out`` (T, K) and ``state_out``
     (T, K, 6); without the GIL, so threads share a batch (:func:`kernels._rows.run_rows`).
@@ -274,7 +274,7 @@ def fly_rows(start, stop, launches, config, t_out, state_out, n_samples, endings
         n_samples[k], endings[k] = _fly(launches[k], kick, config, t_out[:, k], state_out[:, k])
 
 
-@compiled(nogil=True)
+@compiled(from_python=True, nogil=True)
 def pad(t, state, n_samples):
     """Repeat each flight's last sample to the end of ``t`` (T, K) and ``state`` (T, K, 6)."""
     for k in range(len(n_samples)):
@@ -317,7 +317,7 @@ def _plane_crossing(t, position, velocity, n, panel, crossing):
             return
 
 
-@compiled()
+@compiled(from_python=True)
 def judge(t, position, velocity, n, panels, radius, crossings):
     """Result code (0 goal, 1 wall, 2 over, 3 wide, 4 short) of one flight's first ``n`` samples.
 
@@ -342,14 +342,14 @@ def judge(t, position, velocity, n, panels, radius, crossings):
     return 0 if crossings[1, 3] <= goal[5] - radius else 2
 
 
-@compiled(nogil=True)
+@compiled(from_python=True, nogil=True)
 def judge_rows(start, stop, t, position, velocity, n_samples, panels, radius, results, crossings):
     """:func:`judge` for flights ``start`` to ``stop`` of a (K, T) batch, without the GIL (threads share a batch)."""
     for k in range(start, stop):
         results[k] = judge(t[k], position[k], velocity[k], n_samples[k], panels, radius, crossings[k])
 
 
-@compiled(nogil=True)
+@compiled(from_python=True, nogil=True)
 def fly_and_judge_rows(start, stop, launches, config, panels, results, crossings, endings):
     """Fly kicks ``start`` to ``stop`` each into a scratch buffer and judge it at once (ball radius from ``config``):
     nothing kept. Without the GIL (threads share a batch)."""

@@ -216,7 +216,7 @@ def _keeper_capsule(pitch, dive_t, target, t, cap):
     cap[6], cap[7] = r, KEEPER
 
 
-@compiled()
+@compiled(from_python=True)
 def keeper_path(pitch, dive_t, target, times, out):
     """The keeper at each of ``times`` (T,) into ``out`` (T, 12): centre of mass (3), the unit vector toward the
     fingertips (3), and the ends of the capsule the ball is tested against (feet end 3, fingertip end 3)."""
@@ -828,7 +828,7 @@ def _forces_along(t_out, state_out, spin_out, n, first, kick, gain, config, forc
     return np.isfinite(forces_out[:n]).all()
 
 
-@compiled(nogil=True)
+@compiled(from_python=True, nogil=True)
 def play_rows(
     start,
     stop,

@@ -258,7 +258,7 @@ def _step(v0, length, drag, rolling, climbing, wind, power_in, mass, b0, b1):  #
     return x
 
 
-@compiled()
+@compiled(from_python=True)
 def _ride_core(
     length,
     drag,

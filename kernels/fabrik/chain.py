@@ -753,7 +753,7 @@ def _solve_chain(
     return count, _LIMITED if stalled else _MAX_ITERATIONS, final_error
 
 
-@compiled(error_model="numpy", nogil=True)
+@compiled(from_python=True, error_model="numpy", nogil=True)
 def _solve_rows(
     lo: int,
     hi: int,
@@ -835,7 +835,7 @@ def _norm_of_difference(a: NDArray[np.float64], b: NDArray[np.float64], dim: int
     return largest * math.sqrt(sum_sq)
 
 
-@compiled(error_model="numpy")
+@compiled(from_python=True, error_model="numpy")
 def _solve_one(
     joints: NDArray[np.float64],
     target: NDArray[np.float64],

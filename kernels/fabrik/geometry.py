@@ -48,7 +48,7 @@ def _unit(
     return fx, fy, fz, norm
 
 
-@compiled(error_model="numpy")
+@compiled(from_python=True, error_model="numpy")
 def _perpendicular(x: float, y: float, z: float, dim: int) -> tuple[float, float, float]:
     """A fixed unit vector perpendicular to the unit vector (x, y, z): in the plane for d = 2."""
     if dim == 2:

@@ -389,7 +389,7 @@ def _holds(table: NDArray[np.float64], row: int) -> bool:
     return not (kind == _KIND_HINGE and table[row, 10] - table[row, 9] >= 2.0 * math.pi)
 
 
-@compiled(error_model="numpy")
+@compiled(from_python=True, error_model="numpy")
 def _limit_flags(table: NDArray[np.float64]) -> tuple[bool, bool]:
     """(any limit at all, any limit that can hold a chain or tree at a fixed point; see :func:`_holds`)."""
     has_limits, holding = False, False
@@ -427,7 +427,7 @@ def _joint_ok(
     return True
 
 
-@compiled(error_model="numpy")
+@compiled(from_python=True, error_model="numpy")
 def _usage(
     p: NDArray[np.float64], table: NDArray[np.float64], rest: NDArray[np.float64], tiny: float
 ) -> NDArray[np.float64]:

@@ -317,7 +317,7 @@ def _tree_table_cached(constraints: Sequence[Constraint], count: int, dim: int, 
     return _limit_table(constraints, count, dim, "constraints", segment_offset=0)
 
 
-@compiled(error_model="numpy")
+@compiled(from_python=True, error_model="numpy")
 def _solve_tree_core(
     p: NDArray[np.float64],
     parents: NDArray[np.int64],
@@ -524,7 +524,7 @@ def _solve_tree_core(
     return iterations
 
 
-@compiled(error_model="numpy")
+@compiled(from_python=True, error_model="numpy")
 def _tree_extent(p: NDArray[np.float64], goal: NDArray[np.float64], effectors: NDArray[np.int64], root: int) -> float:
     """The largest coordinate offset from the root of a joint or a target (m)."""
     extent = 0.0

@@ -21,6 +21,7 @@ from numpy.typing import NDArray
 from kernels import ball
 from kernels.ball import aero, api
 from kernels.ball.core import crossing_fraction
+from tests.helpers.compiled import from_python
 
 WALL, GOAL = ball.free_kick_panels((0.0, 0.0), (25.0, 0.0), (1.0, 0.0))
 GOAL_WIDTH_M, GOAL_HEIGHT_M = 7.32, 2.44  # FIFA, inside the posts and under the bar
@@ -175,14 +176,14 @@ def test_a_stages_drag_from_the_steps_first_is_the_fits_value_to_the_last_bits()
         inverse = 1.0 / reference2
         for r in np.linspace(-1 / 32, 1 / 32, 401):
             speed2 = reference2 * (1.0 + float(r))
-            got = aero._spinning_drag_near(speed2, inverse, 0.7)
+            got = from_python(aero._spinning_drag_near)(speed2, inverse, 0.7)
             exact_r = Decimal(speed2) * Decimal(inverse) - 1  # the r the kernel forms, but for its rounding
             if abs(exact_r) > Decimal(1) / 32:
                 continue
             exact = Decimal.from_float(0.7) * ((1 + exact_r).ln() * power).exp()
             assert abs(Decimal(got) / exact - 1) <= Decimal(2) ** -51, (reference2, r)
         for outside in (1 + 1 / 30, 1 - 1 / 30, math.inf, math.nan):
-            assert math.isnan(aero._spinning_drag_near(reference2 * outside, inverse, 0.7))
+            assert math.isnan(from_python(aero._spinning_drag_near)(reference2 * outside, inverse, 0.7))
 
 
 def test_a_tenth_more_spin_changes_the_flight_only_in_the_measured_model() -> None:
@@ -937,7 +938,7 @@ def test_the_crossing_is_the_first_root_of_the_step_cubic(
 ) -> None:
     # For any step with the plane bracketed (d0 ≥ 0 ≥ d1), the fraction lies in [0, 1], the cubic is (to rounding)
     # on the plane there, and it is on the near side everywhere before it.
-    s = crossing_fraction(d0, dd0, d1, dd1, h)
+    s = from_python(crossing_fraction)(d0, dd0, d1, dd1, h)
     assert 0.0 <= s <= 1.0
 
     def cubic(

@@ -19,6 +19,7 @@ from hypothesis import strategies as st
 from kernels import ball
 from kernels.ball import api, odds, play
 from kernels.ball.pitch import keeper_slots, pitch_vector
+from tests.helpers.compiled import from_python
 
 R, G, ALPHA = 0.11, 9.81, 2.0 / 3.0
 VACUUM = {"air_density": 0.0, "method": "rk4", "ground_m": R}
@@ -1037,7 +1038,7 @@ def test_the_keepers_box_holds_his_body_at_every_instant(
     boxes = np.empty((3, 6))
     times = np.concatenate([np.linspace(0.0, dive_t + 3.0, 200), [dive_t + 1e6]])
     for dive in (None, ball.KeeperDive(dive_t, target)):
-        play._keeper_box(vector, math.inf if dive is None else dive.t, np.array(target), reach, boxes)
+        from_python(play._keeper_box)(vector, math.inf if dive is None else dive.t, np.array(target), reach, boxes)
         ends = ball.keeper_path(keeper, spot, dive, times).capsule.reshape(-1, 3)
         lo, hi = boxes[2, :3] + reach + keeper.body_radius_m, boxes[2, 3:] - reach - keeper.body_radius_m
         assert np.all(ends >= lo - 1e-9) and np.all(ends <= hi + 1e-9)
@@ -1048,11 +1049,11 @@ def test_the_goal_frame_and_wall_boxes_hold_each_of_their_capsules() -> None:
     pitch = ball.Pitch(goal, wall, wall_players=5)
     vector = pitch_vector(pitch, (-25.0, 4.0), R, R)
     caps = np.empty((play.MAX_CAPSULES, 8))
-    n_fixed = play._fixed_capsules(vector, caps)
+    n_fixed = from_python(play._fixed_capsules)(vector, caps)
     assert n_fixed == 8
     boxes = np.empty((3, 6))
     reach = R + 1e-3
-    play._group_boxes(caps, n_fixed, reach, boxes)
+    from_python(play._group_boxes)(caps, n_fixed, reach, boxes)
     for c in range(n_fixed):
         box = boxes[0 if c < 3 else 1]
         grow = reach + caps[c, 6]
@@ -1083,7 +1084,7 @@ def test_the_keepers_reach_box_holds_him_before_and_after_any_dive_the_flight_ca
     keeper_slots(vector, keeper, spot)
     reach = R + 1e-3
     boxes = np.empty((5, 6))
-    play._reach_boxes(vector, reach, boxes)
+    from_python(play._reach_boxes)(vector, reach, boxes)
     target = (0.0, lateral * 0.5 * ball.GOAL_WIDTH_M, R + height * (ball.GOAL_HEIGHT_M - R))
     times = np.concatenate([np.linspace(0.0, dive_t + 3.0, 200), [dive_t + 1e6]])
     ends = ball.keeper_path(keeper, spot, ball.KeeperDive(dive_t, target), times).capsule.reshape(-1, 3)

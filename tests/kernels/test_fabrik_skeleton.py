@@ -14,6 +14,7 @@ from hypothesis import strategies as st
 from numpy.typing import NDArray
 
 from kernels import fabrik
+from tests.helpers.compiled import from_python
 
 PROPERTY = settings(max_examples=examples(50), deadline=None)
 Array = NDArray[np.float64]
@@ -678,11 +679,13 @@ def test_chain_and_one_branch_tree_judge_a_pose_alike(seed: int, n: int, limited
     parents = np.arange(-1, n, dtype=np.int64)
     order = np.arange(n + 1, dtype=np.int64)
     tree_table = np.vstack([np.zeros((1, table.shape[1])), table])
-    as_chain = chain._admissible(p, tiny, rest, limited, table, (centres, radii, live))
-    as_tree = tree._tree_admissible(p, parents, order, tree_table, rest, tiny, limited, (centres, radii, live))
+    as_chain = from_python(chain._admissible)(p, tiny, rest, limited, table, (centres, radii, live))
+    as_tree = from_python(tree._tree_admissible)(
+        p, parents, order, tree_table, rest, tiny, limited, (centres, radii, live)
+    )
     assert as_chain == as_tree
     for i in range(n):  # the one segment test, zero-length segments included, never NaN
-        cut = geometry._segment_cuts(p, i, i + 1, (centres, radii, live), 1.0)
+        cut = from_python(geometry._segment_cuts)(p, i, i + 1, (centres, radii, live), 1.0)
         length = float(np.linalg.norm(p[i + 1] - p[i]))
         if length == 0.0:
             inside = bool(np.any(live & (np.linalg.norm(centres - p[i], axis=1) < radii)))
@@ -694,10 +697,12 @@ def test_a_zero_length_segment_inside_a_sphere_cuts_it_for_chain_and_tree() -> N
 
     p = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, 1.0]])
     centres, radii, live = np.array([[0.05, 0.0, 1.0]]), np.array([0.1]), np.array([True])
-    assert geometry._segment_cuts(p, 1, 2, (centres, radii, live), 1.0)
-    assert not geometry._segment_cuts(p, 1, 2, (centres + 1.0, radii, live), 1.0)
+    assert from_python(geometry._segment_cuts)(p, 1, 2, (centres, radii, live), 1.0)
+    assert not from_python(geometry._segment_cuts)(p, 1, 2, (centres + 1.0, radii, live), 1.0)
     table = np.zeros((1, 13))
     rest = np.array([0.0, 0.0, 1.0])
     parents, order = np.array([-1, 0, 1]), np.array([0, 1, 2])
-    assert not chain._admissible(p, 1e-12, rest, False, table, (centres, radii, live))
-    assert not tree._tree_admissible(p, parents, order, np.zeros((3, 13)), rest, 1e-12, False, (centres, radii, live))
+    assert not from_python(chain._admissible)(p, 1e-12, rest, False, table, (centres, radii, live))
+    assert not from_python(tree._tree_admissible)(
+        p, parents, order, np.zeros((3, 13)), rest, 1e-12, False, (centres, radii, live)
+    )

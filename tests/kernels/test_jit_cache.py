@@ -81,29 +81,55 @@ def test_without_a_writable_cache_directory_the_kernels_compile_uncached(
 ) -> None:
     # numba refuses cache=True when neither the package's __pycache__ nor ~/.cache/numba is writable (checked by
     # hand as user nobody with a read-only HOME): the module must still import, just compiling at every start.
-    calls: list[dict[str, object]] = []
+    from numba.core.registry import CPUDispatcher
 
-    def refusing_njit(**options: object):
-        calls.append(options)
-        if options.get("cache"):
-            raise RuntimeError("cannot cache function 'f': no locator available for file 'chain.py'")
-        return lambda function: function
+    def refuse(self: CPUDispatcher) -> None:
+        raise RuntimeError("cannot cache function 'f': no locator available for file 'chain.py'")
 
-    monkeypatch.setattr(jit, "njit", refusing_njit)
+    monkeypatch.setattr(CPUDispatcher, "enable_caching", refuse)
     monkeypatch.setattr(jit, "UNCACHED", [])
 
     def core() -> int:
         return 7
 
-    assert jit.compiled(parallel=True)(core)() == 7
-    assert calls == [
-        {"cache": True, "no_cfunc_wrapper": True, "parallel": True},
-        {"no_cfunc_wrapper": True, "parallel": True},
-    ]
-    assert jit.UNCACHED == ["core"]
-    monkeypatch.setattr(jit, "njit", lambda **options: (_ for _ in ()).throw(RuntimeError("other failure")))
+    def helper() -> int:
+        return 6
+
+    entry = jit.compiled(from_python=True, error_model="numpy")(core)
+    assert entry() == 7
+    assert entry.targetoptions == {
+        "nopython": True,
+        "boundscheck": None,
+        "no_cfunc_wrapper": True,
+        "error_model": "numpy",
+    }
+    assert jit.compiled(error_model="numpy")(helper).targetoptions == {
+        **entry.targetoptions,
+        "no_cpython_wrapper": True,
+    }
+    assert jit.UNCACHED == ["core", "helper"]
+
+    def other(self: CPUDispatcher) -> None:
+        raise RuntimeError("other failure")
+
+    monkeypatch.setattr(CPUDispatcher, "enable_caching", other)
     with pytest.raises(RuntimeError, match="other failure"):
         jit.compiled()(core)
+
+
+def test_a_compiled_only_kernel_refuses_a_call_from_python_and_runs_from_compiled_code() -> None:
+    # Built without numba's CPython wrapper, a call from Python would jump to code that does not exist (a crash).
+    def twice(x: float) -> float:
+        return 2.0 * x
+
+    helper = jit.compiled()(twice)
+    with pytest.raises(TypeError, match="twice is compiled for compiled callers only"):
+        helper(1.5)
+
+    def caller(x: float) -> float:
+        return helper(x) + 1.0
+
+    assert jit.compiled(from_python=True)(caller)(1.5) == 4.0
 
 
 def test_every_compiled_kernel_is_made_one_way() -> None:
@@ -123,3 +149,8 @@ def test_every_compiled_kernel_is_made_one_way() -> None:
     assert len(dispatchers) > 100
     made_otherwise = [name for name, d in dispatchers.items() if not d.targetoptions.get("no_cfunc_wrapper")]
     assert made_otherwise == []
+    # Each is callable from Python (with numba's CPython wrapper) or refuses Python's call (built without it).
+    wrapperless = {name for name, d in dispatchers.items() if d.targetoptions.get("no_cpython_wrapper")}
+    refusing = {name for name, d in dispatchers.items() if isinstance(d, jit.CompiledOnly)}
+    assert wrapperless == refusing
+    assert len(refusing) > 70

@@ -174,6 +174,15 @@ def test_a_twin_calls_no_compiled_code() -> None:
         warming.python_twin(len)
 
 
+def test_an_entry_wraps_only_what_python_may_call() -> None:
+    from kernels.fabrik.chain import _solve_chain, _solve_one
+
+    assert warming.Entry(_solve_one).compiled is _solve_one
+    for not_callable in (_solve_chain, len):  # built without numba's CPython wrapper; not compiled at all
+        with pytest.raises(TypeError, match="Python may call"):
+            warming.Entry(not_callable)
+
+
 def test_entries_run_twins_only_while_their_package_is_pending(fresh_warming: None) -> None:
     from kernels.fabrik import api
 
