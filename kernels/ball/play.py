@@ -663,6 +663,8 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
             best, kind = 1.0, -3  # over a touchline
         if kind == -1:
             x, y, z, vx, vy, vz = x1, y1, z1, vx1, vy1, vz1
+            if rolling:  # rolling without slipping: ω = (ẑ × v)/R as the roll slows
+                wx, wy = -vy / radius, vx / radius
             t = t + h
             if store and n < max_rows:
                 _write_spin_sample(t_out, state_out, spin_out, n, t, x, y, z, vx, vy, vz, wx, wy, wz)
@@ -682,6 +684,7 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
             ez, evz = _hermite(z, vz, z1, vz1, h, f)
         if rolling:
             ez, evz = ground, 0.0
+            wx, wy = -evy / radius, evx / radius
         t = t + f * h
         x, y, z, vx, vy, vz = ex, ey, ez, evx, evy, evz
         done = False
@@ -724,7 +727,6 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
                     # (its spin outweighs the rebound); the body stops that part and the ball rolls on along it,
                     # or rests against it. Without this it struck the body again at once, contact after contact.
                     vx, vy = vx - into * normal[0], vy - into * normal[1]
-                wx, wy, wz = -vy / radius, vx / radius, 0.0
             elif kind != GROUND_HIT and normal[2] >= 0.5:  # on a body below it: a head, the bar, a post's top
                 chatter = chatter + 1 if t - supported_t < 0.01 else 0
                 supported_t = t
@@ -749,6 +751,8 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
             ending, done = ENDED_X_STOP, True
         else:  # kind == -3
             ending, done = OUT, True
+        if rolling:  # rolling without slipping, or stopped (by a body, the net): ω = (ẑ × v)/R
+            wx, wy, wz = -vy / radius, vx / radius, 0.0
         if kind >= 0:
             if n_events < MAX_EVENTS:
                 events[n_events, 0], events[n_events, 1] = t, kind

@@ -621,6 +621,73 @@ def test_a_roll_with_heavy_spin_flies_on_a_pitch_as_without_one(spin: float) -> 
     assert np.all(np.diff(energy(flight)) <= 1e-9 * energy(flight)[0])
 
 
+def rolling_samples(flight: ball.Trajectory) -> np.ndarray:
+    """Indices of the samples at which the ball rolls: on the turf with no vertical speed, after the step before."""
+    on_turf = (flight.position[:, 2] == R) & (flight.velocity[:, 2] == 0.0)
+    return np.flatnonzero(on_turf & np.r_[False, on_turf[:-1]])
+
+
+@given(
+    speed=st.floats(0.5, 12.0),
+    elevation=st.floats(-3.0, 25.0),
+    azimuth=st.floats(-180.0, 180.0),
+    spin=st.floats(-60.0, 60.0),
+    model=st.sampled_from(["constant", "measured"]),
+)
+def test_a_rolling_ball_spins_at_its_speed_over_its_radius(speed, elevation, azimuth, spin, model) -> None:
+    # Rolling without slipping, ω = (ẑ × v)/R at every sample of the roll, as the turf and the air slow it. The
+    # spin was left at what the ball had when it began to roll (45.6 rad/s at 0.45 m/s, where v/R is 4 rad/s), and a
+    # roll into a post took that spin into the impact. Rolls begin from bounces, skids and rolls at the kick, in
+    # every direction, some into the wall, the posts and the net.
+    velocity = ball.launch_velocity(speed, math.radians(elevation), math.radians(azimuth))
+    start = (-6.0, 3.0, R)
+    flight = ball.simulate(
+        start,
+        velocity,
+        (0.0, 0.0, spin),
+        dt=1e-2,
+        t_max=12.0,
+        method="rk4",
+        model=model,
+        ground_m=R,
+        pitch=ball.Pitch(GOAL, ball.free_kick_panels((-12.0, 0.0), (0.0, 0.0), (1.0, 0.0))[0]),
+    )
+    assert flight.spin is not None
+    rolling = rolling_samples(flight)
+    v = flight.velocity[rolling]
+    expected = np.column_stack([-v[:, 1] / R, v[:, 0] / R, np.zeros(len(v))])
+    np.testing.assert_allclose(flight.spin[rolling], expected, rtol=0.0, atol=1e-9 * max(speed, 1.0) / R)
+
+
+def test_a_ball_rolled_at_3_2_m_s_slows_its_spin_with_its_speed() -> None:
+    # In a vacuum the turf alone slows it, 0.8 m/s²: after 2.5 s it rolls at 1.2 m/s, so it spins at 1.2/R about
+    # +y; once stopped, it does not spin.
+    flight = ball.simulate(
+        (0.0, 5.0, R), (3.2, 0.0, 0.0), (0.0, 3.2 / R, 0.0), dt=1e-2, t_max=20.0, pitch=OPEN, **VACUUM
+    )
+    assert flight.spin is not None
+    at = int(np.argmin(np.abs(flight.t - 2.5)))
+    assert flight.t[at] == pytest.approx(2.5, abs=1e-9)
+    np.testing.assert_allclose(flight.spin[at], (0.0, 1.2 / R, 0.0), rtol=0.0, atol=1e-9)
+    np.testing.assert_array_equal(flight.spin[-1], (0.0, 0.0, 0.0))
+
+
+def test_a_roll_into_a_post_meets_it_spinning_at_its_speed_over_its_radius() -> None:
+    # Rolling along the goal line into the left post (its axis at y = 3.72 m), from a skid with no spin: the ball
+    # grips, rolls at 3/5 of its speed, slows at the turf's 0.8 m/s², and meets the post with ω = (ẑ × v)/R.
+    flight = ball.simulate(
+        (-0.1, 0.0, R), (0.0, 6.0, 0.0), (0.0, 0.0, 0.0), dt=1e-2, t_max=3.0, pitch=ball.Pitch(GOAL), **VACUUM
+    )
+    assert flight.spin is not None
+    hits = [event for event in flight.events if event.kind == "post"]
+    assert hits, [event.kind for event in flight.events]
+    i = int(np.searchsorted(flight.t, hits[0].t))
+    assert flight.t[i] == pytest.approx(hits[0].t, abs=1e-12)
+    before = flight.velocity[i - 1]
+    np.testing.assert_allclose(flight.spin[i - 1], (-before[1] / R, before[0] / R, 0.0), atol=1e-9)
+    assert before[1] == pytest.approx(3.6 - 0.8 * flight.t[i - 1], rel=1e-9)  # 3/5 of 6 m/s, less the turf's 0.8 m/s²
+
+
 def test_without_a_wall_outcomes_still_judge_the_goal() -> None:
     velocity = ball.launch_velocity(25.0, math.radians(14.0), 0.0)
     judged = ball.simulate_outcomes(
