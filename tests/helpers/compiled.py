@@ -17,5 +17,7 @@ from numba import njit
 def from_python(helper: Any) -> Any:
     """``helper`` (a compiled-only kernel function) as a dispatcher Python can call: the same ``py_func``, compiled
     with the same target options (calling the same compiled callees), plus numba's CPython wrapper."""
-    options = {key: value for key, value in helper.targetoptions.items() if key != "no_cpython_wrapper"}
+    options = {
+        key: value for key, value in helper.targetoptions.items() if key not in ("no_cpython_wrapper", "nopython")
+    }
     return njit(**options)(helper.py_func)
