@@ -423,6 +423,200 @@ def _write_spin_sample(t_out, state_out, spin_out, n, t, x, y, z, vx, vy, vz, wx
 
 
 @compiled()
+def _roll_step(x, y, z, vx, vy, h, law, decel):
+    """One step of a roll (horizontal velocity (vx, vy) ≠ 0): RK4 on the horizontal velocity, or the exact stop
+    where the speed runs out inside the step. Returns the step's end (x, y, z, vx, vy, vz), its length and whether
+    the ball stopped."""
+    speed = math.sqrt(vx * vx + vy * vy)
+    ax0, ay0 = _roll_acceleration(vx, vy, law, decel)
+    a = math.sqrt(ax0 * ax0 + ay0 * ay0)
+    if speed <= a * h:  # it stops inside this step (the deceleration is nearly constant over it)
+        h = speed / a
+        return x + 0.5 * vx * h, y + 0.5 * vy * h, z, 0.0, 0.0, 0.0, h, True
+    half = 0.5 * h
+    a2x, a2y = _roll_acceleration(vx + half * ax0, vy + half * ay0, law, decel)
+    a3x, a3y = _roll_acceleration(vx + half * a2x, vy + half * a2y, law, decel)
+    a4x, a4y = _roll_acceleration(vx + h * a3x, vy + h * a3y, law, decel)
+    x1 = x + h / 6.0 * (vx + 2.0 * (vx + half * ax0) + 2.0 * (vx + half * a2x) + vx + h * a3x)
+    y1 = y + h / 6.0 * (vy + 2.0 * (vy + half * ay0) + 2.0 * (vy + half * a2y) + vy + h * a3y)
+    vx1 = vx + h / 6.0 * (ax0 + 2.0 * (a2x + a3x) + a4x)
+    vy1 = vy + h / 6.0 * (ay0 + 2.0 * (a2y + a3y) + a4y)
+    if vx1 * vx + vy1 * vy <= 0.0:  # reversed: stop where the speed reached zero
+        return x1, y1, z, 0.0, 0.0, 0.0, h, True
+    return x1, y1, z, vx1, vy1, 0.0, h, False
+
+
+@compiled()
+def _verdict(pitch, info, radius, scored, touched_keeper, first_body):
+    """The play's result code from what it met and where it crossed the goal line (``info``)."""
+    if scored:
+        return GOAL
+    elif touched_keeper:
+        return SAVED_RESULT
+    elif first_body == WALL:
+        return WALL_RESULT
+    elif first_body == POST:
+        return POST_RESULT
+    elif first_body == BAR:
+        return BAR_RESULT
+    elif not math.isnan(info[I_GOAL]):
+        lateral = -(info[I_GOAL + 1] - pitch[GX]) * pitch[GNY] + (info[I_GOAL + 2] - pitch[GY]) * pitch[GNX]
+        if abs(lateral) > 0.5 * pitch[GW] - radius:
+            return WIDE
+        elif info[I_GOAL + 3] > pitch[TURF] + pitch[GH] - radius:
+            return OVER
+        else:
+            return SHORT
+    return SHORT
+
+
+@compiled()
+def _keeper_reads(pitch, x, y, z, vx, vy, vz, t, g, radius, target, info, boxes):
+    """The keeper's read of the ball at time ``t``: where it will cross his goal line if it reaches it within
+    :data:`DIVE_HORIZON_S` within his hands' reach of the goal, he dives for that point now (its time and target into
+    ``info``, his new box into ``boxes[2]``). Returns the dive's start, ``inf`` while he waits."""
+    gx, gy, gnx, gny = pitch[GX], pitch[GY], pitch[GNX], pitch[GNY]
+    half_goal, turf = 0.5 * pitch[GW], pitch[TURF]
+    depth = (x - gx) * gnx + (y - gy) * gny
+    approach = vx * gnx + vy * gny
+    lead = -depth / approach if approach > 1e-9 and depth < 0.0 else math.inf
+    if not lead <= DIVE_HORIZON_S:
+        return math.inf
+    lateral = -(x + vx * lead - gx) * gny + (y + vy * lead - gy) * gnx
+    height = z + vz * lead - 0.5 * g * lead * lead
+    if not (abs(lateral) <= half_goal + pitch[K_HANDS] and height <= turf + pitch[GH] + pitch[K_HANDS]):
+        return math.inf
+    lateral = min(max(lateral, -half_goal), half_goal)
+    height = min(max(height, turf + radius), turf + pitch[GH])
+    target[0], target[1], target[2] = gx - lateral * gny, gy + lateral * gnx, height
+    info[I_DIVE] = t
+    info[I_TARGET], info[I_TARGET + 1], info[I_TARGET + 2] = target[0], target[1], target[2]
+    _keeper_box(pitch, t, target, radius + 1e-3, boxes)
+    return t
+
+
+@compiled()
+def _goal_mouth(
+    pitch, x, y, z, vx, vy, vz, x1, y1, z1, vx1, vy1, vz1, t, h, radius, best, kind, inside, scored, crossed, info
+):
+    """The goal in one step: the ball crossing the goal line (into the mouth, where the crossing goes into ``info``, or
+    outside the goal: out of the pitch), back out through the mouth, wholly over the line (the fraction ``crossed``)
+    and stopped by the net's back, sides or roof. Returns the step's first contact (fraction ``best``, ``kind``),
+    whether the ball is inside the goal, and ``crossed``."""
+    gx, gy, gnx, gny = pitch[GX], pitch[GY], pitch[GNX], pitch[GNY]
+    half_goal, rp, turf = 0.5 * pitch[GW], pitch[POST_R], pitch[TURF]
+    depth0 = (x - gx) * gnx + (y - gy) * gny
+    depth1 = (x1 - gx) * gnx + (y1 - gy) * gny
+    rate0, rate1 = vx * gnx + vy * gny, vx1 * gnx + vy1 * gny
+    if not inside and depth0 <= 0.0 < depth1:  # from on the line too (a kick from it flew through the net unseen)
+        f = crossing_fraction(-depth0, -rate0, -depth1, -rate1, h)
+        if f <= best:
+            cx, _ = _hermite(x, vx, x1, vx1, h, f)
+            cy, _ = _hermite(y, vy, y1, vy1, h, f)
+            cz, _ = _hermite(z, vz, z1, vz1, h, f)
+            if math.isnan(info[I_GOAL]):
+                info[I_GOAL], info[I_GOAL + 1], info[I_GOAL + 2], info[I_GOAL + 3] = t + f * h, cx, cy, cz
+            lateral = -(cx - gx) * gny + (cy - gy) * gnx
+            if abs(lateral) <= half_goal + rp and cz <= turf + pitch[GH] + rp:
+                inside = True
+            else:
+                best, kind = f, -3  # over the goal line outside the goal: it leaves the pitch
+    elif inside and depth0 >= 0.0 > depth1:
+        inside = False  # back out through the mouth
+    if inside:
+        # Wholly over the line (Law 10: a goal), then the net: back, sides and roof stop it.
+        line = rp + radius
+        if not scored and depth1 >= line:
+            crossed = 0.0 if depth0 >= line else crossing_fraction(line - depth0, -rate0, line - depth1, -rate1, h)
+        limit = pitch[NET_DEPTH] - radius
+        if depth1 >= limit:
+            f = crossing_fraction(limit - depth0, -rate0, limit - depth1, -rate1, h)
+            if f < best:
+                best, kind = f, NET
+        lat0 = -(x - gx) * gny + (y - gy) * gnx
+        lat1 = -(x1 - gx) * gny + (y1 - gy) * gnx
+        side = half_goal + rp - radius
+        if depth1 > rp and abs(lat1) >= side and abs(lat0) < side:
+            sign = 1.0 if lat1 > 0.0 else -1.0
+            f = crossing_fraction(
+                side - sign * lat0,
+                -sign * (-vx * gny + vy * gnx),
+                side - sign * lat1,
+                -sign * (-vx1 * gny + vy1 * gnx),
+                h,
+            )
+            if f < best:
+                best, kind = f, NET
+        roof = turf + pitch[GH] + 2.0 * rp - radius
+        if depth1 > rp and z1 >= roof > z:
+            f = crossing_fraction(roof - z, -vz, roof - z1, -vz1, h)
+            if f < best:
+                best, kind = f, NET
+    return best, kind, inside, crossed
+
+
+@compiled()
+def _bounce(pitch, kind, cap, x, y, z, vx, vy, vz, wx, wy, wz, t, rolling, chatter, supported_t, ground, radius):
+    """The ball meets the turf (``kind`` GROUND_HIT) or the body ``cap`` (a post, the bar, a player of the wall) at
+    time ``t``: Cross's impact (:func:`~kernels.ball.contact.impact`) on the surface's normal, the roll it starts or
+    keeps, and a ball that settles on a body below it. Returns the state after (z, velocity, spin), whether it
+    rolls, the count and time of quick contacts on bodies below it, and whether it settled there."""
+    scratch = np.empty((5, 3))
+    v_in, w_in, normal, v_new, w_new = scratch[0], scratch[1], scratch[2], scratch[3], scratch[4]
+    settled = False
+    if kind == GROUND_HIT:
+        z = ground
+        normal[0], normal[1], normal[2] = 0.0, 0.0, 1.0
+        surface = pitch[TURF_SURFACE : TURF_SURFACE + N_SURFACE]
+    else:
+        _, nx, ny, nz = _to_axis(x, y, z, cap)
+        if rolling:
+            nz = 0.0
+            length = math.sqrt(nx * nx + ny * ny)
+            if length > 0.0:
+                nx, ny = nx / length, ny / length
+            else:
+                speed = max(math.sqrt(vx * vx + vy * vy), 1e-300)
+                nx, ny = -vx / speed, -vy / speed
+        normal[0], normal[1], normal[2] = nx, ny, nz
+        slot = FRAME_SURFACE if kind != WALL else BODY_SURFACE
+        surface = pitch[slot : slot + N_SURFACE]
+    v_in[0], v_in[1], v_in[2] = vx, vy, vz
+    w_in[0], w_in[1], w_in[2] = wx, wy, wz
+    impact(v_in, w_in, normal, surface, v_new, w_new)
+    vx, vy, vz = v_new[0], v_new[1], v_new[2]
+    wx, wy, wz = w_new[0], w_new[1], w_new[2]
+    if kind == GROUND_HIT and vz < pitch[ROLL_SPEED]:
+        rolling = True
+    if rolling:
+        # Onto the turf, rolling without slipping: a gripping tangential impulse that stops the contact
+        # point (Cross's grip with e_t = 0; it conserves the angular momentum about the contact point and
+        # never adds energy), then ω = (ẑ × v)/R; spin about the vertical is lost to the turf.
+        vz = 0.0
+        alpha = pitch[TURF_SURFACE + 4]
+        share = alpha / (1.0 + alpha)
+        ux, uy = vx - radius * wy, vy + radius * wx
+        vx, vy = vx - share * ux, vy - share * uy
+        into = vx * normal[0] + vy * normal[1]
+        if kind != GROUND_HIT and into < 0.0:
+            # The turf's grip can leave a ball that rolled into a post or a player still rolling into it
+            # (its spin outweighs the rebound); the body stops that part and the ball rolls on along it,
+            # or rests against it. Without this it struck the body again at once, contact after contact.
+            vx, vy = vx - into * normal[0], vy - into * normal[1]
+    elif kind != GROUND_HIT and normal[2] >= 0.5:  # on a body below it: a head, the bar, a post's top
+        chatter = chatter + 1 if t - supported_t < 0.01 else 0
+        supported_t = t
+        if vx * vx + vy * vy + vz * vz < pitch[ROLL_SPEED] ** 2 or chatter >= 2:
+            # Settled there: it leaves slower than a ground bounce that starts the roll (slow overall: a
+            # fast ball grazing the bar leaves with a weak rebound too), or it is caught between two heads,
+            # struck three times inside 10 ms. Each bounce would come sooner than the last, without end.
+            # The ball rests there.
+            vx, vy, vz, wx, wy, wz = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+            settled = True
+    return z, vx, vy, vz, wx, wy, wz, rolling, chatter, supported_t, settled
+
+
+@compiled()
 def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
     """Fly one kick on the pitch. Writes samples (time, position and velocity, spin) to ``t_out`` (T,), ``state_out``
     (T, 6) and ``spin_out`` (T, 3), T ≥ n_steps + 1 + :data:`EXTRA_ROWS` (T = 0: count only); contacts (time, kind,
@@ -474,12 +668,7 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
             info[I_RESULT] = SHORT
             return 1, INSIDE
     seen_t = math.inf if pitch[WALL_ON] != 0.0 else 0.0
-    v_in, w_in, normal, v_new, w_new = np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3)
-    turf_surface = pitch[TURF_SURFACE : TURF_SURFACE + N_SURFACE]
-    frame_surface = pitch[FRAME_SURFACE : FRAME_SURFACE + N_SURFACE]
-    body_surface = pitch[BODY_SURFACE : BODY_SURFACE + N_SURFACE]
     gx, gy, gnx, gny = pitch[GX], pitch[GY], pitch[GNX], pitch[GNY]
-    half_goal, rp, turf = 0.5 * pitch[GW], pitch[POST_R], pitch[TURF]
     n_events, first_body, touched_keeper, scored, inside = 0, -1, False, False, False
     rolling = False
     chatter, supported_t = 0, -math.inf  # contacts in quick succession on bodies below the ball, the last one's time
@@ -523,51 +712,16 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
         # The keeper reads the ball a reaction time after it passes the wall (or after the kick), and again each
         # step until it will reach his line within DIVE_HORIZON_S, within his hands' reach of the goal: then he dives.
         if keeper and dive_t == math.inf and t >= seen_t + pitch[K_REACT]:
-            depth = (x - gx) * gnx + (y - gy) * gny
-            approach = vx * gnx + vy * gny
-            lead = -depth / approach if approach > 1e-9 and depth < 0.0 else math.inf
-            lateral = -(x + vx * lead - gx) * gny + (y + vy * lead - gy) * gnx if lead <= DIVE_HORIZON_S else 0.0
-            height = z + vz * lead - 0.5 * g * lead * lead if lead <= DIVE_HORIZON_S else 0.0
-            if (
-                lead <= DIVE_HORIZON_S
-                and abs(lateral) <= half_goal + pitch[K_HANDS]
-                and height <= turf + pitch[GH] + pitch[K_HANDS]
-            ):
-                dive_t = t
-                lateral = min(max(lateral, -half_goal), half_goal)
-                height = min(max(height, turf + radius), turf + pitch[GH])
-                target[0], target[1], target[2] = gx - lateral * gny, gy + lateral * gnx, height
-                info[I_DIVE] = dive_t
-                info[I_TARGET], info[I_TARGET + 1], info[I_TARGET + 2] = target[0], target[1], target[2]
-                _keeper_box(pitch, dive_t, target, radius + 1e-3, boxes)
+            dive_t = _keeper_reads(pitch, x, y, z, vx, vy, vz, t, g, radius, target, info, boxes)
+            if dive_t < math.inf:
                 keeper_box = _box(boxes, 2)
         # One step: RK4/Euler in flight; rolling, the same step on the horizontal velocity, or the exact stop.
         stop_here = False
         if rolling:
-            speed = math.sqrt(vx * vx + vy * vy)
-            if speed == 0.0:
+            if math.sqrt(vx * vx + vy * vy) == 0.0:
                 ending = STOPPED
                 break
-            ax0, ay0 = _roll_acceleration(vx, vy, law, pitch[ROLL_DECEL])
-            decel = math.sqrt(ax0 * ax0 + ay0 * ay0)
-            if speed <= decel * h:  # it stops inside this step (the deceleration is nearly constant over it)
-                h = speed / decel
-                x1, y1, z1 = x + 0.5 * vx * h, y + 0.5 * vy * h, z
-                vx1, vy1, vz1 = 0.0, 0.0, 0.0
-                stop_here = True
-            else:
-                half = 0.5 * h
-                a2x, a2y = _roll_acceleration(vx + half * ax0, vy + half * ay0, law, pitch[ROLL_DECEL])
-                a3x, a3y = _roll_acceleration(vx + half * a2x, vy + half * a2y, law, pitch[ROLL_DECEL])
-                a4x, a4y = _roll_acceleration(vx + h * a3x, vy + h * a3y, law, pitch[ROLL_DECEL])
-                x1 = x + h / 6.0 * (vx + 2.0 * (vx + half * ax0) + 2.0 * (vx + half * a2x) + vx + h * a3x)
-                y1 = y + h / 6.0 * (vy + 2.0 * (vy + half * ay0) + 2.0 * (vy + half * a2y) + vy + h * a3y)
-                z1, vz1 = z, 0.0
-                vx1 = vx + h / 6.0 * (ax0 + 2.0 * (a2x + a3x) + a4x)
-                vy1 = vy + h / 6.0 * (ay0 + 2.0 * (a2y + a3y) + a4y)
-                if vx1 * vx + vy1 * vy <= 0.0:  # reversed: stop where the speed reached zero
-                    vx1, vy1 = 0.0, 0.0
-                    stop_here = True
+            x1, y1, z1, vx1, vy1, vz1, h, stop_here = _roll_step(x, y, z, vx, vy, h, law, pitch[ROLL_DECEL])
         else:
             x1, y1, z1, vx1, vy1, vz1 = _step(x, y, z, vx, vy, vz, t, h, law, rk4)
         if vx1 * vx1 + vy1 * vy1 + vz1 * vz1 + 2.0 * g * z1 > energy_limit or not math.isfinite(
@@ -594,53 +748,32 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
             f = _capsule_fraction(x, y, z, vx, vy, vz, x1, y1, z1, vx1, vy1, vz1, h, caps[c], radius)
             if f < best:
                 best, kind, which = f, int(caps[c, 7]), c
-        depth0 = (x - gx) * gnx + (y - gy) * gny
-        depth1 = (x1 - gx) * gnx + (y1 - gy) * gny
-        rate0, rate1 = vx * gnx + vy * gny, vx1 * gnx + vy1 * gny
-        if not inside and depth0 <= 0.0 < depth1:  # from on the line too (a kick from it flew through the net unseen)
-            f = crossing_fraction(-depth0, -rate0, -depth1, -rate1, h)
-            if f <= best:
-                cx, _ = _hermite(x, vx, x1, vx1, h, f)
-                cy, _ = _hermite(y, vy, y1, vy1, h, f)
-                cz, _ = _hermite(z, vz, z1, vz1, h, f)
-                if math.isnan(info[I_GOAL]):
-                    info[I_GOAL], info[I_GOAL + 1], info[I_GOAL + 2], info[I_GOAL + 3] = t + f * h, cx, cy, cz
-                lateral = -(cx - gx) * gny + (cy - gy) * gnx
-                if abs(lateral) <= half_goal + rp and cz <= turf + pitch[GH] + rp:
-                    inside = True
-                else:
-                    best, kind = f, -3  # over the goal line outside the goal: it leaves the pitch
-        elif inside and depth0 >= 0.0 > depth1:
-            inside = False  # back out through the mouth
-        if inside:
-            # Wholly over the line (Law 10: a goal), then the net: back, sides and roof stop it.
-            line = rp + radius
-            if not scored and depth1 >= line:
-                crossed = 0.0 if depth0 >= line else crossing_fraction(line - depth0, -rate0, line - depth1, -rate1, h)
-            limit = pitch[NET_DEPTH] - radius
-            if depth1 >= limit:
-                f = crossing_fraction(limit - depth0, -rate0, limit - depth1, -rate1, h)
-                if f < best:
-                    best, kind = f, NET
-            lat0 = -(x - gx) * gny + (y - gy) * gnx
-            lat1 = -(x1 - gx) * gny + (y1 - gy) * gnx
-            side = half_goal + rp - radius
-            if depth1 > rp and abs(lat1) >= side and abs(lat0) < side:
-                sign = 1.0 if lat1 > 0.0 else -1.0
-                f = crossing_fraction(
-                    side - sign * lat0,
-                    -sign * (-vx * gny + vy * gnx),
-                    side - sign * lat1,
-                    -sign * (-vx1 * gny + vy1 * gnx),
-                    h,
-                )
-                if f < best:
-                    best, kind = f, NET
-            roof = turf + pitch[GH] + 2.0 * rp - radius
-            if depth1 > rp and z1 >= roof > z:
-                f = crossing_fraction(roof - z, -vz, roof - z1, -vz1, h)
-                if f < best:
-                    best, kind = f, NET
+        depth0, depth1 = (x - gx) * gnx + (y - gy) * gny, (x1 - gx) * gnx + (y1 - gy) * gny
+        if inside or depth0 <= 0.0 < depth1:  # the goal only where the ball is in it or crosses its line
+            best, kind, inside, crossed = _goal_mouth(
+                pitch,
+                x,
+                y,
+                z,
+                vx,
+                vy,
+                vz,
+                x1,
+                y1,
+                z1,
+                vx1,
+                vy1,
+                vz1,
+                t,
+                h,
+                radius,
+                best,
+                kind,
+                inside,
+                scored,
+                crossed,
+                info,
+            )
         # The wall's plane (the keeper's first clear sight of the ball).
         if pitch[WALL_ON] != 0.0 and math.isnan(info[I_WALL]):
             d0 = (x - pitch[WX]) * pitch[WNX] + (y - pitch[WY]) * pitch[WNY]
@@ -689,54 +822,28 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
         x, y, z, vx, vy, vz = ex, ey, ez, evx, evy, evz
         done = False
         if kind == GROUND_HIT or kind == POST or kind == BAR or kind == WALL:
-            if kind == GROUND_HIT:
-                z = ground
-                normal[0], normal[1], normal[2] = 0.0, 0.0, 1.0
-                surface = turf_surface
-            else:
-                _, nx, ny, nz = _to_axis(x, y, z, caps[which])
-                if rolling:
-                    nz = 0.0
-                    length = math.sqrt(nx * nx + ny * ny)
-                    if length > 0.0:
-                        nx, ny = nx / length, ny / length
-                    else:
-                        speed = max(math.sqrt(vx * vx + vy * vy), 1e-300)
-                        nx, ny = -vx / speed, -vy / speed
-                normal[0], normal[1], normal[2] = nx, ny, nz
-                surface = frame_surface if kind != WALL else body_surface
-            v_in[0], v_in[1], v_in[2] = vx, vy, vz
-            w_in[0], w_in[1], w_in[2] = wx, wy, wz
-            impact(v_in, w_in, normal, surface, v_new, w_new)
-            vx, vy, vz = v_new[0], v_new[1], v_new[2]
-            wx, wy, wz = w_new[0], w_new[1], w_new[2]
-            if kind == GROUND_HIT and vz < pitch[ROLL_SPEED]:
-                rolling = True
-            if rolling:
-                # Onto the turf, rolling without slipping: a gripping tangential impulse that stops the contact
-                # point (Cross's grip with e_t = 0; it conserves the angular momentum about the contact point and
-                # never adds energy), then ω = (ẑ × v)/R; spin about the vertical is lost to the turf.
-                vz = 0.0
-                alpha = turf_surface[4]
-                share = alpha / (1.0 + alpha)
-                ux, uy = vx - radius * wy, vy + radius * wx
-                vx, vy = vx - share * ux, vy - share * uy
-                into = vx * normal[0] + vy * normal[1]
-                if kind != GROUND_HIT and into < 0.0:
-                    # The turf's grip can leave a ball that rolled into a post or a player still rolling into it
-                    # (its spin outweighs the rebound); the body stops that part and the ball rolls on along it,
-                    # or rests against it. Without this it struck the body again at once, contact after contact.
-                    vx, vy = vx - into * normal[0], vy - into * normal[1]
-            elif kind != GROUND_HIT and normal[2] >= 0.5:  # on a body below it: a head, the bar, a post's top
-                chatter = chatter + 1 if t - supported_t < 0.01 else 0
-                supported_t = t
-                if vx * vx + vy * vy + vz * vz < pitch[ROLL_SPEED] ** 2 or chatter >= 2:
-                    # Settled there: it leaves slower than a ground bounce that starts the roll (slow overall: a
-                    # fast ball grazing the bar leaves with a weak rebound too), or it is caught between two heads,
-                    # struck three times inside 10 ms. Each bounce would come sooner than the last, without end.
-                    # The ball rests there.
-                    vx, vy, vz, wx, wy, wz = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
-                    ending, done = STOPPED, True
+            z, vx, vy, vz, wx, wy, wz, rolling, chatter, supported_t, settled = _bounce(
+                pitch,
+                kind,
+                caps[which],
+                x,
+                y,
+                z,
+                vx,
+                vy,
+                vz,
+                wx,
+                wy,
+                wz,
+                t,
+                rolling,
+                chatter,
+                supported_t,
+                ground,
+                radius,
+            )
+            if settled:
+                ending, done = STOPPED, True
             if kind != GROUND_HIT and first_body < 0:
                 first_body = kind  # the wall's players, a post or the bar: the first of them decides the verdict
         elif kind == KEEPER:
@@ -780,26 +887,7 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
     # or the keeper too), is a goal; then the keeper; then the first of the wall and the frame it struck (a ball off
     # the bar that bounces back into the wall's backs hit the bar: the wall did not block it); then where it crossed
     # the line.
-    if scored:
-        result = GOAL
-    elif touched_keeper:
-        result = SAVED_RESULT
-    elif first_body == WALL:
-        result = WALL_RESULT
-    elif first_body == POST:
-        result = POST_RESULT
-    elif first_body == BAR:
-        result = BAR_RESULT
-    elif not math.isnan(info[I_GOAL]):
-        lateral = -(info[I_GOAL + 1] - gx) * gny + (info[I_GOAL + 2] - gy) * gnx
-        if abs(lateral) > half_goal - radius:
-            result = WIDE
-        elif info[I_GOAL + 3] > turf + pitch[GH] - radius:
-            result = OVER
-        else:
-            result = SHORT
-    else:
-        result = SHORT
+    result = _verdict(pitch, info, radius, scored, touched_keeper, first_body)
     info[I_RESULT] = result
     info[I_EVENTS] = min(n_events, MAX_EVENTS)
     return min(n, max_rows) if store else n, ending
