@@ -1,19 +1,19 @@
-"""How every kernel is compiled: ``numba.njit(cache=True, no_cfunc_wrapper=True)``, and, for a function that only
-compiled code calls, without numba's CPython wrapper; falling back to no disk cache where numba finds no writable
-cache directory.
+"""How every kernel is compiled: ``numba.njit(no_cfunc_wrapper=True)``; an entry point (a function Python calls)
+with numba's disk cache, a helper (a function only compiled code calls) without the cache or the CPython wrapper.
 
-Compiled code is cached in ``__pycache__`` beside each kernel module, or, where that is read-only (an installed
-package), in numba's user-wide cache (``~/.cache/numba``; ``NUMBA_CACHE_DIR`` overrides both; with neither writable,
-no disk cache). :mod:`kernels._jit_cache` keeps the cache in step with the sources.
+An entry point's compiled code is cached in ``__pycache__`` beside its module, or, where that is read-only (an
+installed package), in numba's user-wide cache (``~/.cache/numba``; ``NUMBA_CACHE_DIR`` overrides both; with neither
+writable, no disk cache). :mod:`kernels._jit_cache` keeps the cache in step with the sources.
 
-Two wrappers numba builds around every compiled function by default are left out where nothing uses them:
+What numba builds by default and nothing here uses is left out (each measured on a cold compile):
 
 - the C wrapper, for calls through a C function pointer (numba's first-class functions, ``cfunc``): no kernel is
   called that way. About a twentieth of a cold compile.
-- the CPython wrapper, which unboxes Python arguments and boxes the result: only functions that Python calls need it
-  (``compiled(from_python=True)``: the entry points, and a few helpers the tests call on their own). The others,
-  called only from compiled code, are built without it, about a fifteenth of a cold compile. Calling one of those
-  from Python would jump to a wrapper that does not exist; :class:`CompiledOnly` refuses the call instead.
+- a helper's CPython wrapper, which unboxes Python arguments and boxes the result: only entry points
+  (``compiled(from_python=True)``) need one; about a fifteenth of a cold compile. Calling a helper from Python
+  would jump to a wrapper that does not exist; :class:`CompiledOnly` refuses the call instead.
+- a helper's disk cache: an entry point's cached code holds every helper it calls (numba links them in), and a
+  process that loads entry points from the cache never compiles a helper. About 2 % of a cold compile.
 
 numba internals used here, read from numba 0.68: the dispatcher class of the CPU target
 (``numba.core.registry.CPUDispatcher``), which ``njit`` itself builds, and the target flag ``no_cpython_wrapper``,
@@ -44,8 +44,8 @@ class CompiledOnly(CPUDispatcher):
 
 
 def compiled(*, from_python: bool = False, **options: Any) -> Callable[[Callable[..., Any]], Any]:
-    """``numba.njit(cache=True, no_cfunc_wrapper=True, **options)``; without the CPython wrapper unless
-    ``from_python``; without the disk cache where numba finds no writable directory.
+    """``numba.njit(no_cfunc_wrapper=True, **options)``: with ``from_python``, an entry point with numba's disk cache
+    (without it where numba finds no writable directory); otherwise a :class:`CompiledOnly` helper.
 
     numba caches beside the module, else in ``~/.cache/numba`` (or ``NUMBA_CACHE_DIR``); where none of those is
     writable it refuses ``cache=True`` outright, which would make the kernel's module fail to import.
@@ -55,8 +55,8 @@ def compiled(*, from_python: bool = False, **options: Any) -> Callable[[Callable
 
     def decorate(function: Callable[..., Any]) -> Any:
         dispatcher = njit(**options)(function)
-        if not from_python:  # the same dispatcher, but for the wrapper and Python's call
-            dispatcher = CompiledOnly(
+        if not from_python:  # the same dispatcher, but for the wrapper, Python's call and the disk cache
+            return CompiledOnly(
                 py_func=function,
                 locals=dispatcher.locals,
                 targetoptions={**dispatcher.targetoptions, "no_cpython_wrapper": True},
