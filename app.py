@@ -21,10 +21,16 @@ import socket
 import sys
 from typing import Annotated
 
+from kernels import warming
+
+if __name__ == "__main__" and not {"-h", "--help"} & set(sys.argv[1:]):
+    # A first start's compile processes begin before the imports below: about a second in which one of two cores
+    # would idle. main() starts them where this did not (the installed command; start() runs once).
+    warming.start()
+
 import tyro
 import viser
 
-from kernels import warming
 from scenes import SceneName
 from scenes._look import configure_lighting
 from scenes.sdf_gallery import COMPILE_LIMIT_S, FRAME_LIMIT_S, MAX_SOURCE_CHARS, set_editing_allowed

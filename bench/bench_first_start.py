@@ -32,14 +32,10 @@ SCENE_KEYS = ("peloton", "arm", "freekick", "sdf")
 def run_child(warming_on: bool) -> None:
     """In a fresh process: build each scene and time it (the parent set an empty ``NUMBA_CACHE_DIR``)."""
     started = time.perf_counter()
-    import viser
-
     from kernels import warming
-    from scenes import SCENES
-    from server.switcher import SceneSwitcher
 
     ready: list[float] = []  # when the last package was loaded (the thread ends later: it waits for its children)
-    if warming_on:
+    if warming_on:  # as app.py does: the compile processes start before the app's other imports
 
         def report(progress: warming.Progress) -> None:
             ready.append(time.perf_counter() - started)
@@ -47,7 +43,12 @@ def run_child(warming_on: bool) -> None:
 
         warming.on_progress(report)
     thread = warming.start() if warming_on else None
-    print(f"| imports{' + start' if warming_on else ''} | {time.perf_counter() - started:.2f} |", flush=True)
+    import viser
+
+    from scenes import SCENES
+    from server.switcher import SceneSwitcher
+
+    print(f"| {'start + ' if warming_on else ''}imports | {time.perf_counter() - started:.2f} |", flush=True)
     server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
     try:
         for key in SCENE_KEYS:
