@@ -23,9 +23,17 @@ from typing import Annotated
 
 from kernels import warming
 
+
+def configure_logging() -> None:
+    """The app's log lines on stderr, with time and source; websockets' line per connection left out."""
+    logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s %(levelname)s %(message)s")
+    logging.getLogger("websockets").setLevel(logging.WARNING)
+
+
 if __name__ == "__main__" and not {"-h", "--help"} & set(sys.argv[1:]):
     # A first start's compile processes begin before the imports below: about a second in which one of two cores
     # would idle. main() starts them where this did not (the installed command; start() runs once).
+    configure_logging()  # first: a warm cache's loads are logged within the second
     warming.start()
 
 import tyro
@@ -146,8 +154,7 @@ def main(
             tab has its own scene.
     """
     let_ctrl_c_stop_the_app()
-    logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s %(levelname)s %(message)s")
-    logging.getLogger("websockets").setLevel(logging.WARNING)  # not a line per start and stop
+    configure_logging()
     asked = DEFAULT_PORT if port is None else port
     set_editing_allowed(is_loopback(host) or allow_remote_glsl)
     warning = exposure_warning(host, asked, allow_remote_glsl=allow_remote_glsl)
