@@ -374,8 +374,8 @@ IoU is lowest when a box edge is on the silhouette.
         source = EXAMPLES.get(self.params.example)
         if source is None:  # OWN_CODE: nothing to put in
             return
+        self.params = dataclasses.replace(self.params, editor_text=source)  # the state first, then what it shows
         self.write_back(self.editor, source)
-        self.params = dataclasses.replace(self.params, editor_text=source)
         self._request_source(source)
 
     def _on_editor_text(self) -> None:
@@ -387,8 +387,8 @@ IoU is lowest when a box edge is on the silhouette.
         if problem is None:
             self.params = dataclasses.replace(self.params, editor_text=text)
             if text != EXAMPLES.get(self.params.example, text):  # no longer the example: the menu says so
-                self.write_back(self.example_controls["example"], OWN_CODE)
                 self.params = dataclasses.replace(self.params, example=OWN_CODE)
+                self.write_back(self.example_controls["example"], OWN_CODE)
             return
         self.write_back(self.editor, self.params.editor_text)
         if problem:
