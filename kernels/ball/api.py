@@ -9,9 +9,9 @@ in m, m/s and N), :class:`BatchTrajectory` ((K, T) and (K, T, 3)), :class:`Outco
 from __future__ import annotations
 
 import dataclasses
+import decimal
 import functools
 import math
-import sys
 from collections.abc import Sequence
 from typing import Any
 
@@ -184,10 +184,9 @@ def _round_down(value: float) -> float:
     """``value`` cut (not rounded) to three significant digits, so a printed limit is one a caller can use."""
     if not 0.0 < value < math.inf:
         return value
-    scale = 10.0 ** (math.floor(math.log10(value)) - 2)
-    if scale < sys.float_info.min:  # a subnormal scale: rounding there is coarser than three digits
-        return value
-    return math.floor(value / scale) * scale
+    exact = decimal.Decimal(value)  # the float's exact decimal expansion: no division to round up, no underflow
+    cut = exact.quantize(decimal.Decimal(1).scaleb(exact.adjusted() - 2), rounding=decimal.ROUND_DOWN)
+    return float(cut)  # the float nearest the cut, so printed with three digits it reads as the cut
 
 
 def _refuse_overflow(endings: NDArray[np.int64], config: NDArray[np.float64], launches: NDArray[np.float64]) -> None:
@@ -200,12 +199,15 @@ def _refuse_overflow(endings: NDArray[np.int64], config: NDArray[np.float64], la
         first = int(refused[0])
         limit, fastest = stable_step(launches[first], config)
         which = "" if len(endings) == 1 else f" of kicks {refused[:5].tolist()}"
+        velocity = "velocity" if len(endings) == 1 else f"velocities[{first}]"
         method = "rk4" if config[RK4] else "euler"
+        launched = math.hypot(*launches[first, 3:6].tolist())
         raise ValueError(
             f"dt = {config[DT]:g} s is too long for this drag{which}: at most {_round_down(limit):.3g} s for "
             f"{method}, the method's stability limit with the drag at {fastest:.3g} m/s (the fastest this ball "
-            "can fly; see kernels.ball): a longer step overshoots the drag, reversing or amplifying the velocity; "
-            "use a smaller dt, or a smaller air_density or a larger mass_kg"
+            f"can fly, launched at |{velocity}| = {launched:.3g} m/s; see kernels.ball): a longer step overshoots "
+            f"the drag, reversing or amplifying the velocity; use a smaller dt or {velocity}, or a smaller "
+            "air_density or a larger mass_kg"
         )
     inside = np.flatnonzero(endings == 9)
     if inside.size:

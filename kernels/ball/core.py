@@ -248,7 +248,9 @@ def simulate_one(launch, config, t_out, state_out, forces_out):
     # Strided views ([::1] types as any layout), as fly_rows hands it a batch's columns: one compiled _fly.
     n, ending = _fly(launch, kick, config, t_out[::1], state_out[::1])
     sample_forces(t_out[:n], state_out[:n], kick, config, forces_out[:n])
-    if not np.isfinite(forces_out[:n]).all():  # a finite flight with an infinite force: a 1e-300 kg ball
+    # A finite flight with an infinite force (a 1e-300 kg ball) diverged; a kick not flown (ending 4: its one
+    # sample's drag may overflow, |v| = 1e200 m/s) keeps its ending, as in a batch.
+    if ending < 3 and not np.isfinite(forces_out[:n]).all():
         ending = 3
     return n, ending
 

@@ -952,7 +952,8 @@ def play_rows(
         n, ending = play(
             launches[k], kick, config, pitches[which[k]], t_out[k], state_out[k], spin_out[k], events[k], info[k]
         )
-        if with_forces:
+        # A kick not flown (refused, or starting inside a body) keeps its ending, whatever its one sample's drag.
+        if with_forces and ending != REFUSED and ending != INSIDE:
             first = info[k, I_FIRST] if not math.isnan(info[k, I_FIRST]) else math.inf
             if not _forces_along(t_out[k], state_out[k], spin_out[k], n, first, kick, gain, config, forces_out[k]):
                 ending = DIVERGED

@@ -142,6 +142,72 @@ def test_a_flight_is_refused_naming_dt_or_lands_ahead_as_the_reference_does(
     assert abs(x - x_ref) <= u * x_ref + dt * (speed + ball.G * t_ref) + 1e-9
 
 
+# --------------------------------------------------------------------------------------------- absurd launches
+# The fault's kind: a kick refused before it flies (its step beyond the limit) had its one sample's drag, |v|·v,
+# overflow from |v| ≈ 1.3e154 m/s, and the single and on-pitch paths then reported a diverged flight that blamed dt
+# alone, where a batch named the limit and the speed. Every path must give the one refusal, naming the velocity.
+_WALL, _GOAL = ball.free_kick_panels((0.0, 0.0), (20.0, 0.0), (1.0, 0.0))
+_PITCH = ball.Pitch(_GOAL, _WALL, ball.Keeper())
+
+
+def _refusals(velocity: np.ndarray, method: ball.Method, dt: float) -> list[str]:
+    """The message of each path's refusal of one kick from (0, 0, 1): alone, on a pitch, second of a batch, second
+    of a batch judged against a wall and goal."""
+    start, still, calm = (0.0, 0.0, 1.0), (0.0, 0.0, 0.0), (5.0, 0.0, 1.0)
+    calls = [
+        lambda: ball.simulate(start, velocity, still, method=method, dt=dt),
+        lambda: ball.simulate(start, velocity, still, method=method, dt=dt, pitch=_PITCH),
+        lambda: ball.simulate_batch([start] * 2, [calm, velocity], [still] * 2, method=method, dt=dt),
+        lambda: ball.simulate_outcomes([start] * 2, [calm, velocity], [still] * 2, _WALL, _GOAL, method=method, dt=dt),
+    ]
+    messages = []
+    for call in calls:
+        with pytest.raises(ValueError) as caught:
+            call()
+        messages.append(str(caught.value))
+    return messages
+
+
+def _check_refusals(velocity: np.ndarray, method: ball.Method, dt: float) -> None:
+    speed = math.hypot(*velocity)
+    alone, on_pitch, batch, judged = _refusals(velocity, method, dt)
+    # The limit 1/(k·|v|) for Euler (β/(2k|v|), β = 2.7853, for RK4): no spin, and the speed only falls from |v0|.
+    beta = 2.0 if method == "euler" else 2.785293563405289
+    expected = beta / (2.0 * _drag_factor(ball.AIR_DENSITY) * speed)
+    for message, name, which in (
+        (alone, "velocity", ""),
+        (on_pitch, "velocity", ""),
+        (batch, "velocities[1]", " of kicks [1]"),
+        (judged, "velocities[1]", " of kicks [1]"),
+    ):
+        assert message.startswith(f"dt = {dt:g} s is too long for this drag{which}: at most "), message
+        assert f"launched at |{name}| = {speed:.3g} m/s" in message, message
+        assert f"use a smaller dt or {name}" in message, message
+        limit = _limit_named(ValueError(message))  # cut to three digits
+        assert limit == pytest.approx(expected, rel=1e-2) and limit <= expected, message
+    assert alone == on_pitch and batch == judged
+
+
+@pytest.mark.parametrize("speed", [1e6, 1.3e154, 1.4e154, 1e200, 1.7e308])
+def test_an_absurd_launch_speed_is_refused_naming_the_velocity_on_every_path(speed: float) -> None:
+    _check_refusals(np.array([speed, 0.0, 0.0]), "euler", 1e-3)
+
+
+@given(
+    log_speed=st.floats(math.log(2e6), math.log(1.7e308)),  # each method's limit under the shortest dt, 1e-4 s
+    direction=st.tuples(*[st.floats(-1.0, 1.0)] * 3).filter(lambda d: math.hypot(*d) > 0.1),
+    method=st.sampled_from(("euler", "rk4")),
+    dt=st.floats(math.log(1e-4), math.log(0.05)).map(math.exp),  # 0.05 s: the longest step on a pitch
+)
+@settings(max_examples=examples(40), deadline=None)
+def test_every_path_refuses_a_too_fast_launch_alike(
+    log_speed: float, direction: tuple[float, float, float], method: ball.Method, dt: float
+) -> None:
+    speed = min(math.exp(log_speed), 1.7e308)
+    d = np.array(direction) / math.hypot(*direction)
+    _check_refusals(speed * d, method, dt)
+
+
 # --------------------------------------------------------------------------------------------- the scene
 @pytest.mark.parametrize("model", ["constant", "measured"])
 @pytest.mark.parametrize("knuckle", [None, 3])
@@ -179,7 +245,27 @@ def test_the_free_kick_scene_never_meets_the_limit(model: ball.Model, knuckle: i
                     )
 
 
-@pytest.mark.parametrize(("value", "cut"), [(0.0123456, 0.0123), (987.6, 987.0), (5e-324, 5e-324), (1e-320, 1e-320)])
-def test_a_printed_limit_is_cut_to_three_digits_even_when_subnormal(value: float, cut: float) -> None:
+@pytest.mark.parametrize(
+    ("value", "printed"),
+    [
+        (0.0123456, "0.0123"),
+        (987.6, "987"),
+        (1.4399999999999998e-09, "1.43e-09"),  # just under 1.44e-9: its quotient by 1e-11 once rounded up to 144
+        (4.345484343042e-307, "4.34e-307"),  # the limit at 1.7e308 m/s; printed as 4.35e-307 once
+        (1e-320, "9.99e-321"),  # subnormal: the float is 9.99988…e-321
+        (5e-324, "4.94e-324"),  # the smallest float
+    ],
+)
+def test_a_printed_limit_is_cut_to_three_digits_even_when_subnormal(value: float, printed: str) -> None:
     # The family of the chart axis's fault: a power of ten under a subnormal value underflows to zero.
-    assert _round_down(value) == pytest.approx(cut, rel=1e-12, abs=0.0)
+    assert f"{_round_down(value):.3g}" == printed
+
+
+@given(st.floats(min_value=5e-324, max_value=1.7e308))
+@settings(max_examples=examples(500), deadline=None)
+def test_a_printed_limit_never_exceeds_the_limit(value: float) -> None:
+    """ "At most X s" must be a step the kernel accepts: X, as printed, is never above the limit, and within the
+    three digits' resolution of it (coarser among the subnormals, where a float has fewer digits)."""
+    printed = float(f"{_round_down(value):.3g}")
+    assert printed <= value
+    assert printed >= value * (1.0 - 1e-2) or value < 1e-305
