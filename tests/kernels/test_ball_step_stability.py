@@ -153,12 +153,13 @@ _PITCH = ball.Pitch(_GOAL, _WALL, ball.Keeper())
 def _refusals(velocity: np.ndarray, method: ball.Method, dt: float) -> list[str]:
     """The message of each path's refusal of one kick from (0, 0, 1): alone, on a pitch, second of a batch, second
     of a batch judged against a wall and goal."""
-    start, still, calm = (0.0, 0.0, 1.0), (0.0, 0.0, 0.0), (5.0, 0.0, 1.0)
+    start, still = (0.0, 0.0, 1.0), (0.0, 0.0, 0.0)
+    pair = np.array([(5.0, 0.0, 1.0), velocity])  # a calm kick, then this one
     calls = [
         lambda: ball.simulate(start, velocity, still, method=method, dt=dt),
         lambda: ball.simulate(start, velocity, still, method=method, dt=dt, pitch=_PITCH),
-        lambda: ball.simulate_batch([start] * 2, [calm, velocity], [still] * 2, method=method, dt=dt),
-        lambda: ball.simulate_outcomes([start] * 2, [calm, velocity], [still] * 2, _WALL, _GOAL, method=method, dt=dt),
+        lambda: ball.simulate_batch([start] * 2, pair, [still] * 2, method=method, dt=dt),
+        lambda: ball.simulate_outcomes([start] * 2, pair, [still] * 2, _WALL, _GOAL, method=method, dt=dt),
     ]
     messages = []
     for call in calls:
