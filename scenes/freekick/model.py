@@ -952,8 +952,31 @@ def outcome_map(p: FreeKickParams) -> NDArray[np.str_]:
     return judged.result.reshape(spins.shape)
 
 
+def _off_map(value: float, axis: NDArray[np.float64]) -> int:
+    """−1 or +1 where ``value`` lies more than half a cell below or above the map's ``axis`` (evenly spaced), else 0."""
+    half = 0.5 * (axis[1] - axis[0])
+    return -1 if value < axis[0] - half else 1 if value > axis[-1] + half else 0
+
+
+def map_marker_words(p: FreeKickParams) -> str:
+    """Where the current kick lies when the outcome map cannot show it ("" when it can): its speed (or spin) beyond
+    the map's range, marked by an arrow on the map's edge (:func:`outcome_map_image`)."""
+    for value, axis, unit, sides in (
+        (p.speed_ms, MAP_SPEEDS_MS, "m/s", ("left of", "right of")),
+        (p.spin_rev_s, MAP_SPINS_REV_S, "rev/s", ("below", "above")),
+    ):
+        side = _off_map(value, axis)
+        if side:
+            return (
+                f"This kick's {value:g} {unit} lies {sides[side > 0]} the map ({axis[0]:g}–{axis[-1]:g} {unit}): the "
+                "white arrow on its edge points toward it."
+            )
+    return ""
+
+
 def outcome_map_image(results: NDArray[np.str_], p: FreeKickParams) -> NDArray[np.uint8]:
-    """RGB image of an outcome map, speed left to right, spin bottom to top, the current kick marked in white."""
+    """RGB image of an outcome map, speed left to right, spin bottom to top, the current kick marked in white: a cross
+    on its cell, or, where its speed or spin lies off the map, an arrowhead on that edge pointing out toward it."""
     rows, cols = results.shape
     image = np.zeros((rows, cols, 3), np.uint8)
     for name, colour in RESULT_COLOURS.items():
@@ -963,8 +986,19 @@ def outcome_map_image(results: NDArray[np.str_], p: FreeKickParams) -> NDArray[n
     col = int(np.argmin(np.abs(MAP_SPEEDS_MS - p.speed_ms)))
     row = rows - 1 - int(np.argmin(np.abs(MAP_SPINS_REV_S - p.spin_rev_s)))
     cy, cx = row * MAP_CELL_PX + MAP_CELL_PX // 2, col * MAP_CELL_PX + MAP_CELL_PX // 2
-    image[cy, max(cx - 6, 0) : cx + 7] = 255
-    image[max(cy - 6, 0) : cy + 7, cx] = 255
+    across, up = _off_map(p.speed_ms, MAP_SPEEDS_MS), _off_map(p.spin_rev_s, MAP_SPINS_REV_S)
+    height, width = image.shape[:2]
+    if across:  # tip on the left or right edge, 7 px deep and 13 px tall at its base
+        for depth in range(7):
+            x = depth if across < 0 else width - 1 - depth
+            image[max(cy - depth, 0) : cy + depth + 1, x] = 255
+    elif up:  # tip on the top or bottom edge (spin grows upward)
+        for depth in range(7):
+            y = depth if up > 0 else height - 1 - depth
+            image[y, max(cx - depth, 0) : cx + depth + 1] = 255
+    else:
+        image[cy, max(cx - 6, 0) : cx + 7] = 255
+        image[max(cy - 6, 0) : cy + 7, cx] = 255
     return image
 
 

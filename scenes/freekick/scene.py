@@ -59,6 +59,7 @@ from scenes.freekick.model import (
     keeper_words,
     knuckle_ticked,
     knuckle_wobble_m,
+    map_marker_words,
     odds_map_settings,
     odds_map_words,
     outcome_map,
@@ -270,7 +271,8 @@ reads it again, so a ball that bounces in front of him beats him more often than
             with gui.add_folder("Outcome map"):
                 self.map_legend = gui.add_markdown(
                     "Launch speed 15–35 m/s left to right, spin 0–15 rev/s bottom to top, other settings as set. "
-                    "Green goal, red wall, orange over, yellow wide, grey short; white cross: this kick."
+                    "Green goal, red wall, orange over, yellow wide, grey short; white cross: this kick (an arrow "
+                    "on the edge when it lies off the map)."
                 )
                 self.map_image = gui.add_image(
                     np.full(
@@ -560,6 +562,8 @@ reads it again, so a ball that bounces in front of him beats him more often than
                 summary = f"Of {results.size} kicks: " + ", ".join(
                     f"{n} {words[name]}" for name, n in counts.items() if n
                 )
+                if where := map_marker_words(params):
+                    summary += f"  \n{where}"
                 if params.model == "constant":
                     summary += (
                         "  \nConstant C_L: any spin above zero curls the same, so the rows repeat. Pick the "

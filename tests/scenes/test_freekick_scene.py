@@ -46,7 +46,7 @@ from scenes.freekick import (
     view_points,
     wall_hides,
 )
-from scenes.freekick.model import keeper_words, knuckle_wobble_m, spot_odds_map, strike_chances
+from scenes.freekick.model import MAP_CELL_PX, keeper_words, knuckle_wobble_m, spot_odds_map, strike_chances
 from scenes.freekick.scene import GRASS_HALF_M
 
 
@@ -304,6 +304,49 @@ def test_outcome_map_matches_single_runs(freekick: FreeKickScene) -> None:
     freekick.controls["wall_jumps"].value = True  # the map follows the settings
     assert freekick.wait_idle()
     assert np.sum(freekick.map_results == "wall") > np.sum(results == "wall")  # type: ignore[operator]
+
+
+def _white(image: NDArray[np.uint8]) -> NDArray[np.bool_]:
+    return np.all(image == 255, axis=2)
+
+
+@pytest.mark.parametrize(("speed", "side"), [(5.0, "left"), (14.7, "left"), (35.3, "right"), (40.0, "right")])
+def test_a_kick_off_the_outcome_map_is_an_arrow_on_its_edge_not_a_cross_in_the_wrong_cell(
+    freekick: FreeKickScene, speed: float, side: str
+) -> None:
+    # The fault: the cross went to the nearest column, so a 5 m/s kick was marked as the 15 m/s one.
+    freekick.controls["speed_ms"].value = speed
+    assert freekick.wait_idle()
+    image = np.asarray(freekick.map_image.image)
+    white = _white(image)
+    cell = MAP_CELL_PX
+    row = len(MAP_SPINS_REV_S) - 1 - int(np.argmin(np.abs(MAP_SPINS_REV_S - freekick.params.spin_rev_s)))
+    cy = row * cell + cell // 2
+    edge = 0 if side == "left" else image.shape[1] - 1
+    inward = 1 if side == "left" else -1
+    # An arrowhead: its tip on the edge at the kick's spin row, one pixel wider each step inward, 7 px deep.
+    for depth in range(7):
+        column = white[:, edge + inward * depth]
+        assert np.flatnonzero(column).tolist() == list(range(cy - depth, cy + depth + 1)), depth
+    assert white.sum() == sum(2 * depth + 1 for depth in range(7))  # nothing else is white: no cross
+    assert f"This kick's {speed:g} m/s lies {side} of the map (15–35 m/s)" in freekick.map_status.content
+
+
+@pytest.mark.parametrize("speed", [15.0, 14.8, 25.0, 35.2])
+def test_a_kick_on_the_outcome_map_is_a_cross_on_its_cell(freekick: FreeKickScene, speed: float) -> None:
+    freekick.controls["speed_ms"].value = speed
+    assert freekick.wait_idle()
+    white = _white(np.asarray(freekick.map_image.image))
+    col = int(np.argmin(np.abs(MAP_SPEEDS_MS - speed)))
+    row = len(MAP_SPINS_REV_S) - 1 - int(np.argmin(np.abs(MAP_SPINS_REV_S - freekick.params.spin_rev_s)))
+    cy, cx = row * MAP_CELL_PX + MAP_CELL_PX // 2, col * MAP_CELL_PX + MAP_CELL_PX // 2
+    ys, xs = np.nonzero(white)
+    assert set(zip(ys.tolist(), xs.tolist(), strict=True)) == {
+        (y, x)
+        for y, x in [(cy, cx + d) for d in range(-6, 7)] + [(cy + d, cx) for d in range(-6, 7)]
+        if 0 <= y < white.shape[0] and 0 <= x < white.shape[1]
+    }
+    assert "lies" not in freekick.map_status.content
 
 
 def test_a_burst_of_slider_changes_computes_one_outcome_map_for_the_last(
