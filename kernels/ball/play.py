@@ -219,7 +219,14 @@ def _keeper_capsule(pitch, dive_t, target, t, cap):
 @compiled(from_python=True)
 def keeper_path(pitch, dive_t, target, times, out):
     """The keeper at each of ``times`` (T,) into ``out`` (T, 12): centre of mass (3), the unit vector toward the
-    fingertips (3), and the ends of the capsule the ball is tested against (feet end 3, fingertip end 3)."""
+    fingertips (3), and the ends of the capsule the ball is tested against (feet end 3, fingertip end 3).
+
+    Raises:
+        ValueError: ``pitch`` shorter than N_PITCH, ``target`` than 3, or ``out`` smaller than (T, 12). Of the
+        compiled cores only this one shares a public function's name, so it checks the sizes it writes by.
+    """
+    if pitch.shape[0] < N_PITCH or target.shape[0] < 3 or out.shape[0] < times.shape[0] or out.shape[1] < 12:
+        raise ValueError("keeper_path core: pitch needs N_PITCH values, target 3 and out (T, 12) for T times")
     cap = np.empty(8)
     for i in range(times.shape[0]):
         out[i, 0], out[i, 1], out[i, 2], out[i, 3], out[i, 4], out[i, 5] = _keeper_pose(pitch, dive_t, target, times[i])

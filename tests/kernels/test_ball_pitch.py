@@ -321,6 +321,25 @@ def test_the_keeper_path_refuses_bad_input_naming_it(argument: str, call: Callab
         call()
 
 
+@pytest.mark.parametrize(
+    ("pitch_size", "target_size", "out_shape"),
+    [
+        (play.N_PITCH, 3, (1, 12)),
+        (play.N_PITCH, 3, (2, 11)),
+        (play.N_PITCH, 2, (2, 12)),
+        (play.N_PITCH - 1, 3, (2, 12)),
+    ],
+)
+def test_the_compiled_keeper_path_refuses_arrays_too_small_for_what_it_writes(
+    pitch_size: int, target_size: int, out_shape: tuple[int, int]
+) -> None:
+    # The compiled core behind ball.keeper_path shares its name, so a caller may reach it; it wrote past a short
+    # output (heap corruption) before it checked.
+    pitch = np.zeros(pitch_size)
+    with pytest.raises(ValueError, match="keeper_path core: pitch needs N_PITCH values, target 3 and out"):
+        play.keeper_path(pitch, 0.1, np.zeros(target_size), np.array([0.0, 0.1]), np.zeros(out_shape))
+
+
 def test_outcomes_on_a_pitch_count_post_bar_and_saved_and_match_single_flights() -> None:
     pitch = ball.Pitch(GOAL, WALL, ball.Keeper())
     speeds = np.linspace(18.0, 32.0, 60)
