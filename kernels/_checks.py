@@ -19,8 +19,10 @@ from numpy.typing import ArrayLike, NDArray
 
 __all__ = [
     "bounded_array",
+    "choice",
     "finite_array",
     "finite_number",
+    "flag",
     "instance",
     "integer",
     "non_negative",
@@ -48,6 +50,22 @@ def finite_number(name: str, value: object) -> float:
         if math.isfinite(number):
             return number
     raise ValueError(f"{name} must be a finite number, got {value!r}")
+
+
+def choice(name: str, value: object, options: tuple[str, ...]) -> str:
+    """``value`` when it is one of the strings ``options``, else ``ValueError`` naming it and the options (an array,
+    a number or ``None`` included: compared with ``in``, an array would raise numpy's "truth value is ambiguous")."""
+    if isinstance(value, str) and value in options:
+        return value
+    listed = ", ".join(repr(option) for option in options)
+    raise ValueError(f"{name} must be one of {listed}, got {value!r}")
+
+
+def flag(name: str, value: object) -> bool:
+    """``value`` when it is a Python or numpy bool, else ``ValueError`` naming it (``"no"`` or NaN is not a flag)."""
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    raise ValueError(f"{name} must be True or False, got {value!r}")
 
 
 def integer(name: str, value: object, minimum: int | None = None) -> int:

@@ -163,10 +163,8 @@ class FlightConfig:
         duration = _checks.positive("t_max", self.t_max)
         if duration / step > _MAX_STEPS:
             raise ValueError(f"dt must be at least t_max/{_MAX_STEPS} = {duration / _MAX_STEPS:g} s, got {step!r}")
-        if self.method not in ("euler", "rk4"):
-            raise ValueError(f"method must be 'euler' or 'rk4', got {self.method!r}")
-        if self.model not in ("constant", "measured"):
-            raise ValueError(f"model must be 'constant' or 'measured', got {self.model!r}")
+        _checks.choice("method", self.method, ("euler", "rk4"))
+        _checks.choice("model", self.model, ("constant", "measured"))
         c_d = _checks.non_negative("drag_coefficient", self.drag_coefficient)
         c_l = _checks.non_negative("lift_coefficient", self.lift_coefficient)
         mass = _checks.positive("mass_kg", self.mass_kg)
