@@ -50,6 +50,7 @@ from kernels.sdf.meshing import (
     sample_near_surface,
 )
 from kernels.sdf.operators import (
+    MAX_RATE,
     op_bend,
     op_elongate,
     op_onion,
@@ -60,6 +61,7 @@ from kernels.sdf.operators import (
 )
 from kernels.sdf.primitives import (
     BUILT_IN_KINDS,
+    MAX_COORDINATE,
     PRIMITIVES,
     ROUND_BOX_ROUNDING,
     AnyFloatArray,
@@ -112,8 +114,10 @@ __all__ = [
     "EXP_SHARPNESS_PER_WIDTH",
     "ISO_NUDGE_VOXELS",
     "MAX_BLEND_WIDTH",
+    "MAX_COORDINATE",
     "MAX_FIELD_COORDINATE",
     "MAX_PRIMITIVES",
+    "MAX_RATE",
     "MAX_RESOLUTION",
     "MIN_BLEND_WIDTH",
     "MIN_RESOLUTION",

@@ -13,6 +13,10 @@ weights (``h`` and ``1 − h`` for poly, a logistic for exp), so a blend of 1-Li
 exact distance, but a distance bound, which is what sphere tracing (Hart 1996) and the coarse-to-fine mesher rely
 on. The same weights blend a scene's colours (:func:`combine_weighted` returns them).
 
+Distances may be ±inf (a point too far for float64 has an infinite distance) but not NaN, nor anything that is not
+a real number (:func:`distance_array`): every function here then gives the hard boolean's answer wherever it is
+infinite (a union with −inf is −inf, an intersection with +inf is +inf), never NaN.
+
 Booleans: union ``min(a, b)``, subtraction ``max(a, −b)`` (a minus b), intersection ``max(a, b)``; the smooth forms
 are ``smin(a, b)``, ``−smin(−a, b)`` and ``−smin(−a, −b)``. One blend width ``k`` (m) serves both forms; the
 exponential form uses the sharpness ``4·ln 2 / k``, which makes both forms dip by the same ``k/4`` where two surfaces
@@ -46,12 +50,18 @@ above it 0.5/k and the exp sharpness 4·ln 2/k stay finite in float32."""
 
 
 def _distances(a: ArrayLike, b: ArrayLike) -> tuple[FloatArray, FloatArray]:
-    return _distance_array("a", a), _distance_array("b", b)
+    return distance_array("a", a), distance_array("b", b)
 
 
-def _distance_array(name: str, value: ArrayLike) -> FloatArray:
-    """Distances (m) as float64, ±inf allowed; NaN, bool, complex and text refused with ``ValueError`` naming
-    ``name`` (numpy turned True into 1 m, dropped an imaginary part, or raised its own TypeError)."""
+def distance_array(name: str, value: ArrayLike) -> FloatArray:
+    """Distances (m) as float64, ±inf allowed; NaN, bool, complex, text, None and objects refused with
+    ``ValueError`` naming ``name`` (numpy turned True into 1 m and None into NaN, dropped an imaginary part, or
+    raised its own TypeError).
+
+    Every function that takes distances here and in :mod:`kernels.sdf.operators` takes them through this, so an
+    infinite distance (a point too far away for float64) is an answer they define, never NaN: the hard and smooth
+    booleans give what ``min``/``max`` give (a union with −inf is −inf, an intersection with +inf is +inf, a
+    subtraction of −inf leaves +inf), and rounding or an onion of ±inf is ±inf or +inf."""
     try:
         array = np.asarray(value)
         if array.dtype.kind not in "fiu":
@@ -182,9 +192,10 @@ def combine_weighted(
             case _:
                 raise ValueError(f"blend must be one of {BLEND_FORMS}, got {blend!r}")
 
-    if blend not in BLEND_FORMS:  # also for k = 0, which never reaches the match above
-        raise ValueError(f"blend must be one of {BLEND_FORMS}, got {blend!r}")
-    match op:
+    # Checked here for k = 0 too, which never reaches the match above; choice() also names an array, which `in`
+    # and `match` would meet with numpy's "truth value is ambiguous".
+    _checks.choice("blend", blend, BLEND_FORMS)
+    match _checks.choice("op", op, BOOLEAN_OPS):
         case "union":
             return smin(a, b)
         case "subtract":

@@ -56,15 +56,16 @@ def make_grid(scene: Scene, resolution: int, bounds: ArrayLike | None = None) ->
         resolution: samples along the longest side, 16..512.
         bounds: optional (2, 3) min and max corners (m).
     """
+    _checks.instance("scene", scene, Scene)
     _checks.integer("resolution", resolution)
     if not MIN_RESOLUTION <= int(resolution) <= MAX_RESOLUTION:
         raise ValueError(f"resolution must be in {MIN_RESOLUTION}..{MAX_RESOLUTION}, got {resolution}")
     if bounds is None:
         box = scene_bounds(scene)
     else:
-        box = np.asarray(bounds, dtype=np.float64)
-        if box.shape != (2, 3) or not np.all(np.isfinite(box)) or np.any(box[1] <= box[0]):
-            raise ValueError("bounds must be finite (2, 3) min and max corners with max > min")
+        box = _checks.finite_array("bounds", bounds)
+        if box.shape != (2, 3) or np.any(box[1] <= box[0]):
+            raise ValueError(f"bounds must be finite (2, 3) min and max corners with max > min, got {bounds!r}")
     if not np.all(np.abs(box) <= MAX_FIELD_COORDINATE):
         raise ValueError(
             f"bounds (given or the scene's) must lie within ±{MAX_FIELD_COORDINATE:g} m for the float32 field, "
@@ -82,8 +83,29 @@ def make_grid(scene: Scene, resolution: int, bounds: ArrayLike | None = None) ->
     )
 
 
+def _grid(value: object) -> Grid:
+    """A :class:`Grid` whose fields are what :func:`make_grid` makes (a frozen dataclass takes anything), else
+    ``ValueError`` naming ``grid``."""
+    grid = _checks.instance("grid", value, Grid)
+    origin = _checks.finite_array("grid", grid.origin)
+    spacing = _checks.finite_number("grid", grid.spacing)
+    shape = np.asarray(grid.shape)
+    if (
+        origin.shape != (3,)
+        or not (np.abs(origin) <= MAX_FIELD_COORDINATE).all()
+        or not 0.0 < spacing <= MAX_FIELD_COORDINATE
+        or shape.shape != (3,)
+        or shape.dtype.kind not in "iu"
+        or not ((shape >= 2) & (shape <= MAX_RESOLUTION)).all()
+    ):
+        raise ValueError(f"grid must be a Grid from make_grid, got {grid!r}")
+    return grid
+
+
 def sample_full(scene: Scene, grid: Grid) -> NDArray[np.float32]:
     """The field at every grid sample, (nx, ny, nz) float32: the plain baseline the coarse-to-fine pass matches."""
+    _checks.instance("scene", scene, Scene)
+    _grid(grid)
     axes = [grid.origin[i] + grid.spacing * np.arange(grid.shape[i]) for i in range(3)]
     xs, ys, zs = np.meshgrid(*axes, indexing="ij")
     return _field_at(scene, np.stack([xs.ravel(), ys.ravel(), zs.ravel()], axis=1)).reshape(grid.shape)
@@ -116,6 +138,11 @@ class NearSurfaceField:
     """Points evaluated, block centres included."""
 
 
+def _progress(value: object) -> None:
+    if value is not None and not callable(value):
+        raise ValueError(f"progress must be a function of the fraction done or None, got {type(value).__name__}")
+
+
 def sample_near_surface(scene: Scene, grid: Grid, progress: Callable[[float], None] | None = None) -> NearSurfaceField:
     """The field, evaluated exactly where marching cubes reads it and sign-filled elsewhere.
 
@@ -124,6 +151,9 @@ def sample_near_surface(scene: Scene, grid: Grid, progress: Callable[[float], No
         grid: the grid.
         progress: optional callback receiving the fraction done, 0..1.
     """
+    _checks.instance("scene", scene, Scene)
+    _grid(grid)
+    _progress(progress)
     h = grid.spacing
     # A corner of a crossed cell lies within one voxel diagonal of the surface.
     margin = math.sqrt(3.0) * h * (1.0 + 1e-3) + 1e-6  # slack for float32 rounding
@@ -199,12 +229,14 @@ def mesh(
         surface inside the bounds) gives empty arrays.
 
     Raises:
-        ValueError: a bad resolution, or bounds (given or the scene's) not finite or beyond
-            ±:data:`MAX_FIELD_COORDINATE`.
+        ValueError: naming the argument: a scene that is not a :class:`Scene`, a resolution that is not an integer
+            in 16..512, bounds (given or the scene's) not finite or beyond ±:data:`MAX_FIELD_COORDINATE`, a
+            ``near_surface`` that is not a bool, a ``progress`` that is not callable.
     """
     grid = make_grid(scene, resolution, bounds)
+    _progress(progress)
     mask = None
-    if near_surface:
+    if _checks.flag("near_surface", near_surface):
         sampled = sample_near_surface(scene, grid, progress)
         field, mask = sampled.field, sampled.mask
     else:
@@ -331,8 +363,29 @@ def _touches_solid(scene: Scene, grid: Grid, samples: NDArray[np.bool_]) -> NDAr
     return out
 
 
+def _faces(value: ArrayLike, vertex_count: int) -> NDArray[np.int64]:
+    """(F, 3) indices into ``vertex_count`` vertices, else ``ValueError`` naming ``faces``."""
+    try:
+        faces = np.asarray(value)
+        if faces.size == 0:
+            return np.zeros((0, 3), dtype=np.int64)
+        if faces.dtype.kind not in "iu":
+            raise TypeError(faces.dtype)
+        faces = faces.astype(np.int64)
+    except (TypeError, ValueError, OverflowError) as error:
+        raise ValueError(f"faces must be (F, 3) integer indices into the vertices, got {value!r}") from error
+    if faces.ndim != 2 or faces.shape[1] != 3 or faces.min() < 0 or faces.max() >= vertex_count:
+        raise ValueError(f"faces must be (F, 3) integer indices into the {vertex_count} vertices, got {value!r}")
+    return faces
+
+
 def mesh_trimesh(vertices: FloatArray, faces: NDArray[np.int64], colors: FloatArray) -> trimesh.Trimesh:
     """The output of :func:`mesh` as a ``trimesh.Trimesh`` with 8-bit vertex colours (for export)."""
+    vertices = _checks.points("vertices", vertices)
+    faces = _faces(faces, len(vertices))
+    colors = _checks.finite_array("colors", colors)
+    if colors.shape != vertices.shape:
+        raise ValueError(f"colors must have the vertices' shape {vertices.shape}, got {colors.shape}")
     rgba = np.concatenate([np.clip(colors, 0.0, 1.0), np.ones((len(colors), 1))], axis=1)
     return trimesh.Trimesh(
         vertices=vertices,
@@ -356,12 +409,21 @@ def mesh_samples(
     Returns:
         vertices (V, 3) in metres and faces (F, 3) wound outward; empty when no surface crosses the grid.
     """
-    if field.shape != grid.shape:
+    _grid(grid)
+    # Not through _checks.finite_array: a 512³ field would be copied to float64 (1 GiB).
+    if not isinstance(field, np.ndarray) or field.dtype.kind != "f":
+        raise ValueError(f"field must be a float array of distances (m), got {type(field).__name__}")
+    if field.shape != tuple(grid.shape):
         raise ValueError(f"field must have the grid's shape {grid.shape}, got {field.shape}")
-    if not np.all(np.isfinite(field)):
-        raise ValueError("field must be finite")
+    values = field.astype(np.float32, copy=False)
+    if not np.isfinite(values).all():
+        raise ValueError("field must be finite float32 distances (m)")
+    if mask is not None:
+        mask = np.asarray(mask)
+        if mask.dtype != np.bool_ or mask.shape != tuple(grid.shape):
+            raise ValueError(f"mask must be None or bools of the grid's shape {grid.shape}, got {mask!r}")
     # _polygonise colours its vertices from a scene; one small sphere keeps that cost to a few ms.
-    verts, faces, _ = _polygonise(_COLOURLESS, grid, field.astype(np.float32, copy=False), mask)
+    verts, faces, _ = _polygonise(_COLOURLESS, grid, values, mask)
     return verts, faces
 
 

@@ -13,7 +13,19 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from kernels import _checks
-from kernels.sdf.primitives import FloatArray
+from kernels.sdf.blend import distance_array
+from kernels.sdf.primitives import MAX_COORDINATE, FloatArray, coordinates, length
+
+MAX_RATE = 1e150
+"""Largest twist or bend (rad/m): times a coordinate within ±MAX_COORDINATE the angle stays finite (cos and sin
+of an infinite angle are NaN)."""
+
+
+def _rate(value: object) -> float:
+    k = _checks.finite_number("rate", value)
+    if abs(k) > MAX_RATE:
+        raise ValueError(f"rate must be of magnitude ≤ {MAX_RATE:g} rad/m, got {value!r}")
+    return k
 
 
 # Quilez, "distance functions": rounding, onion, and the point transforms (elongation, twist, bend, finite
@@ -23,20 +35,20 @@ def op_round(d: ArrayLike, radius: float) -> FloatArray:
     """d − radius: a shape grown by ``radius`` with rounded edges (Quilez, "Rounding"). Exact if d is, outside.
 
     Args:
-        d: (N,) distances (m).
-        radius: rounding radius (m), ≥ 0.
+        d: (N,) distances (m), ±inf allowed (±inf stays ±inf), never NaN.
+        radius: rounding radius (m), in [0, :data:`~kernels.sdf.primitives.MAX_COORDINATE`].
     """
-    return np.asarray(d, dtype=np.float64) - _checks.non_negative("radius", radius)
+    return distance_array("d", d) - length("radius", radius, zero_ok=True)
 
 
 def op_onion(d: ArrayLike, thickness: float) -> FloatArray:
     """|d| − thickness: a shell of the surface (Quilez, "Onion"). Exact if d is.
 
     Args:
-        d: (N,) distances (m).
-        thickness: half the shell's wall thickness (m), ≥ 0.
+        d: (N,) distances (m), ±inf allowed (giving +inf), never NaN.
+        thickness: half the shell's wall thickness (m), in [0, :data:`~kernels.sdf.primitives.MAX_COORDINATE`].
     """
-    return np.abs(np.asarray(d, dtype=np.float64)) - _checks.non_negative("thickness", thickness)
+    return np.abs(distance_array("d", d)) - length("thickness", thickness, zero_ok=True)
 
 
 def op_elongate(p: ArrayLike, half_length: ArrayLike) -> tuple[FloatArray, FloatArray]:
@@ -46,14 +58,14 @@ def op_elongate(p: ArrayLike, half_length: ArrayLike) -> tuple[FloatArray, Float
     the sign of p (Quilez writes ``max(q, 0)``, which needs a shape symmetric in every axis). Exact if sd is.
 
     Args:
-        p: (N, 3) points (m).
-        half_length: (3,) elongation along x, y, z (m), each ≥ 0.
+        p: (N, 3) points (m), within ±:data:`~kernels.sdf.primitives.MAX_COORDINATE`.
+        half_length: (3,) elongation along x, y, z (m), each in [0, :data:`~kernels.sdf.primitives.MAX_COORDINATE`].
 
     Returns:
         (N, 3) points to evaluate the shape at, and (N,) the term to add to its distance.
     """
-    pts = _checks.points("p", p)
-    h = _checks.vector("half_length", half_length, 3)
+    pts = coordinates("p", p)
+    h = _checks.vector("half_length", _checks.bounded_array("half_length", half_length, MAX_COORDINATE), 3)
     if np.any(h < 0.0):
         raise ValueError(f"half_length must be non-negative, got {h.tolist()}")
     q = np.abs(pts) - h
@@ -67,14 +79,14 @@ def op_twist(p: ArrayLike, rate: float) -> FloatArray:
     sqrt(1 + (rate·ρ)²) to stay a bound.
 
     Args:
-        p: (N, 3) points (m).
-        rate: twist (rad/m), finite.
+        p: (N, 3) points (m), within ±:data:`~kernels.sdf.primitives.MAX_COORDINATE`.
+        rate: twist (rad/m), of magnitude ≤ :data:`MAX_RATE`.
 
     Returns:
         (N, 3) points: (c·x − s·z, y, s·x + c·z) with c, s = cos, sin(rate·y).
     """
-    pts = _checks.points("p", p)
-    k = _checks.finite_number("rate", rate)
+    pts = coordinates("p", p)
+    k = _rate(rate)
     c, s = np.cos(k * pts[:, 1]), np.sin(k * pts[:, 1])
     return np.stack([c * pts[:, 0] - s * pts[:, 2], pts[:, 1], s * pts[:, 0] + c * pts[:, 2]], axis=1)
 
@@ -85,14 +97,14 @@ def op_bend(p: ArrayLike, rate: float) -> FloatArray:
     Not distance-preserving either (the same bound correction as :func:`op_twist`).
 
     Args:
-        p: (N, 3) points (m).
-        rate: bend (rad/m), finite.
+        p: (N, 3) points (m), within ±:data:`~kernels.sdf.primitives.MAX_COORDINATE`.
+        rate: bend (rad/m), of magnitude ≤ :data:`MAX_RATE`.
 
     Returns:
         (N, 3) points: (c·x − s·y, s·x + c·y, z) with c, s = cos, sin(rate·x).
     """
-    pts = _checks.points("p", p)
-    k = _checks.finite_number("rate", rate)
+    pts = coordinates("p", p)
+    k = _rate(rate)
     c, s = np.cos(k * pts[:, 0]), np.sin(k * pts[:, 0])
     return np.stack([c * pts[:, 0] - s * pts[:, 1], s * pts[:, 0] + c * pts[:, 1], pts[:, 2]], axis=1)
 
@@ -105,16 +117,16 @@ def op_repeat_finite(p: ArrayLike, spacing: ArrayLike, limit: ArrayLike) -> Floa
     whose round() leaves halves to the driver). Exact for a shape that fits in its cell and is symmetric.
 
     Args:
-        p: (N, 3) points (m).
-        spacing: (3,) cell size along x, y, z (m), each > 0.
-        limit: (3,) copies on each side of the middle one, each ≥ 0 (whole numbers).
+        p: (N, 3) points (m), within ±:data:`~kernels.sdf.primitives.MAX_COORDINATE`.
+        spacing: (3,) cell size along x, y, z (m), each in (0, :data:`~kernels.sdf.primitives.MAX_COORDINATE`].
+        limit: (3,) copies on each side of the middle one, each ≥ 0 (whole numbers, at most MAX_COORDINATE).
 
     Returns:
         (N, 3) points in the nearest copy's frame.
     """
-    pts = _checks.points("p", p)
-    c = _checks.positive_vector("spacing", spacing, 3)
-    lim = _checks.vector("limit", limit, 3)
+    pts = coordinates("p", p)
+    c = _checks.positive_vector("spacing", _checks.bounded_array("spacing", spacing, MAX_COORDINATE), 3)
+    lim = _checks.vector("limit", _checks.bounded_array("limit", limit, MAX_COORDINATE), 3)
     if np.any(lim < 0.0) or np.any(lim != np.round(lim)):
         raise ValueError(f"limit must be whole numbers ≥ 0, got {lim.tolist()}")
     return pts - c * np.clip(np.floor(pts / c + 0.5), -lim, lim)
@@ -124,13 +136,13 @@ def op_symmetry(p: ArrayLike, axes: ArrayLike) -> FloatArray:
     """Mirror symmetry: the chosen coordinates replaced by their absolute values (Quilez, "Symmetry").
 
     Args:
-        p: (N, 3) points (m).
+        p: (N, 3) points (m), within ±:data:`~kernels.sdf.primitives.MAX_COORDINATE`.
         axes: (3,) 1 (mirror across that coordinate's plane) or 0 (leave it), for x, y, z.
 
     Returns:
         (N, 3) points.
     """
-    pts = _checks.points("p", p)
+    pts = coordinates("p", p)
     mask = _checks.vector("axes", axes, 3)
     if not np.all((mask == 0.0) | (mask == 1.0)):
         raise ValueError(f"axes must be 0 or 1 each, got {mask.tolist()}")

@@ -50,20 +50,53 @@ AnyFloatArray = NDArray[np.floating]
 
 ROUND_BOX_ROUNDING = 0.25
 """A scene's round box is rounded by this fraction of its smallest half size."""
+MAX_COORDINATE = 1e150
+"""Largest magnitude (m) of a coordinate, position or size a primitive or operator takes: squares and products of
+sums of such numbers stay finite in float64 (1e300 at most), so no formula overflows to inf or NaN. Anything larger
+is refused by name (a sphere at 1e300 m had the distance inf; a capsule's end at 1e300 m gave NaN)."""
+
+
+def coordinates(name: str, value: ArrayLike) -> FloatArray:
+    """(N, 3) points (m) as float64, each coordinate within ±:data:`MAX_COORDINATE`, else ``ValueError`` naming
+    ``name``."""
+    pts = _checks.points(name, value)
+    if not (np.abs(pts) <= MAX_COORDINATE).all():
+        raise ValueError(f"{name} must be of magnitude ≤ {MAX_COORDINATE:g} m, got {value!r}")
+    return pts
+
+
+def position(name: str, value: ArrayLike) -> FloatArray:
+    """A (3,) position (m) within ±:data:`MAX_COORDINATE`, else ``ValueError`` naming ``name``."""
+    return _checks.vector(name, _checks.bounded_array(name, value, MAX_COORDINATE), 3)
+
+
+def length(name: str, value: object, *, zero_ok: bool = False) -> float:
+    """A length (m) > 0 (≥ 0 with ``zero_ok``) and ≤ :data:`MAX_COORDINATE`, else ``ValueError`` naming it."""
+    number = _checks.non_negative(name, value) if zero_ok else _checks.positive(name, value)
+    if number > MAX_COORDINATE:
+        raise ValueError(f"{name} must be at most {MAX_COORDINATE:g} m, got {value!r}")
+    return number
+
+
+def lengths(name: str, value: ArrayLike, size: int) -> FloatArray:
+    """(size,) lengths (m), each > 0 and ≤ :data:`MAX_COORDINATE`, else ``ValueError`` naming ``name``."""
+    return _checks.positive_vector(name, _checks.bounded_array(name, value, MAX_COORDINATE), size)
 
 
 def sd_sphere(p: ArrayLike, radius: float) -> FloatArray:
     """Exact distance to a sphere at the origin.
 
     Args:
-        p: (N, 3) points in the local frame (m).
+        p: (N, 3) points in the local frame (m), within ±:data:`MAX_COORDINATE` (as every length here).
         radius: radius (m), > 0.
 
     Returns:
         (N,) signed distances (m).
     """
-    pts = _checks.points("p", p)
-    r = _checks.positive("radius", radius)
+    return _sd_sphere(coordinates("p", p), length("radius", radius))
+
+
+def _sd_sphere(pts: FloatArray, r: float) -> FloatArray:
     return np.linalg.norm(pts, axis=1) - r
 
 
@@ -77,9 +110,11 @@ def sd_box(p: ArrayLike, half_size: ArrayLike) -> FloatArray:
     Returns:
         (N,) signed distances (m).
     """
-    pts = _checks.points("p", p)
-    b = _checks.positive_vector("half_size", half_size, 3)
-    q = np.abs(pts) - b
+    return _sd_box(coordinates("p", p), lengths("half_size", half_size, 3))
+
+
+def _sd_box(pts: FloatArray, b: FloatArray | Sizes) -> FloatArray:
+    q = np.abs(pts) - np.asarray(b)
     outside = np.linalg.norm(np.maximum(q, 0.0), axis=1)
     inside = np.minimum(q.max(axis=1), 0.0)
     return outside + inside
@@ -96,9 +131,11 @@ def sd_torus(p: ArrayLike, major_radius: float, minor_radius: float) -> FloatArr
     Returns:
         (N,) signed distances (m).
     """
-    pts = _checks.points("p", p)
-    big_r = _checks.positive("major_radius", major_radius)
-    small_r = _checks.positive("minor_radius", minor_radius)
+    pts = coordinates("p", p)
+    return _sd_torus(pts, length("major_radius", major_radius), length("minor_radius", minor_radius))
+
+
+def _sd_torus(pts: FloatArray, big_r: float, small_r: float) -> FloatArray:
     qx = np.hypot(pts[:, 0], pts[:, 2]) - big_r
     return np.hypot(qx, pts[:, 1]) - small_r
 
@@ -115,9 +152,11 @@ def sd_capsule(p: ArrayLike, a: ArrayLike, b: ArrayLike, radius: float) -> Float
     Returns:
         (N,) signed distances (m).
     """
-    pts = _checks.points("p", p)
-    a_vec, b_vec = _checks.vector("a", a, 3), _checks.vector("b", b, 3)
-    r = _checks.positive("radius", radius)
+    pts = coordinates("p", p)
+    return _sd_capsule(pts, position("a", a), position("b", b), length("radius", radius))
+
+
+def _sd_capsule(pts: FloatArray, a_vec: FloatArray, b_vec: FloatArray, r: float) -> FloatArray:
     pa = pts - a_vec
     ba = b_vec - a_vec
     length_sq = float(ba @ ba)
@@ -140,8 +179,11 @@ def sd_cylinder(p: ArrayLike, half_height: float, radius: float) -> FloatArray:
     Returns:
         (N,) signed distances (m).
     """
-    pts = _checks.points("p", p)
-    h, r = _checks.positive("half_height", half_height), _checks.positive("radius", radius)
+    pts = coordinates("p", p)
+    return _sd_cylinder(pts, length("half_height", half_height), length("radius", radius))
+
+
+def _sd_cylinder(pts: FloatArray, h: float, r: float) -> FloatArray:
     dx = np.hypot(pts[:, 0], pts[:, 2]) - r
     dy = np.abs(pts[:, 1]) - h
     return np.minimum(np.maximum(dx, dy), 0.0) + np.hypot(np.maximum(dx, 0.0), np.maximum(dy, 0.0))
@@ -160,12 +202,16 @@ def sd_round_box(p: ArrayLike, half_size: ArrayLike, radius: float) -> FloatArra
     Returns:
         (N,) signed distances (m).
     """
-    pts = _checks.points("p", p)
-    b = _checks.positive_vector("half_size", half_size, 3)
-    r = _checks.non_negative("radius", radius)
+    pts = coordinates("p", p)
+    b = lengths("half_size", half_size, 3)
+    r = length("radius", radius, zero_ok=True)
     if r > b.min():
         raise ValueError(f"radius must be at most min(half_size) = {b.min()}, got {radius!r}")
-    q = np.abs(pts) - b + r
+    return _sd_round_box(pts, b, r)
+
+
+def _sd_round_box(pts: FloatArray, b: FloatArray | Sizes, r: float) -> FloatArray:
+    q = np.abs(pts) - np.asarray(b) + r
     return np.linalg.norm(np.maximum(q, 0.0), axis=1) + np.minimum(q.max(axis=1), 0.0) - r
 
 
@@ -179,8 +225,11 @@ def sd_octahedron(p: ArrayLike, size: float) -> FloatArray:
     Returns:
         (N,) signed distances (m).
     """
-    pts = np.abs(_checks.points("p", p))
-    s = _checks.positive("size", size)
+    return _sd_octahedron(coordinates("p", p), length("size", size))
+
+
+def _sd_octahedron(p: FloatArray, s: float) -> FloatArray:
+    pts = np.abs(p)
     m = pts.sum(axis=1) - s
     x, y, z = pts[:, 0], pts[:, 1], pts[:, 2]
     # Pick the face region: q is p with its axes cycled so the nearest edge is the one the formula handles.
@@ -209,8 +258,10 @@ def sd_cone(p: ArrayLike, radius: float, height: float) -> FloatArray:
     Returns:
         (N,) signed distances (m).
     """
-    pts = _checks.points("p", p)
-    r, h = _checks.positive("radius", radius), _checks.positive("height", height)
+    return _sd_cone(coordinates("p", p), length("radius", radius), length("height", height))
+
+
+def _sd_cone(pts: FloatArray, r: float, h: float) -> FloatArray:
     # Quilez's frame: apex at the origin, base at y = −h; q is the base rim in the (radial, y) half-plane.
     qx, qy = r, -h
     wx = np.hypot(pts[:, 0], pts[:, 2])
@@ -235,8 +286,12 @@ def sd_hex_prism(p: ArrayLike, apothem: float, half_height: float) -> FloatArray
     Returns:
         (N,) signed distances (m).
     """
-    pts = np.abs(_checks.points("p", p))
-    a, h = _checks.positive("apothem", apothem), _checks.positive("half_height", half_height)
+    pts = coordinates("p", p)
+    return _sd_hex_prism(pts, length("apothem", apothem), length("half_height", half_height))
+
+
+def _sd_hex_prism(p: FloatArray, a: float, h: float) -> FloatArray:
+    pts = np.abs(p)
     kx, ky, kz = -math.sqrt(3.0) / 2.0, 0.5, 1.0 / math.sqrt(3.0)
     fold = 2.0 * np.minimum(kx * pts[:, 0] + ky * pts[:, 1], 0.0)
     x, y = pts[:, 0] - fold * kx, pts[:, 1] - fold * ky
@@ -260,8 +315,8 @@ def sd_ellipsoid(p: ArrayLike, radii: ArrayLike) -> FloatArray:
     Returns:
         (N,) signed distance estimates (m).
     """
-    pts = _checks.points("p", p)
-    r = _checks.positive_vector("radii", radii, 3)
+    pts = coordinates("p", p)
+    r = lengths("radii", radii, 3)
     k0 = np.linalg.norm(pts / r, axis=1)
     k1 = np.linalg.norm(pts / (r * r), axis=1)
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -285,8 +340,11 @@ def sd_ellipsoid_lipschitz(p: ArrayLike, radii: ArrayLike) -> FloatArray:
     Returns:
         (N,) signed distance bounds (m).
     """
-    pts = _checks.points("p", p)
-    r = _checks.positive_vector("radii", radii, 3)
+    return _sd_ellipsoid_lipschitz(coordinates("p", p), lengths("radii", radii, 3))
+
+
+def _sd_ellipsoid_lipschitz(pts: FloatArray, radii: FloatArray | Sizes) -> FloatArray:
+    r = np.asarray(radii)
     return (np.linalg.norm(pts / r, axis=1) - 1.0) * r.min()
 
 
@@ -295,19 +353,23 @@ def sd_plane(p: ArrayLike, normal: ArrayLike, offset: float) -> FloatArray:
 
     Args:
         p: (N, 3) points (m).
-        normal: (3,) normal; normalised here (must be non-zero).
-        offset: the plane's signed distance from the origin along −n (m).
+        normal: (3,) normal of any finite non-zero length; normalised here (scaled by its largest component first,
+            so neither a huge nor a tiny one overflows or underflows).
+        offset: the plane's signed distance from the origin along −n (m), within ±:data:`MAX_COORDINATE`.
 
     Returns:
         (N,) signed distances (m).
     """
-    pts = _checks.points("p", p)
+    pts = coordinates("p", p)
     n = _checks.vector("normal", normal, 3)
-    length = float(np.linalg.norm(n))
-    if length < 1e-12:
-        raise ValueError("normal must be non-zero")
+    largest = float(np.abs(n).max())
+    if largest == 0.0:
+        raise ValueError(f"normal must be non-zero, got {n.tolist()}")
+    n = n / largest
     off = _checks.finite_number("offset", offset)
-    return pts @ (n / length) + off
+    if abs(off) > MAX_COORDINATE:
+        raise ValueError(f"offset must be of magnitude ≤ {MAX_COORDINATE:g} m, got {offset!r}")
+    return pts @ (n / float(np.linalg.norm(n))) + off
 
 
 # ------------------------------------------------------------------------------------------ the registry
@@ -331,7 +393,9 @@ class PrimitiveSpec:
     sizes: tuple[tuple[str, str], ...]
     """Name and unit of each size parameter, in order (1 to 3: the GLSL holds them in a vec3)."""
     distance: LocalDistance
-    """The numpy distance of points in the local frame, from its ``sd_*`` function."""
+    """The numpy distance of points in the local frame: the unchecked formula of its ``sd_*`` function for the
+    built-in kinds (a :class:`~kernels.sdf.scene.Primitive` has checked its sizes, and a scene's local points may
+    lie beyond what ``sd_*`` takes as its argument ``p``)."""
     bounding_radius: Callable[[Sizes], float]
     """Radius (m) of a sphere about the local origin that holds the primitive."""
     half_extents: Callable[[Sizes], tuple[float, float, float]]
@@ -385,28 +449,28 @@ _M = "m"
 _BUILT_IN = (
     PrimitiveSpec(
         "sphere", "Sphere", 0, (("radius", _M),),
-        lambda p, s: sd_sphere(p, s[0]),
+        lambda p, s: _sd_sphere(p, s[0]),
         lambda s: s[0],
         lambda s: (s[0], s[0], s[0]),
         "sd_sphere", "p, s.x", fused=True, distance_xyz=_sphere_xyz,
     ),
     PrimitiveSpec(
         "box", "Box", 1, (("half_x", _M), ("half_y", _M), ("half_z", _M)),
-        lambda p, s: sd_box(p, s),
+        lambda p, s: _sd_box(p, s),
         _norm3,
         lambda s: (s[0], s[1], s[2]),
         "sd_box", "p, s", fused=True, distance_xyz=_box_xyz,
     ),
     PrimitiveSpec(
         "torus", "Torus", 2, (("major_radius", _M), ("minor_radius", _M)),
-        lambda p, s: sd_torus(p, s[0], s[1]),
+        lambda p, s: _sd_torus(p, s[0], s[1]),
         lambda s: s[0] + s[1],
         lambda s: (s[0] + s[1], s[1], s[0] + s[1]),
         "sd_torus", "p, s.x, s.y", fused=True, distance_xyz=_torus_xyz,
     ),
     PrimitiveSpec(
         "capsule", "Capsule", 3, (("half_length", _M), ("radius", _M)),
-        lambda p, s: sd_capsule(p, (0.0, -s[0], 0.0), (0.0, s[0], 0.0), s[1]),
+        lambda p, s: _sd_capsule(p, np.array([0.0, -s[0], 0.0]), np.array([0.0, s[0], 0.0]), s[1]),
         lambda s: s[0] + s[1],
         lambda s: (s[1], s[0] + s[1], s[1]),
         "sd_capsule", "p, vec3(0.0, -s.x, 0.0), vec3(0.0, s.x, 0.0), s.y",
@@ -414,35 +478,35 @@ _BUILT_IN = (
     ),
     PrimitiveSpec(
         "cylinder", "Cylinder", 4, (("half_height", _M), ("radius", _M)),
-        lambda p, s: sd_cylinder(p, s[0], s[1]),
+        lambda p, s: _sd_cylinder(p, s[0], s[1]),
         lambda s: math.hypot(s[0], s[1]),
         lambda s: (s[1], s[0], s[1]),
         "sd_cylinder", "p, s.x, s.y",
     ),
     PrimitiveSpec(
         "round_box", "Round box", 5, (("half_x", _M), ("half_y", _M), ("half_z", _M)),
-        lambda p, s: sd_round_box(p, s, ROUND_BOX_ROUNDING * min(s)),
+        lambda p, s: _sd_round_box(p, s, ROUND_BOX_ROUNDING * min(s)),
         _norm3,
         lambda s: (s[0], s[1], s[2]),
         "sd_round_box", "p, s, ROUND_BOX_ROUNDING * min(s.x, min(s.y, s.z))",
     ),
     PrimitiveSpec(
         "octahedron", "Octahedron", 6, (("size", _M),),
-        lambda p, s: sd_octahedron(p, s[0]),
+        lambda p, s: _sd_octahedron(p, s[0]),
         lambda s: s[0],
         lambda s: (s[0], s[0], s[0]),
         "sd_octahedron", "p, s.x",
     ),
     PrimitiveSpec(
         "cone", "Cone", 7, (("radius", _M), ("height", _M)),
-        lambda p, s: sd_cone(p, s[0], s[1]),
+        lambda p, s: _sd_cone(p, s[0], s[1]),
         lambda s: math.hypot(s[0], s[1] / 2),
         lambda s: (s[0], s[1] / 2, s[0]),
         "sd_cone", "p, s.x, s.y",
     ),
     PrimitiveSpec(
         "hex_prism", "Hexagonal prism", 8, (("apothem", _M), ("half_height", _M)),
-        lambda p, s: sd_hex_prism(p, s[0], s[1]),
+        lambda p, s: _sd_hex_prism(p, s[0], s[1]),
         lambda s: math.hypot(2 * s[0] / math.sqrt(3.0), s[1]),
         lambda s: (2 * s[0] / math.sqrt(3.0), s[0], s[1]),
         "sd_hex_prism", "p, s.x, s.y",
@@ -450,7 +514,7 @@ _BUILT_IN = (
     # A scene's ellipsoid uses the 1-Lipschitz bound: Quilez's estimate is not 1-Lipschitz when elongated.
     PrimitiveSpec(
         "ellipsoid", "Ellipsoid (bound)", 9, (("radius_x", _M), ("radius_y", _M), ("radius_z", _M)),
-        lambda p, s: sd_ellipsoid_lipschitz(p, s),
+        lambda p, s: _sd_ellipsoid_lipschitz(p, s),
         lambda s: max(s),
         lambda s: (s[0], s[1], s[2]),
         "sd_ellipsoid_lipschitz", "p, s",
@@ -470,7 +534,7 @@ def primitive_kinds() -> tuple[str, ...]:
 
 def primitive_spec(kind: str) -> PrimitiveSpec:
     """The registry entry of ``kind``, or ``ValueError`` naming the kinds there are."""
-    spec = PRIMITIVES.get(kind)
+    spec = PRIMITIVES.get(kind) if isinstance(kind, str) else None
     if spec is None:
         raise ValueError(f"kind must be one of {primitive_kinds()}, got {kind!r}")
     return spec
@@ -482,6 +546,9 @@ def register_primitive(spec: PrimitiveSpec) -> None:
     Its GLSL function must be defined in ``spec.glsl_file`` (or already in ``shaders/sdf.glsl``); renderers created
     afterwards dispatch to it.
     """
+    _checks.instance("spec", spec, PrimitiveSpec)
+    if not isinstance(spec.kind, str) or not spec.kind.isidentifier():
+        raise ValueError(f"kind must be a name (a Python identifier), got {spec.kind!r}")
     if spec.kind in PRIMITIVES:
         raise ValueError(f"kind {spec.kind!r} is already registered")
     next_code = max(s.code for s in PRIMITIVES.values()) + 1
@@ -498,6 +565,7 @@ def register_primitive(spec: PrimitiveSpec) -> None:
 
 def unregister_primitive(kind: str) -> None:
     """Remove a kind added by :func:`register_primitive` (the built-in ten stay)."""
+    _checks.choice("kind", kind, primitive_kinds())
     if kind in BUILT_IN_KINDS:
         raise ValueError(f"kind {kind!r} is built in")
     primitive_spec(kind)

@@ -24,7 +24,16 @@ from numpy.typing import ArrayLike, NDArray
 
 from kernels import _checks
 from kernels.sdf.blend import BLEND_FORMS, BOOLEAN_OPS, BlendForm, BooleanOp, combine_weighted
-from kernels.sdf.primitives import FloatArray, PrimitiveKind, primitive_kinds, primitive_spec
+from kernels.sdf.primitives import (
+    MAX_COORDINATE,
+    FloatArray,
+    PrimitiveKind,
+    coordinates,
+    lengths,
+    position,
+    primitive_kinds,
+    primitive_spec,
+)
 
 MAX_PRIMITIVES = 4
 MAX_BLEND_WIDTH = 1e6
@@ -33,15 +42,21 @@ grid spans about k: past ~1e18 m float32 squares of its coordinates overflow and
 empty from k ≈ 1e19). 1000 km is far beyond any gallery scene yet keeps every float32 value small."""
 
 
+def unit_quaternion(name: str, value: ArrayLike) -> FloatArray:
+    """(4,) unit quaternion (w, x, y, z) from 4 finite real numbers not all zero, else ``ValueError`` naming
+    ``name``. It is scaled by its largest component before its norm is taken, so a huge one (1e300) does not
+    overflow the norm to inf and a tiny one (1e-300) does not underflow it to zero."""
+    q = _checks.vector(name, value, 4)
+    largest = float(np.abs(q).max())
+    if largest == 0.0:
+        raise ValueError(f"{name} must be a non-zero quaternion (w, x, y, z), got {q.tolist()}")
+    q = q / largest
+    return q / float(np.linalg.norm(q))
+
+
 def rotation_matrix(wxyz: ArrayLike) -> FloatArray:
-    """(3, 3) rotation of a unit quaternion (w, x, y, z); it is normalised first."""
-    q = np.asarray(wxyz, dtype=np.float64)
-    if q.shape != (4,) or not np.all(np.isfinite(q)):
-        raise ValueError(f"rotation must be 4 finite numbers (w, x, y, z), got {q.tolist()}")
-    norm = float(np.linalg.norm(q))
-    if norm < 1e-9:
-        raise ValueError("rotation must be a non-zero quaternion")
-    w, x, y, z = q / norm
+    """(3, 3) rotation of a quaternion (w, x, y, z) of any finite non-zero length; it is normalised first."""
+    w, x, y, z = unit_quaternion("wxyz", wxyz)
     return np.array(
         [
             [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
@@ -73,24 +88,21 @@ class Primitive:
     """How it combines with the shape made by the primitives before it (unused for the first)."""
 
     def __post_init__(self) -> None:
-        if self.kind not in primitive_kinds():
-            raise ValueError(f"kind must be one of {primitive_kinds()}, got {self.kind!r}")
-        if self.op not in BOOLEAN_OPS:
-            raise ValueError(f"op must be one of {BOOLEAN_OPS}, got {self.op!r}")
-        center = _checks.vector("center", self.center, 3)
-        size = _checks.positive_array("size", self.size)
+        _checks.choice("kind", self.kind, primitive_kinds())
+        _checks.choice("op", self.op, BOOLEAN_OPS)
+        center = position("center", self.center)
         count = primitive_spec(self.kind).size_count
+        size = _checks.finite_array("size", self.size)
         if size.shape != (count,):
             raise ValueError(f"size of a {self.kind} must have {count} values, got {size.shape}")
-        rotation = rotation_matrix(self.rotation)  # raises for a bad quaternion
-        del rotation
-        q = np.asarray(self.rotation, dtype=np.float64)
+        size = lengths("size", size, count)
+        q = unit_quaternion("rotation", self.rotation)
         color = _checks.vector("color", self.color, 3)
         if np.any(color < 0.0) or np.any(color > 1.0):
             raise ValueError(f"color must lie in [0, 1], got {color.tolist()}")
         object.__setattr__(self, "center", tuple(float(v) for v in center))
         object.__setattr__(self, "size", tuple(float(v) for v in size))
-        object.__setattr__(self, "rotation", tuple(float(v) for v in q / np.linalg.norm(q)))
+        object.__setattr__(self, "rotation", tuple(float(v) for v in q))
         object.__setattr__(self, "color", tuple(float(v) for v in color))
 
     @property
@@ -149,13 +161,14 @@ class Scene:
     """"poly" (the seed's polynomial smin) or "exp" (its exponential smin, sharpness 4·ln 2 / k)."""
 
     def __post_init__(self) -> None:
+        if not isinstance(self.primitives, (tuple, list)):
+            raise ValueError(f"primitives must be a tuple of Primitive, got {type(self.primitives).__name__}")
         prims = tuple(self.primitives)
         if not 1 <= len(prims) <= MAX_PRIMITIVES:
             raise ValueError(f"primitives must hold 1 to {MAX_PRIMITIVES}, got {len(prims)}")
         if not all(isinstance(p, Primitive) for p in prims):
-            raise ValueError("primitives must all be Primitive")
-        if self.blend not in BLEND_FORMS:
-            raise ValueError(f"blend must be one of {BLEND_FORMS}, got {self.blend!r}")
+            raise ValueError(f"primitives must all be Primitive, got {[type(p).__name__ for p in prims]}")
+        _checks.choice("blend", self.blend, BLEND_FORMS)
         object.__setattr__(self, "primitives", prims)
         k = _checks.non_negative("k", self.k)
         if k > MAX_BLEND_WIDTH:
@@ -188,6 +201,8 @@ def fold_xyz(
     Returns:
         (N,) distances (m) and (N, 3) RGB in [0, 1], or None without ``with_color``.
     """
+    _checks.instance("scene", scene, Scene)
+    _checks.flag("with_color", with_color)
     first = scene.primitives[0]
     # A point far enough away (|p| beyond ~1e154 m in float64, ~1e19 m in float32) has an infinite distance; the
     # blends take infinities without NaN, so that is the answer there, not a warning.
@@ -212,6 +227,7 @@ def scene_distance(scene: Scene, points: ArrayLike) -> FloatArray:
         (N,) signed distances (m): exact for one primitive or hard unions away from seams, a 1-Lipschitz bound
         otherwise.
     """
+    _checks.instance("scene", scene, Scene)
     return _fold(scene, _checks.points("points", points), with_color=False)[0]
 
 
@@ -225,6 +241,7 @@ def scene_color(scene: Scene, points: ArrayLike) -> FloatArray:
     Returns:
         (N, 3) RGB in [0, 1].
     """
+    _checks.instance("scene", scene, Scene)
     color = _fold(scene, _checks.points("points", points), with_color=True)[1]
     assert color is not None
     return color
@@ -232,6 +249,7 @@ def scene_color(scene: Scene, points: ArrayLike) -> FloatArray:
 
 def scene_bounds(scene: Scene) -> FloatArray:
     """(2, 3) box (min corner, max corner) in metres that holds the scene with room for the blend."""
+    _checks.instance("scene", scene, Scene)
     centers = np.array([p.center for p in scene.primitives])
     radii = np.array([p.bounding_radius for p in scene.primitives])
     lo = (centers - radii[:, None]).min(axis=0)
@@ -249,6 +267,7 @@ def scene_bounding_spheres(scene: Scene) -> tuple[FloatArray, FloatArray]:
     primitives (k/4 per blend), and subtraction and intersection only remove. Rays that miss every sphere miss the
     scene; marching runs from the first entry to the last exit. 1 mm of slack covers float32 in the shader.
     """
+    _checks.instance("scene", scene, Scene)
     centers = np.array([p.center for p in scene.primitives], dtype=np.float64)
     radii = np.array([p.bounding_radius for p in scene.primitives]) + scene.k + 1e-3
     return centers, radii
@@ -267,7 +286,16 @@ def ray_spheres_interval(
 
     Returns:
         (N,) t_enter ≥ 0 and (N,) t_exit (m); t_exit < t_enter where a ray meets no sphere ahead of it.
+
+    Every coordinate and radius lies within ±:data:`~kernels.sdf.primitives.MAX_COORDINATE` (and the directions'
+    components within ±1), so the squares below stay finite.
     """
+    origins = coordinates("origins", origins)
+    directions = _unit_directions("directions", directions, len(origins))
+    centers = coordinates("centers", centers)
+    radii = _checks.bounded_array("radii", radii, MAX_COORDINATE)
+    if radii.shape != (len(centers),) or np.any(radii < 0.0):
+        raise ValueError(f"radii must be ({len(centers)},) lengths ≥ 0, got {radii!r}")
     oc = origins[:, None, :] - centers[None, :, :]
     b = np.einsum("npk,nk->np", oc, directions)
     c = np.einsum("npk,npk->np", oc, oc) - radii[None, :] ** 2
@@ -278,6 +306,17 @@ def ray_spheres_interval(
     t_enter = np.where(ahead, np.maximum(-b - root, 0.0), np.inf).min(axis=1)
     t_exit = np.where(ahead, exit_, -1.0).max(axis=1)
     return t_enter, t_exit
+
+
+def _unit_directions(name: str, value: ArrayLike, count: int) -> FloatArray:
+    """(count, 3) unit vectors (length within 1e-6 of 1), else ``ValueError`` naming ``name``."""
+    d = _checks.bounded_array(name, value, 2.0)
+    d = _checks.points(name, d)
+    if len(d) != count:
+        raise ValueError(f"{name} must match origins' shape ({count}, 3), got {d.shape}")
+    if not (np.abs(np.einsum("ij,ij->i", d, d) - 1.0) <= 2e-6).all():
+        raise ValueError(f"{name} must be unit vectors, got {value!r}")
+    return d
 
 
 def sphere_trace(
@@ -296,21 +335,21 @@ def sphere_trace(
 
     Args:
         scene: the scene.
-        origins: (N, 3) ray origins (m), outside the shape.
-        directions: (N, 3) unit directions.
-        max_steps: steps before a ray counts as a miss.
+        origins: (N, 3) ray origins (m), outside the shape, within ±:data:`~kernels.sdf.primitives.MAX_COORDINATE`.
+        directions: (N, 3) unit directions (length within 1e-6 of 1).
+        max_steps: steps before a ray counts as a miss, an integer in 1..10000.
         hit_epsilon: hit threshold (m at t ≤ 1, relative beyond).
         max_distance: rays longer than this miss (m).
 
     Returns:
         (N,) distance along each ray to the hit (m); ``inf`` for a miss.
     """
-    o = _checks.points("origins", origins)
-    d = _checks.points("directions", directions)
-    if o.shape != d.shape:
-        raise ValueError(f"directions must match origins' shape {o.shape}, got {d.shape}")
-    if not 1 <= int(max_steps) <= 10_000:
-        raise ValueError(f"max_steps must be in 1..10000, got {max_steps}")
+    _checks.instance("scene", scene, Scene)
+    o = coordinates("origins", origins)
+    d = _unit_directions("directions", directions, len(o))
+    steps = _checks.integer("max_steps", max_steps, 1)
+    if steps > 10_000:
+        raise ValueError(f"max_steps must be in 1..10000, got {max_steps!r}")
     eps = _checks.positive("hit_epsilon", hit_epsilon)
     far = _checks.positive("max_distance", max_distance)
     centers, radii = scene_bounding_spheres(scene)
@@ -318,7 +357,7 @@ def sphere_trace(
     t_exit = np.minimum(t_exit, far)
     hit = np.zeros(len(o), dtype=bool)
     active = t_exit >= t
-    for _ in range(int(max_steps)):
+    for _ in range(steps):
         idx = np.flatnonzero(active)
         if idx.size == 0:
             break
