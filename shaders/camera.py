@@ -14,6 +14,13 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
+from kernels import _checks
+from kernels.sdf import MAX_FIELD_COORDINATE
+
+MAX_CAMERA_COORDINATE = MAX_FIELD_COORDINATE
+"""Largest |coordinate| (m) of a camera's position and target: the shaders march in float32, where squares of
+differences of such coordinates stay finite (a camera at 1e300 m drew an empty image with overflow warnings)."""
+
 
 @dataclasses.dataclass(frozen=True)
 class Camera:
@@ -29,17 +36,28 @@ class Camera:
     """Vertical field of view (rad), in (0, π)."""
 
     def __post_init__(self) -> None:
-        eye, target, up = (np.asarray(v, dtype=np.float64) for v in (self.position, self.look_at, self.up))
-        for name, v in (("position", eye), ("look_at", target), ("up", up)):
-            if v.shape != (3,) or not np.all(np.isfinite(v)):
-                raise ValueError(f"{name} must be 3 finite numbers, got {v.tolist()}")
+        eye = _checks.vector("position", self.position, 3)
+        target = _checks.vector("look_at", self.look_at, 3)
+        for name, v in (("position", eye), ("look_at", target)):
+            if not (np.abs(v) <= MAX_CAMERA_COORDINATE).all():
+                raise ValueError(f"{name} must be of magnitude ≤ {MAX_CAMERA_COORDINATE:g} m, got {v.tolist()}")
+        up = _checks.vector("up", self.up, 3)
+        largest = float(np.abs(up).max())
+        if largest == 0.0:
+            raise ValueError(f"up must be non-zero, got {up.tolist()}")
+        up = up / largest  # any finite length: scaled first, so its norm neither overflows nor underflows
         forward = target - eye
         if np.linalg.norm(forward) < 1e-9:
             raise ValueError("look_at must differ from position")
-        if np.linalg.norm(np.cross(forward, up)) < 1e-9 * np.linalg.norm(forward) * max(np.linalg.norm(up), 1e-30):
+        if np.linalg.norm(np.cross(forward, up)) < 1e-9 * np.linalg.norm(forward) * np.linalg.norm(up):
             raise ValueError("up must not be parallel to the view axis")
-        if not (math.isfinite(self.fov_y_rad) and 0.0 < self.fov_y_rad < math.pi):
-            raise ValueError(f"fov_y_rad must be in (0, π), got {self.fov_y_rad}")
+        fov = _checks.finite_number("fov_y_rad", self.fov_y_rad)
+        if not 0.0 < fov < math.pi:
+            raise ValueError(f"fov_y_rad must be in (0, π), got {self.fov_y_rad!r}")
+        object.__setattr__(self, "position", tuple(float(v) for v in eye))
+        object.__setattr__(self, "look_at", tuple(float(v) for v in target))
+        object.__setattr__(self, "up", tuple(float(v) for v in up))
+        object.__setattr__(self, "fov_y_rad", fov)
 
     def basis(self) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
         """Unit (forward, right, up) vectors of the image."""
@@ -100,31 +118,47 @@ class Shading:
     """Central-difference step for normals (m)."""
 
     def __post_init__(self) -> None:
+        # The shaders read these as float32 uniforms: each must be finite there too.
+        big = float(np.finfo(np.float32).max)
         for name in ("ambient", "diffuse", "specular", "occlusion_strength"):
-            value = getattr(self, name)
-            if not (math.isfinite(value) and 0.0 <= value <= 10.0):
-                raise ValueError(f"{name} must be in [0, 10], got {value}")
+            value = _checks.finite_number(name, getattr(self, name))
+            if not 0.0 <= value <= 10.0:
+                raise ValueError(f"{name} must be in [0, 10], got {getattr(self, name)!r}")
+            object.__setattr__(self, name, value)
         for name in (
             "shininess",
             "shadow_sharpness",
             "occlusion_step",
             "hit_epsilon",
             "max_distance",
+            "normal_epsilon",
         ):
             value = getattr(self, name)
-            if not (math.isfinite(value) and value > 0.0):
-                raise ValueError(f"{name} must be finite and positive, got {value}")
-        if not (math.isfinite(self.normal_epsilon) and self.normal_epsilon > 0.0):
-            raise ValueError(f"normal_epsilon must be finite and positive, got {self.normal_epsilon}")
-        light = np.asarray(self.light_direction, dtype=np.float64)
-        if light.shape != (3,) or not np.all(np.isfinite(light)) or np.linalg.norm(light) < 1e-9:
-            raise ValueError(f"light_direction must be a finite non-zero 3-vector, got {light.tolist()}")
-        if not 1 <= self.max_steps <= 4096:
-            raise ValueError(f"max_steps must be in 1..4096, got {self.max_steps}")
+            number = _checks.positive(name, value)
+            if number > big:
+                raise ValueError(f"{name} must be at most {big:g} (float32), got {value!r}")
+            object.__setattr__(self, name, number)
+        light = _checks.vector("light_direction", self.light_direction, 3)
+        largest = float(np.abs(light).max())
+        if largest == 0.0:
+            raise ValueError(f"light_direction must be non-zero, got {light.tolist()}")
+        light = light / largest  # normalised on use; scaled here so that cannot overflow or underflow
+        object.__setattr__(self, "light_direction", tuple(float(v) for v in light))
+        for name in ("shadows", "occlusion"):
+            object.__setattr__(self, name, _checks.flag(name, getattr(self, name)))
+        background = _checks.vector("background", self.background, 3)
+        if not ((background >= 0.0) & (background <= 1.0)).all():
+            raise ValueError(f"background must lie in [0, 1], got {background.tolist()}")
+        object.__setattr__(self, "background", tuple(float(v) for v in background))
+        steps = _checks.integer("max_steps", self.max_steps, 1)
+        if steps > 4096:
+            raise ValueError(f"max_steps must be in 1..4096, got {self.max_steps!r}")
+        object.__setattr__(self, "max_steps", steps)
 
 
 def camera_rays(camera: Camera, width: int, height: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """The renderer's rays in numpy: origins and unit directions, (H·W, 3) each, row-major from the top row."""
+    _checks.instance("camera", camera, Camera)
     check_image_size(width, height)
     forward, right, up = camera.basis()
     tan_half = math.tan(camera.fov_y_rad / 2)
@@ -140,7 +174,11 @@ def camera_rays(camera: Camera, width: int, height: int) -> tuple[NDArray[np.flo
 def check_image_size(width: int, height: int) -> None:
     """``ValueError`` unless ``width`` and ``height`` are integers in 1..8192 (px)."""
     for name, value in (("width", width), ("height", height)):
-        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not 1 <= value <= 8192:
+        if (
+            isinstance(value, (bool, np.timedelta64))
+            or not isinstance(value, (int, np.integer))
+            or not 1 <= value <= 8192
+        ):
             raise ValueError(f"{name} must be an integer in 1..8192, got {value!r}")
 
 
@@ -152,6 +190,11 @@ def screen_rectangle(
     Conservative: the rectangle bounds the points' projections, widened by a pixel; if any point lies near or
     behind the eye it is the whole image, and if all lie behind it, empty.
     """
+    _checks.instance("camera", camera, Camera)
+    check_image_size(width, height)
+    corners = _checks.points("corners", corners)
+    if not (np.abs(corners) <= MAX_CAMERA_COORDINATE).all():
+        raise ValueError(f"corners must be of magnitude ≤ {MAX_CAMERA_COORDINATE:g} m, got {corners!r}")
     forward, right, up = camera.basis()
     rel = corners - np.asarray(camera.position)
     z = rel @ forward

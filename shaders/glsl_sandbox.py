@@ -17,6 +17,7 @@ import re
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from kernels import _checks
 from shaders.glsl_library import SHADER_DIR, sdf_library
 
 MAX_SOURCE_CHARS = 8000
@@ -525,11 +526,11 @@ def user_glsl(source: str) -> str:
 
 def check_field_bounds(bounds: ArrayLike) -> NDArray[np.float64]:
     """An editor field's (2, 3) min and max corners (m) as float64, within ±1000 m, else ``ValueError``."""
-    box = np.asarray(bounds, dtype=np.float64)
-    if box.shape != (2, 3) or not np.all(np.isfinite(box)) or np.any(box[1] <= box[0]):
+    box = _checks.finite_array("bounds", bounds)
+    if box.shape != (2, 3) or np.any(box[1] <= box[0]):
         raise ValueError(f"bounds must be finite (2, 3) min and max corners with max > min, got {box.tolist()}")
     if np.any(np.abs(box) > 1e3):
-        raise ValueError("bounds must lie within ±1000 m")
+        raise ValueError(f"bounds must lie within ±1000 m, got {box.tolist()}")
     return box
 
 

@@ -24,8 +24,8 @@ import numpy as np
 import trimesh
 from numpy.typing import ArrayLike, NDArray
 
-from kernels import sdf
-from shaders.camera import Camera, Shading, camera_rays, check_image_size, screen_rectangle
+from kernels import _checks, sdf
+from shaders.camera import MAX_CAMERA_COORDINATE, Camera, Shading, camera_rays, check_image_size, screen_rectangle
 from shaders.glsl_library import SHADER_DIR, read_source, sdf_library, with_defines
 from shaders.glsl_sandbox import (
     DEFAULT_COLOR_GLSL,
@@ -122,11 +122,33 @@ def _box_scissor(camera: Camera, box: NDArray[np.float64], width: int, height: i
 
 
 def _probe_points(points: ArrayLike) -> NDArray[np.float32]:
-    """Points to probe as (N, 3) float32, or ValueError unless they are finite and N ≥ 1."""
-    pts = np.asarray(points, dtype=np.float32)
-    if pts.ndim != 2 or pts.shape[1] != 3 or not np.all(np.isfinite(pts)) or len(pts) == 0:
-        raise ValueError(f"points must be finite (N, 3) with N ≥ 1, got {pts.shape}")
-    return pts
+    """Points to probe as (N, 3) float32, or ValueError unless they are (N, 3) with N ≥ 1 and finite in float32 (a
+    point so far that float32 squares of it overflow has the distance inf there, as in the kernel)."""
+    pts = _checks.points("points", points)
+    big = float(np.finfo(np.float32).max)
+    if len(pts) == 0 or not (np.abs(pts) <= big).all():
+        raise ValueError(
+            f"points must be (N, 3) with N ≥ 1, finite in float32, got {pts.shape} "
+            f"of magnitude up to {np.abs(pts).max(initial=0.0):g}"
+        )
+    return pts.astype(np.float32)
+
+
+def _drawable_scene(scene: object) -> sdf.Scene:
+    """``scene`` when it is a :class:`kernels.sdf.Scene` whose bounds lie within
+    ±:data:`~shaders.camera.MAX_CAMERA_COORDINATE` (the shaders' float32), else ``ValueError`` naming it."""
+    checked = _checks.instance("scene", scene, sdf.Scene)
+    box = sdf.scene_bounds(checked)
+    if not (np.abs(box) <= MAX_CAMERA_COORDINATE).all():
+        raise ValueError(
+            f"scene must lie within ±{MAX_CAMERA_COORDINATE:g} m for the float32 shaders, got bounds {box.tolist()}"
+        )
+    return checked
+
+
+def _shading(shading: object) -> Shading:
+    """``shading``, or the defaults for None; ``ValueError`` naming it for anything else."""
+    return Shading() if shading is None else _checks.instance("shading", shading, Shading, "a Shading or None")
 
 
 def create_context() -> object:
@@ -150,10 +172,18 @@ def _mesh_arrays(
     vertices: ArrayLike, indices: ArrayLike, name: str, corners: int
 ) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
     """(V, 3) float vertices and (N, ``corners``) int indices into them, or ValueError naming what is malformed."""
-    v = np.asarray(vertices, dtype=np.float64)
-    idx = np.asarray(indices, dtype=np.int64)
-    if v.ndim != 2 or v.shape[1] != 3 or not np.all(np.isfinite(v)):
-        raise ValueError(f"vertices must be finite (V, 3), got {v.shape}")
+    v = _checks.points("vertices", vertices)
+    if not (np.abs(v) <= MAX_CAMERA_COORDINATE).all():
+        raise ValueError(f"vertices must be within ±{MAX_CAMERA_COORDINATE:g} m for float32, got {vertices!r}")
+    try:
+        raw = np.asarray(indices)
+        if raw.size and raw.dtype.kind not in "iu":
+            raise TypeError(raw.dtype)
+        idx = raw.astype(np.int64)
+    except (TypeError, ValueError, OverflowError) as error:
+        raise ValueError(f"{name} must be (N, {corners}) integer indices into vertices, got {indices!r}") from error
+    if idx.size == 0:
+        idx = idx.reshape(0, corners)
     if idx.ndim != 2 or idx.shape[1] != corners or (idx.size and (idx.min() < 0 or idx.max() >= len(v))):
         raise ValueError(f"{name} must be (N, {corners}) indices into vertices, got {idx.shape}")
     return v, idx
@@ -345,8 +375,10 @@ class Renderer:
             where a ray misses.
         """
 
+        scene = _drawable_scene(scene)
+        _checks.instance("camera", camera, Camera)
         check_image_size(width, height)
-        shading = shading or Shading()
+        shading = _shading(shading)
         # sdf.glsl's smin_blend uses the polynomial form for hard scenes (k = 0) whatever the blend.
         variant = (
             shading.shadows,
@@ -437,10 +469,11 @@ class Renderer:
         """
         import moderngl
 
+        _checks.instance("camera", camera, Camera)
         check_image_size(width, height)
-        shading = shading or Shading()
+        shading = _shading(shading)
         v, f = _mesh_arrays(vertices, faces, "faces", 3)
-        c = np.asarray(colors, dtype=np.float64)
+        c = _checks.finite_array("colors", colors)
         if c.shape != v.shape:
             raise ValueError(f"colors must match vertices' shape {v.shape}, got {c.shape}")
         normals = (trimesh.Trimesh(v, f, process=False).vertex_normals if len(f) else np.zeros_like(v)).astype(
@@ -500,10 +533,13 @@ class Renderer:
         """
         import moderngl
 
+        _checks.instance("camera", camera, Camera)
         check_image_size(width, height)
         v, e = _mesh_arrays(vertices, edges, "edges", 2)
-        if not (math.isfinite(tolerance_m) and tolerance_m >= 0.0):
-            raise ValueError(f"tolerance_m must be finite and >= 0, got {tolerance_m}")
+        tolerance = _checks.non_negative("tolerance_m", tolerance_m)
+        levels = np.asarray(color)
+        if levels.shape != (3,) or levels.dtype.kind not in "iu" or not ((levels >= 0) & (levels <= 255)).all():
+            raise ValueError(f"color must be 3 integers in 0..255, got {color!r}")
         if self._target_size != (width, height):
             raise ValueError(f"draw_edges needs a march of {width}x{height} before it, got {self._target_size}")
         _, color_only, _, color_tex, depth_tex, _ = self._target_objects
@@ -512,7 +548,7 @@ class Renderer:
         if len(e):
             prog = self._edges
             self._set_mesh_camera(prog, v, camera, width, height)
-            self._set(prog, "u_tolerance", float(tolerance_m))
+            self._set(prog, "u_tolerance", tolerance)
             # sRGB levels are what the marched image holds: the lines are written as they should read.
             self._set(prog, "u_color", tuple(float(c) / 255.0 for c in color))
             self._set(prog, "u_depth", 0)
@@ -538,7 +574,7 @@ class Renderer:
             (N,) distances (m) and (N, 3) colours, float32, computed by the GLSL.
         """
         pts = _probe_points(points)
-        self._set_scene(self._probe, scene)
+        self._set_scene(self._probe, _drawable_scene(scene))
         return self._draw_probe(self._probe, self._probe_vao, pts)
 
     def _draw_probe(
@@ -628,7 +664,7 @@ class Renderer:
         """Check and compile an editor source (its sampling programs and the ray-march for ``shading``'s shadow and
         occlusion switches), or raise ValueError saying why and where."""
         check_source(source)
-        shading = shading or Shading()
+        shading = _shading(shading)
         self._field_program(source, "sample")
         self._field_program(source, f"march:{int(shading.shadows)}:{int(shading.occlusion)}")
 
@@ -688,10 +724,11 @@ class Renderer:
             RGB (H, W, 3) uint8 and depth along the view axis (H, W) float32 (m), inf where a ray misses.
         """
 
+        _checks.instance("camera", camera, Camera)
         check_image_size(width, height)
         check_source(source)
         box = check_field_bounds(bounds)
-        shading = shading or Shading()
+        shading = _shading(shading)
         prog, vao = self._field_program(source, f"march:{int(shading.shadows)}:{int(shading.occlusion)}")
         self._set(prog, "u_field_lo", tuple(float(v) for v in box[0]))
         self._set(prog, "u_field_hi", tuple(float(v) for v in box[1]))
@@ -714,6 +751,11 @@ def render(
     scene: sdf.Scene, camera: Camera, width: int, height: int, shading: Shading | None = None
 ) -> tuple[NDArray[np.uint8], NDArray[np.float32]]:
     """Ray-march ``scene`` with this thread's :class:`Renderer`: RGB (H, W, 3) uint8 and depth (H, W) float32."""
+    # Checked before the renderer is made, so a bad argument is named even where GL is missing.
+    _drawable_scene(scene)
+    _checks.instance("camera", camera, Camera)
+    check_image_size(width, height)
+    _shading(shading)
     return renderer().render(scene, camera, width, height, shading)
 
 
