@@ -71,7 +71,9 @@ Step limit: a kick whose ``dt`` is beyond the method's stability limit for its d
 and classical RK4 in [−2.7853, 0] (Hairer & Wanner, Solving ODEs II, §IV.2), so dt ≤ β/(2k|v|), which for Euler is
 k|v|·dt ≤ 1: a step never reverses the velocity. The lift and knuckle factors are added to k, and |v| is the fastest
 the ball can fly (its launch speed, or the terminal speed, or the speed a fall from its height gives: whichever
-bound is least). A flight whose steps still overshoot, so that |v|² + 2gz grows far past its launch value (or
+bound is least). On a pitch a bounce can turn the spin's energy into speed and spin up a ball launched without
+spin, so there |v| adds 2·√(α·R²)·|ω₀| in quadrature and the lift counts whatever the launch spin; the refusal then
+names the spin too. A flight whose steps still overshoot, so that |v|² + 2gz grows far past its launch value (or
 overflows), also raises ``ValueError`` naming ``dt`` rather than returning an absurd path.
 
 Modules: :mod:`~kernels.ball.config` (constants, :class:`FlightConfig`, input checks), :mod:`~kernels.ball.pitch` (goal

@@ -98,8 +98,9 @@ def fill_kick(launch, config, kick):
 
 
 @compiled()
-def max_stable_step(launch, kick, config):
-    """(longest stable dt (s), fastest speed bound (m/s)) of one kick: its launch row, constants and the settings.
+def max_stable_step(launch, kick, config, spin_inertia):
+    """(longest stable dt (s), fastest speed bound (m/s)) of one kick: its launch row, constants and the settings;
+    ``spin_inertia`` α·R² (m²) of the ball on a pitch, 0 for a flight that meets nothing.
 
     The acceleration's velocity-dependent part a(v) = |v|·(−k_D·v + k_L·ω̂ × v + knuckle), k = ½ρA·C/m, has the
     Jacobian ∂a/∂v; for drag alone its eigenvalues are −k_D|v| (twice, across the motion) and −2k_D|v| (along it).
@@ -114,6 +115,10 @@ def max_stable_step(launch, kick, config):
     the speed never passes max(|v₀|, √(|g|/c)) (d|v|²/dt ≤ 2|v|(|g| − c|v|²)) nor, under downward gravity,
     √(|v₀|² + 2g·(z₀ − ground)) (|v|² + 2gz never grows); and never |v₀| + |g|·t_max. The measured C_D's bound at
     that speed is max(0.501, 0.4127·max(S, 0.05)^0.3056), S = r|ω|/|v| (C_D·|v| grows with |v| under both fits).
+
+    On a pitch a bounce can turn the spin's energy into speed (per unit mass ½α·R²·|ω|², α·R² = ``spin_inertia``),
+    and can spin up a ball launched without spin; so there the bound adds 2·√(α·R²)·|ω₀| in quadrature, the
+    margin of :func:`kernels.ball.play.play`'s energy guard, and the lift counts whatever the launch spin.
     """
     q, g = config[Q], config[GRAVITY]
     speed = _norm(launch[3:6])
@@ -128,14 +133,16 @@ def max_stable_step(launch, kick, config):
         if g > 0.0:
             height = max(launch[2] - config[GROUND], 0.0)
             fastest = min(fastest, math.sqrt(speed * speed + 2.0 * g * height))
+    if spin_inertia > 0.0 and kick[RATE] > 0.0:
+        fastest = math.hypot(fastest, 2.0 * math.sqrt(spin_inertia) * kick[RATE])
     if config[MEASURED] == 0.0:
         drag, lift = config[C_D], config[C_L]
     else:
         spin_parameter = config[RADIUS] * kick[RATE] / max(fastest, 1e-9)
         drag = max(_MEASURED_STILL_DRAG_MAX, 0.4127 * max(spin_parameter, 0.05) ** 0.3056)
         lift = _MEASURED_LIFT_MAX
-    if kick[RATE] == 0.0:
-        lift = 0.0  # no spin, no Magnus force
+    if kick[RATE] == 0.0 and spin_inertia == 0.0:
+        lift = 0.0  # no spin, no Magnus force (on a pitch a bounce may spin the ball up)
     rate = (q * (drag + lift) + knuckle) * fastest  # 1/s, ≥ ‖∂a/∂v‖ / 2
     beta = RK4_STABILITY if config[RK4] != 0.0 else EULER_STABILITY
     return (beta / (2.0 * rate) if rate > 0.0 else math.inf), fastest

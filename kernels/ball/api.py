@@ -189,25 +189,40 @@ def _round_down(value: float) -> float:
     return float(cut)  # the float nearest the cut, so printed with three digits it reads as the cut
 
 
-def _refuse_overflow(endings: NDArray[np.int64], config: NDArray[np.float64], launches: NDArray[np.float64]) -> None:
+def _refuse_overflow(
+    endings: NDArray[np.int64],
+    config: NDArray[np.float64],
+    launches: NDArray[np.float64],
+    pitches: NDArray[np.float64] | None = None,
+    pitch_of: NDArray[np.int64] | None = None,
+    strikes: bool = False,
+) -> None:
     """Raise where a kick's step was beyond the method's stability limit (ending 4, not flown), where its ball
     started inside a body of the pitch (ending 9, not flown), or where a flight overflowed to inf or NaN (ending 3: a
     step too long for its drag that the limit does not bound, or absurd input).
-    ``launches`` are the (K, 13) launch rows, for the limit the message names."""
+    ``launches`` are the (K, 13) launch rows, for the limit the message names; on a pitch, where a bounce can turn
+    the spin into speed, kick k flew on ``pitches[pitch_of[k]]`` ((P, N_PITCH) rows). ``strikes``: the kicks are
+    strikes scattered about one intended kick, so a refusal names its ``speed_ms`` and ``spin_rads``."""
     refused = np.flatnonzero(endings == 4)
     if refused.size:
         first = int(refused[0])
-        limit, fastest = stable_step(launches[first], config)
-        which = "" if len(endings) == 1 else f" of kicks {refused[:5].tolist()}"
-        velocity = "velocity" if len(endings) == 1 else f"velocities[{first}]"
+        spin_inertia = 0.0 if pitches is None or pitch_of is None else _spin_inertia_bound(pitches[pitch_of[first]])
+        limit, fastest = stable_step(launches[first], config, spin_inertia)
+        single = len(endings) == 1
+        which = "" if single else f" of {'strikes' if strikes else 'kicks'} {refused[:5].tolist()}"
+        velocity, spin = ("velocity", "spin") if single or strikes else (f"velocities[{first}]", f"spins[{first}]")
         method = "rk4" if config[RK4] else "euler"
-        launched = math.hypot(*launches[first, 3:6].tolist())
+        launched = f"launched at |{velocity}| = {math.hypot(*launches[first, 3:6].tolist()):.3g} m/s"
+        smaller = "dt or speed_ms" if strikes else f"dt or {velocity}"
+        rate = math.hypot(*launches[first, 6:9].tolist())
+        if spin_inertia > 0.0 and rate > 0.0:
+            launched += f" and spinning at |{spin}| = {rate:.3g} rad/s, whose energy a bounce can turn into speed"
+            smaller = "dt, speed_ms or spin_rads" if strikes else f"dt, {velocity} or {spin}"
         raise ValueError(
             f"dt = {config[DT]:g} s is too long for this drag{which}: at most {_round_down(limit):.3g} s for "
             f"{method}, the method's stability limit with the drag at {fastest:.3g} m/s (the fastest this ball "
-            f"can fly, launched at |{velocity}| = {launched:.3g} m/s; see kernels.ball): a longer step overshoots "
-            f"the drag, reversing or amplifying the velocity; use a smaller dt or {velocity}, or a smaller "
-            "air_density or a larger mass_kg"
+            f"can fly, {launched}; see kernels.ball): a longer step overshoots the drag, reversing or amplifying "
+            f"the velocity; use a smaller {smaller}, or a smaller air_density or a larger mass_kg"
         )
     inside = np.flatnonzero(endings == 9)
     if inside.size:
@@ -420,7 +435,7 @@ def _simulate_on_pitch(launch: NDArray[np.float64], settings: NDArray[np.float64
     n, ending, t, state, spin, forces = int(n_samples[0]), int(endings[0]), t[0], state[0], spin[0], forces[0]
     events, info = events[0], info[0]
     if ending in (3, 4, 9):
-        _refuse_overflow(np.array([ending]), settings, launch[None])
+        _refuse_overflow(np.array([ending]), settings, launch[None], vector[None], _FIRST)
     return dataclasses.replace(
         _trajectory(t, state, forces, n, ending),
         events=_events(events, int(info[play.I_EVENTS])),
@@ -497,6 +512,12 @@ MAX_PITCH_LENGTH_M = 120.0
 """How far from the goal line a kick on a pitch may start (m; Law 1: a touchline is 90–120 m long)."""
 
 
+def _spin_inertia_bound(pitch: NDArray[np.float64]) -> float:
+    """:func:`kernels.ball.play.spin_inertia_bound` of one (N_PITCH,) pitch row, in the same operations."""
+    slots = (play.TURF_SURFACE, play.FRAME_SURFACE, play.BODY_SURFACE)
+    return max(0.0, *(float(pitch[slot + 4]) * float(pitch[slot + 3]) * float(pitch[slot + 3]) for slot in slots))
+
+
 MAX_PITCH_DT_S = 0.05
 """The longest step a flight on a pitch takes (s): contacts are found once a step, with the keeper where he is at its
 middle, so a coarser step can decide the verdict (the default kick, a goal at dt ≤ 0.1 s, was saved at 0.3 s)."""
@@ -564,6 +585,7 @@ def _play_batch(
     pitches: NDArray[np.float64],
     which: NDArray[np.int64],
     keep: bool,
+    strikes: bool = False,
 ) -> tuple[Any, ...]:
     """Every kick on its pitch (``pitches[which[k]]``, read-only (P, N_PITCH) rows), in parallel: (t, state, spin,
     events, info, n_samples, endings); flights kept only when ``keep`` (else zero-length rows, and each flight ends
@@ -576,7 +598,7 @@ def _play_batch(
     n_samples, endings = np.ones(k, dtype=np.int64), np.full(k, 2, dtype=np.int64)
     forces = np.empty((k, 0, 12))  # a batch keeps no forces
     run_rows(play_rows, k, launches, settings, pitches, which, t, state, spin, forces, events, info, n_samples, endings)
-    _refuse_overflow(endings, settings, launches)
+    _refuse_overflow(endings, settings, launches, pitches, which, strikes)
     return t, state, spin, events, info, n_samples, endings
 
 
@@ -602,15 +624,42 @@ def _placed_pitch(launches: NDArray[np.float64], settings: NDArray[np.float64], 
 
 
 def pitch_outcomes(
-    launches: NDArray[np.float64], settings: NDArray[np.float64], pitches: NDArray[np.float64], which: NDArray[np.int64]
+    launches: NDArray[np.float64],
+    settings: NDArray[np.float64],
+    pitches: NDArray[np.float64],
+    which: NDArray[np.int64],
+    strikes: bool = False,
 ) -> NDArray[np.int64]:
     """Result codes (:data:`RESULTS` order) of K checked launch rows (``kick_rows``) each on its own pitch row
     (``pitch_vector`` rows stacked, ``which[k]`` the row of kick k), in one parallel call: what a map over many spots
-    wants. Trusts its arguments (the callers in this package check them)."""
+    wants. Trusts its arguments (the callers in this package check them); ``strikes`` as for the refusal of
+    :func:`pitch_strike_outcomes`."""
     stacked = np.array(pitches, dtype=np.float64, order="C")
     stacked.setflags(write=False)
-    *_, info, _, _ = _play_batch(launches, settings, stacked, np.asarray(which, dtype=np.int64), keep=False)
+    *_, info, _, _ = _play_batch(launches, settings, stacked, np.asarray(which, dtype=np.int64), False, strikes)
     return info[:, play.I_RESULT].astype(np.int64)
+
+
+def pitch_strike_outcomes(
+    positions: ArrayLike, velocities: ArrayLike, spins: ArrayLike, pitch: Pitch, options: dict[str, Any]
+) -> BatchOutcome:
+    """:func:`simulate_outcomes` on ``pitch`` for strikes scattered about one intended kick: a step too long for
+    them is refused naming that kick's ``speed_ms`` and ``spin_rads``, the arguments its caller was given."""
+    options = dict(options)
+    config = options.pop("config", None)  # as simulate_outcomes takes it
+    settings, launches = _checked_batch(positions, velocities, spins, None, config, options)
+    return _pitch_outcome(launches, settings, pitch, strikes=True)
+
+
+def _pitch_outcome(
+    launches: NDArray[np.float64], settings: NDArray[np.float64], pitch: Pitch, strikes: bool
+) -> BatchOutcome:
+    *_, info, _, _ = _play_batch(launches, settings, *_one_pitch(launches, settings, pitch), False, strikes)
+    return BatchOutcome(
+        result=np.array(RESULTS, dtype="<U5")[info[:, play.I_RESULT].astype(np.int64)],
+        wall_point=info[:, play.I_WALL + 1 : play.I_WALL + 4].copy(),
+        goal_point=info[:, play.I_GOAL + 1 : play.I_GOAL + 4].copy(),
+    )
 
 
 def _batch_on_pitch(launches: NDArray[np.float64], settings: NDArray[np.float64], pitch: Pitch) -> BatchTrajectory:
@@ -756,12 +805,7 @@ def simulate_outcomes(
         _checks.instance("pitch", pitch, Pitch)
         if (wall is not None and wall != pitch.wall) or (goal is not None and goal != pitch.goal):
             raise ValueError("with a pitch, wall and goal are the pitch's own: pass None (or the same panels)")
-        *_, info, _, _ = _play_batch(launches, settings, *_one_pitch(launches, settings, pitch), keep=False)
-        return BatchOutcome(
-            result=np.array(RESULTS, dtype="<U5")[info[:, play.I_RESULT].astype(np.int64)],
-            wall_point=info[:, play.I_WALL + 1 : play.I_WALL + 4].copy(),
-            goal_point=info[:, play.I_GOAL + 1 : play.I_GOAL + 4].copy(),
-        )
+        return _pitch_outcome(launches, settings, pitch, strikes=False)
     if goal is None:
         raise ValueError("goal must be a Panel (or pass a pitch)")
     no_wall = wall is None

@@ -195,7 +195,7 @@ def _fly(launch, kick, config, t_out, state_out):
     """
     store = len(t_out) > 0
     dt, ground, x_stop = config[DT], config[GROUND], config[X_STOP]
-    refused = dt > max_stable_step(launch, kick, config)[0]
+    refused = dt > max_stable_step(launch, kick, config, 0.0)[0]
     n_steps = int(config[N_STEPS])
     x, y, z, vx, vy, vz = launch[0], launch[1], launch[2], launch[3], launch[4], launch[5]
     g = config[GRAVITY]
@@ -256,11 +256,12 @@ def simulate_one(launch, config, t_out, state_out, forces_out):
 
 
 @compiled(from_python=True)
-def stable_step(launch, config):
-    """(longest stable dt (s), fastest speed bound (m/s)) of one kick's (13,) launch row: what ending 4 compared."""
+def stable_step(launch, config, spin_inertia):
+    """(longest stable dt (s), fastest speed bound (m/s)) of one kick's (13,) launch row: what ending 4 compared
+    (``spin_inertia``: α·R² (m²) on a pitch, 0 in free flight; see :func:`~kernels.ball.aero.max_stable_step`)."""
     kick = np.empty(N_KICK)
     fill_kick(launch, config, kick)
-    return max_stable_step(launch, kick, config)
+    return max_stable_step(launch, kick, config, spin_inertia)
 
 
 @compiled(from_python=True, nogil=True)

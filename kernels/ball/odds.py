@@ -20,7 +20,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from kernels import _checks
 from kernels.ball import play
-from kernels.ball.api import pitch_outcomes, simulate_outcomes
+from kernels.ball.api import pitch_outcomes, pitch_strike_outcomes
 from kernels.ball.config import GROUND, RADIUS, check_launches, checked_seed, checked_vector, flight_config
 from kernels.ball.core import RESULTS
 from kernels.ball.pitch import (
@@ -188,7 +188,7 @@ def strike_odds(
         speed_ms, elevation_rad, azimuth_rad, spin_rads, StrikeSpread() if spread is None else spread, n, draw
     )
     starts = np.broadcast_to(start, velocities.shape)
-    judged = simulate_outcomes(starts, velocities, spins, pitch=pitch, **options)
+    judged = pitch_strike_outcomes(starts, velocities, spins, pitch, options)
     return Odds(judged.counts(), len(velocities))
 
 
@@ -276,7 +276,7 @@ def odds_map(
     bounds = np.linspace(0, len(spots), min(chunks, max(len(spots), 1)) + 1).astype(int)
     for lo, hi in itertools.pairwise(bounds.tolist()):
         a, b = lo * len(velocities), hi * len(velocities)
-        codes[a:b] = pitch_outcomes(launches[a:b], settings, vectors[lo:hi], which[a:b] - lo)
+        codes[a:b] = pitch_outcomes(launches[a:b], settings, vectors[lo:hi], which[a:b] - lo, strikes=True)
         if progress is not None:
             progress(hi / len(spots))
     per_spot = codes.reshape(len(spots), len(velocities))

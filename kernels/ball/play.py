@@ -206,6 +206,16 @@ def _keeper_pose(pitch, dive_t, target, t):
 
 
 @compiled()
+def spin_inertia_bound(pitch):
+    """The largest α·R² (m²) of the ball in the pitch's surface slots (turf, frame, bodies): how much of the spin's
+    energy a contact can turn into speed (:func:`~kernels.ball.aero.max_stable_step`)."""
+    bound = 0.0
+    for slot in (TURF_SURFACE, FRAME_SURFACE, BODY_SURFACE):
+        bound = max(bound, pitch[slot + 4] * pitch[slot + 3] * pitch[slot + 3])
+    return bound
+
+
+@compiled()
 def _keeper_capsule(pitch, dive_t, target, t, cap):
     """The keeper's capsule at time ``t`` into ``cap`` (8,): a stick from feet to fingertips through the centre of
     mass (:func:`_keeper_pose`), its ends pulled in by the body's radius and kept above the turf."""
@@ -644,7 +654,7 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
     energy_limit = _energy_limit(vx, vy, vz, z, g) + 4.0 * spin_energy
     if store:
         _write_spin_sample(t_out, state_out, spin_out, 0, 0.0, x, y, z, vx, vy, vz, wx, wy, wz)
-    refused = dt > max_stable_step(launch, kick, config)[0]
+    refused = dt > max_stable_step(launch, kick, config, spin_inertia_bound(pitch))[0]
     if refused:
         info[I_RESULT] = SHORT
         return 1, REFUSED

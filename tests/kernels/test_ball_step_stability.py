@@ -148,45 +148,55 @@ def test_a_flight_is_refused_naming_dt_or_lands_ahead_as_the_reference_does(
 # alone, where a batch named the limit and the speed. Every path must give the one refusal, naming the velocity.
 _WALL, _GOAL = ball.free_kick_panels((0.0, 0.0), (20.0, 0.0), (1.0, 0.0))
 _PITCH = ball.Pitch(_GOAL, _WALL, ball.Keeper())
+_ALPHA = 2.0 / 3.0  # I/(m·R²) of the ball's thin shell, the pitch's
+_C_L = ball.FlightConfig().lift_coefficient
 
 
-def _refusals(velocity: np.ndarray, method: ball.Method, dt: float) -> list[str]:
-    """The message of each path's refusal of one kick from (0, 0, 1): alone, on a pitch, second of a batch, second
-    of a batch judged against a wall and goal."""
+def _q(density: float) -> float:
+    """½ρA/m (1/m) of the default ball."""
+    return _drag_factor(density) / C_D
+
+
+def _refusals(velocity: np.ndarray, method: ball.Method, dt: float) -> list[tuple[str, bool]]:
+    """Each path's refusal of one kick from (0, 0, 1), and whether it flew on a pitch: alone, alone on a pitch,
+    second of a batch, second of a batch judged against a wall and goal, second of a batch on a pitch."""
     start, still = (0.0, 0.0, 1.0), (0.0, 0.0, 0.0)
     pair = np.array([(5.0, 0.0, 1.0), velocity])  # a calm kick, then this one
     calls = [
-        lambda: ball.simulate(start, velocity, still, method=method, dt=dt),
-        lambda: ball.simulate(start, velocity, still, method=method, dt=dt, pitch=_PITCH),
-        lambda: ball.simulate_batch([start] * 2, pair, [still] * 2, method=method, dt=dt),
-        lambda: ball.simulate_outcomes([start] * 2, pair, [still] * 2, _WALL, _GOAL, method=method, dt=dt),
+        (lambda: ball.simulate(start, velocity, still, method=method, dt=dt), False),
+        (lambda: ball.simulate(start, velocity, still, method=method, dt=dt, pitch=_PITCH), True),
+        (lambda: ball.simulate_batch([start] * 2, pair, [still] * 2, method=method, dt=dt), False),
+        (lambda: ball.simulate_outcomes([start] * 2, pair, [still] * 2, _WALL, _GOAL, method=method, dt=dt), False),
+        (lambda: ball.simulate_outcomes([start] * 2, pair, [still] * 2, pitch=_PITCH, method=method, dt=dt), True),
     ]
-    messages = []
-    for call in calls:
+    refusals = []
+    for call, on_pitch in calls:
         with pytest.raises(ValueError) as caught:
             call()
-        messages.append(str(caught.value))
-    return messages
+        refusals.append((str(caught.value), on_pitch))
+    return refusals
 
 
 def _check_refusals(velocity: np.ndarray, method: ball.Method, dt: float) -> None:
     speed = math.hypot(*velocity)
-    alone, on_pitch, batch, judged = _refusals(velocity, method, dt)
-    # The limit 1/(k·|v|) for Euler (β/(2k|v|), β = 2.7853, for RK4): no spin, and the speed only falls from |v0|.
+    refusals = _refusals(velocity, method, dt)
+    # The limit β/(2q·C·|v|), β = 2 for Euler and 2.7853 for RK4: the speed only falls from |v0|. C is C_D in free
+    # flight without spin; on a pitch C_D + C_L, as a bounce can spin the ball up.
     beta = 2.0 if method == "euler" else 2.785293563405289
-    expected = beta / (2.0 * _drag_factor(ball.AIR_DENSITY) * speed)
-    for message, name, which in (
-        (alone, "velocity", ""),
-        (on_pitch, "velocity", ""),
-        (batch, "velocities[1]", " of kicks [1]"),
-        (judged, "velocities[1]", " of kicks [1]"),
+    for (message, on_pitch), name, which in zip(
+        refusals,
+        ["velocity", "velocity", "velocities[1]", "velocities[1]", "velocities[1]"],
+        ["", "", " of kicks [1]", " of kicks [1]", " of kicks [1]"],
+        strict=True,
     ):
+        expected = beta / (2.0 * _q(ball.AIR_DENSITY) * (C_D + (_C_L if on_pitch else 0.0)) * speed)
         assert message.startswith(f"dt = {dt:g} s is too long for this drag{which}: at most "), message
-        assert f"launched at |{name}| = {speed:.3g} m/s" in message, message
+        assert f"launched at |{name}| = {speed:.3g} m/s;" in message, message  # no spin to name
         assert f"use a smaller dt or {name}" in message, message
         limit = _limit_named(ValueError(message))  # cut to three digits
         assert limit == pytest.approx(expected, rel=1e-2) and limit <= expected, message
-    assert alone == on_pitch and batch == judged
+    assert refusals[0][0] == refusals[2][0].replace(" of kicks [1]", "").replace("velocities[1]", "velocity")
+    assert refusals[2][0] == refusals[3][0]
 
 
 @pytest.mark.parametrize("speed", [1e6, 1.3e154, 1.4e154, 1e200, 1.7e308])
@@ -207,6 +217,66 @@ def test_every_path_refuses_a_too_fast_launch_alike(
     speed = min(math.exp(log_speed), 1.7e308)
     d = np.array(direction) / math.hypot(*direction)
     _check_refusals(speed * d, method, dt)
+
+
+# --------------------------------------------------------------------------------------------- spin into speed
+# The fault's kind: on a pitch a bounce turns spin into speed, which the limit did not count. A ball launched at
+# 15 m/s with 1e20 rad/s of backspin left the turf at 4.4e18 m/s and flew on, its 1 ms steps 1e14 times its
+# stability limit, to a verdict; at 1e300 rad/s it overflowed and the refusal blamed dt alone.
+def _stable_along(flight: ball.Trajectory, dt: float, method: ball.Method) -> bool:
+    """Whether every step of a constant-coefficient flight lay inside its method's interval: q(C_D + C_L)|v|·dt ≤
+    β/2 at each sample's speed (the Jacobian bound of kernels.ball.aero.max_stable_step)."""
+    beta = 2.0 if method == "euler" else 2.785293563405289
+    speeds = np.linalg.norm(flight.velocity, axis=1)
+    return bool((_q(ball.AIR_DENSITY) * (C_D + _C_L) * speeds * dt <= beta / 2.0).all())
+
+
+def test_backspin_a_bounce_turns_into_speed_is_refused_naming_the_spin() -> None:
+    velocity, spin = (15.0, 0.0, 3.0), (0.0, 1e20, 0.0)
+    with pytest.raises(ValueError) as caught:
+        ball.simulate((0.0, 0.0, 1.0), velocity, spin, dt=1e-3, pitch=_PITCH)
+    message = str(caught.value)
+    assert "and spinning at |spin| = 1e+20 rad/s, whose energy a bounce can turn into speed" in message
+    assert "use a smaller dt, velocity or spin" in message
+    # The fastest is the spin's: 2·√α·R·|ω| (the launch's 15.3 m/s is 1e-38 of it in quadrature).
+    fastest = 2.0 * math.sqrt(_ALPHA) * ball.BALL_RADIUS_M * 1e20
+    expected = 2.0 / (2.0 * _q(ball.AIR_DENSITY) * (C_D + _C_L) * fastest)
+    assert _limit_named(caught.value) == pytest.approx(expected, rel=1e-2)
+    # In free flight there is nothing to bounce off: the same kick flies, its spin's axis alone mattering.
+    assert ball.simulate((0.0, 0.0, 1.0), velocity, spin, dt=1e-3).ended == "ground"
+    # A strike's odds and an odds map name their own arguments.
+    for call in (
+        lambda: ball.strike_odds((-20.0, 0.0, 0.11), 25.0, 0.3, 0.05, (0.0, 1e300, 0.0), _PITCH, n=20),
+        lambda: ball.odds_map([20.0], [0.0], 25.0, 0.3, 0.05, (0.0, 1e300, 0.0), n=8),
+    ):
+        with pytest.raises(
+            ValueError, match=r"of strikes \[0, 1, 2, 3, 4\]: .* use a smaller dt, speed_ms or spin_rads"
+        ):
+            call()
+
+
+@given(
+    speed=st.floats(5.0, 40.0),
+    elevation=st.floats(-0.1, 0.6),
+    log_spin=st.floats(0.0, math.log(1e8)),
+    axis=st.tuples(*[st.floats(-1.0, 1.0)] * 3).filter(lambda a: math.hypot(*a) > 0.1),
+    dt=st.floats(math.log(1e-4), math.log(0.05)).map(lambda x: min(math.exp(x), 0.05)),
+    method=st.sampled_from(("euler", "rk4")),
+)
+@settings(max_examples=examples(60), deadline=None)
+def test_a_flight_on_a_pitch_is_refused_or_stays_within_its_stability_limit(
+    speed: float, elevation: float, log_spin: float, axis: tuple[float, float, float], dt: float, method: ball.Method
+) -> None:
+    velocity = speed * np.array([math.cos(elevation), 0.0, math.sin(elevation)])
+    spin = math.exp(log_spin) * np.array(axis) / math.hypot(*axis)
+    try:
+        flight = ball.simulate((0.0, 0.0, 0.3), velocity, spin, dt=dt, method=method, pitch=_PITCH, t_max=4.0)
+    except ValueError as error:
+        assert str(error).startswith(f"dt = {dt:g} s is too long for this drag: at most "), str(error)
+        assert _limit_named(error) < dt
+        assert f"and spinning at |spin| = {math.exp(log_spin):.3g} rad/s" in str(error)
+        return
+    assert _stable_along(flight, dt, method)
 
 
 # --------------------------------------------------------------------------------------------- the scene
