@@ -58,6 +58,7 @@ SCALE_HEIGHT_M = 8500.0
 """Scale height of the seed's exponential atmosphere (m)."""
 
 DraftModel = Literal["seed", "measured"]
+DRAFT_MODELS: tuple[DraftModel, ...] = ("seed", "measured")
 
 # "measured" drafting model constants (see the module docstring for the sources).
 _MEASURED_PLATEAU = (0.40, 0.48, 0.50)  # positions 2, 3, 4+ at zero gap
@@ -86,23 +87,57 @@ _positive = _checks.positive_array
 _non_negative = _checks.non_negative_array
 
 
+def _shown(value: object) -> str:
+    """``value`` for a message: a number as given, an array as its first few values and its shape."""
+    if isinstance(value, (np.ndarray, list, tuple)) and np.size(value) > 3:
+        flat = np.asarray(value, dtype=object).ravel()
+        return f"[{', '.join(repr(v) for v in flat[:3].tolist())}, ...] (shape {np.shape(value)})"
+    return repr(value)
+
+
+def _broadcast(**values: ArrayLike) -> None:
+    """``ValueError`` naming the first of ``values`` whose shape does not broadcast with the ones before it (numpy
+    would say "operands could not be broadcast together" and name none)."""
+    shape: tuple[int, ...] = ()
+    for name, value in values.items():
+        here = np.shape(value)
+        try:
+            shape = np.broadcast_shapes(shape, here)
+        except ValueError as error:
+            raise ValueError(
+                f"{name} must broadcast with the shape {shape} of the arguments before it, got {here}"
+            ) from error
+
+
 def _efficiency(value: ArrayLike) -> NDArray[np.float64]:
     array = _finite("drivetrain_efficiency", value)
     if np.any((array < 1e-3) | (array > 1.0)):  # a thousandth: far below any drivetrain, and no overflow
-        raise ValueError(f"drivetrain_efficiency must be in [0.001, 1], got {value!r}")
+        raise ValueError(f"drivetrain_efficiency must be in [0.001, 1], got {_shown(value)}")
     return array
+
+
+AIR_DENSITY_ALTITUDE_M = (-10_000.0, 30_000.0)
+"""Altitudes :func:`air_density` takes (m): from 10 km below sea level (the deepest a course may reach,
+:data:`kernels.course.MIN_ELEVATION_M`; 3.97 kg/m³ there) to 30 km, where :data:`MODEL_DOMAIN` stops (the
+exponential atmosphere is no air above). Beyond them it gave 157 573 kg/m³ at −100 km and inf at −10³⁰⁰ m."""
 
 
 def air_density(altitude_m: ArrayLike) -> NDArray[np.float64]:
     """Air density of the seed's exponential atmosphere, 1.225·exp(−h/8500).
 
     Args:
-        altitude_m: altitude above sea level (m), any shape.
+        altitude_m: altitude above sea level (m, −10 000 to 30 000: :data:`AIR_DENSITY_ALTITUDE_M`), any shape.
 
     Returns:
         Density (kg/m³), same shape.
+
+    Raises:
+        ValueError: an altitude is not a finite number or outside its range; the message names ``altitude_m``.
     """
     h = _finite("altitude_m", altitude_m)
+    low, high = AIR_DENSITY_ALTITUDE_M
+    if np.any((h < low) | (h > high)):
+        raise ValueError(f"altitude_m must be in [{low:g}, {high:g}] m, got {_shown(altitude_m)}")
     return RHO_SEA_LEVEL * np.exp(-h / SCALE_HEIGHT_M)
 
 
@@ -127,8 +162,7 @@ def drag_reduction(n_riders: int, gap_m: float, model: DraftModel = "measured") 
     if n_riders > MAX_FORMATION_RIDERS:  # 10¹² riders asked numpy for 7 TiB
         raise ValueError(f"n_riders must be at most {MAX_FORMATION_RIDERS}, got {n_riders!r}")
     gap = _checks.non_negative("gap_m", gap_m)  # one gap: an array raised numpy's TypeError
-    if model not in ("seed", "measured"):  # checked for one rider too
-        raise ValueError(f"model must be 'seed' or 'measured', got {model!r}")
+    _checks.choice("model", model, DRAFT_MODELS)  # checked for one rider too
     reduction = np.zeros(int(n_riders))
     if n_riders == 1:
         return reduction
@@ -176,11 +210,32 @@ def road_forces(
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Rolling and climbing forces along the road (N): Crr·m·g·cos θ and m·g·sin θ, with θ = atan(grade).
 
-    Inputs are trusted (checked by the caller: mass > 0, Crr ≥ 0, grade finite); outputs broadcast.
+    Args:
+        mass_kg: rider plus bike (kg, > 0, at most 10⁶: :data:`MODEL_DOMAIN`).
+        crr: rolling-resistance coefficient (0 to 1).
+        grade: rise over run, any finite value.
+
+    Returns:
+        The two forces, with the broadcast shape of the inputs.
+
+    Raises:
+        ValueError: an argument is not finite, out of its range or of a shape that does not broadcast; the message
+            names it.
     """
+    mass = _positive("mass_kg", mass_kg)
+    friction = _non_negative("crr", crr)
+    slope = _finite("grade", grade)
+    _check_domain("road_forces", MODEL_DOMAIN, mass_kg=mass, crr=friction)
+    _broadcast(mass_kg=mass, crr=friction, grade=slope)
+    return _road_forces(mass, friction, slope)
+
+
+def _road_forces(
+    mass: NDArray[np.float64], crr: NDArray[np.float64], grade: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """:func:`road_forces` of inputs its callers checked."""
     theta = np.arctan(grade)
-    mass = np.asarray(mass_kg, dtype=np.float64)
-    return np.asarray(crr, dtype=np.float64) * mass * G * np.cos(theta), mass * G * np.sin(theta)
+    return crr * mass * G * np.cos(theta), mass * G * np.sin(theta)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -206,7 +261,7 @@ def _resistance(
     headwind_ms: ArrayLike,
     drivetrain_efficiency: ArrayLike,
 ) -> _Resistance:
-    rolling_force, climbing_force = road_forces(
+    rolling_force, climbing_force = _road_forces(
         _positive("mass_kg", mass_kg), _non_negative("crr", crr), _finite("grade", grade)
     )
     return _Resistance(
@@ -244,6 +299,16 @@ def power(
         :class:`Power` with the broadcast shape of the inputs.
     """
     _check_model_domain(cda_m2, mass_kg, crr, altitude_m, headwind_ms, speed_ms, "power")
+    _broadcast(
+        speed_ms=speed_ms,
+        cda_m2=cda_m2,
+        mass_kg=mass_kg,
+        crr=crr,
+        grade=_finite("grade", grade),
+        altitude_m=altitude_m,
+        headwind_ms=headwind_ms,
+        drivetrain_efficiency=_efficiency(drivetrain_efficiency),
+    )
     return _power(speed_ms, cda_m2, mass_kg, crr, grade, altitude_m, headwind_ms, drivetrain_efficiency)
 
 
@@ -323,6 +388,16 @@ def speed_for_power(
         altitude_m=altitude_m,
         headwind_ms=headwind_ms,
     )
+    _broadcast(
+        power_w=target,
+        cda_m2=cda_m2,
+        mass_kg=mass_kg,
+        crr=crr,
+        grade=_finite("grade", grade),
+        altitude_m=altitude_m,
+        headwind_ms=headwind_ms,
+        drivetrain_efficiency=_efficiency(drivetrain_efficiency),
+    )
     r = _resistance(cda_m2, mass_kg, crr, grade, altitude_m, headwind_ms, drivetrain_efficiency)
     # Validated above. Rolling plus climbing as m·g·cos θ·(Crr + grade), which is exactly 0 where Crr = −grade
     # (the sum of the two forces would leave rounding there, and its square root would move v_c); the ratio
@@ -373,7 +448,7 @@ def _check_domain(function: str, domain: dict[str, tuple[float, float]], **value
         low, high = domain[name]
         array = _finite(name, value)
         if np.any((array < low) | (array > high)):
-            raise ValueError(f"{name} must be in [{low:g}, {high:g}] for {function}, got {value!r}")
+            raise ValueError(f"{name} must be in [{low:g}, {high:g}] for {function}, got {_shown(value)}")
 
 
 class _PowerBalance(NamedTuple):
@@ -533,10 +608,13 @@ def paceline(
         n_riders: riders in the line (1 to :data:`MAX_FORMATION_RIDERS`, 200).
         gap_m: wheel-to-wheel gap (m, ≥ 0).
         model: ``"seed"`` or ``"measured"`` drafting (see the module docstring).
-        Other arguments as for :func:`power`, for one rider.
+        Other arguments as for :func:`power`, for one rider: each one number (the riders are alike).
 
     Returns:
         :class:`Power` whose fields have shape (n_riders,).
+
+    Raises:
+        ValueError: an argument is not a number (an array included) or out of its range; the message names it.
     """
     return _group_power(
         "paceline",
@@ -568,17 +646,31 @@ def _group_power(
     ((N,) fractions of a lone rider's drag), which is called once the rider's own inputs are checked against
     :data:`MODEL_DOMAIN` (``function`` names the caller in the message)."""
     speed = _checks.non_negative("speed_ms", speed_ms)  # the group's one speed
-    _check_model_domain(cda_m2, mass_kg, crr, altitude_m, headwind_ms, speed, function)
+    # One rider's numbers, each a number: an array of another length than the group raised numpy's "operands
+    # could not be broadcast together", naming none of them.
+    cda, mass, friction, slope, altitude, wind, efficiency = (
+        _checks.finite_number(name, value)
+        for name, value in (
+            ("cda_m2", cda_m2),
+            ("mass_kg", mass_kg),
+            ("crr", crr),
+            ("grade", grade),
+            ("altitude_m", altitude_m),
+            ("headwind_ms", headwind_ms),
+            ("drivetrain_efficiency", drivetrain_efficiency),
+        )
+    )
+    _check_model_domain(cda, mass, friction, altitude, wind, speed, function)
     drag = drag_fraction()
     return _power(
         np.full(drag.shape, speed),
-        _positive("cda_m2", cda_m2) * drag,
-        mass_kg,
-        crr,
-        grade,
-        altitude_m,
-        headwind_ms,
-        drivetrain_efficiency,
+        _positive("cda_m2", cda) * drag,
+        mass,
+        friction,
+        slope,
+        altitude,
+        wind,
+        efficiency,
     )
 
 
@@ -621,7 +713,7 @@ def saturation_vapour_pressure_hpa(temperature_c: ArrayLike) -> NDArray[np.float
     """
     t = _finite("temperature_c", temperature_c)
     if np.any((t < -60.0) | (t > 60.0)):
-        raise ValueError(f"temperature_c must be in [-60, 60] °C, got {temperature_c!r}")
+        raise ValueError(f"temperature_c must be in [-60, 60] °C, got {_shown(temperature_c)}")
     return 6.1121 * np.exp(17.502 * t / (240.97 + t))
 
 
@@ -650,10 +742,11 @@ def air_density_weather(
     t_k = _finite("temperature_c", temperature_c) + _KELVIN
     p = _finite("pressure_hpa", pressure_hpa)
     if np.any((p < 10.0) | (p > 1100.0)):
-        raise ValueError(f"pressure_hpa must be in [10, 1100] hPa, got {pressure_hpa!r}")
+        raise ValueError(f"pressure_hpa must be in [10, 1100] hPa, got {_shown(pressure_hpa)}")
     rh = _finite("relative_humidity", relative_humidity)
     if np.any((rh < 0.0) | (rh > 1.0)):
-        raise ValueError(f"relative_humidity must be a fraction in [0, 1], got {relative_humidity!r}")
+        raise ValueError(f"relative_humidity must be a fraction in [0, 1], got {_shown(relative_humidity)}")
+    _broadcast(temperature_c=t_k, pressure_hpa=p, relative_humidity=rh)
     e = rh * e_s
     if np.any(e >= p):
         raise ValueError("relative_humidity: the vapour pressure would reach the total pressure")
@@ -667,7 +760,7 @@ def _isa_altitude(altitude_m: ArrayLike) -> NDArray[np.float64]:
     """Geopotential altitude H = r₀·h/(r₀ + h) of the geometric altitude h (what a map or a GPS gives)."""
     h = _finite("altitude_m", altitude_m)
     if np.any((h < -1000.0) | (h > _ISA_TOP_M)):
-        raise ValueError(f"altitude_m must be in [-1000, 20000] m, got {altitude_m!r}")
+        raise ValueError(f"altitude_m must be in [-1000, 20000] m, got {_shown(altitude_m)}")
     return _EARTH_RADIUS_ISA_M * h / (_EARTH_RADIUS_ISA_M + h)
 
 
@@ -806,8 +899,23 @@ def martin_power(
     radius = _positive("wheel_radius_m", wheel_radius_m)
     acceleration = _finite("acceleration_ms2", acceleration_ms2)
     efficiency = _efficiency(drivetrain_efficiency)
+    friction = _non_negative("crr", crr)
+    _broadcast(
+        speed_ms=v,
+        cda_m2=cda_m2,
+        mass_kg=mass,
+        crr=friction,
+        grade=slope,
+        headwind_ms=wind,
+        air_density=rho,
+        drivetrain_efficiency=efficiency,
+        spoke_drag_m2=spoke_drag_m2,
+        wheel_inertia_kgm2=inertia,
+        wheel_radius_m=radius,
+        acceleration_ms2=acceleration,
+    )
 
-    rolling_force, climbing_force = road_forces(mass, _non_negative("crr", crr), slope)
+    rolling_force, climbing_force = _road_forces(mass, friction, slope)
     aero, rolling, bearings, climbing = wheel_power_terms(
         v, 0.5 * rho * drag_area, rolling_force, climbing_force, wind, *MARTIN_BEARING_W
     )
@@ -894,6 +1002,7 @@ def formation(
     lateral = _checks.finite_number("lateral_m", lateral_m)
     if not 0.3 <= lateral <= 5.0:
         raise ValueError(f"lateral_m must be in [0.3, 5] m, got {lateral_m!r}")
+    _checks.choice("shape", shape, FORMATION_SHAPES)
     n = int(n_riders)
     k = np.arange(n, dtype=np.float64)
     step = BIKE_LENGTH_M + gap
@@ -1004,8 +1113,7 @@ def formation_drag(
     pos = _checks.bounded_array("positions_xy", positions_xy, 1e6)
     if pos.ndim != 2 or pos.shape[1] != 2 or not 1 <= pos.shape[0] <= 2000:
         raise ValueError(f"positions_xy must have shape (N, 2) with 1 <= N <= 2000, got {pos.shape}")
-    if model not in ("seed", "measured"):
-        raise ValueError(f"model must be 'seed' or 'measured', got {model!r}")
+    _checks.choice("model", model, DRAFT_MODELS)
     yaw = _checks.finite_number("yaw_rad", yaw_rad)
     if not abs(yaw) < 0.5 * math.pi:
         raise ValueError(f"yaw_rad must be in (-pi/2, pi/2), got {yaw_rad!r}")
@@ -1053,10 +1161,13 @@ def formation_power(
     Args:
         positions_xy: (N, 2) rider positions (m), as for :func:`formation_drag`.
         model: ``"measured"`` or ``"seed"`` (see :func:`formation_drag`).
-        Other arguments as for :func:`power`, for one rider riding alone.
+        Other arguments as for :func:`power`, for one rider riding alone: each one number (the riders are alike).
 
     Returns:
         :class:`Power` whose fields have shape (N,), in the order of ``positions_xy``.
+
+    Raises:
+        ValueError: an argument is not a number (an array included) or out of its range; the message names it.
     """
     return _group_power(
         "formation_power",

@@ -401,3 +401,99 @@ def test_a_group_at_the_cda_floor_is_accepted_though_drafting_takes_it_below() -
     group = cycling.formation_power(np.column_stack([x, y]), 10.0, 0.3, 80.0, 0.004)
     rolling = float(cycling.power(10.0, 0.3, 80.0, 0.004).rolling)
     assert np.all(group.total >= rolling) and np.all(np.isfinite(group.total))
+
+
+# Kind: an array for one rider's number in a group leaked numpy's "operands could not be broadcast together".
+GROUP_ARGUMENTS = ["cda_m2", "mass_kg", "crr", "grade", "altitude_m", "headwind_ms", "drivetrain_efficiency"]
+GROUP_BASE = {"speed_ms": 10.0, "cda_m2": 0.3, "mass_kg": 80.0, "crr": 0.004}
+BAD_NUMBERS: list[Any] = [None, "1", True, object(), 1 + 2j, 10**400, math.nan, math.inf, -math.inf]
+
+
+@pytest.mark.parametrize("value", [[0.3, 0.3, 0.3, 0.3], np.array([0.1, 0.2]), *BAD_NUMBERS])
+@pytest.mark.parametrize("name", GROUP_ARGUMENTS)
+def test_a_groups_rider_numbers_are_one_number_each(name: str, value: Any) -> None:
+    with pytest.raises(ValueError, match=f"^{name} must"):
+        cycling.paceline(3, 1.0, **{**GROUP_BASE, name: value})
+    with pytest.raises(ValueError, match=f"^{name} must"):
+        cycling.formation_power([[0.0, 0.0], [-2.0, 0.0], [-4.0, 0.0]], **{**GROUP_BASE, name: value})
+
+
+@pytest.mark.parametrize("name", ["cda_m2", "mass_kg", "crr", "grade", "altitude_m", "headwind_ms"])
+def test_power_names_the_argument_whose_shape_does_not_broadcast(name: str) -> None:
+    # The first argument whose shape does not fit those before it (speed_ms, (3,)) is named.
+    args: dict[str, Any] = {**GROUP_BASE, "speed_ms": [8.0, 9.0, 10.0]}
+    args[name] = [1.0, 1.0, 1.0, 1.0] if name != "crr" else [0.004] * 4
+    with pytest.raises(ValueError, match=f"^{name} must broadcast"):
+        cycling.power(**args)
+
+
+def test_speed_for_power_and_martin_power_name_a_shape_that_does_not_broadcast() -> None:
+    with pytest.raises(ValueError, match=r"^mass_kg must broadcast"):
+        cycling.speed_for_power([100.0, 200.0, 300.0], 0.3, [80.0, 81.0], 0.004)
+    with pytest.raises(ValueError, match=r"^air_density must broadcast"):
+        cycling.martin_power([8.0, 9.0, 10.0], 0.3, 80.0, 0.004, air_density=[1.2, 1.1])
+    with pytest.raises(ValueError, match=r"^relative_humidity must broadcast"):
+        cycling.air_density_weather([10.0, 20.0, 30.0], 1000.0, [0.1, 0.2])
+
+
+# Kind: an array or a non-string as a string choice raised "truth value of an array is ambiguous".
+@pytest.mark.parametrize("value", [None, math.nan, object(), 1, np.array(["seed", "seed"]), np.array("seed")])
+def test_a_model_or_shape_must_be_one_of_its_strings(value: Any) -> None:
+    with pytest.raises(ValueError, match=r"^model must be one of 'seed', 'measured'"):
+        cycling.paceline(3, 1.0, 10.0, 0.3, 80.0, 0.004, model=value)
+    with pytest.raises(ValueError, match=r"^model must be one of"):
+        cycling.drag_reduction(3, 1.0, model=value)
+    with pytest.raises(ValueError, match=r"^model must be one of"):
+        cycling.formation_drag([[0.0, 0.0], [-2.0, 0.0]], model=value)
+    with pytest.raises(ValueError, match=r"^model must be one of"):
+        cycling.formation_power([[0.0, 0.0], [-2.0, 0.0]], 10.0, 0.3, 80.0, 0.004, model=value)
+    with pytest.raises(ValueError, match=r"^shape must be one of"):
+        cycling.formation(3, value)
+
+
+# Kind: the exponential atmosphere beyond any air (157 573 kg/m³ at −100 km, inf at −10³⁰⁰ m).
+@pytest.mark.parametrize("altitude_m", [-1e300, -1e5, -10_000.001, 30_000.001, 1e300, [0.0, -1e5], *BAD_NUMBERS])
+def test_air_density_refuses_an_altitude_off_its_range_by_name(altitude_m: Any) -> None:
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(ValueError, match=r"^altitude_m must"):
+            cycling.air_density(altitude_m)
+
+
+@pytest.mark.parametrize(("altitude_m", "density"), [(-10_000.0, 1.225 * math.exp(10 / 8.5)), (0.0, 1.225)])
+def test_air_density_at_the_ends_of_its_range(altitude_m: float, density: float) -> None:
+    assert float(cycling.air_density(altitude_m)) == pytest.approx(density, rel=1e-15)
+    assert float(cycling.air_density(30_000.0)) == pytest.approx(1.225 * math.exp(-30 / 8.5), rel=1e-15)
+
+
+def test_an_air_density_message_shows_a_few_values_not_the_array() -> None:
+    with pytest.raises(ValueError, match=r"^altitude_m must be in") as refused:
+        cycling.air_density(np.full(5000, -1e5))
+    assert len(str(refused.value)) < 200
+
+
+# Kind: road_forces is public and trusted its inputs ((nan, nan) for None, "1", True).
+@pytest.mark.parametrize(
+    ("mass_kg", "crr", "grade", "name"),
+    [
+        (None, 0.004, 0.0, "mass_kg"),
+        ("80", 0.004, 0.0, "mass_kg"),
+        (-80.0, 0.004, 0.0, "mass_kg"),
+        (1e300, 0.004, 0.0, "mass_kg"),
+        (80.0, "1", 0.0, "crr"),
+        (80.0, -0.1, 0.0, "crr"),
+        (80.0, 2.0, 0.0, "crr"),
+        (80.0, 0.004, True, "grade"),
+        (80.0, 0.004, math.nan, "grade"),
+        (80.0, 0.004, [0.0, 0.1, 0.2], "grade"),
+    ],
+)
+def test_road_forces_refuse_bad_input_by_name(mass_kg: Any, crr: Any, grade: Any, name: str) -> None:
+    with pytest.raises(ValueError, match=f"^{name} must"):
+        cycling.road_forces([80.0, 90.0] if name == "grade" and np.ndim(grade) else mass_kg, crr, grade)
+
+
+def test_road_forces_on_a_slope() -> None:
+    rolling, climbing = cycling.road_forces(80.0, 0.004, 0.75)  # a 3-4-5 triangle: cos 0.8, sin 0.6
+    assert float(rolling) == pytest.approx(0.004 * 80.0 * cycling.G * 0.8)
+    assert float(climbing) == pytest.approx(80.0 * cycling.G * 0.6)
