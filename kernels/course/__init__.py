@@ -7,7 +7,7 @@ W, rad); headings are compass bearings, clockwise from north, in radians.
 **Course.** :func:`load_gpx` reads the track and route points of a GPX file with gpxpy. Segment lengths on the map are great-circle
 (haversine) distances on a sphere of radius 6 371 008.8 m (the IUGG mean Earth radius); headings are the initial
 great-circle bearings. GPS elevation is noisy, so it is smoothed by a moving average over a distance window
-(``smoothing_m``, 50 m by default); grade is the smoothed rise over the map distance, and the rider travels the
+(``smoothing_m``, 50 m by default; under :data:`SMOOTHING_FLOOR_M`, 1 cm, none); grade is the smoothed rise over the map distance, and the rider travels the
 slope length run·√(1 + grade²). A GPX file's track segments and routes are joined in file order, and pieces more
 than 2 km apart are refused, however they arrive. :attr:`Course.climbing_m` is the noise-aware total ascent
 (:func:`total_ascent`: spikes out, a 100 m moving average, climbs counted past a 5 m hysteresis threshold).
@@ -52,6 +52,7 @@ from kernels.course.gpx import (
     load_gpx,
 )
 from kernels.course.ride import (
+    MAX_POWER_W,
     Air,
     AirKind,
     Model,
@@ -69,7 +70,10 @@ from kernels.course.route import (
     ASCENT_THRESHOLD_M,
     ASCENT_WINDOW_M,
     EARTH_RADIUS_M,
+    MAX_ELEVATION_M,
     MAX_POINTS,
+    MIN_ELEVATION_M,
+    SMOOTHING_FLOOR_M,
     Course,
     azimuthal_equidistant,
     course_from_points,
@@ -84,11 +88,15 @@ __all__ = [
     "ASCENT_WINDOW_M",
     "EARTH_RADIUS_M",
     "GRADE_WINDOW_M",
+    "MAX_ELEVATION_M",
     "MAX_FILE_BYTES",
     "MAX_GPX_GRADE",
     "MAX_POINTS",
+    "MAX_POWER_W",
     "MAX_SEGMENT_GAP_M",
+    "MIN_ELEVATION_M",
     "SAMPLE_ROUTE",
+    "SMOOTHING_FLOOR_M",
     "Air",
     "AirKind",
     "Course",

@@ -24,9 +24,12 @@ import gpxpy.gpx
 import numpy as np
 from numpy.typing import NDArray
 
+from kernels import _checks
 from kernels.course.route import (
     EARTH_RADIUS_M,
+    MAX_ELEVATION_M,
     MAX_POINTS,
+    MIN_ELEVATION_M,
     Course,
     course_from_points,
     steepest_grade,
@@ -45,8 +48,9 @@ def load_gpx(source: str | os.PathLike[str] | bytes, *, name: str | None = None,
 
     Args:
         source: a path, the file's bytes, or the file's text (a string that starts with ``<``).
-        name: course name; default the track's name, else the file name, else "GPX course".
-        smoothing_m: elevation moving-average window (m).
+        name: course name (a str); default (None) the track's name, else the file name, else "GPX course".
+        smoothing_m: elevation moving-average window (m, ≥ 0); 0, or a window shorter than
+            :data:`~kernels.course.route.SMOOTHING_FLOOR_M` (1 cm), keeps the elevation as read.
 
     Returns:
         The course: every track segment and every route joined in the order the file gives them.
@@ -56,11 +60,15 @@ def load_gpx(source: str | os.PathLike[str] | bytes, *, name: str | None = None,
             has no track points, one point, points without elevation, non-finite or out-of-range values, more
             than 200 000 points, a stretch steeper than :data:`MAX_GPX_GRADE` (50 %), or consecutive pieces (track
             segments or routes, in any mix) more than :data:`MAX_SEGMENT_GAP_M` (2 km) apart; the message names
-            both pieces and the gap. Nothing else escapes for a bad file.
+            both pieces and the gap. Nothing else escapes for a bad file. A bad ``name`` or ``smoothing_m`` is
+            refused naming it.
 
     The text is decoded by its byte-order mark, else the XML declaration's encoding (ISO-8859-1, UTF-16...),
     else as UTF-8; a namespace prefix on the GPX elements (``<g:gpx xmlns:g=...>``) is read too.
     """
+    if name is not None and not isinstance(name, str):
+        raise ValueError(f"name must be a str or None, got {type(name).__name__}")
+    _checks.non_negative("smoothing_m", smoothing_m)
     label = "the file"
     if isinstance(source, bytes):
         if len(source) > MAX_FILE_BYTES:
@@ -186,10 +194,10 @@ def _check_values(
     ele: NDArray[np.float64],
 ) -> None:
     """Refuse a point that is not on the map, in words a rider reads (point numbers from 1, as in the file)."""
-    for values, what, limit, unit in (
-        (lat, "latitude", 90.0, "°"),
-        (lon, "longitude", 180.0, "°"),
-        (ele, "elevation", 10_000.0, " m"),
+    for values, what, low, high, unit in (
+        (lat, "latitude", -90.0, 90.0, "°"),
+        (lon, "longitude", -180.0, 180.0, "°"),
+        (ele, "elevation", MIN_ELEVATION_M, MAX_ELEVATION_M, " m"),
     ):
         bad = ~np.isfinite(values)
         if np.any(bad):
@@ -198,12 +206,11 @@ def _check_values(
                 f"{label}: {kind} point {first + 1} has {what} {values[first]}, not a number; "
                 f"{int(bad.sum())} point(s) like it"
             )
-        out = np.abs(values) > limit
+        out = (values < low) | (values > high)
         if np.any(out):
             first = int(np.argmax(out))
-            raise ValueError(
-                f"{label}: {kind} point {first + 1} has {what} {values[first]:g}{unit}, outside ±{_spaced(limit)}{unit}"
-            )
+            span = f"±{_spaced(high)}{unit}" if low == -high else f"{_spaced(low)}{unit} to {_spaced(high)}{unit}"
+            raise ValueError(f"{label}: {kind} point {first + 1} has {what} {values[first]:g}{unit}, outside {span}")
 
 
 @dataclasses.dataclass(frozen=True)

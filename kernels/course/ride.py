@@ -24,6 +24,8 @@ from kernels.warming import Entry
 
 Model = Literal["seed", "martin"]
 AirKind = Literal["seed", "weather"]
+_MODELS: tuple[Model, ...] = ("seed", "martin")
+_AIR_KINDS: tuple[AirKind, ...] = ("seed", "weather")
 
 
 # --------------------------------------------------------------------------------------------- rider and air
@@ -60,10 +62,9 @@ class Rider:
             if not low <= getattr(self, key) <= high:
                 raise ValueError(f"{key} must be in [{low:g}, {high:g}], got {getattr(self, key)!r}")
         eta = self.drivetrain_efficiency
-        if not (isinstance(eta, (int, float)) and not isinstance(eta, bool) and 1e-3 <= eta <= 1.0):
+        if not 1e-3 <= _checks.finite_number("drivetrain_efficiency", eta) <= 1.0:
             raise ValueError(f"drivetrain_efficiency must be in [0.001, 1], got {eta!r}")
-        if self.model not in ("seed", "martin"):
-            raise ValueError(f"model must be 'seed' or 'martin', got {self.model!r}")
+        _checks.choice("model", self.model, _MODELS)
 
     @property
     def effective_mass_kg(self) -> float:
@@ -83,30 +84,44 @@ class Air:
     """
 
     kind: AirKind = "seed"
+    """``"seed"`` (the exponential atmosphere) or ``"weather"`` (the reading below)."""
     temperature_c: float = 15.0
-    """Air temperature at ``altitude_m`` (°C)."""
+    """Air temperature at ``altitude_m`` (°C, −60 to 60)."""
     pressure_hpa: float = 1013.25
-    """Station pressure at ``altitude_m`` (hPa)."""
+    """Station pressure at ``altitude_m`` (hPa, 10 to 1100)."""
     relative_humidity: float = 0.0
     """Relative humidity, a fraction in [0, 1]."""
     altitude_m: float = 0.0
-    """Where the reading was taken (m)."""
+    """Where the reading was taken (m, −1000 to 20 000)."""
 
     def __post_init__(self) -> None:
-        if self.kind not in ("seed", "weather"):
-            raise ValueError(f"kind must be 'seed' or 'weather', got {self.kind!r}")
-        cycling.air_density_weather(self.temperature_c, self.pressure_hpa, self.relative_humidity)
-        cycling.isa_pressure_hpa(self.altitude_m)
+        _checks.choice("kind", self.kind, _AIR_KINDS)
+        # One number each (an array broadcast against the route's elevations inside the ride).
+        reading = [
+            _checks.finite_number(key, getattr(self, key))
+            for key in ("temperature_c", "pressure_hpa", "relative_humidity", "altitude_m")
+        ]
+        cycling.air_density_weather(*reading[:3])
+        cycling.isa_pressure_hpa(reading[3])
 
     def density(self, elevation_m: ArrayLike) -> NDArray[np.float64]:
-        """Air density (kg/m³) at each elevation (m, any shape)."""
-        h = np.asarray(elevation_m, dtype=np.float64)
+        """Air density (kg/m³) at each elevation (m, −10 000 to 30 000, :data:`kernels.cycling.AIR_DENSITY_ALTITUDE_M`,
+        which holds every course's; any shape). A weather reading is carried by the standard atmosphere's pressure
+        ratio within its range, −1000 to 20 000 m (an elevation beyond takes the ratio at the range's end), and held
+        within −60…60 °C and 10…1100 hPa."""
+        h = _checks.finite_array("elevation_m", elevation_m)
+        low, high = cycling.AIR_DENSITY_ALTITUDE_M
+        if np.any((h < low) | (h > high)):
+            raise ValueError(f"elevation_m must be in [{low:g}, {high:g}] m, got {_brief(h)}")
         match self.kind:
             case "seed":
                 return cycling.air_density(h)
             case "weather":
                 temperature = self.temperature_c - cycling.ISA_LAPSE_RATE_K_PER_M * (h - self.altitude_m)
-                pressure = self.pressure_hpa * cycling.isa_pressure_hpa(h) / cycling.isa_pressure_hpa(self.altitude_m)
+                isa_h = np.clip(h, *_ISA_RANGE_M)
+                pressure = (
+                    self.pressure_hpa * cycling.isa_pressure_hpa(isa_h) / cycling.isa_pressure_hpa(self.altitude_m)
+                )
                 return cycling.air_density_weather(
                     np.clip(temperature, -60.0, 60.0),
                     np.clip(pressure, 10.0, 1100.0),
@@ -114,6 +129,17 @@ class Air:
                 )
             case _:
                 raise ValueError(f"kind must be 'seed' or 'weather', got {self.kind!r}")
+
+
+_ISA_RANGE_M = (-1000.0, 20_000.0)
+"""Altitudes of :func:`kernels.cycling.isa_pressure_hpa` (m): a weather reading is carried within them."""
+
+
+def _brief(array: NDArray[np.float64]) -> str:
+    """A few of an array's values for a message, never the whole array."""
+    flat = array.ravel()
+    shown = ", ".join(f"{v:g}" for v in flat[:3].tolist())
+    return f"[{shown}{', ...' if flat.size > 3 else ''}] (shape {array.shape})"
 
 
 # --------------------------------------------------------------------------------------------- ride
@@ -161,11 +187,11 @@ class Ride:
 
     def splits(self, every_m: float = 1000.0) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """(marks, elapsed): the elapsed time (s) at every ``every_m`` metres and at the finish."""
-        _checks.positive("every_m", every_m)
+        every = _checks.positive("every_m", every_m)
         total = float(self.distance_m[-1])
-        marks = np.arange(every_m, total, every_m)
-        if marks.shape[0] > 10_000:
-            raise ValueError("every_m gives more than 10 000 splits")
+        if total / every > 10_000:  # before numpy is asked for the marks (10²⁹⁹ of them at 1e-300 m)
+            raise ValueError(f"every_m must give at most 10 000 splits, got {every_m!r} over {total:g} m")
+        marks = np.arange(every, total, every)
         marks = np.concatenate((marks, [total]))
         return marks, np.interp(marks, self.distance_m, self.elapsed_s)
 
@@ -366,7 +392,10 @@ def _ride_core(
     return 0
 
 
-_MIN_POWER_W, _MAX_POWER_W = 1.0, 5000.0
+MAX_POWER_W = 5000.0
+"""Most pedal power a ride takes (W), per segment: twice a track sprinter's peak, and the ceiling
+:func:`power_for_time` searches to. (At 10³⁰⁰ W the sub-steps that hold the speed cap took seconds.)"""
+_MIN_POWER_W, _MAX_POWER_W = 1.0, MAX_POWER_W
 _MAX_SPEED_MS = cycling.MODEL_DOMAIN["speed_ms"][1]
 _MAX_WIND_MS = cycling.MODEL_DOMAIN["headwind_ms"][1]
 """A ride's safe speed and wind stay within the power law's range (:data:`kernels.cycling.MODEL_DOMAIN`)."""
@@ -425,13 +454,16 @@ def _segment_power(power_w: ArrayLike, n_segments: int) -> NDArray[np.float64]:
             raise TypeError(power.dtype)
         power = np.asarray(power, dtype=np.float64)
     except (TypeError, ValueError) as error:
-        raise ValueError(f"power_w must be a number or an array of numbers, got {power_w!r}") from error
+        raise ValueError(f"power_w must be a number or an array of numbers, got {type(power_w).__name__}") from error
     if power.ndim == 0:
         power = np.full(n_segments, float(power))
     if power.shape != (n_segments,):
         raise ValueError(f"power_w must be a number or shape ({n_segments},), got shape {power.shape}")
     if not np.all(np.isfinite(power)) or np.any(power <= 0.0):
         raise ValueError("power_w must be finite and > 0 (W)")
+    if np.any(power > MAX_POWER_W):
+        shown = repr(power_w) if np.ndim(power_w) == 0 else _brief(power)
+        raise ValueError(f"power_w must be at most {MAX_POWER_W:g} W, got {shown}")
     return np.ascontiguousarray(power)
 
 
@@ -507,7 +539,7 @@ def ride(
 
     Args:
         course: the route.
-        power_w: pedal power (W, > 0): one number, or (N − 1,) one per segment.
+        power_w: pedal power (W, in (0, :data:`MAX_POWER_W`], 5000 W): one number, or (N − 1,) one per segment.
         rider: rider, bike and model.
         wind_ms: wind speed (m/s, at most 1000 either way; negative reverses it).
         wind_from_deg: where the wind blows from, clockwise from north (°): 0 is a north wind.
@@ -611,9 +643,28 @@ class Pacing:
     """constant.time_s − paced.time_s (s); positive when pacing is faster."""
 
 
+def _gain(gain: object) -> float:
+    g = _checks.finite_number("gain", gain)
+    if not 0.0 <= g <= 0.5:
+        raise ValueError(f"gain must be in [0, 0.5], got {gain!r}")
+    return g
+
+
 def pacing_factors(grade: ArrayLike, gain: float) -> NDArray[np.float64]:
-    """Relative power per segment: 1 + gain·tanh(grade / 0.05), more uphill, less downhill (unnormalised)."""
-    return 1.0 + gain * np.tanh(np.asarray(grade, dtype=np.float64) / 0.05)
+    """Relative power per segment: 1 + gain·tanh(grade / 0.05), more uphill, less downhill (unnormalised).
+
+    Args:
+        grade: rise over run of each segment, any shape (finite).
+        gain: how strongly power follows the grade (0 to 0.5, as for :func:`paced_ride`).
+
+    Returns:
+        Factors in [1 − gain, 1 + gain], the shape of ``grade``.
+
+    Raises:
+        ValueError: ``grade`` not finite real numbers, or ``gain`` not a number in [0, 0.5]; the message names it.
+    """
+    slope = _checks.finite_array("grade", grade)
+    return 1.0 + _gain(gain) * np.tanh(slope / 0.05)
 
 
 def paced_ride(
@@ -635,7 +686,7 @@ def paced_ride(
     ``power_w`` unless the constant ride eased off to hold the speed cap).
 
     Args:
-        power_w: the constant ride's power and the paced ride's time-averaged power (W, > 0).
+        power_w: the constant ride's power and the paced ride's time-averaged power (W, in (0, 5000]).
         gain: how strongly power follows the grade (0 to 0.5; 0 is constant power).
         Other arguments as for :func:`ride`.
 
@@ -646,9 +697,9 @@ def paced_ride(
         ValueError: an argument is invalid (the message names it).
     """
     target = _checks.positive("power_w", power_w)
-    g = _checks.finite_number("gain", gain)
-    if not 0.0 <= g <= 0.5:
-        raise ValueError(f"gain must be in [0, 0.5], got {gain!r}")
+    if target > MAX_POWER_W:
+        raise ValueError(f"power_w must be at most {MAX_POWER_W:g} W, got {power_w!r}")
+    g = _gain(gain)
     s = _segments(course, rider, wind_ms, wind_from_deg, air)
     cap, start = _speeds(max_speed_ms, start_speed_ms)
     n = course.n_points - 1

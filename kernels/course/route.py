@@ -39,9 +39,37 @@ swings under 5 m, so 5 m loses fewer real rollers."""
 ASCENT_WINDOW_M = 100.0
 """Moving-average window for :func:`total_ascent` (m): at least ten points of a 1 s log at up to 36 km/h, and
 under 0.5 % off the height of a hill 2 km long."""
+SMOOTHING_FLOOR_M = 0.01
+"""Shortest moving-average window that smooths (m); a shorter one (or one under a billionth of the distances' own
+magnitude, where their rounding would swamp it) keeps the profile as given. A window h moves a point by at most
+h/8 times the change of grade there, under 2 mm for any road below 1 cm, while the average's rounding grows as 1/h:
+at 1e-10 m it was metres, and at 1e-300 m every value was 0/0."""
+MIN_ELEVATION_M, MAX_ELEVATION_M = -10_000.0, 10_000.0
+"""Elevations a course may have (m): ±10 km, past any road (Everest is 8 849 m, the Dead Sea's shore −430 m)."""
 ASCENT_SPIKE_GRADE = 0.5
 """A point farther from its neighbours' median than this grade times their reach is a spike (the steepest roads are
 about 37 %), replaced by that median before :func:`total_ascent` smooths; a real road's profile is never touched."""
+
+
+_MAX_DISTANCE_M = 1e15
+"""Largest distance :func:`total_ascent` and :func:`steepest_grade` take (m): far past any route, and their sums and
+differences stay finite."""
+_MAX_ABS_ELEVATION_M = 1e6
+"""Largest elevation magnitude :func:`total_ascent` and :func:`steepest_grade` take (m)."""
+_MAX_MAP_M = 2e7
+"""Largest map coordinate :func:`course_from_xy` takes (m): half the Earth's circumference."""
+_MIN_STEP_M = 1e-6
+"""Shortest distance between points that counts as a move (m): a course merges points closer than this."""
+_MIN_GRADE_STEP_M = 1e-7
+"""Shortest step between the distances :func:`steepest_grade` takes (m): a course's (above :data:`_MIN_STEP_M`,
+less rounding) pass, and every grade stays finite."""
+
+
+def _name(name: object) -> str:
+    """A course name as given, when it is a str; else ``ValueError`` naming it (None or NaN is not a name)."""
+    if not isinstance(name, str):
+        raise ValueError(f"name must be a str, got {type(name).__name__}")
+    return name
 
 
 # --------------------------------------------------------------------------------------------- course
@@ -108,20 +136,20 @@ def total_ascent(
     most its steepest grade × ``window_m`` / 4, so a clean profile never reads more than its own sum of rises.
 
     Args:
-        distance_m: (N,) distance along the route (m), non-decreasing.
-        elevation_m: (N,) elevation (m), raw or smoothed.
+        distance_m: (N,) distance along the route (m), non-decreasing, of magnitude at most 10¹⁵ m.
+        elevation_m: (N,) elevation (m), raw or smoothed, of magnitude at most 10⁶ m.
         threshold_m: smallest climb counted (m, > 0).
-        window_m: moving-average window (m, ≥ 0; 0 does not smooth).
+        window_m: moving-average window (m, ≥ 0; 0, or less than :data:`SMOOTHING_FLOOR_M`, does not smooth).
 
     Returns:
         The total ascent (m, ≥ 0).
 
     Raises:
         ValueError: naming the argument: arrays not one-dimensional, of different lengths, empty or not finite,
-            distance decreasing, threshold not positive or window negative.
+            distance decreasing or too large, threshold not positive or window negative.
     """
-    d = _checks.finite_array("distance_m", distance_m)
-    z = _checks.finite_array("elevation_m", elevation_m)
+    d = _checks.bounded_array("distance_m", distance_m, _MAX_DISTANCE_M)
+    z = _checks.bounded_array("elevation_m", elevation_m, _MAX_ABS_ELEVATION_M)
     threshold = _checks.positive("threshold_m", threshold_m)
     window = _checks.non_negative("window_m", window_m)
     if d.ndim != 1 or z.ndim != 1 or d.shape != z.shape or d.shape[0] == 0:
@@ -191,9 +219,22 @@ def _hysteresis_ascent(z: NDArray[np.float64], threshold: float) -> float:
 
 
 def _smooth(distance: NDArray[np.float64], z: NDArray[np.float64], window_m: float) -> NDArray[np.float64]:
-    """Moving average of the piecewise-linear profile z(s) over [s − h, s + h] ∩ route, h = window/2."""
-    if window_m <= 0.0 or distance.shape[0] < 3:
+    """Moving average of the piecewise-linear profile z(s) over [s − h, s + h] ∩ route, h = window/2.
+
+    A window below :data:`SMOOTHING_FLOOR_M`, or below a billionth of the distances' magnitude, returns z as it is:
+    the average is a difference of running integrals over the window's width, whose rounding grows as the window
+    shrinks (0/0 once s ± h rounds to s)."""
+    resolution = max(SMOOTHING_FLOOR_M, 1e-9 * max(abs(float(distance[0])), abs(float(distance[-1]))))
+    if window_m < resolution or distance.shape[0] < 3:
         return z.copy()
+    # Integrate the profile about its first value: the running integral stays as small as the climb, not the
+    # altitude, and so does its rounding.
+    base = float(z[0])
+    smoothed = _smooth_about(distance, z - base, window_m)
+    return smoothed + base
+
+
+def _smooth_about(distance: NDArray[np.float64], z: NDArray[np.float64], window_m: float) -> NDArray[np.float64]:
     run = np.diff(distance)
     integral = np.concatenate(([0.0], np.cumsum(run * 0.5 * (z[1:] + z[:-1]))))
     slope = np.diff(z) / np.where(run > 0.0, run, 1.0)
@@ -255,11 +296,11 @@ def _finish(
     elevation: NDArray[np.float64],
     smoothing_m: float,
 ) -> Course:
-    _checks.non_negative("smoothing_m", smoothing_m)
-    if np.any(np.abs(elevation) > 10_000.0):
+    window = _checks.non_negative("smoothing_m", smoothing_m)
+    if np.any((elevation < MIN_ELEVATION_M) | (elevation > MAX_ELEVATION_M)):
         raise ValueError(f"{name}: elevation outside ±10 000 m")
     # Points at one place (a paused GPS logs many) carry no distance: keep the first of each run.
-    keep = np.concatenate(([True], run > 1e-6))
+    keep = np.concatenate(([True], run > _MIN_STEP_M))
     if int(keep.sum()) < 2:
         raise ValueError(f"{name}: every point is at one place; a course needs two distinct points")
     seg_keep = keep[1:]
@@ -267,8 +308,10 @@ def _finish(
     # Lengths of the merged segments: the dropped zero-length ones add nothing.
     run, heading = run[seg_keep], heading[seg_keep]
     distance = np.concatenate(([0.0], np.cumsum(run)))
-    smoothed = _smooth(distance, elevation, smoothing_m)
+    smoothed = _smooth(distance, elevation, window)
     grade = np.diff(smoothed) / run
+    if not (np.isfinite(smoothed).all() and np.isfinite(grade).all()):  # a guard: _smooth keeps it finite
+        raise ValueError(f"smoothing_m must smooth to finite elevations, got {smoothing_m!r}")
     for array in (east, north, distance, smoothed, elevation, grade, heading):
         array.setflags(write=False)
     return Course(
@@ -295,13 +338,15 @@ def course_from_points(
     Args:
         latitude_deg: (N,) latitude (°, −90 to 90).
         longitude_deg: (N,) longitude (°, −180 to 180).
-        elevation_m: (N,) elevation (m).
-        name: course name.
-        smoothing_m: width of the elevation moving-average window (m, ≥ 0; 0 keeps the raw profile).
+        elevation_m: (N,) elevation (m, within ±10 000).
+        name: course name (a str).
+        smoothing_m: width of the elevation moving-average window (m, ≥ 0; 0 keeps the raw profile, and so does a
+            window shorter than :data:`SMOOTHING_FLOOR_M`, 1 cm, which would move no point by 2 mm).
 
     Raises:
         ValueError: fewer than two distinct points, non-finite or out-of-range values; the message says which.
     """
+    name = _name(name)
     p = _checked_points(
         name,
         {"latitude_deg": latitude_deg, "longitude_deg": longitude_deg, "elevation_m": elevation_m},
@@ -365,16 +410,21 @@ def course_from_xy(
     """Build a :class:`Course` on a flat map (synthetic routes, tests, benchmarks).
 
     Args:
-        east_m, north_m: (N,) map position (m).
-        elevation_m: (N,) elevation (m).
-        name: course name.
-        smoothing_m: elevation moving-average window (m, ≥ 0); 0 (the default) keeps the profile as given.
+        east_m, north_m: (N,) map position (m, within ±2·10⁷ m, half the Earth's circumference).
+        elevation_m: (N,) elevation (m, within ±10 000).
+        name: course name (a str).
+        smoothing_m: elevation moving-average window (m, ≥ 0); 0 (the default) keeps the profile as given, and so
+            does a window shorter than :data:`SMOOTHING_FLOOR_M` (1 cm).
 
     Raises:
         ValueError: as :func:`course_from_points`.
     """
+    name = _name(name)
     p = _checked_points(name, {"east_m": east_m, "north_m": north_m, "elevation_m": elevation_m})
     east, north = p["east_m"], p["north_m"]
+    for key, array in (("east_m", east), ("north_m", north)):
+        if np.any(np.abs(array) > _MAX_MAP_M):
+            raise ValueError(f"{key} must be within ±{_MAX_MAP_M:g} m, got {_brief(array)}")
     d_east, d_north = np.diff(east), np.diff(north)
     run = np.hypot(d_east, d_north)
     heading = np.arctan2(d_east, d_north) % (2.0 * np.pi)
@@ -384,16 +434,48 @@ def course_from_xy(
 def steepest_grade(distance_m: ArrayLike, elevation_m: ArrayLike, window_m: float) -> tuple[float, int]:
     """Largest |rise| / run over the stretches from each point to the first point at least ``window_m`` further on
     (the whole route when it is shorter). A cliff anywhere lies inside one such stretch, so no moving average can
-    hide it. Returns the grade and the stretch's first point. (N,) inputs, distance strictly increasing (m)."""
-    distance_m = np.asarray(distance_m, dtype=np.float64)
-    elevation_m = np.asarray(elevation_m, dtype=np.float64)
-    n = distance_m.shape[0]
-    end = np.searchsorted(distance_m, distance_m + window_m, side="left")
+    hide it.
+
+    Args:
+        distance_m: (N,) distance along the route (m), N ≥ 2, each point at least 10⁻⁷ m past the one before (a
+            :class:`Course`'s are 10⁻⁶ m apart), of magnitude at most 10¹⁵ m.
+        elevation_m: (N,) elevation (m), of magnitude at most 10⁶ m.
+        window_m: the shortest stretch (m, > 0); a window shorter than the spacing of the points measures each
+            stretch from a point to the next.
+
+    Returns:
+        The grade (rise over run, ≥ 0) and the stretch's first point.
+
+    Raises:
+        ValueError: naming the argument: not finite, of the wrong shape, too few points, distance not increasing,
+            or the window not a positive number.
+    """
+    d = _checks.bounded_array("distance_m", distance_m, _MAX_DISTANCE_M)
+    z = _checks.bounded_array("elevation_m", elevation_m, _MAX_ABS_ELEVATION_M)
+    window = _checks.positive("window_m", window_m)
+    if d.ndim != 1 or d.shape[0] < 2:
+        raise ValueError(f"distance_m must have shape (N,) with N >= 2, got {d.shape}")
+    if z.shape != d.shape:
+        raise ValueError(f"elevation_m must have the shape of distance_m, {d.shape}, got {z.shape}")
+    if not np.all(np.diff(d) >= _MIN_GRADE_STEP_M):
+        raise ValueError(f"distance_m must increase by at least {_MIN_GRADE_STEP_M:g} m from point to point")
+    n = d.shape[0]
+    start = np.arange(n)
+    # The first point at least the window further on, and never the point itself (d + window rounds to d when
+    # the window is below the distances' resolution).
+    end = np.maximum(np.searchsorted(d, d + window, side="left"), start + 1)
     full = end < n
     if np.any(full):
-        start, end = np.flatnonzero(full), end[full]
+        start, end = start[full], end[full]
     else:
         start, end = np.array([0]), np.array([n - 1])
-    grade = np.abs(elevation_m[end] - elevation_m[start]) / (distance_m[end] - distance_m[start])
+    grade = np.abs(z[end] - z[start]) / (d[end] - d[start])
     k = int(np.argmax(grade))
     return float(grade[k]), int(start[k])
+
+
+def _brief(array: NDArray[np.float64]) -> str:
+    """A few of an array's values for a message, never the whole array."""
+    flat = array.ravel()
+    shown = ", ".join(f"{v:g}" for v in flat[:3].tolist())
+    return f"[{shown}{', ...' if flat.size > 3 else ''}] (shape {array.shape})"
