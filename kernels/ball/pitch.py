@@ -297,6 +297,16 @@ class Pitch:
     roll_speed_ms: float = 0.5
     """A ground bounce leaving less than this upward (a hop under 1.3 cm) starts the roll (m/s)."""
 
+    def __post_init__(self) -> None:
+        # Its parts' types now, so a wrong one is named here and not met later as an AttributeError; their values
+        # are checked where the flight reads them (pitch_vector), with the spot that places the keeper.
+        _checks.instance("pitch.goal", self.goal, Panel)
+        for name, kind in (("wall", Panel), ("keeper", Keeper)):
+            if getattr(self, name) is not None:
+                _checks.instance(f"pitch.{name}", getattr(self, name), kind, f"None or a {kind.__name__}")
+        for name in ("surface", "frame", "body"):
+            _checks.instance(f"pitch.{name}", getattr(self, name), Surface)
+
 
 def _surface_slots(name: str, surface: Surface, radius: float) -> list[float]:
     e_n, e_t = surface.restitution, surface.tangential_restitution

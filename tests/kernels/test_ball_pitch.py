@@ -767,11 +767,7 @@ def test_drag_crisis_centre_is_a_setting() -> None:
         (ball.Pitch(GOAL, WALL, wall_players=0), "wall_players"),
         (ball.Pitch(GOAL, keeper=ball.Keeper(push_off_s=0.0)), "push_off_s"),
         ("pitch", "pitch must be a Pitch"),
-        # Each field of the wrong type, the goal named as the goal, sizes a pitch cannot have.
-        (ball.Pitch(None), r"pitch\.goal must be a Panel"),  # type: ignore[arg-type]
-        (ball.Pitch(GOAL, "wall"), r"pitch\.wall must be a Panel"),  # type: ignore[arg-type]
-        (ball.Pitch(GOAL, surface="turf"), r"pitch\.surface must be a Surface"),  # type: ignore[arg-type]
-        (ball.Pitch(GOAL, frame=None), r"pitch\.frame must be a Surface"),  # type: ignore[arg-type]
+        # The goal named as the goal, sizes a pitch cannot have.
         (ball.Pitch(ball.Panel((math.nan, 0.0), (1.0, 0.0), 7.32, 2.44)), r"pitch\.goal\.centre_xy"),
         (ball.Pitch(ball.Panel((0.0, 0.0), (1.0, 0.0), 0.0, 2.44)), r"pitch\.goal\.width_m"),
         (ball.Pitch(ball.Panel((0.0, 0.0), (1.0, 0.0), 7.32, -1.0)), r"pitch\.goal\.height_m"),
@@ -798,6 +794,23 @@ def test_drag_crisis_centre_is_a_setting() -> None:
 def test_a_bad_pitch_raises_naming_the_field(pitch, name) -> None:
     with pytest.raises(ValueError, match=name):
         ball.simulate((-22.0, 0.0, R), (20.0, 0.0, 3.0), (0.0, 0.0, 0.0), ground_m=R, pitch=pitch)
+
+
+@pytest.mark.parametrize(
+    ("fields", "name"),
+    [
+        ({"goal": None}, r"^pitch\.goal must be a Panel, got NoneType"),
+        ({"wall": "wall"}, r"^pitch\.wall must be None or a Panel, got str"),
+        ({"keeper": 3}, r"^pitch\.keeper must be None or a Keeper, got int"),  # met later as an AttributeError
+        ({"keeper": ball.Surface()}, r"^pitch\.keeper must be None or a Keeper, got Surface"),
+        ({"surface": "turf"}, r"^pitch\.surface must be a Surface, got str"),
+        ({"frame": None}, r"^pitch\.frame must be a Surface, got NoneType"),
+        ({"body": ball.Keeper()}, r"^pitch\.body must be a Surface, got Keeper"),
+    ],
+)
+def test_a_pitch_part_of_the_wrong_type_is_refused_when_the_pitch_is_made(fields: dict[str, Any], name: str) -> None:
+    with pytest.raises(ValueError, match=name):
+        ball.Pitch(**{"goal": GOAL} | fields)
 
 
 @pytest.mark.parametrize("turn_deg", [0.0, 37.0, 180.0])
