@@ -809,8 +809,9 @@ def test_a_bad_pitch_raises_naming_the_field(pitch, name) -> None:
     ],
 )
 def test_a_pitch_part_of_the_wrong_type_is_refused_when_the_pitch_is_made(fields: dict[str, Any], name: str) -> None:
+    parts: dict[str, Any] = {"goal": GOAL, **fields}
     with pytest.raises(ValueError, match=name):
-        ball.Pitch(**{"goal": GOAL} | fields)
+        ball.Pitch(**parts)
 
 
 @pytest.mark.parametrize("turn_deg", [0.0, 37.0, 180.0])
