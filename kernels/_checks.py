@@ -12,6 +12,7 @@ under a microsecond per argument here.
 from __future__ import annotations
 
 import math
+import reprlib
 from typing import Any, TypeVar
 
 import numpy as np
@@ -31,10 +32,29 @@ __all__ = [
     "positive",
     "positive_array",
     "positive_vector",
+    "shown",
     "vector",
 ]
 
 _REAL_SCALARS = (float, int, np.floating, np.integer)
+_SHOWN_CHARS = 200
+"""The longest a refused value is quoted in a message: a million-point array is not printed whole."""
+
+
+def shown(value: object) -> str:
+    """``repr(value)`` for a message: an array's middle elided (numpy's summary, three items at each end), a long
+    list's or tuple's tail (:mod:`reprlib`), and cut to :data:`_SHOWN_CHARS` characters."""
+    if isinstance(value, np.ndarray):
+        with np.printoptions(threshold=6, edgeitems=3):
+            text = repr(value)
+    else:
+        text = _REPR.repr(value)
+    return text if len(text) <= _SHOWN_CHARS else text[: _SHOWN_CHARS - 1] + "…"
+
+
+_REPR = reprlib.Repr()
+_REPR.maxlist = _REPR.maxtuple = _REPR.maxdict = _REPR.maxset = 6
+_REPR.maxstring, _REPR.maxother = _SHOWN_CHARS, 80
 T = TypeVar("T")
 
 
@@ -49,7 +69,7 @@ def finite_number(name: str, value: object) -> float:
             number = math.inf
         if math.isfinite(number):
             return number
-    raise ValueError(f"{name} must be a finite number, got {value!r}")
+    raise ValueError(f"{name} must be a finite number, got {shown(value)}")
 
 
 def choice(name: str, value: object, options: tuple[str, ...]) -> str:
@@ -58,14 +78,14 @@ def choice(name: str, value: object, options: tuple[str, ...]) -> str:
     if isinstance(value, str) and value in options:
         return value
     listed = ", ".join(repr(option) for option in options)
-    raise ValueError(f"{name} must be one of {listed}, got {value!r}")
+    raise ValueError(f"{name} must be one of {listed}, got {shown(value)}")
 
 
 def flag(name: str, value: object) -> bool:
     """``value`` when it is a Python or numpy bool, else ``ValueError`` naming it (``"no"`` or NaN is not a flag)."""
     if isinstance(value, (bool, np.bool_)):
         return bool(value)
-    raise ValueError(f"{name} must be True or False, got {value!r}")
+    raise ValueError(f"{name} must be True or False, got {shown(value)}")
 
 
 def integer(name: str, value: object, minimum: int | None = None) -> int:
@@ -77,7 +97,7 @@ def integer(name: str, value: object, minimum: int | None = None) -> int:
         or (minimum is not None and value < minimum)
     ):
         at_least = "" if minimum is None else f" >= {minimum}"
-        raise ValueError(f"{name} must be an integer{at_least}, got {value!r}")
+        raise ValueError(f"{name} must be an integer{at_least}, got {shown(value)}")
     return int(value)
 
 
@@ -95,7 +115,7 @@ def positive(name: str, value: object) -> float:
     """A finite real scalar > 0 as a float, else ``ValueError`` naming it."""
     number = finite_number(name, value)
     if number <= 0.0:
-        raise ValueError(f"{name} must be > 0, got {value!r}")
+        raise ValueError(f"{name} must be > 0, got {shown(value)}")
     return number
 
 
@@ -103,7 +123,7 @@ def non_negative(name: str, value: object) -> float:
     """A finite real scalar ≥ 0 as a float, else ``ValueError`` naming it."""
     number = finite_number(name, value)
     if number < 0.0:
-        raise ValueError(f"{name} must be >= 0, got {value!r}")
+        raise ValueError(f"{name} must be >= 0, got {shown(value)}")
     return number
 
 
@@ -115,9 +135,12 @@ def finite_array(name: str, value: ArrayLike) -> NDArray[np.float64]:
             raise TypeError(array.dtype)
         array = np.asarray(array, dtype=np.float64)
     except (TypeError, ValueError, OverflowError) as error:
-        raise ValueError(f"{name} must be an array of real numbers, got {value!r}") from error
+        raise ValueError(f"{name} must be an array of real numbers, got {shown(value)}") from error
     if not np.isfinite(array).all():
-        raise ValueError(f"{name} must be finite, got {value!r}")
+        if array.ndim == 0:
+            raise ValueError(f"{name} must be finite, got {shown(value)}")
+        where = [int(i) for i in np.argwhere(~np.isfinite(array))[0]]
+        raise ValueError(f"{name} must be finite, got {float(array[tuple(where)])!r} at {where} of {shown(value)}")
     return array
 
 
@@ -125,7 +148,7 @@ def bounded_array(name: str, value: ArrayLike, bound: float) -> NDArray[np.float
     """As :func:`finite_array`, and every magnitude ≤ ``bound``, so sums and differences of them stay finite."""
     array = finite_array(name, value)
     if not (np.abs(array) <= bound).all():
-        raise ValueError(f"{name} must be of magnitude ≤ {bound:g}, got {value!r}")
+        raise ValueError(f"{name} must be of magnitude ≤ {bound:g}, got {shown(value)}")
     return array
 
 
@@ -133,7 +156,7 @@ def positive_array(name: str, value: ArrayLike) -> NDArray[np.float64]:
     """:func:`finite_array` with every element > 0, else ``ValueError`` naming it."""
     array = finite_array(name, value)
     if np.any(array <= 0.0):
-        raise ValueError(f"{name} must be > 0, got {value!r}")
+        raise ValueError(f"{name} must be > 0, got {shown(value)}")
     return array
 
 
@@ -141,7 +164,7 @@ def non_negative_array(name: str, value: ArrayLike) -> NDArray[np.float64]:
     """:func:`finite_array` with every element ≥ 0, else ``ValueError`` naming it."""
     array = finite_array(name, value)
     if np.any(array < 0.0):
-        raise ValueError(f"{name} must be >= 0, got {value!r}")
+        raise ValueError(f"{name} must be >= 0, got {shown(value)}")
     return array
 
 

@@ -1,0 +1,62 @@
+"""The shared input checks: what they accept, and messages that name the argument and quote the value briefly."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from kernels import _checks
+
+
+@pytest.mark.parametrize(
+    "value",
+    [np.array(["rk4", "euler"]), None, 3, "RK4", b"rk4", ["rk4"], math.nan],
+)
+def test_a_choice_refuses_what_is_not_one_of_its_strings_naming_it(value: object) -> None:
+    # An array compared with `in` raised numpy's "truth value of an array is ambiguous", naming nothing.
+    with pytest.raises(ValueError, match=r"^method must be one of 'euler', 'rk4', got "):
+        _checks.choice("method", value, ("euler", "rk4"))
+
+
+def test_a_choice_returns_its_string() -> None:
+    assert _checks.choice("method", "rk4", ("euler", "rk4")) == "rk4"
+
+
+@pytest.mark.parametrize("value", ["no", math.nan, 0, 1, None, np.array([True])])
+def test_a_flag_is_a_bool_only(value: object) -> None:
+    with pytest.raises(ValueError, match=r"^extrapolate must be True or False, got "):
+        _checks.flag("extrapolate", value)
+
+
+@pytest.mark.parametrize(("value", "expected"), [(True, True), (np.bool_(False), False)])
+def test_a_flag_returns_a_python_bool(value: object, expected: bool) -> None:
+    assert _checks.flag("extrapolate", value) is expected
+
+
+@pytest.mark.parametrize(
+    ("value", "quoted"),
+    [
+        (np.full(5000, math.nan), "got nan at [0] of array([nan, nan, nan, ..., nan, nan, nan], shape=(5000,))"),
+        ([1.0] * 50 + [math.nan], "got nan at [50] of [1.0, 1.0, 1.0, 1.0, 1.0, 1.0, ...]"),
+        ([[1.0, 2.0], [3.0, math.inf]], "got inf at [1, 1] of [[1.0, 2.0], [3.0, inf]]"),
+        (math.inf, "got inf"),
+    ],
+)
+def test_a_non_finite_array_is_refused_naming_the_first_bad_element_and_quoting_the_value_briefly(
+    value: object, quoted: str
+) -> None:
+    with pytest.raises(ValueError) as caught:
+        _checks.finite_array("elevation_m", value)  # type: ignore[arg-type]
+    assert str(caught.value) == f"elevation_m must be finite, {quoted}"
+
+
+@pytest.mark.parametrize(
+    "value", [np.arange(10**6, dtype=float), list(range(10**5)), "x" * 10**6, 10**4000, tuple(range(1000))]
+)
+def test_a_refused_value_is_quoted_in_at_most_two_hundred_characters(value: object) -> None:
+    assert len(_checks.shown(value)) <= 200
+    with pytest.raises(ValueError) as caught:
+        _checks.positive("gap_m", value)
+    assert str(caught.value).startswith("gap_m must be a finite number, got ") and len(str(caught.value)) < 260
