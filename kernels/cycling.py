@@ -87,14 +87,6 @@ _positive = _checks.positive_array
 _non_negative = _checks.non_negative_array
 
 
-def _shown(value: object) -> str:
-    """``value`` for a message: a number as given, an array as its first few values and its shape."""
-    if isinstance(value, (np.ndarray, list, tuple)) and np.size(value) > 3:
-        flat = np.asarray(value, dtype=object).ravel()
-        return f"[{', '.join(repr(v) for v in flat[:3].tolist())}, ...] (shape {np.shape(value)})"
-    return repr(value)
-
-
 def _broadcast(**values: ArrayLike) -> None:
     """``ValueError`` naming the first of ``values`` whose shape does not broadcast with the ones before it (numpy
     would say "operands could not be broadcast together" and name none)."""
@@ -112,7 +104,7 @@ def _broadcast(**values: ArrayLike) -> None:
 def _efficiency(value: ArrayLike) -> NDArray[np.float64]:
     array = _finite("drivetrain_efficiency", value)
     if np.any((array < 1e-3) | (array > 1.0)):  # a thousandth: far below any drivetrain, and no overflow
-        raise ValueError(f"drivetrain_efficiency must be in [0.001, 1], got {_shown(value)}")
+        raise ValueError(f"drivetrain_efficiency must be in [0.001, 1], got {_checks.shown(value)}")
     return array
 
 
@@ -137,7 +129,7 @@ def air_density(altitude_m: ArrayLike) -> NDArray[np.float64]:
     h = _finite("altitude_m", altitude_m)
     low, high = AIR_DENSITY_ALTITUDE_M
     if np.any((h < low) | (h > high)):
-        raise ValueError(f"altitude_m must be in [{low:g}, {high:g}] m, got {_shown(altitude_m)}")
+        raise ValueError(f"altitude_m must be in [{low:g}, {high:g}] m, got {_checks.shown(altitude_m)}")
     return RHO_SEA_LEVEL * np.exp(-h / SCALE_HEIGHT_M)
 
 
@@ -448,7 +440,7 @@ def _check_domain(function: str, domain: dict[str, tuple[float, float]], **value
         low, high = domain[name]
         array = _finite(name, value)
         if np.any((array < low) | (array > high)):
-            raise ValueError(f"{name} must be in [{low:g}, {high:g}] for {function}, got {_shown(value)}")
+            raise ValueError(f"{name} must be in [{low:g}, {high:g}] for {function}, got {_checks.shown(value)}")
 
 
 class _PowerBalance(NamedTuple):
@@ -713,7 +705,7 @@ def saturation_vapour_pressure_hpa(temperature_c: ArrayLike) -> NDArray[np.float
     """
     t = _finite("temperature_c", temperature_c)
     if np.any((t < -60.0) | (t > 60.0)):
-        raise ValueError(f"temperature_c must be in [-60, 60] °C, got {_shown(temperature_c)}")
+        raise ValueError(f"temperature_c must be in [-60, 60] °C, got {_checks.shown(temperature_c)}")
     return 6.1121 * np.exp(17.502 * t / (240.97 + t))
 
 
@@ -742,10 +734,10 @@ def air_density_weather(
     t_k = _finite("temperature_c", temperature_c) + _KELVIN
     p = _finite("pressure_hpa", pressure_hpa)
     if np.any((p < 10.0) | (p > 1100.0)):
-        raise ValueError(f"pressure_hpa must be in [10, 1100] hPa, got {_shown(pressure_hpa)}")
+        raise ValueError(f"pressure_hpa must be in [10, 1100] hPa, got {_checks.shown(pressure_hpa)}")
     rh = _finite("relative_humidity", relative_humidity)
     if np.any((rh < 0.0) | (rh > 1.0)):
-        raise ValueError(f"relative_humidity must be a fraction in [0, 1], got {_shown(relative_humidity)}")
+        raise ValueError(f"relative_humidity must be a fraction in [0, 1], got {_checks.shown(relative_humidity)}")
     _broadcast(temperature_c=t_k, pressure_hpa=p, relative_humidity=rh)
     e = rh * e_s
     if np.any(e >= p):
@@ -760,7 +752,7 @@ def _isa_altitude(altitude_m: ArrayLike) -> NDArray[np.float64]:
     """Geopotential altitude H = r₀·h/(r₀ + h) of the geometric altitude h (what a map or a GPS gives)."""
     h = _finite("altitude_m", altitude_m)
     if np.any((h < -1000.0) | (h > _ISA_TOP_M)):
-        raise ValueError(f"altitude_m must be in [-1000, 20000] m, got {_shown(altitude_m)}")
+        raise ValueError(f"altitude_m must be in [-1000, 20000] m, got {_checks.shown(altitude_m)}")
     return _EARTH_RADIUS_ISA_M * h / (_EARTH_RADIUS_ISA_M + h)
 
 

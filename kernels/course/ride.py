@@ -112,7 +112,7 @@ class Air:
         h = _checks.finite_array("elevation_m", elevation_m)
         low, high = cycling.AIR_DENSITY_ALTITUDE_M
         if np.any((h < low) | (h > high)):
-            raise ValueError(f"elevation_m must be in [{low:g}, {high:g}] m, got {_brief(h)}")
+            raise ValueError(f"elevation_m must be in [{low:g}, {high:g}] m, got {_checks.shown(h)}")
         match self.kind:
             case "seed":
                 return cycling.air_density(h)
@@ -133,13 +133,6 @@ class Air:
 
 _ISA_RANGE_M = (-1000.0, 20_000.0)
 """Altitudes of :func:`kernels.cycling.isa_pressure_hpa` (m): a weather reading is carried within them."""
-
-
-def _brief(array: NDArray[np.float64]) -> str:
-    """A few of an array's values for a message, never the whole array."""
-    flat = array.ravel()
-    shown = ", ".join(f"{v:g}" for v in flat[:3].tolist())
-    return f"[{shown}{', ...' if flat.size > 3 else ''}] (shape {array.shape})"
 
 
 # --------------------------------------------------------------------------------------------- ride
@@ -462,7 +455,7 @@ def _segment_power(power_w: ArrayLike, n_segments: int) -> NDArray[np.float64]:
     if not np.all(np.isfinite(power)) or np.any(power <= 0.0):
         raise ValueError("power_w must be finite and > 0 (W)")
     if np.any(power > MAX_POWER_W):
-        shown = repr(power_w) if np.ndim(power_w) == 0 else _brief(power)
+        shown = repr(power_w) if np.ndim(power_w) == 0 else _checks.shown(power)
         raise ValueError(f"power_w must be at most {MAX_POWER_W:g} W, got {shown}")
     return np.ascontiguousarray(power)
 

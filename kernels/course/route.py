@@ -424,7 +424,7 @@ def course_from_xy(
     east, north = p["east_m"], p["north_m"]
     for key, array in (("east_m", east), ("north_m", north)):
         if np.any(np.abs(array) > _MAX_MAP_M):
-            raise ValueError(f"{key} must be within ±{_MAX_MAP_M:g} m, got {_brief(array)}")
+            raise ValueError(f"{key} must be within ±{_MAX_MAP_M:g} m, got {_checks.shown(array)}")
     d_east, d_north = np.diff(east), np.diff(north)
     run = np.hypot(d_east, d_north)
     heading = np.arctan2(d_east, d_north) % (2.0 * np.pi)
@@ -472,10 +472,3 @@ def steepest_grade(distance_m: ArrayLike, elevation_m: ArrayLike, window_m: floa
     grade = np.abs(z[end] - z[start]) / (d[end] - d[start])
     k = int(np.argmax(grade))
     return float(grade[k]), int(start[k])
-
-
-def _brief(array: NDArray[np.float64]) -> str:
-    """A few of an array's values for a message, never the whole array."""
-    flat = array.ravel()
-    shown = ", ".join(f"{v:g}" for v in flat[:3].tolist())
-    return f"[{shown}{', ...' if flat.size > 3 else ''}] (shape {array.shape})"

@@ -9,6 +9,7 @@ value it was found with is in the family.
 from __future__ import annotations
 
 import math
+import re
 from decimal import Decimal
 from typing import Any
 
@@ -35,7 +36,10 @@ NOT_A_SCENE: list[Any] = [None, 0, "scene", object(), SPHERE, (SPHERE,), np.zero
 
 
 def ids(value: object) -> str:
-    return type(value).__name__ + ":" + repr(value)[:30]
+    """A test id the same in every process: an object's repr holds its address, which pytest-xdist's workers must
+    agree on, so it is left out."""
+    text = re.sub(r" at 0x[0-9a-f]+", "", repr(value))
+    return type(value).__name__ + ":" + text[:30]
 
 
 def vector_family(size: int) -> list[Any]:
