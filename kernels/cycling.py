@@ -87,12 +87,23 @@ _positive = _checks.positive_array
 _non_negative = _checks.non_negative_array
 
 
+def _shape(name: str, value: ArrayLike) -> tuple[int, ...]:
+    if type(value) is float or type(value) is int:  # the common case, without numpy's conversion
+        return ()
+    try:
+        return np.shape(value)
+    except ValueError as error:  # a ragged list: numpy's "inhomogeneous shape" names nothing
+        raise ValueError(f"{name} must be an array of real numbers, got {_checks.shown(value)}") from error
+
+
 def _broadcast(**values: ArrayLike) -> None:
     """``ValueError`` naming the first of ``values`` whose shape does not broadcast with the ones before it (numpy
     would say "operands could not be broadcast together" and name none)."""
+    shapes = [(name, _shape(name, value)) for name, value in values.items()]
+    if not any(here for _, here in shapes):  # all scalars, the common case: nothing to broadcast
+        return
     shape: tuple[int, ...] = ()
-    for name, value in values.items():
-        here = np.shape(value)
+    for name, here in shapes:
         try:
             shape = np.broadcast_shapes(shape, here)
         except ValueError as error:
@@ -296,10 +307,10 @@ def power(
         cda_m2=cda_m2,
         mass_kg=mass_kg,
         crr=crr,
-        grade=_finite("grade", grade),
+        grade=grade,
         altitude_m=altitude_m,
         headwind_ms=headwind_ms,
-        drivetrain_efficiency=_efficiency(drivetrain_efficiency),
+        drivetrain_efficiency=drivetrain_efficiency,
     )
     return _power(speed_ms, cda_m2, mass_kg, crr, grade, altitude_m, headwind_ms, drivetrain_efficiency)
 
@@ -385,10 +396,10 @@ def speed_for_power(
         cda_m2=cda_m2,
         mass_kg=mass_kg,
         crr=crr,
-        grade=_finite("grade", grade),
+        grade=grade,
         altitude_m=altitude_m,
         headwind_ms=headwind_ms,
-        drivetrain_efficiency=_efficiency(drivetrain_efficiency),
+        drivetrain_efficiency=drivetrain_efficiency,
     )
     r = _resistance(cda_m2, mass_kg, crr, grade, altitude_m, headwind_ms, drivetrain_efficiency)
     # Validated above. Rolling plus climbing as m·g·cos θ·(Crr + grade), which is exactly 0 where Crr = −grade

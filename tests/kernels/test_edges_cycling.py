@@ -497,3 +497,11 @@ def test_road_forces_on_a_slope() -> None:
     rolling, climbing = cycling.road_forces(80.0, 0.004, 0.75)  # a 3-4-5 triangle: cos 0.8, sin 0.6
     assert float(rolling) == pytest.approx(0.004 * 80.0 * cycling.G * 0.8)
     assert float(climbing) == pytest.approx(80.0 * cycling.G * 0.6)
+
+
+@pytest.mark.parametrize("argument", ["speed_ms", "grade", "drivetrain_efficiency"])
+def test_a_ragged_list_is_refused_naming_it_not_as_numpy_s_inhomogeneous_shape(argument: str) -> None:
+    values: dict[str, object] = {"speed_ms": 10.0, "cda_m2": 0.32, "mass_kg": 80.0, "crr": 0.004}
+    values[argument] = [[1.0, 0.5], [0.5]]
+    with pytest.raises(ValueError, match=rf"^{argument} must be an array of real numbers"):
+        cycling.power(**values)  # type: ignore[arg-type]
