@@ -8,6 +8,7 @@ value it was found with is in the family.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import re
 from decimal import Decimal
@@ -376,18 +377,12 @@ def test_a_bad_field_of_view_is_refused_by_name(bad: Any) -> None:
         Camera((3.0, 0.0, 1.0), (0.0, 0.0, 0.0), fov_y_rad=bad)
 
 
-SHADING_NUMBERS = [
-    "ambient",
-    "diffuse",
-    "specular",
-    "occlusion_strength",
-    "shininess",
-    "shadow_sharpness",
-    "occlusion_step",
-    "hit_epsilon",
-    "max_distance",
-    "normal_epsilon",
-]
+SHADING_NUMBERS = [field.name for field in dataclasses.fields(Shading) if field.type in ("float", float)]
+"""Every real-number field of Shading, so a new one is tested as soon as it is declared."""
+
+
+def test_the_shading_numbers_are_its_ten_real_fields() -> None:
+    assert len(SHADING_NUMBERS) == 10 and {"ambient", "shininess", "normal_epsilon"} <= set(SHADING_NUMBERS)
 
 
 @pytest.mark.parametrize("name", SHADING_NUMBERS)
