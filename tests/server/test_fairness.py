@@ -482,7 +482,8 @@ def test_uploads_beyond_the_server_wide_count_are_refused_with_a_notice_and_the_
                     what=f"tab {i}'s upload",
                 )
                 assert not notices(client)
-            assert gate.uploads_in_flight() == (0, 0)
+            # Each tab sent two uploads; its course changes with the first, and the second may still be landing.
+            tabs[0][0].wait_for(lambda: gate.uploads_in_flight() == (0, 0), what="every upload landed")
             assert tabs[4][1].course_mode.route.name != "Tab 4"
             # Once the others are done, the refused tab's upload goes through.
             upload(tabs[4][0], "Upload GPX", "again.gpx", data[4])
