@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from kernels import _checks
 from kernels._checks import bounded_array, finite_number
 from kernels._rows import run_rows
 from kernels.fabrik.chain import (
@@ -204,7 +205,7 @@ def solve_batch(
     if points.shape != (batch, dim):
         raise ValueError(f"targets must have shape ({batch}, {dim}) to match joints, got {points.shape}")
     if not isinstance(solver, str) or solver not in _SOLVER_IDS:
-        raise ValueError(f"solver must be one of 'fabrik', 'ccd', 'jacobian_dls', got {solver!r}")
+        raise ValueError(f"solver must be one of 'fabrik', 'ccd', 'jacobian_dls', got {_checks.shown(solver)}")
     setup = _Setup.build(
         dim, tolerance, max_iterations, cone_half_angle_rad, obstacles, root_direction, _SOLVER_IDS[solver], extrapolate
     )
@@ -404,8 +405,16 @@ def two_bone(
 
 
 def link_lengths(joints: ArrayLike) -> NDArray[np.float64]:
-    """Link lengths (m): (n,) for (n + 1, d) joints, (B, n) for (B, n + 1, d)."""
-    segments = np.diff(np.asarray(joints, dtype=np.float64), axis=-2)
+    """Link lengths (m): (n,) for (n + 1, d) joints, (B, n) for (B, n + 1, d).
+
+    Raises:
+        ValueError: ``joints`` not finite real numbers of magnitude ≤ 1e150 m, or not of shape (n + 1, d) or
+            (B, n + 1, d) with d = 2 or 3; the message names ``joints``.
+    """
+    points = bounded_array("joints", joints, _LARGEST)
+    if points.ndim not in (2, 3) or points.shape[-1] not in (2, 3):
+        raise ValueError(f"joints must have shape (n + 1, d) or (B, n + 1, d) with d = 2 or 3, got {points.shape}")
+    segments = np.diff(points, axis=-2)
     # each segment first to max-abs 1, so its squared norm neither overflows (1e300) nor underflows (1e-160)
     largest = np.abs(segments).max(axis=-1, keepdims=True)
     largest = np.where(largest > 0.0, largest, 1.0)
@@ -456,7 +465,7 @@ def reach_limits(lengths: ArrayLike) -> tuple[float, float]:
     """
     links = bounded_array("lengths", lengths, _LARGEST)
     if links.ndim != 1 or links.shape[0] < 1 or not bool((links >= 0.0).all()):
-        raise ValueError(f"lengths must be a non-empty (n,) array of lengths ≥ 0, got {lengths!r}")
+        raise ValueError(f"lengths must be a non-empty (n,) array of lengths ≥ 0, got {_checks.shown(lengths)}")
     total = float(links.sum())
     return max(0.0, 2.0 * float(links.max()) - total), total
 
@@ -482,7 +491,7 @@ def _check_vector(name: str, value: ArrayLike, dim: int) -> NDArray[np.float64]:
 def _check_length(name: str, value: float) -> float:
     number = bounded_array(name, value, _LARGEST)
     if number.shape != () or float(number) < 0.0:
-        raise ValueError(f"{name} must be a finite number ≥ 0, got {value!r}")
+        raise ValueError(f"{name} must be a finite number ≥ 0, got {_checks.shown(value)}")
     return float(number)
 
 
@@ -494,7 +503,7 @@ def _root_direction(value: ArrayLike | None, dim: int) -> NDArray[np.float64]:
     axis = _check_vector("root_direction", value, dim)
     largest = float(np.abs(axis).max())
     if largest == 0.0:
-        raise ValueError(f"root_direction must be non-zero, got {value!r}")
+        raise ValueError(f"root_direction must be non-zero, got {_checks.shown(value)}")
     # first to max-abs 1, so neither a huge nor a tiny vector over- or underflows its norm
     axis = axis / largest
     return axis / float(np.linalg.norm(axis))
@@ -504,7 +513,7 @@ def _status_literal(text: str) -> Status:
     for status in STATUSES:
         if status == text:
             return status
-    raise ValueError(f"unknown status {text!r}")
+    raise ValueError(f"unknown status {_checks.shown(text)}")
 
 
 def _perpendicular_numpy(axis: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -601,7 +610,9 @@ class _Setup:
             try:
                 obstacles = list(obstacles)
             except TypeError as error:
-                raise ValueError(f"obstacles must be a sequence of (centre, radius), got {obstacles!r}") from error
+                raise ValueError(
+                    f"obstacles must be a sequence of (centre, radius), got {_checks.shown(obstacles)}"
+                ) from error
         if root_direction is None and not obstacles:
             return options
         count = len(obstacles)
@@ -610,11 +621,13 @@ class _Setup:
             try:
                 centre, radius = obstacle
             except (TypeError, ValueError) as error:
-                raise ValueError(f"obstacles[{k}] must be (centre, radius), got {obstacle!r}") from error
+                raise ValueError(f"obstacles[{k}] must be (centre, radius), got {_checks.shown(obstacle)}") from error
             centres[k, :dim] = _check_vector(f"obstacles[{k}] centre", centre, dim)
             radii[k] = finite_number(f"obstacles[{k}] radius", radius)
             if not 0.0 < radii[k] <= _LARGEST:
-                raise ValueError(f"obstacles[{k}] radius must be a finite number in (0, {_LARGEST:g}], got {radius!r}")
+                raise ValueError(
+                    f"obstacles[{k}] radius must be a finite number in (0, {_LARGEST:g}], got {_checks.shown(radius)}"
+                )
         rest = options.root_direction
         if root_direction is not None:
             rest = np.zeros(3)
@@ -635,16 +648,16 @@ def _options(
     chain asks for the same ones every frame (the compiled core never writes to them)."""
     tol = finite_number("tolerance", tolerance)
     if tol < 0.0:
-        raise ValueError(f"tolerance must be a finite number ≥ 0, got {tolerance!r}")
+        raise ValueError(f"tolerance must be a finite number ≥ 0, got {_checks.shown(tolerance)}")
     if isinstance(max_iterations, bool) or not isinstance(max_iterations, (int, np.integer)):
-        raise ValueError(f"max_iterations must be an integer, got {max_iterations!r}")
+        raise ValueError(f"max_iterations must be an integer, got {_checks.shown(max_iterations)}")
     if not 1 <= max_iterations <= _MAX_ITERATIONS_CAP:
         raise ValueError(f"max_iterations must be in [1, {_MAX_ITERATIONS_CAP}], got {max_iterations}")
     cos_phi, sin_phi, has_limits = -1.0, 0.0, 0
     if cone_half_angle_rad is not None:
         phi = finite_number("cone_half_angle_rad", cone_half_angle_rad)
         if not 0.0 <= phi <= math.pi:
-            raise ValueError(f"cone_half_angle_rad must be in [0, π], got {cone_half_angle_rad!r}")
+            raise ValueError(f"cone_half_angle_rad must be in [0, π], got {_checks.shown(cone_half_angle_rad)}")
         if phi < math.pi:
             cos_phi, sin_phi, has_limits = math.cos(phi), math.sin(phi), 1
     rest = np.zeros(3)
@@ -657,7 +670,7 @@ def _options(
         table=table,
         params=np.array([tol, cos_phi, sin_phi]),
         flags=np.array(
-            [int(max_iterations), dim, solver, int(bool(extrapolate)), has_limits, has_limits],
+            [int(max_iterations), dim, solver, int(_checks.flag("extrapolate", extrapolate)), has_limits, has_limits],
             dtype=np.int64,
         ),
         root_direction=rest,

@@ -16,6 +16,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from kernels import _checks
 from kernels._checks import bounded_array, finite_number
 from kernels._jit import compiled
 from kernels.fabrik.geometry import (
@@ -42,7 +43,7 @@ class Cone:
     def __post_init__(self) -> None:
         phi = finite_number("half_angle_rad", self.half_angle_rad)
         if not 0.0 <= phi <= math.pi:
-            raise ValueError(f"half_angle_rad must be in [0, π], got {self.half_angle_rad!r}")
+            raise ValueError(f"half_angle_rad must be in [0, π], got {_checks.shown(self.half_angle_rad)}")
         object.__setattr__(self, "half_angle_rad", phi)
 
 
@@ -86,28 +87,32 @@ class Hinge:
     def __post_init__(self) -> None:
         axis = bounded_array("axis", self.axis, _LARGEST)
         if axis.shape != (3,) or not float(np.linalg.norm(axis)) > _TINY:
-            raise ValueError(f"axis must be a non-zero (3,) vector, got {self.axis!r}")
+            raise ValueError(f"axis must be a non-zero (3,) vector, got {_checks.shown(self.axis)}")
         axis = axis / float(np.linalg.norm(axis))
         low = finite_number("min_angle_rad", self.min_angle_rad)
         high = finite_number("max_angle_rad", self.max_angle_rad)
         if not -math.pi <= low <= math.pi:
-            raise ValueError(f"min_angle_rad must be in [−π, π], got {self.min_angle_rad!r}")
+            raise ValueError(f"min_angle_rad must be in [−π, π], got {_checks.shown(self.min_angle_rad)}")
         if not low <= high <= math.pi:
-            raise ValueError(f"max_angle_rad must be in [min_angle_rad, π] = [{low}, π], got {self.max_angle_rad!r}")
+            raise ValueError(
+                f"max_angle_rad must be in [min_angle_rad, π] = [{low}, π], got {_checks.shown(self.max_angle_rad)}"
+            )
         reference = None
         if self.reference_axis is not None:
             raw = bounded_array("reference_axis", self.reference_axis, _LARGEST)
             if raw.shape != (3,):
-                raise ValueError(f"reference_axis must be a (3,) vector, got {self.reference_axis!r}")
+                raise ValueError(f"reference_axis must be a (3,) vector, got {_checks.shown(self.reference_axis)}")
             off = raw - float(raw @ axis) * axis
             if not float(np.linalg.norm(off)) > 1e-9 * max(float(np.linalg.norm(raw)), _TINY):
-                raise ValueError(f"reference_axis must not be parallel to axis, got {self.reference_axis!r}")
+                raise ValueError(
+                    f"reference_axis must not be parallel to axis, got {_checks.shown(self.reference_axis)}"
+                )
             reference = tuple(float(v) for v in off / float(np.linalg.norm(off)))
         match self.frame:
             case "global" | "local":
                 pass
             case _:
-                raise ValueError(f"frame must be 'global' or 'local', got {self.frame!r}")
+                raise ValueError(f"frame must be 'global' or 'local', got {_checks.shown(self.frame)}")
         object.__setattr__(self, "axis", tuple(float(v) for v in axis))
         object.__setattr__(self, "min_angle_rad", low)
         object.__setattr__(self, "max_angle_rad", high)
@@ -135,13 +140,13 @@ def _limit_table(
 
     ``segment_offset`` rows are left free at the start (the root of a tree has no segment)."""
     if isinstance(constraints, (str, bytes)) or not isinstance(constraints, Sequence):
-        raise ValueError(f"{name} must be a sequence of Cone, Hinge or None, got {constraints!r}")
+        raise ValueError(f"{name} must be a sequence of Cone, Hinge or None, got {_checks.shown(constraints)}")
     if len(constraints) != count:
         raise ValueError(f"{name} must have one entry per segment ({count}), got {len(constraints)}")
     table = np.zeros((count, _TABLE_WIDTH))
     for i, item in enumerate(constraints):
         if i < segment_offset and item is not None:
-            raise ValueError(f"{name}[{i}] must be None (the root has no segment), got {item!r}")
+            raise ValueError(f"{name}[{i}] must be None (the root has no segment), got {_checks.shown(item)}")
         match item:
             case None:
                 pass
@@ -151,7 +156,7 @@ def _limit_table(
             case Hinge():
                 axis = np.asarray(item.axis)
                 if dim == 2 and abs(axis[2]) < 1.0 - 1e-12:
-                    raise ValueError(f"{name}[{i}].axis must be ±z for a 2D chain, got {item.axis!r}")
+                    raise ValueError(f"{name}[{i}].axis must be ±z for a 2D chain, got {_checks.shown(item.axis)}")
                 table[i, 0] = _KIND_HINGE
                 table[i, 3:6] = axis
                 if item.reference_axis is not None:
@@ -160,7 +165,7 @@ def _limit_table(
                 table[i, 9], table[i, 10] = item.min_angle_rad, item.max_angle_rad
                 table[i, 11] = 1.0 if item.frame == "local" else 0.0
             case _:
-                raise ValueError(f"{name}[{i}] must be a Cone, a Hinge or None, got {item!r}")
+                raise ValueError(f"{name}[{i}] must be a Cone, a Hinge or None, got {_checks.shown(item)}")
     return table
 
 

@@ -15,6 +15,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from kernels import _checks
 from kernels._jit import compiled
 from kernels.fabrik.api import (
     _UNSCALED,
@@ -146,12 +147,12 @@ def solve_tree(
     points = _check_joints("joints", joints, batched=False)
     count, dim = points.shape
     if not isinstance(targets, Mapping) or not targets:
-        raise ValueError(f"targets must be a non-empty mapping joint index → target, got {targets!r}")
+        raise ValueError(f"targets must be a non-empty mapping joint index → target, got {_checks.shown(targets)}")
     # Keys and parents are checked for type and shape before the cache: 2.0 and True hash as 2 and 1, and a
     # flattened (1, J) array as its (J,) row, so the cache would otherwise answer for input it must refuse.
     for key in targets:
         if isinstance(key, bool) or not isinstance(key, (int, np.integer)) or not 0 <= key < count:
-            raise ValueError(f"targets keys must be joint indices in [0, {count - 1}], got {key!r}")
+            raise ValueError(f"targets keys must be joint indices in [0, {count - 1}], got {_checks.shown(key)}")
     keys = tuple(sorted(int(key) for key in targets))
     try:
         raw = np.asarray(parents)
@@ -268,9 +269,9 @@ def _tree_topology(
     try:
         raw = np.asarray(parents)
     except (TypeError, ValueError) as error:
-        raise ValueError(f"parents must be a ({count},) array of integers, got {parents!r}") from error
+        raise ValueError(f"parents must be a ({count},) array of integers, got {_checks.shown(parents)}") from error
     if raw.shape != (count,) or raw.dtype.kind not in "iu" or np.any(raw < -1) or np.any(raw >= count):
-        raise ValueError(f"parents must be ({count},) integers in [−1, {count - 1}], got {parents!r}")
+        raise ValueError(f"parents must be ({count},) integers in [−1, {count - 1}], got {_checks.shown(parents)}")
     parent = raw.astype(np.int64)
     roots = np.flatnonzero(parent == -1)
     if roots.size != 1:
@@ -287,7 +288,7 @@ def _tree_topology(
     has_goal = np.zeros(count, dtype=np.bool_)
     for key in keys:
         if isinstance(key, bool) or not isinstance(key, (int, np.integer)) or not 0 <= key < count:
-            raise ValueError(f"targets keys must be joint indices in [0, {count - 1}], got {key!r}")
+            raise ValueError(f"targets keys must be joint indices in [0, {count - 1}], got {_checks.shown(key)}")
         if children[key]:
             raise ValueError(f"targets[{key}] is on a joint with children: targets go on end effectors")
         has_goal[key] = True
