@@ -524,7 +524,11 @@ middle, so a coarser step can decide the verdict (the default kick, a goal at dt
 
 
 def _refuse_unplayable(
-    launches: NDArray[np.float64], pitches: NDArray[np.float64], which: NDArray[np.int64], settings: NDArray[np.float64]
+    launches: NDArray[np.float64],
+    pitches: NDArray[np.float64],
+    which: NDArray[np.int64],
+    settings: NDArray[np.float64],
+    strikes: bool = False,
 ) -> None:
     """``ValueError`` naming ``dt`` where it is over :data:`MAX_PITCH_DT_S`, or the first kick that starts off its
     pitch: behind the goal line (it would fly in through the back of the net), more than
@@ -532,7 +536,7 @@ def _refuse_unplayable(
     if settings[DT] > MAX_PITCH_DT_S:
         raise ValueError(
             f"dt must be at most {MAX_PITCH_DT_S:g} s on a pitch (contacts are found once a step), got "
-            f"{float(settings[DT])!r}"
+            f"{_checks.shown(float(settings[DT]))}"
         )
     rows = pitches[which]
     dx, dy = launches[:, 0] - rows[:, play.GX], launches[:, 1] - rows[:, play.GY]
@@ -541,7 +545,7 @@ def _refuse_unplayable(
     off = np.flatnonzero((depth > 0.0) | (depth < -MAX_PITCH_LENGTH_M) | (np.abs(across) > rows[:, play.HALF_WIDTH]))
     if off.size:
         k = int(off[0])
-        which_kick = f"positions[{k}]" if len(launches) > 1 else "position"
+        which_kick = f"positions[{k}]" if len(launches) > 1 and not strikes else "position"
         where = f"{abs(depth[k]):.4g} m {'behind' if depth[k] > 0.0 else 'in front of'}"
         raise ValueError(
             f"{which_kick} must be on the pitch, in front of the goal line (at most {MAX_PITCH_LENGTH_M:g} m) and "
@@ -569,13 +573,15 @@ def _checked_batch(
     knuckle_seeds: Sequence[int | None] | None,
     config: FlightConfig | None,
     options: dict[str, Any],
+    strikes: bool = False,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """A batch's (14,) settings and its (K, 13) launch rows, checked (``ValueError`` naming the argument)."""
+    """A batch's (14,) settings and its (K, 13) launch rows, checked (``ValueError`` naming the argument; for
+    ``strikes``, see :func:`~kernels.ball.config.check_launches`)."""
     settings = flight_config(config, options).settings
     launches = kick_rows(positions, velocities, spins, knuckle_seeds)
     if len(launches) > MAX_KICKS:
         raise ValueError(f"positions must hold at most {MAX_KICKS:,} kicks in one call, got {len(launches):,}")
-    check_launches(launches, settings, batch=True)
+    check_launches(launches, settings, batch=True, strikes=strikes)
     return settings, launches
 
 
@@ -591,7 +597,7 @@ def _play_batch(
     events, info, n_samples, endings); flights kept only when ``keep`` (else zero-length rows, and each flight ends
     once its verdict cannot change)."""
     k = len(launches)
-    _refuse_unplayable(launches, pitches, which, settings)
+    _refuse_unplayable(launches, pitches, which, settings, strikes)
     rows = int(settings[N_STEPS]) + 1 + play.EXTRA_ROWS if keep else 0
     t, state, spin = np.empty((k, rows)), np.empty((k, rows, 6)), np.empty((k, rows, 3))
     events, info = np.empty((k, play.MAX_EVENTS, 5)), np.empty((k, play.N_INFO))
@@ -603,13 +609,15 @@ def _play_batch(
 
 
 def _one_pitch(
-    launches: NDArray[np.float64], settings: NDArray[np.float64], pitch: Pitch
+    launches: NDArray[np.float64], settings: NDArray[np.float64], pitch: Pitch, strikes: bool = False
 ) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
     """(1, N_PITCH) read-only rows of ``pitch`` (a keeper placed for the first kick's spot) and every kick's index."""
-    return _placed_pitch(launches, settings, pitch)[None], np.zeros(len(launches), dtype=np.int64)
+    return _placed_pitch(launches, settings, pitch, strikes)[None], np.zeros(len(launches), dtype=np.int64)
 
 
-def _placed_pitch(launches: NDArray[np.float64], settings: NDArray[np.float64], pitch: Pitch) -> NDArray[np.float64]:
+def _placed_pitch(
+    launches: NDArray[np.float64], settings: NDArray[np.float64], pitch: Pitch, strikes: bool = False
+) -> NDArray[np.float64]:
     """``pitch``'s vector with its keeper placed from the first kick's spot; a spot off the pitch (behind the goal,
     where the keeper's placement would be refused first, naming his fields) is refused naming the kick's position."""
     ground, radius = float(settings[GROUND]), float(settings[RADIUS])
@@ -619,7 +627,7 @@ def _placed_pitch(launches: NDArray[np.float64], settings: NDArray[np.float64], 
     except ValueError:  # the keeper's placement, or another field: is it the kick's spot that is wrong?
         if isinstance(pitch, Pitch) and pitch.keeper is not None and pitch.keeper.position_xy is None and len(launches):
             bare = _pitch_vector(dataclasses.replace(pitch, keeper=None), spot, ground, radius)
-            _refuse_unplayable(launches, bare[None], np.zeros(len(launches), dtype=np.int64), settings)
+            _refuse_unplayable(launches, bare[None], np.zeros(len(launches), dtype=np.int64), settings, strikes)
         raise
 
 
@@ -647,14 +655,14 @@ def pitch_strike_outcomes(
     them is refused naming that kick's ``speed_ms`` and ``spin_rads``, the arguments its caller was given."""
     options = dict(options)
     config = options.pop("config", None)  # as simulate_outcomes takes it
-    settings, launches = _checked_batch(positions, velocities, spins, None, config, options)
+    settings, launches = _checked_batch(positions, velocities, spins, None, config, options, strikes=True)
     return _pitch_outcome(launches, settings, pitch, strikes=True)
 
 
 def _pitch_outcome(
     launches: NDArray[np.float64], settings: NDArray[np.float64], pitch: Pitch, strikes: bool
 ) -> BatchOutcome:
-    *_, info, _, _ = _play_batch(launches, settings, *_one_pitch(launches, settings, pitch), False, strikes)
+    *_, info, _, _ = _play_batch(launches, settings, *_one_pitch(launches, settings, pitch, strikes), False, strikes)
     return BatchOutcome(
         result=np.array(RESULTS, dtype="<U5")[info[:, play.I_RESULT].astype(np.int64)],
         wall_point=info[:, play.I_WALL + 1 : play.I_WALL + 4].copy(),
@@ -706,7 +714,7 @@ def outcome(trajectory: Trajectory, wall: Panel, goal: Panel, *, radius_m: float
     if trajectory.result is not None:
         raise ValueError(
             "trajectory was played on a pitch: its verdict, with the posts, the bar, the wall's players and the "
-            f"keeper, is trajectory.result ({trajectory.result!r}); outcome() judges a free flight"
+            f"keeper, is trajectory.result ({_checks.shown(trajectory.result)}); outcome() judges a free flight"
         )
     crossings = np.empty((2, 4))
     # Judged from a writable copy laid out as a batch's row (times strided, positions and velocities slices of one

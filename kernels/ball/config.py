@@ -79,7 +79,7 @@ def checked_vector(name: str, value: ArrayLike, size: int) -> NDArray[np.float64
     """:func:`kernels._checks.vector`, and no boolean anywhere inside (special to this kernel: numpy turns a
     ``[1.0, True, 2.0]`` into floats, and a flag where a coordinate belongs is a caller's bug)."""
     if _booleans(value):
-        raise ValueError(f"{name} must be numbers, not booleans, got {value!r}")
+        raise ValueError(f"{name} must be numbers, not booleans, got {_checks.shown(value)}")
     return _checks.vector(name, value, size)
 
 
@@ -115,8 +115,13 @@ def checked_seed(name: str, value: object) -> int | None:
     if value is None:
         return None
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
-        raise ValueError(f"{name} must be None or an integer >= 0, got {value!r}")
+        raise ValueError(f"{name} must be None or an integer >= 0, got {_checks.shown(value)}")
     return int(value)
+
+
+MAX_GRAVITY = 1000.0
+"""Largest |gravity| a flight takes (m/s²): past the Sun's surface, and far from where a step limit in air or the
+flight's energy bound would overflow (1e300 was refused naming dt)."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -162,7 +167,9 @@ class FlightConfig:
         step = _checks.positive("dt", self.dt)
         duration = _checks.positive("t_max", self.t_max)
         if duration / step > _MAX_STEPS:
-            raise ValueError(f"dt must be at least t_max/{_MAX_STEPS} = {duration / _MAX_STEPS:g} s, got {step!r}")
+            raise ValueError(
+                f"dt must be at least t_max/{_MAX_STEPS} = {duration / _MAX_STEPS:g} s, got {_checks.shown(step)}"
+            )
         _checks.choice("method", self.method, ("euler", "rk4"))
         _checks.choice("model", self.model, ("constant", "measured"))
         c_d = _checks.non_negative("drag_coefficient", self.drag_coefficient)
@@ -170,9 +177,13 @@ class FlightConfig:
         mass = _checks.positive("mass_kg", self.mass_kg)
         radius = _checks.positive("radius_m", self.radius_m)
         if radius > MAX_BALL_RADIUS_M:
-            raise ValueError(f"radius_m must be at most {MAX_BALL_RADIUS_M:g} m (a ball), got {self.radius_m!r}")
+            raise ValueError(
+                f"radius_m must be at most {MAX_BALL_RADIUS_M:g} m (a ball), got {_checks.shown(self.radius_m)}"
+            )
         density = _checks.non_negative("air_density", self.air_density)
         g = _checks.finite_number("gravity", self.gravity)
+        if abs(g) > MAX_GRAVITY:
+            raise ValueError(f"gravity must be within ±{MAX_GRAVITY:g} m/s² (the Sun's is 274), got {_checks.shown(g)}")
         stop = math.inf if self.x_stop is None else _checks.finite_number("x_stop", self.x_stop)
         ground = _checks.finite_number("ground_m", self.ground_m)
         crisis = _checks.positive("drag_crisis_re", self.drag_crisis_re)
@@ -274,7 +285,7 @@ def kick_rows(
         seeds: list[int | None] = [None] * k
     else:
         if isinstance(knuckle_seeds, (str, bytes)) or not isinstance(knuckle_seeds, (Sequence, np.ndarray)):
-            raise ValueError(f"knuckle_seeds must be None or a sequence of K seeds, got {knuckle_seeds!r}")
+            raise ValueError(f"knuckle_seeds must be None or a sequence of K seeds, got {_checks.shown(knuckle_seeds)}")
         seeds = [checked_seed("knuckle_seeds", seed) for seed in knuckle_seeds]
         if len(seeds) != k:
             raise ValueError(f"knuckle_seeds must have {k} entries, got {len(seeds)}")
@@ -288,23 +299,27 @@ def _safe_norms(rows: NDArray[np.float64]) -> NDArray[np.float64]:
     return scale * np.sqrt(((rows / safe[:, None]) ** 2).sum(axis=1))
 
 
-def check_launches(launches: NDArray[np.float64], config: NDArray[np.float64], batch: bool) -> None:
-    """Refuse a launch below the ground and, in the measured model, a spin far beyond its fits."""
+def check_launches(
+    launches: NDArray[np.float64], config: NDArray[np.float64], batch: bool, strikes: bool = False
+) -> None:
+    """Refuse a launch below the ground and, in the measured model, a spin far beyond its fits; named as the kick's
+    ``position`` and ``spin``, a batch's ``positions[k]`` and ``spins[k]``, or (``strikes``: strikes scattered
+    about one intended kick) that kick's ``position`` and ``spin_rads``."""
     if not batch and not config[MEASURED] and launches[0, 2] >= config[GROUND]:
         return  # one kick in the constant model, above the ground: the common case, without array work
     low = np.flatnonzero(launches[:, 2] < config[GROUND])
     if low.size:
-        which = f"positions[{low[0]}]" if batch else "position"
+        which = f"positions[{low[0]}]" if batch and not strikes else "position"
         raise ValueError(
-            f"{which} starts below the ground: z = {float(launches[low[0], 2])!r} m < ground_m = "
-            f"{float(config[GROUND])!r} m"
+            f"{which} starts below the ground: z = {_checks.shown(float(launches[low[0], 2]))} m < ground_m = "
+            f"{_checks.shown(float(config[GROUND]))} m"
         )
     if config[MEASURED]:
         speeds = np.maximum(_safe_norms(launches[:, 3:6]), 1.0)
         spin_parameter = config[RADIUS] * _safe_norms(launches[:, 6:9]) / speeds
         bad = np.flatnonzero(spin_parameter > _SPIN_PARAMETER_LIMIT)
         if bad.size:
-            which = f"spins[{bad[0]}]" if batch else "spin"
+            which = "spin_rads" if strikes else f"spins[{bad[0]}]" if batch else "spin"
             raise ValueError(
                 f"{which} is too fast for the measured model: spin parameter S = r·|ω|/max(|v|, 1 m/s) = "
                 f"{spin_parameter[bad[0]]:.3g} > {_SPIN_PARAMETER_LIMIT:g} (its fits stop at S ≈ 0.3)"

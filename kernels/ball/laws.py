@@ -41,7 +41,7 @@ centre), and a size-5 football's usual model (Cross 2002)."""
 def _real_array(name: str, value: ArrayLike, *, non_negative: bool = False) -> NDArray[np.float64]:
     """Finite float64 array (any shape) from ``value``, refusing booleans anywhere in it; ≥ 0 if asked."""
     if _booleans(value):
-        raise ValueError(f"{name} must be numbers, not booleans, got {value!r}")
+        raise ValueError(f"{name} must be numbers, not booleans, got {_checks.shown(value)}")
     return _checks.non_negative_array(name, value) if non_negative else _checks.finite_array(name, value)
 
 
@@ -121,7 +121,7 @@ def _impact_rows(name: str, value: ArrayLike) -> NDArray[np.float64]:
 def _fraction(name: str, value: object) -> float:
     number = _checks.finite_number(name, value)
     if not 0.0 <= number <= 1.0:
-        raise ValueError(f"{name} must be in [0, 1], got {value!r}")
+        raise ValueError(f"{name} must be in [0, 1], got {_checks.shown(value)}")
     return number
 
 
@@ -177,7 +177,7 @@ def bounce(
     direction = checked_vector("normal", normal, 3)
     scale = float(np.abs(direction).max())
     if scale == 0.0:
-        raise ValueError(f"normal must not be zero, got {normal!r}")
+        raise ValueError(f"normal must not be zero, got {_checks.shown(normal)}")
     direction = direction / scale  # largest component ±1 first: neither overflows nor underflows when squared
     unit = direction / math.sqrt(float(direction @ direction))
     e_n = _fraction("restitution", restitution)
@@ -186,7 +186,9 @@ def bounce(
     radius = _checks.positive("radius_m", radius_m)
     alpha = _checks.positive("inertia_factor", inertia_factor)
     if alpha > SHELL_INERTIA_FACTOR * (1.0 + 1e-12):
-        raise ValueError(f"inertia_factor must be in (0, 2/3] (2/3 is a thin shell), got {inertia_factor!r}")
+        raise ValueError(
+            f"inertia_factor must be in (0, 2/3] (2/3 is a thin shell), got {_checks.shown(inertia_factor)}"
+        )
     try:
         shape = np.broadcast_shapes(v.shape, w.shape)
     except ValueError as error:

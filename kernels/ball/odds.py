@@ -64,7 +64,7 @@ class StrikeSpread:
             name = f"spread.{field.name}"
             value = _checks.non_negative(name, getattr(self, field.name))
             if value > SPREAD_LIMITS[field.name]:
-                raise ValueError(f"{name} must be at most {SPREAD_LIMITS[field.name]:g}, got {value!r}")
+                raise ValueError(f"{name} must be at most {SPREAD_LIMITS[field.name]:g}, got {_checks.shown(value)}")
         return self
 
 
@@ -92,7 +92,7 @@ class Odds:
     def probability(self, result: str) -> float:
         """Share of the strikes that ended as ``result`` (0–1)."""
         if result not in self.counts:
-            raise ValueError(f"result must be one of {sorted(self.counts)}, got {result!r}")
+            raise ValueError(f"result must be one of {sorted(self.counts)}, got {_checks.shown(result)}")
         return self.counts[result] / self.n if self.n else 0.0
 
 
@@ -112,14 +112,16 @@ def draw_strikes(
     """
     speed_ms = _checks.non_negative("speed_ms", speed_ms)
     if speed_ms > MAX_STRIKE_SPEED_MS:
-        raise ValueError(f"speed_ms must be at most {MAX_STRIKE_SPEED_MS:g} m/s (a strike), got {speed_ms!r}")
+        raise ValueError(
+            f"speed_ms must be at most {MAX_STRIKE_SPEED_MS:g} m/s (a strike), got {_checks.shown(speed_ms)}"
+        )
     elevation_rad = _checks.finite_number("elevation_rad", elevation_rad)
     azimuth_rad = _checks.finite_number("azimuth_rad", azimuth_rad)
     spin = checked_vector("spin_rads", spin_rads, 3)
     scale = float(np.abs(spin).max())
     rate = scale * float(np.linalg.norm(spin / scale)) if scale > 0.0 else 0.0  # |ω| without overflowing its square
     if not math.isfinite(rate):
-        raise ValueError(f"spin_rads must have a finite magnitude, got {spin_rads!r}")
+        raise ValueError(f"spin_rads must have a finite magnitude, got {_checks.shown(spin_rads)}")
     spread = _checks.instance("spread", spread, StrikeSpread).checked()
     count = _strike_count("n", n, 1)
     rng = np.random.default_rng(checked_seed("draw", draw))
@@ -228,10 +230,12 @@ def odds_map(
     if not ((distances > WALL_DISTANCE_M) & (distances <= MAX_DISTANCE_M)).all():
         raise ValueError(
             f"distances_m must be in ({WALL_DISTANCE_M}, {MAX_DISTANCE_M:g}] m (beyond the wall's distance, on a "
-            f"pitch), got {distances_m!r}"
+            f"pitch), got {_checks.shown(distances_m)}"
         )
     if not (np.abs(angles) < 0.5 * math.pi).all():
-        raise ValueError(f"angles_rad must be in (−π/2, π/2) (in front of the goal line), got {angles_rad!r}")
+        raise ValueError(
+            f"angles_rad must be in (−π/2, π/2) (in front of the goal line), got {_checks.shown(angles_rad)}"
+        )
     half_width = 0.5 * PITCH_WIDTH_M
     across = np.abs(np.outer(distances, np.sin(angles)))
     if (across > half_width).any():
@@ -245,9 +249,9 @@ def odds_map(
     _strike_count("n", n * len(distances) * len(angles), len(distances) * len(angles), "n × spots")
     _checks.integer("chunks", chunks, 1)
     if progress is not None and not callable(progress):
-        raise ValueError(f"progress must be None or a function of the share done, got {progress!r}")
+        raise ValueError(f"progress must be None or a function of the share done, got {_checks.shown(progress)}")
     if not isinstance(wall, bool):
-        raise ValueError(f"wall must be True or False, got {wall!r}")
+        raise ValueError(f"wall must be True or False, got {_checks.shown(wall)}")
     if keeper is not None:
         _checks.instance("keeper", keeper, Keeper)
     if surface is not None:
@@ -270,7 +274,7 @@ def odds_map(
         rows = launches[s * len(velocities) : (s + 1) * len(velocities)]
         rows[:, 0:2], rows[:, 2] = spot, ground
         rows[:, 3:6], rows[:, 6:9] = velocities @ turn.T, spins @ turn.T
-    check_launches(launches, settings, batch=True)
+    check_launches(launches, settings, batch=True, strikes=True)
     which = np.repeat(np.arange(len(spots)), len(velocities))
     codes = np.empty(len(launches), dtype=np.int64)
     bounds = np.linspace(0, len(spots), min(chunks, max(len(spots), 1)) + 1).astype(int)

@@ -73,8 +73,8 @@ def free_kick_panels(
         raise ValueError("goal_normal_xy must not be zero")
     if float((centre - ball) @ normal) <= 0.0:
         raise ValueError(
-            f"goal_normal_xy points from the pitch into the net, away from the ball; {tuple(normal.tolist())!r} "
-            f"points from the goal at {tuple(centre.tolist())!r} toward the ball at {tuple(ball.tolist())!r}"
+            f"goal_normal_xy points from the pitch into the net, away from the ball; {_checks.shown(tuple(normal.tolist()))} "
+            f"points from the goal at {_checks.shown(tuple(centre.tolist()))} toward the ball at {_checks.shown(tuple(ball.tolist()))}"
         )
     aim = centre - ball
     distance = float(np.hypot(*aim))
@@ -102,7 +102,7 @@ def _panel_size(name: str, value: object) -> float:
     """A size in (0, :data:`MAX_PANEL_M`] m, else ``ValueError`` naming it."""
     size = _checks.positive(name, value)
     if size > MAX_PANEL_M:
-        raise ValueError(f"{name} must be at most {MAX_PANEL_M:g} m, got {value!r}")
+        raise ValueError(f"{name} must be at most {MAX_PANEL_M:g} m, got {_checks.shown(value)}")
     return size
 
 
@@ -127,7 +127,9 @@ def panel_row(name: str, panel: Panel, *, standing: bool = False) -> NDArray[np.
     # Bounded by a pitch's size, many times over: a wall 1e300 m high let a shot through (its top overflowed).
     for slot, field in ((4, "width_m"), (5, "height_m")):
         if row[slot] > MAX_PANEL_M:
-            raise ValueError(f"{name}.{field} must be at most {MAX_PANEL_M:g} m, got {getattr(panel, field)!r}")
+            raise ValueError(
+                f"{name}.{field} must be at most {MAX_PANEL_M:g} m, got {_checks.shown(getattr(panel, field))}"
+            )
     return row
 
 
@@ -234,10 +236,14 @@ class Keeper:
             return float(spot[0]), float(spot[1])
         depth = _checks.finite_number("keeper.depth_m", self.depth_m)
         if not 0.0 <= depth <= PENALTY_AREA_DEPTH_M:
-            raise ValueError(f"keeper.depth_m must be in [0, {PENALTY_AREA_DEPTH_M:g}] m, got {self.depth_m!r}")
+            raise ValueError(
+                f"keeper.depth_m must be in [0, {PENALTY_AREA_DEPTH_M:g}] m, got {_checks.shown(self.depth_m)}"
+            )
         shift = _checks.finite_number("keeper.shift_m", self.shift_m)
         if abs(shift) > PENALTY_AREA_HALF_WIDTH_M:
-            raise ValueError(f"keeper.shift_m must be within ±{PENALTY_AREA_HALF_WIDTH_M:g} m, got {self.shift_m!r}")
+            raise ValueError(
+                f"keeper.shift_m must be within ±{PENALTY_AREA_HALF_WIDTH_M:g} m, got {_checks.shown(self.shift_m)}"
+            )
         ball = _checks.bounded_array("ball_xy", checked_vector("ball_xy", ball_xy, 2), 1e300)  # no hypot overflows
         # The bisector of the angle at the ball runs from the ball through the point that splits the goal line in
         # the ratio of the ball's distances to the posts; the keeper stands on it, depth_m out from the line.
@@ -266,7 +272,7 @@ def _refuse_outside_area(
         raise ValueError(
             f"{name} must put the keeper in his penalty area: 0 to {PENALTY_AREA_DEPTH_M:g} m out from the goal line "
             f"and within {PENALTY_AREA_HALF_WIDTH_M:g} m of the goal's centre across it; he would stand at "
-            f"{tuple(round(float(v), 6) for v in spot)!r} m, {out:.3g} m out and {across:.3g} m across"
+            f"{_checks.shown(tuple(round(float(v), 6) for v in spot))} m, {out:.3g} m out and {across:.3g} m across"
         )
 
 
@@ -313,7 +319,7 @@ def _surface_slots(name: str, surface: Surface, radius: float) -> list[float]:
     for label, value in (("restitution", e_n), ("tangential_restitution", e_t)):
         number = _checks.finite_number(f"{name}.{label}", value)
         if not 0.0 <= number <= 1.0:
-            raise ValueError(f"{name}.{label} must be in [0, 1], got {value!r}")
+            raise ValueError(f"{name}.{label} must be in [0, 1], got {_checks.shown(value)}")
     mu = _checks.non_negative(f"{name}.friction", surface.friction)
     _checks.non_negative(f"{name}.rolling_deceleration_ms2", surface.rolling_deceleration_ms2)
     return [float(e_n), float(e_t), mu, radius, 2.0 / 3.0]
@@ -332,7 +338,7 @@ def pitch_vector(pitch: Pitch, ball_xy: ArrayLike, ground_m: float, radius_m: fl
     if vector[play.NET_DEPTH] <= 2.0 * radius_m + post_radius:  # room for the whole ball over the line (a goal)
         raise ValueError(
             f"pitch.net_depth_m must be more than the ball's diameter and the post's radius "
-            f"({2.0 * radius_m + post_radius:g} m), got {pitch.net_depth_m!r}"
+            f"({2.0 * radius_m + post_radius:g} m), got {_checks.shown(pitch.net_depth_m)}"
         )
     vector[play.TURF] = ground_m - radius_m
     vector[play.HALF_WIDTH] = 0.5 * _within("pitch.pitch_width_m", pitch.pitch_width_m, MAX_PANEL_M)
@@ -340,7 +346,7 @@ def pitch_vector(pitch: Pitch, ball_xy: ArrayLike, ground_m: float, radius_m: fl
     if vector[play.HALF_WIDTH] * 2.0 <= least:
         raise ValueError(
             f"pitch.pitch_width_m must be more than the goal's width and its posts ({least:g} m), "
-            f"got {pitch.pitch_width_m!r}"
+            f"got {_checks.shown(pitch.pitch_width_m)}"
         )
     vector[play.ROLL_DECEL] = _checks.non_negative(
         "pitch.surface.rolling_deceleration_ms2", pitch.surface.rolling_deceleration_ms2
@@ -363,7 +369,7 @@ def pitch_vector(pitch: Pitch, ball_xy: ArrayLike, ground_m: float, radius_m: fl
                     f"16 (8 m): give pitch.wall_players, or a narrower wall"
                 )
         if isinstance(players, bool) or not isinstance(players, (int, np.integer)) or not 1 <= players <= 16:
-            raise ValueError(f"pitch.wall_players must be None or an integer in [1, 16], got {players!r}")
+            raise ValueError(f"pitch.wall_players must be None or an integer in [1, 16], got {_checks.shown(players)}")
         vector[play.WALL_ON] = 1.0
         vector[play.WX : play.WH + 1] = wall_row
         vector[play.N_PLAYERS] = players
@@ -396,5 +402,5 @@ def _within(name: str, value: object, most: float, *, zero: bool = False) -> flo
     """A number in (0, ``most``] (``zero``: [0, ``most``]), else ``ValueError`` naming it."""
     number = _checks.non_negative(name, value) if zero else _checks.positive(name, value)
     if number > most:
-        raise ValueError(f"{name} must be at most {most:g}, got {value!r}")
+        raise ValueError(f"{name} must be at most {most:g}, got {_checks.shown(value)}")
     return number

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Callable
 
 import numpy as np
 import pytest
@@ -340,3 +341,42 @@ def test_a_printed_limit_never_exceeds_the_limit(value: float) -> None:
     printed = float(f"{_round_down(value):.3g}")
     assert printed <= value
     assert printed >= value * (1.0 - 1e-2) or value < 1e-305
+
+
+# --------------------------------------------------------------------------------------------- a strike's own names
+# The kind: a function that scatters one intended kick into many named the batch it built (positions[0],
+# spins[0]) where its caller gave position and spin_rads.
+@pytest.mark.parametrize(
+    ("call", "message"),
+    [
+        (
+            lambda: ball.strike_odds(
+                (-20.0, 0.0, 0.11), 25.0, 0.3, 0.0, (0.0, 0.0, 1e20), _PITCH, n=8, model="measured"
+            ),
+            r"^spin_rads is too fast for the measured model",
+        ),
+        (
+            lambda: ball.odds_map([20.0], [0.0], 25.0, 0.3, 0.0, (0.0, 0.0, 1e20), n=8, model="measured"),
+            r"^spin_rads is too fast for the measured model",
+        ),
+        (
+            lambda: ball.strike_odds((-20.0, 0.0, -1.0), 25.0, 0.3, 0.0, (0.0, 0.0, 50.0), _PITCH, n=8),
+            r"^position starts below the ground",
+        ),
+        (
+            lambda: ball.strike_odds((25.0, 0.0, 1.0), 25.0, 0.3, 0.0, (0.0, 0.0, 50.0), _PITCH, n=8),
+            r"^position must be on the pitch",
+        ),
+    ],
+)
+def test_a_strikes_refusal_names_the_arguments_its_caller_gave(call: Callable[[], object], message: str) -> None:
+    with pytest.raises(ValueError, match=message):
+        call()
+
+
+@pytest.mark.parametrize("gravity", [1e300, -1e300, 1000.1, math.inf])
+def test_an_absurd_gravity_is_refused_naming_it(gravity: float) -> None:
+    # 1e300 m/s² overflowed the flight, and the refusal named dt.
+    with pytest.raises(ValueError, match=r"^gravity must be"):
+        ball.simulate((0.0, 0.0, 1.0), (20.0, 0.0, 5.0), (0.0, 0.0, 0.0), gravity=gravity)
+    assert ball.simulate((0.0, 0.0, 1.0), (20.0, 0.0, 5.0), (0.0, 0.0, 0.0), gravity=274.0).ended == "ground"
