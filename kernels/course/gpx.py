@@ -81,11 +81,11 @@ def load_gpx(source: str | os.PathLike[str] | bytes, *, name: str | None = None,
         label = path.name
         try:
             size = path.stat().st_size
+            if size > MAX_FILE_BYTES:
+                raise ValueError(f"{label} is {size / 2**20:.1f} MiB; the limit is 20 MiB")
+            data = path.read_bytes()  # a directory or an unreadable file: OSError, as a missing one
         except OSError as error:
             raise ValueError(f"cannot read {path}: {error.strerror}") from error
-        if size > MAX_FILE_BYTES:
-            raise ValueError(f"{label} is {size / 2**20:.1f} MiB; the limit is 20 MiB")
-        data = path.read_bytes()
     elif isinstance(source, str):
         if len(source) > MAX_FILE_BYTES or len(source.encode("utf-8")) > MAX_FILE_BYTES:
             raise ValueError("the file is larger than the 20 MiB limit")
@@ -177,7 +177,7 @@ def _decode(data: bytes, label: str) -> str:
         try:
             codecs.lookup(encoding)
         except LookupError as error:
-            raise ValueError(f"{label} declares an unknown text encoding {encoding!r}") from error
+            raise ValueError(f"{label} declares an unknown text encoding {_checks.shown(encoding)}") from error
     try:
         text = data.decode(encoding)
     except (UnicodeDecodeError, ValueError) as error:

@@ -60,10 +60,10 @@ class Rider:
         for key in ("cda_m2", "mass_kg", "crr", "spoke_drag_m2", "wheel_inertia_kgm2", "wheel_radius_m"):
             low, high = cycling.MARTIN_DOMAIN[key]
             if not low <= getattr(self, key) <= high:
-                raise ValueError(f"{key} must be in [{low:g}, {high:g}], got {getattr(self, key)!r}")
+                raise ValueError(f"{key} must be in [{low:g}, {high:g}], got {_checks.shown(getattr(self, key))}")
         eta = self.drivetrain_efficiency
         if not 1e-3 <= _checks.finite_number("drivetrain_efficiency", eta) <= 1.0:
-            raise ValueError(f"drivetrain_efficiency must be in [0.001, 1], got {eta!r}")
+            raise ValueError(f"drivetrain_efficiency must be in [0.001, 1], got {_checks.shown(eta)}")
         _checks.choice("model", self.model, _MODELS)
 
     @property
@@ -128,7 +128,7 @@ class Air:
                     self.relative_humidity,
                 )
             case _:
-                raise ValueError(f"kind must be 'seed' or 'weather', got {self.kind!r}")
+                raise ValueError(f"kind must be 'seed' or 'weather', got {_checks.shown(self.kind)}")
 
 
 _ISA_RANGE_M = (-1000.0, 20_000.0)
@@ -183,7 +183,7 @@ class Ride:
         every = _checks.positive("every_m", every_m)
         total = float(self.distance_m[-1])
         if total / every > 10_000:  # before numpy is asked for the marks (10²⁹⁹ of them at 1e-300 m)
-            raise ValueError(f"every_m must give at most 10 000 splits, got {every_m!r} over {total:g} m")
+            raise ValueError(f"every_m must give at most 10 000 splits, got {_checks.shown(every_m)} over {total:g} m")
         marks = np.arange(every, total, every)
         marks = np.concatenate((marks, [total]))
         return marks, np.interp(marks, self.distance_m, self.elapsed_s)
@@ -417,7 +417,7 @@ def _segments(course: Course, rider: Rider, wind_ms: float, wind_from_deg: float
     wind = _checks.finite_number("wind_ms", wind_ms)
     if abs(wind) > _MAX_WIND_MS:
         raise ValueError(
-            f"wind_ms must be in [-{_MAX_WIND_MS:g}, {_MAX_WIND_MS:g}] m/s (the model's range), got {wind_ms!r}"
+            f"wind_ms must be in [-{_MAX_WIND_MS:g}, {_MAX_WIND_MS:g}] m/s (the model's range), got {_checks.shown(wind_ms)}"
         )
     wind_from = math.radians(_checks.finite_number("wind_from_deg", wind_from_deg))
     rolling, climbing = cycling.road_forces(rider.mass_kg, rider.crr, course.grade)
@@ -510,11 +510,11 @@ def _speeds(max_speed_ms: float, start_speed_ms: float) -> tuple[float, float]:
     cap = _checks.positive("max_speed_ms", max_speed_ms)
     if cap > _MAX_SPEED_MS:
         raise ValueError(
-            f"max_speed_ms must be at most {_MAX_SPEED_MS:g} m/s (the model's range), got {max_speed_ms!r}"
+            f"max_speed_ms must be at most {_MAX_SPEED_MS:g} m/s (the model's range), got {_checks.shown(max_speed_ms)}"
         )
     start = _checks.finite_number("start_speed_ms", start_speed_ms)
     if start < 0.0 or start > cap:
-        raise ValueError(f"start_speed_ms must be in [0, max_speed_ms], got {start_speed_ms!r}")
+        raise ValueError(f"start_speed_ms must be in [0, max_speed_ms], got {_checks.shown(start_speed_ms)}")
     return cap, start
 
 
@@ -639,7 +639,7 @@ class Pacing:
 def _gain(gain: object) -> float:
     g = _checks.finite_number("gain", gain)
     if not 0.0 <= g <= 0.5:
-        raise ValueError(f"gain must be in [0, 0.5], got {gain!r}")
+        raise ValueError(f"gain must be in [0, 0.5], got {_checks.shown(gain)}")
     return g
 
 
@@ -691,7 +691,7 @@ def paced_ride(
     """
     target = _checks.positive("power_w", power_w)
     if target > MAX_POWER_W:
-        raise ValueError(f"power_w must be at most {MAX_POWER_W:g} W, got {power_w!r}")
+        raise ValueError(f"power_w must be at most {MAX_POWER_W:g} W, got {_checks.shown(power_w)}")
     g = _gain(gain)
     s = _segments(course, rider, wind_ms, wind_from_deg, air)
     cap, start = _speeds(max_speed_ms, start_speed_ms)

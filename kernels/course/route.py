@@ -271,7 +271,9 @@ def _checked_points(name: str, arrays: dict[str, ArrayLike], n_min: int = 2) -> 
         if array.ndim != 1:
             raise ValueError(f"{key} must be one-dimensional, got shape {array.shape}")
         if shape is not None and array.shape != shape:
-            raise ValueError(f"{key} has shape {array.shape}, the other arrays {shape}")
+            lengths = {k: np.shape(v) for k, v in arrays.items()}
+            odd = next((k for k, v in lengths.items() if list(lengths.values()).count(v) == 1), key)
+            raise ValueError(f"{odd} must have as many points as the others: the shapes are {lengths}")
         shape = array.shape
         bad = ~np.isfinite(array)
         if np.any(bad):
@@ -311,7 +313,7 @@ def _finish(
     smoothed = _smooth(distance, elevation, window)
     grade = np.diff(smoothed) / run
     if not (np.isfinite(smoothed).all() and np.isfinite(grade).all()):  # a guard: _smooth keeps it finite
-        raise ValueError(f"smoothing_m must smooth to finite elevations, got {smoothing_m!r}")
+        raise ValueError(f"smoothing_m must smooth to finite elevations, got {_checks.shown(smoothing_m)}")
     for array in (east, north, distance, smoothed, elevation, grade, heading):
         array.setflags(write=False)
     return Course(

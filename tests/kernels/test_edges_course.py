@@ -7,6 +7,7 @@ import math
 import time
 from collections.abc import Callable
 from decimal import Decimal
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -227,3 +228,21 @@ def test_splits_too_fine_or_not_numbers_are_refused_by_name(every_m: Any) -> Non
     ride = course.ride(FLAT, 200.0)
     with pytest.raises(ValueError, match=r"^every_m must"):
         ride.splits(every_m)
+
+
+@pytest.mark.parametrize("odd", [0, 1, 2])
+def test_the_array_of_the_wrong_length_is_the_one_named(odd: int) -> None:
+    # The first array set the shape, so a short east_m was reported as "north_m has shape (200,)".
+    arrays = [np.linspace(0.0, 1000.0, 200) for _ in range(3)]
+    arrays[odd] = arrays[odd][:2]
+    name = ["east_m", "north_m", "elevation_m"][odd]
+    with pytest.raises(ValueError, match=rf"^{name} must have as many points as the others"):
+        course.course_from_xy(arrays[0], arrays[1], arrays[2])
+
+
+def test_a_directory_is_refused_as_a_file_it_cannot_read(tmp_path: Path) -> None:
+    # A missing file said "cannot read"; a directory raised IsADirectoryError.
+    with pytest.raises(ValueError, match=r"^cannot read .*: Is a directory"):
+        course.load_gpx(tmp_path)
+    with pytest.raises(ValueError, match=r"^cannot read .*: No such file or directory"):
+        course.load_gpx(tmp_path / "missing.gpx")
