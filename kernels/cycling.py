@@ -163,7 +163,7 @@ def drag_reduction(n_riders: int, gap_m: float, model: DraftModel = "measured") 
     """
     _checks.integer("n_riders", n_riders, 1)
     if n_riders > MAX_FORMATION_RIDERS:  # 10¹² riders asked numpy for 7 TiB
-        raise ValueError(f"n_riders must be at most {MAX_FORMATION_RIDERS}, got {n_riders!r}")
+        raise ValueError(f"n_riders must be at most {MAX_FORMATION_RIDERS}, got {_checks.shown(n_riders)}")
     gap = _checks.non_negative("gap_m", gap_m)  # one gap: an array raised numpy's TypeError
     _checks.choice("model", model, DRAFT_MODELS)  # checked for one rider too
     reduction = np.zeros(int(n_riders))
@@ -177,7 +177,7 @@ def drag_reduction(n_riders: int, gap_m: float, model: DraftModel = "measured") 
             reduction[1:] = plateau * np.exp(-gap / _MEASURED_FADE_M)
             reduction[0] = _LEADER_PLATEAU * np.exp(-gap / _LEADER_FADE_M)
         case _:
-            raise ValueError(f"model must be 'seed' or 'measured', got {model!r}")
+            raise ValueError(f"model must be 'seed' or 'measured', got {_checks.shown(model)}")
     return reduction
 
 
@@ -998,13 +998,13 @@ def formation(
     """
     _checks.integer("n_riders", n_riders)
     if not 1 <= n_riders <= MAX_FORMATION_RIDERS:
-        raise ValueError(f"n_riders must be in [1, {MAX_FORMATION_RIDERS}], got {n_riders!r}")
+        raise ValueError(f"n_riders must be in [1, {MAX_FORMATION_RIDERS}], got {_checks.shown(n_riders)}")
     gap = _checks.non_negative("gap_m", gap_m)
     if gap > 50.0:
-        raise ValueError(f"gap_m must be at most 50 m, got {gap_m!r}")
+        raise ValueError(f"gap_m must be at most 50 m, got {_checks.shown(gap_m)}")
     lateral = _checks.finite_number("lateral_m", lateral_m)
     if not 0.3 <= lateral <= 5.0:
-        raise ValueError(f"lateral_m must be in [0.3, 5] m, got {lateral_m!r}")
+        raise ValueError(f"lateral_m must be in [0.3, 5] m, got {_checks.shown(lateral_m)}")
     _checks.choice("shape", shape, FORMATION_SHAPES)
     n = int(n_riders)
     k = np.arange(n, dtype=np.float64)
@@ -1034,7 +1034,7 @@ def formation(
                 row += 1
             return np.stack([np.array(xs[:n]), np.array(ys[:n])], axis=1)
         case _:
-            raise ValueError(f"shape must be one of {FORMATION_SHAPES}, got {shape!r}")
+            raise ValueError(f"shape must be one of {FORMATION_SHAPES}, got {_checks.shown(shape)}")
 
 
 def _plateau(depth: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -1119,7 +1119,7 @@ def formation_drag(
     _checks.choice("model", model, DRAFT_MODELS)
     yaw = _checks.finite_number("yaw_rad", yaw_rad)
     if not abs(yaw) < 0.5 * math.pi:
-        raise ValueError(f"yaw_rad must be in (-pi/2, pi/2), got {yaw_rad!r}")
+        raise ValueError(f"yaw_rad must be in (-pi/2, pi/2), got {_checks.shown(yaw_rad)}")
     x, y = pos[:, 0], pos[:, 1]
     if yaw != 0.0:  # offsets in the wind's frame: its x toward where the apparent wind comes from
         c, s = math.cos(yaw), math.sin(yaw)

@@ -53,7 +53,7 @@ class Camera:
             raise ValueError("up must not be parallel to the view axis")
         fov = _checks.finite_number("fov_y_rad", self.fov_y_rad)
         if not 0.0 < fov < math.pi:
-            raise ValueError(f"fov_y_rad must be in (0, π), got {self.fov_y_rad!r}")
+            raise ValueError(f"fov_y_rad must be in (0, π), got {_checks.shown(self.fov_y_rad)}")
         object.__setattr__(self, "position", tuple(float(v) for v in eye))
         object.__setattr__(self, "look_at", tuple(float(v) for v in target))
         object.__setattr__(self, "up", tuple(float(v) for v in up))
@@ -123,7 +123,7 @@ class Shading:
         for name in ("ambient", "diffuse", "specular", "occlusion_strength"):
             value = _checks.finite_number(name, getattr(self, name))
             if not 0.0 <= value <= 10.0:
-                raise ValueError(f"{name} must be in [0, 10], got {getattr(self, name)!r}")
+                raise ValueError(f"{name} must be in [0, 10], got {_checks.shown(getattr(self, name))}")
             object.__setattr__(self, name, value)
         for name in (
             "shininess",
@@ -136,7 +136,7 @@ class Shading:
             value = getattr(self, name)
             number = _checks.positive(name, value)
             if number > big:
-                raise ValueError(f"{name} must be at most {big:g} (float32), got {value!r}")
+                raise ValueError(f"{name} must be at most {big:g} (float32), got {_checks.shown(value)}")
             object.__setattr__(self, name, number)
         light = _checks.vector("light_direction", self.light_direction, 3)
         largest = float(np.abs(light).max())
@@ -152,7 +152,7 @@ class Shading:
         object.__setattr__(self, "background", tuple(float(v) for v in background))
         steps = _checks.integer("max_steps", self.max_steps, 1)
         if steps > 4096:
-            raise ValueError(f"max_steps must be in 1..4096, got {self.max_steps!r}")
+            raise ValueError(f"max_steps must be in 1..4096, got {_checks.shown(self.max_steps)}")
         object.__setattr__(self, "max_steps", steps)
 
 
@@ -179,7 +179,7 @@ def check_image_size(width: int, height: int) -> None:
             or not isinstance(value, (int, np.integer))
             or not 1 <= value <= 8192
         ):
-            raise ValueError(f"{name} must be an integer in 1..8192, got {value!r}")
+            raise ValueError(f"{name} must be an integer in 1..8192, got {_checks.shown(value)}")
 
 
 def screen_rectangle(
@@ -194,7 +194,7 @@ def screen_rectangle(
     check_image_size(width, height)
     corners = _checks.points("corners", corners)
     if not (np.abs(corners) <= MAX_CAMERA_COORDINATE).all():
-        raise ValueError(f"corners must be of magnitude ≤ {MAX_CAMERA_COORDINATE:g} m, got {corners!r}")
+        raise ValueError(f"corners must be of magnitude ≤ {MAX_CAMERA_COORDINATE:g} m, got {_checks.shown(corners)}")
     forward, right, up = camera.basis()
     rel = corners - np.asarray(camera.position)
     z = rel @ forward

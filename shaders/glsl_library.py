@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from kernels import sdf
+from kernels import _checks, sdf
 
 SHADER_DIR = Path(__file__).resolve().parent
 """Where the GLSL files live (installed as package data next to this module)."""
@@ -70,6 +70,6 @@ def sdf_library() -> str:
     text = read_source("sdf.glsl")
     for line in (KIND_DEFINES_LINE, CATALOGUE_DISTANCE_LINE):
         if text.count(line + "\n") != 1:
-            raise ValueError(f"sdf.glsl must hold the line {line!r} once")
+            raise ValueError(f"sdf.glsl must hold the line {_checks.shown(line)} once")
     text = text.replace(KIND_DEFINES_LINE + "\n", kind_defines() + "\n")
     return text.replace(CATALOGUE_DISTANCE_LINE + "\n", catalogue_distance() + "\n")

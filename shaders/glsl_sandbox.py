@@ -470,7 +470,7 @@ def check_source(source: object) -> str:
         if bad == "\r":
             raise ShaderCompileError("carriage returns are not allowed (end lines with a plain newline)", number)
         if bad is not None:
-            raise ShaderCompileError(f"character {bad!r} is not allowed (printable ASCII only)", number)
+            raise ShaderCompileError(f"character {_checks.shown(bad)} is not allowed (printable ASCII only)", number)
         if "\\" in line:
             raise ShaderCompileError(
                 "backslashes are not allowed (a backslash at a line's end joins it to the next)",

@@ -174,14 +174,18 @@ def _mesh_arrays(
     """(V, 3) float vertices and (N, ``corners``) int indices into them, or ValueError naming what is malformed."""
     v = _checks.points("vertices", vertices)
     if not (np.abs(v) <= MAX_CAMERA_COORDINATE).all():
-        raise ValueError(f"vertices must be within ±{MAX_CAMERA_COORDINATE:g} m for float32, got {vertices!r}")
+        raise ValueError(
+            f"vertices must be within ±{MAX_CAMERA_COORDINATE:g} m for float32, got {_checks.shown(vertices)}"
+        )
     try:
         raw = np.asarray(indices)
         if raw.size and raw.dtype.kind not in "iu":
             raise TypeError(raw.dtype)
         idx = raw.astype(np.int64)
     except (TypeError, ValueError, OverflowError) as error:
-        raise ValueError(f"{name} must be (N, {corners}) integer indices into vertices, got {indices!r}") from error
+        raise ValueError(
+            f"{name} must be (N, {corners}) integer indices into vertices, got {_checks.shown(indices)}"
+        ) from error
     if idx.size == 0:
         idx = idx.reshape(0, corners)
     if idx.ndim != 2 or idx.shape[1] != corners or (idx.size and (idx.min() < 0 or idx.max() >= len(v))):
@@ -539,7 +543,7 @@ class Renderer:
         tolerance = _checks.non_negative("tolerance_m", tolerance_m)
         levels = np.asarray(color)
         if levels.shape != (3,) or levels.dtype.kind not in "iu" or not ((levels >= 0) & (levels <= 255)).all():
-            raise ValueError(f"color must be 3 integers in 0..255, got {color!r}")
+            raise ValueError(f"color must be 3 integers in 0..255, got {_checks.shown(color)}")
         if self._target_size != (width, height):
             raise ValueError(f"draw_edges needs a march of {width}x{height} before it, got {self._target_size}")
         _, color_only, _, color_tex, depth_tex, _ = self._target_objects

@@ -68,7 +68,7 @@ def distance_array(name: str, value: ArrayLike) -> FloatArray:
             raise TypeError(array.dtype)
         array = np.asarray(array, dtype=np.float64)
     except (TypeError, ValueError, OverflowError) as error:
-        raise ValueError(f"{name} must be real distances (m), got {value!r}") from error
+        raise ValueError(f"{name} must be real distances (m), got {_checks.shown(value)}") from error
     if np.any(np.isnan(array)):
         raise ValueError(f"{name} must not be NaN")
     return array
@@ -190,7 +190,7 @@ def combine_weighted(
             case "exp":
                 return _smin_exp_weighted(x, y, EXP_SHARPNESS_PER_WIDTH / k)
             case _:
-                raise ValueError(f"blend must be one of {BLEND_FORMS}, got {blend!r}")
+                raise ValueError(f"blend must be one of {BLEND_FORMS}, got {_checks.shown(blend)}")
 
     # Checked here for k = 0 too, which never reaches the match above; choice() also names an array, which `in`
     # and `match` would meet with numpy's "truth value is ambiguous".
@@ -205,7 +205,7 @@ def combine_weighted(
             d, w = smin(-a, -b)
             return -d, w
         case _:
-            raise ValueError(f"op must be one of {BOOLEAN_OPS}, got {op!r}")
+            raise ValueError(f"op must be one of {BOOLEAN_OPS}, got {_checks.shown(op)}")
 
 
 def smooth_union(a: ArrayLike, b: ArrayLike, k: float, blend: BlendForm = "poly") -> FloatArray:

@@ -65,7 +65,9 @@ def make_grid(scene: Scene, resolution: int, bounds: ArrayLike | None = None) ->
     else:
         box = _checks.finite_array("bounds", bounds)
         if box.shape != (2, 3) or np.any(box[1] <= box[0]):
-            raise ValueError(f"bounds must be finite (2, 3) min and max corners with max > min, got {bounds!r}")
+            raise ValueError(
+                f"bounds must be finite (2, 3) min and max corners with max > min, got {_checks.shown(bounds)}"
+            )
     if not np.all(np.abs(box) <= MAX_FIELD_COORDINATE):
         raise ValueError(
             f"bounds (given or the scene's) must lie within ±{MAX_FIELD_COORDINATE:g} m for the float32 field, "
@@ -98,7 +100,7 @@ def _grid(value: object) -> Grid:
         or shape.dtype.kind not in "iu"
         or not ((shape >= 2) & (shape <= MAX_RESOLUTION)).all()
     ):
-        raise ValueError(f"grid must be a Grid from make_grid, got {grid!r}")
+        raise ValueError(f"grid must be a Grid from make_grid, got {_checks.shown(grid)}")
     return grid
 
 
@@ -373,9 +375,13 @@ def _faces(value: ArrayLike, vertex_count: int) -> NDArray[np.int64]:
             raise TypeError(faces.dtype)
         faces = faces.astype(np.int64)
     except (TypeError, ValueError, OverflowError) as error:
-        raise ValueError(f"faces must be (F, 3) integer indices into the vertices, got {value!r}") from error
+        raise ValueError(
+            f"faces must be (F, 3) integer indices into the vertices, got {_checks.shown(value)}"
+        ) from error
     if faces.ndim != 2 or faces.shape[1] != 3 or faces.min() < 0 or faces.max() >= vertex_count:
-        raise ValueError(f"faces must be (F, 3) integer indices into the {vertex_count} vertices, got {value!r}")
+        raise ValueError(
+            f"faces must be (F, 3) integer indices into the {vertex_count} vertices, got {_checks.shown(value)}"
+        )
     return faces
 
 
@@ -421,7 +427,7 @@ def mesh_samples(
     if mask is not None:
         mask = np.asarray(mask)
         if mask.dtype != np.bool_ or mask.shape != tuple(grid.shape):
-            raise ValueError(f"mask must be None or bools of the grid's shape {grid.shape}, got {mask!r}")
+            raise ValueError(f"mask must be None or bools of the grid's shape {grid.shape}, got {_checks.shown(mask)}")
     # _polygonise colours its vertices from a scene; one small sphere keeps that cost to a few ms.
     verts, faces, _ = _polygonise(_COLOURLESS, grid, values, mask)
     return verts, faces

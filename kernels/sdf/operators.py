@@ -24,7 +24,7 @@ of an infinite angle are NaN)."""
 def _rate(value: object) -> float:
     k = _checks.finite_number("rate", value)
     if abs(k) > MAX_RATE:
-        raise ValueError(f"rate must be of magnitude ≤ {MAX_RATE:g} rad/m, got {value!r}")
+        raise ValueError(f"rate must be of magnitude ≤ {MAX_RATE:g} rad/m, got {_checks.shown(value)}")
     return k
 
 

@@ -61,7 +61,7 @@ def coordinates(name: str, value: ArrayLike) -> FloatArray:
     ``name``."""
     pts = _checks.points(name, value)
     if not (np.abs(pts) <= MAX_COORDINATE).all():
-        raise ValueError(f"{name} must be of magnitude ≤ {MAX_COORDINATE:g} m, got {value!r}")
+        raise ValueError(f"{name} must be of magnitude ≤ {MAX_COORDINATE:g} m, got {_checks.shown(value)}")
     return pts
 
 
@@ -74,7 +74,7 @@ def length(name: str, value: object, *, zero_ok: bool = False) -> float:
     """A length (m) > 0 (≥ 0 with ``zero_ok``) and ≤ :data:`MAX_COORDINATE`, else ``ValueError`` naming it."""
     number = _checks.non_negative(name, value) if zero_ok else _checks.positive(name, value)
     if number > MAX_COORDINATE:
-        raise ValueError(f"{name} must be at most {MAX_COORDINATE:g} m, got {value!r}")
+        raise ValueError(f"{name} must be at most {MAX_COORDINATE:g} m, got {_checks.shown(value)}")
     return number
 
 
@@ -206,7 +206,7 @@ def sd_round_box(p: ArrayLike, half_size: ArrayLike, radius: float) -> FloatArra
     b = lengths("half_size", half_size, 3)
     r = length("radius", radius, zero_ok=True)
     if r > b.min():
-        raise ValueError(f"radius must be at most min(half_size) = {b.min()}, got {radius!r}")
+        raise ValueError(f"radius must be at most min(half_size) = {b.min()}, got {_checks.shown(radius)}")
     return _sd_round_box(pts, b, r)
 
 
@@ -368,7 +368,7 @@ def sd_plane(p: ArrayLike, normal: ArrayLike, offset: float) -> FloatArray:
     n = n / largest
     off = _checks.finite_number("offset", offset)
     if abs(off) > MAX_COORDINATE:
-        raise ValueError(f"offset must be of magnitude ≤ {MAX_COORDINATE:g} m, got {offset!r}")
+        raise ValueError(f"offset must be of magnitude ≤ {MAX_COORDINATE:g} m, got {_checks.shown(offset)}")
     return pts @ (n / float(np.linalg.norm(n))) + off
 
 
@@ -536,7 +536,7 @@ def primitive_spec(kind: str) -> PrimitiveSpec:
     """The registry entry of ``kind``, or ``ValueError`` naming the kinds there are."""
     spec = PRIMITIVES.get(kind) if isinstance(kind, str) else None
     if spec is None:
-        raise ValueError(f"kind must be one of {primitive_kinds()}, got {kind!r}")
+        raise ValueError(f"kind must be one of {primitive_kinds()}, got {_checks.shown(kind)}")
     return spec
 
 
@@ -548,18 +548,18 @@ def register_primitive(spec: PrimitiveSpec) -> None:
     """
     _checks.instance("spec", spec, PrimitiveSpec)
     if not isinstance(spec.kind, str) or not spec.kind.isidentifier():
-        raise ValueError(f"kind must be a name (a Python identifier), got {spec.kind!r}")
+        raise ValueError(f"kind must be a name (a Python identifier), got {_checks.shown(spec.kind)}")
     if spec.kind in PRIMITIVES:
-        raise ValueError(f"kind {spec.kind!r} is already registered")
+        raise ValueError(f"kind {_checks.shown(spec.kind)} is already registered")
     next_code = max(s.code for s in PRIMITIVES.values()) + 1
     if spec.code != next_code:
-        raise ValueError(f"code must be the next free code {next_code}, got {spec.code!r}")
+        raise ValueError(f"code must be the next free code {next_code}, got {_checks.shown(spec.code)}")
     if not 1 <= spec.size_count <= 3:
         raise ValueError(f"sizes must name 1 to 3 parameters, got {spec.size_count}")
     if spec.fused:
         raise ValueError("fused must be False: only the built-in four share sdf.glsl's one formula")
     if not spec.glsl_function.isidentifier():
-        raise ValueError(f"glsl_function must be a GLSL name, got {spec.glsl_function!r}")
+        raise ValueError(f"glsl_function must be a GLSL name, got {_checks.shown(spec.glsl_function)}")
     PRIMITIVES[spec.kind] = spec
 
 
@@ -567,6 +567,6 @@ def unregister_primitive(kind: str) -> None:
     """Remove a kind added by :func:`register_primitive` (the built-in ten stay)."""
     _checks.choice("kind", kind, primitive_kinds())
     if kind in BUILT_IN_KINDS:
-        raise ValueError(f"kind {kind!r} is built in")
+        raise ValueError(f"kind {_checks.shown(kind)} is built in")
     primitive_spec(kind)
     del PRIMITIVES[kind]

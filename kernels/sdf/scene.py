@@ -172,7 +172,7 @@ class Scene:
         object.__setattr__(self, "primitives", prims)
         k = _checks.non_negative("k", self.k)
         if k > MAX_BLEND_WIDTH:
-            raise ValueError(f"k must be at most MAX_BLEND_WIDTH = {MAX_BLEND_WIDTH:g} m, got {self.k!r}")
+            raise ValueError(f"k must be at most MAX_BLEND_WIDTH = {MAX_BLEND_WIDTH:g} m, got {_checks.shown(self.k)}")
         object.__setattr__(self, "k", k)
 
 
@@ -295,7 +295,7 @@ def ray_spheres_interval(
     centers = coordinates("centers", centers)
     radii = _checks.bounded_array("radii", radii, MAX_COORDINATE)
     if radii.shape != (len(centers),) or np.any(radii < 0.0):
-        raise ValueError(f"radii must be ({len(centers)},) lengths ≥ 0, got {radii!r}")
+        raise ValueError(f"radii must be ({len(centers)},) lengths ≥ 0, got {_checks.shown(radii)}")
     oc = origins[:, None, :] - centers[None, :, :]
     b = np.einsum("npk,nk->np", oc, directions)
     c = np.einsum("npk,npk->np", oc, oc) - radii[None, :] ** 2
@@ -315,7 +315,7 @@ def _unit_directions(name: str, value: ArrayLike, count: int) -> FloatArray:
     if len(d) != count:
         raise ValueError(f"{name} must match origins' shape ({count}, 3), got {d.shape}")
     if not (np.abs(np.einsum("ij,ij->i", d, d) - 1.0) <= 2e-6).all():
-        raise ValueError(f"{name} must be unit vectors, got {value!r}")
+        raise ValueError(f"{name} must be unit vectors, got {_checks.shown(value)}")
     return d
 
 
@@ -349,7 +349,7 @@ def sphere_trace(
     d = _unit_directions("directions", directions, len(o))
     steps = _checks.integer("max_steps", max_steps, 1)
     if steps > 10_000:
-        raise ValueError(f"max_steps must be in 1..10000, got {max_steps!r}")
+        raise ValueError(f"max_steps must be in 1..10000, got {_checks.shown(max_steps)}")
     eps = _checks.positive("hit_epsilon", hit_epsilon)
     far = _checks.positive("max_distance", max_distance)
     centers, radii = scene_bounding_spheres(scene)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 import pytest
@@ -60,3 +61,36 @@ def test_a_refused_value_is_quoted_in_at_most_two_hundred_characters(value: obje
     with pytest.raises(ValueError) as caught:
         _checks.positive("gap_m", value)
     assert str(caught.value).startswith("gap_m must be a finite number, got ") and len(str(caught.value)) < 260
+
+
+# The kind, across the kernels: a refusal that quoted its input with !r printed all of it (600,000 characters for
+# 50,000 bounds). Every refusal quotes through shown().
+_N = 50_000
+
+
+def _long_refusals() -> list[tuple[str, Callable[[], object]]]:
+    from kernels import ball, course, fabrik, sdf
+
+    chain = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]]
+    many = [[0.0, 0.0, 0.0]] * _N
+    x = np.linspace(0.0, 1000.0, 10)
+    return [
+        ("make_grid bounds", lambda: sdf.make_grid(sdf.default_scene(), 16, bounds=[[0.0, 0.0]] * _N)),
+        ("sd_sphere p", lambda: sdf.sd_sphere([*many, [1e200, 0.0, 0.0]], 1.0)),
+        ("smin_poly a", lambda: sdf.smin_poly(["x"] * _N, [0.0] * _N, 0.1)),
+        ("op_round d", lambda: sdf.op_round([0.0] * _N + [None], 0.1)),  # type: ignore[arg-type]
+        ("odds_map distances", lambda: ball.odds_map([1000.0] * _N, [0.0], 25.0, 0.3, 0.0, (0.0, 0.0, 50.0))),
+        ("odds_map angles", lambda: ball.odds_map([20.0], [3.0] * _N, 25.0, 0.3, 0.0, (0.0, 0.0, 50.0))),
+        ("solve max_iterations", lambda: fabrik.solve(chain, [1.0, 0.0, 0.0], max_iterations=many)),  # type: ignore[arg-type]
+        ("two_bone upper_length", lambda: fabrik.two_bone((0, 0), many, 1.0, (1, 1), (0, 1))),  # type: ignore[arg-type]
+        ("course_from_xy east_m", lambda: course.course_from_xy(np.full(_N, np.nan), x, x)),
+        ("simulate velocity", lambda: ball.simulate((0.0, 0.0, 1.0), [1.0] * _N, (0.0, 0.0, 0.0))),
+    ]
+
+
+@pytest.mark.parametrize("index", range(10))
+def test_no_refusal_prints_its_whole_input(index: int) -> None:
+    label, call = _long_refusals()[index]
+    with pytest.raises(ValueError) as caught:
+        call()
+    assert len(str(caught.value)) < 500, (label, len(str(caught.value)))
