@@ -92,7 +92,8 @@ class Air:
     relative_humidity: float = 0.0
     """Relative humidity, a fraction in [0, 1]."""
     altitude_m: float = 0.0
-    """Where the reading was taken (m, −1000 to 20 000)."""
+    """Where the reading was taken (m, −10 000 to 30 000, as a course's elevations; the standard atmosphere's pressure
+    ratio that carries it is taken within −1000 to 20 000 m)."""
 
     def __post_init__(self) -> None:
         _checks.choice("kind", self.kind, _AIR_KINDS)
@@ -102,7 +103,9 @@ class Air:
             for key in ("temperature_c", "pressure_hpa", "relative_humidity", "altitude_m")
         ]
         cycling.air_density_weather(*reading[:3])
-        cycling.isa_pressure_hpa(reading[3])
+        low, high = cycling.AIR_DENSITY_ALTITUDE_M  # every course's range; the ratio below clamps to the ISA's
+        if not low <= reading[3] <= high:
+            raise ValueError(f"altitude_m must be in [{low:g}, {high:g}] m, got {_checks.shown(self.altitude_m)}")
 
     def density(self, elevation_m: ArrayLike) -> NDArray[np.float64]:
         """Air density (kg/m³) at each elevation (m, −10 000 to 30 000, :data:`kernels.cycling.AIR_DENSITY_ALTITUDE_M`,
@@ -120,7 +123,9 @@ class Air:
                 temperature = self.temperature_c - cycling.ISA_LAPSE_RATE_K_PER_M * (h - self.altitude_m)
                 isa_h = np.clip(h, *_ISA_RANGE_M)
                 pressure = (
-                    self.pressure_hpa * cycling.isa_pressure_hpa(isa_h) / cycling.isa_pressure_hpa(self.altitude_m)
+                    self.pressure_hpa
+                    * cycling.isa_pressure_hpa(isa_h)
+                    / cycling.isa_pressure_hpa(np.clip(self.altitude_m, *_ISA_RANGE_M))
                 )
                 return cycling.air_density_weather(
                     np.clip(temperature, -60.0, 60.0),

@@ -186,7 +186,9 @@ def course_air(route: course_kernel.Course, p: CourseParams) -> course_kernel.Ai
     pressure = (
         p.pressure_hpa
         if p.pressure_from_barometer
-        else float(cycling.isa_pressure_hpa(np.clip(start, -1000.0, 20_000.0)))
+        # The standard atmosphere at the start, within its range and the reading's 10–1100 hPa (a start below
+        # about −700 m would read more than 1100 hPa and be refused).
+        else float(np.clip(cycling.isa_pressure_hpa(np.clip(start, -1000.0, 20_000.0)), 10.0, 1100.0))
     )
     return course_kernel.Air(p.air, p.temperature_c, pressure, p.humidity_pct / 100.0, altitude_m=start)
 

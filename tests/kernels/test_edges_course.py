@@ -246,3 +246,13 @@ def test_a_directory_is_refused_as_a_file_it_cannot_read(tmp_path: Path) -> None
         course.load_gpx(tmp_path)
     with pytest.raises(ValueError, match=r"^cannot read .*: No such file or directory"):
         course.load_gpx(tmp_path / "missing.gpx")
+
+
+def test_a_weather_reading_below_the_standard_atmospheres_range_is_taken_where_it_was_read() -> None:
+    # A course starting 2 km below sea level had its reading refused as altitude_m (the scene reads at the start).
+    reading = course.Air("weather", 15.0, 1013.0, 0.5, altitude_m=-2000.0)
+    at_reading = cycling.air_density_weather(15.0, 1013.0, 0.5)
+    np.testing.assert_allclose(reading.density([-2000.0]), at_reading, rtol=1e-12)
+    assert reading.density([0.0])[0] < at_reading  # thinner up the road
+    with pytest.raises(ValueError, match=r"^altitude_m must be in \[-10000, 30000\] m"):
+        course.Air("weather", 15.0, 1013.0, 0.5, altitude_m=-20000.0)

@@ -30,7 +30,7 @@ from scenes.peloton import (
     format_duration,
     group_cda,
 )
-from scenes.peloton.course_model import lay_out_road, route_points
+from scenes.peloton.course_model import course_air, lay_out_road, route_points
 from scenes.peloton.meshes import rider_head_m
 from scenes.peloton.model import FORMATION_FROM_LABEL as FORMATION
 
@@ -746,3 +746,15 @@ def test_the_course_camera_frames_the_group_left_of_the_panel_and_clear_of_the_n
         assert f"front 45 m of the group (its first {framed} riders)" in scene.density.content
     else:
         assert "front 45 m" not in scene.density.content
+
+
+@pytest.mark.parametrize("start_m", [-430.0, -700.0, -2000.0, -9000.0, 8848.0, 9900.0])
+def test_the_weather_reading_is_taken_at_any_start_a_course_may_have(start_m: float) -> None:
+    # Below about −700 m the standard atmosphere reads more than 1100 hPa, so the reading at the start was refused
+    # (a route's elevations may be ±10 km); the reading is now held to the pressures it takes.
+    x = np.linspace(0.0, 5000.0, 100)
+    route = course_kernel.course_from_xy(x, 0.0 * x, start_m + 0.01 * x)
+    air = course_air(route, CourseParams(air="weather"))
+    density = air.density(route.elevation_m)
+    assert np.isfinite(density).all() and (density > 0.0).all()
+    assert air.pressure_hpa <= 1100.0 and air.altitude_m == route.elevation_m[0]
