@@ -24,6 +24,7 @@ __all__ = [
     "finite_array",
     "finite_number",
     "flag",
+    "indices",
     "instance",
     "integer",
     "non_negative",
@@ -109,6 +110,25 @@ def instance(name: str, value: object, kind: type[T], what: str = "") -> T:
     if not isinstance(value, kind):
         raise ValueError(f"{name} must be {what or 'a ' + kind.__name__}, got {type(value).__name__}")
     return value
+
+
+def indices(name: str, value: ArrayLike, corners: int, count: int) -> NDArray[np.int64]:
+    """(N, ``corners``) integer indices into ``count`` items (a mesh's faces or lines into its vertices) as int64;
+    an empty array is (0, ``corners``). Else ``ValueError`` naming it: floats, bools, text, a wrong shape, or an
+    index outside [0, count)."""
+    wanted = f"{name} must be (N, {corners}) integer indices into the {count} vertices"
+    try:
+        raw = np.asarray(value)
+        if raw.size and raw.dtype.kind not in "iu":
+            raise TypeError(raw.dtype)
+        array = raw.astype(np.int64)
+    except (TypeError, ValueError, OverflowError) as error:
+        raise ValueError(f"{wanted}, got {shown(value)}") from error
+    if array.size == 0:
+        return np.zeros((0, corners), dtype=np.int64)
+    if array.ndim != 2 or array.shape[1] != corners or array.min() < 0 or array.max() >= count:
+        raise ValueError(f"{wanted}, got {shown(value)}")
+    return array
 
 
 def positive(name: str, value: object) -> float:

@@ -177,20 +177,7 @@ def _mesh_arrays(
         raise ValueError(
             f"vertices must be within ±{MAX_CAMERA_COORDINATE:g} m for float32, got {_checks.shown(vertices)}"
         )
-    try:
-        raw = np.asarray(indices)
-        if raw.size and raw.dtype.kind not in "iu":
-            raise TypeError(raw.dtype)
-        idx = raw.astype(np.int64)
-    except (TypeError, ValueError, OverflowError) as error:
-        raise ValueError(
-            f"{name} must be (N, {corners}) integer indices into vertices, got {_checks.shown(indices)}"
-        ) from error
-    if idx.size == 0:
-        idx = idx.reshape(0, corners)
-    if idx.ndim != 2 or idx.shape[1] != corners or (idx.size and (idx.min() < 0 or idx.max() >= len(v))):
-        raise ValueError(f"{name} must be (N, {corners}) indices into vertices, got {idx.shape}")
-    return v, idx
+    return v, _checks.indices(name, indices, corners, len(v))
 
 
 class Renderer:

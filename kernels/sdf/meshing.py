@@ -365,30 +365,10 @@ def _touches_solid(scene: Scene, grid: Grid, samples: NDArray[np.bool_]) -> NDAr
     return out
 
 
-def _faces(value: ArrayLike, vertex_count: int) -> NDArray[np.int64]:
-    """(F, 3) indices into ``vertex_count`` vertices, else ``ValueError`` naming ``faces``."""
-    try:
-        faces = np.asarray(value)
-        if faces.size == 0:
-            return np.zeros((0, 3), dtype=np.int64)
-        if faces.dtype.kind not in "iu":
-            raise TypeError(faces.dtype)
-        faces = faces.astype(np.int64)
-    except (TypeError, ValueError, OverflowError) as error:
-        raise ValueError(
-            f"faces must be (F, 3) integer indices into the vertices, got {_checks.shown(value)}"
-        ) from error
-    if faces.ndim != 2 or faces.shape[1] != 3 or faces.min() < 0 or faces.max() >= vertex_count:
-        raise ValueError(
-            f"faces must be (F, 3) integer indices into the {vertex_count} vertices, got {_checks.shown(value)}"
-        )
-    return faces
-
-
 def mesh_trimesh(vertices: FloatArray, faces: NDArray[np.int64], colors: FloatArray) -> trimesh.Trimesh:
     """The output of :func:`mesh` as a ``trimesh.Trimesh`` with 8-bit vertex colours (for export)."""
     vertices = _checks.points("vertices", vertices)
-    faces = _faces(faces, len(vertices))
+    faces = _checks.indices("faces", faces, 3, len(vertices))
     colors = _checks.finite_array("colors", colors)
     if colors.shape != vertices.shape:
         raise ValueError(f"colors must have the vertices' shape {vertices.shape}, got {colors.shape}")

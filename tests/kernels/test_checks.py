@@ -94,3 +94,18 @@ def test_no_refusal_prints_its_whole_input(index: int) -> None:
     with pytest.raises(ValueError) as caught:
         call()
     assert len(str(caught.value)) < 500, (label, len(str(caught.value)))
+
+
+@pytest.mark.parametrize(
+    "value",
+    [[[0, 1, 3]], [[0, 1, -1]], [[0.0, 1.0, 2.0]], [[True, False, True]], [["0", "1", "2"]], [0, 1, 2], [[0, 1]], None],
+)
+def test_indices_into_vertices_are_integers_of_their_shape_within_the_count(value: object) -> None:
+    with pytest.raises(ValueError, match=r"^faces must be \(N, 3\) integer indices into the 3 vertices, got "):
+        _checks.indices("faces", value, 3, 3)  # type: ignore[arg-type]
+
+
+def test_indices_come_back_as_int64_rows_and_an_empty_list_as_no_rows() -> None:
+    np.testing.assert_array_equal(_checks.indices("faces", [[0, 1, 2]], 3, 3), [[0, 1, 2]])
+    assert _checks.indices("faces", np.array([[0, 1, 2]], np.uint8), 3, 3).dtype == np.int64
+    assert _checks.indices("edges", [], 2, 0).shape == (0, 2)
