@@ -256,6 +256,7 @@ class _Resistance:
 
 
 def _resistance(
+    lead: tuple[str, ArrayLike],
     cda_m2: ArrayLike,
     mass_kg: ArrayLike,
     crr: ArrayLike,
@@ -264,6 +265,18 @@ def _resistance(
     headwind_ms: ArrayLike,
     drivetrain_efficiency: ArrayLike,
 ) -> _Resistance:
+    """The coefficients of :func:`power` and :func:`speed_for_power`, their inputs' shapes first checked to broadcast
+    with ``lead``'s (the speed or the power, by name)."""
+    _broadcast(
+        **{lead[0]: lead[1]},
+        cda_m2=cda_m2,
+        mass_kg=mass_kg,
+        crr=crr,
+        grade=grade,
+        altitude_m=altitude_m,
+        headwind_ms=headwind_ms,
+        drivetrain_efficiency=drivetrain_efficiency,
+    )
     rolling_force, climbing_force = _road_forces(
         _positive("mass_kg", mass_kg), _non_negative("crr", crr), _finite("grade", grade)
     )
@@ -302,16 +315,6 @@ def power(
         :class:`Power` with the broadcast shape of the inputs.
     """
     _check_model_domain(cda_m2, mass_kg, crr, altitude_m, headwind_ms, speed_ms, "power")
-    _broadcast(
-        speed_ms=speed_ms,
-        cda_m2=cda_m2,
-        mass_kg=mass_kg,
-        crr=crr,
-        grade=grade,
-        altitude_m=altitude_m,
-        headwind_ms=headwind_ms,
-        drivetrain_efficiency=drivetrain_efficiency,
-    )
     return _power(speed_ms, cda_m2, mass_kg, crr, grade, altitude_m, headwind_ms, drivetrain_efficiency)
 
 
@@ -328,7 +331,7 @@ def _power(
     """:func:`power` once its callers have checked the ranges (a group's CdA times its drag share may lie below
     the range a rider's CdA is checked against)."""
     v = _non_negative("speed_ms", speed_ms)
-    r = _resistance(cda_m2, mass_kg, crr, grade, altitude_m, headwind_ms, drivetrain_efficiency)
+    r = _resistance(("speed_ms", v), cda_m2, mass_kg, crr, grade, altitude_m, headwind_ms, drivetrain_efficiency)
 
     aero, rolling, _, climbing = wheel_power_terms(v, r.drag, r.rolling_force, r.climbing_force, r.wind, 0.0, 0.0)
     aero, rolling, climbing, efficiency = np.broadcast_arrays(aero, rolling, climbing, r.efficiency)
@@ -391,17 +394,7 @@ def speed_for_power(
         altitude_m=altitude_m,
         headwind_ms=headwind_ms,
     )
-    _broadcast(
-        power_w=target,
-        cda_m2=cda_m2,
-        mass_kg=mass_kg,
-        crr=crr,
-        grade=grade,
-        altitude_m=altitude_m,
-        headwind_ms=headwind_ms,
-        drivetrain_efficiency=drivetrain_efficiency,
-    )
-    r = _resistance(cda_m2, mass_kg, crr, grade, altitude_m, headwind_ms, drivetrain_efficiency)
+    r = _resistance(("power_w", target), cda_m2, mass_kg, crr, grade, altitude_m, headwind_ms, drivetrain_efficiency)
     # Validated above. Rolling plus climbing as m·g·cos θ·(Crr + grade), which is exactly 0 where Crr = −grade
     # (the sum of the two forces would leave rounding there, and its square root would move v_c); the ratio
     # (Crr + grade)/√(1 + grade²) is formed first, so a huge grade gives ±m·g instead of overflowing.
