@@ -515,7 +515,7 @@ MAX_PITCH_LENGTH_M = 120.0
 def _spin_inertia_bound(pitch: NDArray[np.float64]) -> float:
     """:func:`kernels.ball.play.spin_inertia_bound` of one (N_PITCH,) pitch row, in the same operations."""
     slots = (play.TURF_SURFACE, play.FRAME_SURFACE, play.BODY_SURFACE)
-    return max(0.0, *(float(pitch[slot + 4]) * float(pitch[slot + 3]) * float(pitch[slot + 3]) for slot in slots))
+    return max(0.0, *(float(pitch[slot + 4]) * float(pitch[slot + 3]) ** 2 for slot in slots))
 
 
 MAX_PITCH_DT_S = 0.05

@@ -211,7 +211,7 @@ def spin_inertia_bound(pitch):
     energy a contact can turn into speed (:func:`~kernels.ball.aero.max_stable_step`)."""
     bound = 0.0
     for slot in (TURF_SURFACE, FRAME_SURFACE, BODY_SURFACE):
-        bound = max(bound, pitch[slot + 4] * pitch[slot + 3] * pitch[slot + 3])
+        bound = max(bound, pitch[slot + 4] * pitch[slot + 3] ** 2)
     return bound
 
 
@@ -649,12 +649,13 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
     x, y, z, vx, vy, vz = launch[0], launch[1], launch[2], launch[3], launch[4], launch[5]
     wx, wy, wz = launch[6], launch[7], launch[8]
     # The spin's energy counts too (α·R²·|ω|² per unit mass, doubled as |v|² is), with the same margin: a bounce can
-    # turn it into speed, and a ball rolled with heavy backspin leaves the turf faster than it came.
-    spin_energy = pitch[TURF_SURFACE + 4] * radius * radius * (wx * wx + wy * wy + wz * wz)
-    energy_limit = _energy_limit(vx, vy, vz, z, g) + 4.0 * spin_energy
+    # turn it into speed, and a ball rolled with heavy backspin leaves the turf faster than it came. The one α·R²
+    # serves this guard, the step limit and the energy bound of _out_of_reach.
+    spin_inertia = spin_inertia_bound(pitch)
+    energy_limit = _energy_limit(vx, vy, vz, z, g) + 4.0 * spin_inertia * (wx * wx + wy * wy + wz * wz)
     if store:
         _write_spin_sample(t_out, state_out, spin_out, 0, 0.0, x, y, z, vx, vy, vz, wx, wy, wz)
-    refused = dt > max_stable_step(launch, kick, config, spin_inertia_bound(pitch))[0]
+    refused = dt > max_stable_step(launch, kick, config, spin_inertia)[0]
     if refused:
         info[I_RESULT] = SHORT
         return 1, REFUSED
@@ -673,9 +674,8 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
     mouth_box, keeper_reach = _box(boxes, 3), _box(boxes, 4)
     # The energy bound of _out_of_reach counts the spin with the ball's α and R, the same in every surface's slots
     # (pitch_vector writes the ball's); where they differ, it is not used.
-    spin_inertia = pitch[TURF_SURFACE + 4] * pitch[TURF_SURFACE + 3] ** 2
     bounded = True
-    for slot in (FRAME_SURFACE, BODY_SURFACE):
+    for slot in (TURF_SURFACE, FRAME_SURFACE, BODY_SURFACE):
         if pitch[slot + 4] * pitch[slot + 3] ** 2 != spin_inertia:
             bounded = False
     if keeper:
