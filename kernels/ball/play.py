@@ -4,7 +4,7 @@ and ends in the net, at rest, off the pitch, in the keeper's hands or at ``t_max
 One compiled loop, :func:`play`, steps the same force law and RK4/Euler step as the free flight
 (:func:`kernels.ball.core._step`) between contacts; each contact is the first one found inside a step (the ground by
 the cubic Hermite root of :func:`~kernels.ball.core.crossing_fraction`, a capsule by bisection on the Hermite
-interpolant after a swept test of the step's chord) and applies :func:`kernels.ball.contact.impact`, Cross's
+interpolant after a swept test of the step's chord, grown by how far the path can stray from it) and applies :func:`kernels.ball.contact.impact`, Cross's
 grip–slip impulse (Cross 2002), with the surface's coefficients. The step then restarts from the contact, so samples
 are every ``dt`` between contacts, plus one at each contact. Spin is constant between contacts and changed by each.
 
@@ -127,22 +127,82 @@ def _to_axis(x, y, z, cap):
 
 
 @compiled()
-def _capsule_fraction(x, y, z, vx, vy, vz, x1, y1, z1, vx1, vy1, vz1, h, cap, radius):
+def _path_stray(x, y, z, vx, vy, vz, x1, y1, z1, vx1, vy1, vz1, h):
+    """How far the step's cubic Hermite path strays from its chord at most (m).
+
+    Written about the chord velocity c = (p₁ − p₀)/h, the path less the chord at fraction s is
+    h·s(1 − s)·((1 − s)(v₀ − c) − s(v₁ − c)), so its length is at most h/4 · max(|v₀ − c|, |v₁ − c|). Gravity bends
+    a long step's path off its chord, and drag slows the ball along it.
+    """
+    cx, cy, cz = (x1 - x) / h, (y1 - y) / h, (z1 - z) / h
+    a2 = (vx - cx) ** 2 + (vy - cy) ** 2 + (vz - cz) ** 2
+    b2 = (vx1 - cx) ** 2 + (vy1 - cy) ** 2 + (vz1 - cz) ** 2
+    return 0.25 * h * math.sqrt(max(a2, b2))
+
+
+@compiled()
+def _path_to_axis(x, y, z, vx, vy, vz, x1, y1, z1, vx1, vy1, vz1, h, s, cap):
+    """Distance from the step's path at fraction ``s`` to the capsule's axis (m)."""
+    px, _ = _hermite(x, vx, x1, vx1, h, s)
+    py, _ = _hermite(y, vy, y1, vy1, h, s)
+    pz, _ = _hermite(z, vz, z1, vz1, h, s)
+    distance, _, _, _ = _to_axis(px, py, pz, cap)
+    return distance
+
+
+PATH_SAMPLES = 16
+"""Points of a step's path sampled for its first touch of a capsule, where the chord's closest approach does not
+bracket it."""
+
+
+@compiled()
+def _path_bracket(x, y, z, vx, vy, vz, x1, y1, z1, vx1, vy1, vz1, h, cap, reach):
+    """Fractions (lo, hi) of the step with the path clear of the capsule at ``lo`` and touching it at ``hi``, the
+    first touch between them; (0, 2) if no touch is found. The first of :data:`PATH_SAMPLES` samples that touches,
+    else a golden-section search for the least distance about the nearest sample."""
+    nearest, least = 1, math.inf
+    for k in range(1, PATH_SAMPLES + 1):
+        distance = _path_to_axis(x, y, z, vx, vy, vz, x1, y1, z1, vx1, vy1, vz1, h, k / PATH_SAMPLES, cap)
+        if distance <= reach:
+            return (k - 1) / PATH_SAMPLES, k / PATH_SAMPLES
+        if distance < least:
+            nearest, least = k, distance
+    lo = (nearest - 1) / PATH_SAMPLES
+    a, b = lo, min(nearest + 1, PATH_SAMPLES) / PATH_SAMPLES
+    shrink = 0.5 * (math.sqrt(5.0) - 1.0)
+    while b - a > 1e-13:
+        c, d = b - shrink * (b - a), a + shrink * (b - a)
+        at_c = _path_to_axis(x, y, z, vx, vy, vz, x1, y1, z1, vx1, vy1, vz1, h, c, cap)
+        if at_c <= reach:
+            return lo, c
+        at_d = _path_to_axis(x, y, z, vx, vy, vz, x1, y1, z1, vx1, vy1, vz1, h, d, cap)
+        if at_d <= reach:
+            return lo, d
+        if at_c < at_d:
+            b = d
+        else:
+            a = c
+    return 0.0, 2.0
+
+
+@compiled()
+def _capsule_fraction(x, y, z, vx, vy, vz, x1, y1, z1, vx1, vy1, vz1, h, cap, radius, stray):
     """First fraction of the step at which the ball (radius ``radius``) touches the capsule ``cap`` while moving
-    into it, or 2.0 for none: a swept test of the chord, then bisection on the cubic Hermite path."""
+    into it, or 2.0 for none: a swept test of the chord, grown by how far the path strays from it (``stray``,
+    :func:`_path_stray`), then bisection on the cubic Hermite path."""
     reach = radius + cap[6]
     # Broad phase: the step's chord and the capsule's axis, each boxed, must come within reach (most steps do not).
-    margin = reach + 1e-3
+    margin = reach + 1e-3 + stray
     if max(x, x1) < min(cap[0], cap[3]) - margin or min(x, x1) > max(cap[0], cap[3]) + margin:
         return 2.0
     if max(y, y1) < min(cap[1], cap[4]) - margin or min(y, y1) > max(cap[1], cap[4]) + margin:
         return 2.0
     if max(z, z1) < min(cap[2], cap[5]) - margin or min(z, z1) > max(cap[2], cap[5]) + margin:
         return 2.0
-    _, _, d2 = _segment_closest(
+    s_hi, _, d2 = _segment_closest(
         x, y, z, x1 - x, y1 - y, z1 - z, cap[0], cap[1], cap[2], cap[3] - cap[0], cap[4] - cap[1], cap[5] - cap[2]
     )
-    if d2 > (reach + 1e-3) ** 2:
+    if d2 > margin * margin:
         return 2.0
     distance, nx, ny, nz = _to_axis(x, y, z, cap)
     # Touching at the start (to rounding: the last contact leaves a ball at reach ± 1 ulp): a contact only if moving
@@ -150,24 +210,18 @@ def _capsule_fraction(x, y, z, vx, vy, vz, x1, y1, z1, vx1, vy1, vz1, h, cap, ra
     # the tolerances such a ball met the body again at once, contact after contact with no change.
     if distance <= reach * (1.0 + 1e-12):
         return 0.0 if vx * nx + vy * ny + vz * nz < -1e-9 else 2.0
-    # The chord's closest approach brackets the first touch (distance to a convex body is convex along a line).
-    s_hi, _, _ = _segment_closest(
-        x, y, z, x1 - x, y1 - y, z1 - z, cap[0], cap[1], cap[2], cap[3] - cap[0], cap[4] - cap[1], cap[5] - cap[2]
-    )
+    # The chord's closest approach brackets the first touch (distance to a convex body is convex along a line) when
+    # the path there touches. In a long step it may not: drag slows the ball along the step, so the path at that
+    # fraction lies short of the chord's point, and gravity bends the path off the chord. Then the path's samples
+    # bracket it: the first sample that touches, or the least distance about the nearest sample.
     lo, hi = 0.0, max(s_hi, 1e-12)
-    px, _ = _hermite(x, vx, x1, vx1, h, hi)
-    py, _ = _hermite(y, vy, y1, vy1, h, hi)
-    pz, _ = _hermite(z, vz, z1, vz1, h, hi)
-    distance, _, _, _ = _to_axis(px, py, pz, cap)
-    if distance > reach:
-        return 2.0
+    if _path_to_axis(x, y, z, vx, vy, vz, x1, y1, z1, vx1, vy1, vz1, h, hi, cap) > reach:
+        lo, hi = _path_bracket(x, y, z, vx, vy, vz, x1, y1, z1, vx1, vy1, vz1, h, cap, reach)
+        if hi > 1.0:
+            return 2.0
     for _ in range(60):
         mid = 0.5 * (lo + hi)
-        px, _ = _hermite(x, vx, x1, vx1, h, mid)
-        py, _ = _hermite(y, vy, y1, vy1, h, mid)
-        pz, _ = _hermite(z, vz, z1, vz1, h, mid)
-        distance, _, _, _ = _to_axis(px, py, pz, cap)
-        if distance > reach:
+        if _path_to_axis(x, y, z, vx, vy, vz, x1, y1, z1, vx1, vy1, vz1, h, mid, cap) > reach:
             lo = mid
         else:
             hi = mid
@@ -298,15 +352,15 @@ def _box(boxes, g):
 
 
 @compiled()
-def _chord_meets(x, y, z, x1, y1, z1, box):
-    """Whether the box of the step's chord meets ``box`` (:func:`_box`)."""
+def _chord_meets(x, y, z, x1, y1, z1, box, grow):
+    """Whether the box of the step's chord, grown by ``grow`` (m), meets ``box`` (:func:`_box`)."""
     return not (
-        max(x, x1) < box[0]
-        or min(x, x1) > box[3]
-        or max(y, y1) < box[1]
-        or min(y, y1) > box[4]
-        or max(z, z1) < box[2]
-        or min(z, z1) > box[5]
+        max(x, x1) + grow < box[0]
+        or min(x, x1) - grow > box[3]
+        or max(y, y1) + grow < box[1]
+        or min(y, y1) - grow > box[4]
+        or max(z, z1) + grow < box[2]
+        or min(z, z1) - grow > box[5]
     )
 
 
@@ -340,9 +394,9 @@ def _rolls_clear(x, y, z, vx, vy, pitch, boxes, dived):
     reach = math.sqrt(vx * vx + vy * vy) / (2.0 * decel)  # the stop is at (x, y) + (vx, vy)·reach
     x1, y1 = x + vx * reach, y + vy * reach
     return not (
-        _chord_meets(x, y, z, x1, y1, z, _box(boxes, 0))
-        or _chord_meets(x, y, z, x1, y1, z, _box(boxes, 1))
-        or (keeper and _chord_meets(x, y, z, x1, y1, z, _box(boxes, 2)))
+        _chord_meets(x, y, z, x1, y1, z, _box(boxes, 0), 0.0)
+        or _chord_meets(x, y, z, x1, y1, z, _box(boxes, 1), 0.0)
+        or (keeper and _chord_meets(x, y, z, x1, y1, z, _box(boxes, 2), 0.0))
     )
 
 
@@ -746,7 +800,8 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
         ):
             ending = DIVERGED
             break
-        near_keeper = keeper and _chord_meets(x, y, z, x1, y1, z1, keeper_box)
+        stray = _path_stray(x, y, z, vx, vy, vz, x1, y1, z1, vx1, vy1, vz1, h)
+        near_keeper = keeper and _chord_meets(x, y, z, x1, y1, z1, keeper_box, stray)
         if near_keeper:
             _keeper_capsule(pitch, dive_t, target, t + 0.5 * h, caps[n_fixed])
         # The first contact in the step.
@@ -757,12 +812,12 @@ def play(launch, kick, config, pitch, t_out, state_out, spin_out, events, info):
             f = crossing_fraction(x_stop - x, -vx, x_stop - x1, -vx1, h)
             if f < best:
                 best, kind = f, -2
-        near_frame = _chord_meets(x, y, z, x1, y1, z1, frame_box)
-        near_wall = _chord_meets(x, y, z, x1, y1, z1, wall_box)
+        near_frame = _chord_meets(x, y, z, x1, y1, z1, frame_box, stray)
+        near_wall = _chord_meets(x, y, z, x1, y1, z1, wall_box, stray)
         for c in range(n_caps):
             if (c < 3 and not near_frame) or (3 <= c < n_fixed and not near_wall) or (c == n_fixed and not near_keeper):
                 continue
-            f = _capsule_fraction(x, y, z, vx, vy, vz, x1, y1, z1, vx1, vy1, vz1, h, caps[c], radius)
+            f = _capsule_fraction(x, y, z, vx, vy, vz, x1, y1, z1, vx1, vy1, vz1, h, caps[c], radius, stray)
             if f < best:
                 best, kind, which = f, int(caps[c, 7]), c
         depth0, depth1 = (x - gx) * gnx + (y - gy) * gny, (x1 - gx) * gnx + (y1 - gy) * gny
