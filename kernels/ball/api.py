@@ -25,10 +25,12 @@ from kernels.ball.config import (
     BALL_RADIUS_M,
     DT,
     GROUND,
+    MAX_STEPS,
     MEASURED,
     N_STEPS,
     RADIUS,
     RK4,
+    T_MAX,
     FlightConfig,
     check_launches,
     checked_seed,
@@ -209,20 +211,30 @@ def _refuse_overflow(
         spin_inertia = 0.0 if pitches is None or pitch_of is None else _spin_inertia_bound(pitches[pitch_of[first]])
         limit, fastest = stable_step(launches[first], config, spin_inertia)
         single = len(endings) == 1
-        which = "" if single else f" of {'strikes' if strikes else 'kicks'} {refused[:5].tolist()}"
         velocity, spin = ("velocity", "spin") if single or strikes else (f"velocities[{first}]", f"spins[{first}]")
-        method = "rk4" if config[RK4] else "euler"
         launched = f"launched at |{velocity}| = {math.hypot(*launches[first, 3:6].tolist()):.3g} m/s"
-        smaller = "dt or speed_ms" if strikes else f"dt or {velocity}"
+        subjects = ["speed_ms" if strikes else velocity]
         rate = math.hypot(*launches[first, 6:9].tolist())
         if spin_inertia > 0.0 and rate > 0.0:
             launched += f" and spinning at |{spin}| = {rate:.3g} rad/s, whose energy a bounce can turn into speed"
-            smaller = "dt, speed_ms or spin_rads" if strikes else f"dt, {velocity} or {spin}"
+            subjects.append("spin_rads" if strikes else spin)
+        at_most = (
+            f"at most {_round_down(limit):.3g} s for {'rk4' if config[RK4] else 'euler'}, the method's stability "
+            f"limit with the drag at {fastest:.3g} m/s (the fastest this ball can fly, {launched}; see kernels.ball)"
+        )
+        which = "" if single else f" of {'strikes' if strikes else 'kicks'} {refused[:5].tolist()}"
+        shortest = config[T_MAX] / MAX_STEPS
+        if limit >= shortest:
+            remedy = "use a smaller " + ", ".join(["dt", *subjects[:-1]]) + f" or {subjects[-1]}"
+        else:  # no dt the flight takes is that short: a shorter t_max allows one
+            remedy = (
+                f"t_max = {config[T_MAX]:g} s takes no step under t_max/{MAX_STEPS} = {shortest:g} s, so use a "
+                f"smaller {' or '.join(subjects)}, a t_max of at most {_round_down(limit * MAX_STEPS):.3g} s"
+            )
         raise ValueError(
-            f"dt = {config[DT]:g} s is too long for this drag{which}: at most {_round_down(limit):.3g} s for "
-            f"{method}, the method's stability limit with the drag at {fastest:.3g} m/s (the fastest this ball "
-            f"can fly, {launched}; see kernels.ball): a longer step overshoots the drag, reversing or amplifying "
-            f"the velocity; use a smaller {smaller}, or a smaller air_density or a larger mass_kg"
+            f"dt = {config[DT]:g} s is too long for this drag{which}: {at_most}: a longer "
+            f"step overshoots the drag, reversing or amplifying the velocity; {remedy}, or a smaller air_density or "
+            "a larger mass_kg"
         )
     inside = np.flatnonzero(endings == 9)
     if inside.size:
@@ -274,8 +286,9 @@ def simulate(
         ValueError: naming the argument, for non-finite, boolean or wrongly shaped input, an invalid
             :class:`FlightConfig` field, a position below ``ground_m``, a spin beyond the measured model's range
             (see :mod:`kernels.ball`); naming dt and its limit when dt is beyond the method's stability limit for
-            this kick's drag (a step that would reverse or amplify the velocity; see :mod:`kernels.ball`), or when
-            the steps still overshoot and the ball gains energy without bound.
+            this kick's drag (a step that would reverse or amplify the velocity; see :mod:`kernels.ball`), and
+            the t_max that allows so short a step where ``t_max``'s :data:`~kernels.ball.config.MAX_STEPS` steps do
+            not; or when the steps still overshoot and the ball gains energy without bound.
         TypeError: an unknown keyword.
     """
     flight = flight_config(config, options)

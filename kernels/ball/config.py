@@ -46,7 +46,8 @@ Jabulani's, Goff, Asai & Hong 2014), so set the centre from the ball's own measu
 Method = Literal["euler", "rk4"]
 Model = Literal["constant", "measured"]
 
-_MAX_STEPS = 1_000_000
+MAX_STEPS = 1_000_000
+"""The most steps a flight takes: ``dt`` is at least ``t_max / MAX_STEPS``."""
 
 # The compiled cores read their settings from one float64 vector; these are its slots.
 MAX_BALL_RADIUS_M = 1.0
@@ -166,9 +167,9 @@ class FlightConfig:
     def __post_init__(self) -> None:
         step = _checks.positive("dt", self.dt)
         duration = _checks.positive("t_max", self.t_max)
-        if duration / step > _MAX_STEPS:
+        if duration / step > MAX_STEPS:
             raise ValueError(
-                f"dt must be at least t_max/{_MAX_STEPS} = {duration / _MAX_STEPS:g} s, got {_checks.shown(step)}"
+                f"dt must be at least t_max/{MAX_STEPS} = {duration / MAX_STEPS:g} s, got {_checks.shown(step)}"
             )
         _checks.choice("method", self.method, ("euler", "rk4"))
         _checks.choice("model", self.model, ("constant", "measured"))

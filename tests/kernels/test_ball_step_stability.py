@@ -184,6 +184,7 @@ def _check_refusals(velocity: np.ndarray, method: ball.Method, dt: float) -> Non
     # The limit β/(2q·C·|v|), β = 2 for Euler and 2.7853 for RK4: the speed only falls from |v0|. C is C_D in free
     # flight without spin; on a pitch C_D + C_L, as a bounce can spin the ball up.
     beta = 2.0 if method == "euler" else 2.785293563405289
+    shortest = 5.0 / 1e6  # the default t_max over the most steps a flight takes: no dt may be shorter
     for (message, on_pitch), name, which in zip(
         refusals,
         ["velocity", "velocity", "velocities[1]", "velocities[1]", "velocities[1]"],
@@ -191,13 +192,31 @@ def _check_refusals(velocity: np.ndarray, method: ball.Method, dt: float) -> Non
         strict=True,
     ):
         expected = beta / (2.0 * _q(ball.AIR_DENSITY) * (C_D + (_C_L if on_pitch else 0.0)) * speed)
-        assert message.startswith(f"dt = {dt:g} s is too long for this drag{which}: at most "), message
         assert f"launched at |{name}| = {speed:.3g} m/s;" in message, message  # no spin to name
-        assert f"use a smaller dt or {name}" in message, message
         limit = _limit_named(ValueError(message))  # cut to three digits
         assert limit == pytest.approx(expected, rel=1e-2) and limit <= expected, message
+        assert message.startswith(f"dt = {dt:g} s is too long for this drag{which}: at most "), message
+        if expected > 1.01 * shortest or (expected > 0.99 * shortest and f"use a smaller dt or {name}" in message):
+            assert f"use a smaller dt or {name}, or" in message, message
+        else:  # no step the flight takes is that short: not dt but a t_max that allows one is named
+            assert f"so use a smaller {name}, a t_max of at most " in message, message
+            found = re.search(r"a t_max of at most ([0-9.e+-]+) s", message)
+            assert found is not None, message
+            assert float(found.group(1)) == pytest.approx(1e6 * limit, rel=1e-2), message
+            assert float(found.group(1)) <= 1e6 * expected, message
     assert refusals[0][0] == refusals[2][0].replace(" of kicks [1]", "").replace("velocities[1]", "velocity")
     assert refusals[2][0] == refusals[3][0]
+
+
+def test_the_t_max_a_refusal_names_lets_the_kick_fly() -> None:
+    # At 1e8 m/s Euler's limit is 7.38e-7 s, under the 5e-6 s a 5 s flight's million steps allow, so the refusal
+    # named a dt no flight took. It now names the t_max that allows one: 0.738 s flies, 0.739 s does not.
+    with pytest.raises(ValueError, match=r"so use a smaller velocity, a t_max of at most 0\.738 s, or"):
+        ball.simulate((0.0, 0.0, 1.0), (1e8, 0.0, 0.0), (0.0, 0.0, 0.0), dt=1e-3)
+    flight = ball.simulate((0.0, 0.0, 1.0), (1e8, 0.0, 0.0), (0.0, 0.0, 0.0), t_max=0.738, dt=0.738e-6)
+    assert flight.ended == "ground" and np.isfinite(flight.position).all()
+    with pytest.raises(ValueError, match=r"^dt = 7\.39e-07 s is too long for this drag: at most 7\.38e-07 s"):
+        ball.simulate((0.0, 0.0, 1.0), (1e8, 0.0, 0.0), (0.0, 0.0, 0.0), t_max=0.739, dt=0.739e-6)
 
 
 @pytest.mark.parametrize("speed", [1e6, 1.3e154, 1.4e154, 1e200, 1.7e308])
@@ -238,7 +257,8 @@ def test_backspin_a_bounce_turns_into_speed_is_refused_naming_the_spin() -> None
         ball.simulate((0.0, 0.0, 1.0), velocity, spin, dt=1e-3, pitch=_PITCH)
     message = str(caught.value)
     assert "and spinning at |spin| = 1e+20 rad/s, whose energy a bounce can turn into speed" in message
-    assert "use a smaller dt, velocity or spin" in message
+    # Its limit, about 2e-18 s, is under any step a 5 s flight takes (5e-6 s): a t_max that allows one is named.
+    assert "so use a smaller velocity or spin, a t_max of at most 2.0" in message
     # The fastest is the spin's: 2·√α·R·|ω| (the launch's 15.3 m/s is 1e-38 of it in quadrature).
     fastest = 2.0 * math.sqrt(_ALPHA) * ball.BALL_RADIUS_M * 1e20
     expected = 2.0 / (2.0 * _q(ball.AIR_DENSITY) * (C_D + _C_L) * fastest)
@@ -251,9 +271,13 @@ def test_backspin_a_bounce_turns_into_speed_is_refused_naming_the_spin() -> None
         lambda: ball.odds_map([20.0], [0.0], 25.0, 0.3, 0.05, (0.0, 1e300, 0.0), n=8),
     ):
         with pytest.raises(
-            ValueError, match=r"of strikes \[0, 1, 2, 3, 4\]: .* use a smaller dt, speed_ms or spin_rads"
+            ValueError,
+            match=r"of strikes \[0, 1, 2, 3, 4\]: .* so use a smaller speed_ms or spin_rads, a t_max of at most",
         ):
             call()
+    # Where a shorter step would do, the step is refused.
+    with pytest.raises(ValueError, match=r"of strikes \[0, 1, 2, 3, 4\]: .* use a smaller dt, speed_ms or spin_rads"):
+        ball.strike_odds((-20.0, 0.0, 0.11), 25.0, 0.3, 0.05, (0.0, 1e6, 0.0), _PITCH, n=20)
 
 
 @given(
