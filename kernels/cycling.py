@@ -176,8 +176,6 @@ def drag_reduction(n_riders: int, gap_m: float, model: DraftModel = "measured") 
             plateau = np.array([_MEASURED_PLATEAU[min(k, len(_MEASURED_PLATEAU)) - 1] for k in range(1, n_riders)])
             reduction[1:] = plateau * np.exp(-gap / _MEASURED_FADE_M)
             reduction[0] = _LEADER_PLATEAU * np.exp(-gap / _LEADER_FADE_M)
-        case _:
-            raise ValueError(f"model must be 'seed' or 'measured', got {_checks.shown(model)}")
     return reduction
 
 
@@ -1026,8 +1024,6 @@ def formation(
                 xs += [-row * step] * width
                 row += 1
             return np.stack([np.array(xs[:n]), np.array(ys[:n])], axis=1)
-        case _:
-            raise ValueError(f"shape must be one of {FORMATION_SHAPES}, got {_checks.shown(shape)}")
 
 
 def _plateau(depth: NDArray[np.float64]) -> NDArray[np.float64]:

@@ -132,8 +132,6 @@ class Air:
                     np.clip(pressure, 10.0, 1100.0),
                     self.relative_humidity,
                 )
-            case _:
-                raise ValueError(f"kind must be 'seed' or 'weather', got {_checks.shown(self.kind)}")
 
 
 _ISA_RANGE_M = (-1000.0, 20_000.0)
