@@ -62,6 +62,7 @@ from kernels.sdf.operators import (
 from kernels.sdf.primitives import (
     BUILT_IN_KINDS,
     MAX_COORDINATE,
+    MIN_SEMI_AXIS,
     PRIMITIVES,
     ROUND_BOX_ROUNDING,
     AnyFloatArray,
@@ -121,6 +122,7 @@ __all__ = [
     "MAX_RESOLUTION",
     "MIN_BLEND_WIDTH",
     "MIN_RESOLUTION",
+    "MIN_SEMI_AXIS",
     "PRIMITIVES",
     "PRIMITIVE_KINDS",
     "ROUND_BOX_ROUNDING",

@@ -54,6 +54,8 @@ MAX_COORDINATE = 1e150
 """Largest magnitude (m) of a coordinate, position or size a primitive or operator takes: squares and products of
 sums of such numbers stay finite in float64 (1e300 at most), so no formula overflows to inf or NaN. Anything larger
 is refused by name (a sphere at 1e300 m had the distance inf; a capsule's end at 1e300 m gave NaN)."""
+MIN_SEMI_AXIS = 1.0 / MAX_COORDINATE
+"""Smallest semi-axis (m) an ellipsoid takes: a point within ±:data:`MAX_COORDINATE` over it stays finite."""
 
 
 def coordinates(name: str, value: ArrayLike) -> FloatArray:
@@ -76,6 +78,15 @@ def length(name: str, value: object, *, zero_ok: bool = False) -> float:
     if number > MAX_COORDINATE:
         raise ValueError(f"{name} must be at most {MAX_COORDINATE:g} m, got {_checks.shown(value)}")
     return number
+
+
+def semi_axes(radii: ArrayLike) -> FloatArray:
+    """(3,) an ellipsoid's semi-axes (m), each in [:data:`MIN_SEMI_AXIS`, :data:`MAX_COORDINATE`], else
+    ``ValueError`` naming ``radii``."""
+    r = lengths("radii", radii, 3)
+    if r.min() < MIN_SEMI_AXIS:
+        raise ValueError(f"radii must each be at least {MIN_SEMI_AXIS:g} m, got {_checks.shown(r)}")
+    return r
 
 
 def lengths(name: str, value: ArrayLike, size: int) -> FloatArray:
@@ -268,7 +279,8 @@ def _sd_cone(pts: FloatArray, r: float, h: float) -> FloatArray:
     wy = pts[:, 1] - 0.5 * h
     t = np.clip((wx * qx + wy * qy) / (qx * qx + qy * qy), 0.0, 1.0)
     ax, ay = wx - qx * t, wy - qy * t
-    bx, by = wx - qx * np.clip(wx / qx, 0.0, 1.0), wy - qy
+    with np.errstate(over="ignore"):  # a radius under 1e-292 m: w/q passes the float maximum, clipped to 1
+        bx, by = wx - qx * np.clip(wx / qx, 0.0, 1.0), wy - qy
     d = np.minimum(ax * ax + ay * ay, bx * bx + by * by)
     # k = sign(q.y) = −1
     s = np.maximum(-(wx * qy - wy * qx), -(wy - qy))
@@ -310,18 +322,28 @@ def sd_ellipsoid(p: ArrayLike, radii: ArrayLike) -> FloatArray:
 
     Args:
         p: (N, 3) points in the local frame (m).
-        radii: (3,) semi-axes along x, y, z (m), each > 0.
+        radii: (3,) semi-axes along x, y, z (m), each in [:data:`MIN_SEMI_AXIS`, :data:`MAX_COORDINATE`].
 
     Returns:
         (N,) signed distance estimates (m).
     """
     pts = coordinates("p", p)
-    r = lengths("radii", radii, 3)
-    k0 = np.linalg.norm(pts / r, axis=1)
-    k1 = np.linalg.norm(pts / (r * r), axis=1)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        d = k0 * (k0 - 1.0) / k1
-    return np.where(k1 > 0.0, d, -r.min())
+    r = semi_axes(radii)
+    # k0/k1 depends only on p's direction, so it is taken of p scaled by a power of two (exactly) to a largest
+    # component in [0.5, 1): then |p/r| ≤ 1e150 and the largest of |p/r²| ≥ 5e-301, with no overflow, and nothing
+    # that matters to the norms is a subnormal. Its product with k0 − 1 (k0 ≤ 1e300) is at most |p| (Cauchy–Schwarz).
+    # As written above, p/r² overflowed for a semi-axis under 1e-154 m, and a point under 1e-300 m lost digits.
+    _, exponent = np.frexp(np.abs(pts).max(axis=1, keepdims=True))
+    direction = np.ldexp(pts, -exponent) / r
+    with np.errstate(invalid="ignore"):  # 0/0 at the centre only
+        ratio = _hypot3(direction) / _hypot3(direction / r)  # k0/k1 (m), in [min(r), max(r)]
+    d = ratio * (_hypot3(pts / r) - 1.0)
+    return np.where(np.isfinite(ratio), d, -r.min())
+
+
+def _hypot3(v: AnyFloatArray) -> AnyFloatArray:
+    """(N,) lengths of (N, 3) vectors without squaring, so a component up to the float maximum does not overflow."""
+    return np.hypot(np.hypot(v[:, 0], v[:, 1]), v[:, 2])
 
 
 def sd_ellipsoid_lipschitz(p: ArrayLike, radii: ArrayLike) -> FloatArray:
@@ -335,17 +357,17 @@ def sd_ellipsoid_lipschitz(p: ArrayLike, radii: ArrayLike) -> FloatArray:
 
     Args:
         p: (N, 3) points in the local frame (m).
-        radii: (3,) semi-axes along x, y, z (m), each > 0.
+        radii: (3,) semi-axes along x, y, z (m), each in [:data:`MIN_SEMI_AXIS`, :data:`MAX_COORDINATE`].
 
     Returns:
         (N,) signed distance bounds (m).
     """
-    return _sd_ellipsoid_lipschitz(coordinates("p", p), lengths("radii", radii, 3))
+    return _sd_ellipsoid_lipschitz(coordinates("p", p), semi_axes(radii))
 
 
 def _sd_ellipsoid_lipschitz(pts: FloatArray, radii: FloatArray | Sizes) -> FloatArray:
     r = np.asarray(radii)
-    return (np.linalg.norm(pts / r, axis=1) - 1.0) * r.min()
+    return (_hypot3(pts / r) - 1.0) * r.min()  # hypot's norm: p/r passes 1e154 for a semi-axis under 1e-4 m
 
 
 def sd_plane(p: ArrayLike, normal: ArrayLike, offset: float) -> FloatArray:

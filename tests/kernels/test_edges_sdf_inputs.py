@@ -9,6 +9,7 @@ value it was found with is in the family.
 from __future__ import annotations
 
 import dataclasses
+import decimal
 import math
 import re
 from decimal import Decimal
@@ -16,6 +17,8 @@ from typing import Any
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from kernels import sdf
 from shaders.camera import Camera, Shading, camera_rays, check_image_size, screen_rectangle
@@ -187,6 +190,53 @@ def test_geometry_at_max_coordinate_gives_finite_distances(call: Any) -> None:
         with np.errstate(over="raise", invalid="raise"):
             d = fn(far, **args)
         assert np.all(np.isfinite(d)), (fn.__name__, name, d)
+
+
+@pytest.mark.parametrize("tiny", [1e-150, 1e-300, 5e-324])
+@pytest.mark.parametrize("call", PRIMITIVE_CALLS, ids=lambda c: c[0].__name__)
+def test_the_smallest_geometry_gives_finite_distances_or_is_refused_by_name(call: Any, tiny: float) -> None:
+    # Once: an ellipsoid with a semi-axis under 1e-154 m gave NaN (p/r² overflowed), and a cone with a radius under
+    # 1e-292 m warned of an overflow. An ellipsoid's semi-axes are now at least 1e-150 m (MIN_SEMI_AXIS), so that
+    # any point allowed over any semi-axis stays finite; every other size may be any positive float.
+    fn, kwargs, names = call
+    bound = sdf.MAX_COORDINATE
+    points = np.array(
+        [[bound, -bound, bound], [0.0, 0.0, 0.0], [-bound, 0.0, 1.0], [1.0, 1.0, 1.0], [0.0, 1e-300, 0.0]]
+    )
+    for name in names:
+        if (fn is sdf.sd_capsule and name in ("a", "b")) or fn is sdf.sd_plane or fn is sdf.sd_round_box:
+            continue  # a point, not a size; the plane's offset may be 0; the round box's rounding is below its size
+        args = {**kwargs, name: [tiny] * len(kwargs[name]) if isinstance(kwargs[name], list) else tiny}
+        if fn in (sdf.sd_ellipsoid, sdf.sd_ellipsoid_lipschitz) and tiny < sdf.MIN_SEMI_AXIS:
+            with pytest.raises(ValueError, match=r"^radii must each be at least 1e-150 m, got"):
+                fn(points, **args)
+            continue
+        with np.errstate(over="raise", invalid="raise", divide="raise"):
+            d = fn(points, **args)
+        assert np.all(np.isfinite(d)), (fn.__name__, name, d)
+        assert d[0] == pytest.approx(math.sqrt(3.0) * bound, rel=1e-6), (fn.__name__, name, d)  # far from a speck
+
+
+@given(
+    radii=st.tuples(*[st.floats(math.log(1e-150), math.log(1e150)).map(math.exp)] * 3),
+    point=st.tuples(*[st.floats(-1.0, 1.0)] * 3),
+    log_scale=st.floats(math.log(1e-300), math.log(1e150)),
+)
+def test_the_ellipsoid_estimate_is_quilezs_formula_at_any_scale(radii, point, log_scale) -> None:
+    # k0·(k0 − 1)/k1 with k0 = |p/r|, k1 = |p/r²| (Quilez 2008), worked in 60-digit decimals as the reference.
+    p = np.array(point) * math.exp(log_scale)
+    if not p.any():
+        return
+    with decimal.localcontext() as context:
+        context.prec = 60
+        pd, rd = [Decimal(float(c)) for c in p], [Decimal(r) for r in radii]
+        k0 = sum((a / b) ** 2 for a, b in zip(pd, rd, strict=True)).sqrt()
+        k1 = sum((a / b / b) ** 2 for a, b in zip(pd, rd, strict=True)).sqrt()
+        expected = float(k0 * (k0 - 1) / k1)
+    with np.errstate(over="raise", invalid="raise", divide="raise"):
+        got = sdf.sd_ellipsoid(p[None], radii)[0]
+    # Rounding of k0 near the surface (k0 − 1 cancels) is worth about an ulp of the point's distance.
+    assert got == pytest.approx(expected, rel=1e-9, abs=1e-12 * (np.linalg.norm(p) + min(radii)))
 
 
 def test_a_huge_plane_normal_is_normalised() -> None:
