@@ -15,6 +15,7 @@ tracing", The Visual Computer 12 (1996).
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import functools
 import math
@@ -205,12 +206,20 @@ def fold_xyz(
     _checks.flag("with_color", with_color)
     first = scene.primitives[0]
     # A point far enough away (|p| beyond ~1e154 m in float64, ~1e19 m in float32) has an infinite distance; the
-    # blends take infinities without NaN, so that is the answer there, not a warning.
-    with np.errstate(over="ignore"):
-        d = first.distance_xyz(x, y, z)
+    # blends take infinities without NaN, so that is the answer there, not a warning. Beyond MAX_COORDINATE a
+    # primitive's formula may meet inf − inf (the octahedron's and the cone's at 1e308 m): its NaN is that infinity,
+    # as such a point lies outside every primitive.
+    far = max(float(np.abs(c).max(initial=0.0)) for c in (x, y, z)) > MAX_COORDINATE
+
+    def distance(prim: Primitive) -> NDArray[np.floating]:
+        d = prim.distance_xyz(x, y, z)
+        return np.where(np.isnan(d), np.inf, d) if far else d
+
+    with np.errstate(over="ignore"), np.errstate(invalid="ignore") if far else contextlib.nullcontext():
+        d = distance(first)
         color = np.tile(np.asarray(first.color, dtype=d.dtype), (len(d), 1)) if with_color else None
         for prim in scene.primitives[1:]:
-            d, w = combine_weighted(d, prim.distance_xyz(x, y, z), prim.op, scene.k, scene.blend)
+            d, w = combine_weighted(d, distance(prim), prim.op, scene.k, scene.blend)
             if color is not None:
                 color += w[:, None] * (np.asarray(prim.color, dtype=d.dtype) - color)
     return d, color

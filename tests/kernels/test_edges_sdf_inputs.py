@@ -145,6 +145,23 @@ def test_a_primitive_at_max_coordinate_has_finite_distances() -> None:
             assert np.all(np.isfinite(d)), (kind, center, size, d)
 
 
+@pytest.mark.parametrize("blend", ["poly", "exp"])
+@pytest.mark.parametrize("op", ["union", "subtract", "intersect"])
+@pytest.mark.parametrize("kind", sdf.BUILT_IN_KINDS)
+def test_a_point_beyond_max_coordinate_is_infinitely_far_never_nan(kind: str, op: str, blend: str) -> None:
+    # Once: an octahedron's or a cone's distance at (1.7e308, −1.7e308, 1.7e308) was NaN (inf − inf), and its
+    # colour NaN. A point that far lies outside every primitive: its distance is +inf (or exact, while finite).
+    count = sdf.primitive_spec(kind).size_count
+    first = sdf.Primitive(kind, (0.1, 0.2, 0.3), (0.3,) * count, rotation=(0.9, 0.1, 0.3, 0.2))  # type: ignore[arg-type]
+    second = sdf.Primitive(kind, (0.2, 0.1, 0.3), (0.4,) * count, op=op)  # type: ignore[arg-type]
+    scene = sdf.Scene((first, second), k=0.2, blend=blend)  # type: ignore[arg-type]
+    points = [[1e155, 0.0, 0.0], [0.0, 1e160, -1e160], [1e300, 1e300, 0.0], [1.7e308, -1.7e308, 1.7e308]]
+    with np.errstate(over="raise", invalid="raise", divide="raise"):  # an exp blend's weights may underflow to 0
+        d, colour = sdf.scene_distance(scene, points), sdf.scene_color(scene, points)
+    assert np.all((d == np.inf) | ((d > 0.99e155) & np.isfinite(d))), d
+    assert np.all(np.isfinite(colour)) and np.all((0.0 <= colour) & (colour <= 1.0)), colour
+
+
 # (function, keyword arguments that work, the arguments a huge value is tried in)
 PRIMITIVE_CALLS: list[tuple[Any, dict[str, Any], list[str]]] = [
     (sdf.sd_sphere, {"radius": 0.5}, ["radius"]),
