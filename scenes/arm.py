@@ -131,6 +131,8 @@ class SolveReport:
     the best admissible one it has seen (:func:`admissible_history`); the last is ``result.error``."""
     start: str = "last pose"
     """Where the returned pose's solve started: "last pose", or the gently bent start that came closer."""
+    last_pose_solution: fabrik.Solution | None = None
+    """The solve from the last pose (world joints) when another start's pose was returned instead; else None."""
 
 
 def rest_pose(n_links: int, link_length_m: float) -> NDArray[np.float64]:
@@ -296,6 +298,7 @@ def solve_arm(
     began = time.perf_counter()
     result = _run(method, to_kernel(joints, three_d), goal, **kwargs)
     start, start_name = joints, "last pose"
+    from_last_pose = result
     tolerance = params.tolerance_mm / 1000.0
     if result.status != "reached" and constrained(params):
         for k, pose in enumerate(arc_starts(params, target)):
@@ -321,6 +324,11 @@ def solve_arm(
         ghost_gap_m=float(np.linalg.norm(ghost[1] - middle)),
         best_history=best,
         start=start_name,
+        last_pose_solution=(
+            None
+            if start_name == "last pose"
+            else dataclasses.replace(from_last_pose, joints=to_world(from_last_pose.joints, three_d))
+        ),
     )
 
 
@@ -334,6 +342,62 @@ def segment_clearance(joints: NDArray[np.float64], centre: NDArray[np.float64]) 
 
 def _listed(words: list[str]) -> str:
     return words[0] if len(words) == 1 else ", ".join(words[:-1]) + " and " + words[-1]
+
+
+def avoided_obstacles(params: ArmParams, obstacle_centres: NDArray[np.float64]) -> list[int]:
+    """Indices of the obstacles the solver avoids: shown, Avoid on, and not over the root at the origin (ignored)."""
+    if not params.avoid:
+        return []
+    return [k for k in range(params.n_obstacles) if np.linalg.norm(obstacle_centres[k]) > params.radii_m[k]]
+
+
+def touched_obstacles(
+    params: ArmParams, joints: NDArray[np.float64], obstacle_centres: NDArray[np.float64]
+) -> list[int]:
+    """Numbers (from 1) of the avoided obstacles the chain ``joints`` (n + 1, 3) rests against."""
+    return [
+        k + 1
+        for k in avoided_obstacles(params, obstacle_centres)
+        if segment_clearance(joints, obstacle_centres[k]) <= params.radii_m[k] * (1 + 1e-3) + 1e-4
+    ]
+
+
+def joints_at_limit(params: ArmParams, joints: NDArray[np.float64]) -> NDArray[np.intp]:
+    """Indices of the joints of ``joints`` (n + 1, 3) bent to within 0.5° of the cone limit (none without limits)."""
+    if not params.limits:
+        return np.zeros(0, dtype=np.intp)
+    angles = fabrik.joint_angles(to_kernel(joints, params.three_d), _root_direction(params.three_d))
+    return np.flatnonzero(angles >= math.radians(params.half_angle_deg) - math.radians(0.5))
+
+
+def why_restarted(params: ArmParams, report: SolveReport, obstacle_centres: NDArray[np.float64]) -> str:
+    """In words, why the returned pose was solved from another start ("" when it was solved from the last pose).
+
+    Names only what held the last pose's solve and is on: the joints at their limit, the obstacles it rests against,
+    the iteration cap; where none of them shows in that pose, the constraints that apply (joint limits on, obstacles
+    shown and avoided)."""
+    first = report.last_pose_solution
+    if report.start == "last pose" or first is None:
+        return ""
+    causes: list[str] = []
+    if len(joints_at_limit(params, first.joints)):
+        causes.append("the joint limits")
+    touching = touched_obstacles(params, first.joints, obstacle_centres)
+    if touching:
+        causes.append(f"obstacle{'s' if len(touching) > 1 else ''} {_listed([str(k) for k in touching])}")
+    if first.status == "max_iterations":
+        causes.append(f"the cap of {params.max_iterations} iterations")
+    if not causes:
+        avoided = [k + 1 for k in avoided_obstacles(params, obstacle_centres)]
+        if params.limits:
+            causes.append("the joint limits")
+        if avoided:
+            causes.append(f"obstacle{'s' if len(avoided) > 1 else ''} {_listed([str(k) for k in avoided])}")
+    held = f"{_listed(causes)} held the arm" if causes else "the solve stopped"
+    return (
+        f"From the last pose {held} farther from the target, so this pose was solved again from a {report.start} "
+        f"(other starts are tried when the solve falls short)."
+    )
 
 
 def why_short(
@@ -353,24 +417,17 @@ def why_short(
     reasons: list[str] = []
     if distance > reach:
         reasons.append(f"the target is {distance:.2f} m from the base, beyond the chain's reach of {reach:.2f} m")
-    avoided = range(params.n_obstacles) if params.avoid else range(0)
-    covering = [k for k in avoided if np.linalg.norm(obstacle_centres[k] - joints[0]) <= params.radii_m[k]]
-    inside = [
-        k + 1 for k in avoided if k not in covering and np.linalg.norm(target - obstacle_centres[k]) < params.radii_m[k]
-    ]
+    avoided = avoided_obstacles(params, obstacle_centres)
+    inside = [k + 1 for k in avoided if np.linalg.norm(target - obstacle_centres[k]) < params.radii_m[k]]
     if inside:
         reasons.append(f"the target is inside obstacle {_listed([str(k) for k in inside])}")
-    touching = [
-        k + 1
-        for k in avoided
-        if k not in covering and segment_clearance(joints, obstacle_centres[k]) <= params.radii_m[k] * (1 + 1e-3) + 1e-4
-    ]
+    touching = touched_obstacles(params, joints, obstacle_centres)
     if touching and not inside:
         which = _listed([str(k) for k in touching])
         reasons.append(f"obstacle {which} is in the way (the chain rests against it)")
     if params.limits:
         angles = fabrik.joint_angles(to_kernel(joints, params.three_d), _root_direction(params.three_d))
-        held = np.flatnonzero(angles >= math.radians(params.half_angle_deg) - math.radians(0.5))
+        held = joints_at_limit(params, joints)
         if len(held):
             names = ["the base" if j == 0 else f"joint {j + 1}" for j in held]
             verb = "is" if len(held) == 1 else "are"
@@ -871,11 +928,9 @@ is a static pose.
             f"error **{r.error * 1000.0:.3f} mm**, status **{r.status}**  \n"
             f"Solve time **{report.micros:,.0f} µs**{plain_python_note()}"
         )
-        if report.start != "last pose":
-            text += (
-                f"  \nFrom the last pose the joint limits held the arm farther from the target, so this pose was "
-                f"solved again from a {report.start} (other starts are tried when the solve falls short)."
-            )
+        restarted = why_restarted(p, report, self.obstacle_centres)
+        if restarted:
+            text += f"  \n{restarted}"
         short = why_short(p, report, self.target, self.obstacle_centres)
         if short:
             text += f"  \n{short}"

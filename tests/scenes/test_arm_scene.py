@@ -463,13 +463,73 @@ def test_a_short_pose_says_in_words_why(scene: ArmScene, setup: dict, words: str
 
 
 def test_a_solve_from_another_start_is_told_in_a_users_words(scene: ArmScene) -> None:
-    # Two links of 0.5 m: the last pose falls short under the limits and a bent start comes closer. The readout said
-    # "The last pose led to a worse fixed point: this pose was solved from arc 8 of 9".
-    scene.controls["n_links"].value = 2
+    # The outside tester's input, on the defaults (limits off, one obstacle avoided): Link length 0.5, then Links 2.
+    # The readout blamed "the joint limits", which were off; the obstacle held the arm.
     scene.controls["link_length_m"].value = 0.5
+    scene.controls["n_links"].value = 2
     report = scene.report
     assert report is not None and report.start == "gently bent start 8 of 9"
     text = scene.readout.content
-    assert "the joint limits held the arm farther from the target" in text
-    assert "solved again from a gently bent start 8 of 9" in text
+    assert (
+        "From the last pose obstacle 1 held the arm farther from the target, so this pose was solved again from a "
+        "gently bent start 8 of 9" in text
+    ), text
+    assert "joint limit" not in text
     assert "fixed point" not in text and "arc " not in text
+
+
+RESTARTS = {
+    # setup: (n_links, link_length_m, half_angle_deg, target), and the (limits, n_obstacles, avoid) that restart there
+    "limits hold": (
+        (6, 0.25, 20.0, (1.08, 0.0, 0.47)),
+        {(True, 0, True), (True, 0, False), (True, 1, True), (True, 1, False), (False, 1, True)},
+    ),
+    "the obstacle holds": ((2, 0.5, 45.0, (0.9, 0.0, 0.6)), {(True, 1, True), (False, 1, True)}),
+}
+
+
+@pytest.mark.parametrize("setup", list(RESTARTS))
+@pytest.mark.parametrize(
+    ("limits", "n_obstacles", "avoid"), list(itertools.product([True, False], [0, 1], [True, False]))
+)
+def test_a_restart_names_only_what_is_on_and_held_the_arm(
+    scene: ArmScene, setup: str, limits: bool, n_obstacles: int, avoid: bool
+) -> None:
+    """Every combination of limits × obstacles × avoidance, solved from the rest pose where other starts come
+    closer: the readout's restart sentence names what held the last pose's solve (a joint at its limit, the obstacle
+    it rests against) and never a constraint that is off or absent; with nothing on, no other start is tried."""
+    (n_links, length, half_angle, target), restarting = RESTARTS[setup]
+    scene.controls["limits"].value = limits
+    scene.controls["n_obstacles"].value = n_obstacles
+    scene.controls["avoid"].value = avoid
+    scene.controls["half_angle_deg"].value = half_angle
+    scene.controls["n_links"].value = n_links
+    scene.controls["link_length_m"].value = length
+    scene.target_gizmo.position = target
+    scene._apply_target()
+    scene._on_reset_pose()  # solved from the rest pose: what the table above was measured from
+    report, text = scene.report, scene.readout.content
+    assert report is not None
+    restarted = (limits, n_obstacles, avoid) in restarting
+    assert (report.start != "last pose") == restarted, (report.start, text)
+    if not restarted:
+        assert "held the arm" not in text and "solved again" not in text, text
+        return
+    sentence = text.split("From the last pose")[1].split("held the arm")[0]
+    assert ("joint limit" in sentence) <= limits, text
+    assert ("obstacle" in sentence) <= (avoid and n_obstacles > 0), text
+    first = report.last_pose_solution
+    assert first is not None
+    # What held the last pose's solve, found here independently of the scene's words.
+    angles = fabrik.joint_angles(first.joints[:, [0, 2]], [0.0, 1.0])
+    at_limit = limits and bool(np.any(angles >= math.radians(half_angle - 0.5)))
+    radius = scene.params.radii_m[0]
+    touching = (
+        avoid and n_obstacles == 1 and clearance(first.joints, scene.obstacle_centres[0]) <= radius * 1.001 + 1e-4
+    )
+    causes = [c for c, held in (("the joint limits", at_limit), ("obstacle 1", touching)) if held] or [
+        c for c, on in (("the joint limits", limits), ("obstacle 1", avoid and n_obstacles == 1)) if on
+    ]
+    assert causes  # a restart happens only under a constraint that is on
+    said = f"From the last pose {' and '.join(causes)} held the arm farther from the target, so this pose was solved "
+    assert said + f"again from a {report.start}" in text, text
