@@ -38,7 +38,7 @@ from typing import TYPE_CHECKING, Any, Generic, Literal, TypeAlias, TypedDict, T
 
 import viser
 
-from server.clean import ControlSpec, clean_value, record_spec
+from server.clean import MAX_TEXT_CHARS, ControlSpec, clean_value, record_spec
 
 if TYPE_CHECKING:
     from _typeshed import DataclassInstance
@@ -79,6 +79,8 @@ class Control:
     """What the dropdown shows for each of :attr:`options`."""
     multiline: bool = False
     """Text only: a multi-line box."""
+    max_chars: int = MAX_TEXT_CHARS
+    """Text only: the longest text the gate passes on (longer is refused there without a word)."""
     folder: str | None = None
     """The folder the control goes in, or None for wherever the builder is called."""
     costly: bool = False
@@ -105,7 +107,7 @@ class Control:
             case "checkbox":
                 return ControlSpec("bool", costly=self.costly)
             case "text":
-                return ControlSpec("text", costly=self.costly)
+                return ControlSpec("text", max_chars=self.max_chars, costly=self.costly)
             case "rgb":
                 return ControlSpec("rgb", lo=0.0, hi=255.0, integer=True, length=3, costly=self.costly)
 
@@ -199,9 +201,12 @@ def checkbox(label: str, **placement: Unpack[Placement]) -> dict[str, Control]:
     return _declare(Control("checkbox", label, **placement))
 
 
-def text(label: str, *, multiline: bool = False, **placement: Unpack[Placement]) -> dict[str, Control]:
-    """A text box for a ``str`` field (the gate refuses text over :data:`server.clean.MAX_TEXT_CHARS`)."""
-    return _declare(Control("text", label, multiline=multiline, **placement))
+def text(
+    label: str, *, multiline: bool = False, max_chars: int = MAX_TEXT_CHARS, **placement: Unpack[Placement]
+) -> dict[str, Control]:
+    """A text box for a ``str`` field; the gate refuses text over ``max_chars`` without a word, so a scene that
+    answers over-long text itself declares more than it keeps."""
+    return _declare(Control("text", label, multiline=multiline, max_chars=max_chars, **placement))
 
 
 def rgb(label: str, **placement: Unpack[Placement]) -> dict[str, Control]:

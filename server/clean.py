@@ -20,6 +20,7 @@ import viser
 ControlKind = Literal["number", "choice", "bool", "button", "rgb", "text", "vector", "display"]
 
 MAX_TEXT_CHARS = 10_000
+"""Longest text a text control takes unless it declares its own :attr:`ControlSpec.max_chars`."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -38,6 +39,9 @@ class ControlSpec:
     """The dropdown's options."""
     length: int = 0
     """Number of components (RGB, vectors)."""
+    max_chars: int = MAX_TEXT_CHARS
+    """Longest text (text controls): longer is refused here, silently, so a control whose scene answers an over-long
+    text in words declares more than it keeps."""
     costly: bool = False
     """Whether a change rebuilds a scene or starts a long job: such inputs share a per-tab budget at the gate, and a
     burst beyond it is coalesced (see :func:`mark_costly`)."""
@@ -188,9 +192,9 @@ def clean_value(spec: ControlSpec, value: object) -> tuple[bool, Any, str]:
                 return False, None, "a colour that is not three numbers in 0..255"
             return True, tuple(round(c) for c in rgb), ""
         case "text":
-            if isinstance(value, str) and len(value) <= MAX_TEXT_CHARS:
+            if isinstance(value, str) and len(value) <= spec.max_chars:
                 return True, value, ""
-            return False, None, "text that is not a string of at most 10 000 characters"
+            return False, None, f"text that is not a string of at most {spec.max_chars:,} characters"
         case "vector":
             vector = finite_vector(value, spec.length)
             if vector is None:

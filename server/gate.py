@@ -328,6 +328,20 @@ class Gate:
         if not accepted:
             label = str(getattr(handle, "label", "?"))
             self.log.refuse(f"GUI value ({reason})", f"{label!r} got {updates['value']!r}"[:200])
+            if spec.kind == "text" and isinstance(updates["value"], str):  # a paste too long: say so to its tab
+                tell = self._tell(
+                    server,
+                    client_id,
+                    "Text refused",
+                    f"That text was {len(updates['value']):,} characters long; “{label}” takes at most "
+                    f"{spec.max_chars:,}, so the previous text is back.",
+                )
+
+                def send_back_and_tell() -> None:
+                    send_back()
+                    tell()
+
+                return None, send_back_and_tell
             return None, send_back
         return messages.GuiUpdateMessage(message.uuid, {"value": value}), send_back
 
@@ -349,6 +363,7 @@ class Gate:
             return None, self._tell(
                 server,
                 client_id,
+                "Upload refused",
                 f"The file is {size / MIB:.1f} MiB; this server takes files up to {MAX_UPLOAD_BYTES / MIB:.0f} MiB.",
             )
         if not all(
@@ -369,6 +384,7 @@ class Gate:
             return None, self._tell(
                 server,
                 client_id,
+                "Upload refused",
                 f"This tab already has {MAX_UPLOADS_IN_FLIGHT} uploads under way; wait for one to finish.",
             )
         own_bytes = sum(upload.size_bytes for upload in list(in_flight.values()))
@@ -380,6 +396,7 @@ class Gate:
             return None, self._tell(
                 server,
                 client_id,
+                "Upload refused",
                 f"This tab's uploads under way already announce {own_bytes / MIB:.1f} MiB; it takes "
                 f"{MAX_UPLOAD_BYTES_IN_FLIGHT_PER_TAB / MIB:.0f} MiB at once. Wait for them to finish.",
             )
@@ -393,6 +410,7 @@ class Gate:
             return None, self._tell(
                 server,
                 client_id,
+                "Upload refused",
                 f"The server is receiving other uploads ({count} files, "
                 f"{total_bytes / MIB:.1f} MiB in flight from all tabs; it takes "
                 f"{MAX_UPLOADS_IN_FLIGHT_TOTAL} files or {MAX_UPLOAD_BYTES_IN_FLIGHT_TOTAL / MIB:.0f} MiB at "
@@ -402,13 +420,13 @@ class Gate:
             in_flight[message.transfer_uuid] = Upload(parts, size, time.monotonic())
         return message, None
 
-    def _tell(self, server: viser.ViserServer, client_id: int, body: str) -> Callable[[], None]:
-        """A notification of a refused upload for the tab that sent it (shown after the refusal)."""
+    def _tell(self, server: viser.ViserServer, client_id: int, title: str, body: str) -> Callable[[], None]:
+        """A notification of a refused upload or text for the tab that sent it (shown after the refusal)."""
 
         def notify() -> None:
             client = self._client(server, client_id)
             if client is not None:
-                client.add_notification("Upload refused", body, color="red", auto_close_seconds=15.0)
+                client.add_notification(title, body, color="red", auto_close_seconds=15.0)
 
         return notify
 

@@ -18,7 +18,7 @@ import numpy as np
 
 from kernels import sdf
 from scenes._controls import checkbox, dropdown, dropdown_from_labels, rgb, slider, text
-from scenes.sdf_gallery.editor import EDITOR_HALF_SIZE_M, EXAMPLES, OWN_CODE, EditorField
+from scenes.sdf_gallery.editor import EDITOR_HALF_SIZE_M, EDITOR_KEEP_CHARS, EXAMPLES, OWN_CODE, EditorField
 from shaders.renderer import Camera, Shading
 
 BOX_M = 1.5
@@ -206,7 +206,7 @@ class SdfGalleryParams:
     :data:`OWN_CODE` once the editor's text is no example's."""
     editor_text: str = field(
         default=next(iter(EXAMPLES.values())),
-        metadata=text("sdf(p) in GLSL", multiline=True, folder="GLSL editor"),
+        metadata=text("sdf(p) in GLSL", multiline=True, max_chars=EDITOR_KEEP_CHARS, folder="GLSL editor"),
     )
     """The editor's text as last kept (at most EDITOR_KEEP_CHARS; Apply compiles it)."""
     editor_half_size: float = field(

@@ -1,4 +1,4 @@
-"""File uploads as a browser sends them over viser's websocket, and the notices a tab is shown."""
+"""File uploads as a browser sends them over viser's websocket."""
 
 from __future__ import annotations
 
@@ -40,9 +40,3 @@ def send_part(client: BrowserClient, transfer: str, index: int, content: Any) ->
         part_index=index,
         content=content,
     )
-
-
-def notices(client: BrowserClient) -> list[dict[str, Any]]:
-    return [
-        message["props"] for _at, message in list(client.received) if message.get("type") == "NotificationShowMessage"
-    ]

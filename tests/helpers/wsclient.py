@@ -262,6 +262,12 @@ class BrowserClient:
             self.gui[uuid]["value"] = value
         self.send("GuiUpdateMessage", uuid=uuid, updates={"value": value})
 
+    def notices(self) -> list[dict[str, Any]]:
+        """The props (title, body, colour...) of every notification the server has shown this client, in order."""
+        return [
+            message["props"] for _at, message in list(self.received) if message.get("type") == "NotificationShowMessage"
+        ]
+
     def set_value_answered(self, label: str, value: Any, settle_s: float = 0.15) -> None:
         """Wait for the control labelled ``label``, send ``value`` to it (crafted: anything, as :meth:`send_value`),
         wait for the server's answer, then ``settle_s`` more for the callback (it runs on viser's thread pool) to

@@ -707,16 +707,39 @@ def test_an_over_long_editor_text_is_put_back_for_every_viewer(
         crafted.set_value(label, SPHERE_SOURCE)  # a text within the limit is kept
         wait_until(lambda: scene.editor.value == SPHERE_SOURCE, "the kept text")
         crafted.set_value(label, "x" * (EDITOR_KEEP_CHARS + extra))
-        # Refused at the app's message gate (text controls take at most MAX_TEXT_CHARS) or by the editor's own
-        # handler: either way the server keeps the last good text and sends it to every viewer.
-        time.sleep(0.5)
+        # Refused at the app's message gate (the editor declares it takes EDITOR_KEEP_CHARS): the server keeps the
+        # last good text, sends it to every viewer, and tells the sender why.
+        crafted.wait_for(lambda: bool(crafted.notices()), what="the refusal notice")
+        (note,) = crafted.notices()
+        assert note["title"] == "Text refused" and note["body"] == (
+            f"That text was {EDITOR_KEEP_CHARS + extra:,} characters long; “{label}” takes at most 16,000, so the "
+            "previous text is back."
+        )
         assert scene.editor.value == SPHERE_SOURCE != before
         other.wait_for(lambda: other.value_of(label) == SPHERE_SOURCE, what="the text put back")
         crafted.wait_for(lambda: crafted.value_of(label) == SPHERE_SOURCE, what="the text put back")
+        assert not other.notices()
     with BrowserClient(server.get_port()) as late:
         late.wait_for_gui(label)
         late.wait_for(lambda: late.value_of(label) == SPHERE_SOURCE, what="the kept text")
         assert all(len(str(m.get("updates", {}).get("value", ""))) < 10**5 for _, m in late.received)
+
+
+@pytest.mark.parametrize("length", [10_001, 12_000, 16_000])
+def test_a_text_the_editor_keeps_is_kept_and_apply_says_its_length(
+    server: viser.ViserServer, scene: SdfGalleryScene, length: int
+) -> None:
+    # Once: text of 10,001 to 16,000 characters, which the editor keeps, was refused at the gate (it took 10,000
+    # from any text box) without a word, and Apply then compiled the previous text.
+    text = SPHERE_SOURCE + " " * (length - len(SPHERE_SOURCE))
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Apply")
+        client.set_value("sdf(p) in GLSL", text)
+        wait_until(lambda: scene.editor.value == text, "the kept text")
+        client.click("Apply")
+        wait_until(lambda: scene.editor_error is not None, "the refusal")
+        assert f"{length} characters long; the limit is 8000 characters" in str(scene.editor_error)
+        assert not client.notices()
 
 
 def test_apply_of_a_text_over_the_source_limit_says_its_length_and_the_limit(

@@ -21,7 +21,7 @@ import pytest
 import viser
 from helpers.browser import open_viser
 from helpers.gpx import hill_gpx
-from helpers.uploads import notices, send_part, upload
+from helpers.uploads import send_part, upload
 from helpers.wsclient import BrowserClient
 from hypothesis import given
 from hypothesis import strategies as st
@@ -450,8 +450,8 @@ def padded_gpx(name: str, size: int) -> bytes:
 
 
 def refusal_notice(client: BrowserClient) -> dict[str, Any]:
-    client.wait_for(lambda: bool(notices(client)), what="the refusal notice")
-    note = notices(client)[-1]
+    client.wait_for(lambda: bool(client.notices()), what="the refusal notice")
+    note = client.notices()[-1]
     assert note["title"] == "Upload refused" and note["color"] == "red"
     return note
 
@@ -481,7 +481,7 @@ def test_uploads_beyond_the_server_wide_count_are_refused_with_a_notice_and_the_
                     lambda s=scene, n=f"Tab {i}": s.course_mode.route.name == n,
                     what=f"tab {i}'s upload",
                 )
-                assert not notices(client)
+                assert not client.notices()
             # Each tab sent two uploads; its course changes with the first, and the second may still be landing.
             tabs[0][0].wait_for(lambda: gate.uploads_in_flight() == (0, 0), what="every upload landed")
             assert tabs[4][1].course_mode.route.name != "Tab 4"
@@ -520,7 +520,7 @@ def test_uploads_beyond_the_server_wide_bytes_are_refused_with_a_notice_and_the_
                 timeout=30.0,
                 what=f"tab {i}'s 20 MiB upload",
             )
-            assert not notices(client)
+            assert not client.notices()
         assert gate.uploads_in_flight() == (0, 0)
         assert tabs[3][1].course_mode.route.name != "Big 3"
     finally:

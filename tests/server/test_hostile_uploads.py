@@ -14,7 +14,7 @@ from typing import Any
 import pytest
 import viser
 from helpers.gpx import hill_gpx
-from helpers.uploads import notices, send_part, upload
+from helpers.uploads import send_part, upload
 from helpers.wsclient import BrowserClient
 
 import server.budget as budget_module
@@ -123,10 +123,10 @@ def test_uploads_in_flight_are_bounded_per_browser(
             start(client, part_count=1, size_bytes=10)
         client.wait_for(lambda: "refused uploads in flight" in caplog.text, what="the bound")
         # The person at that tab is told why, once per refused upload.
-        client.wait_for(lambda: len(notices(client)) == 3, what="the refusal notices")
+        client.wait_for(lambda: len(client.notices()) == 3, what="the refusal notices")
         assert all(
             note["title"] == "Upload refused" and f"{MAX_UPLOADS_IN_FLIGHT} uploads" in note["body"]
-            for note in notices(client)
+            for note in client.notices()
         )
 
 
@@ -134,8 +134,8 @@ def test_a_file_over_the_size_limit_is_refused_with_a_notice(server: viser.Viser
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("Upload GPX")
         start(client, part_count=25, size_bytes=MAX_UPLOAD_BYTES + 1)
-        client.wait_for(lambda: bool(notices(client)), what="the refusal notice")
-        (note,) = notices(client)
+        client.wait_for(lambda: bool(client.notices()), what="the refusal notice")
+        (note,) = client.notices()
         assert note["title"] == "Upload refused" and "up to 24 MiB" in note["body"]
 
 
@@ -194,8 +194,8 @@ def test_one_tab_holds_at_most_its_share_of_the_upload_budget(server: viser.Vise
         client.wait_for_gui("Upload GPX")
         start(client, part_count=1, size_bytes=big)
         start(client, part_count=1, size_bytes=big)  # over the tab's share
-        client.wait_for(lambda: bool(notices(client)), what="the refusal notice")
-        (note,) = notices(client)
+        client.wait_for(lambda: bool(client.notices()), what="the refusal notice")
+        (note,) = client.notices()
         assert note["title"] == "Upload refused" and "MiB at once" in note["body"]
         assert install_gate(server).uploads_in_flight() == (1, big)
 
