@@ -51,6 +51,11 @@ INTEGRATOR_LABELS: dict[Integrator, str] = {"rk4": "RK4, 10 ms", "euler": "Euler
 INTEGRATOR_STEP_S: dict[Integrator, float] = {"rk4": 1e-2, "euler": 1e-3}
 PLAY_T_MAX_S = 10.0
 """How long the kick is played on after it lands (s)."""
+FLIGHT_T_MAX_S = 8.0
+"""How long every free flight (the kick, its ghost and band, the outcome map's, the aim search's) is followed (s):
+the longest flight the controls allow lasts 5.94 s (40 m/s at 50° from 40 m out with 15 rev/s of backspin, constant
+coefficients), so each lands, or reaches the net, within it. At 4 s such a kick was still 19 m up and read "Lands
+after 4.00 s"."""
 BAND_STEP_S = 2e-2
 """Step of the ±10 % spin band's flights (RK4): they are drawn, not measured, and must not slow a redraw."""
 
@@ -540,8 +545,6 @@ ODDS_MAP_ANGLES_DEG = np.linspace(-40.0, 40.0, 17)
 """The odds map's columns: the spot's angle off the centre line (°, + to the kicker's left), every 5°."""
 ODDS_MAP_STRIKES = 32
 """Strikes per spot of the odds map (21 × 17 spots × 32 = 11,424 kicks played out)."""
-ODDS_MAP_T_MAX_S = 4.0
-"""How long each of the map's kicks is played out (s): every verdict is in well before."""
 
 
 def odds_map_settings(p: FreeKickParams) -> FreeKickParams:
@@ -575,7 +578,7 @@ def spot_odds_map(p: FreeKickParams, progress: Callable[[float], object] | None 
         dt=INTEGRATOR_STEP_S["rk4"],
         method="rk4",
         model=p.model,
-        t_max=ODDS_MAP_T_MAX_S,
+        t_max=PLAY_T_MAX_S,  # each strike played as long as the scene plays its kick: 5 spots' goals came after 4 s
         ground_m=ball.BALL_RADIUS_M,
     )
     return chances["goal"]
@@ -816,7 +819,7 @@ def _fly(p: FreeKickParams, spin_scale: float, *, knuckle: bool, band: bool = Fa
         dt=BAND_STEP_S if band else INTEGRATOR_STEP_S[p.integrator],
         method="rk4" if band else p.integrator,
         model=p.model,
-        t_max=4.0,
+        t_max=FLIGHT_T_MAX_S,
         x_stop=2.0,  # two metres into the net: far enough to see the ball cross the line
         ground_m=ball.BALL_RADIUS_M,
         knuckle_seed=p.knuckle_seed if (knuckle and p.knuckle) else None,
@@ -944,7 +947,7 @@ def outcome_map(p: FreeKickParams) -> NDArray[np.str_]:
         dt=INTEGRATOR_STEP_S["rk4"],
         method="rk4",
         model=p.model,
-        t_max=4.0,
+        t_max=FLIGHT_T_MAX_S,
         x_stop=0.5,
         ground_m=ball.BALL_RADIUS_M,
         knuckle_seeds=[p.knuckle_seed] * k if p.knuckle else None,
@@ -1044,7 +1047,7 @@ def aim_at(p: FreeKickParams, target_yz: tuple[float, float]) -> FreeKickParams 
         dt=1e-2,
         method="rk4",
         model=p.model,
-        t_max=4.0,
+        t_max=FLIGHT_T_MAX_S,
         x_stop=0.5,
         ground_m=ball.BALL_RADIUS_M,
     )

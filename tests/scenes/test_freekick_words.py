@@ -4,6 +4,7 @@ summary, for kicks a review found misdescribed."""
 from __future__ import annotations
 
 import dataclasses
+import itertools
 
 import numpy as np
 import pytest
@@ -104,6 +105,38 @@ def test_a_ball_wide_and_far_over_the_bar_reads_so(freekick: FreeKickScene) -> N
     crossing = freekick.state.outcome.goal_point
     assert crossing is not None and crossing[2] < ball.GOAL_HEIGHT_M
     assert readout.splitlines()[0].strip() == "**Wide of the post**"
+
+
+def test_a_lob_that_lands_after_four_seconds_reads_where_it_lands(freekick: FreeKickScene) -> None:
+    # Reported: "Lands after 4.00 s, 10.4 m short" for a ball still 19.25 m up: every flight stopped at 4 s. It
+    # lands after 5.06 s (scipy's DOP853 on the same coefficients: 5.06 s), 7.3 m short of the line.
+    readout = _show(
+        freekick, distance_m=40.0, angle_deg=45.0, speed_ms=40.0, elevation_deg=50.0, azimuth_deg=-30.0, spin_rev_s=0.0
+    )
+    assert freekick.state.flight.ended == "ground"
+    assert "Lands after **5.06 s**, 7.3 m short" in readout
+
+
+@pytest.mark.parametrize("model", ["measured", "constant"])
+@pytest.mark.parametrize("axis", ["back", "left", "top"])
+def test_every_kick_the_controls_allow_lands_or_reaches_the_net_within_its_time(model: str, axis: str) -> None:
+    # The longest flights: the fastest, steepest kick, from the nearest and farthest spots at the widest angles,
+    # aimed either way, with no spin and the most of each kind. Each must end on the ground or 2 m into the net, not
+    # at the time limit, where the readout would say it lands while it is still in the air.
+    for distance, angle, azimuth, spin in itertools.product((12.0, 40.0), (-45.0, 45.0), (-30.0, 30.0), (0.0, 15.0)):
+        params = FreeKickParams(
+            distance_m=distance,
+            angle_deg=angle,
+            speed_ms=40.0,
+            elevation_deg=50.0,
+            azimuth_deg=azimuth,
+            spin_rev_s=spin,
+            spin_axis=axis,
+            model=model,  # type: ignore[arg-type]
+        )
+        state = compute_kick(params)
+        assert state.flight.ended in ("ground", "x_stop"), (params, state.flight.ended)
+        assert state.ghost.ended in ("ground", "x_stop"), (params, state.ghost.ended)
 
 
 def test_keeper_words_never_give_a_far_distance() -> None:
