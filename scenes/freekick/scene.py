@@ -201,7 +201,8 @@ reads it again, so a ball that bounces in front of him beats him more often than
         """The settings the shown outcome map was computed for."""
         self.chances: ball.Odds | None = None
         """The odds shown for the map's settings: the kick struck many times with a player's scatter."""
-        self.knuckle_note = ""
+        self.knuckle_spin: float | None = None
+        """The spin (rev/s) that ticking Knuckleball set, while the kick still has it; None once anything else has."""
         """Says so when ticking Knuckleball has just set the spin near zero."""
         self.last_target: tuple[float, float] | None = None
         self.aim_message = ""
@@ -421,15 +422,12 @@ reads it again, so a ball that bounces in front of him beats him more often than
         params = self.read_params()
         knuckled = knuckle_ticked(self.params, params)
         if knuckled is not params:
-            self.knuckle_note = (
-                f"Knuckleball: spin set to {knuckled.spin_rev_s:g} rev/s (a knuckleball is struck with almost none; "
-                "spin steadies the wake that makes it wobble)."
-            )
+            self.knuckle_spin = knuckled.spin_rev_s
             handle = self.controls["spin_rev_s"]
             if handle.value != knuckled.spin_rev_s:
                 handle.value = knuckled.spin_rev_s
-        elif not params.knuckle:
-            self.knuckle_note = ""
+        elif not params.knuckle or params.spin_rev_s != self.knuckle_spin:
+            self.knuckle_spin = None  # the spin is the user's again: the note would contradict it
         self._set_params(knuckled)
 
     def _set_params(self, params: FreeKickParams) -> None:
@@ -464,6 +462,7 @@ reads it again, so a ball that bounces in front of him beats him more often than
 
     def apply(self, params: FreeKickParams) -> None:
         """Show ``params``: write every GUI control (without re-running callbacks) and redraw once."""
+        self.knuckle_spin = None  # a preset or reset sets the spin itself
         with self.server.atomic():
             for name, built in self.controls.fields.items():
                 self.write_back(built.handles[0], built.control.to_gui(getattr(params, name)))
@@ -761,8 +760,11 @@ reads it again, so a ball that bounces in front of him beats him more often than
             )
         elif p.knuckle:
             lines.append("Knuckleball: no wobble at this spin (any real spin steadies the wake)")
-        if self.knuckle_note:
-            lines.append(self.knuckle_note)
+        if p.knuckle and p.spin_rev_s == self.knuckle_spin:
+            lines.append(
+                f"Knuckleball: spin set to {p.spin_rev_s:g} rev/s (a knuckleball is struck with almost none; spin "
+                "steadies the wake that makes it wobble)."
+            )
         s_param = ball.BALL_RADIUS_M * 2 * math.pi * p.spin_rev_s / max(p.speed_ms, 1e-9)
         lines.append(f"Spin parameter S = r·ω/v = {s_param:.3f}")
         return "  \n".join(lines)

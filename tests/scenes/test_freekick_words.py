@@ -139,6 +139,30 @@ def test_every_kick_the_controls_allow_lands_or_reaches_the_net_within_its_time(
         assert state.ghost.ended in ("ground", "x_stop"), (params, state.ghost.ended)
 
 
+def test_the_knuckleball_note_stands_only_while_the_spin_it_set_does(freekick: FreeKickScene) -> None:
+    # Reported: tick Knuckleball, then set the spin to 15 rev/s, and the readout still said "Knuckleball: spin set
+    # to 0 rev/s" above "S = r·ω/v = 0.415". The note now stands while the kick keeps the spin it set.
+    note = "Knuckleball: spin set to 0 rev/s"
+    freekick.controls["knuckle"].value = True
+    assert freekick.params.spin_rev_s == 0.0 and note in freekick.result.content
+    freekick.controls["speed_ms"].value = 27.0  # another control: the spin is still the one the tick set
+    assert note in freekick.result.content
+    freekick.controls["spin_rev_s"].value = 15.0
+    readout = freekick.result.content
+    assert note not in readout and "S = r·ω/v = 0.384" in readout  # 0.11 m · 2π · 15 / 27 m/s
+    freekick.controls["spin_rev_s"].value = 0.0  # set by the user, not by the tick
+    assert note not in freekick.result.content
+    freekick.controls["knuckle"].value = False
+    freekick.controls["knuckle"].value = True  # ticked again at zero spin: nothing to set, nothing to say
+    assert note not in freekick.result.content
+    freekick.controls["knuckle"].value = False
+    freekick.controls["spin_rev_s"].value = 8.0
+    freekick.controls["knuckle"].value = True
+    assert note in freekick.result.content
+    freekick.apply(FreeKickParams(knuckle=True, spin_rev_s=0.0))  # a preset or reset says nothing of the tick
+    assert note not in freekick.result.content
+
+
 def test_keeper_words_never_give_a_far_distance() -> None:
     """Over spots and strikes, the words give how near he came only within a couple of metres."""
     for distance in (16.0, 25.0, 35.0):
