@@ -253,7 +253,9 @@ def admissible_history(
     last iterate, and stop from what the iterates did alone, so a run capped at k iterations repeats the first k
     iterations of the full run and returns the best admissible pose among them: its error is the k-th point. Without
     limits or obstacles every iterate is admissible and the points are the running minimum of the error history.
-    Counts where no admissible pose had been seen yet (status "infeasible") are left out."""
+    Counts where no admissible pose had been seen yet (status "infeasible") are left out; where the whole run saw
+    none, the one point is the pose it returns, at its last iteration (never an empty chart: uPlot's client throws
+    on empty data and draws no curve)."""
     history = result.error_history
     if result.iterations == 0:
         return np.zeros(1), np.array([result.error])
@@ -271,10 +273,30 @@ def admissible_history(
         if capped.status != "infeasible":
             kept_k.append(float(k))
             kept_e.append(capped.error)
-    if result.status != "infeasible":
+    if result.status != "infeasible" or not kept_k:
         kept_k.append(float(result.iterations))
         kept_e.append(result.error)
     return np.array(kept_k), np.array(kept_e)
+
+
+CHART_FLOOR_MM = 1e-6
+"""Least error the log-scale chart plots (mm): an exact hit (0) has no logarithm."""
+
+
+def chart_points(report: SolveReport) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The error chart's (iterations (K,), error (K,) mm): :attr:`SolveReport.best_history`'s finite points, K ≥ 1.
+
+    The browser's uPlot throws "object null is not iterable" on empty series and cannot draw NaN or ±inf on a log
+    scale, so whatever the history holds, the chart gets equal-length finite arrays with at least one point (the
+    returned pose's error at its last iteration where no other is left)."""
+    counts, errors = (np.asarray(a, dtype=np.float64) for a in report.best_history)
+    keep = np.isfinite(counts) & np.isfinite(errors)
+    if len(counts) != len(errors) or not np.any(keep):
+        r = report.result
+        counts = np.array([float(r.iterations)])
+        errors = np.array([r.error if math.isfinite(r.error) else 0.0])
+        keep = np.ones(1, dtype=bool)
+    return counts[keep], np.maximum(errors[keep] * 1000.0, CHART_FLOOR_MM)
 
 
 def solve_arm(
@@ -917,8 +939,7 @@ is a static pose.
                 self.obstacle_spheres[k].scale = p.radii_m[k]
             self.readout.content = self._readout_markdown(report)
             self.ghost_readout.content = self._ghost_markdown(report)
-            counts, errors = report.best_history
-            self.plot.data = (counts.astype(np.float64), np.maximum(errors * 1000.0, 1e-6))
+            self.plot.data = chart_points(report)
         self.server.flush()
 
     def _readout_markdown(self, report: SolveReport) -> str:
