@@ -104,9 +104,9 @@ LINE_INPUTS = (
     "n_riders",
     "gap_m",
     "model",
-    "position",
 )
-"""The line's inputs that change the ride on the course (the paceline options apply there too)."""
+"""The line's inputs that change the ride on the course (the paceline options apply there too; so do its preset
+menus, which set the CdA and Crr)."""
 FLAT_ROAD_ONLY = ("speed_kmh", "rotate", "turn_s")
 """The flat road's inputs that the course does not use, hidden while it is ridden."""
 FLAT_ROAD_FOLDERS = ("Course", "Speed at a power")
@@ -222,7 +222,8 @@ class CourseMode:
         line = self.scene.controls
         for name in LINE_INPUTS:
             line[name].on_update(cb(self._on_input))  # the paceline options apply on the course
-        self.scene.crr_preset.on_update(cb(self._on_input))
+        for menu in self.scene.presets.values():  # a preset writes its field's control without running its callbacks
+            menu.on_update(cb(self._on_input))
 
     @property
     def enable(self) -> viser.GuiInputHandle[bool]:

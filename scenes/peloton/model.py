@@ -18,7 +18,7 @@ from typing import Literal
 import numpy as np
 
 from kernels import cycling
-from scenes._controls import checkbox, dropdown, dropdown_from_labels, number, slider
+from scenes._controls import checkbox, dropdown_from_labels, number, slider
 
 MAX_RIDERS = 8
 """Riders of a single file drawn with their own power bars and labels (more, or another formation, are coloured by
@@ -53,7 +53,6 @@ POSITIONS: dict[Position, RidingPosition] = {
     "tt": RidingPosition("Time-trial tuck", 0.22, 12.0, (0.62, 0.06, 0.98)),
     "hour": RidingPosition("Hour record", 0.16, 6.0, (0.66, 0.05, 0.96)),
 }
-POSITION_FROM_LABEL: dict[str, Position] = {p.label: key for key, p in POSITIONS.items()}
 
 CRR_PRESETS: dict[str, float] = {
     "Track, wooden velodrome (0.0020)": 0.0020,
@@ -84,13 +83,9 @@ class PelotonParams:
 
     speed_kmh: float = field(default=40.0, metadata=slider("Speed (km/h)", 0.0, 80.0, 0.5, folder="Rider"))
     """Ground speed of the line (km/h)."""
-    position: Position = field(
-        default="drops",
-        metadata=dropdown("Position", tuple(POSITIONS), tuple(p.label for p in POSITIONS.values()), folder="Rider"),
-    )
-    """Riding position: sets the drawing and, when chosen, the CdA."""
     cda_m2: float = field(default=0.32, metadata=slider("CdA (m²)", 0.10, 0.80, 0.005, folder="Rider"))
-    """Drag area of one rider riding alone (m²)."""
+    """Drag area of one rider riding alone (m²); the "Position" presets above it set it, and the rider is drawn in
+    the position it is nearest (:attr:`position`)."""
     mass_kg: float = field(default=80.0, metadata=slider("Mass, rider + bike (kg)", 30.0, 150.0, 0.5, folder="Rider"))
     """Rider plus bike (kg)."""
     crr: float = field(default=0.0040, metadata=slider("Crr", 0.0, 0.02, 0.0005, folder="Rider"))
@@ -138,6 +133,57 @@ class PelotonParams:
         default=250.0, metadata=number("Power (W)", 0.0, 2500.0, 5.0, folder="Speed at a power")
     )
     """Power for the 'speed at this power' readout (W)."""
+
+    @property
+    def position(self) -> Position:
+        """The riding position drawn: the one whose typical CdA is nearest :attr:`cda_m2` (the first of two as near),
+        so the drawing and the "Position" menu never disagree."""
+        return min(POSITIONS, key=lambda key: abs(POSITIONS[key].cda_m2 - self.cda_m2))
+
+
+# --------------------------------------------------------------------------------------------- preset menus
+CUSTOM = "Custom"
+"""What a preset menu shows when its field's value is none of its presets; choosing it leaves the value as it is."""
+PRESET_REL_TOL = 1e-9
+"""A value is a preset's when it is within this fraction of it: a slider's steps carry rounding (0.1 + 44 × 0.005
+is 0.32000000000000006), far below any difference a person types."""
+
+
+@dataclasses.dataclass(frozen=True)
+class PresetMenu:
+    """A dropdown that sets one parameter to a named value, and shows the name of the value the parameter holds now
+    (or :data:`CUSTOM`). It is no parameter of its own: it is shown just above its field's control, in its folder."""
+
+    label: str
+    field: str
+    """The :class:`PelotonParams` field a preset sets."""
+    presets: dict[str, float]
+    """Each preset's name (as shown) and value."""
+
+    @property
+    def options(self) -> tuple[str, ...]:
+        """What the dropdown offers: every preset, then :data:`CUSTOM`."""
+        return (*self.presets, CUSTOM)
+
+    def shown(self, params: PelotonParams) -> str:
+        """What the menu shows for ``params``: :func:`preset_name` of its field's value."""
+        return preset_name(self.presets, getattr(params, self.field))
+
+
+def preset_name(presets: dict[str, float], value: float) -> str:
+    """The name of the preset ``value`` is (to :data:`PRESET_REL_TOL`), else :data:`CUSTOM`: the one rule every
+    preset menu shows by."""
+    for name, preset in presets.items():
+        if math.isclose(value, preset, rel_tol=PRESET_REL_TOL):
+            return name
+    return CUSTOM
+
+
+PRESET_MENUS = (
+    PresetMenu("Position", "cda_m2", {p.label: p.cda_m2 for p in POSITIONS.values()}),
+    PresetMenu("Tyres / surface", "crr", CRR_PRESETS),
+)
+"""Every preset menu of the scene, each shown above its field's control."""
 
 
 @dataclasses.dataclass(frozen=True)

@@ -10,6 +10,7 @@ hides the unused ones by scaling them to zero, so changing the rider count never
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from collections.abc import Callable
 
@@ -19,7 +20,7 @@ import viser
 import viser.uplot
 
 from kernels import cycling
-from scenes._base import Scene, set_if_changed
+from scenes._base import ControlSpec, Scene, record_spec, set_if_changed
 from scenes._charts import FittedChart
 from scenes._controls import Controls, build_controls, declared
 from scenes._framing import ClientFraming, Lens, View, beside_notice, frame_points
@@ -48,13 +49,14 @@ from scenes.peloton.meshes import (
 )
 from scenes.peloton.model import (
     BIKE_LENGTH_M,
-    CRR_PRESETS,
+    CUSTOM,
     MAX_GAP_M,
     MAX_GROUP,
     MAX_RIDERS,
-    POSITIONS,
+    PRESET_MENUS,
     PelotonParams,
     Position,
+    PresetMenu,
     compute_line,
     is_line_view,
     solo_curves,
@@ -205,20 +207,7 @@ time-averaged power is the mean over positions, far below the leader's.
         with self.gui_root:
             # A group's colour key, at the top of the panel: seen at once, without scrolling, in a small window.
             self.legend = gui.add_html("", visible=False)
-            rider = build_controls(gui, p, ("speed_kmh", "position", "cda_m2", "mass_kg"))
-            with rider.folders["Rider"]:
-                # Hand-built, not a parameter: a preset that sets the Crr slider, which holds the value used.
-                self.crr_preset = gui.add_dropdown(
-                    "Tyres / surface",
-                    options=list(CRR_PRESETS),
-                    initial_value=next(iter(k for k, v in CRR_PRESETS.items() if v == p.crr)),
-                )
-            line = build_controls(
-                gui,
-                p,
-                [name for name in declared(PelotonParams) if name not in (*rider.fields, *LAST)],
-                folders_open=rider.folders,
-            )
+            line = self._build_line_controls()
             with gui.add_folder("Results"):
                 self.density = gui.add_markdown("")
                 self.table = gui.add_markdown("")
@@ -247,17 +236,39 @@ time-averaged power is the mean over positions, far below the leader's.
             power = build_controls(gui, p, LAST)
             with power.folders["Speed at a power"]:
                 self.speed_out = gui.add_markdown("")
-        self.controls: Controls[PelotonParams] = rider | line | power
+        self.controls: Controls[PelotonParams] = line | power
         """Every declared control of :class:`PelotonParams`, by field name."""
         for name in self.controls.fields:
-            if name == "position":
-                handler = self._on_position
-            elif name in ROTATION:
-                handler = self._on_rotate
-            else:
-                handler = self.apply_inputs
+            handler = self._on_rotate if name in ROTATION else self.apply_inputs
             self.controls[name].on_update(self.callback(handler))
-        self.crr_preset.on_update(self.callback(self._on_crr_preset))
+        for menu in PRESET_MENUS:
+            self.presets[menu.field].on_update(self.callback(functools.partial(self._on_preset, menu)))
+
+    def _build_line_controls(self) -> Controls[PelotonParams]:
+        """Build the declared controls up to the Results folder, each preset menu (:data:`PRESET_MENUS`) just above
+        its field's control, in that control's folder; fills :attr:`presets`."""
+        gui, p = self.server.gui, self.params
+        declarations = declared(PelotonParams)
+        names = [name for name in declarations if name not in LAST]
+        self.presets: dict[str, viser.GuiDropdownHandle[str]] = {}
+        """Each preset menu's dropdown, by the field it sets: it shows :meth:`PresetMenu.shown` of the params."""
+        built: Controls[PelotonParams] | None = None
+        start = 0
+        for menu in sorted(PRESET_MENUS, key=lambda m: names.index(m.field)):
+            end = names.index(menu.field)
+            part = build_controls(gui, p, names[start:end], folders_open=built.folders if built else None)
+            built = part if built is None else built | part
+            folder = declarations[menu.field].folder
+            assert folder is not None, f"{menu.label}: its field's control has no folder to go in"
+            if folder not in built.folders:
+                built = dataclasses.replace(built, folders={**built.folders, folder: gui.add_folder(folder)})
+            with built.folders[folder]:
+                handle = gui.add_dropdown(menu.label, menu.options, initial_value=menu.shown(p))
+            record_spec(handle, ControlSpec("choice", options=menu.options))  # from the menu, not the handle
+            self.presets[menu.field] = handle
+            start = end
+        part = build_controls(gui, p, names[start:], folders_open=built.folders if built else None)
+        return part if built is None else built | part
 
     # ----------------------------------------------------------------------------------------- world
     def _build_world(self) -> None:
@@ -326,17 +337,21 @@ time-averaged power is the mean over positions, far below the leader's.
         )
 
     # ----------------------------------------------------------------------------------------- callbacks
-    def _on_position(self) -> None:
-        """A riding position brings its typical CdA with it."""
-        position = self.read_params().position
-        self.write_back(self.controls["cda_m2"], POSITIONS[position].cda_m2)
+    def _on_preset(self, menu: PresetMenu) -> None:
+        """A preset chosen in ``menu`` sets its field's control to its value (:data:`CUSTOM` leaves it), then every
+        input is applied (which shows each menu's name for the values held)."""
+        name = self.read_choice(self.presets[menu.field], menu.options, menu.shown(self.params))
+        if name != CUSTOM:
+            self.write_back(self.controls[menu.field], menu.presets[name])
         self.apply_inputs()
 
-    def _on_crr_preset(self) -> None:
-        closest = min(CRR_PRESETS, key=lambda label: abs(CRR_PRESETS[label] - self.params.crr))
-        label = self.read_choice(self.crr_preset, list(CRR_PRESETS), closest)
-        self.write_back(self.controls["crr"], CRR_PRESETS[label])
-        self.apply_inputs()
+    def _show_presets(self) -> None:
+        """Show in each preset menu the name of the value its field holds now, or Custom: after every input, so no
+        menu names a preset the value has left."""
+        for menu in PRESET_MENUS:
+            handle, name = self.presets[menu.field], menu.shown(self.params)
+            if handle.value != name:
+                self.write_back(handle, name)
 
     def _on_rotate(self) -> None:
         rotation = self.read_params()  # only the rotation is taken: the line's power stays as computed
@@ -360,6 +375,8 @@ time-averaged power is the mean over positions, far below the leader's.
             self.params, self.state = last_good  # never show one state while holding another
             self.redraw()
             raise
+        finally:
+            self._show_presets()  # the menus name what is held, also when a value was clamped or refused
         self._update_framing()
         # An input can start the rotation (Riders raised from 1 while Rotate is on): wake the loop.
         if self._rotating():

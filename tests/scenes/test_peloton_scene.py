@@ -112,7 +112,7 @@ def test_dragging_the_speed_up_reframes_every_few_kmh_and_keeps_the_bars_framed(
 
 def test_position_preset_sets_cda_and_redraws_the_rider(scene: PelotonScene) -> None:
     before = np.array(scene.riders_nodes["body"].vertices)
-    scene.controls["position"].value = "Time-trial tuck"
+    scene.presets["cda_m2"].value = "Time-trial tuck"
     assert scene.controls["cda_m2"].value == pytest.approx(0.22)
     assert scene.params.cda_m2 == pytest.approx(0.22)
     after = np.array(scene.riders_nodes["body"].vertices)
@@ -120,7 +120,7 @@ def test_position_preset_sets_cda_and_redraws_the_rider(scene: PelotonScene) -> 
 
 
 def test_crr_preset_sets_crr(scene: PelotonScene) -> None:
-    scene.crr_preset.value = "Mountain bike, knobbly (0.0120)"
+    scene.presets["crr"].value = "Mountain bike, knobbly (0.0120)"
     assert scene.params.crr == pytest.approx(0.012)
     assert float(scene.state.power.rolling[0]) == pytest.approx(0.012 * 80 * 9.81 * 40 / 3.6, rel=1e-6)
 
