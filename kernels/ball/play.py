@@ -128,16 +128,17 @@ def _to_axis(x, y, z, cap):
 
 @compiled()
 def _path_stray(x, y, z, vx, vy, vz, x1, y1, z1, vx1, vy1, vz1, h):
-    """How far the step's cubic Hermite path strays from its chord at most (m).
+    """A bound on how far the step's cubic Hermite path strays from its chord (m).
 
     Written about the chord velocity c = (p₁ − p₀)/h, the path less the chord at fraction s is
-    h·s(1 − s)·((1 − s)(v₀ − c) − s(v₁ − c)), so its length is at most h/4 · max(|v₀ − c|, |v₁ − c|). Gravity bends
+    h·s(1 − s)·((1 − s)(v₀ − c) − s(v₁ − c)), so its length is at most h/4 · max(|v₀ − c|, |v₁ − c|); taken here
+    with the sum of the components' sizes, no less than the length, so each step pays no square root. Gravity bends
     a long step's path off its chord, and drag slows the ball along it.
     """
-    cx, cy, cz = (x1 - x) / h, (y1 - y) / h, (z1 - z) / h
-    a2 = (vx - cx) ** 2 + (vy - cy) ** 2 + (vz - cz) ** 2
-    b2 = (vx1 - cx) ** 2 + (vy1 - cy) ** 2 + (vz1 - cz) ** 2
-    return 0.25 * h * math.sqrt(max(a2, b2))
+    dx, dy, dz = x1 - x, y1 - y, z1 - z
+    a = abs(h * vx - dx) + abs(h * vy - dy) + abs(h * vz - dz)
+    b = abs(h * vx1 - dx) + abs(h * vy1 - dy) + abs(h * vz1 - dz)
+    return 0.25 * max(a, b)
 
 
 @compiled()
