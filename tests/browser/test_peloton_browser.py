@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import contextlib
 from collections.abc import Iterator
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -407,3 +408,21 @@ def test_course_mode_colours_a_bunch_by_power_with_its_legend_clear_of_the_notic
             assert "Ride mean" in text and "rides at the mean drag of its formation" in text
             assert error_text(page) == []
         mode.enable.value = False
+
+
+def test_a_preset_menu_reads_custom_off_its_presets_and_sets_a_chosen_one(shown: ScenePage, tmp_path: Path) -> None:
+    # The outside tester's case in a real page: Crr 0.02 typed, the Tyres / surface menu must not name a tyre.
+    scene, page = shown.scene, shown.page
+    menu = control_row(page, "Tyres / surface").locator("input").first
+    try:
+        set_number(page, "Crr", 0.02)
+        wait_until(lambda: scene.params.crr == 0.02, "the typed Crr to reach the scene")
+        wait_until(lambda: menu.input_value() == "Custom", "the Tyres / surface menu to read Custom")
+        menu.scroll_into_view_if_needed()
+        page.screenshot(path=str(tmp_path / "custom.png"))  # for a person to look at: pytest's own temporary folder
+        choose(page, "Tyres / surface", "Gravel tyre (0.0080)")
+        wait_until(lambda: scene.params.crr == 0.008, "the chosen preset to set Crr")
+        wait_until(lambda: menu.input_value() == "Gravel tyre (0.0080)", "the menu to name the chosen tyre")
+    finally:
+        choose(page, "Tyres / surface", "Race tyre, smooth asphalt (0.0040)")  # the next test's opening state
+        wait_until(lambda: scene.params.crr == 0.004, "the default tyre back")
