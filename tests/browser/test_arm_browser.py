@@ -16,16 +16,20 @@ from helpers.browser import (
     assert_seen,
     changed_mask,
     chart_fits_test,
+    chart_image,
     control_row,
     error_text,
+    line_mask,
     project,
     save_scene_screenshot,
     scene_page_fixture,
     screenshot,
     settle,
+    wait_frames,
     with_nodes_hidden,
 )
 from helpers.waiting import wait_until
+from playwright.sync_api import Error as PlaywrightError
 
 from scenes.arm import ArmScene
 
@@ -231,3 +235,49 @@ def test_the_3d_view_and_each_preset_show_everything_whole(shown: ScenePage) -> 
     wait_until(lambda: not scene.skeletons.active, "the chain back")
     settle(shown)
     _assert_chain_fills_the_view(shown, "the chain again")
+
+
+def test_a_solve_with_no_admissible_pose_charts_without_an_error_and_the_next_draws_its_curve(
+    shown: ScenePage,
+) -> None:
+    # An empty series made viser's client throw "object null is not iterable" and leave the chart without its red
+    # curve; a solve that saw no admissible pose ("infeasible") sent one. Its chart is now its one final error.
+    from scenes.arm import OBSTACLE_STARTS, TARGET_START, ArmParams, rest_pose, solve_arm
+
+    scene = shown.scene
+    assert isinstance(scene, ArmScene)
+    errors: list[str] = []
+    shown.page.on("pageerror", lambda error: errors.append(str(error)))
+    params = ArmParams(
+        n_links=6, link_length_m=0.5, three_d=True, limits=True, n_obstacles=3, solver="Jacobian DLS",
+        tolerance_mm=50.0, max_iterations=3,
+    )  # fmt: skip
+    bent = np.array([[0.0, 0.0, 0.0], [-0.2089, 0.0, 0.4543], [-0.3073, 0.0, 0.9445], [-0.0450, 0.0, 1.3702],
+                     [0.4515, 0.0, 1.3111], [0.9041, 0.0, 1.0987], [0.8502, 0.0, 0.6016]])  # fmt: skip
+    report = solve_arm(params, bent, TARGET_START, OBSTACLE_STARTS)
+    assert report.result.status == "infeasible"
+    red = {"error": (230, 50, 50)}
+
+    def red_px() -> int | None:
+        """The chart's red pixels, or None while viser's client is replacing the chart's element."""
+        try:
+            return int(np.count_nonzero(line_mask(chart_image(shown.page, CHART), red["error"])))
+        except PlaywrightError:
+            return None
+
+    with scene._lock:
+        before = scene.params
+        scene.params = params
+        scene._draw(report)
+    try:
+        wait_until(lambda: (red_px() or 25) < 25, "the chart showing the one final error", timeout_s=30.0)
+        wait_frames(shown.page, 10)
+        assert not errors, errors
+    finally:
+        with scene._lock:  # a solve from the rest pose, which takes several iterations, as the scene opens
+            scene.params = before
+            scene.pose = rest_pose(before.n_links, before.link_length_m)
+            scene.solve_and_draw()
+    wait_until(lambda: (red_px() or 0) >= 25, "a solve's curve drawn again", timeout_s=30.0)
+    assert not errors, errors
+    assert_chart_draws(shown.page, CHART, red)
