@@ -81,6 +81,9 @@ ROAD_X_M = (-(MAX_GROUP - 1) * (BIKE_LENGTH_M + MAX_GAP_M) - 15.0, 15.0)
 it, with 15 m spare at each end."""
 ROAD_HALF_WIDTH_M = 3.0
 """Half the road's width (m): a bunch eight abreast fits on it."""
+GRASS_BEYOND_M = 150.0
+"""How far the grass reaches beyond the road's sides and ends (m): the camera that frames the tallest bars (80 km/h
+up 20 %) looks down from far enough back that grass ending 15 m from the road showed the page's white beneath it."""
 BAR_METRES_PER_WATT = 1.0 / 400.0
 """Height of the stacked power bars above the riders."""
 VIEW_DIRECTION = (-1.2, 7.5, -0.6)
@@ -276,12 +279,17 @@ time-averaged power is the mean over positions, far below the leader's.
         self.course = scene.add_frame(f"{self.root.name}/course", show_axes=False)
         start, end = ROAD_X_M
         length, middle = end - start, 0.5 * (start + end)
-        # Grass either side of the road, not under it: in software WebGL every pixel drawn twice costs a frame.
+        # Grass either side of the road and beyond its ends, not under it: in software WebGL every pixel drawn twice
+        # costs a frame.
         verges = []
         for side in (-1.0, 1.0):
-            verge = trimesh.creation.box(extents=(length + 30.0, 30.0 - ROAD_HALF_WIDTH_M, 0.02))
-            verge.apply_translation((middle, side * 0.5 * (30.0 + ROAD_HALF_WIDTH_M), -0.03))
-            verges.append(verge)
+            verge = trimesh.creation.box(
+                extents=(length + 2.0 * GRASS_BEYOND_M, GRASS_BEYOND_M - ROAD_HALF_WIDTH_M, 0.02)
+            )
+            verge.apply_translation((middle, side * 0.5 * (GRASS_BEYOND_M + ROAD_HALF_WIDTH_M), -0.03))
+            beyond_end = trimesh.creation.box(extents=(GRASS_BEYOND_M, 2.0 * ROAD_HALF_WIDTH_M, 0.02))
+            beyond_end.apply_translation((middle + side * 0.5 * (length + GRASS_BEYOND_M), 0.0, -0.03))
+            verges += [verge, beyond_end]
         grass = trimesh.util.concatenate(verges)
         assert isinstance(grass, trimesh.Trimesh)
         self.grass = add_ground(scene, f"{self.course.name}/grass", grass.vertices, grass.faces, GRASS_COLOUR)

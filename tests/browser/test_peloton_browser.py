@@ -426,3 +426,41 @@ def test_a_preset_menu_reads_custom_off_its_presets_and_sets_a_chosen_one(shown:
     finally:
         choose(page, "Tyres / surface", "Race tyre, smooth asphalt (0.0040)")  # the next test's opening state
         wait_until(lambda: scene.params.crr == 0.004, "the default tyre back")
+
+
+STEEP_AND_FAST = [
+    NumberChange("Speed (km/h)", "speed_kmh", 80.0, 40.0),
+    NumberChange("Grade (%)", "grade_pct", 20.0, 0.0),
+    NumberChange("CdA (m²)", "cda_m2", 0.8, 0.32),
+    NumberChange("Mass, rider + bike (kg)", "mass_kg", 150.0, 80.0),
+    NumberChange("Crr", "crr", 0.02, 0.004),
+]
+"""The tallest bars the controls allow: the camera backs off to frame them, and the ground must still fill the
+bottom of the view (the grass ended 15 m from the road and the page's white showed in the lower right)."""
+
+
+def test_the_ground_fills_the_bottom_of_the_view_when_the_bars_are_tallest(shown: ScenePage) -> None:
+    scene = shown.scene
+    assert isinstance(scene, PelotonScene)
+    try:
+        for change in STEEP_AND_FAST:
+            set_number(shown.page, change.label, change.value)
+        wait_until(
+            lambda: all(getattr(scene.params, c.field) == c.value for c in STEEP_AND_FAST), "the steep, fast settings"
+        )
+        settle(shown)
+        image = screenshot(shown.page)
+        left, top, _, bottom = panel_rect(shown.page)
+        strip = image[-24:, :]  # the bottom rows of the view, across its whole width
+        under_panel = np.zeros(strip.shape[:2], dtype=bool)
+        rows = np.arange(image.shape[0] - 24, image.shape[0])
+        under_panel[(rows >= top) & (rows <= bottom), int(left) :] = True
+        background = np.all(strip == 255, axis=2) & ~under_panel
+        assert background.sum() == 0, f"{int(background.sum())} px of the page's background under the ground"
+    finally:
+        for change in STEEP_AND_FAST:
+            set_number(shown.page, change.label, change.restore)
+        wait_until(
+            lambda: all(getattr(scene.params, c.field) == c.restore for c in STEEP_AND_FAST), "the settings restored"
+        )
+        settle(shown)
