@@ -4,6 +4,7 @@ toggle shows the floor grid from an angle. (The mouse drags are in ``test_intera
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -256,7 +257,7 @@ def test_a_solve_with_no_admissible_pose_charts_without_an_error_and_the_next_dr
                      [0.4515, 0.0, 1.3111], [0.9041, 0.0, 1.0987], [0.8502, 0.0, 0.6016]])  # fmt: skip
     report = solve_arm(params, bent, TARGET_START, OBSTACLE_STARTS)
     assert report.result.status == "infeasible"
-    red = {"error": (230, 50, 50)}
+    red: dict[str, Sequence[int]] = {"error": (230, 50, 50)}
 
     def red_px() -> int | None:
         """The chart's red pixels, or None while viser's client is replacing the chart's element."""

@@ -247,8 +247,8 @@ def test_the_ellipsoid_estimate_is_quilezs_formula_at_any_scale(radii, point, lo
     with decimal.localcontext() as context:
         context.prec = 60
         pd, rd = [Decimal(float(c)) for c in p], [Decimal(r) for r in radii]
-        k0 = sum((a / b) ** 2 for a, b in zip(pd, rd, strict=True)).sqrt()
-        k1 = sum((a / b / b) ** 2 for a, b in zip(pd, rd, strict=True)).sqrt()
+        k0 = sum(((a / b) ** 2 for a, b in zip(pd, rd, strict=True)), Decimal(0)).sqrt()
+        k1 = sum(((a / b / b) ** 2 for a, b in zip(pd, rd, strict=True)), Decimal(0)).sqrt()
         expected = float(k0 * (k0 - 1) / k1)
     with np.errstate(over="raise", invalid="raise", divide="raise"):
         got = sdf.sd_ellipsoid(p[None], radii)[0]

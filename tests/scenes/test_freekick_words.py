@@ -131,7 +131,7 @@ def test_every_kick_the_controls_allow_lands_or_reaches_the_net_within_its_time(
             elevation_deg=50.0,
             azimuth_deg=azimuth,
             spin_rev_s=spin,
-            spin_axis=axis,
+            spin_axis=axis,  # type: ignore[arg-type]
             model=model,  # type: ignore[arg-type]
         )
         state = compute_kick(params)
