@@ -439,16 +439,21 @@ STEEP_AND_FAST = [
 bottom of the view (the grass ended 15 m from the road and the page's white showed in the lower right)."""
 
 
-def test_the_ground_fills_the_bottom_of_the_view_when_the_bars_are_tallest(shown: ScenePage) -> None:
+def type_numbers(shown: ScenePage, changes: list[NumberChange], restore: bool = False) -> None:
+    """Type each change's value (or, with ``restore``, its value to restore) and wait until the scene has them all
+    and the page has settled."""
     scene = shown.scene
-    assert isinstance(scene, PelotonScene)
+    wanted = {c.field: c.restore if restore else c.value for c in changes}
+    for change in changes:
+        set_number(shown.page, change.label, wanted[change.field])
+    wait_until(lambda: all(getattr(scene.params, f) == v for f, v in wanted.items()), f"the values {wanted}")
+    settle(shown)
+
+
+def test_the_ground_fills_the_bottom_of_the_view_when_the_bars_are_tallest(shown: ScenePage) -> None:
+    assert isinstance(shown.scene, PelotonScene)
     try:
-        for change in STEEP_AND_FAST:
-            set_number(shown.page, change.label, change.value)
-        wait_until(
-            lambda: all(getattr(scene.params, c.field) == c.value for c in STEEP_AND_FAST), "the steep, fast settings"
-        )
-        settle(shown)
+        type_numbers(shown, STEEP_AND_FAST)
         image = screenshot(shown.page)
         left, top, _, bottom = panel_rect(shown.page)
         strip = image[-24:, :]  # the bottom rows of the view, across its whole width
@@ -458,9 +463,4 @@ def test_the_ground_fills_the_bottom_of_the_view_when_the_bars_are_tallest(shown
         background = np.all(strip == 255, axis=2) & ~under_panel
         assert background.sum() == 0, f"{int(background.sum())} px of the page's background under the ground"
     finally:
-        for change in STEEP_AND_FAST:
-            set_number(shown.page, change.label, change.restore)
-        wait_until(
-            lambda: all(getattr(scene.params, c.field) == c.restore for c in STEEP_AND_FAST), "the settings restored"
-        )
-        settle(shown)
+        type_numbers(shown, STEEP_AND_FAST, restore=True)

@@ -76,18 +76,12 @@ def test_a_value_that_is_no_preset_shows_custom(server: viser.ViserServer, scene
 
 
 @pytest.mark.parametrize(("menu", "preset"), EVERY_PRESET, ids=lambda x: str(x))
-def test_typing_a_presets_value_shows_that_preset(
+def test_typing_a_presets_value_shows_that_preset_and_choosing_it_sets_its_value(
     server: viser.ViserServer, scene: PelotonScene, menu: Menu, preset: str
 ) -> None:
     control(server, menu.control).value = menu.off_preset
     control(server, menu.control).value = menu.presets[preset]
     assert shown(server, menu) == preset
-
-
-@pytest.mark.parametrize(("menu", "preset"), EVERY_PRESET, ids=lambda x: str(x))
-def test_choosing_a_preset_sets_its_value(
-    server: viser.ViserServer, scene: PelotonScene, menu: Menu, preset: str
-) -> None:
     control(server, menu.control).value = menu.off_preset
     control(server, menu.label).value = preset
     assert getattr(scene.params, menu.field) == menu.presets[preset]
