@@ -332,9 +332,9 @@ class Gate:
                 tell = self._tell(
                     server,
                     client_id,
-                    "Text refused",
                     f"That text was {len(updates['value']):,} characters long; “{label}” takes at most "
                     f"{spec.max_chars:,}, so the previous text is back.",
+                    title="Text refused",
                 )
 
                 def send_back_and_tell() -> None:
@@ -363,7 +363,6 @@ class Gate:
             return None, self._tell(
                 server,
                 client_id,
-                "Upload refused",
                 f"The file is {size / MIB:.1f} MiB; this server takes files up to {MAX_UPLOAD_BYTES / MIB:.0f} MiB.",
             )
         if not all(
@@ -384,7 +383,6 @@ class Gate:
             return None, self._tell(
                 server,
                 client_id,
-                "Upload refused",
                 f"This tab already has {MAX_UPLOADS_IN_FLIGHT} uploads under way; wait for one to finish.",
             )
         own_bytes = sum(upload.size_bytes for upload in list(in_flight.values()))
@@ -396,7 +394,6 @@ class Gate:
             return None, self._tell(
                 server,
                 client_id,
-                "Upload refused",
                 f"This tab's uploads under way already announce {own_bytes / MIB:.1f} MiB; it takes "
                 f"{MAX_UPLOAD_BYTES_IN_FLIGHT_PER_TAB / MIB:.0f} MiB at once. Wait for them to finish.",
             )
@@ -410,7 +407,6 @@ class Gate:
             return None, self._tell(
                 server,
                 client_id,
-                "Upload refused",
                 f"The server is receiving other uploads ({count} files, "
                 f"{total_bytes / MIB:.1f} MiB in flight from all tabs; it takes "
                 f"{MAX_UPLOADS_IN_FLIGHT_TOTAL} files or {MAX_UPLOAD_BYTES_IN_FLIGHT_TOTAL / MIB:.0f} MiB at "
@@ -420,7 +416,9 @@ class Gate:
             in_flight[message.transfer_uuid] = Upload(parts, size, time.monotonic())
         return message, None
 
-    def _tell(self, server: viser.ViserServer, client_id: int, title: str, body: str) -> Callable[[], None]:
+    def _tell(
+        self, server: viser.ViserServer, client_id: int, body: str, title: str = "Upload refused"
+    ) -> Callable[[], None]:
         """A notification of a refused upload or text for the tab that sent it (shown after the refusal)."""
 
         def notify() -> None:
