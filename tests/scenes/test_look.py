@@ -21,7 +21,7 @@ from scenes._instances import PARKED_AT_M, park_hidden
 from scenes._look import mesh_glb
 from scenes.peloton.meshes import CROWD_ABOVE, LIGHT_ABOVE, rider_detail, rider_meshes, rod
 from scenes.peloton.model import MAX_GROUP, POSITIONS
-from scenes.peloton.scene import ROAD_HALF_WIDTH_M, PelotonScene
+from scenes.peloton.scene import ROAD_HALF_WIDTH_M, ROAD_X_M, PelotonScene
 
 scene = scene_fixture(PelotonScene)
 
@@ -156,9 +156,17 @@ def test_an_open_rod_is_a_prism_wound_outwards() -> None:
 def test_the_grass_lies_beside_the_road_not_under_it(scene: PelotonScene) -> None:
     """Every pixel of road drawn over grass is shaded twice; in software WebGL the ground is a third of a frame."""
     grass = read_glb(scene.grass.glb_data)
-    inside = np.abs(grass.triangles_center[:, 1]) < ROAD_HALF_WIDTH_M - 1e-6
-    assert not inside.any()
-    assert grass.bounds[0, 1] <= -25.0 and grass.bounds[1, 1] >= 25.0  # and it still reaches the horizon either side
+    start, end = ROAD_X_M
+    centre = grass.triangles_center
+    across = np.abs(centre[:, 1]) < ROAD_HALF_WIDTH_M - 1e-6
+    along = (centre[:, 0] > start + 1e-6) & (centre[:, 0] < end - 1e-6)
+    assert not (across & along).any()
+    # It still reaches the horizon either side, and lies beyond the road's ends, where a camera framing the
+    # tallest bars looks down past the leader (the page's white showed there).
+    assert grass.bounds[0, 1] <= -25.0 and grass.bounds[1, 1] >= 25.0
+    assert grass.bounds[0, 0] <= start - 100.0 and grass.bounds[1, 0] >= end + 100.0
+    beyond = across & ~along
+    assert centre[beyond, 0].min() < start and centre[beyond, 0].max() > end
 
 
 def test_a_group_rides_light_and_a_line_rides_full(scene: PelotonScene) -> None:
