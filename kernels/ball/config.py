@@ -49,6 +49,13 @@ Model = Literal["constant", "measured"]
 MAX_STEPS = 1_000_000
 """The most steps a flight takes: ``dt`` is at least ``t_max / MAX_STEPS``."""
 
+
+def _step_count(duration: float, step: float) -> int:
+    """Steps of ``step`` in a flight of ``duration`` (s): the last one shortened to end on it. A quotient over a
+    whole number by rounding (0.514/5.14e-7 is 1000000.0000000001) is that whole number."""
+    return max(1, math.ceil(duration / step - 1e-9))
+
+
 # The compiled cores read their settings from one float64 vector; these are its slots.
 MAX_BALL_RADIUS_M = 1.0
 """The largest ball a flight takes (m; a football's radius is 0.11 m): a 1e9 m ball was refused as a shallow net."""
@@ -167,7 +174,7 @@ class FlightConfig:
     def __post_init__(self) -> None:
         step = _checks.positive("dt", self.dt)
         duration = _checks.positive("t_max", self.t_max)
-        if duration / step > MAX_STEPS:
+        if _step_count(duration, step) > MAX_STEPS:
             raise ValueError(
                 f"dt must be at least t_max/{MAX_STEPS} = {duration / MAX_STEPS:g} s, got {_checks.shown(step)}"
             )
@@ -202,7 +209,7 @@ class FlightConfig:
                 step,
                 ground,
                 stop,
-                max(1, math.ceil(duration / step - 1e-9)),
+                _step_count(duration, step),
                 self.method == "rk4",
                 self.model == "measured",
                 duration,

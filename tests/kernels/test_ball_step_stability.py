@@ -219,6 +219,32 @@ def test_the_t_max_a_refusal_names_lets_the_kick_fly() -> None:
         ball.simulate((0.0, 0.0, 1.0), (1e8, 0.0, 0.0), (0.0, 0.0, 0.0), t_max=0.739, dt=0.739e-6)
 
 
+@given(
+    log_speed=st.floats(math.log(3e7), math.log(1e150)),  # every limit under t_max/10⁶ = 5e-6 s
+    method=st.sampled_from(("euler", "rk4")),
+    on_pitch=st.booleans(),
+)
+@settings(max_examples=examples(40), deadline=None)
+def test_the_dt_and_t_max_a_refusal_names_are_taken_together(log_speed: float, method: ball.Method, on_pitch: bool):
+    # A review: at 1e8 m/s toward a wall (RK4) the refusal named dt 5.14e-7 s and t_max 0.514 s, and that pair was
+    # refused in turn: 0.514/5.14e-7 is 1000000.0000000001 in floating point, over the million-step cap.
+    velocity = (math.exp(log_speed), 0.0, 0.0)
+    with pytest.raises(ValueError) as caught:
+        ball.simulate((0.0, 0.0, 1.0), velocity, (0.0, 0.0, 0.0), method=method, dt=1e-3,
+                      pitch=_PITCH if on_pitch else None)  # fmt: skip
+    message = str(caught.value)
+    found = re.search(r"a t_max of at most ([0-9.e+-]+) s", message)
+    assert found is not None, message
+    config = ball.FlightConfig(dt=_limit_named(caught.value), t_max=float(found.group(1)), method=method)
+    assert config.settings[10] <= 1_000_000  # N_STEPS
+
+
+def test_a_step_count_a_whole_number_but_for_rounding_is_that_number() -> None:
+    assert ball.FlightConfig(dt=5.14e-7, t_max=0.514).settings[10] == 1_000_000
+    with pytest.raises(ValueError, match=r"^dt must be at least t_max/1000000 = 5\.141e-07 s, got 5\.14e-07"):
+        ball.FlightConfig(dt=5.14e-7, t_max=0.5141)
+
+
 @pytest.mark.parametrize("speed", [1e6, 1.3e154, 1.4e154, 1e200, 1.7e308])
 def test_an_absurd_launch_speed_is_refused_naming_the_velocity_on_every_path(speed: float) -> None:
     _check_refusals(np.array([speed, 0.0, 0.0]), "euler", 1e-3)
