@@ -385,7 +385,9 @@ def test_tab_churn_leaves_rss_flat_and_sends_nothing_to_closed_tabs() -> None:
     app = AppProcess()
     try:
         # viser's callback pool grows toward its 32 threads as builds overlap, each thread adding its stack pages
-        # (~0.4 MiB): measure over a run of tabs in which the pool no longer grew.
+        # (~0.4 MiB): measure over a run of tabs in which the pool no longer grew. A leak grows every run; under
+        # CI's load one run of a steady pool read 55 KiB a tab where the runs before and after read 14-30, so a
+        # run over the limit is measured again, up to four runs.
         app.wait_compiled()
         churn(30)
         measured: list[str] = []
@@ -397,7 +399,7 @@ def test_tab_churn_leaves_rss_flat_and_sends_nothing_to_closed_tabs() -> None:
             end, threads_after = settled_rss(app), thread_count(app.process.pid)
             per_tab_kib = (end - start) / 30 / 1024
             measured.append(f"{per_tab_kib:.0f} KiB a tab, threads {threads_before} -> {threads_after}")
-            if threads_after <= threads_before:
+            if threads_after <= threads_before and per_tab_kib <= 50.0:
                 break
         print(f"tab churn: {start / MIB:.1f} -> {end / MIB:.1f} MiB over 30 tabs; {measured}")
         assert threads_after <= threads_before, f"the thread pool kept growing: {measured}"
