@@ -80,7 +80,7 @@ class Control:
     multiline: bool = False
     """Text only: a multi-line box."""
     max_chars: int = MAX_TEXT_CHARS
-    """Text only: the longest text the gate passes on (longer is refused there without a word)."""
+    """Text only: the longest text the gate passes on (a longer one is refused there, and its tab told why)."""
     folder: str | None = None
     """The folder the control goes in, or None for wherever the builder is called."""
     costly: bool = False
@@ -204,8 +204,8 @@ def checkbox(label: str, **placement: Unpack[Placement]) -> dict[str, Control]:
 def text(
     label: str, *, multiline: bool = False, max_chars: int = MAX_TEXT_CHARS, **placement: Unpack[Placement]
 ) -> dict[str, Control]:
-    """A text box for a ``str`` field; the gate refuses text over ``max_chars`` without a word, so a scene that
-    answers over-long text itself declares more than it keeps."""
+    """A text box for a ``str`` field; the gate refuses text over ``max_chars`` and tells the tab that sent it, so a
+    scene declares the most it keeps."""
     return _declare(Control("text", label, multiline=multiline, max_chars=max_chars, **placement))
 
 

@@ -40,8 +40,8 @@ class ControlSpec:
     length: int = 0
     """Number of components (RGB, vectors)."""
     max_chars: int = MAX_TEXT_CHARS
-    """Longest text (text controls): longer is refused here, silently, so a control whose scene answers an over-long
-    text in words declares more than it keeps."""
+    """Longest text (text controls): the gate refuses a longer one, puts the last kept text back and tells the tab
+    that sent it the length and this limit."""
     costly: bool = False
     """Whether a change rebuilds a scene or starts a long job: such inputs share a per-tab budget at the gate, and a
     burst beyond it is coalesced (see :func:`mark_costly`)."""
