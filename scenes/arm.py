@@ -284,19 +284,11 @@ CHART_FLOOR_MM = 1e-6
 
 
 def chart_points(report: SolveReport) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """The error chart's (iterations (K,), error (K,) mm): :attr:`SolveReport.best_history`'s finite points, K ≥ 1.
-
-    The browser's uPlot throws "object null is not iterable" on empty series and cannot draw NaN or ±inf on a log
-    scale, so whatever the history holds, the chart gets equal-length finite arrays with at least one point (the
-    returned pose's error at its last iteration where no other is left)."""
-    counts, errors = (np.asarray(a, dtype=np.float64) for a in report.best_history)
-    keep = np.isfinite(counts) & np.isfinite(errors)
-    if len(counts) != len(errors) or not np.any(keep):
-        r = report.result
-        counts = np.array([float(r.iterations)])
-        errors = np.array([r.error if math.isfinite(r.error) else 0.0])
-        keep = np.ones(1, dtype=bool)
-    return counts[keep], np.maximum(errors[keep] * 1000.0, CHART_FLOOR_MM)
+    """The error chart's (iterations (K,), error (K,) mm): :attr:`SolveReport.best_history`, which has at least one
+    point (:func:`admissible_history`: uPlot's client throws "object null is not iterable" on empty series), floored
+    at :data:`CHART_FLOOR_MM` for the log scale."""
+    counts, errors = report.best_history
+    return counts.astype(np.float64), np.maximum(errors * 1000.0, CHART_FLOOR_MM)
 
 
 def solve_arm(
@@ -448,13 +440,13 @@ def why_short(
         which = _listed([str(k) for k in touching])
         reasons.append(f"obstacle {which} is in the way (the chain rests against it)")
     if params.limits:
-        angles = fabrik.joint_angles(to_kernel(joints, params.three_d), _root_direction(params.three_d))
         held = joints_at_limit(params, joints)
         if len(held):
             names = ["the base" if j == 0 else f"joint {j + 1}" for j in held]
             verb = "is" if len(held) == 1 else "are"
             reasons.append(f"{_listed(names)} {verb} at the {params.half_angle_deg:g}° joint limit")
         elif r.status == "limited":
+            angles = fabrik.joint_angles(to_kernel(joints, params.three_d), _root_direction(params.three_d))
             used = float(np.max(angles)) / max(math.radians(params.half_angle_deg), 1e-12)
             reasons.append(
                 f"under the {params.half_angle_deg:g}° joint limits the solver found no closer pose "
