@@ -21,6 +21,7 @@ from numpy.typing import ArrayLike, NDArray
 __all__ = [
     "bounded_array",
     "choice",
+    "direction",
     "finite_array",
     "finite_number",
     "flag",
@@ -194,6 +195,18 @@ def vector(name: str, value: ArrayLike, size: int) -> NDArray[np.float64]:
     if array.shape != (size,):
         raise ValueError(f"{name} must have shape ({size},), got {array.shape}")
     return array
+
+
+def direction(name: str, value: ArrayLike, size: int, what: str = "") -> NDArray[np.float64]:
+    """The unit vector along a finite, non-zero :func:`vector` of any length, else ``ValueError`` naming it (as a
+    non-zero ``what`` where given, e.g. "quaternion (w, x, y, z)"). It is scaled by its largest component before its
+    norm is taken, so a huge one (1e300) does not overflow the norm and a tiny one (1e-300) does not underflow it."""
+    array = vector(name, value, size)
+    largest = float(np.abs(array).max())
+    if largest == 0.0:
+        raise ValueError(f"{name} must be {'a non-zero ' + what if what else 'non-zero'}, got {shown(value)}")
+    array = array / largest
+    return array / math.sqrt(float(array @ array))
 
 
 def positive_vector(name: str, value: ArrayLike, size: int) -> NDArray[np.float64]:

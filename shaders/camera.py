@@ -41,11 +41,7 @@ class Camera:
         for name, v in (("position", eye), ("look_at", target)):
             if not (np.abs(v) <= MAX_CAMERA_COORDINATE).all():
                 raise ValueError(f"{name} must be of magnitude ≤ {MAX_CAMERA_COORDINATE:g} m, got {v.tolist()}")
-        up = _checks.vector("up", self.up, 3)
-        largest = float(np.abs(up).max())
-        if largest == 0.0:
-            raise ValueError(f"up must be non-zero, got {up.tolist()}")
-        up = up / largest  # any finite length: scaled first, so its norm neither overflows nor underflows
+        up = _checks.direction("up", self.up, 3)
         forward = target - eye
         if np.linalg.norm(forward) < 1e-9:
             raise ValueError("look_at must differ from position")
@@ -138,11 +134,7 @@ class Shading:
             if number > big:
                 raise ValueError(f"{name} must be at most {big:g} (float32), got {_checks.shown(value)}")
             object.__setattr__(self, name, number)
-        light = _checks.vector("light_direction", self.light_direction, 3)
-        largest = float(np.abs(light).max())
-        if largest == 0.0:
-            raise ValueError(f"light_direction must be non-zero, got {light.tolist()}")
-        light = light / largest  # normalised on use; scaled here so that cannot overflow or underflow
+        light = _checks.direction("light_direction", self.light_direction, 3)
         object.__setattr__(self, "light_direction", tuple(float(v) for v in light))
         for name in ("shadows", "occlusion"):
             object.__setattr__(self, name, _checks.flag(name, getattr(self, name)))

@@ -852,12 +852,7 @@ def spin_vector(rate_rev_s: float, axis: ArrayLike) -> NDArray[np.float64]:
         (3,) ω (rad/s).
     """
     rate = _checks.non_negative("rate_rev_s", rate_rev_s)
-    direction = checked_vector("axis", axis, 3)
-    scale = float(np.abs(direction).max())
-    if scale == 0.0:
-        raise ValueError("axis must not be zero")
-    direction = direction / scale  # largest component ±1 first: neither overflows nor underflows when squared
-    return 2.0 * math.pi * rate * direction / float(np.linalg.norm(direction))
+    return 2.0 * math.pi * rate * _checks.direction("axis", checked_vector("axis", axis, 3), 3)
 
 
 def launch_velocity(speed_ms: float, elevation_rad: float, azimuth_rad: float) -> NDArray[np.float64]:

@@ -9,7 +9,6 @@ arrays to their compiled cores. The flight on a pitch applies the same compiled 
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
@@ -174,12 +173,7 @@ def bounce(
     """
     v = _impact_rows("velocity", velocity)
     w = _impact_rows("spin", spin)
-    direction = checked_vector("normal", normal, 3)
-    scale = float(np.abs(direction).max())
-    if scale == 0.0:
-        raise ValueError(f"normal must not be zero, got {_checks.shown(normal)}")
-    direction = direction / scale  # largest component ±1 first: neither overflows nor underflows when squared
-    unit = direction / math.sqrt(float(direction @ direction))
+    unit = _checks.direction("normal", checked_vector("normal", normal, 3), 3)
     e_n = _fraction("restitution", restitution)
     e_t = _fraction("tangential_restitution", tangential_restitution)
     mu = _checks.non_negative("friction", friction)

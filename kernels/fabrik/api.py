@@ -500,13 +500,7 @@ def _root_direction(value: ArrayLike | None, dim: int) -> NDArray[np.float64]:
         axis = np.zeros(dim)
         axis[-1] = 1.0
         return axis
-    axis = _check_vector("root_direction", value, dim)
-    largest = float(np.abs(axis).max())
-    if largest == 0.0:
-        raise ValueError(f"root_direction must be non-zero, got {_checks.shown(value)}")
-    # first to max-abs 1, so neither a huge nor a tiny vector over- or underflows its norm
-    axis = axis / largest
-    return axis / float(np.linalg.norm(axis))
+    return _checks.direction("root_direction", _check_vector("root_direction", value, dim), dim)
 
 
 def _status_literal(text: str) -> Status:

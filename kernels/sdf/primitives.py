@@ -383,15 +383,11 @@ def sd_plane(p: ArrayLike, normal: ArrayLike, offset: float) -> FloatArray:
         (N,) signed distances (m).
     """
     pts = coordinates("p", p)
-    n = _checks.vector("normal", normal, 3)
-    largest = float(np.abs(n).max())
-    if largest == 0.0:
-        raise ValueError(f"normal must be non-zero, got {n.tolist()}")
-    n = n / largest
+    n = _checks.direction("normal", normal, 3)
     off = _checks.finite_number("offset", offset)
     if abs(off) > MAX_COORDINATE:
         raise ValueError(f"offset must be of magnitude ≤ {MAX_COORDINATE:g} m, got {_checks.shown(offset)}")
-    return pts @ (n / float(np.linalg.norm(n))) + off
+    return pts @ n + off
 
 
 # ------------------------------------------------------------------------------------------ the registry

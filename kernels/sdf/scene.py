@@ -47,12 +47,7 @@ def unit_quaternion(name: str, value: ArrayLike) -> FloatArray:
     """(4,) unit quaternion (w, x, y, z) from 4 finite real numbers not all zero, else ``ValueError`` naming
     ``name``. It is scaled by its largest component before its norm is taken, so a huge one (1e300) does not
     overflow the norm to inf and a tiny one (1e-300) does not underflow it to zero."""
-    q = _checks.vector(name, value, 4)
-    largest = float(np.abs(q).max())
-    if largest == 0.0:
-        raise ValueError(f"{name} must be a non-zero quaternion (w, x, y, z), got {q.tolist()}")
-    q = q / largest
-    return q / float(np.linalg.norm(q))
+    return _checks.direction(name, value, 4, "quaternion (w, x, y, z)")
 
 
 def rotation_matrix(wxyz: ArrayLike) -> FloatArray:

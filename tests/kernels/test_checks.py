@@ -109,3 +109,35 @@ def test_indices_come_back_as_int64_rows_and_an_empty_list_as_no_rows() -> None:
     np.testing.assert_array_equal(_checks.indices("faces", [[0, 1, 2]], 3, 3), [[0, 1, 2]])
     assert _checks.indices("faces", np.array([[0, 1, 2]], np.uint8), 3, 3).dtype == np.int64
     assert _checks.indices("edges", [], 2, 0).shape == (0, 2)
+
+
+@pytest.mark.parametrize(
+    ("value", "expected"),
+    [
+        ((3.0, 0.0, -4.0), (0.6, 0.0, -0.8)),
+        ((3e300, 4e300, 0.0), (0.6, 0.8, 0.0)),  # its squares overflow to inf
+        ((0.0, 3e-320, -4e-320), (0.0, 0.6, -0.8)),  # its squares underflow to 0
+        ((0.0, 0.0, 7.0), (0.0, 0.0, 1.0)),
+    ],
+)
+def test_a_direction_is_its_unit_vector_at_any_finite_length(
+    value: tuple[float, ...], expected: tuple[float, ...]
+) -> None:
+    unit = _checks.direction("axis", value, 3)
+    np.testing.assert_allclose(unit, expected, rtol=1e-3, atol=1e-15)  # 3e-320 is subnormal: 3 digits
+    assert math.isclose(float(unit @ unit), 1.0, rel_tol=1e-15)
+
+
+@pytest.mark.parametrize(
+    ("value", "what", "message"),
+    [
+        ((0.0, 0.0, 0.0), "", r"^axis must be non-zero, got \(0\.0, 0\.0, 0\.0\)$"),
+        ((0.0, -0.0, 0.0, 0.0), "quaternion (w, x, y, z)", r"^axis must be a non-zero quaternion \(w, x, y, z\), got "),
+        ((1.0, math.inf, 0.0), "", r"^axis must be finite"),
+        ((1.0, 0.0), "", r"^axis must have shape \(3,\), got \(2,\)$"),
+    ],
+)
+def test_a_direction_refuses_a_zero_or_bad_vector_naming_it(value: tuple[float, ...], what: str, message: str) -> None:
+    size = 4 if what else 3
+    with pytest.raises(ValueError, match=message):
+        _checks.direction("axis", value, size, what)
