@@ -4,11 +4,15 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from fractions import Fraction
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from kernels import _checks
+from tests.helpers.properties import examples
 
 
 @pytest.mark.parametrize(
@@ -141,3 +145,20 @@ def test_a_direction_refuses_a_zero_or_bad_vector_naming_it(value: tuple[float, 
     size = 4 if what else 3
     with pytest.raises(ValueError, match=message):
         _checks.direction("axis", value, size, what)
+
+
+_ANY_FINITE = st.floats(allow_nan=False, allow_infinity=False)
+
+
+@settings(max_examples=examples(300), deadline=None)
+@given(st.lists(_ANY_FINITE, min_size=3, max_size=3).filter(any))
+def test_a_direction_is_a_unit_vector_along_any_finite_non_zero_vector(value: list[float]) -> None:
+    # Against exact rational arithmetic: the unit vector's components are in the input's ratios, to rounding.
+    unit = _checks.direction("axis", value, 3)
+    assert abs(float(unit @ unit) - 1.0) <= 1e-15  # a few ulps of 1
+    exact = [Fraction(v) for v in value]
+    largest = max(abs(v) for v in exact)
+    for got, v in zip(unit.tolist(), exact, strict=True):
+        # u_i · |v| / max|v| = v_i / max|v|: compared where the component is not lost below the largest's ulp
+        norm = math.sqrt(float(sum((x / largest) ** 2 for x in exact)))
+        assert got == pytest.approx(float(v / largest) / norm, rel=1e-15, abs=1e-15)
