@@ -767,7 +767,8 @@ def mesh_glsl(source: str, resolution: int, bounds: ArrayLike) -> trimesh.Trimes
 
     Raises:
         ValueError: a bad resolution or bounds, or (:class:`ShaderCompileError`) a source the checks or the
-            compiler reject, with the compiler's message and the source line.
+            compiler reject, with the compiler's message and the source line, or whose ``sdf`` is not finite
+            inside the bounds or ``color`` not finite on the surface.
         GLUnavailableError: no OpenGL context on this machine.
     """
     from shaders import gl_service
@@ -792,6 +793,8 @@ def mesh_glsl(source: str, resolution: int, bounds: ArrayLike) -> trimesh.Trimes
         except RuntimeError:  # scikit-image's "No surface found at the given iso value"
             vertices, faces = np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64)
         colors = gl.probe_field(source, vertices)[1] if len(vertices) else np.zeros((0, 3))
+        if not np.all(np.isfinite(colors)):
+            raise ShaderCompileError("color() returned NaN or infinity on the surface", None)
         return sdf.mesh_trimesh(vertices, faces, np.clip(colors.astype(np.float64), 0.0, 1.0))
 
     return gl_service.run(job)

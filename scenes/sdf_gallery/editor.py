@@ -13,6 +13,7 @@ import dataclasses
 
 import numpy as np
 
+from kernels import sdf
 from shaders import gl_service
 from shaders import renderer as gl_renderer
 from shaders.renderer import MAX_SOURCE_CHARS, Camera, ShaderCompileError, Shading
@@ -126,19 +127,33 @@ def trial_source(
     )
 
 
+def _no_surface(field: EditorField, resolution: int) -> str:
+    """Why a field gave no mesh, from the signs of the samples the mesher read (all one sign: no surface crossed)."""
+    grid = sdf.make_grid(sdf.default_scene(), resolution, field.bounds)  # the mesher's grid (the scene is unused)
+    samples = gl_service.run(lambda gl: gl.sample_field(field.source, grid))
+    box = f"the ±{field.half_size:g} m box"
+    if float(samples.min()) > 0.0:
+        nearest = float(samples.min())
+        why = f"every sample of {box} is outside (sdf > 0)"
+        if nearest < 2.0 * grid.spacing:  # within two samples: a surface may lie between them
+            why += (
+                f"; the nearest comes within {nearest:.3g} m of the surface, so a shape smaller than the sample "
+                f"spacing ({grid.spacing:.3g} m) may fall between samples: shrink the bounds or raise the mesh "
+                "resolution"
+            )
+    elif float(samples.max()) <= 0.0:
+        why = f"every sample of {box} is inside (sdf ≤ 0)"
+    else:
+        why = f"sdf() changes sign in {box} only where no surface can be placed"
+    return f"no surface lies inside the bounds: {why}, so there is nothing to mesh (change sdf() or the bounds)"
+
+
 def mesh_field(field: EditorField, resolution: int) -> tuple[np.ndarray, ...]:
     """Mesh the editor's field at ``resolution`` on the GL thread: vertices (V, 3) (m), faces (F, 3), colours
     (V, 3) in [0, 1] and normals (V, 3). ShaderCompileError when no surface lies inside the bounds."""
     tri = gl_renderer.mesh_glsl(field.source, resolution, field.bounds)
     if len(tri.faces) == 0:
-        centre = gl_service.run(lambda gl: gl.probe_field(field.source, [[0.0, 0.0, 0.0]]))[0]
-        side = "outside (sdf > 0)" if float(centre[0]) > 0.0 else "inside (sdf ≤ 0)"
-        h = field.half_size
-        raise ShaderCompileError(
-            f"no surface lies inside the bounds: every sample of the ±{h:g} m box is {side}, so there "
-            "is nothing to mesh (change sdf() or the editor's bounds)",
-            None,
-        )
+        raise ShaderCompileError(_no_surface(field, resolution), None)
     vertices = np.asarray(tri.vertices, dtype=np.float64)
     faces = np.asarray(tri.faces, dtype=np.int64)
     rgba = getattr(tri.visual, "vertex_colors", np.zeros((len(vertices), 4)))

@@ -298,6 +298,7 @@ IoU is lowest when a box edge is on the silhouette.
         self.view_controls.on_update(self.callback(self._on_view_input))
         self.example_controls.on_update(self.callback(self._on_example))
         self.editor.on_update(self.callback(self._on_editor_text))
+        self.half_size_controls.on_update(self.callback(self._on_bounds_input))
         self.apply.on_click(self.callback(self._on_apply))
 
     def _build_world(self) -> None:
@@ -364,6 +365,14 @@ IoU is lowest when a box edge is on the silhouette.
         with self._state:
             self._view_key = None
         self._wake()
+
+    def _on_bounds_input(self) -> None:
+        """The editor's bounds: the next Apply meshes and ray-marches in them, and a field on screen is meshed in
+        them at once."""
+        if self.params.shape_source == "editor":
+            self._request_mesh()  # reads the bounds into the parameters and their field
+        else:
+            self.params = self.read_controls(self.half_size_controls)
 
     def _on_example(self) -> None:
         self.params = self.read_controls(self.example_controls)
@@ -630,7 +639,7 @@ IoU is lowest when a box edge is on the silhouette.
 
     def _apply_source(self, text: str, resolution: int) -> None:
         """Check, compile, time and mesh an editor source; show it, or say why not and keep the last good one."""
-        field = EditorField(text, self.params.editor.half_size)
+        field = EditorField(text, self.params.editor_half_size)  # the bounds on screen
         start = time.perf_counter()
         try:
             check_source(text)
@@ -662,6 +671,8 @@ IoU is lowest when a box edge is on the silhouette.
             self.editor_status.content = (
                 f"**Applied** in {total_ms:.0f} ms (compile, a test frame and a {resolution}³ mesh)."
             )
+            if self.params.editor_half_size != field.half_size:  # the bounds moved while it compiled
+                self._request_mesh()
         with self._state:
             self._reference_due = True
             self._view_key = None

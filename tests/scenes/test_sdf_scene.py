@@ -761,20 +761,76 @@ def test_apply_of_a_text_over_the_source_limit_says_its_length_and_the_limit(
 
 @pytest.mark.gl
 @pytest.mark.parametrize(
-    ("body", "side"),
-    [("return 1.0;", "outside"), ("return -2.0;", "inside"), ("return 1e30;", "outside")],
+    ("body", "side", "between"),
+    [
+        ("return 1.0;", "outside (sdf > 0)", False),
+        ("return -2.0;", "inside (sdf ≤ 0)", False),
+        ("return 1e30;", "outside (sdf > 0)", False),
+        # Smaller than a sample spacing (3 cm at 64 samples over 3 m): every sample is outside. Once the message
+        # said "inside", read from the field at the box's centre alone.
+        ("return length(p) - 0.01;", "outside (sdf > 0)", True),
+        ("return length(p - vec3(0.7, -0.3, 0.2)) - 0.0001;", "outside (sdf > 0)", True),
+        ("return 0.01 - length(p);", "inside (sdf ≤ 0)", False),  # a hollow too small to sample
+    ],
 )
 def test_a_field_without_a_surface_in_the_bounds_is_not_applied(
-    server: viser.ViserServer, scene: SdfGalleryScene, body: str, side: str
+    server: viser.ViserServer, scene: SdfGalleryScene, body: str, side: str, between: bool
 ) -> None:
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("Apply")
         apply_glsl(client, f"float sdf(vec3 p) {{ {body} }}\n")
         wait_until(lambda: scene.editor_error is not None, "the refusal", timeout_s=30.0)
         assert "no surface lies inside the bounds" in str(scene.editor_error)
-        assert side in str(scene.editor_error) and "±1.5 m" in str(scene.editor_error)
+        assert f"every sample of the ±1.5 m box is {side}" in str(scene.editor_error)
+        assert ("smaller than the sample spacing" in str(scene.editor_error)) is between
         assert "0 triangles" not in scene.editor_status.content and "Applied" not in scene.editor_status.content
         assert scene.editor_serial == 0 and len(scene.mesh_faces) > 500  # the primitives' mesh stays
+
+
+@pytest.mark.gl
+def test_a_colour_that_is_not_finite_is_not_applied_and_says_so(
+    server: viser.ViserServer, scene: SdfGalleryScene
+) -> None:
+    # Once: the mesher raised a plain ValueError for the NaN colours; Apply kept its old status and said nothing.
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Apply")
+        apply_glsl(
+            client, "float sdf(vec3 p) { return length(p) - 0.5; }\nvec3 color(vec3 p) { return vec3(0.0/0.0); }\n"
+        )
+        wait_until(lambda: scene.editor_error is not None, "the refusal", timeout_s=30.0)
+        assert "color() returned NaN or infinity on the surface" in str(scene.editor_error)
+        assert "Not applied" in scene.editor_status.content
+        assert scene.editor_serial == 0 and len(scene.mesh_faces) > 500  # the primitives' mesh stays
+
+
+@pytest.mark.gl
+def test_apply_and_a_shown_field_use_the_editor_bounds_on_screen(
+    server: viser.ViserServer, scene: SdfGalleryScene
+) -> None:
+    # Once: Apply meshed in the bounds of the last field applied; the slider counted only from the next mesh.
+    source = "float sdf(vec3 p) { return length(p) - 0.4; }\n"
+    with BrowserClient(server.get_port()) as client:
+        apply_glsl(client, source)
+        wait_until(lambda: scene.editor_serial == 1, "the first apply")
+        assert scene.params.editor.half_size == 1.5
+        spacing = 3.0 / (scene.params.resolution - 1)
+        assert np.abs(np.linalg.norm(scene.mesh_vertices, axis=1) - 0.4).max() < spacing
+        first = len(scene.mesh_faces)
+        # The bounds on a field on screen: it is meshed in them at once.
+        meshes = scene.mesh_serial
+        client.set_value("Editor bounds half size (m)", 3.0)
+        wait_until(lambda: scene.mesh_serial > meshes and scene.params.editor.half_size == 3.0, "the remesh")
+        wide = np.ptp(scene.mesh_vertices, axis=0)
+        assert np.all(np.abs(wide - 0.8) < 6.0 / (scene.params.resolution - 1))  # the same sphere, coarser
+        assert len(scene.mesh_faces) < 0.5 * first  # on a grid twice as coarse: about a quarter the triangles
+        # Apply meshes and ray-marches in the bounds on screen.
+        client.set_value("Editor bounds half size (m)", 0.5)
+        wait_until(lambda: scene.params.editor.half_size == 0.5, "the narrow bounds")
+        apply_glsl(client, "float sdf(vec3 p) { return length(p) - 0.41; }\n")
+        wait_until(lambda: scene.editor_serial == 2, "the second apply")
+        assert scene.params.editor.half_size == 0.5 and scene.params.editor_half_size == 0.5
+        radii = np.linalg.norm(scene.mesh_vertices, axis=1)
+        assert np.abs(radii - 0.41).max() < 1.0 / (scene.params.resolution - 1)
 
 
 _ODD = st.one_of(
