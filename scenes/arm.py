@@ -125,7 +125,7 @@ class SolveReport:
     ghost_error_m: float
     """Distance of the ghost's end from the target (m)."""
     ghost_gap_m: float
-    """Distance from the ghost's elbow to the chain's middle joint (m); for two links, FABRIK's elbow."""
+    """Distance from the ghost's elbow to the chain's middle joint (m); for two links, the solver's elbow."""
     best_history: tuple[NDArray[np.float64], NDArray[np.float64]] = (np.zeros(1), np.zeros(1))
     """(iterations (K,), error (K,) m): the error of the pose the solver would return after that many iterations,
     the best admissible one it has seen (:func:`admissible_history`); the last is ``result.error``."""
@@ -958,7 +958,7 @@ is a static pose.
 
     def _ghost_markdown(self, report: SolveReport) -> str:
         r = report.result
-        which = "FABRIK's elbow" if self.params.n_links == 2 else "the chain's middle joint"
+        which = f"{self.params.solver}'s elbow" if self.params.n_links == 2 else "the chain's middle joint"
         return (
             f"Two-bone ghost (analytic, one step): end error **{report.ghost_error_m * 1000.0:.3f} mm** "
             f"vs {r.error * 1000.0:.3f} mm; its elbow is **{report.ghost_gap_m * 1000.0:.1f} mm** from {which}."

@@ -79,6 +79,18 @@ def test_two_links_ghost_is_the_fabrik_solution(scene: ArmScene) -> None:
     assert "FABRIK's elbow" in scene.ghost_readout.content
 
 
+@pytest.mark.parametrize("solver", ["CCD", "Jacobian DLS"])
+def test_the_ghost_readout_names_the_solver_it_compares_with(scene: ArmScene, solver: str) -> None:
+    # Once: it said "FABRIK's elbow" whichever solver had placed the elbow.
+    scene.controls["n_links"].value = 2
+    scene.controls["solver"].value = solver
+    assert scene.params.solver == solver
+    assert f"from {solver}'s elbow." in scene.ghost_readout.content
+    assert "FABRIK" not in scene.ghost_readout.content
+    scene.controls["n_links"].value = 3
+    assert "from the chain's middle joint." in scene.ghost_readout.content
+
+
 def test_more_links_and_joint_limits(scene: ArmScene) -> None:
     scene.controls["n_links"].value = MAX_LINKS
     scene.controls["half_angle_deg"].value = 30.0
