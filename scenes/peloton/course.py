@@ -132,6 +132,9 @@ class CourseMode:
         self.playing = False
         self.play_time_s = 0.0
         self.message = ""
+        """Why the last file was not loaded, in the panel (Markdown); empty once one is."""
+        self.refusal = ""
+        """The same, as plain text, for the notification to the tab that uploaded it."""
         self.solve_note: tuple[float, float, str] | None = None
         """(target min, power W, what it says) of the last 'Find the power' whose target lay outside the power
         input's range: the readout says it while that target and that power are still set."""
@@ -386,9 +389,13 @@ class CourseMode:
     def _on_sample(self) -> None:
         self.load(course_kernel.SAMPLE_ROUTE.read_bytes(), SAMPLE_LABEL)
 
-    def _on_upload(self, _event: object = None) -> None:
+    def _on_upload(self, event: object = None) -> None:
         """An upload arrived (viser's thread pool). Parse it off the scene's lock, since gpxpy needs seconds for a
-        large file, then install it (or the reason it failed) as a guarded callback. Nothing escapes."""
+        large file, then install it (or the reason it failed) as a guarded callback. Nothing escapes.
+
+        A refused file is also told to the tab that sent it, in a notification: viser's own "uploaded successfully"
+        shows there for any file that arrived whole."""
+        client = getattr(event, "client", None)
         # The number and the file are taken together: a higher number is a newer file.
         with self._upload_lock:
             self._upload_seq += 1
@@ -412,7 +419,9 @@ class CourseMode:
         def install() -> None:
             if seq != self._upload_seq:  # a newer upload arrived while this one parsed: it wins
                 return
-            self._install(route, error, name)
+            if not self._install(route, error, name) and isinstance(client, viser.ClientHandle):
+                body = self.refusal if len(self.refusal) <= 500 else self.refusal[:499] + "…"
+                client.add_notification("GPX not loaded", body, color="red", auto_close_seconds=15.0)
 
         self.scene.callback(install)(None)
 
@@ -433,6 +442,7 @@ class CourseMode:
                 error = str(failure)
         if route is None or state is None:
             reason = str(error).removeprefix("the file: ")  # the file is named already
+            self.refusal = f"{label} was not loaded: {reason}. Still showing {self.route.name}."
             self.message = (
                 f"**{_escape(label)}** was not loaded: {_escape(reason)}. Still showing **{_escape(self.route.name)}**."
             )
@@ -530,7 +540,7 @@ class CourseMode:
         """Where the Position slider puts the riders (m), cleaned."""
         raw = self.scrub.value
         ok = isinstance(raw, (int, float)) and not isinstance(raw, bool) and math.isfinite(raw)
-        return 1000.0 * float(np.clip(raw if ok else 0.0, 0.0, self._total_km()))
+        return min(1000.0 * float(np.clip(raw if ok else 0.0, 0.0, self._total_km())), self.route.total_distance_m)
 
     def _on_scrub(self) -> None:
         if self.state is None:
@@ -566,7 +576,9 @@ class CourseMode:
 
     # ----------------------------------------------------------------------------------------- drawing
     def _total_km(self) -> float:
-        return math.floor(self.route.total_distance_m / 10.0) / 100.0
+        """The Position slider's end: the route's length rounded up to the slider's 10 m step, so the finish is on
+        it (a position past the finish is the finish)."""
+        return math.ceil(self.route.total_distance_m / 10.0 - 1e-9) / 100.0
 
     def leader_distance_m(self) -> float:
         if self.state is None:

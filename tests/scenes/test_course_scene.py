@@ -4,6 +4,7 @@ bad files), play / pause / scrub, air and model choices, the shared paceline, an
 from __future__ import annotations
 
 import math
+import re
 import threading
 import time
 
@@ -250,6 +251,12 @@ def test_a_bad_upload_from_a_browser_is_reported(
             lambda: any("was not loaded" in str(e["props"].get("_markdown", "")) for e in client.gui.values()),
             what="the message",
         )
+        # Told where viser's own "uploaded successfully" shows too (once, that was all a person saw there).
+        client.wait_for(lambda: bool(client.notices()), what="the notification")
+        (notice,) = client.notices()
+        assert notice["title"] == "GPX not loaded" and notice["color"] == "red"
+        assert notice["body"].startswith(f"{kind}.gpx was not loaded: ")
+        assert re.search(message, notice["body"]) and notice["body"].endswith(f"Still showing {good.name}.")
     assert mode.route is good
     assert message.split()[0] in mode.route_info.content
     assert not [r for r in caplog.records if r.levelname == "ERROR"]
@@ -290,7 +297,7 @@ def test_crafted_scrub_positions_are_clamped(server: viser.ViserServer, mode: Co
             d = mode.leader_distance_m()
             assert 0.0 <= d <= mode.route.total_distance_m
             if value == 1e9:
-                assert d == pytest.approx(mode.route.total_distance_m, abs=10.0)
+                assert d == pytest.approx(mode.route.total_distance_m, rel=1e-12)
             elif value == -3.0:
                 assert d == 0.0
             else:
@@ -341,6 +348,19 @@ def test_the_newest_upload_wins_when_an_older_parse_finishes_last(
         assert older_done.wait(5.0)
         time.sleep(0.3)  # the older parse's install, had it been allowed, has run by now
     assert mode.route.name == "Newer hill" and mode.route_label == "newer.gpx"
+
+
+# Kind: a place on the route the Position slider cannot reach. Its end was the length rounded down to its 10 m
+# step, 1–9 m short of the finish (a 2,127 m route ended at 2.12 km).
+@pytest.mark.parametrize("n", [2, 3, 17, 300, 1001])
+def test_the_position_slider_reaches_the_finish_of_any_route(mode: CourseMode, n: int) -> None:
+    assert mode.load(hill_gpx(f"Hill of {n}", n), "hill.gpx")
+    total_m = mode.route.total_distance_m
+    assert total_m / 1000.0 <= mode.scrub.max < total_m / 1000.0 + 0.01
+    assert mode.scrub.max * 100.0 == pytest.approx(round(mode.scrub.max * 100.0), abs=1e-9)  # on its 0.01 km step
+    mode.scrub.value = mode.scrub.max
+    assert mode.leader_distance_m() == pytest.approx(total_m, rel=1e-12)
+    assert mode.state is not None and mode.play_time_s == pytest.approx(mode.state.ride.time_s, rel=1e-12)
 
 
 # Kind: state left over from the last course. The Position slider goes back to 0 with a new course.
