@@ -12,6 +12,7 @@ under a microsecond per argument here.
 from __future__ import annotations
 
 import math
+import numbers
 import reprlib
 from typing import Any, TypeVar
 
@@ -25,6 +26,7 @@ __all__ = [
     "finite_array",
     "finite_number",
     "flag",
+    "holds_booleans",
     "indices",
     "instance",
     "integer",
@@ -148,12 +150,36 @@ def non_negative(name: str, value: object) -> float:
     return number
 
 
+def holds_booleans(value: object) -> bool:
+    """Whether ``value`` is a boolean, a boolean array or a (nested) list or tuple holding one: numpy would turn a
+    ``[1.0, True, 2.0]`` into floats, and a flag where a number belongs is a caller's bug."""
+    if isinstance(value, np.ndarray):
+        return value.dtype == np.bool_
+    if isinstance(value, (list, tuple)):
+        for item in value:  # a plain loop: this runs on every kick's three vectors
+            kind = type(item)
+            if kind is bool or kind is np.bool_:
+                return True
+            if (kind is list or kind is tuple or kind is np.ndarray) and holds_booleans(item):
+                return True
+        return False
+    return isinstance(value, (bool, np.bool_))
+
+
+def _is_real(item: object) -> bool:
+    return isinstance(item, numbers.Real) and not isinstance(item, (bool, np.bool_))
+
+
 def finite_array(name: str, value: ArrayLike) -> NDArray[np.float64]:
     """Real numbers of any shape as float64, all finite; bool, complex, text and ragged input are refused."""
     try:
+        if isinstance(value, (list, tuple)) and holds_booleans(value):
+            raise TypeError("a boolean")
         array: Any = np.asarray(value)
         if array.dtype.kind not in "fiuO":
             raise TypeError(array.dtype)
+        if array.dtype.kind == "O" and not all(_is_real(item) for item in array.flat):
+            raise TypeError("not a real number")  # None would become NaN, and be called "not finite"
         array = np.asarray(array, dtype=np.float64)
     except (TypeError, ValueError, OverflowError) as error:
         raise ValueError(f"{name} must be an array of real numbers, got {shown(value)}") from error

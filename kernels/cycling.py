@@ -436,11 +436,18 @@ SPEED_FOR_POWER_DOMAIN: dict[str, tuple[float, float]] = {
 …) still apply. Within them no intermediate of the solver overflows or underflows to a wrong answer."""
 
 
+_POSITIVE = frozenset({"mass_kg", "air_density", "wheel_radius_m", "cda_m2"})
+"""Arguments that must be > 0: a domain's range (closed) may start at 0 for them, and 0 itself is refused."""
+
+
 def _check_domain(function: str, domain: dict[str, tuple[float, float]], **values: ArrayLike) -> None:
-    """``ValueError`` naming the first of ``values`` that is not finite or lies outside its ``domain`` range."""
+    """``ValueError`` naming the first of ``values`` that is not finite, not > 0 where it must be, or outside its
+    ``domain`` range."""
     for name, value in values.items():
         low, high = domain[name]
         array = _finite(name, value)
+        if name in _POSITIVE and np.any(array <= 0.0):  # else -80 kg was told a range [0, …] that holds 0
+            raise ValueError(f"{name} must be > 0, got {_checks.shown(value)}")
         if np.any((array < low) | (array > high)):
             raise ValueError(f"{name} must be in [{low:g}, {high:g}] for {function}, got {_checks.shown(value)}")
 

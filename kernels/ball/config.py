@@ -68,32 +68,17 @@ constant beyond) and no kick comes near 10 (S = 1e3 is ~2·10⁵ rev/s at 25 m/s
 
 
 # --------------------------------------------------------------------------------------------- validation
-def _booleans(value: object) -> bool:
-    """Whether ``value`` is a boolean array or a sequence holding booleans (refused like a bool scalar)."""
-    if isinstance(value, np.ndarray):
-        return value.dtype == np.bool_
-    if isinstance(value, (list, tuple)):
-        for item in value:  # a plain loop: this runs on every kick's three vectors
-            kind = type(item)
-            if kind is bool or kind is np.bool_:
-                return True
-            if (kind is list or kind is tuple or kind is np.ndarray) and _booleans(item):
-                return True
-        return False
-    return isinstance(value, (bool, np.bool_))
-
-
 def checked_vector(name: str, value: ArrayLike, size: int) -> NDArray[np.float64]:
-    """:func:`kernels._checks.vector`, and no boolean anywhere inside (special to this kernel: numpy turns a
-    ``[1.0, True, 2.0]`` into floats, and a flag where a coordinate belongs is a caller's bug)."""
-    if _booleans(value):
+    """:func:`kernels._checks.vector`, saying in the ball's words when a boolean is inside
+    (:func:`kernels._checks.holds_booleans`)."""
+    if _checks.holds_booleans(value):
         raise ValueError(f"{name} must be numbers, not booleans, got {_checks.shown(value)}")
     return _checks.vector(name, value, size)
 
 
 def checked_rows(name: str, value: ArrayLike) -> NDArray[np.float64]:
     """:func:`kernels._checks.points` with the same boolean guard as :func:`checked_vector`."""
-    if _booleans(value):
+    if _checks.holds_booleans(value):
         raise ValueError(f"{name} must be numbers, not booleans")
     return _checks.points(name, value, 3)
 

@@ -22,7 +22,6 @@ from kernels.ball.config import (
     MEASURED,
     RADIUS,
     Model,
-    _booleans,
     checked_vector,
     flight_config,
 )
@@ -39,7 +38,7 @@ centre), and a size-5 football's usual model (Cross 2002)."""
 
 def _real_array(name: str, value: ArrayLike, *, non_negative: bool = False) -> NDArray[np.float64]:
     """Finite float64 array (any shape) from ``value``, refusing booleans anywhere in it; ≥ 0 if asked."""
-    if _booleans(value):
+    if _checks.holds_booleans(value):
         raise ValueError(f"{name} must be numbers, not booleans, got {_checks.shown(value)}")
     return _checks.non_negative_array(name, value) if non_negative else _checks.finite_array(name, value)
 

@@ -456,7 +456,8 @@ def _segment_power(power_w: ArrayLike, n_segments: int) -> NDArray[np.float64]:
     if power.shape != (n_segments,):
         raise ValueError(f"power_w must be a number or shape ({n_segments},), got shape {power.shape}")
     if not np.all(np.isfinite(power)) or np.any(power <= 0.0):
-        raise ValueError("power_w must be finite and > 0 (W)")
+        shown = repr(power_w) if np.ndim(power_w) == 0 else _checks.shown(power)
+        raise ValueError(f"power_w must be finite and > 0 (W), got {shown}")
     if np.any(power > MAX_POWER_W):
         shown = repr(power_w) if np.ndim(power_w) == 0 else _checks.shown(power)
         raise ValueError(f"power_w must be at most {MAX_POWER_W:g} W, got {shown}")

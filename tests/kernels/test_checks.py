@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from fractions import Fraction
+from typing import Any
 
 import numpy as np
 import pytest
@@ -162,3 +163,34 @@ def test_a_direction_is_a_unit_vector_along_any_finite_non_zero_vector(value: li
         # u_i · |v| / max|v| = v_i / max|v|: compared where the component is not lost below the largest's ulp
         norm = math.sqrt(float(sum((x / largest) ** 2 for x in exact)))
         assert got == pytest.approx(float(v / largest) / norm, rel=1e-15, abs=1e-15)
+
+
+# Kind: a value that is not a number, called "not finite" (None became NaN in an object array) or taken as one
+# (numpy turns [1.0, True] into [1.0, 1.0]).
+@pytest.mark.parametrize(
+    "value",
+    [
+        None,
+        [1.0, None],
+        (None, None),
+        np.array([1.0, None], dtype=object),
+        [True, 1.0],
+        (1.0, [2.0, False]),
+        [[1.0, 2.0], [3.0, np.True_]],
+        ["1.0"],
+        [1.0, 2 + 0j],
+    ],
+    ids=repr,
+)
+def test_what_is_not_a_real_number_is_refused_as_such(value: Any) -> None:
+    with pytest.raises(ValueError, match=r"^speed_ms must be an array of real numbers, got "):
+        _checks.finite_array("speed_ms", value)
+
+
+@pytest.mark.parametrize(
+    ("value", "expected"),
+    [([1, 2**80], [1.0, 2.0**80]), ([Fraction(1, 4), 2], [0.25, 2.0]), (np.array([1.0, 2], dtype=object), [1.0, 2.0])],
+    ids=repr,
+)
+def test_real_numbers_of_any_python_kind_are_taken(value: Any, expected: list[float]) -> None:
+    np.testing.assert_array_equal(_checks.finite_array("speed_ms", value), expected)

@@ -217,6 +217,15 @@ def test_a_power_beyond_the_maximum_is_refused_by_name_at_once(power_w: Any) -> 
     assert time.perf_counter() - start < 1.0
 
 
+# Kind: a refusal that does not quote the value it refused.
+@pytest.mark.parametrize(("power_w", "quoted"), [(0, "0"), (-5.0, "-5.0"), (math.nan, "nan"), (-math.inf, "-inf")])
+def test_a_power_not_above_zero_is_refused_quoting_it(power_w: float, quoted: str) -> None:
+    sample = course.load_gpx(course.SAMPLE_ROUTE)
+    for ride in (course.ride, course.paced_ride):
+        with pytest.raises(ValueError, match=rf"^power_w must be .*, got {quoted}$"):
+            ride(sample, power_w)
+
+
 def test_the_maximum_power_rides_the_sample() -> None:
     sample = course.load_gpx(course.SAMPLE_ROUTE)
     pacing = course.paced_ride(sample, course.MAX_POWER_W)

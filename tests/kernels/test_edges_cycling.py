@@ -370,6 +370,23 @@ def test_power_refuses_every_argument_past_its_domain_by_name(
             function(**{**POWER_BASE, name: value})
 
 
+# Kind: a refusal that tells a range holding the refused value. −80 kg was told "in [0, 1e+06]" while 0 kg is
+# refused ("must be > 0"): every argument that must be > 0 says so for any value ≤ 0, in every function.
+@pytest.mark.parametrize(("function", "domain"), FORWARD, ids=["power", "martin_power"])
+@pytest.mark.parametrize("value", [0.0, -0.0, -5e-324, -80.0, -1.7e308])
+def test_an_argument_that_must_be_positive_says_so_for_any_value_not_above_zero(
+    function: Callable[..., Any], domain: dict, value: float
+) -> None:
+    positive = [name for name in domain if name in ("mass_kg", "cda_m2", "air_density", "wheel_radius_m")]
+    assert "mass_kg" in positive and "cda_m2" in positive
+    for name in positive:
+        with pytest.raises(ValueError, match=rf"^{name} must be > 0, got "):
+            function(**{**POWER_BASE, name: value})
+    for name in ("mass_kg", "cda_m2"):
+        with pytest.raises(ValueError, match=rf"^{name} must be > 0, got "):
+            cycling.speed_for_power(250.0, **{**{k: POWER_BASE[k] for k in ("cda_m2", "mass_kg", "crr")}, name: value})
+
+
 @pytest.mark.parametrize(
     ("call", "message"),
     [
