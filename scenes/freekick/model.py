@@ -402,6 +402,39 @@ def wall_passed_s(state: KickState, played: ball.Trajectory) -> float | None:
     return _plane_crossed_s(state.wall, played)
 
 
+def wall_height_words(state: KickState) -> str:
+    """The ball's height where it meets the wall's plane, for the readout: the kick's own line (the free flight), or
+    the played-on ball's (the pale line) where that bounced first or the free flight lands short of the wall."""
+    o, played = state.outcome, state.played
+    bounced = played is not None and any(
+        e.kind == "ground" and (o.wall_time is None or e.t < o.wall_time) for e in played.events
+    )
+    if o.wall_point is not None and not bounced:
+        return f"{o.wall_point[2]:.2f} m"
+    if played is None or not bounced:
+        return "never reaches the wall"
+    struck = next((e for e in played.events if e.kind == "wall"), None)
+    if struck is not None:
+        return f"{struck.position[2]:.2f} m, after bouncing, into a defender (pale line)"
+    crossed = wall_passed_s(state, played)
+    if crossed is not None:
+        return f"{position_at(played, crossed)[2]:.2f} m, after bouncing (pale line)"
+    return "never reaches the wall"
+
+
+def landing_words(state: KickState) -> str:
+    """Where a kick that never reaches the goal line first comes down: on a pitch that is the played ball's first
+    bounce, unless something (the wall) touched it first; then it is where the kick's own line would land."""
+    t, short = float(state.flight.t[-1]), -float(state.flight.position[-1, 0])
+    played = state.played
+    first = played.events[0] if played is not None and played.events else None
+    if first is not None and first.kind == "ground" and abs(first.t - t) < 1e-3:
+        return f"First bounce after **{t:.2f} s**, {short:.1f} m short of the goal line"
+    if first is not None and first.t < t:
+        return f"In free flight it would land after **{t:.2f} s**, {short:.1f} m short"
+    return f"Lands after **{t:.2f} s**, {short:.1f} m short"  # nothing touched it before (or no pitch)
+
+
 def _plane_crossed_s(panel: ball.Panel, played: ball.Trajectory) -> float | None:
     """When (s) the played-on ball's centre first crosses ``panel``'s plane along its normal, None if never."""
     normal, _along = wall_axes(panel)

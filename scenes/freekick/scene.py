@@ -59,6 +59,7 @@ from scenes.freekick.model import (
     keeper_words,
     knuckle_ticked,
     knuckle_wobble_m,
+    landing_words,
     map_marker_words,
     odds_map_settings,
     odds_map_words,
@@ -76,6 +77,7 @@ from scenes.freekick.model import (
     strike_chances,
     verdict_words,
     wall_axes,
+    wall_height_words,
     wobble_path,
     wobble_words,
 )
@@ -721,7 +723,6 @@ reads it again, so a ball that bounces in front of him beats him more often than
         played = state.played
         result = played.result if played is not None and played.result in VERDICT_WORDS else o.result
         reached = goal_line_reached(state)  # then the played ball crossed where the free flight does
-        wall_height = "never reaches the wall" if o.wall_point is None else f"{o.wall_point[2]:.2f} m"
         margin = save_margin_s(state)
         if result == "saved" and margin is not None:
             headline = f"Saved: the keeper reached it {margin:.2f} s early"
@@ -732,7 +733,7 @@ reads it again, so a ball that bounces in front of him beats him more often than
             lines.append(f"In free flight through the goal plane: {verdict_words(o.result, o.goal_point)}")
         lines += [
             "",
-            f"Height at the wall: **{wall_height}** (wall top {state.wall.height_m:.2f} m)",
+            f"Height at the wall: **{wall_height_words(state)}** (wall top {state.wall.height_m:.2f} m)",
         ]
         if reached and o.goal_point is not None and o.goal_time is not None:
             lines.append(
@@ -740,9 +741,7 @@ reads it again, so a ball that bounces in front of him beats him more often than
                 f"**{o.goal_time:.2f} s**"
             )
         elif o.goal_point is None:
-            lines.append(
-                f"Lands after **{float(state.flight.t[-1]):.2f} s**, {-state.flight.position[-1, 0]:.1f} m short"
-            )
+            lines.append(landing_words(state))
         deflection = deflection_m(state)
         if deflection is not None:
             lines.append(f"Sideways against the no-spin kick: **{deflection:+.2f} m** (+ = left)")

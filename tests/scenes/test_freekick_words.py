@@ -195,3 +195,75 @@ def test_the_map_says_where_its_keeper_flatters_far_spots() -> None:
     assert with_keeper.startswith("Best spot: **35 m, on the centre line: goal 90 %**")
     assert ODDS_MAP_CAVEAT in with_keeper and "straight on" in ODDS_MAP_CAVEAT
     assert ODDS_MAP_CAVEAT not in odds_map_words(chance, FreeKickParams(keeper=False))
+
+
+# Kind: lines of one readout about two different paths. A kick driven into the turf read "Height at the wall: never
+# reaches the wall" and "Lands after 0.00 s" (its free flight) beside "GOAL" and a keeper line about the ball
+# "after it passes the wall" (the ball played on, which bounced). The wall and landing lines now say which path,
+# and a path that reaches the wall's plane is never said not to.
+def _wall_crossing_height(state: object, played: ball.Trajectory) -> float | None:
+    """The played ball's centre height where it first crosses the wall's plane toward the goal, by linear
+    interpolation between its samples (the test's own reckoning)."""
+    wall = state.wall  # type: ignore[attr-defined]
+    normal = np.array(wall.normal_xy) / np.hypot(*wall.normal_xy)
+    side = (played.position[:, :2] - np.array(wall.centre_xy)) @ normal
+    past = np.flatnonzero((side[:-1] < 0.0) & (side[1:] >= 0.0))
+    if not len(past):
+        return None
+    i = int(past[0])
+    f = -side[i] / (side[i + 1] - side[i])
+    return float(played.position[i, 2] + f * (played.position[i + 1, 2] - played.position[i, 2]))
+
+
+@pytest.mark.parametrize(
+    ("distance_m", "angle_deg", "speed_ms", "elevation_deg"),
+    [
+        (12.0, 45.0, 40.0, -5.0),  # the report's kick: into the turf at once, then in
+        (20.0, 0.0, 30.0, 2.0),
+        (16.0, 0.0, 10.0, -5.0),
+        (30.0, -30.0, 20.0, 0.0),
+        (22.0, 0.0, 25.0, 17.0),  # over the wall in the air: the free flight's height
+        (25.0, 10.0, 5.0, 30.0),  # a lob that lands short of the wall
+        (20.0, 0.0, 30.0, 2.0),  # bounces, then into a defender's feet
+        (20.0, 0.0, 6.0, 10.0),  # bounces and stops short of the wall
+        (12.0, 0.0, 16.0, 15.0),  # into the wall in the air: its own line would land beyond
+        (12.0, 0.0, 8.0, 15.0),  # bounces once, then into the wall
+    ],
+)
+def test_the_wall_and_landing_lines_describe_the_path_they_name(
+    freekick: FreeKickScene, distance_m: float, angle_deg: float, speed_ms: float, elevation_deg: float
+) -> None:
+    readout = _show(
+        freekick, distance_m=distance_m, angle_deg=angle_deg, speed_ms=speed_ms, elevation_deg=elevation_deg
+    )
+    state = freekick.state
+    played, free = state.played, state.outcome
+    assert played is not None
+    line = next(text for text in readout.splitlines() if text.startswith("Height at the wall"))
+    bounced = any(e.kind == "ground" and (free.wall_time is None or e.t < free.wall_time) for e in played.events)
+    if free.wall_point is not None and not bounced:
+        assert line.startswith(f"Height at the wall: **{free.wall_point[2]:.2f} m**")
+    else:
+        struck = [e for e in played.events if e.kind == "wall"]
+        height = _wall_crossing_height(state, played)
+        if struck:
+            z = struck[0].position[2]
+            assert line.startswith(f"Height at the wall: **{z:.2f} m, after bouncing, into a defender (pale line)**")
+        elif height is None:
+            assert "never reaches the wall" in line
+        else:
+            assert line.startswith(f"Height at the wall: **{height:.2f} m, after bouncing (pale line)**")
+    if "never reaches the wall" in line:
+        assert "passes the wall" not in readout
+    landing = [text for text in readout.splitlines() if "short" in text and "after **" in text]
+    if free.goal_point is None:
+        (said,) = landing
+        first, down = (played.events[0] if played.events else None), float(state.flight.t[-1])
+        if said.startswith("First bounce"):
+            assert first is not None and first.kind == "ground" and abs(first.t - down) < 1e-3
+        elif said.startswith("In free flight it would land"):
+            assert first is not None and first.kind != "ground" and first.t < down
+        else:
+            assert said.startswith("Lands after") and (first is None or first.t >= down)
+    else:
+        assert not landing
