@@ -202,6 +202,9 @@ class Renderer:
         self._raymarch_vao: dict[tuple[bool, bool, bool, bool], object] = {}
         self._fields: collections.OrderedDict[tuple[str, str], tuple[object, object]] = collections.OrderedDict()
         """Compiled editor programs by (source, variant), least recently used first."""
+        self._field_scales: collections.OrderedDict[tuple[str, bytes], float] = collections.OrderedDict()
+        """What each editor field is multiplied by to march, by (source, bounds' bytes): 1 / its largest gradient
+        where :func:`mesh_glsl` measured one far from 1 (a field that is not a distance), least recently used first."""
         self.renderer_name = str(self.ctx.info.get("GL_RENDERER", "unknown"))
         self._target_size: tuple[int, int] | None = None
         self._target_objects: list = []
@@ -651,6 +654,14 @@ class Renderer:
             old_prog.release()  # pyright: ignore[reportAttributeAccessIssue]
         return prog, vao
 
+    def remember_field_scale(self, source: str, bounds: NDArray[np.float64], scale: float) -> None:
+        """Keep what :meth:`render_field` multiplies ``source``'s field by in ``bounds`` (see there)."""
+        key = (source, np.asarray(bounds, dtype=np.float64).tobytes())
+        self._field_scales[key] = scale
+        self._field_scales.move_to_end(key)
+        while len(self._field_scales) > _FIELD_CACHE:
+            self._field_scales.popitem(last=False)
+
     def compile_field(self, source: str, shading: Shading | None = None) -> None:
         """Check and compile an editor source (its sampling programs and the ray-march for ``shading``'s shadow and
         occlusion switches), or raise ValueError saying why and where."""
@@ -711,6 +722,10 @@ class Renderer:
     ) -> tuple[NDArray[np.uint8], NDArray[np.float32]]:
         """Ray-march the editor's field inside ``bounds`` ((2, 3) min and max corners, m), as :meth:`render` does.
 
+        A field :func:`mesh_glsl` has meshed in these bounds and found far from a distance (its largest gradient
+        outside [0.5, 1.5], e.g. 1e30·sdf or 1e-6·sdf) is marched divided by that gradient, as it is meshed: a
+        sphere tracer's steps are the field's values, so 1e30·sdf overshot every surface and 1e-6·sdf stopped short.
+
         Returns:
             RGB (H, W, 3) uint8 and depth along the view axis (H, W) float32 (m), inf where a ray misses.
         """
@@ -723,6 +738,7 @@ class Renderer:
         prog, vao = self._field_program(source, f"march:{int(shading.shadows)}:{int(shading.occlusion)}")
         self._set(prog, "u_field_lo", tuple(float(v) for v in box[0]))
         self._set(prog, "u_field_hi", tuple(float(v) for v in box[1]))
+        self._set(prog, "u_field_scale", self._field_scales.get((source, box.tobytes()), 1.0))
         return self._march(prog, vao, camera, width, height, shading, _box_scissor(camera, box, width, height))
 
 
@@ -788,6 +804,9 @@ def mesh_glsl(source: str, resolution: int, bounds: ArrayLike) -> trimesh.Trimes
         lipschitz = _lipschitz_estimate(field, grid.spacing)
         if math.isfinite(lipschitz) and (lipschitz > 1.5 or 0.0 < lipschitz < 0.5):
             field = (field / np.float32(lipschitz)).astype(np.float32)
+            gl.remember_field_scale(source, box, 1.0 / lipschitz)
+        else:
+            gl.remember_field_scale(source, box, 1.0)
         try:
             vertices, faces = sdf.mesh_samples(grid, field, _near_surface_mask(field, grid.spacing))
         except RuntimeError:  # scikit-image's "No surface found at the given iso value"
