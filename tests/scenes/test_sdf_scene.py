@@ -833,6 +833,25 @@ def test_apply_and_a_shown_field_use_the_editor_bounds_on_screen(
         assert np.abs(radii - 0.41).max() < 1.0 / (scene.params.resolution - 1)
 
 
+@pytest.mark.gl
+@pytest.mark.parametrize("k", ["1e30", "1e-6"])
+def test_a_typed_field_far_from_a_distance_agrees_with_its_mesh(
+    server: viser.ViserServer, scene: SdfGalleryScene, k: str
+) -> None:
+    # Once: k·sdf applied, and the ray-march beside its correct mesh read IoU 0.0000 (1e30) or 0.07 (1e-6).
+    with BrowserClient(server.get_port()) as client:
+        client.send_camera(position=(2.3, -2.5, 1.7), look_at=(0.0, 0.0, 0.0), size=(600, 800))
+        apply_glsl(client, f"float sdf(vec3 p) {{ return {k} * (length(p) - 0.5); }}\n")
+        wait_until(lambda: scene.editor_serial == 1, "the apply", timeout_s=60.0)
+        serial = scene.reference_serial
+        wait_until(
+            lambda: scene.reference_serial > serial and scene.agreement.iou is not None, "its reference", timeout_s=90
+        )
+        a = scene.agreement
+        assert a.iou is not None and a.iou > 0.97
+        assert a.depth_diff_voxels is not None and a.depth_diff_voxels < 0.2
+
+
 _ODD = st.one_of(
     st.floats(allow_nan=True, allow_infinity=True),
     st.integers(-(2**70), 2**70),
