@@ -207,12 +207,9 @@ def _wall_crossing_height(state: object, played: ball.Trajectory) -> float | Non
     wall = state.wall  # type: ignore[attr-defined]
     normal = np.array(wall.normal_xy) / np.hypot(*wall.normal_xy)
     side = (played.position[:, :2] - np.array(wall.centre_xy)) @ normal
-    past = np.flatnonzero((side[:-1] < 0.0) & (side[1:] >= 0.0))
-    if not len(past):
-        return None
-    i = int(past[0])
-    f = -side[i] / (side[i + 1] - side[i])
-    return float(played.position[i, 2] + f * (played.position[i + 1, 2] - played.position[i, 2]))
+    crossings = np.flatnonzero((side[:-1] < 0.0) & (side[1:] >= 0.0))
+    i = int(crossings[0]) if crossings.size else None
+    return None if i is None else float(np.interp(0.0, side[i : i + 2], played.position[i : i + 2, 2]))
 
 
 @pytest.mark.parametrize(
