@@ -21,8 +21,8 @@ float sdf(vec3 p);
 vec3 color(vec3 p);
 uniform vec3 u_field_lo;  // the editor's bounds (m)
 uniform vec3 u_field_hi;
-uniform float u_field_scale;  // 1, or 1 / the largest gradient the mesher measured for a field far from a distance
-#define FIELD_DISTANCE(p) (sdf(p) * u_field_scale)
+uniform float u_field_gradient;  // 1, or the largest gradient the mesher measured for a field far from a distance
+#define FIELD_DISTANCE(p) (sdf(p) / u_field_gradient)  // a division: 1 / 1e38 is below float32's normal range
 #define FIELD_COLOR(p) color(p)
 #else
 #define FIELD_DISTANCE(p) scene_distance(p)

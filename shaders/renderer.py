@@ -202,9 +202,9 @@ class Renderer:
         self._raymarch_vao: dict[tuple[bool, bool, bool, bool], object] = {}
         self._fields: collections.OrderedDict[tuple[str, str], tuple[object, object]] = collections.OrderedDict()
         """Compiled editor programs by (source, variant), least recently used first."""
-        self._field_scales: collections.OrderedDict[tuple[str, bytes], float] = collections.OrderedDict()
-        """What each editor field is multiplied by to march, by (source, bounds' bytes): 1 / its largest gradient
-        where :func:`mesh_glsl` measured one far from 1 (a field that is not a distance), least recently used first."""
+        self._field_gradients: collections.OrderedDict[tuple[str, bytes], float] = collections.OrderedDict()
+        """What each editor field is divided by to march, by (source, bounds' bytes): its largest gradient where
+        :func:`mesh_glsl` measured one far from 1 (a field that is not a distance), least recently used first."""
         self.renderer_name = str(self.ctx.info.get("GL_RENDERER", "unknown"))
         self._target_size: tuple[int, int] | None = None
         self._target_objects: list = []
@@ -654,13 +654,14 @@ class Renderer:
             old_prog.release()  # pyright: ignore[reportAttributeAccessIssue]
         return prog, vao
 
-    def remember_field_scale(self, source: str, bounds: NDArray[np.float64], scale: float) -> None:
-        """Keep what :meth:`render_field` multiplies ``source``'s field by in ``bounds`` (see there)."""
+    def remember_field_gradient(self, source: str, bounds: NDArray[np.float64], gradient: float) -> None:
+        """Keep what :meth:`render_field` divides ``source``'s field by in ``bounds`` (see there), at most the largest
+        float32."""
         key = (source, np.asarray(bounds, dtype=np.float64).tobytes())
-        self._field_scales[key] = scale
-        self._field_scales.move_to_end(key)
-        while len(self._field_scales) > _FIELD_CACHE:
-            self._field_scales.popitem(last=False)
+        self._field_gradients[key] = min(gradient, float(np.finfo(np.float32).max))
+        self._field_gradients.move_to_end(key)
+        while len(self._field_gradients) > _FIELD_CACHE:
+            self._field_gradients.popitem(last=False)
 
     def compile_field(self, source: str, shading: Shading | None = None) -> None:
         """Check and compile an editor source (its sampling programs and the ray-march for ``shading``'s shadow and
@@ -738,7 +739,7 @@ class Renderer:
         prog, vao = self._field_program(source, f"march:{int(shading.shadows)}:{int(shading.occlusion)}")
         self._set(prog, "u_field_lo", tuple(float(v) for v in box[0]))
         self._set(prog, "u_field_hi", tuple(float(v) for v in box[1]))
-        self._set(prog, "u_field_scale", self._field_scales.get((source, box.tobytes()), 1.0))
+        self._set(prog, "u_field_gradient", self._field_gradients.get((source, box.tobytes()), 1.0))
         return self._march(prog, vao, camera, width, height, shading, _box_scissor(camera, box, width, height))
 
 
@@ -797,16 +798,19 @@ def mesh_glsl(source: str, resolution: int, bounds: ArrayLike) -> trimesh.Trimes
         field = gl.sample_field(source, grid)
         if not np.all(np.isfinite(field)):
             raise ShaderCompileError("sdf() returned NaN or infinity inside the bounds", None)
+        outside = field > 0.0
+        if not outside.any() or outside.all():  # one side everywhere (0 is inside; 0 everywhere was meshed as a blob)
+            return sdf.mesh_trimesh(np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64), np.zeros((0, 3)))
         # Marching cubes places vertices from the corners' values by linear interpolation, so a positive scale of
         # the field changes nothing but the kernel's level nudge (a thousandth of a voxel, in metres): a field far
         # from a distance (|∇d| not near 1, e.g. 100·sdf or 0.001·sdf) is scaled to one first, so K·sdf meshes as
         # sdf does.
-        lipschitz = _lipschitz_estimate(field, grid.spacing)
+        lipschitz = lipschitz_estimate(field, grid.spacing)
         if math.isfinite(lipschitz) and (lipschitz > 1.5 or 0.0 < lipschitz < 0.5):
             field = (field / np.float32(lipschitz)).astype(np.float32)
-            gl.remember_field_scale(source, box, 1.0 / lipschitz)
+            gl.remember_field_gradient(source, box, lipschitz)
         else:
-            gl.remember_field_scale(source, box, 1.0)
+            gl.remember_field_gradient(source, box, 1.0)
         try:
             vertices, faces = sdf.mesh_samples(grid, field, _near_surface_mask(field, grid.spacing))
         except RuntimeError:  # scikit-image's "No surface found at the given iso value"
@@ -846,7 +850,7 @@ def _near_surface_mask(field: NDArray[np.float32], spacing: float) -> NDArray[np
     return mask
 
 
-def _lipschitz_estimate(field: NDArray[np.float32], spacing: float) -> float:
+def lipschitz_estimate(field: NDArray[np.float32], spacing: float) -> float:
     """The largest gradient norm of ``field`` by forward differences over its grid (field units per m), in slabs of
     float64 (no overflow for huge fields, a bounded extra memory)."""
     nx = field.shape[0]

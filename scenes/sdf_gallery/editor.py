@@ -10,6 +10,7 @@ field on the GL thread.
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import numpy as np
 
@@ -128,24 +129,27 @@ def trial_source(
 
 
 def _no_surface(field: EditorField, resolution: int) -> str:
-    """Why a field gave no mesh, from the signs of the samples the mesher read (all one sign: no surface crossed)."""
+    """Why a field gave no mesh, from the samples the mesher read: all on one side of the surface (0 is inside), and
+    where the nearest comes within two sample spacings of a surface (in metres: the values divided by the field's
+    largest gradient), that a shape or hollow may fall between samples."""
     grid = sdf.make_grid(sdf.default_scene(), resolution, field.bounds)  # the mesher's grid (the scene is unused)
     samples = gl_service.run(lambda gl: gl.sample_field(field.source, grid))
     box = f"the ±{field.half_size:g} m box"
-    if float(samples.min()) > 0.0:
-        nearest = float(samples.min())
-        why = f"every sample of {box} is outside (sdf > 0)"
-        if nearest < 2.0 * grid.spacing:  # within two samples: a surface may lie between them
-            why += (
-                f"; the nearest comes within {nearest:.3g} m of the surface, so a shape smaller than the sample "
-                f"spacing ({grid.spacing:.3g} m) may fall between samples: shrink the bounds or raise the mesh "
-                "resolution"
-            )
-    elif float(samples.max()) <= 0.0:
-        why = f"every sample of {box} is inside (sdf ≤ 0)"
-    else:
-        why = f"sdf() changes sign in {box} only where no surface can be placed"
-    return f"no surface lies inside the bounds: {why}, so there is nothing to mesh (change sdf() or the bounds)"
+    lowest, highest = float(samples.min()), float(samples.max())
+    if lowest == highest == 0.0:
+        return f"no surface lies inside the bounds: sdf() is 0 at every sample of {box}, so there is nothing to mesh"
+    side = "outside (sdf > 0)" if lowest > 0.0 else "inside (sdf ≤ 0)"
+    message = f"no surface lies inside the bounds: every sample of {box} is {side}, so there is nothing to mesh"
+    gradient = gl_renderer.lipschitz_estimate(samples, grid.spacing)
+    nearest = (lowest if lowest > 0.0 else -highest) / (gradient if 0.0 < gradient < math.inf else 1.0)
+    if nearest < 2.0 * grid.spacing:
+        shape = "shape" if lowest > 0.0 else "hollow"
+        return (
+            f"{message}. The field comes within about {nearest:.3g} m of a surface: a {shape} smaller than the "
+            f"sample spacing ({grid.spacing:.3g} m) may fall between samples; shrink the bounds or raise the mesh "
+            "resolution"
+        )
+    return f"{message} (change sdf() or the bounds)"
 
 
 def mesh_field(field: EditorField, resolution: int) -> tuple[np.ndarray, ...]:

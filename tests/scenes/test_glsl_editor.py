@@ -344,7 +344,8 @@ def _sphere_depth(camera: Camera) -> tuple[NDArray[np.float64], NDArray[np.float
 
 @pytest.mark.gl
 @pytest.mark.parametrize(
-    ("k", "meshed"), [(1.0, False), (1.0, True), (1e30, True), (1e6, True), (3.0, True), (0.2, True), (1e-6, True)]
+    ("k", "meshed"),
+    [(1.0, False), (1.0, True), (1e38, True), (1e30, True), (1e6, True), (3.0, True), (0.2, True), (1e-6, True)],
 )
 def test_the_field_raymarch_is_the_analytic_sphere_at_any_scale_once_meshed(k: float, meshed: bool) -> None:
     # Once: 1e30·sdf meshed as the sphere but ray-marched to nothing (every step overshot), and 1e-6·sdf stopped

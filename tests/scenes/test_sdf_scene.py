@@ -770,7 +770,8 @@ def test_apply_of_a_text_over_the_source_limit_says_its_length_and_the_limit(
         # said "inside", read from the field at the box's centre alone.
         ("return length(p) - 0.01;", "outside (sdf > 0)", True),
         ("return length(p - vec3(0.7, -0.3, 0.2)) - 0.0001;", "outside (sdf > 0)", True),
-        ("return 0.01 - length(p);", "inside (sdf ≤ 0)", False),  # a hollow too small to sample
+        ("return 1000.0 * (length(p) - 0.01);", "outside (sdf > 0)", True),  # near in metres, not in values
+        ("return 0.01 - length(p);", "inside (sdf ≤ 0)", True),  # a hollow too small to sample
     ],
 )
 def test_a_field_without_a_surface_in_the_bounds_is_not_applied(
@@ -780,10 +781,25 @@ def test_a_field_without_a_surface_in_the_bounds_is_not_applied(
         client.wait_for_gui("Apply")
         apply_glsl(client, f"float sdf(vec3 p) {{ {body} }}\n")
         wait_until(lambda: scene.editor_error is not None, "the refusal", timeout_s=30.0)
-        assert "no surface lies inside the bounds" in str(scene.editor_error)
-        assert f"every sample of the ±1.5 m box is {side}" in str(scene.editor_error)
-        assert ("smaller than the sample spacing" in str(scene.editor_error)) is between
+        error = str(scene.editor_error)
+        assert error.startswith(f"no surface lies inside the bounds: every sample of the ±1.5 m box is {side}, so ")
+        assert ("smaller than the sample spacing (0.0476 m) may fall between samples" in error) is between
+        assert error.endswith("raise the mesh resolution" if between else "(change sdf() or the bounds)")
         assert "0 triangles" not in scene.editor_status.content and "Applied" not in scene.editor_status.content
+        assert scene.editor_serial == 0 and len(scene.mesh_faces) > 500  # the primitives' mesh stays
+
+
+@pytest.mark.gl
+def test_a_field_that_is_zero_everywhere_is_not_applied(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
+    # Once: "return 0.0;" was applied, meshed for 18 s into a blob of 17,420 triangles filling the box.
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Apply")
+        apply_glsl(client, "float sdf(vec3 p) { return 0.0; }\n")
+        wait_until(lambda: scene.editor_error is not None, "the refusal", timeout_s=30.0)
+        assert str(scene.editor_error) == (
+            "no surface lies inside the bounds: sdf() is 0 at every sample of the ±1.5 m box, so there is nothing to "
+            "mesh"
+        )
         assert scene.editor_serial == 0 and len(scene.mesh_faces) > 500  # the primitives' mesh stays
 
 
@@ -834,7 +850,7 @@ def test_apply_and_a_shown_field_use_the_editor_bounds_on_screen(
 
 
 @pytest.mark.gl
-@pytest.mark.parametrize("k", ["1e30", "1e-6"])
+@pytest.mark.parametrize("k", ["1e38", "1e30", "1e-6"])
 def test_a_typed_field_far_from_a_distance_agrees_with_its_mesh(
     server: viser.ViserServer, scene: SdfGalleryScene, k: str
 ) -> None:
