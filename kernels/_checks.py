@@ -36,6 +36,7 @@ __all__ = [
     "positive",
     "positive_array",
     "positive_vector",
+    "real_array",
     "shown",
     "vector",
 ]
@@ -170,8 +171,10 @@ def _is_real(item: object) -> bool:
     return isinstance(item, numbers.Real) and not isinstance(item, (bool, np.bool_))
 
 
-def finite_array(name: str, value: ArrayLike) -> NDArray[np.float64]:
-    """Real numbers of any shape as float64, all finite; bool, complex, text and ragged input are refused."""
+def real_array(name: str, value: ArrayLike, what: str = "an array of real numbers") -> NDArray[np.float64]:
+    """Real numbers of any shape as float64, not yet checked finite. Bool (anywhere in a list), complex, text, None,
+    other objects and ragged input are refused with ``ValueError`` saying ``name`` must be ``what``: numpy would take
+    True as 1 and None as NaN (then called "not finite"), drop an imaginary part, or raise its own error."""
     try:
         if isinstance(value, (list, tuple)) and holds_booleans(value):
             raise TypeError("a boolean")
@@ -179,10 +182,15 @@ def finite_array(name: str, value: ArrayLike) -> NDArray[np.float64]:
         if array.dtype.kind not in "fiuO":
             raise TypeError(array.dtype)
         if array.dtype.kind == "O" and not all(_is_real(item) for item in array.flat):
-            raise TypeError("not a real number")  # None would become NaN, and be called "not finite"
-        array = np.asarray(array, dtype=np.float64)
+            raise TypeError("not a real number")
+        return np.asarray(array, dtype=np.float64)
     except (TypeError, ValueError, OverflowError) as error:
-        raise ValueError(f"{name} must be an array of real numbers, got {shown(value)}") from error
+        raise ValueError(f"{name} must be {what}, got {shown(value)}") from error
+
+
+def finite_array(name: str, value: ArrayLike) -> NDArray[np.float64]:
+    """:func:`real_array`, all finite."""
+    array = real_array(name, value)
     if not np.isfinite(array).all():
         if array.ndim == 0:
             raise ValueError(f"{name} must be finite, got {shown(value)}")

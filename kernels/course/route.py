@@ -261,13 +261,7 @@ def _checked_points(name: str, arrays: dict[str, ArrayLike], n_min: int = 2) -> 
     out: dict[str, NDArray[np.float64]] = {}
     shape = None
     for key, value in arrays.items():
-        try:
-            array = np.asarray(value)
-            if array.dtype.kind not in "fiu":  # True was a metre and "10" ten of them
-                raise TypeError(array.dtype)
-            array = np.asarray(array, dtype=np.float64)
-        except (TypeError, ValueError) as error:
-            raise ValueError(f"{key} must be an array of numbers") from error
+        array = _checks.real_array(key, value, "an array of numbers")  # True was a metre and "10" ten of them
         if array.ndim != 1:
             raise ValueError(f"{key} must be one-dimensional, got shape {array.shape}")
         if shape is not None and array.shape != shape:

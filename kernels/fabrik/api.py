@@ -489,10 +489,10 @@ def _check_vector(name: str, value: ArrayLike, dim: int) -> NDArray[np.float64]:
 
 
 def _check_length(name: str, value: float) -> float:
-    number = bounded_array(name, value, _LARGEST)
-    if number.shape != () or float(number) < 0.0:
-        raise ValueError(f"{name} must be a finite number ≥ 0, got {_checks.shown(value)}")
-    return float(number)
+    number = _checks.finite_number(name, value)  # a scalar: "a finite number", not "an array" (True, None, [1.0])
+    if not 0.0 <= number <= _LARGEST:
+        raise ValueError(f"{name} must be a finite number in [0, {_LARGEST:g}], got {_checks.shown(value)}")
+    return number
 
 
 def _root_direction(value: ArrayLike | None, dim: int) -> NDArray[np.float64]:

@@ -62,13 +62,7 @@ def distance_array(name: str, value: ArrayLike) -> FloatArray:
     infinite distance (a point too far away for float64) is an answer they define, never NaN: the hard and smooth
     booleans give what ``min``/``max`` give (a union with −inf is −inf, an intersection with +inf is +inf, a
     subtraction of −inf leaves +inf), and rounding or an onion of ±inf is ±inf or +inf."""
-    try:
-        array = np.asarray(value)
-        if array.dtype.kind not in "fiu":
-            raise TypeError(array.dtype)
-        array = np.asarray(array, dtype=np.float64)
-    except (TypeError, ValueError, OverflowError) as error:
-        raise ValueError(f"{name} must be real distances (m), got {_checks.shown(value)}") from error
+    array = _checks.real_array(name, value, "real distances (m)")
     if np.any(np.isnan(array)):
         raise ValueError(f"{name} must not be NaN")
     return array

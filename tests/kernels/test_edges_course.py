@@ -265,3 +265,12 @@ def test_a_weather_reading_below_the_standard_atmospheres_range_is_taken_where_i
     assert reading.density([0.0])[0] < at_reading  # thinner up the road
     with pytest.raises(ValueError, match=r"^altitude_m must be in \[-10000, 30000\] m"):
         course.Air("weather", 15.0, 1013.0, 0.5, altitude_m=-20000.0)
+
+
+# Kind: a flag taken as a coordinate (True was latitude 1°), and a refusal that did not quote the value.
+@pytest.mark.parametrize("bad", [[0.0, True], [0.0, None], ["0", "1"]], ids=repr)
+def test_a_route_refuses_what_is_not_numbers_quoting_it(bad: Any) -> None:
+    with pytest.raises(ValueError, match=r"^latitude_deg must be an array of numbers, got \["):
+        course.course_from_points(bad, [0.0, 0.01], [0.0, 0.0])
+    with pytest.raises(ValueError, match=r"^elevation_m must be an array of numbers, got \["):
+        course.course_from_xy([0.0, 100.0], [0.0, 100.0], bad)

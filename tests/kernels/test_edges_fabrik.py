@@ -55,3 +55,14 @@ def test_link_lengths_of_a_chain_and_a_batch() -> None:
     # Scaled before the squares: neither 1e149 m nor 1e-160 m is lost.
     np.testing.assert_allclose(fabrik.link_lengths([[0.0, 0.0], [3e149, 4e149]]), [5e149], rtol=1e-15)
     np.testing.assert_allclose(fabrik.link_lengths([[0.0, 0.0], [3e-160, 4e-160]]), [5e-160], rtol=1e-15)
+
+
+# Kind: a scalar argument told it must be an array ("upper_length must be an array of real numbers, got True").
+@pytest.mark.parametrize("bad", [True, None, "1", [1.0], math.nan, -1.0], ids=repr)
+def test_a_two_bone_length_is_refused_as_a_number(bad: Any) -> None:
+    for name in ("upper_length", "lower_length"):
+        lengths = {"upper_length": 1.0, "lower_length": 1.0, name: bad}
+        with pytest.raises(ValueError, match=rf"^{name} must be a finite number"):
+            fabrik.two_bone(
+                [0.0, 0.0, 0.0], lengths["upper_length"], lengths["lower_length"], [1.0, 1.0, 0.0], [0, 0, 1]
+            )

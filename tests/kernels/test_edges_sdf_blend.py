@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 import warnings
+from typing import Any
 
 import numpy as np
 import pytest
@@ -356,3 +357,18 @@ def test_a_timedelta_width_is_refused_by_name(name: str) -> None:
     # numpy's timedelta64 is an integer type: accepted as a number, then float() raised TypeError.
     with pytest.raises(ValueError, match=r"^k must be a finite number"):
         getattr(sdf, name)(0.3, 0.5, np.timedelta64(1, "s"))
+
+
+# Kind: a flag taken as a distance. numpy made [1.0, True] two distances of 1 m; None in a list a NaN.
+@pytest.mark.parametrize("bad", [[1.0, True], [[0.5], [np.True_]], [1.0, None]], ids=repr)
+def test_booleans_or_none_in_a_list_of_distances_are_refused_by_name(bad: Any) -> None:
+    good = [0.5, 0.5]
+    for call, side in [
+        (lambda: sdf.smin_poly(bad, good, 0.1), "a"),
+        (lambda: sdf.smin_poly(good, bad, 0.1), "b"),
+        (lambda: sdf.smin_exp(bad, good, 0.1), "a"),
+        (lambda: sdf.op_round(bad, 0.1), "d"),
+        (lambda: sdf.op_onion(bad, 0.1), "d"),
+    ]:
+        with pytest.raises(ValueError, match=rf"^{side} must be real distances \(m\), got "):
+            call()
