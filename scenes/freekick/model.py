@@ -687,11 +687,13 @@ def chances_words(odds: ball.Odds) -> str:
 
 
 def play_words(played: ball.Trajectory | None) -> str:
-    """What the kick did once it touched something, in words: "hits the left post at 1.8 m, goes in"."""
+    """What the kick did once it touched something, in words: "hits the left post at 1.8 m, goes in"; contacts that
+    read alike in a row are said once, counted ("hits a defender at 0.3 m twice"), and two defenders met at one
+    instant (the ball between them) as such."""
     if played is None or not played.events:
         return ""
     phrases: list[str] = []
-    bounces = 0
+    bounces, repeats, last_t = 0, 1, math.nan
     for event in played.events:
         _, y, z = event.position
         if event.kind == "ground":
@@ -701,12 +703,22 @@ def play_words(played: ball.Trajectory | None) -> str:
             phrases.append("bounces" if bounces == 1 else f"bounces {bounces}×")
             bounces = 0
         side = "left" if y > 0 else "right"
-        if event.kind == "post":
-            phrases.append(f"hits the {side} post at {z:.1f} m")
-        elif event.kind == "bar":
-            phrases.append(f"hits the bar {abs(y):.1f} m {side} of centre")
-        elif event.kind == "wall":
-            phrases.append(f"hits a defender at {z:.1f} m")
+        phrase = {
+            "post": f"hits the {side} post at {z:.1f} m",
+            "bar": f"hits the bar {abs(y):.1f} m {side} of centre",
+            "wall": f"hits a defender at {z:.1f} m",
+        }.get(event.kind)
+        if phrase is None:
+            continue
+        if event.kind == "wall" and event.t == last_t and phrases and phrases[-1] == phrase:
+            phrases[-1] = f"hits two defenders at {z:.1f} m"  # at once: the ball between them
+            continue
+        last_t = event.t
+        repeats = repeats + 1 if phrases and phrases[-1].startswith(phrase) else 1
+        if repeats > 1:
+            phrases[-1] = f"{phrase} twice" if repeats == 2 else f"{phrase} {repeats}×"
+        else:
+            phrases.append(phrase)
     ending = {
         "net": "ends in the net",
         "out": "goes out of play",

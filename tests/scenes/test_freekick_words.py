@@ -19,6 +19,7 @@ from scenes.freekick.model import (
     compute_kick,
     keeper_words,
     odds_map_words,
+    play_words,
 )
 
 
@@ -264,3 +265,25 @@ def test_the_wall_and_landing_lines_describe_the_path_they_name(
             assert said.startswith("Lands after") and (first is None or first.t >= down)
     else:
         assert not landing
+
+
+# Kind: one contact said twice. A ball between two defenders touches both at one instant, and read "hits a defender
+# at 0.3 m, hits a defender at 0.3 m".
+def test_contacts_that_read_alike_are_said_once() -> None:
+    params = dataclasses.replace(
+        FreeKickParams(), distance_m=22.0, speed_ms=20.0, elevation_deg=8.0, azimuth_deg=0.0, spin_rev_s=0.0
+    )
+    played = compute_kick(params).played
+    assert played is not None and [e.kind for e in played.events[:2]] == ["wall", "wall"]
+    assert played.events[0].t == played.events[1].t
+    assert play_words(played).startswith("Hits two defenders at 0.3 m, bounces")
+    # The same contact again later, and a third time: counted, not repeated.
+    post = ball.Event(1.0, "post", (0.0, 3.6, 1.5))
+    again = dataclasses.replace(played, events=(post, dataclasses.replace(post, t=1.2)))
+    assert play_words(again).startswith("Hits the left post at 1.5 m twice, ")
+    thrice = dataclasses.replace(
+        played, events=(post, dataclasses.replace(post, t=1.2), dataclasses.replace(post, t=1.4))
+    )
+    assert play_words(thrice).startswith("Hits the left post at 1.5 m 3×, ")
+    alternating = dataclasses.replace(played, events=(post, ball.Event(1.1, "ground", (0.0, 3.0, 0.11)), post))
+    assert play_words(alternating).startswith("Hits the left post at 1.5 m, bounces, hits the left post at 1.5 m, ")
