@@ -184,7 +184,9 @@ def real_array(name: str, value: ArrayLike, what: str = "an array of real number
         if array.dtype.kind == "O" and not all(_is_real(item) for item in array.flat):
             raise TypeError("not a real number")
         return np.asarray(array, dtype=np.float64)
-    except (TypeError, ValueError, OverflowError) as error:
+    except OverflowError as error:  # a Python int past float64 (10**400): a real number, but not a finite float
+        raise ValueError(f"{name} must be finite (within float64's range), got {shown(value)}") from error
+    except (TypeError, ValueError) as error:
         raise ValueError(f"{name} must be {what}, got {shown(value)}") from error
 
 

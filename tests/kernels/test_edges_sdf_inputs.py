@@ -478,3 +478,19 @@ def test_a_zero_light_direction_and_a_background_outside_the_unit_cube_are_refus
         Shading(light_direction=(0.0, 0.0, 0.0))
     with pytest.raises(ValueError, match=r"^background must"):
         Shading(background=(0.5, 0.5, 1.5))
+
+
+# Kind: a refusal that implies a value would pass. A direction of length 100 was told "of magnitude ≤ 2", and then
+# one of length 1.5 "must be unit vectors".
+@pytest.mark.parametrize("length", [0.0, 0.5, 1.5, 1.99, 2.5, 100.0, 1e200, 1.7e308])
+def test_a_ray_direction_that_is_not_unit_is_refused_as_such(length: float) -> None:
+    scene = sdf.Scene((sdf.Primitive("sphere", (0.0, 0.0, 0.0), (0.5,)),))
+    with pytest.raises(ValueError, match=r"^directions must be unit vectors, got "):
+        sdf.sphere_trace(scene, [[0.0, 0.0, -3.0]], [[0.0, 0.0, length]])
+    assert np.isfinite(sdf.sphere_trace(scene, [[0.0, 0.0, -3.0]], [[0.0, 0.0, 1.0]])).all()
+
+
+# Kind: a real number called "not a real number": a Python int past float64 is refused as not finite.
+def test_an_integer_past_float64_is_refused_as_not_finite() -> None:
+    with pytest.raises(ValueError, match=r"^p must be finite \(within float64's range\), got "):
+        sdf.sd_sphere([[10**400, 0, 0]], 0.5)
