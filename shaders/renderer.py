@@ -806,11 +806,10 @@ def mesh_glsl(source: str, resolution: int, bounds: ArrayLike) -> trimesh.Trimes
         # from a distance (|∇d| not near 1, e.g. 100·sdf or 0.001·sdf) is scaled to one first, so K·sdf meshes as
         # sdf does.
         lipschitz = lipschitz_estimate(field, grid.spacing)
-        if math.isfinite(lipschitz) and (lipschitz > 1.5 or 0.0 < lipschitz < 0.5):
+        far = math.isfinite(lipschitz) and (lipschitz > 1.5 or 0.0 < lipschitz < 0.5)
+        if far:
             field = (field / np.float32(lipschitz)).astype(np.float32)
-            gl.remember_field_gradient(source, box, lipschitz)
-        else:
-            gl.remember_field_gradient(source, box, 1.0)
+        gl.remember_field_gradient(source, box, lipschitz if far else 1.0)
         try:
             vertices, faces = sdf.mesh_samples(grid, field, _near_surface_mask(field, grid.spacing))
         except RuntimeError:  # scikit-image's "No surface found at the given iso value"

@@ -444,24 +444,23 @@ def _segments(course: Course, rider: Rider, wind_ms: float, wind_from_deg: float
 
 def _segment_power(power_w: ArrayLike, n_segments: int) -> NDArray[np.float64]:
     # Special to a ride: one number for the whole course or one per segment, so not a kernels._checks shape.
-    try:
-        power = np.asarray(power_w)
-        if power.dtype.kind not in "fiu":  # True rode as 1 W, "250" as 250 W, a complex power lost its imaginary part
-            raise TypeError(power.dtype)
-        power = np.asarray(power, dtype=np.float64)
-    except (TypeError, ValueError) as error:
-        raise ValueError(f"power_w must be a number or an array of numbers, got {type(power_w).__name__}") from error
-    if power.ndim == 0:
+    # True rode as 1 W, "250" as 250 W, a complex power lost its imaginary part.
+    power = _checks.real_array("power_w", power_w, "a number or an array of numbers")
+    scalar = power.ndim == 0
+    if scalar:
         power = np.full(n_segments, float(power))
     if power.shape != (n_segments,):
         raise ValueError(f"power_w must be a number or shape ({n_segments},), got shape {power.shape}")
     if not np.all(np.isfinite(power)) or np.any(power <= 0.0):
-        shown = repr(power_w) if np.ndim(power_w) == 0 else _checks.shown(power)
-        raise ValueError(f"power_w must be finite and > 0 (W), got {shown}")
+        raise ValueError(f"power_w must be finite and > 0 (W), got {_shown_power(power_w, power, scalar)}")
     if np.any(power > MAX_POWER_W):
-        shown = repr(power_w) if np.ndim(power_w) == 0 else _checks.shown(power)
-        raise ValueError(f"power_w must be at most {MAX_POWER_W:g} W, got {shown}")
+        raise ValueError(f"power_w must be at most {MAX_POWER_W:g} W, got {_shown_power(power_w, power, scalar)}")
     return np.ascontiguousarray(power)
+
+
+def _shown_power(power_w: ArrayLike, power: NDArray[np.float64], scalar: bool) -> str:
+    """A refused power as given (one number) or in brief (one per segment)."""
+    return repr(power_w) if scalar else _checks.shown(power)
 
 
 def _ride(course: Course, power: NDArray[np.float64], s: _Segments, max_speed: float, start: float) -> Ride:

@@ -205,7 +205,6 @@ reads it again, so a ball that bounces in front of him beats him more often than
         """The odds shown for the map's settings: the kick struck many times with a player's scatter."""
         self.knuckle_spin: float | None = None
         """The spin (rev/s) that ticking Knuckleball set, while the kick still has it; None once anything else has."""
-        """Says so when ticking Knuckleball has just set the spin near zero."""
         self.last_target: tuple[float, float] | None = None
         self.aim_message = ""
         self._odds_version = 0

@@ -540,7 +540,7 @@ class CourseMode:
         """Where the Position slider puts the riders (m), cleaned."""
         raw = self.scrub.value
         ok = isinstance(raw, (int, float)) and not isinstance(raw, bool) and math.isfinite(raw)
-        return min(1000.0 * float(np.clip(raw if ok else 0.0, 0.0, self._total_km())), self.route.total_distance_m)
+        return float(np.clip(1000.0 * (raw if ok else 0.0), 0.0, self.route.total_distance_m))
 
     def _on_scrub(self) -> None:
         if self.state is None:
