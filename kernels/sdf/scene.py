@@ -375,15 +375,16 @@ def sphere_trace(
 
 
 def default_scene() -> Scene:
-    """The gallery's opening scene: a sphere, a box, a torus lying flat and a capsule, smoothly united."""
-    # A quarter turn about x takes local y to world z: the torus lies flat.
+    """The gallery's opening scene: a sphere, a box, a torus lying flat and a standing capsule, smoothly united;
+    from the gallery's opening camera each is in sight, none behind another."""
+    # A quarter turn about x takes local y to world z: the torus lies flat and the capsule (along local y) stands.
     flat = (math.cos(math.pi / 4), math.sin(math.pi / 4), 0.0, 0.0)
     return Scene(
         primitives=(
             Primitive("sphere", (0.0, 0.0, 0.5), (0.45,), color=(0.90, 0.35, 0.30)),
             Primitive("box", (0.6, 0.0, 0.3), (0.3, 0.3, 0.3), color=(0.30, 0.60, 0.90)),
             Primitive("torus", (0.0, 0.0, 0.1), (0.6, 0.12), rotation=flat, color=(0.95, 0.80, 0.30)),
-            Primitive("capsule", (-0.5, 0.2, 0.5), (0.35, 0.15), color=(0.40, 0.80, 0.45)),
+            Primitive("capsule", (-0.55, -0.45, 0.35), (0.3, 0.14), rotation=flat, color=(0.40, 0.80, 0.45)),
         ),
         k=0.25,
         blend="poly",

@@ -13,6 +13,7 @@ import trimesh
 import viser
 from helpers.properties import examples
 from helpers.scenes import apply_glsl, read_glb, scene_fixture
+from helpers.screen_geometry import pinhole_ndc
 from helpers.viser_private import gui_uuid, gui_uuids, node_names
 from helpers.waiting import wait_until
 from helpers.wsclient import BrowserClient
@@ -24,6 +25,7 @@ from trimesh.visual.texture import TextureVisuals
 from kernels import sdf
 from scenes.sdf_gallery import RESOLUTION_LABEL, SdfGalleryParams, SdfGalleryScene
 from shaders import gl_service
+from shaders.camera import camera_rays
 from shaders.renderer import Camera, GLUnavailableError
 
 MESH = "/sdf/mesh"
@@ -421,8 +423,8 @@ def test_each_gizmo_is_sized_coloured_and_named_for_its_own_primitive(
     from scenes.sdf_gallery import GIZMO_MARGIN_M
 
     scales = [g.scale for g in scene.gizmos]
-    # Sphere r = 0.45 m, box half size 0.3 m, torus ring 0.6 + 0.12 m, capsule 0.35 + 0.15 m: each plus the margin.
-    reach = np.array([0.45, 0.3, 0.72, 0.5]) + GIZMO_MARGIN_M
+    # Sphere r = 0.45 m, box half size 0.3 m, torus ring 0.6 + 0.12 m, capsule 0.3 + 0.14 m: each plus the margin.
+    reach = np.array([0.45, 0.3, 0.72, 0.44]) + GIZMO_MARGIN_M
     assert scales == pytest.approx(reach, abs=0.011)
     for i, (marker, label, slot) in enumerate(
         zip(scene.gizmo_markers, scene.gizmo_labels, scene.params.primitives, strict=True)
@@ -440,6 +442,42 @@ def test_each_gizmo_is_sized_coloured_and_named_for_its_own_primitive(
         )
         client.set_value("P1 colour", (10, 200, 30))
         wait_until(lambda: tuple(scene.gizmo_markers[0].color) == (10, 200, 30), "the marker colour")
+
+
+def test_the_opening_view_shows_every_primitive_and_keeps_their_names_apart(scene: SdfGalleryScene) -> None:
+    # Once the capsule stood behind the sphere from the opening camera: three shapes in sight, and the label "P4
+    # capsule" printed over "P1 sphere" at 1280×720.
+    params = SdfGalleryParams()
+    camera = Camera(SdfGalleryScene.camera_position, SdfGalleryScene.camera_look_at)
+    origins, directions = camera_rays(camera, 160, 100)
+    depth = sdf.sphere_trace(params.scene(), origins, directions)
+    hit = np.isfinite(depth)
+    points = origins[hit] + depth[hit, None] * directions[hit]
+    own = np.stack([sdf.scene_distance(sdf.Scene((slot.primitive(),)), points) for slot in params.primitives])
+    shares = np.bincount(own.argmin(axis=0), minlength=len(own)) / hit.sum()
+    assert shares.min() > 0.05, shares  # each primitive is the nearest surface of 5 % or more of the shape's pixels
+    # Each name where viser draws it: at the tip of its gizmo's local z arrow, seen by viser's 75° opening camera.
+    width, height = 1280, 720
+    tips = np.array(
+        [
+            np.asarray(gizmo.position)
+            + trimesh.transformations.quaternion_matrix(gizmo.wxyz)[:3, :3] @ np.asarray(label.position)
+            for gizmo, label in zip(scene.gizmos, scene.gizmo_labels, strict=True)
+        ]
+    )
+    ndc = pinhole_ndc(
+        tips,
+        np.array(SdfGalleryScene.camera_position),
+        np.array(SdfGalleryScene.camera_look_at),
+        math.radians(75.0),
+        width / height,
+    )
+    px = np.stack([ndc[:, 0] * width / 2, ndc[:, 1] * height / 2], axis=1)
+    for i in range(len(px)):
+        for j in range(i):
+            dx, dy = np.abs(px[i] - px[j])
+            # A label such as "P4 capsule" is about 70 px wide and 16 px tall in viser's font.
+            assert dx > 80 or dy > 20, (scene.gizmo_labels[i].text, scene.gizmo_labels[j].text, dx, dy)
 
 
 @pytest.mark.parametrize(
