@@ -30,9 +30,10 @@ def configure_logging() -> None:
     logging.getLogger("websockets").setLevel(logging.WARNING)
 
 
-if __name__ == "__main__" and not {"-h", "--help"} & set(sys.argv[1:]):
+if __name__ == "__main__" and not any(arg in ("-h", "--help") or arg.startswith("--port") for arg in sys.argv[1:]):
     # A first start's compile processes begin before the imports below: about a second in which one of two cores
-    # would idle. main() starts them where this did not (the installed command; start() runs once).
+    # would idle. main() starts them where this did not (the installed command, a --port that may be refused,
+    # --help; start() runs once).
     configure_logging()  # first: a warm cache's loads are logged within the second
     warming.start()
 

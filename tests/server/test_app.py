@@ -150,6 +150,8 @@ def test_a_busy_port_given_explicitly_is_refused_plainly() -> None:
     assert result.returncode == 2
     assert f"Port {port} is already in use" in result.stderr
     assert "Traceback" not in result.stderr + result.stdout
+    # Refused before any compiling: it once logged "compiled kernels ready" first, as if it had started.
+    assert "compil" not in result.stderr + result.stdout
     assert "Open http" not in result.stdout  # it did not quietly serve elsewhere
 
 
