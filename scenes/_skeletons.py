@@ -373,15 +373,15 @@ def usage_colours(usage: NDArray[np.float64], free: NDArray[np.bool_]) -> NDArra
 
 def clean_target(raw: object, planar: bool) -> NDArray[np.float64] | None:
     """A browser-sent position as a world point: three finite numbers inside the world box (y put back to 0 in the
-    plane: a crafted client may send any y), else None."""
+    plane: a crafted client may send any y), else None. Always a new array: the handle's own, changed in place
+    later (a target flattened when 3D is turned off), would leave viser nothing to send."""
     try:
-        point = np.asarray(raw, dtype=np.float64)
+        point = np.array(raw, dtype=np.float64)
     except (TypeError, ValueError):
         return None
     if point.shape != (3,) or not np.all(np.isfinite(point)) or np.any(np.abs(point) > WORLD_LIMIT_M):
         return None
     if planar:
-        point = point.copy()
         point[1] = 0.0
     return point
 

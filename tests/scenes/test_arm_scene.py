@@ -202,6 +202,33 @@ def test_an_off_plane_drag_is_put_back_in_the_plane(server: viser.ViserServer, s
             np.testing.assert_array_equal(np.asarray(scene.target_gizmo.position), (0.7, 0.0, 0.9))
 
 
+def test_leaving_3d_puts_every_gizmo_the_browser_moved_back_on_the_plane(
+    server: viser.ViserServer, scene: ArmScene
+) -> None:
+    # Once the target stayed off the plane in the browser, its y axis locked, while the chain solved for its
+    # projection and read "reached": the scene flattened its target in place, which was the gizmo's own array, so
+    # viser saw no change to send.
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_node("/arm/obstacle_0")
+        client.set_value("3D (free target, sphere obstacles)", True)
+        client.wait_for(lambda: scene.params.three_d, what="3D on")
+        client.drag_transform("/arm/target", [(0.7, 0.8, 0.9)])
+        client.drag_transform("/arm/obstacle_0", [(-0.4, -0.6, 0.5)])
+        client.wait_for(lambda: scene.gizmo_events >= 6, what="both drags handled")
+        client.set_value("3D (free target, sphere obstacles)", False)
+        client.wait_for(lambda: not scene.params.three_d, what="back to the plane")
+        client.wait_for(
+            lambda: client.pose_of("/arm/target")[0][1] == 0.0 and client.pose_of("/arm/obstacle_0")[0][1] == 0.0,
+            what="both gizmos shown on the plane",
+        )
+        assert client.pose_of("/arm/target")[0] == (0.7, 0.0, 0.9)
+        assert client.pose_of("/arm/obstacle_0")[0] == (-0.4, 0.0, 0.5)
+        with scene._lock:
+            np.testing.assert_array_equal(scene.target, (0.7, 0.0, 0.9))
+            assert scene.report is not None
+            assert np.linalg.norm(scene.pose[-1] - scene.target) <= scene.report.result.error + 1e-12
+
+
 @pytest.mark.parametrize(
     "bad",
     [
