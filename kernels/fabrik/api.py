@@ -219,6 +219,14 @@ def solve_batch(
     iterations = np.empty(batch, dtype=np.int64)
     status = np.empty(batch, dtype=np.int64)
     error = np.empty(batch)
+    if batch == 0:  # an empty batch is solved at once, as numpy reduces nothing (every argument still checked)
+        return BatchSolution(
+            joints=chains.copy(),
+            iterations=iterations,
+            error=error,
+            status=np.array(STATUSES)[status],
+            error_history=history,
+        )
     check_reach_span(chains, points, "targets")
     scale, params, centres, radii = _to_unit_scale(p, goal, setup)
     args = (

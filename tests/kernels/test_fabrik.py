@@ -202,6 +202,18 @@ def test_batch_equals_single_solves(n: int, d: int, seed: int, limits: bool) -> 
         np.testing.assert_allclose(batch[i].error_history, single.error_history, atol=1e-12)
 
 
+@pytest.mark.parametrize("solver", ["fabrik", "ccd", "jacobian_dls"])
+@pytest.mark.parametrize("d", [2, 3])
+def test_an_empty_batch_gives_an_empty_solution_as_the_other_batch_kernels_do(solver: str, d: int) -> None:
+    # Once numpy's "zero-size array to reduction operation maximum which has no identity".
+    batch = fabrik.solve_batch(np.zeros((0, 5, d)), np.zeros((0, d)), solver=solver, max_iterations=7)
+    assert batch.joints.shape == (0, 5, d)
+    assert batch.iterations.shape == batch.error.shape == batch.status.shape == (0,)
+    assert batch.error_history.shape == (0, 8)
+    with pytest.raises(ValueError, match="targets must have shape"):
+        fabrik.solve_batch(np.zeros((0, 5, d)), np.zeros((1, d)))
+
+
 def test_single_solve_gives_the_batch_paths_bits_while_dragging_past_obstacles() -> None:
     """``solve`` runs its own one-chain driver; every field must equal a batch of one, bit for bit, on every status."""
     rng = np.random.default_rng(7)
