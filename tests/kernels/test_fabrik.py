@@ -204,7 +204,7 @@ def test_batch_equals_single_solves(n: int, d: int, seed: int, limits: bool) -> 
 
 @pytest.mark.parametrize("solver", ["fabrik", "ccd", "jacobian_dls"])
 @pytest.mark.parametrize("d", [2, 3])
-def test_an_empty_batch_gives_an_empty_solution_as_the_other_batch_kernels_do(solver: str, d: int) -> None:
+def test_an_empty_batch_gives_an_empty_solution_as_the_other_batch_kernels_do(solver: fabrik.Solver, d: int) -> None:
     # Once numpy's "zero-size array to reduction operation maximum which has no identity".
     batch = fabrik.solve_batch(np.zeros((0, 5, d)), np.zeros((0, d)), solver=solver, max_iterations=7)
     assert batch.joints.shape == (0, 5, d)
