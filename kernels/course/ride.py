@@ -171,6 +171,9 @@ class Ride:
     """Kinetic energy at the finish, ½·M·v² (J) (the start is from rest unless asked)."""
     brakes_j: float
     """Taken by the brakes to hold the speed cap (J)."""
+    brakes_w: NDArray[np.float64]
+    """(N − 1,) power the brakes take on each segment to hold the speed cap, time-averaged over it (W at the wheel;
+    0 where the rider does not brake). Over the ride it sums to :attr:`brakes_j`."""
 
     @property
     def average_speed_ms(self) -> float:
@@ -297,10 +300,11 @@ def _ride_core(
     speed,
     elapsed,
     power_out,
+    brake_out,
     energy,
 ):  # pragma: no cover - compiled
-    """Integrate every segment; fills speed/elapsed (N,), power_out (N − 1,) and energy (6,). Returns 0 or the
-    1-based index of a segment that could not be crossed."""
+    """Integrate every segment; fills speed/elapsed (N,), power_out and brake_out (N − 1,) and energy (6,). Returns 0
+    or the 1-based index of a segment that could not be crossed."""
     v0 = v_start
     t = 0.0
     speed[0] = v0
@@ -385,6 +389,7 @@ def _ride_core(
         speed[i + 1] = v
         elapsed[i + 1] = t
         power_out[i] = work / dt_total
+        brake_out[i] = brake / dt_total
     return 0
 
 
@@ -466,7 +471,7 @@ def _shown_power(power_w: ArrayLike, power: NDArray[np.float64], scalar: bool) -
 def _ride(course: Course, power: NDArray[np.float64], s: _Segments, max_speed: float, start: float) -> Ride:
     n = course.n_points
     speed, elapsed = np.empty(n), np.empty(n)
-    power_out, energy = np.empty(n - 1), np.zeros(6)
+    power_out, brake_out, energy = np.empty(n - 1), np.empty(n - 1), np.zeros(6)
     failed = _ride_core_entry(
         s.length,
         s.drag,
@@ -483,6 +488,7 @@ def _ride(course: Course, power: NDArray[np.float64], s: _Segments, max_speed: f
         speed,
         elapsed,
         power_out,
+        brake_out,
         energy,
     )
     if failed:
@@ -506,6 +512,7 @@ def _ride(course: Course, power: NDArray[np.float64], s: _Segments, max_speed: f
         climbing_j=float(energy[_E_CLIMB]),
         kinetic_j=0.5 * s.mass * float(speed[-1]) ** 2,
         brakes_j=float(energy[_E_BRAKE]),
+        brakes_w=brake_out,
     )
 
 

@@ -265,24 +265,36 @@ def place_powers(state: CourseState, at_m: float) -> tuple[np.ndarray, np.ndarra
     """Each place's pedal power in the formation (W), leader first: (n,) where the leader is ``at_m`` (m along the
     route) and (n,) its mean over the ride (by time).
 
-    The group rides at the mean drag of its places, at the group's power P (the ride's); a place with drag area
-    CdA_i needs P + (CdA_i − CdA_group)·a, with a the aero power per m² (½·ρ·(v + w)·|v + w|·v / η): here at the
-    speed v at ``at_m`` (0 at a standing start, where every place needs P), over the ride at each segment's mean
-    speed (:func:`aero_watts_per_m2`), so the places' mean is P. Riders who share the work in turn each average P
-    over the ride. A place that would need less than nothing (a sheltered rider on a descent where the group coasts)
-    shows 0 W: it brakes or sits up.
+    The group rides at the mean drag of its places, at the group's power P (the ride's), less what its brakes take
+    to hold the speed cap, B (:attr:`~kernels.course.Ride.brakes_w`, at the wheel: B/η at the pedals). A place with
+    drag area CdA_i needs P − B/η + (CdA_i − CdA_group)·a, with a the aero power per m² (½·ρ·(v + w)·|v + w|·v / η):
+    here at the speed v at ``at_m`` (0 at a standing start, where every place needs P), and segment by segment
+    over the ride at each one's mean speed (:func:`aero_watts_per_m2`). A place that would need less than nothing (a
+    sheltered rider on a descent, or every rider where the group brakes) pedals 0 W: it brakes or sits up. So the
+    places average the group's power wherever none of them brakes; riders who share the work in turn each average
+    it over the ride.
     """
     ride = state.ride
-    per_m2 = aero_watts_per_m2(ride, state.efficiency)
+    eta = state.efficiency
+    per_m2 = aero_watts_per_m2(ride, eta)
     extra = state.rider_cda_m2 * np.asarray(state.drag) - state.group_cda_m2  # (n,) m²
     segment = int(np.clip(np.searchsorted(ride.distance_m, at_m, side="right") - 1, 0, per_m2.shape[0] - 1))
     v = np.interp(at_m, ride.distance_m, ride.speed_ms)
-    here_per_m2 = float(_per_m2(v, ride.headwind_ms[segment], ride.air_density[segment], state.efficiency))
-    here = float(ride.power_w[segment]) + extra * here_per_m2
+    here_per_m2 = float(_per_m2(v, ride.headwind_ms[segment], ride.air_density[segment], eta))
+    here = float(ride.power_w[segment] - ride.brakes_w[segment] / eta) + extra * here_per_m2
+    group = ride.power_w[:-1] - ride.brakes_w / eta  # (S,) the group's net pedal power on each segment (W)
     seconds = np.diff(ride.elapsed_s)
-    mean_per_m2 = float(np.sum(per_m2 * seconds) / max(float(np.sum(seconds)), 1e-9))
-    mean = ride.average_power_w + extra * mean_per_m2
-    return np.maximum(here, 0.0), np.maximum(mean, 0.0)
+    mean = np.empty_like(extra)
+    rows = max(1, _MEAN_CHUNK // max(group.shape[0], 1))  # places at a time: at most ~1e6 values in flight
+    for start in range(0, extra.shape[0], rows):
+        needs = group[None, :] + extra[start : start + rows, None] * per_m2[None, :]
+        mean[start : start + rows] = np.maximum(needs, 0.0) @ seconds
+    mean /= max(float(np.sum(seconds)), 1e-9)
+    return np.maximum(here, 0.0), mean
+
+
+_MEAN_CHUNK = 1_000_000
+"""How many (place, segment) needs :func:`place_powers` holds at once (8 MB)."""
 
 
 def format_duration(seconds: float) -> str:

@@ -227,6 +227,22 @@ def test_energy_balance_over_a_closed_loop(rider: Rider) -> None:
     assert work * rider.drivetrain_efficiency == pytest.approx(balance, rel=1e-9)
     assert r.drivetrain_j == pytest.approx(work * (1 - rider.drivetrain_efficiency), rel=1e-12)
     assert np.all(v <= cap + 1e-12)
+    # Segment by segment, the brakes take what the wheel gets and the terms and the speed change do not.
+    per_segment = sum(
+        f_mean / v_mean * reach + f_cap / cap * hold
+        for f_mean, f_cap in zip(
+            wheel_power(v_mean, rider, rho, headwind, theta),
+            wheel_power(np.full_like(v_mean, cap), rider, rho, headwind, theta),
+            strict=True,
+        )
+    )
+    speeds = np.concatenate(([6.0], v[1:]))
+    kinetic_per_segment = 0.5 * rider.effective_mass_kg * np.diff(speeds**2)
+    braked = rider.drivetrain_efficiency * r.power_w[:-1] * dt - per_segment - kinetic_per_segment
+    assert r.brakes_w.shape == dt.shape and np.all(r.brakes_w >= 0.0)
+    np.testing.assert_allclose(r.brakes_w * dt, braked, rtol=0, atol=1e-9 * power * dt.max())
+    assert np.sum(r.brakes_w * dt) == pytest.approx(r.brakes_j, rel=1e-12)
+    assert np.count_nonzero(r.brakes_w) >= 3 and np.all(r.brakes_w[v[1:] < cap] == 0.0)
 
 
 def descent_time_by_ode(c: course.Course, rider: Rider, power: float, v0: float, cap: float) -> float:

@@ -616,6 +616,50 @@ def _place_watts_reference(mode: CourseMode, at_m: float) -> tuple[np.ndarray, n
     return here, mean
 
 
+@pytest.mark.parametrize(("shape", "n"), [("Single file", 4), ("Bunch (peloton)", 40)])
+def test_where_the_group_brakes_no_place_pedals_and_each_places_mean_counts_only_its_pedalling(
+    mode: CourseMode, shape: str, n: int
+) -> None:
+    # The failing input (an outside tester): 5.5 km at −30 %, 250 W. At 5 km the group held the 72 km/h cap on its
+    # brakes (about 3 kW of them), yet the leader's place read 419 W and the places' ride means 342 W, with the
+    # lone rider coasting: the places ignored the braking.
+    scene = mode.scene
+    scene.controls["formation"].value, scene.controls["n_riders"].value = shape, n
+    down = [(45.0 + i * 1e-4, 6.0, 2000.0 - 0.3 * 11.1195 * i) for i in range(495)]
+    assert mode.load(gpx_text(down).encode(), "descent.gpx")
+    state = mode.state
+    assert state is not None
+    ride = state.ride
+    mode.scrub.value = 5.0
+    at = mode.leader_distance_m()
+    j = int(np.searchsorted(ride.distance_m, at, side="right")) - 1
+    assert ride.brakes_w[j] > 1000.0 and ride.power_w[j] == 0.0
+    here, mean = mode.place_watts()
+    np.testing.assert_array_equal(here, np.zeros(n))
+    # Each place's mean, segment by segment: the group's power less its brakes (at the pedals), plus the place's
+    # own aero difference, never below 0, averaged by time.
+    eta = scene.params.drivetrain_pct / 100.0
+    cda = state.rider_cda_m2 * np.asarray(state.drag)
+    dt = np.diff(ride.elapsed_s)
+    v = np.diff(ride.distance_m) / dt
+    air = v + ride.headwind_ms
+    per_m2 = 0.5 * ride.air_density * air * np.abs(air) * v / eta
+    reference = [
+        sum(
+            max(ride.power_w[k] - ride.brakes_w[k] / eta + (cda[i] - state.group_cda_m2) * per_m2[k], 0.0) * dt[k]
+            for k in range(len(dt))
+        )
+        / ride.time_s
+        for i in range(n)
+    ]
+    np.testing.assert_allclose(mean, reference, rtol=1e-9)
+    assert float(np.max(mean)) < 2.0 * ride.average_power_w  # not the 342 W the braking hid
+    table = scene.table.content.splitlines()
+    assert "| Drag (%) | Here | Ride mean |" in scene.table.content
+    assert "**0**" in table[4]
+    assert "the leader's place 0 W" in mode.now.content
+
+
 @pytest.mark.parametrize(("shape", "n"), [("Bunch (peloton)", 121), ("Single file", 8), ("Single file", 1)])
 def test_the_leader_readout_gives_the_groups_power_and_the_leaders_place(mode: CourseMode, shape: str, n: int) -> None:
     # The failing input (a review): at 13.15 km "Leader at 13.15 km … 250 W" while the table's row 1 said 277 W:
