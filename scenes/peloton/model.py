@@ -262,9 +262,11 @@ that the model knows; past 85° it is held there."""
 
 def formation_yaw(p: PelotonParams) -> float:
     """Yaw of the apparent wind the group rides in (rad, + from the left): :func:`kernels.cycling.apparent_yaw` of the
-    speed, headwind and crosswind, held within ±:data:`MAX_YAW_RAD`; 0 without a crosswind."""
+    speed, headwind and crosswind, held within ±:data:`MAX_YAW_RAD`. Without a crosswind: 0 where the air meets the
+    riders head on, and :data:`MAX_YAW_RAD` where a tailwind as fast as they or faster brings it from behind, as the
+    least crosswind there does (the wakes, which the model lays out behind the riders, give no shelter)."""
     if p.crosswind_ms == 0.0:
-        return 0.0
+        return 0.0 if p.speed_kmh / 3.6 + p.headwind_ms > 0.0 else MAX_YAW_RAD
     yaw = cycling.apparent_yaw(p.speed_kmh / 3.6, p.headwind_ms, p.crosswind_ms)
     return float(np.clip(yaw, -MAX_YAW_RAD, MAX_YAW_RAD))
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import re
 import time
@@ -14,7 +15,7 @@ from helpers.properties import examples
 from helpers.scenes import glb_vertices, scene_fixture
 from helpers.screen_geometry import pinhole_ndc
 from helpers.wsclient import BrowserClient, Crafted, crafted_sent, shows_number
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 from kernels import cycling
@@ -523,20 +524,20 @@ def test_a_tailwind_that_pushes_the_riders_is_not_called_a_slope(scene: PelotonS
     assert "the slope gives more" in scene.table.content and "tailwind" not in scene.table.content
 
 
-def test_riders_sheltered_from_a_tailwinds_push_pedal_and_are_not_called_coasting(scene: PelotonScene) -> None:
-    # The failing input (a second review): 4 riders, 20 km/h, 10 m/s tailwind: the leader coasts, the riders behind
-    # get less of the push and pedal 4–6 W, but every label said "coasting", the summary "1 rider coast" and the
-    # rotation "nobody needs to pedal".
+def test_in_a_tailwind_faster_than_the_riders_nobody_is_sheltered_and_nobody_is_told_so(scene: PelotonScene) -> None:
+    # A second review: 4 riders, 20 km/h, 10 m/s tailwind read "coasting" on riders said to pedal 4–6 W. Those watts
+    # came from wakes laid out behind the riders while the air came from behind them; the model has no wake for
+    # that air (as with any crosswind there), so every rider now gets the solo rider's push and is told so.
     c = scene.controls
     c["speed_kmh"].value, c["headwind_ms"].value = 20.0, -10.0
     need = np.asarray(scene.state.power.total)
-    assert need[0] <= -0.5 and np.all(need[1:] >= 0.5)  # the kernel's: the leader is pushed, the others pedal
-    assert scene.label_text(0) == "0 W · coasting"
-    for i in range(1, 4):
-        assert scene.label_text(i) == f"{round(float(need[i]))} W · solo coasts"
-    assert "1 rider coasts at 0 W" in scene.table.content and "it brakes off" in scene.table.content
-    assert scene.rotation.content.startswith("The leader coasts: the tailwind pushes it along")
-    assert f"pedal up to {float(np.max(need)):.0f} W" in scene.rotation.content
+    np.testing.assert_allclose(need, float(scene.state.solo.total), rtol=1e-9)
+    assert float(need[0]) <= -0.5
+    for i in range(4):
+        assert scene.label_text(i) == "0 W · coasting"
+    assert "every rider coasts" in scene.table.content or "4 riders coast" in scene.table.content
+    assert "nobody needs to pedal, so nobody needs shelter" in scene.rotation.content
+    assert "sheltered" not in scene.rotation.content
 
 
 # The failing inputs of a third review: (formation, riders, speed km/h, grade %, headwind, crosswind), what the
@@ -612,7 +613,8 @@ def test_riders_a_tailwind_pushes_less_than_the_solo_rider_say_what_alone_would_
             assert share is not None and int(share[1]) <= 100, text
     table = scene.table.content
     assert not re.search(r"-\d+(\.\d)? %", table), table
-    assert "W more)" in table
+    # With the air from behind, no wake shelters anyone: each pedals the solo rider's power.
+    np.testing.assert_allclose(scene.state.pedal_w[:8], solo, rtol=1e-9)
 
 
 @pytest.mark.parametrize(
@@ -1071,3 +1073,39 @@ def test_a_group_is_framed_with_riders_a_person_can_see(
     shown = [label for label in scene.labels if label.visible]
     assert 2 <= len(shown) <= 4 and all(" W · drag " in label.text for label in shown)
     assert_labels_apart_and_in_view(label_boxes_px(scene, lens), lens)
+
+
+# Kind: a result that jumps where its input barely moves.
+@settings(max_examples=examples(200), deadline=None)
+@given(
+    speed_kmh=st.floats(0.0, 80.0),
+    headwind_ms=st.floats(-15.0, 15.0),
+    formation=st.sampled_from(["single", "double", "bunch", "echelon"]),
+    n_riders=st.integers(2, 12),
+    model=st.sampled_from(["measured", "seed"]),
+)
+def test_a_crosswind_of_a_hair_changes_the_shelter_by_a_hair(
+    speed_kmh: float, headwind_ms: float, formation: cycling.FormationShape, n_riders: int, model: cycling.DraftModel
+) -> None:
+    # The failing input (an outside tester): 30 km/h in a 12 m/s tailwind. With no crosswind the riders behind
+    # were sheltered (CdA 0.313 / 0.198 / 0.174 / 0.168); with 0.1 m/s of crosswind nobody was (0.320 each): the air
+    # from straight behind was taken as head on, and any crosswind at all turned it 178° (held at 85°).
+    # Where the riders meet almost no air (|v + w| under 0.1 m/s) its direction turns with any breeze, and with no
+    # air there is nothing to shelter from: left out.
+    assume(abs(speed_kmh / 3.6 + headwind_ms) >= 0.1)
+    still = PelotonParams(
+        speed_kmh=speed_kmh, headwind_ms=headwind_ms, formation=formation, n_riders=n_riders, model=model
+    )
+    for side in (1e-7, -1e-7):
+        breeze = dataclasses.replace(still, crosswind_ms=side)
+        # Sorted: air from straight behind is mirrored by a hair of crosswind from either side (riders side by side
+        # swap which one is sheltered); from ahead nothing moves at all.
+        np.testing.assert_allclose(
+            np.sort(compute_line(breeze).cda_m2), np.sort(compute_line(still).cda_m2), rtol=0, atol=1e-4
+        )
+
+
+def test_a_tailwind_faster_than_the_riders_gives_no_shelter_with_or_without_a_crosswind() -> None:
+    for crosswind in (0.0, 0.1, -0.1):
+        p = PelotonParams(speed_kmh=30.0, headwind_ms=-12.0, crosswind_ms=crosswind)
+        np.testing.assert_allclose(compute_line(p).cda_m2, np.full(4, 0.32), rtol=1e-9)
