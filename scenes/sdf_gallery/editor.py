@@ -18,7 +18,7 @@ from kernels import sdf
 from shaders import gl_service
 from shaders import renderer as gl_renderer
 from shaders.renderer import MAX_SOURCE_CHARS, Camera, ShaderCompileError, Shading
-from shaders.trial import trial
+from shaders.trial import TrialTimes, trial
 
 COMPILE_LIMIT_S = 5.0
 """An editor source whose programs (moving and fully shaded) take longer to compile in the trial process is refused
@@ -106,17 +106,17 @@ def trial_source(
     camera: Camera,
     field: EditorField,
     width: int,
-) -> None:
-    """Compile ``text`` with each of ``shadings`` and draw one ``width``-wide frame in a child process, killed at
-    COMPILE_LIMIT_S plus FRAME_LIMIT_S; ShaderCompileError says why it is refused. The server's own examples are
-    known to compile quickly and skip it.
+) -> TrialTimes | None:
+    """Compile ``text`` with each of ``shadings`` and draw one ``width`` × ``width·5/8`` frame with the first in a
+    child process, killed at COMPILE_LIMIT_S plus FRAME_LIMIT_S, and return what it measured; ShaderCompileError
+    says why it is refused. The server's own examples are known to compile quickly and skip it (None).
 
     A compiler can take minutes on a short source, and moderngl holds the GIL while it compiles, which would freeze
     every viewer: only a source that passes is compiled in this process.
     """
     if text in EXAMPLE_SOURCES:
-        return
-    trial(
+        return None
+    return trial(
         text,
         shadings,
         camera,

@@ -194,6 +194,11 @@ IoU is lowest when a box edge is on the silhouette.
         self._rest_s_per_pixel: float | None = None
         """Seconds a pixel of the last rest frame took: the next one is sized to REST_FRAME_BUDGET_S."""
         self._moving_s_per_pixel: float | None = None
+        self._costs_of: Shape | None = None
+        """The editor field the two costs above were measured on, or None for the primitives' scenes: another
+        field's frames may cost a hundred times more, so its first rest frame is not sized by them."""
+        self._trial_cost: tuple[EditorField, float] | None = None
+        """The last applied field and the seconds a pixel of its trial's moving frame took (:mod:`shaders.trial`)."""
         self._build_gui()
         self._build_world()
         self._sync_enabled_inputs()
@@ -646,7 +651,7 @@ IoU is lowest when a box edge is on the silhouette.
             # Trial it in a child process first; then compile the moving frames' program (no shadows, no AO)
             # here: the new shape appears with it, and the fully shaded one compiles when the view next rests.
             shading = self.params.shading
-            editor.trial_source(
+            times = editor.trial_source(
                 text,
                 [moving_shading(shading), shading],
                 self._camera_or_default(),
@@ -677,6 +682,8 @@ IoU is lowest when a box edge is on the silhouette.
             self._reference_due = True
             self._view_key = None
             self._scene_time = time.monotonic()
+            if times is not None:
+                self._trial_cost = (field, times.frame_s / (MOVING_WIDTH_PX * (MOVING_WIDTH_PX * 5 // 8)))
 
     def _mesh_and_show(self, scene: Shape, resolution: int, *, preview: bool = False) -> None:
         """Mesh ``scene`` at ``resolution`` and show it; a ``preview`` goes to the 3D view only (the readouts, the
@@ -798,6 +805,12 @@ IoU is lowest when a box edge is on the silhouette.
                 self._view_moving = False
                 return
         aspect, viewer_width = viewer.aspect, viewer.width_px
+        with self._state:
+            costs_of = shape if isinstance(shape, EditorField) else None
+            if costs_of != self._costs_of:  # a new field: its costs, not the last one's (the trial's, if it had one)
+                trial = self._trial_cost
+                self._costs_of, self._rest_s_per_pixel = costs_of, None
+                self._moving_s_per_pixel = trial[1] if trial is not None and trial[0] == costs_of else None
         with self._lock:
             wire = self._wire if params.view_mode == "both" else None
         key = (shape, camera, aspect, viewer_width, moving, params.shading, params.view_mode, wire and wire.serial)

@@ -6,6 +6,7 @@ from __future__ import annotations
 import io
 import math
 import time
+from typing import Any
 
 import numpy as np
 import pytest
@@ -27,6 +28,7 @@ from scenes.sdf_gallery import RESOLUTION_LABEL, SdfGalleryParams, SdfGallerySce
 from shaders import gl_service
 from shaders.camera import camera_rays
 from shaders.renderer import Camera, GLUnavailableError
+from shaders.trial import TrialTimes
 
 MESH = "/sdf/mesh"
 
@@ -696,6 +698,61 @@ def chain_source(links: int) -> str:
         lines.append(f"float f{i}(vec3 p){{ return min(f{i - 1}(p*1.01), f{i - 1}(p.yzx+0.01)); }}")
     lines.append(f"float sdf(vec3 p){{ return f{links}(p); }}")
     return "\n".join(lines) + "\n"
+
+
+HEAVY_SOURCE = (
+    "float a(vec3 p) { float w = p.x + p.y;"
+    + " w = sin(w);" * 60
+    + " return w; }\nfloat sdf(vec3 p) { float w = a(p) + a(p + vec3(1.0)) + a(p + vec3(2.0));"
+    " return sd_sphere(p, 0.78) + 1e-7 * w; }"
+)
+"""A valid field whose fully shaded frame costs llvmpipe seconds at 1600 × 1000: 180 sines a call (an outside
+tester's)."""
+
+
+@pytest.mark.gl
+def test_a_new_fields_first_rest_frame_is_sized_by_its_own_trial_not_the_last_fields_frames(
+    server: viser.ViserServer, scene: SdfGalleryScene, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # The failing input (an outside tester): after a sphere, Apply of HEAVY_SOURCE drew its first rest frame at the
+    # viewer's full 1600 px, sized by the sphere's cost: 5.7 s inside the server, every tab frozen. It is now sized
+    # by the new field's trial frame (four times its cost a pixel, as any first rest frame is).
+    import scenes.sdf_gallery.editor as gallery
+    from scenes.sdf_gallery.params import MOVING_WIDTH_PX
+
+    trial_source = gallery.trial_source
+    trials: list[TrialTimes | None] = []
+
+    def recorded(*args: Any, **kwargs: Any) -> TrialTimes | None:
+        times = trial_source(*args, **kwargs)
+        trials.append(times)
+        return times
+
+    monkeypatch.setattr(gallery, "trial_source", recorded)
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("View")
+        client.send_camera(position=(2.0, -2.4, 1.6), look_at=(0.0, 0.0, 0.3), size=(1000, 1600))
+        client.set_value("Shape", "GLSL editor")
+        client.set_value("View", "Ray-marched")
+        apply_glsl(client, "float sdf(vec3 p) { return length(p) - 0.6; }")
+        wait_until(lambda: scene.editor_serial == 1, "the sphere applied")
+        wait_until(lambda: scene.view_rgb is not None and scene.view_rgb.shape[1] > MOVING_WIDTH_PX, "its rest frame")
+        serial = scene.view_serial
+        apply_glsl(client, HEAVY_SOURCE)
+        wait_until(lambda: scene.editor_serial == 2, "the heavy field applied", timeout_s=60.0)
+        wait_until(
+            lambda: (
+                scene.view_serial > serial and scene.view_rgb is not None and scene.view_rgb.shape[1] > MOVING_WIDTH_PX
+            ),
+            "the heavy field's first rest frame",
+            timeout_s=60.0,
+        )
+        assert scene.view_rgb is not None
+        times = trials[-1]
+        assert times is not None
+        per_pixel = times.frame_s / (MOVING_WIDTH_PX * (MOVING_WIDTH_PX * 5 // 8))
+        width, height = gallery_rest_size(1600, 1.6, 4.0 * per_pixel)
+        assert scene.view_rgb.shape[:2] == (height, width)
 
 
 @pytest.mark.gl
