@@ -410,7 +410,7 @@ def wall_height_words(state: KickState) -> str:
         e.kind == "ground" and (o.wall_time is None or e.t < o.wall_time) for e in played.events
     )
     if o.wall_point is not None and not bounced:
-        return f"{o.wall_point[2]:.2f} m"
+        return f"{o.wall_point[2]:.2f} m{_beside_words(state.wall, o.wall_point)}"
     if played is None or not bounced:
         return "never reaches the wall"
     struck = next((e for e in played.events if e.kind == "wall"), None)
@@ -418,8 +418,20 @@ def wall_height_words(state: KickState) -> str:
         return f"{struck.position[2]:.2f} m, after bouncing, into a defender (pale line)"
     crossed = wall_passed_s(state, played)
     if crossed is not None:
-        return f"{position_at(played, crossed)[2]:.2f} m, after bouncing (pale line)"
+        point = position_at(played, crossed)
+        return f"{point[2]:.2f} m{_beside_words(state.wall, point)}, after bouncing (pale line)"
     return "never reaches the wall"
+
+
+def _beside_words(wall: ball.Panel, point: NDArray[np.float64]) -> str:
+    """ ", beside the wall, 0.45 m right of its end" where the ball's centre at ``point`` (m), in the wall's plane,
+    passes clear of the wall's span (by more than the ball's radius); "" where it is over or in front of it."""
+    _normal, along = wall_axes(wall)
+    lateral = float((np.asarray(point[:2]) - np.array(wall.centre_xy)) @ along)
+    clear = abs(lateral) - 0.5 * wall.width_m
+    if clear <= ball.BALL_RADIUS_M:
+        return ""
+    return f", beside the wall, {clear:.2f} m {'left' if lateral > 0 else 'right'} of its end"
 
 
 def landing_words(state: KickState) -> str:

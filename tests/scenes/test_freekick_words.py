@@ -202,15 +202,29 @@ def test_the_map_says_where_its_keeper_flatters_far_spots() -> None:
 # reaches the wall" and "Lands after 0.00 s" (its free flight) beside "GOAL" and a keeper line about the ball
 # "after it passes the wall" (the ball played on, which bounced). The wall and landing lines now say which path,
 # and a path that reaches the wall's plane is never said not to.
-def _wall_crossing_height(state: object, played: ball.Trajectory) -> float | None:
-    """The played ball's centre height where it first crosses the wall's plane toward the goal, by linear
-    interpolation between its samples (the test's own reckoning)."""
+def _wall_crossing(state: object, played: ball.Trajectory) -> np.ndarray | None:
+    """The played ball's centre where it first crosses the wall's plane toward the goal, by linear interpolation
+    between its samples (the test's own reckoning)."""
     wall = state.wall  # type: ignore[attr-defined]
     normal = np.array(wall.normal_xy) / np.hypot(*wall.normal_xy)
     side = (played.position[:, :2] - np.array(wall.centre_xy)) @ normal
     crossings = np.flatnonzero((side[:-1] < 0.0) & (side[1:] >= 0.0))
-    i = int(crossings[0]) if crossings.size else None
-    return None if i is None else float(np.interp(0.0, side[i : i + 2], played.position[i : i + 2, 2]))
+    if not crossings.size:
+        return None
+    i = int(crossings[0])
+    return np.array([np.interp(0.0, side[i : i + 2], played.position[i : i + 2, k]) for k in range(3)])
+
+
+def _beside(state: object, point: np.ndarray) -> str:
+    """What the wall line adds for a ball whose centre at ``point`` passes clear of the wall's span (the test's own
+    reckoning: along the wall, + to the kicker's left)."""
+    wall = state.wall  # type: ignore[attr-defined]
+    normal = np.array(wall.normal_xy) / np.hypot(*wall.normal_xy)
+    lateral = float((point[:2] - np.array(wall.centre_xy)) @ np.array([-normal[1], normal[0]]))
+    clear = abs(lateral) - 0.5 * wall.width_m
+    if clear <= ball.BALL_RADIUS_M:
+        return ""
+    return f", beside the wall, {clear:.2f} m {'left' if lateral > 0 else 'right'} of its end"
 
 
 @pytest.mark.parametrize(
@@ -240,17 +254,19 @@ def test_the_wall_and_landing_lines_describe_the_path_they_name(
     line = next(text for text in readout.splitlines() if text.startswith("Height at the wall"))
     bounced = any(e.kind == "ground" and (free.wall_time is None or e.t < free.wall_time) for e in played.events)
     if free.wall_point is not None and not bounced:
-        assert line.startswith(f"Height at the wall: **{free.wall_point[2]:.2f} m**")
+        point = free.wall_point
+        assert line.startswith(f"Height at the wall: **{point[2]:.2f} m{_beside(state, point)}**")
     else:
         struck = [e for e in played.events if e.kind == "wall"]
-        height = _wall_crossing_height(state, played)
+        crossing = _wall_crossing(state, played)
         if struck:
             z = struck[0].position[2]
             assert line.startswith(f"Height at the wall: **{z:.2f} m, after bouncing, into a defender (pale line)**")
-        elif height is None:
+        elif crossing is None:
             assert "never reaches the wall" in line
         else:
-            assert line.startswith(f"Height at the wall: **{height:.2f} m, after bouncing (pale line)**")
+            beside = _beside(state, crossing)
+            assert line.startswith(f"Height at the wall: **{crossing[2]:.2f} m{beside}, after bouncing (pale line)**")
     if "never reaches the wall" in line:
         assert "passes the wall" not in readout
     landing = [text for text in readout.splitlines() if "short" in text and "after **" in text]
@@ -265,6 +281,41 @@ def test_the_wall_and_landing_lines_describe_the_path_they_name(
             assert said.startswith("Lands after") and (first is None or first.t >= down)
     else:
         assert not landing
+
+
+# Kind: a height at the wall with no word of where along it. Topspin at 14° read "Height at the wall: 1.14 m (wall
+# top 1.80 m)" beside GOAL, as if through the wall: the ball passed 1.45 m right of the wall's centre, beside its
+# end at 1.0 m (an outside tester).
+@pytest.mark.parametrize(
+    ("changes", "side"),
+    [
+        ({"spin_axis": "top", "elevation_deg": 14.0}, "right"),  # the tester's kick
+        ({"spin_axis": "right", "azimuth_deg": -14.0, "elevation_deg": 12.0}, "right"),
+        ({"spin_axis": "left", "azimuth_deg": 8.0, "elevation_deg": 12.0}, "left"),
+        ({}, None),  # the default curler goes over
+        ({"elevation_deg": 10.0}, None),  # into the wall
+    ],
+)
+def test_a_ball_that_passes_beside_the_wall_says_so_and_which_side(
+    freekick: FreeKickScene, changes: dict, side: str | None
+) -> None:
+    readout = _show(freekick, **changes)
+    line = next(text for text in readout.splitlines() if text.startswith("Height at the wall"))
+    state = freekick.state
+    point = state.outcome.wall_point
+    assert point is not None
+    wall = state.wall
+    normal = np.array(wall.normal_xy) / np.hypot(*wall.normal_xy)
+    lateral = float((point[:2] - np.array(wall.centre_xy)) @ np.array([-normal[1], normal[0]]))  # + to the left
+    clear = abs(lateral) - 0.5 * wall.width_m
+    if side is None:
+        assert clear <= ball.BALL_RADIUS_M and "beside" not in line
+        assert line.startswith(f"Height at the wall: **{point[2]:.2f} m**")
+    else:
+        assert clear > ball.BALL_RADIUS_M and (lateral > 0) == (side == "left")
+        assert line.startswith(
+            f"Height at the wall: **{point[2]:.2f} m, beside the wall, {clear:.2f} m {side} of its end**"
+        )
 
 
 # Kind: one contact said twice. A ball between two defenders touches both at one instant, and read "hits a defender
