@@ -426,7 +426,10 @@ class CourseMode:
         self.scene.callback(install)(None)
 
     def load(self, data: bytes, label: str) -> bool:
-        """Load a GPX file's bytes as the course; on a bad file keep the last good course and show why."""
+        """Load a GPX file's bytes as the course; on a bad file keep the last good course and show why. An upload
+        still being read is dropped: the user's last choice of route wins (:meth:`_on_upload`)."""
+        with self._upload_lock:
+            self._upload_seq += 1
         try:
             route, error = course_kernel.load_gpx(data), None
         except ValueError as failure:

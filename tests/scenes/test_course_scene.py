@@ -350,6 +350,36 @@ def test_the_newest_upload_wins_when_an_older_parse_finishes_last(
     assert mode.route.name == "Newer hill" and mode.route_label == "newer.gpx"
 
 
+def test_the_sample_route_pressed_after_an_upload_wins_when_the_upload_finishes_last(
+    server: viser.ViserServer, mode: CourseMode, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # The failing input (an outside tester): a 12.5 MiB upload, then "Load the sample route" a second later: the
+    # sample showed, then the upload replaced it when its parse finished. The user's last action wins.
+    real = course_kernel.load_gpx
+    older_done = threading.Event()
+
+    def slow_for_the_upload(source: bytes, **kwargs: object) -> course_kernel.Course:
+        if b"Slow hill" in source:
+            time.sleep(1.0)
+            try:
+                return real(source)
+            finally:
+                older_done.set()
+        return real(source)
+
+    monkeypatch.setattr(course_kernel, "load_gpx", slow_for_the_upload)
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Upload GPX")
+        assert mode.load(hill_gpx("First hill"), "first.gpx")
+        upload(client, "Upload GPX", "slow.gpx", hill_gpx("Slow hill"))
+        time.sleep(0.2)  # the upload's parse is under way
+        client.click("Load the sample route")
+        client.wait_for(lambda: mode.route_label == SAMPLE_LABEL, what="the sample route")
+        assert older_done.wait(5.0)
+        time.sleep(0.3)  # the upload's install, had it been allowed, has run by now
+    assert mode.route_label == SAMPLE_LABEL and mode.route.name != "Slow hill"
+
+
 # Kind: a place on the route the Position slider cannot reach. Its end was the length rounded down to its 10 m
 # step, 1–9 m short of the finish (a 2,127 m route ended at 2.12 km).
 @pytest.mark.parametrize("n", [2, 3, 17, 300, 1001])
