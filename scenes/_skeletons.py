@@ -371,6 +371,11 @@ def usage_colours(usage: NDArray[np.float64], free: NDArray[np.bool_]) -> NDArra
     return ramp.round().astype(np.uint8)
 
 
+def iterations_words(count: int) -> str:
+    """ "1 iteration", "7 iterations"."""
+    return f"{count} iteration{'' if count == 1 else 's'}"
+
+
 def clean_target(raw: object, planar: bool) -> NDArray[np.float64] | None:
     """A browser-sent position as a world point: three finite numbers inside the world box (y put back to 0 in the
     plane: a crafted client may send any y), else None. Always a new array: the handle's own, changed in place
@@ -612,8 +617,8 @@ class SkeletonView:
             f"| {label} | {r.error[k] * 1000.0:.2f} | {r.status[k]} |" for k, label in enumerate(sk.effector_labels)
         )
         return (
-            f"**{sk.name}**: {r.iterations} iteration{'s' if r.iterations != 1 else ''}, "
+            f"**{sk.name}**: {iterations_words(r.iterations)}, "
             f"solve **{report.micros:,.0f} µs**{plain_python_note()}  \n"
-            f"Multi-end-effector FABRIK, tolerance {sk.tolerance_mm:g} mm, at most {sk.max_iterations} iterations."
+            f"Multi-end-effector FABRIK, tolerance {sk.tolerance_mm:g} mm, at most {iterations_words(sk.max_iterations)}."
             f"\n\n| Effector | Error (mm) | Status |\n|---|---|---|\n{rows}"
         )

@@ -38,6 +38,7 @@ from scenes._skeletons import (
     PresetLabel,
     SkeletonView,
     clean_target,
+    iterations_words,
     moved_gizmo,
     plain_python_note,
 )
@@ -400,7 +401,7 @@ def why_restarted(params: ArmParams, report: SolveReport, obstacle_centres: NDAr
     if touching:
         causes.append(f"obstacle{'s' if len(touching) > 1 else ''} {_listed([str(k) for k in touching])}")
     if first.status == "max_iterations":
-        causes.append(f"the cap of {params.max_iterations} iterations")
+        causes.append(f"the cap of {iterations_words(params.max_iterations)}")
     if not causes:
         avoided = [k + 1 for k in avoided_obstacles(params, obstacle_centres)]
         if params.limits:
@@ -453,7 +454,7 @@ def why_short(
                 f"(its joints bend up to {min(used, 1.0):.0%} of the limit)"
             )
     if r.status == "max_iterations":
-        reasons.append(f"it was still closing in after {r.iterations} iterations (raise Max iterations)")
+        reasons.append(f"it was still closing in after {iterations_words(r.iterations)} (raise Max iterations)")
     if r.status == "infeasible":
         reasons.append("no pose it saw kept every limit and cleared every obstacle")
     if not reasons:
@@ -937,7 +938,7 @@ is a static pose.
     def _readout_markdown(self, report: SolveReport) -> str:
         r, p = report.result, self.params
         text = (
-            f"**{p.solver}**: {r.iterations} iteration{'s' if r.iterations != 1 else ''}, "
+            f"**{p.solver}**: {iterations_words(r.iterations)}, "
             f"error **{r.error * 1000.0:.3f} mm**, status **{r.status}**  \n"
             f"Solve time **{report.micros:,.0f} µs**{plain_python_note()}"
         )

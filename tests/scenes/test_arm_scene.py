@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import re
 
 import numpy as np
 import pytest
@@ -572,3 +573,16 @@ def test_a_restart_names_only_what_is_on_and_held_the_arm(
     assert causes  # a restart happens only under a constraint that is on
     said = f"From the last pose {' and '.join(causes)} held the arm farther from the target, so this pose was solved "
     assert said + f"again from a {report.start}" in text, text
+
+
+def test_iteration_counts_read_in_good_english(scene: ArmScene) -> None:
+    # An outside tester read "still closing in after 1 iterations".
+    scene.controls["tolerance_mm"].value = 0.01
+    scene.controls["max_iterations"].value = 1
+    scene.target_gizmo.position = (-0.6, 0.0, 0.9)
+    scene._apply_target()
+    report = scene.report
+    assert report is not None and report.result.iterations == 1 and report.result.status != "reached"
+    text = scene.readout.content
+    assert re.search(r"\b1 iterations\b", text) is None
+    assert "**FABRIK**: 1 iteration," in text and "after 1 iteration (raise Max iterations)" in text
