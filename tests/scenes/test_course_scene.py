@@ -3,6 +3,7 @@ bad files), play / pause / scrub, air and model choices, the shared paceline, an
 
 from __future__ import annotations
 
+import html
 import math
 import re
 import threading
@@ -221,7 +222,15 @@ def test_file_text_is_escaped_in_the_readouts(mode: CourseMode) -> None:
     assert mode.load(hill_gpx(name), "x.gpx")
     assert mode.route.name.startswith("<img")
     info = mode.route_info.content
-    assert "<img" not in info and "](" not in info and "&lt;img" in info
+    assert "<img" not in info and "](" not in info and "<img src=x onerror=alert(1)>" in html.unescape(info)
+    # Bare addresses, which GitHub-flavoured markdown makes links (an outside tester's name "http://x" showed as
+    # one), and emphasis, code and strike-through marks: each shown as itself, as a character reference.
+    name = "see http://x, www.y.org or a@b.com _it_ `code` ~gone~ \\ #1!"
+    assert mode.load(hill_gpx(name), "y.gpx")
+    info = mode.route_info.content
+    for raw in ("http://", "www.", "@", "_it_", "`", "~", "\\"):
+        assert raw not in info, raw
+    assert html.unescape(info).count(name) == 1
 
 
 # ------------------------------------------------------------------------------------------------ over the websocket
@@ -472,7 +481,7 @@ REVIEW_FILES = {
     ),
     "not gpx": (
         "<html><body>hi</body></html>",
-        "was not loaded: the file is not GPX: no &lt;gpx&gt;",
+        "was not loaded: the file is not GPX: no <gpx>",
     ),
 }
 
@@ -483,9 +492,10 @@ def test_bad_files_are_refused_in_a_riders_words(mode: CourseMode, kind: str) ->
     text, message = REVIEW_FILES[kind]
     assert not mode.load(text.encode(), f"{kind}.gpx")
     assert mode.route is good
-    assert message in mode.route_info.content
+    shown = html.unescape(mode.route_info.content)  # the file's words are shown as character references
+    assert message in shown
     for word in ("elevation_m", "latitude_deg", "non-finite", "time_s", "GPX is not"):
-        assert word not in mode.route_info.content
+        assert word not in shown
 
 
 def test_the_riders_keep_their_place_when_the_ride_changes(mode: CourseMode) -> None:
