@@ -41,6 +41,9 @@ SAMPLE_ROUTE = Path(__file__).parent.with_name("routes") / "alpe_dhuez.gpx"
 """The bundled sample: Alpe d'Huez rebuilt from its published profile (see the file's description)."""
 
 _GPX_ROOT = re.compile(r"<(?:([A-Za-z_][\w.-]*):)?gpx[\s>/]")
+_PROLOG = re.compile(r"(?:[\s\ufeff]+|<\?.*?\?>|<!--.*?-->|<!DOCTYPE(?:[^>\[]|\[.*?\])*>)*", re.DOTALL)
+"""What XML allows before the root element: white space, processing instructions (``<?xml ...?>``), comments and a
+document type, of any length."""
 
 
 def load_gpx(source: str | os.PathLike[str] | bytes, *, name: str | None = None, smoothing_m: float = 50.0) -> Course:
@@ -93,7 +96,8 @@ def load_gpx(source: str | os.PathLike[str] | bytes, *, name: str | None = None,
     else:
         raise ValueError(f"source must be a path, bytes or GPX text, got {type(source).__name__}")
     text = _decode(data, label)
-    root = _GPX_ROOT.search(text[:4096])
+    prolog = _PROLOG.match(text)
+    root = _GPX_ROOT.match(text, prolog.end() if prolog else 0)
     if root is None:
         raise ValueError(f"{label} is not GPX: no <gpx> element at its start")
     # Count before parsing (gpxpy would build every point first), whatever the namespace prefix.

@@ -783,6 +783,30 @@ def test_a_namespace_prefixed_gpx_is_read_and_counted_before_parsing(
         course.load_gpx(prefixed(20))
 
 
+# Kind: a valid file refused for what comes before its root. The root was looked for in the first 4096 characters
+# only, so a GPX with a 5 KB comment first read "is not GPX: no <gpx> element at its start" (an outside tester).
+@pytest.mark.parametrize(
+    "prolog",
+    [
+        "<!-- " + "x" * 5000 + " -->",
+        '<?xml-stylesheet type="text/xsl" href="a.xsl"?>\n' * 200,
+        "\n" * 10_000,
+        '<!DOCTYPE gpx [<!ENTITY who "me">]>' + "<!-- > -->" * 500,
+    ],
+    ids=["long comment", "many instructions", "blank lines", "doctype then comments"],
+)
+def test_whatever_xml_allows_before_the_root_is_read_past(prolog: str) -> None:
+    text = gpx_text(line_points(5))
+    head, body = text.split("?>", 1)
+    assert course.load_gpx(f"{head}?>{prolog}{body}").n_points == 5
+
+
+@pytest.mark.parametrize("text", ["<html><gpx version='1.1'></gpx></html>", "<p>see <gpx></p>", "<kml/><gpx/>"])
+def test_a_gpx_element_that_is_not_the_root_is_not_gpx(text: str) -> None:
+    with pytest.raises(ValueError, match="not GPX: no <gpx> element at its start"):
+        course.load_gpx(text.encode())
+
+
 # Kind: messages in a rider's words (no kernel argument names, no "GPX is not a GPX file").
 @pytest.mark.parametrize("kind", list(BAD_FILES))
 def test_bad_file_messages_name_no_kernel_arguments(kind: str) -> None:
