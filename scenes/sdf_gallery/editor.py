@@ -152,6 +152,19 @@ def _no_surface(field: EditorField, resolution: int) -> str:
     return f"{message} (change sdf() or the bounds)"
 
 
+def cut_by_bounds(field: EditorField, vertices: np.ndarray) -> str:
+    """What to tell a person whose field crosses its bounds: there marching cubes leaves the mesh open (vertices on
+    the box's faces, where the field is still inside); "" for a shape inside them."""
+    lo, hi = np.asarray(field.bounds, dtype=np.float64)
+    tol = 1e-6 * float(np.max(hi - lo))
+    if not len(vertices) or not np.any((np.abs(vertices - lo) < tol) | (np.abs(vertices - hi) < tol)):
+        return ""
+    return (
+        f"⚠ The shape reaches the ±{field.half_size:g} m box and is cut open there (the mesh and its downloads have "
+        "holes). Raise Editor bounds half size to take it all in."
+    )
+
+
 def mesh_field(field: EditorField, resolution: int) -> tuple[np.ndarray, ...]:
     """Mesh the editor's field at ``resolution`` on the GL thread: vertices (V, 3) (m), faces (F, 3), colours
     (V, 3) in [0, 1] and normals (V, 3). ShaderCompileError when no surface lies inside the bounds."""

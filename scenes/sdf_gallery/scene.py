@@ -31,7 +31,7 @@ import viser
 
 from kernels import sdf
 from scenes import _controls
-from scenes._base import TURNS, Scene, mark_costly
+from scenes._base import TURNS, Scene, mark_costly, set_if_changed
 from scenes._controls import build_controls
 from scenes._framing import ClientFraming, Lens, View, box_corners, frame_points
 from scenes._worker import LatestWorker
@@ -273,6 +273,7 @@ IoU is lowest when a box edge is on the silhouette.
                 api.add_html(EDITOR_STYLE)
                 self.apply = mark_costly(gui.add_button("Apply"))  # compiles GLSL, remeshes
                 self.editor_status = gui.add_markdown(EDITOR_HELP if allowed else EDITING_OFF)
+                self.bounds_note = gui.add_markdown("", visible=False)
             self.scene_controls = build_controls(gui, p, SCENE_FIELDS)
             with self.scene_controls.folders["Blend and mesh"]:
                 self.progress = gui.add_progress_bar(0.0, visible=False)
@@ -734,6 +735,9 @@ IoU is lowest when a box edge is on the silhouette.
                 else:
                     self.mesh_vertices, self.mesh_faces, self.mesh_colors = vertices, faces, colors
                     self.mesh_shape = shape
+                    cut = editor.cut_by_bounds(shape, vertices) if isinstance(shape, EditorField) else ""
+                    set_if_changed(self.bounds_note, "content", cut)
+                    set_if_changed(self.bounds_note, "visible", bool(cut))
                     self.mesh_scene = shape if isinstance(shape, sdf.Scene) else None
                     grid_scene = shape if isinstance(shape, sdf.Scene) else sdf.default_scene()
                     bounds = None if isinstance(shape, sdf.Scene) else shape.bounds

@@ -945,6 +945,30 @@ def test_apply_and_a_shown_field_use_the_editor_bounds_on_screen(
 
 
 @pytest.mark.gl
+def test_a_field_cut_open_by_its_bounds_says_so_and_a_whole_one_does_not(
+    server: viser.ViserServer, scene: SdfGalleryScene
+) -> None:
+    # The failing input (an outside tester): the first example in bounds of ±0.5 m meshed open at the box, with no
+    # word; its downloads were not watertight and the depth difference jumped to 3.2 voxels.
+    with BrowserClient(server.get_port()) as client:
+        apply_glsl(client, "float sdf(vec3 p) { return sd_box(p, vec3(0.3, 0.3, 0.7)); }\n")
+        wait_until(lambda: scene.editor_serial == 1, "the box applied")
+        mesh = trimesh.Trimesh(scene.mesh_vertices, scene.mesh_faces)
+        assert mesh.is_watertight and not scene.bounds_note.visible
+        meshes = scene.mesh_serial
+        client.set_value("Editor bounds half size (m)", 0.5)
+        wait_until(lambda: scene.mesh_serial > meshes and scene.params.editor.half_size == 0.5, "the remesh")
+        mesh = trimesh.Trimesh(scene.mesh_vertices, scene.mesh_faces)
+        assert not mesh.is_watertight  # the box's ends (±0.7 m in z) lie outside ±0.5 m
+        assert scene.bounds_note.visible and "reaches the ±0.5 m box and is cut open" in scene.bounds_note.content
+        meshes = scene.mesh_serial
+        client.set_value("Editor bounds half size (m)", 1.0)
+        wait_until(lambda: scene.mesh_serial > meshes and scene.params.editor.half_size == 1.0, "the wider remesh")
+        assert trimesh.Trimesh(scene.mesh_vertices, scene.mesh_faces).is_watertight
+        assert not scene.bounds_note.visible
+
+
+@pytest.mark.gl
 @pytest.mark.parametrize("k", ["1e38", "1e30", "1e-6"])
 def test_a_typed_field_far_from_a_distance_agrees_with_its_mesh(
     server: viser.ViserServer, scene: SdfGalleryScene, k: str
