@@ -50,7 +50,13 @@ above it 0.5/k and the exp sharpness 4·ln 2/k stay finite in float32."""
 
 
 def _distances(a: ArrayLike, b: ArrayLike) -> tuple[FloatArray, FloatArray]:
-    return distance_array("a", a), distance_array("b", b)
+    """``a`` and ``b`` as distances (:func:`distance_array`) whose shapes broadcast together."""
+    a_arr, b_arr = distance_array("a", a), distance_array("b", b)
+    try:
+        np.broadcast_shapes(a_arr.shape, b_arr.shape)
+    except ValueError:
+        raise ValueError(f"a and b must broadcast together, got shapes {a_arr.shape} and {b_arr.shape}") from None
+    return a_arr, b_arr
 
 
 def distance_array(name: str, value: ArrayLike) -> FloatArray:
@@ -132,7 +138,8 @@ def smin_exp(a: ArrayLike, b: ArrayLike, k: float) -> FloatArray:
     Args:
         a: distances (m), any shape broadcastable with ``b``.
         b: distances (m).
-        k: sharpness (1/m), > 0; larger is sharper (→ min(a, b) as k → ∞).
+        k: sharpness (1/m), > 0; larger is sharper (→ min(a, b) as k → ∞). Unlike every other blend here, whose
+            k is a width in metres: ``smin_exp(a, b, 4·ln 2 / k)`` is ``smooth_union(a, b, k, "exp")``.
 
     Returns:
         Blended distances (m), ≤ min(a, b) − 0 and ≥ min(a, b) − ln 2 / k.

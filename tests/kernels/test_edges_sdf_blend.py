@@ -372,3 +372,35 @@ def test_booleans_or_none_in_a_list_of_distances_are_refused_by_name(bad: Any) -
     ]:
         with pytest.raises(ValueError, match=rf"^{side} must be real distances \(m\), got "):
             call()
+
+
+# Kind: a refusal in numpy's words. smin_poly([0, 1], [0, 1, 2], 0.1) raised "operands could not be broadcast
+# together", naming neither a nor b (an outside tester).
+@pytest.mark.parametrize(
+    "blend",
+    [
+        lambda a, b: sdf.smin_poly(a, b, 0.1),
+        lambda a, b: sdf.smin_exp(a, b, 10.0),
+        sdf.op_union,
+        sdf.op_subtract,
+        sdf.op_intersect,
+        lambda a, b: sdf.smooth_union(a, b, 0.1, "exp"),
+        lambda a, b: sdf.smooth_subtract(a, b, 0.1),
+        lambda a, b: sdf.smooth_intersect(a, b, 0.1),
+    ],
+    ids=["smin_poly", "smin_exp", "op_union", "op_subtract", "op_intersect", "union", "subtract", "intersect"],
+)
+def test_distances_that_do_not_broadcast_are_refused_by_name(blend: Any) -> None:
+    with pytest.raises(ValueError, match=r"a and b must broadcast together, got shapes \(2,\) and \(3,\)"):
+        blend([0.0, 1.0], [0.0, 1.0, 2.0])
+    assert np.asarray(blend([[0.0], [1.0]], [0.0, 1.0, 2.0])).shape == (2, 3)  # shapes that broadcast still do
+
+
+def test_smin_exp_takes_the_sharpness_that_the_width_k_gives() -> None:
+    # Every other blend's k is a width in metres; smin_exp's is the seed's sharpness (docs/sdf.md says both).
+    a, b = np.linspace(-1.0, 1.0, 41), np.linspace(1.0, -1.0, 41)
+    for k in (0.05, 0.4, 2.0):
+        np.testing.assert_allclose(
+            sdf.smin_exp(a, b, 4.0 * np.log(2.0) / k), sdf.smooth_union(a, b, k, "exp"), rtol=1e-12, atol=1e-15
+        )
+        assert sdf.smooth_union([0.0], [0.0], k, "exp")[0] == pytest.approx(-k / 4.0, rel=1e-12)
