@@ -683,8 +683,9 @@ def paced_ride(
 ) -> Pacing:
     """Vary power with the grade (Swain 1997) at the same time-averaged power as a constant ``power_w``.
 
-    Segment i gets P_i = k·(1 + gain·tanh(grade_i / 0.05)): up to ``gain`` more on steep climbs and less on
-    descents, and k is set (a few fixed-point rescalings) so that the paced ride's time-averaged power
+    Segment i gets P_i = min(k·(1 + gain·tanh(grade_i / 0.05)), :data:`MAX_POWER_W`): up to ``gain`` more on steep
+    climbs and less on descents, and k is set (a few fixed-point rescalings) so that the paced ride's time-averaged
+    power
     Σ P_i·t_i / Σ t_i equals the constant ride's (what a power meter would show for both rides; that is
     ``power_w`` unless the constant ride eased off to hold the speed cap).
 
@@ -710,15 +711,52 @@ def paced_ride(
     shape = pacing_factors(course.grade, g)
     # Match what the constant ride really averaged: where it eases off to hold the speed cap it is below target.
     average = constant.average_power_w
-    scale = target
-    paced = constant
-    for _ in range(30):
-        paced = _ride(course, scale * shape, s, cap, start)
-        ratio = average / paced.average_power_w
-        scale *= ratio
-        if abs(ratio - 1.0) < 1e-9:
+
+    def paced_at(scale: float) -> Ride:
+        return _ride(course, np.minimum(scale * shape, MAX_POWER_W), s, cap, start)
+
+    # Rescale to the constant ride's average; where that does not settle (segments held at MAX_POWER_W, or easing
+    # off at the speed cap), bisect between the scales tried that gave less and more.
+    scale, tried = target, []
+    for _ in range(_PACING_STEPS):
+        paced = paced_at(scale)
+        if abs(paced.average_power_w / average - 1.0) < _PACING_TOLERANCE:
+            return Pacing(constant=constant, paced=paced, time_saved_s=constant.time_s - paced.time_s)
+        tried.append((scale, paced.average_power_w))
+        scale *= average / paced.average_power_w
+    low = max((sc for sc, got in tried if got < average), default=None)
+    high = min((sc for sc, got in tried if got > average), default=None)
+    for _ in range(_PACING_STEPS):  # widen to a bracket: halve below the least scale tried, double above the most
+        if low is not None and high is not None:
             break
-    return Pacing(constant=constant, paced=paced, time_saved_s=constant.time_s - paced.time_s)
+        probe = 0.5 * min(sc for sc, _got in tried) if low is None else 2.0 * max(sc for sc, _got in tried)
+        try:
+            got = paced_at(probe).average_power_w
+        except ValueError:  # too little power to cross a segment: below any average
+            got = 0.0
+        tried.append((probe, got))
+        if got < average:
+            low = probe if low is None else max(low, probe)
+        elif got > average:
+            high = probe if high is None else min(high, probe)
+    if low is not None and high is not None and low < high:
+        for _ in range(_PACING_STEPS):
+            scale = 0.5 * (low + high)
+            paced = paced_at(scale)
+            if abs(paced.average_power_w / average - 1.0) < _PACING_TOLERANCE:
+                return Pacing(constant=constant, paced=paced, time_saved_s=constant.time_s - paced.time_s)
+            low, high = (scale, high) if paced.average_power_w < average else (low, scale)
+    raise ValueError(
+        f"power_w = {_checks.shown(power_w)} W cannot be paced with gain {g:g}: held at most {MAX_POWER_W:g} W on "
+        f"each segment and eased off at the speed cap, the paced ride does not average the constant ride's "
+        f"{average:.1f} W; a lower power or gain paces"
+    )
+
+
+_PACING_STEPS = 60
+"""Fixed-point rescalings :func:`paced_ride` tries before it says the power cannot be paced."""
+_PACING_TOLERANCE = 1e-9
+"""Relative difference of the two rides' time-averaged powers at which :func:`paced_ride` stops."""
 
 
 # The compiled ride loop as _ride calls it: plain Python while the app's first start compiles it (kernels.warming).

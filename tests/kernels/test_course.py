@@ -439,6 +439,27 @@ def test_pacing_keeps_the_average_power_and_saves_time_on_hills() -> None:
         course.paced_ride(c, 250.0, MARTIN, gain=0.9)
 
 
+# Kind: a contract broken where the power is high. paced_ride(sample, 5000 W, gain 0.5) averaged 2785.8 W against
+# the constant ride's 2782.9 W with segments at 7134 W (over the 5000 W a ride takes), and returned anyway after
+# 30 rescalings that did not settle (an outside tester).
+@pytest.mark.parametrize("power", [250.0, 2000.0, 3000.0, 4000.0, 4500.0, 5000.0])
+@pytest.mark.parametrize("gain", [0.15, 0.3, 0.5])
+@pytest.mark.parametrize("route", ["sample", "hills"])
+def test_a_paced_ride_averages_the_constant_rides_power_within_the_power_limit(
+    power: float, gain: float, route: str
+) -> None:
+    if route == "sample":
+        c = course.load_gpx(course.SAMPLE_ROUTE)
+    else:
+        s = np.arange(0.0, 20_000.0 + 5, 10.0)
+        c = course.course_from_xy(s, np.zeros_like(s), 60.0 * np.sin(2 * np.pi * s / 4000.0))
+    pacing = course.paced_ride(c, power, MARTIN, gain=gain)
+    assert pacing.paced.average_power_w == pytest.approx(pacing.constant.average_power_w, rel=1e-8)
+    assert np.all(pacing.paced.power_w <= course.MAX_POWER_W * (1.0 + 1e-12))  # the core's work / time
+    dt = np.diff(pacing.paced.elapsed_s)  # the average is the time-weighted one a power meter shows
+    assert float(pacing.paced.power_w[:-1] @ dt / dt.sum()) == pytest.approx(pacing.paced.average_power_w, rel=1e-9)
+
+
 def test_splits_are_the_times_at_each_kilometre() -> None:
     v_star = float(cycling.speed_for_power(250.0, 0.32, 80.0, 0.004, drivetrain_efficiency=0.976))
     r = course.ride(straight(3500.0), 250.0, SEED, start_speed_ms=v_star)
