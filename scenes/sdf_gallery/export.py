@@ -50,8 +50,8 @@ def download(
     match fmt:
         case "png":
             if reference is None or reference.size == 0:
-                return Download("sdf_reference.png", None, "The reference image has not been rendered.")
-            return Download("sdf_reference.png", png_bytes(reference))
+                return Download("sdf_ref.png", None, "The reference image has not been rendered.")
+            return Download("sdf_ref.png", png_bytes(reference))
         case "glb" | "stl" | "obj":
             name = f"sdf_mesh.{fmt}"
             if len(faces) == 0:

@@ -130,7 +130,7 @@ def test_no_reference_image_downloads_nothing_with_the_same_notice(
         kind, title, body = press(client, BUTTONS["png"])
         assert (kind, title) == ("notice", NOTHING_TO_DOWNLOAD)
         assert "reference image" in body
-        assert scene.export("png") == ("sdf_reference.png", None)
+        assert scene.export("png") == ("sdf_ref.png", None)
 
 
 # ------------------------------------------------------------------------------------------ the rule, over shapes
@@ -178,3 +178,16 @@ def test_the_png_download_is_the_image_or_nothing(image: np.ndarray | None) -> N
 
         assert answer.content is not None
         np.testing.assert_array_equal(np.asarray(Image.open(io.BytesIO(answer.content))), image)
+
+
+def test_every_download_name_fits_viser_s_download_notice() -> None:
+    # viser's notice draws "name (size)" in a fixed-width button and clips the rest: "sdf_reference.png (5.8K" lost
+    # its bracket at both window sizes, while "sdf_mesh.obj (0.7M)" (19 characters) showed whole (an outside
+    # tester's screenshots). No name is longer than those seen whole.
+    from scenes.sdf_gallery.export import download
+
+    vertices, faces, colors = sdf.mesh(sdf.default_scene(), 32)
+    image = np.zeros((4, 4, 3), np.uint8)
+    names = [download(fmt, vertices, faces, colors, image).name for fmt in ("glb", "stl", "obj", "png")]
+    assert names == ["sdf_mesh.glb", "sdf_mesh.stl", "sdf_mesh.obj", "sdf_ref.png"]
+    assert all(len(name) <= len("sdf_mesh.obj") for name in names)

@@ -308,7 +308,7 @@ def test_png_download_is_the_reference_image(scene: SdfGalleryScene) -> None:
     from PIL import Image
 
     name, png = scene.export("png")
-    assert name == "sdf_reference.png" and png is not None
+    assert name == "sdf_ref.png" and png is not None
     assert scene.reference_rgb is not None
     np.testing.assert_array_equal(np.asarray(Image.open(io.BytesIO(png))), scene.reference_rgb)
 
