@@ -875,7 +875,7 @@ time-averaged power is the mean over positions, far below the leader's.
         thinner = 100 * (1 - rho / cycling.RHO_SEA_LEVEL)
         where = "sea level" if abs(thinner) < 0.05 else f"{thinner:.1f} % thinner than at sea level"
         if spent > 0 and aero + rolling + climbing > 0:
-            share = f"the air takes **{100.0 * max(aero, 0.0) / spent:.1f} %** of the power spent"
+            share = f"the air takes **{100.0 * max(aero, 0.0) / spent:.1f} %** of the power spent at the wheel"
         else:  # standing still, or a descent or tailwind that pays for it all: no share of nothing
             share = "no power needed at the wheel"
         total = float(solo.total)
@@ -890,8 +890,10 @@ time-averaged power is the mean over positions, far below the leader's.
     def _table_markdown(self) -> str:
         state = self.state
         # Narrow columns run together in the panel ("RollClimb"), so the three parts share one cell with slashes.
+        # The parts are at the wheel; the rider pedals their sum over the drivetrain's efficiency η.
         rows = [
-            "| Rider | CdA (m²) | Aero / rolling / climbing (W) | Total (W) | Saving |",
+            "| Rider | CdA (m²) | Aero / rolling / climbing at the wheel (W) | "
+            f"Pedals (W, η {self.params.drivetrain_pct:g} %) | Saving |",
             "|---|---|---|---|---|",
         ]
         for i in range(self.params.n_riders):

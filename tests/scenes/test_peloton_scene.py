@@ -1109,3 +1109,19 @@ def test_a_tailwind_faster_than_the_riders_gives_no_shelter_with_or_without_a_cr
     for crosswind in (0.0, 0.1, -0.1):
         p = PelotonParams(speed_kmh=30.0, headwind_ms=-12.0, crosswind_ms=crosswind)
         np.testing.assert_allclose(compute_line(p).cda_m2, np.full(4, 0.32), rtol=1e-9)
+
+
+@pytest.mark.parametrize("drivetrain_pct", [97.6, 80.0])
+def test_the_results_table_says_which_columns_are_at_the_wheel_and_which_at_the_pedals(
+    scene: PelotonScene, drivetrain_pct: float
+) -> None:
+    # An outside tester: "263 + 35 = 298, but the Total is 305": the parts were at the wheel, the Total at the
+    # pedals, and nothing said so.
+    scene.controls["drivetrain_pct"].value = drivetrain_pct
+    header, _rule, first = scene.table.content.splitlines()[:3]
+    assert "Aero / rolling / climbing at the wheel (W)" in header and f"Pedals (W, η {drivetrain_pct:g} %)" in header
+    cells = [cell.strip() for cell in first.split("|")[1:-1]]
+    parts = [float(w) for w in cells[2].split(" / ")]
+    pedals = float(cells[3].strip("*"))
+    assert sum(parts) / (drivetrain_pct / 100.0) == pytest.approx(pedals, abs=2.0)  # each shown to the watt
+    assert "of the power spent at the wheel" in scene.density.content
