@@ -6,6 +6,7 @@ solver and playback. What it rides and draws comes from :mod:`scenes.peloton.cou
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import math
 import threading
@@ -144,6 +145,9 @@ class CourseMode:
         self._upload_lock = threading.Lock()
         self._upload_seq = 0
         """Number of the newest upload: parses run in parallel on viser's pool, and only the newest installs."""
+        self.refusal_notices: list[viser.NotificationHandle] = []
+        """The "GPX not loaded" notifications still up: the next route loaded, or refused, takes them down, so
+        none is left saying "Still showing" a route that is no longer shown."""
         self._build_gui()
         self._show_air_inputs(self.params)
         self._build_world()
@@ -421,7 +425,8 @@ class CourseMode:
                 return
             if not self._install(route, error, name) and isinstance(client, viser.ClientHandle):
                 body = self.refusal if len(self.refusal) <= 500 else self.refusal[:499] + "…"
-                client.add_notification("GPX not loaded", body, color="red", auto_close_seconds=15.0)
+                notice = client.add_notification("GPX not loaded", body, color="red", auto_close_seconds=15.0)
+                self.refusal_notices.append(notice)
 
         self.scene.callback(install)(None)
 
@@ -437,6 +442,10 @@ class CourseMode:
         return self._install(route, error, label)
 
     def _install(self, route: course_kernel.Course | None, error: str | None, label: str) -> bool:
+        for notice in self.refusal_notices:  # each said what was shown then; this load changes that
+            with contextlib.suppress(Exception):  # its tab may have closed
+                notice.remove()
+        self.refusal_notices.clear()
         state = None
         if route is not None:
             try:

@@ -271,6 +271,23 @@ def test_a_bad_upload_from_a_browser_is_reported(
     assert not [r for r in caplog.records if r.levelname == "ERROR"]
 
 
+def test_a_refusal_notice_comes_down_when_the_next_route_is_loaded(server: viser.ViserServer, mode: CourseMode) -> None:
+    # An outside tester: after two later good loads, a red "GPX not loaded … Still showing <the old route>" was still
+    # up, naming a route no longer shown.
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Upload GPX")
+        upload(client, "Upload GPX", "bad.gpx", b"hello, I am not a GPX file")
+        client.wait_for(lambda: bool(client.notices()), what="the notice")
+        client.wait_for(lambda: len(mode.refusal_notices) == 1, what="the notice kept")
+        upload(client, "Upload GPX", "good.gpx", hill_gpx("Good hill"))
+        client.wait_for(lambda: mode.route.name == "Good hill", what="the good route")
+        client.wait_for(
+            lambda: any(m.get("type") == "RemoveNotificationMessage" for _at, m in list(client.received)),
+            what="the notice taken down",
+        )
+        assert not mode.refusal_notices
+
+
 CRAFTED = [
     Crafted("Course power (W)", float("nan"), "power_w", 250.0),
     Crafted("Course power (W)", 1e9, "power_w", 2000.0),
