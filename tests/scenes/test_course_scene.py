@@ -349,61 +349,46 @@ def test_play_from_a_browser(server: viser.ViserServer, mode: CourseMode) -> Non
 # ------------------------------------------------------------------------------------------------ uploads out of order
 # Kind: work that finishes out of order. Two uploads close together parse in parallel on viser's pool; the last
 # file picked must win even when its parse finishes first.
-def test_the_newest_upload_wins_when_an_older_parse_finishes_last(
-    server: viser.ViserServer, mode: CourseMode, monkeypatch: pytest.MonkeyPatch
-) -> None:
+def _slow_parse_of(monkeypatch: pytest.MonkeyPatch, marker: bytes) -> threading.Event:
+    """Make the kernel take a second longer to read a GPX holding ``marker``; the event is set once it has."""
     real = course_kernel.load_gpx
-    older_done = threading.Event()
+    done = threading.Event()
 
-    def slow_for_the_first(source: bytes, **kwargs: object) -> course_kernel.Course:
-        if b"Older hill" in source:
-            time.sleep(1.0)
-            try:
-                return real(source)
-            finally:
-                older_done.set()
-        return real(source)
+    def slow(source: bytes, **kwargs: object) -> course_kernel.Course:
+        if marker not in source:
+            return real(source)
+        time.sleep(1.0)
+        try:
+            return real(source)
+        finally:
+            done.set()
 
-    monkeypatch.setattr(course_kernel, "load_gpx", slow_for_the_first)
-    with BrowserClient(server.get_port()) as client:
-        client.wait_for_gui("Upload GPX")
-        upload(client, "Upload GPX", "older.gpx", hill_gpx("Older hill"))
-        time.sleep(0.2)  # the older parse is under way
-        upload(client, "Upload GPX", "newer.gpx", hill_gpx("Newer hill"))
-        client.wait_for(lambda: mode.route.name == "Newer hill", what="the newer course")
-        assert older_done.wait(5.0)
-        time.sleep(0.3)  # the older parse's install, had it been allowed, has run by now
-    assert mode.route.name == "Newer hill" and mode.route_label == "newer.gpx"
+    monkeypatch.setattr(course_kernel, "load_gpx", slow)
+    return done
 
 
-def test_the_sample_route_pressed_after_an_upload_wins_when_the_upload_finishes_last(
-    server: viser.ViserServer, mode: CourseMode, monkeypatch: pytest.MonkeyPatch
+@pytest.mark.parametrize("then", ["a newer upload", "the sample route"])
+def test_the_last_route_chosen_wins_when_an_older_upload_finishes_last(
+    server: viser.ViserServer, mode: CourseMode, monkeypatch: pytest.MonkeyPatch, then: str
 ) -> None:
-    # The failing input (an outside tester): a 12.5 MiB upload, then "Load the sample route" a second later: the
-    # sample showed, then the upload replaced it when its parse finished. The user's last action wins.
-    real = course_kernel.load_gpx
-    older_done = threading.Event()
-
-    def slow_for_the_upload(source: bytes, **kwargs: object) -> course_kernel.Course:
-        if b"Slow hill" in source:
-            time.sleep(1.0)
-            try:
-                return real(source)
-            finally:
-                older_done.set()
-        return real(source)
-
-    monkeypatch.setattr(course_kernel, "load_gpx", slow_for_the_upload)
+    # The second failing input (an outside tester): a 12.5 MiB upload, then "Load the sample route" a second later:
+    # the sample showed, then the upload replaced it when its parse finished.
+    older_done = _slow_parse_of(monkeypatch, b"Older hill")
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("Upload GPX")
         assert mode.load(hill_gpx("First hill"), "first.gpx")
-        upload(client, "Upload GPX", "slow.gpx", hill_gpx("Slow hill"))
-        time.sleep(0.2)  # the upload's parse is under way
-        client.click("Load the sample route")
-        client.wait_for(lambda: mode.route_label == SAMPLE_LABEL, what="the sample route")
+        upload(client, "Upload GPX", "older.gpx", hill_gpx("Older hill"))
+        time.sleep(0.2)  # the older parse is under way
+        if then == "a newer upload":
+            upload(client, "Upload GPX", "newer.gpx", hill_gpx("Newer hill"))
+            expected = "newer.gpx"
+        else:
+            client.click("Load the sample route")
+            expected = SAMPLE_LABEL
+        client.wait_for(lambda: mode.route_label == expected, what="the last route chosen")
         assert older_done.wait(5.0)
-        time.sleep(0.3)  # the upload's install, had it been allowed, has run by now
-    assert mode.route_label == SAMPLE_LABEL and mode.route.name != "Slow hill"
+        time.sleep(0.3)  # the older parse's install, had it been allowed, has run by now
+    assert mode.route_label == expected and mode.route.name != "Older hill"
 
 
 # Kind: a place on the route the Position slider cannot reach. Its end was the length rounded down to its 10 m
