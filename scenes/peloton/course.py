@@ -9,6 +9,7 @@ from __future__ import annotations
 import contextlib
 import logging
 import math
+import re
 import threading
 from typing import TYPE_CHECKING
 
@@ -846,6 +847,12 @@ _MARKDOWN_ESCAPES = str.maketrans({c: f"&#{ord(c)};" for c in "<>[]*_`~|\\:@.!#"
 GitHub-flavoured markdown makes a link (``http://x``, ``www.x``, ``a@b.c``), as a character reference."""
 
 
+_WORD_JOINER = "\u2060"
+_BARE_ADDRESS = re.compile(r"(?i)(?<=www)(?=\.)|(?<=:)(?=//)|(?=@)")
+"""Where GitHub-flavoured markdown's bare-address links start (``www.``, ``://``, ``@``). Its link finder runs on the
+text after character references are read, so these get an invisible word joiner (U+2060) instead."""
+
+
 def _escape(text: str) -> str:
     """Text from a file, shown in markdown as the same characters: no HTML, links, images or emphasis."""
-    return text.translate(_MARKDOWN_ESCAPES)
+    return _BARE_ADDRESS.sub(_WORD_JOINER, text).translate(_MARKDOWN_ESCAPES)

@@ -230,7 +230,11 @@ def test_file_text_is_escaped_in_the_readouts(mode: CourseMode) -> None:
     info = mode.route_info.content
     for raw in ("http://", "www.", "@", "_it_", "`", "~", "\\"):
         assert raw not in info, raw
-    assert html.unescape(info).count(name) == 1
+    # The link finder reads the text after character references: there a word joiner (U+2060) breaks each address.
+    shown = html.unescape(info)
+    for address in ("http://", "www.", "a@"):
+        assert address not in shown, address
+    assert shown.replace("\u2060", "").count(name) == 1
 
 
 # ------------------------------------------------------------------------------------------------ over the websocket
