@@ -100,6 +100,11 @@ def apply_problem(text: object) -> str | None:
     return None
 
 
+def trial_height(width: int) -> int:
+    """The height (px) of the frame :func:`trial_source` draws ``width`` wide."""
+    return width * 5 // 8
+
+
 def trial_source(
     text: str,
     shadings: list[Shading],
@@ -122,7 +127,7 @@ def trial_source(
         camera,
         field.bounds,
         width,
-        width * 5 // 8,
+        trial_height(width),
         COMPILE_LIMIT_S,
         FRAME_LIMIT_S,
     )

@@ -684,7 +684,8 @@ IoU is lowest when a box edge is on the silhouette.
             self._view_key = None
             self._scene_time = time.monotonic()
             if times is not None:
-                self._trial_cost = (field, times.frame_s / (MOVING_WIDTH_PX * (MOVING_WIDTH_PX * 5 // 8)))
+                per_pixel = times.frame_s / (MOVING_WIDTH_PX * editor.trial_height(MOVING_WIDTH_PX))
+                self._trial_cost = (field, per_pixel)
 
     def _mesh_and_show(self, scene: Shape, resolution: int, *, preview: bool = False) -> None:
         """Mesh ``scene`` at ``resolution`` and show it; a ``preview`` goes to the 3D view only (the readouts, the
