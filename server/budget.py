@@ -56,6 +56,8 @@ class Upload:
     """When its start message was taken (``time.monotonic()``)."""
     bytes_seen: int = 0
     parts_seen: set[int] = dataclasses.field(default_factory=set)
+    button_uuid: str = ""
+    """The upload button it was started on."""
 
 
 Item = typing.TypeVar("Item")

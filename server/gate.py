@@ -77,6 +77,8 @@ class Gate:
         self._client_dispatch: dict[int, Dispatch] = {}
         self._uploads: dict[int, dict[str, Upload]] = {}
         """Per client, the uploads started and not finished, by transfer id."""
+        self._finished_upload_starts: dict[tuple[int, str], float] = {}
+        """When the last upload each (client, upload button) finished was started (:meth:`upload_started_at`)."""
         self._budgets: dict[int, TabBudget] = {}
         """Per client, its costly-input budget (only touched on the event loop)."""
         self._deliveries: set[asyncio.Future[None]] = set()
@@ -94,6 +96,8 @@ class Gate:
         client_id = int(connection.client_id)
         self._client_dispatch.pop(client_id, None)
         self._uploads.pop(client_id, None)
+        for key in [key for key in list(self._finished_upload_starts) if key[0] == client_id]:
+            self._finished_upload_starts.pop(key, None)
         tab = self._budgets.pop(client_id, None)
         if tab is not None and tab.timer is not None:
             tab.timer.cancel()
@@ -263,6 +267,12 @@ class Gate:
             return None, None
         return self._clean_gui(server, client_id, messages.GuiUpdateMessage(matches[0], message.updates))
 
+    def upload_started_at(self, client_id: int, button: object) -> float | None:
+        """When (``time.monotonic()``) the gate took the start of the last upload tab ``client_id`` finished on upload
+        button ``button``; None if none has. A scene reads it in the button's ``on_upload`` to tell a file picked
+        before its user's later choice (which the file, still arriving, would otherwise overrule) from one after."""
+        return self._finished_upload_starts.get((client_id, viser_compat.gui_uuid(button)))
+
     def uploads_in_flight(self) -> tuple[int, int]:
         """(uploads, bytes they announced) started and not finished, across every tab of this server."""
         # Mutated only on the event loop; list() copies each dict in one step under the GIL, so a test thread may
@@ -360,9 +370,10 @@ class Gate:
             return None, None
         if not 0 <= size <= MAX_UPLOAD_BYTES:
             self.log.refuse("upload size", f"{size!r} bytes (limit {MAX_UPLOAD_BYTES})")
-            return None, self._tell(
+            return None, self._end_refused(
                 server,
                 client_id,
+                message,
                 f"The file is {size / MIB:.1f} MiB; this server takes files up to {MAX_UPLOAD_BYTES / MIB:.0f} MiB.",
             )
         if not all(
@@ -380,9 +391,10 @@ class Gate:
         in_flight = self._uploads.setdefault(client_id, {})
         if len(in_flight) >= MAX_UPLOADS_IN_FLIGHT:
             self.log.refuse("uploads in flight", f"more than {MAX_UPLOADS_IN_FLIGHT} at once")
-            return None, self._tell(
+            return None, self._end_refused(
                 server,
                 client_id,
+                message,
                 f"This tab already has {MAX_UPLOADS_IN_FLIGHT} uploads under way; wait for one to finish.",
             )
         own_bytes = sum(upload.size_bytes for upload in list(in_flight.values()))
@@ -391,9 +403,10 @@ class Gate:
                 "upload bytes in flight",
                 f"{own_bytes} + {size} bytes from one tab (limit {MAX_UPLOAD_BYTES_IN_FLIGHT_PER_TAB})",
             )
-            return None, self._tell(
+            return None, self._end_refused(
                 server,
                 client_id,
+                message,
                 f"This tab's uploads under way already announce {own_bytes / MIB:.1f} MiB; it takes "
                 f"{MAX_UPLOAD_BYTES_IN_FLIGHT_PER_TAB / MIB:.0f} MiB at once. Wait for them to finish.",
             )
@@ -404,16 +417,20 @@ class Gate:
                 f"{count} uploads of {total_bytes} bytes under way, {size} more asked (limits "
                 f"{MAX_UPLOADS_IN_FLIGHT_TOTAL} uploads, {MAX_UPLOAD_BYTES_IN_FLIGHT_TOTAL} bytes)",
             )
-            return None, self._tell(
+            return None, self._end_refused(
                 server,
                 client_id,
+                message,
                 f"The server is receiving other uploads ({count} files, "
                 f"{total_bytes / MIB:.1f} MiB in flight from all tabs; it takes "
                 f"{MAX_UPLOADS_IN_FLIGHT_TOTAL} files or {MAX_UPLOAD_BYTES_IN_FLIGHT_TOTAL / MIB:.0f} MiB at "
                 "once). Try again in a moment.",
             )
+        now, button = time.monotonic(), str(message.source_component_uuid)
         if parts > 0:
-            in_flight[message.transfer_uuid] = Upload(parts, size, time.monotonic())
+            in_flight[message.transfer_uuid] = Upload(parts, size, now, now, button_uuid=button)
+        else:  # viser finishes an empty file at its start
+            self._finished_upload_starts[(client_id, button)] = now
         return message, None
 
     def _tell(
@@ -427,6 +444,24 @@ class Gate:
                 client.add_notification(title, body, color="red", auto_close_seconds=15.0)
 
         return notify
+
+    def _end_refused(
+        self, server: viser.ViserServer, client_id: int, start: messages.FileTransferStartUpload, body: str
+    ) -> Callable[[], None]:
+        """What the tab is sent after the gate refused upload ``start``: the upload is ended there, so its button
+        works again (:func:`~server.viser_compat.end_refused_upload`), then a notice says why."""
+        tell = self._tell(server, client_id, body)
+        transfer = start.transfer_uuid
+        if not (isinstance(transfer, str) and len(transfer) <= MAX_NAME_CHARS):
+            return tell  # not a transfer viser's client could have started
+
+        def end_then_tell() -> None:
+            viser_compat.end_refused_upload(
+                server, client_id, str(start.source_component_uuid), transfer, start.size_bytes
+            )
+            tell()
+
+        return end_then_tell
 
     def _drop_stalled_uploads(self, server: viser.ViserServer) -> None:
         """Forget uploads that received no part for :data:`~server.budget.UPLOAD_STALL_S`, and free the parts viser holds."""
@@ -463,6 +498,7 @@ class Gate:
         upload.last_part_at = time.monotonic()
         if len(upload.parts_seen) == upload.part_count:
             del self._uploads[client_id][str(message.transfer_uuid)]
+            self._finished_upload_starts[(client_id, upload.button_uuid)] = upload.started_at
         return message
 
     def _gizmo_handle(self, server: viser.ViserServer, client_id: int, name: str, owner: str) -> Any:

@@ -252,6 +252,14 @@ class Session:
     def flush(self) -> None:
         (self.viser_server if self.client is None else self.client).flush()
 
+    def upload_started_at(self, event: object) -> float | None:
+        """When (``time.monotonic()``) the upload an upload button's ``on_upload`` ``event`` reports was started in
+        its tab, as the gate took its start; None when unknown (:meth:`server.gate.Gate.upload_started_at`)."""
+        client_id, button = getattr(event, "client_id", None), getattr(event, "target", None)
+        if not isinstance(client_id, int) or button is None:
+            return None
+        return install_gate(self.viser_server).upload_started_at(client_id, button)
+
     def get_clients(self) -> dict[int, viser.ClientHandle]:
         """The clients this session serves, by id."""
         if self.client is None:

@@ -26,7 +26,10 @@ viser's code behind each name below, and nothing else. The private names touched
   ``GuiApi._websock_interface``: a control's uuid and liveness, and sending the server's value back
   (:func:`gui_uuid`, :func:`is_removed`, :func:`parent_container_id`, :func:`send_gui_value`).
 - ``ClientHandle._websock_connection``: the client's message buffer, whose ``sanctioned_dead_writes`` scope keeps a
-  closing tab's last writes from warning (:func:`dead_writes_allowed`).
+  closing tab's last writes from warning (:func:`dead_writes_allowed`), and through which a refused upload is ended
+  in that tab alone (:func:`end_refused_upload`).
+- viser's client (``UploadButton.tsx``, not Python): an upload button stays disabled until the acks of its upload
+  reach the size announced, and its progress notice has the id ``upload-<transfer id>`` (:func:`end_refused_upload`).
 - ``viser._assignable_props_api.AssignablePropsBase._cast_value_recursive`` and ``colors_to_uint8``: the property
   cast, replaced for speed by :func:`cast_value_recursive` (:func:`patch_property_cast`).
 
@@ -58,6 +61,7 @@ __all__ = [
     "connected_client",
     "dead_writes_allowed",
     "drop_upload_parts",
+    "end_refused_upload",
     "gizmo_by_name",
     "gui_container_by_uuid",
     "gui_input_by_uuid",
@@ -146,6 +150,32 @@ def drop_upload_parts(server: viser.ViserServer, client_id: int, transfer_uuid: 
     for api in (server.gui, None if client is None else client.gui):
         if api is not None:
             api._current_file_upload_states.pop(transfer_uuid, None)
+
+
+def end_refused_upload(
+    server: viser.ViserServer, client_id: int, button_uuid: str, transfer_uuid: str, size_bytes: int
+) -> None:
+    """End upload ``transfer_uuid`` (of ``size_bytes``, on upload button ``button_uuid``) in tab ``client_id`` after
+    the gate refused its start, so the tab can upload again.
+
+    viser's client disables the button until acks for the whole size arrive, and shows an "Uploading …" notice with
+    a spinner meanwhile; a refused start gets no ack, so both stayed until the page was reloaded. This sends the tab
+    one ack for every byte (the button comes back) and removes that notice, which the ack would otherwise turn into
+    "File uploaded successfully". The gate's own notice then says why the file was refused.
+    """
+    client = connected_client(server, client_id)
+    if client is None:
+        return
+    connection = client._websock_connection  # pyright: ignore[reportPrivateUsage]
+    connection.queue_message(
+        messages.FileTransferPartAck(
+            source_component_uuid=button_uuid,
+            transfer_uuid=transfer_uuid,
+            transferred_bytes=size_bytes,
+            total_bytes=size_bytes,
+        )
+    )
+    connection.queue_message(messages.RemoveNotificationMessage(uuid=f"upload-{transfer_uuid}"))
 
 
 def send_gui_value(handle: Any) -> None:

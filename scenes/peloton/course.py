@@ -11,6 +11,7 @@ import logging
 import math
 import re
 import threading
+import time
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -146,6 +147,9 @@ class CourseMode:
         self._upload_lock = threading.Lock()
         self._upload_seq = 0
         """Number of the newest upload: parses run in parallel on viser's pool, and only the newest installs."""
+        self._chosen_at = 0.0
+        """When (``time.monotonic()``) a route was last loaded by :meth:`load` (the sample button): a file picked
+        before that and still arriving then is not the user's last choice, and is dropped."""
         self.refusal_notices: list[viser.NotificationHandle] = []
         """The "GPX not loaded" notifications still up: the next route loaded, or refused, takes them down, so
         none is left saying "Still showing" a route that is no longer shown."""
@@ -401,11 +405,17 @@ class CourseMode:
         A refused file is also told to the tab that sent it, in a notification: viser's own "uploaded successfully"
         shows there for any file that arrived whole."""
         client = getattr(event, "client", None)
+        started_at = self.server.upload_started_at(event)
         # The number and the file are taken together: a higher number is a newer file.
         with self._upload_lock:
-            self._upload_seq += 1
+            picked_before_a_later_choice = started_at is not None and started_at < self._chosen_at
+            if not picked_before_a_later_choice:
+                self._upload_seq += 1
             seq = self._upload_seq
             uploaded = self.upload.value
+        if picked_before_a_later_choice:
+            self.scene.callback(lambda: self._tell_superseded(client, uploaded))(None)
+            return
         try:
             name = str(getattr(uploaded, "name", "") or "upload")[:80]
             content = getattr(uploaded, "content", b"")
@@ -431,11 +441,24 @@ class CourseMode:
 
         self.scene.callback(install)(None)
 
+    def _tell_superseded(self, client: object, uploaded: object) -> None:
+        """Tell the tab that file ``uploaded`` arrived after a later choice of route, which stays."""
+        if not isinstance(client, viser.ClientHandle):
+            return
+        name = str(getattr(uploaded, "name", "") or "The file")[:80]
+        body = (
+            f"{name} was still arriving when you chose {self.route.name}, which stays. Upload {name} again to ride it."
+        )
+        self.refusal_notices.append(
+            client.add_notification("GPX not loaded", body, color="red", auto_close_seconds=15.0)
+        )
+
     def load(self, data: bytes, label: str) -> bool:
         """Load a GPX file's bytes as the course; on a bad file keep the last good course and show why. An upload
-        still being read is dropped: the user's last choice of route wins (:meth:`_on_upload`)."""
+        still being read, or still arriving, is dropped: the user's last choice of route wins (:meth:`_on_upload`)."""
         with self._upload_lock:
             self._upload_seq += 1
+            self._chosen_at = time.monotonic()
         try:
             route, error = course_kernel.load_gpx(data), None
         except ValueError as failure:

@@ -20,6 +20,8 @@ import numpy as np
 import pytest
 import viser
 from helpers.browser import (
+    TOAST,
+    VIEWPORTS,
     assert_instance_drawn_at,
     canvas_is_not_blank,
     changed_mask,
@@ -30,6 +32,7 @@ from helpers.browser import (
     screen_of,
     screenshot,
     served_scene,
+    served_scene_at,
     settle,
     wait_frames,
     wait_moved_and_still,
@@ -45,6 +48,7 @@ from scenes.arm import ArmScene
 from scenes.freekick import FreeKickScene, ball_spot
 from scenes.peloton import PelotonScene
 from scenes.sdf_gallery import SdfGalleryScene
+from server.budget import MAX_UPLOAD_BYTES, MIB
 
 pytestmark = pytest.mark.browser
 
@@ -247,6 +251,47 @@ def test_upload_a_gpx_and_play_it(server: viser.ViserServer, browser_page: Any, 
         assert has_colour((120, 90, 60)) and has_colour((220, 40, 40))
         # The page tells the person where the leader is.
         page.get_by_text("Leader at", exact=False).first.wait_for(timeout=10_000)
+
+
+@pytest.mark.parametrize("viewport", VIEWPORTS, ids=lambda v: f"{v[0]}x{v[1]}")
+def test_a_file_over_the_upload_limit_is_refused_and_the_button_works_again(
+    server: viser.ViserServer, browser_page: Any, tmp_path: Path, viewport: tuple[int, int]
+) -> None:
+    """A 25 MiB file: the server refused its start, but viser's page kept the "Upload GPX" button disabled and its
+    "Uploading … (25.0M)" spinner up until a reload, waiting for acks that never came. Now the page shows only the
+    refusal, and the button uploads the next file."""
+    with served_scene_at(server, browser_page, "peloton", "/peloton/course_mode/route", viewport) as served:
+        scene, page = served.scene, served.page
+        assert isinstance(scene, PelotonScene)
+        mode = scene.course_mode
+        close_notifications(page)
+        page.get_by_text("Ride a course", exact=True).first.click()
+        wait_until(lambda: mode.enabled and mode.state is not None, "course mode on", timeout_s=15.0)
+        button = page.get_by_role("button", name="Upload GPX")
+
+        big = tmp_path / "too_big.gpx"
+        big.write_bytes(b" " * (MAX_UPLOAD_BYTES + MIB))
+        with page.expect_file_chooser() as chooser:
+            button.click()
+        chooser.value.set_files(str(big))
+        refusal = page.locator(TOAST, has_text="Upload refused")
+        refusal.wait_for(timeout=15_000)
+        assert "The file is 25.0 MiB; this server takes files up to 24 MiB." in refusal.inner_text()
+        page.wait_for_function(
+            "() => ![...document.querySelectorAll('button')].some(b => b.textContent.includes('Upload GPX') && b.disabled)",
+            timeout=10_000,
+        )
+        wait_frames(page, 5)
+        toasts = [page.locator(TOAST).nth(i).inner_text() for i in range(page.locator(TOAST).count())]
+        assert all("Uploading" not in text and "successfully" not in text for text in toasts), toasts
+        screenshot(page, str(tmp_path / "refused.png"))
+
+        small = tmp_path / "after.gpx"
+        small.write_bytes(hill_gpx("After the refusal", 800))
+        with page.expect_file_chooser() as chooser:
+            button.click()
+        chooser.value.set_files(str(small))
+        wait_until(lambda: mode.route.name == "After the refusal", "the next upload", timeout_s=20.0)
 
 
 # ------------------------------------------------------------------------------------------------ the free kick

@@ -8,6 +8,7 @@ import math
 import re
 import threading
 import time
+import uuid
 
 import numpy as np
 import pytest
@@ -16,7 +17,7 @@ from helpers.browser import VIEWPORTS
 from helpers.gpx import BAD_FILES, gpx_text, hill_gpx
 from helpers.scenes import glb_vertices, scene_fixture
 from helpers.screen_geometry import pinhole_ndc
-from helpers.uploads import upload
+from helpers.uploads import send_part, upload
 from helpers.wsclient import BrowserClient, Crafted, crafted_sent
 
 from kernels import course as course_kernel
@@ -393,6 +394,46 @@ def test_the_last_route_chosen_wins_when_an_older_upload_finishes_last(
         assert older_done.wait(5.0)
         time.sleep(0.3)  # the older parse's install, had it been allowed, has run by now
     assert mode.route_label == expected and mode.route.name != "Older hill"
+
+
+def test_a_file_still_arriving_when_the_sample_route_is_chosen_does_not_replace_it(
+    server: viser.ViserServer, mode: CourseMode
+) -> None:
+    """The kind above, one step earlier: a 17 MiB upload still being sent when "Load the sample route" was pressed
+    arrived afterwards and, as the newest file, replaced the sample. A file picked before the user's later choice
+    now stays out, and its tab is told."""
+    data = hill_gpx("Sent before", 3000)
+    half = len(data) // 2
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Upload GPX")
+        assert mode.load(hill_gpx("First hill"), "first.gpx")
+        transfer = str(uuid.uuid4())
+        button = client.uuid_of("Upload GPX")
+        client.send(
+            "FileTransferStartUpload",
+            source_component_uuid=button,
+            transfer_uuid=transfer,
+            filename="before.gpx",
+            mime_type="application/gpx+xml",
+            part_count=2,
+            size_bytes=len(data),
+        )
+        send_part(client, transfer, 0, data[:half])
+        client.wait_for(
+            lambda: any(m.get("type") == "FileTransferPartAck" for _at, m in list(client.received)),
+            what="the first part taken",
+        )
+        client.click("Load the sample route")
+        client.wait_for(lambda: mode.route_label == SAMPLE_LABEL, what="the sample route")
+        send_part(client, transfer, 1, data[half:])
+        client.wait_for(lambda: any("before.gpx" in n["body"] for n in client.notices()), what="the tab told")
+        time.sleep(0.3)  # an install, had the file been let through, has run by now
+        (note,) = [n for n in client.notices() if "before.gpx" in n["body"]]
+        assert note["title"] == "GPX not loaded" and "was still arriving when you chose" in note["body"]
+        # A file picked after that choice loads as before.
+        upload(client, "Upload GPX", "after.gpx", hill_gpx("Picked after"))
+        client.wait_for(lambda: mode.route_label == "after.gpx", what="the later upload")
+    assert mode.route.name == "Picked after"
 
 
 # Kind: a place on the route the Position slider cannot reach. Its end was the length rounded down to its 10 m
