@@ -88,6 +88,8 @@ def test_lengths_preserved_and_finite(chain: tuple[int, int, int], where: float,
 def test_reachable_targets_are_reached(chain: tuple[int, int, int], where: float, solver: fabrik.Solver) -> None:
     n, d, seed = chain
     n = max(n, 2)  # one link reaches only its own circle
+    if solver == "jacobian_dls" and d == 2:
+        n = max(n, 3)  # plain DLS can stall on a planar two-link chain: see the test after this one
     rng = np.random.default_rng(seed)
     joints = random_chain(rng, n, d)
     inner, outer = fabrik.reach_limits(fabrik.link_lengths(joints))
@@ -99,6 +101,42 @@ def test_reachable_targets_are_reached(chain: tuple[int, int, int], where: float
     assert result.status == "reached"
     assert result.error < tolerance
     assert np.linalg.norm(result.joints[-1] - target) < tolerance
+
+
+# Kind: a planar two-link chain, which has no spare freedom, under plain damped least squares with its fixed
+# damping. Where the target asks for a nearly folded elbow, the steps overshoot back and forth across the folded,
+# singular pose (where Jᵀe → 0); where it lies behind the chain, Jᵀe is small and the chain swings round slowly.
+# The method does this (Buss & Kim 2005, selectively damped least squares, is the published remedy); the solver
+# says so by not claiming "reached". An explore run drew the first case; 24 of 8,000 two-link chains drawn with targets in the
+# inner 40 % of the reach behaved so (all planar), none of 5,256 with three or more links or in 3D. FABRIK and CCD reach both targets.
+@pytest.mark.parametrize(
+    ("joints", "target", "best_error_m"),
+    [
+        (  # elbow nearly folded: the target 0.097 m from the root, 0.028 m beyond the folded reach
+            [[0.48623859, -0.28313472], [0.70236197, 0.13626589], [0.84062411, 0.55834103]],
+            [0.42838135, -0.20519768],
+            0.134,
+        ),
+        (  # the target behind the chain, 2.9 m from its end effector
+            [[0.52756938, -0.71312533], [-0.31272923, 0.48627492], [-0.25203530, 0.74902191]],
+            [1.63943953, -1.38961195],
+            2.25,
+        ),
+    ],
+)
+def test_plain_dls_can_stall_on_a_planar_two_link_chain_where_fabrik_and_ccd_reach(
+    joints: list[list[float]], target: list[float], best_error_m: float
+) -> None:
+    chain, goal = np.array(joints), np.array(target)
+    _inner, outer = fabrik.reach_limits(fabrik.link_lengths(chain))
+    tolerance = 1e-3 * outer
+    dls = fabrik.jacobian_dls(chain, goal, tolerance=tolerance, max_iterations=3000)
+    assert dls.status == "max_iterations"
+    assert dls.error == pytest.approx(best_error_m, abs=0.01)
+    assert np.linalg.norm(dls.joints[-1] - goal) == pytest.approx(dls.error, abs=1e-12)
+    for solve in (fabrik.solve, fabrik.ccd):
+        result = solve(chain, goal, tolerance=tolerance, max_iterations=3000)
+        assert result.status == "reached" and result.error < tolerance
 
 
 @PROPERTY
