@@ -11,9 +11,11 @@ frame that does not decode ends the sender's connection with a traceback. Only t
 - a **camera**: finite numbers, a unit quaternion, positive image sizes; otherwise the client's last good camera.
 
 Everything else is refused, and each kind of refusal is logged once (one line, no traceback) per
-:attr:`server.refusals.RefusalLog.interval_s`, with a count of the ones left unlogged. After each accepted value the
-server's value is sent back to every viewer, so two browsers moving one slider a few milliseconds apart end on the
-same value.
+:attr:`server.refusals.RefusalLog.interval_s`, with a count of the ones left unlogged. The server's value is sent
+back to the sender only where the sender may show another (:meth:`Gate._echo`): after a refusal, after a clean that
+changed the value, and when another tab or the scene wrote the control a moment before (so two browsers moving one
+slider a few milliseconds apart end on the same value). Not while a person may still be typing: viser's page sends
+a box's value at every keystroke, and a value sent back over the box reset what was being typed.
 
 Frames are decoded by :mod:`server.decode`; values are cleaned against each control's recorded spec
 (:mod:`server.clean`); the costly-input and upload budgets are :mod:`server.budget`'s. What the gate needs of viser's
@@ -25,6 +27,7 @@ from __future__ import annotations
 import asyncio
 import dataclasses
 import functools
+import math
 import threading
 import time
 import weakref
@@ -47,7 +50,7 @@ from server.budget import (
     TabBudget,
     Upload,
 )
-from server.clean import clean_value, control_spec, finite_vector, unit_quaternion
+from server.clean import ControlSpec, clean_value, control_spec, finite_vector, unit_quaternion
 from server.decode import ALLOWED_MESSAGES, camera_fields, click_problem, decode_frame
 from server.refusals import refusals
 from server.viser_compat import Dispatch, messages
@@ -61,6 +64,13 @@ IN_LINE = (
     messages.ScenePointerMessage,
 )
 """The inputs a tab's held-back or running scene switch or Reset keeps in line behind it: values, drags, clicks."""
+ECHO_AFTER_TYPING_S = 1.5
+"""A value clamped up from nearer zero than the control's range (the "7" on the way to "75" in a box of 30..150)
+is sent back to its tab only after the tab has sent nothing to that control for this long: more digits may still
+bring it into range, and viser's box clamps by itself when it loses focus."""
+ECHO_IN_FLIGHT_S = 1.0
+"""A value of a control sent to a tab this recently (another tab's edit, the scene's write, a send-back) may reach
+it after the tab's own next edit of that control: that edit's value is then sent back too, so the tab ends on it."""
 
 
 class Gate:
@@ -77,6 +87,12 @@ class Gate:
         self._client_dispatch: dict[int, Dispatch] = {}
         self._uploads: dict[int, dict[str, Upload]] = {}
         """Per client, the uploads started and not finished, by transfer id."""
+        self._seen_at: dict[tuple[int, str], float] = {}
+        """Per (tab, control uuid), the control's ``update_timestamp`` after the tab's last edit of it was applied."""
+        self._echoes: dict[tuple[int, str], asyncio.TimerHandle] = {}
+        self._echoed_at: dict[tuple[int, str], float] = {}
+        """Per (tab, control uuid), when the server's value was last sent back to that tab."""
+        """Per (tab, control uuid), a send-back waiting for the tab to stop typing (:data:`ECHO_AFTER_TYPING_S`)."""
         self._finished_upload_starts: dict[tuple[int, str], float] = {}
         """When the last upload each (client, upload button) finished was started (:meth:`upload_started_at`)."""
         self._budgets: dict[int, TabBudget] = {}
@@ -98,6 +114,12 @@ class Gate:
         self._uploads.pop(client_id, None)
         for key in [key for key in list(self._finished_upload_starts) if key[0] == client_id]:
             self._finished_upload_starts.pop(key, None)
+        for key in [key for key in list(self._seen_at) if key[0] == client_id]:
+            self._seen_at.pop(key, None)
+        for key in [key for key in list(self._echoes) if key[0] == client_id]:
+            self._echoes.pop(key).cancel()
+        for key in [key for key in list(self._echoed_at) if key[0] == client_id]:
+            self._echoed_at.pop(key, None)
         tab = self._budgets.pop(client_id, None)
         if tab is not None and tab.timer is not None:
             tab.timer.cancel()
@@ -332,9 +354,16 @@ class Gate:
             return None, None
         spec = control_spec(handle)
         accepted, value, reason = clean_value(spec, updates["value"])
-        # After each change, and after each refusal (the sender shows its own edit), every viewer is sent the
-        # server's value: two viewers that moved one slider a few ms apart both end on the server's.
-        send_back = functools.partial(viser_compat.send_gui_value, handle)
+        key = (client_id, str(message.uuid))
+        waiting = self._echoes.pop(key, None)
+        if waiting is not None:  # the tab is still at it: its newer value decides
+            waiting.cancel()
+
+        # After a refusal the sender still shows its own edit: every viewer is sent the server's value.
+        def send_back() -> None:
+            self._echoed_at[key] = time.monotonic()
+            viser_compat.send_gui_value(handle)
+
         if not accepted:
             label = str(getattr(handle, "label", "?"))
             self.log.refuse(f"GUI value ({reason})", f"{label!r} got {updates['value']!r}"[:200])
@@ -353,7 +382,56 @@ class Gate:
 
                 return None, send_back_and_tell
             return None, send_back
-        return messages.GuiUpdateMessage(message.uuid, {"value": value}), send_back
+        return messages.GuiUpdateMessage(message.uuid, {"value": value}), self._echo(
+            key, handle, spec, updates["value"], value, send_back
+        )
+
+    def _echo(
+        self,
+        key: tuple[int, str],
+        handle: Any,
+        spec: ControlSpec,
+        sent: object,
+        value: object,
+        send_back: Callable[[], None],
+    ) -> Callable[[], None]:
+        """What to send tab ``key[0]`` after its value ``sent`` for control ``key[1]`` was accepted as ``value``.
+
+        viser sends an accepted value to every other viewer, but not to its sender, which shows what it sent. So the
+        sender is sent the server's value only where it may show another: at once after a value sent to it that may
+        arrive after its edit (another tab's or the scene's write, or an earlier send-back, within
+        :data:`ECHO_IN_FLIGHT_S`) or after a clean it cannot foresee; once it stops typing where more typing may still
+        bring the value into range (:data:`ECHO_AFTER_TYPING_S`); otherwise never, so a box being typed in keeps
+        its text. Whatever is sent, the write that this edit makes is then counted as seen by the tab.
+        """
+        written_at = float(handle.update_timestamp)  # the last write of this control, by anyone (time.time())
+        written_to_it = time.time() - written_at < ECHO_IN_FLIGHT_S and written_at > self._seen_at.get(key, 0.0)
+        echoed = time.monotonic() - self._echoed_at.get(key, -math.inf) < ECHO_IN_FLIGHT_S
+
+        def seen() -> None:
+            self._seen_at[key] = float(handle.update_timestamp)
+
+        def now() -> None:
+            seen()
+            send_back()
+
+        if written_to_it or echoed:
+            return now
+        if _same_value(sent, value):
+            return seen
+        if spec.kind == "number" and _may_be_typed_on(sent, spec):
+
+            def later() -> None:
+                seen()
+
+                def echo() -> None:
+                    self._echoes.pop(key, None)
+                    send_back()
+
+                self._echoes[key] = asyncio.get_running_loop().call_later(ECHO_AFTER_TYPING_S, echo)
+
+            return later
+        return now
 
     def _clean_upload_start(
         self, server: viser.ViserServer, client_id: int, message: messages.FileTransferStartUpload
@@ -603,3 +681,22 @@ device pixels put the scene under the panel on HiDPI screens, and each resolutio
 (during a drag, too). The script wraps the client's ``sendMessage`` (reassigned on each connection, so each
 connection gets the script again) and sends the camera once at once.
 """
+
+
+def _same_value(sent: object, value: object) -> bool:
+    """Whether a browser that sent ``sent`` shows ``value`` (a number as int or float, a vector as list or tuple)."""
+    if isinstance(sent, (list, tuple)) and isinstance(value, (list, tuple)):
+        return len(sent) == len(value) and all(_same_value(a, b) for a, b in zip(sent, value, strict=True))
+    if isinstance(sent, bool) or isinstance(value, bool):
+        return sent is value
+    if isinstance(sent, (int, float)) and isinstance(value, (int, float)):
+        return float(sent) == float(value)
+    return type(sent) is type(value) and sent == value
+
+
+def _may_be_typed_on(sent: object, spec: ControlSpec) -> bool:
+    """Whether number ``sent``, outside ``spec``'s range, lies between zero and the range: a box's text on its way to
+    a number in range (typing a digit moves a number away from zero, never towards it)."""
+    if isinstance(sent, bool) or not isinstance(sent, (int, float)) or not math.isfinite(sent):
+        return False
+    return (spec.lo is not None and 0.0 <= sent < spec.lo) or (spec.hi is not None and spec.hi < sent <= 0.0)

@@ -49,6 +49,7 @@ from scenes.freekick import FreeKickScene, ball_spot
 from scenes.peloton import PelotonScene
 from scenes.sdf_gallery import SdfGalleryScene
 from server.budget import MAX_UPLOAD_BYTES, MIB
+from server.gate import ECHO_AFTER_TYPING_S
 
 pytestmark = pytest.mark.browser
 
@@ -292,6 +293,48 @@ def test_a_file_over_the_upload_limit_is_refused_and_the_button_works_again(
             button.click()
         chooser.value.set_files(str(small))
         wait_until(lambda: mode.route.name == "After the refusal", "the next upload", timeout_s=20.0)
+
+
+# ------------------------------------------------------------------------------------------------ typing in a box
+# Kind: the server's value sent back over a box a person is still typing in. viser's page sends a box's value at
+# every keystroke; the server sent each (clamped) value back, so "75" typed into Mass (30–150 kg) became 30 at the
+# "7" and then 150, "300" W became 2000, and "1234" typed fast lost digits.
+def _type(page: Any, label: str, text: str, delay_ms: float) -> Any:
+    box = control_row(page, label).locator("input").last
+    box.click()
+    box.press("Control+a")
+    box.type(text, delay=delay_ms)
+    return box
+
+
+@pytest.mark.parametrize("viewport", VIEWPORTS, ids=lambda v: f"{v[0]}x{v[1]}")
+def test_a_number_typed_into_a_box_keystroke_by_keystroke_is_kept(
+    server: viser.ViserServer, browser_page: Any, viewport: tuple[int, int]
+) -> None:
+    typed = [  # label, text, field, value, keystroke gap (ms)
+        ("Mass, rider + bike (kg)", "75", "mass_kg", 75.0, 250),  # "7" is below the range
+        ("Mass, rider + bike (kg)", "123", "mass_kg", 123.0, 150),  # "1", "12" are below it
+        ("Drivetrain efficiency (%)", "95", "drivetrain_pct", 95.0, 250),
+        ("Speed (km/h)", "35.5", "speed_kmh", 35.5, 200),  # a slider's box
+        ("Power (W)", "1234", "target_power_w", 1234.0, 0),  # a number box, typed as fast as the page takes keys
+    ]
+    with served_scene_at(server, browser_page, "peloton", "/peloton", viewport) as served:
+        scene, page = served.scene, served.page
+        assert isinstance(scene, PelotonScene)
+        close_notifications(page)
+        for label, text, field, value, delay_ms in typed:
+            box = _type(page, label, text, delay_ms)
+            wait_until(lambda f=field, v=value: getattr(scene.params, f) == v, f"{label} = {text}", timeout_s=10.0)
+            time.sleep(ECHO_AFTER_TYPING_S + 0.5)  # anything the server would send back has arrived
+            assert box.input_value() == text, (label, box.input_value())
+            assert getattr(scene.params, field) == value
+
+        # Out of range, the box is put right once the person stops typing: below the range after a pause, above it
+        # at once (no digit typed after it can bring it back).
+        for text, shown in (("7", "30"), ("1500", "150")):
+            box = _type(page, "Mass, rider + bike (kg)", text, 100)
+            wait_until(lambda b=box, s=shown: b.input_value() == s, f"{text} shown as {shown}", timeout_s=10.0)
+            assert scene.params.mass_kg == float(shown)
 
 
 # ------------------------------------------------------------------------------------------------ the free kick
