@@ -123,6 +123,12 @@ def mark_costly(handle: H) -> H:
 
 
 # ------------------------------------------------------------------------------------------------ values
+NEGLIGIBLE = 1e-9
+"""A number nearer zero than this share of its control's range (1 where the range is open; a vector's component:
+this) is taken as zero. No control means anything at that resolution, and a tiny one underflowed downstream: a
+headwind of 1e-320 m/s has a direction whose norm is 0, so the wind arrow was drawn from NaN."""
+
+
 def finite_number(value: object) -> float | None:
     """``value`` as a float when it is a finite int or float (not a bool), else None."""
     if isinstance(value, bool) or not isinstance(value, (int, float)):
@@ -177,6 +183,9 @@ def clean_value(spec: ControlSpec, value: object) -> tuple[bool, Any, str]:
                 whole = int(number)
                 whole = whole if lo is None else max(whole, lo)
                 return True, (whole if hi is None else min(whole, hi)), ""
+            span = 1.0 if spec.lo is None or spec.hi is None else spec.hi - spec.lo
+            if abs(number) < NEGLIGIBLE * span:
+                number = 0.0
             if spec.lo is not None:
                 number = max(number, spec.lo)
             if spec.hi is not None:
@@ -199,6 +208,6 @@ def clean_value(spec: ControlSpec, value: object) -> tuple[bool, Any, str]:
             vector = finite_vector(value, spec.length)
             if vector is None:
                 return False, None, f"a vector that is not {spec.length} finite numbers"
-            return True, vector, ""
+            return True, tuple(0.0 if abs(x) < NEGLIGIBLE else x for x in vector), ""
         case "display":
             return False, None, "a value for a control a browser may not set"

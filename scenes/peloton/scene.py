@@ -851,12 +851,12 @@ time-averaged power is the mean over positions, far below the leader's.
         headwind, across from the left for a crosswind from the left), 0.25 m per m/s up to 15 m/s."""
         p = self.params
         length = _arrow_length(p)
-        if length == 0.0:
+        speed = math.hypot(p.headwind_ms, p.crosswind_ms)  # no underflow: a tiny wind has a direction too
+        if length == 0.0 or not speed > 0.0:
             self.wind_arrow.visible = self.wind_label.visible = False
             return
         self.wind_arrow.visible = self.wind_label.visible = True
-        blowing = np.array([-p.headwind_ms, -p.crosswind_ms, 0.0])
-        u = blowing / float(np.linalg.norm(blowing))
+        u = np.array([-p.headwind_ms, -p.crosswind_ms, 0.0]) / speed
         centre = np.array([3.0 + 0.5 * length, 0.0, 1.2])
         tail, tip = centre - 0.5 * length * u, centre + 0.5 * length * u
         head = [tip - 0.3 * u + [0.0, 0.0, 0.2], tip - 0.3 * u - [0.0, 0.0, 0.2]]

@@ -442,6 +442,38 @@ def test_huge_numbers_clamp_to_the_range_the_scene_declared(server: viser.ViserS
                     assert math.isfinite(value), name
 
 
+# Kind: a finite number so small that a scene's arithmetic underflows on it. A headwind of 1e-320 m/s was in range
+# and finite, so it came through; the wind arrow's direction divided by its norm, 0, and viser was sent NaN points.
+@pytest.mark.parametrize("tiny", [1e-320, -1e-300, 1e-200, -5e-160])
+def test_numbers_nearer_zero_than_their_range_can_tell_are_zero(
+    server: viser.ViserServer, key: str, tiny: float, capfd: pytest.CaptureFixture[str]
+) -> None:
+    with two_viewers(server, key) as (switcher, attacker, _observer):
+        handles = gui_inputs(server.gui)
+        numbers = {
+            uuid: control_spec(handles[uuid])
+            for uuid, e in attacker.gui.items()
+            if e["type"] in ("GuiSliderMessage", "GuiNumberMessage")
+        }
+        for uuid in numbers:
+            attacker.send("GuiUpdateMessage", uuid=uuid, updates={"value": tiny})
+        for uuid, spec in numbers.items():
+            expected = min(max(0.0, spec.lo if spec.lo is not None else 0.0), spec.hi if spec.hi is not None else 0.0)
+            handle = handles[uuid]
+            attacker.wait_for(
+                lambda h=handle, e=expected: float(h.value) == e,  # type: ignore[attr-defined]
+                timeout=60,
+                what=f"{getattr(handle, 'label', uuid)} at {expected}",
+            )
+        time.sleep(0.5)  # the scene's callbacks have drawn
+        scene = switcher.scene
+        with scene._lock:
+            for name in scene.params.__dataclass_fields__:  # type: ignore[attr-defined]
+                value = getattr(scene.params, name)  # type: ignore[attr-defined]
+                assert not (isinstance(value, float) and 0.0 < abs(value) < 1e-9), (name, value)
+    assert "RuntimeWarning" not in capfd.readouterr().err
+
+
 @pytest.mark.parametrize(
     ("updates", "kind"),
     [
