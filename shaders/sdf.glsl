@@ -198,8 +198,9 @@ float sd_ellipsoid(vec3 p, vec3 radii) {  // a bound, not exact; -min(radii) at 
     return k1 > 0.0 ? k0 * (k0 - 1.0) / k1 : -min(radii.x, min(radii.y, radii.z));
 }
 
-float sd_ellipsoid_lipschitz(vec3 p, vec3 radii) {  // a 1-Lipschitz bound: (|p/r| - 1)·min(r)
-    return (length(p / radii) - 1.0) * min(radii.x, min(radii.y, radii.z));
+float sd_ellipsoid_lipschitz(vec3 p, vec3 radii) {  // a 1-Lipschitz bound: max((|p/r| - 1)·min(r), |p| - max(r))
+    return max((length(p / radii) - 1.0) * min(radii.x, min(radii.y, radii.z)),
+               length(p) - max(radii.x, max(radii.y, radii.z)));
 }
 
 float sd_plane(vec3 p, vec3 normal, float offset) {  // exact; n·p + offset, n normalised here
