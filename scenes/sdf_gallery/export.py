@@ -59,11 +59,21 @@ def download(
             return Download(name, mesh_file(fmt, vertices, faces, colors))
 
 
+Z_UP_TO_Y_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
+"""The rotation (a quarter turn about x) from the scene's frame, z up, to y up: (x, y, z) → (x, z, −y)."""
+Y_UP_FORMATS: frozenset[MeshFormat] = frozenset({"glb", "obj"})
+"""The formats written y up: glTF 2.0 defines +y as up, and OBJ readers (Blender's among them) take +y as up. STL
+stays z up, as slicers for 3D printing read it."""
+
+
 def mesh_file(fmt: MeshFormat, vertices: np.ndarray, faces: np.ndarray, colors: np.ndarray) -> bytes:
-    """The mesh as a file of format ``fmt``, with its colours where the format has them; ValueError for a mesh of
-    no triangles (its files would be broken: an OBJ of bare ``v``/``f`` lines, a GLB node with no mesh)."""
+    """The mesh as a file of format ``fmt``, with its colours where the format has them, in the format's own up
+    direction (:data:`Y_UP_FORMATS`); ValueError for a mesh of no triangles (its files would be broken: an OBJ of
+    bare ``v``/``f`` lines, a GLB node with no mesh)."""
     if len(faces) == 0:
         raise ValueError("a mesh of no triangles has no file")
+    if fmt in Y_UP_FORMATS:  # a rotation: the winding, hence the outward side, is kept
+        vertices = np.asarray(vertices, dtype=np.float64) @ Z_UP_TO_Y_UP.T
     data = sdf.mesh_trimesh(vertices, faces, colors).export(file_type=fmt)
     return data.encode() if isinstance(data, str) else bytes(data)
 

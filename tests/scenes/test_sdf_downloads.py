@@ -116,6 +116,25 @@ def test_a_shape_downloads_as_files_that_parse_back_with_its_triangles(
             assert triangles_in(data, fmt) == triangles
 
 
+def test_each_mesh_download_has_its_format_s_up_direction(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
+    """glTF 2.0 defines +y as up and OBJ readers take it so; the scene is z up, so a GLB lay on its side in Blender
+    and web viewers. GLB and OBJ are written y up, STL (read by slicers) z up; each is the scene's mesh turned."""
+    lo, hi = np.asarray(scene.mesh_vertices).min(axis=0), np.asarray(scene.mesh_vertices).max(axis=0)
+    assert hi[2] - lo[2] > 0.1 and not np.isclose(hi[1] - lo[1], hi[2] - lo[2])  # tells y from z
+    y_up = {"x": (lo[0], hi[0]), "y": (lo[2], hi[2]), "z": (-hi[1], -lo[1])}
+    z_up = {"x": (lo[0], hi[0]), "y": (lo[1], hi[1]), "z": (lo[2], hi[2])}
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Download mesh (GLB)")
+        for fmt, expected in (("glb", y_up), ("obj", y_up), ("stl", z_up)):
+            kind, _name, data = press(client, BUTTONS[fmt])
+            assert kind == "file"
+            loaded = trimesh.load(io.BytesIO(data), file_type=fmt, force="mesh", process=False)
+            assert isinstance(loaded, trimesh.Trimesh)
+            for axis, (a, b) in zip("xyz", loaded.bounds.T, strict=True):
+                assert (a, b) == pytest.approx(expected[axis], abs=1e-5), (fmt, axis)
+            assert loaded.is_winding_consistent and loaded.volume > 0  # still wound outward
+
+
 def test_no_reference_image_downloads_nothing_with_the_same_notice(
     server: viser.ViserServer, show_scene: MakeScene, monkeypatch: pytest.MonkeyPatch
 ) -> None:
