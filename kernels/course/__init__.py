@@ -48,6 +48,7 @@ from kernels.course.gpx import (
     MAX_FILE_BYTES,
     MAX_GPX_GRADE,
     MAX_SEGMENT_GAP_M,
+    MIN_COURSE_M,
     SAMPLE_ROUTE,
     load_gpx,
 )
@@ -94,6 +95,7 @@ __all__ = [
     "MAX_POINTS",
     "MAX_POWER_W",
     "MAX_SEGMENT_GAP_M",
+    "MIN_COURSE_M",
     "MIN_ELEVATION_M",
     "SAMPLE_ROUTE",
     "SMOOTHING_FLOOR_M",

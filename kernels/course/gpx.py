@@ -2,7 +2,8 @@
 
 :func:`load_gpx` takes a path, bytes or text (at most 20 MiB and 200 000 points), decodes it by its byte-order mark or
 XML declaration (XML 1.0 §4.3.3), parses it with gpxpy, and refuses points off the map, pieces more than 2 km
-apart, and any stretch steeper than 50 % (:data:`MAX_GPX_GRADE`), which no road is. The pieces are every track
+apart, any stretch steeper than 50 % (:data:`MAX_GPX_GRADE`), which no road is, and a route shorter than
+:data:`MIN_COURSE_M` (100 m), too short to ride or draw. The pieces are every track
 segment and every route, joined in the order the file gives them: points arriving as tracks, as segments of one
 track, as routes or as a mix of them make the same course, under the same rule. :data:`SAMPLE_ROUTE` is the
 bundled Alpe d'Huez course in ``kernels/routes/``.
@@ -61,7 +62,7 @@ def load_gpx(source: str | os.PathLike[str] | bytes, *, name: str | None = None,
     Raises:
         ValueError: with a message a person can act on: the file is larger than 20 MiB, not GPX (or not text),
             has no track points, one point, points without elevation, non-finite or out-of-range values, more
-            than 200 000 points, a stretch steeper than :data:`MAX_GPX_GRADE` (50 %), or consecutive pieces (track
+            than 200 000 points, a route shorter than :data:`MIN_COURSE_M` (100 m), a stretch steeper than :data:`MAX_GPX_GRADE` (50 %), or consecutive pieces (track
             segments or routes, in any mix) more than :data:`MAX_SEGMENT_GAP_M` (2 km) apart; the message names
             both pieces and the gap. Nothing else escapes for a bad file. A bad ``name`` or ``smoothing_m`` is
             refused naming it.
@@ -75,7 +76,7 @@ def load_gpx(source: str | os.PathLike[str] | bytes, *, name: str | None = None,
     label = "the file"
     if isinstance(source, bytes):
         if len(source) > MAX_FILE_BYTES:
-            raise ValueError(f"the file is {len(source) / 2**20:.1f} MiB; the limit is 20 MiB")
+            raise ValueError(f"the file is {_mib(len(source))}; the limit is 20 MiB")
         data = source
     elif isinstance(source, os.PathLike) or (
         isinstance(source, str) and not source.lstrip("\ufeff \t\r\n").startswith("<")
@@ -85,7 +86,7 @@ def load_gpx(source: str | os.PathLike[str] | bytes, *, name: str | None = None,
         try:
             size = path.stat().st_size
             if size > MAX_FILE_BYTES:
-                raise ValueError(f"{label} is {size / 2**20:.1f} MiB; the limit is 20 MiB")
+                raise ValueError(f"{label} is {_mib(size)}; the limit is 20 MiB")
             data = path.read_bytes()  # a directory or an unreadable file: OSError, as a missing one
         except OSError as error:
             raise ValueError(f"cannot read {path}: {error.strerror}") from error
@@ -145,10 +146,15 @@ def load_gpx(source: str | os.PathLike[str] | bytes, *, name: str | None = None,
     except ValueError as error:  # the builders name the course; a reader is told about the file
         message = str(error).removeprefix(f"{title}: ")
         raise ValueError(f"{label}: {message}") from error
-    _check_grades(label, result)
+    _check_grades(label, result)  # a cliff's words first: a vertical profile is short on the map too
+    _check_length(label, kind, result)
     return result
 
 
+MIN_COURSE_M = 100.0
+"""Shortest route :func:`load_gpx` accepts, along the map (m): ten steps of the scene's 10 m Position slider, longer
+than the 45 m of a group the scene frames (so its Start and Finish lines are never framed as one), and a ride of
+some twenty seconds from rest. A shorter file (two points a centimetre apart) rode to "Finish 0:00"."""
 MAX_GPX_GRADE = 0.5
 """Steepest grade :func:`load_gpx` accepts (50 %), over any stretch of :data:`GRADE_WINDOW_M` (or the whole route
 if shorter), raw and smoothed. The steepest paved streets are about 35–37 % (Baldwin Street, Canton Avenue), so a
@@ -213,8 +219,10 @@ def _check_values(
         out = (values < low) | (values > high)
         if np.any(out):
             first = int(np.argmax(out))
+            value = float(values[first])
+            shown = _as_given(value)
             span = f"±{_spaced(high)}{unit}" if low == -high else f"{_spaced(low)}{unit} to {_spaced(high)}{unit}"
-            raise ValueError(f"{label}: {kind} point {first + 1} has {what} {values[first]:g}{unit}, outside {span}")
+            raise ValueError(f"{label}: {kind} point {first + 1} has {what} {shown}{unit}, outside {span}")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -266,7 +274,8 @@ def _check_gaps(label: str, pieces: Sequence[_Piece]) -> None:
         gap = _great_circle_m(a.latitude, a.longitude, b.latitude, b.longitude)
         if gap > MAX_SEGMENT_GAP_M:
             raise ValueError(
-                f"{label}: segment {i + 1} starts {_km(gap)} from where segment {i} ends (segment {i} is "
+                f"{label}: segment {i + 1} starts {_beyond(gap / 1000, MAX_SEGMENT_GAP_M / 1000, 1)} km from where "
+                f"segment {i} ends (segment {i} is "
                 f"{pieces[i - 1].name}, segment {i + 1} is {pieces[i].name}; at most "
                 f"{MAX_SEGMENT_GAP_M / 1000:.0f} km is joined); load the pieces as separate files"
             )
@@ -284,8 +293,43 @@ def _spaced(number: float, digits: int = 0) -> str:
     return f"{number:,.{digits}f}".replace(",", " ")
 
 
-def _km(metres: float) -> str:
-    return f"{_spaced(metres / 1000, 1)} km"
+def _as_given(value: float) -> str:
+    """A number read from the file as it was written (the shortest decimal that reads back as it), in the 12 345.6
+    style: a longitude of 180.0002 is refused as 180.0002°, not as "180°" against ±180°."""
+    if not math.isfinite(value) or abs(value) >= 1e15:
+        return f"{value:.3g}"
+    whole, _, fraction = np.format_float_positional(abs(value), trim="-").partition(".")
+    sign = "-" if value < 0 else ""
+    return sign + f"{int(whole):,}".replace(",", " ") + (f".{fraction}" if fraction else "")
+
+
+def _beyond(value: float, bound: float, decimals: int = 0) -> str:
+    """``value`` in the 12 345.6 style with at least ``decimals`` decimals and two significant digits, and as many
+    more as it takes to read past ``bound`` on its side: 180.0002° outside ±180° is not "180°", nor a 2 000.4 m gap
+    over a 2 km bound "2.0 km", nor 0.011 m "0 m"."""
+    if not math.isfinite(value) or abs(value) >= 1e15:  # past any bound by orders of magnitude: no digits to add
+        return f"{value:.3g}"
+    if value != 0.0:
+        decimals = max(decimals, 1 - math.floor(math.log10(abs(value))))
+    for digits in range(decimals, 21):
+        text = f"{value:.{digits}f}"
+        if float(text) != bound and (float(text) > bound) == (value > bound):
+            return _spaced(value, digits)
+    return repr(value)
+
+
+def _mib(size_bytes: int) -> str:
+    return f"{_beyond(size_bytes / 2**20, MAX_FILE_BYTES / 2**20, 1)} MiB"
+
+
+def _check_length(label: str, kind: str, route: Course) -> None:
+    """Refuse a route too short to ride or draw (:data:`MIN_COURSE_M`)."""
+    total = route.total_distance_m
+    if total < MIN_COURSE_M:
+        raise ValueError(
+            f"{label}: the {kind} is {_beyond(total, MIN_COURSE_M)} m long from its first point to its last; "
+            f"a course needs {MIN_COURSE_M:.0f} m or more"
+        )
 
 
 def _check_grades(label: str, route: Course) -> None:
@@ -297,7 +341,8 @@ def _check_grades(label: str, route: Course) -> None:
             first = int(np.argmax(np.abs(route.grade)))
         at = route.distance_m[first]
         raise ValueError(
-            f"{label}: the elevation changes {_spaced(100 * max(grade, smoothed))} % of the distance near "
+            f"{label}: the elevation changes {_beyond(100 * max(grade, smoothed), 100 * MAX_GPX_GRADE)} % of the "
+            "distance near "
             f"{at / 1000:.2f} km; no road is steeper than about 40 % (the limit is "
             f"{100 * MAX_GPX_GRADE:.0f} %), so the file's elevation or positions are wrong"
         )

@@ -283,6 +283,18 @@ def _checked_points(name: str, arrays: dict[str, ArrayLike], n_min: int = 2) -> 
     return out
 
 
+def _check_range(name: str, key: str, values: NDArray[np.float64], low: float, high: float) -> None:
+    """Refuse values outside [low, high], naming the first such point and its value in full (``repr``: 180.0002,
+    not a rounded 180 that reads as the bound)."""
+    out = (values < low) | (values > high)
+    if np.any(out):
+        first = int(np.argmax(out))
+        raise ValueError(
+            f"{name}: {key} outside [{low:g}, {high:g}]: point {first} is {_checks.shown(float(values[first]))}, "
+            f"{int(out.sum())} point(s) like it"
+        )
+
+
 def _finish(
     name: str,
     east: NDArray[np.float64],
@@ -293,8 +305,7 @@ def _finish(
     smoothing_m: float,
 ) -> Course:
     window = _checks.non_negative("smoothing_m", smoothing_m)
-    if np.any((elevation < MIN_ELEVATION_M) | (elevation > MAX_ELEVATION_M)):
-        raise ValueError(f"{name}: elevation outside ±10 000 m")
+    _check_range(name, "elevation_m", elevation, MIN_ELEVATION_M, MAX_ELEVATION_M)
     # Points at one place (a paused GPS logs many) carry no distance: keep the first of each run.
     keep = np.concatenate(([True], run > _MIN_STEP_M))
     if int(keep.sum()) < 2:
@@ -348,10 +359,8 @@ def course_from_points(
         {"latitude_deg": latitude_deg, "longitude_deg": longitude_deg, "elevation_m": elevation_m},
     )
     lat, lon = p["latitude_deg"], p["longitude_deg"]
-    if np.any(np.abs(lat) > 90.0):
-        raise ValueError(f"{name}: latitude_deg outside [-90, 90]")
-    if np.any(np.abs(lon) > 180.0):
-        raise ValueError(f"{name}: longitude_deg outside [-180, 180]")
+    _check_range(name, "latitude_deg", lat, -90.0, 90.0)
+    _check_range(name, "longitude_deg", lon, -180.0, 180.0)
     phi, lam = np.radians(lat), np.radians(lon)
     d_phi, d_lam = np.diff(phi), np.diff(lam)
     d_lam = (d_lam + np.pi) % (2.0 * np.pi) - np.pi  # across the antimeridian

@@ -48,4 +48,5 @@ BAD_FILES = {
     "latitude out of range": (gpx_text([(45.0, 6.0, 1.0), (95.0, 6.0, 2.0)]), "latitude"),
     "bad number": (gpx_text([(45.0, 6.0, 1.0)]).replace('lat="45.0"', 'lat="abc"'), "not a valid GPX"),
     "elevation absurd": (gpx_text([(45.0, 6.0, 1.0), (45.001, 6.0, 1e7)]), "elevation"),
+    "too short": (gpx_text([(45.0, 6.0, 10.0), (45.0000001, 6.0, 10.0)]), "100 m or more"),
 }

@@ -596,7 +596,7 @@ def test_binary_and_missing_files(tmp_path: Path) -> None:
 
 
 def test_over_20_mib_is_refused_before_parsing(tmp_path: Path) -> None:
-    head = gpx_text(line_points(3))
+    head = gpx_text(line_points(12))
     big = head + "<!--" + "x" * (course.MAX_FILE_BYTES + 1) + "-->"
     with pytest.raises(ValueError, match="20 MiB"):
         course.load_gpx(big)
@@ -609,7 +609,7 @@ def test_over_20_mib_is_refused_before_parsing(tmp_path: Path) -> None:
     # Exactly at the limit is fine (as far as size goes).
     exact = head + "<!--" + "x" * (course.MAX_FILE_BYTES - len(head) - 7) + "-->"
     assert len(exact.encode()) == course.MAX_FILE_BYTES
-    assert course.load_gpx(exact).n_points == 3
+    assert course.load_gpx(exact).n_points == 12
 
 
 def test_more_than_200_000_points_is_refused() -> None:
@@ -714,8 +714,11 @@ def test_grades_are_refused_exactly_beyond_the_bound(grade: float, spacing: floa
     if grade > course.MAX_GPX_GRADE * 1.001:
         with pytest.raises(ValueError, match="no road is steeper"):
             course.load_gpx(gpx_text(points))
-    elif grade < course.MAX_GPX_GRADE * 0.999 and n * spacing > 1e-3:
+    elif grade < course.MAX_GPX_GRADE * 0.999 and (n - 1) * spacing > course.MIN_COURSE_M * 1.001:
         assert course.load_gpx(gpx_text(points)).n_points == n
+    elif grade < course.MAX_GPX_GRADE * 0.999 and (n - 1) * spacing < course.MIN_COURSE_M * 0.999:
+        with pytest.raises(ValueError, match="a course needs 100 m or more"):
+            course.load_gpx(gpx_text(points))
 
 
 def test_gps_noise_on_a_real_climb_is_not_refused() -> None:
@@ -746,7 +749,8 @@ def test_tracks_far_apart_are_refused_and_near_ones_joined() -> None:
     metre_deg = 1.0 / (course.EARTH_RADIUS_M * math.pi / 180.0)
     joined = course.load_gpx(two_tracks(1999.0 * metre_deg))  # just under the 2 km bound
     assert joined.total_distance_m == pytest.approx(2 * 2 * 111.195 + 1999.0, rel=1e-3)
-    with pytest.raises(ValueError, match=r"segment 2 starts 2\.0 km"):
+    # A gap past the bound reads past it: "2.001 km", not "2.0 km" against "at most 2 km".
+    with pytest.raises(ValueError, match=r"segment 2 starts 2\.001 km"):
         course.load_gpx(two_tracks(2001.0 * metre_deg))
 
 
@@ -817,9 +821,9 @@ def test_a_namespace_prefixed_gpx_is_read_and_counted_before_parsing(
     ids=["long comment", "many instructions", "blank lines", "doctype then comments"],
 )
 def test_whatever_xml_allows_before_the_root_is_read_past(prolog: str) -> None:
-    text = gpx_text(line_points(5))
+    text = gpx_text(line_points(12))
     head, body = text.split("?>", 1)
-    assert course.load_gpx(f"{head}?>{prolog}{body}").n_points == 5
+    assert course.load_gpx(f"{head}?>{prolog}{body}").n_points == 12
 
 
 @pytest.mark.parametrize("text", ["<html><gpx version='1.1'></gpx></html>", "<p>see <gpx></p>", "<kml/><gpx/>"])
@@ -934,3 +938,103 @@ def test_an_out_of_reach_time_is_quoted_as_given(time_s: float, shown: str) -> N
     # ":.1f" printed 1e300 as 301 digits and 1e-300 as "0.0 s".
     with pytest.raises(ValueError, match=f"^{re.escape(shown)} is out of reach"):
         course.power_for_time(course.load_gpx(course.SAMPLE_ROUTE), time_s)
+
+
+# Kind: a route too short to ride or draw. Two points 1.1 cm apart loaded as a course that rode to "Finish 0:00,
+# average 1.1 km/h", its chart's ticks all "0" and its Start and Finish labels on top of each other.
+METRE_DEG = 1.0 / (course.EARTH_RADIUS_M * math.pi / 180.0)
+
+
+@pytest.mark.parametrize(
+    ("points", "shown"),
+    [
+        ([(45.0, 6.0, 10.0), (45.0 + 0.011 * METRE_DEG, 6.0, 10.0)], "0.011 m"),  # the tester's file
+        ([(45.0 + i * METRE_DEG, 6.0, 10.0) for i in range(51)], "50 m"),  # many points, 1 m apart
+        ([(45.0, 6.0, 10.0), (45.0 + 99.96 * METRE_DEG, 6.0, 10.0)], "99.96 m"),  # just short: not "100 m"
+        ([(45.0, 6.0, 10.0)] * 3 + [(45.0 + 30.0 * METRE_DEG, 6.0, 10.0)] * 3, "30 m"),  # paused GPS at both ends
+    ],
+    ids=["1.1 cm", "50 m in 51 points", "99.96 m", "30 m with repeats"],
+)
+def test_a_route_shorter_than_a_course_is_refused(points: list[tuple[float, float, float]], shown: str) -> None:
+    with pytest.raises(ValueError) as refused:
+        course.load_gpx(gpx_text(points))
+    message = str(refused.value)
+    print(message)
+    assert (
+        message == f"the file: the track is {shown} long from its first point to its last; a course needs 100 m or more"
+    )
+
+
+def test_a_route_of_a_course_length_is_kept() -> None:
+    points = [(45.0, 6.0, 10.0), (45.0 + 100.01 * METRE_DEG, 6.0, 10.0)]
+    assert course.MIN_COURSE_M == 100.0
+    assert course.load_gpx(gpx_text(points)).total_distance_m == pytest.approx(100.01, abs=1e-6)
+    short_route = gpx_text([(45.0, 6.0, 10.0), (45.0 + 5.0 * METRE_DEG, 6.0, 10.0)], kind="rte")
+    with pytest.raises(ValueError, match=r"the route is 5\.0 m long"):
+        course.load_gpx(short_route)
+
+
+# Kind: a refusal whose number reads as its bound. A longitude of 180.0002 was refused as "longitude 180°, outside
+# ±180°"; an elevation 1 cm over 10 km, a grade a hair over 50 % and a file a byte over 20 MiB read the same way.
+def _refusal(text: str | bytes) -> str:
+    with pytest.raises(ValueError) as refused:
+        course.load_gpx(text)
+    print(refused.value)
+    return str(refused.value)
+
+
+@pytest.mark.parametrize(
+    ("point", "expected"),
+    [
+        ((45.0, 180.0002, 10.0), "point 2 has longitude 180.0002°, outside ±180°"),
+        ((45.0, -180.00000001, 10.0), "point 2 has longitude -180.00000001°, outside ±180°"),
+        ((90.000001, 6.0, 10.0), "point 2 has latitude 90.000001°, outside ±90°"),
+        ((45.001, 6.0, 10_000.01), "point 2 has elevation 10 000.01 m, outside ±10 000 m"),
+        ((45.001, 6.0, -10_000.0000001), "point 2 has elevation -10 000.0000001 m, outside ±10 000 m"),
+        ((45.001, 6.0, 1e7), "point 2 has elevation 10 000 000 m, outside ±10 000 m"),
+        ((45.001, 6.0, 1e300), "point 2 has elevation 1e+300 m, outside ±10 000 m"),
+    ],
+)
+def test_an_out_of_range_point_is_shown_past_its_bound(point: tuple[float, float, float], expected: str) -> None:
+    assert expected in _refusal(gpx_text([(45.0, 6.0, 10.0), point]))
+
+
+@settings(max_examples=examples(60), deadline=None)
+@given(excess=st.floats(1e-13, 1.0), sign=st.sampled_from([-1.0, 1.0]))
+def test_any_longitude_past_180_reads_past_it(excess: float, sign: float) -> None:
+    lon = sign * (180.0 + excess)
+    assume(abs(lon) > 180.0)
+    message = _refusal(gpx_text([(45.0, 6.0, 10.0), (45.0, lon, 10.0)]))
+    found = re.search(r"longitude (-?[\d.]+)°, outside", message)
+    assert found is not None, message
+    number = float(found.group(1))
+    assert abs(number) > 180.0 and number == pytest.approx(lon, rel=1e-9), message
+
+
+def test_a_grade_and_a_size_just_past_their_bounds_read_past_them() -> None:
+    # 50.04 % over 100 m: "no road is steeper" named a 50 % stretch against its 50 % limit.
+    step_m = 100.0
+    rise = 0.5004 * step_m
+    message = _refusal(gpx_text([(45.0, 6.0, 100.0), (45.0 + step_m * METRE_DEG, 6.0, 100.0 + rise)]))
+    found = re.search(r"the elevation changes ([\d.]+) % of the distance", message)
+    assert found is not None and found.group(1) == "50.04", message
+    # A byte over 20 MiB: "20.0 MiB; the limit is 20 MiB".
+    head = gpx_text(line_points(12))
+    big = head + "<!--" + "x" * (course.MAX_FILE_BYTES - len(head) - 6) + "-->"
+    assert len(big.encode()) == course.MAX_FILE_BYTES + 1
+    assert "the file is 20.000001 MiB; the limit is 20 MiB" in _refusal(big.encode())
+
+
+@pytest.mark.parametrize(
+    ("lat", "lon", "ele", "expected"),
+    [
+        (45.0, 180.0002, 10.0, "r: longitude_deg outside [-180, 180]: point 1 is 180.0002, 1 point(s) like it"),
+        (-90.000001, 6.0, 10.0, "r: latitude_deg outside [-90, 90]: point 1 is -90.000001, 1 point(s) like it"),
+        (45.001, 6.0, 10_000.01, "r: elevation_m outside [-10000, 10000]: point 1 is 10000.01, 1 point(s) like it"),
+    ],
+)
+def test_the_builders_name_an_out_of_range_value_in_full(lat: float, lon: float, ele: float, expected: str) -> None:
+    with pytest.raises(ValueError) as refused:
+        course.course_from_points([45.0, lat], [6.0, lon], [10.0, ele], name="r")
+    print(refused.value)
+    assert str(refused.value) == expected

@@ -79,7 +79,7 @@ def expected_verdict(pieces: Sequence[Piece]) -> tuple[int, float] | None:
 
 @st.composite
 def piece_sets(draw: st.DrawFn) -> list[Piece]:
-    """2–5 short straight pieces (2–5 points 11 m apart, heading north); each starts near the previous one's end
+    """2–5 short straight pieces (10–14 points 11 m apart, heading north: each a course's 100 m or more); each starts near the previous one's end
     (within about 3 km, either side of the 2 km bound) or anywhere on Earth."""
     pieces: list[Piece] = []
     lat = draw(st.floats(-75.0, 75.0))
@@ -91,7 +91,7 @@ def piece_sets(draw: st.DrawFn) -> list[Piece]:
                 lon = max(-170.0, min(170.0, lon + draw(st.floats(-0.03, 0.03))))
             else:
                 lat, lon = draw(st.floats(-75.0, 75.0)), draw(st.floats(-170.0, 170.0))
-        n = draw(st.integers(2, 5))
+        n = draw(st.integers(10, 14))
         pieces.append([(lat + i * 1e-4, lon) for i in range(n)])
         lat = pieces[-1][-1][0]
     # Keep clear of the bound itself: a gap within 10 m of 2 km is a matter of rounding, not of rule.
@@ -138,7 +138,7 @@ def test_every_arrangement_of_the_pieces_gets_the_same_verdict(pieces: list[Piec
             course.load_gpx(text)
         message = str(refused.value)
         k, gap = verdict
-        found = re.search(rf"segment {k} starts ([\d ]+\.\d) km from where segment {k - 1} ends", message)
+        found = re.search(rf"segment {k} starts ([\d ]+\.\d+) km from where segment {k - 1} ends", message)
         assert found is not None, (layout, message)
         assert float(found.group(1).replace(" ", "")) == pytest.approx(gap / 1000.0, abs=0.051), (
             layout,
@@ -160,12 +160,12 @@ def test_routes_in_france_and_sydney_are_refused_not_joined() -> None:
     """The public case: no track, one route at 45° N 6° E and one at 33.8° S 151.2° E (loaded as 16 807 km)."""
     gap_km = haversine_m((45.002, 6.0), (-33.8, 151.2)) / 1000.0
     print(f"routes 45N 6E and 33.8S 151.2E: {gap_km:.1f} km apart")
-    with pytest.raises(ValueError, match=r"segment 2 starts [\d ]+\.\d km from where segment 1 ends") as refused:
+    with pytest.raises(ValueError, match=r"segment 2 starts [\d ]+\.\d+ km from where segment 1 ends") as refused:
         course.load_gpx(two_routes((-33.8, 151.2)))
     message = str(refused.value)
     print(message)
     assert "segment 1 is route 1, segment 2 is route 2" in message
-    number = re.search(r"starts ([\d ]+\.\d) km", message)
+    number = re.search(r"starts ([\d ]+\.\d+) km", message)
     assert number is not None and float(number.group(1).replace(" ", "")) == pytest.approx(gap_km, abs=0.051)
 
 
