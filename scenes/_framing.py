@@ -282,17 +282,19 @@ def beside_notice(
     return [(x0, x1, y0, min(y1, below)), (max(x0, right), x1, y0, y1)]
 
 
-def shows(view: View, lens: Lens, points: NDArray[np.float64], *, slack_px: float = 1.0) -> bool:
+def shows(
+    view: View, lens: Lens, points: NDArray[np.float64], *, slack_px: float = 1.0, clear_of_notice: bool = True
+) -> bool:
     """Whether a camera at ``view`` shows every one of (N, 3) ``points`` (m) where framing puts them: in front of it,
-    inside the canvas left of the panel (:meth:`Lens.usable_ndc`, give or take ``slack_px``) and none under
-    :data:`NOTICE_PX`."""
+    inside the canvas left of the panel (:meth:`Lens.usable_ndc`, give or take ``slack_px``) and, with
+    ``clear_of_notice`` (for views framed by :func:`frame_clear_of_notice`), none under :data:`NOTICE_PX`."""
     xy = project_points(view, lens, points)
     width, height = max(lens.width_px, 1), max(lens.height_px, 1)
     x0, x1, y0, y1 = lens.usable_ndc()
     x_ndc, y_ndc = 2.0 * xy[:, 0] / width - 1.0, 1.0 - 2.0 * xy[:, 1] / height
     sx, sy = 2.0 * slack_px / width, 2.0 * slack_px / height
     inside = (x_ndc >= x0 - sx) & (x_ndc <= x1 + sx) & (y_ndc >= y0 - sy) & (y_ndc <= y1 + sy)
-    return bool(np.all(inside & (xy[:, 2] >= NEAR_M)) and not in_notice(xy).any())
+    return bool(np.all(inside & (xy[:, 2] >= NEAR_M)) and not (clear_of_notice and in_notice(xy).any()))
 
 
 def frame_clear_of_notice(
@@ -399,10 +401,10 @@ class ClientFraming:
         for camera in cameras:
             self._frame(camera)
 
-    def keep_in_view(self, points: NDArray[np.float64]) -> None:
+    def keep_in_view(self, points: NDArray[np.float64], *, clear_of_notice: bool = True) -> None:
         """Frame again every camera that no longer shows all of (N, 3) ``points`` (m) where framing would put them
-        (:func:`shows`): what the scene shows has grown out of the view, as when a kick flies higher. A camera that
-        still shows them keeps its pose, a person's own included."""
+        (:func:`shows`; ``clear_of_notice`` as the scene's framing is): what the scene shows has grown out of the
+        view, as when a kick flies higher. A camera that still shows them keeps its pose, a person's own included."""
         with self._lock:
             cameras = list(self._cameras.values())
         for camera in cameras:
@@ -412,7 +414,11 @@ class ClientFraming:
                 view = View((px, py, pz), (lx, ly, lz))
             except (AttributeError, TypeError, ValueError, AssertionError):
                 continue
-            if lens.width_px <= 0 or lens.height_px <= 0 or not shows(view, lens, points):
+            if (
+                lens.width_px <= 0
+                or lens.height_px <= 0
+                or not shows(view, lens, points, clear_of_notice=clear_of_notice)
+            ):
                 self._frame(camera)
 
     def _frame(self, camera: Any) -> None:

@@ -202,13 +202,14 @@ IoU is lowest when a box edge is on the silhouette.
         self._build_gui()
         self._build_world()
         self._sync_enabled_inputs()
+        self.framing = ClientFraming(self._view_for, opening=self.camera_position)
+        """Frames each tab's camera on the shape and its gizmos when it opens (and when its window is resized), and
+        again when a field applied in the editor leaves the picture."""
         self._mesh_and_show(self.params.scene(), self.params.resolution)
         self.worker = LatestWorker("sdf-worker")
         """Runs :meth:`step`: the meshing and ray-marching, off the callback threads."""
         self._threads.append(self.worker.thread)
         self.watch_cameras(self.on_camera)
-        self.framing = ClientFraming(self._view_for, opening=self.camera_position)
-        """Frames each tab's camera on the shape and its gizmos when it opens (and when its window is resized)."""
         self.watch_cameras(self.framing.on_camera)
         self._wake()
 
@@ -679,6 +680,9 @@ IoU is lowest when a box edge is on the silhouette.
             )
             if self.params.editor_half_size != field.half_size:  # the bounds moved while it compiled
                 self._request_mesh()
+            points = self.framed_points()
+        # A field anywhere in its box: framed if it left the picture (the gallery frames under viser's notice)
+        self.framing.keep_in_view(points, clear_of_notice=False)
         with self._state:
             self._reference_due = True
             self._view_key = None
@@ -724,6 +728,15 @@ IoU is lowest when a box edge is on the silhouette.
         with self._lock:
             if self.closed:
                 return
+            # A field re-bounded in the editor may lie anywhere in its box: the view follows it if it left the
+            # picture (a field just applied is followed once the scene shows the editor: _apply_source). Primitives
+            # never move the view: a drag would pull the camera along.
+            follow = (
+                not preview
+                and isinstance(shape, EditorField)
+                and shape != self.mesh_shape
+                and self.params.shape_source == "editor"
+            )
             with self.server.atomic():
                 self.mesh_node.glb_data = glb
                 # The "both" view draws this mesh's edges into its ray-marched frame (never sent as lines: a
@@ -747,6 +760,9 @@ IoU is lowest when a box edge is on the silhouette.
                     self.agreement = dataclasses.replace(self.agreement, triangles=len(faces), mesh_ms=mesh_ms)
                     self.readout.content = readout_markdown(self.agreement)
             self.server.flush()
+            points = self.framed_points() if follow else None
+        if points is not None:
+            self.framing.keep_in_view(points, clear_of_notice=False)
 
     def _render_reference(self) -> None:
         with self._state:

@@ -24,6 +24,7 @@ from trimesh.visual.material import PBRMaterial
 from trimesh.visual.texture import TextureVisuals
 
 from kernels import sdf
+from scenes._framing import Lens, View, box_corners, shows
 from scenes.sdf_gallery import RESOLUTION_LABEL, SdfGalleryParams, SdfGalleryScene
 from shaders import gl_service
 from shaders.camera import camera_rays
@@ -966,6 +967,40 @@ def test_a_field_cut_open_by_its_bounds_says_so_and_a_whole_one_does_not(
         wait_until(lambda: scene.mesh_serial > meshes and scene.params.editor.half_size == 1.0, "the wider remesh")
         assert trimesh.Trimesh(scene.mesh_vertices, scene.mesh_faces).is_watertight
         assert not scene.bounds_note.visible
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("size", [(1000, 1600), (720, 1280)], ids=["1600x1000", "1280x720"])
+def test_a_field_applied_out_of_the_picture_is_brought_into_it_and_one_in_it_leaves_the_view(
+    server: viser.ViserServer, scene: SdfGalleryScene, size: tuple[int, int]
+) -> None:
+    # The failing input (an outside tester): a sphere at x = 1 m applied in the editor stayed half under the panel,
+    # its bottom at the window's edge; the view was framed only when the tab opened.
+    with BrowserClient(server.get_port()) as client:
+        client.send_camera(size=size)
+        wait_until(lambda: len(server.get_clients()) == 1 and scene.framing.frames >= 1, "the opening framing")
+        (tab,) = server.get_clients().values()
+        lens = Lens(float(tab.camera.fov), size[1], size[0])
+
+        def view() -> View:
+            position, look_at = (tuple(float(v) for v in vec) for vec in (tab.camera.position, tab.camera.look_at))
+            return View(position, look_at)  # type: ignore[arg-type]
+
+        opening = view()
+        client.send_camera(opening.position, opening.look_at, size)  # the tab reports the framed view, as a page does
+        apply_glsl(client, "float sdf(vec3 p) { return length(p - vec3(1.0, 0.0, 0.0)) - 0.4; }\n")
+        wait_until(lambda: scene.editor_serial == 1, "the apply", timeout_s=60.0)
+        box = box_corners(scene.mesh_vertices.min(axis=0), scene.mesh_vertices.max(axis=0))
+        wait_until(lambda: shows(view(), lens, box, clear_of_notice=False), "the sphere in the picture", timeout_s=10.0)
+        # A field that is already in the picture keeps the person's view.
+        held = view()
+        client.send_camera(held.position, held.look_at, size)
+        time.sleep(0.3)
+        frames = scene.framing.frames
+        apply_glsl(client, "float sdf(vec3 p) { return length(p - vec3(1.0, 0.0, 0.0)) - 0.35; }\n")
+        wait_until(lambda: scene.editor_serial == 2, "the second apply", timeout_s=60.0)
+        time.sleep(0.3)
+        assert scene.framing.frames == frames and view() == held
 
 
 @pytest.mark.gl
