@@ -339,6 +339,14 @@ KEEPER_STEP_S = 2e-3
 """Time step (s) at which the keeper's reach is searched for the readout's "reached it … early"."""
 
 
+def margin_words(margin_s: float, apart: str, together: str) -> str:
+    """A time margin (s) as the readouts say it: ``apart`` with ``{s}`` replaced by the margin to two decimals
+    ("reaches it {s} s early" reads "reaches it 0.26 s early"), or ``together`` ("just reaches it") where that would
+    read 0.00 s: "0.00 s early" contradicts itself. A negative margin counts as none."""
+    shown = f"{max(margin_s, 0.0):.2f}"
+    return together if shown == "0.00" else apart.format(s=shown)
+
+
 def save_margin_s(state: KickState) -> float | None:
     """How much earlier (s) the keeper's body could have touched the ball where he met it than it arrived there;
     None unless he saved it. The kernel's keeper (:func:`kernels.ball.keeper_path`) searched every
@@ -373,8 +381,8 @@ def dive_words(dive: ball.KeeperDive, spot: tuple[float, float]) -> str:
 
 def keeper_words(state: KickState) -> str:
     """What the keeper did, in words: "dives to his left (your right) 0.67 s after the kick, reaches it 0.26 s
-    early", "... the ball beats him by 0.42 m" or "never dives"; how near he came only when it was within
-    :data:`KEEPER_NEAR_M`. Empty without a keeper."""
+    early" (or "just reaches it"), "... the ball beats him by 0.42 m" or "never dives"; how near he came only when it
+    was within :data:`KEEPER_NEAR_M`. Empty without a keeper."""
     played, spot = state.played, state.keeper_xy
     if played is None or spot is None:
         return ""
@@ -384,7 +392,7 @@ def keeper_words(state: KickState) -> str:
     dived = f"{dive_words(dive, spot)} {dive.t:.2f} s after the kick"
     margin = save_margin_s(state)
     if margin is not None:
-        return f"{dived}, reaches it {margin:.2f} s early"
+        return f"{dived}, {margin_words(margin, 'reaches it {s} s early', 'just reaches it')}"
     # The ball got past: how close his body came to it over the flight.
     gap = keeper_gap_m(ball.keeper_path(KEEPER, spot, dive, played.t), played.position)
     nearest = max(float(gap.min()), 0.0)
@@ -481,10 +489,8 @@ def _why_no_dive(state: KickState, played: ball.Trajectory) -> str:
     }.get(str(played.result), "the play is over")
     step = float(played.t[1] - played.t[0]) if len(played.t) > 1 else 0.0  # he reads at a step's start
     if over < KEEPER.reaction_s + step:
-        return (
-            f"never dives: {what} {max(over, 0.0):.2f} s after it passes the wall, within his reaction time "
-            f"({KEEPER.reaction_s:.2f} s)"
-        )
+        when = margin_words(over, "{s} s after it passes the wall", "as it passes the wall")
+        return f"never dives: {what} {when}, within his reaction time ({KEEPER.reaction_s:.2f} s)"
     return "never dives: the ball never comes at his goal"
 
 

@@ -61,6 +61,7 @@ from scenes.freekick.model import (
     knuckle_wobble_m,
     landing_words,
     map_marker_words,
+    margin_words,
     odds_map_settings,
     odds_map_words,
     outcome_map,
@@ -724,7 +725,7 @@ reads it again, so a ball that bounces in front of him beats him more often than
         reached = goal_line_reached(state)  # then the played ball crossed where the free flight does
         margin = save_margin_s(state)
         if result == "saved" and margin is not None:
-            headline = f"Saved: the keeper reached it {margin:.2f} s early"
+            headline = f"Saved: the keeper {margin_words(margin, 'reached it {s} s early', 'just reached it')}"
         else:
             headline = verdict_words(result, o.goal_point if reached else None)
         lines = [f"**{headline}**"]

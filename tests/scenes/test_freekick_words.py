@@ -11,6 +11,8 @@ import pytest
 
 from kernels import ball
 from scenes.freekick import FreeKickParams, FreeKickScene
+from scenes.freekick import model as freekick_model
+from scenes.freekick import scene as freekick_scene
 from scenes.freekick.model import (
     ODDS_MAP_ANGLES_DEG,
     ODDS_MAP_CAVEAT,
@@ -162,6 +164,55 @@ def test_the_knuckleball_note_stands_only_while_the_spin_it_set_does(freekick: F
     assert note in freekick.result.content
     freekick.apply(FreeKickParams(knuckle=True, spin_rev_s=0.0))  # a preset or reset says nothing of the tick
     assert note not in freekick.result.content
+
+
+SHOWN_MARGINS = [(0.0, None), (0.001, None), (0.004, None), (0.006, "0.01"), (0.26, "0.26")]
+"""Time margins (s) and how each reads at two decimals; None where that would be 0.00 s and words say it instead."""
+
+
+@pytest.mark.parametrize(("margin_s", "shown"), SHOWN_MARGINS)
+def test_a_save_with_no_margin_to_show_reads_just_reached(
+    freekick: FreeKickScene, monkeypatch: pytest.MonkeyPatch, margin_s: float, shown: str | None
+) -> None:
+    # Reported after an aim: "Saved: the keeper reached it 0.00 s early". The default curler is saved; give its save
+    # each margin, in the headline and the keeper's line alike.
+    monkeypatch.setattr(freekick_scene, "save_margin_s", lambda _state: margin_s)
+    monkeypatch.setattr(freekick_model, "save_margin_s", lambda _state: margin_s)
+    readout = freekick.readout_markdown()
+    assert "0.00 s" not in readout
+    if shown is None:
+        assert "**Saved: the keeper just reached it**" in readout
+        assert ", just reaches it**" in readout
+    else:
+        assert f"**Saved: the keeper reached it {shown} s early**" in readout
+        assert f", reaches it {shown} s early**" in readout
+
+
+@pytest.mark.parametrize(("margin_s", "shown"), SHOWN_MARGINS[:-1] + [(0.2, "0.20")])
+def test_a_ball_in_the_goal_as_it_passes_the_wall_reads_so(
+    monkeypatch: pytest.MonkeyPatch, margin_s: float, shown: str | None
+) -> None:
+    # From 12 m at 30 m/s the ball is in the goal before the keeper can react. Moving the instant it passes the wall
+    # gives its time from there into the goal each margin.
+    state = compute_kick(FreeKickParams(distance_m=12.0, speed_ms=30.0, elevation_deg=8.0, azimuth_deg=-12.0))
+    played = state.played
+    assert played is not None and played.result == "goal" and played.keeper_dive is None
+    assert not any(event.kind in ("post", "bar") for event in played.events)
+    i = int(np.flatnonzero(played.position[:, 0] >= 0.0)[0])  # the goal line is x = 0
+    x0, x1 = played.position[i - 1, 0], played.position[i, 0]
+    line_s = float(played.t[i - 1] + (played.t[i] - played.t[i - 1]) * -x0 / (x1 - x0))
+    passed_s = freekick_model.wall_passed_s(state, played)
+    assert passed_s is not None
+    assert f"in the goal {line_s - passed_s:.2f} s after it passes the wall" in keeper_words(state)
+    monkeypatch.setattr(freekick_model, "wall_passed_s", lambda _state, _played: line_s - margin_s)
+    words = keeper_words(state)
+    assert "0.00 s" not in words
+    if shown is None:
+        assert words == "never dives: it is in the goal as it passes the wall, within his reaction time (0.25 s)"
+    else:
+        assert words == (
+            f"never dives: it is in the goal {shown} s after it passes the wall, within his reaction time (0.25 s)"
+        )
 
 
 def test_keeper_words_never_give_a_far_distance() -> None:
