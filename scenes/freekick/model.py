@@ -149,6 +149,10 @@ class FreeKickParams:
     """Unsteady knuckleball side force (only acts with near-zero spin)."""
     knuckle_seed: int = field(default=1, metadata=number("Random draw", 0, 9999, 1, folder="Physics", disabled=True))
     """Random draw of the knuckleball's side force: the same number, the same flight. Greyed out without the knuckleball."""
+    spin_before_knuckle_rev_s: float | None = None
+    """The spin rate (rev/s) that ticking Knuckleball replaced with :data:`KNUCKLE_SPIN_REV_S`, kept while the kick
+    still has that spin: unticking the box brings it back. None once the spin is the user's (set by them after the
+    tick, or by a preset or an aim). No control of its own: the checkbox sets it (:func:`knuckle_toggled`)."""
     wall_jumps: bool = field(default=False, metadata=checkbox("Wall jumps", folder="Physics"))
     """Whether the wall jumps (its top rises by 0.35 m)."""
     keeper: bool = field(default=True, metadata=checkbox("Goalkeeper", folder="Physics"))
@@ -599,11 +603,16 @@ ODDS_MAP_STRIKES = 32
 
 
 def odds_map_settings(p: FreeKickParams) -> FreeKickParams:
-    """What the odds map of ``p`` depends on: ``p`` without its spot and its display settings (the map is the same
-    strike from every spot)."""
+    """What the odds map of ``p`` depends on: ``p`` without its spot, its display settings and the spin a
+    Knuckleball tick keeps (the map is the same strike from every spot)."""
     plain = FreeKickParams()
     return dataclasses.replace(
-        p, distance_m=plain.distance_m, angle_deg=plain.angle_deg, show_forces=plain.show_forces, view=plain.view
+        p,
+        distance_m=plain.distance_m,
+        angle_deg=plain.angle_deg,
+        show_forces=plain.show_forces,
+        view=plain.view,
+        spin_before_knuckle_rev_s=plain.spin_before_knuckle_rev_s,
     )
 
 
@@ -753,11 +762,24 @@ def play_words(played: ball.Trajectory | None) -> str:
     return text[0].upper() + text[1:]
 
 
-def knuckle_ticked(before: FreeKickParams, after: FreeKickParams) -> FreeKickParams:
-    """``after``, with the spin set to :data:`KNUCKLE_SPIN_REV_S` if the knuckleball has just been switched on with
-    spin enough to steady it: ticking the box gives a knuckleball, not a curler with a dead checkbox."""
-    if after.knuckle and not before.knuckle and after.spin_rev_s != KNUCKLE_SPIN_REV_S:
-        return dataclasses.replace(after, spin_rev_s=KNUCKLE_SPIN_REV_S)
+def knuckle_toggled(before: FreeKickParams, after: FreeKickParams) -> FreeKickParams:
+    """``after`` (the controls as read; ``before`` the kick shown) with the spin the Knuckleball checkbox implies.
+
+    Ticked with spin enough to steady the wake, the spin becomes :data:`KNUCKLE_SPIN_REV_S` (a knuckleball, not a
+    curler with a dead checkbox) and the spin it replaced is kept; unticked while the kick still has that spin, the
+    kept spin comes back (the kick it was). A spin the user sets meanwhile is theirs: nothing is kept, and
+    unticking leaves it.
+    """
+    if after.knuckle and not before.knuckle:
+        replaced = after.spin_rev_s if after.spin_rev_s != KNUCKLE_SPIN_REV_S else None
+        return dataclasses.replace(after, spin_rev_s=KNUCKLE_SPIN_REV_S, spin_before_knuckle_rev_s=replaced)
+    kept = after.spin_before_knuckle_rev_s
+    if kept is None:
+        return after
+    if after.spin_rev_s != before.spin_rev_s:
+        return dataclasses.replace(after, spin_before_knuckle_rev_s=None)
+    if not after.knuckle:
+        return dataclasses.replace(after, spin_rev_s=kept, spin_before_knuckle_rev_s=None)
     return after
 
 
@@ -931,6 +953,7 @@ def _without_spin(p: FreeKickParams) -> FreeKickParams:
         axis_turn_deg=plain.axis_turn_deg,
         knuckle=False,
         knuckle_seed=plain.knuckle_seed,
+        spin_before_knuckle_rev_s=plain.spin_before_knuckle_rev_s,
         keeper=plain.keeper,
         show_forces=plain.show_forces,
         view=plain.view,
@@ -1126,6 +1149,7 @@ def aim_at(p: FreeKickParams, target_yz: tuple[float, float]) -> FreeKickParams 
         spin_rev_s=abs(float(s[best])),
         spin_axis=p.spin_axis if s[best] == 0 else ("left" if s[best] > 0 else "right"),
         knuckle=False,
+        spin_before_knuckle_rev_s=None,
     )
 
     def crossing(k: FreeKickParams, *, goal_only: bool = False) -> NDArray[np.float64] | None:

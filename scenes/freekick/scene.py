@@ -57,7 +57,7 @@ from scenes.freekick.model import (
     keeper_limbs,
     keeper_show_time,
     keeper_words,
-    knuckle_ticked,
+    knuckle_toggled,
     knuckle_wobble_m,
     landing_words,
     map_marker_words,
@@ -204,8 +204,6 @@ reads it again, so a ball that bounces in front of him beats him more often than
         """The settings the shown outcome map was computed for."""
         self.chances: ball.Odds | None = None
         """The odds shown for the map's settings: the kick struck many times with a player's scatter."""
-        self.knuckle_spin: float | None = None
-        """The spin (rev/s) that ticking Knuckleball set, while the kick still has it; None once anything else has."""
         self.last_target: tuple[float, float] | None = None
         self.aim_message = ""
         self._odds_version = 0
@@ -420,17 +418,13 @@ reads it again, so a ball that bounces in front of him beats him more often than
 
     def apply_inputs(self) -> None:
         """Read the controls and show the kick they set (what a change of any control but the view runs). Ticking
-        Knuckleball sets the spin near zero, and the slider shows it."""
-        params = self.read_params()
-        knuckled = knuckle_ticked(self.params, params)
-        if knuckled is not params:
-            self.knuckle_spin = knuckled.spin_rev_s
-            handle = self.controls["spin_rev_s"]
-            if handle.value != knuckled.spin_rev_s:
-                handle.value = knuckled.spin_rev_s
-        elif not params.knuckle or params.spin_rev_s != self.knuckle_spin:
-            self.knuckle_spin = None  # the spin is the user's again: the note would contradict it
-        self._set_params(knuckled)
+        Knuckleball sets the spin near zero and unticking it brings the spin back (:func:`knuckle_toggled`); the
+        slider shows it."""
+        params = knuckle_toggled(self.params, self.read_params())
+        handle = self.controls["spin_rev_s"]
+        if handle.value != params.spin_rev_s:
+            self.write_back(handle, params.spin_rev_s)
+        self._set_params(params)
 
     def _set_params(self, params: FreeKickParams) -> None:
         state = compute_kick(params)  # raises (and keeps the last state) if the kernels refuse the input
@@ -464,12 +458,17 @@ reads it again, so a ball that bounces in front of him beats him more often than
 
     def apply(self, params: FreeKickParams) -> None:
         """Show ``params``: write every GUI control (without re-running callbacks) and redraw once."""
-        self.knuckle_spin = None  # a preset or reset sets the spin itself
         with self.server.atomic():
             for name, built in self.controls.fields.items():
                 self.write_back(built.handles[0], built.control.to_gui(getattr(params, name)))
         view = self.params.view
-        self._set_params(self.read_params())
+        # What no control holds (the spin a Knuckleball tick kept) is ``params``'s, not the kick's before.
+        unshown = {
+            member.name: getattr(params, member.name)
+            for member in dataclasses.fields(params)
+            if member.name not in self.controls.fields
+        }
+        self._set_params(dataclasses.replace(self.read_params(), **unshown))
         if self.params.view != view:
             self.framing.reframe()
 
@@ -759,10 +758,11 @@ reads it again, so a ball that bounces in front of him beats him more often than
             )
         elif p.knuckle:
             lines.append("Knuckleball: no wobble at this spin (any real spin steadies the wake)")
-        if p.knuckle and p.spin_rev_s == self.knuckle_spin:
+        if p.knuckle and p.spin_before_knuckle_rev_s is not None:
             lines.append(
                 f"Knuckleball: spin set to {p.spin_rev_s:g} rev/s (a knuckleball is struck with almost none; spin "
-                "steadies the wake that makes it wobble)."
+                f"steadies the wake that makes it wobble). Untick it to get the {p.spin_before_knuckle_rev_s:g} rev/s "
+                "back."
             )
         s_param = ball.BALL_RADIUS_M * 2 * math.pi * p.spin_rev_s / max(p.speed_ms, 1e-9)
         lines.append(f"Spin parameter S = r·ω/v = {s_param:.3f}")

@@ -400,6 +400,41 @@ def test_ticking_knuckleball_in_a_browser_sets_the_spin_near_zero_and_the_wobble
         client.wait_for_gui("Random draw")
 
 
+def test_unticking_knuckleball_in_a_browser_brings_back_the_spin_the_tick_took(
+    server: viser.ViserServer, freekick: FreeKickScene
+) -> None:
+    # Ticking Knuckleball on the default curler sets its 8 rev/s to 0; unticking it must give the curler back, not a
+    # spinless kick at the right post. A spin the user sets while the box is ticked is theirs, and stays.
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Knuckleball")
+        client.set_value("Knuckleball", True)
+        client.wait_for(lambda: freekick.params.knuckle and freekick.params.spin_rev_s == 0.0, what="spin set to zero")
+        client.set_value("Knuckleball", False)
+        client.wait_for(lambda: not freekick.params.knuckle, what="the knuckleball off")
+        assert freekick.params == FreeKickParams()  # the opening curler, as it was before the tick
+        client.wait_for(lambda: client.value_of("Spin rate (rev/s)") == 8.0, what="the slider back at 8")
+        client.wait_for(lambda: not _markdown_shown(client, "Knuckleball: spin set"), what="the note gone")
+        assert freekick.state.played is not None and freekick.state.played.result == "saved"
+
+        client.set_value("Knuckleball", True)
+        client.wait_for(lambda: freekick.params.spin_rev_s == 0.0, what="spin set to zero again")
+        client.wait_for(
+            lambda: _markdown_shown(client, "Untick it to get the 8 rev/s back"), what="the way back said in words"
+        )
+        client.set_value("Spin rate (rev/s)", 2.5)  # the user's own spin while the box is ticked
+        client.wait_for(lambda: freekick.params.spin_rev_s == 2.5, what="the user's spin")
+        client.set_value("Knuckleball", False)
+        client.wait_for(lambda: not freekick.params.knuckle, what="the knuckleball off")
+        assert freekick.params.spin_rev_s == 2.5 and client.value_of("Spin rate (rev/s)") == 2.5
+
+        knuckler = next(k for k, preset in enumerate(PRESETS) if preset.params.knuckle)
+        freekick.preset_buttons[knuckler].value = True  # a click, server side (the checkbox shares its label)
+        client.wait_for(lambda: freekick.params.knuckle and freekick.params.distance_m == 27.0, what="the preset")
+        client.set_value("Knuckleball", False)
+        client.wait_for(lambda: not freekick.params.knuckle, what="the knuckleball off")
+        assert freekick.params.spin_rev_s == 0.0
+
+
 def test_spin_slider_from_a_browser_changes_the_path_and_the_outcome(
     server: viser.ViserServer, freekick: FreeKickScene
 ) -> None:

@@ -166,6 +166,36 @@ def test_the_knuckleball_note_stands_only_while_the_spin_it_set_does(freekick: F
     assert note not in freekick.result.content
 
 
+def test_unticking_knuckleball_brings_back_the_spin_through_other_changes_but_not_past_the_users(
+    freekick: FreeKickScene,
+) -> None:
+    freekick.controls["knuckle"].value = True
+    freekick.controls["speed_ms"].value = 27.0  # another control: the spin is still the one the tick set
+    freekick.controls["knuckle_seed"].value = 7
+    assert freekick.params.spin_rev_s == 0.0
+    freekick.controls["knuckle"].value = False
+    assert freekick.params == FreeKickParams(speed_ms=27.0, knuckle_seed=7)
+    assert freekick.controls["spin_rev_s"].value == 8.0
+    freekick.controls["knuckle"].value = True
+    assert "Untick it to get the 8 rev/s back" in freekick.result.content
+    freekick.controls["spin_rev_s"].value = 0.0  # unchanged: still the tick's
+    freekick.controls["spin_rev_s"].value = 3.0
+    freekick.controls["spin_rev_s"].value = 0.0  # the user's zero now: nothing comes back
+    assert "rev/s back" not in freekick.result.content
+    freekick.controls["knuckle"].value = False
+    assert freekick.params.spin_rev_s == 0.0 and freekick.controls["spin_rev_s"].value == 0.0
+    freekick.controls["spin_rev_s"].value = 6.0
+    freekick.controls["knuckle"].value = True
+    freekick.apply(dataclasses.replace(freekick.params, view="above"))  # a change of view keeps the spin to restore
+    freekick.controls["knuckle"].value = False
+    assert freekick.params.spin_rev_s == 6.0
+    freekick.controls["knuckle"].value = True
+    freekick.apply(dataclasses.replace(FreeKickParams(), knuckle=True, spin_rev_s=0.0))  # a preset sets the spin
+    assert "rev/s back" not in freekick.result.content
+    freekick.controls["knuckle"].value = False
+    assert freekick.params.spin_rev_s == 0.0
+
+
 SHOWN_MARGINS = [(0.0, None), (0.001, None), (0.004, None), (0.006, "0.01"), (0.26, "0.26")]
 """Time margins (s) and how each reads at two decimals; None where that would be 0.00 s and words say it instead."""
 
