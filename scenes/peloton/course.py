@@ -12,6 +12,7 @@ import math
 import re
 import threading
 import time
+import unicodedata
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -47,6 +48,9 @@ from scenes.peloton.course_model import (
     framed_words,
     lay_out_road,
     place_powers,
+    position_end_km,
+    position_km,
+    position_m,
     rider_boxes,
     split_every_m,
 )
@@ -570,13 +574,17 @@ class CourseMode:
         self.scene.write_back(self.scrub, km)
         if self.state is not None:
             ride = self.state.ride
-            self.play_time_s = float(np.interp(km * 1000.0, ride.distance_m, ride.elapsed_s))
+            self.play_time_s = float(np.interp(self._km_to_m(km), ride.distance_m, ride.elapsed_s))
+
+    def _km_to_m(self, km: float) -> float:
+        """Where the Position slider at ``km`` puts the leader (m): its end is the finish."""
+        return position_m(km, self.route.total_distance_m)
 
     def _scrub_m(self) -> float:
         """Where the Position slider puts the riders (m), cleaned."""
         raw = self.scrub.value
         ok = isinstance(raw, (int, float)) and not isinstance(raw, bool) and math.isfinite(raw)
-        return float(np.clip(1000.0 * (raw if ok else 0.0), 0.0, self.route.total_distance_m))
+        return self._km_to_m(raw if ok else 0.0)
 
     def _on_scrub(self) -> None:
         if self.state is None:
@@ -587,7 +595,7 @@ class CourseMode:
         if not ok or km != raw:
             self.scene.write_back(self.scrub, km)
         ride = self.state.ride
-        self.play_time_s = float(np.interp(km * 1000.0, ride.distance_m, ride.elapsed_s))
+        self.play_time_s = float(np.interp(self._km_to_m(km), ride.distance_m, ride.elapsed_s))
         self.redraw(readouts=False)
         # The group keeps its place in the picture as the road under it bends and steepens.
         self.scene.framing.reframe()
@@ -612,9 +620,8 @@ class CourseMode:
 
     # ----------------------------------------------------------------------------------------- drawing
     def _total_km(self) -> float:
-        """The Position slider's end: the route's length rounded up to the slider's 10 m step, so the finish is on
-        it (a position past the finish is the finish)."""
-        return math.ceil(self.route.total_distance_m / 10.0 - 1e-9) / 100.0
+        """The Position slider's end, the finish, and the length the summary gives (:func:`position_end_km`)."""
+        return position_end_km(self.route.total_distance_m)
 
     def leader_distance_m(self) -> float:
         if self.state is None:
@@ -623,7 +630,8 @@ class CourseMode:
         return float(np.interp(self.play_time_s, ride.elapsed_s, ride.distance_m))
 
     def _leader_km(self) -> float:
-        return self.leader_distance_m() / 1000.0
+        """Where the leader is as the Position slider gives it (km, on its 10 m step; its end at the finish)."""
+        return position_km(self.leader_distance_m(), self.route.total_distance_m)
 
     def redraw(self, *, readouts: bool = True, now: bool = True) -> None:
         """Show or hide the mode and push its state: the road and riders always, the readouts when asked."""
@@ -749,7 +757,7 @@ class CourseMode:
         r = self.route
         average = 100.0 * (r.elevation_m[-1] - r.elevation_m[0]) / r.total_distance_m
         text = (
-            f"**{_escape(r.name)}**: {r.total_distance_m / 1000:.2f} km, +{r.climbing_m:.0f} m, "
+            f"**{_escape(r.name)}**: {self._total_km():.2f} km, +{r.climbing_m:.0f} m, "
             f"{r.elevation_m[0]:.0f} → {r.elevation_m[-1]:.0f} m ({average:+.1f} % on average), {r.n_points} points"
         )
         if self.route_label == SAMPLE_LABEL:
@@ -852,7 +860,7 @@ class CourseMode:
         else:
             watts = f"{power:.0f} W{coasting}"
         return (
-            f"Leader at **{d / 1000:.2f} km**, {format_duration(self.play_time_s)}: "
+            f"Leader at **{self._leader_km():.2f} km**, {format_duration(self.play_time_s)}: "
             f"{3.6 * speed:.1f} km/h, {watts}, {elevation:.0f} m"
         )
 
@@ -876,6 +884,49 @@ _BARE_ADDRESS = re.compile(r"(?i)(?<=www)(?=\.)|(?<=:)(?=//)|(?=@)")
 text after character references are read, so these get an invisible word joiner (U+2060) instead."""
 
 
+_BREAK = "\u200b"
+BREAK_EVERY = 24
+"""Longest run of characters without a place to wrap that :func:`_escape` leaves: a file name or track name with no
+spaces (a 240-character one) ran past the panel's right edge, clipped, where the notification wrapped it."""
+_ZERO_WIDTH_JOINER = "\u200d"
+"""What joins emoji into one picture (👨‍👩‍👧): no break after it."""
+
+
+def _is_flag_half(c: str) -> bool:
+    """Whether ``c`` is a regional indicator: two make a flag."""
+    return "\U0001f1e6" <= c <= "\U0001f1ff"
+
+
+def _breakable(before: str, after: str, flag_halves: int) -> bool:
+    """Whether a zero-width space may go between two characters without splitting what is drawn as one: not before
+    a combining mark, a format character or an emoji's skin tone, not after a zero-width joiner, not inside a flag
+    (``flag_halves`` regional indicators run up to ``before``)."""
+    if before == _ZERO_WIDTH_JOINER or unicodedata.category(after) in ("Mn", "Mc", "Me", "Cf"):
+        return False
+    if "\U0001f3fb" <= after <= "\U0001f3ff":
+        return False
+    return not (_is_flag_half(after) and flag_halves % 2 == 1)
+
+
+def _wrappable(text: str) -> str:
+    """``text`` with a zero-width space (U+200B, a place to wrap, drawn as nothing) in every run of more than
+    :data:`BREAK_EVERY` characters without white space, that far apart, or a little further where a character and
+    its marks are drawn as one; never more than twice as far (text made of joiners and marks wraps too)."""
+    out: list[str] = []
+    run = flag_halves = 0
+    for i, c in enumerate(text):
+        if c.isspace() or c == _BREAK:
+            run = 0
+        elif run >= BREAK_EVERY and (run >= 2 * BREAK_EVERY or _breakable(text[i - 1], c, flag_halves)):
+            out.append(_BREAK)
+            run = 0
+        out.append(c)
+        run += not c.isspace() and c != _BREAK
+        flag_halves = flag_halves + 1 if _is_flag_half(c) else 0
+    return "".join(out)
+
+
 def _escape(text: str) -> str:
-    """Text from a file, shown in markdown as the same characters: no HTML, links, images or emphasis."""
-    return _BARE_ADDRESS.sub(_WORD_JOINER, text).translate(_MARKDOWN_ESCAPES)
+    """Text from a file, shown in markdown as the same characters: no HTML, links, images or emphasis, and a place
+    to wrap in every long run without white space (:func:`_wrappable`)."""
+    return _BARE_ADDRESS.sub(_WORD_JOINER, _wrappable(text)).translate(_MARKDOWN_ESCAPES)

@@ -33,6 +33,11 @@ POWER_MODEL_FROM_LABEL: dict[str, course_kernel.Model] = {
     "Martin et al. 1998 (full)": "martin",
     "Textbook (aero, rolling, climbing)": "seed",
 }
+BAROMETER_RANGE_HPA = (250.0, 1100.0)
+"""What the barometer input takes (hPa). A course may start as high as 10 000 m
+(:data:`kernels.course.MAX_ELEVATION_M`), where the standard atmosphere reads 265 hPa and a deep low some 5 % less;
+Everest's summit reads about 337 hPa. The air kernel takes 10 to 1100 hPa. (From 500 hPa, a route above 5 500 m,
+which the reader accepts, could not be given its real reading: 480 hPa at 5 800 m.)"""
 COURSE_POWER_RANGE_W = (20.0, 2000.0)
 """What the Course power input takes (W); 'Find the power for this time' says when a target needs more or less."""
 MODEL_LABEL = {model: label for label, model in POWER_MODEL_FROM_LABEL.items()}
@@ -124,7 +129,7 @@ class CourseParams:
     """Weather air: the barometer's pressure, or the standard atmosphere's at the start's altitude."""
     pressure_hpa: float = field(
         default=1013.25,
-        metadata=number("Pressure at the start (hPa)", 500.0, 1100.0, 0.5, folder=POWER_FOLDER),
+        metadata=number("Pressure at the start (hPa)", *BAROMETER_RANGE_HPA, 0.5, folder=POWER_FOLDER),
     )
     """Station pressure at the start (hPa), when read from a barometer."""
     humidity_pct: float = field(default=50.0, metadata=slider("Humidity (%)", 0.0, 100.0, 1.0, folder=POWER_FOLDER))
@@ -295,6 +300,33 @@ def place_powers(state: CourseState, at_m: float) -> tuple[np.ndarray, np.ndarra
 
 _MEAN_CHUNK = 1_000_000
 """How many (place, segment) needs :func:`place_powers` holds at once (8 MB)."""
+
+
+POSITION_STEP_KM = 0.01
+"""The Position (km) slider's step: 10 m."""
+
+
+def position_end_km(total_m: float) -> float:
+    """The Position slider's end, and the route's length as the panel gives it (km): the length to the slider's
+    10 m step, nearest. That end is the finish (:func:`position_m`), so the slider reaches it and the two agree (the
+    end had been rounded up, 13.16 against a 13.15 km route)."""
+    return round(total_m / 10.0) / 100.0
+
+
+def position_m(km: float, total_m: float) -> float:
+    """Where the Position slider at ``km`` puts the leader (m along a route of ``total_m``): its end
+    (:func:`position_end_km`) is the finish, and a place short of it is that far along, at most the finish."""
+    if km >= position_end_km(total_m):
+        return float(total_m)
+    return float(np.clip(1000.0 * km, 0.0, total_m))
+
+
+def position_km(distance_m: float, total_m: float) -> float:
+    """The Position slider's value (km, on its 10 m step) for a leader ``distance_m`` along a route of ``total_m``:
+    its end at the finish. The readouts give the same, so slider, summary and readout say one number."""
+    if distance_m >= total_m:
+        return position_end_km(total_m)
+    return min(round(distance_m / 10.0) / 100.0, position_end_km(total_m))
 
 
 def format_duration(seconds: float) -> str:

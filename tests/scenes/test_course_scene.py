@@ -8,6 +8,7 @@ import math
 import re
 import threading
 import time
+import unicodedata
 import uuid
 
 import numpy as np
@@ -15,10 +16,13 @@ import pytest
 import viser
 from helpers.browser import VIEWPORTS
 from helpers.gpx import BAD_FILES, gpx_text, hill_gpx
+from helpers.properties import examples
 from helpers.scenes import glb_vertices, scene_fixture
 from helpers.screen_geometry import pinhole_ndc
 from helpers.uploads import send_part, upload
 from helpers.wsclient import BrowserClient, Crafted, crafted_sent
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from kernels import course as course_kernel
 from kernels import cycling
@@ -33,7 +37,8 @@ from scenes.peloton import (
     format_duration,
     group_cda,
 )
-from scenes.peloton.course_model import course_air, lay_out_road, route_points
+from scenes.peloton.course import BREAK_EVERY, _escape
+from scenes.peloton.course_model import BAROMETER_RANGE_HPA, course_air, lay_out_road, route_points
 from scenes.peloton.meshes import rider_head_m
 from scenes.peloton.model import FORMATION_FROM_LABEL as FORMATION
 
@@ -437,12 +442,13 @@ def test_a_file_still_arriving_when_the_sample_route_is_chosen_does_not_replace_
 
 
 # Kind: a place on the route the Position slider cannot reach. Its end was the length rounded down to its 10 m
-# step, 1–9 m short of the finish (a 2,127 m route ended at 2.12 km).
-@pytest.mark.parametrize("n", [2, 3, 17, 300, 1001])
+# step, 1–9 m short of the finish (a 2,127 m route ended at 2.12 km). Its end, the length to the nearest step, is the
+# finish.
+@pytest.mark.parametrize("n", [10, 17, 300, 1001])
 def test_the_position_slider_reaches_the_finish_of_any_route(mode: CourseMode, n: int) -> None:
     assert mode.load(hill_gpx(f"Hill of {n}", n), "hill.gpx")
     total_m = mode.route.total_distance_m
-    assert total_m / 1000.0 <= mode.scrub.max < total_m / 1000.0 + 0.01
+    assert abs(mode.scrub.max - total_m / 1000.0) <= 0.005
     assert mode.scrub.max * 100.0 == pytest.approx(round(mode.scrub.max * 100.0), abs=1e-9)  # on its 0.01 km step
     mode.scrub.value = mode.scrub.max
     assert mode.leader_distance_m() == pytest.approx(total_m, rel=1e-12)
@@ -695,7 +701,7 @@ def _place_watts_reference(mode: CourseMode, at_m: float) -> tuple[np.ndarray, n
     v = np.diff(ride.distance_m) / dt
     air = v + ride.headwind_ms
     per_m2 = 0.5 * ride.air_density * air * np.abs(air) * v / eta
-    j = int(np.searchsorted(ride.distance_m, at_m, side="right")) - 1
+    j = min(int(np.searchsorted(ride.distance_m, at_m, side="right")) - 1, len(ride.headwind_ms) - 1)
     v_here = np.interp(at_m, ride.distance_m, ride.speed_ms)
     air_here = v_here + ride.headwind_ms[j]
     here = ride.power_w[j] + (cda - group) * 0.5 * ride.air_density[j] * air_here * abs(air_here) * v_here / eta
@@ -756,7 +762,11 @@ def test_the_leader_readout_gives_the_groups_power_and_the_leaders_place(mode: C
     mode.scrub.value = 13.15
     assert mode.state is not None
     ride = mode.state.ride
-    group = float(ride.power_w[int(np.searchsorted(ride.distance_m, mode.leader_distance_m(), side="right")) - 1])
+    # 13.15 km is the sample's finish (13 151 m), the Position slider's end: the last segment's power.
+    segment = min(
+        int(np.searchsorted(ride.distance_m, mode.leader_distance_m(), side="right")) - 1, len(ride.brakes_w) - 1
+    )
+    group = float(ride.power_w[segment])
     here, _ = _place_watts_reference(mode, mode.leader_distance_m())
     text = mode.now.content
     if n == 1:
@@ -909,3 +919,134 @@ def test_the_weather_reading_is_taken_at_any_start_a_course_may_have(start_m: fl
     density = air.density(route.elevation_m)
     assert np.isfinite(density).all() and (density > 0.0).all()
     assert air.pressure_hpa <= 1100.0 and air.altitude_m == route.elevation_m[0]
+
+
+# ------------------------------------------------------------------------------------------------ outside tester's faults
+def north_gpx(name: str, length_m: float, elevation_m: float = 100.0) -> bytes:
+    """A straight, level route due north from 45° N 6° E, ``length_m`` along the ground, points about 100 m apart."""
+    n = max(2, math.ceil(length_m / 100.0) + 1)
+    step_deg = length_m / (n - 1) / (course_kernel.EARTH_RADIUS_M * math.pi / 180.0)
+    text = gpx_text([(45.0 + i * step_deg, 6.0, elevation_m) for i in range(n)])
+    return text.replace("<name>t</name>", f"<name>{name}</name>").encode()
+
+
+# Kind: a route too short to ride or draw. Two points 1.1 cm apart rode to "Finish 0:00, average 1.1 km/h", "alone
+# the same power takes 0:00", a chart ticked "0 0 0" and Start and Finish labels on top of each other.
+@pytest.mark.parametrize("length_m", [0.011, 9.99, 99.9])
+def test_a_route_too_short_to_ride_is_refused_in_the_panel(mode: CourseMode, length_m: float) -> None:
+    good = mode.route
+    assert not mode.load(north_gpx("Short", length_m), "short.gpx")
+    assert mode.route is good and mode.route_label == SAMPLE_LABEL
+    shown = html.unescape(mode.route_info.content)
+    print(shown.splitlines()[-1])
+    assert "was not loaded: the track is " in shown and "a course needs 100 m or more" in shown
+    assert "Finish **0:00**" not in mode.readout.content
+    assert mode.load(north_gpx("Long enough", 100.5), "long.gpx") and mode.route.name == "Long enough"
+
+
+# Kind: text from a file that cannot wrap. A refused file's 240-character name without spaces ran past the panel's
+# right edge and was clipped there (the notification wrapped it). Every file name, track name and refusal shown in
+# the panel's markdown gets a place to wrap (a zero-width space) at least every 24 characters.
+def _runs(markdown: str) -> list[str]:
+    """The stretches of the decoded text with no place to wrap: no white space, no zero-width space."""
+    return re.split(r"[\s\u200b]+", html.unescape(markdown))
+
+
+def test_a_long_unbroken_name_wraps_in_the_panel(mode: CourseMode) -> None:
+    name = "L" * 236 + ".gpx"
+    assert not mode.load(b"not a gpx file", name)
+    shown = html.unescape(mode.route_info.content)
+    longest = max(_runs(mode.route_info.content), key=len)
+    print(f"longest run without a place to wrap: {len(longest)} characters")
+    assert len(longest) <= 26  # 24, and the bold marks or a full stop about it
+    assert f"⚠️ **{name}** was not loaded" in shown.replace("\u200b", "")
+    # A track name (80 characters at most) and what a refusal quotes from the file wrap the same way.
+    assert mode.load(hill_gpx("T" * 80), "t.gpx")
+    assert max(map(len, _runs(mode.route_info.content))) <= 26
+    assert html.unescape(mode.route_info.content).replace("\u200b", "").startswith(f"**{'T' * 80}**")
+    encoding = '<?xml version="1.0" encoding="' + "x" * 150 + '"?><gpx/>'
+    assert not mode.load(encoding.encode(), "enc.gpx")
+    assert "x" * 150 in html.unescape(mode.route_info.content).replace("\u200b", "")
+    assert max(map(len, _runs(mode.route_info.content))) <= 26
+
+
+def test_wrapping_keeps_combining_marks_emoji_and_flags_whole() -> None:
+    for text in ("e\u0301" * 40, "👍🏽" * 40, "👨\u200d👩\u200d👧" * 20, "🇫🇷" * 40, "a\u2060" * 40):
+        shown = html.unescape(_escape(text))
+        assert shown.replace("\u200b", "") == text
+        breaks = [i for i, c in enumerate(shown) if c == "\u200b"]
+        assert breaks, repr(text)
+        for at in breaks:
+            before, after = shown[at - 1], shown[at + 1]
+            assert unicodedata.category(after) not in ("Mn", "Mc", "Me", "Cf") and before != "\u200d", repr(text)
+            assert not "\U0001f3fb" <= after <= "\U0001f3ff", repr(text)
+            flags_before = sum("\U0001f1e6" <= c <= "\U0001f1ff" for c in shown[:at])
+            assert flags_before % 2 == 0, repr(text)  # a flag is two regional indicators: never split
+        assert max(map(len, shown.split("\u200b"))) <= BREAK_EVERY + 2
+    # Text that is all joiners and marks still wraps, at most twice as far apart.
+    for text in ("a\u200d" * 60, "e" + "\u0301" * 100):
+        shown = html.unescape(_escape(text))
+        assert shown.replace("\u200b", "") == text
+        assert max(map(len, shown.split("\u200b"))) <= 2 * BREAK_EVERY
+
+
+@settings(max_examples=examples(200), deadline=None)
+@given(text=st.text(st.characters(codec="ascii", exclude_categories=("Cc",)), max_size=300))
+def test_escaped_text_reads_as_itself_and_wraps_every_24_characters(text: str) -> None:
+    shown = html.unescape(_escape(text))
+    assert shown.replace("\u200b", "").replace("\u2060", "") == text
+    assert max(len(run.replace("\u2060", "")) for run in re.split(r"[\s\u200b]+", shown)) <= BREAK_EVERY
+
+
+# Kind: a control whose range misses values the course can need. The barometer input began at 500 hPa, yet the reader
+# accepts routes up to 10 000 m: at 5 800 m the real reading is about 480 hPa (Everest's summit about 337 hPa).
+def test_a_barometer_reading_at_any_accepted_start_can_be_entered(mode: CourseMode) -> None:
+    low, high = BAROMETER_RANGE_HPA
+    box = mode.controls["pressure_hpa"]
+    assert isinstance(box, viser.GuiNumberHandle) and (box.min, box.max) == (low, high)
+    # The standard atmosphere at the highest start the reader accepts, less a deep low's 5 %, is in range, and the
+    # air kernel takes the whole range.
+    assert low <= 0.95 * float(cycling.isa_pressure_hpa(course_kernel.MAX_ELEVATION_M))
+    for pressure in (low, high):
+        assert math.isfinite(float(cycling.air_density_weather(0.0, pressure, 0.5)))
+    assert mode.load(north_gpx("High pass", 2000.0, elevation_m=5800.0), "high.gpx")
+    mode.controls["air"].value = "Weather reading"
+    mode.controls["pressure_from_barometer"].value = "Barometer"
+    mode.controls["temperature_c"].value = -5.0
+    mode.controls["pressure_hpa"].value = 480.0
+    print(f"pressure kept: {mode.params.pressure_hpa} hPa, shown {mode.controls['pressure_hpa'].value}")
+    assert mode.params.pressure_hpa == 480.0 and mode.controls["pressure_hpa"].value == 480.0
+    assert mode.state is not None
+    expected = float(cycling.air_density_weather(-5.0, 480.0, 0.5))
+    assert mode.state.density_weather == pytest.approx(expected, rel=1e-12)
+    assert "480 hPa read" in mode.readout.content
+    mode.controls["pressure_hpa"].value = 337.0  # Everest's summit
+    assert mode.params.pressure_hpa == 337.0
+
+
+# Kind: one length shown as two numbers. The Position slider ended at the length rounded up (13.16) while the summary
+# rounded it to the nearest (13.15 km): 333.59 against 333.58, 1.11 against 1.10. Both are now the length to the
+# nearest 10 m, and the slider's end is the finish, as the leader's readout there says.
+@pytest.mark.parametrize("length_m", [100.02, 1104.0, 1146.0, 2000.0, 2127.0, 13_154.0, 13_151.28, 333_584.0])
+def test_the_summary_and_the_position_sliders_end_give_one_length(mode: CourseMode, length_m: float) -> None:
+    assert mode.load(north_gpx("Straight", length_m), "straight.gpx")
+    total_m = mode.route.total_distance_m
+    assert total_m == pytest.approx(length_m, abs=0.01)
+    end = mode.scrub.max
+    shown = re.search(r"\*\*: ([\d.]+) km, ", mode.route_info.content)
+    assert shown is not None
+    print(f"{length_m:.2f} m: summary {shown.group(1)} km, slider end {end}")
+    assert shown.group(1) == f"{end:.2f}" == f"{round(length_m / 10.0) / 100.0:.2f}"
+    assert abs(end - total_m / 1000.0) <= 0.005 + 1e-9
+    mode.scrub.value = end  # the slider's end is the finish
+    assert mode.leader_distance_m() == pytest.approx(total_m, rel=1e-12)
+    assert f"Leader at **{end:.2f} km**" in mode.now.content
+    mode.scrub.value = round(end - 0.01, 2)  # a step short of it is that far along
+    assert mode.leader_distance_m() == pytest.approx(1000.0 * round(end - 0.01, 2), abs=1e-6)
+    # Ridden to the end, playback leaves the slider at its end.
+    mode._on_play()
+    assert mode.state is not None
+    mode.play_time_s = mode.state.ride.time_s - 1e-9
+    while mode._animate(0.2):
+        pass
+    assert mode.scrub.value == end and f"Leader at **{end:.2f} km**" in mode.now.content
