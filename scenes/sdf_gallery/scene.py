@@ -757,7 +757,8 @@ IoU is lowest when a box edge is on the silhouette.
                     bounds = None if isinstance(shape, sdf.Scene) else shape.bounds
                     self._mesh_voxel = sdf.make_grid(grid_scene, resolution, bounds).spacing
                     self.mesh_serial += 1
-                    self.agreement = dataclasses.replace(self.agreement, triangles=len(faces), mesh_ms=mesh_ms)
+                    # The comparison was of the last mesh: "–" until the reference is rendered against this one.
+                    self.agreement = Agreement(len(faces), mesh_ms, None, None, None)
                     self.readout.content = readout_markdown(self.agreement)
             self.server.flush()
             points = self.framed_points() if follow else None
@@ -799,13 +800,14 @@ IoU is lowest when a box edge is on the silhouette.
                 self.reference_params, self.reference_camera = params, camera
                 self.reference_serial += 1
                 self.reference_mesh_serial = mesh_serial
-                self.agreement = dataclasses.replace(
-                    self.agreement,
-                    render_ms=render_ms,
-                    iou=iou,
-                    depth_diff_voxels=None if depth_diff is None else depth_diff / self._mesh_voxel,
-                )
-                self.readout.content = readout_markdown(self.agreement)
+                if mesh_serial == self.mesh_serial:  # else a newer mesh is shown: this compares an older one
+                    self.agreement = dataclasses.replace(
+                        self.agreement,
+                        render_ms=render_ms,
+                        iou=iou,
+                        depth_diff_voxels=None if depth_diff is None else depth_diff / self._mesh_voxel,
+                    )
+                    self.readout.content = readout_markdown(self.agreement)
                 self.reference_note.content = f"{width}×{height} px on {renderer_name}."
             self.server.flush()
 

@@ -304,6 +304,37 @@ def test_downloads(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
 
 
 @pytest.mark.gl
+def test_the_readouts_never_pair_a_new_mesh_with_the_last_mesh_s_comparison(
+    server: viser.ViserServer, scene: SdfGalleryScene
+) -> None:
+    # The failing input (an outside tester): just after Apply, Triangles read 10,556 for the new sphere while the
+    # IoU (0.9488) and the time to render (48 ms) were still the previous example's, for about 2 s.
+    with BrowserClient(server.get_port()) as client:
+        client.send_camera(position=(2.3, -2.5, 1.7), look_at=(0.05, 0.0, 0.3), size=(600, 800))
+        wait_until(lambda: scene.agreement.iou is not None, "the first comparison", timeout_s=90)
+        before = scene.agreement
+        readout = gui_uuid(scene.readout)
+        client.take_received()
+        serial = scene.reference_serial
+        apply_glsl(client, "float sdf(vec3 p) { return length(p) - 0.45; }\n")
+        wait_until(lambda: scene.editor_serial == 1, "the apply", timeout_s=60)
+        wait_until(
+            lambda: scene.reference_serial > serial and scene.agreement.iou is not None, "its comparison", timeout_s=90
+        )
+        after = scene.agreement
+        assert after.triangles != before.triangles and after.iou != before.iou
+        shown = [  # what the page was sent to show, in order (viser sends a markdown's text as "_markdown")
+            m["updates"]["_markdown"]
+            for _at, m in list(client.received)
+            if m.get("type") == "GuiUpdateMessage" and m.get("uuid") == readout and "_markdown" in m["updates"]
+        ]
+        with_new_mesh = [text for text in shown if f"| Triangles | {after.triangles:,} |" in text]
+        assert with_new_mesh, shown
+        assert f"| Silhouette IoU (mesh vs ray-march) | {before.iou:.4f} |" not in "".join(with_new_mesh)
+        assert "| Silhouette IoU (mesh vs ray-march) | – |" in with_new_mesh[0]
+
+
+@pytest.mark.gl
 def test_png_download_is_the_reference_image(scene: SdfGalleryScene) -> None:
     wait_until(lambda: scene.reference_rgb is not None, "reference", timeout_s=60)
     from PIL import Image
