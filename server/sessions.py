@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING, ParamSpec, TypeVar
 import numpy as np
 import viser
 
+from server import viser_compat
 from server.clean import record_spec
 from server.gate import install_gate
 from server.memory import give_memory_back
@@ -251,6 +252,17 @@ class Session:
 
     def flush(self) -> None:
         (self.viser_server if self.client is None else self.client).flush()
+
+    @staticmethod
+    def send_download(client: viser.ClientHandle, filename: str, content: bytes) -> str:
+        """Send tab ``client`` a download (a link in a notice); returns the notice's id, for :meth:`remove_notice`."""
+        return viser_compat.send_download(client, filename, content)
+
+    @staticmethod
+    def remove_notice(client: viser.ClientHandle, notice_id: str) -> None:
+        """Take notice ``notice_id`` (e.g. a download's, which frees its file) down in tab ``client``."""
+        with dead_writes_allowed(client):  # its tab may have closed
+            viser_compat.remove_notice(client, notice_id)
 
     def upload_started_at(self, event: object) -> float | None:
         """When (``time.monotonic()``) the upload an upload button's ``on_upload`` ``event`` reports was started in

@@ -27,9 +27,12 @@ viser's code behind each name below, and nothing else. The private names touched
   (:func:`gui_uuid`, :func:`is_removed`, :func:`parent_container_id`, :func:`send_gui_value`).
 - ``ClientHandle._websock_connection``: the client's message buffer, whose ``sanctioned_dead_writes`` scope keeps a
   closing tab's last writes from warning (:func:`dead_writes_allowed`), and through which a refused upload is ended
-  in that tab alone (:func:`end_refused_upload`).
+  in that tab alone (:func:`end_refused_upload`), a download is sent under a transfer id we choose
+  (:func:`send_download`) and a notice is taken down (:func:`remove_notice`).
 - viser's client (``UploadButton.tsx``, not Python): an upload button stays disabled until the acks of its upload
   reach the size announced, and its progress notice has the id ``upload-<transfer id>`` (:func:`end_refused_upload`).
+- viser's client (``MessageHandler.tsx``): a download's notice, which holds its link, has the id
+  ``download-<transfer id>`` (:func:`send_download`); ``ClientHandle.send_file_download`` does not return that id.
 - ``viser._assignable_props_api.AssignablePropsBase._cast_value_recursive`` and ``colors_to_uint8``: the property
   cast, replaced for speed by :func:`cast_value_recursive` (:func:`patch_property_cast`).
 
@@ -42,6 +45,8 @@ aliases built once; ``tests/test_viser_patches.py`` holds it to the original for
 
 from __future__ import annotations
 
+import mimetypes
+import uuid
 from collections.abc import Callable, Coroutine, Mapping
 from contextlib import AbstractContextManager
 from typing import Any
@@ -74,6 +79,8 @@ __all__ = [
     "messages",
     "parent_container_id",
     "patch_property_cast",
+    "remove_notice",
+    "send_download",
     "send_gizmo_pose",
     "send_gui_value",
     "take_connection_dispatch",
@@ -176,6 +183,37 @@ def end_refused_upload(
         )
     )
     connection.queue_message(messages.RemoveNotificationMessage(uuid=f"upload-{transfer_uuid}"))
+
+
+def send_download(client: viser.ClientHandle, filename: str, content: bytes, chunk_bytes: int = 1024 * 1024) -> str:
+    """Send ``content`` to tab ``client`` as a download named ``filename`` shown as a link in a notice, as
+    ``ClientHandle.send_file_download`` does; return that notice's id, for :func:`remove_notice`."""
+    transfer = str(uuid.uuid4())
+    mime_type = mimetypes.guess_type(filename, strict=False)[0] or "application/octet-stream"
+    parts = [content[i : i + chunk_bytes] for i in range(0, len(content), chunk_bytes)]
+    connection = client._websock_connection  # pyright: ignore[reportPrivateUsage]
+    connection.queue_message(
+        messages.FileTransferStartDownload(
+            save_immediately=False,
+            transfer_uuid=transfer,
+            filename=filename,
+            mime_type=mime_type,
+            part_count=len(parts),
+            size_bytes=len(content),
+        )
+    )
+    for index, part in enumerate(parts):
+        connection.queue_message(
+            messages.FileTransferPart(None, transfer_uuid=transfer, part_index=index, content=part)
+        )
+        client.flush()
+    return f"download-{transfer}"
+
+
+def remove_notice(client: viser.ClientHandle, notice_id: str) -> None:
+    """Take notice ``notice_id`` down in tab ``client`` (a download's link notice frees its file there too)."""
+    connection = client._websock_connection  # pyright: ignore[reportPrivateUsage]
+    connection.queue_message(messages.RemoveNotificationMessage(uuid=notice_id))
 
 
 def send_gui_value(handle: Any) -> None:

@@ -199,6 +199,8 @@ IoU is lowest when a box edge is on the silhouette.
         field's frames may cost a hundred times more, so its first rest frame is not sized by them."""
         self._trial_cost: tuple[EditorField, float] | None = None
         """The last applied field and the seconds a pixel of its trial's moving frame took (:mod:`shaders.trial`)."""
+        self._download_notices: dict[tuple[int, str], tuple[viser.ClientHandle, str]] = {}
+        """The download links shown, by (tab, file name): the tab and the notice's id."""
         self._build_gui()
         self._build_world()
         self._sync_enabled_inputs()
@@ -247,6 +249,10 @@ IoU is lowest when a box edge is on the silhouette.
         self.worker.close(timeout_s=60.0)
         with self._lock:
             self.server.scene.set_background_image(None)
+            notices = list(self._download_notices.values())
+            self._download_notices.clear()
+        for client, notice in notices:
+            self.server.remove_notice(client, notice)
         super().close()
 
     def wait_idle(self, timeout_s: float = 60.0) -> bool:
@@ -888,7 +894,14 @@ IoU is lowest when a box edge is on the silhouette.
             if answer.content is None:
                 client.add_notification(NOTHING_TO_DOWNLOAD, answer.why_not)
                 return
-            client.send_file_download(answer.name, answer.content)
+            notice = self.server.send_download(client, answer.name, answer.content)
+            with self._lock:
+                # One link a file and tab: the newer one replaces it (its file freed); the scene's close takes the
+                # rest down, so no link is left over another scene.
+                older = self._download_notices.pop((client.client_id, answer.name), None)
+                self._download_notices[(client.client_id, answer.name)] = (client, notice)
+            if older is not None:
+                self.server.remove_notice(*older)
 
         return handler
 

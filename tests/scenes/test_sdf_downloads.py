@@ -26,6 +26,7 @@ from scenes.sdf_gallery.export import (
     download,
     mesh_file,
 )
+from server.switcher import SceneSwitcher
 from shaders import gl_service
 from shaders.renderer import GLUnavailableError
 
@@ -133,6 +134,42 @@ def test_each_mesh_download_has_its_format_s_up_direction(server: viser.ViserSer
             for axis, (a, b) in zip("xyz", loaded.bounds.T, strict=True):
                 assert (a, b) == pytest.approx(expected[axis], abs=1e-5), (fmt, axis)
             assert loaded.is_winding_consistent and loaded.volume > 0  # still wound outward
+
+
+def test_a_newer_download_replaces_its_link_and_leaving_the_scene_takes_the_links_down(
+    server: viser.ViserServer, switcher: SceneSwitcher
+) -> None:
+    """An outside tester's four download links stacked over the 3D view, and stayed over the free kick after a
+    scene switch and a Reset. A newer download of the same file now replaces its link (the file freed in the page),
+    and the scene's close takes down the links it made."""
+
+    def notice_ids(client: BrowserClient, kind: str) -> list[str]:
+        key = "transfer_uuid" if kind == "FileTransferStartDownload" else "uuid"
+        return [
+            f"download-{m[key]}" if kind == "FileTransferStartDownload" else m[key]
+            for _at, m in list(client.received)
+            if m.get("type") == kind
+        ]
+
+    assert isinstance(switcher.show("sdf"), SdfGalleryScene)
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Download mesh (GLB)")
+        first = press(client, BUTTONS["glb"])
+        links = notice_ids(client, "FileTransferStartDownload")
+        second = press(client, BUTTONS["glb"])
+        links += notice_ids(client, "FileTransferStartDownload")
+        assert first[0] == second[0] == "file" and len(links) == 2
+        client.wait_for(
+            lambda: notice_ids(client, "RemoveNotificationMessage") == links[:1], what="the older link down"
+        )
+        press(client, BUTTONS["stl"])
+        links += notice_ids(client, "FileTransferStartDownload")
+        client.take_received()
+        switcher.show("freekick")
+        client.wait_for(
+            lambda: sorted(notice_ids(client, "RemoveNotificationMessage")) == sorted(links[1:]),
+            what="the scene's links down",
+        )
 
 
 def test_no_reference_image_downloads_nothing_with_the_same_notice(
