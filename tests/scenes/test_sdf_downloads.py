@@ -126,7 +126,12 @@ def test_each_mesh_download_has_its_format_s_up_direction(server: viser.ViserSer
     z_up = {"x": (lo[0], hi[0]), "y": (lo[1], hi[1]), "z": (lo[2], hi[2])}
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("Download mesh (GLB)")
-        for fmt, expected in (("glb", y_up), ("obj", y_up), ("stl", z_up)):
+        ups: tuple[tuple[MeshFormat, dict[str, tuple[float, float]]], ...] = (
+            ("glb", y_up),
+            ("obj", y_up),
+            ("stl", z_up),
+        )
+        for fmt, expected in ups:
             kind, _name, data = press(client, BUTTONS[fmt])
             assert kind == "file"
             loaded = trimesh.load(io.BytesIO(data), file_type=fmt, force="mesh", process=False)
