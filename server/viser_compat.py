@@ -171,18 +171,9 @@ def end_refused_upload(
     "File uploaded successfully". The gate's own notice then says why the file was refused.
     """
     client = connected_client(server, client_id)
-    if client is None:
-        return
-    connection = client._websock_connection  # pyright: ignore[reportPrivateUsage]
-    connection.queue_message(
-        messages.FileTransferPartAck(
-            source_component_uuid=button_uuid,
-            transfer_uuid=transfer_uuid,
-            transferred_bytes=size_bytes,
-            total_bytes=size_bytes,
-        )
-    )
-    connection.queue_message(messages.RemoveNotificationMessage(uuid=f"upload-{transfer_uuid}"))
+    if client is not None:
+        ack = messages.FileTransferPartAck(button_uuid, transfer_uuid, size_bytes, size_bytes)
+        _send(client, ack, messages.RemoveNotificationMessage(uuid=f"upload-{transfer_uuid}"))
 
 
 def send_download(client: viser.ClientHandle, filename: str, content: bytes, chunk_bytes: int = 1024 * 1024) -> str:
@@ -191,29 +182,23 @@ def send_download(client: viser.ClientHandle, filename: str, content: bytes, chu
     transfer = str(uuid.uuid4())
     mime_type = mimetypes.guess_type(filename, strict=False)[0] or "application/octet-stream"
     parts = [content[i : i + chunk_bytes] for i in range(0, len(content), chunk_bytes)]
-    connection = client._websock_connection  # pyright: ignore[reportPrivateUsage]
-    connection.queue_message(
-        messages.FileTransferStartDownload(
-            save_immediately=False,
-            transfer_uuid=transfer,
-            filename=filename,
-            mime_type=mime_type,
-            part_count=len(parts),
-            size_bytes=len(content),
-        )
-    )
+    _send(client, messages.FileTransferStartDownload(False, transfer, filename, mime_type, len(parts), len(content)))
     for index, part in enumerate(parts):
-        connection.queue_message(
-            messages.FileTransferPart(None, transfer_uuid=transfer, part_index=index, content=part)
-        )
+        _send(client, messages.FileTransferPart(None, transfer, index, part))
         client.flush()
     return f"download-{transfer}"
 
 
 def remove_notice(client: viser.ClientHandle, notice_id: str) -> None:
     """Take notice ``notice_id`` down in tab ``client`` (a download's link notice frees its file there too)."""
+    _send(client, messages.RemoveNotificationMessage(uuid=notice_id))
+
+
+def _send(client: viser.ClientHandle, *queued: messages.Message) -> None:
+    """Queue ``queued`` for tab ``client`` alone, in order."""
     connection = client._websock_connection  # pyright: ignore[reportPrivateUsage]
-    connection.queue_message(messages.RemoveNotificationMessage(uuid=notice_id))
+    for message in queued:
+        connection.queue_message(message)
 
 
 def send_gui_value(handle: Any) -> None:

@@ -406,15 +406,17 @@ def dataclass_replace(params: Any, field: str, value: Any) -> Any:
     return dataclasses.replace(params, **{field: value})
 
 
+def number_specs(attacker: BrowserClient, handles: Any) -> dict[str, Any]:
+    """The recorded spec of every number control (slider or number box) the browser ``attacker`` shows, by uuid."""
+    number_kinds = ("GuiSliderMessage", "GuiNumberMessage")
+    return {uuid: control_spec(handles[uuid]) for uuid, e in attacker.gui.items() if e["type"] in number_kinds}
+
+
 def test_huge_numbers_clamp_to_the_range_the_scene_declared(server: viser.ViserServer, key: str) -> None:
     """±1e308 are finite: every number control ends on the bound of its declared range, in every viewer."""
     with two_viewers(server, key) as (switcher, attacker, observer):
         handles = gui_inputs(server.gui)
-        numbers = {
-            uuid: control_spec(handles[uuid])
-            for uuid, e in attacker.gui.items()
-            if e["type"] in ("GuiSliderMessage", "GuiNumberMessage")
-        }
+        numbers = number_specs(attacker, handles)
         for huge in (1e308, -1e308):
             for uuid in numbers:
                 attacker.send("GuiUpdateMessage", uuid=uuid, updates={"value": huge})
@@ -450,11 +452,7 @@ def test_numbers_nearer_zero_than_their_range_can_tell_are_zero(
 ) -> None:
     with two_viewers(server, key) as (switcher, attacker, _observer):
         handles = gui_inputs(server.gui)
-        numbers = {
-            uuid: control_spec(handles[uuid])
-            for uuid, e in attacker.gui.items()
-            if e["type"] in ("GuiSliderMessage", "GuiNumberMessage")
-        }
+        numbers = number_specs(attacker, handles)
         for uuid in numbers:
             attacker.send("GuiUpdateMessage", uuid=uuid, updates={"value": tiny})
         for uuid, spec in numbers.items():
