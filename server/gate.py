@@ -417,7 +417,7 @@ class Gate:
 
         if written_to_it or echoed:
             return now
-        if _same_value(sent, value):
+        if same_value(sent, value):
             return seen
         if spec.kind == "number" and _may_be_typed_on(sent, spec):
 
@@ -447,11 +447,11 @@ class Gate:
             self.log.refuse("upload size", f"{size!r} bytes in {parts!r} parts")
             return None, None
         if not 0 <= size <= MAX_UPLOAD_BYTES:
-            self.log.refuse("upload size", f"{size!r} bytes (limit {MAX_UPLOAD_BYTES})")
-            return None, self._end_refused(
+            return self._refused_start(
                 server,
                 client_id,
                 message,
+                ("upload size", f"{size!r} bytes (limit {MAX_UPLOAD_BYTES})"),
                 f"The file is {size / MIB:.1f} MiB; this server takes files up to {MAX_UPLOAD_BYTES / MIB:.0f} MiB.",
             )
         if not all(
@@ -468,37 +468,37 @@ class Gate:
             return None, None
         in_flight = self._uploads.setdefault(client_id, {})
         if len(in_flight) >= MAX_UPLOADS_IN_FLIGHT:
-            self.log.refuse("uploads in flight", f"more than {MAX_UPLOADS_IN_FLIGHT} at once")
-            return None, self._end_refused(
+            return self._refused_start(
                 server,
                 client_id,
                 message,
+                ("uploads in flight", f"more than {MAX_UPLOADS_IN_FLIGHT} at once"),
                 f"This tab already has {MAX_UPLOADS_IN_FLIGHT} uploads under way; wait for one to finish.",
             )
         own_bytes = sum(upload.size_bytes for upload in list(in_flight.values()))
         if own_bytes + size > MAX_UPLOAD_BYTES_IN_FLIGHT_PER_TAB:
-            self.log.refuse(
-                "upload bytes in flight",
-                f"{own_bytes} + {size} bytes from one tab (limit {MAX_UPLOAD_BYTES_IN_FLIGHT_PER_TAB})",
-            )
-            return None, self._end_refused(
+            return self._refused_start(
                 server,
                 client_id,
                 message,
+                (
+                    "upload bytes in flight",
+                    f"{own_bytes} + {size} bytes from one tab (limit {MAX_UPLOAD_BYTES_IN_FLIGHT_PER_TAB})",
+                ),
                 f"This tab's uploads under way already announce {own_bytes / MIB:.1f} MiB; it takes "
                 f"{MAX_UPLOAD_BYTES_IN_FLIGHT_PER_TAB / MIB:.0f} MiB at once. Wait for them to finish.",
             )
         count, total_bytes = self.uploads_in_flight()
         if count >= MAX_UPLOADS_IN_FLIGHT_TOTAL or total_bytes + size > MAX_UPLOAD_BYTES_IN_FLIGHT_TOTAL:
-            self.log.refuse(
-                "uploads in flight across all tabs",
-                f"{count} uploads of {total_bytes} bytes under way, {size} more asked (limits "
-                f"{MAX_UPLOADS_IN_FLIGHT_TOTAL} uploads, {MAX_UPLOAD_BYTES_IN_FLIGHT_TOTAL} bytes)",
-            )
-            return None, self._end_refused(
+            return self._refused_start(
                 server,
                 client_id,
                 message,
+                (
+                    "uploads in flight across all tabs",
+                    f"{count} uploads of {total_bytes} bytes under way, {size} more asked (limits "
+                    f"{MAX_UPLOADS_IN_FLIGHT_TOTAL} uploads, {MAX_UPLOAD_BYTES_IN_FLIGHT_TOTAL} bytes)",
+                ),
                 f"The server is receiving other uploads ({count} files, "
                 f"{total_bytes / MIB:.1f} MiB in flight from all tabs; it takes "
                 f"{MAX_UPLOADS_IN_FLIGHT_TOTAL} files or {MAX_UPLOAD_BYTES_IN_FLIGHT_TOTAL / MIB:.0f} MiB at "
@@ -523,15 +523,22 @@ class Gate:
 
         return notify
 
-    def _end_refused(
-        self, server: viser.ViserServer, client_id: int, start: messages.FileTransferStartUpload, body: str
-    ) -> Callable[[], None]:
-        """What the tab is sent after the gate refused upload ``start``: the upload is ended there, so its button
-        works again (:func:`~server.viser_compat.end_refused_upload`), then a notice says why."""
+    def _refused_start(
+        self,
+        server: viser.ViserServer,
+        client_id: int,
+        start: messages.FileTransferStartUpload,
+        refusal: tuple[str, str],
+        body: str,
+    ) -> tuple[None, Callable[[], None]]:
+        """Refuse upload ``start`` (logged as ``refusal``: its kind and detail) and give what its tab is then sent:
+        the upload ended there, so its button works again (:func:`~server.viser_compat.end_refused_upload`), then
+        a notice that says why (``body``)."""
+        self.log.refuse(*refusal)
         tell = self._tell(server, client_id, body)
         transfer = start.transfer_uuid
         if not (isinstance(transfer, str) and len(transfer) <= MAX_NAME_CHARS):
-            return tell  # not a transfer viser's client could have started
+            return None, tell  # not a transfer viser's client could have started
 
         def end_then_tell() -> None:
             viser_compat.end_refused_upload(
@@ -539,7 +546,7 @@ class Gate:
             )
             tell()
 
-        return end_then_tell
+        return None, end_then_tell
 
     def _drop_stalled_uploads(self, server: viser.ViserServer) -> None:
         """Forget uploads that received no part for :data:`~server.budget.UPLOAD_STALL_S`, and free the parts viser holds."""
@@ -683,10 +690,11 @@ connection gets the script again) and sends the camera once at once.
 """
 
 
-def _same_value(sent: object, value: object) -> bool:
-    """Whether a browser that sent ``sent`` shows ``value`` (a number as int or float, a vector as list or tuple)."""
+def same_value(sent: object, value: object) -> bool:
+    """Whether a browser that sent (or shows) ``sent`` shows the control's value ``value``: a number as int or float,
+    a vector as list or tuple."""
     if isinstance(sent, (list, tuple)) and isinstance(value, (list, tuple)):
-        return len(sent) == len(value) and all(_same_value(a, b) for a, b in zip(sent, value, strict=True))
+        return len(sent) == len(value) and all(same_value(a, b) for a, b in zip(sent, value, strict=True))
     if isinstance(sent, bool) or isinstance(value, bool):
         return sent is value
     if isinstance(sent, (int, float)) and isinstance(value, (int, float)):

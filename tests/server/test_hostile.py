@@ -34,6 +34,7 @@ from server.clean import (
     control_spec,
     unit_quaternion,
 )
+from server.gate import same_value
 from server.refusals import refusals
 from server.switcher import SceneSwitcher
 
@@ -110,16 +111,6 @@ def server_values(server: viser.ViserServer) -> dict[str, Any]:
         for uuid, handle in gui_inputs(server.gui).items()
         if not isinstance(handle, viser.GuiUploadButtonHandle)
     }
-
-
-def same_value(a: Any, b: Any) -> bool:
-    if isinstance(a, (tuple, list)) and isinstance(b, (tuple, list)):
-        return len(a) == len(b) and all(same_value(x, y) for x, y in zip(a, b, strict=True))
-    if isinstance(a, bool) or isinstance(b, bool):
-        return a is b
-    if isinstance(a, (int, float)) and isinstance(b, (int, float)):
-        return float(a) == float(b)
-    return a == b
 
 
 def shows_server_values(client: BrowserClient, server: viser.ViserServer) -> bool:
