@@ -90,9 +90,9 @@ class Gate:
         self._seen_at: dict[tuple[int, str], float] = {}
         """Per (tab, control uuid), the control's ``update_timestamp`` after the tab's last edit of it was applied."""
         self._echoes: dict[tuple[int, str], asyncio.TimerHandle] = {}
+        """Per (tab, control uuid), a send-back waiting for the tab to stop typing (:data:`ECHO_AFTER_TYPING_S`)."""
         self._echoed_at: dict[tuple[int, str], float] = {}
         """Per (tab, control uuid), when the server's value was last sent back to that tab."""
-        """Per (tab, control uuid), a send-back waiting for the tab to stop typing (:data:`ECHO_AFTER_TYPING_S`)."""
         self._finished_upload_starts: dict[tuple[int, str], float] = {}
         """When the last upload each (client, upload button) finished was started (:meth:`upload_started_at`)."""
         self._budgets: dict[int, TabBudget] = {}
