@@ -62,10 +62,10 @@ def load_gpx(source: str | os.PathLike[str] | bytes, *, name: str | None = None,
     Raises:
         ValueError: with a message a person can act on: the file is larger than 20 MiB, not GPX (or not text),
             has no track points, one point, points without elevation, non-finite or out-of-range values, more
-            than 200 000 points, a route shorter than :data:`MIN_COURSE_M` (100 m), a stretch steeper than :data:`MAX_GPX_GRADE` (50 %), or consecutive pieces (track
-            segments or routes, in any mix) more than :data:`MAX_SEGMENT_GAP_M` (2 km) apart; the message names
-            both pieces and the gap. Nothing else escapes for a bad file. A bad ``name`` or ``smoothing_m`` is
-            refused naming it.
+            than 200 000 points, a route shorter than :data:`MIN_COURSE_M` (100 m), a stretch steeper than
+            :data:`MAX_GPX_GRADE` (50 %), or consecutive pieces (track segments or routes, in any mix) more than
+            :data:`MAX_SEGMENT_GAP_M` (2 km) apart; the message names both pieces and the gap. Nothing else
+            escapes for a bad file. A bad ``name`` or ``smoothing_m`` is refused naming it.
 
     The text is decoded by its byte-order mark, else the XML declaration's encoding (ISO-8859-1, UTF-16...),
     else as UTF-8; a namespace prefix on the GPX elements (``<g:gpx xmlns:g=...>``) is read too.

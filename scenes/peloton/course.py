@@ -34,6 +34,7 @@ from scenes.peloton.course_model import (
     MODE_FOLDER,
     MODEL_LABEL,
     MORE_FOLDER,
+    POSITION_STEP_M,
     POWER_FOLDER,
     SAMPLE_LABEL,
     CourseParams,
@@ -174,7 +175,9 @@ class CourseMode:
             self.play = gui.add_button("Play")
             self.pause = gui.add_button("Pause")
             # Hand-built, not a parameter: playback moves it, and its range is the loaded route's length.
-            self.scrub = gui.add_slider("Position (km)", min=0.0, max=self._total_km(), step=0.01, initial_value=0.0)
+            self.scrub = gui.add_slider(
+                "Position (km)", min=0.0, max=self._total_km(), step=POSITION_STEP_M / 1000.0, initial_value=0.0
+            )
             self.now = gui.add_markdown("")
             self.readout = gui.add_markdown("")
             self.chart = FittedChart(

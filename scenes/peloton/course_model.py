@@ -302,15 +302,15 @@ _MEAN_CHUNK = 1_000_000
 """How many (place, segment) needs :func:`place_powers` holds at once (8 MB)."""
 
 
-POSITION_STEP_KM = 0.01
-"""The Position (km) slider's step: 10 m."""
+POSITION_STEP_M = 10.0
+"""The Position (km) slider's step (m)."""
 
 
 def position_end_km(total_m: float) -> float:
     """The Position slider's end, and the route's length as the panel gives it (km): the length to the slider's
     10 m step, nearest. That end is the finish (:func:`position_m`), so the slider reaches it and the two agree (the
     end had been rounded up, 13.16 against a 13.15 km route)."""
-    return round(total_m / 10.0) / 100.0
+    return round(total_m / POSITION_STEP_M) * POSITION_STEP_M / 1000.0
 
 
 def position_m(km: float, total_m: float) -> float:
