@@ -734,14 +734,16 @@ IoU is lowest when a box edge is on the silhouette.
         with self._lock:
             if self.closed:
                 return
-            # A field re-bounded in the editor may lie anywhere in its box: the view follows it if it left the
-            # picture (a field just applied is followed once the scene shows the editor: _apply_source). Primitives
-            # never move the view: a drag would pull the camera along.
+            # A field re-bounded in the editor may lie anywhere in its new box: the view follows it if it left the
+            # picture (a newly applied field is followed by _apply_source, once the scene shows the editor).
+            # Primitives never move the view: a drag would pull the camera along.
+            shown = self.mesh_shape
             follow = (
                 not preview
                 and isinstance(shape, EditorField)
-                and shape != self.mesh_shape
-                and self.params.shape_source == "editor"
+                and isinstance(shown, EditorField)
+                and shape.source == shown.source
+                and shape.half_size != shown.half_size
             )
             with self.server.atomic():
                 self.mesh_node.glb_data = glb
