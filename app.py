@@ -42,11 +42,12 @@ import viser
 
 from scenes import SceneName
 from scenes._look import configure_lighting
-from scenes.sdf_gallery import COMPILE_LIMIT_S, FRAME_LIMIT_S, MAX_SOURCE_CHARS, set_editing_allowed
+from scenes.sdf_gallery.editor import COMPILE_LIMIT_S, FRAME_LIMIT_S, set_editing_allowed
 from server.gate import install_gate
 from server.memory import limit_malloc_arenas
 from server.sessions import Sessions
 from server.switcher import SceneSwitcher
+from shaders.glsl_sandbox import MAX_SOURCE_CHARS
 
 logger = logging.getLogger("app")
 

@@ -49,7 +49,8 @@ from bench._timing import row, time_handling, timings  # noqa: E402
 from kernels import ball  # noqa: E402
 from kernels.ball.config import N_STEPS  # noqa: E402
 from kernels.ball.core import simulate_one  # noqa: E402
-from scenes.freekick import MAP_QUIET_S, FreeKickParams, FreeKickScene, outcome_map  # noqa: E402
+from scenes.freekick import FreeKickParams, FreeKickScene  # noqa: E402
+from scenes.freekick.model import MAP_QUIET_S, outcome_map  # noqa: E402
 from server.switcher import SceneSwitcher  # noqa: E402
 from tests.helpers.ball_reference import START, G, Q, R, reference_at_x  # noqa: E402
 from tests.helpers.wsclient import BrowserClient  # noqa: E402

@@ -44,7 +44,8 @@ from helpers.wsclient import BrowserClient  # noqa: E402
 
 from bench._timing import p95, timings  # noqa: E402
 from kernels import sdf  # noqa: E402
-from scenes.sdf_gallery import EXAMPLES, SdfGalleryScene  # noqa: E402
+from scenes.sdf_gallery import SdfGalleryScene  # noqa: E402
+from scenes.sdf_gallery.editor import EXAMPLES  # noqa: E402
 from shaders import gl_service  # noqa: E402
 from shaders import renderer as gl_renderer  # noqa: E402
 from shaders.renderer import Camera, GLUnavailableError, Renderer, Shading  # noqa: E402

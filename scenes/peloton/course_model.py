@@ -20,7 +20,7 @@ from numpy.typing import ArrayLike
 from kernels import course as course_kernel
 from kernels import cycling
 from scenes._controls import checkbox, dropdown, dropdown_from_labels, number, slider
-from scenes.peloton.model import PelotonParams, drag_reductions, group_cda
+from scenes.peloton.model import ROAD_HALF_WIDTH_M, PelotonParams, drag_reductions, group_cda
 
 CourseAirLabel = Literal["Textbook atmosphere", "Weather reading"]
 AIR_FROM_LABEL: dict[str, course_kernel.AirKind] = {
@@ -42,8 +42,6 @@ COURSE_POWER_RANGE_W = (20.0, 2000.0)
 """What the Course power input takes (W); 'Find the power for this time' says when a target needs more or less."""
 MODEL_LABEL = {model: label for label, model in POWER_MODEL_FROM_LABEL.items()}
 SAMPLE_LABEL = "Alpe d'Huez (sample, from the published profile)"
-ROAD_HALF_WIDTH_M = 3.0
-"""Half the drawn road's width (m) at least: wider where the formation is wider."""
 VERGE_HALF_WIDTH_M = 16.0
 """Half the width of the grass either side of the road (m)."""
 VERGE_DROP_M = 0.5

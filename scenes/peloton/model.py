@@ -31,6 +31,9 @@ BIKE_LENGTH_M = 1.70
 """Wheel-to-wheel length of one bike; the gap is measured from the front wheel to the wheel ahead."""
 MAX_GAP_M = 15.0
 """Largest wheel-to-wheel gap the slider offers (m): beyond ~3 m drafting is gone (Blocken et al. 2013)."""
+ROAD_HALF_WIDTH_M = 3.0
+"""Half the drawn road's width (m): a bunch eight abreast fits on it. A course's road is wider where its formation
+is wider."""
 
 Position = Literal["upright", "hoods", "drops", "tt", "hour"]
 

@@ -54,6 +54,7 @@ from scenes.peloton.model import (
     MAX_GROUP,
     MAX_RIDERS,
     PRESET_MENUS,
+    ROAD_HALF_WIDTH_M,
     PelotonParams,
     Position,
     PresetMenu,
@@ -79,8 +80,6 @@ from scenes.peloton.projection import (
 ROAD_X_M = (-(MAX_GROUP - 1) * (BIKE_LENGTH_M + MAX_GAP_M) - 15.0, 15.0)
 """(start, end) x of the drawn road (m): the longest group (121 riders in single file at the largest gap) rides on
 it, with 15 m spare at each end."""
-ROAD_HALF_WIDTH_M = 3.0
-"""Half the road's width (m): a bunch eight abreast fits on it."""
 GRASS_BEYOND_M = 150.0
 """How far the grass reaches beyond the road's sides and ends (m): the camera that frames the tallest bars (80 km/h
 up 20 %) looks down from far enough back that grass ending 15 m from the road showed the page's white beneath it."""

@@ -4,51 +4,13 @@ Modules: :mod:`~scenes.sdf_gallery.params` (the parameters, each control declare
 :mod:`~scenes.sdf_gallery.editor` (the GLSL editor's field, the editing switch and source checks),
 :mod:`~scenes.sdf_gallery.export` (the mesh as GLB for the view and as files to download),
 :mod:`~scenes.sdf_gallery.compare` (how mesh and ray-march agree) and :mod:`~scenes.sdf_gallery.scene` (the scene).
-The names callers use are re-exported here.
+
+The package exports the scene and its parameters; everything else is imported from the module it lives in.
 """
 
-from scenes.sdf_gallery.compare import Agreement
-from scenes.sdf_gallery.editor import (
-    COMPILE_LIMIT_S,
-    EDITOR_KEEP_CHARS,
-    EXAMPLES,
-    FRAME_LIMIT_S,
-    EditorField,
-    editing_allowed,
-    set_editing_allowed,
-)
-from scenes.sdf_gallery.params import (
-    CAMERA_REST_S,
-    GIZMO_MARGIN_M,
-    KIND_LABELS,
-    PREVIEW_RESOLUTION,
-    RESOLUTION_LABEL,
-    SIZES_USED,
-    PrimitiveParams,
-    SdfGalleryParams,
-    rest_size,
-)
-from scenes.sdf_gallery.scene import SdfGalleryScene
-from shaders.renderer import MAX_SOURCE_CHARS
+from __future__ import annotations
 
-__all__ = [
-    "CAMERA_REST_S",
-    "COMPILE_LIMIT_S",
-    "EDITOR_KEEP_CHARS",
-    "EXAMPLES",
-    "FRAME_LIMIT_S",
-    "GIZMO_MARGIN_M",
-    "KIND_LABELS",
-    "MAX_SOURCE_CHARS",
-    "PREVIEW_RESOLUTION",
-    "RESOLUTION_LABEL",
-    "SIZES_USED",
-    "Agreement",
-    "EditorField",
-    "PrimitiveParams",
-    "SdfGalleryParams",
-    "SdfGalleryScene",
-    "editing_allowed",
-    "rest_size",
-    "set_editing_allowed",
-]
+from scenes.sdf_gallery.params import SdfGalleryParams
+from scenes.sdf_gallery.scene import SdfGalleryScene
+
+__all__ = ["SdfGalleryParams", "SdfGalleryScene"]

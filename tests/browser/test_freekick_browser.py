@@ -39,21 +39,10 @@ from helpers.screen_geometry import GOAL_CORNERS, polyline_gap
 from helpers.waiting import wait_until
 
 from scenes._framing import NOTICE_PX, Lens, project_points
-from scenes.freekick import (
-    FORCE_COLOURS,
-    KNUCKLE_COLOUR,
-    PATH_COLOUR,
-    PRESETS,
-    VIEW_LABELS,
-    FreeKickParams,
-    FreeKickScene,
-    ViewName,
-    ball_spot,
-    frame_view,
-    resample,
-    view_points,
-)
-from scenes.freekick.model import heat_cells
+from scenes.freekick import FreeKickParams, FreeKickScene
+from scenes.freekick.model import PRESETS, VIEW_LABELS, ViewName, ball_spot, heat_cells, resample
+from scenes.freekick.props import FORCE_COLOURS, KNUCKLE_COLOUR, PATH_COLOUR
+from scenes.freekick.views import frame_view, view_points
 
 pytestmark = pytest.mark.browser
 

@@ -45,7 +45,8 @@ from scipy import ndimage
 
 from scenes._skeletons import hand
 from scenes.arm import ArmScene
-from scenes.freekick import FreeKickScene, ball_spot
+from scenes.freekick import FreeKickScene
+from scenes.freekick.model import ball_spot
 from scenes.peloton import PelotonScene
 from scenes.sdf_gallery import SdfGalleryScene
 from server.budget import MAX_UPLOAD_BYTES, MIB

@@ -45,11 +45,13 @@ from helpers.gpx import gpx_text
 from helpers.waiting import wait_until
 
 from scenes._framing import NOTICE_PX
-from scenes.peloton import COMPONENT_COLOURS, LABEL_PX, PelotonScene
+from scenes.peloton import PelotonScene
 from scenes.peloton.course_model import FRAMED_LENGTH_M
 from scenes.peloton.legend import POWER_COLOURS
 from scenes.peloton.meshes import rider_head_m
 from scenes.peloton.model import FORMATION_FROM_LABEL
+from scenes.peloton.projection import LABEL_PX
+from scenes.peloton.scene import COMPONENT_COLOURS
 
 pytestmark = pytest.mark.browser
 

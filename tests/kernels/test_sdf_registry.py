@@ -18,7 +18,7 @@ from helpers.paths import GLSL
 from scipy import ndimage
 
 from kernels import sdf
-from scenes import sdf_gallery
+from scenes.sdf_gallery import params as gallery_params
 from shaders import glsl_library
 from shaders import renderer as gl_renderer
 from shaders.renderer import Camera, Renderer, Shading
@@ -86,9 +86,9 @@ def test_registry_lists_the_built_in_kinds_in_code_order() -> None:
 
 
 def test_gallery_menus_come_from_the_registry() -> None:
-    assert list(sdf_gallery.KIND_LABELS.values()) == list(sdf.PRIMITIVE_KINDS)
-    assert list(sdf_gallery.KIND_LABELS) == [s.label for s in sdf.PRIMITIVES.values()]
-    assert sdf_gallery.SIZES_USED == {s.kind: s.size_count for s in sdf.PRIMITIVES.values()}
+    assert list(gallery_params.KIND_LABELS.values()) == list(sdf.PRIMITIVE_KINDS)
+    assert list(gallery_params.KIND_LABELS) == [s.label for s in sdf.PRIMITIVES.values()]
+    assert gallery_params.SIZES_USED == {s.kind: s.size_count for s in sdf.PRIMITIVES.values()}
 
 
 def test_glsl_codes_and_dispatch_match_the_registry() -> None:

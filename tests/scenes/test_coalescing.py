@@ -27,8 +27,11 @@ from hypothesis import strategies as st
 
 from kernels import sdf
 from scenes.arm import ArmScene
-from scenes.freekick import FreeKickParams, FreeKickScene, _segments, compute_kick, resample
-from scenes.sdf_gallery import PREVIEW_RESOLUTION, SdfGalleryScene
+from scenes.freekick import FreeKickParams, FreeKickScene
+from scenes.freekick.model import compute_kick, resample
+from scenes.freekick.props import polyline_segments
+from scenes.sdf_gallery import SdfGalleryScene
+from scenes.sdf_gallery.params import PREVIEW_RESOLUTION
 from server.switcher import SceneSwitcher
 from server.turns import Turns
 from shaders import gl_service
@@ -212,7 +215,7 @@ def test_flooding_a_slider_ends_on_the_last_value_for_every_viewer(
             sender.set_value(SPEED, value)
         wait_until(lambda: scene.params.speed_ms == 27.5, "the scene on the last speed")
         scene.wait_idle()
-        expected = _segments(resample(compute_kick(FreeKickParams(speed_ms=27.5)).flight))
+        expected = polyline_segments(resample(compute_kick(FreeKickParams(speed_ms=27.5)).flight))
         np.testing.assert_allclose(scene.path.points, expected, rtol=1e-6)
         for client in (sender, viewer):
             client.wait_for(lambda c=client: c.value_of(SPEED) == 27.5, what="the slider at 27.5")

@@ -27,20 +27,21 @@ from hypothesis import strategies as st
 from kernels import course as course_kernel
 from kernels import cycling
 from scenes._framing import MARGIN_PX, NOTICE_PX, PANEL_PX, Lens
-from scenes.peloton import (
+from scenes.peloton import PelotonParams, PelotonScene
+from scenes.peloton.course import BREAK_EVERY, CourseMode, _escape
+from scenes.peloton.course_model import (
+    BAROMETER_RANGE_HPA,
     SAMPLE_LABEL,
-    CourseMode,
     CourseParams,
-    PelotonParams,
-    PelotonScene,
     compute_course,
+    course_air,
     format_duration,
-    group_cda,
+    lay_out_road,
+    route_points,
 )
-from scenes.peloton.course import BREAK_EVERY, _escape
-from scenes.peloton.course_model import BAROMETER_RANGE_HPA, course_air, lay_out_road, route_points
 from scenes.peloton.meshes import rider_head_m
 from scenes.peloton.model import FORMATION_FROM_LABEL as FORMATION
+from scenes.peloton.model import group_cda
 
 scene = scene_fixture(PelotonScene)
 

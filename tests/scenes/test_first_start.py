@@ -13,7 +13,8 @@ import viser
 
 from kernels import warming
 from scenes import SCENES
-from scenes.freekick import MAP_SPEEDS_MS, MAP_SPINS_REV_S, FreeKickScene
+from scenes.freekick import FreeKickScene
+from scenes.freekick.model import MAP_SPEEDS_MS, MAP_SPINS_REV_S
 
 
 @pytest.fixture

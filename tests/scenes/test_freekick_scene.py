@@ -18,36 +18,35 @@ from numpy.typing import NDArray
 
 from kernels import ball
 from scenes._framing import MARGIN_PX, NOTICE_PX, PANEL_PX, Lens, View, frame_points, project_points
-from scenes.freekick import (
+from scenes.freekick import FreeKickParams, FreeKickScene
+from scenes.freekick.model import (
     AIM_TOLERANCE_M,
-    ARROW_POINTS,
     JUMP_M,
+    MAP_CELL_PX,
     MAP_SPEEDS_MS,
     MAP_SPINS_REV_S,
     PATH_POINTS,
     PRESETS,
     RESULT_COLOURS,
     VIEW_LABELS,
-    VIEW_MIN_DEPTH_M,
-    FreeKickParams,
-    FreeKickScene,
     KickState,
     Preset,
     ViewName,
     aim_at,
     ball_spot,
     compute_kick,
-    frame_view,
-    goal_hides,
+    keeper_words,
+    knuckle_wobble_m,
     outcome_map,
     resample,
     sample_rows,
     spin_words,
-    view_points,
-    wall_hides,
+    spot_odds_map,
+    strike_chances,
 )
-from scenes.freekick.model import MAP_CELL_PX, keeper_words, knuckle_wobble_m, spot_odds_map, strike_chances
+from scenes.freekick.props import ARROW_POINTS
 from scenes.freekick.scene import GRASS_HALF_M
+from scenes.freekick.views import VIEW_MIN_DEPTH_M, frame_view, goal_hides, view_points, wall_hides
 
 
 @settings(max_examples=examples(200), deadline=None)

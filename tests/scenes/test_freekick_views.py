@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 from scenes._framing import NOTICE_PX, PANEL_PX, Lens, View, project_points
-from scenes.freekick import VIEW_LABELS, FreeKickScene, ViewName, ball_spot, resample
+from scenes.freekick import FreeKickScene
+from scenes.freekick.model import VIEW_LABELS, ViewName, ball_spot, resample
 
 LENSES = [Lens(math.radians(75.0), 1600, 1000), Lens(math.radians(75.0), 1280, 720)]
 """viser's opening field of view at the two window sizes the browser tests use."""

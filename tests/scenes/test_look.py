@@ -20,8 +20,8 @@ import app
 from scenes._instances import PARKED_AT_M, park_hidden
 from scenes._look import mesh_glb
 from scenes.peloton.meshes import CROWD_ABOVE, LIGHT_ABOVE, rider_detail, rider_meshes, rod
-from scenes.peloton.model import MAX_GROUP, POSITIONS
-from scenes.peloton.scene import ROAD_HALF_WIDTH_M, ROAD_X_M, PelotonScene
+from scenes.peloton.model import MAX_GROUP, POSITIONS, ROAD_HALF_WIDTH_M
+from scenes.peloton.scene import ROAD_X_M, PelotonScene
 
 scene = scene_fixture(PelotonScene)
 

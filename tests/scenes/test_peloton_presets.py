@@ -14,7 +14,8 @@ from helpers.scenes import scene_fixture
 from helpers.viser_private import gui_inputs
 from helpers.wsclient import BrowserClient
 
-from scenes.peloton import PelotonScene, compute_course
+from scenes.peloton import PelotonScene
+from scenes.peloton.course_model import compute_course
 from scenes.peloton.model import CRR_PRESETS, POSITIONS
 from server.switcher import SceneSwitcher
 

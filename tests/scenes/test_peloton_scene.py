@@ -20,21 +20,20 @@ from hypothesis import strategies as st
 
 from kernels import cycling
 from scenes._framing import MARGIN_PX, NOTICE_PX, PANEL_PX, Lens, View
-from scenes.peloton import (
-    BAR_METRES_PER_WATT,
-    LABEL_PX,
-    MAX_GAP_M,
-    MAX_GROUP,
-    MAX_RIDERS,
-    PelotonParams,
-    PelotonScene,
-    compute_line,
-)
+from scenes.peloton import PelotonParams, PelotonScene
 from scenes.peloton.course_model import FRAMED_LENGTH_M
 from scenes.peloton.legend import legend_html, power_range
 from scenes.peloton.meshes import rider_head_m
-from scenes.peloton.model import FORMATION_FROM_LABEL, formation_positions
-from scenes.peloton.scene import TEXT_PX_PER_CHAR
+from scenes.peloton.model import (
+    FORMATION_FROM_LABEL,
+    MAX_GAP_M,
+    MAX_GROUP,
+    MAX_RIDERS,
+    compute_line,
+    formation_positions,
+)
+from scenes.peloton.projection import LABEL_PX
+from scenes.peloton.scene import BAR_METRES_PER_WATT, TEXT_PX_PER_CHAR
 from server.switcher import SceneSwitcher
 
 scene = scene_fixture(PelotonScene)

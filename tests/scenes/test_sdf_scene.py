@@ -25,7 +25,8 @@ from trimesh.visual.texture import TextureVisuals
 
 from kernels import sdf
 from scenes._framing import Lens, View, box_corners, shows
-from scenes.sdf_gallery import RESOLUTION_LABEL, SdfGalleryParams, SdfGalleryScene
+from scenes.sdf_gallery import SdfGalleryParams, SdfGalleryScene
+from scenes.sdf_gallery.params import RESOLUTION_LABEL
 from shaders import gl_service
 from shaders.camera import camera_rays
 from shaders.renderer import Camera, GLUnavailableError
@@ -454,7 +455,7 @@ def test_each_gizmo_is_sized_coloured_and_named_for_its_own_primitive(
 ) -> None:
     # Gizmos over each other: four 0.8 m gizmos once drawn without depth test piled up over the middle. Each is now its primitive's
     # size plus a margin, with a ball of its colour and its name.
-    from scenes.sdf_gallery import GIZMO_MARGIN_M
+    from scenes.sdf_gallery.params import GIZMO_MARGIN_M
 
     scales = [g.scale for g in scene.gizmos]
     # Sphere r = 0.45 m, box half size 0.3 m, torus ring 0.6 + 0.12 m, capsule 0.3 + 0.14 m: each plus the margin.
@@ -521,7 +522,7 @@ def test_the_opening_view_shows_every_primitive_and_keeps_their_names_apart(scen
 def test_catalogue_primitives_from_the_dropdown_are_meshed(
     server: viser.ViserServer, scene: SdfGalleryScene, label: str, kind: str
 ) -> None:
-    from scenes.sdf_gallery import KIND_LABELS
+    from scenes.sdf_gallery.params import KIND_LABELS
 
     assert {"Cylinder", "Round box", "Octahedron", "Cone", "Hexagonal prism"} <= set(KIND_LABELS)
     with BrowserClient(server.get_port()) as client:
@@ -593,7 +594,7 @@ def test_typed_source_is_meshed_and_a_bad_one_keeps_the_last_good(
 
 @pytest.mark.gl
 def test_every_example_applies_and_meshes(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
-    from scenes.sdf_gallery import EXAMPLES
+    from scenes.sdf_gallery.editor import EXAMPLES
 
     assert len(EXAMPLES) >= 6
     with BrowserClient(server.get_port()) as client:
@@ -611,8 +612,7 @@ def test_typed_code_shows_as_your_own_and_the_same_example_can_be_picked_again(
     server: viser.ViserServer, scene: SdfGalleryScene
 ) -> None:
     # After typing, the menu still showed the example, and picking it again was no change: nothing came back.
-    from scenes.sdf_gallery import EXAMPLES
-    from scenes.sdf_gallery.editor import OWN_CODE
+    from scenes.sdf_gallery.editor import EXAMPLES, OWN_CODE
 
     first = next(iter(EXAMPLES))
     with BrowserClient(server.get_port()) as client:
@@ -824,7 +824,7 @@ def test_a_slow_compile_is_stopped_at_the_limit_while_the_server_keeps_serving(
 def test_an_over_long_editor_text_is_put_back_for_every_viewer(
     server: viser.ViserServer, scene: SdfGalleryScene, extra: int
 ) -> None:
-    from scenes.sdf_gallery import EDITOR_KEEP_CHARS
+    from scenes.sdf_gallery.editor import EDITOR_KEEP_CHARS
 
     label = "sdf(p) in GLSL"
     with BrowserClient(server.get_port()) as crafted, BrowserClient(server.get_port()) as other:
@@ -872,7 +872,7 @@ def test_a_text_the_editor_keeps_is_kept_and_apply_says_its_length(
 def test_apply_of_a_text_over_the_source_limit_says_its_length_and_the_limit(
     server: viser.ViserServer, scene: SdfGalleryScene
 ) -> None:
-    from scenes.sdf_gallery import MAX_SOURCE_CHARS
+    from shaders.glsl_sandbox import MAX_SOURCE_CHARS
 
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("Apply")
@@ -1113,7 +1113,7 @@ def test_a_camera_with_nan_numbers_is_ignored(scene: SdfGalleryScene) -> None:
 
 
 def gallery_rest_size(width: int, aspect: float, s_per_pixel: float | None) -> tuple[int, int]:
-    from scenes.sdf_gallery import rest_size
+    from scenes.sdf_gallery.params import rest_size
 
     return rest_size(width, aspect, s_per_pixel)
 

@@ -27,7 +27,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from scenes import SCENES, Scene
-from scenes.peloton import MAX_GROUP
+from scenes.peloton.model import MAX_GROUP
 from server.clean import (
     ControlSpec,
     clean_value,

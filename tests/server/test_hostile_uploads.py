@@ -18,7 +18,8 @@ from helpers.uploads import send_part, upload
 from helpers.wsclient import BrowserClient
 
 import server.budget as budget_module
-from scenes.peloton import CourseMode, PelotonScene
+from scenes.peloton import PelotonScene
+from scenes.peloton.course import CourseMode
 from server.budget import (
     MAX_UPLOAD_BYTES,
     MAX_UPLOAD_BYTES_IN_FLIGHT_PER_TAB,
