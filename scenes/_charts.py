@@ -69,6 +69,15 @@ LOG_DECIMALS_MIN = -MAX_DECIMALS
 """The smallest decade uPlot's own labels can write ("0.001"); below it they read "0"."""
 
 
+def number_scales(*y: str, log: Sequence[str] = ()) -> dict[str, viser.uplot.Scale]:
+    """uPlot scales for a chart of numbers: x on a number line (uPlot's x is time unless told) and each of the
+    ``y`` scale keys, all fitted to the data; the keys also in ``log`` on a log₁₀ axis (uPlot's ``distr=3``)."""
+    scales = {"x": viser.uplot.Scale(time=False, auto=True)}
+    for key in y:
+        scales[key] = viser.uplot.Scale(distr=3, auto=True) if key in log else viser.uplot.Scale(auto=True)
+    return scales
+
+
 class AddUplot(Protocol):
     """The ``add_uplot`` of viser's GUI API (or of the scenes' facade over it)."""
 
@@ -330,7 +339,7 @@ class FittedChart:
         """
         assert "padding" not in kwargs, "the padding is fitted"
         if scales is None:
-            scales = {"x": viser.uplot.Scale(time=False, auto=True), "y": viser.uplot.Scale(auto=True)}
+            scales = number_scales("y")
         self._series, self._scales, self._axes = series, scales, axes
         fitted, padding = fit_layout(data, series, scales, axes)
         self.handle = gui.add_uplot(

@@ -27,7 +27,7 @@ from numpy.typing import NDArray
 
 from kernels import fabrik
 from scenes._base import Scene
-from scenes._charts import FittedChart
+from scenes._charts import FittedChart, number_scales
 from scenes._controls import build_controls, checkbox, dropdown, slider
 from scenes._framing import ClientFraming, Lens, View, frame_points
 from scenes._instances import add_instances, park_hidden
@@ -623,10 +623,7 @@ is a static pose.
                         viser.uplot.Series(label="Iteration"),
                         viser.uplot.Series(label="Best pose's error (mm)", stroke="rgb(230,50,50)", width=2),
                     ),
-                    scales={
-                        "x": viser.uplot.Scale(time=False, auto=True),
-                        "y": viser.uplot.Scale(distr=3, auto=True),
-                    },
+                    scales=number_scales("y", log=("y",)),
                     legend=viser.uplot.Legend(show=True),
                     title="Error after each iteration (log scale)",
                     aspect=1.6,

@@ -21,7 +21,7 @@ import viser.uplot
 
 from kernels import course as course_kernel
 from scenes._base import record_spec, set_if_changed
-from scenes._charts import FittedChart
+from scenes._charts import FittedChart, number_scales
 from scenes._controls import build_controls, declared, read_controls
 from scenes._framing import Lens, View, frame_clear_of_notice
 from scenes._instances import park_hidden
@@ -189,12 +189,7 @@ class CourseMode:
                     viser.uplot.Series(label="Speed (km/h)", stroke="rgb(30,110,220)", width=1.5, scale="kmh"),
                     viser.uplot.Series(label="Power (W)", stroke="rgb(220,40,40)", width=1.5, scale="W"),
                 ),
-                scales={
-                    "x": viser.uplot.Scale(time=False, auto=True),
-                    "m": viser.uplot.Scale(auto=True),
-                    "kmh": viser.uplot.Scale(auto=True),
-                    "W": viser.uplot.Scale(auto=True),
-                },
+                scales=number_scales("m", "kmh", "W"),
                 # Three y axes share a panel-wide chart: each axis is coloured as its series and the units are in
                 # the legend's names, so no axis spends width on a unit label (with them the plot was 104 px wide).
                 axes=(

@@ -22,7 +22,7 @@ from helpers.properties import examples
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from scenes._charts import FittedChart
+from scenes._charts import FittedChart, number_scales
 
 pytestmark = pytest.mark.browser
 
@@ -39,10 +39,7 @@ class Probe:
             server.gui,
             data=(x, x),
             series=(viser.uplot.Series(label="x"), viser.uplot.Series(label="y", stroke="red")),
-            scales={
-                "x": viser.uplot.Scale(time=False, auto=True),
-                "y": viser.uplot.Scale(auto=True),
-            },
+            scales=number_scales("y"),
             title=LINEAR,
             aspect=1.4,
         )
@@ -50,10 +47,7 @@ class Probe:
             server.gui,
             data=(x, x + 1.0),
             series=(viser.uplot.Series(label="x"), viser.uplot.Series(label="y", stroke="red")),
-            scales={
-                "x": viser.uplot.Scale(time=False, auto=True),
-                "y": viser.uplot.Scale(distr=3, auto=True),
-            },
+            scales=number_scales("y", log=("y",)),
             title=LOG,
             aspect=1.6,
         )
@@ -66,12 +60,7 @@ class Probe:
                 viser.uplot.Series(label="b", stroke="blue", scale="b"),
                 viser.uplot.Series(label="c", stroke="green", scale="c"),
             ),
-            scales={
-                "x": viser.uplot.Scale(time=False, auto=True),
-                "a": viser.uplot.Scale(auto=True),
-                "b": viser.uplot.Scale(auto=True),
-                "c": viser.uplot.Scale(auto=True),
-            },
+            scales=number_scales("a", "b", "c"),
             axes=(
                 viser.uplot.Axis(scale="x", label="x"),
                 viser.uplot.Axis(scale="a", label="a", side=3),

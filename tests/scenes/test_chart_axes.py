@@ -20,16 +20,14 @@ from scenes._charts import (
     fit_scales,
     label_px,
     log_ticks,
+    number_scales,
     whole_numbers,
     widest_linear_label,
 )
 
 SERIES = (viser.uplot.Series(label="Iteration"), viser.uplot.Series(label="Error (mm)"))
-ARM_SCALES = {
-    "x": viser.uplot.Scale(time=False, auto=True),
-    "y": viser.uplot.Scale(distr=3, auto=True),
-}
-LINEAR_SCALES = {"x": viser.uplot.Scale(time=False, auto=True), "y": viser.uplot.Scale(auto=True)}
+ARM_SCALES = number_scales("y", log=("y",))
+LINEAR_SCALES = number_scales("y")
 
 
 def _x_axis(data: tuple[np.ndarray, ...], scales: dict[str, viser.uplot.Scale]) -> viser.uplot.Axis:
