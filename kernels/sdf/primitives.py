@@ -142,8 +142,7 @@ def sd_torus(p: ArrayLike, major_radius: float, minor_radius: float) -> FloatArr
     Returns:
         (N,) signed distances (m).
     """
-    pts = coordinates("p", p)
-    return _sd_torus(pts, length("major_radius", major_radius), length("minor_radius", minor_radius))
+    return _sd_torus(coordinates("p", p), length("major_radius", major_radius), length("minor_radius", minor_radius))
 
 
 def _sd_torus(pts: FloatArray, big_r: float, small_r: float) -> FloatArray:
@@ -163,8 +162,7 @@ def sd_capsule(p: ArrayLike, a: ArrayLike, b: ArrayLike, radius: float) -> Float
     Returns:
         (N,) signed distances (m).
     """
-    pts = coordinates("p", p)
-    return _sd_capsule(pts, position("a", a), position("b", b), length("radius", radius))
+    return _sd_capsule(coordinates("p", p), position("a", a), position("b", b), length("radius", radius))
 
 
 def _sd_capsule(pts: FloatArray, a_vec: FloatArray, b_vec: FloatArray, r: float) -> FloatArray:
@@ -190,8 +188,7 @@ def sd_cylinder(p: ArrayLike, half_height: float, radius: float) -> FloatArray:
     Returns:
         (N,) signed distances (m).
     """
-    pts = coordinates("p", p)
-    return _sd_cylinder(pts, length("half_height", half_height), length("radius", radius))
+    return _sd_cylinder(coordinates("p", p), length("half_height", half_height), length("radius", radius))
 
 
 def _sd_cylinder(pts: FloatArray, h: float, r: float) -> FloatArray:
