@@ -1035,6 +1035,55 @@ def test_a_field_applied_out_of_the_picture_is_brought_into_it_and_one_in_it_lea
 
 
 @pytest.mark.gl
+@pytest.mark.parametrize("size", [(1000, 1600), (720, 1280)], ids=["1600x1000", "1280x720"])
+def test_a_field_that_wider_bounds_bring_out_of_the_picture_is_followed_and_one_in_it_keeps_the_view(
+    server: viser.ViserServer, scene: SdfGalleryScene, size: tuple[int, int]
+) -> None:
+    # The editor's field is meshed in a box: of two spheres, the one at x = 2.2 m lies outside the ±1 m box they are
+    # applied in, and widening the box to ±3 m meshes it where the opening view does not reach. The view follows the
+    # new mesh once; narrowing the box a little, with both spheres already in the picture, leaves the view as it is.
+    with BrowserClient(server.get_port()) as client:
+        client.send_camera(size=size)
+        wait_until(lambda: len(server.get_clients()) == 1 and scene.framing.frames >= 1, "the opening framing")
+        (tab,) = server.get_clients().values()
+        lens = Lens(float(tab.camera.fov), size[1], size[0])
+
+        def view() -> View:
+            position, look_at = (tuple(float(v) for v in vec) for vec in (tab.camera.position, tab.camera.look_at))
+            return View(position, look_at)  # type: ignore[arg-type]
+
+        opening = view()
+        client.send_camera(opening.position, opening.look_at, size)  # the tab reports the framed view, as a page does
+        client.wait_for_gui("Editor bounds half size (m)")
+        client.set_value("Editor bounds half size (m)", 1.0)
+        apply_glsl(
+            client, "float sdf(vec3 p) { return min(length(p) - 0.3, length(p - vec3(2.2, 0.0, 0.0)) - 0.4); }\n"
+        )
+        wait_until(lambda: scene.editor_serial == 1, "the apply", timeout_s=60.0)
+        meshes = scene.mesh_serial
+        client.set_value("Editor bounds half size (m)", 3.0)
+        wait_until(lambda: scene.mesh_serial > meshes and scene.params.editor.half_size == 3.0, "the wider remesh")
+        box = box_corners(scene.mesh_vertices.min(axis=0), scene.mesh_vertices.max(axis=0))
+        assert scene.mesh_vertices[:, 0].max() > 2.5  # the far sphere, where the opening view did not reach
+        assert not shows(opening, lens, box, clear_of_notice=False)
+        wait_until(lambda: shows(view(), lens, box, clear_of_notice=False), "the sphere in the picture", timeout_s=10.0)
+        # The person steps back a little (the framed view is tight), then narrows the box: both spheres stay in view.
+        followed = view()
+        client.send_camera(followed.position, followed.look_at, size)  # the tab reports the framed view
+        wait_until(lambda: not scene.framing.pending(tab.client_id), "the framed view reported")
+        eye = np.add(followed.look_at, 1.3 * np.subtract(followed.position, followed.look_at))
+        held = View(tuple(float(v) for v in eye), followed.look_at)  # type: ignore[arg-type]
+        client.send_camera(held.position, held.look_at, size)
+        wait_until(lambda: np.allclose(view().position, held.position, atol=1e-6), "the step back")
+        held = view()
+        frames, meshes = scene.framing.frames, scene.mesh_serial
+        client.set_value("Editor bounds half size (m)", 2.8)
+        wait_until(lambda: scene.mesh_serial > meshes and scene.params.editor.half_size == 2.8, "the narrower remesh")
+        time.sleep(0.3)
+        assert scene.framing.frames == frames and view() == held
+
+
+@pytest.mark.gl
 @pytest.mark.parametrize("k", ["1e38", "1e30", "1e-6"])
 def test_a_typed_field_far_from_a_distance_agrees_with_its_mesh(
     server: viser.ViserServer, scene: SdfGalleryScene, k: str
