@@ -65,7 +65,7 @@ from scenes.peloton.meshes import (
     rider_head_m,
     show_position,
 )
-from scenes.peloton.model import BIKE_LENGTH_M, MAX_GROUP, Position, group_cda, is_line_view
+from scenes.peloton.model import BIKE_LENGTH_M, MAX_GROUP, PelotonParams, Position, group_cda, is_line_view
 
 CHART_TITLE = "Elevation, speed and power"
 """The course chart's title (short: the panel is narrow)."""
@@ -143,9 +143,11 @@ class CourseMode:
         """Why the last file was not loaded, in the panel (Markdown); empty once one is."""
         self.refusal = ""
         """The same, as plain text, for the notification to the tab that uploaded it."""
-        self.solve_note: tuple[float, float, str] | None = None
-        """(target min, power W, what it says) of the last 'Find the power' whose target lay outside the power
-        input's range: the readout says it while that target and that power are still set."""
+        self._ridden: tuple[object, ...] | None = None
+        """The route and the inputs the shown ride was ridden with (:data:`RIDE_INPUTS`, :data:`LINE_INPUTS`)."""
+        self.solve_note: tuple[tuple[object, ...], str] | None = None
+        """What the last 'Find the power' said (a target outside the power input's range, or why no power was found)
+        and the ride and target it said it of (:meth:`_solve_key`): shown under the button while they are."""
         self._since_readout = 0.0
         self._drawn_riders: tuple[Position, Detail] | None = None
         """The riding position and mesh detail the riders were last meshed for."""
@@ -367,13 +369,20 @@ class CourseMode:
             set_if_changed(self.controls[name], "visible", weather)
         set_if_changed(self.controls["pressure_hpa"], "visible", weather and p.pressure_from_barometer)
 
-    def _on_input(self) -> None:
+    def _on_input(self, solve_note: str = "") -> None:
+        """Ride again with every input as it is now; ``solve_note``, what a 'Find the power' says of this ride."""
         self._show_air_inputs(self.read_params())
         if not self.enabled:  # the line's sliders move often: ride the course only while it is shown
             self.state = None
             return
         self.recompute()
+        if solve_note:
+            self.solve_note = (self._solve_key(), solve_note)
         self.redraw()
+
+    def _solve_key(self) -> tuple[object, ...]:
+        """What a 'Find the power' note speaks of: the shown ride's route and inputs, and the target time."""
+        return (self._ridden, self.params.target_min)
 
     def _on_view(self) -> None:
         self.params = self.read_params()
@@ -392,6 +401,7 @@ class CourseMode:
         # ride that is now faster or slower: else the readout and the slider part (5.57 km against 5.5).
         at_m = self.leader_distance_m() if self.state is not None else self._scrub_m()
         self.params, self.state = params, state
+        self._ridden = _ride_inputs(self.route, params, line)
         self.message = ""
         self.play_time_s = float(np.interp(at_m, state.ride.distance_m, state.ride.elapsed_s))
         if self.enabled and self.playing:  # a ride that had none to play now has one
@@ -472,10 +482,10 @@ class CourseMode:
             with contextlib.suppress(Exception):  # its tab may have closed
                 notice.remove()
         self.refusal_notices.clear()
-        state = None
+        state, params, line = None, self.read_params(), self.scene.read_params()
         if route is not None:
             try:
-                state = compute_course(route, self.read_params(), self.scene.read_params())
+                state = compute_course(route, params, line)
             except ValueError as failure:
                 error = str(failure)
         if route is None or state is None:
@@ -487,7 +497,7 @@ class CourseMode:
             self.redraw()
             return False
         self.route, self.route_label, self.state = route, label, state
-        self.params = self.read_params()
+        self.params, self._ridden = params, _ride_inputs(route, params, line)
         self.message = ""
         self.play_time_s = 0.0
         self.playing = False
@@ -542,16 +552,15 @@ class CourseMode:
                 )
             except ValueError as error:
                 reason = f"Could not find the power for {wanted}: {_escape(str(error))}"
-                self.solve_note = (params.target_min, params.power_w, reason)
+                self.solve_note = (self._solve_key(), reason)
                 self.redraw()
                 return
             note = ""
         power = float(np.clip(round(power, 1), low, high))
-        # Shown under the button while this target and this power are set (it stood at the top of the folder,
-        # scrolled out of view by the time the button is reached).
-        self.solve_note = (params.target_min, power, note) if note else None
         self.scene.write_back(self.controls["power_w"], power)
-        self._on_input()
+        # Shown under the button (it stood at the top of the folder, scrolled out of view by the time the button is
+        # reached) while this ride is: its finish time is the one the note gives.
+        self._on_input(solve_note=note)
 
     def _on_play(self) -> None:
         if self.state is None:
@@ -768,9 +777,9 @@ class CourseMode:
         return text
 
     def _solve_note_markdown(self) -> str:
-        """The last 'Find the power' note while its target and its power are still set, else ""."""
-        note, p = self.solve_note, self.params
-        return f"⚠️ {note[2]}" if note is not None and note[:2] == (p.target_min, p.power_w) else ""
+        """The last 'Find the power' note while the ride and target it speaks of are shown, else ""."""
+        note = self.solve_note
+        return f"⚠️ {note[1]}" if note is not None and self.state is not None and note[0] == self._solve_key() else ""
 
     def _readout_markdown(self) -> str:
         state = self.state
@@ -928,3 +937,14 @@ def _escape(text: str) -> str:
     """Text from a file, shown in markdown as the same characters: no HTML, links, images or emphasis, and a place
     to wrap in every long run without white space (:func:`_wrappable`)."""
     return _BARE_ADDRESS.sub(_WORD_JOINER, _wrappable(text)).translate(_MARKDOWN_ESCAPES)
+
+
+def _ride_inputs(route: course_kernel.Course, params: CourseParams, line: PelotonParams) -> tuple[object, ...]:
+    """What a ride on ``route`` depends on, to compare with ``==``: the route itself (compared as the same object:
+    its arrays do not compare with ``==``), the course's :data:`RIDE_INPUTS` and the line's :data:`LINE_INPUTS`."""
+    return (
+        id(route),
+        route,
+        *(getattr(params, name) for name in RIDE_INPUTS),
+        *(getattr(line, name) for name in LINE_INPUTS),
+    )
