@@ -93,8 +93,9 @@ class Gate:
         """Per (tab, control uuid), a send-back waiting for the tab to stop typing (:data:`ECHO_AFTER_TYPING_S`)."""
         self._echoed_at: dict[tuple[int, str], float] = {}
         """Per (tab, control uuid), when the server's value was last sent back to that tab."""
-        self._finished_upload_starts: dict[tuple[int, str], float] = {}
-        """When the last upload each (client, upload button) finished was started (:meth:`upload_started_at`)."""
+        self._finished_uploads: dict[tuple[int, str], tuple[float, str]] = {}
+        """When the last upload each (client, upload button) finished was started, and its transfer id
+        (:meth:`upload_started_at`, :meth:`upload_notice`)."""
         self._budgets: dict[int, TabBudget] = {}
         """Per client, its costly-input budget (only touched on the event loop)."""
         self._deliveries: set[asyncio.Future[None]] = set()
@@ -112,8 +113,8 @@ class Gate:
         client_id = int(connection.client_id)
         self._client_dispatch.pop(client_id, None)
         self._uploads.pop(client_id, None)
-        for key in [key for key in list(self._finished_upload_starts) if key[0] == client_id]:
-            self._finished_upload_starts.pop(key, None)
+        for key in [key for key in list(self._finished_uploads) if key[0] == client_id]:
+            self._finished_uploads.pop(key, None)
         for key in [key for key in list(self._seen_at) if key[0] == client_id]:
             self._seen_at.pop(key, None)
         for key in [key for key in list(self._echoes) if key[0] == client_id]:
@@ -293,7 +294,15 @@ class Gate:
         """When (``time.monotonic()``) the gate took the start of the last upload tab ``client_id`` finished on upload
         button ``button``; None if none has. A scene reads it in the button's ``on_upload`` to tell a file picked
         before its user's later choice (which the file, still arriving, would otherwise overrule) from one after."""
-        return self._finished_upload_starts.get((client_id, viser_compat.gui_uuid(button)))
+        finished = self._finished_uploads.get((client_id, viser_compat.gui_uuid(button)))
+        return None if finished is None else finished[0]
+
+    def upload_notice(self, client_id: int, button: object) -> str | None:
+        """The id of viser's own notice of the last upload tab ``client_id`` finished on upload button ``button``
+        ("Uploading…", then "File uploaded successfully"); None if none has. A scene that refuses the file takes
+        it down, so that its refusal is the one message the tab shows about the file."""
+        finished = self._finished_uploads.get((client_id, viser_compat.gui_uuid(button)))
+        return None if finished is None else viser_compat.upload_notice_id(finished[1])
 
     def uploads_in_flight(self) -> tuple[int, int]:
         """(uploads, bytes they announced) started and not finished, across every tab of this server."""
@@ -508,7 +517,7 @@ class Gate:
         if parts > 0:
             in_flight[message.transfer_uuid] = Upload(parts, size, now, now, button_uuid=button)
         else:  # viser finishes an empty file at its start
-            self._finished_upload_starts[(client_id, button)] = now
+            self._finished_uploads[(client_id, button)] = (now, str(message.transfer_uuid))
         return message, None
 
     def _tell(
@@ -583,7 +592,7 @@ class Gate:
         upload.last_part_at = time.monotonic()
         if len(upload.parts_seen) == upload.part_count:
             del self._uploads[client_id][str(message.transfer_uuid)]
-            self._finished_upload_starts[(client_id, upload.button_uuid)] = upload.started_at
+            self._finished_uploads[(client_id, upload.button_uuid)] = (upload.started_at, str(message.transfer_uuid))
         return message
 
     def _gizmo_handle(self, server: viser.ViserServer, client_id: int, name: str, owner: str) -> Any:

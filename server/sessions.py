@@ -272,6 +272,14 @@ class Session:
             return None
         return install_gate(self.viser_server).upload_started_at(client_id, button)
 
+    def upload_notice(self, event: object) -> str | None:
+        """The id of viser's own notice of the upload an ``on_upload`` ``event`` reports, in its tab ("File uploaded
+        successfully"), for :meth:`remove_notice`; None when unknown (:meth:`server.gate.Gate.upload_notice`)."""
+        client_id, button = getattr(event, "client_id", None), getattr(event, "target", None)
+        if not isinstance(client_id, int) or button is None:
+            return None
+        return install_gate(self.viser_server).upload_notice(client_id, button)
+
     def get_clients(self) -> dict[int, viser.ClientHandle]:
         """The clients this session serves, by id."""
         if self.client is None:

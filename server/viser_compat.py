@@ -30,7 +30,8 @@ viser's code behind each name below, and nothing else. The private names touched
   in that tab alone (:func:`end_refused_upload`), a download is sent under a transfer id we choose
   (:func:`send_download`) and a notice is taken down (:func:`remove_notice`).
 - viser's client (``UploadButton.tsx``, not Python): an upload button stays disabled until the acks of its upload
-  reach the size announced, and its progress notice has the id ``upload-<transfer id>`` (:func:`end_refused_upload`).
+  reach the size announced, and its progress notice has the id ``upload-<transfer id>`` (:func:`end_refused_upload`,
+  :func:`upload_notice_id`).
 - viser's client (``MessageHandler.tsx``): a download's notice, which holds its link, has the id
   ``download-<transfer id>`` (:func:`send_download`); ``ClientHandle.send_file_download`` does not return that id.
 - ``viser._assignable_props_api.AssignablePropsBase._cast_value_recursive`` and ``colors_to_uint8``: the property
@@ -173,7 +174,13 @@ def end_refused_upload(
     client = connected_client(server, client_id)
     if client is not None:
         ack = messages.FileTransferPartAck(button_uuid, transfer_uuid, size_bytes, size_bytes)
-        _send(client, ack, messages.RemoveNotificationMessage(uuid=f"upload-{transfer_uuid}"))
+        _send(client, ack, messages.RemoveNotificationMessage(uuid=upload_notice_id(transfer_uuid)))
+
+
+def upload_notice_id(transfer_uuid: str) -> str:
+    """The id of the notice viser's client shows for upload ``transfer_uuid`` ("Uploading…", then "File uploaded
+    successfully"), for :func:`remove_notice`."""
+    return f"upload-{transfer_uuid}"
 
 
 def send_download(client: viser.ClientHandle, filename: str, content: bytes, chunk_bytes: int = 1024 * 1024) -> str:

@@ -414,10 +414,10 @@ class CourseMode:
         """An upload arrived (viser's thread pool). Parse it off the scene's lock, since gpxpy needs seconds for a
         large file, then install it (or the reason it failed) as a guarded callback. Nothing escapes.
 
-        A refused file is also told to the tab that sent it, in a notification: viser's own "uploaded successfully"
-        shows there for any file that arrived whole."""
+        A refused file is also told to the tab that sent it, in a notification that takes the place of viser's own
+        "File uploaded successfully" (:meth:`_tell_not_loaded`)."""
         client = getattr(event, "client", None)
-        started_at = self.server.upload_started_at(event)
+        started_at, upload_notice = self.server.upload_started_at(event), self.server.upload_notice(event)
         # The number and the file are taken together: a higher number is a newer file.
         with self._upload_lock:
             picked_before_a_later_choice = started_at is not None and started_at < self._chosen_at
@@ -426,7 +426,7 @@ class CourseMode:
             seq = self._upload_seq
             uploaded = self.upload.value
         if picked_before_a_later_choice:
-            self.scene.callback(lambda: self._tell_superseded(client, uploaded))(None)
+            self.scene.callback(lambda: self._tell_superseded(client, upload_notice, uploaded))(None)
             return
         try:
             name = str(getattr(uploaded, "name", "") or "upload")[:80]
@@ -446,21 +446,27 @@ class CourseMode:
         def install() -> None:
             if seq != self._upload_seq:  # a newer upload arrived while this one parsed: it wins
                 return
-            if not self._install(route, error, name) and isinstance(client, viser.ClientHandle):
+            if not self._install(route, error, name):
                 body = self.refusal if len(self.refusal) <= 500 else self.refusal[:499] + "…"
-                notice = client.add_notification("GPX not loaded", body, color="red", auto_close_seconds=15.0)
-                self.refusal_notices.append(notice)
+                self._tell_not_loaded(client, upload_notice, body)
 
         self.scene.callback(install)(None)
 
-    def _tell_superseded(self, client: object, uploaded: object) -> None:
+    def _tell_superseded(self, client: object, upload_notice: str | None, uploaded: object) -> None:
         """Tell the tab that file ``uploaded`` arrived after a later choice of route, which stays."""
-        if not isinstance(client, viser.ClientHandle):
-            return
         name = str(getattr(uploaded, "name", "") or "The file")[:80]
         body = (
             f"{name} was still arriving when you chose {self.route.name}, which stays. Upload {name} again to ride it."
         )
+        self._tell_not_loaded(client, upload_notice, body)
+
+    def _tell_not_loaded(self, client: object, upload_notice: str | None, body: str) -> None:
+        """Tell the tab that uploaded a file why it was not loaded, in place of viser's own "File uploaded
+        successfully" (notice ``upload_notice``), which would contradict it."""
+        if not isinstance(client, viser.ClientHandle):
+            return
+        if upload_notice is not None:
+            self.server.remove_notice(client, upload_notice)
         self.refusal_notices.append(
             client.add_notification("GPX not loaded", body, color="red", auto_close_seconds=15.0)
         )

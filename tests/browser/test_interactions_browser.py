@@ -296,6 +296,33 @@ def test_a_file_over_the_upload_limit_is_refused_and_the_button_works_again(
         wait_until(lambda: mode.route.name == "After the refusal", "the next upload", timeout_s=20.0)
 
 
+@pytest.mark.parametrize("viewport", VIEWPORTS, ids=lambda v: f"{v[0]}x{v[1]}")
+def test_a_file_the_course_refuses_shows_one_message_not_uploaded_successfully_beside_it(
+    server: viser.ViserServer, browser_page: Any, tmp_path: Path, viewport: tuple[int, int]
+) -> None:
+    """A KML file named .gpx arrived whole, so viser's page said "File uploaded successfully" next to the course's red
+    "GPX not loaded": two toasts that contradict each other. Now the refusal is the one message about the file."""
+    with served_scene_at(server, browser_page, "peloton", "/peloton/course_mode/route", viewport) as served:
+        scene, page = served.scene, served.page
+        assert isinstance(scene, PelotonScene)
+        mode = scene.course_mode
+        close_notifications(page)
+        page.get_by_text("Ride a course", exact=True).first.click()
+        wait_until(lambda: mode.enabled and mode.state is not None, "course mode on", timeout_s=15.0)
+        kml = tmp_path / "route.gpx"
+        kml.write_bytes(b'<?xml version="1.0"?><kml xmlns="http://www.opengis.net/kml/2.2"><Document/></kml>')
+        with page.expect_file_chooser() as chooser:
+            page.get_by_role("button", name="Upload GPX").click()
+        chooser.value.set_files(str(kml))
+        refusal = page.locator(TOAST, has_text="GPX not loaded")
+        refusal.wait_for(timeout=15_000)
+        assert "route.gpx was not loaded" in refusal.inner_text()
+        wait_frames(page, 10)
+        toasts = [page.locator(TOAST).nth(i).inner_text() for i in range(page.locator(TOAST).count())]
+        assert len(toasts) == 1 and "successfully" not in toasts[0] and "Uploading" not in toasts[0], toasts
+        screenshot(page, str(tmp_path / "one_message.png"))
+
+
 # ------------------------------------------------------------------------------------------------ typing in a box
 # Kind: the server's value sent back over a box a person is still typing in. viser's page sends a box's value at
 # every keystroke; the server sent each (clamped) value back, so "75" typed into Mass (30–150 kg) became 30 at the

@@ -8,8 +8,8 @@ from typing import Any
 from helpers.wsclient import BrowserClient
 
 
-def upload(client: BrowserClient, label: str, filename: str, data: bytes, part: int = 64_000) -> None:
-    """What the browser sends when a person picks a file for the upload button ``label``."""
+def upload(client: BrowserClient, label: str, filename: str, data: bytes, part: int = 64_000) -> str:
+    """What the browser sends when a person picks a file for the upload button ``label``; returns its transfer id."""
     source = client.uuid_of(label)
     transfer = str(uuid.uuid4())
     parts = [data[i : i + part] for i in range(0, len(data), part)]
@@ -30,6 +30,7 @@ def upload(client: BrowserClient, label: str, filename: str, data: bytes, part: 
             part_index=index,
             content=content,
         )
+    return transfer
 
 
 def send_part(client: BrowserClient, transfer: str, index: int, content: Any) -> None:

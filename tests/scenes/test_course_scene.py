@@ -11,6 +11,7 @@ import time
 import unicodedata
 import uuid
 from typing import Any
+from unittest.mock import ANY
 
 import numpy as np
 import pytest
@@ -267,13 +268,16 @@ def test_a_bad_upload_from_a_browser_is_reported(
     text, message = BAD_FILES[kind]
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("Upload GPX")
-        upload(client, "Upload GPX", f"{kind}.gpx", text.encode())
+        transfer = upload(client, "Upload GPX", f"{kind}.gpx", text.encode())
         client.wait_for(
             lambda: any("was not loaded" in str(e["props"].get("_markdown", "")) for e in client.gui.values()),
             what="the message",
         )
-        # Told where viser's own "uploaded successfully" shows too (once, that was all a person saw there).
+        # Told in a notification (once, viser's own "uploaded successfully" was all a person saw there), which takes
+        # the place of viser's: the two contradicted each other.
         client.wait_for(lambda: bool(client.notices()), what="the notification")
+        kinds = [(m["type"], m.get("uuid")) for _at, m in list(client.received) if "Notification" in m["type"]]
+        assert kinds[-2:] == [("RemoveNotificationMessage", f"upload-{transfer}"), ("NotificationShowMessage", ANY)]
         (notice,) = client.notices()
         assert notice["title"] == "GPX not loaded" and notice["color"] == "red"
         assert notice["body"].startswith(f"{kind}.gpx was not loaded: ")
@@ -291,10 +295,13 @@ def test_a_refusal_notice_comes_down_when_the_next_route_is_loaded(server: viser
         upload(client, "Upload GPX", "bad.gpx", b"hello, I am not a GPX file")
         client.wait_for(lambda: bool(client.notices()), what="the notice")
         client.wait_for(lambda: len(mode.refusal_notices) == 1, what="the notice kept")
+        (shown,) = [m["uuid"] for _at, m in list(client.received) if m["type"] == "NotificationShowMessage"]
         upload(client, "Upload GPX", "good.gpx", hill_gpx("Good hill"))
         client.wait_for(lambda: mode.route.name == "Good hill", what="the good route")
         client.wait_for(
-            lambda: any(m.get("type") == "RemoveNotificationMessage" for _at, m in list(client.received)),
+            lambda: any(
+                m["type"] == "RemoveNotificationMessage" and m.get("uuid") == shown for _at, m in list(client.received)
+            ),
             what="the notice taken down",
         )
         assert not mode.refusal_notices
@@ -437,6 +444,8 @@ def test_a_file_still_arriving_when_the_sample_route_is_chosen_does_not_replace_
         time.sleep(0.3)  # an install, had the file been let through, has run by now
         (note,) = [n for n in client.notices() if "before.gpx" in n["body"]]
         assert note["title"] == "GPX not loaded" and "was still arriving when you chose" in note["body"]
+        removed = [m.get("uuid") for _at, m in list(client.received) if m["type"] == "RemoveNotificationMessage"]
+        assert f"upload-{transfer}" in removed  # viser's "uploaded successfully" is not left beside it
         # A file picked after that choice loads as before.
         upload(client, "Upload GPX", "after.gpx", hill_gpx("Picked after"))
         client.wait_for(lambda: mode.route_label == "after.gpx", what="the later upload")
