@@ -454,7 +454,13 @@ def why_short(
                 f"(its joints bend up to {min(used, 1.0):.0%} of the limit)"
             )
     if r.status == "max_iterations":
-        reasons.append(f"it was still closing in after {iterations_words(r.iterations)} (raise Max iterations)")
+        # More iterations help only where nothing else named holds the end off the target (a 0° cone, the reach).
+        capped = f"it stopped at its cap of {iterations_words(r.iterations)}"
+        reasons.append(
+            capped
+            if reasons
+            else f"it was still closing in after {iterations_words(r.iterations)} (raise Max iterations)"
+        )
     if r.status == "infeasible":
         reasons.append("no pose it saw kept every limit and cleared every obstacle")
     if not reasons:

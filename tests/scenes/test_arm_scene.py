@@ -586,3 +586,18 @@ def test_iteration_counts_read_in_good_english(scene: ArmScene) -> None:
     text = scene.readout.content
     assert re.search(r"\b1 iterations\b", text) is None
     assert "**FABRIK**: 1 iteration," in text and "after 1 iteration (raise Max iterations)" in text
+
+
+def test_the_iteration_cap_is_not_blamed_where_the_joint_limits_hold_the_end_off(scene: ArmScene) -> None:
+    # Kind: advice that cannot help. At Max iterations 1 a chain of 0° cones read "still closing in after 1 iteration
+    # (raise Max iterations)"; at 500 the same pose, 984.9 mm short, reads "limited".
+    scene.controls["limits"].value = True
+    scene.controls["half_angle_deg"].value = 0.0
+    scene.controls["max_iterations"].value = 1
+    scene.target_gizmo.position = (-0.4, 0.0, 0.6)
+    scene._apply_target()
+    report = scene.report
+    assert report is not None and report.result.status == "max_iterations"
+    text = scene.readout.content
+    assert "at the 0° joint limit" in text and "it stopped at its cap of 1 iteration" in text
+    assert "raise Max iterations" not in text and "closing in" not in text
