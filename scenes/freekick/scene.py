@@ -211,6 +211,9 @@ reads it again, so a ball that bounces in front of him beats him more often than
         """The goal chance over the pitch's spots (:func:`~scenes.freekick.model.spot_odds_map`), once asked for."""
         self.odds_map_params: FreeKickParams | None = None
         """The strike (:func:`~scenes.freekick.model.odds_map_settings`) the shown odds map is for."""
+        self.odds_map_asked: FreeKickParams | None = None
+        """The strike of the odds map being computed (the latest click's), None once it is done or has failed: what
+        the status says follows it, not the worker, whose own job is still running when it shows its result."""
         self._map_worker = LatestWorker("freekick-map")
         self._aim_worker = LatestWorker("freekick-aim")
         self._odds_worker = LatestWorker("freekick-odds-map")
@@ -581,10 +584,10 @@ reads it again, so a ball that bounces in front of him beats him more often than
         follows it, and a newer request drops this one's result."""
         self._odds_version += 1
         version, params = self._odds_version, self.params
+        self.odds_map_asked = odds_map_settings(params)
         with self.server.atomic():
             self.heat_progress.value = 0.0
-            self.heat_progress.visible = True
-            self.heat_status.content = "Striking the kick from every spot…"
+            self._show_odds_map()
 
         def progress(share: float) -> None:
             with self._lock:
@@ -592,14 +595,25 @@ reads it again, so a ball that bounces in front of him beats him more often than
                     self.heat_progress.value = round(100.0 * share, 1)
 
         def job() -> None:
-            chance = spot_odds_map(params, progress)
+            try:
+                chance = spot_odds_map(params, progress)
+            except Exception:
+                with self._lock:
+                    if not self.closed and version == self._odds_version:
+                        self.odds_map_asked = None
+                        with self.server.atomic():
+                            self._show_odds_map()
+                            self.heat_status.content = "The goal chance map failed (the log says why): map it again."
+                raise  # the worker logs it
             with self._lock:
                 if self.closed or version != self._odds_version:
-                    return
+                    return  # a newer click's map is on its way, and its status is shown
                 self.odds_map, self.odds_map_params = chance, odds_map_settings(params)
+                self.odds_map_asked = None
                 self.heat_nodes.batched_colors = heat_colours(chance.ravel())
-                self.heat_progress.visible = False
                 self._show_odds_map()
+                if not self.heat_nodes.visible:  # the strike changed while it was mapped: the view stays
+                    return
                 if self.params.view != "above":  # a map of the pitch reads best from above
                     self.apply(dataclasses.replace(self.params, view="above"))
                 else:
@@ -608,18 +622,25 @@ reads it again, so a ball that bounces in front of him beats him more often than
         self._odds_worker.submit(job)
 
     def _show_odds_map(self) -> None:
-        """Show the odds map if it is for the current strike (from any spot), else hide it and say why."""
-        current = self.odds_map is not None and self.odds_map_params == odds_map_settings(self.params)
+        """Show the odds map if it is for the current strike (from any spot), else hide it and say why; the progress
+        bar shows while a map of the current strike is computed. A map asked for a strike that has since changed
+        still finishes (it is shown should that strike come back), but says at once that this strike needs its own."""
+        strike = odds_map_settings(self.params)
+        current = self.odds_map is not None and self.odds_map_params == strike
+        striking = self.odds_map_asked == strike
         with self.server.atomic():
             set_if_changed(self.heat_nodes, "visible", current)
             set_if_changed(self.heat_legend, "visible", current)
-            if current and self.odds_map is not None:
+            set_if_changed(self.heat_progress, "visible", striking)
+            if striking:
+                self.heat_status.content = "Striking the kick from every spot…"
+            elif current and self.odds_map is not None:
                 self.heat_status.content = (
                     f"{odds_map_words(self.odds_map, self.params)}  \nEach tile: this strike from there, 32 times "
                     "with a player's scatter, the wall square to the goal. Shown from above (pick another View to "
                     "see the kick)."
                 )
-            elif self.odds_map is not None and self._odds_worker.idle():
+            elif self.odds_map is not None or self.odds_map_asked is not None:
                 self.heat_status.content = "The strike has changed: map it again to see its goal chance."
 
     def wait_idle(self, timeout_s: float = 30.0) -> bool:

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import threading
+from collections.abc import Callable
 
 import numpy as np
 import pytest
@@ -19,6 +21,7 @@ from numpy.typing import NDArray
 from kernels import ball
 from scenes._framing import MARGIN_PX, NOTICE_PX, PANEL_PX, Lens, View, frame_points, project_points
 from scenes.freekick import FreeKickParams, FreeKickScene
+from scenes.freekick import scene as freekick_scene
 from scenes.freekick.model import (
     AIM_TOLERANCE_M,
     JUMP_M,
@@ -1040,6 +1043,149 @@ def test_the_odds_map_reports_its_progress_to_the_end() -> None:
     shares: list[float] = []
     spot_odds_map(FreeKickParams(speed_ms=20.0, keeper=False), shares.append)
     assert len(shares) >= 10 and shares == sorted(shares) and shares[-1] == 1.0
+
+
+# Kind: a status shown for work that was dropped or superseded. An outside tester clicked "Map the goal chance from
+# every spot" and changed the launch speed before the map was done (4–5 s on a busy 2-core machine): "Striking the
+# kick from every spot…" stayed for good, with no bar and no tiles, where it should have said the strike had changed.
+HEAT_BUTTON = "Map the goal chance from every spot"
+STRIKING = "Striking the kick from every spot…"
+STRIKE_CHANGED = "The strike has changed: map it again to see its goal chance."
+
+
+def _held_odds_maps(monkeypatch: pytest.MonkeyPatch) -> tuple[threading.Event, threading.Event]:
+    """Hold every goal chance map the scene computes at its start until released, as a busy machine holds it for
+    seconds; returns (started, release): set once the first map is under way, and the release."""
+    started, release = threading.Event(), threading.Event()
+
+    def held(p: FreeKickParams, progress: Callable[[float], object] | None = None) -> NDArray[np.float64]:
+        started.set()
+        assert release.wait(60.0), "the test never released the map"
+        return spot_odds_map(p, progress)
+
+    monkeypatch.setattr(freekick_scene, "spot_odds_map", held)
+    return started, release
+
+
+def _node_shown(client: BrowserClient, name: str) -> bool:
+    """Whether the last visibility this browser was sent for node ``name`` shows it."""
+    shown = False
+    for _at, message in list(client.received):
+        if message.get("type") == "SetSceneNodeVisibilityMessage" and message.get("name") == name:
+            shown = bool(message["visible"])
+    return shown
+
+
+def _progress_shown(client: BrowserClient) -> bool:
+    """Whether this browser shows the scene's one progress bar (the goal chance map's); read it in a wait."""
+    bars = [element for element in client.gui.values() if element["type"] == "GuiProgressBarMessage"]
+    assert len(bars) == 1
+    return bool(bars[0]["props"].get("visible"))
+
+
+def _sent_while_mapping(client: BrowserClient, freekick: FreeKickScene, then: str) -> None:
+    """Send ``then`` as a person does and wait for the scene to take it (the map is still held)."""
+    match then:
+        case "a new launch speed":
+            client.set_value("Launch speed (m/s)", 27.0)
+            client.wait_for(lambda: freekick.params.speed_ms == 27.0, what="the new speed")
+        case "a preset":
+            client.click(PRESETS[1].label)
+            client.wait_for(lambda: freekick.params.speed_ms == PRESETS[1].params.speed_ms, what="the preset")
+        case "ticking Knuckleball":
+            client.set_value("Knuckleball", True)
+            client.wait_for(lambda: freekick.params.knuckle, what="the knuckleball")
+        case "an aim at the goal mouth":
+            _click_the_goal_mouth(client, ray_origin=(-20.0, 1.5, 1.2))
+            client.wait_for(lambda: _markdown_shown(client, "Found:"), timeout=60.0, what="the aimed kick")
+        case "moving the ball":
+            client.set_value("Distance to goal (m)", 25.0)
+            client.wait_for(lambda: freekick.params.distance_m == 25.0, what="the ball on its new spot")
+        case "a second click on Map":
+            client.click(HEAT_BUTTON)
+            client.wait_for(lambda: freekick._odds_version == 2, what="the second click")
+        case _:
+            raise AssertionError(then)
+
+
+@pytest.mark.parametrize(
+    ("then", "same_strike"),
+    [
+        ("a new launch speed", False),
+        ("a preset", False),
+        ("ticking Knuckleball", False),
+        ("an aim at the goal mouth", False),
+        ("moving the ball", True),  # the map is the same strike from every spot
+        ("a second click on Map", True),
+    ],
+)
+def test_an_input_while_the_goal_chance_is_mapped_leaves_a_true_status(
+    server: viser.ViserServer,
+    freekick: FreeKickScene,
+    monkeypatch: pytest.MonkeyPatch,
+    then: str,
+    same_strike: bool,
+) -> None:
+    started, release = _held_odds_maps(monkeypatch)
+    view = freekick.params.view
+    try:
+        with BrowserClient(server.get_port()) as client:
+            client.wait_for_gui(HEAT_BUTTON)
+            client.click(HEAT_BUTTON)
+            assert started.wait(30.0), "the map never started"
+            client.wait_for(lambda: _markdown_shown(client, STRIKING) and _progress_shown(client), what="the bar")
+            _sent_while_mapping(client, freekick, then)
+            # While the map is still held: striking on for this strike, or says at once that the strike has changed.
+            if same_strike:
+                client.wait_for(lambda: _markdown_shown(client, STRIKING) and _progress_shown(client), what="the bar")
+            else:
+                client.wait_for(
+                    lambda: (
+                        _markdown_shown(client, STRIKE_CHANGED)
+                        and not _markdown_shown(client, STRIKING)
+                        and not _progress_shown(client)
+                    ),
+                    what="the strike changed, said at once",
+                )
+            release.set()
+            assert freekick.wait_idle(300.0)
+            # Both settled: the map if it is this strike's, else why there is none; never "striking" for good.
+            if same_strike:
+                client.wait_for(
+                    lambda: (
+                        _markdown_shown(client, "Best spot:")
+                        and _node_shown(client, "/freekick/odds_map")
+                        and not _progress_shown(client)
+                    ),
+                    what="the map shown",
+                )
+                assert freekick.params.view == "above"
+            else:
+                client.wait_for(
+                    lambda: (
+                        _markdown_shown(client, STRIKE_CHANGED)
+                        and not _markdown_shown(client, STRIKING)
+                        and not _progress_shown(client)
+                    ),
+                    what="the strike changed, said once the map is done",
+                )
+                assert not _node_shown(client, "/freekick/odds_map") and freekick.params.view == view
+    finally:
+        release.set()
+
+
+def test_a_goal_chance_map_that_fails_says_so_and_hides_its_bar(
+    freekick: FreeKickScene, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # A map dropped by its own failure: the bar must not stay up with "striking" under it.
+    def failing(p: FreeKickParams, progress: Callable[[float], object] | None = None) -> NDArray[np.float64]:
+        raise RuntimeError("the kernels refused the strike")
+
+    monkeypatch.setattr(freekick_scene, "spot_odds_map", failing)
+    freekick.heat_button.value = True  # the click
+    assert freekick.wait_idle()
+    assert not freekick.heat_progress.visible and not freekick.heat_nodes.visible
+    assert "map failed" in freekick.heat_status.content and freekick.odds_map_asked is None
 
 
 # ------------------------------------------------------------------------------------------------ knuckleball
