@@ -2,10 +2,11 @@
 and the knuckleball, drawn from :mod:`scenes.freekick.model` onto viser.
 
 Every redraw writes the same nodes' arrays (line-segment points, one band mesh's vertices) and never re-adds a node.
-Two searches run on :class:`~scenes._worker.LatestWorker` threads, never on a callback: the outcome map (a speed ×
-spin grid through :func:`kernels.ball.simulate_batch`) and "aim at a clicked point of the goal mouth". Each worker
-runs only the latest request; a newer request makes an older one's result be dropped, and the map waits for the
-settings to be still for a moment so dragging a slider redraws at full speed.
+Three searches run on :class:`~scenes._worker.LatestWorker` threads, never on a callback: the outcome map (a speed
+× spin grid through :func:`kernels.ball.simulate_batch`), "aim at a clicked point of the goal mouth" and the goal
+chance from every spot (on request). Each worker runs only the latest request; a newer request makes an older
+one's result be dropped, and the outcome map waits for the settings to be still for a moment so dragging a slider
+redraws at full speed.
 """
 
 from __future__ import annotations
