@@ -7,7 +7,7 @@
 Prints:
 
 * the goal table: one 30 m curler (28 m/s, 19°, 9 rev/s sidespin, constant coefficients) at RK4 10 ms
-  and at the seed's Euler 1 ms; ``simulate_batch`` on 10 000 kicks (RK4 10 ms); the 41 × 31 outcome map; the app's
+  and at Euler 1 ms; ``simulate_batch`` on 10 000 kicks (RK4 10 ms); the 41 × 31 outcome map; the app's
   start to serving its page with numba's cache warm and cold (a fresh ``NUMBA_CACHE_DIR``), and when its background
   warm-up finished. Each kernel row has a ratio against a plain numpy implementation of the same equations run in
   this process (:func:`numpy_flight`, :func:`numpy_batch`); the machine's CPU, numba's thread count and the load
@@ -71,7 +71,7 @@ def kernel_rows() -> None:
     reference = scipy_flight("DOP853", 1e-12, 1e-12)
     cases: list[tuple[str, Callable[[], NDArray[np.float64]], int]] = [
         (
-            "Euler 1 ms (seed), one 30 m flight",
+            "Euler 1 ms, one 30 m flight",
             lambda: ball.simulate(START, VELOCITY, SPIN, dt=1e-3, method="euler", x_stop=LINE_M).position[-1],
             30,
         ),
@@ -102,7 +102,7 @@ def kernel_rows() -> None:
         else:
             note = f"error at 30 m {np.linalg.norm(end - reference) * 1e3:.4g} mm"
         if name.startswith("Euler"):
-            note += "; seed claims < 10 mm"
+            note += "; < 10 mm asked of it"
         if name.startswith("RK4 10 ms, one"):
             note += "; goal <= 0.1 mm in <= 1 ms"
         row(name, timings(run, repeat), 1e-3, "ms", note)
@@ -379,7 +379,7 @@ def goal_rows() -> None:
     )
     kicks: tuple[tuple[ball.Method, float, float, int, str], ...] = (
         ("rk4", 1e-2, 20.0, 3000, "one 30 m kick, RK4 10 ms"),
-        ("euler", 1e-3, 100.0, 1000, "one 30 m kick, the seed's Euler 1 ms"),
+        ("euler", 1e-3, 100.0, 1000, "one 30 m kick, Euler 1 ms"),
     )
     for method, dt, goal, repeat, label in kicks:
         compiled = timings(

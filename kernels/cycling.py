@@ -3,7 +3,7 @@
 All quantities are SI: speed and wind in m/s, CdA in m², mass in kg, power in W, altitude in m. Grade is rise over
 run (0.05 is 5 %), so the road angle is θ = atan(grade). Every function accepts numpy arrays and broadcasts them.
 
-Model (the seed's, with wind made sign-correct):
+Model (the textbook one, with wind made sign-correct):
 
     P_aero  = ½·ρ·CdA·(v + w)·|v + w|·v        w = headwind (negative for a tailwind)
     P_roll  = Crr·m·g·cos θ·v
@@ -17,8 +17,8 @@ watts), yaw-free CdA.
 
 Drafting, two models:
 
-* ``"seed"``: every follower gets the seed's ``CdA·(1 − 0.27·exp(−gap/3.5))``. Note the seed's prose claims ~35 %,
-  ~10 % and ~4 % at 0, 5 and 10 m; its own formula gives 27.0 %, 6.5 % and 1.6 %.
+* ``"textbook"``: every follower gets ``CdA·(1 − 0.27·exp(−gap/3.5))``, a simple exponential fade: 27.0 %, 6.5 % and
+  1.6 % less drag at 0, 5 and 10 m, whatever the place in the line.
 * ``"measured"``: position-dependent drag reductions fitted to published measurements::
 
       reduction(position k ≥ 2, gap g) = R_k · exp(−g / 9.7 m)
@@ -55,10 +55,10 @@ G = 9.81
 RHO_SEA_LEVEL = 1.225
 """Air density at sea level (kg/m³)."""
 SCALE_HEIGHT_M = 8500.0
-"""Scale height of the seed's exponential atmosphere (m)."""
+"""Scale height of the textbook exponential atmosphere (m)."""
 
-DraftModel = Literal["seed", "measured"]
-DRAFT_MODELS: tuple[DraftModel, ...] = ("seed", "measured")
+DraftModel = Literal["textbook", "measured"]
+DRAFT_MODELS: tuple[DraftModel, ...] = ("textbook", "measured")
 
 # "measured" drafting model constants (see the module docstring for the sources).
 _MEASURED_PLATEAU = (0.40, 0.48, 0.50)  # positions 2, 3, 4+ at zero gap
@@ -126,7 +126,7 @@ exponential atmosphere is no air above). Beyond them it gave 157 573 kg/m³ at �
 
 
 def air_density(altitude_m: ArrayLike) -> NDArray[np.float64]:
-    """Air density of the seed's exponential atmosphere, 1.225·exp(−h/8500).
+    """Air density of the textbook exponential atmosphere, 1.225·exp(−h/8500).
 
     Args:
         altitude_m: altitude above sea level (m, −10 000 to 30 000: :data:`AIR_DENSITY_ALTITUDE_M`), any shape.
@@ -145,7 +145,7 @@ def air_density(altitude_m: ArrayLike) -> NDArray[np.float64]:
 
 
 def draft_factor(gap_m: ArrayLike) -> NDArray[np.float64]:
-    """The seed's CdA multiplier for a rider following at ``gap_m``: 1 − 0.27·exp(−gap/3.5)."""
+    """The textbook CdA multiplier for a rider following at ``gap_m``: 1 − 0.27·exp(−gap/3.5)."""
     gap = _non_negative("gap_m", gap_m)
     return 1.0 - 0.27 * np.exp(-gap / 3.5)
 
@@ -156,7 +156,7 @@ def drag_reduction(n_riders: int, gap_m: float, model: DraftModel = "measured") 
     Args:
         n_riders: riders in the line (1 to :data:`MAX_FORMATION_RIDERS`, 200).
         gap_m: wheel-to-wheel gap between consecutive riders (m, ≥ 0).
-        model: ``"seed"`` or ``"measured"`` (see the module docstring).
+        model: ``"textbook"`` or ``"measured"`` (see the module docstring).
 
     Returns:
         (n_riders,) reductions in [0, 1); effective CdA is ``cda·(1 − reduction)``.
@@ -170,7 +170,7 @@ def drag_reduction(n_riders: int, gap_m: float, model: DraftModel = "measured") 
     if n_riders == 1:
         return reduction
     match model:
-        case "seed":
+        case "textbook":
             reduction[1:] = 1.0 - float(draft_factor(gap))
         case "measured":
             plateau = np.array([_MEASURED_PLATEAU[min(k, len(_MEASURED_PLATEAU)) - 1] for k in range(1, n_riders)])
@@ -187,7 +187,7 @@ def wheel_power_terms(v, drag, rolling_force, climbing_force, wind, b0, b1):
 
         aero     = drag·(v + wind)·|v + wind|·v      drag = ½ρ·CdA (kg/m), wind = headwind (m/s)
         rolling  = rolling_force·v                   rolling_force = Crr·m·g·cos θ (N)
-        bearings = b0·v + b1·v²                      wheel bearings (W); 0, 0 in the seed's model
+        bearings = b0·v + b1·v²                      wheel bearings (W); 0, 0 in the textbook model
         climbing = climbing_force·v                  climbing_force = m·g·sin θ (N)
 
     Martin et al. (1998), J. Appl. Biomech. 14:276–291, eq. 9 without its kinetic term (the ride loop of
@@ -601,14 +601,14 @@ def paceline(
     altitude_m: float = 0.0,
     headwind_ms: float = 0.0,
     drivetrain_efficiency: float = 1.0,
-    model: DraftModel = "seed",
+    model: DraftModel = "textbook",
 ) -> Power:
     """Power of each rider in a single-file line at one speed, leader first.
 
     Args:
         n_riders: riders in the line (1 to :data:`MAX_FORMATION_RIDERS`, 200).
         gap_m: wheel-to-wheel gap (m, ≥ 0).
-        model: ``"seed"`` or ``"measured"`` drafting (see the module docstring).
+        model: ``"textbook"`` or ``"measured"`` drafting (see the module docstring).
         Other arguments as for :func:`power`, for one rider: each one number (the riders are alike).
 
     Returns:
@@ -1094,12 +1094,12 @@ def formation_drag(
     The drag is a fraction of the same rider's alone in the same wind; how a rider's own drag grows with yaw is not
     modelled.
 
-    ``model="seed"``: the textbook formula for any layout, drag = 1 − 0.27·max_j a·φ·exp(−g/3.5 m) (in single file,
+    ``model="textbook"``: the textbook formula for any layout, drag = 1 − 0.27·max_j a·φ·exp(−g/3.5 m) (in single file,
     :func:`draft_factor` for every follower and 1 for the leader).
 
     Args:
         positions_xy: (N, 2) rider positions (m), x forward along the road, y to the left, any order; N ≥ 1.
-        model: ``"measured"`` (the wake model above) or ``"seed"``.
+        model: ``"measured"`` (the wake model above) or ``"textbook"``.
         yaw_rad: yaw of the apparent wind (rad, + from the left, |ψ| < π/2); 0 for still air or a head wind.
 
     Returns:
@@ -1125,7 +1125,7 @@ def formation_drag(
     own_wake = np.exp(-((dy / WAKE_WIDTH_M) ** 2))
     ahead = np.clip(dx / BIKE_LENGTH_M, 0.0, 1.0)
     gap_ahead = np.maximum(dx - BIKE_LENGTH_M, 0.0)
-    if model == "seed":
+    if model == "textbook":
         shelter = (own_wake * ahead * np.exp(-gap_ahead / 3.5)).max(axis=1)
         return 1.0 - 0.27 * shelter
     q = (dy / BUNCH_OFFSET_M) ** 2
@@ -1159,7 +1159,7 @@ def formation_power(
 
     Args:
         positions_xy: (N, 2) rider positions (m), as for :func:`formation_drag`.
-        model: ``"measured"`` or ``"seed"`` (see :func:`formation_drag`).
+        model: ``"measured"`` or ``"textbook"`` (see :func:`formation_drag`).
         Other arguments as for :func:`power`, for one rider riding alone: each one number (the riders are alike).
 
     Returns:

@@ -13,7 +13,7 @@ than 2 km apart are refused, however they arrive. :attr:`Course.climbing_m` is t
 (:func:`total_ascent`: spikes out, a 100 m moving average, climbs counted past a 5 m hysteresis threshold).
 
 **Ride.** Along each segment the rider's kinetic energy changes by the work of the pedals minus the resistances
-(the power terms of :mod:`kernels.cycling`, the seed's or Martin et al. 1998's):
+(the power terms of :mod:`kernels.cycling`, the textbook terms or Martin et al. 1998's):
 
     d(½·M·v²)/ds = η·P/v − F(v),    M = m + I/r² (wheel inertia, Martin model),  F·v = P_wheel(v)
 

@@ -2,7 +2,7 @@
 time, and power paced with the grade.
 
 Along each segment the rider's kinetic energy changes by the work of the pedals minus the resistances (the power
-terms of :mod:`kernels.cycling`, the seed's or Martin et al. 1998's), integrated with an implicit midpoint step on
+terms of :mod:`kernels.cycling`, the textbook terms or Martin et al. 1998's), integrated with an implicit midpoint step on
 the segment's mean speed so the energy books balance exactly; pacing after Swain (1997, Med. Sci. Sports Exerc.
 29:1104). Per-segment arrays are (N − 1,); SI units (m, s, kg, W). The model and its assumptions in full:
 :mod:`kernels.course`. The loop is compiled with numba (``@njit(cache=True)``); :func:`warm_up` compiles it.
@@ -22,10 +22,10 @@ from kernels._jit import compiled
 from kernels.course.route import Course, course_from_xy
 from kernels.warming import Entry
 
-Model = Literal["seed", "martin"]
-AirKind = Literal["seed", "weather"]
-_MODELS: tuple[Model, ...] = ("seed", "martin")
-_AIR_KINDS: tuple[AirKind, ...] = ("seed", "weather")
+Model = Literal["textbook", "martin"]
+AirKind = Literal["textbook", "weather"]
+_MODELS: tuple[Model, ...] = ("textbook", "martin")
+_AIR_KINDS: tuple[AirKind, ...] = ("textbook", "weather")
 
 
 # --------------------------------------------------------------------------------------------- rider and air
@@ -42,7 +42,7 @@ class Rider:
     drivetrain_efficiency: float = 0.976
     """Fraction of pedal power reaching the wheel, [0.001, 1]; Martin et al. 1998's 0.976."""
     model: Model = "martin"
-    """``"seed"``: aero, rolling, climbing; ``"martin"``: Martin et al. 1998's terms."""
+    """``"textbook"``: aero, rolling, climbing; ``"martin"``: Martin et al. 1998's terms."""
     spoke_drag_m2: float = 0.0044
     """Martin's F_w (m², ≥ 0)."""
     wheel_inertia_kgm2: float = 0.14
@@ -68,7 +68,7 @@ class Rider:
 
     @property
     def effective_mass_kg(self) -> float:
-        """m + I/r² under the Martin model (the wheels' spin stores energy too), m under the seed's."""
+        """m + I/r² under the Martin model (the wheels' spin stores energy too), m under the textbook model."""
         if self.model == "martin":
             return self.mass_kg + self.wheel_inertia_kgm2 / self.wheel_radius_m**2
         return self.mass_kg
@@ -76,15 +76,15 @@ class Rider:
 
 @dataclasses.dataclass(frozen=True)
 class Air:
-    """Air along the route: the seed's exponential atmosphere, or a weather reading taken at one altitude.
+    """Air along the route: the textbook exponential atmosphere, or a weather reading taken at one altitude.
 
     ``"weather"``: the reading (temperature, station pressure, humidity at ``altitude_m``) is carried along the
     route by the standard atmosphere: temperature falls 6.5 K/km, pressure follows the ISA ratio
     p_ISA(h)/p_ISA(h_ref), relative humidity stays. Density by :func:`kernels.cycling.air_density_weather`.
     """
 
-    kind: AirKind = "seed"
-    """``"seed"`` (the exponential atmosphere) or ``"weather"`` (the reading below)."""
+    kind: AirKind = "textbook"
+    """``"textbook"`` (the exponential atmosphere) or ``"weather"`` (the reading below)."""
     temperature_c: float = 15.0
     """Air temperature at ``altitude_m`` (°C, −60 to 60)."""
     pressure_hpa: float = 1013.25
@@ -117,7 +117,7 @@ class Air:
         if np.any((h < low) | (h > high)):
             raise ValueError(f"elevation_m must be in [{low:g}, {high:g}] m, got {_checks.shown(h)}")
         match self.kind:
-            case "seed":
+            case "textbook":
                 return cycling.air_density(h)
             case "weather":
                 temperature = self.temperature_c - cycling.ISA_LAPSE_RATE_K_PER_M * (h - self.altitude_m)

@@ -2,7 +2,7 @@
 
 Distances are arrays of any (broadcastable) shape, in metres, negative inside.
 
-Smooth minimum, as the seed writes it (I. Quilez, "smooth minimum", iquilezles.org, 2008–2024):
+Smooth minimum (I. Quilez, "smooth minimum", iquilezles.org, 2008–2024):
 
     smin_poly(a, b, k) = mix(b, a, h) − k·h·(1 − h),   h = clamp(0.5 + 0.5·(b − a)/k, 0, 1)   (k: blend width, m)
     smin_exp(a, b, k)  = −log(exp(−k·a) + exp(−k·b)) / k                                       (k: sharpness, 1/m)
@@ -118,7 +118,7 @@ def _smin_exp_weighted(a: AnyFloatArray, b: AnyFloatArray, k: float) -> tuple[An
 
 
 def smin_poly(a: ArrayLike, b: ArrayLike, k: float) -> FloatArray:
-    """The seed's polynomial smooth minimum; ≤ min(a, b), equal to it where |a − b| ≥ k.
+    """The polynomial smooth minimum (Quilez); ≤ min(a, b), equal to it where |a − b| ≥ k.
 
     Args:
         a: distances (m), any shape broadcastable with ``b``.
@@ -133,7 +133,7 @@ def smin_poly(a: ArrayLike, b: ArrayLike, k: float) -> FloatArray:
 
 
 def smin_exp(a: ArrayLike, b: ArrayLike, k: float) -> FloatArray:
-    """The seed's exponential smooth minimum −log(exp(−ka) + exp(−kb))/k, evaluated without overflow.
+    """The exponential smooth minimum (Quilez) −log(exp(−ka) + exp(−kb))/k, evaluated without overflow.
 
     Args:
         a: distances (m), any shape broadcastable with ``b``.

@@ -154,7 +154,7 @@ class Scene:
     k: float = 0.25
     """Blend width (m), ≥ 0; 0 gives hard booleans."""
     blend: BlendForm = "poly"
-    """"poly" (the seed's polynomial smin) or "exp" (its exponential smin, sharpness 4·ln 2 / k)."""
+    """"poly" (the polynomial smooth minimum) or "exp" (the exponential one, sharpness 4·ln 2 / k)."""
 
     def __post_init__(self) -> None:
         if not isinstance(self.primitives, (tuple, list)):

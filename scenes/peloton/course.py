@@ -822,10 +822,10 @@ class CourseMode:
             text += (
                 f"{start}the weather reading, **{state.density_weather:.3f}** kg/m³ ({p.temperature_c:g} °C, "
                 f"{source}, {p.humidity_pct:g} % humidity); the textbook atmosphere would give "
-                f"{state.density_seed:.3f} kg/m³"
+                f"{state.density_textbook:.3f} kg/m³"
             )
         else:
-            text += f"{start}the textbook atmosphere (exponential), **{state.density_seed:.3f}** kg/m³"
+            text += f"{start}the textbook atmosphere (exponential), **{state.density_textbook:.3f}** kg/m³"
         if ride.brakes_j > 0.0:
             text += f"  \nBraking to hold {p.max_speed_kmh:.0f} km/h took {ride.brakes_j / 1000:.0f} kJ"
         return text

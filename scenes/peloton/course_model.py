@@ -24,14 +24,14 @@ from scenes.peloton.model import ROAD_HALF_WIDTH_M, PelotonParams, drag_reductio
 
 CourseAirLabel = Literal["Textbook atmosphere", "Weather reading"]
 AIR_FROM_LABEL: dict[str, course_kernel.AirKind] = {
-    "Textbook atmosphere": "seed",
+    "Textbook atmosphere": "textbook",
     "Weather reading": "weather",
 }
 PRESSURE_SOURCES = ("Standard atmosphere", "Barometer")
 """What the "Pressure from" dropdown shows for :attr:`CourseParams.pressure_from_barometer` False and True."""
 POWER_MODEL_FROM_LABEL: dict[str, course_kernel.Model] = {
     "Martin et al. 1998 (full)": "martin",
-    "Textbook (aero, rolling, climbing)": "seed",
+    "Textbook (aero, rolling, climbing)": "textbook",
 }
 BAROMETER_RANGE_HPA = (250.0, 1100.0)
 """What the barometer input takes (hPa). A course may start as high as 10 000 m
@@ -114,7 +114,7 @@ class CourseParams:
     )
     """Power model: Martin et al. 1998's full terms or the textbook three."""
     air: course_kernel.AirKind = field(
-        default="seed",
+        default="textbook",
         metadata=dropdown_from_labels("Air", AIR_FROM_LABEL, folder=POWER_FOLDER),
     )
     """Air along the route: the textbook exponential atmosphere or a weather reading."""
@@ -177,7 +177,7 @@ class CourseState:
     """The rider's CdA alone (m²)."""
     efficiency: float
     """Drivetrain efficiency (0, 1]."""
-    density_seed: float
+    density_textbook: float
     """The exponential atmosphere's density at the start (kg/m³)."""
     density_weather: float
     """The weather reading's density at the start (kg/m³)."""
@@ -242,7 +242,7 @@ def compute_course(route: course_kernel.Course, p: CourseParams, line: PelotonPa
         drag=drag,
         rider_cda_m2=line.cda_m2,
         efficiency=line.drivetrain_pct / 100.0,
-        density_seed=float(cycling.air_density(start)),
+        density_textbook=float(cycling.air_density(start)),
         density_weather=float(weather.density(start)),
     )
 

@@ -72,7 +72,7 @@ FORMATION_FROM_LABEL: dict[str, cycling.FormationShape] = {
 }
 DraftModelLabel = Literal["Textbook formula (exponential fade)", "Measured (by position)"]
 MODEL_FROM_LABEL: dict[str, cycling.DraftModel] = {
-    "Textbook formula (exponential fade)": "seed",
+    "Textbook formula (exponential fade)": "textbook",
     "Measured (by position)": "measured",
 }
 

@@ -20,7 +20,7 @@ from scipy.integrate import solve_ivp
 from kernels import course, cycling
 from kernels.course import Air, Rider, gpx
 
-SEED = Rider(cda_m2=0.32, mass_kg=80.0, crr=0.004, drivetrain_efficiency=0.976, model="seed")
+TEXTBOOK = Rider(cda_m2=0.32, mass_kg=80.0, crr=0.004, drivetrain_efficiency=0.976, model="textbook")
 MARTIN = Rider(cda_m2=0.32, mass_kg=80.0, crr=0.004, model="martin")
 
 
@@ -57,19 +57,19 @@ def test_flat_straight_route_matches_distance_over_steady_speed(power: float) ->
     v_star = float(cycling.speed_for_power(power, 0.32, 80.0, 0.004, drivetrain_efficiency=0.976))
     lost = []
     for length in (10_000.0, 20_000.0):
-        r = course.ride(straight(length), power, SEED)
+        r = course.ride(straight(length), power, TEXTBOOK)
         assert r.speed_ms[0] == 0.0
         assert r.speed_ms[-1] == pytest.approx(v_star, rel=1e-7)
         lost.append(r.time_s - length / v_star)
     # The only difference is the start from rest: a fixed time lost, the same on both lengths...
     assert lost[0] > 0.0 and lost[1] == pytest.approx(lost[0], abs=1e-6)
     # ...and equal to what an accurate integration in time loses (10 m steps cost a few hundredths of a s).
-    assert lost[0] == pytest.approx(lost_time_by_ode(power, SEED, v_star), abs=0.03)
+    assert lost[0] == pytest.approx(lost_time_by_ode(power, TEXTBOOK, v_star), abs=0.03)
 
 
 def test_a_rolling_start_loses_nothing() -> None:
     v_star = float(cycling.speed_for_power(250.0, 0.32, 80.0, 0.004, drivetrain_efficiency=0.976))
-    r = course.ride(straight(5000.0), 250.0, SEED, start_speed_ms=v_star)
+    r = course.ride(straight(5000.0), 250.0, TEXTBOOK, start_speed_ms=v_star)
     assert r.time_s == pytest.approx(5000.0 / v_star, rel=1e-12)
     np.testing.assert_allclose(r.speed_ms, v_star, rtol=1e-12)
 
@@ -85,7 +85,7 @@ def test_a_rolling_start_loses_nothing() -> None:
 )
 def test_headwind_component_from_the_wind_direction(heading: float, wind_from: float, headwind: float) -> None:
     c = straight(3000.0, heading_deg=heading)
-    r = course.ride(c, 250.0, SEED, wind_ms=5.0, wind_from_deg=wind_from)
+    r = course.ride(c, 250.0, TEXTBOOK, wind_ms=5.0, wind_from_deg=wind_from)
     np.testing.assert_allclose(r.headwind_ms, headwind, atol=1e-12)
     v_star = float(cycling.speed_for_power(250.0, 0.32, 80.0, 0.004, headwind_ms=headwind, drivetrain_efficiency=0.976))
     assert r.speed_ms[-1] == pytest.approx(v_star, rel=1e-6)
@@ -94,7 +94,7 @@ def test_headwind_component_from_the_wind_direction(heading: float, wind_from: f
 def test_a_steady_climb_settles_at_the_steady_climbing_speed() -> None:
     s = np.arange(0.0, 5000.0 + 5, 10.0)
     c = course.course_from_xy(s, np.zeros_like(s), 0.08 * s)
-    r = course.ride(c, 300.0, SEED, start_speed_ms=8.0)
+    r = course.ride(c, 300.0, TEXTBOOK, start_speed_ms=8.0)
     altitude = float(np.mean(c.elevation_m[-30:]))
     # The kernel's speed follows the slope length; speed_for_power takes the same ground speed.
     v_star = float(
@@ -123,7 +123,7 @@ def martin_1998_pedal_power(
     return wheel / rider.drivetrain_efficiency
 
 
-@pytest.mark.parametrize("rider", [SEED, MARTIN], ids=["seed", "martin"])
+@pytest.mark.parametrize("rider", [TEXTBOOK, MARTIN], ids=["textbook", "martin"])
 def test_per_point_power_is_the_cycling_law(rider: Rider) -> None:
     """Each segment's power, less the kinetic energy it stored, is cycling's law at the segment's mean speed."""
     s = np.arange(0.0, 3000.0 + 5, 10.0)
@@ -143,7 +143,7 @@ def test_per_point_power_is_the_cycling_law(rider: Rider) -> None:
     reference = martin_1998_pedal_power(mean, r.air_density, c.grade, r.headwind_ms, rider)
     np.testing.assert_allclose(law[one_step], reference[one_step], rtol=1e-9)
     altitude = 0.5 * (c.elevation_m[1:] + c.elevation_m[:-1])
-    if rider.model == "seed":
+    if rider.model == "textbook":
         kernel = cycling.power(
             mean, rider.cda_m2, rider.mass_kg, rider.crr, c.grade, altitude, r.headwind_ms, eta
         ).total
@@ -179,7 +179,7 @@ def wheel_power(
     return aero, rolling, bearings, climbing
 
 
-@pytest.mark.parametrize("rider", [SEED, MARTIN], ids=["seed", "martin"])
+@pytest.mark.parametrize("rider", [TEXTBOOK, MARTIN], ids=["textbook", "martin"])
 def test_energy_balance_over_a_closed_loop(rider: Rider) -> None:
     c = loop_course()
     air = Air("weather", temperature_c=25.0, pressure_hpa=950.0, relative_humidity=0.6, altitude_m=500.0)
@@ -271,7 +271,7 @@ def descent_time_by_ode(c: course.Course, rider: Rider, power: float, v0: float,
 # at 1350 W the step refined, at 1300 W it did not). The step now reaches the cap where the model's equation says,
 # then holds it. The same kind without the cap: a step refined only where the speed changed by half let 925 W
 # climb 2.5 % faster than 930 W (refined where it changes by a tenth, the property test below compares 2 % more).
-@pytest.mark.parametrize("rider", [SEED, MARTIN], ids=["seed", "martin"])
+@pytest.mark.parametrize("rider", [TEXTBOOK, MARTIN], ids=["textbook", "martin"])
 def test_a_step_that_reaches_the_cap_holds_it_from_where_it_is_reached(rider: Rider) -> None:
     run = np.array([0.0, 350.0])
     c = course.course_from_xy(np.zeros(2), run, -0.16 * run)  # one 350 m step down 16 %
@@ -332,7 +332,7 @@ def ride_by_ode(length: float, grade: float, rider: Rider, power: float, v0: flo
         (1000.0, 0.0, 200.0, 0.0),
     ],
 )
-@pytest.mark.parametrize("rider", [SEED, MARTIN], ids=["seed", "martin"])
+@pytest.mark.parametrize("rider", [TEXTBOOK, MARTIN], ids=["textbook", "martin"])
 def test_one_long_segment_settles_as_the_ode_does(
     length: float, grade: float, power: float, v0: float, rider: Rider
 ) -> None:
@@ -350,7 +350,7 @@ def test_one_long_segment_settles_as_the_ode_does(
     grade=st.floats(-0.08, 0.12),
     power=st.floats(50.0, 1000.0),
     start=st.floats(0.0, 1.0),
-    model=st.sampled_from(["seed", "martin"]),
+    model=st.sampled_from(["textbook", "martin"]),
 )
 def test_any_single_segment_ends_at_the_ode_s_speed_and_time(
     length: float, grade: float, power: float, start: float, model: str
@@ -358,7 +358,7 @@ def test_any_single_segment_ends_at_the_ode_s_speed_and_time(
     """Segments from 500 m (before: up to 46 % off in speed, a 48.7 km climb at 54 W; 0.8 % in time; now at most
     0.11 % and 0.051 % in 6,000 fresh examples). A shorter step changing the speed by just under a tenth keeps its
     midpoint rule's second-order error: up to 0.4 % of its time on 50–120 m at 15–20 m/s, before and after."""
-    rider = SEED if model == "seed" else MARTIN
+    rider = TEXTBOOK if model == "textbook" else MARTIN
     v0 = 20.0 * start**3  # as often near rest as near racing speed
     c = course.course_from_xy([0.0, length], [0.0, 0.0], [0.0, grade * length])
     r = course.ride(c, power, rider, max_speed_ms=100.0, start_speed_ms=v0)
@@ -374,7 +374,7 @@ def test_more_power_climbs_faster_where_the_step_is_refined() -> None:
     north = np.concatenate(([0.0], np.cumsum(108.0 * np.cos(heading))))
     c = course.course_from_xy(east, north, np.array([0.0, 0.15625 * 108.0, 0.15625 * 108.0]))
     times = [
-        course.ride(c, power, SEED, 15.0, 56.0, max_speed_ms=18.0, start_speed_ms=18.0).time_s
+        course.ride(c, power, TEXTBOOK, 15.0, 56.0, max_speed_ms=18.0, start_speed_ms=18.0).time_s
         for power in np.arange(900.0, 1001.0, 5.0)
     ]
     assert np.all(np.diff(times) < 0.0)  # 925 W rode 0.48 s faster than 930 W
@@ -390,7 +390,7 @@ def test_energy_books_balance_from_rest() -> None:
 
 def test_martin_terms_cost_time_against_the_seed_model() -> None:
     c = loop_course()
-    seed = course.ride(c, 250.0, SEED)
+    seed = course.ride(c, 250.0, TEXTBOOK)
     martin = course.ride(c, 250.0, MARTIN)
     assert martin.time_s > seed.time_s  # spokes and bearings take watts
     assert martin.bearings_j > 0.0 and seed.bearings_j == 0.0
@@ -401,11 +401,11 @@ def test_martin_terms_cost_time_against_the_seed_model() -> None:
 @given(
     power=st.floats(40.0, 900.0),
     wind=st.floats(-8.0, 8.0),
-    model=st.sampled_from(["seed", "martin"]),
+    model=st.sampled_from(["textbook", "martin"]),
 )
 def test_power_for_time_inverts_ride(power: float, wind: float, model: str) -> None:
     c = loop_course(600)
-    rider = SEED if model == "seed" else MARTIN
+    rider = TEXTBOOK if model == "textbook" else MARTIN
     t = course.ride(c, power, rider, wind_ms=wind, wind_from_deg=200.0).time_s
     found = course.power_for_time(c, t, rider, wind_ms=wind, wind_from_deg=200.0, tolerance_s=1e-3)
     assert course.ride(c, found, rider, wind_ms=wind, wind_from_deg=200.0).time_s == pytest.approx(t, abs=1e-3)
@@ -462,7 +462,7 @@ def test_a_paced_ride_averages_the_constant_rides_power_within_the_power_limit(
 
 def test_splits_are_the_times_at_each_kilometre() -> None:
     v_star = float(cycling.speed_for_power(250.0, 0.32, 80.0, 0.004, drivetrain_efficiency=0.976))
-    r = course.ride(straight(3500.0), 250.0, SEED, start_speed_ms=v_star)
+    r = course.ride(straight(3500.0), 250.0, TEXTBOOK, start_speed_ms=v_star)
     marks, times = r.splits(1000.0)
     np.testing.assert_allclose(marks, [1000.0, 2000.0, 3000.0, 3500.0])
     np.testing.assert_allclose(times, marks / v_star, rtol=1e-9)
@@ -512,16 +512,16 @@ def test_bad_ride_arguments_name_themselves() -> None:
 def test_a_power_too_low_to_cross_a_segment_is_named() -> None:
     # It read "the rider cannot cross segment 0 at this power", naming no argument.
     with pytest.raises(ValueError, match=r"^power_w is too low: at this power the rider cannot cross segment 0 "):
-        course.ride(straight(100.0), 1e-300, SEED)
+        course.ride(straight(100.0), 1e-300, TEXTBOOK)
 
 
 def test_a_very_low_power_on_a_wall_still_finishes() -> None:
     """A 25 % wall at 30 W and a fast entry: segments split until they can be crossed, and the books balance."""
     s = np.arange(0.0, 300.0 + 5, 50.0)
     c = course.course_from_xy(s, np.zeros_like(s), 0.25 * s)
-    r = course.ride(c, 30.0, SEED, start_speed_ms=15.0)
+    r = course.ride(c, 30.0, TEXTBOOK, start_speed_ms=15.0)
     balance = r.aero_j + r.rolling_j + r.climbing_j + r.kinetic_j + r.brakes_j
-    kinetic_in = 0.5 * SEED.effective_mass_kg * 15.0**2
+    kinetic_in = 0.5 * TEXTBOOK.effective_mass_kg * 15.0**2
     assert r.work_j * 0.976 + kinetic_in == pytest.approx(balance, rel=1e-9)
     assert np.all(np.isfinite(r.elapsed_s)) and r.speed_ms[-1] > 0.0
 
@@ -644,7 +644,7 @@ def test_arbitrary_bytes_never_escape_as_anything_but_value_error(data: bytes) -
     wind_from=st.floats(0.0, 360.0),
     cap=st.floats(3.0, 30.0),
     start=st.floats(0.0, 1.0),
-    model=st.sampled_from(["seed", "martin"]),
+    model=st.sampled_from(["textbook", "martin"]),
 )
 def test_any_course_balances_its_books_and_more_power_is_faster(
     grades: list[float],
@@ -666,7 +666,7 @@ def test_any_course_balances_its_books_and_more_power_is_faster(
     north = np.concatenate(([0.0], np.cumsum(step * np.cos(heading[:-1]))))
     del s
     c = course.course_from_xy(east, north, z)
-    rider = SEED if model == "seed" else MARTIN
+    rider = TEXTBOOK if model == "textbook" else MARTIN
     v0 = start * cap
     r = course.ride(c, power, rider, wind, wind_from, max_speed_ms=cap, start_speed_ms=v0)
     assert math.isfinite(r.time_s) and r.time_s > 0.0
@@ -876,7 +876,7 @@ def test_the_route_over_the_north_pole_is_drawn_straight() -> None:
     assert min(float(np.ptp(c.north_m)), float(np.ptp(c.east_m))) < 0.01  # a line, not a "U"
 
 
-@pytest.mark.parametrize("model", ["martin", "seed"])
+@pytest.mark.parametrize("model", ["martin", "textbook"])
 @pytest.mark.parametrize("key", ["cda_m2", "mass_kg", "crr", "spoke_drag_m2", "wheel_inertia_kgm2", "wheel_radius_m"])
 def test_a_rider_at_either_end_of_every_range_rides_the_sample_climb_in_finite_time(model: str, key: str) -> None:
     # The family of the refusals above: inside the ranges no ride overflows, warns or divides by zero.

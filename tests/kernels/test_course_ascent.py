@@ -151,7 +151,7 @@ def test_the_ride_is_unchanged_by_noise_in_its_net_climbing_work() -> None:
     so the ride keeps the smoothed profile and only the readout needed a noise-aware count."""
     s = np.arange(0.0, 5_000.0, 5.0)
     c = along_a_meridian(s, noisy(np.full_like(s, 300.0), 2.0, 0.0, seed=7))
-    rider = course.Rider(cda_m2=0.32, mass_kg=80.0, crr=0.004, model="seed")
+    rider = course.Rider(cda_m2=0.32, mass_kg=80.0, crr=0.004, model="textbook")
     r = course.ride(c, 250.0, rider)
     net = rider.mass_kg * 9.81 * float(c.elevation_m[-1] - c.elevation_m[0])
     assert r.climbing_j == pytest.approx(net, rel=1e-3, abs=50.0)

@@ -64,7 +64,7 @@ def test_measured_model_is_monotone_in_position_and_gap(n: int, gap: float) -> N
 
 
 def test_one_rider_gets_no_draft() -> None:
-    for model in ("seed", "measured"):
+    for model in ("textbook", "measured"):
         assert cycling.drag_reduction(1, 0.0, model).tolist() == [0.0]  # type: ignore[arg-type]
 
 
@@ -217,7 +217,7 @@ def test_speed_for_power_broadcasts() -> None:
 
 # ------------------------------------------------------------------------------------------------ paceline
 def test_seed_paceline_gives_every_follower_the_seed_factor() -> None:
-    line = cycling.paceline(4, 2.0, 12.0, 0.3, 80.0, 0.004, model="seed")
+    line = cycling.paceline(4, 2.0, 12.0, 0.3, 80.0, 0.004, model="textbook")
     solo = cycling.power(12.0, 0.3, 80.0, 0.004)
     follower = cycling.power(12.0, 0.3 * float(cycling.draft_factor(2.0)), 80.0, 0.004)
     assert line.total.shape == (4,)

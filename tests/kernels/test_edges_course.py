@@ -16,7 +16,7 @@ import pytest
 from kernels import course, cycling
 
 BAD_NUMBERS: list[Any] = [None, "1", True, object(), 1 + 2j, 10**400, math.nan, math.inf, -math.inf, Decimal("1.5")]
-BAD_CHOICES: list[Any] = [None, math.nan, object(), 1, np.array(["seed", "seed"]), np.array("seed")]
+BAD_CHOICES: list[Any] = [None, math.nan, object(), 1, np.array(["textbook", "textbook"]), np.array("textbook")]
 X = np.array([0.0, 10.0, 20.0, 30.0, 40.0])
 Z = np.array([0.0, 1.0, 0.5, 2.0, 1.0])
 FLAT = course.course_from_xy([0.0, 10.0, 20.0], [0.0, 0.0, 0.0], [0.0, 0.5, 0.0])
@@ -171,9 +171,9 @@ def test_every_rider_field_is_one_number(field: str, value: Any) -> None:
 
 @pytest.mark.parametrize("value", BAD_CHOICES)
 def test_a_model_or_kind_must_be_one_of_its_strings(value: Any) -> None:
-    with pytest.raises(ValueError, match=r"^model must be one of 'seed', 'martin'"):
+    with pytest.raises(ValueError, match=r"^model must be one of 'textbook', 'martin'"):
         course.Rider(model=value)
-    with pytest.raises(ValueError, match=r"^kind must be one of 'seed', 'weather'"):
+    with pytest.raises(ValueError, match=r"^kind must be one of 'textbook', 'weather'"):
         course.Air(kind=value)
 
 
@@ -191,7 +191,7 @@ def test_weather_air_below_the_standard_atmosphere_takes_its_edge() -> None:
 
 @pytest.mark.parametrize("elevation", [math.nan, -1e5, 1e300, [0.0, math.inf]])
 def test_air_density_refuses_an_elevation_by_name(elevation: Any) -> None:
-    for kind in ("seed", "weather"):
+    for kind in ("textbook", "weather"):
         with pytest.raises(ValueError, match=r"^elevation_m must"):
             course.Air(kind).density(elevation)  # type: ignore[arg-type]
 

@@ -36,7 +36,7 @@ def _interior(positions: np.ndarray) -> np.ndarray:
 
 
 # ------------------------------------------------------------------------------------------------ (a) single file
-@given(n=st.integers(1, 40), gap=st.floats(0.0, 15.0), model=st.sampled_from(["measured", "seed"]))
+@given(n=st.integers(1, 40), gap=st.floats(0.0, 15.0), model=st.sampled_from(["measured", "textbook"]))
 @settings(max_examples=examples(80))
 def test_single_file_is_the_line_model(n: int, gap: float, model: cycling.DraftModel) -> None:
     drag = cycling.formation_drag(cycling.formation(n, "single", gap_m=gap), model)
@@ -112,7 +112,10 @@ layouts = st.lists(st.tuples(st.floats(-40.0, 0.0), st.floats(-4.0, 4.0)), min_s
 
 
 @given(
-    layout=layouts, back=st.floats(0.0, 20.0), side=st.floats(-4.0, 4.0), model=st.sampled_from(["measured", "seed"])
+    layout=layouts,
+    back=st.floats(0.0, 20.0),
+    side=st.floats(-4.0, 4.0),
+    model=st.sampled_from(["measured", "textbook"]),
 )
 @settings(max_examples=examples(150))
 def test_a_rider_joining_behind_never_raises_anyones_drag(
@@ -124,7 +127,7 @@ def test_a_rider_joining_behind_never_raises_anyones_drag(
     assert np.all(after[:-1] <= before + 1e-12)
 
 
-@given(layout=layouts, model=st.sampled_from(["measured", "seed"]))
+@given(layout=layouts, model=st.sampled_from(["measured", "textbook"]))
 @settings(max_examples=examples(150))
 def test_the_mirror_image_across_the_road_gives_the_same_drags(layout: np.ndarray, model: cycling.DraftModel) -> None:
     mirrored = layout * np.array([1.0, -1.0])

@@ -123,7 +123,7 @@ def test_model_and_air_choices_change_the_ride_and_the_readout_shows_both_densit
     assert mode.state is not None
     martin = mode.state.ride.time_s
     mode.controls["model"].value = "Textbook (aero, rolling, climbing)"
-    assert mode.params.model == "seed" and mode.state.ride.time_s < martin  # no bearings, no spokes
+    assert mode.params.model == "textbook" and mode.state.ride.time_s < martin  # no bearings, no spokes
     # The textbook atmosphere uses no reading: its inputs are hidden, and the readout names it as the menu does.
     air_inputs = ("temperature_c", "pressure_from_barometer", "pressure_hpa", "humidity_pct")
     assert not any(mode.controls[name].visible for name in air_inputs)
@@ -313,7 +313,7 @@ CRAFTED = [
     Crafted("Course power (W)", -5.0, "power_w", 20.0),
     Crafted("Humidity (%)", float("inf"), "humidity_pct", 50.0),
     Crafted("Temp (°C)", 1e6, "temperature_c", 45.0),
-    Crafted("Air", "vacuum", "air", "seed"),
+    Crafted("Air", "vacuum", "air", "textbook"),
     Crafted("Power model", "<b>x</b>", "model", "martin"),
     Crafted("Pressure from", "guess", "pressure_from_barometer", False),
     Crafted("Safe descending speed (km/h)", 0.0, "max_speed_kmh", 20.0),

@@ -1081,7 +1081,7 @@ def test_a_group_is_framed_with_riders_a_person_can_see(
     headwind_ms=st.floats(-15.0, 15.0),
     formation=st.sampled_from(["single", "double", "bunch", "echelon"]),
     n_riders=st.integers(2, 12),
-    model=st.sampled_from(["measured", "seed"]),
+    model=st.sampled_from(["measured", "textbook"]),
 )
 def test_a_crosswind_of_a_hair_changes_the_shelter_by_a_hair(
     speed_kmh: float, headwind_ms: float, formation: cycling.FormationShape, n_riders: int, model: cycling.DraftModel
