@@ -29,6 +29,7 @@ from kernels.ball.config import (
     RE_CRISIS,
     RE_PER_SPEED,
     RK4,
+    SLOW_SPEED_MS,
     T_MAX,
     Q,
 )
@@ -44,6 +45,8 @@ _MEASURED_STILL_DRAG_MAX = 0.501
 _MEASURED_LIFT_MAX = 0.27
 _SPINNING_AT_BLEND = 0.4127 * 0.05**0.3056
 """The spinning C_D at S = 0.05, where the blend from the still fit reaches it (a constant: no power per call)."""
+_SLOW2 = SLOW_SPEED_MS * SLOW_SPEED_MS
+"""|v|² (m²/s²) below which the measured coefficients are held at their value at :data:`SLOW_SPEED_MS`."""
 
 EULER_STABILITY = 2.0
 """Forward Euler's stability interval on the negative real axis, |1 + z| ≤ 1 for z ∈ [−2, 0]."""
@@ -138,7 +141,7 @@ def max_stable_step(launch, kick, config, spin_inertia):
     if config[MEASURED] == 0.0:
         drag, lift = config[C_D], config[C_L]
     else:
-        spin_parameter = config[RADIUS] * kick[RATE] / max(fastest, 1e-9)
+        spin_parameter = config[RADIUS] * kick[RATE] / max(fastest, SLOW_SPEED_MS)
         drag = max(_MEASURED_STILL_DRAG_MAX, 0.4127 * max(spin_parameter, 0.05) ** 0.3056)
         lift = _MEASURED_LIFT_MAX
     if kick[RATE] == 0.0 and spin_inertia == 0.0:
@@ -153,7 +156,9 @@ def drag_lift_speeds(speed2, rate, measured, constant_drag, constant_lift, radiu
     """(C_D·|v|, C_L·|v|) in m/s of a ball with squared speed ``speed2`` = |v|² (m²/s², ≥ 0) spinning at ``rate`` =
     |ω| (rad/s, ≥ 0): ``constant_drag`` and ``constant_lift`` times |v| when ``measured`` is 0, else the measured fits
     C_D(Re, S) of Goff & Carré 2010 (Eur. J. Phys. 31), its drag crisis centred at Re = ``re_crisis``, and
-    C_L(S) = 0.9·min(S, 0.3), with S = ``radius``·|ω|/|v| and Re = ``re_per_speed``·|v| (ρ·2r/μ).
+    C_L(S) = 0.9·min(S, 0.3), with S = ``radius``·|ω|/|v| and Re = ``re_per_speed``·|v| (ρ·2r/μ); below
+    :data:`~kernels.ball.config.SLOW_SPEED_MS` (1 m/s) the measured C_D and C_L are held at their value there (so
+    S = r·|ω|/max(|v|, 1 m/s), the spin parameter the launch check bounds), and C·|v| goes to zero with |v|.
 
     The one implementation of the law: the flight's force law (through :func:`_drag_lift_spin`, with the spin's
     logarithm taken once per :class:`ForceLaw`), the rolling ball and the public :func:`kernels.ball.coefficients`
@@ -249,6 +254,9 @@ def _drag_lift_spin(
         return constant_drag * speed, constant_lift * speed, 0.0
     if speed2 == 0.0:
         return 0.0, 0.0, 0.0  # at rest, no force: the logarithms below need |v| > 0
+    scale = 1.0
+    if speed2 < _SLOW2:  # the coefficients at 1 m/s (S = r|ω|/max(|v|, 1 m/s)), times |v|; no reference from here
+        scale, speed2, reference_drag = math.sqrt(speed2) / SLOW_SPEED_MS, _SLOW2, 0.0
     # Below Asai et al. 2007's wind-tunnel values: see kernels.ball.
     lift = 0.9 * spin_speed if spin_speed * spin_speed <= 0.09 * speed2 else 0.27 * math.sqrt(speed2)
     if spin_speed * spin_speed >= 0.0025 * speed2:  # S ≥ 0.05: the spinning fit alone (the blend's weight is 1)
@@ -258,19 +266,22 @@ def _drag_lift_spin(
         if math.isnan(drag):
             # 0.4127·S^0.3056·|v| (Goff & Carré 2010) as one exponential (here r|ω| > 0).
             drag = 0.4127 * math.exp(spin_term + _SPINNING_POWER * math.log(speed2))
+        if scale != 1.0:
+            return drag * scale, lift * scale, 0.0
         return drag, lift, drag
     speed = math.sqrt(speed2)
     arg = min((re_per_speed * speed - re_crisis) / _RE_WIDTH, 50.0)
     still = 0.155 + 0.346 / (1.0 + math.exp(arg))  # Goff & Carré 2010
     # The blend C_D0 + (S/0.05)·(C_Ds(0.05) − C_D0), times |v|: (S/0.05)·|v| = r|ω|/0.05.
-    return still * speed + (spin_speed / 0.05) * (_SPINNING_AT_BLEND - still), lift, 0.0
+    return scale * (still * speed + (spin_speed / 0.05) * (_SPINNING_AT_BLEND - still)), scale * lift, 0.0
 
 
 @compiled()
 def drag_lift(speed, rate, measured, constant_drag, constant_lift, radius, re_per_speed, re_crisis):
     """(C_D, C_L) of a ball at ``speed`` (m/s, ≥ 0) spinning at ``rate`` = |ω| (rad/s, ≥ 0): :func:`drag_lift_speeds`
-    divided by the speed, taken as at least 10⁻⁹ m/s (so a ball at rest has the spin parameter of one at 10⁻⁹ m/s)."""
-    speed = max(speed, 1e-9)
+    divided by the speed, taken as at least :data:`~kernels.ball.config.SLOW_SPEED_MS` (1 m/s), below which the
+    measured coefficients are held (so a ball at rest has those of one at 1 m/s, S = r·|ω|/1 m/s)."""
+    speed = max(speed, SLOW_SPEED_MS)
     if speed > 1e150:  # |v|² would overflow: so far past the drag crisis the coefficients depend on S alone
         rate, speed = rate * (1e150 / speed), 1e150
     drag, lift = drag_lift_speeds(

@@ -17,13 +17,13 @@ from numpy.typing import ArrayLike, NDArray
 from kernels import _checks
 from kernels.ball import aero, contact
 from kernels.ball.config import (
-    _SPIN_PARAMETER_LIMIT,
     BALL_RADIUS_M,
     MEASURED,
     RADIUS,
     Model,
     checked_vector,
     flight_config,
+    refuse_fast_spin,
 )
 from kernels.warming import Entry
 
@@ -59,10 +59,12 @@ def coefficients(
     with Re_c the crisis centre (``drag_crisis_re``, 1.815·10⁵ for the Teamgeist they measured), so a spinless
     ball's drag falls through the drag crisis (0.501 well below, 0.328 at 12.19 m/s, 0.155 well above, for the
     default ball and air) and a spinning one's grows with S. The fits were measured up to S ≈ 0.3–0.5; beyond, C_Ds
-    is their extrapolation, which grows without bound as the speed falls at a fixed spin (S → ∞; a speed below
-    10⁻⁹ m/s counts as 10⁻⁹ m/s), so ``coefficients(0, 50)`` gives C_D ≈ 391: the drag force, ∝ C_D·|v|², still
-    goes to zero with the speed. Computed by the very compiled function
-    the flight's force law calls (:func:`kernels.ball.aero.drag_lift`); details and sources in :mod:`kernels.ball`.
+    is their extrapolation. As for :func:`simulate`, S is r·|ω|/max(|v|, 1 m/s): below 1 m/s the coefficients are
+    held at their value at 1 m/s (``coefficients(0, 10)`` is C_D = 0.4127·1.1^0.3056 = 0.425, C_L = 0.27; the
+    force, ∝ C·|v|², still goes to zero with the speed), and a spin with S above 10³ is refused, as :func:`simulate`
+    refuses it at launch (:func:`kernels.ball.config.refuse_fast_spin`, the one check). Computed by the very
+    compiled function the flight's force law calls (:func:`kernels.ball.aero.drag_lift`); details and sources in
+    :mod:`kernels.ball`.
 
     Args:
         speed_ms: the ball's speed |v| (m/s, ≥ 0): a number or an array.
@@ -80,7 +82,7 @@ def coefficients(
     Raises:
         ValueError: naming the argument, for a non-finite, negative or boolean speed or spin, shapes that do not
             broadcast, an unknown model or an invalid option, and (measured model, as :func:`simulate` refuses at
-            launch) a spin parameter r·|ω|/max(|v|, 1 m/s) above 10³.
+            launch, by the same check) ``spin_rads`` for a spin parameter r·|ω|/max(|v|, 1 m/s) above 10³.
         TypeError: an unknown keyword.
     """
     settings = flight_config(None, {"model": model, **options}).settings
@@ -95,13 +97,7 @@ def coefficients(
     speeds = np.array(np.broadcast_to(speed, shape), dtype=np.float64, order="C").reshape(-1)
     rates = np.array(np.broadcast_to(rate, shape), dtype=np.float64, order="C").reshape(-1)
     if settings[MEASURED]:
-        spin_parameter = settings[RADIUS] * rates / np.maximum(speeds, 1.0)
-        bad = np.flatnonzero(spin_parameter > _SPIN_PARAMETER_LIMIT)
-        if bad.size:
-            raise ValueError(
-                f"spin_rads is too fast for the measured model: spin parameter S = r·|ω|/max(|v|, 1 m/s) = "
-                f"{spin_parameter[bad[0]]:.3g} > {_SPIN_PARAMETER_LIMIT:g} (its fits stop at S ≈ 0.3)"
-            )
+        refuse_fast_spin(float(settings[RADIUS]), speeds, rates, lambda _: "spin_rads")
     drag, lift = np.empty(len(speeds)), np.empty(len(speeds))
     drag_lift_table(speeds, rates, settings, drag, lift)
     if not shape:

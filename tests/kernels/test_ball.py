@@ -20,6 +20,7 @@ from numpy.typing import NDArray
 
 from kernels import ball
 from kernels.ball import aero, api
+from kernels.ball.config import MAX_DT_S
 from kernels.ball.core import crossing_fraction
 from tests.helpers.compiled import from_python
 
@@ -780,7 +781,7 @@ def test_the_constant_model_curls_by_the_spin_axis_for_any_rate(exponent: int, a
 @given(
     air_density=st.floats(0.0, 1e300),
     mass=st.floats(1e-300, 10.0),
-    dt=st.floats(1e-3, 2.0),
+    dt=st.floats(1e-3, MAX_DT_S),
     speed=st.floats(0.0, 1e200),
     method=st.sampled_from(["euler", "rk4"]),
 )
@@ -812,14 +813,68 @@ def test_huge_parameters_give_a_finite_flight_or_an_error_naming_dt(
     assert np.all(np.isfinite(batch.position))
 
 
+def test_a_step_too_long_for_an_accurate_landing_is_refused_naming_dt() -> None:
+    # Kind: dt = 1 s was accepted, and this kick (Euler, the default) landed at x = 7.9 m after 0.41 s; it lands at
+    # x = 29.6 m after 1.52 s. Only unstable steps were refused; now any step over MAX_DT_S = 0.1 s, where RK4's
+    # landing point on the free kick's kicks strays past 1 cm (kernels.ball.config), is refused.
+    position, velocity, spin = (0.0, 0.0, 0.11), (25.0, 0.0, 8.0), (0.0, 0.0, 50.0)
+    refused = r"^dt must be at most 0\.1 s for accuracy"
+    with pytest.raises(ValueError, match=refused):
+        ball.simulate(position, velocity, spin, dt=1.0)
+    true = ball.simulate(position, velocity, spin, dt=1e-4, method="rk4")
+    assert true.position[-1, 0] == pytest.approx(29.6, abs=0.05) and true.t[-1] == pytest.approx(1.52, abs=0.01)
+    at_bound = ball.simulate(position, velocity, spin, dt=MAX_DT_S, method="rk4")
+    assert np.linalg.norm(at_bound.position[-1] - true.position[-1]) < 0.01
+    # RK4 follows a vacuum's parabola exactly at any step, so there no step is refused; Euler's still is.
+    assert ball.simulate(position, velocity, spin, dt=1.0, method="rk4", air_density=0.0).ended == "ground"
+    with pytest.raises(ValueError, match=refused):
+        ball.simulate(position, velocity, spin, dt=1.0, air_density=0.0)
+
+
+@pytest.mark.parametrize("method", ["euler", "rk4"])
+@pytest.mark.parametrize("entry", ["simulate", "simulate_batch", "simulate_outcomes", "FlightConfig"])
+def test_every_entry_takes_the_longest_step_and_refuses_the_next(method: ball.Method, entry: str) -> None:
+    position, velocity, spin = (0.0, 0.0, 0.11), (25.0, 0.0, 8.0), (0.0, 0.0, 50.0)
+    call = {
+        "simulate": lambda dt: ball.simulate(position, velocity, spin, dt=dt, method=method),
+        "simulate_batch": lambda dt: ball.simulate_batch([position], [velocity], [spin], dt=dt, method=method),
+        "simulate_outcomes": lambda dt: ball.simulate_outcomes(
+            [position], [velocity], [spin], WALL, GOAL, dt=dt, method=method
+        ),
+        "FlightConfig": lambda dt: ball.FlightConfig(dt=dt, method=method),
+    }[entry]
+    call(MAX_DT_S)  # the bound itself is accepted
+    with pytest.raises(ValueError, match=r"^dt must be at most 0\.1 s for accuracy"):
+        call(math.nextafter(MAX_DT_S, math.inf))
+
+
+@pytest.mark.parametrize(
+    ("model", "speed", "elevation_deg", "rev_s", "axis"),
+    [  # the scene's kicks worst placed at 0.1 s in the measurement behind MAX_DT_S
+        ("measured", 40.0, 0.0, 15.0, (0.0, -1.0, 0.0)),
+        ("measured", 35.0, 0.0, 15.0, (0.0, -1.0, 0.0)),
+        ("constant", 40.0, 50.0, 15.0, (0.0, 1.0, 0.0)),
+    ],
+)
+def test_rk4_at_the_longest_step_lands_within_a_centimetre(
+    model: ball.Model, speed: float, elevation_deg: float, rev_s: float, axis: tuple[float, float, float]
+) -> None:
+    velocity, spin = kick(speed, elevation_deg), ball.spin_vector(rev_s, axis)
+    options = {"method": "rk4", "model": model, "t_max": 8.0, "ground_m": R}
+    fine = ball.simulate((0.0, 0.0, R), velocity, spin, dt=1e-4, **options)  # type: ignore[arg-type]
+    coarse = ball.simulate((0.0, 0.0, R), velocity, spin, dt=MAX_DT_S, **options)  # type: ignore[arg-type]
+    assert fine.ended == coarse.ended == "ground"
+    assert np.linalg.norm(coarse.position[-1] - fine.position[-1]) < 0.01
+
+
 def test_the_overflow_that_used_to_be_silent() -> None:
     # A thousand times sea-level air and no gravity: a 10 ms Euler step at 30 m/s overshoots the drag, so the
     # velocity flips and grows each step until it is inf, then NaN. This came back as a NaN trajectory.
     with pytest.raises(ValueError, match=r"dt = 0\.01 s is too long"):
         ball.simulate(START, (30.0, 0.0, 0.0), np.zeros(3), dt=1e-2, air_density=1225.0, gravity=0.0)
-    # A 1e-300 kg ball: one 0.5 s Euler step flings it 2e294 m sideways, finite but absurd (hypothesis found it).
-    with pytest.raises(ValueError, match=r"dt = 0\.5 s is too long"):
-        ball.simulate_batch([START], [(0.5, 0.0, 0.5)], [(0.0, 0.0, 50.0)], dt=0.5, mass_kg=1e-300)
+    # A 1e-300 kg ball: one long Euler step flung it 2e294 m sideways, finite but absurd (hypothesis found it).
+    with pytest.raises(ValueError, match=r"dt = 0\.05 s is too long"):
+        ball.simulate_batch([START], [(0.5, 0.0, 0.5)], [(0.0, 0.0, 50.0)], dt=0.05, mass_kg=1e-300)
     # The same guard leaves stiff but stable flights alone: RK4 at 10 ms in ten times sea-level air.
     thick = ball.simulate(START, kick(30.0, 15.0), np.zeros(3), dt=1e-2, method="rk4", air_density=12.25)
     assert thick.ended == "ground" and 0.0 < thick.position[-1, 0] < 15.0
@@ -882,13 +937,14 @@ def test_a_ball_that_peaks_and_lands_within_one_step_lands_there_not_at_the_laun
     np.testing.assert_allclose(flight.position[-1], [0.27146477587624, 0.0, 0.11], rtol=1e-12)
     low = ball.simulate((0, 0, 0.12), (1, 0, 0.3), (0, 0, 0), ground_m=0.11, air_density=0, method="rk4", dt=0.5)
     assert low.t[-1] == pytest.approx(0.08511484556613763, rel=1e-12)
-    # The default 25 m/s kick at 17° in air, with one step longer than the flight: lands ~27 m out, not at x = 0.
-    fine = ball.simulate(START, kick(25.0, 17.0), np.zeros(3), ground_m=R, method="rk4", dt=1e-3)
-    coarse = ball.simulate(START, kick(25.0, 17.0), np.zeros(3), ground_m=R, method="rk4", dt=2.0)
-    assert fine.position[-1, 0] == pytest.approx(27.27, abs=0.01)
-    assert coarse.position[-1, 0] == pytest.approx(26.83, abs=0.01) and coarse.t[-1] > 1.0
-    euler = ball.simulate(START, kick(25.0, 17.0), np.zeros(3), ground_m=R, dt=0.9)
-    assert euler.t[-1] == pytest.approx(0.376, abs=1e-3) and euler.position[-1, 0] > 5.0
+    # In air, with one step longer than the flight (a 1 m/s chip, 0.07 s up and down, in one 0.1 s step): it lands
+    # where the fine flight does, not at x = 0. (A step longer than a free kick's flight is refused for accuracy.)
+    fine = ball.simulate(START, kick(1.0, 20.0), np.zeros(3), ground_m=R, method="rk4", dt=1e-4)
+    assert fine.t[-1] == pytest.approx(0.0697, abs=1e-4) and fine.position[-1, 0] == pytest.approx(0.0655, abs=1e-4)
+    coarse = ball.simulate(START, kick(1.0, 20.0), np.zeros(3), ground_m=R, method="rk4", dt=MAX_DT_S)
+    assert len(coarse.t) == 2 and coarse.position[-1, 0] == pytest.approx(fine.position[-1, 0], abs=1e-5)
+    euler = ball.simulate(START, kick(1.0, 20.0), np.zeros(3), ground_m=R, dt=MAX_DT_S)  # the seed's order, one step
+    assert len(euler.t) == 2 and euler.t[-1] > 0.01 and euler.position[-1, 0] > 0.01
 
 
 @given(
@@ -1047,11 +1103,11 @@ def test_the_last_sample_is_exactly_t_max_for_any_step(dt: float, t_max: float) 
 
 def test_t_max_cases_the_reviewer_found() -> None:
     high = ((0.0, 0.0, 100.0), (1.0, 0.0, 0.0), (0, 0, 0))
-    assert ball.simulate(*high, t_max=1.0, dt=0.3).t.tolist() == pytest.approx([0.0, 0.3, 0.6, 0.9, 1.0])
+    assert ball.simulate(*high, t_max=0.1, dt=0.03).t.tolist() == pytest.approx([0.0, 0.03, 0.06, 0.09, 0.1])
     # A step longer than the whole flight lands on the parabola, not 10 s later or never.
     lob = ball.simulate(*high, t_max=5.0, dt=10.0, air_density=0.0, method="rk4")
     assert lob.ended == "ground" and lob.t[-1] == pytest.approx(math.sqrt(2.0 * 100.0 / G), rel=1e-12)
-    far = ball.simulate((0.0, 0.0, 1e4), (1.0, 0.0, 0.0), (0, 0, 0), t_max=5.0, dt=1e10, air_density=0.0)
+    far = ball.simulate((0.0, 0.0, 1e4), (1.0, 0.0, 0.0), (0, 0, 0), t_max=5.0, dt=1e10, air_density=0.0, method="rk4")
     assert far.t.tolist() == [0.0, 5.0] and far.ended == "t_max"
 
 

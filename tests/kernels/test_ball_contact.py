@@ -26,6 +26,8 @@ ROOT = Path(__file__).resolve().parents[2]
 
 # ------------------------------------------------------------------------------------------------ coefficients
 FLIGHTS = {
+    # dropped from rest, spinning: under 1 m/s for most of its fall, where the coefficients are held at 1 m/s's
+    "measured, dropped spinning": (np.zeros(3), ball.spin_vector(5.0, (0.0, 1.0, 0.0)), {}),
     # a spinless lob that slows through the drag crisis (12.19 m/s) and speeds up again as it falls
     "measured, no spin, through the crisis": (ball.launch_velocity(16.0, math.radians(50.0), 0.0), np.zeros(3), {}),
     "measured, curler": (
@@ -150,6 +152,33 @@ def test_numbers_in_give_floats_out_and_arrays_keep_their_shape() -> None:
 def test_bad_coefficient_input_raises_naming_the_argument(args: tuple, kwargs: dict, name: str) -> None:
     with pytest.raises(ValueError, match=name):
         ball.coefficients(*args, **kwargs)
+
+
+def test_a_ball_at_rest_has_a_slow_balls_coefficients_not_the_fits_extrapolation() -> None:
+    # Kind: coefficients(0, 10) gave C_D = 239.16. Its range check, like simulate's, counted S = r·|ω|/max(|v|, 1 m/s)
+    # = 1.1 and let it through, but the law then took |v| as 10⁻⁹ m/s: S ≈ 10⁹, far past the fits. One spin
+    # parameter now, S = r·|ω|/max(|v|, 1 m/s), for the check and the law alike.
+    c_d, c_l = ball.coefficients(0, 10, model="measured")
+    s = R * 10.0 / 1.0
+    assert c_d == pytest.approx(0.4127 * s**0.3056, rel=1e-12) and c_l == 0.27  # Goff & Carré 2010; Asai et al. 2007
+    assert ball.coefficients(0.0, 10.0) == ball.coefficients(0.5, 10.0) == ball.coefficients(1.0, 10.0)
+    assert ball.coefficients(np.linspace(0.0, 40.0, 41), 60.0)[0].max() < 1.0
+
+
+def test_the_coefficients_refuse_a_spin_where_simulate_refuses_it() -> None:
+    # The boundary is simulate's: S = r·|ω|/max(|v|, 1 m/s) up to 10³, at rest as at speed.
+    for speed in (0.0, 0.5, 20.0):
+        limit = 1e3 * max(speed, 1.0) / R  # rad/s
+        inside, outside = limit * (1.0 - 1e-9), limit * (1.0 + 1e-9)
+        c_d, _ = ball.coefficients(speed, inside)
+        assert c_d == pytest.approx(0.4127 * 1e3**0.3056, rel=1e-6)  # the fit at S = 10³, finite
+        with pytest.raises(ValueError, match=r"^spin_rads is too fast for the measured model: spin parameter S"):
+            ball.coefficients(speed, outside)
+        velocity = (speed, 0.0, 0.0)
+        ball.simulate((0.0, 0.0, 1.0), velocity, (0.0, 0.0, inside), model="measured", t_max=0.05)
+        with pytest.raises(ValueError, match=r"^spin is too fast for the measured model: spin parameter S"):
+            ball.simulate((0.0, 0.0, 1.0), velocity, (0.0, 0.0, outside), model="measured", t_max=0.05)
+    assert ball.coefficients(0.0, 1e9, "constant") == (0.25, 0.25)  # the constant model has no spin parameter
 
 
 def test_an_unknown_keyword_is_a_type_error() -> None:
