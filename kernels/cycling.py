@@ -365,10 +365,10 @@ def speed_for_power(
     Numerical Recipes, 2007) then polishes it to rounding level, so ``power(v) == P`` and v moves continuously as P → 0⁺.
 
     Domain: the inverse is defined on :data:`SPEED_FOR_POWER_DOMAIN` (power up to 1 MW, CdA 1 mm² to 10⁴ m²,
-    mass up to 10⁶ kg, Crr up to 1, altitude −500 to 30 000 m, |wind| up to 1 000 m/s; any finite grade). Far
-    beyond any rider, and where the model still means something (the exponential atmosphere is no air above
-    ~30 km; drag ∝ v² fails past the speed of sound), it also keeps every intermediate (P/a, |c|/a, a·w²·v, the
-    cubic's coefficients) inside float64, so no answer is inf or silently wrong. Outside it: ValueError naming
+    mass up to 10⁶ kg, Crr up to 1, altitude −10 000 to 30 000 m as :func:`air_density`'s, |wind| up to 1 000 m/s;
+    any finite grade). Far beyond any rider, and where the model still means something (the exponential atmosphere
+    is no air above ~30 km; drag ∝ v² fails past the speed of sound), it also keeps every intermediate (P/a, |c|/a,
+    a·w²·v, the cubic's coefficients) inside float64, so no answer is inf or silently wrong. Outside it: ValueError naming
     the argument.
 
     Args:
@@ -410,7 +410,7 @@ MODEL_DOMAIN: dict[str, tuple[float, float]] = {
     "cda_m2": (1e-6, 1e4),
     "mass_kg": (0.0, 1e6),
     "crr": (0.0, 1.0),
-    "altitude_m": (-500.0, 30_000.0),
+    "altitude_m": AIR_DENSITY_ALTITUDE_M,
     "headwind_ms": (-1000.0, 1000.0),
 }
 """Closed ranges (SI units) on which :func:`power` (and :func:`paceline`, :func:`formation_power`,
@@ -688,7 +688,9 @@ ISA_SEA_LEVEL_TEMPERATURE_C = 15.0
 ISA_LAPSE_RATE_K_PER_M = 0.0065
 """Temperature lapse rate of the standard troposphere (K/m)."""
 _ISA_TROPOPAUSE_M = 11_000.0
-_ISA_TOP_M = 20_000.0
+ISA_ALTITUDE_M = (-5_000.0, 20_000.0)
+"""Geometric altitudes (m) the standard atmosphere functions take: from −5 km, where the U.S. Standard Atmosphere
+1976 tables begin, to 20 km, the top of the isothermal layer above the tropopause that they model."""
 _ISA_G0 = 9.80665
 _ISA_MOLAR_MASS = 0.0289644  # kg/mol, U.S. Standard Atmosphere 1976
 _ISA_R = 8.31432  # J/(mol·K), the constant the 1976 standard uses
@@ -760,8 +762,9 @@ _EARTH_RADIUS_ISA_M = 6_356_766.0  # r₀ of the geopotential conversion, U.S. S
 def _isa_altitude(altitude_m: ArrayLike) -> NDArray[np.float64]:
     """Geopotential altitude H = r₀·h/(r₀ + h) of the geometric altitude h (what a map or a GPS gives)."""
     h = _finite("altitude_m", altitude_m)
-    if np.any((h < -1000.0) | (h > _ISA_TOP_M)):
-        raise ValueError(f"altitude_m must be in [-1000, 20000] m, got {_checks.shown(altitude_m)}")
+    low, high = ISA_ALTITUDE_M
+    if np.any((h < low) | (h > high)):
+        raise ValueError(f"altitude_m must be in [{low:g}, {high:g}] m, got {_checks.shown(altitude_m)}")
     return _EARTH_RADIUS_ISA_M * h / (_EARTH_RADIUS_ISA_M + h)
 
 
@@ -769,8 +772,8 @@ def isa_temperature_c(altitude_m: ArrayLike) -> NDArray[np.float64]:
     """Temperature of the International Standard Atmosphere (°C): 15 − 6.5 K/km up to 11 km, −56.5 °C above.
 
     Args:
-        altitude_m: geometric altitude above mean sea level (m, −1000 to 20 000), any shape; converted to
-            geopotential altitude H = r₀·h/(r₀ + h), r₀ = 6 356 766 m, as the standard's tables are.
+        altitude_m: geometric altitude above mean sea level (m, −5000 to 20 000: :data:`ISA_ALTITUDE_M`), any shape;
+            converted to geopotential altitude H = r₀·h/(r₀ + h), r₀ = 6 356 766 m, as the standard's tables are.
 
     Returns:
         Temperature (°C), same shape.
@@ -786,14 +789,14 @@ def isa_pressure_hpa(altitude_m: ArrayLike) -> NDArray[np.float64]:
     5.25588; above, the isothermal layer at 216.65 K: p = p₁₁·exp(−g₀M·(H − 11 000)/(R·216.65)).
 
     Args:
-        altitude_m: geometric altitude above mean sea level (m, −1000 to 20 000), any shape; converted to
-            geopotential altitude H = r₀·h/(r₀ + h), r₀ = 6 356 766 m, as the standard's tables are.
+        altitude_m: geometric altitude above mean sea level (m, −5000 to 20 000: :data:`ISA_ALTITUDE_M`), any shape;
+            converted to geopotential altitude H = r₀·h/(r₀ + h), r₀ = 6 356 766 m, as the standard's tables are.
 
     Returns:
         Pressure (hPa), same shape.
 
     Raises:
-        ValueError: an altitude is not finite or outside −1000…20 000 m.
+        ValueError: an altitude is not finite or outside −5000…20 000 m.
     """
     h = _isa_altitude(altitude_m)
     t0 = ISA_SEA_LEVEL_TEMPERATURE_C + _KELVIN

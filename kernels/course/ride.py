@@ -93,7 +93,7 @@ class Air:
     """Relative humidity, a fraction in [0, 1]."""
     altitude_m: float = 0.0
     """Where the reading was taken (m, −10 000 to 30 000, as a course's elevations; the standard atmosphere's pressure
-    ratio that carries it is taken within −1000 to 20 000 m)."""
+    ratio that carries it is taken within −5000 to 20 000 m, :data:`kernels.cycling.ISA_ALTITUDE_M`)."""
 
     def __post_init__(self) -> None:
         _checks.choice("kind", self.kind, _AIR_KINDS)
@@ -110,7 +110,7 @@ class Air:
     def density(self, elevation_m: ArrayLike) -> NDArray[np.float64]:
         """Air density (kg/m³) at each elevation (m, −10 000 to 30 000, :data:`kernels.cycling.AIR_DENSITY_ALTITUDE_M`,
         which holds every course's; any shape). A weather reading is carried by the standard atmosphere's pressure
-        ratio within its range, −1000 to 20 000 m (an elevation beyond takes the ratio at the range's end), and held
+        ratio within its range, −5000 to 20 000 m (an elevation beyond takes the ratio at the range's end), and held
         within −60…60 °C and 10…1100 hPa."""
         h = _checks.finite_array("elevation_m", elevation_m)
         low, high = cycling.AIR_DENSITY_ALTITUDE_M
@@ -121,21 +121,17 @@ class Air:
                 return cycling.air_density(h)
             case "weather":
                 temperature = self.temperature_c - cycling.ISA_LAPSE_RATE_K_PER_M * (h - self.altitude_m)
-                isa_h = np.clip(h, *_ISA_RANGE_M)
+                isa_h = np.clip(h, *cycling.ISA_ALTITUDE_M)
                 pressure = (
                     self.pressure_hpa
                     * cycling.isa_pressure_hpa(isa_h)
-                    / cycling.isa_pressure_hpa(np.clip(self.altitude_m, *_ISA_RANGE_M))
+                    / cycling.isa_pressure_hpa(np.clip(self.altitude_m, *cycling.ISA_ALTITUDE_M))
                 )
                 return cycling.air_density_weather(
                     np.clip(temperature, -60.0, 60.0),
                     np.clip(pressure, 10.0, 1100.0),
                     self.relative_humidity,
                 )
-
-
-_ISA_RANGE_M = (-1000.0, 20_000.0)
-"""Altitudes of :func:`kernels.cycling.isa_pressure_hpa` (m): a weather reading is carried within them."""
 
 
 # --------------------------------------------------------------------------------------------- ride

@@ -99,8 +99,8 @@ class PelotonParams:
     """Drivetrain efficiency (%), Martin et al. 1998."""
     grade_pct: float = field(default=0.0, metadata=slider("Grade (%)", -15.0, 20.0, 0.5, folder="Course"))
     """Road grade (%), rise over run."""
-    altitude_m: float = field(default=0.0, metadata=slider("Altitude (m)", 0.0, 4000.0, 50.0, folder="Course"))
-    """Altitude (m): sets air density."""
+    altitude_m: float = field(default=0.0, metadata=slider("Altitude (m)", -500.0, 4000.0, 50.0, folder="Course"))
+    """Altitude (m): sets air density; from the Dead Sea's shore (−430 m) to the highest passes."""
     headwind_ms: float = field(
         default=0.0,
         metadata=slider("Headwind (m/s, − = tailwind)", -15.0, 15.0, 0.5, folder="Course"),

@@ -111,7 +111,7 @@ def test_density_falls_with_heat_and_humidity_and_rises_with_pressure(
         assert float(cycling.air_density_weather(t, p, rh + drh)) <= base
 
 
-@given(h=st.floats(-1000.0, 19_990.0), dh=st.floats(1.0, 10.0))
+@given(h=st.floats(-5000.0, 19_990.0), dh=st.floats(1.0, 10.0))
 def test_isa_pressure_falls_with_altitude(h: float, dh: float) -> None:
     assert float(cycling.isa_pressure_hpa(h + dh)) < float(cycling.isa_pressure_hpa(h))
 
@@ -119,7 +119,7 @@ def test_isa_pressure_falls_with_altitude(h: float, dh: float) -> None:
 def test_range_edges_are_accepted_and_beyond_them_rejected() -> None:
     for t in (-60.0, 60.0):
         assert math.isfinite(float(cycling.air_density_weather(t, 1013.25, 1.0)))
-    for h in (-1000.0, 20_000.0):
+    for h in (-5000.0, 20_000.0):
         assert math.isfinite(float(cycling.isa_pressure_hpa(h)))
     cases = [
         (lambda: cycling.air_density_weather(60.001, 1013.25), "temperature_c"),
@@ -130,6 +130,7 @@ def test_range_edges_are_accepted_and_beyond_them_rejected() -> None:
         (lambda: cycling.air_density_weather(15.0, 1013.25, -1e-300), "relative_humidity"),
         (lambda: cycling.air_density_weather(60.0, 100.0, 1.0), "relative_humidity"),
         (lambda: cycling.isa_pressure_hpa(20_000.5), "altitude_m"),
+        (lambda: cycling.isa_pressure_hpa(-5000.5), "altitude_m"),
         (lambda: cycling.isa_pressure_hpa("high"), "altitude_m"),
     ]
     for call, name in cases:
@@ -225,3 +226,14 @@ def test_martin_broadcasts_and_rejects_bad_arguments() -> None:
         args = {"speed_ms": 10.0, "cda_m2": 0.3, "mass_kg": 80.0, "crr": 0.004, **kwargs}
         with pytest.raises(ValueError, match=name):
             cycling.martin_power(**args)
+
+
+def test_the_standard_atmosphere_reaches_down_to_where_its_1976_tables_begin() -> None:
+    # The tables (and the troposphere's formula) begin at −5 km; −1000 m was refused. Written out here: geopotential
+    # H = r₀h/(r₀ + h), T = 288.15 − 0.0065·H K, p = 1013.25·(T/288.15)^5.25588 hPa.
+    h = -5000.0
+    geopotential = 6_356_766.0 * h / (6_356_766.0 + h)
+    kelvin = 288.15 - 0.0065 * geopotential
+    assert kelvin == pytest.approx(320.68, abs=0.01)
+    assert float(cycling.isa_temperature_c(h)) == pytest.approx(kelvin - 273.15, abs=1e-9)
+    assert float(cycling.isa_pressure_hpa(h)) == pytest.approx(1013.25 * (kelvin / 288.15) ** 5.25588, rel=1e-5)

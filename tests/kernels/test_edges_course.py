@@ -178,15 +178,17 @@ def test_a_model_or_kind_must_be_one_of_its_strings(value: Any) -> None:
 
 
 def test_weather_air_below_the_standard_atmosphere_takes_its_edge() -> None:
-    deep = course.course_from_xy([0.0, 10.0, 20.0], [0.0, 0.0, 0.0], [-2000.0, -2000.0, -2000.0])
-    air = course.Air("weather", temperature_c=20.0)
-    ride = course.ride(deep, 200.0, air=air)  # refused as "altitude_m must be in [-1000, 20000]", an Air field
+    deep = course.course_from_xy([0.0, 10.0, 20.0], [0.0, 0.0, 0.0], [-6000.0, -6000.0, -6000.0])
+    air = course.Air("weather", temperature_c=-20.0, pressure_hpa=500.0)
+    ride = course.ride(deep, 200.0, air=air)  # refused as "altitude_m must be in [-5000, 20000]", an Air field
     assert np.all(np.isfinite(ride.air_density))
-    np.testing.assert_allclose(ride.air_density, air.density(-2000.0))
-    # The pressure ratio is the one at −1000 m (then held at 1100 hPa); the temperature follows the lapse rate.
-    pressure = 1013.25 * float(cycling.isa_pressure_hpa(-1000.0)) / float(cycling.isa_pressure_hpa(0.0))
-    expected = float(cycling.air_density_weather(33.0, min(pressure, 1100.0), 0.0))  # held at 1100 hPa
-    assert float(air.density(-2000.0)) == pytest.approx(expected, rel=1e-12)
+    np.testing.assert_allclose(ride.air_density, air.density(-6000.0))
+    # The pressure ratio is the one at −5000 m, the standard atmosphere's lowest; the temperature follows the lapse
+    # rate (−20 °C + 6.5 K/km × 6 km = 19 °C).
+    pressure = 500.0 * float(cycling.isa_pressure_hpa(-5000.0)) / float(cycling.isa_pressure_hpa(0.0))
+    assert pressure < 1100.0  # not held at the reading's top
+    expected = float(cycling.air_density_weather(19.0, pressure, 0.0))
+    assert float(air.density(-6000.0)) == pytest.approx(expected, rel=1e-12)
 
 
 @pytest.mark.parametrize("elevation", [math.nan, -1e5, 1e300, [0.0, math.inf]])

@@ -524,3 +524,33 @@ def test_a_ragged_list_is_refused_naming_it_not_as_numpy_s_inhomogeneous_shape(a
     values[argument] = [[1.0, 0.5], [0.5]]
     with pytest.raises(ValueError, match=rf"^{argument} must be an array of real numbers"):
         cycling.power(**values)  # type: ignore[arg-type]
+
+
+# Kind: one quantity with a different range in each function that takes it. power() refused altitudes below
+# −500 m that air_density (down to −10 km, the deepest a course may reach) and the course took.
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda h: cycling.air_density(h),
+        lambda h: cycling.power(10.0, 0.3, 80.0, 0.004, altitude_m=h),
+        lambda h: cycling.speed_for_power(250.0, 0.3, 80.0, 0.004, altitude_m=h),
+        lambda h: cycling.paceline(4, 1.0, 10.0, 0.3, 80.0, 0.004, altitude_m=h),
+    ],
+    ids=["air_density", "power", "speed_for_power", "paceline"],
+)
+def test_the_textbook_model_takes_one_altitude_range(call: Callable[[float], object]) -> None:
+    low, high = cycling.AIR_DENSITY_ALTITUDE_M
+    assert cycling.MODEL_DOMAIN["altitude_m"] == (low, high) == (-10_000.0, 30_000.0)
+    for h in (low, -1000.0, high):
+        call(h)
+    for h in (np.nextafter(low, -math.inf), np.nextafter(high, math.inf)):
+        with pytest.raises(ValueError, match=r"altitude_m"):
+            call(float(h))
+
+
+def test_power_at_1000_m_below_sea_level_is_the_formula_with_its_air() -> None:
+    rho = 1.225 * math.exp(1000.0 / 8500.0)
+    v = 10.0
+    expected = 0.5 * rho * 0.3 * v**3 + 0.004 * 80.0 * 9.81 * v  # level road, no wind, efficiency 1 (the default)
+    got = float(cycling.power(v, 0.3, 80.0, 0.004, altitude_m=-1000.0).total)
+    assert got == pytest.approx(expected, rel=1e-12)
