@@ -899,11 +899,16 @@ IoU is lowest when a box edge is on the silhouette.
             notice = self.server.send_download(client, answer.name, answer.content)
             with self._lock:
                 # One link a file and tab: the newer one replaces it (its file freed); the scene's close takes the
-                # rest down, so no link is left over another scene.
+                # rest down, so no link is left over another scene. A close that began while this one was sent has
+                # taken down the links it found: this one goes too.
                 older = self._download_notices.pop((client.client_id, answer.name), None)
-                self._download_notices[(client.client_id, answer.name)] = (client, notice)
-            if older is not None:
-                self.server.remove_notice(*older)
+                stale = [] if older is None else [older]
+                if self.closed:
+                    stale.append((client, notice))
+                else:
+                    self._download_notices[(client.client_id, answer.name)] = (client, notice)
+            for link in stale:
+                self.server.remove_notice(*link)
 
         return handler
 

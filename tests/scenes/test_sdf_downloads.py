@@ -4,6 +4,7 @@ export (an empty shape, no reference image yet), no file and the same plain noti
 from __future__ import annotations
 
 import io
+import threading
 from typing import Any
 
 import numpy as np
@@ -252,3 +253,37 @@ def test_every_download_name_fits_viser_s_download_notice() -> None:
     names = [download(fmt, vertices, faces, colors, image).name for fmt in ("glb", "stl", "obj", "png")]
     assert names == ["sdf_mesh.glb", "sdf_mesh.stl", "sdf_mesh.obj", "sdf_ref.png"]
     assert all(len(name) <= len("sdf_mesh.obj") for name in names)
+
+
+def test_a_download_sent_while_the_scene_closes_takes_its_link_down_too(
+    server: viser.ViserServer, switcher: SceneSwitcher, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Kind: bookkeeping that races a close. A download is sent, then noted for the close to take down; a switch in
+    between (seen once under load) closed the scene first, and the link stayed over the next scene."""
+    scene = switcher.show("sdf")
+    assert isinstance(scene, SdfGalleryScene)
+    sent: list[str] = []
+    send = scene.server.send_download
+
+    def send_then_switch(client: viser.ClientHandle, filename: str, content: bytes) -> str:
+        notice = send(client, filename, content)
+        sent.append(notice)
+        switch = threading.Thread(target=switcher.show, args=("freekick",))
+        switch.start()
+        switch.join(timeout=60.0)  # the whole close, between the send and its note
+        assert not switch.is_alive()
+        return notice
+
+    monkeypatch.setattr(scene.server, "send_download", send_then_switch)
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Download mesh (GLB)")
+        client.click(BUTTONS["glb"])
+        client.wait_for(
+            lambda: (
+                bool(sent)
+                and any(
+                    m.get("type") == "RemoveNotificationMessage" and m["uuid"] == sent[0] for _at, m in client.received
+                )
+            ),
+            what="the link taken down",
+        )
