@@ -11,8 +11,10 @@ with software WebGL on two cores slowed each of these several times over.
 
 from __future__ import annotations
 
+import contextlib
 import io
 import time
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -48,6 +50,7 @@ from scenes.arm import ArmScene
 from scenes.freekick import FreeKickScene
 from scenes.freekick.model import ball_spot
 from scenes.peloton import PelotonScene
+from scenes.peloton.course import CourseMode
 from scenes.sdf_gallery import SdfGalleryScene
 from server.budget import MAX_UPLOAD_BYTES, MIB
 from server.gate import ECHO_AFTER_TYPING_S
@@ -255,13 +258,11 @@ def test_upload_a_gpx_and_play_it(server: viser.ViserServer, browser_page: Any, 
         page.get_by_text("Leader at", exact=False).first.wait_for(timeout=10_000)
 
 
-@pytest.mark.parametrize("viewport", VIEWPORTS, ids=lambda v: f"{v[0]}x{v[1]}")
-def test_a_file_over_the_upload_limit_is_refused_and_the_button_works_again(
-    server: viser.ViserServer, browser_page: Any, tmp_path: Path, viewport: tuple[int, int]
-) -> None:
-    """A 25 MiB file: the server refused its start, but viser's page kept the "Upload GPX" button disabled and its
-    "Uploading … (25.0M)" spinner up until a reload, waiting for acks that never came. Now the page shows only the
-    refusal, and the button uploads the next file."""
+@contextlib.contextmanager
+def course_mode_page(
+    server: viser.ViserServer, browser_page: Any, viewport: tuple[int, int]
+) -> Iterator[tuple[Any, CourseMode]]:
+    """The peloton in a Chromium page of size ``viewport``, notifications closed, "Ride a course" ticked by a click."""
     with served_scene_at(server, browser_page, "peloton", "/peloton/course_mode/route", viewport) as served:
         scene, page = served.scene, served.page
         assert isinstance(scene, PelotonScene)
@@ -269,6 +270,17 @@ def test_a_file_over_the_upload_limit_is_refused_and_the_button_works_again(
         close_notifications(page)
         page.get_by_text("Ride a course", exact=True).first.click()
         wait_until(lambda: mode.enabled and mode.state is not None, "course mode on", timeout_s=15.0)
+        yield page, mode
+
+
+@pytest.mark.parametrize("viewport", VIEWPORTS, ids=lambda v: f"{v[0]}x{v[1]}")
+def test_a_file_over_the_upload_limit_is_refused_and_the_button_works_again(
+    server: viser.ViserServer, browser_page: Any, tmp_path: Path, viewport: tuple[int, int]
+) -> None:
+    """A 25 MiB file: the server refused its start, but viser's page kept the "Upload GPX" button disabled and its
+    "Uploading … (25.0M)" spinner up until a reload, waiting for acks that never came. Now the page shows only the
+    refusal, and the button uploads the next file."""
+    with course_mode_page(server, browser_page, viewport) as (page, mode):
         button = page.get_by_role("button", name="Upload GPX")
 
         big = tmp_path / "too_big.gpx"
@@ -302,13 +314,7 @@ def test_a_file_the_course_refuses_shows_one_message_not_uploaded_successfully_b
 ) -> None:
     """A KML file named .gpx arrived whole, so viser's page said "File uploaded successfully" next to the course's red
     "GPX not loaded": two toasts that contradict each other. Now the refusal is the one message about the file."""
-    with served_scene_at(server, browser_page, "peloton", "/peloton/course_mode/route", viewport) as served:
-        scene, page = served.scene, served.page
-        assert isinstance(scene, PelotonScene)
-        mode = scene.course_mode
-        close_notifications(page)
-        page.get_by_text("Ride a course", exact=True).first.click()
-        wait_until(lambda: mode.enabled and mode.state is not None, "course mode on", timeout_s=15.0)
+    with course_mode_page(server, browser_page, viewport) as (page, _mode):
         kml = tmp_path / "route.gpx"
         kml.write_bytes(b'<?xml version="1.0"?><kml xmlns="http://www.opengis.net/kml/2.2"><Document/></kml>')
         with page.expect_file_chooser() as chooser:

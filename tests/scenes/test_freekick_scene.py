@@ -1083,6 +1083,15 @@ def _progress_shown(client: BrowserClient) -> bool:
     return bool(bars[0]["props"].get("visible"))
 
 
+def _says_the_strike_changed(client: BrowserClient) -> bool:
+    """Whether this browser shows that the strike changed since the map, and neither "striking" nor the bar."""
+    return (
+        _markdown_shown(client, STRIKE_CHANGED)
+        and not _markdown_shown(client, STRIKING)
+        and not _progress_shown(client)
+    )
+
+
 def _sent_while_mapping(client: BrowserClient, freekick: FreeKickScene, then: str) -> None:
     """Send ``then`` as a person does and wait for the scene to take it (the map is still held)."""
     match then:
@@ -1139,14 +1148,7 @@ def test_an_input_while_the_goal_chance_is_mapped_leaves_a_true_status(
             if same_strike:
                 client.wait_for(lambda: _markdown_shown(client, STRIKING) and _progress_shown(client), what="the bar")
             else:
-                client.wait_for(
-                    lambda: (
-                        _markdown_shown(client, STRIKE_CHANGED)
-                        and not _markdown_shown(client, STRIKING)
-                        and not _progress_shown(client)
-                    ),
-                    what="the strike changed, said at once",
-                )
+                client.wait_for(lambda: _says_the_strike_changed(client), what="the strike changed, said at once")
             release.set()
             assert freekick.wait_idle(300.0)
             # Both settled: the map if it is this strike's, else why there is none; never "striking" for good.
@@ -1162,12 +1164,7 @@ def test_an_input_while_the_goal_chance_is_mapped_leaves_a_true_status(
                 assert freekick.params.view == "above"
             else:
                 client.wait_for(
-                    lambda: (
-                        _markdown_shown(client, STRIKE_CHANGED)
-                        and not _markdown_shown(client, STRIKING)
-                        and not _progress_shown(client)
-                    ),
-                    what="the strike changed, said once the map is done",
+                    lambda: _says_the_strike_changed(client), what="the strike changed, said once the map is done"
                 )
                 assert not _node_shown(client, "/freekick/odds_map") and freekick.params.view == view
     finally:

@@ -6,6 +6,7 @@ from __future__ import annotations
 import io
 import math
 import time
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -1000,6 +1001,25 @@ def test_a_field_cut_open_by_its_bounds_says_so_and_a_whole_one_does_not(
         assert not scene.bounds_note.visible
 
 
+def _framed_tab(
+    server: viser.ViserServer, scene: SdfGalleryScene, client: BrowserClient, size: tuple[int, int]
+) -> tuple[viser.ClientHandle, Lens, Callable[[], View]]:
+    """Open ``client`` as a tab of canvas ``size`` (height, width), wait for the scene to frame it and report the
+    framed view back, as a page does; returns the tab, its lens and a reader of its current view."""
+    client.send_camera(size=size)
+    wait_until(lambda: len(server.get_clients()) == 1 and scene.framing.frames >= 1, "the opening framing")
+    (tab,) = server.get_clients().values()
+    lens = Lens(float(tab.camera.fov), size[1], size[0])
+
+    def view() -> View:
+        position, look_at = (tuple(float(v) for v in vec) for vec in (tab.camera.position, tab.camera.look_at))
+        return View(position, look_at)  # type: ignore[arg-type]
+
+    framed = view()
+    client.send_camera(framed.position, framed.look_at, size)
+    return tab, lens, view
+
+
 @pytest.mark.gl
 @pytest.mark.parametrize("size", [(1000, 1600), (720, 1280)], ids=["1600x1000", "1280x720"])
 def test_a_field_applied_out_of_the_picture_is_brought_into_it_and_one_in_it_leaves_the_view(
@@ -1008,17 +1028,7 @@ def test_a_field_applied_out_of_the_picture_is_brought_into_it_and_one_in_it_lea
     # The failing input (an outside tester): a sphere at x = 1 m applied in the editor stayed half under the panel,
     # its bottom at the window's edge; the view was framed only when the tab opened.
     with BrowserClient(server.get_port()) as client:
-        client.send_camera(size=size)
-        wait_until(lambda: len(server.get_clients()) == 1 and scene.framing.frames >= 1, "the opening framing")
-        (tab,) = server.get_clients().values()
-        lens = Lens(float(tab.camera.fov), size[1], size[0])
-
-        def view() -> View:
-            position, look_at = (tuple(float(v) for v in vec) for vec in (tab.camera.position, tab.camera.look_at))
-            return View(position, look_at)  # type: ignore[arg-type]
-
-        opening = view()
-        client.send_camera(opening.position, opening.look_at, size)  # the tab reports the framed view, as a page does
+        _tab, lens, view = _framed_tab(server, scene, client, size)
         apply_glsl(client, "float sdf(vec3 p) { return length(p - vec3(1.0, 0.0, 0.0)) - 0.4; }\n")
         wait_until(lambda: scene.editor_serial == 1, "the apply", timeout_s=60.0)
         box = box_corners(scene.mesh_vertices.min(axis=0), scene.mesh_vertices.max(axis=0))
@@ -1043,17 +1053,8 @@ def test_a_field_that_wider_bounds_bring_out_of_the_picture_is_followed_and_one_
     # applied in, and widening the box to ±3 m meshes it where the opening view does not reach. The view follows the
     # new mesh once; narrowing the box a little, with both spheres already in the picture, leaves the view as it is.
     with BrowserClient(server.get_port()) as client:
-        client.send_camera(size=size)
-        wait_until(lambda: len(server.get_clients()) == 1 and scene.framing.frames >= 1, "the opening framing")
-        (tab,) = server.get_clients().values()
-        lens = Lens(float(tab.camera.fov), size[1], size[0])
-
-        def view() -> View:
-            position, look_at = (tuple(float(v) for v in vec) for vec in (tab.camera.position, tab.camera.look_at))
-            return View(position, look_at)  # type: ignore[arg-type]
-
+        tab, lens, view = _framed_tab(server, scene, client, size)
         opening = view()
-        client.send_camera(opening.position, opening.look_at, size)  # the tab reports the framed view, as a page does
         client.wait_for_gui("Editor bounds half size (m)")
         client.set_value("Editor bounds half size (m)", 1.0)
         apply_glsl(
