@@ -1061,13 +1061,15 @@ def test_a_field_that_wider_bounds_bring_out_of_the_picture_is_followed_and_one_
             client, "float sdf(vec3 p) { return min(length(p) - 0.3, length(p - vec3(2.2, 0.0, 0.0)) - 0.4); }\n"
         )
         wait_until(lambda: scene.editor_serial == 1, "the apply", timeout_s=60.0)
-        meshes = scene.mesh_serial
+        meshes, frames = scene.mesh_serial, scene.framing.frames
         client.set_value("Editor bounds half size (m)", 3.0)
         wait_until(lambda: scene.mesh_serial > meshes and scene.params.editor.half_size == 3.0, "the wider remesh")
         box = box_corners(scene.mesh_vertices.min(axis=0), scene.mesh_vertices.max(axis=0))
         assert scene.mesh_vertices[:, 0].max() > 2.5  # the far sphere, where the opening view did not reach
         assert not shows(opening, lens, box, clear_of_notice=False)
-        wait_until(lambda: shows(view(), lens, box, clear_of_notice=False), "the sphere in the picture", timeout_s=10.0)
+        # Read once the framing has written both the position and the look-at point (not between the two).
+        wait_until(lambda: scene.framing.frames > frames, "the view followed", timeout_s=10.0)
+        assert shows(view(), lens, box, clear_of_notice=False)
         # The person steps back a little (the framed view is tight), then narrows the box: both spheres stay in view.
         followed = view()
         client.send_camera(followed.position, followed.look_at, size)  # the tab reports the framed view
