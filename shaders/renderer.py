@@ -59,6 +59,8 @@ __all__ = [
     "mesh_glsl",
     "render",
     "renderer",
+    "sample_glsl",
+    "slab_planes",
     "user_glsl",
 ]
 
@@ -679,10 +681,12 @@ class Renderer:
         self._set(prog, "u_sample_points", 1)
         return self._draw_probe(prog, vao, pts)
 
-    def sample_field(self, source: str, grid: sdf.Grid) -> NDArray[np.float32]:
-        """The editor's ``sdf`` at every sample of ``grid``: (nx, ny, nz) float32 (m), sampled in GLSL.
+    def sample_field(self, source: str, grid: sdf.Grid, planes: tuple[int, int] | None = None) -> NDArray[np.float32]:
+        """The editor's ``sdf`` at every sample of ``grid``, or of its z planes ``planes`` = (first, end): (nx, ny, n)
+        float32 (m), n the planes sampled, in GLSL.
 
-        The samples are drawn as images of nx × (ny·slices) pixels, as many z slices a draw as fit in 8192 rows.
+        The samples are drawn as images of nx × (ny·slices) pixels, as many z slices a draw as fit in 8192 rows
+        (:func:`slab_planes`).
         """
         import moderngl
 
@@ -690,7 +694,10 @@ class Renderer:
         prog, vao = self._field_program(source, "sample")
         self._set(prog, "u_sample_points", 0)
         nx, ny, nz = grid.shape
-        slices = max(1, min(nz, _MAX_ROWS // ny))
+        first, end = (0, nz) if planes is None else planes
+        if not 0 <= first < end <= nz:
+            raise ValueError(f"planes must lie within the grid's {nz} z planes, got {planes!r}")
+        slices = slab_planes(grid)
         distance = self.ctx.texture((nx, ny * slices), 1, dtype="f4")
         color = self.ctx.texture((nx, ny * slices), 4, dtype="f1")  # a quarter of the points pass's bytes
         fbo = self.ctx.framebuffer(color_attachments=[distance, color])
@@ -698,15 +705,15 @@ class Renderer:
         self._set(prog, "u_origin", tuple(float(v) for v in grid.origin))
         self._set(prog, "u_spacing", float(grid.spacing))
         self._set(prog, "u_ny", ny)
-        out = np.empty((nz, ny, nx), np.float32)
+        out = np.empty((end - first, ny, nx), np.float32)
         try:
-            for z0 in range(0, nz, slices):
-                count = min(slices, nz - z0)
+            for z0 in range(first, end, slices):
+                count = min(slices, end - z0)
                 self._set(prog, "u_z0", z0)
                 fbo.scissor = (0, 0, nx, ny * count)
                 vao.render(moderngl.TRIANGLES, vertices=3)  # pyright: ignore[reportAttributeAccessIssue]
                 block = np.frombuffer(distance.read(), np.float32).reshape(ny * slices, nx)
-                out[z0 : z0 + count] = block[: ny * count].reshape(count, ny, nx)
+                out[z0 - first : z0 - first + count] = block[: ny * count].reshape(count, ny, nx)
         finally:
             for obj in (fbo, distance, color):
                 obj.release()
@@ -793,33 +800,52 @@ def mesh_glsl(source: str, resolution: int, bounds: ArrayLike) -> trimesh.Trimes
     check_source(source)
     box = check_field_bounds(bounds)
     grid = sdf.make_grid(sdf.default_scene(), resolution, box)  # the scene is unused when bounds are given
+    field = sample_glsl(source, grid)
+    if not np.all(np.isfinite(field)):
+        raise ShaderCompileError("sdf() returned NaN or infinity inside the bounds", None)
+    outside = field > 0.0
+    if not outside.any() or outside.all():  # one side everywhere (0 is inside; 0 everywhere was meshed as a blob)
+        return sdf.mesh_trimesh(np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64), np.zeros((0, 3)))
+    # Marching cubes places vertices from the corners' values by linear interpolation, so a positive scale of the
+    # field changes nothing but the kernel's level nudge (a thousandth of a voxel, in metres): a field far from a
+    # distance (|∇d| not near 1, e.g. 100·sdf or 0.001·sdf) is scaled to one first, so K·sdf meshes as sdf does.
+    lipschitz = lipschitz_estimate(field, grid.spacing)
+    far = math.isfinite(lipschitz) and (lipschitz > 1.5 or 0.0 < lipschitz < 0.5)
+    if far:
+        field = (field / np.float32(lipschitz)).astype(np.float32)
+    gradient = lipschitz if far else 1.0
+    gl_service.run(lambda gl: gl.remember_field_gradient(source, box, gradient))
+    try:  # on the caller's thread: the GL thread serves other callers meanwhile
+        vertices, faces = sdf.mesh_samples(grid, field, _near_surface_mask(field, grid.spacing))
+    except RuntimeError:  # scikit-image's "No surface found at the given iso value"
+        vertices, faces = np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64)
+    colors = gl_service.run(lambda gl: gl.probe_field(source, vertices)[1]) if len(vertices) else np.zeros((0, 3))
+    if not np.all(np.isfinite(colors)):
+        raise ShaderCompileError("color() returned NaN or infinity on the surface", None)
+    return sdf.mesh_trimesh(vertices, faces, np.clip(colors.astype(np.float64), 0.0, 1.0))
 
-    def job(gl: Renderer) -> trimesh.Trimesh:
-        field = gl.sample_field(source, grid)
-        if not np.all(np.isfinite(field)):
-            raise ShaderCompileError("sdf() returned NaN or infinity inside the bounds", None)
-        outside = field > 0.0
-        if not outside.any() or outside.all():  # one side everywhere (0 is inside; 0 everywhere was meshed as a blob)
-            return sdf.mesh_trimesh(np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64), np.zeros((0, 3)))
-        # Marching cubes places vertices from the corners' values by linear interpolation, so a positive scale of
-        # the field changes nothing but the kernel's level nudge (a thousandth of a voxel, in metres): a field far
-        # from a distance (|∇d| not near 1, e.g. 100·sdf or 0.001·sdf) is scaled to one first, so K·sdf meshes as
-        # sdf does.
-        lipschitz = lipschitz_estimate(field, grid.spacing)
-        far = math.isfinite(lipschitz) and (lipschitz > 1.5 or 0.0 < lipschitz < 0.5)
-        if far:
-            field = (field / np.float32(lipschitz)).astype(np.float32)
-        gl.remember_field_gradient(source, box, lipschitz if far else 1.0)
-        try:
-            vertices, faces = sdf.mesh_samples(grid, field, _near_surface_mask(field, grid.spacing))
-        except RuntimeError:  # scikit-image's "No surface found at the given iso value"
-            vertices, faces = np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64)
-        colors = gl.probe_field(source, vertices)[1] if len(vertices) else np.zeros((0, 3))
-        if not np.all(np.isfinite(colors)):
-            raise ShaderCompileError("color() returned NaN or infinity on the surface", None)
-        return sdf.mesh_trimesh(vertices, faces, np.clip(colors.astype(np.float64), 0.0, 1.0))
 
-    return gl_service.run(job)
+def slab_planes(grid: sdf.Grid) -> int:
+    """How many z planes of ``grid`` one sampling draw covers: as many as fit in 8192 rows of ny each."""
+    _nx, ny, nz = grid.shape
+    return max(1, min(nz, _MAX_ROWS // ny))
+
+
+def sample_glsl(source: str, grid: sdf.Grid) -> NDArray[np.float32]:
+    """An editor source's ``sdf`` at every sample of ``grid``: (nx, ny, nz) float32 (m), sampled in GLSL on the
+    process's one GL thread (:mod:`shaders.gl_service`) one draw's slab of z planes (:func:`slab_planes`) at a time.
+
+    Other callers' GL work (another gallery tab's frame) runs between the slabs: a field that is costly to evaluate,
+    sampled whole, held every other tab's frames for as long as it took (4.6 s for a nine-level chain at 256³).
+    """
+    from shaders import gl_service
+
+    nz, step = grid.shape[2], slab_planes(grid)
+    slabs = [
+        gl_service.run(lambda gl, first=first: gl.sample_field(source, grid, (first, min(first + step, nz))))
+        for first in range(0, nz, step)
+    ]
+    return np.concatenate(slabs, axis=2)
 
 
 def _near_surface_mask(field: NDArray[np.float32], spacing: float) -> NDArray[np.bool_]:

@@ -15,7 +15,6 @@ import math
 import numpy as np
 
 from kernels import sdf
-from shaders import gl_service
 from shaders import renderer as gl_renderer
 from shaders.renderer import MAX_SOURCE_CHARS, Camera, ShaderCompileError, Shading
 from shaders.trial import TrialTimes, trial
@@ -138,7 +137,7 @@ def _no_surface(field: EditorField, resolution: int) -> str:
     where the nearest comes within two sample spacings of a surface (in metres: the values divided by the field's
     largest gradient), that a shape or hollow may fall between samples."""
     grid = sdf.make_grid(sdf.default_scene(), resolution, field.bounds)  # the mesher's grid (the scene is unused)
-    samples = gl_service.run(lambda gl: gl.sample_field(field.source, grid))
+    samples = gl_renderer.sample_glsl(field.source, grid)
     box = f"the ±{field.half_size:g} m box"
     lowest, highest = float(samples.min()), float(samples.max())
     if lowest == highest == 0.0:

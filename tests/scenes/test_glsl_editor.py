@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 import re
+from typing import Any
 
 import numpy as np
 import pytest
@@ -232,6 +233,45 @@ def test_gl_sampled_grid_equals_numpy_at_every_sample() -> None:
     ).reshape(grid.shape)
     assert field.shape == grid.shape
     np.testing.assert_allclose(field, expected, atol=1e-5, rtol=0)
+
+
+@pytest.mark.gl
+def test_a_grid_sampled_a_slab_at_a_time_is_the_grid_sampled_whole() -> None:
+    grid = sdf.make_grid(sdf.default_scene(), 160, CUBE_BOUNDS)  # 51 planes a draw: four slabs, the last of 7
+    assert gl_renderer.slab_planes(grid) == 51 and grid.shape[2] == 160
+    whole = gl_service.run(lambda gl: gl.sample_field(SPHERE, grid))
+    np.testing.assert_array_equal(gl_renderer.sample_glsl(SPHERE, grid), whole)
+    middle = gl_service.run(lambda gl: gl.sample_field(SPHERE, grid, (51, 102)))
+    np.testing.assert_array_equal(middle, whole[:, :, 51:102])
+    for planes in [(0, 0), (-1, 5), (100, 161), (5, 3)]:
+        with pytest.raises(ValueError, match="planes"):
+            gl_service.run(lambda gl, planes=planes: gl.sample_field(SPHERE, grid, planes))
+
+
+@pytest.mark.gl
+def test_another_callers_gl_work_runs_between_the_slabs_of_a_costly_field(monkeypatch: pytest.MonkeyPatch) -> None:
+    # Kind: one caller holding the process's one GL thread. A nine-level field meshed at 256³ took 6 s as one GL job,
+    # and another gallery tab's light slider waited 4.6 s for its frame. Its samples are now drawn a slab at a time,
+    # and marching cubes runs on the caller's thread: a job that arrives meanwhile waits for one slab at most.
+    real_run = gl_service.run
+    slabs: list[int] = []
+    seen_by_the_other: list[int] = []
+
+    def run(job: Any) -> Any:
+        def slab(gl: gl_renderer.Renderer) -> Any:
+            out = job(gl)
+            slabs.append(1)
+            if len(slabs) == 1:  # another tab's frame, asked for while the first slab is drawn
+                gl_service.submit(lambda _gl: seen_by_the_other.append(len(slabs)))
+            return out
+
+        return real_run(slab)
+
+    monkeypatch.setattr(gl_service, "run", run)
+    tri = mesh_glsl(SPHERE, 160, CUBE_BOUNDS)
+    assert len(tri.faces) > 0
+    assert len(slabs) >= 4 + 2  # four slabs, then the gradient noted and the colours probed
+    assert seen_by_the_other == [1]
 
 
 @pytest.mark.gl
