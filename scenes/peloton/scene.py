@@ -871,8 +871,7 @@ time-averaged power is the mean over positions, far below the leader's.
         rho = float(cycling.air_density(p.altitude_m))
         aero, rolling, climbing = float(solo.aero), float(solo.rolling), float(solo.climbing)
         spent = self.state.solo_spent_w
-        thinner = 100 * (1 - rho / cycling.RHO_SEA_LEVEL)
-        where = "sea level" if abs(thinner) < 0.05 else f"{thinner:.1f} % thinner than at sea level"
+        where = density_words(rho)
         if spent > 0 and aero + rolling + climbing > 0:
             share = f"the air takes **{100.0 * max(aero, 0.0) / spent:.1f} %** of the power spent at the wheel"
         else:  # standing still, or a descent or tailwind that pays for it all: no share of nothing
@@ -1018,3 +1017,12 @@ time-averaged power is the mean over positions, far below the leader's.
         if self._ridden_s <= 0:
             return np.zeros(n)
         return self._energy_j[:n] / self._ridden_s
+
+
+def density_words(rho: float) -> str:
+    """How air of density ``rho`` (kg/m³) compares with the sea level's: "sea level", or so many percent thinner
+    (above it) or denser (below it, down to the Dead Sea's shore)."""
+    change = 100.0 * (rho / cycling.RHO_SEA_LEVEL - 1.0)
+    if abs(change) < 0.05:
+        return "sea level"
+    return f"{abs(change):.1f} % {'denser' if change > 0 else 'thinner'} than at sea level"

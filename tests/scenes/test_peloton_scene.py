@@ -1124,3 +1124,20 @@ def test_the_results_table_says_which_columns_are_at_the_wheel_and_which_at_the_
     pedals = float(cells[3].strip("*"))
     assert sum(parts) / (drivetrain_pct / 100.0) == pytest.approx(pedals, abs=2.0)  # each shown to the watt
     assert "of the power spent at the wheel" in scene.density.content
+
+
+# Kind: a comparison worded for one side of its reference only. With the Altitude slider reaching below sea level,
+# −500 m read "-6.1 % thinner than at sea level".
+@pytest.mark.parametrize(
+    ("altitude_m", "words"),
+    [
+        (-500.0, f"{100.0 * (math.exp(500.0 / 8500.0) - 1.0):.1f} % denser than at sea level"),
+        (0.0, "(sea level)"),
+        (2000.0, f"{100.0 * (1.0 - math.exp(-2000.0 / 8500.0)):.1f} % thinner than at sea level"),
+    ],
+)
+def test_the_air_is_compared_with_sea_level_in_the_right_direction(
+    scene: PelotonScene, altitude_m: float, words: str
+) -> None:
+    scene.controls["altitude_m"].value = altitude_m
+    assert words in scene.density.content and "-" not in scene.density.content.split("(")[1].split(")")[0]
