@@ -275,18 +275,36 @@ def test_an_efficiency_below_a_thousandth_is_refused_and_a_thousandth_solves() -
     assert_solves_to_the_nearest_float(solve_without_warnings(**args), **args)
 
 
-def test_a_fast_tailwind_lands_on_the_nearest_float() -> None:
-    # Stopped 15 ulps early: power(v) missed 0.001 W by 1.2e-8 W (one ulp of v is 1.5e-9 W here).
-    args = dict(
-        power_w=0.001,
-        cda_m2=0.3,
-        mass_kg=80.0,
-        crr=0.008023272163568376,
-        grade=0.0749270873968717,
-        headwind_ms=-1000.0,
-    )
+@pytest.mark.parametrize(
+    "args",
+    [
+        # Stopped 15 ulps early: power(v) missed 0.001 W by 1.2e-8 W (one ulp of v is 1.5e-9 W here).
+        dict(
+            power_w=0.001,
+            cda_m2=0.3,
+            mass_kg=80.0,
+            crr=0.008023272163568376,
+            grade=0.0749270873968717,
+            headwind_ms=-1000.0,
+        ),
+        # An explore run's case: a 300 m/s tailwind, CdA 4334 m² and 270 t on a grade of 7 at η = 0.01 cancel to
+        # 1 W (v = 243.4275 m/s); the check allowed for power()'s rounding before the division by η.
+        dict(
+            power_w=1.0,
+            cda_m2=4334.125,
+            mass_kg=269838.0,
+            crr=0.0,
+            grade=7.0,
+            altitude_m=9998.0,
+            headwind_ms=-300.0,
+            drivetrain_efficiency=0.01,
+        ),
+    ],
+    ids=["a fast tailwind", "huge terms cancelling at a low efficiency"],
+)
+def test_drawn_cases_solve_to_rounding(args: dict[str, float]) -> None:
     v = solve_without_warnings(**args)
-    assert_solves_to_the_nearest_float(v, **args)
+    assert_solves_to_the_nearest_float(v, **dict(args))
 
 
 # ------------------------------------------------------------------------------------------------ the scene's readout
@@ -557,20 +575,3 @@ def test_power_at_1000_m_below_sea_level_is_the_formula_with_its_air() -> None:
     expected = 0.5 * rho * 0.3 * v**3 + 0.004 * 80.0 * 9.81 * v  # level road, no wind, efficiency 1 (the default)
     got = float(cycling.power(v, 0.3, 80.0, 0.004, altitude_m=-1000.0).total)
     assert got == pytest.approx(expected, rel=1e-12)
-
-
-def test_speed_for_power_where_huge_terms_cancel_at_a_low_efficiency() -> None:
-    # An explore run's case: a 300 m/s tailwind, CdA 4334 m² and 270 t on a grade of 7 at η = 0.01 cancel to 1 W.
-    args = dict(
-        power_w=1.0,
-        cda_m2=4334.125,
-        mass_kg=269838.0,
-        crr=0.0,
-        grade=7.0,
-        altitude_m=9998.0,
-        headwind_ms=-300.0,
-        drivetrain_efficiency=0.01,
-    )
-    v = solve_without_warnings(**args)
-    assert v == pytest.approx(243.42754010231738, rel=1e-12)
-    assert_solves_to_the_nearest_float(v, **args)
