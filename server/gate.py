@@ -73,6 +73,22 @@ ECHO_IN_FLIGHT_S = 1.0
 it after the tab's own next edit of that control: that edit's value is then sent back too, so the tab ends on it."""
 
 
+@dataclasses.dataclass(frozen=True)
+class FinishedUpload:
+    """An upload a tab finished, as the gate took it (:meth:`Gate.finished_upload`)."""
+
+    started_at: float
+    """When (``time.monotonic()``) the gate took its start: a scene tells a file picked before its user's later
+    choice (which the file, still arriving, would otherwise overrule) from one picked after."""
+    transfer_uuid: str
+
+    @property
+    def notice_id(self) -> str:
+        """The id of viser's own notice of it in its tab ("Uploading…", then "File uploaded successfully"): a scene
+        that refuses the file takes it down, so that its refusal is the one message the tab shows about the file."""
+        return viser_compat.upload_notice_id(self.transfer_uuid)
+
+
 class Gate:
     """The one gate in front of one server's message dispatch. Made by :func:`install_gate`.
 
@@ -93,9 +109,8 @@ class Gate:
         """Per (tab, control uuid), a send-back waiting for the tab to stop typing (:data:`ECHO_AFTER_TYPING_S`)."""
         self._echoed_at: dict[tuple[int, str], float] = {}
         """Per (tab, control uuid), when the server's value was last sent back to that tab."""
-        self._finished_uploads: dict[tuple[int, str], tuple[float, str]] = {}
-        """When the last upload each (client, upload button) finished was started, and its transfer id
-        (:meth:`upload_started_at`, :meth:`upload_notice`)."""
+        self._finished_uploads: dict[tuple[int, str], FinishedUpload] = {}
+        """The last upload each (client, upload button) finished (:meth:`finished_upload`)."""
         self._budgets: dict[int, TabBudget] = {}
         """Per client, its costly-input budget (only touched on the event loop)."""
         self._deliveries: set[asyncio.Future[None]] = set()
@@ -290,19 +305,10 @@ class Gate:
             return None, None
         return self._clean_gui(server, client_id, messages.GuiUpdateMessage(matches[0], message.updates))
 
-    def upload_started_at(self, client_id: int, button: object) -> float | None:
-        """When (``time.monotonic()``) the gate took the start of the last upload tab ``client_id`` finished on upload
-        button ``button``; None if none has. A scene reads it in the button's ``on_upload`` to tell a file picked
-        before its user's later choice (which the file, still arriving, would otherwise overrule) from one after."""
-        finished = self._finished_uploads.get((client_id, viser_compat.gui_uuid(button)))
-        return None if finished is None else finished[0]
-
-    def upload_notice(self, client_id: int, button: object) -> str | None:
-        """The id of viser's own notice of the last upload tab ``client_id`` finished on upload button ``button``
-        ("Uploading…", then "File uploaded successfully"); None if none has. A scene that refuses the file takes
-        it down, so that its refusal is the one message the tab shows about the file."""
-        finished = self._finished_uploads.get((client_id, viser_compat.gui_uuid(button)))
-        return None if finished is None else viser_compat.upload_notice_id(finished[1])
+    def finished_upload(self, client_id: int, button: object) -> FinishedUpload | None:
+        """The last upload tab ``client_id`` finished on upload button ``button``; None if none has. A scene reads it
+        in the button's ``on_upload``."""
+        return self._finished_uploads.get((client_id, viser_compat.gui_uuid(button)))
 
     def uploads_in_flight(self) -> tuple[int, int]:
         """(uploads, bytes they announced) started and not finished, across every tab of this server."""
@@ -517,7 +523,7 @@ class Gate:
         if parts > 0:
             in_flight[message.transfer_uuid] = Upload(parts, size, now, now, button_uuid=button)
         else:  # viser finishes an empty file at its start
-            self._finished_uploads[(client_id, button)] = (now, str(message.transfer_uuid))
+            self._finished_uploads[(client_id, button)] = FinishedUpload(now, str(message.transfer_uuid))
         return message, None
 
     def _tell(
@@ -592,7 +598,9 @@ class Gate:
         upload.last_part_at = time.monotonic()
         if len(upload.parts_seen) == upload.part_count:
             del self._uploads[client_id][str(message.transfer_uuid)]
-            self._finished_uploads[(client_id, upload.button_uuid)] = (upload.started_at, str(message.transfer_uuid))
+            self._finished_uploads[(client_id, upload.button_uuid)] = FinishedUpload(
+                upload.started_at, str(message.transfer_uuid)
+            )
         return message
 
     def _gizmo_handle(self, server: viser.ViserServer, client_id: int, name: str, owner: str) -> Any:

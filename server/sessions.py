@@ -27,7 +27,7 @@ import viser
 
 from server import viser_compat
 from server.clean import record_spec
-from server.gate import install_gate
+from server.gate import FinishedUpload, install_gate
 from server.memory import give_memory_back
 from server.viser_compat import dead_writes_allowed
 
@@ -264,21 +264,13 @@ class Session:
         with dead_writes_allowed(client):  # its tab may have closed
             viser_compat.remove_notice(client, notice_id)
 
-    def upload_started_at(self, event: object) -> float | None:
-        """When (``time.monotonic()``) the upload an upload button's ``on_upload`` ``event`` reports was started in
-        its tab, as the gate took its start; None when unknown (:meth:`server.gate.Gate.upload_started_at`)."""
+    def finished_upload(self, event: object) -> FinishedUpload | None:
+        """The upload an upload button's ``on_upload`` ``event`` reports, as the gate took it; None when unknown
+        (:meth:`server.gate.Gate.finished_upload`)."""
         client_id, button = getattr(event, "client_id", None), getattr(event, "target", None)
         if not isinstance(client_id, int) or button is None:
             return None
-        return install_gate(self.viser_server).upload_started_at(client_id, button)
-
-    def upload_notice(self, event: object) -> str | None:
-        """The id of viser's own notice of the upload an ``on_upload`` ``event`` reports, in its tab ("File uploaded
-        successfully"), for :meth:`remove_notice`; None when unknown (:meth:`server.gate.Gate.upload_notice`)."""
-        client_id, button = getattr(event, "client_id", None), getattr(event, "target", None)
-        if not isinstance(client_id, int) or button is None:
-            return None
-        return install_gate(self.viser_server).upload_notice(client_id, button)
+        return install_gate(self.viser_server).finished_upload(client_id, button)
 
     def get_clients(self) -> dict[int, viser.ClientHandle]:
         """The clients this session serves, by id."""

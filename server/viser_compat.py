@@ -85,6 +85,7 @@ __all__ = [
     "send_gizmo_pose",
     "send_gui_value",
     "take_connection_dispatch",
+    "upload_notice_id",
 ]
 
 VISER_VERSION = "1.1.1"

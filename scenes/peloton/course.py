@@ -417,10 +417,11 @@ class CourseMode:
         A refused file is also told to the tab that sent it, in a notification that takes the place of viser's own
         "File uploaded successfully" (:meth:`_tell_not_loaded`)."""
         client = getattr(event, "client", None)
-        started_at, upload_notice = self.server.upload_started_at(event), self.server.upload_notice(event)
+        finished = self.server.finished_upload(event)
+        upload_notice = None if finished is None else finished.notice_id
         # The number and the file are taken together: a higher number is a newer file.
         with self._upload_lock:
-            picked_before_a_later_choice = started_at is not None and started_at < self._chosen_at
+            picked_before_a_later_choice = finished is not None and finished.started_at < self._chosen_at
             if not picked_before_a_later_choice:
                 self._upload_seq += 1
             seq = self._upload_seq
