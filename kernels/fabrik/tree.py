@@ -115,10 +115,11 @@ def solve_tree(
     ``max_iterations``, or when no effector's error changes by more than 0.1 % of the tolerance in an iteration
     where limits or obstacles can hold the tree or a target is out of reach (as :func:`solve`); a free tree within
     reach that stalls so goes on once from every segment turned aside (a mirror-symmetric start stays symmetric
-    under the centroid rule; a tree already on its targets to rounding is not turned), then to the cap. "Reached" is error ≤ tolerance on a pose that keeps every limit (a
-    start that breaks one is iterated on); the returned pose is the last iterate, or the best admissible one where
-    the last is not. Huge or tiny trees are divided by a power of 2 first (as :func:`solve`): a tree scaled by 2^k
-    gives the same result scaled.
+    under the centroid rule; a tree already on its targets to rounding is not turned), then to the cap. "Reached"
+    is error ≤ tolerance on a pose that keeps every limit (a start that breaks one is iterated on). The returned
+    pose is the last iterate, or the best admissible one (smallest largest error) where the last is not admissible,
+    or where the pose the restart left was better than any after it. Huge or tiny trees are divided by a power of 2
+    first (as :func:`solve`): a tree scaled by 2^k gives the same result scaled.
 
     A tree that is one chain (no joint with two children) is solved by :func:`solve` itself, so it gives
     ``solve``'s result (with its extrapolation, its best-pose rule and its closest pose for targets out of reach).
@@ -340,8 +341,9 @@ def _solve_tree_core(
 ) -> int:
     """Multi-end-effector FABRIK on ``p`` (J, 3), in place; ``order`` is breadth first from the root.
 
-    Leaves the returned pose in ``p``: the last iterate where it keeps every limit and clears every live obstacle,
-    else the best (smallest largest error) that did, else the last. Fills ``history`` (max_iterations + 1, E) with
+    Leaves the returned pose in ``p``: the last iterate where it keeps every limit and clears every live obstacle
+    (and, after a restart, is not worse than the best pose before or after it), else the best (smallest largest
+    error) that did, else the last. Fills ``history`` (max_iterations + 1, E) with
     the iterates' errors, NaN past the last iteration, ``final`` (E,) with the returned pose's errors and ``codes``
     (E,) with each effector's status: reached (error ≤ tolerance, on an admissible pose); unreachable (farther from
     the root than its path's length); blocked (target inside a live obstacle, or the pose touching one); limited
@@ -494,10 +496,13 @@ def _solve_tree_core(
                 # Not a tree already on its targets to rounding (tolerance 0 asks for more than rounding gives):
                 # turned aside, it left them by 1.7 m.
                 retry = False
+                if worst < best_worst and _tree_admissible(p, parents, order, table, rest, tiny, has_limits, obstacles):
+                    _copy(p, best)  # the basin it leaves, so that the restart is never worse than where it stood
+                    best_worst = worst
                 _tree_turn_aside(p, parents, order, lengths, tiny, dim)
     feasible = best_worst < np.inf
     if feasible and (
-        not retry  # restarted: never worse than the best before or after
+        (not retry and best_worst < worst - stall)  # restarted: the best before or after it, the last among equals
         or not _tree_admissible(p, parents, order, table, rest, tiny, has_limits, obstacles)
     ):
         _copy(best, p)  # never an inadmissible last iterate where an admissible one was seen
