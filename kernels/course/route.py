@@ -5,9 +5,9 @@ shape (N − 1,) (grade, heading, length); segment i runs from point i to point 
 compass bearings, clockwise from north. Map lengths are haversine distances on a sphere of radius 6 371 008.8 m (the
 IUGG mean Earth radius) with initial great-circle bearings (Sinnott 1984, Sky & Telescope 68:159); map positions are
 the azimuthal equidistant projection about the route's centroid (Snyder 1987, USGS Prof. Paper 1395). Elevation is
-smoothed by a moving average over a distance window (a local linear fit, Cleveland 1979, where the window meets an
-end of the route, so a steady climb keeps its grade and its first and last heights); grade is the smoothed rise over
-the map distance.
+smoothed by a moving average over a distance window; within half a window of an end, by the least-squares line
+over that end's first whole window (Savitzky & Golay 1964, order 1, as scipy's ``savgol_filter`` at its edges), so
+a steady climb keeps its grade and its first and last heights. Grade is the smoothed rise over the map distance.
 
 **Total ascent.** Summing every rise of a GPS profile counts its noise: on a flat 10 km road logged every 5 m with
 1.5 m of elevation noise the rises add up to over 100 m. :func:`total_ascent` counts climbs the way OsmAnd
