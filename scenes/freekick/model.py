@@ -783,13 +783,14 @@ def knuckle_toggled(before: FreeKickParams, after: FreeKickParams) -> FreeKickPa
     return after
 
 
-def knuckle_wobble_m(state: KickState) -> float | None:
+def knuckle_wobble_m(p: FreeKickParams, state: KickState) -> float | None:
     """Largest distance (m) of the kick from its spinless ghost across the line of flight (sideways and up or down),
     up to the played ball's first contact, where the kick carries a knuckle force; None without one."""
-    found = _knuckle_difference(state, 400)
+    found = _knuckle_across(p, state)
     if found is None:
         return None
-    return float(np.linalg.norm(found[1][:, 1:], axis=1).max())
+    _, sideways, rise = found
+    return float(np.hypot(sideways, rise).max())
 
 
 WOBBLE_SCALE = 10.0
@@ -813,6 +814,19 @@ def _knuckle_difference(state: KickState, n: int) -> tuple[NDArray[np.float64], 
     return base, sample_rows(times, flight.t, flight.position) - base
 
 
+def _knuckle_across(
+    p: FreeKickParams, state: KickState, n: int = 400
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]] | None:
+    """(n, 3) the spinless ghost, and (n,) the kick's sideways (m, + to the kicker's left, square to the launch
+    heading, along which the ghost flies) and upward differences from it, as :func:`_knuckle_difference`."""
+    found = _knuckle_difference(state, n)
+    if found is None:
+        return None
+    base, diff = found
+    heading = aim_heading_rad(p)
+    return base, diff @ np.array([-math.sin(heading), math.cos(heading), 0.0]), diff[:, 2]
+
+
 def wobble_path(state: KickState, n: int = PATH_POINTS) -> NDArray[np.float64] | None:
     """(n, 3) the knuckleball's path drawn with its difference from the spinless path magnified
     :data:`WOBBLE_SCALE` times; None without a knuckle force."""
@@ -824,12 +838,10 @@ def knuckle_swerves(p: FreeKickParams, state: KickState) -> list[tuple[float, fl
     """Where the knuckleball swerves furthest each way: for each stretch of flight on one side of the spinless path
     (by at least 2 cm), its furthest point as (distance from the spot along the ground (m), sideways offset (m, + to
     the kicker's left)), in flight order. Empty without a knuckle force."""
-    found = _knuckle_difference(state, 400)
+    found = _knuckle_across(p, state)
     if found is None:
         return []
-    base, diff = found
-    heading = aim_heading_rad(p)
-    sideways = diff @ np.array([-math.sin(heading), math.cos(heading), 0.0])
+    base, sideways, _ = found
     spot = ball_spot(p)
     along = np.hypot(base[:, 0] - spot[0], base[:, 1] - spot[1])
     side = np.where(np.abs(sideways) >= 0.02, np.sign(sideways), 0.0)
@@ -849,14 +861,14 @@ def knuckle_swerves(p: FreeKickParams, state: KickState) -> list[tuple[float, fl
 def wobble_words(p: FreeKickParams, state: KickState) -> str:
     """The knuckleball's swerves in words: "swerves 0.12 m left at 8 m, then 0.33 m right at 21 m; 0.10 m lower at
     most"; empty without a knuckle force."""
-    found = _knuckle_difference(state, 400)
+    found = _knuckle_across(p, state)
     if found is None:
         return ""
     said = [
         f"{abs(side):.2f} m {'left' if side > 0 else 'right'} at {at:.0f} m" for at, side in knuckle_swerves(p, state)
     ]
     words = "swerves " + ", then ".join(said) if said else "keeps within 2 cm sideways"
-    rise = found[1][:, 2]
+    rise = found[2]
     far = int(np.argmax(np.abs(rise)))
     if abs(rise[far]) >= 0.02:
         words += f"; {abs(rise[far]):.2f} m {'higher' if rise[far] > 0 else 'lower'} at most"

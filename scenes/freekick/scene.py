@@ -772,7 +772,7 @@ reads it again, so a ball that bounces in front of him beats him more often than
         keeper = keeper_words(state)
         if keeper:
             lines.append(f"Keeper (drawn as the ball arrives): **{keeper}**")
-        wobble = knuckle_wobble_m(state)
+        wobble = knuckle_wobble_m(p, state)
         if wobble is not None:
             lines.append(
                 f"Knuckle wobble: up to **{wobble:.2f} m** off the spinless path (dashed): "

@@ -396,7 +396,7 @@ def test_ticking_knuckleball_in_a_browser_sets_the_spin_near_zero_and_the_wobble
         client.wait_for(lambda: _markdown_shown(client, "Knuckle wobble: up to"), what="the wobble in the readout")
         with freekick._lock:
             assert np.abs(freekick.state.flight.knuckle).max() > 0.1  # the side force acts
-            wobble = knuckle_wobble_m(freekick.state)
+            wobble = knuckle_wobble_m(freekick.params, freekick.state)
         # Cohen et al. 2012, Texier et al. 2016: about one ball diameter (0.22 m) at a striker's speed.
         assert wobble is not None and 0.05 < wobble < 0.6
         client.wait_for_gui("Random draw")

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
+import re
 
 import numpy as np
 import pytest
@@ -419,3 +420,32 @@ def test_contacts_that_read_alike_are_said_once() -> None:
     assert play_words(thrice).startswith("Hits the left post at 1.5 m 3×, ")
     alternating = dataclasses.replace(played, events=(post, ball.Event(1.1, "ground", (0.0, 3.0, 0.11)), post))
     assert play_words(alternating).startswith("Hits the left post at 1.5 m, bounces, hits the left post at 1.5 m, ")
+
+
+# Kind: one quantity measured along two different axes. At a 45° spot the readout said "up to 0.11 m off the
+# spinless path: swerves 0.19 m right at 30 m": the "up to" took world y for sideways, the swerves the direction of
+# the kick. Both now measure square to the launch heading, so no swerve or rise named exceeds the "up to".
+@pytest.mark.parametrize(
+    ("angle_deg", "azimuth_deg", "seed"),
+    [(45.0, 0.0, 7), (0.0, 0.0, 7), (-30.0, 0.0, 3), (30.0, 6.0, 11), (-45.0, -8.0, 0), (15.0, 3.0, 5)],
+)
+def test_the_knuckle_wobble_bounds_every_swerve_it_names(
+    freekick: FreeKickScene, angle_deg: float, azimuth_deg: float, seed: int
+) -> None:
+    readout = _show(
+        freekick, knuckle=True, spin_rev_s=0.0, knuckle_seed=seed, angle_deg=angle_deg, azimuth_deg=azimuth_deg
+    )
+    line = next(line for line in readout.splitlines() if line.startswith("Knuckle wobble"))
+    up_to = float(re.search(r"up to \*\*([0-9.]+) m", line).group(1))  # type: ignore[union-attr]
+    named = [float(m) for m in re.findall(r"([0-9.]+) m (?:left|right|higher|lower)", line)]
+    assert named and max(named) <= up_to
+    # Against the flights themselves: the kick's offset from its ghost at equal times, square to the launch.
+    state = freekick.state
+    assert state.played is not None
+    end = min(state.flight.t[-1], state.ghost.t[-1], *(e.t for e in state.played.events[:1]))
+    times = np.linspace(0.0, end, 2000)
+    diff = np.stack([np.interp(times, state.flight.t, state.flight.position[:, k]) for k in range(3)], axis=1)
+    diff -= np.stack([np.interp(times, state.ghost.t, state.ghost.position[:, k]) for k in range(3)], axis=1)
+    launch = state.ghost.velocity[0, :2] / np.linalg.norm(state.ghost.velocity[0, :2])
+    across = np.hypot(diff[:, :2] @ np.array([-launch[1], launch[0]]), diff[:, 2])
+    assert freekick_model.knuckle_wobble_m(freekick.params, state) == pytest.approx(across.max(), abs=2e-3)
