@@ -57,8 +57,9 @@ def impact(velocity, spin, normal, surface, v_out, w_out):
     grip = -(1.0 + surface[TANGENTIAL_RESTITUTION]) * alpha / (1.0 + alpha)
     jx, jy, jz = grip * ux, grip * uy, grip * uz  # J_t/m when the ball grips
     limit = surface[FRICTION] * jn
-    if math.sqrt(jx * jx + jy * jy + jz * jz) > limit:  # it slides: J_t = −μ·J_n·û_t
-        slide = -limit / math.sqrt(ux * ux + uy * uy + uz * uz)
+    # hypot, not the root of a sum of squares: those overflow from 1e154 m/s, and the slide lost its friction
+    if math.hypot(math.hypot(jx, jy), jz) > limit:  # it slides: J_t = −μ·J_n·û_t
+        slide = -limit / math.hypot(math.hypot(ux, uy), uz)
         jx, jy, jz = slide * ux, slide * uy, slide * uz
     v_out[0], v_out[1], v_out[2] = vx + jn * nx + jx, vy + jn * ny + jy, vz + jn * nz + jz
     arm = 1.0 / (alpha * radius)  # ω' = ω − n × (J_t/m)/(α·R)

@@ -337,6 +337,21 @@ def test_mirror_images_bounce_as_mirror_images() -> None:
         np.testing.assert_allclose(w_m, -(w @ mirror), rtol=1e-13, atol=1e-12)
 
 
+# Kind: a norm taken as the root of a sum of squares. From 1e154 m/s the squares overflowed, the slide's impulse
+# became −μ·J_n/∞ = 0 and the ball bounced without friction (and below 1e-154 they underflowed the other way).
+@pytest.mark.parametrize("power", [-1020, -600, -300, -100, 0, 100, 300, 500, 511, 1000, 1010])
+def test_a_bounce_scales_with_its_velocity_and_spin_at_any_magnitude(power: int) -> None:
+    """Every term of the impulse is linear in (v, ω) together: scaled by 2^k, the result is scaled by 2^k."""
+    rng = np.random.default_rng(power + 2000)
+    v_in, w_in = rng.uniform(-20, 20, (100, 3)), rng.uniform(-300, 300, (100, 3))
+    v_in[:, 2] = -np.abs(v_in[:, 2])
+    v, w = ball.bounce(v_in, w_in)
+    scale = math.ldexp(1.0, power)
+    v_s, w_s = ball.bounce(v_in * scale, w_in * scale)
+    np.testing.assert_allclose(v_s / scale, v, rtol=1e-14, atol=0.0)
+    np.testing.assert_allclose(w_s / scale, w, rtol=1e-14, atol=0.0)
+
+
 def test_a_tilted_surface_bounces_as_the_ground_in_a_rotated_frame() -> None:
     rng = np.random.default_rng(11)
     rotation, _ = np.linalg.qr(rng.normal(size=(3, 3)))
