@@ -520,6 +520,24 @@ def verdict_words(result: str, crossing: NDArray[np.float64] | None) -> str:
     return VERDICT_WORDS[result]
 
 
+def free_flight_result(state: KickState) -> str:
+    """The free flight's verdict where it crosses the goal's plane, with the goal's frame in it: the kernel's free
+    flight has no posts or bar and calls a ball not wholly inside the goal mouth wide or over, but one whose centre
+    crosses within a ball's and a post's radius of a post's axis, or of the bar's, meets the frame there ("post",
+    "bar"; a ball centred 2 cm inside the post was "wide")."""
+    o, post = state.outcome, ball.Pitch.post_radius_m
+    if o.result not in ("wide", "over") or o.goal_point is None:
+        return str(o.result)
+    y, z = abs(float(o.goal_point[1])), float(o.goal_point[2])
+    reach = ball.BALL_RADIUS_M + post
+    post_y, bar_z = 0.5 * ball.GOAL_WIDTH_M + post, ball.GOAL_HEIGHT_M + post
+    if (z < bar_z and abs(y - post_y) < reach) or math.hypot(y - post_y, z - bar_z) < reach:  # a post, or its corner
+        return "post"
+    if y < post_y and abs(z - bar_z) < reach:
+        return "bar"
+    return str(o.result)
+
+
 def goal_line_reached(state: KickState) -> bool:
     """Whether the ball as played on reaches the goal line where its free flight (:attr:`KickState.outcome`)
     crosses it: the free flight crosses the goal's plane and the played ball touched nothing but the goal's frame

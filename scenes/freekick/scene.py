@@ -52,6 +52,7 @@ from scenes.freekick.model import (
     chances_words,
     compute_kick,
     deflection_m,
+    free_flight_result,
     goal_line_reached,
     heat_cells,
     heat_colours,
@@ -750,8 +751,9 @@ reads it again, so a ball that bounces in front of him beats him more often than
         else:
             headline = verdict_words(result, o.goal_point if reached else None)
         lines = [f"**{headline}**"]
-        if result != o.result:
-            lines.append(f"In free flight through the goal plane: {verdict_words(o.result, o.goal_point)}")
+        free = free_flight_result(state)
+        if result != free:
+            lines.append(f"In free flight through the goal plane: {verdict_words(free, o.goal_point)}")
         lines += [
             "",
             f"Height at the wall: **{wall_height_words(state)}** (wall top {state.wall.height_m:.2f} m)",

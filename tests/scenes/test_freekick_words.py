@@ -449,3 +449,44 @@ def test_the_knuckle_wobble_bounds_every_swerve_it_names(
     launch = state.ghost.velocity[0, :2] / np.linalg.norm(state.ghost.velocity[0, :2])
     across = np.hypot(diff[:, :2] @ np.array([-launch[1], launch[0]]), diff[:, 2])
     assert freekick_model.knuckle_wobble_m(freekick.params, state) == pytest.approx(across.max(), abs=2e-3)
+
+
+# Kind: the free flight's verdict read without the goal's frame. "In free flight through the goal plane: Over the
+# bar" stood beside "z = 2.43 m" (the bar's underside is 2.44 m), and "Wide of the post" beside "y = −3.64 m" (its
+# inside edge is 3.66 m): the free flight has no frame and calls a ball not wholly inside wide or over. A crossing
+# that overlaps a post or the bar meets it, as the pitch's verdict says.
+@pytest.mark.parametrize(
+    ("changes", "headline"),
+    [
+        ({"distance_m": 12.0, "angle_deg": 45.0}, "Hits the bar"),
+        ({"knuckle": True, "spin_rev_s": 0.0, "knuckle_seed": 7}, "Hits the post"),
+    ],
+)
+def test_a_free_flight_into_the_frame_is_not_called_wide_or_over(
+    freekick: FreeKickScene, changes: dict[str, object], headline: str
+) -> None:
+    readout = _show(freekick, **changes)
+    assert readout.splitlines()[0].strip() == f"**{headline}**"
+    assert "In free flight through the goal plane" not in readout
+
+
+def test_the_free_flights_words_agree_with_the_crossing_they_stand_beside(freekick: FreeKickScene) -> None:
+    post_axis, bar_axis = 0.5 * ball.GOAL_WIDTH_M + 0.06, ball.GOAL_HEIGHT_M + 0.06
+    reach = ball.BALL_RADIUS_M + 0.06
+    said = set()
+    for azimuth, elevation in itertools.product(np.linspace(-16.0, 4.0, 21), (12.0, 17.0, 19.0)):
+        readout = _show(freekick, keeper=False, azimuth_deg=float(azimuth), elevation_deg=elevation)
+        crossing = freekick.state.outcome.goal_point
+        line = next((line for line in readout.splitlines() if line.startswith("In free flight through")), None)
+        if line is None or crossing is None:
+            continue
+        y, z = abs(crossing[1]), crossing[2]
+        words = line.split(": ", 1)[1].strip()
+        said.add(words)
+        if words == "Wide of the post":
+            assert y - post_axis >= reach or z > bar_axis + reach, (azimuth, elevation, crossing)
+        elif words == "Over the bar":
+            assert z - bar_axis >= reach and y < post_axis, (azimuth, elevation, crossing)
+        elif words == "GOAL":
+            assert y <= post_axis - reach and z <= bar_axis - reach, (azimuth, elevation, crossing)
+    assert said  # the sweep crosses posts and bar: the pitch and the free flight differ somewhere
