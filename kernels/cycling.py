@@ -927,7 +927,7 @@ def martin_power(
     aero, rolling, bearings, climbing, kinetic, efficiency = np.broadcast_arrays(
         aero, rolling, bearings, climbing, kinetic, efficiency
     )
-    wheel = aero + rolling + bearings + climbing + kinetic
+    wheel = np.asarray(aero + rolling + bearings + climbing + kinetic)  # 0-d sums are numpy scalars, not arrays
     total = np.where(wheel > 0.0, wheel / efficiency, wheel)
     return MartinPower(
         aero=aero.copy(),

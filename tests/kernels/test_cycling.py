@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -10,6 +11,7 @@ from helpers import riders
 from helpers.properties import examples
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from numpy.typing import NDArray
 
 from kernels import cycling
 
@@ -118,6 +120,17 @@ def test_power_broadcasts_over_arrays() -> None:
     p = cycling.power(speeds, 0.3, 80.0, 0.004, grade=grades)
     assert p.total.shape == (5, 3)
     assert float(p.climbing[2, 1]) == pytest.approx(80 * G * math.sin(math.atan(0.05)) * float(speeds[2, 0]))
+
+
+# Kind: one field of a result of another type. martin_power's wheel was a numpy scalar where its six other fields
+# were 0-d arrays (a sum of 0-d arrays is a scalar); every field is an array of the inputs' broadcast shape.
+@pytest.mark.parametrize("speed", [10.0, np.array(10.0), np.array([8.0, 12.0]), np.full((2, 3), 9.0)])
+def test_every_power_term_is_an_array_of_the_inputs_shape(speed: float | NDArray[np.float64]) -> None:
+    shape = np.shape(speed)
+    for result in (cycling.power(speed, 0.3, 80.0, 0.004), cycling.martin_power(speed, 0.3, 80.0, 0.004)):
+        for field in dataclasses.fields(result):
+            value = getattr(result, field.name)
+            assert type(value) is np.ndarray and value.shape == shape, (type(result).__name__, field.name)
 
 
 @given(
