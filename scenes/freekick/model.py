@@ -663,8 +663,8 @@ def spot_odds_map(p: FreeKickParams, progress: Callable[[float], object] | None 
 
 
 HEAT_STOPS = np.array([[0.0, 20, 20, 110], [0.35, 170, 20, 150], [0.7, 240, 80, 20], [1.0, 255, 240, 40]])
-"""The heat map's colour ramp: (share, R, G, B) stops from no goals (dark purple) through red to every strike a
-goal (pale yellow); every stop stands out from the grass."""
+"""The heat map's colour ramp: (share, R, G, B) stops from no goals (dark blue) through magenta and orange to every
+strike a goal (yellow), as docs/freekick.md says; every stop stands out from the grass."""
 
 
 def heat_colours(chance: NDArray[np.float64]) -> NDArray[np.uint8]:
