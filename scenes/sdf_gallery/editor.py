@@ -156,17 +156,30 @@ def _no_surface(field: EditorField, resolution: int) -> str:
     return f"{message} (change sdf() or the bounds)"
 
 
-def cut_by_bounds(field: EditorField, vertices: np.ndarray) -> str:
-    """What to tell a person whose field crosses its bounds: there marching cubes leaves the mesh open (vertices on
-    the box's faces, where the field is still inside); "" for a shape inside them."""
+def mesh_warning(field: EditorField, vertices: np.ndarray, faces: np.ndarray) -> str:
+    """What to tell a person whose field meshes but not as they would want; "" for a closed shape inside its bounds.
+
+    A field that crosses its bounds: there marching cubes leaves the mesh open (vertices on the box's faces, where
+    the field is still inside). A field inside out (−sdf: negative outside its surface): its closed mesh encloses a
+    negative volume (Σ v₀·(v₁ × v₂)/6 over the faces, by the divergence theorem; marching cubes winds them outward
+    from sdf ≤ 0), and the ray-march, which starts outside, stops on the box."""
     lo, hi = np.asarray(field.bounds, dtype=np.float64)
     tol = 1e-6 * float(np.max(hi - lo))
-    if not len(vertices) or not np.any((np.abs(vertices - lo) < tol) | (np.abs(vertices - hi) < tol)):
+    if not len(vertices):
         return ""
-    return (
-        f"⚠ The shape reaches the ±{field.half_size:g} m box and is cut open there (the mesh and its downloads have "
-        "holes). Raise Editor bounds half size to take it all in."
-    )
+    if np.any((np.abs(vertices - lo) < tol) | (np.abs(vertices - hi) < tol)):
+        return (
+            f"⚠ The shape reaches the ±{field.half_size:g} m box and is cut open there (the mesh and its downloads "
+            "have holes). Raise Editor bounds half size to take it all in."
+        )
+    v0, v1, v2 = (vertices[faces[:, k]].astype(np.float64) for k in range(3))
+    if np.einsum("ij,ij->", v0, np.cross(v1, v2)) < 0.0:
+        return (
+            "⚠ The field is inside out: sdf() is negative outside its surface (as −sdf is), so the mesh and its "
+            "downloads face inward, and the ray-march, which starts outside, stops on the box. Negate sdf() to "
+            "turn it right side out."
+        )
+    return ""
 
 
 def mesh_field(field: EditorField, resolution: int) -> tuple[np.ndarray, ...]:

@@ -280,7 +280,7 @@ IoU is lowest when a box edge is on the silhouette.
                 api.add_html(EDITOR_STYLE)
                 self.apply = mark_costly(gui.add_button("Apply"))  # compiles GLSL, remeshes
                 self.editor_status = gui.add_markdown(EDITOR_HELP if allowed else EDITING_OFF)
-                self.bounds_note = gui.add_markdown("", visible=False)
+                self.mesh_note = gui.add_markdown("", visible=False)
             self.scene_controls = build_controls(gui, p, SCENE_FIELDS)
             with self.scene_controls.folders["Blend and mesh"]:
                 self.progress = gui.add_progress_bar(0.0, visible=False)
@@ -757,9 +757,9 @@ IoU is lowest when a box edge is on the silhouette.
                 else:
                     self.mesh_vertices, self.mesh_faces, self.mesh_colors = vertices, faces, colors
                     self.mesh_shape = shape
-                    cut = editor.cut_by_bounds(shape, vertices) if isinstance(shape, EditorField) else ""
-                    set_if_changed(self.bounds_note, "content", cut)
-                    set_if_changed(self.bounds_note, "visible", bool(cut))
+                    note = editor.mesh_warning(shape, vertices, faces) if isinstance(shape, EditorField) else ""
+                    set_if_changed(self.mesh_note, "content", note)
+                    set_if_changed(self.mesh_note, "visible", bool(note))
                     self.mesh_scene = shape if isinstance(shape, sdf.Scene) else None
                     grid_scene = shape if isinstance(shape, sdf.Scene) else sdf.default_scene()
                     bounds = None if isinstance(shape, sdf.Scene) else shape.bounds

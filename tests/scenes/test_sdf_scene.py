@@ -987,18 +987,39 @@ def test_a_field_cut_open_by_its_bounds_says_so_and_a_whole_one_does_not(
         apply_glsl(client, "float sdf(vec3 p) { return sd_box(p, vec3(0.3, 0.3, 0.7)); }\n")
         wait_until(lambda: scene.editor_serial == 1, "the box applied")
         mesh = trimesh.Trimesh(scene.mesh_vertices, scene.mesh_faces)
-        assert mesh.is_watertight and not scene.bounds_note.visible
+        assert mesh.is_watertight and not scene.mesh_note.visible
         meshes = scene.mesh_serial
         client.set_value("Editor bounds half size (m)", 0.5)
         wait_until(lambda: scene.mesh_serial > meshes and scene.params.editor.half_size == 0.5, "the remesh")
         mesh = trimesh.Trimesh(scene.mesh_vertices, scene.mesh_faces)
         assert not mesh.is_watertight  # the box's ends (±0.7 m in z) lie outside ±0.5 m
-        assert scene.bounds_note.visible and "reaches the ±0.5 m box and is cut open" in scene.bounds_note.content
+        assert scene.mesh_note.visible and "reaches the ±0.5 m box and is cut open" in scene.mesh_note.content
         meshes = scene.mesh_serial
         client.set_value("Editor bounds half size (m)", 1.0)
         wait_until(lambda: scene.mesh_serial > meshes and scene.params.editor.half_size == 1.0, "the wider remesh")
         assert trimesh.Trimesh(scene.mesh_vertices, scene.mesh_faces).is_watertight
-        assert not scene.bounds_note.visible
+        assert not scene.mesh_note.visible
+
+
+@pytest.mark.gl
+def test_a_field_turned_inside_out_says_so_and_its_negation_does_not(
+    server: viser.ViserServer, scene: SdfGalleryScene
+) -> None:
+    # An outside tester applied −sd_sphere: "Applied", then an IoU of 0.06 and a depth difference of 31 voxels with
+    # no word why; the mesh and its downloads faced inward (volume −0.52 m³).
+    with BrowserClient(server.get_port()) as client:
+        apply_glsl(client, "float sdf(vec3 p) { return -sd_sphere(p, 0.5); }\n")
+        wait_until(lambda: scene.editor_serial == 1, "the inside-out sphere applied")
+        assert trimesh.Trimesh(scene.mesh_vertices, scene.mesh_faces).volume < -0.5
+        assert scene.mesh_note.visible and "inside out" in scene.mesh_note.content
+        apply_glsl(client, "float sdf(vec3 p) { return sd_sphere(p, 0.5); }\n")
+        wait_until(lambda: scene.editor_serial == 2, "the sphere applied")
+        assert trimesh.Trimesh(scene.mesh_vertices, scene.mesh_faces).volume > 0.5
+        assert not scene.mesh_note.visible
+        # A hollow shell is not inside out: its closed mesh encloses the shell's positive volume.
+        apply_glsl(client, "float sdf(vec3 p) { return abs(sd_sphere(p, 0.5)) - 0.1; }\n")
+        wait_until(lambda: scene.editor_serial == 3, "the shell applied")
+        assert not scene.mesh_note.visible
 
 
 def _framed_tab(
