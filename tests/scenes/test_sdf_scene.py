@@ -984,9 +984,7 @@ def test_a_field_cut_open_by_its_bounds_says_so_and_a_whole_one_does_not(
     # The failing input (an outside tester): the first example in bounds of ±0.5 m meshed open at the box, with no
     # word; its downloads were not watertight and the depth difference jumped to 3.2 voxels.
     with BrowserClient(server.get_port()) as client:
-        apply_glsl(client, "float sdf(vec3 p) { return sd_box(p, vec3(0.3, 0.3, 0.7)); }\n")
-        wait_until(lambda: scene.editor_serial == 1, "the box applied")
-        mesh = trimesh.Trimesh(scene.mesh_vertices, scene.mesh_faces)
+        mesh = _applied(client, scene, "float sdf(vec3 p) { return sd_box(p, vec3(0.3, 0.3, 0.7)); }\n")
         assert mesh.is_watertight and not scene.mesh_note.visible
         meshes = scene.mesh_serial
         client.set_value("Editor bounds half size (m)", 0.5)
@@ -1008,18 +1006,21 @@ def test_a_field_turned_inside_out_says_so_and_its_negation_does_not(
     # An outside tester applied −sd_sphere: "Applied", then an IoU of 0.06 and a depth difference of 31 voxels with
     # no word why; the mesh and its downloads faced inward (volume −0.52 m³).
     with BrowserClient(server.get_port()) as client:
-        apply_glsl(client, "float sdf(vec3 p) { return -sd_sphere(p, 0.5); }\n")
-        wait_until(lambda: scene.editor_serial == 1, "the inside-out sphere applied")
-        assert trimesh.Trimesh(scene.mesh_vertices, scene.mesh_faces).volume < -0.5
+        assert _applied(client, scene, "float sdf(vec3 p) { return -sd_sphere(p, 0.5); }\n").volume < -0.5
         assert scene.mesh_note.visible and "inside out" in scene.mesh_note.content
-        apply_glsl(client, "float sdf(vec3 p) { return sd_sphere(p, 0.5); }\n")
-        wait_until(lambda: scene.editor_serial == 2, "the sphere applied")
-        assert trimesh.Trimesh(scene.mesh_vertices, scene.mesh_faces).volume > 0.5
+        assert _applied(client, scene, "float sdf(vec3 p) { return sd_sphere(p, 0.5); }\n").volume > 0.5
         assert not scene.mesh_note.visible
         # A hollow shell is not inside out: its closed mesh encloses the shell's positive volume.
-        apply_glsl(client, "float sdf(vec3 p) { return abs(sd_sphere(p, 0.5)) - 0.1; }\n")
-        wait_until(lambda: scene.editor_serial == 3, "the shell applied")
+        _applied(client, scene, "float sdf(vec3 p) { return abs(sd_sphere(p, 0.5)) - 0.1; }\n")
         assert not scene.mesh_note.visible
+
+
+def _applied(client: BrowserClient, scene: SdfGalleryScene, source: str) -> trimesh.Trimesh:
+    """The mesh of ``source`` once the editor has applied it."""
+    applied = scene.editor_serial
+    apply_glsl(client, source)
+    wait_until(lambda: scene.editor_serial == applied + 1, "the field applied")
+    return trimesh.Trimesh(scene.mesh_vertices, scene.mesh_faces)
 
 
 def _framed_tab(
