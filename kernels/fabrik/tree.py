@@ -343,13 +343,13 @@ def _solve_tree_core(
 
     Leaves the returned pose in ``p``: the last iterate where it keeps every limit and clears every live obstacle
     (and, after a restart, is not worse than the best pose before or after it), else the best (smallest largest
-    error) that did, else the last. Fills ``history`` (max_iterations + 1, E) with
-    the iterates' errors, NaN past the last iteration, ``final`` (E,) with the returned pose's errors and ``codes``
-    (E,) with each effector's status: reached (error ≤ tolerance, on an admissible pose); unreachable (farther from
-    the root than its path's length); blocked (target inside a live obstacle, or the pose touching one); limited
-    (stopped at a fixed point while limits or obstacles hold the tree); infeasible (no admissible pose seen);
-    max_iterations. Returns the iterations run. Every test is relative to the tree's size (no absolute floor), so
-    a tree scaled by a power of 2 gives the same bits scaled."""
+    error) that did, else the last. Fills ``history`` (max_iterations + 1, E) with the iterates' errors, NaN past
+    the last iteration, ``final`` (E,) with the returned pose's errors and ``codes`` (E,) with each effector's
+    status: reached (error ≤ tolerance, on an admissible pose); unreachable (farther from the root than its path's
+    length); blocked (target inside a live obstacle, or the pose touching one); limited (stopped at a fixed point
+    while limits or obstacles hold the tree); infeasible (no admissible pose seen); max_iterations. Returns the
+    iterations run. Every test is relative to the tree's size (no absolute floor), so a tree scaled by a power of 2
+    gives the same bits scaled."""
     count = p.shape[0]
     root = int(order[0])
     for row in range(history.shape[0]):  # loops, here and below: slice assignments compile overloads of their own
