@@ -49,13 +49,10 @@ from scenes.freekick.model import (
     after_contact,
     aim_at,
     ball_spot,
-    chances_words,
     compute_kick,
     deflection_m,
     free_flight_result,
     goal_line_reached,
-    heat_cells,
-    heat_colours,
     keeper_limbs,
     keeper_show_time,
     keeper_words,
@@ -64,8 +61,6 @@ from scenes.freekick.model import (
     landing_words,
     map_marker_words,
     margin_words,
-    odds_map_settings,
-    odds_map_words,
     outcome_map,
     outcome_map_image,
     play_words,
@@ -76,13 +71,20 @@ from scenes.freekick.model import (
     spin_axis,
     spin_vector,
     spin_words,
-    spot_odds_map,
-    strike_chances,
     verdict_words,
     wall_axes,
     wall_height_words,
     wobble_path,
     wobble_words,
+)
+from scenes.freekick.odds import (
+    chances_words,
+    heat_cells,
+    heat_colours,
+    odds_map_settings,
+    odds_map_words,
+    spot_odds_map,
+    strike_chances,
 )
 from scenes.freekick.props import (
     AFTER_COLOUR,
@@ -210,9 +212,9 @@ reads it again, so a ball that bounces in front of him beats him more often than
         self.aim_message = ""
         self._odds_version = 0
         self.odds_map: NDArray[np.float64] | None = None
-        """The goal chance over the pitch's spots (:func:`~scenes.freekick.model.spot_odds_map`), once asked for."""
+        """The goal chance over the pitch's spots (:func:`~scenes.freekick.odds.spot_odds_map`), once asked for."""
         self.odds_map_params: FreeKickParams | None = None
-        """The strike (:func:`~scenes.freekick.model.odds_map_settings`) the shown odds map is for."""
+        """The strike (:func:`~scenes.freekick.odds.odds_map_settings`) the shown odds map is for."""
         self.odds_map_asked: FreeKickParams | None = None
         """The strike of the odds map being computed (the latest click's), None once it is done or has failed: what
         the status says follows it, not the worker, whose own job is still running when it shows its result."""

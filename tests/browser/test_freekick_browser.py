@@ -40,7 +40,8 @@ from helpers.waiting import wait_until
 
 from scenes._framing import NOTICE_PX, Lens, project_points
 from scenes.freekick import FreeKickParams, FreeKickScene
-from scenes.freekick.model import PRESETS, VIEW_LABELS, ViewName, ball_spot, heat_cells, resample
+from scenes.freekick.model import PRESETS, VIEW_LABELS, ViewName, ball_spot, resample
+from scenes.freekick.odds import heat_cells
 from scenes.freekick.props import FORCE_COLOURS, KNUCKLE_COLOUR, PATH_COLOUR
 from scenes.freekick.views import frame_view, view_points
 

@@ -44,6 +44,8 @@ from scenes.freekick.model import (
     resample,
     sample_rows,
     spin_words,
+)
+from scenes.freekick.odds import (
     spot_odds_map,
     strike_chances,
 )
