@@ -59,8 +59,9 @@ def impact(velocity, spin, normal, surface, v_out, w_out):
     limit = surface[FRICTION] * jn
     # hypot, not the root of a sum of squares: those overflow from 1e154 m/s, and the slide lost its friction
     if math.hypot(math.hypot(jx, jy), jz) > limit:  # it slides: J_t = −μ·J_n·û_t
-        slide = -limit / math.hypot(math.hypot(ux, uy), uz)
-        jx, jy, jz = slide * ux, slide * uy, slide * uz
+        # û_t first: −μ·J_n/|u_t| underflowed to 0 for a spin 10⁴⁰⁰ times the speed (no friction again)
+        norm = math.hypot(math.hypot(ux, uy), uz)
+        jx, jy, jz = -limit * (ux / norm), -limit * (uy / norm), -limit * (uz / norm)
     v_out[0], v_out[1], v_out[2] = vx + jn * nx + jx, vy + jn * ny + jy, vz + jn * nz + jz
     arm = 1.0 / (alpha * radius)  # ω' = ω − n × (J_t/m)/(α·R)
     w_out[0] = wx - (ny * jz - nz * jy) * arm

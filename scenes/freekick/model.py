@@ -534,6 +534,8 @@ def free_flight_result(state: KickState) -> str:
         return "post"
     if y < post_y and abs(z - bar_z) < reach:
         return "bar"
+    if y < post_y and z > bar_z:  # clear over the bar between the posts' axes: over, though not wholly inside
+        return "over"
     return str(o.result)
 
 

@@ -352,6 +352,21 @@ def test_a_bounce_scales_with_its_velocity_and_spin_at_any_magnitude(power: int)
     np.testing.assert_allclose(w_s / scale, w, rtol=1e-14, atol=0.0)
 
 
+# The same family, apart: a spin 10⁴⁰⁰ times the speed made −μ·J_n/|u_t| underflow to 0 (no friction again).
+@pytest.mark.parametrize(
+    ("speed", "spin"), [(1.0, 1e10), (1e-100, 1e200), (1e-150, 1e150), (1e-160, 1e160), (1e-300, 1e100)]
+)
+def test_a_ball_spinning_far_faster_than_it_moves_slides_at_any_magnitude(speed: float, spin: float) -> None:
+    """The contact point's velocity is the spin's alone, so the ball slides along −û_t set by the spin: the
+    velocity after is the speed's scale times one result (μ = 0.6, e_n = 0.6), and the spin barely changes."""
+    v_in, w_in = np.array([3.0, 1.0, -5.0]), np.array([10.0, -20.0, 30.0]) / 0.11
+    v, w = ball.bounce(speed * v_in, spin * w_in)
+    u = np.cross(w_in, [0.0, 0.0, -ball.BALL_RADIUS_M])  # ω × r_c, r_c = −R·n: the contact point's velocity
+    expected = v_in + 8.0 * np.array([0.0, 0.0, 1.0]) - 0.6 * 8.0 * u / np.linalg.norm(u)  # J_n/m = 1.6·5
+    np.testing.assert_allclose(v / speed, expected, rtol=1e-9)  # u_t is the spin's to 1e-10 at (1, 1e10)
+    np.testing.assert_allclose(w / spin, w_in, rtol=1e-8)
+
+
 def test_a_tilted_surface_bounces_as_the_ground_in_a_rotated_frame() -> None:
     rng = np.random.default_rng(11)
     rotation, _ = np.linalg.qr(rng.normal(size=(3, 3)))
