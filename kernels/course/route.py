@@ -284,13 +284,14 @@ def _end_line(
     where it is shorter), at the distances ``at``: the mean plus the slope ∫ z·(s − c) ds / ∫ (s − c)² ds about the
     window's middle c, times the distance from c. The integrals are exact (z is linear on each segment) and taken
     from the route's start, so they stay as small as the window."""
-    e = distance - distance[0]
+    width = min(window_m, float(distance[-1] - distance[0]))
+    within = min(int(np.searchsorted(distance, distance[0] + width, side="right")) + 1, distance.shape[0])
+    e, z = distance[:within] - distance[0], z[:within]  # the window's segments only: a long route costs nothing more
     integral, slope = _running(e, z)
     # ∫ z(s)·(s − s₀) ds over each segment: a cubic in the segment's length.
     run = np.diff(e)
     piece = z[:-1] * e[:-1] * run + (z[:-1] + slope * e[:-1]) * run**2 / 2.0 + slope * run**3 / 3.0
     moment = np.concatenate(([0.0], np.cumsum(piece)))
-    width = min(window_m, float(e[-1]))
     j = min(int(np.searchsorted(e, width, side="right")) - 1, e.shape[0] - 2)
     t = width - e[j]
     zeroth = _integral_at(e, z, integral, slope, width)
