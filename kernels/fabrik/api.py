@@ -367,7 +367,8 @@ def two_bone(
         lower_length: elbow-to-end length (m), ≥ 0.
         target: (d,) target (m).
         bend_direction: (d,) the side the elbow bends toward (only its part perpendicular to the root–target line
-            counts; if it has none, a fixed perpendicular is used).
+            counts; if it has none, a fixed perpendicular is used). For a target on the root, where there is no
+            root–target line, the folded chain lies along it with the elbow toward it.
 
     Returns:
         (3, d) root, elbow and end positions (m).
@@ -393,7 +394,8 @@ def two_bone(
     bend = bend / largest if largest > 0.0 else bend
     distance = float(np.linalg.norm(offset))
     scale = max(upper + lower, distance, 1.0)
-    axis = offset / distance if distance > _TINY * scale else _fallback_axis(bend, dim)
+    on_root = distance <= _TINY * scale
+    axis = offset / distance if not on_root else _toward(bend, dim)
     side = bend - float(bend @ axis) * axis
     side_norm = float(np.linalg.norm(side))
     side = side / side_norm if side_norm > _TINY else _perpendicular_numpy(axis)
@@ -404,6 +406,9 @@ def two_bone(
     else:
         cos_alpha = (upper**2 + reach**2 - lower**2) / (2.0 * upper * reach)
     cos_alpha = min(1.0, max(-1.0, cos_alpha))
+    if on_root and cos_alpha < 0.0:
+        # No root–target line: the folded chain lies on the line of bend_direction, its elbow toward it.
+        axis = -axis  # the elbow, upper·cos α·axis with cos α = −1, then lies toward bend_direction
     sin_alpha = math.sqrt(max(0.0, 1.0 - cos_alpha**2))
     elbow = upper * (cos_alpha * axis + sin_alpha * side)
     end_offset = reach * axis - elbow
@@ -526,14 +531,14 @@ def _perpendicular_numpy(axis: NDArray[np.float64]) -> NDArray[np.float64]:
     return np.array([x, y, z])
 
 
-def _fallback_axis(bend: NDArray[np.float64], dim: int) -> NDArray[np.float64]:
-    """Any unit axis perpendicular to ``bend`` (or +last axis), for a target on the root."""
+def _toward(bend: NDArray[np.float64], dim: int) -> NDArray[np.float64]:
+    """``bend`` as a unit axis (or +last axis where it is zero): the line a chain folds on for a target on the root."""
     norm = float(np.linalg.norm(bend))
     if norm <= _TINY:
         axis = np.zeros(dim)
         axis[-1] = 1.0
         return axis
-    return _perpendicular_numpy(bend / norm)
+    return bend / norm
 
 
 _F64 = NDArray[np.float64]

@@ -473,8 +473,10 @@ def _solve_tree_core(
         worst = _tree_errors(p, goal, effectors, history, iteration)
         # Checked only where it matters, since it costs a pass of its own: a pose within tolerance, or a better one
         # where the last iterate may not be the one returned (live obstacles can leave it cutting one; after a
-        # restart the best is returned). The backward stage keeps every limit on every iterate.
-        track = any_live or not retry
+        # restart the best is returned), or any while none was admissible (a start that breaks a limit: without
+        # it, "infeasible" was said of iterates that kept every one). The backward stage keeps every limit on
+        # every iterate.
+        track = any_live or not retry or best_worst == np.inf
         admissible = (worst <= tolerance or (track and worst < best_worst)) and _tree_admissible(
             p, parents, order, table, rest, tiny, has_limits, obstacles
         )

@@ -464,6 +464,27 @@ def test_two_bone_matches_the_law_of_cosines() -> None:
     np.testing.assert_allclose(fabrik.two_bone([0, 0], 1.0, 2.0, [0.5, 0.0], [0, 1])[2], [1.0, 0.0], atol=1e-12)
 
 
+# Kind: a degenerate case that drops an argument. With the target on the root there is no root–target line, and the
+# elbow went to a fixed perpendicular of bend_direction: two_bone([0, 0], 1, 1, [0, 0], [1, 0]) put it at (0, −1).
+@pytest.mark.parametrize(
+    ("upper", "lower", "bend", "elbow", "end"),
+    [
+        (1.0, 1.0, [1.0, 0.0], [1.0, 0.0], [0.0, 0.0]),  # folded onto the root
+        (1.0, 0.5, [0.0, 2.0], [0.0, 1.0], [0.0, 0.5]),  # the inner radius: the end as near as it comes
+        (0.5, 1.0, [3.0, 4.0], [0.3, 0.4], [-0.3, -0.4]),
+        (1.0, 1.0, [0.0, 0.0], [0.0, 1.0], [0.0, 0.0]),  # no bend direction: the last axis
+    ],
+)
+def test_a_target_on_the_root_folds_the_elbow_toward_the_bend_direction(
+    upper: float, lower: float, bend: list[float], elbow: list[float], end: list[float]
+) -> None:
+    joints = fabrik.two_bone([0.0, 0.0], upper, lower, [0.0, 0.0], bend)
+    np.testing.assert_allclose(joints, [[0.0, 0.0], elbow, end], atol=1e-12)
+    if any(bend):  # in 3D, about another root, the same fold
+        shifted = fabrik.two_bone([5.0, 5.0, 5.0], upper, lower, [5.0, 5.0, 5.0], [*bend, 0.0])
+        np.testing.assert_allclose(shifted - 5.0, [[0.0, 0.0, 0.0], [*elbow, 0.0], [*end, 0.0]], atol=1e-12)
+
+
 @PROPERTY
 @given(st.sampled_from([2, 3]), st.integers(0, 2**32 - 1), st.floats(0.2, 0.9))
 def test_two_bone_equals_fabrik_at_two_links(d: int, seed: int, where: float) -> None:

@@ -664,6 +664,33 @@ def test_a_restarted_tree_returns_no_worse_than_before_the_restart(
     assert result.error.max() <= worst[-1] + 1e-12  # never worse than the last iterate
 
 
+# Kind: "infeasible" said of iterates that keep every limit. A Y tree whose start broke its hinges (±0.01 rad, or
+# none at all) was never checked again, since the backward stage keeps every limit, and was reported infeasible.
+@pytest.mark.parametrize("half_range", [0.01, 0.0])
+def test_a_start_that_breaks_a_limit_is_not_infeasible_once_an_iterate_keeps_them(half_range: float) -> None:
+    joints = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.5, 0.0, 1.8], [-0.5, 0.0, 1.8]])
+    hinge = fabrik.Hinge((0.0, 1.0, 0.0), -half_range, half_range)
+    result = fabrik.solve_tree(
+        [-1, 0, 1, 1], joints, {2: [0.8, 0.0, 1.2], 3: [-0.8, 0.0, 1.2]}, constraints=[None, hinge, hinge, hinge]
+    )
+    assert result.status == ("limited", "limited")
+    for branch in ([0, 1, 2], [0, 1, 3]):
+        usage = fabrik.limit_usage(result.joints[branch], [hinge, hinge])
+        assert np.all(usage <= 1.0 + 1e-9)
+
+
+@PROPERTY
+@given(SEEDS, st.floats(0.0, 0.5), st.floats(0.3, 1.5))
+def test_a_hinged_tree_without_obstacles_is_never_infeasible(seed: int, half_range: float, bent: float) -> None:
+    """The backward stage keeps every limit on every iterate: whatever the start, the first iterate is admissible."""
+    rng = np.random.default_rng(seed)
+    joints = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [bent, 0.0, 1.8], [-bent, 0.0, 1.8]])
+    hinge = fabrik.Hinge((0.0, 1.0, 0.0), -half_range, half_range)
+    targets = {2: rng.normal(size=3), 3: rng.normal(size=3)}
+    result = fabrik.solve_tree([-1, 0, 1, 1], joints, targets, constraints=[None, hinge, hinge, hinge])
+    assert "infeasible" not in result.status
+
+
 @pytest.mark.parametrize(
     ("key", "alias", "parents"),
     [(2, 2.0, [-1, 0, 1]), (1, True, [-1, 0]), (2, np.float64(2.0), [-1, 0, 1])],
