@@ -442,16 +442,25 @@ def why_short(
         reasons.append(f"obstacle {which} is in the way (the chain rests against it)")
     if params.limits:
         held = joints_at_limit(params, joints)
+        angles = fabrik.joint_angles(to_kernel(joints, params.three_d), _root_direction(params.three_d))
+        share = angles / max(math.radians(params.half_angle_deg), 1e-12)
+        free = np.delete(share, held)
         if len(held):
             names = ["the base" if j == 0 else f"joint {j + 1}" for j in held]
             verb = "is" if len(held) == 1 else "are"
-            reasons.append(f"{_listed(names)} {verb} at the {params.half_angle_deg:g}° joint limit")
+            words = f"{_listed(names)} {verb} at the {params.half_angle_deg:g}° joint limit"
+            if r.status == "limited" and len(free):
+                # Not proof that the limits hold the end off: "limited" is a fixed point of the method, and with
+                # joints to spare a closer pose can exist (a 20° chain settled 240 mm short of one 64 mm short).
+                words += (
+                    f" (the other joints bend up to {min(float(free.max()), 1.0):.0%} of it); the solver settled "
+                    "here, and a closer pose may exist"
+                )
+            reasons.append(words)
         elif r.status == "limited":
-            angles = fabrik.joint_angles(to_kernel(joints, params.three_d), _root_direction(params.three_d))
-            used = float(np.max(angles)) / max(math.radians(params.half_angle_deg), 1e-12)
             reasons.append(
-                f"under the {params.half_angle_deg:g}° joint limits the solver found no closer pose "
-                f"(its joints bend up to {min(used, 1.0):.0%} of the limit)"
+                f"under the {params.half_angle_deg:g}° joint limits the solver settled here (its joints bend up to "
+                f"{min(float(share.max()), 1.0):.0%} of the limit), and a closer pose may exist"
             )
     if r.status == "max_iterations":
         # More iterations help only where nothing else named holds the end off the target (a 0° cone, the reach).

@@ -502,6 +502,28 @@ def test_a_short_pose_says_in_words_why(scene: ArmScene, setup: dict, words: str
     assert "Short by" not in scene.readout.content
 
 
+def test_a_limited_chain_with_joints_to_spare_is_not_said_to_be_held_by_its_limits(scene: ArmScene) -> None:
+    # An outside tester: 20° cones, target (0.3, 0, 1.2), "Short by 239.7 mm: The base is at the 20° joint limit",
+    # while the other joints bent 6–14° and a pose that keeps every cone ends 63.6 mm short. "limited" is a fixed
+    # point of the solver, not proof; the words say so where joints are left to spare.
+    scene.controls["half_angle_deg"].value = 20.0
+    scene.controls["limits"].value = True
+    scene.target_gizmo.position = (0.3, 0.0, 1.2)
+    scene._apply_target()
+    report = scene.report
+    assert report is not None and report.result.status == "limited"
+    text = scene.readout.content
+    assert "the base is at the 20° joint limit (the other joints bend up to" in text.lower(), text
+    assert "a closer pose may exist" in text
+    # It does: bends of −20, 1.8, 20, 20, 20, 20° (each within the cone) clear obstacle 1 and end 63.6 mm short.
+    headings = np.cumsum(np.radians([-20.0, 1.8, 20.0, 20.0, 20.0, 20.0]))
+    ends = np.cumsum(0.25 * np.column_stack([np.sin(headings), np.cos(headings)]), axis=0)
+    closer = float(np.linalg.norm(ends[-1] - [0.3, 1.2]))
+    assert closer == pytest.approx(0.0636, abs=1e-4) and closer < report.result.error - 0.1
+    pose = np.vstack([[0.0, 0.0], ends])
+    assert clearance(np.column_stack([pose[:, 0], np.zeros(7), pose[:, 1]]), scene.obstacle_centres[0]) > 0.5
+
+
 def test_a_solve_from_another_start_is_told_in_a_users_words(scene: ArmScene) -> None:
     # The outside tester's input, on the defaults (limits off, one obstacle avoided): Link length 0.5, then Links 2.
     # The readout blamed "the joint limits", which were off; the obstacle held the arm.
