@@ -12,6 +12,7 @@ with --port must be free, or the app refuses to start.
 from __future__ import annotations
 
 import contextlib
+import errno
 import io
 import ipaddress
 import logging
@@ -106,13 +107,39 @@ def port_message(asked: int, bound: int, explicit: bool) -> str | None:
     return f"Port {asked} is already in use; serving on port {bound} instead."
 
 
+def host_problem(host: str) -> str | None:
+    """Why the app cannot listen on ``host`` at all, in words, or None. viser takes every failure to bind for a busy
+    port and tries the next one, a thousand times over: a mistyped address hung the app without a word, or was
+    refused as a busy port."""
+    try:
+        infos = socket.getaddrinfo(host, 0, type=socket.SOCK_STREAM, flags=socket.AI_PASSIVE)
+    except (socket.gaierror, UnicodeError) as error:
+        return f"--host {host!r} is not a name or address this machine can resolve ({error})."
+    family, kind, proto, _name, address = infos[0]
+    with socket.socket(family, kind, proto) as probe:
+        try:
+            probe.bind(address)  # port 0: any free port, so only the address is tried
+        except OSError as error:
+            if error.errno == errno.EADDRNOTAVAIL:
+                return (
+                    f"--host {host} is not an address of this machine, so the app cannot listen on it. Give one of "
+                    "its own addresses, 127.0.0.1 (the default, this machine only) or 0.0.0.0 (every network it "
+                    "is on)."
+                )
+            return f"The app cannot listen on --host {host}: {error.strerror or error}."
+    return None
+
+
+def browser_url(host: str, port: int) -> str:
+    """The address to open: this machine's for a wildcard bind, an IPv6 address in brackets (RFC 3986)."""
+    shown = "127.0.0.1" if host in ("0.0.0.0", "::") else host
+    return f"http://[{shown}]:{port}" if ":" in shown else f"http://{shown}:{port}"
+
+
 def port_is_free(host: str, port: int) -> bool:
     """Whether ``port`` on ``host`` can be bound now, as viser would bind it (address reuse on, so a port whose last
     connections are closing still counts as free; one another process listens on does not)."""
-    try:
-        infos = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM, flags=socket.AI_PASSIVE)
-    except socket.gaierror:
-        return True  # viser reports an address it cannot resolve in its own words
+    infos = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM, flags=socket.AI_PASSIVE)  # host_problem first
     family, kind, proto, _name, address = infos[0]
     with socket.socket(family, kind, proto) as probe:
         probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
@@ -158,13 +185,17 @@ def main(
     let_ctrl_c_stop_the_app()
     configure_logging()
     asked = DEFAULT_PORT if port is None else port
+    if port is not None and not 1 <= port <= 65535:
+        print(f"--port must be a TCP port from 1 to 65535, got {port}.", file=sys.stderr, flush=True)
+        raise SystemExit(2)
+    problem = host_problem(host)
+    if problem is not None:
+        print(problem, file=sys.stderr, flush=True)
+        raise SystemExit(2)
     set_editing_allowed(is_loopback(host) or allow_remote_glsl)
     warning = exposure_warning(host, asked, allow_remote_glsl=allow_remote_glsl)
     if warning is not None:
         print(warning, flush=True)
-    if port is not None and not 1 <= port <= 65535:
-        print(f"--port must be a TCP port from 1 to 65535, got {port}.", file=sys.stderr, flush=True)
-        raise SystemExit(2)
     if port is not None and not port_is_free(host, port):  # refuse before viser prints a URL it will not serve
         print(port_message(port, port + 1, explicit=True), file=sys.stderr, flush=True)
         raise SystemExit(2)
@@ -180,11 +211,7 @@ def main(
         if message is not None:
             print(message, flush=True)
         serve_scenes(server, scene, shared=shared)
-        shown_host = "127.0.0.1" if host in ("0.0.0.0", "::") else host
-        print(
-            f"Open http://{shown_host}:{server.get_port()} in a browser (Ctrl+C to stop).",
-            flush=True,
-        )
+        print(f"Open {browser_url(host, server.get_port())} in a browser (Ctrl+C to stop).", flush=True)
         sleep_until_a_signal()
     except KeyboardInterrupt:
         if server is not None:
@@ -228,7 +255,9 @@ def sleep_until_a_signal() -> None:
 
 
 def _stop_quietly(server: viser.ViserServer) -> None:
-    """Stop the server without viser's own farewell line: Ctrl+C answers with exactly one line."""
+    """Stop the server without viser's own farewell line: Ctrl+C answers with exactly one line, and a second Ctrl+C
+    while it stops (about a second) does not interrupt the stop with a traceback."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     with contextlib.redirect_stdout(io.StringIO()):
         server.stop()
 

@@ -7,6 +7,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 import app
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -57,3 +59,46 @@ def test_a_port_outside_the_tcp_range_is_refused_in_words() -> None:
         assert run.returncode == 2, port
         assert "--port must be a TCP port from 1 to 65535" in run.stderr and "Traceback" not in run.stderr
         assert "http://" not in run.stdout + run.stderr
+
+
+# Kind: a bind failure read as a busy port. viser tries the next port on any failure to bind, a thousand times: a
+# host that is not this machine's (--host 10.255.255.1) hung the app without a word, or, with --port, was refused
+# as "Port 8096 is already in use"; a name that does not resolve hung it too.
+def test_a_host_that_is_not_this_machines_is_refused_in_words() -> None:
+    run = subprocess.run(
+        [sys.executable, "app.py", "--host", "192.0.2.1", "--port", "8199"],  # TEST-NET-1 (RFC 5737): no machine's
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert run.returncode == 2
+    assert "--host 192.0.2.1 is not an address of this machine" in run.stderr
+    assert "already in use" not in run.stderr and "http://" not in run.stdout + run.stderr
+    assert "WARNING" not in run.stdout  # nothing is exposed: the exposure warning would mislead
+
+
+def test_host_problem_names_an_unresolvable_name_and_passes_this_machines(monkeypatch: pytest.MonkeyPatch) -> None:
+    assert app.host_problem("127.0.0.1") is None
+    assert app.host_problem("localhost") is None
+
+    def unresolvable(*args: object, **kwargs: object) -> object:
+        raise socket.gaierror(socket.EAI_NONAME, "Name or service not known")
+
+    monkeypatch.setattr(socket, "getaddrinfo", unresolvable)
+    problem = app.host_problem("not-a-host.invalid")
+    assert problem is not None and "'not-a-host.invalid' is not a name or address this machine can resolve" in problem
+
+
+@pytest.mark.parametrize(
+    ("host", "url"),
+    [
+        ("127.0.0.1", "http://127.0.0.1:8080"),
+        ("0.0.0.0", "http://127.0.0.1:8080"),
+        ("::", "http://127.0.0.1:8080"),
+        ("::1", "http://[::1]:8080"),  # it read http://::1:8080, which no browser opens
+        ("localhost", "http://localhost:8080"),
+    ],
+)
+def test_the_url_to_open_is_one_a_browser_opens(host: str, url: str) -> None:
+    assert app.browser_url(host, 8080) == url
