@@ -26,7 +26,7 @@ import logging
 import threading
 import time
 from collections.abc import Callable, Sequence
-from typing import Any, ClassVar, Generic, TypeVar
+from typing import Any, ClassVar, Generic, Literal, TypeVar
 
 import numpy as np
 import viser
@@ -107,6 +107,8 @@ class Scene(abc.ABC, Generic[P]):
         self._threads: list[threading.Thread] = []
         self._wakes: list[threading.Event] = []
         self._camera_listeners: list[Callable[[viser.CameraHandle], None]] = []
+        self._notices: dict[int, tuple[viser.ClientHandle, viser.NotificationHandle, float]] = {}
+        """The notifications :meth:`notify` showed and that may still be up, by id: (tab, handle, closes at)."""
         with self.gui_root, session.gui.add_folder("About", expand_by_default=False):
             session.gui.add_markdown(self.about)
         session.frame_camera(self.camera_position, self.camera_look_at)
@@ -131,6 +133,44 @@ class Scene(abc.ABC, Generic[P]):
         with self._lock:
             self.root.remove()
             self.gui_root.remove()
+            notices = list(self._notices.values())
+            self._notices.clear()
+        for client, notice, _ in notices:
+            self.server.remove_notification(client, notice)
+
+    def notify(
+        self,
+        client: viser.ClientHandle,
+        title: str,
+        body: str,
+        *,
+        color: Literal["red"] | None = None,
+        auto_close_seconds: float = 15.0,
+    ) -> viser.NotificationHandle:
+        """Show tab ``client`` a notification about this scene; it goes when the scene closes (a red "GPX not
+        loaded" stood over the free kick for the rest of its 15 s), or earlier by :meth:`take_down`."""
+        notice = client.add_notification(
+            title,
+            body,
+            color=color,
+            auto_close_seconds=auto_close_seconds,
+        )
+        now = time.monotonic()
+        with self._lock:
+            closed = self.closed
+            if not closed:  # kept while it may be up; those past their time are dropped as others come
+                self._notices = {key: kept for key, kept in self._notices.items() if kept[2] > now}
+                self._notices[id(notice)] = (client, notice, now + auto_close_seconds)
+        if closed:
+            self.server.remove_notification(client, notice)
+        return notice
+
+    def take_down(self, notice: viser.NotificationHandle) -> None:
+        """Remove a notification :meth:`notify` showed (once; a second call, or one after the close, does nothing)."""
+        with self._lock:
+            kept = self._notices.pop(id(notice), None)
+        if kept is not None:
+            self.server.remove_notification(kept[0], notice)
 
     def join(self, timeout_s: float) -> bool:
         """After :meth:`close`, wait up to ``timeout_s`` for the scene's threads (a job in flight finishes first);

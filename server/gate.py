@@ -376,8 +376,12 @@ class Gate:
 
         # After a refusal the sender still shows its own edit: every viewer is sent the server's value.
         def send_back() -> None:
+            client = self._client(server, client_id)
+            if client is None:  # the tab has gone: nobody shows its edit
+                return
             self._echoed_at[key] = time.monotonic()
-            viser_compat.send_gui_value(handle)
+            with viser_compat.dead_writes_allowed(client):  # it may be closing now: no warning for a lost write
+                viser_compat.send_gui_value(handle)
 
         if not accepted:
             label = str(getattr(handle, "label", "?"))

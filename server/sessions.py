@@ -15,6 +15,7 @@ stays reachable from viser.
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import logging
 import threading
 import weakref
@@ -257,6 +258,18 @@ class Session:
     def send_download(client: viser.ClientHandle, filename: str, content: bytes) -> str:
         """Send tab ``client`` a download (a link in a notice); returns the notice's id, for :meth:`remove_notice`."""
         return viser_compat.send_download(client, filename, content)
+
+    def tab_may_close(self) -> AbstractContextManager[object]:
+        """A scope for a rebuild of this session's scene (a pick or a Reset): what it queues after its tab closed is
+        dropped with the tab, which tears the session down, without viser's "closed connection" warning (a tab that
+        picked a scene and closed within 50 ms logged one for each kind of message the build sent)."""
+        return dead_writes_allowed(self.client) if self.client is not None else contextlib.nullcontext()
+
+    @staticmethod
+    def remove_notification(client: viser.ClientHandle, notification: viser.NotificationHandle) -> None:
+        """Take ``notification`` down in tab ``client``, which may have closed."""
+        with dead_writes_allowed(client):
+            notification.remove()
 
     @staticmethod
     def remove_notice(client: viser.ClientHandle, notice_id: str) -> None:

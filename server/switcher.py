@@ -86,8 +86,9 @@ class SceneSwitcher:
         if self.closed:
             return
         if self.scene.key != key or rebuild:
-            self.scene.close()
-            self.scene = SCENES[key](self.server)
+            with self.server.tab_may_close():
+                self.scene.close()
+                self.scene = SCENES[key](self.server)
 
     # A browser's pick or Reset builds without writing the dropdown back: a newer pick that arrived during the
     # build is in the dropdown already, and its own callback (next in line for the lock) builds it.

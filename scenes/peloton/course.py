@@ -6,7 +6,6 @@ solver and playback. What it rides and draws comes from :mod:`scenes.peloton.cou
 
 from __future__ import annotations
 
-import contextlib
 import logging
 import math
 import re
@@ -468,9 +467,7 @@ class CourseMode:
             return
         if upload_notice is not None:
             self.server.remove_notice(client, upload_notice)
-        self.refusal_notices.append(
-            client.add_notification("GPX not loaded", body, color="red", auto_close_seconds=15.0)
-        )
+        self.refusal_notices.append(self.scene.notify(client, "GPX not loaded", body, color="red"))
 
     def load(self, data: bytes, label: str) -> bool:
         """Load a GPX file's bytes as the course; on a bad file keep the last good course and show why. An upload
@@ -486,8 +483,7 @@ class CourseMode:
 
     def _install(self, route: course_kernel.Course | None, error: str | None, label: str) -> bool:
         for notice in self.refusal_notices:  # each said what was shown then; this load changes that
-            with contextlib.suppress(Exception):  # its tab may have closed
-                notice.remove()
+            self.scene.take_down(notice)
         self.refusal_notices.clear()
         state, params, line = None, self.read_params(), self.scene.read_params()
         if route is not None:

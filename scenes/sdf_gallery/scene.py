@@ -891,10 +891,10 @@ IoU is lowest when a box edge is on the silhouette.
                 answer = self.download(fmt)
             except Exception:
                 logger.exception("sdf: export %s failed", fmt)
-                client.add_notification("The download failed", "See the server's log.")
+                self.notify(client, "The download failed", "See the server's log.", color="red")
                 return
             if answer.content is None:
-                client.add_notification(NOTHING_TO_DOWNLOAD, answer.why_not)
+                self.notify(client, NOTHING_TO_DOWNLOAD, answer.why_not)
                 return
             notice = self.server.send_download(client, answer.name, answer.content)
             with self._lock:

@@ -44,6 +44,7 @@ from scenes.peloton.course_model import (
 from scenes.peloton.meshes import rider_head_m
 from scenes.peloton.model import FORMATION_FROM_LABEL as FORMATION
 from scenes.peloton.model import group_cda
+from server.switcher import SceneSwitcher
 
 scene = scene_fixture(PelotonScene)
 
@@ -305,6 +306,25 @@ def test_a_refusal_notice_comes_down_when_the_next_route_is_loaded(server: viser
             what="the notice taken down",
         )
         assert not mode.refusal_notices
+
+
+def test_a_refusal_notice_comes_down_when_the_scene_closes(
+    server: viser.ViserServer, mode: CourseMode, switcher: SceneSwitcher
+) -> None:
+    # An outside tester: a red "GPX not loaded … Still showing Alpe d'Huez" stood over the free kick for the rest of
+    # its 15 s after a switch of scene.
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Upload GPX")
+        upload(client, "Upload GPX", "bad.gpx", b"hello, I am not a GPX file")
+        client.wait_for(lambda: bool(client.notices()), what="the notice")
+        (shown,) = [m["uuid"] for _at, m in list(client.received) if m["type"] == "NotificationShowMessage"]
+        switcher.show("freekick")
+        client.wait_for(
+            lambda: any(
+                m["type"] == "RemoveNotificationMessage" and m.get("uuid") == shown for _at, m in list(client.received)
+            ),
+            what="the notice taken down with the scene",
+        )
 
 
 CRAFTED = [

@@ -179,7 +179,7 @@ def test_a_newer_download_replaces_its_link_and_leaving_the_scene_takes_the_link
 
 
 def test_no_reference_image_downloads_nothing_with_the_same_notice(
-    server: viser.ViserServer, show_scene: MakeScene, monkeypatch: pytest.MonkeyPatch
+    server: viser.ViserServer, show_scene: MakeScene, switcher: SceneSwitcher, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     def no_gl(job: object, timeout_s: float | None = None) -> None:
         raise GLUnavailableError("No OpenGL context (test): no reference image")
@@ -193,6 +193,16 @@ def test_no_reference_image_downloads_nothing_with_the_same_notice(
         assert (kind, title) == ("notice", NOTHING_TO_DOWNLOAD)
         assert "reference image" in body
         assert scene.export("png") == ("sdf_ref.png", None)
+        # A note about this scene goes with it: it stood over the next scene until closed by hand.
+        (shown,) = [m["uuid"] for _at, m in list(client.received) if m.get("type") == "NotificationShowMessage"]
+        switcher.show("arm")
+        client.wait_for(
+            lambda: any(
+                m.get("type") == "RemoveNotificationMessage" and m.get("uuid") == shown
+                for _at, m in list(client.received)
+            ),
+            what="the notice taken down with the scene",
+        )
 
 
 # ------------------------------------------------------------------------------------------ the rule, over shapes

@@ -370,6 +370,26 @@ def test_sixteen_sessions_fit_the_budget_and_are_given_back(scene: str, budget_m
         app.close()
 
 
+def test_a_tab_that_picks_a_scene_and_closes_at_once_leaves_no_warning() -> None:
+    """An outside tester: a tab that picked another scene and closed within 50 ms logged viser's "Queued a … on a
+    closed connection" for each kind of message the new scene's build sent its dead tab."""
+    app = AppProcess()
+    try:
+        app.wait_compiled()
+        for i in range(30):
+            tab = BrowserClient(app.port)
+            tab.wait_for_gui("Scene", timeout=60)
+            options = tab.element("Scene")["props"]["options"]
+            tab.set_value("Scene", options[1 + i % 3])
+            time.sleep(0.05)  # gone while the scene it picked is being built
+            tab.close()
+        time.sleep(2.0)  # the last builds finish on viser's pool
+        assert "closed connection" not in app.log
+        assert "Traceback" not in app.log
+    finally:
+        app.close()
+
+
 def test_tab_churn_leaves_rss_flat_and_sends_nothing_to_closed_tabs() -> None:
     """Tabs opened and closed one after another, every third closed while its session is still being built."""
 
