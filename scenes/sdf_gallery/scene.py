@@ -201,6 +201,9 @@ IoU is lowest when a box edge is on the silhouette.
         """The last applied field and the seconds a pixel of its trial's moving frame took (:mod:`shaders.trial`)."""
         self._download_notices: dict[tuple[int, str], tuple[viser.ClientHandle, str]] = {}
         """The download links shown, by (tab, file name): the tab and the notice's id."""
+        self._sending = threading.Lock()
+        """Held from a link's send to its record: a second click's handler (viser's pool runs them side by side)
+        found the first link not yet recorded once its file had arrived, and left it up."""
         self._build_gui()
         self._build_world()
         self._sync_enabled_inputs()
@@ -896,17 +899,18 @@ IoU is lowest when a box edge is on the silhouette.
             if answer.content is None:
                 self.notify(client, NOTHING_TO_DOWNLOAD, answer.why_not)
                 return
-            notice = self.server.send_download(client, answer.name, answer.content)
-            with self._lock:
-                # One link a file and tab: the newer one replaces it (its file freed); the scene's close takes the
-                # rest down, so no link is left over another scene. A close that began while this one was sent has
-                # taken down the links it found: this one goes too.
-                older = self._download_notices.pop((client.client_id, answer.name), None)
-                stale = [] if older is None else [older]
-                if self.closed:
-                    stale.append((client, notice))
-                else:
-                    self._download_notices[(client.client_id, answer.name)] = (client, notice)
+            with self._sending:
+                notice = self.server.send_download(client, answer.name, answer.content)
+                with self._lock:
+                    # One link a file and tab: the newer one replaces it (its file freed); the scene's close takes
+                    # the rest down, so no link is left over another scene. A close that began while this one was
+                    # sent has taken down the links it found: this one goes too.
+                    older = self._download_notices.pop((client.client_id, answer.name), None)
+                    stale = [] if older is None else [older]
+                    if self.closed:
+                        stale.append((client, notice))
+                    else:
+                        self._download_notices[(client.client_id, answer.name)] = (client, notice)
             for link in stale:
                 self.server.remove_notice(*link)
 
