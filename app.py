@@ -107,26 +107,33 @@ def port_message(asked: int, bound: int, explicit: bool) -> str | None:
     return f"Port {asked} is already in use; serving on port {bound} instead."
 
 
+def _bind(host: str, port: int, *, reuse: bool) -> None:
+    """Bind a throwaway socket to ``host``:``port`` as viser would (``reuse``: address reuse on); raises
+    ``socket.gaierror`` for a name that does not resolve, ``OSError`` for a bind that fails."""
+    family, kind, proto, _name, address = socket.getaddrinfo(
+        host, port, type=socket.SOCK_STREAM, flags=socket.AI_PASSIVE
+    )[0]
+    with socket.socket(family, kind, proto) as probe:
+        if reuse:
+            probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        probe.bind(address)
+
+
 def host_problem(host: str) -> str | None:
     """Why the app cannot listen on ``host`` at all, in words, or None. viser takes every failure to bind for a busy
     port and tries the next one, a thousand times over: a mistyped address hung the app without a word, or was
     refused as a busy port."""
     try:
-        infos = socket.getaddrinfo(host, 0, type=socket.SOCK_STREAM, flags=socket.AI_PASSIVE)
+        _bind(host, 0, reuse=False)  # port 0: any free port, so only the address is tried
     except (socket.gaierror, UnicodeError) as error:
         return f"--host {host!r} is not a name or address this machine can resolve ({error})."
-    family, kind, proto, _name, address = infos[0]
-    with socket.socket(family, kind, proto) as probe:
-        try:
-            probe.bind(address)  # port 0: any free port, so only the address is tried
-        except OSError as error:
-            if error.errno == errno.EADDRNOTAVAIL:
-                return (
-                    f"--host {host} is not an address of this machine, so the app cannot listen on it. Give one of "
-                    "its own addresses, 127.0.0.1 (the default, this machine only) or 0.0.0.0 (every network it "
-                    "is on)."
-                )
-            return f"The app cannot listen on --host {host}: {error.strerror or error}."
+    except OSError as error:
+        if error.errno == errno.EADDRNOTAVAIL:
+            return (
+                f"--host {host} is not an address of this machine, so the app cannot listen on it. Give one of its "
+                "own addresses, 127.0.0.1 (the default, this machine only) or 0.0.0.0 (every network it is on)."
+            )
+        return f"The app cannot listen on --host {host}: {error.strerror or error}."
     return None
 
 
@@ -138,15 +145,12 @@ def browser_url(host: str, port: int) -> str:
 
 def port_is_free(host: str, port: int) -> bool:
     """Whether ``port`` on ``host`` can be bound now, as viser would bind it (address reuse on, so a port whose last
-    connections are closing still counts as free; one another process listens on does not)."""
-    infos = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM, flags=socket.AI_PASSIVE)  # host_problem first
-    family, kind, proto, _name, address = infos[0]
-    with socket.socket(family, kind, proto) as probe:
-        probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-        try:
-            probe.bind(address)
-        except OSError:
-            return False
+    connections are closing still counts as free; one another process listens on does not). Ask
+    :func:`host_problem` about the address first."""
+    try:
+        _bind(host, port, reuse=True)
+    except OSError:
+        return False
     return True
 
 
