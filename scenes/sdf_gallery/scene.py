@@ -181,6 +181,11 @@ IoU is lowest when a box edge is on the silhouette.
         self._state = threading.Lock()
         self._wanted_scene: Shape | None = None
         self._wanted_source: str | None = None
+        self._shape_choices = 0
+        """How many times the Shape menu has changed: an Apply that finishes after the menu changed leaves the shape
+        the person chose."""
+        self._source_choice = 0
+        """``_shape_choices`` when the wanted source was asked for."""
         self._wanted_resolution = self.params.resolution
         self._wanted_preview = False
         """Whether the wanted mesh came in a burst of inputs (mesh it as a preview)."""
@@ -376,6 +381,8 @@ IoU is lowest when a box edge is on the silhouette.
                 for gizmo in self.gizmos:
                     gizmo.disable_rotations = not self.params.rings
         if self.params.shape_source != before.shape_source:
+            with self._state:
+                self._shape_choices += 1
             self._sync_enabled_inputs()
             self._request_mesh()
         with self._state:
@@ -487,7 +494,7 @@ IoU is lowest when a box edge is on the silhouette.
 
     def _request_source(self, text: str) -> None:
         with self._state:
-            self._wanted_source = text
+            self._wanted_source, self._source_choice = text, self._shape_choices
         self._wake()
 
     # ----------------------------------------------------------------------------------------- showing inputs
@@ -575,7 +582,7 @@ IoU is lowest when a box edge is on the silhouette.
                 # Asked again under the turn: a request that came meanwhile may be a full mesh.
                 meshed_here = quick and self._quick_job()
                 scene, resolution = self._wanted_scene, self._wanted_resolution
-                source, preview = self._wanted_source, self._wanted_preview
+                source, preview, choice = self._wanted_source, self._wanted_preview, self._source_choice
                 self._wanted_scene = self._wanted_source = None
                 refine = self._refine
                 rested = time.monotonic() - self._scene_time >= CAMERA_REST_S
@@ -587,7 +594,7 @@ IoU is lowest when a box edge is on the silhouette.
             self._mesh_request(scene, resolution, preview)
         elif source is not None:
             self._refine = None
-            self._apply_source(source, resolution)
+            self._apply_source(source, resolution, choice)
         elif scene is None and refine is not None and rested:
             self._refine = None
             self._mesh_and_show(*refine)
@@ -653,8 +660,12 @@ IoU is lowest when a box edge is on the silhouette.
         """The latest viewer's camera, or the scene's opening one before any viewer sent one."""
         return self.viewer.camera or Camera(self.camera_position, self.camera_look_at)
 
-    def _apply_source(self, text: str, resolution: int) -> None:
-        """Check, compile, time and mesh an editor source; show it, or say why not and keep the last good one."""
+    def _apply_source(self, text: str, resolution: int, choice: int) -> None:
+        """Check, compile, time and mesh an editor source; show it, or say why not and keep the last good one.
+
+        An Apply shows the editor's field (Shape turns to the editor), unless the Shape menu was turned away from
+        the editor after it (``choice``: :attr:`_shape_choices` when it was asked for): the source is then applied
+        to the editor, and the shape chosen last stays on screen."""
         field = EditorField(text, self.params.editor_half_size)  # the bounds on screen
         start = time.perf_counter()
         try:
@@ -670,7 +681,8 @@ IoU is lowest when a box edge is on the silhouette.
                 MOVING_WIDTH_PX,
             )
             gl_service.run(lambda gl: gl.compile_field(text, moving_shading(shading)))
-            self._mesh_and_show(field, resolution)
+            if not self._turned_away(choice):
+                self._mesh_and_show(field, resolution)
         except ShaderCompileError as exc:
             self._show_editor_error(str(exc))
             return
@@ -678,9 +690,19 @@ IoU is lowest when a box edge is on the silhouette.
         with self._lock:
             if self.closed:
                 return
+            if self._turned_away(choice):
+                self.params = dataclasses.replace(self.params, editor=field)
+                self.editor_error = None
+                self.editor_serial += 1
+                self.editor_status.content = f"**Applied** in {total_ms:.0f} ms; choose GLSL editor in Shape to see it."
+                self._request_mesh()  # the chosen shape, also where the Apply took the request that chose it
+                return
             self.params = dataclasses.replace(self.params, editor=field, shape_source="editor")
             self.editor_error = None
             self.editor_serial += 1
+            with self._state:  # an older field asked for while this one compiled (Shape turned away and back)
+                if isinstance(self._wanted_scene, EditorField):
+                    self._wanted_scene = None
             source_control = self.view_controls.fields["shape_source"].control
             self.write_back(self.view_controls["shape_source"], source_control.to_gui("editor"))
             self._sync_enabled_inputs()
@@ -699,6 +721,12 @@ IoU is lowest when a box edge is on the silhouette.
             if times is not None:
                 per_pixel = times.frame_s / (MOVING_WIDTH_PX * editor.trial_height(MOVING_WIDTH_PX))
                 self._trial_cost = (field, per_pixel)
+
+    def _turned_away(self, choice: int) -> bool:
+        """Whether the Shape menu turned away from the editor since an Apply asked at ``choice`` (see
+        :meth:`_apply_source`)."""
+        with self._state:
+            return self._shape_choices != choice and self.params.shape_source != "editor"
 
     def _mesh_and_show(self, scene: Shape, resolution: int, *, preview: bool = False) -> None:
         """Mesh ``scene`` at ``resolution`` and show it; a ``preview`` goes to the 3D view only (the readouts, the

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import io
 import math
+import threading
 import time
 from collections.abc import Callable
 from typing import Any
@@ -786,6 +787,56 @@ def test_a_new_fields_first_rest_frame_is_sized_by_its_own_trial_not_the_last_fi
         per_pixel = times.frame_s / (MOVING_WIDTH_PX * (MOVING_WIDTH_PX * 5 // 8))
         width, height = gallery_rest_size(1600, 1.6, 4.0 * per_pixel)
         assert scene.view_rgb.shape[:2] == (height, width)
+
+
+TORUS_SOURCE = "float sdf(vec3 p) { return sd_torus(p, 0.8, 0.2); }\n"
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("turns", [("Primitives (panels below)",), ("Primitives (panels below)", "GLSL editor")])
+def test_a_shape_chosen_while_an_apply_compiles_is_the_one_shown(
+    server: viser.ViserServer, scene: SdfGalleryScene, monkeypatch: pytest.MonkeyPatch, turns: tuple[str, ...]
+) -> None:
+    # The failing input (an outside tester): Shape turned back to the primitives while a torus was applied. The menu
+    # went back to "GLSL editor" and said "Applied", the mesh and downloads were the primitives, and the ray-marched
+    # view the torus under the primitives' wireframe, for good. Turned away and back, the older field was meshed.
+    import scenes.sdf_gallery.editor as gallery
+
+    started, release = threading.Event(), threading.Event()
+    trial_source = gallery.trial_source
+
+    def held(*args: Any, **kwargs: Any) -> TrialTimes | None:
+        started.set()
+        release.wait(60.0)
+        return trial_source(*args, **kwargs)
+
+    monkeypatch.setattr(gallery, "trial_source", held)
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("Shape")
+        client.set_value("Shape", "GLSL editor")
+        wait_until(lambda: scene.params.shape_source == "editor", "the editor chosen")
+        apply_glsl(client, TORUS_SOURCE)
+        assert started.wait(60.0)
+        for label in turns:
+            client.set_value("Shape", label)
+            chosen = "editor" if label == "GLSL editor" else "primitives"
+            wait_until(lambda chosen=chosen: scene.params.shape_source == chosen, f"{label} chosen")
+        release.set()
+        wait_until(lambda: scene.editor_serial == 1, "the torus applied", timeout_s=60.0)
+        assert scene.worker.wait_idle(60.0)
+        assert scene.params.shape_source == chosen and scene.params.editor.source == TORUS_SOURCE
+        client.wait_for(lambda: client.value_of("Shape") == turns[-1], what="the menu as chosen")
+        if chosen == "primitives":
+            assert scene.mesh_scene == scene.params.scene() and scene.mesh_shape == scene.params.shape()
+            assert "choose GLSL editor in Shape" in scene.editor_status.content
+            client.set_value("Shape", "GLSL editor")  # coming back shows the applied torus
+            wait_until(lambda: scene.mesh_shape == scene.params.editor, "the torus meshed")
+        assert scene.worker.wait_idle(60.0)
+        assert scene.mesh_shape == scene.params.editor and scene.mesh_scene is None
+        # The torus: every vertex 0.2 m from the ring of radius 0.8 in the xz plane, within a fraction of a voxel.
+        x, y, z = scene.mesh_vertices.T
+        ring = np.hypot(np.hypot(x, z) - 0.8, y)
+        assert len(ring) > 1000 and np.abs(ring - 0.2).max() < 0.01
 
 
 @pytest.mark.gl
