@@ -64,6 +64,8 @@ IN_LINE = (
     messages.ScenePointerMessage,
 )
 """The inputs a tab's held-back or running scene switch or Reset keeps in line behind it: values, drags, clicks."""
+UNREGISTERED_MAY_SEND = (messages.ViewerCameraMessage, messages.GetRenderResponseMessage)
+"""What a tab may send before viser has registered it (at its first usable camera); any input is refused until then."""
 ECHO_AFTER_TYPING_S = 1.5
 """A value clamped up from nearer zero than the control's range (the "7" on the way to "75" in a box of 30..150)
 is sent back to its tab only after the tab has sent nothing to that control for this long: more digits may still
@@ -326,6 +328,11 @@ class Gate:
         return viser_compat.connected_client(server, client_id)
 
     def _clean(self, server: viser.ViserServer, client_id: int, message: Any) -> tuple[Any, Callable[[], None] | None]:
+        if not isinstance(message, UNREGISTERED_MAY_SEND) and self._client(server, client_id) is None:
+            # viser registers a tab at its first camera; before that it still stores and relays a value or a gizmo
+            # pose, but runs no callback: every viewer would see a control that no longer describes the picture.
+            self.log.refuse("input from a tab that has sent no camera yet", f"{type(message).__name__}")
+            return None, None
         if isinstance(message, messages.GuiUpdateMessage):
             return self._clean_gui(server, client_id, message)
         if isinstance(message, messages.TransformControlsUpdateMessage):

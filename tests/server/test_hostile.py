@@ -22,6 +22,7 @@ import pytest
 import viser
 from helpers.scenes import StubScene
 from helpers.viser_private import control_state, gizmos, gui_inputs
+from helpers.waiting import wait_until
 from helpers.wsclient import BrowserClient, connect_tab
 from hypothesis import given
 from hypothesis import strategies as st
@@ -389,6 +390,43 @@ def test_every_hostile_message_leaves_every_viewer_on_the_last_good_state(
         with BrowserClient(server.get_port()) as late:
             late.wait_for_gui(label)
             late.wait_for(lambda: same_value(late.value_of(label), good), what="the late tab's value")
+
+
+def test_a_tab_that_sent_no_camera_changes_nothing_until_it_does(
+    server: viser.ViserServer, key: str, caplog: pytest.LogCaptureFixture
+) -> None:
+    # The failing input (an outside tester, --shared): a client that never sent a camera set "Blend width k (m)" to
+    # 0.9 and View to Mesh. viser stored and relayed the values but ran no callback (it registers a tab at its first
+    # camera): every viewer and late joiner read k = 0.9 over the k = 0.25 mesh.
+    label, good, field = SENTINELS[key]
+    with (
+        two_viewers(server, key) as (switcher, _first, observer),
+        BrowserClient(server.get_port(), send_camera=False) as early,
+    ):
+        scene = switcher.scene
+        early.wait_for_gui(label)
+        with scene._lock:
+            params_before = scene.params  # type: ignore[attr-defined]
+        values_before, poses_before = server_values(server), scene_poses(server)
+        caplog.clear()
+        early.set_value(label, good)
+        for name, gizmo in gizmos(server.scene).items():  # a drag too: viser would store and relay its pose
+            early.drag_transform(name, [tuple(float(v) + 0.2 for v in gizmo.position)])
+        early.send("GuiUpdateMessage", uuid=early.uuid_of(label), updates={"value": good})  # last, to wait for
+        wait_until(
+            lambda: any(refused_kind(r).startswith("input from a tab") for r in refused_lines(caplog)), "the refusal"
+        )
+        time.sleep(0.3)  # anything let through would have reached the server and the observer by now
+        with scene._lock:
+            assert scene.params == params_before  # type: ignore[attr-defined]
+        assert_untouched_but("", server, values_before, poses_before)
+        observer.wait_for(lambda: shows_server_values(observer, server), what="the observer shows the server's")
+        assert not same_value(observer.value_of(label), good)
+        # Once it sends a camera it is a tab like any other.
+        early.send_camera()
+        early.set_value(label, good)
+        wait_until(lambda: same_value(getattr(scene.params, field), good), "the edit after its camera")
+        observer.wait_for(lambda: same_value(observer.value_of(label), good), what="the observer shows it")
 
 
 def dataclass_replace(params: Any, field: str, value: Any) -> Any:
