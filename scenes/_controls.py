@@ -73,6 +73,9 @@ class Control:
     """Largest value (slider, number)."""
     step: float | None = None
     """Step (slider, number)."""
+    decimals: int | None = None
+    """Number only: digits the box shows and takes after the point, where a value the scene sets may be finer than
+    the step (viser shows as many as the opening value, the range and the step need, and no more)."""
     options: tuple[Any, ...] = ()
     """The values a dropdown's field may take, in the order shown."""
     labels: tuple[str, ...] = ()
@@ -140,7 +143,10 @@ class Control:
                 assert self.lo is not None and self.hi is not None and self.step is not None
                 return gui.add_slider(label, self.lo, self.hi, self.step, value, **common)
             case "number":
-                return gui.add_number(label, value, min=self.lo, max=self.hi, step=self.step, **common)
+                box = gui.add_number(label, value, min=self.lo, max=self.hi, step=self.step, **common)
+                if self.decimals is not None:
+                    box.precision = self.decimals
+                return box
             case "dropdown":
                 return gui.add_dropdown(label, self.labels, initial_value=self.to_gui(value), **common)
             case "checkbox":
@@ -174,10 +180,12 @@ def number(
     lo: float | None = None,
     hi: float | None = None,
     step: float | None = None,
+    *,
+    decimals: int | None = None,
     **placement: Unpack[Placement],
 ) -> dict[str, Control]:
-    """A number box, clamped to [lo, hi] where given."""
-    return _declare(Control("number", label, lo, hi, step, **placement))
+    """A number box, clamped to [lo, hi] where given, showing ``decimals`` digits after the point where given."""
+    return _declare(Control("number", label, lo, hi, step, decimals=decimals, **placement))
 
 
 def dropdown(

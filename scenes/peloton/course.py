@@ -26,6 +26,7 @@ from scenes._framing import Lens, View, frame_clear_of_notice
 from scenes._instances import park_hidden
 from scenes._look import add_ground, mesh_glb
 from scenes.peloton.course_model import (
+    COURSE_POWER_DECIMALS,
     COURSE_POWER_RANGE_W,
     GROUP_VIEW_DIRECTION,
     LINE_VIEW_DIRECTION,
@@ -53,6 +54,7 @@ from scenes.peloton.course_model import (
     position_m,
     rider_boxes,
     split_every_m,
+    time_saved_words,
 )
 from scenes.peloton.legend import formation_table, legend_html, power_colours, power_range, riders_text
 from scenes.peloton.meshes import (
@@ -423,10 +425,10 @@ class CourseMode:
             picked_before_a_later_choice = finished is not None and finished.started_at < self._chosen_at
             if not picked_before_a_later_choice:
                 self._upload_seq += 1
-            seq = self._upload_seq
+            seq, arrived_at = self._upload_seq, time.monotonic()
             uploaded = self.upload.value
         if picked_before_a_later_choice:
-            self.scene.callback(lambda: self._tell_superseded(client, upload_notice, uploaded))(None)
+            self.scene.callback(lambda: self._tell_superseded(client, upload_notice, uploaded, "arriving"))(None)
             return
         try:
             name = str(getattr(uploaded, "name", "") or "upload")[:80]
@@ -444,7 +446,11 @@ class CourseMode:
             name, route, error = "upload", None, "the file could not be read"
 
         def install() -> None:
-            if seq != self._upload_seq:  # a newer upload arrived while this one parsed: it wins
+            with self._upload_lock:
+                superseded, chosen_since = seq != self._upload_seq, self._chosen_at > arrived_at
+            if superseded:  # a later choice of route, or a newer upload, came while this one was read: it wins
+                if chosen_since:  # the newer upload says what became of it itself
+                    self._tell_superseded(client, upload_notice, uploaded, "being read")
                 return
             if not self._install(route, error, name):
                 body = self.refusal if len(self.refusal) <= 500 else self.refusal[:499] + "…"
@@ -452,11 +458,12 @@ class CourseMode:
 
         self.scene.callback(install)(None)
 
-    def _tell_superseded(self, client: object, upload_notice: str | None, uploaded: object) -> None:
-        """Tell the tab that file ``uploaded`` arrived after a later choice of route, which stays."""
+    def _tell_superseded(self, client: object, upload_notice: str | None, uploaded: object, stage: str) -> None:
+        """Tell the tab that file ``uploaded`` was still ``stage`` ("arriving", "being read") when a later choice of
+        route was made, which stays."""
         name = str(getattr(uploaded, "name", "") or "The file")[:80]
         body = (
-            f"{name} was still arriving when you chose {self.route.name}, which stays. Upload {name} again to ride it."
+            f"{name} was still {stage} when you chose {self.route.name}, which stays. Upload {name} again to ride it."
         )
         self._tell_not_loaded(client, upload_notice, body)
 
@@ -559,7 +566,12 @@ class CourseMode:
                 self.redraw()
                 return
             note = ""
-        power = float(np.clip(round(power, 1), low, high))
+        if not note:  # as few digits as put the finish within half a second of the target (a readout's second)
+            for digits in range(1, COURSE_POWER_DECIMALS + 1):
+                rounded = round(power, digits)
+                if abs(finish_at(rounded) - target_s) < 0.5:
+                    break
+            power = rounded
         self.scene.write_back(self.controls["power_w"], power)
         # Shown under the button (it stood at the top of the folder, scrolled out of view by the time the button is
         # reached) while this ride is: its finish time is the one the note gives.
@@ -806,10 +818,10 @@ class CourseMode:
                 f"alone the same power takes {format_duration(state.solo.time_s)}"
             )
         if state.pacing is not None:
-            saved = state.pacing.time_saved_s
             text += (
                 f"  \nPacing by grade (±{p.pacing_gain_pct:.0f} %): {format_duration(state.constant.time_s)} at constant "
-                f"power → {format_duration(ride.time_s)}, **{saved:.0f} s {'saved' if saved >= 0 else 'lost'}** at the same average power"
+                f"power → {format_duration(ride.time_s)}, **{time_saved_words(state.pacing.time_saved_s)}** at the same "
+                "average power"
             )
         start = f"  \nAir at the start ({state.route.elevation_m[0]:.0f} m): "
         if p.air == "weather":
