@@ -188,7 +188,11 @@ def _clamp_cone(
     sx, sy, sz, side = _unit(vx - cos_v * ax, vy - cos_v * ay, vz - cos_v * az, 0.0, 0.0, 0.0, 1e-9)
     if side <= 1e-9:  # v (anti)parallel to the axis: any side will do
         sx, sy, sz = _perpendicular(ax, ay, az, dim)
-    # A nearly (anti)parallel v leaves the side only roughly perpendicular: renormalise so lengths stay exact.
+    # A nearly (anti)parallel v leaves the side only roughly perpendicular (v − (v·a)a cancels: its direction is off
+    # by 1e-16/|side|, and a chain folded on its root left its cone by 2.5e-9 in cos): made square to a once more.
+    along = sx * ax + sy * ay + sz * az
+    sx, sy, sz, _ = _unit(sx - along * ax, sy - along * ay, sz - along * az, sx, sy, sz, 0.5)
+    # Renormalised so lengths stay exact.
     cx, cy, cz = (
         cos_phi * ax + sin_phi * sx,
         cos_phi * ay + sin_phi * sy,

@@ -757,6 +757,9 @@ CAPS = (1, 2, 3, 5, 8, 13, 21, 34)
 
 @PROPERTY
 @given(problems(st.integers(0, 4), st.floats(0.1, 2.0)), st.sampled_from(SOLVERS), st.booleans())
+# Folded on its root (target 6e-8 of the reach from it), the second link's clamp into its 115° cone was off by
+# 2.5e-9 in cos: the side v − (v·a)a of a nearly antiparallel v cancels. The better iterate was inadmissible.
+@example(problem=_problem((2, 2, 0), 5.960464477539063e-08, 2.0, 0, 1.0), solver="fabrik", extrapolate=False)
 def test_the_returned_pose_is_the_best_admissible_pose_seen(
     problem: Problem, solver: fabrik.Solver, extrapolate: bool
 ) -> None:
@@ -792,6 +795,19 @@ def test_the_returned_pose_is_the_best_admissible_pose_seen(
             assert phi is not None or obstacles
         if result.status == "blocked":
             assert obstacles
+
+
+@pytest.mark.parametrize("phi", [1.6, 2.0, 2.5, 3.0, 3.1])
+@pytest.mark.parametrize("d", [2, 3])
+def test_a_chain_folded_onto_its_root_keeps_its_cones_exactly(phi: float, d: int) -> None:
+    """Kind: a cone clamp of a direction nearly opposite its axis. Each iterate of a chain asked to fold onto its root
+    keeps every cone to the documented 1e-12 in cos, so the best iterate is the one returned."""
+    for n, where, seed in itertools.product((2, 3), (1e-7, 6e-8, 1e-9), range(30)):
+        problem = _problem((n, d, seed), where, phi, 0, 1.0)
+        outer = fabrik.reach_limits(fabrik.link_lengths(problem.joints))[1]
+        result = problem.solve(tolerance=1e-3 * outer, max_iterations=40, solver="fabrik", extrapolate=False)
+        assert problem.admissible(result.joints), (n, where, seed)
+        assert result.error <= result.error_history[1:].min() + 1e-12 * outer, (n, where, seed)
 
 
 def test_a_limited_chain_returns_its_best_pose_not_its_last() -> None:
