@@ -170,7 +170,8 @@ original brief's prose overstates it). *Measured*: position-dependent, fitted to
 Fitton et al. 2018; Broker, Kyle & Burke 1999), fading with gap as Swiss Side's CFD does; the leader gains ~3 %
 from the rider behind (Blocken et al. 2013). *Crosswind*: the wakes trail along the apparent wind, at yaw
 ψ = atan(crosswind/(v + w)), so a line loses its shelter and an echelon angled downwind keeps it (checked against a
-2022 CFD study of five riders in a crosswind); the power's air speed is the wind along the road.
+2022 CFD study of five riders in a crosswind). The echelon keeps its 24° diagonal, so it shelters most at ψ ≈ 20–28°
+and little past 45° (real echelons steepen there). The power's air speed is the wind along the road.
 
 **Assumptions.** Steady speed, no bearing or wheel-rotation losses, CdA independent of yaw; the exponential
 atmosphere is the textbook one (ISA gives ρ about 4 % higher at 2000 m).
