@@ -430,6 +430,29 @@ def test_a_preset_menu_reads_custom_off_its_presets_and_sets_a_chosen_one(shown:
         wait_until(lambda: scene.params.crr == 0.004, "the default tyre back")
 
 
+def test_the_found_course_power_shows_every_decimal_it_has(shown: ScenePage) -> None:
+    # The box was made with a 5 W step: viser showed no decimals, so a found 25.2 W read "25" (and the finish was
+    # 70 s off a ten-hour target). The page must show the power the ride uses, as typed digits.
+    scene, page = shown.scene, shown.page
+    assert isinstance(scene, PelotonScene)
+    mode = scene.course_mode
+    try:
+        mode.enable.value = True
+        mode.controls["target_min"].value = 600.0
+        mode.solve.value = True  # what a click does, on the server
+        power = mode.params.power_w
+        assert round(power, 1) != power  # the case: more than one decimal needed
+        box = control_row(page, "Course power (W)").locator("input").first
+        box.scroll_into_view_if_needed()
+        wait_until(lambda: box.input_value() == f"{power:g}", f"the box to show {power:g} W")
+        assert "Finish **10:00:00**" in mode.readout.content
+        wait_until(lambda: "Finish 10:00:00" in visible_text(page), "the page to say the finish")
+    finally:
+        mode.controls["power_w"].value = 250.0
+        mode.enable.value = False
+        settle(shown)
+
+
 STEEP_AND_FAST = [
     NumberChange("Speed (km/h)", "speed_kmh", 80.0, 40.0),
     NumberChange("Grade (%)", "grade_pct", 20.0, 0.0),
