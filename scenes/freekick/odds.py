@@ -56,8 +56,9 @@ ODDS_MAP_STRIKES = 32
 
 
 def odds_map_settings(p: FreeKickParams) -> FreeKickParams:
-    """What the odds map of ``p`` depends on: ``p`` without its spot, its display settings and the spin a
-    Knuckleball tick keeps (the map is the same strike from every spot)."""
+    """What the odds map of ``p`` depends on: ``p`` without its spot, its display settings, its integrator (the map
+    flies RK4 at its step whatever the Integrator says) and the spin a Knuckleball tick keeps (the map is the same
+    strike from every spot)."""
     plain = FreeKickParams()
     return dataclasses.replace(
         p,
@@ -65,6 +66,7 @@ def odds_map_settings(p: FreeKickParams) -> FreeKickParams:
         angle_deg=plain.angle_deg,
         show_forces=plain.show_forces,
         view=plain.view,
+        integrator=plain.integrator,
         spin_before_knuckle_rev_s=plain.spin_before_knuckle_rev_s,
     )
 

@@ -1113,6 +1113,9 @@ def _sent_while_mapping(client: BrowserClient, freekick: FreeKickScene, then: st
         case "moving the ball":
             client.set_value("Distance to goal (m)", 25.0)
             client.wait_for(lambda: freekick.params.distance_m == 25.0, what="the ball on its new spot")
+        case "another integrator":
+            client.set_value("Integrator", "Euler, 1 ms (textbook)")
+            client.wait_for(lambda: freekick.params.integrator == "euler", what="the Euler integrator")
         case "a second click on Map":
             client.click(HEAT_BUTTON)
             client.wait_for(lambda: freekick._odds_version == 2, what="the second click")
@@ -1128,6 +1131,7 @@ def _sent_while_mapping(client: BrowserClient, freekick: FreeKickScene, then: st
         ("ticking Knuckleball", False),
         ("an aim at the goal mouth", False),
         ("moving the ball", True),  # the map is the same strike from every spot
+        ("another integrator", True),  # the map flies RK4 at 10 ms whatever the Integrator (an outside tester)
         ("a second click on Map", True),
     ],
 )
