@@ -21,8 +21,10 @@ float sdf(vec3 p);
 vec3 color(vec3 p);
 uniform vec3 u_field_lo;  // the editor's bounds (m)
 uniform vec3 u_field_hi;
-uniform float u_field_gradient;  // 1, or the largest gradient the mesher measured for a field far from a distance
-#define FIELD_DISTANCE(p) (sdf(p) / u_field_gradient)  // a division: 1 / 1e38 is below float32's normal range
+uniform float u_field_root;  // √ of 1, or of the slope the mesher measured for a field far from a distance
+// Divided twice by the root: a slope over float32's range (a ±3e38 step) fits as its root, and 1 / 1e38 would be
+// below float32's normal range.
+#define FIELD_DISTANCE(p) (sdf(p) / u_field_root / u_field_root)
 #define FIELD_COLOR(p) color(p)
 #else
 #define FIELD_DISTANCE(p) scene_distance(p)

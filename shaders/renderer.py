@@ -659,10 +659,10 @@ class Renderer:
         return prog, vao
 
     def remember_field_gradient(self, source: str, bounds: NDArray[np.float64], gradient: float) -> None:
-        """Keep what :meth:`render_field` divides ``source``'s field by in ``bounds`` (see there), at most the largest
-        float32."""
+        """Keep what :meth:`render_field` divides ``source``'s field by in ``bounds`` (see there): the shader divides
+        by its square root twice, so a slope over float32's range (a ±3e38 step) is kept whole."""
         key = (source, np.asarray(bounds, dtype=np.float64).tobytes())
-        self._field_gradients[key] = min(gradient, _FLOAT32_MAX)
+        self._field_gradients[key] = gradient
         self._field_gradients.move_to_end(key)
         while len(self._field_gradients) > _FIELD_CACHE:
             self._field_gradients.popitem(last=False)
@@ -748,7 +748,7 @@ class Renderer:
         prog, vao = self._field_program(source, f"march:{int(shading.shadows)}:{int(shading.occlusion)}")
         self._set(prog, "u_field_lo", tuple(float(v) for v in box[0]))
         self._set(prog, "u_field_hi", tuple(float(v) for v in box[1]))
-        self._set(prog, "u_field_gradient", self._field_gradients.get((source, box.tobytes()), 1.0))
+        self._set(prog, "u_field_root", math.sqrt(self._field_gradients.get((source, box.tobytes()), 1.0)))
         return self._march(prog, vao, camera, width, height, shading, _box_scissor(camera, box, width, height))
 
 
