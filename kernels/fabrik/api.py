@@ -249,6 +249,8 @@ def solve_batch(
         out_p *= scale
         history *= scale
         error *= scale
+    still = iterations == 0  # a start returned as it stands: its own coordinates, not their round trip about the root
+    out_p[still, :, :dim] = chains[still]
     return BatchSolution(
         joints=out_p[:, :, :dim].copy() if dim == 2 else out_p,
         iterations=iterations,

@@ -219,9 +219,13 @@ def solve_tree(
     history = np.empty((setup.max_iterations + 1, len(effector_ids)))
     codes = np.empty(len(effector_ids), dtype=np.int64)
     final = np.empty(len(effector_ids))
-    # As solve: divided by a power of 2 near the extent (exact), so squared norms neither overflow nor underflow
+    # As solve: about the root (a coordinate far out rounds to a share of its own size, not the tree's), and divided
+    # by a power of 2 near the extent (exact), so squared norms neither overflow nor underflow
+    anchor = p[root].copy()
+    p -= anchor
+    goal = goal - anchor
+    scale, centres, radii = 1.0, setup.centres - anchor, setup.radii
     extent = _tree_extent_entry(p, goal, effector_ids, root)
-    scale, centres, radii = 1.0, setup.centres, setup.radii
     if extent != 0.0 and not _UNSCALED[0] <= extent <= _UNSCALED[1]:
         scale = math.ldexp(1.0, math.frexp(extent)[1])
         p /= scale
@@ -250,6 +254,9 @@ def solve_tree(
         p *= scale
         history *= scale
         final *= scale
+    p += anchor
+    if iterations == 0:  # a start returned as it stands: its own coordinates, not their round trip about the root
+        p[:, :dim] = points
     return TreeSolution(
         joints=p[:, :dim].copy() if dim == 2 else p,
         effectors=effector_ids.copy(),

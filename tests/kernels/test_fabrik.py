@@ -810,6 +810,39 @@ def test_a_chain_folded_onto_its_root_keeps_its_cones_exactly(phi: float, d: int
         assert result.error <= result.error_history[1:].min() + 1e-12 * outer, (n, where, seed)
 
 
+def test_a_chain_far_from_the_origin_is_solved_as_at_the_origin() -> None:
+    """Kind: a chain whose coordinates are large against its size. A 3 cm chain 1100 m out left its cones by 1e-12
+    in cos to rounding, so its iterates were inadmissible and it returned its start, 0.039 m off where an iterate
+    was 0.0037 m off (an outside re-test: 115 of 3,000 such chains). Each chain is now solved about its root."""
+    joints = np.array(
+        [
+            [-1101.7166275810448, 33.057220158269196],
+            [-1101.7328967766075, 33.05531031125808],
+            [-1101.7345000592845, 33.061340095841494],
+            [-1101.7410781456933, 33.06544938230675],
+        ]
+    )
+    target = np.array([-1101.7277669676946, 33.02895993199057])
+    far = fabrik.solve(joints, target, cone_half_angle_rad=2.2728161511405647, max_iterations=5)
+    near = fabrik.solve(
+        joints - joints[0], target - joints[0], cone_half_angle_rad=2.2728161511405647, max_iterations=5
+    )
+    assert far.error == pytest.approx(0.0037436, abs=1e-7) and far.status == near.status == "unreachable"
+    assert far.error == pytest.approx(near.error, rel=1e-9)
+    np.testing.assert_array_equal(far.joints[0], joints[0])
+    for n, d, seed, phi in itertools.product((2, 3, 5), (2, 3), range(12), (None, 0.6, 2.3)):
+        problem = _problem((n, d, seed), 1.0 + 1e-7, phi, 0, 1.0)  # just beyond reach: the case's kind
+        outer = fabrik.reach_limits(fabrik.link_lengths(problem.joints))[1]
+        shift = random_direction(np.random.default_rng(seed), d) * 1e5 * outer
+        moved = dataclasses.replace(problem, joints=problem.joints + shift, target=problem.target + shift)
+        a = problem.solve(tolerance=1e-3 * outer, max_iterations=30)
+        b = moved.solve(tolerance=1e-3 * outer, max_iterations=30)
+        assert b.status == a.status, (n, d, seed, phi)
+        assert b.error == pytest.approx(a.error, rel=1e-6, abs=1e-9 * outer), (n, d, seed, phi)
+        # The pose as the coordinates hold it: 1e5 reaches out they round to 1e-11 of a reach, beyond 1e-12 in cos.
+        np.testing.assert_allclose(b.joints - shift, a.joints, atol=1e-9 * outer)
+
+
 def test_a_limited_chain_returns_its_best_pose_not_its_last() -> None:
     """The case that showed it: it ended "unreachable" at 0.724 m from a 0.600 m start; its best iterate was
     0.412 m. The target is within reach, so the status is "limited", with the best pose (0.412 m)."""

@@ -762,3 +762,26 @@ def test_a_zero_length_segment_inside_a_sphere_cuts_it_for_chain_and_tree() -> N
     assert not from_python(tree._tree_admissible)(
         p, parents, order, np.zeros((3, 13)), rest, 1e-12, False, (centres, radii, live)
     )
+
+
+def test_a_tree_far_from_the_origin_is_solved_as_at_the_origin() -> None:
+    """The kind of the chain's far-out case (tests/kernels/test_fabrik.py): a 3 cm Y tree 1 km out was solved in
+    coordinates that round to 1e-13 m, and its iterates went another way (233 of 300 such trees ended apart from the
+    same tree at the origin). Solved about its root, each ends as at the origin."""
+    rng = np.random.default_rng(3)
+    parents = [-1, 0, 1, 2, 3, 2, 5]  # a sub-base at joint 2, effectors 4 and 6
+    constraints = [None] + [fabrik.Cone(1.0)] * 6
+    for trial in range(60):
+        joints = np.zeros((7, 3))
+        for i, parent in enumerate(parents):
+            if parent >= 0:
+                joints[i] = joints[parent] + rng.normal(size=3) * 0.01
+        targets = {4: joints[4] + rng.normal(size=3) * 0.01, 6: joints[6] + rng.normal(size=3) * 0.01}
+        shift = rng.normal(size=3)
+        shift *= 1e3 / np.linalg.norm(shift)
+        kwargs: dict[str, Any] = {"tolerance": 1e-5, "max_iterations": 40, "constraints": constraints}
+        near = fabrik.solve_tree(parents, joints, targets, **kwargs)
+        far = fabrik.solve_tree(parents, joints + shift, {k: v + shift for k, v in targets.items()}, **kwargs)
+        assert far.status == near.status, trial
+        np.testing.assert_allclose(far.error, near.error, rtol=1e-6, atol=1e-12, err_msg=str(trial))
+        np.testing.assert_array_equal(far.joints[0], joints[0] + shift)
