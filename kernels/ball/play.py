@@ -68,9 +68,9 @@ GROUND_HIT, POST, BAR, WALL, KEEPER, NET = range(6)
 ENDED_X_STOP, ENDED_T_MAX, DIVERGED, REFUSED, STOPPED, IN_NET, OUT, SAVED, INSIDE, CONTACTS = range(1, 11)
 GOAL, WALL_RESULT, OVER, WIDE, SHORT, POST_RESULT, BAR_RESULT, SAVED_RESULT = range(8)
 CONTACT_S = 0.009
-"""How long a football's contact with a body lasts (s): under 10 ms for a kick's foot (Shinkai et al. 2009, Med.
-Sci. Sports Exerc. 41:889, filmed at 5000 Hz) and for a ball fired at a force plate (Iga et al., ISBS proceedings).
-A second body within the ball's compression over it is met in the same contact (:func:`_also_met`)."""
+"""How long a football's contact with a body lasts (s): under 10 ms for a kick's foot, filmed at 5000 Hz (Shinkai
+et al. 2009, Med. Sci. Sports Exerc. 41:889). A second body within the ball's compression over it is met in the same
+contact (:func:`_also_met`)."""
 DIVE_HORIZON_S = 1.5
 """The keeper dives only for a ball that his read puts on his line within this time (s), within his hands' reach of
 the goal; until then he stands and reads it again each step (a slow roll or a ball far over the bar draws no dive)."""
