@@ -58,6 +58,8 @@ class Upload:
     parts_seen: set[int] = dataclasses.field(default_factory=set)
     button_uuid: str = ""
     """The upload button it was started on."""
+    filename: str = ""
+    """The file's name, as its start message gave it."""
 
 
 Item = typing.TypeVar("Item")

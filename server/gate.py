@@ -353,7 +353,7 @@ class Gate:
         if isinstance(message, messages.FileTransferStartUpload):
             return self._clean_upload_start(server, client_id, message)
         if isinstance(message, messages.FileTransferPart):
-            return self._clean_upload_part(client_id, message), None
+            return self._clean_upload_part(server, client_id, message)
         if isinstance(message, ALLOWED_MESSAGES):
             return message, None
         self.log.refuse("message type", f"{type(message).__name__} is not one a browser may send")
@@ -532,7 +532,9 @@ class Gate:
             )
         now, button = time.monotonic(), str(message.source_component_uuid)
         if parts > 0:
-            in_flight[message.transfer_uuid] = Upload(parts, size, now, now, button_uuid=button)
+            in_flight[message.transfer_uuid] = Upload(
+                parts, size, now, now, button_uuid=button, filename=str(message.filename)
+            )
         else:  # viser finishes an empty file at its start
             self._finished_uploads[(client_id, button)] = FinishedUpload(now, str(message.transfer_uuid))
         return message, None
@@ -592,27 +594,48 @@ class Gate:
                 )
                 viser_compat.drop_upload_parts(server, client_id, transfer)
 
-    def _clean_upload_part(self, client_id: int, message: messages.FileTransferPart) -> Any:
+    def _clean_upload_part(
+        self, server: viser.ViserServer, client_id: int, message: messages.FileTransferPart
+    ) -> tuple[Any, Callable[[], None] | None]:
         upload = self._uploads.get(client_id, {}).get(str(message.transfer_uuid))
         index, content = message.part_index, message.content
         if upload is None or not isinstance(index, int) or not 0 <= index < upload.part_count:
             self.log.refuse("upload part", "for no upload in flight, or out of range")
-            return None
+            return None, None
         if index in upload.parts_seen:
             self.log.refuse("upload part", "sent twice")
-            return None
+            return None, None
         if not isinstance(content, bytes) or upload.bytes_seen + len(content) > upload.size_bytes:
             self.log.refuse("upload part", "more bytes than the upload announced")
-            return None
+            return None, None
         upload.bytes_seen += len(content)
         upload.parts_seen.add(index)
         upload.last_part_at = time.monotonic()
-        if len(upload.parts_seen) == upload.part_count:
-            del self._uploads[client_id][str(message.transfer_uuid)]
-            self._finished_uploads[(client_id, upload.button_uuid)] = FinishedUpload(
-                upload.started_at, str(message.transfer_uuid)
-            )
-        return message
+        if len(upload.parts_seen) < upload.part_count:
+            return message, None
+        transfer = str(message.transfer_uuid)
+        del self._uploads[client_id][transfer]
+        self._finished_uploads[(client_id, upload.button_uuid)] = FinishedUpload(upload.started_at, transfer)
+        if self._gui_handle(server, client_id, upload.button_uuid) is not None:
+            return message, None
+        # Its button went while the file arrived (a Reset or a scene switch): viser acks the last part, which its
+        # client shows as "File uploaded successfully", and drops the file. Take that notice down and say so.
+        name = upload.filename[:80] or "The file"
+        tell = self._tell(
+            server,
+            client_id,
+            f"{name} was still arriving when the scene was reset or switched, so it was not loaded. "
+            "Upload it again to use it.",
+            title="File not loaded",
+        )
+
+        def take_down_then_tell() -> None:
+            client = self._client(server, client_id)
+            if client is not None:
+                viser_compat.remove_notice(client, viser_compat.upload_notice_id(transfer))
+            tell()
+
+        return message, take_down_then_tell
 
     def _gizmo_handle(self, server: viser.ViserServer, client_id: int, name: str, owner: str) -> Any:
         return viser_compat.gizmo_by_name(server, client_id, name, owner)

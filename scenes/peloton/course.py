@@ -445,7 +445,11 @@ class CourseMode:
             logger.exception("peloton: reading an uploaded GPX failed")
             name, route, error = "upload", None, "the file could not be read"
 
+        installed = False
+
         def install() -> None:
+            nonlocal installed
+            installed = True
             with self._upload_lock:
                 superseded, chosen_since = seq != self._upload_seq, self._chosen_at > arrived_at
             if superseded:  # a later choice of route, or a newer upload, came while this one was read: it wins
@@ -457,6 +461,19 @@ class CourseMode:
                 self._tell_not_loaded(client, upload_notice, body)
 
         self.scene.callback(install)(None)
+        if not installed and self.scene.closed:  # a Reset or a scene switch came while it was read
+            self._tell_left(client, upload_notice, name)
+
+    def _tell_left(self, client: object, upload_notice: str | None, name: str) -> None:
+        """Tell the tab that file ``name`` was still being read when this scene closed (a Reset or a scene switch),
+        in place of viser's "File uploaded successfully": the closed scene cannot show it, so it stands over the
+        next one for its 15 s."""
+        if not isinstance(client, viser.ClientHandle):
+            return
+        if upload_notice is not None:
+            self.server.remove_notice(client, upload_notice)
+        body = f"{name} was still being read when the scene was reset or switched, so it was not loaded. Upload it again to ride it."
+        client.add_notification("GPX not loaded", body, color="red", auto_close_seconds=15.0)
 
     def _tell_superseded(self, client: object, upload_notice: str | None, uploaded: object, stage: str) -> None:
         """Tell the tab that file ``uploaded`` was still ``stage`` ("arriving", "being read") when a later choice of
