@@ -10,18 +10,8 @@ from helpers.wsclient import BrowserClient
 
 def upload(client: BrowserClient, label: str, filename: str, data: bytes, part: int = 64_000) -> str:
     """What the browser sends when a person picks a file for the upload button ``label``; returns its transfer id."""
-    source = client.uuid_of(label)
-    transfer = str(uuid.uuid4())
     parts = [data[i : i + part] for i in range(0, len(data), part)]
-    client.send(
-        "FileTransferStartUpload",
-        source_component_uuid=source,
-        transfer_uuid=transfer,
-        filename=filename,
-        mime_type="application/gpx+xml",
-        part_count=len(parts),
-        size_bytes=len(data),
-    )
+    source, transfer = start_upload(client, label, filename, len(data), len(parts))
     for index, content in enumerate(parts):
         client.send(
             "FileTransferPart",
@@ -31,6 +21,21 @@ def upload(client: BrowserClient, label: str, filename: str, data: bytes, part: 
             content=content,
         )
     return transfer
+
+
+def start_upload(client: BrowserClient, label: str, filename: str, size_bytes: int, part_count: int) -> tuple[str, str]:
+    """The start of an upload to the button ``label``, as the browser sends it; returns (button id, transfer id)."""
+    source, transfer = client.uuid_of(label), str(uuid.uuid4())
+    client.send(
+        "FileTransferStartUpload",
+        source_component_uuid=source,
+        transfer_uuid=transfer,
+        filename=filename,
+        mime_type="application/gpx+xml",
+        part_count=part_count,
+        size_bytes=size_bytes,
+    )
+    return source, transfer
 
 
 def send_part(client: BrowserClient, transfer: str, index: int, content: Any) -> None:

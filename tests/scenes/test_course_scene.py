@@ -9,7 +9,6 @@ import re
 import threading
 import time
 import unicodedata
-import uuid
 from typing import Any
 from unittest.mock import ANY
 
@@ -21,7 +20,7 @@ from helpers.gpx import BAD_FILES, gpx_text, hill_gpx
 from helpers.properties import examples
 from helpers.scenes import glb_vertices, scene_fixture
 from helpers.screen_geometry import pinhole_ndc
-from helpers.uploads import send_part, upload
+from helpers.uploads import send_part, start_upload, upload
 from helpers.wsclient import BrowserClient, Crafted, crafted_sent
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -496,17 +495,7 @@ def test_a_file_still_arriving_when_the_sample_route_is_chosen_does_not_replace_
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("Upload GPX")
         assert mode.load(hill_gpx("First hill"), "first.gpx")
-        transfer = str(uuid.uuid4())
-        button = client.uuid_of("Upload GPX")
-        client.send(
-            "FileTransferStartUpload",
-            source_component_uuid=button,
-            transfer_uuid=transfer,
-            filename="before.gpx",
-            mime_type="application/gpx+xml",
-            part_count=2,
-            size_bytes=len(data),
-        )
+        _button, transfer = start_upload(client, "Upload GPX", "before.gpx", len(data), 2)
         send_part(client, transfer, 0, data[:half])
         client.wait_for(
             lambda: any(m.get("type") == "FileTransferPartAck" for _at, m in list(client.received)),
@@ -544,16 +533,7 @@ def test_a_file_the_scene_closed_under_is_told_to_its_tab(
     half = len(data) // 2
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("Upload GPX")
-        button, transfer = client.uuid_of("Upload GPX"), str(uuid.uuid4())
-        client.send(
-            "FileTransferStartUpload",
-            source_component_uuid=button,
-            transfer_uuid=transfer,
-            filename="dropped.gpx",
-            mime_type="application/gpx+xml",
-            part_count=2,
-            size_bytes=len(data),
-        )
+        button, transfer = start_upload(client, "Upload GPX", "dropped.gpx", len(data), 2)
         send_part(client, transfer, 0, data[:half])
         if stage == "being read":
             send_part(client, transfer, 1, data[half:])
