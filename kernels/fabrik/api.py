@@ -424,11 +424,12 @@ def link_lengths(joints: ArrayLike) -> NDArray[np.float64]:
 
     Raises:
         ValueError: ``joints`` not finite real numbers of magnitude ≤ 1e150 m, or not of shape (n + 1, d) or
-            (B, n + 1, d) with d = 2 or 3; the message names ``joints``.
+            (B, n + 1, d) with n ≥ 1 and d = 2 or 3; the message names ``joints``.
     """
     points = bounded_array("joints", joints, _LARGEST)
     if points.ndim not in (2, 3) or points.shape[-1] not in (2, 3):
         raise ValueError(f"joints must have shape (n + 1, d) or (B, n + 1, d) with d = 2 or 3, got {points.shape}")
+    points = _check_joints("joints", points, batched=points.ndim == 3)  # and n ≥ 1
     segments = np.diff(points, axis=-2)
     # each segment first to max-abs 1, so its squared norm neither overflows (1e300) nor underflows (1e-160)
     largest = np.abs(segments).max(axis=-1, keepdims=True)

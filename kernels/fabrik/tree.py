@@ -159,7 +159,7 @@ def solve_tree(
         raw = np.asarray(parents)
     except (TypeError, ValueError):
         raw = None
-    if raw is not None and raw.dtype.kind in "iu" and raw.shape == (count,):
+    if raw is not None and raw.dtype.kind in "iu" and raw.shape == (count,) and not _checks.holds_booleans(parents):
         topology = _tree_topology(tuple(raw.tolist()), count, keys)
     else:  # refused (ValueError naming parents) without the cache
         topology = _tree_topology.__wrapped__(parents, count, keys)
@@ -278,7 +278,13 @@ def _tree_topology(
         raw = np.asarray(parents)
     except (TypeError, ValueError) as error:
         raise ValueError(f"parents must be a ({count},) array of integers, got {_checks.shown(parents)}") from error
-    if raw.shape != (count,) or raw.dtype.kind not in "iu" or np.any(raw < -1) or np.any(raw >= count):
+    if (
+        raw.shape != (count,)
+        or raw.dtype.kind not in "iu"
+        or _checks.holds_booleans(parents)  # numpy reads [-1, False, True] as integers
+        or np.any(raw < -1)
+        or np.any(raw >= count)
+    ):
         raise ValueError(f"parents must be ({count},) integers in [−1, {count - 1}], got {_checks.shown(parents)}")
     parent = raw.astype(np.int64)
     roots = np.flatnonzero(parent == -1)

@@ -41,6 +41,10 @@ def test_extrapolate_takes_python_and_numpy_bools(value: Any) -> None:
         (0.0, r"^joints must have shape \(n \+ 1, d\) or \(B, n \+ 1, d\) with d = 2 or 3, got \(\)"),
         ([1.0, 2.0], r"^joints must have shape .* got \(2,\)"),
         ([[0.0, 0.0, 0.0, 0.0]], r"^joints must have shape .* got \(1, 4\)"),
+        # Kind: a chain of no links. One joint gave an empty array, where its docstring promises the error.
+        ([[0.0, 0.0]], r"^joints must hold at least two joints \(n ≥ 1 link\), got \(1, 2\)"),
+        (np.zeros((3, 1, 3)), r"^joints must hold at least two joints \(n ≥ 1 link\), got \(3, 1, 3\)"),
+        (np.zeros((0, 3)), r"^joints must hold at least two joints"),
     ],
 )
 def test_link_lengths_refuses_what_is_not_a_chain_by_name(joints: Any, message: str) -> None:

@@ -704,6 +704,22 @@ def test_keys_that_hash_as_a_cached_index_are_still_refused(key: int, alias: Any
         fabrik.solve_tree(parents, joints, {alias: [0.0, 0.0, 0.0]})
 
 
+@pytest.mark.parametrize(
+    "parents",
+    [[-1, False, True, True], [-1, 0, True, 1], (-1, np.False_, 1, 1), np.array([False, True]), [-1, 0, 1, 1.0]],
+)
+@pytest.mark.parametrize("cached_first", [False, True])
+def test_parents_holding_bools_or_floats_are_refused(parents: Any, cached_first: bool) -> None:
+    """Kind: an index that is not an integer. numpy reads [-1, False, True, True] as integers, so the tree was
+    solved, where a bool key or a float parent is refused; also after the integer form was cached."""
+    joints = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, 2.0], [0.0, 1.0, 2.0]])[: len(parents)]
+    targets = {len(parents) - 1: joints[-1]}
+    if cached_first:
+        fabrik.solve_tree([-1, 0, 1, 1][: len(parents)] if len(parents) == 4 else [-1, 0], joints, targets)
+    with pytest.raises(ValueError, match=r"^parents must be"):
+        fabrik.solve_tree(parents, joints, targets)
+
+
 def test_parents_of_the_wrong_shape_are_refused_after_the_right_one() -> None:
     targets = {4: np.array([-1.5, 0.0, 3.0])}
     fabrik.solve_tree(Y3_PARENTS, Y3, targets)
