@@ -439,7 +439,10 @@ def why_short(
     touching = touched_obstacles(params, joints, obstacle_centres)
     if touching and not inside:
         which = _listed([str(k) for k in touching])
-        reasons.append(f"obstacle {which} is in the way (the chain rests against it)")
+        if len(touching) == 1:
+            reasons.append(f"obstacle {which} is in the way (the chain rests against it)")
+        else:
+            reasons.append(f"obstacles {which} are in the way (the chain rests against them)")
     if params.limits:
         held = joints_at_limit(params, joints)
         angles = fabrik.joint_angles(to_kernel(joints, params.three_d), _root_direction(params.three_d))
@@ -456,6 +459,10 @@ def why_short(
                     f" (the other joints bend up to {min(float(free.max()), 1.0):.0%} of it); the solver settled "
                     "here, and a closer pose may exist"
                 )
+            elif r.status == "limited":
+                # Every joint at its limit proves no more: a 20° chain settled 187 mm short of one 129 mm short,
+                # whose base bends 13° of its 20°.
+                words += "; the solver settled here, and a closer pose may exist"
             reasons.append(words)
         elif r.status == "limited":
             reasons.append(

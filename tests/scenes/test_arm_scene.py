@@ -524,6 +524,41 @@ def test_a_limited_chain_with_joints_to_spare_is_not_said_to_be_held_by_its_limi
     assert clearance(np.column_stack([pose[:, 0], np.zeros(7), pose[:, 1]]), scene.obstacle_centres[0]) > 0.5
 
 
+def test_a_limited_chain_with_every_joint_at_its_limit_is_not_said_to_be_held_by_them(scene: ArmScene) -> None:
+    # An outside tester: 20° cones, target (−1, 0, 0.5): "Short by 186.7 mm: The base, joint 2 … joint 6 are at the
+    # 20° joint limit", as if the limits held it there, while a pose within every cone ends 128.8 mm short.
+    scene.controls["half_angle_deg"].value = 20.0
+    scene.controls["limits"].value = True
+    scene.target_gizmo.position = (-1.0, 0.0, 0.5)
+    scene._apply_target()
+    report = scene.report
+    assert report is not None and report.result.status == "limited"
+    text = scene.readout.content
+    assert "joint 6 are at the 20° joint limit; the solver settled here, and a closer pose may exist" in text, text
+    # It does (found by SLSQP from 300 starts): bends of −13.4, then −20° five times; it clears obstacle 1.
+    headings = np.cumsum(np.radians([-13.4, -20.0, -20.0, -20.0, -20.0, -20.0]))
+    ends = np.cumsum(0.25 * np.column_stack([np.sin(headings), np.cos(headings)]), axis=0)
+    closer = float(np.linalg.norm(ends[-1] - [-1.0, 0.5]))
+    assert closer == pytest.approx(0.1288, abs=1e-4) and closer < report.result.error - 0.05
+    pose = np.vstack([[0.0, 0.0], ends])
+    assert clearance(np.column_stack([pose[:, 0], np.zeros(7), pose[:, 1]]), scene.obstacle_centres[0]) > 0.3
+
+
+def test_two_obstacles_in_the_way_are_named_in_the_plural(scene: ArmScene) -> None:
+    # An outside tester read "Obstacle 1 and 2 is in the way (the chain rests against it)".
+    scene.controls["n_obstacles"].value = 2
+    for k, centre in enumerate([(0.3, 0.0, 0.12), (0.94, 0.0, 0.53)]):
+        scene.controls.each("radii_m")[k].value = 0.31
+        scene.obstacle_gizmos[k].position = centre
+        scene._apply_obstacle(k)
+    scene.target_gizmo.position = (1.31, 0.0, 0.7)
+    scene._apply_target()
+    assert scene.report is not None and scene.report.result.status == "blocked"
+    text = scene.readout.content.lower()
+    assert "obstacles 1 and 2 are in the way (the chain rests against them)" in text, text
+    assert " is in the way" not in text
+
+
 def test_a_solve_from_another_start_is_told_in_a_users_words(scene: ArmScene) -> None:
     # The outside tester's input, on the defaults (limits off, one obstacle avoided): Link length 0.5, then Links 2.
     # The readout blamed "the joint limits", which were off; the obstacle held the arm.
