@@ -33,9 +33,10 @@ PresetLabel = Literal["Chain", "Robot arm", "Hand", "Upper body"]
 PRESET_LABELS: tuple[PresetLabel, ...] = ("Chain", "Robot arm", "Hand", "Upper body")
 MAX_JOINTS = 24
 MAX_EFFECTORS = 5
-WORLD_LIMIT_M = 4.0
-"""Targets and obstacles, the chain's and the skeletons', stay inside this box (±m on each axis); anything a browser
-sends beyond it is refused."""
+WORLD_LIMIT_M = 8.0
+"""Targets and obstacles, the chain's and the skeletons', stay inside this box (±m on each axis): 2 m beyond the
+longest chain's reach (12 links of 0.5 m), so every chain can be seen stretched toward a target out of its reach.
+A position a browser sends beyond it is brought to its edge."""
 LINK_RADIUS_M = 0.016
 JOINT_RADIUS_M = 0.026
 GIZMO_SCALE_M = 0.12
@@ -377,15 +378,17 @@ def iterations_words(count: int) -> str:
 
 
 def clean_target(raw: object, planar: bool) -> NDArray[np.float64] | None:
-    """A browser-sent position as a world point: three finite numbers inside the world box (y put back to 0 in the
-    plane: a crafted client may send any y), else None. Always a new array: the handle's own, changed in place
-    later (a target flattened when 3D is turned off), would leave viser nothing to send."""
+    """A browser-sent position as a world point: three finite numbers, brought into the world box
+    (:data:`WORLD_LIMIT_M`) and, in the plane, with y put back to 0 (a crafted client may send any y); else None.
+    Always a new array: the handle's own, changed in place later (a target flattened when 3D is turned off), would
+    leave viser nothing to send."""
     try:
         point = np.array(raw, dtype=np.float64)
     except (TypeError, ValueError):
         return None
-    if point.shape != (3,) or not np.all(np.isfinite(point)) or np.any(np.abs(point) > WORLD_LIMIT_M):
+    if point.shape != (3,) or not np.all(np.isfinite(point)):
         return None
+    point = np.clip(point, -WORLD_LIMIT_M, WORLD_LIMIT_M)
     if planar:
         point[1] = 0.0
     return point
@@ -395,7 +398,7 @@ def moved_gizmo(
     gizmo: viser.TransformControlsHandle, last: NDArray[np.float64], planar: bool, *, upright: bool = False
 ) -> NDArray[np.float64] | None:
     """Where a dragged gizmo now puts its point, cleaned by :func:`clean_target` and drawn there (a crafted y off
-    the plane is put back); None for a position that cannot be used, with the gizmo put back on ``last`` (and
+    the plane, or a point beyond the world box, is put back); None for a position that cannot be used, with the gizmo put back on ``last`` (and
     upright when ``upright``): the last good point and pose stay."""
     point = clean_target(gizmo.position, planar)
     if point is None:

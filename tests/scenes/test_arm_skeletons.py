@@ -10,7 +10,7 @@ from helpers.wsclient import BrowserClient
 
 from kernels import fabrik
 from scenes import _skeletons
-from scenes.arm import ArmScene
+from scenes.arm import MAX_LINKS, ArmScene
 
 scene = scene_fixture(ArmScene)
 
@@ -44,10 +44,12 @@ def test_presets_open_in_a_pose_that_keeps_their_limits_and_lengths(
         assert np.all(report.result.joints[:, 1] == 0.0)  # the hinges about y keep it in the x–z plane
 
 
-def test_clean_target_refuses_what_is_not_three_finite_numbers_in_the_box() -> None:
-    for bad in ([np.nan, 0, 0], [0, 0], "abc", [0, 0, 1e9], [[0, 0, 0]], None):
+def test_clean_target_refuses_what_is_not_three_finite_numbers_and_brings_the_rest_into_the_box() -> None:
+    for bad in ([np.nan, 0, 0], [0, 0], "abc", [0, 0, np.inf], [[0, 0, 0]], None):
         assert _skeletons.clean_target(bad, planar=False) is None
     np.testing.assert_array_equal(_skeletons.clean_target([0.1, 0.5, 0.2], planar=True), [0.1, 0.0, 0.2])
+    np.testing.assert_array_equal(_skeletons.clean_target([0, -1e300, 1e9], planar=False), [0.0, -8.0, 8.0])
+    assert _skeletons.WORLD_LIMIT_M >= MAX_LINKS * 0.5 + 2.0  # the longest chain, stretched, and room beyond
 
 
 # ------------------------------------------------------------------------------------------------ websocket
@@ -100,7 +102,7 @@ def test_choosing_the_hand_and_dragging_a_fingertip_target_curls_the_finger(
         )
 
 
-@pytest.mark.parametrize("bad", [(float("nan"), 0.0, 0.5), (1e12, 0.0, 0.5), (0.3, float("-inf"), 0.5)])
+@pytest.mark.parametrize("bad", [(float("nan"), 0.0, 0.5), (1e12, float("nan"), 0.5), (0.3, float("-inf"), 0.5)])
 def test_crafted_skeleton_gizmo_and_preset_messages_keep_the_last_good_state(
     server: viser.ViserServer, scene: ArmScene, bad: tuple[float, float, float]
 ) -> None:
@@ -119,6 +121,21 @@ def test_crafted_skeleton_gizmo_and_preset_messages_keep_the_last_good_state(
             np.testing.assert_array_equal(view.targets, targets)
             assert view.solves == solves
             np.testing.assert_array_equal(np.asarray(view.gizmos[0].position), targets[0])
+
+
+def test_a_skeleton_target_dragged_beyond_the_world_box_is_brought_to_its_edge(
+    server: viser.ViserServer, scene: ArmScene
+) -> None:
+    # Past 4 m a Hand or Robot arm target was dropped without a word; the box is now ±8 m and a point beyond it
+    # is brought to its edge, as the chain's target is.
+    view = scene.skeletons
+    with BrowserClient(server.get_port()) as client:
+        choose_preset(client, scene, "Upper body")
+        client.drag_transform("/arm/skeleton/target_0", [(1e12, 0.2, -20.0)])
+        client.wait_for(lambda: view.gizmo_events >= 3, what="the drag handled")
+        with scene._lock:
+            np.testing.assert_array_equal(view.targets[0], [8.0, 0.2, -8.0])
+            np.testing.assert_array_equal(np.asarray(view.gizmos[0].position), [8.0, 0.2, -8.0])
 
 
 @pytest.mark.parametrize("label", [label for label in _skeletons.PRESET_LABELS if label != "Chain"])
