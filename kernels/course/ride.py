@@ -567,16 +567,19 @@ def power_for_time(
     max_speed_ms: float = 20.0,
     start_speed_ms: float = 0.0,
     tolerance_s: float = 0.01,
+    gain: float = 0.0,
 ) -> float:
-    """The constant pedal power that rides ``course`` in ``time_s``: the inverse of :func:`ride`.
+    """The constant pedal power that rides ``course`` in ``time_s``: the inverse of :func:`ride`; with a ``gain``,
+    the time-averaged power of the ride paced by grade that does (the inverse of :func:`paced_ride`).
 
     The finish time falls strictly as power rises, so the root is unique; it is found by a safeguarded secant
     method on log(time) against log(power) (close to a straight line: P ∝ v³ on the flat, ∝ v on a climb),
-    between 1 W and 5000 W; typically 4–6 rides.
+    between 1 W and 5000 W; typically 4–6 rides (each a few rides when paced).
 
     Args:
         time_s: target finish time (s, > 0).
         tolerance_s: how close the ride's time must come (s, > 0).
+        gain: pacing by grade, as for :func:`paced_ride` (0 to 0.5; 0, the default, rides at constant power).
         Other arguments as for :func:`ride`.
 
     Returns:
@@ -588,12 +591,15 @@ def power_for_time(
     """
     target = _checks.positive("time_s", time_s)
     tol = _checks.positive("tolerance_s", tolerance_s)
+    g = _gain(gain)
     s = _segments(course, rider, wind_ms, wind_from_deg, air)
     cap, start = _speeds(max_speed_ms, start_speed_ms)
     n = course.n_points - 1
 
     def time_at(power: float) -> float:
-        return _ride(course, np.full(n, power), s, cap, start).time_s
+        if g == 0.0:
+            return _ride(course, np.full(n, power), s, cap, start).time_s
+        return _paced(course, power, g, s, cap, start).paced.time_s
 
     lo_p, hi_p = _MIN_POWER_W, _MAX_POWER_W
     # Secant steps on f(x) = log t(eᵡ) − log target (x = log P), which is close to a straight line of slope
@@ -702,6 +708,11 @@ def paced_ride(
     g = _gain(gain)
     s = _segments(course, rider, wind_ms, wind_from_deg, air)
     cap, start = _speeds(max_speed_ms, start_speed_ms)
+    return _paced(course, target, g, s, cap, start)
+
+
+def _paced(course: Course, target: float, g: float, s: _Segments, cap: float, start: float) -> Pacing:
+    """:func:`paced_ride` of checked arguments: ``target`` (W), ``g`` the gain, ``s`` the course's segments."""
     n = course.n_points - 1
     constant = _ride(course, np.full(n, target), s, cap, start)
     shape = pacing_factors(course.grade, g)
@@ -743,7 +754,7 @@ def paced_ride(
                 return Pacing(constant=constant, paced=paced, time_saved_s=constant.time_s - paced.time_s)
             low, high = (scale, high) if paced.average_power_w < average else (low, scale)
     raise ValueError(
-        f"power_w = {_checks.shown(power_w)} W cannot be paced with gain {g:g}: held at most {MAX_POWER_W:g} W on "
+        f"power_w = {target:.6g} W cannot be paced with gain {g:g}: held at most {MAX_POWER_W:g} W on "
         f"each segment and eased off at the speed cap, the paced ride does not average the constant ride's "
         f"{average:.1f} W; a lower power or gain paces"
     )

@@ -542,12 +542,15 @@ class CourseMode:
         rider = course_rider(line, params, group_cda(line))
         target_s, cap = params.target_min * 60.0, params.max_speed_kmh / 3.6
         low, high = COURSE_POWER_RANGE_W
+        # The finish shown is the paced ride's when pacing is on: the power is found for that one.
+        gain = params.pacing_gain_pct / 100.0 if params.pacing else 0.0
 
         def finish_at(power_w: float) -> float:
+            conditions = (params.wind_ms, params.wind_from_deg, air, cap)
             try:
-                return course_kernel.ride(
-                    self.route, power_w, rider, params.wind_ms, params.wind_from_deg, air, cap
-                ).time_s
+                if gain:
+                    return course_kernel.paced_ride(self.route, power_w, rider, gain, *conditions).paced.time_s
+                return course_kernel.ride(self.route, power_w, rider, *conditions).time_s
             except ValueError:  # too little power to cross a wall: never finishes
                 return math.inf
 
@@ -576,6 +579,7 @@ class CourseMode:
                     air,
                     max_speed_ms=cap,
                     tolerance_s=0.05,
+                    gain=gain,
                 )
             except ValueError as error:
                 reason = f"Could not find the power for {wanted}: {_escape(str(error))}"

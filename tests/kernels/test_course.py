@@ -412,6 +412,28 @@ def test_power_for_time_inverts_ride(power: float, wind: float, model: str) -> N
     assert found == pytest.approx(power, rel=1e-3)
 
 
+@settings(max_examples=examples(10), deadline=None)
+@given(power=st.floats(60.0, 700.0), gain=st.floats(0.01, 0.5), wind=st.floats(-6.0, 6.0))
+def test_power_for_time_with_a_gain_inverts_the_paced_ride(power: float, gain: float, wind: float) -> None:
+    """Kind: an inverse of the wrong ride. Paced by grade, the power found was the constant ride's: on 20 km of
+    60 m rollers a 45 min target finished in 43:39 (81 s off)."""
+    s = np.arange(0.0, 20_000.0 + 5, 10.0)
+    c = course.course_from_xy(s, np.zeros_like(s), 60.0 * np.sin(2 * np.pi * s / 4000.0))
+    t = course.paced_ride(c, power, TEXTBOOK, gain, wind_ms=wind).paced.time_s
+    found = course.power_for_time(c, t, TEXTBOOK, wind_ms=wind, tolerance_s=1e-3, gain=gain)
+    assert course.paced_ride(c, found, TEXTBOOK, gain, wind_ms=wind).paced.time_s == pytest.approx(t, abs=1e-3)
+    assert found == pytest.approx(power, rel=1e-3)
+    if gain >= 0.1:  # not the constant ride's power, which finishes later
+        assert course.ride(c, found, TEXTBOOK, wind_ms=wind).time_s > t + 5.0
+
+
+def test_power_for_time_refuses_a_gain_out_of_range_by_name() -> None:
+    c = loop_course(600)
+    for bad in (-0.1, 0.6, float("nan"), True, "0.1"):
+        with pytest.raises(ValueError, match=r"^gain must"):
+            course.power_for_time(c, 3600.0, gain=bad)  # type: ignore[arg-type]
+
+
 def test_power_for_time_out_of_reach_says_so() -> None:
     c = course.load_gpx(course.SAMPLE_ROUTE)
     with pytest.raises(ValueError, match="more than 5000 W"):

@@ -175,6 +175,23 @@ def test_a_found_power_has_the_digits_its_finish_needs_and_the_box_shows_them(
     assert round(power, 1) == power or abs(ride_time(mode, round(power, 1)) - target_min * 60.0) >= 0.5  # no finer
 
 
+@pytest.mark.parametrize("target_min", [45.0, 60.0])
+def test_find_the_power_paced_by_grade_finishes_on_the_target(mode: CourseMode, target_min: float) -> None:
+    # An outside tester: on 20 km of 60 m rollers, paced by grade at 15 %, "Find the power" for 45 min set 256.6 W
+    # and the readout said "Finish 43:39": the power was the constant ride's, the finish shown the paced one's.
+    s = np.arange(0.0, 20_000.0 + 5, 10.0)
+    rollers = course_kernel.course_from_xy(s, np.zeros_like(s), 60.0 * np.sin(2 * np.pi * s / 4000.0))
+    mode.scene.controls["drafting"].value = False
+    mode.controls["pacing"].value = True
+    assert mode._install(rollers, None, "rollers.gpx")
+    mode.controls["target_min"].value = target_min
+    mode.solve.value = True
+    assert mode.state is not None and mode.state.pacing is not None
+    assert abs(mode.state.ride.time_s - target_min * 60.0) < 0.5
+    assert f"Finish **{format_duration(target_min * 60.0)}**" in mode.readout.content
+    assert mode.state.pacing.time_saved_s > 30.0  # the constant ride at that power is well off the target
+
+
 def ride_time(mode: CourseMode, power_w: float) -> float:
     mode.controls["power_w"].value = power_w
     assert mode.state is not None
