@@ -108,6 +108,10 @@ gives every control's label a column of its own: the box was 236 px wide, 34 cha
 than cut off."""
 
 
+_SEE_IT = "; choose GLSL editor in Shape to see it."
+"""How an Apply's status ends while Shape shows another shape; dropped once the editor is chosen."""
+
+
 class SdfGalleryScene(Scene[SdfGalleryParams]):
     key = "sdf"
     title = "SDF gallery (ray marching)"
@@ -383,6 +387,9 @@ IoU is lowest when a box edge is on the silhouette.
         if self.params.shape_source != before.shape_source:
             with self._state:
                 self._shape_choices += 1
+            status = self.editor_status.content
+            if self.params.shape_source == "editor" and status.endswith(_SEE_IT):  # it is seen now
+                self.editor_status.content = status.removesuffix(_SEE_IT) + "."
             self._sync_enabled_inputs()
             self._request_mesh()
         with self._state:
@@ -694,7 +701,7 @@ IoU is lowest when a box edge is on the silhouette.
                 self.params = dataclasses.replace(self.params, editor=field)
                 self.editor_error = None
                 self.editor_serial += 1
-                self.editor_status.content = f"**Applied** in {total_ms:.0f} ms; choose GLSL editor in Shape to see it."
+                self.editor_status.content = f"**Applied** in {total_ms:.0f} ms{_SEE_IT}"
                 self._request_mesh()  # the chosen shape, also where the Apply took the request that chose it
                 return
             self.params = dataclasses.replace(self.params, editor=field, shape_source="editor")

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import io
 import math
+import re
 import threading
 import time
 from collections.abc import Callable
@@ -831,6 +832,10 @@ def test_a_shape_chosen_while_an_apply_compiles_is_the_one_shown(
             assert "choose GLSL editor in Shape" in scene.editor_status.content
             client.set_value("Shape", "GLSL editor")  # coming back shows the applied torus
             wait_until(lambda: scene.mesh_shape == scene.params.editor, "the torus meshed")
+            # and the status no longer asks for the choice just made (an outside tester saw it stay)
+            assert re.fullmatch(r"\*\*Applied\*\* in \d+ ms\.", scene.editor_status.content), (
+                scene.editor_status.content
+            )
         assert scene.worker.wait_idle(60.0)
         assert scene.mesh_shape == scene.params.editor and scene.mesh_scene is None
         # The torus: every vertex 0.2 m from the ring of radius 0.8 in the xz plane, within a fraction of a voxel.
