@@ -143,6 +143,11 @@ float smooth_intersect(float a, float b, float k, int blend) {
     return combine(a, b, OP_INTERSECT, k, blend).x;
 }
 
+// Without a blend, the polynomial one: kernels/sdf's default, so a call written for either reads the same.
+float smooth_union(float a, float b, float k) { return smooth_union(a, b, k, BLEND_POLY); }
+float smooth_subtract(float a, float b, float k) { return smooth_subtract(a, b, k, BLEND_POLY); }
+float smooth_intersect(float a, float b, float k) { return smooth_intersect(a, b, k, BLEND_POLY); }
+
 // ------------------------------------------------------------------------------ more primitives
 // After I. Quilez, "distance functions" (iquilezles.org/articles/distfunctions); kernels/sdf has the same names,
 // arguments and frames, and says which are exact and which only bounds.

@@ -238,6 +238,23 @@ def test_gl_sampled_grid_equals_numpy_at_every_sample() -> None:
 
 
 @pytest.mark.gl
+@pytest.mark.parametrize("name", ["smooth_union", "smooth_subtract", "smooth_intersect"])
+def test_a_blend_called_without_its_form_is_the_polynomial_one_as_in_python(name: str) -> None:
+    # An outside tester: `smooth_union(d, x, .1)` works in Python (the blend defaults to "poly") but was refused in
+    # the editor, "no matching function for call to 'smooth_union(float, float, float)'".
+    call = f"{name}(sd_sphere(p, 0.6), sd_box(p - vec3(0.4, 0.1, 0.0), vec3(0.3)), 0.15"
+    grid = sdf.make_grid(sdf.default_scene(), 32, CUBE_BOUNDS)
+    three = gl_service.run(lambda gl: gl.sample_field(f"float sdf(vec3 p) {{ return {call}); }}", grid))
+    four = gl_service.run(lambda gl: gl.sample_field(f"float sdf(vec3 p) {{ return {call}, BLEND_POLY); }}", grid))
+    np.testing.assert_array_equal(three, four)
+    axes = [grid.origin[i] + grid.spacing * np.arange(grid.shape[i]) for i in range(3)]
+    points = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+    a, b = sdf.sd_sphere(points, 0.6), sdf.sd_box(points - [0.4, 0.1, 0.0], [0.3, 0.3, 0.3])
+    expected = getattr(sdf, name)(a, b, 0.15).reshape(grid.shape)  # Python's default form
+    np.testing.assert_allclose(three, expected, atol=1e-5, rtol=0)
+
+
+@pytest.mark.gl
 def test_a_grid_sampled_a_slab_at_a_time_is_the_grid_sampled_whole() -> None:
     grid = sdf.make_grid(sdf.default_scene(), 160, CUBE_BOUNDS)  # 51 planes a draw: four slabs, the last of 7
     assert gl_renderer.slab_planes(grid) == 51 and grid.shape[2] == 160
