@@ -50,7 +50,9 @@ from kernels.course.gpx import (
     MAX_GPX_GRADE,
     MAX_SEGMENT_GAP_M,
     MIN_COURSE_M,
+    NOISE_WINDOW_PER_M,
     SAMPLE_ROUTE,
+    grade_window_m,
     load_gpx,
 )
 from kernels.course.ride import (
@@ -98,6 +100,7 @@ __all__ = [
     "MAX_SEGMENT_GAP_M",
     "MIN_COURSE_M",
     "MIN_ELEVATION_M",
+    "NOISE_WINDOW_PER_M",
     "SAMPLE_ROUTE",
     "SMOOTHING_FLOOR_M",
     "Air",
@@ -110,6 +113,7 @@ __all__ = [
     "azimuthal_equidistant",
     "course_from_points",
     "course_from_xy",
+    "grade_window_m",
     "load_gpx",
     "paced_ride",
     "pacing_factors",

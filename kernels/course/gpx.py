@@ -129,7 +129,8 @@ def load_gpx(source: str | os.PathLike[str] | bytes, *, name: str | None = None,
     missing = sum(p.elevation is None for p in points)
     if missing:
         raise ValueError(
-            f"{label}: {missing} of {len(points)} {kind} points have no elevation (<ele>); "
+            f"{label}: {missing} of {len(points)} {kind} points {'has' if missing == 1 else 'have'} no elevation "
+            "(<ele>); "
             "export the file with elevation"
         )
     lat = np.array([p.latitude for p in points], dtype=np.float64)
@@ -160,8 +161,12 @@ MAX_GPX_GRADE = 0.5
 if shorter), raw and smoothed. The steepest paved streets are about 35–37 % (Baldwin Street, Canton Avenue), so a
 steeper stretch is a fault in the file (a GPS elevation jump, points logged in one place), not a road."""
 GRADE_WINDOW_M = 25.0
-"""Stretch over which :data:`MAX_GPX_GRADE` is checked on the raw elevation (m): long enough that ±2 m GPS noise
-between points a metre apart stays under 20 %, short enough that a real cliff cannot hide."""
+"""Shortest stretch over which :data:`MAX_GPX_GRADE` is checked on the raw elevation (m): long enough that ±2 m GPS
+noise between points a metre apart stays under 20 %, short enough that a real cliff cannot hide. A noisier file is
+checked over a longer one (:func:`grade_window_m`)."""
+NOISE_WINDOW_PER_M = 32.0
+"""Metres of raw-grade window per metre of the file's elevation noise (:func:`grade_window_m`): the largest of
+~10⁵ differences of two noisy samples is about 4.5·√2·σ, which this keeps under 20 % of the window."""
 MAX_SEGMENT_GAP_M = 2000.0
 """Largest jump :func:`load_gpx` accepts between the end of one piece (track segment or route) and the start of the
 next (m)."""
@@ -332,9 +337,28 @@ def _check_length(label: str, kind: str, route: Course) -> None:
         )
 
 
+def grade_window_m(elevation_m: NDArray[np.float64]) -> float:
+    """Stretch (m) over which :func:`load_gpx` checks the raw grade of a profile of (N,) elevations (m):
+    :data:`GRADE_WINDOW_M`, or :data:`NOISE_WINDOW_PER_M` times the elevation's point-to-point noise where that is
+    longer. Phone GPS without a barometer logs a few metres of noise from point to point: σ = 3 m at 4 m spacing
+    read as 62 % over 25 m, and the file was refused as a cliff.
+
+    The noise σ is read from the second differences, z[i−1] − 2z[i] + z[i+1], which white noise spreads by √6·σ
+    and a road's own bends in grade barely move; by their median absolute deviation (×1.4826, Rousseeuw & Croux
+    1993), so a few spikes or one step do not count as noise. On so noisy a file a step shorter than about a fifth
+    of the window is taken for noise; the smoothed profile is still checked.
+    """
+    if elevation_m.shape[0] < 3:
+        return GRADE_WINDOW_M
+    bends = np.diff(elevation_m, 2)
+    sigma = 1.4826 * float(np.median(np.abs(bends - np.median(bends)))) / math.sqrt(6.0)
+    return max(GRADE_WINDOW_M, NOISE_WINDOW_PER_M * sigma)
+
+
 def _check_grades(label: str, route: Course) -> None:
     """Refuse a profile steeper than any road (:data:`MAX_GPX_GRADE`), before smoothing can hide it."""
-    grade, first = steepest_grade(route.distance_m, route.elevation_raw_m, GRADE_WINDOW_M)
+    window = grade_window_m(route.elevation_raw_m)
+    grade, first = steepest_grade(route.distance_m, route.elevation_raw_m, window)
     smoothed = float(np.max(np.abs(route.grade)))
     if max(grade, smoothed) > MAX_GPX_GRADE:
         if smoothed > grade:
