@@ -394,6 +394,9 @@ MAX_POWER_W = 5000.0
 :func:`power_for_time` searches to. (At 10³⁰⁰ W the sub-steps that hold the speed cap took seconds.)"""
 _MIN_POWER_W, _MAX_POWER_W = 1.0, MAX_POWER_W
 _MAX_SPEED_MS = cycling.MODEL_DOMAIN["speed_ms"][1]
+_MIN_CAP_MS = 0.1
+"""Slowest safe speed a ride takes (m/s, 0.36 km/h, below walking pace): a cap of 1e-320 m/s rode a course in an
+infinite time with NaN energies."""
 _MAX_WIND_MS = cycling.MODEL_DOMAIN["headwind_ms"][1]
 """A ride's safe speed and wind stay within the power law's range (:data:`kernels.cycling.MODEL_DOMAIN`)."""
 
@@ -514,9 +517,10 @@ def _ride(course: Course, power: NDArray[np.float64], s: _Segments, max_speed: f
 
 def _speeds(max_speed_ms: float, start_speed_ms: float) -> tuple[float, float]:
     cap = _checks.positive("max_speed_ms", max_speed_ms)
-    if cap > _MAX_SPEED_MS:
+    if not _MIN_CAP_MS <= cap <= _MAX_SPEED_MS:
         raise ValueError(
-            f"max_speed_ms must be at most {_MAX_SPEED_MS:g} m/s (the model's range), got {_checks.shown(max_speed_ms)}"
+            f"max_speed_ms must be in [{_MIN_CAP_MS:g}, {_MAX_SPEED_MS:g}] m/s (the model's range), "
+            f"got {_checks.shown(max_speed_ms)}"
         )
     start = _checks.finite_number("start_speed_ms", start_speed_ms)
     if start < 0.0 or start > cap:
@@ -543,7 +547,7 @@ def ride(
         wind_ms: wind speed (m/s, at most 1000 either way; negative reverses it).
         wind_from_deg: where the wind blows from, clockwise from north (°): 0 is a north wind.
         air: air density along the route.
-        max_speed_ms: safe descending speed (m/s, in (0, 10⁸]; 20 m/s = 72 km/h); the rider brakes to hold it.
+        max_speed_ms: safe descending speed (m/s, in [0.1, 10⁸]; 20 m/s = 72 km/h); the rider brakes to hold it.
         start_speed_ms: speed at the start (m/s, 0 = from rest).
 
     Returns:

@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 import pytest
+from helpers.gpx import gpx_text
 from helpers.properties import examples
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -333,3 +334,13 @@ def test_a_route_refuses_what_is_not_numbers_quoting_it(bad: Any) -> None:
         course.course_from_points(bad, [0.0, 0.01], [0.0, 0.0])
     with pytest.raises(ValueError, match=r"^elevation_m must be an array of numbers, got \["):
         course.course_from_xy([0.0, 100.0], [0.0, 100.0], bad)
+
+
+@pytest.mark.parametrize(
+    ("missing", "words"), [(1, "1 of 5 track points has no elevation"), (2, "2 of 5 track points have")]
+)
+def test_points_without_elevation_are_counted_in_words(missing: int, words: str) -> None:
+    # An outside tester read "1 of 200 track points have no elevation".
+    points = [(45.0 + i * 1e-3, 6.0, None if i < missing else 300.0) for i in range(5)]
+    with pytest.raises(ValueError, match=words):
+        course.load_gpx(gpx_text(points).encode())
