@@ -566,7 +566,7 @@ def test_a_file_the_scene_closed_under_is_told_to_its_tab(
             client.click("Reset scene to defaults")
         else:
             client.set_value("Scene", "Arm: FABRIK inverse kinematics")
-        client.wait_for(lambda: switcher.scene is not closed, what="the scene closed")
+        client.wait_for(lambda: switcher.scene is not closed, timeout=30.0, what="the scene closed")  # a build
         if stage == "arriving":
             client.send(
                 "FileTransferPart",
@@ -575,7 +575,9 @@ def test_a_file_the_scene_closed_under_is_told_to_its_tab(
                 part_index=1,
                 content=data[half:],
             )
-        client.wait_for(lambda: any("dropped.gpx" in n["body"] for n in client.notices()), what="the tab told")
+        client.wait_for(
+            lambda: any("dropped.gpx" in n["body"] for n in client.notices()), timeout=30.0, what="the tab told"
+        )
         (note,) = [n for n in client.notices() if "dropped.gpx" in n["body"]]
         assert note["body"].startswith(f"dropped.gpx was still {stage} when the scene was reset or switched")
         assert note["color"] == "red"
@@ -700,11 +702,37 @@ def test_the_readout_names_the_model_by_its_label_and_explains_coasting(mode: Co
     average = mode.state.ride.average_power_w
     assert average < 100.0
     assert (
-        f"Average {average:.0f} W of the 250 W set: the riders coast where 250 W would take them "
+        f"Average {average:.0f} W of the 250 W set: the riders ease off or coast where 250 W would take them "
         "over the 72 km/h safe speed"
     ) in mode.readout.content
     mode.scrub.value = 1.5
     assert "(coasting at the 72 km/h safe speed)" in mode.now.content
+
+
+@pytest.mark.parametrize(("length_m", "last"), [(20_010.5, "20.01"), (20_001.0, "20.001"), (20_400.0, "20.4")])
+def test_the_finish_split_reads_apart_from_the_whole_split_before_it(
+    mode: CourseMode, length_m: float, last: str
+) -> None:
+    # An outside tester: a 20.0105 km route's splits ended "20.0 | 43:38" then "20.0 | 43:39".
+    s = np.linspace(0.0, length_m, 2001)
+    assert mode._install(course_kernel.course_from_xy(s, np.zeros_like(s), np.zeros_like(s)), None, "flat.gpx")
+    rows = [row.split("|")[1].strip() for row in mode.splits.content.splitlines()[2:]]
+    assert rows[-2:] == ["20.0", last] and len(set(rows)) == len(rows)
+
+
+def test_pedalling_less_to_hold_the_safe_speed_on_a_climb_is_not_called_coasting(mode: CourseMode) -> None:
+    # An outside tester: a bunch at 2000 W up 6.5 % read "72.0 km/h, the group's 1431 W (coasting at the 72 km/h
+    # safe speed)". The riders pedal 1431 W: they ease off, they do not coast.
+    up = [(45.0 + i * 1e-4, 6.0, 1000.0 + 0.03 * 11.1195 * i) for i in range(180)]
+    assert mode.load(gpx_text(up).encode(), "up.gpx")
+    mode.controls["power_w"].value = 2000.0
+    mode.scrub.value = 1.5
+    assert mode.state is not None
+    assert mode.state.ride.speed_ms.max() == pytest.approx(20.0, rel=1e-6)  # the cap holds it
+    content = mode.now.content
+    watts = re.search(r"(\d+) W \(easing off to hold the 72 km/h safe speed\)", content)
+    assert watts is not None and 100 < int(watts.group(1)) < 2000, content
+    assert "coasting" not in content
 
 
 # Kind: bad files, through the scene: refused in a rider's words, the last good course kept.
