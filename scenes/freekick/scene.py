@@ -184,8 +184,8 @@ spin rate changes nothing but the direction. *Measured*: C_L = 0.9·S (S = r|ω|
 visibly moves the ball. *Knuckleball*: with almost no spin, an unsteady side force zig-zags the ball by about a
 diameter per ~15 m (Cohen, Texier, Quéré & Clanet 2012; Texier et al. 2016), drawn from a random draw number (the same number, the same flight).
 
-**Integrators.** RK4 at 10 ms is within a micrometre of a DOP853 reference over 30 m; the original brief's Euler at 1 ms is
-off by about 1.4 cm, not "within a centimetre".
+**Integrators.** RK4 at 10 ms is within a few micrometres of a DOP853 reference over 30 m; the original brief's Euler at
+1 ms is off by 7–17 mm (more with spin), not "within a centimetre".
 
 **Assumptions.** Constant spin between contacts, still air. The orange flight ends at the turf or two metres past
 the goal line; the played-on flight and its verdict are the pitch's. A goal needs the whole ball over the line
@@ -278,7 +278,8 @@ reads it again, so a ball that bounces in front of him beats him more often than
                 self.aim_status = gui.add_markdown("")
             with gui.add_folder("Outcome map"):
                 self.map_legend = gui.add_markdown(
-                    "Launch speed 15–35 m/s left to right, spin 0–15 rev/s bottom to top, other settings as set. "
+                    "Launch speed 15–35 m/s left to right, spin 0–15 rev/s bottom to top, other settings as set "
+                    "(flown by RK4 at 10 ms whatever the Integrator). "
                     "Green goal, red wall, orange over, yellow wide, grey short; white cross: this kick (an arrow "
                     "on the edge when it lies off the map)."
                 )
