@@ -123,19 +123,20 @@ def test_crafted_skeleton_gizmo_and_preset_messages_keep_the_last_good_state(
             np.testing.assert_array_equal(np.asarray(view.gizmos[0].position), targets[0])
 
 
+@pytest.mark.parametrize("label", ["Robot arm", "Hand", "Upper body"])
 def test_a_skeleton_target_dragged_beyond_the_world_box_is_brought_to_its_edge(
-    server: viser.ViserServer, scene: ArmScene
+    server: viser.ViserServer, scene: ArmScene, label: _skeletons.PresetLabel
 ) -> None:
     # Past 4 m a Hand or Robot arm target was dropped without a word; the box is now ±8 m and a point beyond it
-    # is brought to its edge, as the chain's target is.
-    view = scene.skeletons
+    # is brought to its edge, as the chain's target is (in the plane of a planar preset).
+    edge = [8.0, 0.0 if _skeletons.PRESETS[label]().planar else 0.2, -8.0]
     with BrowserClient(server.get_port()) as client:
-        choose_preset(client, scene, "Upper body")
+        choose_preset(client, scene, label)
         client.drag_transform("/arm/skeleton/target_0", [(1e12, 0.2, -20.0)])
-        client.wait_for(lambda: view.gizmo_events >= 3, what="the drag handled")
+        client.wait_for(lambda: scene.skeletons.gizmo_events >= 3, what="the drag handled")
         with scene._lock:
-            np.testing.assert_array_equal(view.targets[0], [8.0, 0.2, -8.0])
-            np.testing.assert_array_equal(np.asarray(view.gizmos[0].position), [8.0, 0.2, -8.0])
+            np.testing.assert_array_equal(scene.skeletons.targets[0], edge)
+            np.testing.assert_array_equal(np.asarray(scene.skeletons.gizmos[0].position), edge)
 
 
 @pytest.mark.parametrize("label", [label for label in _skeletons.PRESET_LABELS if label != "Chain"])
