@@ -133,7 +133,14 @@ class CameraReport:
         return getattr(object.__getattribute__(self, "handle"), name)
 
     def __setattr__(self, name: str, value: object) -> None:
-        setattr(self.handle, name, value)
+        """Write through to the live handle. A report is read after its tab spoke, and the tab may have closed since
+        (a camera framed for a tab as it goes): that write is lost without viser's "closed connection" warning."""
+        try:
+            client = self.handle.client
+        except Exception:  # a handle without a client: nothing closes under it
+            client = None
+        with dead_writes_allowed(client) if isinstance(client, viser.ClientHandle) else contextlib.nullcontext():
+            setattr(self.handle, name, value)
 
 
 class CameraHub:

@@ -17,6 +17,7 @@ import subprocess
 import sys
 import threading
 import time
+import warnings
 import weakref
 
 import numpy as np
@@ -32,7 +33,7 @@ from app import serve_scenes
 from scenes import SCENES, Scene
 from scenes.arm import MAX_LINKS
 from scenes.sdf_gallery import SdfGalleryScene
-from server.sessions import Session, Sessions
+from server.sessions import CameraReport, Session, Sessions
 from server.switcher import SceneSwitcher
 
 MIB = 1024 * 1024
@@ -126,6 +127,21 @@ def test_a_closed_tab_frees_its_session(server: viser.ViserServer, sessions: Ses
         return all(ref() is None for ref in refs)
 
     wait_until(all_freed, "the closed tabs' switchers, scenes and sessions collected", timeout_s=10.0)
+
+
+@pytest.mark.parametrize("field", ["look_at", "position", "up_direction", "fov"])
+def test_a_camera_written_after_its_tab_closed_is_lost_without_a_warning(server: viser.ViserServer, field: str) -> None:
+    """Kind: a write to a closed tab. A scene frames a camera from the report its tab sent; the explore profile saw
+    a tab close in between, and viser warned "Queued a SetCameraLookAtMessage on a closed connection"."""
+    with BrowserClient(server.get_port()):
+        wait_until(lambda: len(server.get_clients()) == 1, "the tab registered")
+        (handle,) = server.get_clients().values()
+        report = CameraReport(handle.camera)
+    wait_until(lambda: not server.get_clients(), "the tab gone")
+    value = {"look_at": (0.0, 0.0, 1.0), "position": (1.0, 2.0, 3.0), "up_direction": (0.0, 0.0, 1.0), "fov": 0.9}
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        setattr(report, field, value[field])
 
 
 def test_a_tab_closed_while_its_session_builds_is_torn_down_and_sent_nothing(
