@@ -304,7 +304,7 @@ class Session:
             self.viser_server.initial_camera.position = position
             self.viser_server.initial_camera.look_at = look_at
         for client in self.get_clients().values():
-            with client.atomic():
+            with client.atomic(), dead_writes_allowed(client):  # a tab may close as it is framed
                 client.camera.position = position
                 client.camera.look_at = look_at
 
