@@ -402,8 +402,8 @@ def moved_gizmo(
     gizmo: viser.TransformControlsHandle, last: NDArray[np.float64], planar: bool, *, upright: bool = False
 ) -> NDArray[np.float64] | None:
     """Where a dragged gizmo now puts its point, cleaned by :func:`clean_target` and drawn there (a crafted y off
-    the plane, or a point beyond the world box, is put back); None for a position that cannot be used, with the gizmo put back on ``last`` (and
-    upright when ``upright``): the last good point and pose stay."""
+    the plane, or a point beyond the world box, is put back); None for a position that cannot be used, with the
+    gizmo put back on ``last`` (and upright when ``upright``): the last good point and pose stay."""
     point = clean_target(gizmo.position, planar)
     if point is None:
         gizmo.position = last

@@ -130,8 +130,7 @@ def load_gpx(source: str | os.PathLike[str] | bytes, *, name: str | None = None,
     if missing:
         raise ValueError(
             f"{label}: {missing} of {len(points)} {kind} points {'has' if missing == 1 else 'have'} no elevation "
-            "(<ele>); "
-            "export the file with elevation"
+            "(<ele>); export the file with elevation"
         )
     lat = np.array([p.latitude for p in points], dtype=np.float64)
     lon = np.array([p.longitude for p in points], dtype=np.float64)

@@ -472,7 +472,10 @@ class CourseMode:
             return
         if upload_notice is not None:
             self.server.remove_notice(client, upload_notice)
-        body = f"{name} was still being read when the scene was reset or switched, so it was not loaded. Upload it again to ride it."
+        body = (
+            f"{name} was still being read when the scene was reset or switched, so it was not loaded. "
+            "Upload it again to ride it."
+        )
         client.add_notification("GPX not loaded", body, color="red", auto_close_seconds=15.0)
 
     def _tell_superseded(self, client: object, upload_notice: str | None, uploaded: object, stage: str) -> None:
