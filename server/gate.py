@@ -630,9 +630,9 @@ class Gate:
         )
 
         def take_down_then_tell() -> None:
-            client = self._client(server, client_id)
-            if client is not None:
-                viser_compat.remove_notice(client, viser_compat.upload_notice_id(transfer))
+            for client in server.get_clients().values():  # a shared button's acks showed it in every tab
+                with viser_compat.dead_writes_allowed(client):
+                    viser_compat.remove_notice(client, viser_compat.upload_notice_id(transfer))
             tell()
 
         return message, take_down_then_tell

@@ -284,6 +284,13 @@ class Session:
         with dead_writes_allowed(client):  # its tab may have closed
             viser_compat.remove_notice(client, notice_id)
 
+    def remove_upload_notice(self, notice_id: str) -> None:
+        """Take an upload's progress notice (``upload-<transfer id>``) down in every tab of this session: a shared
+        upload button's acks reach every tab, and each shows the upload's progress; a tab other than the sender's
+        kept "Uploading…" with its spinner for good once a Reset took the button away mid-upload."""
+        for client in self.get_clients().values():
+            self.remove_notice(client, notice_id)
+
     def finished_upload(self, event: object) -> FinishedUpload | None:
         """The upload an upload button's ``on_upload`` ``event`` reports, as the gate took it; None when unknown
         (:meth:`server.gate.Gate.finished_upload`)."""

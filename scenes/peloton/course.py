@@ -471,7 +471,7 @@ class CourseMode:
         if not isinstance(client, viser.ClientHandle):
             return
         if upload_notice is not None:
-            self.server.remove_notice(client, upload_notice)
+            self.server.remove_upload_notice(upload_notice)
         body = (
             f"{name} was still being read when the scene was reset or switched, so it was not loaded. "
             "Upload it again to ride it."
@@ -493,7 +493,7 @@ class CourseMode:
         if not isinstance(client, viser.ClientHandle):
             return
         if upload_notice is not None:
-            self.server.remove_notice(client, upload_notice)
+            self.server.remove_upload_notice(upload_notice)
         self.refusal_notices.append(self.scene.notify(client, "GPX not loaded", body, color="red"))
 
     def load(self, data: bytes, label: str) -> bool:

@@ -548,8 +548,9 @@ def test_a_file_the_scene_closed_under_is_told_to_its_tab(
     _slow_parse_of(monkeypatch, b"Dropped hill")
     data = hill_gpx("Dropped hill", 3000)
     half = len(data) // 2
-    with BrowserClient(server.get_port()) as client:
+    with BrowserClient(server.get_port()) as client, BrowserClient(server.get_port()) as other:
         client.wait_for_gui("Upload GPX")
+        other.wait_for_gui("Upload GPX")
         button, transfer = start_upload(client, "Upload GPX", "dropped.gpx", len(data), 2)
         send_part(client, transfer, 0, data[:half])
         if stage == "being read":
@@ -583,6 +584,17 @@ def test_a_file_the_scene_closed_under_is_told_to_its_tab(
         assert note["color"] == "red"
         removed = [m.get("uuid") for _at, m in list(client.received) if m["type"] == "RemoveNotificationMessage"]
         assert f"upload-{transfer}" in removed  # viser's "uploaded successfully" is not left beside it
+        # Every tab shares the scene here, and the button's acks showed the upload's progress in the other tab
+        # too: its notice goes as well (an outside tester saw "Uploading undefined (6.6M)" stay there for good).
+        other.wait_for(
+            lambda: any(
+                m["type"] == "RemoveNotificationMessage" and m.get("uuid") == f"upload-{transfer}"
+                for _at, m in list(other.received)
+            ),
+            timeout=30.0,
+            what="the other tab's progress notice taken down",
+        )
+        assert not any("dropped.gpx" in n["body"] for n in other.notices())  # the refusal is the sender's
 
 
 # Kind: a place on the route the Position slider cannot reach. Its end was the length rounded down to its 10 m
