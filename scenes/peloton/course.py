@@ -869,6 +869,8 @@ class CourseMode:
         ride = self.state.ride
         every = split_every_m(float(ride.distance_m[-1]))
         marks, times = ride.splits(every)
+        if marks.shape[0] >= 2 and marks[-1] - marks[-2] < 0.5:  # a finish within half a metre of a whole split:
+            marks, times = np.delete(marks, -2), np.delete(times, -2)  # one row, not "5.0" and "5.000" at 9:52
         rows = ["| km | elapsed | split | km/h |", "|---:|---:|---:|---:|"]
         previous_mark, previous_time = 0.0, 0.0
         shown = np.unique(np.linspace(0, marks.shape[0] - 1, min(marks.shape[0], 20)).round().astype(int))
@@ -876,13 +878,14 @@ class CourseMode:
             split = times[i] - previous_time
             speed = 3.6 * (marks[i] - previous_mark) / split if split > 0 else 0.0
             if i in shown:
-                # The finish a few metres past a whole split reads with the digits that tell it apart (20.01 after
-                # 20.0, not 20.0 twice).
-                digits = 1
-                while digits < 3 and i > 0 and round(marks[i] / 1000, digits) == round(marks[i - 1] / 1000, 1):
+                # The finish reads to the metre, with as few digits as that takes (20.01 after 20.0, not 20.0 twice;
+                # 0.13, not 0.1); every other mark is a whole split.
+                km, digits = marks[i] / 1000, 1
+                while i == marks.shape[0] - 1 and digits < 3 and abs(round(km, digits) - km) >= 0.0005:
                     digits += 1
-                km = f"{marks[i] / 1000:.{digits}f}"
-                rows.append(f"| {km} | {format_duration(times[i])} | {format_duration(split)} | {speed:.1f} |")
+                rows.append(
+                    f"| {km:.{digits}f} | {format_duration(times[i])} | {format_duration(split)} | {speed:.1f} |"
+                )
             previous_mark, previous_time = marks[i], times[i]
         return "\n".join(rows)
 

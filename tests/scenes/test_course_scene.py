@@ -721,15 +721,29 @@ def test_the_readout_names_the_model_by_its_label_and_explains_coasting(mode: Co
     assert "(coasting at the 72 km/h safe speed)" in mode.now.content
 
 
-@pytest.mark.parametrize(("length_m", "last"), [(20_010.5, "20.01"), (20_001.0, "20.001"), (20_400.0, "20.4")])
-def test_the_finish_split_reads_apart_from_the_whole_split_before_it(
-    mode: CourseMode, length_m: float, last: str
+@pytest.mark.parametrize(
+    ("length_m", "last_rows"),
+    [
+        (20_010.5, ["20.0", "20.01"]),
+        (20_001.0, ["20.0", "20.001"]),
+        (20_400.0, ["20.0", "20.4"]),
+        (5_003.0, ["5.0", "5.003"]),
+        (5_000.4, ["4.0", "5.0"]),  # within half a metre: one row, not "5.0" and "5.000" at one time
+        (5_000.04, ["4.0", "5.0"]),
+        (130.2, ["0.13"]),
+        (1_000.6, ["1.0", "1.001"]),
+    ],
+)
+def test_the_finish_split_reads_to_the_metre_and_apart_from_the_whole_split_before_it(
+    mode: CourseMode, length_m: float, last_rows: list[str]
 ) -> None:
-    # An outside tester: a 20.0105 km route's splits ended "20.0 | 43:38" then "20.0 | 43:39".
+    # Outside testers: a 20.0105 km route's splits ended "20.0 | 43:38" then "20.0 | 43:39"; then 5000.4 m read
+    # "5.0" and "5.000" at the same second, and a 130.2 m route's one row "0.1".
     s = np.linspace(0.0, length_m, 2001)
     assert mode._install(course_kernel.course_from_xy(s, np.zeros_like(s), np.zeros_like(s)), None, "flat.gpx")
     rows = [row.split("|")[1].strip() for row in mode.splits.content.splitlines()[2:]]
-    assert rows[-2:] == ["20.0", last] and len(set(rows)) == len(rows)
+    assert rows[-len(last_rows) :] == last_rows and len(set(rows)) == len(rows), rows
+    assert abs(float(rows[-1]) * 1000.0 - length_m) <= 0.5 + 1e-9  # the finish, to the metre
 
 
 def test_pedalling_less_to_hold_the_safe_speed_on_a_climb_is_not_called_coasting(mode: CourseMode) -> None:
