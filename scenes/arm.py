@@ -359,6 +359,11 @@ def _listed(words: list[str]) -> str:
     return words[0] if len(words) == 1 else ", ".join(words[:-1]) + " and " + words[-1]
 
 
+def _obstacles(numbers: list[int]) -> str:
+    """ "obstacle 2", "obstacles 1 and 2" (numbered from 1)."""
+    return f"obstacle{'s' if len(numbers) > 1 else ''} {_listed([str(k) for k in numbers])}"
+
+
 def avoided_obstacles(params: ArmParams, obstacle_centres: NDArray[np.float64]) -> list[int]:
     """Indices of the obstacles the solver avoids: shown, Avoid on, and not over the root at the origin (ignored)."""
     if not params.avoid:
@@ -399,7 +404,7 @@ def why_restarted(params: ArmParams, report: SolveReport, obstacle_centres: NDAr
         causes.append("the joint limits")
     touching = touched_obstacles(params, first.joints, obstacle_centres)
     if touching:
-        causes.append(f"obstacle{'s' if len(touching) > 1 else ''} {_listed([str(k) for k in touching])}")
+        causes.append(_obstacles(touching))
     if first.status == "max_iterations":
         causes.append(f"the cap of {iterations_words(params.max_iterations)}")
     if not causes:
@@ -407,7 +412,7 @@ def why_restarted(params: ArmParams, report: SolveReport, obstacle_centres: NDAr
         if params.limits:
             causes.append("the joint limits")
         if avoided:
-            causes.append(f"obstacle{'s' if len(avoided) > 1 else ''} {_listed([str(k) for k in avoided])}")
+            causes.append(_obstacles(avoided))
     held = f"{_listed(causes)} held the arm" if causes else "the solve stopped"
     return (
         f"From the last pose {held} farther from the target, so this pose was solved again from a {report.start} "
@@ -435,14 +440,13 @@ def why_short(
     avoided = avoided_obstacles(params, obstacle_centres)
     inside = [k + 1 for k in avoided if np.linalg.norm(target - obstacle_centres[k]) < params.radii_m[k]]
     if inside:
-        reasons.append(f"the target is inside obstacle {_listed([str(k) for k in inside])}")
+        reasons.append(f"the target is inside {_obstacles(inside)}")
     touching = touched_obstacles(params, joints, obstacle_centres)
     if touching and not inside:
-        which = _listed([str(k) for k in touching])
-        if len(touching) == 1:
-            reasons.append(f"obstacle {which} is in the way (the chain rests against it)")
-        else:
-            reasons.append(f"obstacles {which} are in the way (the chain rests against them)")
+        one = len(touching) == 1
+        reasons.append(
+            f"{_obstacles(touching)} {'is' if one else 'are'} in the way (the chain rests against {'it' if one else 'them'})"
+        )
     if params.limits:
         held = joints_at_limit(params, joints)
         angles = fabrik.joint_angles(to_kernel(joints, params.three_d), _root_direction(params.three_d))
@@ -459,9 +463,9 @@ def why_short(
                     f" (the other joints bend up to {min(float(free.max()), 1.0):.0%} of it); the solver settled "
                     "here, and a closer pose may exist"
                 )
-            elif r.status == "limited":
+            elif r.status == "limited" and params.half_angle_deg > 0.0:
                 # Every joint at its limit proves no more: a 20° chain settled 187 mm short of one 129 mm short,
-                # whose base bends 13° of its 20°.
+                # whose base bends 13° of its 20°. (At 0° the straight chain is the only pose.)
                 words += "; the solver settled here, and a closer pose may exist"
             reasons.append(words)
         elif r.status == "limited":

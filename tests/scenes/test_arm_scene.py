@@ -575,6 +575,29 @@ def test_a_limited_chain_with_every_joint_at_its_limit_is_not_said_to_be_held_by
     assert clearance(np.column_stack([pose[:, 0], np.zeros(7), pose[:, 1]]), scene.obstacle_centres[0]) > 0.3
 
 
+def test_a_target_inside_two_obstacles_names_them_in_the_plural(scene: ArmScene) -> None:
+    # An outside tester read "The target is inside obstacle 1 and 2".
+    scene.controls["n_obstacles"].value = 2
+    for k, centre in enumerate([(0.9, 0.0, 0.6), (0.95, 0.0, 0.62)]):
+        scene.obstacle_gizmos[k].position = centre
+        scene._apply_obstacle(k)
+    scene.target_gizmo.position = (0.9, 0.0, 0.6)
+    scene._apply_target()
+    assert "the target is inside obstacles 1 and 2" in scene.readout.content.lower(), scene.readout.content
+
+
+def test_a_straight_chain_held_by_0_degree_limits_is_not_said_to_have_a_closer_pose(scene: ArmScene) -> None:
+    # At 0° the straight chain is the only pose: "a closer pose may exist" was wrong there.
+    scene.controls["half_angle_deg"].value = 0.0
+    scene.controls["limits"].value = True
+    scene.controls["n_obstacles"].value = 0
+    scene.target_gizmo.position = (0.8, 0.0, 0.9)
+    scene._apply_target()
+    assert scene.report is not None and scene.report.result.status != "reached"
+    text = scene.readout.content
+    assert "at the 0° joint limit" in text and "closer pose" not in text, text
+
+
 def test_two_obstacles_in_the_way_are_named_in_the_plural(scene: ArmScene) -> None:
     # An outside tester read "Obstacle 1 and 2 is in the way (the chain rests against it)".
     scene.controls["n_obstacles"].value = 2
