@@ -443,10 +443,8 @@ def why_short(
         reasons.append(f"the target is inside {_obstacles(inside)}")
     touching = touched_obstacles(params, joints, obstacle_centres)
     if touching and not inside:
-        one = len(touching) == 1
-        reasons.append(
-            f"{_obstacles(touching)} {'is' if one else 'are'} in the way (the chain rests against {'it' if one else 'them'})"
-        )
+        verb, it = ("is", "it") if len(touching) == 1 else ("are", "them")
+        reasons.append(f"{_obstacles(touching)} {verb} in the way (the chain rests against {it})")
     if params.limits:
         held = joints_at_limit(params, joints)
         angles = fabrik.joint_angles(to_kernel(joints, params.three_d), _root_direction(params.three_d))
