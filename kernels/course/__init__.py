@@ -52,6 +52,7 @@ from kernels.course.gpx import (
     MIN_COURSE_M,
     NOISE_WINDOW_PER_M,
     SAMPLE_ROUTE,
+    elevation_noise_m,
     grade_window_m,
     load_gpx,
 )
@@ -113,6 +114,7 @@ __all__ = [
     "azimuthal_equidistant",
     "course_from_points",
     "course_from_xy",
+    "elevation_noise_m",
     "grade_window_m",
     "load_gpx",
     "paced_ride",

@@ -766,7 +766,10 @@ def test_gps_noise_on_a_real_climb_is_not_refused() -> None:
     assert c.total_distance_m == pytest.approx(1999 * 1.112, rel=1e-3)
 
 
-@pytest.mark.parametrize(("spacing_m", "sigma_m"), [(4.0, 3.0), (8.0, 5.0), (1.5, 2.0), (4.0, 1.0), (25.0, 4.0)])
+@pytest.mark.parametrize(
+    ("spacing_m", "sigma_m"),
+    [(4.0, 3.0), (8.0, 5.0), (1.5, 2.0), (4.0, 1.0), (25.0, 4.0), (1.0, 6.0), (2.0, 6.0), (3.0, 6.0), (10.0, 6.0)],
+)
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_phone_gps_noise_of_several_metres_is_not_refused_as_a_cliff(
     spacing_m: float, sigma_m: float, seed: int
@@ -778,13 +781,27 @@ def test_phone_gps_noise_of_several_metres_is_not_refused_as_a_cliff(
     c = course.load_gpx(noisy_climb(spacing_m, sigma_m, seed))
     assert c.n_points == 1500 and np.abs(c.grade).max() <= course.MAX_GPX_GRADE
     assert np.mean(c.grade) == pytest.approx(0.1, abs=0.01)
+    # Smoothed over its noise's window (σ = 6 m every metre, over 50 m, still rode grades of ±50 %): the climb is
+    # ridden as the steady 10 % it is, its noise's peaks within the 20 % the window is sized for.
+    off = c.grade[(c.distance_m[:-1] > 200.0) & (c.distance_m[:-1] < c.total_distance_m - 200.0)] - 0.1
+    assert np.abs(off).max() < 0.2 and np.std(off) < 0.05
 
 
-@pytest.mark.parametrize(("spacing_m", "sigma_m", "step_m"), [(4.0, 0.0, 30.0), (4.0, 1.0, 40.0), (4.0, 3.0, 120.0)])
+@pytest.mark.parametrize(
+    ("spacing_m", "sigma_m", "step_m"), [(4.0, 0.0, 30.0), (4.0, 1.0, 40.0), (4.0, 3.0, 120.0), (4.0, 0.0, -25.0)]
+)
 def test_a_cliff_still_stands_out_of_a_files_noise(spacing_m: float, sigma_m: float, step_m: float) -> None:
     # A step in elevation well past what the file's noise explains is refused still, on a clean file and a noisy one.
     with pytest.raises(ValueError, match="no road is steeper"):
         course.load_gpx(noisy_climb(spacing_m, sigma_m, 0, step=(700, step_m)))
+
+
+def test_a_clean_file_keeps_the_smoothing_asked_for() -> None:
+    # The window grows with the noise only: a clean climb smoothed over 10 m is smoothed over 10 m.
+    text = noisy_climb(4.0, 0.0, 0, step=(700, 3.0))
+    assert course.elevation_noise_m(course.load_gpx(text).elevation_raw_m) < 1e-9
+    sharp, soft = course.load_gpx(text, smoothing_m=10.0), course.load_gpx(text, smoothing_m=50.0)
+    assert np.abs(sharp.grade).max() > np.abs(soft.grade).max() + 0.05
 
 
 @pytest.mark.parametrize(("sigma_m", "window_m"), [(0.0, 25.0), (0.5, 25.0), (3.0, 96.0), (5.0, 160.0)])
