@@ -603,7 +603,10 @@ def power_for_time(
     def time_at(power: float) -> float:
         if g == 0.0:
             return _ride(course, np.full(n, power), s, cap, start).time_s
-        return _paced(course, power, g, s, cap, start).paced.time_s
+        try:
+            return _paced(course, power, g, s, cap, start).paced.time_s
+        except ValueError as error:  # said of the time asked for, not of a power the search tried
+            raise ValueError(f"time_s {target:.6g} s is out of reach paced by grade (gain {g:g}): {error}") from error
 
     lo_p, hi_p = _MIN_POWER_W, _MAX_POWER_W
     # Secant steps on f(x) = log t(eᵡ) − log target (x = log P), which is close to a straight line of slope

@@ -802,9 +802,10 @@ class CourseMode:
     def _route_markdown(self) -> str:
         r = self.route
         average = 100.0 * (r.elevation_m[-1] - r.elevation_m[0]) / r.total_distance_m
+        slope = "0.0" if round(average, 1) == 0.0 else f"{average:+.1f}"  # a loop's tiny difference read "-0.0 %"
         text = (
             f"**{_escape(r.name)}**: {self._total_km():.2f} km, +{r.climbing_m:.0f} m, "
-            f"{r.elevation_m[0]:.0f} → {r.elevation_m[-1]:.0f} m ({average:+.1f} % on average), {r.n_points} points"
+            f"{r.elevation_m[0]:.0f} → {r.elevation_m[-1]:.0f} m ({slope} % on average), {r.n_points} points"
         )
         if self.route_label == SAMPLE_LABEL:
             text += (

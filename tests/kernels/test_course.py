@@ -427,6 +427,15 @@ def test_power_for_time_with_a_gain_inverts_the_paced_ride(power: float, gain: f
         assert course.ride(c, found, TEXTBOOK, wind_ms=wind).time_s > t + 5.0
 
 
+def test_power_for_time_paced_out_of_reach_names_the_time_asked_for() -> None:
+    # An outside tester: on a descent, a target beyond 5000 W with a gain was refused as "power_w = 5000 W cannot
+    # be paced", naming a power the search tried, not the time the caller gave.
+    s = np.arange(0.0, 3000.0 + 5, 10.0)
+    descent = course.course_from_xy(s, np.zeros_like(s), -0.07 * s)
+    with pytest.raises(ValueError, match=r"^time_s 60 s is out of reach"):
+        course.power_for_time(descent, 60.0, gain=0.05)
+
+
 def test_power_for_time_refuses_a_gain_out_of_range_by_name() -> None:
     c = loop_course(600)
     for bad in (-0.1, 0.6, float("nan"), True, "0.1"):

@@ -746,6 +746,17 @@ def test_the_finish_split_reads_to_the_metre_and_apart_from_the_whole_split_befo
     assert abs(float(rows[-1]) * 1000.0 - length_m) <= 0.5 + 1e-9  # the finish, to the metre
 
 
+@pytest.mark.parametrize(
+    ("end_m", "words"), [(-0.004, "(0.0 % on average)"), (0.004, "(0.0 % on average)"), (-30.0, "(-0.6 % on average)")]
+)
+def test_a_route_ending_where_it_starts_reads_no_signed_zero(mode: CourseMode, end_m: float, words: str) -> None:
+    # An outside tester: a 5 km loop that ends at the height it starts read "(-0.0 % on average)".
+    s = np.linspace(0.0, 5000.0, 501)
+    z = 40.0 * np.sin(2 * np.pi * s / 2500.0) + end_m * s / 5000.0
+    assert mode._install(course_kernel.course_from_xy(s, np.zeros_like(s), z), None, "loop.gpx")
+    assert words in mode.route_info.content, mode.route_info.content
+
+
 def test_pedalling_less_to_hold_the_safe_speed_on_a_climb_is_not_called_coasting(mode: CourseMode) -> None:
     # An outside tester: a bunch at 2000 W up 6.5 % read "72.0 km/h, the group's 1431 W (coasting at the 72 km/h
     # safe speed)". The riders pedal 1431 W: they ease off, they do not coast.
