@@ -31,9 +31,11 @@ from kernels.course.route import (
     MAX_ELEVATION_M,
     MAX_POINTS,
     MIN_ELEVATION_M,
-    SMOOTHING_FLOOR_M,
+    NOISE_WINDOW_PER_M,
     Course,
     course_from_points,
+    elevation_noise_m,
+    noise_smoothing_m,
     steepest_grade,
 )
 
@@ -57,7 +59,7 @@ def load_gpx(source: str | os.PathLike[str] | bytes, *, name: str | None = None,
         smoothing_m: elevation moving-average window (m, ≥ 0); 0, or a window shorter than
             :data:`~kernels.course.route.SMOOTHING_FLOOR_M` (1 cm), keeps the elevation as read. A file whose
             elevation jitters by σ from point to point is smoothed over :data:`NOISE_WINDOW_PER_M`·σ where that is
-            longer (:func:`elevation_noise_m`).
+            longer (:func:`~kernels.course.route.noise_smoothing_m`).
 
     Returns:
         The course: every track segment and every route joined in the order the file gives them.
@@ -144,12 +146,8 @@ def load_gpx(source: str | os.PathLike[str] | bytes, *, name: str | None = None,
     title = name or next((t.name for t in named if t.name), None) or gpx.name
     title = title or (label if label != "the file" else "GPX course")
     title = str(title)[:80]
-    # A noisy file is smoothed over as long a window as its grade is checked over, or its noise is ridden as grade:
-    # σ = 6 m every metre, averaged over 50 m, still read 52 % from one point to the next (√2·σ/window, its peaks).
-    noisy = NOISE_WINDOW_PER_M * elevation_noise_m(ele)
-    smoothing = smoothing_m if smoothing_m < SMOOTHING_FLOOR_M else max(smoothing_m, noisy)
     try:
-        result = course_from_points(lat, lon, ele, name=title, smoothing_m=smoothing)
+        result = course_from_points(lat, lon, ele, name=title, smoothing_m=noise_smoothing_m(ele, smoothing_m))
     except ValueError as error:  # the builders name the course; a reader is told about the file
         message = str(error).removeprefix(f"{title}: ")
         raise ValueError(f"{label}: {message}") from error
@@ -170,9 +168,6 @@ GRADE_WINDOW_M = 25.0
 """Shortest stretch over which :data:`MAX_GPX_GRADE` is checked on the raw elevation (m): long enough that ±2 m GPS
 noise between points a metre apart stays under 20 %, short enough that a real cliff cannot hide. A noisier file is
 checked over a longer one (:func:`grade_window_m`)."""
-NOISE_WINDOW_PER_M = 32.0
-"""Metres of raw-grade window per metre of the file's elevation noise (:func:`grade_window_m`): the largest of
-~10⁵ differences of two noisy samples is about 4.5·√2·σ, which this keeps under 20 % of the window."""
 MAX_SEGMENT_GAP_M = 2000.0
 """Largest jump :func:`load_gpx` accepts between the end of one piece (track segment or route) and the start of the
 next (m)."""
@@ -341,17 +336,6 @@ def _check_length(label: str, kind: str, route: Course) -> None:
             f"{label}: the {kind} is {_beyond(total, MIN_COURSE_M)} m long from its first point to its last; "
             f"a course needs {MIN_COURSE_M:.0f} m or more"
         )
-
-
-def elevation_noise_m(elevation_m: NDArray[np.float64]) -> float:
-    """The point-to-point noise σ (m) of a profile of (N,) elevations (m), read from its second differences,
-    z[i−1] − 2z[i] + z[i+1], which white noise spreads by √6·σ and a road's own bends in grade barely move; by their
-    median absolute deviation (×1.4826, Rousseeuw & Croux 1993), so a few spikes or one step do not count as noise.
-    0 for fewer than three points."""
-    if elevation_m.shape[0] < 3:
-        return 0.0
-    bends = np.diff(elevation_m, 2)
-    return 1.4826 * float(np.median(np.abs(bends - np.median(bends)))) / math.sqrt(6.0)
 
 
 def grade_window_m(elevation_m: NDArray[np.float64]) -> float:
