@@ -488,8 +488,8 @@ class Gate:
             return None, None
         self._drop_stalled_uploads(server)
         if any(message.transfer_uuid in uploads for uploads in list(self._uploads.values())):
-            # Every tab sees a shared upload button's part acks, with their transfer id: a second start under
-            # that id would mix another tab's parts into the first tab's file.
+            # A second start under an id in flight (a crafted tab's: acks go to the sender alone) would mix
+            # another tab's parts into the first tab's file.
             self.log.refuse("upload transfer id", "already in flight")
             return None, None
         in_flight = self._uploads.setdefault(client_id, {})
@@ -710,6 +710,7 @@ def install_gate(server: viser.ViserServer) -> Gate:
         gate = _gates.get(server)
         if gate is None:
             viser_compat.install_frame_decoder(decode_frame)
+            viser_compat.route_upload_acks(server)
             gate = _gates[server] = Gate(server)
         return gate
 

@@ -17,7 +17,9 @@ viser's code behind each name below, and nothing else. The private names touched
   :func:`gui_inputs`).
 - ``GuiApi._container_handle_from_uuid``: the folders a control sits in (:func:`gui_container_by_uuid`).
 - ``GuiApi._current_file_upload_states``: the parts viser holds for an upload in flight, freed when the gate drops
-  a stalled upload (:func:`drop_upload_parts`).
+  a stalled upload (:func:`drop_upload_parts`), and the tab each upload came from (:func:`route_upload_acks`).
+- the server's ``GuiApi._websock_interface.queue_message``: wrapped so that an upload's acks go to the tab that sent
+  it alone (:func:`route_upload_acks`).
 - ``SceneApi._owner_id`` and ``SceneApi._handle_from_transform_controls_name``: the gizmo a browser names, on the
   server's or its own scene (:func:`gizmo_by_name`); ``SceneApi._queue_scene_message``: send a gizmo's pose back
   (:func:`send_gizmo_pose`).
@@ -81,6 +83,7 @@ __all__ = [
     "parent_container_id",
     "patch_property_cast",
     "remove_notice",
+    "route_upload_acks",
     "send_download",
     "send_gizmo_pose",
     "send_gui_value",
@@ -176,6 +179,32 @@ def end_refused_upload(
     if client is not None:
         ack = messages.FileTransferPartAck(button_uuid, transfer_uuid, size_bytes, size_bytes)
         _send(client, ack, messages.RemoveNotificationMessage(uuid=upload_notice_id(transfer_uuid)))
+
+
+def route_upload_acks(server: viser.ViserServer) -> None:
+    """Send each upload's part acks to the tab that sent it, not to every tab (once per server).
+
+    An upload button shared by every tab (``--shared``) acks through the server, which broadcasts. viser's client
+    in a tab that did not start the upload then shows "Uploading undefined" under an id of its own, which the
+    upload's end never reaches: its spinner stayed until the page was reloaded.
+    """
+    api = server.gui
+    interface = api._websock_interface  # pyright: ignore[reportPrivateUsage]
+    broadcast = interface.queue_message
+    if getattr(broadcast, "routes_upload_acks", False):
+        return
+
+    def queue_message(message: Any) -> None:
+        if isinstance(message, messages.FileTransferPartAck):
+            upload = api._current_file_upload_states.get(message.transfer_uuid)  # pyright: ignore[reportPrivateUsage]
+            client = None if upload is None else connected_client(server, upload["client_id"])
+            if client is not None:
+                _send(client, message)
+                return
+        broadcast(message)
+
+    queue_message.routes_upload_acks = True  # type: ignore[attr-defined]
+    interface.queue_message = queue_message  # type: ignore[method-assign]
 
 
 def upload_notice_id(transfer_uuid: str) -> str:

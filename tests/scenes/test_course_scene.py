@@ -597,6 +597,23 @@ def test_a_file_the_scene_closed_under_is_told_to_its_tab(
         assert not any("dropped.gpx" in n["body"] for n in other.notices())  # the refusal is the sender's
 
 
+def test_an_uploads_acks_reach_only_the_tab_that_sent_it(server: viser.ViserServer, mode: CourseMode) -> None:
+    """Every tab shares the scene here, and the upload button's acks were broadcast: viser's client in a tab that
+    sent nothing showed "Uploading undefined (6.4M)" with a spinner that never went (an outside tester, with and
+    without a Reset)."""
+    data = hill_gpx("Shared hill", 3000)
+    with BrowserClient(server.get_port()) as sender, BrowserClient(server.get_port()) as other:
+        sender.wait_for_gui("Upload GPX")
+        other.wait_for_gui("Upload GPX")
+        upload(sender, "Upload GPX", "shared.gpx", data, part=len(data) // 3 + 1)
+        sender.wait_for(lambda: mode.route_label == "shared.gpx", timeout=30.0, what="the file loaded")
+        acks = [
+            [m for _at, m in list(client.received) if m["type"] == "FileTransferPartAck"] for client in (sender, other)
+        ]
+        assert len(acks[0]) == 3 and acks[0][-1]["transferred_bytes"] == len(data)
+        assert acks[1] == []
+
+
 # Kind: a place on the route the Position slider cannot reach. Its end was the length rounded down to its 10 m
 # step, 1–9 m short of the finish (a 2,127 m route ended at 2.12 km). Its end, the length to the nearest step, is the
 # finish.

@@ -165,8 +165,9 @@ def test_an_upload_of_tiny_parts_is_refused(
 def test_a_transfer_id_in_flight_cannot_be_taken_by_another_tab(
     server: viser.ViserServer, mode: CourseMode, caplog: pytest.LogCaptureFixture
 ) -> None:
-    """Every tab sees a shared upload button's part acks (with the transfer id): a second tab's start under that id
-    is refused, so its parts cannot mix into the first tab's file."""
+    """A second tab's start under a transfer id in flight is refused, so its parts cannot mix into the first tab's
+    file. (Every tab once saw a shared button's acks, with the id; they now reach the sender alone, so here the
+    second tab is a crafted one that knows the id.)"""
     data = hill_gpx("Mine", 300)
     half = len(data) // 2
     with (
@@ -178,9 +179,10 @@ def test_a_transfer_id_in_flight_cannot_be_taken_by_another_tab(
         b.wait_for_gui("Upload GPX")
         transfer = start(a, part_count=2, size_bytes=len(data), filename="mine.gpx")
         send_part(a, transfer, 0, data[:half])
-        # b learns the id from the part's ack, as a real second tab would. Waiting for it also orders the two
-        # sockets: without it, b's start could reach the server first and rightly own the id, refusing a's.
-        b.wait_for(lambda: acked(b, transfer), what="the ack of a's first part")
+        # Waiting for the ack orders the two sockets: without it, b's start could reach the server first and
+        # rightly own the id, refusing a's.
+        a.wait_for(lambda: acked(a, transfer), what="the ack of a's first part")
+        assert not acked(b, transfer)  # the id is not told to other tabs
         start(b, part_count=2, size_bytes=len(data), filename="theirs.gpx", transfer_uuid=transfer)
         client_b_part = hill_gpx("Theirs", 300)
         send_part(b, transfer, 1, client_b_part[half:])  # refused: b has no upload under that id
