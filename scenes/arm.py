@@ -975,7 +975,8 @@ is a static pose.
             if np.linalg.norm(self.obstacle_centres[k] - self.pose[0]) <= p.radii_m[k]
         ]
         if p.avoid and covering:
-            text += f"  \nObstacle {', '.join(map(str, covering))} covers the root and cannot be avoided: ignored."
+            verb = "covers" if len(covering) == 1 else "cover"
+            text += f"  \n{_obstacles(covering).capitalize()} {verb} the root and cannot be avoided: ignored."
         return text
 
     def _ghost_markdown(self, report: SolveReport) -> str:

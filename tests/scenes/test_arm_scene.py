@@ -134,7 +134,12 @@ def test_an_obstacle_over_the_root_is_ignored_and_said_so(scene: ArmScene) -> No
     scene._apply_obstacle(0)
     report = scene.report
     assert report is not None and report.result.status == "reached"
-    assert "Obstacle 1 covers the root" in scene.readout.content
+    assert "Obstacle 1 covers the root and cannot be avoided" in scene.readout.content
+    # An outside tester read "Obstacle 1, 2 covers the root" for two.
+    scene.controls["n_obstacles"].value = 2
+    scene.obstacle_gizmos[1].position = (0.0, 0.0, 0.0)
+    scene._apply_obstacle(1)
+    assert "Obstacles 1 and 2 cover the root and cannot be avoided" in scene.readout.content, scene.readout.content
 
 
 def test_solvers_all_reach_the_target(scene: ArmScene) -> None:
