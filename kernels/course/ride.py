@@ -590,8 +590,8 @@ def power_for_time(
         Power (W).
 
     Raises:
-        ValueError: an argument is invalid, or the time is out of reach (faster than 5000 W rides it, or slower
-            than 1 W); the message says which.
+        ValueError: an argument is invalid, or the time is out of reach (faster than 5000 W rides it, faster than
+            the course's distance at ``max_speed_ms`` all the way, or slower than 1 W); the message says which.
     """
     target = _checks.positive("time_s", time_s)
     tol = _checks.positive("tolerance_s", tolerance_s)
@@ -634,7 +634,7 @@ def power_for_time(
             nxt = x - f / slope
             if nxt > math.log(hi_p):
                 if x >= math.log(hi_p) or time_at(hi_p) > target + tol:
-                    raise ValueError(f"time_s {target:.6g} s is out of reach: it needs more than {hi_p:.0f} W")
+                    raise ValueError(_too_fast(target, course, cap, hi_p))
                 nxt = math.log(hi_p)
             elif nxt < math.log(lo_p):
                 if x <= math.log(lo_p) or time_at(lo_p) < target - tol:
@@ -643,6 +643,18 @@ def power_for_time(
         x_prev, f_prev = x, f
         x = nxt
     return math.exp(x)
+
+
+def _too_fast(time_s: float, course: Course, max_speed_ms: float, power_w: float) -> str:
+    """Why ``time_s`` is beyond ``power_w``: the safe speed where no power rides the course that fast (its distance
+    at ``max_speed_ms`` all the way is the bound), else the power."""
+    floor_s = course.total_distance_m / max_speed_ms
+    if time_s <= floor_s:
+        return (
+            f"time_s {time_s:.6g} s is out of reach: held to the safe speed max_speed_ms = {max_speed_ms:g} m/s, "
+            f"no power rides the {course.total_distance_m / 1000:.4g} km in under {floor_s:.6g} s"
+        )
+    return f"time_s {time_s:.6g} s is out of reach: it needs more than {power_w:.0f} W"
 
 
 @dataclasses.dataclass(frozen=True)

@@ -436,6 +436,22 @@ def test_power_for_time_paced_out_of_reach_names_the_time_asked_for() -> None:
         course.power_for_time(descent, 60.0, gain=0.05)
 
 
+# Kind: a target blamed on the power where the safe speed bounds every ride. 20 km held to 12 m/s take at least
+# 1666.67 s whatever the power (5000 W: 1667.07 s); 1100 s read "it needs more than 5000 W".
+@pytest.mark.parametrize("gain", [0.0, 0.15])
+@pytest.mark.parametrize("target", [1100.0, 1666.6])
+def test_power_for_time_blames_the_safe_speed_below_its_bound(gain: float, target: float) -> None:
+    s = np.arange(0.0, 20_000.0 + 5, 100.0)
+    flat = course.course_from_xy(s, np.zeros_like(s), np.zeros_like(s))
+    message = f"time_s {target:g} s is out of reach: held to the safe speed max_speed_ms = 12 m/s, no power rides the"
+    with pytest.raises(ValueError, match=f"^{re.escape(message)} 20 km in under 1666.67 s$"):
+        course.power_for_time(flat, target, max_speed_ms=12.0, gain=gain)
+    # Just above the bound the power is what is short: 5000 W rides it in 1667.07 s (the start from rest).
+    with pytest.raises(ValueError, match=r"^time_s 1666.9 s is out of reach: it needs more than 5000 W$"):
+        course.power_for_time(flat, 1666.9, max_speed_ms=12.0)
+    assert course.ride(flat, 5000.0, max_speed_ms=12.0).time_s == pytest.approx(1667.07, abs=0.01)
+
+
 def test_power_for_time_refuses_a_gain_out_of_range_by_name() -> None:
     c = loop_course(600)
     for bad in (-0.1, 0.6, float("nan"), True, "0.1"):
@@ -444,9 +460,11 @@ def test_power_for_time_refuses_a_gain_out_of_range_by_name() -> None:
 
 
 def test_power_for_time_out_of_reach_says_so() -> None:
-    c = course.load_gpx(course.SAMPLE_ROUTE)
-    with pytest.raises(ValueError, match="more than 5000 W"):
+    c = course.load_gpx(course.SAMPLE_ROUTE)  # 13.15 km: 657.56 s at 20 m/s all the way; 5000 W: 661.32 s
+    with pytest.raises(ValueError, match=r"the 13.15 km in under 657.564 s$"):
         course.power_for_time(c, 60.0)
+    with pytest.raises(ValueError, match=r"^time_s 659 s is out of reach: it needs more than 5000 W$"):
+        course.power_for_time(c, 659.0)
     with pytest.raises(ValueError, match="time_s"):
         course.power_for_time(c, float("nan"))
 

@@ -639,7 +639,8 @@ def test_a_new_course_puts_the_position_slider_back_to_the_start(mode: CourseMod
 
 
 # Kind: a found value silently clipped to an input's range. Each target is solved within the input's range or
-# the message says plainly, in minutes, that it is out of it (12 min needed > 2000 W; 6000 min < 20 W).
+# the message says plainly, in minutes, that it is out of it (12 min needed > 2000 W; 6000 min < 20 W; 1 min is
+# faster than the safe speed allows, whatever the power).
 @pytest.mark.parametrize("target_min", [1.0, 12.0, 30.0, 50.0, 90.0, 600.0, 6000.0])
 def test_find_the_power_says_when_the_target_is_out_of_the_inputs_range(mode: CourseMode, target_min: float) -> None:
     mode.controls["target_min"].value = target_min
@@ -647,9 +648,15 @@ def test_find_the_power_says_when_the_target_is_out_of_the_inputs_range(mode: Co
     assert mode.state is not None
     ride = mode.state.ride
     content = mode.solve_info.content if mode.solve_info.visible else ""
-    assert "out of reach" not in content and "time_s" not in content
+    assert "time_s" not in content and "max_speed_ms" not in content  # the kernel's words, not the page's
     if mode.controls["power_w"].value == 2000.0 and ride.time_s > target_min * 60.0 + 1.0:
-        assert f"A {target_min:g} min finish needs more than 2000 W" in content
+        if target_min == 1.0:  # below 13.15 km at 72 km/h all the way, 657.6 s: beyond any power
+            assert (
+                "A 1 min finish is out of reach: held to the 72 km/h safe speed, no power rides these 13.2 km in"
+                " under 10:58: set to 2000 W" in content
+            )
+        else:
+            assert f"A {target_min:g} min finish needs more than 2000 W, the most this input takes" in content
         assert format_duration(ride.time_s) in content
     elif mode.controls["power_w"].value == 20.0 and ride.time_s < target_min * 60.0 - 1.0:
         assert f"A {target_min:g} min finish needs less than 20 W" in content
@@ -659,8 +666,25 @@ def test_find_the_power_says_when_the_target_is_out_of_the_inputs_range(mode: Co
         assert abs(ride.time_s - target_min * 60.0) < 0.5
         assert format_duration(ride.time_s) == format_duration(target_min * 60.0)
         assert "finish needs" not in content
-    assert (target_min <= 12.0) == ("more than 2000 W" in content)
+    assert (target_min == 12.0) == ("more than 2000 W" in content)
+    assert (target_min == 1.0) == ("safe speed" in content)
     assert (target_min >= 6000.0) == ("less than 20 W" in content)
+
+
+# Kind: an out-of-reach note that blames the power where the safe speed bounds the ride. At 20 km/h the sample
+# climb's 13.15 km take at least 39:27 whatever the power; a 30 min target read "needs more than 2000 W".
+@pytest.mark.parametrize(("safe_kmh", "target_min", "floor"), [(20.0, 30.0, "39:27"), (30.0, 20.0, "26:18")])
+def test_find_the_power_blames_the_safe_speed_where_no_power_is_enough(
+    mode: CourseMode, safe_kmh: float, target_min: float, floor: str
+) -> None:
+    mode.controls["max_speed_kmh"].value = safe_kmh
+    mode.controls["target_min"].value = target_min
+    mode.solve.value = True
+    assert mode.controls["power_w"].value == 2000.0 and mode.state is not None
+    assert mode.state.ride.time_s > 13151.28 / (safe_kmh / 3.6)
+    content = mode.solve_info.content
+    assert f"held to the {safe_kmh:.0f} km/h safe speed, no power rides these 13.2 km in under {floor}" in content
+    assert "needs more than" not in content
 
 
 def test_the_out_of_range_note_stays_under_the_button_while_its_target_and_power_are_set(mode: CourseMode) -> None:
@@ -668,7 +692,7 @@ def test_the_out_of_range_note_stays_under_the_button_while_its_target_and_power
     mode.solve.value = True
     assert mode.controls["power_w"].value == 2000.0
     mode.controls["power_w"].value = 2000.0  # the page's own copy of the power coming back changes nothing
-    assert mode.solve_info.visible and "A 1 min finish needs more than 2000 W" in mode.solve_info.content
+    assert mode.solve_info.visible and "A 1 min finish is out of reach" in mode.solve_info.content
     mode.controls["power_w"].value = 1500.0
     assert not mode.solve_info.visible
     mode.controls["power_w"].value = 2000.0
@@ -699,7 +723,7 @@ def test_the_out_of_range_note_goes_with_any_input_that_changes_the_ride(
 ) -> None:
     mode.controls["target_min"].value = 1.0
     mode.solve.value = True
-    assert mode.solve_info.visible and "A 1 min finish needs more than 2000 W" in mode.solve_info.content
+    assert mode.solve_info.visible and "A 1 min finish is out of reach" in mode.solve_info.content
     for view in ("exaggeration", "playback"):
         mode.controls[view].value = _another_value(mode.controls[view])
     assert mode.solve_info.visible
