@@ -12,6 +12,7 @@ import dataclasses
 import decimal
 import functools
 import math
+import sys
 from collections.abc import Sequence
 from typing import Any
 
@@ -850,9 +851,16 @@ def spin_vector(rate_rev_s: float, axis: ArrayLike) -> NDArray[np.float64]:
 
     Returns:
         (3,) ω (rad/s).
+
+    Raises:
+        ValueError: ``rate_rev_s`` negative, not a finite number, or so large that ω overflows (over about
+            2.9·10³⁰⁷ rev/s); ``axis`` not three finite numbers of non-zero length. The message names it.
     """
     rate = _checks.non_negative("rate_rev_s", rate_rev_s)
-    return 2.0 * math.pi * rate * _checks.direction("axis", checked_vector("axis", axis, 3), 3)
+    omega = 2.0 * math.pi * rate
+    if not math.isfinite(omega):  # inf times an axis's 0 would be NaN
+        raise ValueError(f"rate_rev_s must be at most {sys.float_info.max / (2.0 * math.pi):.3g} rev/s, got {rate:g}")
+    return omega * _checks.direction("axis", checked_vector("axis", axis, 3), 3)
 
 
 def launch_velocity(speed_ms: float, elevation_rad: float, azimuth_rad: float) -> NDArray[np.float64]:

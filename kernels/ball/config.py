@@ -52,8 +52,10 @@ MAX_STEPS = 1_000_000
 
 def _step_count(duration: float, step: float) -> int:
     """Steps of ``step`` in a flight of ``duration`` (s): the last one shortened to end on it. A quotient over a
-    whole number by rounding (0.514/5.14e-7 is 1000000.0000000001) is that whole number."""
-    return max(1, math.ceil(duration / step - 1e-9))
+    whole number by rounding (0.514/5.14e-7 is 1000000.0000000001) is that whole number. More than
+    :data:`MAX_STEPS` reads as ``MAX_STEPS + 1``: a quotient that overflows to inf has no whole number."""
+    quotient = duration / step - 1e-9
+    return max(1, math.ceil(quotient)) if quotient <= MAX_STEPS else MAX_STEPS + 1
 
 
 # The compiled cores read their settings from one float64 vector; these are its slots.
@@ -171,6 +173,13 @@ class FlightConfig:
     def __post_init__(self) -> None:
         step = _checks.positive("dt", self.dt)
         duration = _checks.positive("t_max", self.t_max)
+        density = _checks.non_negative("air_density", self.air_density)
+        exact = density == 0.0 and self.method == "rk4"  # a vacuum's parabola, exact at any step
+        if duration > MAX_STEPS * MAX_DT_S and not exact:
+            raise ValueError(
+                f"t_max must be at most {MAX_STEPS * MAX_DT_S:g} s ({MAX_STEPS} steps of at most {MAX_DT_S:g} s), "
+                f"got {_checks.shown(self.t_max)}"
+            )
         if _step_count(duration, step) > MAX_STEPS:
             raise ValueError(
                 f"dt must be at least t_max/{MAX_STEPS} = {duration / MAX_STEPS:g} s, got {_checks.shown(step)}"
@@ -185,8 +194,7 @@ class FlightConfig:
             raise ValueError(
                 f"radius_m must be at most {MAX_BALL_RADIUS_M:g} m (a ball), got {_checks.shown(self.radius_m)}"
             )
-        density = _checks.non_negative("air_density", self.air_density)
-        if step > MAX_DT_S and not (density == 0.0 and self.method == "rk4"):
+        if step > MAX_DT_S and not exact:
             raise ValueError(
                 f"dt must be at most {MAX_DT_S:g} s for accuracy (beyond it RK4's landing point strays more than 1 cm "
                 f"on a free kick; only RK4 in a vacuum, exact at any step, takes more), got {_checks.shown(self.dt)}"

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
+import warnings
 from concurrent.futures import ThreadPoolExecutor
 from decimal import Decimal, getcontext
 from pathlib import Path
@@ -369,6 +371,39 @@ def test_invalid_input_raises_naming_the_argument(kwargs: dict[str, object], nam
     arguments.update(kwargs)
     with pytest.raises(ValueError, match=name):
         ball.simulate(**arguments)  # type: ignore[arg-type]
+
+
+# Kind: a count or vector derived from a finite input overflows. t_max = 1e308 (or dt = 1e-320) made a step count of
+# inf: OverflowError from math.ceil; a spin rate of 1e308 rev/s made ω = [nan, nan, inf] with a warning.
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"t_max": 1e308}, "t_max must be at most 100000 s (1000000 steps of at most 0.1 s), got 1e+308"),
+        (
+            {"t_max": 100_000.5, "dt": 0.1},
+            "t_max must be at most 100000 s (1000000 steps of at most 0.1 s), got 100000.5",
+        ),
+        ({"dt": 1e-320}, "dt must be at least t_max/1000000 = 5e-06 s, got 1e-320"),
+        ({"dt": 5e-324, "t_max": 99_999.0}, "dt must be at least t_max/1000000 = 0.099999 s, got 5e-324"),
+    ],
+)
+def test_a_step_count_beyond_any_float_is_refused_by_name(kwargs: dict[str, float], message: str) -> None:
+    with pytest.raises(ValueError, match=f"^{re.escape(message)}$"):
+        ball.simulate(START, kick(25, 15), (0.0, 0.0, 50.0), **kwargs)  # type: ignore[arg-type]
+    # A vacuum's RK4 is exact at any step, so only the step count bounds its t_max.
+    vacuum = ball.FlightConfig(dt=1e303, t_max=1e308, method="rk4", air_density=0.0)
+    assert vacuum.t_max == 1e308
+    assert ball.FlightConfig(dt=0.1, t_max=100_000.0).t_max == 100_000.0
+
+
+@pytest.mark.parametrize("rate", [1e308, 2.87e307, math.inf])
+def test_a_spin_rate_whose_angular_velocity_overflows_is_refused_by_name(rate: float) -> None:
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(ValueError, match=r"^rate_rev_s must be"):
+            ball.spin_vector(rate, (0.0, 0.0, 1.0))
+        top = ball.spin_vector(2.86e307, (0.0, 0.0, 1.0))
+    assert top[2] == pytest.approx(2 * math.pi * 2.86e307) and top[0] == top[1] == 0.0
 
 
 def test_batch_rejects_mismatched_rows() -> None:
