@@ -210,6 +210,8 @@ reads it again, so a ball that bounces in front of him beats him more often than
         """The odds shown for the map's settings: the kick struck many times with a player's scatter."""
         self.last_target: tuple[float, float] | None = None
         self.aim_message = ""
+        self._aim_searching = False
+        """Whether a goal-mouth click's search is under way (for the kick shown when it was clicked)."""
         self._odds_version = 0
         self.odds_map: NDArray[np.float64] | None = None
         """The goal chance over the pitch's spots (:func:`~scenes.freekick.odds.spot_odds_map`), once asked for."""
@@ -440,6 +442,8 @@ reads it again, so a ball that bounces in front of him beats him more often than
             self.params.distance_m,
             self.params.angle_deg,
         )
+        if params.shown_as(self.params) != self.params:  # another kick, not only its arrows or view
+            self._drop_aim()
         self.params, self.state = params, state
         self.kick_time_s = None
         self.redraw()
@@ -512,6 +516,7 @@ reads it again, so a ball that bounces in front of him beats him more often than
         """Queue a search for a kick reaching (y, z) on the goal line; its result is applied when it finishes."""
         self.last_target = (y, z)
         self._aim_version += 1
+        self._aim_searching = True
         version, params = self._aim_version, self.params
         with self.server.atomic():
             self.target_marker.position = (0.0, y, z)
@@ -523,11 +528,13 @@ reads it again, so a ball that bounces in front of him beats him more often than
             with self._lock:
                 if self.closed or version != self._aim_version:
                     return
+                self._aim_searching = False
                 if found is None:
                     self.aim_message = "No kick at this speed reaches that point over the wall; try another speed."
                     self.aim_status.content = self.aim_message
                     return
-                self.apply(found.shown_as(self.params))  # as shown now, not when the click came
+                self.apply(found.shown_as(self.params))  # arrows and view as shown now, not when the click came
+                self.target_marker.visible = True  # (the kick's change took the last one's down)
                 point = self.state.outcome.goal_point
                 reached = "" if point is None else f" It crosses at y = {point[1]:+.2f} m, z = {point[2]:.2f} m."
                 self.aim_message = (
@@ -537,6 +544,19 @@ reads it again, so a ball that bounces in front of him beats him more often than
                 self.aim_status.content = self.aim_message
 
         self._aim_worker.submit(job)
+
+    def _drop_aim(self) -> None:
+        """The kick changed: a search under way was for the kick before, and is dropped (it said so); a result and
+        its marker spoke of the kick before, and are taken down."""
+        self._aim_version += 1
+        if not (self._aim_searching or self.aim_message or self.target_marker.visible):
+            return
+        stopped = "The kick changed during the search, which was stopped; click the goal again to aim this one."
+        self.aim_message = stopped if self._aim_searching else ""
+        self._aim_searching = False
+        with self.server.atomic():
+            self.target_marker.visible = False
+            self.aim_status.content = self.aim_message
 
     # ----------------------------------------------------------------------------------------- outcome map
     def request_outcome_map(self) -> None:
