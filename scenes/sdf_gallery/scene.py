@@ -389,7 +389,7 @@ IoU is lowest when a box edge is on the silhouette.
                 self._shape_choices += 1
             status = self.editor_status.content
             if self.params.shape_source == "editor" and status.endswith(_SEE_IT):  # it is seen now
-                self.editor_status.content = status.removesuffix(_SEE_IT) + "."
+                self._show_editor_status(status.removeprefix(f"{EDITING_OFF}\n\n").removesuffix(_SEE_IT) + ".")
             self._sync_enabled_inputs()
             self._request_mesh()
         with self._state:
@@ -505,11 +505,16 @@ IoU is lowest when a box edge is on the silhouette.
         self._wake()
 
     # ----------------------------------------------------------------------------------------- showing inputs
+    def _show_editor_status(self, status: str) -> None:
+        """Say ``status`` under the editor, after why typing is off where it is (the box stays disabled: a status
+        alone would leave it unexplained)."""
+        self.editor_status.content = status if editor.editing_allowed() else f"{EDITING_OFF}\n\n{status}"
+
     def _show_editor_error(self, message: str) -> None:
         self.editor_error = message
         with self._lock:
             if not self.closed:
-                self.editor_status.content = f"**Not applied.** {message}\n\nThe last good shape stays on screen."
+                self._show_editor_status(f"**Not applied.** {message}\n\nThe last good shape stays on screen.")
 
     def _show_view_mode(self) -> None:
         mode = self.params.view_mode
@@ -701,7 +706,7 @@ IoU is lowest when a box edge is on the silhouette.
                 self.params = dataclasses.replace(self.params, editor=field)
                 self.editor_error = None
                 self.editor_serial += 1
-                self.editor_status.content = f"**Applied** in {total_ms:.0f} ms{_SEE_IT}"
+                self._show_editor_status(f"**Applied** in {total_ms:.0f} ms{_SEE_IT}")
                 self._request_mesh()  # the chosen shape, also where the Apply took the request that chose it
                 return
             self.params = dataclasses.replace(self.params, editor=field, shape_source="editor")
@@ -713,7 +718,7 @@ IoU is lowest when a box edge is on the silhouette.
             source_control = self.view_controls.fields["shape_source"].control
             self.write_back(self.view_controls["shape_source"], source_control.to_gui("editor"))
             self._sync_enabled_inputs()
-            self.editor_status.content = (
+            self._show_editor_status(
                 f"**Applied** in {total_ms:.0f} ms (compile, a test frame and a {resolution}³ mesh)."
             )
             if self.params.editor_half_size != field.half_size:  # the bounds moved while it compiled

@@ -702,6 +702,20 @@ def test_with_editing_off_apply_uses_only_the_servers_examples(
             apply_glsl(client, SPHERE_SOURCE)  # a crafted client can still send text
             wait_until(lambda: scene.editor_serial == 1, "an apply")
             assert scene.params.editor.source == next(iter(gallery.EXAMPLES.values()))
+            # Why the box is disabled stays said above each status (an outside tester: "Applied" replaced it).
+            status = scene.editor_status.content
+            assert status.startswith(f"{gallery.EDITING_OFF}\n\n**Applied** in") and status.count("Editing is off") == 1
+            title = list(gallery.EXAMPLES)[1]
+            client.set_value("Example", title)
+            wait_until(lambda: scene.editor_serial == 2, "the example applied")
+            assert scene.params.editor.source == gallery.EXAMPLES[title]
+            status = scene.editor_status.content
+            assert status.startswith(f"{gallery.EDITING_OFF}\n\n**Applied** in") and status.count("Editing is off") == 1
+            # Shape turned away and back: the note is still said once.
+            for source in ("Primitives (panels below)", "GLSL editor"):
+                client.set_value("Shape", source)
+            wait_until(lambda: scene.params.shape_source == "editor", "the editor shown again")
+            assert scene.editor_status.content.count("Editing is off") == 1
     finally:
         scene.close()
 
