@@ -1,4 +1,4 @@
-// Smooth blend: a cylinder, an octahedron and a cone
+// Smooth blend: cylinder, octahedron, cone
 // smooth_union blends two distances over a width k (m); Z is up, the catalogue's shapes stand along their local y.
 float sdf(vec3 p) {
     vec3 q = p.xzy;  // local y = world z

@@ -1,4 +1,4 @@
-// Onion: a hollow shell, cut open to show its wall
+// Onion: a hollow shell, cut open
 // op_onion(d, t) = |d| - t turns any shape into a shell of wall 2t; a plane cuts the top off.
 float sdf(vec3 p) {
     float shell = op_onion(sd_sphere(p, 0.8), 0.04);

@@ -1,4 +1,4 @@
-// Twist: a hexagonal prism turned as it rises
+// Twist: a hexagonal prism turning
 // op_twist maps the point, which stretches distances: dividing by the map's Lipschitz factor keeps a safe bound.
 float sdf(vec3 p) {
     float rate = 2.0;                     // rad/m

@@ -1,4 +1,4 @@
-// Finite repetition: a 5 x 3 grid of rounded octahedra on a slab
+// Repetition: a 5 x 3 grid of octahedra
 // op_repeat_finite folds space into cells; limit says how many copies on each side of the middle one.
 float sdf(vec3 p) {
     vec3 q = op_repeat_finite(p - vec3(0.0, 0.0, 0.2), vec3(0.45, 0.5, 1.0), vec3(2.0, 1.0, 0.0));

@@ -1,5 +1,6 @@
-// Elongation: a torus stretched into a running track, with an ellipsoid inside
-// op_elongate splits a shape at its centre planes and moves the halves apart (exact for an exact shape).
+// Elongation: a torus stretched into a track
+// op_elongate splits a shape at its centre planes and moves the halves apart (exact for an exact shape); an
+// ellipsoid sits inside the running track.
 float sdf(vec3 p) {
     vec4 e = op_elongate(p.xzy, vec3(0.5, 0.0, 0.2));
     float track = sd_torus(e.xyz, 0.45, 0.1) + e.w;
