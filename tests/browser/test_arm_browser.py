@@ -21,6 +21,7 @@ from helpers.browser import (
     control_row,
     error_text,
     line_mask,
+    menu_test,
     project,
     save_scene_screenshot,
     scene_page_fixture,
@@ -41,6 +42,7 @@ CHART = "Error after each iteration (log scale)"
 
 
 shown = scene_page_fixture("arm")
+test_every_menu_option_fits_its_menu = menu_test()
 
 
 def _chain_points(scene: ArmScene) -> np.ndarray:

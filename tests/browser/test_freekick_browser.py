@@ -22,6 +22,7 @@ from helpers.browser import (
     chart_fits_test,
     colour_pixels,
     error_text,
+    menu_test,
     notice_left_open,
     panel_rect,
     peaks_over,
@@ -109,6 +110,7 @@ def test_the_kick_fills_the_view_clear_of_the_panel(shown: ScenePage) -> None:
 
 
 test_the_chart_draws_every_series, test_no_error_text_on_the_page = chart_and_text_tests(CHART, CHART_COLOURS)
+test_every_menu_option_fits_its_menu = menu_test()
 
 
 def test_ten_percent_more_spin_moves_the_path_on_the_screen(shown: ScenePage) -> None:

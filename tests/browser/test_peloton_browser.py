@@ -27,6 +27,7 @@ from helpers.browser import (
     control_row,
     error_text,
     line_mask,
+    menu_test,
     node_box_corners,
     notice_left_open,
     panel_rect,
@@ -122,6 +123,7 @@ def test_the_line_is_in_view_clear_of_the_panel(shown: ScenePage) -> None:
 
 
 test_the_chart_draws_every_series, test_no_error_text_on_the_page = chart_and_text_tests(CHART, CHART_COLOURS)
+test_every_menu_option_fits_its_menu = menu_test()
 
 
 def test_eight_riders_far_apart_stay_in_view(shown: ScenePage) -> None:

@@ -308,6 +308,58 @@ def chart_and_text_tests(chart: str, colours: dict[str, Sequence[int]]) -> tuple
     return test_the_chart_draws_every_series, test_no_error_text_on_the_page
 
 
+MENU_ROOMS = """
+([labels, texts]) => {
+  const rooms = {};
+  let font = null;
+  for (const label of labels) {
+    for (const tag of document.querySelectorAll('label')) {
+      if (tag.textContent.trim() !== label || tag.offsetParent === null) continue;
+      let row = tag;
+      while (row && !row.querySelector('input:not([type=hidden])')) row = row.parentElement;
+      const input = row && row.querySelector('input:not([type=hidden])');
+      if (!input || input.offsetParent === null) continue;
+      const style = getComputedStyle(input);
+      const room = input.clientWidth - parseFloat(style.paddingLeft) - parseFloat(style.paddingRight);
+      rooms[label] = Math.min(rooms[label] ?? Infinity, room);
+      font = font ?? `${style.fontWeight} ${style.fontSize} ${style.fontFamily}`;
+    }
+  }
+  if (font === null) return null;
+  const pen = document.createElement('canvas').getContext('2d');
+  pen.font = font;
+  return [rooms, texts.map(text => pen.measureText(text).width)];
+}
+"""
+"""The room for text in each shown menu of ``labels`` (CSS px, by label) and the width each of ``texts`` takes in
+their font; null where no menu is shown."""
+
+
+def menu_test() -> Any:
+    """A test for a module with a ``shown`` fixture (assign it to a ``test_…`` name): every option of every dropdown
+    the scene holds fits its menu, so the option picked is read whole. A menu not shown (a closed folder, a hidden
+    one) is held to the narrowest shown."""
+
+    def test_every_menu_option_fits_its_menu(shown: ScenePage) -> None:
+        from helpers.viser_private import dropdowns
+
+        menus = dropdowns(shown.server)
+        texts = sorted({option for options in menus.values() for option in options})
+        measured = shown.page.evaluate(MENU_ROOMS, [list(menus), texts])
+        assert measured is not None, ("no menu shown", list(menus))
+        rooms, widths = measured
+        width = dict(zip(texts, widths, strict=True))
+        narrowest = min(rooms.values())
+        assert narrowest > 100.0, rooms
+        too_wide = {
+            label: {option: round(width[option]) for option in options if width[option] > rooms.get(label, narrowest)}
+            for label, options in menus.items()
+        }
+        assert not any(too_wide.values()), ({label: round(room) for label, room in rooms.items()}, too_wide)
+
+    return test_every_menu_option_fits_its_menu
+
+
 def scene_page_fixture(key: str, viewports: Sequence[tuple[int, int]] = VIEWPORTS, *, gl: bool = False) -> Any:
     """A module-scoped fixture (assign it to ``shown``): scene ``key`` served and shown in one settled page per
     viewport (:func:`scene_page`), shared by the module's tests at that viewport. ``gl``: the scene needs the

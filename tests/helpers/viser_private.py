@@ -57,3 +57,9 @@ def control_state(handle: object) -> dict[str, object]:
         "callbacks": len(impl.update_cb),
         "removed": impl.removed,
     }
+
+
+def dropdowns(server: viser.ViserServer) -> dict[str, tuple[str, ...]]:
+    """Every dropdown the server holds: its label and its options."""
+    handles = server.gui._gui_input_handle_from_uuid.values()
+    return {handle.label: tuple(handle.options) for handle in handles if isinstance(handle, viser.GuiDropdownHandle)}
