@@ -823,7 +823,12 @@ def mesh_glsl(source: str, resolution: int, bounds: ArrayLike) -> trimesh.Trimes
     gradient = lipschitz if far else 1.0
     gl_service.run(lambda gl: gl.remember_field_gradient(source, box, gradient))
     try:  # on the caller's thread: the GL thread serves other callers meanwhile
-        vertices, faces = sdf.mesh_samples(grid, field, _near_surface_mask(field, grid.spacing))
+        # Cell centres beside samples on the zero level are read from the source itself (whether the solid has
+        # volume there); the field's positive scale above changes no sign.
+        def distance_at(points: NDArray[np.float64]) -> NDArray[np.float32]:
+            return gl_service.run(lambda gl: gl.probe_field(source, points)[0])
+
+        vertices, faces = sdf.mesh_samples(grid, field, _near_surface_mask(field, grid.spacing), distance_at)
     except RuntimeError:  # scikit-image's "No surface found at the given iso value"
         vertices, faces = np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64)
     colors = gl_service.run(lambda gl: gl.probe_field(source, vertices)[1]) if len(vertices) else np.zeros((0, 3))

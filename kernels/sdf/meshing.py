@@ -17,6 +17,7 @@ topological guarantees", J. Graphics Tools 8(2) (2003).
 from __future__ import annotations
 
 import dataclasses
+import functools
 import itertools
 import math
 from collections.abc import Callable
@@ -28,7 +29,7 @@ from skimage.measure import label, marching_cubes
 
 from kernels import _checks
 from kernels.sdf.primitives import FloatArray
-from kernels.sdf.scene import Primitive, Scene, fold_xyz, scene_bounds, scene_color
+from kernels.sdf.scene import Scene, fold_xyz, scene_bounds, scene_color
 
 MIN_RESOLUTION = 16
 MAX_RESOLUTION = 512
@@ -245,7 +246,8 @@ def mesh(
         field = sample_full(scene, grid)
     if progress is not None:
         progress(0.8)
-    return _polygonise(scene, grid, field, mask)
+    verts, faces = _polygonise(grid, field, mask, lambda points: _field_at(scene, points))
+    return verts, faces, scene_color(scene, verts) if len(verts) else np.zeros((0, 3))
 
 
 ISO_NUDGE_VOXELS = 1e-3
@@ -253,8 +255,11 @@ ISO_NUDGE_VOXELS = 1e-3
 
 
 def _polygonise(
-    scene: Scene, grid: Grid, field: NDArray[np.float32], mask: NDArray[np.bool_] | None
-) -> tuple[FloatArray, NDArray[np.int64], FloatArray]:
+    grid: Grid,
+    field: NDArray[np.float32],
+    mask: NDArray[np.bool_] | None,
+    distance_at: Callable[[FloatArray], NDArray[np.floating]],
+) -> tuple[FloatArray, NDArray[np.int64]]:
     # A sample exactly on the level is a tie that marching cubes breaks differently in neighbouring cells (its
     # classification and its face test disagree), which leaves holes (scikit-image issue 8116), so every sample
     # closer than δ = 1e-3 voxel to the level moves to ±δ. Which side: a sample on the level is a boundary point of
@@ -275,20 +280,21 @@ def _polygonise(
         # one (a blend grazing a sample) stays outside, so a sub-voxel blend keeps the topology it always had.
         # On the grid's outer layer a sample stays outside as well: the solid may go on beyond the bounds, and
         # marching cubes only closes a surface that crosses inside them (a box that fills its bounds).
-        lined = near_level & (field >= 0.0) & _beside(near_level)
-        lined[[0, -1], :, :] = False
-        lined[:, [0, -1], :] = False
-        lined[:, :, [0, -1]] = False
-        inward = (field < 0.0) | _holds_volume(_touches_solid(scene, grid, lined), field < 0.0)
+        outer = np.zeros(field.shape, dtype=bool)
+        outer[[0, -1], :, :] = outer[:, [0, -1], :] = outer[:, :, [0, -1]] = True
+        lined = near_level & (field >= 0.0) & _beside(near_level) & ~outer
+        inward = (field < 0.0) | _holds_volume(_touches_solid(distance_at, grid, lined), field < 0.0)
         nudged = np.where(inward, -delta, delta)
         # A level sample left outside next to one moved inside: the edge between them runs along a face that only
         # the inside one bounds (a cut flush with another face), so the surface belongs at the inside sample, not
         # halfway between ±δ. The outside one takes half a voxel instead, putting the vertex ~2δ from it.
-        beside = _beside(near_level & inward) & near_level & ~inward
+        # (Not on the outer layer, left outside for the bounds' sake, not the geometry's: a plane on a grid plane
+        # that crosses the bounds kept its vertices there a third of a voxel off it.)
+        beside = _beside(near_level & inward) & near_level & ~inward & ~outer
         nudged = np.where(beside, np.float32(0.5 * grid.spacing), nudged)
         field = np.where(near_level, nudged, field)
     if not (field.min() < 0.0 < field.max()):
-        return np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64), np.zeros((0, 3))
+        return np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64)
     verts, faces, _normals, _values = marching_cubes(
         np.ascontiguousarray(field, dtype=np.float32),
         level=0.0,
@@ -297,7 +303,7 @@ def _polygonise(
     )
     verts = verts.astype(np.float64) + np.asarray(grid.origin)
     # scikit-image's default winding faces a field that is negative inside outward (tests check the volume's sign).
-    return verts, faces.astype(np.int64), scene_color(scene, verts)
+    return verts, faces.astype(np.int64)
 
 
 def _holds_volume(level_in: NDArray[np.bool_], inside: NDArray[np.bool_]) -> NDArray[np.bool_]:
@@ -344,8 +350,11 @@ def _beside(samples: NDArray[np.bool_]) -> NDArray[np.bool_]:
     return out
 
 
-def _touches_solid(scene: Scene, grid: Grid, samples: NDArray[np.bool_]) -> NDArray[np.bool_]:
-    """(nx, ny, nz) True at the ``samples`` that are a corner of a grid cell whose centre is inside (d < 0)."""
+def _touches_solid(
+    distance_at: Callable[[FloatArray], NDArray[np.floating]], grid: Grid, samples: NDArray[np.bool_]
+) -> NDArray[np.bool_]:
+    """(nx, ny, nz) True at the ``samples`` that are a corner of a grid cell whose centre is inside (d < 0 by
+    ``distance_at``, the field at (N, 3) points)."""
     out = np.zeros(samples.shape, dtype=bool)
     at = np.argwhere(samples)
     if len(at) == 0:
@@ -355,9 +364,9 @@ def _touches_solid(scene: Scene, grid: Grid, samples: NDArray[np.bool_]) -> NDAr
     cells = (at[:, None, :] + offsets[None, :, :]).reshape(-1, 3)
     valid = np.all((cells >= 0) & (cells < cells_shape), axis=1)
     unique = np.unique(cells[valid], axis=0)
-    centres = np.asarray(grid.origin) + grid.spacing * (unique + 0.5)
+    centres = (np.asarray(grid.origin) + grid.spacing * (unique + 0.5)).astype(np.float64)
     inside_cell = np.zeros(tuple(cells_shape), dtype=bool)
-    inside_cell[unique[:, 0], unique[:, 1], unique[:, 2]] = _field_at(scene, centres) < 0.0
+    inside_cell[unique[:, 0], unique[:, 1], unique[:, 2]] = np.asarray(distance_at(centres)) < 0.0
     hit = np.zeros(len(cells), dtype=bool)
     good = cells[valid]
     hit[valid] = inside_cell[good[:, 0], good[:, 1], good[:, 2]]
@@ -383,7 +392,10 @@ def mesh_trimesh(vertices: FloatArray, faces: NDArray[np.int64], colors: FloatAr
 
 # ------------------------------------------------------------------------------------------ sampled fields
 def mesh_samples(
-    grid: Grid, field: NDArray[np.float32], mask: NDArray[np.bool_] | None = None
+    grid: Grid,
+    field: NDArray[np.float32],
+    mask: NDArray[np.bool_] | None = None,
+    distance_at: Callable[[FloatArray], NDArray[np.floating]] | None = None,
 ) -> tuple[FloatArray, NDArray[np.int64]]:
     """Marching cubes of a field sampled elsewhere (the GLSL editor's, sampled on the GPU), by :func:`mesh`'s pass.
 
@@ -391,6 +403,9 @@ def mesh_samples(
         grid: where the samples are (:func:`make_grid`).
         field: (nx, ny, nz) float32 distances (m), negative inside, shaped like ``grid.shape``.
         mask: optional (nx, ny, nz) cells marching cubes may visit.
+        distance_at: optional, the field at (N, 3) points (m), for the centres of the cells next to samples on the
+            zero level (whether the solid has volume there: see :func:`mesh`); without it, a centre's distance is
+            the mean of its cell's eight corners.
 
     Returns:
         vertices (V, 3) in metres and faces (F, 3) wound outward; empty when no surface crosses the grid.
@@ -408,9 +423,17 @@ def mesh_samples(
         mask = np.asarray(mask)
         if mask.dtype != np.bool_ or mask.shape != tuple(grid.shape):
             raise ValueError(f"mask must be None or bools of the grid's shape {grid.shape}, got {_checks.shown(mask)}")
-    # _polygonise colours its vertices from a scene; one small sphere keeps that cost to a few ms.
-    verts, faces, _ = _polygonise(_COLOURLESS, grid, values, mask)
-    return verts, faces
+    if distance_at is None:
+        distance_at = functools.partial(_corner_mean, grid, values)
+    return _polygonise(grid, values, mask, distance_at)
 
 
-_COLOURLESS = Scene((Primitive("sphere", (0.0, 0.0, 0.0), (1.0,)),))
+def _corner_mean(grid: Grid, field: NDArray[np.float32], centres: FloatArray) -> NDArray[np.float32]:
+    """The mean of the eight samples of ``field`` around each of the (N, 3) cell ``centres`` (trilinear at the
+    centre)."""
+    corner = np.rint((centres - np.asarray(grid.origin)) / grid.spacing - 0.5).astype(np.int64)
+    total = np.zeros(len(centres), dtype=np.float64)
+    for offset in itertools.product((0, 1), repeat=3):
+        at = corner + offset
+        total += field[at[:, 0], at[:, 1], at[:, 2]]
+    return (total / 8.0).astype(np.float32)

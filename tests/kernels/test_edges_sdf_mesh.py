@@ -17,6 +17,7 @@ from helpers.meshing import CUBE_BOUNDS, assert_near_surface_meshes_like_the_ful
 from helpers.properties import examples
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
+from numpy.typing import NDArray
 
 from kernels import sdf
 
@@ -293,6 +294,29 @@ def test_a_feature_one_voxel_thick_on_grid_planes_meshes_closed(
     nudge = 2.0 * sdf.ISO_NUDGE_VOXELS * spacing(resolution) * tri.area
     assert exact - 1e-9 <= tri.volume <= exact + nudge + 1e-9
     assert_near_surface_meshes_like_the_full_grid(scene, resolution, CUBE_BOUNDS)
+
+
+# Kind: samples on the zero level judged by a field other than the one meshed (mesh_samples read a stand-in unit
+# sphere), and the bounds' outer layer moved half a voxel off the level beside them. A half-space and a box on grid
+# planes, crossing the bounds, sampled elsewhere: every vertex on its plane, to the 2δ nudge.
+@pytest.mark.parametrize("shape", ["half-space", "box"])
+@pytest.mark.parametrize("with_distance", [False, True])
+def test_a_sampled_field_on_grid_planes_meshes_on_them(shape: str, with_distance: bool) -> None:
+    grid = sdf.make_grid(sdf.default_scene(), 64, [[-1.5] * 3, [1.5] * 3])
+    spacing = 3.0 / 63.0
+
+    def distance(points: NDArray[np.float64]) -> NDArray[np.float32]:
+        if shape == "half-space":  # z ≤ −0.5
+            return (points[:, 2] + 0.5).astype(np.float32)
+        # A box from (−0.5, −0.5, −2) to (0.5, 0.5, 0.5): through the bounds' floor, its other faces on sample planes
+        return sdf.sd_box(points - np.array([0.0, 0.0, -0.75]), (0.5, 0.5, 1.25)).astype(np.float32)
+
+    axes = [grid.origin[i] + grid.spacing * np.arange(grid.shape[i]) for i in range(3)]
+    points = np.asarray(np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3), dtype=np.float64)
+    field = distance(points).reshape(grid.shape)
+    vertices, faces = sdf.mesh_samples(grid, field, distance_at=distance if with_distance else None)
+    assert len(faces) > 0
+    np.testing.assert_allclose(distance(vertices), 0.0, atol=2.0 * sdf.ISO_NUDGE_VOXELS * spacing + 1e-6)
 
 
 def test_zero_volume_sets_stay_empty() -> None:

@@ -335,6 +335,22 @@ def test_mesh_glsl_equals_the_numpy_mesher_on_the_same_field() -> None:
     np.testing.assert_allclose(np.sort(tri.vertices, axis=0), np.sort(vertices, axis=0), atol=1e-5)
 
 
+# Kind: samples on the zero level judged by a field other than the one meshed. Which level samples hold volume was
+# read from a stand-in unit sphere, not the editor's source: sd_plane(p, (0, 0, 1), 0.5), on a grid plane of a
+# 64-sample ±1.5 m grid, put 112 vertices a third of a voxel under the plane, where the sphere's section lay (an
+# outside tester); read from the source, the 248 vertices on the bounds' faces were still a third of a voxel off.
+@pytest.mark.gl
+@pytest.mark.parametrize("sign", [1.0, -1.0])
+@pytest.mark.parametrize("axis", [0, 1, 2])
+def test_a_plane_on_a_grid_plane_meshes_on_it_out_to_the_bounds(axis: int, sign: float) -> None:
+    normal = ", ".join(f"{sign if k == axis else 0.0:.1f}" for k in range(3))
+    tri = mesh_glsl(f"float sdf(vec3 p) {{ return sd_plane(p, vec3({normal}), 0.5); }}", 64, [[-1.5] * 3, [1.5] * 3])
+    spacing = 3.0 / 63.0  # the plane p·n = −0.5 lies on sample plane 21
+    assert len(tri.faces) > 0
+    np.testing.assert_allclose(tri.vertices[:, axis], -0.5 * sign, atol=2.0 * sdf.ISO_NUDGE_VOXELS * spacing + 1e-6)
+    assert tri.vertices[:, (axis + 1) % 3].min() == pytest.approx(-1.5) and tri.vertices.max() == pytest.approx(1.5)
+
+
 @pytest.mark.gl
 def test_empty_field_gives_an_empty_mesh() -> None:
     tri = mesh_glsl("float sdf(vec3 p) {\n    return 1.0;\n}\n", 32, CUBE_BOUNDS)
