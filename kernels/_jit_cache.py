@@ -28,7 +28,9 @@ logger = logging.getLogger(__name__)
 STAMP_NAME = "numba-sources.sha256"
 """The stamp's file name, in the kernels' own ``__pycache__``."""
 
-_CACHE_SUFFIXES = (".nbi", ".nbc")
+WARM_SUFFIX = ".warm"
+"""A package's marker beside its cache: its warm-up finished writing it (:func:`kernels.warming.has_cache`)."""
+_CACHE_SUFFIXES = (".nbi", ".nbc", WARM_SUFFIX)
 
 
 def source_hash(root: Path) -> str:

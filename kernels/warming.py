@@ -37,7 +37,7 @@ from typing import Any, Generic, ParamSpec, TypeVar
 from numba.core.dispatcher import Dispatcher
 
 from kernels._jit import CompiledOnly
-from kernels._jit_cache import cache_dirs
+from kernels._jit_cache import WARM_SUFFIX, cache_dirs
 
 logger = logging.getLogger(__name__)
 
@@ -280,7 +280,7 @@ def _load(name: str) -> None:
     """Load ``name``'s compiled code from the cache (or compile it here, where the cache lacks it)."""
     _LOADING.here = True  # this thread's entries call their dispatchers while the package is still pending
     try:
-        importlib.import_module(name).warm_up()
+        warm(name)
     except Exception:  # the kernel then compiles on first use instead; say why (unless the app is exiting)
         if not _EXITING.is_set():
             logger.exception("compiling %s failed", name)
@@ -303,28 +303,52 @@ _EXITING = threading.Event()
 
 
 def has_cache(package: str) -> bool:
-    """Whether numba's disk cache holds compiled code of ``package`` (beside it, or under ``NUMBA_CACHE_DIR``); the
-    cache is dropped whole when any kernel source changes (:mod:`kernels._jit_cache`), so any index means a warm one."""
-    spec = importlib.util.find_spec(package)
-    if spec is None or spec.origin is None:
-        return False
-    override = os.environ.get("NUMBA_CACHE_DIR")  # when set, numba reads only there
-    for directory in cache_dirs(Path(spec.origin).parent):
-        if override and not directory.is_relative_to(override):
-            continue
+    """Whether numba's disk cache holds all of ``package``'s compiled code (beside it, or under ``NUMBA_CACHE_DIR``):
+    a warm-up finished writing it (:func:`warm`'s marker) and its index is still there. A start stopped while it
+    compiled leaves some indexes but no marker: that package compiles in the background again, with its status line,
+    rather than inside the first scene that calls it. The cache and its markers are dropped whole when any kernel
+    source changes (:mod:`kernels._jit_cache`)."""
+    marker = package + WARM_SUFFIX
+    for directory in _cache_dirs(package):
         try:
-            if any(path.suffix == ".nbi" for path in directory.iterdir()):
-                return True
+            names = {path.name for path in directory.iterdir()}
         except OSError:
             continue
+        if marker in names and any(name.endswith(".nbi") for name in names):
+            return True
     return False
 
 
+def warm(package: str) -> None:
+    """Compile ``package``'s kernels (or load them from the cache), then mark its cache whole (:func:`has_cache`)."""
+    importlib.import_module(package).warm_up()
+    for directory in _cache_dirs(package):
+        try:
+            if any(path.suffix == ".nbi" for path in directory.iterdir()):
+                (directory / (package + WARM_SUFFIX)).touch()
+        except OSError:
+            continue  # a read-only cache directory: the next start compiles again, as it would without the marker
+
+
+def _cache_dirs(package: str) -> list[Path]:
+    """Where numba reads ``package``'s cache: beside its sources, or only under ``NUMBA_CACHE_DIR`` when set."""
+    spec = importlib.util.find_spec(package)
+    if spec is None or spec.origin is None:
+        return []
+    override = os.environ.get("NUMBA_CACHE_DIR")
+    return [
+        directory
+        for directory in cache_dirs(Path(spec.origin).parent)
+        if not override or directory.is_relative_to(override)
+    ]
+
+
 _CHILD = (
-    "import importlib, signal, sys\n"
+    "import signal, sys\n"
     "signal.signal(signal.SIGINT, signal.SIG_IGN)\n"  # Ctrl+C stops the app, which stops this (not a traceback)
+    "from kernels import warming\n"
     "for name in sys.argv[1:]:\n"
-    "    importlib.import_module(name).warm_up()\n"
+    "    warming.warm(name)\n"
     "    print(name, flush=True)\n"
 )
 """What a compile process runs: each package's ``warm_up()`` (which writes numba's cache), its name printed after.

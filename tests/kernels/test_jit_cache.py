@@ -24,6 +24,7 @@ def _package(root: Path) -> tuple[Path, Path]:
 def _cache(cached: Path) -> None:
     cached.write_bytes(b"index")
     cached.with_suffix(".nbc").write_bytes(b"code")
+    (cached.parent / f"pkg{_jit_cache.WARM_SUFFIX}").touch()  # its warm-up finished (kernels.warming.has_cache)
 
 
 def test_a_changed_callee_module_drops_the_callers_cache(tmp_path: Path) -> None:
@@ -35,6 +36,7 @@ def test_a_changed_callee_module_drops_the_callers_cache(tmp_path: Path) -> None
     rules.write_text("def g():\n    return 3\n")  # only the callee's module changes
     assert _jit_cache.drop_stale_cache(tmp_path)
     assert not cached.exists() and not cached.with_suffix(".nbc").exists()
+    assert not (cached.parent / f"pkg{_jit_cache.WARM_SUFFIX}").exists()  # the marker goes with the cache
     _cache(cached)  # compiled again from the new sources
     assert not _jit_cache.drop_stale_cache(tmp_path)
     assert cached.exists()
