@@ -16,6 +16,7 @@ import errno
 import io
 import ipaddress
 import logging
+import logging.handlers
 import select
 import signal
 import socket
@@ -24,18 +25,46 @@ from typing import Annotated
 
 from kernels import warming
 
+_HELD = logging.handlers.MemoryHandler(capacity=1_000, flushLevel=logging.CRITICAL + 1)
+"""Log lines from before the command line is read, held until it is (and dropped if it is refused)."""
 
-def configure_logging() -> None:
-    """The app's log lines on stderr, with time and source; websockets' line per connection left out."""
-    logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s %(levelname)s %(message)s")
+
+def configure_logging(*, hold: bool = False) -> None:
+    """The app's log lines on stderr, with time and source; websockets' line per connection left out, and its
+    traceback for a connection that closes before its handshake (a port probe) too. ``hold``: keep them until the
+    next call (which prints them), so that a refused command line prints only why."""
+    root = logging.getLogger()
+    root.setLevel(logging.INFO)
     logging.getLogger("websockets").setLevel(logging.WARNING)
+    quiet = logging.getLogger("websockets.server")
+    if _no_handshake not in quiet.filters:
+        quiet.addFilter(_no_handshake)
+    if hold:
+        if not root.handlers:
+            root.addHandler(_HELD)
+        return
+    if any(handler is not _HELD for handler in root.handlers):
+        return  # configured already
+    stream = logging.StreamHandler()
+    stream.setFormatter(logging.Formatter("%(asctime)s %(name)s %(levelname)s %(message)s"))
+    root.addHandler(stream)
+    if _HELD in root.handlers:
+        root.removeHandler(_HELD)
+        _HELD.setTarget(stream)
+        _HELD.flush()
+
+
+def _no_handshake(record: logging.LogRecord) -> bool:
+    """False for websockets' "opening handshake failed": a connection closed (or sent no HTTP) before its
+    handshake, which a port probe or a health check does; it was an ERROR with three chained tracebacks."""
+    return record.getMessage() != "opening handshake failed"
 
 
 if __name__ == "__main__" and not any(arg in ("-h", "--help") or arg.startswith("--port") for arg in sys.argv[1:]):
     # A first start's compile processes begin before the imports below: about a second in which one of two cores
     # would idle. main() starts them where this did not (the installed command, a --port that may be refused,
     # --help; start() runs once).
-    configure_logging()  # first: a warm cache's loads are logged within the second
+    configure_logging(hold=True)  # first: a warm cache's loads are logged within the second, once main() runs
     warming.start()
 
 import tyro
@@ -138,8 +167,9 @@ def host_problem(host: str) -> str | None:
 
 
 def browser_url(host: str, port: int) -> str:
-    """The address to open: this machine's for a wildcard bind, an IPv6 address in brackets (RFC 3986)."""
-    shown = "127.0.0.1" if host in ("0.0.0.0", "::") else host
+    """The address to open: this machine's for a wildcard bind (IPv6's for ``::``, which serves IPv6 alone), an IPv6
+    address in brackets (RFC 3986)."""
+    shown = {"0.0.0.0": "127.0.0.1", "::": "::1"}.get(host, host)
     return f"http://[{shown}]:{port}" if ":" in shown else f"http://{shown}:{port}"
 
 
@@ -206,7 +236,7 @@ def main(
     warming.start()  # every scene draws at once; kernels run as plain Python until compiled
     server = None
     try:
-        server = make_server(host, asked)
+        server = make_server(host, asked, verbose=":" not in host)  # viser's box shows IPv6 as http://:::8080
         message = port_message(asked, server.get_port(), explicit=port is not None)
         if message is not None and port is not None:  # taken between the check and the bind
             _stop_quietly(server)

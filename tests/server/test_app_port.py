@@ -95,7 +95,7 @@ def test_host_problem_names_an_unresolvable_name_and_passes_this_machines(monkey
     [
         ("127.0.0.1", "http://127.0.0.1:8080"),
         ("0.0.0.0", "http://127.0.0.1:8080"),
-        ("::", "http://127.0.0.1:8080"),
+        ("::", "http://[::1]:8080"),  # asyncio binds :: to IPv6 alone: 127.0.0.1 was refused
         ("::1", "http://[::1]:8080"),  # it read http://::1:8080, which no browser opens
         ("localhost", "http://localhost:8080"),
     ],
