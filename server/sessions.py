@@ -244,6 +244,13 @@ class Session:
         self.cameras = cameras
         """Camera updates of the clients this session serves."""
         install_gate(server)
+        self._dead_writes = contextlib.ExitStack()
+        if client is not None:
+            # Whatever this session writes after its tab closed (a callback, a loop step or a worker's result that
+            # ran just then; its teardown waits for them) is lost with the tab, which drops the session: not the
+            # stale-handle writes viser's one-shot "closed connection" warning is for. A click on "Goal chance"
+            # as the tab closed logged "Queued a GuiUpdateMessage on a closed connection".
+            self._dead_writes.enter_context(dead_writes_allowed(client))
 
     @classmethod
     def shared(cls, server: viser.ViserServer) -> Session:
@@ -265,12 +272,6 @@ class Session:
     def send_download(client: viser.ClientHandle, filename: str, content: bytes) -> str:
         """Send tab ``client`` a download (a link in a notice); returns the notice's id, for :meth:`remove_notice`."""
         return viser_compat.send_download(client, filename, content)
-
-    def tab_may_close(self) -> AbstractContextManager[object]:
-        """A scope for a rebuild of this session's scene (a pick or a Reset): what it queues after its tab closed is
-        dropped with the tab, which tears the session down, without viser's "closed connection" warning (a tab that
-        picked a scene and closed within 50 ms logged one for each kind of message the build sent)."""
-        return dead_writes_allowed(self.client) if self.client is not None else contextlib.nullcontext()
 
     @staticmethod
     def remove_notification(client: viser.ClientHandle, notification: viser.NotificationHandle) -> None:

@@ -85,10 +85,9 @@ class SceneSwitcher:
     def _build(self, key: str, *, rebuild: bool) -> None:
         if self.closed:
             return
-        if self.scene.key != key or rebuild:
-            with self.server.tab_may_close():
-                self.scene.close()
-                self.scene = SCENES[key](self.server)
+        if self.scene.key != key or rebuild:  # (a tab closing meanwhile: its session's writes are lost without a word)
+            self.scene.close()
+            self.scene = SCENES[key](self.server)
 
     # A browser's pick or Reset builds without writing the dropdown back: a newer pick that arrived during the
     # build is in the dropdown already, and its own callback (next in line for the lock) builds it.

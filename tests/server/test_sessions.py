@@ -19,6 +19,7 @@ import threading
 import time
 import warnings
 import weakref
+from typing import Any
 
 import numpy as np
 import pytest
@@ -30,7 +31,7 @@ from helpers.waiting import wait_until
 from helpers.wsclient import BrowserClient, connect_tab
 
 from app import serve_scenes
-from scenes import SCENES, Scene
+from scenes import SCENES, Scene, SceneName
 from scenes.arm import MAX_LINKS
 from scenes.sdf_gallery import SdfGalleryScene
 from server.sessions import CameraReport, Session, Sessions
@@ -180,6 +181,46 @@ def test_a_tab_closed_while_its_session_builds_is_torn_down_and_sent_nothing(
     finally:
         release.set()
         manager.close()
+
+
+@pytest.mark.parametrize("key", ["freekick", "peloton"])
+def test_a_tabs_session_writing_between_its_close_and_its_teardown_warns_nothing(
+    server: viser.ViserServer, monkeypatch: pytest.MonkeyPatch, key: SceneName
+) -> None:
+    """Kind: a write to a closed tab before its session is torn down. A click on "Goal chance" as its tab closed
+    wrote the progress bar to the dead tab: "Queued a GuiUpdateMessage on a closed connection" (an outside tester,
+    five tabs closing mid-work). Here the teardown is held while the scene writes: a callback's redraw, a notice."""
+    held, release = threading.Event(), threading.Event()
+    close = Sessions._close  # pyright: ignore[reportPrivateUsage]
+
+    def held_close(self: Sessions, client: viser.ClientHandle) -> None:
+        held.set()
+        release.wait(30.0)
+        close(self, client)
+
+    monkeypatch.setattr(Sessions, "_close", held_close)  # before the sessions register it with viser
+    manager = serve_scenes(server, key, shared=False)
+    assert isinstance(manager, Sessions)
+    try:
+        with BrowserClient(server.get_port()) as tab:
+            tab.wait_for_gui("Reset scene to defaults")
+            wait_until(lambda: manager.count == 1, "the tab's session built")
+            (client,) = server.get_clients().values()
+            (switcher,) = manager._switchers.values()  # pyright: ignore[reportPrivateUsage]
+        assert held.wait(30.0), "the disconnect reached the sessions"
+        scene: Any = switcher.scene
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            if key == "freekick":
+                scene.callback(scene.request_odds_map)()  # the button's handler
+            else:
+                scene.callback(scene.redraw)()
+            scene.notify(client, "Late", "written after the tab closed")
+        assert not [str(w.message) for w in caught if "closed connection" in str(w.message)]
+    finally:
+        release.set()
+    wait_until(lambda: manager.count == 0, "the session torn down")
+    manager.close()
 
 
 @pytest.mark.parametrize("action", ["pick", "reset"])
