@@ -169,8 +169,9 @@ def mesh_warning(field: EditorField, vertices: np.ndarray, faces: np.ndarray) ->
         return ""
     if np.any((np.abs(vertices - lo) < tol) | (np.abs(vertices - hi) < tol)):
         return (
-            f"⚠ The shape reaches the ±{field.half_size:g} m box and is cut open there (the mesh and its downloads "
-            "have holes). Raise Editor bounds half size to take it all in."
+            f"⚠ The shape reaches the ±{field.half_size:g} m box and is cut there: the mesh and its downloads are "
+            "open (holes), while the ray-march shows the cut face closed. Raise Editor bounds half size to take it all "
+            "in, if it is finite: a plane or any other unbounded shape is always cut."
         )
     v0, v1, v2 = (vertices[faces[:, k]].astype(np.float64) for k in range(3))
     if np.einsum("ij,ij->", v0, np.cross(v1, v2)) < 0.0:

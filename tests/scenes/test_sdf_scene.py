@@ -1061,7 +1061,9 @@ def test_a_field_cut_open_by_its_bounds_says_so_and_a_whole_one_does_not(
         wait_until(lambda: scene.mesh_serial > meshes and scene.params.editor.half_size == 0.5, "the remesh")
         mesh = trimesh.Trimesh(scene.mesh_vertices, scene.mesh_faces)
         assert not mesh.is_watertight  # the box's ends (±0.7 m in z) lie outside ±0.5 m
-        assert scene.mesh_note.visible and "reaches the ±0.5 m box and is cut open" in scene.mesh_note.content
+        note = scene.mesh_note.content
+        assert scene.mesh_note.visible and "reaches the ±0.5 m box and is cut there: the mesh" in note
+        assert "the ray-march shows the cut face closed" in note and "if it is finite" in note
         meshes = scene.mesh_serial
         client.set_value("Editor bounds half size (m)", 1.0)
         wait_until(lambda: scene.mesh_serial > meshes and scene.params.editor.half_size == 1.0, "the wider remesh")
