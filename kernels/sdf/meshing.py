@@ -425,6 +425,8 @@ def mesh_samples(
             raise ValueError(f"mask must be None or bools of the grid's shape {grid.shape}, got {_checks.shown(mask)}")
     if distance_at is None:
         distance_at = functools.partial(_corner_mean, grid, values)
+    elif not callable(distance_at):
+        raise ValueError(f"distance_at must be None or a function of (N, 3) points, got {_checks.shown(distance_at)}")
     return _polygonise(grid, values, mask, distance_at)
 
 

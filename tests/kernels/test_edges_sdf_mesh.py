@@ -317,6 +317,8 @@ def test_a_sampled_field_on_grid_planes_meshes_on_them(shape: str, with_distance
     vertices, faces = sdf.mesh_samples(grid, field, distance_at=distance if with_distance else None)
     assert len(faces) > 0
     np.testing.assert_allclose(distance(vertices), 0.0, atol=2.0 * sdf.ISO_NUDGE_VOXELS * spacing + 1e-6)
+    with pytest.raises(ValueError, match=r"^distance_at must be None or a function"):
+        sdf.mesh_samples(grid, field, distance_at=0.5)  # type: ignore[arg-type]
 
 
 def test_zero_volume_sets_stay_empty() -> None:
