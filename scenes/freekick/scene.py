@@ -180,8 +180,8 @@ keeps its direction and gives its 3–5 m of curl over 25 m.
 
 **Models.** *Constant*: C_D = C_L = 0.25; the curl radius is then 2m/(ρA·C_L) ≈ 74 m whatever the spin rate, so the
 spin rate changes nothing but the direction. *Measured*: C_L = 0.9·S (S = r|ω|/|v|, up to S = 0.3; Asai et al.
-2007), C_D from Goff & Carré 2010 (drag crisis centred at Re 1.8·10⁵, 12 m/s; 0.4127·S^0.3056 when spinning): 10 % more spin
-visibly moves the ball. *Knuckleball*: with almost no spin, an unsteady side force zig-zags the ball by about a
+2007), C_D from Goff & Carré 2010 (drag crisis centred at Re 1.8·10⁵, 12 m/s; 0.4127·S^0.3056 when spinning):
+10 % more spin visibly moves the ball. *Knuckleball*: with almost no spin, an unsteady side force zig-zags the ball by about a
 diameter per ~15 m (Cohen, Texier, Quéré & Clanet 2012; Texier et al. 2016), drawn from a random draw number (the same number, the same flight).
 
 **Integrators.** RK4 at 10 ms is within a few micrometres of a DOP853 reference over 30 m; the original brief's Euler at
