@@ -351,7 +351,7 @@ _CHILD = (
     "    warming.warm(name)\n"
     "    print(name, flush=True)\n"
 )
-"""What a compile process runs: each package's ``warm_up()`` (which writes numba's cache), its name printed after.
+"""What a compile process runs: each package's :func:`warm` (numba's cache, then its marker), its name printed after.
 It ignores SIGINT: Ctrl+C in the app's terminal reaches the whole process group, and a child that died of it first
 was reported as a failed compile, with numba's traceback, before the app's exit stopped it."""
 
