@@ -559,14 +559,14 @@ class CourseMode:
 
         fastest, slowest = finish_at(high), finish_at(low)
         wanted = f"{params.target_min:g} min"
-        floor_s = self.route.total_distance_m / cap  # the safe speed all the way: no power rides faster
+        floor_s = course_kernel.fastest_time_s(self.route, cap)  # the safe speed all the way: no power beats it
         if target_s < fastest:
             power = high
             needs = f"needs more than {high:.0f} W, the most this input takes"
             if target_s <= floor_s:
                 needs = (
                     f"is out of reach: held to the {params.max_speed_kmh:.0f} km/h safe speed, no power rides these "
-                    f"{self.route.total_distance_m / 1000:.1f} km in under {format_duration(floor_s)}"
+                    f"{floor_s * cap / 1000:.1f} km in under {format_duration(floor_s)}"
                 )
             note = f"A {wanted} finish {needs}: set to {high:.0f} W, which finishes in {format_duration(fastest)}."
         elif target_s > slowest:

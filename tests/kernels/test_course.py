@@ -452,6 +452,36 @@ def test_power_for_time_blames_the_safe_speed_below_its_bound(gain: float, targe
     assert course.ride(flat, 5000.0, max_speed_ms=12.0).time_s == pytest.approx(1667.07, abs=0.01)
 
 
+# Kind: a power search that stalls on the safe speed's kink and returns its last guess unchecked. On the sample climb
+# at 12 m/s, a 1106.9 s target came back as 1658.5 W, which rides 1101.74 s; at 20 m/s, 664.14 s as 3576.5 W
+# (662.41 s); on a flat 10 km at 5 m/s, 2020 s as 99.7 W (2004.08 s). The right powers exist (1300 W: 1108.2 s).
+@pytest.mark.parametrize(
+    ("route", "cap", "target"), [("sample", 12.0, 1106.9), ("sample", 20.0, 664.14), ("flat", 5.0, 2020.0)]
+)
+def test_power_for_time_reaches_a_target_near_the_safe_speed(route: str, cap: float, target: float) -> None:
+    s = np.arange(0.0, 10_000.0 + 5, 100.0)
+    c = course.load_gpx(course.SAMPLE_ROUTE) if route == "sample" else course.course_from_xy(s, 0 * s, 0 * s)
+    for gain in (0.0, 0.15):
+        found = course.power_for_time(c, target, max_speed_ms=cap, gain=gain)
+        if gain:
+            assert course.paced_ride(c, found, gain=gain, max_speed_ms=cap).paced.time_s == pytest.approx(
+                target, abs=0.01
+            )
+        else:
+            assert course.ride(c, found, max_speed_ms=cap).time_s == pytest.approx(target, abs=0.01)
+
+
+def test_a_safe_speed_bound_is_taken_along_the_slope() -> None:
+    # 10 km on the map at 20 %: 10.198 km ridden, at 5 m/s at least 2039.6 s; 2020 s read "needs more than 5000 W".
+    s = np.arange(0.0, 10_000.0 + 5, 100.0)
+    climb = course.course_from_xy(s, 0 * s, 0.2 * s)
+    assert course.fastest_time_s(climb, 5.0) == pytest.approx(10_000.0 * math.sqrt(1.04) / 5.0)
+    with pytest.raises(ValueError, match=r"the 10.2 km in under 2039.61 s$"):
+        course.power_for_time(climb, 2020.0, max_speed_ms=5.0)
+    with pytest.raises(ValueError, match=r"^max_speed_ms must be"):
+        course.fastest_time_s(climb, 0.0)
+
+
 def test_power_for_time_refuses_a_gain_out_of_range_by_name() -> None:
     c = loop_course(600)
     for bad in (-0.1, 0.6, float("nan"), True, "0.1"):
@@ -460,11 +490,14 @@ def test_power_for_time_refuses_a_gain_out_of_range_by_name() -> None:
 
 
 def test_power_for_time_out_of_reach_says_so() -> None:
-    c = course.load_gpx(course.SAMPLE_ROUTE)  # 13.15 km: 657.56 s at 20 m/s all the way; 5000 W: 661.32 s
-    with pytest.raises(ValueError, match=r"the 13.15 km in under 657.564 s$"):
+    c = course.load_gpx(course.SAMPLE_ROUTE)  # 13.196 km along the slope: 659.82 s at 20 m/s; 5000 W: 661.32 s
+    with pytest.raises(ValueError, match=r"the 13.2 km in under 659.82 s$"):
         course.power_for_time(c, 60.0)
-    with pytest.raises(ValueError, match=r"^time_s 659 s is out of reach: it needs more than 5000 W$"):
+    with pytest.raises(ValueError, match=r"the 13.2 km in under 659.82 s$"):  # within the map's 657.56 s bound
         course.power_for_time(c, 659.0)
+    with pytest.raises(ValueError, match=r"^time_s 660.5 s is out of reach: it needs more than 5000 W$"):
+        course.power_for_time(c, 660.5)
+    assert course.fastest_time_s(c, 20.0) == pytest.approx(np.sum(c.length_m) / 20.0)
     with pytest.raises(ValueError, match="time_s"):
         course.power_for_time(c, float("nan"))
 
