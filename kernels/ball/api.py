@@ -33,6 +33,7 @@ from kernels.ball.config import (
     RK4,
     T_MAX,
     FlightConfig,
+    Q,
     check_launches,
     checked_seed,
     checked_vector,
@@ -245,6 +246,12 @@ def _refuse_overflow(
             f"{launches[int(inside[0]), :3].tolist()} m); it would leave the body with no contact: start it outside"
         )
     bad = np.flatnonzero(endings == 3)
+    if bad.size and config[Q] == 0.0:  # no air: nothing to overshoot; the flight outran the floats
+        which = "the flight" if len(endings) == 1 else f"the flights of kicks {bad[:5].tolist()}"
+        raise ValueError(
+            f"t_max = {config[T_MAX]:g} s is too long for {which}: with no air (air_density 0) nothing slows the "
+            "ball, and it leaves the range of floating-point numbers; use a shorter t_max"
+        )
     if bad.size:
         which = "the flight" if len(endings) == 1 else f"kicks {bad[:5].tolist()}"
         raise ValueError(
@@ -853,13 +860,14 @@ def spin_vector(rate_rev_s: float, axis: ArrayLike) -> NDArray[np.float64]:
         (3,) ω (rad/s).
 
     Raises:
-        ValueError: ``rate_rev_s`` negative, not a finite number, or so large that ω overflows (over about
-            2.9·10³⁰⁷ rev/s); ``axis`` not three finite numbers of non-zero length. The message names it.
+        ValueError: ``rate_rev_s`` negative, not a finite number, or so large that |ω|² overflows (over about
+            2.1·10¹⁵³ rev/s); ``axis`` not three finite numbers of non-zero length. The message names it.
     """
     rate = _checks.non_negative("rate_rev_s", rate_rev_s)
     omega = 2.0 * math.pi * rate
-    if not math.isfinite(omega):  # inf times an axis's 0 would be NaN
-        raise ValueError(f"rate_rev_s must be at most {sys.float_info.max / (2.0 * math.pi):.3g} rev/s, got {rate:g}")
+    if not math.isfinite(omega * omega):  # inf times an axis's 0 was NaN; |ω|² must be finite too
+        bound = math.sqrt(sys.float_info.max) / (2.0 * math.pi)
+        raise ValueError(f"rate_rev_s must be at most {bound:.3g} rev/s (|ω|² a finite number), got {rate:g}")
     return omega * _checks.direction("axis", checked_vector("axis", axis, 3), 3)
 
 

@@ -396,14 +396,24 @@ def test_a_step_count_beyond_any_float_is_refused_by_name(kwargs: dict[str, floa
     assert ball.FlightConfig(dt=0.1, t_max=100_000.0).t_max == 100_000.0
 
 
-@pytest.mark.parametrize("rate", [1e308, 2.87e307, math.inf])
+@pytest.mark.parametrize("rate", [1e308, 2.8e307, 2.2e153, math.inf])
 def test_a_spin_rate_whose_angular_velocity_overflows_is_refused_by_name(rate: float) -> None:
+    # (2.8e307 rev/s about (1, 1, 1) gave components of 1.0e308 each, whose length overflowed.)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         with pytest.raises(ValueError, match=r"^rate_rev_s must be"):
-            ball.spin_vector(rate, (0.0, 0.0, 1.0))
-        top = ball.spin_vector(2.86e307, (0.0, 0.0, 1.0))
-    assert top[2] == pytest.approx(2 * math.pi * 2.86e307) and top[0] == top[1] == 0.0
+            ball.spin_vector(rate, (1.0, 1.0, 1.0))
+        top = ball.spin_vector(2.1e153, (1.0, 1.0, 1.0))
+        assert np.isfinite(np.linalg.norm(top))
+    assert np.linalg.norm(top) == pytest.approx(2 * math.pi * 2.1e153)
+
+
+def test_a_flight_in_a_vacuum_that_outruns_the_floats_names_t_max() -> None:
+    # It said "each step overshoots the drag … use a smaller air_density", with no air and no drag.
+    with pytest.raises(ValueError, match=r"^t_max = 1e\+308 s is too long for the flight: with no air"):
+        ball.simulate(
+            START, kick(25, 15), (0.0, 0.0, 50.0), air_density=0.0, method="rk4", t_max=1e308, dt=1e308, gravity=0.0
+        )
 
 
 def test_batch_rejects_mismatched_rows() -> None:
