@@ -546,13 +546,14 @@ reads it again, so a ball that bounces in front of him beats him more often than
         self._aim_worker.submit(job)
 
     def _drop_aim(self) -> None:
-        """The kick changed: a search under way was for the kick before, and is dropped (it said so); a result and
-        its marker spoke of the kick before, and are taken down."""
+        """The kick changed: a search under way was for the kick before, and is dropped (it says so until the next
+        click: a drag's later updates leave it up); a result and its marker spoke of the kick before, and are taken
+        down."""
         self._aim_version += 1
         if not (self._aim_searching or self.aim_message or self.target_marker.visible):
             return
         stopped = "The kick changed during the search, which was stopped; click the goal again to aim this one."
-        self.aim_message = stopped if self._aim_searching else ""
+        self.aim_message = stopped if self._aim_searching or self.aim_message == stopped else ""
         self._aim_searching = False
         with self.server.atomic():
             self.target_marker.visible = False

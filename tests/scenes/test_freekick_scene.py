@@ -302,6 +302,10 @@ def test_a_search_the_kick_changes_under_is_stopped_and_says_so(
     assert freekick.params == dataclasses.replace(before, speed_ms=33.0)  # the found angles were not applied
     assert freekick.aim_status.content.startswith("The kick changed during the search, which was stopped")
     assert not freekick.target_marker.visible
+    # A drag goes on sending values: the words stay up until the next click (a re-tester saw them for one update).
+    for speed in (33.5, 34.0, 34.5):
+        freekick.controls["speed_ms"].value = speed
+    assert freekick.aim_status.content.startswith("The kick changed during the search, which was stopped")
     # A click on the kick as it is now aims it.
     monkeypatch.setattr(freekick_scene, "aim_at", searched)
     freekick.aim_at_point(-2.0, 1.2)
