@@ -23,7 +23,20 @@ import socket
 import sys
 from typing import Annotated
 
-from kernels import warming
+_STOP_ASKED: list[int] = []
+"""Ctrl+C while the app imports its libraries: held, and obeyed once they are in."""
+
+
+def _hold_ctrl_c(signum: int, _frame: object) -> None:
+    _STOP_ASKED.append(signum)
+
+
+if __name__ == "__main__":
+    # A KeyboardInterrupt in the imports below (about two seconds) printed a traceback, or was swallowed by a library
+    # that catches BaseException (trimesh importing scipy), and the app then served on as if nothing had happened.
+    signal.signal(signal.SIGINT, _hold_ctrl_c)
+
+from kernels import warming  # (numba: Ctrl+C is held from here on)
 
 _HELD = logging.handlers.MemoryHandler(capacity=1_000, flushLevel=logging.CRITICAL + 1)
 """Log lines from before the command line is read, held until it is (and dropped if it is refused)."""
@@ -79,6 +92,12 @@ from server.sessions import Sessions
 from server.switcher import SceneSwitcher
 from shaders.glsl_sandbox import MAX_SOURCE_CHARS
 
+if __name__ == "__main__":
+    if _STOP_ASKED:
+        print("Stopped.", flush=True)
+        raise SystemExit(0)
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+
 logger = logging.getLogger("app")
 
 DEFAULT_PORT = 8080
@@ -110,8 +129,9 @@ def exposure_warning(host: str, port: int, *, allow_remote_glsl: bool = False) -
         if allow_remote_glsl
         else "GLSL editing in the SDF gallery is OFF (its examples still work); --allow-remote-glsl turns it on."
     )
+    bound = f"[{host}]:{port}" if ":" in host else f"{host}:{port}"
     return (
-        f"WARNING: binding {host}:{port} exposes this server beyond this machine. Anyone who can reach that "
+        f"WARNING: binding {bound} exposes this server beyond this machine. Anyone who can reach that "
         "address can open the page, move every slider and drag every gizmo, with no password; the server runs "
         f"their inputs on this machine. Use --host 127.0.0.1 (the default) unless that is what you want. {glsl}"
     )
@@ -145,6 +165,8 @@ def _bind(host: str, port: int, *, reuse: bool) -> None:
     with socket.socket(family, kind, proto) as probe:
         if reuse:
             probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        if family == socket.AF_INET6:  # as asyncio binds it: IPv6 alone, which takes no IPv4-mapped address
+            probe.setsockopt(socket.IPPROTO_IPV6, socket.IPV6_V6ONLY, 1)
         probe.bind(address)
 
 
@@ -152,6 +174,11 @@ def host_problem(host: str) -> str | None:
     """Why the app cannot listen on ``host`` at all, in words, or None. viser takes every failure to bind for a busy
     port and tries the next one, a thousand times over: a mistyped address hung the app without a word, or was
     refused as a busy port."""
+    with contextlib.suppress(ValueError):
+        mapped = ipaddress.ip_address(host)
+        if isinstance(mapped, ipaddress.IPv6Address) and mapped.ipv4_mapped is not None:
+            # viser's server listens on IPv6 alone there, which cannot take it: its bind failed and the app hung
+            return f"--host {host} is an IPv4 address written as IPv6; give it as --host {mapped.ipv4_mapped}."
     try:
         _bind(host, 0, reuse=False)  # port 0: any free port, so only the address is tried
     except (socket.gaierror, UnicodeError) as error:
@@ -217,7 +244,6 @@ def main(
             tab has its own scene.
     """
     let_ctrl_c_stop_the_app()
-    configure_logging()
     asked = DEFAULT_PORT if port is None else port
     if port is not None and not 1 <= port <= 65535:
         print(f"--port must be a TCP port from 1 to 65535, got {port}.", file=sys.stderr, flush=True)
@@ -233,10 +259,12 @@ def main(
     if port is not None and not port_is_free(host, port):  # refuse before viser prints a URL it will not serve
         print(port_message(port, port + 1, explicit=True), file=sys.stderr, flush=True)
         raise SystemExit(2)
+    configure_logging()  # the command line is good: log lines held since the start come now
     warming.start()  # every scene draws at once; kernels run as plain Python until compiled
     server = None
     try:
-        server = make_server(host, asked, verbose=":" not in host)  # viser's box shows IPv6 as http://:::8080
+        with contextlib.redirect_stdout(io.StringIO()) if ":" in host else contextlib.nullcontext():
+            server = make_server(host, asked)  # viser's box shows an IPv6 host as http://:::8080, no address
         message = port_message(asked, server.get_port(), explicit=port is not None)
         if message is not None and port is not None:  # taken between the check and the bind
             _stop_quietly(server)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import socket
 import subprocess
 import sys
@@ -76,6 +77,61 @@ def test_a_host_that_is_not_this_machines_is_refused_in_words() -> None:
     assert "--host 192.0.2.1 is not an address of this machine" in run.stderr
     assert "already in use" not in run.stderr and "http://" not in run.stdout + run.stderr
     assert "WARNING" not in run.stdout  # nothing is exposed: the exposure warning would mislead
+
+
+# The failing input (an outside re-tester): an IPv4-mapped loopback passed the probe bind, which took it on a dual-stack
+# socket, while viser's server listens on IPv6 alone: its bind failed, and the app hung with no address.
+@pytest.mark.parametrize(("host", "plain"), [("::ffff:127.0.0.1", "127.0.0.1"), ("::ffff:192.0.2.1", "192.0.2.1")])
+def test_an_ipv4_address_written_as_ipv6_is_refused_with_its_plain_form(host: str, plain: str) -> None:
+    assert app.host_problem(host) == f"--host {host} is an IPv4 address written as IPv6; give it as --host {plain}."
+    run = subprocess.run(
+        [sys.executable, "app.py", "--host", host, "--port", "8199"],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert run.returncode == 2 and "give it as --host" in run.stderr and "http://" not in run.stdout + run.stderr
+
+
+def _has_ipv6_loopback() -> bool:
+    try:
+        with socket.socket(socket.AF_INET6, socket.SOCK_STREAM) as probe:
+            probe.bind(("::1", 0))
+    except OSError:
+        return False
+    return True
+
+
+# Kind: an address no browser opens. For an IPv6 host viser's own box printed http://::1:8197 (and http://:::8197 for
+# ::) beside the app's line; the warning read "binding :::8197".
+@pytest.mark.skipif(not _has_ipv6_loopback(), reason="this machine has no IPv6 loopback")
+def test_an_ipv6_host_prints_only_addresses_a_browser_opens() -> None:
+    with socket.socket() as free:
+        free.bind(("127.0.0.1", 0))
+        port = free.getsockname()[1]
+    process = subprocess.Popen(
+        [sys.executable, "app.py", "--host", "::1", "--port", str(port)],
+        cwd=ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+    )
+    try:
+        assert process.stdout is not None
+        lines = []
+        for line in process.stdout:
+            lines.append(line)
+            if "Open http" in line:
+                break
+    finally:
+        process.kill()
+        process.wait(30)
+    shown = "".join(lines)
+    assert f"Open http://[::1]:{port} in a browser" in shown
+    assert re.findall(r"(?:http|ws)://\S+", shown) == [f"http://[::1]:{port}"], shown
+    warning = app.exposure_warning("::", port)
+    assert warning is not None and f"binding [::]:{port} exposes" in warning
 
 
 def test_host_problem_names_an_unresolvable_name_and_passes_this_machines(monkeypatch: pytest.MonkeyPatch) -> None:
