@@ -13,7 +13,7 @@ import time
 import pytest
 import viser
 from helpers.paths import ROOT
-from helpers.processes import python_stdout
+from helpers.processes import AppProcess, free_port, python_stdout
 from helpers.viser_private import gui_uuid, gui_uuids, node_names
 from helpers.wsclient import BrowserClient
 
@@ -53,12 +53,6 @@ def test_port_messages_say_plainly_what_happened() -> None:
     assert refusal is not None and "Port 9000 is already in use" in refusal and "--port" in refusal
 
 
-def _free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return int(probe.getsockname()[1])
-
-
 def _ignore_sigint() -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 
@@ -67,36 +61,23 @@ def _ignore_sigint() -> None:
 def test_ctrl_c_stops_the_app_with_one_line(how: str) -> None:
     # A shell that starts a command in the background (`python app.py &` in a script) starts it with SIGINT ignored;
     # Ctrl+C must stop the app whichever way it was started.
-    port = _free_port()
-    process = subprocess.Popen(
-        [sys.executable, str(ROOT / "app.py"), "--port", str(port)],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.STDOUT,
-        text=True,
-        preexec_fn=_ignore_sigint if how == "as a background job" else None,
-    )
+    running = AppProcess(preexec_fn=_ignore_sigint if how == "as a background job" else None)
     try:
-        assert process.stdout is not None
-        started = []
-        for line in process.stdout:
-            started.append(line)
-            if "Open http" in line:
-                break
-        assert f"Open http://127.0.0.1:{port} " in started[-1], started
+        port = running.port
+        assert f"Open http://127.0.0.1:{port} " in running.lines[-1], running.lines
         # A port probe and a request cut off mid-line, as a health check sends: they logged "opening handshake
         # failed" at ERROR with three chained tracebacks (139 of them in 8 s of polling).
         socket.create_connection(("127.0.0.1", port), timeout=5).close()
         with socket.create_connection(("127.0.0.1", port), timeout=5) as cut:
             cut.sendall(b"GET / HTTP/1.1\r\n")
         time.sleep(1.0)
-        process.send_signal(signal.SIGINT)
-        rest, _ = process.communicate(timeout=60)
+        rest = running.interrupt()
     finally:
-        process.kill()
-    assert process.returncode == 0
+        running.close()
+    assert running.process.returncode == 0
     # No traceback, no farewell from viser or websockets (the kernels' ready line may come after the address).
-    assert [line for line in rest.splitlines() if " kernels.warming INFO " not in line] == ["Stopped."], rest
-    assert "Traceback" not in "".join(started)
+    assert [line for line in rest if " kernels.warming INFO " not in line] == ["Stopped.\n"], rest
+    assert "Traceback" not in "".join(running.lines[: running.started])
 
 
 CTRL_C_LIVE_BEFORE_THE_ADDRESS = """
@@ -214,7 +195,7 @@ print("served on")
 @pytest.mark.parametrize("module", ["numba", "viser", "numpy.testing", "trimesh"])
 def test_ctrl_c_while_the_app_imports_stops_it_with_one_line(module: str) -> None:
     result = subprocess.run(
-        [sys.executable, "-c", CTRL_C_DURING_AN_IMPORT, module, str(_free_port())],
+        [sys.executable, "-c", CTRL_C_DURING_AN_IMPORT, module, str(free_port())],
         capture_output=True,
         text=True,
         timeout=60,

@@ -9,6 +9,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from helpers.processes import AppProcess
 
 import app
 
@@ -107,27 +108,9 @@ def _has_ipv6_loopback() -> bool:
 # ::) beside the app's line; the warning read "binding :::8197".
 @pytest.mark.skipif(not _has_ipv6_loopback(), reason="this machine has no IPv6 loopback")
 def test_an_ipv6_host_prints_only_addresses_a_browser_opens() -> None:
-    with socket.socket() as free:
-        free.bind(("127.0.0.1", 0))
-        port = free.getsockname()[1]
-    process = subprocess.Popen(
-        [sys.executable, "app.py", "--host", "::1", "--port", str(port)],
-        cwd=ROOT,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.STDOUT,
-        text=True,
-    )
-    try:
-        assert process.stdout is not None
-        lines = []
-        for line in process.stdout:
-            lines.append(line)
-            if "Open http" in line:
-                break
-    finally:
-        process.kill()
-        process.wait(30)
-    shown = "".join(lines)
+    running = AppProcess("--host", "::1")
+    running.close()
+    port, shown = running.port, "".join(running.lines)
     assert f"Open http://[::1]:{port} in a browser" in shown
     assert re.findall(r"(?:http|ws)://\S+", shown) == [f"http://[::1]:{port}"], shown
     warning = app.exposure_warning("::", port)

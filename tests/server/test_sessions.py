@@ -12,9 +12,6 @@ import gc
 import math
 import os
 import re
-import socket
-import subprocess
-import sys
 import threading
 import time
 import warnings
@@ -25,7 +22,7 @@ import numpy as np
 import pytest
 import viser
 from helpers.ci import need_gl
-from helpers.paths import ROOT
+from helpers.processes import AppProcess, rss_bytes
 from helpers.viser_private import gizmos, node_names, store_value
 from helpers.waiting import wait_until
 from helpers.wsclient import BrowserClient, connect_tab
@@ -271,70 +268,6 @@ def test_shared_mode_is_one_scene_for_every_tab(server: viser.ViserServer) -> No
 
 
 # ------------------------------------------------------------------------------------------------ memory
-def rss_bytes(pid: int | str = "self") -> int:
-    with open(f"/proc/{pid}/status") as status:
-        match = re.search(r"VmRSS:\s+(\d+) kB", status.read())
-    assert match is not None
-    return int(match.group(1)) * 1024
-
-
-def free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return int(sock.getsockname()[1])
-
-
-class AppProcess:
-    """``app.py`` in its own process, on a free port."""
-
-    def __init__(self, *args: str) -> None:
-        self.port = free_port()
-        self.process = subprocess.Popen(
-            [sys.executable, str(ROOT / "app.py"), "--port", str(self.port), *args],
-            cwd=ROOT,
-            stdout=subprocess.PIPE,
-            stderr=subprocess.STDOUT,
-            text=True,
-        )
-        assert self.process.stdout is not None
-        self.lines: list[str] = []
-        """What the app has printed and logged so far."""
-        deadline = time.monotonic() + 120
-        for line in self.process.stdout:
-            self.lines.append(line)
-            if "Open http" in line or time.monotonic() > deadline:
-                break
-        assert self.process.poll() is None, "the app did not start"
-        # Keep reading, so a chatty app never blocks on a full pipe, and a test can look at its log.
-        threading.Thread(target=self._read_output, daemon=True).start()
-
-    def wait_compiled(self, timeout_s: float = 300.0) -> None:
-        """Wait until the app has loaded every compiled kernel (its first start compiles them in the background, and
-        loading them grows its memory: measure after that)."""
-        wait_until(lambda: "compiled kernels ready" in self.log, "the app's kernels compiled and loaded", timeout_s)
-
-    def _read_output(self) -> None:
-        assert self.process.stdout is not None
-        for line in self.process.stdout:
-            self.lines.append(line)
-
-    @property
-    def log(self) -> str:
-        return "".join(self.lines)
-
-    @property
-    def rss(self) -> int:
-        return rss_bytes(self.process.pid)
-
-    def close(self) -> None:
-        self.process.terminate()
-        try:
-            self.process.wait(timeout=20)
-        except subprocess.TimeoutExpired:
-            self.process.kill()
-            self.process.wait(timeout=20)
-
-
 GL_REQUIRED = os.environ.get("CI", "").lower() in ("1", "true", "yes")
 """Under CI=true Mesa's EGL is there: an SDF tab is up only once its reference is rendered, so the memory budgets
 below measure sessions that share the one GL context, never sessions that gave up on GL."""
