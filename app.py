@@ -11,20 +11,11 @@ with --port must be free, or the app refuses to start.
 
 from __future__ import annotations
 
-import contextlib
-import errno
-import io
-import ipaddress
-import logging
-import logging.handlers
-import select
 import signal
-import socket
-import sys
-from typing import Annotated
 
 _STOP_ASKED: list[int] = []
-"""Ctrl+C while the app imports its libraries: held, and obeyed once they are in."""
+"""Ctrl+C while the app starts (its imports, reading its command line, starting the compile): held, and obeyed as
+soon as the server is about to start (:func:`_obey_ctrl_c`)."""
 
 
 def _hold_ctrl_c(signum: int, _frame: object) -> None:
@@ -32,11 +23,23 @@ def _hold_ctrl_c(signum: int, _frame: object) -> None:
 
 
 if __name__ == "__main__":
-    # A KeyboardInterrupt in the imports below (about two seconds) printed a traceback, or was swallowed by a library
-    # that catches BaseException (trimesh importing scipy), and the app then served on as if nothing had happened.
+    # A KeyboardInterrupt in the first seconds (imports; tyro's lazy ones as it reads the command line) printed a
+    # traceback, or was swallowed by a library that catches BaseException (trimesh importing scipy, importlib's
+    # module-lock cleanup), and the app then served on as if nothing had happened.
     signal.signal(signal.SIGINT, _hold_ctrl_c)
 
-from kernels import warming  # (numba: Ctrl+C is held from here on)
+import contextlib
+import errno
+import io
+import ipaddress
+import logging
+import logging.handlers
+import select
+import socket
+import sys
+from typing import Annotated
+
+from kernels import warming
 
 _HELD = logging.handlers.MemoryHandler(capacity=1_000, flushLevel=logging.CRITICAL + 1)
 """Log lines from before the command line is read, held until it is (and dropped if it is refused)."""
@@ -91,12 +94,6 @@ from server.memory import limit_malloc_arenas
 from server.sessions import Sessions
 from server.switcher import SceneSwitcher
 from shaders.glsl_sandbox import MAX_SOURCE_CHARS
-
-if __name__ == "__main__":
-    if _STOP_ASKED:
-        print("Stopped.", flush=True)
-        raise SystemExit(0)
-    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 logger = logging.getLogger("app")
 
@@ -243,7 +240,7 @@ def main(
         shared: one scene for every browser tab (a switch or Reset in one tab changes it for all); by default each
             tab has its own scene.
     """
-    let_ctrl_c_stop_the_app()
+    signal.signal(signal.SIGINT, _hold_ctrl_c)  # (the installed command's start: held from here)
     asked = DEFAULT_PORT if port is None else port
     if port is not None and not 1 <= port <= 65535:
         print(f"--port must be a TCP port from 1 to 65535, got {port}.", file=sys.stderr, flush=True)
@@ -263,6 +260,7 @@ def main(
     warming.start()  # every scene draws at once; kernels run as plain Python until compiled
     server = None
     try:
+        _obey_ctrl_c()
         with contextlib.redirect_stdout(io.StringIO()) if ":" in host else contextlib.nullcontext():
             server = make_server(host, asked)  # viser's box shows an IPv6 host as http://:::8080, no address
         message = port_message(asked, server.get_port(), explicit=port is not None)
@@ -281,12 +279,19 @@ def main(
         print("Stopped.", flush=True)
 
 
+def _obey_ctrl_c() -> None:
+    """Ctrl+C is live from here on, and one held since the start (:data:`_STOP_ASKED`) stops the app now."""
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    if _STOP_ASKED:
+        raise KeyboardInterrupt
+
+
 def let_ctrl_c_stop_the_app() -> None:
     """Restore Python's Ctrl+C where it was ignored.
 
     A shell starts a background job (`python app.py &` in a script) with SIGINT ignored, and Python then leaves it
-    ignored: Ctrl+C would not stop the app. :func:`main` calls this before it prints the address, so a Ctrl+C sent as
-    soon as the address shows is not lost.
+    ignored: Ctrl+C would not stop the app. (:func:`main` holds Ctrl+C from its start and makes it live before the
+    server starts, so a Ctrl+C sent as soon as the address shows is not lost.)
     """
     if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
         signal.signal(signal.SIGINT, signal.default_int_handler)

@@ -622,9 +622,10 @@ def power_for_time(
     x_prev, f_prev = math.nan, math.nan
     moved, repeats = "", 0
     for _ in range(_MAX_SEARCH_RIDES):
-        t = time_at(math.exp(x))
+        power = min(max(math.exp(x), lo_p), hi_p)  # exp(log(5000)) is 5000.000000000004, which a ride refuses
+        t = time_at(power)
         if abs(t - target) <= tol:
-            return math.exp(x)
+            return power
         f = math.log(t / target)
         end = "lo" if f > 0.0 else "hi"
         repeats, moved = (repeats + 1 if end == moved else 0), end

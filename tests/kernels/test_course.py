@@ -471,6 +471,18 @@ def test_power_for_time_reaches_a_target_near_the_safe_speed(route: str, cap: fl
             assert course.ride(c, found, max_speed_ms=cap).time_s == pytest.approx(target, abs=0.01)
 
 
+def test_a_power_found_at_the_inputs_ceiling_is_one_a_ride_takes() -> None:
+    # A re-tester: a target 0.05 % over the bound came back as 5000.000000000004 W (exp(log(5000))), which ride
+    # refused as over 5000 W.
+    s = np.arange(0.0, 10_000.0 + 5, 50.0)
+    flat = course.course_from_xy(s, 0 * s, 0 * s)
+    target = course.fastest_time_s(flat, 12.0) * 1.0005
+    for gain in (0.0, 0.3):
+        found = course.power_for_time(flat, target, max_speed_ms=12.0, wind_ms=8.0, wind_from_deg=45.0, gain=gain)
+        assert found <= course.MAX_POWER_W
+        course.ride(flat, found, max_speed_ms=12.0, wind_ms=8.0, wind_from_deg=45.0)
+
+
 def test_a_safe_speed_bound_is_taken_along_the_slope() -> None:
     # 10 km on the map at 20 %: 10.198 km ridden, at 5 m/s at least 2039.6 s; 2020 s read "needs more than 5000 W".
     s = np.arange(0.0, 10_000.0 + 5, 100.0)
