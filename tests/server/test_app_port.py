@@ -9,6 +9,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from helpers.ci import skip_or_fail
 from helpers.processes import AppProcess
 
 import app
@@ -106,8 +107,9 @@ def _has_ipv6_loopback() -> bool:
 
 # Kind: an address no browser opens. For an IPv6 host viser's own box printed http://::1:8197 (and http://:::8197 for
 # ::) beside the app's line; the warning read "binding :::8197".
-@pytest.mark.skipif(not _has_ipv6_loopback(), reason="this machine has no IPv6 loopback")
 def test_an_ipv6_host_prints_only_addresses_a_browser_opens() -> None:
+    if not _has_ipv6_loopback():
+        skip_or_fail("this machine has no IPv6 loopback")
     running = AppProcess("--host", "::1")
     running.close()
     port, shown = running.port, "".join(running.lines)
