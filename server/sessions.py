@@ -355,10 +355,8 @@ class Sessions:
         if not self._connected(client):
             return
         try:
-            # What the build queues after the tab went lies in that client's dead buffer, freed with it, and is
-            # torn down below: not the stale-handle writes viser's "closed connection" warning is for.
-            with dead_writes_allowed(client):
-                switcher = SceneSwitcher(Session.for_client(self.server, client), self.initial)
+            # (What the build queues after the tab went is lost with it, without a warning: see Session.)
+            switcher = SceneSwitcher(Session.for_client(self.server, client), self.initial)
         except Exception:
             logger.exception("building the session of client %s failed", client.client_id)
             return
@@ -384,8 +382,7 @@ class Sessions:
     def _close_switcher(self, client: viser.ClientHandle, switcher: SceneSwitcher) -> None:
         """Close a tab's session and wait for its scene's threads (a thread-pool callback: off the event loop)."""
         try:
-            with dead_writes_allowed(client):
-                switcher.close()
+            switcher.close()  # (its session writes to its closed tab without a warning)
             if not switcher.scene.join(timeout_s=120.0):
                 logger.warning("session of client %s: a scene thread is still running", client.client_id)
         except Exception:
@@ -396,10 +393,5 @@ class Sessions:
         with self._lock:
             switchers = list(self._switchers.values())
             self._switchers.clear()
-        for switcher in switchers:
-            client = switcher.server.client
-            if client is None:
-                switcher.close()
-            else:  # its tab may be closing now, its disconnect callback still queued
-                with dead_writes_allowed(client):
-                    switcher.close()
+        for switcher in switchers:  # a tab may be closing now: its session writes to it without a warning
+            switcher.close()
