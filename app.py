@@ -280,21 +280,15 @@ def main(
 
 
 def _obey_ctrl_c() -> None:
-    """Ctrl+C is live from here on, and one held since the start (:data:`_STOP_ASKED`) stops the app now."""
+    """Ctrl+C is live from here on, and one held since the start (:data:`_STOP_ASKED`) stops the app now.
+
+    Also where it was ignored: a shell starts a background job (`python app.py &` in a script) with SIGINT ignored,
+    and Python leaves it so; Ctrl+C would not stop the app. It is live before the server starts, so a Ctrl+C sent as
+    soon as the address shows is not lost.
+    """
     signal.signal(signal.SIGINT, signal.default_int_handler)
     if _STOP_ASKED:
         raise KeyboardInterrupt
-
-
-def let_ctrl_c_stop_the_app() -> None:
-    """Restore Python's Ctrl+C where it was ignored.
-
-    A shell starts a background job (`python app.py &` in a script) with SIGINT ignored, and Python then leaves it
-    ignored: Ctrl+C would not stop the app. (:func:`main` holds Ctrl+C from its start and makes it live before the
-    server starts, so a Ctrl+C sent as soon as the address shows is not lost.)
-    """
-    if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
-        signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 def sleep_until_a_signal() -> None:
@@ -305,7 +299,6 @@ def sleep_until_a_signal() -> None:
     on Python's signal wake-up socket, which the interpreter writes to on any signal from any thread; the pending
     ``KeyboardInterrupt`` is then raised here.
     """
-    let_ctrl_c_stop_the_app()
     reader, writer = socket.socketpair()
     reader.setblocking(False)
     writer.setblocking(False)
