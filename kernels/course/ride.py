@@ -620,7 +620,7 @@ def power_for_time(
     x_lo, f_lo, x_hi, f_hi = -math.inf, math.inf, math.inf, -math.inf
     x, slope = math.log(250.0), -0.5
     x_prev, f_prev = math.nan, math.nan
-    moved, repeats = "", 0
+    moved = ""
     for _ in range(_MAX_SEARCH_RIDES):
         power = min(max(math.exp(x), lo_p), hi_p)  # exp(log(5000)) is 5000.000000000004, which a ride refuses
         t = time_at(power)
@@ -628,14 +628,14 @@ def power_for_time(
             return power
         f = math.log(t / target)
         end = "lo" if f > 0.0 else "hi"
-        repeats, moved = (repeats + 1 if end == moved else 0), end
+        again, moved = end == moved, end
         if f > 0.0:
             x_lo, f_lo = x, f
         else:
             x_hi, f_hi = x, f
         if math.isfinite(x_lo) and math.isfinite(x_hi):
             nxt = x_lo - f_lo * (x_hi - x_lo) / (f_hi - f_lo)
-            if not (x_lo < nxt < x_hi) or x_hi - x_lo < 1e-12 or repeats >= 1:
+            if not (x_lo < nxt < x_hi) or x_hi - x_lo < 1e-12 or again:
                 nxt = 0.5 * (x_lo + x_hi)
         else:
             if math.isfinite(x_prev) and x_prev != x and (f - f_prev) / (x - x_prev) < 0.0:
@@ -673,7 +673,7 @@ def _too_fast(time_s: float, course: Course, max_speed_ms: float, power_w: float
     (:func:`fastest_time_s`), else the power."""
     floor_s = fastest_time_s(course, max_speed_ms)
     if time_s <= floor_s:
-        ridden_km = float(np.sum(course.length_m)) / 1000.0
+        ridden_km = floor_s * max_speed_ms / 1000.0
         return (
             f"time_s {time_s:.6g} s is out of reach: held to the safe speed max_speed_ms = {max_speed_ms:g} m/s, "
             f"no power rides the {ridden_km:.4g} km in under {floor_s:.6g} s"
