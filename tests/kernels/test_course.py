@@ -427,6 +427,38 @@ def test_power_for_time_with_a_gain_inverts_the_paced_ride(power: float, gain: f
         assert course.ride(c, found, TEXTBOOK, wind_ms=wind).time_s > t + 5.0
 
 
+@settings(max_examples=examples(15), deadline=None)
+@given(
+    cap=st.floats(5.0, 30.0),
+    over=st.floats(1e-4, 0.5),
+    wind=st.floats(-8.0, 8.0),
+    gain=st.sampled_from([0.0, 0.15]),
+    hilly=st.booleans(),
+)
+def test_power_for_time_reaches_any_target_near_the_safe_speed_or_says_why(
+    cap: float, over: float, wind: float, gain: float, hilly: bool
+) -> None:
+    """Kind: a power search stalled on the safe speed's kink, its last guess returned unchecked. A target a little
+    over the bound (``fastest_time_s``) is reached to the tolerance, or refused as beyond the power's range."""
+    s = np.arange(0.0, 5_000.0 + 5, 25.0)
+    c = course.course_from_xy(s, 0 * s, (40.0 * np.sin(2 * np.pi * s / 2500.0)) if hilly else 0 * s)
+    target = course.fastest_time_s(c, cap) * (1.0 + over)
+    try:
+        found = course.power_for_time(c, target, wind_ms=wind, wind_from_deg=30.0, max_speed_ms=cap, gain=gain)
+    except ValueError as error:
+        # Beyond 5000 W, or (paced) beyond what pacing at the ceiling averages: refused, saying so.
+        assert str(error).endswith("it needs more than 5000 W") or "out of reach paced by grade" in str(error), error
+        if not gain:
+            assert course.ride(c, 5000.0, wind_ms=wind, wind_from_deg=30.0, max_speed_ms=cap).time_s > target
+        return
+    assert 1.0 <= found <= course.MAX_POWER_W
+    if gain:
+        ridden = course.paced_ride(c, found, gain=gain, wind_ms=wind, wind_from_deg=30.0, max_speed_ms=cap).paced
+    else:
+        ridden = course.ride(c, found, wind_ms=wind, wind_from_deg=30.0, max_speed_ms=cap)
+    assert ridden.time_s == pytest.approx(target, abs=0.01)
+
+
 def test_power_for_time_paced_out_of_reach_names_the_time_asked_for() -> None:
     # An outside tester: on a descent, a target beyond 5000 W with a gain was refused as "power_w = 5000 W cannot
     # be paced", naming a power the search tried, not the time the caller gave.
