@@ -481,6 +481,12 @@ def why_short(
         )
     if r.status == "infeasible":
         reasons.append("no pose it saw kept every limit and cleared every obstacle")
+    if not reasons and r.status == "limited" and avoided:
+        it = "it" if len(avoided) == 1 else "them"
+        reasons.append(
+            f"the iterations stalled beside {_obstacles([k + 1 for k in avoided])}, clear of {it}, and a closer pose "
+            "may exist"
+        )
     if not reasons:
         reasons.append("the iterations stalled there")
     text = "; ".join(reasons)
@@ -587,8 +593,8 @@ it saw that keeps every limit and clears every obstacle; when that falls short, 
 few gently bent arcs that keep the limits, and keeps whichever pose comes closest. **Status**: "reached" (within the tolerance);
 "unreachable" (the target lies outside the reach annulus max(0, 2·max L − ΣL) ≤ |target − root| ≤ ΣL; the chain
 stretches straight toward it at once); "blocked" (within reach, but the chain rests against an obstacle short of it, or the
-target is inside one); "limited" (within reach, but the iterates stalled at a fixed point under the joint limits
-short of it); "max_iterations" (still converging at the cap); "infeasible" (no pose seen kept every limit and
+target is inside one); "limited" (within reach, but the iterates stalled at a fixed point under the joint limits,
+or beside an obstacle they do not touch, short of it); "max_iterations" (still converging at the cap); "infeasible" (no pose seen kept every limit and
 cleared every obstacle).
 
 **Compared with.** CCD (turn each joint, end to root, to aim the end at the target) and damped-least-squares

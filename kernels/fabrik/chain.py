@@ -649,7 +649,7 @@ def _solve_chain(
     trusted, moved, reached, stalled = True, False, False, False
     count, mark_iteration, mark_error = 0, 0, best_error
     # Extrapolated FABRIK under limits, within reach, restarts once where it stalls (see below) at ``restart``
-    retry, restart = extrapolate and has_limits and not out_of_reach, 0
+    retry, restart = extrapolate and (has_limits or any_live) and not out_of_reach, 0
     # ... and under hinges, polishes once where it stalls after that or creeps (see _polish), at ``creep_iteration``
     polish = retry and _holding_hinge(table)
     creep_iteration, creep_error, creeping = 0, best_error, False
@@ -659,6 +659,10 @@ def _solve_chain(
         if extrapolate and iteration >= restart + 2:  # from the third iteration on, and while trusted
             allowed = iteration >= restart + 3 and trusted
             moved = _extrapolate(p, previous, last_error, history[iteration - 2], allowed)
+        if solver != _DLS:
+            # A pass can fold the chain onto the target's line (a target on the line of the first link): a fixed
+            # point of both FABRIK and CCD, which no longer bend it. Bent off the line, the passes go on.
+            _unbend(p, target, lengths, tiny, rest, limits, cos_phi, dim)
         if solver == _FABRIK:
             _forward_pass(p, target, lengths, tiny, rest, limits, obstacles, has_zero, dim)
         elif solver == _CCD:
@@ -681,16 +685,15 @@ def _solve_chain(
         if best_error < mark_error - progress:
             mark_iteration, mark_error = iteration, best_error
         stalled = stall_applies and (abs(last_error - error) < stall or iteration - mark_iteration >= _PATIENCE)
-        if stalled and not reached and retry:
+        if polish and not reached and iteration - creep_iteration >= _PATIENCE:
+            creeping = best_error > _CREEP * creep_error
+            creep_iteration, creep_error = iteration, best_error
+        if (stalled or creeping) and not reached and retry:
             # A stall under limits is a fixed point of this start, not proof that the limits keep the target
             # away: go on once from the straight pose toward the target, clamped into the cones (another basin).
-            retry, stalled, restart, trusted, mark_iteration = (
-                False,
-                False,
-                iteration,
-                True,
-                iteration,
-            )
+            # A creep (see _CREEP) restarts too, before any polish: an iterate that circles the optimum closes in by
+            # less than _PROGRESS some iterations and more in others, and never stalls.
+            retry, stalled, creeping, restart, trusted, mark_iteration = False, False, False, iteration, True, iteration
             ux, uy, uz, _ = _unit(ox, oy, oz, rest[0], rest[1], rest[2], tiny)
             _place_on_line(p, best[0], lengths, ux, uy, uz, bool(_OFF))
             _unbend(p, target, lengths, tiny, rest, limits, cos_phi, dim)  # a straight chain never bends
@@ -706,9 +709,6 @@ def _solve_chain(
                     break
             continue
         if polish and not reached:
-            if iteration - creep_iteration >= _PATIENCE:
-                creeping = best_error > _CREEP * creep_error
-                creep_iteration, creep_error = iteration, best_error
             if (stalled and not retry) or creeping:
                 # Decided by the iterates alone, which a longer run repeats: more iterations are never worse.
                 polish = False

@@ -60,21 +60,31 @@ def _perpendicular(x: float, y: float, z: float, dim: int) -> tuple[float, float
     return cx / norm, cy / norm, cz / norm
 
 
+_HALF_TURN = 0.5e-16
+"""1 + s·t (= δ²/2) below which :func:`_turn_shortest` turns by half a turn: δ < 10⁻⁸ rad from t = −s."""
+
+
 @compiled(error_model="numpy")
 def _turn_shortest(
     vx: float, vy: float, vz: float, s: NDArray[np.float64], tx: float, ty: float, tz: float
 ) -> tuple[float, float, float]:
     """v turned by the shortest rotation taking unit s onto unit t (π about a perpendicular where t = −s).
 
-    ``R v = v + c × v + c × (c × v) / (1 + s·t)`` with ``c = s × t`` (Rodrigues' formula without the angle)."""
+    ``R v = v + c × v + c × (c × v) / (1 + s·t)`` with ``c = s × t`` (Rodrigues' formula without the angle).
+
+    Within δ of t = −s the formula's rounding grows as ε/δ (c = s × t cancels) and the half turn's error as δ, so
+    the half turn takes over at δ = 10⁻⁸ ≈ √ε: each is then within about 10⁻⁸. (At 1.4·10⁻⁶, where it took over
+    before, a zero-range local hinge after a segment that far from −s bent by as much.) 1 + s·t is taken as
+    ``|s + t|² / 2``, which keeps its digits there."""
     cx, cy, cz = s[1] * tz - s[2] * ty, s[2] * tx - s[0] * tz, s[0] * ty - s[1] * tx
-    dot = s[0] * tx + s[1] * ty + s[2] * tz
-    if dot < -1.0 + 1e-12:
+    hx, hy, hz = s[0] + tx, s[1] + ty, s[2] + tz
+    one_plus_dot = 0.5 * (hx * hx + hy * hy + hz * hz)
+    if one_plus_dot < _HALF_TURN:
         kx, ky, kz = _perpendicular(s[0], s[1], s[2], int(_DIM_3D))
         along = 2.0 * (kx * vx + ky * vy + kz * vz)
         return along * kx - vx, along * ky - vy, along * kz - vz
     wx, wy, wz = cy * vz - cz * vy, cz * vx - cx * vz, cx * vy - cy * vx
-    k = 1.0 / (1.0 + dot)
+    k = 1.0 / one_plus_dot
     ux, uy, uz = cy * wz - cz * wy, cz * wx - cx * wz, cx * wy - cy * wx
     return vx + wx + k * ux, vy + wy + k * uy, vz + wz + k * uz
 

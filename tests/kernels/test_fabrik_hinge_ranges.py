@@ -198,6 +198,43 @@ def test_a_3d_rod_of_local_hinges_ends_at_its_optimum(target: tuple[float, float
     assert np.all(fabrik.joint_angles(result.joints)[1:] <= flex + 1e-7)
 
 
+def test_a_rod_pointing_nearly_away_from_its_target_turns_to_it_within_the_default_iterations() -> None:
+    # An explore run's case: a 5 m rod of zero-range local hinges along +z, its target 1 m away and 3.2° off straight
+    # below. FABRIK circled the optimum, 2.9 mm off it after the default 50 iterations: it never stalled, so the
+    # restart from the straight pose toward the target (the optimum here) came only at iteration 59.
+    joints = np.zeros((6, 3))
+    joints[:, -1] = np.arange(6.0)
+    azimuth, elevation = 0.19921875, -1.515625
+    point = np.array(
+        [math.cos(elevation) * math.cos(azimuth), math.cos(elevation) * math.sin(azimuth), math.sin(elevation)]
+    )
+    hinge = fabrik.Hinge((1.0, 0.0, 0.0), 0.0, 0.0, frame="local")
+    result = fabrik.solve(joints, point, constraints=[None] + [hinge] * 4)
+    assert rod_optimum(point, 5.0) == pytest.approx(4.0)
+    assert result.error == pytest.approx(4.0, abs=TOLERANCE)
+
+
+@pytest.mark.parametrize("n", [2, 3, 4])
+@pytest.mark.parametrize("short_of_a_half_turn", [0.0, 1e-12, 1e-9, 1e-7, 1e-6])
+@pytest.mark.parametrize("azimuth", [0.0, 1.0])
+def test_a_rod_turned_to_point_against_its_root_direction_stays_straight(
+    n: int, short_of_a_half_turn: float, azimuth: float
+) -> None:
+    # An explore run's case (n = 2, the target straight below the rod along +z): the first segment ended 1.3 µrad
+    # short of pointing straight down, and the second, held straight by a zero-range local hinge, 1.3 µrad off it.
+    # The hinge's frame turned by half a turn for any segment within 1.4 µrad of −z, not by the exact turn.
+    joints = np.zeros((n + 1, 3))
+    joints[:, -1] = np.arange(n + 1.0)
+    elevation = -math.pi / 2 + short_of_a_half_turn
+    point = np.array(
+        [math.cos(elevation) * math.cos(azimuth), math.cos(elevation) * math.sin(azimuth), math.sin(elevation)]
+    )
+    hinge = fabrik.Hinge((1.0, 0.0, 0.0), 0.0, 0.0, frame="local")
+    result = fabrik.solve(joints, point, constraints=[None] + [hinge] * (n - 1))
+    assert result.error == pytest.approx(n - 1.0, abs=TOLERANCE)
+    assert np.abs(fabrik.joint_angles(result.joints)[1:]).max() <= 1e-7
+
+
 @PROPERTY
 @given(
     st.integers(2, 5),
