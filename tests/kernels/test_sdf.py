@@ -11,6 +11,7 @@ from helpers.meshing import assert_near_surface_meshes_like_the_full_grid
 from helpers.properties import examples
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from scipy.spatial import KDTree
 
 from kernels import sdf
 
@@ -435,3 +436,54 @@ def test_sphere_trace_hits_and_misses() -> None:
     assert t[0] == pytest.approx(4.0, abs=1e-3)
     assert t[1] == pytest.approx(5.0 - math.sqrt(1 - 0.36), abs=1e-3)
     assert t[2] == np.inf
+
+
+# ------------------------------------------------------------------------------------------------ far from the origin
+def _moved(scene: sdf.Scene, offset: np.ndarray) -> sdf.Scene:
+    return sdf.Scene(
+        tuple(
+            sdf.Primitive(p.kind, tuple(np.add(p.center, offset)), p.size, p.rotation, p.color, p.op)
+            for p in scene.primitives
+        ),
+        k=scene.k,
+        blend=scene.blend,
+    )
+
+
+def test_a_sphere_1e8_m_out_is_meshed_as_the_same_sphere_at_the_origin() -> None:
+    # An outside tester's input: the field was evaluated in world float32 coordinates, which step by 8 m there, and
+    # the mesh filled the whole ±0.8 m box with 2,560 vertices, not watertight, of volume 0.
+    far = sdf.mesh(sdf.Scene((sdf.Primitive("sphere", (1e8, 0.0, 0.0), (0.5,)),)), 32)
+    near = sdf.mesh(sdf.Scene((sdf.Primitive("sphere", (0.0, 0.0, 0.0), (0.5,)),)), 32)
+    solid = sdf.mesh_trimesh(*far)
+    assert solid.is_watertight
+    assert solid.volume == pytest.approx(4.0 / 3.0 * math.pi * 0.5**3, rel=0.01)
+    assert far[1].shape == near[1].shape
+    np.testing.assert_allclose(far[0] - (1e8, 0.0, 0.0), near[0], atol=1e-6)
+
+
+@pytest.mark.parametrize("distance", [1e3, 1e5, 1e7, 1e9, 1e10])
+@pytest.mark.parametrize("direction", [(1.0, 0.0, 0.0), (-0.48, 0.6, 0.64)])
+def test_the_default_scene_anywhere_float64_resolves_its_grid_meshes_as_at_the_origin(
+    distance: float, direction: tuple[float, float, float]
+) -> None:
+    """The whole kind: the blended default scene moved out to 10¹⁰ m in any direction gives the origin's mesh moved,
+    each vertex within 1/100 of a voxel of the other mesh's."""
+    offset = distance * np.array(direction)
+    near = sdf.mesh(sdf.default_scene(), 48)
+    far = sdf.mesh(_moved(sdf.default_scene(), offset), 48)
+    voxel = sdf.make_grid(sdf.default_scene(), 48).spacing
+    assert abs(len(far[0]) - len(near[0])) <= 0.01 * len(near[0])
+    # Rounding moves a few samples across the iso level (vertex order and count may differ), never the surface.
+    gap = max(KDTree(near[0]).query(far[0] - offset)[0].max(), KDTree(far[0] - offset).query(near[0])[0].max())
+    assert gap <= 0.01 * voxel
+    assert sdf.mesh_trimesh(*far).volume == pytest.approx(sdf.mesh_trimesh(*near).volume, rel=1e-3)
+
+
+@pytest.mark.parametrize("distance", [1e12, 1e15, 1e17])
+def test_a_grid_finer_than_float64_resolves_where_it_lies_is_refused_naming_bounds(distance: float) -> None:
+    scene = sdf.Scene((sdf.Primitive("sphere", (distance, 0.0, 0.0), (0.5,)),))
+    with pytest.raises(ValueError, match=r"^bounds .* reach .* float64: mesh the shape nearer the origin"):
+        sdf.mesh(scene, 32)
+    with pytest.raises(ValueError, match=r"^bounds"):
+        sdf.make_grid(scene, 32, bounds=[[distance - 1, -1, -1], [distance + 1, 1, 1]])
