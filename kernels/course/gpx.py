@@ -218,9 +218,9 @@ def _check_values(
         bad = ~np.isfinite(values)
         if np.any(bad):
             first = int(np.argmax(bad))
+            reading = "not a number" if np.isnan(values[first]) else "infinite"
             raise ValueError(
-                f"{label}: {kind} point {first + 1} has {what} {values[first]}, not a number; "
-                f"{int(bad.sum())} point(s) like it"
+                f"{label}: {kind} point {first + 1}'s {what} is {reading}; {int(bad.sum())} point(s) like it"
             )
         out = (values < low) | (values > high)
         if np.any(out):
