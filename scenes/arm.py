@@ -560,8 +560,17 @@ def _unit_cylinder() -> trimesh.Trimesh:
     return mesh
 
 
+DISC_STEP_M = 0.002
+"""Obstacle k's disc stands k times this nearer the camera (−y) than the plane, its thickness fixed (scaled in x and
+z only): overlapping discs had their faces in one plane, which the depth test split into torn patches."""
+
+
+def _disc_scale(radius_m: float) -> tuple[float, float, float]:
+    return (radius_m, 1.0, radius_m)
+
+
 def _disc() -> trimesh.Trimesh:
-    """Radius 1, thin, facing ±y: a circle obstacle in the x–z plane."""
+    """Radius 1, 0.04 m thick, facing ±y: a circle obstacle in the x–z plane."""
     mesh = trimesh.creation.cylinder(radius=1.0, height=0.04, sections=48)
     mesh.apply_transform(trimesh.transformations.rotation_matrix(math.pi / 2, (1.0, 0.0, 0.0)))
     return mesh
@@ -741,7 +750,8 @@ is a static pose.
                     disc.faces,
                     color=OBSTACLE_COLOUR,
                     opacity=0.8,
-                    scale=self.params.radii_m[k],
+                    scale=_disc_scale(self.params.radii_m[k]),
+                    position=(0.0, -DISC_STEP_M * k, 0.0),
                 )
             )
             self.obstacle_spheres.append(
@@ -955,7 +965,7 @@ is a static pose.
                 self.obstacle_gizmos[k].visible = shown
                 self.obstacle_discs[k].visible = shown and not p.three_d
                 self.obstacle_spheres[k].visible = shown and p.three_d
-                self.obstacle_discs[k].scale = p.radii_m[k]
+                self.obstacle_discs[k].scale = _disc_scale(p.radii_m[k])
                 self.obstacle_spheres[k].scale = p.radii_m[k]
             self.readout.content = self._readout_markdown(report)
             self.ghost_readout.content = self._ghost_markdown(report)

@@ -739,3 +739,23 @@ def test_a_stall_beside_an_obstacle_without_limits_is_said_to_be_beside_it(scene
     scene.controls["avoid"].value = False  # an obstacle the chain may pass through holds nothing
     words = why_short(scene.params, stalled, scene.target, scene.obstacle_centres)
     assert words == "Short by **31.4 mm**: The iterations stalled there."
+
+
+@pytest.mark.parametrize("radii", [(0.6, 0.6, 0.6, 0.6), (0.3, 0.4, 0.5, 0.6)])
+def test_overlapping_obstacle_discs_never_share_a_face_plane(scene: ArmScene, radii: tuple[float, ...]) -> None:
+    # An outside tester: four discs of radius 0.6 overlapped in torn, jagged patches: their faces lay in one plane,
+    # which the depth test split between them. Each disc now stands 2 mm nearer the camera than the one before, at
+    # a thickness its radius does not change.
+    scene.controls["n_obstacles"].value = 4
+    for k, radius in enumerate(radii):
+        scene.controls.each("radii_m")[k].value = radius
+    faces = []
+    for k, disc in enumerate(scene.obstacle_discs):
+        assert disc.visible
+        y = np.asarray(disc.vertices)[:, 1] * np.asarray(disc.scale)[1] + np.asarray(disc.position)[1]
+        assert y.min() < 0.0 < y.max()  # it still stands across the chain's plane
+        width = np.ptp(np.asarray(disc.vertices)[:, 0]) * np.asarray(disc.scale)[0]
+        assert width == pytest.approx(2.0 * radii[k], rel=1e-3)  # drawn at its radius
+        faces += [y.min(), y.max()]
+    gaps = np.diff(np.sort(faces))
+    assert gaps.min() >= 1e-3, np.sort(faces)
