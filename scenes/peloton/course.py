@@ -74,6 +74,16 @@ ROAD_SHOWN_M = {True: (3.0, 0.0), False: (10.0, 4.0)}
 """Road the camera frames ahead of the leader and behind the last framed rider (m), the road's full width, for a line
 seen from its side (True) and a group seen from behind (False): a small group is seen on its road, not from a metre
 away (two abreast of 8 stood 37 % of the window tall)."""
+MARK_COLOUR = (250, 250, 250)
+"""The start and finish lines' paint."""
+MARK_LABEL_M = 0.3
+"""Height of the "Start" and "Finish" labels over the lines' right end (m): the road's edge on the riders' right,
+the side the chase camera looks from, below the riders rather than over a head."""
+_UNIT_BAND = (
+    np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0]]),
+    np.array([[0, 1, 3], [0, 3, 2]]),
+)
+"""A placeholder quad for a line's node until a layout places it."""
 BACKDROP_HALF_M = 2000.0
 """Half the side of the flat grass under course mode's road window (m): to the horizon at every camera distance."""
 BACKDROP_DROP_M = 1.0
@@ -279,9 +289,7 @@ class CourseMode:
         self.course_riders = add_riders(scene, f"{name}/riders", self.scene.params.position, 0.0, MAX_GROUP)
         self._drawn_riders = (self.scene.params.position, "full")
         self.mark_lines = {
-            mark: scene.add_line_segments(
-                f"{name}/{mark.lower()}_line", np.zeros((1, 2, 3)), colors=(250, 250, 250), thickness=0.25
-            )
+            mark: add_ground(scene, f"{name}/{mark.lower()}_line", *_UNIT_BAND, MARK_COLOUR, visible=False)
             for mark in layout.marks
         }
         self.mark_labels = {
@@ -771,12 +779,13 @@ class CourseMode:
         self.backdrop.position = (0.0, 0.0, float(layout.verge[0][:, 2].min()) - BACKDROP_DROP_M)
         self.road_edges.points = layout.edges
         self.centre_line.points = layout.dashes
-        for mark, ends in layout.marks.items():
+        for mark, band in layout.marks.items():
             line, label = self.mark_lines[mark], self.mark_labels[mark]
-            line.visible = label.visible = ends is not None
-            if ends is not None:
-                line.points = ends[None].astype(np.float32)
-                label.position = ends[0] + np.array([0.0, 0.0, 2.2])
+            line.visible = label.visible = band is not None
+            if band is not None:
+                vertices, faces = band
+                line.glb_data = mesh_glb(vertices, faces, color=MARK_COLOUR, unlit=True)
+                label.position = vertices[2:].mean(axis=0) + np.array([0.0, 0.0, MARK_LABEL_M])
         positions, wxyz = layout.riders
         n = positions.shape[0]
         all_positions = np.zeros((MAX_GROUP, 3), np.float32)

@@ -20,7 +20,7 @@ from numpy.typing import ArrayLike
 from kernels import course as course_kernel
 from kernels import cycling
 from scenes._controls import checkbox, dropdown, dropdown_from_labels, number, slider
-from scenes.peloton.model import ROAD_HALF_WIDTH_M, PelotonParams, drag_reductions, group_cda
+from scenes.peloton.model import BIKE_LENGTH_M, ROAD_HALF_WIDTH_M, PelotonParams, drag_reductions, group_cda
 
 CourseAirLabel = Literal["Textbook atmosphere", "Weather reading"]
 AIR_FROM_LABEL: dict[str, course_kernel.AirKind] = {
@@ -544,8 +544,13 @@ class RoadLayout:
     """(m, 2, 3) segments of the centre line's dashes."""
     riders: tuple[np.ndarray, np.ndarray]
     """(n, 3) positions and (n, 4) wxyz of the riders, leader first."""
-    marks: dict[str, np.ndarray | None]
-    """"Start" and "Finish": (2, 3) ends of the line across the road there, or None when it is not in the window."""
+    marks: dict[str, tuple[np.ndarray, np.ndarray] | None]
+    """"Start" and "Finish": the painted line across the road there, (4, 3) vertices (left edge, then right edge)
+    and (2, 3) faces of a flat band :data:`MARK_WIDTH_M` wide, or None when it is not in the window."""
+
+
+MARK_WIDTH_M = 0.3
+"""Width along the road of the painted start and finish lines (m)."""
 
 
 def lay_out_road(
@@ -569,11 +574,14 @@ def lay_out_road(
     edges = np.concatenate([np.stack([side[:-1], side[1:]], axis=1) for side in (inset[:k], inset[k:])])
     dash_m = dash_distances(d_from, d_to, count=int((d_to - d_from) / 3.0) + 1)
     dashes = frame.along(route, dash_m.ravel())[0].reshape(-1, 2, 3) + [0.0, 0.0, 0.004]
-    marks: dict[str, np.ndarray | None] = {}
+    marks: dict[str, tuple[np.ndarray, np.ndarray] | None] = {}
     for name, at in (("Start", 0.0), ("Finish", float(route.total_distance_m))):
-        if d_from <= at <= d_to:
-            across, _ = road_strip(frame, route, np.array([at, at + 0.01]), half_width, 0.006)
-            marks[name] = np.stack([across[0], across[2]])
+        # Where the leader's front wheel is when the ride's clock starts and stops (a rider's distance is the bike's
+        # centre): the leader stood across the start line at 0.00 km, his rear wheel on it.
+        line_at = at + 0.5 * BIKE_LENGTH_M
+        if d_from <= line_at - 0.5 * MARK_WIDTH_M and line_at + 0.5 * MARK_WIDTH_M <= d_to:
+            span = np.array([line_at - 0.5 * MARK_WIDTH_M, line_at + 0.5 * MARK_WIDTH_M])
+            marks[name] = road_strip(frame, route, span, half_width, 0.006)
         else:
             marks[name] = None
     return RoadLayout(

@@ -32,6 +32,7 @@ from scenes.peloton import PelotonParams, PelotonScene
 from scenes.peloton.course import BREAK_EVERY, LINE_INPUTS, RIDE_INPUTS, CourseMode, _escape
 from scenes.peloton.course_model import (
     BAROMETER_RANGE_HPA,
+    MARK_WIDTH_M,
     SAMPLE_LABEL,
     CourseParams,
     compute_course,
@@ -42,8 +43,8 @@ from scenes.peloton.course_model import (
     time_saved_words,
 )
 from scenes.peloton.meshes import rider_head_m
+from scenes.peloton.model import BIKE_LENGTH_M, group_cda
 from scenes.peloton.model import FORMATION_FROM_LABEL as FORMATION
-from scenes.peloton.model import group_cda
 from server.switcher import SceneSwitcher
 
 scene = scene_fixture(PelotonScene)
@@ -910,6 +911,30 @@ def test_the_road_and_riders_lie_where_the_route_runs() -> None:
     assert layout.marks == {"Start": None, "Finish": None}
     at_start = lay_out_road(route, 0.0, xy, 1.0)
     assert at_start.marks["Start"] is not None and at_start.marks["Finish"] is None
+
+
+@pytest.mark.parametrize("mark", ["Start", "Finish"])
+def test_the_start_and_finish_lines_are_painted_across_the_road_at_the_leaders_front_wheel(mark: str) -> None:
+    # An outside tester: at 0.00 km the start line, a 0.25 m tube, lay under the leader's rear wheel, ran past the
+    # road's edge onto the grass, and its label floated 2.2 m over the far edge.
+    route = course_kernel.load_gpx(course_kernel.SAMPLE_ROUTE)
+    xy = cycling.formation(4, "single", gap_m=0.5, lateral_m=0.6)
+    at = 0.0 if mark == "Start" else route.total_distance_m
+    layout = lay_out_road(route, at, xy, 1.0)
+    band = layout.marks[mark]
+    assert band is not None
+    vertices, faces = band
+    assert vertices.shape == (4, 3) and faces.shape == (2, 3)
+    # Flat on the road, a few mm over it, exactly as wide as the road, 0.3 m along it.
+    centre, tangent = layout.frame.along(route, np.array([at + 0.5 * BIKE_LENGTH_M]))
+    left, right = vertices[:2].mean(axis=0), vertices[2:].mean(axis=0)
+    np.testing.assert_allclose(0.5 * (left + right), centre[0] + [0.0, 0.0, 0.006], atol=0.02)
+    assert np.linalg.norm(left - right) == pytest.approx(2.0 * layout.half_width_m, rel=1e-6)
+    assert np.linalg.norm(vertices[1] - vertices[0]) == pytest.approx(MARK_WIDTH_M, rel=0.05)
+    # The leader's front wheel (half a bike ahead of his centre) is on it.
+    leader, _ = layout.riders
+    front = leader[0] + 0.5 * BIKE_LENGTH_M * tangent[0]
+    np.testing.assert_allclose(front[:2], centre[0][:2], atol=0.02)
 
 
 def _surface_heights(vertices: np.ndarray, faces: np.ndarray, points_xy: np.ndarray) -> np.ndarray:
