@@ -112,6 +112,16 @@ _SEE_IT = "; choose GLSL editor in Shape to see it."
 """How an Apply's status ends while Shape shows another shape; dropped once the editor is chosen."""
 
 
+def _rebounded(shape: Shape, shown: Shape | None) -> bool:
+    """Whether ``shape`` is the shown editor field meshed in another box."""
+    return (
+        isinstance(shape, EditorField)
+        and isinstance(shown, EditorField)
+        and shape.source == shown.source
+        and shape.half_size != shown.half_size
+    )
+
+
 class SdfGalleryScene(Scene[SdfGalleryParams]):
     key = "sdf"
     title = "SDF gallery (ray marching)"
@@ -188,6 +198,10 @@ IoU is lowest when a box edge is on the silhouette.
         self._shape_choices = 0
         """How many times the Shape menu has changed: an Apply that finishes after the menu changed leaves the shape
         the person chose."""
+        self._gizmo_moves = 0
+        """How many inputs have moved or turned a primitive (its gizmo); ``_moves_at_mesh``: how many had when the
+        last full mesh was shown. A mesh after none follows its shape out of the picture; one after a drag does not."""
+        self._moves_at_mesh = 0
         self._source_choice = 0
         """``_shape_choices`` when the wanted source was asked for."""
         self._wanted_resolution = self.params.resolution
@@ -372,6 +386,10 @@ IoU is lowest when a box edge is on the silhouette.
         except ValueError:
             logger.warning("sdf: rejected scene input; keeping the last good scene", exc_info=True)
             return
+        placed = [(slot.position, slot.wxyz) for slot in params.primitives]
+        if placed != [(slot.position, slot.wxyz) for slot in self.params.primitives]:
+            with self._state:
+                self._gizmo_moves += 1  # a gizmo moved or turned one: the mesh it makes keeps the view
         self.params = params
         self._sync_enabled_inputs()
         self._request_mesh()
@@ -777,16 +795,18 @@ IoU is lowest when a box edge is on the silhouette.
         with self._lock:
             if self.closed:
                 return
-            # A field re-bounded in the editor may lie anywhere in its new box: the view follows it if it left the
-            # picture (a newly applied field is followed by _apply_source, once the scene shows the editor).
-            # Primitives never move the view: a drag would pull the camera along.
+            # A field re-bounded in the editor may lie anywhere in its new box, and primitives changed by a control
+            # (a size, a kind, one turned on, the blend) may outgrow the picture: the view follows either if it
+            # left the picture (a newly applied field is followed by _apply_source, once the scene shows the
+            # editor). A gizmo's drag never moves the view, here or since the last mesh: it would pull the camera.
+            with self._state:
+                unmoved = self._gizmo_moves == self._moves_at_mesh
+                if not preview:
+                    self._moves_at_mesh = self._gizmo_moves
             shown = self.mesh_shape
-            follow = (
-                not preview
-                and isinstance(shape, EditorField)
-                and isinstance(shown, EditorField)
-                and shape.source == shown.source
-                and shape.half_size != shown.half_size
+            follow = not preview and (
+                _rebounded(shape, shown)
+                or (isinstance(shape, sdf.Scene) and isinstance(shown, sdf.Scene) and shape != shown and unmoved)
             )
             with self.server.atomic():
                 self.mesh_node.glb_data = glb

@@ -1371,3 +1371,49 @@ def test_the_opening_view_frames_the_shape_large_with_its_gizmos(scene: SdfGalle
     xy = project_points(view, lens, gizmos)
     assert xy[:, 0].min() >= left - 0.5 and xy[:, 0].max() <= right + 0.5
     assert xy[:, 1].min() >= top - 0.5 and xy[:, 1].max() <= bottom + 0.5
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("size", [(1000, 1600), (720, 1280)], ids=["1600x1000", "1280x720"])
+def test_primitives_grown_out_of_the_picture_by_their_sliders_are_followed_and_a_gizmo_drag_keeps_the_view(
+    server: viser.ViserServer, scene: SdfGalleryScene, size: tuple[int, int]
+) -> None:
+    # An outside tester: P1 alone as an octahedron of a = 1 m ran off the top of the view (and a smooth blend at
+    # k = 1 under the panel), which was framed only when the tab opened.
+    with BrowserClient(server.get_port()) as client:
+        _tab, lens, view = _framed_tab(server, scene, client, size)
+        for slot in (2, 3, 4):
+            client.set_value(f"P{slot} on", False)
+        client.set_value("P1 kind", "Octahedron")
+        wait_until(
+            lambda: (
+                scene.params.primitives[0].kind == "octahedron"
+                and not any(slot.enabled for slot in scene.params.primitives[1:])
+                and scene.mesh_shape == scene.params.scene()
+            ),
+            "the octahedron meshed",
+            timeout_s=60.0,
+        )
+        opening = view()
+        frames = scene.framing.frames
+        client.set_value("P1 size a (m)", 1.0)
+        wait_until(
+            lambda: scene.params.primitives[0].size[0] == 1.0 and scene.mesh_shape == scene.params.scene(), "the remesh"
+        )
+        box = box_corners(scene.mesh_vertices.min(axis=0), scene.mesh_vertices.max(axis=0))
+        assert not shows(opening, lens, box, clear_of_notice=False)
+        wait_until(lambda: scene.framing.frames > frames, "the view followed", timeout_s=10.0)
+        wait_until(lambda: shows(view(), lens, box, clear_of_notice=False), "the octahedron in the picture")
+        # Dragging the gizmo out of the picture moves the shape, not the camera.
+        assert scene.wait_idle()
+        held = view()
+        client.send_camera(held.position, held.look_at, size)
+        time.sleep(0.3)
+        frames = scene.framing.frames
+        client.drag_transform(scene.gizmos[0].name, [(0.6, 0.6, 0.6), (1.2, 1.2, 1.2), (1.5, 1.5, 1.5)])
+        wait_until(
+            lambda: scene.params.primitives[0].position == (1.5, 1.5, 1.5) and scene.mesh_shape == scene.params.scene(),
+            "the moved mesh",
+        )
+        time.sleep(0.3)
+        assert scene.framing.frames == frames and view() == held
