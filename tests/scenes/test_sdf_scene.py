@@ -1095,6 +1095,10 @@ def _applied(client: BrowserClient, scene: SdfGalleryScene, source: str) -> trim
     return trimesh.Trimesh(scene.mesh_vertices, scene.mesh_faces)
 
 
+AT_BOTH_WINDOWS = pytest.mark.parametrize("size", [(1000, 1600), (720, 1280)], ids=["1600x1000", "1280x720"])
+"""Each test of the framing in the two windows the browser tests use, as canvas (height, width)."""
+
+
 def _framed_tab(
     server: viser.ViserServer, scene: SdfGalleryScene, client: BrowserClient, size: tuple[int, int]
 ) -> tuple[viser.ClientHandle, Lens, Callable[[], View]]:
@@ -1115,7 +1119,7 @@ def _framed_tab(
 
 
 @pytest.mark.gl
-@pytest.mark.parametrize("size", [(1000, 1600), (720, 1280)], ids=["1600x1000", "1280x720"])
+@AT_BOTH_WINDOWS
 def test_a_field_applied_out_of_the_picture_is_brought_into_it_and_one_in_it_leaves_the_view(
     server: viser.ViserServer, scene: SdfGalleryScene, size: tuple[int, int]
 ) -> None:
@@ -1139,7 +1143,7 @@ def test_a_field_applied_out_of_the_picture_is_brought_into_it_and_one_in_it_lea
 
 
 @pytest.mark.gl
-@pytest.mark.parametrize("size", [(1000, 1600), (720, 1280)], ids=["1600x1000", "1280x720"])
+@AT_BOTH_WINDOWS
 def test_a_field_that_wider_bounds_bring_out_of_the_picture_is_followed_and_one_in_it_keeps_the_view(
     server: viser.ViserServer, scene: SdfGalleryScene, size: tuple[int, int]
 ) -> None:
@@ -1374,7 +1378,7 @@ def test_the_opening_view_frames_the_shape_large_with_its_gizmos(scene: SdfGalle
 
 
 @pytest.mark.gl
-@pytest.mark.parametrize("size", [(1000, 1600), (720, 1280)], ids=["1600x1000", "1280x720"])
+@AT_BOTH_WINDOWS
 def test_primitives_grown_out_of_the_picture_by_their_sliders_are_followed_and_a_gizmo_drag_keeps_the_view(
     server: viser.ViserServer, scene: SdfGalleryScene, size: tuple[int, int]
 ) -> None:
