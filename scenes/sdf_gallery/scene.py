@@ -199,15 +199,17 @@ IoU is lowest when a box edge is on the silhouette.
         """How many times the Shape menu has changed: an Apply that finishes after the menu changed leaves the shape
         the person chose."""
         self._gizmo_moves = 0
-        """How many inputs have moved or turned a primitive (its gizmo); ``_moves_at_mesh``: how many had when the
-        last full mesh was shown. A mesh after none follows its shape out of the picture; one after a drag does not."""
-        self._moves_at_mesh = 0
+        """How many inputs have moved or turned a primitive (its gizmo). Each mesh request carries the count it was
+        made at, and ``_moves_at_mesh`` is the shown full mesh's: a mesh with none since follows its shape out of
+        the picture; one after a drag does not."""
+        self._moves_at_mesh: int | None = None
+        self._wanted_moves: int | None = None
         self._source_choice = 0
         """``_shape_choices`` when the wanted source was asked for."""
         self._wanted_resolution = self.params.resolution
         self._wanted_preview = False
         """Whether the wanted mesh came in a burst of inputs (mesh it as a preview)."""
-        self._refine: tuple[Shape, int] | None = None
+        self._refine: tuple[Shape, int, int | None] | None = None
         """The scene and resolution to mesh in full once the inputs rest (a preview is on screen)."""
         self._scene_time = 0.0
         self._reference_due = True
@@ -233,7 +235,7 @@ IoU is lowest when a box edge is on the silhouette.
         self.framing = ClientFraming(self._view_for, opening=self.camera_position)
         """Frames each tab's camera on the shape and its gizmos when it opens (and when its window is resized), and
         again when a field applied in the editor leaves the picture."""
-        self._mesh_and_show(self.params.scene(), self.params.resolution)
+        self._mesh_and_show(self.params.scene(), self.params.resolution, moves=self._gizmo_moves)
         self.worker = LatestWorker("sdf-worker")
         """Runs :meth:`step`: the meshing and ray-marching, off the callback threads."""
         self._threads.append(self.worker.thread)
@@ -515,6 +517,7 @@ IoU is lowest when a box edge is on the silhouette.
             self._scene_time = now
             self._wanted_scene = params.shape()
             self._wanted_resolution = params.resolution
+            self._wanted_moves = self._gizmo_moves
         self._wake()
 
     def _request_source(self, text: str) -> None:
@@ -611,23 +614,23 @@ IoU is lowest when a box edge is on the silhouette.
             with self._state:
                 # Asked again under the turn: a request that came meanwhile may be a full mesh.
                 meshed_here = quick and self._quick_job()
-                scene, resolution = self._wanted_scene, self._wanted_resolution
+                scene, resolution, moves = self._wanted_scene, self._wanted_resolution, self._wanted_moves
                 source, preview, choice = self._wanted_source, self._wanted_preview, self._source_choice
                 self._wanted_scene = self._wanted_source = None
                 refine = self._refine
                 rested = time.monotonic() - self._scene_time >= CAMERA_REST_S
             if meshed_here and scene is not None:
-                self._mesh_request(scene, resolution, preview)
+                self._mesh_request(scene, resolution, preview, moves)
         if self.closed:
             return
         if source is None and scene is not None and not meshed_here:
-            self._mesh_request(scene, resolution, preview)
+            self._mesh_request(scene, resolution, preview, moves)
         elif source is not None:
             self._refine = None
             self._apply_source(source, resolution, choice)
         elif scene is None and refine is not None and rested:
             self._refine = None
-            self._mesh_and_show(*refine)
+            self._mesh_and_show(refine[0], refine[1], moves=refine[2])
             with self._state:
                 self._reference_due = True
 
@@ -656,11 +659,12 @@ IoU is lowest when a box edge is on the silhouette.
             and (self._wanted_preview or self._wanted_resolution <= PREVIEW_RESOLUTION)
         )
 
-    def _mesh_request(self, scene: Shape, resolution: int, preview: bool) -> None:
-        """Mesh a wanted scene: a preview at 32³ while a drag's inputs keep coming, else at ``resolution``."""
+    def _mesh_request(self, scene: Shape, resolution: int, preview: bool, moves: int | None) -> None:
+        """Mesh a wanted scene (asked for when ``moves`` gizmo inputs had come): a preview at 32³ while a drag's
+        inputs keep coming, else at ``resolution``."""
         preview = preview and resolution > PREVIEW_RESOLUTION
-        self._refine = (scene, resolution) if preview else None
-        self._mesh_and_show(scene, PREVIEW_RESOLUTION if preview else resolution, preview=preview)
+        self._refine = (scene, resolution, moves) if preview else None
+        self._mesh_and_show(scene, PREVIEW_RESOLUTION if preview else resolution, preview=preview, moves=moves)
         with self._state:
             self._reference_due = True
 
@@ -758,9 +762,10 @@ IoU is lowest when a box edge is on the silhouette.
         with self._state:
             return self._shape_choices != choice and self.params.shape_source != "editor"
 
-    def _mesh_and_show(self, scene: Shape, resolution: int, *, preview: bool = False) -> None:
+    def _mesh_and_show(self, scene: Shape, resolution: int, *, preview: bool = False, moves: int | None = None) -> None:
         """Mesh ``scene`` at ``resolution`` and show it; a ``preview`` goes to the 3D view only (the readouts, the
-        export and the reference keep the last full mesh)."""
+        export and the reference keep the last full mesh). ``moves``: the gizmo inputs counted when it was asked
+        for (None: not a request of the primitives' controls)."""
         start = time.perf_counter()
         if isinstance(scene, EditorField):
             vertices, faces, colors, normals = editor.mesh_field(scene, resolution)
@@ -778,7 +783,7 @@ IoU is lowest when a box edge is on the silhouette.
             normals = scene_normals(scene, vertices)
         glb = viewer_glb(vertices, faces, colors, normals)
         mesh_ms = 1e3 * (time.perf_counter() - start)
-        self._show_mesh(scene, vertices, faces, colors, glb, mesh_ms, resolution, preview=preview)
+        self._show_mesh(scene, vertices, faces, colors, glb, mesh_ms, resolution, preview=preview, moves=moves)
 
     def _show_mesh(
         self,
@@ -791,6 +796,7 @@ IoU is lowest when a box edge is on the silhouette.
         resolution: int,
         *,
         preview: bool = False,
+        moves: int | None = None,
     ) -> None:
         with self._lock:
             if self.closed:
@@ -799,10 +805,9 @@ IoU is lowest when a box edge is on the silhouette.
             # (a size, a kind, one turned on, the blend) may outgrow the picture: the view follows either if it
             # left the picture (a newly applied field is followed by _apply_source, once the scene shows the
             # editor). A gizmo's drag never moves the view, here or since the last mesh: it would pull the camera.
-            with self._state:
-                unmoved = self._gizmo_moves == self._moves_at_mesh
-                if not preview:
-                    self._moves_at_mesh = self._gizmo_moves
+            unmoved = moves is not None and moves == self._moves_at_mesh
+            if not preview:
+                self._moves_at_mesh = moves
             shown = self.mesh_shape
             follow = not preview and (
                 _rebounded(shape, shown)

@@ -1385,7 +1385,8 @@ def test_primitives_grown_out_of_the_picture_by_their_sliders_are_followed_and_a
     # An outside tester: P1 alone as an octahedron of a = 1 m ran off the top of the view (and a smooth blend at
     # k = 1 under the panel), which was framed only when the tab opened.
     with BrowserClient(server.get_port()) as client:
-        _tab, lens, view = _framed_tab(server, scene, client, size)
+        tab, lens, view = _framed_tab(server, scene, client, size)
+        client.wait_for_gui("P4 on")
         for slot in (2, 3, 4):
             client.set_value(f"P{slot} on", False)
         client.set_value("P1 kind", "Octahedron")
@@ -1411,8 +1412,8 @@ def test_primitives_grown_out_of_the_picture_by_their_sliders_are_followed_and_a
         # Dragging the gizmo out of the picture moves the shape, not the camera.
         assert scene.wait_idle()
         held = view()
-        client.send_camera(held.position, held.look_at, size)
-        time.sleep(0.3)
+        client.send_camera(held.position, held.look_at, size)  # the tab reports the framed view
+        wait_until(lambda: not scene.framing.pending(tab.client_id), "the framed view reported")
         frames = scene.framing.frames
         client.drag_transform(scene.gizmos[0].name, [(0.6, 0.6, 0.6), (1.2, 1.2, 1.2), (1.5, 1.5, 1.5)])
         wait_until(
