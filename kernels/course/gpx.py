@@ -117,7 +117,7 @@ def load_gpx(source: str | os.PathLike[str] | bytes, *, name: str | None = None,
     try:
         gpx = gpxpy.parse(text)
     except gpxpy.gpx.GPXException as error:
-        raise ValueError(f"{label} is not a valid GPX file: {str(error)[:200]}") from error
+        raise ValueError(f"{label} is not a valid GPX file: {_gpx_error_words(str(error))}") from error
     except (ValueError, TypeError, AttributeError, IndexError) as error:
         raise ValueError(f"{label} is not a valid GPX file: {type(error).__name__}") from error
 
@@ -200,6 +200,19 @@ def _decode(data: bytes, label: str) -> str:
         raise ValueError(f"{label} is not GPX: it is not text in {encoding.upper()}") from error
     # The text is decoded now: the declaration's encoding must not be applied a second time by the XML parser.
     return re.sub(r"""^(\ufeff?<\?xml[^>]*?)\s+encoding\s*=\s*["'][^"']*["']""", r"\1", text, count=1)
+
+
+def _gpx_error_words(message: str) -> str:
+    """gpxpy's complaint in a rider's words, without its Python text or the value it could not read ("could not
+    convert string to float: 'nan(123)'" once reached the page)."""
+    value = re.match(r"Invalid value for <(\w+)>", message)
+    if message.startswith("Invalid value for"):
+        tag = value.group(1) if value and value.group(1) != "None" else None
+        where = {"ele": "an elevation (<ele>)", "time": "a time (<time>)"}.get(tag or "", "a latitude or longitude")
+        return f"{where} is not a number"
+    place = re.search(r"line (\d+), column (\d+)", message)
+    at = f" at line {place.group(1)}, column {place.group(2)}" if place else ""
+    return f"its XML is broken{at} (a tag left open or closed twice, or the file cut short)"
 
 
 def _check_values(

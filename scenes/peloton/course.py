@@ -76,9 +76,10 @@ seen from its side (True) and a group seen from behind (False): a small group is
 away (two abreast of 8 stood 37 % of the window tall)."""
 MARK_COLOUR = (250, 250, 250)
 """The start and finish lines' paint."""
-MARK_LABEL_M = 0.3
-"""Height of the "Start" and "Finish" labels over the lines' right end (m): the road's edge on the riders' right,
-the side the chase camera looks from, below the riders rather than over a head."""
+MARK_LABEL_M = 0.02
+"""Height of the "Start" and "Finish" labels over the lines' right end (m): on the road's edge on the riders' right,
+the side the chase camera looks from, below the riders rather than over a head, and at the line however close the
+camera comes (0.3 m stood 80 px over it for one rider)."""
 _UNIT_BAND = (
     np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0]]),
     np.array([[0, 1, 3], [0, 3, 2]]),
@@ -527,7 +528,8 @@ class CourseMode:
             except ValueError as failure:
                 error = str(failure)
         if route is None or state is None:
-            reason = str(error).removeprefix("the file: ")  # the file is named already
+            # The file is named already: "x.gpx was not loaded: it is not a valid GPX file", not "the file is".
+            reason = re.sub(r"^the file(: | )", lambda m: "" if m.group(1) == ": " else "it ", str(error))
             self.refusal = f"{label} was not loaded: {reason}. Still showing {self.route.name}."
             self.message = (
                 f"**{_escape(label)}** was not loaded: {_escape(reason)}. Still showing **{_escape(self.route.name)}**."

@@ -32,7 +32,7 @@ def hill_gpx(name: str = "Test hill", n: int = 300) -> bytes:
 BAD_FILES = {
     "plain text": ("hello, I am not a GPX file", "not (a )?GPX"),
     "html": ("<html><body>hi</body></html>", "is not GPX"),
-    "broken xml": ('<?xml version="1.0"?><gpx><trk><trkseg><trkpt lat="1"', "not a valid GPX"),
+    "broken xml": ('<?xml version="1.0"?><gpx><trk><trkseg><trkpt lat="1"', "its XML is broken at line 1, column 39"),
     "kml": ('<?xml version="1.0"?><kml><Document/></kml>', "is not GPX"),
     "no track points": ('<?xml version="1.0"?><gpx version="1.1"><wpt lat="1" lon="2"/></gpx>', "no track points"),
     "empty segment": (gpx_text([]), "no track points"),
@@ -46,7 +46,15 @@ BAD_FILES = {
         "point 2's elevation is infinite",
     ),
     "latitude out of range": (gpx_text([(45.0, 6.0, 1.0), (95.0, 6.0, 2.0)]), "latitude"),
-    "bad number": (gpx_text([(45.0, 6.0, 1.0)]).replace('lat="45.0"', 'lat="abc"'), "not a valid GPX"),
+    "bad number": (
+        gpx_text([(45.0, 6.0, 1.0)]).replace('lat="45.0"', 'lat="abc"'),
+        "not a valid GPX file: a latitude or longitude is not a number",
+    ),
+    # An outside tester: gpxpy's "could not convert string to float: 'nan(123)'" reached the page.
+    "unreadable elevation": (
+        gpx_text([(45.0, 6.0, 1.0), (45.001, 6.0, 2.0)]).replace("<ele>2.0</ele>", "<ele>nan(123)</ele>"),
+        r"not a valid GPX file: an elevation \(<ele>\) is not a number$",
+    ),
     "elevation absurd": (gpx_text([(45.0, 6.0, 1.0), (45.001, 6.0, 1e7)]), "elevation"),
     "too short": (gpx_text([(45.0, 6.0, 10.0), (45.0000001, 6.0, 10.0)]), "100 m or more"),
 }

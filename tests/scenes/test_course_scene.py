@@ -846,7 +846,7 @@ REVIEW_FILES = {
     ),
     "not gpx": (
         "<html><body>hi</body></html>",
-        "was not loaded: the file is not GPX: no <gpx>",
+        "was not loaded: it is not GPX: no <gpx>",
     ),
 }
 
