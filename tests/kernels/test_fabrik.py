@@ -393,6 +393,74 @@ def test_an_obstacle_that_stalls_fabrik_clear_of_it_is_gone_around_by_a_restart(
         assert segment_clearance(result.joints, centre) >= radius
 
 
+# An outside tester's inputs: no limits, 3-4 obstacles, and FABRIK stopped "limited" 0.8-1.7 m short of a target
+# that CCD or DLS reached with every obstacle 0.06-0.39 m clear (the first returned its start pose).
+STALLED_BESIDE_OBSTACLES = [
+    (
+        [[0, 0], [-0.072, 0.42], [0.835, 0.51]],
+        [0.388, -1.147],
+        [([0.08, -0.368], 0.137), ([-0.068, 0.95], 0.099), ([0.437, -0.274], 0.247), ([1.104, 0.753], 0.311)],
+    ),
+    (
+        [[0, 0], [0.446, 0.307], [0.443, -0.648]],
+        [0.382, 0.299],
+        [([0.95, -0.739], 0.229), ([0.901, 0.197], 0.341), ([-0.736, -1.08], 0.209)],
+    ),
+    (
+        [[0, 0], [-0.696, 0.586], [-0.325, 1.458]],
+        [-0.768, 0.646],
+        [([-0.243, 1.189], 0.105), ([0.685, 0.21], 0.328), ([0.243, 0.919], 0.303)],
+    ),
+]
+
+
+@pytest.mark.parametrize(("joints", "target", "obstacles"), STALLED_BESIDE_OBSTACLES)
+def test_a_fabrik_stall_beside_obstacles_is_polished_to_the_target(
+    joints: list[list[float]], target: list[float], obstacles: list[tuple[list[float], float]]
+) -> None:
+    result = fabrik.solve(np.array(joints, dtype=float), target, obstacles=obstacles, max_iterations=200)
+    assert result.status == "reached" and result.error <= 1e-3
+    for centre, radius in obstacles:
+        assert segment_clearance(result.joints, np.array(centre)) >= radius * (1.0 - 1e-9)
+
+
+def test_fabrik_reaches_what_ccd_or_dls_reach_clear_of_obstacles_without_limits() -> None:
+    """The kind: 1,485 random chains (2-4 links, 2D and 3D) and targets among 1-4 random obstacles, no limits.
+    FABRIK stalled short of 5 that CCD or DLS reached clear of every obstacle; the polish after a stall (damped
+    least squares projected by the constrained passes) leaves 1, a fixed point of its own."""
+    rng = np.random.default_rng(2)
+    missed = 0
+    for k in range(1500):
+        d = 2 if k % 2 == 0 else 3
+        lengths = rng.uniform(0.2, 0.6, int(rng.integers(2, 5)))
+        joints, direction = [np.zeros(d)], np.eye(d)[-1]
+        for length in lengths:
+            direction = direction + rng.normal(size=d) * 0.8
+            direction /= np.linalg.norm(direction)
+            joints.append(joints[-1] + length * direction)
+        reach = lengths.sum()
+        target = rng.normal(size=d)
+        target *= rng.uniform(0.05, 0.95) * reach / np.linalg.norm(target)
+        obstacles = []
+        for _ in range(int(rng.integers(1, 5))):
+            centre, radius = rng.uniform(-reach, reach, d), rng.uniform(0.05, 0.35)
+            if np.linalg.norm(centre) > radius and np.linalg.norm(centre - target) > radius:
+                obstacles.append((centre, radius))
+        if not obstacles:
+            continue
+        chain = np.array(joints)
+        if fabrik.solve(chain, target, obstacles=obstacles, max_iterations=200).status == "reached":
+            continue
+        for other in (fabrik.ccd, fabrik.jacobian_dls):
+            pose = other(chain, target, obstacles=obstacles, max_iterations=200)
+            if pose.status == "reached" and all(
+                segment_clearance(pose.joints, c) >= r * (1.0 - 1e-6) for c, r in obstacles
+            ):
+                missed += 1
+                break
+    assert missed <= 1
+
+
 @pytest.mark.parametrize("solver", ["fabrik", "ccd", "jacobian_dls"])
 def test_inputs_are_not_modified(solver: fabrik.Solver) -> None:
     # Straight, with the target on its axis: the solver bends it, on its own copy.
