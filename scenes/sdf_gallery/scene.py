@@ -210,7 +210,8 @@ IoU is lowest when a box edge is on the silhouette.
         self._wanted_preview = False
         """Whether the wanted mesh came in a burst of inputs (mesh it as a preview)."""
         self._refine: tuple[Shape, int, int | None] | None = None
-        """The scene and resolution to mesh in full once the inputs rest (a preview is on screen)."""
+        """The scene, resolution and gizmo-input count of the mesh to make in full once the inputs rest (a preview
+        is on screen)."""
         self._scene_time = 0.0
         self._reference_due = True
         self._view_key: tuple[Any, ...] | None = None
@@ -234,7 +235,7 @@ IoU is lowest when a box edge is on the silhouette.
         self._sync_enabled_inputs()
         self.framing = ClientFraming(self._view_for, opening=self.camera_position)
         """Frames each tab's camera on the shape and its gizmos when it opens (and when its window is resized), and
-        again when a field applied in the editor leaves the picture."""
+        again when a field applied in the editor, or a shape a control changed, leaves the picture."""
         self._mesh_and_show(self.params.scene(), self.params.resolution, moves=self._gizmo_moves)
         self.worker = LatestWorker("sdf-worker")
         """Runs :meth:`step`: the meshing and ray-marching, off the callback threads."""
