@@ -1141,3 +1141,21 @@ def test_the_air_is_compared_with_sea_level_in_the_right_direction(
 ) -> None:
     scene.controls["altitude_m"].value = altitude_m
     assert words in scene.density.content and "-" not in scene.density.content.split("(")[1].split(")")[0]
+
+
+@pytest.mark.parametrize("efficiency_pct", [97.6, 90.0, 100.0])
+def test_the_power_chart_says_its_parts_are_at_the_wheel_and_its_total_at_the_pedals(
+    scene: PelotonScene, efficiency_pct: float
+) -> None:
+    # An outside tester: at 4 %, 2000 m and 40 km/h the chart's Aero, Rolling and Climbing added to 595.9 W and its
+    # "Total (W)" read 610.5 W (595.9 / 0.976), with nothing to say why.
+    scene.controls["grade_pct"].value = 4.0
+    scene.controls["altitude_m"].value = 2000.0
+    scene.controls["drivetrain_pct"].value = efficiency_pct
+    speed, aero, rolling, climbing, total, _now = scene.chart.data
+    labels = [series["label"] for series in scene.chart.handle.series]
+    assert labels[1:5] == ["Aero, wheel (W)", "Rolling, wheel (W)", "Climbing, wheel (W)", "Total at the pedals (W)"]
+    wheel = np.asarray(aero) + np.asarray(rolling) + np.asarray(climbing)
+    at_40 = int(np.argmin(np.abs(np.asarray(speed) - 40.0)))
+    assert wheel[at_40] > 0.0
+    assert total[at_40] == pytest.approx(wheel[at_40] / (efficiency_pct / 100.0), rel=1e-9)
