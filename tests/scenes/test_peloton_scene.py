@@ -1153,7 +1153,7 @@ def test_the_power_chart_says_its_parts_are_at_the_wheel_and_its_total_at_the_pe
     scene.controls["altitude_m"].value = 2000.0
     scene.controls["drivetrain_pct"].value = efficiency_pct
     speed, aero, rolling, climbing, total, _now = scene.chart.data
-    labels = [series["label"] for series in scene.chart.handle.series]
+    labels = [series.get("label") for series in scene.chart.handle.series]
     assert labels[1:5] == ["Aero, wheel (W)", "Rolling, wheel (W)", "Climbing, wheel (W)", "Total at the pedals (W)"]
     wheel = np.asarray(aero) + np.asarray(rolling) + np.asarray(climbing)
     at_40 = int(np.argmin(np.abs(np.asarray(speed) - 40.0)))
