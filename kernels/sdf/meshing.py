@@ -147,8 +147,8 @@ def _field_at(scene: Scene, grid: Grid, points: NDArray[np.floating]) -> NDArray
 def _grid_shift(grid: Grid) -> FloatArray:
     """(3,) where the field is evaluated from (m): the grid's centre rounded to a multiple of the power of two at or
     above its longest side, so 0 for a grid about the world's origin (the world frame, bit for bit) and within one
-    such multiple of the grid elsewhere (a sphere 10⁸ m out, in world float32 coordinates whose step there is 8 m,
-    meshed as the whole box)."""
+    such multiple of the grid elsewhere. (In world float32 coordinates, which step by 8 m at 10⁸ m, a sphere there
+    was meshed as its whole box.)"""
     origin = np.asarray(grid.origin, dtype=np.float64)
     extent = grid.spacing * (np.asarray(grid.shape, dtype=np.float64) - 1.0)
     quantum = 2.0 ** math.ceil(math.log2(float(extent.max())))
