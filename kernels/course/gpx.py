@@ -205,11 +205,10 @@ def _decode(data: bytes, label: str) -> str:
 def _gpx_error_words(message: str) -> str:
     """gpxpy's complaint in a rider's words, without its Python text or the value it could not read ("could not
     convert string to float: 'nan(123)'" once reached the page)."""
-    value = re.match(r"Invalid value for <(\w+)>", message)
-    if message.startswith("Invalid value for"):
-        tag = value.group(1) if value and value.group(1) != "None" else None
-        where = {"ele": "an elevation (<ele>)", "time": "a time (<time>)"}.get(tag or "", "a latitude or longitude")
-        return f"{where} is not a number"
+    if message.startswith("Invalid value for"):  # "<ele>", "<time>", or "<None>" for an attribute (lat, lon)
+        tag = re.match(r"Invalid value for <(\w+)>", message)
+        where = {"ele": "an elevation (<ele>)", "time": "a time (<time>)"}.get(tag.group(1) if tag else "")
+        return f"{where or 'a latitude or longitude'} is not a number"
     place = re.search(r"line (\d+), column (\d+)", message)
     at = f" at line {place.group(1)}, column {place.group(2)}" if place else ""
     return f"its XML is broken{at} (a tag left open or closed twice, or the file cut short)"
