@@ -170,7 +170,7 @@ IoU is lowest when a box edge is on the silhouette.
         self.editor_error: str | None = None
         """Why the latest editor source was refused (None once one is applied)."""
         self.editor_serial = 0
-        """How many editor sources have been applied."""
+        """How many editor sources have been applied, counted once an apply is complete (its view framed too)."""
         self.mesh_serial = 0
         """How many full-resolution meshes have been shown (``mesh_vertices`` … describe the latest)."""
         self.preview_serial = 0
@@ -734,7 +734,6 @@ IoU is lowest when a box edge is on the silhouette.
                 return
             self.params = dataclasses.replace(self.params, editor=field, shape_source="editor")
             self.editor_error = None
-            self.editor_serial += 1
             with self._state:  # an older field asked for while this one compiled (Shape turned away and back)
                 if isinstance(self._wanted_scene, EditorField):
                     self._wanted_scene = None
@@ -756,6 +755,8 @@ IoU is lowest when a box edge is on the silhouette.
             if times is not None:
                 per_pixel = times.frame_s / (MOVING_WIDTH_PX * editor.trial_height(MOVING_WIDTH_PX))
                 self._trial_cost = (field, per_pixel)
+        with self._lock:
+            self.editor_serial += 1
 
     def _turned_away(self, choice: int) -> bool:
         """Whether the Shape menu turned away from the editor since an Apply asked at ``choice`` (see

@@ -1121,14 +1121,27 @@ def _framed_tab(
 @pytest.mark.gl
 @AT_BOTH_WINDOWS
 def test_a_field_applied_out_of_the_picture_is_brought_into_it_and_one_in_it_leaves_the_view(
-    server: viser.ViserServer, scene: SdfGalleryScene, size: tuple[int, int]
+    server: viser.ViserServer, scene: SdfGalleryScene, size: tuple[int, int], monkeypatch: pytest.MonkeyPatch
 ) -> None:
     # The failing input (an outside tester): a sphere at x = 1 m applied in the editor stayed half under the panel,
     # its bottom at the window's edge; the view was framed only when the tab opened.
+    # An apply counts once its view is framed: a slow framing (a loaded machine; here a 0.3 s pause) must not let the
+    # count run ahead of it, or the person's view read after the count is moved under them (once, in CI).
+    keep_in_view = scene.framing.keep_in_view
+
+    def slow_keep_in_view(points: np.ndarray, *, clear_of_notice: bool = True) -> None:
+        time.sleep(0.3)
+        keep_in_view(points, clear_of_notice=clear_of_notice)
+
+    monkeypatch.setattr(scene.framing, "keep_in_view", slow_keep_in_view)
     with BrowserClient(server.get_port()) as client:
         _tab, lens, view = _framed_tab(server, scene, client, size)
+        opened = scene.framing.frames
         apply_glsl(client, "float sdf(vec3 p) { return length(p - vec3(1.0, 0.0, 0.0)) - 0.4; }\n")
         wait_until(lambda: scene.editor_serial == 1, "the apply", timeout_s=60.0)
+        # Counted only once framed: a view read now is whole (read between the position's write and the look-at
+        # point's, it kept the old look-at point, and the person's view sent back from it was moved on).
+        assert scene.framing.frames > opened
         box = box_corners(scene.mesh_vertices.min(axis=0), scene.mesh_vertices.max(axis=0))
         wait_until(lambda: shows(view(), lens, box, clear_of_notice=False), "the sphere in the picture", timeout_s=10.0)
         # A field that is already in the picture keeps the person's view.
