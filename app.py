@@ -224,8 +224,7 @@ def main(
     scene: SceneName = "peloton",
     host: str = "127.0.0.1",
     port: Annotated[
-        int | None,
-        tyro.conf.arg(metavar="INT", help_behavior_hint="(default: 8080, or the next free port)"),
+        int | None, tyro.conf.arg(metavar="INT", help_behavior_hint="(default: 8080, or the next free port)")
     ] = None,
     allow_remote_glsl: bool = False,
     shared: bool = False,

@@ -23,15 +23,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from bench._timing import p95, timings  # noqa: E402
-from scenes._framing import (  # noqa: E402
-    FULL_NDC,
-    NEAR_M,
-    Lens,
-    Sight,
-    View,
-    box_corners,
-    frame_points,
-)
+from scenes._framing import FULL_NDC, NEAR_M, Lens, Sight, View, box_corners, frame_points  # noqa: E402
 
 
 def baseline_frame_points(

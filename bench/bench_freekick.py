@@ -87,11 +87,7 @@ def kernel_rows() -> None:
             ).position[-1],
             200,
         ),
-        (
-            "scipy DOP853 rtol=atol=1e-12 (reference)",
-            lambda: scipy_flight("DOP853", 1e-12, 1e-12),
-            10,
-        ),
+        ("scipy DOP853 rtol=atol=1e-12 (reference)", lambda: scipy_flight("DOP853", 1e-12, 1e-12), 10),
         ("scipy RK45 default tolerances", lambda: scipy_flight("RK45", 1e-3, 1e-6), 30),
         ("scipy DOP853 rtol=1e-8, atol=1e-10", lambda: scipy_flight("DOP853", 1e-8, 1e-10), 30),
     ]
@@ -156,29 +152,11 @@ def scene_rows() -> None:
             client.wait_for(lambda done=done: len(handling) > done, what="the callback")
             time.sleep(0.02)
         euler_speed = handling[len(constant) + len(measured) + len(euler) :]
-    row(
-        "spin slider -> recompute + redraw (server)",
-        constant,
-        1e-3,
-        "ms",
-        "constant model; goal p95 <= 16 ms",
-    )
+    row("spin slider -> recompute + redraw (server)", constant, 1e-3, "ms", "constant model; goal p95 <= 16 ms")
     row("  same, measured model", measured, 1e-3, "ms", "goal p95 <= 16 ms")
     row("  same, measured model, Euler 1 ms", euler, 1e-3, "ms", "goal p95 <= 16 ms")
-    row(
-        "speed slider, measured model, Euler 1 ms",
-        euler_speed,
-        1e-3,
-        "ms",
-        "ghost re-flown too; goal p95 <= 16 ms",
-    )
-    row(
-        "spin slider message -> new path at client",
-        round_trips,
-        1e-3,
-        "ms",
-        "measured model, websocket client",
-    )
+    row("speed slider, measured model, Euler 1 ms", euler_speed, 1e-3, "ms", "ghost re-flown too; goal p95 <= 16 ms")
+    row("spin slider message -> new path at client", round_trips, 1e-3, "ms", "measured model, websocket client")
 
     map_times = timings(lambda: (scene.request_outcome_map(), scene.wait_idle()), 3)
     row(
@@ -239,10 +217,7 @@ def numpy_flight(method: str, dt: float, x_stop: float) -> NDArray[np.float64]:
 
 
 def numpy_batch(
-    starts: NDArray[np.float64],
-    velocities: NDArray[np.float64],
-    spins: NDArray[np.float64],
-    x_stop: float,
+    starts: NDArray[np.float64], velocities: NDArray[np.float64], spins: NDArray[np.float64], x_stop: float
 ) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
     """RK4 10 ms over all kicks at once in plain numpy until each lands or passes x_stop: (T, K, 6), samples."""
     dt = 1e-2
@@ -383,25 +358,13 @@ def goal_rows() -> None:
     )
     for method, dt, goal, repeat, label in kicks:
         compiled = timings(
-            lambda method=method, dt=dt: ball.simulate(
-                START,
-                VELOCITY,
-                SPIN,
-                dt=dt,
-                method=method,
-                x_stop=LINE_M,
-            ),
+            lambda method=method, dt=dt: ball.simulate(START, VELOCITY, SPIN, dt=dt, method=method, x_stop=LINE_M),
             repeat,
         )
         plain = timings(lambda method=method, dt=dt: numpy_flight(method, dt, LINE_M), 20)
         ratio = statistics.median(plain) / statistics.median(compiled)
         goal_row(
-            label,
-            compiled,
-            1e-6,
-            "µs",
-            goal,
-            f"{ratio:.0f}x plain numpy ({statistics.median(plain) * 1e3:.1f} ms)",
+            label, compiled, 1e-6, "µs", goal, f"{ratio:.0f}x plain numpy ({statistics.median(plain) * 1e3:.1f} ms)"
         )
 
     starts, velocities, spins = batch_kicks()

@@ -104,10 +104,7 @@ def main() -> None:
     powers = rng.uniform(0.0, 800.0, 100_000)
     grades = rng.uniform(-0.1, 0.15, 100_000)
     winds = rng.uniform(-10.0, 10.0, 100_000)
-    inverse = timings(
-        lambda: cycling.speed_for_power(powers, 0.3, 80.0, 0.004, grade=grades, headwind_ms=winds),
-        7,
-    )
+    inverse = timings(lambda: cycling.speed_for_power(powers, 0.3, 80.0, 0.004, grade=grades, headwind_ms=winds), 7)
     row(
         "speed_for_power, 10^5 (grade, wind mixed)",
         inverse,

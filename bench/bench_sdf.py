@@ -89,11 +89,7 @@ def bench_mesh(repeats: int) -> list[str]:
     near = times_ms(lambda: sdf.mesh(scene, 161, bounds), repeats)
     same = all(
         np.array_equal(a, b)
-        for a, b in zip(
-            sdf.mesh(scene, 161, bounds),
-            sdf.mesh(scene, 161, bounds, near_surface=False),
-            strict=True,
-        )
+        for a, b in zip(sdf.mesh(scene, 161, bounds), sdf.mesh(scene, 161, bounds, near_surface=False), strict=True)
     )
     evaluated = sdf.sample_near_surface(scene, grid).evaluated
     ratio = statistics.median(full) / statistics.median(near)
@@ -120,10 +116,7 @@ def _bench_reference(renderer: Renderer, repeats: int) -> list[str]:
     scene = sdf.default_scene()
     camera = Camera(SdfGalleryScene.camera_position, SdfGalleryScene.camera_look_at)
     rows = []
-    for label, shading in [
-        ("full shading", Shading()),
-        ("no shadows, no AO", Shading(shadows=False, occlusion=False)),
-    ]:
+    for label, shading in [("full shading", Shading()), ("no shadows, no AO", Shading(shadows=False, occlusion=False))]:
         cpu_start = time.process_time()
         t = times_ms(lambda shading=shading: renderer.render(scene, camera, 512, 512, shading), repeats)
         cpu_ms = 1e3 * (time.process_time() - cpu_start) / (repeats + 1)  # llvmpipe's threads are ours
@@ -232,10 +225,7 @@ def bench_view(repeats: int) -> list[str]:
     rows = []
     try:
         for label, march in [
-            (
-                "default scene",
-                lambda gl, w, h, shading: gl.render(sdf.default_scene(), camera, w, h, shading),
-            ),
+            ("default scene", lambda gl, w, h, shading: gl.render(sdf.default_scene(), camera, w, h, shading)),
             (
                 "editor example 1",
                 lambda gl, w, h, shading: gl.render_field(BLEND_EXAMPLE, EDITOR_BOUNDS, camera, w, h, shading),
@@ -277,9 +267,7 @@ def bench_edit(edits: int) -> list[str]:
     try:
         with BrowserClient(server.get_port()) as client:
             client.send_camera(
-                position=SdfGalleryScene.camera_position,
-                look_at=SdfGalleryScene.camera_look_at,
-                size=(400, 640),
+                position=SdfGalleryScene.camera_position, look_at=SdfGalleryScene.camera_look_at, size=(400, 640)
             )
             client.wait_for_gui("Apply")
             client.set_value("View", "Both")

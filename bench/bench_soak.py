@@ -105,11 +105,7 @@ def run_client(port: int, scene: str, rate: float, seconds: float, index: int, b
             else:
                 name, radius = GIZMOS[scene]
                 x, y, z = centre
-                last = (
-                    round(x + radius * math.cos(phase), 4),
-                    y,
-                    round(z + radius * math.sin(phase), 4),
-                )
+                last = (round(x + radius * math.cos(phase), 4), y, round(z + radius * math.sin(phase), 4))
                 client.drag_transform_step(name, last, owner)
             if last != previous:  # a repeated value changes nothing: no update follows it, so it is not timed
                 sends.append(time.monotonic())
@@ -212,15 +208,7 @@ def soak(mode: str, scene: str, clients: int, rate: float, seconds: float) -> di
         try:
             browsers = [  # results go to files: a pipe would fill (64 KiB) and block the browser before it exits
                 subprocess.Popen(
-                    [
-                        sys.executable,
-                        __file__,
-                        "--client",
-                        str(port),
-                        scene,
-                        str(rate),
-                        str(seconds),
-                    ]
+                    [sys.executable, __file__, "--client", str(port), scene, str(rate), str(seconds)]
                     + [str(i), str(out), str(barrier)],
                     cwd=ROOT,
                     stdout=subprocess.DEVNULL,
@@ -376,12 +364,7 @@ def main() -> None:
     parser.add_argument("--clients", type=int, default=8)
     parser.add_argument("--rate", type=float, default=30.0, help="messages per second per browser")
     parser.add_argument("--seconds", type=float, default=60.0, help="per scene and mode")
-    parser.add_argument(
-        "--scenes",
-        nargs="+",
-        default=["peloton", "arm", "freekick", "sdf"],
-        choices=list(GOAL_P95_MS),
-    )
+    parser.add_argument("--scenes", nargs="+", default=["peloton", "arm", "freekick", "sdf"], choices=list(GOAL_P95_MS))
     parser.add_argument("--modes", nargs="+", default=["session", "shared"], choices=["session", "shared"])
     args = parser.parse_args()
     started = time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())

@@ -91,8 +91,5 @@ def drop_stale_cache(root: Path) -> bool:
     except OSError:
         return False
     if dropped:
-        logger.info(
-            "kernel sources changed: dropped %d cached numba files; they compile again on first use",
-            dropped,
-        )
+        logger.info("kernel sources changed: dropped %d cached numba files; they compile again on first use", dropped)
     return dropped > 0

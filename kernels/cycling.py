@@ -664,14 +664,7 @@ def _group_power(
     _check_model_domain(cda, mass, friction, altitude, wind, speed, function)
     drag = drag_fraction()
     return _power(
-        np.full(drag.shape, speed),
-        _positive("cda_m2", cda) * drag,
-        mass,
-        friction,
-        slope,
-        altitude,
-        wind,
-        efficiency,
+        np.full(drag.shape, speed), _positive("cda_m2", cda) * drag, mass, friction, slope, altitude, wind, efficiency
     )
 
 

@@ -149,12 +149,7 @@ class Scene(abc.ABC, Generic[P]):
     ) -> viser.NotificationHandle:
         """Show tab ``client`` a notification about this scene; it goes when the scene closes (a red "GPX not
         loaded" stood over the free kick for the rest of its 15 s), or earlier by :meth:`take_down`."""
-        notice = client.add_notification(
-            title,
-            body,
-            color=color,
-            auto_close_seconds=auto_close_seconds,
-        )
+        notice = client.add_notification(title, body, color=color, auto_close_seconds=auto_close_seconds)
         now = time.monotonic()
         with self._lock:
             closed = self.closed
@@ -278,11 +273,7 @@ class Scene(abc.ABC, Generic[P]):
                     with TURNS.turn():
                         func()
                 except Exception:
-                    logger.exception(
-                        "%s: callback %s failed; keeping the last good state",
-                        self.key,
-                        _describe(func),
-                    )
+                    logger.exception("%s: callback %s failed; keeping the last good state", self.key, _describe(func))
                 finally:
                     self._in_callback = False
 

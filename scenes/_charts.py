@@ -226,9 +226,7 @@ def fit_x_scale(data: Sequence[np.ndarray], scales: Mapping[str, Mapping[str, An
 
 
 def fit_scales(
-    data: Sequence[np.ndarray],
-    series: Sequence[Mapping[str, Any]],
-    scales: Mapping[str, Mapping[str, Any]],
+    data: Sequence[np.ndarray], series: Sequence[Mapping[str, Any]], scales: Mapping[str, Mapping[str, Any]]
 ) -> dict[str, viser.uplot.Scale]:
     """:func:`fit_x_scale`, and each log y scale whose data reach below 10⁻³ pinned to its decade ticks'
     range (:func:`log_ticks`), so the fixed ticks :func:`fit_layout` gives its axis span the plot."""
@@ -343,12 +341,7 @@ class FittedChart:
         self._series, self._scales, self._axes = series, scales, axes
         fitted, padding = fit_layout(data, series, scales, axes)
         self.handle = gui.add_uplot(
-            data=data,
-            series=series,
-            scales=fit_scales(data, series, scales),
-            axes=fitted,
-            padding=padding,
-            **kwargs,
+            data=data, series=series, scales=fit_scales(data, series, scales), axes=fitted, padding=padding, **kwargs
         )
         """The viser handle underneath."""
 

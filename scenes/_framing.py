@@ -70,12 +70,7 @@ class Lens:
         width, height = max(self.width_px, 1), max(self.height_px, 1)
         panel = PANEL_PX if width > 2.0 * PANEL_PX else 0.0
         mx, my = 2.0 * MARGIN_PX / width, 2.0 * MARGIN_PX / height
-        return (
-            -1.0 + mx,
-            1.0 - 2.0 * (panel + right_px) / width - mx,
-            -1.0 + my,
-            1.0 - 2.0 * top_px / height - my,
-        )
+        return (-1.0 + mx, 1.0 - 2.0 * (panel + right_px) / width - mx, -1.0 + my, 1.0 - 2.0 * top_px / height - my)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -172,9 +167,7 @@ def frame_points(
     # k positive); it is never over `far`, beyond which the rectangle counts as unable to hold the points.
     far = depth_extent + least_depth + 1000.0 * (size + 1.0)
     distance = max(
-        least_depth - float(np.min(w)),
-        _least_distance(u, w, tan_x, x0, x1),
-        _least_distance(v, w, tan_y, y0, y1),
+        least_depth - float(np.min(w)), _least_distance(u, w, tan_x, x0, x1), _least_distance(v, w, tan_y, y0, y1)
     )
     # Also NaN: the rectangle is empty, or too small to hold the points from `far`.
     if not distance <= far:
@@ -335,11 +328,7 @@ class ClientFraming:
     person orbiting does not stop at exactly that pose.
     """
 
-    def __init__(
-        self,
-        view_for: Callable[[Lens], View],
-        opening: tuple[float, float, float] | None = None,
-    ) -> None:
+    def __init__(self, view_for: Callable[[Lens], View], opening: tuple[float, float, float] | None = None) -> None:
         self._view_for = view_for
         self._opening = None if opening is None else np.asarray(opening, dtype=np.float64)
         self._lock = threading.Lock()

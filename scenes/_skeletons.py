@@ -48,15 +48,7 @@ MARKER_RADIUS_M = 0.6 * JOINT_RADIUS_M
 """Radius of the coloured ball at each target (m): smaller than an end's, so an effector on its target shows."""
 AXIS_HALF_LENGTH_M = 0.05
 CHAIN_COLOURS = np.array(
-    [
-        (70, 110, 200),
-        (200, 120, 40),
-        (60, 160, 90),
-        (160, 70, 170),
-        (40, 160, 170),
-        (120, 120, 130),
-    ],
-    dtype=np.uint8,
+    [(70, 110, 200), (200, 120, 40), (60, 160, 90), (160, 70, 170), (40, 160, 170), (120, 120, 130)], dtype=np.uint8
 )
 """Link colour of chain 0, 1, …; the last is the palm and trunk."""
 LIMIT_RAMP = np.array([(60, 200, 90), (250, 200, 40), (230, 50, 50)], dtype=np.float64)
@@ -275,11 +267,7 @@ def gizmo_scale(skeleton: Skeleton) -> float:
     return float(min(GIZMO_SCALE_M, 0.4 * least))
 
 
-PRESETS: dict[PresetLabel, Callable[[], Skeleton]] = {
-    "Robot arm": robot_arm,
-    "Hand": hand,
-    "Upper body": upper_body,
-}
+PRESETS: dict[PresetLabel, Callable[[], Skeleton]] = {"Robot arm": robot_arm, "Hand": hand, "Upper body": upper_body}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -554,11 +542,7 @@ class SkeletonView:
         if sk is None:
             return
         report = solve_skeleton(
-            sk,
-            self.pose,
-            self.targets,
-            tolerance_m=sk.tolerance_mm / 1000.0,
-            max_iterations=sk.max_iterations,
+            sk, self.pose, self.targets, tolerance_m=sk.tolerance_mm / 1000.0, max_iterations=sk.max_iterations
         )
         self.pose = report.result.joints
         self.report = report
@@ -566,9 +550,7 @@ class SkeletonView:
         self._draw(sk, report)
 
     def _draw(self, sk: Skeleton, report: SkeletonReport) -> None:
-        from scenes.arm import (
-            segment_pose,
-        )  # the chain's own segment geometry (imported late: arm imports us)
+        from scenes.arm import segment_pose  # the chain's own segment geometry (imported late: arm imports us)
 
         joints = report.result.joints
         count = len(sk.parents)

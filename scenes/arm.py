@@ -49,11 +49,7 @@ LINK_RADIUS_M = 0.018
 JOINT_RADIUS_M = 0.03
 
 SolverLabel = Literal["FABRIK", "CCD", "Jacobian DLS"]
-SOLVER_FROM_LABEL: dict[SolverLabel, fabrik.Solver] = {
-    "FABRIK": "fabrik",
-    "CCD": "ccd",
-    "Jacobian DLS": "jacobian_dls",
-}
+SOLVER_FROM_LABEL: dict[SolverLabel, fabrik.Solver] = {"FABRIK": "fabrik", "CCD": "ccd", "Jacobian DLS": "jacobian_dls"}
 
 REST_COLOUR = (205, 210, 220)
 GHOST_COLOUR = (120, 190, 255)
@@ -86,8 +82,7 @@ class ArmParams:
     limits: bool = field(default=False, metadata=checkbox("Joint limits", folder="Joint limits"))
     """Whether joint limits (cones) apply."""
     half_angle_deg: float = field(
-        default=45.0,
-        metadata=slider("Cone half-angle (°)", 0.0, 180.0, 1.0, folder="Joint limits"),
+        default=45.0, metadata=slider("Cone half-angle (°)", 0.0, 180.0, 1.0, folder="Joint limits")
     )
     """Cone half-angle of every joint (degrees)."""
     avoid: bool = field(default=True, metadata=checkbox("Avoid obstacles", folder="Obstacles"))
@@ -95,8 +90,7 @@ class ArmParams:
     n_obstacles: int = field(default=1, metadata=slider("Obstacles", 0, MAX_OBSTACLES, 1, folder="Obstacles"))
     """Obstacles shown (0–4)."""
     radii_m: tuple[float, ...] = field(
-        default=(0.18, 0.15, 0.12, 0.2),
-        metadata=slider("Obstacle {n} radius (m)", 0.03, 0.6, 0.01, folder="Obstacles"),
+        default=(0.18, 0.15, 0.12, 0.2), metadata=slider("Obstacle {n} radius (m)", 0.03, 0.6, 0.01, folder="Obstacles")
     )
     """Radius of each obstacle (m): one slider each."""
     solver: SolverLabel = field(
@@ -421,10 +415,7 @@ def why_restarted(params: ArmParams, report: SolveReport, obstacle_centres: NDAr
 
 
 def why_short(
-    params: ArmParams,
-    report: SolveReport,
-    target: NDArray[np.float64],
-    obstacle_centres: NDArray[np.float64],
+    params: ArmParams, report: SolveReport, target: NDArray[np.float64], obstacle_centres: NDArray[np.float64]
 ) -> str:
     """In words, why the returned pose's end is not on the target ("" when it is, within the tolerance): the reach,
     the obstacle the chain rests against or the target is in, the joints held at their limit, the iteration cap."""
@@ -518,10 +509,7 @@ def box_points() -> NDArray[np.float64]:
 
 
 def framed_points(
-    params: ArmParams,
-    pose: NDArray[np.float64],
-    target: NDArray[np.float64],
-    obstacle_centres: NDArray[np.float64],
+    params: ArmParams, pose: NDArray[np.float64], target: NDArray[np.float64], obstacle_centres: NDArray[np.float64]
 ) -> NDArray[np.float64]:
     """(N, 3) world points (m) the camera must show: what matters now, not the chain's whole reach.
 
@@ -847,11 +835,7 @@ is a static pose.
         if p.three_d != last.three_d:
             self._set_mode(p.three_d)
         self.solve_and_draw()
-        if (p.three_d, p.n_links, p.link_length_m) != (
-            last.three_d,
-            last.n_links,
-            last.link_length_m,
-        ):
+        if (p.three_d, p.n_links, p.link_length_m) != (last.three_d, last.n_links, last.link_length_m):
             self.framing.reframe()
         else:
             self._reframe_if_outgrown()

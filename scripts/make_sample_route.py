@@ -24,14 +24,7 @@ sys.path.insert(0, str(ROOT))
 
 from kernels.course import SAMPLE_ROUTE  # noqa: E402
 
-SECTIONS_KM_GRADE = [
-    (2.5, 0.102),
-    (1.0, 0.080),
-    (1.0, 0.100),
-    (2.6, 0.085),
-    (4.1, 0.075),
-    (2.0, 0.054),
-]
+SECTIONS_KM_GRADE = [(2.5, 0.102), (1.0, 0.080), (1.0, 0.100), (2.6, 0.085), (4.1, 0.075), (2.0, 0.054)]
 START_ELEVATION_M = 744.0
 START_LAT, START_LON = 45.0560, 6.0300
 LEGS, HAIRPIN_RADIUS_M, STEP_M = 22, 15.0, 20.0

@@ -69,14 +69,7 @@ def camera_fields(message: messages.ViewerCameraMessage) -> tuple[dict[str, Any]
     assert up is not None
     if math.hypot(*up) == 0.0:
         return None, "up_direction"
-    return {
-        "wxyz": wxyz,
-        **points,
-        "fov": fov,
-        "near": near,
-        "far": far,
-        **sizes,
-    }, ""
+    return {"wxyz": wxyz, **points, "fov": fov, "near": near, "far": far, **sizes}, ""
 
 
 def _ray(origin: object, direction: object) -> bool:

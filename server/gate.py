@@ -165,13 +165,7 @@ class Gate:
             after()
 
     # ----------------------------------------------------------------------------------------- costly inputs
-    def _admit(
-        self,
-        server: viser.ViserServer,
-        client_id: int,
-        message: Any,
-        after: Callable[[], None] | None,
-    ) -> bool:
+    def _admit(self, server: viser.ViserServer, client_id: int, message: Any, after: Callable[[], None] | None) -> bool:
         """Whether ``message`` goes through now; a costly input beyond the tab's budget is held back instead, and
         so is any input of that tab behind it (in line, free of the budget): a cheap edit or a drag that follows a
         held-back Reset or scene switch would otherwise be applied first and then undone by it."""
@@ -641,10 +635,7 @@ class Gate:
         return viser_compat.gizmo_by_name(server, client_id, name, owner)
 
     def _clean_gizmo(
-        self,
-        server: viser.ViserServer,
-        client_id: int,
-        message: messages.TransformControlsUpdateMessage,
+        self, server: viser.ViserServer, client_id: int, message: messages.TransformControlsUpdateMessage
     ) -> tuple[Any, Callable[[], None] | None]:
         handle = self._gizmo_handle(server, client_id, str(message.name), str(message.owner))
         if handle is None:
@@ -657,10 +648,7 @@ class Gate:
         if position is None:
             self.log.refuse("gizmo position (not 3 finite numbers)", f"{message.position!r}"[:200])
         if wxyz is None:
-            self.log.refuse(
-                "gizmo orientation (not 4 finite numbers with a non-zero norm)",
-                f"{message.wxyz!r}"[:200],
-            )
+            self.log.refuse("gizmo orientation (not 4 finite numbers with a non-zero norm)", f"{message.wxyz!r}"[:200])
         last_position = tuple(float(v) for v in handle.position)
         last_wxyz = tuple(float(v) for v in handle.wxyz)
         cleaned = dataclasses.replace(

@@ -22,9 +22,7 @@ from server.sessions import Session
 logger = logging.getLogger(__name__)
 
 
-def _in_a_thread(
-    handler: Callable[[object], None],
-) -> Callable[[object], Coroutine[Any, Any, None]]:
+def _in_a_thread(handler: Callable[[object], None]) -> Callable[[object], Coroutine[Any, Any, None]]:
     """``handler`` as a coroutine function that runs it on the event loop's worker threads and returns when done."""
 
     async def run(event: object) -> None:
@@ -58,10 +56,7 @@ class SceneSwitcher:
             # Both rebuild a scene: costly inputs, budgeted per tab at the gate (a burst of Resets is one Reset).
             self.dropdown = mark_costly(
                 session.gui.add_dropdown(
-                    "Scene",
-                    options=tuple(titles),
-                    initial_value=SCENES[initial].title,
-                    order=-100.0,
+                    "Scene", options=tuple(titles), initial_value=SCENES[initial].title, order=-100.0
                 )
             )
             self.reset_button = mark_costly(session.gui.add_button("Reset scene to defaults", order=-99.0))

@@ -473,8 +473,7 @@ def check_source(source: object) -> str:
             raise ShaderCompileError(f"character {_checks.shown(bad)} is not allowed (printable ASCII only)", number)
         if "\\" in line:
             raise ShaderCompileError(
-                "backslashes are not allowed (a backslash at a line's end joins it to the next)",
-                number,
+                "backslashes are not allowed (a backslash at a line's end joins it to the next)", number
             )
         code = line.split("//", 1)[0]
         if "#" in code:

@@ -82,9 +82,7 @@ class GLUnavailableError(RuntimeError):
     """No OpenGL 3.3 context could be created; the mesh side of the app keeps working without one."""
 
 
-def _bounding_boxes(
-    scene: sdf.Scene,
-) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+def _bounding_boxes(scene: sdf.Scene) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """Oriented boxes whose union holds the scene: (P, 3) centres, (P, 3, 3) local-to-world rotations, (P, 3) half
     extents (m).
 
@@ -217,8 +215,7 @@ class Renderer:
         for shadows, occlusion in ((True, True), (False, False)):  # the gallery's opening variants
             self._raymarch_program((shadows, occlusion, True, False))
         self._probe = self.ctx.program(
-            vertex_shader=fullscreen,
-            fragment_shader=with_defines(read_source("probe.frag"), EXTRA_KINDS=1),
+            vertex_shader=fullscreen, fragment_shader=with_defines(read_source("probe.frag"), EXTRA_KINDS=1)
         )
         self._mesh = self.ctx.program(vertex_shader=read_source("mesh.vert"), fragment_shader=read_source("mesh.frag"))
         self._edges = self.ctx.program(
@@ -269,11 +266,7 @@ class Renderer:
     def _set_scene(self, program: object, scene: sdf.Scene) -> None:
         n = sdf.MAX_PRIMITIVES
         kind, op = np.zeros(n, np.int32), np.zeros(n, np.int32)
-        center, size, color = (
-            np.zeros((n, 3), np.float32),
-            np.zeros((n, 3), np.float32),
-            np.zeros((n, 3), np.float32),
-        )
+        center, size, color = (np.zeros((n, 3), np.float32), np.zeros((n, 3), np.float32), np.zeros((n, 3), np.float32))
         rotation = np.tile(np.eye(3, dtype=np.float32), (n, 1, 1))
         for i, prim in enumerate(scene.primitives):
             kind[i], op[i] = sdf.primitive_spec(prim.kind).code, OP_CODE[prim.op]
@@ -352,12 +345,7 @@ class Renderer:
 
     # ------------------------------------------------------------------------------------- passes
     def render(
-        self,
-        scene: sdf.Scene,
-        camera: Camera,
-        width: int,
-        height: int,
-        shading: Shading | None = None,
+        self, scene: sdf.Scene, camera: Camera, width: int, height: int, shading: Shading | None = None
     ) -> tuple[NDArray[np.uint8], NDArray[np.float32]]:
         """Ray-march the scene.
 
@@ -622,11 +610,7 @@ class Renderer:
         else:
             _, shadows, occlusion = variant.split(":")
             template = with_defines(
-                self._raymarch_source,
-                USER_FIELD=1,
-                SHADOWS=int(shadows),
-                OCCLUSION=int(occlusion),
-                POLY_BLEND_ONLY=1,
+                self._raymarch_source, USER_FIELD=1, SHADOWS=int(shadows), OCCLUSION=int(occlusion), POLY_BLEND_ONLY=1
             )
         try:
             prog = self.ctx.program(vertex_shader=self._fullscreen, fragment_shader=template + user_glsl(source))
@@ -722,13 +706,7 @@ class Renderer:
         return np.ascontiguousarray(out.transpose(2, 1, 0))
 
     def render_field(
-        self,
-        source: str,
-        bounds: ArrayLike,
-        camera: Camera,
-        width: int,
-        height: int,
-        shading: Shading | None = None,
+        self, source: str, bounds: ArrayLike, camera: Camera, width: int, height: int, shading: Shading | None = None
     ) -> tuple[NDArray[np.uint8], NDArray[np.float32]]:
         """Ray-march the editor's field inside ``bounds`` ((2, 3) min and max corners, m), as :meth:`render` does.
 

@@ -118,8 +118,7 @@ def trial(
         raise ShaderCompileError(answer["compile_error"], answer.get("line"))
     if "compile_s" not in answer:
         raise ShaderCompileError(
-            "the GLSL trial process ended without an answer (the driver may have crashed on this source)",
-            None,
+            "the GLSL trial process ended without an answer (the driver may have crashed on this source)", None
         )
     times = TrialTimes(float(answer["compile_s"]), float(answer["frame_s"]))
     if times.compile_s > compile_limit_s:
@@ -164,14 +163,7 @@ def _child() -> None:
             gl.compile_field(request["source"], shading)
         compile_s = time.perf_counter() - start
         start = time.perf_counter()
-        gl.render_field(
-            request["source"],
-            request["bounds"],
-            camera,
-            request["width"],
-            request["height"],
-            shadings[0],
-        )
+        gl.render_field(request["source"], request["bounds"], camera, request["width"], request["height"], shadings[0])
         frame_s = time.perf_counter() - start
     except ShaderCompileError as exc:
         _say(json.dumps({"compile_error": exc.reason, "line": exc.line}))

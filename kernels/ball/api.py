@@ -373,12 +373,7 @@ class KeeperPath:
 
 
 def keeper_path(
-    keeper: Keeper,
-    position_xy: ArrayLike,
-    dive: KeeperDive | None,
-    times: ArrayLike,
-    *,
-    turf_m: float = 0.0,
+    keeper: Keeper, position_xy: ArrayLike, dive: KeeperDive | None, times: ArrayLike, *, turf_m: float = 0.0
 ) -> KeeperPath:
     """Where ``keeper``, standing at ``position_xy`` (m) on turf at height ``turf_m``, is at each of ``times`` (s since
     the kick), after ``dive`` (a flight's :attr:`Trajectory.keeper_dive`; None: he stands). The flight's own compiled
@@ -776,11 +771,7 @@ def outcome_batch(batch: BatchTrajectory, wall: Panel, goal: Panel, *, radius_m:
             "are batch.result; outcome_batch() judges free flights"
         )
     k = len(batch.n_samples)
-    results, crossings, panels = (
-        np.empty(k, dtype=np.int64),
-        np.empty((k, 2, 4)),
-        panel_rows(wall, goal),
-    )
+    results, crossings, panels = (np.empty(k, dtype=np.int64), np.empty((k, 2, 4)), panel_rows(wall, goal))
     run_rows(
         judge_rows, k, batch.t, batch.position, batch.velocity, batch.n_samples, panels, radius, results, crossings
     )
@@ -789,9 +780,7 @@ def outcome_batch(batch: BatchTrajectory, wall: Panel, goal: Panel, *, radius_m:
 
 def _batch_outcome(results: NDArray[np.int64], crossings: NDArray[np.float64]) -> BatchOutcome:
     return BatchOutcome(
-        result=np.array(RESULTS, dtype="<U5")[results],
-        wall_point=crossings[:, 0, 1:],
-        goal_point=crossings[:, 1, 1:],
+        result=np.array(RESULTS, dtype="<U5")[results], wall_point=crossings[:, 0, 1:], goal_point=crossings[:, 1, 1:]
     )
 
 
@@ -877,11 +866,7 @@ def launch_velocity(speed_ms: float, elevation_rad: float, azimuth_rad: float) -
     elevation = _checks.finite_number("elevation_rad", elevation_rad)
     azimuth = _checks.finite_number("azimuth_rad", azimuth_rad)
     return speed * np.array(
-        [
-            math.cos(elevation) * math.cos(azimuth),
-            math.cos(elevation) * math.sin(azimuth),
-            math.sin(elevation),
-        ]
+        [math.cos(elevation) * math.cos(azimuth), math.cos(elevation) * math.sin(azimuth), math.sin(elevation)]
     )
 
 

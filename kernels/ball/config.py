@@ -285,10 +285,7 @@ def launch_rows(
 
 
 def kick_rows(
-    positions: ArrayLike,
-    velocities: ArrayLike,
-    spins: ArrayLike,
-    knuckle_seeds: Sequence[int | None] | None,
+    positions: ArrayLike, velocities: ArrayLike, spins: ArrayLike, knuckle_seeds: Sequence[int | None] | None
 ) -> NDArray[np.float64]:
     """Validated kicks of a batch as (K, 13) launch rows (see :func:`launch_rows`)."""
     p0, v0, w0 = (

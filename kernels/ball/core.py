@@ -310,12 +310,7 @@ def _plane_crossing(t, position, velocity, n, panel, crossing):
             s = crossing_fraction(-d0, -dd0, -d1, -dd1, h)
             crossing[0] = t[i] + s * h
             for c in range(3):
-                p0, v0, p1, v1 = (
-                    position[i, c],
-                    velocity[i, c],
-                    position[i + 1, c],
-                    velocity[i + 1, c],
-                )
+                p0, v0, p1, v1 = (position[i, c], velocity[i, c], position[i + 1, c], velocity[i + 1, c])
                 crossing[1 + c], _ = _hermite(p0, v0, p1, v1, h, s)
             return
 

@@ -16,15 +16,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from kernels import _checks
 from kernels.ball import aero, contact
-from kernels.ball.config import (
-    BALL_RADIUS_M,
-    MEASURED,
-    RADIUS,
-    Model,
-    checked_vector,
-    flight_config,
-    refuse_fast_spin,
-)
+from kernels.ball.config import BALL_RADIUS_M, MEASURED, RADIUS, Model, checked_vector, flight_config, refuse_fast_spin
 from kernels.warming import Entry
 
 # The compiled cores called from here: plain Python while the app's first start compiles them (kernels.warming).

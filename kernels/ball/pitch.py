@@ -90,10 +90,7 @@ def free_kick_panels(
         _panel_size("wall_height_m", wall_height_m),
     )
     goal = Panel(
-        (float(centre[0]), float(centre[1])),
-        (float(normal[0]), float(normal[1])),
-        GOAL_WIDTH_M,
-        GOAL_HEIGHT_M,
+        (float(centre[0]), float(centre[1])), (float(normal[0]), float(normal[1])), GOAL_WIDTH_M, GOAL_HEIGHT_M
     )
     return wall, goal
 

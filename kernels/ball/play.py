@@ -36,16 +36,7 @@ from kernels.ball.aero import (
     max_stable_step,
     sample_forces,
 )
-from kernels.ball.config import (
-    DT,
-    GRAVITY,
-    GROUND,
-    N_STEPS,
-    RADIUS,
-    RK4,
-    T_MAX,
-    X_STOP,
-)
+from kernels.ball.config import DT, GRAVITY, GROUND, N_STEPS, RADIUS, RK4, T_MAX, X_STOP
 from kernels.ball.contact import N_SURFACE, impact
 from kernels.ball.core import _energy_limit, _hermite, _step, _write_sample, crossing_fraction
 

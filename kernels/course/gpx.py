@@ -215,11 +215,7 @@ def _gpx_error_words(message: str) -> str:
 
 
 def _check_values(
-    label: str,
-    kind: str,
-    lat: NDArray[np.float64],
-    lon: NDArray[np.float64],
-    ele: NDArray[np.float64],
+    label: str, kind: str, lat: NDArray[np.float64], lon: NDArray[np.float64], ele: NDArray[np.float64]
 ) -> None:
     """Refuse a point that is not on the map, in words a rider reads (point numbers from 1, as in the file)."""
     for values, what, low, high, unit in (
@@ -266,11 +262,7 @@ def _pieces(gpx: gpxpy.gpx.GPX, text: str) -> list[_Piece]:
     """
     tracks = [
         [
-            _Piece(
-                "track",
-                f"track {i + 1}" + (f", segment {j + 1}" if len(track.segments) > 1 else ""),
-                seg.points,
-            )
+            _Piece("track", f"track {i + 1}" + (f", segment {j + 1}" if len(track.segments) > 1 else ""), seg.points)
             for j, seg in enumerate(track.segments)
         ]
         for i, track in enumerate(gpx.tracks)

@@ -128,9 +128,7 @@ class Air:
                     / cycling.isa_pressure_hpa(np.clip(self.altitude_m, *cycling.ISA_ALTITUDE_M))
                 )
                 return cycling.air_density_weather(
-                    np.clip(temperature, -60.0, 60.0),
-                    np.clip(pressure, 10.0, 1100.0),
-                    self.relative_humidity,
+                    np.clip(temperature, -60.0, 60.0), np.clip(pressure, 10.0, 1100.0), self.relative_humidity
                 )
 
 

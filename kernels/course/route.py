@@ -199,12 +199,7 @@ def _hysteresis_ascent(z: NDArray[np.float64], threshold: float) -> float:
     keep = np.flatnonzero(step != 0.0)
     turns = keep[1:][direction[1:] != direction[:-1]]
     values = z[np.concatenate(([0], turns, [z.shape[0] - 1]))].tolist()
-    total, low, high, state = (
-        0.0,
-        values[0],
-        values[0],
-        0,
-    )  # state: +1 climbing, -1 descending, 0 not yet known
+    total, low, high, state = (0.0, values[0], values[0], 0)  # state: +1 climbing, -1 descending, 0 not yet known
     for v in values:
         if state > 0:
             if v > high:
@@ -412,8 +407,7 @@ def course_from_points(
     """
     name = _name(name)
     p = _checked_points(
-        name,
-        {"latitude_deg": latitude_deg, "longitude_deg": longitude_deg, "elevation_m": elevation_m},
+        name, {"latitude_deg": latitude_deg, "longitude_deg": longitude_deg, "elevation_m": elevation_m}
     )
     lat, lon = p["latitude_deg"], p["longitude_deg"]
     _check_range(name, "latitude_deg", lat, -90.0, 90.0)
@@ -463,11 +457,7 @@ def azimuthal_equidistant(
 
 
 def course_from_xy(
-    east_m: ArrayLike,
-    north_m: ArrayLike,
-    elevation_m: ArrayLike,
-    name: str = "course",
-    smoothing_m: float = 0.0,
+    east_m: ArrayLike, north_m: ArrayLike, elevation_m: ArrayLike, name: str = "course", smoothing_m: float = 0.0
 ) -> Course:
     """Build a :class:`Course` on a flat map (synthetic routes, tests, benchmarks).
 

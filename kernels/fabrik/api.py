@@ -33,18 +33,9 @@ from kernels.fabrik.chain import (
 )
 from kernels.fabrik.chain import _solve_one as _compiled_solve_one
 from kernels.fabrik.chain import _solve_rows as _compiled_solve_rows
-from kernels.fabrik.geometry import (
-    _LARGEST,
-    _TINY,
-)
+from kernels.fabrik.geometry import _LARGEST, _TINY
 from kernels.fabrik.geometry import _perpendicular as _compiled_perpendicular
-from kernels.fabrik.limits import (
-    _FREE_TABLE,
-    _KIND_CONE,
-    _TABLE_WIDTH,
-    Constraint,
-    _limit_table,
-)
+from kernels.fabrik.limits import _FREE_TABLE, _KIND_CONE, _TABLE_WIDTH, Constraint, _limit_table
 from kernels.fabrik.limits import _limit_flags as _compiled_limit_flags
 from kernels.fabrik.limits import _usage as _compiled_usage
 from kernels.warming import Entry
@@ -319,9 +310,7 @@ def jacobian_dls(
 
 
 def limit_usage(
-    joints: ArrayLike,
-    constraints: Sequence[Constraint],
-    root_direction: ArrayLike | None = None,
+    joints: ArrayLike, constraints: Sequence[Constraint], root_direction: ArrayLike | None = None
 ) -> NDArray[np.float64]:
     """How near each segment is to its joint's limit: 0 free or centred, 1 at the limit.
 
@@ -351,11 +340,7 @@ def limit_usage(
 
 
 def two_bone(
-    root: ArrayLike,
-    upper_length: float,
-    lower_length: float,
-    target: ArrayLike,
-    bend_direction: ArrayLike,
+    root: ArrayLike, upper_length: float, lower_length: float, target: ArrayLike, bend_direction: ArrayLike
 ) -> NDArray[np.float64]:
     """The analytic two-link solution by the law of cosines.
 
@@ -647,12 +632,7 @@ class _Setup:
 
 @functools.lru_cache(maxsize=64, typed=True)
 def _options(
-    dim: int,
-    tolerance: float,
-    max_iterations: int,
-    cone_half_angle_rad: float | None,
-    solver: int,
-    extrapolate: bool,
+    dim: int, tolerance: float, max_iterations: int, cone_half_angle_rad: float | None, solver: int, extrapolate: bool
 ) -> _Setup:
     """The checked scalar options, without obstacles, on the default root direction; cached, since a dragged
     chain asks for the same ones every frame (the compiled core never writes to them)."""

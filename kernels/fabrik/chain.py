@@ -27,14 +27,7 @@ from kernels.fabrik.geometry import (
     _segment_cuts,
     _unit,
 )
-from kernels.fabrik.limits import (
-    _bend_within,
-    _constrain,
-    _forward_limits,
-    _holding_hinge,
-    _inside_limit,
-    _joint_ok,
-)
+from kernels.fabrik.limits import _bend_within, _constrain, _forward_limits, _holding_hinge, _inside_limit, _joint_ok
 
 Status = Literal["reached", "unreachable", "max_iterations", "blocked", "limited", "infeasible"]
 """Why a solve stopped:
@@ -180,11 +173,7 @@ def _backward_pass(
 
 @compiled(error_model="numpy")
 def _ccd_sweep(
-    p: NDArray[np.float64],
-    target: NDArray[np.float64],
-    tiny: float,
-    rest: NDArray[np.float64],
-    dim: int,
+    p: NDArray[np.float64], target: NDArray[np.float64], tiny: float, rest: NDArray[np.float64], dim: int
 ) -> None:
     """One CCD sweep (Wang & Chen 1991): each joint, end to root, turns what lies beyond it about
     ``to_end × to_target`` (Rodrigues' formula) so that the end points at the target."""
@@ -253,11 +242,7 @@ def _dls_step(
     yz = (c02 * ex + c12 * ey + c22 * ez) / det
     for i in range(n):  # Δθ_i = J_iᵀ y = l_i × y
         lx, ly, lz = endx - p[i, 0], endy - p[i, 1], endz - p[i, 2]
-        turns[i, 0], turns[i, 1], turns[i, 2] = (
-            ly * yz - lz * yy,
-            lz * yx - lx * yz,
-            lx * yy - ly * yx,
-        )
+        turns[i, 0], turns[i, 1], turns[i, 2] = (ly * yz - lz * yy, lz * yx - lx * yz, lx * yy - ly * yx)
     # Turn every segment by the joints up to it and re-chain from the root: ``turn`` (t00 … t22, row by row) is
     # the product of the joints' rotations so far, on scalars (3 × 3 arrays compiled for seconds more).
     t00, t01, t02, t10, t11, t12, t20, t21, t22 = 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0
@@ -340,11 +325,7 @@ def _admissible(
 @compiled(error_model="numpy")
 def _copy(source: NDArray[np.float64], destination: NDArray[np.float64]) -> None:
     for i in range(source.shape[0]):
-        destination[i, 0], destination[i, 1], destination[i, 2] = (
-            source[i, 0],
-            source[i, 1],
-            source[i, 2],
-        )
+        destination[i, 0], destination[i, 1], destination[i, 2] = (source[i, 0], source[i, 1], source[i, 2])
 
 
 @compiled(error_model="numpy")
@@ -444,11 +425,7 @@ def _unbend(
 
 @compiled(error_model="numpy")
 def _extrapolate(
-    p: NDArray[np.float64],
-    previous: NDArray[np.float64],
-    error: float,
-    previous_error: float,
-    allowed: bool,
+    p: NDArray[np.float64], previous: NDArray[np.float64], error: float, previous_error: float, allowed: bool
 ) -> bool:
     """Move the joints on along their last step, in place, by the rest of a geometric series; ``previous`` (the
     pose before the last step) becomes the pose before this move.
@@ -498,11 +475,7 @@ def _admissible_start(
         v = (pair * _GOLDEN[2] + i * _GOLDEN[1]) % 1.0
         dx, dy, dz = _inside_limit(qx, qy, qz, table, i, rest, u, v, dim)
         length = lengths[i]
-        p[i + 1, 0], p[i + 1, 1], p[i + 1, 2] = (
-            p[i, 0] + length * dx,
-            p[i, 1] + length * dy,
-            p[i, 2] + length * dz,
-        )
+        p[i + 1, 0], p[i + 1, 1], p[i + 1, 2] = (p[i, 0] + length * dx, p[i, 1] + length * dy, p[i, 2] + length * dz)
         if not has_zero or length > tiny:
             qx, qy, qz = dx, dy, dz
 

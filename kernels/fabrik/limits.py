@@ -19,16 +19,7 @@ from numpy.typing import ArrayLike, NDArray
 from kernels import _checks
 from kernels._checks import bounded_array, finite_number
 from kernels._jit import compiled
-from kernels.fabrik.geometry import (
-    _DIM_3D,
-    _LARGEST,
-    _TINY,
-    _perpendicular,
-    _rotate,
-    _turn_shortest,
-    _unit,
-    _wrap,
-)
+from kernels.fabrik.geometry import _DIM_3D, _LARGEST, _TINY, _perpendicular, _rotate, _turn_shortest, _unit, _wrap
 
 
 # ================================================================================================ joint types
@@ -171,15 +162,7 @@ def _limit_table(
 
 @compiled(error_model="numpy")
 def _clamp_cone(
-    vx: float,
-    vy: float,
-    vz: float,
-    ax: float,
-    ay: float,
-    az: float,
-    cos_phi: float,
-    sin_phi: float,
-    dim: int,
+    vx: float, vy: float, vz: float, ax: float, ay: float, az: float, cos_phi: float, sin_phi: float, dim: int
 ) -> tuple[float, float, float]:
     """The unit direction v turned, by the least angle, into the cone of half-angle φ around the unit ``a``."""
     cos_v = vx * ax + vy * ay + vz * az
@@ -193,11 +176,7 @@ def _clamp_cone(
     along = sx * ax + sy * ay + sz * az
     sx, sy, sz, _ = _unit(sx - along * ax, sy - along * ay, sz - along * az, sx, sy, sz, 0.5)
     # Renormalised so lengths stay exact.
-    cx, cy, cz = (
-        cos_phi * ax + sin_phi * sx,
-        cos_phi * ay + sin_phi * sy,
-        cos_phi * az + sin_phi * sz,
-    )
+    cx, cy, cz = (cos_phi * ax + sin_phi * sx, cos_phi * ay + sin_phi * sy, cos_phi * az + sin_phi * sz)
     norm = math.sqrt(cx * cx + cy * cy + cz * cz)
     return cx / norm, cy / norm, cz / norm
 
@@ -209,12 +188,7 @@ def _row(table: NDArray[np.float64], i: int) -> int:
 
 @compiled(error_model="numpy")
 def _hinge_axes(
-    table: NDArray[np.float64],
-    row: int,
-    qx: float,
-    qy: float,
-    qz: float,
-    rest: NDArray[np.float64],
+    table: NDArray[np.float64], row: int, qx: float, qy: float, qz: float, rest: NDArray[np.float64]
 ) -> tuple[float, float, float, float, float, float]:
     """The hinge's world axis a and unit reference r ⊥ a, for a previous-segment direction q (unit)."""
     ax, ay, az = table[row, 3], table[row, 4], table[row, 5]

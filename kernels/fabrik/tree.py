@@ -17,15 +17,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from kernels import _checks
 from kernels._jit import compiled
-from kernels.fabrik.api import (
-    _UNSCALED,
-    Obstacle,
-    _check_joints,
-    _check_vector,
-    _norms,
-    _Setup,
-    _solve_single,
-)
+from kernels.fabrik.api import _UNSCALED, Obstacle, _check_joints, _check_vector, _norms, _Setup, _solve_single
 from kernels.fabrik.chain import (
     _BLOCKED,
     _FABRIK,
@@ -526,18 +518,7 @@ def _solve_tree_core(
         x, y, z = p[k, 0] - goal[k, 0], p[k, 1] - goal[k, 1], p[k, 2] - goal[k, 2]
         final[e] = math.sqrt(x * x + y * y + z * z)
     _tree_statuses(
-        p,
-        parents,
-        goal,
-        effectors,
-        lengths,
-        obstacles,
-        tolerance,
-        tiny,
-        final,
-        stalled,
-        holding or any_live,
-        codes,
+        p, parents, goal, effectors, lengths, obstacles, tolerance, tiny, final, stalled, holding or any_live, codes
     )
     if not feasible:
         for e in range(codes.shape[0]):

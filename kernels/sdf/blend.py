@@ -212,18 +212,14 @@ def combine_weighted(
 def smooth_union(a: ArrayLike, b: ArrayLike, k: float, blend: BlendForm = "poly") -> FloatArray:
     """Smooth union ``smin(a, b)``; ``k`` is the blend width (m), 0 for the hard union."""
     a_arr, b_arr = _distances(a, b)
-    return np.asarray(
-        combine_weighted(a_arr, b_arr, "union", _checks.non_negative("k", k), blend)[0],
-        dtype=np.float64,
-    )
+    return np.asarray(combine_weighted(a_arr, b_arr, "union", _checks.non_negative("k", k), blend)[0], dtype=np.float64)
 
 
 def smooth_subtract(a: ArrayLike, b: ArrayLike, k: float, blend: BlendForm = "poly") -> FloatArray:
     """Smooth subtraction, ``a`` minus ``b``: −smin(−a, b); ``k`` is the blend width (m)."""
     a_arr, b_arr = _distances(a, b)
     return np.asarray(
-        combine_weighted(a_arr, b_arr, "subtract", _checks.non_negative("k", k), blend)[0],
-        dtype=np.float64,
+        combine_weighted(a_arr, b_arr, "subtract", _checks.non_negative("k", k), blend)[0], dtype=np.float64
     )
 
 
@@ -231,6 +227,5 @@ def smooth_intersect(a: ArrayLike, b: ArrayLike, k: float, blend: BlendForm = "p
     """Smooth intersection −smin(−a, −b); ``k`` is the blend width (m)."""
     a_arr, b_arr = _distances(a, b)
     return np.asarray(
-        combine_weighted(a_arr, b_arr, "intersect", _checks.non_negative("k", k), blend)[0],
-        dtype=np.float64,
+        combine_weighted(a_arr, b_arr, "intersect", _checks.non_negative("k", k), blend)[0], dtype=np.float64
     )

@@ -414,10 +414,7 @@ def mesh_trimesh(vertices: FloatArray, faces: NDArray[np.int64], colors: FloatAr
         raise ValueError(f"colors must have the vertices' shape {vertices.shape}, got {colors.shape}")
     rgba = np.concatenate([np.clip(colors, 0.0, 1.0), np.ones((len(colors), 1))], axis=1)
     return trimesh.Trimesh(
-        vertices=vertices,
-        faces=faces,
-        vertex_colors=(rgba * 255).round().astype(np.uint8),
-        process=False,
+        vertices=vertices, faces=faces, vertex_colors=(rgba * 255).round().astype(np.uint8), process=False
     )
 
 

@@ -31,16 +31,7 @@ from numpy.typing import ArrayLike, NDArray
 from kernels import _checks
 
 PrimitiveKind = Literal[
-    "sphere",
-    "box",
-    "torus",
-    "capsule",
-    "cylinder",
-    "round_box",
-    "octahedron",
-    "cone",
-    "hex_prism",
-    "ellipsoid",
+    "sphere", "box", "torus", "capsule", "cylinder", "round_box", "octahedron", "cone", "hex_prism", "ellipsoid"
 ]
 """The built-in kinds of primitive; see :data:`PRIMITIVES` for what each one's sizes mean."""
 
@@ -242,11 +233,7 @@ def _sd_octahedron(p: FloatArray, s: float) -> FloatArray:
     x, y, z = pts[:, 0], pts[:, 1], pts[:, 2]
     # Pick the face region: q is p with its axes cycled so the nearest edge is the one the formula handles.
     use_x, use_y, use_z = 3.0 * x < m, 3.0 * y < m, 3.0 * z < m
-    q = np.where(
-        use_x[:, None],
-        pts,
-        np.where(use_y[:, None], pts[:, [1, 2, 0]], pts[:, [2, 0, 1]]),
-    )
+    q = np.where(use_x[:, None], pts, np.where(use_y[:, None], pts[:, [1, 2, 0]], pts[:, [2, 0, 1]]))
     k = np.clip(0.5 * (q[:, 2] - q[:, 1] + s), 0.0, s)
     edge = np.sqrt(q[:, 0] ** 2 + (q[:, 1] - s + k) ** 2 + (q[:, 2] - k) ** 2)
     return np.where(use_x | use_y | use_z, edge, m * (1.0 / math.sqrt(3.0)))

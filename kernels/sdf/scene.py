@@ -179,11 +179,7 @@ def _fold(scene: Scene, points: FloatArray, with_color: bool) -> tuple[FloatArra
 
 
 def fold_xyz(
-    scene: Scene,
-    x: NDArray[np.floating],
-    y: NDArray[np.floating],
-    z: NDArray[np.floating],
-    with_color: bool,
+    scene: Scene, x: NDArray[np.floating], y: NDArray[np.floating], z: NDArray[np.floating], with_color: bool
 ) -> tuple[NDArray[np.floating], NDArray[np.floating] | None]:
     """The scene's distances (and colours when ``with_color``) at points given as coordinate arrays.
 

@@ -97,8 +97,7 @@ class FreeKickParams:
     )
     """Distance from the ball to the centre of the goal line (m)."""
     angle_deg: float = field(
-        default=0.0,
-        metadata=slider("Spot angle (°, + = left)", -45.0, 45.0, 1.0, folder="Ball spot"),
+        default=0.0, metadata=slider("Spot angle (°, + = left)", -45.0, 45.0, 1.0, folder="Ball spot")
     )
     """Where the spot is, seen from the goal: angle off the pitch's centre line, + toward the kicker's left (°)."""
     speed_ms: float = field(default=25.0, metadata=slider("Launch speed (m/s)", 5.0, 40.0, 0.5, folder="Strike"))
@@ -117,14 +116,12 @@ class FreeKickParams:
     )
     """Spin axis: sidespin either way, topspin, backspin, or custom."""
     axis_tilt_deg: float = field(
-        default=0.0,
-        metadata=slider("Axis tilt from vertical (°)", -180.0, 180.0, 1.0, folder="Strike", disabled=True),
+        default=0.0, metadata=slider("Axis tilt from vertical (°)", -180.0, 180.0, 1.0, folder="Strike", disabled=True)
     )
     """Custom axis: tilt from vertical toward the kicker's left (°); 0 is sidespin left, 90 topspin. Its control is
     greyed out unless the spin axis is custom."""
     axis_turn_deg: float = field(
-        default=0.0,
-        metadata=slider("Axis turn toward the kick (°)", -90.0, 90.0, 1.0, folder="Strike", disabled=True),
+        default=0.0, metadata=slider("Axis turn toward the kick (°)", -90.0, 90.0, 1.0, folder="Strike", disabled=True)
     )
     """Custom axis: turn of the tilted part toward the kick direction (°); 90 with tilt 90 is rifle spin. Greyed out
     unless the spin axis is custom."""
@@ -136,12 +133,7 @@ class FreeKickParams:
     curls every spinning kick alike."""
     integrator: Integrator = field(
         default="rk4",
-        metadata=dropdown(
-            "Integrator",
-            tuple(INTEGRATOR_LABELS),
-            tuple(INTEGRATOR_LABELS.values()),
-            folder="Physics",
-        ),
+        metadata=dropdown("Integrator", tuple(INTEGRATOR_LABELS), tuple(INTEGRATOR_LABELS.values()), folder="Physics"),
     )
     """Integrator and its step."""
     knuckle: bool = field(default=False, metadata=checkbox("Knuckleball", folder="Physics"))
@@ -159,8 +151,7 @@ class FreeKickParams:
     show_forces: bool = field(default=True, metadata=checkbox("Force arrows", folder="Physics"))
     """Whether the force arrows are drawn along the path (how the kick is shown, not what it is)."""
     view: ViewName = field(
-        default="broadcast",
-        metadata=dropdown("View", tuple(VIEW_LABELS), tuple(VIEW_LABELS.values())),
+        default="broadcast", metadata=dropdown("View", tuple(VIEW_LABELS), tuple(VIEW_LABELS.values()))
     )
     """Where each browser's camera frames the kick from (how the kick is shown, not what it is)."""
 
@@ -188,8 +179,7 @@ PRESETS: tuple[Preset, ...] = (
         FreeKickParams(speed_ms=25.0, elevation_deg=12.0, azimuth_deg=-10.0, spin_rev_s=8.0),
     ),
     Preset(
-        "Driven, off the post",
-        FreeKickParams(speed_ms=28.0, elevation_deg=12.0, azimuth_deg=-10.0, spin_rev_s=0.0),
+        "Driven, off the post", FreeKickParams(speed_ms=28.0, elevation_deg=12.0, azimuth_deg=-10.0, spin_rev_s=0.0)
     ),
     Preset(
         "Dipping topspin",
@@ -245,9 +235,7 @@ def aim_heading_rad(p: FreeKickParams) -> float:
 
 def launch_velocity(p: FreeKickParams, speed_ms: float | None = None) -> NDArray[np.float64]:
     return ball.launch_velocity(
-        p.speed_ms if speed_ms is None else speed_ms,
-        math.radians(p.elevation_deg),
-        aim_heading_rad(p),
+        p.speed_ms if speed_ms is None else speed_ms, math.radians(p.elevation_deg), aim_heading_rad(p)
     )
 
 
@@ -291,12 +279,7 @@ def panels(p: FreeKickParams) -> tuple[ball.Panel, ball.Panel]:
         post_lateral = ball.WALL_DISTANCE_M * float(to_post @ left) / float(to_post @ aim)
         offset = post_lateral - math.copysign(0.5 * width - 0.5 * DEFENDER_WIDTH_M, post_lateral)
     return ball.free_kick_panels(
-        spot[:2],
-        (0.0, 0.0),
-        (1.0, 0.0),
-        wall_width_m=width,
-        wall_height_m=height,
-        wall_offset_m=offset,
+        spot[:2], (0.0, 0.0), (1.0, 0.0), wall_width_m=width, wall_height_m=height, wall_offset_m=offset
     )
 
 
@@ -1007,12 +990,7 @@ def aim_at(p: FreeKickParams, target_yz: tuple[float, float]) -> FreeKickParams 
     heading = goal_heading_rad(p) + np.radians(a)
     elevation = np.radians(e)
     velocities = p.speed_ms * np.stack(
-        [
-            np.cos(elevation) * np.cos(heading),
-            np.cos(elevation) * np.sin(heading),
-            np.sin(elevation),
-        ],
-        axis=1,
+        [np.cos(elevation) * np.cos(heading), np.cos(elevation) * np.sin(heading), np.sin(elevation)], axis=1
     )
     omegas = np.zeros((len(e), 3))
     omegas[:, 2] = 2.0 * math.pi * s

@@ -78,12 +78,7 @@ def pitch_markings() -> NDArray[np.float64]:
     segs: list[tuple[tuple[float, float, float], tuple[float, float, float]]] = []
 
     def box(depth: float, half_width: float) -> None:
-        corners = [
-            (0.0, -half_width),
-            (-depth, -half_width),
-            (-depth, half_width),
-            (0.0, half_width),
-        ]
+        corners = [(0.0, -half_width), (-depth, -half_width), (-depth, half_width), (0.0, half_width)]
         for (x0, y0), (x1, y1) in itertools.pairwise(corners):
             segs.append(((x0, y0, z), (x1, y1, z)))
 
@@ -94,10 +89,7 @@ def pitch_markings() -> NDArray[np.float64]:
     for a in np.linspace(0.0, 2 * math.pi, 9)[:-1]:
         b = a + 2 * math.pi / 8
         segs.append(
-            (
-                (spot + 0.11 * math.cos(a), 0.11 * math.sin(a), z),
-                (spot + 0.11 * math.cos(b), 0.11 * math.sin(b), z),
-            )
+            ((spot + 0.11 * math.cos(a), 0.11 * math.sin(a), z), (spot + 0.11 * math.cos(b), 0.11 * math.sin(b), z))
         )
     # The arc: the part of the 9.15 m circle round the spot that lies outside the area.
     half_angle = math.acos(5.5 / 9.15)
@@ -133,11 +125,7 @@ def arrow_segments(
     left = tips - barb * direction + 0.5 * barb * side
     right = tips - barb * direction - 0.5 * barb * side
     return np.concatenate(
-        [
-            np.stack([origins, tips], axis=1),
-            np.stack([left, tips], axis=1),
-            np.stack([right, tips], axis=1),
-        ]
+        [np.stack([origins, tips], axis=1), np.stack([left, tips], axis=1), np.stack([right, tips], axis=1)]
     )
 
 

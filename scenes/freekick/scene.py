@@ -286,11 +286,7 @@ reads it again, so a ball that bounces in front of him beats him more often than
                     "on the edge when it lies off the map)."
                 )
                 self.map_image = gui.add_image(
-                    np.full(
-                        (len(MAP_SPINS_REV_S) * MAP_CELL_PX, len(MAP_SPEEDS_MS) * MAP_CELL_PX, 3),
-                        200,
-                        np.uint8,
-                    ),
+                    np.full((len(MAP_SPINS_REV_S) * MAP_CELL_PX, len(MAP_SPEEDS_MS) * MAP_CELL_PX, 3), 200, np.uint8),
                     label="Speed × spin",
                     format="png",
                 )
@@ -338,11 +334,7 @@ reads it again, so a ball that bounces in front of him beats him more often than
         )
         self.goal_mouth.on_click(self._on_goal_click)
         self.target_marker = scene.add_icosphere(
-            f"{root}/target",
-            radius=0.12,
-            color=(255, 60, 200),
-            position=(0.0, 0.0, 1.0),
-            visible=False,
+            f"{root}/target", radius=0.12, color=(255, 60, 200), position=(0.0, 0.0, 1.0), visible=False
         )
 
         # The goal chance over the pitch: one flat tile per spot, coloured once a map is computed.
@@ -438,10 +430,7 @@ reads it again, so a ball that bounces in front of him beats him more often than
 
     def _set_params(self, params: FreeKickParams) -> None:
         state = compute_kick(params)  # raises (and keeps the last state) if the kernels refuse the input
-        moved = (params.distance_m, params.angle_deg) != (
-            self.params.distance_m,
-            self.params.angle_deg,
-        )
+        moved = (params.distance_m, params.angle_deg) != (self.params.distance_m, self.params.angle_deg)
         if params.shown_as(self.params) != self.params:  # another kick, not only its arrows or view
             self._drop_aim()
         self.params, self.state = params, state
@@ -709,8 +698,7 @@ reads it again, so a ball that bounces in front of him beats him more often than
         origins, forces = at[:, :3], at[:, 3:].reshape(ARROW_POINTS, len(names), 3)
         # Every force's arrows in one call: (3 parts, force, arrow, 2, 3), each force's (3K, 2, 3) a slice.
         arrows = arrow_segments(
-            np.tile(origins, (len(names), 1)),
-            METRES_PER_NEWTON * forces.transpose(1, 0, 2).reshape(-1, 3),
+            np.tile(origins, (len(names), 1)), METRES_PER_NEWTON * forces.transpose(1, 0, 2).reshape(-1, 3)
         ).reshape(3, len(names), ARROW_POINTS, 2, 3)
         wall = state.wall
         normal, along = wall_axes(wall)
@@ -778,10 +766,7 @@ reads it again, so a ball that bounces in front of him beats him more often than
         free = free_flight_result(state)
         if result != free:
             lines.append(f"In free flight through the goal plane: {verdict_words(free, o.goal_point)}")
-        lines += [
-            "",
-            f"Height at the wall: **{wall_height_words(state)}** (wall top {state.wall.height_m:.2f} m)",
-        ]
+        lines += ["", f"Height at the wall: **{wall_height_words(state)}** (wall top {state.wall.height_m:.2f} m)"]
         if reached and o.goal_point is not None and o.goal_time is not None:
             lines.append(
                 f"At the goal line: **y = {o.goal_point[1]:+.2f} m, z = {o.goal_point[2]:.2f} m** after "

@@ -23,13 +23,7 @@ from scenes.freekick.model import (
     wall_axes,
 )
 
-VIEW_MIN_DEPTH_M: dict[ViewName, float] = {
-    "broadcast": 3.0,
-    "behind": 4.0,
-    "side": 3.0,
-    "goal": 1.0,
-    "above": 3.0,
-}
+VIEW_MIN_DEPTH_M: dict[ViewName, float] = {"broadcast": 3.0, "behind": 4.0, "side": 3.0, "goal": 1.0, "above": 3.0}
 """How far in front of each view's camera everything stays (m): behind the ball means a few steps back."""
 VIEW_TILTS: dict[ViewName, tuple[float, ...]] = {
     "broadcast": (1.5,),

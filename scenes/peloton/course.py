@@ -114,17 +114,7 @@ RIDE_INPUTS = (
     "pacing_gain_pct",
 )
 """The course inputs that change the ride (the rest change only the view or the solver's target)."""
-LINE_INPUTS = (
-    "cda_m2",
-    "mass_kg",
-    "crr",
-    "drivetrain_pct",
-    "drafting",
-    "formation",
-    "n_riders",
-    "gap_m",
-    "model",
-)
+LINE_INPUTS = ("cda_m2", "mass_kg", "crr", "drivetrain_pct", "drafting", "formation", "n_riders", "gap_m", "model")
 """The line's inputs that change the ride on the course (the paceline options apply there too; so do its preset
 menus, which set the CdA and Crr)."""
 FLAT_ROAD_ONLY = ("speed_kmh", "rotate", "turn_s")
@@ -912,12 +902,7 @@ class CourseMode:
         d = self.leader_distance_m()
         speed = float(np.interp(d, ride.distance_m, ride.speed_ms))
         power = float(
-            ride.power_w[
-                min(
-                    int(np.searchsorted(ride.distance_m, d, side="right")) - 1,
-                    ride.power_w.shape[0] - 1,
-                )
-            ]
+            ride.power_w[min(int(np.searchsorted(ride.distance_m, d, side="right")) - 1, ride.power_w.shape[0] - 1)]
         )
         elevation = float(np.interp(d, self.route.distance_m, self.route.elevation_m))
         coasting = ""

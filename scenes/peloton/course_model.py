@@ -23,10 +23,7 @@ from scenes._controls import checkbox, dropdown, dropdown_from_labels, number, s
 from scenes.peloton.model import BIKE_LENGTH_M, ROAD_HALF_WIDTH_M, PelotonParams, drag_reductions, group_cda
 
 CourseAirLabel = Literal["Textbook atmosphere", "Weather reading"]
-AIR_FROM_LABEL: dict[str, course_kernel.AirKind] = {
-    "Textbook atmosphere": "textbook",
-    "Weather reading": "weather",
-}
+AIR_FROM_LABEL: dict[str, course_kernel.AirKind] = {"Textbook atmosphere": "textbook", "Weather reading": "weather"}
 PRESSURE_SOURCES = ("Standard atmosphere", "Barometer")
 """What the "Pressure from" dropdown shows for :attr:`CourseParams.pressure_from_barometer` False and True."""
 POWER_MODEL_FROM_LABEL: dict[str, course_kernel.Model] = {
@@ -114,25 +111,21 @@ class CourseParams:
     target_min: float = field(default=60.0, metadata=number("Target time (min)", 1.0, 6000.0, 1.0, folder=POWER_FOLDER))
     """Finish time that 'Find the power for this time' aims at (min)."""
     model: course_kernel.Model = field(
-        default="martin",
-        metadata=dropdown_from_labels("Power model", POWER_MODEL_FROM_LABEL, folder=POWER_FOLDER),
+        default="martin", metadata=dropdown_from_labels("Power model", POWER_MODEL_FROM_LABEL, folder=POWER_FOLDER)
     )
     """Power model: Martin et al. 1998's full terms or the textbook three."""
     air: course_kernel.AirKind = field(
-        default="textbook",
-        metadata=dropdown_from_labels("Air", AIR_FROM_LABEL, folder=POWER_FOLDER),
+        default="textbook", metadata=dropdown_from_labels("Air", AIR_FROM_LABEL, folder=POWER_FOLDER)
     )
     """Air along the route: the textbook exponential atmosphere or a weather reading."""
     temperature_c: float = field(default=15.0, metadata=slider("Temp (°C)", -20.0, 45.0, 0.5, folder=POWER_FOLDER))
     """Air temperature at the start (°C), weather air."""
     pressure_from_barometer: bool = field(
-        default=False,
-        metadata=dropdown("Pressure from", (False, True), PRESSURE_SOURCES, folder=POWER_FOLDER),
+        default=False, metadata=dropdown("Pressure from", (False, True), PRESSURE_SOURCES, folder=POWER_FOLDER)
     )
     """Weather air: the barometer's pressure, or the standard atmosphere's at the start's altitude."""
     pressure_hpa: float = field(
-        default=1013.25,
-        metadata=number("Pressure at the start (hPa)", *BAROMETER_RANGE_HPA, 0.5, folder=POWER_FOLDER),
+        default=1013.25, metadata=number("Pressure at the start (hPa)", *BAROMETER_RANGE_HPA, 0.5, folder=POWER_FOLDER)
     )
     """Station pressure at the start (hPa), when read from a barometer."""
     humidity_pct: float = field(default=50.0, metadata=slider("Humidity (%)", 0.0, 100.0, 1.0, folder=POWER_FOLDER))
@@ -140,23 +133,18 @@ class CourseParams:
     wind_ms: float = field(default=0.0, metadata=slider("Wind (m/s)", 0.0, 20.0, 0.5, folder=MORE_FOLDER))
     """Wind speed (m/s)."""
     wind_from_deg: float = field(
-        default=0.0,
-        metadata=slider("Wind from (° from north)", 0.0, 359.0, 1.0, folder=MORE_FOLDER),
+        default=0.0, metadata=slider("Wind from (° from north)", 0.0, 359.0, 1.0, folder=MORE_FOLDER)
     )
     """Where the wind blows from, clockwise from north (°)."""
     max_speed_kmh: float = field(
-        default=72.0,
-        metadata=slider("Safe descending speed (km/h)", 20.0, 110.0, 1.0, folder=MORE_FOLDER),
+        default=72.0, metadata=slider("Safe descending speed (km/h)", 20.0, 110.0, 1.0, folder=MORE_FOLDER)
     )
     """Safe descending speed (km/h): riders brake to hold it."""
     pacing: bool = field(default=False, metadata=checkbox("Pace by grade", folder=MORE_FOLDER))
     """Vary power with the grade (Swain 1997) at the same average."""
     pacing_gain_pct: float = field(default=15.0, metadata=slider("Pacing gain (%)", 0.0, 50.0, 1.0, folder=MORE_FOLDER))
     """How much more power on steep climbs, and less on descents (%)."""
-    exaggeration: float = field(
-        default=1.0,
-        metadata=slider("Steepness drawn (×)", 1.0, 5.0, 0.5, folder=MORE_FOLDER),
-    )
+    exaggeration: float = field(default=1.0, metadata=slider("Steepness drawn (×)", 1.0, 5.0, 0.5, folder=MORE_FOLDER))
     """Vertical exaggeration of the drawn road (the ride itself is on the real grades)."""
     playback: float = field(default=60.0, metadata=slider("Playback speed (×)", 1.0, 600.0, 1.0, folder=MORE_FOLDER))
     """Playback speed (× real time)."""

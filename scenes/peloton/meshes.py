@@ -126,14 +126,7 @@ def rider_meshes(position: Position, detail: Detail = "full") -> dict[str, trime
         wheel.apply_transform(trimesh.transformations.rotation_matrix(math.pi / 2, [1, 0, 0]))
         wheel.apply_translation(centre)
         bike_parts.append(wheel)
-    for a, b in (
-        (rear, bb),
-        (rear, seat),
-        (bb, seat),
-        (bb, head_top),
-        (seat, head_top),
-        (head_top, front),
-    ):
+    for a, b in ((rear, bb), (rear, seat), (bb, seat), (bb, head_top), (seat, head_top), (head_top, front)):
         bike_parts.append(rod_n(a, b, 0.016))
     bike_parts.append(rod_n(head_top, bars, 0.014))
     bike_parts.append(rod_n(bars + [0, -0.2, 0], bars + [0, 0.2, 0], 0.012))

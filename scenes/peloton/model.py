@@ -102,13 +102,11 @@ class PelotonParams:
     altitude_m: float = field(default=0.0, metadata=slider("Altitude (m)", -500.0, 4000.0, 50.0, folder="Course"))
     """Altitude (m): sets air density; from the Dead Sea's shore (−430 m) to the highest passes."""
     headwind_ms: float = field(
-        default=0.0,
-        metadata=slider("Headwind (m/s, − = tailwind)", -15.0, 15.0, 0.5, folder="Course"),
+        default=0.0, metadata=slider("Headwind (m/s, − = tailwind)", -15.0, 15.0, 0.5, folder="Course")
     )
     """Wind against the riders (m/s); negative is a tailwind."""
     crosswind_ms: float = field(
-        default=0.0,
-        metadata=slider("Crosswind (m/s, + from the left)", -15.0, 15.0, 0.5, folder="Course"),
+        default=0.0, metadata=slider("Crosswind (m/s, + from the left)", -15.0, 15.0, 0.5, folder="Course")
     )
     """Wind across the road (m/s, + blowing from the riders' left): it turns the wakes downwind
     (:func:`formation_yaw`), so a line loses its shelter and an echelon forms on the downwind side. The power's air
@@ -124,8 +122,7 @@ class PelotonParams:
     gap_m: float = field(default=0.5, metadata=slider("Gap (m)", 0.0, MAX_GAP_M, 0.1, folder="Drafting"))
     """Wheel-to-wheel gap between riders (m)."""
     model: cycling.DraftModel = field(
-        default="measured",
-        metadata=dropdown_from_labels("Draft model", MODEL_FROM_LABEL, folder="Drafting"),
+        default="measured", metadata=dropdown_from_labels("Draft model", MODEL_FROM_LABEL, folder="Drafting")
     )
     """Drafting model: the textbook formula or the position-dependent fit to measurements."""
     rotate: bool = field(default=False, metadata=checkbox("Rotate the lead", folder="Drafting"))

@@ -111,11 +111,7 @@ def project_px(points_world: np.ndarray, view: View, lens: Lens) -> np.ndarray:
 
 
 def lift_to_metres(
-    anchors_world: np.ndarray,
-    lifts_px: np.ndarray,
-    up_world: np.ndarray,
-    view: View,
-    lens: Lens,
+    anchors_world: np.ndarray, lifts_px: np.ndarray, up_world: np.ndarray, view: View, lens: Lens
 ) -> np.ndarray:
     """(N,) distances (m) along ``up_world`` that raise each anchor by its lift (px) in ``lens`` from ``view``.
 

@@ -28,14 +28,7 @@ from scenes._instances import add_instances, park_hidden
 from scenes._look import add_ground
 from scenes.peloton.course import CourseMode
 from scenes.peloton.course_model import framed_front, framed_words
-from scenes.peloton.legend import (
-    coasting_words,
-    formation_table,
-    legend_html,
-    power_colours,
-    power_range,
-    riders_text,
-)
+from scenes.peloton.legend import coasting_words, formation_table, legend_html, power_colours, power_range, riders_text
 from scenes.peloton.legend import watts_text as _watts
 from scenes.peloton.meshes import (
     GRASS_COLOUR,
@@ -322,12 +315,7 @@ time-averaged power is the mean over positions, far below the leader's.
                 cast_shadow=False,
             )
         self.labels = [
-            scene.add_label(
-                f"{self.course.name}/label_{i}",
-                text="",
-                position=(0.0, 0.0, 2.0),
-                font_screen_scale=0.9,
-            )
+            scene.add_label(f"{self.course.name}/label_{i}", text="", position=(0.0, 0.0, 2.0), font_screen_scale=0.9)
             for i in range(MAX_RIDERS)
         ]
         # A thin line from each bar's top up to its label: a label lifted clear of its neighbours still shows whose
@@ -432,10 +420,7 @@ time-averaged power is the mean over positions, far below the leader's.
             patch = [[front - length * i, width * (j - 0.5), 0.0] for i in (0, 1) for j in (0, 1)]
             local = np.vstack([local, patch])
             return course_to_world(local, p.grade_pct)
-        front, back = (
-            0.5 * BIKE_LENGTH_M,
-            float(slot_offsets(n, p.gap_m)[n - 1]) - 0.5 * BIKE_LENGTH_M,
-        )
+        front, back = (0.5 * BIKE_LENGTH_M, float(slot_offsets(n, p.gap_m)[n - 1]) - 0.5 * BIKE_LENGTH_M)
         top = 1.95 + LABEL_STAGGER_M + bar_headroom * float(np.max(self._bar_heights_m()))
         x_hi = front + (3.0 + _arrow_length(p) if _arrow_length(p) > 0 else 0.0)
         lo, hi = np.array([back, -1.1, 0.0]), np.array([x_hi, 1.1, max(top, 2.2)])
@@ -721,11 +706,7 @@ time-averaged power is the mean over positions, far below the leader's.
                         label.text = text
                     # Neighbours' labels alternate in height so close riders' labels never overlap.
                     # Lifted by the layout for the framed camera, so no two labels overlap.
-                    set_if_changed(
-                        label,
-                        "position",
-                        (x[i], y[i], 1.95 + base[i] + lifts[i]),
-                    )
+                    set_if_changed(label, "position", (x[i], y[i], 1.95 + base[i] + lifts[i]))
 
             set_if_changed(self.legend, "visible", False)
             self._show_panel(self._table_markdown, readouts=readouts)

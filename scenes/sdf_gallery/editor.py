@@ -105,11 +105,7 @@ def trial_height(width: int) -> int:
 
 
 def trial_source(
-    text: str,
-    shadings: list[Shading],
-    camera: Camera,
-    field: EditorField,
-    width: int,
+    text: str, shadings: list[Shading], camera: Camera, field: EditorField, width: int
 ) -> TrialTimes | None:
     """Compile ``text`` with each of ``shadings`` and draw one ``width`` × ``width·5/8`` frame with the first in a
     child process, killed at COMPILE_LIMIT_S plus FRAME_LIMIT_S, and return what it measured; ShaderCompileError
@@ -120,16 +116,7 @@ def trial_source(
     """
     if text in EXAMPLE_SOURCES:
         return None
-    return trial(
-        text,
-        shadings,
-        camera,
-        field.bounds,
-        width,
-        trial_height(width),
-        COMPILE_LIMIT_S,
-        FRAME_LIMIT_S,
-    )
+    return trial(text, shadings, camera, field.bounds, width, trial_height(width), COMPILE_LIMIT_S, FRAME_LIMIT_S)
 
 
 def _no_surface(field: EditorField, resolution: int) -> str:

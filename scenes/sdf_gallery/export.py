@@ -38,11 +38,7 @@ class Download:
 
 
 def download(
-    fmt: DownloadFormat,
-    vertices: np.ndarray,
-    faces: np.ndarray,
-    colors: np.ndarray,
-    reference: np.ndarray | None,
+    fmt: DownloadFormat, vertices: np.ndarray, faces: np.ndarray, colors: np.ndarray, reference: np.ndarray | None
 ) -> Download:
     """The download of format ``fmt``: the mesh (vertices (V, 3) m, faces (F, 3), colours (V, 3) in [0, 1]) as GLB,
     STL or OBJ, or the reference image ((H, W, 3) uint8, None before one is rendered) as PNG; no file when there is

@@ -29,27 +29,16 @@ SIZE_RANGE_M = (0.05, 1.0)
 KIND_LABELS: dict[str, sdf.PrimitiveKind] = {s.label: s.kind for s in sdf.PRIMITIVES.values()}
 SIZES_USED: dict[sdf.PrimitiveKind, int] = {s.kind: s.size_count for s in sdf.PRIMITIVES.values()}
 """How many of the sliders a, b, c each kind reads."""
-OP_LABELS: dict[str, sdf.BooleanOp] = {
-    "Union": "union",
-    "Subtract": "subtract",
-    "Intersect": "intersect",
-}
+OP_LABELS: dict[str, sdf.BooleanOp] = {"Union": "union", "Subtract": "subtract", "Intersect": "intersect"}
 BlendChoice = Literal["hard", "poly", "exp"]
 """Hard booleans, or a smooth minimum in one of its two forms."""
-BLEND_LABELS: dict[str, BlendChoice] = {
-    "Hard": "hard",
-    "Smooth (polynomial)": "poly",
-    "Smooth (exponential)": "exp",
-}
+BLEND_LABELS: dict[str, BlendChoice] = {"Hard": "hard", "Smooth (polynomial)": "poly", "Smooth (exponential)": "exp"}
 ReferenceMode = Literal["stopped", "live"]
 MODE_LABELS: dict[str, ReferenceMode] = {"When the camera stops": "stopped", "Live": "live"}
 ViewMode = Literal["mesh", "raymarch", "both"]
 VIEW_LABELS: dict[str, ViewMode] = {"Mesh": "mesh", "Ray-marched": "raymarch", "Both": "both"}
 ShapeSource = Literal["primitives", "editor"]
-SOURCE_LABELS: dict[str, ShapeSource] = {
-    "Primitives (panels below)": "primitives",
-    "GLSL editor": "editor",
-}
+SOURCE_LABELS: dict[str, ShapeSource] = {"Primitives (panels below)": "primitives", "GLSL editor": "editor"}
 SIZE_MEANING = (
     "**Sizes (m).** Sphere: a = radius. Box: a, b, c = half sizes along local x, y, z. "
     "Torus: a = major radius, b = tube radius (ring in the local xz plane). "
@@ -160,11 +149,7 @@ def _default_primitives() -> tuple[PrimitiveParams, ...]:
                 kind=prim.kind,
                 op=prim.op,
                 size=(size[0], size[1], size[2]),
-                color=(
-                    round(prim.color[0] * 255),
-                    round(prim.color[1] * 255),
-                    round(prim.color[2] * 255),
-                ),
+                color=(round(prim.color[0] * 255), round(prim.color[1] * 255), round(prim.color[2] * 255)),
                 position=prim.center,
                 wxyz=prim.rotation,
             )
@@ -186,21 +171,18 @@ class SdfGalleryParams:
     """
 
     view_mode: ViewMode = field(
-        default="mesh",
-        metadata=dropdown_from_labels("View", VIEW_LABELS, folder="Shape and view"),
+        default="mesh", metadata=dropdown_from_labels("View", VIEW_LABELS, folder="Shape and view")
     )
     """The main 3D view: the mesh, the GLSL ray-march (background image with depth), or both (mesh as wireframe)."""
     shape_source: ShapeSource = field(
-        default="primitives",
-        metadata=dropdown_from_labels("Shape", SOURCE_LABELS, folder="Shape and view"),
+        default="primitives", metadata=dropdown_from_labels("Shape", SOURCE_LABELS, folder="Shape and view")
     )
     """Show the primitives' scene or the editor's field."""
     rings: bool = field(default=False, metadata=checkbox("Rotation rings on the gizmos", folder="Shape and view"))
     """Whether the gizmos show their rotation rings (turn a primitive); off, only the arrows (move it) clutter the
     shape."""
     example: str = field(
-        default=next(iter(EXAMPLES)),
-        metadata=dropdown("Example", (*EXAMPLES, OWN_CODE), folder="GLSL editor"),
+        default=next(iter(EXAMPLES)), metadata=dropdown("Example", (*EXAMPLES, OWN_CODE), folder="GLSL editor")
     )
     """The title of the example last picked (picking one puts its source in the editor and applies it), or
     :data:`OWN_CODE` once the editor's text is no example's."""
@@ -210,80 +192,62 @@ class SdfGalleryParams:
     )
     """The editor's text as last kept (at most EDITOR_KEEP_CHARS; Apply compiles it)."""
     editor_half_size: float = field(
-        default=EDITOR_HALF_SIZE_M,
-        metadata=slider("Editor bounds half size (m)", 0.5, 3.0, 0.1, folder="GLSL editor"),
+        default=EDITOR_HALF_SIZE_M, metadata=slider("Editor bounds half size (m)", 0.5, 3.0, 0.1, folder="GLSL editor")
     )
     """Half the side of the cube the editor's field is meshed and ray-marched in, for the next mesh (m)."""
     blend: BlendChoice = field(
-        default="poly",
-        metadata=dropdown_from_labels("Blend", BLEND_LABELS, folder="Blend and mesh"),
+        default="poly", metadata=dropdown_from_labels("Blend", BLEND_LABELS, folder="Blend and mesh")
     )
     """Hard booleans (k is not used), or the polynomial or exponential smooth minimum of width k."""
     k: float = field(default=0.25, metadata=slider("Blend width k (m)", 0.0, 1.0, 0.01, folder="Blend and mesh"))
     """Blend width (m); 0 is a hard boolean."""
     resolution: int = field(
-        default=64,
-        metadata=slider(RESOLUTION_LABEL, 32, 256, 16, folder="Blend and mesh", costly=True),
+        default=64, metadata=slider(RESOLUTION_LABEL, 32, 256, 16, folder="Blend and mesh", costly=True)
     )
     """Marching-cubes samples along the longest side of the bounds (32–256); a change remeshes (up to seconds)."""
     reference_mode: ReferenceMode = field(
-        default="stopped",
-        metadata=dropdown_from_labels("Re-render", MODE_LABELS, folder=REFERENCE_FOLDER),
+        default="stopped", metadata=dropdown_from_labels("Re-render", MODE_LABELS, folder=REFERENCE_FOLDER)
     )
     """Render the reference when the camera stops, or live while it moves."""
     reference_width: int = field(
-        default=320,
-        metadata=slider("Reference width (px)", 128, 640, 32, folder=REFERENCE_FOLDER),
+        default=320, metadata=slider("Reference width (px)", 128, 640, 32, folder=REFERENCE_FOLDER)
     )
     """Width of the reference image (px); its height follows the viewer's aspect."""
     ambient: float = field(
-        default=_SHADING.ambient,
-        metadata=slider("Ambient k_a", 0.0, 1.0, 0.01, folder=REFERENCE_FOLDER),
+        default=_SHADING.ambient, metadata=slider("Ambient k_a", 0.0, 1.0, 0.01, folder=REFERENCE_FOLDER)
     )
     """k_a, ambient reflection."""
     diffuse: float = field(
-        default=_SHADING.diffuse,
-        metadata=slider("Diffuse k_d", 0.0, 1.0, 0.01, folder=REFERENCE_FOLDER),
+        default=_SHADING.diffuse, metadata=slider("Diffuse k_d", 0.0, 1.0, 0.01, folder=REFERENCE_FOLDER)
     )
     """k_d, diffuse reflection."""
     specular: float = field(
-        default=_SHADING.specular,
-        metadata=slider("Specular k_s", 0.0, 1.0, 0.01, folder=REFERENCE_FOLDER),
+        default=_SHADING.specular, metadata=slider("Specular k_s", 0.0, 1.0, 0.01, folder=REFERENCE_FOLDER)
     )
     """k_s, specular reflection."""
     shininess: float = field(
-        default=_SHADING.shininess,
-        metadata=slider("Shininess α", 1.0, 128.0, 1.0, folder=REFERENCE_FOLDER),
+        default=_SHADING.shininess, metadata=slider("Shininess α", 1.0, 128.0, 1.0, folder=REFERENCE_FOLDER)
     )
     """α, the Phong exponent."""
-    shadows: bool = field(
-        default=_SHADING.shadows,
-        metadata=checkbox("Soft shadows", folder=REFERENCE_FOLDER),
-    )
+    shadows: bool = field(default=_SHADING.shadows, metadata=checkbox("Soft shadows", folder=REFERENCE_FOLDER))
     """Soft shadows (Quilez's improved technique)."""
     shadow_sharpness: float = field(
         default=_SHADING.shadow_sharpness,
         metadata=slider("Shadow sharpness k", 1.0, 64.0, 1.0, folder=REFERENCE_FOLDER),
     )
     """k of the soft shadow: penumbra width ∝ 1/k."""
-    occlusion: bool = field(
-        default=_SHADING.occlusion,
-        metadata=checkbox("Ambient occlusion", folder=REFERENCE_FOLDER),
-    )
+    occlusion: bool = field(default=_SHADING.occlusion, metadata=checkbox("Ambient occlusion", folder=REFERENCE_FOLDER))
     """Ambient occlusion along the normal."""
     occlusion_strength: float = field(
-        default=_SHADING.occlusion_strength,
-        metadata=slider("AO strength", 0.0, 6.0, 0.1, folder=REFERENCE_FOLDER),
+        default=_SHADING.occlusion_strength, metadata=slider("AO strength", 0.0, 6.0, 0.1, folder=REFERENCE_FOLDER)
     )
     """How strongly occluded samples darken the ambient term."""
     light_elevation_deg: float = field(
-        default=_LIGHT_ELEVATION_DEG,
-        metadata=slider("Light elevation (°)", 5.0, 90.0, 1.0, folder=REFERENCE_FOLDER),
+        default=_LIGHT_ELEVATION_DEG, metadata=slider("Light elevation (°)", 5.0, 90.0, 1.0, folder=REFERENCE_FOLDER)
     )
     """The light's elevation above the ground plane (°)."""
     light_azimuth_deg: float = field(
-        default=_LIGHT_AZIMUTH_DEG,
-        metadata=slider("Light azimuth (°)", -180.0, 180.0, 1.0, folder=REFERENCE_FOLDER),
+        default=_LIGHT_AZIMUTH_DEG, metadata=slider("Light azimuth (°)", -180.0, 180.0, 1.0, folder=REFERENCE_FOLDER)
     )
     """The light's azimuth from +x toward +y (°)."""
     primitives: tuple[PrimitiveParams, ...] = field(default_factory=_default_primitives)

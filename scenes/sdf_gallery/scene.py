@@ -38,14 +38,7 @@ from scenes._worker import LatestWorker
 from scenes.sdf_gallery import editor
 from scenes.sdf_gallery.compare import Agreement, Wire, compare, readout_markdown
 from scenes.sdf_gallery.editor import EDITING_OFF, EDITOR_HELP, EXAMPLES, OWN_CODE, EditorField
-from scenes.sdf_gallery.export import (
-    NOTHING_TO_DOWNLOAD,
-    Download,
-    DownloadFormat,
-    download,
-    scene_normals,
-    viewer_glb,
-)
+from scenes.sdf_gallery.export import NOTHING_TO_DOWNLOAD, Download, DownloadFormat, download, scene_normals, viewer_glb
 from scenes.sdf_gallery.params import (
     BOX_HI,
     BOX_LO,
@@ -67,21 +60,9 @@ from scenes.sdf_gallery.params import (
     rest_size,
     viewer_size,
 )
-from scenes.sdf_gallery.slots import (
-    add_slot_gizmo,
-    build_slot_controls,
-    read_wxyz,
-    update_gizmo_looks,
-)
+from scenes.sdf_gallery.slots import add_slot_gizmo, build_slot_controls, read_wxyz, update_gizmo_looks
 from shaders import gl_service
-from shaders.renderer import (
-    Camera,
-    GLUnavailableError,
-    Renderer,
-    ShaderCompileError,
-    Shading,
-    check_source,
-)
+from shaders.renderer import Camera, GLUnavailableError, Renderer, ShaderCompileError, Shading, check_source
 
 logger = logging.getLogger(__name__)
 
@@ -506,9 +487,7 @@ IoU is lowest when a box edge is on the silhouette.
         half_size = self.read_controls(self.half_size_controls).editor_half_size
         if half_size != params.editor.half_size:
             params = dataclasses.replace(
-                params,
-                editor_half_size=half_size,
-                editor=dataclasses.replace(params.editor, half_size=half_size),
+                params, editor_half_size=half_size, editor=dataclasses.replace(params.editor, half_size=half_size)
             )
             self.params = params
         with self._state:
@@ -709,11 +688,7 @@ IoU is lowest when a box edge is on the silhouette.
             # here: the new shape appears with it, and the fully shaded one compiles when the view next rests.
             shading = self.params.shading
             times = editor.trial_source(
-                text,
-                [moving_shading(shading), shading],
-                self._camera_or_default(),
-                field,
-                MOVING_WIDTH_PX,
+                text, [moving_shading(shading), shading], self._camera_or_default(), field, MOVING_WIDTH_PX
             )
             gl_service.run(lambda gl: gl.compile_field(text, moving_shading(shading)))
             if not self._turned_away(choice):
@@ -849,12 +824,7 @@ IoU is lowest when a box edge is on the silhouette.
             camera, aspect = self._camera_or_default(), self.viewer.aspect
         with self._lock:  # one consistent mesh: the worker replaces all four together under this lock
             params = self.params
-            scene, vertices, faces, colors = (
-                self.mesh_shape,
-                self.mesh_vertices,
-                self.mesh_faces,
-                self.mesh_colors,
-            )
+            scene, vertices, faces, colors = (self.mesh_shape, self.mesh_vertices, self.mesh_faces, self.mesh_colors)
             mesh_serial = self.mesh_serial
         assert scene is not None
         width = params.reference_width

@@ -17,13 +17,7 @@ import viser
 
 from scenes._base import record_spec
 from scenes._controls import Built, Controls, declared
-from scenes.sdf_gallery.params import (
-    GIZMO_MARKER_RADIUS_M,
-    PrimitiveParams,
-    gizmo_label,
-    gizmo_reach,
-    gizmo_tips,
-)
+from scenes.sdf_gallery.params import GIZMO_MARKER_RADIUS_M, PrimitiveParams, gizmo_label, gizmo_reach, gizmo_tips
 
 
 def build_slot_controls(gui: Any, index: int, slot: PrimitiveParams) -> Controls[PrimitiveParams]:

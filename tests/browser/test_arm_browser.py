@@ -240,9 +240,7 @@ def test_the_3d_view_and_each_preset_show_everything_whole(shown: ScenePage) -> 
     _assert_chain_fills_the_view(shown, "the chain again")
 
 
-def test_a_solve_with_no_admissible_pose_charts_without_an_error_and_the_next_draws_its_curve(
-    shown: ScenePage,
-) -> None:
+def test_a_solve_with_no_admissible_pose_charts_without_an_error_and_the_next_draws_its_curve(shown: ScenePage) -> None:
     # An empty series made viser's client throw "object null is not iterable" and leave the chart without its red
     # curve; a solve that saw no admissible pose ("infeasible") sent one. Its chart is now its one final error.
     from scenes.arm import OBSTACLE_STARTS, TARGET_START, ArmParams, rest_pose, solve_arm

@@ -62,8 +62,7 @@ def test_the_camera_reports_css_pixels_and_the_line_is_framed_clear_of_the_panel
         frames, position = scene.framing.frames, np.asarray(camera.position).copy()
         page.evaluate("() => window.__viserTestpoints.devSettings.set({ fixedDpr: 0.6 })")
         page.wait_for_function(
-            f"() => Math.abs(window.__viserMutable.canvas.width - 0.6 * {VIEWPORT[0]}) <= 2",
-            timeout=30_000,
+            f"() => Math.abs(window.__viserMutable.canvas.width - 0.6 * {VIEWPORT[0]}) <= 2", timeout=30_000
         )
         stamp = camera.update_timestamp
         page.evaluate("() => window.__viserMutable.sendCamera()")

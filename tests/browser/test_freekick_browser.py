@@ -142,10 +142,7 @@ def test_ten_percent_more_spin_moves_the_path_on_the_screen(shown: ScenePage) ->
 def test_every_camera_view_keeps_the_kick_in_view(shown: ScenePage) -> None:
     scene = shown.scene
     views: list[ViewName] = list(VIEW_LABELS)
-    order: list[ViewName] = [
-        *views[1:],
-        views[0],
-    ]  # the opening view last: choosing it again changes nothing
+    order: list[ViewName] = [*views[1:], views[0]]  # the opening view last: choosing it again changes nothing
     for view in order:
         frames = scene.framing.frames
         scene.controls["view"].value = VIEW_LABELS[view]  # type: ignore[index]

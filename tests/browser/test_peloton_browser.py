@@ -81,12 +81,7 @@ def _look_at_the_line(shown: ScenePage) -> None:
         n = scene.params.n_riders
     xy = assert_in_view(shown, "/peloton", points, f"the line of {n} riders, bars and labels")
     assert_seen(
-        shown,
-        with_labels_hidden(shown.page),
-        RIDERS + BARS,
-        xy,
-        f"{n} riders and their bars",
-        without_labels=True,
+        shown, with_labels_hidden(shown.page), RIDERS + BARS, xy, f"{n} riders and their bars", without_labels=True
     )
     # Every label (drawn at its anchor, extending right and up) lies inside the page and left of the panel, and
     # there is dark text there.

@@ -70,13 +70,7 @@ def reference_at_x(
 
     crossing.terminal = True  # type: ignore[attr-defined]
     solution = solve_ivp(
-        rhs,
-        (0.0, 5.0),
-        np.concatenate((START, velocity)),
-        method=method,
-        rtol=rtol,
-        atol=atol,
-        events=crossing,
+        rhs, (0.0, 5.0), np.concatenate((START, velocity)), method=method, rtol=rtol, atol=atol, events=crossing
     )
     assert solution.status == 1, "the reference flight must reach the line"
     return solution.y_events[0][0][:3]

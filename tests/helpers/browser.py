@@ -858,11 +858,7 @@ class NumberChange:
 
 
 def assert_chart_fits_after(
-    shown: ScenePage,
-    title: str,
-    changes: Sequence[NumberChange],
-    chart_data: Any,
-    check: Any,
+    shown: ScenePage, title: str, changes: Sequence[NumberChange], chart_data: Any, check: Any
 ) -> None:
     """Assert chart ``title``'s tick labels stay inside its canvas, before and after the ``changes`` are typed in,
     and that the redrawn chart shows all of its new data; then type the old values back.

@@ -41,10 +41,7 @@ BAD_FILES = {
     "no elevation": (gpx_text([(45.0 + i * 1e-4, 6.0, None) for i in range(5)]), "no elevation"),
     "some elevation missing": (gpx_text([(45.0, 6.0, 1.0), (45.001, 6.0, None), (45.002, 6.0, 3.0)]), "1 of 3"),
     "nan latitude": (gpx_text([(45.0, 6.0, 1.0), (float("nan"), 6.0, 2.0)]), "point 2's latitude is not a number"),
-    "inf elevation": (
-        gpx_text([(45.0, 6.0, 1.0), (45.001, 6.0, float("inf"))]),
-        "point 2's elevation is infinite",
-    ),
+    "inf elevation": (gpx_text([(45.0, 6.0, 1.0), (45.001, 6.0, float("inf"))]), "point 2's elevation is infinite"),
     "latitude out of range": (gpx_text([(45.0, 6.0, 1.0), (95.0, 6.0, 2.0)]), "latitude"),
     "bad number": (
         gpx_text([(45.0, 6.0, 1.0)]).replace('lat="45.0"', 'lat="abc"'),

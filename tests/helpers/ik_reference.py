@@ -36,11 +36,7 @@ def limit(v: Array, axis: Array, phi: float | None) -> Array:
 
 
 def fabrik(
-    joints: Array,
-    target: Array,
-    iterations: int,
-    phi: float | None = None,
-    root_direction: Array | None = None,
+    joints: Array, target: Array, iterations: int, phi: float | None = None, root_direction: Array | None = None
 ) -> list[Array]:
     """Poses after each of ``iterations`` FABRIK iterations (Aristidou & Lasenby 2011, Algorithm 1)."""
     p = np.array(joints, dtype=np.float64)
@@ -131,8 +127,7 @@ def dls(joints: Array, target: Array, iterations: int) -> list[Array]:
             angles = np.cumsum(step)
             c, s = np.cos(angles), np.sin(angles)
             segments = np.stack(
-                [c * segments[:, 0] - s * segments[:, 1], s * segments[:, 0] + c * segments[:, 1]],
-                axis=1,
+                [c * segments[:, 0] - s * segments[:, 1], s * segments[:, 0] + c * segments[:, 1]], axis=1
             )
         else:
             turn = np.eye(3)

@@ -14,11 +14,7 @@ def upload(client: BrowserClient, label: str, filename: str, data: bytes, part: 
     source, transfer = start_upload(client, label, filename, len(data), len(parts))
     for index, content in enumerate(parts):
         client.send(
-            "FileTransferPart",
-            source_component_uuid=source,
-            transfer_uuid=transfer,
-            part_index=index,
-            content=content,
+            "FileTransferPart", source_component_uuid=source, transfer_uuid=transfer, part_index=index, content=content
         )
     return transfer
 

@@ -52,11 +52,7 @@ def store_value(handle: object, value: object) -> None:
 def control_state(handle: object) -> dict[str, object]:
     """What a browser must not be able to change about a control: its props, callbacks and liveness."""
     impl = handle._impl  # type: ignore[attr-defined]
-    return {
-        "props": repr(impl.props),
-        "callbacks": len(impl.update_cb),
-        "removed": impl.removed,
-    }
+    return {"props": repr(impl.props), "callbacks": len(impl.update_cb), "removed": impl.removed}
 
 
 def dropdowns(server: viser.ViserServer) -> dict[str, tuple[str, ...]]:

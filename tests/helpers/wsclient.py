@@ -64,9 +64,7 @@ class BrowserClient:
 
     def __init__(self, port: int, host: str = "127.0.0.1", *, send_camera: bool = True) -> None:
         self._ws: ClientConnection = connect(
-            f"ws://{host}:{port}",
-            subprotocols=[Subprotocol(VISER_SUBPROTOCOL)],
-            max_size=None,
+            f"ws://{host}:{port}", subprotocols=[Subprotocol(VISER_SUBPROTOCOL)], max_size=None
         )
         self._lock = threading.Condition()
         self.gui: dict[str, dict[str, Any]] = {}
@@ -304,11 +302,7 @@ class BrowserClient:
         )
 
     def drag_transform(
-        self,
-        name: str,
-        positions: Iterable[Any],
-        wxyz: Any = (1.0, 0.0, 0.0, 0.0),
-        period_s: float = 0.0,
+        self, name: str, positions: Iterable[Any], wxyz: Any = (1.0, 0.0, 0.0, 0.0), period_s: float = 0.0
     ) -> None:
         """Drag the transform-controls gizmo ``name`` through ``positions`` (parent frame), as a mouse drag does."""
         owner = str(self.wait_for_node(name).get("owner", "") or "")
@@ -317,24 +311,12 @@ class BrowserClient:
             with self._lock:  # the browser shows the gizmo where the mouse put it, as the real one does
                 self.nodes[name]["position"] = position
                 self.nodes[name]["wxyz"] = wxyz
-            self.send(
-                "TransformControlsUpdateMessage",
-                name=name,
-                wxyz=wxyz,
-                position=position,
-                owner=owner,
-            )
+            self.send("TransformControlsUpdateMessage", name=name, wxyz=wxyz, position=position, owner=owner)
             if period_s:
                 time.sleep(period_s)
         self.send("TransformControlsDragEndMessage", name=name, owner=owner)
 
-    def drag_transform_step(
-        self,
-        name: str,
-        position: Any,
-        owner: str,
-        wxyz: Any = (1.0, 0.0, 0.0, 0.0),
-    ) -> None:
+    def drag_transform_step(self, name: str, position: Any, owner: str, wxyz: Any = (1.0, 0.0, 0.0, 0.0)) -> None:
         """One move of a drag already started (``TransformControlsDragStartMessage``), as a mouse move sends."""
         with self._lock:
             self.nodes[name]["position"] = position

@@ -95,13 +95,7 @@ def test_constant_lift_and_drag_without_gravity_fly_a_circle() -> None:
     radius = 2 * M / (RHO * AREA * 0.25)
     assert radius == pytest.approx(73.9, abs=0.1)  # physics notes
     flight = ball.simulate(
-        START,
-        (30.0, 0.0, 0.0),
-        ball.spin_vector(8.0, (0, 0, 1)),
-        dt=2e-3,
-        method="rk4",
-        gravity=0.0,
-        t_max=4.0,
+        START, (30.0, 0.0, 0.0), ball.spin_vector(8.0, (0, 0, 1)), dt=2e-3, method="rk4", gravity=0.0, t_max=4.0
     )
     centre = START + np.array([0.0, radius, 0.0])  # spin +z curls a +x kick to the left
     np.testing.assert_allclose(np.linalg.norm(flight.position - centre, axis=1), radius, rtol=1e-9)
@@ -280,36 +274,17 @@ def test_knuckle_force_needs_near_zero_spin() -> None:
 # ------------------------------------------------------------------------------------------------ batch
 @pytest.mark.parametrize(
     ("method", "dt", "model"),
-    [
-        ("rk4", 1e-2, "constant"),
-        ("euler", 1e-3, "measured"),
-        ("rk4", 5e-3, "measured"),
-        ("euler", 1e-3, "constant"),
-    ],
+    [("rk4", 1e-2, "constant"), ("euler", 1e-3, "measured"), ("rk4", 5e-3, "measured"), ("euler", 1e-3, "constant")],
 )
 def test_batch_equals_single_runs(method: ball.Method, dt: float, model: ball.Model) -> None:
     velocities = np.array([kick(25, 16, -9), kick(30, 30, 0), kick(12, 20, 0), kick(25, 12, 0), kick(20, 8, 2)])
     spins = np.array(
-        [
-            ball.spin_vector(8, (0, 0, 1)),
-            np.zeros(3),
-            ball.spin_vector(5, (0, 1, 0)),
-            np.zeros(3),
-            np.zeros(3),
-        ]
+        [ball.spin_vector(8, (0, 0, 1)), np.zeros(3), ball.spin_vector(5, (0, 1, 0)), np.zeros(3), np.zeros(3)]
     )
     positions = np.tile(START, (len(velocities), 1))
     seeds = [None, None, None, 3, None]
     batch = ball.simulate_batch(
-        positions,
-        velocities,
-        spins,
-        knuckle_seeds=seeds,
-        dt=dt,
-        method=method,
-        model=model,
-        ground_m=R,
-        x_stop=26.0,
+        positions, velocities, spins, knuckle_seeds=seeds, dt=dt, method=method, model=model, ground_m=R, x_stop=26.0
     )
     judged = ball.outcome_batch(batch, WALL, GOAL)
     results = set()
@@ -363,11 +338,7 @@ def test_batch_equals_single_runs(method: ball.Method, dt: float, model: ball.Mo
     ],
 )
 def test_invalid_input_raises_naming_the_argument(kwargs: dict[str, object], name: str) -> None:
-    arguments: dict[str, object] = {
-        "position": START,
-        "velocity": kick(25, 15),
-        "spin": (0.0, 0.0, 50.0),
-    }
+    arguments: dict[str, object] = {"position": START, "velocity": kick(25, 15), "spin": (0.0, 0.0, 50.0)}
     arguments.update(kwargs)
     with pytest.raises(ValueError, match=name):
         ball.simulate(**arguments)  # type: ignore[arg-type]
@@ -603,12 +574,7 @@ def reference_outcome(flight: ball.Trajectory, wall: ball.Panel, goal: ball.Pane
                 h = flight.t[i + 1] - flight.t[i]
                 s = hermite_root(d[i], dd[i], d[i + 1], dd[i + 1], h)
                 point = hermite(
-                    flight.position[i],
-                    flight.velocity[i],
-                    flight.position[i + 1],
-                    flight.velocity[i + 1],
-                    h,
-                    s,
+                    flight.position[i], flight.velocity[i], flight.position[i + 1], flight.velocity[i + 1], h, s
                 )
                 break
         lateral = None if point is None else float((point - centre) @ [-normal[1], normal[0], 0.0])
@@ -617,27 +583,16 @@ def reference_outcome(flight: ball.Trajectory, wall: ball.Panel, goal: ball.Pane
     margins = [math.inf]
     if wall_point is not None:
         assert wall_lateral is not None
-        margins += [
-            abs(abs(wall_lateral) - (wall.width_m / 2 + radius)),
-            abs(wall_point[2] - (wall.height_m + radius)),
-        ]
+        margins += [abs(abs(wall_lateral) - (wall.width_m / 2 + radius)), abs(wall_point[2] - (wall.height_m + radius))]
         if abs(wall_lateral) <= wall.width_m / 2 + radius and wall_point[2] <= wall.height_m + radius:
             return "wall", wall_point, goal_point, min(margins)
     if goal_point is None:
         return "short", wall_point, goal_point, min(margins)
     assert goal_lateral is not None
-    margins += [
-        abs(abs(goal_lateral) - (goal.width_m / 2 - radius)),
-        abs(goal_point[2] - (goal.height_m - radius)),
-    ]
+    margins += [abs(abs(goal_lateral) - (goal.width_m / 2 - radius)), abs(goal_point[2] - (goal.height_m - radius))]
     if abs(goal_lateral) > goal.width_m / 2 - radius:
         return "wide", wall_point, goal_point, min(margins)
-    return (
-        ("goal" if goal_point[2] <= goal.height_m - radius else "over"),
-        wall_point,
-        goal_point,
-        min(margins),
-    )
+    return (("goal" if goal_point[2] <= goal.height_m - radius else "over"), wall_point, goal_point, min(margins))
 
 
 @given(kick_settings_=kick_settings, wall_height=st.floats(1.0, 2.4), wall_offset=st.floats(-2.0, 2.0))
@@ -717,10 +672,7 @@ def test_a_sample_exactly_on_the_plane_is_the_crossing() -> None:
     assert judged.goal_point.tolist() == [0.0, 0.3, 1.0]
 
 
-@given(
-    kicks=st.lists(kick_settings, min_size=0, max_size=6),
-    method=st.sampled_from(["euler", "rk4"]),
-)
+@given(kicks=st.lists(kick_settings, min_size=0, max_size=6), method=st.sampled_from(["euler", "rk4"]))
 @settings(max_examples=examples(15), deadline=None)
 def test_simulate_outcomes_equals_outcome_batch_of_simulate_batch(kicks: list[dict], method: str) -> None:
     pairs = [kick_of(k) for k in kicks]
@@ -728,13 +680,7 @@ def test_simulate_outcomes_equals_outcome_batch_of_simulate_batch(kicks: list[di
     spins = np.array([p[1] for p in pairs]).reshape(-1, 3)
     positions = np.tile(START, (len(pairs), 1))
     seeds = [k["seed"] for k in kicks]
-    options = {
-        "dt": 1e-2 if method == "rk4" else 2e-3,
-        "method": method,
-        "t_max": 3.0,
-        "x_stop": 26.0,
-        "ground_m": R,
-    }
+    options = {"dt": 1e-2 if method == "rk4" else 2e-3, "method": method, "t_max": 3.0, "x_stop": 26.0, "ground_m": R}
     batch = ball.simulate_batch(positions, velocities, spins, knuckle_seeds=seeds, **options)  # type: ignore[arg-type]
     assert batch.t.shape == (len(pairs), max([1, *batch.n_samples.tolist()]))
     judged = ball.outcome_batch(batch, WALL, GOAL)
@@ -747,9 +693,7 @@ def test_simulate_outcomes_equals_outcome_batch_of_simulate_batch(kicks: list[di
         assert fused.result[i] == ball.outcome(single, WALL, GOAL).result
 
 
-def test_a_batch_too_large_to_reserve_counts_first_and_stores_the_same(
-    monkeypatch: pytest.MonkeyPatch,
-) -> None:
+def test_a_batch_too_large_to_reserve_counts_first_and_stores_the_same(monkeypatch: pytest.MonkeyPatch) -> None:
     velocities = np.array([kick(25, 16, -9), kick(30, 30, 0), kick(12, 20, 0)])
     spins = np.array([ball.spin_vector(8, (0, 0, 1)), np.zeros(3), ball.spin_vector(5, (0, 1, 0))])
     positions = np.tile(START, (3, 1))
@@ -777,10 +721,7 @@ def test_threads_judging_at_once_get_the_results_of_one_at_a_time() -> None:
     alone = ball.simulate_outcomes(positions, velocities, spins, WALL, GOAL, **options)  # type: ignore[arg-type]
     with ThreadPoolExecutor(4) as pool:
         runs = list(
-            pool.map(
-                lambda _: ball.simulate_outcomes(positions, velocities, spins, WALL, GOAL, **options),
-                range(8),
-            )
+            pool.map(lambda _: ball.simulate_outcomes(positions, velocities, spins, WALL, GOAL, **options), range(8))
         )  # type: ignore[arg-type]
     for run in runs:
         np.testing.assert_array_equal(run.result, alone.result)
@@ -792,13 +733,7 @@ def test_a_ball_dropped_from_rest_falls_straight_down_in_every_mode() -> None:
     for model in ("constant", "measured"):
         for seed in (None, 5):
             flight = ball.simulate(
-                (1.0, 2.0, 3.0),
-                (0, 0, 0),
-                (0, 0, 0),
-                dt=1e-2,
-                method="rk4",
-                model=model,
-                knuckle_seed=seed,
+                (1.0, 2.0, 3.0), (0, 0, 0), (0, 0, 0), dt=1e-2, method="rk4", model=model, knuckle_seed=seed
             )  # type: ignore[arg-type]
             assert flight.ended == "ground"
             np.testing.assert_array_equal(flight.position[:, :2], np.tile([1.0, 2.0], (len(flight.t), 1)))
@@ -806,10 +741,7 @@ def test_a_ball_dropped_from_rest_falls_straight_down_in_every_mode() -> None:
             assert math.sqrt(2 * 3.0 / G) < flight.t[-1] < math.sqrt(2 * 3.0 / G) + 0.02
 
 
-@given(
-    exponent=st.integers(-300, 300),
-    axis=st.tuples(st.floats(-1, 1), st.floats(-1, 1), st.floats(0.1, 1)),
-)
+@given(exponent=st.integers(-300, 300), axis=st.tuples(st.floats(-1, 1), st.floats(-1, 1), st.floats(0.1, 1)))
 @settings(max_examples=examples(30), deadline=None)
 def test_the_constant_model_curls_by_the_spin_axis_for_any_rate(exponent: int, axis: tuple) -> None:
     # Constant C_L: the Magnus force is ½ρA·C_L·|v|·(ω̂ × v), whatever |ω|, from 1e-300 to 1e300 rad/s.
@@ -834,13 +766,7 @@ def test_the_constant_model_curls_by_the_spin_axis_for_any_rate(exponent: int, a
 def test_huge_parameters_give_a_finite_flight_or_an_error_naming_dt(
     air_density: float, mass: float, dt: float, speed: float, method: str
 ) -> None:
-    arguments = {
-        "dt": dt,
-        "method": method,
-        "air_density": air_density,
-        "mass_kg": mass,
-        "t_max": 4.0,
-    }
+    arguments = {"dt": dt, "method": method, "air_density": air_density, "mass_kg": mass, "t_max": 4.0}
     velocity = (speed, 0.0, speed)
     spin = (0.0, 0.0, 50.0)
     try:
@@ -1007,14 +933,7 @@ def test_a_kick_in_a_vacuum_lands_on_the_parabola_for_any_step(
     # is the analytic one whatever the step: a family test of the crossing finder (rises, peaks, tangent starts).
     start = (0.0, 0.0, ground + z0)
     flight = ball.simulate(
-        start,
-        (vx, 0.0, vz),
-        (0, 0, 0),
-        air_density=0.0,
-        method="rk4",
-        dt=dt,
-        ground_m=ground,
-        t_max=20.0,
+        start, (vx, 0.0, vz), (0, 0, 0), air_density=0.0, method="rk4", dt=dt, ground_m=ground, t_max=20.0
     )
     expected = vacuum_landing_time(ground + z0, vz, ground)
     if z0 == 0.0 and vz <= 0.0:
@@ -1042,9 +961,7 @@ def test_the_crossing_is_the_first_root_of_the_step_cubic(
     s = from_python(crossing_fraction)(d0, dd0, d1, dd1, h)
     assert 0.0 <= s <= 1.0
 
-    def cubic(
-        u: NDArray[np.float64],
-    ) -> NDArray[np.float64]:  # written out independently, power basis
+    def cubic(u: NDArray[np.float64]) -> NDArray[np.float64]:  # written out independently, power basis
         m0, m1 = h * dd0, h * dd1
         a, b = 2 * d0 + m0 - 2 * d1 + m1, -3 * d0 - 2 * m0 + 3 * d1 - m1
         return ((a * u + b) * u + m0) * u + d0
@@ -1133,13 +1050,7 @@ def test_the_last_sample_is_exactly_t_max_for_any_step(dt: float, t_max: float) 
     if t_max / dt > 1e5:
         return
     flight = ball.simulate(
-        (0.0, 0.0, 1e6),
-        (3.0, 0.0, 0.0),
-        (0, 0, 0),
-        air_density=0.0,
-        method="rk4",
-        dt=dt,
-        t_max=t_max,
+        (0.0, 0.0, 1e6), (3.0, 0.0, 0.0), (0, 0, 0), air_density=0.0, method="rk4", dt=dt, t_max=t_max
     )
     assert flight.ended == "t_max" and flight.t[-1] == t_max
     assert np.all(np.diff(flight.t) > 0.0) and np.all(np.diff(flight.t) <= dt * (1 + 1e-9))
@@ -1180,10 +1091,7 @@ def test_more_bad_input_raises_naming_the_argument() -> None:
     assert ball.simulate(START, kick(5, 15), ball.spin_vector(100, (0, 0, 1)), model="measured").ended == "ground"
 
 
-@given(
-    exponent=st.integers(-300, 300),
-    axis=st.sampled_from([(1, 1, 0), (1, 0, 0), (0, -3, 4), (1, 1, 1)]),
-)
+@given(exponent=st.integers(-300, 300), axis=st.sampled_from([(1, 1, 0), (1, 0, 0), (0, -3, 4), (1, 1, 1)]))
 @settings(max_examples=examples(60), deadline=None)
 def test_spin_vector_normalises_any_scale_of_axis(exponent: int, axis: tuple[int, int, int]) -> None:
     # Kind: the axis's squares overflowed (1e300) or underflowed (3e-200) before the division.
@@ -1202,15 +1110,7 @@ def test_a_flight_config_is_checked_once_and_flies_as_its_keywords() -> None:
     velocity, spin = (25.0, 1.0, 6.0), (0.0, 0.0, 40.0)
     by_config = ball.simulate(START, velocity, spin, config)
     by_keywords = ball.simulate(
-        START,
-        velocity,
-        spin,
-        dt=1e-2,
-        method="rk4",
-        model="measured",
-        t_max=3.0,
-        x_stop=20.0,
-        ground_m=R,
+        START, velocity, spin, dt=1e-2, method="rk4", model="measured", t_max=3.0, x_stop=20.0, ground_m=R
     )
     np.testing.assert_array_equal(by_config.position, by_keywords.position)
     np.testing.assert_array_equal(by_config.drag, by_keywords.drag)

@@ -75,8 +75,7 @@ def _stability_limit(density: float, velocity: np.ndarray, height: float, method
 
 # --------------------------------------------------------------------------------------------- the public inputs
 @pytest.mark.parametrize(
-    ("density", "velocity", "dt"),
-    [(1000.0, (10.0, 0.0, 2.0), 0.01), (100.0, (25.0, 0.0, 5.0), 0.05)],
+    ("density", "velocity", "dt"), [(1000.0, (10.0, 0.0, 2.0), 0.01), (100.0, (25.0, 0.0, 5.0), 0.05)]
 )
 def test_the_reported_long_euler_steps_are_refused_with_their_limit(
     density: float, velocity: tuple[float, float, float], dt: float
@@ -101,11 +100,7 @@ def test_rk4_allows_its_longer_stability_interval() -> None:
 
 
 def test_batches_refuse_the_same_kick_the_single_call_refuses() -> None:
-    positions, velocities, spins = (
-        [[0.0, 0.0, 1.0]] * 2,
-        [[5.0, 0.0, 1.0], [25.0, 0.0, 5.0]],
-        [[0.0, 0.0, 0.0]] * 2,
-    )
+    positions, velocities, spins = ([[0.0, 0.0, 1.0]] * 2, [[5.0, 0.0, 1.0], [25.0, 0.0, 5.0]], [[0.0, 0.0, 0.0]] * 2)
     with pytest.raises(ValueError, match=r"^dt = 0.05 s is too long for this drag of kicks \[1\]"):
         ball.simulate_batch(positions, velocities, spins, air_density=100.0, dt=0.05)
     wall, goal = ball.free_kick_panels((0.0, 0.0), (20.0, 0.0), (1.0, 0.0))

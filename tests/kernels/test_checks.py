@@ -16,10 +16,7 @@ from kernels import _checks
 from tests.helpers.properties import examples
 
 
-@pytest.mark.parametrize(
-    "value",
-    [np.array(["rk4", "euler"]), None, 3, "RK4", b"rk4", ["rk4"], math.nan],
-)
+@pytest.mark.parametrize("value", [np.array(["rk4", "euler"]), None, 3, "RK4", b"rk4", ["rk4"], math.nan])
 def test_a_choice_refuses_what_is_not_one_of_its_strings_naming_it(value: object) -> None:
     # An array compared with `in` raised numpy's "truth value of an array is ambiguous", naming nothing.
     with pytest.raises(ValueError, match=r"^method must be one of 'euler', 'rk4', got "):

@@ -398,11 +398,7 @@ def test_martin_terms_cost_time_against_the_seed_model() -> None:
 
 # ------------------------------------------------------------------------------------------------ inverse, pacing
 @settings(max_examples=examples(20), deadline=None)
-@given(
-    power=st.floats(40.0, 900.0),
-    wind=st.floats(-8.0, 8.0),
-    model=st.sampled_from(["textbook", "martin"]),
-)
+@given(power=st.floats(40.0, 900.0), wind=st.floats(-8.0, 8.0), model=st.sampled_from(["textbook", "martin"]))
 def test_power_for_time_inverts_ride(power: float, wind: float, model: str) -> None:
     c = loop_course(600)
     rider = TEXTBOOK if model == "textbook" else MARTIN
@@ -753,9 +749,7 @@ def test_more_than_200_000_points_is_refused() -> None:
         course.load_gpx(text)
     with pytest.raises(ValueError, match="200000"):
         course.course_from_xy(
-            np.arange(course.MAX_POINTS + 1.0),
-            np.zeros(course.MAX_POINTS + 1),
-            np.zeros(course.MAX_POINTS + 1),
+            np.arange(course.MAX_POINTS + 1.0), np.zeros(course.MAX_POINTS + 1), np.zeros(course.MAX_POINTS + 1)
         )
 
 
@@ -781,14 +775,7 @@ def test_arbitrary_bytes_never_escape_as_anything_but_value_error(data: bytes) -
     model=st.sampled_from(["textbook", "martin"]),
 )
 def test_any_course_balances_its_books_and_more_power_is_faster(
-    grades: list[float],
-    step: float,
-    power: float,
-    wind: float,
-    wind_from: float,
-    cap: float,
-    start: float,
-    model: str,
+    grades: list[float], step: float, power: float, wind: float, wind_from: float, cap: float, start: float, model: str
 ) -> None:
     """The family of integration faults (stalls, overshoot past the cap, energy leaks, NaN): any profile of
     short or long segments, steep both ways, any wind, any cap, any entry speed."""
@@ -831,11 +818,7 @@ def test_a_vertical_profile_is_refused_before_smoothing_hides_it() -> None:
 
 
 @settings(max_examples=examples(40), deadline=None)
-@given(
-    grade=st.floats(0.0, 3.0),
-    spacing=st.sampled_from([0.01, 1.0, 11.12, 100.0]),
-    n=st.integers(2, 60),
-)
+@given(grade=st.floats(0.0, 3.0), spacing=st.sampled_from([0.01, 1.0, 11.12, 100.0]), n=st.integers(2, 60))
 def test_grades_are_refused_exactly_beyond_the_bound(grade: float, spacing: float, n: int) -> None:
     """A steady slope of any length and point spacing: accepted up to 50 %, refused beyond (values on the bound
     are accepted). The steepest-stretch check is exact on a straight slope."""
@@ -982,9 +965,7 @@ def prefixed(n: int) -> bytes:
     ).encode()
 
 
-def test_a_namespace_prefixed_gpx_is_read_and_counted_before_parsing(
-    monkeypatch: pytest.MonkeyPatch,
-) -> None:
+def test_a_namespace_prefixed_gpx_is_read_and_counted_before_parsing(monkeypatch: pytest.MonkeyPatch) -> None:
     c = course.load_gpx(prefixed(20))
     assert c.n_points == 20 and c.name == "prefixed"
     monkeypatch.setattr(gpx, "MAX_POINTS", 10)
@@ -1035,11 +1016,7 @@ def test_bad_file_messages_name_no_kernel_arguments(kind: str) -> None:
 
 # Kind: the drawing projection keeps every route's true shape (north_pole.gpx drew a 3.5 km "U").
 @settings(max_examples=examples(40), deadline=None)
-@given(
-    lat=st.floats(-90.0, 90.0),
-    lon=st.floats(-180.0, 180.0),
-    bearing=st.floats(0.0, 360.0),
-)
+@given(lat=st.floats(-90.0, 90.0), lon=st.floats(-180.0, 180.0), bearing=st.floats(0.0, 360.0))
 def test_a_straight_route_is_drawn_straight_anywhere(lat: float, lon: float, bearing: float) -> None:
     """A 2 km great-circle route from any start in any direction (over a pole, across the antimeridian): the
     drawn line is straight and its drawn length is the ground distance."""

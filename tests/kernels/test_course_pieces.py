@@ -104,10 +104,7 @@ LAYOUTS = ("tracks", "segments", "routes", "mixed")
 
 
 @settings(max_examples=examples(EXAMPLES), deadline=None)
-@given(
-    pieces=piece_sets(),
-    mix=st.lists(st.sampled_from(["trk", "seg", "rte", "note", "empty"]), max_size=40),
-)
+@given(pieces=piece_sets(), mix=st.lists(st.sampled_from(["trk", "seg", "rte", "note", "empty"]), max_size=40))
 def test_every_arrangement_of_the_pieces_gets_the_same_verdict(pieces: list[Piece], mix: list[str]) -> None:
     """Tracks, segments of one track, routes, or a random mix: the same course when the pieces follow on, the same
     refusal (which pieces, how far apart) when two consecutive ones are more than 2 km apart."""
@@ -140,14 +137,8 @@ def test_every_arrangement_of_the_pieces_gets_the_same_verdict(pieces: list[Piec
         k, gap = verdict
         found = re.search(rf"segment {k} starts ([\d ]+\.\d+) km from where segment {k - 1} ends", message)
         assert found is not None, (layout, message)
-        assert float(found.group(1).replace(" ", "")) == pytest.approx(gap / 1000.0, abs=0.051), (
-            layout,
-            message,
-        )
-        assert f"segment {k - 1} is " in message and f"segment {k} is " in message, (
-            layout,
-            message,
-        )
+        assert float(found.group(1).replace(" ", "")) == pytest.approx(gap / 1000.0, abs=0.051), (layout, message)
+        assert f"segment {k - 1} is " in message and f"segment {k} is " in message, (layout, message)
 
 
 def two_routes(second: Point) -> str:

@@ -28,10 +28,7 @@ def test_air_density_matches_the_seed_formula_and_its_21_percent_claim() -> None
     assert 1 - rho_2000 / 1.225 == pytest.approx(0.21, abs=0.005)  # the seed's "about 21 % thinner"
 
 
-@pytest.mark.parametrize(
-    ("gap_m", "reduction"),
-    [(0.0, 0.270), (2.0, 0.153), (5.0, 0.065), (10.0, 0.016)],
-)
+@pytest.mark.parametrize(("gap_m", "reduction"), [(0.0, 0.270), (2.0, 0.153), (5.0, 0.065), (10.0, 0.016)])
 def test_seed_draft_factor_gives_what_its_formula_gives(gap_m: float, reduction: float) -> None:
     # Not the seed's prose (35 %, 10 %, 4 %): the notes show the formula gives these.
     assert 1 - float(cycling.draft_factor(gap_m)) == pytest.approx(reduction, abs=6e-4)
@@ -170,14 +167,7 @@ def test_speed_for_power_known_flat_case() -> None:
 )
 @settings(max_examples=examples(200), deadline=None)
 def test_speed_for_power_round_trips_to_1e_6(
-    power_w: float,
-    cda: float,
-    mass: float,
-    crr: float,
-    grade: float,
-    altitude: float,
-    wind: float,
-    efficiency: float,
+    power_w: float, cda: float, mass: float, crr: float, grade: float, altitude: float, wind: float, efficiency: float
 ) -> None:
     args = dict(grade=grade, altitude_m=altitude, headwind_ms=wind, drivetrain_efficiency=efficiency)
     v = float(cycling.speed_for_power(power_w, cda, mass, crr, **args))
@@ -191,12 +181,7 @@ def test_speed_for_power_round_trips_to_1e_6(
     assert float(cycling.power(v * 1.001 + 1e-6, cda, mass, crr, **args).total) > power_w
 
 
-@given(
-    v=st.floats(0.5, 25.0),
-    cda=riders.cda_m2,
-    grade=st.floats(0.0, 0.2),
-    wind=st.floats(0.0, 10.0),
-)
+@given(v=st.floats(0.5, 25.0), cda=riders.cda_m2, grade=st.floats(0.0, 0.2), wind=st.floats(0.0, 10.0))
 @settings(max_examples=examples(100), deadline=None)
 def test_speed_from_power_from_speed_is_identity_where_power_is_monotone(
     v: float, cda: float, grade: float, wind: float

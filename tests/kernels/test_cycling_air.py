@@ -65,13 +65,7 @@ def mole_fraction_density(t_c: float, p_hpa: float, rh: float) -> float:
 
 @pytest.mark.parametrize(
     ("t_c", "p_hpa", "rh"),
-    [
-        (20.0, 1013.25, 0.5),
-        (30.0, 1013.25, 1.0),
-        (0.0, 1013.25, 0.8),
-        (10.0, 850.0, 0.3),
-        (40.0, 950.0, 0.9),
-    ],
+    [(20.0, 1013.25, 0.5), (30.0, 1013.25, 1.0), (0.0, 1013.25, 0.8), (10.0, 850.0, 0.3), (40.0, 950.0, 0.9)],
 )
 def test_moist_air_density_against_the_mole_fraction_form(t_c: float, p_hpa: float, rh: float) -> None:
     assert float(cycling.air_density_weather(t_c, p_hpa, rh)) == pytest.approx(

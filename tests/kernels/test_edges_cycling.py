@@ -179,11 +179,7 @@ def assert_solves_to_the_nearest_float(v: float, **args: float) -> None:
     # The total is the terms' sum over the efficiency: where terms of 10⁹ W cancel to 1 W at η = 0.01, power() itself
     # rounds by 1e-13 of 10¹¹ W, and the root lies within two ulps of v of that (once these were a max, not a sum).
     rounding = 1e-13 * scale / float(args.get("drivetrain_efficiency", 1.0))
-    assert miss[1] <= max(1e-9 * target, 1e-9, rounding + 2.0 * per_ulp), (
-        v,
-        parts.total[1],
-        target,
-    )
+    assert miss[1] <= max(1e-9 * target, 1e-9, rounding + 2.0 * per_ulp), (v, parts.total[1], target)
     # (The speed is the root to a few ulps; the nearest float is not promised: near v the float power() rounds
     # by about an ulp of v itself.)
 

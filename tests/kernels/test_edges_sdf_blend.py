@@ -24,16 +24,8 @@ TINY_WIDTHS = [0.0, 5e-324, 1e-320, 1e-310, 2.2e-308, 1e-300, 1e-45, 1e-40, 1.2e
 widths = st.one_of(st.sampled_from(TINY_WIDTHS), st.floats(0.0, 1e-3), st.floats(0.0, 1.0))
 distances = st.one_of(st.sampled_from([0.0, -0.0, 1e-30, -1e-30, 0.25, -0.25]), st.floats(-3.0, 3.0))
 
-HARD = {
-    "union": np.minimum,
-    "subtract": lambda a, b: np.maximum(a, -b),
-    "intersect": np.maximum,
-}
-SMOOTH = {
-    "union": sdf.smooth_union,
-    "subtract": sdf.smooth_subtract,
-    "intersect": sdf.smooth_intersect,
-}
+HARD = {"union": np.minimum, "subtract": lambda a, b: np.maximum(a, -b), "intersect": np.maximum}
+SMOOTH = {"union": sdf.smooth_union, "subtract": sdf.smooth_subtract, "intersect": sdf.smooth_intersect}
 
 
 def smooth_in_its_dtype(op: sdf.BooleanOp, x: np.ndarray, y: np.ndarray, k: float, blend: sdf.BlendForm) -> np.ndarray:
@@ -162,10 +154,7 @@ def test_a_tiny_width_meshes_like_the_hard_scene(pair: tuple[sdf.Scene, sdf.Scen
 # ------------------------------------------------------------------------------------------------ public inputs
 def two_spheres(k: float, blend: sdf.BlendForm) -> sdf.Scene:
     return sdf.Scene(
-        (
-            sdf.Primitive("sphere", (-0.5, 0.0, 0.0), (0.5,)),
-            sdf.Primitive("sphere", (0.5, 0.0, 0.0), (0.5,)),
-        ),
+        (sdf.Primitive("sphere", (-0.5, 0.0, 0.0), (0.5,)), sdf.Primitive("sphere", (0.5, 0.0, 0.0), (0.5,))),
         k=k,
         blend=blend,
     )

@@ -111,10 +111,7 @@ def on_grid_box_pairs(draw: st.DrawFn, smooth: bool) -> BoxPair:
     k = draw(st.sampled_from([0.5 * h, h, 2.0 * h])) if smooth else 0.0
     blend = draw(st.sampled_from(sdf.BLEND_FORMS))
     scene = sdf.Scene(
-        (
-            box_from_indices(lo_a, hi_a, resolution, "union"),
-            box_from_indices(lo_b, hi_b, resolution, op),
-        ),
+        (box_from_indices(lo_a, hi_a, resolution, "union"), box_from_indices(lo_b, hi_b, resolution, op)),
         k=k,
         blend=blend,
     )
@@ -284,9 +281,7 @@ def one_voxel_features(draw: st.DrawFn) -> tuple[sdf.Scene, int, float]:
 
 @given(case=one_voxel_features())
 @settings(max_examples=examples(60), deadline=None)
-def test_a_feature_one_voxel_thick_on_grid_planes_meshes_closed(
-    case: tuple[sdf.Scene, int, float],
-) -> None:
+def test_a_feature_one_voxel_thick_on_grid_planes_meshes_closed(case: tuple[sdf.Scene, int, float]) -> None:
     scene, resolution, exact = case
     tri = assert_closed_solid(scene, resolution, chi=1)
     assert tri is not None  # it came out empty

@@ -70,11 +70,7 @@ def test_lengths_preserved_and_finite(chain: tuple[int, int, int], where: float,
     obstacles = [(joints[0] + random_direction(rng, d) * 0.5 * total, 0.1 * total)] if obstacle else []
     obstacles = [o for o in obstacles if np.linalg.norm(o[0] - joints[0]) > o[1]]
     result = fabrik.solve(
-        joints,
-        target,
-        cone_half_angle_rad=0.7 if limits else None,
-        obstacles=obstacles,
-        max_iterations=200,
+        joints, target, cone_half_angle_rad=0.7 if limits else None, obstacles=obstacles, max_iterations=200
     )
     assert np.all(np.isfinite(result.joints))
     assert np.all(np.isfinite(result.error_history))
@@ -243,11 +239,7 @@ def test_batch_equals_single_solves(n: int, d: int, seed: int, limits: bool) -> 
     total = fabrik.link_lengths(joints).sum(axis=1)
     targets = np.stack([random_direction(rng, d) * rng.uniform(0.0, 1.3) * t for t in total])
     obstacles = [(random_direction(rng, d) * 0.6 * total.min(), 0.1 * total.min())]
-    kwargs = {
-        "cone_half_angle_rad": 0.9 if limits else None,
-        "obstacles": obstacles,
-        "max_iterations": 40,
-    }
+    kwargs = {"cone_half_angle_rad": 0.9 if limits else None, "obstacles": obstacles, "max_iterations": 40}
     batch = fabrik.solve_batch(joints, targets, **kwargs)
     for i in range(len(joints)):
         single = fabrik.solve(joints[i], targets[i], **kwargs)
@@ -668,24 +660,12 @@ def test_two_bone_equals_fabrik_at_two_links(d: int, seed: int, where: float) ->
         (lambda: fabrik.solve([[0, 0], [0, 1]], [np.inf, 1]), "target"),
         (lambda: fabrik.solve([[0, 0], [0, 1]], [0, 1], tolerance=-1.0), "tolerance"),
         (lambda: fabrik.solve([[0, 0], [0, 1]], [0, 1], max_iterations=0), "max_iterations"),
-        (
-            lambda: fabrik.solve([[0, 0], [0, 1]], [0, 1], cone_half_angle_rad=4.0),
-            "cone_half_angle_rad",
-        ),
-        (
-            lambda: fabrik.solve([[0, 0], [0, 1]], [0, 1], obstacles=[([1, 1], -0.5)]),
-            "obstacles[0] radius",
-        ),
-        (
-            lambda: fabrik.solve([[0, 0], [0, 1]], [0, 1], obstacles=[([1, 1, 1], 0.5)]),
-            "obstacles[0] centre",
-        ),
+        (lambda: fabrik.solve([[0, 0], [0, 1]], [0, 1], cone_half_angle_rad=4.0), "cone_half_angle_rad"),
+        (lambda: fabrik.solve([[0, 0], [0, 1]], [0, 1], obstacles=[([1, 1], -0.5)]), "obstacles[0] radius"),
+        (lambda: fabrik.solve([[0, 0], [0, 1]], [0, 1], obstacles=[([1, 1, 1], 0.5)]), "obstacles[0] centre"),
         (lambda: fabrik.solve([[0, 0], [0, 1]], [0, 1], root_direction=[0, 0]), "root_direction"),
         (lambda: fabrik.solve_batch(np.zeros((2, 3, 2)), np.zeros((3, 2))), "targets"),
-        (
-            lambda: fabrik.solve_batch(np.zeros((1, 3, 2)), np.zeros((1, 2)), solver=BAD_SOLVER),
-            "solver",
-        ),
+        (lambda: fabrik.solve_batch(np.zeros((1, 3, 2)), np.zeros((1, 2)), solver=BAD_SOLVER), "solver"),
         (lambda: fabrik.ccd([[0, 0], [0, 1]], [0, 1], tolerance=np.nan), "tolerance"),
         (lambda: fabrik.jacobian_dls([[0, 0], [0, 1]], [[0, 1]]), "target"),
         (lambda: fabrik.two_bone([0, 0], -1.0, 1.0, [1, 0], [0, 1]), "upper_length"),
@@ -721,14 +701,7 @@ def test_fabrik_iterates_are_the_papers_algorithm(
     rng = np.random.default_rng(seed)
     joints = random_chain(rng, n, d, bend=1.0)
     target = reachable_target(rng, joints, where)
-    result = fabrik.solve(
-        joints,
-        target,
-        tolerance=0.0,
-        max_iterations=cap,
-        cone_half_angle_rad=phi,
-        extrapolate=False,
-    )
+    result = fabrik.solve(joints, target, tolerance=0.0, max_iterations=cap, cone_half_angle_rad=phi, extrapolate=False)
 
     def reference(start: NDArray[np.float64], goal: NDArray[np.float64]) -> list[NDArray[np.float64]]:
         return ik_reference.fabrik(start, goal, result.iterations, phi)
@@ -786,11 +759,7 @@ def test_paper_setup_reaches_in_fewer_iterations_than_table_1() -> None:
     counts = []
     for plain in (False, True):
         batch = fabrik.solve_batch(
-            np.repeat(joints[None], 40, axis=0),
-            targets,
-            tolerance=0.01,
-            max_iterations=1000,
-            extrapolate=not plain,
+            np.repeat(joints[None], 40, axis=0), targets, tolerance=0.01, max_iterations=1000, extrapolate=not plain
         )
         assert np.all(batch.status == "reached")
         counts.append(batch.iterations.mean())
@@ -1149,9 +1118,7 @@ def test_warm_up_compiles_every_core_with_a_cache() -> None:
     assert chain._solve_rows.signatures and chain._solve_one.signatures
 
 
-def test_compile_cache_falls_back_to_a_user_directory_when_the_package_is_read_only(
-    tmp_path: Path,
-) -> None:
+def test_compile_cache_falls_back_to_a_user_directory_when_the_package_is_read_only(tmp_path: Path) -> None:
     """numba's cache=True writes beside the module; where that cannot be written (a read-only site-packages),
     it uses the user-wide cache directory. A ``__pycache__`` that is a file stands in for the read-only directory
     (chmod would not stop root); the second process must load the machine code from the user cache."""
@@ -1166,11 +1133,7 @@ def test_compile_cache_falls_back_to_a_user_directory_when_the_package_is_read_o
         "assert cached_core.twice(2.0) == 4.0\n"
         "print(sum(cached_core.twice.stats.cache_hits.values()), cached_core.twice._cache._cache_path)\n"
     )
-    environment = {
-        **os.environ,
-        "PYTHONPATH": str(package),
-        "XDG_CACHE_HOME": str(tmp_path / "user-cache"),
-    }
+    environment = {**os.environ, "PYTHONPATH": str(package), "XDG_CACHE_HOME": str(tmp_path / "user-cache")}
     environment.pop("NUMBA_CACHE_DIR", None)
     runs = [python_stdout(script, timeout_s=120, env=environment).split() for _ in range(2)]
     assert runs[0][1].startswith(str(tmp_path / "user-cache" / "numba"))
@@ -1188,21 +1151,9 @@ def folded_pose(
 
 
 @PROPERTY
-@given(
-    chains,
-    st.floats(-1.0, 1.0),
-    st.floats(1e-6, 0.1),
-    st.integers(0, 3),
-    st.floats(1.05, 3.0),
-    st.booleans(),
-)
+@given(chains, st.floats(-1.0, 1.0), st.floats(1e-6, 0.1), st.integers(0, 3), st.floats(1.05, 3.0), st.booleans())
 def test_targets_within_tolerance_of_the_inner_radius_are_reached(
-    chain: tuple[int, int, int],
-    fraction: float,
-    relative_tolerance: float,
-    count: int,
-    dominance: float,
-    batched: bool,
+    chain: tuple[int, int, int], fraction: float, relative_tolerance: float, count: int, dominance: float, batched: bool
 ) -> None:
     """Targets at the inner reach, the mirror of full reach, over the whole family: where one link is longer than all
     the others together (inner radius > 0), a target at inner + δ, |δ| ≤ tolerance, in any direction, is "reached"
@@ -1246,10 +1197,7 @@ def test_inner_radius_targets_are_reached_at_once(d: int, x: float, right_error:
     joints[:, -1] = [0.0, 2.0, 2.5, 3.0]
     target = np.zeros(d)
     target[0] = x
-    for result in (
-        fabrik.solve(joints, target),
-        fabrik.solve_batch(joints[None], target[None])[0],
-    ):
+    for result in (fabrik.solve(joints, target), fabrik.solve_batch(joints[None], target[None])[0]):
         assert result.status == "reached"
         assert result.iterations == 1
         assert result.error == pytest.approx(right_error, abs=1e-15)
@@ -1285,10 +1233,7 @@ def test_solves_at_any_power_of_two_scale_are_the_unit_solve_scaled(
     assert (scaled.status, scaled.iterations) == (unit.status, unit.iterations)
     np.testing.assert_array_equal(scaled.joints, unit.joints * s)
     assert scaled.error == unit.error * s
-    for result, tolerance in (
-        (unit, relative_tolerance * outer),
-        (scaled, relative_tolerance * outer * s),
-    ):
+    for result, tolerance in ((unit, relative_tolerance * outer), (scaled, relative_tolerance * outer * s)):
         assert (result.status == "reached") == (result.error <= tolerance and result.status != "infeasible")
 
 
@@ -1509,10 +1454,7 @@ def test_targets_an_admissible_pose_reaches_are_seldom_limited() -> None:
 
 @pytest.mark.parametrize(
     ("lengths", "target", "before"),
-    [
-        ([0.2652, 0.8842, 0.889, 0.9012], [0.9685, 2.7443], 0.708),
-        ([0.6049, 0.8281, 0.436], [-0.2333, 1.8494], 0.154),
-    ],
+    [([0.2652, 0.8842, 0.889, 0.9012], [0.9685, 2.7443], 0.708), ([0.6049, 0.8281, 0.436], [-0.2333, 1.8494], 0.154)],
 )
 def test_stalled_limited_chains_restart(lengths: list[float], target: list[float], before: float) -> None:
     """F7's inputs (p9.py), φ = 0.3 rad, from straight up: "limited" at 0.708 m and 0.154 m, while an admissible
@@ -1597,11 +1539,7 @@ def test_a_target_at_the_limits_last_ulps_is_solved_never_returned_empty() -> No
     )
     target = np.array([-107811740882.1749, -836115064268.9324])
     batch = fabrik.solve_batch(joints[None], target[None])[0]
-    for result in (
-        fabrik.solve(joints, target),
-        fabrik.ccd(joints, target),
-        fabrik.jacobian_dls(joints, target),
-    ):
+    for result in (fabrik.solve(joints, target), fabrik.ccd(joints, target), fabrik.jacobian_dls(joints, target)):
         assert result.joints.shape == (4, 2) and result.status == "unreachable" == batch.status
         np.testing.assert_allclose(fabrik.link_lengths(result.joints), fabrik.link_lengths(joints), rtol=1e-9)
     assert fabrik.solve_tree([-1, 0, 1, 2], joints, {3: target}).joints.shape == (4, 2)

@@ -34,9 +34,7 @@ def planar_pose(angles: NDArray[np.float64], lengths: NDArray[np.float64]) -> ND
     return np.vstack([np.zeros(2), np.cumsum(steps, axis=0)])
 
 
-def one_sided_chain(
-    rng: np.random.Generator,
-) -> tuple[NDArray[np.float64], list[tuple[float, float]]]:
+def one_sided_chain(rng: np.random.Generator) -> tuple[NDArray[np.float64], list[tuple[float, float]]]:
     """Random lengths (m) and ranges (rad) of a 2–6 link arm: the shoulder ±90°, each other joint one-sided."""
     n = int(rng.integers(2, 7))
     lengths = rng.uniform(0.3, 2.0, n)
@@ -257,11 +255,7 @@ def test_any_rod_of_zero_range_hinges_ends_at_its_optimum(
         axis = Z
     else:
         point = radius * np.array(
-            [
-                math.cos(elevation) * math.cos(azimuth),
-                math.cos(elevation) * math.sin(azimuth),
-                math.sin(elevation),
-            ]
+            [math.cos(elevation) * math.cos(azimuth), math.cos(elevation) * math.sin(azimuth), math.sin(elevation)]
         )
         axis = (1.0, 0.0, 0.0)
     # In 3D only a local hinge makes a rod: a global one about x holds the later segments in the y-z plane.

@@ -351,17 +351,7 @@ def test_reachable_effectors_on_separate_branches_reach(branches: int, links: in
 def y_tree() -> tuple[list[int], Array]:
     """Root, a trunk of two links to a sub-base, and two arms of two links each, mirror-symmetric in x."""
     parents = [-1, 0, 1, 2, 3, 2, 5]
-    joints = np.array(
-        [
-            [0.0, 0.0],
-            [0.0, 0.5],
-            [0.0, 1.0],
-            [-0.4, 1.3],
-            [-0.8, 1.6],
-            [0.4, 1.3],
-            [0.8, 1.6],
-        ]
-    )
+    joints = np.array([[0.0, 0.0], [0.0, 0.5], [0.0, 1.0], [-0.4, 1.3], [-0.8, 1.6], [0.4, 1.3], [0.8, 1.6]])
     return parents, joints
 
 
@@ -451,14 +441,8 @@ TREE = [[0.0, 0.0], [0.0, 1.0], [-1.0, 2.0], [1.0, 2.0]]
         (lambda: fabrik.Hinge((0, 0, 1), frame="world"), "frame"),  # type: ignore[arg-type]
         (lambda: fabrik.Cone(-0.1), "half_angle_rad"),
         (lambda: fabrik.solve(CHAIN2, [1, 1], constraints=[None]), "constraints"),
-        (
-            lambda: fabrik.solve(CHAIN2, [1, 1], constraints=[None, BAD_CONSTRAINT]),
-            r"constraints\[1\]",
-        ),
-        (
-            lambda: fabrik.solve(CHAIN2, [1, 1], constraints=[fabrik.Hinge((1, 0, 0)), None]),
-            r"constraints\[0\].axis",
-        ),
+        (lambda: fabrik.solve(CHAIN2, [1, 1], constraints=[None, BAD_CONSTRAINT]), r"constraints\[1\]"),
+        (lambda: fabrik.solve(CHAIN2, [1, 1], constraints=[fabrik.Hinge((1, 0, 0)), None]), r"constraints\[0\].axis"),
         (
             lambda: fabrik.solve(CHAIN2, [1, 1], cone_half_angle_rad=0.5, constraints=[None, None]),
             "cone_half_angle_rad",
@@ -471,10 +455,7 @@ TREE = [[0.0, 0.0], [0.0, 1.0], [-1.0, 2.0], [1.0, 2.0]]
         (lambda: fabrik.solve_tree(PARENTS, TREE, {}), "targets"),
         (lambda: fabrik.solve_tree(PARENTS, TREE, {9: [0, 0]}), "targets keys"),
         (lambda: fabrik.solve_tree(PARENTS, TREE, {2: [0, np.inf]}), r"targets\[2\]"),
-        (
-            lambda: fabrik.solve_tree(PARENTS, TREE, {2: [0, 0]}, constraints=[fabrik.Cone(1)] * 4),
-            r"constraints\[0\]",
-        ),
+        (lambda: fabrik.solve_tree(PARENTS, TREE, {2: [0, 0]}, constraints=[fabrik.Cone(1)] * 4), r"constraints\[0\]"),
         (lambda: fabrik.solve_tree(PARENTS, TREE, {2: [0, 0]}, max_iterations=0), "max_iterations"),
     ],
 )
@@ -692,8 +673,7 @@ def test_a_hinged_tree_without_obstacles_is_never_infeasible(seed: int, half_ran
 
 
 @pytest.mark.parametrize(
-    ("key", "alias", "parents"),
-    [(2, 2.0, [-1, 0, 1]), (1, True, [-1, 0]), (2, np.float64(2.0), [-1, 0, 1])],
+    ("key", "alias", "parents"), [(2, 2.0, [-1, 0, 1]), (1, True, [-1, 0]), (2, np.float64(2.0), [-1, 0, 1])]
 )
 def test_keys_that_hash_as_a_cached_index_are_still_refused(key: int, alias: Any, parents: list[int]) -> None:
     """Kind: validation behind a cache. 2.0 and True hash as 2 and 1, so after a call with the integer key the

@@ -158,10 +158,7 @@ def test_in_a_crosswind_a_line_loses_its_shelter_and_an_echelon_keeps_it() -> No
     assert np.all(in_echelon[1:] < in_line[1:])
 
 
-@given(
-    layout=layouts,
-    yaw=st.floats(-1.5, 1.5),
-)
+@given(layout=layouts, yaw=st.floats(-1.5, 1.5))
 @settings(max_examples=examples(100))
 def test_a_layout_turned_into_the_wind_is_the_same_layout_in_still_air(layout: np.ndarray, yaw: float) -> None:
     # Wakes trail along the apparent wind: turning the riders with it changes nothing.

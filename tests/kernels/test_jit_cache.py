@@ -78,9 +78,7 @@ def test_the_real_kernels_are_stamped_with_their_sources() -> None:
     assert stamp.read_text().strip() == _jit_cache.source_hash(root)
 
 
-def test_without_a_writable_cache_directory_the_kernels_compile_uncached(
-    monkeypatch: pytest.MonkeyPatch,
-) -> None:
+def test_without_a_writable_cache_directory_the_kernels_compile_uncached(monkeypatch: pytest.MonkeyPatch) -> None:
     # numba refuses cache=True when neither the package's __pycache__ nor ~/.cache/numba is writable (checked by
     # hand as user nobody with a read-only HOME): the module must still import, just compiling at every start.
     from numba.core.registry import CPUDispatcher

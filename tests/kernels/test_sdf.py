@@ -29,8 +29,7 @@ def quat_about(axis: tuple[float, float, float], angle_rad: float) -> tuple[floa
 
 # ------------------------------------------------------------------------------------------ primitives
 @pytest.mark.parametrize(
-    ("p", "expected"),
-    [((2, 0, 0), 1.0), ((0, 0, 0), -1.0), ((0, 0.5, 0), -0.5), ((0, 3, 4), 4.0), ((-1, 0, 0), 0.0)],
+    ("p", "expected"), [((2, 0, 0), 1.0), ((0, 0, 0), -1.0), ((0, 0.5, 0), -0.5), ((0, 3, 4), 4.0), ((-1, 0, 0), 0.0)]
 )
 def test_sphere_exact(p: tuple[float, float, float], expected: float) -> None:
     assert sdf.sd_sphere(np.array([p], float), 1.0)[0] == pytest.approx(expected, abs=1e-12)
@@ -66,8 +65,7 @@ def test_torus_exact(p: tuple[float, float, float], expected: float) -> None:
 
 
 @pytest.mark.parametrize(
-    ("p", "expected"),
-    [((0, 0, -1), 0.5), ((1, 0, 1), 0.5), ((0, 0, 1), -0.5), ((0, 0, 3), 0.5), ((3, 4, 2), 4.5)],
+    ("p", "expected"), [((0, 0, -1), 0.5), ((1, 0, 1), 0.5), ((0, 0, 1), -0.5), ((0, 0, 3), 0.5), ((3, 4, 2), 4.5)]
 )
 def test_capsule_exact(p: tuple[float, float, float], expected: float) -> None:
     got = sdf.sd_capsule(np.array([p], float), (0, 0, 0), (0, 0, 2), 0.5)[0]
@@ -157,12 +155,7 @@ def test_hard_booleans() -> None:
 
 
 @SETTINGS
-@given(
-    a=st.floats(-3, 3),
-    b=st.floats(-3, 3),
-    k=st.floats(0.01, 1.0),
-    blend=st.sampled_from(sdf.BLEND_FORMS),
-)
+@given(a=st.floats(-3, 3), b=st.floats(-3, 3), k=st.floats(0.01, 1.0), blend=st.sampled_from(sdf.BLEND_FORMS))
 def test_smooth_booleans_bound_the_hard_ones(a: float, b: float, k: float, blend: sdf.BlendForm) -> None:
     # Both forms dip by at most k/4 (exp with sharpness 4·ln2/k: ln2/sharpness = k/4).
     dip = k / 4 + 1e-12
@@ -325,11 +318,7 @@ def test_default_scene_mesh_is_watertight_with_blended_colors() -> None:
 def test_samples_exactly_on_the_surface_are_merged() -> None:
     """Box faces on grid planes put samples exactly on the level: nudged off it, vertices distinct, watertight."""
     scene = sdf.Scene(
-        (
-            sdf.Primitive("box", (0, 0, 0), (0.5, 0.5, 0.5)),
-            sdf.Primitive("sphere", (0.5, 0.5, 0.5), (0.25,)),
-        ),
-        k=0.0,
+        (sdf.Primitive("box", (0, 0, 0), (0.5, 0.5, 0.5)), sdf.Primitive("sphere", (0.5, 0.5, 0.5), (0.25,))), k=0.0
     )
     bounds = [[-1, -1, -1], [1, 1, 1]]
     grid = sdf.make_grid(scene, 17, bounds)

@@ -37,40 +37,24 @@ DISTANCES: list[tuple[str, Callable[[np.ndarray], np.ndarray], str]] = [
     ("sd_octahedron", lambda p: sdf.sd_octahedron(p, 0.8), "sd_octahedron(p, 0.8)"),
     ("sd_cone", lambda p: sdf.sd_cone(p, 0.5, 1.1), "sd_cone(p, 0.5, 1.1)"),
     ("sd_hex_prism", lambda p: sdf.sd_hex_prism(p, 0.45, 0.7), "sd_hex_prism(p, 0.45, 0.7)"),
-    (
-        "sd_ellipsoid",
-        lambda p: sdf.sd_ellipsoid(p, (0.9, 0.5, 0.3)),
-        "sd_ellipsoid(p, vec3(0.9, 0.5, 0.3))",
-    ),
+    ("sd_ellipsoid", lambda p: sdf.sd_ellipsoid(p, (0.9, 0.5, 0.3)), "sd_ellipsoid(p, vec3(0.9, 0.5, 0.3))"),
     (
         "sd_ellipsoid_lipschitz",
         lambda p: sdf.sd_ellipsoid_lipschitz(p, (0.9, 0.5, 0.3)),
         "sd_ellipsoid_lipschitz(p, vec3(0.9, 0.5, 0.3))",
     ),
-    (
-        "sd_plane",
-        lambda p: sdf.sd_plane(p, (0.3, -0.5, 0.8), 0.2),
-        "sd_plane(p, vec3(0.3, -0.5, 0.8), 0.2)",
-    ),
+    ("sd_plane", lambda p: sdf.sd_plane(p, (0.3, -0.5, 0.8), 0.2), "sd_plane(p, vec3(0.3, -0.5, 0.8), 0.2)"),
     (
         "op_round",
         lambda p: sdf.op_round(sdf.sd_box(p, (0.5, 0.4, 0.3)), 0.1),
         "op_round(sd_box(p, vec3(0.5, 0.4, 0.3)), 0.1)",
     ),
-    (
-        "op_onion",
-        lambda p: sdf.op_onion(sdf.sd_sphere(p, 0.8), 0.05),
-        "op_onion(sd_sphere(p, 0.8), 0.05)",
-    ),
+    ("op_onion", lambda p: sdf.op_onion(sdf.sd_sphere(p, 0.8), 0.05), "op_onion(sd_sphere(p, 0.8), 0.05)"),
 ]
 
 # name, numpy point map (N, 3) -> (N, 3), the GLSL body of color(p) (a vec3, read back unclamped)
 POINT_MAPS: list[tuple[str, Callable[[np.ndarray], np.ndarray], str]] = [
-    (
-        "op_elongate",
-        lambda p: sdf.op_elongate(p, (0.3, 0.0, 0.2))[0],
-        "op_elongate(p, vec3(0.3, 0.0, 0.2)).xyz",
-    ),
+    ("op_elongate", lambda p: sdf.op_elongate(p, (0.3, 0.0, 0.2))[0], "op_elongate(p, vec3(0.3, 0.0, 0.2)).xyz"),
     (
         "op_elongate (w)",
         lambda p: np.repeat(sdf.op_elongate(p, (0.3, 0.0, 0.2))[1][:, None], 3, axis=1),
@@ -306,8 +290,7 @@ def test_finite_repetition_of_a_sphere_is_the_union_of_its_copies() -> None:
 def test_finite_repetition_rounds_halves_up_like_the_glsl() -> None:
     on_boundary = np.array([[0.25, 0.0, 0.0], [-0.25, 0.0, 0.0]])
     np.testing.assert_allclose(
-        sdf.op_repeat_finite(on_boundary, (0.5, 1.0, 1.0), (3, 0, 0)),
-        [[-0.25, 0.0, 0.0], [-0.25, 0.0, 0.0]],
+        sdf.op_repeat_finite(on_boundary, (0.5, 1.0, 1.0), (3, 0, 0)), [[-0.25, 0.0, 0.0], [-0.25, 0.0, 0.0]]
     )
 
 
@@ -319,13 +302,7 @@ def test_mirror_symmetry_is_the_shape_and_its_reflection() -> None:
     np.testing.assert_allclose(mirrored, union, atol=1e-12)
 
 
-@given(
-    h=st.floats(0.05, 2.0),
-    r=st.floats(0.05, 2.0),
-    x=st.floats(-3, 3),
-    y=st.floats(-3, 3),
-    z=st.floats(-3, 3),
-)
+@given(h=st.floats(0.05, 2.0), r=st.floats(0.05, 2.0), x=st.floats(-3, 3), y=st.floats(-3, 3), z=st.floats(-3, 3))
 def test_cylinder_against_its_closed_form_everywhere(h: float, r: float, x: float, y: float, z: float) -> None:
     rho, height = math.hypot(x, z), abs(y)
     if rho <= r and height <= h:

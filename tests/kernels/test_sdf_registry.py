@@ -74,12 +74,7 @@ def test_registry_lists_the_built_in_kinds_in_code_order() -> None:
     assert sdf.PRIMITIVE_KINDS == typing.get_args(sdf.PrimitiveKind)
     assert tuple(sdf.PRIMITIVES) == sdf.PRIMITIVE_KINDS
     assert [s.code for s in sdf.PRIMITIVES.values()] == list(range(len(sdf.PRIMITIVES)))
-    assert [s.kind for s in sdf.PRIMITIVES.values() if s.fused] == [
-        "sphere",
-        "box",
-        "torus",
-        "capsule",
-    ]
+    assert [s.kind for s in sdf.PRIMITIVES.values() if s.fused] == ["sphere", "box", "torus", "capsule"]
     for spec in sdf.PRIMITIVES.values():
         assert 1 <= spec.size_count <= 3
         assert all(unit == "m" for _, unit in spec.sizes)

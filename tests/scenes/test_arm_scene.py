@@ -14,15 +14,7 @@ from helpers.scenes import scene_fixture
 from helpers.wsclient import BrowserClient
 
 from kernels import fabrik
-from scenes.arm import (
-    MAX_LINKS,
-    TARGET_START,
-    ArmParams,
-    ArmScene,
-    rest_pose,
-    solve_arm,
-    why_short,
-)
+from scenes.arm import MAX_LINKS, TARGET_START, ArmParams, ArmScene, rest_pose, solve_arm, why_short
 
 scene = scene_fixture(ArmScene)
 
@@ -186,10 +178,7 @@ def test_dragging_the_target_gizmo_moves_the_chain_end_onto_it(server: viser.Vis
         path = [(0.9 - 0.05 * i, 0.0, 0.6 + 0.04 * i) for i in range(1, 13)]
         client.drag_transform("/arm/target", path, period_s=0.01)
         goal = np.array(path[-1])
-        client.wait_for(
-            lambda: bool(np.linalg.norm(scene.pose[-1] - goal) < 1e-3),
-            what="the chain end on the target",
-        )
+        client.wait_for(lambda: bool(np.linalg.norm(scene.pose[-1] - goal) < 1e-3), what="the chain end on the target")
         assert scene.report is not None and scene.report.result.status == "reached"
 
         def browser_shows_end_on_target() -> bool:
@@ -237,14 +226,7 @@ def test_leaving_3d_puts_every_gizmo_the_browser_moved_back_on_the_plane(
             assert np.linalg.norm(scene.pose[-1] - scene.target) <= scene.report.result.error + 1e-12
 
 
-@pytest.mark.parametrize(
-    "bad",
-    [
-        (float("nan"), 0.0, 0.5),
-        (float("inf"), 0.0, 0.5),
-        (0.3, float("nan"), 0.5),
-    ],
-)
+@pytest.mark.parametrize("bad", [(float("nan"), 0.0, 0.5), (float("inf"), 0.0, 0.5), (0.3, float("nan"), 0.5)])
 def test_crafted_gizmo_messages_keep_the_last_good_pose(
     server: viser.ViserServer, scene: ArmScene, bad: tuple[float, float, float]
 ) -> None:
@@ -341,12 +323,10 @@ def test_clicking_in_the_plane_places_the_target(server: viser.ViserServer, scen
         origin = (-0.5, -4.0, 1.0)
         client.click_scene(origin, (0.0, 1.0, 0.0))
         client.wait_for(
-            lambda: bool(np.allclose(scene.target, (-0.5, 0.0, 1.0))),
-            what="the target placed by the click",
+            lambda: bool(np.allclose(scene.target, (-0.5, 0.0, 1.0))), what="the target placed by the click"
         )
         client.wait_for(
-            lambda: bool(np.linalg.norm(scene.pose[-1] - (-0.5, 0.0, 1.0)) < 1e-3),
-            what="the chain to follow",
+            lambda: bool(np.linalg.norm(scene.pose[-1] - (-0.5, 0.0, 1.0)) < 1e-3), what="the chain to follow"
         )
         np.testing.assert_allclose(np.asarray(scene.target_gizmo.position), (-0.5, 0.0, 1.0))
 
@@ -381,10 +361,7 @@ def test_the_view_frames_what_matters_not_the_whole_reach(scene: ArmScene) -> No
     assert np.all(target + GIZMO_SCALE_M * np.array([1.0, 0.0, 1.0]) <= hi + 1e-12)
     reach = 12 * 0.5
     width, height = hi[0] - lo[0], hi[2] - lo[2]
-    assert width < reach and height < reach, (
-        width,
-        height,
-    )  # the whole reach framed 2 × 6 m by 6 m
+    assert width < reach and height < reach, (width, height)  # the whole reach framed 2 × 6 m by 6 m
 
 
 def test_moving_the_target_out_of_the_framed_box_frames_again(scene: ArmScene) -> None:

@@ -21,15 +21,11 @@ def link_lengths(skeleton: _skeletons.Skeleton, joints: np.ndarray) -> np.ndarra
 
 # ------------------------------------------------------------------------------------------------ pure
 @pytest.mark.parametrize("label", ["Robot arm", "Hand", "Upper body"])
-def test_presets_open_in_a_pose_that_keeps_their_limits_and_lengths(
-    label: _skeletons.PresetLabel,
-) -> None:
+def test_presets_open_in_a_pose_that_keeps_their_limits_and_lengths(label: _skeletons.PresetLabel) -> None:
     skeleton = _skeletons.PRESETS[label]()
     report = _skeletons.solve_skeleton(skeleton, skeleton.joints, skeleton.targets, tolerance_m=1e-3, max_iterations=50)
     np.testing.assert_allclose(
-        link_lengths(skeleton, report.result.joints),
-        link_lengths(skeleton, skeleton.joints),
-        rtol=1e-9,
+        link_lengths(skeleton, report.result.joints), link_lengths(skeleton, skeleton.joints), rtol=1e-9
     )
     assert np.all((report.usage >= 0.0) & (report.usage <= 1.0))
     # Every segment keeps its joint type: checked segment by segment with the kernel's own usage (≤ 1 + rounding)
@@ -82,8 +78,7 @@ def test_choosing_the_hand_and_dragging_a_fingertip_target_curls_the_finger(
         client.drag_transform(f"/arm/skeleton/target_{index}", path, period_s=0.01)
         effector = _skeletons.hand().effectors[index]
         client.wait_for(
-            lambda: bool(np.linalg.norm(view.pose[effector] - goal) < 1e-3),
-            what="the index fingertip on its target",
+            lambda: bool(np.linalg.norm(view.pose[effector] - goal) < 1e-3), what="the index fingertip on its target"
         )
         report = view.report
         assert report is not None and report.result.status[index] == "reached"

@@ -116,11 +116,7 @@ def test_subnormal_x_gets_a_label_width_and_uplot_s_own_ticks(x: list[float], wi
 
 
 @given(
-    values=st.lists(
-        st.one_of(st.just(0.0), st.floats(1e-300, 1e300)),
-        min_size=1,
-        max_size=30,
-    ),
+    values=st.lists(st.one_of(st.just(0.0), st.floats(1e-300, 1e300)), min_size=1, max_size=30),
     floor_exponent=st.integers(-12, -1),
 )
 @settings(max_examples=examples(300), deadline=None)

@@ -63,10 +63,7 @@ def test_a_flat_or_empty_x_range_is_widened_or_left_alone() -> None:
     # a flat whole-number x (one iteration) gets one whole step, lo..lo + 1, so its ticks are whole numbers
     assert fit_x_scale((np.full(3, 0.0), np.zeros(3)), scales)["x"].get("range") == (0.0, 1.0)
     assert fit_x_scale((np.full(3, 0.25), np.zeros(3)), scales)["x"].get("range") == (-0.25, 0.75)
-    assert fit_x_scale((np.full(3, 1e308), np.zeros(3)), scales)["x"].get("range") == (
-        1e308 - 1e306,
-        1e308 + 1e306,
-    )
+    assert fit_x_scale((np.full(3, 1e308), np.zeros(3)), scales)["x"].get("range") == (1e308 - 1e306, 1e308 + 1e306)
     assert fit_x_scale((np.full(3, np.nan), np.zeros(3)), scales) == scales
     log = {"x": viser.uplot.Scale(distr=3, auto=True)}
     assert fit_x_scale((np.full(3, 10.0), np.zeros(3)), log)["x"].get("range") == (5.0, 20.0)

@@ -279,10 +279,7 @@ def test_sdf_preview_while_dragging_ends_on_the_full_mesh_and_reference(
 
 @pytest.mark.parametrize("gizmo", ["/arm/target", "/arm/obstacle_0"])
 def test_a_drag_burst_on_an_arm_gizmo_coalesces_and_ends_on_its_last_pose(
-    server: viser.ViserServer,
-    switcher: SceneSwitcher,
-    gizmo: str,
-    monkeypatch: pytest.MonkeyPatch,
+    server: viser.ViserServer, switcher: SceneSwitcher, gizmo: str, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """Every gizmo's handler is made once, so a burst of drag messages queued behind a busy scene runs the handler
     a few times, not once a message, and the chain ends on the last pose sent. Before, the arm made a new wrapper
@@ -307,8 +304,7 @@ def test_a_drag_burst_on_an_arm_gizmo_coalesces_and_ends_on_its_last_pose(
         with scene._lock:  # the scene is busy: every message queues behind the lock
             client.drag_transform(gizmo, path)
             wait_until(
-                lambda: np.allclose(np.asarray(handle.position), path[-1]),
-                "the last message to reach the server",
+                lambda: np.allclose(np.asarray(handle.position), path[-1]), "the last message to reach the server"
             )
             time.sleep(0.2)  # let viser's pool start the queued calls (each returns or waits on the lock)
         wait_until(lambda: sum(runs) >= len(path), "every message handled")

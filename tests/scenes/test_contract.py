@@ -88,10 +88,7 @@ def test_a_declared_control_moved_in_range_changes_the_params(server: viser.Vise
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui(control.label)
         client.set_value(control.label, value)
-        client.wait_for(
-            lambda: getattr(scene.params, name) == pytest.approx(value),
-            what=f"{name} = {value}",
-        )
+        client.wait_for(lambda: getattr(scene.params, name) == pytest.approx(value), what=f"{name} = {value}")
     assert scene.params == dataclasses.replace(before, **{name: getattr(scene.params, name)})
 
 
@@ -110,18 +107,13 @@ def test_hostile_values_are_refused_or_clamped_and_the_last_good_params_kept(
             client.set_value(control.label, hostile)
             # The sender showed its own edit; a refusal sends the server's value back.
             client.wait_for(
-                lambda: client.value_of(control.label) == shown,
-                what=f"{hostile!r} refused and {shown} sent back",
+                lambda: client.value_of(control.label) == shown, what=f"{hostile!r} refused and {shown} sent back"
             )
             assert scene.params == good
-        for hostile, clamped in (
-            (control.hi + 10 * span, control.hi),
-            (control.lo - 10 * span, control.lo),
-        ):
+        for hostile, clamped in ((control.hi + 10 * span, control.hi), (control.lo - 10 * span, control.lo)):
             client.set_value(control.label, hostile)
             client.wait_for(
-                lambda clamped=clamped: getattr(scene.params, name) == clamped,
-                what=f"{hostile} clamped to {clamped}",
+                lambda clamped=clamped: getattr(scene.params, name) == clamped, what=f"{hostile} clamped to {clamped}"
             )
             client.wait_for(
                 lambda clamped=clamped: client.value_of(control.label) == clamped,

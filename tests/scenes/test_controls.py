@@ -43,8 +43,7 @@ class Demo:
     power_w: float = field(default=250.0, metadata=number("Power (W)", 0.0, 2500.0, 5.0))
     """A number box."""
     mode: Mode = field(
-        default="exact",
-        metadata=dropdown("Mode", ("fast", "exact"), ("Fast (approximate)", "Exact"), folder="B"),
+        default="exact", metadata=dropdown("Mode", ("fast", "exact"), ("Fast (approximate)", "Exact"), folder="B")
     )
     """A dropdown whose field holds the option and whose GUI shows its label."""
     drafting: bool = field(default=True, metadata=checkbox("Drafting", folder="B"))
@@ -117,16 +116,7 @@ def test_the_builder_makes_each_declared_control(demo: Controls[Demo]) -> None:
     assert isinstance(demo["colour"], viser.GuiRgbHandle) and demo["colour"].value == (10, 20, 30)
     assert isinstance(demo["source"], viser.GuiTextHandle) and demo["source"].value == "sphere"
     # In field order, nothing for the undeclared field, and the declared folders, opened once each.
-    assert list(demo.fields) == [
-        "speed_kmh",
-        "riders",
-        "power_w",
-        "mode",
-        "drafting",
-        "radii_m",
-        "colour",
-        "source",
-    ]
+    assert list(demo.fields) == ["speed_kmh", "riders", "power_w", "mode", "drafting", "radii_m", "colour", "source"]
     assert [h.label for h in demo][:3] == ["Speed (km/h)", "Riders", "Power (W)"]
     assert {label: folder.label for label, folder in demo.folders.items()} == {"A": "A", "B": "B"}
 
@@ -168,9 +158,7 @@ def test_the_reader_returns_the_values_shown(demo: Controls[Demo]) -> None:
     assert log == []  # nothing to clean, nothing written back
 
 
-def test_the_reader_clamps_numbers_to_the_declared_range_and_writes_them_back(
-    demo: Controls[Demo],
-) -> None:
+def test_the_reader_clamps_numbers_to_the_declared_range_and_writes_them_back(demo: Controls[Demo]) -> None:
     store_value(demo["speed_kmh"], 1e308)
     store_value(demo["riders"], -40)
     store_value(demo["power_w"], 9999.0)
@@ -251,13 +239,7 @@ def test_adding_a_control_is_one_declaration(server: viser.ViserServer) -> None:
     assert len(list(after)) == len(list(before)) + 1
     damping = after["damping"]
     assert isinstance(damping, viser.GuiSliderHandle)
-    assert (damping.label, damping.min, damping.max, damping.step, damping.value) == (
-        "Damping",
-        0.0,
-        1.0,
-        0.05,
-        0.5,
-    )
+    assert (damping.label, damping.min, damping.max, damping.step, damping.value) == ("Damping", 0.0, 1.0, 0.05, 0.5)
     assert control_spec(damping) == ControlSpec("number", lo=0.0, hi=1.0)
     store_value(damping, 7.0)
     assert read_controls(after, More()).damping == 1.0 and damping.value == 1.0
@@ -305,10 +287,5 @@ def test_a_browser_value_is_cleaned_once_by_the_declared_spec(server: viser.Vise
             timeout_s=10.0,
         )
     params, log = read_logged(demo, Demo())
-    assert (params.riders, params.power_w, params.speed_kmh, params.mode) == (
-        16,
-        2500.0,
-        40.0,
-        "exact",
-    )
+    assert (params.riders, params.power_w, params.speed_kmh, params.mode) == (16, 2500.0, 40.0, "exact")
     assert log == []  # the gate already sent what the reader would: nothing left to clean

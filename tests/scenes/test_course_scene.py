@@ -119,9 +119,7 @@ def test_the_kernel_rides_with_the_paceline_sharing_the_work(mode: CourseMode) -
     assert group_cda(scene.params) < four.group_cda_m2
 
 
-def test_model_and_air_choices_change_the_ride_and_the_readout_shows_both_densities(
-    mode: CourseMode,
-) -> None:
+def test_model_and_air_choices_change_the_ride_and_the_readout_shows_both_densities(mode: CourseMode) -> None:
     assert mode.state is not None
     martin = mode.state.ride.time_s
     mode.controls["model"].value = "Textbook (aero, rolling, climbing)"
@@ -844,10 +842,7 @@ REVIEW_FILES = {
         gpx_text([(45.0, 6.0, 1.0), (45.001, 6.0, float("nan"))]),
         "was not loaded: track point 2's elevation is not a number",
     ),
-    "not gpx": (
-        "<html><body>hi</body></html>",
-        "was not loaded: it is not GPX: no <gpx>",
-    ),
+    "not gpx": ("<html><body>hi</body></html>", "was not loaded: it is not GPX: no <gpx>"),
 }
 
 

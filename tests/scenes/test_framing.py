@@ -25,11 +25,7 @@ coordinate = st.floats(-50.0, 50.0, allow_nan=False)
 
 def _direction(azimuth: float, pitch: float) -> tuple[float, float, float]:
     """Unit view direction at ``azimuth`` about z and ``pitch`` above the horizontal (rad)."""
-    return (
-        math.cos(azimuth) * math.cos(pitch),
-        math.sin(azimuth) * math.cos(pitch),
-        math.sin(pitch),
-    )
+    return (math.cos(azimuth) * math.cos(pitch), math.sin(azimuth) * math.cos(pitch), math.sin(pitch))
 
 
 def _rectangle(x0: float, width: float, y0: float, height: float) -> tuple[float, float, float, float]:
@@ -207,11 +203,7 @@ class _Tab:
         self.client = self
         self.client_id = 7
         self.image_width, self.image_height, self.fov = 1280, 720, math.radians(75.0)
-        self.position, self.look_at, self.up_direction = (
-            (1.0, -7.5, 2.8),
-            (0.0, 0.0, 1.0),
-            (0.0, 0.0, 1.0),
-        )
+        self.position, self.look_at, self.up_direction = ((1.0, -7.5, 2.8), (0.0, 0.0, 1.0), (0.0, 0.0, 1.0))
 
     def atomic(self) -> contextlib.AbstractContextManager[None]:
         return contextlib.nullcontext()
@@ -236,9 +228,7 @@ def test_a_tab_put_back_at_its_opening_view_before_showing_the_framing_is_framed
 
 
 @pytest.mark.parametrize("confirmations", [0, 1, 3, 6])
-def test_a_tab_put_back_at_its_opening_view_after_showing_the_framing_is_framed_again(
-    confirmations: int,
-) -> None:
+def test_a_tab_put_back_at_its_opening_view_after_showing_the_framing_is_framed_again(confirmations: int) -> None:
     # The kind: viser's client resets a tab to the server's initial camera at any time after connecting (its
     # InitialCameraSetter effect, the root turning, "Reset View"), also after the tab reported the framed view
     # back, however many times it did. The old rule took every move after a confirmation for the person's.

@@ -46,10 +46,7 @@ from scenes.freekick.model import (
     sample_rows,
     spin_words,
 )
-from scenes.freekick.odds import (
-    spot_odds_map,
-    strike_chances,
-)
+from scenes.freekick.odds import spot_odds_map, strike_chances
 from scenes.freekick.props import ARROW_POINTS
 from scenes.freekick.scene import GRASS_HALF_M
 from scenes.freekick.views import VIEW_MIN_DEPTH_M, frame_view, goal_hides, view_points, wall_hides
@@ -153,8 +150,7 @@ def _kernel_flight(
 
 
 @pytest.mark.parametrize(
-    ("integrator", "method", "dt"),
-    [("RK4, 10 ms", "rk4", 1e-2), ("Euler, 1 ms (textbook)", "euler", 1e-3)],
+    ("integrator", "method", "dt"), [("RK4, 10 ms", "rk4", 1e-2), ("Euler, 1 ms (textbook)", "euler", 1e-3)]
 )
 @pytest.mark.parametrize("model_label", ["Constant C_D = C_L = 0.25 (textbook)", "Measured C_D(Re, S), C_L(S)"])
 def test_drawn_path_ghost_and_band_are_the_kernels_flights(
@@ -175,8 +171,7 @@ def test_drawn_path_ghost_and_band_are_the_kernels_flights(
         np.testing.assert_array_equal(freekick.state.ghost.position, ghost.position)
         drawn_ghost = np.asarray(freekick.ghost.points)
         np.testing.assert_array_equal(
-            np.concatenate([drawn_ghost[:, 0], drawn_ghost[-1:, 1]]),
-            resample(ghost).astype(np.float32),
+            np.concatenate([drawn_ghost[:, 0], drawn_ghost[-1:, 1]]), resample(ghost).astype(np.float32)
         )
         band = np.asarray(freekick.band.vertices)  # the ±10 % edges fly RK4 at 20 ms
         for edge, scale in ((band[0::2], 0.9), (band[1::2], 1.1)):
@@ -240,9 +235,7 @@ def test_kick_flies_the_ball_spinning_along_its_path(freekick: FreeKickScene) ->
         np.testing.assert_allclose(freekick.ball_frame.position, spot)
 
 
-def test_aiming_at_a_point_of_the_goal_mouth_finds_a_kick_over_the_wall(
-    freekick: FreeKickScene,
-) -> None:
+def test_aiming_at_a_point_of_the_goal_mouth_finds_a_kick_over_the_wall(freekick: FreeKickScene) -> None:
     freekick.aim_at_point(-2.6, 1.9)
     assert freekick.wait_idle()
     point = freekick.state.outcome.goal_point
@@ -414,9 +407,7 @@ def test_a_kick_on_the_outcome_map_is_a_cross_on_its_cell(freekick: FreeKickScen
     assert "lies" not in freekick.map_status.content
 
 
-def test_a_burst_of_slider_changes_computes_one_outcome_map_for_the_last(
-    freekick: FreeKickScene,
-) -> None:
+def test_a_burst_of_slider_changes_computes_one_outcome_map_for_the_last(freekick: FreeKickScene) -> None:
     runs = freekick.map_runs
     for spin in np.linspace(5.0, 9.0, 12):
         freekick.controls["spin_rev_s"].value = float(spin)  # each redraws at once; the map waits for the burst to end
@@ -545,12 +536,7 @@ CRAFTED = [
 
 @pytest.mark.parametrize(("label", "value", "field", "expected"), CRAFTED)
 def test_crafted_values_keep_the_last_good_state(
-    server: viser.ViserServer,
-    freekick: FreeKickScene,
-    label: str,
-    value: object,
-    field: str,
-    expected: object,
+    server: viser.ViserServer, freekick: FreeKickScene, label: str, value: object, field: str, expected: object
 ) -> None:
     good = freekick.state
     with BrowserClient(server.get_port()) as client:
@@ -678,13 +664,7 @@ OPENING_GOAL_SHARE = 0.21
 and 0.250 at 1600×1000 now that it keeps clear of the software-WebGL notice)."""
 
 
-GOAL_SHARE_FLOOR: dict[ViewName, float] = {
-    "broadcast": 0.09,
-    "behind": 0.095,
-    "side": 0.05,
-    "goal": 0.2,
-    "above": 0.10,
-}
+GOAL_SHARE_FLOOR: dict[ViewName, float] = {"broadcast": 0.09, "behind": 0.095, "side": 0.05, "goal": 0.2, "above": 0.10}
 """Least share of the free canvas width the goal spans in each view that shows it, for every preset and ball spot
 (12–40 m, ±45°; measured minima 0.094, 0.078, 0.060, 0.105, each for a ball 36–40 m out; the raised view gave
 0.157 before it kept clear of the software-WebGL notice, which at 1280×720 takes a quarter of the free height). Side-on the goal is seen
@@ -1197,11 +1177,7 @@ def _sent_while_mapping(client: BrowserClient, freekick: FreeKickScene, then: st
     ],
 )
 def test_an_input_while_the_goal_chance_is_mapped_leaves_a_true_status(
-    server: viser.ViserServer,
-    freekick: FreeKickScene,
-    monkeypatch: pytest.MonkeyPatch,
-    then: str,
-    same_strike: bool,
+    server: viser.ViserServer, freekick: FreeKickScene, monkeypatch: pytest.MonkeyPatch, then: str, same_strike: bool
 ) -> None:
     started, release = _held_odds_maps(monkeypatch)
     view = freekick.params.view

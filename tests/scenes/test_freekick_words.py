@@ -14,18 +14,8 @@ from kernels import ball
 from scenes.freekick import FreeKickParams, FreeKickScene
 from scenes.freekick import model as freekick_model
 from scenes.freekick import scene as freekick_scene
-from scenes.freekick.model import (
-    PRESETS,
-    compute_kick,
-    keeper_words,
-    play_words,
-)
-from scenes.freekick.odds import (
-    ODDS_MAP_ANGLES_DEG,
-    ODDS_MAP_CAVEAT,
-    ODDS_MAP_DISTANCES_M,
-    odds_map_words,
-)
+from scenes.freekick.model import PRESETS, compute_kick, keeper_words, play_words
+from scenes.freekick.odds import ODDS_MAP_ANGLES_DEG, ODDS_MAP_CAVEAT, ODDS_MAP_DISTANCES_M, odds_map_words
 
 
 def _show(freekick: FreeKickScene, **changes: object) -> str:

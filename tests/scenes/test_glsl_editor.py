@@ -20,13 +20,7 @@ from numpy.typing import NDArray
 from kernels import sdf
 from shaders import gl_service
 from shaders import renderer as gl_renderer
-from shaders.renderer import (
-    MAX_SOURCE_CHARS,
-    Camera,
-    ShaderCompileError,
-    check_source,
-    mesh_glsl,
-)
+from shaders.renderer import MAX_SOURCE_CHARS, Camera, ShaderCompileError, check_source, mesh_glsl
 
 SPHERE = "float sdf(vec3 p) {\n    return sd_sphere(p - vec3(0.1, -0.2, 0.05), 0.55);\n}\n"
 
@@ -70,16 +64,10 @@ def test_any_text_is_either_accepted_or_refused_cleanly(text: str) -> None:
 @pytest.mark.parametrize(
     ("source", "words"),
     [
-        (
-            "float sdf(vec3 p){ float s=0.0; fo\\\nr(int i=0;i<3;i++){s+=0.1;} return s; }\n",
-            "backslash",
-        ),
+        ("float sdf(vec3 p){ float s=0.0; fo\\\nr(int i=0;i<3;i++){s+=0.1;} return s; }\n", "backslash"),
         ("float sdf(vec3 p){ disc\\\nard; return 1.0; }\n", "backslash"),
         ("unif\\\norm float u;\nfloat sdf(vec3 p){ return u; }\n", "backslash"),
-        (
-            "float sdf(vec3 p){ return 1.0; } // hi\rfloat g(){ for(int i=0;i<3;i++){} return 0.0; }\n",
-            "carriage",
-        ),
+        ("float sdf(vec3 p){ return 1.0; } // hi\rfloat g(){ for(int i=0;i<3;i++){} return 0.0; }\n", "carriage"),
         ("float sdf(vec3 p){ return length(p)-F; }\r#define F 1.0\r", "carriage"),
         ("float sdf(vec3 p){ return length(p)-1.0; } // x \\\n\n", "backslash"),
         ("float sdf(vec3 p){ return 1.0; } # define X\n", "preprocessor"),
@@ -229,9 +217,7 @@ def test_gl_sampled_grid_equals_numpy_at_every_sample() -> None:
     axes = [grid.origin[i] + grid.spacing * np.arange(grid.shape[i]) for i in range(3)]
     points = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
     expected = sdf.smooth_union(
-        sdf.sd_cylinder(points, 0.5, 0.3),
-        sdf.sd_octahedron(points - [0.3, 0.2, 0.1], 0.4),
-        0.2,
+        sdf.sd_cylinder(points, 0.5, 0.3), sdf.sd_octahedron(points - [0.3, 0.2, 0.1], 0.4), 0.2
     ).reshape(grid.shape)
     assert field.shape == grid.shape
     np.testing.assert_allclose(field, expected, atol=1e-5, rtol=0)

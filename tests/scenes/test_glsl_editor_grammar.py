@@ -273,10 +273,7 @@ COMPILE_ERRORS = {
     "extra number": lambda line: line.replace("0.9", "0.9 2.0"),
     "extra operator": lambda line: line.replace("* 0.9", "* * 0.9"),
 }
-BRACE_ERRORS = {
-    "unclosed if": lambda line: "    if (p.x > 0.0) {",
-    "extra close": lambda line: "    }",
-}
+BRACE_ERRORS = {"unclosed if": lambda line: "    if (p.x > 0.0) {", "extra close": lambda line: "    }"}
 
 
 def _inject(program: tuple[list[str], list[int]], choice: int, kind: str) -> tuple[str, int]:

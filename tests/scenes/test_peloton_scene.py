@@ -213,10 +213,7 @@ def test_crafted_values_keep_a_good_state(
         if value == 2.6:
             return  # viser truncated it to an int before the scene saw it: nothing for the scene to echo
         # Every browser is told the cleaned value, not the crafted one.
-        client.wait_for(
-            lambda: _shown_matches(client.value_of(label), expected),
-            what="the cleaned value echoed",
-        )
+        client.wait_for(lambda: _shown_matches(client.value_of(label), expected), what="the cleaned value echoed")
 
 
 def _shown_matches(shown: object, expected: object) -> bool:
@@ -286,12 +283,7 @@ def assert_labels_apart_and_in_view(boxes: np.ndarray, lens: Lens) -> None:
     grade=st.sampled_from([-15.0, -8.0, 0.0, 12.0, 20.0]),
 )
 def test_labels_never_overlap_and_stay_in_view_clear_of_the_panel(
-    switcher: SceneSwitcher,
-    n: int,
-    gap_tenths: int,
-    viewport: tuple[int, int],
-    speed: float,
-    grade: float,
+    switcher: SceneSwitcher, n: int, gap_tenths: int, viewport: tuple[int, int], speed: float, grade: float
 ) -> None:
     # The family: any rider count and gap on the sliders' range, any window a person uses; the labels are laid out
     # for the camera the scene frames and read back from the label handles.

@@ -63,9 +63,7 @@ def _wait_ticks(probe: Probe, at_least: int) -> None:
     assert probe.ticks >= at_least
 
 
-def test_an_idle_loop_sleeps_until_woken_and_a_sleeping_loop_still_stops(
-    server: viser.ViserServer,
-) -> None:
+def test_an_idle_loop_sleeps_until_woken_and_a_sleeping_loop_still_stops(server: viser.ViserServer) -> None:
     probe = Probe(server)
     _wait_ticks(probe, 2)
     with probe._lock:

@@ -20,13 +20,7 @@ from hypothesis import strategies as st
 
 from kernels import sdf
 from scenes.sdf_gallery import SdfGalleryScene
-from scenes.sdf_gallery.export import (
-    NOTHING_TO_DOWNLOAD,
-    DownloadFormat,
-    MeshFormat,
-    download,
-    mesh_file,
-)
+from scenes.sdf_gallery.export import NOTHING_TO_DOWNLOAD, DownloadFormat, MeshFormat, download, mesh_file
 from server.switcher import SceneSwitcher
 from shaders import gl_service
 from shaders.renderer import GLUnavailableError

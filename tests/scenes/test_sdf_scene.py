@@ -141,8 +141,7 @@ def test_gui_changes_remesh(server: viser.ViserServer, scene: SdfGalleryScene) -
         for got, want in zip((scene.mesh_vertices, scene.mesh_faces, scene.mesh_colors), expected, strict=True):
             np.testing.assert_array_equal(got, want)
         client.wait_for(  # a box uses all three sizes
-            lambda: client.element("P1 size b (m)")["props"]["disabled"] is False,
-            what="size b enabled",
+            lambda: client.element("P1 size b (m)")["props"]["disabled"] is False, what="size b enabled"
         )
 
 
@@ -157,18 +156,12 @@ def test_crafted_bad_values_keep_the_last_good_scene(server: viser.ViserServer, 
         client.wait_for(lambda: client.value_of("P2 kind") == "Box", what="kind written back")
         client.set_value("P3 size a (m)", "big")  # viser itself refuses this one; the final check covers it
         client.set_value("P1 colour", (300, -4, 20))
-        client.wait_for(
-            lambda: tuple(client.value_of("P1 colour")) == good.primitives[0].color,
-            what="colour back",
-        )
+        client.wait_for(lambda: tuple(client.value_of("P1 colour")) == good.primitives[0].color, what="colour back")
         client.drag_transform("/sdf/gizmo_1", [(float("nan"), 0.0, 0.0)])
         client.drag_transform("/sdf/gizmo_2", [(0.6, 0.0, 0.3)], wxyz=(0.0, 0.0, 0.0, 0.0))
         client.set_value(RESOLUTION_LABEL, -5)  # out of range: clamped to the slider's minimum
         client.wait_for(lambda: client.value_of(RESOLUTION_LABEL) == 32, what="resolution clamped")
-        wait_until(
-            lambda: scene.mesh_scene is not None and scene.params.resolution == 32,
-            "the mesh at resolution 32",
-        )
+        wait_until(lambda: scene.mesh_scene is not None and scene.params.resolution == 32, "the mesh at resolution 32")
         wait_until(lambda: len(scene.mesh_vertices) == len(sdf.mesh(good.scene(), 32)[0]), "32³ mesh")
     assert scene.params == SdfGalleryParams(resolution=32)
     assert scene.mesh_scene == good.scene()
@@ -197,11 +190,7 @@ def test_high_resolution_shows_progress_then_a_fine_mesh(server: viser.ViserServ
             ),
             what="progress bar shown",
         )
-        wait_until(
-            lambda: scene.mesh_serial > 0 and len(scene.mesh_faces) > 100_000,
-            "256³ mesh",
-            timeout_s=60,
-        )
+        wait_until(lambda: scene.mesh_serial > 0 and len(scene.mesh_faces) > 100_000, "256³ mesh", timeout_s=60)
         wait_until(lambda: scene.progress.visible is False, "progress bar hidden")
 
 
@@ -276,15 +265,9 @@ def test_live_mode_renders_while_the_camera_moves(server: viser.ViserServer, sce
 def test_downloads(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("Download mesh (STL)")
-        for label, name in [
-            ("Download mesh (STL)", "sdf_mesh.stl"),
-            ("Download mesh (OBJ)", "sdf_mesh.obj"),
-        ]:
+        for label, name in [("Download mesh (STL)", "sdf_mesh.stl"), ("Download mesh (OBJ)", "sdf_mesh.obj")]:
             client.click(label)
-            client.wait_for(
-                lambda name=name: any(m.get("filename") == name for _, m in client.received),
-                what=name,
-            )
+            client.wait_for(lambda name=name: any(m.get("filename") == name for _, m in client.received), what=name)
             start = next(m for _, m in client.received if m.get("filename") == name)
             client.wait_for(
                 lambda start=start: (
@@ -390,9 +373,7 @@ def rss_mib() -> float:
 
 
 @pytest.mark.gl
-def test_fifty_builds_share_one_gl_context_and_do_not_grow_memory(
-    server: viser.ViserServer,
-) -> None:
+def test_fifty_builds_share_one_gl_context_and_do_not_grow_memory(server: viser.ViserServer) -> None:
     """Each build once made a new EGL context on a new thread (~50 MiB each, never reclaimed)."""
     import gc
     import threading
@@ -425,11 +406,7 @@ def test_blend_dropdown_says_hard_and_smooth_and_hard_ignores_k(
 ) -> None:
     blend = scene.scene_controls["blend"]
     assert isinstance(blend, viser.GuiDropdownHandle)
-    assert blend.options == (
-        "Hard",
-        "Smooth (polynomial)",
-        "Smooth (exponential)",
-    )
+    assert blend.options == ("Hard", "Smooth (polynomial)", "Smooth (exponential)")
     assert "samples per side" in scene.scene_controls["resolution"].label
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("Blend")
@@ -475,8 +452,7 @@ def test_each_gizmo_is_sized_coloured_and_named_for_its_own_primitive(
         client.wait_for_gui("P1 size a (m)")
         client.set_value("P1 size a (m)", 0.25)
         wait_until(
-            lambda: scene.gizmos[0].scale == pytest.approx(0.25 + GIZMO_MARGIN_M, abs=0.011),
-            "the resized gizmo",
+            lambda: scene.gizmos[0].scale == pytest.approx(0.25 + GIZMO_MARGIN_M, abs=0.011), "the resized gizmo"
         )
         client.set_value("P1 colour", (10, 200, 30))
         wait_until(lambda: tuple(scene.gizmo_markers[0].color) == (10, 200, 30), "the marker colour")
@@ -519,8 +495,7 @@ def test_the_opening_view_shows_every_primitive_and_keeps_their_names_apart(scen
 
 
 @pytest.mark.parametrize(
-    ("label", "kind"),
-    [("Cylinder", "cylinder"), ("Octahedron", "octahedron"), ("Ellipsoid (bound)", "ellipsoid")],
+    ("label", "kind"), [("Cylinder", "cylinder"), ("Octahedron", "octahedron"), ("Ellipsoid (bound)", "ellipsoid")]
 )
 def test_catalogue_primitives_from_the_dropdown_are_meshed(
     server: viser.ViserServer, scene: SdfGalleryScene, label: str, kind: str
@@ -580,10 +555,7 @@ def test_typed_source_is_meshed_and_a_bad_one_keeps_the_last_good(
         assert "line 3" in scene.editor_status.content
         # A loop and an over-long source are refused before the compiler sees them.
         for text, words in [
-            (
-                "float sdf(vec3 p) {\n    float d = 1.0;\n    for (;;) { d = 0.5; }\n    return d;\n}",
-                "line 3",
-            ),
+            ("float sdf(vec3 p) {\n    float d = 1.0;\n    for (;;) { d = 0.5; }\n    return d;\n}", "line 3"),
             ("float sdf(vec3 p) { return 1.0; }\n" + "//" * 4100, "limit"),
             ("#extension GL_ARB_foo : enable\nfloat sdf(vec3 p) { return 1.0; }", "line 1"),
         ]:
@@ -723,11 +695,7 @@ def test_with_editing_off_apply_uses_only_the_servers_examples(
 @pytest.mark.gl
 @pytest.mark.parametrize(("limit", "words"), [("COMPILE_LIMIT_S", "compiling took"), ("FRAME_LIMIT_S", "frame took")])
 def test_compile_and_frame_time_limits_refuse_a_slow_source(
-    server: viser.ViserServer,
-    scene: SdfGalleryScene,
-    monkeypatch: pytest.MonkeyPatch,
-    limit: str,
-    words: str,
+    server: viser.ViserServer, scene: SdfGalleryScene, monkeypatch: pytest.MonkeyPatch, limit: str, words: str
 ) -> None:
     import scenes.sdf_gallery.editor as gallery
 
@@ -1284,12 +1252,7 @@ def gallery_rest_size(width: int, aspect: float, s_per_pixel: float | None) -> t
 @pytest.mark.parametrize(
     ("viewer", "aspect", "s_per_pixel", "size"),
     [
-        (
-            1600,
-            1.6,
-            None,
-            (1600, 1000),
-        ),  # an odd canvas: drawn at its size, not 640 stretched
+        (1600, 1.6, None, (1600, 1000)),  # an odd canvas: drawn at its size, not 640 stretched
         (2400, 1.6, None, (1600, 1000)),  # capped
         (1600, 2.5, None, (1600, 640)),
         (1000, 0.5, None, (500, 1000)),  # a tall canvas: the height is the limit

@@ -131,10 +131,7 @@ def test_a_busy_port_given_explicitly_is_refused_plainly() -> None:
         holder.listen()
         port = int(holder.getsockname()[1])
         result = subprocess.run(
-            [sys.executable, str(ROOT / "app.py"), "--port", str(port)],
-            capture_output=True,
-            text=True,
-            timeout=60,
+            [sys.executable, str(ROOT / "app.py"), "--port", str(port)], capture_output=True, text=True, timeout=60
         )
     assert result.returncode == 2
     assert f"Port {port} is already in use" in result.stderr
@@ -159,11 +156,7 @@ def test_other_hosts_warn_what_they_expose(host: str) -> None:
 
 def test_cli_help_lists_scene_host_and_port() -> None:
     result = subprocess.run(
-        [sys.executable, str(ROOT / "app.py"), "--help"],
-        capture_output=True,
-        text=True,
-        timeout=60,
-        check=True,
+        [sys.executable, str(ROOT / "app.py"), "--help"], capture_output=True, text=True, timeout=60, check=True
     )
     for flag in ("--scene", "--host", "--port", "--shared"):
         assert flag in result.stdout
@@ -238,10 +231,7 @@ def test_log_lines_from_before_the_command_line_is_read_wait_for_it(command_line
 
 def test_cli_rejects_an_unknown_scene() -> None:
     result = subprocess.run(
-        [sys.executable, str(ROOT / "app.py"), "--scene", "pinball"],
-        capture_output=True,
-        text=True,
-        timeout=60,
+        [sys.executable, str(ROOT / "app.py"), "--scene", "pinball"], capture_output=True, text=True, timeout=60
     )
     assert result.returncode != 0
     assert "pinball" in result.stdout + result.stderr
@@ -259,9 +249,7 @@ def test_switcher_lists_every_scene(switcher: SceneSwitcher) -> None:
     assert tuple(switcher.dropdown.options) == tuple(cls.title for cls in SCENES.values())
 
 
-def test_switching_removes_every_node_and_gui_element_of_the_old_scene(
-    server: viser.ViserServer,
-) -> None:
+def test_switching_removes_every_node_and_gui_element_of_the_old_scene(server: viser.ViserServer) -> None:
     bare_nodes = node_names(server)
     keys = list(SCENES)
     switcher = SceneSwitcher(server, keys[0])

@@ -35,11 +35,7 @@ def test_a_busy_port_given_with_port_is_refused_without_a_url() -> None:
     with _listening() as holder:
         busy = holder.getsockname()[1]
         run = subprocess.run(
-            [sys.executable, "app.py", "--port", str(busy)],
-            cwd=ROOT,
-            capture_output=True,
-            text=True,
-            timeout=120,
+            [sys.executable, "app.py", "--port", str(busy)], cwd=ROOT, capture_output=True, text=True, timeout=120
         )
     assert run.returncode == 2
     assert f"Port {busy} is already in use" in run.stderr

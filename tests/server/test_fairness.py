@@ -152,10 +152,7 @@ def test_a_reset_flood_does_not_delay_another_tab_and_ends_in_a_reset_scene(
         built_before = len(builds_of(flooder, f"/{key}"))
         caplog.clear()
         started = time.monotonic()
-        with Flood(
-            lambda _i: flooder.send("GuiUpdateMessage", uuid=reset, updates={"value": True}),
-            FLOOD_HZ,
-        ) as flood:
+        with Flood(lambda _i: flooder.send("GuiUpdateMessage", uuid=reset, updates={"value": True}), FLOOD_HZ) as flood:
             time.sleep(0.5)  # the flood is under way
             delay = first_gui_delay(server, sessions)
         flood_s = flood.last_sent_at - started
@@ -186,8 +183,7 @@ def test_a_reset_flood_does_not_delay_another_tab_and_ends_in_a_reset_scene(
         defaults = type(scene.params)()  # type: ignore[attr-defined]
         assert scene.params == defaults  # type: ignore[attr-defined]
         flooder.wait_for(
-            lambda: flooder.value_of(label) == getattr(defaults, field),
-            what="the flooder shows the reset scene",
+            lambda: flooder.value_of(label) == getattr(defaults, field), what="the flooder shows the reset scene"
         )
     kinds = [r.getMessage() for r in caplog.records if "costly input" in r.getMessage()]
     assert 1 <= len(kinds) <= 2  # one rate-limited line, not one per click
@@ -341,16 +337,12 @@ def assert_within_the_budget(times: list[float]) -> None:
 def arrivals_of(controls: str) -> st.SearchStrategy[list[tuple[float, str, int]]]:
     """1 to 80 arrivals (gap s, control, value) of the one-letter ``controls``, as ``replay`` takes them."""
     return st.lists(
-        st.tuples(st.floats(0.0, 0.6), st.sampled_from(controls), st.integers(0, 9)),
-        min_size=1,
-        max_size=80,
+        st.tuples(st.floats(0.0, 0.6), st.sampled_from(controls), st.integers(0, 9)), min_size=1, max_size=80
     )
 
 
 @given(arrivals_of("abc"))
-def test_the_budget_bounds_work_and_delivers_each_controls_last_value(
-    arrivals: list[tuple[float, str, int]],
-) -> None:
+def test_the_budget_bounds_work_and_delivers_each_controls_last_value(arrivals: list[tuple[float, str, int]]) -> None:
     """Any arrivals of costly inputs (gap s, control, value): at most ``burst + rate·t`` go in any ``t`` s, and each
     control's last value delivered is the last one sent."""
     delivered = replay(arrivals)
@@ -361,9 +353,7 @@ def test_the_budget_bounds_work_and_delivers_each_controls_last_value(
 
 
 @given(arrivals_of("abcxy"))
-def test_an_input_after_a_held_back_one_is_applied_after_it(
-    arrivals: list[tuple[float, str, int]],
-) -> None:
+def test_an_input_after_a_held_back_one_is_applied_after_it(arrivals: list[tuple[float, str, int]]) -> None:
     """Costly controls a, b, c and free ones x, y (cheap sliders, gizmos) arriving in any order: each control ends
     on its last value, free inputs never spend the budget, and an input sent after a costly control's last value is
     delivered after it (an edit after a Reset is not undone by the Reset)."""
@@ -381,19 +371,13 @@ def test_an_input_after_a_held_back_one_is_applied_after_it(
 def test_an_edit_after_a_held_back_reset_waits_for_it() -> None:
     budget: CostlyBudget[str] = CostlyBudget(1, 1.0, now=0.0)
     assert budget.offer("reset", "first reset", 0.0) == (True, False)
-    assert budget.offer("reset", "second reset", 0.1) == (
-        False,
-        False,
-    )  # beyond the budget: held back
+    assert budget.offer("reset", "second reset", 0.1) == (False, False)  # beyond the budget: held back
     assert budget.offer("speed", "33 km/h", 0.2, free=True) == (False, False)  # behind it, in line
     assert budget.wait_s(0.2) == pytest.approx(0.8)
     assert budget.take(1.0) == ("reset", "second reset")
     assert budget.wait_s(1.0) == 0.0  # a free input goes as soon as it is first in line
     assert budget.take(1.0) == ("speed", "33 km/h")
-    assert budget.offer("speed", "34 km/h", 1.0, free=True) == (
-        True,
-        False,
-    )  # nothing held: at once
+    assert budget.offer("speed", "34 km/h", 1.0, free=True) == (True, False)  # nothing held: at once
 
 
 def test_a_burst_of_resets_is_one_held_back_reset() -> None:
@@ -477,10 +461,7 @@ def test_uploads_beyond_the_server_wide_count_are_refused_with_a_notice_and_the_
                 for transfer in transfers[i]:
                     send_part(client, transfer, 0, data[i])
             for i, (client, scene) in enumerate(tabs[:4]):
-                client.wait_for(
-                    lambda s=scene, n=f"Tab {i}": s.course_mode.route.name == n,
-                    what=f"tab {i}'s upload",
-                )
+                client.wait_for(lambda s=scene, n=f"Tab {i}": s.course_mode.route.name == n, what=f"tab {i}'s upload")
                 assert not client.notices()
             # Each tab sent two uploads; its course changes with the first, and the second may still be landing.
             tabs[0][0].wait_for(lambda: gate.uploads_in_flight() == (0, 0), what="every upload landed")
@@ -529,10 +510,7 @@ def test_uploads_beyond_the_server_wide_bytes_are_refused_with_a_notice_and_the_
 
 
 def test_a_stalled_upload_stops_holding_the_server_wide_budget(
-    server: viser.ViserServer,
-    sessions: Sessions,
-    monkeypatch: pytest.MonkeyPatch,
-    caplog: pytest.LogCaptureFixture,
+    server: viser.ViserServer, sessions: Sessions, monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
 ) -> None:
     monkeypatch.setattr("server.budget.UPLOAD_STALL_S", 0.3)  # 30 s in the app
     gate = install_gate(server)
@@ -575,10 +553,7 @@ def pick_file(page: Any, name: str, data: bytes) -> None:
 
 @pytest.mark.browser
 def test_a_person_whose_upload_is_refused_is_told_why_and_can_retry(
-    server: viser.ViserServer,
-    browser_page: Any,
-    caplog: pytest.LogCaptureFixture,
-    monkeypatch: pytest.MonkeyPatch,
+    server: viser.ViserServer, browser_page: Any, caplog: pytest.LogCaptureFixture, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """Chromium uploads a GPX while crafted tabs hold the server-wide budget: a red notice, then a retry works."""
     # Software WebGL on busy cores can take over 30 s to run the page's script: the hogs must not stall out first.

@@ -29,13 +29,7 @@ from hypothesis import strategies as st
 
 from scenes import SCENES, Scene
 from scenes.peloton.model import MAX_GROUP
-from server.clean import (
-    NEGLIGIBLE,
-    ControlSpec,
-    clean_value,
-    control_spec,
-    unit_quaternion,
-)
+from server.clean import NEGLIGIBLE, ControlSpec, clean_value, control_spec, unit_quaternion
 from server.gate import same_value
 from server.refusals import refusals
 from server.switcher import SceneSwitcher
@@ -241,12 +235,7 @@ def hostile_barrage(attacker: BrowserClient, server: viser.ViserServer) -> int:
         for wxyz in BAD_WXYZ:
             attacker.drag_transform(name, [good_position], wxyz=wxyz)
         sent += len(BAD_POSITIONS) + len(BAD_WXYZ)
-    attacker.send(
-        "TransformControlsUpdateMessage",
-        name="/no/such/gizmo",
-        wxyz=(1, 0, 0, 0),
-        position=(0, 0, 0),
-    )
+    attacker.send("TransformControlsUpdateMessage", name="/no/such/gizmo", wxyz=(1, 0, 0, 0), position=(0, 0, 0))
     bad_rays: list[Any] = [(NAN, 0.0, 1.0), (0.0, INF, 1.0), (0.0, 0.0), "up", None]
     for ray in bad_rays:
         attacker.send(
@@ -328,10 +317,7 @@ def two_viewers(server: viser.ViserServer, key: str) -> Iterator[tuple[SceneSwit
     callbacks: the first sends, the second watches. The scene closes after the browsers."""
     switcher = SceneSwitcher(server, key)
     try:
-        with (
-            BrowserClient(server.get_port()) as first,
-            BrowserClient(server.get_port()) as second,
-        ):
+        with BrowserClient(server.get_port()) as first, BrowserClient(server.get_port()) as second:
             label = SENTINELS[key][0]
             first.wait_for_gui(label)
             second.wait_for_gui(label)
@@ -343,10 +329,7 @@ def two_viewers(server: viser.ViserServer, key: str) -> Iterator[tuple[SceneSwit
 
 
 def test_every_hostile_message_leaves_every_viewer_on_the_last_good_state(
-    server: viser.ViserServer,
-    key: str,
-    caplog: pytest.LogCaptureFixture,
-    capfd: pytest.CaptureFixture[str],
+    server: viser.ViserServer, key: str, caplog: pytest.LogCaptureFixture, capfd: pytest.CaptureFixture[str]
 ) -> None:
     label, good, field = SENTINELS[key]
     with two_viewers(server, key) as (switcher, attacker, observer):
@@ -461,11 +444,7 @@ def test_huge_numbers_clamp_to_the_range_the_scene_declared(server: viser.ViserS
                     what=f"{getattr(handle, 'label', uuid)} clamped to {bound}",
                 )
         for viewer in (attacker, observer):
-            viewer.wait_for(
-                lambda v=viewer: shows_server_values(v, server),
-                timeout=60,
-                what="values converge",
-            )
+            viewer.wait_for(lambda v=viewer: shows_server_values(v, server), timeout=60, what="values converge")
         scene = switcher.scene
         with scene._lock:
             for name in scene.params.__dataclass_fields__:  # type: ignore[attr-defined]
@@ -724,8 +703,7 @@ def test_a_valid_but_not_unit_orientation_reaches_every_viewer_normalised(server
                 sender.drag_transform(name, [position], wxyz=wxyz)
                 for viewer in (sender, observer):
                     viewer.wait_for(
-                        lambda v=viewer: shows_server_poses(v, server),
-                        what=f"{name} {wxyz}: the viewers converge",
+                        lambda v=viewer: shows_server_poses(v, server), what=f"{name} {wxyz}: the viewers converge"
                     )
                 norm = float(np.linalg.norm(np.asarray(gizmo.wxyz, dtype=np.float64)))
                 assert abs(norm - 1.0) < 1e-9, (name, wxyz, gizmo.wxyz)
@@ -751,10 +729,7 @@ class _TabView:
 
 
 def test_every_hostile_message_leaves_each_tab_on_its_last_good_state(
-    server: viser.ViserServer,
-    key: str,
-    caplog: pytest.LogCaptureFixture,
-    capfd: pytest.CaptureFixture[str],
+    server: viser.ViserServer, key: str, caplog: pytest.LogCaptureFixture, capfd: pytest.CaptureFixture[str]
 ) -> None:
     """The default mode, a scene per tab: the same barrage at a tab's own controls and gizmos (looked up through
     the tab's own registries), plus edits aimed at another tab's controls, which must not reach that tab."""

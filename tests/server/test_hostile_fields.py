@@ -124,10 +124,7 @@ def test_dict_names_on_drags_and_clicks_are_refused_without_a_traceback(
 
 @pytest.mark.parametrize("depth", [2_000, 100_000])
 def test_a_frame_nested_thousands_deep_is_one_refusal_and_the_connection_stays(
-    server: viser.ViserServer,
-    switcher: SceneSwitcher,
-    depth: int,
-    caplog: pytest.LogCaptureFixture,
+    server: viser.ViserServer, switcher: SceneSwitcher, depth: int, caplog: pytest.LogCaptureFixture
 ) -> None:
     with caplog.at_level(logging.WARNING), BrowserClient(server.get_port()) as client:
         client.wait_for_gui("Scene")

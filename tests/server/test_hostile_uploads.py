@@ -20,12 +20,7 @@ from helpers.wsclient import BrowserClient
 import server.budget as budget_module
 from scenes.peloton import PelotonScene
 from scenes.peloton.course import CourseMode
-from server.budget import (
-    MAX_UPLOAD_BYTES,
-    MAX_UPLOAD_BYTES_IN_FLIGHT_PER_TAB,
-    MAX_UPLOADS_IN_FLIGHT,
-    MIN_PART_BYTES,
-)
+from server.budget import MAX_UPLOAD_BYTES, MAX_UPLOAD_BYTES_IN_FLIGHT_PER_TAB, MAX_UPLOADS_IN_FLIGHT, MIN_PART_BYTES
 from server.gate import install_gate
 from server.switcher import SceneSwitcher
 
@@ -78,10 +73,7 @@ CRAFTED_STARTS: list[dict[str, Any]] = [
 
 @pytest.mark.parametrize("override", CRAFTED_STARTS, ids=lambda o: ",".join(o))
 def test_a_crafted_upload_start_is_refused_and_the_course_stays(
-    server: viser.ViserServer,
-    mode: CourseMode,
-    override: dict[str, Any],
-    caplog: pytest.LogCaptureFixture,
+    server: viser.ViserServer, mode: CourseMode, override: dict[str, Any], caplog: pytest.LogCaptureFixture
 ) -> None:
     before = mode.route.name
     with BrowserClient(server.get_port()) as client, caplog.at_level(logging.WARNING):
@@ -142,15 +134,10 @@ def test_a_file_over_the_size_limit_is_refused_with_a_notice(server: viser.Viser
 
 # ---------------------------------------------------- what one tab's uploads may hold
 @pytest.mark.parametrize(
-    ("size", "parts"),
-    [(300_000, 300_000), (MAX_UPLOAD_BYTES, MAX_UPLOAD_BYTES), (2 * MIN_PART_BYTES, 3), (1, 2)],
+    ("size", "parts"), [(300_000, 300_000), (MAX_UPLOAD_BYTES, MAX_UPLOAD_BYTES), (2 * MIN_PART_BYTES, 3), (1, 2)]
 )
 def test_an_upload_of_tiny_parts_is_refused(
-    server: viser.ViserServer,
-    mode: CourseMode,
-    caplog: pytest.LogCaptureFixture,
-    size: int,
-    parts: int,
+    server: viser.ViserServer, mode: CourseMode, caplog: pytest.LogCaptureFixture, size: int, parts: int
 ) -> None:
     """The kind: memory the budget does not count. viser keeps ~100 bytes a part, so 300 000 one-byte parts held
     32 MiB for a 300 kB upload; an upload may announce at most one part per MIN_PART_BYTES (viser's own browser
@@ -170,11 +157,7 @@ def test_a_transfer_id_in_flight_cannot_be_taken_by_another_tab(
     second tab is a crafted one that knows the id.)"""
     data = hill_gpx("Mine", 300)
     half = len(data) // 2
-    with (
-        BrowserClient(server.get_port()) as a,
-        BrowserClient(server.get_port()) as b,
-        caplog.at_level(logging.WARNING),
-    ):
+    with BrowserClient(server.get_port()) as a, BrowserClient(server.get_port()) as b, caplog.at_level(logging.WARNING):
         a.wait_for_gui("Upload GPX")
         b.wait_for_gui("Upload GPX")
         transfer = start(a, part_count=2, size_bytes=len(data), filename="mine.gpx")

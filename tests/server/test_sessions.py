@@ -110,11 +110,7 @@ def test_a_closed_tab_frees_its_session(server: viser.ViserServer, sessions: Ses
         with client:
             client.set_value("Scene", SCENES[key].title)
             client.wait_for(lambda switcher=switcher, key=key: switcher.scene.key == key, timeout=60)
-            refs += [
-                weakref.ref(switcher),
-                weakref.ref(switcher.scene),
-                weakref.ref(switcher.server),
-            ]
+            refs += [weakref.ref(switcher), weakref.ref(switcher.scene), weakref.ref(switcher.server)]
             del switcher
         wait_until(lambda: not (sessions.count or server.get_clients()), "the closed tab's session freed")
         assert sessions.count == 0
@@ -325,15 +321,7 @@ def settled_rss(app: AppProcess, timeout_s: float = 120.0) -> int:
     return app.rss
 
 
-@pytest.mark.parametrize(
-    ("scene", "budget_mib"),
-    [
-        ("peloton", 40),
-        ("arm", 40),
-        ("freekick", 40),
-        ("sdf", 60),
-    ],
-)
+@pytest.mark.parametrize(("scene", "budget_mib"), [("peloton", 40), ("arm", 40), ("freekick", 40), ("sdf", 60)])
 def test_sixteen_sessions_fit_the_budget_and_are_given_back(scene: str, budget_mib: int) -> None:
     app = AppProcess()
     try:
@@ -429,15 +417,7 @@ def _trim_heap() -> None:
         pass
 
 
-@pytest.mark.parametrize(
-    "key",
-    [
-        "peloton",
-        "arm",
-        "freekick",
-        "sdf",
-    ],
-)
+@pytest.mark.parametrize("key", ["peloton", "arm", "freekick", "sdf"])
 def test_fifty_builds_and_closes_grow_rss_at_most_20_mib(server: viser.ViserServer, key: str) -> None:
     """Each build runs until the scene is fully up (the SDF gallery: its first reference image) before it closes."""
 
@@ -472,9 +452,7 @@ def _fully_up(scene: object) -> bool:
 
 
 @pytest.mark.gl
-def test_each_tab_s_sdf_reference_is_rendered_from_that_tab_s_camera(
-    server: viser.ViserServer,
-) -> None:
+def test_each_tab_s_sdf_reference_is_rendered_from_that_tab_s_camera(server: viser.ViserServer) -> None:
     """Per tab, the SDF gallery renders its reference from its own tab's camera: a landscape tab gets a landscape
     image and a portrait tab a portrait one, and moving one tab's camera re-renders that tab's reference only."""
     need_gl()

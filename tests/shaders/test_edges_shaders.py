@@ -94,8 +94,7 @@ def glsl_blends(gl: Renderer, inputs: np.ndarray) -> tuple[np.ndarray, np.ndarra
 
     ctx = gl.ctx
     program = ctx.program(
-        vertex_shader=(gl_renderer.SHADER_DIR / "fullscreen.vert").read_text(),
-        fragment_shader=BLEND_PROBE.read_text(),
+        vertex_shader=(gl_renderer.SHADER_DIR / "fullscreen.vert").read_text(), fragment_shader=BLEND_PROBE.read_text()
     )
     n = len(inputs)
     source = ctx.texture((n, 1), 4, inputs.astype(np.float32).tobytes(), dtype="f4")
@@ -119,9 +118,7 @@ def glsl_blends(gl: Renderer, inputs: np.ndarray) -> tuple[np.ndarray, np.ndarra
 @given(
     k=st.one_of(st.sampled_from(TINY_WIDTHS), st.floats(0.0, 0.0010000000474974513, width=32)),
     a=st.lists(
-        st.one_of(st.sampled_from([0.0, 0.25, -0.25, 1e-30]), st.floats(-2.0, 2.0, width=32)),
-        min_size=8,
-        max_size=8,
+        st.one_of(st.sampled_from([0.0, 0.25, -0.25, 1e-30]), st.floats(-2.0, 2.0, width=32)), min_size=8, max_size=8
     ),
 )
 @settings(max_examples=examples(30), deadline=None)
@@ -170,8 +167,7 @@ FLOAT32_MAX = float(np.finfo(np.float32).max)
 @pytest.mark.gl
 @given(
     k=st.one_of(
-        st.sampled_from([0.0, 1e-40, 1.2e-38, 0.1, 1.0, 1e19, 1e30, FLOAT32_MAX]),
-        st.floats(0.0, 1e6, width=32),
+        st.sampled_from([0.0, 1e-40, 1.2e-38, 0.1, 1.0, 1e19, 1e30, FLOAT32_MAX]), st.floats(0.0, 1e6, width=32)
     ),
     values=st.lists(
         st.sampled_from([np.inf, -np.inf, FLOAT32_MAX, -FLOAT32_MAX, 1e30, -1e30, 0.0, 0.5, -0.5]),

@@ -146,9 +146,7 @@ def catalogue_scene() -> sdf.Scene:
 
 @pytest.mark.gl
 @pytest.mark.parametrize(
-    "scene",
-    [sdf.default_scene(), every_op_scene(), "catalogue"],
-    ids=["default", "every-op", "catalogue"],
+    "scene", [sdf.default_scene(), every_op_scene(), "catalogue"], ids=["default", "every-op", "catalogue"]
 )
 def test_raymarched_depth_matches_numpy_sphere_tracer(gl: Renderer, scene: sdf.Scene | str) -> None:
     if scene == "catalogue":
