@@ -114,7 +114,7 @@ def bench_reference(repeats: int) -> list[str]:
 
 def _bench_reference(renderer: Renderer, repeats: int) -> list[str]:
     scene = sdf.default_scene()
-    camera = Camera(SdfGalleryScene.camera_position, SdfGalleryScene.camera_look_at)
+    camera = Camera(SdfGalleryScene.opening_view.position, SdfGalleryScene.opening_view.look_at)
     rows = []
     for label, shading in [("full shading", Shading()), ("no shadows, no AO", Shading(shadows=False, occlusion=False))]:
         cpu_start = time.process_time()
@@ -221,7 +221,7 @@ def bench_gl_sharing() -> list[str]:
 
 def bench_view(repeats: int) -> list[str]:
     server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
-    camera = Camera(SdfGalleryScene.camera_position, SdfGalleryScene.camera_look_at)
+    camera = Camera(SdfGalleryScene.opening_view.position, SdfGalleryScene.opening_view.look_at)
     rows = []
     try:
         for label, march in [
@@ -267,7 +267,9 @@ def bench_edit(edits: int) -> list[str]:
     try:
         with BrowserClient(server.get_port()) as client:
             client.send_camera(
-                position=SdfGalleryScene.camera_position, look_at=SdfGalleryScene.camera_look_at, size=(400, 640)
+                position=SdfGalleryScene.opening_view.position,
+                look_at=SdfGalleryScene.opening_view.look_at,
+                size=(400, 640),
             )
             client.wait_for_gui("Apply")
             client.set_value("View", "Both")

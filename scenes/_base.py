@@ -33,6 +33,7 @@ import viser
 
 from scenes import _controls
 from scenes._controls import Controls, P
+from scenes._framing import View
 
 # The one bridge from the scenes to server/: a scene module imports what it needs of server/ from here.
 from server.clean import ControlSpec as ControlSpec
@@ -63,10 +64,8 @@ class Scene(abc.ABC, Generic[P]):
     """Human title shown in the scene switcher."""
     about: ClassVar[str]
     """Markdown for the About panel: what it shows, equations, assumptions, sources."""
-    camera_position: ClassVar[tuple[float, float, float]] = (6.0, -6.0, 4.0)
-    """Where the camera opens (world frame, m)."""
-    camera_look_at: ClassVar[tuple[float, float, float]] = (0.0, 0.0, 0.5)
-    """What the camera opens looking at (world frame, m)."""
+    opening_view: ClassVar[View] = View((6.0, -6.0, 4.0), (0.0, 0.0, 0.5))
+    """Where the camera opens and the point it looks at (world frame, m)."""
     params: P
     """What the user set, cleaned: the scene shows a function of it (set by the subclass before it builds)."""
 
@@ -111,7 +110,7 @@ class Scene(abc.ABC, Generic[P]):
         """The notifications :meth:`notify` showed and that may still be up, by id: (tab, handle, closes at)."""
         with self.gui_root, session.gui.add_folder("About", expand_by_default=False):
             session.gui.add_markdown(self.about)
-        session.frame_camera(self.camera_position, self.camera_look_at)
+        session.frame_camera(self.opening_view.position, self.opening_view.look_at)
 
     @property
     def state_lock(self) -> threading.RLock:

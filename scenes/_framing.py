@@ -39,6 +39,12 @@ class View:
     position: tuple[float, float, float]
     look_at: tuple[float, float, float]
 
+    @property
+    def direction(self) -> tuple[float, float, float]:
+        """From the position to the look-at point (m)."""
+        (px, py, pz), (lx, ly, lz) = self.position, self.look_at
+        return lx - px, ly - py, lz - pz
+
 
 def _basis(direction: NDArray[np.float64]) -> tuple[NDArray[np.float64], ...]:
     d = direction / np.linalg.norm(direction)

@@ -568,8 +568,7 @@ def _disc() -> trimesh.Trimesh:
 class ArmScene(Scene[ArmParams]):
     key = "arm"
     title = "Arm: FABRIK inverse kinematics"
-    camera_position = (0.3, -2.9, 1.0)
-    camera_look_at = (0.3, 0.0, 0.75)
+    opening_view = View((0.3, -2.9, 1.0), (0.3, 0.0, 0.75))
     about = """
 **What it shows.** A chain of 2–12 rigid links whose root is fixed. Drag the red target's gizmo (or click in the
 plane) and the chain's end follows it. The readout gives the iterations this frame took, the final error, the
@@ -626,7 +625,7 @@ is a static pose.
         self.solve_and_draw()
         self._framed_box: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None
         """(lo, hi) world box (m) of what the cameras were last framed to show."""
-        self.framing = ClientFraming(self._view_for, opening=self.camera_position)
+        self.framing = ClientFraming(self._view_for, opening=self.opening_view.position)
         self.watch_cameras(self.framing.on_camera)
 
     def close(self) -> None:

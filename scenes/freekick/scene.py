@@ -156,8 +156,7 @@ def _css(rgb: tuple[int, int, int]) -> str:
 class FreeKickScene(Scene[FreeKickParams]):
     key = "freekick"
     title = "Free kick: Magnus effect"
-    camera_position = (-31.0, -4.0, 3.6)
-    camera_look_at = (-6.0, 0.0, 1.4)
+    opening_view = View((-31.0, -4.0, 3.6), (-6.0, 0.0, 1.4))
     about = """
 **What it shows.** A free kick's flight in 3D over a four-man wall 9.15 m from the ball (1.8 m tall; 2.15 m when it
 jumps): the kick as set (thick orange line), the same kick with no spin (dark dashed ghost), a faint band between 10 % less
@@ -228,7 +227,7 @@ reads it again, so a ball that bounces in front of him beats him more often than
         self._build_gui()
         self._build_world()
         self.redraw()
-        self.framing = ClientFraming(self._view_for, opening=self.camera_position)
+        self.framing = ClientFraming(self._view_for, opening=self.opening_view.position)
         self.watch_cameras(self.framing.on_camera)
         # On a first start the map (1,271 kicks) waits for the compiled flight; plain Python would take ~10 s.
         warming.on_progress(self._on_kernels_compiled)

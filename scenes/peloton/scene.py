@@ -146,8 +146,7 @@ def _arrow_length(p: PelotonParams) -> float:
 class PelotonScene(Scene[PelotonParams]):
     key = "peloton"
     title = "Peloton: cycling power"
-    camera_position = (-2.0, -7.5, 2.8)
-    camera_look_at = (-3.2, 0.0, 1.0)
+    opening_view = View((-2.0, -7.5, 2.8), (-3.2, 0.0, 1.0))
     about = """
 **What it shows.** Riders at one speed: a line of up to eight with power bars, or a formation of up to 121 (two
 abreast, a bunch, an echelon) with each rider coloured by power. Each rider's power is split into pushing air (aero), tyre
@@ -192,7 +191,7 @@ time-averaged power is the mean over positions, far below the leader's.
         self.redraw()
         self._framed_for = self._framing_key()
         self._framed_points = self.line_points()
-        self.framing = ClientFraming(self._view_for, opening=self.camera_position)
+        self.framing = ClientFraming(self._view_for, opening=self.opening_view.position)
         self.watch_cameras(self.framing.on_camera)
         self.start_loop(self._animate, 1.0 / 30.0)
         self.course_mode = CourseMode(self)

@@ -106,8 +106,7 @@ def _rebounded(shape: Shape, shown: Shape | None) -> bool:
 class SdfGalleryScene(Scene[SdfGalleryParams]):
     key = "sdf"
     title = "SDF gallery (ray marching)"
-    camera_position = (1.9, -2.1, 1.4)
-    camera_look_at = (0.05, 0.0, 0.3)
+    opening_view = View((1.9, -2.1, 1.4), (0.05, 0.0, 0.3))
     about = """
 **What it shows.** A scene of up to four signed-distance primitives (sphere, box, torus, capsule and Quilez's
 cylinder, round box, octahedron, cone, hexagonal prism, ellipsoid) combined by union, subtraction or intersection,
@@ -214,7 +213,7 @@ IoU is lowest when a box edge is on the silhouette.
         self._build_gui()
         self._build_world()
         self._sync_enabled_inputs()
-        self.framing = ClientFraming(self._view_for, opening=self.camera_position)
+        self.framing = ClientFraming(self._view_for, opening=self.opening_view.position)
         """Frames each tab's camera on the shape and its gizmos when it opens (and when its window is resized), and
         again when a field applied in the editor, or a shape a control changed, leaves the picture."""
         self._mesh_and_show(self.params.scene(), self.params.resolution, moves=self._gizmo_moves)
@@ -230,11 +229,7 @@ IoU is lowest when a box edge is on the silhouette.
         canvas left of the panel (:func:`scenes._framing.frame_points`)."""
         return frame_points(
             self.framed_points(),
-            (
-                self.camera_look_at[0] - self.camera_position[0],
-                self.camera_look_at[1] - self.camera_position[1],
-                self.camera_look_at[2] - self.camera_position[2],
-            ),
+            self.opening_view.direction,
             fov_rad=lens.fov_rad,
             aspect=lens.aspect,
             ndc=lens.usable_ndc(),
@@ -672,7 +667,7 @@ IoU is lowest when a box edge is on the silhouette.
 
     def _camera_or_default(self) -> Camera:
         """The latest viewer's camera, or the scene's opening one before any viewer sent one."""
-        return self.viewer.camera or Camera(self.camera_position, self.camera_look_at)
+        return self.viewer.camera or Camera(self.opening_view.position, self.opening_view.look_at)
 
     def _apply_source(self, text: str, resolution: int, choice: int) -> None:
         """Check, compile, time and mesh an editor source; show it, or say why not and keep the last good one.

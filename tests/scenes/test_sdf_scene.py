@@ -462,7 +462,7 @@ def test_the_opening_view_shows_every_primitive_and_keeps_their_names_apart(scen
     # Once the capsule stood behind the sphere from the opening camera: three shapes in sight, and the label "P4
     # capsule" printed over "P1 sphere" at 1280×720.
     params = SdfGalleryParams()
-    camera = Camera(SdfGalleryScene.camera_position, SdfGalleryScene.camera_look_at)
+    camera = Camera(SdfGalleryScene.opening_view.position, SdfGalleryScene.opening_view.look_at)
     origins, directions = camera_rays(camera, 160, 100)
     depth = sdf.sphere_trace(params.scene(), origins, directions)
     hit = np.isfinite(depth)
@@ -481,8 +481,8 @@ def test_the_opening_view_shows_every_primitive_and_keeps_their_names_apart(scen
     )
     ndc = pinhole_ndc(
         tips,
-        np.array(SdfGalleryScene.camera_position),
-        np.array(SdfGalleryScene.camera_look_at),
+        np.array(SdfGalleryScene.opening_view.position),
+        np.array(SdfGalleryScene.opening_view.look_at),
         math.radians(75.0),
         width / height,
     )
