@@ -3,12 +3,13 @@ reference image and its readouts, downloads, and a clean teardown."""
 
 from __future__ import annotations
 
+import dataclasses
 import io
 import math
 import re
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
@@ -1063,33 +1064,44 @@ def _applied(client: BrowserClient, scene: SdfGalleryScene, source: str) -> trim
     return trimesh.Trimesh(scene.mesh_vertices, scene.mesh_faces)
 
 
-AT_BOTH_WINDOWS = pytest.mark.parametrize("size", [(1000, 1600), (720, 1280)], ids=["1600x1000", "1280x720"])
-"""Each test of the framing in the two windows the browser tests use, as canvas (height, width)."""
+@dataclasses.dataclass(frozen=True)
+class FramedTab:
+    """A tab the scene has framed, which reported the framed view back as a page does."""
 
+    client: BrowserClient
+    tab: viser.ClientHandle
+    size: tuple[int, int]
+    """Its canvas (height, width) in pixels."""
+    lens: Lens
 
-def _framed_tab(
-    server: viser.ViserServer, scene: SdfGalleryScene, client: BrowserClient, size: tuple[int, int]
-) -> tuple[viser.ClientHandle, Lens, Callable[[], View]]:
-    """Open ``client`` as a tab of canvas ``size`` (height, width), wait for the scene to frame it and report the
-    framed view back, as a page does; returns the tab, its lens and a reader of its current view."""
-    client.send_camera(size=size)
-    wait_until(lambda: len(server.get_clients()) == 1 and scene.framing.frames >= 1, "the opening framing")
-    (tab,) = server.get_clients().values()
-    lens = Lens(float(tab.camera.fov), size[1], size[0])
-
-    def view() -> View:
-        position, look_at = (tuple(float(v) for v in vec) for vec in (tab.camera.position, tab.camera.look_at))
+    def view(self) -> View:
+        """The tab's view as the server holds it now."""
+        position, look_at = (
+            tuple(float(v) for v in vec) for vec in (self.tab.camera.position, self.tab.camera.look_at)
+        )
         return View(position, look_at)  # type: ignore[arg-type]
 
-    framed = view()
-    client.send_camera(framed.position, framed.look_at, size)
-    return tab, lens, view
+    def report(self, view: View) -> None:
+        """Send ``view`` as the tab's camera, as a page does after a framing or an orbit."""
+        self.client.send_camera(view.position, view.look_at, self.size)
+
+
+@pytest.fixture(params=[(1000, 1600), (720, 1280)], ids=["1600x1000", "1280x720"])
+def framed(server: viser.ViserServer, scene: SdfGalleryScene, request: pytest.FixtureRequest) -> Iterator[FramedTab]:
+    """A tab in each of the two windows the browser tests use, framed by the scene."""
+    size: tuple[int, int] = request.param
+    with BrowserClient(server.get_port()) as client:
+        client.send_camera(size=size)
+        wait_until(lambda: len(server.get_clients()) == 1 and scene.framing.frames >= 1, "the opening framing")
+        (tab,) = server.get_clients().values()
+        framed = FramedTab(client, tab, size, Lens(float(tab.camera.fov), size[1], size[0]))
+        framed.report(framed.view())
+        yield framed
 
 
 @pytest.mark.gl
-@AT_BOTH_WINDOWS
 def test_a_field_applied_out_of_the_picture_is_brought_into_it_and_one_in_it_leaves_the_view(
-    server: viser.ViserServer, scene: SdfGalleryScene, size: tuple[int, int], monkeypatch: pytest.MonkeyPatch
+    scene: SdfGalleryScene, framed: FramedTab, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     # The failing input (an outside tester): a sphere at x = 1 m applied in the editor stayed half under the panel,
     # its bottom at the window's edge; the view was framed only when the tab opened.
@@ -1102,67 +1114,62 @@ def test_a_field_applied_out_of_the_picture_is_brought_into_it_and_one_in_it_lea
         keep_in_view(points, clear_of_notice=clear_of_notice)
 
     monkeypatch.setattr(scene.framing, "keep_in_view", slow_keep_in_view)
-    with BrowserClient(server.get_port()) as client:
-        _tab, lens, view = _framed_tab(server, scene, client, size)
-        opened = scene.framing.frames
-        apply_glsl(client, "float sdf(vec3 p) { return length(p - vec3(1.0, 0.0, 0.0)) - 0.4; }\n")
-        wait_until(lambda: scene.editor_serial == 1, "the apply", timeout_s=60.0)
-        # Counted only once framed: a view read now is whole (read between the position's write and the look-at
-        # point's, it kept the old look-at point, and the person's view sent back from it was moved on).
-        assert scene.framing.frames > opened
-        box = box_corners(scene.mesh_vertices.min(axis=0), scene.mesh_vertices.max(axis=0))
-        wait_until(lambda: shows(view(), lens, box, clear_of_notice=False), "the sphere in the picture", timeout_s=10.0)
-        # A field that is already in the picture keeps the person's view.
-        held = view()
-        client.send_camera(held.position, held.look_at, size)
-        time.sleep(0.3)
-        frames = scene.framing.frames
-        apply_glsl(client, "float sdf(vec3 p) { return length(p - vec3(1.0, 0.0, 0.0)) - 0.35; }\n")
-        wait_until(lambda: scene.editor_serial == 2, "the second apply", timeout_s=60.0)
-        time.sleep(0.3)
-        assert scene.framing.frames == frames and view() == held
+    opened = scene.framing.frames
+    apply_glsl(framed.client, "float sdf(vec3 p) { return length(p - vec3(1.0, 0.0, 0.0)) - 0.4; }\n")
+    wait_until(lambda: scene.editor_serial == 1, "the apply", timeout_s=60.0)
+    # Counted only once framed: a view read now is whole (read between the position's write and the look-at
+    # point's, it kept the old look-at point, and the person's view sent back from it was moved on).
+    assert scene.framing.frames > opened
+    box = box_corners(scene.mesh_vertices.min(axis=0), scene.mesh_vertices.max(axis=0))
+    wait_until(lambda: shows(framed.view(), framed.lens, box, clear_of_notice=False), "the sphere in the picture")
+    # A field that is already in the picture keeps the person's view.
+    held = framed.view()
+    framed.report(held)
+    time.sleep(0.3)
+    frames = scene.framing.frames
+    apply_glsl(framed.client, "float sdf(vec3 p) { return length(p - vec3(1.0, 0.0, 0.0)) - 0.35; }\n")
+    wait_until(lambda: scene.editor_serial == 2, "the second apply", timeout_s=60.0)
+    time.sleep(0.3)
+    assert scene.framing.frames == frames and framed.view() == held
 
 
 @pytest.mark.gl
-@AT_BOTH_WINDOWS
 def test_a_field_that_wider_bounds_bring_out_of_the_picture_is_followed_and_one_in_it_keeps_the_view(
-    server: viser.ViserServer, scene: SdfGalleryScene, size: tuple[int, int]
+    scene: SdfGalleryScene, framed: FramedTab
 ) -> None:
     # The editor's field is meshed in a box: of two spheres, the one at x = 2.2 m lies outside the ±1 m box they are
     # applied in, and widening the box to ±3 m meshes it where the opening view does not reach. The view follows the
     # new mesh once; narrowing the box a little, with both spheres already in the picture, leaves the view as it is.
-    with BrowserClient(server.get_port()) as client:
-        tab, lens, view = _framed_tab(server, scene, client, size)
-        opening = view()
-        client.wait_for_gui("Editor bounds half size (m)")
-        client.set_value("Editor bounds half size (m)", 1.0)
-        apply_glsl(
-            client, "float sdf(vec3 p) { return min(length(p) - 0.3, length(p - vec3(2.2, 0.0, 0.0)) - 0.4); }\n"
-        )
-        wait_until(lambda: scene.editor_serial == 1, "the apply", timeout_s=60.0)
-        meshes, frames = scene.mesh_serial, scene.framing.frames
-        client.set_value("Editor bounds half size (m)", 3.0)
-        wait_until(lambda: scene.mesh_serial > meshes and scene.params.editor.half_size == 3.0, "the wider remesh")
-        box = box_corners(scene.mesh_vertices.min(axis=0), scene.mesh_vertices.max(axis=0))
-        assert scene.mesh_vertices[:, 0].max() > 2.5  # the far sphere, where the opening view did not reach
-        assert not shows(opening, lens, box, clear_of_notice=False)
-        # Read once the framing has written both the position and the look-at point (not between the two).
-        wait_until(lambda: scene.framing.frames > frames, "the view followed", timeout_s=10.0)
-        assert shows(view(), lens, box, clear_of_notice=False)
-        # The person steps back a little (the framed view is tight), then narrows the box: both spheres stay in view.
-        followed = view()
-        client.send_camera(followed.position, followed.look_at, size)  # the tab reports the framed view
-        wait_until(lambda: not scene.framing.pending(tab.client_id), "the framed view reported")
-        eye = np.add(followed.look_at, 1.3 * np.subtract(followed.position, followed.look_at))
-        held = View(tuple(float(v) for v in eye), followed.look_at)  # type: ignore[arg-type]
-        client.send_camera(held.position, held.look_at, size)
-        wait_until(lambda: np.allclose(view().position, held.position, atol=1e-6), "the step back")
-        held = view()
-        frames, meshes = scene.framing.frames, scene.mesh_serial
-        client.set_value("Editor bounds half size (m)", 2.8)
-        wait_until(lambda: scene.mesh_serial > meshes and scene.params.editor.half_size == 2.8, "the narrower remesh")
-        time.sleep(0.3)
-        assert scene.framing.frames == frames and view() == held
+    opening = framed.view()
+    framed.client.wait_for_gui("Editor bounds half size (m)")
+    framed.client.set_value("Editor bounds half size (m)", 1.0)
+    apply_glsl(
+        framed.client, "float sdf(vec3 p) { return min(length(p) - 0.3, length(p - vec3(2.2, 0.0, 0.0)) - 0.4); }\n"
+    )
+    wait_until(lambda: scene.editor_serial == 1, "the apply", timeout_s=60.0)
+    meshes, frames = scene.mesh_serial, scene.framing.frames
+    framed.client.set_value("Editor bounds half size (m)", 3.0)
+    wait_until(lambda: scene.mesh_serial > meshes and scene.params.editor.half_size == 3.0, "the wider remesh")
+    box = box_corners(scene.mesh_vertices.min(axis=0), scene.mesh_vertices.max(axis=0))
+    assert scene.mesh_vertices[:, 0].max() > 2.5  # the far sphere, where the opening view did not reach
+    assert not shows(opening, framed.lens, box, clear_of_notice=False)
+    # Read once the framing has written both the position and the look-at point (not between the two).
+    wait_until(lambda: scene.framing.frames > frames, "the view followed", timeout_s=10.0)
+    assert shows(framed.view(), framed.lens, box, clear_of_notice=False)
+    # The person steps back a little (the framed view is tight), then narrows the box: both spheres stay in view.
+    followed = framed.view()
+    framed.report(followed)  # the tab reports the framed view
+    wait_until(lambda: not scene.framing.pending(framed.tab.client_id), "the framed view reported")
+    eye = np.add(followed.look_at, 1.3 * np.subtract(followed.position, followed.look_at))
+    held = View(tuple(float(v) for v in eye), followed.look_at)  # type: ignore[arg-type]
+    framed.report(held)
+    wait_until(lambda: np.allclose(framed.view().position, held.position, atol=1e-6), "the step back")
+    held = framed.view()
+    frames, meshes = scene.framing.frames, scene.mesh_serial
+    framed.client.set_value("Editor bounds half size (m)", 2.8)
+    wait_until(lambda: scene.mesh_serial > meshes and scene.params.editor.half_size == 2.8, "the narrower remesh")
+    time.sleep(0.3)
+    assert scene.framing.frames == frames and framed.view() == held
 
 
 @pytest.mark.gl
@@ -1354,47 +1361,44 @@ def test_the_opening_view_frames_the_shape_large_with_its_gizmos(scene: SdfGalle
 
 
 @pytest.mark.gl
-@AT_BOTH_WINDOWS
 def test_primitives_grown_out_of_the_picture_by_their_sliders_are_followed_and_a_gizmo_drag_keeps_the_view(
-    server: viser.ViserServer, scene: SdfGalleryScene, size: tuple[int, int]
+    scene: SdfGalleryScene, framed: FramedTab
 ) -> None:
     # An outside tester: P1 alone as an octahedron of a = 1 m ran off the top of the view (and a smooth blend at
     # k = 1 under the panel), which was framed only when the tab opened.
-    with BrowserClient(server.get_port()) as client:
-        tab, lens, view = _framed_tab(server, scene, client, size)
-        client.wait_for_gui("P4 on")
-        for slot in (2, 3, 4):
-            client.set_value(f"P{slot} on", False)
-        client.set_value("P1 kind", "Octahedron")
-        wait_until(
-            lambda: (
-                scene.params.primitives[0].kind == "octahedron"
-                and not any(slot.enabled for slot in scene.params.primitives[1:])
-                and scene.mesh_shape == scene.params.scene()
-            ),
-            "the octahedron meshed",
-            timeout_s=60.0,
-        )
-        opening = view()
-        frames = scene.framing.frames
-        client.set_value("P1 size a (m)", 1.0)
-        wait_until(
-            lambda: scene.params.primitives[0].size[0] == 1.0 and scene.mesh_shape == scene.params.scene(), "the remesh"
-        )
-        box = box_corners(scene.mesh_vertices.min(axis=0), scene.mesh_vertices.max(axis=0))
-        assert not shows(opening, lens, box, clear_of_notice=False)
-        wait_until(lambda: scene.framing.frames > frames, "the view followed", timeout_s=10.0)
-        wait_until(lambda: shows(view(), lens, box, clear_of_notice=False), "the octahedron in the picture")
-        # Dragging the gizmo out of the picture moves the shape, not the camera.
-        assert scene.wait_idle()
-        held = view()
-        client.send_camera(held.position, held.look_at, size)  # the tab reports the framed view
-        wait_until(lambda: not scene.framing.pending(tab.client_id), "the framed view reported")
-        frames = scene.framing.frames
-        client.drag_transform(scene.gizmos[0].name, [(0.6, 0.6, 0.6), (1.2, 1.2, 1.2), (1.5, 1.5, 1.5)])
-        wait_until(
-            lambda: scene.params.primitives[0].position == (1.5, 1.5, 1.5) and scene.mesh_shape == scene.params.scene(),
-            "the moved mesh",
-        )
-        time.sleep(0.3)
-        assert scene.framing.frames == frames and view() == held
+    framed.client.wait_for_gui("P4 on")
+    for slot in (2, 3, 4):
+        framed.client.set_value(f"P{slot} on", False)
+    framed.client.set_value("P1 kind", "Octahedron")
+    wait_until(
+        lambda: (
+            scene.params.primitives[0].kind == "octahedron"
+            and not any(slot.enabled for slot in scene.params.primitives[1:])
+            and scene.mesh_shape == scene.params.scene()
+        ),
+        "the octahedron meshed",
+        timeout_s=60.0,
+    )
+    opening = framed.view()
+    frames = scene.framing.frames
+    framed.client.set_value("P1 size a (m)", 1.0)
+    wait_until(
+        lambda: scene.params.primitives[0].size[0] == 1.0 and scene.mesh_shape == scene.params.scene(), "the remesh"
+    )
+    box = box_corners(scene.mesh_vertices.min(axis=0), scene.mesh_vertices.max(axis=0))
+    assert not shows(opening, framed.lens, box, clear_of_notice=False)
+    wait_until(lambda: scene.framing.frames > frames, "the view followed", timeout_s=10.0)
+    wait_until(lambda: shows(framed.view(), framed.lens, box, clear_of_notice=False), "the octahedron in the picture")
+    # Dragging the gizmo out of the picture moves the shape, not the camera.
+    assert scene.wait_idle()
+    held = framed.view()
+    framed.report(held)  # the tab reports the framed view
+    wait_until(lambda: not scene.framing.pending(framed.tab.client_id), "the framed view reported")
+    frames = scene.framing.frames
+    framed.client.drag_transform(scene.gizmos[0].name, [(0.6, 0.6, 0.6), (1.2, 1.2, 1.2), (1.5, 1.5, 1.5)])
+    wait_until(
+        lambda: scene.params.primitives[0].position == (1.5, 1.5, 1.5) and scene.mesh_shape == scene.params.scene(),
+        "the moved mesh",
+    )
+    time.sleep(0.3)
+    assert scene.framing.frames == frames and framed.view() == held
