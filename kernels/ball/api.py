@@ -246,11 +246,15 @@ def _refuse_overflow(
             f"{launches[int(inside[0]), :3].tolist()} m); it would leave the body with no contact: start it outside"
         )
     bad = np.flatnonzero(endings == 3)
-    if bad.size and config[Q] == 0.0:  # no air: nothing to overshoot; the flight outran the floats
-        which = "the flight" if len(endings) == 1 else f"the flights of kicks {bad[:5].tolist()}"
+    if bad.size and config[Q] == 0.0:
+        # No air: nothing to overshoot, and the spin is bounded (refuse_fast_spin). What overflows is the square of
+        # a speed over ~1.34e154 m/s (|v|² > 1.8e308), long before any position can: t_max is at most 10⁶ steps.
+        first = int(bad[0])
+        subject = "speed_ms" if strikes else "velocity" if len(endings) == 1 else f"velocities[{first}]"
+        speed = math.hypot(*launches[first, 3:6].tolist())
         raise ValueError(
-            f"t_max = {config[T_MAX]:g} s is too long for {which}: with no air (air_density 0) nothing slows the "
-            "ball, and it leaves the range of floating-point numbers; use a shorter t_max"
+            f"{subject}: a launch at {speed:.3g} m/s is beyond floating-point numbers (its square overflows); "
+            "launch it slower"
         )
     if bad.size:
         which = "the flight" if len(endings) == 1 else f"kicks {bad[:5].tolist()}"
