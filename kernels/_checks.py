@@ -57,6 +57,11 @@ def shown(value: object) -> str:
     return text if len(text) <= _SHOWN_CHARS else text[: _SHOWN_CHARS - 1] + "…"
 
 
+def and_more(count: int) -> str:
+    """What follows the first of ``count`` refused values in a message: `` (and 2 more)``, or nothing for one."""
+    return "" if count <= 1 else f" (and {count - 1} more)"
+
+
 _REPR = reprlib.Repr()
 _REPR.maxlist = _REPR.maxtuple = _REPR.maxdict = _REPR.maxset = 6
 _REPR.maxstring, _REPR.maxother = _SHOWN_CHARS, 80

@@ -228,7 +228,7 @@ def _check_values(
             first = int(np.argmax(bad))
             reading = "not a number" if np.isnan(values[first]) else "infinite"
             raise ValueError(
-                f"{label}: {kind} point {first + 1}'s {what} is {reading}; {int(bad.sum())} point(s) like it"
+                f"{label}: {kind} point {first + 1}'s {what} is {reading}{_checks.and_more(int(bad.sum()))}"
             )
         out = (values < low) | (values > high)
         if np.any(out):

@@ -342,8 +342,8 @@ def _check_range(name: str, key: str, values: NDArray[np.float64], low: float, h
     if np.any(out):
         first = int(np.argmax(out))
         raise ValueError(
-            f"{name}: {key} outside [{low:g}, {high:g}]: point {first} is {_checks.shown(float(values[first]))}, "
-            f"{int(out.sum())} point(s) like it"
+            f"{name}: {key} outside [{low:g}, {high:g}]: point {first} is {_checks.shown(float(values[first]))}"
+            + _checks.and_more(int(out.sum()))
         )
 
 

@@ -1194,9 +1194,9 @@ def test_a_grade_and_a_size_just_past_their_bounds_read_past_them() -> None:
 @pytest.mark.parametrize(
     ("lat", "lon", "ele", "expected"),
     [
-        (45.0, 180.0002, 10.0, "r: longitude_deg outside [-180, 180]: point 1 is 180.0002, 1 point(s) like it"),
-        (-90.000001, 6.0, 10.0, "r: latitude_deg outside [-90, 90]: point 1 is -90.000001, 1 point(s) like it"),
-        (45.001, 6.0, 10_000.01, "r: elevation_m outside [-10000, 10000]: point 1 is 10000.01, 1 point(s) like it"),
+        (45.0, 180.0002, 10.0, "r: longitude_deg outside [-180, 180]: point 1 is 180.0002"),
+        (-90.000001, 6.0, 10.0, "r: latitude_deg outside [-90, 90]: point 1 is -90.000001"),
+        (45.001, 6.0, 10_000.01, "r: elevation_m outside [-10000, 10000]: point 1 is 10000.01"),
     ],
 )
 def test_the_builders_name_an_out_of_range_value_in_full(lat: float, lon: float, ele: float, expected: str) -> None:
@@ -1204,3 +1204,15 @@ def test_the_builders_name_an_out_of_range_value_in_full(lat: float, lon: float,
         course.course_from_points([45.0, lat], [6.0, lon], [10.0, ele], name="r")
     print(refused.value)
     assert str(refused.value) == expected
+
+
+def test_a_refusal_counts_the_other_bad_points_only_when_there_are_some() -> None:
+    # An outside tester read "track point 6's elevation is not a number; 1 point(s) like it" as two bad points.
+    nan = float("nan")
+    one = gpx_text([(45.0, 6.0, 1.0), (45.001, 6.0, nan), (45.002, 6.0, 3.0)])
+    assert _refusal(one).endswith("track point 2's elevation is not a number")
+    three = gpx_text([(45.0, 6.0, 1.0), (45.001, 6.0, nan), (45.002, 6.0, nan), (45.003, 6.0, nan)])
+    assert _refusal(three).endswith("track point 2's elevation is not a number (and 2 more)")
+    with pytest.raises(ValueError) as refused:
+        course.course_from_points([45.0, 45.0, 45.0], [6.0, 180.5, -181.0], [10.0, 10.0, 10.0], name="r")
+    assert str(refused.value) == "r: longitude_deg outside [-180, 180]: point 1 is 180.5 (and 1 more)"
