@@ -773,16 +773,19 @@ IoU is lowest when a box edge is on the silhouette.
         with self._lock:
             if self.closed:
                 return
-            # A field re-bounded in the editor may lie anywhere in its new box, and primitives changed by a control
-            # (a size, a kind, one turned on, the blend) may outgrow the picture: the view follows either if it
-            # left the picture (a newly applied field is followed by _apply_source, once the scene shows the
-            # editor). A gizmo's drag never moves the view, here or since the last mesh: it would pull the camera.
+            # A field re-bounded in the editor may lie anywhere in its new box, primitives changed by a control
+            # (a size, a kind, one turned on, the blend) may outgrow the picture, and the Shape menu turned from the
+            # one to the other shows what the last view was not framed for: the view follows if it left the picture
+            # (a newly applied field is followed by _apply_source, once the scene shows the editor). A gizmo's drag
+            # never moves the view, here or since the last mesh: it would pull the camera.
             unmoved = moves is not None and moves == self._moves_at_mesh
             if not preview:
                 self._moves_at_mesh = moves
             shown = self.mesh_shape
+            switched = shown is not None and isinstance(shape, EditorField) != isinstance(shown, EditorField)
             follow = not preview and (
-                _rebounded(shape, shown)
+                switched
+                or _rebounded(shape, shown)
                 or (isinstance(shape, sdf.Scene) and isinstance(shown, sdf.Scene) and shape != shown and unmoved)
             )
             with self.server.atomic():

@@ -30,6 +30,7 @@ from trimesh.visual.texture import TextureVisuals
 from kernels import sdf
 from scenes._framing import Lens, View, box_corners, shows
 from scenes.sdf_gallery import SdfGalleryParams, SdfGalleryScene
+from scenes.sdf_gallery.editor import EditorField
 from scenes.sdf_gallery.params import RESOLUTION_LABEL
 from shaders import gl_service
 from shaders.camera import camera_rays
@@ -1338,21 +1339,13 @@ def test_the_opening_view_frames_the_shape_large_with_its_gizmos(scene: SdfGalle
     """The shape spans at least 55 % of the view left of the panel (it spanned 25–30 %, off to one side), and every
     gizmo's arrows, rings and label stay inside that view."""
     from scenes._framing import MARGIN_PX, PANEL_PX, Lens, box_corners, project_points
-    from scenes.sdf_gallery.params import GIZMO_MARKER_RADIUS_M, gizmo_reach
 
     lens = Lens(math.radians(75.0), *size)
     view = scene._view_for(lens)
     with scene._lock:
         vertices = scene.mesh_vertices if len(scene.mesh_vertices) else scene._opening_vertices
         shape = project_points(view, lens, box_corners(vertices.min(axis=0), vertices.max(axis=0)))
-        gizmos = np.vstack(
-            [
-                np.asarray(slot.position)
-                + (gizmo_reach(slot) + 2.5 * GIZMO_MARKER_RADIUS_M) * np.vstack([np.eye(3), -np.eye(3)])
-                for slot in scene.params.primitives
-                if slot.enabled
-            ]
-        )
+        gizmos = scene_points_of_primitives(scene)
     left, right, top, bottom = MARGIN_PX, size[0] - PANEL_PX - MARGIN_PX, MARGIN_PX, size[1] - MARGIN_PX
     assert np.ptp(shape[:, 0]) >= 0.55 * (right - left) or np.ptp(shape[:, 1]) >= 0.55 * (bottom - top)
     xy = project_points(view, lens, gizmos)
@@ -1402,3 +1395,43 @@ def test_primitives_grown_out_of_the_picture_by_their_sliders_are_followed_and_a
     )
     time.sleep(0.3)
     assert scene.framing.frames == frames and framed.view() == held
+
+
+@pytest.mark.gl
+def test_turning_the_shape_menu_back_to_the_primitives_frames_them(scene: SdfGalleryScene, framed: FramedTab) -> None:
+    # An outside tester: the grid-of-octahedra example was framed, and Shape turned back to the primitives kept that
+    # view, with the sphere's and the box's tops and their labels above the window.
+    framed.client.wait_for_gui("Shape")
+    framed.client.set_value("Shape", "GLSL editor")
+    framed.client.set_value("Example", "Repetition: a 5 x 3 grid of octahedra")
+    wait_until(lambda: scene.editor_serial >= 1 and "Repetition" in scene.params.editor.source, "the example applied")
+    assert scene.wait_idle()
+    assert not shows(framed.view(), framed.lens, scene_points_of_primitives(scene), clear_of_notice=False)
+    framed.report(framed.view())
+    wait_until(lambda: not scene.framing.pending(framed.tab.client_id), "the framed view reported")
+    frames = scene.framing.frames
+    framed.client.set_value("Shape", "Primitives (panels below)")
+    wait_until(lambda: isinstance(scene.mesh_shape, sdf.Scene) and scene.framing.frames > frames, "the view followed")
+    assert shows(framed.view(), framed.lens, scene.framed_points(), clear_of_notice=False)
+    # And back: the grid, wider than the primitives' view, is framed again.
+    framed.report(framed.view())
+    wait_until(lambda: not scene.framing.pending(framed.tab.client_id), "the framed view reported")
+    frames = scene.framing.frames
+    framed.client.set_value("Shape", "GLSL editor")
+    wait_until(lambda: isinstance(scene.mesh_shape, EditorField) and scene.framing.frames > frames, "the view followed")
+    grid = box_corners(scene.mesh_vertices.min(axis=0), scene.mesh_vertices.max(axis=0))
+    assert shows(framed.view(), framed.lens, grid, clear_of_notice=False)
+
+
+def scene_points_of_primitives(scene: SdfGalleryScene) -> np.ndarray:
+    """What the view must show of the gallery's primitives: each enabled one's gizmo reach about its centre."""
+    from scenes.sdf_gallery.params import GIZMO_MARKER_RADIUS_M, gizmo_reach
+
+    return np.vstack(
+        [
+            np.asarray(slot.position)
+            + (gizmo_reach(slot) + 2.5 * GIZMO_MARKER_RADIUS_M) * np.vstack([np.eye(3), -np.eye(3)])
+            for slot in scene.params.primitives
+            if slot.enabled
+        ]
+    )
