@@ -149,6 +149,9 @@ IoU is lowest when a box edge is on the silhouette.
         """Time to ray-march it (ms)."""
         self.editor_error: str | None = None
         """Why the latest editor source was refused (None once one is applied)."""
+        self._bounds_refused = False
+        """Whether ``editor_error`` is a remesh's of the applied field in new bounds (the next good one clears it),
+        not a refused source's (which stands until a source is applied)."""
         self.editor_serial = 0
         """How many editor sources have been applied, counted once an apply is complete (its view framed too)."""
         self.mesh_serial = 0
@@ -506,8 +509,8 @@ IoU is lowest when a box edge is on the silhouette.
         alone would leave it unexplained)."""
         self.editor_status.content = status if editor.editing_allowed() else f"{EDITING_OFF}\n\n{status}"
 
-    def _show_editor_error(self, message: str) -> None:
-        self.editor_error = message
+    def _show_editor_error(self, message: str, *, bounds: bool = False) -> None:
+        self.editor_error, self._bounds_refused = message, bounds
         with self._lock:
             if not self.closed:
                 self._show_editor_status(f"**Not applied.** {message}\n\nThe last good shape stays on screen.")
@@ -563,7 +566,7 @@ IoU is lowest when a box edge is on the silhouette.
         except GLUnavailableError as exc:
             self._no_gl(exc)
         except ShaderCompileError as exc:  # a remesh of the editor's field found no surface
-            self._show_editor_error(str(exc))
+            self._show_editor_error(str(exc), bounds=True)
         except Exception:
             # One failed mesh or render must not stop every later one: log it and wait for new input.
             logger.exception("sdf: meshing or rendering failed; keeping the last good picture")
@@ -697,13 +700,13 @@ IoU is lowest when a box edge is on the silhouette.
                 return
             if self._turned_away(choice):
                 self.params = dataclasses.replace(self.params, editor=field)
-                self.editor_error = None
+                self.editor_error, self._bounds_refused = None, False
                 self.editor_serial += 1
                 self._show_editor_status(f"**Applied** in {total_ms:.0f} ms{_SEE_IT}")
                 self._request_mesh()  # the chosen shape, also where the Apply took the request that chose it
                 return
             self.params = dataclasses.replace(self.params, editor=field, shape_source="editor")
-            self.editor_error = None
+            self.editor_error, self._bounds_refused = None, False
             with self._state:  # an older field asked for while this one compiled (Shape turned away and back)
                 if isinstance(self._wanted_scene, EditorField):
                     self._wanted_scene = None
@@ -801,6 +804,9 @@ IoU is lowest when a box edge is on the silhouette.
                     self.mesh_vertices, self.mesh_faces, self.mesh_colors = vertices, faces, colors
                     self.mesh_shape = shape
                     note = editor.mesh_warning(shape, vertices, faces) if isinstance(shape, EditorField) else ""
+                    if isinstance(shape, EditorField) and self._bounds_refused:  # the box that had no surface is gone
+                        self.editor_error, self._bounds_refused = None, False
+                        self._show_editor_status(f"**Meshed again** in the ±{shape.half_size:g} m box.")
                     set_if_changed(self.mesh_note, "content", note)
                     set_if_changed(self.mesh_note, "visible", bool(note))
                     self.mesh_scene = shape if isinstance(shape, sdf.Scene) else None

@@ -1042,6 +1042,33 @@ def test_a_field_cut_open_by_its_bounds_says_so_and_a_whole_one_does_not(
 
 
 @pytest.mark.gl
+def test_bounds_with_no_surface_say_so_until_bounds_that_have_one_and_a_refused_source_stands(
+    server: viser.ViserServer, scene: SdfGalleryScene
+) -> None:
+    # An outside tester: a sphere of 1.2 m in bounds of ±0.5 m was "Not applied ... every sample of the ±0.5 m box
+    # is inside", rightly; at ±3 m it was meshed again, and the status still said so (beside a mesh that had one).
+    with BrowserClient(server.get_port()) as client:
+        _applied(client, scene, "float sdf(vec3 p) { return length(p) - 1.2; }\n")
+        status = scene.editor_status.content
+        client.set_value("Editor bounds half size (m)", 0.5)
+        wait_until(lambda: scene.editor_status.content != status, "the narrow bounds refused")
+        assert "**Not applied.**" in scene.editor_status.content and "±0.5 m box" in scene.editor_status.content
+        meshes = scene.mesh_serial
+        client.set_value("Editor bounds half size (m)", 3.0)
+        wait_until(lambda: scene.mesh_serial > meshes and scene.params.editor.half_size == 3.0, "the wide remesh")
+        assert scene.wait_idle()
+        assert scene.editor_error is None and scene.editor_status.content.startswith("**Meshed again** in the ±3 m box")
+        # A refused source stands through a remesh of the shape on screen: the editor still holds it.
+        apply_glsl(client, "float sdf(vec3 p) { return length(p) - ; }\n")
+        wait_until(lambda: scene.editor_error is not None, "the refusal")
+        meshes = scene.mesh_serial
+        client.set_value("Editor bounds half size (m)", 2.5)
+        wait_until(lambda: scene.mesh_serial > meshes, "the remesh")
+        assert scene.wait_idle()
+        assert scene.editor_error is not None and "**Not applied.**" in scene.editor_status.content
+
+
+@pytest.mark.gl
 def test_a_field_turned_inside_out_says_so_and_its_negation_does_not(
     server: viser.ViserServer, scene: SdfGalleryScene
 ) -> None:
