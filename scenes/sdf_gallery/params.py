@@ -374,8 +374,9 @@ def _reach(kind: sdf.PrimitiveKind, size: tuple[float, ...], wxyz: tuple[float, 
 
 
 def gizmo_label(index: int, slot: PrimitiveParams) -> str:
-    """The name shown by the gizmo of slot ``index`` (from 0): "P1 sphere"."""
-    return f"P{index + 1} {slot.kind}"
+    """The name shown by the gizmo of slot ``index`` (from 0): "P1 sphere", "P2 round box", the kind's menu label
+    in lower case without its note ("Ellipsoid (bound)" is "ellipsoid")."""
+    return f"P{index + 1} {sdf.PRIMITIVES[slot.kind].label.split(' (')[0].lower()}"
 
 
 def gizmo_tips(reach: float) -> tuple[tuple[float, float, float], tuple[float, float, float]]:

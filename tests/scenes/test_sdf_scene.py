@@ -443,11 +443,9 @@ def test_each_gizmo_is_sized_coloured_and_named_for_its_own_primitive(
     # Sphere r = 0.45 m, box half size 0.3 m, torus ring 0.6 + 0.12 m, capsule 0.3 + 0.14 m: each plus the margin.
     reach = np.array([0.45, 0.3, 0.72, 0.44]) + GIZMO_MARGIN_M
     assert scales == pytest.approx(reach, abs=0.011)
-    for i, (marker, label, slot) in enumerate(
-        zip(scene.gizmo_markers, scene.gizmo_labels, scene.params.primitives, strict=True)
-    ):
+    for marker, slot in zip(scene.gizmo_markers, scene.params.primitives, strict=True):
         assert tuple(marker.color) == slot.color
-        assert label.text == f"P{i + 1} {slot.kind}"
+    assert [label.text for label in scene.gizmo_labels] == ["P1 sphere", "P2 box", "P3 torus", "P4 capsule"]
     assert len({tuple(m.color) for m in scene.gizmo_markers}) == 4
     # The sphere's gizmo follows its radius: 0.45 m → 0.25 m.
     with BrowserClient(server.get_port()) as client:
@@ -497,10 +495,18 @@ def test_the_opening_view_shows_every_primitive_and_keeps_their_names_apart(scen
 
 
 @pytest.mark.parametrize(
-    ("label", "kind"), [("Cylinder", "cylinder"), ("Octahedron", "octahedron"), ("Ellipsoid (bound)", "ellipsoid")]
+    ("label", "kind", "shown"),
+    [
+        ("Cylinder", "cylinder", "P2 cylinder"),
+        ("Octahedron", "octahedron", "P2 octahedron"),
+        ("Ellipsoid (bound)", "ellipsoid", "P2 ellipsoid"),
+        # An outside tester: the gizmo said "P2 round_box" and "P2 hex_prism", the code's names, not the menu's.
+        ("Round box", "round_box", "P2 round box"),
+        ("Hexagonal prism", "hex_prism", "P2 hexagonal prism"),
+    ],
 )
-def test_catalogue_primitives_from_the_dropdown_are_meshed(
-    server: viser.ViserServer, scene: SdfGalleryScene, label: str, kind: str
+def test_catalogue_primitives_from_the_dropdown_are_meshed_and_named(
+    server: viser.ViserServer, scene: SdfGalleryScene, label: str, kind: str, shown: str
 ) -> None:
     from scenes.sdf_gallery.params import KIND_LABELS
 
@@ -519,6 +525,7 @@ def test_catalogue_primitives_from_the_dropdown_are_meshed(
         # The mesh's vertices lie on the surface of the scene with the new kind.
         d = sdf.scene_distance(meshed, scene.mesh_vertices)
         assert np.abs(d).max() < 0.5 * sdf.make_grid(meshed, scene.params.resolution).spacing
+        assert scene.gizmo_labels[1].text == shown
 
 
 # ------------------------------------------------------------------------------------------ editor and view
