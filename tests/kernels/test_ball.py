@@ -791,7 +791,9 @@ def test_huge_parameters_give_a_finite_flight_or_an_error_naming_dt(
 
 def test_a_launch_whose_speed_squared_overflows_in_no_air_is_refused_naming_the_velocity() -> None:
     # An explore run's case: no air and |v| = 1.3408e154 m/s, whose square passes 1.8e308, was told "t_max = 4 s is
-    # too long ... use a shorter t_max", which no t_max mends. Just under it the flight is finite.
+    # too long ... use a shorter t_max", which no t_max mends (a flight that outruns the floats in a vacuum's long
+    # t_max still names t_max: test_a_flight_in_a_vacuum_that_outruns_the_floats_names_t_max). Just under it the
+    # flight is finite.
     spin = (0.0, 0.0, 50.0)
     arguments: dict[str, Any] = {"dt": 0.0625, "air_density": 0.0, "mass_kg": 1.0, "t_max": 4.0}
     fast = 9.480751908109177e153
