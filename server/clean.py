@@ -148,14 +148,18 @@ def finite_vector(value: object, length: int) -> tuple[float, ...] | None:
 
 
 def unit_quaternion(value: object) -> tuple[float, float, float, float] | None:
-    """``value`` as a unit wxyz quaternion, or None when it is not 4 finite numbers with a non-zero norm."""
+    """``value`` as a unit wxyz quaternion, or None when it is not 4 finite numbers, not all zero."""
     q = finite_vector(value, 4)
     if q is None:
         return None
-    norm = math.hypot(*q)  # overflow-safe for components near 1e308
-    if not (math.isfinite(norm) and norm > 1e-12):
+    largest = max(abs(component) for component in q)
+    if largest == 0.0:
         return None
-    w, x, y, z = (component / norm for component in q)
+    # Scaled to a largest component of ±1 first: the norm neither overflows (1e308) nor loses its digits in
+    # subnormals (a 1e-300 quaternion, which the SDF kernel accepts, was refused as having no norm).
+    scaled = [component / largest for component in q]
+    norm = math.hypot(*scaled)
+    w, x, y, z = (component / norm for component in scaled)
     return (w, x, y, z)
 
 

@@ -648,7 +648,7 @@ class Gate:
         if position is None:
             self.log.refuse("gizmo position (not 3 finite numbers)", f"{message.position!r}"[:200])
         if wxyz is None:
-            self.log.refuse("gizmo orientation (not 4 finite numbers with a non-zero norm)", f"{message.wxyz!r}"[:200])
+            self.log.refuse("gizmo orientation (not 4 finite numbers, or all zero)", f"{message.wxyz!r}"[:200])
         last_position = tuple(float(v) for v in handle.position)
         last_wxyz = tuple(float(v) for v in handle.wxyz)
         cleaned = dataclasses.replace(
