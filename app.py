@@ -236,8 +236,7 @@ def main(
         host: address to bind; the default accepts connections from this machine only.
         port: TCP port to bind. A port given here must be free, or the app refuses to start.
         allow_remote_glsl: with a non-loopback host, still let browsers type GLSL into the SDF gallery's editor.
-        shared: one scene for every browser tab (a switch or Reset in one tab changes it for all); by default each
-            tab has its own scene.
+        shared: one scene for all browser tabs (a switch or Reset in one changes it for all); else each has its own.
     """
     signal.signal(signal.SIGINT, _hold_ctrl_c)  # (the installed command's start: held from here)
     asked = DEFAULT_PORT if port is None else port

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import re
 import socket
 import subprocess
@@ -48,6 +49,14 @@ def test_help_names_the_port_default_in_words() -> None:
     text = " ".join(run.stdout.split())
     assert "--port INT" in text and "{None}" not in text
     assert "default: 8080, or the next free port" in text.replace("│ ", "").replace(" │", "")
+    # An outside tester read "by default each          │ tab has its own scene": a line break of the docstring came
+    # through, ending a line where the next word fitted. Every line of an entry is as full as the wrapping allows.
+    box = [line[2:-2] for line in run.stdout.splitlines() if line.startswith("│ ") and line.endswith(" │")]
+    for above, below in itertools.pairwise(box):
+        column = len(below) - len(below.lstrip())  # where an entry's help text starts
+        # ``below`` continues help text that ``above`` holds in that column (not an option too long for its own)
+        if column >= 10 and above[column - 2 : column] == "  " and above[column:].strip():
+            assert len(above.rstrip()) + 1 + len(below.split()[0]) > len(above), (above, below)
 
 
 def test_a_port_outside_the_tcp_range_is_refused_in_words() -> None:
