@@ -75,7 +75,8 @@ class Primitive:
     radius), the segment running along local y; cylinder (half height, radius) along y; round_box (hx, hy, hz),
     rounded by ROUND_BOX_ROUNDING of the smallest; octahedron (size,); cone (base radius, height) along y;
     hex_prism (apothem, half height) along z; ellipsoid (rx, ry, rz), by :func:`sd_ellipsoid_lipschitz` (a bound
-    that keeps the scene 1-Lipschitz, which Quilez's estimate does not for an elongated ellipsoid)."""
+    that keeps the scene 1-Lipschitz, which Quilez's estimate does not for an elongated ellipsoid). A kind of one
+    parameter also takes it as a bare number (``0.5`` for ``(0.5,)``)."""
     rotation: tuple[float, float, float, float] = (1.0, 0.0, 0.0, 0.0)
     """Orientation as a unit quaternion (w, x, y, z), local to world; normalised on construction."""
     color: tuple[float, float, float] = (0.8, 0.8, 0.8)
@@ -89,9 +90,12 @@ class Primitive:
         center = position("center", self.center)
         count = primitive_spec(self.kind).size_count
         size = _checks.finite_array("size", self.size)
+        if size.ndim == 0 and count == 1:  # a bare number: the one parameter (a sphere's radius)
+            size = size.reshape(1)
         if size.shape != (count,):
-            raise ValueError(f"size of a {self.kind} must have {count} values, got {size.shape}")
-        size = lengths("size", size, count)
+            values = "one value" if count == 1 else f"{count} values"
+            raise ValueError(f"size of a {self.kind} must have {values}, got {_checks.shown(self.size)}")
+        size = lengths("size", size.tolist(), count)
         q = unit_quaternion("rotation", self.rotation)
         color = _checks.vector("color", self.color, 3)
         if np.any(color < 0.0) or np.any(color > 1.0):

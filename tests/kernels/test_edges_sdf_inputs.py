@@ -494,3 +494,28 @@ def test_a_ray_direction_that_is_not_unit_is_refused_as_such(length: float) -> N
 def test_an_integer_past_float64_is_refused_as_not_finite() -> None:
     with pytest.raises(ValueError, match=r"^p must be finite \(within float64's range\), got "):
         sdf.sd_sphere([[10**400, 0, 0]], 0.5)
+
+
+@pytest.mark.parametrize(
+    ("kind", "size", "message"),
+    [
+        # An outside tester: "size of a sphere must have 1 values, got ()" for a bare radius, and "got
+        # array([1.e+300])" (numpy's repr) for a huge one. A bare number is a one-parameter kind's parameter.
+        ("sphere", (0.5, 0.3), "size of a sphere must have one value, got (0.5, 0.3)"),
+        ("sphere", (), "size of a sphere must have one value, got ()"),
+        ("box", 0.5, "size of a box must have 3 values, got 0.5"),
+        ("torus", (1.0,), "size of a torus must have 2 values, got (1.0,)"),
+        ("sphere", (1e300,), "size must be of magnitude ≤ 1e+150, got [1e+300]"),
+    ],
+)
+def test_a_primitive_size_of_the_wrong_count_or_magnitude_is_refused_in_plain_values(
+    kind: sdf.PrimitiveKind, size: Any, message: str
+) -> None:
+    with pytest.raises(ValueError) as refused:
+        sdf.Primitive(kind, (0.0, 0.0, 0.0), size)
+    assert str(refused.value) == message
+
+
+def test_a_bare_number_is_the_size_of_a_one_parameter_kind() -> None:
+    assert sdf.Primitive("sphere", (0.0, 0.0, 0.0), 0.5).size == (0.5,)  # type: ignore[arg-type]
+    assert sdf.Primitive("octahedron", (0.0, 0.0, 0.0), 0.25).size == (0.25,)  # type: ignore[arg-type]
