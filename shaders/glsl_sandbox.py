@@ -439,9 +439,34 @@ class ShaderCompileError(ValueError):
             if line >= APPENDED_FIRST_LINE and tokens:
                 last = tokens[-1]
                 return cls(plain_compiler_message(message, tokens, None, None), last.line)
+            # Mesa's "0:0(0): error: function `float sdf(vec3)' has static recursion" names no line: the call does.
+            recursion = _RECURSION.search(message)
+            call = None if recursion is None else _call_within(tokens, recursion.group(1))
+            if recursion is not None and call is not None:
+                return cls(f"{recursion.group(1)}() calls itself, and GLSL has no recursion", call.line)
             return cls(plain_compiler_message(message, tokens, None, None), None)
         text = " ".join(log.replace("GLSL Compiler failed", "").split()) or "the shader did not compile"
         return cls(_plain_words(text), None)
+
+
+_RECURSION = re.compile(r"function [`']\w+ (\w+)\([^`']*\)' has static recursion")
+
+
+def _call_within(tokens: list[Token], name: str) -> Token | None:
+    """The first call of ``name`` inside the body of a function called ``name`` (its recursion), if any."""
+    for header in function_headers(tokens):
+        if header.name.text != name or not header.has_body:
+            continue
+        start = tokens.index(header.name)
+        opening = next(k for k in range(start, len(tokens)) if tokens[k].text == "{")
+        depth = 0
+        for k in range(opening, len(tokens) - 1):
+            depth += {"{": 1, "}": -1}.get(tokens[k].text, 0)
+            if depth == 0:
+                break
+            if tokens[k].text == name and tokens[k + 1].text == "(":
+                return tokens[k]
+    return None
 
 
 def check_source(source: object) -> str:

@@ -187,6 +187,29 @@ def test_compile_error_is_a_value_error_with_the_compilers_message_and_line() ->
 
 @pytest.mark.gl
 @pytest.mark.parametrize(
+    ("source", "line"),
+    [
+        # An outside tester: "function 'float sdf(vec3)' has static recursion", with no line (Mesa's linker names
+        # none); the line is the recursive call's.
+        ("float sdf(vec3 p){ return p.x > 0.0 ? sdf(-p) : length(p)-0.5; }\n", 1),
+        (
+            "float f(vec3 p) {\n  return length(p) - 0.5;\n}\nfloat sdf(vec3 p)\n{\n  float d = f(p);\n  return d + sdf(p);\n}\n",
+            7,
+        ),
+        ("float g(vec3 p) {\n  return 1.0 + g(p * 0.5);\n}\nfloat sdf(vec3 p) { return g(p); }\n", 2),
+    ],
+)
+def test_a_function_that_calls_itself_is_refused_on_the_line_of_the_call(source: str, line: int) -> None:
+    with pytest.raises(ShaderCompileError) as refused:
+        mesh_glsl(source, 32, CUBE_BOUNDS)
+    assert refused.value.line == line and "calls itself, and GLSL has no recursion" in str(refused.value)
+    # An overload calling another of its name is no recursion: it compiles.
+    overload = "float g(float x) { return x - 0.5; }\nfloat g(vec3 p) { return g(length(p)); }\nfloat sdf(vec3 p) { return g(p); }\n"
+    assert len(mesh_glsl(overload, 32, CUBE_BOUNDS).faces) > 0
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize(
     ("resolution", "bounds", "words"),
     [
         (8, CUBE_BOUNDS, "resolution"),
