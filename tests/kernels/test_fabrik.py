@@ -212,6 +212,54 @@ def test_dls_toward_a_target_out_of_reach_ends_at_the_closest_pose() -> None:
     assert 1.0 <= folded.error <= 1.0 + 1e-3
 
 
+def test_a_free_chain_short_of_its_closest_pose_at_the_cap_says_max_iterations() -> None:
+    # A re-tester: 12 links, the target 23 µm beyond full reach; DLS's default 50 iterations left it 0.29 m short
+    # of the straight pose and it said "unreachable", as if that were the closest it could come.
+    joints = np.array(
+        [
+            [-0.2594171408036668, -0.12241368584410932],
+            [-0.33916710563793506, -0.05828043349805127],
+            [-0.6364144712915205, 0.15810493752518157],
+            [-0.49225966637049273, 1.4285380455240981],
+            [-0.8253811158063509, 1.3817375947268506],
+            [-1.0867152320814208, 1.2905907056817754],
+            [-0.7829085527920294, 1.1558248276806604],
+            [-1.129411539774405, 0.5542247952049063],
+            [-1.0014224084685948, 0.5935132726132893],
+            [-1.4829815905122803, 0.8643244875302613],
+            [-1.30876562378438, 1.3693674885654554],
+            [-2.379307307444526, 4.269866720854543],
+            [-2.173248845950767, 4.211101222717765],
+        ]
+    )
+    target = np.array([-2.175277732028869, 7.557248592014241])
+    closest = np.linalg.norm(target - joints[0]) - fabrik.link_lengths(joints).sum()
+    assert closest == pytest.approx(2.3e-5, abs=1e-6)
+    capped = fabrik.jacobian_dls(joints, target)
+    assert capped.status == "max_iterations" and capped.iterations == 50
+    assert capped.error - closest == pytest.approx(0.2907, abs=1e-4)
+    # Given the iterations, it comes within the tolerance of the target (23 µm beyond the reach): reached.
+    assert fabrik.jacobian_dls(joints, target, max_iterations=500).status == "reached"
+
+
+@PROPERTY
+@given(chains, st.floats(1.05, 3.0), st.integers(1, 60))
+def test_dls_beyond_reach_says_unreachable_only_within_the_tolerance_of_the_closest_pose(
+    chain: tuple[int, int, int], factor: float, cap: int
+) -> None:
+    n, d, seed = chain
+    rng = np.random.default_rng(seed)
+    joints = random_chain(rng, max(n, 2), d, bend=1.0)
+    total = fabrik.link_lengths(joints).sum()
+    target = joints[0] + random_direction(rng, d) * factor * total
+    result = fabrik.jacobian_dls(joints, target, max_iterations=cap)
+    closest = (factor - 1.0) * total
+    if result.status == "unreachable":
+        assert result.error <= closest + 1e-3 + 1e-12 * total
+    else:
+        assert result.status == "max_iterations" and result.iterations == cap and result.error > closest + 1e-3
+
+
 @PROPERTY
 @given(chains, st.floats(1.05, 3.0))
 def test_dls_ends_within_the_tolerance_of_the_closest_pose_beyond_reach(
@@ -1584,8 +1632,14 @@ def test_a_target_at_the_limits_last_ulps_is_solved_never_returned_empty() -> No
     target = np.array([-107811740882.1749, -836115064268.9324])
     batch = fabrik.solve_batch(joints[None], target[None])[0]
     for result in (fabrik.solve(joints, target), fabrik.ccd(joints, target), fabrik.jacobian_dls(joints, target)):
-        assert result.joints.shape == (4, 2) and result.status == "unreachable" == batch.status
+        assert result.joints.shape == (4, 2)
         np.testing.assert_allclose(fabrik.link_lengths(result.joints), fabrik.link_lengths(joints), rtol=1e-9)
+    # 10¹² chain lengths away the core's rounding scale follows the target and passes the links' lengths: FABRIK
+    # places the straight chain at once; DLS no longer turns the links, 1.1 m short of that pose at its cap, and says
+    # so ("max_iterations"); CCD stalls there at once ("unreachable", as a stall's status is).
+    assert fabrik.solve(joints, target).status == "unreachable" == batch.status
+    assert fabrik.ccd(joints, target).status == "unreachable"
+    assert fabrik.jacobian_dls(joints, target).status == "max_iterations"
     assert fabrik.solve_tree([-1, 0, 1, 2], joints, {3: target}).joints.shape == (4, 2)
     # The family: chains and targets at and around the limit, every one solved with its links or refused by name.
     rng = np.random.default_rng(5)
