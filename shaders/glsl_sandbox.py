@@ -12,7 +12,9 @@ metres, colours linear RGB.
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import re
+from collections.abc import Iterable
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -388,6 +390,12 @@ def plain_compiler_message(message: str, tokens: list[Token], line: int | None, 
     token starts a line; other messages keep Mesa's words with its quoting made plain. ``line`` None: the error
     was past the source's end (in code the app appended)."""
     syntax = _SYNTAX.match(message)
+    undefined = _UNDEFINED.match(message)
+    if undefined is not None:
+        name = undefined.group(1)
+        later = next((h for h in function_headers(tokens) if h.name.text == name and h.has_body), None)
+        if later is not None and line is not None and later.line >= line:
+            return f"{name}() is used before it is defined (line {later.line}): define it above its first use"
     if syntax is None:
         return _plain_words(message)
     kind, words = _kind_words(syntax.group(1).strip())
@@ -441,31 +449,59 @@ class ShaderCompileError(ValueError):
                 return cls(plain_compiler_message(message, tokens, None, None), last.line)
             # Mesa's "0:0(0): error: function `float sdf(vec3)' has static recursion" names no line: the call does.
             recursion = _RECURSION.search(message)
-            call = None if recursion is None else _call_within(tokens, recursion.group(1))
-            if recursion is not None and call is not None:
-                return cls(f"{recursion.group(1)}() calls itself, and GLSL has no recursion", call.line)
+            if recursion is not None:
+                name = recursion.group(1)
+                call = _recursive_call(tokens, name)
+                if call is not None and call.text == name:
+                    return cls(f"{name}() calls itself, and GLSL has no recursion", call.line)
+                if call is not None:  # through a prototype, declared above and defined below
+                    return cls(
+                        f"{name}() calls {call.text}(), which calls back into {name}(): GLSL has no recursion",
+                        call.line,
+                    )
             return cls(plain_compiler_message(message, tokens, None, None), None)
         text = " ".join(log.replace("GLSL Compiler failed", "").split()) or "the shader did not compile"
         return cls(_plain_words(text), None)
 
 
+_UNDEFINED = re.compile(r"no function with name [`'](\w+)'")
 _RECURSION = re.compile(r"function [`']\w+ (\w+)\([^`']*\)' has static recursion")
 
 
-def _call_within(tokens: list[Token], name: str) -> Token | None:
-    """The first call of ``name`` inside the body of a function called ``name`` (its recursion), if any."""
+def _bodies(tokens: list[Token]) -> dict[str, list[Token]]:
+    """Each function defined in ``tokens``: the tokens of its body (overloads' bodies joined), by name."""
+    bodies: dict[str, list[Token]] = {}
     for header in function_headers(tokens):
-        if header.name.text != name or not header.has_body:
+        if not header.has_body:
             continue
-        start = tokens.index(header.name)
-        opening = next(k for k in range(start, len(tokens)) if tokens[k].text == "{")
-        depth = 0
-        for k in range(opening, len(tokens) - 1):
-            depth += {"{": 1, "}": -1}.get(tokens[k].text, 0)
+        k = next(k for k in range(tokens.index(header.name), len(tokens)) if tokens[k].text == "{")
+        depth, body = 0, bodies.setdefault(header.name.text, [])
+        for token in tokens[k:]:
+            depth += {"{": 1, "}": -1}.get(token.text, 0)
+            body.append(token)
             if depth == 0:
                 break
-            if tokens[k].text == name and tokens[k + 1].text == "(":
-                return tokens[k]
+    return bodies
+
+
+def _calls(body: list[Token], names: Iterable[str]) -> list[Token]:
+    """The calls in ``body`` of any of ``names``, in order."""
+    wanted = set(names)
+    return [t for t, after in itertools.pairwise(body) if t.text in wanted and after.text == "("]
+
+
+def _recursive_call(tokens: list[Token], name: str) -> Token | None:
+    """The first call in the body of ``name`` that leads back to ``name`` (itself, or a function whose calls do)."""
+    bodies = _bodies(tokens)
+    for call in _calls(bodies.get(name, []), bodies):
+        seen, todo = set(), [call.text]
+        while todo:
+            current = todo.pop()
+            if current == name:
+                return call
+            if current not in seen:
+                seen.add(current)
+                todo.extend(t.text for t in _calls(bodies.get(current, []), bodies))
     return None
 
 
