@@ -94,7 +94,8 @@ class Primitive:
             size = size.reshape(1)
         if size.shape != (count,):
             values = "one value" if count == 1 else f"{count} values"
-            raise ValueError(f"size of a {self.kind} must have {values}, got {_checks.shown(self.size)}")
+            article = "an" if self.kind[0] in "aeiou" else "a"
+            raise ValueError(f"size of {article} {self.kind} must have {values}, got {_checks.shown(self.size)}")
         size = lengths("size", size.tolist(), count)
         q = unit_quaternion("rotation", self.rotation)
         color = _checks.vector("color", self.color, 3)

@@ -513,7 +513,8 @@ IoU is lowest when a box edge is on the silhouette.
         self.editor_error, self._bounds_refused = message, bounds
         with self._lock:
             if not self.closed:
-                self._show_editor_status(f"**Not applied.** {message}\n\nThe last good shape stays on screen.")
+                said = message[:1].upper() + message[1:]  # a sentence after the bold one
+                self._show_editor_status(f"**Not applied.** {said}\n\nThe last good shape stays on screen.")
 
     def _show_view_mode(self) -> None:
         mode = self.params.view_mode

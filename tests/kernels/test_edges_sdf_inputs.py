@@ -505,6 +505,8 @@ def test_an_integer_past_float64_is_refused_as_not_finite() -> None:
         ("sphere", (), "size of a sphere must have one value, got ()"),
         ("box", 0.5, "size of a box must have 3 values, got 0.5"),
         ("torus", (1.0,), "size of a torus must have 2 values, got (1.0,)"),
+        ("ellipsoid", 0.5, "size of an ellipsoid must have 3 values, got 0.5"),  # a re-tester: "a ellipsoid"
+        ("octahedron", (0.5, 0.5), "size of an octahedron must have one value, got (0.5, 0.5)"),
         ("sphere", (1e300,), "size must be of magnitude ≤ 1e+150, got [1e+300]"),
     ],
 )

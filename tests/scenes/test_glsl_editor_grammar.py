@@ -332,4 +332,4 @@ def test_the_editor_applies_a_const_in_source_and_names_an_unclosed_brace(
         wait_until(lambda: scene.editor_error is not None, "the error", timeout_s=60)
         assert scene.editor_error is not None
         assert scene.editor_error.startswith("line 1: '{' is never closed")
-        assert "line 1" in scene.editor_status.content
+        assert "Line 1: " in scene.editor_status.content

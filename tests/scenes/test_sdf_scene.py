@@ -561,7 +561,7 @@ def test_typed_source_is_meshed_and_a_bad_one_keeps_the_last_good(
         apply_glsl(client, "float sdf(vec3 p) {\n    return sd_sphere(p, 0.5)\n}\n")
         wait_until(lambda: scene.editor_error is not None, "the error")
         assert scene.editor_error is not None and scene.editor_error.startswith("line 3:")
-        assert "line 3" in scene.editor_status.content
+        assert "**Not applied.** Line 3: " in scene.editor_status.content  # a sentence: a capital after the bold one
         # A loop and an over-long source are refused before the compiler sees them.
         for text, words in [
             ("float sdf(vec3 p) {\n    float d = 1.0;\n    for (;;) { d = 0.5; }\n    return d;\n}", "line 3"),
@@ -1059,7 +1059,8 @@ def test_bounds_with_no_surface_say_so_until_bounds_that_have_one_and_a_refused_
         status = scene.editor_status.content
         client.set_value("Editor bounds half size (m)", 0.5)
         wait_until(lambda: scene.editor_status.content != status, "the narrow bounds refused")
-        assert "**Not applied.**" in scene.editor_status.content and "±0.5 m box" in scene.editor_status.content
+        assert "**Not applied.** No surface lies" in scene.editor_status.content  # a re-tester: "… no surface"
+        assert "±0.5 m box" in scene.editor_status.content
         meshes = scene.mesh_serial
         client.set_value("Editor bounds half size (m)", 3.0)
         wait_until(lambda: scene.mesh_serial > meshes and scene.params.editor.half_size == 3.0, "the wide remesh")
