@@ -1470,3 +1470,14 @@ def scene_points_of_primitives(scene: SdfGalleryScene) -> np.ndarray:
             if slot.enabled
         ]
     )
+
+
+def test_every_kinds_gizmo_label_is_its_menu_name() -> None:
+    # The family of "P2 round_box": each registry kind's label is its menu label, lower case, without its note.
+    from scenes.sdf_gallery.params import KIND_LABELS, gizmo_label
+
+    slot = SdfGalleryParams().primitives[0]
+    for label, kind in KIND_LABELS.items():
+        shown = gizmo_label(2, dataclasses.replace(slot, kind=kind))
+        # the menu's words (a note such as "(bound)" may be left off), never the code's name
+        assert shown.startswith("P3 ") and label.lower().startswith(shown[3:]) and "_" not in shown, (kind, shown)
