@@ -66,14 +66,16 @@ def load_gpx(source: str | os.PathLike[str] | bytes, *, name: str | None = None,
 
     Raises:
         ValueError: with a message a person can act on: the file is larger than 20 MiB, not GPX (or not text),
-            has no track points, one point, points without elevation, non-finite or out-of-range values, more
+            has no track points, one point, points without elevation, unreadable (named by point and line),
+            non-finite or out-of-range values, more
             than 200 000 points, a route shorter than :data:`MIN_COURSE_M` (100 m), a stretch steeper than
             :data:`MAX_GPX_GRADE` (50 %), or consecutive pieces (track segments or routes, in any mix) more than
             :data:`MAX_SEGMENT_GAP_M` (2 km) apart; the message names both pieces and the gap. Nothing else
             escapes for a bad file. A bad ``name`` or ``smoothing_m`` is refused naming it.
 
     The text is decoded by its byte-order mark, else the XML declaration's encoding (ISO-8859-1, UTF-16...),
-    else as UTF-8; a namespace prefix on the GPX elements (``<g:gpx xmlns:g=...>``) is read too.
+    else as UTF-8; a namespace prefix on the GPX elements (``<g:gpx xmlns:g=...>``) is read too. Only positions and
+    elevations are read: waypoints and other fields (:data:`_UNUSED`) cannot refuse a file.
     """
     if name is not None and not isinstance(name, str):
         raise ValueError(f"name must be a str or None, got {type(name).__name__}")
@@ -114,9 +116,13 @@ def load_gpx(source: str | os.PathLike[str] | bytes, *, name: str | None = None,
         raise ValueError(f"{label} has {tagged} points; the limit is {MAX_POINTS}")
     if prefix:  # <g:gpx xmlns:g=...>: gpxpy reads only unprefixed names, so drop the prefix
         text = text.replace(f"<{prefix}:", "<").replace(f"</{prefix}:", "</")
+    text = _UNUSED.sub(_lines_kept, text)
     try:
         gpx = gpxpy.parse(text)
     except gpxpy.gpx.GPXException as error:
+        unreadable = _unreadable_position(text)
+        if unreadable is not None:
+            raise ValueError(f"{label}: {unreadable}") from error
         raise ValueError(f"{label} is not a valid GPX file: {_gpx_error_words(str(error))}") from error
     except (ValueError, TypeError, AttributeError, IndexError) as error:
         raise ValueError(f"{label} is not a valid GPX file: {type(error).__name__}") from error
@@ -200,6 +206,60 @@ def _decode(data: bytes, label: str) -> str:
         raise ValueError(f"{label} is not GPX: it is not text in {encoding.upper()}") from error
     # The text is decoded now: the declaration's encoding must not be applied a second time by the XML parser.
     return re.sub(r"""^(\ufeff?<\?xml[^>]*?)\s+encoding\s*=\s*["'][^"']*["']""", r"\1", text, count=1)
+
+
+_UNUSED = re.compile(
+    r"<wpt(?:\s[^<>]*?)?(?:/>|>.*?</wpt\s*>)"  # waypoints: places beside the course, not on it
+    r"|<bounds(?:\s[^<>]*?)?(?:/>|>[^<]*</bounds\s*>)"
+    r"|<(ageofdgpsdata|course|dgpsid|fix|geoidheight|hdop|magvar|number|pdop|sat|speed|time|vdop|year)"
+    r"(?:\s[^<>]*?)?(?:/>|>[^<]*</\1\s*>)",
+    re.DOTALL,
+)
+"""What :func:`load_gpx` does not read: waypoints, the bounds, and the typed fields of a point, track or file other
+than its position and elevation (time, satellites, dilution, fix, speed...). gpxpy refuses a whole file for one of
+these it cannot read (``<hdop>x</hdop>``), which says nothing of the ride, so they are dropped before it parses."""
+_POINT = re.compile(r"<(trkpt|rtept)(?=[\s>/])([^<>]*)>(?:(?<=/>)|(.*?)</\1\s*>)", re.DOTALL)
+_ATTRIBUTE = re.compile(r"""(?<![\w:.-])(lat|lon)\s*=\s*(["'])(.*?)\2""", re.DOTALL)
+_ELEVATION = re.compile(r"<ele(?:\s[^<>]*)?>([^<]*)</ele\s*>")
+
+
+def _lines_kept(match: re.Match[str]) -> str:
+    """Nothing in place of what :data:`_UNUSED` drops, but its line breaks: later messages name lines of the file."""
+    return "\n" * match.group(0).count("\n")
+
+
+def _unreadable_position(text: str) -> str | None:
+    """The first track or route point whose latitude, longitude or elevation gpxpy cannot read, named as a rider
+    finds it ("track point 6's elevation (<ele>) is not a number (line 9)"), or None where none is found here.
+    Points are counted from 1 in the file, each kind on its own."""
+    counts = {"trkpt": 0, "rtept": 0}
+    for point in _POINT.finditer(text):
+        counts[point.group(1)] += 1
+        named = f"{'track' if point.group(1) == 'trkpt' else 'route'} point {counts[point.group(1)]}"
+        attributes = {a.group(1): a.group(3) for a in _ATTRIBUTE.finditer(point.group(2))}
+        for key, word in (("lat", "latitude"), ("lon", "longitude")):
+            if key not in attributes:
+                return f"{named} has no {word} ({key}) (line {_line(text, point.start())})"
+            if not _is_number(attributes[key]):
+                return f"{named}'s {word} ({key}) is not a number (line {_line(text, point.start())})"
+        for elevation in _ELEVATION.finditer(text, point.start(3) if point.group(3) else point.end(), point.end()):
+            if elevation.group(1).strip() and not _is_number(elevation.group(1)):
+                return f"{named}'s elevation (<ele>) is not a number (line {_line(text, elevation.start())})"
+    return None
+
+
+def _line(text: str, index: int) -> int:
+    """The line of ``text`` that character ``index`` lies on, counted from 1."""
+    return text.count("\n", 0, index) + 1
+
+
+def _is_number(text: str) -> bool:
+    """Whether gpxpy reads ``text`` as a number (it uses Python's ``float``)."""
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
 
 
 def _gpx_error_words(message: str) -> str:

@@ -43,14 +43,20 @@ BAD_FILES = {
     "nan latitude": (gpx_text([(45.0, 6.0, 1.0), (float("nan"), 6.0, 2.0)]), "point 2's latitude is not a number"),
     "inf elevation": (gpx_text([(45.0, 6.0, 1.0), (45.001, 6.0, float("inf"))]), "point 2's elevation is infinite"),
     "latitude out of range": (gpx_text([(45.0, 6.0, 1.0), (95.0, 6.0, 2.0)]), "latitude"),
+    # gpxpy's refusals named no point ("a latitude or longitude is not a number"), and a missing latitude read as
+    # broken XML: each now names the point and its line.
     "bad number": (
         gpx_text([(45.0, 6.0, 1.0)]).replace('lat="45.0"', 'lat="abc"'),
-        "not a valid GPX file: a latitude or longitude is not a number",
+        r"^the file: track point 1's latitude \(lat\) is not a number \(line 1\)$",
+    ),
+    "no longitude": (
+        gpx_text([(45.0, 6.0, 1.0), (45.001, 6.0, 2.0)], kind="rte").replace('lat="45.001" lon="6.0"', 'lat="45.001"'),
+        r"^the file: route point 2 has no longitude \(lon\) \(line 1\)$",
     ),
     # An outside tester: gpxpy's "could not convert string to float: 'nan(123)'" reached the page.
     "unreadable elevation": (
         gpx_text([(45.0, 6.0, 1.0), (45.001, 6.0, 2.0)]).replace("<ele>2.0</ele>", "<ele>nan(123)</ele>"),
-        r"not a valid GPX file: an elevation \(<ele>\) is not a number$",
+        r"^the file: track point 2's elevation \(<ele>\) is not a number \(line 1\)$",
     ),
     "elevation absurd": (gpx_text([(45.0, 6.0, 1.0), (45.001, 6.0, 1e7)]), "elevation"),
     "too short": (gpx_text([(45.0, 6.0, 10.0), (45.0000001, 6.0, 10.0)]), "100 m or more"),

@@ -716,6 +716,83 @@ def test_every_bad_file_gets_a_clear_message(kind: str) -> None:
         course.load_gpx(text.encode())
 
 
+def _typed_fields(cls: type, version: str) -> list[str]:
+    """The tags gpxpy converts (numbers, times, a fixed list) for one of its classes, from its own tables."""
+    import gpxpy.gpxfield
+
+    fields = getattr(cls, f"gpx_{version.replace('.', '')}_fields")
+    typed = [f for f in fields if isinstance(f, gpxpy.gpxfield.GPXField) and (f.type_converter or f.possible)]
+    return [f.tag for f in typed if f.tag and f.tag != "ele"]
+
+
+def _unused_field_cases() -> list[tuple[str, str, str]]:
+    """(version, where, tag) for every typed field gpxpy reads that a course does not: in a point, a track or
+    route, or the file; and the bounds and a waypoint, which are not on the course either."""
+    import gpxpy.gpx
+
+    cases = []
+    for version in ("1.0", "1.1"):
+        for where, cls in (
+            ("trkpt", gpxpy.gpx.GPXTrackPoint),
+            ("rtept", gpxpy.gpx.GPXRoutePoint),
+            ("trk", gpxpy.gpx.GPXTrack),
+            ("rte", gpxpy.gpx.GPXRoute),
+            ("gpx", gpxpy.gpx.GPX),
+        ):
+            cases += [(version, where, tag) for tag in _typed_fields(cls, version)]
+        cases += [(version, "gpx", "bounds"), (version, "gpx", "wpt")]
+    return cases
+
+
+@pytest.mark.parametrize(("version", "where", "tag"), _unused_field_cases())
+def test_a_field_the_course_does_not_read_cannot_refuse_the_file(version: str, where: str, tag: str) -> None:
+    # An unreadable <hdop>x</hdop> (satellites, dilution, fix, a track's number, the bounds, a waypoint...) refused
+    # the whole file as "a latitude or longitude is not a number" or "its XML is broken", naming neither.
+    kind = "rte" if where.startswith("rte") else "trk"
+    clean = gpx_text(line_points(20), kind=kind).replace('version="1.1"', f'version="{version}"')
+    bad = {
+        "bounds": '<bounds minlat="x" minlon="y" maxlat="46" maxlon=""/>',
+        "wpt": '<wpt lat="north" lon="6"><ele>high</ele><name>a</name><link href="x"/></wpt><wpt lat="?" lon="6"/>',
+    }.get(tag, f"<{tag}>not readable</{tag}>")
+    if where in ("trkpt", "rtept"):
+        text = clean.replace(f"</{where}>", f"{bad}</{where}>")
+    elif where == "gpx":
+        top = f"<metadata>{bad}</metadata>" if version == "1.1" and tag in ("time", "bounds") else bad
+        text = clean.replace('creator="test">', f'creator="test">{top}')
+    else:
+        text = clean.replace(f"<{where}>", f"<{where}>{bad}")
+    assert text != clean
+    read, expected = course.load_gpx(text), course.load_gpx(clean)
+    np.testing.assert_array_equal(read.distance_m, expected.distance_m)
+    np.testing.assert_array_equal(read.elevation_m, expected.elevation_m)
+
+
+def test_an_unreadable_position_names_its_point_and_line() -> None:
+    lines = [f'<trkpt lat="{45 + i * 1e-4}" lon="6.0">\n  <ele>{100 + i}</ele>\n</trkpt>' for i in range(6)]
+    text = '<?xml version="1.0"?>\n<gpx version="1.1" creator="t">\n<trk><trkseg>\n' + "\n".join(lines)
+    text += "\n</trkseg></trk>\n</gpx>\n"
+    # Point k (from 1) opens on line 4 + 3(k - 1); its elevation is on the line after.
+    cases = {
+        "<ele>103</ele>": ("<ele>1O3</ele>", "track point 4's elevation (<ele>) is not a number (line 14)"),
+        'lat="45.0005"': ('lat="45,0005"', "track point 6's latitude (lat) is not a number (line 19)"),
+        'lon="6.0">\n  <ele>101<': ('lon="">\n  <ele>101<', "track point 2's longitude (lon) is not a number (line 7)"),
+        'lat="45.0002" ': ("", "track point 3 has no latitude (lat) (line 10)"),
+    }
+    for good, (bad, message) in cases.items():
+        assert text.count(good) == 1, good
+        with pytest.raises(ValueError) as caught:
+            course.load_gpx(text.replace(good, bad).encode())
+        assert str(caught.value) == f"the file: {message}"
+    # Waypoints, before the track, are dropped with their lines kept: the numbers still name the file's lines.
+    shifted = text.replace("<trk>", '<wpt lat="1" lon="2">\n<name>a</name>\n</wpt>\n<trk>').replace(
+        "<ele>103<", "<ele>x<"
+    )
+    with pytest.raises(
+        ValueError, match=r"^the file: track point 4's elevation \(<ele>\) is not a number \(line 17\)$"
+    ):
+        course.load_gpx(shifted)
+
+
 def test_binary_and_missing_files(tmp_path: Path) -> None:
     with pytest.raises(ValueError, match="not text in UTF-8"):
         course.load_gpx(b"\x89PNG\r\n\x1a\n\xff\xfe<gpx")
