@@ -12,7 +12,8 @@ from the control's is written back so every browser shows what the scene uses.
 Kinds: :func:`slider`, :func:`number`, :func:`dropdown` (the field holds the option, the GUI shows its label;
 :func:`dropdown_from_labels` takes them from a label → option table),
 :func:`checkbox`, :func:`text` and :func:`rgb`. A number is an integer when the field's default is an ``int``. A
-field whose default is a tuple of scalars gets one control per element, its label formatted with ``n`` (1, 2, ...).
+field whose default is a tuple of scalars gets one control per element, its label formatted with ``n`` (1, 2, ...)
+and ``axis`` (a, b, ...).
 A declaration's ``folder`` puts the control in a folder of that name, opened around consecutive fields that name it
 (its handle is in :attr:`Controls.folders`, to add buttons or readouts to it). ``names`` builds only some fields,
 where the caller is; ``a | b`` joins two builds so one read covers both. A control whose greyed-out state depends on
@@ -80,6 +81,10 @@ class Control:
     """The values a dropdown's field may take, in the order shown."""
     labels: tuple[str, ...] = ()
     """What the dropdown shows for each of :attr:`options`."""
+    choices: Callable[[], Mapping[str, Any]] | None = None
+    """A dropdown whose options are read when it is built, as a label → option table, rather than when its class is
+    defined (the SDF gallery's kinds come from a registry a program may add to); :meth:`resolved` fills
+    :attr:`options` and :attr:`labels` from it."""
     multiline: bool = False
     """Text only: a multi-line box."""
     max_chars: int = MAX_TEXT_CHARS
@@ -93,6 +98,13 @@ class Control:
     """Shown greyed out at first (a scene may set ``handle.disabled`` later)."""
     hint: str | None = None
     """A tooltip."""
+
+    def resolved(self) -> Control:
+        """This control with its :attr:`choices` read now (itself when it has none)."""
+        if self.choices is None:
+            return self
+        table = self.choices()
+        return dataclasses.replace(self, options=tuple(table.values()), labels=tuple(table), choices=None)
 
     def spec(self, default: object) -> ControlSpec:
         """The gate's spec for this control on a field (or tuple element) whose default is ``default``."""
@@ -198,9 +210,12 @@ def dropdown(
 
 
 def dropdown_from_labels(
-    label: str, option_from_label: Mapping[str, Any], **placement: Unpack[Placement]
+    label: str, option_from_label: Mapping[str, Any] | Callable[[], Mapping[str, Any]], **placement: Unpack[Placement]
 ) -> dict[str, Control]:
-    """A dropdown of ``option_from_label``'s values, each shown as its key (a scene's ``X_FROM_LABEL`` table)."""
+    """A dropdown of ``option_from_label``'s values, each shown as its key (a scene's ``X_FROM_LABEL`` table); given
+    a function returning that table, the table is read each time the dropdown is built (:attr:`Control.choices`)."""
+    if callable(option_from_label):
+        return _declare(Control("dropdown", label, choices=option_from_label, **placement))
     return dropdown(label, tuple(option_from_label.values()), tuple(option_from_label), **placement)
 
 
@@ -288,6 +303,7 @@ def build_controls(
     *,
     collapsed: Collection[str] = (),
     folders_open: Mapping[str, viser.GuiFolderHandle] | None = None,
+    label_args: Mapping[str, object] | None = None,
 ) -> Controls[P]:
     """Make the declared controls of ``params`` (all of them, or the fields in ``names``), in field order.
 
@@ -295,7 +311,9 @@ def build_controls(
     go where ``gui`` adds them now (inside a ``with folder:`` block of the caller's), or into a folder of the name
     their declaration gives, opened once around consecutive fields that name it; folders in ``collapsed`` open
     closed. A folder in ``folders_open`` (an earlier build's :attr:`Controls.folders`) is filled on instead of
-    opened again, so a scene can put a control of its own between two builds of one folder.
+    opened again, so a scene can put a control of its own between two builds of one folder. Where ``label_args`` is
+    given, labels and folder names are formatted with it (the SDF gallery builds each primitive slot's controls
+    from one declaration, "P{slot} kind" in "Primitive {slot}"); ``collapsed`` names folders as formatted.
     """
     params_type = type(params)
     controls = declared(params_type)
@@ -305,22 +323,27 @@ def build_controls(
     chosen = [(name, c) for name, c in controls.items() if names is None or name in names]
     fields: dict[str, Built] = {}
     folders: dict[str, viser.GuiFolderHandle] = dict(folders_open or {})
-    for label, group in itertools.groupby(chosen, key=lambda item: item[1].folder):
+    for folder, group in itertools.groupby(chosen, key=lambda item: item[1].folder):
+        label = folder if folder is None or label_args is None else folder.format(**label_args)
         if label is not None and label not in folders:
             folders[label] = gui.add_folder(label, expand_by_default=label not in collapsed)
         with contextlib.nullcontext() if label is None else folders[label]:
             for name, control in group:
-                fields[name] = _build_field(gui, control, getattr(params, name))
+                fields[name] = _build_field(gui, control, getattr(params, name), label_args)
     return Controls(params_type, fields, folders)
 
 
-def _build_field(gui: GuiLike, control: Control, value: Any) -> Built:
+def _build_field(gui: GuiLike, control: Control, value: Any, label_args: Mapping[str, object] | None) -> Built:
+    control = control.resolved()
     per_element = isinstance(value, tuple) and control.per_element
     values = value if per_element else (value,)
     handles: list[Handle] = []
     specs: list[ControlSpec] = []
     for n, element in enumerate(values, start=1):
-        label = control.label.format(n=n) if per_element else control.label
+        if per_element:  # "Rider {n} power (W)", "P{slot} size {axis} (m)"
+            label = control.label.format(n=n, axis=chr(ord("a") + n - 1), **(label_args or {}))
+        else:
+            label = control.label if label_args is None else control.label.format(**label_args)
         handle = control.add(gui, label, element)
         spec = record_spec(handle, control.spec(element))
         handles.append(handle)

@@ -23,17 +23,15 @@ import dataclasses
 import math
 from collections.abc import Callable
 from pathlib import Path
-from typing import Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from kernels import _checks
 
-PrimitiveKind = Literal[
-    "sphere", "box", "torus", "capsule", "cylinder", "round_box", "octahedron", "cone", "hex_prism", "ellipsoid"
-]
-"""The built-in kinds of primitive; see :data:`PRIMITIVES` for what each one's sizes mean."""
+PrimitiveKind = str
+"""The name of a kind of primitive in the registry, :data:`PRIMITIVES` (the built-in ten, :data:`BUILT_IN_KINDS`, and
+any added by :func:`register_primitive`), which says what each one's sizes mean."""
 
 FloatArray = NDArray[np.float64]
 AnyFloatArray = NDArray[np.floating]
@@ -419,11 +417,20 @@ class PrimitiveSpec:
     codes); every other kind goes through the generated ``catalogue_distance`` (programs with EXTRA_KINDS)."""
     distance_xyz: CoordinateDistance | None = None
     """Optional fast path on coordinate arrays (no (N, 3) temporaries, dtype kept), equal to ``distance``."""
+    meaning: str = ""
+    """What its sizes are, named a, b, c in order, for a reader ("a = major radius, b = tube radius (ring in the
+    local xz plane)"); empty: :attr:`size_meaning` names them from :attr:`sizes`."""
 
     @property
     def size_count(self) -> int:
         """How many size parameters it takes."""
         return len(self.sizes)
+
+    @property
+    def size_meaning(self) -> str:
+        """What its sizes a, b, c are: :attr:`meaning`, or each size's name ("a = half length, b = radius")."""
+        named = (f"{axis} = {name.replace('_', ' ')}" for axis, (name, _) in zip("abc", self.sizes, strict=False))
+        return self.meaning or ", ".join(named)
 
 
 def _sphere_xyz(x: AnyFloatArray, y: AnyFloatArray, z: AnyFloatArray, s: Sizes) -> AnyFloatArray:
@@ -460,6 +467,7 @@ _BUILT_IN = (
         lambda s: s[0],
         lambda s: (s[0], s[0], s[0]),
         "sd_sphere", "p, s.x", fused=True, distance_xyz=_sphere_xyz,
+        meaning="a = radius",
     ),
     PrimitiveSpec(
         "box", "Box", 1, (("half_x", _M), ("half_y", _M), ("half_z", _M)),
@@ -467,6 +475,7 @@ _BUILT_IN = (
         _norm3,
         lambda s: (s[0], s[1], s[2]),
         "sd_box", "p, s", fused=True, distance_xyz=_box_xyz,
+        meaning="a, b, c = half sizes along local x, y, z",
     ),
     PrimitiveSpec(
         "torus", "Torus", 2, (("major_radius", _M), ("minor_radius", _M)),
@@ -474,6 +483,7 @@ _BUILT_IN = (
         lambda s: s[0] + s[1],
         lambda s: (s[0] + s[1], s[1], s[0] + s[1]),
         "sd_torus", "p, s.x, s.y", fused=True, distance_xyz=_torus_xyz,
+        meaning="a = major radius, b = tube radius (ring in the local xz plane)",
     ),
     PrimitiveSpec(
         "capsule", "Capsule", 3, (("half_length", _M), ("radius", _M)),
@@ -482,6 +492,7 @@ _BUILT_IN = (
         lambda s: (s[1], s[0] + s[1], s[1]),
         "sd_capsule", "p, vec3(0.0, -s.x, 0.0), vec3(0.0, s.x, 0.0), s.y",
         fused=True, distance_xyz=_capsule_xyz,
+        meaning="a = half length along local y, b = radius",
     ),
     PrimitiveSpec(
         "cylinder", "Cylinder", 4, (("half_height", _M), ("radius", _M)),
@@ -489,6 +500,7 @@ _BUILT_IN = (
         lambda s: math.hypot(s[0], s[1]),
         lambda s: (s[1], s[0], s[1]),
         "sd_cylinder", "p, s.x, s.y",
+        meaning="a = half height along local y, b = radius",
     ),
     PrimitiveSpec(
         "round_box", "Round box", 5, (("half_x", _M), ("half_y", _M), ("half_z", _M)),
@@ -496,6 +508,7 @@ _BUILT_IN = (
         _norm3,
         lambda s: (s[0], s[1], s[2]),
         "sd_round_box", "p, s, ROUND_BOX_ROUNDING * min(s.x, min(s.y, s.z))",
+        meaning="a, b, c = half sizes, edges rounded by a quarter of the smallest",
     ),
     PrimitiveSpec(
         "octahedron", "Octahedron", 6, (("size", _M),),
@@ -503,6 +516,7 @@ _BUILT_IN = (
         lambda s: s[0],
         lambda s: (s[0], s[0], s[0]),
         "sd_octahedron", "p, s.x",
+        meaning="a = centre to vertex",
     ),
     PrimitiveSpec(
         "cone", "Cone", 7, (("radius", _M), ("height", _M)),
@@ -510,6 +524,7 @@ _BUILT_IN = (
         lambda s: math.hypot(s[0], s[1] / 2),
         lambda s: (s[0], s[1] / 2, s[0]),
         "sd_cone", "p, s.x, s.y",
+        meaning="a = base radius, b = height, along local y",
     ),
     PrimitiveSpec(
         "hex_prism", "Hexagonal prism", 8, (("apothem", _M), ("half_height", _M)),
@@ -517,6 +532,7 @@ _BUILT_IN = (
         lambda s: math.hypot(2 * s[0] / math.sqrt(3.0), s[1]),
         lambda s: (2 * s[0] / math.sqrt(3.0), s[0], s[1]),
         "sd_hex_prism", "p, s.x, s.y",
+        meaning="a = centre to flat side, b = half height along local z",
     ),
     # A scene's ellipsoid uses the 1-Lipschitz bound: Quilez's estimate is not 1-Lipschitz when elongated.
     PrimitiveSpec(
@@ -525,6 +541,7 @@ _BUILT_IN = (
         lambda s: max(s),
         lambda s: (s[0], s[1], s[2]),
         "sd_ellipsoid_lipschitz", "p, s",
+        meaning="a, b, c = semi-axes (a distance bound, not exact)",
     ),
 )
 # fmt: on

@@ -26,9 +26,24 @@ BOX_M = 1.5
 BOX_LO: tuple[float, float, float] = (-BOX_M, -BOX_M, -BOX_M)
 BOX_HI: tuple[float, float, float] = (BOX_M, BOX_M, BOX_M)
 SIZE_RANGE_M = (0.05, 1.0)
-KIND_LABELS: dict[str, sdf.PrimitiveKind] = {s.label: s.kind for s in sdf.PRIMITIVES.values()}
-SIZES_USED: dict[sdf.PrimitiveKind, int] = {s.kind: s.size_count for s in sdf.PRIMITIVES.values()}
-"""How many of the sliders a, b, c each kind reads."""
+
+
+def kind_labels() -> dict[str, sdf.PrimitiveKind]:
+    """The kind menu's labels and kinds, read from the primitive registry now (a kind registered after this module
+    was imported is in the menus of the scenes built since)."""
+    return {spec.label: spec.kind for spec in sdf.PRIMITIVES.values()}
+
+
+def sizes_used(kind: sdf.PrimitiveKind) -> int:
+    """How many of the sliders a, b, c a kind reads."""
+    return sdf.primitive_spec(kind).size_count
+
+
+def size_meaning() -> str:
+    """The note under the slots: what each kind's sizes a, b, c are, from the registry."""
+    return "**Sizes (m).** " + " ".join(f"{s.label}: {s.size_meaning}." for s in sdf.PRIMITIVES.values())
+
+
 OP_LABELS: dict[str, sdf.BooleanOp] = {"Union": "union", "Subtract": "subtract", "Intersect": "intersect"}
 BlendChoice = Literal["hard", "poly", "exp"]
 """Hard booleans, or a smooth minimum in one of its two forms."""
@@ -39,14 +54,6 @@ ViewMode = Literal["mesh", "raymarch", "both"]
 VIEW_LABELS: dict[str, ViewMode] = {"Mesh": "mesh", "Ray-marched": "raymarch", "Both": "both"}
 ShapeSource = Literal["primitives", "editor"]
 SOURCE_LABELS: dict[str, ShapeSource] = {"Primitives (panels below)": "primitives", "GLSL editor": "editor"}
-SIZE_MEANING = (
-    "**Sizes (m).** Sphere: a = radius. Box: a, b, c = half sizes along local x, y, z. "
-    "Torus: a = major radius, b = tube radius (ring in the local xz plane). "
-    "Capsule: a = half length along local y, b = radius. Cylinder: a = half height along local y, b = radius. "
-    "Round box: a, b, c = half sizes, edges rounded by a quarter of the smallest. Octahedron: a = centre to vertex. "
-    "Cone: a = base radius, b = height, along local y. Hexagonal prism: a = centre to flat side, b = half "
-    "height along local z. Ellipsoid: a, b, c = semi-axes (a distance bound, not exact)."
-)
 RESOLUTION_LABEL = "Mesh resolution (samples per side)"
 """Marching-cubes samples along the longest side of the scene's bounds."""
 GIZMO_MARGIN_M = 0.12
@@ -111,7 +118,7 @@ class PrimitiveParams:
     enabled: bool = field(metadata=checkbox("P{slot} on", folder="Primitive {slot}"))
     """Whether it is part of the scene (the first always is)."""
     kind: sdf.PrimitiveKind = field(
-        metadata=dropdown_from_labels("P{slot} kind", KIND_LABELS, folder="Primitive {slot}")
+        metadata=dropdown_from_labels("P{slot} kind", kind_labels, folder="Primitive {slot}")
     )
     """One of the kernel's kinds (sphere, box, torus, capsule and the catalogue's six)."""
     op: sdf.BooleanOp = field(metadata=dropdown_from_labels("P{slot} combine", OP_LABELS, folder="Primitive {slot}"))
@@ -119,7 +126,7 @@ class PrimitiveParams:
     size: tuple[float, float, float] = field(
         metadata=slider("P{slot} size {axis} (m)", *SIZE_RANGE_M, 0.01, folder="Primitive {slot}")
     )
-    """Sizes a, b, c (m); which ones count depends on the kind (see SIZE_MEANING)."""
+    """Sizes a, b, c (m); which ones count depends on the kind (see :func:`size_meaning`)."""
     color: tuple[int, int, int] = field(metadata=rgb("P{slot} colour", folder="Primitive {slot}"))
     """8-bit RGB."""
     position: tuple[float, float, float]
@@ -128,7 +135,7 @@ class PrimitiveParams:
     """Orientation, the gizmo's."""
 
     def primitive(self) -> sdf.Primitive:
-        size = self.size[: SIZES_USED[self.kind]]
+        size = self.size[: sizes_used(self.kind)]
         return sdf.Primitive(
             self.kind,
             self.position,
@@ -354,7 +361,7 @@ def gizmo_reach(slot: PrimitiveParams) -> float:
 
     It does not depend on where the primitive is, so it is computed once per kind, size and orientation (every
     scene input re-checks all four gizmos: 5 ms a time uncached, most of a gizmo drag's callback)."""
-    return _reach(slot.kind, slot.size[: SIZES_USED[slot.kind]], slot.wxyz)
+    return _reach(slot.kind, slot.size[: sizes_used(slot.kind)], slot.wxyz)
 
 
 @functools.lru_cache(maxsize=256)

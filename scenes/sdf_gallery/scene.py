@@ -49,8 +49,6 @@ from scenes.sdf_gallery.params import (
     REFERENCE_FOLDER,
     SCENE_FIELDS,
     SHADING_FIELDS,
-    SIZE_MEANING,
-    SIZES_USED,
     SdfGalleryParams,
     Shape,
     Viewer,
@@ -58,6 +56,8 @@ from scenes.sdf_gallery.params import (
     gizmo_reach,
     moving_shading,
     rest_size,
+    size_meaning,
+    sizes_used,
     viewer_size,
 )
 from scenes.sdf_gallery.slots import add_slot_gizmo, build_slot_controls, read_wxyz, update_gizmo_looks
@@ -300,7 +300,7 @@ IoU is lowest when a box edge is on the silhouette.
                 gui, p, SHADING_FIELDS, folders_open={REFERENCE_FOLDER: reference_folder}
             )
             self.slot_controls = [build_slot_controls(gui, i, slot) for i, slot in enumerate(p.primitives)]
-            self.size_note = gui.add_markdown(SIZE_MEANING)
+            self.size_note = gui.add_markdown(size_meaning())
             with gui.add_folder("Downloads", expand_by_default=False):
                 self.downloads: dict[DownloadFormat, viser.GuiButtonHandle] = {
                     "glb": gui.add_button("Download mesh (GLB)"),
@@ -539,7 +539,7 @@ IoU is lowest when a box edge is on the silhouette.
         for controls, gizmo, slot in zip(self.slot_controls, self.gizmos, self.params.primitives, strict=True):
             gizmo.visible = slot.enabled and primitives
             for j, handle in enumerate(controls.each("size")):
-                handle.disabled = j >= SIZES_USED[slot.kind] or not slot.enabled
+                handle.disabled = j >= sizes_used(slot.kind) or not slot.enabled
         # Each gizmo's size, marker colour and label follow its primitive's kind, size and colour.
         handles = zip(self.gizmos, self.gizmo_markers, self.gizmo_labels, strict=True)
         for i, (gizmo, marker, label) in enumerate(handles):

@@ -1,48 +1,29 @@
 """The gallery's four primitive slots in the GUI and the 3D view: each slot's folder of controls, built from the
 declarations on :class:`~scenes.sdf_gallery.params.PrimitiveParams`, and its gizmo with a marker ball and a name.
-
-The slots' controls are built by a small loop here rather than :func:`scenes._controls.build_controls`: one
-folder per slot, labels formatted with the slot's number and the size's axis ("P2 size b (m)"), the first slot
-without an "on" checkbox and with "combine" greyed out. What it returns is an ordinary
-:class:`~scenes._controls.Controls`, read with :func:`scenes._controls.read_controls`.
 """
 
 from __future__ import annotations
 
-import dataclasses
 from typing import Any
 
 import numpy as np
 import viser
 
-from scenes._base import record_spec
-from scenes._controls import Built, Controls, declared
+from scenes._controls import Controls, build_controls, declared
 from scenes.sdf_gallery.params import GIZMO_MARKER_RADIUS_M, PrimitiveParams, gizmo_label, gizmo_reach, gizmo_tips
 
 
 def build_slot_controls(gui: Any, index: int, slot: PrimitiveParams) -> Controls[PrimitiveParams]:
-    """The controls of primitive slot ``index`` (from 0) in its own folder, from PrimitiveParams' declarations:
-    labels formatted with the slot's number and the size's axis; the first slot has no "on" checkbox (it is
+    """The controls of primitive slot ``index`` (from 0) in its own closed folder, from PrimitiveParams'
+    declarations, labelled with the slot's number ("P2 size b (m)"); the first slot has no "on" checkbox (it is
     always on) and its "combine" is greyed out (nothing comes before it)."""
     n = index + 1
-    declarations = declared(PrimitiveParams)
-    label = str(declarations["kind"].folder).format(slot=n)
-    folder = gui.add_folder(label, expand_by_default=False)
-    fields: dict[str, Built] = {}
-    for name, control in declarations.items():
-        if name == "enabled" and index == 0:
-            continue
-        shown = dataclasses.replace(control, disabled=name == "op" and index == 0)
-        value = getattr(slot, name)
-        per_element = isinstance(value, tuple) and control.per_element
-        handles, specs = [], []
-        with folder:
-            for axis, element in zip("abc", value if per_element else (value,), strict=False):
-                handle = shown.add(gui, control.label.format(slot=n, axis=axis), element)
-                handles.append(handle)
-                specs.append(record_spec(handle, control.spec(element)))
-        fields[name] = Built(control, tuple(handles), tuple(specs), per_element)
-    return Controls(PrimitiveParams, fields, {label: folder})
+    names = [name for name in declared(PrimitiveParams) if not (name == "enabled" and index == 0)]
+    folder = str(declared(PrimitiveParams)["kind"].folder).format(slot=n)
+    controls = build_controls(gui, slot, names, collapsed=(folder,), label_args={"slot": n})
+    if index == 0:
+        controls["op"].disabled = True
+    return controls
 
 
 def add_slot_gizmo(

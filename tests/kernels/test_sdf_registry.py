@@ -13,8 +13,12 @@ from collections.abc import Iterator
 
 import numpy as np
 import pytest
+import viser
 from helpers.ci import fresh_renderer
 from helpers.paths import GLSL
+from helpers.scenes import MakeScene
+from helpers.waiting import wait_until
+from helpers.wsclient import BrowserClient
 from scipy import ndimage
 
 from kernels import sdf
@@ -71,7 +75,9 @@ def extra_scene() -> sdf.Scene:
 
 # ------------------------------------------------------------------------------------------ one table
 def test_registry_lists_the_built_in_kinds_in_code_order() -> None:
-    assert sdf.PRIMITIVE_KINDS == typing.get_args(sdf.PrimitiveKind)
+    assert sdf.PRIMITIVE_KINDS == (
+        "sphere", "box", "torus", "capsule", "cylinder", "round_box", "octahedron", "cone", "hex_prism", "ellipsoid"
+    )  # fmt: skip
     assert tuple(sdf.PRIMITIVES) == sdf.PRIMITIVE_KINDS
     assert [s.code for s in sdf.PRIMITIVES.values()] == list(range(len(sdf.PRIMITIVES)))
     assert [s.kind for s in sdf.PRIMITIVES.values() if s.fused] == ["sphere", "box", "torus", "capsule"]
@@ -81,9 +87,32 @@ def test_registry_lists_the_built_in_kinds_in_code_order() -> None:
 
 
 def test_gallery_menus_come_from_the_registry() -> None:
-    assert list(gallery_params.KIND_LABELS.values()) == list(sdf.PRIMITIVE_KINDS)
-    assert list(gallery_params.KIND_LABELS) == [s.label for s in sdf.PRIMITIVES.values()]
-    assert gallery_params.SIZES_USED == {s.kind: s.size_count for s in sdf.PRIMITIVES.values()}
+    assert list(gallery_params.kind_labels().values()) == list(sdf.PRIMITIVE_KINDS)
+    assert list(gallery_params.kind_labels()) == [s.label for s in sdf.PRIMITIVES.values()]
+    assert [gallery_params.sizes_used(kind) for kind in sdf.PRIMITIVE_KINDS] == [1, 3, 2, 2, 2, 3, 1, 2, 2, 3]
+    note = gallery_params.size_meaning()
+    assert "Torus: a = major radius, b = tube radius (ring in the local xz plane)." in note
+    assert "Hexagonal prism: a = centre to flat side, b = half height along local z." in note
+
+
+def test_a_kind_registered_after_the_gallery_was_imported_is_in_its_menus_and_meshed(
+    octahedron_bound: sdf.PrimitiveSpec, server: viser.ViserServer, show_scene: MakeScene
+) -> None:
+    # The gallery's kind menu was read once, when its module was imported: a kind registered afterwards never
+    # reached it. It is read each time a gallery is built now, and so is the note of what each kind's sizes are.
+    from scenes.sdf_gallery.scene import SdfGalleryScene
+
+    scene = show_scene(SdfGalleryScene)
+    assert "Octahedron (bound)" in scene.slot_controls[1]["kind"].options
+    assert "Octahedron (bound): a = size." in scene.size_note.content
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("P2 kind")
+        client.set_value("P2 kind", "Octahedron (bound)")
+        wait_until(
+            lambda: scene.mesh_scene is not None and scene.mesh_scene.primitives[1].kind == octahedron_bound.kind,
+            "a mesh with the registered kind",
+        )
+    assert scene.gizmo_labels[1].text == "P2 octahedron"
 
 
 def test_glsl_codes_and_dispatch_match_the_registry() -> None:

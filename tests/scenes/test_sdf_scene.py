@@ -508,9 +508,9 @@ def test_the_opening_view_shows_every_primitive_and_keeps_their_names_apart(scen
 def test_catalogue_primitives_from_the_dropdown_are_meshed_and_named(
     server: viser.ViserServer, scene: SdfGalleryScene, label: str, kind: str, shown: str
 ) -> None:
-    from scenes.sdf_gallery.params import KIND_LABELS
+    from scenes.sdf_gallery.params import kind_labels
 
-    assert {"Cylinder", "Round box", "Octahedron", "Cone", "Hexagonal prism"} <= set(KIND_LABELS)
+    assert {"Cylinder", "Round box", "Octahedron", "Cone", "Hexagonal prism"} <= set(kind_labels())
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("P2 kind")
         client.set_value("P2 kind", label)
@@ -1474,10 +1474,10 @@ def scene_points_of_primitives(scene: SdfGalleryScene) -> np.ndarray:
 
 def test_every_kinds_gizmo_label_is_its_menu_name() -> None:
     # The family of "P2 round_box": each registry kind's label is its menu label, lower case, without its note.
-    from scenes.sdf_gallery.params import KIND_LABELS, gizmo_label
+    from scenes.sdf_gallery.params import gizmo_label, kind_labels
 
     slot = SdfGalleryParams().primitives[0]
-    for label, kind in KIND_LABELS.items():
+    for label, kind in kind_labels().items():
         shown = gizmo_label(2, dataclasses.replace(slot, kind=kind))
         # the menu's words (a note such as "(bound)" may be left off), never the code's name
         assert shown.startswith("P3 ") and label.lower().startswith(shown[3:]) and "_" not in shown, (kind, shown)
