@@ -103,7 +103,9 @@ def test_a_kind_registered_after_the_gallery_was_imported_is_in_its_menus_and_me
     from scenes.sdf_gallery.scene import SdfGalleryScene
 
     scene = show_scene(SdfGalleryScene)
-    assert "Octahedron (bound)" in scene.slot_controls[1]["kind"].options
+    menu = scene.slot_controls[1]["kind"]
+    assert isinstance(menu, viser.GuiDropdownHandle)
+    assert "Octahedron (bound)" in menu.options
     assert "Octahedron (bound): a = size." in scene.size_note.content
     with BrowserClient(server.get_port()) as client:
         client.wait_for_gui("P2 kind")
