@@ -10,9 +10,9 @@ given a plain ``viser.ViserServer`` it builds on the shared session of that serv
 Every value a browser sends is untrusted. The gate (:mod:`server.gate`) lets only a control's value, a gizmo's pose
 and a camera through, already checked against the control's recorded spec. Scenes still read GUI values only through
 :meth:`Scene.read_controls` (the controls declared on the scene's parameter dataclass, :mod:`scenes._controls`) or
-:meth:`Scene.read_number`, :meth:`Scene.read_choice` and :meth:`Scene.read_bool`, which clean a value with the gate's
-own :func:`server.clean.clean_value` against the recorded spec (never a handle's props), fall back to the last good
-value for anything unusable and write the cleaned value back. They wrap every callback in :meth:`Scene.callback`,
+:meth:`Scene.read_choice` (a menu that is not a parameter of its own: the peloton's presets), which clean a value with
+the gate's own :func:`server.clean.clean_value` against the recorded spec (never a handle's props), fall back to the
+last good value for anything unusable and write the cleaned value back. They wrap every callback in :meth:`Scene.callback`,
 which serialises callbacks (viser runs plain callbacks on a thread pool) and logs, rather than raises, anything that
 goes wrong.
 """
@@ -20,7 +20,6 @@ goes wrong.
 from __future__ import annotations
 
 import abc
-import dataclasses
 import functools
 import logging
 import threading
@@ -279,26 +278,6 @@ class Scene(abc.ABC, Generic[P]):
         return handler
 
     # ----------------------------------------------------------------------------------------- inputs
-    def read_number(self, handle: Any, last_good: float, *, integer: bool = False) -> float:
-        """The handle's value as a finite number clamped to the range the scene gave the control; ``last_good`` if
-        it is not a number.
-
-        The range is the control's recorded spec (:func:`server.clean.control_spec`), never the handle's props, and
-        the value is cleaned by the gate's own :func:`server.clean.clean_value`. The cleaned value is written back to
-        the GUI so every browser shows what the scene uses.
-        """
-        raw = handle.value
-        spec = control_spec(handle)
-        if integer and not spec.integer:
-            spec = dataclasses.replace(spec, integer=True)
-        accepted, cleaned, _reason = clean_value(spec, raw)
-        if not accepted:
-            self.write_back(handle, int(last_good) if integer else float(last_good))
-            return float(last_good)
-        if not _controls.same_value(raw, cleaned):
-            self.write_back(handle, cleaned)
-        return float(cleaned)
-
     def read_choice(self, handle: Any, options: Sequence[T], last_good: T) -> T:
         """The handle's value if it is one of ``options`` and of the control's recorded options, else ``last_good``
         (written back)."""
@@ -307,14 +286,6 @@ class Scene(abc.ABC, Generic[P]):
             for option in options:
                 if option == cleaned:
                     return option
-        self.write_back(handle, last_good)
-        return last_good
-
-    def read_bool(self, handle: Any, last_good: bool) -> bool:
-        """The checkbox's value if it is a bool, else ``last_good`` (written back)."""
-        accepted, cleaned, _reason = clean_value(control_spec(handle), handle.value)
-        if accepted and isinstance(cleaned, bool):
-            return cleaned
         self.write_back(handle, last_good)
         return last_good
 

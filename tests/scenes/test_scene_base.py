@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import gc
 import threading
 import time
@@ -14,7 +15,13 @@ from helpers.viser_private import gui_uuids, node_names
 from helpers.wsclient import BrowserClient
 
 from scenes import SCENES
+from scenes._controls import build_controls, slider
 from server.sessions import camera_hub
+
+
+@dataclasses.dataclass(frozen=True)
+class ProbeParams:
+    value: float = dataclasses.field(default=1.0, metadata=slider("Value", 0.0, 10.0, 0.1))
 
 
 class Probe(StubScene):
@@ -23,6 +30,7 @@ class Probe(StubScene):
 
     def __init__(self, server: viser.ViserServer) -> None:
         super().__init__(server)
+        self.params = ProbeParams()
         self.value = 1.0
         self.point = (0.0, 0.0, 0.0)
         self.calls = 0
@@ -31,7 +39,8 @@ class Probe(StubScene):
         """What the loop's step reports: False puts the loop to sleep until wake_loops()."""
         self.gizmo_events = 0
         with self.gui_root:
-            self.slider = server.gui.add_slider("Value", min=0.0, max=10.0, step=0.1, initial_value=1.0)
+            self.controls = build_controls(self.server.gui, self.params)
+            self.slider = self.controls["value"]
             self.choice = server.gui.add_dropdown("Choice", options=("a", "b"), initial_value="a")
             self.boom = server.gui.add_button("Boom")
         self.gizmo = server.scene.add_transform_controls(f"{self.root.name}/gizmo", scale=0.5)
@@ -42,7 +51,8 @@ class Probe(StubScene):
 
     def _on_value(self) -> None:
         self.calls += 1
-        self.value = self.read_number(self.slider, self.value)
+        self.params = self.read_controls(self.controls)
+        self.value = self.params.value
 
     def _explode(self) -> None:
         raise RuntimeError("a bug in a callback")
