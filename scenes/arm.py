@@ -28,7 +28,7 @@ from numpy.typing import NDArray
 from kernels import fabrik
 from scenes._base import Scene
 from scenes._charts import FittedChart, number_scales
-from scenes._controls import build_controls, checkbox, dropdown, slider
+from scenes._controls import build_controls, checkbox, declared, dropdown, slider
 from scenes._framing import ClientFraming, Lens, View, frame_points
 from scenes._instances import add_instances, park_hidden
 from scenes._skeletons import JOINT_RADIUS_M as SKELETON_JOINT_M
@@ -66,9 +66,10 @@ LIMIT_RAMP = np.array([(60, 200, 90), (250, 200, 40), (230, 50, 50)], dtype=np.f
 
 @dataclasses.dataclass(frozen=True)
 class ArmParams:
-    """Everything the scene shows is a function of these, the target and the obstacles; defaults open the scene.
+    """Everything the scene's own chain shows is a function of these; defaults open the scene.
 
-    Each field is also its GUI control, declared once (:mod:`scenes._controls`), in the order and folder shown.
+    Each field but the gizmos' is also its GUI control, declared once (:mod:`scenes._controls`), in the order and
+    folder shown; the target and the obstacle centres are set by dragging their gizmos (or clicking, for the target).
     """
 
     preset: PresetLabel = field(default="Chain", metadata=dropdown("Preset", PRESET_LABELS, folder="Skeleton"))
@@ -101,11 +102,22 @@ class ArmParams:
     """Stop when the end effector is this close to the target (mm)."""
     max_iterations: int = field(default=50, metadata=slider("Max iterations", 1, 500, 1, folder="Solver"))
     """Iteration cap per solve."""
+    target: tuple[float, float, float] = (0.9, 0.0, 0.6)
+    """Where the end effector is sent (world, m): the target gizmo's position (y = 0 on the plane)."""
+    obstacle_centres: tuple[tuple[float, float, float], ...] = (
+        (0.45, 0.0, 0.45),
+        (-0.6, 0.0, 0.9),
+        (0.3, 0.0, 1.45),
+        (-0.4, 0.0, 0.3),
+    )
+    """Each obstacle's centre (world, m), its gizmo's position: :data:`MAX_OBSTACLES` of them, the first
+    ``n_obstacles`` shown."""
 
 
-OBSTACLE_STARTS = np.array([[0.45, 0.0, 0.45], [-0.6, 0.0, 0.9], [0.3, 0.0, 1.45], [-0.4, 0.0, 0.3]])
-"""Where the obstacles open (world, m)."""
-TARGET_START = np.array([0.9, 0.0, 0.6])
+OBSTACLE_STARTS = np.array(ArmParams().obstacle_centres)
+"""Where the obstacles open (world, m), (MAX_OBSTACLES, 3)."""
+TARGET_START = np.array(ArmParams().target)
+"""Where the target opens (world, m)."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -173,6 +185,12 @@ def limit_colours(joints: NDArray[np.float64], params: ArmParams) -> NDArray[np.
     ramp = np.stack([np.interp(share, (0.0, 0.5, 1.0), LIMIT_RAMP[:, c]) for c in range(3)], axis=1)
     end = np.array([REST_COLOUR], dtype=np.float64)
     return np.vstack([ramp, end]).round().astype(np.uint8)
+
+
+def _point(xyz: NDArray[np.float64]) -> tuple[float, float, float]:
+    """A (3,) point as the parameters hold it."""
+    x, y, z = (float(v) for v in xyz)
+    return (x, y, z)
 
 
 def _root_direction(three_d: bool) -> NDArray[np.float64]:
@@ -609,8 +627,6 @@ is a static pose.
     def __init__(self, server: viser.ViserServer) -> None:
         super().__init__(server)
         self.params = ArmParams()
-        self.target = TARGET_START.copy()
-        self.obstacle_centres = OBSTACLE_STARTS.copy()
         self.pose = rest_pose(self.params.n_links, self.params.link_length_m)
         self.report: SolveReport | None = None
         self.solves = 0
@@ -654,7 +670,7 @@ is a static pose.
                     title="Error after each iteration (log scale)",
                     aspect=1.6,
                 )
-            chain = [f.name for f in dataclasses.fields(ArmParams) if f.name != "preset"]
+            chain = [name for name in declared(ArmParams) if name != "preset"]
             self.controls = skeleton | build_controls(gui, p, names=chain)
             with self.controls.folders["Chain"]:  # after the chain's controls
                 self.reset_pose = gui.add_button("Straighten the chain")
@@ -778,7 +794,9 @@ is a static pose.
         point = moved_gizmo(self.obstacle_gizmos[k], self.obstacle_centres[k], not self.params.three_d)
         if point is None or np.array_equal(point, self.obstacle_centres[k]):
             return
-        self.obstacle_centres[k] = point
+        centres = list(self.params.obstacle_centres)
+        centres[k] = _point(point)
+        self.params = dataclasses.replace(self.params, obstacle_centres=tuple(centres))
         self.solve_and_draw()
 
     def _on_scene_click(self, event: viser.SceneClickEvent) -> None:
@@ -892,8 +910,9 @@ is a static pose.
             for k in range(MAX_OBSTACLES):
                 self.obstacle_gizmos[k].active_axes = axes
             if not three_d:
-                self.target[1] = 0.0
-                self.obstacle_centres[:, 1] = 0.0
+                flat = tuple((x, 0.0, z) for x, _, z in self.params.obstacle_centres)
+                self.params = dataclasses.replace(self.params, obstacle_centres=flat)
+                self.target = self.target * (1.0, 0.0, 1.0)
                 self.pose = rest_pose(self.params.n_links, self.params.link_length_m)
                 self.target_gizmo.position = self.target
                 for k in range(MAX_OBSTACLES):
@@ -902,6 +921,20 @@ is a static pose.
     def read_params(self) -> ArmParams:
         """The current GUI values, cleaned: anything non-finite, out of range or unknown keeps the last good value."""
         return self.read_controls(self.controls)
+
+    @property
+    def target(self) -> NDArray[np.float64]:
+        """Where the end effector is sent (world, m): ``params.target`` as a new (3,) array."""
+        return np.array(self.params.target)
+
+    @target.setter
+    def target(self, point: NDArray[np.float64]) -> None:
+        self.params = dataclasses.replace(self.params, target=_point(point))
+
+    @property
+    def obstacle_centres(self) -> NDArray[np.float64]:
+        """Each obstacle's centre (world, m): ``params.obstacle_centres`` as a new (MAX_OBSTACLES, 3) array."""
+        return np.array(self.params.obstacle_centres)
 
     # ----------------------------------------------------------------------------------------- solve + draw
     def solve_and_draw(self) -> None:

@@ -199,6 +199,25 @@ def test_an_off_plane_drag_is_put_back_in_the_plane(server: viser.ViserServer, s
             np.testing.assert_array_equal(np.asarray(scene.target_gizmo.position), (0.7, 0.0, 0.9))
 
 
+def test_the_target_and_obstacles_a_person_moved_are_parameters_a_control_keeps(
+    server: viser.ViserServer, scene: ArmScene
+) -> None:
+    # Everything a person sets is in the scene's parameters: the gizmos' places too, kept when a control changes.
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_node("/arm/obstacle_0")
+        client.drag_transform("/arm/target", [(0.7, 0.0, 0.9)])
+        client.drag_transform("/arm/obstacle_0", [(-0.4, 0.0, 0.5)])
+        client.wait_for(lambda: scene.gizmo_events >= 6, what="both drags handled")
+        client.set_value("Links", 7)
+        client.wait_for(lambda: scene.params.n_links == 7, what="the new chain")
+    with scene.state_lock:
+        assert scene.params.target == (0.7, 0.0, 0.9)
+        assert scene.params.obstacle_centres[0] == (-0.4, 0.0, 0.5)
+        assert scene.params.obstacle_centres[1:] == ArmParams().obstacle_centres[1:]
+        assert scene.report is not None
+        assert np.linalg.norm(scene.pose[-1] - (0.7, 0.0, 0.9)) <= scene.report.result.error + 1e-12
+
+
 def test_leaving_3d_puts_every_gizmo_the_browser_moved_back_on_the_plane(
     server: viser.ViserServer, scene: ArmScene
 ) -> None:
