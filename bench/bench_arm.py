@@ -12,12 +12,13 @@ numba's threads and threading layer, the load average before and after), then:
    limits and 4 obstacles (goal ≥ 300 k chains/s).
 4. Cold start: compiling every core in a fresh process with an empty cache, and loading them from the cache.
 5. The Python around the core: for chains of 2, 4, 8 and 16 links, the median and p95 of the compiled single-chain
-   entry alone (``kernels.fabrik.api.compiled_single_solve``: the compiled call on prepared arguments, numba's dispatch included) and of a full public
-   ``solve`` call on the same chain and target, and their ratio. Goal: ``solve`` within 2× of the core.
+   entry alone (``kernels.fabrik.api.compiled_single_solve``: the compiled call on prepared arguments, numba's dispatch
+   included) and of a full public ``solve`` call on the same chain and target, and their ratio. Goal: ``solve`` within
+   2× of the core.
 6. The goal table.
 
-The baseline is ``tests/helpers/ik_reference.py``'s FABRIK: Aristidou & Lasenby's Algorithm 1 in plain numpy, one joint at a
-time, with the same cone limits (it has no obstacles), iterated to the same tolerance and cap in the same process;
+The baseline is ``tests/helpers/ik_reference.py``'s FABRIK: Aristidou & Lasenby's Algorithm 1 in plain numpy, one joint
+at a time, with the same cone limits (it has no obstacles), iterated to the same tolerance and cap in the same process;
 ``× baseline`` is its time over ours. Every single-solve time is the fastest of three runs (timeit's rule: another
 process taking the core mid-solve says nothing about the solver). The machine may be shared: read the figures with
 the load printed beside them.

@@ -11,9 +11,9 @@ drawing width (viser's client lowers its resolution while frames are slow; "held
 the browser tests do). The WebGL renderer string says whether it was software (SwiftShader) or a GPU.
 
 The cases are the scenes as they open, plus ``peloton-bunch``: the peloton with Formation set to a bunch and Riders
-to 121 through the page, as a person sets them, and ``sdf-both``: the SDF gallery's View set to Both. Each case runs ``repeats`` times (a fresh page each time) and a
-last table gives the median frames per second of its runs: on a machine shared with other work one run can be
-unlucky.
+to 121 through the page, as a person sets them, and ``sdf-both``: the SDF gallery's View set to Both. Each case runs
+``repeats`` times (a fresh page each time) and a last table gives the median frames per second of its runs: on a machine
+shared with other work one run can be unlucky.
 """
 
 from __future__ import annotations

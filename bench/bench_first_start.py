@@ -11,7 +11,8 @@ Two runs, each in a fresh process with its own empty ``NUMBA_CACHE_DIR``:
 - *baseline*, the same scenes with no background compile: each first call compiles where it stands.
 
 Prints a table per run (seconds); the warming run adds the CPU seconds its compile processes used (user + system,
-summed over them: on a busy machine the wall time stretches, this much less). The browser's own draw adds a fraction of a second on top (see docs/performance.md).
+summed over them: on a busy machine the wall time stretches, this much less). The browser's own draw adds a fraction of
+a second on top (see docs/performance.md).
 """
 
 from __future__ import annotations

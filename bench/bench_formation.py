@@ -101,7 +101,8 @@ def browser_rows() -> None:
                 fps = 1000.0 / gaps_ms
                 row(f"Chromium software WebGL, {case}: frame time", list(gaps_ms * 1e-3), 1e-3, "ms")
                 print(
-                    f"| {'  frames per second while orbiting':<48} | {np.median(fps):>10.1f} | {np.percentile(fps, 5):>10.1f} | fps  | median, 5th percentile; goal >= 10"
+                    f"| {'  frames per second while orbiting':<48} | {np.median(fps):>10.1f} "
+                    f"| {np.percentile(fps, 5):>10.1f} | fps  | median, 5th percentile; goal >= 10"
                 )
 
 

@@ -432,7 +432,8 @@ def goal_rows() -> None:
     load_after = os.getloadavg()
     print(
         f"\nCPU: {cpu}, {os.cpu_count()} logical CPUs; numba {numba.__version__}, {numba.get_num_threads()} threads "
-        f"({numba.threading_layer()} layer); load average (1 min) {load_before[0]:.2f} before, {load_after[0]:.2f} after\n"
+        f"({numba.threading_layer()} layer); load average (1 min) {load_before[0]:.2f} before, "
+        f"{load_after[0]:.2f} after\n"
     )
 
 
@@ -440,9 +441,9 @@ def overhead_rows(calls: int = 20_000) -> None:
     """The Python around one kick: the compiled core alone against a full public ``simulate`` call, in turns.
 
     A typical free kick: the scene's RK4 at 10 ms, a 30 m curler to the plane x = 30 m, t_max 4 s, the ball's
-    underside on the turf. (a) is :func:`kernels.ball.core.simulate_one` on a prepared launch row and preallocated buffers; (b) is
-    ``ball.simulate`` with a reused :class:`kernels.ball.FlightConfig`, (c) with the same settings as keywords.
-    Each call is timed on its own; the three alternate, so a neighbour's load falls on all of them alike.
+    underside on the turf. (a) is :func:`kernels.ball.core.simulate_one` on a prepared launch row and preallocated
+    buffers; (b) is ``ball.simulate`` with a reused :class:`kernels.ball.FlightConfig`, (c) with the same settings as
+    keywords. Each call is timed on its own; the three alternate, so a neighbour's load falls on all of them alike.
     """
     config = ball.FlightConfig(dt=1e-2, method="rk4", t_max=4.0, x_stop=LINE_M, ground_m=R)
     options = {"dt": 1e-2, "method": "rk4", "t_max": 4.0, "x_stop": LINE_M, "ground_m": R}

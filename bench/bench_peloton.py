@@ -164,7 +164,8 @@ def machine() -> None:
 
     print(
         f"\nmachine: {sys.platform}, {_cpus()} CPUs, load {load:.1f}, Python {sys.version.split()[0]}, "
-        f"numpy {np.__version__}, numba {numba.__version__} ({numba.get_num_threads()} threads; the ride loop is serial)"
+        f"numpy {np.__version__}, numba {numba.__version__} "
+        f"({numba.get_num_threads()} threads; the ride loop is serial)"
     )
 
 

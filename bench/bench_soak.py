@@ -4,8 +4,8 @@
                                [--modes session shared]
 
 For each mode and scene it starts ``app.py`` in its own process (``--shared`` for the shared mode) and N fake
-browsers (``tests/helpers/wsclient.py``), each in its own process. Every browser connects and receives its scene first; then
-all start together (a barrier file) and each moves its scene's main input at ``rate`` messages per second for
+browsers (``tests/helpers/wsclient.py``), each in its own process. Every browser connects and receives its scene first;
+then all start together (a barrier file) and each moves its scene's main input at ``rate`` messages per second for
 exactly ``seconds``: the peloton's speed slider, the arm's target gizmo, the free kick's launch speed slider, the SDF
 gallery's second primitive's gizmo. A browser keeps only the arrival times of the scene updates it receives (kept
 whole, a minute of SDF meshes is gigabytes per browser). It prints the date, the machine and the load average, then

@@ -144,7 +144,8 @@ def frame_points(
     ndc: tuple[float, float, float, float] = FULL_NDC,
     min_depth: float = 0.0,
 ) -> View:
-    """The camera looking along ``direction`` (z up) that shows every one of ``points`` inside ``ndc``, as close as it can.
+    """The camera looking along ``direction`` (z up) that shows every one of ``points`` inside ``ndc``, as close as it
+    can.
 
     Args:
         points: (N, 3) world points that must be seen (m).

@@ -608,6 +608,7 @@ class SkeletonView:
         return (
             f"**{sk.name}**: {iterations_words(r.iterations)}, "
             f"solve **{report.micros:,.0f} µs**{plain_python_note()}  \n"
-            f"Multi-end-effector FABRIK, tolerance {sk.tolerance_mm:g} mm, at most {iterations_words(sk.max_iterations)}."
+            f"Multi-end-effector FABRIK, tolerance {sk.tolerance_mm:g} mm, "
+            f"at most {iterations_words(sk.max_iterations)}."
             f"\n\n| Effector | Error (mm) | Status |\n|---|---|---|\n{rows}"
         )

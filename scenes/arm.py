@@ -604,12 +604,12 @@ outwards. Repeat until |pₙ − target| < tolerance. No angles, no matrices.
 the vertical), clamped inside each pass. **Obstacles** (circles in the plane, spheres in 3D): a segment that would
 cut one is turned about its anchor by the least angle until it just clears it. The solver returns the best pose
 it saw that keeps every limit and clears every obstacle; when that falls short, the scene also solves from a
-few gently bent arcs that keep the limits, and keeps whichever pose comes closest. **Status**: "reached" (within the tolerance);
-"unreachable" (the target lies outside the reach annulus max(0, 2·max L − ΣL) ≤ |target − root| ≤ ΣL; the chain
-stretches straight toward it at once); "blocked" (within reach, but the chain rests against an obstacle short of it, or the
-target is inside one); "limited" (within reach, but the iterates stalled at a fixed point under the joint limits,
-or beside an obstacle they do not touch, short of it); "max_iterations" (still converging at the cap); "infeasible" (no pose seen kept every limit and
-cleared every obstacle).
+few gently bent arcs that keep the limits, and keeps whichever pose comes closest. **Status**: "reached" (within the
+tolerance); "unreachable" (the target lies outside the reach annulus max(0, 2·max L − ΣL) ≤ |target − root| ≤ ΣL; the
+chain stretches straight toward it at once); "blocked" (within reach, but the chain rests against an obstacle short of
+it, or the target is inside one); "limited" (within reach, but the iterates stalled at a fixed point under the joint
+limits, or beside an obstacle they do not touch, short of it); "max_iterations" (still converging at the cap);
+"infeasible" (no pose seen kept every limit and cleared every obstacle).
 
 **Compared with.** CCD (turn each joint, end to root, to aim the end at the target) and damped-least-squares
 Jacobian IK, Δθ = Jᵀ(JJᵀ + λ²I)⁻¹e. The paper's Table 1 (10 joints): FABRIK 15.5 iterations, CCD 26.3, DLS 999.

@@ -27,11 +27,18 @@ from kernels.course import SAMPLE_ROUTE  # noqa: E402
 SECTIONS_KM_GRADE = [(2.5, 0.102), (1.0, 0.080), (1.0, 0.100), (2.6, 0.085), (4.1, 0.075), (2.0, 0.054)]
 START_ELEVATION_M = 744.0
 START_LAT, START_LON = 45.0560, 6.0300
+DESCRIPTION = (
+    "Sample route rebuilt from Alpe d'Huez's published climb profile: 13.2 km, 744 m to 1815 m, 8.1 % average "
+    "(Road Cycling UK; Epic Cols), section grades read from the guides' descriptions. The plan shape (21 hairpins) "
+    "is schematic, not the real road."
+)
+"""The route's description in the GPX file."""
 LEGS, HAIRPIN_RADIUS_M, STEP_M = 22, 15.0, 20.0
 
 
 def plan(total_m: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(east, north, distance) every STEP_M metres along 22 straight legs alternating 20° and 160° joined by hairpins."""
+    """(east, north, distance) every STEP_M metres along 22 straight legs alternating 20° and 160° joined by
+    hairpins."""
     turn = math.radians(140.0)
     arc = HAIRPIN_RADIUS_M * turn
     leg = (total_m - (LEGS - 1) * arc) / LEGS
@@ -65,7 +72,7 @@ def main() -> None:
 <gpx version="1.1" creator="viser-physics-scenes scripts/make_sample_route.py" xmlns="http://www.topografix.com/GPX/1/1">
   <metadata>
     <name>Alpe d'Huez (sample, from the published profile)</name>
-    <desc>Sample route rebuilt from Alpe d'Huez's published climb profile: 13.2 km, 744 m to 1815 m, 8.1 % average (Road Cycling UK; Epic Cols), section grades read from the guides' descriptions. The plan shape (21 hairpins) is schematic, not the real road.</desc>
+    <desc>{DESCRIPTION}</desc>
   </metadata>
   <trk>
     <name>Alpe d'Huez (sample, from the published profile)</name>

@@ -94,8 +94,8 @@ class FinishedUpload:
 class Gate:
     """The one gate in front of one server's message dispatch. Made by :func:`install_gate`.
 
-    Besides cleaning, it shares two budgets out fairly: costly inputs per tab (:func:`~server.clean.mark_costly`), so one tab
-    flooding Reset or scene switches cannot fill viser's callback pool and delay every other tab; and uploads in
+    Besides cleaning, it shares two budgets out fairly: costly inputs per tab (:func:`~server.clean.mark_costly`), so
+    one tab flooding Reset or scene switches cannot fill viser's callback pool and delay every other tab; and uploads in
     flight across all tabs (:data:`MAX_UPLOADS_IN_FLIGHT_TOTAL`, :data:`MAX_UPLOAD_BYTES_IN_FLIGHT_TOTAL`).
     """
 
@@ -571,7 +571,8 @@ class Gate:
         return None, end_then_tell
 
     def _drop_stalled_uploads(self, server: viser.ViserServer) -> None:
-        """Forget uploads that received no part for :data:`~server.budget.UPLOAD_STALL_S`, and free the parts viser holds."""
+        """Forget uploads that received no part for :data:`~server.budget.UPLOAD_STALL_S`, and free the parts viser
+        holds."""
         now = time.monotonic()
         for client_id, uploads in list(self._uploads.items()):
             for transfer, upload in list(uploads.items()):

@@ -225,7 +225,8 @@ def camera_hub(server: viser.ViserServer) -> CameraHub:
 
 
 class Session:
-    """The scene, GUI and cameras one scene draws on: one client's (:meth:`for_client`) or everyone's (:meth:`shared`)."""
+    """The scene, GUI and cameras one scene draws on: one client's (:meth:`for_client`) or everyone's
+    (:meth:`shared`)."""
 
     def __init__(
         self,

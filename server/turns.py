@@ -14,8 +14,8 @@ class Turns:
     Python runs one thread at a time anyway. Left to interleave, the callbacks of 8 tabs at 30 inputs/s each ran
     about four at once, each about four times slower (a free kick input: 2.8 ms alone, a median of 19 ms in the
     soak), so a tab's next input arrived while its last was still running and latest-wins coalescing
-    (:meth:`scenes._base.Scene.callback`) never had a burst to merge. Taking turns, each callback runs at its own speed and the
-    inputs that arrive meanwhile wait, to be merged. A turn is handed to the longest waiter (no tab starves).
+    (:meth:`scenes._base.Scene.callback`) never had a burst to merge. Taking turns, each callback runs at its own speed
+    and the inputs that arrive meanwhile wait, to be merged. A turn is handed to the longest waiter (no tab starves).
     """
 
     def __init__(self) -> None:

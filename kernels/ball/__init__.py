@@ -48,16 +48,16 @@ one ball diameter" (0.22 m) those papers report.
 Assumptions: spin is constant in flight (spin decay over a 1–2 s free kick is a few percent); still air; the ball is
 rigid. Without a pitch the flight stops at the first touch of the ground and a ball that touches the wall or the
 frame does not rebound; with a :class:`Pitch` (``simulate(..., pitch=...)``) it bounces, rolls and strikes the posts,
-bar, wall and keeper (:mod:`kernels.ball.play`). Integrators: ``"euler"`` is the fixed-step method of most web demos (v += a·dt, then x += v·dt; first order),
-``"rk4"`` the classical fourth-order Runge–Kutta. The last sample of a flight is placed on the ground (or on the
-``x_stop`` plane) by cubic Hermite interpolation of the last step, which keeps RK4's accuracy: the first root of
-that cubic in the step, bracketed between its turning points (a ball may rise, peak and land within one long step).
-Wall and goal crossings are found the same way. Every step is ``dt`` but the last, which is shortened to end exactly
-on ``t_max``. Planes are closed on the start side: a ball launched on the ``x_stop``, wall or goal plane and moving
-through it crosses at t = 0; one launched on the ground (``z = ground_m``) and not moving up lands at t = 0; one
-launched below it is refused. The measured model refuses a launch spin parameter r·|ω|/max(|v|, 1 m/s) above 10³
-(its fits stop at S ≈ 0.3; 10³ is ~2·10⁵ rev/s at 25 m/s) with a ``ValueError`` naming the spin; :func:`coefficients`
-refuses the same inputs by the same check (:func:`kernels.ball.config.refuse_fast_spin`).
+bar, wall and keeper (:mod:`kernels.ball.play`). Integrators: ``"euler"`` is the fixed-step method of most web
+demos (v += a·dt, then x += v·dt; first order), ``"rk4"`` the classical fourth-order Runge–Kutta. The last sample of a
+flight is placed on the ground (or on the ``x_stop`` plane) by cubic Hermite interpolation of the last step, which keeps
+RK4's accuracy: the first root of that cubic in the step, bracketed between its turning points (a ball may rise, peak
+and land within one long step). Wall and goal crossings are found the same way. Every step is ``dt`` but the last, which
+is shortened to end exactly on ``t_max``. Planes are closed on the start side: a ball launched on the ``x_stop``, wall
+or goal plane and moving through it crosses at t = 0; one launched on the ground (``z = ground_m``) and not moving up
+lands at t = 0; one launched below it is refused. The measured model refuses a launch spin parameter
+r·|ω|/max(|v|, 1 m/s) above 10³ (its fits stop at S ≈ 0.3; 10³ is ~2·10⁵ rev/s at 25 m/s) with a ``ValueError`` naming
+the spin; :func:`coefficients` refuses the same inputs by the same check (:func:`kernels.ball.config.refuse_fast_spin`).
 
 Implementation: every numeric core (force law, Euler and RK4 steps, the Hermite end of a flight, plane crossings and
 the verdict) is written once, on scalars, and compiled by numba (``@njit(cache=True)``). One kick and a batch run the

@@ -5,8 +5,9 @@ Scalar cores on the (14,) settings vector of :class:`kernels.ball.config.FlightC
 constants (slots :data:`AXIS` … :data:`N2`: ω̂, |ω|, knuckle gain, rate, phases, directions). Accelerations are per
 unit mass (m/s²), forces in N. Coefficients: constant C_D and C_L, or the measured model: C_L(S) = 0.9·min(S, 0.3)
 (below Asai et al. 2007's wind-tunnel values, Sports Eng. 10) and C_D(Re, S) of Goff & Carré 2010 (Eur. J. Phys. 31),
-its drag crisis centred at the configured Reynolds number (1.815·10⁵, their Teamgeist fit); knuckle force after Cohen et al. 2012 and
-Texier et al. 2016 (New J. Phys. 18). The model, its assumptions and its sources in full: :mod:`kernels.ball`.
+its drag crisis centred at the configured Reynolds number (1.815·10⁵, their Teamgeist fit); knuckle force after Cohen et
+al. 2012 and Texier et al. 2016 (New J. Phys. 18). The model, its assumptions and its sources in full:
+:mod:`kernels.ball`.
 """
 
 from __future__ import annotations
@@ -54,8 +55,8 @@ RK4_STABILITY = 2.785293563405289
 """Classical RK4's: |1 + z + z²/2 + z³/6 + z⁴/24| ≤ 1 for z ∈ [−2.7853, 0], the real root of z³ + 4z² + 12z + 24
 (Hairer & Wanner, Solving ODEs II, 2nd ed. 1996, §IV.2, Fig. 2.1)."""
 
-# Each kick's constants are one row of 14 (beside the settings vector of FlightConfig): ω̂, |ω|, knuckle gain ½ρA·C_K·w/m, rate Ω, phases φ₁ φ₂,
-# cos θ·n₁ and sin θ·n₂.
+# Each kick's constants are one row of 14 (beside the settings vector of FlightConfig): ω̂, |ω|, knuckle gain
+# ½ρA·C_K·w/m, rate Ω, phases φ₁ φ₂, cos θ·n₁ and sin θ·n₂.
 AXIS, RATE, GAIN, OMEGA, PHASE, N1, N2 = 0, 3, 4, 5, 6, 8, 11
 N_KICK = 14
 

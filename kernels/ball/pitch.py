@@ -73,8 +73,9 @@ def free_kick_panels(
         raise ValueError("goal_normal_xy must not be zero")
     if float((centre - ball) @ normal) <= 0.0:
         raise ValueError(
-            f"goal_normal_xy points from the pitch into the net, away from the ball; {_checks.shown(tuple(normal.tolist()))} "
-            f"points from the goal at {_checks.shown(tuple(centre.tolist()))} toward the ball at {_checks.shown(tuple(ball.tolist()))}"
+            "goal_normal_xy points from the pitch into the net, away from the ball; "
+            f"{_checks.shown(tuple(normal.tolist()))} points from the goal at {_checks.shown(tuple(centre.tolist()))} "
+            f"toward the ball at {_checks.shown(tuple(ball.tolist()))}"
         )
     aim = centre - ball
     distance = float(np.hypot(*aim))

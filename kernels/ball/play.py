@@ -4,9 +4,10 @@ and ends in the net, at rest, off the pitch, in the keeper's hands or at ``t_max
 One compiled loop, :func:`play`, steps the same force law and RK4/Euler step as the free flight
 (:func:`kernels.ball.core._step`) between contacts; each contact is the first one found inside a step (the ground by
 the cubic Hermite root of :func:`~kernels.ball.core.crossing_fraction`, a capsule by bisection on the Hermite
-interpolant after a swept test of the step's chord, grown by how far the path can stray from it) and applies :func:`kernels.ball.contact.impact`, Cross's
-grip–slip impulse (Cross 2002), with the surface's coefficients. The step then restarts from the contact, so samples
-are every ``dt`` between contacts, plus one at each contact. Spin is constant between contacts and changed by each.
+interpolant after a swept test of the step's chord, grown by how far the path can stray from it) and applies
+:func:`kernels.ball.contact.impact`, Cross's grip–slip impulse (Cross 2002), with the surface's coefficients. The step
+then restarts from the contact, so samples are every ``dt`` between contacts, plus one at each contact. Spin is constant
+between contacts and changed by each.
 
 Pitch geometry is one (:data:`N_PITCH`,) vector (slots below) built by :func:`kernels.ball.pitch.pitch_vector`:
 the goal (posts: vertical capsules of radius r_p on the goal line at ±(w/2 + r_p); bar: a horizontal capsule with

@@ -4,14 +4,15 @@ A course of N points has per-point arrays of shape (N,) (distance, elevation, ma
 shape (N − 1,) (grade, heading, length); segment i runs from point i to point i + 1. SI units throughout (m, s, kg,
 W, rad); headings are compass bearings, clockwise from north, in radians.
 
-**Course.** :func:`load_gpx` reads the track and route points of a GPX file with gpxpy. Segment lengths on the map are great-circle
-(haversine) distances on a sphere of radius 6 371 008.8 m (the IUGG mean Earth radius); headings are the initial
-great-circle bearings. GPS elevation is noisy, so it is smoothed by a moving average over a distance window
+**Course.** :func:`load_gpx` reads the track and route points of a GPX file with gpxpy. Segment lengths on the map are
+great-circle (haversine) distances on a sphere of radius 6 371 008.8 m (the IUGG mean Earth radius); headings are the
+initial great-circle bearings. GPS elevation is noisy, so it is smoothed by a moving average over a distance window
 (``smoothing_m``, 50 m by default; under :data:`SMOOTHING_FLOOR_M`, 1 cm, none), and within half a window of an
-end by the least-squares line over that end's first window (a steady climb keeps its grade and its end heights); grade is the smoothed
-rise over the map distance, and the rider travels the slope length run·√(1 + grade²). A GPX file's track segments and routes are joined in file order, and pieces more
-than 2 km apart are refused, however they arrive. :attr:`Course.climbing_m` is the noise-aware total ascent
-(:func:`total_ascent`: spikes out, a 100 m moving average, climbs counted past a 5 m hysteresis threshold).
+end by the least-squares line over that end's first window (a steady climb keeps its grade and its end heights); grade
+is the smoothed rise over the map distance, and the rider travels the slope length run·√(1 + grade²). A GPX file's track
+segments and routes are joined in file order, and pieces more than 2 km apart are refused, however they arrive.
+:attr:`Course.climbing_m` is the noise-aware total ascent (:func:`total_ascent`: spikes out, a 100 m moving average,
+climbs counted past a 5 m hysteresis threshold).
 
 **Ride.** Along each segment the rider's kinetic energy changes by the work of the pedals minus the resistances
 (the power terms of :mod:`kernels.cycling`, the textbook terms or Martin et al. 1998's):

@@ -2,8 +2,8 @@
 time, and power paced with the grade.
 
 Along each segment the rider's kinetic energy changes by the work of the pedals minus the resistances (the power
-terms of :mod:`kernels.cycling`, the textbook terms or Martin et al. 1998's), integrated with an implicit midpoint step on
-the segment's mean speed so the energy books balance exactly; pacing after Swain (1997, Med. Sci. Sports Exerc.
+terms of :mod:`kernels.cycling`, the textbook terms or Martin et al. 1998's), integrated with an implicit midpoint step
+on the segment's mean speed so the energy books balance exactly; pacing after Swain (1997, Med. Sci. Sports Exerc.
 29:1104). Per-segment arrays are (N − 1,); SI units (m, s, kg, W). The model and its assumptions in full:
 :mod:`kernels.course`. The loop is compiled with numba (``@njit(cache=True)``); :func:`warm_up` compiles it.
 """
@@ -197,8 +197,8 @@ _SETTLE_TOLERANCE = 1e-3
 """Largest error a step's gain may put on its end speed, as a fraction of the speed. Near a steady speed the midpoint
 step's gain dv₁/dv₀ is A = (1 − x/2)/(1 + x/2), x = λh for relaxation rate λ (1/m) and step h, where the true gain is
 e^(−x): on a step much longer than 1/λ, A falls to −1 and the speed rings about the steady one, never settling. The
-step moves the speed by (A − 1)·d for a distance d from the steady speed, so it misses by |A − e^(−x)|·|v₁ − v₀|/|1 − A|;
-a step that misses by more is redone in halves."""
+step moves the speed by (A − 1)·d for a distance d from the steady speed, so it misses
+by |A − e^(−x)|·|v₁ − v₀|/|1 − A|; a step that misses by more is redone in halves."""
 _SETTLE_UP_TO = 4096
 """At most this many sub-steps to settle a segment (a 100 km segment, relaxing over about 130 m, takes about 800)."""
 _GRADED_BELOW = 0.01
@@ -425,7 +425,8 @@ def _segments(course: Course, rider: Rider, wind_ms: float, wind_from_deg: float
     wind = _checks.finite_number("wind_ms", wind_ms)
     if abs(wind) > _MAX_WIND_MS:
         raise ValueError(
-            f"wind_ms must be in [-{_MAX_WIND_MS:g}, {_MAX_WIND_MS:g}] m/s (the model's range), got {_checks.shown(wind_ms)}"
+            f"wind_ms must be in [-{_MAX_WIND_MS:g}, {_MAX_WIND_MS:g}] m/s (the model's range), "
+            f"got {_checks.shown(wind_ms)}"
         )
     wind_from = math.radians(_checks.finite_number("wind_from_deg", wind_from_deg))
     rolling, climbing = cycling.road_forces(rider.mass_kg, rider.crr, course.grade)

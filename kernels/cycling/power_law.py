@@ -267,14 +267,15 @@ def speed_for_power(
     there is one root, inside [v₀, v₀ + 2·√(|c|/a) + ∛(P/a)]. The closed-form cubic of its branch (Cardano, or the
     trigonometric form for three real roots) gives the first guess; a safeguarded Newton iteration (the
     bracket's secant or midpoint whenever a step would leave the shrinking bracket, after ``rtsafe`` in Press et al.,
-    Numerical Recipes, 2007) then polishes it to rounding level, so ``power(v) == P`` and v moves continuously as P → 0⁺.
+    Numerical Recipes, 2007) then polishes it to rounding level, so ``power(v) == P`` and v moves continuously
+    as P → 0⁺.
 
     Domain: the inverse is defined on :data:`SPEED_FOR_POWER_DOMAIN` (power up to 1 MW, CdA 1 mm² to 10⁴ m²,
     mass up to 10⁶ kg, Crr up to 1, altitude −10 000 to 30 000 m as :func:`air_density`'s, |wind| up to 1 000 m/s;
     any finite grade). Far beyond any rider, and where the model still means something (the exponential atmosphere
     is no air above ~30 km; drag ∝ v² fails past the speed of sound), it also keeps every intermediate (P/a, |c|/a,
-    a·w²·v, the cubic's coefficients) inside float64, so no answer is inf or silently wrong. Outside it: ValueError naming
-    the argument.
+    a·w²·v, the cubic's coefficients) inside float64, so no answer is inf or silently wrong. Outside it: ValueError
+    naming the argument.
 
     Args:
         power_w: power at the pedals (W, ≥ 0).

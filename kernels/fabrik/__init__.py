@@ -10,8 +10,8 @@ Model and method:
   Graphical Models 73(5)): a forward pass sets ``p_n`` on the target and re-places every joint on the line to the
   joint before it at the link's length; a backward pass sets ``p_0`` back on the root and does the same outwards.
 * Reach: a target at distance ``r`` from the root is reachable only if ``max(0, 2·max L − ΣL) ≤ r ≤ ΣL`` (the
-  reach annulus, to within 1e-12 of the chain's scale ``max(ΣL, r)``). Outside it FABRIK returns the closest pose at once
-  (stretched straight toward the target, or folded back onto the inner boundary), as the paper does for
+  reach annulus, to within 1e-12 of the chain's scale ``max(ΣL, r)``). Outside it FABRIK returns the closest pose at
+  once (stretched straight toward the target, or folded back onto the inner boundary), as the paper does for
   unreachable targets, unless joint limits or obstacles forbid that pose.
 * Full and inner reach: a target within ``tolerance`` of full reach (``r ≥ ΣL − tolerance``) is first tried with
   the straight pose toward it (error ``ΣL − r``), one within ``tolerance`` of a non-zero inner radius with the
@@ -46,15 +46,16 @@ Model and method:
   targets an admissible pose reaches, "limited" fell from 22 % to 2 %); the restart pose is a candidate itself. Under
   hinges, a chain that stalls again, or creeps (its best error not halved in 10 iterations), is polished once by
   damped least squares projected through the backward pass, from its best pose and from two mirrored pairs of
-  admissible poses spread over the ranges: on planar arms of 2–6 links with one-sided ranges, missed reachable targets fell from
-  32 % to 0.2 %, the same for a chain and its mirror image. The straight chain's unbending arc bends each hinge
-  toward the inside of its range (not at all for a zero range), so a near-rigid chain is not turned off its line.
+  admissible poses spread over the ranges: on planar arms of 2–6 links with one-sided ranges, missed reachable targets
+  fell from 32 % to 0.2 %, the same for a chain and its mirror image. The straight chain's unbending arc bends each
+  hinge toward the inside of its range (not at all for a zero range), so a near-rigid chain is not turned off its line.
   Both decide from the iterates alone, so more iterations are never worse. Only FABRIK is extrapolated, and only
   FABRIK tries the closest-pose, straight and folded candidates: ``ccd`` and ``jacobian_dls`` run as published.
 * Stopping: at the tolerance (``error ≤ tolerance``), at ``max_iterations``, or, where limits or obstacles apply or
   the target is out of reach, at a fixed point: when the error changes by less than 0.1 % of the tolerance in an
   iteration (caliko's "minimum change" rule), or the best admissible error has improved by less than 10 % of the
-  tolerance in 10 iterations (the iterates creep toward, or circle, a fixed point). Without constraints the iterations converge and run to the cap.
+  tolerance in 10 iterations (the iterates creep toward, or circle, a fixed point). Without constraints the iterations
+  converge and run to the cap.
 * Degenerate input never makes NaN: a zero-length link or coincident joints keep the last defined direction, a
   straight chain whose target lies on its own axis is first bent into a gentle arc (a straight chain otherwise never
   bends, a known FABRIK complaint), and a target on the root picks the root direction.
@@ -69,9 +70,10 @@ Model and method:
   the same result.
 * Speed: each solver is one implementation compiled by numba (``@njit(cache=True)``) on the scalars of one chain;
   :func:`solve` calls it for one chain, :func:`solve_batch` for every chain, in parallel over the batch
-  (the core runs without the GIL on a pool of threads; ``numba.set_num_threads`` sets how many). 2D chains run as 3D ones in the plane ``z = 0``. The
-  first call compiles (seconds) or loads the machine code from numba's cache (``__pycache__`` beside this file, or
-  numba's user-wide cache directory where that is read-only); :func:`warm_up` does it ahead of time.
+  (the core runs without the GIL on a pool of threads; ``numba.set_num_threads`` sets how many). 2D chains run as 3D
+  ones in the plane ``z = 0``. The first call compiles (seconds) or loads the machine code from numba's cache
+  (``__pycache__`` beside this file, or numba's user-wide cache directory where that is read-only); :func:`warm_up` does
+  it ahead of time.
 
 Modules: :mod:`~kernels.fabrik.api` (the chain functions and their checks), :mod:`~kernels.fabrik.limits` (joint
 types and their compiled rules), :mod:`~kernels.fabrik.geometry` (compiled vectors and the obstacle rule),

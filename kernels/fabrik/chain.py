@@ -2,8 +2,9 @@
 (Wampler 1986; Buss 2004) on the scalars of one chain of ``n + 1`` joints ``p`` (n + 1, 3), metres.
 
 Every solver lives once, here; ``_solve_rows`` runs it over some rows of a batch (without the GIL, so the batch
-driver in :mod:`~kernels.fabrik.api` runs chunks of a batch on several threads), ``_solve_one`` for one chain. A 2D chain has z = 0 and ``dim = 2`` where the
-perpendicular and the rotations differ. See :mod:`kernels.fabrik` for the model, the statuses and the stopping rules.
+driver in :mod:`~kernels.fabrik.api` runs chunks of a batch on several threads), ``_solve_one`` for one chain. A 2D
+chain has z = 0 and ``dim = 2`` where the perpendicular and the rotations differ. See :mod:`kernels.fabrik` for the
+model, the statuses and the stopping rules.
 """
 
 from __future__ import annotations
@@ -501,8 +502,8 @@ def _polish(
 ) -> float:
     """Damped least squares (:func:`_dls_step`, each iterate projected by the constrained backward pass) from the
     best pose, then from admissible poses (:func:`_admissible_start`), once FABRIK under hinges stalls or creeps
-    short of a reachable target. FABRIK's fixed points under one-sided or narrow hinge ranges are many (a joint resting at a
-    range's end, a near-rigid chain pulled along a line), and its outcome there depended on which side a tie fell
+    short of a reachable target. FABRIK's fixed points under one-sided or narrow hinge ranges are many (a joint resting
+    at a range's end, a near-rigid chain pulled along a line), and its outcome there depended on which side a tie fell
     (a chain and its mirror image missed 1 % and 24 % of reachable targets); joint-space steps from a few
     admissible starts leave those basins. Each start runs up to ``budget`` steps and stops once its error has not
     improved by :data:`_PROGRESS` of the tolerance in :data:`_PATIENCE` steps; the first iterate within the

@@ -129,8 +129,8 @@ class FreeKickParams:
         default="measured",
         metadata=dropdown("Model", tuple(MODEL_LABELS), tuple(MODEL_LABELS.values()), folder="Physics"),
     )
-    """Coefficient model: the measured one, under which the spin rate changes the flight; the original brief's constant one
-    curls every spinning kick alike."""
+    """Coefficient model: the measured one, under which the spin rate changes the flight; the original brief's constant
+    one curls every spinning kick alike."""
     integrator: Integrator = field(
         default="rk4",
         metadata=dropdown("Integrator", tuple(INTEGRATOR_LABELS), tuple(INTEGRATOR_LABELS.values()), folder="Physics"),
@@ -139,7 +139,8 @@ class FreeKickParams:
     knuckle: bool = field(default=False, metadata=checkbox("Knuckleball", folder="Physics"))
     """Unsteady knuckleball side force (only acts with near-zero spin)."""
     knuckle_seed: int = field(default=1, metadata=number("Random draw", 0, 9999, 1, folder="Physics", disabled=True))
-    """Random draw of the knuckleball's side force: the same number, the same flight. Greyed out without the knuckleball."""
+    """Random draw of the knuckleball's side force: the same number, the same flight. Greyed out without the
+    knuckleball."""
     spin_before_knuckle_rev_s: float | None = None
     """The spin rate (rev/s) that ticking Knuckleball replaced with :data:`KNUCKLE_SPIN_REV_S`, kept while the kick
     still has that spin: unticking the box brings it back. None once the spin is the user's (set by them after the

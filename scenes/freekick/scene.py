@@ -130,7 +130,8 @@ REPLAY_MAX_S = 4.0
 
 
 def _z_to(directions: NDArray[np.float64]) -> NDArray[np.float64]:
-    """(N, 4) wxyz quaternions turning +z onto each of (N, 3) unit ``directions`` (half-way vector; −z turns about x)."""
+    """(N, 4) wxyz quaternions turning +z onto each of (N, 3) unit ``directions`` (half-way
+    vector; −z turns about x)."""
     z = np.array([0.0, 0.0, 1.0])
     w = 1.0 + directions @ z
     xyz = np.cross(z, directions)
@@ -159,12 +160,12 @@ class FreeKickScene(Scene[FreeKickParams]):
     opening_view = View((-31.0, -4.0, 3.6), (-6.0, 0.0, 1.4))
     about = """
 **What it shows.** A free kick's flight in 3D over a four-man wall 9.15 m from the ball (1.8 m tall; 2.15 m when it
-jumps): the kick as set (thick orange line), the same kick with no spin (dark dashed ghost), a faint band between 10 % less
-and 10 % more spin, and force arrows along the path: drag (red), Magnus (blue), gravity (purple). **View** frames
-the kick raised over the kicker's shoulder, from behind the ball, side-on, as the goalkeeper sees it or from above. **Kick** flies the ball, spinning,
-in real time. Click a point in the goal mouth to have the scene find a kick that reaches it over the wall. The
-outcome map colours each launch speed × spin rate by result: goal (green), wall (red), over (orange), wide (yellow),
-short (grey); the white cross is the current kick.
+jumps): the kick as set (thick orange line), the same kick with no spin (dark dashed ghost), a faint band between 10 %
+less and 10 % more spin, and force arrows along the path: drag (red), Magnus (blue), gravity (purple). **View** frames
+the kick raised over the kicker's shoulder, from behind the ball, side-on, as the goalkeeper sees it or from above.
+**Kick** flies the ball, spinning, in real time. Click a point in the goal mouth to have the scene find a kick that
+reaches it over the wall. The outcome map colours each launch speed × spin rate by result: goal (green), wall (red),
+over (orange), wide (yellow), short (grey); the white cross is the current kick.
 
 **On the pitch.** The same kick played on (pale line): it bounces, rolls, strikes the posts, bar and the wall's
 players, and the goalkeeper (yellow shirt) stands on the bisector of the posts' angle, reads the ball 0.25 s after
@@ -174,14 +175,15 @@ from each of 357 spots and colours each spot by its goal chance. *Knuckleball*: 
 kick's difference from the spinless path ten times larger.
 
 **Equations** (A = πr², ω̂ = ω/|ω|): F_drag = −½ρA·C_D·|v|·v, F_Magnus = ½ρA·C_L·|v|·(ω̂ × v), F_g = −m·g·ẑ;
-m = 0.43 kg, r = 0.11 m, ρ = 1.225 kg/m³. The original brief's Magnus formula (C_L·ρπr²·|v×ω|/|ω|) is not a force; this form
-keeps its direction and gives its 3–5 m of curl over 25 m.
+m = 0.43 kg, r = 0.11 m, ρ = 1.225 kg/m³. The original brief's Magnus formula (C_L·ρπr²·|v×ω|/|ω|) is not a force; this
+form keeps its direction and gives its 3–5 m of curl over 25 m.
 
 **Models.** *Constant*: C_D = C_L = 0.25; the curl radius is then 2m/(ρA·C_L) ≈ 74 m whatever the spin rate, so the
 spin rate changes nothing but the direction. *Measured*: C_L = 0.9·S (S = r|ω|/|v|, up to S = 0.3; Asai et al.
 2007), C_D from Goff & Carré 2010 (drag crisis centred at Re 1.8·10⁵, 12 m/s; 0.4127·S^0.3056 when spinning):
-10 % more spin visibly moves the ball. *Knuckleball*: with almost no spin, an unsteady side force zig-zags the ball by about a
-diameter per ~15 m (Cohen, Texier, Quéré & Clanet 2012; Texier et al. 2016), drawn from a random draw number (the same number, the same flight).
+10 % more spin visibly moves the ball. *Knuckleball*: with almost no spin, an unsteady side force zig-zags the ball by
+about a diameter per ~15 m (Cohen, Texier, Quéré & Clanet 2012; Texier et al. 2016), drawn from a random draw number
+(the same number, the same flight).
 
 **Integrators.** RK4 at 10 ms is within a few micrometres of a DOP853 reference over 30 m; the original brief's Euler at
 1 ms is off by 7–17 mm (more with spin), not "within a centimetre".

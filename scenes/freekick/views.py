@@ -32,10 +32,10 @@ VIEW_TILTS: dict[ViewName, tuple[float, ...]] = {
     "goal": (0.3, 0.4, 0.5, 0.65, 0.8, 1.0, 1.3),
     "above": (1.0,),
 }
-"""Downward tilts each view tries (the down part of its look for its horizontal part: see :func:`view_direction`). The goalkeeper's view takes the flattest from
-which it sees the ball and the keeper over the goal and the ball past the wall; the others the one that shows the
-goal widest (the first on a tie). The raised view keeps one: steeper, it drew the goal at most 0.01 of the width
-wider and the flight narrower across the screen."""
+"""Downward tilts each view tries (the down part of its look for its horizontal part: see :func:`view_direction`). The
+goalkeeper's view takes the flattest from which it sees the ball and the keeper over the goal and the ball past the
+wall; the others the one that shows the goal widest (the first on a tie). The raised view keeps one: steeper, it drew
+the goal at most 0.01 of the width wider and the flight narrower across the screen."""
 GOAL_CLEAR_M = 0.3
 """How far above the crossbar and the net's roof (m) the goalkeeper's view sees the ball and the keeper's head."""
 KEEPER_BOX_M = 0.5
@@ -70,8 +70,8 @@ def view_points(
     p: FreeKickParams, state: KickState, view: ViewName, also: NDArray[np.float64] | None = None
 ) -> NDArray[np.float64]:
     """(N, 3) what ``view`` keeps in frame (m): the ball on its spot (its whole sphere), the flight and its
-    no-spin ghost (the played-on flight after its first contact may roll away out of frame), the wall, the goal with its net
-    and the keeper standing in it (his box to his raised hands). ``view`` is for the callers' symmetry: every view
+    no-spin ghost (the played-on flight after its first contact may roll away out of frame), the wall, the goal with its
+    net and the keeper standing in it (his box to his raised hands). ``view`` is for the callers' symmetry: every view
     keeps the same points. ``also``: (M, 3) more points the view from above keeps in frame (the odds map's tiles,
     when it is shown).
     """

@@ -851,9 +851,9 @@ class CourseMode:
             )
         if state.pacing is not None:
             text += (
-                f"  \nPacing by grade (±{p.pacing_gain_pct:.0f} %): {format_duration(state.constant.time_s)} at constant "
-                f"power → {format_duration(ride.time_s)}, **{time_saved_words(state.pacing.time_saved_s)}** at the same "
-                "average power"
+                f"  \nPacing by grade (±{p.pacing_gain_pct:.0f} %): {format_duration(state.constant.time_s)} "
+                f"at constant power → {format_duration(ride.time_s)}, "
+                f"**{time_saved_words(state.pacing.time_saved_s)}** at the same average power"
             )
         start = f"  \nAir at the start ({state.route.elevation_m[0]:.0f} m): "
         if p.air == "weather":

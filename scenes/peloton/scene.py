@@ -149,8 +149,8 @@ class PelotonScene(Scene[PelotonParams]):
     opening_view = View((-2.0, -7.5, 2.8), (-3.2, 0.0, 1.0))
     about = """
 **What it shows.** Riders at one speed: a line of up to eight with power bars, or a formation of up to 121 (two
-abreast, a bunch, an echelon) with each rider coloured by power. Each rider's power is split into pushing air (aero), tyre
-rolling resistance and climbing; riders behind draft. The bars above the riders stack aero (blue), rolling
+abreast, a bunch, an echelon) with each rider coloured by power. Each rider's power is split into pushing air (aero),
+tyre rolling resistance and climbing; riders behind draft. The bars above the riders stack aero (blue), rolling
 (orange) and climbing (green); the label gives watts and the share of the solo rider's power.
 
 **Equations** (SI, θ = atan(grade), w = headwind):
@@ -158,8 +158,8 @@ P_aero = ½ρ·CdA·(v+w)|v+w|·v, P_roll = Crr·m·g·cos θ·v, P_climb = m·g
 P = (P_aero + P_roll + P_climb)/η, ρ = 1.225·exp(−h/8500).
 
 **Drafting.** *Textbook formula*: CdA·(1 − 0.27·exp(−gap/3.5)) for every follower (27 % at 0 m, 6.5 % at 5 m; the
-original brief's prose overstates it). *Measured*: position-dependent, fitted to team-pursuit measurements (Barry et al. 2015;
-Fitton et al. 2018; Broker, Kyle & Burke 1999), fading with gap as Swiss Side's CFD does; the leader gains ~3 %
+original brief's prose overstates it). *Measured*: position-dependent, fitted to team-pursuit measurements (Barry et al.
+2015; Fitton et al. 2018; Broker, Kyle & Burke 1999), fading with gap as Swiss Side's CFD does; the leader gains ~3 %
 from the rider behind (Blocken et al. 2013). *Crosswind*: the wakes trail along the apparent wind, at yaw
 ψ = atan(crosswind/(v + w)), so a line loses its shelter and an echelon angled downwind keeps it (checked against a
 2022 CFD study of five riders in a crosswind). The echelon keeps its 24° diagonal, so it shelters most at ψ ≈ 20–28°
@@ -820,8 +820,8 @@ time-averaged power is the mean over positions, far below the leader's.
         state, p = self.state, self.params
         total, drag = state.pedal_w, 1.0 - state.reduction
         summary = (
-            f"{riders_text(p.n_riders)} · mean drag **{100 * float(np.mean(drag)):.0f} %** of a lone rider's · mean power "
-            f"**{_watts(float(np.mean(total)))} W** (a lone rider {_watts(state.solo_pedal_w)} W)"
+            f"{riders_text(p.n_riders)} · mean drag **{100 * float(np.mean(drag)):.0f} %** of a lone rider's "
+            f"· mean power **{_watts(float(np.mean(total)))} W** (a lone rider {_watts(state.solo_pedal_w)} W)"
         )
         if coasting := coasting_words(state.brake_w, *self.push_cause()):
             summary += "  \n" + coasting
@@ -879,8 +879,9 @@ time-averaged power is the mean over positions, far below the leader's.
         ]
         for i in range(self.params.n_riders):
             rows.append(
-                f"| {i + 1} | {state.cda_m2[i]:.3f} | {_watts(state.power.aero[i])} / {_watts(state.power.rolling[i])} / "
-                f"{_watts(state.power.climbing[i])} | **{_watts(state.pedal_w[i])}** | {self._saving_text(i)} |"
+                f"| {i + 1} | {state.cda_m2[i]:.3f} | {_watts(state.power.aero[i])} / "
+                f"{_watts(state.power.rolling[i])} / {_watts(state.power.climbing[i])} "
+                f"| **{_watts(state.pedal_w[i])}** | {self._saving_text(i)} |"
             )
         coasting = coasting_words(state.brake_w, *self.push_cause())
         if coasting:  # the bars stand for what is spent, which the rider's 0 W is not
@@ -916,8 +917,8 @@ time-averaged power is the mean over positions, far below the leader's.
         lead = float(self.state.pedal_w[0])
         if self._rotation_width() == 0:
             return (
-                f"In {'a bunch' if self.params.formation == 'bunch' else 'an echelon'} riders do not take turns in order: "
-                f"the mean over its places is **{_watts(mean)} W** against the leader's {_watts(lead)} W."
+                f"In {'a bunch' if self.params.formation == 'bunch' else 'an echelon'} riders do not take turns in "
+                f"order: the mean over its places is **{_watts(mean)} W** against the leader's {_watts(lead)} W."
             )
         hardest = float(np.max(self.state.pedal_w))
         if self.params.speed_kmh == 0.0:
@@ -935,9 +936,15 @@ time-averaged power is the mean over positions, far below the leader's.
                 f"pedal up to {hardest:.0f} W, so the lead is the easy turn here."
             )
         elif self.params.n_riders <= self._rotation_width():
-            text = f"The two ride side by side at the front: there is nobody to rotate with; each pedals about {mean:.0f} W."
+            text = (
+                "The two ride side by side at the front: there is nobody to rotate with; "
+                f"each pedals about {mean:.0f} W."
+            )
         elif not self.params.drafting:
-            text = f"Drafting is off: every rider rides in clean air at the leader's {lead:.0f} W, so rotating saves nothing."
+            text = (
+                f"Drafting is off: every rider rides in clean air at the leader's {lead:.0f} W, "
+                "so rotating saves nothing."
+            )
         elif mean >= 0.995 * lead:
             text = (
                 f"Nobody gains from shelter here{self._no_shelter_reason()}: every rider works about as hard as the "
@@ -974,7 +981,10 @@ time-averaged power is the mean over positions, far below the leader's.
     def _speed_markdown(self) -> str:
         p = self.params
         v = solo_speed(solo_key(p), p.target_power_w)
-        text = f"Riding alone, {p.target_power_w:.0f} W ({p.target_power_w / p.mass_kg:.2f} W/kg of system mass) holds **{3.6 * v:.1f} km/h** here"
+        text = (
+            f"Riding alone, {p.target_power_w:.0f} W ({p.target_power_w / p.mass_kg:.2f} W/kg of system mass) "
+            f"holds **{3.6 * v:.1f} km/h** here"
+        )
         if v > 0.1:
             minutes, seconds = divmod(round(40_000.0 / v), 60)
             hours, minutes = divmod(minutes, 60)

@@ -193,7 +193,8 @@ def test_drag_speed_slider_with_the_mouse(server: viser.ViserServer, browser_pag
         assert final_power > before_power
         # The page shows the server's new value in the slider's number box.
         page.wait_for_function(
-            "v => [...document.querySelectorAll('[role=slider]')].some(e => Number(e.getAttribute('aria-valuenow')) === v)",
+            "v => [...document.querySelectorAll('[role=slider]')]"
+            ".some(e => Number(e.getAttribute('aria-valuenow')) === v)",
             arg=final_speed,
             timeout=10_000,
             polling=100,
@@ -292,7 +293,8 @@ def test_a_file_over_the_upload_limit_is_refused_and_the_button_works_again(
         refusal.wait_for(timeout=15_000)
         assert "The file is 25.0 MiB; this server takes files up to 24 MiB." in refusal.inner_text()
         page.wait_for_function(
-            "() => ![...document.querySelectorAll('button')].some(b => b.textContent.includes('Upload GPX') && b.disabled)",
+            "() => ![...document.querySelectorAll('button')]"
+            ".some(b => b.textContent.includes('Upload GPX') && b.disabled)",
             timeout=10_000,
         )
         wait_frames(page, 5)

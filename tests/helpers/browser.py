@@ -84,7 +84,8 @@ def drawn_width(page: Any) -> int:
 
 SOFTWARE_WEBGL = """
 () => {
-  const gl = document.createElement("canvas").getContext("webgl2") || document.createElement("canvas").getContext("webgl");
+  const gl = document.createElement("canvas").getContext("webgl2")
+    || document.createElement("canvas").getContext("webgl");
   const info = gl && gl.getExtension("WEBGL_debug_renderer_info");
   const renderer = (info ? gl.getParameter(info.UNMASKED_RENDERER_WEBGL) : "").toLowerCase();
   return ["swiftshader", "llvmpipe", "softpipe", "software"].some(name => renderer.includes(name));
@@ -134,7 +135,8 @@ def screenshot(page: Any, path: str | None = None) -> NDArray[np.uint8]:
 
 
 def project(page: Any, frame: str, points: Iterable[Sequence[float]]) -> NDArray[np.float64]:
-    """(N, 3): CSS x, y and NDC depth of ``points`` (in scene node ``frame``'s coordinates) through the page's camera."""
+    """(N, 3): CSS x, y and NDC depth of ``points`` (in scene node ``frame``'s coordinates) through the page's
+    camera."""
     pts = [[float(c) for c in p] for p in points]
     return np.asarray(page.evaluate(PROJECT, {"name": frame, "points": pts}), dtype=np.float64)
 
@@ -524,7 +526,9 @@ def node_box_corners(page: Any, name: str) -> NDArray[np.float64]:
             }
           });
           const out = [];
-          for (const x of [lo[0], hi[0]]) for (const y of [lo[1], hi[1]]) for (const z of [lo[2], hi[2]]) out.push([x, y, z]);
+          for (const x of [lo[0], hi[0]])
+            for (const y of [lo[1], hi[1]])
+              for (const z of [lo[2], hi[2]]) out.push([x, y, z]);
           return out;
         }""",
         name,

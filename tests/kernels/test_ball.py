@@ -1,4 +1,5 @@
-"""kernels.ball against analytic flights, a high-accuracy scipy reference, published coefficients and hand-made kicks."""
+"""kernels.ball against analytic flights, a high-accuracy scipy reference, published coefficients and hand-made
+kicks."""
 
 from __future__ import annotations
 

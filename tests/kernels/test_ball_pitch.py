@@ -1030,8 +1030,8 @@ UNIT = st.tuples(st.floats(0.0, 2.0 * math.pi), st.floats(-1.0, 1.0)).map(
 def test_a_steps_first_touch_of_a_capsule_is_its_paths(direction, speed, h, slowing, turn, at, offset, axis, radius):
     # One step's cubic Hermite path, as the flight makes it: the end velocity slowed by drag (up to 60 %), turned by
     # the Magnus force (up to 0.5 rad) and pulled down by gravity, the end where the velocities carry the ball. A
-    # capsule (a post, a player of the wall) lies near a point of the path, up to three times the ball's reach off it. The
-    # step's first touch is that of 20,001 points along its path.
+    # capsule (a post, a player of the wall) lies near a point of the path, up to three times the ball's reach off it.
+    # The step's first touch is that of 20,001 points along its path.
     c, s_ = math.cos(turn), math.sin(turn)
     side = np.cross(direction, (0.0, 0.0, 1.0)) if abs(direction[2]) < 0.9 else np.cross(direction, (1.0, 0.0, 0.0))
     v0 = speed * direction

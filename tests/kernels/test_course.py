@@ -1004,7 +1004,10 @@ def test_tracks_far_apart_are_refused_and_near_ones_joined() -> None:
 
 
 # Kind: text encodings XML allows (the declaration or a byte-order mark says which).
-ENCODED = '<?xml version="1.0" encoding="{enc}"?><gpx version="1.1" creator="t"><trk><name>Col de l\'Échelle</name><trkseg>{pts}</trkseg></trk></gpx>'
+ENCODED = (
+    '<?xml version="1.0" encoding="{enc}"?><gpx version="1.1" creator="t">'
+    "<trk><name>Col de l'Échelle</name><trkseg>{pts}</trkseg></trk></gpx>"
+)
 PTS = "".join(f'<trkpt lat="{45 + i * 1e-3}" lon="6"><ele>{100 + i}</ele></trkpt>' for i in range(5))
 
 

@@ -79,8 +79,8 @@ def expected_verdict(pieces: Sequence[Piece]) -> tuple[int, float] | None:
 
 @st.composite
 def piece_sets(draw: st.DrawFn) -> list[Piece]:
-    """2–5 short straight pieces (10–14 points 11 m apart, heading north: each a course's 100 m or more); each starts near the previous one's end
-    (within about 3 km, either side of the 2 km bound) or anywhere on Earth."""
+    """2–5 short straight pieces (10–14 points 11 m apart, heading north: each a course's 100 m or more); each starts
+    near the previous one's end (within about 3 km, either side of the 2 km bound) or anywhere on Earth."""
     pieces: list[Piece] = []
     lat = draw(st.floats(-75.0, 75.0))
     lon = draw(st.floats(-170.0, 170.0))

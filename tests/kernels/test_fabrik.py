@@ -27,7 +27,8 @@ BAD_SOLVER: Any = "newton"
 
 # ------------------------------------------------------------------------------------------------ helpers
 def random_chain(rng: np.random.Generator, n: int, d: int, *, bend: float = 0.6) -> NDArray[np.float64]:
-    """A chain of n links, lengths 0.2–1.5 m, each turning by up to ``bend`` rad from the last, rooted at a random place."""
+    """A chain of n links, lengths 0.2–1.5 m, each turning by up to ``bend`` rad from the last, rooted at a random
+    place."""
     lengths = rng.uniform(0.2, 1.5, n)
     direction = np.zeros(d)
     direction[-1] = 1.0
@@ -103,10 +104,10 @@ def test_reachable_targets_are_reached(chain: tuple[int, int, int], where: float
 # damping. Where the target asks for a nearly folded elbow, the steps overshoot back and forth across the folded,
 # singular pose (where Jᵀe → 0); where it lies behind the chain, Jᵀe is small and the chain swings round slowly.
 # The method does this (Buss & Kim 2005, selectively damped least squares, is the published remedy); the solver
-# says so by not claiming "reached". An explore run drew the first case; 24 of 8,000 two-link chains drawn with targets in the
-# inner 40 % of the reach behaved so (all planar), none of 5,256 with three or more links or in 3D. A later explore run
-# drew the third, a planar three-link chain whose last link is longer than the other two (1 of 4,000 random planar
-# 3–5-link chains stalls so). FABRIK and CCD reach every one.
+# says so by not claiming "reached". An explore run drew the first case; 24 of 8,000 two-link chains drawn with targets
+# in the inner 40 % of the reach behaved so (all planar), none of 5,256 with three or more links or in 3D. A later
+# explore run drew the third, a planar three-link chain whose last link is longer than the other two (1 of 4,000 random
+# planar 3–5-link chains stalls so). FABRIK and CCD reach every one.
 THREE_LINK_STALL = (
     [
         [0.9730079894414903, 0.7112133681807056],
@@ -631,7 +632,7 @@ def test_max_iterations_is_respected_and_error_history_decreases() -> None:
     assert result.error_history[-1] < result.error_history[0]
 
 
-# ------------------------------------------------------------------------------------------------ convergence near limits
+# ---------------------------------------------------------------------------------------------- convergence near limits
 def test_dragged_target_near_the_cone_limits_is_followed_in_few_iterations() -> None:
     """The benchmark's drag: the chain's tip curls onto its 30° limits, where plain FABRIK needed up to 48
     iterations a frame (error ratio 0.8–0.95 per iteration); the extrapolated iterates need a few."""
@@ -882,7 +883,7 @@ def test_every_solver_gives_a_batch_the_bits_of_single_solves(n: int, d: int, se
             assert (single.iterations, single.status) == (batch[i].iterations, batch[i].status)
 
 
-# ------------------------------------------------------------------------------------------------ limited chains keep their best pose
+# ---------------------------------------------------------------------------------- limited chains keep their best pose
 def admissible(
     joints: NDArray[np.float64],
     phi: float | None,
@@ -977,8 +978,9 @@ CAPS = (1, 2, 3, 5, 8, 13, 21, 34)
 def test_the_returned_pose_is_the_best_admissible_pose_seen(
     problem: Problem, solver: fabrik.Solver, extrapolate: bool
 ) -> None:
-    """Limited chains keep their best pose, over the whole family: never worse than an admissible start, never worse than an admissible
-    iterate, admissible whenever an admissible pose was seen, and status words that say what happened."""
+    """Limited chains keep their best pose, over the whole family: never worse than an admissible start, never worse
+    than an admissible iterate, admissible whenever an admissible pose was seen, and status words that say what
+    happened."""
     joints, target, phi, obstacles = problem.joints, problem.target, problem.phi, problem.obstacles
     inner, outer = fabrik.reach_limits(fabrik.link_lengths(joints))
     start_ok = problem.admissible(joints)

@@ -78,7 +78,7 @@ def test_a_two_abreast_paceline_shelters_at_least_as_well_as_single_file() -> No
     np.testing.assert_allclose(double[0::2], double[1::2], rtol=0, atol=1e-15)  # the two files mirror each other
 
 
-# ------------------------------------------------------------------------------------------------ (c) the 121-rider bunch
+# ---------------------------------------------------------------------------------------------- (c) the 121-rider bunch
 def test_bunch_matches_blocken_2018_map() -> None:
     rows = _rows(BUNCH)
     interior = _interior(BUNCH)

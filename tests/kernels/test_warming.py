@@ -65,8 +65,9 @@ def _called_names(code: types.CodeType, namespace: dict[str, Any]) -> Iterator[s
 
 
 def test_python_code_in_the_kernels_calls_compiled_cores_only_through_entries() -> None:
-    # A bare dispatcher called from Python (the scenes' too) would compile in the serving process during the first start (seconds
-    # holding its GIL) instead of running its twin. compiled_single_solve hands the raw core to a benchmark on purpose.
+    # A bare dispatcher called from Python (the scenes' too) would compile in the serving process during the first start
+    # (seconds holding its GIL) instead of running its twin. compiled_single_solve hands the raw core to a benchmark on
+    # purpose.
     bare = []
     infos = [info for package in ("kernels", "scenes", "server", "shaders") for info in _modules(package)]
     for info in infos:

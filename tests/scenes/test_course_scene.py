@@ -722,7 +722,8 @@ def test_the_out_of_range_note_stays_under_the_button_while_its_target_and_power
 
 
 def _another_value(handle: Any) -> object:
-    """A valid value of GUI input ``handle`` other than its own: the other state, option or a number a step or so away."""
+    """A valid value of GUI input ``handle`` other than its own: the other state, option or a number a step or so
+    away."""
     value = handle.value
     if isinstance(value, bool):
         return not value
@@ -1256,7 +1257,7 @@ def test_the_weather_reading_is_taken_at_any_start_a_course_may_have(start_m: fl
     assert air.pressure_hpa <= 1100.0 and air.altitude_m == route.elevation_m[0]
 
 
-# ------------------------------------------------------------------------------------------------ outside tester's faults
+# ---------------------------------------------------------------------------------------------- outside tester's faults
 def north_gpx(name: str, length_m: float, elevation_m: float = 100.0) -> bytes:
     """A straight, level route due north from 45° N 6° E, ``length_m`` along the ground, points about 100 m apart."""
     n = max(2, math.ceil(length_m / 100.0) + 1)

@@ -1,4 +1,5 @@
-"""Blend widths at their edges through the SDF gallery: a browser may send any blend width the slider accepts, tiny ones too."""
+"""Blend widths at their edges through the SDF gallery: a browser may send any blend width the slider accepts, tiny ones
+too."""
 
 from __future__ import annotations
 

@@ -667,9 +667,9 @@ and 0.250 at 1600×1000 now that it keeps clear of the software-WebGL notice).""
 GOAL_SHARE_FLOOR: dict[ViewName, float] = {"broadcast": 0.09, "behind": 0.095, "side": 0.05, "goal": 0.2, "above": 0.10}
 """Least share of the free canvas width the goal spans in each view that shows it, for every preset and ball spot
 (12–40 m, ±45°; measured minima 0.094, 0.078, 0.060, 0.105, each for a ball 36–40 m out; the raised view gave
-0.157 before it kept clear of the software-WebGL notice, which at 1280×720 takes a quarter of the free height). Side-on the goal is seen
-edge on. Behind the ball the goal was 0.078 wide (about 60 px at 1280×720) under two-thirds of sky; it now looks
-down the flight: 0.10 at 40 m. The goalkeeper's view looks over the goal from behind it: 0.26 at 40 m."""
+0.157 before it kept clear of the software-WebGL notice, which at 1280×720 takes a quarter of the free height). Side-on
+the goal is seen edge on. Behind the ball the goal was 0.078 wide (about 60 px at 1280×720) under two-thirds of sky; it
+now looks down the flight: 0.10 at 40 m. The goalkeeper's view looks over the goal from behind it: 0.26 at 40 m."""
 SKY_SHARE_MAX = 0.1
 """Largest share of the canvas height above the horizon in the views along the kick (behind the ball, raised, from
 the goal, from above): the view behind the ball showed 42 % sky over a goal 60 px wide."""

@@ -193,7 +193,8 @@ def test_compile_error_is_a_value_error_with_the_compilers_message_and_line() ->
         # none); the line is the recursive call's.
         ("float sdf(vec3 p){ return p.x > 0.0 ? sdf(-p) : length(p)-0.5; }\n", 1),
         (
-            "float f(vec3 p) {\n  return length(p) - 0.5;\n}\nfloat sdf(vec3 p)\n{\n  float d = f(p);\n  return d + sdf(p);\n}\n",
+            "float f(vec3 p) {\n  return length(p) - 0.5;\n}\n"
+            "float sdf(vec3 p)\n{\n  float d = f(p);\n  return d + sdf(p);\n}\n",
             7,
         ),
         ("float g(vec3 p) {\n  return 1.0 + g(p * 0.5);\n}\nfloat sdf(vec3 p) { return g(p); }\n", 2),
@@ -204,7 +205,10 @@ def test_a_function_that_calls_itself_is_refused_on_the_line_of_the_call(source:
         mesh_glsl(source, 32, CUBE_BOUNDS)
     assert refused.value.line == line and "calls itself, and GLSL has no recursion" in str(refused.value)
     # Through a prototype (a re-tester's): b() calls a(), declared above b() and defined below it, which calls b().
-    mutual = "float a(vec3 p);\nfloat b(vec3 p){\n  return a(p);\n}\nfloat a(vec3 p){ return b(p*0.5); }\nfloat sdf(vec3 p){ return a(p); }\n"
+    mutual = (
+        "float a(vec3 p);\nfloat b(vec3 p){\n  return a(p);\n}\n"
+        "float a(vec3 p){ return b(p*0.5); }\nfloat sdf(vec3 p){ return a(p); }\n"
+    )
     with pytest.raises(ShaderCompileError) as refused:
         mesh_glsl(mutual, 32, CUBE_BOUNDS)
     # (Mesa names either function of the cycle; the words name the call that closes it from the one named.)
@@ -213,14 +217,20 @@ def test_a_function_that_calls_itself_is_refused_on_the_line_of_the_call(source:
         "line 5: a() calls b(), which calls back into a(): GLSL has no recursion",
     )
     # An overload calling another of its name is no recursion: it compiles.
-    overload = "float g(float x) { return x - 0.5; }\nfloat g(vec3 p) { return g(length(p)); }\nfloat sdf(vec3 p) { return g(p); }\n"
+    overload = (
+        "float g(float x) { return x - 0.5; }\nfloat g(vec3 p) { return g(length(p)); }\n"
+        "float sdf(vec3 p) { return g(p); }\n"
+    )
     assert len(mesh_glsl(overload, 32, CUBE_BOUNDS).faces) > 0
 
 
 @pytest.mark.gl
 def test_a_function_used_above_its_definition_is_named_with_where_it_is() -> None:
     # A re-tester: "line 1: no function with name 'g'", with g defined on the next line (GLSL wants it above).
-    source = "float f(vec3 p){ return g(p); }\nfloat g(vec3 p) { return length(p) - 0.5; }\nfloat sdf(vec3 p){ return f(p); }\n"
+    source = (
+        "float f(vec3 p){ return g(p); }\nfloat g(vec3 p) { return length(p) - 0.5; }\n"
+        "float sdf(vec3 p){ return f(p); }\n"
+    )
     with pytest.raises(ShaderCompileError) as refused:
         mesh_glsl(source, 32, CUBE_BOUNDS)
     assert str(refused.value) == "line 1: g() is used before it is defined (line 2): define it above its first use"

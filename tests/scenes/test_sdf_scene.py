@@ -435,8 +435,8 @@ def test_gizmos_draw_over_the_mesh_and_reach_out_of_it(scene: SdfGalleryScene) -
 def test_each_gizmo_is_sized_coloured_and_named_for_its_own_primitive(
     server: viser.ViserServer, scene: SdfGalleryScene
 ) -> None:
-    # Gizmos over each other: four 0.8 m gizmos once drawn without depth test piled up over the middle. Each is now its primitive's
-    # size plus a margin, with a ball of its colour and its name.
+    # Gizmos over each other: four 0.8 m gizmos once drawn without depth test piled up over the middle. Each is now its
+    # primitive's size plus a margin, with a ball of its colour and its name.
     from scenes.sdf_gallery.params import GIZMO_MARGIN_M
 
     scales = [g.scale for g in scene.gizmos]

@@ -88,7 +88,9 @@ signal.signal(signal.SIGINT, signal.SIG_IGN)  # started as a background job
 with socket.socket() as probe:
     probe.bind(("127.0.0.1", 0))
     port = probe.getsockname()[1]
-app.serve_scenes = lambda *args, **kwargs: print("live" if signal.getsignal(signal.SIGINT) is signal.default_int_handler else "ignored")
+app.serve_scenes = lambda *args, **kwargs: print(
+    "live" if signal.getsignal(signal.SIGINT) is signal.default_int_handler else "ignored"
+)
 app.sleep_until_a_signal = lambda: None
 app.main(port=port)
 """

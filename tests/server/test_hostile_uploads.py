@@ -1,7 +1,7 @@
 """Crafted uploads through the gate: only an upload button the sender sees, within the announced size and parts.
 
-The honest path (a GPX picked in the browser) is tested in ``tests/scenes/test_course_scene.py``; here every field of the
-two upload messages is bent, one at a time, and the course stays what it was while the server keeps serving.
+The honest path (a GPX picked in the browser) is tested in ``tests/scenes/test_course_scene.py``; here every field of
+the two upload messages is bent, one at a time, and the course stays what it was while the server keeps serving.
 """
 
 from __future__ import annotations

@@ -1,5 +1,5 @@
-"""The patched property cast (:func:`server.viser_compat.cast_value_recursive`) returns what viser 1.1.1's own does, for every property
-hint viser declares and values of every shape the scenes write, and it is the one in use."""
+"""The patched property cast (:func:`server.viser_compat.cast_value_recursive`) returns what viser 1.1.1's own does, for
+every property hint viser declares and values of every shape the scenes write, and it is the one in use."""
 
 from __future__ import annotations
 

@@ -1,7 +1,7 @@
 """The blends in the GLSL: shaders/sdf.glsl's blends at tiny widths, evaluated through the probe shader.
 
-Property (the kernel's, tests/kernels/test_edges_sdf_blend.py): for every finite k ≥ 0, subnormals included (the uniform is
-float32, so 1e-40 arrives subnormal and 1e-310 as 0), every blend form and boolean gives finite distances within
+Property (the kernel's, tests/kernels/test_edges_sdf_blend.py): for every finite k ≥ 0, subnormals included (the uniform
+is float32, so 1e-40 arrives subnormal and 1e-310 as 0), every blend form and boolean gives finite distances within
 k/4 of the hard operation, and the colours stay finite. Needs an OpenGL context (``gl`` marker).
 """
 
