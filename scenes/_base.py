@@ -12,9 +12,9 @@ and a camera through, already checked against the control's recorded spec. Scene
 :meth:`Scene.read_controls` (the controls declared on the scene's parameter dataclass, :mod:`scenes._controls`) or
 :meth:`Scene.read_choice` (a menu that is not a parameter of its own: the peloton's presets), which clean a value with
 the gate's own :func:`server.clean.clean_value` against the recorded spec (never a handle's props), fall back to the
-last good value for anything unusable and write the cleaned value back. They wrap every callback in :meth:`Scene.callback`,
-which serialises callbacks (viser runs plain callbacks on a thread pool) and logs, rather than raises, anything that
-goes wrong.
+last good value for anything unusable and write the cleaned value back. They wrap every callback in
+:meth:`Scene.callback`, which serialises callbacks (viser runs plain callbacks on a thread pool) and logs, rather
+than raises, anything that goes wrong.
 """
 
 from __future__ import annotations

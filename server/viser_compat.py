@@ -43,7 +43,8 @@ The property cast: viser 1.1.1 casts every property write through the property's
 compares the hint with four ``npt.NDArray[...]`` aliases that it builds anew on every call. Building them runs
 typing's substitution (numpy's ``NDArray`` is a ``types.GenericAlias``, which caches nothing): about 50 µs a write,
 0.8 ms of a 1.75 ms peloton input on this machine. :func:`cast_value_recursive` is the same function comparing with
-aliases built once; ``tests/server/test_viser_patches.py`` holds it to the original for every property hint viser declares.
+aliases built once; ``tests/server/test_viser_patches.py`` holds it to the original for every property hint viser
+declares.
 """
 
 from __future__ import annotations
