@@ -53,3 +53,46 @@ def test_only_the_compat_module_reaches_into_private_names() -> None:
     assert reaches[COMPAT], "the compat module is where viser's private names are read"
     offenders = {name: found for name, found in reaches.items() if found and name != COMPAT}
     assert offenders == {}
+
+
+# ------------------------------------------------------------------------------------------------------ the layers
+LAYERS = ("kernels", "shaders", "scenes", "server", "app")
+"""docs/development.md's layers, each using only the ones to its left."""
+BASE_BRIDGE = {"scenes/_base.py", "scenes/_controls.py"}
+"""The scene base, the one place scenes stand on the server: a scene is built on a session, its controls are cleaned
+by the gate's rules, its callbacks take the process's turn."""
+BRIDGED = {"server.clean", "server.sessions", "server.turns"}
+
+
+def _our_imports(source: str) -> set[str]:
+    """Every module of ours a source imports, at its top or inside a function, as a dotted name."""
+    found = set()
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.ImportFrom) and node.module is not None and node.level == 0:
+            found.add(node.module)
+        elif isinstance(node, ast.Import):
+            found.update(alias.name for alias in node.names)
+    return {name for name in found if name.split(".")[0] in LAYERS}
+
+
+def _layer(path: str) -> str:
+    return path.removesuffix(".py").split("/")[0]
+
+
+def test_each_layer_imports_only_the_ones_to_its_left_and_scenes_reach_the_server_through_the_base() -> None:
+    wrong = {}
+    for path in _production_files():
+        rank = LAYERS.index(_layer(path))
+        for module in sorted(_our_imports((ROOT / path).read_text())):
+            target = LAYERS.index(module.split(".")[0])
+            bridged = path in BASE_BRIDGE and module in BRIDGED
+            if target > rank and not bridged:
+                wrong.setdefault(path, []).append(module)
+    assert wrong == {}
+
+
+def test_the_layer_finder_sees_an_import_to_the_right() -> None:
+    assert _our_imports("import numpy\nfrom scenes._base import Scene\ndef f():\n    import server.gate\n") == {
+        "scenes._base",
+        "server.gate",
+    }
