@@ -22,6 +22,7 @@ import contextlib
 import dataclasses
 import logging
 import math
+import re
 import threading
 import time
 from typing import Any
@@ -91,6 +92,13 @@ than cut off."""
 
 _SEE_IT = "; choose GLSL editor in Shape to see it."
 """How an Apply's status ends while Shape shows another shape; dropped once the editor is chosen."""
+
+
+def as_sentence(message: str) -> str:
+    """A refusal as a sentence after the bold "Not applied.": a capital first (not where it opens with code,
+    "sdf() returned NaN"), a full stop last."""
+    said = message if re.match(r"\w+\(", message) else message[:1].upper() + message[1:]
+    return said + "." if said[-1:].isalnum() or said.endswith((")", "'", '"')) else said
 
 
 def _rebounded(shape: Shape, shown: Shape | None) -> bool:
@@ -513,8 +521,9 @@ IoU is lowest when a box edge is on the silhouette.
         self.editor_error, self._bounds_refused = message, bounds
         with self._lock:
             if not self.closed:
-                said = message[:1].upper() + message[1:]  # a sentence after the bold one
-                self._show_editor_status(f"**Not applied.** {said}\n\nThe last good shape stays on screen.")
+                self._show_editor_status(
+                    f"**Not applied.** {as_sentence(message)}\n\nThe last good shape stays on screen."
+                )
 
     def _show_view_mode(self) -> None:
         mode = self.params.view_mode

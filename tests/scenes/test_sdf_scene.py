@@ -1472,6 +1472,29 @@ def scene_points_of_primitives(scene: SdfGalleryScene) -> np.ndarray:
     )
 
 
+@pytest.mark.parametrize(
+    ("message", "said"),
+    [
+        (
+            "line 3: sdf() calls itself, and GLSL has no recursion",
+            "Line 3: sdf() calls itself, and GLSL has no recursion.",
+        ),
+        # An outside tester: "Sdf() returned NaN", a code name capitalised; most refusals had no full stop.
+        ("sdf() returned NaN or infinity inside the bounds", "sdf() returned NaN or infinity inside the bounds."),
+        ("color() returned NaN or infinity on the surface", "color() returned NaN or infinity on the surface."),
+        (
+            "no surface lies inside the bounds (change sdf() or the bounds)",
+            "No surface lies inside the bounds (change sdf() or the bounds).",
+        ),
+        ("the source is 8001 characters; the limit is 8000.", "The source is 8001 characters; the limit is 8000."),
+    ],
+)
+def test_a_refusal_reads_as_a_sentence_after_not_applied(message: str, said: str) -> None:
+    from scenes.sdf_gallery.scene import as_sentence
+
+    assert as_sentence(message) == said
+
+
 def test_every_kinds_gizmo_label_is_its_menu_name() -> None:
     # The family of "P2 round_box": each registry kind's label is its menu label, lower case, without its note.
     from scenes.sdf_gallery.params import gizmo_label, kind_labels
