@@ -69,6 +69,8 @@ def camera_fields(message: messages.ViewerCameraMessage) -> tuple[dict[str, Any]
     assert up is not None
     if math.hypot(*up) == 0.0:
         return None, "up_direction"
+    if points["look_at"] == points["position"]:  # no view direction: viser refuses to frame such a camera
+        return None, "look_at"
     return {"wxyz": wxyz, **points, "fov": fov, "near": near, "far": far, **sizes}, ""
 
 

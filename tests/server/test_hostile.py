@@ -808,6 +808,10 @@ def test_every_hostile_message_leaves_each_tab_on_its_last_good_state(
         ({"far": 0.001}, "near/far"),
         ({"image_height": 0}, "image_height"),
         ({"image_width": 10**12}, "image_width"),
+        # An outside tester: a camera at its own look-at point passed, and each scene's framing of it logged
+        # viser's "look_at cannot equal position" with a traceback.
+        ({"position": (1.0, 2.0, 3.0), "look_at": (1.0, 2.0, 3.0)}, "look_at"),
+        ({"position": (0.0, 0.0, 0.0), "look_at": (-0.0, 0.0, 0.0)}, "look_at"),
     ],
 )
 def test_a_camera_out_of_bounds_is_refused_naming_its_field(change: dict[str, Any], field: str) -> None:
