@@ -28,6 +28,7 @@ from scenes._controls import build_controls, declared
 from scenes._framing import ClientFraming, Lens, View
 from scenes._instances import add_instances
 from scenes._look import add_ground
+from scenes._numbers import fixed, signed
 from scenes._worker import LatestWorker
 from scenes.freekick.model import (
     DEFENDER_WIDTH_M,
@@ -511,7 +512,7 @@ reads it again, so a ball that bounces in front of him beats him more often than
         with self.server.atomic():
             self.target_marker.position = (0.0, y, z)
             self.target_marker.visible = True
-            self.aim_status.content = f"Searching for a kick to y = {y:+.2f} m, z = {z:.2f} m…"
+            self.aim_status.content = f"Searching for a kick to y = {signed(y, 2)} m, z = {fixed(z, 2)} m…"
 
         def job() -> None:
             found = aim_at(params, (y, z))
@@ -526,9 +527,10 @@ reads it again, so a ball that bounces in front of him beats him more often than
                 self.apply(found.shown_as(self.params))  # arrows and view as shown now, not when the click came
                 self.target_marker.visible = True  # (the kick's change took the last one's down)
                 point = self.state.outcome.goal_point
-                reached = "" if point is None else f" It crosses at y = {point[1]:+.2f} m, z = {point[2]:.2f} m."
+                crossing = "" if point is None else f"y = {signed(point[1], 2)} m, z = {fixed(point[2], 2)} m"
+                reached = f" It crosses at {crossing}." if crossing else ""
                 self.aim_message = (
-                    f"Found: elevation {found.elevation_deg:.1f}°, azimuth {found.azimuth_deg:+.1f}°, "
+                    f"Found: elevation {found.elevation_deg:.1f}°, azimuth {signed(found.azimuth_deg, 1)}°, "
                     f"{spin_words(found)}.{reached}"
                 )
                 self.aim_status.content = self.aim_message
@@ -770,14 +772,14 @@ reads it again, so a ball that bounces in front of him beats him more often than
         lines += ["", f"Height at the wall: **{wall_height_words(state)}** (wall top {state.wall.height_m:.2f} m)"]
         if reached and o.goal_point is not None and o.goal_time is not None:
             lines.append(
-                f"At the goal line: **y = {o.goal_point[1]:+.2f} m, z = {o.goal_point[2]:.2f} m** after "
+                f"At the goal line: **y = {signed(o.goal_point[1], 2)} m, z = {fixed(o.goal_point[2], 2)} m** after "
                 f"**{o.goal_time:.2f} s**"
             )
         elif o.goal_point is None:
             lines.append(landing_words(state))
         deflection = deflection_m(state)
         if deflection is not None:
-            lines.append(f"Sideways against the no-spin kick: **{deflection:+.2f} m** (+ = left)")
+            lines.append(f"Sideways against the no-spin kick: **{signed(deflection, 2)} m** (+ = left)")
         words = play_words(state.played)
         if words:
             lines.append(f"Played on: **{words}** (pale line)")

@@ -26,6 +26,7 @@ from scenes._controls import build_controls, declared, read_controls
 from scenes._framing import Lens, View, frame_clear_of_notice
 from scenes._instances import park_hidden
 from scenes._look import add_ground, mesh_glb
+from scenes._numbers import signed
 from scenes.peloton.course_model import (
     COURSE_POWER_DECIMALS,
     COURSE_POWER_RANGE_W,
@@ -809,7 +810,7 @@ class CourseMode:
     def _route_markdown(self) -> str:
         r = self.route
         average = 100.0 * (r.elevation_m[-1] - r.elevation_m[0]) / r.total_distance_m
-        slope = "0.0" if round(average, 1) == 0.0 else f"{average:+.1f}"  # a loop's tiny difference read "-0.0 %"
+        slope = signed(average, 1)  # a loop's tiny difference read "-0.0 %"
         text = (
             f"**{_escape(r.name)}**: {self._total_km():.2f} km, +{r.climbing_m:.0f} m, "
             f"{r.elevation_m[0]:.0f} → {r.elevation_m[-1]:.0f} m ({slope} % on average), {r.n_points} points"
