@@ -405,7 +405,8 @@ def wall_height_words(state: KickState) -> str:
         e.kind == "ground" and (o.wall_time is None or e.t < o.wall_time) for e in played.events
     )
     if o.wall_point is not None and not bounced:
-        return f"{o.wall_point[2]:.2f} m{_beside_words(state.wall, o.wall_point)}"
+        point = o.wall_point
+        return f"{point[2]:.2f} m{_clipping_words(state.wall, point)}{_beside_words(state.wall, point)}"
     if played is None or not bounced:
         return "never reaches the wall"
     struck = next((e for e in played.events if e.kind == "wall"), None)
@@ -416,6 +417,15 @@ def wall_height_words(state: KickState) -> str:
         point = position_at(played, crossed)
         return f"{point[2]:.2f} m{_beside_words(state.wall, point)}, after bouncing (pale line)"
     return "never reaches the wall"
+
+
+def _clipping_words(wall: ball.Panel, point: NDArray[np.float64]) -> str:
+    """ ", its underside 0.02 m below the wall's top" where the ball's centre at ``point`` (m) passes over the top
+    but the ball does not (an outside tester read "1.89 m (wall top 1.80 m)" beside "Blocked by the wall")."""
+    below = wall.height_m - (float(point[2]) - ball.BALL_RADIUS_M)
+    if float(point[2]) <= wall.height_m or below <= 0.0:
+        return ""
+    return f", its underside {max(below, 0.005):.2f} m below the wall's top"
 
 
 def _beside_words(wall: ball.Panel, point: NDArray[np.float64]) -> str:

@@ -329,7 +329,13 @@ def test_the_wall_and_landing_lines_describe_the_path_they_name(
     bounced = any(e.kind == "ground" and (free.wall_time is None or e.t < free.wall_time) for e in played.events)
     if free.wall_point is not None and not bounced:
         point = free.wall_point
-        assert line.startswith(f"Height at the wall: **{point[2]:.2f} m{_beside(state, point)}**")
+        # A ball whose centre passes over the wall's top but whose underside does not says so (the free flight
+        # then reads "Blocked by the wall").
+        below = state.wall.height_m - (point[2] - ball.BALL_RADIUS_M)
+        clips = (
+            f", its underside {max(below, 0.005):.2f} m below the wall's top" if 0 < below < ball.BALL_RADIUS_M else ""
+        )
+        assert line.startswith(f"Height at the wall: **{point[2]:.2f} m{clips}{_beside(state, point)}**")
     else:
         struck = [e for e in played.events if e.kind == "wall"]
         crossing = _wall_crossing(state, played)
@@ -505,3 +511,19 @@ def test_the_free_flights_words_agree_with_the_crossing_they_stand_beside(freeki
         elif words == "GOAL":
             assert y <= post_axis - reach and z <= bar_axis - reach, (azimuth, elevation, crossing)
     assert said  # the sweep crosses posts and bar: the pitch and the free flight differ somewhere
+
+
+def test_a_ball_whose_underside_clips_the_wall_says_so_beside_the_free_flights_block(freekick: FreeKickScene) -> None:
+    # An outside tester: the default kick at 22 m/s read "GOAL", "In free flight through the goal plane: Blocked by
+    # the wall" and "Height at the wall: 1.89 m (wall top 1.80 m)": the centre passes over, the ball does not.
+    readout = _show(freekick, speed_ms=22.0)
+    assert "In free flight through the goal plane: Blocked by the wall" in readout
+    assert "Height at the wall: **1.89 m, its underside 0.02 m below the wall's top** (wall top 1.80 m)" in readout
+
+
+@pytest.mark.parametrize("spin", ["back", "top"])
+def test_a_kick_with_no_sideways_movement_reads_zero_not_minus_zero(freekick: FreeKickScene, spin: str) -> None:
+    # An outside tester: 40 m/s with backspin read "Sideways against the no-spin kick: -0.00 m".
+    readout = _show(freekick, speed_ms=40.0, spin_axis=spin)
+    line = next(text for text in readout.splitlines() if text.startswith("Sideways against"))
+    assert "**0.00 m**" in line, line
