@@ -50,12 +50,20 @@ _PROLOG = re.compile(r"(?:[\s\ufeff]+|<\?.*?\?>|<!--.*?-->|<!DOCTYPE(?:[^>\[]|\[
 document type, of any length."""
 
 
-def load_gpx(source: str | os.PathLike[str] | bytes, *, name: str | None = None, smoothing_m: float = 50.0) -> Course:
+def load_gpx(
+    source: str | os.PathLike[str] | bytes,
+    *,
+    name: str | None = None,
+    file_name: str | None = None,
+    smoothing_m: float = 50.0,
+) -> Course:
     """Read a GPX file's track and route points into a :class:`Course`.
 
     Args:
         source: a path, the file's bytes, or the file's text (a string that starts with ``<``).
         name: course name (a str); default (None) the track's name, else the file name, else "GPX course".
+        file_name: the file's name where ``source`` is its bytes or text (an upload's): the course's name when the
+            file names no track (a path's own name is used without it).
         smoothing_m: elevation moving-average window (m, ≥ 0); 0, or a window shorter than
             :data:`~kernels.course.route.SMOOTHING_FLOOR_M` (1 cm), keeps the elevation as read. A file whose
             elevation jitters by σ from point to point is smoothed over :data:`NOISE_WINDOW_PER_M`·σ where that is
@@ -77,8 +85,9 @@ def load_gpx(source: str | os.PathLike[str] | bytes, *, name: str | None = None,
     else as UTF-8; a namespace prefix on the GPX elements (``<g:gpx xmlns:g=...>``) is read too. Only positions and
     elevations are read: waypoints and other fields (:data:`_UNUSED`) cannot refuse a file.
     """
-    if name is not None and not isinstance(name, str):
-        raise ValueError(f"name must be a str or None, got {type(name).__name__}")
+    for argument, value in (("name", name), ("file_name", file_name)):
+        if value is not None and not isinstance(value, str):
+            raise ValueError(f"{argument} must be a str or None, got {type(value).__name__}")
     _checks.non_negative("smoothing_m", smoothing_m)
     label = "the file"
     if isinstance(source, bytes):
@@ -108,6 +117,10 @@ def load_gpx(source: str | os.PathLike[str] | bytes, *, name: str | None = None,
     root = _GPX_ROOT.match(text, prolog.end() if prolog else 0)
     if root is None:
         raise ValueError(f"{label} is not GPX: no <gpx> element at its start")
+    # A "billion laughs", or an outside file (XXE): an entity the file declares and uses is never expanded.
+    declared = re.findall(r"<!ENTITY\s+(?:%\s*)?([\w.:-]+)", prolog.group(0)) if prolog else []
+    if any(f"&{entity};" in text or f"%{entity};" in text for entity in declared):
+        raise ValueError(f"{label} uses XML entities (<!ENTITY>), which a GPX file does not need; they are not read")
     # Count before parsing (gpxpy would build every point first), whatever the namespace prefix.
     prefix = root.group(1)
     tags = ("<trkpt", "<rtept") + ((f"<{prefix}:trkpt", f"<{prefix}:rtept") if prefix else ())
@@ -150,7 +163,7 @@ def load_gpx(source: str | os.PathLike[str] | bytes, *, name: str | None = None,
     _check_gaps(label, pieces)
     named = [*gpx.tracks, *gpx.routes]
     title = name or next((t.name for t in named if t.name), None) or gpx.name
-    title = title or (label if label != "the file" else "GPX course")
+    title = title or (label if label != "the file" else file_name or "GPX course")
     title = str(title)[:80]
     try:
         result = course_from_points(lat, lon, ele, name=title, smoothing_m=noise_smoothing_m(ele, smoothing_m))

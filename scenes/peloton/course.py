@@ -440,7 +440,7 @@ class CourseMode:
                 error = "the upload carried no file"
             else:
                 try:
-                    route = course_kernel.load_gpx(content)
+                    route = course_kernel.load_gpx(content, file_name=name)
                 except ValueError as failure:
                     error = str(failure)
         except Exception:  # a file must never take the scene down; say so and keep the course
@@ -505,7 +505,7 @@ class CourseMode:
             self._upload_seq += 1
             self._chosen_at = time.monotonic()
         try:
-            route, error = course_kernel.load_gpx(data), None
+            route, error = course_kernel.load_gpx(data, file_name=label), None
         except ValueError as failure:
             route, error = None, str(failure)
         return self._install(route, error, label)

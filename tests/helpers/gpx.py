@@ -58,6 +58,20 @@ BAD_FILES = {
         gpx_text([(45.0, 6.0, 1.0), (45.001, 6.0, 2.0)]).replace("<ele>2.0</ele>", "<ele>nan(123)</ele>"),
         r"^the file: track point 2's elevation \(<ele>\) is not a number \(line 1\)$",
     ),
+    # An outside tester: a "billion laughs" file read as an elevation that is not a number, an outside entity (XXE)
+    # as broken XML. Neither is expanded; both are refused for what they are.
+    "entities": (
+        gpx_text(line_points(3))
+        .replace('<?xml version="1.0"?>', '<?xml version="1.0"?><!DOCTYPE g [<!ENTITY a "1"><!ENTITY b "&a;&a;">]>')
+        .replace("<ele>101</ele>", "<ele>&b;</ele>"),
+        r"^the file uses XML entities \(<!ENTITY>\), which a GPX file does not need; they are not read$",
+    ),
+    "outside entity": (
+        gpx_text(line_points(3))
+        .replace('<?xml version="1.0"?>', '<?xml version="1.0"?><!DOCTYPE g [<!ENTITY x SYSTEM "file:///etc/passwd">]>')
+        .replace("<name>t</name>", "<name>&x;</name>"),
+        r"^the file uses XML entities",
+    ),
     "elevation absurd": (gpx_text([(45.0, 6.0, 1.0), (45.001, 6.0, 1e7)]), "elevation"),
     "too short": (gpx_text([(45.0, 6.0, 10.0), (45.0000001, 6.0, 10.0)]), "100 m or more"),
 }

@@ -793,6 +793,17 @@ def test_an_unreadable_position_names_its_point_and_line() -> None:
         course.load_gpx(shifted)
 
 
+def test_an_upload_that_names_no_track_is_named_by_its_file() -> None:
+    # An outside tester: an upload without <name> was "GPX course" in the panel, while its notices named the file.
+    untitled = gpx_text(line_points(20), kind="rte")
+    assert course.load_gpx(untitled.encode(), file_name="morning ride.gpx").name == "morning ride.gpx"
+    assert course.load_gpx(untitled.encode()).name == "GPX course"
+    titled = gpx_text(line_points(20)).replace("<name>t</name>", "<name>Col</name>")
+    assert course.load_gpx(titled.encode(), file_name="morning ride.gpx").name == "Col"
+    with pytest.raises(ValueError, match="file_name must be a str or None, got int"):
+        course.load_gpx(titled.encode(), file_name=3)  # type: ignore[arg-type]
+
+
 def test_binary_and_missing_files(tmp_path: Path) -> None:
     with pytest.raises(ValueError, match="not text in UTF-8"):
         course.load_gpx(b"\x89PNG\r\n\x1a\n\xff\xfe<gpx")
