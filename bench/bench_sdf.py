@@ -282,7 +282,7 @@ def bench_edit(edits: int) -> list[str]:
                     f"sd_sphere(p - vec3(0.0, 0.0, 0.4), {radius:.6f}), 0.2, BLEND_POLY);\n}}\n"
                 )
                 client.set_value("sdf(p) in GLSL", source)
-                client.wait_for(lambda s=source: client.value_of("sdf(p) in GLSL") == s)
+                client.wait_for(lambda s=source: client.value_of("sdf(p) in GLSL") == s, "the typed source")
                 count = len(client.received)
                 serial = scene.editor_serial
                 start = time.monotonic()
@@ -303,7 +303,7 @@ def bench_edit(edits: int) -> list[str]:
                     return mesh, frame
 
                 try:
-                    client.wait_for(lambda: None not in arrivals(), timeout=20.0)
+                    client.wait_for(lambda: None not in arrivals(), "the new mesh and frame", timeout_s=20.0)
                 except AssertionError:
                     failures.append(str(scene.editor_error))
                     continue
@@ -359,7 +359,7 @@ def bench_drag(drags: int) -> list[str]:
                         for _, m in client.received[count:]
                     )
 
-                client.wait_for(arrived, timeout=10.0, what="new mesh")
+                client.wait_for(arrived, timeout_s=10.0, what="new mesh")
                 arrival = next(
                     t
                     for t, m in client.received[count:]

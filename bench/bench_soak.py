@@ -76,11 +76,11 @@ def run_client(port: int, scene: str, rate: float, seconds: float, index: int, b
         owner = ""
         if scene in SLIDERS:
             label, lo, hi = SLIDERS[scene]
-            client.wait_for_gui(label, timeout=CONNECT_TIMEOUT_S)
-            client.wait_for_node(f"/{scene}", timeout=CONNECT_TIMEOUT_S)
+            client.wait_for_gui(label, timeout_s=CONNECT_TIMEOUT_S)
+            client.wait_for_node(f"/{scene}", timeout_s=CONNECT_TIMEOUT_S)
         else:
             name, radius = GIZMOS[scene]
-            node = client.wait_for_node(name, timeout=CONNECT_TIMEOUT_S)
+            node = client.wait_for_node(name, timeout_s=CONNECT_TIMEOUT_S)
             centre = [float(v) for v in node.get("position", (0.0, 0.0, 0.0))]
             if scene == "arm":
                 centre = [0.55, 0.0, 0.6]
@@ -297,12 +297,12 @@ def check_convergence(mode: str, scene: str, port: int, results: list[dict[str, 
     with BrowserClient(port) as auditor:  # a new tab is told the server's value
         if scene in SLIDERS:
             label = SLIDERS[scene][0]
-            auditor.wait_for_gui(label, timeout=60)
+            auditor.wait_for_gui(label, timeout_s=60)
             time.sleep(1.0)
             server_value: Any = auditor.value_of(label)
         else:
             name = GIZMOS[scene][0]
-            auditor.wait_for_node(name, timeout=60)
+            auditor.wait_for_node(name, timeout_s=60)
             time.sleep(1.0)
             server_value = auditor.pose_of(name)[0]
     return all(_same(r["shown"], server_value) for r in results)

@@ -7,7 +7,7 @@ numbers, wrong types, unknown uuids): the scenes must survive those.
 
     with BrowserClient(port) as client:
         client.set_value("Speed (km/h)", 45.0)
-        client.wait_for(lambda: ...)
+        client.wait_for(lambda: ..., "what the test waits for")
 
 Server → client frames: ``[u64 msgpack length][u64 zstd length] zstd(msgpack {messages, timestampSec,
 binaryBufferLengths}) [padding to 8] [raw buffers, each 8-aligned]``; numpy arrays arrive as
@@ -30,6 +30,8 @@ import zstandard
 from websockets.exceptions import ConnectionClosed
 from websockets.sync.client import ClientConnection, connect
 from websockets.typing import Subprotocol
+
+from helpers.waiting import wait_until
 
 VISER_SUBPROTOCOL = "viser-v1.1.1"
 
@@ -66,7 +68,7 @@ class BrowserClient:
         self._ws: ClientConnection = connect(
             f"ws://{host}:{port}", subprotocols=[Subprotocol(VISER_SUBPROTOCOL)], max_size=None
         )
-        self._lock = threading.Condition()
+        self._lock = threading.RLock()
         self.gui: dict[str, dict[str, Any]] = {}
         """uuid → {"type", "value", "props", "container_uuid"} for every live GUI element."""
         self.nodes: dict[str, dict[str, Any]] = {}
@@ -108,13 +110,11 @@ class BrowserClient:
                     for message in messages:
                         self.received.append((now, message))
                         self._apply(message)
-                    self._lock.notify_all()
         except ConnectionClosed:
             pass
         finally:
             with self._lock:
                 self.closed_by_server = True
-                self._lock.notify_all()
 
     def _apply(self, message: dict[str, Any]) -> None:
         kind = message.get("type", "")
@@ -151,24 +151,24 @@ class BrowserClient:
             self.nodes[message["name"]] = dict(message)
 
     # ------------------------------------------------------------------------------------------ waiting
-    def wait_for(self, predicate: Callable[[], bool], timeout: float = 10.0, what: str = "condition") -> None:
-        """Block until ``predicate()`` is true (checked whenever messages arrive); AssertionError on timeout."""
-        deadline = time.monotonic() + timeout
-        with self._lock:
-            while not predicate():
-                remaining = deadline - time.monotonic()
-                if remaining <= 0:
-                    raise AssertionError(f"timed out after {timeout} s waiting for {what}")
-                self._lock.wait(min(remaining, 0.05))
+    def wait_for(self, predicate: Callable[[], object], what: str, timeout_s: float = 10.0) -> None:
+        """:func:`helpers.waiting.wait_until` (same arguments), with ``predicate()`` read under the lock the reader
+        thread updates this mirror under: it sees each message whole, and may walk ``gui`` or ``nodes``."""
 
-    def wait_for_gui(self, label: str, timeout: float = 10.0) -> str:
-        self.wait_for(lambda: self._find(label) is not None, timeout, f"GUI element {label!r}")
+        def holds() -> object:
+            with self._lock:
+                return predicate()
+
+        wait_until(holds, what, timeout_s)
+
+    def wait_for_gui(self, label: str, timeout_s: float = 10.0) -> str:
+        self.wait_for(lambda: self._find(label) is not None, f"GUI element {label!r}", timeout_s)
         uuid = self._find(label)
         assert uuid is not None
         return uuid
 
-    def wait_for_node(self, name: str, timeout: float = 10.0) -> dict[str, Any]:
-        self.wait_for(lambda: name in self.nodes, timeout, f"scene node {name!r}")
+    def wait_for_node(self, name: str, timeout_s: float = 10.0) -> dict[str, Any]:
+        self.wait_for(lambda: name in self.nodes, f"scene node {name!r}", timeout_s)
         return self.nodes[name]
 
     # ------------------------------------------------------------------------------------------ GUI

@@ -572,7 +572,7 @@ def test_a_file_the_scene_closed_under_is_told_to_its_tab(
             client.click("Reset scene to defaults")
         else:
             client.set_value("Scene", "Arm: FABRIK inverse kinematics")
-        client.wait_for(lambda: switcher.scene is not closed, timeout=30.0, what="the scene closed")  # a build
+        client.wait_for(lambda: switcher.scene is not closed, timeout_s=30.0, what="the scene closed")  # a build
         if stage == "arriving":
             client.send(
                 "FileTransferPart",
@@ -582,7 +582,7 @@ def test_a_file_the_scene_closed_under_is_told_to_its_tab(
                 content=data[half:],
             )
         client.wait_for(
-            lambda: any("dropped.gpx" in n["body"] for n in client.notices()), timeout=30.0, what="the tab told"
+            lambda: any("dropped.gpx" in n["body"] for n in client.notices()), timeout_s=30.0, what="the tab told"
         )
         (note,) = [n for n in client.notices() if "dropped.gpx" in n["body"]]
         assert note["body"].startswith(f"dropped.gpx was still {stage} when the scene was reset or switched")
@@ -596,7 +596,7 @@ def test_a_file_the_scene_closed_under_is_told_to_its_tab(
                 m["type"] == "RemoveNotificationMessage" and m.get("uuid") == f"upload-{transfer}"
                 for _at, m in list(other.received)
             ),
-            timeout=30.0,
+            timeout_s=30.0,
             what="the other tab's progress notice taken down",
         )
         assert not any("dropped.gpx" in n["body"] for n in other.notices())  # the refusal is the sender's
@@ -611,7 +611,7 @@ def test_an_uploads_acks_reach_only_the_tab_that_sent_it(server: viser.ViserServ
         sender.wait_for_gui("Upload GPX")
         other.wait_for_gui("Upload GPX")
         upload(sender, "Upload GPX", "shared.gpx", data, part=len(data) // 3 + 1)
-        sender.wait_for(lambda: mode.route_label == "shared.gpx", timeout=30.0, what="the file loaded")
+        sender.wait_for(lambda: mode.route_label == "shared.gpx", timeout_s=30.0, what="the file loaded")
         acks = [
             [m for _at, m in list(client.received) if m["type"] == "FileTransferPartAck"] for client in (sender, other)
         ]

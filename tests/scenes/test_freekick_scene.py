@@ -1150,7 +1150,7 @@ def _sent_while_mapping(client: BrowserClient, freekick: FreeKickScene, then: st
             client.wait_for(lambda: freekick.params.knuckle, what="the knuckleball")
         case "an aim at the goal mouth":
             _click_the_goal_mouth(client, ray_origin=(-20.0, 1.5, 1.2))
-            client.wait_for(lambda: _markdown_shown(client, "Found:"), timeout=60.0, what="the aimed kick")
+            client.wait_for(lambda: _markdown_shown(client, "Found:"), timeout_s=60.0, what="the aimed kick")
         case "moving the ball":
             client.set_value("Distance to goal (m)", 25.0)
             client.wait_for(lambda: freekick.params.distance_m == 25.0, what="the ball on its new spot")

@@ -92,9 +92,9 @@ def first_gui_delay(server: viser.ViserServer, sessions: Sessions) -> float:
     known = set(server.get_clients())
     start = time.monotonic()
     with BrowserClient(server.get_port()) as late:
-        late.wait_for_gui("Reset scene to defaults", timeout=60.0)
+        late.wait_for_gui("Reset scene to defaults", timeout_s=60.0)
         delay = time.monotonic() - start
-        late.wait_for_node("/peloton", timeout=30.0)
+        late.wait_for_node("/peloton", timeout_s=30.0)
         switcher = sessions.switcher(own_session(server, sessions, known))
         assert switcher is not None
         late.set_value("Speed (km/h)", 31.0)  # a slider moved there reaches its own scene
@@ -140,12 +140,12 @@ def test_a_reset_flood_does_not_delay_another_tab_and_ends_in_a_reset_scene(
         assert switcher is not None
         reset = flooder.wait_for_gui("Reset scene to defaults")
         flooder.set_value("Scene", SCENES[key].title)
-        flooder.wait_for(lambda: switcher.scene.key == key, timeout=30.0, what=f"the session shows {key}")
+        flooder.wait_for(lambda: switcher.scene.key == key, timeout_s=30.0, what=f"the session shows {key}")
         flooder.wait_for_gui(label)
         flooder.set_value(label, value)
         flooder.wait_for(
             lambda: getattr(switcher.scene.params, field) == value,  # type: ignore[attr-defined]
-            timeout=30.0,
+            timeout_s=30.0,
             what="the edit",
         )
         edited = switcher.scene
@@ -169,7 +169,7 @@ def test_a_reset_flood_does_not_delay_another_tab_and_ends_in_a_reset_scene(
             builds = builds_of(flooder, f"/{key}")[built_before:]
             return bool(builds) and builds[-1] >= flood.last_sent_at and shown is not edited and not shown.closed
 
-        flooder.wait_for(rebuilt_after_the_last_click, timeout=30.0, what="a rebuild after the last Reset")
+        flooder.wait_for(rebuilt_after_the_last_click, timeout_s=30.0, what="a rebuild after the last Reset")
         builds = builds_of(flooder, f"/{key}")[built_before:]
         print(f"{key} Reset flood: {len(builds)} rebuilds")
         # A burst of Resets is a few rebuilds (the budget), not one per click...
@@ -230,7 +230,7 @@ def test_an_edit_sent_after_resets_beyond_the_budget_is_not_undone(
                 and switcher.scene.params.speed_kmh == 33.0  # type: ignore[attr-defined]
                 and client.value_of("Speed (km/h)") == 33.0
             ),
-            timeout=30.0,
+            timeout_s=30.0,
             what="the speed sent after the Resets, in the reset scene",
         )
         time.sleep(1.0)  # nothing left to undo it
@@ -265,7 +265,7 @@ def test_a_scene_switch_flood_ends_on_the_last_pick_and_does_not_delay_another_t
         assert switcher is not None
         flooder.wait_for(
             lambda: switcher.scene.key == last_key and not switcher.scene.closed,
-            timeout=30.0,
+            timeout_s=30.0,
             what=f"the session shows {last_key}",
         )
         flooder.wait_for(
@@ -273,7 +273,7 @@ def test_a_scene_switch_flood_ends_on_the_last_pick_and_does_not_delay_another_t
                 f"/{last_key}" in flooder.nodes
                 and not any(f"/{key}" in flooder.nodes for key in SCENES if key != last_key)
             ),
-            timeout=20.0,
+            timeout_s=20.0,
             what="the flooder shows only the last pick",
         )
         assert flooder.value_of("Scene") == picked[-1]
@@ -498,7 +498,7 @@ def test_uploads_beyond_the_server_wide_bytes_are_refused_with_a_notice_and_the_
         for i, (client, scene) in enumerate(tabs[:3]):
             client.wait_for(
                 lambda s=scene, n=f"Big {i}": s.course_mode.route.name == n,
-                timeout=30.0,
+                timeout_s=30.0,
                 what=f"tab {i}'s 20 MiB upload",
             )
             assert not client.notices()

@@ -203,7 +203,7 @@ def assert_an_honest_edit_lands_after(
     attacker.set_value(label, good)
     attacker.wait_for(
         lambda: getattr(scene.params, field) == good,  # type: ignore[attr-defined]
-        timeout=60,
+        timeout_s=60,
         what=f"the honest {label} edit after {sent} hostile messages",
     )
     assert not attacker.closed_by_server
@@ -439,11 +439,11 @@ def test_huge_numbers_clamp_to_the_range_the_scene_declared(server: viser.ViserS
                     continue
                 attacker.wait_for(
                     lambda h=handle, b=bound: float(h.value) == b,  # type: ignore[attr-defined]
-                    timeout=60,
+                    timeout_s=60,
                     what=f"{getattr(handle, 'label', uuid)} clamped to {bound}",
                 )
         for viewer in (attacker, observer):
-            viewer.wait_for(lambda v=viewer: shows_server_values(v, server), timeout=60, what="values converge")
+            viewer.wait_for(lambda v=viewer: shows_server_values(v, server), timeout_s=60, what="values converge")
         scene = switcher.scene
         with scene._lock:
             for name in scene.params.__dataclass_fields__:  # type: ignore[attr-defined]
@@ -468,7 +468,7 @@ def test_numbers_nearer_zero_than_their_range_can_tell_are_zero(
             handle = handles[uuid]
             attacker.wait_for(
                 lambda h=handle, e=expected: float(h.value) == e,  # type: ignore[attr-defined]
-                timeout=60,
+                timeout_s=60,
                 what=f"{getattr(handle, 'label', uuid)} at {expected}",
             )
         time.sleep(0.5)  # the scene's callbacks have drawn
@@ -586,7 +586,8 @@ def test_two_viewers_moving_one_slider_ms_apart_end_equal(server: viser.ViserSer
                             handle.value in sent  # type: ignore[attr-defined]
                             and v.value_at(uuid) == handle.value  # type: ignore[attr-defined]
                         ),
-                        timeout=10.0,
+                        "one of the two values, shown by both viewers",
+                        timeout_s=10.0,
                     )
             except AssertionError:
                 differ.append((gap_s, a.value_at(uuid), b.value_at(uuid), handle.value))  # type: ignore[attr-defined]

@@ -109,7 +109,7 @@ def test_a_closed_tab_frees_its_session(server: viser.ViserServer, sessions: Ses
         client, switcher = connect_tab(server, sessions)
         with client:
             client.set_value("Scene", SCENES[key].title)
-            client.wait_for(lambda switcher=switcher, key=key: switcher.scene.key == key, timeout=60)
+            client.wait_for(lambda switcher=switcher, key=key: switcher.scene.key == key, f"the tab shows {key}", 60.0)
             refs += [weakref.ref(switcher), weakref.ref(switcher.scene), weakref.ref(switcher.server)]
             del switcher
         wait_until(lambda: not (sessions.count or server.get_clients()), "the closed tab's session freed")
@@ -285,12 +285,12 @@ def open_tabs(app: AppProcess, count: int, scene: str) -> list[BrowserClient]:
     tabs = []
     for _ in range(count):
         tab = BrowserClient(app.port)
-        tab.wait_for_gui("Scene", timeout=60)
+        tab.wait_for_gui("Scene", timeout_s=60)
         if scene != "peloton":
             tab.set_value("Scene", SCENES[scene].title)
-        tab.wait_for_node(f"/{scene}", timeout=120)
+        tab.wait_for_node(f"/{scene}", timeout_s=120)
         if scene == "sdf":
-            tab.wait_for(lambda tab=tab: reference_shown(tab), timeout=120, what="its reference")
+            tab.wait_for(lambda tab=tab: reference_shown(tab), timeout_s=120, what="its reference")
         tabs.append(tab)
     return tabs
 
@@ -356,7 +356,7 @@ def test_a_tab_that_picks_a_scene_and_closes_at_once_leaves_no_warning() -> None
         app.wait_compiled()
         for i in range(30):
             tab = BrowserClient(app.port)
-            tab.wait_for_gui("Scene", timeout=60)
+            tab.wait_for_gui("Scene", timeout_s=60)
             options = tab.element("Scene")["props"]["options"]
             tab.set_value("Scene", options[1 + i % 3])
             time.sleep(0.05)  # gone while the scene it picked is being built
@@ -377,7 +377,7 @@ def test_tab_churn_leaves_rss_flat_and_sends_nothing_to_closed_tabs() -> None:
             if i % 3 == 0:
                 time.sleep(0.01 * (i % 7))  # gone before (or while) its session is built
             else:
-                tab.wait_for_gui("Scene", timeout=60)
+                tab.wait_for_gui("Scene", timeout_s=60)
             tab.close()
 
     app = AppProcess()
@@ -475,13 +475,13 @@ def test_each_tab_s_sdf_reference_is_rendered_from_that_tab_s_camera(server: vis
                 s = shape(scene)
                 return s is not None and abs(s[0] / s[1] - height_over_width) < 0.02
 
-            a.wait_for(lambda: aspect_is(scene_a, 600 / 800), timeout=120, what="A's landscape reference")
-            b.wait_for(lambda: aspect_is(scene_b, 800 / 600), timeout=120, what="B's portrait reference")
+            a.wait_for(lambda: aspect_is(scene_a, 600 / 800), timeout_s=120, what="A's landscape reference")
+            b.wait_for(lambda: aspect_is(scene_b, 800 / 600), timeout_s=120, what="B's portrait reference")
             first_b = scene_b.reference_rgb
             serial_a = scene_a.reference_serial
             serial_b = scene_b.reference_serial
             b.send_camera(position=(0.0, -3.5, 0.4), look_at=(0.0, 0.0, 0.3), size=(800, 600))
-            b.wait_for(lambda: scene_b.reference_serial > serial_b, timeout=60, what="B re-rendered")
+            b.wait_for(lambda: scene_b.reference_serial > serial_b, timeout_s=60, what="B re-rendered")
             assert scene_b.reference_rgb is not None and first_b is not None
             assert not np.array_equal(scene_b.reference_rgb, first_b)
             time.sleep(0.5)  # A's camera did not move: nothing re-renders A's reference
