@@ -318,6 +318,12 @@ class Gate:
         tab = self._budgets.get(client_id)
         return 0 if tab is None else tab.budget.held
 
+    def costly_in_flight(self, client_id: int) -> int:
+        """How many costly inputs of ``client_id`` were delivered and their handlers have not finished (a scene
+        switch or Reset still rebuilding)."""
+        tab = self._budgets.get(client_id)
+        return 0 if tab is None else tab.in_flight
+
     def _client(self, server: viser.ViserServer, client_id: int) -> viser.ClientHandle | None:
         return viser_compat.connected_client(server, client_id)
 

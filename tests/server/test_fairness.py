@@ -13,7 +13,6 @@ import dataclasses
 import logging
 import threading
 import time
-import uuid
 from collections.abc import Callable
 from typing import Any
 
@@ -21,7 +20,8 @@ import pytest
 import viser
 from helpers.browser import open_viser
 from helpers.gpx import hill_gpx
-from helpers.uploads import send_part, upload
+from helpers.uploads import send_part, start_upload, upload
+from helpers.waiting import wait_until
 from helpers.wsclient import BrowserClient
 from hypothesis import given
 from hypothesis import strategies as st
@@ -47,15 +47,20 @@ FLOOD_HZ = 200.0
 
 def own_session(server: viser.ViserServer, sessions: Sessions, known: set[int]) -> int:
     """The client id of the one tab that registered since ``known``, once its session is built."""
-    deadline = time.monotonic() + 20.0
-    while time.monotonic() < deadline:
+    built: list[int] = []
+
+    def session_built() -> bool:
         new = set(server.get_clients()) - known
-        if new:
-            (client_id,) = new
-            if sessions.switcher(client_id) is not None:
-                return client_id
-        time.sleep(0.01)
-    raise AssertionError("the tab's session was never built")
+        if not new:
+            return False
+        (client_id,) = new  # one tab, not two
+        if sessions.switcher(client_id) is None:
+            return False
+        built.append(client_id)
+        return True
+
+    wait_until(session_built, "the tab's session built", 20.0)
+    return built[-1]
 
 
 class Flood:
@@ -87,6 +92,16 @@ class Flood:
         self._thread.join(timeout=5.0)
 
 
+def wait_flooding(server: viser.ViserServer, client_id: int, flood: Flood) -> None:
+    """Until ``flood`` (from tab ``client_id``) has sent half a second's worth and the gate holds its inputs back."""
+    gate = install_gate(server)
+    wait_until(
+        lambda: flood.sent > 0.5 * FLOOD_HZ and gate.costly_held_back(client_id) > 0,
+        "the flood under way, beyond the tab's budget",
+        30.0,
+    )
+
+
 def first_gui_delay(server: viser.ViserServer, sessions: Sessions) -> float:
     """Seconds from a new tab's connection to the first control of its own session (then checks it is served)."""
     known = set(server.get_clients())
@@ -112,14 +127,25 @@ def builds_of(client: BrowserClient, root: str) -> list[float]:
     ]
 
 
-def wait_settled(server: viser.ViserServer, client_id: int) -> None:
-    """Until the gate holds back nothing of ``client_id`` and its callbacks have run."""
+def wait_settled(server: viser.ViserServer, client: BrowserClient, client_id: int) -> None:
+    """Until every input ``client`` (tab ``client_id``) has sent reached the gate, which holds back none of them and
+    runs none: the last delivered scene switch or Reset has rebuilt (on viser's callback pool) and nothing is left
+    that could change the scene."""
     gate = install_gate(server)
-    deadline = time.monotonic() + 30.0
-    while gate.costly_held_back(client_id) and time.monotonic() < deadline:
-        time.sleep(0.05)
-    assert gate.costly_held_back(client_id) == 0
-    time.sleep(0.5)  # the last delivered input's rebuild, on viser's callback pool
+    tab = server.get_clients()[client_id]
+    marked_at = time.time()
+    # A camera message is not held in line: the gate takes it in order after every input sent before it, and viser
+    # stamps the tab's camera with it. Once stamped, the gate has taken all of them (held back or delivered).
+    client.send_camera()
+    wait_until(
+        lambda: (
+            tab.camera.update_timestamp >= marked_at
+            and gate.costly_held_back(client_id) == 0
+            and gate.costly_in_flight(client_id) == 0
+        ),
+        "the tab's inputs taken by the gate, none held back and none still running",
+        30.0,
+    )
 
 
 EDITS = {  # an edit per scene that a Reset undoes: (label, value, params field)
@@ -153,14 +179,14 @@ def test_a_reset_flood_does_not_delay_another_tab_and_ends_in_a_reset_scene(
         caplog.clear()
         started = time.monotonic()
         with Flood(lambda _i: flooder.send("GuiUpdateMessage", uuid=reset, updates={"value": True}), FLOOD_HZ) as flood:
-            time.sleep(0.5)  # the flood is under way
+            wait_flooding(server, client_id, flood)
             delay = first_gui_delay(server, sessions)
         flood_s = flood.last_sent_at - started
         print(f"{key} Reset flood: {flood.sent} clicks in {flood_s:.1f} s; another tab's first GUI in {delay:.2f} s")
         assert flood.sent > 0.5 * FLOOD_HZ
         assert delay <= FIRST_GUI_BOUND_S, f"the second tab's first GUI took {delay:.2f} s"
 
-        wait_settled(server, client_id)
+        wait_settled(server, flooder, client_id)
 
         def rebuilt_after_the_last_click() -> bool:
             # The last delivered Reset rebuilds on viser's callback pool: wait for that rebuild, not a fixed time
@@ -223,7 +249,7 @@ def test_an_edit_sent_after_resets_beyond_the_budget_is_not_undone(
 
         client.wait_for(held_with_the_tab_on_a_built_scene, what="a Reset held back")
         client.set_value("Speed (km/h)", 33.0)
-        wait_settled(server, client_id)
+        wait_settled(server, client, client_id)
         client.wait_for(
             lambda: (
                 not switcher.scene.closed
@@ -233,7 +259,7 @@ def test_an_edit_sent_after_resets_beyond_the_budget_is_not_undone(
             timeout_s=30.0,
             what="the speed sent after the Resets, in the reset scene",
         )
-        time.sleep(1.0)  # nothing left to undo it
+        wait_settled(server, client, client_id)  # nothing is left that could undo it
         scene = switcher.scene
         assert scene.params == dataclasses.replace(type(scene.params)(), speed_kmh=33.0)  # type: ignore[attr-defined]
 
@@ -254,12 +280,12 @@ def test_a_scene_switch_flood_ends_on_the_last_pick_and_does_not_delay_another_t
             flooder.send("GuiUpdateMessage", uuid=pick, updates={"value": picked[-1]})
 
         with Flood(switch, FLOOD_HZ) as flood:
-            time.sleep(0.5)
+            wait_flooding(server, client_id, flood)
             delay = first_gui_delay(server, sessions)
         print(f"Switch flood: {flood.sent} picks; another tab's first GUI in {delay:.2f} s")
         assert delay <= FIRST_GUI_BOUND_S, f"the second tab's first GUI took {delay:.2f} s"
 
-        wait_settled(server, client_id)
+        wait_settled(server, flooder, client_id)
         (last_key,) = [key for key, cls in SCENES.items() if cls.title == picked[-1]]
         switcher = sessions.switcher(client_id)
         assert switcher is not None
@@ -396,18 +422,9 @@ def test_a_budget_that_lets_nothing_through_is_refused(burst: int, rate_hz: floa
 
 
 # ------------------------------------------------------------------------------------------ uploads
-def start_upload(client: BrowserClient, size: int, parts: int) -> str:
-    transfer = str(uuid.uuid4())
-    client.send(
-        "FileTransferStartUpload",
-        source_component_uuid=client.uuid_of("Upload GPX"),
-        transfer_uuid=transfer,
-        filename="big.gpx",
-        mime_type="application/gpx+xml",
-        part_count=parts,
-        size_bytes=size,
-    )
-    return transfer
+def start_big_upload(client: BrowserClient, size: int, parts: int) -> str:
+    """Start an upload of ``size`` bytes in ``parts`` parts to the course's button; returns its transfer id."""
+    return start_upload(client, "Upload GPX", "big.gpx", size, parts)[1]
 
 
 def open_course_tabs(
@@ -450,7 +467,7 @@ def test_uploads_beyond_the_server_wide_count_are_refused_with_a_notice_and_the_
             data = [hill_gpx(f"Tab {i}", 300) for i in range(len(tabs))]
             transfers: list[list[str]] = []
             for i, (client, _scene) in enumerate(tabs):  # 5 tabs × 2 uploads: 10 > the cap of 8
-                transfers.append([start_upload(client, len(data[i]), 1) for _ in range(2)])
+                transfers.append([start_big_upload(client, len(data[i]), 1) for _ in range(2)])
                 if i < 4:
                     client.wait_for(lambda i=i: gate.uploads_in_flight()[0] == 2 * (i + 1), what="in flight")
             assert MAX_UPLOADS_IN_FLIGHT_TOTAL == 8
@@ -485,9 +502,9 @@ def test_uploads_beyond_the_server_wide_bytes_are_refused_with_a_notice_and_the_
     try:
         transfers = []
         for i, (client, _scene) in enumerate(tabs[:3]):
-            transfers.append(start_upload(client, big, 1))
+            transfers.append(start_big_upload(client, big, 1))
             client.wait_for(lambda i=i: gate.uploads_in_flight()[0] == i + 1, what="in flight")
-        start_upload(tabs[3][0], big, 1)  # 60 + 20 MiB > 64 MiB
+        start_big_upload(tabs[3][0], big, 1)  # 60 + 20 MiB > 64 MiB
         note = refusal_notice(tabs[3][0])
         assert "60.0 MiB in flight" in note["body"] and "64 MiB" in note["body"]
         # A small file still fits beside the three big ones.
@@ -519,9 +536,17 @@ def test_a_stalled_upload_stops_holding_the_server_wide_budget(
         with caplog.at_level(logging.WARNING):
             (stalled, _), (honest, scene) = tabs
             data = hill_gpx("Stalled", 300)
-            transfer = start_upload(stalled, len(data), 2)
+            transfer = start_big_upload(stalled, len(data), 2)
             stalled.wait_for(lambda: gate.uploads_in_flight()[0] == 1, what="in flight")
             send_part(stalled, transfer, 0, data[:100])
+            stalled.wait_for(
+                lambda: any(
+                    m.get("type") == "FileTransferPartAck" and m.get("transfer_uuid") == transfer
+                    for _at, m in stalled.received
+                ),
+                "the first part taken",
+            )
+            # Stalled is time gone by, not an event: the gate finds a stalled upload when the next one starts.
             time.sleep(0.5)
             upload(honest, "Upload GPX", "honest.gpx", hill_gpx("Honest", 300))
             honest.wait_for(lambda: scene.course_mode.route.name == "Honest", what="the upload")
@@ -576,29 +601,20 @@ def test_a_person_whose_upload_is_refused_is_told_why_and_can_retry(
         for hog in hogs:
             hog.wait_for_gui("Upload GPX")
             for _ in range(4):
-                start_upload(hog, 1000, 1)
+                start_big_upload(hog, 1000, 1)
         hogs[0].wait_for(lambda: gate.uploads_in_flight()[0] == 8, what="the budget held")
         data = hill_gpx("Browser retry", 300)
         pick_file(page, "retry.gpx", data)
-        wait_logged = time.monotonic() + 60.0
-        while "across all tabs" not in caplog.text and time.monotonic() < wait_logged:
-            time.sleep(0.1)
-        assert "refused uploads in flight across all tabs" in caplog.text
+        wait_until(lambda: "refused uploads in flight across all tabs" in caplog.text, "the refusal logged", 60.0)
         page.get_by_text("Upload refused", exact=True).first.wait_for(timeout=60_000)
         page.get_by_text("receiving other uploads", exact=False).first.wait_for(timeout=10_000)
         assert mode.route.name != "Browser retry"
 
         for hog in hogs:
             hog.close()  # their uploads end with their tabs
-        deadline = time.monotonic() + 20.0
-        while gate.uploads_in_flight()[0] and time.monotonic() < deadline:
-            time.sleep(0.05)
-        assert gate.uploads_in_flight() == (0, 0)
+        wait_until(lambda: gate.uploads_in_flight() == (0, 0), "the hogs' uploads gone", 20.0)
         pick_file(page, "retry.gpx", data)
-        deadline = time.monotonic() + 60.0
-        while mode.route.name != "Browser retry" and time.monotonic() < deadline:
-            time.sleep(0.05)
-        assert mode.route.name == "Browser retry"
+        wait_until(lambda: mode.route.name == "Browser retry", "the retried upload's course", 60.0)
     finally:
         for hog in hogs:
             hog.close()
