@@ -2,13 +2,17 @@
 
 A scene builds its GUI and its nodes under its root; a declared control moved by a browser changes
 ``scene.params``; a hostile value (NaN, a string, out of range) is refused or clamped and leaves the last good
-parameters; and ``close()`` removes every node and GUI element the scene made.
+parameters; and ``close()`` removes every node and GUI element the scene made, ends every thread it started and
+leaves nothing on the server that holds the closed scene alive.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import gc
 import math
+import threading
+import weakref
 from typing import Any, NamedTuple
 
 import pytest
@@ -20,6 +24,8 @@ from helpers.wsclient import BrowserClient
 from scenes import SCENES
 from scenes._base import Scene
 from scenes._controls import Control, declared
+from server.sessions import camera_hub
+from shaders import gl_service
 
 KINDS = list(SCENES.values())
 IDS = list(SCENES)
@@ -58,12 +64,28 @@ class Bare(NamedTuple):
     """The scene node names."""
     gui: set[str]
     """The GUI elements' ids."""
+    threads: set[threading.Thread]
+    """The process's threads."""
 
 
 @pytest.fixture
 def bare(server: viser.ViserServer) -> Bare:
-    """The server's nodes and GUI elements before the test's scene is built."""
-    return Bare(node_names(server), gui_uuids(server))
+    """The server's nodes and GUI elements, and the process's threads, before the test's scene is built."""
+    return Bare(node_names(server), gui_uuids(server), set(threading.enumerate()))
+
+
+def started_since(bare: Bare) -> set[threading.Thread]:
+    """The threads alive now that were not when ``bare`` was read, less the process's one GL thread: the first scene
+    that renders starts it, and every later one shares it (``test_sdf_scene``'s fifty builds count it)."""
+    return {thread for thread in threading.enumerate() if thread not in bare.threads} - {gl_service.thread()}
+
+
+def wait_idle(scene: Scene) -> None:
+    """Until ``scene``'s background jobs (meshing, searches) are done. A scene with a job worker says when through its
+    ``wait_idle``; one without (the peloton and the arm compute in their callbacks) has none to wait for."""
+    idle = getattr(scene, "wait_idle", None)
+    if idle is not None:
+        assert idle(), f"{type(scene).__name__}'s background jobs never finished"
 
 
 @pytest.fixture(params=KINDS, ids=IDS)
@@ -122,11 +144,39 @@ def test_hostile_values_are_refused_or_clamped_and_the_last_good_params_kept(
             assert scene.params == dataclasses.replace(good, **{name: clamped})
 
 
-def test_close_removes_every_node_and_gui_element_the_scene_made(
-    server: viser.ViserServer, scene: Scene, bare: Bare
+@pytest.mark.parametrize("when", ["at once", "once idle"])
+def test_close_removes_every_node_and_gui_element_the_scene_made_and_ends_its_threads(
+    server: viser.ViserServer, scene: Scene, bare: Bare, when: str
 ) -> None:
+    """Closed at once (a job may be running: it finishes, then its thread ends) or once idle (nothing is running:
+    every thread has ended by the time ``close()`` returns)."""
     assert node_names(server) != bare.nodes and gui_uuids(server) != bare.gui
+    if when == "once idle":
+        wait_idle(scene)
+    started = started_since(bare)
+    # Every thread the scene started is one it keeps, so one its close() ends. A scene that starts none (the arm)
+    # keeps none: a thread it started and did not keep would show here, and again below.
+    assert started == set(scene._threads), "a thread the scene started is not one it keeps"
     scene.close()
+    if when == "once idle":
+        assert not [thread.name for thread in started if thread.is_alive()], "the idle scene's threads outlived close()"
     assert scene.join(10.0), "the scene's threads outlived close()"
+    assert not [thread.name for thread in started if thread.is_alive()], "the scene's threads outlived close()"
     assert node_names(server) == bare.nodes
     assert gui_uuids(server) == bare.gui
+
+
+@pytest.mark.parametrize("kind", KINDS, ids=IDS)
+def test_a_closed_scene_is_released(server: viser.ViserServer, kind: type[Scene]) -> None:
+    """Nothing the server keeps (callbacks, camera listeners) may hold a closed scene alive."""
+    with BrowserClient(server.get_port()) as client:  # a connected browser, so per-client callbacks exist
+        client.wait_for(lambda: len(server.get_clients()) == 1, what="the client to register")
+        refs = []
+        for _ in range(2):
+            scene = kind(server)
+            refs.append(weakref.ref(scene))
+            scene.close()
+            del scene
+        gc.collect()
+        assert camera_hub(server).listener_count == 0
+        assert [ref() for ref in refs] == [None, None]

@@ -417,19 +417,6 @@ def test_a_burst_of_slider_changes_computes_one_outcome_map_for_the_last(freekic
     assert freekick.map_params == freekick.params and freekick.params.spin_rev_s == 9.0
 
 
-def test_scene_close_leaves_only_the_switcher(server: viser.ViserServer) -> None:
-    from helpers.viser_private import gui_uuids, node_names
-
-    bare_nodes, bare_gui = node_names(server), gui_uuids(server)
-    freekick = FreeKickScene(server)
-    assert freekick.wait_idle()
-    assert len(node_names(server)) > len(bare_nodes) + 10
-    freekick.close()
-    assert node_names(server) == bare_nodes
-    assert gui_uuids(server) == bare_gui
-    assert not any(thread.is_alive() for thread in freekick._threads)
-
-
 # ------------------------------------------------------------------------------------------------ over the websocket
 def _markdown_shown(client: BrowserClient, text: str) -> bool:
     return any(text in str(element["props"].get("_markdown", "")) for element in client.gui.values())
