@@ -428,35 +428,41 @@ def test_browser_shows_the_mesh_and_the_reference_image(server: viser.ViserServe
 
         # The 3D view shows the mesh: the sphere's red and the box's blue are on the canvas (once the page has
         # drawn the full mesh: a render taken as the page opens can catch it on its way; CI saw 198 blue px).
+        # viser registers the page at its first camera message, which can come after the page has drawn the scene.
+        wait_until(lambda: len(server.get_clients()) == 1, "the page registered", 30.0)
         clients = list(server.get_clients().values())
         assert len(clients) == 1
-        deadline = time.monotonic() + 60
-        while True:
-            render = clients[0].get_render(height=360, width=480)
-            rgb = np.asarray(render)[..., :3].astype(int)
+        counts: list[tuple[int, int]] = []  # (red, blue) pixels of each render
+
+        def red_and_blue_drawn() -> bool:
+            rgb = np.asarray(clients[0].get_render(height=360, width=480))[..., :3].astype(int)
             reddish = (rgb[..., 0] > rgb[..., 2] + 60) & (rgb[..., 0] > 120)
             bluish = (rgb[..., 2] > rgb[..., 0] + 60) & (rgb[..., 2] > 120)
-            if (reddish.sum() > 200 and bluish.sum() > 200) or time.monotonic() > deadline:
-                break
-            time.sleep(0.5)
-        assert reddish.sum() > 200 and bluish.sum() > 200, (reddish.sum(), bluish.sum())
+            counts.append((int(reddish.sum()), int(bluish.sum())))
+            return min(counts[-1]) > 200
+
+        with contextlib.suppress(AssertionError):  # on a timeout, the assert below gives the last counts
+            wait_until(red_and_blue_drawn, "the sphere's red and the box's blue on the canvas", 60.0)
+        assert counts and min(counts[-1]) > 200, counts[-1:]
 
         # The reference panel shows the ray-marched image, pixel for pixel as the server rendered it.
-        deadline = time.monotonic() + 60
-        while scene.reference_rgb is None and time.monotonic() < deadline:
-            time.sleep(0.05)
-        assert scene.reference_rgb is not None
+        wait_until(lambda: scene.reference_rgb is not None, "the reference image", 60.0)
         # The browser may move its camera once more (a re-render); wait until the page and the server agree.
-        shown = None
-        while time.monotonic() < deadline:
+        images: list[np.ndarray] = []  # the reference panel's image, as the page shows it, at each look
+
+        def page_shows_the_reference() -> bool:
             expected = scene.reference_rgb
+            if expected is None:
+                return False
             height, width = expected.shape[:2]
             handle = page.wait_for_function(f"({READ_IMAGE})([{width}, {height}])", timeout=30_000, polling=200)
-            shown = np.asarray(handle.json_value(), dtype=np.uint8).reshape(height, width, 4)[..., :3]
-            if np.array_equal(shown, scene.reference_rgb):
-                break
-            time.sleep(0.2)
-        assert shown is not None and scene.reference_rgb is not None
+            images.append(np.asarray(handle.json_value(), dtype=np.uint8).reshape(height, width, 4)[..., :3])
+            return np.array_equal(images[-1], expected)
+
+        with contextlib.suppress(AssertionError):  # on a timeout, the assert below says how the two differ
+            wait_until(page_shows_the_reference, "the page to show the server's reference image", 60.0)
+        assert images and scene.reference_rgb is not None
+        shown = images[-1]
         np.testing.assert_array_equal(shown, scene.reference_rgb)
         height, width = shown.shape[:2]
         object_pixels = (np.abs(shown.astype(int) - shown[0, 0].astype(int)).sum(axis=2) > 30).sum()
@@ -481,13 +487,16 @@ def green_mask(png: bytes) -> np.ndarray:
 
 
 def wait_for_green(page: Any, pixels: int = 5000, timeout_s: float = 30.0) -> np.ndarray:
-    """Screenshots until the green shape shows (the picture a person sees), its mask."""
-    deadline = time.monotonic() + timeout_s
-    mask = green_mask(page.screenshot())
-    while mask.sum() < pixels and time.monotonic() < deadline:
-        time.sleep(0.2)
-        mask = green_mask(page.screenshot())
-    return mask
+    """Screenshots until the green shape shows (the picture a person sees), its mask; AssertionError after
+    ``timeout_s``."""
+    masks: list[np.ndarray] = []
+
+    def green_shown() -> bool:
+        masks.append(green_mask(page.screenshot()))
+        return masks[-1].sum() >= pixels
+
+    wait_until(green_shown, f"{pixels} green pixels on the screen", timeout_s)
+    return masks[-1]
 
 
 @pytest.mark.gl
@@ -515,9 +524,7 @@ def test_typed_shape_is_meshed_and_ray_marched_in_the_main_view(server: viser.Vi
         assert editor.evaluate("e => e.scrollWidth <= e.clientWidth + 1")
         editor.fill(OCTAHEDRON)
         page.get_by_role("button", name="Apply").click()
-        deadline = time.monotonic() + 60
-        while scene.editor_serial == 0 and time.monotonic() < deadline:
-            time.sleep(0.05)
+        wait_until(lambda: scene.editor_serial != 0, "the typed shape applied", 60.0)
         assert scene.editor_serial == 1 and scene.params.editor.source == OCTAHEDRON.strip("\n") + "\n"
         # Meshed: every vertex on the octahedron the person typed.
         d = sdf.sd_octahedron(scene.mesh_vertices - [0.0, 0.0, 0.4], 0.7)
@@ -530,10 +537,10 @@ def test_typed_shape_is_meshed_and_ray_marched_in_the_main_view(server: viser.Vi
         page.locator("input[value='Mesh']").first.click()
         page.get_by_role("option", name="Ray-marched").click()
         page.wait_for_function("() => !window.__viserMutable.nodeRefFromName['/sdf/mesh'].visible", timeout=30_000)
-        deadline = time.monotonic() + 60
         # The frame at rest: the canvas's width (at least 640 px; a moving frame is 320).
-        while time.monotonic() < deadline and not (scene.view_rgb is not None and scene.view_rgb.shape[1] >= 640):
-            time.sleep(0.05)
+        wait_until(
+            lambda: scene.view_rgb is not None and scene.view_rgb.shape[1] >= 640, "a ray-marched frame at rest", 60.0
+        )
         assert scene.view_rgb is not None and scene.view_rgb.shape[1] >= 640
         marched_green = wait_for_green(page)
         assert marched_green.sum() > 5000
@@ -544,11 +551,11 @@ def test_typed_shape_is_meshed_and_ray_marched_in_the_main_view(server: viser.Vi
         # Both: the mesh's edges as dark lines over the ray-marched shape, and nowhere off it.
         page.locator("input[value='Ray-marched']").first.click()
         page.get_by_role("option", name="Both", exact=True).click()
-        deadline = time.monotonic() + 60
-        while time.monotonic() < deadline and not (
-            scene.view_edges > 0 and scene.view_rgb is not None and scene.view_rgb.shape[1] >= 640
-        ):
-            time.sleep(0.05)
+        wait_until(
+            lambda: scene.view_edges > 0 and scene.view_rgb is not None and scene.view_rgb.shape[1] >= 640,
+            "a frame at rest with the mesh's edges",
+            60.0,
+        )
         assert scene.view_edges > 0 and scene.view_rgb is not None and scene.view_rgb.shape[1] >= 640
         wait_frames(page, 3)
         both_rgb = screenshot(page)

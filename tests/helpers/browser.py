@@ -461,19 +461,21 @@ def settle(shown: ScenePage, timeout_s: float = 30.0) -> None:
     if framing is not None:
         wait_until(lambda: framing.frames >= 1, "the scene to frame the camera", timeout_s)
     client_ids = list(shown.server.get_clients())
-    deadline = time.monotonic() + timeout_s
-    last, still = None, 0
-    while time.monotonic() < deadline and still < 3:  # the same pose over three drawn frames, not one glance
+    looks: list[Any] = []  # the camera's pose at each look, one drawn frame apart
+    steady: list[bool] = []
+
+    def still_over_three_frames() -> bool:  # the same pose over three drawn frames, not one glance
         now = shown.page.evaluate(
             "() => [...window.__viserMutable.camera.position.toArray(),"
             " ...window.__viserMutable.camera.quaternion.toArray()]"
         )
         framing_pending = framing is not None and any(framing.pending(c) for c in client_ids)
-        steady = last is not None and np.allclose(now, last, atol=1e-6) and not framing_pending
-        still = still + 1 if steady else 0
-        last = now
-        time.sleep(0.2)
+        steady.append(bool(looks) and np.allclose(now, looks[-1], atol=1e-6) and not framing_pending)
+        looks.append(now)
         wait_frames(shown.page, 1)
+        return len(steady) >= 3 and all(steady[-3:])
+
+    wait_until(still_over_three_frames, "the framed camera to hold still over three drawn frames", timeout_s)
     wait_frames(shown.page, 3)
 
 
@@ -809,16 +811,20 @@ def drag(
 
 def wait_moved_and_still(read: Callable[[], T], moved: Callable[[T], bool], timeout_s: float = 15.0) -> T:
     """Poll ``read()`` until its value has ``moved`` and then held still for half a second: every message of a drag
-    has been handled. Returns the value then, or after ``timeout_s`` (the caller asserts what it must be)."""
-    deadline = time.monotonic() + timeout_s
-    last, still_since = read(), time.monotonic()
-    while time.monotonic() < deadline:
+    has been handled. Returns the value then; AssertionError after ``timeout_s``.
+
+    Still for a while, not an event: a mouse drag sends its moves and then nothing that the server answers, so no
+    message says that the last move has been handled."""
+    last: list[tuple[T, float]] = [(read(), time.monotonic())]  # the value, and since when it has held
+
+    def moved_and_still() -> bool:
         now = read()
-        if not np.array_equal(np.asarray(now), np.asarray(last)):
-            last, still_since = now, time.monotonic()
-        elif moved(now) and time.monotonic() - still_since > 0.5:
-            break
-        time.sleep(0.05)
+        if not np.array_equal(np.asarray(now), np.asarray(last[0][0])):
+            last[0] = (now, time.monotonic())
+            return False
+        return moved(now) and time.monotonic() - last[0][1] > 0.5
+
+    wait_until(moved_and_still, "the value to move, then hold still for 0.5 s", timeout_s)
     return read()
 
 
@@ -842,12 +848,15 @@ def assert_instance_drawn_at(
 ) -> None:
     """Assert that the page comes to draw instance ``i`` of batched mesh node ``name`` at ``expected`` (the pose the
     server solved), within ``timeout_s``."""
-    deadline = time.monotonic() + timeout_s
-    drawn = page.evaluate(INSTANCE, {"name": name, "i": i})
-    while time.monotonic() < deadline and (drawn is None or np.linalg.norm(np.array(drawn) - expected) > atol):
-        time.sleep(0.1)
+
+    def drawn_there() -> bool:
         drawn = page.evaluate(INSTANCE, {"name": name, "i": i})
-    assert drawn is not None
+        return drawn is not None and float(np.linalg.norm(np.array(drawn) - expected)) <= atol
+
+    with contextlib.suppress(AssertionError):  # on a timeout, the asserts below say where it is drawn instead
+        wait_until(drawn_there, f"instance {i} of {name} drawn at {expected}", timeout_s)
+    drawn = page.evaluate(INSTANCE, {"name": name, "i": i})
+    assert drawn is not None, f"{name} has no instance {i}"
     np.testing.assert_allclose(drawn, expected, atol=atol)
 
 
