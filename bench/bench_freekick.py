@@ -23,12 +23,11 @@ Prints:
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 import platform
-import re
 import statistics
-import subprocess
 import sys
 import tempfile
 import time
@@ -41,9 +40,14 @@ from numpy.typing import NDArray
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "tests"))
 
 import numba  # noqa: E402
 import viser  # noqa: E402
+from helpers.ball_reference import START, G, Q, R, reference_at_x  # noqa: E402
+from helpers.processes import AppProcess  # noqa: E402
+from helpers.waiting import wait_until  # noqa: E402
+from helpers.wsclient import BrowserClient  # noqa: E402
 
 from bench._timing import row, time_handling, timings  # noqa: E402
 from kernels import ball  # noqa: E402
@@ -52,8 +56,6 @@ from kernels.ball.core import simulate_one  # noqa: E402
 from scenes.freekick import FreeKickParams, FreeKickScene  # noqa: E402
 from scenes.freekick.model import MAP_QUIET_S, outcome_map  # noqa: E402
 from server.switcher import SceneSwitcher  # noqa: E402
-from tests.helpers.ball_reference import START, G, Q, R, reference_at_x  # noqa: E402
-from tests.helpers.wsclient import BrowserClient  # noqa: E402
 
 VELOCITY = ball.launch_velocity(28.0, math.radians(19.0), math.radians(-8.0))
 SPIN = ball.spin_vector(9.0, (0.0, 0.0, 1.0))
@@ -285,44 +287,33 @@ def batch_kicks(k: int = 10_000) -> tuple[NDArray[np.float64], ...]:
 
 
 def app_start(cache_dir: str | None) -> tuple[float, float | None]:
-    """Seconds from launching ``app.py`` to its page answering, and to its log saying the kernels are warm."""
+    """Seconds from launching ``app.py`` to its page answering, and to its log saying the kernels are warm (None if
+    they were not within 300 s)."""
     env = dict(os.environ)
     if cache_dir is not None:
         env["NUMBA_CACHE_DIR"] = cache_dir
     start = time.perf_counter()
-    process = subprocess.Popen(
-        [sys.executable, str(ROOT / "app.py"), "--port", "0"],
-        cwd=ROOT,
-        env=env,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.STDOUT,
-        text=True,
-    )
+    app = AppProcess(env=env, timeout_s=300.0)
     try:
-        assert process.stdout is not None
-        serving = warm = None
-        port = None
-        deadline = time.perf_counter() + 300.0
-        while warm is None and time.perf_counter() < deadline:
-            line = process.stdout.readline()
-            if not line:
-                break
-            if port is None and (match := re.search(r"http://127\.0\.0\.1:(\d+)", line)):
-                port = int(match.group(1))
-                while serving is None:
-                    try:
-                        with urllib.request.urlopen(f"http://127.0.0.1:{port}/", timeout=5) as page:
-                            if page.status == 200:
-                                serving = time.perf_counter() - start
-                    except OSError:
-                        time.sleep(0.01)
-            if "compiled kernels ready" in line:
-                warm = time.perf_counter() - start
-        assert serving is not None, "the app never served its page"
-        return serving, warm
+        served: list[float] = []
+
+        def page_answers() -> bool:
+            with (
+                contextlib.suppress(OSError),
+                urllib.request.urlopen(f"http://127.0.0.1:{app.port}/", timeout=5) as page,
+            ):
+                if page.status == 200:
+                    served.append(time.perf_counter() - start)
+            return bool(served)
+
+        wait_until(page_answers, "the app's page to answer", 300.0)
+        try:
+            app.wait_compiled(max(0.0, 300.0 - (time.perf_counter() - start)))
+        except AssertionError:
+            return served[0], None
+        return served[0], time.perf_counter() - start
     finally:
-        process.terminate()
-        process.wait(timeout=30)
+        app.close()
 
 
 def goal_row(name: str, values: list[float], unit: float, unit_name: str, goal: float | None, note: str) -> None:

@@ -28,17 +28,16 @@ arm and free kick, ≤ 150 ms for the SDF gallery.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import math
 import os
 import platform
 import re
-import socket
 import statistics
 import subprocess
 import sys
 import tempfile
-import threading
 import time
 from pathlib import Path
 from typing import Any
@@ -46,6 +45,8 @@ from typing import Any
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))
 
+from helpers.processes import AppProcess  # noqa: E402
+from helpers.waiting import wait_until  # noqa: E402
 from helpers.wsclient import BrowserClient  # noqa: E402
 
 MIB = 1024 * 1024
@@ -87,8 +88,7 @@ def run_client(port: int, scene: str, rate: float, seconds: float, index: int, b
             owner = str(node.get("owner", "") or "")
             client.send("TransformControlsDragStartMessage", name=name, owner=owner)
         Path(f"{barrier}.ready{index}").write_text("ready")
-        while not barrier.exists():
-            time.sleep(0.05)
+        wait_until(barrier.exists, "the parent's start", CONNECT_TIMEOUT_S + 60.0)  # it waits for the others first
         start_wall = float(barrier.read_text() or "0")
         time.sleep(max(0.0, start_wall - time.time()))
         result["late_s"] = max(0.0, time.time() - start_wall)
@@ -163,12 +163,6 @@ def latencies_ms(arrivals: list[float], sends: list[float]) -> list[float]:
 
 
 # ------------------------------------------------------------------------------------------------ the app
-def free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return int(sock.getsockname()[1])
-
-
 def rss_mib(pid: int) -> float:
     with open(f"/proc/{pid}/status") as status:
         match = re.search(r"VmRSS:\s+(\d+) kB", status.read())
@@ -186,19 +180,8 @@ def slope_mib_per_min(samples: list[tuple[float, float]], after_s: float) -> flo
 
 
 def soak(mode: str, scene: str, clients: int, rate: float, seconds: float) -> dict[str, Any]:
-    port = free_port()
-    args = [sys.executable, str(ROOT / "app.py"), "--port", str(port), "--scene", scene]
-    if mode == "shared":
-        args.append("--shared")
-    log: list[str] = []
-    app = subprocess.Popen(args, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    assert app.stdout is not None
-    for line in app.stdout:
-        log.append(line)
-        if "Open http" in line:
-            break
-    reader = threading.Thread(target=lambda: log.extend(app.stdout or ()), daemon=True)
-    reader.start()
+    app = AppProcess("--scene", scene, *(["--shared"] if mode == "shared" else []))
+    port = app.port
     samples: list[tuple[float, float]] = []
     """(s since the browsers started sending, app RSS in MiB); negative while they connect."""
     load_start = os.getloadavg()[0]
@@ -216,18 +199,19 @@ def soak(mode: str, scene: str, clients: int, rate: float, seconds: float) -> di
                 )
                 for i, out in enumerate(outputs)
             ]
+
             # Every browser connects and builds its scene first; then all start sending together.
-            connect_start = time.monotonic()
-            while time.monotonic() - connect_start < CONNECT_TIMEOUT_S + 10.0:
-                ready = sum(Path(f"{barrier}.ready{i}").exists() for i in range(clients))
-                if ready == clients or all(b.poll() is not None for b in browsers):
-                    break
-                time.sleep(0.1)
+            def every_browser_ready_or_gone() -> bool:
+                return all(Path(f"{barrier}.ready{i}").exists() or b.poll() is not None for i, b in enumerate(browsers))
+
+            # A browser still not ready by then starts late, and its result says so (late_s); one gone reports why.
+            with contextlib.suppress(AssertionError):
+                wait_until(every_browser_ready_or_gone, "every browser ready", CONNECT_TIMEOUT_S + 10.0)
             start_wall = time.time() + 1.0
             barrier.write_text(repr(start_wall))
             start = time.monotonic() + 1.0
             while any(b.poll() is None for b in browsers):
-                samples.append((time.monotonic() - start, rss_mib(app.pid)))
+                samples.append((time.monotonic() - start, rss_mib(app.process.pid)))
                 time.sleep(1.0)
             load_end = os.getloadavg()[0]
             results = []
@@ -238,17 +222,11 @@ def soak(mode: str, scene: str, clients: int, rate: float, seconds: float) -> di
             running = [(t, r) for t, r in samples if 0.0 <= t <= seconds]
             slope = slope_mib_per_min(running, min(60.0, seconds / 3.0))
             converged = check_convergence(mode, scene, port, results)
-            samples.append((time.monotonic() - start, rss_mib(app.pid)))  # after they closed
+            samples.append((time.monotonic() - start, rss_mib(app.process.pid)))  # after they closed
         finally:
-            app.terminate()
-            try:
-                app.wait(timeout=60)
-            except subprocess.TimeoutExpired:
-                app.kill()
-                app.wait()
-    reader.join(timeout=5)
+            app.close()
     latencies = [v for r in results for v in r["latencies_ms"]]
-    errors = [e for r in results for e in r["errors"]] + app_errors(log)
+    errors = [e for r in results for e in r["errors"]] + app_errors(app.lines)
     return {
         "mode": mode,
         "scene": scene,

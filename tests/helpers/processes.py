@@ -8,7 +8,6 @@ import socket
 import subprocess
 import sys
 import threading
-import time
 from collections.abc import Callable, Mapping
 from pathlib import Path
 
@@ -48,32 +47,47 @@ def free_port() -> int:
 class AppProcess:
     """``app.py`` in its own process, on a free port, started and read up to the address it prints (stdout and
     stderr together, as a terminal shows them); ``preexec_fn`` runs in the child first (e.g. a background job's
-    ignored SIGINT)."""
+    ignored SIGINT), ``env`` is its environment (this process's by default)."""
 
-    def __init__(self, *args: str, preexec_fn: Callable[[], object] | None = None) -> None:
+    def __init__(
+        self,
+        *args: str,
+        preexec_fn: Callable[[], object] | None = None,
+        env: Mapping[str, str] | None = None,
+        timeout_s: float = 120.0,
+    ) -> None:
         self.port = free_port()
         self.process = subprocess.Popen(
             [sys.executable, str(ROOT / "app.py"), "--port", str(self.port), *args],
             cwd=ROOT,
+            env=env,
             stdout=subprocess.PIPE,
             stderr=subprocess.STDOUT,
             text=True,
             preexec_fn=preexec_fn,
         )
-        assert self.process.stdout is not None
         self.lines: list[str] = []
         """What the app has printed and logged so far."""
-        deadline = time.monotonic() + 120
-        for line in self.process.stdout:
-            self.lines.append(line)
-            if "Open http" in line or time.monotonic() > deadline:
-                break
-        self.started = len(self.lines)
-        """How many lines it printed up to its address."""
-        assert self.process.poll() is None, "the app did not start"
-        # Keep reading, so a chatty app never blocks on a full pipe, and a test can look at its log.
+        # Read from the start, so a chatty app never blocks on a full pipe, and a test can look at its log.
         self._reader = threading.Thread(target=self._read_output, daemon=True)
         self._reader.start()
+        try:
+            wait_until(
+                lambda: self._address_line() is not None or self.process.poll() is not None,
+                "the app to print its address",
+                timeout_s,
+            )
+            address = self._address_line()
+            assert address is not None and self.process.poll() is None, f"the app did not start:\n{self.log}"
+        except AssertionError:
+            self.close()
+            raise
+        self.started = address + 1
+        """How many lines it printed up to its address."""
+
+    def _address_line(self) -> int | None:
+        """The index of the line that gives the app's address, once printed."""
+        return next((i for i, line in enumerate(list(self.lines)) if "Open http" in line), None)
 
     def wait_compiled(self, timeout_s: float = 300.0) -> None:
         """Wait until the app has loaded every compiled kernel (its first start compiles them in the background, and
@@ -101,11 +115,12 @@ class AppProcess:
         return self.lines[self.started :]
 
     def close(self) -> None:
-        if self.process.poll() is not None:
-            return
-        self.process.terminate()
-        try:
-            self.process.wait(timeout=20)
-        except subprocess.TimeoutExpired:
-            self.process.kill()
-            self.process.wait(timeout=20)
+        """Stop the app (SIGTERM, then SIGKILL after 20 s) and read the rest of what it printed into ``lines``."""
+        if self.process.poll() is None:
+            self.process.terminate()
+            try:
+                self.process.wait(timeout=20)
+            except subprocess.TimeoutExpired:
+                self.process.kill()
+                self.process.wait(timeout=20)
+        self._reader.join(timeout=5.0)
