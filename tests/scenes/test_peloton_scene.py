@@ -14,6 +14,7 @@ from helpers.browser import VIEWPORTS
 from helpers.properties import examples
 from helpers.scenes import glb_vertices, scene_fixture
 from helpers.screen_geometry import pinhole_ndc
+from helpers.waiting import wait_until
 from helpers.wsclient import BrowserClient, Crafted, crafted_sent, shows_number
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
@@ -438,14 +439,12 @@ def test_the_lead_starts_rotating_when_riders_join_with_rotate_on(scene: Peloton
     with scene._lock:
         assert scene._rotation_time_s == 0.0
     scene.controls["n_riders"].value = 3
-    deadline = time.monotonic() + 10.0
-    while time.monotonic() < deadline:
+
+    def rotating() -> bool:
         with scene._lock:
-            if scene._rotation_time_s > 0.1:
-                break
-        time.sleep(0.02)
-    with scene._lock:
-        assert scene._rotation_time_s > 0.1, "the rotation did not start when riders joined"
+            return scene._rotation_time_s > 0.1
+
+    wait_until(rotating, "the rotation to start when riders joined", 10.0)
 
 
 @pytest.mark.parametrize(

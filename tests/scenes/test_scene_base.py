@@ -10,6 +10,7 @@ import pytest
 import viser
 from helpers.scenes import StubScene
 from helpers.viser_private import gui_uuids, node_names
+from helpers.waiting import wait_until
 from helpers.wsclient import BrowserClient
 
 from scenes._controls import build_controls, slider
@@ -63,10 +64,7 @@ class Probe(StubScene):
 
 
 def _wait_ticks(probe: Probe, at_least: int) -> None:
-    deadline = time.monotonic() + 5
-    while probe.ticks < at_least and time.monotonic() < deadline:
-        time.sleep(0.01)
-    assert probe.ticks >= at_least
+    wait_until(lambda: probe.ticks >= at_least, f"{at_least} steps of the loop", 5.0)
 
 
 def test_an_idle_loop_sleeps_until_woken_and_a_sleeping_loop_still_stops(server: viser.ViserServer) -> None:
@@ -76,11 +74,11 @@ def test_an_idle_loop_sleeps_until_woken_and_a_sleeping_loop_still_stops(server:
         probe.animating = False
     _wait_ticks(probe, probe.ticks + 1)  # the step that reports "idle"
     asleep = probe.ticks
-    time.sleep(0.3)  # 30 periods: an awake loop would have stepped ~30 times
+    time.sleep(0.3)  # 30 periods: an awake loop would have stepped ~30 times (a step not taken sends no event)
     assert probe.ticks == asleep
     probe.wake_loops()  # a wake-up while idle runs one step, which reports idle again
     _wait_ticks(probe, asleep + 1)
-    time.sleep(0.1)
+    time.sleep(0.1)  # 10 periods: a loop the wake-up left awake would have stepped again
     assert probe.ticks == asleep + 1
     with probe._lock:
         probe.animating = True
@@ -144,13 +142,10 @@ def test_gizmo_positions_from_a_browser_are_cleaned(server: viser.ViserServer) -
 def test_close_stops_the_loop_and_removes_everything(server: viser.ViserServer) -> None:
     nodes, gui = node_names(server), gui_uuids(server)
     probe = Probe(server)
-    deadline = time.monotonic() + 5
-    while probe.ticks < 3 and time.monotonic() < deadline:
-        time.sleep(0.01)
-    assert probe.ticks >= 3
+    _wait_ticks(probe, 3)
     probe.close()
     ticks = probe.ticks
-    time.sleep(0.1)
+    time.sleep(0.1)  # 10 periods: a loop still running would have stepped again (no event marks a step not taken)
     assert probe.ticks == ticks
     assert not any(t.name == "probe-loop" and t.is_alive() for t in threading.enumerate())
     assert node_names(server) == nodes and gui_uuids(server) == gui
