@@ -1,6 +1,6 @@
 """Typing for the scene fixtures of ``tests/conftest.py`` (a callable that makes or shows a scene of a given class),
-the ``scene`` fixture a scene's test module declares in one line, readers of the GLB meshes scenes send, and
-what a person does in the SDF gallery's GLSL editor."""
+the ``scene`` and course ``mode`` fixtures a test module declares in one line, readers of the GLB meshes scenes
+send, and what a person does in the SDF gallery's GLSL editor."""
 
 from __future__ import annotations
 
@@ -13,6 +13,8 @@ import trimesh
 
 from helpers.wsclient import BrowserClient
 from scenes._base import Scene
+from scenes.peloton import PelotonScene
+from scenes.peloton.course import CourseMode
 
 S = TypeVar("S", bound=Scene)
 
@@ -39,6 +41,19 @@ def scene_fixture(kind: type[Scene]) -> Any:
         return show_scene(kind)
 
     return scene
+
+
+def course_mode_fixture() -> Any:
+    """A fixture (assign it to ``mode``): the peloton shown on the test's switcher (``show_scene``, so the same scene
+    a ``scene`` fixture of that class gives), its course mode switched on."""
+
+    @pytest.fixture
+    def mode(show_scene: MakeScene) -> CourseMode:
+        course = show_scene(PelotonScene).course_mode
+        course.enable.value = True
+        return course
+
+    return mode
 
 
 def read_glb(glb_data: bytes) -> trimesh.Trimesh:

@@ -18,7 +18,7 @@ import viser
 from helpers.browser import ERROR_TEXT, VIEWPORTS
 from helpers.gpx import BAD_FILES, gpx_text, hill_gpx
 from helpers.properties import examples
-from helpers.scenes import glb_vertices, scene_fixture
+from helpers.scenes import course_mode_fixture, glb_vertices, scene_fixture
 from helpers.screen_geometry import pinhole_ndc
 from helpers.uploads import send_part, start_upload, upload
 from helpers.wsclient import BrowserClient, Crafted, crafted_sent
@@ -50,10 +50,7 @@ from server.switcher import SceneSwitcher
 scene = scene_fixture(PelotonScene)
 
 
-@pytest.fixture
-def mode(scene: PelotonScene) -> CourseMode:
-    scene.course_mode.enable.value = True
-    return scene.course_mode
+mode = course_mode_fixture()
 
 
 # ------------------------------------------------------------------------------------------------ server side

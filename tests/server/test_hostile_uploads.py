@@ -14,23 +14,16 @@ from typing import Any
 import pytest
 import viser
 from helpers.gpx import hill_gpx
+from helpers.scenes import course_mode_fixture
 from helpers.uploads import send_part, upload
 from helpers.wsclient import BrowserClient
 
 import server.budget as budget_module
-from scenes.peloton import PelotonScene
 from scenes.peloton.course import CourseMode
 from server.budget import MAX_UPLOAD_BYTES, MAX_UPLOAD_BYTES_IN_FLIGHT_PER_TAB, MAX_UPLOADS_IN_FLIGHT, MIN_PART_BYTES
 from server.gate import install_gate
-from server.switcher import SceneSwitcher
 
-
-@pytest.fixture
-def mode(switcher: SceneSwitcher) -> CourseMode:
-    scene = switcher.show("peloton")
-    assert isinstance(scene, PelotonScene)
-    scene.course_mode.enable.value = True
-    return scene.course_mode
+mode = course_mode_fixture()
 
 
 def start(client: BrowserClient, **override: Any) -> str:
