@@ -58,11 +58,21 @@ def readout_markdown(a: Agreement) -> str:
     render = "–" if a.render_ms is None else f"{a.render_ms:.0f} ms"
     iou = "–" if a.iou is None else f"{a.iou:.4f}"
     depth = "–" if a.depth_diff_voxels is None else f"{a.depth_diff_voxels:.3f} voxel"
-    return (
+    table = (
         f"| | |\n|---|---|\n| Triangles | {a.triangles:,} |\n| Time to mesh | {a.mesh_ms:.0f} ms |\n"
         f"| Time to render | {render} |\n| Silhouette IoU (mesh vs ray-march) | {iou} |\n"
         f"| Mean depth difference | {depth} |"
     )
+    if a.triangles == 0:  # an outside tester: an empty view and "Triangles 0", with no word of why
+        return f"{table}\n\n{EMPTY_MESH}"
+    return table
+
+
+EMPTY_MESH = (
+    "**The mesh is empty:** nothing is left inside the bounds at this resolution. A subtraction or an intersection "
+    "may remove every part, or what is left may be finer than the mesh resolution."
+)
+"""Said under the readout when a mesh has no triangles."""
 
 
 class Wire:

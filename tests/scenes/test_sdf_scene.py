@@ -111,6 +111,23 @@ def test_a_burst_of_drags_coalesces_to_the_latest(server: viser.ViserServer, sce
         assert scene.mesh_serial - before < 20  # 40 updates, far fewer meshes
 
 
+def test_an_empty_mesh_says_why_under_the_readout(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
+    # An outside tester: P2 subtracting a box that holds all of a small P1 left an empty view, "Triangles 0" and
+    # dashes, with no sentence saying why.
+    from scenes.sdf_gallery.compare import EMPTY_MESH
+
+    assert EMPTY_MESH not in scene.readout.content
+    with BrowserClient(server.get_port()) as client:
+        client.wait_for_gui("P4 on")
+        for label, value in [("P3 on", False), ("P4 on", False), ("P1 size a (m)", 0.05), ("P2 kind", "Box")]:
+            client.set_value(label, value)
+        for axis in "abc":
+            client.set_value(f"P2 size {axis} (m)", 1.0)
+        client.set_value("P2 combine", "Subtract")
+        wait_until(lambda: EMPTY_MESH in scene.readout.content, "the empty mesh explained")
+    assert scene.mesh_faces.shape[0] == 0 and "| Triangles | 0 |" in scene.readout.content
+
+
 def test_gui_changes_remesh(server: viser.ViserServer, scene: SdfGalleryScene) -> None:
     volume_union = shown_mesh(scene).volume
     with BrowserClient(server.get_port()) as client:
