@@ -295,6 +295,20 @@ class Controls(Generic[P]):
         for handle in self:
             handle.on_update(callback)
 
+    def with_range(self, name: str, lo: float, hi: float) -> Controls[P]:
+        """These controls with field ``name``'s slider or number box over [lo, hi]: the handle shows the range, and
+        the gate and :func:`read_controls` clamp to it (a range that depends on what the scene loaded, such as the
+        course's Position slider over the route's length). The handle is the same; use the returned controls."""
+        built = self.fields[name]
+        control = dataclasses.replace(built.control, lo=lo, hi=hi)
+        assert control.kind in ("slider", "number") and not built.per_element, f"{name} has no one range"
+        handle = built.handles[0]
+        assert isinstance(handle, (viser.GuiSliderHandle, viser.GuiNumberHandle))
+        handle.min, handle.max = lo, hi
+        spec = record_spec(handle, dataclasses.replace(built.specs[0], lo=float(lo), hi=float(hi)))
+        fields = {**self.fields, name: dataclasses.replace(built, control=control, specs=(spec,))}
+        return Controls(self.params_type, fields, self.folders)
+
 
 def build_controls(
     gui: GuiLike,

@@ -6,6 +6,7 @@ solver and playback. What it rides and draws comes from :mod:`scenes.peloton.cou
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import math
 import re
@@ -19,7 +20,7 @@ import viser
 import viser.uplot
 
 from kernels import course as course_kernel
-from scenes._base import record_spec, set_if_changed
+from scenes._base import set_if_changed
 from scenes._charts import FittedChart, number_scales
 from scenes._controls import build_controls, declared, read_controls
 from scenes._framing import Lens, View, frame_clear_of_notice
@@ -35,7 +36,6 @@ from scenes.peloton.course_model import (
     MODE_FOLDER,
     MODEL_LABEL,
     MORE_FOLDER,
-    POSITION_STEP_M,
     POWER_FOLDER,
     SAMPLE_LABEL,
     CourseParams,
@@ -179,10 +179,12 @@ class CourseMode:
             self.upload = gui.add_upload_button("Upload GPX", mime_type=".gpx,application/gpx+xml")
             self.play = gui.add_button("Play")
             self.pause = gui.add_button("Pause")
-            # Hand-built, not a parameter: playback moves it, and its range is the loaded route's length.
-            self.scrub = gui.add_slider(
-                "Position (km)", min=0.0, max=self._total_km(), step=POSITION_STEP_M / 1000.0, initial_value=0.0
-            )
+            # Its range is the loaded route's length; playback moves it too.
+            place = build_controls(gui, p, ("position_km",))
+            place = place.with_range("position_km", 0.0, self._total_km())
+            scrub = place["position_km"]
+            assert isinstance(scrub, viser.GuiSliderHandle)
+            self.scrub = scrub
             self.now = gui.add_markdown("")
             self.readout = gui.add_markdown("")
             self.chart = FittedChart(
@@ -216,7 +218,7 @@ class CourseMode:
             rest = build_controls(
                 gui,
                 p,
-                [name for name in declared(CourseParams) if name not in {*head.fields, *power.fields}],
+                [name for name in declared(CourseParams) if name not in {*head.fields, *place.fields, *power.fields}],
                 collapsed=(MORE_FOLDER,),
                 folders_open=power.folders,
             )
@@ -224,7 +226,7 @@ class CourseMode:
                 self.splits = gui.add_markdown("")
         self.head = head
         """The "Ride a course" checkbox, read on its own (:meth:`_on_enable`)."""
-        self.controls = head | power | rest
+        self.controls = head | place | power | rest
         """Every declared control of :class:`CourseParams`, by field name."""
         cb = self.scene.callback
         self.enable.on_update(cb(self._on_enable))
@@ -532,10 +534,9 @@ class CourseMode:
         self.message = ""
         self.play_time_s = 0.0
         self.playing = False
-        self.scrub.max = self._total_km()
         # The gate clamps a browser's scrub to the new course's length, not the first one's.
-        record_spec(self.scrub)
-        self.scene.write_back(self.scrub, 0.0)  # the riders are back at the start
+        self.controls = self.controls.with_range("position_km", 0.0, self._total_km())
+        self._put_position(0.0)  # the riders are back at the start
         self.redraw()
         return True
 
@@ -620,9 +621,14 @@ class CourseMode:
         self.redraw(readouts=False)
         self.scene.framing.reframe()  # framed for the road where they stopped
 
+    def _put_position(self, km: float) -> None:
+        """Put the Position slider and ``params.position_km`` at ``km`` (playback, a new route, a pause)."""
+        self.params = dataclasses.replace(self.params, position_km=km)
+        self.scene.write_back(self.scrub, km)
+
     def _show_at_km(self, km: float) -> None:
         """Put the Position slider and the riders at ``km`` together (the readout then says the same place)."""
-        self.scene.write_back(self.scrub, km)
+        self._put_position(km)
         if self.state is not None:
             ride = self.state.ride
             self.play_time_s = float(np.interp(self._km_to_m(km), ride.distance_m, ride.elapsed_s))
@@ -632,19 +638,15 @@ class CourseMode:
         return position_m(km, self.route.total_distance_m)
 
     def _scrub_m(self) -> float:
-        """Where the Position slider puts the riders (m), cleaned."""
-        raw = self.scrub.value
-        ok = isinstance(raw, (int, float)) and not isinstance(raw, bool) and math.isfinite(raw)
-        return self._km_to_m(raw if ok else 0.0)
+        """Where the Position slider puts the riders (m)."""
+        return self._km_to_m(self.params.position_km)
 
     def _on_scrub(self) -> None:
         if self.state is None:
             return
-        raw = self.scrub.value
-        ok = isinstance(raw, (int, float)) and not isinstance(raw, bool) and math.isfinite(raw)
-        km = float(np.clip(raw if ok else self._leader_km(), 0.0, self._total_km()))
-        if not ok or km != raw:
-            self.scene.write_back(self.scrub, km)
+        # Only the position is taken here: every other input is applied by its own callback.
+        km = self.read_params().position_km
+        self.params = dataclasses.replace(self.params, position_km=km)
         ride = self.state.ride
         self.play_time_s = float(np.interp(self._km_to_m(km), ride.distance_m, ride.elapsed_s))
         self.redraw(readouts=False)
@@ -663,7 +665,7 @@ class CourseMode:
         self._since_readout += dt
         if self._since_readout >= 0.2 or not self.playing:  # the slider and readout follow at 5 Hz
             self._since_readout = 0.0
-            self.scene.write_back(self.scrub, round(self._leader_km(), 2))
+            self._put_position(round(self._leader_km(), 2))
             self.redraw(readouts=False, now=True)
         else:
             self.redraw(readouts=False, now=False)

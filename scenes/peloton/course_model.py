@@ -92,6 +92,10 @@ MORE_FOLDER = "Wind, descents, pacing, view"
 """Opens collapsed."""
 
 
+POSITION_STEP_M = 10.0
+"""The Position (km) slider's step (m)."""
+
+
 @dataclasses.dataclass(frozen=True)
 class CourseParams:
     """Course-mode inputs (the rider, the line and drafting come from :class:`PelotonParams`).
@@ -101,6 +105,10 @@ class CourseParams:
 
     enabled: bool = field(default=False, metadata=checkbox("Ride a course", folder=MODE_FOLDER))
     """Whether the course mode is shown (and ridden) instead of the line."""
+    position_km: float = field(default=0.0, metadata=slider("Position (km)", 0.0, 1.0, POSITION_STEP_M / 1000.0))
+    """Where the leader is along the route (km, on the slider's 10 m step; its end is the finish): set by the person
+    or by playback. Built in the mode's folder under the Play and Pause buttons; the declared range is a placeholder,
+    which the scene sets to the loaded route's length."""
     power_w: float = field(
         default=250.0,
         metadata=number(
@@ -291,10 +299,6 @@ def place_powers(state: CourseState, at_m: float) -> tuple[np.ndarray, np.ndarra
 
 _MEAN_CHUNK = 1_000_000
 """How many (place, segment) needs :func:`place_powers` holds at once (8 MB)."""
-
-
-POSITION_STEP_M = 10.0
-"""The Position (km) slider's step (m)."""
 
 
 def position_end_km(total_m: float) -> float:

@@ -420,12 +420,14 @@ def test_crafted_scrub_positions_are_clamped(server: viser.ViserServer, mode: Co
         with mode.scene._lock:
             d = mode.leader_distance_m()
             assert 0.0 <= d <= mode.route.total_distance_m
+            # The place is a parameter, clamped by the one clean to the loaded route's length.
             if value == 1e9:
                 assert d == pytest.approx(mode.route.total_distance_m, rel=1e-12)
+                assert mode.params.position_km == mode.scrub.value == mode.scrub.max
             elif value == -3.0:
-                assert d == 0.0
+                assert d == 0.0 and mode.params.position_km == mode.scrub.value == 0.0
             else:
-                assert d == pytest.approx(4000.0, abs=1.0)
+                assert d == pytest.approx(4000.0, abs=1.0) and mode.params.position_km == mode.scrub.value == 4.0
 
 
 def test_play_from_a_browser(server: viser.ViserServer, mode: CourseMode) -> None:
@@ -633,7 +635,7 @@ def test_a_new_course_puts_the_position_slider_back_to_the_start(mode: CourseMod
     mode.scrub.value = 1.04
     assert mode.leader_distance_m() == pytest.approx(1040.0, abs=1.0)
     assert mode.load(hill_gpx("Next hill"), "next.gpx")
-    assert mode.scrub.value == 0.0
+    assert mode.scrub.value == 0.0 and mode.params.position_km == 0.0
     assert mode.leader_distance_m() == 0.0
     assert "Leader at **0.00 km**" in mode.now.content
 
