@@ -376,10 +376,6 @@ class Gate:
             return None, None
         spec = control_spec(handle)
         accepted, value, reason = clean_value(spec, updates["value"])
-        if accepted and (getattr(handle, "disabled", False) or not getattr(handle, "visible", True)):
-            # No person can change a greyed-out or hidden control: a value for one was kept, and took effect when
-            # the control came back (an axis tilt sent while the spin axis was not Custom).
-            accepted, reason = False, "the control is disabled" if handle.disabled else "the control is hidden"
         key = (client_id, str(message.uuid))
         waiting = self._echoes.pop(key, None)
         if waiting is not None:  # the tab is still at it: its newer value decides

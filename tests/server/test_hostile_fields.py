@@ -139,28 +139,3 @@ def test_every_allowed_message_is_a_dataclass_the_check_can_read() -> None:
     for cls in ALLOWED_MESSAGES:
         assert dataclasses.is_dataclass(cls) and issubclass(cls, messages.Message)
         assert field_hints(cls), cls
-
-
-def test_a_value_for_a_greyed_out_or_hidden_control_is_refused(
-    server: viser.ViserServer, switcher: SceneSwitcher, caplog: pytest.LogCaptureFixture
-) -> None:
-    # An outside tester: "Axis tilt" = 90 sent while Spin axis was Sidespin was kept, and took effect when the person
-    # later chose Custom; an honest tab could never have sent it. A hidden control is the same: no one can use it.
-    from helpers.waiting import wait_until
-
-    kick = switcher.show("freekick")
-    assert isinstance(kick, FreeKickScene)
-    tilt = kick.controls["axis_tilt_deg"]
-    assert tilt.disabled
-    with caplog.at_level(logging.INFO), BrowserClient(server.get_port()) as client:
-        client.wait_for_gui("Axis tilt from vertical (°)")
-        client.set_value("Axis tilt from vertical (°)", 90.0)
-        wait_until(lambda: "the control is disabled" in caplog.text, "the refusal")
-        client.set_value("Spin axis", "Custom (two angles)")
-        wait_until(lambda: kick.params.spin_axis == "custom", "the custom axis")
-        assert kick.params.axis_tilt_deg == 0.0 and tilt.value == 0.0
-        client.wait_for(lambda: client.value_of("Axis tilt from vertical (°)") == 0.0, "the browser shows 0 again")
-        tilt.visible = False
-        client.set_value("Axis tilt from vertical (°)", 45.0)
-        wait_until(lambda: "the control is hidden" in caplog.text, "the hidden control's refusal")
-        assert kick.params.axis_tilt_deg == 0.0
