@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from scenes._numbers import fixed
+
 POWER_COLOURS = np.array([(40, 90, 220), (40, 180, 200), (90, 190, 80), (245, 200, 40), (225, 50, 40)], np.float64)
 """Rider colours by power, low to high: blue, teal, green, yellow, red."""
 LEGEND_NAMES = ("blue", "teal", "green", "yellow", "red")
@@ -15,7 +17,7 @@ TABLE_ROWS = 14
 
 def watts_text(value: float) -> str:
     """Whole watts, never "-0"."""
-    return f"{round(float(value))}"  # an int: round(-0.4) is 0, not -0.0
+    return fixed(float(value), 0)
 
 
 def coasting_words(brake_w: np.ndarray, cause: str, plural: bool = False) -> str:
